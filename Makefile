@@ -1,0 +1,36 @@
+# Every target sets up what it needs: a fresh Debian machine as root needs nothing else.
+SHELL := /bin/bash
+PY := .venv/bin/python
+VENV_STAMP := .venv/.installed
+export MPLBACKEND := Agg
+
+.PHONY: setup system-deps demo test bench clean
+
+setup: system-deps $(VENV_STAMP)
+
+# ngspice (CLI backend) and libngspice (PySpice's shared backend) come from Debian.
+system-deps:
+	@if ! command -v ngspice >/dev/null 2>&1 || ! dpkg -s libngspice0-dev >/dev/null 2>&1; then \
+	  echo "Installing ngspice and libngspice0-dev from Debian"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq ngspice libngspice0-dev; \
+	fi
+
+$(VENV_STAMP): pyproject.toml
+	python3 -m venv .venv
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -e '.[test]'
+	touch $@
+
+demo: setup
+	.venv/bin/design-plant --fc 3500 --zeta 0.2 --name plant_fc3500_z0.2 --out .
+
+test: setup
+	$(PY) -m pytest -q -p no:cacheprovider tests
+
+bench: setup
+	$(PY) benchmarks/run.py
+
+clean:
+	rm -rf .venv build *.egg-info .pytest_cache

@@ -1,0 +1,89 @@
+"""IEC 60063 preferred-number series E3 to E192 and nearest-value helpers.
+
+E3..E24 are tabulated in the standard (they are not the rounded geometric
+series); E48..E192 follow round(10**(i/N), 2) with the one exception the
+standard makes (E192 lists 9.20 where the formula gives 9.19).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import DesignError
+
+_E24 = (1.0, 1.1, 1.2, 1.3, 1.5, 1.6, 1.8, 2.0, 2.2, 2.4, 2.7, 3.0,
+        3.3, 3.6, 3.9, 4.3, 4.7, 5.1, 5.6, 6.2, 6.8, 7.5, 8.2, 9.1)
+
+
+def _geometric(n: int) -> tuple:
+    vals = [round(100 * 10 ** (i / n)) / 100 for i in range(n)]
+    if n == 192:
+        vals[185] = 9.20
+    return tuple(vals)
+
+
+SERIES = {
+    "E3": (1.0, 2.2, 4.7),
+    "E6": (1.0, 1.5, 2.2, 3.3, 4.7, 6.8),
+    "E12": _E24[::2],
+    "E24": _E24,
+    "E48": _geometric(48),
+    "E96": _geometric(96),
+    "E192": _geometric(192),
+}
+
+#: Tolerance that goes with each series (IEC 60063), as a fraction.
+TOLERANCE = {"E3": 0.40, "E6": 0.20, "E12": 0.10, "E24": 0.05,
+             "E48": 0.02, "E96": 0.01, "E192": 0.005}
+
+
+def series_name(name: str) -> str:
+    """Normalise ``"e24"``/``"24"`` to ``"E24"``; a :class:`DesignError` if unknown."""
+    key = str(name).strip().upper()
+    if not key.startswith("E"):
+        key = "E" + key
+    if key not in SERIES:
+        raise DesignError(
+            f"unknown E-series {name!r}; allowed: {', '.join(SERIES)}")
+    return key
+
+
+def values(series: str, lo: float, hi: float) -> np.ndarray:
+    """All values of ``series`` in the closed range [lo, hi], ascending.
+
+    A relative slack of 1e-9 keeps the bounds themselves (1 kOhm, 1 MOhm) in
+    despite floating-point decades.
+    """
+    key = series_name(series)
+    if not (lo > 0 and hi > 0):
+        raise DesignError(f"value bounds must be positive, got {lo:g}..{hi:g}")
+    if lo > hi:
+        raise DesignError(f"value bounds are reversed: {lo:g} > {hi:g}")
+    base = np.asarray(SERIES[key])
+    d0 = int(np.floor(np.log10(lo))) - 1
+    d1 = int(np.ceil(np.log10(hi))) + 1
+    decades = 10.0 ** np.arange(d0, d1 + 1)
+    # round to 3 significant figures so 4.7 * 1e-9 prints and compares cleanly
+    allv = np.array([float(f"{v:.3g}") for v in np.outer(decades, base).ravel()])
+    keep = (allv >= lo * (1 - 1e-9)) & (allv <= hi * (1 + 1e-9))
+    return np.unique(allv[keep])
+
+
+def nearest(value: float, series: str = "E24") -> float:
+    """The series value nearest to ``value`` by log distance (no bounds)."""
+    if not value > 0:
+        raise DesignError(f"cannot round {value!r} to a series value: must be positive")
+    cands = values(series, value / 20, value * 20)
+    return float(cands[np.argmin(np.abs(np.log(cands / value)))])
+
+
+def nearest_ratio_pair(ratio: float, series: str, lo: float, hi: float):
+    """Two values a, b of ``series`` in [lo, hi] whose ratio a/b is nearest to ``ratio``
+    (log distance); ties go to the pair with the larger b (lower noise gain error
+    does not depend on it, but larger resistors load op-amps less)."""
+    v = values(series, lo, hi)
+    if v.size == 0:
+        raise DesignError(f"no {series} value between {lo:g} and {hi:g}")
+    err = np.abs(np.log(np.outer(v, 1.0 / v) / ratio))
+    i, j = np.unravel_index(np.argmin(err), err.shape)
+    return float(v[i]), float(v[j])

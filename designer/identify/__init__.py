@@ -1,0 +1,1 @@
+"""Classical identification from step and frequency responses (seeds 000, 002, 003)."""

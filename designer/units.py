@@ -1,0 +1,119 @@
+"""Engineering notation: parse ``4k7``, ``10n``, ``2u2``, ``3.5k``, ``1e-9``
+and format numbers back as ``4k7``-style value codes or ``4.70 kOhm``.
+
+Parsing is strict: anything that is not a finite number is a
+:class:`~designer.errors.DesignError` naming the field.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+from .errors import DesignError
+
+# SI multipliers; "u" and "µ" both mean micro, "M"/"meg" mega (SPICE writes meg).
+_PREFIX = {
+    "f": 1e-15, "p": 1e-12, "n": 1e-9, "u": 1e-6, "µ": 1e-6, "μ": 1e-6,
+    "m": 1e-3, "": 1.0, "k": 1e3, "K": 1e3, "M": 1e6, "meg": 1e6, "G": 1e9,
+    "R": 1.0, "r": 1.0,
+}
+_UNITS = ("ohms", "ohm", "Ω", "hz", "Hz", "f", "F", "s", "v", "V")
+
+_PLAIN = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
+# 3.5k, 10n, 2.2meg
+_SUFFIX = re.compile(r"^([+-]?(?:\d+\.?\d*|\.\d+))(meg|[fpnuµμmkKMGRr])$")
+# 4k7, 2u2, 1M5, 4R7: the prefix letter stands for the decimal point
+_INFIX = re.compile(r"^([+-]?\d+)(meg|[fpnuµμmkKMGRr])(\d+)$")
+
+
+def parse_value(text, name: str = "value") -> float:
+    """Parse a number in engineering notation.
+
+    Parameters
+    ----------
+    text : str or float
+        ``"4k7"``, ``"10n"``, ``"2u2"``, ``"3.5k"``, ``"1e-9"``, ``"220nF"``...
+    name : str
+        What the number is, for the error message.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    DesignError
+        If the text is not a finite number.
+    """
+    if isinstance(text, (int, float)) and not isinstance(text, bool):
+        value = float(text)
+    else:
+        s = str(text).strip().replace(" ", "")
+        for unit in _UNITS:
+            # strip a trailing unit, but never the prefix itself ("1f" is femto)
+            if s.endswith(unit) and len(s) > len(unit) and not _PLAIN.match(s):
+                stripped = s[: -len(unit)]
+                if _PLAIN.match(stripped) or _SUFFIX.match(stripped) or _INFIX.match(stripped):
+                    s = stripped
+                    break
+        if _PLAIN.match(s):
+            value = float(s)
+        elif (m := _SUFFIX.match(s)):
+            value = float(m.group(1)) * _PREFIX[m.group(2)]
+        elif (m := _INFIX.match(s)):
+            sign = -1.0 if m.group(1).startswith("-") else 1.0
+            whole = m.group(1).lstrip("+-")
+            value = sign * float(f"{whole}.{m.group(3)}") * _PREFIX[m.group(2)]
+        else:
+            raise DesignError(
+                f"{name}: {text!r} is not a number (use plain or engineering notation "
+                "such as 4k7, 820, 10n, 2u2, 3.5k, 1e-9)")
+    if not math.isfinite(value):
+        raise DesignError(f"{name}: {text!r} is not a finite number")
+    return value
+
+
+def parse_positive(text, name: str) -> float:
+    """Parse a strictly positive finite number (see :func:`parse_value`)."""
+    value = parse_value(text, name)
+    if value <= 0:
+        raise DesignError(f"{name}: must be greater than 0, got {text!r}")
+    return value
+
+
+_ENG = [(1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "u"),
+        (1e-9, "n"), (1e-12, "p"), (1e-15, "f")]
+
+
+def _split(value: float):
+    a = abs(value)
+    if a == 0 or not math.isfinite(a):
+        return value, ""
+    for mult, prefix in _ENG:
+        if a >= mult * 0.9995:
+            return value / mult, prefix
+    return value / 1e-15, "f"
+
+
+def format_eng(value: float, unit: str = "", digits: int = 4) -> str:
+    """``format_eng(4700, "Ohm")`` -> ``"4.7 kOhm"``; ``digits`` significant."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "n/a"
+    mant, prefix = _split(float(value))
+    text = f"{mant:.{digits}g}"
+    sep = " " if unit or prefix else ""
+    return f"{text}{sep}{prefix}{unit}"
+
+
+def value_code(value: float) -> str:
+    """Part marking style: 4700 -> ``4k7``, 820 -> ``820``, 1e-8 -> ``10n``,
+    2.2e-6 -> ``2u2``, 4.7 -> ``4R7``, 1e6 -> ``1M``."""
+    mant, prefix = _split(float(value))
+    text = f"{mant:.3g}"
+    if "e" in text:  # mantissa always < 1000, but be safe
+        text = f"{mant:.0f}"
+    if "." in text:
+        whole, frac = text.split(".")
+        return f"{whole}{prefix or 'R'}{frac}"
+    return f"{text}{prefix}"
