@@ -36,7 +36,7 @@ _NOT_ERROR = re.compile(r"^\s*(?:note|warning|info)\b", re.I)
 
 @dataclass
 class SimResult:
-    """Vectors by lower-case name (``time``, ``v(out)``...), ``.meas`` results, and the log."""
+    """Vectors by lower-case name (``time``, node names such as ``out``; ``v(out)`` also works), ``.meas`` results, and the log."""
 
     vectors: dict
     measurements: dict = field(default_factory=dict)
@@ -47,8 +47,9 @@ class SimResult:
         key = name.lower()
         if key in self.vectors:
             return self.vectors[key]
-        if f"v({key})" in self.vectors:
-            return self.vectors[f"v({key})"]
+        inner = re.sub(r"^v\((.*)\)$", r"\1", key)
+        if inner in self.vectors:
+            return self.vectors[inner]
         raise KeyError(f"no vector {name!r} in the simulation (have {', '.join(sorted(self.vectors))})")
 
 
@@ -100,7 +101,8 @@ def read_raw(path) -> dict:
 
 
 def _result(vectors: dict, log: str, backend: str, deck: str) -> SimResult:
-    vectors = {k.lower(): v for k, v in vectors.items()}
+    # the raw file says v(out), the shared library out: one naming for both backends
+    vectors = {re.sub(r"^v\((.*)\)$", r"\1", k.lower()): v for k, v in vectors.items()}
     if "time" in vectors:
         # ngspice can emit a repeated time point at breakpoints; keep time strictly increasing
         t = vectors["time"]

@@ -1,0 +1,460 @@
+"""From a raw capture to the normalised step response the methods work on.
+
+The methods of seeds 000-003 all assume a clean unit step applied at t = 0
+to a system at rest. A real capture has an offset, a trigger somewhere in the
+record, noise, sometimes a whole square wave. This module turns it into
+``t`` (time since the step), ``y`` (deviation from the pre-step baseline
+divided by the input step amplitude) and ``yf`` (its settled value = static
+gain), and provides the robust primitives the methods share:
+
+- :func:`noise_sigma`: noise standard deviation from sample-to-sample differences;
+- :func:`find_edges` / :func:`detect_step`: step times and amplitude from the input;
+- :func:`baseline` and :func:`final_value`: y0 from pre-step samples, yf from a
+  settled tail (and a clear error when the record ends before settling);
+- :func:`crossing_time`: time the response crosses y0 + p (yf - y0), robust
+  to noise (never p yf: the seed's pitfall);
+- :func:`smooth_derivative`: Savitzky-Golay derivative for tangent methods;
+- :func:`prepare_step`: all of the above, including square-wave captures
+  split into their steps and averaged.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.signal import savgol_filter
+
+from ..errors import DesignError
+
+#: Fraction of the post-step record used as the settled tail for yf.
+TAIL_FRACTION = 0.1
+#: Steps smaller than this many noise standard deviations are refused.
+MIN_STEP_SNR = 8.0
+#: A tail drifting by more than this fraction of the step is "not settled".
+SETTLE_TOL = 0.02
+#: Methods and least squares run on at most this many samples (block means).
+MAX_WORK_SAMPLES = 40000
+
+
+def noise_sigma(y) -> float:
+    """Noise standard deviation, from the median absolute second difference.
+
+    Second differences cancel a smooth signal's slope, so a densely sampled
+    response contributes almost nothing and white noise of variance s^2 gives
+    differences of variance 6 s^2; the median makes it robust to the step
+    itself and to spikes.
+    """
+    y = np.asarray(y, float)
+    if y.size < 5:
+        return 0.0
+    d2 = y[2:] - 2.0 * y[1:-1] + y[:-2]
+    return float(np.median(np.abs(d2)) / 0.6745 / math.sqrt(6.0))
+
+
+@dataclass
+class Edge:
+    """One transition of the input: time (mid-level crossing), levels before and after."""
+
+    time: float
+    index: int
+    before: float
+    after: float
+
+    @property
+    def amplitude(self) -> float:
+        return self.after - self.before
+
+
+def find_edges(t, u) -> list:
+    """Transitions of a two-level input (a step or a square wave).
+
+    Levels are the 5th and 95th percentiles; a transition is counted when the
+    signal moves from below 25 % to above 75 % of the span (or back), so noise
+    near a level never makes a false edge. Each edge's time is the interpolated
+    50 % crossing; its levels are the means of the settled parts of the
+    neighbouring plateaus.
+    """
+    t = np.asarray(t, float)
+    u = np.asarray(u, float)
+    lo, hi = np.percentile(u, [5, 95])
+    span = hi - lo
+    sigma = noise_sigma(u)
+    if span <= max(MIN_STEP_SNR * sigma, 1e-12 * max(abs(lo), abs(hi), 1e-300)):
+        return []
+    state = np.full(u.shape, -1, dtype=np.int8)
+    state[u >= lo + 0.75 * span] = 1
+    state[u <= lo + 0.25 * span] = 0
+    known = np.nonzero(state >= 0)[0]
+    if known.size == 0:
+        return []
+    s = state[known]
+    change = np.nonzero(np.diff(s) != 0)[0]
+    mid = lo + 0.5 * span
+    edges = []
+    bounds = [0] + [int(known[c + 1]) for c in change] + [u.size]
+    for k, c in enumerate(change):
+        i_last, i_next = int(known[c]), int(known[c + 1])
+        seg = u[i_last:i_next + 1]
+        rising = s[c + 1] == 1
+        rel = np.nonzero(seg >= mid)[0] if rising else np.nonzero(seg <= mid)[0]
+        j = i_last + int(rel[0]) if rel.size else i_next
+        j = max(j, 1)
+        a, b = u[j - 1], u[j]
+        frac = 0.5 if a == b else min(max((mid - a) / (b - a), 0.0), 1.0)
+        te = float(t[j - 1] + frac * (t[j] - t[j - 1]))
+        prev = u[bounds[k]:i_last + 1]
+        nxt = u[i_next:bounds[k + 2]]
+        # Plateau levels from their second halves, where the input has settled.
+        before = float(np.mean(prev[prev.size // 2:])) if prev.size else float(a)
+        after = float(np.mean(nxt[nxt.size // 2:])) if nxt.size else float(b)
+        edges.append(Edge(time=te, index=j, before=before, after=after))
+    return edges
+
+
+def baseline(t, y, t_step: float) -> tuple:
+    """Pre-step level y0: mean of the samples before the step.
+
+    Returns ``(y0, n_used)``; with no pre-step sample the first sample is used
+    (``n_used`` = 0 tells the caller to say so).
+    """
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    pre = y[t < t_step]
+    if pre.size == 0:
+        return float(y[0]), 0
+    return float(np.mean(pre)), int(pre.size)
+
+
+def final_value(t, y, y0: float, *, sigma: float | None = None) -> float:
+    """Settled value: mean of the last ``TAIL_FRACTION`` of the record.
+
+    Raises DesignError when the tail still drifts: its two halves differ, or
+    a straight line through it changes, by more than ``SETTLE_TOL`` of the
+    step (beyond what the noise explains). ``t`` and ``y`` are the post-step
+    samples.
+    """
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    n = y.size
+    m = max(4, int(n * TAIL_FRACTION))
+    tail_t, tail = t[-m:], y[-m:]
+    yf = float(np.mean(tail))
+    span = yf - y0
+    if sigma is None:
+        sigma = noise_sigma(y)
+    h = m // 2
+    drift = abs(float(np.mean(tail[h:]) - np.mean(tail[:h])))
+    # Two earlier windows as well: a response still rising shows a larger
+    # change there; noise alone gives about sigma * 2 / sqrt(m).
+    prev = y[-2 * m:-m] if n >= 2 * m else y[:max(1, n - m)]
+    drift_prev = abs(float(np.mean(prev)) - yf)
+    allowed = SETTLE_TOL * abs(span) + 6.0 * sigma / math.sqrt(max(h, 1))
+    if abs(span) > 0 and (drift > allowed or drift_prev > 2.0 * allowed):
+        pct = 100.0 * max(drift, drift_prev / 2.0) / abs(span)
+        raise DesignError(
+            f"the record ends before the response settles: its last {100 * TAIL_FRACTION:.0f} % "
+            f"still moves by {pct:.1f} % of the step (allowed {100 * SETTLE_TOL:.0f} %); "
+            "capture a longer record after the step (at least 5 settling times)")
+    del tail_t
+    return yf
+
+
+def crossing_time(t, y, level: float, *, sigma: float = 0.0, start: int = 0) -> float:
+    """Time ``y`` first crosses ``level`` going up, robust to noise.
+
+    With noise, the first sample above the level may be a noise spike. The
+    crossing is bracketed by the last sample clearly below (level - 3 sigma)
+    before the first sample clearly above (level + 3 sigma); a straight line
+    fitted to the samples in that bracket gives the time. Without noise this
+    is plain linear interpolation. Returns nan if never crossed.
+    """
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    band = 3.0 * sigma
+    above = np.nonzero(y[start:] >= level + band)[0]
+    if above.size == 0:
+        return math.nan
+    b = int(above[0]) + start
+    below = np.nonzero(y[start:b] <= level - band)[0]
+    a = int(below[-1]) + start if below.size else start
+    if b - a <= 1 or band == 0.0:
+        # Plain interpolation between the last sample below and the first at/above.
+        cross = np.nonzero(y[a:b + 1] >= level)[0]
+        j = a + int(cross[0]) if cross.size else b
+        if j == 0:
+            return float(t[0])
+        y0, y1 = y[j - 1], y[j]
+        frac = 0.0 if y1 == y0 else (level - y0) / (y1 - y0)
+        return float(t[j - 1] + frac * (t[j] - t[j - 1]))
+    tt, yy = t[a:b + 1], y[a:b + 1]
+    tm = tt.mean()
+    slope, icpt = np.polyfit(tt - tm, yy, 1)
+    if slope <= 0:
+        return float(0.5 * (t[a] + t[b]))
+    return float(tm + (level - icpt) / slope)
+
+
+def crossing_times(t, y, yf: float, fractions, *, sigma: float = 0.0) -> list:
+    """Crossing times of y0 + p (yf - y0) for each p (y is already relative: y0 = 0)."""
+    return [crossing_time(t, y, p * yf, sigma=sigma) for p in fractions]
+
+
+def is_uniform(t, rtol: float = 1e-3) -> bool:
+    dt = np.diff(np.asarray(t, float))
+    return bool(dt.size and np.ptp(dt) <= rtol * np.mean(dt))
+
+
+def uniform(t, y, n: int | None = None) -> tuple:
+    """(t, y) on a uniform grid (linear interpolation) when they are not already."""
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    if is_uniform(t):
+        return t, y
+    n = n or t.size
+    tu = np.linspace(t[0], t[-1], n)
+    return tu, np.interp(tu, t, y)
+
+
+def smooth_derivative(t, y, *, window_s: float | None = None, sigma: float = 0.0,
+                      span: float = 1.0) -> tuple:
+    """Smoothed response and its time derivative (Savitzky-Golay, cubic).
+
+    The window is ``window_s`` seconds when given; otherwise it grows with the
+    noise: 5 samples on clean data (so tangent methods stay exact), up to
+    ~4 % of the record for noise near 1 % of the step. Returns ``(t, ys, dy)``
+    on a uniform grid (resampled when the input grid is not uniform).
+    """
+    tu, yu = uniform(t, y)
+    dt = float((tu[-1] - tu[0]) / max(tu.size - 1, 1))
+    n = tu.size
+    if window_s is not None:
+        w = int(round(window_s / dt))
+    else:
+        rel = sigma / abs(span) if span else 0.0
+        # Derivative noise of an SG window of w samples scales as w^-1.5:
+        # choose w so that it stays well below the steepest slope of interest.
+        w = int(5 + (rel / 2e-4) ** (2.0 / 3.0) * 5) if rel > 0 else 5
+        w = min(w, max(5, n // 25))
+    w = max(5, min(w, n - (1 - n % 2)))
+    if w % 2 == 0:
+        w += 1
+    if w > n:
+        w = n if n % 2 else n - 1
+    poly = 3 if w > 5 else 2
+    ys = savgol_filter(yu, w, poly, mode="interp")
+    dy = savgol_filter(yu, w, poly, deriv=1, delta=dt, mode="interp")
+    return tu, ys, dy
+
+
+def block_mean(t, y, max_samples: int = MAX_WORK_SAMPLES) -> tuple:
+    """Reduce a long record by averaging blocks of samples (anti-aliased decimation).
+
+    Block means of time keep the samples centred, so no delay is introduced.
+    """
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    n = t.size
+    if n <= max_samples:
+        return t, y
+    m = int(math.ceil(n / max_samples))
+    k = n // m
+    tb = t[:k * m].reshape(k, m).mean(axis=1)
+    yb = y[:k * m].reshape(k, m).mean(axis=1)
+    return tb, yb
+
+
+@dataclass
+class PreparedStep:
+    """The normalised step response and how it was obtained.
+
+    ``t`` is time since the step (s), ``y`` the response deviation divided by
+    the input amplitude (so it settles at ``yf`` = static gain), both possibly
+    block-averaged to at most MAX_WORK_SAMPLES. ``t_raw``/``y_raw`` are the
+    full-resolution data the IAE/ISE are computed against (original units, the
+    step at ``t_step``).
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    yf: float
+    t_step: float
+    amplitude: float
+    y0: float
+    y_final: float
+    sigma: float
+    t_raw: np.ndarray
+    y_raw: np.ndarray
+    n_steps: int = 1
+    notes: list = field(default_factory=list)
+
+    @property
+    def gain(self) -> float:
+        return self.yf
+
+    def to_dict(self) -> dict:
+        return {"step_time_s": self.t_step, "step_amplitude": self.amplitude,
+                "y0": self.y0, "y_final": self.y_final, "gain": self.yf,
+                "noise_sigma": self.sigma,
+                "noise_pct_of_step": (100.0 * self.sigma / abs(self.y_final - self.y0)
+                                      if self.y_final != self.y0 else None),
+                "samples": int(self.t_raw.size), "work_samples": int(self.t.size),
+                "steps_averaged": self.n_steps, "notes": list(self.notes)}
+
+
+def _check_step(y0, yf, sigma, what="the response"):
+    span = yf - y0
+    if span == 0 or abs(span) < MIN_STEP_SNR * sigma:
+        ratio = abs(span) / sigma if sigma > 0 else 0.0
+        raise DesignError(
+            f"no usable step in {what}: the change from the baseline ({y0:.4g}) to the final "
+            f"value ({yf:.4g}) is {ratio:.1f} noise standard deviations; at least "
+            f"{MIN_STEP_SNR:.0f} are needed (use a larger step or average captures)")
+
+
+def prepare_step(t, y, u=None, *, step_time: float | None = None,
+                 step_amplitude: float | None = None) -> PreparedStep:
+    """Normalise a capture to a unit step response (see module docstring).
+
+    Parameters
+    ----------
+    t, y : array_like
+        Time (s, strictly increasing) and output.
+    u : array_like, optional
+        Input; its edges give the step time(s) and amplitude. Several edges (a
+        square wave) are split into steps, normalised and averaged.
+    step_time, step_amplitude : float, optional
+        When there is no input column (or to override it). Without either,
+        the step is taken at t = 0 when the record spans it (scope trigger
+        convention), else at the first sample; the amplitude defaults to 1.
+    """
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    notes = []
+    if step_amplitude is not None:
+        if not (math.isfinite(step_amplitude) and step_amplitude != 0):
+            raise DesignError(f"step amplitude must be a non-zero number; got {step_amplitude}")
+    edges = []
+    if u is not None and step_time is None:
+        edges = find_edges(t, u)
+        if not edges:
+            raise DesignError("no step in the input column: it never moves between two levels "
+                              "by more than the noise; give --step-time (and --step-amplitude) "
+                              "or check the column order (t,u,y)")
+    if len(edges) >= 2:
+        return _prepare_square(t, y, edges, step_amplitude, notes)
+    if edges:
+        e = edges[0]
+        t_step = e.time
+        amp = step_amplitude if step_amplitude is not None else e.amplitude
+        notes.append(f"step detected in the input at t = {t_step:.6g} s, amplitude {amp:.6g}")
+    else:
+        if step_time is not None:
+            if not (math.isfinite(step_time) and t[0] <= step_time < t[-1]):
+                raise DesignError(f"step time {step_time!r} s is outside the record "
+                                  f"[{t[0]:.6g}, {t[-1]:.6g}] s")
+            t_step = float(step_time)
+        elif t[0] < 0.0 <= t[-1]:
+            t_step = 0.0
+            notes.append("no input column: step assumed at t = 0 (the trigger); "
+                         "pass --step-time otherwise")
+        else:
+            t_step = float(t[0])
+            notes.append(f"no input column: step assumed at the first sample, t = {t_step:.6g} s; "
+                         "pass --step-time otherwise")
+        if step_amplitude is not None:
+            amp = float(step_amplitude)
+        elif u is not None:
+            amp = _amplitude_from_u(t, u, t_step)
+        else:
+            amp = 1.0
+            notes.append("no input amplitude: gain is per unit input (pass --step-amplitude)")
+    y0, n_pre = baseline(t, y, t_step)
+    if n_pre == 0:
+        notes.append("no samples before the step: baseline taken from the first sample")
+    post = t >= t_step
+    tp, yp = t[post] - t_step, y[post]
+    if tp.size < 10:
+        raise DesignError("fewer than 10 samples after the step; capture more of the response")
+    sigma = noise_sigma(yp)
+    yf = final_value(tp, yp, y0, sigma=sigma)
+    _check_step(y0, yf, sigma)
+    yn = (yp - y0) / amp
+    tw, yw = block_mean(tp, yn)
+    return PreparedStep(t=tw, y=yw, yf=(yf - y0) / amp, t_step=t_step, amplitude=float(amp),
+                        y0=y0, y_final=yf, sigma=sigma, t_raw=t, y_raw=y, notes=notes)
+
+
+def _amplitude_from_u(t, u, t_step):
+    u = np.asarray(u, float)
+    pre, post = u[t < t_step], u[t >= t_step]
+    if pre.size == 0 or post.size == 0:
+        raise DesignError("cannot measure the step amplitude from the input around "
+                          f"t = {t_step:.6g} s; give --step-amplitude")
+    amp = float(np.mean(post[post.size // 2:]) - np.mean(pre))
+    if amp == 0 or abs(amp) < MIN_STEP_SNR * noise_sigma(u):
+        raise DesignError(f"the input does not step at t = {t_step:.6g} s; give --step-amplitude")
+    return amp
+
+
+def _prepare_square(t, y, edges, step_amplitude, notes) -> PreparedStep:
+    """Split a square-wave capture into its steps, normalise each and average.
+
+    Each step runs from one edge to the next; its baseline is the settled end
+    of the step before it (so the first edge, without a settled history, is
+    used only when it has pre-step samples). Every step must settle within
+    its half period.
+    """
+    bounds = [0] + [e.index for e in edges] + [t.size]
+    segs = []
+    sigma_all = noise_sigma(y)
+    first_valid = 0 if edges[0].index > 10 else 1
+    for k in range(first_valid, len(edges)):
+        e = edges[k]
+        i0, i1 = e.index, bounds[k + 2]
+        if k + 1 == len(edges) and (t[-1] - e.time) < 0.9 * (edges[k].time - edges[k - 1].time):
+            break  # last step cut short by the end of the record
+        prev = y[bounds[k]:i0]
+        if prev.size < 4:
+            continue
+        m = max(2, int(prev.size * TAIL_FRACTION))
+        y0 = float(np.mean(prev[-m:]))
+        tp, yp = t[i0:i1] - e.time, y[i0:i1]
+        try:
+            yf = final_value(tp, yp, y0, sigma=sigma_all)
+        except DesignError:
+            raise DesignError(
+                f"the square wave is too fast: the response to the edge at t = {e.time:.6g} s has "
+                "not settled before the next edge; use a lower frequency (half period >= 5 "
+                "settling times)") from None
+        amp = step_amplitude if step_amplitude is not None else e.amplitude
+        if step_amplitude is not None and e.amplitude < 0:
+            amp = -abs(step_amplitude)
+        segs.append((e, tp, (yp - y0) / amp, y0, yf, amp))
+    if not segs:
+        raise DesignError("the square-wave capture has no complete step with a settled "
+                          "level before it; capture at least one full period")
+    length = min(s[1][-1] for s in segs)
+    dt = min(float(np.median(np.diff(s[1]))) for s in segs)
+    n = int(length / dt) + 1
+    grid = np.linspace(0.0, length, n)
+    acc = np.zeros(n)
+    for _, tp, yn, *_ in segs:
+        acc += np.interp(grid, tp, yn)
+    yavg = acc / len(segs)
+    e0, _, _, y0, yfirst, amp0 = segs[0]
+    sigma = noise_sigma(yavg) * abs(amp0)
+    yf_n = final_value(grid, yavg, 0.0, sigma=sigma / abs(amp0))
+    _check_step(y0, y0 + yf_n * amp0, sigma / math.sqrt(len(segs)) if len(segs) > 1 else sigma)
+    notes.append(f"square wave: {len(segs)} steps (rising and falling) normalised and averaged; "
+                 f"IAE/ISE are against the average, scaled to the first step")
+    # The "raw" data for the indices: the averaged step in the first step's units.
+    t_raw = e0.time + grid
+    y_raw = y0 + yavg * amp0
+    t_raw = np.concatenate([[t[max(e0.index - 1, 0)]], t_raw]) if e0.index > 0 else t_raw
+    y_raw = np.concatenate([[y0], y_raw]) if e0.index > 0 else y_raw
+    tw, yw = block_mean(grid, yavg)
+    return PreparedStep(t=tw, y=yw, yf=yf_n, t_step=e0.time, amplitude=float(amp0), y0=y0,
+                        y_final=y0 + yf_n * amp0, sigma=sigma, t_raw=t_raw, y_raw=y_raw,
+                        n_steps=len(segs), notes=notes)

@@ -1,0 +1,372 @@
+"""From a spec (fc, zeta, gain) to a verified Sallen-Key plant: synthesis,
+joint E-series selection, analytic models, netlist, simulation and comparison.
+
+``design_plant`` and ``analyze_plant`` return a :class:`PlantResult`, whose
+``to_dict`` is the JSON of ``design-plant --json`` and ``result.json``; the
+report module renders the same data as text, Markdown and HTML.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import optimize
+
+from . import eseries, opamps
+from .bench import recommend_square_wave, signal_checks, tolerance_band
+from .compare import metric_deltas, nrms, resample
+from .errors import DesignError
+from .metrics import step_metrics
+from .models import (dense_time, dominant_pair, plant_tf, plant_tf_opamp, response_span,
+                     sensitivities, step_response)
+from .netlist import SquareTest, plant_deck
+from .opamps import OpAmp
+from .sallenkey import (SallenKeyParts, check_spec, ratios_from_rc, realizability_notes,
+                        resistors_for_caps)
+from .selection import around, brute_force, joint_search
+from .simulate import get_simulator
+
+
+@dataclass
+class PlantSpec:
+    """What the user asked for. Values in ohms, farads, hertz, volts."""
+
+    fc_hz: float
+    zeta: float
+    gain: float = 1.0
+    r_series: str = "E24"
+    c_series: str = "E12"
+    r_min: float = 1e3
+    r_max: float = 1e6
+    c_min: float = 1e-9
+    c_max: float = 1e-5
+    r: float | None = None        #: the seed's procedure: fix R ...
+    c: float | None = None        #: ... and C, solve m and n
+    opamp: str = "LM741"
+    compensate_gbw: bool = False
+    amplitude_v: float = 2.0
+    square_hz: float | None = None
+    alternatives: int = 5
+
+    def validate(self) -> None:
+        check_spec(self.fc_hz, self.zeta, self.gain)
+        self.r_series = eseries.series_name(self.r_series)
+        self.c_series = eseries.series_name(self.c_series)
+        for name in ("r_min", "r_max", "c_min", "c_max", "amplitude_v"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise DesignError(f"{name.replace('_', '-')} must be a positive finite number, got {v!r}")
+        if self.r_min > self.r_max:
+            raise DesignError(f"r-min ({self.r_min:g} Ohm) is above r-max ({self.r_max:g} Ohm)")
+        if self.c_min > self.c_max:
+            raise DesignError(f"c-min ({self.c_min:g} F) is above c-max ({self.c_max:g} F)")
+        if (self.r is None) != (self.c is None):
+            raise DesignError("--r and --c go together (the seed's procedure fixes both R and C)")
+        if self.square_hz is not None and not (math.isfinite(self.square_hz) and self.square_hz > 0):
+            raise DesignError(f"square-wave frequency must be above 0 Hz, got {self.square_hz!r}")
+        opamps.get(self.opamp)
+
+
+@dataclass
+class PlantResult:
+    """Everything known about one plant design; ``to_dict`` is the JSON."""
+
+    spec: dict
+    ratios: dict
+    ideal: SallenKeyParts | None
+    built: SallenKeyParts
+    opamp: OpAmp
+    series: dict
+    alternatives: list
+    notes: list
+    fn_opamp_hz: float
+    zeta_opamp: float
+    analytic: dict
+    analytic_opamp: dict
+    spice: dict | None
+    comparison: dict
+    sensitivity: dict
+    sensitivity_opamp: dict
+    tolerance: dict
+    test: SquareTest
+    checks: list
+    waveforms: dict = field(default_factory=dict, repr=False)
+    files: dict = field(default_factory=dict)
+    timings: dict = field(default_factory=dict)
+    simulator: str | None = None
+    mode: str = "design"
+
+    def to_dict(self) -> dict:
+        b = self.built
+        target_fn = self.spec.get("fc_hz")
+        target_z = self.spec.get("zeta")
+        built = {**b.as_dict(), "q": b.q,
+                 "fn_error_pct": _pct(b.fn_hz, target_fn), "zeta_error_pct": _pct(b.zeta, target_z),
+                 "fn_opamp_hz": self.fn_opamp_hz, "zeta_opamp": self.zeta_opamp,
+                 "fn_opamp_error_pct": _pct(self.fn_opamp_hz, target_fn),
+                 "zeta_opamp_error_pct": _pct(self.zeta_opamp, target_z),
+                 "tolerance_band": self.tolerance}
+        return _clean({
+            "mode": self.mode,
+            "spec": self.spec,
+            "ratios": self.ratios,
+            "ideal": None if self.ideal is None else {**self.ideal.as_dict(), "q": self.ideal.q},
+            "built": built,
+            "series": self.series,
+            "alternatives": self.alternatives,
+            "opamp": {"name": self.opamp.name, "gbw_hz": self.opamp.gbw_hz,
+                      "slew_v_per_s": self.opamp.slew_v_per_s, "a0": self.opamp.a0,
+                      "vcc": self.opamp.vcc, "vee": self.opamp.vee,
+                      "vout_max": self.opamp.vout_max, "vout_min": self.opamp.vout_min},
+            "test_signal": {"kind": "square", "low_v": 0.0, "high_v": self.test.amplitude_v,
+                            "frequency_hz": self.test.frequency_hz,
+                            "offset_v": self.test.amplitude_v / 2,
+                            "amplitude_vpp": self.test.amplitude_v},
+            "checks": self.checks,
+            "notes": self.notes,
+            "analytic": self.analytic,
+            "analytic_opamp": self.analytic_opamp,
+            "spice": self.spice,
+            "comparison": self.comparison,
+            "sensitivity": {"ideal": self.sensitivity, "opamp": self.sensitivity_opamp},
+            "simulator": self.simulator,
+            "files": self.files,
+        })
+
+
+def _pct(value, target):
+    if target is None or value is None:
+        return None
+    return 100.0 * (value / target - 1.0)
+
+
+def _clean(obj):
+    """JSON-safe: numpy scalars to float, nan/inf to None."""
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, (np.floating, np.integer)):
+        obj = obj.item()
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def candidates(series: str, lo: float, hi: float, what: str) -> np.ndarray:
+    vals = eseries.values(series, lo, hi)
+    if vals.size == 0:
+        raise DesignError(f"no {series} {what} value between {lo:g} and {hi:g}; widen the bounds")
+    return vals
+
+
+def gain_resistors(gain: float, spec: PlantSpec):
+    """R3 (to ground) and R4 (feedback) for K = 1 + R4/R3 from the resistor series."""
+    if gain == 1.0:
+        return None, None, 1.0
+    r4, r3 = eseries.nearest_ratio_pair(gain - 1.0, spec.r_series, spec.r_min, spec.r_max)
+    return r3, r4, 1.0 + r4 / r3
+
+
+def predistort(fc_hz, zeta, c1, c2, gain, opamp: OpAmp):
+    """Targets (fc', zeta') whose exact design with these capacitors lands on
+    (fc, zeta) once the op-amp's finite GBW shifts it (``--compensate-gbw``)."""
+    def realised(x):
+        f, z = math.exp(x[0]), math.exp(x[1])
+        lo, hi = resistors_for_caps(f, z, c1, c2, gain)
+        r1 = float(lo) if not math.isnan(float(lo)) else float(hi)
+        if math.isnan(r1):
+            return np.array([10.0, 10.0])
+        r2 = 1.0 / ((2 * math.pi * f) ** 2 * c1 * c2 * r1)
+        fa, za = dominant_pair(plant_tf_opamp(SallenKeyParts(r1, r2, c1, c2, gain), opamp)[1])
+        return np.array([math.log(fa / fc_hz), math.log(za / zeta)])
+    sol = optimize.fsolve(realised, [math.log(fc_hz), math.log(zeta)], xtol=1e-12)
+    return math.exp(sol[0]), math.exp(sol[1])
+
+
+def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspice") -> PlantResult:
+    """Design, analyse and (unless ``simulate`` is False) verify a plant."""
+    tick = time.perf_counter()
+    spec.validate()
+    amp = opamps.get(spec.opamp)
+    rv = candidates(spec.r_series, spec.r_min, spec.r_max, "resistor")
+    cv = candidates(spec.c_series, spec.c_min, spec.c_max, "capacitor")
+    r3, r4, k = gain_resistors(spec.gain, spec)
+    notes = realizability_notes(spec.fc_hz, spec.zeta, spec.gain, spec.c_min, spec.c_max)
+    if k != spec.gain:
+        notes.append(f"gain K = {spec.gain:g} realised as 1 + {r4:g}/{r3:g} = {k:.5g}")
+    fc_t, z_t = spec.fc_hz, spec.zeta
+    ratios = {"m": None, "n": None}
+    top = max(1, spec.alternatives)
+
+    if spec.r is not None:
+        # the seed's procedure: R and C fixed, m and n solved, each part rounded jointly
+        m, n = ratios_from_rc(spec.fc_hz, spec.zeta, spec.r, spec.c, k)
+        ratios = {"m": m, "n": n}
+        ideal = SallenKeyParts(m * spec.r, spec.r, spec.c, n * spec.c, k, r3, r4)
+        if spec.compensate_gbw:
+            fc_t, z_t = predistort(spec.fc_hz, spec.zeta, ideal.c1, ideal.c2, k, amp)
+            m, n = ratios_from_rc(fc_t, z_t, spec.r, spec.c, k)
+            ideal = SallenKeyParts(m * spec.r, spec.r, spec.c, n * spec.c, k, r3, r4)
+        pool_r = np.unique(np.concatenate([around(ideal.r1, rv), around(ideal.r2, rv)]))
+        pool_c = np.unique(np.concatenate([around(ideal.c1, cv), around(ideal.c2, cv)]))
+        ranked = brute_force(fc_t, z_t, pool_r, pool_c, k, top=4 * top)
+    else:
+        ranked = joint_search(fc_t, z_t, rv, cv, k, top=4 * top)
+        if spec.compensate_gbw:
+            fc_t, z_t = predistort(spec.fc_hz, spec.zeta, ranked[0].c1, ranked[0].c2, k, amp)
+            ranked = joint_search(fc_t, z_t, rv, cv, k, top=4 * top)
+        best = ranked[0]
+        lo, hi = resistors_for_caps(fc_t, z_t, best.c1, best.c2, k)
+        roots = [float(x) for x in (lo, hi) if not math.isnan(float(x))]
+        if roots:
+            r1 = min(roots, key=lambda r: abs(math.log(r / best.r1)))
+            r2 = 1.0 / ((2 * math.pi * fc_t) ** 2 * best.c1 * best.c2 * r1)
+            ideal = SallenKeyParts(r1, r2, best.c1, best.c2, k, r3, r4)
+            ratios = {"m": r1 / r2, "n": best.c2 / best.c1}
+        else:
+            ideal = None
+    ranked = _distinct(ranked, k)[:top]
+    best = ranked[0]
+    built = SallenKeyParts(best.r1, best.r2, best.c1, best.c2, k, r3, r4)
+    worst = best.worst if not spec.compensate_gbw else None
+    if worst is not None and worst > 0.05:
+        notes.append(f"the best {spec.r_series}/{spec.c_series} combination within the bounds is "
+                     f"{100 * worst:.3g} % off; widen the bounds or use a finer series")
+    t_search = time.perf_counter() - tick
+    result = _analyse(built, ideal, amp, spec.r_series, spec.c_series,
+                      {"fc_hz": spec.fc_hz, "zeta": spec.zeta, "gain": spec.gain},
+                      ratios, notes, spec.amplitude_v, spec.square_hz, simulate, simulator)
+    result.alternatives = [_alt(c, spec.fc_hz, spec.zeta) for c in ranked]
+    if spec.compensate_gbw:
+        result.notes.append(f"--compensate-gbw: designed for fn {fc_t:.5g} Hz, zeta {z_t:.4g} so that with "
+                            f"the {amp.name}'s {amp.gbw_hz / 1e6:g} MHz GBW it lands on the spec")
+    result.timings = {"search_s": t_search, **result.timings}
+    return result
+
+
+def analyze_plant(parts: SallenKeyParts, opamp: str = "LM741", target_fc=None, target_zeta=None,
+                  r_series: str = "E24", c_series: str = "E12", amplitude_v: float = 2.0,
+                  square_hz=None, simulate: bool = True, simulator: str = "pyspice") -> PlantResult:
+    """Analyse parts as built (e.g. the seed's rounded 820/1k/10n/220n)."""
+    for name, v in (("R1", parts.r1), ("R2", parts.r2), ("C1", parts.c1), ("C2", parts.c2)):
+        if not (math.isfinite(v) and v > 0):
+            raise DesignError(f"{name} must be a positive value, got {v!r}")
+    if parts.zeta <= 0:
+        raise DesignError(f"these parts give zeta = {parts.zeta:.4g} <= 0: the circuit oscillates")
+    amp = opamps.get(opamp)
+    spec = {"fc_hz": target_fc, "zeta": target_zeta, "gain": parts.gain}
+    notes = [f"these parts give fn = {parts.fn_hz:.5g} Hz and zeta = {parts.zeta:.4g} (Q = {parts.q:.4g})"]
+    res = _analyse(parts, None, amp, eseries.series_name(r_series), eseries.series_name(c_series), spec,
+                   {"m": parts.r1 / parts.r2, "n": parts.c2 / parts.c1}, notes, amplitude_v, square_hz,
+                   simulate, simulator)
+    res.mode = "analyze"
+    return res
+
+
+def _alt(c, fc, zeta):
+    return {"R1_ohm": c.r1, "R2_ohm": c.r2, "C1_f": c.c1, "C2_f": c.c2, "fn_hz": c.fn_hz,
+            "zeta": c.zeta, "fn_error_pct": _pct(c.fn_hz, fc), "zeta_error_pct": _pct(c.zeta, zeta)}
+
+
+def _distinct(ranked, gain):
+    """For unity gain R1 and R2 can swap without changing anything: list each build once."""
+    seen, out = set(), []
+    for c in ranked:
+        key = (tuple(sorted((c.r1, c.r2))) if gain == 1.0 else (c.r1, c.r2), c.c1, c.c2)
+        if key not in seen:
+            seen.add(key)
+            out.append(c)
+    return out
+
+
+def _analyse(built, ideal, amp, r_series, c_series, spec, ratios, notes, amplitude_v, square_hz,
+             simulate, simulator) -> PlantResult:
+    tick = time.perf_counter()
+    num_i, den_i = plant_tf(built)
+    num_o, den_o = plant_tf_opamp(built, amp)
+    fn_o, z_o = dominant_pair(den_o)
+    span = response_span(min(built.fn_hz, fn_o), min(built.zeta, z_o))
+    t = dense_time(span)
+    y_i = step_response(num_i, den_i, t)
+    y_o = step_response(num_o, den_o, t)
+    k_i = float(num_i[-1] / den_i[-1])
+    k_o = float(num_o[-1] / den_o[-1])
+    m_i = step_metrics(t, y_i, final=k_i)
+    m_o = step_metrics(t, y_o, final=k_o)
+    test = recommend_square_wave(m_o.settling_time_s, amplitude_v, square_hz)
+    # the comparisons and plots use the rising half period of the bench test
+    tw = dense_time(test.half_period_s)
+    y_iw, y_ow = step_response(num_i, den_i, tw), step_response(num_o, den_o, tw)
+    checks = signal_checks(tw, y_ow, amplitude_v, amp)
+    if test.half_period_s < m_o.settling_time_s:
+        checks.append({"name": "square-wave period", "ok": False,
+                       "detail": f"half period {test.half_period_s * 1e6:.4g} us is shorter than the 2 % settling "
+                                 f"time {m_o.settling_time_s * 1e6:.4g} us: the scope will not show a settled step"})
+    sens = sensitivities(built)
+    sens_o = sensitivities(built, amp)
+    tol = tolerance_band(built, eseries.TOLERANCE[r_series], eseries.TOLERANCE[c_series], test.half_period_s)
+    timings = {"analytic_s": time.perf_counter() - tick}
+    result = PlantResult(
+        spec=spec, ratios=ratios, ideal=ideal, built=built, opamp=amp,
+        series={"r": r_series, "c": c_series, "r_tolerance_pct": 100 * eseries.TOLERANCE[r_series],
+                "c_tolerance_pct": 100 * eseries.TOLERANCE[c_series]},
+        alternatives=[], notes=list(notes), fn_opamp_hz=fn_o, zeta_opamp=z_o,
+        analytic=_metrics_dict(m_i), analytic_opamp=_metrics_dict(m_o), spice=None, comparison={},
+        sensitivity=sens, sensitivity_opamp=sens_o, tolerance=tol, test=test, checks=checks,
+        waveforms={"t": tw, "analytic": y_iw * amplitude_v, "analytic_opamp": y_ow * amplitude_v,
+                   "bode": (num_i, den_i, num_o, den_o)},
+        timings=timings)
+    result.deck = plant_deck(built, amp, test, _title(built, amp))
+    if simulate:
+        run_spice(result, simulator, k_o)
+    else:
+        result.notes.append("SPICE simulation skipped (--no-sim): the figures are analytic only")
+    return result
+
+
+def _title(parts, amp):
+    return (f"Sallen-Key low-pass plant fn={parts.fn_hz:.5g}Hz zeta={parts.zeta:.4g} "
+            f"K={parts.gain:.4g} op-amp={amp.name}")
+
+
+def _metrics_dict(m) -> dict:
+    d = m.to_dict()
+    return {"overshoot_pct": d["overshoot_pct"], "peak_time_s": d["peak_time_s"],
+            "rise_time_s": d["rise_time_s"], "settling_time_s": d["settling_time_s"],
+            "settling_time_5pct_s": d["settling_time_5pct_s"], "rise_time_0_100_s": d["rise_time_0_100_s"],
+            "peak_value": d["peak_value"], "final_value": d["final_value"]}
+
+
+def run_spice(result: PlantResult, simulator: str, dc_gain_opamp: float) -> None:
+    """Simulate the deck and compare SPICE with both analytic models."""
+    tick = time.perf_counter()
+    sim = get_simulator(simulator)
+    res = sim.run(result.deck)
+    test = result.test
+    t, y = res["time"], res["v(out)"]
+    tw = result.waveforms["t"]
+    y_s = resample(t, y, tw + test.delay_s)
+    amp_v = test.amplitude_v
+    m_s = step_metrics(tw, y_s / amp_v, final=dc_gain_opamp)
+    spice = _metrics_dict(m_s)
+    abstol = 0.01 * abs(result.built.gain * amp_v)
+    spice["nrms"] = nrms(result.waveforms["analytic_opamp"], y_s, abstol)
+    spice["nrms_ideal"] = nrms(result.waveforms["analytic"], y_s, abstol)
+    spice["measurements"] = res.measurements
+    result.spice = spice
+    result.simulator = sim.name
+    from .metrics import StepMetrics
+    def sm(d):
+        return StepMetrics(**{k: (math.nan if d.get(k) is None else d[k]) for k in StepMetrics.__dataclass_fields__})
+    result.comparison = {
+        "spice_vs_analytic": metric_deltas(sm(result.analytic), m_s),
+        "spice_vs_analytic_opamp": metric_deltas(sm(result.analytic_opamp), m_s),
+        "nrms_abstol_v": abstol,
+        "pass": spice["nrms"] < 1.0,
+    }
+    result.waveforms["spice"] = y_s
+    result.timings["simulation_s"] = time.perf_counter() - tick
