@@ -1,0 +1,190 @@
+"""``identify``: plant models from a measured or simulated step response.
+
+Reads a CSV capture (generic, Tektronix, Rigol or this project's waveforms),
+runs every classical method of seeds 000-003 plus least squares, and prints
+them ranked by IAE; ``--json`` prints one JSON object instead.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+import math
+import sys
+
+from .errors import DesignError
+
+EPILOG = """\
+examples:
+  identify capture.csv                         # t,y or t,u,y (header optional)
+  identify scope.csv --step-time 0 --step-amplitude 2
+        a scope export of the output only: step at t = 0 s, input step of 2 V
+  identify plant.csv --json > models.json      # methods[], best, preprocessing
+  identify bench.csv --against reports/plant_fc3500_z0.2/result.json
+        compare fn, zeta, gain and overshoot with the design and its part tolerances
+  identify sq330.csv --plot fit.png            # a 330 Hz square wave: steps averaged
+  identify capture.csv --methods smith,alfaro,least-squares
+
+input layouts: generic CSV (comma, semicolon with decimal comma, tab), Tektronix
+TDS/TBS and MSO/DPO exports, Rigol X,CH1,Start,Increment exports, design-plant /
+design-pid waveforms (time_s,...). With two signals the first is the input and
+the second the output unless their names say otherwise (u/vin/in, y/vout/out);
+--input-column/--output-column choose by name or column number.
+
+methods: first order (ziegler-nichols, hagglund, smith, sundaresan-krishnaswamy,
+nishikawa, alfaro, broida, chen-yang, ho, viteckova), double pole
+(ho-double-pole, viteckova-double-pole), the second-order methods when
+available, and least-squares fits (fopdt, overdamped, underdamped) with 95 %
+confidence intervals. Parameters: K, tau_s, theta_s; K, wn_rad_s, zeta,
+theta_s; K, tau1_s, tau2_s, theta_s.
+
+exit status: 0 success, 2 bad input (one line on stderr saying what and why).
+"""
+
+
+def _number(text: str, what: str) -> float:
+    from .units import parse_value
+    try:
+        v = parse_value(text, what)
+    except DesignError:
+        raise
+    except (ValueError, TypeError):
+        raise DesignError(f"{what} must be a number like 1e-3 or 1m; got {text!r}") from None
+    if not math.isfinite(v):
+        raise DesignError(f"{what} must be a finite number; got {text!r}")
+    return v
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2, as every other bad input
+        raise DesignError(f"{message} (see identify --help)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="identify", description=__doc__.split("\n\n")[0].strip(),
+                epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("capture", help="CSV file with the step response")
+    p.add_argument("--step-time", metavar="T",
+                   help="when the input stepped, in seconds (default: from the input column, "
+                        "else t = 0 if the record spans it, else the first sample)")
+    p.add_argument("--step-amplitude", metavar="A",
+                   help="input step size in input units (default: from the input column, else 1)")
+    p.add_argument("--input-column", metavar="NAME|N",
+                   help="input column by header name or number (time is 1); 'none' ignores it")
+    p.add_argument("--output-column", metavar="NAME|N", help="output column by name or number")
+    p.add_argument("--methods", nargs="+", metavar="NAME",
+                   help="only these methods (space or comma separated), e.g. smith alfaro "
+                        "least-squares")
+    p.add_argument("--no-refine", action="store_true", help="skip the least-squares fits")
+    p.add_argument("--against", metavar="RESULT_JSON",
+                   help="a design-plant result.json to compare fn, zeta, gain and overshoot with")
+    p.add_argument("--plot", metavar="OUT_PNG", help="write a PNG of the data against the best models")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+    return p
+
+
+def run(argv=None) -> dict:
+    """Parse arguments, identify, write the plot; return the result (for tests)."""
+    from .identify.csvio import read_capture
+    from .identify.step import compare_with_design, identify_step, load_design
+
+    args = build_parser().parse_args(argv)
+    step_time = None if args.step_time is None else _number(args.step_time, "--step-time")
+    amp = None if args.step_amplitude is None else _number(args.step_amplitude, "--step-amplitude")
+    if amp is not None and amp == 0:
+        raise DesignError("--step-amplitude must be non-zero")
+    design = load_design(args.against) if args.against else None
+    cap = read_capture(args.capture, input_column=args.input_column,
+                       output_column=args.output_column)
+    u = cap.u
+    if step_time is not None:
+        u = None if amp is not None else u
+    result = identify_step(cap.t, cap.y, u, step_time=step_time, step_amplitude=amp,
+                           methods=args.methods, refine=not args.no_refine,
+                           capture=cap.to_dict())
+    if design is not None:
+        result.comparison = compare_with_design(result, design)
+    if args.plot:
+        plot_fit(result, args.plot)
+    return {"args": args, "result": result}
+
+
+def identify_main(argv=None) -> int:
+    """Console entry point ``identify``."""
+    try:
+        out = run(argv)
+    except DesignError as exc:
+        print(f"identify: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:  # pragma: no cover
+        print("identify: interrupted", file=sys.stderr)
+        return 130
+    args, result = out["args"], out["result"]
+    if args.json:
+        buf = io.StringIO()
+        json.dump(_finite(result.to_dict()), buf, indent=2, allow_nan=False,
+                  default=_json_default)
+        print(buf.getvalue())
+    else:
+        print(result.to_text())
+        if args.plot:
+            print(f"\nPlot written to {args.plot}")
+    return 0
+
+
+def _finite(o):
+    """Replace NaN/inf by None everywhere (JSON has no NaN)."""
+    if isinstance(o, dict):
+        return {k: _finite(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_finite(v) for v in o]
+    if isinstance(o, float) and not math.isfinite(o):
+        return None
+    return o
+
+
+def plot_fit(result, path, n_models: int = 3) -> None:
+    """PNG of the data against the best ``n_models`` valid models (written atomically)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from .fileio import atomic_write
+    from .identify.core import model_step
+    from .identify.preprocess import block_mean
+
+    s = result.step
+    t, y = block_mean(s.t_raw, s.y_raw, 20000)
+    fig, ax = plt.subplots(figsize=(8, 4.5), dpi=110)
+    ax.plot(t - s.t_step, y, color="0.6", lw=1.0, label="data")
+    shown = [m for m in result.methods if m.valid][:n_models]
+    tt = t - s.t_step
+    for m in shown:
+        ym = s.y0 + s.amplitude * model_step(m.model, m.params, tt)
+        ax.plot(tt, ym, lw=1.2, label=f"{m.name} ({m.model}), IAE {m.iae:.3g}")
+    ax.axvline(0.0, color="k", lw=0.6, ls=":")
+    ax.set_xlabel("time since the step (s)")
+    ax.set_ylabel(result.capture.get("output", "output") if result.capture else "output")
+    ax.set_title("Step response: data and best identified models")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png")
+    plt.close(fig)
+    del np
+    atomic_write(path, buf.getvalue())
+
+
+def _json_default(o):
+    import numpy as np
+    if isinstance(o, np.generic):
+        v = o.item()
+        return None if isinstance(v, float) and not math.isfinite(v) else v
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(identify_main())
