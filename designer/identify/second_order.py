@@ -357,36 +357,41 @@ def overshoot(t, y, yf) -> MethodResult:
 def log_decrement(t, y, yf) -> MethodResult:
     """First and second overshoot and the period (seed 002 eqs 5-7), zeta <= 0.5.
 
-    zeta is the mean of ln(Y1)/sqrt(pi^2 + ln^2 Y1) and
-    ln(Y2)/sqrt(4 pi^2 + ln^2 Y2) in magnitude (Y1, Y2 the overshoots above the
-    final value as fractions of it) and wn = 2 pi / (T sqrt(1 - zeta^2)) with
-    T the time between the two peaks.
+    Seed 002 eq 5 has Y1/Y0 = e^{-zeta pi/sqrt(1-zeta^2)} and
+    Y2/Y0 = e^{-2 zeta pi/sqrt(1-zeta^2)}: Y1 is the first overshoot above the
+    final value and Y2 the next deviation from it, i.e. the depth of the first
+    undershoot (the second peak above the final value would be e^{-3 ...}).
+    zeta is the mean of |ln Y1|/sqrt(pi^2 + ln^2 Y1) and
+    |ln Y2|/sqrt(4 pi^2 + ln^2 Y2) (eq 6; the seed's signs need the magnitude)
+    and wn = 2 pi / (T sqrt(1 - zeta^2)) (eq 7), T the time between the first
+    two peaks (twice the peak-to-trough time if the record shows one peak only).
     """
     name, model = "log-decrement", "underdamped"
     t, z, sigma, err = _prepare(t, y, yf)
     if err:
         return _fail(name, model, err, yf)
     ext = extrema(t, z, sigma, count=3)
-    if len(ext) < 3 or ext[0][0] != "max" or ext[2][0] != "max":
-        return _fail(name, model, "needs two overshoot peaks above the noise: valid for "
-                     "zeta <= 0.5 (second overshoot >= 1.6 % of the first's square)", yf)
-    (_, t1, z1), _, (_, t2, z2) = ext
-    y1, y2 = z1 - 1.0, z2 - 1.0
-    if y2 <= 0.0 or y1 <= 0.0:
-        return _fail(name, model, "second peak not above the final value: not a clean "
-                     "underdamped response (valid for zeta <= 0.5)", yf)
+    if len(ext) < 2 or ext[0][0] != "max" or ext[1][0] != "min":
+        return _fail(name, model, "needs a first overshoot and an undershoot above the noise: "
+                     "valid for zeta <= 0.5", yf)
+    (_, t1, z1), (_, tm, zm) = ext[0], ext[1]
+    y1, y2 = z1 - 1.0, 1.0 - zm
+    if y2 <= 0.0 or y1 <= 0.0 or y2 >= y1:
+        return _fail(name, model, "the undershoot is not smaller than the overshoot: not a "
+                     "decaying second-order oscillation (valid for zeta <= 0.5)", yf)
+    period = ext[2][1] - t1 if len(ext) >= 3 and ext[2][0] == "max" else 2.0 * (tm - t1)
     l1, l2 = abs(math.log(y1)), abs(math.log(y2))
     zeta1 = l1 / math.sqrt(math.pi ** 2 + l1 * l1)
     zeta2 = l2 / math.sqrt(4.0 * math.pi ** 2 + l2 * l2)
     zeta = 0.5 * (zeta1 + zeta2)
-    period = t2 - t1
     wn = 2.0 * math.pi / (period * math.sqrt(1.0 - zeta * zeta))
     valid = zeta <= 0.5 + 1e-9
-    note = "" if valid else (f"zeta = {zeta:.3f} > 0.5: outside the method's range "
-                             "(zeta <= 0.5, seed 002); use t4-t3")
+    note = "assumes no dead time" if valid else (
+        f"zeta = {zeta:.3f} > 0.5: outside the method's range (zeta <= 0.5, seed 002); "
+        "use t4-t3")
     return MethodResult(name, model, {"K": float(yf), "wn_rad_s": wn, "zeta": zeta, "theta_s": 0.0},
                         valid=valid, note=note,
-                        points={"t1_s": t1, "y1": y1, "t2_s": t2, "y2": y2, "period_s": period,
+                        points={"t1_s": t1, "y1": y1, "t_min_s": tm, "y2": y2, "period_s": period,
                                 "zeta_first": zeta1, "zeta_second": zeta2})
 
 
@@ -603,7 +608,7 @@ def _logfit(t, v):
     return math.exp(icpt), (-1.0 / slope if slope < 0.0 else math.inf)
 
 
-def peeling(t, y, yf, iterations: int = 8) -> MethodResult:
+def peeling(t, y, yf, iterations: int = 500) -> MethodResult:
     """Exponential peeling of two time constants (seed 003 section 2.3).
 
     1 - z(t) = K2 e^{-t/tau2} - K1 e^{-t/tau1}: the straight tail of
@@ -612,8 +617,8 @@ def peeling(t, y, yf, iterations: int = 8) -> MethodResult:
     and tau1 (eq 2.3.44). The seed peels once; here the two fits alternate
     (each one on the data minus the other's exponential) until they agree, so
     a noise-free two-pole response is recovered exactly even when the time
-    constants are close. A dead time then follows from
-    K2 e^{-theta/tau2} - K1 e^{-theta/tau1} = 1.
+    constants are close. A dead time then follows from where the fitted
+    K2 e^{-t/tau2} - K1 e^{-t/tau1} has zero slope (the response's start).
 
     Valid when the fast term has the sign of two cascaded poles (K1 > 0);
     a response with a zero, like seed 003's furnace (both exponentials
@@ -623,6 +628,9 @@ def peeling(t, y, yf, iterations: int = 8) -> MethodResult:
     t, z, sigma, err = _prepare(t, y, yf)
     if err:
         return _fail(name, model, err, yf)
+    if float(np.max(z)) > 1.0 + max(5.0 * sigma, 1e-3):
+        return _fail(name, model, "the response overshoots: two real time constants "
+                     "cannot produce it (valid for overdamped responses)", yf)
     r = 1.0 - z
     r_lo = max(0.01, 5.0 * sigma)
     slow_sel = (r <= 0.35) & (r >= r_lo)
@@ -630,7 +638,8 @@ def peeling(t, y, yf, iterations: int = 8) -> MethodResult:
     rise = crossing_time(t, z, 0.5, sigma)
     if math.isfinite(rise):
         slow_sel &= t >= rise
-    fast_sel_base = z >= max(0.02, 5.0 * sigma)
+    # past the dead time: exactly 0 before it on clean data, 5 sigma on noisy data
+    fast_sel_base = z > 5.0 * sigma
     if slow_sel.sum() < 3:
         return _fail(name, model, "too few samples in the tail (1 - y/yf between "
                      f"{r_lo:.3g} and 0.35) to fit the slow exponential", yf)
@@ -642,15 +651,19 @@ def peeling(t, y, yf, iterations: int = 8) -> MethodResult:
     for _ in range(max(1, iterations)):
         f = k2 * np.exp(-t / tau2) - r             # = K1 e^{-t/tau1}
         sel = fast_sel_base & (t < ts[0] + 0.5 * (ts[-1] - ts[0]))
-        if sel.sum() < 3:
+        if sel.sum() < 2:
             break
         fs = f[sel]
-        sign = 1.0 if np.median(fs) >= 0.0 else -1.0
+        # the fast term is largest just after the rise starts: its sign there
+        sign = 1.0 if fs[int(np.argmax(np.abs(fs)))] >= 0.0 else -1.0
         fs = sign * fs
+        if float(np.max(fs)) < 10.0 * sigma:
+            k1, tau1 = 0.0, math.nan        # nothing above the noise to peel
+            break
         # keep the part of the fast exponential still well above the noise and
         # above what the slow fit's error would leave
         keep = fs > max(5.0 * sigma, 0.02 * float(np.max(fs)))
-        if keep.sum() < 3:
+        if keep.sum() < 2:
             break
         a, tau_f = _logfit(t[sel][keep], fs[keep])
         if not math.isfinite(tau_f) or tau_f <= 0.0:
@@ -675,10 +688,12 @@ def peeling(t, y, yf, iterations: int = 8) -> MethodResult:
         return _fail(name, model, "the fast exponential has the sign of a sum of lags "
                      "(a zero), not of two cascaded poles: K1 = %.4g, K2 = %.4g, tau1 = %.4g s, "
                      "tau2 = %.4g s" % (k1, k2, tau1, tau2), yf, pts)
-    g = lambda th: k2 * math.exp(-th / tau2) - k1 * math.exp(-th / tau1) - 1.0  # noqa: E731
+    # the two-pole step response leaves its start with zero slope, so the dead
+    # time is where the fitted K2 e^{-t/tau2} - K1 e^{-t/tau1} has its maximum
     theta = 0.0
-    if g(0.0) > 0.0 and g(float(t[-1])) < 0.0:
-        theta = brentq(g, 0.0, float(t[-1]), xtol=1e-15 + 1e-12 * tau1)
+    if tau1 != tau2:
+        arg = (k1 * tau2) / (k2 * tau1)
+        theta = max(0.0, math.log(arg) / (1.0 / tau1 - 1.0 / tau2)) if arg > 0.0 else 0.0
     pts["theta_s"] = theta
     fast, slow = sorted((tau1, tau2))
     valid = slow >= 1.5 * fast
