@@ -87,16 +87,17 @@ def build_parser() -> argparse.ArgumentParser:
 def run(argv=None) -> dict:
     """Parse arguments, identify, write the plot; return the result (for tests)."""
     from .identify.csvio import read_capture
-    from .identify.step import compare_with_design, identify_step, load_design
 
     args = build_parser().parse_args(argv)
     step_time = None if args.step_time is None else _number(args.step_time, "--step-time")
     amp = None if args.step_amplitude is None else _number(args.step_amplitude, "--step-amplitude")
     if amp is not None and amp == 0:
         raise DesignError("--step-amplitude must be non-zero")
-    design = load_design(args.against) if args.against else None
+    # The file is read before scipy is imported, so bad input fails fast.
     cap = read_capture(args.capture, input_column=args.input_column,
                        output_column=args.output_column)
+    from .identify.step import compare_with_design, identify_step, load_design
+    design = load_design(args.against) if args.against else None
     u = cap.u
     if step_time is not None:
         u = None if amp is not None else u

@@ -78,9 +78,16 @@ def find_edges(t, u) -> list:
     """
     t = np.asarray(t, float)
     u = np.asarray(u, float)
-    lo, hi = np.percentile(u, [5, 95])
-    span = hi - lo
     sigma = noise_sigma(u)
+    # Levels: the record's two ends when they differ (a single step, however
+    # close to either end), else robust extremes (a square wave).
+    k = max(3, u.size // 200)
+    a, b = float(np.median(u[:k])), float(np.median(u[-k:]))
+    if abs(b - a) > MIN_STEP_SNR * sigma and abs(b - a) > 0:
+        lo, hi = min(a, b), max(a, b)
+    else:
+        lo, hi = np.percentile(u, [1, 99])
+    span = hi - lo
     if span <= max(MIN_STEP_SNR * sigma, 1e-12 * max(abs(lo), abs(hi), 1e-300)):
         return []
     state = np.full(u.shape, -1, dtype=np.int8)

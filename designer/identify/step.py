@@ -286,6 +286,11 @@ def _check_names(methods):
 
 def _measured(step: PreparedStep, t_eval, y_eval) -> dict:
     from ..metrics import step_metrics
+    from .preprocess import smooth_derivative
+    if step.sigma > 0 and t_eval.size > 50:
+        # Noise spikes would read as overshoot: measure on the smoothed record.
+        t_eval, y_eval, _ = smooth_derivative(t_eval, y_eval, sigma=step.sigma,
+                                              span=step.y_final - step.y0)
     try:
         sm = step_metrics(t_eval, y_eval, t_step=step.t_step, initial=step.y0,
                           final=step.y_final)
@@ -377,7 +382,7 @@ def _band_from_built(built: dict):
         elif isinstance(v, dict):
             lo = v.get("lo", v.get("min", v.get("low")))
             hi = v.get("hi", v.get("max", v.get("high")))
-            if lo is not None and hi is not None:
+            if isinstance(lo, (int, float)) and isinstance(hi, (int, float)):
                 out[k] = [float(lo), float(hi)]
     return out or None
 
@@ -412,7 +417,10 @@ def compare_with_design(result: IdentifyResult, design: dict) -> dict:
     gain = float(spec.get("gain", 1.0) or 1.0)
     band = _band_from_built(built)
     if band is not None:
+        tb = built["tolerance_band"]
         basis = "built.tolerance_band"
+        if "r_tolerance_pct" in tb and "c_tolerance_pct" in tb:
+            basis += f" ({tb['r_tolerance_pct']:g} % R / {tb['c_tolerance_pct']:g} % C)"
         computed = tolerance_band(built, gain)
         for k, v in computed.items():
             band.setdefault(k, v)
