@@ -1,0 +1,61 @@
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from designer import opamps
+from designer.models import (dominant_pair, plant_tf, plant_tf_opamp, sensitivities, step_response)
+from designer.sallenkey import SallenKeyParts
+
+SEED = SallenKeyParts(819.1, 1e3, 10e-9, 252.445e-9)
+
+
+def test_opamp_model_tends_to_the_ideal():
+    huge = replace(opamps.get("LM741"), a0=1e9, gbw_hz=1e15)
+    num, den = plant_tf_opamp(SEED, huge)
+    fn, z = dominant_pair(den)
+    assert fn == pytest.approx(SEED.fn_hz, rel=1e-6)
+    assert z == pytest.approx(SEED.zeta, rel=1e-5)
+    assert num[-1] / den[-1] == pytest.approx(1.0, rel=1e-8)
+
+
+def test_opamp_model_with_gain_has_dc_gain_a0_over_1_plus_a0_beta():
+    p = SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, gain=2.0, r3=10e3, r4=10e3)
+    amp = opamps.get("LM741")
+    num, den = plant_tf_opamp(p, amp)
+    assert num[-1] / den[-1] == pytest.approx(amp.a0 / (1 + amp.a0 / 2.0), rel=1e-12)
+
+
+def test_finite_gbw_lowers_fn_and_zeta_of_the_seed_plant():
+    fn, z = dominant_pair(plant_tf_opamp(SEED, opamps.get("LM741"))[1])
+    assert fn < SEED.fn_hz and z < SEED.zeta
+    # a faster op-amp shifts less
+    fn5, z5 = dominant_pair(plant_tf_opamp(SEED, opamps.get("NE5532"))[1])
+    assert SEED.fn_hz - fn5 < SEED.fn_hz - fn
+
+
+def test_dominant_pair_of_real_poles():
+    fn, z = dominant_pair(np.polymul([1, 10], [1, 1000]))
+    assert fn == pytest.approx(math.sqrt(10 * 1000) / (2 * math.pi))
+    assert z == pytest.approx(1010 / (2 * math.sqrt(10 * 1000)))
+
+
+def test_sensitivities_match_closed_form():
+    s = sensitivities(SEED)
+    r1, r2 = SEED.r1, SEED.r2
+    for part in ("R1", "R2", "C1", "C2"):
+        assert s[part]["wn"] == pytest.approx(-0.5, abs=1e-6)
+    # zeta = (R1 + R2) sqrt(C1/C2) / (2 sqrt(R1 R2)) at K = 1
+    assert s["R1"]["zeta"] == pytest.approx(r1 / (r1 + r2) - 0.5, abs=1e-6)
+    assert s["C1"]["zeta"] == pytest.approx(0.5, abs=1e-6)
+    assert s["C2"]["zeta"] == pytest.approx(-0.5, abs=1e-6)
+
+
+def test_step_response_closed_form():
+    t = np.linspace(0, 2e-3, 2001)
+    y = step_response(*plant_tf(SEED), t)
+    wn, z = SEED.wn, SEED.zeta
+    wd = wn * math.sqrt(1 - z * z)
+    exact = 1 - np.exp(-z * wn * t) * (np.cos(wd * t) + z / math.sqrt(1 - z * z) * np.sin(wd * t))
+    assert np.max(np.abs(y - exact)) < 1e-9
