@@ -181,7 +181,7 @@ def steepest_tangent(t, y, yf, *, sigma: float | None = None) -> Tangent:
         den = d0 - 2 * d1 + d2
         # Refine only a smooth maximum; at a kink (FOPDT: slope jumps at the
         # dead time) a parabola would overshoot the true slope.
-        if den < 0 and min(d0, d2) > 0.95 * d1:
+        if den < 0 and min(d0, d2) > 0.99 * d1:
             off = 0.5 * (d0 - d2) / den
             if abs(off) < 1:
                 h = ts[1] - ts[0]

@@ -225,8 +225,13 @@ def uniform(t, y, n: int | None = None) -> tuple:
 
 
 def smooth_derivative(t, y, *, window_s: float | None = None, sigma: float = 0.0,
-                      span: float = 1.0) -> tuple:
-    """Smoothed response and its time derivative (Savitzky-Golay, cubic).
+                      span: float = 1.0, polyorder: int = 2) -> tuple:
+    """Smoothed response and its time derivative (Savitzky-Golay).
+
+    The default quadratic fit gives the least-squares slope over the window,
+    a positively weighted mean of the sample-to-sample slopes: it never
+    exceeds the steepest true slope, even across the kink an FOPDT response
+    has at its dead time (a cubic fit overshoots there).
 
     The window is ``window_s`` seconds when given; otherwise it grows with the
     noise: 5 samples on clean data (so tangent methods stay exact), up to
@@ -249,7 +254,7 @@ def smooth_derivative(t, y, *, window_s: float | None = None, sigma: float = 0.0
         w += 1
     if w > n:
         w = n if n % 2 else n - 1
-    poly = 3 if w > 5 else 2
+    poly = min(polyorder, w - 1)
     ys = savgol_filter(yu, w, poly, mode="interp")
     dy = savgol_filter(yu, w, poly, deriv=1, delta=dt, mode="interp")
     return tu, ys, dy
