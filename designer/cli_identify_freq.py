@@ -1,0 +1,203 @@
+"""``identify-freq``: plant models from a measured frequency response (Bode table).
+
+Reads a table of frequency, gain and (optionally) phase, reads asymptotes,
+resonant peak and dead time as seeds 000 and 003 do, fits FOPDT,
+underdamped and overdamped models to the complex response by least squares,
+and prints them ranked by fit error; ``--json`` prints one JSON object.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+import math
+import sys
+
+from .errors import DesignError
+from .units import format_eng
+
+EPILOG = """\
+examples:
+  identify-freq bode.csv                      # f_hz,gain_db,phase_deg (header optional)
+  identify-freq sensor.csv --gain-units ratio --phase-units s
+        gain as Vout/Vin and phase as the output's time shift behind the input
+  identify-freq opamp.csv --json > models.json  # methods[], best, data, error_definition
+  identify-freq bode.csv --plot bode.png      # data against the fitted models
+
+table: one row per frequency: frequency, gain[, phase]; comma, semicolon (decimal
+comma allowed), tab or space separated; '#' lines are comments. A header row may
+name the units (f_hz, f_khz, w_rad_s, gain_db, gain_ratio, phase_deg, phase_rad,
+shift_s, shift_us); options override it. Defaults: Hz, dB, degrees. A phase
+given as a time shift dt is the output lagging the input: phase = -360 f dt.
+
+methods: asymptotes (K, high-frequency slope -> order, corner where the gain
+has fallen 3n dB; 1 pole -> fopdt, 2 -> double-pole), resonant-peak (zeta from
+the peak height -10 log(4 zeta^2 (1 - zeta^2)), wn from its frequency),
+least-squares (fopdt, underdamped, overdamped, with dead time when there is
+phase; 95 % confidence half-widths). Dead time is read from the phase lag the
+model does not explain.
+
+fit error (the iae/ise columns): e = |G_model/G_data - 1| at each tabulated
+frequency (gain only without phase); iae = mean of e, ise = mean of e^2.
+
+exit status: 0 success, 2 bad input (one line on stderr saying what and why).
+"""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2, as every other bad input
+        raise DesignError(f"{message} (see identify-freq --help)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="identify-freq", description=__doc__.split("\n\n")[0].strip(),
+                epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("table", help="CSV table: frequency, gain[, phase]")
+    p.add_argument("--gain-units", choices=("db", "ratio"),
+                   help="gain in decibels or as the amplitude ratio Vout/Vin (default: from the "
+                        "header, else db)")
+    p.add_argument("--phase-units", choices=("deg", "rad", "s"),
+                   help="phase in degrees, radians, or the output's time shift in seconds "
+                        "(default: from the header, else deg)")
+    p.add_argument("--freq-units", choices=("hz", "rad/s"),
+                   help="frequency in Hz or rad/s (default: from the header, else hz)")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+    p.add_argument("--plot", metavar="OUT_PNG", help="write a Bode plot of the data and the fits")
+    return p
+
+
+def _fmt_params(p: dict) -> str:
+    out = []
+    for k, v in p.items():
+        if v is None or (isinstance(v, float) and not math.isfinite(v)):
+            out.append(f"{k} n/a")
+        elif k.endswith("_rad_s"):
+            out.append(f"{k[:-6]} {v:.4g} rad/s ({format_eng(v / (2 * math.pi), 'Hz')})")
+        elif k.endswith("_s"):
+            out.append(f"{k[:-2]} {format_eng(v, 's')}")
+        else:
+            out.append(f"{k} {v:.4g}")
+    return ", ".join(out)
+
+
+def _pct(v):
+    return "n/a" if v is None or not math.isfinite(v) else f"{100.0 * v:.3g} %"
+
+
+def to_text(result) -> str:
+    d = result.data
+    lines = [f"Table: {d.source or 'data'}: {d.w.size} points, "
+             f"{format_eng(d.f_hz[0], 'Hz')} to {format_eng(d.f_hz[-1], 'Hz')}, "
+             f"gain in {d.units['gain']}, "
+             + (f"phase in {d.units['phase']}" if d.phase is not None else "no phase")
+             + (" (inverting: K < 0)" if d.sign < 0 else ""), "",
+             "Methods ranked by fit error (mean |G_model/G_data - 1| over the table; "
+             "lower is better)"]
+    head = f"{'#':>2}  {'method':<15} {'model':<12} {'parameters':<78} {'error':>9}  ok"
+    lines += [head, "-" * len(head)]
+    for i, m in enumerate(result.methods, 1):
+        lines.append(f"{i:>2}  {m.name:<15} {m.model:<12} {_fmt_params(m.params):<78} "
+                     f"{_pct(m.iae):>9}  {'yes' if m.valid else 'NO'}")
+        if m.note:
+            lines.append(f"{'':>4}{m.note}")
+    lines.append("")
+    b = result.best
+    lines.append(f"Best: {b.name} ({b.model}): {_fmt_params(b.params)}" if b else
+                 "Best: none of the methods is valid for these data")
+    return "\n".join(lines)
+
+
+def plot_bode(result, path, n_models: int = 3) -> None:
+    """PNG Bode plot of the data and the best valid models (written atomically)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from .fileio import atomic_write
+    from .identify.frequency import model_phase, model_response
+
+    d = result.data
+    w = np.geomspace(d.w[0] / 2.0, d.w[-1] * 2.0, 400)
+    f = w / (2 * math.pi)
+    has_phase = d.phase is not None
+    fig, axes = plt.subplots(2 if has_phase else 1, 1, sharex=True,
+                             figsize=(8, 6 if has_phase else 4), dpi=110, squeeze=False)
+    ax_g = axes[0][0]
+    ax_g.semilogx(d.f_hz, d.gain_db, "o", color="k", ms=4, label="data")
+    shown = [m for m in result.methods if m.valid][:n_models]
+    for m in shown:
+        g = model_response(m.model, m.params, w)
+        label = f"{m.name} ({m.model}), error {100 * m.iae:.2g} %"
+        ax_g.semilogx(f, 20 * np.log10(np.abs(g)), lw=1.2, label=label)
+        if has_phase:
+            p = dict(m.params)
+            axes[1][0].semilogx(f, np.rad2deg(model_phase(m.model, p, w)), lw=1.2)
+    ax_g.set_ylabel("gain (dB)")
+    ax_g.set_title("Frequency response: data and identified models")
+    ax_g.grid(True, which="both", alpha=0.3)
+    ax_g.legend(fontsize=8, loc="lower left")
+    if has_phase:
+        ax_p = axes[1][0]
+        ax_p.semilogx(d.f_hz, np.rad2deg(d.phase), "o", color="k", ms=4)
+        ax_p.set_ylabel("phase (deg)")
+        ax_p.grid(True, which="both", alpha=0.3)
+    axes[-1][0].set_xlabel("frequency (Hz)")
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png")
+    plt.close(fig)
+    atomic_write(path, buf.getvalue())
+
+
+def _finite(o):
+    """NaN/inf -> None and numpy scalars -> Python numbers, everywhere (JSON has no NaN)."""
+    if isinstance(o, dict):
+        return {k: _finite(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_finite(v) for v in o]
+    if hasattr(o, "item") and not isinstance(o, (str, bytes)):
+        o = o.item()
+    if isinstance(o, float) and not math.isfinite(o):
+        return None
+    return o
+
+
+def run(argv=None):
+    """Parse arguments, identify, write the plot; return (args, result)."""
+    args = build_parser().parse_args(argv)
+    from .identify.frequency import identify_freq, read_freq_table
+    data = read_freq_table(args.table, gain_units=args.gain_units,
+                           phase_units=args.phase_units, freq_units=args.freq_units)
+    result = identify_freq(data)
+    if args.plot:
+        plot_bode(result, args.plot)
+    return args, result
+
+
+def identify_freq_main(argv=None) -> int:
+    """Console entry point ``identify-freq``."""
+    try:
+        args, result = run(argv)
+    except DesignError as exc:
+        print(f"identify-freq: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:  # pragma: no cover
+        print("identify-freq: interrupted", file=sys.stderr)
+        return 130
+    try:
+        if args.json:
+            print(json.dumps(_finite(result.to_dict()), indent=2, allow_nan=False))
+        else:
+            print(to_text(result))
+            if args.plot:
+                print(f"\nPlot written to {args.plot}")
+        sys.stdout.flush()
+    except BrokenPipeError:  # e.g. piped into head: not an error of ours
+        sys.stdout = None
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(identify_freq_main())

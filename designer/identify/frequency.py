@@ -1,0 +1,706 @@
+"""Identification from a measured frequency response (seed 000 section 5, seed 003 section 3.1).
+
+Input is a table of frequency, gain (dB or amplitude ratio) and optionally
+phase (degrees, radians, or the time shift of the output behind the input, as
+seed 000 Table IV measures it: phase = -360 f dt degrees).
+
+Methods (all return :class:`~designer.identify.core.MethodResult`):
+
+``asymptotes``     low-frequency gain K, the high-frequency slope -20 n dB/decade
+                   (order n), and the corner where the gain has fallen by
+                   3 n dB (seed 000 examples 1-3 and 6; seed 003 Table 3.1):
+                   n = 1 -> ``fopdt`` tau = 1/wc; n = 2 -> ``double-pole``
+                   tau = 1/wc (zeta = 1, the seed's reading of Table IV).
+``resonant-peak``  zeta from the peak height -10 log(4 zeta^2 (1 - zeta^2)) at
+                   wn sqrt(1 - 2 zeta^2) (seed 000 eq 79) -> ``underdamped``;
+                   the seed's quicker -20 log(2 zeta)-at-wn reading (eq 75)
+                   is in ``points``.
+``least-squares``  complex-response fits of ``fopdt``, ``underdamped`` and
+                   ``overdamped`` with dead time (scipy least_squares on the log
+                   of G_model/G_data: gain error in nepers, phase error in
+                   radians), started from the classical estimates, with 95 %
+                   confidence half-widths in ``points`` (``<param>_ci95``).
+
+Every method with phase data also reads a dead time from the phase: the
+median over the points above a tenth of the corner of
+(phase_model_without_delay - phase_data)/w (seed 000 example 2), never
+negative.
+
+Fit error. The step methods' ``iae``/``ise`` (integrals over time) have no
+meaning here; in their place, with e_k = |G_model(j w_k)/G_data(j w_k) - 1|
+the relative complex error at each tabulated frequency (gain only when the
+table has no phase),
+
+- ``iae`` = mean over the points of e_k (dimensionless; 0.01 = 1 %),
+- ``ise`` = mean over the points of e_k^2.
+
+Results are ranked by that ``iae`` (valid first), as ``identify`` ranks by IAE.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DesignError
+from .core import MethodResult
+
+ERROR_DEFINITION = ("iae = mean over the table's frequencies of |G_model/G_data - 1| "
+                    "(relative complex error; gain only when there is no phase), "
+                    "ise = mean of its square; dimensionless")
+
+GAIN_UNITS = ("db", "ratio")
+PHASE_UNITS = ("deg", "rad", "s")
+FREQ_UNITS = ("hz", "rad/s")
+MIN_POINTS = 5
+
+PARAMS = {
+    "fopdt": ("K", "tau_s", "theta_s"),
+    "double-pole": ("K", "tau_s", "theta_s"),
+    "underdamped": ("K", "wn_rad_s", "zeta", "theta_s"),
+    "overdamped": ("K", "tau1_s", "tau2_s", "theta_s"),
+}
+
+
+# --------------------------------------------------------------------------
+# data
+# --------------------------------------------------------------------------
+
+@dataclass
+class FreqData:
+    """A validated frequency-response table.
+
+    ``w`` in rad/s (increasing, > 0), ``gain`` as an amplitude ratio (> 0),
+    ``phase`` in radians, unwrapped, 0 at DC for a non-inverting plant (or
+    None when the table has no phase). ``sign`` is -1 when the low-frequency
+    phase is near +-180 degrees (an inverting plant; the phase is then stored
+    without that 180 degrees).
+    """
+
+    w: np.ndarray
+    gain: np.ndarray
+    phase: np.ndarray | None = None
+    sign: float = 1.0
+    source: str = ""
+    units: dict = field(default_factory=dict)
+
+    @property
+    def f_hz(self) -> np.ndarray:
+        return self.w / (2.0 * math.pi)
+
+    @property
+    def gain_db(self) -> np.ndarray:
+        return 20.0 * np.log10(self.gain)
+
+    def response(self) -> np.ndarray:
+        """Complex G(j w) of the data (magnitude only, phase 0, if no phase)."""
+        ph = self.phase if self.phase is not None else np.zeros_like(self.w)
+        return self.gain * np.exp(1j * ph)
+
+    def to_dict(self) -> dict:
+        return {"source": self.source, "points": int(self.w.size),
+                "f_min_hz": float(self.f_hz[0]), "f_max_hz": float(self.f_hz[-1]),
+                "has_phase": self.phase is not None, "inverting": self.sign < 0,
+                "units": dict(self.units)}
+
+
+def freq_data(freq, gain, phase=None, *, gain_units="db", phase_units="deg",
+              freq_units="hz", source="") -> FreqData:
+    """Validate and convert a table (arrays) into :class:`FreqData`.
+
+    Raises
+    ------
+    DesignError
+        Too few points, non-finite values, frequency not strictly increasing
+        or not positive, non-positive amplitude ratio, unknown units.
+    """
+    if gain_units not in GAIN_UNITS:
+        raise DesignError(f"gain units {gain_units!r} unknown; allowed: {', '.join(GAIN_UNITS)}")
+    if phase_units not in PHASE_UNITS:
+        raise DesignError(f"phase units {phase_units!r} unknown; allowed: {', '.join(PHASE_UNITS)}")
+    if freq_units not in FREQ_UNITS:
+        raise DesignError(f"frequency units {freq_units!r} unknown; allowed: {', '.join(FREQ_UNITS)}")
+    f = np.asarray(freq, float)
+    g = np.asarray(gain, float)
+    if f.ndim != 1 or g.shape != f.shape:
+        raise DesignError("frequency and gain must be columns of the same length")
+    if f.size < MIN_POINTS:
+        raise DesignError(f"too few points: {f.size}; at least {MIN_POINTS} frequencies are "
+                          "needed to fit a model")
+    for name, arr in (("frequency", f), ("gain", g)):
+        if not np.all(np.isfinite(arr)):
+            k = int(np.argmin(np.isfinite(arr)))
+            raise DesignError(f"{name} at row {k + 1} is not a finite number ({arr[k]})")
+    if np.any(f <= 0):
+        k = int(np.argmax(f <= 0))
+        raise DesignError(f"frequency at row {k + 1} is {f[k]:g}: frequencies must be positive")
+    bad = np.nonzero(np.diff(f) <= 0)[0]
+    if bad.size:
+        k = int(bad[0])
+        raise DesignError(f"frequency not increasing at row {k + 2} ({f[k + 1]:g} after {f[k]:g}); "
+                          "sort the table and remove repeated frequencies")
+    w = f if freq_units == "rad/s" else 2.0 * math.pi * f
+    if gain_units == "ratio":
+        if np.any(g <= 0):
+            k = int(np.argmax(g <= 0))
+            raise DesignError(f"gain at row {k + 1} is {g[k]:g}: an amplitude ratio must be "
+                              "positive (use --gain-units db for decibels)")
+        ratio = g
+    else:
+        ratio = 10.0 ** (g / 20.0)
+    ph = None
+    sign = 1.0
+    if phase is not None:
+        p = np.asarray(phase, float)
+        if p.shape != f.shape:
+            raise DesignError("phase column must have as many rows as frequency")
+        if not np.all(np.isfinite(p)):
+            k = int(np.argmin(np.isfinite(p)))
+            raise DesignError(f"phase at row {k + 1} is not a finite number ({p[k]})")
+        if phase_units == "deg":
+            ph = np.deg2rad(p)
+        elif phase_units == "rad":
+            ph = p.copy()
+        else:
+            # a positive time shift is the output lagging the input: -w dt
+            ph = -w * p
+        ph = np.unwrap(ph)
+        ph -= 2.0 * math.pi * round(ph[0] / (2.0 * math.pi))
+        if abs(ph[0]) > math.pi / 2.0:
+            sign = -1.0
+            ph -= math.copysign(math.pi, ph[0])
+    return FreqData(w, ratio, ph, sign, source,
+                    {"frequency": freq_units, "gain": gain_units,
+                     "phase": phase_units if phase is not None else None})
+
+
+_NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
+
+
+def _tokens(name: str) -> set:
+    return set(re.split(r"[^a-z0-9/µμ°]+", name.lower().replace("µ", "u").replace("μ", "u"))) - {""}
+
+
+def _hint(name: str, kind: str):
+    """Units named in a header cell, or None."""
+    tk = _tokens(name)
+    low = name.lower()
+    if kind == "frequency":
+        if tk & {"rad/s", "rad_s", "rads", "w", "omega"} or "rad/s" in low:
+            return "rad/s", 1.0
+        if "khz" in tk:
+            return "hz", 1e3
+        if "mhz" in tk:
+            return "hz", 1e6
+        if "hz" in tk or "f" in tk:
+            return "hz", 1.0
+    elif kind == "gain":
+        if "db" in tk:
+            return "db", 1.0
+        if tk & {"ratio", "v/v", "abs", "mag"}:
+            return "ratio", 1.0
+    elif kind == "phase":
+        if tk & {"deg", "degrees", "°"} or "°" in low:
+            return "deg", 1.0
+        if tk & {"rad", "radians"}:
+            return "rad", 1.0
+        if "us" in tk:
+            return "s", 1e-6
+        if "ms" in tk:
+            return "s", 1e-3
+        if tk & {"s", "shift", "dt", "delay"}:
+            return "s", 1.0
+    return None
+
+
+def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units=None,
+                     source="") -> FreqData:
+    """Parse CSV text: ``frequency, gain[, phase]`` per row.
+
+    Comma, semicolon (with decimal commas), tab or space separated; ``#``
+    comment lines and blank lines ignored; one optional header row whose names
+    may give units (``f_hz``, ``f_khz``, ``w_rad_s``, ``gain_db``,
+    ``gain_ratio``, ``phase_deg``, ``phase_rad``, ``shift_us``...). Units given
+    as arguments win over the header; the defaults are Hz, dB and degrees.
+    """
+    lines = [(i + 1, ln.strip()) for i, ln in enumerate(text.splitlines())]
+    lines = [(i, ln) for i, ln in lines if ln and not ln.startswith("#")]
+    if not lines:
+        raise DesignError(f"{source or 'table'} is empty: expected rows of frequency, gain[, phase]")
+    first = lines[0][1]
+    if ";" in first:
+        sep, decimal_comma = ";", True
+    elif "," in first:
+        sep, decimal_comma = ",", False
+    elif "\t" in first:
+        sep, decimal_comma = "\t", False
+    else:
+        sep, decimal_comma = None, False
+
+    def cells(ln):
+        parts = ln.split(sep) if sep else ln.split()
+        parts = [c.strip().strip('"').strip("'") for c in parts]
+        if decimal_comma:
+            parts = [c.replace(",", ".") for c in parts]
+        while parts and parts[-1] == "":
+            parts.pop()
+        return parts
+
+    header = None
+    c0 = cells(first)
+    if not all(_NUM.match(c) or c.lower() in ("nan", "inf", "-inf") for c in c0):
+        header = c0
+        lines = lines[1:]
+    if not lines:
+        raise DesignError(f"{source or 'table'} has a header but no data rows")
+    rows = []
+    ncol = None
+    for lineno, ln in lines:
+        cs = cells(ln)
+        if ncol is None:
+            ncol = len(cs)
+            if ncol not in (2, 3):
+                raise DesignError(f"line {lineno}: {ncol} columns; expected 2 or 3 "
+                                  "(frequency, gain[, phase])")
+        if len(cs) != ncol:
+            raise DesignError(f"line {lineno}: {len(cs)} columns where the table has {ncol}")
+        vals = []
+        for c in cs:
+            if c.lower() in ("nan", "inf", "-inf", "+inf"):
+                raise DesignError(f"line {lineno}: {c!r} is not a finite number")
+            if not _NUM.match(c):
+                raise DesignError(f"line {lineno}: {c!r} is not a number (plain decimal or "
+                                  "1e3 notation)")
+            vals.append(float(c))
+        rows.append(vals)
+    arr = np.array(rows, float)
+    names = header if header and len(header) == ncol else [""] * ncol
+    kinds = ("frequency", "gain", "phase")
+    units, scale = {}, {}
+    given = {"frequency": freq_units, "gain": gain_units, "phase": phase_units}
+    default = {"frequency": "hz", "gain": "db", "phase": "deg"}
+    for k, name in zip(kinds, names):
+        h = _hint(name, k) if name else None
+        if given[k] is not None:
+            units[k], scale[k] = given[k], 1.0
+            if h and h[0] == given[k]:
+                scale[k] = h[1]        # e.g. a "shift_us" column with --phase-units s
+        elif h:
+            units[k], scale[k] = h
+        else:
+            units[k], scale[k] = default[k], 1.0
+    f = arr[:, 0] * scale["frequency"]
+    g = arr[:, 1] * scale["gain"]
+    p = arr[:, 2] * scale["phase"] if ncol == 3 else None
+    return freq_data(f, g, p, gain_units=units["gain"], phase_units=units.get("phase", "deg"),
+                     freq_units=units["frequency"], source=source)
+
+
+def read_freq_table(path, **units) -> FreqData:
+    """Read a frequency-response CSV file (see :func:`parse_freq_table`)."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise DesignError(f"{str(p)!r} not found") from None
+    except IsADirectoryError:
+        raise DesignError(f"{str(p)!r} is a directory, not a table") from None
+    except UnicodeDecodeError:
+        raise DesignError(f"{str(p)!r} is not a text (UTF-8) file") from None
+    except OSError as exc:
+        raise DesignError(f"cannot read {str(p)!r}: {exc.strerror or exc}") from None
+    return parse_freq_table(text, source=str(p), **units)
+
+
+# --------------------------------------------------------------------------
+# model responses
+# --------------------------------------------------------------------------
+
+def model_response(model: str, params: dict, w) -> np.ndarray:
+    """Complex G(j w) of ``model`` (same parameters as core.model_step)."""
+    w = np.asarray(w, float)
+    s = 1j * w
+    K = params["K"]
+    delay = np.exp(-s * (params.get("theta_s", 0.0) or 0.0))
+    if model == "fopdt":
+        g = 1.0 / (1.0 + s * params["tau_s"])
+    elif model == "double-pole":
+        g = 1.0 / (1.0 + s * params["tau_s"]) ** 2
+    elif model == "underdamped":
+        wn, z = params["wn_rad_s"], params["zeta"]
+        g = wn * wn / (wn * wn + 2.0 * z * wn * s + s * s)
+    elif model == "overdamped":
+        g = 1.0 / ((1.0 + s * params["tau1_s"]) * (1.0 + s * params["tau2_s"]))
+    else:
+        raise ValueError(f"unknown model {model!r}")
+    return K * g * delay
+
+
+def model_phase(model: str, params: dict, w, with_delay: bool = True) -> np.ndarray:
+    """Continuous (unwrapped) phase in radians of ``model`` for K > 0."""
+    w = np.asarray(w, float)
+    if model == "fopdt":
+        ph = -np.arctan(w * params["tau_s"])
+    elif model == "double-pole":
+        ph = -2.0 * np.arctan(w * params["tau_s"])
+    elif model == "underdamped":
+        wn, z = params["wn_rad_s"], params["zeta"]
+        ph = -np.arctan2(2.0 * z * wn * w, wn * wn - w * w)
+    elif model == "overdamped":
+        ph = -np.arctan(w * params["tau1_s"]) - np.arctan(w * params["tau2_s"])
+    else:
+        raise ValueError(f"unknown model {model!r}")
+    if with_delay:
+        ph = ph - w * (params.get("theta_s", 0.0) or 0.0)
+    return ph
+
+
+def fit_error(model: str, params: dict, data: FreqData) -> tuple[float, float]:
+    """(iae, ise) replacement: mean of e and of e^2, e = |G_model/G_data - 1|."""
+    p = dict(params)
+    p["K"] = abs(p["K"])
+    if data.phase is not None:
+        gm = np.abs(model_response(model, p, data.w))
+        ratio = gm / data.gain * np.exp(1j * (model_phase(model, p, data.w) - data.phase))
+        e = np.abs(ratio - 1.0)
+    else:
+        e = np.abs(np.abs(model_response(model, p, data.w)) / data.gain - 1.0)
+    return float(np.mean(e)), float(np.mean(e * e))
+
+
+def dead_time_from_phase(w, phase_data, phase_model, w_min: float = 0.0) -> float:
+    """Dead time from the phase lag the model (without delay) does not explain:
+    median of (phase_model - phase_data)/w over ``w >= w_min``, clipped at 0."""
+    w = np.asarray(w, float)
+    sel = w >= w_min
+    if not sel.any():
+        return 0.0
+    th = (np.asarray(phase_model)[sel] - np.asarray(phase_data)[sel]) / w[sel]
+    return max(0.0, float(np.median(th)))
+
+
+# --------------------------------------------------------------------------
+# classical readings
+# --------------------------------------------------------------------------
+
+def _interp_logf(w, y, level):
+    """First w (interpolated in log w) where the decreasing y falls to ``level``."""
+    below = np.nonzero(y <= level)[0]
+    if below.size == 0:
+        return math.nan
+    i = int(below[0])
+    if i == 0:
+        return float(w[0])
+    y0, y1 = y[i - 1], y[i]
+    frac = 0.0 if y1 == y0 else (level - y0) / (y1 - y0)
+    return float(10.0 ** (math.log10(w[i - 1]) + frac * (math.log10(w[i]) - math.log10(w[i - 1]))))
+
+
+def low_frequency_gain(data: FreqData, tol_db: float = 0.25) -> tuple[float, int]:
+    """K (amplitude ratio) from the flat low-frequency run: the mean dB of the
+    first points within ``tol_db`` of the first one. Returns (K, points used)."""
+    db = data.gain_db
+    run = 1
+    while run < db.size and abs(db[run] - db[0]) <= tol_db:
+        run += 1
+    return float(10.0 ** (np.mean(db[:run]) / 20.0)), run
+
+
+def high_frequency_slope(data: FreqData, k_db: float, drop_db: float = 10.0):
+    """Slope in dB/decade of the high-frequency asymptote: a line through the
+    points at least ``drop_db`` below K (at least the last two points)."""
+    db = data.gain_db
+    lw = np.log10(data.w)
+    sel = np.nonzero(db <= k_db - drop_db)[0]
+    if sel.size < 2:
+        sel = np.arange(db.size - 2, db.size)
+    slope = float(np.polyfit(lw[sel], db[sel], 1)[0])
+    return slope, sel
+
+
+def _with_delay(name, model, params, data, w_corner, points, note=""):
+    """Add the dead time read from the phase, and the fit error."""
+    if data.phase is not None:
+        ph0 = model_phase(model, params, data.w, with_delay=False)
+        params["theta_s"] = dead_time_from_phase(data.w, data.phase, ph0, 0.1 * w_corner)
+    else:
+        params["theta_s"] = 0.0
+        note = "; ".join(s for s in (note, "no phase in the table: dead time not identified") if s)
+    params["K"] = data.sign * abs(params["K"])
+    iae, ise = fit_error(model, params, data)
+    return MethodResult(name, model, params, iae, ise, True, note, points)
+
+
+def _invalid(name, model, note, points=None):
+    return MethodResult(name, model, {k: math.nan for k in PARAMS[model]}, valid=False,
+                        note=note, points=points or {})
+
+
+def asymptotes(data: FreqData) -> MethodResult:
+    """Asymptote reading (seed 000 examples 1-3, 6; seed 003 Table 3.1).
+
+    K from the flat low-frequency gain, order n from the high-frequency slope
+    (-20 n dB/decade, rounded), corner wc where the gain has fallen 3 n dB
+    below K (the seed's rule: the asymptotes meet there for n equal real
+    poles). n = 1: fopdt with tau = 1/wc; n = 2: double pole tau = 1/wc
+    (zeta = 1). The intersection of the fitted high-frequency line with K
+    is reported in ``points`` as ``w_intersection_rad_s``.
+    """
+    name = "asymptotes"
+    K, run = low_frequency_gain(data)
+    k_db = 20.0 * math.log10(K)
+    slope, sel = high_frequency_slope(data, k_db)
+    n = int(round(-slope / 20.0))
+    pts = {"K_points": run, "hf_slope_db_dec": slope, "order": n}
+    if n < 1:
+        return _invalid(name, "fopdt", f"the gain does not roll off (high-frequency slope "
+                        f"{slope:.1f} dB/decade): no low-pass model to read", pts)
+    wc = _interp_logf(data.w, data.gain_db, k_db - 3.0 * n)
+    # where the -20 n dB/decade line through the high-frequency points meets K
+    b = float(np.mean(data.gain_db[sel] + 20.0 * n * np.log10(data.w[sel])))
+    pts["w_intersection_rad_s"] = 10.0 ** ((b - k_db) / (20.0 * n))
+    if not math.isfinite(wc):
+        return _invalid(name, "fopdt" if n == 1 else "double-pole",
+                        f"the gain never falls {3 * n} dB below K in the table: "
+                        "extend it to higher frequencies", pts)
+    pts["wc_rad_s"] = wc
+    pts["fc_hz"] = wc / (2.0 * math.pi)
+    if n > 2:
+        return _invalid(name, "double-pole", f"high-frequency slope {slope:.0f} dB/decade means "
+                        f"order {n}; the models here have at most two poles (the seed's "
+                        f"({n}-pole) reading: {n} poles at {wc:.4g} rad/s)", pts)
+    model = "fopdt" if n == 1 else "double-pole"
+    return _with_delay(name, model, {"K": K, "tau_s": 1.0 / wc, "theta_s": 0.0}, data, wc, pts,
+                       "" if n == 1 else "two equal poles (zeta = 1)")
+
+
+def zeta_from_peak(mr_db: float) -> float:
+    """Damping ratio from the resonant peak height above K in dB (seed 000 eq 79),
+    the root below 1/sqrt(2); nan if ``mr_db`` <= 0."""
+    if not mr_db > 0.0:
+        return math.nan
+    q = 10.0 ** (-mr_db / 10.0)            # = 4 zeta^2 (1 - zeta^2)
+    return math.sqrt((1.0 - math.sqrt(max(0.0, 1.0 - q))) / 2.0)
+
+
+def peak_gain_db(zeta: float) -> float:
+    """Seed 000 eq 79: -10 log(4 zeta^2 (1 - zeta^2)), for zeta < 1/sqrt(2)."""
+    return -10.0 * math.log10(4.0 * zeta * zeta * (1.0 - zeta * zeta))
+
+
+def resonant_peak(data: FreqData, min_db: float = 0.1) -> MethodResult:
+    """Resonant-peak damping (seed 000 example 5, eqs 75 and 79).
+
+    The peak (a parabola in log w through the highest point and its
+    neighbours) gives Mr = peak - K in dB; zeta solves
+    -10 log(4 zeta^2 (1 - zeta^2)) = Mr and wn = w_peak / sqrt(1 - 2 zeta^2).
+    Valid when the table shows a peak at least ``min_db`` above K between its
+    first and last points (zeta < 0.707).
+    """
+    name, model = "resonant-peak", "underdamped"
+    K, _ = low_frequency_gain(data)
+    k_db = 20.0 * math.log10(K)
+    db = data.gain_db
+    i = int(np.argmax(db))
+    if db[i] - k_db < min_db or i == 0 or i == db.size - 1:
+        return _invalid(name, model, f"no resonant peak {min_db} dB above the low-frequency gain "
+                        "inside the table: zeta >= 0.707 or the peak was not measured")
+    x = np.log10(data.w[i - 1:i + 2])
+    a, b, c = np.polyfit(x - x[1], db[i - 1:i + 2], 2)
+    if a < 0:
+        xv = -b / (2.0 * a)
+        peak_db, w_peak = c - b * b / (4.0 * a), 10.0 ** (x[1] + xv)
+    else:
+        peak_db, w_peak = float(db[i]), float(data.w[i])
+    mr = peak_db - k_db
+    zeta = zeta_from_peak(mr)
+    wn = w_peak / math.sqrt(1.0 - 2.0 * zeta * zeta)
+    pts = {"w_peak_rad_s": w_peak, "peak_db": peak_db, "mr_db": mr,
+           "zeta_at_wn_eq75": 10.0 ** (-mr / 20.0) / 2.0}
+    return _with_delay(name, model, {"K": K, "wn_rad_s": wn, "zeta": zeta, "theta_s": 0.0},
+                       data, wn, pts)
+
+
+# --------------------------------------------------------------------------
+# least squares
+# --------------------------------------------------------------------------
+
+def _x_to_params(model, x, fit_delay):
+    th = x[-1] if fit_delay else 0.0
+    if model == "fopdt":
+        return {"K": math.exp(x[0]), "tau_s": math.exp(x[1]), "theta_s": th}
+    if model == "underdamped":
+        return {"K": math.exp(x[0]), "wn_rad_s": math.exp(x[1]), "zeta": x[2], "theta_s": th}
+    return {"K": math.exp(x[0]), "tau1_s": math.exp(x[1]), "tau2_s": math.exp(x[2]), "theta_s": th}
+
+
+def _params_to_x(model, p, fit_delay):
+    K = abs(p["K"])
+    if model == "fopdt":
+        x = [math.log(K), math.log(p["tau_s"])]
+    elif model == "underdamped":
+        x = [math.log(K), math.log(p["wn_rad_s"]), min(max(p["zeta"], 0.011), 0.989)]
+    else:
+        x = [math.log(K), math.log(p["tau1_s"]), math.log(p["tau2_s"])]
+    if fit_delay:
+        x.append(max(p.get("theta_s", 0.0) or 0.0, 0.0))
+    return np.array(x, float)
+
+
+def _residual(model, data, fit_delay):
+    lg = np.log(data.gain)
+    ph = data.phase
+
+    def fun(x):
+        p = _x_to_params(model, x, fit_delay)
+        gm = np.log(np.abs(model_response(model, p, data.w)))
+        r = gm - lg
+        if ph is None:
+            return r
+        return np.concatenate((r, model_phase(model, p, data.w) - ph))
+    return fun
+
+
+def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
+    """Fit ``model`` to the complex response from each of ``starts`` (parameter
+    dicts) and keep the lowest cost; 95 % half-widths from the Jacobian."""
+    from scipy.optimize import least_squares
+    from scipy.stats import t as student_t
+
+    name = "least-squares"
+    fit_delay = data.phase is not None
+    fun = _residual(model, data, fit_delay)
+    lo = {"fopdt": [-np.inf, -np.inf], "underdamped": [-np.inf, -np.inf, 0.01],
+          "overdamped": [-np.inf, -np.inf, -np.inf]}[model]
+    hi = {"fopdt": [np.inf, np.inf], "underdamped": [np.inf, np.inf, 0.99],
+          "overdamped": [np.inf, np.inf, np.inf]}[model]
+    if fit_delay:
+        lo, hi = lo + [0.0], hi + [np.inf]
+    best = None
+    for p0 in starts:
+        try:
+            x0 = np.clip(_params_to_x(model, p0, fit_delay), np.array(lo) + 1e-12,
+                         np.array(hi) - 1e-12)
+            sol = least_squares(fun, x0, bounds=(lo, hi), method="trf", x_scale="jac",
+                                max_nfev=400)
+        except (ValueError, OverflowError, ZeroDivisionError, KeyError):
+            continue
+        if np.all(np.isfinite(sol.x)) and (best is None or sol.cost < best.cost):
+            best = sol
+    if best is None:
+        return _invalid(name, model, "the fit did not converge from any starting point")
+    params = _x_to_params(model, best.x, fit_delay)
+    pts = {}
+    m, n = best.fun.size, best.x.size
+    note = "" if fit_delay else "no phase in the table: fitted the gain only, dead time not identified"
+    if m > n:
+        s2 = 2.0 * best.cost / (m - n)
+        try:
+            cov = np.linalg.inv(best.jac.T @ best.jac) * s2
+            half = student_t.ppf(0.975, m - n) * np.sqrt(np.clip(np.diag(cov), 0.0, None))
+            # back from log variables: d(e^x) = e^x dx
+            names = {"fopdt": ["K", "tau_s"], "underdamped": ["K", "wn_rad_s", "zeta"],
+                     "overdamped": ["K", "tau1_s", "tau2_s"]}[model] + (["theta_s"] if fit_delay else [])
+            for k, h, xv in zip(names, half, best.x):
+                scale = abs(params[k]) if k not in ("zeta", "theta_s") else 1.0
+                if model == "overdamped" and k in ("tau1_s", "tau2_s"):
+                    scale = math.exp(xv)
+                pts[f"{k}_ci95"] = float(h * scale)
+        except np.linalg.LinAlgError:
+            note = "; ".join(s for s in (note, "singular Jacobian: no confidence intervals") if s)
+    if model == "overdamped" and params["tau1_s"] > params["tau2_s"]:
+        params["tau1_s"], params["tau2_s"] = params["tau2_s"], params["tau1_s"]
+        if "tau1_s_ci95" in pts:
+            pts["tau1_s_ci95"], pts["tau2_s_ci95"] = pts["tau2_s_ci95"], pts["tau1_s_ci95"]
+    params["K"] = data.sign * params["K"]
+    iae, ise = fit_error(model, params, data)
+    valid = True
+    if model == "overdamped" and params["tau1_s"] < 1e-3 * params["tau2_s"]:
+        note = "; ".join(s for s in (note, "tau1 << tau2: the data show one pole (see the fopdt fit)")
+                         if s)
+    if model == "underdamped" and params["zeta"] >= 0.98:
+        note = "; ".join(s for s in (note, "zeta at its bound 0.99: the data are not underdamped "
+                                     "(see the overdamped fit)") if s)
+        valid = False
+    return MethodResult(name, model, params, iae, ise, valid, note, pts)
+
+
+def _starts(model, classical, K, wc):
+    """Starting points: the classical results of compatible models, then a small grid."""
+    out = []
+    for m in classical:
+        if not m.valid:
+            continue
+        p = m.params
+        try:
+            if model == "fopdt":
+                tau = p.get("tau_s") or (1.0 / p["wn_rad_s"] if "wn_rad_s" in p else p["tau2_s"])
+                out.append({"K": K, "tau_s": tau, "theta_s": p["theta_s"]})
+            elif model == "underdamped":
+                if m.model == "underdamped":
+                    out.append(dict(p))
+                else:
+                    tau = p.get("tau_s") or math.sqrt(p["tau1_s"] * p["tau2_s"])
+                    out.append({"K": K, "wn_rad_s": 1.0 / tau, "zeta": 0.9, "theta_s": p["theta_s"]})
+            else:
+                if m.model == "overdamped":
+                    out.append(dict(p))
+                elif m.model == "double-pole":
+                    out.append({"K": K, "tau1_s": 0.8 * p["tau_s"], "tau2_s": 1.25 * p["tau_s"],
+                                "theta_s": p["theta_s"]})
+                elif m.model == "fopdt":
+                    out.append({"K": K, "tau1_s": 0.1 * p["tau_s"], "tau2_s": p["tau_s"],
+                                "theta_s": p["theta_s"]})
+        except (KeyError, TypeError, ZeroDivisionError):
+            continue
+    if math.isfinite(wc) and wc > 0:
+        if model == "fopdt":
+            out.append({"K": K, "tau_s": 1.0 / wc, "theta_s": 0.0})
+        elif model == "underdamped":
+            out += [{"K": K, "wn_rad_s": wc, "zeta": z, "theta_s": 0.0} for z in (0.15, 0.4, 0.7)]
+        else:
+            out += [{"K": K, "tau1_s": r / wc, "tau2_s": 1.0 / (r * wc), "theta_s": 0.0}
+                    for r in (0.9, 0.3, 0.05)]
+    return out
+
+
+# --------------------------------------------------------------------------
+# orchestration
+# --------------------------------------------------------------------------
+
+@dataclass
+class FreqIdentifyResult:
+    """Every method's result, ranked by fit error (valid first), and the best."""
+
+    methods: list
+    best: MethodResult | None
+    data: FreqData
+
+    def to_dict(self) -> dict:
+        return {"methods": [m.to_dict() for m in self.methods],
+                "best": self.best.to_dict() if self.best else None,
+                "data": self.data.to_dict(),
+                "error_definition": ERROR_DEFINITION}
+
+
+def _rank_key(m):
+    iae = m.iae if m.iae is not None and math.isfinite(m.iae) else math.inf
+    return (not m.valid, iae)
+
+
+def identify_freq(data: FreqData) -> FreqIdentifyResult:
+    """Run the classical readings and the least-squares fits; rank by fit error."""
+    classical = [asymptotes(data), resonant_peak(data)]
+    K, _ = low_frequency_gain(data)
+    wc = _interp_logf(data.w, data.gain_db, 20.0 * math.log10(K) - 3.0)
+    if not math.isfinite(wc):
+        wc = float(data.w[-1])
+    fits = [least_squares_fit(data, model, _starts(model, classical, K, wc))
+            for model in ("fopdt", "underdamped", "overdamped")]
+    methods = sorted(classical + fits, key=_rank_key)
+    best = next((m for m in methods if m.valid and math.isfinite(m.iae)), None)
+    return FreqIdentifyResult(methods, best, data)
