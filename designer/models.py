@@ -74,8 +74,22 @@ def response_span(fn_hz: float, zeta: float) -> float:
 
 
 def step_response(num, den, t):
-    """Response to a unit step applied at t = 0, evaluated at ``t`` (t[0] must be 0)."""
+    """Response to a unit step applied at t = 0, evaluated at ``t``.
+
+    Closed form from the partial-fraction expansion, y(t) = H(0) + sum r_i/p_i e^(p_i t),
+    which is exact and vectorised (scipy's lsim steps through the grid in a loop);
+    repeated or zero poles fall back to scipy.signal.step.
+    """
     t = np.asarray(t, float)
+    num = np.atleast_1d(np.asarray(num, float))
+    den = np.atleast_1d(np.asarray(den, float))
+    if len(num) < len(den):
+        r, p, _ = signal.residue(num, den)
+        close = np.abs(p[:, None] - p[None, :]) <= 1e-6 * np.abs(p)[:, None]
+        np.fill_diagonal(close, False)
+        if np.all(np.abs(p) > 0) and not np.any(close):
+            h0 = num[-1] / den[-1]
+            return np.real(h0 + np.exp(np.outer(t, p)) @ (r / p))
     _, y = signal.step((num, den), T=t)
     return y
 
