@@ -232,10 +232,8 @@ def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspi
     ranked = _distinct(ranked, k)[:top]
     best = ranked[0]
     built = SallenKeyParts(best.r1, best.r2, best.c1, best.c2, k, r3, r4)
-    worst = best.worst if not spec.compensate_gbw else None
-    if worst is not None and worst > 0.05:
-        notes.append(f"the best {spec.r_series}/{spec.c_series} combination within the bounds is "
-                     f"{100 * worst:.3g} % off; widen the bounds or use a finer series")
+    if best.worst > MAX_ERROR:
+        raise DesignError(_unreachable(spec, fc_t, best.worst))
     t_search = time.perf_counter() - tick
     result = _analyse(built, ideal, amp, spec.r_series, spec.c_series,
                       {"fc_hz": spec.fc_hz, "zeta": spec.zeta, "gain": spec.gain},
@@ -265,6 +263,27 @@ def analyze_plant(parts: SallenKeyParts, opamp: str = "LM741", target_fc=None, t
                    simulate, simulator)
     res.mode = "analyze"
     return res
+
+
+#: a design further off than this is refused, with the reason
+MAX_ERROR = 0.05
+
+
+def _unreachable(spec: PlantSpec, fc: float, worst: float) -> str:
+    """Why no combination within the bounds comes close, and what to change."""
+    head = (f"no {spec.r_series}/{spec.c_series} combination within the bounds comes within "
+            f"{100 * MAX_ERROR:g} % of the target (best: {100 * worst:.3g} % off)")
+    rc = 1.0 / (2 * math.pi * fc)
+    if rc < spec.r_min * spec.c_min:
+        return (f"{head}: fc {fc:.4g} Hz needs R*C near {rc:.3g} s but the bounds allow no less than "
+                f"{spec.r_min * spec.c_min:.3g} s; lower --r-min or --c-min")
+    if rc > spec.r_max * spec.c_max:
+        return (f"{head}: fc {fc:.4g} Hz needs R*C near {rc:.3g} s but the bounds allow no more than "
+                f"{spec.r_max * spec.c_max:.3g} s; raise --r-max or --c-max")
+    if spec.gain == 1.0 and 1 / spec.zeta ** 2 > spec.c_max / spec.c_min:
+        return (f"{head}: unity gain needs C2/C1 >= 1/zeta^2 = {1 / spec.zeta ** 2:.4g}; "
+                f"use --gain K > 1 or widen --c-min/--c-max")
+    return f"{head}; widen the bounds or use a finer series (--r-series/--c-series)"
 
 
 def _alt(c, fc, zeta):

@@ -67,6 +67,7 @@ def test_summary_has_units(tmp_path):
     (["--fc", "3500", "--zeta", "0.2", "--r-series", "E7"], "allowed: E3"),
     (["--fc", "3500", "--zeta", "0.2", "--opamp", "uA709"], "allowed: ideal"),
     (["--fc", "3500", "--zeta", "0.2", "--r-min", "1.01k", "--r-max", "1.05k"], "widen the bounds"),
+    (["--fc", "1meg", "--zeta", "0.5"], "lower --r-min or --c-min"),
     (["--fc", "3500", "--zeta", "0.2", "--gain", "0.5"], "gain"),
     (["--fc", "3500", "--zeta", "0.2", "--r", "1k"], "--r and --c"),
     (["--fc", "3500", "--zeta", "0.2", "--r", "100k", "--c", "1u"], "R*C"),
