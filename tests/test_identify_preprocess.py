@@ -190,3 +190,13 @@ def test_no_step_and_step_too_small():
         prepare_step(t, small + 0.01 * rng.standard_normal(t.size))
     with pytest.raises(DesignError, match="no step in the input column"):
         prepare_step(t, small, u=np.ones_like(t))
+
+
+@pytest.mark.parametrize("window, poly, deriv", [(5, 2, 0), (5, 2, 1), (11, 3, 1), (21, 2, 1)])
+def test_savgol_matches_scipy(window, poly, deriv):
+    from scipy.signal import savgol_filter
+
+    from designer.identify.preprocess import savgol
+    y = np.random.default_rng(0).standard_normal(300).cumsum()
+    ref = savgol_filter(y, window, poly, deriv=deriv, delta=0.1, mode="interp")
+    assert np.allclose(savgol(y, window, poly, deriv=deriv, delta=0.1), ref, atol=1e-10)

@@ -24,7 +24,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.signal import savgol_filter
 
 from ..errors import DesignError
 
@@ -208,6 +207,33 @@ def crossing_times(t, y, yf: float, fractions, *, sigma: float = 0.0) -> list:
     return [crossing_time(t, y, p * yf, sigma=sigma) for p in fractions]
 
 
+def savgol(y, window: int, polyorder: int, deriv: int = 0, delta: float = 1.0) -> np.ndarray:
+    """Savitzky-Golay filter (least-squares polynomial over a sliding window).
+
+    Same result as ``scipy.signal.savgol_filter(..., mode="interp")``: interior
+    samples by convolution, the first and last half-windows from one
+    polynomial fitted to the edge window. Written here because importing
+    scipy.signal costs about a second on every command-line run.
+    """
+    y = np.asarray(y, float)
+    w, p = int(window), int(polyorder)
+    h = w // 2
+    x = np.arange(-h, h + 1, dtype=float)
+    A = np.vander(x, p + 1, increasing=True)           # columns x^0 .. x^p
+    pinv = np.linalg.pinv(A)                            # rows: polynomial coefficients
+    fact = math.factorial(deriv)
+    scale = fact / delta ** deriv
+    kernel = pinv[deriv] * scale                        # value of the deriv at x = 0
+    out = np.empty_like(y)
+    out[h:y.size - h] = np.correlate(y, kernel, mode="valid")
+    # Edges: derivative of the polynomial fitted to the first/last window.
+    for seg, xs, dst in ((y[:w], x[:h], slice(0, h)), (y[-w:], x[h + 1:], slice(y.size - h, y.size))):
+        c = pinv @ seg                                  # coefficients in x (samples)
+        dc = np.polynomial.polynomial.polyder(c, deriv) if deriv else c
+        out[dst] = np.polynomial.polynomial.polyval(xs, dc) / delta ** deriv
+    return out
+
+
 def is_uniform(t, rtol: float = 1e-3) -> bool:
     dt = np.diff(np.asarray(t, float))
     return bool(dt.size and np.ptp(dt) <= rtol * np.mean(dt))
@@ -255,8 +281,8 @@ def smooth_derivative(t, y, *, window_s: float | None = None, sigma: float = 0.0
     if w > n:
         w = n if n % 2 else n - 1
     poly = min(polyorder, w - 1)
-    ys = savgol_filter(yu, w, poly, mode="interp")
-    dy = savgol_filter(yu, w, poly, deriv=1, delta=dt, mode="interp")
+    ys = savgol(yu, w, poly)
+    dy = savgol(yu, w, poly, deriv=1, delta=dt)
     return tu, ys, dy
 
 

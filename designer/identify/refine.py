@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.stats import t as student_t
+from scipy.special import stdtrit
 
 from .core import MethodResult, model_step
 from .preprocess import crossing_time, noise_sigma
@@ -172,7 +172,7 @@ def _confidence(model, sol, n, scale):
         cov = np.linalg.pinv(J.T @ J) * s2
     except np.linalg.LinAlgError:  # pragma: no cover - defensive
         return {k: math.nan for k in names}
-    q = float(student_t.ppf(0.975, dof))
+    q = float(stdtrit(dof, 0.975))
     sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     x = sol.x
     out = {}

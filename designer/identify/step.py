@@ -33,6 +33,8 @@ from .refine import refine_all
 #: Part tolerances assumed when the design's ``built`` has no ``tolerance_band``.
 DEFAULT_R_TOL = 0.05
 DEFAULT_C_TOL = 0.10
+#: Allowance on the static gain for the measurement itself (two scope channels).
+GAIN_MEASUREMENT_TOL = 0.02
 SECOND_ORDER = ("underdamped", "overdamped", "double-pole")
 
 
@@ -362,7 +364,9 @@ def tolerance_band(built: dict, gain: float = 1.0, r_tol: float = DEFAULT_R_TOL,
         fns = [fn0 / ((1 + r_tol) * (1 + c_tol)), fn0 / ((1 - r_tol) * (1 - c_tol))]
         zetas = [z0 * math.sqrt((1 - c_tol) / (1 + c_tol)), z0 * math.sqrt((1 + c_tol) / (1 - c_tol))]
         basis = "scaling of the nominal fn and zeta"
-    gains = [g_lo, g_hi]
+    # The gain is read as the ratio of two measured signals: allow the
+    # measurement's own error (scope channel gain, follower offset) on top.
+    gains = [g_lo * (1 - GAIN_MEASUREMENT_TOL), g_hi * (1 + GAIN_MEASUREMENT_TOL)]
     zl, zh = min(zetas), max(zetas)
     return {"fn_hz": [min(fns), max(fns)], "zeta": [zl, zh],
             "overshoot_pct": [overshoot_from_zeta(zh), overshoot_from_zeta(zl)],

@@ -1,0 +1,183 @@
+"""The installed ``identify`` console script: JSON shape, table, plot, --against, bad input."""
+
+import json
+import math
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from designer.identify.core import model_step
+from designer.identify.step import overshoot_from_zeta, sallen_key
+
+ROOT = Path(__file__).resolve().parents[1]
+EXE = Path(sys.executable).parent / "identify"
+if not EXE.exists():
+    EXE = ROOT / ".venv" / "bin" / "identify"
+FIX = Path(__file__).parent / "fixtures" / "identify"
+TRUTH = json.loads((FIX / "truth.json").read_text())
+
+
+def run(*args, cwd=None):
+    return subprocess.run([str(EXE), *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, timeout=120)
+
+
+def run_many(arglists, cwd=None):
+    with ThreadPoolExecutor(max_workers=4) as ex:
+        return list(ex.map(lambda a: run(*a, cwd=cwd), arglists))
+
+
+def _second_order(params):
+    """(fn, zeta) of the truth or of a model's params."""
+    if "wn_rad_s" in params:
+        return params["wn_rad_s"] / (2 * math.pi), params["zeta"]
+    return None
+
+
+@pytest.fixture(scope="module")
+def json_runs():
+    names = ["generic_ty.csv", "generic_tuy_semicolon.csv", "waveform.csv",
+             "tektronix_tds.csv", "tektronix_mso.csv", "rigol_square.csv"]
+    args = []
+    for n in names:
+        extra = ["--step-amplitude", "2"] if n == "tektronix_tds.csv" else []
+        args.append([FIX / n, "--json", *extra])
+    return dict(zip(names, run_many(args)))
+
+
+def test_json_shape_and_best_model_for_every_fixture(json_runs):
+    for name, proc in json_runs.items():
+        assert proc.returncode == 0, (name, proc.stderr)
+        out = json.loads(proc.stdout)
+        assert {"methods", "best", "preprocessing"} <= set(out)
+        for m in out["methods"]:
+            assert {"name", "model", "params", "iae", "ise", "valid", "note"} <= set(m)
+            assert m["model"] in ("fopdt", "double-pole", "underdamped", "overdamped")
+            assert m["name"] == m["name"].lower()
+        best = out["best"]
+        assert best["valid"] and best in out["methods"]
+        valid_iae = [m["iae"] for m in out["methods"] if m["valid"] and m["iae"] is not None]
+        assert best["iae"] == min(valid_iae)
+        truth = TRUTH[name]
+        assert best["params"]["K"] == pytest.approx(truth["params"]["K"], rel=0.02), name
+        fz = _second_order(truth["params"])
+        if fz:  # the seed 001 plant: fn and zeta within 2 %
+            assert best["model"] == "underdamped", name
+            fn, z = _second_order(best["params"])
+            assert fn == pytest.approx(fz[0], rel=0.02) and z == pytest.approx(fz[1], rel=0.03)
+        else:
+            # FOPDT or overdamped truth: the best fit's step response matches the truth
+            t = np.linspace(0, 10 * sum(v for k, v in truth["params"].items() if k != "K"), 2000)
+            yt = model_step(truth["model"], truth["params"], t)
+            yb = model_step(best["model"], best["params"], t)
+            assert np.max(np.abs(yt - yb)) < 0.02 * truth["params"]["K"], name
+
+
+def test_rigol_square_wave_is_split(json_runs):
+    out = json.loads(json_runs["rigol_square.csv"].stdout)
+    pre = out["preprocessing"]
+    assert pre["steps_averaged"] >= 3
+    assert pre["step_amplitude"] == pytest.approx(2.0, rel=0.01)
+    # the seed's bench figures: overshoot ~ 52.7 %, peak time ~ 146 us (analytic)
+    meas = out["measured"]
+    assert meas["overshoot_pct"] == pytest.approx(overshoot_from_zeta(0.2), abs=1.5)
+
+
+def test_table_and_plot(tmp_path):
+    png = tmp_path / "fit.png"
+    proc = run(FIX / "waveform.csv", "--plot", png, "--methods", "smith,least-squares", "chen-yang")
+    assert proc.returncode == 0, proc.stderr
+    assert "ranked by IAE" in proc.stdout and "Best: least-squares (underdamped)" in proc.stdout
+    names = {ln.split()[1] for ln in proc.stdout.splitlines()
+             if ln[:4].strip().isdigit() and len(ln.split()) > 2}
+    assert names == {"smith", "least-squares", "chen-yang"}
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["fit.png"]   # no temp files left
+
+
+def _design(tmp_path, scale=1.0):
+    """A design-plant result.json for the seed's rounded parts (820, 1k, 10n, 220n)."""
+    r1, r2, c1, c2 = 820.0, 1000.0, 10e-9, 220e-9
+    fn, z = sallen_key(r1, r2, c1, c2)
+    d = {"spec": {"fc_hz": 3500.0, "zeta": 0.2, "gain": 1.0},
+         "built": {"R1_ohm": r1, "R2_ohm": r2, "C1_f": c1, "C2_f": c2, "fn_hz": fn * scale,
+                   "zeta": z, "q": 1 / (2 * z)},
+         "spice": {"overshoot_pct": overshoot_from_zeta(z), "peak_time_s": None,
+                   "rise_time_s": None, "settling_time_s": None}}
+    if scale != 1.0:
+        del d["built"]["R1_ohm"]   # no parts: band from the nominal fn, zeta
+    path = tmp_path / f"result_{scale}.json"
+    path.write_text(json.dumps(d))
+    return path
+
+
+def test_against_a_design(tmp_path):
+    """The waveform fixture is the seed's unrounded design (3500 Hz, 0.2); the rounded
+    parts give ~3747 Hz and ~0.214: inside the 5 % R / 10 % C band."""
+    ok, far = run_many([[FIX / "waveform.csv", "--json", "--against", _design(tmp_path)],
+                        [FIX / "waveform.csv", "--against", _design(tmp_path, 2.0)]])
+    assert ok.returncode == 0, ok.stderr
+    c = json.loads(ok.stdout)["comparison"]
+    q = c["quantities"]
+    assert set(q) == {"fn_hz", "zeta", "gain", "overshoot_pct"}
+    fn_built = sallen_key(820.0, 1000.0, 10e-9, 220e-9)[0]
+    assert q["fn_hz"]["identified"] == pytest.approx(3500.0, rel=0.01)
+    assert q["fn_hz"]["difference_pct"] == pytest.approx(100 * (3500 / fn_built - 1), abs=1.0)
+    assert all(v["within_tolerance"] for v in q.values())
+    assert "tolerances explain" in c["verdict"] and "5 % R / 10 % C" in c["tolerance_basis"]
+    assert far.returncode == 0, far.stderr
+    assert "OUTSIDE" in far.stdout and "do not explain" in far.stdout
+
+
+def test_help_teaches():
+    proc = run("--help")
+    assert proc.returncode == 0
+    assert "examples:" in proc.stdout and "--against" in proc.stdout
+
+
+def test_bad_input_exit_2_with_one_line(tmp_path):
+    t = np.linspace(0, 1, 400)
+    good = model_step("fopdt", {"K": 1, "tau_s": 0.05, "theta_s": 0.1}, t)
+    files = {
+        "empty.csv": "",
+        "words.csv": "t,y\n" + "".join(f"{a},{b}\n" for a, b in zip(t, good)).replace(
+            "\n0.5", "\nhalf", 1),
+        "nan.csv": "".join(f"{a},{'nan' if i == 50 else b}\n" for i, (a, b) in enumerate(zip(t, good))),
+        "time.csv": "".join(f"{a if i != 60 else 0.0},{b}\n" for i, (a, b) in enumerate(zip(t, good))),
+        "flat.csv": "".join(f"{a},1.0\n" for a in t),
+        "small.csv": "".join(f"{a},{1e-3 * b + 0.01 * np.sin(1e4 * a * (i % 7))}\n"
+                             for i, (a, b) in enumerate(zip(t, good))),
+        "unsettled.csv": "".join(f"{a},{b}\n" for a, b in zip(t[:60], good[:60])),
+    }
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    good_path = tmp_path / "good.csv"
+    good_path.write_text("".join(f"{a},{b}\n" for a, b in zip(t, good)))
+    (tmp_path / "notjson.json").write_text("{")
+    cases = {
+        "empty.csv": ([tmp_path / "empty.csv"], "empty"),
+        "words.csv": ([tmp_path / "words.csv"], "is not a number"),
+        "nan.csv": ([tmp_path / "nan.csv"], "NaN"),
+        "time.csv": ([tmp_path / "time.csv"], "time is not increasing"),
+        "flat.csv": ([tmp_path / "flat.csv"], "no usable step"),
+        "small.csv": ([tmp_path / "small.csv"], "noise standard deviations"),
+        "unsettled.csv": ([tmp_path / "unsettled.csv"], "before the response settles"),
+        "missing": ([tmp_path / "missing.csv"], "does not exist"),
+        "amp": ([good_path, "--step-amplitude", "abc"], "step-amplitude"),
+        "amp0": ([good_path, "--step-amplitude", "0"], "non-zero"),
+        "method": ([good_path, "--methods", "magic"], "unknown method"),
+        "against": ([good_path, "--against", tmp_path / "notjson.json"], "not JSON"),
+        "option": ([good_path, "--frobnicate"], "unrecognized arguments"),
+        "noarg": ([], "required"),
+    }
+    procs = run_many([a for a, _ in cases.values()])
+    for (key, (_, needle)), proc in zip(cases.items(), procs):
+        assert proc.returncode == 2, (key, proc.stdout, proc.stderr)
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1, (key, proc.stderr)
+        assert lines[0].startswith("identify: error:") and needle in lines[0], (key, lines[0])
+        assert "Traceback" not in proc.stderr and proc.stdout == ""
