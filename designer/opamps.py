@@ -29,6 +29,7 @@ class OpAmp:
     swing_high_v: float  #: output headroom below vcc (V)
     swing_low_v: float   #: output headroom above vee (V)
     ideal: bool = False
+    pins: dict | None = None  #: DIP-8 pin numbers (out, inn, inp, vcc, vee) and package
 
     @property
     def vout_max(self) -> float:

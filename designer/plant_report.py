@@ -36,7 +36,8 @@ def sections(result, with_images: bool = True) -> list:
                 R.part_row("R4", b.r4, "Ohm", "gain: output to inverting input", ser["r"], ser["r_tolerance_pct"])]
     bom.append(["U1", amp.name, "", "", "", f"op-amp on {amp.vcc:g} V / {amp.vee:g} V"
                 + (" (follower: output to inverting input)" if b.r3 is None else "")])
-    out = [("Bill of materials", [R.table(["Ref", "Value", "Code", "Series", "Tolerance", "Where"], bom)])]
+    out = [("Bill of materials", [R.table(["Ref", "Value", "Code", "Series", "Tolerance", "Where"], bom)]),
+           ("Wiring", [R.table(["from", "to", "part"], wiring(b, amp))])]
 
     s = d["spec"]
     bl = d["built"]
@@ -120,6 +121,28 @@ def sections(result, with_images: bool = True) -> list:
         out.append(("Plots", [R.image("step.png", "step response: analytic and SPICE"),
                               R.image("bode.png", "Bode plot")]))
     return out
+
+
+def wiring(b, amp) -> list:
+    """Point-to-point wiring for the breadboard, with the op-amp's DIP-8 pin numbers."""
+    pins = amp.pins or {}
+    def pin(name, label):
+        return f"U1 pin {pins[name]} ({label})" if name in pins else f"U1 {label}"
+    rows = [["generator output", "node A", f"R1 {R.value_code(b.r1)}"],
+            ["node A", pin("inp", "+ input"), f"R2 {R.value_code(b.r2)}"],
+            [pin("inp", "+ input"), "ground", f"C1 {R.value_code(b.c1)}"],
+            ["node A", pin("out", "output"), f"C2 {R.value_code(b.c2)}"]]
+    if b.r3 is None:
+        rows.append([pin("inn", "- input"), pin("out", "output"), "wire (voltage follower)"])
+    else:
+        rows += [[pin("inn", "- input"), "ground", f"R3 {R.value_code(b.r3)}"],
+                 [pin("out", "output"), pin("inn", "- input"), f"R4 {R.value_code(b.r4)}"]]
+    rows += [[pin("vcc", "V+"), f"{amp.vcc:+g} V supply", "100n decoupling to ground"],
+             [pin("vee", "V-"), f"{amp.vee:+g} V supply", "100n decoupling to ground"],
+             ["generator ground, scope grounds", "ground", "wire"]]
+    if pins.get("package"):
+        rows.append(["", "", f"{amp.name}: {pins['package']} pinout"])
+    return rows
 
 
 def _f(v, unit):

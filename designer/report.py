@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from .fileio import atomic_write
-from .units import format_eng, value_code
+from .units import format_eng, value_code  # noqa: F401  (value_code is part of this module's API)
 
 
 # ---- content blocks ---------------------------------------------------------
