@@ -8,7 +8,7 @@ Methods (all return :class:`~designer.identify.core.MethodResult`):
 
 ``asymptotes``     low-frequency gain K, the high-frequency slope -20 n dB/decade
                    (order n), and the corner where the gain has fallen by
-                   3 n dB (seed 000 examples 1-3 and 6; seed 003 Table 3.1):
+                   3.01 n dB (seed 000 examples 1-3 and 6; seed 003 Table 3.1):
                    n = 1 -> ``fopdt`` tau = 1/wc; n = 2 -> ``double-pole``
                    tau = 1/wc (zeta = 1, the seed's reading of Table IV).
 ``resonant-peak``  zeta from the peak height -10 log(4 zeta^2 (1 - zeta^2)) at
@@ -57,6 +57,7 @@ GAIN_UNITS = ("db", "ratio")
 PHASE_UNITS = ("deg", "rad", "s")
 FREQ_UNITS = ("hz", "rad/s")
 MIN_POINTS = 5
+DB_PER_POLE = 10.0 * math.log10(2.0)
 
 PARAMS = {
     "fopdt": ("K", "tau_s", "theta_s"),
@@ -162,13 +163,12 @@ def freq_data(freq, gain, phase=None, *, gain_units="db", phase_units="deg",
             k = int(np.argmin(np.isfinite(p)))
             raise DesignError(f"phase at row {k + 1} is not a finite number ({p[k]})")
         if phase_units == "deg":
-            ph = np.deg2rad(p)
+            ph = _unwrap_lag(np.deg2rad(p))
         elif phase_units == "rad":
-            ph = p.copy()
+            ph = _unwrap_lag(p.copy())
         else:
             # a positive time shift is the output lagging the input: -w dt
             ph = -w * p
-        ph = np.unwrap(ph)
         ph -= 2.0 * math.pi * round(ph[0] / (2.0 * math.pi))
         if abs(ph[0]) > math.pi / 2.0:
             sign = -1.0
@@ -176,6 +176,18 @@ def freq_data(freq, gain, phase=None, *, gain_units="db", phase_units="deg",
     return FreqData(w, ratio, ph, sign, source,
                     {"frequency": freq_units, "gain": gain_units,
                      "phase": phase_units if phase is not None else None})
+
+
+def _unwrap_lag(ph: np.ndarray) -> np.ndarray:
+    """Undo the wrapping of a phase read into (-180, 180] degrees.
+
+    A causal low-pass plant's phase falls with frequency, so a rise of more
+    than pi between neighbouring rows can only be a wrap, and is removed. A
+    fall of any size is kept: with a dead time a sparse table legitimately
+    drops by more than pi between rows (np.unwrap would "correct" that)."""
+    d = np.diff(ph)
+    jumps = np.where(d > math.pi, -2.0 * math.pi * np.ceil((d - math.pi) / (2.0 * math.pi)), 0.0)
+    return np.concatenate(([ph[0]], ph[0] + np.cumsum(d + jumps)))
 
 
 _NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
@@ -400,12 +412,15 @@ def _interp_logf(w, y, level):
     return float(10.0 ** (math.log10(w[i - 1]) + frac * (math.log10(w[i]) - math.log10(w[i - 1]))))
 
 
-def low_frequency_gain(data: FreqData, tol_db: float = 0.25) -> tuple[float, int]:
-    """K (amplitude ratio) from the flat low-frequency run: the mean dB of the
-    first points within ``tol_db`` of the first one. Returns (K, points used)."""
+def low_frequency_gain(data: FreqData, tol_db: float = 0.05, span: float = 3.0):
+    """K (amplitude ratio) from the lowest frequencies: the mean dB of the points
+    within ``span`` times the lowest frequency that stay within ``tol_db`` of
+    the first one (the table must start well below the corner, as the seeds'
+    do). Returns (K, points used)."""
     db = data.gain_db
     run = 1
-    while run < db.size and abs(db[run] - db[0]) <= tol_db:
+    while (run < db.size and data.w[run] <= span * data.w[0]
+           and abs(db[run] - db[0]) <= tol_db):
         run += 1
     return float(10.0 ** (np.mean(db[:run]) / 20.0)), run
 
@@ -444,9 +459,9 @@ def asymptotes(data: FreqData) -> MethodResult:
     """Asymptote reading (seed 000 examples 1-3, 6; seed 003 Table 3.1).
 
     K from the flat low-frequency gain, order n from the high-frequency slope
-    (-20 n dB/decade, rounded), corner wc where the gain has fallen 3 n dB
-    below K (the seed's rule: the asymptotes meet there for n equal real
-    poles). n = 1: fopdt with tau = 1/wc; n = 2: double pole tau = 1/wc
+    (-20 n dB/decade, rounded), corner wc where the gain has fallen
+    n 10 log10(2) = 3.01 n dB below K (the seed's "3 dB x n" rule: the
+    asymptotes of n equal real poles meet there). n = 1: fopdt with tau = 1/wc; n = 2: double pole tau = 1/wc
     (zeta = 1). The intersection of the fitted high-frequency line with K
     is reported in ``points`` as ``w_intersection_rad_s``.
     """
@@ -459,20 +474,26 @@ def asymptotes(data: FreqData) -> MethodResult:
     if n < 1:
         return _invalid(name, "fopdt", f"the gain does not roll off (high-frequency slope "
                         f"{slope:.1f} dB/decade): no low-pass model to read", pts)
-    wc = _interp_logf(data.w, data.gain_db, k_db - 3.0 * n)
+    # n equal poles are 10 log10(2) = 3.01 dB down per pole at their corner
+    wc = _interp_logf(data.w, data.gain_db, k_db - DB_PER_POLE * n)
     # where the -20 n dB/decade line through the high-frequency points meets K
     b = float(np.mean(data.gain_db[sel] + 20.0 * n * np.log10(data.w[sel])))
     pts["w_intersection_rad_s"] = 10.0 ** ((b - k_db) / (20.0 * n))
     if not math.isfinite(wc):
         return _invalid(name, "fopdt" if n == 1 else "double-pole",
-                        f"the gain never falls {3 * n} dB below K in the table: "
+                        f"the gain never falls {DB_PER_POLE * n:.1f} dB below K in the table: "
                         "extend it to higher frequencies", pts)
     pts["wc_rad_s"] = wc
     pts["fc_hz"] = wc / (2.0 * math.pi)
     if n > 2:
+        if data.phase is not None:
+            ph0 = -n * np.arctan(data.w / wc)
+            pts["theta_s"] = dead_time_from_phase(data.w, data.phase, ph0, 0.1 * wc)
         return _invalid(name, "double-pole", f"high-frequency slope {slope:.0f} dB/decade means "
                         f"order {n}; the models here have at most two poles (the seed's "
-                        f"({n}-pole) reading: {n} poles at {wc:.4g} rad/s)", pts)
+                        f"reading: {n} equal poles at {wc:.4g} rad/s"
+                        + (f", dead time {pts['theta_s']:.4g} s" if "theta_s" in pts else "")
+                        + ")", pts)
     model = "fopdt" if n == 1 else "double-pole"
     return _with_delay(name, model, {"K": K, "tau_s": 1.0 / wc, "theta_s": 0.0}, data, wc, pts,
                        "" if n == 1 else "two equal poles (zeta = 1)")
@@ -495,8 +516,8 @@ def peak_gain_db(zeta: float) -> float:
 def resonant_peak(data: FreqData, min_db: float = 0.1) -> MethodResult:
     """Resonant-peak damping (seed 000 example 5, eqs 75 and 79).
 
-    The peak (a parabola in log w through the highest point and its
-    neighbours) gives Mr = peak - K in dB; zeta solves
+    The peak (the vertex of 1/|G|^2 as a parabola in w^2 through the highest
+    point and its neighbours, exact for a second-order system) gives Mr = peak - K in dB; zeta solves
     -10 log(4 zeta^2 (1 - zeta^2)) = Mr and wn = w_peak / sqrt(1 - 2 zeta^2).
     Valid when the table shows a peak at least ``min_db`` above K between its
     first and last points (zeta < 0.707).
@@ -509,11 +530,17 @@ def resonant_peak(data: FreqData, min_db: float = 0.1) -> MethodResult:
     if db[i] - k_db < min_db or i == 0 or i == db.size - 1:
         return _invalid(name, model, f"no resonant peak {min_db} dB above the low-frequency gain "
                         "inside the table: zeta >= 0.707 or the peak was not measured")
-    x = np.log10(data.w[i - 1:i + 2])
-    a, b, c = np.polyfit(x - x[1], db[i - 1:i + 2], 2)
-    if a < 0:
-        xv = -b / (2.0 * a)
-        peak_db, w_peak = c - b * b / (4.0 * a), 10.0 ** (x[1] + xv)
+    # For a second-order system (K/|G|)^2 = (1 - u^2)^2 + 4 zeta^2 u^2 is a
+    # quadratic in w^2: a parabola through the three points around the highest
+    # one has its vertex exactly at the peak.
+    v = data.w[i - 1:i + 2] ** 2
+    q = 1.0 / data.gain[i - 1:i + 2] ** 2
+    vc = v[1]
+    a, b, c = np.polyfit(v / vc - 1.0, q, 2)
+    xv = -b / (2.0 * a) if a > 0 else math.nan
+    if a > 0 and -1.0 < xv < 3.0 and c - b * b / (4.0 * a) > 0:
+        qmin = c - b * b / (4.0 * a)
+        peak_db, w_peak = -10.0 * math.log10(qmin), math.sqrt(vc * (1.0 + xv))
     else:
         peak_db, w_peak = float(db[i]), float(data.w[i])
     mr = peak_db - k_db
@@ -586,7 +613,7 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
             x0 = np.clip(_params_to_x(model, p0, fit_delay), np.array(lo) + 1e-12,
                          np.array(hi) - 1e-12)
             sol = least_squares(fun, x0, bounds=(lo, hi), method="trf", x_scale="jac",
-                                max_nfev=400)
+                                max_nfev=400, ftol=1e-12, xtol=1e-12, gtol=1e-12)
         except (ValueError, OverflowError, ZeroDivisionError, KeyError):
             continue
         if np.all(np.isfinite(sol.x)) and (best is None or sol.cost < best.cost):
@@ -620,8 +647,9 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     iae, ise = fit_error(model, params, data)
     valid = True
     if model == "overdamped" and params["tau1_s"] < 1e-3 * params["tau2_s"]:
-        note = "; ".join(s for s in (note, "tau1 << tau2: the data show one pole (see the fopdt fit)")
-                         if s)
+        note = "; ".join(s for s in (note, "tau1 < tau2/1000: the data show one pole, this is "
+                                     "the fopdt fit") if s)
+        valid = False
     if model == "underdamped" and params["zeta"] >= 0.98:
         note = "; ".join(s for s in (note, "zeta at its bound 0.99: the data are not underdamped "
                                      "(see the overdamped fit)") if s)
