@@ -18,6 +18,7 @@ from __future__ import annotations
 import itertools
 import json
 import math
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -78,6 +79,7 @@ class IdentifyResult:
     capture: dict | None = None
     comparison: dict | None = None
     measured: dict = field(default_factory=dict)
+    timings: dict = field(default_factory=dict)
 
     def best_of(self, models) -> MethodResult | None:
         for m in self.methods:
@@ -89,7 +91,8 @@ class IdentifyResult:
         d = {"methods": [m.to_dict() for m in self.methods],
              "best": self.best.to_dict() if self.best else None,
              "preprocessing": self.step.to_dict(),
-             "measured": {k: _clean(v) for k, v in self.measured.items()}}
+             "measured": {k: _clean(v) for k, v in self.measured.items()},
+             "timings_s": dict(self.timings)}
         if self.capture is not None:
             d["capture"] = self.capture
         if self.comparison is not None:
@@ -184,6 +187,17 @@ def _score(m: MethodResult, step: PreparedStep, t_eval, y_eval) -> None:
             m.note = "; ".join(s for s in (m.note, f"model cannot be evaluated: {exc}") if s)
 
 
+def _score_all(results, step, t_eval, y_eval) -> None:
+    """Score every result; long records in two threads (numpy releases the GIL)."""
+    if t_eval.size < 200_000 or len(results) < 2:
+        for m in results:
+            _score(m, step, t_eval, y_eval)
+        return
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(max_workers=2) as ex:
+        list(ex.map(lambda m: _score(m, step, t_eval, y_eval), results))
+
+
 def _rank_key(m):
     iae = m.iae if m.iae is not None and math.isfinite(m.iae) else math.inf
     return (not m.valid, iae)
@@ -211,7 +225,10 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
     -------
     IdentifyResult
     """
+    clock = time.perf_counter
+    t0 = clock()
     step = prepare_step(t, y, u, step_time=step_time, step_amplitude=step_amplitude)
+    timings = {"prepare": clock() - t0}
     want = _check_names(methods)
     # Methods assume a rising response; a negative gain is flipped and restored.
     sgn = 1.0 if step.yf >= 0 else -1.0
@@ -223,11 +240,15 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
         results.extend(run_method(fn, tw, yw, yfw))
     if want is not None:
         results = [r for r in results if r.name in want]
+    timings["methods"] = clock() - t0 - timings["prepare"]
     post = step.t_raw >= step.t_step
     t_eval, y_eval = step.t_raw[post], step.y_raw[post]
+    t1 = clock()
     for m in results:
         _flip(m, sgn)
-        _score(m, step, t_eval, y_eval)
+    _score_all(results, step, t_eval, y_eval)
+    timings["score"] = clock() - t1
+    t1 = clock()
     if refine and (want is None or "least-squares" in want):
         starts = {}
         for model, compatible in (("fopdt", ("fopdt",)), ("overdamped", ("overdamped", "double-pole")),
@@ -238,23 +259,28 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
                 c = cands[0]
                 starts[model] = MethodResult(c.name, c.model, {k: (sgn * v if k == "K" else v)
                                                                for k, v in c.params.items()})
-        for m in refine_all(tw, yw, yfw, starts):
+        fits = refine_all(tw, yw, yfw, starts)
+        for m in fits:
             m.note = "; ".join(s for s in (f"started from {starts[m.model].name}"
                                            if m.model in starts else "", m.note) if s)
             _flip(m, sgn)
-            _score(m, step, t_eval, y_eval)
-            results.append(m)
+        _score_all(fits, step, t_eval, y_eval)
+        results.extend(fits)
     if want is not None:
         found = {r.name for r in results}
         missing = sorted(set(want) - found)
         if missing:
             raise DesignError(f"unknown method(s) {', '.join(missing)}; allowed: "
                               f"{', '.join(sorted(known_method_names()))}")
+    timings["refine"] = clock() - t1
     results.sort(key=_rank_key)
     best = next((m for m in results if m.valid and math.isfinite(m.iae)), None)
+    t1 = clock()
     measured = _measured(step, t_eval, y_eval)
+    timings["measure"] = clock() - t1
+    timings["total"] = clock() - t0
     return IdentifyResult(methods=results, best=best, step=step, capture=capture,
-                          measured=measured)
+                          measured=measured, timings=timings)
 
 
 def _flip(m: MethodResult, sgn: float) -> None:
