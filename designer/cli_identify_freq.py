@@ -32,7 +32,7 @@ shift_s, shift_us); options override it. Defaults: Hz, dB, degrees. A phase
 given as a time shift dt is the output lagging the input: phase = -360 f dt.
 
 methods: asymptotes (K, high-frequency slope -> order, corner where the gain
-has fallen 3n dB; 1 pole -> fopdt, 2 -> double-pole), resonant-peak (zeta from
+has fallen 3.01n dB; 1 pole -> fopdt, 2 -> double-pole), resonant-peak (zeta from
 the peak height -10 log(4 zeta^2 (1 - zeta^2)), wn from its frequency),
 least-squares (fopdt, underdamped, overdamped, with dead time when there is
 phase; 95 % confidence half-widths). Dead time is read from the phase lag the
