@@ -41,8 +41,11 @@ STAGES = (("U1", "difference", "ve"), ("U2", "inverter", "vp"), ("U3", "differen
 #: "Well below / well above" the plant's fn for the check (factor).
 CORNER_MARGIN = 5.0
 #: Default corner targets relative to fn (the seed used 130 Hz and 33 kHz for fn = 3.5 kHz).
-F_INTEGRATOR_RATIO = 1.0 / 25.0
+F_INTEGRATOR_RATIO = 1.0 / 100.0
 F_DIFFERENTIATOR_RATIO = 10.0
+#: R12 and R13 (set only by the corners) stay at or below this: with bipolar
+#: op-amps (LM741 bias current ~80 nA) larger feedback resistors add offsets.
+R_CORNER_MAX = 100e3
 
 
 @dataclass(frozen=True)
@@ -237,8 +240,9 @@ def select_parts(kp: float, ti_s: float, td_s: float, fn_hz: float, *,
     R6. Among the choices within max(that error, ``tol``), the one with the
     smallest largest noise gain of the summer, final gain and differentiator
     wins (most bandwidth). R13 and R12 set the integrator-leak and
-    derivative-filter corners (defaults fn/25 and 10 fn) and are the series
-    values nearest to them. :func:`brute_force` checks this on small sets.
+    derivative-filter corners (defaults fn/100 and 10 fn) and are the series
+    values nearest to them, at most :data:`R_CORNER_MAX`. :func:`brute_force`
+    checks the search on small sets.
 
     Returns
     -------
@@ -272,7 +276,7 @@ def select_parts(kp: float, ti_s: float, td_s: float, fn_hz: float, *,
 
 
 def _search(kp, ti, td, rv, cv, f_i, f_d, has_d, unity, tol):
-    lo, hi = rv[0], rv[-1]
+    lo, hi = rv[0], min(rv[-1], max(R_CORNER_MAX, rv[0]))
     r13 = _corner_resistor(f_i, cv, rv, lo, hi)
     c4s, r13s = cv[~np.isnan(r13)], r13[~np.isnan(r13)]
     if c4s.size == 0:
@@ -327,18 +331,21 @@ def _search(kp, ti, td, rv, cv, f_i, f_d, has_d, unity, tol):
         r5o, ngf = k5[sk], 1 + k3[sk] / k4[sk]
         if r5o.size == 0 or si.stop <= si.start:
             continue
-        keep = _min_per_key(r5o, ngf)
+        keep = _min_per_key(r5o, ngf, np.abs(np.log(k4[sk] / 1e4)))
         r5u, ngfu, kidx = r5o[keep], ngf[keep], np.arange(sk.start, sk.stop)[keep]
         # Ti: the largest R8 (it only enters the summer's noise gain)
         r8cand = i8[si]
-        imax = si.start + int(np.argmax(r8cand))
-        r8 = i8[imax]
+        r8 = r8cand.max()
+        # free choice among (R14, C4) for that R8: resistors nearest 10 kOhm
+        cand = np.arange(si.start, si.stop)[r8cand == r8]
+        spread = np.maximum(np.abs(np.log(i14[cand] / 1e4)), np.abs(np.log(r13s[ic4[cand]] / 1e4)))
+        imax = int(cand[np.argmin(spread)])
         if has_d:
             sd = window(vd_s, td / r6)
             if sd.stop <= sd.start:
                 continue
             r7o, ngdo = d7[sd], ngd_all[sd]
-            keepd = _min_per_key(r7o, ngdo)
+            keepd = _min_per_key(r7o, ngdo, np.abs(np.log(d11[sd] / 1e4)))
             r7u, ngdu, didx = r7o[keepd], ngdo[keepd], np.arange(sd.start, sd.stop)[keepd]
             inv7 = 1.0 / r7u
         else:
@@ -364,9 +371,9 @@ def _search(kp, ti, td, rv, cv, f_i, f_d, has_d, unity, tol):
     return parts, best, ncand
 
 
-def _min_per_key(keys, vals):
-    """Indices of the smallest ``vals`` entry for each distinct key."""
-    order = np.lexsort((vals, keys))
+def _min_per_key(keys, vals, tie):
+    """Indices of the smallest ``vals`` entry for each distinct key (ties: smallest ``tie``)."""
+    order = np.lexsort((tie, vals, keys))
     k = keys[order]
     first = np.ones(k.size, bool)
     first[1:] = k[1:] != k[:-1]
@@ -383,8 +390,9 @@ def brute_force(kp: float, ti_s: float, td_s: float, fn_hz: float, *, r_series: 
     cv = eseries.values(c_series, c_min, c_max)
     f_i = fn_hz * F_INTEGRATOR_RATIO if f_integrator_hz is None else f_integrator_hz
     f_d = fn_hz * F_DIFFERENTIATOR_RATIO if f_differentiator_hz is None else f_differentiator_hz
-    r13 = _corner_resistor(f_i, cv, rv, rv[0], rv[-1])
-    r12 = _corner_resistor(f_d, cv, rv, rv[0], rv[-1])
+    hi = min(rv[-1], max(R_CORNER_MAX, rv[0]))
+    r13 = _corner_resistor(f_i, cv, rv, rv[0], hi)
+    r12 = _corner_resistor(f_d, cv, rv, rv[0], hi)
     c4s = cv[~np.isnan(r13)]
     c3s, r12s = cv[~np.isnan(r12)], r12[~np.isnan(r12)]
     best_err = math.inf
@@ -464,3 +472,25 @@ def seed_parts() -> PidParts:
     return PidParts(r3=12e3, r4=1.777e3, r5=22e3, r6=3.3e3, r7=14.356e3, r8=1.2e3, r9=10e3,
                     r10=10e3, r11=10e3, r12=1.026e3, r13=26.048e3, r14=2.528e3, r15=10e3,
                     r16=10e3, r17=10e3, r18=10e3, c3=4.7e-9, c4=47e-9)
+
+
+def continuous_parts(kp: float, ti_s: float, td_s: float, fn_hz: float, *,
+                     f_integrator_hz: float | None = None, f_differentiator_hz: float | None = None,
+                     r: float = 10e3) -> PidParts:
+    """Exact (unrounded) parts with a fixed, balanced structure, for searching
+    gains before any part is chosen: R6 = R7 = R8 = R9 = R10 = R14 = R15..R18 = r,
+    R11 C3 = Td, R14 C4 = Ti, corners as in :func:`select_parts`, and Kp split
+    between the summer and the final gain so that their noise gains match
+    (1 + 3 g = 1 + Kp/g, g = sqrt(Kp/3); 1 + 2 g and g = sqrt(Kp/2) for a PI)."""
+    _check_targets(kp, ti_s, td_s)
+    f_i = fn_hz * F_INTEGRATOR_RATIO if f_integrator_hz is None else f_integrator_hz
+    f_d = fn_hz * F_DIFFERENTIATOR_RATIO if f_differentiator_hz is None else f_differentiator_hz
+    has_d = td_s > 0
+    g = math.sqrt(kp / (3.0 if has_d else 2.0))
+    c4 = ti_s / r
+    c3 = td_s / r if has_d else None
+    return PidParts(r3=r * kp / g, r4=r, r5=g * r, r6=r, r7=r if has_d else None, r8=r, r9=r, r10=r,
+                    r11=r if has_d else None,
+                    r12=1.0 / (2 * math.pi * f_d * c3) if has_d else None,
+                    r13=1.0 / (2 * math.pi * f_i * c4), r14=r, r15=r, r16=r, r17=r, r18=r,
+                    c3=c3, c4=c4)

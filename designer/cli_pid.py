@@ -1,0 +1,180 @@
+"""Command-line layer of ``design-pid``: parse, call :func:`designer.pid.design.design_pid`,
+print. Any :class:`~designer.errors.DesignError` becomes one line on stderr and exit status 2."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from . import __version__, opamps
+from .cli import OneLineParser, _check_name, run_cli
+from .eseries import SERIES
+from .errors import DesignError
+from .units import parse_positive, parse_value
+
+EPILOG = """examples:
+  design-pid --plant-fc 3500 --plant-zeta 0.2
+        the seed's plant, Ziegler-Nichols reaction curve done right (T from L, not from 0), LM741s
+  design-pid --plant-fc 3500 --plant-zeta 0.2 --kp 45 --ti 43.215u --td 10.8037u
+        the seed's final gains with LM741s: see what really happens (and why) in the checks
+  design-pid --plant-fc 3500 --plant-zeta 0.2 --kp 45 --ti 43.215u --td 10.8037u --seed-parts
+        ... built with the seed's own part list (V.13) instead of E-series parts
+  design-pid --plant-fc 3500 --plant-zeta 0.2 --tuning optimize --target-overshoot 10
+        gains that keep every LM741 out of saturation and within its slew rate for a 1 V step
+  design-pid --plant-r1 820 --plant-r2 1k --plant-c1 10n --plant-c2 220n --tuning amigo --opamp TL072
+  design-pid --plant-json reports/plant_fc3500_z0.2/result.json --tuning chr0 --json --no-sim
+
+The controller (seed 001, Fig. 66): U1 difference amp (R15-R18), U2 unity inverter (R9, R10),
+U3 differentiator (R12 + C3 in, R11 feedback), U4 integrator (R14 in, R13 || C4 feedback),
+U5 summer (R6, R7, R8 in, R5 feedback), U6 final gain (R4 in, R3 feedback):
+  Kp = R5 R3/(R6 R4),  Ti = R8 R14 C4/R6,  Td = R6 R11 C3/R7.
+Rules: zn, cohen-coon, chr0, chr20 (Chien-Hrones-Reswick set-point, 0 and 20 % overshoot), amigo,
+simc (a PI for an FOPDT model), optimize. Values accept engineering notation (43.215u, 4k7, 10n).
+Outputs: netlists/<name>.cir (runs alone with `ngspice -b`), reports/<name>/build-sheet.md/.html,
+result.json and plots. Exit status 2 on bad input."""
+
+
+def _parser():
+    p = OneLineParser(
+        prog="design-pid",
+        description="Tune an analog PID controller for a Sallen-Key plant, size its six op-amp stages from "
+                    "E-series parts, check them against the op-amp's bandwidth, slew rate and swing, and verify "
+                    "the whole closed loop (controller + plant circuit) in ngspice.",
+        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    g = p.add_argument_group("plant (one of three ways)")
+    g.add_argument("--plant-fc", metavar="HZ", help="design the plant as design-plant does: natural frequency")
+    g.add_argument("--plant-zeta", metavar="Z", help="... and damping ratio")
+    for n, what in (("r1", "input resistor"), ("r2", "resistor to the non-inverting input"),
+                    ("c1", "non-inverting input to ground"), ("c2", "feedback capacitor")):
+        g.add_argument(f"--plant-{n}", metavar="VALUE", help=f"plant as built: {what}")
+    g.add_argument("--plant-gain", metavar="K", help="plant gain K = 1 + R4/R3 with --plant-r1.. (default 1)")
+    g.add_argument("--plant-json", metavar="FILE", help="a result.json written by design-plant or analyze-plant")
+    t = p.add_argument_group("tuning")
+    t.add_argument("--tuning", metavar="RULE",
+                   help="zn (default), cohen-coon, chr0, chr20, amigo, simc, optimize")
+    t.add_argument("--kp", help="explicit proportional gain (with --ti and --td)")
+    t.add_argument("--ti", metavar="S", help="explicit integral time, seconds (e.g. 43.215u)")
+    t.add_argument("--td", metavar="S", help="explicit derivative time, seconds (0 for a PI)")
+    t.add_argument("--target-overshoot", metavar="PCT", help="--tuning optimize: largest overshoot, percent")
+    t.add_argument("--target-settling", metavar="S", help="--tuning optimize: largest 2 %% settling time")
+    t.add_argument("--seed-parts", action="store_true",
+                   help="use the seed's own controller parts (V.13, difference amp untrimmed) instead of sizing")
+    s = p.add_argument_group("parts")
+    s.add_argument("--r-series", default="E24", help=f"resistor series: {', '.join(SERIES)} (default E24)")
+    s.add_argument("--c-series", default="E12", help="capacitor series (default E12)")
+    s.add_argument("--r-min", default="1k", help="smallest resistor (default 1k)")
+    s.add_argument("--r-max", default="1M", help="largest resistor (default 1M)")
+    s.add_argument("--c-min", default="1n", help="smallest capacitor (default 1n)")
+    s.add_argument("--c-max", default="10u", help="largest capacitor (default 10u)")
+    s.add_argument("--f-integrator", metavar="HZ", help="integrator leak corner 1/(2 pi R13 C4) (default fn/100)")
+    s.add_argument("--f-differentiator", metavar="HZ",
+                   help="derivative filter corner 1/(2 pi R12 C3) (default 10 fn)")
+    o = p.add_argument_group("op-amps and test signal")
+    o.add_argument("--opamp", default="LM741", metavar="NAME",
+                   help=f"{', '.join(opamps.names())} (default LM741, as the seed's bench)")
+    o.add_argument("--step", default="1", metavar="V", help="reference square wave 0 -> V volts (default 1)")
+    o.add_argument("--edge", default="100n", metavar="S", help="rise/fall time of the reference (default 100n, "
+                                                                 "a function generator)")
+    o.add_argument("--square-freq", metavar="HZ", help="reference frequency (default: half period = 1.5x the "
+                                                        "closed loop's settling time, rounded)")
+    out = p.add_argument_group("output")
+    out.add_argument("--out", default=".", metavar="DIR", help="write netlists/ and reports/ under DIR (default .)")
+    out.add_argument("--name", help="design name for the files (default pid_<tuning>_<opamp>_fn<fn>_z<zeta>)")
+    out.add_argument("--json", action="store_true", help="print one JSON object on stdout instead of the summary")
+    out.add_argument("--no-files", action="store_true", help="write no netlist or report files")
+    out.add_argument("--no-sim", action="store_true", help="skip ngspice (analytic figures only)")
+    out.add_argument("--simulator", default="pyspice", choices=("pyspice", "ngspice-cli"),
+                     help="pyspice: ngspice shared library (default); ngspice-cli: `ngspice -b` subprocess")
+    return p
+
+
+def _opt(v, name, parse=parse_positive):
+    return None if v is None else parse(v, name)
+
+
+def _build_spec(args):
+    from .pid.blocks import seed_parts
+    from .pid.design import PidSpec
+    from .sallenkey import SallenKeyParts
+    plant_parts = None
+    given = [getattr(args, f"plant_{n}") for n in ("r1", "r2", "c1", "c2")]
+    if any(v is not None for v in given):
+        if not all(v is not None for v in given):
+            raise DesignError("--plant-r1, --plant-r2, --plant-c1 and --plant-c2 go together")
+        gain = 1.0 if args.plant_gain is None else parse_value(args.plant_gain, "--plant-gain")
+        if not gain >= 1:
+            raise DesignError(f"--plant-gain must be >= 1 (K = 1 + R4/R3), got {args.plant_gain!r}")
+        r3, r4 = (None, None) if gain == 1 else (10e3, (gain - 1) * 10e3)
+        plant_parts = SallenKeyParts(*(parse_positive(v, f"--plant-{n}") for v, n in
+                                       zip(given, ("r1", "r2", "c1", "c2"))), gain, r3, r4)
+    elif args.plant_gain is not None:
+        raise DesignError("--plant-gain goes with --plant-r1..--plant-c2")
+    tuning = None if args.tuning is None else args.tuning.strip().lower()
+    kp = _opt(args.kp, "--kp", parse_value)
+    ti = _opt(args.ti, "--ti", parse_value)
+    td = _opt(args.td, "--td", parse_value)
+    if kp is not None and kp <= 0:
+        raise DesignError(f"--kp must be greater than 0, got {args.kp!r}")
+    if ti is not None and ti <= 0:
+        raise DesignError(f"--ti must be a time greater than 0 s, got {args.ti!r}")
+    if td is not None and td < 0:
+        raise DesignError(f"--td must be a time of 0 s or more, got {args.td!r}")
+    spec = PidSpec(
+        plant_fc_hz=_opt(args.plant_fc, "--plant-fc"),
+        plant_zeta=_opt(args.plant_zeta, "--plant-zeta"),
+        plant_parts=plant_parts, plant_json=args.plant_json, tuning=tuning, kp=kp, ti_s=ti, td_s=td,
+        opamp=args.opamp, step_v=parse_positive(args.step, "--step"),
+        edge_s=parse_value(args.edge, "--edge"),
+        r_series=args.r_series, c_series=args.c_series,
+        r_min=parse_positive(args.r_min, "--r-min"), r_max=parse_positive(args.r_max, "--r-max"),
+        c_min=parse_positive(args.c_min, "--c-min"), c_max=parse_positive(args.c_max, "--c-max"),
+        target_overshoot_pct=_opt(args.target_overshoot, "--target-overshoot", parse_value),
+        target_settling_s=_opt(args.target_settling, "--target-settling"),
+        f_integrator_hz=_opt(args.f_integrator, "--f-integrator"),
+        f_differentiator_hz=_opt(args.f_differentiator, "--f-differentiator"),
+        square_hz=_opt(args.square_freq, "--square-freq"),
+        controller_parts=seed_parts() if args.seed_parts else None)
+    if args.plant_zeta is not None and args.plant_fc is None:
+        raise DesignError("--plant-zeta needs --plant-fc")
+    spec.validate()
+    return spec
+
+
+def _default_name(spec, fn_hz, zeta) -> str:
+    method = "explicit" if spec.kp is not None else (spec.tuning or "zn")
+    extra = "_seedparts" if spec.controller_parts is not None else ""
+    return f"pid_{method}_{spec.opamp.lower()}_fn{fn_hz:.5g}_z{zeta:.3g}{extra}"
+
+
+def _run(args) -> int:
+    from .pid.design import design_pid
+    from .pid.report import summary_text, write_outputs
+    spec = _build_spec(args)
+    if args.name is not None:
+        _check_name(args.name)
+    if not args.no_files:
+        from .fileio import ensure_dir
+        ensure_dir(args.out)  # fail before the work, not after
+    result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
+    name = args.name or _default_name(spec, result.plant.fn_hz, result.plant.zeta)
+    if not args.no_files:
+        write_outputs(result, args.out, name)
+    if args.json:
+        print(json.dumps(result.to_dict(), indent=2))
+    else:
+        print(summary_text(result), end="")
+        if result.files:
+            print("\nFiles:")
+            for key, path in result.files.items():
+                print(f"  {key}: {', '.join(path) if isinstance(path, list) else path}")
+    return 0
+
+
+def design_pid_main(argv=None) -> int:
+    return run_cli("design-pid", _parser, _run, argv)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(design_pid_main())

@@ -1,0 +1,489 @@
+"""From a plant and a tuning choice to a sized, checked and SPICE-verified
+op-amp PID controller: the orchestration behind ``design-pid``.
+
+:func:`design_pid` returns a :class:`PidResult`; its ``to_dict`` is the JSON of
+``design-pid --json`` and ``result.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy import signal
+
+from .. import eseries, opamps
+from ..bench import recommend_square_wave
+from ..errors import DesignError
+from ..metrics import step_metrics
+from ..models import dominant_pair, plant_tf, plant_tf_opamp, response_span
+from ..opamps import OpAmp
+from ..sallenkey import SallenKeyParts
+from ..units import format_eng
+from . import blocks, model, tuning
+from .netlist import ReferenceTest, closed_loop_deck
+
+#: phase margin below which the loop is called under-damped on the bench
+MIN_PHASE_MARGIN_DEG = 30.0
+#: largest acceptable steady-state error of the leaky-integrator loop
+MAX_STEADY_STATE_ERROR = 0.02
+
+
+@dataclass
+class PidSpec:
+    """What the user asked for (SI units)."""
+
+    plant_fc_hz: float | None = None
+    plant_zeta: float | None = None
+    plant_parts: SallenKeyParts | None = None
+    plant_json: str | None = None
+    tuning: str | None = None          #: rule name, "optimize", or None (zn, or explicit if given)
+    kp: float | None = None
+    ti_s: float | None = None
+    td_s: float | None = None
+    opamp: str = "LM741"
+    step_v: float = 1.0
+    edge_s: float = 100e-9
+    r_series: str = "E24"
+    c_series: str = "E12"
+    r_min: float = 1e3
+    r_max: float = 1e6
+    c_min: float = 1e-9
+    c_max: float = 10e-6
+    target_overshoot_pct: float | None = None
+    target_settling_s: float | None = None
+    f_integrator_hz: float | None = None
+    f_differentiator_hz: float | None = None
+    square_hz: float | None = None
+    controller_parts: blocks.PidParts | None = None   #: skip sizing (e.g. the seed's own parts)
+    tol: float = 0.01
+
+    def validate(self) -> None:
+        sources = sum(x is not None for x in (self.plant_fc_hz, self.plant_parts, self.plant_json))
+        if sources != 1:
+            raise DesignError("give the plant one way: --plant-fc/--plant-zeta, --plant-r1..--plant-c2, "
+                              "or --plant-json")
+        if self.plant_fc_hz is not None:
+            if self.plant_zeta is None:
+                raise DesignError("--plant-fc needs --plant-zeta")
+            for name, v in (("--plant-fc", self.plant_fc_hz), ("--plant-zeta", self.plant_zeta)):
+                if not (math.isfinite(v) and v > 0):
+                    raise DesignError(f"{name} must be a finite number above 0, got {v!r}")
+        opamps.get(self.opamp)
+        self.r_series = eseries.series_name(self.r_series)
+        self.c_series = eseries.series_name(self.c_series)
+        for name in ("step_v", "r_min", "r_max", "c_min", "c_max"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0):
+                raise DesignError(f"--{name.replace('_v', '').replace('_', '-')} must be a positive finite "
+                                  f"number, got {v!r}")
+        if not (math.isfinite(self.edge_s) and self.edge_s >= 0):
+            raise DesignError(f"--edge must be a time of 0 s or more, got {self.edge_s!r}")
+        if self.r_min > self.r_max:
+            raise DesignError(f"--r-min ({self.r_min:g} Ohm) is above --r-max ({self.r_max:g} Ohm)")
+        if self.c_min > self.c_max:
+            raise DesignError(f"--c-min ({self.c_min:g} F) is above --c-max ({self.c_max:g} F)")
+        explicit = [v is not None for v in (self.kp, self.ti_s, self.td_s)]
+        if any(explicit) and not all(explicit):
+            raise DesignError("--kp, --ti and --td go together (give all three)")
+        if all(explicit):
+            if self.tuning not in (None, "explicit"):
+                raise DesignError(f"--tuning {self.tuning} and explicit --kp/--ti/--td exclude each other")
+            tuning.explicit(self.kp, self.ti_s, self.td_s)
+        elif self.tuning not in (None, "optimize") and self.tuning not in tuning.RULES:
+            raise DesignError(f"unknown --tuning {self.tuning!r}; allowed: {', '.join(tuning.RULES)}, optimize")
+        if self.tuning == "optimize":
+            if self.target_overshoot_pct is None:
+                raise DesignError("--tuning optimize needs --target-overshoot P (percent)")
+            if not (math.isfinite(self.target_overshoot_pct) and self.target_overshoot_pct >= 0):
+                raise DesignError(f"--target-overshoot must be a percentage of 0 or more, "
+                                  f"got {self.target_overshoot_pct!r}")
+            if self.target_settling_s is not None and not (math.isfinite(self.target_settling_s)
+                                                           and self.target_settling_s > 0):
+                raise DesignError(f"--target-settling must be a time above 0 s, got {self.target_settling_s!r}")
+        elif self.target_overshoot_pct is not None or self.target_settling_s is not None:
+            raise DesignError("--target-overshoot/--target-settling only apply to --tuning optimize")
+        for name in ("f_integrator_hz", "f_differentiator_hz", "square_hz"):
+            v = getattr(self, name)
+            if v is not None and not (math.isfinite(v) and v > 0):
+                raise DesignError(f"--{name.replace('_hz', '').replace('_', '-')} must be a frequency above 0 Hz, "
+                                  f"got {v!r}")
+
+
+@dataclass
+class PidResult:
+    """Everything known about one controller design; ``to_dict`` is the JSON."""
+
+    spec: PidSpec
+    plant: SallenKeyParts
+    plant_source: str
+    opamp: OpAmp
+    tuning: tuning.Tuning
+    rules: list
+    parts: blocks.PidParts
+    selection: blocks.Selection | None
+    checks: list
+    analytic: dict
+    ideal_pid: dict
+    margins: dict
+    levels: dict
+    test: ReferenceTest
+    expected_final_v: float
+    deck: str
+    spice: dict | None = None
+    spice_levels: dict | None = None
+    verdict: dict | None = None
+    optimizer: dict | None = None
+    notes: list = field(default_factory=list)
+    waveforms: dict = field(default_factory=dict, repr=False)
+    files: dict = field(default_factory=dict)
+    timings: dict = field(default_factory=dict)
+    simulator: str | None = None
+
+    def achieved(self) -> dict:
+        p = self.parts
+        ng = p.noise_gains()
+        bw = p.stage_bandwidths(self.opamp.gbw_hz)
+        d = {"kp": p.kp, "ti_s": p.ti_s, "td_s": p.td_s,
+             "f_integrator_hz": p.f_integrator_hz,
+             "f_differentiator_hz": p.f_differentiator_hz if p.has_derivative else None,
+             "f_summer_hz": bw["summer"], "integrator_dc_gain": p.integrator_dc_gain,
+             "noise_gains": ng, "stage_bandwidths_hz": bw}
+        t = self.tuning
+        d["errors_pct"] = {"kp": 100 * (p.kp / t.kp - 1), "ti": 100 * (p.ti_s / t.ti_s - 1),
+                           "td": 100 * (p.td_s / t.td_s - 1) if t.td_s > 0 else None}
+        return d
+
+    def to_dict(self) -> dict:
+        pl = self.plant
+        amp = self.opamp
+        sel = self.selection
+        spice = None
+        if self.spice is not None:
+            spice = {**self.spice, "backend": self.simulator}
+        out = {
+            "plant": {"source": self.plant_source, **pl.as_dict(), "q": pl.q,
+                      "fn_opamp_hz": self.waveforms.get("plant_fn_opamp_hz"),
+                      "zeta_opamp": self.waveforms.get("plant_zeta_opamp")},
+            "opamp": {"name": amp.name, "gbw_hz": amp.gbw_hz, "slew_v_per_s": amp.slew_v_per_s, "a0": amp.a0,
+                      "vcc": amp.vcc, "vee": amp.vee, "vout_max": amp.vout_max, "vout_min": amp.vout_min},
+            "tuning": self.tuning.to_dict(),
+            "rules": self.rules,
+            "optimizer": self.optimizer,
+            "components": self.parts.to_dict(),
+            "series": None if sel is None else {
+                "r": sel.r_series, "c": sel.c_series,
+                "r_tolerance_pct": 100 * eseries.TOLERANCE[sel.r_series],
+                "c_tolerance_pct": 100 * eseries.TOLERANCE[sel.c_series],
+                "best_possible_error_pct": sel.best_possible_pct, "candidates": sel.candidates},
+            "achieved": self.achieved(),
+            "checks": self.checks,
+            "closed_loop": {"analytic": self.analytic, "ideal_pid": self.ideal_pid, "spice": spice,
+                            "margins": self.margins, "verdict": self.verdict},
+            "levels": {"analytic": self.levels, "spice": self.spice_levels},
+            "test_signal": {"kind": "square", "low_v": 0.0, "high_v": self.test.step_v,
+                            "frequency_hz": self.test.frequency_hz, "edge_s": self.test.edge_s,
+                            "expected_final_v": self.expected_final_v},
+            "notes": self.notes,
+            "simulator": self.simulator,
+            "files": self.files,
+        }
+        return _clean(out)
+
+
+def _clean(obj):
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, (np.floating, np.integer)):
+        obj = obj.item()
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+# ---- plant ------------------------------------------------------------------
+
+def plant_from_json(path) -> SallenKeyParts:
+    """The built plant of a ``design-plant``/``analyze-plant`` result.json."""
+    p = Path(path)
+    try:
+        data = json.loads(p.read_text())
+    except OSError as exc:
+        raise DesignError(f"--plant-json: cannot read {str(p)!r}: {exc.strerror or exc}") from None
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        raise DesignError(f"--plant-json: {str(p)!r} is not JSON (expected a design-plant result.json)") from None
+    built = data.get("built") if isinstance(data, dict) else None
+    keys = ("R1_ohm", "R2_ohm", "C1_f", "C2_f")
+    if not isinstance(built, dict) or not all(isinstance(built.get(k), (int, float)) for k in keys):
+        raise DesignError(f"--plant-json: {str(p)!r} is not a design-plant result "
+                          "(no 'built' object with R1_ohm, R2_ohm, C1_f, C2_f)")
+    vals = [float(built[k]) for k in keys]
+    if not all(math.isfinite(v) and v > 0 for v in vals):
+        raise DesignError(f"--plant-json: {str(p)!r} has non-positive part values")
+    gain = float(built.get("gain", 1.0) or 1.0)
+    return SallenKeyParts(*vals, gain, built.get("R3_ohm"), built.get("R4_ohm"))
+
+
+def resolve_plant(spec: PidSpec):
+    """(parts, description) of the plant, designed or given."""
+    if spec.plant_parts is not None:
+        p = spec.plant_parts
+        for name, v in (("R1", p.r1), ("R2", p.r2), ("C1", p.c1), ("C2", p.c2)):
+            if not (math.isfinite(v) and v > 0):
+                raise DesignError(f"--plant-{name.lower()} must be a positive value, got {v!r}")
+        if p.zeta <= 0:
+            raise DesignError(f"these plant parts give zeta = {p.zeta:.4g} <= 0: the plant oscillates on its own")
+        return p, "parts"
+    if spec.plant_json is not None:
+        return plant_from_json(spec.plant_json), f"json:{spec.plant_json}"
+    from ..plant import PlantSpec, design_plant
+    ps = PlantSpec(fc_hz=spec.plant_fc_hz, zeta=spec.plant_zeta, opamp=spec.opamp,
+                   r_series=spec.r_series, c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
+                   c_min=spec.c_min, c_max=spec.c_max, alternatives=1)
+    res = design_plant(ps, simulate=False)
+    return res.built, f"design-plant fc={spec.plant_fc_hz:g} Hz zeta={spec.plant_zeta:g}"
+
+
+def plant_model(parts: SallenKeyParts, amp: OpAmp):
+    return plant_tf(parts) if amp.ideal else plant_tf_opamp(parts, amp)
+
+
+# ---- the flow ----------------------------------------------------------------
+
+def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice") -> PidResult:
+    """Tune, size, check, and (unless ``simulate`` is False) verify in SPICE."""
+    tick = time.perf_counter()
+    timings = {}
+    spec.validate()
+    amp = opamps.get(spec.opamp)
+    plant, source = resolve_plant(spec)
+    pn, pd = plant_model(plant, amp)
+    fn_o, z_o = dominant_pair(pd)
+    dc = float(pn[-1] / pd[-1])
+    span = response_span(min(plant.fn_hz, fn_o), min(plant.zeta, z_o))
+    # reaction curve of the plant as built (with its op-amp), on a dense grid
+    tp = np.linspace(0.0, span, 20001)
+    _, yp = signal.step((pn, pd), T=tp)
+    curve = tuning.reaction_curve(tp, yp, final=dc)
+    rules = [r.to_dict() for r in tuning.all_rules(curve)]
+    notes = []
+    opt = None
+    timings["plant_s"] = time.perf_counter() - tick
+    tick = time.perf_counter()
+    if spec.kp is not None:
+        tun = tuning.explicit(spec.kp, spec.ti_s, spec.td_s)
+        tun = tuning.Tuning("explicit", tun.kp, tun.ti_s, tun.td_s, curve, ())
+    elif spec.tuning == "optimize":
+        tun, opt = _optimize(spec, plant, amp, pn, pd, curve, span)
+        notes.append(f"optimize: {opt['message']} after {opt['evaluations']} closed-loop evaluations")
+    else:
+        tun = tuning.tune(spec.tuning or "zn", curve)
+    notes += list(tun.notes)
+    if tun.method == "zn":
+        notes.append(f"ZN reaction curve: inflection at {format_eng(curve.t_inflection_s, 's')}, "
+                     f"L = {format_eng(curve.L_s, 's')}, T = {format_eng(curve.T_s, 's')} (from L to where the "
+                     f"tangent reaches the final value, {format_eng(curve.t_tangent_final_s, 's')}; the seed "
+                     "used that absolute time as T)")
+    timings["tuning_s"] = time.perf_counter() - tick
+    tick = time.perf_counter()
+    if spec.controller_parts is not None:
+        parts, sel = spec.controller_parts, None
+        targets = {"kp": tun.kp, "ti_s": tun.ti_s, "td_s": tun.td_s}
+    else:
+        sel = blocks.select_parts(tun.kp, tun.ti_s, tun.td_s, plant.fn_hz, r_series=spec.r_series,
+                                  c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
+                                  c_min=spec.c_min, c_max=spec.c_max, f_integrator_hz=spec.f_integrator_hz,
+                                  f_differentiator_hz=spec.f_differentiator_hz, tol=spec.tol)
+        parts, targets = sel.parts, sel.targets
+        notes += sel.notes
+    checks = blocks.static_checks(parts, plant.fn_hz, amp.gbw_hz, targets, r_min=spec.r_min,
+                                  r_max=spec.r_max, c_min=spec.c_min, c_max=spec.c_max, tol=spec.tol)
+    timings["sizing_s"] = time.perf_counter() - tick
+    tick = time.perf_counter()
+    res = _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, span, notes)
+    res.optimizer = opt
+    res.waveforms.update(plant_fn_opamp_hz=fn_o, plant_zeta_opamp=z_o, reaction_curve=(tp, yp))
+    timings["analytic_s"] = time.perf_counter() - tick
+    res.timings = timings
+    if simulate:
+        run_spice(res, simulator)
+    else:
+        res.notes.append("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only")
+    return res
+
+
+def _optimize(spec, plant, amp, pn, pd, curve, span):
+    from . import optimize as O
+    t = np.linspace(0.0, 0.6 * span, 2001)
+    ctx = O.Context(pn, pd, amp, plant.fn_hz, spec.step_v, spec.edge_s, t, spec.target_overshoot_pct,
+                    spec.target_settling_s, spec.f_integrator_hz, spec.f_differentiator_hz)
+    starts = []
+    for rule in ("zn", "chr0"):
+        r = tuning.tune(rule, curve)
+        starts.append((r.kp, r.ti_s, r.td_s if r.td_s > 0 else 0.3 * curve.L_s))
+    res = O.optimize(ctx, starts)
+    b = res.best
+    note = (f"optimize: target overshoot <= {spec.target_overshoot_pct:g} %"
+            + ("" if spec.target_settling_s is None else f", settling <= {format_eng(spec.target_settling_s, 's')}")
+            + f" for a {spec.step_v:g} V step with {amp.name} limits")
+    return tuning.Tuning("optimize", b.kp, b.ti_s, b.td_s, curve, (note,)), res.to_dict()
+
+
+def _metrics(t, y, final=None) -> dict:
+    try:
+        m = step_metrics(t, y, initial=0.0, final=final).to_dict()
+    except DesignError:
+        return {k: None for k in ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")}
+    return {k: m[k] for k in ("overshoot_pct", "peak_time_s", "rise_time_s", "rise_time_0_100_s",
+                              "settling_time_s", "settling_time_5pct_s", "peak_value", "final_value")}
+
+
+def _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, span, notes) -> PidResult:
+    lm = model.assemble(parts, amp, pn, pd)
+    stable = lm.stable()
+    # closed-loop DC gain y/r from the state-space model (the integrator leaks)
+    iy = model.SIGNALS.index("y")
+    try:
+        dc_cl = float(-(lm.c[iy] @ np.linalg.solve(lm.a, lm.b)).item() + lm.d[iy, 0])
+    except np.linalg.LinAlgError:
+        dc_cl = math.nan
+    # a first look on a long grid for the settling time, to size the square wave
+    t_long = np.linspace(0.0, span, 8001)
+    ts = None
+    if stable:
+        w_long = lm.simulate(t_long, model.reference(t_long, 1.0, 0.0, spec.edge_s))
+        ts = _metrics(t_long, w_long["y"]).get("settling_time_s")
+    if ts is None:
+        ts = span / 2
+    sq = recommend_square_wave(ts, spec.step_v, spec.square_hz)
+    hp = sq.half_period_s
+    test = ReferenceTest(spec.step_v, sq.frequency_hz, 0.05 * hp, spec.edge_s)
+    t = np.linspace(0.0, hp, 20001)
+    r = model.reference(t, spec.step_v, 0.0, spec.edge_s)
+    waves = lm.simulate(t, r) if stable else _diverging(lm, t, r, 2 * max(abs(amp.vcc), abs(amp.vee)))
+    ideal_n, ideal_d = plant_tf(plant)
+    y_ideal = model.simulate_ideal(tun.kp, tun.ti_s, tun.td_s, ideal_n, ideal_d, t, r)
+    _, y_open, _ = signal.lsim((pn, pd), r, t)
+    analytic = _metrics(t, waves["y"])
+    analytic.update(stable=stable, dc_gain=dc_cl, steady_state_error_pct=100 * (1 - dc_cl))
+    ideal = _metrics(t, y_ideal)
+    rise = analytic.get("rise_time_s") or (hp / 20)
+    levels = model.waveform_limits(waves, t, amp, model.SLEW_DELAY_FRACTION * rise) if stable else {}
+    f_lo = min(parts.f_integrator_hz, plant.fn_hz) / 20
+    f_hi = max(amp.gbw_hz if not amp.ideal else 0.0, 100 * plant.fn_hz)
+    w = 2 * np.pi * np.logspace(np.log10(f_lo), np.log10(f_hi), 4000)
+    mg = model.margins(w, model.loop_gain(parts, amp, pn, pd, w))
+    checks = list(checks) + _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, spec.step_v, rise)
+    expected = spec.step_v * dc_cl if math.isfinite(dc_cl) else spec.step_v
+    title = (f"PID closed loop Kp={parts.kp:.4g} Ti={parts.ti_s:.4g}s Td={parts.td_s:.4g}s "
+             f"plant fn={plant.fn_hz:.5g}Hz zeta={plant.zeta:.4g} op-amp={amp.name}")
+    deck = closed_loop_deck(parts, plant, amp, test, title, expected)
+    res = PidResult(spec=spec, plant=plant, plant_source=source, opamp=amp, tuning=tun, rules=rules,
+                    parts=parts, selection=sel, checks=checks, analytic=analytic, ideal_pid=ideal,
+                    margins=mg, levels=levels, test=test, expected_final_v=expected, deck=deck,
+                    notes=list(notes))
+    res.waveforms = {"t": t, "r": r, "analytic": waves, "ideal_pid": y_ideal, "open_loop": y_open,
+                     "bode_w": w}
+    return res
+
+
+def _diverging(lm, t, r, limit):
+    """Waveforms of an unstable loop, cut where they leave +/-``limit`` volts (plots only)."""
+    with np.errstate(all="ignore"):
+        w = lm.simulate(t, r)
+    for k, v in w.items():
+        bad = ~np.isfinite(v) | (np.abs(v) > limit)
+        if np.any(bad):
+            v = v.copy()
+            v[np.argmax(bad):] = np.nan
+            w[k] = v
+    return w
+
+
+def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise) -> list:
+    out = []
+    poles = lm.poles()
+    worst = float(np.max(poles.real)) if poles.size else -math.inf
+    out.append({"name": "closed_loop_stable", "ok": bool(stable),
+                "detail": ("all closed-loop poles in the left half plane" if stable else
+                           f"a closed-loop pole has real part {worst:+.4g} 1/s: the loop oscillates or "
+                           "latches at a rail")})
+    pm = mg["phase_margin_deg"]
+    out.append({"name": "phase_margin", "ok": bool(math.isfinite(pm) and pm >= MIN_PHASE_MARGIN_DEG),
+                "detail": (f"{pm:.3g} deg at {format_eng(mg['crossover_hz'], 'Hz')} with the op-amp poles "
+                           f"(want >= {MIN_PHASE_MARGIN_DEG:g} deg)") if math.isfinite(pm)
+                else "the loop gain never crosses 1"})
+    if math.isfinite(dc_cl):
+        e = 1 - dc_cl
+        out.append({"name": "steady_state_error", "ok": bool(abs(e) <= MAX_STEADY_STATE_ERROR),
+                    "detail": f"{100 * e:.3g} % of the step (the integrator leaks through R13; "
+                              f"want <= {100 * MAX_STEADY_STATE_ERROR:g} %)"})
+    if not stable:
+        out.append({"name": "slew_rate", "ok": False, "detail": "unstable loop: no steady waveforms to check"})
+        out.append({"name": "output_swing", "ok": False, "detail": "unstable loop: the outputs run to the rails"})
+        return out
+    if amp.ideal:
+        worst_sw = max(levels.values(), key=lambda v: max(abs(v["v_max"]), abs(v["v_min"])))
+        out.append({"name": "slew_rate", "ok": True, "detail": "ideal op-amps (no slew limit)"})
+        out.append({"name": "output_swing", "ok": True,
+                    "detail": f"ideal op-amps; the largest excursion is {worst_sw['opamp']} "
+                              f"({worst_sw['signal']}) {worst_sw['v_min']:.3g} V to {worst_sw['v_max']:.3g} V"})
+        return out
+    budget = model.SLEW_DELAY_FRACTION * rise
+    slow = [f"{v['opamp']} {role} needs {v['slope_v_per_s'] / 1e6:.3g} V/us, slews for ~"
+            f"{format_eng(v['slew_delay_s'], 's')}" for role, v in levels.items() if not v["slew_ok"]]
+    worst = max(levels.items(), key=lambda kv: kv[1]["slew_delay_s"])
+    out.append({"name": "slew_rate", "ok": not slow,
+                "detail": (f"{amp.name} slews at {amp.slew_v_per_s / 1e6:.3g} V/us; slewing may delay a stage by "
+                           f"at most {format_eng(budget, 's')} (5 % of the rise time). "
+                           + ("; ".join(slow) if slow else
+                              f"worst: {worst[1]['opamp']} {worst[0]}, {format_eng(worst[1]['slew_delay_s'], 's')}"))})
+    clip = [f"{v['opamp']} {role} {v['v_min']:.3g}..{v['v_max']:.3g} V" for role, v in levels.items()
+            if not v["swing_ok"]]
+    out.append({"name": "output_swing", "ok": not clip,
+                "detail": (f"{amp.name} outputs reach {amp.vout_min:.3g} V to {amp.vout_max:.3g} V on "
+                           f"{amp.vcc:g}/{amp.vee:g} V supplies for a {step_v:g} V square wave; "
+                           + ("would need " + "; ".join(clip) if clip else "all stages stay inside"))})
+    return out
+
+
+def run_spice(res: PidResult, simulator: str) -> None:
+    """Simulate the deck, compare, detect saturation and oscillation."""
+    from .verify import explain, run_and_compare
+    tick = time.perf_counter()
+    t = res.waveforms["t"]
+    out = run_and_compare(res.deck, simulator, t, res.test.delay_s, res.test.half_period_s,
+                          res.waveforms["analytic"], res.test.step_v, res.expected_final_v, res.opamp)
+    res.simulator = out["backend"]
+    sp = dict(out["metrics"])
+    sp["deltas_vs_analytic"] = out["deltas"]
+    sp["nrms_abstol_v"] = out["nrms_abstol_v"]
+    sp["measurements"] = out["measurements"]
+    sp["oscillation"] = out["oscillation"]
+    res.spice = sp
+    res.spice_levels = {role: {**out["saturation"].get(role, {}), **out["slewing"].get(role, {}),
+                               "v_min": out["extremes"][sig][0], "v_max": out["extremes"][sig][1]}
+                        for _, role, sig in model.OPAMP_OUTPUTS if sig in out["extremes"]}
+    res.waveforms["spice"] = out["waves"]
+    res.verdict = explain(sp, res.analytic, res.checks)
+    sat = [f"{v['opamp']} {role}" for role, v in out["saturation"].items() if v["saturated"]]
+    if sat:
+        res.notes.append("SPICE: op-amp output pinned at a rail: " + ", ".join(sat))
+    osc = out["oscillation"]
+    if osc["oscillating"]:
+        res.notes.append(f"SPICE: the loop is still oscillating at the end of the half period "
+                         f"({osc['tail_p2p_v']:.3g} V peak to peak)")
+    if osc["latched"]:
+        res.notes.append(f"SPICE: the output is stuck at {osc['tail_mean_v']:.3g} V instead of settling near "
+                         f"{res.expected_final_v:.3g} V (latch-up)")
+    if res.verdict["unexplained"]:
+        res.notes.append("SPICE and the analytic loop disagree and no check explains it (please report this)")
+    res.timings["simulation_s"] = time.perf_counter() - tick

@@ -1,0 +1,371 @@
+"""Analytic closed loop of the op-amp PID controller and its plant.
+
+Each op-amp stage is an inverting amplifier with feedback impedance Zf and
+input admittances Y_k; with the single-pole op-amp A(s) = A0/(1 + s/wp) its
+output is
+
+    v_out = -Zf sum(Y_k v_k) / (1 + NG(s)/A(s)),   NG = 1 + Zf sum(Y_k)
+
+(the difference amplifier likewise, with NG = 1 + R16/R15). So the realised
+controller has a leaky integrator (corner 1/(2 pi R13 C4)), a filtered
+derivative (corner 1/(2 pi R12 C3)) and one extra pole per stage near
+GBW/NG. The blocks are assembled into one state-space model whose outputs
+are every op-amp's output, so the same simulation gives the plant output and
+the levels and slew rates each op-amp must deliver. An ideal op-amp
+(catalogue ``ideal``) is taken as infinite gain, not as a very fast pole.
+
+All transfer functions are (num, den) in descending powers of s (seconds).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import signal
+
+from ..errors import DesignError
+from ..opamps import OpAmp
+from .blocks import PidParts
+
+SIGNALS = ("ve", "vp", "vd", "vi", "vs", "u", "y")
+#: op-amp reference, role and output signal; U7 is the plant's Sallen-Key buffer.
+OPAMP_OUTPUTS = (("U1", "difference", "ve"), ("U2", "inverter", "vp"),
+                 ("U3", "differentiator", "vd"), ("U4", "integrator", "vi"),
+                 ("U5", "summer", "vs"), ("U6", "gain", "u"), ("U7", "plant", "y"))
+
+
+def _opamp_inv(opamp: OpAmp | None):
+    """1/A(s) as (num, den), or None for an ideal op-amp."""
+    if opamp is None or opamp.ideal:
+        return None
+    tau = opamp.a0 / (2 * math.pi * opamp.gbw_hz)
+    return np.array([tau, 1.0]) / opamp.a0, np.array([1.0])
+
+
+def inverting_stage(p, q, g, opamp):
+    """Transfer function -(p/q) / (1 + (g/q)/A) of an inverting stage whose
+    ideal gain is -p/q and whose noise gain is g/q (same denominator)."""
+    p, q, g = (np.atleast_1d(np.asarray(x, float)) for x in (p, q, g))
+    inv = _opamp_inv(opamp)
+    if inv is None:
+        return -p, q
+    ia_n, _ = inv
+    den = np.polyadd(q, np.polymul(g, ia_n))
+    return -p, den
+
+
+def stage_tfs(parts: PidParts, opamp: OpAmp | None) -> dict:
+    """Transfer function of every controller stage from its input node.
+
+    Keys: ``ve`` (difference amp, applied to the weighted sum g_y y - g_r r;
+    see :func:`difference_weights`), ``vp``, ``vd``, ``vi`` (from ve), ``vs``
+    (applied to the weighted sum of vp, vd, vi; see :func:`summer_weights`),
+    ``u`` (from vs). The summer and difference entries are the closed-loop
+    factor 1/(1 + NG/A) with sign, the weights carry the resistor ratios.
+    """
+    pr = parts
+    out = {}
+    ng_diff = 1 + pr.r16 / pr.r15
+    # difference: v = (g_y y - g_r r) * 1/(1 + NG/A) -> a stage with p = -1, q = 1
+    out["ve"] = inverting_stage([-1.0], [1.0], [ng_diff], opamp)
+    out["vp"] = inverting_stage([pr.r9 / pr.r10], [1.0], [1 + pr.r9 / pr.r10], opamp)
+    if pr.has_derivative:
+        t12, t11 = pr.r12 * pr.c3, pr.r11 * pr.c3
+        out["vd"] = inverting_stage([t11, 0.0], [t12, 1.0], [t12 + t11, 1.0], opamp)
+    t13 = pr.r13 * pr.c4
+    k = pr.r13 / pr.r14
+    out["vi"] = inverting_stage([k], [t13, 1.0], [t13, 1.0 + k], opamp)
+    ysum = 1 / pr.r6 + 1 / pr.r8 + (1 / pr.r7 if pr.has_derivative else 0.0)
+    out["vs"] = inverting_stage([-1.0], [1.0], [1 + pr.r5 * ysum], opamp)  # weights carry -R5/Rk
+    out["u"] = inverting_stage([pr.r3 / pr.r4], [1.0], [1 + pr.r3 / pr.r4], opamp)
+    return out
+
+
+def difference_weights(parts: PidParts):
+    """(g_y, g_r): the difference amplifier's ideal output is g_y y - g_r r."""
+    g_r = parts.r16 / parts.r15
+    g_y = (1 + g_r) * parts.r18 / (parts.r17 + parts.r18)
+    return g_y, g_r
+
+
+def summer_weights(parts: PidParts) -> dict:
+    """The summer's ideal output is -R5 (vp/R6 + vd/R7 + vi/R8)."""
+    w = {"vp": -parts.r5 / parts.r6, "vi": -parts.r5 / parts.r8}
+    if parts.has_derivative:
+        w["vd"] = -parts.r5 / parts.r7
+    return w
+
+
+@dataclass
+class LoopModel:
+    """State-space model of the whole loop: input r, outputs :data:`SIGNALS`."""
+
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    d: np.ndarray
+    outputs: tuple
+
+    def poles(self) -> np.ndarray:
+        return np.linalg.eigvals(self.a) if self.a.size else np.array([])
+
+    def stable(self) -> bool:
+        p = self.poles()
+        return bool(np.all(p.real < 0)) if p.size else True
+
+    def simulate(self, t, r) -> dict:
+        """Outputs for the reference samples ``r`` at uniform times ``t`` (from rest)."""
+        t = np.asarray(t, float)
+        r = np.asarray(r, float)
+        n = self.a.shape[0]
+        dt = t[1] - t[0]
+        # first-order hold discretisation (exact for a piecewise-linear reference)
+        m = np.zeros((n + 2, n + 2))
+        m[:n, :n] = self.a * dt
+        m[:n, n:n + 1] = self.b * dt
+        m[n, n + 1] = 1.0
+        em = _expm(m)
+        phi, g1, g2 = em[:n, :n], em[:n, n:n + 1], em[:n, n + 1:n + 2]
+        bd0 = (g1 - g2).ravel()
+        bd1 = g2.ravel()
+        x = np.zeros((t.size, n))
+        xk = np.zeros(n)
+        # step through the samples while the reference moves; once it is
+        # constant the response is a sum of modes, evaluated all at once
+        moving = np.nonzero(np.diff(r) != 0)[0]
+        k0 = int(moving[-1]) + 1 if moving.size else 0
+        for k in range(1, k0 + 1):
+            xk = phi @ xk + bd0 * r[k - 1] + bd1 * r[k]
+            x[k] = xk
+        if k0 < t.size - 1 and n:
+            x[k0:] = _constant_tail(phi, bd0 + bd1, xk, r[k0], t.size - k0)
+        y = x @ self.c.T + np.outer(r, self.d.ravel())
+        return {name: y[:, i] for i, name in enumerate(self.outputs)}
+
+
+
+def _constant_tail(phi, bsum, x0, rc, count):
+    """States x_k = phi^k (x0 - xss) + xss, k = 0..count-1, for a constant
+    input, by doubling: the block of k in [m, 2m) is phi^m times the block of
+    [0, m), so about log2(count) matrix products instead of a Python loop."""
+    n = phi.shape[0]
+    try:
+        xss = np.linalg.solve(np.eye(n) - phi, bsum * rc)
+    except np.linalg.LinAlgError:
+        xss = None
+    if xss is None or not np.all(np.isfinite(xss)):
+        out = np.empty((count, n))
+        xk = x0
+        for k in range(count):
+            out[k] = xk
+            xk = phi @ xk + bsum * rc
+        return out
+    blk = (x0 - xss)[:, None]
+    p = phi.copy()
+    while blk.shape[1] < count:
+        blk = np.concatenate([blk, p @ blk], axis=1)
+        p = p @ p
+    return blk[:, :count].T + xss
+
+
+def _expm(m):
+    """expm with diagonal balancing first: companion-form blocks with poles
+    from 1e2 to 1e7 rad/s make badly scaled matrices that expm squares many
+    times (slow and less accurate)."""
+    from scipy.linalg import expm, matrix_balance
+    b, tr = matrix_balance(m, permute=False, separate=True)
+    scale = tr[0]
+    return (expm(b) * scale[:, None]) / scale[None, :]
+
+
+def _ss(num, den):
+    num = np.atleast_1d(np.asarray(num, float))
+    den = np.atleast_1d(np.asarray(den, float))
+    num, den = _trim(num), _trim(den)
+    if np.all(num == 0) or den.size == 1:   # a static gain has no states
+        k = 0.0 if np.all(num == 0) else num[-1] / den[0]
+        return np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.full((1, 1), k)
+    a, b, c, d = signal.tf2ss(num, den)
+    return a, b, c, d
+
+
+def assemble(parts: PidParts, opamp: OpAmp | None, plant_num, plant_den) -> LoopModel:
+    """The closed loop as one state-space model.
+
+    Each block is y_k = H_k(s) (sum of weighted signals); the signal vector
+    z = (ve, vp, vd, vi, vs, u, y) satisfies z = C x + Dz z + Dr r, solved once.
+    """
+    tfs = stage_tfs(parts, opamp)
+    g_y, g_r = difference_weights(parts)
+    sw = summer_weights(parts)
+    names = list(SIGNALS)
+    idx = {n: i for i, n in enumerate(names)}
+    # block: output signal -> (tf, {input signal or 'r': weight})
+    blocks = {"ve": (tfs["ve"], {"y": g_y, "r": -g_r}),
+              "vp": (tfs["vp"], {"ve": 1.0}),
+              "vi": (tfs["vi"], {"ve": 1.0}),
+              "vs": (tfs["vs"], {k: v for k, v in sw.items()}),
+              "u": (tfs["u"], {"vs": 1.0}),
+              "y": ((plant_num, plant_den), {"u": 1.0})}
+    if parts.has_derivative:
+        blocks["vd"] = (tfs["vd"], {"ve": 1.0})
+    nz = len(names)
+    mats = []
+    nx = 0
+    for name in names:
+        if name not in blocks:
+            mats.append((name, *_ss([0.0], [1.0]), {}))
+            continue
+        (num, den), ins = blocks[name]
+        a, b, c, d = _ss(num, den)
+        mats.append((name, a, b, c, d, ins))
+        nx += a.shape[0]
+    A = np.zeros((nx, nx))
+    Bz = np.zeros((nx, nz))
+    Br = np.zeros((nx, 1))
+    C = np.zeros((nz, nx))
+    Dz = np.zeros((nz, nz))
+    Dr = np.zeros((nz, 1))
+    o = 0
+    for name, a, b, c, d, ins in mats:
+        k = a.shape[0]
+        i = idx[name]
+        A[o:o + k, o:o + k] = a
+        C[i, o:o + k] = c.ravel()
+        for src, w in ins.items():
+            if src == "r":
+                Br[o:o + k, 0] += b.ravel() * w
+                Dr[i, 0] += d.item() * w
+            else:
+                Bz[o:o + k, idx[src]] += b.ravel() * w
+                Dz[i, idx[src]] += d.item() * w
+        o += k
+    try:
+        M = np.linalg.inv(np.eye(nz) - Dz)
+    except np.linalg.LinAlgError:  # pragma: no cover - needs a plant with direct feedthrough
+        raise DesignError("the loop has an algebraic loop (no dynamics around it)") from None
+    Acl = A + Bz @ M @ C
+    Bcl = Br + Bz @ M @ Dr
+    return LoopModel(Acl, Bcl, M @ C, M @ Dr, tuple(names))
+
+
+def loop_gain(parts: PidParts, opamp: OpAmp | None, plant_num, plant_den, w) -> np.ndarray:
+    """Loop gain L(jw), signed so that the loop is the usual 1 + L(s) = 0
+    negative-feedback loop (the three inversions are accounted for)."""
+    s = 1j * np.asarray(w, float)
+    tfs = stage_tfs(parts, opamp)
+    ev = lambda tf: np.polyval(tf[0], s) / np.polyval(tf[1], s)  # noqa: E731
+    g_y, _ = difference_weights(parts)
+    sw = summer_weights(parts)
+    paths = sw["vp"] * ev(tfs["vp"]) + sw["vi"] * ev(tfs["vi"])
+    if parts.has_derivative:
+        paths = paths + sw["vd"] * ev(tfs["vd"])
+    chain = ev(tfs["ve"]) * g_y * paths * ev(tfs["vs"]) * ev(tfs["u"]) * ev((plant_num, plant_den))
+    return -chain
+
+
+def margins(w, L) -> dict:
+    """Phase margin (deg) at every gain crossover (the smallest is reported),
+    gain margin (dB) at the first -180 deg crossing, from samples of L(jw)."""
+    w = np.asarray(w, float)
+    mag = np.abs(L)
+    ph = np.unwrap(np.angle(L))
+    pm, wc = math.inf, math.nan
+    above = mag >= 1.0
+    for i in np.nonzero(above[:-1] != above[1:])[0]:
+        f = (0 - math.log(mag[i])) / (math.log(mag[i + 1]) - math.log(mag[i]))
+        phase = ph[i] + f * (ph[i + 1] - ph[i])
+        m = (math.degrees(phase) + 180.0) % 360.0
+        m = m - 360.0 if m > 180.0 else m
+        if m < pm:
+            pm, wc = m, w[i] + f * (w[i + 1] - w[i])
+    gm, w180 = math.inf, math.nan
+    wrapped = (np.degrees(ph) + 180.0) % 360.0 - 180.0   # 0 at -180 deg
+    for i in np.nonzero(np.sign(wrapped[:-1]) != np.sign(wrapped[1:]))[0]:
+        if abs(wrapped[i] - wrapped[i + 1]) > 180:  # wrap jump, not a crossing
+            continue
+        f = wrapped[i] / (wrapped[i] - wrapped[i + 1])
+        mg = math.exp(math.log(mag[i]) + f * (math.log(mag[i + 1]) - math.log(mag[i])))
+        if mg > 0:
+            gm, w180 = -20 * math.log10(mg), w[i] + f * (w[i + 1] - w[i])
+            break
+    return {"phase_margin_deg": pm, "crossover_hz": wc / (2 * math.pi) if math.isfinite(wc) else math.nan,
+            "gain_margin_db": gm, "phase_crossover_hz": w180 / (2 * math.pi) if math.isfinite(w180) else math.nan}
+
+
+def ideal_pid_tf(kp: float, ti: float, td: float):
+    """Ideal parallel PID Kp (1 + 1/(Ti s) + Td s) as (num, den) (improper when Td > 0)."""
+    return kp * np.array([ti * td, ti, 1.0]), np.array([ti, 0.0])
+
+
+def ideal_closed_loop(kp, ti, td, plant_num, plant_den):
+    """y/r of the ideal PID with the plant: PC/(1 + PC) (proper for a 2nd-order plant)."""
+    cn, cd = ideal_pid_tf(kp, ti, td)
+    n = np.polymul(cn, plant_num)
+    d = np.polyadd(np.polymul(cd, plant_den), n)
+    return _trim(n), _trim(d)
+
+
+def _trim(p):
+    p = np.atleast_1d(np.asarray(p, float))
+    nz = np.nonzero(np.abs(p) > 1e-300)[0]
+    return p[nz[0]:] if nz.size else np.array([0.0])
+
+
+def reference(t, step: float, t0: float, edge: float) -> np.ndarray:
+    """A step of ``step`` volts starting at ``t0`` with a linear edge of ``edge`` seconds."""
+    t = np.asarray(t, float)
+    if edge <= 0:
+        return np.where(t >= t0, step, 0.0)
+    return step * np.clip((t - t0) / edge, 0.0, 1.0)
+
+
+def simulate_ideal(kp, ti, td, plant_num, plant_den, t, r) -> np.ndarray:
+    """Plant output of the ideal-PID loop for reference samples ``r``."""
+    n, d = ideal_closed_loop(kp, ti, td, plant_num, plant_den)
+    if len(n) >= len(d):
+        raise DesignError("ideal closed loop is improper (plant of order < 2 with Td > 0)")
+    a, b, c, dd = signal.tf2ss(n, d)
+    lm = LoopModel(a, b, c, dd, ("y",))
+    return lm.simulate(t, r)["y"]
+
+
+#: slewing may delay a stage by at most this fraction of the closed-loop rise time
+SLEW_DELAY_FRACTION = 0.05
+
+
+def slew_delay(t, v, slew_v_per_s: float) -> float:
+    """Extra time a slew-limited op-amp needs to follow the linear waveform
+    ``v``: the part of its excursions faster than the slew rate, divided by
+    the slew rate, sum(max(0, |dv| - SR dt)) / SR (0 when it never slews)."""
+    dv = np.abs(np.diff(np.asarray(v, float)))
+    dt = np.diff(np.asarray(t, float))
+    return float(np.sum(np.maximum(0.0, dv - slew_v_per_s * dt)) / slew_v_per_s)
+
+
+def waveform_limits(wave: dict, t, opamp: OpAmp, delay_budget_s: float) -> dict:
+    """Per op-amp: peak output, peak slope and slew delay of the linear
+    waveforms, and whether they stay within the op-amp's swing and slew
+    rate (slewing is accepted while it delays the stage by less than
+    ``delay_budget_s``). ``wave`` is the rising half of the square wave, from
+    rest; the extremes cover the falling half too."""
+    t = np.asarray(t, float)
+    out = {}
+    for ref, role, sig in OPAMP_OUTPUTS:
+        if sig not in wave:
+            continue
+        v = np.asarray(wave[sig], float)
+        slope = float(np.max(np.abs(np.diff(v)) / np.diff(t))) if v.size > 1 else 0.0
+        # the falling edge of the square wave mirrors the rising one about the
+        # settled level (linear superposition), so the period's extremes are:
+        vf = float(v[-1])
+        vmax = max(float(v.max()), vf - float(v.min()))
+        vmin = min(float(v.min()), vf - float(v.max()))
+        delay = 0.0 if opamp.ideal else slew_delay(t, v, opamp.slew_v_per_s)
+        out[role] = {"opamp": ref, "signal": sig, "v_max": vmax, "v_min": vmin,
+                     "slope_v_per_s": slope, "slew_delay_s": delay,
+                     "swing_ok": bool(opamp.ideal or (vmax <= opamp.vout_max and vmin >= opamp.vout_min)),
+                     "slew_ok": bool(opamp.ideal or delay <= delay_budget_s)}
+    return out
