@@ -150,7 +150,6 @@ def plot_fit(result, path, n_models: int = 3) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import numpy as np
 
     from .fileio import atomic_write
     from .identify.core import model_step
@@ -158,24 +157,27 @@ def plot_fit(result, path, n_models: int = 3) -> None:
 
     s = result.step
     t, y = block_mean(s.t_raw, s.y_raw, 20000)
-    fig, ax = plt.subplots(figsize=(8, 4.5), dpi=110)
-    ax.plot(t - s.t_step, y, color="0.6", lw=1.0, label="data")
-    shown = [m for m in result.methods if m.valid][:n_models]
+    fig, (ax, axr) = plt.subplots(2, 1, figsize=(8, 6), dpi=110, sharex=True,
+                                  gridspec_kw={"height_ratios": [3, 1]})
     tt = t - s.t_step
-    for m in shown:
+    ax.plot(tt, y, color="k", lw=2.2, alpha=0.35, label="data")
+    shown = [m for m in result.methods if m.valid][:n_models]
+    for m, style in zip(shown, ("-", "--", ":")):
         ym = s.y0 + s.amplitude * model_step(m.model, m.params, tt)
-        ax.plot(tt, ym, lw=1.2, label=f"{m.name} ({m.model}), IAE {m.iae:.3g}")
-    ax.axvline(0.0, color="k", lw=0.6, ls=":")
-    ax.set_xlabel("time since the step (s)")
+        line, = ax.plot(tt, ym, lw=1.2, ls=style, label=f"{m.name} ({m.model}), IAE {m.iae:.3g}")
+        axr.plot(tt, y - ym, lw=0.8, ls=style, color=line.get_color())
+    for a in (ax, axr):
+        a.axvline(0.0, color="k", lw=0.6, ls=":")
+        a.grid(True, alpha=0.3)
+    axr.set_xlabel("time since the step (s)")
+    axr.set_ylabel("data - model")
     ax.set_ylabel(result.capture.get("output", "output") if result.capture else "output")
     ax.set_title("Step response: data and best identified models")
-    ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
     buf = io.BytesIO()
     fig.savefig(buf, format="png")
     plt.close(fig)
-    del np
     atomic_write(path, buf.getvalue())
 
 

@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from designer.identify.core import model_step
 from designer.identify.refine import fit, refine_all
@@ -97,3 +99,15 @@ def test_orchestrator_ranks_least_squares_first_on_noisy_underdamped_data():
     ym = s.y0 + s.amplitude * model_step(r.best.model, r.best.params, t - s.t_step)
     keep = t >= r.step.t_step
     assert r.best.iae == pytest.approx(np.trapezoid(np.abs(y - ym)[keep], t[keep]), rel=1e-9)
+
+
+@settings(max_examples=15, deadline=None)
+@given(tau=st.floats(1e-6, 1e3), ratio=st.floats(0.0, 2.0), K=st.floats(-50.0, 50.0).filter(
+    lambda k: abs(k) > 0.01))
+def test_fopdt_fit_recovers_any_noise_free_fopdt(tau, ratio, K):
+    p = {"K": K, "tau_s": tau, "theta_s": ratio * tau}
+    t = np.linspace(0, p["theta_s"] + 10 * tau, 3001)
+    r = fit("fopdt", t, model_step("fopdt", p, t), K)
+    assert r.params["K"] == pytest.approx(K, rel=1e-5)
+    assert r.params["tau_s"] == pytest.approx(tau, rel=1e-4)
+    assert r.params["theta_s"] == pytest.approx(p["theta_s"], abs=1e-4 * tau)

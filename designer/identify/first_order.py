@@ -112,7 +112,7 @@ def _validity(y, yf, sigma):
     return True, ""
 
 
-def _result(name, model, K, tau, theta, points, valid, note, sigma):
+def _result(name, model, K, tau, theta, points, valid, note):
     notes = [note] if note else []
     if not (math.isfinite(tau) and tau > 0):
         valid = False
@@ -203,7 +203,7 @@ def ziegler_nichols(t, y, yf) -> MethodResult:
     valid, note = _validity(y, yf, sigma)
     return _result("ziegler-nichols", "fopdt", yf, t3 - theta, theta,
                    {"t_inflection_s": tg.t, "y_inflection": tg.y, "slope_per_s": tg.slope,
-                    "t1_s": theta, "t3_s": t3}, valid, note, sigma)
+                    "t1_s": theta, "t3_s": t3}, valid, note)
 
 
 def hagglund(t, y, yf) -> MethodResult:
@@ -218,7 +218,7 @@ def hagglund(t, y, yf) -> MethodResult:
     valid, note = _validity(y, yf, sigma)
     return _result("hagglund", "fopdt", yf, t2 - theta, theta,
                    {"t_inflection_s": tg.t, "slope_per_s": tg.slope, "t1_s": theta,
-                    "t2_s": t2}, valid, note, sigma)
+                    "t2_s": t2}, valid, note)
 
 
 def _cross(t, y, yf, p, sigma):
@@ -238,7 +238,7 @@ def two_point(row: TwoPoint, t, y, yf) -> MethodResult:
     theta = row.c * t1 + row.d * t2
     valid, note = _validity(y, yf, sigma)
     k1, k2 = _pct_key(row.p1), _pct_key(row.p2)
-    return _result(row.name, row.model, yf, tau, theta, {k1: t1, k2: t2}, valid, note, sigma)
+    return _result(row.name, row.model, yf, tau, theta, {k1: t1, k2: t2}, valid, note)
 
 
 def _pct_key(p):
@@ -270,7 +270,7 @@ def nishikawa(t, y, yf) -> MethodResult:
     theta = t0 - tau
     valid, note = _validity(y, yf, sigma)
     return _result("nishikawa", "fopdt", yf, tau, theta, {"A0_s": a0, "A1_s": a1, "t0_s": t0},
-                   valid, note, sigma)
+                   valid, note)
 
 
 def smith(t, y, yf):

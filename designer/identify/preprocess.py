@@ -145,7 +145,7 @@ def final_value(t, y, y0: float, *, sigma: float | None = None) -> float:
     y = np.asarray(y, float)
     n = y.size
     m = max(4, int(n * TAIL_FRACTION))
-    tail_t, tail = t[-m:], y[-m:]
+    tail = y[-m:]
     yf = float(np.mean(tail))
     span = yf - y0
     if sigma is None:
@@ -163,7 +163,6 @@ def final_value(t, y, y0: float, *, sigma: float | None = None) -> float:
             f"the record ends before the response settles: its last {100 * TAIL_FRACTION:.0f} % "
             f"still moves by {pct:.1f} % of the step (allowed {100 * SETTLE_TOL:.0f} %); "
             "capture a longer record after the step (at least 5 settling times)")
-    del tail_t
     return yf
 
 

@@ -146,7 +146,7 @@ def fit(model: str, t, y, yf, start: dict | None = None) -> MethodResult:
     params = _from_x(model, x)
     if model == "overdamped" and params["tau2_s"] > params["tau1_s"]:
         params["tau1_s"], params["tau2_s"] = params["tau2_s"], params["tau1_s"]
-    ci = _confidence(model, best, tf.size, scale)
+    ci = _confidence(model, best, tf.size)
     points = {f"{k}_ci95": v for k, v in ci.items()}
     points["samples_fitted"] = int(tf.size)
     points["rms_residual"] = float(math.sqrt(2 * best.cost / tf.size)) * scale
@@ -161,7 +161,7 @@ def _fmt(v):
     return f"{v:.3g}"
 
 
-def _confidence(model, sol, n, scale):
+def _confidence(model, sol, n):
     """95 % half-widths of the physical parameters (delta method through the log scale)."""
     names = PARAMS[model]
     J = sol.jac
@@ -177,14 +177,12 @@ def _confidence(model, sol, n, scale):
     x = sol.x
     out = {}
     for i, k in enumerate(names):
-        if k == "K":
-            # Residuals were divided by |yf|, K was not: undo nothing (K is in y's units).
-            out[k] = float(q * sd[i])
-        elif k in ("tau_s", "tau1_s", "tau2_s", "wn_rad_s"):
+        if k in ("tau_s", "tau1_s", "tau2_s", "wn_rad_s"):
             out[k] = float(q * sd[i] * math.exp(x[i]))  # d exp(x) = exp(x) dx
         else:
+            # K, zeta, theta are free variables themselves. (Residuals are
+            # divided by |yf|, a constant: it cancels between s^2 and J.)
             out[k] = float(q * sd[i])
-    del scale
     return out
 
 
