@@ -117,3 +117,16 @@ def test_bad_files_name_the_problem():
 def test_missing_file(tmp_path):
     with pytest.raises(DesignError, match="does not exist"):
         read_capture(tmp_path / "nope.csv")
+
+
+def test_input_by_position_only_when_it_looks_like_a_step():
+    t = np.linspace(-1e-3, 9e-3, 2001)
+    y1 = model_step("underdamped", {"K": 1, "wn_rad_s": 6e3, "zeta": 0.3}, t)
+    y2 = model_step("fopdt", {"K": 1, "tau_s": 1e-3, "theta_s": 0.0}, t)
+    u = np.where(t >= 0, 1.0, 0.0)
+    waves = "time_s,analytic,spice\n" + "".join(f"{a},{b},{c}\n" for a, b, c in zip(t, y1, y2))
+    cap = parse_capture_text(waves)
+    assert cap.u is None and cap.output_name == "spice" and "does not look like" in cap.notes[0]
+    tuy = "".join(f"{a},{b},{c}\n" for a, b, c in zip(t, u, y2))
+    cap = parse_capture_text(tuy)
+    assert cap.input_name == "u" and np.array_equal(cap.u, u)

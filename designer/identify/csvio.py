@@ -55,10 +55,12 @@ class Capture:
     output_name: str = ""
     input_name: str | None = None
     source: str = ""
+    notes: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return {"format": self.fmt, "columns": list(self.columns), "samples": int(self.t.size),
-                "output": self.output_name, "input": self.input_name, "source": self.source}
+                "output": self.output_name, "input": self.input_name, "source": self.source,
+                "notes": list(self.notes)}
 
 
 def read_capture(path, *, input_column=None, output_column=None) -> Capture:
@@ -329,16 +331,45 @@ def _assemble(columns, data, fmt, first_row, name, input_column, output_column) 
         j_out = named[0] if named else data.shape[1] - 1
         if j_out == j_in:
             j_out = next(j for j in range(data.shape[1] - 1, 0, -1) if j != j_in)
+    notes = []
     if j_in is None and not no_input and n_sig >= 2:
         named = [j for j in range(1, len(norm)) if norm[j] in INPUT_NAMES and j != j_out]
         if named:
             j_in = named[0]
         else:
             j_in = next(j for j in range(1, data.shape[1]) if j != j_out)
+            # Chosen by position only: accept it as the input only if it
+            # looks like one (e.g. time_s,analytic,spice has no input column).
+            if not looks_like_step_input(data[:, j_in], data[:, j_out]):
+                notes.append(f"column {columns[j_in]!r} does not look like a step input "
+                             "(its transitions are not much faster than the output's); "
+                             "no input column used (see --input-column)")
+                j_in = None
     u = None if j_in is None else np.ascontiguousarray(data[:, j_in])
     return Capture(t=np.ascontiguousarray(t), y=np.ascontiguousarray(data[:, j_out]), u=u,
                    fmt=fmt, columns=columns, output_name=columns[j_out],
-                   input_name=None if j_in is None else columns[j_in], source=name)
+                   input_name=None if j_in is None else columns[j_in], source=name,
+                   notes=notes)
+
+
+def _transition_fraction(x) -> float:
+    lo, hi = np.percentile(x, [1, 99])
+    span = hi - lo
+    if span <= 0:
+        return 1.0
+    mid = (x > lo + 0.1 * span) & (x < lo + 0.9 * span)
+    return float(np.count_nonzero(mid)) / x.size
+
+
+def looks_like_step_input(u, y) -> bool:
+    """True when ``u`` is a two-level signal whose transitions are much faster
+    than ``y``'s: it spends under 2 % of the record between its 10 % and 90 %
+    levels, and under a fifth of the time ``y`` spends between its own."""
+    u = np.asarray(u, float)
+    fu = _transition_fraction(u)
+    if np.ptp(u) == 0:
+        return False
+    return fu < 0.02 and fu < 0.2 * _transition_fraction(np.asarray(y, float))
 
 
 # --------------------------------------------------------------------------- writers

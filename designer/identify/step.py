@@ -109,7 +109,7 @@ class IdentifyResult:
         lines.append(f"Step at {format_eng(s.t_step, 's')}, amplitude {s.amplitude:.4g}; "
                      f"baseline y0 = {s.y0:.4g}, final value {s.y_final:.4g}, "
                      f"static gain K = {s.yf:.4g}; noise {_pct(s.sigma, s.y_final - s.y0)} of the step")
-        for n in s.notes:
+        for n in (self.capture or {}).get("notes", []) + s.notes:
             lines.append(f"  note: {n}")
         if self.measured:
             m = self.measured
