@@ -388,3 +388,19 @@ def test_crossing_time_on_noise_uses_the_neighbourhood():
     # the first sample above the level is much earlier than the true crossing
     first = t[np.argmax(z >= 0.5)]
     assert first < 0.48
+
+
+@pytest.mark.parametrize("method, make", [
+    (so.overshoot, lambda: underdamped(1.0, 2.0, 0.3, theta=1.0)),
+    (so.log_decrement, lambda: underdamped(1.0, 2.0, 0.3, theta=1.0)),
+    (so.t4_t3, lambda: overdamped(1.0, 1.0, 3.0, theta=1.0)),
+    (so.two_pole, lambda: overdamped(1.0, 0.1, 3.0, theta=1.0)),
+    (so.dc_motor, lambda: (lambda t: (t, model_step("fopdt", {"K": 1.0, "tau_s": 1.0,
+                                                               "theta_s": 0.5}, t)))(
+        np.linspace(0, 12, 5001))),
+])
+def test_no_delay_methods_flag_a_dead_time(method, make):
+    t, y = make()
+    r = method(t, y, 1.0)
+    assert not r.valid
+    assert ("delay-free" if method is so.dc_motor else "dead time") in r.note

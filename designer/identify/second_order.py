@@ -328,6 +328,38 @@ def _second_order_params(K, wn, zeta, theta):
                           "tau2_s": 1.0 / (wn * (zeta - r)), "theta_s": theta}
 
 
+def _late_start(t, z, sigma, model, params):
+    """For the methods that assume no dead time: how much later than the
+    identified model the data leave zero (time to 5 %), or 0. A lag over a
+    tenth of the time to 50 % means a dead time the method cannot represent."""
+    t05 = crossing_time(t, z, 0.05, sigma)
+    t50 = crossing_time(t, z, 0.5, sigma)
+    if not (math.isfinite(t05) and math.isfinite(t50)) or t50 <= 0.0:
+        return 0.0
+    p = dict(params, K=1.0, theta_s=0.0)
+    try:
+        tm = np.linspace(0.0, 2.0 * t50, 4001)
+        m05 = crossing_time(tm, model_step(model, p, tm), 0.05)
+    except (ValueError, KeyError, ZeroDivisionError, OverflowError):
+        return 0.0
+    lag = t05 - m05 if math.isfinite(m05) else 0.0
+    return lag if lag > 0.1 * t50 else 0.0
+
+
+def _flag_late(result, t, z, sigma):
+    """Mark a no-dead-time method's result invalid when the data start late
+    (the dead time is then the first thing to tell, before any range note)."""
+    if not all(math.isfinite(v) for v in result.params.values()):
+        return result
+    lag = _late_start(t, z, sigma, result.model, result.params)
+    if lag > 0.0:
+        result.valid = False
+        result.note = (f"the data leave zero {lag:.3g} s later than this model: a dead time, "
+                       "which this method assumes absent (use chen, stark-mollenkamp, "
+                       "jahanmiri-fallahi or least-squares)")
+    return result
+
+
 # --------------------------------------------------------------------------
 # the methods
 # --------------------------------------------------------------------------
@@ -352,9 +384,11 @@ def overshoot(t, y, yf) -> MethodResult:
     mp = zp - 1.0
     zeta = float(zeta_from_overshoot(mp))
     wn = float(wn_from_peak_time(tp, zeta))
-    return MethodResult(name, model, {"K": float(yf), "wn_rad_s": wn, "zeta": zeta, "theta_s": 0.0},
-                        points={"tp_s": tp, "overshoot": mp, "peak": zp * yf},
-                        note="assumes no dead time (peak time measured from the step)")
+    return _flag_late(MethodResult(name, model, {"K": float(yf), "wn_rad_s": wn, "zeta": zeta,
+                                                 "theta_s": 0.0},
+                                   points={"tp_s": tp, "overshoot": mp, "peak": zp * yf},
+                                   note="assumes no dead time (peak time measured from the step)"),
+                      t, z, sigma)
 
 
 def log_decrement(t, y, yf) -> MethodResult:
@@ -392,10 +426,13 @@ def log_decrement(t, y, yf) -> MethodResult:
     note = "assumes no dead time" if valid else (
         f"zeta = {zeta:.3f} > 0.5: outside the method's range (zeta <= 0.5, seed 002); "
         "use t4-t3")
-    return MethodResult(name, model, {"K": float(yf), "wn_rad_s": wn, "zeta": zeta, "theta_s": 0.0},
-                        valid=valid, note=note,
-                        points={"t1_s": t1, "y1": y1, "t_min_s": tm, "y2": y2, "period_s": period,
-                                "zeta_first": zeta1, "zeta_second": zeta2})
+    return _flag_late(MethodResult(name, model, {"K": float(yf), "wn_rad_s": wn, "zeta": zeta,
+                                                 "theta_s": 0.0},
+                                   valid=valid, note=note,
+                                   points={"t1_s": t1, "y1": y1, "t_min_s": tm, "y2": y2,
+                                           "period_s": period, "zeta_first": zeta1,
+                                           "zeta_second": zeta2}),
+                      t, z, sigma)
 
 
 def t4_t3(t, y, yf) -> MethodResult:
@@ -429,7 +466,8 @@ def t4_t3(t, y, yf) -> MethodResult:
         note = (f"t4/t3 = {ratio:.3f} gives zeta = {zeta:.3f}, outside the method's range "
                 f"0.5 <= zeta <= 2 (t4/t3 {lo:.3f} to {hi:.3f}); use "
                 + ("log-decrement" if zeta < 0.5 else "two-pole"))
-    return MethodResult(name, model, params, valid=valid, note=note, points=pts)
+    return _flag_late(MethodResult(name, model, params, valid=valid, note=note, points=pts),
+                      t, z, sigma)
 
 
 def two_pole(t, y, yf, levels=(0.6, 0.9)) -> MethodResult:
@@ -468,7 +506,8 @@ def two_pole(t, y, yf, levels=(0.6, 0.9)) -> MethodResult:
     note = "assumes no dead time" if valid else (
         f"zeta = {zeta:.3f}: outside the method's range zeta > 2 (poles not far enough apart "
         "for the slow one to dominate above 50 %); use t4-t3")
-    return MethodResult(name, model, params, valid=valid, note=note, points=pts)
+    return _flag_late(MethodResult(name, model, params, valid=valid, note=note, points=pts),
+                      t, z, sigma)
 
 
 def chen(t, y, yf) -> MethodResult:
@@ -737,6 +776,7 @@ def dc_motor(t, y, yf) -> MethodResult:
     valid = spread <= 0.1
     note = ("" if valid else f"tau_m from the 20-80 % samples varies by {spread:.0%}: not a "
             "delay-free first-order lag (the method's model)")
+    # (a dead time already shows as the spread: no separate late-start check)
     return MethodResult(name, model, {"K": float(yf), "tau_s": tau, "theta_s": 0.0},
                         valid=valid, note=note, points=pts)
 
