@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .core import MethodResult
-from .preprocess import crossing_time, noise_sigma, smooth_derivative
+from .preprocess import crossing_time, noise_sigma, smooth_derivative, window_samples
 
 #: An FOPDT or double-pole model cannot overshoot; beyond this the data are
 #: outside every method's validity range here.
@@ -149,6 +149,7 @@ class Tangent:
     t: float
     y: float
     slope: float
+    window_s: float = 0.0   #: smoothing window of the derivative
 
     @property
     def t_base(self) -> float:
@@ -167,8 +168,10 @@ def steepest_tangent(t, y, yf, *, sigma: float | None = None) -> Tangent:
     so a dense noise-free record gives the analytic tangent.
     """
     sigma = _sigma(y) if sigma is None else sigma
-    ts, ys, dy = smooth_derivative(t, y, sigma=sigma, span=yf)
     sgn = 1.0 if yf >= 0 else -1.0
+    rise = (crossing_time(t, sgn * np.asarray(y), 0.9 * abs(yf), sigma=sigma)
+            - crossing_time(t, sgn * np.asarray(y), 0.1 * abs(yf), sigma=sigma))
+    ts, ys, dy = smooth_derivative(t, y, sigma=sigma, span=yf, rise_s=rise)
     d = sgn * dy
     # Only up to the first time the response reaches yf: later slopes
     # (ringing) are not the reaction curve's.
@@ -188,7 +191,9 @@ def steepest_tangent(t, y, yf, *, sigma: float | None = None) -> Tangent:
                 t_i = ts[i] + off * h
                 s_i = sgn * (d1 - 0.25 * (d0 - d2) * off)
                 y_i = float(np.interp(t_i, ts, ys))
-    return Tangent(t=float(t_i), y=float(y_i), slope=float(s_i))
+    h = float(ts[1] - ts[0])
+    w = window_samples(h, ts.size, sigma=sigma, span=yf, rise_s=rise)
+    return Tangent(t=float(t_i), y=float(y_i), slope=float(s_i), window_s=w * h)
 
 
 def ziegler_nichols(t, y, yf) -> MethodResult:
@@ -203,7 +208,7 @@ def ziegler_nichols(t, y, yf) -> MethodResult:
     valid, note = _validity(y, yf, sigma)
     return _result("ziegler-nichols", "fopdt", yf, t3 - theta, theta,
                    {"t_inflection_s": tg.t, "y_inflection": tg.y, "slope_per_s": tg.slope,
-                    "t1_s": theta, "t3_s": t3}, valid, note)
+                    "t1_s": theta, "t3_s": t3, "window_s": tg.window_s}, valid, note)
 
 
 def hagglund(t, y, yf) -> MethodResult:
@@ -218,7 +223,7 @@ def hagglund(t, y, yf) -> MethodResult:
     valid, note = _validity(y, yf, sigma)
     return _result("hagglund", "fopdt", yf, t2 - theta, theta,
                    {"t_inflection_s": tg.t, "slope_per_s": tg.slope, "t1_s": theta,
-                    "t2_s": t2}, valid, note)
+                    "t2_s": t2, "window_s": tg.window_s}, valid, note)
 
 
 def _cross(t, y, yf, p, sigma):

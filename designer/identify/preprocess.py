@@ -250,7 +250,8 @@ def uniform(t, y, n: int | None = None) -> tuple:
 
 
 def smooth_derivative(t, y, *, window_s: float | None = None, sigma: float = 0.0,
-                      span: float = 1.0, polyorder: int = 2) -> tuple:
+                      span: float = 1.0, rise_s: float | None = None,
+                      polyorder: int = 2) -> tuple:
     """Smoothed response and its time derivative (Savitzky-Golay).
 
     The default quadratic fit gives the least-squares slope over the window,
@@ -258,31 +259,42 @@ def smooth_derivative(t, y, *, window_s: float | None = None, sigma: float = 0.0
     exceeds the steepest true slope, even across the kink an FOPDT response
     has at its dead time (a cubic fit overshoots there).
 
-    The window is ``window_s`` seconds when given; otherwise it grows with the
-    noise: 5 samples on clean data (so tangent methods stay exact), up to
-    ~4 % of the record for noise near 1 % of the step. Returns ``(t, ys, dy)``
-    on a uniform grid (resampled when the input grid is not uniform).
+    The window is ``window_s`` seconds when given. Otherwise it is the
+    narrowest that keeps the slope noise, sigma sqrt(12 / w^3) / dt for w
+    samples, under 2 % of the typical slope span / rise_s (10-90 % rise time;
+    a tenth of the record if not given), and at most a tenth of the rise time
+    (wider windows flatten the response's shape). Clean data get 5 samples,
+    so tangent methods stay exact. Returns ``(t, ys, dy)`` on a uniform grid
+    (resampled when the input grid is not uniform).
     """
     tu, yu = uniform(t, y)
     dt = float((tu[-1] - tu[0]) / max(tu.size - 1, 1))
-    n = tu.size
-    if window_s is not None:
-        w = int(round(window_s / dt))
-    else:
-        rel = sigma / abs(span) if span else 0.0
-        # Derivative noise of an SG window of w samples scales as w^-1.5:
-        # choose w so that it stays well below the steepest slope of interest.
-        w = int(5 + (rel / 2e-4) ** (2.0 / 3.0) * 5) if rel > 0 else 5
-        w = min(w, max(5, n // 25))
-    w = max(5, min(w, n - (1 - n % 2)))
-    if w % 2 == 0:
-        w += 1
-    if w > n:
-        w = n if n % 2 else n - 1
+    w = window_samples(dt, tu.size, window_s=window_s, sigma=sigma, span=span, rise_s=rise_s)
     poly = min(polyorder, w - 1)
     ys = savgol(yu, w, poly)
     dy = savgol(yu, w, poly, deriv=1, delta=dt)
     return tu, ys, dy
+
+
+def window_samples(dt: float, n: int, *, window_s: float | None = None, sigma: float = 0.0,
+                   span: float = 1.0, rise_s: float | None = None) -> int:
+    """Odd Savitzky-Golay window length in samples (rule in :func:`smooth_derivative`)."""
+    if window_s is not None:
+        w = int(round(window_s / dt))
+    elif sigma > 0 and span:
+        if not (rise_s and math.isfinite(rise_s) and rise_s > 0):
+            rise_s = n * dt / 10.0
+        slope = abs(span) / rise_s
+        w = int(math.ceil((12.0 * (sigma / (dt * 0.02 * slope)) ** 2) ** (1.0 / 3.0)))
+        w = min(w, max(5, int(0.1 * rise_s / dt)))
+    else:
+        w = 5
+    w = max(5, w)
+    if w % 2 == 0:
+        w += 1
+    if w > n:
+        w = n if n % 2 else n - 1
+    return w
 
 
 def block_mean(t, y, max_samples: int = MAX_WORK_SAMPLES) -> tuple:
