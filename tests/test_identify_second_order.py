@@ -21,7 +21,8 @@ def underdamped(K, wn, zeta, theta=0.0, periods=12.0, n=20001):
 
 def overdamped(K, tau1, tau2, theta=0.0, n=20001):
     t = np.linspace(0.0, theta + 14.0 * max(tau1, tau2), n)
-    return t, model_step("overdamped", {"K": K, "tau1_s": tau1, "tau2_s": tau2, "theta_s": theta}, t)
+    p = {"K": K, "tau1_s": tau1, "tau2_s": tau2, "theta_s": theta}
+    return t, model_step("overdamped", p, t)
 
 
 def second_order(K, wn, zeta, n=40001):

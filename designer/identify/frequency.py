@@ -124,7 +124,8 @@ def freq_data(freq, gain, phase=None, *, gain_units="db", phase_units="deg",
     if phase_units not in PHASE_UNITS:
         raise DesignError(f"phase units {phase_units!r} unknown; allowed: {', '.join(PHASE_UNITS)}")
     if freq_units not in FREQ_UNITS:
-        raise DesignError(f"frequency units {freq_units!r} unknown; allowed: {', '.join(FREQ_UNITS)}")
+        raise DesignError(f"frequency units {freq_units!r} unknown; "
+                          f"allowed: {', '.join(FREQ_UNITS)}")
     f = np.asarray(freq, float)
     g = np.asarray(gain, float)
     if f.ndim != 1 or g.shape != f.shape:
@@ -242,7 +243,8 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
     lines = [(i + 1, ln.strip()) for i, ln in enumerate(text.splitlines())]
     lines = [(i, ln) for i, ln in lines if ln and not ln.startswith("#")]
     if not lines:
-        raise DesignError(f"{source or 'table'} is empty: expected rows of frequency, gain[, phase]")
+        raise DesignError(f"{source or 'table'} is empty: expected rows of "
+                          "frequency, gain[, phase]")
     first = lines[0][1]
     if ";" in first:
         sep, decimal_comma = ";", True
@@ -461,7 +463,8 @@ def asymptotes(data: FreqData) -> MethodResult:
     K from the flat low-frequency gain, order n from the high-frequency slope
     (-20 n dB/decade, rounded), corner wc where the gain has fallen
     n 10 log10(2) = 3.01 n dB below K (the seed's "3 dB x n" rule: the
-    asymptotes of n equal real poles meet there). n = 1: fopdt with tau = 1/wc; n = 2: double pole tau = 1/wc
+    asymptotes of n equal real poles meet there). n = 1: fopdt with
+    tau = 1/wc; n = 2: double pole tau = 1/wc
     (zeta = 1). The intersection of the fitted high-frequency line with K
     is reported in ``points`` as ``w_intersection_rad_s``.
     """
@@ -517,7 +520,8 @@ def resonant_peak(data: FreqData, min_db: float = 0.1) -> MethodResult:
     """Resonant-peak damping (seed 000 example 5, eqs 75 and 79).
 
     The peak (the vertex of 1/|G|^2 as a parabola in w^2 through the highest
-    point and its neighbours, exact for a second-order system) gives Mr = peak - K in dB; zeta solves
+    point and its neighbours, exact for a second-order system) gives
+    Mr = peak - K in dB; zeta solves
     -10 log(4 zeta^2 (1 - zeta^2)) = Mr and wn = w_peak / sqrt(1 - 2 zeta^2).
     Valid when the table shows a peak at least ``min_db`` above K between its
     first and last points (zeta < 0.707).
@@ -623,7 +627,8 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     params = _x_to_params(model, best.x, fit_delay)
     pts = {}
     m, n = best.fun.size, best.x.size
-    note = "" if fit_delay else "no phase in the table: fitted the gain only, dead time not identified"
+    note = ("" if fit_delay else
+            "no phase in the table: fitted the gain only, dead time not identified")
     if m > n:
         s2 = 2.0 * best.cost / (m - n)
         try:
@@ -631,7 +636,8 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
             half = student_t.ppf(0.975, m - n) * np.sqrt(np.clip(np.diag(cov), 0.0, None))
             # back from log variables: d(e^x) = e^x dx
             names = {"fopdt": ["K", "tau_s"], "underdamped": ["K", "wn_rad_s", "zeta"],
-                     "overdamped": ["K", "tau1_s", "tau2_s"]}[model] + (["theta_s"] if fit_delay else [])
+                     "overdamped": ["K", "tau1_s", "tau2_s"]}[model]
+            names += ["theta_s"] if fit_delay else []
             for k, h, xv in zip(names, half, best.x):
                 scale = abs(params[k]) if k not in ("zeta", "theta_s") else 1.0
                 if model == "overdamped" and k in ("tau1_s", "tau2_s"):
@@ -673,7 +679,8 @@ def _starts(model, classical, K, wc):
                     out.append(dict(p))
                 else:
                     tau = p.get("tau_s") or math.sqrt(p["tau1_s"] * p["tau2_s"])
-                    out.append({"K": K, "wn_rad_s": 1.0 / tau, "zeta": 0.9, "theta_s": p["theta_s"]})
+                    out.append({"K": K, "wn_rad_s": 1.0 / tau, "zeta": 0.9,
+                                "theta_s": p["theta_s"]})
             else:
                 if m.model == "overdamped":
                     out.append(dict(p))

@@ -573,7 +573,8 @@ def stark_mollenkamp(t, y, yf) -> MethodResult:
     pts = {"t15_s": t15, "t45_s": t45, "t75_s": t75, "x": x}
     num = 0.0805 - 5.547 * (0.475 - x) ** 2
     if x <= 0.356 or num <= 0.0:
-        return _fail(name, "underdamped", f"x = {x:.4f}: eq 32 needs x > 0.356 and gives no positive "
+        return _fail(name, "underdamped", f"x = {x:.4f}: eq 32 needs x > 0.356 and gives no "
+                     "positive "
                      "zeta (the correlation covers about 0.45 <= zeta <= 1.3)", yf, pts)
     zeta = num / (x - 0.356)
     f2 = 0.708 * 2.811 ** zeta if zeta < 1.0 else 2.6 * zeta - 0.60
@@ -738,7 +739,7 @@ def peeling(t, y, yf, iterations: int = 500) -> MethodResult:
         theta = max(0.0, math.log(arg) / (1.0 / tau1 - 1.0 / tau2)) if arg > 0.0 else 0.0
     pts["theta_s"] = theta
     fast, slow = sorted((tau1, tau2))
-    valid = slow >= 1.5 * fast
+    valid = bool(slow >= 1.5 * fast)
     note = "" if valid else (f"time constants {fast:.4g} s and {slow:.4g} s are too close "
                              "(ratio < 1.5) to peel apart reliably")
     return MethodResult(name, model, {"K": float(yf), "tau1_s": fast, "tau2_s": slow,
@@ -773,7 +774,7 @@ def dc_motor(t, y, yf) -> MethodResult:
     spread = float((q90 - q10) / tau)
     t0 = crossing_time(t, z, 1.0 - math.exp(-1.0), sigma)
     pts = {"t0_s": t0, "w_t0": (1.0 - math.exp(-1.0)) * yf, "tau_spread": spread}
-    valid = spread <= 0.1
+    valid = bool(spread <= 0.1)
     note = ("" if valid else f"tau_m from the 20-80 % samples varies by {spread:.0%}: not a "
             "delay-free first-order lag (the method's model)")
     # (a dead time already shows as the spread: no separate late-start check)
