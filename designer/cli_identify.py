@@ -62,7 +62,9 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="identify", description=__doc__.split("\n\n")[0].strip(),
+    p = _Parser(prog="identify",
+                description="Identify plant models (FOPDT, double pole, second order with dead\n"
+                            "time) from a measured or simulated step response, ranked by IAE.",
                 epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("capture", help="CSV file with the step response")
     p.add_argument("--step-time", metavar="T",
@@ -126,11 +128,15 @@ def identify_main(argv=None) -> int:
         buf = io.StringIO()
         json.dump(_finite(result.to_dict()), buf, indent=2, allow_nan=False,
                   default=_json_default)
-        print(buf.getvalue())
+        text = buf.getvalue()
     else:
-        print(result.to_text())
-        if args.plot:
-            print(f"\nPlot written to {args.plot}")
+        text = result.to_text() + (f"\n\nPlot written to {args.plot}" if args.plot else "")
+    try:
+        print(text)
+        sys.stdout.flush()
+    except BrokenPipeError:  # e.g. piped into head: not an error of ours
+        import os
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return 0
 
 
