@@ -224,11 +224,11 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
     -------
     IdentifyResult
     """
+    want = _check_names(methods)
     clock = time.perf_counter
     t0 = clock()
     step = prepare_step(t, y, u, step_time=step_time, step_amplitude=step_amplitude)
     timings = {"prepare": clock() - t0}
-    want = _check_names(methods)
     # Methods assume a rising response; a negative gain is flipped and restored.
     sgn = 1.0 if step.yf >= 0 else -1.0
     tw, yw, yfw = step.t, sgn * step.y, sgn * step.yf
@@ -265,12 +265,6 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
             _flip(m, sgn)
         _score_all(fits, step, t_eval, y_eval)
         results.extend(fits)
-    if want is not None:
-        found = {r.name for r in results}
-        missing = sorted(set(want) - found)
-        if missing:
-            raise DesignError(f"unknown method(s) {', '.join(missing)}; allowed: "
-                              f"{', '.join(sorted(known_method_names()))}")
     timings["refine"] = clock() - t1
     results.sort(key=_rank_key)
     best = next((m for m in results if m.valid and math.isfinite(m.iae)), None)
@@ -308,6 +302,11 @@ def _check_names(methods):
         want.update(x.strip().lower() for x in str(m).split(",") if x.strip())
     if not want:
         raise DesignError("--methods needs at least one method name")
+    known = known_method_names()
+    unknown = sorted(want - known)
+    if unknown:
+        raise DesignError(f"unknown method(s) {', '.join(unknown)}; allowed: "
+                          f"{', '.join(sorted(known))}")
     return want
 
 
