@@ -130,3 +130,15 @@ def test_input_by_position_only_when_it_looks_like_a_step():
     tuy = "".join(f"{a},{b},{c}\n" for a, b, c in zip(t, u, y2))
     cap = parse_capture_text(tuy)
     assert cap.input_name == "u" and np.array_equal(cap.u, u)
+
+
+def test_quoted_cells_and_a_units_row():
+    t = np.linspace(0, 1e-3, 50)
+    y = model_step("fopdt", {"K": 1.0, "tau_s": 2e-4, "theta_s": 0.0}, t)
+    quoted = '"Time (s)","Vout (V)"\n' + "".join(f'"{a:.6e}","{b:.6f}"\n' for a, b in zip(t, y))
+    cap = parse_capture_text(quoted)
+    assert cap.output_name == "Vout (V)" and np.allclose(cap.y, y, atol=1e-6)
+    # Keysight-style: a label row and a units row before the samples
+    units = "x-axis,1\nsecond,Volt\n" + "".join(f"{a:.6e},{b:.6f}\n" for a, b in zip(t, y))
+    cap = parse_capture_text(units)
+    assert cap.columns == ["second", "Volt"] and np.allclose(cap.t, t, rtol=1e-6)

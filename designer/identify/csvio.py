@@ -159,6 +159,8 @@ def _load_numeric(lines: list, first_row: int, delim: str, name: str, usecols=No
                   ncols=None) -> np.ndarray:
     """Load numeric rows with numpy's C parser; on failure find the bad cell."""
     body = lines[first_row:]
+    if body and '"' in body[0]:
+        body = [ln.replace('"', "") for ln in body]   # spreadsheet-quoted numbers
     if delim == ";":
         body = [ln.replace(",", ".") for ln in body]
     kw = {"delimiter": None if delim == "whitespace" else delim, "ndmin": 2, "dtype": float}
