@@ -396,7 +396,9 @@ def prepare_step(t, y, u=None, *, step_time: float | None = None,
     if edges:
         e = edges[0]
         t_step = e.time
-        amp = step_amplitude if step_amplitude is not None else e.amplitude
+        # A given amplitude is a size; the edge says which way it went.
+        amp = math.copysign(step_amplitude, e.amplitude) if step_amplitude is not None \
+            else e.amplitude
         notes.append(f"step detected in the input at t = {t_step:.6g} s, amplitude {amp:.6g}")
     else:
         if step_time is not None:
@@ -477,9 +479,8 @@ def _prepare_square(t, y, edges, step_amplitude, notes) -> PreparedStep:
                 f"the square wave is too fast: the response to the edge at t = {e.time:.6g} s has "
                 "not settled before the next edge; use a lower frequency (half period >= 5 "
                 "settling times)") from None
-        amp = step_amplitude if step_amplitude is not None else e.amplitude
-        if step_amplitude is not None and e.amplitude < 0:
-            amp = -abs(step_amplitude)
+        amp = math.copysign(step_amplitude, e.amplitude) if step_amplitude is not None \
+            else e.amplitude
         segs.append((e, tp, (yp - y0) / amp, y0, yf, amp))
     if not segs:
         raise DesignError("the square-wave capture has no complete step with a settled "
