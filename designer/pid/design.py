@@ -275,14 +275,14 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice")
     curve = tuning.reaction_curve(tp, yp, final=dc)
     rules = [r.to_dict() for r in tuning.all_rules(curve)]
     notes = []
-    opt = None
+    opt = presized = None
     timings["plant_s"] = time.perf_counter() - tick
     tick = time.perf_counter()
     if spec.kp is not None:
         tun = tuning.explicit(spec.kp, spec.ti_s, spec.td_s)
         tun = tuning.Tuning("explicit", tun.kp, tun.ti_s, tun.td_s, curve, ())
     elif spec.tuning == "optimize":
-        tun, opt = _optimize(spec, plant, amp, pn, pd, curve, span)
+        tun, opt, presized = _optimize(spec, plant, amp, pn, pd, curve, span)
         notes.append(f"optimize: {opt['message']} after {opt['evaluations']} closed-loop evaluations")
     else:
         tun = tuning.tune(spec.tuning or "zn", curve)
@@ -298,10 +298,7 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice")
         parts, sel = spec.controller_parts, None
         targets = {"kp": tun.kp, "ti_s": tun.ti_s, "td_s": tun.td_s}
     else:
-        sel = blocks.select_parts(tun.kp, tun.ti_s, tun.td_s, plant.fn_hz, r_series=spec.r_series,
-                                  c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
-                                  c_min=spec.c_min, c_max=spec.c_max, f_integrator_hz=spec.f_integrator_hz,
-                                  f_differentiator_hz=spec.f_differentiator_hz, tol=spec.tol)
+        sel = presized or _select(spec, tun, plant)
         parts, targets = sel.parts, sel.targets
         notes += sel.notes
     checks = blocks.static_checks(parts, plant.fn_hz, amp.gbw_hz, targets, r_min=spec.r_min,
@@ -320,7 +317,17 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice")
     return res
 
 
+def _select(spec, tun, plant):
+    return blocks.select_parts(tun.kp, tun.ti_s, tun.td_s, plant.fn_hz, r_series=spec.r_series,
+                               c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
+                               c_min=spec.c_min, c_max=spec.c_max, f_integrator_hz=spec.f_integrator_hz,
+                               f_differentiator_hz=spec.f_differentiator_hz, tol=spec.tol)
+
+
 def _optimize(spec, plant, amp, pn, pd, curve, span):
+    """Optimise on unrounded parts, size with E-series parts, and check the
+    sized circuit in the same model; if rounding pushed it over the slew or
+    swing budget, optimise again with a wider margin (at most three rounds)."""
     from . import optimize as O
     t = np.linspace(0.0, 0.6 * span, 2001)
     ctx = O.Context(pn, pd, amp, plant.fn_hz, spec.step_v, spec.edge_s, t, spec.target_overshoot_pct,
@@ -329,12 +336,31 @@ def _optimize(spec, plant, amp, pn, pd, curve, span):
     for rule in ("zn", "chr0"):
         r = tuning.tune(rule, curve)
         starts.append((r.kp, r.ti_s, r.td_s if r.td_s > 0 else 0.3 * curve.L_s))
-    res = O.optimize(ctx, starts)
-    b = res.best
+    fine = O.Context(pn, pd, amp, plant.fn_hz, spec.step_v, spec.edge_s, np.linspace(0.0, 0.6 * span, 20001),
+                     spec.target_overshoot_pct, spec.target_settling_s, spec.f_integrator_hz,
+                     spec.f_differentiator_hz)
+    evaluations = 0
+    for attempt in range(3):
+        res = O.optimize(ctx, starts)
+        evaluations += res.evaluations
+        b = res.best
+        sel = _select(spec, tuning.Tuning("optimize", b.kp, b.ti_s, b.td_s), plant)
+        # the optimiser's coarse grid under-reads short slewing: check the sized
+        # circuit on the fine grid the final checks use
+        sized = O.evaluate_parts(sel.parts, fine)
+        if not res.met or O.meets(sized, fine):
+            break
+        ctx.slew_limit *= 0.85
+        ctx.swing_limit *= 0.9
+        starts = [(b.kp, b.ti_s, b.td_s)]
+    res.evaluations = evaluations
     note = (f"optimize: target overshoot <= {spec.target_overshoot_pct:g} %"
             + ("" if spec.target_settling_s is None else f", settling <= {format_eng(spec.target_settling_s, 's')}")
             + f" for a {spec.step_v:g} V step with {amp.name} limits")
-    return tuning.Tuning("optimize", b.kp, b.ti_s, b.td_s, curve, (note,)), res.to_dict()
+    out = res.to_dict()
+    out["sized"] = sized.to_dict()
+    out["rounds"] = attempt + 1
+    return tuning.Tuning("optimize", b.kp, b.ti_s, b.td_s, curve, (note,)), out, sel
 
 
 def _metrics(t, y, final=None) -> dict:

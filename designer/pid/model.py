@@ -282,7 +282,7 @@ def margins(w, L) -> dict:
         if m < pm:
             pm, wc = m, w[i] + f * (w[i + 1] - w[i])
     gm, w180 = math.inf, math.nan
-    wrapped = (np.degrees(ph) + 180.0) % 360.0 - 180.0   # 0 at -180 deg
+    wrapped = (np.degrees(ph) + 360.0) % 360.0 - 180.0   # 0 at -180 deg (mod 360)
     for i in np.nonzero(np.sign(wrapped[:-1]) != np.sign(wrapped[1:]))[0]:
         if abs(wrapped[i] - wrapped[i + 1]) > 180:  # wrap jump, not a crossing
             continue

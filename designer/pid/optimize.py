@@ -47,6 +47,9 @@ class Context:
     f_integrator_hz: float | None = None
     f_differentiator_hz: float | None = None
     t_scale_s: float = 1.0
+    #: penalties start at these fractions of the swing and slew budgets (margin for part rounding)
+    swing_limit: float = 0.98
+    slew_limit: float = 0.95
     #: ITAE of the plant alone for the same reference: the cost's unit
     itae_ref: float = 1.0
 
@@ -90,9 +93,16 @@ class OptimizeResult:
 
 
 def evaluate(kp: float, ti: float, td: float, ctx: Context) -> Evaluation:
-    """Cost and figures of one (Kp, Ti, Td) on the realised closed loop."""
+    """Cost and figures of one (Kp, Ti, Td) on the realised closed loop
+    (unrounded parts, :func:`designer.pid.blocks.continuous_parts`)."""
     parts = blocks.continuous_parts(kp, ti, td, ctx.fn_hz, f_integrator_hz=ctx.f_integrator_hz,
                                     f_differentiator_hz=ctx.f_differentiator_hz)
+    return evaluate_parts(parts, ctx, (kp, ti, td))
+
+
+def evaluate_parts(parts, ctx: Context, gains=None) -> Evaluation:
+    """Cost and figures of a controller built from ``parts``."""
+    kp, ti, td = gains if gains is not None else (parts.kp, parts.ti_s, parts.td_s)
     lm = model.assemble(parts, ctx.opamp, ctx.plant_num, ctx.plant_den)
     if not lm.stable():
         worst = float(np.max(lm.poles().real)) * ctx.t_scale_s
@@ -116,7 +126,7 @@ def evaluate(kp: float, ti: float, td: float, ctx: Context) -> Evaluation:
         slew = max(v["slew_delay_s"] for v in lim.values()) / (model.SLEW_DELAY_FRACTION * rise)
     cost = itae
     cost += 0.2 * max(0.0, m.overshoot_pct - ctx.target_overshoot_pct + 0.2) ** 2
-    cost += 100.0 * max(0.0, swing - 0.98) ** 2 + 100.0 * max(0.0, slew - 0.95) ** 2
+    cost += 100.0 * max(0.0, swing - ctx.swing_limit) ** 2 + 100.0 * max(0.0, slew - ctx.slew_limit) ** 2
     ts = m.settling_time_s
     if not math.isfinite(ts):
         cost += 10.0
