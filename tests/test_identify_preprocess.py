@@ -200,3 +200,15 @@ def test_savgol_matches_scipy(window, poly, deriv):
     y = np.random.default_rng(0).standard_normal(300).cumsum()
     ref = savgol_filter(y, window, poly, deriv=deriv, delta=0.1, mode="interp")
     assert np.allclose(savgol(y, window, poly, deriv=deriv, delta=0.1), ref, atol=1e-10)
+
+
+def test_output_only_square_wave_is_cut_at_the_next_edge():
+    """No input column: the output falling back to baseline marks the next edge."""
+    f = 50.0
+    t = np.linspace(-1e-3, 25e-3, 26001)
+    y = 2.0 * (model_step("fopdt", FOPDT, t) - model_step("fopdt", FOPDT, t - 1 / (2 * f)))
+    s = prepare_step(t, y, step_time=0.0, step_amplitude=2.0)
+    assert any("another input edge" in n for n in s.notes)
+    assert s.t[-1] < 1 / (2 * f) + 1e-9
+    assert s.t[-1] > 1 / (2 * f) - 2 * (t[1] - t[0])
+    assert s.yf == pytest.approx(FOPDT["K"], rel=1e-3)

@@ -429,12 +429,68 @@ def prepare_step(t, y, u=None, *, step_time: float | None = None,
     if tp.size < 10:
         raise DesignError("fewer than 10 samples after the step; capture more of the response")
     sigma = noise_sigma(yp)
+    if u is None:
+        cut = next_step_time(tp, yp, y0, sigma)
+        if cut is not None:
+            notes.append(f"the output returns to its baseline: another input edge near "
+                         f"t = {t_step + cut:.6g} s (a square wave?); the record is cut there "
+                         "(give the input column to average every step)")
+            keep = tp < cut
+            tp, yp = tp[keep], yp[keep]
+            t, y = t[t < t_step + cut], y[t < t_step + cut]
+            if tp.size < 10:
+                raise DesignError("fewer than 10 samples between the step and the next edge")
     yf = final_value(tp, yp, y0, sigma=sigma)
     _check_step(y0, yf, sigma)
     yn = (yp - y0) / amp
     tw, yw = block_mean(tp, yn)
     return PreparedStep(t=tw, y=yw, yf=(yf - y0) / amp, t_step=t_step, amplitude=float(amp),
                         y0=y0, y_final=yf, sigma=sigma, t_raw=t, y_raw=y, notes=notes)
+
+
+def next_step_time(t, y, y0: float, sigma: float = 0.0):
+    """Time of the next (opposite) input edge in an output-only square-wave record, or None.
+
+    After the response's main excursion (beyond half its largest deviation
+    from ``y0``) the output coming back within 5 % of that deviation of the
+    baseline means the input stepped back. For a linear plant the return
+    mirrors the step response, so the edge is the return's 50 % crossing
+    minus the step's own 50 % crossing time.
+    """
+    t = np.asarray(t, float)
+    d = np.asarray(y, float) - y0
+    peak = float(np.max(np.abs(d)))
+    if peak <= MIN_STEP_SNR * sigma or peak == 0:
+        return None
+    sgn = 1.0 if abs(float(np.max(d))) >= abs(float(np.min(d))) else -1.0
+    z = sgn * d / peak
+    half = np.nonzero(z >= 0.5)[0]
+    if half.size == 0:
+        return None
+    i1 = int(half[0])
+    back = np.nonzero(z[i1:] <= 0.05 + 3 * sigma / peak)[0]
+    if back.size == 0:
+        return None
+    i2 = i1 + int(back[0])
+    # 50 % of the settled level (the median of the high plateau, not the
+    # overshoot peak) on both the rise and the return.
+    hi = float(np.median(z[i1:i2]))
+    for _ in range(2):
+        if hi <= 0.25:
+            return None
+        above = np.nonzero(z[:i2] >= 0.5 * hi)[0]
+        j = int(above[-1])       # last sample above 50 % before the return
+        # refine the level on the settled later part of the plateau
+        a, b = i1 + (j - i1) // 2, j - (j - i1) // 10
+        if b > a:
+            hi = float(np.median(z[a:b]))
+    z = z / hi
+    above = np.nonzero(z[:i2] >= 0.5)[0]
+    j = int(above[-1])
+    t50_fall = crossing_time(t[j:i2 + 1], -z[j:i2 + 1], -0.5)
+    t50_rise = crossing_time(t, z, 0.5, sigma=sigma / (peak * hi))
+    edge = t50_fall - (t50_rise - float(t[0]))
+    return edge if math.isfinite(edge) and edge > t[0] else None
 
 
 def _amplitude_from_u(t, u, t_step):
