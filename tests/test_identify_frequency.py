@@ -296,3 +296,21 @@ def test_flat_table_is_flagged_not_raised():
     res = fr.identify_freq(d)
     a = by(res, "asymptotes", "fopdt")
     assert not a.valid and "roll off" in a.note
+
+
+@settings(max_examples=40, deadline=None)
+@given(g=st.lists(st.floats(-100, 100), min_size=5, max_size=30), with_phase=st.booleans(),
+       data=st.data())
+def test_arbitrary_tables_never_raise(g, with_phase, data):
+    n = len(g)
+    ph = (np.array(data.draw(st.lists(st.floats(-720, 720), min_size=n, max_size=n)))
+          if with_phase else None)
+    d = fr.freq_data(np.geomspace(1, 1e5, n), g, ph, freq_units="rad/s")
+    res = fr.identify_freq(d)
+    res.to_dict()
+    for m in res.methods:
+        assert m.model in MODELS
+        if m.valid:
+            assert all(math.isfinite(v) for v in m.params.values())
+        else:
+            assert m.note

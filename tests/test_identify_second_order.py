@@ -405,3 +405,18 @@ def test_no_delay_methods_flag_a_dead_time(method, make):
     r = method(t, y, 1.0)
     assert not r.valid
     assert ("delay-free" if method is so.dc_motor else "dead time") in r.note
+
+
+@settings(max_examples=60, deadline=None)
+@given(y=st.lists(st.floats(-1e3, 1e3), min_size=0, max_size=300),
+       yf=st.floats(-1e3, 1e3) | st.just(0.0) | st.just(math.nan),
+       dt=st.floats(1e-9, 1e3))
+def test_methods_never_raise_on_arbitrary_data(y, yf, dt):
+    y = np.array(y, float)
+    t = dt * np.arange(y.size)
+    for method in so.STEP_METHODS:
+        r = method(t, y, yf)
+        assert isinstance(r, MethodResult) and r.model in MODELS
+        assert r.valid is True or r.valid is False or bool(r.valid) in (True, False)
+        if not r.valid:
+            assert r.note

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -729,6 +730,14 @@ def _rank_key(m):
 
 def identify_freq(data: FreqData) -> FreqIdentifyResult:
     """Run the classical readings and the least-squares fits; rank by fit error."""
+    # odd tables drive the fits through inf/nan; those results are flagged
+    # below, and the warnings would only clutter the one-line CLI contract
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return _identify_freq(data)
+
+
+def _identify_freq(data: FreqData) -> FreqIdentifyResult:
     classical = [asymptotes(data), resonant_peak(data)]
     K, _ = low_frequency_gain(data)
     wc = _interp_logf(data.w, data.gain_db, 20.0 * math.log10(K) - 3.0)
@@ -736,6 +745,12 @@ def identify_freq(data: FreqData) -> FreqIdentifyResult:
         wc = float(data.w[-1])
     fits = [least_squares_fit(data, model, _starts(model, classical, K, wc))
             for model in ("fopdt", "underdamped", "overdamped")]
+    for m in classical + fits:
+        if m.valid and not (all(math.isfinite(v) for v in m.params.values())
+                            and math.isfinite(m.iae)):
+            m.valid = False
+            m.note = "; ".join(x for x in (m.note, "degenerate result: the table does not "
+                                          "have this model's shape") if x)
     methods = sorted(classical + fits, key=_rank_key)
     best = next((m for m in methods if m.valid and math.isfinite(m.iae)), None)
     return FreqIdentifyResult(methods, best, data)

@@ -49,6 +49,7 @@ lobe; lobes are delimited by crossings of the final value with hysteresis.
 
 from __future__ import annotations
 
+import functools
 import math
 from functools import lru_cache
 
@@ -360,10 +361,42 @@ def _flag_late(result, t, z, sigma):
     return result
 
 
+_POSITIVE = ("tau_s", "tau1_s", "tau2_s", "wn_rad_s", "zeta")
+
+
+def _guarded(name, model):
+    """Decorator: run a method with numpy's warnings silenced (degenerate data
+    give inf/nan, handled here), turn an arithmetic failure on degenerate data
+    into valid=False, and likewise any non-finite or non-physical parameter
+    of a "valid" result."""
+    def wrap(method):
+        @functools.wraps(method)
+        def run(t, y, yf, *args, **kwargs):
+            try:
+                with np.errstate(all="ignore"):
+                    r = method(t, y, yf, *args, **kwargs)
+            except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
+                return _fail(name, model, "the data do not have this method's shape "
+                             f"({type(exc).__name__}: {exc})",
+                             math.nan if name == "dc-motor-position" else yf)
+            bad = [k for k, v in r.params.items()
+                   if not math.isfinite(v) or (k in _POSITIVE and v <= 0.0)
+                   or (k == "theta_s" and v < 0.0)]
+            if r.valid and bad:
+                r.valid = False
+                r.note = "; ".join(x for x in (r.note, "degenerate result (" + ", ".join(bad)
+                                              + " not a positive finite number): the data do "
+                                              "not have this method's shape") if x)
+            return r
+        return run
+    return wrap
+
+
 # --------------------------------------------------------------------------
 # the methods
 # --------------------------------------------------------------------------
 
+@_guarded("overshoot", "underdamped")
 def overshoot(t, y, yf) -> MethodResult:
     """Overshoot and peak time (seeds 000 eqs 20-23 and 003 eq 2.2.11).
 
@@ -391,6 +424,7 @@ def overshoot(t, y, yf) -> MethodResult:
                       t, z, sigma)
 
 
+@_guarded("log-decrement", "underdamped")
 def log_decrement(t, y, yf) -> MethodResult:
     """First and second overshoot and the period (seed 002 eqs 5-7), zeta <= 0.5.
 
@@ -435,6 +469,7 @@ def log_decrement(t, y, yf) -> MethodResult:
                       t, z, sigma)
 
 
+@_guarded("t4-t3", "underdamped")
 def t4_t3(t, y, yf) -> MethodResult:
     """Seed 002's t4/t3 method, 0.5 <= zeta <= 2.
 
@@ -470,13 +505,18 @@ def t4_t3(t, y, yf) -> MethodResult:
                       t, z, sigma)
 
 
+@_guarded("two-pole", "overdamped")
 def two_pole(t, y, yf, levels=(0.6, 0.9)) -> MethodResult:
-    """Two real poles from two points above 50 % (seed 002 eqs 16-20), zeta > 2.
+    """Two real poles from the response above 50 % (seed 002 eqs 16-20), zeta > 2.
 
-    The slow pole a2 = |p2| is the log-slope of 1 - z between the two points
-    (eq 16); the fast one follows from eqs 17/18 (averaged):
-    a1 = a2 X / (X - 1), X = (1 - z_k) e^{a2 t_k}. The seed writes e^{p2 t}
-    with p2 signed; only the magnitude makes the equations consistent.
+    Above 50 % the slow pole dominates: 1 - z = X e^{-a2 t} with a2 = |p2|.
+    The seed takes the log-slope between two points Y5, Y6 (eq 16) and the
+    fast pole from eqs 17/18, a1 = a2 X / (X - 1) with X = (1 - z_k) e^{a2 t_k}
+    at each point (averaged). Here the same straight line ln(1 - z) is fitted
+    through every sample between the two levels (60 % and 90 % by default),
+    which is the seed's two-point line on clean data and far less sensitive
+    to noise. The seed writes e^{p2 t} with p2 signed; only the magnitude
+    makes eqs 17/18 consistent.
     """
     name, model = "two-pole", "overdamped"
     t, z, sigma, err = _prepare(t, y, yf)
@@ -487,29 +527,39 @@ def two_pole(t, y, yf, levels=(0.6, 0.9)) -> MethodResult:
     if not (math.isfinite(ta) and math.isfinite(tb)) or tb <= ta:
         return _fail(name, model, f"the response does not rise through {levels[0]:.0%} and "
                      f"{levels[1]:.0%} of its final value", yf)
-    a2 = (math.log(1.0 - levels[1]) - math.log(1.0 - levels[0])) / (ta - tb)
-    a2 = abs(a2)
-    xa = (1.0 - levels[0]) * math.exp(a2 * ta)
-    xb = (1.0 - levels[1]) * math.exp(a2 * tb)
+    sel = (t >= ta) & (t <= tb)
+    r = 1.0 - z[sel]
+    ok = r > 0.0
     pts = {"t5_s": ta, "t6_s": tb, "y5": levels[0], "y6": levels[1]}
-    if xa <= 1.0 or xb <= 1.0:
+    if ok.sum() >= 3:
+        # ln(1 - z) has noise sigma/(1 - z): weight each sample by 1 - z
+        slope, icpt = np.polyfit(t[sel][ok], np.log(r[ok]), 1, w=r[ok])
+        a2, x = -float(slope), math.exp(float(icpt))
+    else:
+        a2 = abs((math.log(1.0 - levels[1]) - math.log(1.0 - levels[0])) / (ta - tb))
+        x = 0.5 * ((1.0 - levels[0]) * math.exp(a2 * ta) + (1.0 - levels[1]) * math.exp(a2 * tb))
+    if a2 <= 0.0 or x <= 1.0:
         return _fail(name, model, "the late response is not the tail of two real poles "
                      "(X <= 1 in eqs 17/18): zeta too low or dead time; valid for zeta > 2",
                      yf, pts)
-    a1 = 0.5 * (a2 * xa / (xa - 1.0) + a2 * xb / (xb - 1.0))
+    a1 = a2 * x / (x - 1.0)
     wn = math.sqrt(a1 * a2)
     zeta = (a1 + a2) / (2.0 * wn)
     fast, slow = max(a1, a2), min(a1, a2)
     params = {"K": float(yf), "tau1_s": 1.0 / fast, "tau2_s": 1.0 / slow, "theta_s": 0.0}
-    pts.update({"p1_rad_s": -a1, "p2_rad_s": -a2, "wn_rad_s": wn, "zeta": zeta})
+    pts.update({"p1_rad_s": -a1, "p2_rad_s": -a2, "X": x, "wn_rad_s": wn, "zeta": zeta})
     valid = zeta > 2.0 - 1e-9
     note = "assumes no dead time" if valid else (
         f"zeta = {zeta:.3f}: outside the method's range zeta > 2 (poles not far enough apart "
         "for the slow one to dominate above 50 %); use t4-t3")
+    if valid and x < 1.0 + 20.0 * sigma:
+        note += (f"; X = {x:.4f} is within the noise of 1, so the fast pole "
+                 f"({fast:.4g} rad/s) is poorly determined")
     return _flag_late(MethodResult(name, model, params, valid=valid, note=note, points=pts),
                       t, z, sigma)
 
 
+@_guarded("chen", "underdamped")
 def chen(t, y, yf) -> MethodResult:
     """Cheng-Liang Chen, underdamped with dead time (seed 000 eqs 24-30).
 
@@ -553,6 +603,7 @@ def chen(t, y, yf) -> MethodResult:
 STARK_RANGE = (0.45, 1.3)
 
 
+@_guarded("stark-mollenkamp", "underdamped")
 def stark_mollenkamp(t, y, yf) -> MethodResult:
     """Stark-Mollenkamp three points 15/45/75 % (seed 000 eqs 31-37).
 
@@ -605,6 +656,7 @@ def _jf_from(theta, t70, t90):
     return eta, zeta, tau
 
 
+@_guarded("jahanmiri-fallahi", "overdamped")
 def jahanmiri_fallahi(t, y, yf) -> MethodResult:
     """Jahanmiri-Fallahi three points (seed 000 eqs 38-42).
 
@@ -651,6 +703,7 @@ def _logfit(t, v):
     return math.exp(icpt), (-1.0 / slope if slope < 0.0 else math.inf)
 
 
+@_guarded("peeling", "overdamped")
 def peeling(t, y, yf, iterations: int = 500) -> MethodResult:
     """Exponential peeling of two time constants (seed 003 section 2.3).
 
@@ -746,6 +799,7 @@ def peeling(t, y, yf, iterations: int = 500) -> MethodResult:
                                       "theta_s": theta}, valid=valid, note=note, points=pts)
 
 
+@_guarded("dc-motor", "fopdt")
 def dc_motor(t, y, yf) -> MethodResult:
     """DC motor velocity from a step of armature voltage (seed 000 eqs 46-55).
 
@@ -782,6 +836,7 @@ def dc_motor(t, y, yf) -> MethodResult:
                         valid=valid, note=note, points=pts)
 
 
+@_guarded("dc-motor-position", "fopdt")
 def dc_motor_position(t, theta, a: float = 1.0, tail: float = 0.3) -> MethodResult:
     """DC motor from its shaft *position* step response (seed 000 eq 45/57).
 
