@@ -592,7 +592,9 @@ def chen(t, y, yf) -> MethodResult:
     theta = 2.0 * tp1 - tm1
     note = ""
     if theta < 0.0:
-        note = f"eq 28 gives a negative dead time ({theta:.3g} s), set to 0"
+        # a sliver below zero is sampling/noise in the peak times: no remark
+        if -theta > 0.02 * (tm1 - tp1):
+            note = f"eq 28 gives a negative dead time ({theta:.3g} s), set to 0"
         theta = 0.0
     return MethodResult(name, model, {"K": float(yf), "wn_rad_s": 1.0 / tau, "zeta": zeta,
                                       "theta_s": theta}, note=note, points=pts)
@@ -633,7 +635,8 @@ def stark_mollenkamp(t, y, yf) -> MethodResult:
     theta = t45 - 0.922 * 1.66 ** zeta / wn
     note = ""
     if theta < 0.0:
-        note = f"eq 36 gives a negative dead time ({theta:.3g} s), set to 0; "
+        if -theta > 0.02 * (t75 - t15):
+            note = f"eq 36 gives a negative dead time ({theta:.3g} s), set to 0; "
         theta = 0.0
     model, params = _second_order_params(float(yf), wn, zeta, theta)
     pts.update({"zeta": zeta, "wn_rad_s": wn})
