@@ -407,7 +407,12 @@ def _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, s
     f_hi = max(amp.gbw_hz if not amp.ideal else 0.0, 100 * plant.fn_hz)
     w = 2 * np.pi * np.logspace(np.log10(f_lo), np.log10(f_hi), 4000)
     mg = model.margins(w, model.loop_gain(parts, amp, pn, pd, w))
-    checks = list(checks) + _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, spec.step_v, rise)
+    checks = list(checks) + _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, spec.step_v, rise, parts)
+    limits = {"closed_loop_stable", "phase_margin", "slew_rate", "output_swing"}
+    if not amp.ideal and any(not c["ok"] for c in checks if c["name"] in limits):
+        notes.append(f"for gains that respect the {amp.name}'s limits for this step, let the optimiser choose them: "
+                     "--tuning optimize --target-overshoot P (it keeps every op-amp inside its swing and slew "
+                     "rate and the loop stable with the op-amp poles)")
     expected = spec.step_v * dc_cl if math.isfinite(dc_cl) else spec.step_v
     title = (f"PID closed loop Kp={parts.kp:.4g} Ti={parts.ti_s:.4g}s Td={parts.td_s:.4g}s "
              f"plant fn={plant.fn_hz:.5g}Hz zeta={plant.zeta:.4g} op-amp={amp.name}")
@@ -434,7 +439,18 @@ def _diverging(lm, t, r, limit):
     return w
 
 
-def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise) -> list:
+def _kick(parts, amp, step_v) -> str:
+    """The controller's answer to the step edge alone (ideal op-amps):
+    u = Kp (1 + Td/(R12 C3)) x step, the high-frequency gain times the step."""
+    hf = parts.kp * (1 + (parts.td_s / (parts.r12 * parts.c3) if parts.has_derivative else 0.0))
+    u = hf * step_v
+    if amp.ideal or abs(u) <= amp.vout_max:
+        return ""
+    return (f"; even before the loop reacts, the step edge alone asks U6 for Kp (1 + Td/(R12 C3)) x "
+            f"{step_v:g} V = {u:.3g} V (the {amp.name} reaches {amp.vout_max:.3g} V)")
+
+
+def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise, parts) -> list:
     out = []
     poles = lm.poles()
     worst = float(np.max(poles.real)) if poles.size else -math.inf
@@ -443,9 +459,18 @@ def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise) -> list:
                            f"a closed-loop pole has real part {worst:+.4g} 1/s: the loop oscillates or "
                            "latches at a rail")})
     pm = mg["phase_margin_deg"]
+    near = ""
+    if math.isfinite(pm) and not amp.ideal:
+        fc = mg["crossover_hz"]
+        close = [f"{k} {format_eng(v, 'Hz')}" for k, v in sorted(parts.stage_bandwidths(amp.gbw_hz).items(),
+                                                                  key=lambda kv: kv[1]) if v < 10 * fc]
+        if parts.has_derivative and parts.f_differentiator_hz < 10 * fc:
+            close.append(f"derivative filter {format_eng(parts.f_differentiator_hz, 'Hz')}")
+        if close:
+            near = "; poles within 10x of the crossover, each costing phase there: " + ", ".join(close)
     out.append({"name": "phase_margin", "ok": bool(math.isfinite(pm) and pm >= MIN_PHASE_MARGIN_DEG),
                 "detail": (f"{pm:.3g} deg at {format_eng(mg['crossover_hz'], 'Hz')} with the op-amp poles "
-                           f"(want >= {MIN_PHASE_MARGIN_DEG:g} deg)") if math.isfinite(pm)
+                           f"(want >= {MIN_PHASE_MARGIN_DEG:g} deg){near}") if math.isfinite(pm)
                 else "the loop gain never crosses 1"})
     if math.isfinite(dc_cl):
         e = 1 - dc_cl
@@ -454,7 +479,8 @@ def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise) -> list:
                               f"want <= {100 * MAX_STEADY_STATE_ERROR:g} %)"})
     if not stable:
         out.append({"name": "slew_rate", "ok": False, "detail": "unstable loop: no steady waveforms to check"})
-        out.append({"name": "output_swing", "ok": False, "detail": "unstable loop: the outputs run to the rails"})
+        out.append({"name": "output_swing", "ok": False,
+                    "detail": "unstable loop: the outputs run to the rails" + _kick(parts, amp, step_v)})
         return out
     if amp.ideal:
         worst_sw = max(levels.values(), key=lambda v: max(abs(v["v_max"]), abs(v["v_min"])))

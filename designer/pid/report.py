@@ -122,13 +122,16 @@ def sections(result, with_images: bool = True) -> list:
             continue
         rows.append([ref, amp.name, "", "", "", f"{role} op-amp, {amp.vcc:g} V / {amp.vee:g} V"])
     pl = result.plant
-    rows += [R.part_row("R1 (plant)", pl.r1, "Ohm", "Sallen-Key input resistor"),
-             R.part_row("R2 (plant)", pl.r2, "Ohm", "Sallen-Key, to the non-inverting input"),
-             R.part_row("C1 (plant)", pl.c1, "F", "Sallen-Key, non-inverting input to ground"),
-             R.part_row("C2 (plant)", pl.c2, "F", "Sallen-Key, feedback from the R1-R2 node")]
+    designed = result.plant_source.startswith("design-plant")
+    prs, pcs = (ser["r"], ser["c"]) if designed else (None, None)
+    prt, pct = (rt, ct) if designed else (None, None)
+    rows += [R.part_row("R1 (plant)", pl.r1, "Ohm", "Sallen-Key input resistor", prs, prt),
+             R.part_row("R2 (plant)", pl.r2, "Ohm", "Sallen-Key, to the non-inverting input", prs, prt),
+             R.part_row("C1 (plant)", pl.c1, "F", "Sallen-Key, non-inverting input to ground", pcs, pct),
+             R.part_row("C2 (plant)", pl.c2, "F", "Sallen-Key, feedback from the R1-R2 node", pcs, pct)]
     if pl.r3 is not None:
-        rows += [R.part_row("R3 (plant)", pl.r3, "Ohm", "Sallen-Key gain, to ground"),
-                 R.part_row("R4 (plant)", pl.r4, "Ohm", "Sallen-Key gain, feedback")]
+        rows += [R.part_row("R3 (plant)", pl.r3, "Ohm", "Sallen-Key gain, to ground", prs, prt),
+                 R.part_row("R4 (plant)", pl.r4, "Ohm", "Sallen-Key gain, feedback", prs, prt)]
     rows.append(["U7", amp.name, "", "", "", "plant op-amp (Sallen-Key)"])
     out.append(("Bill of materials", [
         R.table(["Ref", "Value", "Code", "Series", "Tolerance", "Where"], rows),
