@@ -420,3 +420,22 @@ def test_methods_never_raise_on_arbitrary_data(y, yf, dt):
         assert r.valid is True or r.valid is False or bool(r.valid) in (True, False)
         if not r.valid:
             assert r.note
+
+
+def test_noise_in_a_settled_tail_is_not_an_overshoot():
+    # 200k samples of an overdamped response with 1 % noise: some samples exceed
+    # the final value by 4 sigma; none of them may pass for an overshoot
+    t, y = overdamped(1.0, 1.0, 3.0, n=200001)
+    y = y + np.random.default_rng(11).normal(0.0, 0.01, y.size)
+    for method in (so.overshoot, so.log_decrement, so.chen):
+        assert not method(t, y, 1.0).valid
+
+
+@pytest.mark.parametrize("zeta", [0.3, 0.7])
+def test_overshoot_on_noisy_data(zeta):
+    t, y = second_order(2.0, 3.0, zeta, n=100001)
+    y = y + np.random.default_rng(int(10 * zeta)).normal(0.0, 0.02, y.size)   # 1 % of K
+    r = so.overshoot(t, y, 2.0)
+    assert r.valid
+    assert r.params["zeta"] == pytest.approx(zeta, rel=0.02)
+    assert r.params["wn_rad_s"] == pytest.approx(3.0, rel=0.03)
