@@ -439,3 +439,19 @@ def test_overshoot_on_noisy_data(zeta):
     assert r.valid
     assert r.params["zeta"] == pytest.approx(zeta, rel=0.02)
     assert r.params["wn_rad_s"] == pytest.approx(3.0, rel=0.03)
+
+
+def test_peeling_on_noisy_data():
+    # 1 % noise: close time constants still come out within 10 %; whatever is
+    # reported valid follows the data to a few noise widths
+    rng = np.random.default_rng(0)
+    t, y = overdamped(1.0, 1.0, 2.0, theta=0.5, n=100001)
+    r = so.peeling(t, y + rng.normal(0.0, 0.01, y.size), 1.0)
+    assert r.valid
+    assert r.params["tau1_s"] == pytest.approx(1.0, rel=0.1)
+    assert r.params["tau2_s"] == pytest.approx(2.0, rel=0.1)
+    for k in range(4):
+        t, y = overdamped(1.0, 1.0, 5.0, theta=0.5, n=100001)
+        r = so.peeling(t, y + rng.normal(0.0, 0.01, y.size), 1.0)
+        if r.valid:
+            assert r.points["rms_error"] <= 0.04
