@@ -207,8 +207,22 @@ def _check_targets(kp, ti, td):
 
 def _corner_resistor(f_hz, caps, rvals, lo, hi):
     """For each capacitor, the series resistor nearest 1/(2 pi f C), or nan
-    when the exact value falls outside the bounds."""
+    when the exact value falls outside the bounds. If no capacitor allows the
+    corner at all, the one that comes closest is kept with the resistor at
+    its bound (the corner check then reports the miss)."""
     exact = 1.0 / (2 * np.pi * f_hz * caps)
+    inside = (exact >= lo * 0.999) & (exact <= hi * 1.001)
+    if not np.any(inside):
+        keep = rvals[(rvals >= lo * 0.999) & (rvals <= hi * 1.001)]
+        if keep.size == 0 or caps.size == 0:
+            return np.full_like(exact, np.nan)
+        clipped = np.clip(exact, keep[0], keep[-1])
+        miss = np.abs(np.log(clipped / exact))
+        out = np.full_like(exact, np.nan)
+        best = np.nonzero(miss <= miss.min() * (1 + 1e-9))[0]
+        for i in best:
+            out[i] = keep[0] if exact[i] < keep[0] else keep[-1]
+        return out
     idx = np.clip(np.searchsorted(np.log(rvals), np.log(exact)), 1, rvals.size - 1)
     lo_v, hi_v = rvals[idx - 1], rvals[idx]
     pick = np.where(np.abs(np.log(exact / lo_v)) <= np.abs(np.log(hi_v / exact)), lo_v, hi_v)
