@@ -51,7 +51,8 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="identify-freq", description=__doc__.split("\n\n")[0].strip(),
+    p = _Parser(prog="identify-freq",
+                description=__doc__.split("\n\n")[0].strip().replace("``", ""),
                 epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("table", help="CSV table: frequency, gain[, phase]")
     p.add_argument("--gain-units", choices=("db", "ratio"),
@@ -74,6 +75,10 @@ def _fmt_params(p: dict) -> str:
             out.append(f"{k} n/a")
         elif k.endswith("_rad_s"):
             out.append(f"{k[:-6]} {v:.4g} rad/s ({format_eng(v / (2 * math.pi), 'Hz')})")
+        elif k.startswith("tau") and v > 0:
+            # the corner a student reads off the Bode plot
+            out.append(f"{k[:-2]} {format_eng(v, 's')} "
+                       f"(corner {format_eng(1 / (2 * math.pi * v), 'Hz')})")
         elif k.endswith("_s"):
             out.append(f"{k[:-2]} {format_eng(v, 's')}")
         else:
@@ -94,10 +99,10 @@ def to_text(result) -> str:
              + (" (inverting: K < 0)" if d.sign < 0 else ""), "",
              "Methods ranked by fit error (mean |G_model/G_data - 1| over the table; "
              "lower is better)"]
-    head = f"{'#':>2}  {'method':<15} {'model':<12} {'parameters':<78} {'error':>9}  ok"
+    head = f"{'#':>2}  {'method':<15} {'model':<12} {'parameters':<84} {'error':>9}  ok"
     lines += [head, "-" * len(head)]
     for i, m in enumerate(result.methods, 1):
-        lines.append(f"{i:>2}  {m.name:<15} {m.model:<12} {_fmt_params(m.params):<78} "
+        lines.append(f"{i:>2}  {m.name:<15} {m.model:<12} {_fmt_params(m.params):<84} "
                      f"{_pct(m.iae):>9}  {'yes' if m.valid else 'NO'}")
         if m.note:
             lines.append(f"{'':>4}{m.note}")
