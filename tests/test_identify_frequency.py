@@ -298,7 +298,7 @@ def test_flat_table_is_flagged_not_raised():
     assert not a.valid and "roll off" in a.note
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=15, deadline=None)
 @given(g=st.lists(st.floats(-100, 100), min_size=5, max_size=30), with_phase=st.booleans(),
        data=st.data())
 def test_arbitrary_tables_never_raise(g, with_phase, data):

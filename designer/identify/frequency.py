@@ -618,7 +618,7 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
             x0 = np.clip(_params_to_x(model, p0, fit_delay), np.array(lo) + 1e-12,
                          np.array(hi) - 1e-12)
             sol = least_squares(fun, x0, bounds=(lo, hi), method="trf", x_scale="jac",
-                                max_nfev=400, ftol=1e-12, xtol=1e-12, gtol=1e-12)
+                                max_nfev=200, ftol=1e-12, xtol=1e-12, gtol=1e-12)
         except (ValueError, OverflowError, ZeroDivisionError, KeyError):
             continue
         if np.all(np.isfinite(sol.x)) and (best is None or sol.cost < best.cost):
