@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import functools
 import math
-from functools import lru_cache
 
 import numpy as np
 from scipy.optimize import brentq
@@ -111,8 +110,9 @@ def normalized_step(zeta: float, t) -> np.ndarray:
 
 def _normalized_crossing(zeta: float, level: float) -> float:
     """First time the normalised (wn = 1) response reaches ``level`` (0 < level < 1)."""
-    # The response is increasing until its first peak at pi/wd (or forever if
-    # zeta >= 1); the crossing lies before both, and before 1-e^{-t/(2 zeta)}'s.
+    # The response rises monotonically to its first peak (forever if zeta >= 1)
+    # and stays above 1 for pi/wd after crossing it, so the first hi of this
+    # 1.5x sequence that is past the level brackets only the first crossing.
     hi = 1.0
     while float(normalized_step(zeta, hi)) < level:
         hi *= 1.5
@@ -120,7 +120,7 @@ def _normalized_crossing(zeta: float, level: float) -> float:
     return brentq(lambda s: float(normalized_step(zeta, s)) - level, lo, hi, xtol=1e-14, rtol=1e-13)
 
 
-@lru_cache(maxsize=4096)
+@functools.lru_cache(maxsize=4096)
 def _t3_t4(zeta: float) -> tuple[float, float]:
     return _normalized_crossing(zeta, Y3_LEVEL), _normalized_crossing(zeta, Y4_LEVEL)
 
