@@ -121,6 +121,9 @@ def run_and_compare(deck: str, simulator: str, t_grid, delay_s: float, half_peri
         m = step_metrics(tg, waves["y"], initial=0.0).to_dict()
     except Exception:  # a flat or broken response has no step figures
         m = {k: None for k in ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")}
+    if not osc["stable"]:
+        # step figures of an oscillating or latched output mean nothing
+        m = {k: (v if k == "final_value" else None) for k, v in m.items()}
     abstol = 0.01 * abs(step_v)
     m.update(nrms=nrms(analytic["y"], waves["y"], abstol), saturated=saturated, stable=osc["stable"])
     try:
