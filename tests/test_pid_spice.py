@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from designer import opamps
-from designer.pid import blocks, model, verify
+from designer.pid import blocks, verify
 from designer.pid.design import PidSpec, design_pid
 from designer.pid.netlist import ReferenceTest, closed_loop_deck
 from designer.sallenkey import SallenKeyParts

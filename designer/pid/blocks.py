@@ -34,10 +34,6 @@ from .. import eseries
 from ..errors import DesignError
 from ..units import format_eng
 
-#: Op-amps of the controller, in signal order, with the signal each drives.
-STAGES = (("U1", "difference", "ve"), ("U2", "inverter", "vp"), ("U3", "differentiator", "vd"),
-          ("U4", "integrator", "vi"), ("U5", "summer", "vs"), ("U6", "gain", "u"))
-
 #: "Well below / well above" the plant's fn for the check (factor).
 CORNER_MARGIN = 5.0
 #: Default corner targets relative to fn (the seed used 130 Hz and 33 kHz for fn = 3.5 kHz).
