@@ -134,3 +134,22 @@ def test_optimizer_respects_lm741_limits():
     # the seed's gains break the limits in the same model
     seed = optimize.evaluate(45, 43.215e-6, 10.8037e-6, ctx)
     assert not seed.stable or seed.swing_ratio > 1 or seed.slew_ratio > 1
+
+
+def test_realised_controller_tf_is_the_pid_between_its_corners():
+    kp, ti, td = 3.34, 43.215e-6, 10.8037e-6
+    parts = blocks.continuous_parts(kp, ti, td, 3500, f_integrator_hz=1.0, f_differentiator_hz=1e7)
+    num, den = model.controller_tf(parts, IDEAL)
+    w = 2 * np.pi * np.array([300.0, 3500.0, 30e3])
+    _, c = signal.freqs(num, den, worN=w)
+    ideal = kp * (1 + 1 / (1j * w * ti) + 1j * w * td)
+    assert np.allclose(c, ideal, rtol=0.01)
+    # the leak and the filter: finite gain at DC (Kp (1 + R13 C4/Ti)) and at high frequency (Kp (1 + Td/Tf))
+    _, c0 = signal.freqs(num, den, worN=[1e-3])
+    assert c0[0].real == pytest.approx(kp * (1 + parts.integrator_dc_gain), rel=1e-4)
+    # with the LM741 the controller's loop is the one loop_gain evaluates
+    num7, den7 = model.controller_tf(parts, LM741)
+    w = 2 * np.pi * np.logspace(2, 6, 50)
+    _, c7 = signal.freqs(num7, den7, worN=w)
+    _, p7 = signal.freqs(PN, PD, worN=w)
+    assert np.allclose(c7 * p7, model.loop_gain(parts, LM741, PN, PD, w), rtol=1e-6)

@@ -98,6 +98,28 @@ def summer_weights(parts: PidParts) -> dict:
     return w
 
 
+def controller_tf(parts: PidParts, opamp: OpAmp | None):
+    """The realised controller u/(r - y) as (num, den): difference amplifier,
+    the three paths (leaky integrator, filtered derivative), summer and final
+    gain, each with its op-amp's finite gain-bandwidth. (The difference
+    amplifier's two weights are taken equal, as with R15 = R16 = R17 = R18.)"""
+    tfs = stage_tfs(parts, opamp)
+    sw = summer_weights(parts)
+    num, den = np.array([0.0]), np.array([1.0])
+    for sig in ("vp", "vd", "vi"):
+        if sig not in tfs:
+            continue
+        n, d = tfs[sig]
+        num = np.polyadd(np.polymul(num, d), np.polymul(n * sw[sig], den))
+        den = np.polymul(den, d)
+    for sig in ("vs", "u", "ve"):
+        n, d = tfs[sig]
+        num, den = np.polymul(num, n), np.polymul(den, d)
+    g_y, g_r = difference_weights(parts)
+    # ve = F (g_y y - g_r r) = -F g_r (r - y) when g_y = g_r
+    return _trim(-g_r * num), _trim(den)
+
+
 @dataclass
 class LoopModel:
     """State-space model of the whole loop: input r, outputs :data:`SIGNALS`."""
