@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import math
 import statistics
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -71,6 +73,14 @@ def main():
         b = res.best
         params = ", ".join(f"{k} {v:.4g}" for k, v in b.params.items()) if b else "none"
         print(f"| {label} | {d.w.size} | {1e3 * dt:.1f} | {b.name} ({b.model}) | {params} |")
+
+    exe = Path(sys.executable).with_name("identify-freq")
+    if exe.exists():
+        dt, _ = _median_time(lambda: subprocess.run(
+            [str(exe), str(FIX / "seed000_table4_deg.csv"), "--json"], capture_output=True,
+            check=True))
+        print(f"| `identify-freq seed000_table4_deg.csv --json` end to end (new process) | 14 "
+              f"| {1e3 * dt:.0f} | | |")
 
     t, y, p = step_capture()
     print(f"\n### second-order step methods on {N:,} samples (seed 001 plant, 1 % noise; "

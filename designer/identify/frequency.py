@@ -601,7 +601,8 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     """Fit ``model`` to the complex response from each of ``starts`` (parameter
     dicts) and keep the lowest cost; 95 % half-widths from the Jacobian."""
     from scipy.optimize import least_squares
-    from scipy.stats import t as student_t
+    # Student t quantile from scipy.special: scipy.stats costs 0.4 s to import
+    from scipy.special import stdtrit
 
     name = "least-squares"
     fit_delay = data.phase is not None
@@ -634,7 +635,7 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
         s2 = 2.0 * best.cost / (m - n)
         try:
             cov = np.linalg.inv(best.jac.T @ best.jac) * s2
-            half = student_t.ppf(0.975, m - n) * np.sqrt(np.clip(np.diag(cov), 0.0, None))
+            half = stdtrit(m - n, 0.975) * np.sqrt(np.clip(np.diag(cov), 0.0, None))
             # back from log variables: d(e^x) = e^x dx
             names = {"fopdt": ["K", "tau_s"], "underdamped": ["K", "wn_rad_s", "zeta"],
                      "overdamped": ["K", "tau1_s", "tau2_s"]}[model]
