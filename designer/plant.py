@@ -347,6 +347,32 @@ def _analyse(built, ideal, amp, r_series, c_series, spec, ratios, notes, amplitu
     return result
 
 
+def bench_waveforms(result, n: int = 4001) -> dict:
+    """The whole simulated bench period (rising and falling edge) on a uniform
+    grid: input, the analytic responses (by superposition of two steps) and,
+    when simulated, SPICE. Keys are the CSV column names."""
+    test = result.test
+    t = np.linspace(0.0, test.stop_s, n)
+    u = np.where((t >= test.delay_s) & (t < test.delay_s + test.half_period_s), test.amplitude_v, 0.0)
+    num_i, den_i, num_o, den_o = result.waveforms["bode"]
+
+    def square(num, den):
+        up = np.clip(t - test.delay_s, 0.0, None)
+        down = np.clip(t - test.delay_s - test.half_period_s, 0.0, None)
+        y = step_response(num, den, up) * (t >= test.delay_s)
+        return test.amplitude_v * (y - step_response(num, den, down) * (t >= test.delay_s + test.half_period_s))
+
+    cols = {"time_s": t, "input_v": u, "analytic_v": square(num_i, den_i),
+            "analytic_opamp_v": square(num_o, den_o)}
+    if "spice_period" in result.waveforms:
+        ts, ys, us = result.waveforms["spice_period"]
+        cols["input_v"] = resample(ts, us, t)
+        cols["output_v"] = resample(ts, ys, t)
+    else:
+        cols["output_v"] = cols["analytic_opamp_v"]
+    return cols
+
+
 def _title(parts, amp):
     return (f"Sallen-Key low-pass plant fn={parts.fn_hz:.5g}Hz zeta={parts.zeta:.4g} "
             f"K={parts.gain:.4g} op-amp={amp.name}")
@@ -388,4 +414,5 @@ def run_spice(result: PlantResult, simulator: str, dc_gain_opamp: float) -> None
         "pass": spice["nrms"] < 1.0,
     }
     result.waveforms["spice"] = y_s
+    result.waveforms["spice_period"] = (t, y, res["input"])
     result.timings["simulation_s"] = time.perf_counter() - tick

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import time
 from pathlib import Path
 
@@ -171,6 +172,19 @@ def plots(result) -> dict:
                                     fn / 100, fn * 100, "Plant frequency response")}
 
 
+def waveforms_csv(result) -> str:
+    """The bench period as CSV (``time_s,input_v,output_v,...``; output is SPICE when
+    simulated), the format ``identify`` reads: the tool's own scope capture."""
+    from .plant import bench_waveforms
+    cols = bench_waveforms(result)
+    order = ["time_s", "input_v", "output_v", "analytic_v", "analytic_opamp_v"]
+    import numpy as np
+    data = np.column_stack([cols[k] for k in order])
+    buf = io.StringIO()
+    np.savetxt(buf, data, delimiter=",", header=",".join(order), comments="", fmt="%.9g")
+    return buf.getvalue()
+
+
 def write_outputs(result, out_dir, name: str) -> dict:
     """Write ``netlists/<name>.cir`` and ``reports/<name>/`` under ``out_dir``.
 
@@ -186,10 +200,12 @@ def write_outputs(result, out_dir, name: str) -> dict:
                     "build_sheet_md": str(rep_dir / "build-sheet.md"),
                     "build_sheet_html": str(rep_dir / "build-sheet.html"),
                     "result_json": str(rep_dir / "result.json"),
+                    "waveforms_csv": str(rep_dir / "waveforms.csv"),
                     "plots": [str(rep_dir / n) for n in images]}
     title = title_of(result)
     secs = sections(result)
     atomic_write(result.files["netlist"], result.deck)
+    atomic_write(result.files["waveforms_csv"], waveforms_csv(result))
     for n, data in images.items():
         atomic_write(rep_dir / n, data)
     atomic_write(result.files["build_sheet_md"], R.to_markdown(title, secs))
