@@ -410,9 +410,9 @@ def _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, s
     checks = list(checks) + _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, spec.step_v, rise, parts)
     limits = {"closed_loop_stable", "phase_margin", "slew_rate", "output_swing"}
     if not amp.ideal and any(not c["ok"] for c in checks if c["name"] in limits):
-        notes.append(f"for gains that respect the {amp.name}'s limits for this step, let the optimiser choose them: "
-                     "--tuning optimize --target-overshoot P (it keeps every op-amp inside its swing and slew "
-                     "rate and the loop stable with the op-amp poles)")
+        notes.append(f"to have gains chosen for the loop as built with {amp.name}s (stable with the op-amp poles, "
+                     "every op-amp inside its swing and slew rate for this step): --tuning optimize "
+                     "--target-overshoot P")
     expected = spec.step_v * dc_cl if math.isfinite(dc_cl) else spec.step_v
     title = (f"PID closed loop Kp={parts.kp:.4g} Ti={parts.ti_s:.4g}s Td={parts.td_s:.4g}s "
              f"plant fn={plant.fn_hz:.5g}Hz zeta={plant.zeta:.4g} op-amp={amp.name}")
