@@ -314,3 +314,14 @@ def test_arbitrary_tables_never_raise(g, with_phase, data):
             assert all(math.isfinite(v) for v in m.params.values())
         else:
             assert m.note
+
+
+def test_seed000_example3_integrator_is_flagged():
+    # seed 000 example 3: G = 1.04/(s (s + 5.2)), -20 dB/decade from the lowest frequency
+    w = np.geomspace(0.01, 100, 60)
+    g = 1.04 / (1j * w * (1j * w + 5.2))
+    d = fr.freq_data(w, np.abs(g), np.unwrap(np.angle(g)), gain_units="ratio",
+                     phase_units="rad", freq_units="rad/s")
+    for r in (fr.asymptotes(d), fr.resonant_peak(d)):
+        assert not r.valid and "dB/decade at the lowest frequencies" in r.note
+    fr.identify_freq(d)    # the fits still run (and are ranked by their error)

@@ -79,7 +79,7 @@ class FreqData:
     ``w`` in rad/s (increasing, > 0), ``gain`` as an amplitude ratio (> 0),
     ``phase`` in radians, unwrapped, 0 at DC for a non-inverting plant (or
     None when the table has no phase). ``sign`` is -1 when the low-frequency
-    phase is near +-180 degrees (an inverting plant; the phase is then stored
+    phase is within 45 degrees of +-180 (an inverting plant; the phase is then stored
     without that 180 degrees).
     """
 
@@ -172,7 +172,8 @@ def freq_data(freq, gain, phase=None, *, gain_units="db", phase_units="deg",
             # a positive time shift is the output lagging the input: -w dt
             ph = -w * p
         ph -= 2.0 * math.pi * round(ph[0] / (2.0 * math.pi))
-        if abs(ph[0]) > math.pi / 2.0:
+        # within 45 degrees of +-180 at the lowest frequency: an inverting plant
+        if abs(ph[0]) > 0.75 * math.pi:
             sign = -1.0
             ph -= math.copysign(math.pi, ph[0])
     return FreqData(w, ratio, ph, sign, source,
@@ -428,6 +429,12 @@ def low_frequency_gain(data: FreqData, tol_db: float = 0.05, span: float = 3.0):
     return float(10.0 ** (np.mean(db[:run]) / 20.0)), run
 
 
+def low_frequency_slope(data: FreqData) -> float:
+    """Slope in dB/decade between the two lowest frequencies (0 for a flat start)."""
+    dlw = math.log10(data.w[1] / data.w[0])
+    return float((data.gain_db[1] - data.gain_db[0]) / dlw) if dlw > 0 else 0.0
+
+
 def high_frequency_slope(data: FreqData, k_db: float, drop_db: float = 10.0):
     """Slope in dB/decade of the high-frequency asymptote: a line through the
     points at least ``drop_db`` below K (at least the last two points)."""
@@ -470,6 +477,12 @@ def asymptotes(data: FreqData) -> MethodResult:
     is reported in ``points`` as ``w_intersection_rad_s``.
     """
     name = "asymptotes"
+    lf = low_frequency_slope(data)
+    if lf < -10.0:
+        return _invalid(name, "fopdt", f"the gain already falls {-lf:.0f} dB/decade at the "
+                        "lowest frequencies: a pole at the origin (integrator, seed 000 "
+                        "examples 3-4) or a table that starts above the corner; the models "
+                        "here need a flat low-frequency gain", {"lf_slope_db_dec": lf})
     K, run = low_frequency_gain(data)
     k_db = 20.0 * math.log10(K)
     slope, sel = high_frequency_slope(data, k_db)
@@ -528,6 +541,11 @@ def resonant_peak(data: FreqData, min_db: float = 0.1) -> MethodResult:
     first and last points (zeta < 0.707).
     """
     name, model = "resonant-peak", "underdamped"
+    lf = low_frequency_slope(data)
+    if lf < -10.0:
+        return _invalid(name, model, f"the gain already falls {-lf:.0f} dB/decade at the "
+                        "lowest frequencies: no flat low-frequency gain to measure the peak "
+                        "against", {"lf_slope_db_dec": lf})
     K, _ = low_frequency_gain(data)
     k_db = 20.0 * math.log10(K)
     db = data.gain_db
