@@ -10,16 +10,12 @@ its plant); the time constant is that time minus L (60.14 us).
 The same K, L, T are a first-order-plus-dead-time (FOPDT) model
 K e^(-L s)/(T s + 1), from which the other rules work:
 
-==========  =========================================  ======================  =================
-rule        Kp                                         Ti                      Td
-==========  =========================================  ======================  =================
-zn          1.2 T / (K L)                              2 L                     0.5 L
-cohen-coon  (T / (K L)) (4/3 + L / (4 T))              L (32 + 6 L/T)/(13 + 8 L/T)   4 L / (11 + 2 L/T)
-chr0        0.6 T / (K L)                              T                       0.5 L
-chr20       0.95 T / (K L)                             1.4 T                   0.47 L
-amigo       (0.2 + 0.45 T / L) / K                     L (0.4 L + 0.8 T)/(L + 0.1 T)  0.5 L T / (0.3 L + T)
-simc        T / (K (tc + L)), tc = L                   min(T, 4 (tc + L))      0 (PI)
-==========  =========================================  ======================  =================
+* zn:         Kp = 1.2 T/(K L),                 Ti = 2 L,                        Td = 0.5 L
+* cohen-coon: Kp = (T/(K L)) (4/3 + L/(4 T)),   Ti = L (32 + 6 L/T)/(13 + 8 L/T), Td = 4 L/(11 + 2 L/T)
+* chr0:       Kp = 0.6 T/(K L),                 Ti = T,                          Td = 0.5 L
+* chr20:      Kp = 0.95 T/(K L),                Ti = 1.4 T,                      Td = 0.47 L
+* amigo:      Kp = (0.2 + 0.45 T/L)/K,          Ti = L (0.4 L + 0.8 T)/(L + 0.1 T), Td = 0.5 L T/(0.3 L + T)
+* simc:       Kp = T/(K (tc + L)), tc = L,      Ti = min(T, 4 (tc + L)),         Td = 0 (a PI)
 
 (Ziegler & Nichols 1942; Cohen & Coon 1953; Chien, Hrones & Reswick 1952,
 set-point response; Astrom & Hagglund 2004, AMIGO; Skogestad 2003, SIMC, which
