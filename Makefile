@@ -23,8 +23,15 @@ $(VENV_STAMP): pyproject.toml
 	$(PY) -m pip install -q -e '.[test]'
 	touch $@
 
+# The main job: the seed's plant, and PID controllers for it with LM741s (ZN tuning done right,
+# the optimiser, and the seed's own final design to show what really happens).
 demo: setup
 	.venv/bin/design-plant --fc 3500 --zeta 0.2 --name plant_fc3500_z0.2 --out .
+	.venv/bin/design-pid --plant-fc 3500 --plant-zeta 0.2 --opamp LM741 --name pid_zn_lm741_fc3500_z0.2 --out .
+	.venv/bin/design-pid --plant-fc 3500 --plant-zeta 0.2 --opamp LM741 --tuning optimize --target-overshoot 10 \
+	  --name pid_optimize_os10_lm741_fc3500_z0.2 --out .
+	.venv/bin/design-pid --plant-fc 3500 --plant-zeta 0.2 --opamp LM741 --kp 45 --ti 43.215u --td 10.8037u \
+	  --seed-parts --name pid_seed_kp45_lm741_fc3500_z0.2 --out .
 
 test: setup
 	$(PY) -m pytest -q -p no:cacheprovider tests

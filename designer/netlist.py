@@ -28,6 +28,7 @@ class SquareTest:
     amplitude_v: float
     frequency_hz: float
     delay_s: float
+    edge_time_s: float | None = None  #: rise/fall time of the edges; default 1e-5 half period
 
     @property
     def half_period_s(self) -> float:
@@ -36,7 +37,7 @@ class SquareTest:
     @property
     def edge_s(self) -> float:
         # fast against the response, but not a zero-time discontinuity for the solver
-        return self.half_period_s * 1e-5
+        return self.half_period_s * 1e-5 if self.edge_time_s is None else self.edge_time_s
 
     @property
     def stop_s(self) -> float:

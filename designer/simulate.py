@@ -30,7 +30,8 @@ INSTALL_HINT = "install it with: apt-get install ngspice libngspice0-dev (or run
 BACKENDS = ("pyspice", "ngspice-cli")
 
 _MEAS = re.compile(r"^\s*([A-Za-z_][\w]*)\s*=\s*([-+]?[\d.]+(?:[eE][-+]?\d+)?)", re.M)
-_ERROR = re.compile(r"^(?:.*\berror\b.*|.*fatal.*|.*failed.*)$", re.I | re.M)
+# a failed .meas ("name failed!", "meas ... failed") is a missing measurement, not a failed run
+_ERROR = re.compile(r"^(?:.*\berror\b.*|.*fatal.*|.*aborted.*|.*timestep too small.*)$", re.I | re.M)
 _NOT_ERROR = re.compile(r"^\s*(?:note|warning|info)\b", re.I)
 
 

@@ -84,3 +84,12 @@ def test_raw_reader_reads_ascii_and_binary(deck, tmp_path):
 def test_error_lines_skip_notes():
     assert error_lines("Note: No compatibility mode selected!\nWarning: x failed\n") == []
     assert error_lines("Error: unknown subckt: x1 a b\n") == ["Error: unknown subckt: x1 a b"]
+
+
+def test_a_failed_measurement_is_not_a_failed_run(deck):
+    # regression: ngspice prints "name failed!" for a .meas whose level is never crossed
+    never = deck.replace(".end\n", ".meas tran never WHEN v(out)=1e6 CROSS=1\n.end\n")
+    for name in ("pyspice", "ngspice-cli"):
+        res = get_simulator(name).run(never)
+        assert "never" not in res.measurements
+        assert "overshoot_pct" in res.measurements

@@ -25,7 +25,8 @@ from ..opamps import OpAmp
 from ..sallenkey import SallenKeyParts
 from ..units import format_eng
 from . import blocks, model, tuning
-from .netlist import ReferenceTest, closed_loop_deck
+from ..netlist import SquareTest
+from .netlist import closed_loop_deck
 
 #: phase margin below which the loop is called under-damped on the bench
 MIN_PHASE_MARGIN_DEG = 30.0
@@ -131,7 +132,7 @@ class PidResult:
     ideal_pid: dict
     margins: dict
     levels: dict
-    test: ReferenceTest
+    test: SquareTest
     expected_final_v: float
     deck: str
     spice: dict | None = None
@@ -185,7 +186,7 @@ class PidResult:
             "closed_loop": {"analytic": self.analytic, "ideal_pid": self.ideal_pid, "spice": spice,
                             "margins": self.margins, "verdict": self.verdict},
             "levels": {"analytic": self.levels, "spice": self.spice_levels},
-            "test_signal": {"kind": "square", "low_v": 0.0, "high_v": self.test.step_v,
+            "test_signal": {"kind": "square", "low_v": 0.0, "high_v": self.test.amplitude_v,
                             "frequency_hz": self.test.frequency_hz, "edge_s": self.test.edge_s,
                             "expected_final_v": self.expected_final_v},
             "notes": self.notes,
@@ -391,7 +392,7 @@ def _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, s
         ts = span / 2
     sq = recommend_square_wave(ts, spec.step_v, spec.square_hz)
     hp = sq.half_period_s
-    test = ReferenceTest(spec.step_v, sq.frequency_hz, 0.05 * hp, spec.edge_s)
+    test = SquareTest(spec.step_v, sq.frequency_hz, 0.05 * hp, spec.edge_s)
     t = np.linspace(0.0, hp, 20001)
     r = model.reference(t, spec.step_v, 0.0, spec.edge_s)
     waves = lm.simulate(t, r) if stable else _diverging(lm, t, r, 2 * max(abs(amp.vcc), abs(amp.vee)))
@@ -513,7 +514,7 @@ def run_spice(res: PidResult, simulator: str) -> None:
     tick = time.perf_counter()
     t = res.waveforms["t"]
     out = run_and_compare(res.deck, simulator, t, res.test.delay_s, res.test.half_period_s,
-                          res.waveforms["analytic"], res.test.step_v, res.expected_final_v, res.opamp)
+                          res.waveforms["analytic"], res.test.amplitude_v, res.expected_final_v, res.opamp)
     res.simulator = out["backend"]
     sp = dict(out["metrics"])
     sp["deltas_vs_analytic"] = out["deltas"]

@@ -12,7 +12,6 @@ controller output (plant input), ``y`` plant output. Op-amps are XU1..XU6
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
 
 from ..netlist import (SquareTest, add_opamp, add_sallen_key, add_supplies, finish_deck,
                        measure_lines, opamp_library_text, settle_error_source)
@@ -22,34 +21,6 @@ from .blocks import PidParts
 
 #: signals whose extremes the deck measures (one per op-amp output)
 PROBES = ("ve", "vp", "vd", "vi", "vs", "u", "y")
-
-
-@dataclass(frozen=True)
-class ReferenceTest:
-    """0 -> ``step_v`` square wave with linear edges of ``edge_s``; one period is
-    simulated (the rising step at ``delay_s``, the falling one half a period later)."""
-
-    step_v: float
-    frequency_hz: float
-    delay_s: float
-    edge_s: float
-
-    @property
-    def half_period_s(self) -> float:
-        return 0.5 / self.frequency_hz
-
-    @property
-    def stop_s(self) -> float:
-        return self.delay_s + 2 * self.half_period_s
-
-    def source(self) -> str:
-        hp, e = self.half_period_s, self.edge_s
-        return (f"PULSE(0 {self.step_v:.6g} {self.delay_s:.6g} {e:.6g} {e:.6g} "
-                f"{hp - e:.6g} {2 * hp:.6g})")
-
-    def square(self) -> SquareTest:
-        """The same timing as the project's :class:`~designer.netlist.SquareTest` (for ``.meas``)."""
-        return SquareTest(self.step_v, self.frequency_hz, self.delay_s)
 
 
 def add_controller(circuit, parts: PidParts, opamp: OpAmp, ref="ref", y="y", u="u"):
@@ -90,7 +61,7 @@ def add_controller(circuit, parts: PidParts, opamp: OpAmp, ref="ref", y="y", u="
     add_opamp(circuit, "U6", gnd, "n6", u, opamp)
 
 
-def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test: ReferenceTest,
+def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test: SquareTest,
                      title: str, expected_final: float, points: int = 20000) -> str:
     """The whole loop as a standalone deck; ``expected_final`` (V) is the settled
     plant output the ``.meas`` levels refer to (the analytic closed loop's)."""
@@ -100,7 +71,7 @@ def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test:
     circuit.raw_spice = "\n".join([
         f"* {title}",
         f"* op-amps: {opamp.name} ({opamp.description}); supplies {opamp.vcc:g} V / {opamp.vee:g} V",
-        f"* reference: 0 -> {test.step_v:g} V square wave at {test.frequency_hz:g} Hz, edges "
+        f"* reference: 0 -> {test.amplitude_v:g} V square wave at {test.frequency_hz:g} Hz, edges "
         f"{test.edge_s:.3g} s, rising step at {test.delay_s:.4g} s",
         "* controller (seed 001, Fig. 66): U1 difference (ve = y - r), U2 inverter, U3 differentiator,",
         "*   U4 integrator, U5 summer, U6 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y); plant XP1",
@@ -113,7 +84,7 @@ def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test:
     add_controller(circuit, parts, opamp)
     add_sallen_key(circuit, plant, opamp, "u", "y", prefix="P")
     settle_error_source(circuit, "y", expected_final)
-    sq = test.square()
+    sq = test
     t0 = test.delay_s
     extremes = []
     for node in PROBES:

@@ -237,7 +237,7 @@ def plots(result) -> dict:
     if sp is not None:
         curves["SPICE (ngspice)"] = sp["y"]
     curves["plant alone (open loop)"] = w["open_loop"]
-    images = {"closed-loop.png": R.step_plot(t, curves, f"Closed-loop step, 0 -> {result.test.step_v:g} V")}
+    images = {"closed-loop.png": R.step_plot(t, curves, f"Closed-loop step, 0 -> {result.test.amplitude_v:g} V")}
     cu = {"u analytic": a["u"]}
     if sp is not None:
         cu["u SPICE"] = sp["u"]
