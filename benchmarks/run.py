@@ -25,7 +25,7 @@ def main(argv=None) -> int:
     benches = sorted(HERE.glob("bench_*.py"))
     if argv:
         benches = [b for b in benches if any(a in b.stem for a in argv)]
-    parts = [f"# Benchmark results\n",
+    parts = ["# Benchmark results\n",
              f"Run {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} on {platform.machine()}, "
              f"{os.cpu_count()} cores, Python {platform.python_version()}, by `make bench`.\n"]
     failed = 0

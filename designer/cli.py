@@ -137,6 +137,11 @@ def _check_name(name):
 
 def _emit(result, args, name) -> int:
     from .plant_report import summary_text, write_outputs
+    return emit(result, args, name, write_outputs, summary_text)
+
+
+def emit(result, args, name, write_outputs, summary_text) -> int:
+    """Write the files (unless --no-files), then print JSON or the summary and the file list."""
     if not args.no_files:
         write_outputs(result, args.out, name)
     if args.json:

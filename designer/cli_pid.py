@@ -4,11 +4,10 @@ print. Any :class:`~designer.errors.DesignError` becomes one line on stderr and 
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 
 from . import __version__, opamps
-from .cli import OneLineParser, _check_name, run_cli
+from .cli import OneLineParser, _check_name, emit, run_cli
 from .eseries import SERIES
 from .errors import DesignError
 from .units import parse_positive, parse_value
@@ -159,17 +158,7 @@ def _run(args) -> int:
         ensure_dir(args.out)  # fail before the work, not after
     result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
     name = args.name or _default_name(spec, result.plant.fn_hz, result.plant.zeta)
-    if not args.no_files:
-        write_outputs(result, args.out, name)
-    if args.json:
-        print(json.dumps(result.to_dict(), indent=2))
-    else:
-        print(summary_text(result), end="")
-        if result.files:
-            print("\nFiles:")
-            for key, path in result.files.items():
-                print(f"  {key}: {', '.join(path) if isinstance(path, list) else path}")
-    return 0
+    return emit(result, args, name, write_outputs, summary_text)
 
 
 def design_pid_main(argv=None) -> int:

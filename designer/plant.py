@@ -24,6 +24,7 @@ from .models import (dense_time, dominant_pair, plant_tf, plant_tf_opamp, respon
                      sensitivities, step_response)
 from .netlist import SquareTest, plant_deck
 from .opamps import OpAmp
+from .report import json_safe
 from .sallenkey import (SallenKeyParts, check_spec, ratios_from_rc, realizability_notes,
                         resistors_for_caps)
 from .selection import around, brute_force, joint_search
@@ -109,7 +110,7 @@ class PlantResult:
                  "fn_opamp_error_pct": _pct(self.fn_opamp_hz, target_fn),
                  "zeta_opamp_error_pct": _pct(self.zeta_opamp, target_z),
                  "tolerance_band": self.tolerance}
-        return _clean({
+        return json_safe({
             "mode": self.mode,
             "spec": self.spec,
             "ratios": self.ratios,
@@ -141,19 +142,6 @@ def _pct(value, target):
     if target is None or value is None:
         return None
     return 100.0 * (value / target - 1.0)
-
-
-def _clean(obj):
-    """JSON-safe: numpy scalars to float, nan/inf to None."""
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, (np.floating, np.integer)):
-        obj = obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
 
 
 def candidates(series: str, lo: float, hi: float, what: str) -> np.ndarray:

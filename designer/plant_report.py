@@ -4,10 +4,8 @@ from __future__ import annotations
 
 import io
 import time
-from pathlib import Path
 
 from . import report as R
-from .fileio import atomic_write, ensure_dir
 from .units import format_eng
 
 METRIC_ROWS = (("overshoot_pct", "overshoot Mp", lambda v: "n/a" if v is None else f"{v:.4g} %"),
@@ -192,24 +190,9 @@ def write_outputs(result, out_dir, name: str) -> dict:
     recorded in ``result.files`` before result.json is written, so it lists itself.
     """
     tick = time.perf_counter()
-    out_dir = Path(out_dir)
-    net_dir = ensure_dir(out_dir / "netlists")
-    rep_dir = ensure_dir(out_dir / "reports" / name)
     images = plots(result)
-    result.files = {"netlist": str(net_dir / f"{name}.cir"),
-                    "build_sheet_md": str(rep_dir / "build-sheet.md"),
-                    "build_sheet_html": str(rep_dir / "build-sheet.html"),
-                    "result_json": str(rep_dir / "result.json"),
-                    "waveforms_csv": str(rep_dir / "waveforms.csv"),
-                    "plots": [str(rep_dir / n) for n in images]}
-    title = title_of(result)
-    secs = sections(result)
-    atomic_write(result.files["netlist"], result.deck)
-    atomic_write(result.files["waveforms_csv"], waveforms_csv(result))
-    for n, data in images.items():
-        atomic_write(rep_dir / n, data)
-    atomic_write(result.files["build_sheet_md"], R.to_markdown(title, secs))
-    atomic_write(result.files["build_sheet_html"], R.to_html(title, secs, images))
-    R.write_json(result.files["result_json"], result.to_dict())
+    result.files = R.bundle_paths(out_dir, name, images, {"waveforms_csv": "waveforms.csv"})
+    R.write_bundle(result.files, result.deck, images, title_of(result), sections(result), result.to_dict(),
+                   {"waveforms_csv": waveforms_csv(result)})
     result.timings["report_s"] = time.perf_counter() - tick
     return result.files

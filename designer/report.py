@@ -155,8 +155,56 @@ def bode_plot(systems: dict, f_lo: float, f_hi: float, title: str) -> bytes:
     return _png(fig)
 
 
+def json_safe(obj):
+    """JSON-ready copy: numpy scalars to Python numbers, nan/inf to None."""
+    if isinstance(obj, dict):
+        return {k: json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_safe(v) for v in obj]
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, (np.floating, np.integer)):
+        obj = obj.item()
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
 def write_json(path, data) -> None:
     atomic_write(path, json.dumps(data, indent=2) + "\n")
+
+
+def bundle_paths(out_dir, name: str, images, extra: dict = None) -> dict:
+    """Create ``netlists/`` and ``reports/<name>/`` under ``out_dir`` and name every
+    file of a design's bundle (``extra``: key -> file name in the report folder)."""
+    from .fileio import ensure_dir
+    from pathlib import Path
+    out_dir = Path(out_dir)
+    net_dir = ensure_dir(out_dir / "netlists")
+    rep_dir = ensure_dir(out_dir / "reports" / name)
+    files = {"netlist": str(net_dir / f"{name}.cir"),
+             "build_sheet_md": str(rep_dir / "build-sheet.md"),
+             "build_sheet_html": str(rep_dir / "build-sheet.html"),
+             "result_json": str(rep_dir / "result.json")}
+    files.update({k: str(rep_dir / v) for k, v in (extra or {}).items()})
+    files["plots"] = [str(rep_dir / n) for n in images]
+    return files
+
+
+def write_bundle(files: dict, deck: str, images: dict, title: str, sections, result: dict,
+                 texts: dict = None) -> None:
+    """Write a bundle named by :func:`bundle_paths`, every file atomically: the
+    deck, the plots, extra ``texts`` (key -> content), the build sheet as
+    Markdown and self-contained HTML, and result.json last."""
+    from pathlib import Path
+    atomic_write(files["netlist"], deck)
+    for key, content in (texts or {}).items():
+        atomic_write(files[key], content)
+    for path in files["plots"]:
+        atomic_write(path, images[Path(path).name])
+    atomic_write(files["build_sheet_md"], to_markdown(title, sections))
+    atomic_write(files["build_sheet_html"], to_html(title, sections, images))
+    write_json(files["result_json"], result)
 
 
 def part_row(ref, value, unit, role, series=None, tol_pct=None):

@@ -13,7 +13,7 @@ from designer.identify.step import identify_step
 
 CASES = [
     ("fopdt", {"K": 2.0, "tau_s": 1e-3, "theta_s": 0.4e-3}, 8e-3),
-    ("overdamped", {"K": 0.9, "tau1_s": 2e-3, "tau2_s": 0.5e-3, "theta_s": 0.3e-3}, 20e-3),
+    ("overdamped", {"K": 0.9, "tau1_s": 0.5e-3, "tau2_s": 2e-3, "theta_s": 0.3e-3}, 20e-3),
     ("underdamped", {"K": 1.2, "wn_rad_s": 2 * math.pi * 500, "zeta": 0.35,
                      "theta_s": 0.1e-3}, 10e-3),
 ]

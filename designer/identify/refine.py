@@ -144,9 +144,12 @@ def fit(model: str, t, y, yf, start: dict | None = None) -> MethodResult:
             best = sol
     x = best.x
     params = _from_x(model, x)
-    if model == "overdamped" and params["tau2_s"] > params["tau1_s"]:
-        params["tau1_s"], params["tau2_s"] = params["tau2_s"], params["tau1_s"]
     ci = _confidence(model, best, tf.size)
+    # the fast time constant is tau1, as in seeds 002 and 003 (and second_order.py)
+    if model == "overdamped" and params["tau1_s"] > params["tau2_s"]:
+        params["tau1_s"], params["tau2_s"] = params["tau2_s"], params["tau1_s"]
+        if "tau1_s" in ci and "tau2_s" in ci:
+            ci["tau1_s"], ci["tau2_s"] = ci["tau2_s"], ci["tau1_s"]
     points = {f"{k}_ci95": v for k, v in ci.items()}
     points["samples_fitted"] = int(tf.size)
     points["rms_residual"] = float(math.sqrt(2 * best.cost / tf.size)) * scale

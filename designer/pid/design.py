@@ -22,6 +22,7 @@ from ..errors import DesignError
 from ..metrics import step_metrics
 from ..models import dominant_pair, plant_tf, plant_tf_opamp, response_span
 from ..opamps import OpAmp
+from ..report import json_safe
 from ..sallenkey import SallenKeyParts
 from ..units import format_eng
 from . import blocks, model, tuning
@@ -193,21 +194,7 @@ class PidResult:
             "simulator": self.simulator,
             "files": self.files,
         }
-        return _clean(out)
-
-
-def _clean(obj):
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, (np.floating, np.integer)):
-        obj = obj.item()
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
+        return json_safe(out)
 
 
 # ---- plant ------------------------------------------------------------------
