@@ -116,8 +116,8 @@ def sections(result, with_images: bool = True) -> list:
         if v is not None:
             rows.append(R.part_row(ref, v, "F", role, ser["c"], ct))
     for ref, role, _ in OPAMP_OUTPUTS:
-        if ref == "U3" and not p.has_derivative:
-            continue
+        if (ref == "U3" and not p.has_derivative) or role == "plant":
+            continue  # the plant's op-amp is listed with the plant's parts
         rows.append([ref, amp.name, "", "", "", f"{role} op-amp, {amp.vcc:g} V / {amp.vee:g} V"])
     pl = result.plant
     designed = result.plant_source.startswith("design-plant")
