@@ -6,7 +6,9 @@ export MPLBACKEND := Agg
 
 .PHONY: setup system-deps demo test bench clean
 
+# compileall: the environment may set PYTHONDONTWRITEBYTECODE, and every command would recompile the package
 setup: system-deps $(VENV_STAMP)
+	@$(PY) -m compileall -q designer
 
 # ngspice (CLI backend) and libngspice (PySpice's shared backend) come from Debian.
 system-deps:

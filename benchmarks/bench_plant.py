@@ -69,7 +69,7 @@ def main():
             rows.append(r.timings)
     print("| phase | seconds |")
     print("|---|---|")
-    for key in ("search_s", "analytic_s", "simulation_s", "report_s"):
+    for key in ("search_s", "analytic_s", "netlist_s", "simulation_s", "report_s"):
         print(f"| {key[:-2]} | {statistics.median(t[key] for t in rows):.3f} |")
 
     print("\n### design-plant end to end (new process each run, median of 3; goal < 3 s)\n")

@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import signal
 
 from .opamps import OpAmp
 from .sallenkey import SallenKeyParts
@@ -76,22 +75,31 @@ def response_span(fn_hz: float, zeta: float) -> float:
 def step_response(num, den, t):
     """Response to a unit step applied at t = 0, evaluated at ``t``.
 
-    Closed form from the partial-fraction expansion, y(t) = H(0) + sum r_i/p_i e^(p_i t),
-    which is exact and vectorised (scipy's lsim steps through the grid in a loop);
-    repeated or zero poles fall back to scipy.signal.step.
+    Closed form from the partial-fraction expansion, y(t) = H(0) + sum r_i/p_i e^(p_i t)
+    with residues r_i = num(p_i) / den'(p_i): exact and vectorised (scipy's lsim
+    steps through the grid in a loop, and importing scipy.signal costs half a
+    second per command). Repeated or zero poles fall back to scipy.signal.step.
     """
     t = np.asarray(t, float)
-    num = np.atleast_1d(np.asarray(num, float))
-    den = np.atleast_1d(np.asarray(den, float))
+    num = np.trim_zeros(np.atleast_1d(np.asarray(num, float)), "f")
+    den = np.trim_zeros(np.atleast_1d(np.asarray(den, float)), "f")
     if len(num) < len(den):
-        r, p, _ = signal.residue(num, den)
+        p = np.roots(den)
         close = np.abs(p[:, None] - p[None, :]) <= 1e-6 * np.abs(p)[:, None]
         np.fill_diagonal(close, False)
         if np.all(np.abs(p) > 0) and not np.any(close):
+            r = np.polyval(num, p) / np.polyval(np.polyder(den), p)
             h0 = num[-1] / den[-1]
             return np.real(h0 + np.exp(np.outer(t, p)) @ (r / p))
+    from scipy import signal
     _, y = signal.step((num, den), T=t)
     return y
+
+
+def freq_response(num, den, f_hz):
+    """Complex H(j 2 pi f) at the frequencies ``f_hz``."""
+    s = 2j * np.pi * np.asarray(f_hz, float)
+    return np.polyval(num, s) / np.polyval(den, s)
 
 
 def dense_time(t_end: float, n: int = 20001):

@@ -13,7 +13,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize
 
 from . import eseries, opamps
 from .bench import recommend_square_wave, signal_checks, tolerance_band
@@ -171,6 +170,7 @@ def predistort(fc_hz, zeta, c1, c2, gain, opamp: OpAmp):
         r2 = 1.0 / ((2 * math.pi * f) ** 2 * c1 * c2 * r1)
         fa, za = dominant_pair(plant_tf_opamp(SallenKeyParts(r1, r2, c1, c2, gain), opamp)[1])
         return np.array([math.log(fa / fc_hz), math.log(za / zeta)])
+    from scipy import optimize  # only here: importing it costs ~0.3 s per command
     sol = optimize.fsolve(realised, [math.log(fc_hz), math.log(zeta)], xtol=1e-12)
     return math.exp(sol[0]), math.exp(sol[1])
 
@@ -327,7 +327,9 @@ def _analyse(built, ideal, amp, r_series, c_series, spec, ratios, notes, amplitu
         waveforms={"t": tw, "analytic": y_iw * amplitude_v, "analytic_opamp": y_ow * amplitude_v,
                    "bode": (num_i, den_i, num_o, den_o)},
         timings=timings)
+    tick = time.perf_counter()
     result.deck = plant_deck(built, amp, test, _title(built, amp))
+    result.timings["netlist_s"] = time.perf_counter() - tick
     if simulate:
         run_spice(result, simulator, k_o)
     else:

@@ -59,3 +59,22 @@ def test_step_response_closed_form():
     wd = wn * math.sqrt(1 - z * z)
     exact = 1 - np.exp(-z * wn * t) * (np.cos(wd * t) + z / math.sqrt(1 - z * z) * np.sin(wd * t))
     assert np.max(np.abs(y - exact)) < 1e-9
+
+
+def test_step_and_frequency_response_match_scipy():
+    from scipy import signal
+    from designer.models import freq_response
+    rng = np.random.default_rng(1)
+    for _ in range(20):
+        poles = -rng.uniform(1e2, 1e5, 3)
+        den = np.poly(poles)
+        num = np.array([rng.uniform(0.1, 2.0) * np.prod(-poles)])
+        t = np.linspace(0, 8 / np.min(-poles), 3001)
+        assert np.max(np.abs(step_response(num, den, t) - signal.step((num, den), T=t)[1])) < 1e-6 * num[0] / den[-1]
+        f = np.logspace(0, 6, 50)
+        _, h = signal.freqs(num, den, worN=2 * np.pi * f)
+        assert np.allclose(freq_response(num, den, f), h, rtol=1e-12)
+    # a repeated pole takes the scipy path and still works
+    t = np.linspace(0, 1e-2, 1001)
+    y = step_response([1e6], [1, 2e3, 1e6], t)
+    assert np.max(np.abs(y - (1 - (1 + 1e3 * t) * np.exp(-1e3 * t)))) < 1e-6
