@@ -158,21 +158,11 @@ def gain_resistors(gain: float, spec: PlantSpec):
     return r3, r4, 1.0 + r4 / r3
 
 
-def predistort(fc_hz, zeta, c1, c2, gain, opamp: OpAmp):
-    """Targets (fc', zeta') whose exact design with these capacitors lands on
-    (fc, zeta) once the op-amp's finite GBW shifts it (``--compensate-gbw``)."""
-    def realised(x):
-        f, z = math.exp(x[0]), math.exp(x[1])
-        lo, hi = resistors_for_caps(f, z, c1, c2, gain)
-        r1 = float(lo) if not math.isnan(float(lo)) else float(hi)
-        if math.isnan(r1):
-            return np.array([10.0, 10.0])
-        r2 = 1.0 / ((2 * math.pi * f) ** 2 * c1 * c2 * r1)
-        fa, za = dominant_pair(plant_tf_opamp(SallenKeyParts(r1, r2, c1, c2, gain), opamp)[1])
-        return np.array([math.log(fa / fc_hz), math.log(za / zeta)])
-    from scipy import optimize  # only here: importing it costs ~0.3 s per command
-    sol = optimize.fsolve(realised, [math.log(fc_hz), math.log(zeta)], xtol=1e-12)
-    return math.exp(sol[0]), math.exp(sol[1])
+def gbw_shift(parts: SallenKeyParts, opamp: OpAmp):
+    """How far the op-amp's finite GBW moves these parts: (fn_ideal / fn_opamp,
+    zeta_ideal / zeta_opamp). ``--compensate-gbw`` multiplies the targets by it."""
+    fo, zo = dominant_pair(plant_tf_opamp(parts, opamp)[1])
+    return parts.fn_hz / fo, parts.zeta / zo
 
 
 def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspice") -> PlantResult:
@@ -186,37 +176,40 @@ def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspi
     notes = realizability_notes(spec.fc_hz, spec.zeta, spec.gain, spec.c_min, spec.c_max)
     if k != spec.gain:
         notes.append(f"gain K = {spec.gain:g} realised as 1 + {r4:g}/{r3:g} = {k:.5g}")
-    fc_t, z_t = spec.fc_hz, spec.zeta
-    ratios = {"m": None, "n": None}
     top = max(1, spec.alternatives)
 
-    if spec.r is not None:
-        # the seed's procedure: R and C fixed, m and n solved, each part rounded jointly
-        m, n = ratios_from_rc(spec.fc_hz, spec.zeta, spec.r, spec.c, k)
-        ratios = {"m": m, "n": n}
-        ideal = SallenKeyParts(m * spec.r, spec.r, spec.c, n * spec.c, k, r3, r4)
-        if spec.compensate_gbw:
-            fc_t, z_t = predistort(spec.fc_hz, spec.zeta, ideal.c1, ideal.c2, k, amp)
+    def select(fc_t, z_t):
+        """Ranked E-series candidates, the exact design they round, and its ratios."""
+        if spec.r is not None:
+            # the seed's procedure: R and C fixed, m and n solved, each part rounded jointly
             m, n = ratios_from_rc(fc_t, z_t, spec.r, spec.c, k)
             ideal = SallenKeyParts(m * spec.r, spec.r, spec.c, n * spec.c, k, r3, r4)
-        pool_r = np.unique(np.concatenate([around(ideal.r1, rv), around(ideal.r2, rv)]))
-        pool_c = np.unique(np.concatenate([around(ideal.c1, cv), around(ideal.c2, cv)]))
-        ranked = brute_force(fc_t, z_t, pool_r, pool_c, k, top=4 * top)
-    else:
+            pool_r = np.unique(np.concatenate([around(ideal.r1, rv), around(ideal.r2, rv)]))
+            pool_c = np.unique(np.concatenate([around(ideal.c1, cv), around(ideal.c2, cv)]))
+            return brute_force(fc_t, z_t, pool_r, pool_c, k, top=4 * top), ideal, {"m": m, "n": n}
         ranked = joint_search(fc_t, z_t, rv, cv, k, top=4 * top)
-        if spec.compensate_gbw:
-            fc_t, z_t = predistort(spec.fc_hz, spec.zeta, ranked[0].c1, ranked[0].c2, k, amp)
-            ranked = joint_search(fc_t, z_t, rv, cv, k, top=4 * top)
         best = ranked[0]
         lo, hi = resistors_for_caps(fc_t, z_t, best.c1, best.c2, k)
         roots = [float(x) for x in (lo, hi) if not math.isnan(float(x))]
-        if roots:
-            r1 = min(roots, key=lambda r: abs(math.log(r / best.r1)))
-            r2 = 1.0 / ((2 * math.pi * fc_t) ** 2 * best.c1 * best.c2 * r1)
-            ideal = SallenKeyParts(r1, r2, best.c1, best.c2, k, r3, r4)
-            ratios = {"m": r1 / r2, "n": best.c2 / best.c1}
-        else:
-            ideal = None
+        if not roots:
+            return ranked, None, {"m": None, "n": None}
+        r1 = min(roots, key=lambda r: abs(math.log(r / best.r1)))
+        r2 = 1.0 / ((2 * math.pi * fc_t) ** 2 * best.c1 * best.c2 * r1)
+        return ranked, SallenKeyParts(r1, r2, best.c1, best.c2, k, r3, r4), {"m": r1 / r2, "n": best.c2 / best.c1}
+
+    fc_t, z_t = spec.fc_hz, spec.zeta
+    ranked, ideal, ratios = select(fc_t, z_t)
+    if spec.compensate_gbw:
+        # aim off by the shift the op-amp causes on the parts chosen, and choose again;
+        # the shift hardly depends on the parts, so two or three rounds settle it
+        for _ in range(4):
+            b = ranked[0]
+            sf, sz = gbw_shift(SallenKeyParts(b.r1, b.r2, b.c1, b.c2, k, r3, r4), amp)
+            new = (spec.fc_hz * sf, spec.zeta * sz)
+            if abs(new[0] / fc_t - 1) < 1e-9 and abs(new[1] / z_t - 1) < 1e-9:
+                break
+            fc_t, z_t = new
+            ranked, ideal, ratios = select(fc_t, z_t)
     ranked = _distinct(ranked, k)[:top]
     best = ranked[0]
     built = SallenKeyParts(best.r1, best.r2, best.c1, best.c2, k, r3, r4)

@@ -124,3 +124,12 @@ def test_regenerating_the_reference_reproduces_it():
 
 def r_deck(d):
     return design_plant(PlantSpec(d["spec"]["fc_hz"], d["spec"]["zeta"]), simulate=False).deck.split("\n", 1)[1]
+
+
+def test_compensate_gbw_never_crashes_on_a_rounded_capacitor_pair():
+    # regression: the pre-distortion solved for exact resistors on the chosen capacitors,
+    # which for C2/C1 < 1/zeta^2 do not exist, and crashed
+    r = design_plant(PlantSpec(50e3, 0.3, opamp="NE5532", compensate_gbw=True), simulate=False)
+    d = r.to_dict()
+    assert abs(d["built"]["fn_opamp_error_pct"]) < 1
+    assert any("--compensate-gbw" in n for n in d["notes"])
