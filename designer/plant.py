@@ -189,13 +189,16 @@ def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspi
             return brute_force(fc_t, z_t, pool_r, pool_c, k, top=4 * top), ideal, {"m": m, "n": n}
         ranked = joint_search(fc_t, z_t, rv, cv, k, top=4 * top)
         best = ranked[0]
-        lo, hi = resistors_for_caps(fc_t, z_t, best.c1, best.c2, k)
+        # the exact design the parts round: same capacitors, or, when their ratio is
+        # below the unity-gain limit 1/zeta^2, the nearest ratio that has one
+        c2 = best.c2 if k != 1.0 else max(best.c2, best.c1 / z_t ** 2 * (1 + 1e-12))
+        lo, hi = resistors_for_caps(fc_t, z_t, best.c1, c2, k)
         roots = [float(x) for x in (lo, hi) if not math.isnan(float(x))]
         if not roots:
             return ranked, None, {"m": None, "n": None}
         r1 = min(roots, key=lambda r: abs(math.log(r / best.r1)))
-        r2 = 1.0 / ((2 * math.pi * fc_t) ** 2 * best.c1 * best.c2 * r1)
-        return ranked, SallenKeyParts(r1, r2, best.c1, best.c2, k, r3, r4), {"m": r1 / r2, "n": best.c2 / best.c1}
+        r2 = 1.0 / ((2 * math.pi * fc_t) ** 2 * best.c1 * c2 * r1)
+        return ranked, SallenKeyParts(r1, r2, best.c1, c2, k, r3, r4), {"m": r1 / r2, "n": c2 / best.c1}
 
     fc_t, z_t = spec.fc_hz, spec.zeta
     ranked, ideal, ratios = select(fc_t, z_t)

@@ -133,3 +133,15 @@ def test_compensate_gbw_never_crashes_on_a_rounded_capacitor_pair():
     d = r.to_dict()
     assert abs(d["built"]["fn_opamp_error_pct"]) < 1
     assert any("--compensate-gbw" in n for n in d["notes"])
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(fc=st.floats(10.0, 1e5), zeta=st.floats(0.05, 5.0))
+def test_the_exact_design_is_always_reported_and_exact(fc, zeta):
+    try:
+        d = design_plant(PlantSpec(fc, zeta, alternatives=1), simulate=False).to_dict()
+    except DesignError:
+        return
+    assert d["ideal"] is not None
+    assert d["ideal"]["fn_hz"] == pytest.approx(fc, rel=1e-9)
+    assert d["ideal"]["zeta"] == pytest.approx(zeta, rel=1e-7)
