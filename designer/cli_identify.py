@@ -14,6 +14,7 @@ import math
 import sys
 
 from .errors import DesignError
+from .report import json_safe, png_bytes
 
 EPILOG = """\
 examples:
@@ -126,8 +127,7 @@ def identify_main(argv=None) -> int:
     args, result = out["args"], out["result"]
     if args.json:
         buf = io.StringIO()
-        json.dump(_finite(result.to_dict()), buf, indent=2, allow_nan=False,
-                  default=_json_default)
+        json.dump(json_safe(result.to_dict()), buf, indent=2, allow_nan=False)
         text = buf.getvalue()
     else:
         text = result.to_text() + (f"\n\nPlot written to {args.plot}" if args.plot else "")
@@ -138,17 +138,6 @@ def identify_main(argv=None) -> int:
         import os
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return 0
-
-
-def _finite(o):
-    """Replace NaN/inf by None everywhere (JSON has no NaN)."""
-    if isinstance(o, dict):
-        return {k: _finite(v) for k, v in o.items()}
-    if isinstance(o, (list, tuple)):
-        return [_finite(v) for v in o]
-    if isinstance(o, float) and not math.isfinite(o):
-        return None
-    return o
 
 
 def plot_fit(result, path, n_models: int = 3) -> None:
@@ -181,18 +170,7 @@ def plot_fit(result, path, n_models: int = 3) -> None:
     ax.set_title("Step response: data and best identified models")
     ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png")
-    plt.close(fig)
-    atomic_write(path, buf.getvalue())
-
-
-def _json_default(o):
-    import numpy as np
-    if isinstance(o, np.generic):
-        v = o.item()
-        return None if isinstance(v, float) and not math.isfinite(v) else v
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+    atomic_write(path, png_bytes(fig))
 
 
 if __name__ == "__main__":  # pragma: no cover

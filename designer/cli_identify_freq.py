@@ -9,12 +9,12 @@ and prints them ranked by fit error; ``--json`` prints one JSON object.
 from __future__ import annotations
 
 import argparse
-import io
 import json
 import math
 import sys
 
 from .errors import DesignError
+from .report import json_safe, png_bytes
 from .units import format_eng
 
 EPILOG = """\
@@ -150,23 +150,7 @@ def plot_bode(result, path, n_models: int = 3) -> None:
         ax_p.grid(True, which="both", alpha=0.3)
     axes[-1][0].set_xlabel("frequency (Hz)")
     fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png")
-    plt.close(fig)
-    atomic_write(path, buf.getvalue())
-
-
-def _finite(o):
-    """NaN/inf -> None and numpy scalars -> Python numbers, everywhere (JSON has no NaN)."""
-    if isinstance(o, dict):
-        return {k: _finite(v) for k, v in o.items()}
-    if isinstance(o, (list, tuple)):
-        return [_finite(v) for v in o]
-    if hasattr(o, "item") and not isinstance(o, (str, bytes)):
-        o = o.item()
-    if isinstance(o, float) and not math.isfinite(o):
-        return None
-    return o
+    atomic_write(path, png_bytes(fig))
 
 
 def run(argv=None):
@@ -193,7 +177,7 @@ def identify_freq_main(argv=None) -> int:
         return 130
     try:
         if args.json:
-            print(json.dumps(_finite(result.to_dict()), indent=2, allow_nan=False))
+            print(json.dumps(json_safe(result.to_dict()), indent=2, allow_nan=False))
         else:
             print(to_text(result))
             if args.plot:

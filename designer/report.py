@@ -107,7 +107,8 @@ def to_text(title, sections) -> str:
 
 # ---- plots ------------------------------------------------------------------
 
-def _png(fig) -> bytes:
+def png_bytes(fig) -> bytes:
+    """A matplotlib figure as PNG bytes (the figure is closed)."""
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
     import matplotlib.pyplot as plt
@@ -130,7 +131,7 @@ def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)") -> bytes:
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     ax.legend()
-    return _png(fig)
+    return png_bytes(fig)
 
 
 def bode_plot(systems: dict, f_lo: float, f_hi: float, title: str) -> bytes:
@@ -152,7 +153,7 @@ def bode_plot(systems: dict, f_lo: float, f_hi: float, title: str) -> bytes:
     for a in (a1, a2):
         a.grid(True, which="both", alpha=0.3)
     a1.legend()
-    return _png(fig)
+    return png_bytes(fig)
 
 
 def json_safe(obj):
@@ -161,6 +162,8 @@ def json_safe(obj):
         return {k: json_safe(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
         return [json_safe(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return json_safe(obj.tolist())
     if isinstance(obj, np.bool_):
         return bool(obj)
     if isinstance(obj, (np.floating, np.integer)):

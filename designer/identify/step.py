@@ -24,6 +24,7 @@ from pathlib import Path
 
 
 from ..errors import DesignError
+from ..report import json_safe
 from ..units import format_eng
 from .core import MethodResult, iae_ise, model_step
 from .first_order import FIRST_ORDER_METHODS
@@ -90,7 +91,7 @@ class IdentifyResult:
         d = {"methods": [m.to_dict() for m in self.methods],
              "best": self.best.to_dict() if self.best else None,
              "preprocessing": self.step.to_dict(),
-             "measured": {k: _clean(v) for k, v in self.measured.items()},
+             "measured": {k: json_safe(v) for k, v in self.measured.items()},
              "timings_s": dict(self.timings)}
         if self.capture is not None:
             d["capture"] = self.capture
@@ -148,12 +149,6 @@ def _g(v):
 
 def _pct(a, span):
     return f"{100 * a / abs(span):.2g} %" if span else "n/a"
-
-
-def _clean(v):
-    if isinstance(v, float) and not math.isfinite(v):
-        return None
-    return v
 
 
 def format_params(p: dict) -> str:
@@ -475,7 +470,7 @@ def compare_with_design(result: IdentifyResult, design: dict) -> dict:
         diff = None
         if ident_v is not None and design_v and math.isfinite(ident_v):
             diff = 100.0 * (ident_v - design_v) / abs(design_v)
-        rows[key] = {"design": design_v, "identified": _clean(ident_v) if ident_v is not None else None,
+        rows[key] = {"design": design_v, "identified": json_safe(ident_v) if ident_v is not None else None,
                      "difference_pct": diff, "band": [lo, hi], "within_tolerance": ok,
                      "unit": unit}
 

@@ -272,7 +272,7 @@ def _blocks_plot(result) -> bytes:
     axes[0].legend(fontsize=7, loc="upper right")
     axes[0].set_title("Every op-amp output (red: output limits, drawn when reached)")
     axes[-1].set_xlabel("time after the step (us)")
-    return R._png(fig)
+    return R.png_bytes(fig)
 
 
 def _bode_plot(result) -> bytes:
@@ -299,7 +299,7 @@ def _bode_plot(result) -> bytes:
     a2.set_xlabel("frequency (Hz)")
     for ax in (a1, a2):
         ax.grid(True, which="both", alpha=0.3)
-    return R._png(fig)
+    return R.png_bytes(fig)
 
 
 def _reaction_plot(result) -> bytes:
@@ -319,7 +319,7 @@ def _reaction_plot(result) -> bytes:
     ax.set_ylabel("output per volt of step")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    return R._png(fig)
+    return R.png_bytes(fig)
 
 
 def write_outputs(result, out_dir, name: str) -> dict:
