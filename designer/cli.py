@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 
 from . import __version__, opamps
@@ -21,6 +22,15 @@ class OneLineParser(argparse.ArgumentParser):
 
     def error(self, message):
         raise DesignError(f"{message} (see {self.prog} --help)")
+
+
+def print_output(text: str) -> None:
+    """Print; a pipe closed by the reader (``| head``) is their choice, not an error."""
+    try:
+        print(text)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
 
 
 def run_cli(prog: str, build_parser, action, argv=None) -> int:

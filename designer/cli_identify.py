@@ -8,11 +8,10 @@ them ranked by IAE; ``--json`` prints one JSON object instead.
 from __future__ import annotations
 
 import argparse
-import io
 import json
-import math
 import sys
 
+from .cli import OneLineParser, print_output, run_cli
 from .errors import DesignError
 from .report import json_safe, png_bytes
 
@@ -46,24 +45,11 @@ exit status: 0 success, 2 bad input (one line on stderr saying what and why).
 
 def _number(text: str, what: str) -> float:
     from .units import parse_value
-    try:
-        v = parse_value(text, what)
-    except DesignError:
-        raise
-    except (ValueError, TypeError):
-        raise DesignError(f"{what} must be a number like 1e-3 or 1m; got {text!r}") from None
-    if not math.isfinite(v):
-        raise DesignError(f"{what} must be a finite number; got {text!r}")
-    return v
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):  # one line, exit 2, as every other bad input
-        raise DesignError(f"{message} (see identify --help)")
+    return parse_value(text, what)  # finite, engineering notation (1m, 2u5)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="identify",
+    p = OneLineParser(prog="identify",
                 description="Identify plant models (FOPDT, double pole, second order with dead\n"
                             "time) from a measured or simulated step response, ranked by IAE.",
                 epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -87,11 +73,10 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def run(argv=None) -> dict:
-    """Parse arguments, identify, write the plot; return the result (for tests)."""
+def run(args):
+    """Identify from parsed arguments, write the plot; return the result."""
     from .identify.csvio import read_capture
 
-    args = build_parser().parse_args(argv)
     step_time = None if args.step_time is None else _number(args.step_time, "--step-time")
     amp = None if args.step_amplitude is None else _number(args.step_amplitude, "--step-amplitude")
     if amp is not None and amp == 0:
@@ -111,32 +96,20 @@ def run(argv=None) -> dict:
         result.comparison = compare_with_design(result, design)
     if args.plot:
         plot_fit(result, args.plot)
-    return {"args": args, "result": result}
+    return result
 
 
 def identify_main(argv=None) -> int:
     """Console entry point ``identify``."""
-    try:
-        out = run(argv)
-    except DesignError as exc:
-        print(f"identify: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:  # pragma: no cover
-        print("identify: interrupted", file=sys.stderr)
-        return 130
-    args, result = out["args"], out["result"]
+    return run_cli("identify", build_parser, _main, argv)
+
+
+def _main(args) -> int:
+    result = run(args)
     if args.json:
-        buf = io.StringIO()
-        json.dump(json_safe(result.to_dict()), buf, indent=2, allow_nan=False)
-        text = buf.getvalue()
+        print_output(json.dumps(json_safe(result.to_dict()), indent=2, allow_nan=False))
     else:
-        text = result.to_text() + (f"\n\nPlot written to {args.plot}" if args.plot else "")
-    try:
-        print(text)
-        sys.stdout.flush()
-    except BrokenPipeError:  # e.g. piped into head: not an error of ours
-        import os
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        print_output(result.to_text() + (f"\n\nPlot written to {args.plot}" if args.plot else ""))
     return 0
 
 

@@ -13,7 +13,7 @@ import json
 import math
 import sys
 
-from .errors import DesignError
+from .cli import OneLineParser, print_output, run_cli
 from .report import json_safe, png_bytes
 from .units import format_eng
 
@@ -45,13 +45,8 @@ exit status: 0 success, 2 bad input (one line on stderr saying what and why).
 """
 
 
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):  # one line, exit 2, as every other bad input
-        raise DesignError(f"{message} (see identify-freq --help)")
-
-
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="identify-freq",
+    p = OneLineParser(prog="identify-freq",
                 description=__doc__.split("\n\n")[0].strip().replace("``", ""),
                 epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("table", help="CSV table: frequency, gain[, phase]")
@@ -69,21 +64,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _fmt_params(p: dict) -> str:
-    out = []
-    for k, v in p.items():
-        if v is None or (isinstance(v, float) and not math.isfinite(v)):
-            out.append(f"{k} n/a")
-        elif k.endswith("_rad_s"):
-            out.append(f"{k[:-6]} {v:.4g} rad/s ({format_eng(v / (2 * math.pi), 'Hz')})")
-        elif k.startswith("tau") and v > 0:
-            # the corner a student reads off the Bode plot
-            out.append(f"{k[:-2]} {format_eng(v, 's')} "
-                       f"(corner {format_eng(1 / (2 * math.pi * v), 'Hz')})")
-        elif k.endswith("_s"):
-            out.append(f"{k[:-2]} {format_eng(v, 's')}")
-        else:
-            out.append(f"{k} {v:.4g}")
-    return ", ".join(out)
+    from .identify.step import format_params
+    return format_params(p, corners=True)
 
 
 def _pct(v):
@@ -153,38 +135,28 @@ def plot_bode(result, path, n_models: int = 3) -> None:
     atomic_write(path, png_bytes(fig))
 
 
-def run(argv=None):
-    """Parse arguments, identify, write the plot; return (args, result)."""
-    args = build_parser().parse_args(argv)
+def run(args):
+    """Identify from parsed arguments, write the plot; return the result."""
     from .identify.frequency import identify_freq, read_freq_table
     data = read_freq_table(args.table, gain_units=args.gain_units,
                            phase_units=args.phase_units, freq_units=args.freq_units)
     result = identify_freq(data)
     if args.plot:
         plot_bode(result, args.plot)
-    return args, result
+    return result
 
 
 def identify_freq_main(argv=None) -> int:
     """Console entry point ``identify-freq``."""
-    try:
-        args, result = run(argv)
-    except DesignError as exc:
-        print(f"identify-freq: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:  # pragma: no cover
-        print("identify-freq: interrupted", file=sys.stderr)
-        return 130
-    try:
-        if args.json:
-            print(json.dumps(json_safe(result.to_dict()), indent=2, allow_nan=False))
-        else:
-            print(to_text(result))
-            if args.plot:
-                print(f"\nPlot written to {args.plot}")
-        sys.stdout.flush()
-    except BrokenPipeError:  # e.g. piped into head: not an error of ours
-        sys.stdout = None
+    return run_cli("identify-freq", build_parser, _main, argv)
+
+
+def _main(args) -> int:
+    result = run(args)
+    if args.json:
+        print_output(json.dumps(json_safe(result.to_dict()), indent=2, allow_nan=False))
+    else:
+        print_output(to_text(result) + (f"\n\nPlot written to {args.plot}" if args.plot else ""))
     return 0
 
 

@@ -151,14 +151,17 @@ def _pct(a, span):
     return f"{100 * a / abs(span):.2g} %" if span else "n/a"
 
 
-def format_params(p: dict) -> str:
-    """Parameters with units: K 2, tau 1.5 ms, theta 200 us, wn 2.2e4 rad/s, zeta 0.21."""
+def format_params(p: dict, corners: bool = False) -> str:
+    """Parameters with units: K 2, tau 1.5 ms, theta 200 us, wn 2.2e4 rad/s (3.5 kHz), zeta 0.21;
+    with ``corners``, each time constant also as the corner frequency a Bode plot shows."""
     out = []
     for k, v in p.items():
         if v is None or (isinstance(v, float) and not math.isfinite(v)):
             out.append(f"{k} n/a")
         elif k.endswith("_rad_s"):
-            out.append(f"{k[:-6]} {v:.4g} rad/s")
+            out.append(f"{k[:-6]} {v:.4g} rad/s ({format_eng(v / (2 * math.pi), 'Hz')})")
+        elif corners and k.startswith("tau") and v > 0:
+            out.append(f"{k[:-2]} {format_eng(v, 's')} (corner {format_eng(1 / (2 * math.pi * v), 'Hz')})")
         elif k.endswith("_s"):
             out.append(f"{k[:-2]} {format_eng(v, 's')}")
         else:
