@@ -11,6 +11,7 @@ import time
 
 import numpy as np
 
+from .. import eseries
 from .. import report as R
 from ..units import format_eng
 from .model import OPAMP_OUTPUTS
@@ -120,9 +121,10 @@ def sections(result, with_images: bool = True) -> list:
             continue  # the plant's op-amp is listed with the plant's parts
         rows.append([ref, amp.name, "", "", "", f"{role} op-amp, {amp.vcc:g} V / {amp.vee:g} V"])
     pl = result.plant
+    # a plant designed here comes from the spec's series (whatever the controller's parts are)
     designed = result.plant_source.startswith("design-plant")
-    prs, pcs = (ser["r"], ser["c"]) if designed else (None, None)
-    prt, pct = (rt, ct) if designed else (None, None)
+    prs, pcs = (result.spec.r_series, result.spec.c_series) if designed else (None, None)
+    prt, pct = ((100 * eseries.TOLERANCE[prs], 100 * eseries.TOLERANCE[pcs]) if designed else (None, None))
     rows += [R.part_row("R1 (plant)", pl.r1, "Ohm", "Sallen-Key input resistor", prs, prt),
              R.part_row("R2 (plant)", pl.r2, "Ohm", "Sallen-Key, to the non-inverting input", prs, prt),
              R.part_row("C1 (plant)", pl.c1, "F", "Sallen-Key, non-inverting input to ground", pcs, pct),
