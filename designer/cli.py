@@ -47,6 +47,23 @@ def run_cli(prog: str, build_parser, action, argv=None) -> int:
         return 130
 
 
+def add_part_options(group):
+    """E-series and value bounds for the parts (design-plant and design-pid)."""
+    group.add_argument("--r-series", default="E24", help=f"resistor series: {', '.join(SERIES)} (default E24)")
+    group.add_argument("--c-series", default="E12", help="capacitor series (default E12)")
+    group.add_argument("--r-min", default="1k", help="smallest resistor (default 1k)")
+    group.add_argument("--r-max", default="1M", help="largest resistor (default 1M)")
+    group.add_argument("--c-min", default="1n", help="smallest capacitor (default 1n)")
+    group.add_argument("--c-max", default="10u", help="largest capacitor (default 10u)")
+
+
+def part_options(args) -> dict:
+    """The parsed :func:`add_part_options`, as spec keyword arguments."""
+    return {"r_series": args.r_series, "c_series": args.c_series,
+            **{k: parse_positive(getattr(args, k), f"--{k.replace('_', '-')}")
+               for k in ("r_min", "r_max", "c_min", "c_max")}}
+
+
 def _common_output(p):
     g = p.add_argument_group("output")
     g.add_argument("--out", default=".", metavar="DIR",
@@ -95,12 +112,7 @@ result.json, step.png, bode.png. Exit status 2 on bad input.""",
     sel = p.add_argument_group("parts")
     sel.add_argument("--r", metavar="OHM", help="the seed's procedure: fix R (R2 = R, R1 = m R) ...")
     sel.add_argument("--c", metavar="F", help="... and C (C1 = C, C2 = n C), solve m and n")
-    sel.add_argument("--r-series", default="E24", help=f"resistor series: {', '.join(SERIES)} (default E24)")
-    sel.add_argument("--c-series", default="E12", help="capacitor series (default E12)")
-    sel.add_argument("--r-min", default="1k", help="smallest resistor (default 1k)")
-    sel.add_argument("--r-max", default="1M", help="largest resistor (default 1M)")
-    sel.add_argument("--c-min", default="1n", help="smallest capacitor (default 1n)")
-    sel.add_argument("--c-max", default="10u", help="largest capacitor (default 10u)")
+    add_part_options(sel)
     sel.add_argument("--alternatives", default="5", help="how many best combinations to list (default 5)")
     _common_output(p)
     return p
@@ -111,9 +123,7 @@ def _design(args) -> int:
     spec = PlantSpec(
         fc_hz=parse_positive(args.fc, "--fc"), zeta=parse_positive(args.zeta, "--zeta"),
         gain=parse_value(args.gain, "--gain"),
-        r_series=args.r_series, c_series=args.c_series,
-        r_min=parse_positive(args.r_min, "--r-min"), r_max=parse_positive(args.r_max, "--r-max"),
-        c_min=parse_positive(args.c_min, "--c-min"), c_max=parse_positive(args.c_max, "--c-max"),
+        **part_options(args),
         r=None if args.r is None else parse_positive(args.r, "--r"),
         c=None if args.c is None else parse_positive(args.c, "--c"),
         opamp=args.opamp, compensate_gbw=args.compensate_gbw,

@@ -7,8 +7,7 @@ import argparse
 import sys
 
 from . import __version__, opamps
-from .cli import OneLineParser, _check_name, emit, run_cli
-from .eseries import SERIES
+from .cli import OneLineParser, _check_name, add_part_options, emit, part_options, run_cli
 from .errors import DesignError
 from .units import parse_positive, parse_value
 
@@ -61,12 +60,7 @@ def _parser():
     t.add_argument("--seed-parts", action="store_true",
                    help="use the seed's own controller parts (V.13, difference amp untrimmed) instead of sizing")
     s = p.add_argument_group("parts")
-    s.add_argument("--r-series", default="E24", help=f"resistor series: {', '.join(SERIES)} (default E24)")
-    s.add_argument("--c-series", default="E12", help="capacitor series (default E12)")
-    s.add_argument("--r-min", default="1k", help="smallest resistor (default 1k)")
-    s.add_argument("--r-max", default="1M", help="largest resistor (default 1M)")
-    s.add_argument("--c-min", default="1n", help="smallest capacitor (default 1n)")
-    s.add_argument("--c-max", default="10u", help="largest capacitor (default 10u)")
+    add_part_options(s)
     s.add_argument("--f-integrator", metavar="HZ", help="integrator leak corner 1/(2 pi R13 C4) (default fn/100)")
     s.add_argument("--f-differentiator", metavar="HZ",
                    help="derivative filter corner 1/(2 pi R12 C3) (default 10 fn)")
@@ -126,9 +120,7 @@ def _build_spec(args):
         plant_parts=plant_parts, plant_json=args.plant_json, tuning=tuning, kp=kp, ti_s=ti, td_s=td,
         opamp=args.opamp, step_v=parse_positive(args.step, "--step"),
         edge_s=parse_value(args.edge, "--edge"),
-        r_series=args.r_series, c_series=args.c_series,
-        r_min=parse_positive(args.r_min, "--r-min"), r_max=parse_positive(args.r_max, "--r-max"),
-        c_min=parse_positive(args.c_min, "--c-min"), c_max=parse_positive(args.c_max, "--c-max"),
+        **part_options(args),
         target_overshoot_pct=_opt(args.target_overshoot, "--target-overshoot", parse_value),
         target_settling_s=_opt(args.target_settling, "--target-settling"),
         f_integrator_hz=_opt(args.f_integrator, "--f-integrator"),

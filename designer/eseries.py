@@ -48,6 +48,19 @@ def series_name(name: str) -> str:
     return key
 
 
+def check_bounds(r_series: str, c_series: str, r_min: float, r_max: float, c_min: float, c_max: float):
+    """Validate the part-selection options; returns the normalised series names."""
+    import math
+    for name, v in (("--r-min", r_min), ("--r-max", r_max), ("--c-min", c_min), ("--c-max", c_max)):
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+            raise DesignError(f"{name} must be a positive finite number, got {v!r}")
+    if r_min > r_max:
+        raise DesignError(f"--r-min ({r_min:g} Ohm) is above --r-max ({r_max:g} Ohm)")
+    if c_min > c_max:
+        raise DesignError(f"--c-min ({c_min:g} F) is above --c-max ({c_max:g} F)")
+    return series_name(r_series), series_name(c_series)
+
+
 def values(series: str, lo: float, hi: float) -> np.ndarray:
     """All values of ``series`` in the closed range [lo, hi], ascending.
 

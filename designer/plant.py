@@ -53,16 +53,10 @@ class PlantSpec:
 
     def validate(self) -> None:
         check_spec(self.fc_hz, self.zeta, self.gain)
-        self.r_series = eseries.series_name(self.r_series)
-        self.c_series = eseries.series_name(self.c_series)
-        for name in ("r_min", "r_max", "c_min", "c_max", "amplitude_v"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise DesignError(f"{name.replace('_', '-')} must be a positive finite number, got {v!r}")
-        if self.r_min > self.r_max:
-            raise DesignError(f"r-min ({self.r_min:g} Ohm) is above r-max ({self.r_max:g} Ohm)")
-        if self.c_min > self.c_max:
-            raise DesignError(f"c-min ({self.c_min:g} F) is above c-max ({self.c_max:g} F)")
+        self.r_series, self.c_series = eseries.check_bounds(
+            self.r_series, self.c_series, self.r_min, self.r_max, self.c_min, self.c_max)
+        if not (math.isfinite(self.amplitude_v) and self.amplitude_v > 0):
+            raise DesignError(f"--amplitude must be a positive finite number of volts, got {self.amplitude_v!r}")
         if (self.r is None) != (self.c is None):
             raise DesignError("--r and --c go together (the seed's procedure fixes both R and C)")
         if self.square_hz is not None and not (math.isfinite(self.square_hz) and self.square_hz > 0):

@@ -42,3 +42,11 @@ def test_unknown_series_is_a_clear_error():
     with pytest.raises(DesignError, match="allowed: E3"):
         eseries.series_name("E25")
     assert eseries.series_name("e96") == "E96"
+
+
+def test_check_bounds_names_the_option():
+    assert eseries.check_bounds("e24", "12", 1e3, 1e6, 1e-9, 1e-5) == ("E24", "E12")
+    with pytest.raises(DesignError, match="--r-min .* is above --r-max"):
+        eseries.check_bounds("E24", "E12", 1e6, 1e3, 1e-9, 1e-5)
+    with pytest.raises(DesignError, match="--c-max must be a positive"):
+        eseries.check_bounds("E24", "E12", 1e3, 1e6, 1e-9, float("inf"))

@@ -76,19 +76,12 @@ class PidSpec:
                 if not (math.isfinite(v) and v > 0):
                     raise DesignError(f"{name} must be a finite number above 0, got {v!r}")
         opamps.get(self.opamp)
-        self.r_series = eseries.series_name(self.r_series)
-        self.c_series = eseries.series_name(self.c_series)
-        for name in ("step_v", "r_min", "r_max", "c_min", "c_max"):
-            v = getattr(self, name)
-            if not (math.isfinite(v) and v > 0):
-                raise DesignError(f"--{name.replace('_v', '').replace('_', '-')} must be a positive finite "
-                                  f"number, got {v!r}")
+        self.r_series, self.c_series = eseries.check_bounds(
+            self.r_series, self.c_series, self.r_min, self.r_max, self.c_min, self.c_max)
+        if not (math.isfinite(self.step_v) and self.step_v > 0):
+            raise DesignError(f"--step must be a positive finite number of volts, got {self.step_v!r}")
         if not (math.isfinite(self.edge_s) and self.edge_s >= 0):
             raise DesignError(f"--edge must be a time of 0 s or more, got {self.edge_s!r}")
-        if self.r_min > self.r_max:
-            raise DesignError(f"--r-min ({self.r_min:g} Ohm) is above --r-max ({self.r_max:g} Ohm)")
-        if self.c_min > self.c_max:
-            raise DesignError(f"--c-min ({self.c_min:g} F) is above --c-max ({self.c_max:g} F)")
         explicit = [v is not None for v in (self.kp, self.ti_s, self.td_s)]
         if any(explicit) and not all(explicit):
             raise DesignError("--kp, --ti and --td go together (give all three)")
