@@ -11,7 +11,7 @@ from dataclasses import replace
 import numpy as np
 
 from .metrics import step_metrics
-from .models import dense_time, plant_tf, response_span, step_response
+from .models import dense_time, plant_tf, step_response
 from .netlist import SquareTest, nice_frequency_below
 from .opamps import OpAmp
 from .sallenkey import SallenKeyParts
@@ -73,8 +73,3 @@ def tolerance_band(parts: SallenKeyParts, r_tol: float, c_tol: float, t_end: flo
     band["r_tolerance_pct"] = 100 * r_tol
     band["c_tolerance_pct"] = 100 * c_tol
     return band
-
-
-def unit_step_grid(parts: SallenKeyParts, half_period_s: float, n: int = 20001):
-    """Dense grid over the rising half period (and at least the response span)."""
-    return dense_time(max(half_period_s, 0.0) or response_span(parts.fn_hz, parts.zeta), n)

@@ -21,12 +21,6 @@ def plant_tf(parts: SallenKeyParts):
     return np.array([parts.gain]), np.array([parts.a, parts.b, 1.0])
 
 
-def opamp_tf(opamp: OpAmp):
-    """Open-loop gain A(s) = A0 / (1 + s/wp), wp = 2 pi GBW / A0."""
-    wp = 2 * math.pi * opamp.gbw_hz / opamp.a0
-    return np.array([opamp.a0]), np.array([1.0 / wp, 1.0])
-
-
 def plant_tf_opamp(parts: SallenKeyParts, opamp: OpAmp):
     """Sallen-Key low-pass with a single-pole op-amp (third order).
 

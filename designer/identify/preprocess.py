@@ -201,11 +201,6 @@ def crossing_time(t, y, level: float, *, sigma: float = 0.0, start: int = 0) -> 
     return float(tm + (level - icpt) / slope)
 
 
-def crossing_times(t, y, yf: float, fractions, *, sigma: float = 0.0) -> list:
-    """Crossing times of y0 + p (yf - y0) for each p (y is already relative: y0 = 0)."""
-    return [crossing_time(t, y, p * yf, sigma=sigma) for p in fractions]
-
-
 def savgol(y, window: int, polyorder: int, deriv: int = 0, delta: float = 1.0) -> np.ndarray:
     """Savitzky-Golay filter (least-squares polynomial over a sliding window).
 
