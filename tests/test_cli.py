@@ -33,10 +33,10 @@ def test_design_plant_json_and_files(tmp_path):
     assert "sensitivity" in d
     for key in ("netlist", "build_sheet_md", "build_sheet_html", "result_json"):
         assert os.path.getsize(d["files"][key]) > 0
-    assert json.loads(open(d["files"]["result_json"]).read()) == d
-    html = open(d["files"]["build_sheet_html"]).read()
+    assert json.loads(Path(d["files"]["result_json"]).read_text()) == d
+    html = Path(d["files"]["build_sheet_html"]).read_text()
     assert "data:image/png;base64," in html and "<table>" in html  # self-contained
-    md = open(d["files"]["build_sheet_md"]).read()
+    md = Path(d["files"]["build_sheet_md"]).read_text()
     assert "Bill of materials" in md and "Bench test" in md and " %" in md
     # no temporary files left behind
     assert not [p for p in tmp_path.rglob("*.tmp")]

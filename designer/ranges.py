@@ -1,0 +1,103 @@
+"""The physical range of every numeric input, in one table.
+
+Each command's ``--help`` states these ranges and every parser checks them, so a
+value outside them ends in one line naming the input and the allowed range,
+before any work is done (no overflow, no NaN deep inside a solver, no
+eight-second wait to be told no). The ranges are generous engineering limits,
+not design advice: a value inside a range may still be refused later, with a
+reason, by the design itself (e.g. no E-series parts within the bounds).
+
+Keys are the library's parameter names; the CLI shows its flag names.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .errors import DesignError
+from .units import format_eng, parse_value
+
+
+@dataclass(frozen=True)
+class Range:
+    """A closed (or half-open) interval of allowed values with its unit."""
+
+    lo: float
+    hi: float
+    unit: str = ""
+    lo_open: bool = False   #: lo itself is not allowed (e.g. a time > 0)
+    zero_ok: bool = False   #: 0 is allowed besides [lo, hi] (e.g. Td = 0 for a PI)
+
+    def text(self) -> str:
+        """``"1 mHz to 10 MHz"``, for messages and --help."""
+        lo, hi = _fmt(self.lo, self.unit), _fmt(self.hi, self.unit)
+        core = f"above {lo} up to {hi}" if self.lo_open else f"{lo} to {hi}"
+        return f"0 or {core}" if self.zero_ok else core
+
+    def contains(self, value: float) -> bool:
+        if self.zero_ok and value == 0:
+            return True
+        above = value > self.lo if self.lo_open else value >= self.lo * (1 - 1e-12)
+        return math.isfinite(value) and above and value <= self.hi * (1 + 1e-12)
+
+    def check(self, value: float, name: str, shown=None) -> float:
+        """``value`` if inside the range, else a :class:`DesignError` naming ``name``."""
+        if not self.contains(value):
+            got = shown if shown is not None else _show(value)
+            raise DesignError(f"{name} must be {self.text()}, got {got}")
+        return float(value)
+
+
+def _fmt(v: float, unit: str) -> str:
+    if unit in ("", "%") or v == 0:
+        return f"{v:g}" + (f" {unit}" if unit else "")
+    return format_eng(v, unit, 4)
+
+
+def _show(value) -> str:
+    if isinstance(value, str):
+        return repr(value)
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return repr(value)
+    return f"{v:g}"
+
+
+#: Every numeric input of every command (library parameter name -> range).
+RANGES = {
+    # plant targets and test signal
+    "fc_hz": Range(0.01, 10e6, "Hz"),
+    "zeta": Range(0.01, 10.0),
+    "gain": Range(1.0, 100.0),
+    "amplitude_v": Range(1e-3, 100.0, "V"),
+    "square_hz": Range(1e-3, 100e6, "Hz"),
+    # parts
+    "resistor_ohm": Range(0.1, 1e9, "Ohm"),
+    "capacitor_f": Range(1e-13, 1.0, "F"),
+    "alternatives": Range(1, 50),
+    # PID
+    "kp": Range(1e-4, 1e4),
+    "ti_s": Range(1e-9, 1e4, "s"),
+    "td_s": Range(1e-10, 1e4, "s", zero_ok=True),
+    "step_v": Range(1e-3, 100.0, "V"),
+    "edge_s": Range(1e-12, 1.0, "s", zero_ok=True),
+    "target_overshoot_pct": Range(0.0, 100.0, "%"),
+    "target_settling_s": Range(1e-9, 1e4, "s"),
+    "f_integrator_hz": Range(1e-4, 10e6, "Hz"),
+    "f_differentiator_hz": Range(0.01, 1e9, "Hz"),
+    # identify and identify-freq (add their inputs here)
+}
+
+
+def parse_in_range(text, name: str, key: str) -> float:
+    """Parse engineering notation (see :func:`designer.units.parse_value`) and
+    check it against ``RANGES[key]``; errors name ``name`` (e.g. ``--fc``)."""
+    value = parse_value(text, name)
+    return RANGES[key].check(value, name, shown=repr(text) if isinstance(text, str) else None)
+
+
+def help_range(key: str) -> str:
+    """``"(1 mHz to 10 MHz)"`` for a --help line."""
+    return f"({RANGES[key].text()})"
