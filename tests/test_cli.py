@@ -1,6 +1,7 @@
 import json
 import os
 import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -96,3 +97,19 @@ def test_help_teaches():
     assert out.returncode == 0
     assert "examples:" in out.stdout and "4k7" in out.stdout
     assert run("analyze-plant", "--help").returncode == 0
+
+
+@pytest.mark.parametrize("cmd,args", [
+    ("design-plant", ["--fc", "1592", "--zeta", "1"]),
+    ("analyze-plant", ["--r1", "10k", "--r2", "10k", "--c1", "10n", "--c2", "10n"]),
+])
+def test_critically_damped_builds_write_their_bundle(cmd, args, tmp_path):
+    """Regression (issue 7.1): the textbook equal-component unity-gain Sallen-Key
+    (zeta = 1, a repeated pole) crashed after the simulation and left an empty report folder."""
+    out = run(cmd, *args, "--json", "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    assert d["built"]["zeta"] == pytest.approx(1.0, abs=2e-3)
+    assert d["comparison"]["pass"] is True
+    for key in ("netlist", "build_sheet_md", "build_sheet_html", "result_json", "waveforms_csv"):
+        assert os.path.getsize(d["files"][key]) > 0

@@ -3,6 +3,8 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from designer import opamps
 from designer.models import (dominant_pair, plant_tf, plant_tf_opamp, sensitivities, step_response)
@@ -74,7 +76,34 @@ def test_step_and_frequency_response_match_scipy():
         f = np.logspace(0, 6, 50)
         _, h = signal.freqs(num, den, worN=2 * np.pi * f)
         assert np.allclose(freq_response(num, den, f), h, rtol=1e-12)
-    # a repeated pole takes the scipy path and still works
-    t = np.linspace(0, 1e-2, 1001)
+
+
+def test_repeated_poles_in_closed_form_on_any_grid():
+    """Regression (issue 7.1): zeta = 1 fell back to scipy.signal.step, which
+    refuses the clipped, uneven grids of the bench waveforms."""
+    t = np.concatenate([np.zeros(5), np.linspace(0, 1e-2, 1001) ** 1.5 * 10])  # clipped and uneven
     y = step_response([1e6], [1, 2e3, 1e6], t)
-    assert np.max(np.abs(y - (1 - (1 + 1e3 * t) * np.exp(-1e3 * t)))) < 1e-6
+    assert np.max(np.abs(y - (1 - (1 + 1e3 * t) * np.exp(-1e3 * t)))) < 1e-12
+    # triple pole: 1 - e^(-at) (1 + at + (at)^2/2)
+    a = 1e2
+    y = step_response([a ** 3], np.poly([-a, -a, -a]), t)
+    assert np.max(np.abs(y - (1 - np.exp(-a * t) * (1 + a * t + (a * t) ** 2 / 2)))) < 1e-12
+    # a pole at zero (integrator): a ramp; before the step, zero
+    assert np.allclose(step_response([2.0], [1.0, 0.0], t), 2 * t, rtol=1e-12, atol=0)
+    assert np.all(step_response([1.0], [1.0, 1.0], [-1.0, -1e-9]) == 0)
+
+
+@settings(max_examples=60)
+@given(st.lists(st.sampled_from([10.0, 30.0, 100.0, 300.0, 1e3, 3e3]), min_size=1, max_size=3, unique=True),
+       st.lists(st.integers(1, 3), min_size=3, max_size=3), st.sampled_from([0.0, 0.5, 2.0]))
+def test_step_response_with_repeated_poles_matches_scipy(rates, mult, zero):
+    """Simple and repeated real poles, with a zero (biproper when the order is 1),
+    against scipy's matrix-exponential lsim."""
+    from scipy import signal
+    poles = [-r for r, m in zip(rates, mult) for _ in range(m)]
+    den = np.poly(poles)
+    num = np.polymul([zero / max(rates), 1.0], [np.prod(np.abs(poles))])[-len(den):]
+    t = np.linspace(0, 10 / min(rates), 4001)
+    ref = signal.step((num, den), T=t)[1]
+    got = step_response(num, den, t)
+    assert np.max(np.abs(got - ref)) <= 1e-7 * max(1.0, np.max(np.abs(ref)))
