@@ -12,19 +12,38 @@ import re
 
 from .errors import DesignError
 
-# SI multipliers; "u" and "µ" both mean micro, "M"/"meg" mega (SPICE writes meg).
+# SI multipliers; "u" and "µ" both mean micro, "M" mega and "m" milli as in engineering
+# notation, and SPICE's "meg" (any case: MEG, Meg) mega too.
 _PREFIX = {
     "f": 1e-15, "p": 1e-12, "n": 1e-9, "u": 1e-6, "µ": 1e-6, "μ": 1e-6,
-    "m": 1e-3, "": 1.0, "k": 1e3, "K": 1e3, "M": 1e6, "meg": 1e6, "G": 1e9,
+    "m": 1e-3, "": 1.0, "k": 1e3, "K": 1e3, "M": 1e6, "meg": 1e6, "G": 1e9, "T": 1e12,
     "R": 1.0, "r": 1.0,
 }
-_UNITS = ("ohms", "ohm", "Ω", "hz", "Hz", "f", "F", "s", "v", "V")
+_NUM = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
+_P = r"(?i:meg)|[fpnuµμmkKMGTRr]"
+# 3.5k, 10n, 2.2meg, 1e-9
+_SUFFIX = re.compile(rf"^({_NUM})({_P})?$")
+# 4k7, 2u2, 1M5, 4R7, 1meg5: the prefix letter stands for the decimal point
+_INFIX = re.compile(rf"^([+-]?\d+)({_P})(\d+)$")
+# prefix letters a trailing f/F can follow as the farad unit ("10pf", "100fF")
+_PREFIX_LETTERS = "fpnuµμmkKMGT"
 
-_PLAIN = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
-# 3.5k, 10n, 2.2meg
-_SUFFIX = re.compile(r"^([+-]?(?:\d+\.?\d*|\.\d+))(meg|[fpnuµμmkKMGRr])$")
-# 4k7, 2u2, 1M5, 4R7: the prefix letter stands for the decimal point
-_INFIX = re.compile(r"^([+-]?\d+)(meg|[fpnuµμmkKMGRr])(\d+)$")
+
+def _strip_unit(s: str) -> str:
+    """Drop a trailing unit: ohm(s)/Ω, Hz, V, s, or F. A trailing ``f`` is femto
+    (as in SPICE) unless it follows a prefix (``10pf``, ``100fF``); ``F`` after a
+    digit is farads (``10F``)."""
+    low = s.lower()
+    for unit in ("ohms", "ohm", "ω", "hz"):
+        if low.endswith(unit) and len(s) > len(unit):
+            return s[: -len(unit)]
+    last = s[-1:]
+    if len(s) > 1 and last in ("v", "V", "s"):
+        return s[:-1]
+    if len(s) > 1 and last in ("f", "F"):
+        if s[-2] in _PREFIX_LETTERS or low[:-1].endswith("meg") or last == "F":
+            return s[:-1]
+    return s
 
 
 def parse_value(text, name: str = "value") -> float:
@@ -33,7 +52,10 @@ def parse_value(text, name: str = "value") -> float:
     Parameters
     ----------
     text : str or float
-        ``"4k7"``, ``"10n"``, ``"2u2"``, ``"3.5k"``, ``"1e-9"``, ``"220nF"``...
+        ``"4k7"``, ``"10n"``, ``"2u2"``, ``"3.5k"``, ``"1e-9"``, ``"220nF"``,
+        ``"3.5MEG"``, ``"1.6 kOhm"`` (this tool's own printed values read back),
+        ``"4.7kΩ"``. A trailing ``f`` is femto, as in SPICE (``10f`` = 10e-15),
+        unless it is the farad after a prefix (``10pf``); ``10F`` is 10 farads.
     name : str
         What the number is, for the error message.
 
@@ -49,36 +71,42 @@ def parse_value(text, name: str = "value") -> float:
     if isinstance(text, (int, float)) and not isinstance(text, bool):
         value = float(text)
     else:
-        s = str(text).strip().replace(" ", "")
-        for unit in _UNITS:
-            # strip a trailing unit, but never the prefix itself ("1f" is femto)
-            if s.endswith(unit) and len(s) > len(unit) and not _PLAIN.match(s):
-                stripped = s[: -len(unit)]
-                if _PLAIN.match(stripped) or _SUFFIX.match(stripped) or _INFIX.match(stripped):
-                    s = stripped
-                    break
-        if _PLAIN.match(s):
-            value = float(s)
-        elif (m := _SUFFIX.match(s)):
-            value = float(m.group(1)) * _PREFIX[m.group(2)]
+        s = "".join(str(text).split())
+        s = _strip_unit(s)
+        if (m := _SUFFIX.match(s)):
+            value = float(m.group(1)) * _PREFIX[_prefix_key(m.group(2))]
         elif (m := _INFIX.match(s)):
             sign = -1.0 if m.group(1).startswith("-") else 1.0
             whole = m.group(1).lstrip("+-")
-            value = sign * float(f"{whole}.{m.group(3)}") * _PREFIX[m.group(2)]
+            value = sign * float(f"{whole}.{m.group(3)}") * _PREFIX[_prefix_key(m.group(2))]
         else:
             raise DesignError(
-                f"{name}: {text!r} is not a number (use plain or engineering notation "
+                f"{name}: {_short(text)} is not a number (use plain or engineering notation "
                 "such as 4k7, 820, 10n, 2u2, 3.5k, 1e-9)")
     if not math.isfinite(value):
-        raise DesignError(f"{name}: {text!r} is not a finite number")
+        raise DesignError(f"{name}: {_short(text)} is not a finite number")
     return value
+
+
+def _prefix_key(p) -> str:
+    if p is None:
+        return ""
+    return "meg" if p.lower() == "meg" else p
+
+
+def _short(text, limit: int = 40) -> str:
+    """A printable, bounded rendering of user text for a one-line message."""
+    if isinstance(text, float):
+        return f"{text:g}"
+    r = repr(str(text))
+    return r if len(r) <= limit else r[: limit - 4] + "...'"
 
 
 def parse_positive(text, name: str) -> float:
     """Parse a strictly positive finite number (see :func:`parse_value`)."""
     value = parse_value(text, name)
     if value <= 0:
-        raise DesignError(f"{name}: must be greater than 0, got {text!r}")
+        raise DesignError(f"{name}: must be greater than 0, got {_short(text)}")
     return value
 
 
