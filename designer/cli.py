@@ -24,27 +24,60 @@ class OneLineParser(argparse.ArgumentParser):
         raise DesignError(f"{message} (see {self.prog} --help)")
 
 
-def print_output(text: str) -> None:
+def print_output(text: str, end: str = "\n") -> None:
     """Print; a pipe closed by the reader (``| head``) is their choice, not an error."""
     try:
-        print(text)
+        print(text, end=end)
         sys.stdout.flush()
     except BrokenPipeError:
+        _silence_stdout()
+
+
+def _silence_stdout() -> None:
+    # the interpreter flushes stdout again at exit: point it at /dev/null so that
+    # a reader who stopped early (| head) gets no "Exception ignored" message
+    try:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 def run_cli(prog: str, build_parser, action, argv=None) -> int:
-    """Run ``action(args)`` with the one-line error convention; returns the exit status."""
+    """Run ``action(args)`` with the one-line error convention; returns the exit status:
+    0 done, 1 a check failed (when asked), 2 bad input or usage, 3 simulator error,
+    130 interrupted. Every failure is one line on stderr, never a traceback."""
+    from .errors import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_SIMULATOR, SimulatorError
     try:
         parser = build_parser()
         args = parser.parse_args(argv)
         return action(args) or 0
+    except SimulatorError as exc:
+        _fail(prog, f"simulator error: {exc}")
+        return EXIT_SIMULATOR
     except DesignError as exc:
-        print(f"{prog}: error: {exc}", file=sys.stderr)
-        return 2
+        _fail(prog, str(exc))
+        return EXIT_BAD_INPUT
+    except BrokenPipeError:
+        _silence_stdout()
+        return 0
     except KeyboardInterrupt:
-        print(f"{prog}: interrupted", file=sys.stderr)
-        return 130
+        _fail(prog, "interrupted")
+        return EXIT_INTERRUPTED
+    except MemoryError:
+        _fail(prog, "out of memory: the input is too large for this machine")
+        return EXIT_BAD_INPUT
+    except OSError as exc:   # a file system problem no check caught earlier
+        where = f" {exc.filename!r}" if getattr(exc, "filename", None) else ""
+        _fail(prog, f"cannot read or write{where}: {exc.strerror or exc}")
+        return EXIT_BAD_INPUT
+
+
+def _fail(prog: str, message: str) -> None:
+    line = " ".join(str(message).split())   # one line, whatever the message holds
+    try:
+        print(f"{prog}: error: {line}", file=sys.stderr)
+    except OSError:
+        pass
 
 
 def add_part_options(group):
@@ -165,13 +198,14 @@ def emit(result, args, name, write_outputs, summary_text) -> int:
     if not args.no_files:
         write_outputs(result, args.out, name)
     if args.json:
-        print(json.dumps(result.to_dict(), indent=2))
+        print_output(json.dumps(result.to_dict(), indent=2))
     else:
-        print(summary_text(result), end="")
+        text = summary_text(result)
         if result.files:
-            print("\nFiles:")
-            for key, path in result.files.items():
-                print(f"  {key}: {', '.join(path) if isinstance(path, list) else path}")
+            text += "\nFiles:\n" + "".join(
+                f"  {key}: {', '.join(path) if isinstance(path, list) else path}\n"
+                for key, path in result.files.items())
+        print_output(text, end="")
     return 0
 
 

@@ -173,18 +173,16 @@ def json_safe(obj):
     return obj
 
 
-def write_json(path, data) -> None:
-    atomic_write(path, json.dumps(data, indent=2) + "\n")
-
-
 def bundle_paths(out_dir, name: str, images, extra: dict = None) -> dict:
-    """Create ``netlists/`` and ``reports/<name>/`` under ``out_dir`` and name every
-    file of a design's bundle (``extra``: key -> file name in the report folder)."""
-    from .fileio import ensure_dir
+    """Name every file of a design's bundle under ``out_dir``: ``reports/<name>/``
+    (build sheets, result.json, plots, the deck as ``<name>.cir``, and ``extra``:
+    key -> file name in the report folder) and ``netlists/<name>.cir``, a link to
+    that deck. Creates ``netlists/`` and ``reports/`` only."""
     from pathlib import Path
+    from .fileio import ensure_dir
     out_dir = Path(out_dir)
     net_dir = ensure_dir(out_dir / "netlists")
-    rep_dir = ensure_dir(out_dir / "reports" / name)
+    rep_dir = ensure_dir(out_dir / "reports") / name
     files = {"netlist": str(net_dir / f"{name}.cir"),
              "build_sheet_md": str(rep_dir / "build-sheet.md"),
              "build_sheet_html": str(rep_dir / "build-sheet.html"),
@@ -196,18 +194,35 @@ def bundle_paths(out_dir, name: str, images, extra: dict = None) -> dict:
 
 def write_bundle(files: dict, deck: str, images: dict, title: str, sections, result: dict,
                  texts: dict = None) -> None:
-    """Write a bundle named by :func:`bundle_paths`, every file atomically: the
-    deck, the plots, extra ``texts`` (key -> content), the build sheet as
-    Markdown and self-contained HTML, and result.json last."""
+    """Write a bundle named by :func:`bundle_paths` so that it is never half-written
+    nor mixed with an older one: everything goes into a staging folder beside the
+    report folder, which is then swapped in atomically; the netlist path is a link
+    to the deck inside it, so it switches in the same step (see :mod:`designer.fileio`).
+    Stale temporaries of killed runs are cleaned first."""
     from pathlib import Path
-    atomic_write(files["netlist"], deck)
-    for key, content in (texts or {}).items():
-        atomic_write(files[key], content)
-    for path in files["plots"]:
-        atomic_write(path, images[Path(path).name])
-    atomic_write(files["build_sheet_md"], to_markdown(title, sections))
-    atomic_write(files["build_sheet_html"], to_html(title, sections, images))
-    write_json(files["result_json"], result)
+    from . import fileio
+    rep_dir = Path(files["result_json"]).parent
+    net = Path(files["netlist"])
+    for folder in (rep_dir.parent, net.parent):
+        fileio.clean_stale(folder)
+    stage = fileio.new_folder_beside(rep_dir)
+    contents = {net.name: deck, **{Path(files[k]).name: v for k, v in (texts or {}).items()},
+                **{Path(p).name: images[Path(p).name] for p in files["plots"]},
+                "build-sheet.md": to_markdown(title, sections),
+                "build-sheet.html": to_html(title, sections, images),
+                "result.json": json.dumps(result, indent=2) + "\n"}
+    try:
+        try:
+            for fname, data in contents.items():
+                (stage / fname).write_bytes(data if isinstance(data, bytes) else data.encode("utf-8"))
+        except OSError as exc:
+            raise fileio.os_error("write the report bundle in", rep_dir.parent, exc) from None
+        linked = fileio.link_into(net, rep_dir / net.name)
+        fileio.publish_folder(stage, rep_dir)
+    finally:
+        fileio.remove_tree(stage)   # gone already when published; else a failed or interrupted write
+    if not linked:  # no symbolic links on this file system: a copy, written atomically
+        fileio.atomic_write(net, deck)
 
 
 def part_row(ref, value, unit, role, series=None, tol_pct=None):

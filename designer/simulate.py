@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import DesignError
+from .errors import DesignError, SimulatorError
 
 INSTALL_HINT = "install it with: apt-get install ngspice libngspice0-dev (or run `make setup`)"
 BACKENDS = ("pyspice", "ngspice-cli")
@@ -75,29 +75,60 @@ def error_lines(text: str) -> list:
 
 
 def read_raw(path) -> dict:
-    """Read an ngspice raw file (binary or ASCII, real data) into a dict of arrays."""
-    data = Path(path).read_bytes()
+    """Read an ngspice raw file (binary or ASCII, real or complex data) into a
+    dict of arrays; a missing, truncated or corrupt file is a :class:`SimulatorError`."""
+    try:
+        data = Path(path).read_bytes()
+    except OSError as exc:
+        raise SimulatorError(f"cannot read the ngspice raw file {str(path)!r}: {exc.strerror or exc}") from None
+    try:
+        return parse_raw(data)
+    except (ValueError, IndexError, AttributeError, UnicodeDecodeError) as exc:
+        raise SimulatorError(f"the ngspice raw file {str(path)!r} is unreadable ({exc})") from None
+
+
+def parse_raw(data: bytes) -> dict:
+    """The vectors of an ngspice raw file's bytes; ValueError if malformed."""
+    if not data:
+        raise ValueError("it is empty")
     marker_b, marker_a = b"Binary:\n", b"Values:\n"
     header_end = data.find(marker_b)
     binary = header_end >= 0
     if not binary:
         header_end = data.find(marker_a)
     if header_end < 0:
-        raise DesignError(f"ngspice raw file {str(path)!r} has no data section")
+        raise ValueError("no data section")
     header = data[:header_end].decode("latin-1")
-    nvars = int(re.search(r"No\. Variables:\s*(\d+)", header).group(1))
-    npts = int(re.search(r"No\. Points:\s*(\d+)", header).group(1))
-    flags = re.search(r"Flags:\s*(.*)", header).group(1)
-    if "complex" in flags:
-        raise DesignError("complex raw files are not supported (transient analyses only)")
-    var_block = header.split("Variables:\n", 1)[1]
-    names = [ln.split()[1].lower() for ln in var_block.strip().splitlines()[:nvars]]
+    nv = re.search(r"No\. Variables:\s*(\d+)", header)
+    npt = re.search(r"No\. Points:\s*(\d+)", header)
+    fl = re.search(r"Flags:\s*(.*)", header)
+    if not (nv and npt and fl and "Variables:\n" in header):
+        raise ValueError("its header lacks the variable count, point count or flags")
+    nvars, npts = int(nv.group(1)), int(npt.group(1))
+    cplx = "complex" in fl.group(1)
+    names = [ln.split()[1].lower() for ln in header.split("Variables:\n", 1)[1].strip().splitlines()[:nvars]]
+    if nvars < 1 or len(names) != nvars:
+        raise ValueError(f"it declares {nvars} variables and lists {len(names)}")
     body = data[header_end + (len(marker_b) if binary else len(marker_a)):]
+    width = 2 if cplx else 1
     if binary:
-        arr = np.frombuffer(body[: npts * nvars * 8], dtype="<f8").reshape(npts, nvars)
+        need = npts * nvars * width * 8
+        if len(body) < need:
+            raise ValueError(f"it is truncated ({len(body)} of {need} data bytes)")
+        arr = np.frombuffer(body[:need], dtype="<f8").reshape(npts, nvars * width)
     else:
-        nums = [float(tok) for ln in body.decode().splitlines() for tok in ln.split()[-1:]]
-        arr = np.array(nums[: npts * nvars]).reshape(npts, nvars)
+        rows = [ln.split() for ln in body.decode("latin-1").splitlines() if ln.strip()]
+        # ASCII: a point index then the first value on one line, one value per line after
+        vals = [r[-1] for r in rows]
+        nums = []
+        for v in vals[: npts * nvars]:
+            parts = v.split(",")
+            nums.extend(float(x) for x in parts[:width])
+        if len(nums) < npts * nvars * width:
+            raise ValueError("it is truncated")
+        arr = np.array(nums).reshape(npts, nvars * width)
+    if cplx:
+        return {name: arr[:, 2 * i] + 1j * arr[:, 2 * i + 1] for i, name in enumerate(names)}
     return {name: np.array(arr[:, i]) for i, name in enumerate(names)}
 
 
@@ -137,7 +168,7 @@ class NgspiceCli:
     def run(self, deck: str, workdir=None) -> SimResult:
         exe = shutil.which(self.executable)
         if exe is None:
-            raise DesignError(f"ngspice is not installed ({self.executable!r} not found); {INSTALL_HINT}")
+            raise SimulatorError(f"ngspice is not installed ({self.executable!r} not found); {INSTALL_HINT}")
         with tempfile.TemporaryDirectory(prefix="designer-sim-") as tmp:
             cwd = Path(workdir) if workdir else Path(tmp)
             deck_path = Path(tmp) / "deck.cir"
@@ -148,12 +179,18 @@ class NgspiceCli:
                                       capture_output=True, text=True, timeout=self.timeout,
                                       stdin=subprocess.DEVNULL)
             except subprocess.TimeoutExpired:
-                raise DesignError(f"ngspice did not finish within {self.timeout:g} s") from None
+                raise SimulatorError(f"ngspice did not finish within {self.timeout:g} s") from None
             log = proc.stdout + "\n" + proc.stderr
-            if proc.returncode != 0 or not raw_path.exists() or raw_path.stat().st_size == 0:
-                errs = error_lines(log) or [ln for ln in proc.stderr.splitlines() if ln.strip()][-1:]
-                raise DesignError("ngspice failed: " + ("; ".join(errs[:3]) or f"exit status {proc.returncode}"))
-            return _result(read_raw(raw_path), log, self.name, deck)
+            errs = error_lines(log) or [ln for ln in proc.stderr.splitlines() if ln.strip()][-1:]
+            if proc.returncode != 0:
+                raise SimulatorError("ngspice failed: " + ("; ".join(errs[:3]) or f"exit status {proc.returncode}"))
+            if not raw_path.exists() or raw_path.stat().st_size == 0:
+                raise SimulatorError("ngspice exited without writing any results"
+                                     + (f" ({'; '.join(errs[:3])})" if errs else " (no analysis ran?)"))
+            vectors = read_raw(raw_path)
+            if "time" not in vectors and "frequency" not in vectors:
+                raise SimulatorError("ngspice ran no analysis: the deck has no .tran or .ac line")
+            return _result(vectors, log, self.name, deck)
 
 
 class PySpiceShared:
@@ -171,14 +208,14 @@ class PySpiceShared:
         try:
             from PySpice.Spice.NgSpice.Shared import NgSpiceShared
         except ImportError as exc:  # pragma: no cover - dependency of the package
-            raise DesignError(f"PySpice is not installed: {exc}") from None
+            raise SimulatorError(f"PySpice is not installed: {exc}") from None
         import logging
         logging.getLogger("PySpice").setLevel(logging.CRITICAL)
         with self._lock:
             try:
                 ng = NgSpiceShared.new_instance()
             except (OSError, Exception) as exc:
-                raise DesignError(f"cannot load the ngspice shared library ({exc}); {INSTALL_HINT}") from None
+                raise SimulatorError(f"cannot load the ngspice shared library ({exc}); {INSTALL_HINT}") from None
             old = os.getcwd()
             try:
                 if workdir:
@@ -193,12 +230,13 @@ class PySpiceShared:
                 load_log = ng.stdout + "\n" + ng.stderr
                 errs = error_lines(load_log)
                 if rc or errs:
-                    raise DesignError("ngspice failed to load the deck: " + ("; ".join(errs[:3]) or f"code {rc}"))
+                    raise SimulatorError("ngspice failed to load the deck: " + ("; ".join(errs[:3]) or f"code {rc}"))
                 log = self._command(ng, "run")
                 errs = error_lines(log)
                 plot = ng.last_plot
                 if errs or not plot.startswith("tran"):
-                    raise DesignError("ngspice failed: " + ("; ".join(errs[:3]) or "no transient data"))
+                    raise SimulatorError("ngspice failed: " + "; ".join(errs[:3]) if errs else
+                                         "ngspice ran no analysis: the deck has no .tran line")
                 vectors = {name: np.real(vec._data) for name, vec in ng.plot(None, plot).items()}
             finally:
                 os.chdir(old)

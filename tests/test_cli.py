@@ -113,3 +113,17 @@ def test_critically_damped_builds_write_their_bundle(cmd, args, tmp_path):
     assert d["comparison"]["pass"] is True
     for key in ("netlist", "build_sheet_md", "build_sheet_html", "result_json", "waveforms_csv"):
         assert os.path.getsize(d["files"][key]) > 0
+
+
+@pytest.mark.parametrize("cmd,args", [
+    ("design-plant", ["--fc", "3500", "--zeta", "0.2", "--no-sim", "--no-files"]),
+    ("design-plant", ["--fc", "3500", "--zeta", "0.2", "--no-sim", "--no-files", "--json"]),
+    ("design-pid", ["--plant-fc", "3500", "--plant-zeta", "0.2", "--no-sim", "--no-files", "--json"]),
+])
+def test_reader_closing_the_pipe_is_not_an_error(cmd, args):
+    """Regression (issue 7.10): `--json | head -c 10` was a BrokenPipeError traceback."""
+    with subprocess.Popen([script(cmd), *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE) as p:
+        p.stdout.close()   # the reader is gone before anything is written
+        err = p.stderr.read().decode()
+        assert p.wait(timeout=120) == 0
+    assert err == ""

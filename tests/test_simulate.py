@@ -93,3 +93,33 @@ def test_a_failed_measurement_is_not_a_failed_run(deck):
         res = get_simulator(name).run(never)
         assert "never" not in res.measurements
         assert "overshoot_pct" in res.measurements
+
+
+NO_ANALYSIS = "* no analysis\nR1 a 0 1k\nV1 a 0 1\n.end\n"
+
+
+@pytest.mark.parametrize("backend", ["pyspice", "ngspice-cli"])
+def test_a_deck_with_no_analysis_says_so(backend):
+    """Regression (issue 7.9): the CLI backend returned ngspice's constants as if they were results."""
+    from designer.errors import SimulatorError
+    with pytest.raises(SimulatorError, match="no analysis"):
+        get_simulator(backend).run(NO_ANALYSIS)
+
+
+@pytest.mark.parametrize("damage", ["empty", "truncated", "no-header", "garbage"])
+def test_unreadable_raw_file_is_one_clear_error(deck, tmp_path, damage):
+    """Regression (issue 7.9): a corrupt or truncated raw file was a traceback."""
+    import subprocess
+    from designer.errors import SimulatorError
+    good = tmp_path / "good.raw"
+    path = tmp_path / "deck.cir"
+    path.write_text(with_raw_output(deck, good))
+    subprocess.run(["ngspice", "-b", str(path)], capture_output=True, cwd=tmp_path, timeout=60, check=True)
+    data = good.read_bytes()
+    bad = tmp_path / "bad.raw"
+    bad.write_bytes({"empty": b"", "truncated": data[: len(data) // 2],
+                     "no-header": data[data.find(b"Binary:"):], "garbage": bytes(range(256)) * 4}[damage])
+    with pytest.raises(SimulatorError) as e:
+        read_raw(bad)
+    assert "raw file" in str(e.value) and "\n" not in str(e.value)
+    assert read_raw(good)["time"].size > 100
