@@ -18,15 +18,18 @@ from .sallenkey import SallenKeyParts
 
 
 def recommend_square_wave(settling_time_s: float, amplitude_v: float, frequency_hz=None,
-                          delay_s=None) -> SquareTest:
+                          delay_s=None, time_scale_s=None) -> SquareTest:
     """A square wave whose half period leaves the response 1.5 settling times
     (2 %) to settle, rounded down to a round generator setting (the seed used
-    330 Hz for its 891 us settling time)."""
+    330 Hz for its 891 us settling time). ``time_scale_s``: see :class:`SquareTest`."""
     if frequency_hz is None:
         frequency_hz = nice_frequency_below(1.0 / (2 * 1.5 * settling_time_s))
     half = 0.5 / frequency_hz
-    return SquareTest(amplitude_v=amplitude_v, frequency_hz=frequency_hz,
-                      delay_s=half * 0.05 if delay_s is None else delay_s)
+    if delay_s is None:
+        # the rising edge a little after t = 0, within a few time scales for a slow square wave
+        delay_s = half * 0.05 if time_scale_s is None else min(half * 0.05, 20 * time_scale_s)
+    return SquareTest(amplitude_v=amplitude_v, frequency_hz=frequency_hz, delay_s=delay_s,
+                      time_scale_s=time_scale_s)
 
 
 def signal_checks(t, y_unit, amplitude_v: float, opamp: OpAmp) -> list:

@@ -19,16 +19,28 @@ CIRCUITS_DIR = Path(__file__).resolve().parents[1] / "circuits"
 OPAMP_LIBRARY = CIRCUITS_DIR / "opamp_behavioural.lib"
 
 
+#: the simulation's maximum step is at most this fraction of the response's time scale
+STEPS_PER_TIME_SCALE = 50
+#: a bench period needing more simulation steps than this is refused (minutes of ngspice, GBs of data)
+MAX_SIM_POINTS = 2_000_000
+
+
 @dataclass(frozen=True)
 class SquareTest:
     """The bench test: a 0 -> ``amplitude_v`` square wave (a function generator
     with offset amplitude/2), as the seed's 330 Hz test. One period is
-    simulated: the rising step at ``delay_s``, the falling one half a period later."""
+    simulated: the rising step at ``delay_s``, the falling one half a period later.
+
+    ``time_scale_s`` is the fastest time the response must be resolved at (1/wn
+    of the plant): the simulation's maximum step and the edges stay well below it
+    whatever the square-wave frequency, so that a slow square wave cannot hide
+    the response between two time steps."""
 
     amplitude_v: float
     frequency_hz: float
     delay_s: float
-    edge_time_s: float | None = None  #: rise/fall time of the edges; default 1e-5 half period
+    edge_time_s: float | None = None  #: rise/fall time of the edges (default: fast against everything)
+    time_scale_s: float | None = None
 
     @property
     def half_period_s(self) -> float:
@@ -36,12 +48,36 @@ class SquareTest:
 
     @property
     def edge_s(self) -> float:
+        if self.edge_time_s is not None:
+            return self.edge_time_s
         # fast against the response, but not a zero-time discontinuity for the solver
-        return self.half_period_s * 1e-5 if self.edge_time_s is None else self.edge_time_s
+        edge = self.half_period_s * 1e-5
+        return edge if self.time_scale_s is None else min(edge, self.time_scale_s / 100)
 
     @property
     def stop_s(self) -> float:
         return self.delay_s + 2 * self.half_period_s
+
+    def max_step_s(self, points: int = 20000) -> float:
+        """The simulation's maximum time step: a period / ``points``, and at most
+        1/:data:`STEPS_PER_TIME_SCALE` of the response's time scale."""
+        tmax = 2 * self.half_period_s / points
+        return tmax if self.time_scale_s is None else min(tmax, self.time_scale_s / STEPS_PER_TIME_SCALE)
+
+    def simulation_points(self, points: int = 20000) -> float:
+        return self.stop_s / self.max_step_s(points)
+
+    def check_simulable(self, points: int = 20000) -> None:
+        """Refuse a period too long to simulate at the response's resolution."""
+        n = self.simulation_points(points)
+        if n > MAX_SIM_POINTS:
+            from .errors import DesignError
+            from .units import format_eng
+            f_min = self.frequency_hz * n / MAX_SIM_POINTS
+            raise DesignError(
+                f"square wave {format_eng(self.frequency_hz, 'Hz')} is too slow to simulate: its period is "
+                f"{n:.3g} time steps of the response ({format_eng(self.max_step_s(points), 's')}), more than "
+                f"{MAX_SIM_POINTS:.0e}; use --square-freq of at least {format_eng(f_min, 'Hz', 3)}, or --no-sim")
 
     def source(self) -> str:
         """SPICE PULSE source text."""
@@ -126,8 +162,8 @@ def settle_error_source(circuit, node: str, final: float, initial: float = 0.0):
 
 
 def finish_deck(circuit, test: SquareTest, extra_lines=(), points: int = 20000) -> str:
-    """Circuit text plus ``.tran`` (max step ~ one period / ``points``), extra lines and ``.end``."""
-    tmax = 2 * test.half_period_s / points
+    """Circuit text plus ``.tran`` (max step: see :meth:`SquareTest.max_step_s`), extra lines and ``.end``."""
+    tmax = test.max_step_s(points)
     lines = [str(circuit).rstrip(),
              f".tran {tmax:.6g} {test.stop_s:.6g} 0 {tmax:.6g}",
              *extra_lines, ".end"]

@@ -111,8 +111,10 @@ def sections(result, with_images: bool = True) -> list:
         rows.append(["normalised RMS waveform error", f"{spice['nrms_ideal']:.3g}", f"{spice['nrms']:.3g}"])
         out.append(("SPICE against the analytic models", [
             R.text(f"ngspice ({d['simulator']} backend), {amp.name} behavioural model. Deltas are SPICE minus model; "
-                   f"NRMS = RMS of (model - SPICE) / (1 % of |model| + {format_eng(cmp_['nrms_abstol_v'], 'V')}), "
-                   "pass below 1."),
+                   f"NRMS = RMS of (model - SPICE) / (1 % of |model| + {format_eng(cmp_['nrms_abstol_v'], 'V')}). "
+                   "SPICE agrees with the op-amp-aware model when NRMS is below 1 and overshoot is within 1 pp, "
+                   "peak and rise time within 2 %, settling time within 5 % (or half a ringing period): "
+                   + ("it does." if cmp_["pass"] else "it does NOT (" + "; ".join(cmp_["disagreements"]) + ").")),
             R.table(["metric", "vs ideal model", f"vs {amp.name}-aware model"], rows)]))
     if d["notes"]:
         out.append(("Notes", [R.text(n) for n in d["notes"]]))

@@ -145,3 +145,35 @@ def test_the_exact_design_is_always_reported_and_exact(fc, zeta):
     assert d["ideal"] is not None
     assert d["ideal"]["fn_hz"] == pytest.approx(fc, rel=1e-9)
     assert d["ideal"]["zeta"] == pytest.approx(zeta, rel=1e-7)
+
+
+def test_slow_square_wave_still_resolves_the_response():
+    """Regression (issue 7.3): with a slow square wave the time step was a fraction of the
+    period, too coarse for the response (3 Hz: rise time 3.3 % off, passed on NRMS alone)."""
+    from designer.compare import AGREEMENT
+    d = design_plant(PlantSpec(3500, 0.2, square_hz=3)).to_dict()
+    for name, (kind, limit) in AGREEMENT.items():
+        ref, got = d["analytic_opamp"][name], d["spice"][name]
+        assert abs(got - ref) <= (limit if kind == "pp" else limit * ref), name
+    assert d["comparison"]["pass"] is True and d["comparison"]["disagreements"] == []
+
+
+def test_square_wave_too_slow_to_simulate_is_refused_with_the_limit():
+    with pytest.raises(DesignError, match=r"too slow to simulate.*at least .*Hz"):
+        design_plant(PlantSpec(3500, 0.2, square_hz=1e-3))
+    assert design_plant(PlantSpec(3500, 0.2, square_hz=1e-3), simulate=False).test.frequency_hz == 1e-3
+
+
+def test_agreement_needs_the_metrics_not_only_the_waveform():
+    """The pass rule: a simulation that misses the overshoot the model has fails,
+    whatever its NRMS."""
+    from designer.compare import disagreements, metric_deltas
+    from designer.metrics import step_metrics
+    import numpy as np
+    t = np.linspace(0, 2e-3, 20001)
+    ring = 1 - np.exp(-3000 * t) * np.cos(20000 * t)
+    flat = 1 - np.exp(-3000 * t)
+    ref, other = step_metrics(t, ring, final=1.0), step_metrics(t, flat, final=1.0)
+    off = disagreements(metric_deltas(ref, other), ref)
+    assert any(o.startswith("overshoot_pct") for o in off)
+    assert disagreements(metric_deltas(ref, ref), ref) == []
