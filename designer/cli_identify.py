@@ -10,10 +10,13 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from pathlib import Path
 
 from .cli import OneLineParser, print_output, run_cli
 from .errors import DesignError
+from .ranges import RANGES, help_range, parse_in_range
 from .report import json_safe, png_bytes
+from .units import parse_value
 
 EPILOG = """\
 examples:
@@ -43,9 +46,21 @@ exit status: 0 success, 2 bad input (one line on stderr saying what and why).
 """
 
 
-def _number(text: str, what: str) -> float:
-    from .units import parse_value
-    return parse_value(text, what)  # finite, engineering notation (1m, 2u5)
+def step_time(text) -> float:
+    """``--step-time``: engineering notation, inside ``RANGES["capture_time_s"]``."""
+    return parse_in_range(text, "--step-time", "capture_time_s")
+
+
+def step_amplitude(text) -> float:
+    """``--step-amplitude``: non-zero, its size inside ``RANGES["step_amplitude"]``
+    (a negative value is a falling step)."""
+    value = parse_value(text, "--step-amplitude")
+    if value == 0:
+        raise DesignError("--step-amplitude must be non-zero (its size "
+                          f"{RANGES['step_amplitude'].text()}, either sign)")
+    RANGES["step_amplitude"].check(abs(value), "the size of --step-amplitude (either sign)",
+                                   shown=repr(text))
+    return value
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -55,10 +70,13 @@ def build_parser() -> argparse.ArgumentParser:
                 epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("capture", help="CSV file with the step response")
     p.add_argument("--step-time", metavar="T",
-                   help="when the input stepped, in seconds (default: from the input column, "
-                        "else t = 0 if the record spans it, else the first sample)")
+                   help="when the input stepped, in seconds " + help_range("capture_time_s")
+                        + " (default: from the input column, else t = 0 if the record spans "
+                          "it, else the first sample)")
     p.add_argument("--step-amplitude", metavar="A",
-                   help="input step size in input units (default: from the input column, else 1)")
+                   help="input step size in input units, either sign, size "
+                        + help_range("step_amplitude")
+                        + " (default: from the input column, else 1)")
     p.add_argument("--input-column", metavar="NAME|N",
                    help="input column by header name or number (time is 1); 'none' ignores it")
     p.add_argument("--output-column", metavar="NAME|N", help="output column by name or number")
@@ -77,19 +95,19 @@ def run(args):
     """Identify from parsed arguments, write the plot; return the result."""
     from .identify.csvio import read_capture
 
-    step_time = None if args.step_time is None else _number(args.step_time, "--step-time")
-    amp = None if args.step_amplitude is None else _number(args.step_amplitude, "--step-amplitude")
-    if amp is not None and amp == 0:
-        raise DesignError("--step-amplitude must be non-zero")
+    t_step = None if args.step_time is None else step_time(args.step_time)
+    amp = None if args.step_amplitude is None else step_amplitude(args.step_amplitude)
+    if args.plot:
+        check_output_path(args.plot, "--plot")
     # The file is read before scipy is imported, so bad input fails fast.
     cap = read_capture(args.capture, input_column=args.input_column,
                        output_column=args.output_column)
     from .identify.step import compare_with_design, identify_step, load_design
     design = load_design(args.against) if args.against else None
     u = cap.u
-    if step_time is not None:
+    if t_step is not None:
         u = None if amp is not None else u
-    result = identify_step(cap.t, cap.y, u, step_time=step_time, step_amplitude=amp,
+    result = identify_step(cap.t, cap.y, u, step_time=t_step, step_amplitude=amp,
                            methods=args.methods, refine=not args.no_refine,
                            capture=cap.to_dict())
     if design is not None:
@@ -97,6 +115,38 @@ def run(args):
     if args.plot:
         plot_fit(result, args.plot)
     return result
+
+
+def check_output_path(path, option: str) -> None:
+    """Refuse, before any work, an output file that cannot be written: the path
+    is a directory, or one of its parents is a file. (Nothing is created here:
+    a run refused later must leave no trace.)"""
+    from .identify.textfile import shown
+    p = Path(path)
+    try:
+        if str(path) in ("", ".", "..") or p.is_dir():
+            raise DesignError(f"{option} {shown(path)} is a directory; give a file name such "
+                              "as fit.png")
+        for parent in p.parents:
+            if parent.exists():
+                if not parent.is_dir():
+                    raise DesignError(f"{option} {shown(path)}: {shown(parent)} is a file, "
+                                      "not a directory")
+                break
+    except (OSError, ValueError) as exc:   # a name too long, a NUL byte
+        raise DesignError(f"{option} {shown(path)} is not a usable file name: "
+                          f"{getattr(exc, 'strerror', None) or exc}") from None
+
+
+def write_png(path, fig, option: str = "--plot") -> None:
+    """Write a figure atomically; an OS error (disk full, permission) is one line."""
+    from .fileio import atomic_write
+    from .identify.textfile import shown
+    try:
+        atomic_write(path, png_bytes(fig))
+    except OSError as exc:
+        raise DesignError(f"{option}: cannot write {shown(path)}: "
+                          f"{exc.strerror or exc}") from None
 
 
 def identify_main(argv=None) -> int:
@@ -119,7 +169,6 @@ def plot_fit(result, path, n_models: int = 3) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .fileio import atomic_write
     from .identify.core import model_step
     from .identify.preprocess import block_mean
 
@@ -143,7 +192,7 @@ def plot_fit(result, path, n_models: int = 3) -> None:
     ax.set_title("Step response: data and best identified models")
     ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
-    atomic_write(path, png_bytes(fig))
+    write_png(path, fig)
 
 
 if __name__ == "__main__":  # pragma: no cover

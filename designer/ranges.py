@@ -88,6 +88,21 @@ RANGES = {
     "f_integrator_hz": Range(1e-4, 10e6, "Hz"),
     "f_differentiator_hz": Range(0.01, 1e9, "Hz"),
     # identify and identify-freq (add their inputs here)
+    # every time in a capture and --step-time: +-10 Gs covers Unix timestamps
+    "capture_time_s": Range(-1e10, 1e10, "s"),
+    # last time - first time: 1 ps (10 samples at 10 GS/s) up to the whole time range
+    "capture_span_s": Range(1e-12, 2e10, "s"),
+    # every output and input sample, in the file's own units
+    "capture_value": Range(-1e15, 1e15),
+    # size of the input step (--step-amplitude, or measured on the input column), either sign
+    "step_amplitude": Range(1e-12, 1e12),
+    # size of the output's change from baseline to final value, in the file's units
+    "output_step": Range(1e-15, 2e15),
+    # frequency-response tables (identify-freq): every row
+    "freq_hz": Range(1e-6, 1e12, "Hz"),
+    "gain_db": Range(-400.0, 400.0, "dB"),
+    "gain_ratio": Range(1e-20, 1e20),
+    "phase_deg": Range(-1e5, 1e5, "deg"),
 }
 
 

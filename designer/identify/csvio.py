@@ -18,23 +18,38 @@ Which signal is the input and which the output: by name when the header names
 them (``u``, ``vin``, ``in``... and ``y``, ``vout``, ``out``...), otherwise by
 position (``t,u,y``: the first signal is the input, the last the output; one
 signal is the output). ``input_column``/``output_column`` override both.
+
+Files are streamed, never read whole: the layout is recognised from the first
+lines, then the samples are parsed a block at a time by numpy's C parser, and
+only the (at most three) columns used are kept, so memory is about 8 bytes per
+kept value however long the file is. Size, encoding and non-regular files
+(a directory, ``/dev/zero``, a FIFO) are handled by :mod:`.textfile`; the
+checks on the samples themselves (finite, increasing time, physical ranges)
+are :func:`.preprocess.check_samples`.
 """
 
 from __future__ import annotations
 
-import math
+import bisect
+import itertools
 import re
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from ..errors import DesignError
+from .preprocess import check_samples, number_text
+from .textfile import (BLOCK_BYTES, MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, MAX_LINE_BYTES,
+                       SNIFF_BYTES, check_encoding, decode, open_limited, size_text)
 
 #: Header names (lowercase, units stripped) read as the plant input or output.
 INPUT_NAMES = ("u", "vin", "v_in", "in", "input", "uin", "u_in", "v(in)", "ve", "step", "source")
 OUTPUT_NAMES = ("y", "vout", "v_out", "out", "output", "yout", "y_out", "v(out)", "vs", "response")
 TIME_NAMES = ("t", "time", "time_s", "times", "second", "seconds", "s", "x", "tiempo")
+#: Lines examined to recognise the layout (header block, delimiter, first data row).
+HEAD_LINES = 1000
+#: Lines parsed at a time when the text is already in memory.
+BLOCK_LINES = 100_000
 
 
 @dataclass
@@ -64,12 +79,13 @@ class Capture:
 
 
 def read_capture(path, *, input_column=None, output_column=None) -> Capture:
-    """Read a step-response capture from ``path``.
+    """Read a step-response capture from ``path``, streaming it.
 
     Parameters
     ----------
     path : str or Path
-        The CSV file.
+        The CSV file (at most :data:`~.textfile.MAX_CAPTURE_BYTES` bytes and
+        :data:`~.textfile.MAX_CAPTURE_ROWS` data rows).
     input_column, output_column : str or int, optional
         Column name (case-insensitive) or 1-based column number (time is column
         1) of the plant input and output; ``input_column="none"`` ignores any
@@ -78,19 +94,15 @@ def read_capture(path, *, input_column=None, output_column=None) -> Capture:
     Raises
     ------
     DesignError
-        Missing or unreadable file, empty file, non-numeric cells, NaN or
-        infinite values, time not strictly increasing.
+        Missing, unreadable, too large, binary or UTF-16 file, empty file,
+        non-numeric cells, NaN or infinite values, values outside their
+        physical ranges, time not strictly increasing, the same column asked
+        for as input and output.
     """
-    path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except FileNotFoundError:
-        raise DesignError(f"capture file {str(path)!r} does not exist") from None
-    except OSError as exc:
-        raise DesignError(f"cannot read capture file {str(path)!r}: {exc.strerror or exc}") from None
-    text = raw.decode("utf-8", errors="replace")
-    cap = parse_capture_text(text, name=str(path), input_column=input_column,
-                             output_column=output_column)
+    with open_limited(path, "capture file", MAX_CAPTURE_BYTES) as fh:
+        head, carry = _read_head(fh)
+        cap = _parse(head, _file_blocks(fh, carry), fh.name, input_column, output_column,
+                     size_hint=fh.size)
     cap.source = str(path)
     return cap
 
@@ -98,22 +110,105 @@ def read_capture(path, *, input_column=None, output_column=None) -> Capture:
 def parse_capture_text(text: str, *, name: str = "capture", input_column=None,
                        output_column=None) -> Capture:
     """Parse the text of a capture file; see :func:`read_capture`."""
-    text = text.lstrip("\ufeff")
-    lines = text.splitlines()
-    # Trailing blank lines are common (and harmless) in exports.
-    while lines and not lines[-1].strip():
-        lines.pop()
+    lines = text.lstrip("\ufeff").splitlines()
+    head, rest = lines[:HEAD_LINES], lines[HEAD_LINES:]
+    blocks = ((b, _flags(b)) for b in (rest[i:i + BLOCK_LINES]
+                                       for i in range(0, len(rest), BLOCK_LINES)))
+    return _parse(head, blocks, name, input_column, output_column,
+                  size_hint=None if not rest else len(text))
+
+
+# --------------------------------------------------------------------------- streaming
+
+def _flags(lines) -> tuple:
+    """(may hold comment or blank lines, has quotes) of a block of lines."""
+    text = "\n".join(lines)
+    return ("#" in text or "" in lines), '"' in text
+
+
+def _read_head(fh) -> tuple:
+    """The first lines of the file (at least HEAD_LINES unless it is shorter, at
+    most about MAX_LINE_BYTES of them), decoded, and the bytes that follow them."""
+    buf = fh.read(SNIFF_BYTES) or b""
+    bom = check_encoding(buf, fh.name, fh.what)
+    eof = not buf
+    while not eof and buf.count(b"\n") < HEAD_LINES and len(buf) <= MAX_LINE_BYTES:
+        more = fh.read(SNIFF_BYTES)
+        eof = not more
+        buf += more or b""
+    if eof:
+        return decode(buf[bom:]).splitlines(), b""
+    cut = buf.rfind(b"\n")
+    if cut < 0:
+        raise DesignError(f"capture file {fh.name} has no line break in its first "
+                          f"{size_text(len(buf))}: not a CSV text file")
+    return decode(buf[bom:cut + 1]).splitlines(), buf[cut + 1:]
+
+
+def _file_blocks(fh, carry: bytes):
+    """The rest of the file as blocks of decoded lines (about BLOCK_BYTES each),
+    each with its :func:`_flags`; a line longer than MAX_LINE_BYTES is refused."""
+    while True:
+        data = fh.read(BLOCK_BYTES)
+        if not data:
+            if carry.strip():
+                text = decode(carry)
+                yield text.splitlines(), ("#" in text, '"' in text)
+            return
+        buf = carry + data
+        cut = buf.rfind(b"\n")
+        if cut < 0:
+            if len(buf) > MAX_LINE_BYTES:
+                raise DesignError(f"capture file {fh.name} has a line longer than "
+                                  f"{size_text(MAX_LINE_BYTES)}: not a CSV text file")
+            carry = buf
+            continue
+        carry = buf[cut + 1:]
+        text = decode(buf[:cut + 1])
+        lines = text.splitlines()
+        yield lines, ("#" in text or "" in lines, '"' in text)
+
+
+@dataclass
+class _Layout:
+    """Where the samples are: ``columns`` names time and the signals;
+    ``file_cols`` the file column of each; ``first_row`` the head line where the
+    samples start; ``time_axis`` (start, increment) when the time column is a
+    sample index (Rigol)."""
+
+    columns: list
+    fmt: str
+    first_row: int
+    delim: str
+    file_cols: list
+    time_axis: tuple | None = None
+
+
+def _parse(head, blocks, name, input_column, output_column, size_hint=None) -> Capture:
+    first = next(blocks, None)
+    lines = list(head)
+    if first is None:
+        # Trailing blank lines are common (and harmless) in exports.
+        while lines and not lines[-1].strip():
+            lines.pop()
     if not lines:
         raise DesignError(f"{name}: the file is empty; expected CSV rows of time and output "
                           "(t,y or t,u,y)")
+    layout = _layout(lines, name)
+    j_out, j_in, tentative = _choose_columns(layout.columns, input_column, output_column, name)
+    keep = [0, j_out] + ([j_in] if j_in is not None else [])
+    more = itertools.chain([first], blocks) if first is not None else iter(())
+    cols = _load(lines, layout, keep, more, name, size_hint)
+    return _assemble(cols, layout, keep, tentative, name)
+
+
+def _layout(lines, name) -> _Layout:
     first = _cells(lines[0], ",")
     if first and first[0].lower() == "record length":
-        columns, data, fmt, first_row = _read_tektronix_tds(lines, name)
-    elif len(first) >= 3 and first[0].lower() == "x" and "increment" in [c.lower() for c in first]:
-        columns, data, fmt, first_row = _read_rigol(lines, name)
-    else:
-        columns, data, fmt, first_row = _read_table(lines, name)
-    return _assemble(columns, data, fmt, first_row, name, input_column, output_column)
+        return _read_tektronix_tds(lines, name)
+    if len(first) >= 3 and first[0].lower() == "x" and "increment" in [c.lower() for c in first]:
+        return _read_rigol(lines, name)
+    return _read_table(lines, name)
 
 
 # --------------------------------------------------------------------------- layouts
@@ -146,6 +241,7 @@ def _delimiter(lines: list) -> str:
 
 
 def _split(line: str, delim: str) -> list:
+    line = line.split("#", 1)[0]
     if delim == "whitespace":
         return line.split()
     cells = _cells(line, delim)
@@ -155,60 +251,23 @@ def _split(line: str, delim: str) -> list:
     return cells
 
 
-def _load_numeric(lines: list, first_row: int, delim: str, name: str, usecols=None,
-                  ncols=None) -> np.ndarray:
-    """Load numeric rows with numpy's C parser; on failure find the bad cell."""
-    body = lines[first_row:]
-    if body and '"' in body[0]:
-        body = [ln.replace('"', "") for ln in body]   # spreadsheet-quoted numbers
-    if delim == ";":
-        body = [ln.replace(",", ".") for ln in body]
-    kw = {"delimiter": None if delim == "whitespace" else delim, "ndmin": 2, "dtype": float}
-    if usecols is not None:
-        kw["usecols"] = usecols
-    elif ncols is not None and delim not in ("whitespace",):
-        kw["usecols"] = range(ncols)
-    try:
-        data = np.loadtxt(body, **kw)
-    except ValueError:
-        _raise_bad_cell(body, first_row, delim, name, usecols, ncols)
-        raise  # pragma: no cover - _raise_bad_cell always raises
-    return data
+def _show_cell(cell: str) -> str:
+    """A cell for a message: quoted, escaped, and cut to a readable length."""
+    return repr(cell if len(cell) <= 40 else cell[:37] + "...")
 
 
-def _raise_bad_cell(body, first_row, delim, name, usecols, ncols):
-    want = list(usecols) if usecols is not None else None
-    for k, line in enumerate(body):
-        cells = _split(line, delim) if delim != "whitespace" else line.split()
-        if not cells:
-            raise DesignError(f"{name}: line {first_row + k + 1} is blank inside the data; "
-                              "remove it")
-        idx = want if want is not None else range(ncols or len(cells))
-        for j in idx:
-            if j >= len(cells) or cells[j] == "":
-                raise DesignError(f"{name}: line {first_row + k + 1} has no value in column "
-                                  f"{j + 1}; every data row needs all columns")
-            if not _is_number(cells[j]):
-                raise DesignError(f"{name}: line {first_row + k + 1}, column {j + 1}: "
-                                  f"{cells[j]!r} is not a number; data cells must be numbers "
-                                  "like 1.5e-3")
-    raise DesignError(f"{name}: rows from line {first_row + 1} on do not form a numeric table "
-                      "with the same number of columns on every line")
-
-
-def _read_tektronix_tds(lines, name):
+def _read_tektronix_tds(lines, name) -> _Layout:
     """TDS/TBS: rows 'label,value,,time,value,'; the header block occupies cells 1-3."""
     meta = {}
     for line in lines[:40]:
         c = [x.strip() for x in line.split(",")]
         if len(c) >= 2 and c[0]:
             meta[c[0].lower()] = c[1]
-    data = _load_numeric(lines, 0, ",", name, usecols=(3, 4))
     source = meta.get("source", "CH1") or "CH1"
-    return ["TIME", source], data, "tektronix-tds", 0
+    return _Layout(["TIME", source], "tektronix-tds", 0, ",", [3, 4])
 
 
-def _read_rigol(lines, name):
+def _read_rigol(lines, name) -> _Layout:
     """Rigol: 'X,CH1[,CH2...],Start,Increment,' / 'Sequence,Volt,...,<start>,<inc>,'."""
     head = _cells(lines[0], ",")
     low = [h.lower() for h in head]
@@ -220,16 +279,19 @@ def _read_rigol(lines, name):
         start, inc = float(second[i_start]), float(second[i_inc])
     except (ValueError, IndexError):
         raise DesignError(f"{name}: Rigol header line 2 must carry the Start and Increment "
-                          f"values under 'Start' and 'Increment'; got {lines[1]!r}") from None
-    if not (math.isfinite(inc) and inc > 0):
-        raise DesignError(f"{name}: Rigol time increment must be a positive number; got {inc}")
+                          f"values under 'Start' and 'Increment'; got "
+                          f"{_show_cell(lines[1])}") from None
+    if not (np.isfinite(inc) and inc > 0):
+        raise DesignError(f"{name}: Rigol time increment must be a positive number; "
+                          f"got {number_text(inc)}")
+    if not np.isfinite(start):
+        raise DesignError(f"{name}: Rigol start time must be a finite number; got {number_text(start)}")
     channels = head[1:i_start]
-    data = _load_numeric(lines, 2, ",", name, usecols=range(1 + len(channels)))
-    t = start + data[:, 0] * inc
-    return ["TIME", *channels], np.column_stack([t, data[:, 1:]]), "rigol", 2
+    return _Layout(["TIME", *channels], "rigol", 2, ",", list(range(1 + len(channels))),
+                   time_axis=(start, inc))
 
 
-def _read_table(lines, name):
+def _read_table(lines, name) -> _Layout:
     """Generic table, project waveforms and Tektronix MSO/DPO: header lines, then numbers."""
     delim = _delimiter(lines)
     # Find the first row from which every row is numeric: scan from the top,
@@ -252,8 +314,8 @@ def _read_table(lines, name):
         if len(probe) < 2:
             raise DesignError(f"{name}: rows need at least two columns (time and output); "
                               f"line {min(len(lines), 2)} has {len(probe)}")
-        raise DesignError(f"{name}: no numeric table found ({bad!r} is not a number); "
-                          "expected rows of numbers: t,y or t,u,y")
+        raise DesignError(f"{name}: no numeric table found ({_show_cell(bad or '')} is not a "
+                          "number); expected rows of numbers: t,y or t,u,y")
     ncols = len(_split(lines[first_row], delim))
     header = _split(lines[first_row - 1], delim) if first_row > 0 else []
     if len(header) >= ncols and not all(_is_number(c) for c in header):
@@ -272,8 +334,110 @@ def _read_table(lines, name):
         fmt = "waveform"
     else:
         fmt = "generic"
-    data = _load_numeric(lines, first_row, delim, name, ncols=ncols)
-    return columns, data, fmt, first_row
+    return _Layout(columns, fmt, first_row, delim, list(range(ncols)))
+
+
+# --------------------------------------------------------------------------- samples
+
+class _Columns:
+    """The kept columns, filled a block at a time (rows of ``data`` are the
+    columns, each contiguous), with the file line of every sample."""
+
+    def __init__(self, k: int, hint: int):
+        self.data = np.empty((k, max(int(hint), 64)))
+        self.n = 0
+        self._row0 = []     # first sample of each block
+        self._lines = []    # its first line number, or every line number
+
+    def append(self, rows: np.ndarray, lines) -> None:
+        m = rows.shape[0]
+        if self.n + m > self.data.shape[1]:
+            grown = np.empty((self.data.shape[0],
+                              max(int(1.25 * self.data.shape[1]), self.n + m)))
+            grown[:, :self.n] = self.data[:, :self.n]
+            self.data = grown
+        self.data[:, self.n:self.n + m] = rows.T
+        self._row0.append(self.n)
+        self._lines.append(lines)
+        self.n += m
+
+    def line(self, row: int) -> int:
+        """The file line (1-based) of sample ``row``."""
+        b = bisect.bisect_right(self._row0, row) - 1
+        lines = self._lines[b]
+        k = row - self._row0[b]
+        return int(lines[k]) if isinstance(lines, np.ndarray) else lines + k
+
+    def columns(self) -> np.ndarray:
+        d = self.data[:, :self.n]
+        # the size hint is an estimate: give back a large unused tail
+        return d.copy() if self.n < 0.8 * self.data.shape[1] else d
+
+
+def _load(head, layout, keep, blocks, name, size_hint) -> _Columns:
+    """Parse the samples of the kept columns: the head's data lines, then ``blocks``."""
+    usecols = [layout.file_cols[j] for j in keep]
+    body = head[layout.first_row:]
+    if size_hint:
+        # rows expected from the file size and the head's bytes per data line
+        sample = body[:HEAD_LINES]
+        per_line = max(sum(len(ln) + 1 for ln in sample) / max(len(sample), 1), 2.0)
+        hint = min(size_hint / per_line * 1.1 + 64, MAX_CAPTURE_ROWS + 1)
+    else:
+        hint = len(body)
+    cols = _Columns(len(keep), hint)
+    line0 = layout.first_row + 1
+    for lines, flags in itertools.chain([(body, _flags(body))], blocks):
+        rows, where = _parse_block(lines, line0, layout.delim, usecols, flags, name)
+        if cols.n + rows.shape[0] > MAX_CAPTURE_ROWS:
+            raise DesignError(f"{name}: more than {MAX_CAPTURE_ROWS:,} samples, the most "
+                              "identify reads; decimate the record or cut it to the step")
+        cols.append(rows, where)
+        line0 += len(lines)
+    return cols
+
+
+def _parse_block(lines, line0, delim, usecols, flags, name) -> tuple:
+    """Numeric rows of a block of lines and their line numbers (the first one's
+    number when no line was skipped, else an array)."""
+    gaps, quotes = flags
+    if quotes:
+        lines = [ln.replace('"', "") for ln in lines]   # spreadsheet-quoted numbers
+    if delim == ";":
+        lines = [ln.replace(",", ".") for ln in lines]
+    kw = {"delimiter": None if delim == "whitespace" else delim, "usecols": usecols,
+          "ndmin": 2, "dtype": float, "comments": "#"}
+    if not gaps:
+        try:
+            return np.loadtxt(lines, **kw), line0
+        except ValueError:
+            pass  # a blank line, or a bad cell: found below
+    # Skip blank and comment lines, remembering where every sample came from.
+    kept = [i for i, ln in enumerate(lines) if ln.split("#", 1)[0].strip()]
+    rows = [lines[i] for i in kept]
+    where = np.asarray(kept, dtype=np.int64) + line0
+    if not rows:
+        return np.empty((0, len(usecols))), where
+    try:
+        return np.loadtxt(rows, **kw), where
+    except ValueError:
+        _raise_bad_cell(rows, where, delim, name, usecols)
+        raise  # pragma: no cover - _raise_bad_cell always raises
+
+
+def _raise_bad_cell(rows, where, delim, name, usecols):
+    for line, lineno in zip(rows, where):
+        cells = _split(line, delim)
+        for j in usecols:
+            if j >= len(cells) or cells[j] == "":
+                raise DesignError(f"{name}: line {lineno} has no value in column "
+                                  f"{j + 1}; every data row needs all columns")
+            if not _is_number(cells[j]):
+                raise DesignError(f"{name}: line {lineno}, column {j + 1}: "
+                                  f"{_show_cell(cells[j])} is not a number; data cells must "
+                                  "be numbers like 1.5e-3")
+    raise DesignError(f"{name}: rows from line {where[0]} on do not form a numeric table "
+                      "with the same number of columns on every line")
 
 
 # --------------------------------------------------------------------------- columns
@@ -288,68 +452,80 @@ def _norm(name: str) -> str:
 def _pick(spec, columns, what, name):
     if spec is None:
         return None
-    if isinstance(spec, int) or (isinstance(spec, str) and spec.strip().isdigit()):
-        k = int(spec)
+    text = str(spec).strip()
+    if isinstance(spec, int) or (text.isascii() and text.isdigit() and len(text) < 10):
+        k = int(text)
         if not 2 <= k <= len(columns):
             raise DesignError(f"{name}: {what} column {k} does not exist; columns 2..{len(columns)} "
                               f"are signals ({', '.join(columns)})")
         return k - 1
     low = [c.lower() for c in columns]
-    if spec.lower() in low[1:]:
-        return low.index(spec.lower(), 1)
-    raise DesignError(f"{name}: no {what} column named {spec!r}; the file has "
+    if text.lower() in low[1:]:
+        return low.index(text.lower(), 1)
+    raise DesignError(f"{name}: no {what} column named {_show_cell(str(spec))}; the file has "
                       f"{', '.join(columns[1:])}")
 
 
-def _assemble(columns, data, fmt, first_row, name, input_column, output_column) -> Capture:
-    if data.shape[0] == 0:
-        raise DesignError(f"{name}: the file has no data rows")
-    if data.shape[1] < 2:
-        raise DesignError(f"{name}: rows need at least two columns (time and output)")
-    columns = list(columns) + [f"col{j + 1}" for j in range(len(columns), data.shape[1])]
-    bad = ~np.isfinite(data)
-    if bad.any():
-        r, c = np.argwhere(bad)[0]
-        raise DesignError(f"{name}: line {first_row + r + 1}, column {c + 1} is "
-                          f"{data[r, c]!r}; NaN and infinite values are not allowed "
-                          "(remove or interpolate those samples)")
-    if data.shape[0] < 10:
-        raise DesignError(f"{name}: only {data.shape[0]} samples; a step response needs at "
-                          "least 10 (a few hundred is better)")
-    t = data[:, 0]
-    dt = np.diff(t)
-    if not np.all(dt > 0):
-        k = int(np.argmax(~(dt > 0)))
-        raise DesignError(f"{name}: time is not increasing at line {first_row + k + 2} "
-                          f"({t[k]!r} then {t[k + 1]!r}); the first column must be time in "
-                          "seconds, strictly increasing")
+def _choose_columns(columns, input_column, output_column, name) -> tuple:
+    """(output, input, tentative): column indices from the options, the header
+    names or the positions; ``tentative`` when the input was chosen by position
+    only (it must then look like a step, see :func:`looks_like_step_input`)."""
     norm = [_norm(c) for c in columns]
-    n_sig = data.shape[1] - 1
-    no_input = isinstance(input_column, str) and input_column.lower() == "none"
+    no_input = isinstance(input_column, str) and input_column.strip().lower() == "none"
     j_out = _pick(output_column, columns, "output", name)
     j_in = None if no_input else _pick(input_column, columns, "input", name)
+    if j_out is not None and j_out == j_in:
+        raise DesignError(f"{name}: column {j_out + 1} ({columns[j_out]}) is given as both the "
+                          "input and the output; they must be different columns")
     if j_out is None:
         named = [j for j in range(1, len(norm)) if norm[j] in OUTPUT_NAMES and j != j_in]
-        j_out = named[0] if named else data.shape[1] - 1
-        if j_out == j_in:
-            j_out = next(j for j in range(data.shape[1] - 1, 0, -1) if j != j_in)
-    notes = []
-    if j_in is None and not no_input and n_sig >= 2:
+        others = [j for j in range(len(columns) - 1, 0, -1) if j != j_in]
+        if not others:
+            raise DesignError(f"{name}: the only signal column ({columns[j_in]}) cannot be both "
+                              "the input and the output; drop --input-column or give a "
+                              "t,u,y file")
+        j_out = named[0] if named else others[0]
+    tentative = False
+    if j_in is None and not no_input and len(columns) >= 3:
         named = [j for j in range(1, len(norm)) if norm[j] in INPUT_NAMES and j != j_out]
         if named:
             j_in = named[0]
         else:
-            j_in = next(j for j in range(1, data.shape[1]) if j != j_out)
-            # Chosen by position only: accept it as the input only if it
-            # looks like one (e.g. time_s,analytic,spice has no input column).
-            if not looks_like_step_input(data[:, j_in], data[:, j_out]):
-                notes.append(f"column {columns[j_in]!r} does not look like a step input "
-                             "(its transitions are not much faster than the output's); "
-                             "no input column used (see --input-column)")
-                j_in = None
-    u = None if j_in is None else np.ascontiguousarray(data[:, j_in])
-    return Capture(t=np.ascontiguousarray(t), y=np.ascontiguousarray(data[:, j_out]), u=u,
-                   fmt=fmt, columns=columns, output_name=columns[j_out],
+            j_in = next(j for j in range(1, len(columns)) if j != j_out)
+            tentative = True
+    return j_out, j_in, tentative
+
+
+def _assemble(cols: _Columns, layout: _Layout, keep, tentative, name) -> Capture:
+    if cols.n == 0:
+        raise DesignError(f"{name}: the file has no data rows")
+    data = cols.columns()
+    what = ["time", "output", "input"]
+    if layout.time_axis is not None:
+        # Rigol: the first column is the sample index. An absurd index or
+        # increment overflows to inf here, which check_samples then refuses
+        # naming the line: the overflow itself is expected and harmless.
+        start, inc = layout.time_axis
+        with np.errstate(over="ignore", invalid="ignore"):
+            data[0] *= inc
+            data[0] += start
+    file_col = [layout.file_cols[j] + 1 for j in keep]
+    check_samples(*data, name=name, what=what[:len(keep)],
+                  where=lambda i, k: f"line {cols.line(i)}, column {file_col[k]}")
+    t, y = data[0], data[1]
+    u = data[2] if len(keep) == 3 else None
+    columns = layout.columns
+    j_out, j_in = keep[1], (keep[2] if u is not None else None)
+    notes = []
+    # An input chosen by position only is used only if it looks like one
+    # (e.g. time_s,analytic,spice has no input column).
+    if tentative and not looks_like_step_input(u, y):
+        notes.append(f"column {columns[j_in]!r} does not look like a step input "
+                     "(its transitions are not much faster than the output's); "
+                     "no input column used (see --input-column)")
+        u, j_in = None, None
+    return Capture(t=t, y=y, u=u, fmt=layout.fmt, columns=list(columns),
+                   output_name=columns[j_out],
                    input_name=None if j_in is None else columns[j_in], source=name,
                    notes=notes)
 

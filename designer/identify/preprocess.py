@@ -15,7 +15,11 @@ gain), and provides the robust primitives the methods share:
   to noise (never p yf: the seed's pitfall);
 - :func:`smooth_derivative`: Savitzky-Golay derivative for tangent methods;
 - :func:`prepare_step`: all of the above, including square-wave captures
-  split into their steps and averaged.
+  split into their steps and averaged;
+- :func:`check_samples`: the one check that a record is usable at all
+  (finite, enough samples, increasing time, every value inside its physical
+  range from :data:`designer.ranges.RANGES`), so no method ever meets an
+  overflow, a NaN or a time scale of 1e-300 s.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import DesignError
+from ..ranges import RANGES
 
 #: Fraction of the post-step record used as the settled tail for yf.
 TAIL_FRACTION = 0.1
@@ -35,6 +40,82 @@ MIN_STEP_SNR = 8.0
 SETTLE_TOL = 0.02
 #: Methods and least squares run on at most this many samples (block means).
 MAX_WORK_SAMPLES = 40000
+#: Fewest samples a step response may have.
+MIN_SAMPLES = 10
+
+
+def number_text(v) -> str:
+    """A number for a message: plain digits, never a numpy repr."""
+    return f"{float(v):.10g}"
+
+
+def _first_outside(x, rng) -> int | None:
+    """Index of the first value of ``x`` outside ``rng`` (a :class:`~designer.ranges.Range`),
+    or None; min and max first, so a valid record costs no temporary array."""
+    if rng.contains(float(np.min(x))) and rng.contains(float(np.max(x))):
+        return None
+    bad = np.nonzero((x < rng.lo) | (x > rng.hi))[0]
+    if bad.size:
+        return int(bad[0])
+    return int(np.argmin(x)) if not rng.contains(float(np.min(x))) else int(np.argmax(x))
+
+
+def check_samples(t, *signals, name: str = "capture", what=("time", "output", "input"),
+                  where=None) -> None:
+    """Refuse, with one line, a record no method can use.
+
+    Checks, in this order: every value finite; at least :data:`MIN_SAMPLES`
+    samples; time strictly increasing; every time inside
+    ``RANGES["capture_time_s"]`` and the record's duration inside
+    ``RANGES["capture_span_s"]``; every signal value inside
+    ``RANGES["capture_value"]``.
+
+    Parameters
+    ----------
+    t : array_like
+        Time, seconds.
+    *signals : array_like
+        Output (and input) samples, as long as ``t``.
+    name : str
+        The record's name for messages (a file name).
+    what : sequence of str
+        What ``t`` and each signal are, for messages.
+    where : callable, optional
+        ``where(i, k)`` names sample ``i`` of array ``k`` (0 is ``t``), e.g.
+        ``"line 12, column 2"``; default ``"sample i+1 of the <what>"``.
+    """
+    arrays = [np.asarray(t, float)] + [np.asarray(s, float) for s in signals]
+    if where is None:
+        def where(i, k):
+            return f"sample {i + 1} of the {what[k]}"
+    n = arrays[0].size
+    if any(a.ndim != 1 or a.size != n for a in arrays):
+        raise DesignError(f"{name}: time and signals must be 1-D arrays of the same length")
+    for k, a in enumerate(arrays):
+        if not np.isfinite(a).all():
+            i = int(np.argmin(np.isfinite(a)))
+            raise DesignError(f"{name}: {where(i, k)} is {number_text(a[i])}; NaN and infinite "
+                              "values are not allowed (remove or interpolate those samples)")
+    if n < MIN_SAMPLES:
+        raise DesignError(f"{name}: only {n} samples; a step response needs at least "
+                          f"{MIN_SAMPLES} (a few hundred is better)")
+    t = arrays[0]
+    if not (np.diff(t) > 0).all():
+        i = int(np.argmin(np.diff(t) > 0))
+        raise DesignError(f"{name}: time is not increasing at {where(i + 1, 0)} "
+                          f"({number_text(t[i])} then {number_text(t[i + 1])}); the first "
+                          "column must be time in seconds, strictly increasing")
+    i = _first_outside(t, RANGES["capture_time_s"])
+    if i is not None:
+        RANGES["capture_time_s"].check(t[i], f"{name}: {where(i, 0)}: {what[0]} (s)",
+                                       shown=number_text(t[i]))
+    RANGES["capture_span_s"].check(t[-1] - t[0], f"{name}: the record's duration (last "
+                                   "time - first time)", shown=number_text(t[-1] - t[0]) + " s")
+    for k, a in enumerate(arrays[1:], 1):
+        i = _first_outside(a, RANGES["capture_value"])
+        if i is not None:
+            RANGES["capture_value"].check(a[i], f"{name}: {where(i, k)}: {what[k]} value",
+                                          shown=number_text(a[i]))
 
 
 def noise_sigma(y) -> float:
@@ -48,8 +129,12 @@ def noise_sigma(y) -> float:
     y = np.asarray(y, float)
     if y.size < 5:
         return 0.0
-    d2 = y[2:] - 2.0 * y[1:-1] + y[:-2]
-    return float(np.median(np.abs(d2)) / 0.6745 / math.sqrt(6.0))
+    # in place: one temporary the size of the record, not four
+    d2 = np.multiply(y[1:-1], -2.0)
+    d2 += y[2:]
+    d2 += y[:-2]
+    np.abs(d2, out=d2)
+    return float(np.median(d2, overwrite_input=True) / 0.6745 / math.sqrt(6.0))
 
 
 @dataclass
@@ -355,6 +440,17 @@ def _check_step(y0, yf, sigma, what="the response"):
             f"no usable step in {what}: the change from the baseline ({y0:.4g}) to the final "
             f"value ({yf:.4g}) is {ratio:.1f} noise standard deviations; at least "
             f"{MIN_STEP_SNR:.0f} are needed (use a larger step or average captures)")
+    RANGES["output_step"].check(abs(span), f"the size of the step in {what} (final value - "
+                                "baseline)", shown=number_text(span))
+
+
+def _check_amplitude(amp: float, what: str) -> float:
+    """``amp`` if its size is inside ``RANGES["step_amplitude"]`` (either sign)."""
+    if not (math.isfinite(amp) and amp != 0):
+        raise DesignError(f"{what} must be a non-zero number; got {number_text(amp)}")
+    RANGES["step_amplitude"].check(abs(amp), f"the size of {what} (either sign)",
+                                   shown=number_text(amp))
+    return float(amp)
 
 
 def prepare_step(t, y, u=None, *, step_time: float | None = None,
@@ -375,10 +471,12 @@ def prepare_step(t, y, u=None, *, step_time: float | None = None,
     """
     t = np.asarray(t, float)
     y = np.asarray(y, float)
+    check_samples(t, y, *([] if u is None else [u]))
     notes = []
     if step_amplitude is not None:
-        if not (math.isfinite(step_amplitude) and step_amplitude != 0):
-            raise DesignError(f"step amplitude must be a non-zero number; got {step_amplitude}")
+        _check_amplitude(step_amplitude, "the step amplitude")
+    if step_time is not None:
+        RANGES["capture_time_s"].check(step_time, "the step time", shown=number_text(step_time))
     edges = []
     if u is not None and step_time is None:
         edges = find_edges(t, u)
@@ -393,12 +491,12 @@ def prepare_step(t, y, u=None, *, step_time: float | None = None,
         t_step = e.time
         # A given amplitude is a size; the edge says which way it went.
         amp = math.copysign(step_amplitude, e.amplitude) if step_amplitude is not None \
-            else e.amplitude
+            else _check_amplitude(e.amplitude, "the input column's step")
         notes.append(f"step detected in the input at t = {t_step:.6g} s, amplitude {amp:.6g}")
     else:
         if step_time is not None:
             if not (math.isfinite(step_time) and t[0] <= step_time < t[-1]):
-                raise DesignError(f"step time {step_time!r} s is outside the record "
+                raise DesignError(f"step time {number_text(step_time)} s is outside the record "
                                   f"[{t[0]:.6g}, {t[-1]:.6g}] s")
             t_step = float(step_time)
         elif t[0] < 0.0 <= t[-1]:
@@ -412,7 +510,7 @@ def prepare_step(t, y, u=None, *, step_time: float | None = None,
         if step_amplitude is not None:
             amp = float(step_amplitude)
         elif u is not None:
-            amp = _amplitude_from_u(t, u, t_step)
+            amp = _check_amplitude(_amplitude_from_u(t, u, t_step), "the input column's step")
         else:
             amp = 1.0
             notes.append("no input amplitude: gain is per unit input (pass --step-amplitude)")
@@ -420,7 +518,8 @@ def prepare_step(t, y, u=None, *, step_time: float | None = None,
     if n_pre == 0:
         notes.append("no samples before the step: baseline taken from the first sample")
     post = t >= t_step
-    tp, yp = t[post] - t_step, y[post]
+    tp, yp = t[post], y[post]
+    tp -= t_step
     if tp.size < 10:
         raise DesignError("fewer than 10 samples after the step; capture more of the response")
     sigma = noise_sigma(yp)
@@ -531,7 +630,7 @@ def _prepare_square(t, y, edges, step_amplitude, notes) -> PreparedStep:
                 "not settled before the next edge; use a lower frequency (half period >= 5 "
                 "settling times)") from None
         amp = math.copysign(step_amplitude, e.amplitude) if step_amplitude is not None \
-            else e.amplitude
+            else _check_amplitude(e.amplitude, "the input column's step")
         segs.append((e, tp, (yp - y0) / amp, y0, yf, amp))
     if not segs:
         raise DesignError("the square-wave capture has no complete step with a settled "
