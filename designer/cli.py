@@ -9,12 +9,13 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import sys
 
 from . import __version__, opamps
 from .eseries import SERIES
 from .errors import DesignError
-from .units import parse_positive, parse_value
+from .ranges import help_range, parse_in_range
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -84,25 +85,30 @@ def add_part_options(group):
     """E-series and value bounds for the parts (design-plant and design-pid)."""
     group.add_argument("--r-series", default="E24", help=f"resistor series: {', '.join(SERIES)} (default E24)")
     group.add_argument("--c-series", default="E12", help="capacitor series (default E12)")
-    group.add_argument("--r-min", default="1k", help="smallest resistor (default 1k)")
+    group.add_argument("--r-min", default="1k", help=f"smallest resistor (default 1k) {help_range('resistor_ohm')}")
     group.add_argument("--r-max", default="1M", help="largest resistor (default 1M)")
-    group.add_argument("--c-min", default="1n", help="smallest capacitor (default 1n)")
+    group.add_argument("--c-min", default="1n", help=f"smallest capacitor (default 1n) {help_range('capacitor_f')}")
     group.add_argument("--c-max", default="10u", help="largest capacitor (default 10u)")
 
 
 def part_options(args) -> dict:
     """The parsed :func:`add_part_options`, as spec keyword arguments."""
+    keys = {"r_min": "resistor_ohm", "r_max": "resistor_ohm", "c_min": "capacitor_f", "c_max": "capacitor_f"}
     return {"r_series": args.r_series, "c_series": args.c_series,
-            **{k: parse_positive(getattr(args, k), f"--{k.replace('_', '-')}")
-               for k in ("r_min", "r_max", "c_min", "c_max")}}
+            **{k: parse_in_range(getattr(args, k), f"--{k.replace('_', '-')}", key) for k, key in keys.items()}}
+
+
+def optional(text, name: str, key: str):
+    """:func:`parse_in_range`, or None for an option not given."""
+    return None if text is None else parse_in_range(text, name, key)
 
 
 def _common_output(p):
     g = p.add_argument_group("output")
     g.add_argument("--out", default=".", metavar="DIR",
                    help="write netlists/<name>.cir and reports/<name>/ under DIR (default: current directory)")
-    g.add_argument("--name", help="design name used for the files (default from the figures, "
-                                   "e.g. plant_fc3500_z0.2)")
+    g.add_argument("--name", help="design name used for the files: letters, digits and . _ - + = , @ "
+                                   "(default from the figures, e.g. plant_fc3500_z0.2)")
     g.add_argument("--json", action="store_true", help="print one JSON object on stdout instead of the summary")
     g.add_argument("--no-files", action="store_true", help="do not write the netlist and report files")
     s = p.add_argument_group("simulation")
@@ -113,10 +119,11 @@ def _common_output(p):
     s.add_argument("--opamp", default="LM741", metavar="NAME",
                    help=f"op-amp model: {', '.join(opamps.names())} (default LM741, as the seed's bench)")
     s.add_argument("--amplitude", default="2", metavar="V",
-                   help="bench square wave goes 0 -> V volts (default 2, as the seed's bench test)")
+                   help="bench square wave goes 0 -> V volts (default 2, as the seed's bench test) "
+                        + help_range("amplitude_v"))
     s.add_argument("--square-freq", metavar="HZ",
                    help="bench square-wave frequency (default: a round value whose half period is "
-                        "1.5x the 2 %% settling time; 330 Hz for the seed's plant)")
+                        "1.5x the 2 %% settling time; 330 Hz for the seed's plant) " + help_range("square_hz"))
 
 
 def _design_parser():
@@ -137,16 +144,22 @@ result.json, step.png, bode.png. Exit status 2 on bad input.""",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     t = p.add_argument_group("target")
-    t.add_argument("--fc", required=True, metavar="HZ", help="natural frequency fn = wn / 2 pi, Hz (e.g. 3500, 3.5k)")
-    t.add_argument("--zeta", required=True, metavar="Z", help="damping ratio, > 0 (>= 1 is overdamped)")
-    t.add_argument("--gain", default="1", metavar="K", help="DC gain K = 1 + R4/R3, >= 1 (default 1: follower)")
+    t.add_argument("--fc", required=True, metavar="HZ",
+                   help=f"natural frequency fn = wn / 2 pi, Hz (e.g. 3500, 3.5k) {help_range('fc_hz')}")
+    t.add_argument("--zeta", required=True, metavar="Z",
+                   help=f"damping ratio (>= 1 is overdamped) {help_range('zeta')}")
+    t.add_argument("--gain", default="1", metavar="K",
+                   help=f"DC gain K = 1 + R4/R3 (default 1: follower) {help_range('gain')}")
     t.add_argument("--compensate-gbw", action="store_true",
                    help="pre-distort the targets so the circuit lands on them with the op-amp's finite GBW")
     sel = p.add_argument_group("parts")
-    sel.add_argument("--r", metavar="OHM", help="the seed's procedure: fix R (R2 = R, R1 = m R) ...")
-    sel.add_argument("--c", metavar="F", help="... and C (C1 = C, C2 = n C), solve m and n")
+    sel.add_argument("--r", metavar="OHM", help="the seed's procedure: fix R (R2 = R, R1 = m R) ... "
+                                                "(resistors: " + help_range("resistor_ohm")[1:])
+    sel.add_argument("--c", metavar="F", help="... and C (C1 = C, C2 = n C), solve m and n "
+                                              "(capacitors: " + help_range("capacitor_f")[1:])
     add_part_options(sel)
-    sel.add_argument("--alternatives", default="5", help="how many best combinations to list (default 5)")
+    sel.add_argument("--alternatives", default="5",
+                     help=f"how many best combinations to list (default 5) {help_range('alternatives')}")
     _common_output(p)
     return p
 
@@ -154,28 +167,28 @@ result.json, step.png, bode.png. Exit status 2 on bad input.""",
 def _design(args) -> int:
     from .plant import PlantSpec, design_plant
     spec = PlantSpec(
-        fc_hz=parse_positive(args.fc, "--fc"), zeta=parse_positive(args.zeta, "--zeta"),
-        gain=parse_value(args.gain, "--gain"),
+        fc_hz=parse_in_range(args.fc, "--fc", "fc_hz"), zeta=parse_in_range(args.zeta, "--zeta", "zeta"),
+        gain=parse_in_range(args.gain, "--gain", "gain"),
         **part_options(args),
-        r=None if args.r is None else parse_positive(args.r, "--r"),
-        c=None if args.c is None else parse_positive(args.c, "--c"),
+        r=optional(args.r, "--r", "resistor_ohm"), c=optional(args.c, "--c", "capacitor_f"),
         opamp=args.opamp, compensate_gbw=args.compensate_gbw,
-        amplitude_v=parse_positive(args.amplitude, "--amplitude"),
-        square_hz=None if args.square_freq is None else parse_positive(args.square_freq, "--square-freq"),
+        amplitude_v=parse_in_range(args.amplitude, "--amplitude", "amplitude_v"),
+        square_hz=optional(args.square_freq, "--square-freq", "square_hz"),
         alternatives=_count(args.alternatives))
     spec.validate()
-    name = args.name or f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}")
-    _check_name(name)
+    name = args.name if args.name is not None else (
+        f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
+    check_name(name)
     if not args.no_files:
-        from .fileio import ensure_dir
-        ensure_dir(args.out)  # fail before the work, not after
+        from .fileio import check_can_create
+        check_can_create(args.out, ("netlists", "reports"))  # fail before the work, not after
     result = design_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
     return _emit(result, args, name)
 
 
 def _count(text) -> int:
     try:
-        n = int(str(text))
+        n = int(str(text).strip())
     except ValueError:
         raise DesignError(f"--alternatives must be a whole number from 1 to 50, got {text!r}") from None
     if not 1 <= n <= 50:
@@ -183,9 +196,17 @@ def _count(text) -> int:
     return n
 
 
-def _check_name(name):
-    if not name or "/" in name or name.startswith("."):
-        raise DesignError(f"--name {name!r} must be a plain file name (no '/', not starting with '.')")
+_NAME = re.compile(r"^[A-Za-z0-9_+=,@-][A-Za-z0-9._+=,@-]{0,119}$")
+
+
+def check_name(name) -> str:
+    """A design name is a plain file name: letters, digits and ``. _ - + = , @``, not
+    starting with '.', at most 120 characters (it names a folder and a netlist)."""
+    if not _NAME.match(name or ""):
+        what = "must not be empty" if not name else f"{name[:40]!r} is not a plain file name"
+        raise DesignError(f"--name {what}: use letters, digits and . _ - + = , @ (not starting with '.', "
+                          "at most 120 characters)")
+    return name
 
 
 def _emit(result, args, name) -> int:
@@ -222,16 +243,20 @@ def _analyze_parser():
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     g = p.add_argument_group("parts")
-    for n, what in (("r1", "input resistor, ohms"), ("r2", "resistor to the non-inverting input, ohms"),
-                    ("c1", "non-inverting input to ground, farads"), ("c2", "feedback capacitor, farads")):
-        g.add_argument(f"--{n}", required=True, help=what)
-    g.add_argument("--gain", default=None, metavar="K", help="gain K = 1 + R4/R3 (default 1)")
+    for n, what, key in (("r1", "input resistor, ohms", "resistor_ohm"),
+                         ("r2", "resistor to the non-inverting input, ohms", "resistor_ohm"),
+                         ("c1", "non-inverting input to ground, farads", "capacitor_f"),
+                         ("c2", "feedback capacitor, farads", "capacitor_f")):
+        g.add_argument(f"--{n}", required=True, help=f"{what} {help_range(key)}")
+    g.add_argument("--gain", default=None, metavar="K", help=f"gain K = 1 + R4/R3 (default 1) {help_range('gain')}")
     g.add_argument("--r3", help="gain resistor to ground (with --r4, instead of --gain)")
     g.add_argument("--r4", help="gain feedback resistor")
-    g.add_argument("--fc", help="target fn, Hz, to report errors against (optional)")
-    g.add_argument("--zeta", help="target damping, to report errors against (optional)")
-    g.add_argument("--r-series", default="E24", help="series the resistors come from, for the tolerance band")
-    g.add_argument("--c-series", default="E12", help="series the capacitors come from, for the tolerance band")
+    g.add_argument("--fc", help=f"target fn, Hz, to report errors against (optional) {help_range('fc_hz')}")
+    g.add_argument("--zeta", help=f"target damping, to report errors against (optional) {help_range('zeta')}")
+    g.add_argument("--r-series", default=None, help="series the resistors come from, for the tolerance band "
+                                                    "(default: the smallest series that holds each value)")
+    g.add_argument("--c-series", default=None, help="series the capacitors come from, for the tolerance band "
+                                                    "(default: the smallest series that holds each value)")
     _common_output(p)
     return p
 
@@ -239,38 +264,42 @@ def _analyze_parser():
 def _analyze(args) -> int:
     from .plant import analyze_plant
     from .sallenkey import SallenKeyParts
+    from .units import value_code
     r3 = r4 = None
     if (args.r3 is None) != (args.r4 is None):
         raise DesignError("--r3 and --r4 go together (K = 1 + R4/R3)")
     if args.r3 is not None:
         if args.gain is not None:
             raise DesignError("give either --gain or --r3/--r4, not both")
-        r3, r4 = parse_positive(args.r3, "--r3"), parse_positive(args.r4, "--r4")
+        r3, r4 = parse_in_range(args.r3, "--r3", "resistor_ohm"), parse_in_range(args.r4, "--r4", "resistor_ohm")
         gain = 1 + r4 / r3
     else:
-        gain = 1.0 if args.gain is None else parse_value(args.gain, "--gain")
-        if not gain >= 1:
-            raise DesignError(f"--gain must be >= 1 (K = 1 + R4/R3), got {args.gain!r}")
+        gain = 1.0 if args.gain is None else parse_in_range(args.gain, "--gain", "gain")
         if gain != 1:
             r3, r4 = 10e3, (gain - 1) * 10e3
-    parts = SallenKeyParts(parse_positive(args.r1, "--r1"), parse_positive(args.r2, "--r2"),
-                           parse_positive(args.c1, "--c1"), parse_positive(args.c2, "--c2"), gain, r3, r4)
-    fc = None if args.fc is None else parse_positive(args.fc, "--fc")
-    zeta = None if args.zeta is None else parse_positive(args.zeta, "--zeta")
+    vals = {n: parse_in_range(getattr(args, n), f"--{n}", "resistor_ohm" if n[0] == "r" else "capacitor_f")
+            for n in ("r1", "r2", "c1", "c2")}
+    parts = SallenKeyParts(vals["r1"], vals["r2"], vals["c1"], vals["c2"], gain, r3, r4)
+    fc = optional(args.fc, "--fc", "fc_hz")
+    zeta = optional(args.zeta, "--zeta", "zeta")
     from .eseries import series_name
-    series_name(args.r_series), series_name(args.c_series)
+    for s in (args.r_series, args.c_series):
+        if s is not None:
+            series_name(s)
     opamps.get(args.opamp)
-    name = args.name or "built_" + "_".join(
-        f"{k}{v}" for k, v in (("r1", args.r1), ("r2", args.r2), ("c1", args.c1), ("c2", args.c2)))
-    _check_name(name)
+    name = args.name if args.name is not None else "built_" + "_".join(f"{k}{value_code(v)}" for k, v in vals.items())
+    check_name(name)
+    amplitude = parse_in_range(args.amplitude, "--amplitude", "amplitude_v")
+    square = optional(args.square_freq, "--square-freq", "square_hz")
     if not args.no_files:
-        from .fileio import ensure_dir
-        ensure_dir(args.out)
-    result = analyze_plant(parts, args.opamp, fc, zeta, args.r_series, args.c_series,
-                           parse_positive(args.amplitude, "--amplitude"),
-                           None if args.square_freq is None else parse_positive(args.square_freq, "--square-freq"),
+        from .fileio import check_can_create
+        check_can_create(args.out, ("netlists", "reports"))
+    result = analyze_plant(parts, args.opamp, fc, zeta, args.r_series, args.c_series, amplitude, square,
                            simulate=not args.no_sim, simulator=args.simulator)
     return _emit(result, args, name)
+
+
+_check_name = check_name   # the name design-pid imports
 
 
 def design_plant_main(argv=None) -> int:

@@ -82,6 +82,18 @@ def values(series: str, lo: float, hi: float) -> np.ndarray:
     return np.unique(allv[keep])
 
 
+def smallest_series(value: float):
+    """The coarsest series (E3 first) that holds ``value`` (any decade), or None
+    for a value no series has (e.g. 1k26 is E192 only; 1.234k is none)."""
+    if not (value > 0 and np.isfinite(value)):
+        return None
+    mant = value / 10.0 ** np.floor(np.log10(value))
+    for name, vals in SERIES.items():
+        if np.any(np.abs(np.asarray(vals) / mant - 1) < 1e-6) or abs(mant / 10 - 1) < 1e-6 and 1.0 in vals:
+            return name
+    return None
+
+
 def nearest(value: float, series: str = "E24") -> float:
     """The series value nearest to ``value`` by log distance (no bounds)."""
     if not value > 0:

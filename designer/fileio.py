@@ -54,6 +54,22 @@ def ensure_dir(path) -> Path:
     return path
 
 
+def check_can_create(path, subdirs=()) -> Path:
+    """Fail early, creating nothing, when ``path`` (and ``path/<subdir>``) could
+    not be made directories: the nearest existing ancestor must be a writable
+    directory, and whatever exists on the way must be a directory."""
+    path = Path(path)
+    for p in [path / d for d in subdirs] + [path] + list(path.parents):
+        if os.path.lexists(p):
+            if not p.is_dir():
+                raise DesignError(f"cannot create directory {str(p)!r}: a file of that name exists")
+            if p == path or p in path.parents:
+                if not os.access(p, os.W_OK | os.X_OK):
+                    raise DesignError(f"cannot write to directory {str(p)!r}: permission denied")
+                break
+    return path
+
+
 def atomic_write(path, data, mode: str = "w") -> Path:
     """Write ``data`` (str or bytes) to ``path`` through a temporary file and rename."""
     path = Path(path)

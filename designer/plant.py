@@ -23,9 +23,11 @@ from .models import (dense_time, dominant_pair, plant_tf, plant_tf_opamp, respon
                      sensitivities, step_response)
 from .netlist import SquareTest, plant_deck
 from .opamps import OpAmp
+from .ranges import RANGES
 from .report import json_safe
-from .sallenkey import (SallenKeyParts, check_spec, ratios_from_rc, realizability_notes,
+from .sallenkey import (SallenKeyParts, check_parts, ratios_from_rc, realizability_notes,
                         resistors_for_caps)
+from .units import format_eng, value_code
 from .selection import around, brute_force, joint_search
 from .simulate import get_simulator
 
@@ -52,15 +54,27 @@ class PlantSpec:
     alternatives: int = 5
 
     def validate(self) -> None:
-        check_spec(self.fc_hz, self.zeta, self.gain)
+        """Every value inside its physical range (:mod:`designer.ranges`), the
+        options consistent; a :class:`DesignError` naming the option otherwise."""
+        R = RANGES
+        R["fc_hz"].check(self.fc_hz, "--fc")
+        R["zeta"].check(self.zeta, "--zeta")
+        R["gain"].check(self.gain, "--gain")
+        for name, v in (("--r-min", self.r_min), ("--r-max", self.r_max)):
+            R["resistor_ohm"].check(v, name)
+        for name, v in (("--c-min", self.c_min), ("--c-max", self.c_max)):
+            R["capacitor_f"].check(v, name)
         self.r_series, self.c_series = eseries.check_bounds(
             self.r_series, self.c_series, self.r_min, self.r_max, self.c_min, self.c_max)
-        if not (math.isfinite(self.amplitude_v) and self.amplitude_v > 0):
-            raise DesignError(f"--amplitude must be a positive finite number of volts, got {self.amplitude_v!r}")
+        R["amplitude_v"].check(self.amplitude_v, "--amplitude")
         if (self.r is None) != (self.c is None):
             raise DesignError("--r and --c go together (the seed's procedure fixes both R and C)")
-        if self.square_hz is not None and not (math.isfinite(self.square_hz) and self.square_hz > 0):
-            raise DesignError(f"square-wave frequency must be above 0 Hz, got {self.square_hz!r}")
+        if self.r is not None:
+            R["resistor_ohm"].check(self.r, "--r")
+            R["capacitor_f"].check(self.c, "--c")
+        if self.square_hz is not None:
+            R["square_hz"].check(self.square_hz, "--square-freq")
+        R["alternatives"].check(self.alternatives, "--alternatives")
         opamps.get(self.opamp)
 
 
@@ -212,39 +226,149 @@ def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspi
     built = SallenKeyParts(best.r1, best.r2, best.c1, best.c2, k, r3, r4)
     if best.worst > MAX_ERROR:
         raise DesignError(_unreachable(spec, fc_t, best.worst))
+    if spec.r is None and best.worst > NOTE_ERROR:
+        notes += _bound_notes(spec, fc_t, z_t, k, best.worst)
     t_search = time.perf_counter() - tick
     result = _analyse(built, ideal, amp, spec.r_series, spec.c_series,
                       {"fc_hz": spec.fc_hz, "zeta": spec.zeta, "gain": spec.gain},
                       ratios, notes, spec.amplitude_v, spec.square_hz, simulate, simulator)
     result.alternatives = [_alt(c, spec.fc_hz, spec.zeta) for c in ranked]
+    result.series["parts"] = {ref: {"series": spec.r_series if ref[0] == "R" else spec.c_series,
+                                    "tolerance_pct": 100 * eseries.TOLERANCE[spec.r_series if ref[0] == "R"
+                                                                             else spec.c_series]}
+                              for ref in ("R1", "R2", "C1", "C2") + (("R3", "R4") if built.r3 is not None else ())}
     if spec.compensate_gbw:
         result.notes.append(f"--compensate-gbw: designed for fn {fc_t:.5g} Hz, zeta {z_t:.4g} so that with "
                             f"the {amp.name}'s {amp.gbw_hz / 1e6:g} MHz GBW it lands on the spec")
+    elif not amp.ideal:
+        e_fn, e_z = result.fn_opamp_hz / spec.fc_hz - 1, result.zeta_opamp / spec.zeta - 1
+        if max(abs(e_fn), abs(e_z)) > NOTE_ERROR * 2:
+            result.notes.append(
+                f"with the {amp.name}'s {format_eng(amp.gbw_hz, 'Hz')} gain-bandwidth the circuit lands "
+                f"{100 * e_fn:+.3g} % off in fn and {100 * e_z:+.3g} % in zeta; --compensate-gbw aims the "
+                "design off so that it lands on the spec (or choose a faster --opamp)")
     result.timings = {"search_s": t_search, **result.timings}
     return result
 
 
 def analyze_plant(parts: SallenKeyParts, opamp: str = "LM741", target_fc=None, target_zeta=None,
-                  r_series: str = "E24", c_series: str = "E12", amplitude_v: float = 2.0,
+                  r_series: str | None = None, c_series: str | None = None, amplitude_v: float = 2.0,
                   square_hz=None, simulate: bool = True, simulator: str = "pyspice") -> PlantResult:
-    """Analyse parts as built (e.g. the seed's rounded 820/1k/10n/220n)."""
-    for name, v in (("R1", parts.r1), ("R2", parts.r2), ("C1", parts.c1), ("C2", parts.c2)):
-        if not (math.isfinite(v) and v > 0):
-            raise DesignError(f"{name} must be a positive value, got {v!r}")
-    if parts.zeta <= 0:
-        raise DesignError(f"these parts give zeta = {parts.zeta:.4g} <= 0: the circuit oscillates")
+    """Analyse parts as built (e.g. the seed's rounded 820/1k/10n/220n).
+
+    ``r_series``/``c_series``: where the parts come from, for their tolerance;
+    None labels each part with the smallest series that holds its value.
+    """
+    parts = check_parts(parts)
+    for name, v, key in (("target fc", target_fc, "fc_hz"), ("target zeta", target_zeta, "zeta")):
+        if v is not None:
+            RANGES[key].check(v, name)
+    RANGES["amplitude_v"].check(amplitude_v, "amplitude")
+    if square_hz is not None:
+        RANGES["square_hz"].check(square_hz, "square-wave frequency")
     amp = opamps.get(opamp)
     spec = {"fc_hz": target_fc, "zeta": target_zeta, "gain": parts.gain}
     notes = [f"these parts give fn = {parts.fn_hz:.5g} Hz and zeta = {parts.zeta:.4g} (Q = {parts.q:.4g})"]
-    res = _analyse(parts, None, amp, eseries.series_name(r_series), eseries.series_name(c_series), spec,
-                   {"m": parts.r1 / parts.r2, "n": parts.c2 / parts.c1}, notes, amplitude_v, square_hz,
-                   simulate, simulator)
+    values = {"R1": parts.r1, "R2": parts.r2, "C1": parts.c1, "C2": parts.c2}
+    if parts.r3 is not None:
+        values.update(R3=parts.r3, R4=parts.r4)
+    labels, r_s, c_s, why = part_series(values, r_series, c_series)
+    notes += why
+    res = _analyse(parts, None, amp, r_s, c_s, spec, {"m": parts.r1 / parts.r2, "n": parts.c2 / parts.c1},
+                   notes, amplitude_v, square_hz, simulate, simulator)
+    res.series["parts"] = labels
     res.mode = "analyze"
     return res
 
 
+#: what an unlabelled part is assumed to be: a 5 % resistor, a 10 % capacitor
+DEFAULT_SERIES = {"R": "E24", "C": "E12"}
+
+
+def part_series(values: dict, r_series=None, c_series=None):
+    """Each part's series label and tolerance, and the series whose tolerance the band
+    uses (the loosest part's, worst case).
+
+    With a series given, every part of that kind is from it. Without, a part is
+    labelled with the smallest series that holds its value ("not a standard value"
+    when none does) and assumed at least as tight as the default E24 resistor /
+    E12 capacitor: a 1k from a 5 % kit is not a 40 % E3 part, but a 1k26 exists
+    only as an E192 (0.5 %) part.
+
+    Returns (labels {ref: {"series", "tolerance_pct"}}, r band series, c band series, notes).
+    """
+    order = list(eseries.SERIES)
+    given = {"R": None if r_series is None else eseries.series_name(r_series),
+             "C": None if c_series is None else eseries.series_name(c_series)}
+    labels, band, notes = {}, {"R": None, "C": None}, []
+    for ref, v in values.items():
+        kind = ref[0]
+        found = eseries.smallest_series(v)
+        if given[kind] is not None:
+            series = given[kind]
+            label = series if found is not None and order.index(found) <= order.index(series) \
+                else f"{series} (not an {series} value)"
+        elif found is None:
+            series, label = DEFAULT_SERIES[kind], "not a standard value"
+            notes.append(f"{ref} = {format_eng(v, 'Ohm' if kind == 'R' else 'F')} is not a standard E-series value; its tolerance is "
+                         f"taken as {100 * eseries.TOLERANCE[series]:g} %")
+        else:
+            series = order[max(order.index(found), order.index(DEFAULT_SERIES[kind]))]
+            label = found
+        labels[ref] = {"series": label, "tolerance_pct": 100 * eseries.TOLERANCE[series]}
+        if band[kind] is None or eseries.TOLERANCE[series] > eseries.TOLERANCE[band[kind]]:
+            band[kind] = series
+    return labels, band["R"] or DEFAULT_SERIES["R"], band["C"] or DEFAULT_SERIES["C"], notes
+
+
 #: a design further off than this is refused, with the reason
 MAX_ERROR = 0.05
+#: a design further off than this says which bound holds it back (and, at twice it,
+#: that the op-amp's gain-bandwidth moves it)
+NOTE_ERROR = 0.005
+
+
+def _bound_notes(spec: PlantSpec, fc: float, zeta: float, gain: float, worst: float) -> list:
+    """Which part bound keeps the design ``worst`` off. Each bound is relaxed by a
+    decade (within the physical ranges) and the search run again; where that at
+    least halves the error, the bound is named with the mildest series value
+    that gets nearly all of the gain (bisection over the values in between: the
+    error only falls as a bound is relaxed)."""
+    from dataclasses import replace as _replace
+    out = []
+    tries = (("--r-min", "r_min", 0.1, "resistor_ohm", "Ohm", "r_series"),
+             ("--r-max", "r_max", 10.0, "resistor_ohm", "Ohm", "r_series"),
+             ("--c-min", "c_min", 0.1, "capacitor_f", "F", "c_series"),
+             ("--c-max", "c_max", 10.0, "capacitor_f", "F", "c_series"))
+
+    def best_with(attr, value):
+        s2 = _replace(spec, **{attr: value})
+        rv = eseries.values(s2.r_series, s2.r_min, s2.r_max)
+        cv = eseries.values(s2.c_series, s2.c_min, s2.c_max)
+        return joint_search(fc, zeta, rv, cv, gain, top=1)[0].worst if rv.size and cv.size else math.inf
+
+    for flag, attr, factor, key, unit, series in tries:
+        rng, bound = RANGES[key], getattr(spec, attr)
+        relaxed = min(max(bound * factor, rng.lo), rng.hi)
+        if relaxed == bound:
+            continue
+        floor = best_with(attr, relaxed)
+        if not floor <= worst / 2:
+            continue
+        # mildest relaxation first: values from just past the bound out to the decade
+        steps = eseries.values(getattr(spec, series), min(bound, relaxed), max(bound, relaxed))
+        steps = steps[steps != bound][::-1] if factor < 1 else steps[steps != bound]
+        lo, hi = 0, len(steps) - 1           # steps[hi] (the decade) reaches the floor
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if best_with(attr, steps[mid]) <= floor * 1.1 + 1e-9:
+                hi = mid
+            else:
+                lo = mid + 1
+        value = steps[lo] if len(steps) else relaxed
+        out.append(f"the design is {100 * worst:.3g} % off because of {flag} ({format_eng(bound, unit)}): "
+                   f"{flag} {value_code(value)} gets it within {100 * best_with(attr, value):.2g} %")
+    return out
 
 
 def _unreachable(spec: PlantSpec, fc: float, worst: float) -> str:

@@ -26,13 +26,13 @@ def sections(result, with_images: bool = True) -> list:
     b = result.built
     ser = result.series
     amp = result.opamp
-    bom = [R.part_row("R1", b.r1, "Ohm", "input resistor", ser["r"], ser["r_tolerance_pct"]),
-           R.part_row("R2", b.r2, "Ohm", "to the non-inverting input", ser["r"], ser["r_tolerance_pct"]),
-           R.part_row("C1", b.c1, "F", "non-inverting input to ground", ser["c"], ser["c_tolerance_pct"]),
-           R.part_row("C2", b.c2, "F", "R1-R2 node to the output (feedback)", ser["c"], ser["c_tolerance_pct"])]
-    if b.r3 is not None:
-        bom += [R.part_row("R3", b.r3, "Ohm", "gain: inverting input to ground", ser["r"], ser["r_tolerance_pct"]),
-                R.part_row("R4", b.r4, "Ohm", "gain: output to inverting input", ser["r"], ser["r_tolerance_pct"])]
+    lab = ser["parts"]
+    where = {"R1": "input resistor", "R2": "to the non-inverting input", "C1": "non-inverting input to ground",
+             "C2": "R1-R2 node to the output (feedback)", "R3": "gain: inverting input to ground",
+             "R4": "gain: output to inverting input"}
+    bom = [R.part_row(ref, getattr(b, ref.lower()), "Ohm" if ref[0] == "R" else "F", role,
+                      lab[ref]["series"], lab[ref]["tolerance_pct"])
+           for ref, role in where.items() if ref in lab]
     bom.append(["U1", amp.name, "", "", "", f"op-amp on {amp.vcc:g} V / {amp.vee:g} V"
                 + (" (follower: output to inverting input)" if b.r3 is None else "")])
     out = [("Bill of materials", [R.table(["Ref", "Value", "Code", "Series", "Tolerance", "Where"], bom)]),

@@ -179,8 +179,9 @@ def bundle_paths(out_dir, name: str, images, extra: dict = None) -> dict:
     key -> file name in the report folder) and ``netlists/<name>.cir``, a link to
     that deck. Creates ``netlists/`` and ``reports/`` only."""
     from pathlib import Path
-    from .fileio import ensure_dir
+    from .fileio import check_can_create, ensure_dir
     out_dir = Path(out_dir)
+    check_can_create(out_dir, ("netlists", "reports"))   # both, before creating either
     net_dir = ensure_dir(out_dir / "netlists")
     rep_dir = ensure_dir(out_dir / "reports") / name
     files = {"netlist": str(net_dir / f"{name}.cir"),

@@ -50,3 +50,17 @@ def test_check_bounds_names_the_option():
         eseries.check_bounds("E24", "E12", 1e6, 1e3, 1e-9, 1e-5)
     with pytest.raises(DesignError, match="--c-max must be a positive"):
         eseries.check_bounds("E24", "E12", 1e3, 1e6, 1e-9, float("inf"))
+
+
+def test_smallest_series_holds_the_value_and_is_the_coarsest():
+    """Brute force over every value of every series, in several decades."""
+    from designer.eseries import SERIES, smallest_series
+    order = list(SERIES)
+    for name, vals in SERIES.items():
+        for v in vals:
+            for dec in (1e-12, 1e-3, 1.0, 1e3, 1e6):
+                found = smallest_series(v * dec)
+                assert order.index(found) <= order.index(name)
+                assert v in SERIES[found]
+                assert all(v not in SERIES[coarser] for coarser in order[:order.index(found)])
+    assert smallest_series(1234.0) is None and smallest_series(0.0) is None
