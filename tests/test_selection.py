@@ -1,10 +1,32 @@
+import tracemalloc
+
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
+from designer import selection
 from designer.eseries import nearest, values
+from designer.ranges import RANGES
 from designer.sallenkey import SallenKeyParts, ratios_from_rc
 from designer.selection import brute_force, joint_search
+
+#: Peak numpy memory the search may use, whatever the series and bounds (the
+#: benchmark's goal is 300 MB for the whole design-plant process).
+SEARCH_MEMORY_BYTES = 64e6
+
+
+def parts(cands):
+    return [(c.r1, c.r2, c.c1, c.c2) for c in cands]
+
+
+def peak_bytes(fn, *args, **kw):
+    """Peak memory traced (numpy's allocations included) while ``fn`` runs, and its result."""
+    tracemalloc.start()
+    try:
+        out = fn(*args, **kw)
+        return tracemalloc.get_traced_memory()[1], out
+    finally:
+        tracemalloc.stop()
 
 
 @settings(max_examples=60, deadline=None)
@@ -51,3 +73,47 @@ def test_results_are_sorted_and_unique():
     worst = [c.worst for c in res]
     assert worst == sorted(worst)
     assert len({(c.r1, c.r2, c.c1, c.c2) for c in res}) == len(res)
+
+
+@settings(max_examples=80, deadline=None)
+@given(fc=st.floats(1e-2, 1e7), zeta=st.floats(0.01, 10.0), gain=st.sampled_from([1.0, 1.5, 2.0, 10.0, 100.0]),
+       rs=st.sampled_from(["E3", "E6", "E12"]), cs=st.sampled_from(["E3", "E6"]),
+       r_lo=st.floats(-1, 6), r_span=st.floats(0, 2.5), c_lo=st.floats(-13, -3), c_span=st.floats(0, 3),
+       top=st.sampled_from([1, 4, 20, 200]))
+def test_chunked_search_lists_exactly_the_brute_force_ranking(fc, zeta, gain, rs, cs, r_lo, r_span, c_lo,
+                                                              c_span, top):
+    # chunks of a few pairs, rows and candidates, and a seed from 2 pairs: every chunk
+    # boundary and the bound's tightening are exercised, including unreachable targets
+    # (errors above 100 %) and ties
+    rv = values(rs, 10 ** r_lo, 10 ** (r_lo + r_span))
+    cv = values(cs, 10 ** c_lo, 10 ** (c_lo + c_span))
+    if rv.size == 0 or cv.size == 0:
+        return
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(selection, "PAIRS_PER_CHUNK", 3)
+        mp.setattr(selection, "ROWS_PER_BATCH", 7)
+        mp.setattr(selection, "SEED_PAIRS", 2)
+        fast = joint_search(fc, zeta, rv, cv, gain, top=top)
+    assert parts(fast) == parts(brute_force(fc, zeta, rv, cv, gain, top=top))
+
+
+def test_fine_series_search_memory_is_bounded():
+    # issue 7: E96/E96 took 1.8 GB (capacitor pairs x resistors materialised at once)
+    rv, cv = values("E96", 1e3, 1e6), values("E96", 1e-9, 1e-5)
+    peak, res = peak_bytes(joint_search, 3500, 0.2, rv, cv, top=20)
+    assert peak < SEARCH_MEMORY_BYTES and len(res) == 20
+
+
+def test_widest_bounds_search_memory_is_bounded():
+    # every E192 resistor the CLI accepts, E192 capacitors over the default decades
+    r, c = RANGES["resistor_ohm"], RANGES["capacitor_f"]
+    rv, cv = values("E192", r.lo, r.hi), values("E192", 1e-9, 1e-5)
+    peak, res = peak_bytes(joint_search, 3500, 0.2, rv, cv, top=20)
+    assert peak < SEARCH_MEMORY_BYTES
+    # the same best as on the default bounds, or better (more resistors to choose from)
+    assert res[0].worst <= joint_search(3500, 0.2, values("E192", 1e3, 1e6), cv, top=1)[0].worst
+    # a target out of reach of narrow capacitor bounds: the error bound starts loose
+    # (every combination is above 100 % off) and still the memory stays bounded
+    peak, res = peak_bytes(joint_search, 3500, 0.01, rv, values("E192", 1e-9, 1e-8), top=200)
+    assert peak < SEARCH_MEMORY_BYTES
+    assert len(res) == 200 and res[0].worst > 1
