@@ -42,8 +42,22 @@ available, and least-squares fits (fopdt, overdamped, underdamped) with 95 %
 confidence intervals. Parameters: K, tau_s, theta_s; K, wn_rad_s, zeta,
 theta_s; K, tau1_s, tau2_s, theta_s.
 
+limits: a capture of at most {size} and {rows:,} samples; every time
+{t_rng} and the record {span_rng} long; every sample {v_rng}
+(file units); the output's step {step_rng} in size.
+
 exit status: 0 success, 2 bad input (one line on stderr saying what and why).
 """
+
+
+def epilog() -> str:
+    """The --help epilog with the input limits filled in."""
+    from .identify.textfile import MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, size_text
+    return EPILOG.format(size=size_text(MAX_CAPTURE_BYTES), rows=MAX_CAPTURE_ROWS,
+                         t_rng=RANGES["capture_time_s"].text(),
+                         span_rng=RANGES["capture_span_s"].text(),
+                         v_rng=RANGES["capture_value"].text(),
+                         step_rng=RANGES["output_step"].text())
 
 
 def step_time(text) -> float:
@@ -67,7 +81,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = OneLineParser(prog="identify",
                 description="Identify plant models (FOPDT, double pole, second order with dead\n"
                             "time) from a measured or simulated step response, ranked by IAE.",
-                epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+                epilog=epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("capture", help="CSV file with the step response")
     p.add_argument("--step-time", metavar="T",
                    help="when the input stepped, in seconds " + help_range("capture_time_s")
@@ -124,18 +138,18 @@ def check_output_path(path, option: str) -> None:
     from .identify.textfile import shown
     p = Path(path)
     try:
-        if str(path) in ("", ".", "..") or p.is_dir():
-            raise DesignError(f"{option} {shown(path)} is a directory; give a file name such "
-                              "as fit.png")
-        for parent in p.parents:
-            if parent.exists():
-                if not parent.is_dir():
-                    raise DesignError(f"{option} {shown(path)}: {shown(parent)} is a file, "
-                                      "not a directory")
-                break
+        is_dir = str(path) in ("", ".", "..") or p.is_dir()
+        blocker = next((q for q in p.parents if q.exists()), None)
+        blocked = blocker is not None and not blocker.is_dir()
     except (OSError, ValueError) as exc:   # a name too long, a NUL byte
         raise DesignError(f"{option} {shown(path)} is not a usable file name: "
                           f"{getattr(exc, 'strerror', None) or exc}") from None
+    if is_dir:
+        raise DesignError(f"{option} {shown(path)} is a directory; give a file name such as "
+                          "fit.png")
+    if blocked:
+        raise DesignError(f"{option} {shown(path)}: cannot create directory {shown(blocker)}: "
+                          "a file of that name exists")
 
 
 def write_png(path, fig, option: str = "--plot") -> None:

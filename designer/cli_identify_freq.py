@@ -14,7 +14,11 @@ import math
 import sys
 
 from .cli import OneLineParser, print_output, run_cli
-from .report import json_safe, png_bytes
+from .cli_identify import check_output_path, write_png
+from .identify.frequency import (BAND_FACTOR, FREQ_UNITS, GAIN_UNITS, MAX_FIT_ERROR,
+                                 PHASE_UNITS)
+from .identify.textfile import MAX_TABLE_BYTES, size_text
+from .report import json_safe
 from .units import format_eng
 
 EPILOG = """\
@@ -40,23 +44,45 @@ model does not explain.
 
 fit error (the iae/ise columns): e = |G_model/G_data - 1| at each tabulated
 frequency (gain only without phase); iae = mean of e, ise = mean of e^2.
+A model is valid (ok = yes) when its fit error is at most {max_err:g} % and its
+corner frequencies (1/tau, wn) lie inside the measured band widened {band:g} times.
+
+limits: a table of at most {size} and {rows:,} rows; frequency {f_rng},
+gain {db_rng} (ratio {ratio_rng}), phase {ph_rng} degrees
+(after unit conversion).
 
 exit status: 0 success, 2 bad input (one line on stderr saying what and why).
 """
 
 
+def epilog() -> str:
+    """The --help epilog with the validity rule and the input limits filled in."""
+    from .identify.frequency import MAX_POINTS
+    from .ranges import RANGES
+    return EPILOG.format(max_err=100 * MAX_FIT_ERROR, band=BAND_FACTOR,
+                         size=size_text(MAX_TABLE_BYTES), rows=MAX_POINTS,
+                         f_rng=RANGES["freq_hz"].text(), db_rng=RANGES["gain_db"].text(),
+                         ratio_rng=RANGES["gain_ratio"].text(),
+                         ph_rng=RANGES["phase_deg"].text())
+
+
+def _lower(text: str) -> str:
+    return text.strip().lower()
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = OneLineParser(prog="identify-freq",
                 description=__doc__.split("\n\n")[0].strip().replace("``", ""),
-                epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+                epilog=epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("table", help="CSV table: frequency, gain[, phase]")
-    p.add_argument("--gain-units", choices=("db", "ratio"),
+    # units in any case: dB, Hz, Rad/s
+    p.add_argument("--gain-units", choices=GAIN_UNITS, type=_lower,
                    help="gain in decibels or as the amplitude ratio Vout/Vin (default: from the "
                         "header, else db)")
-    p.add_argument("--phase-units", choices=("deg", "rad", "s"),
+    p.add_argument("--phase-units", choices=PHASE_UNITS, type=_lower,
                    help="phase in degrees, radians, or the output's time shift in seconds "
                         "(default: from the header, else deg)")
-    p.add_argument("--freq-units", choices=("hz", "rad/s"),
+    p.add_argument("--freq-units", choices=FREQ_UNITS, type=_lower,
                    help="frequency in Hz or rad/s (default: from the header, else hz)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
     p.add_argument("--plot", metavar="OUT_PNG", help="write a Bode plot of the data and the fits")
@@ -78,7 +104,9 @@ def to_text(result) -> str:
              f"{format_eng(d.f_hz[0], 'Hz')} to {format_eng(d.f_hz[-1], 'Hz')}, "
              f"gain in {d.units['gain']}, "
              + (f"phase in {d.units['phase']}" if d.phase is not None else "no phase")
-             + (" (inverting: K < 0)" if d.sign < 0 else ""), "",
+             + (" (inverting: K < 0)" if d.sign < 0 else "")]
+    lines += [f"  note: {n}" for n in d.notes]
+    lines += ["",
              "Methods ranked by fit error (mean |G_model/G_data - 1| over the table; "
              "lower is better)"]
     head = f"{'#':>2}  {'method':<15} {'model':<12} {'parameters':<84} {'error':>9}  ok"
@@ -102,7 +130,6 @@ def plot_bode(result, path, n_models: int = 3) -> None:
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from .fileio import atomic_write
     from .identify.frequency import model_phase, model_response
 
     d = result.data
@@ -132,12 +159,14 @@ def plot_bode(result, path, n_models: int = 3) -> None:
         ax_p.grid(True, which="both", alpha=0.3)
     axes[-1][0].set_xlabel("frequency (Hz)")
     fig.tight_layout()
-    atomic_write(path, png_bytes(fig))
+    write_png(path, fig)
 
 
 def run(args):
     """Identify from parsed arguments, write the plot; return the result."""
     from .identify.frequency import identify_freq, read_freq_table
+    if args.plot:
+        check_output_path(args.plot, "--plot")
     data = read_freq_table(args.table, gain_units=args.gain_units,
                            phase_units=args.phase_units, freq_units=args.freq_units)
     result = identify_freq(data)

@@ -99,10 +99,10 @@ RANGES = {
     # size of the output's change from baseline to final value, in the file's units
     "output_step": Range(1e-15, 2e15),
     # frequency-response tables (identify-freq): every row
-    "freq_hz": Range(1e-6, 1e12, "Hz"),
+    "freq_hz": Range(1e-9, 1e11, "Hz"),
     "gain_db": Range(-400.0, 400.0, "dB"),
     "gain_ratio": Range(1e-20, 1e20),
-    "phase_deg": Range(-1e5, 1e5, "deg"),
+    "phase_deg": Range(-1e5, 1e5),   # degrees
 }
 
 

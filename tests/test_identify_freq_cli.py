@@ -98,7 +98,7 @@ def test_bad_tables_one_line(tmp_path, content, words):
 
 
 def test_bad_invocations(tmp_path):
-    assert "not found" in one_line_error(run(tmp_path / "missing.csv"))
+    assert "does not exist" in one_line_error(run(tmp_path / "missing.csv"))
     line = one_line_error(run(FIX / "seed003_table31.csv", "--gain-units", "np"))
     assert "invalid choice" in line
     one_line_error(run())

@@ -282,7 +282,7 @@ def test_bad_tables(text, words):
 
 
 def test_missing_file(tmp_path):
-    with pytest.raises(DesignError, match="not found"):
+    with pytest.raises(DesignError, match="does not exist"):
         fr.read_freq_table(tmp_path / "nope.csv")
     (tmp_path / "bin.csv").write_bytes(b"\xff\xfe\x00\x81")
     with pytest.raises(DesignError):

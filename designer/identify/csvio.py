@@ -40,7 +40,7 @@ import numpy as np
 from ..errors import DesignError
 from .preprocess import check_samples, number_text
 from .textfile import (BLOCK_BYTES, MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, MAX_LINE_BYTES,
-                       SNIFF_BYTES, check_encoding, decode, open_limited, size_text)
+                       SNIFF_BYTES, check_encoding, decode, open_limited, show_cell, size_text)
 
 #: Header names (lowercase, units stripped) read as the plant input or output.
 INPUT_NAMES = ("u", "vin", "v_in", "in", "input", "uin", "u_in", "v(in)", "ve", "step", "source")
@@ -251,11 +251,6 @@ def _split(line: str, delim: str) -> list:
     return cells
 
 
-def _show_cell(cell: str) -> str:
-    """A cell for a message: quoted, escaped, and cut to a readable length."""
-    return repr(cell if len(cell) <= 40 else cell[:37] + "...")
-
-
 def _read_tektronix_tds(lines, name) -> _Layout:
     """TDS/TBS: rows 'label,value,,time,value,'; the header block occupies cells 1-3."""
     meta = {}
@@ -280,7 +275,7 @@ def _read_rigol(lines, name) -> _Layout:
     except (ValueError, IndexError):
         raise DesignError(f"{name}: Rigol header line 2 must carry the Start and Increment "
                           f"values under 'Start' and 'Increment'; got "
-                          f"{_show_cell(lines[1])}") from None
+                          f"{show_cell(lines[1])}") from None
     if not (np.isfinite(inc) and inc > 0):
         raise DesignError(f"{name}: Rigol time increment must be a positive number; "
                           f"got {number_text(inc)}")
@@ -314,7 +309,7 @@ def _read_table(lines, name) -> _Layout:
         if len(probe) < 2:
             raise DesignError(f"{name}: rows need at least two columns (time and output); "
                               f"line {min(len(lines), 2)} has {len(probe)}")
-        raise DesignError(f"{name}: no numeric table found ({_show_cell(bad or '')} is not a "
+        raise DesignError(f"{name}: no numeric table found ({show_cell(bad or '')} is not a "
                           "number); expected rows of numbers: t,y or t,u,y")
     ncols = len(_split(lines[first_row], delim))
     header = _split(lines[first_row - 1], delim) if first_row > 0 else []
@@ -434,7 +429,7 @@ def _raise_bad_cell(rows, where, delim, name, usecols):
                                   f"{j + 1}; every data row needs all columns")
             if not _is_number(cells[j]):
                 raise DesignError(f"{name}: line {lineno}, column {j + 1}: "
-                                  f"{_show_cell(cells[j])} is not a number; data cells must "
+                                  f"{show_cell(cells[j])} is not a number; data cells must "
                                   "be numbers like 1.5e-3")
     raise DesignError(f"{name}: rows from line {where[0]} on do not form a numeric table "
                       "with the same number of columns on every line")
@@ -462,7 +457,7 @@ def _pick(spec, columns, what, name):
     low = [c.lower() for c in columns]
     if text.lower() in low[1:]:
         return low.index(text.lower(), 1)
-    raise DesignError(f"{name}: no {what} column named {_show_cell(str(spec))}; the file has "
+    raise DesignError(f"{name}: no {what} column named {show_cell(str(spec))}; the file has "
                       f"{', '.join(columns[1:])}")
 
 

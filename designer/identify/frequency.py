@@ -41,14 +41,15 @@ from __future__ import annotations
 
 import math
 import re
-import warnings
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from ..errors import DesignError
+from ..ranges import RANGES
 from .core import MethodResult
+from .preprocess import number_text
+from .textfile import MAX_TABLE_BYTES, read_text, show_cell, shown
 
 ERROR_DEFINITION = ("iae = mean over the table's frequencies of |G_model/G_data - 1| "
                     "(relative complex error; gain only when there is no phase), "
@@ -58,7 +59,20 @@ GAIN_UNITS = ("db", "ratio")
 PHASE_UNITS = ("deg", "rad", "s")
 FREQ_UNITS = ("hz", "rad/s")
 MIN_POINTS = 5
+#: Most rows a table may have (a network analyser sweeps a few thousand).
+MAX_POINTS = 100_000
 DB_PER_POLE = 10.0 * math.log10(2.0)
+#: A model whose fit error (mean |G_model/G_data - 1|) exceeds this does not
+#: describe the table: 0.2 is an average miss of about 1.6 dB or 11 degrees,
+#: several times what the seeds' hand-read tables show against their own
+#: second-order readings (7 %), and what a table read in the wrong units or
+#: with the wrong phase sign gives (over 20 %).
+MAX_FIT_ERROR = 0.2
+#: Corner frequencies and wn must lie inside the measured band widened by this
+#: factor each way: a pole ten times beyond the last point changes the table's
+#: gain by under 0.05 dB and its phase by under 6 degrees, so the table cannot
+#: place it (a flat table "fits" wn = 2e54 rad/s).
+BAND_FACTOR = 10.0
 
 PARAMS = {
     "fopdt": ("K", "tau_s", "theta_s"),
@@ -89,6 +103,7 @@ class FreqData:
     sign: float = 1.0
     source: str = ""
     units: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
 
     @property
     def f_hz(self) -> np.ndarray:
@@ -107,78 +122,125 @@ class FreqData:
         return {"source": self.source, "points": int(self.w.size),
                 "f_min_hz": float(self.f_hz[0]), "f_max_hz": float(self.f_hz[-1]),
                 "has_phase": self.phase is not None, "inverting": self.sign < 0,
-                "units": dict(self.units)}
+                "units": dict(self.units), "notes": list(self.notes)}
+
+
+def _units(value, allowed, what) -> str:
+    """Units as given, case-insensitive (``dB``, ``Hz``, ``RAD/S``)."""
+    u = str(value).strip().lower()
+    if u not in allowed:
+        raise DesignError(f"{what} units {str(value)!r} unknown; allowed: {', '.join(allowed)}")
+    return u
 
 
 def freq_data(freq, gain, phase=None, *, gain_units="db", phase_units="deg",
-              freq_units="hz", source="") -> FreqData:
+              freq_units="hz", source="", lines=None) -> FreqData:
     """Validate and convert a table (arrays) into :class:`FreqData`.
+
+    ``lines`` (optional) are the file lines of the rows, for messages.
 
     Raises
     ------
     DesignError
-        Too few points, non-finite values, frequency not strictly increasing
-        or not positive, non-positive amplitude ratio, unknown units.
+        Too few or too many points, non-finite values, values outside their
+        physical ranges (``freq_hz``, ``gain_db`` or ``gain_ratio``,
+        ``phase_deg`` of :data:`designer.ranges.RANGES`), frequency not strictly
+        increasing or not positive, non-positive amplitude ratio, unknown units.
     """
-    if gain_units not in GAIN_UNITS:
-        raise DesignError(f"gain units {gain_units!r} unknown; allowed: {', '.join(GAIN_UNITS)}")
-    if phase_units not in PHASE_UNITS:
-        raise DesignError(f"phase units {phase_units!r} unknown; allowed: {', '.join(PHASE_UNITS)}")
-    if freq_units not in FREQ_UNITS:
-        raise DesignError(f"frequency units {freq_units!r} unknown; "
-                          f"allowed: {', '.join(FREQ_UNITS)}")
+    gain_units = _units(gain_units, GAIN_UNITS, "gain")
+    phase_units = _units(phase_units, PHASE_UNITS, "phase")
+    freq_units = _units(freq_units, FREQ_UNITS, "frequency")
+    pre = f"{source}: " if source else ""
+
+    def row(k):
+        return f"line {lines[k]}" if lines is not None else f"row {k + 1}"
+
     f = np.asarray(freq, float)
     g = np.asarray(gain, float)
     if f.ndim != 1 or g.shape != f.shape:
         raise DesignError("frequency and gain must be columns of the same length")
     if f.size < MIN_POINTS:
-        raise DesignError(f"too few points: {f.size}; at least {MIN_POINTS} frequencies are "
+        raise DesignError(f"{pre}too few points: {f.size}; at least {MIN_POINTS} frequencies are "
                           "needed to fit a model")
-    for name, arr in (("frequency", f), ("gain", g)):
-        if not np.all(np.isfinite(arr)):
-            k = int(np.argmin(np.isfinite(arr)))
-            raise DesignError(f"{name} at row {k + 1} is not a finite number ({arr[k]})")
-    if np.any(f <= 0):
-        k = int(np.argmax(f <= 0))
-        raise DesignError(f"frequency at row {k + 1} is {f[k]:g}: frequencies must be positive")
-    bad = np.nonzero(np.diff(f) <= 0)[0]
-    if bad.size:
-        k = int(bad[0])
-        raise DesignError(f"frequency not increasing at row {k + 2} ({f[k + 1]:g} after {f[k]:g}); "
-                          "sort the table and remove repeated frequencies")
-    w = f if freq_units == "rad/s" else 2.0 * math.pi * f
-    if gain_units == "ratio":
-        if np.any(g <= 0):
-            k = int(np.argmax(g <= 0))
-            raise DesignError(f"gain at row {k + 1} is {g[k]:g}: an amplitude ratio must be "
-                              "positive (use --gain-units db for decibels)")
-        ratio = g
-    else:
-        ratio = 10.0 ** (g / 20.0)
-    ph = None
-    sign = 1.0
+    if f.size > MAX_POINTS:
+        raise DesignError(f"{pre}{f.size} points; at most {MAX_POINTS:,} are read (thin the "
+                          "sweep: a few hundred points over the band are plenty)")
+    p = None
     if phase is not None:
         p = np.asarray(phase, float)
         if p.shape != f.shape:
             raise DesignError("phase column must have as many rows as frequency")
-        if not np.all(np.isfinite(p)):
-            k = int(np.argmin(np.isfinite(p)))
-            raise DesignError(f"phase at row {k + 1} is not a finite number ({p[k]})")
-        if phase_units == "deg":
-            ph = _unwrap_lag(np.deg2rad(p))
-        elif phase_units == "rad":
-            ph = _unwrap_lag(p.copy())
-        else:
-            # a positive time shift is the output lagging the input: -w dt
-            ph = -w * p
+    for name, arr in (("frequency", f), ("gain", g), ("phase", p)):
+        if arr is not None and not np.all(np.isfinite(arr)):
+            k = int(np.argmin(np.isfinite(arr)))
+            raise DesignError(f"{pre}{name} at {row(k)} is not a finite number "
+                              f"({number_text(arr[k])})")
+    if np.any(f <= 0):
+        k = int(np.argmax(f <= 0))
+        raise DesignError(f"{pre}frequency at {row(k)} is {f[k]:g}: frequencies must be positive")
+    bad = np.nonzero(np.diff(f) <= 0)[0]
+    if bad.size:
+        k = int(bad[0])
+        raise DesignError(f"{pre}frequency not increasing at {row(k + 1)} ({f[k + 1]:g} after "
+                          f"{f[k]:g}); sort the table and remove repeated frequencies")
+    f_unit = "rad/s" if freq_units == "rad/s" else "Hz"
+    _check_column(f / (2.0 * math.pi) if freq_units == "rad/s" else f, "freq_hz", f, f_unit,
+                  "frequency", pre, row)
+    w = f if freq_units == "rad/s" else 2.0 * math.pi * f
+    if gain_units == "ratio":
+        if np.any(g <= 0):
+            k = int(np.argmax(g <= 0))
+            raise DesignError(f"{pre}gain at {row(k)} is {g[k]:g}: an amplitude ratio must be "
+                              "positive (use --gain-units db for decibels)")
+        _check_column(g, "gain_ratio", g, "", "gain (amplitude ratio)", pre, row)
+        ratio = g
+    else:
+        _check_column(g, "gain_db", g, "dB", "gain", pre, row)
+        ratio = 10.0 ** (g / 20.0)
+    ph = None
+    sign = 1.0
+    notes = []
+    if p is not None:
+        # An absurd phase or time shift (1e300 s) overflows to inf in these
+        # conversions; the range check right after refuses it by line, so the
+        # overflow is expected and harmless.
+        with np.errstate(over="ignore"):
+            if phase_units == "deg":
+                ph, ph_deg = np.deg2rad(p), p
+            elif phase_units == "rad":
+                ph, ph_deg = p.copy(), np.rad2deg(p)
+            else:
+                # a positive time shift is the output lagging the input: -w dt
+                ph = -w * p
+                ph_deg = np.rad2deg(ph)
+        unit = {"deg": "deg", "rad": "rad", "s": "s of time shift"}[phase_units]
+        _check_column(ph_deg, "phase_deg", p, unit, "phase (in degrees)", pre, row)
+        if phase_units != "s":
+            ph = _unwrap_lag(ph)
         ph -= 2.0 * math.pi * round(ph[0] / (2.0 * math.pi))
         # within 45 degrees of +-180 at the lowest frequency: an inverting plant
         if abs(ph[0]) > 0.75 * math.pi:
             sign = -1.0
             ph -= math.copysign(math.pi, ph[0])
+        if ph[-1] > 0.25 * math.pi:
+            notes.append(f"the phase rises to {math.degrees(ph[-1]):+.0f} deg at the highest "
+                         "frequency: a low-pass plant's output lags its input (negative phase); "
+                         "if the table gives the lag as a positive number, negate that column")
     return FreqData(w, ratio, ph, sign, source,
                     {"frequency": freq_units, "gain": gain_units,
-                     "phase": phase_units if phase is not None else None})
+                     "phase": phase_units if phase is not None else None}, notes)
+
+
+def _check_column(values, key, shown_values, unit, what, pre, row) -> None:
+    """One line naming the first row whose value (converted to ``RANGES[key]``'s
+    unit as ``values``; as the table gives it in ``shown_values``) is outside the range."""
+    rng = RANGES[key]
+    lo_ok = rng.contains(float(np.min(values)))
+    if lo_ok and rng.contains(float(np.max(values))):
+        return
+    k = next(i for i, v in enumerate(values) if not rng.contains(float(v)))
+    got = number_text(shown_values[k]) + (f" {unit}" if unit else "")
+    raise DesignError(f"{pre}{what} at {row(k)} must be {rng.text()}, got {got}")
 
 
 def _unwrap_lag(ph: np.ndarray) -> np.ndarray:
@@ -240,13 +302,18 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
     comment lines and blank lines ignored; one optional header row whose names
     may give units (``f_hz``, ``f_khz``, ``w_rad_s``, ``gain_db``,
     ``gain_ratio``, ``phase_deg``, ``phase_rad``, ``shift_us``...). Units given
-    as arguments win over the header; the defaults are Hz, dB and degrees.
+    as arguments (any case: ``dB``, ``Hz``) win over the header; the defaults
+    are Hz, dB and degrees.
     """
-    lines = [(i + 1, ln.strip()) for i, ln in enumerate(text.splitlines())]
+    pre = f"{source}: " if source else ""
+    lines = [(i + 1, ln.strip()) for i, ln in enumerate(text.lstrip("\ufeff").splitlines())]
     lines = [(i, ln) for i, ln in lines if ln and not ln.startswith("#")]
     if not lines:
         raise DesignError(f"{source or 'table'} is empty: expected rows of "
                           "frequency, gain[, phase]")
+    if len(lines) > MAX_POINTS + 1:
+        raise DesignError(f"{pre}{len(lines):,} rows; at most {MAX_POINTS:,} are read (thin the "
+                          "sweep: a few hundred points over the band are plenty)")
     first = lines[0][1]
     if ";" in first:
         sep, decimal_comma = ";", True
@@ -280,17 +347,17 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
         if ncol is None:
             ncol = len(cs)
             if ncol not in (2, 3):
-                raise DesignError(f"line {lineno}: {ncol} columns; expected 2 or 3 "
+                raise DesignError(f"{pre}line {lineno}: {ncol} columns; expected 2 or 3 "
                                   "(frequency, gain[, phase])")
         if len(cs) != ncol:
-            raise DesignError(f"line {lineno}: {len(cs)} columns where the table has {ncol}")
+            raise DesignError(f"{pre}line {lineno}: {len(cs)} columns where the table has {ncol}")
         vals = []
         for c in cs:
             if c.lower() in ("nan", "inf", "-inf", "+inf"):
-                raise DesignError(f"line {lineno}: {c!r} is not a finite number")
+                raise DesignError(f"{pre}line {lineno}: {show_cell(c)} is not a finite number")
             if not _NUM.match(c):
-                raise DesignError(f"line {lineno}: {c!r} is not a number (plain decimal or "
-                                  "1e3 notation)")
+                raise DesignError(f"{pre}line {lineno}: {show_cell(c)} is not a number (plain "
+                                  "decimal or 1e3 notation)")
             vals.append(float(c))
         rows.append(vals)
     arr = np.array(rows, float)
@@ -298,7 +365,9 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
     kinds = ("frequency", "gain", "phase")
     units, scale = {}, {}
     given = {"frequency": freq_units, "gain": gain_units, "phase": phase_units}
+    given = {k: None if v is None else str(v).strip().lower() for k, v in given.items()}
     default = {"frequency": "hz", "gain": "db", "phase": "deg"}
+    defaulted = set()
     for k, name in zip(kinds, names):
         h = _hint(name, k) if name else None
         if given[k] is not None:
@@ -309,27 +378,29 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
             units[k], scale[k] = h
         else:
             units[k], scale[k] = default[k], 1.0
-    f = arr[:, 0] * scale["frequency"]
-    g = arr[:, 1] * scale["gain"]
-    p = arr[:, 2] * scale["phase"] if ncol == 3 else None
-    return freq_data(f, g, p, gain_units=units["gain"], phase_units=units.get("phase", "deg"),
-                     freq_units=units["frequency"], source=source)
+            defaulted.add(k)
+    # A value near 1e308 times a unit prefix (kHz) overflows to inf: freq_data
+    # refuses it by line as not finite, so the overflow is expected and harmless.
+    with np.errstate(over="ignore"):
+        f = arr[:, 0] * scale["frequency"]
+        g = arr[:, 1] * scale["gain"]
+        p = arr[:, 2] * scale["phase"] if ncol == 3 else None
+    data = freq_data(f, g, p, gain_units=units["gain"], phase_units=units.get("phase", "deg"),
+                     freq_units=units["frequency"], source=source,
+                     lines=[lineno for lineno, _ in lines])
+    if "gain" in defaulted and 0.0 <= g.min() and g.max() <= 10.0 and np.ptp(g) > 0.1:
+        data.notes.append("the gain column was read as dB (the default: neither the header "
+                          "nor --gain-units names it), but every value lies between 0 and 10, "
+                          "as an amplitude ratio Vout/Vin would; if it is one, pass "
+                          "--gain-units ratio")
+    return data
 
 
 def read_freq_table(path, **units) -> FreqData:
-    """Read a frequency-response CSV file (see :func:`parse_freq_table`)."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise DesignError(f"{str(p)!r} not found") from None
-    except IsADirectoryError:
-        raise DesignError(f"{str(p)!r} is a directory, not a table") from None
-    except UnicodeDecodeError:
-        raise DesignError(f"{str(p)!r} is not a text (UTF-8) file") from None
-    except OSError as exc:
-        raise DesignError(f"cannot read {str(p)!r}: {exc.strerror or exc}") from None
-    return parse_freq_table(text, source=str(p), **units)
+    """Read a frequency-response CSV file (see :func:`parse_freq_table`): at most
+    :data:`~.textfile.MAX_TABLE_BYTES`, UTF-8 or ASCII."""
+    text = read_text(path, "table", MAX_TABLE_BYTES)
+    return parse_freq_table(text, source=shown(path), **units)
 
 
 # --------------------------------------------------------------------------
@@ -615,6 +686,31 @@ def _residual(model, data, fit_delay):
     return fun
 
 
+#: The fits search time constants and wn within the measured band widened by
+#: this factor (far wider than BAND_FACTOR, so a fit that runs out of the band
+#: is seen and flagged, yet every exp() of a log-parameter stays finite).
+FIT_BAND = 1e3
+
+
+def _fit_bounds(model, data, fit_delay) -> tuple:
+    """Bounds of the free variables (log K, log time scales or log wn, zeta, theta)."""
+    w_lo, w_hi = float(data.w[0]) / FIT_BAND, float(data.w[-1]) * FIT_BAND
+    log_k = [math.log(float(data.gain.min())) - 20.0, math.log(float(data.gain.max())) + 20.0]
+    log_tau = [-math.log(w_hi), -math.log(w_lo)]
+    lo = {"fopdt": [log_k[0], log_tau[0]],
+          "underdamped": [log_k[0], math.log(w_lo), 0.01],
+          "overdamped": [log_k[0], log_tau[0], log_tau[0]]}[model]
+    hi = {"fopdt": [log_k[1], log_tau[1]],
+          "underdamped": [log_k[1], math.log(w_hi), 0.99],
+          "overdamped": [log_k[1], log_tau[1], log_tau[1]]}[model]
+    if fit_delay:
+        # the table's phase is at most RANGES["phase_deg"]: a longer delay than
+        # that at the lowest frequency cannot be in the data
+        theta_max = math.radians(RANGES["phase_deg"].hi) * 2.0 / float(data.w[0])
+        lo, hi = lo + [0.0], hi + [theta_max]
+    return lo, hi
+
+
 def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     """Fit ``model`` to the complex response from each of ``starts`` (parameter
     dicts) and keep the lowest cost; 95 % half-widths from the Jacobian."""
@@ -625,12 +721,7 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     name = "least-squares"
     fit_delay = data.phase is not None
     fun = _residual(model, data, fit_delay)
-    lo = {"fopdt": [-np.inf, -np.inf], "underdamped": [-np.inf, -np.inf, 0.01],
-          "overdamped": [-np.inf, -np.inf, -np.inf]}[model]
-    hi = {"fopdt": [np.inf, np.inf], "underdamped": [np.inf, np.inf, 0.99],
-          "overdamped": [np.inf, np.inf, np.inf]}[model]
-    if fit_delay:
-        lo, hi = lo + [0.0], hi + [np.inf]
+    lo, hi = _fit_bounds(model, data, fit_delay)
     best = None
     for p0 in starts:
         try:
@@ -747,16 +838,46 @@ def _rank_key(m):
     return (not m.valid, iae)
 
 
+def corner_frequencies(model: str, params: dict) -> dict:
+    """The model's corner frequencies (rad/s): 1/tau of each time constant, wn."""
+    out = {}
+    for k, v in params.items():
+        if k.startswith("tau") and isinstance(v, float) and v > 0:
+            out[k] = 1.0 / v
+        elif k == "wn_rad_s":
+            out[k] = v
+    return out
+
+
+def judge(m: MethodResult, data: FreqData) -> None:
+    """Mark a result invalid, saying why, unless it describes the table: finite
+    parameters and error, fit error at most MAX_FIT_ERROR, and every corner
+    frequency inside the measured band widened BAND_FACTOR times."""
+    if not m.valid:
+        return
+    why = None
+    if not (all(math.isfinite(v) for v in m.params.values()) and math.isfinite(m.iae)):
+        why = "degenerate result: the table does not have this model's shape"
+    elif m.iae > MAX_FIT_ERROR:
+        why = (f"fit error {100 * m.iae:.3g} % is above the {100 * MAX_FIT_ERROR:g} % a model "
+               "must reach to describe the table (gain or phase in other units than read, "
+               "or the phase sign flipped?)")
+    else:
+        w_lo, w_hi = data.w[0] / BAND_FACTOR, data.w[-1] * BAND_FACTOR
+        for k, wc in corner_frequencies(m.model, m.params).items():
+            if not w_lo <= wc <= w_hi:
+                name = "wn" if k == "wn_rad_s" else f"the corner of {k[:-2]}"
+                why = (f"{name} ({wc:.4g} rad/s, {wc / (2 * math.pi):.4g} Hz) lies outside the "
+                       f"measured band widened {BAND_FACTOR:g} times ({w_lo:.4g} to "
+                       f"{w_hi:.4g} rad/s): the table cannot place it")
+                break
+    if why:
+        m.valid = False
+        m.note = "; ".join(x for x in (m.note, why) if x)
+
+
 def identify_freq(data: FreqData) -> FreqIdentifyResult:
     """Run the classical readings and the least-squares fits; rank by fit error."""
-    # odd tables drive the fits through inf/nan; those results are flagged
-    # below, and the warnings would only clutter the one-line CLI contract
-    with np.errstate(all="ignore"), warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return _identify_freq(data)
-
-
-def _identify_freq(data: FreqData) -> FreqIdentifyResult:
     classical = [asymptotes(data), resonant_peak(data)]
     K, _ = low_frequency_gain(data)
     wc = _interp_logf(data.w, data.gain_db, 20.0 * math.log10(K) - 3.0)
@@ -765,11 +886,7 @@ def _identify_freq(data: FreqData) -> FreqIdentifyResult:
     fits = [least_squares_fit(data, model, _starts(model, classical, K, wc))
             for model in ("fopdt", "underdamped", "overdamped")]
     for m in classical + fits:
-        if m.valid and not (all(math.isfinite(v) for v in m.params.values())
-                            and math.isfinite(m.iae)):
-            m.valid = False
-            m.note = "; ".join(x for x in (m.note, "degenerate result: the table does not "
-                                          "have this model's shape") if x)
+        judge(m, data)
     methods = sorted(classical + fits, key=_rank_key)
     best = next((m for m in methods if m.valid and math.isfinite(m.iae)), None)
     return FreqIdentifyResult(methods, best, data)

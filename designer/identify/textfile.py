@@ -47,6 +47,11 @@ def shown(path) -> str:
     return s if s.isprintable() else repr(s)
 
 
+def show_cell(cell: str) -> str:
+    """A cell of the user's file for a message: quoted, escaped, cut to a readable length."""
+    return repr(cell if len(cell) <= 40 else cell[:37] + "...")
+
+
 def size_text(n: int) -> str:
     """``256 MiB``, ``1.5 GiB``, ``300 bytes``."""
     for unit, scale in (("GiB", 1 << 30), ("MiB", MIB), ("KiB", 1024)):
