@@ -161,3 +161,85 @@ def realizability_notes(fc_hz: float, zeta: float, gain: float, c_lo: float, c_h
         notes.append(f"gain K = {gain:g} >= 3 makes the equal-component Sallen-Key unstable; "
                      "it relies on R1 C2 (K-1) staying below C1 (R1 + R2), so damping is very sensitive to parts")
     return notes
+
+
+#: relative mismatch allowed between a stated gain K and its resistors' 1 + R4/R3
+GAIN_TOLERANCE = 1e-3
+#: R3 when only K is given (R4 = (K - 1) R3), as the command-line tools derive it
+DEFAULT_R3_OHM = 10e3
+_PART_NAMES = {"r1": "R1", "r2": "R2", "c1": "C1", "c2": "C2", "r3": "R3", "r4": "R4", "gain": "gain K",
+               "plant": "the plant"}
+
+
+def check_parts(parts: SallenKeyParts, name_of=None) -> SallenKeyParts:
+    """The one validation of a Sallen-Key plant as built, however it arrives
+    (designed, typed as parts, or read from a JSON file).
+
+    Checks, in this order: every part value is a real number inside its
+    physical range (``designer.ranges``: ``resistor_ohm``, ``capacitor_f``,
+    ``gain``); R3 and R4 come together; a stated gain agrees with its
+    resistors, K = 1 + R4/R3 (seed 001, Fig. 43), within
+    :data:`GAIN_TOLERANCE`; and the circuit is a stable plant whose fn and
+    zeta (the module's formulas) lie in the ranges ``fc_hz`` and ``zeta``
+    that ``--fc``/``--zeta`` accept. A zeta <= 0 (K too large for the parts)
+    means the circuit oscillates on its own.
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        Values as received, possibly of the wrong type. ``gain`` may be None
+        (then it is 1 + R4/R3, or 1 without R3/R4).
+    name_of : mapping or callable, optional
+        What to call each field in messages: keys ``r1, r2, c1, c2, r3, r4,
+        gain`` and ``plant`` (the whole circuit), e.g. ``{"r1": "--plant-r1"}``;
+        missing keys default to ``R1``... ``gain K``, ``the plant``.
+
+    Returns
+    -------
+    SallenKeyParts
+        Floats only; the gain is the resistors' 1 + R4/R3 when they are given,
+        and a gain K > 1 without them gets R3 = :data:`DEFAULT_R3_OHM` and
+        R4 = (K - 1) R3, so that the netlist builds the gain the model assumes.
+
+    Raises
+    ------
+    DesignError
+        One line naming the offending field and what is allowed.
+    """
+    from .ranges import RANGES
+
+    def name(key):
+        if callable(name_of):
+            return name_of(key)
+        return (name_of or {}).get(key, _PART_NAMES[key])
+
+    def number(key, value, range_key):
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+            shown = repr(value) if isinstance(value, str) and len(value) <= 40 else type(value).__name__
+            raise DesignError(f"{name(key)} must be a number, got {shown}")
+        return RANGES[range_key].check(float(value), name(key))
+
+    r1, r2 = (number(k, getattr(parts, k), "resistor_ohm") for k in ("r1", "r2"))
+    c1, c2 = (number(k, getattr(parts, k), "capacitor_f") for k in ("c1", "c2"))
+    if (parts.r3 is None) != (parts.r4 is None):
+        raise DesignError(f"{name('r3')} and {name('r4')} go together (K = 1 + R4/R3)")
+    gain = None if parts.gain is None else number("gain", parts.gain, "gain")
+    if parts.r3 is not None:
+        r3, r4 = number("r3", parts.r3, "resistor_ohm"), number("r4", parts.r4, "resistor_ohm")
+        k = RANGES["gain"].check(1.0 + r4 / r3, f"1 + {name('r4')}/{name('r3')}")
+        if gain is not None and abs(gain - k) > GAIN_TOLERANCE * k:
+            raise DesignError(f"{name('gain')} = {gain:g} does not match its resistors: K = 1 + R4/R3 = "
+                              f"{k:.6g} (they must agree within {100 * GAIN_TOLERANCE:g} %)")
+        gain = k
+    elif gain is None or gain <= 1.0 + GAIN_TOLERANCE:
+        gain, r3, r4 = 1.0, None, None   # a voltage follower
+    else:
+        r3, r4 = DEFAULT_R3_OHM, (gain - 1.0) * DEFAULT_R3_OHM
+    out = SallenKeyParts(r1, r2, c1, c2, gain, r3, r4)
+    if not out.b > 0:
+        raise DesignError(
+            f"{name('plant')}: these parts give zeta = {out.zeta:.4g} <= 0 (R1 C2 (K - 1) is not below "
+            "C1 (R1 + R2)): the circuit oscillates on its own; lower the gain or change the parts")
+    RANGES["fc_hz"].check(out.fn_hz, f"{name('plant')}: the natural frequency fn of these parts")
+    RANGES["zeta"].check(out.zeta, f"{name('plant')}: the damping ratio zeta of these parts")
+    return out
