@@ -7,9 +7,9 @@ import argparse
 import sys
 
 from . import __version__, opamps
-from .cli import OneLineParser, _check_name, add_part_options, emit, part_options, run_cli
+from .cli import OneLineParser, add_part_options, check_name, emit, optional, part_options, run_cli
 from .errors import DesignError
-from .units import parse_positive, parse_value
+from .ranges import help_range, parse_in_range
 
 EPILOG = """examples:
   design-pid --plant-fc 3500 --plant-zeta 0.2
@@ -33,6 +33,11 @@ Outputs: netlists/<name>.cir (runs alone with `ngspice -b`), reports/<name>/buil
 result.json and plots. Exit status 2 on bad input."""
 
 
+def _r(key: str) -> str:
+    """The range of ``key`` for a --help line (argparse needs %% for %)."""
+    return help_range(key).replace("%", "%%")
+
+
 def _parser():
     p = OneLineParser(
         prog="design-pid",
@@ -42,36 +47,48 @@ def _parser():
         epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     g = p.add_argument_group("plant (one of three ways)")
-    g.add_argument("--plant-fc", metavar="HZ", help="design the plant as design-plant does: natural frequency")
-    g.add_argument("--plant-zeta", metavar="Z", help="... and damping ratio")
-    for n, what in (("r1", "input resistor"), ("r2", "resistor to the non-inverting input"),
-                    ("c1", "non-inverting input to ground"), ("c2", "feedback capacitor")):
-        g.add_argument(f"--plant-{n}", metavar="VALUE", help=f"plant as built: {what}")
-    g.add_argument("--plant-gain", metavar="K", help="plant gain K = 1 + R4/R3 with --plant-r1.. (default 1)")
-    g.add_argument("--plant-json", metavar="FILE", help="a result.json written by design-plant or analyze-plant")
+    g.add_argument("--plant-fc", metavar="HZ",
+                   help=f"design the plant as design-plant does: natural frequency {_r('fc_hz')}")
+    g.add_argument("--plant-zeta", metavar="Z", help=f"... and damping ratio {_r('zeta')}")
+    for n, what, key in (("r1", "input resistor", "resistor_ohm"),
+                         ("r2", "resistor to the non-inverting input", "resistor_ohm"),
+                         ("c1", "non-inverting input to ground", "capacitor_f"),
+                         ("c2", "feedback capacitor", "capacitor_f")):
+        g.add_argument(f"--plant-{n}", metavar="VALUE", help=f"plant as built: {what} {_r(key)}")
+    g.add_argument("--plant-gain", metavar="K",
+                   help=f"plant gain K = 1 + R4/R3 with --plant-r1.. {_r('gain')} (default 1; R3 = 10k, "
+                        "R4 = (K - 1) R3)")
+    g.add_argument("--plant-json", metavar="FILE",
+                   help="a result.json written by design-plant or analyze-plant (its 'built' parts, checked "
+                        "against the same ranges)")
     t = p.add_argument_group("tuning")
     t.add_argument("--tuning", metavar="RULE",
                    help="zn (default), cohen-coon, chr0, chr20, amigo, simc, optimize")
-    t.add_argument("--kp", help="explicit proportional gain (with --ti and --td)")
-    t.add_argument("--ti", metavar="S", help="explicit integral time, seconds (e.g. 43.215u)")
-    t.add_argument("--td", metavar="S", help="explicit derivative time, seconds (0 for a PI)")
-    t.add_argument("--target-overshoot", metavar="PCT", help="--tuning optimize: largest overshoot, percent")
-    t.add_argument("--target-settling", metavar="S", help="--tuning optimize: largest 2 %% settling time")
+    t.add_argument("--kp", help=f"explicit proportional gain {_r('kp')} (with --ti and --td)")
+    t.add_argument("--ti", metavar="S", help=f"explicit integral time {_r('ti_s')} (e.g. 43.215u)")
+    t.add_argument("--td", metavar="S", help=f"explicit derivative time {_r('td_s')}; 0 for a PI")
+    t.add_argument("--target-overshoot", metavar="PCT",
+                   help=f"--tuning optimize: largest overshoot {_r('target_overshoot_pct')}")
+    t.add_argument("--target-settling", metavar="S",
+                   help=f"--tuning optimize: largest 2 %% settling time {_r('target_settling_s')}")
     t.add_argument("--seed-parts", action="store_true",
                    help="use the seed's own controller parts (V.13, difference amp untrimmed) instead of sizing")
     s = p.add_argument_group("parts")
     add_part_options(s)
-    s.add_argument("--f-integrator", metavar="HZ", help="integrator leak corner 1/(2 pi R13 C4) (default fn/100)")
+    s.add_argument("--f-integrator", metavar="HZ",
+                   help=f"integrator leak corner 1/(2 pi R13 C4) {_r('f_integrator_hz')} (default fn/100)")
     s.add_argument("--f-differentiator", metavar="HZ",
-                   help="derivative filter corner 1/(2 pi R12 C3) (default 10 fn)")
+                   help=f"derivative filter corner 1/(2 pi R12 C3) {_r('f_differentiator_hz')} (default 10 fn)")
     o = p.add_argument_group("op-amps and test signal")
     o.add_argument("--opamp", default="LM741", metavar="NAME",
                    help=f"{', '.join(opamps.names())} (default LM741, as the seed's bench)")
-    o.add_argument("--step", default="1", metavar="V", help="reference square wave 0 -> V volts (default 1)")
-    o.add_argument("--edge", default="100n", metavar="S", help="rise/fall time of the reference (default 100n, "
-                                                                 "a function generator)")
-    o.add_argument("--square-freq", metavar="HZ", help="reference frequency (default: half period = 1.5x the "
-                                                        "closed loop's settling time, rounded)")
+    o.add_argument("--step", default="1", metavar="V",
+                   help=f"reference square wave 0 -> V volts {_r('step_v')} (default 1)")
+    o.add_argument("--edge", default="100n", metavar="S",
+                   help=f"rise/fall time of the reference {_r('edge_s')} (default 100n, a function generator)")
+    o.add_argument("--square-freq", metavar="HZ",
+                   help=f"reference frequency {_r('square_hz')} (default: half period = 1.5x the closed "
+                        "loop's settling time, rounded)")
     out = p.add_argument_group("output")
     out.add_argument("--out", default=".", metavar="DIR", help="write netlists/ and reports/ under DIR (default .)")
     out.add_argument("--name", help="design name for the files (default pid_<tuning>_<opamp>_fn<fn>_z<zeta>)")
@@ -83,52 +100,41 @@ def _parser():
     return p
 
 
-def _opt(v, name, parse=parse_positive):
-    return None if v is None else parse(v, name)
-
-
 def _build_spec(args):
     from .pid.blocks import seed_parts
     from .pid.design import PidSpec
     from .sallenkey import SallenKeyParts
     plant_parts = None
-    given = [getattr(args, f"plant_{n}") for n in ("r1", "r2", "c1", "c2")]
+    names = ("r1", "r2", "c1", "c2")
+    given = [getattr(args, f"plant_{n}") for n in names]
     if any(v is not None for v in given):
         if not all(v is not None for v in given):
             raise DesignError("--plant-r1, --plant-r2, --plant-c1 and --plant-c2 go together")
-        gain = 1.0 if args.plant_gain is None else parse_value(args.plant_gain, "--plant-gain")
-        if not gain >= 1:
-            raise DesignError(f"--plant-gain must be >= 1 (K = 1 + R4/R3), got {args.plant_gain!r}")
-        r3, r4 = (None, None) if gain == 1 else (10e3, (gain - 1) * 10e3)
-        plant_parts = SallenKeyParts(*(parse_positive(v, f"--plant-{n}") for v, n in
-                                       zip(given, ("r1", "r2", "c1", "c2"))), gain, r3, r4)
+        keys = ("resistor_ohm", "resistor_ohm", "capacitor_f", "capacitor_f")
+        vals = [parse_in_range(v, f"--plant-{n}", k) for v, n, k in zip(given, names, keys)]
+        gain = 1.0 if args.plant_gain is None else parse_in_range(args.plant_gain, "--plant-gain", "gain")
+        # R3/R4 derived from K by the one plant validation (check_parts, in PidSpec.validate)
+        plant_parts = SallenKeyParts(*vals, gain)
     elif args.plant_gain is not None:
         raise DesignError("--plant-gain goes with --plant-r1..--plant-c2")
-    tuning = None if args.tuning is None else args.tuning.strip().lower()
-    kp = _opt(args.kp, "--kp", parse_value)
-    ti = _opt(args.ti, "--ti", parse_value)
-    td = _opt(args.td, "--td", parse_value)
-    if kp is not None and kp <= 0:
-        raise DesignError(f"--kp must be greater than 0, got {args.kp!r}")
-    if ti is not None and ti <= 0:
-        raise DesignError(f"--ti must be a time greater than 0 s, got {args.ti!r}")
-    if td is not None and td < 0:
-        raise DesignError(f"--td must be a time of 0 s or more, got {args.td!r}")
-    spec = PidSpec(
-        plant_fc_hz=_opt(args.plant_fc, "--plant-fc"),
-        plant_zeta=_opt(args.plant_zeta, "--plant-zeta"),
-        plant_parts=plant_parts, plant_json=args.plant_json, tuning=tuning, kp=kp, ti_s=ti, td_s=td,
-        opamp=args.opamp, step_v=parse_positive(args.step, "--step"),
-        edge_s=parse_value(args.edge, "--edge"),
-        **part_options(args),
-        target_overshoot_pct=_opt(args.target_overshoot, "--target-overshoot", parse_value),
-        target_settling_s=_opt(args.target_settling, "--target-settling"),
-        f_integrator_hz=_opt(args.f_integrator, "--f-integrator"),
-        f_differentiator_hz=_opt(args.f_differentiator, "--f-differentiator"),
-        square_hz=_opt(args.square_freq, "--square-freq"),
-        controller_parts=seed_parts() if args.seed_parts else None)
     if args.plant_zeta is not None and args.plant_fc is None:
         raise DesignError("--plant-zeta needs --plant-fc")
+    tuning = None if args.tuning is None else args.tuning.strip().lower()
+    spec = PidSpec(
+        plant_fc_hz=optional(args.plant_fc, "--plant-fc", "fc_hz"),
+        plant_zeta=optional(args.plant_zeta, "--plant-zeta", "zeta"),
+        plant_parts=plant_parts, plant_json=args.plant_json, tuning=tuning,
+        kp=optional(args.kp, "--kp", "kp"), ti_s=optional(args.ti, "--ti", "ti_s"),
+        td_s=optional(args.td, "--td", "td_s"),
+        opamp=args.opamp, step_v=parse_in_range(args.step, "--step", "step_v"),
+        edge_s=parse_in_range(args.edge, "--edge", "edge_s"),
+        **part_options(args),
+        target_overshoot_pct=optional(args.target_overshoot, "--target-overshoot", "target_overshoot_pct"),
+        target_settling_s=optional(args.target_settling, "--target-settling", "target_settling_s"),
+        f_integrator_hz=optional(args.f_integrator, "--f-integrator", "f_integrator_hz"),
+        f_differentiator_hz=optional(args.f_differentiator, "--f-differentiator", "f_differentiator_hz"),
+        square_hz=optional(args.square_freq, "--square-freq", "square_hz"),
+        controller_parts=seed_parts() if args.seed_parts else None)
     spec.validate()
     return spec
 
@@ -144,10 +150,10 @@ def _run(args) -> int:
     from .pid.report import summary_text, write_outputs
     spec = _build_spec(args)
     if args.name is not None:
-        _check_name(args.name)
+        check_name(args.name)
     if not args.no_files:
-        from .fileio import ensure_dir
-        ensure_dir(args.out)  # fail before the work, not after
+        from .fileio import check_can_create
+        check_can_create(args.out, ("netlists", "reports"))  # fail before the work, creating nothing
     result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
     name = args.name or _default_name(spec, result.plant.fn_hz, result.plant.zeta)
     return emit(result, args, name, write_outputs, summary_text)

@@ -8,12 +8,12 @@ from pathlib import Path
 
 import pytest
 
-BIN = Path("/work/main/.venv/bin")
-if not (BIN / "design-pid").exists():  # another checkout: use the running interpreter's venv
-    import sys
-    BIN = Path(sys.executable).parent
-DESIGN_PID = str(BIN / "design-pid")
-DESIGN_PLANT = str(BIN / "design-plant")
+from designer.pid import tuning
+
+from conftest import script
+
+DESIGN_PID = script("design-pid")
+DESIGN_PLANT = script("design-plant")
 
 
 def run(*args, cwd=None):
@@ -35,7 +35,11 @@ def test_json_keys_and_files(tmp_path):
     assert {"plant", "tuning", "components", "achieved", "checks", "closed_loop", "files"} <= set(d)
     t = d["tuning"]
     assert t["method"] == "zn"
-    assert {"kp", "ti_s", "td_s", "K", "L_s", "T_s"} <= set(t)
+    assert {"kp", "ti_s", "td_s", "model", "reaction_curve", "fopdt_fit"} <= set(t)
+    assert t["model"]["source"] == "tangent" and t["model"]["L_s"] == t["reaction_curve"]["L_s"]
+    assert {"K", "L_s", "T_s"} <= set(t["reaction_curve"]) and {"K", "L_s", "T_s"} <= set(t["fopdt_fit"])
+    # every rule row says which model it used: the tangent for ZN, the fit for the others
+    assert {r["method"]: r["model"]["source"] for r in d["rules"]} == tuning.RULE_MODEL
     comps = d["components"]
     assert {f"R{i}_ohm" for i in range(3, 19)} | {"C3_f", "C4_f"} <= set(comps)
     assert {"kp", "ti_s", "td_s", "f_integrator_hz", "f_differentiator_hz", "f_summer_hz"} <= set(d["achieved"])

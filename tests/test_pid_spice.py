@@ -26,7 +26,8 @@ def _design(**kw):
 
 @pytest.mark.parametrize("backend", ["pyspice", "ngspice-cli"])
 def test_ideal_opamps_agree_within_one_point_of_overshoot(backend):
-    spec = PidSpec(plant_parts=SEED_PLANT, opamp="ideal", tuning="chr20")
+    # Cohen-Coon on the least-squares FOPDT gives a stable loop for this plant (23 % overshoot)
+    spec = PidSpec(plant_parts=SEED_PLANT, opamp="ideal", tuning="cohen-coon")
     res = design_pid(spec, simulate=True, simulator=backend)
     a, s = res.analytic, res.spice
     assert s["stable"] and not s["saturated"]

@@ -19,15 +19,16 @@ from scipy import signal
 from .. import eseries, opamps
 from ..bench import recommend_square_wave
 from ..errors import DesignError
-from ..metrics import step_metrics
 from ..models import dominant_pair, plant_tf, plant_tf_opamp, response_span
 from ..opamps import OpAmp
 from ..report import json_safe
-from ..sallenkey import SallenKeyParts
+from ..ranges import RANGES
+from ..sallenkey import SallenKeyParts, check_parts
 from ..units import format_eng
 from . import blocks, model, tuning
 from ..netlist import SquareTest
 from .netlist import closed_loop_deck
+from .verify import loop_metrics
 
 #: phase margin below which the loop is called under-damped on the bench
 MIN_PHASE_MARGIN_DEG = 30.0
@@ -65,6 +66,9 @@ class PidSpec:
     tol: float = 0.01
 
     def validate(self) -> None:
+        """Refuse, in one line, anything outside :data:`designer.ranges.RANGES` or
+        inconsistent, before any work; the plant's parts go through
+        :func:`designer.sallenkey.check_parts` (the one plant validation)."""
         sources = sum(x is not None for x in (self.plant_fc_hz, self.plant_parts, self.plant_json))
         if sources != 1:
             raise DesignError("give the plant one way: --plant-fc/--plant-zeta, --plant-r1..--plant-c2, "
@@ -72,16 +76,21 @@ class PidSpec:
         if self.plant_fc_hz is not None:
             if self.plant_zeta is None:
                 raise DesignError("--plant-fc needs --plant-zeta")
-            for name, v in (("--plant-fc", self.plant_fc_hz), ("--plant-zeta", self.plant_zeta)):
-                if not (math.isfinite(v) and v > 0):
-                    raise DesignError(f"{name} must be a finite number above 0, got {v!r}")
+            _check("fc_hz", self.plant_fc_hz, "--plant-fc")
+            _check("zeta", self.plant_zeta, "--plant-zeta")
+        elif self.plant_zeta is not None:
+            raise DesignError("--plant-zeta needs --plant-fc")
+        if self.plant_parts is not None:
+            self.plant_parts = check_parts(self.plant_parts, name_of=PLANT_FLAGS)
         opamps.get(self.opamp)
+        for key, flag in (("r_min", "--r-min"), ("r_max", "--r-max")):
+            _check("resistor_ohm", getattr(self, key), flag)
+        for key, flag in (("c_min", "--c-min"), ("c_max", "--c-max")):
+            _check("capacitor_f", getattr(self, key), flag)
         self.r_series, self.c_series = eseries.check_bounds(
             self.r_series, self.c_series, self.r_min, self.r_max, self.c_min, self.c_max)
-        if not (math.isfinite(self.step_v) and self.step_v > 0):
-            raise DesignError(f"--step must be a positive finite number of volts, got {self.step_v!r}")
-        if not (math.isfinite(self.edge_s) and self.edge_s >= 0):
-            raise DesignError(f"--edge must be a time of 0 s or more, got {self.edge_s!r}")
+        _check("step_v", self.step_v, "--step")
+        _check("edge_s", self.edge_s, "--edge")
         explicit = [v is not None for v in (self.kp, self.ti_s, self.td_s)]
         if any(explicit) and not all(explicit):
             raise DesignError("--kp, --ti and --td go together (give all three)")
@@ -90,23 +99,39 @@ class PidSpec:
                 raise DesignError(f"--tuning {self.tuning} and explicit --kp/--ti/--td exclude each other")
             tuning.explicit(self.kp, self.ti_s, self.td_s)
         elif self.tuning not in (None, "optimize") and self.tuning not in tuning.RULES:
-            raise DesignError(f"unknown --tuning {self.tuning!r}; allowed: {', '.join(tuning.RULES)}, optimize")
+            raise DesignError(f"unknown --tuning {_short(self.tuning)}; allowed: {', '.join(tuning.RULES)}, "
+                              "optimize")
         if self.tuning == "optimize":
             if self.target_overshoot_pct is None:
                 raise DesignError("--tuning optimize needs --target-overshoot P (percent)")
-            if not (math.isfinite(self.target_overshoot_pct) and self.target_overshoot_pct >= 0):
-                raise DesignError(f"--target-overshoot must be a percentage of 0 or more, "
-                                  f"got {self.target_overshoot_pct!r}")
-            if self.target_settling_s is not None and not (math.isfinite(self.target_settling_s)
-                                                           and self.target_settling_s > 0):
-                raise DesignError(f"--target-settling must be a time above 0 s, got {self.target_settling_s!r}")
+            _check("target_overshoot_pct", self.target_overshoot_pct, "--target-overshoot")
+            if self.target_settling_s is not None:
+                _check("target_settling_s", self.target_settling_s, "--target-settling")
         elif self.target_overshoot_pct is not None or self.target_settling_s is not None:
             raise DesignError("--target-overshoot/--target-settling only apply to --tuning optimize")
-        for name in ("f_integrator_hz", "f_differentiator_hz", "square_hz"):
-            v = getattr(self, name)
-            if v is not None and not (math.isfinite(v) and v > 0):
-                raise DesignError(f"--{name.replace('_hz', '').replace('_', '-')} must be a frequency above 0 Hz, "
-                                  f"got {v!r}")
+        for key, flag in (("f_integrator_hz", "--f-integrator"), ("f_differentiator_hz", "--f-differentiator"),
+                          ("square_hz", "--square-freq")):
+            v = getattr(self, key)
+            if v is not None:
+                _check("square_hz" if key == "square_hz" else key, v, flag)
+
+
+#: how design-pid names the plant's fields in messages (see check_parts)
+PLANT_FLAGS = {"r1": "--plant-r1", "r2": "--plant-r2", "c1": "--plant-c1", "c2": "--plant-c2",
+               "gain": "--plant-gain", "r3": "R3", "r4": "R4", "plant": "--plant-r1..--plant-c2"}
+
+
+def _check(key: str, value, flag: str) -> float:
+    """``value`` inside ``RANGES[key]`` (a number), else one line naming ``flag``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise DesignError(f"{flag} must be a number, got {_short(value)}")
+    return RANGES[key].check(float(value), flag)
+
+
+def _short(value) -> str:
+    """A value for a one-line message: short, no newlines, no numpy repr."""
+    text = repr(value) if isinstance(value, str) else type(value).__name__
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 @dataclass
@@ -193,36 +218,38 @@ class PidResult:
 # ---- plant ------------------------------------------------------------------
 
 def plant_from_json(path) -> SallenKeyParts:
-    """The built plant of a ``design-plant``/``analyze-plant`` result.json."""
+    """The built plant of a ``design-plant``/``analyze-plant`` result.json,
+    through the one plant validation (:func:`designer.sallenkey.check_parts`):
+    values of the wrong type, out of range, a gain that disagrees with R3/R4 or
+    an unstable circuit are refused in one line naming the file and the key."""
     p = Path(path)
+    shown = _short(str(p))
     try:
-        data = json.loads(p.read_text())
+        data = json.loads(p.read_text(encoding="utf-8"))
     except OSError as exc:
-        raise DesignError(f"--plant-json: cannot read {str(p)!r}: {exc.strerror or exc}") from None
-    except (json.JSONDecodeError, UnicodeDecodeError):
-        raise DesignError(f"--plant-json: {str(p)!r} is not JSON (expected a design-plant result.json)") from None
+        raise DesignError(f"--plant-json: cannot read {shown}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise DesignError(f"--plant-json: {shown} is not UTF-8 text (expected a design-plant result.json)") \
+            from None
+    except (json.JSONDecodeError, RecursionError):
+        raise DesignError(f"--plant-json: {shown} is not JSON (expected a design-plant result.json)") from None
     built = data.get("built") if isinstance(data, dict) else None
-    keys = ("R1_ohm", "R2_ohm", "C1_f", "C2_f")
-    if not isinstance(built, dict) or not all(isinstance(built.get(k), (int, float)) for k in keys):
-        raise DesignError(f"--plant-json: {str(p)!r} is not a design-plant result "
+    keys = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "gain": "gain", "r3": "R3_ohm",
+            "r4": "R4_ohm"}
+    if not isinstance(built, dict) or not all(keys[k] in built for k in ("r1", "r2", "c1", "c2")):
+        raise DesignError(f"--plant-json: {shown} is not a design-plant result "
                           "(no 'built' object with R1_ohm, R2_ohm, C1_f, C2_f)")
-    vals = [float(built[k]) for k in keys]
-    if not all(math.isfinite(v) and v > 0 for v in vals):
-        raise DesignError(f"--plant-json: {str(p)!r} has non-positive part values")
-    gain = float(built.get("gain", 1.0) or 1.0)
-    return SallenKeyParts(*vals, gain, built.get("R3_ohm"), built.get("R4_ohm"))
+    raw = SallenKeyParts(*(built.get(keys[k]) for k in ("r1", "r2", "c1", "c2", "gain", "r3", "r4")))
+    names = {k: f"--plant-json {shown}: built.{v}" for k, v in keys.items()}
+    names["plant"] = f"--plant-json {shown}"
+    return check_parts(raw, name_of=names)
 
 
 def resolve_plant(spec: PidSpec):
-    """(parts, description) of the plant, designed or given."""
+    """(parts, description) of the plant, designed or given, validated by
+    :func:`designer.sallenkey.check_parts` however it arrives."""
     if spec.plant_parts is not None:
-        p = spec.plant_parts
-        for name, v in (("R1", p.r1), ("R2", p.r2), ("C1", p.c1), ("C2", p.c2)):
-            if not (math.isfinite(v) and v > 0):
-                raise DesignError(f"--plant-{name.lower()} must be a positive value, got {v!r}")
-        if p.zeta <= 0:
-            raise DesignError(f"these plant parts give zeta = {p.zeta:.4g} <= 0: the plant oscillates on its own")
-        return p, "parts"
+        return check_parts(spec.plant_parts, name_of=PLANT_FLAGS), "parts"
     if spec.plant_json is not None:
         return plant_from_json(spec.plant_json), f"json:{spec.plant_json}"
     from ..plant import PlantSpec, design_plant
@@ -230,7 +257,11 @@ def resolve_plant(spec: PidSpec):
                    r_series=spec.r_series, c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
                    c_min=spec.c_min, c_max=spec.c_max, alternatives=1)
     res = design_plant(ps, simulate=False)
-    return res.built, f"design-plant fc={spec.plant_fc_hz:g} Hz zeta={spec.plant_zeta:g}"
+    what = f"the plant designed for --plant-fc {spec.plant_fc_hz:g} --plant-zeta {spec.plant_zeta:g}"
+    built = check_parts(res.built, name_of={k: f"{what}: {v}" for k, v in
+                                            (("r1", "R1"), ("r2", "R2"), ("c1", "C1"), ("c2", "C2"),
+                                             ("r3", "R3"), ("r4", "R4"), ("gain", "gain K"))} | {"plant": what})
+    return built, f"design-plant fc={spec.plant_fc_hz:g} Hz zeta={spec.plant_zeta:g}"
 
 
 def plant_model(parts: SallenKeyParts, amp: OpAmp):
@@ -254,7 +285,7 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice")
     tp = np.linspace(0.0, span, 20001)
     _, yp = signal.step((pn, pd), T=tp)
     curve = tuning.reaction_curve(tp, yp, final=dc)
-    rules = [r.to_dict() for r in tuning.all_rules(curve)]
+    rules = [r.to_dict(brief=True) for r in tuning.all_rules(curve)]
     notes = []
     opt = presized = None
     timings["plant_s"] = time.perf_counter() - tick
@@ -313,9 +344,12 @@ def _optimize(spec, plant, amp, pn, pd, curve, span):
     t = np.linspace(0.0, 0.6 * span, 2001)
     ctx = O.Context(pn, pd, amp, plant.fn_hz, spec.step_v, spec.edge_s, t, spec.target_overshoot_pct,
                     spec.target_settling_s, spec.f_integrator_hz, spec.f_differentiator_hz)
+    # starting points only: ZN's gains and the gentler CHR 0 % formulas on the same
+    # tangent (half ZN's Kp, Ti = T); they bracket a working loop even for an underdamped
+    # plant, where the rules on the fitted FOPDT can start from an unstable one
     starts = []
     for rule in ("zn", "chr0"):
-        r = tuning.tune(rule, curve)
+        r = tuning.tune(rule, curve.tangent)
         starts.append((r.kp, r.ti_s, r.td_s if r.td_s > 0 else 0.3 * curve.L_s))
     fine = O.Context(pn, pd, amp, plant.fn_hz, spec.step_v, spec.edge_s, np.linspace(0.0, 0.6 * span, 20001),
                      spec.target_overshoot_pct, spec.target_settling_s, spec.f_integrator_hz,
@@ -344,15 +378,6 @@ def _optimize(spec, plant, amp, pn, pd, curve, span):
     return tuning.Tuning("optimize", b.kp, b.ti_s, b.td_s, curve, (note,)), out, sel
 
 
-def _metrics(t, y, final=None) -> dict:
-    try:
-        m = step_metrics(t, y, initial=0.0, final=final).to_dict()
-    except DesignError:
-        return {k: None for k in ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")}
-    return {k: m[k] for k in ("overshoot_pct", "peak_time_s", "rise_time_s", "rise_time_0_100_s",
-                              "settling_time_s", "settling_time_5pct_s", "peak_value", "final_value")}
-
-
 def _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, span, notes) -> PidResult:
     lm = model.assemble(parts, amp, pn, pd)
     stable = lm.stable()
@@ -362,12 +387,14 @@ def _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, s
         dc_cl = float(-(lm.c[iy] @ np.linalg.solve(lm.a, lm.b)).item() + lm.d[iy, 0])
     except np.linalg.LinAlgError:
         dc_cl = math.nan
+    # the settled output every figure and the deck's .meas levels refer to (verify.loop_metrics)
+    expected = spec.step_v * dc_cl if math.isfinite(dc_cl) and dc_cl > 0 else spec.step_v
     # a first look on a long grid for the settling time, to size the square wave
     t_long = np.linspace(0.0, span, 8001)
     ts = None
     if stable:
         w_long = lm.simulate(t_long, model.reference(t_long, 1.0, 0.0, spec.edge_s))
-        ts = _metrics(t_long, w_long["y"]).get("settling_time_s")
+        ts = loop_metrics(t_long, w_long["y"], expected / spec.step_v).get("settling_time_s")
     if ts is None:
         ts = span / 2
     sq = recommend_square_wave(ts, spec.step_v, spec.square_hz)
@@ -375,13 +402,14 @@ def _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, s
     test = SquareTest(spec.step_v, sq.frequency_hz, 0.05 * hp, spec.edge_s)
     t = np.linspace(0.0, hp, 20001)
     r = model.reference(t, spec.step_v, 0.0, spec.edge_s)
-    waves = lm.simulate(t, r) if stable else _diverging(lm, t, r, 2 * max(abs(amp.vcc), abs(amp.vee)))
-    ideal_n, ideal_d = plant_tf(plant)
-    y_ideal = model.simulate_ideal(tun.kp, tun.ti_s, tun.td_s, ideal_n, ideal_d, t, r)
+    rails = 2 * max(abs(amp.vcc), abs(amp.vee))
+    waves = lm.simulate(t, r) if stable else _diverging(lm, t, r, rails)
+    il = model.ideal_loop(tun.kp, tun.ti_s, tun.td_s, *plant_tf(plant))
+    y_ideal = (il.simulate(t, r) if il.stable() else _diverging(il, t, r, rails))["y"]
     _, y_open, _ = signal.lsim((pn, pd), r, t)
-    analytic = _metrics(t, waves["y"])
+    analytic = loop_metrics(t, waves["y"], expected)
     analytic.update(stable=stable, dc_gain=dc_cl, steady_state_error_pct=100 * (1 - dc_cl))
-    ideal = _metrics(t, y_ideal)
+    ideal = loop_metrics(t, y_ideal, spec.step_v)   # a true integrator: no steady-state error
     rise = analytic.get("rise_time_s") or (hp / 20)
     levels = model.waveform_limits(waves, t, amp, model.SLEW_DELAY_FRACTION * rise) if stable else {}
     f_lo = min(parts.f_integrator_hz, plant.fn_hz) / 20
@@ -394,7 +422,6 @@ def _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, s
         notes.append(f"to have gains chosen for the loop as built with {amp.name}s (stable with the op-amp poles, "
                      "every op-amp inside its swing and slew rate for this step): --tuning optimize "
                      "--target-overshoot P")
-    expected = spec.step_v * dc_cl if math.isfinite(dc_cl) else spec.step_v
     title = (f"PID closed loop Kp={parts.kp:.4g} Ti={parts.ti_s:.4g}s Td={parts.td_s:.4g}s "
              f"plant fn={plant.fn_hz:.5g}Hz zeta={plant.zeta:.4g} op-amp={amp.name}")
     deck = closed_loop_deck(parts, plant, amp, test, title, expected)

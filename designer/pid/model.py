@@ -344,14 +344,18 @@ def reference(t, step: float, t0: float, edge: float) -> np.ndarray:
     return step * np.clip((t - t0) / edge, 0.0, 1.0)
 
 
-def simulate_ideal(kp, ti, td, plant_num, plant_den, t, r) -> np.ndarray:
-    """Plant output of the ideal-PID loop for reference samples ``r``."""
+def ideal_loop(kp, ti, td, plant_num, plant_den) -> LoopModel:
+    """The ideal-PID loop y/r as a :class:`LoopModel` (output ``y``)."""
     n, d = ideal_closed_loop(kp, ti, td, plant_num, plant_den)
     if len(n) >= len(d):
         raise DesignError("ideal closed loop is improper (plant of order < 2 with Td > 0)")
     a, b, c, dd = signal.tf2ss(n, d)
-    lm = LoopModel(a, b, c, dd, ("y",))
-    return lm.simulate(t, r)["y"]
+    return LoopModel(a, b, c, dd, ("y",))
+
+
+def simulate_ideal(kp, ti, td, plant_num, plant_den, t, r) -> np.ndarray:
+    """Plant output of the ideal-PID loop for reference samples ``r`` (a stable loop)."""
+    return ideal_loop(kp, ti, td, plant_num, plant_den).simulate(t, r)["y"]
 
 
 #: slewing may delay a stage by at most this fraction of the closed-loop rise time

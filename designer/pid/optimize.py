@@ -13,8 +13,10 @@ The search minimises the ITAE of the step response (a smooth stand-in for
   (:func:`designer.pid.model.waveform_limits`);
 * a stable loop.
 
-Nelder-Mead in log(Kp, Ti, Td) from several rule-based starts; the gains are
-then sized with E-series parts and checked again by the caller.
+Nelder-Mead in log(Kp, Ti, Td) from several rule-based starts, inside the
+ranges design-pid accepts for given gains (``designer.ranges``: kp, ti_s,
+td_s); the gains are then sized with E-series parts and checked again by the
+caller.
 """
 
 from __future__ import annotations
@@ -28,7 +30,13 @@ from scipy import optimize as sopt
 from ..errors import DesignError
 from ..metrics import step_metrics
 from ..opamps import OpAmp
+from ..ranges import RANGES
 from . import blocks, model
+
+
+#: the search box, log(Kp, Ti, Td): the ranges design-pid accepts for given gains
+BOX_LO = np.log([RANGES["kp"].lo, RANGES["ti_s"].lo, RANGES["td_s"].lo])
+BOX_HI = np.log([RANGES["kp"].hi, RANGES["ti_s"].hi, RANGES["td_s"].hi])
 
 
 @dataclass
@@ -158,9 +166,12 @@ def optimize(ctx: Context, starts, maxiter: int = 120) -> OptimizeResult:
         key = tuple(np.round(x, 9))
         if key not in cache:
             count += 1
-            kp, ti, td = np.exp(x)
-            if np.any(np.abs(x) > 60):  # far outside any sensible gain or time
-                cache[key] = Evaluation(*np.exp(np.clip(x, -60, 60)), 1e6, False)
+            kp, ti, td = np.exp(np.clip(x, -700, 700))
+            if np.any(x < BOX_LO) or np.any(x > BOX_HI):
+                # outside the gains and times design-pid accepts (designer.ranges): no loop
+                # to simulate, a cost that grows with the distance back into the box
+                out = float(np.sum(np.maximum(BOX_LO - x, 0.0) + np.maximum(x - BOX_HI, 0.0)))
+                cache[key] = Evaluation(float(kp), float(ti), float(td), 1e6 * (1.0 + out), False)
             else:
                 cache[key] = evaluate(float(kp), float(ti), float(td), ctx)
         return cache[key].cost
@@ -173,8 +184,9 @@ def optimize(ctx: Context, starts, maxiter: int = 120) -> OptimizeResult:
                                      "initial_simplex": x0 + np.vstack([np.zeros(3), 0.4 * np.eye(3)])})
         f(sol.x)
         results.append(cache[tuple(np.round(sol.x, 9))])
-    best_ok = [e for e in results if meets(e, ctx)]
-    pool = best_ok or results
+    # a stable loop that misses an unreachable target beats an unstable one, whatever the penalties
+    pool = ([e for e in results if meets(e, ctx)] or [e for e in results if e.stable]
+            or [e for e in cache.values() if e.stable] or results)
     best = min(pool, key=lambda e: e.cost)
     met = meets(best, ctx)
     msg = ("targets met" if met else

@@ -15,6 +15,7 @@ from .. import eseries
 from .. import report as R
 from ..units import format_eng
 from .model import OPAMP_OUTPUTS
+from .tuning import MODEL_NAMES
 
 #: what each block's output looks like on the scope for a square-wave reference
 SHAPES = {
@@ -82,21 +83,35 @@ def sections(result, with_images: bool = True) -> list:
     # tuning
     blocks = [R.text(f"Method: {tun['method']}. Kp = {tun['kp']:.4g}, Ti = {_v(tun['ti_s'], 's')}, "
                      f"Td = {_v(tun['td_s'], 's')}.")]
-    if tun.get("L_s") is not None:
+    rc, fit = tun.get("reaction_curve"), tun.get("fopdt_fit")
+    if rc is not None:
         blocks.append(R.text(
-            f"Reaction curve of the plant as built: inflection at {_v(tun['t_inflection_s'], 's')} "
-            f"(y = {tun['y_inflection']:.4g}), tangent slope {tun['slope_per_s']:.5g} /s, K = {tun['K']:.4g}, "
-            f"L = {_v(tun['L_s'], 's')}, T = {_v(tun['T_s'], 's')} (the tangent reaches the final value at "
-            f"{_v(tun['t_tangent_final_s'], 's')}; T is measured from L)."))
-        rows = [[r["method"], f"{r['kp']:.4g}", _v(r["ti_s"], "s"), _v(r["td_s"], "s")] for r in d["rules"]]
-        blocks.append(R.table(["rule (FOPDT K, L, T)", "Kp", "Ti", "Td"], rows))
+            f"Reaction curve of the plant as built: inflection at {_v(rc['t_inflection_s'], 's')} "
+            f"(y = {rc['y_inflection']:.4g}), tangent slope {rc['slope_per_s']:.5g} /s, K = {rc['K']:.4g}, "
+            f"L = {_v(rc['L_s'], 's')}, T = {_v(rc['T_s'], 's')} (the tangent reaches the final value at "
+            f"{_v(rc['t_tangent_final_s'], 's')}; T is measured from L). ZN's rule uses this tangent."))
+    if fit is not None:
+        how = ""
+        if not fit["valid"]:
+            how = (f" The step overshoots {rc['overshoot_pct']:.3g} %, which no FOPDT model can follow: treat "
+                   "the rules below as starting points." if rc is not None and rc["overshoot_pct"] > 2.0
+                   else f" The fit is poor: {fit['note']}.")
+        blocks.append(R.text(
+            f"Least-squares FOPDT K e^(-L s)/(T s + 1) of the same step (the model Cohen-Coon, CHR, AMIGO and "
+            f"SIMC were derived for): K = {fit['K']:.4g}, L = {_v(fit['L_s'], 's')}, T = {_v(fit['T_s'], 's')}"
+            + ("" if fit.get("rms_residual") is None else f", rms residual {fit['rms_residual']:.3g}") + "."
+            + how))
+    if d["rules"]:
+        rows = [[r["method"], _model_cell(r.get("model")), f"{r['kp']:.4g}", _v(r["ti_s"], "s"),
+                 _v(r["td_s"], "s")] for r in d["rules"]]
+        blocks.append(R.table(["rule", "model it uses (K, L, T)", "Kp", "Ti", "Td"], rows))
     if d.get("optimizer"):
         b = d["optimizer"]["best"]
         blocks.append(R.text(
             f"Optimiser: {d['optimizer']['message']} ({d['optimizer']['evaluations']} evaluations); predicted "
-            f"overshoot {b['overshoot_pct']:.3g} %, settling {_v(b['settling_time_s'], 's')}, worst swing "
-            f"{100 * (b['swing_ratio'] or 0):.3g} % of the rails, worst slew delay {100 * (b['slew_ratio'] or 0):.3g} % "
-            "of its budget."))
+            f"overshoot {_fmt(b['overshoot_pct'], '%')}, settling {_v(b['settling_time_s'], 's')}, worst swing "
+            f"{_fmt(_pct(b['swing_ratio']), '%')} of the rails, worst slew delay {_fmt(_pct(b['slew_ratio']), '%')} "
+            "of its budget" + ("" if b["stable"] else " (the best point found is an unstable loop)") + "."))
     out.append(("Tuning", blocks))
 
     # BOM
@@ -208,6 +223,17 @@ def sections(result, with_images: bool = True) -> list:
     return out
 
 
+def _model_cell(m) -> str:
+    if not m:
+        return ""
+    return (f"{MODEL_NAMES.get(m['source'], m['source'])}: {m['K']:.4g}, {_v(m['L_s'], 's')}, "
+            f"{_v(m['T_s'], 's')}")
+
+
+def _pct(ratio):
+    return None if ratio is None else 100 * ratio
+
+
 def _fmt(v, unit, signed=False):
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "n/a"
@@ -315,6 +341,10 @@ def _reaction_plot(result) -> bytes:
         ax.plot(tt * 1e6, c.slope_per_s * (tt - c.t_inflection_s) + c.y_inflection, "--", label="tangent")
         ax.plot([c.t_inflection_s * 1e6], [c.y_inflection], "o", label="inflection")
         ax.axhline(c.K, color="k", lw=0.6)
+        if c.fit is not None:
+            f = c.fit
+            ax.plot(tp * 1e6, f.K * (1 - np.exp(-np.clip(tp - f.L_s, 0.0, None) / f.T_s)), ":",
+                    label="least-squares FOPDT")
         ax.set_xlim(0, min(tp[-1], 6 * c.t_tangent_final_s) * 1e6)
         ax.set_title(f"Reaction curve: L = {format_eng(c.L_s, 's')}, T = {format_eng(c.T_s, 's')}")
     ax.set_xlabel("time (us)")

@@ -7,8 +7,13 @@ value) and T (from L to where it reaches the final value). The seed reads T as
 the absolute time at which the tangent reaches the final value (81.75 us for
 its plant); the time constant is that time minus L (60.14 us).
 
-The same K, L, T are a first-order-plus-dead-time (FOPDT) model
-K e^(-L s)/(T s + 1), from which the other rules work:
+The tangent's K, L, T are the model ZN's rule was derived on. The other rules
+were derived for a *fitted* first-order-plus-dead-time (FOPDT) model
+K e^(-L s)/(T s + 1): they get the least-squares FOPDT of the whole step
+(:func:`designer.identify.refine.fit`, seed 000's FOPDT model). On Skogestad's
+example E1 the tangent's T is 67 % long and would make SIMC's Kc 91 % high.
+Each :class:`Tuning` records the model it used (:class:`Fopdt`, ``source``
+``"tangent"`` or ``"least-squares"``); :data:`RULE_MODEL` says which.
 
 * zn:         Kp = 1.2 T/(K L),                 Ti = 2 L,                        Td = 0.5 L
 * cohen-coon: Kp = (T/(K L)) (4/3 + L/(4 T)),   Ti = L (32 + 6 L/T)/(13 + 8 L/T), Td = 4 L/(11 + 2 L/T)
@@ -33,8 +38,37 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from ..errors import DesignError
+from ..ranges import RANGES
 
 RULES = ("zn", "cohen-coon", "chr0", "chr20", "amigo", "simc")
+#: the model each rule was derived on: the ZN tangent, or a fitted FOPDT
+RULE_MODEL = {"zn": "tangent", "cohen-coon": "least-squares", "chr0": "least-squares",
+              "chr20": "least-squares", "amigo": "least-squares", "simc": "least-squares"}
+#: how the build sheet names each model source
+MODEL_NAMES = {"tangent": "ZN tangent", "least-squares": "least-squares FOPDT"}
+
+
+@dataclass(frozen=True)
+class Fopdt:
+    """A first-order-plus-dead-time model K e^(-L s)/(T s + 1) and how it was
+    obtained (``source``: ``"tangent"`` or ``"least-squares"``)."""
+
+    K: float
+    L_s: float
+    T_s: float
+    source: str
+    valid: bool = True        #: False when the fit says the data do not fit an FOPDT (e.g. they overshoot)
+    note: str = ""
+    rms_residual: float | None = None   #: of the least-squares fit, in output units per unit input
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    def describe(self) -> str:
+        """``"least-squares FOPDT: K 1.02, L 34.8 us, T 17.5 us"``."""
+        from ..units import format_eng
+        return (f"{MODEL_NAMES.get(self.source, self.source)}: K {self.K:.4g}, L {format_eng(self.L_s, 's')}, "
+                f"T {format_eng(self.T_s, 's')}")
 
 
 @dataclass(frozen=True)
@@ -54,14 +88,24 @@ class ReactionCurve:
     slope_per_s: float        #: tangent slope in output units per second
     t_tangent_final_s: float
     overshoot_pct: float      #: of the plant response itself (0 for an S curve)
+    fit: Fopdt | None = None  #: least-squares FOPDT of the same step (for every rule but ZN)
+
+    @property
+    def tangent(self) -> Fopdt:
+        """The tangent's K, L, T as a model (what ZN's rule uses)."""
+        return Fopdt(self.K, self.L_s, self.T_s, "tangent")
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        d = asdict(self)
+        d["fit"] = None if self.fit is None else self.fit.to_dict()
+        return d
 
 
 @dataclass(frozen=True)
 class Tuning:
-    """Ideal parallel PID gains Kp (1 + 1/(Ti s) + Td s) and where they came from."""
+    """Ideal parallel PID gains Kp (1 + 1/(Ti s) + Td s) and where they came from:
+    ``model`` is the FOPDT the rule was applied to (None for given or optimised
+    gains), ``curve`` the plant's reaction curve (with its fit)."""
 
     method: str
     kp: float
@@ -69,15 +113,17 @@ class Tuning:
     td_s: float
     curve: ReactionCurve | None = None
     notes: tuple = field(default_factory=tuple)
+    model: Fopdt | None = None
 
-    def to_dict(self) -> dict:
-        d = {"method": self.method, "kp": self.kp, "ti_s": self.ti_s, "td_s": self.td_s}
-        if self.curve is not None:
-            d.update(K=self.curve.K, L_s=self.curve.L_s, T_s=self.curve.T_s,
-                     t_inflection_s=self.curve.t_inflection_s,
-                     y_inflection=self.curve.y_inflection,
-                     slope_per_s=self.curve.slope_per_s,
-                     t_tangent_final_s=self.curve.t_tangent_final_s)
+    def to_dict(self, brief: bool = False) -> dict:
+        """The gains, the model used and the notes; unless ``brief`` (a row of
+        the rules table), also the reaction curve and the least-squares fit."""
+        d = {"method": self.method, "kp": self.kp, "ti_s": self.ti_s, "td_s": self.td_s,
+             "model": None if self.model is None else self.model.to_dict()}
+        if not brief and self.curve is not None:
+            c = self.curve.to_dict()
+            d["fopdt_fit"] = c.pop("fit")
+            d["reaction_curve"] = c
         d["notes"] = list(self.notes)
         return d
 
@@ -104,8 +150,9 @@ def smooth_derivative(t, y, window: int | None = None) -> np.ndarray:
 
 def reaction_curve(t, y, *, u_step: float = 1.0, t_step: float | None = None,
                    initial: float | None = None, final: float | None = None,
-                   window: int | None = None) -> ReactionCurve:
-    """Tangent at the inflection point of a step response (ZN reaction curve).
+                   window: int | None = None, fit: bool = True) -> ReactionCurve:
+    """Tangent at the inflection point of a step response (ZN reaction curve),
+    and the least-squares FOPDT of the same step (the model of the other rules).
 
     Parameters
     ----------
@@ -119,6 +166,9 @@ def reaction_curve(t, y, *, u_step: float = 1.0, t_step: float | None = None,
         Output before the step and settled output (defaults: first and last samples).
     window : int, optional
         Savitzky-Golay window for the derivative (see :func:`smooth_derivative`).
+    fit : bool
+        Also fit the FOPDT model by least squares (:func:`fit_fopdt`), started
+        from the tangent's K, L, T.
 
     Returns
     -------
@@ -155,9 +205,41 @@ def reaction_curve(t, y, *, u_step: float = 1.0, t_step: float | None = None,
     L = ti - zi / slope
     t_end = ti + (1.0 - zi) / slope
     os_pct = max(0.0, (float(np.max(z)) - 1.0) * 100.0)
-    return ReactionCurve(K=span / u_step, L_s=L, T_s=t_end - L, t_inflection_s=ti,
+    K = span / u_step
+    model = fit_fopdt(t, z * K, K, start=Fopdt(K, L, t_end - L, "tangent")) if fit else None
+    return ReactionCurve(K=K, L_s=L, T_s=t_end - L, t_inflection_s=ti,
                          y_inflection=y0 + zi * span, slope_per_s=slope * span,
-                         t_tangent_final_s=t_end, overshoot_pct=os_pct)
+                         t_tangent_final_s=t_end, overshoot_pct=os_pct, fit=model)
+
+
+def fit_fopdt(t, y, K: float, start: Fopdt | None = None) -> Fopdt:
+    """Least-squares FOPDT of a step response, by the identification code
+    (:func:`designer.identify.refine.fit`, seed 000's FOPDT model).
+
+    Parameters
+    ----------
+    t, y : array_like
+        Time since the step and the response per unit input step (0 -> K).
+    K : float
+        The settled value of ``y`` (the static gain).
+    start : Fopdt, optional
+        Starting estimate (the tangent's), else the fit's own two-point start.
+
+    Returns
+    -------
+    Fopdt
+        ``source`` ``"least-squares"``; ``valid`` and ``note`` as the fit says
+        (e.g. invalid for a response that overshoots).
+    """
+    from ..identify.refine import fit
+    guess = None
+    if start is not None and start.T_s > 0:
+        guess = {"model": "fopdt", "params": {"K": start.K, "tau_s": start.T_s, "theta_s": max(start.L_s, 0.0)}}
+    res = fit("fopdt", t, y, K, guess)
+    p = res.params
+    rms = res.points.get("rms_residual")
+    return Fopdt(float(p["K"]), float(p["theta_s"]), float(p["tau_s"]), "least-squares", bool(res.valid),
+                 res.note, None if rms is None or not math.isfinite(rms) else float(rms))
 
 
 def _gains(rule: str, K: float, L: float, T: float):
@@ -182,10 +264,10 @@ def _gains(rule: str, K: float, L: float, T: float):
     raise DesignError(f"unknown tuning rule {rule!r}; allowed: {', '.join(RULES)}")
 
 
-def _rule_notes(rule: str, curve: ReactionCurve) -> list:
+def _rule_notes(rule: str, curve: ReactionCurve | None, model: Fopdt) -> list:
     notes = []
-    r = curve.L_s / curve.T_s
-    if curve.overshoot_pct > 2.0:
+    r = model.L_s / model.T_s
+    if curve is not None and curve.overshoot_pct > 2.0:
         notes.append(
             f"{rule}: the plant's own step response overshoots {curve.overshoot_pct:.1f} %; "
             "reaction-curve rules assume an S-shaped, non-oscillatory plant, so the loop will be "
@@ -194,38 +276,53 @@ def _rule_notes(rule: str, curve: ReactionCurve) -> list:
         notes.append(f"{rule}: L/T = {r:.3g} is outside 0.1..1 where the rule was derived")
     if rule == "cohen-coon" and not 0.1 <= r <= 1.0:
         notes.append(f"cohen-coon: L/T = {r:.3g} is outside 0.1..1 where the rule is reliable")
+    if model.source == "least-squares":
+        notes.append(f"{rule}: applied to the {model.describe()} of the plant's step (the rule's model), "
+                     "not to the ZN tangent")
     if rule == "simc":
         notes.append("simc: for an FOPDT model SIMC is a PI controller (Td = 0), tuned with tau_c = L")
     return notes
 
 
-def tune(rule: str, curve: ReactionCurve) -> Tuning:
-    """Apply a named rule (see :data:`RULES`) to a reaction curve."""
+def model_for(rule: str, curve: ReactionCurve) -> Fopdt:
+    """The FOPDT ``rule`` is applied to (see :data:`RULE_MODEL`)."""
+    if RULE_MODEL[rule] == "tangent":
+        return curve.tangent
+    if curve.fit is None:
+        raise DesignError(f"{rule}: needs the least-squares FOPDT of the step (reaction_curve(..., fit=True))")
+    return curve.fit
+
+
+def tune(rule: str, source) -> Tuning:
+    """Apply a named rule (see :data:`RULES`).
+
+    ``source`` is a :class:`ReactionCurve` (the rule takes its model, tangent
+    or fit, per :data:`RULE_MODEL`) or a :class:`Fopdt` (applied as given).
+    """
     rule = str(rule).strip().lower()
     if rule not in RULES:
         raise DesignError(f"unknown tuning rule {rule!r}; allowed: {', '.join(RULES)}, optimize")
-    if not (curve.K > 0 and curve.L_s > 0 and curve.T_s > 0):
+    curve = source if isinstance(source, ReactionCurve) else None
+    model = model_for(rule, curve) if curve is not None else source
+    if not all(math.isfinite(v) and v > 0 for v in (model.K, model.L_s, model.T_s)):
         raise DesignError(
-            f"reaction curve gives K = {curve.K:.4g}, L = {curve.L_s:.4g} s, T = {curve.T_s:.4g} s; "
-            "the rules need all three positive (a rising response with a visible delay)")
-    kp, ti, td = _gains(rule, curve.K, curve.L_s, curve.T_s)
-    return Tuning(rule, kp, ti, td, curve, tuple(_rule_notes(rule, curve)))
+            f"{rule}: the {MODEL_NAMES.get(model.source, model.source)} model has K = {model.K:.4g}, "
+            f"L = {model.L_s:.4g} s, T = {model.T_s:.4g} s; the rule needs all three positive "
+            "(a rising response with a visible delay)")
+    kp, ti, td = _gains(rule, model.K, model.L_s, model.T_s)
+    return Tuning(rule, kp, ti, td, curve, tuple(_rule_notes(rule, curve, model)), model)
 
 
 def all_rules(curve: ReactionCurve) -> list:
-    """Every rule of :data:`RULES` applied to one reaction curve."""
+    """Every rule of :data:`RULES` applied to one reaction curve (each to its model)."""
     return [tune(r, curve) for r in RULES]
 
 
 def explicit(kp: float, ti_s: float, td_s: float) -> Tuning:
-    """Gains given by the user, validated (Kp > 0, Ti > 0, Td >= 0)."""
-    for name, v in (("kp", kp), ("ti", ti_s), ("td", td_s)):
-        if v is None or not math.isfinite(v):
-            raise DesignError(f"--{name}: must be a finite number, got {v!r}")
-    if kp <= 0:
-        raise DesignError(f"--kp: must be greater than 0, got {kp:g}")
-    if ti_s <= 0:
-        raise DesignError(f"--ti: must be a time greater than 0 s, got {ti_s:g}")
-    if td_s < 0:
-        raise DesignError(f"--td: must be a time of 0 s or more, got {td_s:g}")
+    """Gains given by the user, inside their ranges (:data:`designer.ranges.RANGES`
+    ``kp``, ``ti_s``, ``td_s``; Td = 0 is a PI)."""
+    for name, key, v in (("--kp", "kp", kp), ("--ti", "ti_s", ti_s), ("--td", "td_s", td_s)):
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise DesignError(f"{name} must be a number, got {type(v).__name__}")
+        RANGES[key].check(float(v), name)
     return Tuning("explicit", float(kp), float(ti_s), float(td_s))

@@ -7,6 +7,12 @@ analytic closed loop, and detect the two ways analog loops fail on the bench:
   half period (several zero crossings about its mean, a peak-to-peak above
   2 % of the step, and no decay between the two halves of the last 30 %), or
   that sits far from where it should settle (latch-up, typically at a rail).
+
+Every closed-loop step figure (analytic, SPICE, and the deck's own ``.meas``
+lines, :func:`designer.netlist.measure_lines`) is measured one way,
+:func:`loop_metrics`: levels and the 2 % band relative to the EXPECTED settled
+value (the analytic closed loop's DC gain times the step, known before the
+simulation, so the standalone deck can use it), over the rising half period.
 """
 
 from __future__ import annotations
@@ -16,6 +22,7 @@ import math
 import numpy as np
 
 from ..compare import metric_deltas, nrms, resample
+from ..errors import DesignError
 from ..metrics import step_metrics
 from ..opamps import OpAmp
 from ..simulate import get_simulator
@@ -23,6 +30,43 @@ from .model import OPAMP_OUTPUTS
 
 PIN_FRACTION = 0.01
 PIN_MIN_TIME_S = 0.5e-6
+
+
+#: what a step figure is when the response has none (flat, or NaN samples)
+NO_FIGURES = {k: None for k in ("overshoot_pct", "peak_time_s", "rise_time_s", "rise_time_0_100_s",
+                                "settling_time_s", "settling_time_5pct_s", "peak_value")}
+
+
+def loop_metrics(t, y, expected_final: float) -> dict:
+    """Step figures of a closed-loop response the way the deck measures them.
+
+    Parameters
+    ----------
+    t : array_like
+        Time from the rising edge, over the rising half period (the deck's
+        ``.meas`` window).
+    y : array_like
+        Plant output, from rest (0 V).
+    expected_final : float
+        The settled output the levels refer to (the deck's literal levels):
+        10/90 % for the rise time, the 2 % (and 5 %) band for the settling
+        time and the overshoot are all relative to it.
+
+    Returns
+    -------
+    dict
+        :class:`designer.metrics.StepMetrics` fields (None when undefined),
+        with ``final_value`` the last sample (what the scope shows at the end
+        of the half period), not the expected value.
+    """
+    y = np.asarray(y, float)
+    try:
+        m = step_metrics(t, y, initial=0.0, final=expected_final).to_dict()
+    except DesignError:  # a flat response or one with NaN samples has no step figures
+        m = dict(NO_FIGURES)
+    last = float(y[-1]) if y.size else math.nan
+    m["final_value"] = last if math.isfinite(last) else None
+    return m
 
 
 def saturation(t, waves: dict, opamp: OpAmp) -> dict:
@@ -106,19 +150,16 @@ def run_and_compare(deck: str, simulator: str, t_grid, delay_s: float, half_peri
     slw = slewing(t, full, opamp)
     osc = oscillation(tg, waves["y"], step_v, expected_final)
     saturated = any(v["saturated"] for v in sat.values())
-    try:
-        m = step_metrics(tg, waves["y"], initial=0.0).to_dict()
-    except Exception:  # a flat or broken response has no step figures
-        m = {k: None for k in ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")}
+    m = loop_metrics(tg, waves["y"], expected_final)
     if not osc["stable"]:
         # step figures of an oscillating or latched output mean nothing
         m = {k: (v if k == "final_value" else None) for k, v in m.items()}
     abstol = 0.01 * abs(step_v)
     m.update(nrms=nrms(analytic["y"], waves["y"], abstol), saturated=saturated, stable=osc["stable"])
     try:
-        deltas = metric_deltas(step_metrics(tg, analytic["y"], initial=0.0),
-                               step_metrics(tg, waves["y"], initial=0.0))
-    except Exception:
+        deltas = metric_deltas(step_metrics(tg, analytic["y"], initial=0.0, final=expected_final),
+                               step_metrics(tg, waves["y"], initial=0.0, final=expected_final))
+    except DesignError:  # a flat or broken waveform has no figures to compare
         deltas = {}
     extremes = {sig: (float(np.min(v)), float(np.max(v))) for sig, v in full.items()}
     return {"metrics": m, "saturation": sat, "extremes": extremes, "slewing": slw, "oscillation": osc, "deltas": deltas,
