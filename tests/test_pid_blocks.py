@@ -2,13 +2,30 @@
 search against brute force, and the static checks."""
 
 import math
+import tracemalloc
 
+import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
 from designer import eseries
 from designer.errors import DesignError
 from designer.pid import blocks
+from designer.ranges import RANGES
+
+#: Peak numpy memory the part search may use, whatever the series and bounds
+#: (the benchmark's goal is 500 MB for the whole design-pid process).
+SEARCH_MEMORY_BYTES = 128e6
+
+
+def peak_bytes(fn, *args, **kw):
+    """Peak memory traced (numpy's allocations included) while ``fn`` runs, and its result."""
+    tracemalloc.start()
+    try:
+        out = fn(*args, **kw)
+        return tracemalloc.get_traced_memory()[1], out
+    finally:
+        tracemalloc.stop()
 
 
 def test_seed_part_list_gives_the_seed_gains_and_corners():
@@ -88,6 +105,61 @@ def test_search_equals_brute_force_property(kp, ti, td):
     assert sel.best_possible_pct / 100 == pytest.approx(best_err, rel=1e-9)
     assert blocks.objective(sel.parts, sel.targets, sel.best_possible_pct / 100, 0.01) == \
         pytest.approx(best_obj, rel=1e-9)
+
+
+@settings(max_examples=25, deadline=None)
+@given(kp=st.floats(0.3, 60), ti=st.floats(10e-6, 500e-6), td=st.floats(2e-6, 50e-6),
+       chunk=st.integers(1, 40), tol=st.sampled_from([0.0, 0.01, 0.1]))
+def test_chunked_search_equals_brute_force(kp, ti, td, chunk, tol):
+    # windows, tables and range minima a few entries at a time: every chunk boundary
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(blocks, "QUERIES_PER_CHUNK", chunk)
+        try:
+            sel = blocks.select_parts(kp, ti, td, 3500, tol=tol, **SMALL)
+        except DesignError:
+            return
+    best_err, best_obj = blocks.brute_force(kp, ti, td, 3500, tol=tol, **SMALL)
+    assert sel.best_possible_pct / 100 == pytest.approx(best_err, rel=1e-9)
+    assert blocks.objective(sel.parts, sel.targets, sel.best_possible_pct / 100, tol) == \
+        pytest.approx(best_obj, rel=1e-9)
+    # the chunking changes nothing
+    assert sel.parts == blocks.select_parts(kp, ti, td, 3500, tol=tol, **SMALL).parts
+
+
+@settings(max_examples=50, deadline=None)
+@given(values=st.lists(st.floats(-1e6, 1e6), min_size=1, max_size=70), chunk=st.integers(1, 9),
+       ranges=st.lists(st.tuples(st.integers(0, 70), st.integers(0, 70)), min_size=1, max_size=30))
+def test_range_min_is_the_minimum_of_each_range(values, chunk, ranges):
+    v = np.array(values)
+    start = np.array([min(a, b, v.size) for a, b in ranges])
+    stop = np.array([min(max(a, b), v.size) for a, b in ranges])
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(blocks, "QUERIES_PER_CHUNK", chunk)
+        got = blocks._range_min(v, start, stop)
+    assert got.tolist() == [min(values[a:b], default=math.inf) for a, b in zip(start, stop)]
+
+
+def test_fine_series_sizing_memory_is_bounded():
+    # issue 7: E96/E96 took 3.4 GB (every Kp triple materialised), E192/E192 more than 24 GB
+    peak, e96 = peak_bytes(blocks.select_parts, 3.34, 43.215e-6, 10.8037e-6, 3500, r_series="E96",
+                           c_series="E96")
+    assert peak < SEARCH_MEMORY_BYTES
+    # E192 holds every E96 value: it can only do better
+    e192 = blocks.select_parts(3.34, 43.215e-6, 10.8037e-6, 3500, r_series="E192", c_series="E192")
+    assert e192.best_possible_pct <= e96.best_possible_pct
+    assert e96.worst_error_pct <= max(e96.best_possible_pct, 100 * e96.tol) * (1 + 1e-9)
+
+
+def test_widest_bounds_sizing_memory_is_bounded():
+    r, c = RANGES["resistor_ohm"], RANGES["capacitor_f"]
+    kw = dict(r_series="E96", c_series="E96", r_min=r.lo, r_max=r.hi, c_min=c.lo, c_max=c.hi)
+    peak, wide = peak_bytes(blocks.select_parts, 3.34, 43.215e-6, 10.8037e-6, 3500, **kw)
+    assert peak < SEARCH_MEMORY_BYTES
+    # wider bounds hold every default part: they can only do better
+    assert wide.best_possible_pct <= blocks.select_parts(3.34, 43.215e-6, 10.8037e-6, 3500, r_series="E96",
+                                                         c_series="E96").best_possible_pct
+    peak, _ = peak_bytes(blocks.select_parts, 1.4, 60e-6, 0.0, 3500, **kw)
+    assert peak < SEARCH_MEMORY_BYTES
 
 
 def test_pi_controller_has_no_derivative_stage():
