@@ -28,9 +28,9 @@ Nothing better than the k-th best found so far lies outside the
 parallelograms, so the top k equal those of brute force (tests check it
 against :func:`brute_force`). Capacitor pairs, rows (pair, R1) and candidates
 are handled in chunks of fixed size, so memory stays bounded (tens of MB) for
-any series and bounds; time grows with the number of capacitor pairs (0.3 s
-for E192/E192 with the default bounds, about 2 s for the widest the CLI
-accepts).
+any series and bounds; time grows with the number of capacitor pairs (a
+fraction of a second for E192/E192 with the default bounds, one to two
+seconds for the widest bounds the CLI accepts).
 """
 
 from __future__ import annotations
