@@ -200,3 +200,64 @@ def test_tolerance_band_contains_every_part_combination():
     # without part values the nominal scaling gives the same fn band (fn ~ 1/sqrt(RRCC))
     nominal = tolerance_band({"fn_hz": fn, "zeta": z})
     assert nominal["fn_hz"] == pytest.approx(band["fn_hz"], rel=1e-12)
+
+
+def test_help_states_every_numeric_range():
+    from designer.identify.textfile import MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, size_text
+    from designer.ranges import RANGES
+    out = " ".join(run("--help").stdout.split())
+    for key in ("capture_time_s", "step_amplitude", "capture_span_s", "capture_value",
+                "output_step"):
+        assert RANGES[key].text() in out, key
+    assert size_text(MAX_CAPTURE_BYTES) in out and f"{MAX_CAPTURE_ROWS:,}" in out
+
+
+def test_step_options_outside_their_range_are_one_line(tmp_path):
+    from designer.ranges import RANGES
+    good = tmp_path / "good.csv"
+    t = np.linspace(0, 1, 400)
+    good.write_text("".join(f"{a},{b}\n" for a, b in zip(
+        t, model_step("fopdt", {"K": 1, "tau_s": 0.05, "theta_s": 0.1}, t))))
+    cases = [(["--step-time", "1e300"], RANGES["capture_time_s"].text()),
+             (["--step-time", "-1e300"], RANGES["capture_time_s"].text()),
+             (["--step-amplitude", "1e-300"], RANGES["step_amplitude"].text()),
+             (["--step-amplitude", "-1e300"], RANGES["step_amplitude"].text()),
+             (["--step-amplitude", "0"], "non-zero"),
+             (["--step-time", "nan"], "is not a number")]
+    procs = run_many([[good, *opts] for opts, _ in cases])
+    for (opts, words), proc in zip(cases, procs):
+        assert proc.returncode == 2, (opts, proc.stderr)
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1 and words in lines[0] and "np." not in lines[0], (opts, lines)
+    # a negative amplitude inside the range is a falling step, and works
+    ok = run(good, "--step-amplitude", "-2", "--json")
+    assert ok.returncode == 0, ok.stderr
+    assert json.loads(ok.stdout)["best"]["params"]["K"] == pytest.approx(-0.5, rel=0.02)
+
+
+def test_refused_run_leaves_no_plot_or_folder(tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t,y\n" + "".join(f"{k},{'nan' if k == 5 else k}\n" for k in range(30)))
+    for target in (tmp_path / "new" / "deeper" / "fit.png", tmp_path):
+        proc = run(bad, "--plot", target)
+        assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.csv"]
+
+
+def test_unphysical_classical_results_are_not_evaluated():
+    """A method that returns tau < 0 (Nishikawa on an overshooting response) made
+    the scoring overflow in exp: such a model is never evaluated, only flagged."""
+    import warnings
+
+    from designer.identify.step import identify_step
+    n = 78
+    t = np.linspace(-0.1, 1.0, n) + 1.0
+    y = model_step("underdamped", {"K": -1.0, "wn_rad_s": 60.0, "zeta": 0.2, "theta_s": 0.0},
+                   t - 1.0) + 0.01 * np.random.default_rng(n).standard_normal(n)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = identify_step(t, y)
+    for m in res.methods:
+        if any(k.startswith("tau") and v <= 0 for k, v in m.params.items()):
+            assert not m.valid and not math.isfinite(m.iae)
+    assert res.best.model == "underdamped"

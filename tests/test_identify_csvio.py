@@ -142,3 +142,152 @@ def test_quoted_cells_and_a_units_row():
     units = "x-axis,1\nsecond,Volt\n" + "".join(f"{a:.6e},{b:.6f}\n" for a, b in zip(t, y))
     cap = parse_capture_text(units)
     assert cap.columns == ["second", "Volt"] and np.allclose(cap.t, t, rtol=1e-6)
+
+
+# ------------------------------------------------------- issue 7: files, encodings, columns
+
+def _capture_text(n, *, u=True):
+    """A t,u,y capture of a first-order step, n rows, and its arrays."""
+    t = np.linspace(-1e-3, 9e-3, n)
+    y = model_step("fopdt", {"K": 2.0, "tau_s": 1e-3, "theta_s": 1e-4}, t)
+    uu = np.where(t >= 0, 1.0, 0.0)
+    return format_generic(t, y, uu if u else None), t, y
+
+
+def test_utf16_and_binary_files_are_named(tmp_path):
+    text, _, _ = _capture_text(50)
+    for enc, bom in (("utf-16", True), ("utf-16-le", False), ("utf-16-be", False),
+                     ("utf-32", True)):
+        p = tmp_path / f"{enc}.csv"
+        p.write_text(text, encoding=enc)
+        label = "UTF-32" if "32" in enc else "UTF-16"
+        with pytest.raises(DesignError, match=f"is {label} text, not UTF-8") as exc:
+            read_capture(p)
+        assert "\\x00" not in str(exc.value)
+    (tmp_path / "bin.csv").write_bytes(bytes(range(256)) * 4)
+    with pytest.raises(DesignError, match="not a text file"):
+        read_capture(tmp_path / "bin.csv")
+    # a UTF-8 BOM and a Latin-1 degree sign in a header cell are fine
+    (tmp_path / "bom.csv").write_bytes(b"\xef\xbb\xbft,temp \xb0C\n" + "".join(
+        f"{k},{min(k, 5)}\n" for k in range(20)).encode())
+    cap = read_capture(tmp_path / "bom.csv")
+    assert cap.columns[0] == "t" and cap.t.size == 20
+
+
+def test_same_column_as_input_and_output_is_refused():
+    text = "time_s,vout,vin\n" + "".join(f"{a},{2 * a},{3 * a}\n" for a in range(20))
+    for inp, out in (("2", "2"), ("vout", "2"), ("VIN", "vin")):
+        with pytest.raises(DesignError, match="both the input and the output"):
+            parse_capture_text(text, input_column=inp, output_column=out)
+    one = "t,y\n" + "".join(f"{a},{a}\n" for a in range(20))
+    with pytest.raises(DesignError, match="cannot be both the input and the output"):
+        parse_capture_text(one, input_column="2")
+
+
+def test_messages_show_plain_numbers():
+    text, t, y = _capture_text(30, u=False)
+    lines = text.splitlines()
+    lines[5], lines[6] = lines[6], lines[5]           # time goes back at line 7
+    with pytest.raises(DesignError) as exc:
+        parse_capture_text("\n".join(lines), name="cap.csv")
+    msg = str(exc.value)
+    assert "np." not in msg and "line 7" in msg
+    assert f"{float(lines[5].split(',')[0]):.10g} then {float(lines[6].split(',')[0]):.10g}" in msg
+
+
+@pytest.mark.parametrize("cell, row, column, key", [
+    ("1e300", -1, 1, "capture_time_s"), ("-1e300", 1, 1, "capture_time_s"),
+    ("1e300", 7, 2, "capture_value"), ("-1e300", -1, 2, "capture_value")])
+def test_values_outside_their_physical_range_name_the_line(cell, row, column, key):
+    from designer.ranges import RANGES
+    text, t, y = _capture_text(40, u=False)
+    lines = text.splitlines()          # a header, then the samples
+    cells = lines[row].split(",")
+    cells[column - 1] = cell
+    lines[row] = ",".join(cells)
+    with pytest.raises(DesignError) as exc:
+        parse_capture_text("\n".join(lines), name="cap.csv")
+    assert f"line {row % len(lines) + 1}, column {column}" in str(exc.value)
+    assert RANGES[key].text() in str(exc.value)
+
+
+def test_record_too_short_in_time_is_refused():
+    from designer.ranges import RANGES
+    t = np.linspace(0, 1e-300, 20)
+    text = "".join(f"{a!r},{min(k, 10)}\n" for k, a in enumerate(t.tolist()))
+    with pytest.raises(DesignError, match="duration") as exc:
+        parse_capture_text(text)
+    assert RANGES["capture_span_s"].text() in str(exc.value)
+
+
+def test_streamed_file_equals_the_text_and_names_lines_across_blocks(tmp_path):
+    """A file longer than one read block (with blank and comment lines in later
+    blocks) gives the same samples as the text in memory, and a bad cell deep in
+    it is reported at its own line."""
+    from designer.identify.textfile import BLOCK_BYTES
+    text, t, y = _capture_text(20)
+    head, body = text.splitlines()[0], text.splitlines()[1:]
+    n = 2 * BLOCK_BYTES // len(body[0]) + 1000
+    tt = np.linspace(-1e-3, 9e-3, n)
+    rows = format_generic(tt, model_step("fopdt", {"K": 2.0, "tau_s": 1e-3, "theta_s": 0.0},
+                                         tt), np.where(tt >= 0, 1.0, 0.0)).splitlines()
+    rows[n // 2] += "\n\n# a note in the middle\n"
+    path = tmp_path / "long.csv"
+    path.write_text("\n".join(rows) + "\n")
+    cap = read_capture(path)
+    mem = parse_capture_text(path.read_text())
+    assert cap.t.size == n and np.array_equal(cap.t, mem.t) and np.array_equal(cap.y, mem.y)
+    assert np.array_equal(cap.u, mem.u)
+    # the same file with a bad cell far into the second block
+    k = n - 10
+    lines = path.read_text().splitlines()
+    line_no = next(i for i, ln in enumerate(lines) if ln == rows[k]) + 1
+    lines[line_no - 1] = lines[line_no - 1].rsplit(",", 1)[0] + ",oops"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(DesignError, match=f"line {line_no}, column 3: 'oops' is not a number"):
+        read_capture(path)
+
+
+def test_size_limit_refused_from_the_size(tmp_path):
+    from designer.identify.textfile import MAX_CAPTURE_BYTES, size_text
+    big = tmp_path / "big.csv"
+    with open(big, "wb") as fh:
+        fh.truncate(MAX_CAPTURE_BYTES + 1)    # sparse: refused before a byte is read
+    with pytest.raises(DesignError, match=f"at most {size_text(MAX_CAPTURE_BYTES)}"):
+        read_capture(big)
+
+
+def test_directory_and_devices(tmp_path):
+    with pytest.raises(DesignError, match="is a directory"):
+        read_capture(tmp_path)
+    with pytest.raises(DesignError, match="not a text file"):
+        read_capture("/dev/zero")
+    with pytest.raises(DesignError, match="empty"):
+        read_capture("/dev/null")
+
+
+def test_reading_memory_is_bounded(tmp_path):
+    """Peak memory of reading a capture stays within twice the samples kept plus
+    a few read blocks (the whole text and a Python string per line was 8x the file)."""
+    import subprocess
+    import sys
+
+    from designer.identify.textfile import BLOCK_BYTES
+    n = 1_000_000
+    t = np.linspace(0.0, 1.0, n)
+    path = tmp_path / "m.csv"
+    with open(path, "w") as fh:
+        fh.write("time_s,vin,vout\n")
+        np.savetxt(fh, np.column_stack([t, t >= 0.1, np.exp(-t)]), delimiter=",", fmt="%.9e")
+    code = ("import resource, sys\n"
+            "from designer.identify.csvio import read_capture\n"
+            "r0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss\n"
+            "c = read_capture(sys.argv[1])\n"
+            "r1 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss\n"
+            "print(c.t.size, (r1 - r0) * 1024)\n")
+    out = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
+                         text=True, check=True, timeout=300).stdout.split()
+    samples_bytes = 3 * 8 * n
+    assert int(out[0]) == n
+    assert int(out[1]) < 2 * samples_bytes + 6 * BLOCK_BYTES, (int(out[1]) / 2**20,
+                                                                path.stat().st_size / 2**20)

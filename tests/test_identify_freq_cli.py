@@ -3,12 +3,13 @@
 import json
 import math
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-EXE = "/work/main/.venv/bin/identify-freq"
+EXE = str(Path(sys.executable).parent / "identify-freq")
 FIX = Path(__file__).parent / "fixtures" / "identify_freq"
 
 
@@ -106,3 +107,31 @@ def test_bad_invocations(tmp_path):
     blocker.write_text("x")
     line = one_line_error(run(FIX / "seed003_table31.csv", "--plot", blocker / "sub" / "b.png"))
     assert "cannot create directory" in line
+
+
+def test_help_states_the_limits_and_the_validity_rule():
+    from designer.identify.frequency import BAND_FACTOR, MAX_FIT_ERROR, MAX_POINTS
+    from designer.identify.textfile import MAX_TABLE_BYTES, size_text
+    from designer.ranges import RANGES
+    out = " ".join(run("--help").stdout.split())
+    for key in ("freq_hz", "gain_db", "gain_ratio", "phase_deg"):
+        assert RANGES[key].text() in out, key
+    assert size_text(MAX_TABLE_BYTES) in out and f"{MAX_POINTS:,}" in out
+    assert f"at most {100 * MAX_FIT_ERROR:g} %" in out and f"widened {BAND_FACTOR:g} times" in out
+
+
+def test_gain_units_any_case_and_notes_in_the_table(tmp_path):
+    d = json.loads(run(FIX / "seed000_table4_deg.csv", "--json").stdout)
+    p = run(FIX / "seed000_table4_deg.csv", "--json", "--gain-units", "dB", "--phase-units",
+            "DEG", "--freq-units", "Hz")
+    assert p.returncode == 0, p.stderr
+    assert json.loads(p.stdout)["best"] == d["best"]
+    # a flipped phase: the table says why no model is valid
+    rows = [ln.split(",") for ln in (FIX / "seed000_table4_deg.csv").read_text().splitlines()
+            if ln and ln[0].isdigit()]
+    flipped = tmp_path / "flipped.csv"
+    flipped.write_text("f_hz,gain_db,phase_deg\n" + "".join(
+        f"{f},{g},{-float(ph)}\n" for f, g, ph in rows))
+    p = run(flipped)
+    assert p.returncode == 0, p.stderr
+    assert "Best: none of the methods is valid" in p.stdout and "note: the phase rises" in p.stdout

@@ -325,3 +325,130 @@ def test_seed000_example3_integrator_is_flagged():
     for r in (fr.asymptotes(d), fr.resonant_peak(d)):
         assert not r.valid and "dB/decade at the lowest frequencies" in r.note
     fr.identify_freq(d)    # the fits still run (and are ranked by their error)
+
+
+# ---------------------------------------------------------------- validity (issue 7, item 11)
+
+SECOND_ORDER = {"K": 1.0, "wn_rad_s": 2 * math.pi * 1e3, "zeta": 0.3, "theta_s": 20e-6}
+
+
+def _second_order_table():
+    """f (Hz), gain ratio, phase (deg) of an underdamped plant with dead time over
+    0.02-50 wn: the table the three wrong readings below are made of."""
+    w = np.geomspace(0.02, 50, 40) * SECOND_ORDER["wn_rad_s"]
+    g = fr.model_response("underdamped", SECOND_ORDER, w)
+    return w / (2 * math.pi), np.abs(g), np.degrees(fr.model_phase("underdamped", SECOND_ORDER, w))
+
+
+def test_the_right_reading_is_valid_and_exact():
+    f, ratio, deg = _second_order_table()
+    res = fr.identify_freq(fr.freq_data(f, ratio, deg, gain_units="ratio"))
+    assert res.best.model == "underdamped" and res.best.valid
+    for k, v in SECOND_ORDER.items():
+        assert res.best.params[k] == pytest.approx(v, rel=1e-6)
+    assert res.best.iae <= fr.MAX_FIT_ERROR
+
+
+def test_flat_table_gives_no_valid_model():
+    # 0 dB and 0 deg everywhere: the fits "explain" it with poles far above the
+    # table (wn = 2e54 rad/s was marked ok); no corner can be placed by these data
+    f = np.geomspace(10, 2e5, 14)
+    res = fr.identify_freq(fr.freq_data(f, np.zeros_like(f), np.zeros_like(f)))
+    assert res.best is None and not any(m.valid for m in res.methods)
+    w_hi = 2 * math.pi * f[-1] * fr.BAND_FACTOR
+    for m in res.methods:
+        if m.name == "least-squares":
+            corners = fr.corner_frequencies(m.model, m.params)
+            assert max(corners.values()) > w_hi and "outside the measured band" in m.note
+
+
+def test_ratio_read_as_db_gives_no_valid_model():
+    f, ratio, deg = _second_order_table()
+    text = "f,g,p\n" + "".join(f"{a!r},{b!r},{c!r}\n" for a, b, c in
+                                zip(f.tolist(), ratio.tolist(), deg.tolist()))
+    data = fr.parse_freq_table(text)            # no units in the header: dB by default
+    res = fr.identify_freq(data)
+    assert res.best is None
+    assert any(m.iae > fr.MAX_FIT_ERROR and "fit error" in m.note for m in res.methods)
+    assert any("--gain-units ratio" in n for n in data.notes)
+    # the same text with the units it really has
+    ok = fr.identify_freq(fr.parse_freq_table(text, gain_units="RATIO"))
+    assert ok.best.params["wn_rad_s"] == pytest.approx(SECOND_ORDER["wn_rad_s"], rel=1e-6)
+
+
+def test_flipped_phase_sign_gives_no_valid_model():
+    f, ratio, deg = _second_order_table()
+    data = fr.freq_data(f, ratio, -deg, gain_units="ratio")
+    res = fr.identify_freq(data)
+    assert res.best is None
+    judged = [m for m in res.methods if "fit error" in m.note]
+    assert judged and all(m.iae > fr.MAX_FIT_ERROR for m in judged)
+    assert any("negate" in n for n in data.notes)
+
+
+def test_every_valid_model_obeys_the_rule():
+    """Whatever a table, a model marked valid has the error and corners the rule asks."""
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        f = np.geomspace(1, 1e5, 25)
+        g = np.cumsum(rng.normal(-1.5, 2.0, f.size))
+        ph = np.cumsum(rng.normal(-8.0, 6.0, f.size))
+        data = fr.freq_data(f, g, ph)
+        for m in fr.identify_freq(data).methods:
+            if m.valid:
+                assert m.iae <= fr.MAX_FIT_ERROR
+                for wc in fr.corner_frequencies(m.model, m.params).values():
+                    assert data.w[0] / fr.BAND_FACTOR <= wc <= data.w[-1] * fr.BAND_FACTOR
+
+
+# ---------------------------------------------------------------- units and ranges (items 7, 13)
+
+def test_units_any_case():
+    f, ratio, deg = _second_order_table()
+    a = fr.freq_data(f, 20 * np.log10(ratio), deg, gain_units="dB", phase_units="DEG",
+                     freq_units="Hz")
+    b = fr.freq_data(f, ratio, np.radians(deg), gain_units="ratio", phase_units="rad")
+    assert a.units == {"frequency": "hz", "gain": "db", "phase": "deg"}
+    assert np.allclose(a.gain, b.gain, rtol=1e-12) and np.allclose(a.phase, b.phase)
+
+
+@pytest.mark.parametrize("row, key, words", [
+    ("1e300,-1,-10", "freq_hz", "frequency at line 4"),
+    ("30,-1e300,-10", "gain_db", "gain at line 4"),
+    ("30,-1,-1e300", "phase_deg", "phase (in degrees) at line 4"),
+    ("1e-300,-1,-10", "freq_hz", "frequency at line 4"),
+])
+def test_values_outside_their_physical_range_are_one_line(row, key, words):
+    from designer.ranges import RANGES
+    rows = ["1,0,0", "2,-0.1,-2", "3,-0.2,-4", row, "40,-3,-40", "50,-6,-50"]
+    text = "f_hz,gain_db,phase_deg\n" + "\n".join(sorted(rows, key=lambda r: float(r.split(",")[0])))
+    with pytest.raises(DesignError) as exc:
+        fr.parse_freq_table(text, source="t.csv")
+    msg = str(exc.value)
+    assert "\n" not in msg and RANGES[key].text() in msg and "np." not in msg
+    assert words.split(" at ")[0] in msg
+
+
+def test_time_shift_overflowing_the_phase_is_one_line():
+    text = "f_khz;gain_ratio;shift_us\n" + "".join(
+        f"{f};{g};{s}\n" for f, g, s in ((1, 1, 0), (2, 1, 1), (5, 0.9, 1), (10, 0.7, 1e300),
+                                          (20, 0.4, 1)))
+    with pytest.raises(DesignError, match=r"phase \(in degrees\) at line 5"):
+        fr.parse_freq_table(text, source="t.csv")
+
+
+def test_table_limits(tmp_path):
+    from designer.identify.textfile import MAX_TABLE_BYTES, size_text
+    big = tmp_path / "big.csv"
+    with open(big, "wb") as fh:
+        fh.truncate(MAX_TABLE_BYTES + 1)       # sparse: refused from its size, never read
+    with pytest.raises(DesignError, match=f"at most {size_text(MAX_TABLE_BYTES)}"):
+        fr.read_freq_table(big)
+    rows = "".join(f"{k + 1},0\n" for k in range(fr.MAX_POINTS + 1))
+    with pytest.raises(DesignError, match=f"at most {fr.MAX_POINTS:,}"):
+        fr.parse_freq_table(rows)
+    with pytest.raises(DesignError, match="is a directory"):
+        fr.read_freq_table(tmp_path)
+    (tmp_path / "u16.csv").write_text("f,g\n1,0\n2,-1\n3,-2\n4,-3\n5,-4\n", encoding="utf-16")
+    with pytest.raises(DesignError, match="UTF-16 text, not UTF-8"):
+        fr.read_freq_table(tmp_path / "u16.csv")

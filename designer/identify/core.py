@@ -48,6 +48,18 @@ def model_step(model: str, params: dict, t) -> np.ndarray:
     return K * np.where(t >= theta, y, 0.0)
 
 
+def unphysical(model: str, params: dict) -> str:
+    """Why ``params`` are not a stable, causal ``model`` ("" when they are): a
+    time constant or wn that is not positive, a negative zeta. Their step
+    response grows without bound (exp overflows), so it is never evaluated."""
+    for k, v in params.items():
+        if (k.startswith("tau") or k == "wn_rad_s") and not v > 0:
+            return f"{k} = {v:.4g} is not positive"
+        if k == "zeta" and not v >= 0:
+            return f"zeta = {v:.4g} is negative"
+    return ""
+
+
 def iae_ise(t, y, y_model):
     """Integral of |error| and of error^2 over the record (trapezoid rule)."""
     e = np.asarray(y, float) - np.asarray(y_model, float)

@@ -31,7 +31,6 @@ are :func:`.preprocess.check_samples`.
 from __future__ import annotations
 
 import bisect
-import itertools
 import re
 from dataclasses import dataclass, field
 
@@ -197,9 +196,19 @@ def _parse(head, blocks, name, input_column, output_column, size_hint=None) -> C
     layout = _layout(lines, name)
     j_out, j_in, tentative = _choose_columns(layout.columns, input_column, output_column, name)
     keep = [0, j_out] + ([j_in] if j_in is not None else [])
-    more = itertools.chain([first], blocks) if first is not None else iter(())
+    more = _then(first, blocks) if first is not None else iter(())
+    del first   # the block is the generator's now: freed once parsed
     cols = _load(lines, layout, keep, more, name, size_hint)
     return _assemble(cols, layout, keep, tentative, name)
+
+
+def _then(first, rest):
+    """``first``, then the items of ``rest``, holding no reference to ``first``
+    once it is consumed (a parsed block is freed before the next is read)."""
+    box = [first]
+    del first
+    yield box.pop()
+    yield from rest
 
 
 def _layout(lines, name) -> _Layout:
@@ -229,7 +238,8 @@ def _is_number(cell: str) -> bool:
 
 
 def _delimiter(lines: list) -> str:
-    sample = lines[-min(len(lines), 20):]
+    # the last lines are samples; comment and blank lines say nothing
+    sample = [ln for ln in lines if ln.strip() and not ln.lstrip().startswith("#")][-20:]
     counts = {d: sum(line.count(d) for line in sample) for d in (";", "\t", ",")}
     if counts[";"]:
         return ";"
@@ -382,13 +392,14 @@ def _load(head, layout, keep, blocks, name, size_hint) -> _Columns:
         hint = len(body)
     cols = _Columns(len(keep), hint)
     line0 = layout.first_row + 1
-    for lines, flags in itertools.chain([(body, _flags(body))], blocks):
+    for lines, flags in _then((body, _flags(body)), blocks):
         rows, where = _parse_block(lines, line0, layout.delim, usecols, flags, name)
         if cols.n + rows.shape[0] > MAX_CAPTURE_ROWS:
             raise DesignError(f"{name}: more than {MAX_CAPTURE_ROWS:,} samples, the most "
                               "identify reads; decimate the record or cut it to the step")
         cols.append(rows, where)
         line0 += len(lines)
+        del lines, rows   # before the next block is read
     return cols
 
 

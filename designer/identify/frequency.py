@@ -593,7 +593,9 @@ def zeta_from_peak(mr_db: float) -> float:
     if not mr_db > 0.0:
         return math.nan
     q = 10.0 ** (-mr_db / 10.0)            # = 4 zeta^2 (1 - zeta^2)
-    return math.sqrt((1.0 - math.sqrt(max(0.0, 1.0 - q))) / 2.0)
+    # 1 - sqrt(1 - q) written as q / (1 + sqrt(1 - q)): no cancellation, so a
+    # tall peak gives a small zeta, never exactly 0 (G would then divide by 0)
+    return math.sqrt(q / (2.0 * (1.0 + math.sqrt(max(0.0, 1.0 - q)))))
 
 
 def peak_gain_db(zeta: float) -> float:
@@ -651,11 +653,12 @@ def resonant_peak(data: FreqData, min_db: float = 0.1) -> MethodResult:
 # --------------------------------------------------------------------------
 
 def _x_to_params(model, x, fit_delay):
-    th = x[-1] if fit_delay else 0.0
+    th = float(x[-1]) if fit_delay else 0.0
     if model == "fopdt":
         return {"K": math.exp(x[0]), "tau_s": math.exp(x[1]), "theta_s": th}
     if model == "underdamped":
-        return {"K": math.exp(x[0]), "wn_rad_s": math.exp(x[1]), "zeta": x[2], "theta_s": th}
+        return {"K": math.exp(x[0]), "wn_rad_s": math.exp(x[1]), "zeta": float(x[2]),
+                "theta_s": th}
     return {"K": math.exp(x[0]), "tau1_s": math.exp(x[1]), "tau2_s": math.exp(x[2]), "theta_s": th}
 
 

@@ -26,7 +26,7 @@ from pathlib import Path
 from ..errors import DesignError
 from ..report import json_safe
 from ..units import format_eng
-from .core import MethodResult, iae_ise, model_step
+from .core import MethodResult, iae_ise, model_step, unphysical
 from .first_order import FIRST_ORDER_METHODS
 from .preprocess import PreparedStep, prepare_step
 from .refine import refine_all
@@ -183,6 +183,9 @@ def _score(m: MethodResult, step: PreparedStep, t_eval, y_eval) -> None:
         if not m.params or any(not (isinstance(v, (int, float)) and math.isfinite(v))
                                for v in m.params.values()):
             raise ValueError("no parameters")
+        why = unphysical(m.model, m.params)
+        if why:
+            raise ValueError(f"unstable or non-physical ({why})")
         iae = ise = 0.0
         for a in range(0, max(t_eval.size - 1, 1), SCORE_BLOCK):
             tb = t_eval[a:a + SCORE_BLOCK + 1]

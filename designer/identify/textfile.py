@@ -37,7 +37,7 @@ MAX_TABLE_BYTES = 16 * MIB
 MAX_LINE_BYTES = 1 * MIB
 #: Bytes examined for the encoding, and read per block when streaming.
 SNIFF_BYTES = 64 * 1024
-BLOCK_BYTES = 8 * MIB
+BLOCK_BYTES = 4 * MIB
 
 
 def shown(path) -> str:
@@ -108,6 +108,8 @@ def open_limited(path, what: str, limit: int) -> LimitedReader:
         Missing file, a directory, no permission, a regular file above ``limit``.
     """
     name = shown(path)
+    if str(path) == "":
+        raise DesignError(f"no {what} given: the name is empty")
     p = Path(path)
     try:
         fh = open(p, "rb", buffering=0)  # noqa: SIM115 - returned to the caller
@@ -145,7 +147,8 @@ def check_encoding(head: bytes, name: str, what: str) -> int:
     if b"\x00" in head:
         # ASCII text in UTF-16 has a NUL in every other byte
         even, odd = head[0::2], head[1::2]
-        if max(even.count(0), odd.count(0)) >= 0.4 * max(len(odd), 1):
+        ne, no = even.count(0) / max(len(even), 1), odd.count(0) / max(len(odd), 1)
+        if max(ne, no) >= 0.4 and min(ne, no) < 0.1:
             raise _not_utf8(name, what, "UTF-16")
         raise DesignError(f"{what} {name} is not a text file (it holds NUL bytes): "
                           "expected CSV text in UTF-8 or ASCII")
@@ -166,6 +169,7 @@ def read_text(path, what: str, limit: int = MAX_TABLE_BYTES) -> str:
     """The whole text of a small input file (a table, a JSON result), with every
     check of this module."""
     with open_limited(path, what, limit) as fh:
-        data = fh.read()
-    skip = check_encoding(data[:SNIFF_BYTES], fh.name, what)
+        head = fh.read(SNIFF_BYTES) or b""
+        skip = check_encoding(head, fh.name, what)   # /dev/zero stops here
+        data = head + (fh.read() or b"")
     return decode(data[skip:])
