@@ -262,6 +262,30 @@ def test_identify_in_range_scales_give_the_right_model(capfd, model, t_exp, y_ex
     assert err < 0.01, best
 
 
+json_values = st.recursive(
+    st.none() | st.booleans() | st.floats() | st.integers() | st.text(max_size=5),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=5), inner,
+                                                                max_size=3),
+    max_leaves=8)
+
+
+@FUZZ
+@given(built=st.dictionaries(st.sampled_from(["fn_hz", "zeta", "R1_ohm", "R2_ohm", "C1_f",
+                                              "C2_f", "tolerance_band"]), json_values),
+       spec=json_values, spice=json_values)
+def test_identify_against_any_json(capfd, built, spec, spice):
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(tmp)
+        cap = root / "c.csv"
+        t = np.linspace(-1e-3, 9e-3, 300)
+        y = model_step("underdamped", {"K": 1.0, "wn_rad_s": 6e3, "zeta": 0.3}, t)
+        cap.write_text("".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), y.tolist())))
+        design = root / "result.json"
+        design.write_text(json.dumps({"built": {"fn_hz": 955.0, "zeta": 0.3, **built},
+                                      "spec": spec, "spice": spice}))
+        run_in_process(identify_main, "identify", [cap, "--against", design], capfd, root)
+
+
 # ----------------------------------------------------------------------- identify-freq
 
 @FUZZ
@@ -334,6 +358,7 @@ def test_worst_inputs_through_the_console_scripts(tmp_path):
         ([ident, str(good), "--step-time", "1e300"], "identify", "--step-time must be"),
         ([ident, str(good), "--step-amplitude", "-1e-300"], "identify", "--step-amplitude"),
         ([ident, str(good), "--plot", str(tmp_path)], "identify", "is a directory"),
+        ([ident, str(good), "--against", "/dev/zero"], "identify", "not a text file"),
         ([ident, ""], "identify", "the name is empty"),
     ]
     for argv, prog, words in cases:

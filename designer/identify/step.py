@@ -432,21 +432,60 @@ def _band_from_built(built: dict):
 
 
 def load_design(path) -> dict:
-    """Read a design-plant result.json; a clear error if it is not one."""
-    path = Path(path)
+    """Read a design-plant result.json (at most MAX_TABLE_BYTES); a clear
+    one-line error if it is not one, or if a value the comparison uses is not
+    a finite number where one is needed."""
+    from .textfile import MAX_TABLE_BYTES, read_text, shown
+    name = shown(path)
+    text = read_text(path, "--against file", MAX_TABLE_BYTES)
     try:
-        d = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise DesignError(f"--against: {str(path)!r} does not exist") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise DesignError(f"--against: cannot read {str(path)!r}: {exc}") from None
+        d = json.loads(text)
     except json.JSONDecodeError as exc:
-        raise DesignError(f"--against: {str(path)!r} is not JSON ({exc.msg} at line {exc.lineno})") from None
+        raise DesignError(f"--against: {name} is not JSON ({exc.msg} at line {exc.lineno})") from None
+    except RecursionError:
+        raise DesignError(f"--against: {name} is nested too deeply to be a result.json") from None
     if not isinstance(d, dict) or not isinstance(d.get("built"), dict) \
             or not {"fn_hz", "zeta"} <= set(d["built"]):
-        raise DesignError(f"--against: {str(path)!r} is not a design-plant result.json "
+        raise DesignError(f"--against: {name} is not a design-plant result.json "
                           "(needs 'built' with fn_hz and zeta)")
+    _check_design(d, name)
     return d
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _check_design(d: dict, name: str) -> None:
+    """The values :func:`compare_with_design` reads: present ones must be usable."""
+    def bad(where, what):
+        raise DesignError(f"--against: {name}: {where} must be {what}")
+    built = d["built"]
+    for k in ("fn_hz", "zeta"):
+        if not (_is_number(built[k]) and built[k] > 0):
+            bad(f"built.{k}", "a positive number")
+    for k in ("R1_ohm", "R2_ohm", "C1_f", "C2_f"):
+        if k in built and built[k] is not None and not (_is_number(built[k]) and built[k] > 0):
+            bad(f"built.{k}", "a positive number (or absent)")
+    for key in ("spec", "spice"):
+        if d.get(key) is not None and not isinstance(d[key], dict):
+            bad(key, "an object (or absent)")
+    gain = (d.get("spec") or {}).get("gain")
+    if gain is not None and not (_is_number(gain) and gain >= 1):
+        bad("spec.gain", "a number >= 1 (or absent)")
+    os_pct = (d.get("spice") or {}).get("overshoot_pct")
+    if os_pct is not None and not _is_number(os_pct):
+        bad("spice.overshoot_pct", "a number (or absent)")
+    tb = built.get("tolerance_band")
+    if tb is not None:
+        if not isinstance(tb, dict):
+            bad("built.tolerance_band", "an object (or absent)")
+        for k, v in tb.items():
+            if isinstance(v, (list, tuple)) and len(v) == 2 and not all(map(_is_number, v)):
+                bad(f"built.tolerance_band.{k}", "two numbers [lo, hi]")
+        for k in ("r_tolerance_pct", "c_tolerance_pct"):
+            if k in tb and not _is_number(tb[k]):
+                bad(f"built.tolerance_band.{k}", "a number")
 
 
 def compare_with_design(result: IdentifyResult, design: dict) -> dict:

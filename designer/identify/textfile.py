@@ -151,7 +151,7 @@ def check_encoding(head: bytes, name: str, what: str) -> int:
         if max(ne, no) >= 0.4 and min(ne, no) < 0.1:
             raise _not_utf8(name, what, "UTF-16")
         raise DesignError(f"{what} {name} is not a text file (it holds NUL bytes): "
-                          "expected CSV text in UTF-8 or ASCII")
+                          "expected UTF-8 or ASCII text")
     return 3 if head.startswith(b"\xef\xbb\xbf") else 0
 
 
