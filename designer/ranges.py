@@ -50,7 +50,7 @@ class Range:
 
 
 def _fmt(v: float, unit: str) -> str:
-    if unit in ("", "%") or v == 0:
+    if unit in ("", "%") or v == 0 or (unit == "s" and abs(v) >= 1e3):   # "10000 s", not "10 ks"
         return f"{v:g}" + (f" {unit}" if unit else "")
     return format_eng(v, unit, 4)
 

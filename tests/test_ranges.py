@@ -1,0 +1,36 @@
+"""The one table of input ranges: its checks, and that the README states every range."""
+
+from pathlib import Path
+
+import pytest
+from hypothesis import given, strategies as st
+
+from designer.errors import DesignError
+from designer.ranges import RANGES, Range, parse_in_range
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+
+def test_readme_states_every_range():
+    text = README.read_text()
+    for key, r in RANGES.items():
+        assert f"| {r.text()}" in text, key
+
+
+@given(st.sampled_from(sorted(RANGES)), st.floats(allow_nan=True, allow_infinity=True))
+def test_check_accepts_exactly_the_range(key, value):
+    r = RANGES[key]
+    inside = value == value and abs(value) != float("inf") and (
+        (r.zero_ok and value == 0) or ((value > r.lo if r.lo_open else value >= r.lo) and value <= r.hi))
+    if inside:
+        assert r.check(value, "--x") == value
+    else:
+        with pytest.raises(DesignError, match=r"^--x must be "):
+            r.check(value, "--x")
+
+
+def test_messages_name_input_range_and_value():
+    with pytest.raises(DesignError) as e:
+        parse_in_range("1e-300", "--fc", "fc_hz")
+    assert str(e.value) == "--fc must be 10 mHz to 10 MHz, got '1e-300'"
+    assert Range(0, 1, "s", zero_ok=True, lo_open=True).text() == "0 or above 0 s up to 1 s"
