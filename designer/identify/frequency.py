@@ -35,6 +35,19 @@ table has no phase),
 - ``ise`` = mean over the points of e_k^2.
 
 Results are ranked by that ``iae`` (valid first), as ``identify`` ranks by IAE.
+
+Validity (:func:`judge`). A result is valid only if it describes the table:
+finite parameters, a fit error of at most :data:`MAX_FIT_ERROR`, and every
+corner frequency (1/tau of each time constant, wn) inside the measured band
+widened :data:`BAND_FACTOR` times each way. A flat table, a ratio read as dB
+or a phase of the wrong sign then has no valid model instead of one with
+wn = 2e54 rad/s or a 47 % error marked "ok". The fits search time constants
+and wn within the band widened :data:`FIT_BAND` times, so every exponential
+of a log-parameter stays finite.
+
+Every row's values are checked against their physical ranges
+(``RANGES["freq_hz"]``, ``["gain_db"]`` or ``["gain_ratio"]``,
+``["phase_deg"]``) before any arithmetic, so no overflow reaches the fits.
 """
 
 from __future__ import annotations
@@ -73,6 +86,10 @@ MAX_FIT_ERROR = 0.2
 #: gain by under 0.05 dB and its phase by under 6 degrees, so the table cannot
 #: place it (a flat table "fits" wn = 2e54 rad/s).
 BAND_FACTOR = 10.0
+#: The fits search time constants and wn within the measured band widened by
+#: this factor (far wider than BAND_FACTOR, so a fit that runs out of the band
+#: is seen and flagged, yet every exp() of a log-parameter stays finite).
+FIT_BAND = 1e3
 
 PARAMS = {
     "fopdt": ("K", "tau_s", "theta_s"),
@@ -687,12 +704,6 @@ def _residual(model, data, fit_delay):
             return r
         return np.concatenate((r, model_phase(model, p, data.w) - ph))
     return fun
-
-
-#: The fits search time constants and wn within the measured band widened by
-#: this factor (far wider than BAND_FACTOR, so a fit that runs out of the band
-#: is seen and flagged, yet every exp() of a log-parameter stays finite).
-FIT_BAND = 1e3
 
 
 def _fit_bounds(model, data, fit_delay) -> tuple:
