@@ -290,7 +290,8 @@ def _read_rigol(lines, name) -> _Layout:
         raise DesignError(f"{name}: Rigol time increment must be a positive number; "
                           f"got {number_text(inc)}")
     if not np.isfinite(start):
-        raise DesignError(f"{name}: Rigol start time must be a finite number; got {number_text(start)}")
+        raise DesignError(f"{name}: Rigol start time must be a finite number; "
+                          f"got {number_text(start)}")
     channels = head[1:i_start]
     return _Layout(["TIME", *channels], "rigol", 2, ",", list(range(1 + len(channels))),
                    time_axis=(start, inc))

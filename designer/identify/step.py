@@ -20,7 +20,6 @@ import json
 import math
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 
 
 from ..errors import DesignError
