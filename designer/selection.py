@@ -67,9 +67,12 @@ PAIRS_PER_CHUNK = 1 << 13
 ROWS_PER_BATCH = 1 << 18
 #: Capacitor pairs that seed the first error bound (the enumeration tightens it).
 SEED_PAIRS = 1 << 15
-#: Relative widening of every band and interval: float rounding must never
-#: drop a combination that belongs (extra ones are just evaluated and ranked).
+#: Relative widening of every band and interval, and absolute widening of eps
+#: in them (errors are computed as x/x0 - 1: their rounding is absolute): float
+#: rounding must never drop a combination that belongs (extra ones are just
+#: evaluated and ranked).
 _SLACK = 1e-9
+_ABS_SLACK = 1e-13
 
 
 def _score(r1, r2, c1, c2, fn0, zeta0, gain):
@@ -100,8 +103,10 @@ def _rank(r1, r2, c1, c2, fn0, zeta0, gain, top):
 
 def _bound(kth_worst):
     """eps that keeps every combination tied with the k-th best after the ranking's
-    rounding to 1e-12 (anything worse than eps ranks strictly after it)."""
-    return kth_worst * (1 + _SLACK) + 2e-12
+    rounding to 1e-12 (anything worse than eps ranks strictly after it). A margin
+    relative to eps itself would not do: near 100 % off (targets out of reach)
+    1e-9 of eps is more than what separates the best combinations."""
+    return kth_worst * (1 + 1e-12) + 2e-12
 
 
 def _neighbours(sorted_vals, x, width=1):
@@ -192,7 +197,8 @@ def _fn_band(fn0, eps, c1, c2):
     """[plo, phi]: the products R1 R2 within eps of fn0 for each pair (widened by the slack)."""
     wn = 2 * np.pi * fn0
     prod = 1.0 / (wn * wn * c1 * c2)
-    plo = prod / (1 + eps) ** 2 * (1 - _SLACK)
+    eps = eps + _ABS_SLACK
+    plo = prod / (1 + eps) / (1 + eps) * (1 - _SLACK)   # (1 + eps)**2 could overflow a float
     phi = prod / (1 - eps) ** 2 * (1 + _SLACK) if eps < 1 else np.full_like(prod, np.inf)
     return plo, phi
 
@@ -221,6 +227,7 @@ def _zeta_sets(zeta0, eps, c1, c2, gain):
     first widened and the second narrowed by the slack, as (lo, hi, empty) each."""
     alpha = c1 + c2 * (1.0 - gain)
     q = 2 * np.sqrt(c1 * c2)
+    eps = eps + _ABS_SLACK
     with np.errstate(invalid="ignore", over="ignore"):  # eps = inf: zhi = inf, zlo = -inf
         zhi = zeta0 * (1 + eps)
         zlo = zeta0 * (1 - eps)
@@ -229,20 +236,23 @@ def _zeta_sets(zeta0, eps, c1, c2, gain):
     return (a_lo * (1 - _SLACK), a_hi * (1 + _SLACK), a_empty), (b_lo * (1 + _SLACK), b_hi * (1 - _SLACK), b_empty)
 
 
-def _zeta_intervals(zeta0, eps, c1, c2, gain):
-    """The (at most two, disjoint) intervals of u = sqrt(R1/R2) where |zeta/zeta0 - 1| <= eps.
+def _zeta_parts(zeta0, eps, c1, c2, gain, lo, hi):
+    """The parts of the intervals [lo, hi] of u = sqrt(R1/R2) (one per entry)
+    where |zeta/zeta0 - 1| <= eps, with the slack.
 
     zeta is (alpha u + C1/u) / (2 sqrt(C1 C2)): the set is {zeta <= zhi} (one
-    interval) minus {zeta < zlo} (one interval inside it, or none). Returns lo,
-    hi of shape (pairs, 2); an empty interval has hi = -inf.
+    interval) minus {zeta < zlo} (one interval inside it, or none), so each
+    entry has at most two disjoint parts. Returns (entry index, lo, hi) of the
+    non-empty parts.
     """
     (a_lo, a_hi, a_empty), (b_lo, b_hi, b_empty) = _zeta_sets(zeta0, eps, c1, c2, gain)
-    b_empty = b_empty | ~(b_hi > b_lo * (1 + 1e-6))       # too thin to take out: keep one interval
-    lo = np.stack([a_lo, np.maximum(b_hi, a_lo)], axis=1)
-    hi = np.stack([np.where(b_empty, a_hi, np.minimum(b_lo, a_hi)), np.where(b_empty, -np.inf, a_hi)], axis=1)
-    hi[a_empty] = -np.inf
-    hi[~(lo <= hi) | ~(lo < np.inf)] = -np.inf
-    return lo, hi
+    b_empty = b_empty | ~(b_hi > b_lo * (1 + 1e-6))       # too thin to take out: keep one part
+    lo = np.maximum(lo, a_lo)
+    hi = np.where(a_empty, -np.inf, np.minimum(hi, a_hi))
+    lo2 = np.concatenate([lo, np.where(b_empty, np.inf, np.maximum(lo, b_hi))])
+    hi2 = np.concatenate([np.where(b_empty, hi, np.minimum(hi, b_lo)), hi])
+    keep = (lo2 <= hi2) & (lo2 < np.inf)
+    return np.flatnonzero(keep) % c1.size, lo2[keep], hi2[keep]
 
 
 def _r2_range(rv, r1, plo, phi, ulo, uhi):
@@ -257,18 +267,17 @@ def _r2_range(rv, r1, plo, phi, ulo, uhi):
 
 
 def _r1_rows(rv, plo, phi, ulo, uhi):
-    """First index and count of the R1 values that can have an R2 in ``rv`` for each (pair, side).
+    """First index and count of the R1 values that can have an R2 in ``rv`` for each
+    band [plo, phi] of R1 R2 and interval [ulo, uhi] of sqrt(R1/R2).
 
     R1 = sqrt(R1 R2) u, and R2 = R1 R2 / R1 = R1 / u^2 must lie between rv's ends.
     """
     rmin, rmax = rv[0], rv[-1]
-    plo, phi = plo[:, None], phi[:, None]
-    with np.errstate(invalid="ignore", over="ignore"):  # empty intervals (hi = -inf) give nan: no rows
+    with np.errstate(invalid="ignore", over="ignore"):  # u = 0 with p = inf and the like: no bound
         lo = np.maximum(np.maximum(np.sqrt(plo) * ulo, plo / rmax), ulo * ulo * rmin)
         hi = np.minimum(np.minimum(np.sqrt(phi) * uhi, phi / rmin), uhi * uhi * rmax)
-    first = np.searchsorted(rv, lo.ravel() * (1 - 1e-12), side="left")
-    rows = np.searchsorted(rv, hi.ravel() * (1 + 1e-12), side="right") - first
-    rows[~(ulo <= uhi).ravel() | (rows < 0)] = 0
+    first = np.searchsorted(rv, lo * (1 - 1e-12), side="left")
+    rows = np.maximum(np.searchsorted(rv, hi * (1 + 1e-12), side="right") - first, 0)
     return first, rows
 
 
@@ -292,27 +301,26 @@ class _Best:
 def _search_pairs(zeta0, rv, c1, c2, best):
     """Evaluate every combination within ``best.eps`` for the pairs (c1[i], c2[i]).
 
-    Pairs go in groups of at most ROWS_PER_BATCH rows (pair, side, R1), rows in
-    batches of at most ROWS_PER_BATCH combinations; the ranges are recomputed
-    with the tightened eps before each group and each batch, so a loose first
-    bound costs one batch, not the whole grid.
+    Pairs go in groups of at most ROWS_PER_BATCH rows (pair, zeta part, R1),
+    rows in batches of at most ROWS_PER_BATCH combinations; the bands are
+    recomputed with the tightened eps before each group and each batch, so a
+    loose first bound costs one batch, not the whole grid.
     """
     fn0, _, gain = best.args
     while c1.size:
-        plo, phi = _fn_band(fn0, best.eps, c1, c2)
-        ulo, uhi = _zeta_intervals(zeta0, best.eps, c1, c2, gain)
+        pair, ulo, uhi = _zeta_parts(zeta0, best.eps, c1, c2, gain, 0.0, np.inf)
+        plo, phi = _fn_band(fn0, best.eps, c1[pair], c2[pair])
         first, rows = _r1_rows(rv, plo, phi, ulo, uhi)
-        group = next(_batches(rows.reshape(-1, 2).sum(axis=1)))
-        owner, i1 = _expand(first[2 * group.start:2 * group.stop], rows[2 * group.start:2 * group.stop])
-        owner += 2 * group.start
-        pair, side = owner // 2, owner % 2
+        group = next(_batches(np.bincount(pair, rows, c1.size).astype(int)))
+        mine = pair < group.stop
+        part, i1 = _expand(first[mine], rows[mine])
+        pair, lo_u, hi_u = pair[mine][part], ulo[mine][part], uhi[mine][part]
         g1, g2, r1 = c1[pair], c2[pair], rv[i1]
-        lo_u, hi_u = ulo[pair, side], uhi[pair, side]
         while r1.size:
-            # the row's interval, within {zeta <= zhi} for the current eps
+            # the row's u interval, within the zeta band for the current eps
+            keep, lo_u, hi_u = _zeta_parts(zeta0, best.eps, g1, g2, gain, lo_u, hi_u)
+            g1, g2, r1 = g1[keep], g2[keep], r1[keep]
             pl, ph = _fn_band(fn0, best.eps, g1, g2)
-            a_lo, a_hi, a_empty = _zeta_sets(zeta0, best.eps, g1, g2, gain)[0]
-            lo_u, hi_u = np.maximum(lo_u, a_lo), np.where(a_empty, -np.inf, np.minimum(hi_u, a_hi))
             start, count = _r2_range(rv, r1, pl, ph, lo_u, hi_u)
             live = count > 0
             g1, g2, r1, lo_u, hi_u, start, count = (x[live] for x in (g1, g2, r1, lo_u, hi_u, start, count))
@@ -350,7 +358,7 @@ def joint_search(fn0: float, zeta0: float, r_values, c_values, gain: float = 1.0
     """
     rv = np.unique(np.asarray(r_values, float))
     cv = np.unique(np.asarray(c_values, float))
-    if rv.size == 0 or cv.size == 0:
+    if rv.size == 0 or cv.size == 0 or top < 1:
         return []
     best = _Best(fn0, zeta0, gain, top, _seed_bound(fn0, zeta0, rv, cv, gain, top))
     for i1, i2 in _pair_chunks(cv.size):

@@ -117,3 +117,22 @@ def test_widest_bounds_search_memory_is_bounded():
     peak, res = peak_bytes(joint_search, 3500, 0.01, rv, values("E192", 1e-9, 1e-8), top=200)
     assert peak < SEARCH_MEMORY_BYTES
     assert len(res) == 200 and res[0].worst > 1
+
+
+def test_targets_far_out_of_reach_evaluate_few_combinations():
+    # every combination is about 100 % off (fn five decades below the target, the
+    # damping out of reach too): an error bound with a margin relative to itself went
+    # above 100 %, opened the fn band completely and evaluated 1.9 billion combinations
+    rv, cv = values("E192", 33e6, 1e9), values("E192", 1.27e-3, 1.0)
+    evaluated = []
+    real_add = selection._Best.add
+
+    def counting_add(self, r1, r2, c1, c2):
+        evaluated.append(r1.size)
+        assert sum(evaluated) <= rv.size * cv.size * 10, "the search enumerates far more than the best few"
+        return real_add(self, r1, r2, c1, c2)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(selection._Best, "add", counting_add)
+        res = joint_search(833, 5.8, rv, cv, 100.0, top=200)
+    assert len(res) == 200 and 0.99 < res[0].worst < 1
