@@ -27,10 +27,14 @@ The controller (seed 001, Fig. 66): U1 difference amp (R15-R18), U2 unity invert
 U3 differentiator (R12 + C3 in, R11 feedback), U4 integrator (R14 in, R13 || C4 feedback),
 U5 summer (R6, R7, R8 in, R5 feedback), U6 final gain (R4 in, R3 feedback):
   Kp = R5 R3/(R6 R4),  Ti = R8 R14 C4/R6,  Td = R6 R11 C3/R7.
-Rules: zn, cohen-coon, chr0, chr20 (Chien-Hrones-Reswick set-point, 0 and 20 % overshoot), amigo,
-simc (a PI for an FOPDT model), optimize. Values accept engineering notation (43.215u, 4k7, 10n).
+Rules: zn (on the reaction curve's tangent, as the seed), and on the least-squares FOPDT fit of the plant's
+step: cohen-coon, chr0, chr20 (Chien-Hrones-Reswick set-point, 0 and 20 % overshoot), amigo, simc (a PI);
+optimize. The build sheet lists every rule with the model it used. Values accept engineering notation
+(43.215u, 4k7, 10n); each option's range is in its help line, and a plant from parts or --plant-json
+is held to the same ranges (fn and zeta as --plant-fc/--plant-zeta) and must be stable.
 Outputs: netlists/<name>.cir (runs alone with `ngspice -b`), reports/<name>/build-sheet.md/.html,
-result.json and plots. Exit status 2 on bad input."""
+result.json and plots. Exit status: 0 done, 2 bad input (one line on stderr, nothing written),
+3 simulator error."""
 
 
 def _r(key: str) -> str:

@@ -64,6 +64,7 @@ class PidSpec:
     square_hz: float | None = None
     controller_parts: blocks.PidParts | None = None   #: skip sizing (e.g. the seed's own parts)
     tol: float = 0.01
+    _json_plant: SallenKeyParts | None = field(default=None, init=False, repr=False)
 
     def validate(self) -> None:
         """Refuse, in one line, anything outside :data:`designer.ranges.RANGES` or
@@ -82,6 +83,8 @@ class PidSpec:
             raise DesignError("--plant-zeta needs --plant-fc")
         if self.plant_parts is not None:
             self.plant_parts = check_parts(self.plant_parts, name_of=PLANT_FLAGS)
+        if self.plant_json is not None:
+            self._json_plant = plant_from_json(self.plant_json)   # read and checked now, not after work
         opamps.get(self.opamp)
         for key, flag in (("r_min", "--r-min"), ("r_max", "--r-max")):
             _check("resistor_ohm", getattr(self, key), flag)
@@ -111,9 +114,8 @@ class PidSpec:
             raise DesignError("--target-overshoot/--target-settling only apply to --tuning optimize")
         for key, flag in (("f_integrator_hz", "--f-integrator"), ("f_differentiator_hz", "--f-differentiator"),
                           ("square_hz", "--square-freq")):
-            v = getattr(self, key)
-            if v is not None:
-                _check("square_hz" if key == "square_hz" else key, v, flag)
+            if getattr(self, key) is not None:
+                _check(key, getattr(self, key), flag)
 
 
 #: how design-pid names the plant's fields in messages (see check_parts)
@@ -251,7 +253,8 @@ def resolve_plant(spec: PidSpec):
     if spec.plant_parts is not None:
         return check_parts(spec.plant_parts, name_of=PLANT_FLAGS), "parts"
     if spec.plant_json is not None:
-        return plant_from_json(spec.plant_json), f"json:{spec.plant_json}"
+        parts = spec._json_plant if spec._json_plant is not None else plant_from_json(spec.plant_json)
+        return parts, f"json:{spec.plant_json}"
     from ..plant import PlantSpec, design_plant
     ps = PlantSpec(fc_hz=spec.plant_fc_hz, zeta=spec.plant_zeta, opamp=spec.opamp,
                    r_series=spec.r_series, c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
