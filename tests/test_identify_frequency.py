@@ -453,3 +453,16 @@ def test_table_limits(tmp_path):
     (tmp_path / "u16.csv").write_text("f,g\n1,0\n2,-1\n3,-2\n4,-3\n5,-4\n", encoding="utf-16")
     with pytest.raises(DesignError, match="UTF-16 text, not UTF-8"):
         fr.read_freq_table(tmp_path / "u16.csv")
+
+
+def test_tall_peak_gives_a_small_zeta_not_zero():
+    """1 - sqrt(1 - q) cancelled to 0 for a peak of ~160 dB: zeta = 0 put a pole
+    on a table frequency and the fit divided by zero (a RuntimeWarning)."""
+    import warnings
+    for zeta in (1e-4, 1e-6, 1e-8):
+        assert fr.zeta_from_peak(fr.peak_gain_db(zeta)) == pytest.approx(zeta, rel=1e-6)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        d = fr.freq_data(np.geomspace(1, 1e5, 5), [-92.0, 0.0, 0.0, 71.0, 0.0],
+                         freq_units="rad/s")
+        fr.identify_freq(d)
