@@ -38,8 +38,8 @@ class Range:
     def contains(self, value: float) -> bool:
         if self.zero_ok and value == 0:
             return True
-        above = value > self.lo if self.lo_open else value >= self.lo * (1 - 1e-12)
-        return math.isfinite(value) and above and value <= self.hi * (1 + 1e-12)
+        above = value > self.lo if self.lo_open else value >= self.lo - 1e-12 * abs(self.lo)
+        return math.isfinite(value) and above and value <= self.hi + 1e-12 * abs(self.hi)
 
     def check(self, value: float, name: str, shown=None) -> float:
         """``value`` if inside the range, else a :class:`DesignError` naming ``name``."""

@@ -34,3 +34,10 @@ def test_messages_name_input_range_and_value():
         parse_in_range("1e-300", "--fc", "fc_hz")
     assert str(e.value) == "--fc must be 10 mHz to 10 MHz, got '1e-300'"
     assert Range(0, 1, "s", zero_ok=True, lo_open=True).text() == "0 or above 0 s up to 1 s"
+
+
+def test_bounds_themselves_are_inside_whatever_their_sign():
+    """Regression: for a negative lower bound the rounding slack pointed inward."""
+    r = RANGES["capture_time_s"]
+    assert r.lo < 0 and r.contains(r.lo) and r.contains(r.hi)
+    assert not r.contains(r.lo * (1 + 1e-9))
