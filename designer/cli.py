@@ -86,9 +86,9 @@ def add_part_options(group):
     group.add_argument("--r-series", default="E24", help=f"resistor series: {', '.join(SERIES)} (default E24)")
     group.add_argument("--c-series", default="E12", help="capacitor series (default E12)")
     group.add_argument("--r-min", default="1k", help=f"smallest resistor (default 1k) {help_range('resistor_ohm')}")
-    group.add_argument("--r-max", default="1M", help="largest resistor (default 1M)")
+    group.add_argument("--r-max", default="1M", help=f"largest resistor (default 1M) {help_range('resistor_ohm')}")
     group.add_argument("--c-min", default="1n", help=f"smallest capacitor (default 1n) {help_range('capacitor_f')}")
-    group.add_argument("--c-max", default="10u", help="largest capacitor (default 10u)")
+    group.add_argument("--c-max", default="10u", help=f"largest capacitor (default 10u) {help_range('capacitor_f')}")
 
 
 def part_options(args) -> dict:
@@ -263,7 +263,7 @@ def _analyze_parser():
 
 def _analyze(args) -> int:
     from .plant import analyze_plant
-    from .sallenkey import SallenKeyParts
+    from .sallenkey import SallenKeyParts, check_parts
     from .units import value_code
     r3 = r4 = None
     if (args.r3 is None) != (args.r4 is None):
@@ -272,14 +272,12 @@ def _analyze(args) -> int:
         if args.gain is not None:
             raise DesignError("give either --gain or --r3/--r4, not both")
         r3, r4 = parse_in_range(args.r3, "--r3", "resistor_ohm"), parse_in_range(args.r4, "--r4", "resistor_ohm")
-        gain = 1 + r4 / r3
-    else:
-        gain = 1.0 if args.gain is None else parse_in_range(args.gain, "--gain", "gain")
-        if gain != 1:
-            r3, r4 = 10e3, (gain - 1) * 10e3
+    gain = None if args.gain is None else parse_in_range(args.gain, "--gain", "gain")
     vals = {n: parse_in_range(getattr(args, n), f"--{n}", "resistor_ohm" if n[0] == "r" else "capacitor_f")
             for n in ("r1", "r2", "c1", "c2")}
-    parts = SallenKeyParts(vals["r1"], vals["r2"], vals["c1"], vals["c2"], gain, r3, r4)
+    # the shared plant check derives R3/R4 for a bare --gain and refuses unstable parts
+    parts = check_parts(SallenKeyParts(vals["r1"], vals["r2"], vals["c1"], vals["c2"], gain, r3, r4),
+                        name_of={k: f"--{k}" for k in ("r1", "r2", "c1", "c2", "r3", "r4", "gain")})
     fc = optional(args.fc, "--fc", "fc_hz")
     zeta = optional(args.zeta, "--zeta", "zeta")
     from .eseries import series_name
@@ -297,9 +295,6 @@ def _analyze(args) -> int:
     result = analyze_plant(parts, args.opamp, fc, zeta, args.r_series, args.c_series, amplitude, square,
                            simulate=not args.no_sim, simulator=args.simulator)
     return _emit(result, args, name)
-
-
-_check_name = check_name   # the name design-pid imports
 
 
 def design_plant_main(argv=None) -> int:
