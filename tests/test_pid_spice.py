@@ -112,3 +112,17 @@ def test_oscillation_detector_on_synthetic_waveforms():
     stuck = np.full_like(t, 14.0)
     v = verify.oscillation(t, stuck, 1.0, 1.0)
     assert v["latched"] and not v["stable"]
+
+
+def test_slow_square_wave_still_resolves_the_loop():
+    """As for the plant (issue 7.3): the time step follows the loop's time scale, not the
+    square wave's period, so a 3 Hz reference gives the figures of the recommended one."""
+    from designer.errors import DesignError
+    fast = design_pid(PidSpec(plant_parts=SEED_PLANT, opamp="ideal", tuning="cohen-coon")).to_dict()
+    slow = design_pid(PidSpec(plant_parts=SEED_PLANT, opamp="ideal", tuning="cohen-coon", square_hz=3)).to_dict()
+    a, b = fast["closed_loop"]["spice"], slow["closed_loop"]["spice"]
+    assert slow["test_signal"]["frequency_hz"] == 3
+    assert b["overshoot_pct"] == pytest.approx(a["overshoot_pct"], abs=0.3)
+    assert b["peak_time_s"] == pytest.approx(a["peak_time_s"], rel=0.02)
+    with pytest.raises(DesignError, match="too slow to simulate"):
+        design_pid(PidSpec(plant_parts=SEED_PLANT, opamp="ideal", tuning="cohen-coon", square_hz=1e-3))

@@ -320,7 +320,7 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice")
                                   r_max=spec.r_max, c_min=spec.c_min, c_max=spec.c_max, tol=spec.tol)
     timings["sizing_s"] = time.perf_counter() - tick
     tick = time.perf_counter()
-    res = _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, span, notes)
+    res = _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, span, notes, simulate)
     res.optimizer = opt
     res.waveforms.update(plant_fn_opamp_hz=fn_o, plant_zeta_opamp=z_o, reaction_curve=(tp, yp))
     timings["analytic_s"] = time.perf_counter() - tick
@@ -381,7 +381,8 @@ def _optimize(spec, plant, amp, pn, pd, curve, span):
     return tuning.Tuning("optimize", b.kp, b.ti_s, b.td_s, curve, (note,)), out, sel
 
 
-def _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, span, notes) -> PidResult:
+def _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, span, notes,
+             simulate=True) -> PidResult:
     lm = model.assemble(parts, amp, pn, pd)
     stable = lm.stable()
     # closed-loop DC gain y/r from the state-space model (the integrator leaks)
@@ -400,10 +401,21 @@ def _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, s
         ts = loop_metrics(t_long, w_long["y"], expected / spec.step_v).get("settling_time_s")
     if ts is None:
         ts = span / 2
-    sq = recommend_square_wave(ts, spec.step_v, spec.square_hz)
+    f_lo = min(parts.f_integrator_hz, plant.fn_hz) / 20
+    f_hi = max(amp.gbw_hz if not amp.ideal else 0.0, 100 * plant.fn_hz)
+    w = 2 * np.pi * np.logspace(np.log10(f_lo), np.log10(f_hi), 4000)
+    mg = model.margins(w, model.loop_gain(parts, amp, pn, pd, w))
+    # the loop's fastest time scale (plant or crossover) bounds the simulation step, so that a
+    # slow --square-freq cannot hide the response between time steps (as for the plant)
+    f_fast = max(plant.fn_hz, mg["crossover_hz"] if math.isfinite(mg.get("crossover_hz") or math.nan) else 0.0)
+    time_scale = 1.0 / (2 * math.pi * f_fast)
+    sq = recommend_square_wave(ts, spec.step_v, spec.square_hz, time_scale_s=time_scale)
     hp = sq.half_period_s
-    test = SquareTest(spec.step_v, sq.frequency_hz, 0.05 * hp, spec.edge_s)
-    t = np.linspace(0.0, hp, 20001)
+    test = SquareTest(spec.step_v, sq.frequency_hz, sq.delay_s, spec.edge_s, time_scale_s=time_scale)
+    if simulate:
+        test.check_simulable()
+    # the rising half period, or its start when the square wave is much slower than the loop
+    t = np.linspace(0.0, min(hp, 10 * max(span, ts)), 20001)
     r = model.reference(t, spec.step_v, 0.0, spec.edge_s)
     rails = 2 * max(abs(amp.vcc), abs(amp.vee))
     waves = lm.simulate(t, r) if stable else _diverging(lm, t, r, rails)
@@ -415,10 +427,6 @@ def _analyse(spec, plant, source, amp, tun, rules, parts, sel, checks, pn, pd, s
     ideal = loop_metrics(t, y_ideal, spec.step_v)   # a true integrator: no steady-state error
     rise = analytic.get("rise_time_s") or (hp / 20)
     levels = model.waveform_limits(waves, t, amp, model.SLEW_DELAY_FRACTION * rise) if stable else {}
-    f_lo = min(parts.f_integrator_hz, plant.fn_hz) / 20
-    f_hi = max(amp.gbw_hz if not amp.ideal else 0.0, 100 * plant.fn_hz)
-    w = 2 * np.pi * np.logspace(np.log10(f_lo), np.log10(f_hi), 4000)
-    mg = model.margins(w, model.loop_gain(parts, amp, pn, pd, w))
     checks = list(checks) + _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, spec.step_v, rise, parts)
     limits = {"closed_loop_stable", "phase_margin", "slew_rate", "output_swing"}
     if not amp.ideal and any(not c["ok"] for c in checks if c["name"] in limits):
