@@ -17,20 +17,28 @@ those with ``p`` in a band (fn) and ``u`` in at most two intervals (zeta; the
 roots of a quadratic in ``u``): a thin parallelogram in (log R1, log R2),
 enumerated in closed form.
 
-1. bound: for capacitor pairs spread over the grid (all of them on small
-   grids), the exact resistor solution's nearest series neighbours give
-   distinct candidates, and so an error bound eps (the k-th best found);
+1. seed: for capacitor pairs spread over the grid (all of them on small
+   grids), the exact resistor solution's nearest series neighbours (moved
+   into the bounds along R1/R2 when outside them) are ranked, and the k-th
+   best gives an error bound eps;
 2. enumerate: for every capacitor pair, every R1 inside the parallelogram for
    eps and, for each, the R2 range that satisfies both bands; all are
    evaluated and ranked, and the running k-th best tightens eps as it goes.
 
-Nothing better than the k-th best found so far lies outside the
+The ranking is by the worse error rounded to 1e-12, then the summed error,
+then the values. Near 100 % off (fn decades below its target) a great many
+combinations round to the same worse error and the summed error ranks them;
+there the parallelogram becomes three (the better rounding classes, and the
+k-th's class with the other error bounded by the summed error), see
+``_Best.boxes``.
+
+Nothing that ranks before the k-th best found so far lies outside the
 parallelograms, so the top k equal those of brute force (tests check it
 against :func:`brute_force`). Capacitor pairs, rows (pair, R1) and candidates
 are handled in chunks of fixed size, so memory stays bounded (tens of MB) for
 any series and bounds; time grows with the number of capacitor pairs (a
-fraction of a second for E192/E192 with the default bounds, one to two
-seconds for the widest bounds the CLI accepts).
+fraction of a second for E192/E192 with the default bounds, about one second
+for the widest bounds the CLI accepts).
 """
 
 from __future__ import annotations
@@ -64,8 +72,8 @@ class Candidate:
 #: Capacitor pairs, rows (pair, R1) and candidates handled at once: these bound
 #: the search's memory (each array of a chunk is at most a few MB).
 PAIRS_PER_CHUNK = 1 << 13
-ROWS_PER_BATCH = 1 << 18
-#: Capacitor pairs that seed the first error bound (the enumeration tightens it).
+ROWS_PER_BATCH = 1 << 17
+#: Capacitor pairs that seed the first ranking (the enumeration tightens its bound).
 SEED_PAIRS = 1 << 15
 #: Relative widening of every band and interval, and absolute widening of eps
 #: in them (errors are computed as x/x0 - 1: their rounding is absolute): float
@@ -102,11 +110,12 @@ def _rank(r1, r2, c1, c2, fn0, zeta0, gain, top):
 
 
 def _bound(kth_worst):
-    """eps that keeps every combination tied with the k-th best after the ranking's
-    rounding to 1e-12 (anything worse than eps ranks strictly after it). A margin
-    relative to eps itself would not do: near 100 % off (targets out of reach)
-    1e-9 of eps is more than what separates the best combinations."""
-    return kth_worst * (1 + 1e-12) + 2e-12
+    """eps that keeps every combination in the k-th best's class of the ranking's
+    rounding to 1e-12 or a better one (anything worse than eps ranks strictly
+    after it): the class's upper edge, with a margin for the rounding's own
+    floating point. (A margin relative to eps would not do: near 100 % off,
+    1e-9 of eps is more than what separates the best combinations.)"""
+    return float(np.round(kth_worst, 12)) + 0.5e-12 + 1e-14 * (1 + kth_worst)
 
 
 def _neighbours(sorted_vals, x, width=1):
@@ -153,44 +162,34 @@ def _expand(starts, counts):
     return owner, starts[owner] + np.arange(owner.size) - first[owner]
 
 
-def _seed_bound(fn0, zeta0, rv, cv, gain, top):
-    """An upper bound on the ``top``-th best worst error (inf with fewer distinct seeds).
-
-    Seeds: for each capacitor pair, R1 next to each exact root (or to sqrt(R1 R2)
-    when there is none) and R2 next to the product's partner; ``width``
-    neighbours on each side, more when there are few capacitor pairs, so
-    that the seeds outnumber ``top`` many times over.
+def _seed(rv, cv, best):
+    """Give ``best`` a first top: for capacitor pairs spread over the grid, R1 next
+    to each exact resistor solution (R1 = R2 = sqrt(R1 R2) when there is none),
+    moved into the bounds along its ratio R1/R2 when outside them, and R2 next
+    to the partner for exact fn and to the one for the exact ratio; ``width``
+    neighbours on each side, more when there are few capacitor pairs, so that
+    the seeds outnumber ``top`` many times over.
     """
-    n_pairs = cv.size * cv.size
-    width = int(min(rv.size, np.ceil(np.sqrt(64.0 * top / (8.0 * n_pairs)))))
-    per_pair = 8 * width ** 2
-    # a combination is seeded at most per_pair times: so many times top smallest
-    # entries hold top distinct combinations, and only they need deduplicating
-    keep = top * per_pair
+    fn0, zeta0, gain = best.args
+    width = int(min(rv.size, np.ceil(np.sqrt(4.0 * best.top / cv.size ** 2))))
     wn = 2 * np.pi * fn0
-    kept = np.empty((0, 3))  # worst, combination code, pair
+    rmin, rmax = rv[0], rv[-1]
     for i1, i2 in _pair_chunks(cv.size, max(1, PAIRS_PER_CHUNK // width ** 2), _seed_stride(cv.size)):
         c1, c2 = cv[i1], cv[i2]
-        lo_root, hi_root = resistors_for_caps(fn0, zeta0, c1, c2, gain)
-        prod = 1.0 / (wn * wn * c1 * c2)           # R1 R2 for exact fn
-        geo = np.sqrt(prod)                         # the nearest one can get when no root
-        roots = np.stack([np.where(np.isnan(r), geo, r) for r in (lo_root, hi_root)], axis=1)
-        j1 = _neighbours(rv, roots, width)                        # (pair, root, 2w)
-        j2 = _neighbours(rv, prod[:, None, None] / rv[j1], width)  # (pair, root, 2w, 2w)
-        j1 = np.broadcast_to(j1[..., None], j2.shape).reshape(i1.size, -1)
-        j2 = j2.reshape(i1.size, -1)
-        worst = _score(rv[j1], rv[j2], c1[:, None], c2[:, None], fn0, zeta0, gain)[4].ravel()
-        code = (j1 * rv.size + j2).ravel()
-        pair = np.repeat(i1 * cv.size + i2, per_pair)
-        if worst.size > keep:
-            sel = np.argpartition(worst, keep - 1)[:keep]
-            worst, code, pair = worst[sel], code[sel], pair[sel]
-        kept = np.concatenate([kept, np.column_stack([worst, code, pair])])
-        if kept.shape[0] > keep:
-            kept = kept[np.argpartition(kept[:, 0], keep - 1)[:keep]]
-    worst = np.unique(kept, axis=0)[:, 0]   # the same combination can be seeded several times
-    worst = worst[np.isfinite(worst)]
-    return _bound(float(np.partition(worst, top - 1)[top - 1])) if worst.size >= top else np.inf
+        prod = 1.0 / (wn * wn * c1 * c2)            # R1 R2 for exact fn
+        geo = np.sqrt(prod)
+        roots = np.stack([np.where(np.isnan(r), geo, r) for r in resistors_for_caps(fn0, zeta0, c1, c2, gain)],
+                         axis=1)
+        ratio = roots * roots / prod[:, None]       # R1/R2 of the exact solution
+        lo, hi = np.maximum(rmin, rmin * ratio), np.minimum(rmax, rmax * ratio)
+        roots = np.where(lo <= hi, np.clip(roots, lo, hi), roots)
+        j1 = _neighbours(rv, roots, width)                                   # (pair, root, 2w)
+        r1 = rv[j1][..., None]
+        j2 = _neighbours(rv, np.concatenate([prod[:, None, None, None] / r1, r1 / ratio[..., None, None]],
+                                            axis=-1), width)                 # (pair, root, 2w, 2, 2w)
+        j1 = np.broadcast_to(j1[..., None, None], j2.shape)
+        pair = np.broadcast_to(np.arange(i1.size)[:, None, None, None, None], j2.shape)
+        best.add(rv[j1].ravel(), rv[j2].ravel(), c1[pair].ravel(), c2[pair].ravel())
 
 
 def _fn_band(fn0, eps, c1, c2):
@@ -236,39 +235,35 @@ def _zeta_sets(zeta0, eps, c1, c2, gain):
     return (a_lo * (1 - _SLACK), a_hi * (1 + _SLACK), a_empty), (b_lo * (1 + _SLACK), b_hi * (1 - _SLACK), b_empty)
 
 
-def _zeta_parts(zeta0, eps, c1, c2, gain, lo, hi):
-    """The parts of the intervals [lo, hi] of u = sqrt(R1/R2) (one per entry)
-    where |zeta/zeta0 - 1| <= eps, with the slack.
+def _zeta_parts(zeta0, eps, c1, c2, gain):
+    """The intervals of u = sqrt(R1/R2) where |zeta/zeta0 - 1| <= eps for each
+    pair (c1[i], c2[i]), with the slack.
 
     zeta is (alpha u + C1/u) / (2 sqrt(C1 C2)): the set is {zeta <= zhi} (one
-    interval) minus {zeta < zlo} (one interval inside it, or none), so each
-    entry has at most two disjoint parts. Returns (entry index, lo, hi) of the
+    interval) minus {zeta < zlo} (one interval inside it, or none), so a pair
+    has at most two disjoint parts. Returns (pair index, lo, hi) of the
     non-empty parts.
     """
     (a_lo, a_hi, a_empty), (b_lo, b_hi, b_empty) = _zeta_sets(zeta0, eps, c1, c2, gain)
     b_empty = b_empty | ~(b_hi > b_lo * (1 + 1e-6))       # too thin to take out: keep one part
-    lo = np.maximum(lo, a_lo)
-    hi = np.where(a_empty, -np.inf, np.minimum(hi, a_hi))
-    lo2 = np.concatenate([lo, np.where(b_empty, np.inf, np.maximum(lo, b_hi))])
-    hi2 = np.concatenate([np.where(b_empty, hi, np.minimum(hi, b_lo)), hi])
-    keep = (lo2 <= hi2) & (lo2 < np.inf)
-    return np.flatnonzero(keep) % c1.size, lo2[keep], hi2[keep]
+    a_hi = np.where(a_empty, -np.inf, a_hi)
+    lo = np.concatenate([a_lo, np.where(b_empty, np.inf, np.maximum(a_lo, b_hi))])
+    hi = np.concatenate([np.where(b_empty, a_hi, np.minimum(a_hi, b_lo)), a_hi])
+    keep = (lo <= hi) & (lo < np.inf)
+    return np.flatnonzero(keep) % c1.size, lo[keep], hi[keep]
 
 
 def _r2_range(rv, r1, plo, phi, ulo, uhi):
-    """First index and count of the R2 values with R1 R2 in [plo, phi] and sqrt(R1/R2) in [ulo, uhi]."""
+    """First index and end of the R2 values with R1 R2 in [plo, phi] and sqrt(R1/R2) in [ulo, uhi]."""
     with np.errstate(divide="ignore", invalid="ignore"):  # u from 0 or to inf: no bound that side
         lo = np.maximum(plo / r1, r1 / (uhi * uhi))
         hi = np.minimum(phi / r1, r1 / (ulo * ulo))
-    start = np.searchsorted(rv, lo, side="left")
-    count = np.searchsorted(rv, hi, side="right") - start
-    count[~(ulo <= uhi) | (count < 0)] = 0
-    return start, count
+    return np.searchsorted(rv, lo, side="left"), np.searchsorted(rv, hi, side="right")
 
 
-def _r1_rows(rv, plo, phi, ulo, uhi):
-    """First index and count of the R1 values that can have an R2 in ``rv`` for each
-    band [plo, phi] of R1 R2 and interval [ulo, uhi] of sqrt(R1/R2).
+def _r1_range(rv, plo, phi, ulo, uhi):
+    """First index and end of the R1 values that can have an R2 in ``rv``, for
+    each band [plo, phi] of R1 R2 and interval [ulo, uhi] of sqrt(R1/R2).
 
     R1 = sqrt(R1 R2) u, and R2 = R1 R2 / R1 = R1 / u^2 must lie between rv's ends.
     """
@@ -276,60 +271,111 @@ def _r1_rows(rv, plo, phi, ulo, uhi):
     with np.errstate(invalid="ignore", over="ignore"):  # u = 0 with p = inf and the like: no bound
         lo = np.maximum(np.maximum(np.sqrt(plo) * ulo, plo / rmax), ulo * ulo * rmin)
         hi = np.minimum(np.minimum(np.sqrt(phi) * uhi, phi / rmin), uhi * uhi * rmax)
-    first = np.searchsorted(rv, lo * (1 - 1e-12), side="left")
-    rows = np.maximum(np.searchsorted(rv, hi * (1 + 1e-12), side="right") - first, 0)
-    return first, rows
+    return np.searchsorted(rv, lo * (1 - 1e-12), side="left"), np.searchsorted(rv, hi * (1 + 1e-12), side="right")
+
+
+def _union(owner, start, stop, n):
+    """The union of the index ranges [start, stop) (values below n) of each owner,
+    as disjoint ranges: (owner, start, count), empty ones dropped."""
+    order = np.lexsort((start, owner))
+    owner, start, stop = owner[order], start[order], stop[order]
+    # how far the owner's earlier ranges reach (an owner's key is above every earlier owner's)
+    reach = np.maximum.accumulate(owner * (n + 1) + stop) - owner * (n + 1)
+    before = np.concatenate([[0], reach[:-1]])
+    before[np.concatenate([[True], owner[1:] != owner[:-1]])] = 0
+    start = np.maximum(start, before)
+    live = stop > start
+    return owner[live], start[live], (stop - start)[live]
+
+
+def _ranges(rv, fn0, zeta0, gain, boxes, c1, c2, r1=None):
+    """Index ranges of R1 (``r1`` None: per pair) or of R2 (per row: pair and R1)
+    inside the union of the error boxes, as disjoint (owner, start, count)."""
+    owner, start, stop = [], [], []
+    for e_fn, e_z in boxes:
+        i, ulo, uhi = _zeta_parts(zeta0, e_z, c1, c2, gain)
+        plo, phi = _fn_band(fn0, e_fn, c1[i], c2[i])
+        a, z = _r1_range(rv, plo, phi, ulo, uhi) if r1 is None else _r2_range(rv, r1[i], plo, phi, ulo, uhi)
+        owner.append(i), start.append(a), stop.append(z)
+    return _union(np.concatenate(owner), np.concatenate(start), np.concatenate(stop), rv.size)
 
 
 class _Best:
-    """The best ``top`` combinations so far and the error bound eps they set."""
+    """The best ``top`` combinations so far, and the error boxes that hold every
+    combination that can still rank among them."""
 
-    def __init__(self, fn0, zeta0, gain, top, eps):
+    def __init__(self, fn0, zeta0, gain, top):
         self.args = (fn0, zeta0, gain)
         self.top = top
-        self.eps = eps
+        self.eps = np.inf              # every combination in the top has its errors within eps
+        self.kth = None                # (worst, summed) errors of the top-th best
         self.parts = np.empty((4, 0))  # rows r1, r2, c1, c2
 
     def add(self, r1, r2, c1, c2):
         cand = np.concatenate([self.parts, np.stack([r1, r2, c1, c2])], axis=1)
         order, worst = _order(*cand, *self.args)
-        self.parts = cand[:, order[:self.top]]
-        if order.size >= self.top:
-            self.eps = min(self.eps, _bound(float(worst[order[self.top - 1]])))
+        cand, worst = cand[:, order], worst[order]
+        # a combination can come twice (seeds, overlapping boxes): equal ones sort together
+        new = np.concatenate([[True], np.any(cand[:, 1:] != cand[:, :-1], axis=0)])
+        self.parts, worst = cand[:, new][:, :self.top], worst[new][:self.top]
+        if worst.size == self.top:
+            _, _, efn, ez, _ = _score(*self.parts[:, -1], *self.args)
+            self.kth = (float(worst[-1]), abs(float(efn)) + abs(float(ez)))
+            self.eps = min(self.eps, _bound(self.kth[0]))
+
+    def boxes(self):
+        """(fn error bound, zeta error bound) pairs; a combination outside all of them ranks after the top.
+
+        One box, eps for both, except near 100 % off: there the errors saturate
+        (fn far below its target gives |fn error| within 1e-12 of 1 for a great
+        many combinations), the ranking's rounding to 1e-12 ties them and the
+        summed error decides. Then a combination ranks before the k-th only if
+        it is in a better rounding class (errors below W - 0.5e-12) or in the
+        same one with a summed error at most S: the one error that is not the
+        worse is then at most S - W + 0.5e-12.
+        """
+        if self.kth is None or abs(np.round(self.kth[0], 12) - 1) > 1e-6:
+            return [(self.eps, self.eps)]
+        w_k = float(np.round(self.kth[0], 12))
+        better = w_k - 0.5e-12 + 2e-14                    # the better classes
+        other = min(self.eps, self.kth[1] - w_k + 1e-12)
+        return [(better, better), (self.eps, other), (other, self.eps)]
 
 
-def _search_pairs(zeta0, rv, c1, c2, best):
-    """Evaluate every combination within ``best.eps`` for the pairs (c1[i], c2[i]).
+def _search_pairs(rv, c1, c2, best):
+    """Evaluate every combination inside ``best``'s boxes for the pairs (c1[i], c2[i]).
 
-    Pairs go in groups of at most ROWS_PER_BATCH rows (pair, zeta part, R1),
-    rows in batches of at most ROWS_PER_BATCH combinations; the bands are
-    recomputed with the tightened eps before each group and each batch, so a
-    loose first bound costs one batch, not the whole grid.
+    Pairs go in groups of at most ROWS_PER_BATCH R2 ranges (pair, R1, box,
+    zeta part), rows in batches of at most ROWS_PER_BATCH combinations; the
+    ranges are recomputed with the tightened boxes before each group and each
+    batch, so a loose first bound costs one batch, not the whole grid.
     """
-    fn0, _, gain = best.args
+    fn0, zeta0, gain = best.args
     while c1.size:
-        pair, ulo, uhi = _zeta_parts(zeta0, best.eps, c1, c2, gain, 0.0, np.inf)
-        plo, phi = _fn_band(fn0, best.eps, c1[pair], c2[pair])
-        first, rows = _r1_rows(rv, plo, phi, ulo, uhi)
-        group = next(_batches(np.bincount(pair, rows, c1.size).astype(int)))
+        boxes = best.boxes()
+        pair, first, rows = _ranges(rv, fn0, zeta0, gain, boxes, c1, c2)
+        # a row has up to two ranges of R2 per box: the group's ranges fit in one batch
+        group = next(_batches(np.bincount(pair, rows, c1.size).astype(int), ROWS_PER_BATCH // (2 * len(boxes))))
         mine = pair < group.stop
-        part, i1 = _expand(first[mine], rows[mine])
-        pair, lo_u, hi_u = pair[mine][part], ulo[mine][part], uhi[mine][part]
-        g1, g2, r1 = c1[pair], c2[pair], rv[i1]
+        row, i1 = _expand(first[mine], rows[mine])
+        g1, g2, r1 = c1[pair[mine][row]], c2[pair[mine][row]], rv[i1]
         while r1.size:
-            # the row's u interval, within the zeta band for the current eps
-            keep, lo_u, hi_u = _zeta_parts(zeta0, best.eps, g1, g2, gain, lo_u, hi_u)
-            g1, g2, r1 = g1[keep], g2[keep], r1[keep]
-            pl, ph = _fn_band(fn0, best.eps, g1, g2)
-            start, count = _r2_range(rv, r1, pl, ph, lo_u, hi_u)
-            live = count > 0
-            g1, g2, r1, lo_u, hi_u, start, count = (x[live] for x in (g1, g2, r1, lo_u, hi_u, start, count))
-            if not r1.size:
+            row, start, count = _ranges(rv, fn0, zeta0, gain, best.boxes(), g1, g2, r1)
+            per_row = np.bincount(row, count, r1.size).astype(int)
+            live = per_row > 0
+            if not live.any():
                 break
-            sl = next(_batches(count))
-            row, i2 = _expand(start[sl], count[sl])
-            best.add(r1[sl][row], rv[i2], g1[sl][row], g2[sl][row])
-            g1, g2, r1, lo_u, hi_u = (x[sl.stop:] for x in (g1, g2, r1, lo_u, hi_u))
+            # renumber the live rows, take those that fit in one batch
+            number = np.cumsum(live) - 1
+            g1, g2, r1, per_row = g1[live], g2[live], r1[live], per_row[live]
+            keep = live[row]
+            row, start, count = number[row[keep]], start[keep], count[keep]
+            sl = next(_batches(per_row))
+            mine = row < sl.stop
+            k, i2 = _expand(start[mine], count[mine])
+            take = row[mine][k]
+            best.add(r1[take], rv[i2], g1[take], g2[take])
+            g1, g2, r1 = g1[sl.stop:], g2[sl.stop:], r1[sl.stop:]
         c1, c2 = c1[group.stop:], c2[group.stop:]
 
 
@@ -360,9 +406,10 @@ def joint_search(fn0: float, zeta0: float, r_values, c_values, gain: float = 1.0
     cv = np.unique(np.asarray(c_values, float))
     if rv.size == 0 or cv.size == 0 or top < 1:
         return []
-    best = _Best(fn0, zeta0, gain, top, _seed_bound(fn0, zeta0, rv, cv, gain, top))
+    best = _Best(fn0, zeta0, gain, top)
+    _seed(rv, cv, best)
     for i1, i2 in _pair_chunks(cv.size):
-        _search_pairs(zeta0, rv, cv[i1], cv[i2], best)
+        _search_pairs(rv, cv[i1], cv[i2], best)
     return _rank(*best.parts, fn0, zeta0, gain, top)
 
 
