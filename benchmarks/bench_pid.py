@@ -13,8 +13,8 @@ process under 5 s and 500 MB peak; the same best error and objective as the
 exhaustive :func:`designer.pid.blocks.brute_force` where that is feasible (E3
 on narrow bounds); with the widest bounds the CLI accepts, the same 500 MB
 (time bounded, no goal). Memory: "sizing peak" is tracemalloc's peak during
-``select_parts`` (numpy's allocations), "process peak" the child's peak
-resident set size (``os.wait4``).
+``select_parts`` (numpy's allocations), "process peak" the command's peak
+resident set size in a new process (``bench_plant.run_measured``).
 """
 
 from __future__ import annotations
