@@ -25,9 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-from designer.identify.core import model_step
-from designer.identify.csvio import read_capture
+from designer.identify.io import read_capture
 from designer.identify.step import identify_step, model_fn_zeta
+from designer.identify.structures import model_step
 
 N = 1_000_000
 GOAL_S = 2.0
@@ -47,7 +47,7 @@ def write_capture(path, t, u, y) -> float:
 #: kernel's ru_maxrss of a child counts the parent's pages at fork time, so a
 #: large benchmark process would inflate it; VmHWM is the new image's own.
 _PEAK = ("import sys\n"
-         "from designer.cli_identify import identify_main\n"
+         "from designer.cli.identify import identify_main\n"
          "rc = identify_main(sys.argv[1:])\n"
          "hwm = [ln for ln in open('/proc/self/status') if ln.startswith('VmHWM')][0]\n"
          "print(int(hwm.split()[1]) / 1024.0, file=sys.stderr)\n"

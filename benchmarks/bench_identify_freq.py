@@ -25,7 +25,7 @@ import numpy as np
 
 from designer.identify import frequency as fr
 from designer.identify import second_order as so
-from designer.identify.core import model_step
+from designer.identify.structures import model_step
 
 N = 1_000_000
 FIX = Path(__file__).resolve().parent.parent / "tests" / "fixtures" / "identify_freq"

@@ -94,9 +94,9 @@ def main():
 
 
 def search_tables():
-    from designer.eseries import SERIES
+    from designer.core.eseries import SERIES
+    from designer.core.ranges import RANGES
     from designer.pid import blocks
-    from designer.ranges import RANGES
     exe = str(Path(sys.executable).parent / "design-pid")
     print(f"### Part search for every series pair: Kp {ZN[0]}, Ti {ZN[1] * 1e6:g} us, Td {ZN[2] * 1e6:g} us "
           "(ZN for the seed plant), default bounds (R 1k..1M, C 1n..10u)\n")

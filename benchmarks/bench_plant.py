@@ -27,10 +27,10 @@ from pathlib import Path
 
 import numpy as np
 
-from designer.eseries import SERIES, values
-from designer.ranges import RANGES
-from designer.sallenkey import fn_zeta
-from designer.selection import joint_search
+from designer.core.eseries import SERIES, values
+from designer.core.ranges import RANGES
+from designer.plant.sallenkey import fn_zeta
+from designer.plant.selection import joint_search
 
 SPEC = (3500, 0.2)
 SPECS = [(3500, 0.2), (1000, 0.707), (50, 0.05), (20e3, 1.5)]
@@ -173,8 +173,8 @@ def main():
                   f"{100 * res[0].worst:.4f} % | {'yes' if same else 'NO'} |")
 
     print("\n### design-plant --fc 3500 --zeta 0.2, in process (median of 3)\n")
-    from designer.plant import PlantSpec, design_plant
-    from designer.plant_report import write_outputs
+    from designer.plant.design import PlantSpec, design_plant
+    from designer.plant.report import write_outputs
     rows = []
     for _ in range(3):
         with tempfile.TemporaryDirectory() as tmp:
@@ -191,7 +191,7 @@ def main():
     walls = []
     for _ in range(3):
         t = time.perf_counter()
-        subprocess.run([sys.executable, "-c", "import designer.cli, designer.plant, designer.plant_report"],
+        subprocess.run([sys.executable, "-c", "import designer.cli.plant, designer.plant.design, designer.plant.report"],
                        check=True)
         imp.append(time.perf_counter() - t)
         with tempfile.TemporaryDirectory() as tmp:

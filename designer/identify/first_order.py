@@ -43,8 +43,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .core import MethodResult
 from .preprocess import crossing_time, noise_sigma, smooth_derivative, window_samples
+from .structures import MethodResult
 
 #: An FOPDT or double-pole model cannot overshoot; beyond this the data are
 #: outside every method's validity range here.

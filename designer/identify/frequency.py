@@ -4,7 +4,7 @@ Input is a table of frequency, gain (dB or amplitude ratio) and optionally
 phase (degrees, radians, or the time shift of the output behind the input, as
 seed 000 Table IV measures it: phase = -360 f dt degrees).
 
-Methods (all return :class:`~designer.identify.core.MethodResult`):
+Methods (all return :class:`~designer.identify.structures.MethodResult`):
 
 ``asymptotes``     low-frequency gain K, the high-frequency slope -20 n dB/decade
                    (order n), and the corner where the gain has fallen by
@@ -58,11 +58,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import DesignError
-from ..ranges import RANGES
-from .core import MethodResult
+from ..core.errors import DesignError
+from ..core.ranges import RANGES
+from ..core.textfile import MAX_TABLE_BYTES, read_text, show_cell, shown
 from .preprocess import number_text
-from .textfile import MAX_TABLE_BYTES, read_text, show_cell, shown
+from .structures import MethodResult
 
 ERROR_DEFINITION = ("iae = mean over the table's frequencies of |G_model/G_data - 1| "
                     "(relative complex error; gain only when there is no phase), "
@@ -415,7 +415,7 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
 
 def read_freq_table(path, **units) -> FreqData:
     """Read a frequency-response CSV file (see :func:`parse_freq_table`): at most
-    :data:`~.textfile.MAX_TABLE_BYTES`, UTF-8 or ASCII."""
+    :data:`~designer.core.textfile.MAX_TABLE_BYTES`, UTF-8 or ASCII."""
     text = read_text(path, "table", MAX_TABLE_BYTES)
     return parse_freq_table(text, source=shown(path), **units)
 
@@ -729,6 +729,7 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     """Fit ``model`` to the complex response from each of ``starts`` (parameter
     dicts) and keep the lowest cost; 95 % half-widths from the Jacobian."""
     from scipy.optimize import least_squares
+
     # Student t quantile from scipy.special: scipy.stats costs 0.4 s to import
     from scipy.special import stdtrit
 

@@ -29,8 +29,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import DesignError
-from ..ranges import RANGES
+from ..core.errors import DesignError
+from ..core.ranges import RANGES
 
 #: Fraction of the post-step record used as the settled tail for yf.
 TAIL_FRACTION = 0.1

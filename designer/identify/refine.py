@@ -21,8 +21,8 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.special import stdtrit
 
-from .core import MethodResult, model_step
 from .preprocess import crossing_time, noise_sigma
+from .structures import MethodResult, model_step
 
 #: Fits run on at most this many samples (the data are block-averaged upstream).
 MAX_FIT_SAMPLES = 4000

@@ -55,7 +55,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from .core import MethodResult, iae_ise, model_step
+from .structures import MethodResult, iae_ise, model_step
 
 __all__ = [
     "STEP_METHODS", "overshoot", "log_decrement", "t4_t3", "two_pole", "chen",

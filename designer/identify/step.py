@@ -21,14 +21,13 @@ import math
 import time
 from dataclasses import dataclass, field
 
-
-from ..errors import DesignError
-from ..report import json_safe
-from ..units import format_eng
-from .core import MethodResult, iae_ise, model_step, unphysical
+from ..core.errors import DesignError
+from ..core.jsonio import json_safe
+from ..core.units import format_eng
 from .first_order import FIRST_ORDER_METHODS
 from .preprocess import PreparedStep, prepare_step
 from .refine import refine_all
+from .structures import MethodResult, iae_ise, model_step, unphysical
 
 #: Part tolerances assumed when the design's ``built`` has no ``tolerance_band``.
 DEFAULT_R_TOL = 0.05
@@ -324,7 +323,7 @@ def _check_names(methods):
 
 
 def _measured(step: PreparedStep, t_eval, y_eval) -> dict:
-    from ..metrics import step_metrics
+    from ..core.metrics import step_metrics
     from .preprocess import block_mean, noise_sigma, smooth_derivative
     if step.sigma > 0 and t_eval.size > 50:
         # Noise spikes would read as overshoot: measure on the smoothed record
@@ -434,7 +433,7 @@ def load_design(path) -> dict:
     """Read a design-plant result.json (at most MAX_TABLE_BYTES); a clear
     one-line error if it is not one, or if a value the comparison uses is not
     a finite number where one is needed."""
-    from .textfile import MAX_TABLE_BYTES, read_text, shown
+    from ..core.textfile import MAX_TABLE_BYTES, read_text, shown
     name = shown(path)
     text = read_text(path, "--against file", MAX_TABLE_BYTES)
     try:

@@ -30,9 +30,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import eseries
-from ..errors import DesignError
-from ..units import format_eng
+from ..core import eseries
+from ..core.errors import DesignError
+from ..core.units import format_eng
 
 #: "Well below / well above" the plant's fn for the check (factor).
 CORNER_MARGIN = 5.0

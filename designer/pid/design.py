@@ -16,17 +16,18 @@ from pathlib import Path
 import numpy as np
 from scipy import signal
 
-from .. import eseries, opamps
-from ..bench import recommend_square_wave
-from ..errors import DesignError
-from ..models import dominant_pair, plant_tf, plant_tf_opamp, response_span
-from ..opamps import OpAmp
-from ..report import json_safe
-from ..ranges import RANGES
-from ..sallenkey import SallenKeyParts, check_parts
-from ..units import format_eng
+from ..core import eseries, opamps
+from ..core.errors import DesignError
+from ..core.jsonio import json_safe
+from ..core.lti import dominant_pair, response_span
+from ..core.opamps import OpAmp
+from ..core.ranges import RANGES
+from ..core.units import format_eng
+from ..plant.bench import recommend_square_wave
+from ..plant.model import plant_tf, plant_tf_opamp
+from ..plant.sallenkey import SallenKeyParts, check_parts
+from ..spice.deck import SquareTest
 from . import blocks, model, tuning
-from ..netlist import SquareTest
 from .netlist import closed_loop_deck
 from .verify import loop_metrics
 
@@ -69,7 +70,7 @@ class PidSpec:
     def validate(self) -> None:
         """Refuse, in one line, anything outside :data:`designer.ranges.RANGES` or
         inconsistent, before any work; the plant's parts go through
-        :func:`designer.sallenkey.check_parts` (the one plant validation)."""
+        :func:`designer.plant.sallenkey.check_parts` (the one plant validation)."""
         sources = sum(x is not None for x in (self.plant_fc_hz, self.plant_parts, self.plant_json))
         if sources != 1:
             raise DesignError("give the plant one way: --plant-fc/--plant-zeta, --plant-r1..--plant-c2, "
@@ -221,7 +222,7 @@ class PidResult:
 
 def plant_from_json(path) -> SallenKeyParts:
     """The built plant of a ``design-plant``/``analyze-plant`` result.json,
-    through the one plant validation (:func:`designer.sallenkey.check_parts`):
+    through the one plant validation (:func:`designer.plant.sallenkey.check_parts`):
     values of the wrong type, out of range, a gain that disagrees with R3/R4 or
     an unstable circuit are refused in one line naming the file and the key."""
     p = Path(path)
@@ -249,13 +250,13 @@ def plant_from_json(path) -> SallenKeyParts:
 
 def resolve_plant(spec: PidSpec):
     """(parts, description) of the plant, designed or given, validated by
-    :func:`designer.sallenkey.check_parts` however it arrives."""
+    :func:`designer.plant.sallenkey.check_parts` however it arrives."""
     if spec.plant_parts is not None:
         return check_parts(spec.plant_parts, name_of=PLANT_FLAGS), "parts"
     if spec.plant_json is not None:
         parts = spec._json_plant if spec._json_plant is not None else plant_from_json(spec.plant_json)
         return parts, f"json:{spec.plant_json}"
-    from ..plant import PlantSpec, design_plant
+    from ..plant.design import PlantSpec, design_plant
     ps = PlantSpec(fc_hz=spec.plant_fc_hz, zeta=spec.plant_zeta, opamp=spec.opamp,
                    r_series=spec.r_series, c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
                    c_min=spec.c_min, c_max=spec.c_max, alternatives=1)

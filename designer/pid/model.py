@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
-from ..errors import DesignError
-from ..opamps import OpAmp
+from ..core.errors import DesignError
+from ..core.opamps import OpAmp
 from .blocks import PidParts
 
 SIGNALS = ("ve", "vp", "vd", "vi", "vs", "u", "y")

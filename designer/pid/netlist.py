@@ -13,10 +13,18 @@ from __future__ import annotations
 
 import logging
 
-from ..netlist import (SquareTest, add_opamp, add_sallen_key, add_supplies, finish_deck,
-                       measure_lines, opamp_library_text, settle_error_source)
-from ..opamps import OpAmp
-from ..sallenkey import SallenKeyParts
+from ..core.opamps import OpAmp
+from ..plant.netlist import add_sallen_key
+from ..plant.sallenkey import SallenKeyParts
+from ..spice.deck import (
+    SquareTest,
+    add_opamp,
+    add_supplies,
+    finish_deck,
+    measure_lines,
+    opamp_library_text,
+    settle_error_source,
+)
 from .blocks import PidParts
 
 #: signals whose extremes the deck measures (one per op-amp output)

@@ -27,12 +27,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize as sopt
 
-from ..errors import DesignError
-from ..metrics import step_metrics
-from ..opamps import OpAmp
-from ..ranges import RANGES
+from ..core.errors import DesignError
+from ..core.metrics import step_metrics
+from ..core.opamps import OpAmp
+from ..core.ranges import RANGES
 from . import blocks, model
-
 
 #: the search box, log(Kp, Ti, Td): the ranges design-pid accepts for given gains
 BOX_LO = np.log([RANGES["kp"].lo, RANGES["ti_s"].lo, RANGES["td_s"].lo])

@@ -11,9 +11,11 @@ import time
 
 import numpy as np
 
-from .. import eseries
-from .. import report as R
-from ..units import format_eng
+from ..core import eseries
+from ..core.units import format_eng
+from ..report import document as R
+from ..report.bundle import bundle_paths, write_bundle
+from ..report.plots import png_bytes, step_plot
 from .model import OPAMP_OUTPUTS
 from .tuning import MODEL_NAMES
 
@@ -263,11 +265,11 @@ def plots(result) -> dict:
     if sp is not None:
         curves["SPICE (ngspice)"] = sp["y"]
     curves["plant alone (open loop)"] = w["open_loop"]
-    images = {"closed-loop.png": R.step_plot(t, curves, f"Closed-loop step, 0 -> {result.test.amplitude_v:g} V")}
+    images = {"closed-loop.png": step_plot(t, curves, f"Closed-loop step, 0 -> {result.test.amplitude_v:g} V")}
     cu = {"u analytic": a["u"]}
     if sp is not None:
         cu["u SPICE"] = sp["u"]
-    images["controller.png"] = R.step_plot(t, cu, "Controller output u (plant input)", "u (V)")
+    images["controller.png"] = step_plot(t, cu, "Controller output u (plant input)", "u (V)")
     images["blocks.png"] = _blocks_plot(result)
     images["loop-bode.png"] = _bode_plot(result)
     images["reaction-curve.png"] = _reaction_plot(result)
@@ -300,12 +302,12 @@ def _blocks_plot(result) -> bytes:
     axes[0].legend(fontsize=7, loc="upper right")
     axes[0].set_title("Every op-amp output (red: output limits, drawn when reached)")
     axes[-1].set_xlabel("time after the step (us)")
-    return R.png_bytes(fig)
+    return png_bytes(fig)
 
 
 def _bode_plot(result) -> bytes:
-    from .model import loop_gain
     from .design import plant_model
+    from .model import loop_gain
     plt = _plt()
     w = result.waveforms["bode_w"]
     pn, pd = plant_model(result.plant, result.opamp)
@@ -327,7 +329,7 @@ def _bode_plot(result) -> bytes:
     a2.set_xlabel("frequency (Hz)")
     for ax in (a1, a2):
         ax.grid(True, which="both", alpha=0.3)
-    return R.png_bytes(fig)
+    return png_bytes(fig)
 
 
 def _reaction_plot(result) -> bytes:
@@ -351,7 +353,7 @@ def _reaction_plot(result) -> bytes:
     ax.set_ylabel("output per volt of step")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    return R.png_bytes(fig)
+    return png_bytes(fig)
 
 
 def write_outputs(result, out_dir, name: str) -> dict:
@@ -359,7 +361,7 @@ def write_outputs(result, out_dir, name: str) -> dict:
     plots) under ``out_dir``, each written atomically."""
     tick = time.perf_counter()
     images = plots(result)
-    result.files = R.bundle_paths(out_dir, name, images)
-    R.write_bundle(result.files, result.deck, images, title_of(result), sections(result), result.to_dict())
+    result.files = bundle_paths(out_dir, name, images)
+    write_bundle(result.files, result.deck, images, title_of(result), sections(result), result.to_dict())
     result.timings["report_s"] = time.perf_counter() - tick
     return result.files

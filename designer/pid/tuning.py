@@ -37,8 +37,8 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy.signal import savgol_filter
 
-from ..errors import DesignError
-from ..ranges import RANGES
+from ..core.errors import DesignError
+from ..core.ranges import RANGES
 
 RULES = ("zn", "cohen-coon", "chr0", "chr20", "amigo", "simc")
 #: the model each rule was derived on: the ZN tangent, or a fitted FOPDT
@@ -66,7 +66,7 @@ class Fopdt:
 
     def describe(self) -> str:
         """``"least-squares FOPDT: K 1.02, L 34.8 us, T 17.5 us"``."""
-        from ..units import format_eng
+        from ..core.units import format_eng
         return (f"{MODEL_NAMES.get(self.source, self.source)}: K {self.K:.4g}, L {format_eng(self.L_s, 's')}, "
                 f"T {format_eng(self.T_s, 's')}")
 

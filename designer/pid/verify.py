@@ -21,11 +21,11 @@ import math
 
 import numpy as np
 
-from ..compare import metric_deltas, nrms, resample
-from ..errors import DesignError
-from ..metrics import step_metrics
-from ..opamps import OpAmp
-from ..simulate import get_simulator
+from ..core.compare import metric_deltas, nrms, resample
+from ..core.errors import DesignError
+from ..core.metrics import step_metrics
+from ..core.opamps import OpAmp
+from ..spice.simulate import get_simulator
 from .model import OPAMP_OUTPUTS
 
 PIN_FRACTION = 0.01

@@ -1,0 +1,155 @@
+"""What every command shares: the one-line error contract and exit statuses
+(:func:`run_cli`), the parser that turns usage mistakes into one line, printing
+that survives a closed pipe, the part-selection and output options, design
+names, and writing a result's files then printing it (:func:`emit`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import sys
+
+from ..core import opamps
+from ..core.errors import DesignError
+from ..core.eseries import SERIES
+from ..core.ranges import help_range, parse_in_range
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """argparse, but a usage mistake is one line (and exit status 2)."""
+
+    def error(self, message):
+        raise DesignError(f"{message} (see {self.prog} --help)")
+
+
+def print_output(text: str, end: str = "\n") -> None:
+    """Print; a pipe closed by the reader (``| head``) is their choice, not an error."""
+    try:
+        print(text, end=end)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _silence_stdout()
+
+
+def _silence_stdout() -> None:
+    # the interpreter flushes stdout again at exit: point it at /dev/null so that
+    # a reader who stopped early (| head) gets no "Exception ignored" message
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+
+
+def run_cli(prog: str, build_parser, action, argv=None) -> int:
+    """Run ``action(args)`` with the one-line error convention; returns the exit status:
+    0 done, 1 a check failed (when asked), 2 bad input or usage, 3 simulator error,
+    130 interrupted. Every failure is one line on stderr, never a traceback."""
+    from ..core.errors import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_SIMULATOR, SimulatorError
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        return action(args) or 0
+    except SimulatorError as exc:
+        _fail(prog, f"simulator error: {exc}")
+        return EXIT_SIMULATOR
+    except DesignError as exc:
+        _fail(prog, str(exc))
+        return EXIT_BAD_INPUT
+    except BrokenPipeError:
+        _silence_stdout()
+        return 0
+    except KeyboardInterrupt:
+        _fail(prog, "interrupted")
+        return EXIT_INTERRUPTED
+    except MemoryError:
+        _fail(prog, "out of memory: the input is too large for this machine")
+        return EXIT_BAD_INPUT
+    except OSError as exc:   # a file system problem no check caught earlier
+        where = f" {exc.filename!r}" if getattr(exc, "filename", None) else ""
+        _fail(prog, f"cannot read or write{where}: {exc.strerror or exc}")
+        return EXIT_BAD_INPUT
+
+
+def _fail(prog: str, message: str) -> None:
+    line = " ".join(str(message).split())   # one line, whatever the message holds
+    try:
+        print(f"{prog}: error: {line}", file=sys.stderr)
+    except OSError:
+        pass
+
+
+def add_part_options(group):
+    """E-series and value bounds for the parts (design-plant and design-pid)."""
+    group.add_argument("--r-series", default="E24", help=f"resistor series: {', '.join(SERIES)} (default E24)")
+    group.add_argument("--c-series", default="E12", help="capacitor series (default E12)")
+    group.add_argument("--r-min", default="1k", help=f"smallest resistor (default 1k) {help_range('resistor_ohm')}")
+    group.add_argument("--r-max", default="1M", help=f"largest resistor (default 1M) {help_range('resistor_ohm')}")
+    group.add_argument("--c-min", default="1n", help=f"smallest capacitor (default 1n) {help_range('capacitor_f')}")
+    group.add_argument("--c-max", default="10u", help=f"largest capacitor (default 10u) {help_range('capacitor_f')}")
+
+
+def part_options(args) -> dict:
+    """The parsed :func:`add_part_options`, as spec keyword arguments."""
+    keys = {"r_min": "resistor_ohm", "r_max": "resistor_ohm", "c_min": "capacitor_f", "c_max": "capacitor_f"}
+    return {"r_series": args.r_series, "c_series": args.c_series,
+            **{k: parse_in_range(getattr(args, k), f"--{k.replace('_', '-')}", key) for k, key in keys.items()}}
+
+
+def optional(text, name: str, key: str):
+    """:func:`parse_in_range`, or None for an option not given."""
+    return None if text is None else parse_in_range(text, name, key)
+
+
+def add_output_options(p):
+    g = p.add_argument_group("output")
+    g.add_argument("--out", default=".", metavar="DIR",
+                   help="write netlists/<name>.cir and reports/<name>/ under DIR (default: current directory)")
+    g.add_argument("--name", help="design name used for the files: letters, digits and . _ - + = , @ "
+                                   "(default from the figures, e.g. plant_fc3500_z0.2)")
+    g.add_argument("--json", action="store_true", help="print one JSON object on stdout instead of the summary")
+    g.add_argument("--no-files", action="store_true", help="do not write the netlist and report files")
+    s = p.add_argument_group("simulation")
+    s.add_argument("--no-sim", action="store_true", help="skip the ngspice run (analytic figures only)")
+    s.add_argument("--simulator", default="pyspice", choices=("pyspice", "ngspice-cli"),
+                   help="pyspice: ngspice shared library via PySpice (default); "
+                        "ngspice-cli: `ngspice -b` subprocess")
+    s.add_argument("--opamp", default="LM741", metavar="NAME",
+                   help=f"op-amp model: {', '.join(opamps.names())} (default LM741, as the seed's bench)")
+    s.add_argument("--amplitude", default="2", metavar="V",
+                   help="bench square wave goes 0 -> V volts (default 2, as the seed's bench test) "
+                        + help_range("amplitude_v"))
+    s.add_argument("--square-freq", metavar="HZ",
+                   help="bench square-wave frequency (default: a round value whose half period is "
+                        "1.5x the 2 %% settling time; 330 Hz for the seed's plant) " + help_range("square_hz"))
+
+
+_NAME = re.compile(r"^[A-Za-z0-9_+=,@-][A-Za-z0-9._+=,@-]{0,119}$")
+
+
+def check_name(name) -> str:
+    """A design name is a plain file name: letters, digits and ``. _ - + = , @``, not
+    starting with '.', at most 120 characters (it names a folder and a netlist)."""
+    if not _NAME.match(name or ""):
+        what = "must not be empty" if not name else f"{name[:40]!r} is not a plain file name"
+        raise DesignError(f"--name {what}: use letters, digits and . _ - + = , @ (not starting with '.', "
+                          "at most 120 characters)")
+    return name
+
+
+def emit(result, args, name, write_outputs, summary_text) -> int:
+    """Write the files (unless --no-files), then print JSON or the summary and the file list."""
+    if not args.no_files:
+        write_outputs(result, args.out, name)
+    if args.json:
+        print_output(json.dumps(result.to_dict(), indent=2))
+    else:
+        text = summary_text(result)
+        if result.files:
+            text += "\nFiles:\n" + "".join(
+                f"  {key}: {', '.join(path) if isinstance(path, list) else path}\n"
+                for key, path in result.files.items())
+        print_output(text, end="")
+    return 0

@@ -1,0 +1,176 @@
+"""Command-line layer of ``design-plant`` and ``analyze-plant``: parse, call
+:func:`designer.plant.design.design_plant` / ``analyze_plant``, print."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .. import __version__
+from ..core import opamps
+from ..core.errors import DesignError
+from ..core.ranges import help_range, parse_in_range
+from .common import (
+    OneLineParser,
+    add_output_options,
+    add_part_options,
+    check_name,
+    emit,
+    optional,
+    part_options,
+    run_cli,
+)
+
+
+def _design_parser():
+    p = OneLineParser(
+        prog="design-plant",
+        description="Design a unity-gain (or gain K) Sallen-Key low-pass that realises the second-order plant "
+                    "T(s) = K wn^2 / (s^2 + 2 zeta wn s + wn^2), pick all four parts jointly from E-series values, "
+                    "and verify it in ngspice. Values accept engineering notation: 4k7, 820, 10n, 2u2, 3.5k.",
+        epilog="""examples:
+  design-plant --fc 3500 --zeta 0.2                  the seed's plant, E24 resistors, E12 capacitors
+  design-plant --fc 3500 --zeta 0.2 --r 1k --c 10n   the seed's procedure: fix R and C, solve m and n
+  design-plant --fc 1k --zeta 0.05 --gain 2          low damping needs a gain K > 1 (C2/C1 >= 1/zeta^2 at K = 1)
+  design-plant --fc 20k --zeta 0.5 --opamp LM358 --compensate-gbw
+  design-plant --fc 3500 --zeta 0.2 --json --no-sim
+
+Outputs: netlists/<name>.cir (run it alone with `ngspice -b`), reports/<name>/build-sheet.md and .html,
+result.json, step.png, bode.png. Exit status 2 on bad input.""",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    t = p.add_argument_group("target")
+    t.add_argument("--fc", required=True, metavar="HZ",
+                   help=f"natural frequency fn = wn / 2 pi, Hz (e.g. 3500, 3.5k) {help_range('fc_hz')}")
+    t.add_argument("--zeta", required=True, metavar="Z",
+                   help=f"damping ratio (>= 1 is overdamped) {help_range('zeta')}")
+    t.add_argument("--gain", default="1", metavar="K",
+                   help=f"DC gain K = 1 + R4/R3 (default 1: follower) {help_range('gain')}")
+    t.add_argument("--compensate-gbw", action="store_true",
+                   help="pre-distort the targets so the circuit lands on them with the op-amp's finite GBW")
+    sel = p.add_argument_group("parts")
+    sel.add_argument("--r", metavar="OHM", help="the seed's procedure: fix R (R2 = R, R1 = m R) ... "
+                                                "(resistors: " + help_range("resistor_ohm")[1:])
+    sel.add_argument("--c", metavar="F", help="... and C (C1 = C, C2 = n C), solve m and n "
+                                              "(capacitors: " + help_range("capacitor_f")[1:])
+    add_part_options(sel)
+    sel.add_argument("--alternatives", default="5",
+                     help=f"how many best combinations to list (default 5) {help_range('alternatives')}")
+    add_output_options(p)
+    return p
+
+
+def _design(args) -> int:
+    from ..plant.design import PlantSpec, design_plant
+    spec = PlantSpec(
+        fc_hz=parse_in_range(args.fc, "--fc", "fc_hz"), zeta=parse_in_range(args.zeta, "--zeta", "zeta"),
+        gain=parse_in_range(args.gain, "--gain", "gain"),
+        **part_options(args),
+        r=optional(args.r, "--r", "resistor_ohm"), c=optional(args.c, "--c", "capacitor_f"),
+        opamp=args.opamp, compensate_gbw=args.compensate_gbw,
+        amplitude_v=parse_in_range(args.amplitude, "--amplitude", "amplitude_v"),
+        square_hz=optional(args.square_freq, "--square-freq", "square_hz"),
+        alternatives=_count(args.alternatives))
+    spec.validate()
+    name = args.name if args.name is not None else (
+        f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
+    check_name(name)
+    if not args.no_files:
+        from ..core.fileio import check_can_create
+        check_can_create(args.out, ("netlists", "reports"))  # fail before the work, not after
+    result = design_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
+    return _emit(result, args, name)
+
+
+def _count(text) -> int:
+    try:
+        n = int(str(text).strip())
+    except ValueError:
+        raise DesignError(f"--alternatives must be a whole number from 1 to 50, got {text!r}") from None
+    if not 1 <= n <= 50:
+        raise DesignError(f"--alternatives must be a whole number from 1 to 50, got {text!r}")
+    return n
+
+
+def _emit(result, args, name) -> int:
+    from ..plant.report import summary_text, write_outputs
+    return emit(result, args, name, write_outputs, summary_text)
+
+
+def _analyze_parser():
+    p = OneLineParser(
+        prog="analyze-plant",
+        description="Analyse a Sallen-Key low-pass as built from its parts: fn, zeta and Q it really gives, step "
+                    "metrics with the op-amp model, tolerance band, sensitivity, and an ngspice check.",
+        epilog="""examples:
+  analyze-plant --r1 820 --r2 1k --c1 10n --c2 220n                 the seed's rounded parts
+  analyze-plant --r1 820 --r2 1k --c1 10n --c2 220n --fc 3500 --zeta 0.2   errors against the seed's target
+  analyze-plant --r1 10k --r2 10k --c1 10n --c2 10n --gain 2.5      equal-component design with gain
+  analyze-plant --r1 10k --r2 10k --c1 10n --c2 10n --r3 10k --r4 15k  gain from its resistors""",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    g = p.add_argument_group("parts")
+    for n, what, key in (("r1", "input resistor, ohms", "resistor_ohm"),
+                         ("r2", "resistor to the non-inverting input, ohms", "resistor_ohm"),
+                         ("c1", "non-inverting input to ground, farads", "capacitor_f"),
+                         ("c2", "feedback capacitor, farads", "capacitor_f")):
+        g.add_argument(f"--{n}", required=True, help=f"{what} {help_range(key)}")
+    g.add_argument("--gain", default=None, metavar="K", help=f"gain K = 1 + R4/R3 (default 1) {help_range('gain')}")
+    g.add_argument("--r3", help="gain resistor to ground (with --r4, instead of --gain)")
+    g.add_argument("--r4", help="gain feedback resistor")
+    g.add_argument("--fc", help=f"target fn, Hz, to report errors against (optional) {help_range('fc_hz')}")
+    g.add_argument("--zeta", help=f"target damping, to report errors against (optional) {help_range('zeta')}")
+    g.add_argument("--r-series", default=None, help="series the resistors come from, for the tolerance band "
+                                                    "(default: the smallest series that holds each value)")
+    g.add_argument("--c-series", default=None, help="series the capacitors come from, for the tolerance band "
+                                                    "(default: the smallest series that holds each value)")
+    add_output_options(p)
+    return p
+
+
+def _analyze(args) -> int:
+    from ..core.units import value_code
+    from ..plant.design import analyze_plant
+    from ..plant.sallenkey import SallenKeyParts, check_parts
+    r3 = r4 = None
+    if (args.r3 is None) != (args.r4 is None):
+        raise DesignError("--r3 and --r4 go together (K = 1 + R4/R3)")
+    if args.r3 is not None:
+        if args.gain is not None:
+            raise DesignError("give either --gain or --r3/--r4, not both")
+        r3, r4 = parse_in_range(args.r3, "--r3", "resistor_ohm"), parse_in_range(args.r4, "--r4", "resistor_ohm")
+    gain = None if args.gain is None else parse_in_range(args.gain, "--gain", "gain")
+    vals = {n: parse_in_range(getattr(args, n), f"--{n}", "resistor_ohm" if n[0] == "r" else "capacitor_f")
+            for n in ("r1", "r2", "c1", "c2")}
+    # the shared plant check derives R3/R4 for a bare --gain and refuses unstable parts
+    parts = check_parts(SallenKeyParts(vals["r1"], vals["r2"], vals["c1"], vals["c2"], gain, r3, r4),
+                        name_of={k: f"--{k}" for k in ("r1", "r2", "c1", "c2", "r3", "r4", "gain")})
+    fc = optional(args.fc, "--fc", "fc_hz")
+    zeta = optional(args.zeta, "--zeta", "zeta")
+    from ..core.eseries import series_name
+    for s in (args.r_series, args.c_series):
+        if s is not None:
+            series_name(s)
+    opamps.get(args.opamp)
+    name = args.name if args.name is not None else "built_" + "_".join(f"{k}{value_code(v)}" for k, v in vals.items())
+    check_name(name)
+    amplitude = parse_in_range(args.amplitude, "--amplitude", "amplitude_v")
+    square = optional(args.square_freq, "--square-freq", "square_hz")
+    if not args.no_files:
+        from ..core.fileio import check_can_create
+        check_can_create(args.out, ("netlists", "reports"))
+    result = analyze_plant(parts, args.opamp, fc, zeta, args.r_series, args.c_series, amplitude, square,
+                           simulate=not args.no_sim, simulator=args.simulator)
+    return _emit(result, args, name)
+
+
+def design_plant_main(argv=None) -> int:
+    return run_cli("design-plant", _design_parser, _design, argv)
+
+
+def analyze_plant_main(argv=None) -> int:
+    return run_cli("analyze-plant", _analyze_parser, _analyze, argv)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(design_plant_main())

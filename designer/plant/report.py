@@ -1,0 +1,202 @@
+"""The plant's build sheet, terminal summary and files (netlist, report folder)."""
+
+from __future__ import annotations
+
+import io
+import time
+
+from ..core.units import format_eng
+from ..report import document as R
+from ..report.bundle import bundle_paths, write_bundle
+from ..report.plots import bode_plot, step_plot
+
+METRIC_ROWS = (("overshoot_pct", "overshoot Mp", lambda v: "n/a" if v is None else f"{v:.4g} %"),
+               ("peak_time_s", "peak time tp", R.fmt_time),
+               ("rise_time_s", "rise time tr (10-90 %)", R.fmt_time),
+               ("settling_time_s", "settling time ts (2 %)", R.fmt_time))
+
+
+def title_of(result) -> str:
+    s = result.spec
+    if result.mode == "analyze":
+        return f"Sallen-Key plant as built: fn {result.built.fn_hz:.5g} Hz, zeta {result.built.zeta:.4g}"
+    return f"Sallen-Key plant: fc {s['fc_hz']:g} Hz, zeta {s['zeta']:g}, gain {s['gain']:g}"
+
+
+def sections(result, with_images: bool = True) -> list:
+    d = result.to_dict()
+    b = result.built
+    ser = result.series
+    amp = result.opamp
+    lab = ser["parts"]
+    where = {"R1": "input resistor", "R2": "to the non-inverting input", "C1": "non-inverting input to ground",
+             "C2": "R1-R2 node to the output (feedback)", "R3": "gain: inverting input to ground",
+             "R4": "gain: output to inverting input"}
+    bom = [R.part_row(ref, getattr(b, ref.lower()), "Ohm" if ref[0] == "R" else "F", role,
+                      lab[ref]["series"], lab[ref]["tolerance_pct"])
+           for ref, role in where.items() if ref in lab]
+    bom.append(["U1", amp.name, "", "", "", f"op-amp on {amp.vcc:g} V / {amp.vee:g} V"
+                + (" (follower: output to inverting input)" if b.r3 is None else "")])
+    out = [("Bill of materials", [R.table(["Ref", "Value", "Code", "Series", "Tolerance", "Where"], bom)]),
+           ("Wiring", [R.table(["from", "to", "part"], wiring(b, amp))])]
+
+    s = d["spec"]
+    bl = d["built"]
+    ideal = d["ideal"] or {}
+    rows = [["fn", _f(s["fc_hz"], "Hz"), _f(ideal.get("fn_hz"), "Hz"), _f(bl["fn_hz"], "Hz"),
+             R.fmt_pct(bl["fn_error_pct"]), _f(bl["fn_opamp_hz"], "Hz"), R.fmt_pct(bl["fn_opamp_error_pct"])],
+            ["zeta", _n(s["zeta"]), _n(ideal.get("zeta")), _n(bl["zeta"]), R.fmt_pct(bl["zeta_error_pct"]),
+             _n(bl["zeta_opamp"]), R.fmt_pct(bl["zeta_opamp_error_pct"])],
+            ["Q", _n(None if s["zeta"] is None else 1 / (2 * s["zeta"])), _n(ideal.get("q")), _n(bl["q"]), "",
+             _n(1 / (2 * bl["zeta_opamp"])), ""]]
+    blocks = [R.table(["", "target", "exact parts", "built (ideal op-amp)", "error",
+                       f"built with {amp.name}", "error"], rows)]
+    if d["ratios"].get("m") is not None:
+        blocks.append(R.text(f"Ratios: m = R1/R2 = {d['ratios']['m']:.4g}, n = C2/C1 = {d['ratios']['n']:.4g}."))
+    out.append(("Target and achieved", blocks))
+
+    ts = d["test_signal"]
+    tol = bl["tolerance_band"]
+    spice = d["spice"] or {}
+    rows = []
+    for key, label, f in METRIC_ROWS:
+        band = tol.get(key, {})
+        rows.append([label, f(d["analytic_opamp"][key]), f(spice.get(key)) if spice else "not simulated",
+                     f"{f(band.get('min'))} .. {f(band.get('max'))}"])
+    amp_v = ts["high_v"]
+    peak = d["analytic_opamp"]["peak_value"] * amp_v
+    rows.append(["peak output", format_eng(peak, "V"), format_eng((spice.get("peak_value") or 0) * amp_v, "V")
+                 if spice else "", ""])
+    out.append(("Bench test", [
+        R.text(f"Function generator: square wave {format_eng(ts['frequency_hz'], 'Hz')}, "
+               f"{format_eng(ts['amplitude_vpp'], 'V')} peak-to-peak with {format_eng(ts['offset_v'], 'V')} "
+               f"offset (0 V to {format_eng(ts['high_v'], 'V')}), into R1. Scope channel 1 on the input, "
+               f"channel 2 on the op-amp output; trigger on the rising edge, "
+               f"{format_eng(ts['frequency_hz'] and 0.5 / ts['frequency_hz'] / 10, 's')}/div."),
+        R.table(["reading (rising edge)", f"expected ({amp.name} model)", "SPICE",
+                 f"band from tolerances (R {tol['r_tolerance_pct']:g} %, C {tol['c_tolerance_pct']:g} %)"], rows)]))
+
+    out.append(("Checks", [R.table(["check", "result", "detail"],
+                                   [[c["name"], "ok" if c["ok"] else "FAILED", c["detail"]] for c in d["checks"]])]))
+
+    sens = d["sensitivity"]
+    rows = [[k, f"{v['wn']:+.3f}", f"{v['zeta']:+.3f}",
+             f"{sens['opamp'][k]['wn']:+.3f}" if k in sens["opamp"] else "",
+             f"{sens['opamp'][k]['zeta']:+.3f}" if k in sens["opamp"] else ""]
+            for k, v in sens["ideal"].items()]
+    rows += [[k, "", "", f"{v['wn']:+.4f}", f"{v['zeta']:+.4f}"]
+             for k, v in sens["opamp"].items() if k not in sens["ideal"]]
+    out.append(("Sensitivity", [
+        R.text("Relative sensitivity S = d ln(y) / d ln(x): a 1 % change in the part changes y by S %."),
+        R.table(["part", "S(wn)", "S(zeta)", f"S(wn) with {amp.name}", f"S(zeta) with {amp.name}"], rows)]))
+
+    if d["alternatives"]:
+        rows = [[i + 1, " / ".join(format_eng(a[k], u, 3) for k, u in (("R1_ohm", "Ohm"), ("R2_ohm", "Ohm"),
+                                                                  ("C1_f", "F"), ("C2_f", "F"))),
+                 _f(a["fn_hz"], "Hz"), _n(a["zeta"]), R.fmt_pct(a["fn_error_pct"]), R.fmt_pct(a["zeta_error_pct"])]
+                for i, a in enumerate(d["alternatives"])]
+        out.append(("Alternatives (best first)", [R.table(["#", "R1 / R2 / C1 / C2", "fn", "zeta", "fn error",
+                                                          "zeta error"], rows)]))
+
+    if spice:
+        cmp_ = d["comparison"]
+        rows = []
+        for key, label, f in METRIC_ROWS:
+            a, o = cmp_["spice_vs_analytic"][key], cmp_["spice_vs_analytic_opamp"][key]
+            unit = " pp" if key == "overshoot_pct" else ""
+            def dd(x):
+                if x["delta"] is None:
+                    return "n/a"
+                return (f"{x['delta']:+.3g}{unit}" if key == "overshoot_pct"
+                        else f"{format_eng(x['delta'], 's', 3)} ({R.fmt_pct(x['delta_pct'])})")
+            rows.append([label, dd(a), dd(o)])
+        rows.append(["normalised RMS waveform error", f"{spice['nrms_ideal']:.3g}", f"{spice['nrms']:.3g}"])
+        out.append(("SPICE against the analytic models", [
+            R.text(f"ngspice ({d['simulator']} backend), {amp.name} behavioural model. Deltas are SPICE minus model; "
+                   f"NRMS = RMS of (model - SPICE) / (1 % of |model| + {format_eng(cmp_['nrms_abstol_v'], 'V')}). "
+                   "SPICE agrees with the op-amp-aware model when NRMS is below 1 and overshoot is within 1 pp, "
+                   "peak and rise time within 2 %, settling time within 5 % (or half a ringing period): "
+                   + ("it does." if cmp_["pass"] else "it does NOT (" + "; ".join(cmp_["disagreements"]) + ").")),
+            R.table(["metric", "vs ideal model", f"vs {amp.name}-aware model"], rows)]))
+    if d["notes"]:
+        out.append(("Notes", [R.text(n) for n in d["notes"]]))
+    if with_images:
+        out.append(("Plots", [R.image("step.png", "step response: analytic and SPICE"),
+                              R.image("bode.png", "Bode plot")]))
+    return out
+
+
+def wiring(b, amp) -> list:
+    """Point-to-point wiring for the breadboard, with the op-amp's DIP-8 pin numbers."""
+    pins = amp.pins or {}
+    def pin(name, label):
+        return f"U1 pin {pins[name]} ({label})" if name in pins else f"U1 {label}"
+    rows = [["generator output", "node A", f"R1 {R.value_code(b.r1)}"],
+            ["node A", pin("inp", "+ input"), f"R2 {R.value_code(b.r2)}"],
+            [pin("inp", "+ input"), "ground", f"C1 {R.value_code(b.c1)}"],
+            ["node A", pin("out", "output"), f"C2 {R.value_code(b.c2)}"]]
+    if b.r3 is None:
+        rows.append([pin("inn", "- input"), pin("out", "output"), "wire (voltage follower)"])
+    else:
+        rows += [[pin("inn", "- input"), "ground", f"R3 {R.value_code(b.r3)}"],
+                 [pin("out", "output"), pin("inn", "- input"), f"R4 {R.value_code(b.r4)}"]]
+    rows += [[pin("vcc", "V+"), f"{amp.vcc:+g} V supply", "100n decoupling to ground"],
+             [pin("vee", "V-"), f"{amp.vee:+g} V supply", "100n decoupling to ground"],
+             ["generator ground, scope grounds", "ground", "wire"]]
+    if pins.get("package"):
+        rows.append(["", "", f"{amp.name}: {pins['package']} pinout"])
+    return rows
+
+
+def _f(v, unit):
+    return "" if v is None else format_eng(v, unit, 5)
+
+
+def _n(v):
+    return "" if v is None else f"{v:.4g}"
+
+
+def summary_text(result) -> str:
+    """The terminal summary: the build sheet without plots."""
+    return R.to_text(title_of(result), sections(result, with_images=False))
+
+
+def plots(result) -> dict:
+    w = result.waveforms
+    amp = result.opamp.name
+    curves = {"analytic (ideal op-amp)": w["analytic"], f"analytic ({amp} model)": w["analytic_opamp"]}
+    if "spice" in w:
+        curves["SPICE (ngspice)"] = w["spice"]
+    num_i, den_i, num_o, den_o = w["bode"]
+    fn = result.built.fn_hz
+    return {"step.png": step_plot(w["t"], curves, f"Step response, 0 -> {result.test.amplitude_v:g} V"),
+            "bode.png": bode_plot({"ideal op-amp": (num_i, den_i), f"{amp} model": (num_o, den_o)},
+                                    fn / 100, fn * 100, "Plant frequency response")}
+
+
+def waveforms_csv(result) -> str:
+    """The bench period as CSV (``time_s,input_v,output_v,...``; output is SPICE when
+    simulated), the format ``identify`` reads: the tool's own scope capture."""
+    from .design import bench_waveforms
+    cols = bench_waveforms(result)
+    order = ["time_s", "input_v", "output_v", "analytic_v", "analytic_opamp_v"]
+    import numpy as np
+    data = np.column_stack([cols[k] for k in order])
+    buf = io.StringIO()
+    np.savetxt(buf, data, delimiter=",", header=",".join(order), comments="", fmt="%.9g")
+    return buf.getvalue()
+
+
+def write_outputs(result, out_dir, name: str) -> dict:
+    """Write ``netlists/<name>.cir`` and ``reports/<name>/`` under ``out_dir``.
+
+    Every file goes through a temporary file and a rename; the paths are
+    recorded in ``result.files`` before result.json is written, so it lists itself.
+    """
+    tick = time.perf_counter()
+    images = plots(result)
+    result.files = bundle_paths(out_dir, name, images, {"waveforms_csv": "waveforms.csv"})
+    write_bundle(result.files, result.deck, images, title_of(result), sections(result), result.to_dict(),
+                   {"waveforms_csv": waveforms_csv(result)})
+    result.timings["report_s"] = time.perf_counter() - tick
+    return result.files

@@ -1,0 +1,245 @@
+"""Sallen-Key low-pass synthesis (seed 001, sections IV.3-IV.9).
+
+Topology and names follow the seed: R1 from the input to node V1, R2 from V1
+to the non-inverting input, C1 from the non-inverting input to ground, C2 from
+V1 to the output; gain K = 1 + R4/R3 (R3 to ground, R4 feedback), K = 1 is a
+voltage follower.
+
+    Vs/Ve = K / (a s^2 + b s + 1),  a = R1 R2 C1 C2,
+    b = C1 (R1 + R2) + R1 C2 (1 - K)
+    wn = 1/sqrt(a),  zeta = b / (2 sqrt(a)),  Q = 1 / (2 zeta)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.errors import DesignError
+
+
+@dataclass(frozen=True)
+class SallenKeyParts:
+    """Component values of a Sallen-Key low-pass (ohms and farads)."""
+
+    r1: float
+    r2: float
+    c1: float
+    c2: float
+    gain: float = 1.0
+    r3: float | None = None  #: gain-setting resistor to ground (None for a follower)
+    r4: float | None = None  #: gain-setting feedback resistor
+
+    @property
+    def a(self) -> float:
+        return self.r1 * self.r2 * self.c1 * self.c2
+
+    @property
+    def b(self) -> float:
+        return self.c1 * (self.r1 + self.r2) + self.r1 * self.c2 * (1.0 - self.gain)
+
+    @property
+    def wn(self) -> float:
+        return 1.0 / math.sqrt(self.a)
+
+    @property
+    def fn_hz(self) -> float:
+        return self.wn / (2 * math.pi)
+
+    @property
+    def zeta(self) -> float:
+        return self.b / (2 * math.sqrt(self.a))
+
+    @property
+    def q(self) -> float:
+        return 1.0 / (2 * self.zeta) if self.zeta > 0 else math.inf
+
+    def as_dict(self) -> dict:
+        d = {"R1_ohm": self.r1, "R2_ohm": self.r2, "C1_f": self.c1, "C2_f": self.c2}
+        if self.r3 is not None:
+            d.update(R3_ohm=self.r3, R4_ohm=self.r4)
+        d.update(gain=self.gain, fn_hz=self.fn_hz, zeta=self.zeta)
+        return d
+
+
+def fn_zeta(r1, r2, c1, c2, gain=1.0):
+    """Vectorised natural frequency (Hz) and damping of the Sallen-Key low-pass."""
+    a = r1 * r2 * c1 * c2
+    b = c1 * (r1 + r2) + r1 * c2 * (1.0 - gain)
+    sa = np.sqrt(a)
+    return 1.0 / (2 * np.pi * sa), b / (2 * sa)
+
+
+def check_spec(fc_hz: float, zeta: float, gain: float = 1.0) -> None:
+    """Raise :class:`DesignError` for a spec no Sallen-Key low-pass can meet."""
+    if not (math.isfinite(fc_hz) and fc_hz > 0):
+        raise DesignError(f"fc must be a finite frequency above 0 Hz, got {fc_hz!r}")
+    if not (math.isfinite(zeta) and zeta > 0):
+        raise DesignError(f"zeta must be a finite damping ratio above 0, got {zeta!r}")
+    if not (math.isfinite(gain) and gain >= 1):
+        raise DesignError(f"gain K must be >= 1 (K = 1 + R4/R3), got {gain!r}")
+
+
+def ratios_from_rc(fc_hz: float, zeta: float, r: float, c: float, gain: float = 1.0):
+    """The seed's procedure (simplification 2): fix R and C, solve m and n.
+
+    With R1 = m R, R2 = R, C1 = C, C2 = n C:  m n = 1/(wn R C)^2 and
+    m = 2 zeta sqrt(mn) - 1 + mn (K - 1),  n = mn / m.
+
+    Returns
+    -------
+    (m, n) : tuple of float
+
+    Raises
+    ------
+    DesignError
+        When m <= 0, i.e. R C is too large for this fc and zeta; the message
+        says how small R C must be.
+    """
+    check_spec(fc_hz, zeta, gain)
+    wn = 2 * math.pi * fc_hz
+    p = 1.0 / (wn * r * c) ** 2
+    m = 2 * zeta * math.sqrt(p) - 1.0 + p * (gain - 1.0)
+    if m <= 0:
+        if gain == 1.0:
+            limit = 2 * zeta / wn
+            raise DesignError(
+                f"no positive m, n for R = {r:g} Ohm, C = {c:g} F: unity gain needs "
+                f"R*C < 2*zeta/wn = {limit:.4g} s (R*C is {r * c:.4g} s); choose a smaller R or C")
+        raise DesignError(f"no positive m, n for R = {r:g} Ohm, C = {c:g} F at gain {gain:g}: "
+                          "choose a smaller R or C, or a larger gain")
+    return m, p / m
+
+
+def resistors_for_caps(fc_hz: float, zeta: float, c1, c2, gain: float = 1.0):
+    """Exact R1, R2 (ohms) that give fc and zeta with capacitors C1, C2.
+
+    From R1 R2 = 1/(wn^2 C1 C2) and b = 2 zeta / wn:
+    (C1 + C2 (1 - K)) R1^2 - (2 zeta/wn) R1 + C1/(wn^2 C1 C2) = 0.
+    Vectorised over c1, c2. Returns two arrays (R1 roots, smaller first); a
+    root is nan where it is not a positive real number (for unity gain that is
+    C2/C1 < 1/zeta^2).
+    """
+    c1 = np.asarray(c1, float)
+    c2 = np.asarray(c2, float)
+    wn = 2 * np.pi * fc_hz
+    alpha = c1 + c2 * (1.0 - gain)
+    beta = 2 * zeta / wn
+    gamma = 1.0 / (wn * wn * c2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        disc = beta * beta - 4 * alpha * gamma
+        sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
+        lin = np.abs(alpha) < 1e-30 * np.maximum(c1, c2)
+        ra = np.where(lin, gamma / beta, (beta - sq) / (2 * alpha))
+        rb = np.where(lin, np.nan, (beta + sq) / (2 * alpha))
+    lo = np.fmin(ra, rb)
+    hi = np.fmax(ra, rb)
+    lo = np.where(lo > 0, lo, np.nan)
+    hi = np.where(hi > 0, hi, np.nan)
+    lo2 = np.where(np.isnan(lo), hi, lo)
+    hi2 = np.where(np.isnan(lo), np.nan, hi)
+    return lo2, hi2
+
+
+def realizability_notes(fc_hz: float, zeta: float, gain: float, c_lo: float, c_hi: float) -> list:
+    """Plain-language warnings about a spec, with a suggested fix."""
+    notes = []
+    if gain == 1.0:
+        need = 1.0 / zeta ** 2
+        if need > c_hi / c_lo:
+            k = 1.0 + 1.0 / (2 * zeta) if zeta < 0.5 else 2.0
+            notes.append(
+                f"unity gain needs C2/C1 >= 1/zeta^2 = {need:.4g}, more than the capacitor bounds allow "
+                f"({c_hi / c_lo:.4g}); use --gain K > 1 (e.g. --gain {k:.2g}) or widen --c-min/--c-max")
+        elif need > 100:
+            notes.append(
+                f"unity gain needs C2/C1 >= 1/zeta^2 = {need:.4g}, an impractical capacitor ratio; "
+                "a gain K > 1 (--gain) lowers it")
+    elif gain >= 3.0:
+        notes.append(f"gain K = {gain:g} >= 3 makes the equal-component Sallen-Key unstable; "
+                     "it relies on R1 C2 (K-1) staying below C1 (R1 + R2), so damping is very sensitive to parts")
+    return notes
+
+
+#: relative mismatch allowed between a stated gain K and its resistors' 1 + R4/R3
+GAIN_TOLERANCE = 1e-3
+#: R3 when only K is given (R4 = (K - 1) R3), as the command-line tools derive it
+DEFAULT_R3_OHM = 10e3
+_PART_NAMES = {"r1": "R1", "r2": "R2", "c1": "C1", "c2": "C2", "r3": "R3", "r4": "R4", "gain": "gain K",
+               "plant": "the plant"}
+
+
+def check_parts(parts: SallenKeyParts, name_of=None) -> SallenKeyParts:
+    """The one validation of a Sallen-Key plant as built, however it arrives
+    (designed, typed as parts, or read from a JSON file).
+
+    Checks, in this order: every part value is a real number inside its
+    physical range (``designer.ranges``: ``resistor_ohm``, ``capacitor_f``,
+    ``gain``); R3 and R4 come together; a stated gain agrees with its
+    resistors, K = 1 + R4/R3 (seed 001, Fig. 43), within
+    :data:`GAIN_TOLERANCE`; and the circuit is a stable plant whose fn and
+    zeta (the module's formulas) lie in the ranges ``fc_hz`` and ``zeta``
+    that ``--fc``/``--zeta`` accept. A zeta <= 0 (K too large for the parts)
+    means the circuit oscillates on its own.
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        Values as received, possibly of the wrong type. ``gain`` may be None
+        (then it is 1 + R4/R3, or 1 without R3/R4).
+    name_of : mapping or callable, optional
+        What to call each field in messages: keys ``r1, r2, c1, c2, r3, r4,
+        gain`` and ``plant`` (the whole circuit), e.g. ``{"r1": "--plant-r1"}``;
+        missing keys default to ``R1``... ``gain K``, ``the plant``.
+
+    Returns
+    -------
+    SallenKeyParts
+        Floats only; the gain is the resistors' 1 + R4/R3 when they are given,
+        and a gain K > 1 without them gets R3 = :data:`DEFAULT_R3_OHM` and
+        R4 = (K - 1) R3, so that the netlist builds the gain the model assumes.
+
+    Raises
+    ------
+    DesignError
+        One line naming the offending field and what is allowed.
+    """
+    from ..core.ranges import RANGES
+
+    def name(key):
+        if callable(name_of):
+            return name_of(key)
+        return (name_of or {}).get(key, _PART_NAMES[key])
+
+    def number(key, value, range_key):
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+            shown = repr(value) if isinstance(value, str) and len(value) <= 40 else type(value).__name__
+            raise DesignError(f"{name(key)} must be a number, got {shown}")
+        return RANGES[range_key].check(float(value), name(key))
+
+    r1, r2 = (number(k, getattr(parts, k), "resistor_ohm") for k in ("r1", "r2"))
+    c1, c2 = (number(k, getattr(parts, k), "capacitor_f") for k in ("c1", "c2"))
+    if (parts.r3 is None) != (parts.r4 is None):
+        raise DesignError(f"{name('r3')} and {name('r4')} go together (K = 1 + R4/R3)")
+    gain = None if parts.gain is None else number("gain", parts.gain, "gain")
+    if parts.r3 is not None:
+        r3, r4 = number("r3", parts.r3, "resistor_ohm"), number("r4", parts.r4, "resistor_ohm")
+        k = RANGES["gain"].check(1.0 + r4 / r3, f"1 + {name('r4')}/{name('r3')}")
+        if gain is not None and abs(gain - k) > GAIN_TOLERANCE * k:
+            raise DesignError(f"{name('gain')} = {gain:g} does not match its resistors: K = 1 + R4/R3 = "
+                              f"{k:.6g} (they must agree within {100 * GAIN_TOLERANCE:g} %)")
+        gain = k
+    elif gain is None or gain <= 1.0 + GAIN_TOLERANCE:
+        gain, r3, r4 = 1.0, None, None   # a voltage follower
+    else:
+        r3, r4 = DEFAULT_R3_OHM, (gain - 1.0) * DEFAULT_R3_OHM
+    out = SallenKeyParts(r1, r2, c1, c2, gain, r3, r4)
+    if not out.b > 0:
+        raise DesignError(
+            f"{name('plant')}: these parts give zeta = {out.zeta:.4g} <= 0 (R1 C2 (K - 1) is not below "
+            "C1 (R1 + R2)): the circuit oscillates on its own; lower the gain or change the parts")
+    RANGES["fc_hz"].check(out.fn_hz, f"{name('plant')}: the natural frequency fn of these parts")
+    RANGES["zeta"].check(out.zeta, f"{name('plant')}: the damping ratio zeta of these parts")
+    return out

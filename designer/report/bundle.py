@@ -1,0 +1,64 @@
+"""A design's files as one bundle: ``reports/<name>/`` (build sheets, result.json,
+plots, the deck) and ``netlists/<name>.cir``, written so that they are never
+half-written nor mixed with an older bundle (see :mod:`designer.core.fileio`)."""
+
+from __future__ import annotations
+
+import json
+
+from .document import to_html, to_markdown
+
+
+def bundle_paths(out_dir, name: str, images, extra: dict = None) -> dict:
+    """Name every file of a design's bundle under ``out_dir``: ``reports/<name>/``
+    (build sheets, result.json, plots, the deck as ``<name>.cir``, and ``extra``:
+    key -> file name in the report folder) and ``netlists/<name>.cir``, a link to
+    that deck. Creates ``netlists/`` and ``reports/`` only."""
+    from pathlib import Path
+
+    from ..core.fileio import check_can_create, ensure_dir
+    out_dir = Path(out_dir)
+    check_can_create(out_dir, ("netlists", "reports"))   # both, before creating either
+    net_dir = ensure_dir(out_dir / "netlists")
+    rep_dir = ensure_dir(out_dir / "reports") / name
+    files = {"netlist": str(net_dir / f"{name}.cir"),
+             "build_sheet_md": str(rep_dir / "build-sheet.md"),
+             "build_sheet_html": str(rep_dir / "build-sheet.html"),
+             "result_json": str(rep_dir / "result.json")}
+    files.update({k: str(rep_dir / v) for k, v in (extra or {}).items()})
+    files["plots"] = [str(rep_dir / n) for n in images]
+    return files
+
+
+def write_bundle(files: dict, deck: str, images: dict, title: str, sections, result: dict,
+                 texts: dict = None) -> None:
+    """Write a bundle named by :func:`bundle_paths` so that it is never half-written
+    nor mixed with an older one: everything goes into a staging folder beside the
+    report folder, which is then swapped in atomically; the netlist path is a link
+    to the deck inside it, so it switches in the same step (see :mod:`designer.fileio`).
+    Stale temporaries of killed runs are cleaned first."""
+    from pathlib import Path
+
+    from ..core import fileio
+    rep_dir = Path(files["result_json"]).parent
+    net = Path(files["netlist"])
+    for folder in (rep_dir.parent, net.parent):
+        fileio.clean_stale(folder)
+    stage = fileio.new_folder_beside(rep_dir)
+    contents = {net.name: deck, **{Path(files[k]).name: v for k, v in (texts or {}).items()},
+                **{Path(p).name: images[Path(p).name] for p in files["plots"]},
+                "build-sheet.md": to_markdown(title, sections),
+                "build-sheet.html": to_html(title, sections, images),
+                "result.json": json.dumps(result, indent=2) + "\n"}
+    try:
+        try:
+            for fname, data in contents.items():
+                (stage / fname).write_bytes(data if isinstance(data, bytes) else data.encode("utf-8"))
+        except OSError as exc:
+            raise fileio.os_error("write the report bundle in", rep_dir.parent, exc) from None
+        linked = fileio.link_into(net, rep_dir / net.name)
+        fileio.publish_folder(stage, rep_dir)
+    finally:
+        fileio.remove_tree(stage)   # gone already when published; else a failed or interrupted write
+    if not linked:  # no symbolic links on this file system: a copy, written atomically
+        fileio.atomic_write(net, deck)

@@ -1,0 +1,260 @@
+"""The simulator behind one small interface, with two backends.
+
+- ``pyspice`` (default): ngspice as a shared library through PySpice.
+- ``ngspice-cli``: ``ngspice -b -r out.raw deck.cir`` in a subprocess; the
+  binary raw file is read with numpy.
+
+Both take the same standalone deck text and return a :class:`SimResult`.
+ngspice writes notes ("Note: ...", "Warning: ...") on stderr during normal
+runs; PySpice 1.5 treats any stderr line as an error (and breaks outright on
+ngspice >= 42), so neither backend trusts stderr alone: a run fails only when
+ngspice reports an error line or produces no data.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..core.errors import DesignError, SimulatorError
+
+INSTALL_HINT = "install it with: apt-get install ngspice libngspice0-dev (or run `make setup`)"
+BACKENDS = ("pyspice", "ngspice-cli")
+
+_MEAS = re.compile(r"^\s*([A-Za-z_][\w]*)\s*=\s*([-+]?[\d.]+(?:[eE][-+]?\d+)?)", re.M)
+# a failed .meas ("name failed!", "meas ... failed") is a missing measurement, not a failed run
+_ERROR = re.compile(r"^(?:.*\berror\b.*|.*fatal.*|.*aborted.*|.*timestep too small.*)$", re.I | re.M)
+_NOT_ERROR = re.compile(r"^\s*(?:note|warning|info)\b", re.I)
+
+
+@dataclass
+class SimResult:
+    """Vectors by lower-case name (``time``, node names such as ``out``; ``v(out)``
+    also works), ``.meas`` results, and the log."""
+
+    vectors: dict
+    measurements: dict = field(default_factory=dict)
+    log: str = ""
+    backend: str = ""
+
+    def __getitem__(self, name):
+        key = name.lower()
+        if key in self.vectors:
+            return self.vectors[key]
+        inner = re.sub(r"^v\((.*)\)$", r"\1", key)
+        if inner in self.vectors:
+            return self.vectors[inner]
+        raise KeyError(f"no vector {name!r} in the simulation (have {', '.join(sorted(self.vectors))})")
+
+
+_MEAS_DEF = re.compile(r"^\s*\.meas\w*\s+\w+\s+(\w+)", re.I | re.M)
+
+
+def parse_measurements(text: str, deck: str) -> dict:
+    """The ``name = value`` lines that ngspice prints for the deck's ``.meas``
+    statements (a measurement that failed is absent)."""
+    wanted = {m.lower() for m in _MEAS_DEF.findall(deck)}
+    out = {}
+    for m in _MEAS.finditer(text):
+        if m.group(1).lower() in wanted:
+            out[m.group(1).lower()] = float(m.group(2))
+    return out
+
+
+def error_lines(text: str) -> list:
+    """ngspice's real error lines, notes and warnings left out."""
+    lines = [ln.strip() for ln in _ERROR.findall(text)]
+    return [ln for ln in lines if ln and not _NOT_ERROR.match(ln)]
+
+
+def read_raw(path) -> dict:
+    """Read an ngspice raw file (binary or ASCII, real or complex data) into a
+    dict of arrays; a missing, truncated or corrupt file is a :class:`SimulatorError`."""
+    try:
+        data = Path(path).read_bytes()
+    except OSError as exc:
+        raise SimulatorError(f"cannot read the ngspice raw file {str(path)!r}: {exc.strerror or exc}") from None
+    try:
+        return parse_raw(data)
+    except (ValueError, IndexError, AttributeError, UnicodeDecodeError) as exc:
+        raise SimulatorError(f"the ngspice raw file {str(path)!r} is unreadable ({exc})") from None
+
+
+def parse_raw(data: bytes) -> dict:
+    """The vectors of an ngspice raw file's bytes; ValueError if malformed."""
+    if not data:
+        raise ValueError("it is empty")
+    marker_b, marker_a = b"Binary:\n", b"Values:\n"
+    header_end = data.find(marker_b)
+    binary = header_end >= 0
+    if not binary:
+        header_end = data.find(marker_a)
+    if header_end < 0:
+        raise ValueError("no data section")
+    header = data[:header_end].decode("latin-1")
+    nv = re.search(r"No\. Variables:\s*(\d+)", header)
+    npt = re.search(r"No\. Points:\s*(\d+)", header)
+    fl = re.search(r"Flags:\s*(.*)", header)
+    if not (nv and npt and fl and "Variables:\n" in header):
+        raise ValueError("its header lacks the variable count, point count or flags")
+    nvars, npts = int(nv.group(1)), int(npt.group(1))
+    cplx = "complex" in fl.group(1)
+    names = [ln.split()[1].lower() for ln in header.split("Variables:\n", 1)[1].strip().splitlines()[:nvars]]
+    if nvars < 1 or len(names) != nvars:
+        raise ValueError(f"it declares {nvars} variables and lists {len(names)}")
+    body = data[header_end + (len(marker_b) if binary else len(marker_a)):]
+    width = 2 if cplx else 1
+    if binary:
+        need = npts * nvars * width * 8
+        if len(body) < need:
+            raise ValueError(f"it is truncated ({len(body)} of {need} data bytes)")
+        arr = np.frombuffer(body[:need], dtype="<f8").reshape(npts, nvars * width)
+    else:
+        rows = [ln.split() for ln in body.decode("latin-1").splitlines() if ln.strip()]
+        # ASCII: a point index then the first value on one line, one value per line after
+        vals = [r[-1] for r in rows]
+        nums = []
+        for v in vals[: npts * nvars]:
+            parts = v.split(",")
+            nums.extend(float(x) for x in parts[:width])
+        if len(nums) < npts * nvars * width:
+            raise ValueError("it is truncated")
+        arr = np.array(nums).reshape(npts, nvars * width)
+    if cplx:
+        return {name: arr[:, 2 * i] + 1j * arr[:, 2 * i + 1] for i, name in enumerate(names)}
+    return {name: np.array(arr[:, i]) for i, name in enumerate(names)}
+
+
+def _result(vectors: dict, log: str, backend: str, deck: str) -> SimResult:
+    # the raw file says v(out), the shared library out: one naming for both backends
+    vectors = {re.sub(r"^v\((.*)\)$", r"\1", k.lower()): v for k, v in vectors.items()}
+    if "time" in vectors:
+        # ngspice can emit a repeated time point at breakpoints; keep time strictly increasing
+        t = vectors["time"]
+        keep = np.concatenate([[True], np.diff(t) > 0])
+        vectors = {k: v[keep] for k, v in vectors.items()}
+    return SimResult(vectors=vectors, measurements=parse_measurements(log, deck), log=log, backend=backend)
+
+
+def with_raw_output(deck: str, raw_path) -> str:
+    """The deck with a ``.control`` block that runs it and writes a binary raw file.
+
+    ``ngspice -b -r file`` would be simpler but disables ``.meas`` in batch mode.
+    """
+    lines = deck.rstrip().splitlines()
+    if lines and lines[-1].strip().lower() == ".end":
+        lines = lines[:-1]
+    control = [".control", "set filetype=binary", "run", f"write {raw_path}", "quit", ".endc", ".end"]
+    return "\n".join(lines + control) + "\n"
+
+
+class NgspiceCli:
+    """``ngspice -b`` in a subprocess; exit status, error lines and a missing raw
+    file decide failure, not stderr."""
+
+    name = "ngspice-cli"
+
+    def __init__(self, executable: str = "ngspice", timeout: float = 120.0):
+        self.executable = executable
+        self.timeout = timeout
+
+    def run(self, deck: str, workdir=None) -> SimResult:
+        exe = shutil.which(self.executable)
+        if exe is None:
+            raise SimulatorError(f"ngspice is not installed ({self.executable!r} not found); {INSTALL_HINT}")
+        with tempfile.TemporaryDirectory(prefix="designer-sim-") as tmp:
+            cwd = Path(workdir) if workdir else Path(tmp)
+            deck_path = Path(tmp) / "deck.cir"
+            raw_path = Path(tmp) / "out.raw"
+            deck_path.write_text(with_raw_output(deck, raw_path))
+            try:
+                proc = subprocess.run([exe, "-b", str(deck_path)], cwd=cwd,
+                                      capture_output=True, text=True, timeout=self.timeout,
+                                      stdin=subprocess.DEVNULL)
+            except subprocess.TimeoutExpired:
+                raise SimulatorError(f"ngspice did not finish within {self.timeout:g} s") from None
+            log = proc.stdout + "\n" + proc.stderr
+            errs = error_lines(log) or [ln for ln in proc.stderr.splitlines() if ln.strip()][-1:]
+            if proc.returncode != 0:
+                raise SimulatorError("ngspice failed: " + ("; ".join(errs[:3]) or f"exit status {proc.returncode}"))
+            if not raw_path.exists() or raw_path.stat().st_size == 0:
+                raise SimulatorError("ngspice exited without writing any results"
+                                     + (f" ({'; '.join(errs[:3])})" if errs else " (no analysis ran?)"))
+            vectors = read_raw(raw_path)
+            if "time" not in vectors and "frequency" not in vectors:
+                raise SimulatorError("ngspice ran no analysis: the deck has no .tran or .ac line")
+            return _result(vectors, log, self.name, deck)
+
+
+class PySpiceShared:
+    """ngspice as a shared library through PySpice.
+
+    PySpice's own ``run``/``exec_command`` raise on any stderr output, which
+    ngspice uses for harmless notes; commands go straight to the library and
+    the output is checked here instead.
+    """
+
+    name = "pyspice"
+    _lock = threading.Lock()  # one shared ngspice instance per process
+
+    def run(self, deck: str, workdir=None) -> SimResult:
+        try:
+            from PySpice.Spice.NgSpice.Shared import NgSpiceShared
+        except ImportError as exc:  # pragma: no cover - dependency of the package
+            raise SimulatorError(f"PySpice is not installed: {exc}") from None
+        import logging
+        logging.getLogger("PySpice").setLevel(logging.CRITICAL)
+        with self._lock:
+            try:
+                ng = NgSpiceShared.new_instance()
+            except (OSError, Exception) as exc:
+                raise SimulatorError(f"cannot load the ngspice shared library ({exc}); {INSTALL_HINT}") from None
+            old = os.getcwd()
+            try:
+                if workdir:
+                    os.chdir(workdir)
+                self._command(ng, "destroy all")
+                self._command(ng, "reset")
+                ng.clear_output()
+                lines = [ln for ln in deck.splitlines() if ln.strip()] + [""]
+                from PySpice.Spice.NgSpice.Shared import FFI, ffi
+                keep = [ffi.new("char[]", ln.encode("utf8")) for ln in lines] + [FFI.NULL]
+                rc = ng._ngspice_shared.ngSpice_Circ(ffi.new("char *[]", keep))
+                load_log = ng.stdout + "\n" + ng.stderr
+                errs = error_lines(load_log)
+                if rc or errs:
+                    raise SimulatorError("ngspice failed to load the deck: " + ("; ".join(errs[:3]) or f"code {rc}"))
+                log = self._command(ng, "run")
+                errs = error_lines(log)
+                plot = ng.last_plot
+                if errs or not plot.startswith("tran"):
+                    raise SimulatorError("ngspice failed: " + "; ".join(errs[:3]) if errs else
+                                         "ngspice ran no analysis: the deck has no .tran line")
+                vectors = {name: np.real(vec._data) for name, vec in ng.plot(None, plot).items()}
+            finally:
+                os.chdir(old)
+        return _result(vectors, load_log + "\n" + log, self.name, deck)
+
+    @staticmethod
+    def _command(ng, command: str) -> str:
+        ng.clear_output()
+        ng._ngspice_shared.ngSpice_Command(command.encode("ascii"))
+        return ng.stdout + "\n" + ng.stderr
+
+
+def get_simulator(name: str = "pyspice"):
+    """A backend by name: ``pyspice`` or ``ngspice-cli``."""
+    key = str(name).strip().lower()
+    if key in ("pyspice", "shared", "ngspice-shared"):
+        return PySpiceShared()
+    if key in ("ngspice-cli", "cli", "ngspice"):
+        return NgspiceCli()
+    raise DesignError(f"unknown simulator {name!r}; allowed: {', '.join(BACKENDS)}")

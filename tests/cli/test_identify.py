@@ -1,0 +1,259 @@
+"""The installed ``identify`` console script: JSON shape, table, plot, --against, bad input."""
+
+import json
+import math
+import subprocess
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+from helpers import FIXTURES, script
+
+from designer.identify.step import overshoot_from_zeta, sallen_key
+from designer.identify.structures import model_step
+
+EXE = script("identify")
+FIX = FIXTURES / "identify"
+TRUTH = json.loads((FIX / "truth.json").read_text())
+
+
+def run(*args, cwd=None):
+    return subprocess.run([str(EXE), *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, timeout=120)
+
+
+def run_many(arglists, cwd=None):
+    with ThreadPoolExecutor(max_workers=4) as ex:
+        return list(ex.map(lambda a: run(*a, cwd=cwd), arglists))
+
+
+def _second_order(params):
+    """(fn, zeta) of the truth or of a model's params."""
+    if "wn_rad_s" in params:
+        return params["wn_rad_s"] / (2 * math.pi), params["zeta"]
+    return None
+
+
+@pytest.fixture(scope="module")
+def json_runs():
+    names = ["generic_ty.csv", "generic_tuy_semicolon.csv", "waveform.csv",
+             "tektronix_tds.csv", "tektronix_mso.csv", "rigol_square.csv"]
+    args = []
+    for n in names:
+        extra = ["--step-amplitude", "2"] if n == "tektronix_tds.csv" else []
+        args.append([FIX / n, "--json", *extra])
+    return dict(zip(names, run_many(args)))
+
+
+def test_json_shape_and_best_model_for_every_fixture(json_runs):
+    for name, proc in json_runs.items():
+        assert proc.returncode == 0, (name, proc.stderr)
+        out = json.loads(proc.stdout)
+        assert {"methods", "best", "preprocessing"} <= set(out)
+        for m in out["methods"]:
+            assert {"name", "model", "params", "iae", "ise", "valid", "note"} <= set(m)
+            assert m["model"] in ("fopdt", "double-pole", "underdamped", "overdamped")
+            assert m["name"] == m["name"].lower()
+        best = out["best"]
+        assert best["valid"] and best in out["methods"]
+        valid_iae = [m["iae"] for m in out["methods"] if m["valid"] and m["iae"] is not None]
+        assert best["iae"] == min(valid_iae)
+        truth = TRUTH[name]
+        assert best["params"]["K"] == pytest.approx(truth["params"]["K"], rel=0.02), name
+        fz = _second_order(truth["params"])
+        if fz:  # the seed 001 plant: fn and zeta within 2 %
+            assert best["model"] == "underdamped", name
+            fn, z = _second_order(best["params"])
+            assert fn == pytest.approx(fz[0], rel=0.02) and z == pytest.approx(fz[1], rel=0.03)
+        else:
+            # FOPDT or overdamped truth: the best fit's step response matches the truth
+            t = np.linspace(0, 10 * sum(v for k, v in truth["params"].items() if k != "K"), 2000)
+            yt = model_step(truth["model"], truth["params"], t)
+            yb = model_step(best["model"], best["params"], t)
+            assert np.max(np.abs(yt - yb)) < 0.02 * truth["params"]["K"], name
+
+
+def test_rigol_square_wave_is_split(json_runs):
+    out = json.loads(json_runs["rigol_square.csv"].stdout)
+    pre = out["preprocessing"]
+    assert pre["steps_averaged"] >= 3
+    assert pre["step_amplitude"] == pytest.approx(2.0, rel=0.01)
+    # the seed's bench figures: overshoot ~ 52.7 %, peak time ~ 146 us (analytic)
+    meas = out["measured"]
+    assert meas["overshoot_pct"] == pytest.approx(overshoot_from_zeta(0.2), abs=1.5)
+
+
+def test_table_and_plot(tmp_path):
+    png = tmp_path / "fit.png"
+    proc = run(FIX / "waveform.csv", "--plot", png, "--methods", "smith,least-squares", "chen-yang")
+    assert proc.returncode == 0, proc.stderr
+    assert "ranked by IAE" in proc.stdout and "Best: least-squares (underdamped)" in proc.stdout
+    names = {ln.split()[1] for ln in proc.stdout.splitlines()
+             if ln[:4].strip().isdigit() and len(ln.split()) > 2}
+    assert names == {"smith", "least-squares", "chen-yang"}
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["fit.png"]   # no temp files left
+
+
+def _design(tmp_path, scale=1.0):
+    """A design-plant result.json for the seed's rounded parts (820, 1k, 10n, 220n)."""
+    r1, r2, c1, c2 = 820.0, 1000.0, 10e-9, 220e-9
+    fn, z = sallen_key(r1, r2, c1, c2)
+    d = {"spec": {"fc_hz": 3500.0, "zeta": 0.2, "gain": 1.0},
+         "built": {"R1_ohm": r1, "R2_ohm": r2, "C1_f": c1, "C2_f": c2, "fn_hz": fn * scale,
+                   "zeta": z, "q": 1 / (2 * z)},
+         "spice": {"overshoot_pct": overshoot_from_zeta(z), "peak_time_s": None,
+                   "rise_time_s": None, "settling_time_s": None}}
+    if scale != 1.0:
+        del d["built"]["R1_ohm"]   # no parts: band from the nominal fn, zeta
+    path = tmp_path / f"result_{scale}.json"
+    path.write_text(json.dumps(d))
+    return path
+
+
+def test_against_a_design(tmp_path):
+    """The waveform fixture is the seed's unrounded design (3500 Hz, 0.2); the rounded
+    parts give ~3747 Hz and ~0.214: inside the 5 % R / 10 % C band."""
+    ok, far = run_many([[FIX / "waveform.csv", "--json", "--against", _design(tmp_path)],
+                        [FIX / "waveform.csv", "--against", _design(tmp_path, 2.0)]])
+    assert ok.returncode == 0, ok.stderr
+    c = json.loads(ok.stdout)["comparison"]
+    q = c["quantities"]
+    assert set(q) == {"fn_hz", "zeta", "gain", "overshoot_pct"}
+    fn_built = sallen_key(820.0, 1000.0, 10e-9, 220e-9)[0]
+    assert q["fn_hz"]["identified"] == pytest.approx(3500.0, rel=0.01)
+    assert q["fn_hz"]["difference_pct"] == pytest.approx(100 * (3500 / fn_built - 1), abs=1.0)
+    assert all(v["within_tolerance"] for v in q.values())
+    assert "tolerances explain" in c["verdict"] and "5 % R / 10 % C" in c["tolerance_basis"]
+    assert far.returncode == 0, far.stderr
+    assert "OUTSIDE" in far.stdout and "do not explain" in far.stdout
+
+
+def test_help_teaches():
+    proc = run("--help")
+    assert proc.returncode == 0
+    assert "examples:" in proc.stdout and "--against" in proc.stdout
+
+
+def test_bad_input_exit_2_with_one_line(tmp_path):
+    t = np.linspace(0, 1, 400)
+    good = model_step("fopdt", {"K": 1, "tau_s": 0.05, "theta_s": 0.1}, t)
+    files = {
+        "empty.csv": "",
+        "words.csv": "t,y\n" + "".join(f"{a},{b}\n" for a, b in zip(t, good)).replace(
+            "\n0.5", "\nhalf", 1),
+        "nan.csv": "".join(f"{a},{'nan' if i == 50 else b}\n" for i, (a, b) in enumerate(zip(t, good))),
+        "time.csv": "".join(f"{a if i != 60 else 0.0},{b}\n" for i, (a, b) in enumerate(zip(t, good))),
+        "flat.csv": "".join(f"{a},1.0\n" for a in t),
+        "small.csv": "".join(f"{a},{1e-3 * b + 0.01 * np.sin(1e4 * a * (i % 7))}\n"
+                             for i, (a, b) in enumerate(zip(t, good))),
+        "unsettled.csv": "".join(f"{a},{b}\n" for a, b in zip(t[:60], good[:60])),
+    }
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    good_path = tmp_path / "good.csv"
+    good_path.write_text("".join(f"{a},{b}\n" for a, b in zip(t, good)))
+    (tmp_path / "notjson.json").write_text("{")
+    cases = {
+        "empty.csv": ([tmp_path / "empty.csv"], "empty"),
+        "words.csv": ([tmp_path / "words.csv"], "is not a number"),
+        "nan.csv": ([tmp_path / "nan.csv"], "NaN"),
+        "time.csv": ([tmp_path / "time.csv"], "time is not increasing"),
+        "flat.csv": ([tmp_path / "flat.csv"], "no usable step"),
+        "small.csv": ([tmp_path / "small.csv"], "noise standard deviations"),
+        "unsettled.csv": ([tmp_path / "unsettled.csv"], "before the response settles"),
+        "missing": ([tmp_path / "missing.csv"], "does not exist"),
+        "amp": ([good_path, "--step-amplitude", "abc"], "step-amplitude"),
+        "amp0": ([good_path, "--step-amplitude", "0"], "non-zero"),
+        "method": ([good_path, "--methods", "magic"], "unknown method"),
+        "against": ([good_path, "--against", tmp_path / "notjson.json"], "not JSON"),
+        "option": ([good_path, "--frobnicate"], "unrecognized arguments"),
+        "noarg": ([], "required"),
+    }
+    procs = run_many([a for a, _ in cases.values()])
+    for (key, (_, needle)), proc in zip(cases.items(), procs):
+        assert proc.returncode == 2, (key, proc.stdout, proc.stderr)
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1, (key, proc.stderr)
+        assert lines[0].startswith("identify: error:") and needle in lines[0], (key, lines[0])
+        assert "Traceback" not in proc.stderr and proc.stdout == ""
+
+
+def test_tolerance_band_contains_every_part_combination():
+    """Brute force: random parts inside the 5 % R / 10 % C box stay inside the corner band."""
+    from designer.identify.step import tolerance_band
+    r1, r2, c1, c2 = 820.0, 1000.0, 10e-9, 220e-9
+    fn, z = sallen_key(r1, r2, c1, c2)
+    band = tolerance_band({"R1_ohm": r1, "R2_ohm": r2, "C1_f": c1, "C2_f": c2, "fn_hz": fn,
+                           "zeta": z})
+    rng = np.random.default_rng(0)
+    k = rng.uniform(-1, 1, (2000, 4)) * [0.05, 0.05, 0.1, 0.1] + 1
+    got = np.array([sallen_key(r1 * a, r2 * b, c1 * c, c2 * d) for a, b, c, d in k])
+    assert band["fn_hz"][0] <= got[:, 0].min() and got[:, 0].max() <= band["fn_hz"][1]
+    assert band["zeta"][0] <= got[:, 1].min() and got[:, 1].max() <= band["zeta"][1]
+    # and the corners are attained (the band is not padded)
+    assert got[:, 0].max() > band["fn_hz"][0] + 0.8 * (band["fn_hz"][1] - band["fn_hz"][0])
+    # without part values the nominal scaling gives the same fn band (fn ~ 1/sqrt(RRCC))
+    nominal = tolerance_band({"fn_hz": fn, "zeta": z})
+    assert nominal["fn_hz"] == pytest.approx(band["fn_hz"], rel=1e-12)
+
+
+def test_help_states_every_numeric_range():
+    from designer.core.ranges import RANGES
+    from designer.core.textfile import MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, size_text
+    out = " ".join(run("--help").stdout.split())
+    for key in ("capture_time_s", "step_amplitude", "capture_span_s", "capture_value",
+                "output_step"):
+        assert RANGES[key].text() in out, key
+    assert size_text(MAX_CAPTURE_BYTES) in out and f"{MAX_CAPTURE_ROWS:,}" in out
+
+
+def test_step_options_outside_their_range_are_one_line(tmp_path):
+    from designer.core.ranges import RANGES
+    good = tmp_path / "good.csv"
+    t = np.linspace(0, 1, 400)
+    good.write_text("".join(f"{a},{b}\n" for a, b in zip(
+        t, model_step("fopdt", {"K": 1, "tau_s": 0.05, "theta_s": 0.1}, t))))
+    cases = [(["--step-time", "1e300"], RANGES["capture_time_s"].text()),
+             (["--step-time", "-1e300"], RANGES["capture_time_s"].text()),
+             (["--step-amplitude", "1e-300"], RANGES["step_amplitude"].text()),
+             (["--step-amplitude", "-1e300"], RANGES["step_amplitude"].text()),
+             (["--step-amplitude", "0"], "non-zero"),
+             (["--step-time", "nan"], "is not a number")]
+    procs = run_many([[good, *opts] for opts, _ in cases])
+    for (opts, words), proc in zip(cases, procs):
+        assert proc.returncode == 2, (opts, proc.stderr)
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1 and words in lines[0] and "np." not in lines[0], (opts, lines)
+    # a negative amplitude inside the range is a falling step, and works
+    ok = run(good, "--step-amplitude", "-2", "--json")
+    assert ok.returncode == 0, ok.stderr
+    assert json.loads(ok.stdout)["best"]["params"]["K"] == pytest.approx(-0.5, rel=0.02)
+
+
+def test_refused_run_leaves_no_plot_or_folder(tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t,y\n" + "".join(f"{k},{'nan' if k == 5 else k}\n" for k in range(30)))
+    for target in (tmp_path / "new" / "deeper" / "fit.png", tmp_path):
+        proc = run(bad, "--plot", target)
+        assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.csv"]
+
+
+def test_unphysical_classical_results_are_not_evaluated():
+    """A method that returns tau < 0 (Nishikawa on an overshooting response) made
+    the scoring overflow in exp: such a model is never evaluated, only flagged."""
+    import warnings
+
+    from designer.identify.step import identify_step
+    n = 78
+    t = np.linspace(-0.1, 1.0, n) + 1.0
+    y = model_step("underdamped", {"K": -1.0, "wn_rad_s": 60.0, "zeta": 0.2, "theta_s": 0.0},
+                   t - 1.0) + 0.01 * np.random.default_rng(n).standard_normal(n)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = identify_step(t, y)
+    for m in res.methods:
+        if any(k.startswith("tau") and v <= 0 for k, v in m.params.items()):
+            assert not m.valid and not math.isfinite(m.iae)
+    assert res.best.model == "underdamped"

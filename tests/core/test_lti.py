@@ -1,0 +1,111 @@
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from designer.core import opamps
+from designer.core.lti import dominant_pair, step_response
+from designer.plant.model import plant_tf, plant_tf_opamp, sensitivities
+from designer.plant.sallenkey import SallenKeyParts
+
+SEED = SallenKeyParts(819.1, 1e3, 10e-9, 252.445e-9)
+
+
+def test_opamp_model_tends_to_the_ideal():
+    huge = replace(opamps.get("LM741"), a0=1e9, gbw_hz=1e15)
+    num, den = plant_tf_opamp(SEED, huge)
+    fn, z = dominant_pair(den)
+    assert fn == pytest.approx(SEED.fn_hz, rel=1e-6)
+    assert z == pytest.approx(SEED.zeta, rel=1e-5)
+    assert num[-1] / den[-1] == pytest.approx(1.0, rel=1e-8)
+
+
+def test_opamp_model_with_gain_has_dc_gain_a0_over_1_plus_a0_beta():
+    p = SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, gain=2.0, r3=10e3, r4=10e3)
+    amp = opamps.get("LM741")
+    num, den = plant_tf_opamp(p, amp)
+    assert num[-1] / den[-1] == pytest.approx(amp.a0 / (1 + amp.a0 / 2.0), rel=1e-12)
+
+
+def test_finite_gbw_lowers_fn_and_zeta_of_the_seed_plant():
+    fn, z = dominant_pair(plant_tf_opamp(SEED, opamps.get("LM741"))[1])
+    assert fn < SEED.fn_hz and z < SEED.zeta
+    # a faster op-amp shifts less
+    fn5, z5 = dominant_pair(plant_tf_opamp(SEED, opamps.get("NE5532"))[1])
+    assert SEED.fn_hz - fn5 < SEED.fn_hz - fn
+
+
+def test_dominant_pair_of_real_poles():
+    fn, z = dominant_pair(np.polymul([1, 10], [1, 1000]))
+    assert fn == pytest.approx(math.sqrt(10 * 1000) / (2 * math.pi))
+    assert z == pytest.approx(1010 / (2 * math.sqrt(10 * 1000)))
+
+
+def test_sensitivities_match_closed_form():
+    s = sensitivities(SEED)
+    r1, r2 = SEED.r1, SEED.r2
+    for part in ("R1", "R2", "C1", "C2"):
+        assert s[part]["wn"] == pytest.approx(-0.5, abs=1e-6)
+    # zeta = (R1 + R2) sqrt(C1/C2) / (2 sqrt(R1 R2)) at K = 1
+    assert s["R1"]["zeta"] == pytest.approx(r1 / (r1 + r2) - 0.5, abs=1e-6)
+    assert s["C1"]["zeta"] == pytest.approx(0.5, abs=1e-6)
+    assert s["C2"]["zeta"] == pytest.approx(-0.5, abs=1e-6)
+
+
+def test_step_response_closed_form():
+    t = np.linspace(0, 2e-3, 2001)
+    y = step_response(*plant_tf(SEED), t)
+    wn, z = SEED.wn, SEED.zeta
+    wd = wn * math.sqrt(1 - z * z)
+    exact = 1 - np.exp(-z * wn * t) * (np.cos(wd * t) + z / math.sqrt(1 - z * z) * np.sin(wd * t))
+    assert np.max(np.abs(y - exact)) < 1e-9
+
+
+def test_step_and_frequency_response_match_scipy():
+    from scipy import signal
+
+    from designer.core.lti import freq_response
+    rng = np.random.default_rng(1)
+    for _ in range(20):
+        poles = -rng.uniform(1e2, 1e5, 3)
+        den = np.poly(poles)
+        num = np.array([rng.uniform(0.1, 2.0) * np.prod(-poles)])
+        t = np.linspace(0, 8 / np.min(-poles), 3001)
+        assert np.max(np.abs(step_response(num, den, t) - signal.step((num, den), T=t)[1])) < 1e-6 * num[0] / den[-1]
+        f = np.logspace(0, 6, 50)
+        _, h = signal.freqs(num, den, worN=2 * np.pi * f)
+        assert np.allclose(freq_response(num, den, f), h, rtol=1e-12)
+
+
+def test_repeated_poles_in_closed_form_on_any_grid():
+    """Regression (issue 7.1): zeta = 1 fell back to scipy.signal.step, which
+    refuses the clipped, uneven grids of the bench waveforms."""
+    t = np.concatenate([np.zeros(5), np.linspace(0, 1e-2, 1001) ** 1.5 * 10])  # clipped and uneven
+    y = step_response([1e6], [1, 2e3, 1e6], t)
+    assert np.max(np.abs(y - (1 - (1 + 1e3 * t) * np.exp(-1e3 * t)))) < 1e-12
+    # triple pole: 1 - e^(-at) (1 + at + (at)^2/2)
+    a = 1e2
+    y = step_response([a ** 3], np.poly([-a, -a, -a]), t)
+    assert np.max(np.abs(y - (1 - np.exp(-a * t) * (1 + a * t + (a * t) ** 2 / 2)))) < 1e-12
+    # a pole at zero (integrator): a ramp; before the step, zero
+    assert np.allclose(step_response([2.0], [1.0, 0.0], t), 2 * t, rtol=1e-12, atol=0)
+    assert np.all(step_response([1.0], [1.0, 1.0], [-1.0, -1e-9]) == 0)
+
+
+@settings(max_examples=60)
+@given(st.lists(st.sampled_from([10.0, 30.0, 100.0, 300.0, 1e3, 3e3]), min_size=1, max_size=3, unique=True),
+       st.lists(st.integers(1, 3), min_size=3, max_size=3), st.sampled_from([0.0, 0.5, 2.0]))
+def test_step_response_with_repeated_poles_matches_scipy(rates, mult, zero):
+    """Simple and repeated real poles, with a zero (biproper when the order is 1),
+    against scipy's matrix-exponential lsim."""
+    from scipy import signal
+    poles = [-r for r, m in zip(rates, mult) for _ in range(m)]
+    den = np.poly(poles)
+    num = np.polymul([zero / max(rates), 1.0], [np.prod(np.abs(poles))])[-len(den):]
+    t = np.linspace(0, 10 / min(rates), 4001)
+    ref = signal.step((num, den), T=t)[1]
+    got = step_response(num, den, t)
+    assert np.max(np.abs(got - ref)) <= 1e-7 * max(1.0, np.max(np.abs(ref)))

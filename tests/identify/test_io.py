@@ -1,0 +1,299 @@
+"""CSV readers: real-format fixtures, round trips and bad files."""
+
+import json
+
+import numpy as np
+import pytest
+from helpers import FIXTURES
+
+from designer.core.errors import DesignError
+from designer.identify.io import format_generic, parse_capture_text, read_capture
+from designer.identify.structures import model_step
+
+FIX = FIXTURES / "identify"
+TRUTH = json.loads((FIX / "truth.json").read_text())
+
+
+def _expected(name, t):
+    s = TRUTH[name]
+    return s["y0"] + s["amplitude"] * model_step(s["model"], s["params"], t - s["step_time_s"])
+
+
+@pytest.mark.parametrize("name, fmt, out, inp, n", [
+    ("generic_ty.csv", "generic", "y", None, 1601),
+    ("generic_tuy_semicolon.csv", "generic", "y", "u", 4001),
+    ("waveform.csv", "waveform", "vout", "vin", 4001),
+    ("tektronix_tds.csv", "tektronix-tds", "CH2", None, 2500),
+    ("tektronix_mso.csv", "tektronix-mso", "CH2", "CH1", 5000),
+    ("rigol_square.csv", "rigol", "CH2", "CH1", 12000),
+])
+def test_fixture_layouts(name, fmt, out, inp, n):
+    cap = read_capture(FIX / name)
+    assert cap.fmt == fmt
+    assert cap.output_name == out and cap.input_name == inp
+    assert cap.t.size == n == cap.y.size
+    assert np.all(np.diff(cap.t) > 0)
+    assert (cap.u is None) == (inp is None)
+
+
+@pytest.mark.parametrize("name", ["generic_ty.csv", "generic_tuy_semicolon.csv", "waveform.csv",
+                                  "tektronix_tds.csv", "tektronix_mso.csv"])
+def test_fixture_values_match_the_generating_model(name):
+    """The parsed output is the generating model's response, within noise and 8-bit steps."""
+    cap = read_capture(FIX / name)
+    s = TRUTH[name]
+    span = abs(s["amplitude"] * s["params"]["K"])
+    err = cap.y - _expected(name, cap.t)
+    # 5 sigma of the added noise plus one 8-bit step of a 0.5 V/div screen.
+    assert np.max(np.abs(err)) <= 5 * s["noise"] * span + 5.0 / 256 + 1e-6 * span
+
+
+def test_rigol_time_axis_from_start_and_increment():
+    cap = read_capture(FIX / "rigol_square.csv")
+    second = (FIX / "rigol_square.csv").read_text().splitlines()[1].split(",")
+    start, inc = float(second[3]), float(second[4])
+    assert cap.t[0] == pytest.approx(start)
+    assert np.allclose(np.diff(cap.t), inc, rtol=1e-9)
+
+
+def test_tektronix_tds_time_axis_and_source():
+    cap = read_capture(FIX / "tektronix_tds.csv")
+    assert cap.columns == ["TIME", "CH2"]
+    assert np.allclose(np.diff(cap.t), 1e-6, rtol=1e-6)
+
+
+@pytest.mark.parametrize("delim, header, comma", [(",", True, False), (",", False, False),
+                                                  (";", True, True), (";", False, True),
+                                                  ("\t", True, False), ("\t", False, False)])
+def test_generic_round_trip(delim, header, comma):
+    t = np.linspace(0, 1e-3, 200)
+    u = np.where(t > 2e-4, 1.5, 0.0)
+    y = 0.3 + model_step("fopdt", {"K": 2.0, "tau_s": 1e-4, "theta_s": 1e-5}, t - 2e-4)
+    text = format_generic(t, y, u, delimiter=delim, header=header, decimal_comma=comma)
+    cap = parse_capture_text(text)
+    assert np.allclose(cap.t, t, rtol=1e-8, atol=0)
+    assert np.allclose(cap.y, y, rtol=1e-8)
+    assert np.allclose(cap.u, u)
+    two = parse_capture_text(format_generic(t, y, delimiter=delim, header=header,
+                                            decimal_comma=comma))
+    assert two.u is None and np.allclose(two.y, y, rtol=1e-8)
+
+
+def test_columns_by_name_and_number():
+    t = np.arange(20.0)
+    text = "time_s,vout,vin\n" + "".join(f"{a},{2 * a},{3 * a}\n" for a in t)
+    cap = parse_capture_text(text)
+    assert cap.output_name == "vout" and cap.input_name == "vin"
+    assert np.allclose(cap.y, 2 * t) and np.allclose(cap.u, 3 * t)
+    cap = parse_capture_text(text, output_column=3, input_column="vout")
+    assert np.allclose(cap.y, 3 * t) and np.allclose(cap.u, 2 * t)
+    cap = parse_capture_text(text, input_column="none")
+    assert cap.u is None
+    with pytest.raises(DesignError, match="no output column named 'foo'"):
+        parse_capture_text(text, output_column="foo")
+    with pytest.raises(DesignError, match="column 7 does not exist"):
+        parse_capture_text(text, output_column=7)
+
+
+def _bad(text, match):
+    with pytest.raises(DesignError, match=match):
+        parse_capture_text(text, name="cap.csv")
+
+
+def test_bad_files_name_the_problem():
+    good = "".join(f"{i * 1e-3},{i}\n" for i in range(20))
+    _bad("", "empty")
+    _bad("\n\n  \n", "empty")
+    _bad("t,y\n", "header but no data")
+    _bad("t,y\n" + good.replace("5,5", "5,abc", 1), r"line 7.*'abc' is not a number")
+    _bad(good.replace("0.005,5", "0.005,nan"), r"line 6, column 2 .*NaN")
+    _bad(good.replace("0.005,5", "0.005,inf"), r"NaN and infinite")
+    _bad(good.replace("0.005,5", "0.003,5"), r"time is not increasing at line 6")
+    _bad("0,1\n1,2\n2,3\n", "only 3 samples")
+    _bad("1\n2\n3\n4\n", "at least two columns")
+    _bad("X,CH1,Start,Increment,\nSequence,Volt,0,0,\n0,1,\n1,2,\n", "increment must be a positive number")
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(DesignError, match="does not exist"):
+        read_capture(tmp_path / "nope.csv")
+
+
+def test_input_by_position_only_when_it_looks_like_a_step():
+    t = np.linspace(-1e-3, 9e-3, 2001)
+    y1 = model_step("underdamped", {"K": 1, "wn_rad_s": 6e3, "zeta": 0.3}, t)
+    y2 = model_step("fopdt", {"K": 1, "tau_s": 1e-3, "theta_s": 0.0}, t)
+    u = np.where(t >= 0, 1.0, 0.0)
+    waves = "time_s,analytic,spice\n" + "".join(f"{a},{b},{c}\n" for a, b, c in zip(t, y1, y2))
+    cap = parse_capture_text(waves)
+    assert cap.u is None and cap.output_name == "spice" and "does not look like" in cap.notes[0]
+    tuy = "".join(f"{a},{b},{c}\n" for a, b, c in zip(t, u, y2))
+    cap = parse_capture_text(tuy)
+    assert cap.input_name == "u" and np.array_equal(cap.u, u)
+
+
+def test_quoted_cells_and_a_units_row():
+    t = np.linspace(0, 1e-3, 50)
+    y = model_step("fopdt", {"K": 1.0, "tau_s": 2e-4, "theta_s": 0.0}, t)
+    quoted = '"Time (s)","Vout (V)"\n' + "".join(f'"{a:.6e}","{b:.6f}"\n' for a, b in zip(t, y))
+    cap = parse_capture_text(quoted)
+    assert cap.output_name == "Vout (V)" and np.allclose(cap.y, y, atol=1e-6)
+    # Keysight-style: a label row and a units row before the samples
+    units = "x-axis,1\nsecond,Volt\n" + "".join(f"{a:.6e},{b:.6f}\n" for a, b in zip(t, y))
+    cap = parse_capture_text(units)
+    assert cap.columns == ["second", "Volt"] and np.allclose(cap.t, t, rtol=1e-6)
+
+
+# ------------------------------------------------------- issue 7: files, encodings, columns
+
+def _capture_text(n, *, u=True):
+    """A t,u,y capture of a first-order step, n rows, and its arrays."""
+    t = np.linspace(-1e-3, 9e-3, n)
+    y = model_step("fopdt", {"K": 2.0, "tau_s": 1e-3, "theta_s": 1e-4}, t)
+    uu = np.where(t >= 0, 1.0, 0.0)
+    return format_generic(t, y, uu if u else None), t, y
+
+
+def test_utf16_and_binary_files_are_named(tmp_path):
+    text, _, _ = _capture_text(50)
+    for enc, bom in (("utf-16", True), ("utf-16-le", False), ("utf-16-be", False),
+                     ("utf-32", True)):
+        p = tmp_path / f"{enc}.csv"
+        p.write_text(text, encoding=enc)
+        label = "UTF-32" if "32" in enc else "UTF-16"
+        with pytest.raises(DesignError, match=f"is {label} text, not UTF-8") as exc:
+            read_capture(p)
+        assert "\\x00" not in str(exc.value)
+    (tmp_path / "bin.csv").write_bytes(bytes(range(256)) * 4)
+    with pytest.raises(DesignError, match="not a text file"):
+        read_capture(tmp_path / "bin.csv")
+    # a UTF-8 BOM and a Latin-1 degree sign in a header cell are fine
+    (tmp_path / "bom.csv").write_bytes(b"\xef\xbb\xbft,temp \xb0C\n" + "".join(
+        f"{k},{min(k, 5)}\n" for k in range(20)).encode())
+    cap = read_capture(tmp_path / "bom.csv")
+    assert cap.columns[0] == "t" and cap.t.size == 20
+
+
+def test_same_column_as_input_and_output_is_refused():
+    text = "time_s,vout,vin\n" + "".join(f"{a},{2 * a},{3 * a}\n" for a in range(20))
+    for inp, out in (("2", "2"), ("vout", "2"), ("VIN", "vin")):
+        with pytest.raises(DesignError, match="both the input and the output"):
+            parse_capture_text(text, input_column=inp, output_column=out)
+    one = "t,y\n" + "".join(f"{a},{a}\n" for a in range(20))
+    with pytest.raises(DesignError, match="cannot be both the input and the output"):
+        parse_capture_text(one, input_column="2")
+
+
+def test_messages_show_plain_numbers():
+    text, t, y = _capture_text(30, u=False)
+    lines = text.splitlines()
+    lines[5], lines[6] = lines[6], lines[5]           # time goes back at line 7
+    with pytest.raises(DesignError) as exc:
+        parse_capture_text("\n".join(lines), name="cap.csv")
+    msg = str(exc.value)
+    assert "np." not in msg and "line 7" in msg
+    assert f"{float(lines[5].split(',')[0]):.10g} then {float(lines[6].split(',')[0]):.10g}" in msg
+
+
+@pytest.mark.parametrize("cell, row, column, key", [
+    ("1e300", -1, 1, "capture_time_s"), ("-1e300", 1, 1, "capture_time_s"),
+    ("1e300", 7, 2, "capture_value"), ("-1e300", -1, 2, "capture_value")])
+def test_values_outside_their_physical_range_name_the_line(cell, row, column, key):
+    from designer.core.ranges import RANGES
+    text, t, y = _capture_text(40, u=False)
+    lines = text.splitlines()          # a header, then the samples
+    cells = lines[row].split(",")
+    cells[column - 1] = cell
+    lines[row] = ",".join(cells)
+    with pytest.raises(DesignError) as exc:
+        parse_capture_text("\n".join(lines), name="cap.csv")
+    assert f"line {row % len(lines) + 1}, column {column}" in str(exc.value)
+    assert RANGES[key].text() in str(exc.value)
+
+
+def test_record_too_short_in_time_is_refused():
+    from designer.core.ranges import RANGES
+    t = np.linspace(0, 1e-300, 20)
+    text = "".join(f"{a!r},{min(k, 10)}\n" for k, a in enumerate(t.tolist()))
+    with pytest.raises(DesignError, match="duration") as exc:
+        parse_capture_text(text)
+    assert RANGES["capture_span_s"].text() in str(exc.value)
+
+
+def test_streamed_file_equals_the_text_and_names_lines_across_blocks(tmp_path):
+    """A file longer than one read block (with blank and comment lines in later
+    blocks) gives the same samples as the text in memory, and a bad cell deep in
+    it is reported at its own line."""
+    from designer.core.textfile import BLOCK_BYTES
+    text, t, y = _capture_text(20)
+    head, body = text.splitlines()[0], text.splitlines()[1:]
+    n = 2 * BLOCK_BYTES // len(body[0]) + 1000
+    tt = np.linspace(-1e-3, 9e-3, n)
+    rows = format_generic(tt, model_step("fopdt", {"K": 2.0, "tau_s": 1e-3, "theta_s": 0.0},
+                                         tt), np.where(tt >= 0, 1.0, 0.0)).splitlines()
+    rows[n // 2] += "\n\n# a note in the middle\n"
+    path = tmp_path / "long.csv"
+    path.write_text("\n".join(rows) + "\n")
+    cap = read_capture(path)
+    mem = parse_capture_text(path.read_text())
+    assert cap.t.size == n and np.array_equal(cap.t, mem.t) and np.array_equal(cap.y, mem.y)
+    assert np.array_equal(cap.u, mem.u)
+    # the same file with a bad cell far into the second block
+    k = n - 10
+    lines = path.read_text().splitlines()
+    line_no = next(i for i, ln in enumerate(lines) if ln == rows[k]) + 1
+    lines[line_no - 1] = lines[line_no - 1].rsplit(",", 1)[0] + ",oops"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(DesignError, match=f"line {line_no}, column 3: 'oops' is not a number"):
+        read_capture(path)
+
+
+def test_size_limit_refused_from_the_size(tmp_path):
+    from designer.core.textfile import MAX_CAPTURE_BYTES, size_text
+    big = tmp_path / "big.csv"
+    with open(big, "wb") as fh:
+        fh.truncate(MAX_CAPTURE_BYTES + 1)    # sparse: refused before a byte is read
+    with pytest.raises(DesignError, match=f"at most {size_text(MAX_CAPTURE_BYTES)}"):
+        read_capture(big)
+
+
+def test_directory_and_devices(tmp_path):
+    with pytest.raises(DesignError, match="is a directory"):
+        read_capture(tmp_path)
+    with pytest.raises(DesignError, match="not a text file"):
+        read_capture("/dev/zero")
+    with pytest.raises(DesignError, match="empty"):
+        read_capture("/dev/null")
+
+
+def test_reading_memory_is_bounded(tmp_path):
+    """Peak memory of reading a capture stays within twice the samples kept plus
+    a few read blocks (a block is held as bytes, as text and as one string per
+    line while it is parsed). Reading the whole text and a Python string per
+    line took 5 times the file: 260 MB here, for 24 MB of samples."""
+    import subprocess
+    import sys
+
+    from designer.core.textfile import BLOCK_BYTES
+    n = 1_000_000
+    t = np.linspace(0.0, 1.0, n)
+    path = tmp_path / "m.csv"
+    with open(path, "w") as fh:
+        fh.write("time_s,vin,vout\n")
+        np.savetxt(fh, np.column_stack([t, t >= 0.1, np.exp(-t)]), delimiter=",", fmt="%.9e")
+    # VmHWM, the new image's own peak: ru_maxrss would count the pages of this
+    # (large) pytest process at fork time
+    code = ("import sys\n"
+            "from designer.identify.io import read_capture\n"
+            "def hwm():\n"
+            "    line = [x for x in open('/proc/self/status') if x.startswith('VmHWM')][0]\n"
+            "    return int(line.split()[1]) * 1024\n"
+            "r0 = hwm()\n"
+            "c = read_capture(sys.argv[1])\n"
+            "print(c.t.size, hwm() - r0)\n")
+    out = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
+                         text=True, check=True, timeout=300).stdout.split()
+    samples_bytes = 3 * 8 * n
+    assert int(out[0]) == n
+    assert int(out[1]) < 2 * samples_bytes + 8 * BLOCK_BYTES, (int(out[1]) / 2**20,
+                                                                path.stat().st_size / 2**20)
