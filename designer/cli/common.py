@@ -18,8 +18,44 @@ from ..core.eseries import SERIES
 from ..core.ranges import help_range, parse_in_range
 
 
+#: library parameter -> the option a user types; errors naming a parameter
+#: (:attr:`DesignError.param`) are shown with the option instead
+FLAGS = {
+    # design-plant / analyze-plant
+    "fc_hz": "--fc", "zeta": "--zeta", "gain": "--gain", "r_series": "--r-series", "c_series": "--c-series",
+    "r_min": "--r-min", "r_max": "--r-max", "c_min": "--c-min", "c_max": "--c-max", "r": "--r", "c": "--c",
+    "opamp": "--opamp", "amplitude_v": "--amplitude", "square_hz": "--square-freq",
+    "alternatives": "--alternatives", "target_fc_hz": "--fc", "target_zeta": "--zeta",
+    "r1": "--r1", "r2": "--r2", "c1": "--c1", "c2": "--c2", "r3": "--r3", "r4": "--r4",
+    # design-pid
+    "plant_fc_hz": "--plant-fc", "plant_zeta": "--plant-zeta", "plant_gain": "--plant-gain",
+    "plant_r1": "--plant-r1", "plant_r2": "--plant-r2", "plant_c1": "--plant-c1", "plant_c2": "--plant-c2",
+    "plant_json": "--plant-json", "tuning": "--tuning", "kp": "--kp", "ti_s": "--ti", "td_s": "--td",
+    "step_v": "--step", "edge_s": "--edge", "target_overshoot_pct": "--target-overshoot",
+    "target_settling_s": "--target-settling", "f_integrator_hz": "--f-integrator",
+    "f_differentiator_hz": "--f-differentiator",
+    # identify / identify-freq
+    "step_time_s": "--step-time", "step_amplitude": "--step-amplitude",
+}
+
+
+def flag_message(exc: DesignError) -> str:
+    """The error's message, its parameter name replaced by the option the user typed."""
+    msg = str(exc)
+    param = getattr(exc, "param", None)
+    if param and param in FLAGS and msg.startswith(param):
+        return FLAGS[param] + msg[len(param):]
+    return msg
+
+
 class OneLineParser(argparse.ArgumentParser):
-    """argparse, but a usage mistake is one line (and exit status 2)."""
+    """argparse, but a usage mistake is one line (and exit status 2), and option
+    values such as ``-1e-3`` or ``-2m`` are values, not unknown options (argparse
+    before Python 3.13 takes only ``-2`` and ``-.5`` for numbers)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
 
     def error(self, message):
         raise DesignError(f"{message} (see {self.prog} --help)")
@@ -56,7 +92,7 @@ def run_cli(prog: str, build_parser, action, argv=None) -> int:
         _fail(prog, f"simulator error: {exc}")
         return EXIT_SIMULATOR
     except DesignError as exc:
-        _fail(prog, str(exc))
+        _fail(prog, flag_message(exc))
         return EXIT_BAD_INPUT
     except BrokenPipeError:
         _silence_stdout()

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 import sys
 from pathlib import Path
 
@@ -79,19 +78,11 @@ def step_amplitude(text) -> float:
     return value
 
 
-def accept_negative_numbers(parser) -> None:
-    """Let option values such as ``-1e-3`` or ``-2m`` through: argparse (before
-    Python 3.13) takes only ``-2`` and ``-.5`` for numbers and reads ``-1e-3`` as
-    an unknown option. Python 3.13 uses this same pattern."""
-    parser._negative_number_matcher = re.compile(r"^-\.?\d")
-
-
 def build_parser() -> argparse.ArgumentParser:
     p = OneLineParser(prog="identify",
                 description="Identify plant models (FOPDT, double pole, second order with dead\n"
                             "time) from a measured or simulated step response, ranked by IAE.",
                 epilog=epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
-    accept_negative_numbers(p)
     p.add_argument("capture", help="CSV file with the step response")
     p.add_argument("--step-time", metavar="T",
                    help="when the input stepped, in seconds " + help_range("capture_time_s")

@@ -9,7 +9,17 @@
 
 class DesignError(ValueError):
     """Bad input or an impossible request, with a message that says what is
-    wrong and what is allowed."""
+    wrong and what is allowed.
+
+    ``param`` names the library parameter at fault (``fc_hz``, ``kp``,
+    ``r_min``); the message then starts with it, and the command-line layer
+    swaps it for the option the user typed (``--fc``) from one table
+    (:data:`designer.cli.common.FLAGS`).
+    """
+
+    def __init__(self, message: str, param: str | None = None):
+        super().__init__(message)
+        self.param = param
 
 
 class SimulatorError(DesignError):

@@ -45,7 +45,7 @@ class Range:
         """``value`` if inside the range, else a :class:`DesignError` naming ``name``."""
         if not self.contains(value):
             got = shown if shown is not None else _show(value)
-            raise DesignError(f"{name} must be {self.text()}, got {got}")
+            raise DesignError(f"{name} must be {self.text()}, got {got}", param=name)
         return float(value)
 
 

@@ -256,11 +256,12 @@ def resolve_plant(spec: PidSpec):
     if spec.plant_json is not None:
         parts = spec._json_plant if spec._json_plant is not None else plant_from_json(spec.plant_json)
         return parts, f"json:{spec.plant_json}"
-    from ..plant.design import PlantSpec, design_plant
+    from ..plant.design import PlantSpec, choose_parts
     ps = PlantSpec(fc_hz=spec.plant_fc_hz, zeta=spec.plant_zeta, opamp=spec.opamp,
                    r_series=spec.r_series, c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
                    c_min=spec.c_min, c_max=spec.c_max, alternatives=1)
-    res = design_plant(ps, simulate=False)
+    ps.validate()
+    res = choose_parts(ps)   # the parts only: no analysis, no deck
     what = f"the plant designed for --plant-fc {spec.plant_fc_hz:g} --plant-zeta {spec.plant_zeta:g}"
     built = check_parts(res.built, name_of={k: f"{what}: {v}" for k, v in
                                             (("r1", "R1"), ("r2", "R2"), ("c1", "C1"), ("c2", "C2"),

@@ -173,10 +173,23 @@ def gbw_shift(parts: SallenKeyParts, opamp: OpAmp):
     return parts.fn_hz / fo, parts.zeta / zo
 
 
-def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspice") -> PlantResult:
-    """Design, analyse and (unless ``simulate`` is False) verify a plant."""
-    tick = time.perf_counter()
-    spec.validate()
+@dataclass
+class Choice:
+    """The parts a spec gets: the build, the exact design it rounds, the ranked
+    alternatives, and the targets aimed at (moved off by ``--compensate-gbw``)."""
+
+    built: SallenKeyParts
+    ideal: SallenKeyParts | None
+    ratios: dict
+    ranked: list
+    notes: list
+    fc_target_hz: float
+    zeta_target: float
+
+
+def choose_parts(spec: PlantSpec) -> Choice:
+    """The E-series parts for a (validated) spec, without any analysis: what
+    ``design-plant`` builds, and what ``design-pid`` needs of a designed plant."""
     amp = opamps.get(spec.opamp)
     rv = candidates(spec.r_series, spec.r_min, spec.r_max, "resistor")
     cv = candidates(spec.c_series, spec.c_min, spec.c_max, "capacitor")
@@ -228,6 +241,17 @@ def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspi
         raise DesignError(_unreachable(spec, fc_t, best.worst))
     if spec.r is None and best.worst > NOTE_ERROR:
         notes += _bound_notes(spec, fc_t, z_t, k, best.worst)
+    return Choice(built, ideal, ratios, ranked, notes, fc_t, z_t)
+
+
+def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspice") -> PlantResult:
+    """Design, analyse and (unless ``simulate`` is False) verify a plant."""
+    tick = time.perf_counter()
+    spec.validate()
+    amp = opamps.get(spec.opamp)
+    choice = choose_parts(spec)
+    built, ideal, ratios, ranked, notes = choice.built, choice.ideal, choice.ratios, choice.ranked, choice.notes
+    fc_t, z_t = choice.fc_target_hz, choice.zeta_target
     t_search = time.perf_counter() - tick
     result = _analyse(built, ideal, amp, spec.r_series, spec.c_series,
                       {"fc_hz": spec.fc_hz, "zeta": spec.zeta, "gain": spec.gain},

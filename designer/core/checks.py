@@ -1,0 +1,48 @@
+"""Checks: one typed record for every pass/fail verdict a design gets (slew
+rate, output swing, phase margin, accuracy of a gain...), with a stable
+snake_case id that is the same in every command and in ``result.json``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+#: what each check id means, for the build sheets (ids not listed print as themselves)
+TITLES = {
+    "slew_rate": "slew rate",
+    "output_swing": "output swing",
+    "square_wave_period": "square-wave period",
+    "spice_agreement": "SPICE agreement",
+    "closed_loop_stable": "closed loop stable",
+    "phase_margin": "phase margin",
+    "steady_state_error": "steady-state error",
+    "kp_accuracy": "Kp accuracy",
+    "ti_accuracy": "Ti accuracy",
+    "td_accuracy": "Td accuracy",
+    "integrator_corner": "integrator corner",
+    "differentiator_corner": "differentiator corner",
+    "resistor_bounds": "resistor bounds",
+    "capacitor_bounds": "capacitor bounds",
+}
+
+
+@dataclass(frozen=True)
+class Check:
+    """One verdict: ``id`` (snake_case, stable), whether it passed, and why."""
+
+    id: str
+    ok: bool
+    detail: str
+
+    @property
+    def title(self) -> str:
+        """A readable name for the sheets: ``slew rate``, ``bandwidth summer``."""
+        return TITLES.get(self.id, self.id.replace("_", " "))
+
+    def to_dict(self) -> dict:
+        # "name" is the id too: the key result.json has always had
+        return {"id": self.id, "name": self.id, "ok": bool(self.ok), "detail": self.detail}
+
+
+def failed(checks) -> list:
+    """The checks that did not pass."""
+    return [c for c in checks if not c.ok]
