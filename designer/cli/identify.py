@@ -53,7 +53,7 @@ exit status: 0 success, 2 bad input (one line on stderr saying what and why).
 
 def epilog() -> str:
     """The --help epilog with the input limits filled in."""
-    from ..core.textfile import MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, size_text
+    from ..core.fileio import MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, size_text
     return EPILOG.format(size=size_text(MAX_CAPTURE_BYTES), rows=MAX_CAPTURE_ROWS,
                          t_rng=RANGES["capture_time_s"].text(),
                          span_rng=RANGES["capture_span_s"].text(),
@@ -136,7 +136,7 @@ def check_output_path(path, option: str) -> None:
     """Refuse, before any work, an output file that cannot be written: the path
     is a directory, or one of its parents is a file. (Nothing is created here:
     a run refused later must leave no trace.)"""
-    from ..core.textfile import shown
+    from ..core.fileio import shown
     if str(path) == "":
         raise DesignError(f"{option} needs a file name, such as fit.png")
     p = Path(path)
@@ -158,7 +158,7 @@ def check_output_path(path, option: str) -> None:
 def write_png(path, fig, option: str = "--plot") -> None:
     """Write a figure atomically; an OS error (disk full, permission) is one line."""
     from ..core.fileio import atomic_write
-    from ..core.textfile import shown
+    from ..core.fileio import shown
     try:
         atomic_write(path, png_bytes(fig))
     except OSError as exc:

@@ -14,7 +14,7 @@ import math
 import sys
 
 from ..core.jsonio import json_safe
-from ..core.textfile import MAX_TABLE_BYTES, size_text
+from ..core.fileio import MAX_TABLE_BYTES, size_text
 from ..core.units import format_eng
 from ..identify.frequency import BAND_FACTOR, FREQ_UNITS, GAIN_UNITS, MAX_FIT_ERROR, PHASE_UNITS
 from .common import OneLineParser, print_output, run_cli

@@ -1,15 +1,22 @@
-"""JSON at the edge: results become plain JSON values here (numpy scalars to
-Python numbers, nan and inf to null)."""
+"""JSON at the edges: results become plain JSON values here (numpy scalars to
+Python numbers, nan and inf to null), and a ``result.json`` a command wrote is
+read back here (:func:`read_result`, for ``identify --against`` and
+``design-pid --plant-json``)."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 
+from .errors import DesignError
+from .fileio import MAX_TABLE_BYTES, read_text, shown
+
 
 def json_safe(obj):
-    """JSON-ready copy: numpy scalars to Python numbers, nan/inf to None."""
+    """JSON-ready copy: numpy scalars and arrays to Python numbers and lists,
+    tuples to lists, nan/inf to None (the one cleaner of every result)."""
     if isinstance(obj, dict):
         return {k: json_safe(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
@@ -23,3 +30,58 @@ def json_safe(obj):
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     return obj
+
+
+def read_result(path, option: str, needs: dict | None = None,
+                what: str = "a design-plant result.json") -> dict:
+    """Read a ``result.json`` a command wrote, refusing anything else in one line.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file (read through :func:`designer.core.fileio.read_text`: at most
+        :data:`~designer.core.fileio.MAX_TABLE_BYTES`, UTF-8 text; a
+        directory, ``/dev/zero`` or a FIFO is refused).
+    option : str
+        The option that named the file (``--against``), for messages.
+    needs : dict, optional
+        ``{section: (key, ...)}``: the object must have each section as an
+        object holding those keys, e.g. ``{"built": ("fn_hz", "zeta")}``.
+    what : str
+        What the file should be, for messages.
+
+    Returns
+    -------
+    dict
+        The parsed object. Values are not checked: the caller checks the ones
+        it uses.
+
+    Raises
+    ------
+    DesignError
+        Unreadable file, not JSON, nested too deeply, not an object, or a
+        needed section or key missing.
+    """
+    name = shown(path)
+    text = read_text(path, f"{option} file", MAX_TABLE_BYTES)
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise DesignError(f"{option}: {name} is not JSON ({exc.msg} at line {exc.lineno}); "
+                          f"expected {what}") from None
+    except RecursionError:
+        raise DesignError(f"{option}: {name} is nested too deeply to be {what}") from None
+    missing = [sec for sec, keys in (needs or {}).items()
+               if not (isinstance(data, dict) and isinstance(data.get(sec), dict)
+                       and set(keys) <= set(data[sec]))]
+    if not isinstance(data, dict) or missing:
+        need = "; ".join(f"'{sec}' with {_and(needs[sec])}" for sec in missing)
+        raise DesignError(f"{option}: {name} is not {what}"
+                          + (f" (needs {need})" if need else " (expected a JSON object)"))
+    return data
+
+
+def _and(keys) -> str:
+    """``a, b and c``."""
+    keys = list(keys)
+    return keys[0] if len(keys) == 1 else ", ".join(keys[:-1]) + " and " + keys[-1]

@@ -60,7 +60,7 @@ import numpy as np
 
 from ..core.errors import DesignError
 from ..core.ranges import RANGES
-from ..core.textfile import MAX_TABLE_BYTES, read_text, show_cell, shown
+from ..core.fileio import MAX_TABLE_BYTES, read_text, show_cell, shown
 from .preprocess import number_text
 from .structures import MethodResult
 
@@ -415,7 +415,7 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
 
 def read_freq_table(path, **units) -> FreqData:
     """Read a frequency-response CSV file (see :func:`parse_freq_table`): at most
-    :data:`~designer.core.textfile.MAX_TABLE_BYTES`, UTF-8 or ASCII."""
+    :data:`~designer.core.fileio.MAX_TABLE_BYTES`, UTF-8 or ASCII."""
     text = read_text(path, "table", MAX_TABLE_BYTES)
     return parse_freq_table(text, source=shown(path), **units)
 

@@ -23,7 +23,7 @@ Files are streamed, never read whole: the layout is recognised from the first
 lines, then the samples are parsed a block at a time by numpy's C parser, and
 only the (at most three) columns used are kept, so memory is about 8 bytes per
 kept value however long the file is. Size, encoding and non-regular files
-(a directory, ``/dev/zero``, a FIFO) are handled by :mod:`designer.core.textfile`; the
+(a directory, ``/dev/zero``, a FIFO) are handled by :mod:`designer.core.fileio`; the
 checks on the samples themselves (finite, increasing time, physical ranges)
 are :func:`.preprocess.check_samples`.
 """
@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.errors import DesignError
-from ..core.textfile import (
+from ..core.fileio import (
     BLOCK_BYTES,
     MAX_CAPTURE_BYTES,
     MAX_CAPTURE_ROWS,
@@ -93,8 +93,8 @@ def read_capture(path, *, input_column=None, output_column=None) -> Capture:
     Parameters
     ----------
     path : str or Path
-        The CSV file (at most :data:`~designer.core.textfile.MAX_CAPTURE_BYTES` bytes and
-        :data:`~designer.core.textfile.MAX_CAPTURE_ROWS` data rows).
+        The CSV file (at most :data:`~designer.core.fileio.MAX_CAPTURE_BYTES` bytes and
+        :data:`~designer.core.fileio.MAX_CAPTURE_ROWS` data rows).
     input_column, output_column : str or int, optional
         Column name (case-insensitive) or 1-based column number (time is column
         1) of the plant input and output; ``input_column="none"`` ignores any

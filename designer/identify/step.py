@@ -16,7 +16,6 @@ tolerances explain the difference.
 from __future__ import annotations
 
 import itertools
-import json
 import math
 import time
 from dataclasses import dataclass, field
@@ -430,23 +429,13 @@ def _band_from_built(built: dict):
 
 
 def load_design(path) -> dict:
-    """Read a design-plant result.json (at most MAX_TABLE_BYTES); a clear
-    one-line error if it is not one, or if a value the comparison uses is not
-    a finite number where one is needed."""
-    from ..core.textfile import MAX_TABLE_BYTES, read_text, shown
-    name = shown(path)
-    text = read_text(path, "--against file", MAX_TABLE_BYTES)
-    try:
-        d = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise DesignError(f"--against: {name} is not JSON ({exc.msg} at line {exc.lineno})") from None
-    except RecursionError:
-        raise DesignError(f"--against: {name} is nested too deeply to be a result.json") from None
-    if not isinstance(d, dict) or not isinstance(d.get("built"), dict) \
-            or not {"fn_hz", "zeta"} <= set(d["built"]):
-        raise DesignError(f"--against: {name} is not a design-plant result.json "
-                          "(needs 'built' with fn_hz and zeta)")
-    _check_design(d, name)
+    """Read a design-plant result.json (:func:`designer.core.jsonio.read_result`);
+    a clear one-line error if it is not one, or if a value the comparison uses
+    is not a finite number where one is needed."""
+    from ..core.fileio import shown
+    from ..core.jsonio import read_result
+    d = read_result(path, "--against", needs={"built": ("fn_hz", "zeta")})
+    _check_design(d, shown(path))
     return d
 
 

@@ -200,7 +200,7 @@ def test_tolerance_band_contains_every_part_combination():
 
 def test_help_states_every_numeric_range():
     from designer.core.ranges import RANGES
-    from designer.core.textfile import MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, size_text
+    from designer.core.fileio import MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, size_text
     out = " ".join(run("--help").stdout.split())
     for key in ("capture_time_s", "step_amplitude", "capture_span_s", "capture_value",
                 "output_step"):

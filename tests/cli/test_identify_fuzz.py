@@ -381,7 +381,7 @@ def test_a_fifo_that_never_ends_is_refused_at_the_limit(tmp_path):
     """A non-regular file is read at most to the size limit (a writer that never
     stops: twenty samples, then comment lines, which are skipped, so only the
     limit can end it)."""
-    from designer.core.textfile import MAX_CAPTURE_BYTES, size_text
+    from designer.core.fileio import MAX_CAPTURE_BYTES, size_text
     fifo = tmp_path / "pipe.csv"
     os.mkfifo(fifo)
     line = ("# " + "x" * 1021 + "\n").encode()

@@ -440,7 +440,7 @@ def test_time_shift_overflowing_the_phase_is_one_line():
 
 
 def test_table_limits(tmp_path):
-    from designer.core.textfile import MAX_TABLE_BYTES, size_text
+    from designer.core.fileio import MAX_TABLE_BYTES, size_text
     big = tmp_path / "big.csv"
     with open(big, "wb") as fh:
         fh.truncate(MAX_TABLE_BYTES + 1)       # sparse: refused from its size, never read

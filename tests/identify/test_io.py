@@ -224,7 +224,7 @@ def test_streamed_file_equals_the_text_and_names_lines_across_blocks(tmp_path):
     """A file longer than one read block (with blank and comment lines in later
     blocks) gives the same samples as the text in memory, and a bad cell deep in
     it is reported at its own line."""
-    from designer.core.textfile import BLOCK_BYTES
+    from designer.core.fileio import BLOCK_BYTES
     text, t, y = _capture_text(20)
     head, body = text.splitlines()[0], text.splitlines()[1:]
     n = 2 * BLOCK_BYTES // len(body[0]) + 1000
@@ -249,7 +249,7 @@ def test_streamed_file_equals_the_text_and_names_lines_across_blocks(tmp_path):
 
 
 def test_size_limit_refused_from_the_size(tmp_path):
-    from designer.core.textfile import MAX_CAPTURE_BYTES, size_text
+    from designer.core.fileio import MAX_CAPTURE_BYTES, size_text
     big = tmp_path / "big.csv"
     with open(big, "wb") as fh:
         fh.truncate(MAX_CAPTURE_BYTES + 1)    # sparse: refused before a byte is read
@@ -274,7 +274,7 @@ def test_reading_memory_is_bounded(tmp_path):
     import subprocess
     import sys
 
-    from designer.core.textfile import BLOCK_BYTES
+    from designer.core.fileio import BLOCK_BYTES
     n = 1_000_000
     t = np.linspace(0.0, 1.0, n)
     path = tmp_path / "m.csv"
