@@ -25,7 +25,7 @@ FLAGS = {
     "fc_hz": "--fc", "zeta": "--zeta", "gain": "--gain", "r_series": "--r-series", "c_series": "--c-series",
     "r_min": "--r-min", "r_max": "--r-max", "c_min": "--c-min", "c_max": "--c-max", "r": "--r", "c": "--c",
     "opamp": "--opamp", "amplitude_v": "--amplitude", "square_hz": "--square-freq",
-    "alternatives": "--alternatives", "target_fc_hz": "--fc", "target_zeta": "--zeta",
+    "alternatives": "--alternatives", "target_fc_hz": "--fc", "target_zeta": "--zeta", "no_sim": "--no-sim",
     "r1": "--r1", "r2": "--r2", "c1": "--c1", "c2": "--c2", "r3": "--r3", "r4": "--r4",
     # design-pid
     "plant_fc_hz": "--plant-fc", "plant_zeta": "--plant-zeta", "plant_gain": "--plant-gain",
@@ -40,10 +40,15 @@ FLAGS = {
 
 
 def flag_message(exc: DesignError) -> str:
-    """The error's message, its parameter name replaced by the option the user typed."""
+    """The error's message with the options the user typed for the parameters it
+    names: every ``{name}`` marker of a :class:`~designer.core.ranges.ParamError`
+    (or any error that reads its markers through a table, ``naming``), else the
+    parameter it starts with (:attr:`DesignError.param`)."""
+    if callable(getattr(exc, "naming", None)):
+        return exc.naming(FLAGS)
     msg = str(exc)
     param = getattr(exc, "param", None)
-    if param and param in FLAGS and msg.startswith(param):
+    if isinstance(param, str) and param in FLAGS and msg.startswith(param):
         return FLAGS[param] + msg[len(param):]
     return msg
 
@@ -128,10 +133,9 @@ def add_part_options(group):
 
 
 def part_options(args) -> dict:
-    """The parsed :func:`add_part_options`, as spec keyword arguments."""
-    keys = {"r_min": "resistor_ohm", "r_max": "resistor_ohm", "c_min": "capacitor_f", "c_max": "capacitor_f"}
-    return {"r_series": args.r_series, "c_series": args.c_series,
-            **{k: parse_in_range(getattr(args, k), f"--{k.replace('_', '-')}", key) for k, key in keys.items()}}
+    """:func:`add_part_options` as typed, as keyword arguments of a spec
+    (a :class:`~designer.core.eseries.PartBounds`, which checks them)."""
+    return {k: getattr(args, k) for k in ("r_series", "c_series", "r_min", "r_max", "c_min", "c_max")}
 
 
 def optional(text, name: str, key: str):
@@ -139,12 +143,16 @@ def optional(text, name: str, key: str):
     return None if text is None else parse_in_range(text, name, key)
 
 
-def add_output_options(p):
+def add_output_options(p, default_name: str):
+    """The options every designing command shares: where and how to write
+    (``--out``, ``--name``, ``--json``, ``--no-files``) and whether and how to
+    simulate (``--no-sim``, ``--simulator``). Returns the "simulation" group,
+    for the command's own test-signal options."""
     g = p.add_argument_group("output")
     g.add_argument("--out", default=".", metavar="DIR",
                    help="write netlists/<name>.cir and reports/<name>/ under DIR (default: current directory)")
     g.add_argument("--name", help="design name used for the files: letters, digits and . _ - + = , @ "
-                                   "(default from the figures, e.g. plant_fc3500_z0.2)")
+                                   f"(default from the figures, e.g. {default_name})")
     g.add_argument("--json", action="store_true", help="print one JSON object on stdout instead of the summary")
     g.add_argument("--no-files", action="store_true", help="do not write the netlist and report files")
     s = p.add_argument_group("simulation")
@@ -152,14 +160,13 @@ def add_output_options(p):
     s.add_argument("--simulator", default="pyspice", choices=("pyspice", "ngspice-cli"),
                    help="pyspice: ngspice shared library via PySpice (default); "
                         "ngspice-cli: `ngspice -b` subprocess")
-    s.add_argument("--opamp", default="LM741", metavar="NAME",
-                   help=f"op-amp model: {', '.join(opamps.names())} (default LM741, as the seed's bench)")
-    s.add_argument("--amplitude", default="2", metavar="V",
-                   help="bench square wave goes 0 -> V volts (default 2, as the seed's bench test) "
-                        + help_range("amplitude_v"))
-    s.add_argument("--square-freq", metavar="HZ",
-                   help="bench square-wave frequency (default: a round value whose half period is "
-                        "1.5x the 2 %% settling time; 330 Hz for the seed's plant) " + help_range("square_hz"))
+    return s
+
+
+def add_opamp_option(group):
+    """``--opamp``: the catalogue's names (the seed's bench used LM741s)."""
+    group.add_argument("--opamp", default="LM741", metavar="NAME",
+                       help=f"op-amp model: {', '.join(opamps.names())} (default LM741, as the seed's bench)")
 
 
 _NAME = re.compile(r"^[A-Za-z0-9_+=,@-][A-Za-z0-9._+=,@-]{0,119}$")

@@ -7,16 +7,15 @@ import argparse
 import sys
 
 from .. import __version__
-from ..core import opamps
 from ..core.errors import DesignError
-from ..core.ranges import help_range, parse_in_range
+from ..core.ranges import help_range
 from .common import (
     OneLineParser,
+    add_opamp_option,
     add_output_options,
     add_part_options,
     check_name,
     emit,
-    optional,
     part_options,
     run_cli,
 )
@@ -56,40 +55,36 @@ result.json, step.png, bode.png. Exit status 2 on bad input.""",
     add_part_options(sel)
     sel.add_argument("--alternatives", default="5",
                      help=f"how many best combinations to list (default 5) {help_range('alternatives')}")
-    add_output_options(p)
+    _add_bench_options(add_output_options(p, "plant_fc3500_z0.2"))
     return p
 
 
+def _add_bench_options(group):
+    """The op-amp and the bench's square wave (design-plant and analyze-plant)."""
+    add_opamp_option(group)
+    group.add_argument("--amplitude", default="2", metavar="V",
+                       help="bench square wave goes 0 -> V volts (default 2, as the seed's bench test) "
+                            + help_range("amplitude_v"))
+    group.add_argument("--square-freq", metavar="HZ",
+                       help="bench square-wave frequency (default: a round value whose half period is "
+                            "1.5x the 2 %% settling time; 330 Hz for the seed's plant) " + help_range("square_hz"))
+
+
 def _design(args) -> int:
-    from ..plant.design import PlantSpec, design_plant
-    spec = PlantSpec(
-        fc_hz=parse_in_range(args.fc, "--fc", "fc_hz"), zeta=parse_in_range(args.zeta, "--zeta", "zeta"),
-        gain=parse_in_range(args.gain, "--gain", "gain"),
-        **part_options(args),
-        r=optional(args.r, "--r", "resistor_ohm"), c=optional(args.c, "--c", "capacitor_f"),
-        opamp=args.opamp, compensate_gbw=args.compensate_gbw,
-        amplitude_v=parse_in_range(args.amplitude, "--amplitude", "amplitude_v"),
-        square_hz=optional(args.square_freq, "--square-freq", "square_hz"),
-        alternatives=_count(args.alternatives))
-    spec.validate()
+    from ..plant.spec import PlantSpec
+    # the spec parses and checks what was typed (once); its errors name parameters, shown as options
+    spec = PlantSpec(fc_hz=args.fc, zeta=args.zeta, gain=args.gain, **part_options(args), r=args.r, c=args.c,
+                     opamp=args.opamp, compensate_gbw=args.compensate_gbw, amplitude_v=args.amplitude,
+                     square_hz=args.square_freq, alternatives=args.alternatives)
     name = args.name if args.name is not None else (
         f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
     check_name(name)
     if not args.no_files:
         from ..core.fileio import check_can_create
         check_can_create(args.out, ("netlists", "reports"))  # fail before the work, not after
+    from ..plant.design import design_plant
     result = design_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
     return _emit(result, args, name)
-
-
-def _count(text) -> int:
-    try:
-        n = int(str(text).strip())
-    except ValueError:
-        raise DesignError(f"--alternatives must be a whole number from 1 to 50, got {text!r}") from None
-    if not 1 <= n <= 50:
-        raise DesignError(f"--alternatives must be a whole number from 1 to 50, got {text!r}")
-    return n
 
 
 def _emit(result, args, name) -> int:
@@ -124,44 +119,30 @@ def _analyze_parser():
                                                     "(default: the smallest series that holds each value)")
     g.add_argument("--c-series", default=None, help="series the capacitors come from, for the tolerance band "
                                                     "(default: the smallest series that holds each value)")
-    add_output_options(p)
+    _add_bench_options(add_output_options(p, "built_r1820_r21k_c110n_c2220n"))
     return p
 
 
 def _analyze(args) -> int:
     from ..core.units import value_code
     from ..plant.design import analyze_plant
-    from ..plant.sallenkey import SallenKeyParts, check_parts
-    r3 = r4 = None
-    if (args.r3 is None) != (args.r4 is None):
-        raise DesignError("--r3 and --r4 go together (K = 1 + R4/R3)")
-    if args.r3 is not None:
-        if args.gain is not None:
-            raise DesignError("give either --gain or --r3/--r4, not both")
-        r3, r4 = parse_in_range(args.r3, "--r3", "resistor_ohm"), parse_in_range(args.r4, "--r4", "resistor_ohm")
-    gain = None if args.gain is None else parse_in_range(args.gain, "--gain", "gain")
-    vals = {n: parse_in_range(getattr(args, n), f"--{n}", "resistor_ohm" if n[0] == "r" else "capacitor_f")
-            for n in ("r1", "r2", "c1", "c2")}
-    # the shared plant check derives R3/R4 for a bare --gain and refuses unstable parts
-    parts = check_parts(SallenKeyParts(vals["r1"], vals["r2"], vals["c1"], vals["c2"], gain, r3, r4),
-                        name_of={k: f"--{k}" for k in ("r1", "r2", "c1", "c2", "r3", "r4", "gain")})
-    fc = optional(args.fc, "--fc", "fc_hz")
-    zeta = optional(args.zeta, "--zeta", "zeta")
-    from ..core.eseries import series_name
-    for s in (args.r_series, args.c_series):
-        if s is not None:
-            series_name(s)
-    opamps.get(args.opamp)
-    name = args.name if args.name is not None else "built_" + "_".join(f"{k}{value_code(v)}" for k, v in vals.items())
+    from ..plant.sallenkey import SallenKeyParts
+    from ..plant.spec import AnalysisSpec
+    if args.r3 is not None and args.gain is not None:
+        raise DesignError("give either --gain or --r3/--r4, not both")
+    # the spec parses and checks what was typed (once): the parts through the plant check,
+    # which derives R3/R4 for a bare --gain and refuses unstable parts
+    spec = AnalysisSpec(SallenKeyParts(args.r1, args.r2, args.c1, args.c2, args.gain, args.r3, args.r4),
+                        opamp=args.opamp, target_fc_hz=args.fc, target_zeta=args.zeta, r_series=args.r_series,
+                        c_series=args.c_series, amplitude_v=args.amplitude, square_hz=args.square_freq)
+    p = spec.parts
+    name = args.name if args.name is not None else "built_" + "_".join(
+        f"{k}{value_code(v)}" for k, v in (("r1", p.r1), ("r2", p.r2), ("c1", p.c1), ("c2", p.c2)))
     check_name(name)
-    amplitude = parse_in_range(args.amplitude, "--amplitude", "amplitude_v")
-    square = optional(args.square_freq, "--square-freq", "square_hz")
     if not args.no_files:
         from ..core.fileio import check_can_create
         check_can_create(args.out, ("netlists", "reports"))
-    result = analyze_plant(parts, args.opamp, fc, zeta, args.r_series, args.c_series, amplitude, square,
-                           simulate=not args.no_sim, simulator=args.simulator)
-    return _emit(result, args, name)
+    return _emit(analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, name)
 
 
 def design_plant_main(argv=None) -> int:

@@ -1,4 +1,5 @@
-"""IEC 60063 preferred-number series E3 to E192 and nearest-value helpers.
+"""IEC 60063 preferred-number series E3 to E192, nearest-value helpers, and
+the part bounds a design chooses within (:class:`PartBounds`).
 
 E3..E24 are tabulated in the standard (they are not the rounded geometric
 series); E48..E192 follow round(10**(i/N), 2) with the one exception the
@@ -7,9 +8,12 @@ standard makes (E192 lists 9.20 where the formula gives 9.19).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .errors import DesignError
+from .ranges import ParamError, parse_in_range
 
 _E24 = (1.0, 1.1, 1.2, 1.3, 1.5, 1.6, 1.8, 2.0, 2.2, 2.4, 2.7, 3.0,
         3.3, 3.6, 3.9, 4.3, 4.7, 5.1, 5.6, 6.2, 6.8, 7.5, 8.2, 9.1)
@@ -48,17 +52,46 @@ def series_name(name: str) -> str:
     return key
 
 
+@dataclass(frozen=True, kw_only=True)
+class PartBounds:
+    """Where a design's parts come from: the E-series of the resistors and the
+    capacitors and the value bounds of each (the ``--r-series``..``--c-max``
+    options of every command that chooses parts).
+
+    Validated once, when built: every bound a number (or engineering notation,
+    ``"4k7"``) inside the physical range of its kind, each minimum at most its
+    maximum, the series names normalised (``"e24"`` -> ``"E24"``). A spec that
+    chooses parts derives from it (keyword-only fields, so they follow the
+    spec's own) and calls :meth:`check_bounds` in its own ``__post_init__``.
+    """
+
+    r_series: str = "E24"
+    c_series: str = "E12"
+    r_min: float = 1e3
+    r_max: float = 1e6
+    c_min: float = 1e-9
+    c_max: float = 1e-5
+
+    def __post_init__(self):
+        self.check_bounds()
+
+    def check_bounds(self) -> None:
+        """Parse, check and normalise the bounds and series (frozen: once, here)."""
+        for name, key in (("r_min", "resistor_ohm"), ("r_max", "resistor_ohm"),
+                          ("c_min", "capacitor_f"), ("c_max", "capacitor_f")):
+            object.__setattr__(self, name, parse_in_range(getattr(self, name), name, key))
+        for kind, unit in (("r", "Ohm"), ("c", "F")):
+            lo, hi = getattr(self, f"{kind}_min"), getattr(self, f"{kind}_max")
+            if lo > hi:
+                raise ParamError(f"{{{kind}_min}} ({lo:g} {unit}) is above {{{kind}_max}} ({hi:g} {unit})")
+        object.__setattr__(self, "r_series", series_name(self.r_series))
+        object.__setattr__(self, "c_series", series_name(self.c_series))
+
+
 def check_bounds(r_series: str, c_series: str, r_min: float, r_max: float, c_min: float, c_max: float):
-    """Validate the part-selection options; returns the normalised series names."""
-    import math
-    for name, v in (("--r-min", r_min), ("--r-max", r_max), ("--c-min", c_min), ("--c-max", c_max)):
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-            raise DesignError(f"{name} must be a positive finite number, got {v!r}")
-    if r_min > r_max:
-        raise DesignError(f"--r-min ({r_min:g} Ohm) is above --r-max ({r_max:g} Ohm)")
-    if c_min > c_max:
-        raise DesignError(f"--c-min ({c_min:g} F) is above --c-max ({c_max:g} F)")
-    return series_name(r_series), series_name(c_series)
+    """The normalised series names of valid bounds (see :class:`PartBounds`)."""
+    b = PartBounds(r_series=r_series, c_series=c_series, r_min=r_min, r_max=r_max, c_min=c_min, c_max=c_max)
+    return b.r_series, b.c_series
 
 
 def values(series: str, lo: float, hi: float) -> np.ndarray:

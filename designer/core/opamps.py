@@ -8,7 +8,7 @@ limit, and an output that stays ``swing_*`` volts inside the rails.
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
 
@@ -45,7 +45,9 @@ class OpAmp:
         return self.gbw_hz / self.a0
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        """The op-amp as every result's JSON gives it: the figures a design used."""
+        return {"name": self.name, "gbw_hz": self.gbw_hz, "slew_v_per_s": self.slew_v_per_s, "a0": self.a0,
+                "vcc": self.vcc, "vee": self.vee, "vout_max": self.vout_max, "vout_min": self.vout_min}
 
 
 @lru_cache(maxsize=1)

@@ -1,22 +1,69 @@
-"""The physical range of every numeric input, in one table.
+"""The physical range of every numeric input, in one table, and how errors
+name the inputs.
 
-Each command's ``--help`` states these ranges and every parser checks them, so a
-value outside them ends in one line naming the input and the allowed range,
-before any work is done (no overflow, no NaN deep inside a solver, no
-eight-second wait to be told no). The ranges are generous engineering limits,
-not design advice: a value inside a range may still be refused later, with a
-reason, by the design itself (e.g. no E-series parts within the bounds).
+Each command's ``--help`` states these ranges and every spec checks them when
+it is built, so a value outside them ends in one line naming the input and the
+allowed range, before any work is done (no overflow, no NaN deep inside a
+solver, no eight-second wait to be told no). The ranges are generous
+engineering limits, not design advice: a value inside a range may still be
+refused later, with a reason, by the design itself (e.g. no E-series parts
+within the bounds).
 
-Keys are the library's parameter names; the CLI shows its flag names.
+Keys are the library's parameter names, and so are the names in its messages
+(``fc_hz must be ...``); the command line shows its options instead
+(``--fc must be ...``) from one table, :data:`designer.cli.common.FLAGS`. A
+message about one parameter starts with its name (:attr:`DesignError.param`);
+a message about several writes them as ``{name}`` markers (:class:`ParamError`).
 """
 
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
+
+import numpy as np
 
 from .errors import DesignError
 from .units import format_eng, parse_value
+
+_MARKER = re.compile(r"\{([a-z][a-z0-9_]*)\}")
+#: how the library writes a marker that is not a parameter name (the CLI has an option for it)
+SPELLING = {"no_sim": "simulate=False"}
+
+
+class ParamError(DesignError):
+    """A refusal whose message names several parameters, as ``{name}`` markers.
+
+    ``str(error)`` reads them as the library's names (``r_min``, or
+    :data:`SPELLING`); :meth:`naming` reads them through another table, e.g.
+    the command line's options (``--r-min``). ``param`` is the first name.
+
+    Parameters
+    ----------
+    marked : str
+        The message, parameters written ``{name}``.
+    params : collection of str, optional
+        The only names that are markers (other ``{...}`` text, e.g. in a file
+        name, stays as it is); default every ``{identifier}``.
+    """
+
+    def __init__(self, marked: str, params=None):
+        self.marked = marked
+        self.params = None if params is None else frozenset(params)
+        first = next((m.group(1) for m in _MARKER.finditer(marked) if self._is_param(m.group(1))), None)
+        super().__init__(self.naming({}), param=first)
+
+    def _is_param(self, name: str) -> bool:
+        return self.params is None or name in self.params
+
+    def naming(self, names: dict) -> str:
+        """The message with each marker read through ``names`` (a name it lacks
+        reads as the library writes it)."""
+        def name(m):
+            key = m.group(1)
+            return names.get(key, SPELLING.get(key, key)) if self._is_param(key) else m.group(0)
+        return _MARKER.sub(name, self.marked)
 
 
 @dataclass(frozen=True)
@@ -41,8 +88,11 @@ class Range:
         above = value > self.lo if self.lo_open else value >= self.lo - 1e-12 * abs(self.lo)
         return math.isfinite(value) and above and value <= self.hi + 1e-12 * abs(self.hi)
 
-    def check(self, value: float, name: str, shown=None) -> float:
-        """``value`` if inside the range, else a :class:`DesignError` naming ``name``."""
+    def check(self, value, name: str, shown=None) -> float:
+        """``value`` as a float if it is a real number inside the range, else a
+        :class:`DesignError` starting with ``name`` (its ``param``)."""
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise DesignError(f"{name} must be a number, got {_short(value)}", param=name)
         if not self.contains(value):
             got = shown if shown is not None else _show(value)
             raise DesignError(f"{name} must be {self.text()}, got {got}", param=name)
@@ -56,13 +106,14 @@ def _fmt(v: float, unit: str) -> str:
 
 
 def _show(value) -> str:
-    if isinstance(value, str):
+    return f"{float(value):g}"
+
+
+def _short(value) -> str:
+    """A value of the wrong type, for a one-line message: short text, else its type."""
+    if isinstance(value, str) and len(value) <= 40:
         return repr(value)
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        return repr(value)
-    return f"{v:g}"
+    return type(value).__name__
 
 
 #: Every numeric input of every command (library parameter name -> range).
@@ -106,11 +157,16 @@ RANGES = {
 }
 
 
-def parse_in_range(text, name: str, key: str) -> float:
-    """Parse engineering notation (see :func:`designer.units.parse_value`) and
-    check it against ``RANGES[key]``; errors name ``name`` (e.g. ``--fc``)."""
-    value = parse_value(text, name)
-    return RANGES[key].check(value, name, shown=repr(text) if isinstance(text, str) else None)
+def parse_in_range(value, name: str, key: str) -> float:
+    """``value`` (a number, or text in engineering notation: see
+    :func:`designer.core.units.parse_value`) as a float inside ``RANGES[key]``.
+
+    What a user typed is handed over as typed, so that a refusal quotes it
+    (``fc_hz must be 10 mHz to 10 MHz, got '1e-300'``); errors start with
+    ``name`` and carry it as their ``param``."""
+    if isinstance(value, str):
+        return RANGES[key].check(parse_value(value, name), name, shown=repr(value))
+    return RANGES[key].check(value, name)
 
 
 def help_range(key: str) -> str:

@@ -2,7 +2,7 @@
 and format numbers back as ``4k7``-style value codes or ``4.70 kOhm``.
 
 Parsing is strict: anything that is not a finite number is a
-:class:`~designer.errors.DesignError` naming the field.
+:class:`~designer.core.errors.DesignError` naming the field (its ``param``).
 """
 
 from __future__ import annotations
@@ -82,9 +82,9 @@ def parse_value(text, name: str = "value") -> float:
         else:
             raise DesignError(
                 f"{name}: {_short(text)} is not a number (use plain or engineering notation "
-                "such as 4k7, 820, 10n, 2u2, 3.5k, 1e-9)")
+                "such as 4k7, 820, 10n, 2u2, 3.5k, 1e-9)", param=name)
     if not math.isfinite(value):
-        raise DesignError(f"{name}: {_short(text)} is not a finite number")
+        raise DesignError(f"{name}: {_short(text)} is not a finite number", param=name)
     return value
 
 
@@ -100,14 +100,6 @@ def _short(text, limit: int = 40) -> str:
         return f"{text:g}"
     r = repr(str(text))
     return r if len(r) <= limit else r[: limit - 4] + "...'"
-
-
-def parse_positive(text, name: str) -> float:
-    """Parse a strictly positive finite number (see :func:`parse_value`)."""
-    value = parse_value(text, name)
-    if value <= 0:
-        raise DesignError(f"{name}: must be greater than 0, got {_short(text)}")
-    return value
 
 
 _ENG = [(1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "u"),

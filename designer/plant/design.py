@@ -1,154 +1,57 @@
 """From a spec (fc, zeta, gain) to a verified Sallen-Key plant: synthesis,
-joint E-series selection, analytic models, netlist, simulation and comparison.
+joint E-series selection, analytic models, netlist, simulation and comparison
+(seed 001, IV.3-IV.9: the plant it designs by hand, with its rounding done
+jointly and its LM741 modelled).
 
-``design_plant`` and ``analyze_plant`` return a :class:`PlantResult`, whose
-``to_dict`` is the JSON of ``design-plant --json`` and ``result.json``; the
-report module renders the same data as text, Markdown and HTML.
+``design_plant`` and ``analyze_plant`` return a
+:class:`~designer.plant.result.PlantResult`, typed; its ``to_dict`` is the
+JSON of ``design-plant --json`` and ``result.json``, and the report module
+renders the same object as text, Markdown and HTML.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import eseries, opamps
+from ..core import eseries
 from ..core.compare import disagreements, metric_deltas, nrms, resample
 from ..core.errors import DesignError
-from ..core.jsonio import json_safe
 from ..core.lti import dense_time, dominant_pair, response_span, step_response
 from ..core.metrics import step_metrics
 from ..core.opamps import OpAmp
-from ..core.ranges import RANGES
+from ..core.ranges import RANGES, ParamError
 from ..core.units import format_eng, value_code
-from ..spice.deck import SquareTest
 from ..spice.simulate import get_simulator
-from .bench import recommend_square_wave, signal_checks, tolerance_band
+from .bench import bench_period, period_check, recommend_square_wave, signal_checks, tolerance_band
 from .model import plant_tf, plant_tf_opamp, sensitivities
 from .netlist import plant_deck
-from .sallenkey import SallenKeyParts, check_parts, ratios_from_rc, realizability_notes, resistors_for_caps
+from .result import (
+    Alternative,
+    Comparison,
+    Figures,
+    Model,
+    PartSource,
+    PlantResult,
+    Ratios,
+    Sourcing,
+    SpiceRun,
+    Target,
+)
+from .sallenkey import (
+    SallenKeyParts,
+    ratios_from_rc,
+    realizability_notes,
+    resistors_for_caps,
+    unity_gain_c2_min,
+)
 from .selection import around, brute_force, joint_search
+from .spec import AnalysisSpec, PlantSpec
 
-
-@dataclass
-class PlantSpec:
-    """What the user asked for. Values in ohms, farads, hertz, volts."""
-
-    fc_hz: float
-    zeta: float
-    gain: float = 1.0
-    r_series: str = "E24"
-    c_series: str = "E12"
-    r_min: float = 1e3
-    r_max: float = 1e6
-    c_min: float = 1e-9
-    c_max: float = 1e-5
-    r: float | None = None        #: the seed's procedure: fix R ...
-    c: float | None = None        #: ... and C, solve m and n
-    opamp: str = "LM741"
-    compensate_gbw: bool = False
-    amplitude_v: float = 2.0
-    square_hz: float | None = None
-    alternatives: int = 5
-
-    def validate(self) -> None:
-        """Every value inside its physical range (:mod:`designer.ranges`), the
-        options consistent; a :class:`DesignError` naming the option otherwise."""
-        R = RANGES
-        R["fc_hz"].check(self.fc_hz, "--fc")
-        R["zeta"].check(self.zeta, "--zeta")
-        R["gain"].check(self.gain, "--gain")
-        for name, v in (("--r-min", self.r_min), ("--r-max", self.r_max)):
-            R["resistor_ohm"].check(v, name)
-        for name, v in (("--c-min", self.c_min), ("--c-max", self.c_max)):
-            R["capacitor_f"].check(v, name)
-        self.r_series, self.c_series = eseries.check_bounds(
-            self.r_series, self.c_series, self.r_min, self.r_max, self.c_min, self.c_max)
-        R["amplitude_v"].check(self.amplitude_v, "--amplitude")
-        if (self.r is None) != (self.c is None):
-            raise DesignError("--r and --c go together (the seed's procedure fixes both R and C)")
-        if self.r is not None:
-            R["resistor_ohm"].check(self.r, "--r")
-            R["capacitor_f"].check(self.c, "--c")
-        if self.square_hz is not None:
-            R["square_hz"].check(self.square_hz, "--square-freq")
-        R["alternatives"].check(self.alternatives, "--alternatives")
-        opamps.get(self.opamp)
-
-
-@dataclass
-class PlantResult:
-    """Everything known about one plant design; ``to_dict`` is the JSON."""
-
-    spec: dict
-    ratios: dict
-    ideal: SallenKeyParts | None
-    built: SallenKeyParts
-    opamp: OpAmp
-    series: dict
-    alternatives: list
-    notes: list
-    fn_opamp_hz: float
-    zeta_opamp: float
-    analytic: dict
-    analytic_opamp: dict
-    spice: dict | None
-    comparison: dict
-    sensitivity: dict
-    sensitivity_opamp: dict
-    tolerance: dict
-    test: SquareTest
-    checks: list
-    waveforms: dict = field(default_factory=dict, repr=False)
-    files: dict = field(default_factory=dict)
-    timings: dict = field(default_factory=dict)
-    simulator: str | None = None
-    mode: str = "design"
-
-    def to_dict(self) -> dict:
-        b = self.built
-        target_fn = self.spec.get("fc_hz")
-        target_z = self.spec.get("zeta")
-        built = {**b.as_dict(), "q": b.q,
-                 "fn_error_pct": _pct(b.fn_hz, target_fn), "zeta_error_pct": _pct(b.zeta, target_z),
-                 "fn_opamp_hz": self.fn_opamp_hz, "zeta_opamp": self.zeta_opamp,
-                 "fn_opamp_error_pct": _pct(self.fn_opamp_hz, target_fn),
-                 "zeta_opamp_error_pct": _pct(self.zeta_opamp, target_z),
-                 "tolerance_band": self.tolerance}
-        return json_safe({
-            "mode": self.mode,
-            "spec": self.spec,
-            "ratios": self.ratios,
-            "ideal": None if self.ideal is None else {**self.ideal.as_dict(), "q": self.ideal.q},
-            "built": built,
-            "series": self.series,
-            "alternatives": self.alternatives,
-            "opamp": {"name": self.opamp.name, "gbw_hz": self.opamp.gbw_hz,
-                      "slew_v_per_s": self.opamp.slew_v_per_s, "a0": self.opamp.a0,
-                      "vcc": self.opamp.vcc, "vee": self.opamp.vee,
-                      "vout_max": self.opamp.vout_max, "vout_min": self.opamp.vout_min},
-            "test_signal": {"kind": "square", "low_v": 0.0, "high_v": self.test.amplitude_v,
-                            "frequency_hz": self.test.frequency_hz,
-                            "offset_v": self.test.amplitude_v / 2,
-                            "amplitude_vpp": self.test.amplitude_v},
-            "checks": self.checks,
-            "notes": self.notes,
-            "analytic": self.analytic,
-            "analytic_opamp": self.analytic_opamp,
-            "spice": self.spice,
-            "comparison": self.comparison,
-            "sensitivity": {"ideal": self.sensitivity, "opamp": self.sensitivity_opamp},
-            "simulator": self.simulator,
-            "files": self.files,
-        })
-
-
-def _pct(value, target):
-    if target is None or value is None:
-        return None
-    return 100.0 * (value / target - 1.0)
+__all__ = ["PlantSpec", "AnalysisSpec", "PlantResult", "choose_parts", "design_plant", "analyze_plant"]
 
 
 def candidates(series: str, lo: float, hi: float, what: str) -> np.ndarray:
@@ -168,104 +71,117 @@ def gain_resistors(gain: float, spec: PlantSpec):
 
 def gbw_shift(parts: SallenKeyParts, opamp: OpAmp):
     """How far the op-amp's finite GBW moves these parts: (fn_ideal / fn_opamp,
-    zeta_ideal / zeta_opamp). ``--compensate-gbw`` multiplies the targets by it."""
+    zeta_ideal / zeta_opamp). ``compensate_gbw`` multiplies the targets by it."""
     fo, zo = dominant_pair(plant_tf_opamp(parts, opamp)[1])
     return parts.fn_hz / fo, parts.zeta / zo
 
 
-@dataclass
+@dataclass(frozen=True)
 class Choice:
-    """The parts a spec gets: the build, the exact design it rounds, the ranked
-    alternatives, and the targets aimed at (moved off by ``--compensate-gbw``)."""
+    """The parts a spec gets: the build, the exact design it rounds and its
+    ratios, the ranked alternatives (:class:`~designer.plant.selection.Candidate`),
+    notes, and the targets aimed at (moved off by ``compensate_gbw``)."""
 
     built: SallenKeyParts
     ideal: SallenKeyParts | None
-    ratios: dict
+    ratios: Ratios
     ranked: list
     notes: list
-    fc_target_hz: float
-    zeta_target: float
+    fc_target_hz: float | None = None
+    zeta_target: float | None = None
 
 
 def choose_parts(spec: PlantSpec) -> Choice:
-    """The E-series parts for a (validated) spec, without any analysis: what
+    """The E-series parts for a spec, without any analysis: what
     ``design-plant`` builds, and what ``design-pid`` needs of a designed plant."""
-    amp = opamps.get(spec.opamp)
     rv = candidates(spec.r_series, spec.r_min, spec.r_max, "resistor")
     cv = candidates(spec.c_series, spec.c_min, spec.c_max, "capacitor")
     r3, r4, k = gain_resistors(spec.gain, spec)
     notes = realizability_notes(spec.fc_hz, spec.zeta, spec.gain, spec.c_min, spec.c_max)
     if k != spec.gain:
         notes.append(f"gain K = {spec.gain:g} realised as 1 + {r4:g}/{r3:g} = {k:.5g}")
-    top = max(1, spec.alternatives)
+    top = spec.alternatives
 
-    def select(fc_t, z_t):
-        """Ranked E-series candidates, the exact design they round, and its ratios."""
-        if spec.r is not None:
-            # the seed's procedure: R and C fixed, m and n solved, each part rounded jointly
-            m, n = ratios_from_rc(fc_t, z_t, spec.r, spec.c, k)
-            ideal = SallenKeyParts(m * spec.r, spec.r, spec.c, n * spec.c, k, r3, r4)
-            pool_r = np.unique(np.concatenate([around(ideal.r1, rv), around(ideal.r2, rv)]))
-            pool_c = np.unique(np.concatenate([around(ideal.c1, cv), around(ideal.c2, cv)]))
-            return brute_force(fc_t, z_t, pool_r, pool_c, k, top=4 * top), ideal, {"m": m, "n": n}
-        ranked = joint_search(fc_t, z_t, rv, cv, k, top=4 * top)
-        best = ranked[0]
-        # the exact design the parts round: same capacitors, or, when their ratio is
-        # below the unity-gain limit 1/zeta^2, the nearest ratio that has one
-        c2 = best.c2 if k != 1.0 else max(best.c2, best.c1 / z_t ** 2 * (1 + 1e-12))
-        lo, hi = resistors_for_caps(fc_t, z_t, best.c1, c2, k)
-        roots = [float(x) for x in (lo, hi) if not math.isnan(float(x))]
-        if not roots:
-            return ranked, None, {"m": None, "n": None}
-        r1 = min(roots, key=lambda r: abs(math.log(r / best.r1)))
-        r2 = 1.0 / ((2 * math.pi * fc_t) ** 2 * best.c1 * c2 * r1)
-        return ranked, SallenKeyParts(r1, r2, best.c1, c2, k, r3, r4), {"m": r1 / r2, "n": c2 / best.c1}
+    def rank(fc_t, z_t):
+        """Ranked E-series candidates for a target; with R and C fixed (the seed's
+        procedure) also the exact design they round, and its m and n."""
+        if spec.r is None:
+            return joint_search(fc_t, z_t, rv, cv, k, top=4 * top), None, None
+        m, n = ratios_from_rc(fc_t, z_t, spec.r, spec.c, k)
+        ideal = SallenKeyParts(m * spec.r, spec.r, spec.c, n * spec.c, k, r3, r4)
+        # each part rounded jointly around the exact design
+        pool_r = np.unique(np.concatenate([around(ideal.r1, rv), around(ideal.r2, rv)]))
+        pool_c = np.unique(np.concatenate([around(ideal.c1, cv), around(ideal.c2, cv)]))
+        return brute_force(fc_t, z_t, pool_r, pool_c, k, top=4 * top), ideal, Ratios(m, n)
 
     fc_t, z_t = spec.fc_hz, spec.zeta
-    ranked, ideal, ratios = select(fc_t, z_t)
+    ranked, ideal, ratios = rank(fc_t, z_t)
     if spec.compensate_gbw:
         # aim off by the shift the op-amp causes on the parts chosen, and choose again;
         # the shift hardly depends on the parts, so two or three rounds settle it
         for _ in range(4):
             b = ranked[0]
-            sf, sz = gbw_shift(SallenKeyParts(b.r1, b.r2, b.c1, b.c2, k, r3, r4), amp)
+            sf, sz = gbw_shift(SallenKeyParts(b.r1, b.r2, b.c1, b.c2, k, r3, r4), spec.amp)
             new = (spec.fc_hz * sf, spec.zeta * sz)
             if abs(new[0] / fc_t - 1) < 1e-9 and abs(new[1] / z_t - 1) < 1e-9:
                 break
             fc_t, z_t = new
-            ranked, ideal, ratios = select(fc_t, z_t)
+            ranked, ideal, ratios = rank(fc_t, z_t)
+    if spec.r is None:
+        # solved once, for the target finally aimed at
+        ideal, ratios = _exact_design(ranked[0], fc_t, z_t, k, r3, r4)
     ranked = _distinct(ranked, k)[:top]
     best = ranked[0]
     built = SallenKeyParts(best.r1, best.r2, best.c1, best.c2, k, r3, r4)
     if best.worst > MAX_ERROR:
-        raise DesignError(_unreachable(spec, fc_t, best.worst))
+        raise _unreachable(spec, fc_t, best.worst)
     if spec.r is None and best.worst > NOTE_ERROR:
         notes += _bound_notes(spec, fc_t, z_t, k, best.worst)
     return Choice(built, ideal, ratios, ranked, notes, fc_t, z_t)
 
 
+def _exact_design(best, fc_hz: float, zeta: float, k: float, r3, r4):
+    """The exact design a candidate rounds, and its ratios: the candidate's
+    capacitors with the resistors that hit the target exactly (nearest to the
+    candidate's R1), or, at unity gain when their ratio is below 1/zeta^2, the
+    nearest capacitor ratio that has such resistors. (None, empty ratios)
+    when no positive resistors exist."""
+    c2 = best.c2 if k != 1.0 else max(best.c2, unity_gain_c2_min(best.c1, zeta) * (1 + 1e-12))
+    lo, hi = resistors_for_caps(fc_hz, zeta, best.c1, c2, k)
+    roots = [float(x) for x in (lo, hi) if not math.isnan(float(x))]
+    if not roots:
+        return None, Ratios()
+    r1 = min(roots, key=lambda r: abs(math.log(r / best.r1)))
+    r2 = 1.0 / ((2 * math.pi * fc_hz) ** 2 * best.c1 * c2 * r1)
+    return SallenKeyParts(r1, r2, best.c1, c2, k, r3, r4), Ratios(r1 / r2, c2 / best.c1)
+
+
 def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspice") -> PlantResult:
     """Design, analyse and (unless ``simulate`` is False) verify a plant."""
     tick = time.perf_counter()
-    spec.validate()
-    amp = opamps.get(spec.opamp)
+    amp = spec.amp
     choice = choose_parts(spec)
-    built, ideal, ratios, ranked, notes = choice.built, choice.ideal, choice.ratios, choice.ranked, choice.notes
-    fc_t, z_t = choice.fc_target_hz, choice.zeta_target
     t_search = time.perf_counter() - tick
-    result = _analyse(built, ideal, amp, spec.r_series, spec.c_series,
-                      {"fc_hz": spec.fc_hz, "zeta": spec.zeta, "gain": spec.gain},
-                      ratios, notes, spec.amplitude_v, spec.square_hz, simulate, simulator)
-    result.alternatives = [_alt(c, spec.fc_hz, spec.zeta) for c in ranked]
-    result.series["parts"] = {ref: {"series": spec.r_series if ref[0] == "R" else spec.c_series,
-                                    "tolerance_pct": 100 * eseries.TOLERANCE[spec.r_series if ref[0] == "R"
-                                                                             else spec.c_series]}
-                              for ref in ("R1", "R2", "C1", "C2") + (("R3", "R4") if built.r3 is not None else ())}
+    target = Target(spec.fc_hz, spec.zeta, spec.gain)
+    built = choice.built
+    refs = ("R1", "R2", "C1", "C2") + (("R3", "R4") if built.r3 is not None else ())
+
+    def source(ref):
+        series = spec.r_series if ref[0] == "R" else spec.c_series
+        return PartSource(series, 100 * eseries.TOLERANCE[series])
+
+    sourcing = Sourcing(spec.r_series, spec.c_series, {ref: source(ref) for ref in refs})
+    alternatives = [Alternative(c.r1, c.r2, c.c1, c.c2, Figures.against(c.fn_hz, c.zeta, target))
+                    for c in choice.ranked]
+    result = _analyse("design", target, choice, sourcing, alternatives, amp, spec.amplitude_v, spec.square_hz,
+                      simulate, simulator)
     if spec.compensate_gbw:
-        result.notes.append(f"--compensate-gbw: designed for fn {fc_t:.5g} Hz, zeta {z_t:.4g} so that with "
-                            f"the {amp.name}'s {amp.gbw_hz / 1e6:g} MHz GBW it lands on the spec")
+        result.notes.append(f"--compensate-gbw: designed for fn {choice.fc_target_hz:.5g} Hz, zeta "
+                            f"{choice.zeta_target:.4g} so that with the {amp.name}'s {amp.gbw_hz / 1e6:g} MHz GBW "
+                            "it lands on the spec")
     elif not amp.ideal:
-        e_fn, e_z = result.fn_opamp_hz / spec.fc_hz - 1, result.zeta_opamp / spec.zeta - 1
+        fig = result.analytic_opamp.figures
+        e_fn, e_z = fig.fn_hz / spec.fc_hz - 1, fig.zeta / spec.zeta - 1
         if max(abs(e_fn), abs(e_z)) > NOTE_ERROR * 2:
             result.notes.append(
                 f"with the {amp.name}'s {format_eng(amp.gbw_hz, 'Hz')} gain-bandwidth the circuit lands "
@@ -275,34 +191,19 @@ def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspi
     return result
 
 
-def analyze_plant(parts: SallenKeyParts, opamp: str = "LM741", target_fc=None, target_zeta=None,
-                  r_series: str | None = None, c_series: str | None = None, amplitude_v: float = 2.0,
-                  square_hz=None, simulate: bool = True, simulator: str = "pyspice") -> PlantResult:
-    """Analyse parts as built (e.g. the seed's rounded 820/1k/10n/220n).
-
-    ``r_series``/``c_series``: where the parts come from, for their tolerance;
-    None labels each part with the smallest series that holds its value.
-    """
-    parts = check_parts(parts)
-    for name, v, key in (("target fc", target_fc, "fc_hz"), ("target zeta", target_zeta, "zeta")):
-        if v is not None:
-            RANGES[key].check(v, name)
-    RANGES["amplitude_v"].check(amplitude_v, "amplitude")
-    if square_hz is not None:
-        RANGES["square_hz"].check(square_hz, "square-wave frequency")
-    amp = opamps.get(opamp)
-    spec = {"fc_hz": target_fc, "zeta": target_zeta, "gain": parts.gain}
+def analyze_plant(spec: AnalysisSpec, simulate: bool = True, simulator: str = "pyspice") -> PlantResult:
+    """Analyse parts as built (e.g. the seed's rounded 820/1k/10n/220n): what
+    they really give, and (unless ``simulate`` is False) SPICE's verdict."""
+    parts = spec.parts
+    target = Target(spec.target_fc_hz, spec.target_zeta, parts.gain)
     notes = [f"these parts give fn = {parts.fn_hz:.5g} Hz and zeta = {parts.zeta:.4g} (Q = {parts.q:.4g})"]
     values = {"R1": parts.r1, "R2": parts.r2, "C1": parts.c1, "C2": parts.c2}
     if parts.r3 is not None:
         values.update(R3=parts.r3, R4=parts.r4)
-    labels, r_s, c_s, why = part_series(values, r_series, c_series)
-    notes += why
-    res = _analyse(parts, None, amp, r_s, c_s, spec, {"m": parts.r1 / parts.r2, "n": parts.c2 / parts.c1},
-                   notes, amplitude_v, square_hz, simulate, simulator)
-    res.series["parts"] = labels
-    res.mode = "analyze"
-    return res
+    labels, r_s, c_s, why = part_series(values, spec.r_series, spec.c_series)
+    choice = Choice(parts, None, Ratios(parts.r1 / parts.r2, parts.c2 / parts.c1), [], notes + why)
+    return _analyse("analyze", target, choice, Sourcing(r_s, c_s, labels), [], spec.amp, spec.amplitude_v,
+                    spec.square_hz, simulate, simulator)
 
 
 #: what an unlabelled part is assumed to be: a 5 % resistor, a 10 % capacitor
@@ -319,7 +220,7 @@ def part_series(values: dict, r_series=None, c_series=None):
     E12 capacitor: a 1k from a 5 % kit is not a 40 % E3 part, but a 1k26 exists
     only as an E192 (0.5 %) part.
 
-    Returns (labels {ref: {"series", "tolerance_pct"}}, r band series, c band series, notes).
+    Returns (labels {ref: :class:`PartSource`}, r band series, c band series, notes).
     """
     order = list(eseries.SERIES)
     given = {"R": None if r_series is None else eseries.series_name(r_series),
@@ -340,7 +241,7 @@ def part_series(values: dict, r_series=None, c_series=None):
         else:
             series = order[max(order.index(found), order.index(DEFAULT_SERIES[kind]))]
             label = found
-        labels[ref] = {"series": label, "tolerance_pct": 100 * eseries.TOLERANCE[series]}
+        labels[ref] = PartSource(label, 100 * eseries.TOLERANCE[series])
         if band[kind] is None or eseries.TOLERANCE[series] > eseries.TOLERANCE[band[kind]]:
             band[kind] = series
     return labels, band["R"] or DEFAULT_SERIES["R"], band["C"] or DEFAULT_SERIES["C"], notes
@@ -359,7 +260,6 @@ def _bound_notes(spec: PlantSpec, fc: float, zeta: float, gain: float, worst: fl
     least halves the error, the bound is named with the mildest series value
     that gets nearly all of the gain (bisection over the values in between: the
     error only falls as a bound is relaxed)."""
-    from dataclasses import replace as _replace
     out = []
     tries = (("--r-min", "r_min", 0.1, "resistor_ohm", "Ohm", "r_series"),
              ("--r-max", "r_max", 10.0, "resistor_ohm", "Ohm", "r_series"),
@@ -367,9 +267,9 @@ def _bound_notes(spec: PlantSpec, fc: float, zeta: float, gain: float, worst: fl
              ("--c-max", "c_max", 10.0, "capacitor_f", "F", "c_series"))
 
     def best_with(attr, value):
-        s2 = _replace(spec, **{attr: value})
-        rv = eseries.values(s2.r_series, s2.r_min, s2.r_max)
-        cv = eseries.values(s2.c_series, s2.c_min, s2.c_max)
+        b = {k: getattr(spec, k) for k in ("r_min", "r_max", "c_min", "c_max")} | {attr: value}
+        rv = eseries.values(spec.r_series, b["r_min"], b["r_max"])
+        cv = eseries.values(spec.c_series, b["c_min"], b["c_max"])
         return joint_search(fc, zeta, rv, cv, gain, top=1)[0].worst if rv.size and cv.size else math.inf
 
     for flag, attr, factor, key, unit, series in tries:
@@ -396,26 +296,23 @@ def _bound_notes(spec: PlantSpec, fc: float, zeta: float, gain: float, worst: fl
     return out
 
 
-def _unreachable(spec: PlantSpec, fc: float, worst: float) -> str:
+def _unreachable(spec: PlantSpec, fc: float, worst: float) -> ParamError:
     """Why no combination within the bounds comes close, and what to change."""
     head = (f"no {spec.r_series}/{spec.c_series} combination within the bounds comes within "
             f"{100 * MAX_ERROR:g} % of the target (best: {100 * worst:.3g} % off)")
     rc = 1.0 / (2 * math.pi * fc)
+    need = unity_gain_c2_min(1.0, spec.zeta)
     if rc < spec.r_min * spec.c_min:
-        return (f"{head}: fc {fc:.4g} Hz needs R*C near {rc:.3g} s but the bounds allow no less than "
-                f"{spec.r_min * spec.c_min:.3g} s; lower --r-min or --c-min")
-    if rc > spec.r_max * spec.c_max:
-        return (f"{head}: fc {fc:.4g} Hz needs R*C near {rc:.3g} s but the bounds allow no more than "
-                f"{spec.r_max * spec.c_max:.3g} s; raise --r-max or --c-max")
-    if spec.gain == 1.0 and 1 / spec.zeta ** 2 > spec.c_max / spec.c_min:
-        return (f"{head}: unity gain needs C2/C1 >= 1/zeta^2 = {1 / spec.zeta ** 2:.4g}; "
-                f"use --gain K > 1 or widen --c-min/--c-max")
-    return f"{head}; widen the bounds or use a finer series (--r-series/--c-series)"
-
-
-def _alt(c, fc, zeta):
-    return {"R1_ohm": c.r1, "R2_ohm": c.r2, "C1_f": c.c1, "C2_f": c.c2, "fn_hz": c.fn_hz,
-            "zeta": c.zeta, "fn_error_pct": _pct(c.fn_hz, fc), "zeta_error_pct": _pct(c.zeta, zeta)}
+        why = (f": fc {fc:.4g} Hz needs R*C near {rc:.3g} s but the bounds allow no less than "
+               f"{spec.r_min * spec.c_min:.3g} s; lower {{r_min}} or {{c_min}}")
+    elif rc > spec.r_max * spec.c_max:
+        why = (f": fc {fc:.4g} Hz needs R*C near {rc:.3g} s but the bounds allow no more than "
+               f"{spec.r_max * spec.c_max:.3g} s; raise {{r_max}} or {{c_max}}")
+    elif spec.gain == 1.0 and need > spec.c_max / spec.c_min:
+        why = f": unity gain needs C2/C1 >= 1/zeta^2 = {need:.4g}; use {{gain}} K > 1 or widen {{c_min}}/{{c_max}}"
+    else:
+        why = "; widen the bounds or use a finer series ({r_series}/{c_series})"
+    return ParamError(head + why, params=("r_min", "r_max", "c_min", "c_max", "gain", "r_series", "c_series"))
 
 
 def _distinct(ranked, gain):
@@ -429,20 +326,19 @@ def _distinct(ranked, gain):
     return out
 
 
-def _analyse(built, ideal, amp, r_series, c_series, spec, ratios, notes, amplitude_v, square_hz,
-             simulate, simulator) -> PlantResult:
+def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternatives, amp: OpAmp, amplitude_v,
+             square_hz, simulate, simulator) -> PlantResult:
+    """The models, bench test, checks, deck and (when ``simulate``) SPICE run of
+    a chosen build, as one result."""
     tick = time.perf_counter()
+    built = choice.built
     num_i, den_i = plant_tf(built)
     num_o, den_o = plant_tf_opamp(built, amp)
     fn_o, z_o = dominant_pair(den_o)
     span = response_span(min(built.fn_hz, fn_o), min(built.zeta, z_o))
     t = dense_time(span)
-    y_i = step_response(num_i, den_i, t)
-    y_o = step_response(num_o, den_o, t)
-    k_i = float(num_i[-1] / den_i[-1])
-    k_o = float(num_o[-1] / den_o[-1])
-    m_i = step_metrics(t, y_i, final=k_i)
-    m_o = step_metrics(t, y_o, final=k_o)
+    m_i = step_metrics(t, step_response(num_i, den_i, t), final=float(num_i[-1] / den_i[-1]))
+    m_o = step_metrics(t, step_response(num_o, den_o, t), final=float(num_o[-1] / den_o[-1]))
     # the response's fastest time scale (1/wn, or the fast real pole) bounds the simulation step
     time_scale = 1.0 / float(np.max(np.abs(np.roots(den_i))))
     test = recommend_square_wave(m_o.settling_time_s, amplitude_v, square_hz, time_scale_s=time_scale)
@@ -453,58 +349,35 @@ def _analyse(built, ideal, amp, r_series, c_series, spec, ratios, notes, amplitu
     tw = dense_time(min(test.half_period_s, 4 * span))
     y_iw, y_ow = step_response(num_i, den_i, tw), step_response(num_o, den_o, tw)
     checks = signal_checks(tw, y_ow, amplitude_v, amp)
-    if test.half_period_s < m_o.settling_time_s:
-        checks.append({"name": "square-wave period", "ok": False,
-                       "detail": f"half period {test.half_period_s * 1e6:.4g} us is shorter than the 2 % settling "
-                                 f"time {m_o.settling_time_s * 1e6:.4g} us: the scope will not show a settled step"})
-    sens = sensitivities(built)
-    sens_o = sensitivities(built, amp)
-    tol = tolerance_band(built, eseries.TOLERANCE[r_series], eseries.TOLERANCE[c_series], tw[-1])
+    late = period_check(test, m_o.settling_time_s)
+    checks += [late] if late is not None else []
+    analytic = Model(num_i, den_i, Figures.against(built.fn_hz, built.zeta, target), m_i, sensitivities(built),
+                     y_iw * amplitude_v)
+    analytic_opamp = Model(num_o, den_o, Figures.against(fn_o, z_o, target), m_o, sensitivities(built, amp),
+                           y_ow * amplitude_v)
+    tolerance = tolerance_band(built, eseries.TOLERANCE[sourcing.r_series], eseries.TOLERANCE[sourcing.c_series],
+                               tw[-1])
     timings = {"analytic_s": time.perf_counter() - tick}
-    result = PlantResult(
-        spec=spec, ratios=ratios, ideal=ideal, built=built, opamp=amp,
-        series={"r": r_series, "c": c_series, "r_tolerance_pct": 100 * eseries.TOLERANCE[r_series],
-                "c_tolerance_pct": 100 * eseries.TOLERANCE[c_series]},
-        alternatives=[], notes=list(notes), fn_opamp_hz=fn_o, zeta_opamp=z_o,
-        analytic=_metrics_dict(m_i), analytic_opamp=_metrics_dict(m_o), spice=None, comparison={},
-        sensitivity=sens, sensitivity_opamp=sens_o, tolerance=tol, test=test, checks=checks,
-        waveforms={"t": tw, "analytic": y_iw * amplitude_v, "analytic_opamp": y_ow * amplitude_v,
-                   "bode": (num_i, den_i, num_o, den_o)},
-        timings=timings)
     tick = time.perf_counter()
-    result.deck = plant_deck(built, amp, test, _title(built, amp))
-    result.timings["netlist_s"] = time.perf_counter() - tick
+    deck = plant_deck(built, amp, test, _title(built, amp))
+    timings["netlist_s"] = time.perf_counter() - tick
+    notes = list(choice.notes)
+    spice = period = None
     if simulate:
-        run_spice(result, simulator, k_o)
+        tick = time.perf_counter()
+        spice, period = run_spice(deck, test, tw, analytic, analytic_opamp, built.gain, simulator)
+        if not spice.comparison.passed:
+            notes.append("SPICE disagrees with the op-amp-aware model: " + "; ".join(spice.comparison.disagreements))
+        timings["simulation_s"] = time.perf_counter() - tick
     else:
-        result.notes.append("SPICE simulation skipped (--no-sim): the figures are analytic only")
-    return result
-
-
-def bench_waveforms(result, n: int = 4001) -> dict:
-    """The whole simulated bench period (rising and falling edge) on a uniform
-    grid: input, the analytic responses (by superposition of two steps) and,
-    when simulated, SPICE. Keys are the CSV column names."""
-    test = result.test
-    t = np.linspace(0.0, test.stop_s, n)
-    u = np.where((t >= test.delay_s) & (t < test.delay_s + test.half_period_s), test.amplitude_v, 0.0)
-    num_i, den_i, num_o, den_o = result.waveforms["bode"]
-
-    def square(num, den):
-        up = np.clip(t - test.delay_s, 0.0, None)
-        down = np.clip(t - test.delay_s - test.half_period_s, 0.0, None)
-        y = step_response(num, den, up) * (t >= test.delay_s)
-        return test.amplitude_v * (y - step_response(num, den, down) * (t >= test.delay_s + test.half_period_s))
-
-    cols = {"time_s": t, "input_v": u, "analytic_v": square(num_i, den_i),
-            "analytic_opamp_v": square(num_o, den_o)}
-    if "spice_period" in result.waveforms:
-        ts, ys, us = result.waveforms["spice_period"]
-        cols["input_v"] = resample(ts, us, t)
-        cols["output_v"] = resample(ts, ys, t)
-    else:
-        cols["output_v"] = cols["analytic_opamp_v"]
-    return cols
+        notes.append("SPICE simulation skipped (--no-sim): the figures are analytic only")
+    tick = time.perf_counter()
+    bench = bench_period(test, (num_i, den_i), (num_o, den_o), period)
+    timings["analytic_s"] += time.perf_counter() - tick
+    return PlantResult(mode=mode, target=target, ratios=choice.ratios, ideal=choice.ideal, built=built,
+                       sourcing=sourcing, alternatives=alternatives, opamp=amp, analytic=analytic,
+                       analytic_opamp=analytic_opamp, time_s=tw, test=test, tolerance=tolerance, checks=checks,
+                       notes=notes, deck=deck, bench=bench, spice=spice, timings=timings)
 
 
 def _title(parts, amp):
@@ -512,51 +385,30 @@ def _title(parts, amp):
             f"K={parts.gain:.4g} op-amp={amp.name}")
 
 
-def _metrics_dict(m) -> dict:
-    d = m.to_dict()
-    return {"overshoot_pct": d["overshoot_pct"], "peak_time_s": d["peak_time_s"],
-            "rise_time_s": d["rise_time_s"], "settling_time_s": d["settling_time_s"],
-            "settling_time_5pct_s": d["settling_time_5pct_s"], "rise_time_0_100_s": d["rise_time_0_100_s"],
-            "peak_value": d["peak_value"], "final_value": d["final_value"]}
+def run_spice(deck: str, test, t, analytic: Model, analytic_opamp: Model, gain: float, simulator: str):
+    """Simulate the deck and compare SPICE with both analytic models on the
+    grid ``t`` (from the rising edge).
 
-
-def run_spice(result: PlantResult, simulator: str, dc_gain_opamp: float) -> None:
-    """Simulate the deck and compare SPICE with both analytic models."""
-    tick = time.perf_counter()
+    Returns
+    -------
+    (SpiceRun, (time, output, input))
+        The run, and the simulated period as ngspice gave it (for the bench capture).
+    """
     sim = get_simulator(simulator)
-    res = sim.run(result.deck)
-    test = result.test
-    t, y = res["time"], res["v(out)"]
-    tw = result.waveforms["t"]
-    y_s = resample(t, y, tw + test.delay_s)
+    res = sim.run(deck)
+    ts, y = res["time"], res["v(out)"]
+    y_s = resample(ts, y, t + test.delay_s)
     amp_v = test.amplitude_v
-    m_s = step_metrics(tw, y_s / amp_v, final=dc_gain_opamp)
-    spice = _metrics_dict(m_s)
-    abstol = 0.01 * abs(result.built.gain * amp_v)
-    spice["nrms"] = nrms(result.waveforms["analytic_opamp"], y_s, abstol)
-    spice["nrms_ideal"] = nrms(result.waveforms["analytic"], y_s, abstol)
-    spice["measurements"] = res.measurements
-    result.spice = spice
-    result.simulator = sim.name
-    from ..core.metrics import StepMetrics
-    def sm(d):
-        return StepMetrics(**{k: (math.nan if d.get(k) is None else d[k]) for k in StepMetrics.__dataclass_fields__})
-    ref = sm(result.analytic_opamp)
+    m_s = step_metrics(t, y_s / amp_v, final=analytic_opamp.dc_gain)
+    abstol = 0.01 * abs(gain * amp_v)
+    fit, fit_ideal = nrms(analytic_opamp.response, y_s, abstol), nrms(analytic.response, y_s, abstol)
+    ref, fig = analytic_opamp.step, analytic_opamp.figures
     deltas = metric_deltas(ref, m_s)
-    z = min(result.zeta_opamp, 0.999)
-    half_ring = 0.5 / (result.fn_opamp_hz * math.sqrt(1 - z * z)) if result.zeta_opamp < 1 else 0.0
+    z = min(fig.zeta, 0.999)
+    half_ring = 0.5 / (fig.fn_hz * math.sqrt(1 - z * z)) if fig.zeta < 1 else 0.0
     off = disagreements(deltas, ref, half_ring)
-    if spice["nrms"] >= 1.0:
-        off.insert(0, f"waveform NRMS {spice['nrms']:.3g} (allowed below 1)")
-    result.comparison = {
-        "spice_vs_analytic": metric_deltas(sm(result.analytic), m_s),
-        "spice_vs_analytic_opamp": deltas,
-        "nrms_abstol_v": abstol,
-        "pass": not off,
-        "disagreements": off,
-    }
-    if off:
-        result.notes.append("SPICE disagrees with the op-amp-aware model: " + "; ".join(off))
-    result.waveforms["spice"] = y_s
-    result.waveforms["spice_period"] = (t, y, res["input"])
-    result.timings["simulation_s"] = time.perf_counter() - tick
+    if fit >= 1.0:
+        off.insert(0, f"waveform NRMS {fit:.3g} (allowed below 1)")
+    comparison = Comparison(metric_deltas(analytic.step, m_s), deltas, abstol, off)
+    return (SpiceRun(sim.name, m_s, fit, fit_ideal, res.measurements, y_s, comparison),
+            (ts, y, res["input"]))

@@ -7,6 +7,7 @@ Step and frequency responses come from :mod:`designer.core.lti`.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -36,12 +37,29 @@ def plant_tf_opamp(parts: SallenKeyParts, opamp: OpAmp):
     return np.array([1.0 / d[-1]]), d / d[-1]
 
 
-def sensitivities(parts: SallenKeyParts, opamp: OpAmp | None = None, rel_step: float = 1e-6):
+@dataclass(frozen=True)
+class Sensitivity:
+    """How much wn and zeta move, relatively, for a relative change of one part:
+    S = d ln(y) / d ln(x)."""
+
+    wn: float
+    zeta: float
+
+    def to_dict(self) -> dict:
+        return {"wn": self.wn, "zeta": self.zeta}
+
+
+def sensitivities(parts: SallenKeyParts, opamp: OpAmp | None = None, rel_step: float = 1e-6) -> dict:
     """Relative sensitivities S_x^y = d ln y / d ln x of wn and zeta.
 
     x runs over R1, R2, C1, C2, the gain K (when not a follower) and, with an
     op-amp, its GBW and DC gain A0 (through the op-amp-aware model). Central
     differences in log space.
+
+    Returns
+    -------
+    dict
+        ``{"R1": Sensitivity, ...}`` in that order.
     """
     def figures(p, amp):
         if amp is None:
@@ -49,28 +67,22 @@ def sensitivities(parts: SallenKeyParts, opamp: OpAmp | None = None, rel_step: f
         fn, z = dominant_pair(plant_tf_opamp(p, amp)[1])
         return 2 * math.pi * fn, z
 
+    h = rel_step
+    dl = math.log((1 + h) / (1 - h))
+
+    def moved(obj, attr):
+        """S of wn and zeta for ``attr`` of ``obj`` (the parts or the op-amp)."""
+        up, dn = (replace(obj, **{attr: getattr(obj, attr) * f}) for f in (1 + h, 1 - h))
+        if obj is parts:
+            (wu, zu), (wd, zd) = figures(up, opamp), figures(dn, opamp)
+        else:
+            (wu, zu), (wd, zd) = figures(parts, up), figures(parts, dn)
+        return Sensitivity(math.log(wu / wd) / dl, math.log(zu / zd) / dl)
+
     names = {"R1": "r1", "R2": "r2", "C1": "c1", "C2": "c2"}
     if parts.gain != 1.0:
         names["K"] = "gain"
-    h = rel_step
-    table = {}
-    for label, attr in names.items():
-        up = _scaled(parts, attr, 1 + h)
-        dn = _scaled(parts, attr, 1 - h)
-        (wu, zu), (wd, zd) = figures(up, opamp), figures(dn, opamp)
-        dl = math.log((1 + h) / (1 - h))
-        table[label] = {"wn": math.log(wu / wd) / dl, "zeta": math.log(zu / zd) / dl}
+    table = {label: moved(parts, attr) for label, attr in names.items()}
     if opamp is not None and not opamp.ideal:
-        from dataclasses import replace
-        for label, attr in (("GBW", "gbw_hz"), ("A0", "a0")):
-            up = replace(opamp, **{attr: getattr(opamp, attr) * (1 + h)})
-            dn = replace(opamp, **{attr: getattr(opamp, attr) * (1 - h)})
-            (wu, zu), (wd, zd) = figures(parts, up), figures(parts, dn)
-            dl = math.log((1 + h) / (1 - h))
-            table[label] = {"wn": math.log(wu / wd) / dl, "zeta": math.log(zu / zd) / dl}
+        table.update({label: moved(opamp, attr) for label, attr in (("GBW", "gbw_hz"), ("A0", "a0"))})
     return table
-
-
-def _scaled(parts, attr, factor):
-    from dataclasses import replace
-    return replace(parts, **{attr: getattr(parts, attr) * factor})

@@ -1,9 +1,13 @@
-"""The plant's build sheet, terminal summary and files (netlist, report folder)."""
+"""The plant's build sheet, terminal summary and files (netlist, report folder),
+rendered from the typed :class:`~designer.plant.result.PlantResult` as it is:
+nothing here computes a figure of the design."""
 
 from __future__ import annotations
 
 import io
 import time
+
+import numpy as np
 
 from ..core.units import format_eng
 from ..report import document as R
@@ -17,92 +21,88 @@ METRIC_ROWS = (("overshoot_pct", "overshoot Mp", lambda v: "n/a" if v is None el
 
 
 def title_of(result) -> str:
-    s = result.spec
+    s = result.target
     if result.mode == "analyze":
         return f"Sallen-Key plant as built: fn {result.built.fn_hz:.5g} Hz, zeta {result.built.zeta:.4g}"
-    return f"Sallen-Key plant: fc {s['fc_hz']:g} Hz, zeta {s['zeta']:g}, gain {s['gain']:g}"
+    return f"Sallen-Key plant: fc {s.fc_hz:g} Hz, zeta {s.zeta:g}, gain {s.gain:g}"
 
 
 def sections(result, with_images: bool = True) -> list:
-    d = result.to_dict()
     b = result.built
-    ser = result.series
     amp = result.opamp
-    lab = ser["parts"]
+    lab = result.sourcing.parts
     where = {"R1": "input resistor", "R2": "to the non-inverting input", "C1": "non-inverting input to ground",
              "C2": "R1-R2 node to the output (feedback)", "R3": "gain: inverting input to ground",
              "R4": "gain: output to inverting input"}
     bom = [R.part_row(ref, getattr(b, ref.lower()), "Ohm" if ref[0] == "R" else "F", role,
-                      lab[ref]["series"], lab[ref]["tolerance_pct"])
+                      lab[ref].series, lab[ref].tolerance_pct)
            for ref, role in where.items() if ref in lab]
     bom.append(["U1", amp.name, "", "", "", f"op-amp on {amp.vcc:g} V / {amp.vee:g} V"
                 + (" (follower: output to inverting input)" if b.r3 is None else "")])
     out = [("Bill of materials", [R.table(["Ref", "Value", "Code", "Series", "Tolerance", "Where"], bom)]),
            ("Wiring", [R.table(["from", "to", "part"], wiring(b, amp))])]
 
-    s = d["spec"]
-    bl = d["built"]
-    ideal = d["ideal"] or {}
-    rows = [["fn", _f(s["fc_hz"], "Hz"), _f(ideal.get("fn_hz"), "Hz"), _f(bl["fn_hz"], "Hz"),
-             R.fmt_pct(bl["fn_error_pct"]), _f(bl["fn_opamp_hz"], "Hz"), R.fmt_pct(bl["fn_opamp_error_pct"])],
-            ["zeta", _n(s["zeta"]), _n(ideal.get("zeta")), _n(bl["zeta"]), R.fmt_pct(bl["zeta_error_pct"]),
-             _n(bl["zeta_opamp"]), R.fmt_pct(bl["zeta_opamp_error_pct"])],
-            ["Q", _n(None if s["zeta"] is None else 1 / (2 * s["zeta"])), _n(ideal.get("q")), _n(bl["q"]), "",
-             _n(1 / (2 * bl["zeta_opamp"])), ""]]
+    s = result.target
+    ideal = result.ideal
+    fig, opa = result.analytic.figures, result.analytic_opamp.figures
+    rows = [["fn", _f(s.fc_hz, "Hz"), _f(ideal and ideal.fn_hz, "Hz"), _f(b.fn_hz, "Hz"),
+             R.fmt_pct(fig.fn_error_pct), _f(opa.fn_hz, "Hz"), R.fmt_pct(opa.fn_error_pct)],
+            ["zeta", _n(s.zeta), _n(ideal and ideal.zeta), _n(b.zeta), R.fmt_pct(fig.zeta_error_pct),
+             _n(opa.zeta), R.fmt_pct(opa.zeta_error_pct)],
+            ["Q", _n(s.q), _n(ideal and ideal.q), _n(b.q), "", _n(opa.q), ""]]
     blocks = [R.table(["", "target", "exact parts", "built (ideal op-amp)", "error",
                        f"built with {amp.name}", "error"], rows)]
-    if d["ratios"].get("m") is not None:
-        blocks.append(R.text(f"Ratios: m = R1/R2 = {d['ratios']['m']:.4g}, n = C2/C1 = {d['ratios']['n']:.4g}."))
+    if result.ratios.m is not None:
+        blocks.append(R.text(f"Ratios: m = R1/R2 = {result.ratios.m:.4g}, n = C2/C1 = {result.ratios.n:.4g}."))
     out.append(("Target and achieved", blocks))
 
-    ts = d["test_signal"]
-    tol = bl["tolerance_band"]
-    spice = d["spice"] or {}
+    ts = result.test
+    tol = result.tolerance
+    spice = result.spice
+    expected = result.analytic_opamp.step
     rows = []
     for key, label, f in METRIC_ROWS:
-        band = tol.get(key, {})
-        rows.append([label, f(d["analytic_opamp"][key]), f(spice.get(key)) if spice else "not simulated",
-                     f"{f(band.get('min'))} .. {f(band.get('max'))}"])
-    amp_v = ts["high_v"]
-    peak = d["analytic_opamp"]["peak_value"] * amp_v
-    rows.append(["peak output", format_eng(peak, "V"), format_eng((spice.get("peak_value") or 0) * amp_v, "V")
-                 if spice else "", ""])
+        band = getattr(tol, key)
+        rows.append([label, f(_value(expected, key)), f(_value(spice.step, key)) if spice else "not simulated",
+                     f"{f(band.lo)} .. {f(band.hi)}"])
+    amp_v = ts.amplitude_v
+    rows.append(["peak output", format_eng(expected.peak_value * amp_v, "V"),
+                 format_eng(spice.step.peak_value * amp_v, "V") if spice else "", ""])
     out.append(("Bench test", [
-        R.text(f"Function generator: square wave {format_eng(ts['frequency_hz'], 'Hz')}, "
-               f"{format_eng(ts['amplitude_vpp'], 'V')} peak-to-peak with {format_eng(ts['offset_v'], 'V')} "
-               f"offset (0 V to {format_eng(ts['high_v'], 'V')}), into R1. Scope channel 1 on the input, "
+        R.text(f"Function generator: square wave {format_eng(ts.frequency_hz, 'Hz')}, "
+               f"{format_eng(amp_v, 'V')} peak-to-peak with {format_eng(amp_v / 2, 'V')} "
+               f"offset (0 V to {format_eng(amp_v, 'V')}), into R1. Scope channel 1 on the input, "
                f"channel 2 on the op-amp output; trigger on the rising edge, "
-               f"{format_eng(ts['frequency_hz'] and 0.5 / ts['frequency_hz'] / 10, 's')}/div."),
+               f"{format_eng(ts.half_period_s / 10, 's')}/div."),
         R.table(["reading (rising edge)", f"expected ({amp.name} model)", "SPICE",
-                 f"band from tolerances (R {tol['r_tolerance_pct']:g} %, C {tol['c_tolerance_pct']:g} %)"], rows)]))
+                 f"band from tolerances (R {tol.r_tolerance_pct:g} %, C {tol.c_tolerance_pct:g} %)"], rows)]))
 
     out.append(("Checks", [R.table(["check", "result", "detail"],
-                                   [[c["name"], "ok" if c["ok"] else "FAILED", c["detail"]] for c in d["checks"]])]))
+                                   [[c.title, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]))
 
-    sens = d["sensitivity"]
-    rows = [[k, f"{v['wn']:+.3f}", f"{v['zeta']:+.3f}",
-             f"{sens['opamp'][k]['wn']:+.3f}" if k in sens["opamp"] else "",
-             f"{sens['opamp'][k]['zeta']:+.3f}" if k in sens["opamp"] else ""]
-            for k, v in sens["ideal"].items()]
-    rows += [[k, "", "", f"{v['wn']:+.4f}", f"{v['zeta']:+.4f}"]
-             for k, v in sens["opamp"].items() if k not in sens["ideal"]]
+    sens, sens_o = result.analytic.sensitivity, result.analytic_opamp.sensitivity
+    rows = [[k, f"{v.wn:+.3f}", f"{v.zeta:+.3f}",
+             f"{sens_o[k].wn:+.3f}" if k in sens_o else "", f"{sens_o[k].zeta:+.3f}" if k in sens_o else ""]
+            for k, v in sens.items()]
+    rows += [[k, "", "", f"{v.wn:+.4f}", f"{v.zeta:+.4f}"] for k, v in sens_o.items() if k not in sens]
     out.append(("Sensitivity", [
         R.text("Relative sensitivity S = d ln(y) / d ln(x): a 1 % change in the part changes y by S %."),
         R.table(["part", "S(wn)", "S(zeta)", f"S(wn) with {amp.name}", f"S(zeta) with {amp.name}"], rows)]))
 
-    if d["alternatives"]:
-        rows = [[i + 1, " / ".join(format_eng(a[k], u, 3) for k, u in (("R1_ohm", "Ohm"), ("R2_ohm", "Ohm"),
-                                                                  ("C1_f", "F"), ("C2_f", "F"))),
-                 _f(a["fn_hz"], "Hz"), _n(a["zeta"]), R.fmt_pct(a["fn_error_pct"]), R.fmt_pct(a["zeta_error_pct"])]
-                for i, a in enumerate(d["alternatives"])]
+    if result.alternatives:
+        rows = [[i + 1, " / ".join(format_eng(v, u, 3) for v, u in ((a.r1, "Ohm"), (a.r2, "Ohm"), (a.c1, "F"),
+                                                                    (a.c2, "F"))),
+                 _f(a.figures.fn_hz, "Hz"), _n(a.figures.zeta), R.fmt_pct(a.figures.fn_error_pct),
+                 R.fmt_pct(a.figures.zeta_error_pct)]
+                for i, a in enumerate(result.alternatives)]
         out.append(("Alternatives (best first)", [R.table(["#", "R1 / R2 / C1 / C2", "fn", "zeta", "fn error",
                                                           "zeta error"], rows)]))
 
     if spice:
-        cmp_ = d["comparison"]
+        cmp_ = spice.comparison
         rows = []
         for key, label, f in METRIC_ROWS:
-            a, o = cmp_["spice_vs_analytic"][key], cmp_["spice_vs_analytic_opamp"][key]
+            a, o = cmp_.vs_ideal[key], cmp_.vs_opamp[key]
             unit = " pp" if key == "overshoot_pct" else ""
             def dd(x):
                 if x["delta"] is None:
@@ -110,16 +110,16 @@ def sections(result, with_images: bool = True) -> list:
                 return (f"{x['delta']:+.3g}{unit}" if key == "overshoot_pct"
                         else f"{format_eng(x['delta'], 's', 3)} ({R.fmt_pct(x['delta_pct'])})")
             rows.append([label, dd(a), dd(o)])
-        rows.append(["normalised RMS waveform error", f"{spice['nrms_ideal']:.3g}", f"{spice['nrms']:.3g}"])
+        rows.append(["normalised RMS waveform error", f"{spice.nrms_ideal:.3g}", f"{spice.nrms:.3g}"])
         out.append(("SPICE against the analytic models", [
-            R.text(f"ngspice ({d['simulator']} backend), {amp.name} behavioural model. Deltas are SPICE minus model; "
-                   f"NRMS = RMS of (model - SPICE) / (1 % of |model| + {format_eng(cmp_['nrms_abstol_v'], 'V')}). "
-                   "SPICE agrees with the op-amp-aware model when NRMS is below 1 and overshoot is within 1 pp, "
+            R.text(f"ngspice ({spice.simulator} backend), {amp.name} behavioural model. Deltas are SPICE minus "
+                   f"model; NRMS = RMS of (model - SPICE) / (1 % of |model| + {format_eng(cmp_.nrms_abstol_v, 'V')})"
+                   ". SPICE agrees with the op-amp-aware model when NRMS is below 1 and overshoot is within 1 pp, "
                    "peak and rise time within 2 %, settling time within 5 % (or half a ringing period): "
-                   + ("it does." if cmp_["pass"] else "it does NOT (" + "; ".join(cmp_["disagreements"]) + ").")),
+                   + ("it does." if cmp_.passed else "it does NOT (" + "; ".join(cmp_.disagreements) + ").")),
             R.table(["metric", "vs ideal model", f"vs {amp.name}-aware model"], rows)]))
-    if d["notes"]:
-        out.append(("Notes", [R.text(n) for n in d["notes"]]))
+    if result.notes:
+        out.append(("Notes", [R.text(n) for n in result.notes]))
     if with_images:
         out.append(("Plots", [R.image("step.png", "step response: analytic and SPICE"),
                               R.image("bode.png", "Bode plot")]))
@@ -152,6 +152,12 @@ def _f(v, unit):
     return "" if v is None else format_eng(v, unit, 5)
 
 
+def _value(metrics, key):
+    """A step metric for the sheet: None where the response has none (nan)."""
+    v = getattr(metrics, key)
+    return None if v != v else v
+
+
 def _n(v):
     return "" if v is None else f"{v:.4g}"
 
@@ -162,28 +168,24 @@ def summary_text(result) -> str:
 
 
 def plots(result) -> dict:
-    w = result.waveforms
+    ideal, real = result.analytic, result.analytic_opamp
     amp = result.opamp.name
-    curves = {"analytic (ideal op-amp)": w["analytic"], f"analytic ({amp} model)": w["analytic_opamp"]}
-    if "spice" in w:
-        curves["SPICE (ngspice)"] = w["spice"]
-    num_i, den_i, num_o, den_o = w["bode"]
+    curves = {"analytic (ideal op-amp)": ideal.response, f"analytic ({amp} model)": real.response}
+    if result.spice is not None:
+        curves["SPICE (ngspice)"] = result.spice.response
     fn = result.built.fn_hz
-    return {"step.png": step_plot(w["t"], curves, f"Step response, 0 -> {result.test.amplitude_v:g} V"),
-            "bode.png": bode_plot({"ideal op-amp": (num_i, den_i), f"{amp} model": (num_o, den_o)},
-                                    fn / 100, fn * 100, "Plant frequency response")}
+    return {"step.png": step_plot(result.time_s, curves, f"Step response, 0 -> {result.test.amplitude_v:g} V"),
+            "bode.png": bode_plot({"ideal op-amp": (ideal.num, ideal.den), f"{amp} model": (real.num, real.den)},
+                                  fn / 100, fn * 100, "Plant frequency response")}
 
 
 def waveforms_csv(result) -> str:
     """The bench period as CSV (``time_s,input_v,output_v,...``; output is SPICE when
     simulated), the format ``identify`` reads: the tool's own scope capture."""
-    from .design import bench_waveforms
-    cols = bench_waveforms(result)
-    order = ["time_s", "input_v", "output_v", "analytic_v", "analytic_opamp_v"]
-    import numpy as np
-    data = np.column_stack([cols[k] for k in order])
+    cols = result.bench.columns()
     buf = io.StringIO()
-    np.savetxt(buf, data, delimiter=",", header=",".join(order), comments="", fmt="%.9g")
+    np.savetxt(buf, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols), comments="",
+               fmt="%.9g")
     return buf.getvalue()
 
 

@@ -8,6 +8,10 @@ voltage follower.
     Vs/Ve = K / (a s^2 + b s + 1),  a = R1 R2 C1 C2,
     b = C1 (R1 + R2) + R1 C2 (1 - K)
     wn = 1/sqrt(a),  zeta = b / (2 sqrt(a)),  Q = 1 / (2 zeta)
+
+These formulas live in :func:`coefficients` and :func:`fn_zeta` only (the
+parts' properties and the vectorised search use them). At unity gain zeta can
+only be reached with C2/C1 >= 1/zeta^2 (:func:`unity_gain_c2_min`).
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.errors import DesignError
+from ..core.ranges import RANGES, parse_in_range
 
 
 @dataclass(frozen=True)
@@ -34,11 +39,11 @@ class SallenKeyParts:
 
     @property
     def a(self) -> float:
-        return self.r1 * self.r2 * self.c1 * self.c2
+        return coefficients(self.r1, self.r2, self.c1, self.c2, self.gain)[0]
 
     @property
     def b(self) -> float:
-        return self.c1 * (self.r1 + self.r2) + self.r1 * self.c2 * (1.0 - self.gain)
+        return coefficients(self.r1, self.r2, self.c1, self.c2, self.gain)[1]
 
     @property
     def wn(self) -> float:
@@ -46,11 +51,11 @@ class SallenKeyParts:
 
     @property
     def fn_hz(self) -> float:
-        return self.wn / (2 * math.pi)
+        return float(fn_zeta(self.r1, self.r2, self.c1, self.c2, self.gain)[0])
 
     @property
     def zeta(self) -> float:
-        return self.b / (2 * math.sqrt(self.a))
+        return float(fn_zeta(self.r1, self.r2, self.c1, self.c2, self.gain)[1])
 
     @property
     def q(self) -> float:
@@ -64,22 +69,23 @@ class SallenKeyParts:
         return d
 
 
+def coefficients(r1, r2, c1, c2, gain=1.0):
+    """a and b of K / (a s^2 + b s + 1), for numbers or arrays of them."""
+    return r1 * r2 * c1 * c2, c1 * (r1 + r2) + r1 * c2 * (1.0 - gain)
+
+
 def fn_zeta(r1, r2, c1, c2, gain=1.0):
-    """Vectorised natural frequency (Hz) and damping of the Sallen-Key low-pass."""
-    a = r1 * r2 * c1 * c2
-    b = c1 * (r1 + r2) + r1 * c2 * (1.0 - gain)
+    """Natural frequency (Hz) and damping of the Sallen-Key low-pass, for numbers
+    or arrays of them (the joint search evaluates millions at once)."""
+    a, b = coefficients(r1, r2, c1, c2, gain)
     sa = np.sqrt(a)
-    return 1.0 / (2 * np.pi * sa), b / (2 * sa)
+    return (1.0 / sa) / (2 * np.pi), b / (2 * sa)
 
 
-def check_spec(fc_hz: float, zeta: float, gain: float = 1.0) -> None:
-    """Raise :class:`DesignError` for a spec no Sallen-Key low-pass can meet."""
-    if not (math.isfinite(fc_hz) and fc_hz > 0):
-        raise DesignError(f"fc must be a finite frequency above 0 Hz, got {fc_hz!r}")
-    if not (math.isfinite(zeta) and zeta > 0):
-        raise DesignError(f"zeta must be a finite damping ratio above 0, got {zeta!r}")
-    if not (math.isfinite(gain) and gain >= 1):
-        raise DesignError(f"gain K must be >= 1 (K = 1 + R4/R3), got {gain!r}")
+def unity_gain_c2_min(c1, zeta: float):
+    """The smallest C2 with which a unity-gain Sallen-Key reaches ``zeta`` with C1:
+    C2/C1 >= 1/zeta^2 (seed 001's realizability condition, n >= 1/zeta^2)."""
+    return c1 / zeta ** 2
 
 
 def ratios_from_rc(fc_hz: float, zeta: float, r: float, c: float, gain: float = 1.0):
@@ -98,7 +104,6 @@ def ratios_from_rc(fc_hz: float, zeta: float, r: float, c: float, gain: float = 
         When m <= 0, i.e. R C is too large for this fc and zeta; the message
         says how small R C must be.
     """
-    check_spec(fc_hz, zeta, gain)
     wn = 2 * math.pi * fc_hz
     p = 1.0 / (wn * r * c) ** 2
     m = 2 * zeta * math.sqrt(p) - 1.0 + p * (gain - 1.0)
@@ -147,7 +152,7 @@ def realizability_notes(fc_hz: float, zeta: float, gain: float, c_lo: float, c_h
     """Plain-language warnings about a spec, with a suggested fix."""
     notes = []
     if gain == 1.0:
-        need = 1.0 / zeta ** 2
+        need = unity_gain_c2_min(1.0, zeta)
         if need > c_hi / c_lo:
             k = 1.0 + 1.0 / (2 * zeta) if zeta < 0.5 else 2.0
             notes.append(
@@ -171,12 +176,12 @@ _PART_NAMES = {"r1": "R1", "r2": "R2", "c1": "C1", "c2": "C2", "r3": "R3", "r4":
                "plant": "the plant"}
 
 
-def check_parts(parts: SallenKeyParts, name_of=None) -> SallenKeyParts:
+def check_parts(parts: SallenKeyParts, name_of=None, text: bool = False) -> SallenKeyParts:
     """The one validation of a Sallen-Key plant as built, however it arrives
     (designed, typed as parts, or read from a JSON file).
 
     Checks, in this order: every part value is a real number inside its
-    physical range (``designer.ranges``: ``resistor_ohm``, ``capacitor_f``,
+    physical range (``designer.core.ranges``: ``resistor_ohm``, ``capacitor_f``,
     ``gain``); R3 and R4 come together; a stated gain agrees with its
     resistors, K = 1 + R4/R3 (seed 001, Fig. 43), within
     :data:`GAIN_TOLERANCE`; and the circuit is a stable plant whose fn and
@@ -192,7 +197,12 @@ def check_parts(parts: SallenKeyParts, name_of=None) -> SallenKeyParts:
     name_of : mapping or callable, optional
         What to call each field in messages: keys ``r1, r2, c1, c2, r3, r4,
         gain`` and ``plant`` (the whole circuit), e.g. ``{"r1": "--plant-r1"}``;
-        missing keys default to ``R1``... ``gain K``, ``the plant``.
+        missing keys default to ``R1``... ``gain K``, ``the plant``. Names
+        may be ``{name}`` markers of a
+        :class:`~designer.core.ranges.ParamError` (the caller raises it).
+    text : bool
+        Also accept values as text in engineering notation (``"4k7"``), as a
+        user typed them; a file's values must be numbers.
 
     Returns
     -------
@@ -206,18 +216,15 @@ def check_parts(parts: SallenKeyParts, name_of=None) -> SallenKeyParts:
     DesignError
         One line naming the offending field and what is allowed.
     """
-    from ..core.ranges import RANGES
-
     def name(key):
         if callable(name_of):
             return name_of(key)
         return (name_of or {}).get(key, _PART_NAMES[key])
 
     def number(key, value, range_key):
-        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-            shown = repr(value) if isinstance(value, str) and len(value) <= 40 else type(value).__name__
-            raise DesignError(f"{name(key)} must be a number, got {shown}")
-        return RANGES[range_key].check(float(value), name(key))
+        if text:
+            return parse_in_range(value, name(key), range_key)
+        return RANGES[range_key].check(value, name(key))
 
     r1, r2 = (number(k, getattr(parts, k), "resistor_ohm") for k in ("r1", "r2"))
     c1, c2 = (number(k, getattr(parts, k), "capacitor_f") for k in ("c1", "c2"))

@@ -13,6 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..core.opamps import OpAmp
+from ..core.ranges import ParamError
+from ..core.units import format_eng
 from .library import library_text
 
 #: the simulation's maximum step is at most this fraction of the response's time scale
@@ -64,16 +66,21 @@ class SquareTest:
         return self.stop_s / self.max_step_s(points)
 
     def check_simulable(self, points: int = 20000) -> None:
-        """Refuse a period too long to simulate at the response's resolution."""
+        """Refuse a period too long to simulate at the response's resolution
+        (naming the parameters ``square_hz`` and ``simulate=False``)."""
         n = self.simulation_points(points)
         if n > MAX_SIM_POINTS:
-            from ..core.errors import DesignError
-            from ..core.units import format_eng
             f_min = self.frequency_hz * n / MAX_SIM_POINTS
-            raise DesignError(
+            raise ParamError(
                 f"square wave {format_eng(self.frequency_hz, 'Hz')} is too slow to simulate: its period is "
                 f"{n:.3g} time steps of the response ({format_eng(self.max_step_s(points), 's')}), more than "
-                f"{MAX_SIM_POINTS:.0e}; use --square-freq of at least {format_eng(f_min, 'Hz', 3)}, or --no-sim")
+                f"{MAX_SIM_POINTS:.0e}; use {{square_hz}} of at least {format_eng(f_min, 'Hz', 3)}, or {{no_sim}}",
+                params=("square_hz", "no_sim"))
+
+    def to_dict(self) -> dict:
+        """The function generator's settings, as every result's JSON gives them."""
+        return {"kind": "square", "low_v": 0.0, "high_v": self.amplitude_v, "frequency_hz": self.frequency_hz,
+                "offset_v": self.amplitude_v / 2, "amplitude_vpp": self.amplitude_v}
 
     def source(self) -> str:
         """SPICE PULSE source text."""

@@ -1,7 +1,9 @@
+import numpy as np
 import pytest
 
 from designer.core import eseries
 from designer.core.errors import DesignError
+from designer.core.ranges import ParamError
 
 
 def test_series_sizes_and_ordering():
@@ -44,12 +46,19 @@ def test_unknown_series_is_a_clear_error():
     assert eseries.series_name("e96") == "E96"
 
 
-def test_check_bounds_names_the_option():
+def test_part_bounds_are_checked_once_and_name_the_parameter():
+    b = eseries.PartBounds(r_series="e24", c_series="12", r_min="1k", c_max=np.float64(1e-5))
+    assert (b.r_series, b.c_series, b.r_min, b.c_max) == ("E24", "E12", 1e3, 1e-5)
+    assert type(b.c_max) is float
     assert eseries.check_bounds("e24", "12", 1e3, 1e6, 1e-9, 1e-5) == ("E24", "E12")
-    with pytest.raises(DesignError, match="--r-min .* is above --r-max"):
-        eseries.check_bounds("E24", "E12", 1e6, 1e3, 1e-9, 1e-5)
-    with pytest.raises(DesignError, match="--c-max must be a positive"):
-        eseries.check_bounds("E24", "E12", 1e3, 1e6, 1e-9, float("inf"))
+    with pytest.raises(ParamError) as e:
+        eseries.PartBounds(r_min=1e6, r_max=1e3)
+    assert str(e.value) == "r_min (1e+06 Ohm) is above r_max (1000 Ohm)" and e.value.param == "r_min"
+    assert e.value.naming({"r_min": "--r-min", "r_max": "--r-max"}).startswith("--r-min (1e+06 Ohm) is above --r-max")
+    with pytest.raises(DesignError, match="^c_max must be 100 fF to 1 F, got inf"):
+        eseries.PartBounds(c_max=float("inf"))
+    with pytest.raises(DesignError, match="^r_min: 'x' is not a number"):
+        eseries.PartBounds(r_min="x")
 
 
 def test_smallest_series_holds_the_value_and_is_the_coarsest():

@@ -48,11 +48,11 @@ def test_sensitivities_match_closed_form():
     s = sensitivities(SEED)
     r1, r2 = SEED.r1, SEED.r2
     for part in ("R1", "R2", "C1", "C2"):
-        assert s[part]["wn"] == pytest.approx(-0.5, abs=1e-6)
+        assert s[part].wn == pytest.approx(-0.5, abs=1e-6)
     # zeta = (R1 + R2) sqrt(C1/C2) / (2 sqrt(R1 R2)) at K = 1
-    assert s["R1"]["zeta"] == pytest.approx(r1 / (r1 + r2) - 0.5, abs=1e-6)
-    assert s["C1"]["zeta"] == pytest.approx(0.5, abs=1e-6)
-    assert s["C2"]["zeta"] == pytest.approx(-0.5, abs=1e-6)
+    assert s["R1"].zeta == pytest.approx(r1 / (r1 + r2) - 0.5, abs=1e-6)
+    assert s["C1"].zeta == pytest.approx(0.5, abs=1e-6)
+    assert s["C2"].zeta == pytest.approx(-0.5, abs=1e-6)
 
 
 def test_step_response_closed_form():

@@ -5,7 +5,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from designer.core.errors import DesignError
-from designer.core.units import format_eng, parse_positive, parse_value, value_code
+from designer.core.ranges import parse_in_range
+from designer.core.units import format_eng, parse_value, value_code
 
 
 @pytest.mark.parametrize("text,expected", [
@@ -23,10 +24,10 @@ def test_parse_rejects_non_numbers(text):
         parse_value(text, "--fc")
 
 
-def test_parse_positive_rejects_zero_and_negative():
-    for text in ("0", "-1k"):
-        with pytest.raises(DesignError, match="greater than 0"):
-            parse_positive(text, "--fc")
+def test_parse_errors_name_the_parameter():
+    with pytest.raises(DesignError) as e:
+        parse_value("abc", "fc_hz")
+    assert e.value.param == "fc_hz" and str(e.value).startswith("fc_hz: 'abc' is not a number")
 
 
 @pytest.mark.parametrize("value,code", [(4700, "4k7"), (820, "820"), (10e-9, "10n"), (2.2e-6, "2u2"),
@@ -58,7 +59,7 @@ def test_parse_units_and_spice_prefixes(text, expected):
 
 
 def test_femto_bound_is_not_farads():
-    assert parse_positive("100f", "--c-min") == pytest.approx(1e-13)
+    assert parse_in_range("100f", "c_min", "capacitor_f") == pytest.approx(1e-13)
 
 
 @given(st.integers(1000, 9999), st.integers(-18, 12), st.sampled_from(["Ohm", "F", "Hz", "s", "V", ""]),

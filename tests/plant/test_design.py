@@ -7,7 +7,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from designer.core.errors import DesignError
-from designer.plant.design import MAX_ERROR, PlantSpec, analyze_plant, design_plant
+from designer.plant.design import MAX_ERROR, analyze_plant, design_plant
+from designer.plant.spec import AnalysisSpec, PlantSpec
 from designer.plant.sallenkey import SallenKeyParts
 
 REFERENCE = ROOT / "reports" / "plant_fc3500_z0.2" / "result.json"
@@ -49,7 +50,8 @@ def test_seed_procedure_mode():
 
 
 def test_analyze_seed_parts_says_what_they_give():
-    r = analyze_plant(SallenKeyParts(820, 1e3, 10e-9, 220e-9), target_fc=3500, target_zeta=0.2, simulate=False)
+    r = analyze_plant(AnalysisSpec(SallenKeyParts(820, 1e3, 10e-9, 220e-9), target_fc_hz=3500, target_zeta=0.2),
+                      simulate=False)
     d = r.to_dict()
     assert d["built"]["fn_hz"] == pytest.approx(3747, abs=1)
     assert d["built"]["zeta"] == pytest.approx(0.214, abs=5e-4)
@@ -76,21 +78,58 @@ def test_overdamped_and_gain_designs():
 
 
 def test_out_of_reach_targets_say_what_to_change():
-    with pytest.raises(DesignError, match="lower --r-min or --c-min"):
+    with pytest.raises(DesignError, match="lower r_min or c_min"):
         design_plant(PlantSpec(1e6, 0.5), simulate=False)
-    with pytest.raises(DesignError, match="raise --r-max or --c-max"):
+    with pytest.raises(DesignError, match="raise r_max or c_max") as e:
         design_plant(PlantSpec(0.01, 0.5), simulate=False)
+    # the command line reads the same parameters as its options
+    assert e.value.naming({"r_max": "--r-max", "c_max": "--c-max"}).endswith("raise --r-max or --c-max")
 
 
 def test_impossible_bounds():
     with pytest.raises(DesignError, match="no E24 resistor value"):
         design_plant(PlantSpec(3500, 0.2, r_min=1.01e3, r_max=1.05e3), simulate=False)
-    with pytest.raises(DesignError, match="above"):
-        design_plant(PlantSpec(3500, 0.2, c_min=1e-6, c_max=1e-9), simulate=False)
-    with pytest.raises(DesignError, match="zeta"):
-        design_plant(PlantSpec(3500, -0.2), simulate=False)
-    with pytest.raises(DesignError, match="fc"):
-        design_plant(PlantSpec(math.nan, 0.2), simulate=False)
+    with pytest.raises(DesignError, match="^c_min .* is above c_max"):
+        PlantSpec(3500, 0.2, c_min=1e-6, c_max=1e-9)
+    with pytest.raises(DesignError, match="^zeta must be"):
+        PlantSpec(3500, -0.2)
+    with pytest.raises(DesignError, match="^fc_hz must be"):
+        PlantSpec(math.nan, 0.2)
+
+
+def test_a_spec_is_valid_once_built_and_names_the_parameter():
+    """Validated once, on construction: text in engineering notation parsed, series
+    normalised; a refusal starts with the parameter (the CLI shows its option)."""
+    s = PlantSpec("3.5k", "0.2", r_series="e24", r_min="1k", opamp="lm741", alternatives="3")
+    assert (s.fc_hz, s.zeta, s.r_series, s.r_min, s.opamp, s.alternatives) == (3500.0, 0.2, "E24", 1e3, "LM741", 3)
+    with pytest.raises(DesignError) as e:
+        PlantSpec("1e-300", 0.2)
+    assert str(e.value) == "fc_hz must be 10 mHz to 10 MHz, got '1e-300'" and e.value.param == "fc_hz"
+    with pytest.raises(DesignError) as e:
+        PlantSpec(3500, 0.2, r=1e3)
+    assert str(e.value).startswith("r and c go together")
+    assert e.value.naming({"r": "--r", "c": "--c"}).startswith("--r and --c go together")
+    for bad in (0, 51, 2.5, "x"):
+        with pytest.raises(DesignError, match="^alternatives must be a whole number from 1 to 50"):
+            PlantSpec(3500, 0.2, alternatives=bad)
+    with pytest.raises(DesignError, match="unknown op-amp"):
+        PlantSpec(3500, 0.2, opamp="uA709")
+    with pytest.raises(Exception):
+        s.fc_hz = 1.0   # frozen: a spec stays valid
+
+
+def test_an_analysis_spec_checks_the_parts_once():
+    s = AnalysisSpec(SallenKeyParts("10k", "10k", "10n", "10n", "2.5"), target_fc_hz="1k", r_series="e96")
+    assert (s.parts.r3, s.parts.r4, s.target_fc_hz, s.r_series) == (10e3, 15e3, 1e3, "E96")
+    with pytest.raises(DesignError) as e:
+        AnalysisSpec(SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, None, 10e3))
+    assert str(e.value).startswith("r3 and r4 go together")
+    assert e.value.naming({"r3": "--r3", "r4": "--r4"}).startswith("--r3 and --r4 go together")
+    with pytest.raises(DesignError) as e:
+        AnalysisSpec(SallenKeyParts("1e300", 1e3, 10e-9, 220e-9))
+    assert str(e.value) == "r1 must be 100 mOhm to 1 GOhm, got '1e300'" and e.value.param == "r1"
+    with pytest.raises(DesignError, match="^target_zeta must be"):
+        AnalysisSpec(SallenKeyParts(820, 1e3, 10e-9, 220e-9), target_zeta=99)
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -101,7 +140,7 @@ def test_designs_hit_targets_within_reported_error_or_say_why(fc, zeta):
     except DesignError as exc:
         # a realizability message that says what to change
         assert "within the bounds" in str(exc)
-        assert any(w in str(exc) for w in ("--r-min", "--r-max", "--gain", "widen"))
+        assert any(w in str(exc) for w in ("r_min", "r_max", "gain", "widen"))
         return
     d = r.to_dict()
     b = r.built
@@ -202,7 +241,7 @@ def test_a_part_bound_holding_the_design_back_is_named():
 def test_gbw_shift_points_to_compensate_gbw():
     """Regression (issue 7.16): an LM741 design landing several % low said nothing of --compensate-gbw."""
     r = design_plant(PlantSpec(46.4e3, 0.7), simulate=False)
-    assert abs(r.fn_opamp_hz / 46.4e3 - 1) > 0.01
+    assert abs(r.analytic_opamp.figures.fn_hz / 46.4e3 - 1) > 0.01
     assert any("--compensate-gbw" in n for n in r.notes)
     c = design_plant(PlantSpec(46.4e3, 0.7, compensate_gbw=True), simulate=False)
     assert not any("aims the design off" in n for n in c.notes)
@@ -212,10 +251,10 @@ def test_gbw_shift_points_to_compensate_gbw():
 def test_analyzed_parts_carry_the_series_that_holds_them(value, label):
     """Regression (issue 7.16): analyze-plant labelled 1k26 "E24, 5 %"."""
     from designer.core import eseries
-    r = analyze_plant(SallenKeyParts(value, 1e3, 10e-9, 220e-9), simulate=False)
-    lab = r.series["parts"]["R1"]
-    assert lab["series"] == label
+    r = analyze_plant(AnalysisSpec(SallenKeyParts(value, 1e3, 10e-9, 220e-9)), simulate=False)
+    lab = r.sourcing.parts["R1"]
+    assert lab.series == label
     held = eseries.smallest_series(value)
     assert held == (None if label.startswith("not") else label)
     if held == "E192":
-        assert lab["tolerance_pct"] == 100 * eseries.TOLERANCE["E192"]
+        assert lab.tolerance_pct == 100 * eseries.TOLERANCE["E192"]
