@@ -7,7 +7,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from designer.core.errors import DesignError
-from designer.core.ranges import RANGES, Range, parse_in_range
+from designer.core.ranges import RANGES, ParamError, Range, parse_in_range
 
 README = ROOT / "README.md"
 
@@ -42,3 +42,25 @@ def test_bounds_themselves_are_inside_whatever_their_sign():
     r = RANGES["capture_time_s"]
     assert r.lo < 0 and r.contains(r.lo) and r.contains(r.hi)
     assert not r.contains(r.lo * (1 + 1e-9))
+
+
+def test_values_of_the_wrong_type_are_refused_in_one_line():
+    for value, shown in (("3500", "'3500'"), (True, "bool"), ([1.0], "list"), (None, "NoneType")):
+        with pytest.raises(DesignError) as e:
+            RANGES["fc_hz"].check(value, "fc_hz")
+        assert str(e.value) == f"fc_hz must be a number, got {shown}" and e.value.param == "fc_hz"
+    # text is what parse_in_range takes; a refusal quotes it as typed
+    assert parse_in_range("3.5k", "fc_hz", "fc_hz") == 3500.0
+    with pytest.raises(DesignError) as e:
+        parse_in_range("abc", "fc_hz", "fc_hz")
+    assert e.value.param == "fc_hz"
+
+
+def test_a_message_about_several_parameters_reads_in_either_naming():
+    e = ParamError("{r} and {c} go together; see {file}.json", params=("r", "c"))
+    assert str(e) == "r and c go together; see {file}.json" and e.param == "r"
+    assert e.naming({"r": "--r", "c": "--c"}) == "--r and --c go together; see {file}.json"
+    # a marker the library spells differently, e.g. a keyword argument
+    e = ParamError("use {square_hz} above 1 Hz, or {no_sim}")
+    assert str(e) == "use square_hz above 1 Hz, or simulate=False"
+    assert e.naming({"square_hz": "--square-freq", "no_sim": "--no-sim"}) == "use --square-freq above 1 Hz, or --no-sim"

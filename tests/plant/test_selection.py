@@ -107,7 +107,7 @@ def test_fine_series_search_memory_is_bounded():
 
 def test_widest_bounds_search_memory_is_bounded():
     # every E192 resistor the CLI accepts, E192 capacitors over the default decades
-    r, c = RANGES["resistor_ohm"], RANGES["capacitor_f"]
+    r = RANGES["resistor_ohm"]
     rv, cv = values("E192", r.lo, r.hi), values("E192", 1e-9, 1e-5)
     peak, res = peak_bytes(joint_search, 3500, 0.2, rv, cv, top=20)
     assert peak < SEARCH_MEMORY_BYTES
