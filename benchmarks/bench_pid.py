@@ -37,8 +37,9 @@ SMALL = dict(r_series="E3", c_series="E3", r_min=1e3, r_max=47e3, c_min=1e-9, c_
 
 
 def _design(tuning, **kw):
-    from designer.pid.design import PidSpec, design_pid
+    from designer.pid.design import design_pid
     from designer.pid.report import write_outputs
+    from designer.pid.spec import PidSpec
     tick = time.perf_counter()
     res = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2, opamp="LM741", tuning=tuning, **kw))
     with tempfile.TemporaryDirectory() as tmp:
@@ -59,7 +60,7 @@ def main():
               for k in ("plant_s", "tuning_s", "sizing_s", "analytic_s", "simulation_s", "report_s")}
         extra = ""
         if res.optimizer:
-            extra = f"{res.optimizer['evaluations']} evaluations, {res.optimizer['rounds']} round(s)"
+            extra = f"{res.optimizer.evaluations} evaluations, {res.optimizer.rounds} round(s)"
         rows.append((label, total, tm, extra, res))
     print("### design_pid in-process, seed plant, LM741, median of 3 (s)\n")
     print("| tuning | total | plant | tuning | sizing | analytic | SPICE | report | goal | notes |")
@@ -71,11 +72,11 @@ def main():
               f"{extra} |")
     print()
     for label, total, tm, extra, res in rows:
-        a, s = res.analytic, res.spice
+        a, s = res.analytic.figures, res.spice
         print(f"- {label}: Kp {res.parts.kp:.4g}, Ti {res.parts.ti_s * 1e6:.4g} us, Td {res.parts.td_s * 1e6:.4g} us; "
-              f"analytic overshoot {a['overshoot_pct']:.3g} %, SPICE {s['overshoot_pct']:.3g} % "
-              f"(nrms {s['nrms']:.3g}); failed checks: "
-              f"{', '.join(c['name'] for c in res.checks if not c['ok']) or 'none'}")
+              f"analytic overshoot {a.overshoot_pct:.3g} %, SPICE {s.figures.overshoot_pct:.3g} % "
+              f"(nrms {s.nrms:.3g}); failed checks: "
+              f"{', '.join(c.id for c in res.failed_checks()) or 'none'}")
     # console script end to end
     exe = Path(sys.executable).parent / "design-pid"
     times = []

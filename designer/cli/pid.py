@@ -1,5 +1,5 @@
 """Command-line layer of ``design-pid``: parse, call :func:`designer.pid.design.design_pid`,
-print. Any :class:`~designer.errors.DesignError` becomes one line on stderr and exit status 2."""
+print. Any :class:`~designer.core.errors.DesignError` becomes one line on stderr and exit status 2."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ import argparse
 import sys
 
 from .. import __version__
-from ..core import opamps
 from ..core.errors import DesignError
-from ..core.ranges import help_range, parse_in_range
-from .common import OneLineParser, add_part_options, check_name, emit, optional, part_options, run_cli
+from ..core.ranges import help_range
+from . import common
+from .common import OneLineParser, add_opamp_option, add_output_options, add_part_options, check_name, emit
 
 EPILOG = """examples:
   design-pid --plant-fc 3500 --plant-zeta 0.2
@@ -85,8 +85,7 @@ def _parser():
     s.add_argument("--f-differentiator", metavar="HZ",
                    help=f"derivative filter corner 1/(2 pi R12 C3) {_r('f_differentiator_hz')} (default 10 fn)")
     o = p.add_argument_group("op-amps and test signal")
-    o.add_argument("--opamp", default="LM741", metavar="NAME",
-                   help=f"{', '.join(opamps.names())} (default LM741, as the seed's bench)")
+    add_opamp_option(o)
     o.add_argument("--step", default="1", metavar="V",
                    help=f"reference square wave 0 -> V volts {_r('step_v')} (default 1)")
     o.add_argument("--edge", default="100n", metavar="S",
@@ -94,60 +93,36 @@ def _parser():
     o.add_argument("--square-freq", metavar="HZ",
                    help=f"reference frequency {_r('square_hz')} (default: half period = 1.5x the closed "
                         "loop's settling time, rounded)")
-    out = p.add_argument_group("output")
-    out.add_argument("--out", default=".", metavar="DIR", help="write netlists/ and reports/ under DIR (default .)")
-    out.add_argument("--name", help="design name for the files (default pid_<tuning>_<opamp>_fn<fn>_z<zeta>)")
-    out.add_argument("--json", action="store_true", help="print one JSON object on stdout instead of the summary")
-    out.add_argument("--no-files", action="store_true", help="write no netlist or report files")
-    out.add_argument("--no-sim", action="store_true", help="skip ngspice (analytic figures only)")
-    out.add_argument("--simulator", default="pyspice", choices=("pyspice", "ngspice-cli"),
-                     help="pyspice: ngspice shared library (default); ngspice-cli: `ngspice -b` subprocess")
+    add_output_options(p, "pid_<tuning>_<opamp>_fn<fn>_z<zeta>")
     return p
 
 
+#: the spec's parameters set from options of the same meaning (their options: FLAGS)
+SPEC_PARAMS = ("plant_fc_hz", "plant_zeta", "plant_json", "tuning", "kp", "ti_s", "td_s", "opamp", "step_v", "edge_s",
+               "r_series", "c_series", "r_min", "r_max", "c_min", "c_max", "target_overshoot_pct",
+               "target_settling_s", "f_integrator_hz", "f_differentiator_hz", "square_hz")
+
+
 def _build_spec(args):
+    """The spec from the options as typed: the spec parses and checks them (the one validation)."""
     from ..pid.blocks import seed_parts
-    from ..pid.design import PidSpec
+    from ..pid.spec import PidSpec
     from ..plant.sallenkey import SallenKeyParts
     plant_parts = None
-    names = ("r1", "r2", "c1", "c2")
-    given = [getattr(args, f"plant_{n}") for n in names]
+    given = [args.plant_r1, args.plant_r2, args.plant_c1, args.plant_c2]
     if any(v is not None for v in given):
         if not all(v is not None for v in given):
             raise DesignError("--plant-r1, --plant-r2, --plant-c1 and --plant-c2 go together")
-        keys = ("resistor_ohm", "resistor_ohm", "capacitor_f", "capacitor_f")
-        vals = [parse_in_range(v, f"--plant-{n}", k) for v, n, k in zip(given, names, keys)]
-        gain = 1.0 if args.plant_gain is None else parse_in_range(args.plant_gain, "--plant-gain", "gain")
-        # R3/R4 derived from K by the one plant validation (check_parts, in PidSpec.validate)
-        plant_parts = SallenKeyParts(*vals, gain)
+        plant_parts = SallenKeyParts(*given, args.plant_gain)
     elif args.plant_gain is not None:
         raise DesignError("--plant-gain goes with --plant-r1..--plant-c2")
-    if args.plant_zeta is not None and args.plant_fc is None:
-        raise DesignError("--plant-zeta needs --plant-fc")
-    tuning = None if args.tuning is None else args.tuning.strip().lower()
-    spec = PidSpec(
-        plant_fc_hz=optional(args.plant_fc, "--plant-fc", "fc_hz"),
-        plant_zeta=optional(args.plant_zeta, "--plant-zeta", "zeta"),
-        plant_parts=plant_parts, plant_json=args.plant_json, tuning=tuning,
-        kp=optional(args.kp, "--kp", "kp"), ti_s=optional(args.ti, "--ti", "ti_s"),
-        td_s=optional(args.td, "--td", "td_s"),
-        opamp=args.opamp, step_v=parse_in_range(args.step, "--step", "step_v"),
-        edge_s=parse_in_range(args.edge, "--edge", "edge_s"),
-        **part_options(args),
-        target_overshoot_pct=optional(args.target_overshoot, "--target-overshoot", "target_overshoot_pct"),
-        target_settling_s=optional(args.target_settling, "--target-settling", "target_settling_s"),
-        f_integrator_hz=optional(args.f_integrator, "--f-integrator", "f_integrator_hz"),
-        f_differentiator_hz=optional(args.f_differentiator, "--f-differentiator", "f_differentiator_hz"),
-        square_hz=optional(args.square_freq, "--square-freq", "square_hz"),
-        controller_parts=seed_parts() if args.seed_parts else None)
-    spec.validate()
-    return spec
+    typed = {p: getattr(args, common.FLAGS[p][2:].replace("-", "_")) for p in SPEC_PARAMS}
+    return PidSpec(plant_parts=plant_parts, controller_parts=seed_parts() if args.seed_parts else None, **typed)
 
 
 def _default_name(spec, fn_hz, zeta) -> str:
-    method = "explicit" if spec.kp is not None else (spec.tuning or "zn")
     extra = "_seedparts" if spec.controller_parts is not None else ""
-    return f"pid_{method}_{spec.opamp.lower()}_fn{fn_hz:.5g}_z{zeta:.3g}{extra}"
+    return f"pid_{spec.method}_{spec.opamp.lower()}_fn{fn_hz:.5g}_z{zeta:.3g}{extra}"
 
 
 def _run(args) -> int:
@@ -165,7 +140,7 @@ def _run(args) -> int:
 
 
 def design_pid_main(argv=None) -> int:
-    return run_cli("design-pid", _parser, _run, argv)
+    return common.run_cli("design-pid", _parser, _run, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core import eseries
+from ..core.checks import Check
 from ..core.errors import DesignError
 from ..core.units import format_eng
 
@@ -153,14 +154,22 @@ class Selection:
     candidates: int               #: size of the searched candidate set
     notes: list = field(default_factory=list)
 
+    tol: float = 0.01             #: errors up to this fraction count as equal (see :func:`objective`)
+
     @property
     def worst_error_pct(self) -> float:
         return max(abs(v) for v in self.errors_pct.values())
 
-    def objective(self) -> tuple:
-        return objective(self.parts, self.targets, self.best_possible_pct / 100, self.tol)
+    @property
+    def tolerances_pct(self) -> tuple:
+        """The resistor and the capacitor series' tolerances, percent (E24: 5, E12: 10)."""
+        return tuple(100 * eseries.TOLERANCE[s] for s in (self.r_series, self.c_series))
 
-    tol: float = 0.01
+    def to_dict(self) -> dict:
+        """The ``series`` object of result.json."""
+        rt, ct = self.tolerances_pct
+        return {"r": self.r_series, "c": self.c_series, "r_tolerance_pct": rt, "c_tolerance_pct": ct,
+                "best_possible_error_pct": self.best_possible_pct, "candidates": self.candidates}
 
 
 def objective(parts: PidParts, targets: dict, best: float, tol: float) -> tuple:
@@ -193,12 +202,13 @@ def unity_resistor(series: str, lo: float, hi: float) -> float:
 
 
 def _check_targets(kp, ti, td):
-    if not (math.isfinite(kp) and kp > 0):
-        raise DesignError(f"Kp must be a finite number greater than 0, got {kp!r}")
-    if not (math.isfinite(ti) and ti > 0):
-        raise DesignError(f"Ti must be a finite time greater than 0 s, got {ti!r}")
-    if not (math.isfinite(td) and td >= 0):
-        raise DesignError(f"Td must be a finite time of 0 s or more, got {td!r}")
+    """The sizing's precondition on gains from any source (a rule, the optimiser, a
+    caller of this module); a user's gains were checked against their ranges by the spec."""
+    for name, v, above, what in (("kp", kp, kp > 0, "a finite gain above 0"),
+                                 ("ti_s", ti, ti > 0, "a finite time above 0 s"),
+                                 ("td_s", td, td >= 0, "a finite time of 0 s or more")):
+        if not (math.isfinite(v) and above):
+            raise DesignError(f"{name} must be {what}, got {float(v):g}", param=name)
 
 
 def _corner_resistor(f_hz, caps, rvals, lo, hi):
@@ -566,7 +576,9 @@ def static_checks(parts: PidParts, fn_hz: float, gbw_hz: float, targets: dict, *
     integrator and differentiator corners against fn, each stage's bandwidth
     against the highest frequency the controller handles, and the bounds.
 
-    Returns a list of {name, ok, detail} dicts.
+    Returns
+    -------
+    list of designer.core.checks.Check
     """
     checks = []
     for key, label, unit in (("kp", "Kp", ""), ("ti_s", "Ti", "s"), ("td_s", "Td", "s")):
@@ -575,39 +587,39 @@ def static_checks(parts: PidParts, fn_hz: float, gbw_hz: float, targets: dict, *
             continue
         got = getattr(parts, key)
         e = got / want - 1
-        checks.append({"name": f"{label.lower()}_accuracy", "ok": abs(e) <= tol * (1 + 1e-9),
-                       "detail": f"{label} = {format_eng(got, unit)} for {format_eng(want, unit)} "
-                                 f"({e * 100:+.2f} %, allowed +/-{tol * 100:g} %)"})
+        checks.append(Check(f"{label.lower()}_accuracy", abs(e) <= tol * (1 + 1e-9),
+                            f"{label} = {format_eng(got, unit)} for {format_eng(want, unit)} "
+                            f"({e * 100:+.2f} %, allowed +/-{tol * 100:g} %)"))
     fi = parts.f_integrator_hz
-    checks.append({"name": "integrator_corner", "ok": fi <= fn_hz / CORNER_MARGIN,
-                   "detail": f"1/(2 pi R13 C4) = {format_eng(fi, 'Hz')}, must be below fn/{CORNER_MARGIN:g} = "
-                             f"{format_eng(fn_hz / CORNER_MARGIN, 'Hz')} (fn = {format_eng(fn_hz, 'Hz')})"})
+    checks.append(Check("integrator_corner", fi <= fn_hz / CORNER_MARGIN,
+                        f"1/(2 pi R13 C4) = {format_eng(fi, 'Hz')}, must be below fn/{CORNER_MARGIN:g} = "
+                        f"{format_eng(fn_hz / CORNER_MARGIN, 'Hz')} (fn = {format_eng(fn_hz, 'Hz')})"))
     if parts.has_derivative:
         fd = parts.f_differentiator_hz
-        checks.append({"name": "differentiator_corner", "ok": fd >= fn_hz * CORNER_MARGIN,
-                       "detail": f"1/(2 pi R12 C3) = {format_eng(fd, 'Hz')}, must be above "
-                                 f"{CORNER_MARGIN:g} fn = {format_eng(fn_hz * CORNER_MARGIN, 'Hz')}"})
+        checks.append(Check("differentiator_corner", fd >= fn_hz * CORNER_MARGIN,
+                            f"1/(2 pi R12 C3) = {format_eng(fd, 'Hz')}, must be above "
+                            f"{CORNER_MARGIN:g} fn = {format_eng(fn_hz * CORNER_MARGIN, 'Hz')}"))
         f_need, why = fd, "the differentiator corner"
     else:
         f_need, why = CORNER_MARGIN * fn_hz, f"{CORNER_MARGIN:g} fn"
     ng = parts.noise_gains()
     for stage, bw in parts.stage_bandwidths(gbw_hz).items():
-        checks.append({"name": f"bandwidth_{stage}", "ok": bw >= f_need,
-                       "detail": f"GBW/noise gain = {format_eng(gbw_hz, 'Hz')}/{ng[stage]:.3g} = "
-                                 f"{format_eng(bw, 'Hz')}, must be above {why} ({format_eng(f_need, 'Hz')})"})
+        checks.append(Check(f"bandwidth_{stage}", bw >= f_need,
+                            f"GBW/noise gain = {format_eng(gbw_hz, 'Hz')}/{ng[stage]:.3g} = "
+                            f"{format_eng(bw, 'Hz')}, must be above {why} ({format_eng(f_need, 'Hz')})"))
     rs, cs = parts.resistors(), parts.capacitors()
     bad_r = [f"{k} = {format_eng(v, 'Ohm')}" for k, v in rs.items()
              if not r_min * (1 - 1e-9) <= v <= r_max * (1 + 1e-9)]
     bad_c = [f"{k} = {format_eng(v, 'F')}" for k, v in cs.items()
              if not c_min * (1 - 1e-9) <= v <= c_max * (1 + 1e-9)]
-    checks.append({"name": "resistor_bounds", "ok": not bad_r,
-                   "detail": (f"all resistors within {format_eng(r_min, 'Ohm')}..{format_eng(r_max, 'Ohm')} "
-                              f"(smallest {format_eng(min(rs.values()), 'Ohm')}, largest "
-                              f"{format_eng(max(rs.values()), 'Ohm')})") if not bad_r
-                   else "outside the bounds: " + ", ".join(bad_r)})
-    checks.append({"name": "capacitor_bounds", "ok": not bad_c,
-                   "detail": (f"all capacitors within {format_eng(c_min, 'F')}..{format_eng(c_max, 'F')}")
-                   if not bad_c else "outside the bounds: " + ", ".join(bad_c)})
+    checks.append(Check("resistor_bounds", not bad_r,
+                        (f"all resistors within {format_eng(r_min, 'Ohm')}..{format_eng(r_max, 'Ohm')} "
+                         f"(smallest {format_eng(min(rs.values()), 'Ohm')}, largest "
+                         f"{format_eng(max(rs.values()), 'Ohm')})") if not bad_r
+                        else "outside the bounds: " + ", ".join(bad_r)))
+    checks.append(Check("capacitor_bounds", not bad_c,
+                        f"all capacitors within {format_eng(c_min, 'F')}..{format_eng(c_max, 'F')}"
+                        if not bad_c else "outside the bounds: " + ", ".join(bad_c)))
     return checks
 
 

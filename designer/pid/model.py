@@ -23,7 +23,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import signal
 
 from ..core.errors import DesignError
 from ..core.opamps import OpAmp
@@ -203,14 +202,31 @@ def _expm(m):
 
 
 def _ss(num, den):
+    """(A, B, C, D) of num/den in controller canonical form, as ``scipy.signal.tf2ss``
+    gives it (same arithmetic, so the same numbers), without importing scipy.signal."""
     num = np.atleast_1d(np.asarray(num, float))
     den = np.atleast_1d(np.asarray(den, float))
     num, den = _trim(num), _trim(den)
     if np.all(num == 0) or den.size == 1:   # a static gain has no states
         k = 0.0 if np.all(num == 0) else num[-1] / den[0]
         return np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.full((1, 1), k)
-    a, b, c, d = signal.tf2ss(num, den)
-    return a, b, c, d
+    num, den = num / den[0], den / den[0]
+    lead = np.flatnonzero(np.abs(num) > 1e-14)
+    num = num[lead[0] if lead.size else num.size - 1:]   # tf2ss drops negligible leading terms too
+    if num.size > den.size:
+        raise DesignError("improper transfer function (numerator of higher degree than the denominator)")
+    num = np.concatenate([np.zeros(den.size - num.size), num])
+    n = den.size - 1
+    a = np.vstack([-den[None, 1:], np.eye(n - 1, n)])
+    b = np.eye(n, 1)
+    c = num[None, 1:] - np.outer(num[:1], den[1:])
+    return a, b, c, np.array([[num[0]]])
+
+
+def state_space(num, den, output: str = "y") -> LoopModel:
+    """One transfer function as a :class:`LoopModel` with one output (for
+    responses to the edged reference, which a closed-form step does not give)."""
+    return LoopModel(*_ss(num, den), (output,))
 
 
 def assemble(parts: PidParts, opamp: OpAmp | None, plant_num, plant_den) -> LoopModel:
@@ -288,7 +304,21 @@ def loop_gain(parts: PidParts, opamp: OpAmp | None, plant_num, plant_den, w) -> 
     return -chain
 
 
-def margins(w, L) -> dict:
+@dataclass(frozen=True)
+class Margins:
+    """Stability margins of the loop gain (inf where there is no crossing, nan for its frequency)."""
+
+    phase_margin_deg: float
+    crossover_hz: float
+    gain_margin_db: float
+    phase_crossover_hz: float
+
+    def to_dict(self) -> dict:
+        return {"phase_margin_deg": self.phase_margin_deg, "crossover_hz": self.crossover_hz,
+                "gain_margin_db": self.gain_margin_db, "phase_crossover_hz": self.phase_crossover_hz}
+
+
+def margins(w, L) -> Margins:
     """Phase margin (deg) at every gain crossover (the smallest is reported),
     gain margin (dB) at the first -180 deg crossing, from samples of L(jw)."""
     w = np.asarray(w, float)
@@ -313,8 +343,8 @@ def margins(w, L) -> dict:
         if mg > 0:
             gm, w180 = -20 * math.log10(mg), w[i] + f * (w[i + 1] - w[i])
             break
-    return {"phase_margin_deg": pm, "crossover_hz": wc / (2 * math.pi) if math.isfinite(wc) else math.nan,
-            "gain_margin_db": gm, "phase_crossover_hz": w180 / (2 * math.pi) if math.isfinite(w180) else math.nan}
+    return Margins(pm, wc / (2 * math.pi) if math.isfinite(wc) else math.nan,
+                   gm, w180 / (2 * math.pi) if math.isfinite(w180) else math.nan)
 
 
 def ideal_pid_tf(kp: float, ti: float, td: float):
@@ -349,13 +379,7 @@ def ideal_loop(kp, ti, td, plant_num, plant_den) -> LoopModel:
     n, d = ideal_closed_loop(kp, ti, td, plant_num, plant_den)
     if len(n) >= len(d):
         raise DesignError("ideal closed loop is improper (plant of order < 2 with Td > 0)")
-    a, b, c, dd = signal.tf2ss(n, d)
-    return LoopModel(a, b, c, dd, ("y",))
-
-
-def simulate_ideal(kp, ti, td, plant_num, plant_den, t, r) -> np.ndarray:
-    """Plant output of the ideal-PID loop for reference samples ``r`` (a stable loop)."""
-    return ideal_loop(kp, ti, td, plant_num, plant_den).simulate(t, r)["y"]
+    return state_space(n, d)
 
 
 #: slewing may delay a stage by at most this fraction of the closed-loop rise time
@@ -371,8 +395,27 @@ def slew_delay(t, v, slew_v_per_s: float) -> float:
     return float(np.sum(np.maximum(0.0, dv - slew_v_per_s * dt)) / slew_v_per_s)
 
 
+@dataclass(frozen=True)
+class StageLevels:
+    """What one op-amp output does in the analytic loop over the square wave's period."""
+
+    opamp: str
+    signal: str
+    v_max: float
+    v_min: float
+    slope_v_per_s: float   #: fastest slope of the linear waveform
+    slew_delay_s: float    #: extra time slewing costs (:func:`slew_delay`)
+    swing_ok: bool
+    slew_ok: bool
+
+    def to_dict(self) -> dict:
+        return {"opamp": self.opamp, "signal": self.signal, "v_max": self.v_max, "v_min": self.v_min,
+                "slope_v_per_s": self.slope_v_per_s, "slew_delay_s": self.slew_delay_s,
+                "swing_ok": self.swing_ok, "slew_ok": self.slew_ok}
+
+
 def waveform_limits(wave: dict, t, opamp: OpAmp, delay_budget_s: float) -> dict:
-    """Per op-amp: peak output, peak slope and slew delay of the linear
+    """Per op-amp role, a :class:`StageLevels`: peak output, peak slope and slew delay of the linear
     waveforms, and whether they stay within the op-amp's swing and slew
     rate (slewing is accepted while it delays the stage by less than
     ``delay_budget_s``). ``wave`` is the rising half of the square wave, from
@@ -390,8 +433,7 @@ def waveform_limits(wave: dict, t, opamp: OpAmp, delay_budget_s: float) -> dict:
         vmax = max(float(v.max()), vf - float(v.min()))
         vmin = min(float(v.min()), vf - float(v.max()))
         delay = 0.0 if opamp.ideal else slew_delay(t, v, opamp.slew_v_per_s)
-        out[role] = {"opamp": ref, "signal": sig, "v_max": vmax, "v_min": vmin,
-                     "slope_v_per_s": slope, "slew_delay_s": delay,
-                     "swing_ok": bool(opamp.ideal or (vmax <= opamp.vout_max and vmin >= opamp.vout_min)),
-                     "slew_ok": bool(opamp.ideal or delay <= delay_budget_s)}
+        out[role] = StageLevels(ref, sig, vmax, vmin, slope, delay,
+                                bool(opamp.ideal or (vmax <= opamp.vout_max and vmin >= opamp.vout_min)),
+                                bool(opamp.ideal or delay <= delay_budget_s))
     return out

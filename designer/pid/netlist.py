@@ -16,15 +16,8 @@ import logging
 from ..core.opamps import OpAmp
 from ..plant.netlist import add_sallen_key
 from ..plant.sallenkey import SallenKeyParts
-from ..spice.deck import (
-    SquareTest,
-    add_opamp,
-    add_supplies,
-    finish_deck,
-    measure_lines,
-    opamp_library_text,
-    settle_error_source,
-)
+from ..spice import deck
+from ..spice.deck import SquareTest
 from .blocks import PidParts
 
 #: signals whose extremes the deck measures (one per op-amp output)
@@ -32,41 +25,37 @@ PROBES = ("ve", "vp", "vd", "vi", "vs", "u", "y")
 
 
 def add_controller(circuit, parts: PidParts, opamp: OpAmp, ref="ref", y="y", u="u"):
-    """The six controller op-amps between the reference, the plant output and ``u``."""
+    """The six controller op-amps between the reference, the plant output and ``u``
+    (U3 and R7 only with a derivative path)."""
     gnd = circuit.gnd
-    r = lambda x: f"{x:.6g}"  # noqa: E731
-    # U1 difference amplifier: ve = y - r (equal resistors)
-    circuit.R(15, ref, "n1", r(parts.r15))
-    circuit.R(16, "n1", "ve", r(parts.r16))
-    circuit.R(17, y, "p1", r(parts.r17))
-    circuit.R(18, "p1", gnd, r(parts.r18))
-    add_opamp(circuit, "U1", "p1", "n1", "ve", opamp)
-    # U2 unity inverter
-    circuit.R(10, "ve", "n2", r(parts.r10))
-    circuit.R(9, "n2", "vp", r(parts.r9))
-    add_opamp(circuit, "U2", gnd, "n2", "vp", opamp)
-    if parts.has_derivative:
+    p = parts
+    # per op-amp: its name, non-inverting input, inverting input and output, after its
+    # passives (kind, number, node, node, value)
+    stages = (
+        # U1 difference amplifier: ve = y - r (equal resistors)
+        ("U1", "p1", "n1", "ve", (("R", 15, ref, "n1", p.r15), ("R", 16, "n1", "ve", p.r16),
+                                  ("R", 17, y, "p1", p.r17), ("R", 18, "p1", gnd, p.r18))),
+        # U2 unity inverter
+        ("U2", gnd, "n2", "vp", (("R", 10, "ve", "n2", p.r10), ("R", 9, "n2", "vp", p.r9))),
         # U3 differentiator with input resistor
-        circuit.R(12, "ve", "d3", r(parts.r12))
-        circuit.C(3, "d3", "n3", r(parts.c3))
-        circuit.R(11, "n3", "vd", r(parts.r11))
-        add_opamp(circuit, "U3", gnd, "n3", "vd", opamp)
-    # U4 integrator with feedback resistor
-    circuit.R(14, "ve", "n4", r(parts.r14))
-    circuit.R(13, "n4", "vi", r(parts.r13))
-    circuit.C(4, "n4", "vi", r(parts.c4))
-    add_opamp(circuit, "U4", gnd, "n4", "vi", opamp)
-    # U5 summer
-    circuit.R(6, "vp", "n5", r(parts.r6))
-    if parts.has_derivative:
-        circuit.R(7, "vd", "n5", r(parts.r7))
-    circuit.R(8, "vi", "n5", r(parts.r8))
-    circuit.R(5, "n5", "vs", r(parts.r5))
-    add_opamp(circuit, "U5", gnd, "n5", "vs", opamp)
-    # U6 final inverting gain
-    circuit.R(4, "vs", "n6", r(parts.r4))
-    circuit.R(3, "n6", u, r(parts.r3))
-    add_opamp(circuit, "U6", gnd, "n6", u, opamp)
+        ("U3", gnd, "n3", "vd", (("R", 12, "ve", "d3", p.r12), ("C", 3, "d3", "n3", p.c3),
+                                 ("R", 11, "n3", "vd", p.r11))),
+        # U4 integrator with feedback resistor
+        ("U4", gnd, "n4", "vi", (("R", 14, "ve", "n4", p.r14), ("R", 13, "n4", "vi", p.r13),
+                                 ("C", 4, "n4", "vi", p.c4))),
+        # U5 summer
+        ("U5", gnd, "n5", "vs", (("R", 6, "vp", "n5", p.r6), ("R", 7, "vd", "n5", p.r7),
+                                 ("R", 8, "vi", "n5", p.r8), ("R", 5, "n5", "vs", p.r5))),
+        # U6 final inverting gain
+        ("U6", gnd, "n6", u, (("R", 4, "vs", "n6", p.r4), ("R", 3, "n6", u, p.r3))),
+    )
+    for name, inp, inn, out, passives in stages:
+        if name == "U3" and not p.has_derivative:
+            continue
+        for kind, number, a, b, value in passives:
+            if value is not None:   # R7 of a PI
+                getattr(circuit, kind)(number, a, b, f"{value:.6g}")
+        deck.add_opamp(circuit, name, inp, inn, out, opamp)
 
 
 def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test: SquareTest,
@@ -85,14 +74,13 @@ def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test:
         "*   U4 integrator, U5 summer, U6 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y); plant XP1",
         "* Run: ngspice -b <this file>   (prints overshoot_pct, peak_time_s, rise_time_s, settling_time_s,",
         "*   and the extremes of every op-amp output)",
-        opamp_library_text().rstrip(),
+        deck.opamp_library_text().rstrip(),
     ])
-    add_supplies(circuit, opamp)
+    deck.add_supplies(circuit, opamp)
     circuit.V("ref", "ref", circuit.gnd, test.source())
     add_controller(circuit, parts, opamp)
     add_sallen_key(circuit, plant, opamp, "u", "y", prefix="P")
-    settle_error_source(circuit, "y", expected_final)
-    sq = test
+    deck.settle_error_source(circuit, "y", expected_final)
     t0 = test.delay_s
     extremes = []
     for node in PROBES:
@@ -100,5 +88,5 @@ def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test:
             continue
         extremes += [f".meas tran {node}_max MAX v({node}) FROM={t0:.6g} TO={test.stop_s:.6g}",
                      f".meas tran {node}_min MIN v({node}) FROM={t0:.6g} TO={test.stop_s:.6g}"]
-    lines = measure_lines("y", sq, expected_final) + extremes
-    return finish_deck(circuit, sq, lines, points=points)
+    lines = deck.measure_lines("y", test, expected_final) + extremes
+    return deck.finish_deck(circuit, test, lines, points=points)

@@ -14,7 +14,7 @@ The search minimises the ITAE of the step response (a smooth stand-in for
 * a stable loop.
 
 Nelder-Mead in log(Kp, Ti, Td) from several rule-based starts, inside the
-ranges design-pid accepts for given gains (``designer.ranges``: kp, ti_s,
+ranges design-pid accepts for given gains (``designer.core.ranges``: kp, ti_s,
 td_s); the gains are then sized with E-series parts and checked again by the
 caller.
 """
@@ -53,7 +53,6 @@ class Context:
     target_settling_s: float | None = None
     f_integrator_hz: float | None = None
     f_differentiator_hz: float | None = None
-    t_scale_s: float = 1.0
     #: penalties start at these fractions of the swing and slew budgets (margin for part rounding)
     swing_limit: float = 0.98
     slew_limit: float = 0.95
@@ -61,8 +60,8 @@ class Context:
     itae_ref: float = 1.0
 
     def __post_init__(self):
-        from scipy import signal
         r = model.reference(self.t, self.step_v, 0.0, self.edge_s)
+        from scipy import signal
         _, y, _ = signal.lsim((self.plant_num, self.plant_den), r, self.t)
         e = np.abs(r - y) / abs(self.step_v)
         self.itae_ref = max(float(np.trapezoid(self.t * e, self.t)), 1e-30)
@@ -88,15 +87,24 @@ class Evaluation:
 
 @dataclass
 class OptimizeResult:
+    """The search's outcome: the best point, whether it meets the targets, and
+    where each start ended; ``sized`` and ``rounds`` are filled in by the caller
+    that sizes the gains with E-series parts (:func:`designer.pid.design.design_pid`)."""
+
     best: Evaluation
     met: bool
     evaluations: int
-    starts: list = field(default_factory=list)
+    starts: list = field(default_factory=list)   #: the Evaluation each start ended at
     message: str = ""
+    sized: Evaluation | None = None               #: the best gains built from E-series parts
+    rounds: int = 1
 
     def to_dict(self) -> dict:
-        return {"met": self.met, "evaluations": self.evaluations, "message": self.message,
-                "best": self.best.to_dict(), "starts": self.starts}
+        out = {"met": self.met, "evaluations": self.evaluations, "message": self.message,
+               "best": self.best.to_dict(), "starts": [e.to_dict() for e in self.starts]}
+        if self.sized is not None:
+            out.update(sized=self.sized.to_dict(), rounds=self.rounds)
+        return out
 
 
 def evaluate(kp: float, ti: float, td: float, ctx: Context) -> Evaluation:
@@ -112,14 +120,14 @@ def evaluate_parts(parts, ctx: Context, gains=None) -> Evaluation:
     kp, ti, td = gains if gains is not None else (parts.kp, parts.ti_s, parts.td_s)
     lm = model.assemble(parts, ctx.opamp, ctx.plant_num, ctx.plant_den)
     if not lm.stable():
-        worst = float(np.max(lm.poles().real)) * ctx.t_scale_s
+        worst = float(np.max(lm.poles().real))   # 1/s, capped below: more than any stable loop costs
         return Evaluation(kp, ti, td, 1e3 + 10.0 * min(worst, 100.0), False)
     r = model.reference(ctx.t, ctx.step_v, 0.0, ctx.edge_s)
     w = lm.simulate(ctx.t, r)
     y = w["y"]
     try:
         m = step_metrics(ctx.t, y, initial=0.0)
-    except Exception:  # a flat response: no figures
+    except DesignError:  # a flat response: no figures
         return Evaluation(kp, ti, td, 1e3, True)
     e = np.abs(r - y) / abs(ctx.step_v)
     itae = float(np.trapezoid(ctx.t * e, ctx.t)) / ctx.itae_ref
@@ -129,8 +137,8 @@ def evaluate_parts(parts, ctx: Context, gains=None) -> Evaluation:
     if amp.ideal:
         swing, slew = 0.0, 0.0
     else:
-        swing = max(max(v["v_max"] / amp.vout_max, v["v_min"] / amp.vout_min) for v in lim.values())
-        slew = max(v["slew_delay_s"] for v in lim.values()) / (model.SLEW_DELAY_FRACTION * rise)
+        swing = max(max(v.v_max / amp.vout_max, v.v_min / amp.vout_min) for v in lim.values())
+        slew = max(v.slew_delay_s for v in lim.values()) / (model.SLEW_DELAY_FRACTION * rise)
     cost = itae
     cost += 0.2 * max(0.0, m.overshoot_pct - ctx.target_overshoot_pct + 0.2) ** 2
     cost += 100.0 * max(0.0, swing - ctx.swing_limit) ** 2 + 100.0 * max(0.0, slew - ctx.slew_limit) ** 2
@@ -152,11 +160,8 @@ def meets(ev: Evaluation, ctx: Context) -> bool:
 
 
 def optimize(ctx: Context, starts, maxiter: int = 120) -> OptimizeResult:
-    """Minimise the cost from each (Kp, Ti, Td) in ``starts``; the best point wins."""
-    if not (math.isfinite(ctx.target_overshoot_pct) and ctx.target_overshoot_pct >= 0):
-        raise DesignError(f"--target-overshoot must be a percentage of 0 or more, got {ctx.target_overshoot_pct!r}")
-    if ctx.target_settling_s is not None and not ctx.target_settling_s > 0:
-        raise DesignError(f"--target-settling must be a time above 0 s, got {ctx.target_settling_s!r}")
+    """Minimise the cost from each (Kp, Ti, Td) in ``starts``; the best point wins.
+    The targets in ``ctx`` are taken as valid (:class:`designer.pid.spec.PidSpec` checks them)."""
     count = 0
     cache = {}
 
@@ -167,7 +172,7 @@ def optimize(ctx: Context, starts, maxiter: int = 120) -> OptimizeResult:
             count += 1
             kp, ti, td = np.exp(np.clip(x, -700, 700))
             if np.any(x < BOX_LO) or np.any(x > BOX_HI):
-                # outside the gains and times design-pid accepts (designer.ranges): no loop
+                # outside the gains and times design-pid accepts (designer.core.ranges): no loop
                 # to simulate, a cost that grows with the distance back into the box
                 out = float(np.sum(np.maximum(BOX_LO - x, 0.0) + np.maximum(x - BOX_HI, 0.0)))
                 cache[key] = Evaluation(float(kp), float(ti), float(td), 1e6 * (1.0 + out), False)
@@ -191,4 +196,4 @@ def optimize(ctx: Context, starts, maxiter: int = 120) -> OptimizeResult:
     msg = ("targets met" if met else
            "targets not met: the best compromise is reported (see the checks); relax the overshoot or "
            "settling target, lower --step, or choose a faster op-amp")
-    return OptimizeResult(best, met, count, [e.to_dict() for e in results], msg)
+    return OptimizeResult(best, met, count, results, msg)

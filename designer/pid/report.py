@@ -45,103 +45,117 @@ def title_of(result) -> str:
             f"zeta {result.plant.zeta:.3g}, with {result.opamp.name}")
 
 
+def _known(x):
+    """None for a figure that is undefined (None, nan or inf), else the figure."""
+    return None if x is None or (isinstance(x, float) and not math.isfinite(x)) else x
+
+
 def _v(x, unit="V", digits=4):
-    return "n/a" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format_eng(x, unit, digits)
+    return "n/a" if _known(x) is None else format_eng(x, unit, digits)
 
 
 def verdict_text(result) -> str:
-    d = result.to_dict()
-    failed = [c["name"] for c in d["checks"] if not c["ok"]]
-    a = d["closed_loop"]["analytic"]
-    s = d["closed_loop"]["spice"]
+    failed = [c.id for c in result.checks if not c.ok]
+    a = result.analytic
+    s = result.spice
     parts = []
-    if a.get("stable") is False:
+    if a.stable is False:
         parts.append("the analytic loop with the op-amp poles is UNSTABLE")
-    elif a.get("overshoot_pct") is not None:
-        parts.append(f"analytic: {a['overshoot_pct']:.3g} % overshoot, settles (2 %) in "
-                     f"{_v(a['settling_time_s'], 's')}")
+    elif _known(a.figures.overshoot_pct) is not None:
+        parts.append(f"analytic: {a.figures.overshoot_pct:.3g} % overshoot, settles (2 %) in "
+                     f"{_v(a.figures.settling_time_s, 's')}")
     if s is not None:
         what = []
-        if s.get("saturated"):
+        if s.saturated:
             what.append("op-amps saturate")
-        if not s.get("stable", True):
+        if not s.stable:
             what.append("the loop oscillates or latches")
-        if s.get("overshoot_pct") is not None and not what:
-            what.append(f"{s['overshoot_pct']:.3g} % overshoot, nrms {s['nrms']:.3g}" if s.get("nrms") is not None
-                        else f"{s['overshoot_pct']:.3g} % overshoot")
+        os_pct = _known(s.figures.overshoot_pct)
+        if os_pct is not None and not what:
+            what.append(f"{os_pct:.3g} % overshoot, nrms {s.nrms:.3g}" if _known(s.nrms) is not None
+                        else f"{os_pct:.3g} % overshoot")
         parts.append("SPICE: " + ", ".join(what))
     parts.append("all checks pass" if not failed else "failed checks: " + ", ".join(failed))
     return "; ".join(parts) + "."
 
 
-def sections(result, with_images: bool = True) -> list:
-    d = result.to_dict()
-    p = result.parts
-    amp = result.opamp
-    tun = d["tuning"]
-    ser = d["series"] or {"r": "as given", "c": "as given", "r_tolerance_pct": None, "c_tolerance_pct": None}
-    out = [("Verdict", [R.text(verdict_text(result))] + [R.text(n) for n in d["notes"]])]
+#: the build sheet's name and role of each controller part
+ROLES = {"R3": "U6 feedback (final gain)", "R4": "U6 input (from the summer)", "R5": "U5 feedback (summer)",
+         "R6": "U5 input from U2 (proportional)", "R7": "U5 input from U3 (derivative)",
+         "R8": "U5 input from U4 (integral)", "R9": "U2 feedback (unity inverter)", "R10": "U2 input",
+         "R11": "U3 feedback (differentiator)", "R12": "U3 input, in series with C3",
+         "R13": "U4 feedback, parallel to C4 (integrator leak)", "R14": "U4 input (integrator)",
+         "R15": "U1 from the reference r to the inverting input", "R16": "U1 feedback",
+         "R17": "U1 from the plant output y to the non-inverting input",
+         "R18": "U1 non-inverting input to ground",
+         "C3": "U3 input, in series with R12 (derivative)", "C4": "U4 feedback (integrator)"}
 
-    # tuning
-    blocks = [R.text(f"Method: {tun['method']}. Kp = {tun['kp']:.4g}, Ti = {_v(tun['ti_s'], 's')}, "
-                     f"Td = {_v(tun['td_s'], 's')}.")]
-    rc, fit = tun.get("reaction_curve"), tun.get("fopdt_fit")
+
+def sections(result, with_images: bool = True) -> list:
+    """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`)."""
+    out = [("Verdict", [R.text(verdict_text(result))] + [R.text(n) for n in result.notes])]
+    out.append(("Tuning", _tuning_blocks(result)))
+    out.append(("Bill of materials", _bom_blocks(result)))
+    out.append(("Target and achieved", _achieved_blocks(result)))
+    out.append(("Checks", [R.table(["check", "result", "detail"],
+                                   [[c.id, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]))
+    out.append(("Closed loop", _loop_blocks(result, with_images)))
+    out.append(("Expected scope readings", _scope_blocks(result, with_images)))
+    return out
+
+
+def _tuning_blocks(result) -> list:
+    tun = result.tuning
+    blocks = [R.text(f"Method: {tun.method}. Kp = {tun.kp:.4g}, Ti = {_v(tun.ti_s, 's')}, "
+                     f"Td = {_v(tun.td_s, 's')}.")]
+    rc = tun.curve
+    fit = None if rc is None else rc.fit
     if rc is not None:
         blocks.append(R.text(
-            f"Reaction curve of the plant as built: inflection at {_v(rc['t_inflection_s'], 's')} "
-            f"(y = {rc['y_inflection']:.4g}), tangent slope {rc['slope_per_s']:.5g} /s, K = {rc['K']:.4g}, "
-            f"L = {_v(rc['L_s'], 's')}, T = {_v(rc['T_s'], 's')} (the tangent reaches the final value at "
-            f"{_v(rc['t_tangent_final_s'], 's')}; T is measured from L). ZN's rule uses this tangent."))
+            f"Reaction curve of the plant as built: inflection at {_v(rc.t_inflection_s, 's')} "
+            f"(y = {rc.y_inflection:.4g}), tangent slope {rc.slope_per_s:.5g} /s, K = {rc.K:.4g}, "
+            f"L = {_v(rc.L_s, 's')}, T = {_v(rc.T_s, 's')} (the tangent reaches the final value at "
+            f"{_v(rc.t_tangent_final_s, 's')}; T is measured from L). ZN's rule uses this tangent."))
     if fit is not None:
         how = ""
-        if not fit["valid"]:
-            how = (f" The step overshoots {rc['overshoot_pct']:.3g} %, which no FOPDT model can follow: treat "
-                   "the rules below as starting points." if rc is not None and rc["overshoot_pct"] > 2.0
-                   else f" The fit is poor: {fit['note']}.")
+        if not fit.valid:
+            how = (f" The step overshoots {rc.overshoot_pct:.3g} %, which no FOPDT model can follow: treat "
+                   "the rules below as starting points." if rc.overshoot_pct > 2.0
+                   else f" The fit is poor: {fit.note}.")
         blocks.append(R.text(
             f"Least-squares FOPDT K e^(-L s)/(T s + 1) of the same step (the model Cohen-Coon, CHR, AMIGO and "
-            f"SIMC were derived for): K = {fit['K']:.4g}, L = {_v(fit['L_s'], 's')}, T = {_v(fit['T_s'], 's')}"
-            + ("" if fit.get("rms_residual") is None else f", rms residual {fit['rms_residual']:.3g}") + "."
+            f"SIMC were derived for): K = {fit.K:.4g}, L = {_v(fit.L_s, 's')}, T = {_v(fit.T_s, 's')}"
+            + ("" if fit.rms_residual is None else f", rms residual {fit.rms_residual:.3g}") + "."
             + how))
-    if d["rules"]:
-        rows = [[r["method"], _model_cell(r.get("model")), f"{r['kp']:.4g}", _v(r["ti_s"], "s"),
-                 _v(r["td_s"], "s")] for r in d["rules"]]
+    if result.rules:
+        rows = [[r.method, _model_cell(r.model), f"{r.kp:.4g}", _v(r.ti_s, "s"), _v(r.td_s, "s")]
+                for r in result.rules]
         blocks.append(R.table(["rule", "model it uses (K, L, T)", "Kp", "Ti", "Td"], rows))
-    if d.get("optimizer"):
-        b = d["optimizer"]["best"]
+    opt = result.optimizer
+    if opt is not None:
+        b = opt.best
         blocks.append(R.text(
-            f"Optimiser: {d['optimizer']['message']} ({d['optimizer']['evaluations']} evaluations); predicted "
-            f"overshoot {_fmt(b['overshoot_pct'], '%')}, settling {_v(b['settling_time_s'], 's')}, worst swing "
-            f"{_fmt(_pct(b['swing_ratio']), '%')} of the rails, worst slew delay {_fmt(_pct(b['slew_ratio']), '%')} "
-            "of its budget" + ("" if b["stable"] else " (the best point found is an unstable loop)") + "."))
-    out.append(("Tuning", blocks))
+            f"Optimiser: {opt.message} ({opt.evaluations} evaluations); predicted "
+            f"overshoot {_fmt(b.overshoot_pct, '%')}, settling {_v(b.settling_time_s, 's')}, worst swing "
+            f"{_fmt(_pct(b.swing_ratio), '%')} of the rails, worst slew delay {_fmt(_pct(b.slew_ratio), '%')} "
+            "of its budget" + ("" if b.stable else " (the best point found is an unstable loop)") + "."))
+    return blocks
 
-    # BOM
-    rt, ct = ser.get("r_tolerance_pct"), ser.get("c_tolerance_pct")
-    roles = {"R3": "U6 feedback (final gain)", "R4": "U6 input (from the summer)", "R5": "U5 feedback (summer)",
-             "R6": "U5 input from U2 (proportional)", "R7": "U5 input from U3 (derivative)",
-             "R8": "U5 input from U4 (integral)", "R9": "U2 feedback (unity inverter)", "R10": "U2 input",
-             "R11": "U3 feedback (differentiator)", "R12": "U3 input, in series with C3",
-             "R13": "U4 feedback, parallel to C4 (integrator leak)", "R14": "U4 input (integrator)",
-             "R15": "U1 from the reference r to the inverting input", "R16": "U1 feedback",
-             "R17": "U1 from the plant output y to the non-inverting input",
-             "R18": "U1 non-inverting input to ground"}
-    rows = []
-    for ref, v in p.resistors().items():
-        rows.append(R.part_row(ref, v, "Ohm", roles[ref], ser["r"], rt))
-    for ref, v, role in (("C3", p.c3, "U3 input, in series with R12 (derivative)"),
-                         ("C4", p.c4, "U4 feedback (integrator)")):
-        if v is not None:
-            rows.append(R.part_row(ref, v, "F", role, ser["c"], ct))
+
+def _bom_blocks(result) -> list:
+    p, amp, sel = result.parts, result.opamp, result.selection
+    r_series, c_series = (sel.r_series, sel.c_series) if sel is not None else ("as given", "as given")
+    rt, ct = sel.tolerances_pct if sel is not None else (None, None)
+    rows = [R.part_row(ref, v, "Ohm", ROLES[ref], r_series, rt) for ref, v in p.resistors().items()]
+    rows += [R.part_row(ref, v, "F", ROLES[ref], c_series, ct) for ref, v in p.capacitors().items()]
     for ref, role, _ in OPAMP_OUTPUTS:
         if (ref == "U3" and not p.has_derivative) or role == "plant":
             continue  # the plant's op-amp is listed with the plant's parts
         rows.append([ref, amp.name, "", "", "", f"{role} op-amp, {amp.vcc:g} V / {amp.vee:g} V"])
     pl = result.plant
     # a plant designed here comes from the spec's series (whatever the controller's parts are)
-    designed = result.plant_source.startswith("design-plant")
-    prs, pcs = (result.spec.r_series, result.spec.c_series) if designed else (None, None)
-    prt, pct = ((100 * eseries.TOLERANCE[prs], 100 * eseries.TOLERANCE[pcs]) if designed else (None, None))
+    prs, pcs = result.plant_series or (None, None)
+    prt, pct = ((100 * eseries.TOLERANCE[prs], 100 * eseries.TOLERANCE[pcs]) if prs else (None, None))
     rows += [R.part_row("R1 (plant)", pl.r1, "Ohm", "Sallen-Key input resistor", prs, prt),
              R.part_row("R2 (plant)", pl.r2, "Ohm", "Sallen-Key, to the non-inverting input", prs, prt),
              R.part_row("C1 (plant)", pl.c1, "F", "Sallen-Key, non-inverting input to ground", pcs, pct),
@@ -150,86 +164,82 @@ def sections(result, with_images: bool = True) -> list:
         rows += [R.part_row("R3 (plant)", pl.r3, "Ohm", "Sallen-Key gain, to ground", prs, prt),
                  R.part_row("R4 (plant)", pl.r4, "Ohm", "Sallen-Key gain, feedback", prs, prt)]
     rows.append(["U7", amp.name, "", "", "", "plant op-amp (Sallen-Key)"])
-    out.append(("Bill of materials", [
-        R.table(["Ref", "Value", "Code", "Series", "Tolerance", "Where"], rows),
-        R.text("Signal path: r -> U1 (ve = y - r) -> U2 / U3 / U4 in parallel -> U5 summer -> U6 -> u -> "
-               "plant -> y, fed back to U1. Kp = R5 R3/(R6 R4), Ti = R8 R14 C4/R6, Td = R6 R11 C3/R7.")]))
+    return [R.table(["Ref", "Value", "Code", "Series", "Tolerance", "Where"], rows),
+            R.text("Signal path: r -> U1 (ve = y - r) -> U2 / U3 / U4 in parallel -> U5 summer -> U6 -> u -> "
+                   "plant -> y, fed back to U1. Kp = R5 R3/(R6 R4), Ti = R8 R14 C4/R6, Td = R6 R11 C3/R7.")]
 
-    # target vs achieved
-    ach = d["achieved"]
-    err = ach["errors_pct"]
-    rows = [["Kp", f"{tun['kp']:.4g}", f"{ach['kp']:.4g}", R.fmt_pct(err["kp"])],
-            ["Ti", _v(tun["ti_s"], "s"), _v(ach["ti_s"], "s"), R.fmt_pct(err["ti"])],
-            ["Td", _v(tun["td_s"], "s"), _v(ach["td_s"], "s"), R.fmt_pct(err.get("td"))],
-            ["integrator corner 1/(2 pi R13 C4)", "", _v(ach["f_integrator_hz"], "Hz"), ""],
-            ["derivative filter 1/(2 pi R12 C3)", "", _v(ach["f_differentiator_hz"], "Hz"), ""]]
-    for stage, ng in ach["noise_gains"].items():
+
+def _achieved_blocks(result) -> list:
+    tun, ach = result.tuning, result.achieved
+    err = ach.errors_pct
+    rows = [["Kp", f"{tun.kp:.4g}", f"{ach.kp:.4g}", R.fmt_pct(err["kp"])],
+            ["Ti", _v(tun.ti_s, "s"), _v(ach.ti_s, "s"), R.fmt_pct(err["ti"])],
+            ["Td", _v(tun.td_s, "s"), _v(ach.td_s, "s"), R.fmt_pct(err["td"])],
+            ["integrator corner 1/(2 pi R13 C4)", "", _v(ach.f_integrator_hz, "Hz"), ""],
+            ["derivative filter 1/(2 pi R12 C3)", "", _v(ach.f_differentiator_hz, "Hz"), ""]]
+    for stage, ng in ach.noise_gains.items():
         rows.append([f"{stage} stage: noise gain, bandwidth", "", f"{ng:.3g}, "
-                     f"{_v(ach['stage_bandwidths_hz'][stage], 'Hz')}", ""])
-    out.append(("Target and achieved", [R.table(["", "target", "achieved", "error"], rows)]))
+                     f"{_v(ach.stage_bandwidths_hz[stage], 'Hz')}", ""])
+    return [R.table(["", "target", "achieved", "error"], rows)]
 
-    out.append(("Checks", [R.table(["check", "result", "detail"],
-                                   [[c["name"], "ok" if c["ok"] else "FAILED", c["detail"]] for c in d["checks"]])]))
 
-    # closed loop
-    cl = d["closed_loop"]
-    a, i, s = cl["analytic"], cl["ideal_pid"], cl["spice"] or {}
-    rows = []
-    for key, label, f in METRICS:
-        rows.append([label, f(i.get(key)), f(a.get(key)), f(s.get(key)) if s else "not simulated"])
-    rows.append(["stable", "", str(a.get("stable")), str(s.get("stable")) if s else ""])
-    rows.append(["saturated", "", "", str(s.get("saturated")) if s else ""])
+def _loop_blocks(result, with_images) -> list:
+    a, i, s, amp = result.analytic, result.ideal_pid, result.spice, result.opamp
+    rows = [[label, f(_known(getattr(i, key))), f(_known(getattr(a.figures, key))),
+             f(_known(getattr(s.figures, key))) if s else "not simulated"] for key, label, f in METRICS]
+    rows.append(["stable", "", str(a.stable), str(s.stable) if s else ""])
+    rows.append(["saturated", "", "", str(s.saturated) if s else ""])
     blocks = [R.table(["", "ideal PID + ideal plant", f"realised (with {amp.name})", "SPICE"], rows)]
-    mg = cl["margins"]
+    mg = result.margins
     blocks.append(R.text(
-        f"Loop with the op-amp poles: phase margin {_fmt(mg.get('phase_margin_deg'), 'deg')} at "
-        f"{_v(mg.get('crossover_hz'), 'Hz')}, gain margin {_fmt(mg.get('gain_margin_db'), 'dB')}. "
-        f"Closed-loop DC gain {a.get('dc_gain', float('nan')):.4g} (steady-state error "
-        f"{_fmt(a.get('steady_state_error_pct'), '%')})."))
+        f"Loop with the op-amp poles: phase margin {_fmt(mg.phase_margin_deg, 'deg')} at "
+        f"{_v(mg.crossover_hz, 'Hz')}, gain margin {_fmt(mg.gain_margin_db, 'dB')}. "
+        f"Closed-loop DC gain {a.dc_gain:.4g} (steady-state error {_fmt(a.steady_state_error_pct, '%')})."))
     if s:
-        v = cl["verdict"]
+        v = result.verdict
         blocks.append(R.text(
-            f"SPICE vs analytic: overshoot {_fmt(v.get('overshoot_delta_pp'), 'pp', signed=True)}, nrms "
-            f"{_fmt(s.get('nrms'), '')} (below 1 is agreement); "
-            + ("they agree." if v["agree"] else
-               ("the difference is explained by the failed checks: " + ", ".join(v["explained_by"]) + "."
-                if v["explained_by"] else "they disagree and no check explains it."))))
+            f"SPICE vs analytic: overshoot {_fmt(v.overshoot_delta_pp, 'pp', signed=True)}, nrms "
+            f"{_fmt(s.nrms, '')} (below 1 is agreement); "
+            + ("they agree." if v.agree else
+               ("the difference is explained by the failed checks: " + ", ".join(v.explained_by) + "."
+                if v.explained_by else "they disagree and no check explains it."))))
     if with_images:
         blocks += [R.image("closed-loop.png", "closed-loop step"), R.image("controller.png", "controller output"),
                    R.image("loop-bode.png", "loop gain")]
-    out.append(("Closed loop", blocks))
+    return blocks
 
-    # expected scope readings
-    tsig = d["test_signal"]
-    la, ls = d["levels"]["analytic"] or {}, d["levels"]["spice"] or {}
+
+def _scope_blocks(result, with_images) -> list:
+    test = result.test
+    la = result.analytic.levels
+    ls = {} if result.spice is None else result.spice.stages
     rows = []
     for ref, role, sig in OPAMP_OUTPUTS:
-        if role not in la and role not in ls:
+        x, y = la.get(role), ls.get(role)
+        if x is None and y is None:
             continue
-        x, y = la.get(role, {}), ls.get(role, {})
-        sat = y.get("time_high_s", 0) + y.get("time_low_s", 0) if y else None
-        rows.append([ref, role, sig, f"{_v(x.get('v_min'))} .. {_v(x.get('v_max'))}",
-                     f"{_v(y.get('v_min'))} .. {_v(y.get('v_max'))}" if y else "",
-                     "" if not x else f"{x['slope_v_per_s'] / 1e6:.3g} V/us",
-                     "" if sat is None else _v(sat, "s"), SHAPES[role]])
-    blocks = [R.text(f"Bench test: square wave 0 -> {tsig['high_v']:g} V at {tsig['frequency_hz']:g} Hz "
-                     f"(edges {_v(tsig['edge_s'], 's')}); the output should settle near "
-                     f"{tsig['expected_final_v']:.4g} V. Probe each op-amp output against ground; levels cover the "
+        rail = None if y is None else y.time_high_s + y.time_low_s if y.time_high_s is not None else 0
+        rows.append([ref, role, sig, "n/a .. n/a" if x is None else f"{_v(x.v_min)} .. {_v(x.v_max)}",
+                     "" if y is None else f"{_v(y.v_min)} .. {_v(y.v_max)}",
+                     "" if x is None else f"{x.slope_v_per_s / 1e6:.3g} V/us",
+                     "" if rail is None else _v(rail, "s"), SHAPES[role]])
+    blocks = [R.text(f"Bench test: square wave 0 -> {test.amplitude_v:g} V at {test.frequency_hz:g} Hz "
+                     f"(edges {_v(test.edge_s, 's')}); the output should settle near "
+                     f"{result.expected_final_v:.4g} V. Probe each op-amp output against ground; levels cover the "
                      "whole period (the falling half mirrors the rising one)."),
               R.table(["op-amp", "block", "node", "expected (analytic)", "SPICE", "fastest slope",
                        "time at a rail (SPICE)", "what the scope shows"], rows)]
     if with_images:
         blocks.append(R.image("blocks.png", "every op-amp output"))
         blocks.append(R.image("reaction-curve.png", "plant reaction curve"))
-    out.append(("Expected scope readings", blocks))
-    return out
+    return blocks
 
 
 def _model_cell(m) -> str:
-    if not m:
+    if m is None:
         return ""
-    return (f"{MODEL_NAMES.get(m['source'], m['source'])}: {m['K']:.4g}, {_v(m['L_s'], 's')}, "
-            f"{_v(m['T_s'], 's')}")
+    return (f"{MODEL_NAMES.get(m.source, m.source)}: {m.K:.4g}, {_v(m.L_s, 's')}, "
+            f"{_v(m.T_s, 's')}")
 
 
 def _pct(ratio):
@@ -237,7 +247,7 @@ def _pct(ratio):
 
 
 def _fmt(v, unit, signed=False):
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+    if _known(v) is None:
         return "n/a"
     return (f"{v:+.3g}" if signed else f"{v:.3g}") + (f" {unit}" if unit else "")
 
@@ -257,14 +267,14 @@ def _plt():
 
 def plots(result) -> dict:
     w = result.waveforms
-    t = w["t"]
-    a = w["analytic"]
-    sp = w.get("spice")
+    t = w.t
+    a = w.analytic
+    sp = None if result.spice is None else result.spice.waves
     amp = result.opamp.name
-    curves = {f"realised loop, analytic ({amp})": a["y"], "ideal PID, ideal plant": w["ideal_pid"]}
+    curves = {f"realised loop, analytic ({amp})": a["y"], "ideal PID, ideal plant": w.ideal_pid}
     if sp is not None:
         curves["SPICE (ngspice)"] = sp["y"]
-    curves["plant alone (open loop)"] = w["open_loop"]
+    curves["plant alone (open loop)"] = w.open_loop
     images = {"closed-loop.png": step_plot(t, curves, f"Closed-loop step, 0 -> {result.test.amplitude_v:g} V")}
     cu = {"u analytic": a["u"]}
     if sp is not None:
@@ -279,23 +289,23 @@ def plots(result) -> dict:
 def _blocks_plot(result) -> bytes:
     plt = _plt()
     w = result.waveforms
-    t = w["t"] * 1e6
-    sp = w.get("spice")
-    sigs = [(ref, role, s) for ref, role, s in OPAMP_OUTPUTS if s in w["analytic"]]
+    t = w.t * 1e6
+    sp = None if result.spice is None else result.spice.waves
+    amp = result.opamp
+    sigs = [(ref, role, s) for ref, role, s in OPAMP_OUTPUTS if s in w.analytic]
     fig, axes = plt.subplots(len(sigs), 1, figsize=(7.5, 1.5 * len(sigs)), sharex=True)
     for ax, (ref, role, s) in zip(axes, sigs):
-        ax.plot(t, w["analytic"][s], "-", lw=1.2, label="analytic")
+        ax.plot(t, w.analytic[s], "-", lw=1.2, label="analytic")
         if sp is not None and s in sp:
             ax.plot(t, sp[s], "--", lw=1.2, label="SPICE")
-        amp = result.opamp
-        peak = max(np.nanmax(np.abs(w["analytic"][s])),
+        peak = max(np.nanmax(np.abs(w.analytic[s])),
                    np.nanmax(np.abs(sp[s])) if sp is not None and s in sp else 0.0)
         if not amp.ideal and peak > 0.5 * amp.vout_max:   # rails only when the signal gets near them
             for lvl in (amp.vout_max, amp.vout_min):
                 ax.axhline(lvl, color="r", lw=0.6, alpha=0.5)
         # an unstable analytic loop runs away: keep the axis on what a scope shows
         lim = 1.15 * max(abs(amp.vcc), abs(amp.vee))
-        if np.nanmax(np.abs(w["analytic"][s])) > lim:
+        if np.nanmax(np.abs(w.analytic[s])) > lim:
             ax.set_ylim(-lim, lim)
         ax.set_ylabel(f"{ref} {s}", fontsize=8)
         ax.grid(True, alpha=0.3)
@@ -306,24 +316,21 @@ def _blocks_plot(result) -> bytes:
 
 
 def _bode_plot(result) -> bytes:
-    from .design import plant_model
-    from .model import loop_gain
     plt = _plt()
-    w = result.waveforms["bode_w"]
-    pn, pd = plant_model(result.plant, result.opamp)
-    L = loop_gain(result.parts, result.opamp, pn, pd, w)
-    f = w / (2 * np.pi)
+    w = result.waveforms
+    L = w.loop_gain
+    f = w.bode_w / (2 * np.pi)
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 5.5), sharex=True)
     a1.semilogx(f, 20 * np.log10(np.abs(L)))
     a1.axhline(0, color="k", lw=0.6)
     a2.semilogx(f, np.degrees(np.unwrap(np.angle(L))))
     a2.axhline(-180, color="k", lw=0.6)
     mg = result.margins
-    if math.isfinite(mg.get("crossover_hz", math.nan)):
+    if math.isfinite(mg.crossover_hz):
         for ax in (a1, a2):
-            ax.axvline(mg["crossover_hz"], color="r", lw=0.8, ls="--")
+            ax.axvline(mg.crossover_hz, color="r", lw=0.8, ls="--")
     a1.set_title(f"Loop gain with {result.opamp.name} poles: phase margin "
-                 f"{_fmt(mg.get('phase_margin_deg'), 'deg')}")
+                 f"{_fmt(mg.phase_margin_deg, 'deg')}")
     a1.set_ylabel("gain (dB)")
     a2.set_ylabel("phase (deg)")
     a2.set_xlabel("frequency (Hz)")
@@ -334,7 +341,8 @@ def _bode_plot(result) -> bytes:
 
 def _reaction_plot(result) -> bytes:
     plt = _plt()
-    tp, yp = result.waveforms["reaction_curve"]
+    w = result.waveforms
+    tp, yp = w.reaction_t, w.reaction_y
     c = result.tuning.curve
     fig, ax = plt.subplots(figsize=(7.5, 4))
     ax.plot(tp * 1e6, yp, label="plant step response")
@@ -343,10 +351,8 @@ def _reaction_plot(result) -> bytes:
         ax.plot(tt * 1e6, c.slope_per_s * (tt - c.t_inflection_s) + c.y_inflection, "--", label="tangent")
         ax.plot([c.t_inflection_s * 1e6], [c.y_inflection], "o", label="inflection")
         ax.axhline(c.K, color="k", lw=0.6)
-        if c.fit is not None:
-            f = c.fit
-            ax.plot(tp * 1e6, f.K * (1 - np.exp(-np.clip(tp - f.L_s, 0.0, None) / f.T_s)), ":",
-                    label="least-squares FOPDT")
+        if w.fopdt_y is not None:
+            ax.plot(tp * 1e6, w.fopdt_y, ":", label="least-squares FOPDT")
         ax.set_xlim(0, min(tp[-1], 6 * c.t_tangent_final_s) * 1e6)
         ax.set_title(f"Reaction curve: L = {format_eng(c.L_s, 's')}, T = {format_eng(c.T_s, 's')}")
     ax.set_xlabel("time (us)")

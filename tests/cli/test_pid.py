@@ -148,7 +148,7 @@ def test_plant_json_that_is_not_a_result(tmp_path, capsys):
     code, err = _main(capsys, "--plant-json", str(bad), "--no-files")
     assert code == 2 and "not JSON" in err
     code, err = _main(capsys, "--plant-json", str(tmp_path / "missing.json"), "--no-files")
-    assert code == 2 and "cannot read" in err
+    assert code == 2 and "--plant-json file" in err and "does not exist" in err
 
 
 def test_unwritable_output_directory(tmp_path, capsys):

@@ -27,7 +27,7 @@ def test_realised_loop_tends_to_the_ideal_pid():
     r = np.ones_like(t)
     r[0] = 0.0
     y = lm.simulate(t, r)["y"]
-    yi = model.simulate_ideal(kp, ti, td, PN, PD, t, r)
+    yi = model.ideal_loop(kp, ti, td, PN, PD).simulate(t, r)["y"]
     assert np.max(np.abs(y - yi)) < 2e-3
     assert step_metrics(t, y).overshoot_pct == pytest.approx(step_metrics(t, yi).overshoot_pct, abs=0.1)
 
@@ -73,18 +73,18 @@ def test_margins_of_known_loops():
     w = np.logspace(-2, 3, 20001)
     # integrator wc/s: PM 90 deg at wc, no phase crossover
     m = model.margins(w, 10.0 / (1j * w))
-    assert m["phase_margin_deg"] == pytest.approx(90.0, abs=1e-6)
-    assert m["crossover_hz"] * 2 * np.pi == pytest.approx(10.0, rel=1e-4)
+    assert m.phase_margin_deg == pytest.approx(90.0, abs=1e-6)
+    assert m.crossover_hz * 2 * np.pi == pytest.approx(10.0, rel=1e-4)
     # K / (s (s + 1)), K = 4: wc^2 sqrt(wc^2 + 1) = 4, PM = 90 - atan(wc)
     L = 4.0 / (1j * w * (1j * w + 1))
     wc = math.sqrt((-1 + math.sqrt(1 + 64)) / 2)
     m = model.margins(w, L)
-    assert m["phase_margin_deg"] == pytest.approx(90 - math.degrees(math.atan(wc)), abs=1e-3)
+    assert m.phase_margin_deg == pytest.approx(90 - math.degrees(math.atan(wc)), abs=1e-3)
     # K/(s+1)^3, K = 4: phase -180 at w = sqrt(3), |L| = 4/8: GM = 6.02 dB
     L = 4.0 / (1j * w + 1) ** 3
     m = model.margins(w, L)
-    assert m["gain_margin_db"] == pytest.approx(20 * math.log10(2), abs=1e-3)
-    assert m["phase_crossover_hz"] * 2 * np.pi == pytest.approx(math.sqrt(3), rel=1e-4)
+    assert m.gain_margin_db == pytest.approx(20 * math.log10(2), abs=1e-3)
+    assert m.phase_crossover_hz * 2 * np.pi == pytest.approx(math.sqrt(3), rel=1e-4)
 
 
 def test_seed_final_gains_are_unstable_with_lm741_but_not_ideal():
@@ -92,7 +92,7 @@ def test_seed_final_gains_are_unstable_with_lm741_but_not_ideal():
     assert model.assemble(seed, IDEAL, PN, PD).stable()
     assert not model.assemble(seed, LM741, PN, PD).stable()
     w = 2 * np.pi * np.logspace(1, 7, 4000)
-    assert model.margins(w, model.loop_gain(seed, LM741, PN, PD, w))["phase_margin_deg"] < 0
+    assert model.margins(w, model.loop_gain(seed, LM741, PN, PD, w)).phase_margin_deg < 0
 
 
 def test_waveform_limits_and_slew_delay():
@@ -102,10 +102,10 @@ def test_waveform_limits_and_slew_delay():
     assert model.slew_delay(t, v, 1e6) == pytest.approx(4e-6, rel=1e-3)
     assert model.slew_delay(t, v, 10e6) == 0.0
     lim = model.waveform_limits({"u": v}, t, LM741, 1e-6)
-    assert lim["gain"]["v_max"] == pytest.approx(5.0) and lim["gain"]["v_min"] == pytest.approx(0.0)
-    assert lim["gain"]["swing_ok"] and not lim["gain"]["slew_ok"]
+    assert lim["gain"].v_max == pytest.approx(5.0) and lim["gain"].v_min == pytest.approx(0.0)
+    assert lim["gain"].swing_ok and not lim["gain"].slew_ok
     big = model.waveform_limits({"u": 3 * v}, t, LM741, 1e-3)
-    assert not big["gain"]["swing_ok"]
+    assert not big["gain"].swing_ok
 
 
 def test_optimizer_meets_overshoot_target_with_ideal_opamps():

@@ -20,3 +20,40 @@ def test_a_designed_plant_keeps_its_series_when_the_controller_uses_the_seed_par
     rows = {row[0]: row for row in bom}
     assert rows["R1 (plant)"][3] == "E24" and rows["C2 (plant)"][3] == "E12"
     assert rows["R5"][3] == "as given"
+
+
+def test_renderers_read_the_typed_result_and_compute_nothing(monkeypatch):
+    # the build sheet and the plots take the result as it is: no JSON round trip, no design code
+    from designer.pid import design, model, report
+    from designer.pid.result import PidResult
+    result = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2, tuning="amigo"), simulate=False)
+    expected = report.summary_text(result)
+
+    def forbidden(*args, **kwargs):
+        raise AssertionError("a renderer called back into the design or its JSON")
+
+    monkeypatch.setattr(PidResult, "to_dict", forbidden)
+    for name in ("plant_model", "design_pid", "resolve_plant"):
+        monkeypatch.setattr(design, name, forbidden)
+    for name in ("loop_gain", "assemble", "margins", "waveform_limits"):
+        monkeypatch.setattr(model, name, forbidden)
+    assert report.summary_text(result) == expected
+    assert set(report.plots(result)) == {"closed-loop.png", "controller.png", "blocks.png", "loop-bode.png",
+                                         "reaction-curve.png"}
+
+
+def test_the_json_keeps_its_keys():
+    # the keys of result.json as committed for the references are all there (additions allowed)
+    import json
+
+    from helpers import REPORTS
+    result = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2), simulate=False).to_dict()
+    ref = json.loads((REPORTS / "pid_zn_lm741_fc3500_z0.2" / "result.json").read_text())
+    assert set(ref) <= set(result)
+    for key in ("plant", "opamp", "tuning", "components", "series", "achieved", "test_signal", "closed_loop"):
+        assert set(ref[key]) <= set(result[key]), key
+    assert set(ref["closed_loop"]["analytic"]) <= set(result["closed_loop"]["analytic"])
+    assert set(ref["levels"]["analytic"]["gain"]) <= set(result["levels"]["analytic"]["gain"])
+    assert [c["name"] for c in result["checks"]] == [c["name"] for c in ref["checks"]]
+    assert all(c["id"] == c["name"] for c in result["checks"])
+    assert result["closed_loop"]["spice"] is None and result["levels"]["spice"] is None

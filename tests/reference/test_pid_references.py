@@ -87,6 +87,6 @@ def test_fresh_deck_alone_prints_the_reports_spice_figures(tmp_path):
     from designer.plant.sallenkey import SallenKeyParts
     res = design_pid(PidSpec(plant_parts=SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, 1.5), opamp="TL072",
                              tuning="simc"))
-    assert res.spice["stable"] and res.spice["settling_time_s"] is not None
+    assert res.spice.stable and res.spice.figures.settling_time_s > 0
     files = write_outputs(res, tmp_path, "fresh")
     assert_deck_measures_like_the_report(files["netlist"], res.to_dict(), tmp_path)

@@ -1,0 +1,176 @@
+"""What a ``design-pid`` user asks for, validated once, when it is built.
+
+A :class:`PidSpec` that exists is a valid one: every number inside its
+physical range (:data:`designer.core.ranges.RANGES`), the options consistent,
+the plant's parts (given, or read from a ``design-plant`` result.json) through
+the one plant validation, :func:`designer.plant.sallenkey.check_parts`.
+Numbers may be given as numbers or in engineering notation (``"43.215u"``),
+so that the command line hands over what the user typed and the message for
+a bad value quotes it.
+
+Errors name the library's parameters (``kp``, ``ti_s``, ``plant_fc_hz``);
+the command line shows its options instead, from one table
+(:data:`designer.cli.common.FLAGS`): a message about one parameter starts
+with its name (:attr:`DesignError.param`), a message about several writes
+them as ``{name}`` markers (:class:`ParamError`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields, replace
+
+from ..core import opamps
+from ..core.errors import DesignError
+from ..core.eseries import PartBounds
+from ..core.jsonio import read_result
+from ..core.ranges import ParamError, parse_in_range
+from ..plant.sallenkey import SallenKeyParts, check_parts
+from . import tuning as rules
+from .blocks import PidParts
+
+#: what the plant validation calls the fields of ``plant_parts`` (markers: see ParamError)
+PLANT_NAMES = {"r1": "{plant_r1}", "r2": "{plant_r2}", "c1": "{plant_c1}", "c2": "{plant_c2}",
+               "gain": "{plant_gain}", "r3": "R3", "r4": "R4", "plant": "{plant_r1}..{plant_c2}"}
+#: the ranges of the plant's parts the command line gives (keys of RANGES)
+PLANT_RANGES = {"r1": "resistor_ohm", "r2": "resistor_ohm", "c1": "capacitor_f", "c2": "capacitor_f", "gain": "gain"}
+#: the spec's own numbers and their ranges (keys of RANGES), in the order they are checked
+NUMBERS = (("plant_fc_hz", "fc_hz"), ("plant_zeta", "zeta"), ("kp", "kp"), ("ti_s", "ti_s"), ("td_s", "td_s"),
+           ("step_v", "step_v"), ("edge_s", "edge_s"), ("target_overshoot_pct", "target_overshoot_pct"),
+           ("target_settling_s", "target_settling_s"), ("f_integrator_hz", "f_integrator_hz"),
+           ("f_differentiator_hz", "f_differentiator_hz"), ("square_hz", "square_hz"))
+
+
+@dataclass(frozen=True)
+class PidSpec(PartBounds):
+    """A controller design request (SI units), validated on construction.
+
+    Give the plant one way: ``plant_fc_hz`` with ``plant_zeta`` (designed as
+    ``design-plant`` would), ``plant_parts`` (as built), or ``plant_json`` (a
+    ``design-plant``/``analyze-plant`` result.json). Gains come from a rule
+    (``tuning``: one of :data:`designer.pid.tuning.RULES`, default ``zn``),
+    from ``tuning="optimize"`` with ``target_overshoot_pct``, or explicitly
+    from ``kp``, ``ti_s`` and ``td_s`` together (``td_s = 0`` for a PI).
+    ``controller_parts`` skips the sizing (e.g. the seed's own parts). The
+    part series and bounds (keyword-only) are those of
+    :class:`~designer.core.eseries.PartBounds`.
+
+    Raises
+    ------
+    DesignError
+        One line naming the parameter at fault and what is allowed.
+    """
+
+    plant_fc_hz: float | None = None
+    plant_zeta: float | None = None
+    plant_parts: SallenKeyParts | None = None
+    plant_json: str | None = None
+    tuning: str | None = None          #: rule name, "optimize", or None (zn, or explicit if gains are given)
+    kp: float | None = None
+    ti_s: float | None = None
+    td_s: float | None = None
+    opamp: str = "LM741"
+    step_v: float = 1.0
+    edge_s: float = 100e-9
+    target_overshoot_pct: float | None = None
+    target_settling_s: float | None = None
+    f_integrator_hz: float | None = None
+    f_differentiator_hz: float | None = None
+    square_hz: float | None = None
+    controller_parts: PidParts | None = None
+    tol: float = 0.01
+    #: the plant read from ``plant_json`` (read and checked on construction, before any work)
+    json_plant: SallenKeyParts | None = field(default=None, init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        def put(name, value):
+            object.__setattr__(self, name, value)   # frozen: the spec is normalised once, here
+
+        for name, key in NUMBERS:
+            value = getattr(self, name)
+            if value is not None:
+                put(name, parse_in_range(value, name, key))
+        self.check_bounds()
+        sources = sum(x is not None for x in (self.plant_fc_hz, self.plant_parts, self.plant_json))
+        if sources != 1:
+            raise _refused("give the plant one way: {plant_fc_hz}/{plant_zeta}, {plant_r1}..{plant_c2}, "
+                           "or {plant_json}")
+        if self.plant_fc_hz is not None and self.plant_zeta is None:
+            raise _refused("{plant_fc_hz} needs {plant_zeta}")
+        if self.plant_fc_hz is None and self.plant_zeta is not None:
+            raise _refused("{plant_zeta} needs {plant_fc_hz}")
+        if self.plant_parts is not None:
+            # parts typed as text (the command line's) are read here, the rest by the plant validation
+            typed = {k: parse_in_range(getattr(self.plant_parts, k), f"plant_{k}", key)
+                     for k, key in PLANT_RANGES.items() if isinstance(getattr(self.plant_parts, k), str)}
+            put("plant_parts", check_plant(replace(self.plant_parts, **typed), PLANT_NAMES))
+        if self.plant_json is not None:
+            put("json_plant", plant_from_json(self.plant_json))
+        put("opamp", opamps.get(self.opamp).name)
+        if self.tuning is not None:
+            put("tuning", str(self.tuning).strip().lower())
+        explicit = [v is not None for v in (self.kp, self.ti_s, self.td_s)]
+        if any(explicit) and not all(explicit):
+            raise _refused("{kp}, {ti_s} and {td_s} go together (give all three)")
+        if all(explicit) and self.tuning not in (None, "explicit"):
+            raise _refused(f"{{tuning}} {self.tuning} and explicit {{kp}}/{{ti_s}}/{{td_s}} "
+                           "exclude each other")
+        if not all(explicit) and self.tuning not in (None, "optimize") and self.tuning not in rules.RULES:
+            raise _refused(f"unknown {{tuning}} {_short(self.tuning)}; allowed: {', '.join(rules.RULES)}, "
+                           "optimize")
+        if self.tuning == "optimize":
+            if self.target_overshoot_pct is None:
+                raise _refused("{tuning} optimize needs {target_overshoot_pct} P (percent)")
+        elif self.target_overshoot_pct is not None or self.target_settling_s is not None:
+            raise _refused("{target_overshoot_pct}/{target_settling_s} only apply to {tuning} optimize")
+
+    @property
+    def method(self) -> str:
+        """How the gains are chosen: ``explicit``, ``optimize`` or a rule name."""
+        return "explicit" if self.kp is not None else (self.tuning or "zn")
+
+
+#: the names a message of the spec marks as parameters (``{kp}``): its fields and the plant's parts
+PARAMS = frozenset({f.name for f in fields(PidSpec)} | {f"plant_{k}" for k in PLANT_RANGES})
+
+
+def _refused(marked: str) -> ParamError:
+    """A refusal naming parameters as ``{name}`` markers (only :data:`PARAMS`: a
+    file name's braces stay as they are)."""
+    return ParamError(marked, PARAMS)
+
+
+def _short(value) -> str:
+    """A value for a one-line message: short, no newlines, no numpy repr."""
+    text = repr(value) if isinstance(value, str) else type(value).__name__
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def check_plant(parts: SallenKeyParts, names: dict) -> SallenKeyParts:
+    """:func:`~designer.plant.sallenkey.check_parts` with its fields named by
+    ``names`` (markers allowed); a refusal as a :class:`ParamError`."""
+    try:
+        return check_parts(parts, name_of=names)
+    except DesignError as exc:
+        raise _refused(str(exc)) from None
+
+
+#: result.json keys of the plant's parts (the ``built`` object of design-plant and analyze-plant)
+BUILT_KEYS = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "gain": "gain", "r3": "R3_ohm",
+              "r4": "R4_ohm"}
+
+
+def plant_from_json(path) -> SallenKeyParts:
+    """The built plant of a ``design-plant``/``analyze-plant`` result.json, read
+    by the one reader (:func:`designer.core.jsonio.read_result`) and checked by
+    the one plant validation (:func:`designer.plant.sallenkey.check_parts`):
+    values of the wrong type, out of range, a gain that disagrees with R3/R4 or
+    an unstable circuit are refused in one line naming the file and the key."""
+    needed = tuple(BUILT_KEYS[k] for k in ("r1", "r2", "c1", "c2"))
+    try:
+        built = read_result(path, "{plant_json}", needs={"built": needed})["built"]
+    except DesignError as exc:
+        raise _refused(str(exc)) from None
+    shown = _short(str(path))
+    raw = SallenKeyParts(*(built.get(v) for v in BUILT_KEYS.values()))
+    names = {k: f"{{plant_json}} {shown}: built.{v}" for k, v in BUILT_KEYS.items()}
+    return check_plant(raw, names | {"plant": f"{{plant_json}} {shown}"})
