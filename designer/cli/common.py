@@ -182,6 +182,16 @@ def check_name(name) -> str:
     return name
 
 
+def check_output(args, name: str) -> None:
+    """Before any work: the design name is a plain file name and, unless
+    ``--no-files``, ``netlists/`` and ``reports/`` can be created under ``--out``
+    (a refusal after the work would waste it, and must write nothing)."""
+    check_name(name)
+    if not args.no_files:
+        from ..core.fileio import check_can_create
+        check_can_create(args.out, ("netlists", "reports"))
+
+
 def emit(result, args, name, write_outputs, summary_text) -> int:
     """Write the files (unless --no-files), then print JSON or the summary and the file list."""
     if not args.no_files:

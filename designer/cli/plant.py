@@ -14,7 +14,7 @@ from .common import (
     add_opamp_option,
     add_output_options,
     add_part_options,
-    check_name,
+    check_output,
     emit,
     part_options,
     run_cli,
@@ -78,10 +78,7 @@ def _design(args) -> int:
                      square_hz=args.square_freq, alternatives=args.alternatives)
     name = args.name if args.name is not None else (
         f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
-    check_name(name)
-    if not args.no_files:
-        from ..core.fileio import check_can_create
-        check_can_create(args.out, ("netlists", "reports"))  # fail before the work, not after
+    check_output(args, name)
     from ..plant.design import design_plant
     result = design_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
     return _emit(result, args, name)
@@ -138,10 +135,7 @@ def _analyze(args) -> int:
     p = spec.parts
     name = args.name if args.name is not None else "built_" + "_".join(
         f"{k}{value_code(v)}" for k, v in (("r1", p.r1), ("r2", p.r2), ("c1", p.c1), ("c2", p.c2)))
-    check_name(name)
-    if not args.no_files:
-        from ..core.fileio import check_can_create
-        check_can_create(args.out, ("netlists", "reports"))
+    check_output(args, name)
     return _emit(analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, name)
 
 

@@ -181,12 +181,11 @@ def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspi
                             "it lands on the spec")
     elif not amp.ideal:
         fig = result.analytic_opamp.figures
-        e_fn, e_z = fig.fn_hz / spec.fc_hz - 1, fig.zeta / spec.zeta - 1
-        if max(abs(e_fn), abs(e_z)) > NOTE_ERROR * 2:
+        if max(abs(fig.fn_error_pct), abs(fig.zeta_error_pct)) > 100 * NOTE_ERROR * 2:
             result.notes.append(
                 f"with the {amp.name}'s {format_eng(amp.gbw_hz, 'Hz')} gain-bandwidth the circuit lands "
-                f"{100 * e_fn:+.3g} % off in fn and {100 * e_z:+.3g} % in zeta; --compensate-gbw aims the "
-                "design off so that it lands on the spec (or choose a faster --opamp)")
+                f"{fig.fn_error_pct:+.3g} % off in fn and {fig.zeta_error_pct:+.3g} % in zeta; --compensate-gbw "
+                "aims the design off so that it lands on the spec (or choose a faster --opamp)")
     result.timings = {"search_s": t_search, **result.timings}
     return result
 
@@ -220,11 +219,11 @@ def part_series(values: dict, r_series=None, c_series=None):
     E12 capacitor: a 1k from a 5 % kit is not a 40 % E3 part, but a 1k26 exists
     only as an E192 (0.5 %) part.
 
+    ``r_series``/``c_series`` are normalised names (an :class:`AnalysisSpec`'s).
     Returns (labels {ref: :class:`PartSource`}, r band series, c band series, notes).
     """
     order = list(eseries.SERIES)
-    given = {"R": None if r_series is None else eseries.series_name(r_series),
-             "C": None if c_series is None else eseries.series_name(c_series)}
+    given = {"R": r_series, "C": c_series}
     labels, band, notes = {}, {"R": None, "C": None}, []
     for ref, v in values.items():
         kind = ref[0]

@@ -28,9 +28,28 @@ def title_of(result) -> str:
 
 
 def sections(result, with_images: bool = True) -> list:
-    b = result.built
-    amp = result.opamp
-    lab = result.sourcing.parts
+    """The build sheet as (heading, blocks) sections (see :mod:`designer.report.document`)."""
+    out = [("Bill of materials", [_bill(result)]),
+           ("Wiring", [R.table(["from", "to", "part"], wiring(result.built, result.opamp))]),
+           ("Target and achieved", _targets(result)),
+           ("Bench test", _bench(result)),
+           ("Checks", [R.table(["check", "result", "detail"],
+                               [[c.title, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]),
+           ("Sensitivity", _sensitivity(result))]
+    if result.alternatives:
+        out.append(("Alternatives (best first)", [_alternatives(result.alternatives)]))
+    if result.spice is not None:
+        out.append(("SPICE against the analytic models", _spice(result)))
+    if result.notes:
+        out.append(("Notes", [R.text(n) for n in result.notes]))
+    if with_images:
+        out.append(("Plots", [R.image("step.png", "step response: analytic and SPICE"),
+                              R.image("bode.png", "Bode plot")]))
+    return out
+
+
+def _bill(result):
+    b, amp, lab = result.built, result.opamp, result.sourcing.parts
     where = {"R1": "input resistor", "R2": "to the non-inverting input", "C1": "non-inverting input to ground",
              "C2": "R1-R2 node to the output (feedback)", "R3": "gain: inverting input to ground",
              "R4": "gain: output to inverting input"}
@@ -39,26 +58,26 @@ def sections(result, with_images: bool = True) -> list:
            for ref, role in where.items() if ref in lab]
     bom.append(["U1", amp.name, "", "", "", f"op-amp on {amp.vcc:g} V / {amp.vee:g} V"
                 + (" (follower: output to inverting input)" if b.r3 is None else "")])
-    out = [("Bill of materials", [R.table(["Ref", "Value", "Code", "Series", "Tolerance", "Where"], bom)]),
-           ("Wiring", [R.table(["from", "to", "part"], wiring(b, amp))])]
+    return R.table(["Ref", "Value", "Code", "Series", "Tolerance", "Where"], bom)
 
-    s = result.target
-    ideal = result.ideal
+
+def _targets(result):
+    s, ideal = result.target, result.ideal
     fig, opa = result.analytic.figures, result.analytic_opamp.figures
-    rows = [["fn", _f(s.fc_hz, "Hz"), _f(ideal and ideal.fn_hz, "Hz"), _f(b.fn_hz, "Hz"),
+    rows = [["fn", _f(s.fc_hz, "Hz"), _f(ideal and ideal.fn_hz, "Hz"), _f(fig.fn_hz, "Hz"),
              R.fmt_pct(fig.fn_error_pct), _f(opa.fn_hz, "Hz"), R.fmt_pct(opa.fn_error_pct)],
-            ["zeta", _n(s.zeta), _n(ideal and ideal.zeta), _n(b.zeta), R.fmt_pct(fig.zeta_error_pct),
+            ["zeta", _n(s.zeta), _n(ideal and ideal.zeta), _n(fig.zeta), R.fmt_pct(fig.zeta_error_pct),
              _n(opa.zeta), R.fmt_pct(opa.zeta_error_pct)],
-            ["Q", _n(s.q), _n(ideal and ideal.q), _n(b.q), "", _n(opa.q), ""]]
+            ["Q", _n(s.q), _n(ideal and ideal.q), _n(result.built.q), "", _n(opa.q), ""]]
     blocks = [R.table(["", "target", "exact parts", "built (ideal op-amp)", "error",
-                       f"built with {amp.name}", "error"], rows)]
+                       f"built with {result.opamp.name}", "error"], rows)]
     if result.ratios.m is not None:
         blocks.append(R.text(f"Ratios: m = R1/R2 = {result.ratios.m:.4g}, n = C2/C1 = {result.ratios.n:.4g}."))
-    out.append(("Target and achieved", blocks))
+    return blocks
 
-    ts = result.test
-    tol = result.tolerance
-    spice = result.spice
+
+def _bench(result):
+    ts, tol, spice = result.test, result.tolerance, result.spice
     expected = result.analytic_opamp.step
     rows = []
     for key, label, f in METRIC_ROWS:
@@ -68,62 +87,54 @@ def sections(result, with_images: bool = True) -> list:
     amp_v = ts.amplitude_v
     rows.append(["peak output", format_eng(expected.peak_value * amp_v, "V"),
                  format_eng(spice.step.peak_value * amp_v, "V") if spice else "", ""])
-    out.append(("Bench test", [
-        R.text(f"Function generator: square wave {format_eng(ts.frequency_hz, 'Hz')}, "
-               f"{format_eng(amp_v, 'V')} peak-to-peak with {format_eng(amp_v / 2, 'V')} "
-               f"offset (0 V to {format_eng(amp_v, 'V')}), into R1. Scope channel 1 on the input, "
-               f"channel 2 on the op-amp output; trigger on the rising edge, "
-               f"{format_eng(ts.half_period_s / 10, 's')}/div."),
-        R.table(["reading (rising edge)", f"expected ({amp.name} model)", "SPICE",
-                 f"band from tolerances (R {tol.r_tolerance_pct:g} %, C {tol.c_tolerance_pct:g} %)"], rows)]))
+    return [R.text(f"Function generator: square wave {format_eng(ts.frequency_hz, 'Hz')}, "
+                   f"{format_eng(amp_v, 'V')} peak-to-peak with {format_eng(amp_v / 2, 'V')} "
+                   f"offset (0 V to {format_eng(amp_v, 'V')}), into R1. Scope channel 1 on the input, "
+                   f"channel 2 on the op-amp output; trigger on the rising edge, "
+                   f"{format_eng(ts.half_period_s / 10, 's')}/div."),
+            R.table(["reading (rising edge)", f"expected ({result.opamp.name} model)", "SPICE",
+                     f"band from tolerances (R {tol.r_tolerance_pct:g} %, C {tol.c_tolerance_pct:g} %)"], rows)]
 
-    out.append(("Checks", [R.table(["check", "result", "detail"],
-                                   [[c.title, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]))
 
+def _sensitivity(result):
+    amp = result.opamp.name
     sens, sens_o = result.analytic.sensitivity, result.analytic_opamp.sensitivity
     rows = [[k, f"{v.wn:+.3f}", f"{v.zeta:+.3f}",
              f"{sens_o[k].wn:+.3f}" if k in sens_o else "", f"{sens_o[k].zeta:+.3f}" if k in sens_o else ""]
             for k, v in sens.items()]
     rows += [[k, "", "", f"{v.wn:+.4f}", f"{v.zeta:+.4f}"] for k, v in sens_o.items() if k not in sens]
-    out.append(("Sensitivity", [
-        R.text("Relative sensitivity S = d ln(y) / d ln(x): a 1 % change in the part changes y by S %."),
-        R.table(["part", "S(wn)", "S(zeta)", f"S(wn) with {amp.name}", f"S(zeta) with {amp.name}"], rows)]))
+    return [R.text("Relative sensitivity S = d ln(y) / d ln(x): a 1 % change in the part changes y by S %."),
+            R.table(["part", "S(wn)", "S(zeta)", f"S(wn) with {amp}", f"S(zeta) with {amp}"], rows)]
 
-    if result.alternatives:
-        rows = [[i + 1, " / ".join(format_eng(v, u, 3) for v, u in ((a.r1, "Ohm"), (a.r2, "Ohm"), (a.c1, "F"),
-                                                                    (a.c2, "F"))),
-                 _f(a.figures.fn_hz, "Hz"), _n(a.figures.zeta), R.fmt_pct(a.figures.fn_error_pct),
-                 R.fmt_pct(a.figures.zeta_error_pct)]
-                for i, a in enumerate(result.alternatives)]
-        out.append(("Alternatives (best first)", [R.table(["#", "R1 / R2 / C1 / C2", "fn", "zeta", "fn error",
-                                                          "zeta error"], rows)]))
 
-    if spice:
-        cmp_ = spice.comparison
-        rows = []
-        for key, label, f in METRIC_ROWS:
-            a, o = cmp_.vs_ideal[key], cmp_.vs_opamp[key]
-            unit = " pp" if key == "overshoot_pct" else ""
-            def dd(x):
-                if x["delta"] is None:
-                    return "n/a"
-                return (f"{x['delta']:+.3g}{unit}" if key == "overshoot_pct"
-                        else f"{format_eng(x['delta'], 's', 3)} ({R.fmt_pct(x['delta_pct'])})")
-            rows.append([label, dd(a), dd(o)])
-        rows.append(["normalised RMS waveform error", f"{spice.nrms_ideal:.3g}", f"{spice.nrms:.3g}"])
-        out.append(("SPICE against the analytic models", [
-            R.text(f"ngspice ({spice.simulator} backend), {amp.name} behavioural model. Deltas are SPICE minus "
+def _alternatives(alternatives):
+    rows = [[i + 1, " / ".join(format_eng(v, u, 3) for v, u in ((a.r1, "Ohm"), (a.r2, "Ohm"), (a.c1, "F"),
+                                                                (a.c2, "F"))),
+             _f(a.figures.fn_hz, "Hz"), _n(a.figures.zeta), R.fmt_pct(a.figures.fn_error_pct),
+             R.fmt_pct(a.figures.zeta_error_pct)]
+            for i, a in enumerate(alternatives)]
+    return R.table(["#", "R1 / R2 / C1 / C2", "fn", "zeta", "fn error", "zeta error"], rows)
+
+
+def _spice(result):
+    spice, amp = result.spice, result.opamp.name
+    cmp_ = spice.comparison
+
+    def delta(x, key):
+        if x["delta"] is None:
+            return "n/a"
+        if key == "overshoot_pct":
+            return f"{x['delta']:+.3g} pp"
+        return f"{format_eng(x['delta'], 's', 3)} ({R.fmt_pct(x['delta_pct'])})"
+
+    rows = [[label, delta(cmp_.vs_ideal[key], key), delta(cmp_.vs_opamp[key], key)] for key, label, _ in METRIC_ROWS]
+    rows.append(["normalised RMS waveform error", f"{spice.nrms_ideal:.3g}", f"{spice.nrms:.3g}"])
+    return [R.text(f"ngspice ({spice.simulator} backend), {amp} behavioural model. Deltas are SPICE minus "
                    f"model; NRMS = RMS of (model - SPICE) / (1 % of |model| + {format_eng(cmp_.nrms_abstol_v, 'V')})"
                    ". SPICE agrees with the op-amp-aware model when NRMS is below 1 and overshoot is within 1 pp, "
                    "peak and rise time within 2 %, settling time within 5 % (or half a ringing period): "
                    + ("it does." if cmp_.passed else "it does NOT (" + "; ".join(cmp_.disagreements) + ").")),
-            R.table(["metric", "vs ideal model", f"vs {amp.name}-aware model"], rows)]))
-    if result.notes:
-        out.append(("Notes", [R.text(n) for n in result.notes]))
-    if with_images:
-        out.append(("Plots", [R.image("step.png", "step response: analytic and SPICE"),
-                              R.image("bode.png", "Bode plot")]))
-    return out
+            R.table(["metric", "vs ideal model", f"vs {amp}-aware model"], rows)]
 
 
 def wiring(b, amp) -> list:
