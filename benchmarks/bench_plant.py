@@ -173,7 +173,8 @@ def main():
                   f"{100 * res[0].worst:.4f} % | {'yes' if same else 'NO'} |")
 
     print("\n### design-plant --fc 3500 --zeta 0.2, in process (median of 3)\n")
-    from designer.plant.design import PlantSpec, design_plant
+    from designer.plant.design import design_plant
+    from designer.plant.spec import PlantSpec
     from designer.plant.report import write_outputs
     rows = []
     for _ in range(3):

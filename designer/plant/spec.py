@@ -46,8 +46,12 @@ def _whole(value, name: str) -> int:
             return int(n)
     except DesignError:
         pass
-    shown = repr(value) if isinstance(value, str) else f"{value:g}" if isinstance(value, (int, float)) \
-        else type(value).__name__
+    if isinstance(value, str):
+        shown = repr(value)
+    elif isinstance(value, (int, float)):
+        shown = f"{value:g}"
+    else:
+        shown = type(value).__name__
     raise DesignError(f"{name} must be a whole number from {RANGES[name].text()}, got {shown}", param=name)
 
 
