@@ -1,7 +1,11 @@
 """What every command shares: the one-line error contract and exit statuses
-(:func:`run_cli`), the parser that turns usage mistakes into one line, printing
-that survives a closed pipe, the part-selection and output options, design
-names, and writing a result's files then printing it (:func:`emit`).
+(:func:`run_cli`), with the library's parameter names shown as the options
+the user typed (:data:`FLAGS`); the parser that turns usage mistakes into one
+line, printing that survives a closed pipe, the part-selection, output and
+op-amp options, design names and the output check before any work
+(:func:`check_output`), and writing a result's files then printing it
+(:func:`emit`). The commands hand the options to the library's specs as
+typed: the specs check them, once.
 """
 
 from __future__ import annotations
@@ -15,7 +19,7 @@ import sys
 from ..core import opamps
 from ..core.errors import DesignError
 from ..core.eseries import SERIES
-from ..core.ranges import help_range, parse_in_range
+from ..core.ranges import help_range
 
 
 #: library parameter -> the option a user types; errors naming a parameter
@@ -136,11 +140,6 @@ def part_options(args) -> dict:
     """:func:`add_part_options` as typed, as keyword arguments of a spec
     (a :class:`~designer.core.eseries.PartBounds`, which checks them)."""
     return {k: getattr(args, k) for k in ("r_series", "c_series", "r_min", "r_max", "c_min", "c_max")}
-
-
-def optional(text, name: str, key: str):
-    """:func:`parse_in_range`, or None for an option not given."""
-    return None if text is None else parse_in_range(text, name, key)
 
 
 def add_output_options(p, default_name: str):
