@@ -79,6 +79,7 @@ def fn_zeta(r1, r2, c1, c2, gain=1.0):
     or arrays of them (the joint search evaluates millions at once)."""
     a, b = coefficients(r1, r2, c1, c2, gain)
     sa = np.sqrt(a)
+    # wn = 1/sqrt(a) first, then fn: the rounding the designs' figures have always had
     return (1.0 / sa) / (2 * np.pi), b / (2 * sa)
 
 
