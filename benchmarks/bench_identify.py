@@ -15,7 +15,6 @@ most 1.5x the file's size plus 150 MB for the interpreter and libraries.
 from __future__ import annotations
 
 import math
-import os
 import statistics
 import subprocess
 import sys
@@ -26,7 +25,8 @@ from pathlib import Path
 import numpy as np
 
 from designer.identify.io import read_capture
-from designer.identify.step import identify_step, model_fn_zeta
+from designer.identify.against import model_fn_zeta
+from designer.identify.step import identify_step
 from designer.identify.structures import model_step
 
 N = 1_000_000

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from designer.identify import frequency as fr
+from designer.identify import io as tio
 from designer.identify import second_order as so
 from designer.identify.structures import model_step
 
@@ -56,7 +57,7 @@ def noisy_table(n=200, seed=1):
     w = np.geomspace(0.01, 30, n) * p["wn_rad_s"]
     g = fr.model_response("underdamped", p, w) * (1 + 0.01 * rng.standard_normal(n))
     ph = fr.model_phase("underdamped", p, w) + np.deg2rad(0.5) * rng.standard_normal(n)
-    return fr.freq_data(w, np.abs(g), ph, gain_units="ratio", phase_units="rad",
+    return tio.freq_data(w, np.abs(g), ph, gain_units="ratio", phase_units="rad",
                         freq_units="rad/s"), p
 
 
@@ -64,9 +65,9 @@ def main():
     print("### identify-freq: frequency-response fits (median of 3)\n")
     print("| table | points | time (ms) | best | parameters |")
     print("|---|---:|---:|---|---|")
-    fr.identify_freq(fr.read_freq_table(FIX / "seed000_table4_deg.csv"))     # warm imports
-    cases = [("seed 000 Table IV", fr.read_freq_table(FIX / "seed000_table4_deg.csv")),
-             ("seed 003 Table 3.1", fr.read_freq_table(FIX / "seed003_table31.csv")),
+    fr.identify_freq(tio.read_freq_table(FIX / "seed000_table4_deg.csv"))     # warm imports
+    cases = [("seed 000 Table IV", tio.read_freq_table(FIX / "seed000_table4_deg.csv")),
+             ("seed 003 Table 3.1", tio.read_freq_table(FIX / "seed003_table31.csv")),
              ("synthetic, 1 % noise (wn 21991 rad/s, zeta 0.2, theta 2 us)", noisy_table()[0])]
     for label, d in cases:
         dt, res = _median_time(lambda d=d: fr.identify_freq(d))

@@ -1,8 +1,12 @@
-"""``identify``: plant models from a measured or simulated step response.
+"""``identify`` and ``identify-freq``: plant models from measurements.
 
-Reads a CSV capture (generic, Tektronix, Rigol or this project's waveforms),
-runs every classical method of seeds 000-003 plus least squares, and prints
-them ranked by IAE; ``--json`` prints one JSON object instead.
+``identify`` reads a CSV step-response capture (generic, Tektronix, Rigol or
+this project's waveforms), runs every classical method of seeds 000-003 plus
+least squares, and prints them ranked by IAE. ``identify-freq`` reads a table
+of frequency, gain and (optionally) phase, reads asymptotes, resonant peak and
+dead time as seeds 000 and 003 do, fits FOPDT, underdamped and overdamped
+models to the complex response by least squares, and prints them ranked by
+fit error. With ``--json`` either prints one JSON object instead.
 """
 
 from __future__ import annotations
@@ -13,13 +17,21 @@ import sys
 from pathlib import Path
 
 from ..core.errors import DesignError
+from ..core.fileio import (
+    MAX_CAPTURE_BYTES,
+    MAX_CAPTURE_ROWS,
+    MAX_TABLE_BYTES,
+    atomic_write,
+    shown,
+    size_text,
+)
 from ..core.jsonio import json_safe
 from ..core.ranges import RANGES, help_range, parse_in_range
 from ..core.units import parse_value
-from ..report.plots import png_bytes
+from ..identify.io import FREQ_UNITS, GAIN_UNITS, MAX_POINTS, PHASE_UNITS
 from .common import OneLineParser, print_output, run_cli
 
-EPILOG = """\
+IDENTIFY_EPILOG = """\
 examples:
   identify capture.csv                         # t,y or t,u,y (header optional)
   identify scope.csv --step-time 0 --step-amplitude 2
@@ -38,10 +50,11 @@ the second the output unless their names say otherwise (u/vin/in, y/vout/out);
 
 methods: first order (ziegler-nichols, hagglund, smith, sundaresan-krishnaswamy,
 nishikawa, alfaro, broida, chen-yang, ho, viteckova), double pole
-(ho-double-pole, viteckova-double-pole), the second-order methods when
-available, and least-squares fits (fopdt, overdamped, underdamped) with 95 %
-confidence intervals. Parameters: K, tau_s, theta_s; K, wn_rad_s, zeta,
-theta_s; K, tau1_s, tau2_s, theta_s.
+(ho-double-pole, viteckova-double-pole), second order (overshoot,
+log-decrement, t4-t3, two-pole, chen, stark-mollenkamp, jahanmiri-fallahi,
+peeling, dc-motor), and least-squares fits (fopdt, overdamped, underdamped)
+with 95 % confidence intervals. Parameters: K, tau_s, theta_s; K, wn_rad_s,
+zeta, theta_s; K, tau1_s, tau2_s, theta_s.
 
 limits: a capture of at most {size} and {rows:,} samples; every time
 {t_rng} and the record {span_rng} long; every sample {v_rng}
@@ -50,15 +63,109 @@ limits: a capture of at most {size} and {rows:,} samples; every time
 exit status: 0 success, 2 bad input (one line on stderr saying what and why).
 """
 
+FREQ_EPILOG = """\
+examples:
+  identify-freq bode.csv                      # f_hz,gain_db,phase_deg (header optional)
+  identify-freq sensor.csv --gain-units ratio --phase-units s
+        gain as Vout/Vin and phase as the output's time shift behind the input
+  identify-freq opamp.csv --json > models.json  # methods[], best, data, error_definition
+  identify-freq bode.csv --plot bode.png      # data against the fitted models
 
-def epilog() -> str:
-    """The --help epilog with the input limits filled in."""
-    from ..core.fileio import MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, size_text
-    return EPILOG.format(size=size_text(MAX_CAPTURE_BYTES), rows=MAX_CAPTURE_ROWS,
-                         t_rng=RANGES["capture_time_s"].text(),
-                         span_rng=RANGES["capture_span_s"].text(),
-                         v_rng=RANGES["capture_value"].text(),
-                         step_rng=RANGES["output_step"].text())
+table: one row per frequency: frequency, gain[, phase]; comma, semicolon (decimal
+comma allowed), tab or space separated; '#' lines are comments. A header row may
+name the units (f_hz, f_khz, w_rad_s, gain_db, gain_ratio, phase_deg, phase_rad,
+shift_s, shift_us); options override it. Defaults: Hz, dB, degrees. A phase
+given as a time shift dt is the output lagging the input: phase = -360 f dt.
+
+methods: asymptotes (K, high-frequency slope -> order, corner where the gain
+has fallen 3.01n dB; 1 pole -> fopdt, 2 -> double-pole), resonant-peak (zeta from
+the peak height -10 log(4 zeta^2 (1 - zeta^2)), wn from its frequency),
+least-squares (fopdt, underdamped, overdamped, with dead time when there is
+phase; 95 % confidence half-widths). Dead time is read from the phase lag the
+model does not explain.
+
+fit error (the iae/ise columns): e = |G_model/G_data - 1| at each tabulated
+frequency (gain only without phase); iae = mean of e, ise = mean of e^2.
+A model is valid (ok = yes) when its fit error is at most {max_err:g} % and its
+corner frequencies (1/tau, wn) lie inside the measured band widened {band:g} times.
+
+limits: a table of at most {size} and {rows:,} rows; frequency {f_rng},
+gain {db_rng} (ratio {ratio_rng}), phase {ph_rng} degrees
+(after unit conversion).
+
+exit status: 0 success, 2 bad input (one line on stderr saying what and why).
+"""
+
+
+# --------------------------------------------------------------------------- shared
+
+def check_output_path(path, option: str) -> None:
+    """Refuse, before any work, an output file that cannot be written: the path
+    is a directory, or one of its parents is a file. (Nothing is created here:
+    a run refused later must leave no trace.)"""
+    if str(path) == "":
+        raise DesignError(f"{option} needs a file name, such as fit.png")
+    p = Path(path)
+    try:
+        is_dir = str(path) in (".", "..") or p.is_dir()
+        blocker = next((q for q in p.parents if q.exists()), None)
+        blocked = blocker is not None and not blocker.is_dir()
+    except (OSError, ValueError) as exc:   # a name too long, a NUL byte
+        raise DesignError(f"{option} {shown(path)} is not a usable file name: "
+                          f"{getattr(exc, 'strerror', None) or exc}") from None
+    if is_dir:
+        raise DesignError(f"{option} {shown(path)} is a directory; give a file name such as "
+                          "fit.png")
+    if blocked:
+        raise DesignError(f"{option} {shown(path)}: cannot create directory {shown(blocker)}: "
+                          "a file of that name exists")
+
+
+def write_png(path, png: bytes, option: str = "--plot") -> None:
+    """Write a PNG atomically; an OS error (disk full, permission) is one line."""
+    try:
+        atomic_write(path, png)
+    except OSError as exc:
+        raise DesignError(f"{option}: cannot write {shown(path)}: "
+                          f"{exc.strerror or exc}") from None
+
+
+def _run(args, identify, text, plot) -> int:
+    """Either command: its result printed as JSON or as its table (and the plot written)."""
+    result = identify(args)
+    if args.plot:
+        write_png(args.plot, plot(result))
+    if args.json:
+        print_output(json.dumps(json_safe(result.to_dict()), indent=2, allow_nan=False))
+    else:
+        print_output(text(result) + (f"\n\nPlot written to {args.plot}" if args.plot else ""))
+    return 0
+
+
+def _parser(prog: str, description: str, epilog: str, data_help: str, data_name: str):
+    p = OneLineParser(prog=prog, description=description, epilog=epilog,
+                      formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument(data_name, help=data_help)
+    return p
+
+
+def _output_options(p, plot_help: str, json_first: bool = False) -> None:
+    options = [(("--plot",), {"metavar": "OUT_PNG", "help": plot_help}),
+               (("--json",), {"action": "store_true",
+                              "help": "print one JSON object instead of the table"})]
+    for flags, kwargs in (options[::-1] if json_first else options):
+        p.add_argument(*flags, **kwargs)
+
+
+# --------------------------------------------------------------------------- identify
+
+def identify_epilog() -> str:
+    """The ``identify --help`` epilog with the input limits filled in."""
+    return IDENTIFY_EPILOG.format(size=size_text(MAX_CAPTURE_BYTES), rows=MAX_CAPTURE_ROWS,
+                                  t_rng=RANGES["capture_time_s"].text(),
+                                  span_rng=RANGES["capture_span_s"].text(),
+                                  v_rng=RANGES["capture_value"].text(),
+                                  step_rng=RANGES["output_step"].text())
 
 
 def step_time(text) -> float:
@@ -79,11 +186,10 @@ def step_amplitude(text) -> float:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = OneLineParser(prog="identify",
-                description="Identify plant models (FOPDT, double pole, second order with dead\n"
-                            "time) from a measured or simulated step response, ranked by IAE.",
-                epilog=epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("capture", help="CSV file with the step response")
+    """The ``identify`` command line."""
+    p = _parser("identify", "Identify plant models (FOPDT, double pole, second order with dead\n"
+                "time) from a measured or simulated step response, ranked by IAE.",
+                identify_epilog(), "CSV file with the step response", "capture")
     p.add_argument("--step-time", metavar="T",
                    help="when the input stepped, in seconds " + help_range("capture_time_s")
                         + " (default: from the input column, else t = 0 if the record spans "
@@ -101,13 +207,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-refine", action="store_true", help="skip the least-squares fits")
     p.add_argument("--against", metavar="RESULT_JSON",
                    help="a design-plant result.json to compare fn, zeta, gain and overshoot with")
-    p.add_argument("--plot", metavar="OUT_PNG", help="write a PNG of the data against the best models")
-    p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+    _output_options(p, "write a PNG of the data against the best models")
     return p
 
 
-def run(args):
-    """Identify from parsed arguments, write the plot; return the result."""
+def identify_capture(args):
+    """Identify from parsed ``identify`` arguments; returns the
+    :class:`~designer.identify.step.IdentifyResult` (with its comparison)."""
     from ..identify.io import read_capture
 
     t_step = None if args.step_time is None else step_time(args.step_time)
@@ -117,99 +223,78 @@ def run(args):
     # The file is read before scipy is imported, so bad input fails fast.
     cap = read_capture(args.capture, input_column=args.input_column,
                        output_column=args.output_column)
-    from ..identify.step import compare_with_design, identify_step, load_design
+    from ..identify.against import compare_with_design, load_design
+    from ..identify.step import identify_step
     design = load_design(args.against) if args.against else None
     u = cap.u
     if t_step is not None:
         u = None if amp is not None else u
     result = identify_step(cap.t, cap.y, u, step_time=t_step, step_amplitude=amp,
                            methods=args.methods, refine=not args.no_refine,
-                           capture=cap.to_dict())
+                           capture=cap.info())
     if design is not None:
         result.comparison = compare_with_design(result, design)
-    if args.plot:
-        plot_fit(result, args.plot)
     return result
-
-
-def check_output_path(path, option: str) -> None:
-    """Refuse, before any work, an output file that cannot be written: the path
-    is a directory, or one of its parents is a file. (Nothing is created here:
-    a run refused later must leave no trace.)"""
-    from ..core.fileio import shown
-    if str(path) == "":
-        raise DesignError(f"{option} needs a file name, such as fit.png")
-    p = Path(path)
-    try:
-        is_dir = str(path) in (".", "..") or p.is_dir()
-        blocker = next((q for q in p.parents if q.exists()), None)
-        blocked = blocker is not None and not blocker.is_dir()
-    except (OSError, ValueError) as exc:   # a name too long, a NUL byte
-        raise DesignError(f"{option} {shown(path)} is not a usable file name: "
-                          f"{getattr(exc, 'strerror', None) or exc}") from None
-    if is_dir:
-        raise DesignError(f"{option} {shown(path)} is a directory; give a file name such as "
-                          "fit.png")
-    if blocked:
-        raise DesignError(f"{option} {shown(path)}: cannot create directory {shown(blocker)}: "
-                          "a file of that name exists")
-
-
-def write_png(path, fig, option: str = "--plot") -> None:
-    """Write a figure atomically; an OS error (disk full, permission) is one line."""
-    from ..core.fileio import atomic_write
-    from ..core.fileio import shown
-    try:
-        atomic_write(path, png_bytes(fig))
-    except OSError as exc:
-        raise DesignError(f"{option}: cannot write {shown(path)}: "
-                          f"{exc.strerror or exc}") from None
 
 
 def identify_main(argv=None) -> int:
     """Console entry point ``identify``."""
-    return run_cli("identify", build_parser, _main, argv)
+    from ..identify.report import fit_plot, step_text
+    return run_cli("identify", build_parser,
+                   lambda args: _run(args, identify_capture, step_text, fit_plot), argv)
 
 
-def _main(args) -> int:
-    result = run(args)
-    if args.json:
-        print_output(json.dumps(json_safe(result.to_dict()), indent=2, allow_nan=False))
-    else:
-        print_output(result.to_text() + (f"\n\nPlot written to {args.plot}" if args.plot else ""))
-    return 0
+# --------------------------------------------------------------------------- identify-freq
+
+def freq_epilog() -> str:
+    """The ``identify-freq --help`` epilog with the validity rule and the input limits."""
+    from ..identify.frequency import BAND_FACTOR, MAX_FIT_ERROR
+    return FREQ_EPILOG.format(max_err=100 * MAX_FIT_ERROR, band=BAND_FACTOR,
+                              size=size_text(MAX_TABLE_BYTES), rows=MAX_POINTS,
+                              f_rng=RANGES["freq_hz"].text(), db_rng=RANGES["gain_db"].text(),
+                              ratio_rng=RANGES["gain_ratio"].text(),
+                              ph_rng=RANGES["phase_deg"].text())
 
 
-def plot_fit(result, path, n_models: int = 3) -> None:
-    """PNG of the data against the best ``n_models`` valid models (written atomically)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+def _lower(text: str) -> str:
+    return text.strip().lower()
 
-    from ..identify.preprocess import block_mean
-    from ..identify.structures import model_step
 
-    s = result.step
-    t, y = block_mean(s.t_raw, s.y_raw, 20000)
-    fig, (ax, axr) = plt.subplots(2, 1, figsize=(8, 6), dpi=110, sharex=True,
-                                  gridspec_kw={"height_ratios": [3, 1]})
-    tt = t - s.t_step
-    ax.plot(tt, y, color="k", lw=2.2, alpha=0.35, label="data")
-    shown = [m for m in result.methods if m.valid][:n_models]
-    for m, style in zip(shown, ("-", "--", ":")):
-        ym = s.y0 + s.amplitude * model_step(m.model, m.params, tt)
-        line, = ax.plot(tt, ym, lw=1.2, ls=style, label=f"{m.name} ({m.model}), IAE {m.iae:.3g}")
-        axr.plot(tt, y - ym, lw=0.8, ls=style, color=line.get_color())
-    for a in (ax, axr):
-        a.axvline(0.0, color="k", lw=0.6, ls=":")
-        a.grid(True, alpha=0.3)
-    axr.set_xlabel("time since the step (s)")
-    axr.set_ylabel("data - model")
-    ax.set_ylabel(result.capture.get("output", "output") if result.capture else "output")
-    ax.set_title("Step response: data and best identified models")
-    ax.legend(fontsize=8, loc="best")
-    fig.tight_layout()
-    write_png(path, fig)
+def build_freq_parser() -> argparse.ArgumentParser:
+    """The ``identify-freq`` command line."""
+    p = _parser("identify-freq", "identify-freq: plant models from a measured frequency response "
+                "(Bode table).",
+                freq_epilog(), "CSV table: frequency, gain[, phase]", "table")
+    # units in any case: dB, Hz, Rad/s
+    p.add_argument("--gain-units", choices=GAIN_UNITS, type=_lower,
+                   help="gain in decibels or as the amplitude ratio Vout/Vin (default: from the "
+                        "header, else db)")
+    p.add_argument("--phase-units", choices=PHASE_UNITS, type=_lower,
+                   help="phase in degrees, radians, or the output's time shift in seconds "
+                        "(default: from the header, else deg)")
+    p.add_argument("--freq-units", choices=FREQ_UNITS, type=_lower,
+                   help="frequency in Hz or rad/s (default: from the header, else hz)")
+    _output_options(p, "write a Bode plot of the data and the fits", json_first=True)
+    return p
+
+
+def identify_table(args):
+    """Identify from parsed ``identify-freq`` arguments; returns the
+    :class:`~designer.identify.frequency.FreqIdentifyResult`."""
+    from ..identify.frequency import identify_freq
+    from ..identify.io import read_freq_table
+    if args.plot:
+        check_output_path(args.plot, "--plot")
+    data = read_freq_table(args.table, gain_units=args.gain_units,
+                           phase_units=args.phase_units, freq_units=args.freq_units)
+    return identify_freq(data)
+
+
+def identify_freq_main(argv=None) -> int:
+    """Console entry point ``identify-freq``."""
+    from ..identify.report import bode_fit_plot, freq_text
+    return run_cli("identify-freq", build_freq_parser,
+                   lambda args: _run(args, identify_table, freq_text, bode_fit_plot), argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

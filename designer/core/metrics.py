@@ -3,7 +3,7 @@
 One pure function, :func:`step_metrics`, takes time and output arrays and
 returns a :class:`StepMetrics`. Crossing times are linearly interpolated
 between samples and the peak is refined with a parabola through its three
-samples, so a dense grid gives figures accurate to a small fraction of the
+samples (:mod:`designer.core.waveform`), so a dense grid gives figures accurate to a small fraction of the
 sample spacing (python-control's automatic grid can be ~4 % off on rise time).
 """
 
@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .errors import DesignError
+from .waveform import crossing_time, normalised_step, refine_peak
 
 
 @dataclass(frozen=True)
@@ -33,22 +34,6 @@ class StepMetrics:
     def to_dict(self) -> dict:
         return {k: (None if isinstance(v, float) and math.isnan(v) else v)
                 for k, v in asdict(self).items()}
-
-
-def first_crossing(t, y, level, start: int = 0) -> float:
-    """Time at which ``y`` first reaches ``level`` (rising) at or after index
-    ``start``, linearly interpolated; nan if never."""
-    t = np.asarray(t, float)
-    y = np.asarray(y, float)
-    idx = np.nonzero(y[start:] >= level)[0]
-    if idx.size == 0:
-        return math.nan
-    i = idx[0] + start
-    if i == 0:
-        return float(t[0])
-    y0, y1 = y[i - 1], y[i]
-    frac = 0.0 if y1 == y0 else (level - y0) / (y1 - y0)
-    return float(t[i - 1] + frac * (t[i] - t[i - 1]))
 
 
 def settling_time(t, y, final, span, band) -> float:
@@ -95,30 +80,20 @@ def step_metrics(t, y, *, t_step: float | None = None, initial: float | None = N
         raise DesignError("step metrics: the waveform contains NaN or infinite samples")
     if np.any(np.diff(t) <= 0):
         raise DesignError("step metrics: time must be strictly increasing")
-    ts0 = float(t[0]) if t_step is None else float(t_step)
-    keep = t >= ts0 - 1e-15 * max(1.0, abs(ts0))
-    t, y = t[keep] - ts0, y[keep]
-    y0 = float(y[0]) if initial is None else float(initial)
-    yf = float(y[-1]) if final is None else float(final)
+    # normalised to a rising 0 -> 1 step so one code path handles steps down
+    t, z, y0, yf = normalised_step(t, y, t_step=t_step, initial=initial, final=final,
+                                   what="step metrics")
     span = yf - y0
-    if span == 0:
-        raise DesignError("step metrics: the output does not change (initial equals final value)")
-    # normalise to a rising 0 -> 1 step so one code path handles steps down
-    z = (y - y0) / span
     ip = int(np.argmax(z))
     zp, tp = float(z[ip]), float(t[ip])
-    if 0 < ip < len(z) - 1:
-        za, zb, zc = z[ip - 1], z[ip], z[ip + 1]
-        denom = za - 2 * zb + zc
-        if denom < 0 and np.isclose(t[ip + 1] - t[ip], t[ip] - t[ip - 1], rtol=1e-6):
-            d = 0.5 * (za - zc) / denom
-            h = t[ip] - t[ip - 1]
-            tp = float(t[ip] + d * h)
-            zp = float(zb - 0.25 * (za - zc) * d)
+    # refined between evenly spaced samples only (SPICE's own time steps are
+    # not: there the sample is the figure, as the committed references have it)
+    if 0 < ip < len(z) - 1 and np.isclose(t[ip + 1] - t[ip], t[ip] - t[ip - 1], rtol=1e-6):
+        tp, zp, _ = refine_peak(t, z, ip)
     overshoot = max(0.0, (zp - 1.0) * 100.0)
-    t10 = first_crossing(t, z, 0.1)
-    t90 = first_crossing(t, z, 0.9)
-    t100 = first_crossing(t, z, 1.0) if zp > 1.0 else math.nan
+    t10 = crossing_time(t, z, 0.1)
+    t90 = crossing_time(t, z, 0.9)
+    t100 = crossing_time(t, z, 1.0) if zp > 1.0 else math.nan
     if overshoot == 0.0:
         # monotone response: "peak" is where it gets to its final value
         tp = math.nan

@@ -8,8 +8,10 @@ always fractions of the change, y0 + p (yf - y0), with y0 = 0 here because
 
 Methods
 -------
-- ``ziegler-nichols``: tangent at the steepest point; theta where it meets the
-  baseline, tau from there to where it meets yf (seed 000 eq. 7, fig. 3).
+- ``ziegler-nichols``: tangent at the steepest point
+  (:func:`designer.core.waveform.inflection_tangent`, the one the PID tuning
+  reads too); theta where it meets the baseline, tau from there to where it
+  meets yf (seed 000 eq. 7, fig. 3).
 - ``hagglund``: theta from the same tangent, tau = t63.2 - theta.
 - ``smith``: 28.3 % and 63.2 %: tau = 1.5 (t2 - t1), theta = t2 - tau (eq. 10).
 - ``sundaresan-krishnaswamy``: 35.3 % and 85.3 %: tau = 0.67 (t2 - t1),
@@ -43,7 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .preprocess import crossing_time, noise_sigma, smooth_derivative, window_samples
+from ..core.waveform import crossing_time, inflection_tangent, noise_sigma
 from .structures import MethodResult
 
 #: An FOPDT or double-pole model cannot overshoot; beyond this the data are
@@ -144,73 +146,15 @@ def _points_ok(name, model, times, K):
     return None
 
 
-def _sigma(y):
-    return noise_sigma(y)
-
-
 # --------------------------------------------------------------------------- tangent
-
-@dataclass(frozen=True)
-class Tangent:
-    """Inflection-point tangent: time, level and slope at the steepest point."""
-
-    t: float
-    y: float
-    slope: float
-    window_s: float = 0.0   #: smoothing window of the derivative
-
-    @property
-    def t_base(self) -> float:
-        """Where the tangent meets the baseline y = 0."""
-        return self.t - self.y / self.slope
-
-    def t_level(self, level: float) -> float:
-        return self.t + (level - self.y) / self.slope
-
-
-def steepest_tangent(t, y, yf, *, sigma: float | None = None) -> Tangent:
-    """Tangent at the point of maximum slope (towards yf), from a smoothed derivative.
-
-    The maximum of the Savitzky-Golay derivative is refined with a parabola
-    through its three samples, and the level there is the smoothed response,
-    so a dense noise-free record gives the analytic tangent.
-    """
-    sigma = _sigma(y) if sigma is None else sigma
-    sgn = 1.0 if yf >= 0 else -1.0
-    rise = (crossing_time(t, sgn * np.asarray(y), 0.9 * abs(yf), sigma=sigma)
-            - crossing_time(t, sgn * np.asarray(y), 0.1 * abs(yf), sigma=sigma))
-    ts, ys, dy = smooth_derivative(t, y, sigma=sigma, span=yf, rise_s=rise)
-    d = sgn * dy
-    # Only up to the first time the response reaches yf: later slopes
-    # (ringing) are not the reaction curve's.
-    reach = np.nonzero(sgn * ys >= abs(yf))[0]
-    stop = int(reach[0]) + 1 if reach.size else ts.size
-    i = int(np.argmax(d[:stop]))
-    t_i, y_i, s_i = ts[i], ys[i], dy[i]
-    if 0 < i < ts.size - 1:
-        d0, d1, d2 = d[i - 1], d[i], d[i + 1]
-        den = d0 - 2 * d1 + d2
-        # Refine only a smooth maximum; at a kink (FOPDT: slope jumps at the
-        # dead time) a parabola would overshoot the true slope.
-        if den < 0 and min(d0, d2) > 0.99 * d1:
-            off = 0.5 * (d0 - d2) / den
-            if abs(off) < 1:
-                h = ts[1] - ts[0]
-                t_i = ts[i] + off * h
-                s_i = sgn * (d1 - 0.25 * (d0 - d2) * off)
-                y_i = float(np.interp(t_i, ts, ys))
-    h = float(ts[1] - ts[0])
-    w = window_samples(h, ts.size, sigma=sigma, span=yf, rise_s=rise)
-    return Tangent(t=float(t_i), y=float(y_i), slope=float(s_i), window_s=w * h)
-
 
 def ziegler_nichols(t, y, yf) -> MethodResult:
     """Ziegler-Nichols reaction curve (seed 000 eq. 7, fig. 3).
 
     Validity: monotonic S-shaped response with an identifiable inflection.
     """
-    sigma = _sigma(y)
-    tg = steepest_tangent(t, y, yf, sigma=sigma)
+    sigma = noise_sigma(y)
+    tg = inflection_tangent(t, y, yf, sigma=sigma)
     theta = tg.t_base
     t3 = tg.t_level(yf)
     valid, note = _validity(y, yf, sigma)
@@ -221,8 +165,8 @@ def ziegler_nichols(t, y, yf) -> MethodResult:
 
 def hagglund(t, y, yf) -> MethodResult:
     """Hägglund: ZN dead time, tau to the 63.2 % point (seed 000 fig. 3)."""
-    sigma = _sigma(y)
-    tg = steepest_tangent(t, y, yf, sigma=sigma)
+    sigma = noise_sigma(y)
+    tg = inflection_tangent(t, y, yf, sigma=sigma)
     theta = tg.t_base
     t2 = _cross(t, y, yf, 0.632, sigma)
     bad = _points_ok("hagglund", "fopdt", [t2], yf)
@@ -241,7 +185,7 @@ def _cross(t, y, yf, p, sigma):
 
 def two_point(row: TwoPoint, t, y, yf) -> MethodResult:
     """General two-point method: tau = a t1 + b t2, theta = c t1 + d t2 (seed 000 eq. 16)."""
-    sigma = _sigma(y)
+    sigma = noise_sigma(y)
     t1 = _cross(t, y, yf, row.p1, sigma)
     t2 = _cross(t, y, yf, row.p2, sigma)
     bad = _points_ok(row.name, row.model, [t1, t2], yf)
@@ -268,7 +212,7 @@ def nishikawa(t, y, yf) -> MethodResult:
     """
     t = np.asarray(t, float)
     y = np.asarray(y, float)
-    sigma = _sigma(y)
+    sigma = noise_sigma(y)
     a0 = float(np.trapezoid(yf - y, t))
     t0 = a0 / yf
     if not (math.isfinite(t0) and t[0] < t0 < t[-1]):

@@ -1,8 +1,7 @@
 """Identification from a measured frequency response (seed 000 section 5, seed 003 section 3.1).
 
-Input is a table of frequency, gain (dB or amplitude ratio) and optionally
-phase (degrees, radians, or the time shift of the output behind the input, as
-seed 000 Table IV measures it: phase = -360 f dt degrees).
+Input is a validated table, :class:`~designer.identify.io.FreqData` (read
+by :func:`designer.identify.io.read_freq_table`).
 
 Methods (all return :class:`~designer.identify.structures.MethodResult`):
 
@@ -45,35 +44,24 @@ wn = 2e54 rad/s or a 47 % error marked "ok". The fits search time constants
 and wn within the band widened :data:`FIT_BAND` times, so every exponential
 of a log-parameter stays finite.
 
-Every row's values are checked against their physical ranges
-(``RANGES["freq_hz"]``, ``["gain_db"]`` or ``["gain_ratio"]``,
-``["phase_deg"]``) before any arithmetic, so no overflow reaches the fits.
 """
 
 from __future__ import annotations
 
 import math
-import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.errors import DesignError
 from ..core.ranges import RANGES
-from ..core.fileio import MAX_TABLE_BYTES, read_text, show_cell, shown
-from .preprocess import number_text
-from .structures import MethodResult
+from ..core.waveform import parabola_vertex
+from .io import FreqData
+from .structures import MethodResult, rank_key
 
 ERROR_DEFINITION = ("iae = mean over the table's frequencies of |G_model/G_data - 1| "
                     "(relative complex error; gain only when there is no phase), "
                     "ise = mean of its square; dimensionless")
 
-GAIN_UNITS = ("db", "ratio")
-PHASE_UNITS = ("deg", "rad", "s")
-FREQ_UNITS = ("hz", "rad/s")
-MIN_POINTS = 5
-#: Most rows a table may have (a network analyser sweeps a few thousand).
-MAX_POINTS = 100_000
 DB_PER_POLE = 10.0 * math.log10(2.0)
 #: A model whose fit error (mean |G_model/G_data - 1|) exceeds this does not
 #: describe the table: 0.2 is an average miss of about 1.6 dB or 11 degrees,
@@ -97,327 +85,6 @@ PARAMS = {
     "underdamped": ("K", "wn_rad_s", "zeta", "theta_s"),
     "overdamped": ("K", "tau1_s", "tau2_s", "theta_s"),
 }
-
-
-# --------------------------------------------------------------------------
-# data
-# --------------------------------------------------------------------------
-
-@dataclass
-class FreqData:
-    """A validated frequency-response table.
-
-    ``w`` in rad/s (increasing, > 0), ``gain`` as an amplitude ratio (> 0),
-    ``phase`` in radians, unwrapped, 0 at DC for a non-inverting plant (or
-    None when the table has no phase). ``sign`` is -1 when the low-frequency
-    phase is within 45 degrees of +-180 (an inverting plant; the phase is then stored
-    without that 180 degrees).
-    """
-
-    w: np.ndarray
-    gain: np.ndarray
-    phase: np.ndarray | None = None
-    sign: float = 1.0
-    source: str = ""
-    units: dict = field(default_factory=dict)
-    notes: list = field(default_factory=list)
-
-    @property
-    def f_hz(self) -> np.ndarray:
-        return self.w / (2.0 * math.pi)
-
-    @property
-    def gain_db(self) -> np.ndarray:
-        return 20.0 * np.log10(self.gain)
-
-    def response(self) -> np.ndarray:
-        """Complex G(j w) of the data (magnitude only, phase 0, if no phase)."""
-        ph = self.phase if self.phase is not None else np.zeros_like(self.w)
-        return self.gain * np.exp(1j * ph)
-
-    def to_dict(self) -> dict:
-        return {"source": self.source, "points": int(self.w.size),
-                "f_min_hz": float(self.f_hz[0]), "f_max_hz": float(self.f_hz[-1]),
-                "has_phase": self.phase is not None, "inverting": self.sign < 0,
-                "units": dict(self.units), "notes": list(self.notes)}
-
-
-def _units(value, allowed, what) -> str:
-    """Units as given, case-insensitive (``dB``, ``Hz``, ``RAD/S``)."""
-    u = str(value).strip().lower()
-    if u not in allowed:
-        raise DesignError(f"{what} units {str(value)!r} unknown; allowed: {', '.join(allowed)}")
-    return u
-
-
-def freq_data(freq, gain, phase=None, *, gain_units="db", phase_units="deg",
-              freq_units="hz", source="", lines=None) -> FreqData:
-    """Validate and convert a table (arrays) into :class:`FreqData`.
-
-    ``lines`` (optional) are the file lines of the rows, for messages.
-
-    Raises
-    ------
-    DesignError
-        Too few or too many points, non-finite values, values outside their
-        physical ranges (``freq_hz``, ``gain_db`` or ``gain_ratio``,
-        ``phase_deg`` of :data:`designer.ranges.RANGES`), frequency not strictly
-        increasing or not positive, non-positive amplitude ratio, unknown units.
-    """
-    gain_units = _units(gain_units, GAIN_UNITS, "gain")
-    phase_units = _units(phase_units, PHASE_UNITS, "phase")
-    freq_units = _units(freq_units, FREQ_UNITS, "frequency")
-    pre = f"{source}: " if source else ""
-
-    def row(k):
-        return f"line {lines[k]}" if lines is not None else f"row {k + 1}"
-
-    f = np.asarray(freq, float)
-    g = np.asarray(gain, float)
-    if f.ndim != 1 or g.shape != f.shape:
-        raise DesignError("frequency and gain must be columns of the same length")
-    if f.size < MIN_POINTS:
-        raise DesignError(f"{pre}too few points: {f.size}; at least {MIN_POINTS} frequencies are "
-                          "needed to fit a model")
-    if f.size > MAX_POINTS:
-        raise DesignError(f"{pre}{f.size} points; at most {MAX_POINTS:,} are read (thin the "
-                          "sweep: a few hundred points over the band are plenty)")
-    p = None
-    if phase is not None:
-        p = np.asarray(phase, float)
-        if p.shape != f.shape:
-            raise DesignError("phase column must have as many rows as frequency")
-    for name, arr in (("frequency", f), ("gain", g), ("phase", p)):
-        if arr is not None and not np.all(np.isfinite(arr)):
-            k = int(np.argmin(np.isfinite(arr)))
-            raise DesignError(f"{pre}{name} at {row(k)} is not a finite number "
-                              f"({number_text(arr[k])})")
-    if np.any(f <= 0):
-        k = int(np.argmax(f <= 0))
-        raise DesignError(f"{pre}frequency at {row(k)} is {f[k]:g}: frequencies must be positive")
-    bad = np.nonzero(np.diff(f) <= 0)[0]
-    if bad.size:
-        k = int(bad[0])
-        raise DesignError(f"{pre}frequency not increasing at {row(k + 1)} ({f[k + 1]:g} after "
-                          f"{f[k]:g}); sort the table and remove repeated frequencies")
-    f_unit = "rad/s" if freq_units == "rad/s" else "Hz"
-    _check_column(f / (2.0 * math.pi) if freq_units == "rad/s" else f, "freq_hz", f, f_unit,
-                  "frequency", pre, row)
-    w = f if freq_units == "rad/s" else 2.0 * math.pi * f
-    if gain_units == "ratio":
-        if np.any(g <= 0):
-            k = int(np.argmax(g <= 0))
-            raise DesignError(f"{pre}gain at {row(k)} is {g[k]:g}: an amplitude ratio must be "
-                              "positive (use --gain-units db for decibels)")
-        _check_column(g, "gain_ratio", g, "", "gain (amplitude ratio)", pre, row)
-        ratio = g
-    else:
-        _check_column(g, "gain_db", g, "dB", "gain", pre, row)
-        ratio = 10.0 ** (g / 20.0)
-    ph = None
-    sign = 1.0
-    notes = []
-    if p is not None:
-        # An absurd phase or time shift (1e300 s) overflows to inf in these
-        # conversions; the range check right after refuses it by line, so the
-        # overflow is expected and harmless.
-        with np.errstate(over="ignore"):
-            if phase_units == "deg":
-                ph, ph_deg = np.deg2rad(p), p
-            elif phase_units == "rad":
-                ph, ph_deg = p.copy(), np.rad2deg(p)
-            else:
-                # a positive time shift is the output lagging the input: -w dt
-                ph = -w * p
-                ph_deg = np.rad2deg(ph)
-        unit = {"deg": "deg", "rad": "rad", "s": "s of time shift"}[phase_units]
-        _check_column(ph_deg, "phase_deg", p, unit, "phase (in degrees)", pre, row)
-        if phase_units != "s":
-            ph = _unwrap_lag(ph)
-        ph -= 2.0 * math.pi * round(ph[0] / (2.0 * math.pi))
-        # within 45 degrees of +-180 at the lowest frequency: an inverting plant
-        if abs(ph[0]) > 0.75 * math.pi:
-            sign = -1.0
-            ph -= math.copysign(math.pi, ph[0])
-        if ph[-1] > 0.25 * math.pi:
-            notes.append(f"the phase rises to {math.degrees(ph[-1]):+.0f} deg at the highest "
-                         "frequency: a low-pass plant's output lags its input (negative phase); "
-                         "if the table gives the lag as a positive number, negate that column")
-    return FreqData(w, ratio, ph, sign, source,
-                    {"frequency": freq_units, "gain": gain_units,
-                     "phase": phase_units if phase is not None else None}, notes)
-
-
-def _check_column(values, key, shown_values, unit, what, pre, row) -> None:
-    """One line naming the first row whose value (converted to ``RANGES[key]``'s
-    unit as ``values``; as the table gives it in ``shown_values``) is outside the range."""
-    rng = RANGES[key]
-    lo_ok = rng.contains(float(np.min(values)))
-    if lo_ok and rng.contains(float(np.max(values))):
-        return
-    k = next(i for i, v in enumerate(values) if not rng.contains(float(v)))
-    got = number_text(shown_values[k]) + (f" {unit}" if unit else "")
-    raise DesignError(f"{pre}{what} at {row(k)} must be {rng.text()}, got {got}")
-
-
-def _unwrap_lag(ph: np.ndarray) -> np.ndarray:
-    """Undo the wrapping of a phase read into (-180, 180] degrees.
-
-    A causal low-pass plant's phase falls with frequency, so a rise of more
-    than pi between neighbouring rows can only be a wrap, and is removed. A
-    fall of any size is kept: with a dead time a sparse table legitimately
-    drops by more than pi between rows (np.unwrap would "correct" that)."""
-    d = np.diff(ph)
-    jumps = np.where(d > math.pi, -2.0 * math.pi * np.ceil((d - math.pi) / (2.0 * math.pi)), 0.0)
-    return np.concatenate(([ph[0]], ph[0] + np.cumsum(d + jumps)))
-
-
-_NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
-
-
-def _tokens(name: str) -> set:
-    return set(re.split(r"[^a-z0-9/µμ°]+", name.lower().replace("µ", "u").replace("μ", "u"))) - {""}
-
-
-def _hint(name: str, kind: str):
-    """Units named in a header cell, or None."""
-    tk = _tokens(name)
-    low = name.lower()
-    if kind == "frequency":
-        if tk & {"rad/s", "rad_s", "rads", "w", "omega"} or "rad/s" in low:
-            return "rad/s", 1.0
-        if "khz" in tk:
-            return "hz", 1e3
-        if "mhz" in tk:
-            return "hz", 1e6
-        if "hz" in tk or "f" in tk:
-            return "hz", 1.0
-    elif kind == "gain":
-        if "db" in tk:
-            return "db", 1.0
-        if tk & {"ratio", "v/v", "abs", "mag"}:
-            return "ratio", 1.0
-    elif kind == "phase":
-        if tk & {"deg", "degrees", "°"} or "°" in low:
-            return "deg", 1.0
-        if tk & {"rad", "radians"}:
-            return "rad", 1.0
-        if "us" in tk:
-            return "s", 1e-6
-        if "ms" in tk:
-            return "s", 1e-3
-        if tk & {"s", "shift", "dt", "delay"}:
-            return "s", 1.0
-    return None
-
-
-def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units=None,
-                     source="") -> FreqData:
-    """Parse CSV text: ``frequency, gain[, phase]`` per row.
-
-    Comma, semicolon (with decimal commas), tab or space separated; ``#``
-    comment lines and blank lines ignored; one optional header row whose names
-    may give units (``f_hz``, ``f_khz``, ``w_rad_s``, ``gain_db``,
-    ``gain_ratio``, ``phase_deg``, ``phase_rad``, ``shift_us``...). Units given
-    as arguments (any case: ``dB``, ``Hz``) win over the header; the defaults
-    are Hz, dB and degrees.
-    """
-    pre = f"{source}: " if source else ""
-    lines = [(i + 1, ln.strip()) for i, ln in enumerate(text.lstrip("\ufeff").splitlines())]
-    lines = [(i, ln) for i, ln in lines if ln and not ln.startswith("#")]
-    if not lines:
-        raise DesignError(f"{source or 'table'} is empty: expected rows of "
-                          "frequency, gain[, phase]")
-    if len(lines) > MAX_POINTS + 1:
-        raise DesignError(f"{pre}{len(lines):,} rows; at most {MAX_POINTS:,} are read (thin the "
-                          "sweep: a few hundred points over the band are plenty)")
-    first = lines[0][1]
-    if ";" in first:
-        sep, decimal_comma = ";", True
-    elif "," in first:
-        sep, decimal_comma = ",", False
-    elif "\t" in first:
-        sep, decimal_comma = "\t", False
-    else:
-        sep, decimal_comma = None, False
-
-    def cells(ln):
-        parts = ln.split(sep) if sep else ln.split()
-        parts = [c.strip().strip('"').strip("'") for c in parts]
-        if decimal_comma:
-            parts = [c.replace(",", ".") for c in parts]
-        while parts and parts[-1] == "":
-            parts.pop()
-        return parts
-
-    header = None
-    c0 = cells(first)
-    if not all(_NUM.match(c) or c.lower() in ("nan", "inf", "-inf") for c in c0):
-        header = c0
-        lines = lines[1:]
-    if not lines:
-        raise DesignError(f"{source or 'table'} has a header but no data rows")
-    rows = []
-    ncol = None
-    for lineno, ln in lines:
-        cs = cells(ln)
-        if ncol is None:
-            ncol = len(cs)
-            if ncol not in (2, 3):
-                raise DesignError(f"{pre}line {lineno}: {ncol} columns; expected 2 or 3 "
-                                  "(frequency, gain[, phase])")
-        if len(cs) != ncol:
-            raise DesignError(f"{pre}line {lineno}: {len(cs)} columns where the table has {ncol}")
-        vals = []
-        for c in cs:
-            if c.lower() in ("nan", "inf", "-inf", "+inf"):
-                raise DesignError(f"{pre}line {lineno}: {show_cell(c)} is not a finite number")
-            if not _NUM.match(c):
-                raise DesignError(f"{pre}line {lineno}: {show_cell(c)} is not a number (plain "
-                                  "decimal or 1e3 notation)")
-            vals.append(float(c))
-        rows.append(vals)
-    arr = np.array(rows, float)
-    names = header if header and len(header) == ncol else [""] * ncol
-    kinds = ("frequency", "gain", "phase")
-    units, scale = {}, {}
-    given = {"frequency": freq_units, "gain": gain_units, "phase": phase_units}
-    given = {k: None if v is None else str(v).strip().lower() for k, v in given.items()}
-    default = {"frequency": "hz", "gain": "db", "phase": "deg"}
-    defaulted = set()
-    for k, name in zip(kinds, names):
-        h = _hint(name, k) if name else None
-        if given[k] is not None:
-            units[k], scale[k] = given[k], 1.0
-            if h and h[0] == given[k]:
-                scale[k] = h[1]        # e.g. a "shift_us" column with --phase-units s
-        elif h:
-            units[k], scale[k] = h
-        else:
-            units[k], scale[k] = default[k], 1.0
-            defaulted.add(k)
-    # A value near 1e308 times a unit prefix (kHz) overflows to inf: freq_data
-    # refuses it by line as not finite, so the overflow is expected and harmless.
-    with np.errstate(over="ignore"):
-        f = arr[:, 0] * scale["frequency"]
-        g = arr[:, 1] * scale["gain"]
-        p = arr[:, 2] * scale["phase"] if ncol == 3 else None
-    data = freq_data(f, g, p, gain_units=units["gain"], phase_units=units.get("phase", "deg"),
-                     freq_units=units["frequency"], source=source,
-                     lines=[lineno for lineno, _ in lines])
-    if "gain" in defaulted and 0.0 <= g.min() and g.max() <= 10.0 and np.ptp(g) > 0.1:
-        data.notes.append("the gain column was read as dB (the default: neither the header "
-                          "nor --gain-units names it), but every value lies between 0 and 10, "
-                          "as an amplitude ratio Vout/Vin would; if it is one, pass "
-                          "--gain-units ratio")
-    return data
-
-
-def read_freq_table(path, **units) -> FreqData:
-    """Read a frequency-response CSV file (see :func:`parse_freq_table`): at most
-    :data:`~designer.core.fileio.MAX_TABLE_BYTES`, UTF-8 or ASCII."""
-    text = read_text(path, "table", MAX_TABLE_BYTES)
-    return parse_freq_table(text, source=shown(path), **units)
 
 
 # --------------------------------------------------------------------------
@@ -649,10 +316,8 @@ def resonant_peak(data: FreqData, min_db: float = 0.1) -> MethodResult:
     v = data.w[i - 1:i + 2] ** 2
     q = 1.0 / data.gain[i - 1:i + 2] ** 2
     vc = v[1]
-    a, b, c = np.polyfit(v / vc - 1.0, q, 2)
-    xv = -b / (2.0 * a) if a > 0 else math.nan
-    if a > 0 and -1.0 < xv < 3.0 and c - b * b / (4.0 * a) > 0:
-        qmin = c - b * b / (4.0 * a)
+    xv, qmin, a = parabola_vertex(v / vc - 1.0, q)
+    if a > 0 and -1.0 < xv < 3.0 and qmin > 0:
         peak_db, w_peak = -10.0 * math.log10(qmin), math.sqrt(vc * (1.0 + xv))
     else:
         peak_db, w_peak = float(db[i]), float(data.w[i])
@@ -848,11 +513,6 @@ class FreqIdentifyResult:
                 "error_definition": ERROR_DEFINITION}
 
 
-def _rank_key(m):
-    iae = m.iae if m.iae is not None and math.isfinite(m.iae) else math.inf
-    return (not m.valid, iae)
-
-
 def corner_frequencies(model: str, params: dict) -> dict:
     """The model's corner frequencies (rad/s): 1/tau of each time constant, wn."""
     out = {}
@@ -902,6 +562,6 @@ def identify_freq(data: FreqData) -> FreqIdentifyResult:
             for model in ("fopdt", "underdamped", "overdamped")]
     for m in classical + fits:
         judge(m, data)
-    methods = sorted(classical + fits, key=_rank_key)
+    methods = sorted(classical + fits, key=rank_key)
     best = next((m for m in methods if m.valid and math.isfinite(m.iae)), None)
     return FreqIdentifyResult(methods, best, data)

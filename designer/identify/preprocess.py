@@ -5,20 +5,17 @@ to a system at rest. A real capture has an offset, a trigger somewhere in the
 record, noise, sometimes a whole square wave. This module turns it into
 ``t`` (time since the step), ``y`` (deviation from the pre-step baseline
 divided by the input step amplitude) and ``yf`` (its settled value = static
-gain), and provides the robust primitives the methods share:
+gain), and provides the robust primitives the methods share (the waveform
+readings, noise, crossing times, derivatives, are :mod:`designer.core.waveform`):
 
-- :func:`noise_sigma`: noise standard deviation from sample-to-sample differences;
-- :func:`find_edges` / :func:`detect_step`: step times and amplitude from the input;
+- :func:`find_edges`: step times and amplitude from the input;
 - :func:`baseline` and :func:`final_value`: y0 from pre-step samples, yf from a
   settled tail (and a clear error when the record ends before settling);
-- :func:`crossing_time`: time the response crosses y0 + p (yf - y0), robust
-  to noise (never p yf: the seed's pitfall);
-- :func:`smooth_derivative`: Savitzky-Golay derivative for tangent methods;
 - :func:`prepare_step`: all of the above, including square-wave captures
   split into their steps and averaged;
 - :func:`check_samples`: the one check that a record is usable at all
   (finite, enough samples, increasing time, every value inside its physical
-  range from :data:`designer.ranges.RANGES`), so no method ever meets an
+  range from :data:`designer.core.ranges.RANGES`), so no method ever meets an
   overflow, a NaN or a time scale of 1e-300 s.
 """
 
@@ -31,6 +28,7 @@ import numpy as np
 
 from ..core.errors import DesignError
 from ..core.ranges import RANGES
+from ..core.waveform import crossing_time, noise_sigma
 
 #: Fraction of the post-step record used as the settled tail for yf.
 TAIL_FRACTION = 0.1
@@ -116,25 +114,6 @@ def check_samples(t, *signals, name: str = "capture", what=("time", "output", "i
         if i is not None:
             RANGES["capture_value"].check(a[i], f"{name}: {where(i, k)}: {what[k]} value",
                                           shown=number_text(a[i]))
-
-
-def noise_sigma(y) -> float:
-    """Noise standard deviation, from the median absolute second difference.
-
-    Second differences cancel a smooth signal's slope, so a densely sampled
-    response contributes almost nothing and white noise of variance s^2 gives
-    differences of variance 6 s^2; the median makes it robust to the step
-    itself and to spikes.
-    """
-    y = np.asarray(y, float)
-    if y.size < 5:
-        return 0.0
-    # in place: one temporary the size of the record, not four
-    d2 = np.multiply(y[1:-1], -2.0)
-    d2 += y[2:]
-    d2 += y[:-2]
-    np.abs(d2, out=d2)
-    return float(np.median(d2, overwrite_input=True) / 0.6745 / math.sqrt(6.0))
 
 
 @dataclass
@@ -249,132 +228,6 @@ def final_value(t, y, y0: float, *, sigma: float | None = None) -> float:
             f"still moves by {pct:.1f} % of the step (allowed {100 * SETTLE_TOL:.0f} %); "
             "capture a longer record after the step (at least 5 settling times)")
     return yf
-
-
-def crossing_time(t, y, level: float, *, sigma: float = 0.0, start: int = 0) -> float:
-    """Time ``y`` first crosses ``level`` going up, robust to noise.
-
-    With noise, the first sample above the level may be a noise spike. The
-    crossing is bracketed by the last sample clearly below (level - 3 sigma)
-    before the first sample clearly above (level + 3 sigma); a straight line
-    fitted to the samples in that bracket gives the time. Without noise this
-    is plain linear interpolation. Returns nan if never crossed.
-    """
-    t = np.asarray(t, float)
-    y = np.asarray(y, float)
-    band = 3.0 * sigma
-    above = np.nonzero(y[start:] >= level + band)[0]
-    if above.size == 0:
-        return math.nan
-    b = int(above[0]) + start
-    below = np.nonzero(y[start:b] <= level - band)[0]
-    a = int(below[-1]) + start if below.size else start
-    if b - a <= 1 or band == 0.0:
-        # Plain interpolation between the last sample below and the first at/above.
-        cross = np.nonzero(y[a:b + 1] >= level)[0]
-        j = a + int(cross[0]) if cross.size else b
-        if j == 0:
-            return float(t[0])
-        y0, y1 = y[j - 1], y[j]
-        frac = 0.0 if y1 == y0 else (level - y0) / (y1 - y0)
-        return float(t[j - 1] + frac * (t[j] - t[j - 1]))
-    tt, yy = t[a:b + 1], y[a:b + 1]
-    tm = tt.mean()
-    slope, icpt = np.polyfit(tt - tm, yy, 1)
-    if slope <= 0:
-        return float(0.5 * (t[a] + t[b]))
-    return float(tm + (level - icpt) / slope)
-
-
-def savgol(y, window: int, polyorder: int, deriv: int = 0, delta: float = 1.0) -> np.ndarray:
-    """Savitzky-Golay filter (least-squares polynomial over a sliding window).
-
-    Same result as ``scipy.signal.savgol_filter(..., mode="interp")``: interior
-    samples by convolution, the first and last half-windows from one
-    polynomial fitted to the edge window. Written here because importing
-    scipy.signal costs about a second on every command-line run.
-    """
-    y = np.asarray(y, float)
-    w, p = int(window), int(polyorder)
-    h = w // 2
-    x = np.arange(-h, h + 1, dtype=float)
-    A = np.vander(x, p + 1, increasing=True)           # columns x^0 .. x^p
-    pinv = np.linalg.pinv(A)                            # rows: polynomial coefficients
-    fact = math.factorial(deriv)
-    scale = fact / delta ** deriv
-    kernel = pinv[deriv] * scale                        # value of the deriv at x = 0
-    out = np.empty_like(y)
-    out[h:y.size - h] = np.correlate(y, kernel, mode="valid")
-    # Edges: derivative of the polynomial fitted to the first/last window.
-    for seg, xs, dst in ((y[:w], x[:h], slice(0, h)), (y[-w:], x[h + 1:], slice(y.size - h, y.size))):
-        c = pinv @ seg                                  # coefficients in x (samples)
-        dc = np.polynomial.polynomial.polyder(c, deriv) if deriv else c
-        out[dst] = np.polynomial.polynomial.polyval(xs, dc) / delta ** deriv
-    return out
-
-
-def is_uniform(t, rtol: float = 1e-3) -> bool:
-    dt = np.diff(np.asarray(t, float))
-    return bool(dt.size and np.ptp(dt) <= rtol * np.mean(dt))
-
-
-def uniform(t, y, n: int | None = None) -> tuple:
-    """(t, y) on a uniform grid (linear interpolation) when they are not already."""
-    t = np.asarray(t, float)
-    y = np.asarray(y, float)
-    if is_uniform(t):
-        return t, y
-    n = n or t.size
-    tu = np.linspace(t[0], t[-1], n)
-    return tu, np.interp(tu, t, y)
-
-
-def smooth_derivative(t, y, *, window_s: float | None = None, sigma: float = 0.0,
-                      span: float = 1.0, rise_s: float | None = None,
-                      polyorder: int = 2) -> tuple:
-    """Smoothed response and its time derivative (Savitzky-Golay).
-
-    The default quadratic fit gives the least-squares slope over the window,
-    a positively weighted mean of the sample-to-sample slopes: it never
-    exceeds the steepest true slope, even across the kink an FOPDT response
-    has at its dead time (a cubic fit overshoots there).
-
-    The window is ``window_s`` seconds when given. Otherwise it is the
-    narrowest that keeps the slope noise, sigma sqrt(12 / w^3) / dt for w
-    samples, under 2 % of the typical slope span / rise_s (10-90 % rise time;
-    a tenth of the record if not given), and at most a tenth of the rise time
-    (wider windows flatten the response's shape). Clean data get 5 samples,
-    so tangent methods stay exact. Returns ``(t, ys, dy)`` on a uniform grid
-    (resampled when the input grid is not uniform).
-    """
-    tu, yu = uniform(t, y)
-    dt = float((tu[-1] - tu[0]) / max(tu.size - 1, 1))
-    w = window_samples(dt, tu.size, window_s=window_s, sigma=sigma, span=span, rise_s=rise_s)
-    poly = min(polyorder, w - 1)
-    ys = savgol(yu, w, poly)
-    dy = savgol(yu, w, poly, deriv=1, delta=dt)
-    return tu, ys, dy
-
-
-def window_samples(dt: float, n: int, *, window_s: float | None = None, sigma: float = 0.0,
-                   span: float = 1.0, rise_s: float | None = None) -> int:
-    """Odd Savitzky-Golay window length in samples (rule in :func:`smooth_derivative`)."""
-    if window_s is not None:
-        w = int(round(window_s / dt))
-    elif sigma > 0 and span:
-        if not (rise_s and math.isfinite(rise_s) and rise_s > 0):
-            rise_s = n * dt / 10.0
-        slope = abs(span) / rise_s
-        w = int(math.ceil((12.0 * (sigma / (dt * 0.02 * slope)) ** 2) ** (1.0 / 3.0)))
-        w = min(w, max(5, int(0.1 * rise_s / dt)))
-    else:
-        w = 5
-    w = max(5, w)
-    if w % 2 == 0:
-        w += 1
-    if w > n:
-        w = n if n % 2 else n - 1
-    return w
 
 
 def block_mean(t, y, max_samples: int = MAX_WORK_SAMPLES) -> tuple:

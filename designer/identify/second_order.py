@@ -55,14 +55,14 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
+from ..core.waveform import crossing_time, noise_sigma, peak_region, refine_peak
 from .structures import MethodResult, iae_ise, model_step
 
 __all__ = [
     "STEP_METHODS", "overshoot", "log_decrement", "t4_t3", "two_pole", "chen",
     "stark_mollenkamp", "jahanmiri_fallahi", "peeling", "dc_motor", "dc_motor_position",
     "zeta_from_overshoot", "wn_from_peak_time", "dc_motor_velocity", "normalized_step",
-    "t4_t3_ratio", "t4_t3_table", "zeta_from_t4_t3", "noise_sigma", "crossing_time",
-    "extrema",
+    "t4_t3_ratio", "t4_t3_table", "zeta_from_t4_t3", "extrema",
 ]
 
 # seed 002 eq 8 prints 0.26416 and 0.80079; the exact values of its own
@@ -166,59 +166,6 @@ def zeta_from_t4_t3(ratio: float) -> float:
 # robust reading of the waveform
 # --------------------------------------------------------------------------
 
-def noise_sigma(z) -> float:
-    """Noise standard deviation of ``z`` from the last quarter of the record:
-    1.4826 x median |second difference| / sqrt(6). Second differences cancel
-    the slope of a smooth response (even an oscillating one, sampled densely),
-    so a clean waveform gives nearly 0. 0 for records too short to tell."""
-    z = np.asarray(z, float)
-    tail = z[-max(len(z) // 4, 3):]
-    if tail.size < 20:
-        return 0.0
-    return float(1.4826 * np.median(np.abs(np.diff(tail, 2))) / math.sqrt(6.0))
-
-
-def crossing_time(t, z, level: float, sigma: float = 0.0, start: int = 0) -> float:
-    """Time at which ``z`` first rises through ``level`` at or after index ``start``.
-
-    The samples between the last one below ``level - 3 sigma`` and the first one
-    above ``level + 3 sigma`` are fitted with a straight line, so that noise does
-    not make the first sample above the level decide the time; with
-    ``sigma = 0`` this is linear interpolation. nan if never reached.
-    """
-    t = np.asarray(t, float)
-    z = np.asarray(z, float)
-    seg = z[start:]
-    above = seg >= level
-    k = int(np.argmax(above))
-    if not above[k]:
-        return math.nan
-    i = start + k
-    if i == 0:
-        return float(t[0])
-    band = 3.0 * sigma
-    lo, hi = i - 1, i
-    if band > 0.0:
-        below = np.nonzero(z[start:i] < level - band)[0]
-        lo = start + int(below[-1]) if below.size else start
-        over = np.nonzero(z[i:] > level + band)[0]
-        hi = i + int(over[0]) if over.size else len(z) - 1
-        lo = min(lo, i - 1)
-        hi = max(hi, i)
-    if hi - lo == 1:
-        z0, z1 = z[lo], z[hi]
-        frac = 0.0 if z1 == z0 else (level - z0) / (z1 - z0)
-        return float(t[lo] + frac * (t[hi] - t[lo]))
-    tt = t[lo:hi + 1]
-    tc = tt.mean()
-    slope, icpt = np.polyfit(tt - tc, z[lo:hi + 1], 1)
-    if slope <= 0.0:
-        z0, z1 = z[i - 1], z[i]
-        frac = 0.0 if z1 == z0 else (level - z0) / (z1 - z0)
-        return float(t[i - 1] + frac * (t[i] - t[i - 1]))
-    return float(tc + (level - icpt) / slope)
-
-
 def _refine_extreme(t, z, zs, idx_lo, idx_hi, sign, sigma):
     """Vertex of a parabola fitted around the extreme of the lobe
     ``z[idx_lo:idx_hi]`` (``sign`` +1 for a maximum, -1 for a minimum).
@@ -231,33 +178,21 @@ def _refine_extreme(t, z, zs, idx_lo, idx_hi, sign, sigma):
     was chosen on 1 % noise: wider windows bias the damped, asymmetric peak).
     Returns (time, value).
     """
-    n = len(z)
     seg_s = sign * (zs[idx_lo:idx_hi] - 1.0)
     k = int(np.argmax(seg_s))
-    i = idx_lo + k
     height = float(seg_s[k])
     noisy = 8.0 * sigma > 1e-4 * max(height, 1e-12)
-    if not noisy:
-        seg = sign * z[idx_lo:idx_hi]
-        k = int(np.argmax(seg))
-        i = idx_lo + k
-    if not 0 < i < n - 1:
-        return float(t[i]), float(z[i])
-    j0, j1 = i - 1, i + 1
     if noisy:
-        top = seg_s >= seg_s[k] - max(sigma, 0.05 * height)
-        left = np.nonzero(~top[:k])[0]
-        right = np.nonzero(~top[k:])[0]
-        j0 = min(idx_lo + (int(left[-1]) + 1 if left.size else 0), i - 1)
-        j1 = max(idx_lo + k + (int(right[0]) - 1 if right.size else len(seg_s) - 1 - k), i + 1)
-        j0, j1 = max(j0, 0), min(j1, n - 1)
-    tt = t[j0:j1 + 1]
-    tc = t[i]
-    a, b, c = np.polyfit(tt - tc, sign * z[j0:j1 + 1], 2)
-    if a < 0.0:
-        dt = -b / (2.0 * a)
-        if tt[0] - tc <= dt <= tt[-1] - tc:
-            return float(tc + dt), float(sign * (c - b * b / (4.0 * a)))
+        i = idx_lo + k
+        j0, j1 = peak_region(sign * zs, i, max(sigma, 0.05 * height), lo=idx_lo, hi=idx_hi)
+    else:
+        i = idx_lo + int(np.argmax(sign * z[idx_lo:idx_hi]))
+        j0, j1 = i - 1, i + 1
+    if not 0 < i < len(z) - 1:
+        return float(t[i]), float(z[i])
+    tv, v, a = refine_peak(t, sign * z, i, lo=j0, hi=j1)
+    if a < 0:
+        return tv, sign * v
     return float(t[i]), float(zs[i] if noisy else z[i])
 
 
@@ -356,8 +291,8 @@ def _late_start(t, z, sigma, model, params):
     """For the methods that assume no dead time: how much later than the
     identified model the data leave zero (time to 5 %), or 0. A lag over a
     tenth of the time to 50 % means a dead time the method cannot represent."""
-    t05 = crossing_time(t, z, 0.05, sigma)
-    t50 = crossing_time(t, z, 0.5, sigma)
+    t05 = crossing_time(t, z, 0.05, sigma=sigma)
+    t50 = crossing_time(t, z, 0.5, sigma=sigma)
     if not (math.isfinite(t05) and math.isfinite(t50)) or t50 <= 0.0:
         return 0.0
     p = dict(params, K=1.0, theta_s=0.0)
@@ -504,8 +439,8 @@ def t4_t3(t, y, yf) -> MethodResult:
     t, z, sigma, err = _prepare(t, y, yf)
     if err:
         return _fail(name, "underdamped", err, yf)
-    t3 = crossing_time(t, z, Y3_LEVEL, sigma)
-    t4 = crossing_time(t, z, Y4_LEVEL, sigma)
+    t3 = crossing_time(t, z, Y3_LEVEL, sigma=sigma)
+    t4 = crossing_time(t, z, Y4_LEVEL, sigma=sigma)
     if not (math.isfinite(t3) and math.isfinite(t4)) or t3 <= 0.0 or t4 <= t3:
         return _fail(name, "underdamped", "the response does not rise through 26.4 % and 80.1 % "
                      "of its final value after the step", yf)
@@ -545,8 +480,8 @@ def two_pole(t, y, yf, levels=(0.6, 0.9)) -> MethodResult:
     t, z, sigma, err = _prepare(t, y, yf)
     if err:
         return _fail(name, model, err, yf)
-    ta = crossing_time(t, z, levels[0], sigma)
-    tb = crossing_time(t, z, levels[1], sigma)
+    ta = crossing_time(t, z, levels[0], sigma=sigma)
+    tb = crossing_time(t, z, levels[1], sigma=sigma)
     if not (math.isfinite(ta) and math.isfinite(tb)) or tb <= ta:
         return _fail(name, model, f"the response does not rise through {levels[0]:.0%} and "
                      f"{levels[1]:.0%} of its final value", yf)
@@ -641,7 +576,7 @@ def stark_mollenkamp(t, y, yf) -> MethodResult:
     t, z, sigma, err = _prepare(t, y, yf)
     if err:
         return _fail(name, "underdamped", err, yf)
-    t15, t45, t75 = (crossing_time(t, z, p, sigma) for p in (0.15, 0.45, 0.75))
+    t15, t45, t75 = (crossing_time(t, z, p, sigma=sigma) for p in (0.15, 0.45, 0.75))
     if not all(math.isfinite(v) for v in (t15, t45, t75)) or not t15 < t45 < t75:
         return _fail(name, "underdamped", "the response does not rise through 15, 45 and 75 % "
                      "of its final value", yf)
@@ -698,7 +633,7 @@ def jahanmiri_fallahi(t, y, yf) -> MethodResult:
     t, z, sigma, err = _prepare(t, y, yf)
     if err:
         return _fail(name, "overdamped", err, yf)
-    t2, t5, t70, t90 = (crossing_time(t, z, p, sigma) for p in (0.02, 0.05, 0.70, 0.90))
+    t2, t5, t70, t90 = (crossing_time(t, z, p, sigma=sigma) for p in (0.02, 0.05, 0.70, 0.90))
     if not all(math.isfinite(v) for v in (t2, t5, t70, t90)) or not t5 < t70 < t90:
         return _fail(name, "overdamped", "the response does not rise through 2/5, 70 and 90 % "
                      "of its final value", yf)
@@ -758,7 +693,7 @@ def peeling(t, y, yf, iterations: int = 500) -> MethodResult:
     r_lo = max(0.01, 5.0 * sigma)
     slow_sel = (r <= 0.35) & (r >= r_lo)
     # the tail fit must come after the response has risen past 50 %
-    rise = crossing_time(t, z, 0.5, sigma)
+    rise = crossing_time(t, z, 0.5, sigma=sigma)
     if math.isfinite(rise):
         slow_sel &= t >= rise
     # past the dead time: exactly 0 before it on clean data, 5 sigma on noisy data
@@ -861,7 +796,7 @@ def dc_motor(t, y, yf) -> MethodResult:
     tau = float(np.median(taus))
     q10, q90 = np.percentile(taus, [10, 90])
     spread = float((q90 - q10) / tau)
-    t0 = crossing_time(t, z, 1.0 - math.exp(-1.0), sigma)
+    t0 = crossing_time(t, z, 1.0 - math.exp(-1.0), sigma=sigma)
     pts = {"t0_s": t0, "w_t0": (1.0 - math.exp(-1.0)) * yf, "tau_spread": spread}
     valid = bool(spread <= 0.1)
     note = ("" if valid else f"tau_m from the 20-80 % samples varies by {spread:.0%}: not a "

@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.jsonio import json_safe
+
 MODELS = ("fopdt", "double-pole", "underdamped", "overdamped")
 
 
@@ -87,11 +89,12 @@ class MethodResult:
     points: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
-        def clean(v):
-            if isinstance(v, float) and not math.isfinite(v):
-                return None
-            return float(v) if isinstance(v, (np.floating, np.integer)) else v
-        return {"name": self.name, "model": self.model,
-                "params": {k: clean(v) for k, v in self.params.items()},
-                "iae": clean(self.iae), "ise": clean(self.ise), "valid": bool(self.valid),
-                "note": self.note, "points": {k: clean(v) for k, v in self.points.items()}}
+        return json_safe({"name": self.name, "model": self.model, "params": self.params,
+                          "iae": self.iae, "ise": self.ise, "valid": bool(self.valid),
+                          "note": self.note, "points": self.points})
+
+
+def rank_key(m: MethodResult) -> tuple:
+    """Sort key of a ranking: valid results first, then by ``iae`` (nan last)."""
+    iae = m.iae if m.iae is not None and math.isfinite(m.iae) else math.inf
+    return (not m.valid, iae)

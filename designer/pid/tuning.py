@@ -2,8 +2,10 @@
 
 The reaction curve (Ziegler-Nichols' first method, seed 001 section V.8) is
 read from a step-response ARRAY: the inflection point is where a smoothed
-derivative peaks, the tangent there gives L (where it crosses the initial
-value) and T (from L to where it reaches the final value). The seed reads T as
+derivative peaks (:func:`designer.core.waveform.inflection_tangent`, the same
+tangent identification's ``ziegler-nichols`` reads), the tangent there gives L
+(where it crosses the initial value) and T (from L to where it reaches the
+final value). The seed reads T as
 the absolute time at which the tangent reaches the final value (81.75 us for
 its plant); the time constant is that time minus L (60.14 us).
 
@@ -35,10 +37,10 @@ import math
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
-from scipy.signal import savgol_filter
 
 from ..core.errors import DesignError
 from ..core.ranges import RANGES
+from ..core.waveform import inflection_tangent, normalised_step
 
 RULES = ("zn", "cohen-coon", "chr0", "chr20", "amigo", "simc")
 #: the model each rule was derived on: the ZN tangent, or a fitted FOPDT
@@ -128,26 +130,6 @@ class Tuning:
         return d
 
 
-def smooth_derivative(t, y, window: int | None = None) -> np.ndarray:
-    """dy/dt of uniformly sampled data with a Savitzky-Golay filter (cubic).
-
-    ``window`` (odd, samples) defaults to about 0.5 % of the record, at least 5:
-    it removes sample-to-sample noise of measured data and leaves a dense
-    analytic curve essentially untouched.
-    """
-    t = np.asarray(t, float)
-    y = np.asarray(y, float)
-    dt = np.diff(t)
-    if dt.size < 4:
-        raise DesignError("reaction curve: need at least 5 samples")
-    if not np.allclose(dt, dt[0], rtol=1e-6, atol=0):
-        raise DesignError("reaction curve: samples must be uniformly spaced in time (resample first)")
-    if window is None:
-        window = max(5, int(0.005 * t.size) | 1)
-    window = min(window, t.size - (1 - t.size % 2))
-    return savgol_filter(y, window, 3, deriv=1, delta=float(dt[0]))
-
-
 def reaction_curve(t, y, *, u_step: float = 1.0, t_step: float | None = None,
                    initial: float | None = None, final: float | None = None,
                    window: int | None = None, fit: bool = True) -> ReactionCurve:
@@ -165,7 +147,8 @@ def reaction_curve(t, y, *, u_step: float = 1.0, t_step: float | None = None,
     initial, final : float, optional
         Output before the step and settled output (defaults: first and last samples).
     window : int, optional
-        Savitzky-Golay window for the derivative (see :func:`smooth_derivative`).
+        Smoothing window of the derivative, in samples (default: the rule of
+        :func:`designer.core.waveform.tangent_window`, from the record's noise).
     fit : bool
         Also fit the FOPDT model by least squares (:func:`fit_fopdt`), started
         from the tangent's K, L, T.
@@ -180,30 +163,21 @@ def reaction_curve(t, y, *, u_step: float = 1.0, t_step: float | None = None,
         raise DesignError("reaction curve: time and output must be 1-D arrays of the same length")
     if u_step == 0 or not math.isfinite(u_step):
         raise DesignError("reaction curve: the input step must be a finite non-zero number")
-    ts0 = float(t[0]) if t_step is None else float(t_step)
-    keep = t >= ts0
-    t, y = t[keep] - ts0, y[keep]
-    y0 = float(y[0]) if initial is None else float(initial)
-    yf = float(y[-1]) if final is None else float(final)
+    t, z, y0, yf = normalised_step(t, y, t_step=t_step, initial=initial, final=final,
+                                   what="reaction curve")
     span = yf - y0
-    if span == 0:
-        raise DesignError("reaction curve: the output does not change")
-    z = (y - y0) / span                      # rising 0 -> 1 whatever the sign
-    dz = smooth_derivative(t, z, window)
-    i = int(np.argmax(dz))
-    if i == 0 or i == len(z) - 1:
+    dt = np.diff(t)
+    if dt.size < 4:
+        raise DesignError("reaction curve: need at least 5 samples")
+    if not np.allclose(dt, dt[0], rtol=1e-6, atol=0):
+        raise DesignError("reaction curve: samples must be uniformly spaced in time (resample first)")
+    tg = inflection_tangent(t, z, 1.0, window_s=None if window is None else window * float(dt[0]))
+    if not tg.interior:
         raise DesignError("reaction curve: the steepest point is at the edge of the record; "
                           "no inflection point (is this a first-order response or a truncated record?)")
-    # refine the slope peak with a parabola through its three samples
-    a, b, c = dz[i - 1], dz[i], dz[i + 1]
-    h = t[i] - t[i - 1]
-    den = a - 2 * b + c
-    d = 0.5 * (a - c) / den if den < 0 else 0.0
-    ti = float(t[i] + d * h)
-    slope = float(b - 0.25 * (a - c) * d)
-    zi = float(np.interp(ti, t, z))
-    L = ti - zi / slope
-    t_end = ti + (1.0 - zi) / slope
+    ti, zi, slope = tg.t, tg.y, tg.slope
+    L = tg.t_base
+    t_end = tg.t_level(1.0)
     os_pct = max(0.0, (float(np.max(z)) - 1.0) * 100.0)
     K = span / u_step
     model = fit_fopdt(t, z * K, K, start=Fopdt(K, L, t_end - L, "tangent")) if fit else None

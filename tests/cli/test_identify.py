@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from helpers import FIXTURES, script
 
-from designer.identify.step import overshoot_from_zeta, sallen_key
+from designer.identify.against import overshoot_from_zeta
+from designer.plant.sallenkey import fn_zeta as sallen_key
 from designer.identify.structures import model_step
 
 EXE = script("identify")
@@ -179,23 +180,23 @@ def test_bad_input_exit_2_with_one_line(tmp_path):
         assert "Traceback" not in proc.stderr and proc.stdout == ""
 
 
-def test_tolerance_band_contains_every_part_combination():
+def test_agreement_band_contains_every_part_combination():
     """Brute force: random parts inside the 5 % R / 10 % C box stay inside the corner band."""
-    from designer.identify.step import tolerance_band
+    from designer.identify.against import agreement_band
     r1, r2, c1, c2 = 820.0, 1000.0, 10e-9, 220e-9
     fn, z = sallen_key(r1, r2, c1, c2)
-    band = tolerance_band({"R1_ohm": r1, "R2_ohm": r2, "C1_f": c1, "C2_f": c2, "fn_hz": fn,
+    band = agreement_band({"R1_ohm": r1, "R2_ohm": r2, "C1_f": c1, "C2_f": c2, "fn_hz": fn,
                            "zeta": z})
     rng = np.random.default_rng(0)
     k = rng.uniform(-1, 1, (2000, 4)) * [0.05, 0.05, 0.1, 0.1] + 1
     got = np.array([sallen_key(r1 * a, r2 * b, c1 * c, c2 * d) for a, b, c, d in k])
-    assert band["fn_hz"][0] <= got[:, 0].min() and got[:, 0].max() <= band["fn_hz"][1]
-    assert band["zeta"][0] <= got[:, 1].min() and got[:, 1].max() <= band["zeta"][1]
+    assert band.fn_hz[0] <= got[:, 0].min() and got[:, 0].max() <= band.fn_hz[1]
+    assert band.zeta[0] <= got[:, 1].min() and got[:, 1].max() <= band.zeta[1]
     # and the corners are attained (the band is not padded)
-    assert got[:, 0].max() > band["fn_hz"][0] + 0.8 * (band["fn_hz"][1] - band["fn_hz"][0])
+    assert got[:, 0].max() > band.fn_hz[0] + 0.8 * (band.fn_hz[1] - band.fn_hz[0])
     # without part values the nominal scaling gives the same fn band (fn ~ 1/sqrt(RRCC))
-    nominal = tolerance_band({"fn_hz": fn, "zeta": z})
-    assert nominal["fn_hz"] == pytest.approx(band["fn_hz"], rel=1e-12)
+    nominal = agreement_band({"fn_hz": fn, "zeta": z})
+    assert nominal.fn_hz == pytest.approx(band.fn_hz, rel=1e-12)
 
 
 def test_help_states_every_numeric_range():

@@ -111,7 +111,8 @@ def test_bad_invocations(tmp_path):
 def test_help_states_the_limits_and_the_validity_rule():
     from designer.core.ranges import RANGES
     from designer.core.fileio import MAX_TABLE_BYTES, size_text
-    from designer.identify.frequency import BAND_FACTOR, MAX_FIT_ERROR, MAX_POINTS
+    from designer.identify.frequency import BAND_FACTOR, MAX_FIT_ERROR
+    from designer.identify.io import MAX_POINTS
     out = " ".join(run("--help").stdout.split())
     for key in ("freq_hz", "gain_db", "gain_ratio", "phase_deg"):
         assert RANGES[key].text() in out, key

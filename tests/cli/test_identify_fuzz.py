@@ -36,8 +36,7 @@ from helpers import script
 from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 
-from designer.cli.identify import identify_main
-from designer.cli.identify_freq import identify_freq_main
+from designer.cli.identify import identify_freq_main, identify_main
 from designer.identify.frequency import model_phase, model_response
 from designer.identify.structures import model_step
 

@@ -16,7 +16,6 @@ from designer.identify.first_order import (
     exact_coefficients,
     hagglund,
     nishikawa,
-    steepest_tangent,
     two_point,
     unit_time,
     ziegler_nichols,
@@ -86,14 +85,10 @@ def test_exact_methods_recover_any_fopdt(tau, ratio, K):
     assert r.points["t0_s"] == pytest.approx(t0, rel=1e-4)
 
 
-def test_tangent_of_a_double_pole_is_the_closed_form():
-    """Double pole: inflection at theta + tau, y = 1 - 2/e, slope K/(e tau)."""
+def test_ziegler_nichols_on_a_double_pole_is_the_closed_form():
+    """The tangent at theta + tau (tests/core/test_waveform.py) gives L and T."""
     p = {"K": 1.0, "tau_s": 1e-3, "theta_s": 0.5e-3}
     t = np.linspace(0, 15e-3, 15001)
-    tg = steepest_tangent(t, model_step("double-pole", p, t), 1.0)
-    assert tg.t == pytest.approx(1.5e-3, rel=1e-3)
-    assert tg.y == pytest.approx(1 - 2 / math.e, rel=1e-4)
-    assert tg.slope == pytest.approx(1 / (math.e * 1e-3), rel=1e-5)
     r = ziegler_nichols(t, model_step("double-pole", p, t), 1.0)
     # L = theta + tau (1 - (e - 2)) and T = e tau, from the line above
     assert r.params["theta_s"] == pytest.approx(0.5e-3 + 1e-3 * (3 - math.e), rel=1e-4)

@@ -1,12 +1,15 @@
-"""CSV readers: real-format fixtures, round trips and bad files."""
+"""Readers: scope CSV captures (real-format fixtures, round trips, bad files) and
+frequency-response tables."""
 
 import json
+import math
 
 import numpy as np
 import pytest
 from helpers import FIXTURES
 
 from designer.core.errors import DesignError
+from designer.identify import io as tio
 from designer.identify.io import format_generic, parse_capture_text, read_capture
 from designer.identify.structures import model_step
 
@@ -297,3 +300,90 @@ def test_reading_memory_is_bounded(tmp_path):
     assert int(out[0]) == n
     assert int(out[1]) < 2 * samples_bytes + 8 * BLOCK_BYTES, (int(out[1]) / 2**20,
                                                                 path.stat().st_size / 2**20)
+
+
+# --------------------------------------------------------------------------- frequency tables
+
+def test_header_hints_and_decimal_comma():
+    d = tio.parse_freq_table("w_rad_s;gain_ratio;phase_rad\n1;1;0\n2;0,9;-0,1\n3;0,8;-0,2\n"
+                            "4;0,7;-0,3\n5;0,6;-0,4\n")
+    assert d.units == {"frequency": "rad/s", "gain": "ratio", "phase": "rad"}
+    assert d.gain[1] == pytest.approx(0.9) and d.w[0] == 1.0
+    # no header: defaults Hz, dB, degrees; whitespace separated; comments ignored
+    d = tio.parse_freq_table("# bench\n10 0 0\n20 -1 -10\n40 -3 -45\n80 -7 -60\n160 -12 -75\n")
+    assert d.units == {"frequency": "hz", "gain": "db", "phase": "deg"}
+    assert d.w[0] == pytest.approx(2 * math.pi * 10)
+    # options win over the header
+    d = tio.parse_freq_table("f,g\n1,1\n2,0.9\n3,0.8\n4,0.7\n5,0.6\n", gain_units="ratio")
+    assert d.gain[0] == 1.0 and d.phase is None
+
+
+@pytest.mark.parametrize("text, words", [
+    ("", "empty"),
+    ("# only a comment\n\n", "empty"),
+    ("f_hz,gain_db\n", "no data"),
+    ("1,0\n2,abc\n3,-1\n4,-2\n5,-3\n", "'abc' is not a number"),
+    ("1,0\n2,nan\n3,-1\n4,-2\n5,-3\n", "not a finite number"),
+    ("1,0\n3,-1\n2,-2\n4,-3\n5,-4\n", "not increasing"),
+    ("1,0\n2,-1\n2,-2\n4,-3\n5,-4\n", "not increasing"),
+    ("1,0\n2,-1\n3,-2\n", "too few points"),
+    ("1,0,0,0\n2,-1,0,0\n3,-2,0,0\n4,-3,0,0\n5,-4,0,0\n", "expected 2 or 3"),
+    ("1,0,0\n2,-1\n3,-2,0\n4,-3,0\n5,-4,0\n", "columns where the table has 3"),
+    ("0,0\n2,-1\n3,-2\n4,-3\n5,-4\n", "must be positive"),
+    ("f,ratio\n1,1\n2,0\n3,0.5\n4,0.4\n5,0.3\n", "amplitude ratio must be positive"),
+])
+def test_bad_tables(text, words):
+    with pytest.raises(DesignError, match=words):
+        tio.parse_freq_table(text, source="t.csv")
+
+
+def test_missing_table(tmp_path):
+    with pytest.raises(DesignError, match="does not exist"):
+        tio.read_freq_table(tmp_path / "nope.csv")
+    (tmp_path / "bin.csv").write_bytes(b"\xff\xfe\x00\x81")
+    with pytest.raises(DesignError):
+        tio.read_freq_table(tmp_path / "bin.csv")
+
+
+
+@pytest.mark.parametrize("row, key, what", [
+    ("1e300,-1,-10", "freq_hz", "frequency"),
+    ("30,-1e300,-10", "gain_db", "gain"),
+    ("30,-1,-1e300", "phase_deg", "phase (in degrees)"),
+    ("1e-300,-1,-10", "freq_hz", "frequency"),
+])
+def test_values_outside_their_physical_range_are_one_line(row, key, what):
+    from designer.core.ranges import RANGES
+    rows = ["1,0,0", "2,-0.1,-2", "3,-0.2,-4", row, "40,-3,-40", "50,-6,-50"]
+    rows.sort(key=lambda r: float(r.split(",")[0]))
+    text = "f_hz,gain_db,phase_deg\n" + "\n".join(rows)
+    with pytest.raises(DesignError) as exc:
+        tio.parse_freq_table(text, source="t.csv")
+    msg = str(exc.value)
+    assert "\n" not in msg and RANGES[key].text() in msg and "np." not in msg
+    assert f"{what} at line {rows.index(row) + 2} " in msg     # the header is line 1
+
+
+def test_time_shift_overflowing_the_phase_is_one_line():
+    text = "f_khz;gain_ratio;shift_us\n" + "".join(
+        f"{f};{g};{s}\n" for f, g, s in ((1, 1, 0), (2, 1, 1), (5, 0.9, 1), (10, 0.7, 1e300),
+                                          (20, 0.4, 1)))
+    with pytest.raises(DesignError, match=r"phase \(in degrees\) at line 5"):
+        tio.parse_freq_table(text, source="t.csv")
+
+
+def test_table_limits(tmp_path):
+    from designer.core.fileio import MAX_TABLE_BYTES, size_text
+    big = tmp_path / "big.csv"
+    with open(big, "wb") as fh:
+        fh.truncate(MAX_TABLE_BYTES + 1)       # sparse: refused from its size, never read
+    with pytest.raises(DesignError, match=f"at most {size_text(MAX_TABLE_BYTES)}"):
+        tio.read_freq_table(big)
+    rows = "".join(f"{k + 1},0\n" for k in range(tio.MAX_POINTS + 1))
+    with pytest.raises(DesignError, match=f"at most {tio.MAX_POINTS:,}"):
+        tio.parse_freq_table(rows)
+    with pytest.raises(DesignError, match="is a directory"):
+        tio.read_freq_table(tmp_path)
+    (tmp_path / "u16.csv").write_text("f,g\n1,0\n2,-1\n3,-2\n4,-3\n5,-4\n", encoding="utf-16")
+    with pytest.raises(DesignError, match="UTF-16 text, not UTF-8"):
+        tio.read_freq_table(tmp_path / "u16.csv")

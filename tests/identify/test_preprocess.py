@@ -1,4 +1,5 @@
-"""Preprocessing: noise, edges, baseline, final value, crossings, derivative, steps."""
+"""Preprocessing: edges, baseline, final value, steps (the waveform readings are
+tests/core/test_waveform.py)."""
 
 import math
 
@@ -8,14 +9,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designer.core.errors import DesignError
+from designer.core.waveform import noise_sigma
 from designer.identify.preprocess import (
     block_mean,
-    crossing_time,
     final_value,
     find_edges,
-    noise_sigma,
     prepare_step,
-    smooth_derivative,
 )
 from designer.identify.structures import model_step
 
@@ -26,14 +25,6 @@ def _square(t, f, amp, t0=0.0):
     """Square wave 0 / amp starting high at t0 (and low before it)."""
     ph = np.floor((t - t0) * 2 * f)
     return np.where((t >= t0) & (ph % 2 == 0), amp, 0.0)
-
-
-def test_noise_sigma_of_white_noise_on_a_response():
-    rng = np.random.default_rng(3)
-    t = np.linspace(0, 10e-3, 20001)
-    y = model_step("fopdt", FOPDT, t) + 0.01 * rng.standard_normal(t.size)
-    assert noise_sigma(y) == pytest.approx(0.01, rel=0.05)
-    assert noise_sigma(model_step("fopdt", FOPDT, t)) < 1e-5
 
 
 def test_edges_of_a_square_wave():
@@ -55,56 +46,6 @@ def test_no_edges_in_a_flat_or_noisy_input():
     t = np.linspace(0, 1, 1000)
     assert find_edges(t, np.ones_like(t)) == []
     assert find_edges(t, 1 + 0.01 * rng.standard_normal(t.size)) == []
-
-
-def test_crossing_time_is_linear_interpolation_without_noise():
-    t = np.linspace(0.0, 1.0, 11)
-    y = 2.0 * t
-    assert crossing_time(t, y, 0.73) == pytest.approx(0.365)
-    assert math.isnan(crossing_time(t, y, 5.0))
-
-
-@settings(max_examples=40, deadline=None)
-@given(tau=st.floats(1e-4, 1e2), theta=st.floats(0.0, 3.0), p=st.floats(0.05, 0.95))
-def test_crossing_times_of_fopdt_are_closed_form(tau, theta, p):
-    """y reaches p at theta - tau ln(1 - p); error only from the grid's linear interpolation."""
-    theta = theta * tau
-    t = np.linspace(0.0, theta + 8 * tau, 4001)
-    y = model_step("fopdt", {"K": 1.0, "tau_s": tau, "theta_s": theta}, t)
-    exact = theta - tau * math.log(1 - p)
-    h = t[1] - t[0]
-    # Interpolation error of a convex-down curve: h^2/8 * max|y''| / slope.
-    bound = h * h / 8 / tau ** 2 / ((1 - p) / tau) + 1e-12 * t[-1]
-    assert abs(crossing_time(t, y, p) - exact) <= bound
-
-
-def test_crossing_time_robust_to_noise():
-    rng = np.random.default_rng(7)
-    t = np.linspace(0, 8e-3, 8001)
-    clean = model_step("fopdt", FOPDT, t) / 2
-    y = clean + 0.01 * rng.standard_normal(t.size)
-    sig = noise_sigma(y)
-    exact = FOPDT["theta_s"] - FOPDT["tau_s"] * math.log(1 - 0.283)
-    robust = crossing_time(t, y, 0.283, sigma=sig)
-    naive = crossing_time(t, y, 0.283)
-    assert abs(robust - exact) < 0.01 * FOPDT["tau_s"]
-    # the naive first crossing is pulled early by noise spikes
-    assert abs(robust - exact) < abs(naive - exact)
-
-
-def test_savitzky_golay_derivative_of_a_cubic_is_exact():
-    t = np.linspace(0, 2, 401)
-    y = 1 + 2 * t - 3 * t ** 2 + 0.5 * t ** 3
-    tu, ys, dy = smooth_derivative(t, y, window_s=0.2, polyorder=3)
-    assert np.allclose(ys, y, atol=1e-10)
-    assert np.allclose(dy, 2 - 6 * t + 1.5 * t ** 2, atol=1e-9)
-
-
-def test_derivative_on_a_non_uniform_grid_is_resampled():
-    t = np.sort(np.concatenate([np.linspace(0, 1, 300), np.linspace(0.3, 0.4, 200)[1:-1]]))
-    tu, ys, dy = smooth_derivative(t, np.sin(t))
-    assert np.ptp(np.diff(tu)) < 1e-12
-    assert np.allclose(dy[5:-5], np.cos(tu[5:-5]), atol=2e-4)
 
 
 def test_block_mean_keeps_a_ramp_without_delay():
@@ -196,16 +137,6 @@ def test_no_step_and_step_too_small():
         prepare_step(t, small + 0.01 * rng.standard_normal(t.size))
     with pytest.raises(DesignError, match="no step in the input column"):
         prepare_step(t, small, u=np.ones_like(t))
-
-
-@pytest.mark.parametrize("window, poly, deriv", [(5, 2, 0), (5, 2, 1), (11, 3, 1), (21, 2, 1)])
-def test_savgol_matches_scipy(window, poly, deriv):
-    from scipy.signal import savgol_filter
-
-    from designer.identify.preprocess import savgol
-    y = np.random.default_rng(0).standard_normal(300).cumsum()
-    ref = savgol_filter(y, window, poly, deriv=deriv, delta=0.1, mode="interp")
-    assert np.allclose(savgol(y, window, poly, deriv=deriv, delta=0.1), ref, atol=1e-10)
 
 
 def test_output_only_square_wave_is_cut_at_the_next_edge():

@@ -1,0 +1,199 @@
+"""What ``identify`` and ``identify-freq`` print and draw: the ranked methods
+table of each command, the comparison with a design, and the PNG plots of the
+data against the best models. Everything here reads the typed results
+(:class:`~.step.IdentifyResult`, :class:`~.frequency.FreqIdentifyResult`,
+:class:`~.against.Comparison`) and recomputes nothing but the models' curves."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..core.units import format_eng
+from ..report.plots import png_bytes
+
+
+def format_params(p: dict, corners: bool = False) -> str:
+    """Parameters with units: K 2, tau 1.5 ms, theta 200 us, wn 2.2e4 rad/s (3.5 kHz), zeta 0.21;
+    with ``corners``, each time constant also as the corner frequency a Bode plot shows."""
+    out = []
+    for k, v in p.items():
+        if v is None or (isinstance(v, float) and not math.isfinite(v)):
+            out.append(f"{k} n/a")
+        elif k.endswith("_rad_s"):
+            out.append(f"{k[:-6]} {v:.4g} rad/s ({format_eng(v / (2 * math.pi), 'Hz')})")
+        elif corners and k.startswith("tau") and v > 0:
+            out.append(f"{k[:-2]} {format_eng(v, 's')} (corner {format_eng(1 / (2 * math.pi * v), 'Hz')})")
+        elif k.endswith("_s"):
+            out.append(f"{k[:-2]} {format_eng(v, 's')}")
+        else:
+            out.append(f"{k} {v:.4g}")
+    return ", ".join(out)
+
+
+def _g(v) -> str:
+    return "n/a" if v is None or not math.isfinite(v) else f"{v:.4g}"
+
+
+def _pct(v) -> str:
+    return "n/a" if v is None or not math.isfinite(v) else f"{100.0 * v:.3g} %"
+
+
+def methods_table(methods, *, name_width: int, params_width: int, corners: bool,
+                  scores) -> list:
+    """The ranked methods, one row each (and its note below it): rank, name,
+    model, parameters, then ``scores``, a list of ``(title, width, text(m))``."""
+    head = (f"{'#':>2}  {'method':<{name_width}} {'model':<12} {'parameters':<{params_width}} "
+            + " ".join(f"{title:>{w}}" for title, w, _ in scores) + "  ok")
+    lines = [head, "-" * len(head)]
+    for i, m in enumerate(methods, 1):
+        lines.append(f"{i:>2}  {m.name:<{name_width}} {m.model:<12} "
+                     f"{format_params(m.params, corners):<{params_width}} "
+                     + " ".join(f"{text(m):>{w}}" for _, w, text in scores)
+                     + f"  {'yes' if m.valid else 'NO'}")
+        if m.note:
+            lines.append(f"{'':>4}{m.note}")
+    return lines
+
+
+def _best_line(best, corners: bool = False) -> str:
+    if best is None:
+        return "Best: none of the methods is valid for these data"
+    return f"Best: {best.name} ({best.model}): {format_params(best.params, corners)}"
+
+
+def step_text(result) -> str:
+    """The ``identify`` table of an :class:`~.step.IdentifyResult`."""
+    s, cap = result.step, result.capture
+    lines = []
+    if cap is not None:
+        lines.append(f"Capture: {cap.source} ({cap.fmt}, {cap.samples} samples, output "
+                     f"{cap.output_name!r}" + (f", input {cap.input_name!r}" if cap.input_name else "")
+                     + ")")
+    span = s.y_final - s.y0
+    noise = f"{100 * s.sigma / abs(span):.2g} %" if span else "n/a"
+    lines.append(f"Step at {format_eng(s.t_step, 's')}, amplitude {s.amplitude:.4g}; "
+                 f"baseline y0 = {s.y0:.4g}, final value {s.y_final:.4g}, "
+                 f"static gain K = {s.yf:.4g}; noise {noise} of the step")
+    for n in (list(cap.notes) if cap is not None else []) + s.notes:
+        lines.append(f"  note: {n}")
+    m = result.measured
+    if m is not None:
+        lines.append("Measured: overshoot "
+                     + (f"{m.overshoot_pct:.2f} %" if not math.isnan(m.overshoot_pct) else "n/a")
+                     + f", peak time {format_eng(m.peak_time_s, 's')}"
+                     + f", rise time (10-90 %) {format_eng(m.rise_time_s, 's')}"
+                     + f", settling (2 %) {format_eng(m.settling_time_s, 's')}")
+    lines += ["", "Methods ranked by IAE (integral of |data - model| over the response; "
+              "lower is better)"]
+    lines += methods_table(result.methods, name_width=24, params_width=52, corners=False,
+                           scores=[("IAE", 10, lambda r: _g(r.iae)), ("ISE", 10, lambda r: _g(r.ise))])
+    lines += ["", "IAE in output units x s, ISE in output units^2 x s.", _best_line(result.best)]
+    if result.comparison is not None:
+        lines.append("")
+        lines.extend(comparison_text(result.comparison))
+    return "\n".join(lines)
+
+
+def comparison_text(c) -> list:
+    """The lines of an :class:`~.against.Comparison`."""
+    lines = [f"Against the design (identified with {c.model or 'n/a'}; "
+             f"tolerances: {c.tolerance_basis}):"]
+    fmt = {"fn_hz": lambda v: format_eng(v, "Hz"), "zeta": lambda v: f"{v:.4g}",
+           "gain": lambda v: f"{v:.4g}", "overshoot_pct": lambda v: f"{v:.2f} %"}
+    for k, q in c.quantities.items():
+        f = fmt[k]
+        ident = "n/a" if q.identified is None or not math.isfinite(q.identified) else f(q.identified)
+        diff = "" if q.difference_pct is None else f" ({q.difference_pct:+.1f} %)"
+        lo, hi = q.band
+        band = "n/a" if not math.isfinite(lo) else f"{f(lo)} .. {f(hi)}"
+        inside = {True: "inside", False: "OUTSIDE", None: "-"}[q.within_tolerance]
+        lines.append(f"  {k:<14} design {f(q.design):>12}  identified {ident:>12}{diff}  "
+                     f"band {band}  {inside}")
+    lines.append(f"  verdict: {c.verdict}")
+    return lines
+
+
+def freq_text(result) -> str:
+    """The ``identify-freq`` table of a :class:`~.frequency.FreqIdentifyResult`."""
+    d = result.data
+    lines = [f"Table: {d.source or 'data'}: {d.w.size} points, "
+             f"{format_eng(d.f_hz[0], 'Hz')} to {format_eng(d.f_hz[-1], 'Hz')}, "
+             f"gain in {d.units['gain']}, "
+             + (f"phase in {d.units['phase']}" if d.phase is not None else "no phase")
+             + (" (inverting: K < 0)" if d.sign < 0 else "")]
+    lines += [f"  note: {n}" for n in d.notes]
+    lines += ["", "Methods ranked by fit error (mean |G_model/G_data - 1| over the table; "
+              "lower is better)"]
+    lines += methods_table(result.methods, name_width=15, params_width=84, corners=True,
+                           scores=[("error", 9, lambda r: _pct(r.iae))])
+    lines += ["", _best_line(result.best, corners=True)]
+    return "\n".join(lines)
+
+
+def _pyplot():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def fit_plot(result, n_models: int = 3) -> bytes:
+    """PNG of the step data against the best ``n_models`` valid models, with the residuals."""
+    from .preprocess import block_mean
+    from .structures import model_step
+    plt = _pyplot()
+    s = result.step
+    t, y = block_mean(s.t_raw, s.y_raw, 20000)
+    fig, (ax, axr) = plt.subplots(2, 1, figsize=(8, 6), dpi=110, sharex=True,
+                                  gridspec_kw={"height_ratios": [3, 1]})
+    tt = t - s.t_step
+    ax.plot(tt, y, color="k", lw=2.2, alpha=0.35, label="data")
+    shown = [m for m in result.methods if m.valid][:n_models]
+    for m, style in zip(shown, ("-", "--", ":")):
+        ym = s.y0 + s.amplitude * model_step(m.model, m.params, tt)
+        line, = ax.plot(tt, ym, lw=1.2, ls=style, label=f"{m.name} ({m.model}), IAE {m.iae:.3g}")
+        axr.plot(tt, y - ym, lw=0.8, ls=style, color=line.get_color())
+    for a in (ax, axr):
+        a.axvline(0.0, color="k", lw=0.6, ls=":")
+        a.grid(True, alpha=0.3)
+    axr.set_xlabel("time since the step (s)")
+    axr.set_ylabel("data - model")
+    ax.set_ylabel(result.capture.output_name if result.capture else "output")
+    ax.set_title("Step response: data and best identified models")
+    ax.legend(fontsize=8, loc="best")
+    fig.tight_layout()
+    return png_bytes(fig)
+
+
+def bode_fit_plot(result, n_models: int = 3) -> bytes:
+    """PNG Bode plot of a frequency table and the best ``n_models`` valid models."""
+    from .frequency import model_phase, model_response
+    plt = _pyplot()
+    d = result.data
+    w = np.geomspace(d.w[0] / 2.0, d.w[-1] * 2.0, 400)
+    f = w / (2 * math.pi)
+    has_phase = d.phase is not None
+    fig, axes = plt.subplots(2 if has_phase else 1, 1, sharex=True,
+                             figsize=(8, 6 if has_phase else 4), dpi=110, squeeze=False)
+    ax_g = axes[0][0]
+    ax_g.semilogx(d.f_hz, d.gain_db, "o", color="k", ms=4, label="data")
+    for m in [m for m in result.methods if m.valid][:n_models]:
+        g = model_response(m.model, m.params, w)
+        ax_g.semilogx(f, 20 * np.log10(np.abs(g)), lw=1.2,
+                      label=f"{m.name} ({m.model}), error {100 * m.iae:.2g} %")
+        if has_phase:
+            axes[1][0].semilogx(f, np.rad2deg(model_phase(m.model, dict(m.params), w)), lw=1.2)
+    ax_g.set_ylabel("gain (dB)")
+    ax_g.set_title("Frequency response: data and identified models")
+    ax_g.grid(True, which="both", alpha=0.3)
+    ax_g.legend(fontsize=8, loc="lower left")
+    if has_phase:
+        ax_p = axes[1][0]
+        ax_p.semilogx(d.f_hz, np.rad2deg(d.phase), "o", color="k", ms=4)
+        ax_p.set_ylabel("phase (deg)")
+        ax_p.grid(True, which="both", alpha=0.3)
+    axes[-1][0].set_xlabel("frequency (Hz)")
+    fig.tight_layout()
+    return png_bytes(fig)
