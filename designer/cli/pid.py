@@ -10,7 +10,7 @@ from .. import __version__
 from ..core.errors import DesignError
 from ..core.ranges import help_range
 from . import common
-from .common import OneLineParser, add_opamp_option, add_output_options, add_part_options, check_name, emit
+from .common import OneLineParser, add_opamp_option, add_output_options, add_part_options, emit
 
 EPILOG = """examples:
   design-pid --plant-fc 3500 --plant-zeta 0.2
@@ -129,11 +129,8 @@ def _run(args) -> int:
     from ..pid.design import design_pid
     from ..pid.report import summary_text, write_outputs
     spec = _build_spec(args)
-    if args.name is not None:
-        check_name(args.name)
-    if not args.no_files:
-        from ..core.fileio import check_can_create
-        check_can_create(args.out, ("netlists", "reports"))  # fail before the work, creating nothing
+    # the default name needs the plant as built; its fixed start stands in for it in the check
+    common.check_output(args, args.name if args.name is not None else f"pid_{spec.method}")
     result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
     name = args.name or _default_name(spec, result.plant.fn_hz, result.plant.zeta)
     return emit(result, args, name, write_outputs, summary_text)

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field, fields, replace
 from ..core import opamps
 from ..core.errors import DesignError
 from ..core.eseries import PartBounds
+from ..core.fileio import show_cell, shown
 from ..core.jsonio import read_result
 from ..core.ranges import ParamError, parse_in_range
 from ..plant.sallenkey import SallenKeyParts, check_parts
@@ -115,7 +116,7 @@ class PidSpec(PartBounds):
             raise _refused(f"{{tuning}} {self.tuning} and explicit {{kp}}/{{ti_s}}/{{td_s}} "
                            "exclude each other")
         if not all(explicit) and self.tuning not in (None, "optimize") and self.tuning not in rules.RULES:
-            raise _refused(f"unknown {{tuning}} {_short(self.tuning)}; allowed: {', '.join(rules.RULES)}, "
+            raise _refused(f"unknown {{tuning}} {show_cell(self.tuning)}; allowed: {', '.join(rules.RULES)}, "
                            "optimize")
         if self.tuning == "optimize":
             if self.target_overshoot_pct is None:
@@ -137,12 +138,6 @@ def _refused(marked: str) -> ParamError:
     """A refusal naming parameters as ``{name}`` markers (only :data:`PARAMS`: a
     file name's braces stay as they are)."""
     return ParamError(marked, PARAMS)
-
-
-def _short(value) -> str:
-    """A value for a one-line message: short, no newlines, no numpy repr."""
-    text = repr(value) if isinstance(value, str) else type(value).__name__
-    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def check_plant(parts: SallenKeyParts, names: dict) -> SallenKeyParts:
@@ -170,7 +165,6 @@ def plant_from_json(path) -> SallenKeyParts:
         built = read_result(path, "{plant_json}", needs={"built": needed})["built"]
     except DesignError as exc:
         raise _refused(str(exc)) from None
-    shown = _short(str(path))
     raw = SallenKeyParts(*(built.get(v) for v in BUILT_KEYS.values()))
-    names = {k: f"{{plant_json}} {shown}: built.{v}" for k, v in BUILT_KEYS.items()}
-    return check_plant(raw, names | {"plant": f"{{plant_json}} {shown}"})
+    names = {k: f"{{plant_json}} {shown(path)}: built.{v}" for k, v in BUILT_KEYS.items()}
+    return check_plant(raw, names | {"plant": f"{{plant_json}} {shown(path)}"})

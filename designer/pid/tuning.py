@@ -39,7 +39,6 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..core.errors import DesignError
-from ..core.ranges import RANGES
 from ..core.waveform import inflection_tangent, normalised_step
 
 RULES = ("zn", "cohen-coon", "chr0", "chr20", "amigo", "simc")
@@ -290,13 +289,3 @@ def tune(rule: str, source) -> Tuning:
 def all_rules(curve: ReactionCurve) -> list:
     """Every rule of :data:`RULES` applied to one reaction curve (each to its model)."""
     return [tune(r, curve) for r in RULES]
-
-
-def explicit(kp: float, ti_s: float, td_s: float) -> Tuning:
-    """Gains given by the user, inside their ranges (:data:`designer.ranges.RANGES`
-    ``kp``, ``ti_s``, ``td_s``; Td = 0 is a PI)."""
-    for name, key, v in (("--kp", "kp", kp), ("--ti", "ti_s", ti_s), ("--td", "td_s", td_s)):
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise DesignError(f"{name} must be a number, got {type(v).__name__}")
-        RANGES[key].check(float(v), name)
-    return Tuning("explicit", float(kp), float(ti_s), float(td_s))
