@@ -155,9 +155,8 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice")
         notes.append(f"to have gains chosen for the loop as built with {amp.name}s (stable with the op-amp poles, "
                      "every op-amp inside its swing and slew rate for this step): --tuning optimize "
                      "--target-overshoot P")
-    fit = curve.fit
     waves = Waveforms(loop.t, loop.r, loop.waves, loop.y_ideal, loop.y_open, loop.bode_w, loop.loop_gain, ps.t, ps.y,
-                      None if fit is None else fit.K * (1 - np.exp(-np.clip(ps.t - fit.L_s, 0.0, None) / fit.T_s)))
+                      None if curve.fit is None else curve.fit.step(ps.t))
     res = PidResult(spec=spec, plant=plant, plant_source=source, plant_series=plant_series,
                     plant_fn_opamp_hz=ps.fn_hz, plant_zeta_opamp=ps.zeta, opamp=amp, tuning=tun, rules=rules,
                     optimizer=opt, parts=parts, selection=sel, achieved=Achieved.of(parts, amp, tun), checks=checks,

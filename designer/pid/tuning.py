@@ -71,6 +71,10 @@ class Fopdt:
         return (f"{MODEL_NAMES.get(self.source, self.source)}: K {self.K:.4g}, L {format_eng(self.L_s, 's')}, "
                 f"T {format_eng(self.T_s, 's')}")
 
+    def step(self, t) -> np.ndarray:
+        """The model's response to a unit step at t = 0: K (1 - e^(-(t - L)/T)) from t = L."""
+        return self.K * (1 - np.exp(-np.clip(np.asarray(t, float) - self.L_s, 0.0, None) / self.T_s))
+
 
 @dataclass(frozen=True)
 class ReactionCurve:
