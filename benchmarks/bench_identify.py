@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from designer.identify.io import read_capture
 from designer.identify.against import model_fn_zeta
+from designer.identify.io import read_capture
 from designer.identify.step import identify_step
 from designer.identify.structures import model_step
 

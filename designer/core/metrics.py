@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .errors import DesignError
+from .jsonio import json_safe
 from .waveform import crossing_time, normalised_step, refine_peak
 
 
@@ -32,8 +33,7 @@ class StepMetrics:
     settling_time_5pct_s: float   #: 5 % band
 
     def to_dict(self) -> dict:
-        return {k: (None if isinstance(v, float) and math.isnan(v) else v)
-                for k, v in asdict(self).items()}
+        return json_safe(asdict(self))
 
 
 def settling_time(t, y, final, span, band) -> float:

@@ -306,7 +306,7 @@ def tangent_window(dt: float, n: int, *, sigma: float = 0.0, span: float = 1.0,
         if not (rise_s and math.isfinite(rise_s) and rise_s > 0):
             rise_s = n * dt / 10.0
         slope = abs(span) / rise_s
-        w = int(math.ceil((12.0 * (sigma / (dt * slope_noise * slope)) ** 2) ** (1.0 / 3.0)))
+        w = math.ceil((12.0 * (sigma / (dt * slope_noise * slope)) ** 2) ** (1.0 / 3.0))
         w = min(w, max(5, int(MAX_WINDOW_OF_RISE * rise_s / dt)))
     else:
         w = 5

@@ -85,8 +85,8 @@ def step_text(result) -> str:
                      + f", peak time {format_eng(m.peak_time_s, 's')}"
                      + f", rise time (10-90 %) {format_eng(m.rise_time_s, 's')}"
                      + f", settling (2 %) {format_eng(m.settling_time_s, 's')}")
-    lines += ["", "Methods ranked by IAE (integral of |data - model| over the response; "
-              "lower is better)"]
+    lines += ["", ("Methods ranked by IAE (integral of |data - model| over the response; "
+                   "lower is better)")]
     lines += methods_table(result.methods, name_width=24, params_width=52, corners=False,
                            scores=[("IAE", 10, lambda r: _g(r.iae)), ("ISE", 10, lambda r: _g(r.ise))])
     lines += ["", "IAE in output units x s, ISE in output units^2 x s.", _best_line(result.best)]
@@ -98,8 +98,8 @@ def step_text(result) -> str:
 
 def comparison_text(c) -> list:
     """The lines of an :class:`~.against.Comparison`."""
-    lines = [f"Against the design (identified with {c.model or 'n/a'}; "
-             f"tolerances: {c.tolerance_basis}):"]
+    lines = [(f"Against the design (identified with {c.model or 'n/a'}; "
+              f"tolerances: {c.tolerance_basis}):")]
     fmt = {"fn_hz": lambda v: format_eng(v, "Hz"), "zeta": lambda v: f"{v:.4g}",
            "gain": lambda v: f"{v:.4g}", "overshoot_pct": lambda v: f"{v:.2f} %"}
     for k, q in c.quantities.items():
@@ -124,8 +124,8 @@ def freq_text(result) -> str:
              + (f"phase in {d.units['phase']}" if d.phase is not None else "no phase")
              + (" (inverting: K < 0)" if d.sign < 0 else "")]
     lines += [f"  note: {n}" for n in d.notes]
-    lines += ["", "Methods ranked by fit error (mean |G_model/G_data - 1| over the table; "
-              "lower is better)"]
+    lines += ["", ("Methods ranked by fit error (mean |G_model/G_data - 1| over the table; "
+                   "lower is better)")]
     lines += methods_table(result.methods, name_width=15, params_width=84, corners=True,
                            scores=[("error", 9, lambda r: _pct(r.iae))])
     lines += ["", _best_line(result.best, corners=True)]

@@ -10,8 +10,8 @@ import pytest
 from helpers import FIXTURES, script
 
 from designer.identify.against import overshoot_from_zeta
-from designer.plant.sallenkey import fn_zeta as sallen_key
 from designer.identify.structures import model_step
+from designer.plant.sallenkey import fn_zeta as sallen_key
 
 EXE = script("identify")
 FIX = FIXTURES / "identify"
@@ -200,8 +200,8 @@ def test_agreement_band_contains_every_part_combination():
 
 
 def test_help_states_every_numeric_range():
-    from designer.core.ranges import RANGES
     from designer.core.fileio import MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, size_text
+    from designer.core.ranges import RANGES
     out = " ".join(run("--help").stdout.split())
     for key in ("capture_time_s", "step_amplitude", "capture_span_s", "capture_value",
                 "output_step"):

@@ -109,8 +109,8 @@ def test_bad_invocations(tmp_path):
 
 
 def test_help_states_the_limits_and_the_validity_rule():
-    from designer.core.ranges import RANGES
     from designer.core.fileio import MAX_TABLE_BYTES, size_text
+    from designer.core.ranges import RANGES
     from designer.identify.frequency import BAND_FACTOR, MAX_FIT_ERROR
     from designer.identify.io import MAX_POINTS
     out = " ".join(run("--help").stdout.split())

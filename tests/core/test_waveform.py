@@ -84,14 +84,14 @@ def test_crossing_time_robust_to_noise():
 def test_savitzky_golay_derivative_of_a_cubic_is_exact():
     t = np.linspace(0, 2, 401)
     y = 1 + 2 * t - 3 * t ** 2 + 0.5 * t ** 3
-    tu, ys, dy = smooth_derivative(t, y, window_s=0.2, polyorder=3)
+    _, ys, dy = smooth_derivative(t, y, window_s=0.2, polyorder=3)
     assert np.allclose(ys, y, atol=1e-10)
     assert np.allclose(dy, 2 - 6 * t + 1.5 * t ** 2, atol=1e-9)
 
 
 def test_derivative_on_a_non_uniform_grid_is_resampled():
     t = np.sort(np.concatenate([np.linspace(0, 1, 300), np.linspace(0.3, 0.4, 200)[1:-1]]))
-    tu, ys, dy = smooth_derivative(t, np.sin(t))
+    tu, _, dy = smooth_derivative(t, np.sin(t))
     assert np.ptp(np.diff(tu)) < 1e-12
     assert np.allclose(dy[5:-5], np.cos(tu[5:-5]), atol=2e-4)
 
@@ -209,7 +209,7 @@ def test_tangent_of_any_underdamped_response(zeta, fn):
     wn = 2 * math.pi * fn
     t = np.linspace(0, 12 / (zeta * wn), 20001)
     y = model_step("underdamped", {"K": 1.0, "wn_rad_s": wn, "zeta": zeta}, t)
-    ti, yi, slope, L, T = underdamped_tangent(wn, zeta)
+    ti, _, slope, L, _ = underdamped_tangent(wn, zeta)
     tg = inflection_tangent(t, y, 1.0)
     # the window's own flattening of the slope is taken back out: ~1e-6 on 20001 samples
     assert tg.t == pytest.approx(ti, rel=1e-4)

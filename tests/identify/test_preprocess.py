@@ -5,8 +5,6 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
 
 from designer.core.errors import DesignError
 from designer.core.waveform import noise_sigma
