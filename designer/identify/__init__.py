@@ -1,1 +1,11 @@
-"""Classical identification from step and frequency responses (seeds 000, 002, 003)."""
+"""Classical identification from step and frequency responses (seeds 000, 002, 003).
+
+``io`` reads scope captures and Bode tables; ``preprocess`` turns a capture
+into a normalised step; ``first_order``, ``second_order`` and ``refine``
+(least squares) are the step methods on the shared ``structures``;
+``step`` runs and ranks them, ``frequency`` does the same for a Bode table;
+``against`` compares an identified plant with its design (the one use of the
+plant wing) and ``report`` prints and plots the results. The waveform
+readings they share (noise, crossings, derivative, tangent) are
+:mod:`designer.core.waveform`.
+"""
