@@ -91,6 +91,13 @@ def _interp_at(t, y, j: int, level: float) -> float:
     return float(t[j - 1] + frac * (t[j] - t[j - 1]))
 
 
+def _first(mask) -> int:
+    """Index of the first True of a boolean array, -1 if none (argmax stops
+    at it, where nonzero would list every True of a long record)."""
+    k = int(np.argmax(mask)) if mask.size else 0
+    return k if mask.size and mask[k] else -1
+
+
 def crossing_time(t, y, level: float, *, sigma: float = 0.0, start: int = 0) -> float:
     """Time ``y`` first rises through ``level`` at or after index ``start``; nan if never.
 
@@ -103,17 +110,17 @@ def crossing_time(t, y, level: float, *, sigma: float = 0.0, start: int = 0) -> 
     """
     t = np.asarray(t, float)
     y = np.asarray(y, float)
-    above = np.nonzero(y[start:] >= level)[0]
-    if above.size == 0:
+    i = _first(y[start:] >= level)
+    if i < 0:
         return math.nan
-    i = start + int(above[0])
+    i += start
     band = 3.0 * sigma
     if band == 0.0 or i == 0:
         return _interp_at(t, y, i, level)
-    below = np.nonzero(y[start:i] < level - band)[0]
-    over = np.nonzero(y[i:] > level + band)[0]
-    lo = min(start + int(below[-1]) if below.size else start, i - 1)
-    hi = max(i + int(over[0]) if over.size else y.size - 1, i)
+    below = _first((y[start:i] < level - band)[::-1])
+    over = _first(y[i:] > level + band)
+    lo = min(i - 1 - below if below >= 0 else start, i - 1)
+    hi = max(i + over if over >= 0 else y.size - 1, i)
     if hi - lo == 1:
         return _interp_at(t, y, i, level)
     tt = t[lo:hi + 1]
