@@ -1,5 +1,6 @@
-"""Shared vocabulary of the identification methods: model step responses,
-the result record every method returns, and the IAE/ISE indices.
+"""Shared vocabulary of the identification methods: the result record every
+method returns and the IAE/ISE indices; the process models and their step
+responses come from :mod:`designer.core.stepfit`.
 
 Parameter names (seconds and rad/s in the names, as in the JSON output):
 - ``fopdt``       K, tau_s, theta_s           K e^(-theta s) / (tau s + 1)
@@ -17,49 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.jsonio import json_safe
-
-MODELS = ("fopdt", "double-pole", "underdamped", "overdamped")
-
-
-def model_step(model: str, params: dict, t) -> np.ndarray:
-    """Unit-input step response (0 -> K) of ``model`` at times ``t`` (step at t = 0)."""
-    t = np.asarray(t, float)
-    K = params["K"]
-    theta = params.get("theta_s", 0.0) or 0.0
-    s = np.clip(t - theta, 0.0, None)
-    if model == "fopdt":
-        y = 1.0 - np.exp(-s / params["tau_s"])
-    elif model == "double-pole":
-        tau = params["tau_s"]
-        y = 1.0 - (1.0 + s / tau) * np.exp(-s / tau)
-    elif model == "overdamped":
-        t1, t2 = params["tau1_s"], params["tau2_s"]
-        if math.isclose(t1, t2, rel_tol=1e-9):
-            y = 1.0 - (1.0 + s / t1) * np.exp(-s / t1)
-        else:
-            y = 1.0 - (t1 * np.exp(-s / t1) - t2 * np.exp(-s / t2)) / (t1 - t2)
-    elif model == "underdamped":
-        wn, z = params["wn_rad_s"], params["zeta"]
-        if z >= 1.0:
-            raise ValueError("underdamped model needs zeta < 1")
-        wd = wn * math.sqrt(1.0 - z * z)
-        phi = math.acos(z)
-        y = 1.0 - np.exp(-z * wn * s) * np.sin(wd * s + phi) / math.sqrt(1.0 - z * z)
-    else:
-        raise ValueError(f"unknown model {model!r}; allowed: {', '.join(MODELS)}")
-    return K * np.where(t >= theta, y, 0.0)
-
-
-def unphysical(model: str, params: dict) -> str:
-    """Why ``params`` are not a stable, causal ``model`` ("" when they are): a
-    time constant or wn that is not positive, a negative zeta. Their step
-    response grows without bound (exp overflows), so it is never evaluated."""
-    for k, v in params.items():
-        if (k.startswith("tau") or k == "wn_rad_s") and not v > 0:
-            return f"{k} = {v:.4g} is not positive"
-        if k == "zeta" and not v >= 0:
-            return f"zeta = {v:.4g} is negative"
-    return ""
+from ..core.stepfit import MODELS, model_step, unphysical  # noqa: F401  (the methods' vocabulary)
 
 
 def iae_ise(t, y, y_model):
