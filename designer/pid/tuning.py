@@ -39,6 +39,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..core.errors import DesignError
+from ..core.stepfit import fit_step, model_step
 from ..core.waveform import inflection_tangent, normalised_step
 
 RULES = ("zn", "cohen-coon", "chr0", "chr20", "amigo", "simc")
@@ -59,8 +60,9 @@ class Fopdt:
     T_s: float
     source: str
     valid: bool = True        #: False when the fit says the data do not fit an FOPDT (e.g. they overshoot)
-    note: str = ""
+    note: str = ""            #: why not, when it does not
     rms_residual: float | None = None   #: of the least-squares fit, in output units per unit input
+    ci95: dict | None = None  #: the fit's 95 % confidence half-widths (K, tau_s, theta_s)
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -73,7 +75,7 @@ class Fopdt:
 
     def step(self, t) -> np.ndarray:
         """The model's response to a unit step at t = 0: K (1 - e^(-(t - L)/T)) from t = L."""
-        return self.K * (1 - np.exp(-np.clip(np.asarray(t, float) - self.L_s, 0.0, None) / self.T_s))
+        return model_step("fopdt", {"K": self.K, "tau_s": self.T_s, "theta_s": self.L_s}, t)
 
 
 @dataclass(frozen=True)
@@ -190,8 +192,8 @@ def reaction_curve(t, y, *, u_step: float = 1.0, t_step: float | None = None,
 
 
 def fit_fopdt(t, y, K: float, start: Fopdt | None = None) -> Fopdt:
-    """Least-squares FOPDT of a step response, by the identification code
-    (:func:`designer.identify.refine.fit`, seed 000's FOPDT model).
+    """Least-squares FOPDT of a step response (:func:`designer.core.stepfit.fit_step`,
+    seed 000's FOPDT model, the fit identification uses too).
 
     Parameters
     ----------
@@ -205,18 +207,17 @@ def fit_fopdt(t, y, K: float, start: Fopdt | None = None) -> Fopdt:
     Returns
     -------
     Fopdt
-        ``source`` ``"least-squares"``; ``valid`` and ``note`` as the fit says
-        (e.g. invalid for a response that overshoots).
+        ``source`` ``"least-squares"``; ``valid``, ``note`` and the confidence
+        half-widths as the fit says (e.g. invalid for a response that overshoots).
     """
-    from ..identify.refine import fit
     guess = None
     if start is not None and start.T_s > 0:
         guess = {"model": "fopdt", "params": {"K": start.K, "tau_s": start.T_s, "theta_s": max(start.L_s, 0.0)}}
-    res = fit("fopdt", t, y, K, guess)
-    p = res.params
-    rms = res.points.get("rms_residual")
-    return Fopdt(float(p["K"]), float(p["theta_s"]), float(p["tau_s"]), "least-squares", bool(res.valid),
-                 res.note, None if rms is None or not math.isfinite(rms) else float(rms))
+    f = fit_step("fopdt", t, y, K, guess)
+    p = f.params
+    rms = f.rms_residual
+    return Fopdt(p["K"], p["theta_s"], p["tau_s"], "least-squares", bool(f.valid), f.note,
+                 rms if math.isfinite(rms) else None, dict(f.ci95))
 
 
 def _gains(rule: str, K: float, L: float, T: float):
