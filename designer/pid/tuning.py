@@ -12,7 +12,7 @@ its plant); the time constant is that time minus L (60.14 us).
 The tangent's K, L, T are the model ZN's rule was derived on. The other rules
 were derived for a *fitted* first-order-plus-dead-time (FOPDT) model
 K e^(-L s)/(T s + 1): they get the least-squares FOPDT of the whole step
-(:func:`designer.identify.refine.fit`, seed 000's FOPDT model). On Skogestad's
+(:func:`designer.core.stepfit.fit_step`, seed 000's FOPDT model). On Skogestad's
 example E1 the tangent's T is 67 % long and would make SIMC's Kc 91 % high.
 Each :class:`Tuning` records the model it used (:class:`Fopdt`, ``source``
 ``"tangent"`` or ``"least-squares"``); :data:`RULE_MODEL` says which.
