@@ -15,8 +15,9 @@ __version__ = "0.1.0"
 #: public name -> module that defines it
 _API = {
     "design_plant": "designer.plant.design", "analyze_plant": "designer.plant.design",
-    "PlantSpec": "designer.plant.design", "SallenKeyParts": "designer.plant.sallenkey",
-    "design_pid": "designer.pid.design", "PidSpec": "designer.pid.design",
+    "PlantSpec": "designer.plant.spec", "AnalysisSpec": "designer.plant.spec",
+    "SallenKeyParts": "designer.plant.sallenkey",
+    "design_pid": "designer.pid.design", "PidSpec": "designer.pid.spec",
     "identify_step": "designer.identify.step", "identify_freq": "designer.identify.frequency",
     "read_capture": "designer.identify.io", "DesignError": "designer.core.errors",
 }

@@ -21,7 +21,6 @@ from ..core.errors import DesignError
 from ..core.eseries import SERIES
 from ..core.ranges import help_range
 
-
 #: library parameter -> the option a user types; errors naming a parameter
 #: (:attr:`DesignError.param`) are shown with the option instead
 FLAGS = {
@@ -45,7 +44,7 @@ FLAGS = {
 
 def flag_message(exc: DesignError) -> str:
     """The error's message with the options the user typed for the parameters it
-    names: every ``{name}`` marker of a :class:`~designer.core.ranges.ParamError`
+    names: every ``{name}`` marker of a :class:`~designer.core.errors.ParamError`
     (or any error that reads its markers through a table, ``naming``), else the
     parameter it starts with (:attr:`DesignError.param`)."""
     if callable(getattr(exc, "naming", None)):

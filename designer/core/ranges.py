@@ -19,51 +19,12 @@ a message about several writes them as ``{name}`` markers (:class:`ParamError`).
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from .errors import DesignError
 from .units import format_eng, parse_value
-
-_MARKER = re.compile(r"\{([a-z][a-z0-9_]*)\}")
-#: how the library writes a marker that is not a parameter name (the CLI has an option for it)
-SPELLING = {"no_sim": "simulate=False"}
-
-
-class ParamError(DesignError):
-    """A refusal whose message names several parameters, as ``{name}`` markers.
-
-    ``str(error)`` reads them as the library's names (``r_min``, or
-    :data:`SPELLING`); :meth:`naming` reads them through another table, e.g.
-    the command line's options (``--r-min``). ``param`` is the first name.
-
-    Parameters
-    ----------
-    marked : str
-        The message, parameters written ``{name}``.
-    params : collection of str, optional
-        The only names that are markers (other ``{...}`` text, e.g. in a file
-        name, stays as it is); default every ``{identifier}``.
-    """
-
-    def __init__(self, marked: str, params=None):
-        self.marked = marked
-        self.params = None if params is None else frozenset(params)
-        first = next((m.group(1) for m in _MARKER.finditer(marked) if self._is_param(m.group(1))), None)
-        super().__init__(self.naming({}), param=first)
-
-    def _is_param(self, name: str) -> bool:
-        return self.params is None or name in self.params
-
-    def naming(self, names: dict) -> str:
-        """The message with each marker read through ``names`` (a name it lacks
-        reads as the library writes it)."""
-        def name(m):
-            key = m.group(1)
-            return names.get(key, SPELLING.get(key, key)) if self._is_param(key) else m.group(0)
-        return _MARKER.sub(name, self.marked)
 
 
 @dataclass(frozen=True)

@@ -20,11 +20,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields, replace
 
 from ..core import opamps
-from ..core.errors import DesignError
+from ..core.errors import DesignError, ParamError
 from ..core.eseries import PartBounds
 from ..core.fileio import show_cell, shown
 from ..core.jsonio import read_result
-from ..core.ranges import ParamError, parse_in_range
+from ..core.ranges import parse_in_range
 from ..plant.sallenkey import SallenKeyParts, check_parts
 from . import tuning as rules
 from .blocks import PidParts

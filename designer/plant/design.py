@@ -19,11 +19,11 @@ import numpy as np
 
 from ..core import eseries
 from ..core.compare import disagreements, metric_deltas, nrms, resample
-from ..core.errors import DesignError
+from ..core.errors import DesignError, ParamError
 from ..core.lti import dense_time, dominant_pair, response_span, step_response
 from ..core.metrics import step_metrics
 from ..core.opamps import OpAmp
-from ..core.ranges import RANGES, ParamError
+from ..core.ranges import RANGES
 from ..core.units import format_eng, value_code
 from ..spice.simulate import get_simulator
 from .bench import bench_period, period_check, recommend_square_wave, signal_checks, tolerance_band

@@ -200,7 +200,7 @@ def check_parts(parts: SallenKeyParts, name_of=None, text: bool = False) -> Sall
         gain`` and ``plant`` (the whole circuit), e.g. ``{"r1": "--plant-r1"}``;
         missing keys default to ``R1``... ``gain K``, ``the plant``. Names
         may be ``{name}`` markers of a
-        :class:`~designer.core.ranges.ParamError` (the caller raises it).
+        :class:`~designer.core.errors.ParamError` (the caller raises it).
     text : bool
         Also accept values as text in engineering notation (``"4k7"``), as a
         user typed them; a file's values must be numbers.

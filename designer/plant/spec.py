@@ -23,10 +23,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..core import opamps
-from ..core.errors import DesignError
+from ..core.errors import DesignError, ParamError
 from ..core.eseries import PartBounds, series_name
 from ..core.opamps import OpAmp
-from ..core.ranges import RANGES, ParamError, parse_in_range
+from ..core.ranges import RANGES, parse_in_range
 from .sallenkey import SallenKeyParts, check_parts
 
 

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..core.errors import ParamError
 from ..core.opamps import OpAmp
-from ..core.ranges import ParamError
 from ..core.units import format_eng
 from .library import library_text
 

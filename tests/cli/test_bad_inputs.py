@@ -8,8 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from designer.cli.identify import identify_main
-from designer.cli.identify import identify_freq_main
+from designer.cli.identify import identify_freq_main, identify_main
 from designer.cli.pid import design_pid_main
 from designer.cli.plant import analyze_plant_main, design_plant_main
 

@@ -2,8 +2,7 @@ import numpy as np
 import pytest
 
 from designer.core import eseries
-from designer.core.errors import DesignError
-from designer.core.ranges import ParamError
+from designer.core.errors import DesignError, ParamError
 
 
 def test_series_sizes_and_ordering():

@@ -6,8 +6,8 @@ from helpers import ROOT
 from hypothesis import given
 from hypothesis import strategies as st
 
-from designer.core.errors import DesignError
-from designer.core.ranges import RANGES, ParamError, Range, parse_in_range
+from designer.core.errors import DesignError, ParamError
+from designer.core.ranges import RANGES, Range, parse_in_range
 
 README = ROOT / "README.md"
 

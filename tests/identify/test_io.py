@@ -229,7 +229,7 @@ def test_streamed_file_equals_the_text_and_names_lines_across_blocks(tmp_path):
     it is reported at its own line."""
     from designer.core.fileio import BLOCK_BYTES
     text, t, y = _capture_text(20)
-    head, body = text.splitlines()[0], text.splitlines()[1:]
+    body = text.splitlines()[1:]
     n = 2 * BLOCK_BYTES // len(body[0]) + 1000
     tt = np.linspace(-1e-3, 9e-3, n)
     rows = format_generic(tt, model_step("fopdt", {"K": 2.0, "tau_s": 1e-3, "theta_s": 0.0},

@@ -8,8 +8,8 @@ from hypothesis import strategies as st
 
 from designer.core.errors import DesignError
 from designer.plant.design import MAX_ERROR, analyze_plant, design_plant
-from designer.plant.spec import AnalysisSpec, PlantSpec
 from designer.plant.sallenkey import SallenKeyParts
+from designer.plant.spec import AnalysisSpec, PlantSpec
 
 REFERENCE = ROOT / "reports" / "plant_fc3500_z0.2" / "result.json"
 
