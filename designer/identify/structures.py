@@ -1,14 +1,6 @@
 """Shared vocabulary of the identification methods: the result record every
-method returns and the IAE/ISE indices; the process models and their step
-responses come from :mod:`designer.core.stepfit`.
-
-Parameter names (seconds and rad/s in the names, as in the JSON output):
-- ``fopdt``       K, tau_s, theta_s           K e^(-theta s) / (tau s + 1)
-- ``double-pole`` K, tau_s, theta_s           K e^(-theta s) / (tau s + 1)^2
-- ``underdamped`` K, wn_rad_s, zeta, theta_s  K wn^2 e^(-theta s) / (s^2 + 2 zeta wn s + wn^2)
-- ``overdamped``  K, tau1_s, tau2_s, theta_s  K e^(-theta s) / ((tau1 s + 1)(tau2 s + 1)),
-  tau1 <= tau2 (the fast time constant first, as seeds 002 and 003 write it)
-"""
+method returns and the IAE/ISE indices. The process models, their parameter
+names and their step responses come from :mod:`designer.core.stepfit`."""
 
 from __future__ import annotations
 
