@@ -28,8 +28,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
-from scipy.special import stdtrit
 
 from .waveform import crossing_time, noise_sigma
 
@@ -184,6 +182,7 @@ def fit_step(model: str, t, y, yf, start: dict | None = None) -> StepFit:
     -------
     StepFit
     """
+    from scipy.optimize import least_squares   # imported on use: model_step users need no scipy
     t = np.asarray(t, float)
     y = np.asarray(y, float)
     tf, yfit = _thin(t, y)
@@ -237,6 +236,7 @@ def _confidence(model, sol, n):
         cov = np.linalg.pinv(J.T @ J) * s2
     except np.linalg.LinAlgError:  # pragma: no cover - defensive
         return {k: math.nan for k in names}
+    from scipy.special import stdtrit
     q = float(stdtrit(dof, 0.975))
     sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     x = sol.x
