@@ -124,7 +124,7 @@ class CaptureInfo:
                 "notes": list(self.notes)}
 
 
-def read_capture(path, *, input_column=None, output_column=None) -> Capture:
+def read_capture(path, *, input_column=None, output_column=None, fmt=None) -> Capture:
     """Read a step-response capture from ``path``, streaming it.
 
     Parameters
@@ -136,6 +136,9 @@ def read_capture(path, *, input_column=None, output_column=None) -> Capture:
         Column name (case-insensitive) or 1-based column number (time is column
         1) of the plant input and output; ``input_column="none"`` ignores any
         input column.
+    fmt : str, optional
+        One of :data:`FORMATS` to read the file as that layout instead of
+        recognising it (``auto``, the default, recognises it).
 
     Raises
     ------
@@ -148,20 +151,20 @@ def read_capture(path, *, input_column=None, output_column=None) -> Capture:
     with open_limited(path, "capture file", MAX_CAPTURE_BYTES) as fh:
         head, carry = _read_head(fh)
         cap = _parse(head, _file_blocks(fh, carry), fh.name, input_column, output_column,
-                     size_hint=fh.size)
+                     size_hint=fh.size, fmt=fmt)
     cap.source = str(path)
     return cap
 
 
 def parse_capture_text(text: str, *, name: str = "capture", input_column=None,
-                       output_column=None) -> Capture:
+                       output_column=None, fmt=None) -> Capture:
     """Parse the text of a capture file; see :func:`read_capture`."""
     lines = text.lstrip("\ufeff").splitlines()
     head, rest = lines[:HEAD_LINES], lines[HEAD_LINES:]
     blocks = ((b, _flags(b)) for b in (rest[i:i + BLOCK_LINES]
                                        for i in range(0, len(rest), BLOCK_LINES)))
     return _parse(head, blocks, name, input_column, output_column,
-                  size_hint=None if not rest else len(text))
+                  size_hint=None if not rest else len(text), fmt=fmt)
 
 
 # --------------------------------------------------------------------------- streaming
@@ -220,7 +223,9 @@ class _Layout:
     """Where the samples are: ``columns`` names time and the signals;
     ``file_cols`` the file column of each; ``first_row`` the head line where the
     samples start; ``time_axis`` (start, increment) when the time column is a
-    sample index (Rigol)."""
+    sample index (Rigol), or when there is no time column (``file_cols[0]`` is
+    None: time is start + row * increment); ``comma`` when the samples write
+    decimal commas; ``scales`` the unit of each column (PicoScope's units row)."""
 
     columns: list
     fmt: str
@@ -228,9 +233,12 @@ class _Layout:
     delim: str
     file_cols: list
     time_axis: tuple | None = None
+    comma: bool = False
+    scales: list | None = None
 
 
-def _parse(head, blocks, name, input_column, output_column, size_hint=None) -> Capture:
+def _parse(head, blocks, name, input_column, output_column, size_hint=None,
+           fmt=None) -> Capture:
     first = next(blocks, None)
     lines = list(head)
     if first is None:
@@ -240,7 +248,7 @@ def _parse(head, blocks, name, input_column, output_column, size_hint=None) -> C
     if not lines:
         raise DesignError(f"{name}: the file is empty; expected CSV rows of time and output "
                           "(t,y or t,u,y)")
-    layout = _layout(lines, name)
+    layout = _layout(lines, name, fmt)
     j_out, j_in, tentative = _choose_columns(layout.columns, input_column, output_column, name)
     keep = [0, j_out] + ([j_in] if j_in is not None else [])
     more = _then(first, blocks) if first is not None else iter(())
@@ -258,12 +266,16 @@ def _then(first, rest):
     yield from rest
 
 
-def _layout(lines, name) -> _Layout:
-    first = _cells(lines[0], ",")
-    if first and first[0].lower() == "record length":
-        return _read_tektronix_tds(lines, name)
-    if len(first) >= 3 and first[0].lower() == "x" and "increment" in [c.lower() for c in first]:
-        return _read_rigol(lines, name)
+def _layout(lines, name, fmt=None) -> _Layout:
+    """The layout of a capture from its first lines: the first format of
+    :data:`FORMATS` whose signature the header shows, or ``fmt`` when given."""
+    if fmt is not None:
+        fmt = check_format(fmt)
+        if fmt != "auto":
+            return _READERS[fmt](lines, name, forced=True)
+    for key, detect in _DETECT:
+        if detect(lines):
+            return _READERS[key](lines, name)
     return _read_table(lines, name)
 
 
@@ -284,45 +296,187 @@ def _is_number(cell: str) -> bool:
     return True
 
 
+def _first_cells(lines, k: int = 0) -> list:
+    """The comma-separated cells of line ``k``, lowercase ([] past the end)."""
+    return [c.lower() for c in _cells(lines[k], ",")] if k < len(lines) else []
+
+
 def _delimiter(lines: list) -> str:
     # the last lines are samples; comment and blank lines say nothing
     sample = [ln for ln in lines if ln.strip() and not ln.lstrip().startswith("#")][-20:]
     counts = {d: sum(line.count(d) for line in sample) for d in (";", "\t", ",")}
     if counts[";"]:
         return ";"
-    if counts["\t"] and not counts[","]:
+    if counts["\t"]:
         return "\t"
     if counts[","]:
         return ","
     return "whitespace"
 
 
-def _split(line: str, delim: str) -> list:
+def _decimal_comma(lines: list, delim: str) -> bool:
+    """True when the samples write decimal commas (a ``;``, tab or space
+    separated file from a European locale)."""
+    if delim == ",":
+        return False
+    sample = [ln for ln in lines if ln.strip() and not ln.lstrip().startswith("#")][-20:]
+    return any("," in ln for ln in sample)
+
+
+def _split(line: str, delim: str, comma: bool = False) -> list:
     line = line.split("#", 1)[0]
-    if delim == "whitespace":
-        return line.split()
-    cells = _cells(line, delim)
-    if delim == ";":
-        # Semicolon files from European locales write decimal commas.
+    cells = line.split() if delim == "whitespace" else _cells(line, delim)
+    if comma or delim == ";":
         cells = [c.replace(",", ".") for c in cells]
     return cells
 
 
-def _read_tektronix_tds(lines, name) -> _Layout:
-    """TDS/TBS: rows 'label,value,,time,value,'; the header block occupies cells 1-3."""
-    meta = {}
-    for line in lines[:40]:
-        c = [x.strip() for x in line.split(",")]
-        if len(c) >= 2 and c[0]:
-            meta[c[0].lower()] = c[1]
-    source = meta.get("source", "CH1") or "CH1"
-    return _Layout(["TIME", source], "tektronix-tds", 0, ",", [3, 4])
+def _numeric_row(line: str, delim: str, comma: bool) -> bool:
+    cells = _split(line, delim, comma)
+    return len(cells) >= 2 and all(_is_number(c) for c in cells)
 
 
-def _read_rigol(lines, name) -> _Layout:
-    """Rigol: 'X,CH1[,CH2...],Start,Increment,' / 'Sequence,Volt,...,<start>,<inc>,'."""
+def _data_start(lines, delim, comma, limit: int = 400):
+    """The first head line from which every row is numeric (checking a few rows
+    ahead, so a lone numeric header value is not taken for the data start), or None."""
+    for i, line in enumerate(lines[:limit]):
+        if _numeric_row(line, delim, comma) and all(
+                _numeric_row(a, delim, comma) for a in lines[i + 1:i + 4]):
+            return i
+    return None
+
+
+def _not_this(name, fmt, k, lines, what) -> DesignError:
+    """The one line of a file that does not fit a forced (or recognised) format."""
+    line = lines[k] if k < len(lines) else ""
+    return DesignError(f"{name}: not a {FORMAT_NAMES[fmt]} export: line {k + 1} "
+                       f"({show_cell(line)}) {what}")
+
+
+def _fit_failure(lines, delim, comma) -> tuple:
+    """(line index, text) of the first line that is neither a comment, a blank,
+    the one header line before the samples, nor a row of numbers."""
+    rows = [i for i, ln in enumerate(lines) if ln.split("#", 1)[0].strip()]
+    for n, i in enumerate(rows):
+        if _numeric_row(lines[i], delim, comma):
+            continue
+        # a single header right before numeric rows fits the generic layout
+        nxt = rows[n + 1] if n + 1 < len(rows) else None
+        if n == 0 and nxt is not None and _numeric_row(lines[nxt], delim, comma):
+            continue
+        return i, lines[i]
+    return rows[0] if rows else 0, lines[rows[0]] if rows else ""
+
+
+def _read_table(lines, name, fmt: str | None = None, forced: bool = False) -> _Layout:
+    """Generic table, project waveforms, Tektronix MSO/DPO, Digilent WaveForms:
+    header or comment lines, then rows of numbers."""
+    delim = _delimiter(lines)
+    comma = _decimal_comma(lines, delim)
+    first_row = _data_start(lines, delim, comma)
+    if first_row is None:
+        probe = _split(lines[min(len(lines) - 1, 1)], delim, comma)
+        if len(lines) <= 1 and probe and not all(_is_number(c) for c in probe):
+            raise DesignError(f"{name}: the file has a header but no data rows")
+        if len(probe) < 2 and all(_is_number(c) for c in probe):
+            raise DesignError(f"{name}: rows need at least two columns (time and output); "
+                              f"line {min(len(lines), 2)} has {len(probe)}")
+        k, line = _fit_failure(lines, delim, comma)
+        if forced and fmt:
+            raise _not_this(name, fmt, k, lines, "is not a row of numbers, and no numeric "
+                            "table follows the header")
+        raise DesignError(f"{name}: not a capture in a known format (tried "
+                          f"{', '.join(FORMATS)}): line {k + 1} ({show_cell(line)}) fits "
+                          "none of them; expected rows of numbers t,y or t,u,y after at most "
+                          "a header")
+    ncols = len(_split(lines[first_row], delim, comma))
+    header = _split(lines[first_row - 1], delim) if first_row > 0 else []
+    if len(header) >= ncols and not all(_is_number(c) for c in header):
+        columns = header[:ncols]
+    else:
+        columns = ["t"] + [f"col{j + 1}" for j in range(1, ncols)]
+        if ncols == 2:
+            columns = ["t", "y"]
+        elif ncols == 3:
+            columns = ["t", "u", "y"]
+    if columns[0].lower().startswith(("freq", "frequency")):
+        raise DesignError(f"{name}: a frequency-response (Bode) table, not a time capture: its "
+                          f"first column is {show_cell(columns[0])}; read it with identify-freq")
+    if fmt is None:
+        if any(_first_cells(lines, k)[:1] == ["model"] for k in range(first_row)):
+            fmt = "tektronix-mso"
+        elif columns and columns[0].lower() == "time_s":
+            fmt = "waveform"
+        elif any(ln.lower().startswith("#digilent waveforms") for ln in lines[:first_row]):
+            fmt = "digilent"
+        else:
+            fmt = "generic"
+    return _Layout(columns, fmt, first_row, delim, list(range(ncols)), comma=comma)
+
+
+def _read_generic(lines, name, forced=False) -> _Layout:
+    return _read_table(lines, name, "generic", forced)
+
+
+def _read_waveform(lines, name, forced=False) -> _Layout:
+    lay = _read_table(lines, name, "waveform", forced)
+    if forced and lay.columns[0].lower() != "time_s":
+        raise _not_this(name, "waveform", max(lay.first_row - 1, 0), lines,
+                        "is not the header time_s,<signal>,...")
+    return lay
+
+
+def _read_tektronix_mso(lines, name, forced=False) -> _Layout:
+    """MSO/DPO: ``Model,...`` key/value lines, then ``TIME,CH1,...`` and the samples."""
+    lay = _read_table(lines, name, "tektronix-mso", forced)
+    if forced and lay.columns[0].upper() != "TIME":
+        raise _not_this(name, "tektronix-mso", max(lay.first_row - 1, 0), lines,
+                        "is not the header TIME,CH1,...")
+    return lay
+
+
+def _read_digilent(lines, name, forced=False) -> _Layout:
+    """WaveForms: ``#`` comment lines, then ``Time (s),Channel 1 (V),...``."""
+    lay = _read_table(lines, name, "digilent", forced)
+    if forced and not lay.columns[0].lower().startswith("time"):
+        raise _not_this(name, "digilent", max(lay.first_row - 1, 0), lines,
+                        "is not the header Time (s),Channel 1 (V),...")
+    return lay
+
+
+def _is_tds(lines) -> bool:
+    c = _cells(lines[0], ",")
+    return (len(c) >= 5 and c[0].lower() == "record length" and _is_number(c[3])
+            and _is_number(c[4]))
+
+
+def _read_tektronix_tds(lines, name, forced=False) -> _Layout:
+    """TDS/TBS: rows ``label,value,,time,value,``; the header block occupies
+    cells 1-3 of the first rows, and a file of several channels repeats the
+    six columns for each (the time of the first is used)."""
+    if forced and not _is_tds(lines):
+        raise _not_this(name, "tektronix-tds", 0, lines, "is not 'Record Length,<n>,,<time>,"
+                        "<value>,' (the six-column TDS/TBS layout)")
+    first = _cells(lines[0], ",")
+    blocks = [b for b in range(0, len(first), 6) if first[b].lower() == "record length"]
+    names, cols = ["TIME"], [3]
+    for b in blocks:
+        meta = {}
+        for line in lines[:40]:
+            c = [x.strip() for x in line.split(",")]
+            if len(c) > b + 1 and c[b]:
+                meta[c[b].lower()] = c[b + 1]
+        names.append(meta.get("source", f"CH{len(names)}") or f"CH{len(names)}")
+        cols.append(b + 4)
+    return _Layout(names, "tektronix-tds", 0, ",", cols)
+
+
+def _rigol_header(lines, name, fmt, forced):
     head = _cells(lines[0], ",")
     low = [h.lower() for h in head]
+    if "start" not in low or "increment" not in low:
+        raise _not_this(name, fmt, 0, lines, "is not the header "
+                        + ("X," if fmt == "rigol" else "") + "CH1,...,Start,Increment,")
     if len(lines) < 3:
         raise DesignError(f"{name}: Rigol export has a header but no samples")
     second = _cells(lines[1], ",")
@@ -339,55 +493,128 @@ def _read_rigol(lines, name) -> _Layout:
     if not np.isfinite(start):
         raise DesignError(f"{name}: Rigol start time must be a finite number; "
                           f"got {number_text(start)}")
+    return head, i_start, start, inc
+
+
+def _read_rigol(lines, name, forced=False) -> _Layout:
+    """Rigol DS1000Z: ``X,CH1[,CH2...],Start,Increment,`` /
+    ``Sequence,Volt,...,<start>,<inc>,`` then the sample index and the values;
+    time is start + index * increment."""
+    if forced and _first_cells(lines)[:1] != ["x"]:
+        raise _not_this(name, "rigol", 0, lines, "is not the header X,CH1,...,Start,Increment,")
+    head, i_start, start, inc = _rigol_header(lines, name, "rigol", forced)
     channels = head[1:i_start]
     return _Layout(["TIME", *channels], "rigol", 2, ",", list(range(1 + len(channels))),
                    time_axis=(start, inc))
 
 
-def _read_table(lines, name) -> _Layout:
-    """Generic table, project waveforms and Tektronix MSO/DPO: header lines, then numbers."""
-    delim = _delimiter(lines)
-    # Find the first row from which every row is numeric: scan from the top,
-    # checking a few rows ahead so a lone numeric header value is not taken
-    # for the data start.
-    first_row = None
-    for i, line in enumerate(lines[:400]):
-        cells = _split(line, delim)
-        if len(cells) >= 2 and all(_is_number(c) for c in cells):
-            ahead = lines[i + 1:i + 4]
-            if all(len(_split(a, delim)) >= 2 and all(_is_number(c) for c in _split(a, delim))
-                   for a in ahead):
-                first_row = i
-                break
-    if first_row is None:
-        probe = _split(lines[min(len(lines) - 1, 1)], delim)
-        if len(lines) <= 1 and probe and not all(_is_number(c) for c in probe):
-            raise DesignError(f"{name}: the file has a header but no data rows")
-        bad = next((c for c in probe if not _is_number(c)), None)
-        if len(probe) < 2:
-            raise DesignError(f"{name}: rows need at least two columns (time and output); "
-                              f"line {min(len(lines), 2)} has {len(probe)}")
-        raise DesignError(f"{name}: no numeric table found ({show_cell(bad or '')} is not a "
-                          "number); expected rows of numbers: t,y or t,u,y")
-    ncols = len(_split(lines[first_row], delim))
-    header = _split(lines[first_row - 1], delim) if first_row > 0 else []
-    if len(header) >= ncols and not all(_is_number(c) for c in header):
-        columns = header[:ncols]
-    else:
-        columns = ["t"] + [f"col{j + 1}" for j in range(1, ncols)]
-        if ncols == 2:
-            columns = ["t", "y"]
-        elif ncols == 3:
-            columns = ["t", "u", "y"]
-    is_mso = any(_cells(ln, ",")[:1] and _cells(ln, ",")[0].lower() == "model"
-                 for ln in lines[:first_row])
-    if is_mso:
-        fmt = "tektronix-mso"
-    elif columns and columns[0].lower() == "time_s":
-        fmt = "waveform"
-    else:
-        fmt = "generic"
-    return _Layout(columns, fmt, first_row, delim, list(range(ncols)))
+def _read_rigol_no_x(lines, name, forced=False) -> _Layout:
+    """Rigol without the index column: ``CH1[,CH2...],Start,Increment,`` /
+    ``Volt,...,<start>,<inc>``, then the values only; time is
+    start + row * increment."""
+    head, i_start, start, inc = _rigol_header(lines, name, "rigol-no-x", forced)
+    channels = head[:i_start]
+    if not channels:
+        raise _not_this(name, "rigol-no-x", 0, lines, "names no channel before Start")
+    return _Layout(["TIME", *channels], "rigol-no-x", 2, ",",
+                   [None] + list(range(len(channels))), time_axis=(start, inc))
+
+
+def _read_siglent(lines, name, forced=False) -> _Layout:
+    """Siglent SDS: ``Record Length,Analog:N`` and other ``key,value`` lines,
+    ``Second,Volt[,Volt...]``, then time and values."""
+    if forced and _first_cells(lines)[:1] != ["record length"]:
+        raise _not_this(name, "siglent", 0, lines, "is not 'Record Length,Analog:<n>'")
+    lay = _read_table(lines, name, "siglent", forced)
+    names = []
+    for k in range(lay.first_row):
+        c = _cells(lines[k], ",")
+        if c and c[0].lower() == "source":
+            names = c[1:]
+    n = len(lay.columns) - 1
+    if len(names) != n:
+        names = [f"CH{j + 1}" for j in range(n)]
+    lay.columns = ["TIME", *names]
+    return lay
+
+
+def _read_keysight(lines, name, forced=False) -> _Layout:
+    """Keysight/Agilent InfiniiVision: ``x-axis,1[,2...]`` / ``second,Volt[,Volt...]``,
+    then time and values (channel numbers become CH1, CH2...)."""
+    if forced and _first_cells(lines)[:1] != ["x-axis"]:
+        raise _not_this(name, "keysight", 0, lines, "is not the header x-axis,1,2,...")
+    lay = _read_table(lines, name, "keysight", forced)
+    labels = _cells(lines[0], ",")[1:len(lay.columns)]
+    lay.columns = ["TIME"] + [f"CH{c}" if c.isdigit() else c for c in labels]
+    lay.columns += [f"col{j + 1}" for j in range(len(lay.columns), len(lay.file_cols))]
+    return lay
+
+
+#: A PicoScope units cell, in seconds or volts per unit.
+_PICO_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6, "ns": 1e-9,
+               "ps": 1e-12, "v": 1.0, "mv": 1e-3, "uv": 1e-6, "µv": 1e-6, "μv": 1e-6}
+
+
+def _pico_units(line) -> list | None:
+    """The scales of a PicoScope units row such as ``(ms),(V),(mV)``, or None."""
+    cells = _cells(line, _delimiter([line]) if "\t" in line or ";" in line else ",")
+    if len(cells) < 2 or not all(c.startswith("(") and c.endswith(")") for c in cells):
+        return None
+    scales = [_PICO_UNITS.get(c[1:-1].strip().lower()) for c in cells]
+    return None if any(s is None for s in scales) else scales
+
+
+def _read_picoscope(lines, name, forced=False) -> _Layout:
+    """PicoScope: ``Time,Channel A[,Channel B...]``, a units row ``(ms),(V)...``
+    (honoured: time in seconds, values in volts), maybe a blank line, then samples."""
+    scales = _pico_units(lines[1]) if len(lines) > 1 else None
+    if forced and scales is None:
+        raise _not_this(name, "picoscope", 1, lines, "is not a units row such as (ms),(V)")
+    lay = _read_table(lines, name, "picoscope", forced)
+    lay.columns = _cells(lines[0], lay.delim if lay.delim != "whitespace" else ",")[
+        :len(lay.file_cols)]
+    lay.scales = scales[:len(lay.file_cols)]
+    return lay
+
+
+def _detect_rigol_no_x(lines) -> bool:
+    c = _first_cells(lines)
+    return bool(c) and c[0] != "x" and "start" in c and "increment" in c
+
+
+#: Every layout recognised, in the order they are tried (generic last).
+FORMATS = ("tektronix-tds", "tektronix-mso", "rigol", "rigol-no-x", "siglent", "keysight",
+           "digilent", "picoscope", "waveform", "generic")
+#: What each is, for messages and ``--help``.
+FORMAT_NAMES = {"tektronix-tds": "Tektronix TDS/TBS", "tektronix-mso": "Tektronix MSO/DPO",
+                "rigol": "Rigol DS1000Z (X column)", "rigol-no-x": "Rigol (no X column)",
+                "siglent": "Siglent SDS", "keysight": "Keysight/Agilent InfiniiVision",
+                "digilent": "Digilent WaveForms", "picoscope": "PicoScope",
+                "waveform": "design-plant/design-pid waveforms", "generic": "generic CSV"}
+_READERS = {"tektronix-tds": _read_tektronix_tds, "tektronix-mso": _read_tektronix_mso,
+            "rigol": _read_rigol, "rigol-no-x": _read_rigol_no_x, "siglent": _read_siglent,
+            "keysight": _read_keysight, "digilent": _read_digilent,
+            "picoscope": _read_picoscope, "waveform": _read_waveform,
+            "generic": _read_generic}
+#: Header signatures of the named layouts (MSO, WaveForms and the project's
+#: waveforms are tagged by the table reader itself, from their header lines).
+_DETECT = (
+    ("tektronix-tds", _is_tds),
+    ("siglent", lambda ls: _first_cells(ls)[:1] == ["record length"]),
+    ("rigol", lambda ls: _first_cells(ls)[:1] == ["x"] and "increment" in _first_cells(ls)),
+    ("rigol-no-x", _detect_rigol_no_x),
+    ("keysight", lambda ls: _first_cells(ls)[:1] == ["x-axis"]),
+    ("picoscope", lambda ls: len(ls) > 1 and _pico_units(ls[1]) is not None),
+)
+
+
+def check_format(fmt) -> str:
+    """``fmt`` lowercased if it is ``auto`` or one of :data:`FORMATS`."""
+    f = str(fmt).strip().lower()
+    if f != "auto" and f not in FORMATS:
+        raise DesignError(f"unknown capture format {show_cell(str(fmt))}; allowed: auto, "
+                          + ", ".join(FORMATS))
+    return f
 
 
 # --------------------------------------------------------------------------- samples
@@ -396,8 +623,9 @@ class _Columns:
     """The kept columns, filled a block at a time (rows of ``data`` are the
     columns, each contiguous), with the file line of every sample."""
 
-    def __init__(self, k: int, hint: int):
+    def __init__(self, k: int, hint: int, skip: int = 0):
         self.data = np.empty((k, max(int(hint), 64)))
+        self.skip = skip    # leading rows not in the file (a time made from the row)
         self.n = 0
         self._row0 = []     # first sample of each block
         self._lines = []    # its first line number, or every line number
@@ -409,7 +637,7 @@ class _Columns:
                               max(int(1.25 * self.data.shape[1]), self.n + m)))
             grown[:, :self.n] = self.data[:, :self.n]
             self.data = grown
-        self.data[:, self.n:self.n + m] = rows.T
+        self.data[self.skip:, self.n:self.n + m] = rows.T
         self._row0.append(self.n)
         self._lines.append(lines)
         self.n += m
@@ -429,7 +657,8 @@ class _Columns:
 
 def _load(head, layout, keep, blocks, name, size_hint) -> _Columns:
     """Parse the samples of the kept columns: the head's data lines, then ``blocks``."""
-    usecols = [layout.file_cols[j] for j in keep]
+    generated = layout.file_cols[0] is None      # no time column: made from the row
+    usecols = [layout.file_cols[j] for j in keep[generated:]]
     body = head[layout.first_row:]
     if size_hint:
         # rows expected from the file size and the head's bytes per data line
@@ -438,10 +667,11 @@ def _load(head, layout, keep, blocks, name, size_hint) -> _Columns:
         hint = min(size_hint / per_line * 1.1 + 64, MAX_CAPTURE_ROWS + 1)
     else:
         hint = len(body)
-    cols = _Columns(len(keep), hint)
+    cols = _Columns(len(keep), hint, skip=int(generated))
     line0 = layout.first_row + 1
     for lines, flags in _then((body, _flags(body)), blocks):
-        rows, where = _parse_block(lines, line0, layout.delim, usecols, flags, name)
+        rows, where = _parse_block(lines, line0, layout.delim, usecols, flags, name,
+                                   layout.comma)
         if cols.n + rows.shape[0] > MAX_CAPTURE_ROWS:
             raise DesignError(f"{name}: more than {MAX_CAPTURE_ROWS:,} samples, the most "
                               "identify reads; decimate the record or cut it to the step")
@@ -451,13 +681,13 @@ def _load(head, layout, keep, blocks, name, size_hint) -> _Columns:
     return cols
 
 
-def _parse_block(lines, line0, delim, usecols, flags, name) -> tuple:
+def _parse_block(lines, line0, delim, usecols, flags, name, comma=False) -> tuple:
     """Numeric rows of a block of lines and their line numbers (the first one's
     number when no line was skipped, else an array)."""
     gaps, quotes = flags
     if quotes:
         lines = [ln.replace('"', "") for ln in lines]   # spreadsheet-quoted numbers
-    if delim == ";":
+    if comma or delim == ";":
         lines = [ln.replace(",", ".") for ln in lines]
     kw = {"delimiter": None if delim == "whitespace" else delim, "usecols": usecols,
           "ndmin": 2, "dtype": float, "comments": "#"}
@@ -475,13 +705,13 @@ def _parse_block(lines, line0, delim, usecols, flags, name) -> tuple:
     try:
         return np.loadtxt(rows, **kw), where
     except ValueError:
-        _raise_bad_cell(rows, where, delim, name, usecols)
+        _raise_bad_cell(rows, where, delim, name, usecols, comma)
         raise  # pragma: no cover - _raise_bad_cell always raises
 
 
-def _raise_bad_cell(rows, where, delim, name, usecols):
+def _raise_bad_cell(rows, where, delim, name, usecols, comma=False):
     for line, lineno in zip(rows, where):
-        cells = _split(line, delim)
+        cells = _split(line, delim, comma)
         for j in usecols:
             if j >= len(cells) or cells[j] == "":
                 raise DesignError(f"{name}: line {lineno} has no value in column "
@@ -555,6 +785,8 @@ def _assemble(cols: _Columns, layout: _Layout, keep, tentative, name) -> Capture
         raise DesignError(f"{name}: the file has no data rows")
     data = cols.columns()
     what = ["time", "output", "input"]
+    if layout.file_cols[0] is None:
+        data[0] = np.arange(cols.n)        # Rigol without X: the row is the index
     if layout.time_axis is not None:
         # Rigol: the first column is the sample index. An absurd index or
         # increment overflows to inf here, which check_samples then refuses
@@ -563,9 +795,17 @@ def _assemble(cols: _Columns, layout: _Layout, keep, tentative, name) -> Capture
         with np.errstate(over="ignore", invalid="ignore"):
             data[0] *= inc
             data[0] += start
-    file_col = [layout.file_cols[j] + 1 for j in keep]
+    if layout.scales is not None:
+        # PicoScope's units row: time in seconds, values in volts
+        with np.errstate(over="ignore", invalid="ignore"):
+            for row, j in enumerate(keep):
+                if j < len(layout.scales) and layout.scales[j] != 1.0:
+                    data[row] *= layout.scales[j]
+    file_col = [(layout.file_cols[j] + 1) if layout.file_cols[j] is not None else 0
+                for j in keep]
     check_samples(*data, name=name, what=what[:len(keep)],
-                  where=lambda i, k: f"line {cols.line(i)}, column {file_col[k]}")
+                  where=lambda i, k: f"line {cols.line(i)}"
+                  + (f", column {file_col[k]}" if file_col[k] else ""))
     t, y = data[0], data[1]
     u = data[2] if len(keep) == 3 else None
     columns = layout.columns
@@ -650,6 +890,7 @@ class FreqData:
     source: str = ""
     units: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
+    fmt: str = "table"
 
     @property
     def f_hz(self) -> np.ndarray:
@@ -665,7 +906,7 @@ class FreqData:
         return self.gain * np.exp(1j * ph)
 
     def to_dict(self) -> dict:
-        return {"source": self.source, "points": int(self.w.size),
+        return {"source": self.source, "format": self.fmt, "points": int(self.w.size),
                 "f_min_hz": float(self.f_hz[0]), "f_max_hz": float(self.f_hz[-1]),
                 "has_phase": self.phase is not None, "inverting": self.sign < 0,
                 "units": dict(self.units), "notes": list(self.notes)}
@@ -853,6 +1094,8 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
     """
     pre = f"{source}: " if source else ""
     lines = [(i + 1, ln.strip()) for i, ln in enumerate(text.lstrip("\ufeff").splitlines())]
+    fmt = ("digilent-bode" if lines and lines[0][1].lower().startswith("#digilent waveforms")
+           else "table")
     lines = [(i, ln) for i, ln in lines if ln and not ln.startswith("#")]
     if not lines:
         raise DesignError(f"{source or 'table'} is empty: expected rows of "
@@ -888,13 +1131,18 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
         raise DesignError(f"{source or 'table'} has a header but no data rows")
     rows = []
     ncol = None
+    use, picked = _analyser_columns(header)
     for lineno, ln in lines:
         cs = cells(ln)
         if ncol is None:
             ncol = len(cs)
-            if ncol not in (2, 3):
+            if use is not None and ncol == len(header):
+                ncol = len(use)
+            elif ncol not in (2, 3):
                 raise DesignError(f"{pre}line {lineno}: {ncol} columns; expected 2 or 3 "
                                   "(frequency, gain[, phase])")
+        if use is not None and len(cs) == len(header):
+            cs = [cs[j] for j in use]
         if len(cs) != ncol:
             raise DesignError(f"{pre}line {lineno}: {len(cs)} columns where the table has {ncol}")
         vals = []
@@ -907,6 +1155,8 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
             vals.append(float(c))
         rows.append(vals)
     arr = np.array(rows, float)
+    if use is not None and ncol == len(use):
+        header = [header[j] for j in use]
     names = header if header and len(header) == ncol else [""] * ncol
     kinds = ("frequency", "gain", "phase")
     units, scale = {}, {}
@@ -934,12 +1184,37 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
     data = freq_data(f, g, p, gain_units=units["gain"], phase_units=units.get("phase", "deg"),
                      freq_units=units["frequency"], source=source,
                      lines=[lineno for lineno, _ in lines])
+    data.fmt = fmt
+    if picked:
+        data.notes.append(picked)
     if "gain" in defaulted and 0.0 <= g.min() and g.max() <= 10.0 and np.ptp(g) > 0.1:
         data.notes.append("the gain column was read as dB (the default: neither the header "
                           "nor --gain-units names it), but every value lies between 0 and 10, "
                           "as an amplitude ratio Vout/Vin would; if it is one, pass "
                           "--gain-units ratio")
     return data
+
+
+def _analyser_columns(header):
+    """``(columns, note)``: for a network analyser's export of more than three
+    columns (WaveForms: frequency, each channel's magnitude, the relative
+    channel's phase), the frequency, the magnitude of the channel whose phase
+    is given (the response relative to the reference channel) and that phase;
+    ``(None, "")`` for any other header."""
+    if not header or len(header) <= 3:
+        return None, ""
+    low = [h.lower() for h in header]
+    phase = [j for j, h in enumerate(low) if "phase" in h]
+    mag = [j for j, h in enumerate(low) if "magnitude" in h or "gain" in h or "mag " in h]
+    if not phase or not mag:
+        return None, ""
+    p = phase[-1]
+    channel = low[p].split("phase")[0].strip()
+    same = [j for j in mag if channel and low[j].startswith(channel)]
+    g = same[-1] if same else mag[-1]
+    return [0, g, p], (f"network-analyser export of {len(header)} columns: read "
+                       f"{header[g]!r} and {header[p]!r} (the response relative to the "
+                       "reference channel)")
 
 
 def read_freq_table(path, **units) -> FreqData:

@@ -141,10 +141,11 @@ def test_quoted_cells_and_a_units_row():
     quoted = '"Time (s)","Vout (V)"\n' + "".join(f'"{a:.6e}","{b:.6f}"\n' for a, b in zip(t, y))
     cap = parse_capture_text(quoted)
     assert cap.output_name == "Vout (V)" and np.allclose(cap.y, y, atol=1e-6)
-    # Keysight-style: a label row and a units row before the samples
+    # Keysight: a label row and a units row before the samples
     units = "x-axis,1\nsecond,Volt\n" + "".join(f"{a:.6e},{b:.6f}\n" for a, b in zip(t, y))
     cap = parse_capture_text(units)
-    assert cap.columns == ["second", "Volt"] and np.allclose(cap.t, t, rtol=1e-6)
+    assert cap.fmt == "keysight" and cap.columns == ["TIME", "CH1"]
+    assert np.allclose(cap.t, t, rtol=1e-6)
 
 
 # ------------------------------------------------------- issue 7: files, encodings, columns
