@@ -37,6 +37,8 @@ FLAGS = {
     "step_v": "--step", "edge_s": "--edge", "target_overshoot_pct": "--target-overshoot",
     "target_settling_s": "--target-settling", "f_integrator_hz": "--f-integrator",
     "f_differentiator_hz": "--f-differentiator",
+    # analyze-pid: the controller as built (r3, r4 as above)
+    **{f"r{i}": f"--r{i}" for i in range(5, 19)}, "c3": "--c3", "c4": "--c4", "controller_json": "--parts-json",
     # identify / identify-freq
     "step_time_s": "--step-time", "step_amplitude": "--step-amplitude",
 }
@@ -44,16 +46,9 @@ FLAGS = {
 
 def flag_message(exc: DesignError) -> str:
     """The error's message with the options the user typed for the parameters it
-    names: every ``{name}`` marker of a :class:`~designer.core.errors.ParamError`
-    (or any error that reads its markers through a table, ``naming``), else the
-    parameter it starts with (:attr:`DesignError.param`)."""
-    if callable(getattr(exc, "naming", None)):
-        return exc.naming(FLAGS)
-    msg = str(exc)
-    param = getattr(exc, "param", None)
-    if isinstance(param, str) and param in FLAGS and msg.startswith(param):
-        return FLAGS[param] + msg[len(param):]
-    return msg
+    names (:meth:`DesignError.naming`: every ``{name}`` marker of a
+    :class:`~designer.core.errors.ParamError`, else the parameter it starts with)."""
+    return exc.naming(FLAGS) if callable(getattr(exc, "naming", None)) else str(exc)
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -95,6 +90,7 @@ def run_cli(prog: str, build_parser, action, argv=None) -> int:
     try:
         parser = build_parser()
         args = parser.parse_args(argv)
+        args.prog = prog   # for messages written after the action's own work (see failed_checks_status)
         return action(args) or 0
     except SimulatorError as exc:
         _fail(prog, f"simulator error: {exc}")
@@ -117,10 +113,10 @@ def run_cli(prog: str, build_parser, action, argv=None) -> int:
         return EXIT_BAD_INPUT
 
 
-def _fail(prog: str, message: str) -> None:
+def _fail(prog: str, message: str, kind: str = "error: ") -> None:
     line = " ".join(str(message).split())   # one line, whatever the message holds
     try:
-        print(f"{prog}: error: {line}", file=sys.stderr)
+        print(f"{prog}: {kind}{line}", file=sys.stderr)
     except OSError:
         pass
 
@@ -153,6 +149,9 @@ def add_output_options(p, default_name: str):
                                    f"(default from the figures, e.g. {default_name})")
     g.add_argument("--json", action="store_true", help="print one JSON object on stdout instead of the summary")
     g.add_argument("--no-files", action="store_true", help="do not write the netlist and report files")
+    g.add_argument("--fail-on-check", action="store_true",
+                   help="exit status 1 when a design check or the SPICE agreement fails (for CI; the files and "
+                        "the summary are written first, the failed checks listed on stderr)")
     s = p.add_argument_group("simulation")
     s.add_argument("--no-sim", action="store_true", help="skip the ngspice run (analytic figures only)")
     s.add_argument("--simulator", default="pyspice", choices=("pyspice", "ngspice-cli"),
@@ -167,17 +166,10 @@ def add_opamp_option(group):
                        help=f"op-amp model: {', '.join(opamps.names())} (default LM741, as the seed's bench)")
 
 
-_NAME = re.compile(r"^[A-Za-z0-9_+=,@-][A-Za-z0-9._+=,@-]{0,119}$")
-
-
 def check_name(name) -> str:
-    """A design name is a plain file name: letters, digits and ``. _ - + = , @``, not
-    starting with '.', at most 120 characters (it names a folder and a netlist)."""
-    if not _NAME.match(name or ""):
-        what = "must not be empty" if not name else f"{name[:40]!r} is not a plain file name"
-        raise DesignError(f"--name {what}: use letters, digits and . _ - + = , @ (not starting with '.', "
-                          "at most 120 characters)")
-    return name
+    """``--name``: a plain file name (:func:`designer.core.fileio.check_plain_name`)."""
+    from ..core.fileio import check_plain_name
+    return check_plain_name(name, "--name")
 
 
 def check_output(args, name: str) -> None:
@@ -191,7 +183,9 @@ def check_output(args, name: str) -> None:
 
 
 def emit(result, args, name, write_outputs, summary_text) -> int:
-    """Write the files (unless --no-files), then print JSON or the summary and the file list."""
+    """Write the files (unless --no-files), then print JSON or the summary and the file list.
+    Returns the exit status: 1 with ``--fail-on-check`` when a verdict failed
+    (:meth:`verdicts` of the result: the checks and the SPICE agreement), else 0."""
     if not args.no_files:
         write_outputs(result, args.out, name)
     if args.json:
@@ -203,4 +197,16 @@ def emit(result, args, name, write_outputs, summary_text) -> int:
                 f"  {key}: {', '.join(path) if isinstance(path, list) else path}\n"
                 for key, path in result.files.items())
         print_output(text, end="")
-    return 0
+    return failed_checks_status(result, args)
+
+
+def failed_checks_status(result, args) -> int:
+    """With ``--fail-on-check``: each failed verdict as a line on stderr
+    (``<prog>: check failed: slew_rate: ...``) and exit status 1; else 0."""
+    from ..core.errors import EXIT_CHECK_FAILED
+    if not getattr(args, "fail_on_check", False):
+        return 0
+    bad = [c for c in result.verdicts() if not c.ok]
+    for c in bad:
+        _fail(args.prog, f"check failed: {c.id}: {c.detail}", "")
+    return EXIT_CHECK_FAILED if bad else 0

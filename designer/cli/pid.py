@@ -51,21 +51,7 @@ def _parser():
                     "the whole closed loop (controller + plant circuit) in ngspice.",
         epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    g = p.add_argument_group("plant (one of three ways)")
-    g.add_argument("--plant-fc", metavar="HZ",
-                   help=f"design the plant as design-plant does: natural frequency {_r('fc_hz')}")
-    g.add_argument("--plant-zeta", metavar="Z", help=f"... and damping ratio {_r('zeta')}")
-    for n, what, key in (("r1", "input resistor", "resistor_ohm"),
-                         ("r2", "resistor to the non-inverting input", "resistor_ohm"),
-                         ("c1", "non-inverting input to ground", "capacitor_f"),
-                         ("c2", "feedback capacitor", "capacitor_f")):
-        g.add_argument(f"--plant-{n}", metavar="VALUE", help=f"plant as built: {what} {_r(key)}")
-    g.add_argument("--plant-gain", metavar="K",
-                   help=f"plant gain K = 1 + R4/R3 with --plant-r1.. {_r('gain')} (default 1; R3 = 10k, "
-                        "R4 = (K - 1) R3)")
-    g.add_argument("--plant-json", metavar="FILE",
-                   help="a result.json written by design-plant or analyze-plant (its 'built' parts, checked "
-                        "against the same ranges)")
+    _add_plant_options(p)
     t = p.add_argument_group("tuning")
     t.add_argument("--tuning", metavar="RULE",
                    help="zn (default), cohen-coon, chr0, chr20, amigo, simc, optimize")
@@ -84,6 +70,32 @@ def _parser():
                    help=f"integrator leak corner 1/(2 pi R13 C4) {_r('f_integrator_hz')} (default fn/100)")
     s.add_argument("--f-differentiator", metavar="HZ",
                    help=f"derivative filter corner 1/(2 pi R12 C3) {_r('f_differentiator_hz')} (default 10 fn)")
+    _add_signal_options(p)
+    add_output_options(p, "pid_<tuning>_<opamp>_fn<fn>_z<zeta>")
+    return p
+
+
+def _add_plant_options(p):
+    """The plant, one of three ways (design-pid and analyze-pid)."""
+    g = p.add_argument_group("plant (one of three ways)")
+    g.add_argument("--plant-fc", metavar="HZ",
+                   help=f"design the plant as design-plant does: natural frequency {_r('fc_hz')}")
+    g.add_argument("--plant-zeta", metavar="Z", help=f"... and damping ratio {_r('zeta')}")
+    for n, what, key in (("r1", "input resistor", "resistor_ohm"),
+                         ("r2", "resistor to the non-inverting input", "resistor_ohm"),
+                         ("c1", "non-inverting input to ground", "capacitor_f"),
+                         ("c2", "feedback capacitor", "capacitor_f")):
+        g.add_argument(f"--plant-{n}", metavar="VALUE", help=f"plant as built: {what} {_r(key)}")
+    g.add_argument("--plant-gain", metavar="K",
+                   help=f"plant gain K = 1 + R4/R3 with --plant-r1.. {_r('gain')} (default 1; R3 = 10k, "
+                        "R4 = (K - 1) R3)")
+    g.add_argument("--plant-json", metavar="FILE",
+                   help="a result.json written by design-plant or analyze-plant (its 'built' parts, checked "
+                        "against the same ranges)")
+
+
+def _add_signal_options(p):
+    """The op-amps and the reference square wave (design-pid and analyze-pid)."""
     o = p.add_argument_group("op-amps and test signal")
     add_opamp_option(o)
     o.add_argument("--step", default="1", metavar="V",
@@ -93,8 +105,6 @@ def _parser():
     o.add_argument("--square-freq", metavar="HZ",
                    help=f"reference frequency {_r('square_hz')} (default: half period = 1.5x the closed "
                         "loop's settling time, rounded)")
-    add_output_options(p, "pid_<tuning>_<opamp>_fn<fn>_z<zeta>")
-    return p
 
 
 #: the spec's parameters set from options of the same meaning (their options: FLAGS)
@@ -107,17 +117,22 @@ def _build_spec(args):
     """The spec from the options as typed: the spec parses and checks them (the one validation)."""
     from ..pid.blocks import seed_parts
     from ..pid.spec import PidSpec
+    typed = {p: getattr(args, common.FLAGS[p][2:].replace("-", "_")) for p in SPEC_PARAMS}
+    return PidSpec(plant_parts=_plant_parts(args), controller_parts=seed_parts() if args.seed_parts else None,
+                   **typed)
+
+
+def _plant_parts(args):
+    """The plant's parts as typed (--plant-r1 ..), or None; the spec checks them."""
     from ..plant.sallenkey import SallenKeyParts
-    plant_parts = None
     given = [args.plant_r1, args.plant_r2, args.plant_c1, args.plant_c2]
     if any(v is not None for v in given):
         if not all(v is not None for v in given):
             raise DesignError("--plant-r1, --plant-r2, --plant-c1 and --plant-c2 go together")
-        plant_parts = SallenKeyParts(*given, args.plant_gain)
-    elif args.plant_gain is not None:
+        return SallenKeyParts(*given, args.plant_gain)
+    if args.plant_gain is not None:
         raise DesignError("--plant-gain goes with --plant-r1..--plant-c2")
-    typed = {p: getattr(args, common.FLAGS[p][2:].replace("-", "_")) for p in SPEC_PARAMS}
-    return PidSpec(plant_parts=plant_parts, controller_parts=seed_parts() if args.seed_parts else None, **typed)
+    return None
 
 
 def _default_name(spec, fn_hz, zeta) -> str:
@@ -138,6 +153,83 @@ def _run(args) -> int:
 
 def design_pid_main(argv=None) -> int:
     return common.run_cli("design-pid", _parser, _run, argv)
+
+
+ANALYZE_EPILOG = """examples:
+  analyze-pid --plant-fc 3500 --plant-zeta 0.2 --parts-json reports/pid_zn_lm741_fc3500_z0.2/result.json
+        a controller as design-pid built it, re-checked (e.g. with --opamp TL072)
+  analyze-pid --plant-r1 1k6 --plant-r2 3k9 --plant-c1 3n3 --plant-c2 100n \\
+      --r3 12k --r4 1k8 --r5 22k --r6 3k3 --r7 15k --r8 1k2 --r9 10k --r10 10k --r11 10k --r12 1k \\
+      --r13 27k --r14 2k7 --r15 10k --r16 10k --r17 10k --r18 10k --c3 4n7 --c4 47n
+        the controller on the bench, part by part (leave out --r7 --r11 --r12 --c3 for a PI)
+  analyze-pid ... --kp 45 --ti 43.215u --td 10.8037u
+        ... and how far its parts are from the gains they were meant to give
+
+The same topology, checks, closed-loop analysis, SPICE verification and build sheet as design-pid
+(see design-pid --help), for parts already chosen: Kp = R5 R3/(R6 R4), Ti = R8 R14 C4/R6,
+Td = R6 R11 C3/R7. Without --kp/--ti/--td the parts' own gains are the tuning (method as-built) and
+the accuracy and part-bound checks are left out. Exit status: 0 done, 1 a check or the SPICE agreement
+failed (with --fail-on-check), 2 bad input (one line on stderr, nothing written), 3 simulator error."""
+
+
+def _analyze_parser():
+    p = OneLineParser(
+        prog="analyze-pid",
+        description="Analyse the seed's six-op-amp PID controller as built from its parts, on its plant: the "
+                    "gains the parts give, the stage checks, the closed loop with the op-amp poles, and ngspice.",
+        epilog=ANALYZE_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    _add_plant_options(p)
+    c = p.add_argument_group("controller as built (every part, or --parts-json)")
+    for i in range(3, 19):
+        c.add_argument(f"--r{i}", metavar="OHM", help=f"R{i} {_r('resistor_ohm')}" if i == 3 else None)
+    c.add_argument("--c3", metavar="F", help=f"differentiator capacitor {_r('capacitor_f')}")
+    c.add_argument("--c4", metavar="F", help=f"integrator capacitor {_r('capacitor_f')}")
+    c.add_argument("--parts-json", metavar="FILE",
+                   help="a result.json of design-pid or analyze-pid: its 'components' (R3_ohm .. C4_f)")
+    t = p.add_argument_group("gains the parts should give (optional, all three)")
+    t.add_argument("--kp", help=f"proportional gain {_r('kp')}")
+    t.add_argument("--ti", metavar="S", help=f"integral time {_r('ti_s')}")
+    t.add_argument("--td", metavar="S", help=f"derivative time {_r('td_s')}; 0 for a PI")
+    _add_signal_options(p)
+    add_output_options(p, "pid_as-built_<opamp>_fn<fn>_z<zeta>")
+    return p
+
+
+#: the controller parts' options, as PidParts fields
+CONTROLLER_FIELDS = tuple(f"r{i}" for i in range(3, 19)) + ("c3", "c4")
+
+
+def _analyze(args) -> int:
+    from ..pid.blocks import PidParts
+    from ..pid.design import analyze_pid
+    from ..pid.report import summary_text, write_outputs
+    from ..pid.spec import PidSpec, controller_from_json
+    typed = {k: getattr(args, k) for k in CONTROLLER_FIELDS}
+    if args.parts_json is not None:
+        if any(v is not None for v in typed.values()):
+            raise DesignError("give the controller either part by part (--r3 .. --c4) or --parts-json, not both")
+        parts = controller_from_json(args.parts_json)
+    elif all(v is None for v in typed.values()):
+        raise DesignError("the controller's parts are needed: --r3 .. --r18, --c3, --c4 (or --parts-json FILE)")
+    else:
+        parts = PidParts(**typed)
+    spec = PidSpec(plant_parts=_plant_parts(args), controller_parts=parts,
+                   **{p: getattr(args, common.FLAGS[p][2:].replace("-", "_")) for p in ANALYZE_PARAMS})
+    common.check_output(args, args.name if args.name is not None else "pid_as-built")
+    result = analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
+    name = args.name or (f"pid_{result.tuning.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}"
+                         f"_z{result.plant.zeta:.3g}")
+    return emit(result, args, name, write_outputs, summary_text)
+
+
+#: the spec's parameters analyze-pid sets from options of the same meaning
+ANALYZE_PARAMS = ("plant_fc_hz", "plant_zeta", "plant_json", "kp", "ti_s", "td_s", "opamp", "step_v", "edge_s",
+                  "square_hz")
+
+
+def analyze_pid_main(argv=None) -> int:
+    return common.run_cli("analyze-pid", _analyze_parser, _analyze, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

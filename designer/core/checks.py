@@ -46,3 +46,18 @@ class Check:
 def failed(checks) -> list:
     """The checks that did not pass."""
     return [c for c in checks if not c.ok]
+
+
+#: the id of the verdict on SPICE against the analytic model (every command that simulates)
+SPICE_AGREEMENT = "spice_agreement"
+
+#: every id a design command can give, by command family; ``bandwidth_<stage>`` ids are the PID's
+#: per-stage checks (``difference``, ``inverter``, ``differentiator``, ``integrator``, ``summer``, ``gain``)
+IDS = {
+    "plant": ("slew_rate", "output_swing", "square_wave_period", SPICE_AGREEMENT),
+    "pid": ("kp_accuracy", "ti_accuracy", "td_accuracy", "integrator_corner", "differentiator_corner",
+            *(f"bandwidth_{s}" for s in ("difference", "inverter", "differentiator", "integrator", "summer",
+                                          "gain")),
+            "resistor_bounds", "capacitor_bounds", "closed_loop_stable", "phase_margin", "steady_state_error",
+            "slew_rate", "output_swing", SPICE_AGREEMENT),
+}

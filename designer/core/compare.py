@@ -18,17 +18,66 @@ def resample(t_src, y_src, t_dst):
     return np.interp(np.asarray(t_dst, float), np.asarray(t_src, float), np.asarray(y_src, float))
 
 
-def nrms(reference, other, abstol: float) -> float:
-    """Normalised RMS error: RMS of (ref - other) / (0.01 |ref| + abstol).
+def trapezoid_weights(t) -> np.ndarray:
+    """Each sample's share of the span of ``t`` under the trapezoidal rule
+    (half an interval on each side; the ends get half of one), so that
+    ``sum(w * f)`` integrates ``f`` over a grid whether its steps are uniform or
+    adaptive (ngspice's are)."""
+    t = np.asarray(t, float)
+    dt = np.diff(t)
+    w = np.zeros_like(t)
+    w[:-1] += dt / 2
+    w[1:] += dt / 2
+    return w
 
-    Below 1 means the waveforms agree to about 1 % of the value plus
-    ``abstol`` everywhere on average (a pass).
+
+def nrms(gold, test, abstol: float, *, reltol: float = 0.01, t=None, t_gold=None) -> float:
+    """The normalised RMS error of ``test`` against ``gold``: Xyce's
+    ``xyce_verify`` rule,
+
+        sqrt( (1/T) integral( ((gold - test) / (reltol |gold| + abstol))^2 dt ) )
+
+    over the test's time points ``t`` (span T) with trapezoidal weights, so
+    adaptive simulator steps count by the time they cover, not by their
+    number. Below 1 is a pass: the waveforms agree to ``reltol`` of the value
+    plus ``abstol`` on (RMS) average. The design commands compare SPICE with
+    their models this way (the model is the gold), and ``check-design`` a run
+    with its golden waveform.
+
+    Parameters
+    ----------
+    gold, test : array_like
+        The reference and the waveform under test. ``gold`` is on the test's
+        time points, or on its own ``t_gold``, then interpolated (linearly) onto ``t``.
+    abstol : float
+        Absolute tolerance, in the signals' units (> 0).
+    reltol : float
+        Relative tolerance (>= 0; 0.01 is 1 %).
+    t : array_like, optional
+        The test's time points (increasing); default a uniform grid.
+    t_gold : array_like, optional
+        The gold's own time points (needs ``t``).
+
+    Returns
+    -------
+    float
+        The error; a single sample (T = 0) gives the plain normalised error there.
     """
-    a = np.asarray(reference, float)
-    b = np.asarray(other, float)
-    if abstol <= 0:
+    if not abstol > 0:
         raise ValueError("abstol must be positive")
-    return float(np.sqrt(np.mean(((a - b) / (0.01 * np.abs(a) + abstol)) ** 2)))
+    if not reltol >= 0:
+        raise ValueError("reltol must not be negative")
+    b = np.asarray(test, float)
+    t = np.arange(b.size, dtype=float) if t is None else np.asarray(t, float)
+    if t_gold is not None:
+        a = resample(t_gold, gold, t)
+    else:
+        a = np.asarray(gold, float)
+    err2 = ((a - b) / (reltol * np.abs(a) + abstol)) ** 2
+    span = float(t[-1] - t[0]) if t.size > 1 else 0.0
+    if span <= 0:
+        return float(np.sqrt(np.mean(err2)))
+    return float(np.sqrt(np.sum(trapezoid_weights(t) * err2) / span))
 
 
 def metric_deltas(reference: StepMetrics, other: StepMetrics) -> dict:

@@ -5,6 +5,8 @@
 - :class:`ParamError`: the same, for a message about several parameters.
 - :class:`SimulatorError`: ngspice missing, crashed, timed out or wrote nothing
   usable (exit status 3).
+- :class:`DeckError`: ngspice refused to load a deck (a user's own netlist
+  that is not valid ngspice input): bad input, exit status 2.
 """
 
 import re
@@ -23,6 +25,14 @@ class DesignError(ValueError):
     def __init__(self, message: str, param: str | None = None):
         super().__init__(message)
         self.param = param
+
+    def naming(self, names: dict) -> str:
+        """The message with the parameter it starts with read through ``names``
+        (the command line's options, a spec file's keys); unchanged otherwise."""
+        msg = str(self)
+        if isinstance(self.param, str) and self.param in names and msg.startswith(self.param):
+            return names[self.param] + msg[len(self.param):]
+        return msg
 
 
 _MARKER = re.compile(r"\{([a-z][a-z0-9_]*)\}")
@@ -66,6 +76,11 @@ class ParamError(DesignError):
 
 class SimulatorError(DesignError):
     """The simulator could not produce a result (not the user's input)."""
+
+
+class DeckError(DesignError):
+    """ngspice refused the deck as it read it (a syntax error, an unknown
+    element or subcircuit): the deck is bad input, not a simulator failure."""
 
 
 #: exit statuses of every command

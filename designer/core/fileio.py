@@ -77,6 +77,21 @@ def show_cell(cell: str) -> str:
     return repr(cell if len(cell) <= 40 else cell[:37] + "...")
 
 
+_PLAIN_NAME = re.compile(r"^[A-Za-z0-9_+=,@-][A-Za-z0-9._+=,@-]{0,119}$")
+
+
+def check_plain_name(name, what: str) -> str:
+    """A name that becomes a file or folder name (a design's ``--name``, a check
+    spec's ``name:``): letters, digits and ``. _ - + = , @``, not starting with
+    '.', at most 120 characters; else a :class:`DesignError` naming ``what``."""
+    if not isinstance(name, str) or not _PLAIN_NAME.match(name):
+        what_is = ("must not be empty" if not name else
+                   f"{show_cell(str(name))} is not a plain file name")
+        raise DesignError(f"{what} {what_is}: use letters, digits and . _ - + = , @ (not starting with '.', "
+                          "at most 120 characters)")
+    return name
+
+
 def size_text(n: int) -> str:
     """``256 MiB``, ``1.5 GiB``, ``300 bytes``."""
     for unit, scale in (("GiB", 1 << 30), ("MiB", MIB), ("KiB", 1024)):

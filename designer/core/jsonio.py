@@ -14,6 +14,11 @@ from .errors import DesignError
 from .fileio import MAX_TABLE_BYTES, read_text, shown
 
 
+#: the layout version of every result.json (``schema_version``; 2 added it and ``tool``, the
+#: program that wrote the file); raised when a key changes meaning or goes
+SCHEMA_VERSION = 2
+
+
 def json_safe(obj):
     """JSON-ready copy: numpy scalars and arrays to Python numbers and lists,
     tuples to lists, nan/inf to None (the one cleaner of every result)."""

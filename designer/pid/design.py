@@ -21,6 +21,7 @@ import numpy as np
 
 from ..core import opamps
 from ..core.checks import Check
+from ..core.errors import ParamError
 from ..core.lti import dominant_pair, response_span, step_response
 from ..core.metrics import StepMetrics
 from ..core.opamps import OpAmp
@@ -116,6 +117,30 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice")
     -------
     PidResult
     """
+    return _run(spec, simulate, simulator, as_built=False)
+
+
+def analyze_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice") -> PidResult:
+    """The controller as built from its parts (``spec.controller_parts``), on
+    its plant: what Kp, Ti and Td the parts give, the same checks, analytic
+    loop and SPICE verification as :func:`design_pid`, and the same result.
+
+    Without gains in the spec (``kp``/``ti_s``/``td_s`` or a ``tuning``
+    rule) the parts' own gains are the tuning (method ``as-built``) and the
+    Kp/Ti/Td accuracy checks, which would compare the parts with themselves,
+    are left out; with them, the parts are held to those gains.
+
+    Raises
+    ------
+    ParamError
+        When the spec has no controller parts.
+    """
+    if spec.controller_parts is None:
+        raise ParamError("analyze_pid needs the controller's parts ({controller_parts})", ("controller_parts",))
+    return _run(spec, simulate, simulator, as_built=spec.kp is None and spec.tuning is None)
+
+
+def _run(spec: PidSpec, simulate: bool, simulator: str, as_built: bool) -> PidResult:
     clock = _Clock()
     amp = opamps.get(spec.opamp)
     plant, source, plant_series = resolve_plant(spec)
@@ -125,7 +150,10 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice")
     notes = []
     opt = presized = None
     clock.lap("plant_s")
-    if spec.kp is not None:
+    if as_built:
+        p = spec.controller_parts
+        tun = tuning.Tuning("as-built", p.kp, p.ti_s, p.td_s, curve, ())
+    elif spec.kp is not None:
         tun = tuning.Tuning("explicit", spec.kp, spec.ti_s, spec.td_s, curve, ())
     elif spec.tuning == "optimize":
         tun, opt, presized = _optimize(spec, plant, amp, ps)
@@ -148,6 +176,10 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice")
         notes += sel.notes
     static = blocks.static_checks(parts, plant.fn_hz, amp.gbw_hz, targets, r_min=spec.r_min,
                                   r_max=spec.r_max, c_min=spec.c_min, c_max=spec.c_max, tol=spec.tol)
+    if as_built:
+        # the gains are the parts' own (accuracy would compare the parts with themselves), and the
+        # part bounds are the sizing search's: neither says anything about parts already chosen
+        static = [c for c in static if not c.id.endswith("_accuracy") and not c.id.endswith("_bounds")]
     clock.lap("sizing_s")
     loop = _analyse(spec, plant, amp, tun, parts, ps, simulate)
     checks = tuple(static) + loop.checks

@@ -16,11 +16,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.jsonio import json_safe
+from ..core.checks import SPICE_AGREEMENT, Check
+from ..core.jsonio import SCHEMA_VERSION, json_safe
 from ..core.metrics import StepMetrics
 from ..core.opamps import OpAmp
 from ..plant.sallenkey import SallenKeyParts
 from ..spice.deck import SquareTest
+from ..spice.simulate import tool_info
 from .blocks import PidParts, Selection
 from .model import Margins
 from .optimize import OptimizeResult
@@ -136,9 +138,28 @@ class PidResult:
     def failed_checks(self) -> list:
         return [c for c in self.checks if not c.ok]
 
+    def verdicts(self) -> list:
+        """Every pass/fail verdict: the design checks and, when simulated, the
+        SPICE agreement with the analytic loop (``--fail-on-check``)."""
+        if self.verdict is None:
+            return list(self.checks)
+        v, s = self.verdict, self.spice
+        why = [f"nrms {s.nrms:.3g} (below 1 agrees)"]
+        if v.overshoot_delta_pp is not None:
+            why.append(f"overshoot {v.overshoot_delta_pp:+.3g} pp (allowed +/-1 pp)")
+        if not s.stable:
+            why.append("the SPICE loop oscillates or latches")
+        if s.saturated:
+            why.append("an op-amp saturates in SPICE")
+        if v.explained_by:
+            why.append("explained by the failed checks " + ", ".join(v.explained_by))
+        return list(self.checks) + [Check(SPICE_AGREEMENT, v.agree, "; ".join(why))]
+
     def to_dict(self) -> dict:
         pl = self.plant
         out = {
+            "schema_version": SCHEMA_VERSION,
+            "tool": tool_info(self.simulator),
             "plant": {"source": self.plant_source, **pl.as_dict(), "q": pl.q, "fn_opamp_hz": self.plant_fn_opamp_hz,
                       "zeta_opamp": self.plant_zeta_opamp},
             "opamp": self.opamp.to_dict(),

@@ -106,6 +106,8 @@ class PidSpec(PartBounds):
             put("plant_parts", check_plant(replace(self.plant_parts, **typed), PLANT_NAMES))
         if self.plant_json is not None:
             put("json_plant", plant_from_json(self.plant_json))
+        if self.controller_parts is not None:
+            put("controller_parts", check_controller(self.controller_parts))
         put("opamp", opamps.get(self.opamp).name)
         if self.tuning is not None:
             put("tuning", str(self.tuning).strip().lower())
@@ -168,3 +170,60 @@ def plant_from_json(path) -> SallenKeyParts:
     raw = SallenKeyParts(*(built.get(v) for v in BUILT_KEYS.values()))
     names = {k: f"{{plant_json}} {shown(path)}: built.{v}" for k, v in BUILT_KEYS.items()}
     return check_plant(raw, names | {"plant": f"{{plant_json}} {shown(path)}"})
+
+
+#: the controller's parts (:class:`~designer.pid.blocks.PidParts` fields) and their ranges (keys of RANGES)
+CONTROLLER_RANGES = {**{f"r{i}": "resistor_ohm" for i in range(3, 19)}, "c3": "capacitor_f", "c4": "capacitor_f"}
+#: the derivative path: all four given (a PID) or none (a PI)
+DERIVATIVE_PARTS = ("r7", "r11", "r12", "c3")
+
+
+def check_controller(parts: PidParts, names: dict | None = None) -> PidParts:
+    """The controller as built, checked once: every part a number (or text in
+    engineering notation) inside its physical range, the derivative path
+    (R7, R11, R12, C3) all given or all left out (a PI).
+
+    ``names`` maps a field (``r5``) to how a message names it (default the
+    field itself, e.g. ``r5``, which the command line shows as ``--r5``).
+
+    Raises
+    ------
+    DesignError
+        One line naming the part at fault and what is allowed.
+    """
+    names = names or {}
+    values = {}
+    for key, rng in CONTROLLER_RANGES.items():
+        value = getattr(parts, key)
+        name = names.get(key, key)
+        if value is None:
+            if key not in DERIVATIVE_PARTS:
+                raise DesignError(f"{name} is missing: every controller part but the derivative path "
+                                  "(R7, R11, R12, C3; all four, or none for a PI) is needed", param=name)
+            values[key] = None
+            continue
+        values[key] = parse_in_range(value, name, rng)
+    given = [k for k in DERIVATIVE_PARTS if values[k] is not None]
+    if given and len(given) != len(DERIVATIVE_PARTS):
+        lacking = [names.get(k, k) for k in DERIVATIVE_PARTS if values[k] is None]
+        raise DesignError(f"{lacking[0]} is missing: the derivative path needs R7, R11, R12 and C3 together "
+                          "(leave all four out for a PI)", param=lacking[0])
+    return PidParts(**values)
+
+
+def controller_from_json(path) -> PidParts:
+    """The controller parts of a ``design-pid``/``analyze-pid`` result.json (its
+    ``components`` object: ``R3_ohm`` .. ``C4_f``), read by the one reader and
+    checked by :func:`check_controller`; a refusal names the file and the key."""
+    try:
+        comp = read_result(path, "{controller_json}", needs={"components": ("R3_ohm",)},
+                           what="a design-pid result.json")["components"]
+    except DesignError as exc:
+        raise ParamError(str(exc), ("controller_json",)) from None
+    keys = {k: (f"{k.upper()}_ohm" if k[0] == "r" else f"{k.upper()}_f") for k in CONTROLLER_RANGES}
+    raw = PidParts(**{k: comp.get(v) for k, v in keys.items()})
+    try:
+        return check_controller(raw, {k: f"{{controller_json}} {shown(path)}: components.{v}"
+                                      for k, v in keys.items()})
+    except DesignError as exc:
+        raise ParamError(str(exc), ("controller_json",)) from None

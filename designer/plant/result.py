@@ -16,10 +16,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core import eseries
-from ..core.jsonio import json_safe
+from ..core.checks import SPICE_AGREEMENT, Check
+from ..core.jsonio import SCHEMA_VERSION, json_safe
 from ..core.metrics import StepMetrics
 from ..core.opamps import OpAmp
 from ..spice.deck import SquareTest
+from ..spice.simulate import tool_info
 from .bench import BenchPeriod, ToleranceBand
 from .sallenkey import SallenKeyParts
 
@@ -225,12 +227,24 @@ class PlantResult:
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
+    def verdicts(self) -> list:
+        """Every pass/fail verdict: the design checks and, when simulated, the
+        SPICE agreement with the op-amp-aware model (``--fail-on-check``)."""
+        if self.spice is None:
+            return list(self.checks)
+        cmp_ = self.spice.comparison
+        detail = ("; ".join(cmp_.disagreements) if cmp_.disagreements else
+                  f"waveform NRMS {self.spice.nrms:.3g} (below 1) and every step figure within its allowance")
+        return list(self.checks) + [Check(SPICE_AGREEMENT, cmp_.passed, detail)]
+
     def to_dict(self) -> dict:
         target, fig, opa = self.target, self.analytic.figures, self.analytic_opamp.figures
         built = {**parts_dict(self.built), "fn_error_pct": fig.fn_error_pct, "zeta_error_pct": fig.zeta_error_pct,
                  "fn_opamp_hz": opa.fn_hz, "zeta_opamp": opa.zeta, "fn_opamp_error_pct": opa.fn_error_pct,
                  "zeta_opamp_error_pct": opa.zeta_error_pct, "tolerance_band": self.tolerance.to_dict()}
         return json_safe({
+            "schema_version": SCHEMA_VERSION,
+            "tool": tool_info(self.spice.simulator if self.spice is not None else None),
             "mode": self.mode,
             "spec": target.to_dict(),
             "ratios": self.ratios.to_dict(),

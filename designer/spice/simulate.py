@@ -18,13 +18,14 @@ import re
 import shutil
 import subprocess
 import tempfile
+import sys
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..core.errors import DesignError, SimulatorError
+from ..core.errors import DeckError, DesignError, SimulatorError
 
 INSTALL_HINT = "install it with: apt-get install ngspice libngspice0-dev (or run `make setup`)"
 BACKENDS = ("pyspice", "ngspice-cli")
@@ -56,12 +57,26 @@ class SimResult:
 
 
 _MEAS_DEF = re.compile(r"^\s*\.meas\w*\s+\w+\s+(\w+)", re.I | re.M)
+#: what ngspice says when it cannot read a deck (as opposed to failing to simulate it)
+_LOAD_ERROR = re.compile(r"error on line|unknown subckt|bad syntax|no circuit loaded|unknown device|"
+                         r"unable to find definition of model|could not find a valid modelname|"
+                         r"undefined (?:parameter|subcircuit)|unknown (?:model|parameter)", re.I)
+
+
+def measure_names(deck: str) -> list:
+    """The names of a deck's ``.meas`` statements, lower case (as ngspice prints them)."""
+    return list(dict.fromkeys(m.lower() for m in _MEAS_DEF.findall(deck)))
+
+
+def deck_refused(log: str) -> bool:
+    """Whether ngspice's output says it could not read the deck (a :class:`DeckError`)."""
+    return bool(_LOAD_ERROR.search(log))
 
 
 def parse_measurements(text: str, deck: str) -> dict:
     """The ``name = value`` lines that ngspice prints for the deck's ``.meas``
     statements (a measurement that failed is absent)."""
-    wanted = {m.lower() for m in _MEAS_DEF.findall(deck)}
+    wanted = set(measure_names(deck))
     out = {}
     for m in _MEAS.finditer(text):
         if m.group(1).lower() in wanted:
@@ -180,9 +195,14 @@ class NgspiceCli:
                                       capture_output=True, text=True, timeout=self.timeout,
                                       stdin=subprocess.DEVNULL)
             except subprocess.TimeoutExpired:
-                raise SimulatorError(f"ngspice did not finish within {self.timeout:g} s") from None
+                raise SimulatorError(f"ngspice did not finish within {self.timeout:g} s (timed out)") from None
             log = proc.stdout + "\n" + proc.stderr
             errs = error_lines(log) or [ln for ln in proc.stderr.splitlines() if ln.strip()][-1:]
+            if deck_refused(log):
+                raise DeckError("ngspice cannot read the deck: " + "; ".join(errs[:3]))
+            if proc.returncode < 0:
+                raise SimulatorError(f"ngspice crashed (signal {-proc.returncode})"
+                                     + (f": {'; '.join(errs[:3])}" if errs else ""))
             if proc.returncode != 0:
                 raise SimulatorError("ngspice failed: " + ("; ".join(errs[:3]) or f"exit status {proc.returncode}"))
             if not raw_path.exists() or raw_path.stat().st_size == 0:
@@ -231,7 +251,10 @@ class PySpiceShared:
                 load_log = ng.stdout + "\n" + ng.stderr
                 errs = error_lines(load_log)
                 if rc or errs:
-                    raise SimulatorError("ngspice failed to load the deck: " + ("; ".join(errs[:3]) or f"code {rc}"))
+                    why = "; ".join(errs[:3]) or f"code {rc}"
+                    if deck_refused(load_log):
+                        raise DeckError("ngspice cannot read the deck: " + why)
+                    raise SimulatorError("ngspice failed to load the deck: " + why)
                 log = self._command(ng, "run")
                 errs = error_lines(log)
                 plot = ng.last_plot
@@ -250,11 +273,68 @@ class PySpiceShared:
         return ng.stdout + "\n" + ng.stderr
 
 
-def get_simulator(name: str = "pyspice"):
-    """A backend by name: ``pyspice`` or ``ngspice-cli``."""
+#: the longest one simulation may take, seconds (``ngspice -b``; the shared library runs in the caller's
+#: process: ``check-design`` runs it in a worker it kills at the same deadline)
+DEFAULT_TIMEOUT_S = 120.0
+
+
+def get_simulator(name: str = "pyspice", timeout: float | None = None):
+    """A backend by name: ``pyspice`` or ``ngspice-cli``; ``timeout`` (seconds)
+    bounds each ``ngspice -b`` run (default :data:`DEFAULT_TIMEOUT_S`)."""
     key = str(name).strip().lower()
     if key in ("pyspice", "shared", "ngspice-shared"):
         return PySpiceShared()
     if key in ("ngspice-cli", "cli", "ngspice"):
-        return NgspiceCli()
+        return NgspiceCli(timeout=DEFAULT_TIMEOUT_S if timeout is None else timeout)
     raise DesignError(f"unknown simulator {name!r}; allowed: {', '.join(BACKENDS)}")
+
+
+_VERSIONS: dict = {}
+
+
+def ngspice_version(simulator: str | None) -> str | None:
+    """The version of ngspice behind a backend (``"39"``; the shared library
+    and the program can differ), None when it cannot be told. Asked once per
+    process and backend."""
+    if simulator is None:
+        return None
+    key = get_simulator(simulator).name
+    if key not in _VERSIONS:
+        _VERSIONS[key] = _shared_version() if key == "pyspice" else _cli_version()
+    return _VERSIONS[key]
+
+
+def _cli_version() -> str | None:
+    exe = shutil.which("ngspice")
+    if exe is None:
+        return None
+    try:
+        out = subprocess.run([exe, "--version"], capture_output=True, text=True, timeout=30,
+                             stdin=subprocess.DEVNULL).stdout
+    except (OSError, subprocess.SubprocessError):
+        return None
+    m = re.search(r"ngspice-(\S+)", out)
+    return m.group(1) if m else None
+
+
+def _shared_version() -> str | None:
+    try:
+        import logging
+
+        from PySpice.Spice.NgSpice.Shared import NgSpiceShared
+        logging.getLogger("PySpice").setLevel(logging.CRITICAL)   # its "unsupported version" notes
+        with PySpiceShared._lock:
+            version = NgSpiceShared.new_instance().ngspice_version
+    except Exception:   # no library, or PySpice could not ask it: unknown, not an error
+        return None
+    return None if version is None else str(version)
+
+
+def tool_info(simulator: str | None, argv=None) -> dict:
+    """What produced a result, for ``result.json``'s ``tool`` and the JUnit
+    properties: this tool's name and version, Python's, ngspice's (None
+    without a simulation) and the backend, and the command line."""
+    from .. import __version__
+    return {"name": "designer", "version": __version__, "python": sys.version.split()[0],
+            "ngspice": ngspice_version(simulator), "simulator": simulator,
+            "argv": list(sys.argv if argv is None else argv)}

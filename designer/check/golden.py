@@ -1,0 +1,115 @@
+"""Golden waveforms: recorded once (``check-design --update-golden``), compared
+on every run by the one waveform rule, :func:`designer.core.compare.nrms`
+(xyce_verify's: the gold interpolated onto the test's time points,
+trapezoidal weights, per-signal ``reltol`` and ``abstol``, a pass below 1).
+
+The file is the ``waveforms.csv`` layout (``time_s`` then one column per
+signal, CSV, ``identify`` reads it) under a header of ``# key: value``
+comment lines recording what produced it: the tool's version, ngspice's, the
+simulator backend, the spec and the corner. A file recorded by other versions
+still compares; the difference is a warning (a JUnit property), not a failure.
+"""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+from ..core.compare import nrms
+from ..core.errors import DesignError
+from ..core.fileio import MAX_TABLE_BYTES, atomic_write, read_text, shown
+
+TITLE = "designer golden waveform"
+#: the header's keys whose change since recording is worth a warning
+VERSIONED = ("tool", "ngspice", "simulator")
+
+
+def header_of(tool: dict, spec: str, corner: str) -> dict:
+    """The header a golden file records: ``tool`` is a :func:`~designer.spice.simulate.tool_info`."""
+    return {"tool": f"{tool.get('name')} {tool.get('version')}", "ngspice": str(tool.get("ngspice")),
+            "simulator": str(tool.get("simulator")), "spec": spec, "corner": corner or "-"}
+
+
+def write_golden(path, t, signals: dict, header: dict) -> None:
+    """Record ``signals`` (name -> samples on ``t``) at ``path``, atomically."""
+    buf = io.StringIO()
+    buf.write(f"# {TITLE}\n" + "".join(f"# {k}: {v}\n" for k, v in header.items()))
+    cols = np.column_stack([np.asarray(t, float)] + [np.asarray(v, float) for v in signals.values()])
+    np.savetxt(buf, cols, delimiter=",", header=",".join(["time_s", *signals]), comments="", fmt="%.12g")
+    atomic_write(path, buf.getvalue())
+
+
+def read_golden(path) -> tuple:
+    """(header dict, time, {signal: samples}) of a golden file; a file that is
+    not one is refused in one line naming it."""
+    name = shown(path)
+    text = read_text(path, "golden file", MAX_TABLE_BYTES * 4)
+    header, body = {}, []
+    for ln in text.splitlines():
+        if ln.startswith("#"):
+            key, sep, value = ln[1:].partition(":")
+            if sep:
+                header[key.strip()] = value.strip()
+        elif ln.strip():
+            body.append(ln)
+    if not body or not body[0].startswith("time_s,"):
+        raise DesignError(f"golden file {name} is not a golden waveform (a time_s,... header line, then "
+                          "samples); record it with check-design --update-golden")
+    names = [c.strip() for c in body[0].split(",")]
+    try:
+        data = np.loadtxt(body[1:], delimiter=",", ndmin=2)
+    except ValueError as exc:
+        raise DesignError(f"golden file {name}: unreadable samples ({exc})") from None
+    if data.shape[0] < 2 or data.shape[1] != len(names):
+        raise DesignError(f"golden file {name}: expected {len(names)} columns and at least 2 rows")
+    t = data[:, 0]
+    if not np.all(np.diff(t) > 0):
+        raise DesignError(f"golden file {name}: time_s must increase")
+    return header, t, {n: data[:, i] for i, n in enumerate(names) if i}
+
+
+def version_warnings(recorded: dict, now: dict, path) -> list:
+    """What differs between the versions a golden file recorded and this run's."""
+    diff = [f"{k} {recorded.get(k, '?')} -> {now[k]}" for k in VERSIONED if recorded.get(k) != now[k]]
+    return [f"golden file {shown(path)} was recorded with other versions: " + ", ".join(diff)] if diff else []
+
+
+def compare(t, test: dict, t_gold, gold: dict, tolerances: dict) -> dict:
+    """signal -> its nrms against the gold (xyce_verify rule), for each signal of ``tolerances``
+    (name -> (reltol, abstol)); the test's time points outside the gold's span are left out."""
+    t = np.asarray(t, float)
+    inside = (t >= t_gold[0]) & (t <= t_gold[-1])
+    out = {}
+    for sig, (reltol, abstol) in tolerances.items():
+        out[sig] = nrms(gold[sig], np.asarray(test[sig], float)[inside], abstol, reltol=reltol, t=t[inside],
+                        t_gold=t_gold)
+    return out
+
+
+def error_plot(t, test, t_gold, gold, reltol: float, abstol: float, title: str) -> bytes:
+    """PNG: gold and test (top) and their normalised error (gold - test) /
+    (reltol |gold| + abstol) on the test's points (bottom, +/-1 marked)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ..core.compare import resample
+    from ..report.plots import png_bytes
+    t = np.asarray(t, float)
+    g = resample(t_gold, gold, t)
+    err = (g - np.asarray(test, float)) / (reltol * np.abs(g) + abstol)
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 5.5), sharex=True)
+    a1.plot(t_gold, gold, "-", lw=1.6, label="gold")
+    a1.plot(t, test, "--", lw=1.3, label="test")
+    a1.set_ylabel("signal")
+    a1.set_title(title)
+    a1.legend()
+    a2.plot(t, err, "-", lw=1.0, color="C3")
+    for y in (-1, 1):
+        a2.axhline(y, color="0.5", lw=0.8, ls=":")
+    a2.set_ylabel("normalised error")
+    a2.set_xlabel("time (s)")
+    for a in (a1, a2):
+        a.grid(True, alpha=0.3)
+    return png_bytes(fig)

@@ -1,0 +1,133 @@
+"""Worker processes for ``check-design --jobs N``: each corner runs in a
+process of its own (one ngspice per process, and a crash of the simulator's
+shared library takes down that worker, not the checker), with a deadline.
+
+A worker that passes its deadline is killed with its whole process group
+(``ngspice -b`` children included) and replaced; one that dies is replaced
+too; either way its task gets the caller's ``lost(task, reason)`` result.
+Results come back in task order whatever order they finish in, so the
+output is deterministic. Workers are forked from the caller, which has
+already loaded the specs and imported the design code, so a worker starts in
+milliseconds and shares those pages.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+import time
+from collections import deque
+from multiprocessing.connection import wait
+
+
+def _serve(conn, work, setup) -> None:
+    """A worker's loop: receive a task, send back its result; None ends it."""
+    os.setpgrp()   # its own process group: the parent kills it with any ngspice it started
+    if setup is not None:
+        setup()
+    while True:
+        try:
+            task = conn.recv()
+        except (EOFError, KeyboardInterrupt):
+            return
+        if task is None:
+            return
+        try:
+            result = ("ok", work(task))
+        except Exception as exc:   # a bug, not a verdict: reported as this task's error, the worker lives on
+            result = ("crash", f"{type(exc).__name__}: {exc}")
+        conn.send(result)
+
+
+class _Worker:
+    def __init__(self, ctx, work, setup):
+        self.conn, child = ctx.Pipe()
+        self.proc = ctx.Process(target=_serve, args=(child, work, setup), daemon=True)
+        self.proc.start()
+        child.close()
+        self.task = None
+        self.deadline = None
+
+    def give(self, index: int, task, timeout: float) -> None:
+        self.task, self.deadline = index, time.monotonic() + timeout
+        self.conn.send(task)
+
+    def kill(self) -> None:
+        try:
+            os.killpg(self.proc.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
+        self.proc.join(5)
+        self.conn.close()
+
+
+def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None) -> list:
+    """``work(task)`` for every task, at most ``jobs`` at a time, each within
+    ``timeout`` seconds; results in task order.
+
+    Parameters
+    ----------
+    tasks : list
+        The tasks (sent to the workers by pickling).
+    work : callable
+        Runs one task in a worker; its result is pickled back.
+    jobs : int
+        Worker processes (at most one per task).
+    timeout : float
+        Seconds a task may take before its worker is killed.
+    lost : callable
+        ``lost(task, reason)``: the result of a task whose worker timed out,
+        died or raised (``reason`` says which).
+    setup : callable, optional
+        Run once in each worker before its first task.
+    """
+    ctx = multiprocessing.get_context("fork")
+    results = [None] * len(tasks)
+    queue = deque(range(len(tasks)))
+    workers = []
+    try:
+        workers = [_Worker(ctx, work, setup) for _ in range(max(1, min(jobs, len(tasks))))]
+        for w in workers:
+            if queue:
+                i = queue.popleft()
+                w.give(i, tasks[i], timeout)
+        while any(w.task is not None for w in workers):
+            busy = [w for w in workers if w.task is not None]
+            left = min(w.deadline for w in busy) - time.monotonic()
+            ready = wait([w.conn for w in busy], timeout=max(0.0, left))
+            for k, w in enumerate(workers):
+                if w.task is None:
+                    continue
+                i = w.task
+                if w.conn in ready:
+                    try:
+                        kind, value = w.conn.recv()
+                    except (EOFError, OSError):
+                        w.proc.join(5)
+                        code = w.proc.exitcode
+                        why = f"signal {-code}" if code is not None and code < 0 else f"exit status {code}"
+                        kind, value = "dead", f"the worker running it died ({why}): the simulator crashed"
+                    results[i] = value if kind == "ok" else lost(tasks[i], value)
+                    w.task = None
+                    if kind == "dead":
+                        w.kill()
+                        workers[k] = w = _Worker(ctx, work, setup)
+                elif time.monotonic() >= w.deadline:
+                    w.kill()
+                    results[i] = lost(tasks[i], f"timed out after {timeout:g} s (killed)")
+                    workers[k] = w = _Worker(ctx, work, setup)
+                if w.task is None and queue:
+                    j = queue.popleft()
+                    w.give(j, tasks[j], timeout)
+    finally:
+        for w in workers:
+            try:
+                w.conn.send(None)
+            except (OSError, ValueError):
+                pass
+        for w in workers:
+            w.proc.join(2)
+            if w.proc.is_alive():
+                w.kill()
+    return results

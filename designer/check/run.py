@@ -1,0 +1,190 @@
+"""One corner of one spec, run and judged: the design (or the analysis of the
+parts as built, or the user's deck) simulated with that corner's op-amp, its
+figures (:mod:`.figures`) held to the spec's limits, the design's own checks,
+the SPICE agreement, the tolerance band and the golden waveforms, each as a
+:class:`~designer.check.result.Case`. With an output folder the corner's build
+sheet and, for every failing golden signal, a plot of gold, test and their
+normalised error are written there.
+
+Errors become cases, never exceptions: a :class:`~designer.core.errors.SimulatorError`
+an ERROR case of the simulator (exit 3), any other
+:class:`~designer.core.errors.DesignError` (a deck ngspice cannot read, a
+design the spec's numbers cannot give, a missing golden signal) an ERROR case
+of the spec (exit 2).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..core.compare import nrms
+from ..core.errors import DesignError, SimulatorError
+from ..core.fileio import atomic_write
+from . import figures as F
+from . import golden as G
+from .result import ERROR, FAIL, PASS, SIM_ERROR, SKIP, SPEC_ERROR, Case, CornerOutcome
+from .spec import CheckSpec
+
+
+def run_corner(spec: CheckSpec, index: int, simulator: str, *, update_golden: bool = False,
+               out_dir=None) -> CornerOutcome:
+    """Run and judge corner ``index`` of ``spec`` (see the module docstring)."""
+    from ..spice.simulate import tool_info
+    corner = spec.corners[index]
+    tick = time.perf_counter()
+    tool = tool_info(simulator)
+    try:
+        ran = _simulate(spec, index, simulator)
+        figures, res, design, waves = ran
+        cases, warnings, files = _judge(spec, corner, figures, res, waves, tool, update_golden, out_dir)
+        if out_dir is not None and res is not None:
+            files.update(_write_design(spec, corner, res, out_dir))
+    except SimulatorError as exc:
+        return _failed(corner, SIM_ERROR, exc, tool, tick)
+    except DesignError as exc:
+        return _failed(corner, SPEC_ERROR, exc, tool, tick)
+    return CornerOutcome(corner, tuple(cases), design, tool, tuple(warnings), files, time.perf_counter() - tick)
+
+
+def _failed(corner, kind, exc, tool, tick) -> CornerOutcome:
+    what = "simulator error" if kind == SIM_ERROR else "bad spec"
+    case = Case("simulation", corner, ERROR, f"simulation: {what}: {' '.join(str(exc).split())}", error_kind=kind)
+    return CornerOutcome(corner, (case,), None, tool, (), {}, time.perf_counter() - tick)
+
+
+def _simulate(spec: CheckSpec, index: int, simulator: str):
+    """(figures, typed result or None, the design's JSON, (t, {signal: samples}))."""
+    design = spec.designs[index]
+    if spec.kind == "netlist":
+        from ..spice.simulate import get_simulator
+        r = get_simulator(simulator).run(design, workdir=spec.deck_dir)
+        vectors = {k: np.real(v) for k, v in r.vectors.items() if k not in ("time", "frequency")}
+        waves = (r.vectors["time"], vectors) if "time" in r.vectors else (None, {})
+        return dict(r.measurements), None, {"measurements": r.measurements, "simulator": r.backend}, waves
+    if spec.kind == "plant":
+        from ..plant.design import analyze_plant, design_plant
+        res = (analyze_plant if spec.analyze else design_plant)(design, simulate=True, simulator=simulator)
+        cols = res.bench.columns()
+        t = cols.pop("time_s")
+        return F.plant_figures(res), res, res.to_dict(), (t, cols)
+    from ..pid.design import analyze_pid, design_pid
+    res = (analyze_pid if spec.analyze else design_pid)(design, simulate=True, simulator=simulator)
+    waves = {f"{k}_v": v for k, v in res.spice.waves.items()}
+    return F.pid_figures(res), res, res.to_dict(), (res.waveforms.t, waves)
+
+
+def _judge(spec, corner, figures, res, waves, tool, update_golden, out_dir):
+    cases = []
+    for lim in spec.checks:
+        value = figures.get(lim.figure)
+        ok, text = lim.judge(value)
+        status = (PASS if ok else FAIL) if lim.fail else SKIP
+        cases.append(Case(lim.figure, corner, status, text if lim.fail else f"report only: {text}",
+                          _num(value), lim.text(), would_pass=None if lim.fail else ok))
+    if spec.design_checks is not None:
+        cases += _design_cases(spec, corner, res)
+    if spec.agreement is not None:
+        cases.append(_agreement_case(spec, corner, res, figures))
+    if spec.tolerance:
+        band = F.band_of(res)
+        limits = {lim.figure: lim for lim in spec.checks}
+        for fig in spec.tolerance:
+            lo, hi = band[fig]
+            lim = limits[fig]
+            ok = lim.inside(lo, hi)
+            span = "none" if lo is None else f"{lim.fmt(lo)} .. {lim.fmt(hi)}"
+            cases.append(Case(f"tolerance_{fig}", corner, PASS if ok else FAIL,
+                              f"tolerance_{fig}: the part-tolerance band {span} is "
+                              f"{'inside' if ok else 'outside'} {lim.text()}",
+                              None, lim.text()))
+    warnings, files = [], {}
+    if spec.golden is not None:
+        g_cases, warnings, files = _golden_cases(spec, corner, waves, tool, update_golden, out_dir)
+        cases += g_cases
+    return cases, warnings, files
+
+
+def _num(value):
+    return None if value is None else float(value)
+
+
+def _design_cases(spec, corner, res) -> list:
+    checks = {c.id: c for c in res.checks}
+    wanted = list(checks) if spec.design_checks == "all" else spec.design_checks
+    out = []
+    for cid in wanted:
+        c = checks.get(cid)
+        if c is None:   # e.g. square_wave_period, reported only when the period is too short
+            out.append(Case(cid, corner, PASS, f"{cid}: not reported by this design (nothing to flag)"))
+        else:
+            out.append(Case(cid, corner, PASS if c.ok else FAIL, f"{cid}: {c.detail}"))
+    return out
+
+
+def _agreement_case(spec, corner, res, figures) -> Case:
+    a = spec.agreement
+    if a.against == "opamp_model":
+        value = figures.get("nrms")
+    elif spec.kind == "plant":
+        value = figures.get("nrms_ideal")
+    else:   # the loop with the ideal PID and plant, against SPICE's plant output, on the same grid
+        s = res.spice
+        value = nrms(res.waveforms.ideal_pid, s.waves["y"], s.nrms_abstol_v, t=res.waveforms.t)
+    model = "op-amp-aware model" if a.against == "opamp_model" else "ideal model"
+    if value is None or not np.isfinite(value):
+        return Case("spice_agreement", corner, FAIL, f"spice_agreement: no nrms against the {model}",
+                    None, f"< {a.nrms_max:g}")
+    ok = value < a.nrms_max
+    return Case("spice_agreement", corner, PASS if ok else FAIL,
+                f"spice_agreement: nrms = {value:.4g} against the {model} "
+                f"{'below' if ok else 'not below'} nrms_max {a.nrms_max:g}", float(value), f"< {a.nrms_max:g}")
+
+
+def _golden_cases(spec, corner, waves, tool, update, out_dir):
+    t, test = waves
+    if t is None:
+        raise DesignError(f"{spec.name}: golden: waveforms need a .tran analysis (the run has no time vector)")
+    lower = spec.kind == "netlist"
+    wanted = {(s.lower() if lower else s): tol for s, tol in spec.golden.signals.items()}
+    missing = [s for s in wanted if s not in test]
+    if missing:
+        raise DesignError(f"{spec.name}: golden signal {missing[0]!r} is not in the run; it has: "
+                          f"{', '.join(sorted(test))}")
+    path = spec.golden.path(corner)
+    header = G.header_of(tool, spec.name, corner)
+    if update:
+        G.write_golden(path, t, {s: test[s] for s in wanted}, header)
+        return ([Case(f"golden_{s}", corner, PASS, f"golden_{s}: recorded in {path.name} (--update-golden)")
+                 for s in wanted], [], {"golden": str(path)})
+    recorded, t_gold, gold = G.read_golden(path)
+    absent = [s for s in wanted if s not in gold]
+    if absent:
+        raise DesignError(f"golden file {path}: no column {absent[0]!r}; record it with --update-golden")
+    warnings = G.version_warnings(recorded, header, path)
+    errors = G.compare(t, test, t_gold, gold, wanted)
+    cases, files = [], {"golden": str(path)}
+    for sig, value in errors.items():
+        reltol, abstol = wanted[sig]
+        ok = bool(np.isfinite(value) and value < 1.0)
+        cases.append(Case(f"golden_{sig}", corner, PASS if ok else FAIL,
+                          f"golden_{sig}: nrms = {value:.4g} {'below' if ok else 'not below'} 1 (reltol {reltol:g}, "
+                          f"abstol {abstol:g}, against {path.name})", float(value), "< 1"))
+        if not ok and out_dir is not None:
+            png = G.error_plot(t, test[sig], t_gold, gold[sig], reltol, abstol,
+                               f"{spec.classname(corner)} {sig}: nrms {value:.3g}")
+            name = f"golden-{corner or spec.name}-{sig}.png"
+            files[f"plot_{sig}"] = str(atomic_write(Path(out_dir) / spec.name / name, png))
+    return cases, warnings, files
+
+
+def _write_design(spec, corner, res, out_dir) -> dict:
+    """The corner's build sheet bundle under ``out_dir/<spec>/`` (reports/<corner>/, netlists/<corner>.cir)."""
+    if spec.kind == "plant":
+        from ..plant.report import write_outputs
+    else:
+        from ..pid.report import write_outputs
+    files = write_outputs(res, Path(out_dir) / spec.name, corner or spec.name)
+    return {"build_sheet": files.get("build_sheet_md"), "design_result": files.get("result_json")}

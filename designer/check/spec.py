@@ -1,0 +1,562 @@
+"""A ``check-design`` spec: one YAML file (read with ``yaml.safe_load``),
+validated once, when it is loaded, into a :class:`CheckSpec`.
+
+Three kinds::
+
+    kind: plant                 # a Sallen-Key plant, designed or as built
+    target: {fc: 3.5k, zeta: 0.2}        # designed as design-plant does, or
+    parts: {R1: 1k6, R2: 3k9, C1: 3n3, C2: 100n}   # as built (target: then only reports errors)
+
+    kind: pid                   # the seed's op-amp PID in its loop
+    plant: {fc: 3.5k, zeta: 0.2}         # or {R1: .., R2: .., C1: .., C2: ..} or {json: result.json}
+    tuning: zn                           # a rule, or {kp: .., ti: .., td: ..}, or {rule: optimize, target_overshoot: 10}
+    controller: {R3: 12k, ..., C4: 47n}  # optional: the parts as built (or {json: result.json})
+
+    kind: netlist               # the user's own ngspice deck
+    deck: filter.cir                     # its .meas results are the figures
+
+and, for every kind: ``checks:`` (figure -> ``{min, typ, max, fail}``), and
+``golden:``; for plant and pid: ``opamp`` (one name or a list: the corners),
+``series``, ``bounds``, ``stimulus``, ``design_checks``, ``spice_agreement``;
+a plant also ``tolerance``. Paths (``deck``, ``golden.file``, the ``json``
+files) are relative to the spec file. Numbers may be written in engineering
+notation (``3n3``, ``1m``, ``3.5k``).
+
+Every refusal is one line: ``file:line: what is wrong, and what is allowed``;
+an unknown key names the allowed keys and the closest one. The design's own
+validation (:class:`~designer.plant.spec.PlantSpec`,
+:class:`~designer.pid.spec.PidSpec`) runs here for every corner, its messages
+naming the spec's keys (``target.fc must be 10 mHz to 10 MHz``) instead of
+the library's parameters (:data:`PLANT_KEYS`, :data:`PID_KEYS`).
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..core import opamps
+from ..core.checks import IDS, SPICE_AGREEMENT
+from ..core.errors import DesignError
+from ..core.fileio import MIB, check_plain_name, read_text, shown
+from ..core.units import parse_value
+from . import figures as F
+from .limits import LIMIT_KEYS, Limit, limit_from
+
+KINDS = ("plant", "pid", "netlist")
+#: the top-level keys of each kind
+TOP = {
+    "plant": ("name", "kind", "description", "target", "parts", "series", "bounds", "opamp", "stimulus", "checks",
+              "design_checks", "spice_agreement", "tolerance", "golden"),
+    "pid": ("name", "kind", "description", "plant", "tuning", "controller", "series", "bounds", "opamp", "stimulus",
+            "checks", "design_checks", "spice_agreement", "golden"),
+    "netlist": ("name", "kind", "description", "deck", "checks", "golden"),
+}
+CONTROLLER_PARTS = tuple(f"R{i}" for i in range(3, 19)) + ("C3", "C4")
+#: the keys of each mapping below the top level
+SUB = {
+    "target": ("fc", "zeta", "gain", "compensate_gbw"),
+    "parts": ("R1", "R2", "C1", "C2", "R3", "R4", "gain"),
+    "series": ("r", "c"),
+    "bounds": ("r_min", "r_max", "c_min", "c_max"),
+    "plant": ("fc", "zeta", "R1", "R2", "C1", "C2", "gain", "json"),
+    "tuning": ("rule", "kp", "ti", "td", "target_overshoot", "target_settling"),
+    "controller": CONTROLLER_PARTS + ("json",),
+    "spice_agreement": ("nrms_max", "against"),
+    "golden": ("file", "signals", "reltol", "abstol"),
+}
+STIMULUS = {"plant": ("amplitude", "frequency"), "pid": ("amplitude", "frequency", "edge")}
+AGAINST = ("opamp_model", "ideal")
+#: golden signals each kind records (a netlist's are the deck's vectors, named in the spec)
+SIGNALS = {"plant": ("output_v", "input_v", "analytic_v", "analytic_opamp_v"),
+           "pid": ("y_v", "u_v", "ve_v", "vp_v", "vd_v", "vi_v", "vs_v")}
+DEFAULT_SIGNALS = {"plant": ("output_v",), "pid": ("y_v",)}
+#: default tolerances of a golden signal: 1 % of the value plus 1 mV
+RELTOL, ABSTOL = 0.01, 1e-3
+#: a spec file is small: at most this many bytes are read
+MAX_SPEC_BYTES = 1 * MIB
+
+#: library parameter -> the plant spec's key (messages of PlantSpec/AnalysisSpec)
+PLANT_KEYS = {"fc_hz": "target.fc", "target_fc_hz": "target.fc", "zeta": "target.zeta",
+              "target_zeta": "target.zeta", "gain": "target.gain", "compensate_gbw": "target.compensate_gbw",
+              **{k: f"parts.{k.upper()}" for k in ("r1", "r2", "c1", "c2", "r3", "r4")},
+              "plant": "parts", "r_series": "series.r", "c_series": "series.c",
+              **{k: f"bounds.{k}" for k in ("r_min", "r_max", "c_min", "c_max")}, "opamp": "opamp",
+              "amplitude_v": "stimulus.amplitude", "square_hz": "stimulus.frequency"}
+#: library parameter -> the pid spec's key (messages of PidSpec)
+PID_KEYS = {"plant_fc_hz": "plant.fc", "plant_zeta": "plant.zeta",
+            **{f"plant_{k}": f"plant.{k.upper()}" for k in ("r1", "r2", "c1", "c2")}, "plant_gain": "plant.gain",
+            "plant_json": "plant.json", "tuning": "tuning.rule", "kp": "tuning.kp", "ti_s": "tuning.ti",
+            "td_s": "tuning.td", "target_overshoot_pct": "tuning.target_overshoot",
+            "target_settling_s": "tuning.target_settling", "opamp": "opamp", "step_v": "stimulus.amplitude",
+            "edge_s": "stimulus.edge", "square_hz": "stimulus.frequency", "r_series": "series.r",
+            "c_series": "series.c", **{k: f"bounds.{k}" for k in ("r_min", "r_max", "c_min", "c_max")},
+            **{p.lower(): f"controller.{p}" for p in CONTROLLER_PARTS}, "controller_json": "controller.json",
+            "controller_parts": "controller"}
+
+
+@dataclass(frozen=True)
+class Agreement:
+    """``spice_agreement``: SPICE within ``nrms_max`` of a model (``opamp_model`` or ``ideal``)."""
+
+    nrms_max: float
+    against: str
+
+
+@dataclass(frozen=True)
+class Golden:
+    """``golden``: the file (``{corner}`` in it stands for the op-amp) and each
+    signal's (reltol, abstol)."""
+
+    file: str
+    signals: dict
+
+    def path(self, corner: str) -> Path:
+        return Path(self.file.replace("{corner}", corner))
+
+
+@dataclass(frozen=True)
+class CheckSpec:
+    """One spec file, valid by construction (:func:`load_spec`).
+
+    ``corners`` are the op-amps (a netlist has one corner, ``""``); ``designs``
+    the library's spec for each (:class:`~designer.plant.spec.PlantSpec`,
+    :class:`~designer.plant.spec.AnalysisSpec` or :class:`~designer.pid.spec.PidSpec`;
+    a netlist's deck text); ``analyze`` says the parts are as built.
+    """
+
+    path: Path
+    name: str
+    kind: str
+    corners: tuple
+    designs: tuple
+    analyze: bool
+    checks: tuple               #: Limit
+    design_checks: tuple | str | None   #: "all", ids, or None
+    agreement: Agreement | None
+    tolerance: tuple            #: figures whose tolerance band must stay inside their limits
+    golden: Golden | None
+    deck_dir: Path | None = None
+
+    def classname(self, corner: str) -> str:
+        """``lab3-plant[TL072]``: the spec and the corner (JUnit's classname)."""
+        return f"{self.name}[{corner}]" if corner else self.name
+
+
+def closest(key, allowed) -> str:
+    """The allowed key nearest to ``key`` (for a typo)."""
+    best = difflib.get_close_matches(str(key), list(allowed), n=1, cutoff=0.0)
+    return best[0] if best else allowed[0]
+
+
+class _Doc:
+    """The parsed YAML with the line of every key, for one-line refusals."""
+
+    def __init__(self, path: Path, data, lines: dict):
+        self.path, self.data, self.lines = path, data, lines
+
+    def where(self, keys) -> str:
+        keys = tuple(k if isinstance(k, int) and not isinstance(k, bool) else str(k) for k in keys)
+        while keys and keys not in self.lines:
+            keys = keys[:-1]
+        return f"{shown(self.path)}:{self.lines.get(keys, 1)}"
+
+    def error(self, keys, message: str) -> DesignError:
+        return DesignError(f"{self.where(keys)}: {message}")
+
+    def mapping(self, keys, allowed, value=None) -> dict:
+        """The mapping at ``keys`` (None: empty), every key text and allowed."""
+        value = self.get(keys) if value is None else value
+        if value is None:
+            return {}
+        label = ".".join(map(str, keys)) or "the spec"
+        if not isinstance(value, dict):
+            raise self.error(keys, f"{label} must be a mapping of {', '.join(allowed)}; got {_kind_of(value)}")
+        for k in value:
+            if k not in allowed:
+                raise self.error(tuple(keys) + (k,), f"unknown key {str(k)!r} in {label}; allowed: "
+                                 f"{', '.join(allowed)}; closest: {closest(k, allowed)!r}")
+        return value
+
+    def get(self, keys):
+        v = self.data
+        for k in keys:
+            if not isinstance(v, dict):
+                return None
+            v = v.get(k)
+        return v
+
+    def resolve(self, keys) -> Path:
+        """A path in the spec, relative to the spec file's folder."""
+        value = self.get(keys)
+        if not isinstance(value, str) or not value.strip():
+            raise self.error(keys, f"{'.'.join(keys)} must be a file name, got {_kind_of(value)}")
+        return self.path.parent / value
+
+
+def _kind_of(value) -> str:
+    if value is None:
+        return "nothing"
+    if isinstance(value, (dict, list)):
+        return f"a {'mapping' if isinstance(value, dict) else 'list'}"
+    return repr(value) if len(repr(value)) <= 40 else type(value).__name__
+
+
+def _marks(node, keys=(), out=None) -> dict:
+    """key path -> 1-based line, from a composed YAML node tree."""
+    import yaml
+    out = {} if out is None else out
+    out.setdefault(keys, node.start_mark.line + 1)
+    if isinstance(node, yaml.MappingNode):
+        for k, v in node.value:
+            key = _scalar(k)
+            out[keys + (key,)] = k.start_mark.line + 1
+            _marks(v, keys + (key,), out)
+    elif isinstance(node, yaml.SequenceNode):
+        for i, v in enumerate(node.value):
+            _marks(v, keys + (i,), out)
+    return out
+
+
+def _scalar(node):
+    """A mapping key as the line table holds it: its text (keys are looked up as text)."""
+    return node.value if hasattr(node, "value") and isinstance(node.value, str) else None
+
+
+def parse_yaml(path) -> _Doc:
+    """Read a spec file: text (at most :data:`MAX_SPEC_BYTES`, UTF-8), YAML
+    (``safe_load``), a mapping; every problem one line naming the file and line."""
+    import yaml
+    path = Path(path)
+    text = read_text(path, "spec file", MAX_SPEC_BYTES)
+    try:
+        data = yaml.safe_load(text)
+        node = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
+        line = mark.line + 1 if mark is not None else 1
+        what = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise DesignError(f"{shown(path)}:{line}: not valid YAML ({what})") from None
+    if not isinstance(data, dict):
+        raise DesignError(f"{shown(path)}:1: a spec is a mapping of keys (kind:, checks:, ...); got "
+                          f"{_kind_of(data)}")
+    return _Doc(path, data, _marks(node) if node is not None else {})
+
+
+def load_spec(path, update_golden: bool = False) -> CheckSpec:
+    """A :class:`CheckSpec` from a YAML file, checked in full (the design's
+    own validation for every corner, the deck's ``.meas`` names, the golden
+    files exist unless ``update_golden``).
+
+    Raises
+    ------
+    DesignError
+        One line: ``file:line: what is wrong``.
+    """
+    doc = parse_yaml(path)
+    kind = doc.data.get("kind")
+    if kind not in KINDS:
+        got = "no kind" if kind is None else f"kind {_kind_of(kind)}"
+        raise doc.error(("kind",), f"{got}; allowed: {', '.join(KINDS)}"
+                        + (f"; closest: {closest(kind, KINDS)!r}" if isinstance(kind, str) else ""))
+    doc.mapping((), TOP[kind])
+    name = doc.data.get("name", Path(path).stem)
+    try:
+        check_plain_name(name if isinstance(name, str) else "", "name")
+    except DesignError as exc:
+        raise doc.error(("name",), str(exc)) from None
+    if kind == "netlist":
+        return _netlist(doc, name, update_golden)
+    corners = _corners(doc)
+    designs, analyze = (_plant_designs if kind == "plant" else _pid_designs)(doc, corners)
+    checks = _checks(doc, kind, set(F.FIGURES[kind]))
+    design_checks = _design_checks(doc, kind)
+    agreement = _agreement(doc)
+    tolerance = _tolerance(doc, checks) if kind == "plant" else ()
+    golden = _golden(doc, kind, corners, update_golden)
+    if not (checks or design_checks or agreement or golden):
+        raise doc.error((), "nothing to check: give checks:, design_checks:, spice_agreement: or golden:")
+    return CheckSpec(doc.path, name, kind, corners, tuple(designs), analyze, checks, design_checks, agreement,
+                     tolerance, golden)
+
+
+def _corners(doc) -> tuple:
+    value = doc.data.get("opamp", "LM741")
+    items = value if isinstance(value, list) else [value]
+    if not items:
+        raise doc.error(("opamp",), f"opamp: an empty list; give one of {', '.join(opamps.names())} or a list")
+    out = []
+    for i, v in enumerate(items):
+        keys = ("opamp", i) if isinstance(value, list) else ("opamp",)
+        try:
+            amp = opamps.get(v) if isinstance(v, str) else None
+        except DesignError:
+            amp = None
+        if amp is None:
+            raise doc.error(keys, f"unknown op-amp {_kind_of(v)}; allowed: {', '.join(opamps.names())}"
+                            + (f"; closest: {closest(v, opamps.names())!r}" if isinstance(v, str) else ""))
+        if amp.name in out:
+            raise doc.error(keys, f"op-amp {amp.name} is listed twice")
+        out.append(amp.name)
+    return tuple(out)
+
+
+def _library(doc, table: dict, build):
+    """``build()`` with the library's refusal shown in the spec's words, at the key's line."""
+    try:
+        return build()
+    except DesignError as exc:
+        msg = exc.naming(table)
+        param = getattr(exc, "param", None)
+        keys = tuple(table.get(param, "").split(".")) if param in table else ()
+        raise doc.error(keys, msg) from None
+
+
+def _common(doc, kind: str) -> dict:
+    """series, bounds and stimulus as the library's keyword arguments (as typed: the library checks them)."""
+    series = doc.mapping(("series",), SUB["series"])
+    bounds = doc.mapping(("bounds",), SUB["bounds"])
+    stim = doc.mapping(("stimulus",), STIMULUS[kind])
+    out = {f"{k}_series": series[k] for k in ("r", "c") if k in series}
+    out.update(bounds)
+    amp_key = "amplitude_v" if kind == "plant" else "step_v"
+    for key, param in (("amplitude", amp_key), ("frequency", "square_hz"), ("edge", "edge_s")):
+        if key in stim:
+            out[param] = stim[key]
+    return out
+
+
+def _plant_designs(doc, corners):
+    from ..plant.sallenkey import SallenKeyParts
+    from ..plant.spec import AnalysisSpec, PlantSpec
+    target = doc.mapping(("target",), SUB["target"])
+    parts = doc.mapping(("parts",), SUB["parts"])
+    common = _common(doc, "plant")
+    if not target and not parts:
+        raise doc.error((), "a plant spec needs target: {fc, zeta} (designed) or parts: {R1, R2, C1, C2} (as built)")
+    if parts:
+        for k in ("gain", "compensate_gbw"):
+            if k in target:
+                raise doc.error(("target", k), f"target.{k} applies to a design; with parts: the gain is "
+                                "parts.gain (or R3/R4)")
+        for k in ("bounds",):
+            if doc.data.get(k) is not None:
+                raise doc.error((k,), "bounds: limit a design's part search; parts: are already chosen")
+        sk = SallenKeyParts(*(parts.get(k) for k in ("R1", "R2", "C1", "C2", "gain", "R3", "R4")))
+        kw = {k: v for k, v in common.items() if k in ("r_series", "c_series", "amplitude_v", "square_hz")}
+        designs = [_library(doc, PLANT_KEYS, lambda amp=amp: AnalysisSpec(
+            sk, opamp=amp, target_fc_hz=target.get("fc"), target_zeta=target.get("zeta"), **kw))
+            for amp in corners]
+        return designs, True
+    for k in ("fc", "zeta"):
+        if k not in target:
+            raise doc.error(("target",), f"target needs {k} (and zeta/fc): the plant to design")
+    extra = {"gain": target["gain"]} if "gain" in target else {}
+    if "compensate_gbw" in target:
+        if not isinstance(target["compensate_gbw"], bool):
+            raise doc.error(("target", "compensate_gbw"), "target.compensate_gbw must be true or false")
+        extra["compensate_gbw"] = target["compensate_gbw"]
+    designs = [_library(doc, PLANT_KEYS, lambda amp=amp: PlantSpec(
+        fc_hz=target["fc"], zeta=target["zeta"], opamp=amp, alternatives=1, **extra, **common))
+        for amp in corners]
+    return designs, False
+
+
+def _pid_designs(doc, corners):
+    from ..pid.blocks import PidParts
+    from ..pid.spec import PidSpec, controller_from_json
+    from ..plant.sallenkey import SallenKeyParts
+    plant = doc.mapping(("plant",), SUB["plant"])
+    if not plant:
+        raise doc.error(("plant",) if "plant" in doc.data else (),
+                        "a pid spec needs plant: {fc, zeta}, {R1, R2, C1, C2} or {json: result.json}")
+    kw = _common(doc, "pid")
+    kw.update({"plant_fc_hz": plant.get("fc"), "plant_zeta": plant.get("zeta")})
+    if "json" in plant:
+        kw["plant_json"] = str(doc.resolve(("plant", "json")))
+    given = [k for k in ("R1", "R2", "C1", "C2") if k in plant]
+    if given:
+        kw["plant_parts"] = SallenKeyParts(*(plant.get(k) for k in ("R1", "R2", "C1", "C2", "gain")))
+    elif "gain" in plant:
+        raise doc.error(("plant", "gain"), "plant.gain goes with plant.R1 .. plant.C2")
+    tuning = doc.data.get("tuning")
+    if isinstance(tuning, str):
+        kw["tuning"] = tuning
+    elif tuning is not None:
+        t = doc.mapping(("tuning",), SUB["tuning"])
+        for key, param in (("rule", "tuning"), ("kp", "kp"), ("ti", "ti_s"), ("td", "td_s"),
+                           ("target_overshoot", "target_overshoot_pct"), ("target_settling", "target_settling_s")):
+            if key in t:
+                kw[param] = t[key]
+    controller = doc.data.get("controller")
+    analyze = controller is not None
+    if analyze:
+        c = doc.mapping(("controller",), SUB["controller"])
+        if "json" in c:
+            if len(c) > 1:
+                raise doc.error(("controller",), "controller: give json: or the parts, not both")
+            path = str(doc.resolve(("controller", "json")))
+            kw["controller_parts"] = _library(doc, PID_KEYS, lambda: controller_from_json(path))
+        else:
+            kw["controller_parts"] = PidParts(**{p.lower(): c.get(p) for p in CONTROLLER_PARTS})
+    designs = [_library(doc, PID_KEYS, lambda amp=amp: PidSpec(opamp=amp, **kw)) for amp in corners]
+    return designs, analyze
+
+
+def _checks(doc, kind: str, known, unit_kind: str | None = None) -> tuple:
+    entries = doc.get(("checks",))
+    if entries is None:
+        return ()
+    allowed = sorted(known)
+    if not isinstance(entries, dict):
+        raise doc.error(("checks",), "checks must be a mapping: figure -> {min, typ, max, fail}")
+    out = []
+    for figure, entry in entries.items():
+        if kind == "netlist" and isinstance(figure, str):
+            figure = figure.lower()   # ngspice reads names case-insensitively (and prints them in lower case)
+        if figure not in known:
+            what = "measurement" if kind == "netlist" else "figure"
+            raise doc.error(("checks", figure), f"unknown {what} {str(figure)!r} in checks; allowed: "
+                            f"{', '.join(allowed) or '(none)'}; closest: {closest(figure, allowed or ['-'])!r}")
+        keys = ("checks", figure)
+        doc.mapping(keys, LIMIT_KEYS, entry if entry is not None else {})
+        if not isinstance(entry, dict):
+            raise doc.error(keys, f"checks.{figure} needs min and/or max (with typ, fail)")
+        try:
+            out.append(limit_from(figure, entry, f"checks.{figure}", F.unit_of(kind, figure)))
+        except DesignError as exc:
+            bad = next((k for k in ("min", "max", "typ", "fail") if k in entry and f".{k}" in str(exc)), None)
+            raise doc.error(keys + ((bad,) if bad else ()), str(exc)) from None
+    return tuple(out)
+
+
+def _design_checks(doc, kind: str):
+    value = doc.data.get("design_checks")
+    if value is None or value is False:
+        return None
+    ids = [i for i in IDS[kind] if i != SPICE_AGREEMENT]
+    if value == "all" or value is True:
+        return "all"
+    if not isinstance(value, list) or not value:
+        raise doc.error(("design_checks",), f"design_checks: all, or a list of {', '.join(ids)}")
+    for i, v in enumerate(value):
+        if v not in ids:
+            raise doc.error(("design_checks", i), f"unknown design check {_kind_of(v)}; allowed: "
+                            f"{', '.join(ids)}; closest: {closest(v, ids)!r}")
+    return tuple(dict.fromkeys(value))
+
+
+def _positive(doc, keys, default=None) -> float:
+    value = doc.get(keys)
+    label = ".".join(map(str, keys))
+    if value is None:
+        if default is None:
+            raise doc.error(keys, f"{label} needs a number")
+        return default
+    try:
+        out = parse_value(value, label) if not isinstance(value, bool) else None
+    except DesignError:
+        out = None
+    if out is None or not out > 0:
+        raise doc.error(keys, f"{label} must be a positive number, got {_kind_of(value)}")
+    return out
+
+
+def _agreement(doc):
+    if doc.data.get("spice_agreement") is None:
+        return None
+    a = doc.mapping(("spice_agreement",), SUB["spice_agreement"])
+    against = a.get("against", "opamp_model")
+    if against not in AGAINST:
+        raise doc.error(("spice_agreement", "against"), f"spice_agreement.against {_kind_of(against)}; "
+                        f"allowed: {', '.join(AGAINST)}")
+    return Agreement(_positive(doc, ("spice_agreement", "nrms_max")), against)
+
+
+def _tolerance(doc, checks) -> tuple:
+    value = doc.data.get("tolerance")
+    if value is None or value is False:
+        return ()
+    limited = [c.figure for c in checks if c.figure in F.BAND]
+    if value is True:
+        if not limited:
+            raise doc.error(("tolerance",), f"tolerance: true needs a check on one of {', '.join(F.BAND)}")
+        return tuple(limited)
+    if not isinstance(value, list) or not value:
+        raise doc.error(("tolerance",), f"tolerance: true, or a list of {', '.join(F.BAND)}")
+    for i, v in enumerate(value):
+        if v not in F.BAND:
+            raise doc.error(("tolerance", i), f"tolerance: {_kind_of(v)} has no tolerance band; allowed: "
+                            f"{', '.join(F.BAND)}; closest: {closest(v, F.BAND)!r}")
+        if v not in limited:
+            raise doc.error(("tolerance", i), f"tolerance: {v} needs a check on {v} (checks.{v}: its limits)")
+    return tuple(dict.fromkeys(value))
+
+
+def _golden(doc, kind: str, corners, update: bool):
+    if doc.data.get("golden") is None:
+        return None
+    g = doc.mapping(("golden",), SUB["golden"])
+    file = doc.resolve(("golden", "file"))
+    if len(corners) > 1 and "{corner}" not in str(file):
+        raise doc.error(("golden", "file"), "golden.file needs {corner} in its name with several op-amps "
+                        f"(one golden waveform per corner: {', '.join(corners)})")
+    reltol = _positive(doc, ("golden", "reltol"), RELTOL) if "reltol" in g else RELTOL
+    abstol = _positive(doc, ("golden", "abstol"), ABSTOL) if "abstol" in g else ABSTOL
+    raw = g.get("signals", list(DEFAULT_SIGNALS.get(kind, ())))
+    if not raw:
+        raise doc.error(("golden",), "golden.signals: name the deck's vectors to compare (e.g. [out])")
+    known = SIGNALS.get(kind)
+    signals = {}
+    items = raw.items() if isinstance(raw, dict) else ((s, None) for s in raw) if isinstance(raw, list) else None
+    if items is None:
+        raise doc.error(("golden", "signals"), "golden.signals: a list of names, or name -> {reltol, abstol}")
+    for sig, tol in items:
+        keys = ("golden", "signals", sig)
+        if not isinstance(sig, str) or (known is not None and sig not in known):
+            allowed = known or ("a vector name",)
+            raise doc.error(keys, f"unknown golden signal {_kind_of(sig)}; allowed: {', '.join(allowed)}; "
+                            f"closest: {closest(sig, allowed)!r}")
+        doc.mapping(keys, ("reltol", "abstol"), tol if tol is not None else {})
+        signals[sig] = (_positive(doc, keys + ("reltol",), reltol) if tol and "reltol" in tol else reltol,
+                        _positive(doc, keys + ("abstol",), abstol) if tol and "abstol" in tol else abstol)
+    golden = Golden(str(file), signals)
+    if not update:
+        for c in corners:
+            if not golden.path(c).is_file():
+                raise doc.error(("golden", "file"), f"golden file {shown(golden.path(c))} does not exist; "
+                                "record it with check-design --update-golden")
+    return golden
+
+
+# ---- kind: netlist ----------------------------------------------------------------
+
+_ANALYSIS = re.compile(r"^\s*\.(tran|ac)\b", re.I | re.M)
+_CONTROL = re.compile(r"^\s*\.control\b", re.I | re.M)
+
+
+def _netlist(doc, name: str, update: bool) -> CheckSpec:
+    from ..spice.simulate import measure_names
+    path = doc.resolve(("deck",))
+    try:
+        deck = read_text(path, "deck", MAX_SPEC_BYTES * 16)
+    except DesignError as exc:
+        raise doc.error(("deck",), str(exc)) from None
+    shown_deck = shown(path)
+    lines = [ln for ln in deck.splitlines() if ln.strip()]
+    if len(lines) < 2:
+        raise doc.error(("deck",), f"deck {shown_deck} is not an ngspice deck: a title line, then the circuit")
+    if _CONTROL.search(deck):
+        raise doc.error(("deck",), f"deck {shown_deck} has a .control block: check-design runs the deck's "
+                        "analysis itself; keep the analysis and .meas lines outside .control")
+    if not _ANALYSIS.search(deck):
+        raise doc.error(("deck",), f"deck {shown_deck} has no .tran or .ac line: "
+                        "nothing to simulate")
+    measures = measure_names(deck)
+    checks = _checks(doc, "netlist", set(measures))
+    golden = _golden(doc, "netlist", ("",), update)
+    if not (checks or golden):
+        raise doc.error((), "nothing to check: give checks: (the deck's .meas names) or golden:")
+    return CheckSpec(doc.path, name, "netlist", ("",), (deck,), False, checks, None, None, (), golden, path.parent)

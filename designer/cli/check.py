@@ -1,0 +1,186 @@
+"""Command-line layer of ``check-design``: load every spec (all refusals before
+any run), run each spec's corners in worker processes, print a line per
+failure, write the JUnit file, the Markdown summary and the ``--out`` folder,
+and exit with the run's status."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from .. import __version__
+from .common import OneLineParser, print_output, run_cli
+
+EPILOG = """spec file (YAML; numbers in engineering notation, paths relative to the spec):
+  name: lab3-plant                      # default: the file's stem
+  kind: plant                           # plant | pid | netlist
+  target: {fc: 3.5k, zeta: 0.2}         # designed as design-plant does; or parts: {R1: 1k6, R2: 3k9, ...}
+  opamp: [LM741, TL072]                 # the corners: every check runs for each
+  stimulus: {amplitude: 2}              # square wave 0 -> amplitude V (frequency: default as design-plant)
+  checks:                               # figure: {min, typ, max, fail}; min/max absolute or "-1%" of typ
+    fn_hz: {typ: 3500, min: "-2%", max: "+2%"}
+    overshoot_pct: {max: 60}
+    zeta_opamp: {min: 0.15, fail: false}    # report only
+  design_checks: all                    # or [slew_rate, output_swing, ...]
+  spice_agreement: {nrms_max: 1, against: opamp_model}   # or ideal
+  tolerance: [fn_hz]                    # the part-tolerance band must stay inside the limits too
+  golden: {file: golden/lab3-{corner}.csv, signals: {output_v: {reltol: 0.01, abstol: 1m}}}
+
+  kind: pid     plant: {fc: 3.5k, zeta: 0.2} (or R1..C2, or json: result.json); tuning: zn (a rule),
+                {kp: 3.3, ti: 43u, td: 11u} or {rule: optimize, target_overshoot: 10}; controller: {R3: 12k,
+                .., C4: 47n} or {json: result.json} (the parts as built, checked with analyze-pid)
+  kind: netlist deck: my_filter.cir (your own ngspice deck with .tran or .ac); checks: its .meas names
+
+examples:
+  check-design specs/*.yaml --junit junit.xml --summary summary.md --out check-out --jobs 2
+  check-design specs/lab3.yaml --simulator ngspice-cli       (as CI runs it, with Debian's ngspice)
+  check-design specs/lab3.yaml --update-golden               (record the golden waveforms on purpose)
+  check-design specs/*.yaml --no-fail --summary "$GITHUB_STEP_SUMMARY"
+
+Exit status: 0 every check passed; 1 a check failed; 2 a bad spec or usage (one line: file, line, what is
+allowed); 3 a simulator error or timeout; --no-fail makes it 0 whatever happened (the files say what)."""
+
+
+def _parser():
+    p = OneLineParser(
+        prog="check-design",
+        description="SPICE regression checks of your own analog designs, for CI: each spec file names a design "
+                    "(a Sallen-Key plant, a PID controller in its loop, or your own ngspice deck), its op-amp "
+                    "corners and the limits it must meet; every check runs for every corner in ngspice.",
+        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    p.add_argument("specs", nargs="+", metavar="SPEC.yaml", help="spec files (YAML)")
+    p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report (one testsuite per spec, one "
+                                                  "testcase per check and corner)")
+    p.add_argument("--summary", metavar="FILE", help="write a Markdown summary (e.g. $GITHUB_STEP_SUMMARY)")
+    p.add_argument("--out", metavar="DIR", help="write each spec's result.json, build sheets, and a plot for "
+                                                "every failing golden waveform under DIR/<spec>/")
+    p.add_argument("--jobs", default="1", metavar="N", help="worker processes, one ngspice each (1 to 64, "
+                                                            "default 1); the output order stays the same")
+    p.add_argument("--simulator", default="pyspice", choices=("pyspice", "ngspice-cli"),
+                   help="pyspice: ngspice's shared library (default); ngspice-cli: `ngspice -b`")
+    p.add_argument("--timeout", default="600", metavar="S",
+                   help="seconds one corner (its design and SPICE run) may take before it is killed and "
+                        "reported as a simulator error (1 to 86400, default 600)")
+    p.add_argument("--update-golden", action="store_true",
+                   help="record the golden waveform files from this run (on purpose: they are then the reference)")
+    p.add_argument("--no-fail", action="store_true", help="exit status 0 whatever the checks say")
+    return p
+
+
+def _whole(text, name: str, lo: int, hi: int) -> int:
+    from ..core.errors import DesignError
+    try:
+        n = float(text)
+    except ValueError:
+        n = None
+    if n is None or n != int(n) or not lo <= n <= hi:
+        raise DesignError(f"{name} must be a whole number from {lo} to {hi}, got {text!r}")
+    return int(n)
+
+
+def _run(args) -> int:
+    from ..check.spec import load_spec
+    from ..core.errors import EXIT_OK, DesignError
+    jobs = _whole(args.jobs, "--jobs", 1, 64)
+    timeout = _whole(args.timeout, "--timeout", 1, 86400)
+    specs = [load_spec(p, update_golden=args.update_golden) for p in args.specs]
+    names = {}
+    for s in specs:
+        if s.name in names:
+            raise DesignError(f"{s.path}: name {s.name!r} is also the name of {names[s.name]}; names must differ "
+                              "(they name the JUnit suites and the --out folders)")
+        names[s.name] = s.path
+    out_dir = None
+    if args.out is not None:
+        from ..core.fileio import check_can_create
+        out_dir = check_can_create(args.out)
+    tick = time.perf_counter()
+    outcomes = run_specs(specs, args.simulator, jobs=jobs, timeout=timeout, update_golden=args.update_golden,
+                         out_dir=out_dir)
+    seconds = time.perf_counter() - tick
+    _report(outcomes, args, seconds, out_dir)
+    from ..check.result import exit_status
+    return EXIT_OK if args.no_fail else exit_status(outcomes)
+
+
+def run_specs(specs, simulator: str, *, jobs: int = 1, timeout: float = 600, update_golden: bool = False,
+              out_dir=None) -> list:
+    """Every corner of every spec in worker processes; a
+    :class:`~designer.check.result.SpecOutcome` per spec, in the order given."""
+    from ..check.pool import run_tasks
+    from ..check.result import ERROR, SIM_ERROR, Case, CornerOutcome, SpecOutcome
+    from ..check.run import run_corner
+    from ..spice import simulate
+    from ..spice.simulate import tool_info
+    kinds = {s.kind for s in specs}
+    # imported here, once: the forked workers share them instead of importing each
+    if "plant" in kinds:
+        import designer.plant.design  # noqa: F401
+        import designer.plant.report  # noqa: F401
+    if "pid" in kinds:
+        import designer.pid.design  # noqa: F401
+        import designer.pid.report  # noqa: F401
+    tasks = [(i, k) for i, s in enumerate(specs) for k in range(len(s.corners))]
+
+    def work(task):
+        i, k = task
+        return run_corner(specs[i], k, simulator, update_golden=update_golden, out_dir=out_dir)
+
+    def lost(task, reason):
+        i, k = task
+        corner = specs[i].corners[k]
+        return CornerOutcome(corner, (Case("simulation", corner, ERROR, f"simulation: simulator error: {reason}",
+                                           error_kind=SIM_ERROR),), None, tool_info(simulator), (), {}, timeout)
+
+    def setup():
+        simulate.DEFAULT_TIMEOUT_S = float(timeout)   # each `ngspice -b` run gets the same deadline
+
+    results = run_tasks(tasks, work, jobs, timeout, lost, setup)
+    outcomes, at = [], 0
+    for s in specs:
+        corners = results[at: at + len(s.corners)]
+        at += len(s.corners)
+        tool = next((c.tool for c in corners if c.tool.get("ngspice")), corners[0].tool)
+        outcomes.append(SpecOutcome(s.name, str(s.path), s.kind, list(corners), tool))
+    return outcomes
+
+
+def _report(outcomes, args, seconds: float, out_dir) -> None:
+    from ..check.junit import junit_xml
+    from ..check.result import ERROR, FAIL, headline
+    from ..check.summary import summary_markdown
+    from ..core.fileio import atomic_write
+    if out_dir is not None:
+        import json
+        for o in outcomes:
+            path = Path(out_dir) / o.name / "result.json"
+            o.files["result_json"] = str(path)
+            atomic_write(path, json.dumps(o.to_dict(), indent=2) + "\n")
+    if args.junit:
+        atomic_write(args.junit, junit_xml(outcomes, seconds))
+    if args.summary:
+        atomic_write(args.summary, summary_markdown(outcomes, seconds))
+    lines = []
+    for o in outcomes:
+        n = o.counts()
+        lines.append(f"{o.name}: {o.status.upper() if o.status != 'pass' else 'pass'} ({n['pass']} passed, "
+                     f"{n[FAIL]} failed, {n[ERROR]} errors, {n['skipped']} report-only)")
+    print_output("\n".join(lines))
+    for o in outcomes:
+        for c in o.cases:
+            if c.status in (FAIL, ERROR):
+                print(f"check-design: {'error' if c.status == ERROR else 'failed'}: {headline(o, c)}",
+                      file=sys.stderr)
+        for w in o.warnings:
+            print(f"check-design: warning: {o.name}: {w}", file=sys.stderr)
+
+
+def check_design_main(argv=None) -> int:
+    return run_cli("check-design", _parser, _run, argv)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(check_design_main())
