@@ -105,6 +105,18 @@ def _add_signal_options(p):
     o.add_argument("--square-freq", metavar="HZ",
                    help=f"reference frequency {_r('square_hz')} (default: half period = 1.5x the closed "
                         "loop's settling time, rounded)")
+    o.add_argument("--package", choices=("single", "dual", "quad"), metavar="KIND",
+                   help="how the build sheet puts the seven op-amps in packages: single (one per DIP-8), dual "
+                        "(DIP-8: TL072, LM358, NE5532) or quad (DIP-14: TL074, LM324); default: the op-amp's "
+                        "first (LM741 single, the others dual)")
+
+
+def _package(args, spec) -> str | None:
+    """The package kind asked for, refused in one line (exit 2) before any work when the
+    op-amp does not come in it (an NE5532 has no quad)."""
+    from ..core.opamps import get
+    get(spec.opamp).package(args.package)
+    return args.package
 
 
 #: the spec's parameters set from options of the same meaning (their options: FLAGS)
@@ -146,7 +158,9 @@ def _run(args) -> int:
     spec = _build_spec(args)
     # the default name needs the plant as built; its fixed start stands in for it in the check
     common.check_output(args, args.name if args.name is not None else f"pid_{spec.method}")
+    package = _package(args, spec)
     result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
+    result.package = package
     name = args.name or _default_name(spec, result.plant.fn_hz, result.plant.zeta)
     return emit(result, args, name, write_outputs, summary_text)
 
@@ -217,7 +231,9 @@ def _analyze(args) -> int:
     spec = PidSpec(plant_parts=_plant_parts(args), controller_parts=parts,
                    **{p: getattr(args, common.FLAGS[p][2:].replace("-", "_")) for p in ANALYZE_PARAMS})
     common.check_output(args, args.name if args.name is not None else "pid_as-built")
+    package = _package(args, spec)
     result = analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
+    result.package = package
     name = args.name or (f"pid_{result.tuning.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}"
                          f"_z{result.plant.zeta:.3g}")
     return emit(result, args, name, write_outputs, summary_text)

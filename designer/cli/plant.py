@@ -68,6 +68,10 @@ def _add_bench_options(group):
     group.add_argument("--square-freq", metavar="HZ",
                        help="bench square-wave frequency (default: a round value whose half period is "
                             "1.5x the 2 %% settling time; 330 Hz for the seed's plant) " + help_range("square_hz"))
+    group.add_argument("--package", choices=("single", "dual", "quad"), metavar="KIND",
+                       help="the op-amp's package on the build sheet: single (DIP-8), dual (DIP-8, the other "
+                            "half tied off) or quad (DIP-14); default: the op-amp's first (LM741 single, the "
+                            "others dual)")
 
 
 def _design(args) -> int:
@@ -79,13 +83,21 @@ def _design(args) -> int:
     name = args.name if args.name is not None else (
         f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
     check_output(args, name)
+    _check_package(args, spec.opamp)
     from ..plant.design import design_plant
     result = design_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
     return _emit(result, args, name)
 
 
+def _check_package(args, opamp: str) -> None:
+    """A --package the op-amp does not come in is refused in one line before any work."""
+    from ..core.opamps import get
+    get(opamp).package(args.package)
+
+
 def _emit(result, args, name) -> int:
     from ..plant.report import summary_text, write_outputs
+    result.package = args.package
     return emit(result, args, name, write_outputs, summary_text)
 
 
@@ -136,6 +148,7 @@ def _analyze(args) -> int:
     name = args.name if args.name is not None else "built_" + "_".join(
         f"{k}{value_code(v)}" for k, v in (("r1", p.r1), ("r2", p.r2), ("c1", p.c1), ("c2", p.c2)))
     check_output(args, name)
+    _check_package(args, spec.opamp)
     return _emit(analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, name)
 
 

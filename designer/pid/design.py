@@ -200,8 +200,33 @@ def _run(spec: PidSpec, simulate: bool, simulator: str, as_built: bool) -> PidRe
         clock.lap("simulation_s")
     else:
         res.notes.append("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only")
+    res.scope = loop_scope(res)
     res.timings = clock.laps
     return res
+
+
+def loop_scope(res: PidResult):
+    """The scope for the loop's bench test (seed 001, Figures 79-90): CH1 on the
+    reference, CH2 on the plant output and then on each op-amp output in turn, each
+    channel's volts/div (1-2-5) fitting what SPICE shows there (the analytic levels
+    when not simulated; the rails for an unstable analytic loop), and the time base
+    showing 1.2 settling times after the edge (at most the half period)."""
+    from ..plant.bench import channel, scope_setup
+    test, amp = res.test, res.opamp
+    rails = (amp.vout_min, amp.vout_max) if not amp.ideal else (amp.vee, amp.vcc)
+    levels = {}
+    for ref, role, sig in model.OPAMP_OUTPUTS:
+        got = (res.spice.stages.get(role) if res.spice is not None else None) or res.analytic.levels.get(role)
+        if got is not None:
+            levels[sig] = (ref, got.v_min, got.v_max)
+        elif sig != "vd" or res.parts.has_derivative:
+            levels[sig] = (ref, *rails)
+    ts = res.spice.figures.settling_time_s if res.spice is not None else res.analytic.figures.settling_time_s
+    window = min(1.2 * ts, test.half_period_s) if ts is not None and math.isfinite(ts) else test.half_period_s
+    chans = [channel("CH1", "reference r", 0.0, test.amplitude_v)]
+    chans.append(channel("CH2", "y", *levels["y"][1:]))
+    chans += [channel("CH2", sig, lo, hi) for sig, (_, lo, hi) in levels.items() if sig != "y"]
+    return scope_setup(window, test.amplitude_v / 2, chans)
 
 
 class _Clock:

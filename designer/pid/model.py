@@ -29,10 +29,11 @@ from ..core.opamps import OpAmp
 from .blocks import PidParts
 
 SIGNALS = ("ve", "vp", "vd", "vi", "vs", "u", "y")
-#: op-amp reference, role and output signal; U7 is the plant's Sallen-Key buffer.
-OPAMP_OUTPUTS = (("U1", "difference", "ve"), ("U2", "inverter", "vp"),
-                 ("U3", "differentiator", "vd"), ("U4", "integrator", "vi"),
-                 ("U5", "summer", "vs"), ("U6", "gain", "u"), ("U7", "plant", "y"))
+#: op-amp designator, role and output signal, in signal order; U1 is the plant's Sallen-Key
+#: op-amp, as on the plant's own sheet (one designator scheme: :mod:`designer.pid.netlist`)
+OPAMP_OUTPUTS = (("U2", "difference", "ve"), ("U3", "inverter", "vp"),
+                 ("U4", "differentiator", "vd"), ("U5", "integrator", "vi"),
+                 ("U6", "summer", "vs"), ("U7", "gain", "u"), ("U1", "plant", "y"))
 
 
 def _opamp_inv(opamp: OpAmp | None):

@@ -1,67 +1,92 @@
-"""Standalone closed-loop ngspice deck: the six-op-amp PID controller of
-seed 001 (Figure 66), the Sallen-Key plant circuit, the project's behavioural
-op-amp models (inlined from ``circuits/``), supplies, a square-wave reference
-like the seed's bench test, ``.tran`` and ``.meas`` lines.
+"""The closed loop as a part and net table and as a standalone ngspice deck:
+the six-op-amp PID controller of seed 001 (Figure 66), the Sallen-Key plant
+circuit, the project's behavioural op-amp models (inlined from
+``circuits/``), supplies, a square-wave reference like the seed's bench test,
+``.tran`` and ``.meas`` lines.
+
+The table (:func:`loop_netlist`) is the one description of the circuit: the
+deck, the schematic (:mod:`designer.pid.schematic`), the wiring table and the
+bill of materials are all written from it. Designators are one scheme with the
+plant's sheet (:mod:`designer.plant.netlist`): the plant keeps R1, R2, C1, C2
+and its op-amp U1; the controller has the seed's R3..R18, C3, C4 and the
+op-amps U2 (difference), U3 (inverter), U4 (differentiator), U5 (integrator),
+U6 (summer) and U7 (final gain), one per package as the seed built it;
+:func:`designer.spice.deck.board` puts them in dual or quad packages.
 
 Node names: ``ref`` reference, ``ve`` error (y - r), ``vp``/``vd``/``vi``
 proportional, derivative and integral stage outputs, ``vs`` summer, ``u``
-controller output (plant input), ``y`` plant output. Op-amps are XU1..XU6
-(controller) and XP1 (plant).
+controller output (plant input), ``y`` plant output; ``n2``..``n7`` the
+inverting inputs, ``p2`` the difference amplifier's non-inverting input,
+``d4`` the differentiator's R12-C3 node, ``pv1``/``pvp``/``pvn`` inside the plant.
 """
 
 from __future__ import annotations
 
-import logging
-
 from ..core.opamps import OpAmp
-from ..plant.netlist import add_sallen_key
+from ..plant.netlist import plant_netlist
 from ..plant.sallenkey import SallenKeyParts
 from ..spice import deck
-from ..spice.deck import SquareTest
+from ..spice.deck import GROUND, Amp, Netlist, Part, SquareTest
 from .blocks import PidParts
 
 #: signals whose extremes the deck measures (one per op-amp output)
 PROBES = ("ve", "vp", "vd", "vi", "vs", "u", "y")
+#: what the nets are called on the sheet (wiring table, schematic labels)
+NET_LABELS = {"ref": "reference r (generator, CH1)", "y": "plant output y (CH2)", "ve": "error ve",
+              "vp": "proportional vp", "vd": "derivative vd", "vi": "integral vi", "vs": "summer vs",
+              "u": "controller output u", "pv1": "plant node A (R1-R2-C2)", "d4": "R12-C3 node", "0": "ground"}
 
 
-def add_controller(circuit, parts: PidParts, opamp: OpAmp, ref="ref", y="y", u="u"):
-    """The six controller op-amps between the reference, the plant output and ``u``
-    (U3 and R7 only with a derivative path)."""
-    gnd = circuit.gnd
+def controller_stages(parts: PidParts, ref="ref", y="y", u="u") -> list:
+    """The controller's op-amps as (Amp, passives) in signal order; passives are
+    :class:`~designer.spice.deck.Part` rows (U4, R7, R11, R12, C3 only with a
+    derivative path)."""
     p = parts
-    # per op-amp: its name, non-inverting input, inverting input and output, after its
-    # passives (kind, number, node, node, value)
-    stages = (
-        # U1 difference amplifier: ve = y - r (equal resistors)
-        ("U1", "p1", "n1", "ve", (("R", 15, ref, "n1", p.r15), ("R", 16, "n1", "ve", p.r16),
-                                  ("R", 17, y, "p1", p.r17), ("R", 18, "p1", gnd, p.r18))),
-        # U2 unity inverter
-        ("U2", gnd, "n2", "vp", (("R", 10, "ve", "n2", p.r10), ("R", 9, "n2", "vp", p.r9))),
-        # U3 differentiator with input resistor
-        ("U3", gnd, "n3", "vd", (("R", 12, "ve", "d3", p.r12), ("C", 3, "d3", "n3", p.c3),
-                                 ("R", 11, "n3", "vd", p.r11))),
-        # U4 integrator with feedback resistor
-        ("U4", gnd, "n4", "vi", (("R", 14, "ve", "n4", p.r14), ("R", 13, "n4", "vi", p.r13),
-                                 ("C", 4, "n4", "vi", p.c4))),
-        # U5 summer
-        ("U5", gnd, "n5", "vs", (("R", 6, "vp", "n5", p.r6), ("R", 7, "vd", "n5", p.r7),
-                                 ("R", 8, "vi", "n5", p.r8), ("R", 5, "n5", "vs", p.r5))),
-        # U6 final inverting gain
-        ("U6", gnd, "n6", u, (("R", 4, "vs", "n6", p.r4), ("R", 3, "n6", u, p.r3))),
-    )
-    for name, inp, inn, out, passives in stages:
-        if name == "U3" and not p.has_derivative:
-            continue
-        for kind, number, a, b, value in passives:
-            if value is not None:   # R7 of a PI
-                getattr(circuit, kind)(number, a, b, f"{value:.6g}")
-        deck.add_opamp(circuit, name, inp, inn, out, opamp)
+    stages = [
+        (Amp("U2", "difference", "p2", "n2", "ve"),
+         [Part("R15", ref, "n2", p.r15, "U2 input from the reference r"), Part("R16", "n2", "ve", p.r16, "U2 feedback"),
+          Part("R17", y, "p2", p.r17, "U2 +in from the plant output y"),
+          Part("R18", "p2", GROUND, p.r18, "U2 +in to ground")]),
+        (Amp("U3", "inverter", GROUND, "n3", "vp"),
+         [Part("R10", "ve", "n3", p.r10, "U3 input (unity inverter)"), Part("R9", "n3", "vp", p.r9, "U3 feedback")]),
+    ]
+    if p.has_derivative:
+        stages.append((Amp("U4", "differentiator", GROUND, "n4", "vd"),
+                       [Part("R12", "ve", "d4", p.r12, "U4 input, in series with C3"),
+                        Part("C3", "d4", "n4", p.c3, "U4 input, in series with R12 (derivative)"),
+                        Part("R11", "n4", "vd", p.r11, "U4 feedback (differentiator)")]))
+    stages += [
+        (Amp("U5", "integrator", GROUND, "n5", "vi"),
+         [Part("R14", "ve", "n5", p.r14, "U5 input (integrator)"),
+          Part("R13", "n5", "vi", p.r13, "U5 feedback, parallel to C4 (integrator leak)"),
+          Part("C4", "n5", "vi", p.c4, "U5 feedback (integrator)")]),
+        (Amp("U6", "summer", GROUND, "n6", "vs"),
+         [Part("R6", "vp", "n6", p.r6, "U6 input from U3 (proportional)")]
+         + ([Part("R7", "vd", "n6", p.r7, "U6 input from U4 (derivative)")] if p.has_derivative else [])
+         + [Part("R8", "vi", "n6", p.r8, "U6 input from U5 (integral)"), Part("R5", "n6", "vs", p.r5, "U6 feedback")]),
+        (Amp("U7", "gain", GROUND, "n7", u),
+         [Part("R4", "vs", "n7", p.r4, "U7 input (final gain)"), Part("R3", "n7", u, p.r3, "U7 feedback")]),
+    ]
+    return stages
+
+
+def loop_netlist(parts: PidParts, plant: SallenKeyParts) -> Netlist:
+    """The whole loop as one table: the plant (U1 and its parts) first, then the
+    controller's stages in signal order."""
+    pl = plant_netlist(plant, "u", "y", prefix="p", amp_ref="U1")
+    rows, amps = list(pl.parts), list(pl.amps)
+    for amp, passives in controller_stages(parts):
+        rows += passives
+        amps.append(amp)
+    return Netlist(tuple(rows), tuple(amps))
 
 
 def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test: SquareTest,
                      title: str, expected_final: float, points: int = 20000) -> str:
     """The whole loop as a standalone deck; ``expected_final`` (V) is the settled
     plant output the ``.meas`` levels refer to (the analytic closed loop's)."""
+    import logging
+
     from PySpice.Spice.Netlist import Circuit
     logging.getLogger("PySpice").setLevel(logging.ERROR)
     circuit = Circuit(title)
@@ -70,16 +95,15 @@ def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test:
         f"* op-amps: {opamp.name} ({opamp.description}); supplies {opamp.vcc:g} V / {opamp.vee:g} V",
         f"* reference: 0 -> {test.amplitude_v:g} V square wave at {test.frequency_hz:g} Hz, edges "
         f"{test.edge_s:.3g} s, rising step at {test.delay_s:.4g} s",
-        "* controller (seed 001, Fig. 66): U1 difference (ve = y - r), U2 inverter, U3 differentiator,",
-        "*   U4 integrator, U5 summer, U6 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y); plant XP1",
+        "* plant (seed 001, Fig. 43-45): XU1 Sallen-Key; controller (Fig. 66): U2 difference (ve = y - r),",
+        "*   U3 inverter, U4 differentiator, U5 integrator, U6 summer, U7 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y)",
         "* Run: ngspice -b <this file>   (prints overshoot_pct, peak_time_s, rise_time_s, settling_time_s,",
         "*   and the extremes of every op-amp output)",
         deck.opamp_library_text().rstrip(),
     ])
     deck.add_supplies(circuit, opamp)
     circuit.V("ref", "ref", circuit.gnd, test.source())
-    add_controller(circuit, parts, opamp)
-    add_sallen_key(circuit, plant, opamp, "u", "y", prefix="P")
+    loop_netlist(parts, plant).add_to(circuit, opamp)
     deck.settle_error_source(circuit, "y", expected_final)
     t0 = test.delay_s
     extremes = []

@@ -1,8 +1,11 @@
-"""The PID build sheet: bill of materials for every part, target vs achieved,
-the checks, closed-loop figures (analytic, ideal PID, SPICE), the expected
-scope waveform and levels at every op-amp output (as the seed photographs
-them, Figures 80-89), and the plots. Rendered as Markdown, self-contained
-HTML and terminal text from one description (:mod:`designer.report`)."""
+"""The PID build sheet: the whole loop's schematic (seed 001, Figure 66 with
+the plant of Figures 43-45) beside the bill of materials and the bench
+settings, the pin-level wiring in the chosen packages, target vs achieved,
+the checks, closed-loop figures (analytic, ideal PID, SPICE), the scope
+settings and expected levels at every op-amp output (as the seed photographs
+them, Figures 79-90), and the plots. Rendered as Markdown, self-contained
+HTML and terminal text from one description (:mod:`designer.report`), plus
+``bom.csv``; the part and net table is the deck's (:mod:`designer.pid.netlist`)."""
 
 from __future__ import annotations
 
@@ -15,8 +18,11 @@ from ..core import eseries
 from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import bundle_paths, write_bundle
-from ..report.plots import png_bytes, step_plot
+from ..report.plots import decimate, figure, loop_gain_plot, png_bytes, step_plot
+from ..report.wiring import bom_csv, bom_rows, wiring_rows
+from ..spice.deck import board
 from .model import OPAMP_OUTPUTS
+from .netlist import NET_LABELS, loop_netlist
 from .tuning import MODEL_NAMES
 
 #: what each block's output looks like on the scope for a square-wave reference
@@ -79,29 +85,69 @@ def verdict_text(result) -> str:
     return "; ".join(parts) + "."
 
 
-#: the build sheet's name and role of each controller part
-ROLES = {"R3": "U6 feedback (final gain)", "R4": "U6 input (from the summer)", "R5": "U5 feedback (summer)",
-         "R6": "U5 input from U2 (proportional)", "R7": "U5 input from U3 (derivative)",
-         "R8": "U5 input from U4 (integral)", "R9": "U2 feedback (unity inverter)", "R10": "U2 input",
-         "R11": "U3 feedback (differentiator)", "R12": "U3 input, in series with C3",
-         "R13": "U4 feedback, parallel to C4 (integrator leak)", "R14": "U4 input (integrator)",
-         "R15": "U1 from the reference r to the inverting input", "R16": "U1 feedback",
-         "R17": "U1 from the plant output y to the non-inverting input",
-         "R18": "U1 non-inverting input to ground",
-         "C3": "U3 input, in series with R12 (derivative)", "C4": "U4 feedback (integrator)"}
+def build_board(result):
+    """The loop as built on the bench: its part and net table (the deck's) in the result's package."""
+    return board(loop_netlist(result.parts, result.plant), result.opamp, result.package)
 
 
-def sections(result, with_images: bool = True) -> list:
+def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`)."""
+    b = build_board(result)
+    first = [R.subhead("Bill of materials"),
+             R.table(["Ref", "Value", "Code", "Qty", "Series", "Tol."], [r[:6] for r in bom(result, b)], "compact"),
+             R.subhead("Generator and scope"), *_settings(result, b)]
+    fig = [R.figure("schematic.png", schematic_svg, "schematic of the loop")] if with_images else []
     out = [("Verdict", [R.text(verdict_text(result))] + [R.text(n) for n in result.notes])]
+    # the loop is wide: the schematic spans the page, the parts and the settings sit under it
+    out.append(("Build", fig + [R.columns(first[:2], first[2:])] if with_images else first))
+    out.append(("Wiring", [R.text(f"{b.package.part} in {b.package.pinout} packages: "
+                                  + ", ".join(f"{u.designator} {a.role}" for a, u in zip(b.netlist.amps, b.units))
+                                  + ". Kp = R5 R3/(R6 R4), Ti = R8 R14 C4/R6, Td = R6 R11 C3/R7."),
+                           R.table(["part", "code", "from", "to"],
+                                   wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee)))]))
     out.append(("Tuning", _tuning_blocks(result)))
-    out.append(("Bill of materials", _bom_blocks(result)))
     out.append(("Target and achieved", _achieved_blocks(result)))
     out.append(("Checks", [R.table(["check", "result", "detail"],
                                    [[c.id, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]))
     out.append(("Closed loop", _loop_blocks(result, with_images)))
-    out.append(("Expected scope readings", _scope_blocks(result, with_images)))
+    out.append(("Expected scope readings", _scope_blocks(result, with_images, b)))
     return out
+
+
+def bom(result, b=None) -> list:
+    """The bill of materials rows (:data:`designer.report.wiring.BOM_HEADER`): the
+    controller's parts from its series, the plant's from the plant's."""
+    b = b or build_board(result)
+    sel = result.selection
+    r_series, c_series = (sel.r_series, sel.c_series) if sel is not None else ("as given", "as given")
+    rt, ct = sel.tolerances_pct if sel is not None else (None, None)
+    prs, pcs = result.plant_series or (None, None)
+    prt, pct = ((100 * eseries.TOLERANCE[prs], 100 * eseries.TOLERANCE[pcs]) if prs else (None, None))
+    plant_refs = {"R1", "R2", "C1", "C2", "R19", "R20"}
+
+    def source(ref):
+        if len(ref) == 4 and ref[0] == "C":     # decoupling
+            return None
+        if ref in plant_refs:
+            return (prs or "as given", prt) if ref[0] == "R" else (pcs or "as given", pct)
+        return (r_series, rt) if ref[0] == "R" else (c_series, ct)
+    return bom_rows(b, source, result.opamp.name)
+
+
+def _settings(result, b) -> list:
+    test, sc = result.test, result.scope
+    a = test.amplitude_v
+    rows = [["generator", f"square {format_eng(test.frequency_hz, 'Hz')}, {format_eng(a, 'V')} pk-pk, offset "
+                          f"{format_eng(a / 2, 'V')} (0 to {format_eng(a, 'V')}), into R15 (r)"]]
+    if sc is not None:
+        rows += [["time base", f"{format_eng(sc.time_per_div_s, 's')}/div, edge {sc.edge_div:g} div from the left"],
+                 ["trigger", f"CH1 rising, {format_eng(sc.trigger_v, 'V')}"]]
+        for c in sc.channels[:2]:
+            rows.append([c.name, f"{format_eng(c.volts_per_div, 'V')}/div DC, 0 V {c.zero_div_below_centre:g} div "
+                                 f"below centre: {c.node}"])
+    return [R.table(["set", "to"], rows, "compact"),
+            R.text("Generator output in High-Z mode (in 50-ohm mode it shows half the amplitude it gives into "
+                   "R15); check the level on CH1. Move CH2 to each TP in turn with its settings below.")]
 
 
 def _tuning_blocks(result) -> list:
@@ -142,33 +188,6 @@ def _tuning_blocks(result) -> list:
     return blocks
 
 
-def _bom_blocks(result) -> list:
-    p, amp, sel = result.parts, result.opamp, result.selection
-    r_series, c_series = (sel.r_series, sel.c_series) if sel is not None else ("as given", "as given")
-    rt, ct = sel.tolerances_pct if sel is not None else (None, None)
-    rows = [R.part_row(ref, v, "Ohm", ROLES[ref], r_series, rt) for ref, v in p.resistors().items()]
-    rows += [R.part_row(ref, v, "F", ROLES[ref], c_series, ct) for ref, v in p.capacitors().items()]
-    for ref, role, _ in OPAMP_OUTPUTS:
-        if (ref == "U3" and not p.has_derivative) or role == "plant":
-            continue  # the plant's op-amp is listed with the plant's parts
-        rows.append([ref, amp.name, "", "", "", f"{role} op-amp, {amp.vcc:g} V / {amp.vee:g} V"])
-    pl = result.plant
-    # a plant designed here comes from the spec's series (whatever the controller's parts are)
-    prs, pcs = result.plant_series or (None, None)
-    prt, pct = ((100 * eseries.TOLERANCE[prs], 100 * eseries.TOLERANCE[pcs]) if prs else (None, None))
-    rows += [R.part_row("R1 (plant)", pl.r1, "Ohm", "Sallen-Key input resistor", prs, prt),
-             R.part_row("R2 (plant)", pl.r2, "Ohm", "Sallen-Key, to the non-inverting input", prs, prt),
-             R.part_row("C1 (plant)", pl.c1, "F", "Sallen-Key, non-inverting input to ground", pcs, pct),
-             R.part_row("C2 (plant)", pl.c2, "F", "Sallen-Key, feedback from the R1-R2 node", pcs, pct)]
-    if pl.r3 is not None:
-        rows += [R.part_row("R3 (plant)", pl.r3, "Ohm", "Sallen-Key gain, to ground", prs, prt),
-                 R.part_row("R4 (plant)", pl.r4, "Ohm", "Sallen-Key gain, feedback", prs, prt)]
-    rows.append(["U7", amp.name, "", "", "", "plant op-amp (Sallen-Key)"])
-    return [R.table(["Ref", "Value", "Code", "Series", "Tolerance", "Where"], rows),
-            R.text("Signal path: r -> U1 (ve = y - r) -> U2 / U3 / U4 in parallel -> U5 summer -> U6 -> u -> "
-                   "plant -> y, fed back to U1. Kp = R5 R3/(R6 R4), Ti = R8 R14 C4/R6, Td = R6 R11 C3/R7.")]
-
-
 def _achieved_blocks(result) -> list:
     tun, ach = result.tuning, result.achieved
     err = ach.errors_pct
@@ -204,22 +223,31 @@ def _loop_blocks(result, with_images) -> list:
                ("the difference is explained by the failed checks: " + ", ".join(v.explained_by) + "."
                 if v.explained_by else "they disagree and no check explains it."))))
     if with_images:
-        blocks += [R.image("closed-loop.png", "closed-loop step"), R.image("controller.png", "controller output"),
-                   R.image("loop-bode.png", "loop gain")]
+        blocks.append(R.columns([R.image("closed-loop.png", "closed-loop step and controller output")],
+                                [R.image("loop-bode.png", "loop gain with its margins")]))
     return blocks
 
 
-def _scope_blocks(result, with_images) -> list:
+def _scope_blocks(result, with_images, b=None) -> list:
     test = result.test
+    b = b or build_board(result)
     la = result.analytic.levels
     ls = {} if result.spice is None else result.spice.stages
+    sc = result.scope
+    vdiv = {} if sc is None else {c.node: c for c in sc.channels}
     rows = []
     for ref, role, sig in OPAMP_OUTPUTS:
         x, y = la.get(role), ls.get(role)
         if x is None and y is None:
             continue
+        amp = next(a for a in b.netlist.amps if a.role == role)
+        unit = b.unit_of(amp.ref)
         rail = None if y is None else y.time_high_s + y.time_low_s if y.time_high_s is not None else 0
-        rows.append([ref, role, sig, "n/a .. n/a" if x is None else f"{_v(x.v_min)} .. {_v(x.v_max)}",
+        ch = vdiv.get(sig)
+        rows.append([f"{unit.designator} pin {unit.pins['out']}", role, sig,
+                     "" if ch is None else f"{format_eng(ch.volts_per_div, 'V')}/div, 0 V {ch.zero_div_below_centre:g}"
+                                           " div down",
+                     "n/a .. n/a" if x is None else f"{_v(x.v_min)} .. {_v(x.v_max)}",
                      "" if y is None else f"{_v(y.v_min)} .. {_v(y.v_max)}",
                      "" if x is None else f"{x.slope_v_per_s / 1e6:.3g} V/us",
                      "" if rail is None else _v(rail, "s"), SHAPES[role]])
@@ -227,11 +255,11 @@ def _scope_blocks(result, with_images) -> list:
                      f"(edges {_v(test.edge_s, 's')}); the output should settle near "
                      f"{result.expected_final_v:.4g} V. Probe each op-amp output against ground; levels cover the "
                      "whole period (the falling half mirrors the rising one)."),
-              R.table(["op-amp", "block", "node", "expected (analytic)", "SPICE", "fastest slope",
-                       "time at a rail (SPICE)", "what the scope shows"], rows)]
+              R.table(["probe", "block", "node", "CH2 setting", "expected (analytic)", "SPICE", "fastest slope",
+                       "at a rail (SPICE)", "what the scope shows"], rows)]
     if with_images:
-        blocks.append(R.image("blocks.png", "every op-amp output"))
-        blocks.append(R.image("reaction-curve.png", "plant reaction curve"))
+        blocks.append(R.columns([R.image("blocks.png", "every op-amp output")],
+                                [R.image("reaction-curve.png", "plant reaction curve")]))
     return blocks
 
 
@@ -258,46 +286,44 @@ def summary_text(result) -> str:
 
 # ---- plots -------------------------------------------------------------------
 
-def _plt():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
-
-
 def plots(result) -> dict:
+    """The sheet's plots: the closed-loop step (SPICE minus the analytic loop below it,
+    the controller output u in its own panel), every op-amp output, the loop gain with
+    its margins, the reaction curve."""
     w = result.waveforms
     t = w.t
     a = w.analytic
     sp = None if result.spice is None else result.spice.waves
     amp = result.opamp.name
-    curves = {f"realised loop, analytic ({amp})": a["y"], "ideal PID, ideal plant": w.ideal_pid}
+    curves = {}
     if sp is not None:
         curves["SPICE (ngspice)"] = sp["y"]
+    curves[f"realised loop, analytic ({amp})"] = a["y"]
+    curves["ideal PID, ideal plant"] = w.ideal_pid
     curves["plant alone (open loop)"] = w.open_loop
-    images = {"closed-loop.png": step_plot(t, curves, f"Closed-loop step, 0 -> {result.test.amplitude_v:g} V")}
-    cu = {"u analytic": a["u"]}
-    if sp is not None:
-        cu["u SPICE"] = sp["u"]
-    images["controller.png"] = step_plot(t, cu, "Controller output u (plant input)", "u (V)")
+    resid = None if sp is None else ("residual: SPICE minus the analytic loop", sp["y"], a["y"])
+    images = {"closed-loop.png": step_plot(t, curves, f"Closed-loop step, 0 -> {result.test.amplitude_v:g} V",
+                                           residual=resid)}
     images["blocks.png"] = _blocks_plot(result)
-    images["loop-bode.png"] = _bode_plot(result)
+    mg = result.margins
+    images["loop-bode.png"] = loop_gain_plot(w.bode_w / (2 * np.pi), w.loop_gain,
+                                             f"Loop gain with {amp} poles", mg.crossover_hz, mg.phase_margin_deg,
+                                             mg.phase_crossover_hz, mg.gain_margin_db)
     images["reaction-curve.png"] = _reaction_plot(result)
     return images
 
 
 def _blocks_plot(result) -> bytes:
-    plt = _plt()
     w = result.waveforms
     t = w.t * 1e6
     sp = None if result.spice is None else result.spice.waves
     amp = result.opamp
     sigs = [(ref, role, s) for ref, role, s in OPAMP_OUTPUTS if s in w.analytic]
-    fig, axes = plt.subplots(len(sigs), 1, figsize=(7.5, 1.5 * len(sigs)), sharex=True)
+    fig, axes = figure(7.5, 1.1 * len(sigs) + 0.6, len(sigs), 1, sharex=True)
     for ax, (ref, role, s) in zip(axes, sigs):
-        ax.plot(t, w.analytic[s], "-", lw=1.2, label="analytic")
+        ax.plot(*decimate(t, w.analytic[s]), "-", lw=1.2, label="analytic")
         if sp is not None and s in sp:
-            ax.plot(t, sp[s], "--", lw=1.2, label="SPICE")
+            ax.plot(*decimate(t, sp[s]), "--", lw=1.2, label="SPICE")
         peak = max(np.nanmax(np.abs(w.analytic[s])),
                    np.nanmax(np.abs(sp[s])) if sp is not None and s in sp else 0.0)
         if not amp.ideal and peak > 0.5 * amp.vout_max:   # rails only when the signal gets near them
@@ -312,62 +338,46 @@ def _blocks_plot(result) -> bytes:
     axes[0].legend(fontsize=7, loc="upper right")
     axes[0].set_title("Every op-amp output (red: output limits, drawn when reached)")
     axes[-1].set_xlabel("time after the step (us)")
-    return png_bytes(fig)
-
-
-def _bode_plot(result) -> bytes:
-    plt = _plt()
-    w = result.waveforms
-    L = w.loop_gain
-    f = w.bode_w / (2 * np.pi)
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 5.5), sharex=True)
-    a1.semilogx(f, 20 * np.log10(np.abs(L)))
-    a1.axhline(0, color="k", lw=0.6)
-    a2.semilogx(f, np.degrees(np.unwrap(np.angle(L))))
-    a2.axhline(-180, color="k", lw=0.6)
-    mg = result.margins
-    if math.isfinite(mg.crossover_hz):
-        for ax in (a1, a2):
-            ax.axvline(mg.crossover_hz, color="r", lw=0.8, ls="--")
-    a1.set_title(f"Loop gain with {result.opamp.name} poles: phase margin "
-                 f"{_fmt(mg.phase_margin_deg, 'deg')}")
-    a1.set_ylabel("gain (dB)")
-    a2.set_ylabel("phase (deg)")
-    a2.set_xlabel("frequency (Hz)")
-    for ax in (a1, a2):
-        ax.grid(True, which="both", alpha=0.3)
-    return png_bytes(fig)
+    return png_bytes(fig, dpi=90)
 
 
 def _reaction_plot(result) -> bytes:
-    plt = _plt()
     w = result.waveforms
     tp, yp = w.reaction_t, w.reaction_y
     c = result.tuning.curve
-    fig, ax = plt.subplots(figsize=(7.5, 4))
-    ax.plot(tp * 1e6, yp, label="plant step response")
+    fig, ax = figure(7.5, 3.6)
+    ax.plot(*decimate(tp * 1e6, yp), label="plant step response")
     if c is not None:
         tt = np.linspace(c.L_s, c.t_tangent_final_s, 50)
         ax.plot(tt * 1e6, c.slope_per_s * (tt - c.t_inflection_s) + c.y_inflection, "--", label="tangent")
         ax.plot([c.t_inflection_s * 1e6], [c.y_inflection], "o", label="inflection")
         ax.axhline(c.K, color="k", lw=0.6)
         if w.fopdt_y is not None:
-            ax.plot(tp * 1e6, w.fopdt_y, ":", label="least-squares FOPDT")
+            ax.plot(*decimate(tp * 1e6, w.fopdt_y), ":", label="least-squares FOPDT")
         ax.set_xlim(0, min(tp[-1], 6 * c.t_tangent_final_s) * 1e6)
         ax.set_title(f"Reaction curve: L = {format_eng(c.L_s, 's')}, T = {format_eng(c.T_s, 's')}")
     ax.set_xlabel("time (us)")
     ax.set_ylabel("output per volt of step")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    return png_bytes(fig)
+    return png_bytes(fig, dpi=90)
+
+
+def schematic(result):
+    """The loop's schematic (:mod:`designer.pid.schematic`) as a drawing."""
+    from .schematic import draw_loop
+    return draw_loop(build_board(result), result.opamp)
 
 
 def write_outputs(result, out_dir, name: str) -> dict:
     """``netlists/<name>.cir`` and ``reports/<name>/`` (build sheet, result.json,
-    plots) under ``out_dir``, each written atomically."""
+    plots, schematic, bom.csv) under ``out_dir``, each written atomically."""
     tick = time.perf_counter()
     images = plots(result)
-    result.files = bundle_paths(out_dir, name, images)
-    write_bundle(result.files, result.deck, images, title_of(result), sections(result), result.to_dict())
+    sheet = schematic(result)
+    images["schematic.png"] = sheet.png()
+    result.files = bundle_paths(out_dir, name, images, {"bom_csv": "bom.csv"})
+    write_bundle(result.files, result.deck, images, title_of(result), sections(result, schematic_svg=sheet.svg()),
+                 result.to_dict(), {"bom_csv": bom_csv(bom(result))})
     result.timings["report_s"] = time.perf_counter() - tick
     return result.files

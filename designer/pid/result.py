@@ -128,6 +128,8 @@ class PidResult:
     notes: list = field(default_factory=list)
     spice: SpiceRun | None = None
     verdict: Verdict | None = None
+    scope: object = None                #: designer.plant.bench.ScopeSetup of the bench test (CH2 per node)
+    package: str | None = None          #: op-amp package kind the sheet wires (None: the op-amp's default)
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
@@ -180,6 +182,7 @@ class PidResult:
                             "expected_final_v": self.expected_final_v},
             "notes": self.notes,
             "simulator": self.simulator,
+            "scope": None if self.scope is None else self.scope.to_dict(),
             "files": self.files,
         }
         return json_safe(out)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -92,10 +92,15 @@ class ToleranceBand:
     settling_time_s: Band
     r_tolerance_pct: float
     c_tolerance_pct: float
+    t_s: np.ndarray | None = field(default=None, repr=False, compare=False)    #: the envelope's grid
+    lo: np.ndarray | None = field(default=None, repr=False, compare=False)     #: lowest unit step over the corners
+    hi: np.ndarray | None = field(default=None, repr=False, compare=False)     #: highest
 
     def to_dict(self) -> dict:
         out = {}
         for f in fields(self):
+            if f.name in ("t_s", "lo", "hi"):
+                continue
             value = getattr(self, f.name)
             out[f.name] = value.to_dict() if isinstance(value, Band) else value
         return out
@@ -106,16 +111,20 @@ def tolerance_band(parts: SallenKeyParts, r_tol: float, c_tol: float, t_end: flo
     R1, R2, C1, C2 at +/- their tolerance (ideal op-amp), for the scope readings."""
     t = dense_time(t_end, 8001)
     rows = []
+    lo = hi = None
     for s in itertools.product((-1, 1), repeat=4):
         p = replace(parts, r1=parts.r1 * (1 + s[0] * r_tol), r2=parts.r2 * (1 + s[1] * r_tol),
                     c1=parts.c1 * (1 + s[2] * c_tol), c2=parts.c2 * (1 + s[3] * c_tol))
-        m = step_metrics(t, step_response(*plant_tf(p), t), final=p.gain)
+        y = step_response(*plant_tf(p), t)
+        lo = y if lo is None else np.minimum(lo, y)
+        hi = y if hi is None else np.maximum(hi, y)
+        m = step_metrics(t, y, final=p.gain)
         rows.append((p.fn_hz, p.zeta, m.overshoot_pct, m.peak_time_s, m.rise_time_s, m.settling_time_s))
     bands = []
     for column in zip(*rows):
         vals = [v for v in column if v is not None and not math.isnan(v)]
         bands.append(Band(min(vals), max(vals)) if vals else Band(None, None))
-    return ToleranceBand(*bands, r_tolerance_pct=100 * r_tol, c_tolerance_pct=100 * c_tol)
+    return ToleranceBand(*bands, r_tolerance_pct=100 * r_tol, c_tolerance_pct=100 * c_tol, t_s=t, lo=lo, hi=hi)
 
 
 @dataclass(frozen=True)
@@ -164,5 +173,173 @@ def nice_frequency_below(f: float) -> float:
         for m in (1.0, 1.5, 2.2, 3.3, 4.7, 6.8):
             v = float(f"{m * 10 ** dec:.3g}")
             if v <= f * (1 + 1e-12):
+                best = v
+    return best
+
+
+# ---- the scope and the generator, as set on the bench ---------------------------------------
+
+#: a scope screen: 10 horizontal and 8 vertical divisions
+H_DIVS, V_DIVS = 10, 8
+#: where the trigger (the rising edge) sits, in divisions from the left of the screen
+EDGE_DIV = 1.0
+
+
+def one_two_five(x: float) -> float:
+    """The smallest 1-2-5 setting (1, 2, 5 x 10^k: what scope knobs step through) at or above ``x``."""
+    k = math.floor(math.log10(x))
+    for dec in (k, k + 1):
+        for m in (1.0, 2.0, 5.0):
+            v = float(f"{m * 10.0 ** dec:.3g}")
+            if v >= x * (1 - 1e-9):
+                return v
+    return float(f"{10.0 ** (k + 1):.3g}")  # pragma: no cover - the loop always returns
+
+
+@dataclass(frozen=True)
+class Channel:
+    """One scope channel: what it probes, its volts/div (1-2-5) and where its
+    0 V sits (divisions below the screen's centre), so that the signal's whole
+    swing ``lo``..``hi`` stays on the 8 divisions."""
+
+    name: str
+    node: str
+    volts_per_div: float
+    zero_div_below_centre: float
+    lo_v: float
+    hi_v: float
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "node": self.node, "volts_per_div": self.volts_per_div,
+                "zero_div_below_centre": self.zero_div_below_centre, "lo_v": self.lo_v, "hi_v": self.hi_v}
+
+
+@dataclass(frozen=True)
+class ScopeSetup:
+    """The scope as set for the square-wave test: time/div (1-2-5) so that the
+    response settles on screen after the edge, the edge ``edge_div`` divisions
+    from the left, trigger on CH1's rising edge at ``trigger_v``, and the channels."""
+
+    time_per_div_s: float
+    edge_div: float
+    trigger_v: float
+    channels: tuple
+
+    def to_dict(self) -> dict:
+        return {"time_per_div_s": self.time_per_div_s, "edge_div": self.edge_div, "trigger_v": self.trigger_v,
+                "channels": [c.to_dict() for c in self.channels]}
+
+
+def channel(name: str, node: str, lo: float, hi: float) -> Channel:
+    """The 1-2-5 volts/div and 0 V position that fit ``lo``..``hi`` on 6 of the 8
+    divisions (a division of headroom at each edge of the screen)."""
+    lo, hi = min(lo, 0.0), max(hi, 0.0)
+    vdiv = one_two_five(max(hi - lo, 1e-6) / (V_DIVS - 2))
+    # centre the swing on the screen: 0 V this many divisions below the centre
+    zero = round(((hi + lo) / 2) / vdiv * 2) / 2
+    return Channel(name, node, vdiv, zero, lo, hi)
+
+
+def scope_setup(window_s: float, trigger_v: float, channels) -> ScopeSetup:
+    """Time/div showing ``window_s`` after the edge (the edge :data:`EDGE_DIV` in)."""
+    return ScopeSetup(one_two_five(window_s / (H_DIVS - EDGE_DIV)), EDGE_DIV, trigger_v, tuple(channels))
+
+
+def plant_scope(test: SquareTest, peak_value: float, trough_value: float,
+                settling_time_s: float) -> ScopeSetup:
+    """The plant's bench scope: CH1 the generator (0 -> amplitude), CH2 the output
+    (its peak and, on the falling edge, its undershoot), 1.2 settling times on screen
+    (at most the half period) after the trigger at half the amplitude."""
+    a = test.amplitude_v
+    window = min(1.2 * settling_time_s, test.half_period_s) if math.isfinite(settling_time_s) \
+        else test.half_period_s
+    return scope_setup(window, a / 2, (channel("CH1", "generator (R1)", 0.0, a),
+                                       channel("CH2", "U1 output", a * trough_value, a * peak_value)))
+
+
+@dataclass(frozen=True, eq=False)
+class SineCheck:
+    """The sine check (a student will try one): the resonance peak and the -3 dB
+    point of the gain, from the model and, when simulated, measured in the SPICE
+    ``.ac`` run; the sine's amplitude to set, and the curves for the Bode plot."""
+
+    amplitude_v: float                  #: generator amplitude (peak) that keeps the output in the op-amp's limits
+    dc_gain: float
+    f_peak_hz: float | None             #: None: no resonance peak (zeta >= 0.707)
+    peak_gain: float | None             #: |H| at the peak, V/V
+    f_3db_hz: float
+    spice_f_peak_hz: float | None = None
+    spice_peak_gain: float | None = None
+    spice_f_3db_hz: float | None = None
+    f_hz: np.ndarray | None = None      #: the model's sweep
+    h_model: np.ndarray | None = None
+    spice_f_hz: np.ndarray | None = None
+    h_spice: np.ndarray | None = None
+
+    def to_dict(self) -> dict:
+        return {"amplitude_v": self.amplitude_v, "dc_gain": self.dc_gain, "f_peak_hz": self.f_peak_hz,
+                "peak_gain": self.peak_gain, "f_3db_hz": self.f_3db_hz, "spice_f_peak_hz": self.spice_f_peak_hz,
+                "spice_peak_gain": self.spice_peak_gain, "spice_f_3db_hz": self.spice_f_3db_hz}
+
+
+def peak_and_corner(f, h) -> tuple:
+    """(f_peak, |H| peak, f_-3dB) of a low-pass's sampled response ``h`` on ``f``:
+    the peak refined by a parabola in log f (None when the gain never rises above its
+    DC value), the -3 dB point interpolated in log f where |H| falls below
+    |H(0)|/sqrt(2) after the peak (None when it never does)."""
+    f = np.asarray(f, float)
+    mag = np.abs(np.asarray(h))
+    dc = mag[0]
+    i = int(np.argmax(mag))
+    fp = gp = None
+    if 0 < i < mag.size - 1 and mag[i] > dc * (1 + 1e-6):
+        x = np.log(f[i - 1:i + 2])
+        y = mag[i - 1:i + 2]
+        c = np.polyfit(x - x[1], y, 2)
+        dx = -c[1] / (2 * c[0]) if c[0] < 0 else 0.0
+        dx = float(np.clip(dx, x[0] - x[1], x[2] - x[1]))
+        fp, gp = float(f[i] * math.exp(dx)), float(np.polyval(c, dx))
+    level = dc / math.sqrt(2)
+    below = np.nonzero(mag[i:] < level)[0]
+    f3 = None
+    if below.size:
+        j = i + int(below[0])
+        a, b = mag[j - 1], mag[j]
+        t = (a - level) / (a - b)
+        f3 = float(math.exp(math.log(f[j - 1]) + t * (math.log(f[j]) - math.log(f[j - 1]))))
+    return fp, gp, f3
+
+
+def sine_check(num, den, opamp: OpAmp, amplitude_v: float, fn_hz: float, spice=None) -> SineCheck:
+    """The sine check of a plant model (num, den) with natural frequency ``fn_hz``:
+    the sweep fn/100 .. 100 fn (the ``.ac`` deck's), its peak and -3 dB point, and
+    the generator amplitude: half the square wave's, lowered (1-2-5 steps) until
+    the peak output stays inside the op-amp's swing and needs at most half its slew
+    rate. ``spice``: (f, complex H) of the ``.ac`` run."""
+    from ..core.lti import freq_response
+    f = np.logspace(math.log10(fn_hz / 100), math.log10(fn_hz * 100), 1201)
+    h = freq_response(num, den, f)
+    fp, gp, f3 = peak_and_corner(f, h)
+    top = float(np.max(np.abs(h)))
+    amp = amplitude_v / 2
+    if not opamp.ideal:
+        fmax = fp or fn_hz
+        amp = min(amp, 0.9 * opamp.vout_max / top, 0.5 * opamp.slew_v_per_s / (2 * math.pi * fmax * top))
+    amp = _one_two_five_below(amp)
+    dc = float(abs(h[0]))
+    if spice is None:
+        return SineCheck(amp, dc, fp, gp, f3, f_hz=f, h_model=h)
+    fs, hs = spice
+    sfp, sgp, sf3 = peak_and_corner(fs, hs)
+    return SineCheck(amp, dc, fp, gp, f3, sfp, sgp, sf3, f, h, np.asarray(fs, float), np.asarray(hs))
+
+
+def _one_two_five_below(x: float) -> float:
+    k = math.floor(math.log10(x))
+    best = None
+    for dec in (k - 1, k):
+        for m in (1.0, 2.0, 5.0):
+            v = float(f"{m * 10.0 ** dec:.3g}")
+            if v <= x * (1 + 1e-9):
                 best = v
     return best

@@ -26,9 +26,17 @@ from ..core.opamps import OpAmp
 from ..core.ranges import RANGES
 from ..core.units import format_eng, value_code
 from ..spice.simulate import get_simulator
-from .bench import bench_period, period_check, recommend_square_wave, signal_checks, tolerance_band
+from .bench import (
+    bench_period,
+    period_check,
+    plant_scope,
+    recommend_square_wave,
+    signal_checks,
+    sine_check,
+    tolerance_band,
+)
 from .model import plant_tf, plant_tf_opamp, sensitivities
-from .netlist import plant_deck
+from .netlist import plant_ac_deck, plant_deck
 from .result import (
     Alternative,
     Comparison,
@@ -370,13 +378,26 @@ def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternati
         timings["simulation_s"] = time.perf_counter() - tick
     else:
         notes.append("SPICE simulation skipped (--no-sim): the figures are analytic only")
+    ac = None
+    if simulate:
+        # the sine check measured in SPICE: an .ac sweep of the same circuit, fn/100 .. 100 fn
+        tick = time.perf_counter()
+        fn = built.fn_hz
+        res = get_simulator(simulator).run(plant_ac_deck(built, amp, fn / 100, fn * 100, _title(built, amp)))
+        ac = (res["frequency"], res["v(out)"])
+        timings["simulation_s"] += time.perf_counter() - tick
     tick = time.perf_counter()
     bench = bench_period(test, (num_i, den_i), (num_o, den_o), period)
+    sine = sine_check(num_o, den_o, amp, amplitude_v, built.fn_hz, ac)
+    # the output's extremes over the period (per volt of square wave): the rising edge's peak, and the
+    # falling edge's undershoot below 0 V, as deep as the overshoot (superposition)
+    peak = m_o.peak_value if math.isfinite(m_o.peak_value) else built.gain
+    scope = plant_scope(test, peak, min(0.0, built.gain - peak), m_o.settling_time_s)
     timings["analytic_s"] += time.perf_counter() - tick
     return PlantResult(mode=mode, target=target, ratios=choice.ratios, ideal=choice.ideal, built=built,
                        sourcing=sourcing, alternatives=alternatives, opamp=amp, analytic=analytic,
                        analytic_opamp=analytic_opamp, time_s=tw, test=test, tolerance=tolerance, checks=checks,
-                       notes=notes, deck=deck, bench=bench, spice=spice, timings=timings)
+                       notes=notes, deck=deck, bench=bench, spice=spice, scope=scope, sine=sine, timings=timings)
 
 
 def _title(parts, amp):

@@ -1,13 +1,29 @@
-"""The Sallen-Key plant as an ngspice deck (seed 001, Figures 43-45): the
-circuit with the seed's part names, and a standalone deck of it under the
-square-wave bench test whose ``.meas`` lines print the step metrics."""
+"""The Sallen-Key plant as a part and net table, and as ngspice decks (seed
+001, Figures 43-45): the circuit with the seed's part names, a standalone deck
+of it under the square-wave bench test whose ``.meas`` lines print the step
+metrics (section IV.9), and the ``.ac`` deck of the sine check.
+
+The table (:class:`~designer.spice.deck.Netlist`) is the one description of the
+circuit: the decks, the schematic (:mod:`designer.plant.schematic`), the wiring
+table and the bill of materials are all written from it.
+
+Designators follow one scheme on every sheet, the seed's: the plant is R1, R2,
+C1, C2 and its op-amp U1; the controller (seed Figure 66) numbers its parts from
+R3 and C3 on. The seed's gain resistors of the general Sallen-Key (its R3 to
+ground and R4 in the feedback, K = (R3 + R4)/R3) would clash with the
+controller's R3 and R4, so they are R19 and R20 here.
+"""
 
 from __future__ import annotations
 
 from ..core.opamps import OpAmp
 from ..spice.deck import (
+    GROUND,
+    Amp,
+    Netlist,
+    Part,
     SquareTest,
-    add_opamp,
+    ac_lines,
     add_supplies,
     finish_deck,
     measure_lines,
@@ -16,41 +32,61 @@ from ..spice.deck import (
 )
 from .sallenkey import SallenKeyParts
 
+#: the seed's name of each plant part (its R3, R4 of the gain are R19, R20 here), by designator
+SEED_NAMES = {"R1": "R1", "R2": "R2", "C1": "C1", "C2": "C2", "R19": "R3", "R20": "R4"}
+#: designators of the gain resistors (to ground, feedback): the seed's R3 and R4
+GAIN_REFS = ("R19", "R20")
+#: the designator of each SallenKeyParts field
+FIELD_OF = {"R1": "r1", "R2": "r2", "C1": "c1", "C2": "c2", "R19": "r3", "R20": "r4"}
 
-def add_sallen_key(circuit, parts: SallenKeyParts, opamp: OpAmp, inp: str, out: str, prefix: str = ""):
-    """The Sallen-Key low-pass between nodes ``inp`` and ``out``, with the seed's
-    part names (R1, R2, C1, C2; R3, R4 for gain), optionally prefixed."""
+
+def plant_netlist(parts: SallenKeyParts, inp: str = "input", out: str = "out", prefix: str = "",
+                  amp_ref: str = "U1") -> Netlist:
+    """The Sallen-Key low-pass between nets ``inp`` and ``out`` (internal nets
+    ``v1``, ``vp``, ``vn`` with ``prefix``): R1 from the input to v1, R2 from v1
+    to the non-inverting input, C1 from there to ground, C2 from v1 to the output
+    (the positive feedback); a follower at K = 1, else R19 (inverting input to
+    ground) and R20 (output to inverting input)."""
     v1, vp, vn = f"{prefix}v1", f"{prefix}vp", f"{prefix}vn"
-    circuit.R(f"{prefix}1", inp, v1, f"{parts.r1:.6g}")
-    circuit.R(f"{prefix}2", v1, vp, f"{parts.r2:.6g}")
-    circuit.C(f"{prefix}1", vp, circuit.gnd, f"{parts.c1:.6g}")
-    circuit.C(f"{prefix}2", v1, out, f"{parts.c2:.6g}")
+    rows = [Part("R1", inp, v1, parts.r1, "input resistor"),
+            Part("R2", v1, vp, parts.r2, "to the non-inverting input"),
+            Part("C1", vp, GROUND, parts.c1, "non-inverting input to ground"),
+            Part("C2", v1, out, parts.c2, "R1-R2 node to the output (feedback)")]
     if parts.r3 is None:
-        add_opamp(circuit, f"{prefix}1", vp, out, out, opamp)
-    else:
-        circuit.R(f"{prefix}3", vn, circuit.gnd, f"{parts.r3:.6g}")
-        circuit.R(f"{prefix}4", out, vn, f"{parts.r4:.6g}")
-        add_opamp(circuit, f"{prefix}1", vp, vn, out, opamp)
+        return Netlist(tuple(rows), (Amp(amp_ref, "plant", vp, out, out),))
+    rows += [Part("R19", vn, GROUND, parts.r3, "gain: inverting input to ground (seed's R3)"),
+             Part("R20", out, vn, parts.r4, "gain: output to inverting input (seed's R4)")]
+    return Netlist(tuple(rows), (Amp(amp_ref, "plant", vp, vn, out),))
 
 
-def plant_deck(parts: SallenKeyParts, opamp: OpAmp, test: SquareTest, title: str) -> str:
-    """Standalone deck of the Sallen-Key plant under the square-wave test."""
+def _circuit(title: str, opamp: OpAmp, header: list):
     import logging
 
     from PySpice.Spice.Netlist import Circuit
     logging.getLogger("PySpice").setLevel(logging.ERROR)
-
     circuit = Circuit(title)
-    circuit.raw_spice = "\n".join([
-        f"* {title}",
+    circuit.raw_spice = "\n".join([f"* {title}", *header, opamp_library_text().rstrip()])
+    add_supplies(circuit, opamp)
+    return circuit
+
+
+def plant_deck(parts: SallenKeyParts, opamp: OpAmp, test: SquareTest, title: str) -> str:
+    """Standalone deck of the Sallen-Key plant under the square-wave test."""
+    circuit = _circuit(title, opamp, [
         f"* op-amp: {opamp.name} ({opamp.description}); supplies {opamp.vcc:g} V / {opamp.vee:g} V",
         f"* test: 0 -> {test.amplitude_v:g} V square wave at {test.frequency_hz:g} Hz, step at {test.delay_s:.4g} s",
-        "* Run: ngspice -b <this file>   (prints overshoot_pct, peak_time_s, rise_time_s, settling_time_s)",
-        opamp_library_text().rstrip(),
-    ])
-    add_supplies(circuit, opamp)
+        "* Run: ngspice -b <this file>   (prints overshoot_pct, peak_time_s, rise_time_s, settling_time_s)"])
     circuit.V("in", "input", circuit.gnd, test.source())
-    add_sallen_key(circuit, parts, opamp, "input", "out")
+    plant_netlist(parts).add_to(circuit, opamp)
     final = parts.gain * test.amplitude_v
     settle_error_source(circuit, "out", final)
     return finish_deck(circuit, test, measure_lines("out", test, final))
+
+
+def plant_ac_deck(parts: SallenKeyParts, opamp: OpAmp, f_lo: float, f_hi: float, title: str) -> str:
+    """The sine check as an ngspice deck: the same circuit driven by a 1 V AC
+    source, an ``.ac`` sweep from ``f_lo`` to ``f_hi`` (v(out) is the gain)."""
+    circuit = _circuit(title, opamp, ["* sine check: 1 V AC at the input, v(out) = gain and phase"])
+    circuit.V("in", "input", circuit.gnd, "DC 0 AC 1")
+    plant_netlist(parts).add_to(circuit, opamp)
+    return "\n".join([str(circuit).rstrip(), *ac_lines(f_lo, f_hi), ".end"]) + "\n"

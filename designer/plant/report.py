@@ -1,10 +1,17 @@
-"""The plant's build sheet, terminal summary and files (netlist, report folder),
-rendered from the typed :class:`~designer.plant.result.PlantResult` as it is:
-nothing here computes a figure of the design."""
+"""The plant's build sheet, terminal summary and files (netlist, report folder,
+``bom.csv``), rendered from the typed :class:`~designer.plant.result.PlantResult`
+as it is: nothing here computes a figure of the design.
+
+The sheet opens with what a student builds from (seed 001, IV.9, the bench test
+of Figures 46-48): the schematic, drawn from the part and net table the deck is
+written from (:mod:`designer.plant.schematic`), beside the bill of materials and
+the generator and scope settings; then the pin-level wiring, the readings to
+expect, the sine check, the checks and the comparisons."""
 
 from __future__ import annotations
 
 import io
+import math
 import time
 
 import numpy as np
@@ -13,6 +20,9 @@ from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import bundle_paths, write_bundle
 from ..report.plots import bode_plot, step_plot
+from ..report.wiring import bom_csv, bom_rows, wiring_rows
+from ..spice.deck import board
+from .netlist import SEED_NAMES, plant_netlist
 
 METRIC_ROWS = (("overshoot_pct", "overshoot Mp", lambda v: "n/a" if v is None else f"{v:.4g} %"),
                ("peak_time_s", "peak time tp", R.fmt_time),
@@ -27,38 +37,83 @@ def title_of(result) -> str:
     return f"Sallen-Key plant: fc {s.fc_hz:g} Hz, zeta {s.zeta:g}, gain {s.gain:g}"
 
 
-def sections(result, with_images: bool = True) -> list:
+def build_board(result):
+    """The plant as built on the bench: its part and net table (the deck's) in the result's package."""
+    return board(plant_netlist(result.built), result.opamp, result.package)
+
+
+#: what the plant's nets are called on the sheet
+NET_LABELS = {"input": "generator (CH1)", "v1": "node A (R1-R2-C2)", "out": "output (CH2)", "0": "ground"}
+
+
+def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     """The build sheet as (heading, blocks) sections (see :mod:`designer.report.document`)."""
-    out = [("Bill of materials", [_bill(result)]),
-           ("Wiring", [R.table(["from", "to", "part"], wiring(result.built, result.opamp))]),
+    b = build_board(result)
+    first = [R.subhead("Bill of materials"), R.table(["Ref", "Value", "Code", "Qty", "Series", "Tol.", "Package"],
+                                                     [r[:7] for r in bom(result, b)], "compact"),
+             R.subhead("Generator and scope"), *_settings(result)]
+    fig = [R.figure("schematic.png", schematic_svg, "schematic")] if with_images else []
+    out = [("Build", [R.columns(fig, first)] if with_images else first),
+           ("Wiring", [R.table(["part", "code", "from", "to"], wiring_rows(b, NET_LABELS, (result.opamp.vcc,
+                                                                                      result.opamp.vee)))]),
+           ("Bench test: what the scope shows", _bench(result)),
            ("Target and achieved", _targets(result)),
-           ("Bench test", _bench(result)),
            ("Checks", [R.table(["check", "result", "detail"],
-                               [[c.title, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]),
-           ("Sensitivity", _sensitivity(result))]
-    if result.alternatives:
-        out.append(("Alternatives (best first)", [_alternatives(result.alternatives)]))
+                               [[c.title, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])])]
     if result.spice is not None:
         out.append(("SPICE against the analytic models", _spice(result)))
+    if with_images:
+        out.append(("Plots", [R.columns([R.image("step.png", "step response: analytic and SPICE, residual")],
+                                        [R.image("bode.png", "Bode plot with the sine check's points")])]))
+    out.append(("Sensitivity", _sensitivity(result)))
+    if result.alternatives:
+        out.append(("Alternatives (best first)", [_alternatives(result.alternatives)]))
     if result.notes:
         out.append(("Notes", [R.text(n) for n in result.notes]))
-    if with_images:
-        out.append(("Plots", [R.image("step.png", "step response: analytic and SPICE"),
-                              R.image("bode.png", "Bode plot")]))
     return out
 
 
-def _bill(result):
-    b, amp, lab = result.built, result.opamp, result.sourcing.parts
-    where = {"R1": "input resistor", "R2": "to the non-inverting input", "C1": "non-inverting input to ground",
-             "C2": "R1-R2 node to the output (feedback)", "R3": "gain: inverting input to ground",
-             "R4": "gain: output to inverting input"}
-    bom = [R.part_row(ref, getattr(b, ref.lower()), "Ohm" if ref[0] == "R" else "F", role,
-                      lab[ref].series, lab[ref].tolerance_pct)
-           for ref, role in where.items() if ref in lab]
-    bom.append(["U1", amp.name, "", "", "", f"op-amp on {amp.vcc:g} V / {amp.vee:g} V"
-                + (" (follower: output to inverting input)" if b.r3 is None else "")])
-    return R.table(["Ref", "Value", "Code", "Series", "Tolerance", "Where"], bom)
+def bom(result, b=None) -> list:
+    """The bill of materials rows (:data:`designer.report.wiring.BOM_HEADER`)."""
+    b = b or build_board(result)
+    lab = result.sourcing.parts
+
+    def source(ref):
+        src = lab.get(SEED_NAMES.get(ref, ref))
+        return None if src is None else (src.series, src.tolerance_pct)
+    return bom_rows(b, source, result.opamp.name)
+
+
+def _settings(result) -> list:
+    """The generator and the scope as set (1-2-5 steps), and the sine check."""
+    ts, sc, sine = result.test, result.scope, result.sine
+    a = ts.amplitude_v
+    rows = [["generator", f"square {format_eng(ts.frequency_hz, 'Hz')}, {format_eng(a, 'V')} pk-pk, offset "
+                          f"{format_eng(a / 2, 'V')} (0 to {format_eng(a, 'V')}), into R1"]]
+    if sc is not None:
+        rows += [["time base", f"{format_eng(sc.time_per_div_s, 's')}/div, edge {sc.edge_div:g} div from the left"],
+                 ["trigger", f"CH1 rising, {format_eng(sc.trigger_v, 'V')}"]]
+        for c in sc.channels:
+            rows.append([c.name, f"{format_eng(c.volts_per_div, 'V')}/div DC, 0 V {c.zero_div_below_centre:g} div "
+                                 f"below centre: {c.node}"])
+    if sine is not None:
+        rows.append(["sine check", _sine_text(sine)])
+    return [R.table(["set", "to"], rows, "compact"),
+            R.text("Set the generator's output to High-Z (not 50 ohm): in 50-ohm mode it shows half the amplitude "
+                   "it really gives into this circuit's high input impedance; check the level on CH1.")]
+
+
+def _sine_text(sine) -> str:
+    head = f"sine {format_eng(sine.amplitude_v, 'V')} pk"
+    parts = []
+    if sine.f_peak_hz is not None:
+        g = sine.spice_peak_gain if sine.spice_peak_gain is not None else sine.peak_gain
+        f = sine.spice_f_peak_hz if sine.spice_f_peak_hz is not None else sine.f_peak_hz
+        parts.append(f"peak x{g / sine.dc_gain:.3g} at {format_eng(f, 'Hz', 3)}")
+    f3 = sine.spice_f_3db_hz if sine.spice_f_3db_hz is not None else sine.f_3db_hz
+    if f3 is not None:
+        parts.append(f"-3 dB (x0.707) at {format_eng(f3, 'Hz', 3)}")
+    return head + ": " + ", ".join(parts)
 
 
 def _targets(result):
@@ -87,13 +142,23 @@ def _bench(result):
     amp_v = ts.amplitude_v
     rows.append(["peak output", format_eng(expected.peak_value * amp_v, "V"),
                  format_eng(spice.step.peak_value * amp_v, "V") if spice else "", ""])
-    return [R.text(f"Function generator: square wave {format_eng(ts.frequency_hz, 'Hz')}, "
-                   f"{format_eng(amp_v, 'V')} peak-to-peak with {format_eng(amp_v / 2, 'V')} "
-                   f"offset (0 V to {format_eng(amp_v, 'V')}), into R1. Scope channel 1 on the input, "
-                   f"channel 2 on the op-amp output; trigger on the rising edge, "
-                   f"{format_eng(ts.half_period_s / 10, 's')}/div."),
-            R.table(["reading (rising edge)", f"expected ({result.opamp.name} model)", "SPICE",
-                     f"band from tolerances (R {tol.r_tolerance_pct:g} %, C {tol.c_tolerance_pct:g} %)"], rows)]
+    blocks = [R.table(["reading (rising edge)", f"expected ({result.opamp.name} model)", "SPICE",
+                       f"band (R {tol.r_tolerance_pct:g} %, C {tol.c_tolerance_pct:g} %)"], rows)]
+    sine = result.sine
+    if sine is not None:
+        srows = [["resonance peak", _fg(sine.f_peak_hz, sine.peak_gain, sine.dc_gain),
+                  _fg(sine.spice_f_peak_hz, sine.spice_peak_gain, sine.dc_gain) if spice else "not simulated"],
+                 ["-3 dB point", _f(sine.f_3db_hz, "Hz"), _f(sine.spice_f_3db_hz, "Hz") if spice else ""]]
+        blocks += [R.text(f"Sine check: a {format_eng(sine.amplitude_v, 'V')} peak sine, no offset; sweep the "
+                          "frequency and read the output's amplitude on CH2 against CH1 (gain relative to the "
+                          "DC gain). SPICE's figures come from an .ac run of the same circuit."),
+                   R.table(["sine", f"{result.opamp.name} model", "SPICE (.ac)"], srows)]
+    return blocks
+
+
+def _fg(f, g, dc):
+    return "none (no peak)" if f is None or g is None else f"x{g / dc:.4g} ({20 * math.log10(g / dc):+.2f} dB) at " \
+        f"{format_eng(f, 'Hz', 4)}"
 
 
 def _sensitivity(result):
@@ -137,28 +202,6 @@ def _spice(result):
             R.table(["metric", "vs ideal model", f"vs {amp}-aware model"], rows)]
 
 
-def wiring(b, amp) -> list:
-    """Point-to-point wiring for the breadboard, with the op-amp's DIP-8 pin numbers."""
-    pins = amp.pins or {}
-    def pin(name, label):
-        return f"U1 pin {pins[name]} ({label})" if name in pins else f"U1 {label}"
-    rows = [["generator output", "node A", f"R1 {R.value_code(b.r1)}"],
-            ["node A", pin("inp", "+ input"), f"R2 {R.value_code(b.r2)}"],
-            [pin("inp", "+ input"), "ground", f"C1 {R.value_code(b.c1)}"],
-            ["node A", pin("out", "output"), f"C2 {R.value_code(b.c2)}"]]
-    if b.r3 is None:
-        rows.append([pin("inn", "- input"), pin("out", "output"), "wire (voltage follower)"])
-    else:
-        rows += [[pin("inn", "- input"), "ground", f"R3 {R.value_code(b.r3)}"],
-                 [pin("out", "output"), pin("inn", "- input"), f"R4 {R.value_code(b.r4)}"]]
-    rows += [[pin("vcc", "V+"), f"{amp.vcc:+g} V supply", "100n decoupling to ground"],
-             [pin("vee", "V-"), f"{amp.vee:+g} V supply", "100n decoupling to ground"],
-             ["generator ground, scope grounds", "ground", "wire"]]
-    if pins.get("package"):
-        rows.append(["", "", f"{amp.name}: {pins['package']} pinout"])
-    return rows
-
-
 def _f(v, unit):
     return "" if v is None else format_eng(v, unit, 5)
 
@@ -179,15 +222,36 @@ def summary_text(result) -> str:
 
 
 def plots(result) -> dict:
+    """step.png (the curves, the tolerance band shaded, SPICE minus the op-amp-aware model
+    below) and bode.png (the models, SPICE's .ac points, the peak and -3 dB markers)."""
     ideal, real = result.analytic, result.analytic_opamp
     amp = result.opamp.name
-    curves = {"analytic (ideal op-amp)": ideal.response, f"analytic ({amp} model)": real.response}
+    a = result.test.amplitude_v
+    curves = {}
     if result.spice is not None:
         curves["SPICE (ngspice)"] = result.spice.response
+    curves[f"analytic ({amp} model)"] = real.response
+    curves["analytic (ideal op-amp)"] = ideal.response
+    tol = result.tolerance
+    band = None if tol.t_s is None else (tol.t_s, tol.lo * a, tol.hi * a,
+                                         f"tolerance band (R {tol.r_tolerance_pct:g} %, C {tol.c_tolerance_pct:g} %)")
+    resid = None if result.spice is None else (f"residual: SPICE minus the {amp} model",
+                                               result.spice.response, real.response)
     fn = result.built.fn_hz
-    return {"step.png": step_plot(result.time_s, curves, f"Step response, 0 -> {result.test.amplitude_v:g} V"),
+    sine = result.sine
+    measured, marks = {}, []
+    if sine is not None:
+        if sine.h_spice is not None:
+            measured["SPICE .ac"] = (sine.spice_f_hz, sine.h_spice)
+        marks += [(sine.f_peak_hz, sine.peak_gain, "peak", "kv"), (sine.f_3db_hz,
+                  None if sine.f_3db_hz is None else sine.dc_gain / math.sqrt(2), "-3 dB", "ks")]
+        if sine.spice_f_peak_hz is not None:
+            marks.append((sine.spice_f_peak_hz, sine.spice_peak_gain, "", "rv"))
+        if sine.spice_f_3db_hz is not None:
+            marks.append((sine.spice_f_3db_hz, sine.dc_gain / math.sqrt(2), "", "rs"))
+    return {"step.png": step_plot(result.time_s, curves, f"Step response, 0 -> {a:g} V", residual=resid, band=band),
             "bode.png": bode_plot({"ideal op-amp": (ideal.num, ideal.den), f"{amp} model": (real.num, real.den)},
-                                  fn / 100, fn * 100, "Plant frequency response")}
+                                  fn / 100, fn * 100, "Plant frequency response", measured, marks)}
 
 
 def waveforms_csv(result) -> str:
@@ -200,6 +264,12 @@ def waveforms_csv(result) -> str:
     return buf.getvalue()
 
 
+def schematic(result):
+    """The plant's schematic (:mod:`designer.plant.schematic`) as a drawing."""
+    from .schematic import draw_plant
+    return draw_plant(build_board(result), result.opamp)
+
+
 def write_outputs(result, out_dir, name: str) -> dict:
     """Write ``netlists/<name>.cir`` and ``reports/<name>/`` under ``out_dir``.
 
@@ -208,8 +278,10 @@ def write_outputs(result, out_dir, name: str) -> dict:
     """
     tick = time.perf_counter()
     images = plots(result)
-    result.files = bundle_paths(out_dir, name, images, {"waveforms_csv": "waveforms.csv"})
-    write_bundle(result.files, result.deck, images, title_of(result), sections(result), result.to_dict(),
-                   {"waveforms_csv": waveforms_csv(result)})
+    sheet = schematic(result)
+    images["schematic.png"] = sheet.png()
+    result.files = bundle_paths(out_dir, name, images, {"waveforms_csv": "waveforms.csv", "bom_csv": "bom.csv"})
+    write_bundle(result.files, result.deck, images, title_of(result), sections(result, schematic_svg=sheet.svg()),
+                 result.to_dict(), {"waveforms_csv": waveforms_csv(result), "bom_csv": bom_csv(bom(result))})
     result.timings["report_s"] = time.perf_counter() - tick
     return result.files

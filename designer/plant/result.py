@@ -22,7 +22,7 @@ from ..core.metrics import StepMetrics
 from ..core.opamps import OpAmp
 from ..spice.deck import SquareTest
 from ..spice.simulate import tool_info
-from .bench import BenchPeriod, ToleranceBand
+from .bench import BenchPeriod, ScopeSetup, SineCheck, ToleranceBand
 from .sallenkey import SallenKeyParts
 
 #: the step metrics a result gives, in the order of its JSON
@@ -224,6 +224,9 @@ class PlantResult:
     deck: str                        #: the standalone ngspice deck
     bench: BenchPeriod
     spice: SpiceRun | None = None
+    scope: ScopeSetup | None = None      #: the scope as set for the square-wave test
+    sine: SineCheck | None = None        #: the sine check (resonance peak, -3 dB), SPICE .ac when simulated
+    package: str | None = None           #: the op-amp package kind the sheet wires (None: the op-amp's default)
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
@@ -263,5 +266,7 @@ class PlantResult:
             "sensitivity": {"ideal": {k: s.to_dict() for k, s in self.analytic.sensitivity.items()},
                             "opamp": {k: s.to_dict() for k, s in self.analytic_opamp.sensitivity.items()}},
             "simulator": None if self.spice is None else self.spice.simulator,
+            "scope": None if self.scope is None else self.scope.to_dict(),
+            "sine_check": None if self.sine is None else self.sine.to_dict(),
             "files": self.files,
         })

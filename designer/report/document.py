@@ -1,6 +1,13 @@
-"""Build sheets: one description of the content (sections of tables, text
-and images) rendered to Markdown, self-contained printable HTML and terminal
-text, so the three never disagree."""
+"""Build sheets: one description of the content (sections of tables, text,
+images, schematics and side-by-side columns) rendered to Markdown,
+self-contained printable HTML and terminal text, so the three never disagree.
+
+The HTML prints: an ``@page`` rule whose margins suit A4 and Letter alike,
+table headers repeated on every page, no row split across pages, numbers that
+never wrap, and two-column figure rows; on screen the first section lays the
+schematic beside the bill of materials and the bench settings, so that a
+1280x800 window shows all three without scrolling.
+"""
 
 from __future__ import annotations
 
@@ -12,8 +19,9 @@ from ..core.units import format_eng, value_code
 
 # ---- content blocks ---------------------------------------------------------
 
-def table(header, rows):
-    return ("table", list(header), [list(r) for r in rows])
+def table(header, rows, cls: str = ""):
+    """A table; ``cls`` is an HTML class (``compact`` for the narrow first-page tables)."""
+    return ("table", list(header), [list(r) for r in rows], cls)
 
 
 def text(s):
@@ -24,6 +32,20 @@ def image(name, alt):
     return ("image", name, alt)
 
 
+def figure(name, svg, alt):
+    """A schematic: inline SVG in the HTML, the PNG ``name`` beside the Markdown."""
+    return ("figure", name, svg, alt)
+
+
+def columns(*cols):
+    """Blocks side by side (each argument a list of blocks); one after the other in Markdown and text."""
+    return ("columns", [list(c) for c in cols])
+
+
+def subhead(s):
+    return ("subhead", s)
+
+
 def fmt_pct(v, digits=3):
     return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:+.{digits}g} %"
 
@@ -32,61 +54,118 @@ def fmt_time(v):
     return "n/a" if v is None else format_eng(v, "s")
 
 
+def _flat(blocks):
+    for b in blocks:
+        if b[0] == "columns":
+            for col in b[1]:
+                yield from _flat(col)
+        else:
+            yield b
+
+
 # ---- renderers --------------------------------------------------------------
 
 def to_markdown(title, sections) -> str:
     out = [f"# {title}", ""]
     for heading, blocks in sections:
         out += [f"## {heading}", ""]
-        for b in blocks:
+        for b in _flat(blocks):
             if b[0] == "text":
                 out += [b[1], ""]
+            elif b[0] == "subhead":
+                out += [f"### {b[1]}", ""]
             elif b[0] == "table":
                 out.append("| " + " | ".join(b[1]) + " |")
                 out.append("|" + "---|" * len(b[1]))
                 out += ["| " + " | ".join(str(c) for c in r) + " |" for r in b[2]]
                 out.append("")
-            elif b[0] == "image":
-                out += [f"![{b[2]}]({b[1]})", ""]
+            elif b[0] in ("image", "figure"):
+                alt = b[2] if b[0] == "image" else b[3]
+                out += [f"![{alt}]({b[1]})", ""]
     return "\n".join(out).rstrip() + "\n"
 
 
-_CSS = """body{font-family:system-ui,Segoe UI,Helvetica,Arial,sans-serif;max-width:60rem;margin:2rem auto;
-padding:0 1rem;color:#111}h1{font-size:1.5rem}h2{font-size:1.15rem;border-bottom:1px solid #ccc;margin-top:1.6rem}
-table{border-collapse:collapse;margin:.5rem 0}td,th{border:1px solid #bbb;padding:.25rem .6rem;text-align:left}
-th{background:#f0f0f0}img{max-width:100%}@media print{body{margin:0}h2{page-break-after:avoid}
-img,table{page-break-inside:avoid}}"""
+_CSS = """body{font-family:system-ui,Segoe UI,Helvetica,Arial,sans-serif;max-width:84rem;margin:.6rem auto;
+padding:0 .8rem;color:#111;font-size:14px;line-height:1.3}h1{font-size:1.25rem;margin:.2rem 0 .3rem}
+h2{font-size:1.05rem;border-bottom:1px solid #ccc;margin:.9rem 0 .3rem;break-after:avoid}
+h3{font-size:.95rem;margin:.4rem 0 .2rem;break-after:avoid}p{margin:.25rem 0}
+table{border-collapse:collapse;margin:.3rem 0}td,th{border:1px solid #bbb;padding:.12rem .4rem;text-align:left;
+vertical-align:top;white-space:nowrap}td.w{white-space:normal;min-width:12rem}th{background:#f0f0f0}
+thead{display:table-header-group}tr{break-inside:avoid}table.compact{font-size:12.5px}
+.cols{display:grid;grid-template-columns:repeat(var(--n),minmax(0,1fr));gap:.4rem 1rem;align-items:start}
+.cols>div{min-width:0}.fig svg{width:100%;height:auto;max-height:30rem}img{max-width:100%}
+.plots{display:grid;grid-template-columns:1fr 1fr;gap:.5rem}.plots img{width:100%}
+@page{margin:11mm 10mm}
+@media print{body{margin:0;max-width:none;padding:0;font-size:9pt}table{font-size:8pt}table.compact{font-size:7.6pt}
+h1{font-size:12.5pt}h2{font-size:10.5pt;margin-top:.5rem}img,.fig{break-inside:avoid}.fig svg{max-height:none}
+.plots img{break-inside:avoid}}"""
+
+
+def _cell(c) -> str:
+    s = html.escape(str(c))
+    # a number never wraps; prose longer than a few words may
+    return f"<td class='w'>{s}</td>" if len(str(c)) > 34 and " " in str(c) else f"<td>{s}</td>"
+
+
+def _html_blocks(blocks, images, out):
+    e = html.escape
+    for b in blocks:
+        if b[0] == "text":
+            out.append(f"<p>{e(b[1])}</p>")
+        elif b[0] == "subhead":
+            out.append(f"<h3>{e(b[1])}</h3>")
+        elif b[0] == "table":
+            cls = f" class='{b[3]}'" if len(b) > 3 and b[3] else ""
+            out.append(f"<table{cls}><thead><tr>" + "".join(f"<th>{e(h)}</th>" for h in b[1]) + "</tr></thead><tbody>")
+            out += ["<tr>" + "".join(_cell(c) for c in r) + "</tr>" for r in b[2]]
+            out.append("</tbody></table>")
+        elif b[0] == "image" and b[1] in images:
+            data = base64.b64encode(images[b[1]]).decode()
+            out.append(f"<img alt='{e(b[2])}' src='data:image/png;base64,{data}'>")
+        elif b[0] == "figure":
+            svg = b[2]
+            svg = svg[svg.find("<svg"):] if "<svg" in svg else svg
+            out.append(f"<div class='fig' role='img' aria-label='{e(b[3])}'>{svg}</div>")
+        elif b[0] == "columns":
+            plots = all(x[0] == "image" for col in b[1] for x in col)
+            if plots:
+                out.append("<div class='plots'>")
+                for col in b[1]:
+                    _html_blocks(col, images, out)
+                out.append("</div>")
+                continue
+            out.append(f"<div class='cols' style='--n:{len(b[1])}'>")
+            for col in b[1]:
+                out.append("<div>")
+                _html_blocks(col, images, out)
+                out.append("</div>")
+            out.append("</div>")
 
 
 def to_html(title, sections, images: dict) -> str:
-    """Self-contained HTML: images are embedded as data URIs."""
+    """Self-contained HTML: images embedded as data URIs, schematics as inline SVG."""
     e = html.escape
     out = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{e(title)}</title>",
            f"<style>{_CSS}</style></head><body>", f"<h1>{e(title)}</h1>"]
     for heading, blocks in sections:
-        out.append(f"<h2>{e(heading)}</h2>")
-        for b in blocks:
-            if b[0] == "text":
-                out.append(f"<p>{e(b[1])}</p>")
-            elif b[0] == "table":
-                out.append("<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in b[1]) + "</tr>")
-                out += ["<tr>" + "".join(f"<td>{e(str(c))}</td>" for c in r) + "</tr>" for r in b[2]]
-                out.append("</table>")
-            elif b[0] == "image" and b[1] in images:
-                data = base64.b64encode(images[b[1]]).decode()
-                out.append(f"<img alt='{e(b[2])}' src='data:image/png;base64,{data}'>")
+        if heading:
+            out.append(f"<h2>{e(heading)}</h2>")
+        _html_blocks(blocks, images, out)
     out.append("</body></html>")
     return "\n".join(out) + "\n"
 
 
 def to_text(title, sections) -> str:
-    """Plain terminal rendering (tables aligned, images listed by name)."""
+    """Plain terminal rendering (tables aligned, images and schematics listed by name)."""
     out = [title, "=" * len(title)]
     for heading, blocks in sections:
-        out += ["", heading, "-" * len(heading)]
-        for b in blocks:
+        if heading:
+            out += ["", heading, "-" * len(heading)]
+        for b in _flat(blocks):
             if b[0] == "text":
                 out.append(b[1])
+            elif b[0] == "subhead":
+                out += [b[1] + ":"]
             elif b[0] == "table":
                 rows = [b[1]] + [[str(c) for c in r] for r in b[2]]
                 widths = [max(len(r[i]) for r in rows) for i in range(len(b[1]))]
@@ -96,9 +175,11 @@ def to_text(title, sections) -> str:
                         out.append("  ".join("-" * w for w in widths))
             elif b[0] == "image":
                 out.append(f"[plot: {b[1]}]")
+            elif b[0] == "figure":
+                out.append(f"[schematic: {b[1]}]")
     return "\n".join(out) + "\n"
 
 
 def part_row(ref, value, unit, role, series=None, tol_pct=None):
-    return [ref, format_eng(value, unit, 4), value_code(value), series or "", 
+    return [ref, format_eng(value, unit, 4), value_code(value), series or "",
             "" if tol_pct is None else f"{tol_pct:g} %", role]

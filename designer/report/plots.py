@@ -1,58 +1,161 @@
 """Plots for the build sheets and the identification results: matplotlib
-figures rendered to PNG bytes (imported only when a plot is drawn)."""
+figures rendered to PNG bytes (matplotlib is imported only when a plot is
+drawn, through its object API: pyplot's import and state are not needed).
+
+Curves are decimated to what a sheet's figure can show (:data:`MAX_POINTS`
+per curve): a 7.5-inch plot at 110 dpi has under a thousand pixel columns, and
+drawing 20 000-point curves only costs time. The step plot has a residual
+panel under it (SPICE minus model: the two overlap to the pixel otherwise)
+and the parts' tolerance band shaded; the Bode plot marks the resonance peak
+and the -3 dB point, measured in SPICE's ``.ac`` run beside the model's; the
+loop-gain plot marks the gain and phase margins.
+"""
 
 from __future__ import annotations
 
 import io
+import math
 
 import numpy as np
 
+#: the most points a curve is drawn with
+MAX_POINTS = 1500
 
-def png_bytes(fig) -> bytes:
-    """A matplotlib figure as PNG bytes (the figure is closed)."""
+
+def decimate(x, *ys, n: int = MAX_POINTS):
+    """``x`` and the ``ys`` at most ``n`` evenly spaced samples (the ends kept)."""
+    x = np.asarray(x)
+    if x.size <= n:
+        return (x, *[None if y is None else np.asarray(y) for y in ys])
+    idx = np.unique(np.linspace(0, x.size - 1, n).round().astype(int))
+    return (x[idx], *[None if y is None else np.asarray(y)[idx] for y in ys])
+
+
+def figure(w: float, h: float, rows: int = 1, cols: int = 1, **kw):
+    """A figure and its axes without pyplot (Agg canvas)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=(w, h))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(rows, cols, **kw)
+    return fig, axes
+
+
+def png_bytes(fig, dpi: int = 110) -> bytes:
+    """A matplotlib figure as PNG bytes (the figure is closed if pyplot owns it)."""
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-    import matplotlib.pyplot as plt
-    plt.close(fig)
+    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
+    import sys
+    if "matplotlib.pyplot" in sys.modules:
+        sys.modules["matplotlib.pyplot"].close(fig)
     return buf.getvalue()
 
 
-def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)") -> bytes:
-    """Overlaid step responses; ``curves`` maps a label to an array on ``t``."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7.5, 4))
+def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)", residual: tuple | None = None,
+              band: tuple | None = None) -> bytes:
+    """Overlaid step responses; ``curves`` maps a label to an array on ``t``.
+
+    ``residual``: (label, measured, model) drawn as measured - model in a panel
+    below; ``band``: (t, lo, hi, label) shaded behind the curves."""
+    if residual is not None:
+        fig, (ax, ar) = figure(7.5, 4.6, 2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.1]})
+    else:
+        fig, ax = figure(7.5, 3.8)
+    tus = np.asarray(t) * 1e6
+    if band is not None:
+        bt, lo, hi, label = band
+        bt, lo, hi = decimate(bt, lo, hi)
+        ax.fill_between(np.asarray(bt) * 1e6, lo, hi, color="#f4c27a", alpha=0.45, lw=0, label=label)
     styles = ["-", "--", ":", "-."]
+    widths = [2.6, 1.4, 1.4, 1.2]
     for i, (label, y) in enumerate(curves.items()):
         if y is not None:
-            ax.plot(np.asarray(t) * 1e6, y, styles[i % 4], label=label, lw=1.6 if i == 0 else 1.3)
-    ax.set_xlabel("time after the step (us)")
+            x, yy = decimate(tus, y)
+            ax.plot(x, yy, styles[i % 4], label=label, lw=widths[i % 4])
     ax.set_ylabel(ylabel)
-    ax.set_title(title)
+    ax.set_title(title, fontsize=10)
     ax.grid(True, alpha=0.3)
-    ax.legend()
-    return png_bytes(fig)
+    ax.legend(fontsize=8)
+    last = ax
+    if residual is not None:
+        label, meas, model = residual
+        x, r = decimate(tus, np.asarray(meas) - np.asarray(model))
+        ar.plot(x, r * 1e3, color="C2", lw=1.1)
+        ar.axhline(0, color="k", lw=0.6)
+        ar.set_ylabel("mV", fontsize=8)
+        ar.set_title(label, fontsize=8, loc="left")
+        ar.grid(True, alpha=0.3)
+        last = ar
+    last.set_xlabel("time after the step (us)")
+    return png_bytes(fig, dpi=100)
 
 
-def bode_plot(systems: dict, f_lo: float, f_hi: float, title: str) -> bytes:
-    """Magnitude (dB) and phase (deg) of transfer functions ``{label: (num, den)}``."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+def bode_plot(systems: dict, f_lo: float, f_hi: float, title: str, measured: dict | None = None,
+              markers: list | None = None) -> bytes:
+    """Magnitude (dB) and phase (deg) of transfer functions ``{label: (num, den)}``;
+    ``measured``: {label: (f, complex H)} drawn as points (SPICE's .ac run);
+    ``markers``: (f, gain V/V, text, style) points marked on the magnitude."""
     from ..core.lti import freq_response
-    f = np.logspace(np.log10(f_lo), np.log10(f_hi), 600)
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 5.5), sharex=True)
+    f = np.logspace(np.log10(f_lo), np.log10(f_hi), 500)
+    fig, (a1, a2) = figure(7.5, 4.6, 2, 1, sharex=True)
     for i, (label, (num, den)) in enumerate(systems.items()):
         h = freq_response(num, den, f)
         a1.semilogx(f, 20 * np.log10(np.abs(h)), ["-", "--", ":"][i % 3], label=label)
         a2.semilogx(f, np.degrees(np.unwrap(np.angle(h))), ["-", "--", ":"][i % 3], label=label)
+    for label, (fm, hm) in (measured or {}).items():
+        fm, hm = decimate(fm, hm, n=120)
+        a1.semilogx(fm, 20 * np.log10(np.abs(hm)), "o", ms=2.5, mfc="none", color="C3", label=label)
+        a2.semilogx(fm, np.degrees(np.unwrap(np.angle(hm))), "o", ms=2.5, mfc="none", color="C3", label=label)
+    for fx, g, txt, style in markers or []:
+        if fx is None or g is None:
+            continue
+        a1.plot([fx], [20 * math.log10(g)], style, ms=7, mfc="none", mew=1.5)
+        a1.annotate(txt, (fx, 20 * math.log10(g)), textcoords="offset points", xytext=(6, 4), fontsize=7.5)
+        a2.axvline(fx, color="0.5", lw=0.6, ls=":")
     a1.set_ylabel("gain (dB)")
     a2.set_ylabel("phase (deg)")
     a2.set_xlabel("frequency (Hz)")
-    a1.set_title(title)
+    a1.set_title(title, fontsize=10)
     for a in (a1, a2):
         a.grid(True, which="both", alpha=0.3)
-    a1.legend()
-    return png_bytes(fig)
+    a1.legend(fontsize=7.5, loc="lower left")
+    return png_bytes(fig, dpi=100)
+
+
+def loop_gain_plot(f, L, title: str, crossover_hz: float, phase_margin_deg: float,
+                   phase_crossover_hz: float, gain_margin_db: float) -> bytes:
+    """Loop gain |L| (dB) and phase with the margins marked: the phase margin at
+    the gain crossover, the gain margin at the -180 deg crossing."""
+    f, L = decimate(f, L)
+    mag = 20 * np.log10(np.abs(L))
+    ph = np.degrees(np.unwrap(np.angle(L)))
+    fig, (a1, a2) = figure(7.5, 4.6, 2, 1, sharex=True)
+    a1.semilogx(f, mag)
+    a1.axhline(0, color="k", lw=0.6)
+    a2.semilogx(f, ph)
+    # the -180 deg line nearest the phase curve at the crossover (the phase may be unwrapped by 360)
+    ref = -180.0
+    if math.isfinite(crossover_hz):
+        pc = float(np.interp(math.log(crossover_hz), np.log(f), ph))
+        ref = -180.0 + 360.0 * round((pc + 180.0 - phase_margin_deg) / 360.0) if math.isfinite(phase_margin_deg) \
+            else ref
+        for ax in (a1, a2):
+            ax.axvline(crossover_hz, color="r", lw=0.8, ls="--")
+        a2.annotate("", xy=(crossover_hz, pc), xytext=(crossover_hz, ref),
+                    arrowprops={"arrowstyle": "<->", "color": "r", "lw": 1.2})
+        a2.text(crossover_hz * 1.1, (pc + ref) / 2, f"PM {phase_margin_deg:.3g} deg", color="r", fontsize=8)
+    a2.axhline(ref, color="k", lw=0.6)
+    if math.isfinite(phase_crossover_hz) and math.isfinite(gain_margin_db):
+        g = float(np.interp(math.log(phase_crossover_hz), np.log(f), mag))
+        for ax in (a1, a2):
+            ax.axvline(phase_crossover_hz, color="m", lw=0.8, ls=":")
+        a1.annotate("", xy=(phase_crossover_hz, g), xytext=(phase_crossover_hz, 0),
+                    arrowprops={"arrowstyle": "<->", "color": "m", "lw": 1.2})
+        a1.text(phase_crossover_hz * 1.1, g / 2, f"GM {gain_margin_db:.3g} dB", color="m", fontsize=8)
+    a1.set_title(title, fontsize=10)
+    a1.set_ylabel("gain (dB)")
+    a2.set_ylabel("phase (deg)")
+    a2.set_xlabel("frequency (Hz)")
+    for ax in (a1, a2):
+        ax.grid(True, which="both", alpha=0.3)
+    return png_bytes(fig, dpi=100)

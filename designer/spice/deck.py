@@ -1,8 +1,12 @@
 """The parts every ngspice deck is built from, with PySpice's Circuit API:
-the square-wave bench test (:class:`SquareTest`, its PULSE source and the time
-step that resolves the response), op-amp instances and supplies from the
-project's behavioural model library, ``.meas`` lines for the step metrics, and
-the closing ``.tran``.
+the part and net table of a circuit (:class:`Netlist`: every resistor,
+capacitor and op-amp with its designator and the nets of its terminals, the one
+description that the deck, the schematic, the wiring table and the bill of
+materials are all written from), the square-wave bench test
+(:class:`SquareTest`, its PULSE source and the time step that resolves the
+response), op-amp instances and supplies from the project's behavioural model
+library, ``.meas`` lines for the step metrics, the closing ``.tran``, and the
+``.ac`` deck of the sine check.
 
 Decks are standalone: the models are inlined, so ``ngspice -b deck.cir`` alone
 prints overshoot, peak time, rise time and settling time.
@@ -21,6 +25,132 @@ from .library import library_text
 STEPS_PER_TIME_SCALE = 50
 #: a bench period needing more simulation steps than this is refused (minutes of ngspice, GBs of data)
 MAX_SIM_POINTS = 2_000_000
+
+
+#: the ground net's name in a :class:`Netlist` (SPICE's node 0)
+GROUND = "0"
+
+
+@dataclass(frozen=True)
+class Part:
+    """One resistor or capacitor: designator (``R1``, ``C3``: its first letter is
+    its kind), the nets of its two terminals, its value (ohm or farad) and its role."""
+
+    ref: str
+    a: str
+    b: str
+    value: float
+    role: str = ""
+
+    @property
+    def kind(self) -> str:
+        return self.ref[0]
+
+    @property
+    def unit(self) -> str:
+        return "Ohm" if self.kind == "R" else "F"
+
+
+@dataclass(frozen=True)
+class Amp:
+    """One op-amp of the circuit: its name in the deck (``U1``..: the designator
+    with one op-amp per package; :func:`designer.core.opamps.assign` gives the
+    package designators), its role and the nets of its inputs and output."""
+
+    ref: str
+    role: str
+    inp: str
+    inn: str
+    out: str
+
+    def nets(self) -> dict:
+        return {"inp": self.inp, "inn": self.inn, "out": self.out, "vcc": "vcc", "vee": "vee"}
+
+
+@dataclass(frozen=True)
+class Netlist:
+    """A circuit as parts and op-amps on named nets (ground is :data:`GROUND`,
+    supplies ``vcc`` and ``vee``), in the order the sheet lists them."""
+
+    parts: tuple
+    amps: tuple
+
+    def part(self, ref: str) -> Part:
+        for p in self.parts:
+            if p.ref == ref:
+                return p
+        raise KeyError(ref)
+
+    def terminals(self) -> dict:
+        """(designator, terminal) -> net, for every part (``a``, ``b``) and op-amp
+        (``inp``, ``inn``, ``out``, ``vcc``, ``vee``)."""
+        out = {}
+        for p in self.parts:
+            out[(p.ref, "a")], out[(p.ref, "b")] = p.a, p.b
+        for a in self.amps:
+            out.update({(a.ref, k): v for k, v in a.nets().items()})
+        return out
+
+    def add_to(self, circuit, opamp: OpAmp) -> None:
+        """Every part and op-amp into a PySpice circuit (element names are the designators)."""
+        node = lambda n: circuit.gnd if n == GROUND else n  # noqa: E731
+        for p in self.parts:
+            getattr(circuit, p.kind)(p.ref[1:], node(p.a), node(p.b), f"{p.value:.6g}")
+        for a in self.amps:
+            add_opamp(circuit, a.ref, node(a.inp), node(a.inn), a.out, opamp)
+
+
+#: decoupling on the bench: one ceramic per supply pin of every package, one bulk capacitor per rail
+DECOUPLING_F, BULK_F = 100e-9, 10e-6
+
+
+@dataclass(frozen=True)
+class Board:
+    """A :class:`Netlist` as built on the bench: its op-amps placed in packages
+    (``units``, one :class:`~designer.core.opamps.Unit` per op-amp, in order),
+    the spare units of the last package (tied off as followers), and the
+    decoupling the deck leaves out (ideal supplies): a ``100n`` from each
+    package's V+ and V- pin to ground (C101/C102 for U1, C201/C202 for U2 ...)
+    and a ``10u`` per rail where the supply enters (C901, C902)."""
+
+    netlist: Netlist
+    units: tuple
+    spares: tuple
+    decoupling: tuple
+    package: object
+
+    def unit_of(self, amp_ref: str):
+        """The package unit of the deck's op-amp ``amp_ref``."""
+        for a, u in zip(self.netlist.amps, self.units):
+            if a.ref == amp_ref:
+                return u
+        raise KeyError(amp_ref)
+
+    @property
+    def ics(self) -> list:
+        """Package designators (U1, U2, ...) in order."""
+        return sorted({u.ic_ref for u in self.units}, key=lambda r: int(r[1:]))
+
+    def parts(self) -> tuple:
+        """Every two-terminal part on the board: the circuit's, then the decoupling."""
+        return self.netlist.parts + self.decoupling
+
+
+def board(netlist: Netlist, opamp: OpAmp, package: str | None = None) -> Board:
+    """The bench build of ``netlist`` with ``opamp`` in ``package`` (``single``,
+    ``dual``, ``quad``; None: the op-amp's default). A kind the op-amp does not
+    come in is a :class:`~designer.core.errors.DesignError` (one line)."""
+    from ..core.opamps import assign, spare_units
+    pkg = opamp.package(package)
+    units = assign(len(netlist.amps), pkg)
+    ics = sorted({u.ic for u in units})
+    dec = []
+    for ic in ics:
+        dec += [Part(f"C{ic}01", "vcc", GROUND, DECOUPLING_F, f"U{ic} V+ (pin {pkg.vcc}) to ground, at the pin"),
+                Part(f"C{ic}02", "vee", GROUND, DECOUPLING_F, f"U{ic} V- (pin {pkg.vee}) to ground, at the pin")]
+    dec += [Part("C901", "vcc", GROUND, BULK_F, "+supply entry to ground (bulk, + to the rail)"),
+            Part("C902", GROUND, "vee", BULK_F, "-supply entry to ground (bulk, + to ground)")]
+    return Board(netlist, tuple(units), tuple(spare_units(len(units), pkg)), tuple(dec), pkg)
 
 
 @dataclass(frozen=True)
@@ -146,6 +276,11 @@ def settle_error_source(circuit, node: str, final: float, initial: float = 0.0):
     span = abs(final - initial)
     circuit.B("settle", "settle_err", circuit.gnd,
               voltage_expression=f"abs(V({node})-{final:.6g})/{span:.6g}")
+
+
+def ac_lines(f_lo: float, f_hi: float, points_per_decade: int = 200) -> list:
+    """The ``.ac`` analysis of the sine check: a decade sweep from ``f_lo`` to ``f_hi``."""
+    return [f".ac dec {points_per_decade} {f_lo:.6g} {f_hi:.6g}"]
 
 
 def finish_deck(circuit, test: SquareTest, extra_lines=(), points: int = 20000) -> str:

@@ -60,7 +60,7 @@ _MEAS_DEF = re.compile(r"^\s*\.meas\w*\s+\w+\s+(\w+)", re.I | re.M)
 #: what ngspice says when it cannot read a deck (as opposed to failing to simulate it)
 _LOAD_ERROR = re.compile(r"error on line|unknown subckt|bad syntax|no circuit loaded|unknown device|"
                          r"unable to find definition of model|could not find a valid modelname|"
-                         r"undefined (?:parameter|subcircuit)|unknown (?:model|parameter)", re.I)
+                         r"unknown model", re.I)
 
 
 def measure_names(deck: str) -> list:
@@ -151,6 +151,8 @@ def parse_raw(data: bytes) -> dict:
 def _result(vectors: dict, log: str, backend: str, deck: str) -> SimResult:
     # the raw file says v(out), the shared library out: one naming for both backends
     vectors = {re.sub(r"^v\((.*)\)$", r"\1", k.lower()): v for k, v in vectors.items()}
+    if "frequency" in vectors:
+        vectors["frequency"] = np.real(vectors["frequency"])
     if "time" in vectors:
         # ngspice can emit a repeated time point at breakpoints; keep time strictly increasing
         t = vectors["time"]
@@ -258,10 +260,13 @@ class PySpiceShared:
                 log = self._command(ng, "run")
                 errs = error_lines(log)
                 plot = ng.last_plot
-                if errs or not plot.startswith("tran"):
+                if errs or not plot.startswith(("tran", "ac")):
                     raise SimulatorError("ngspice failed: " + "; ".join(errs[:3]) if errs else
-                                         "ngspice ran no analysis: the deck has no .tran line")
-                vectors = {name: np.real(vec._data) for name, vec in ng.plot(None, plot).items()}
+                                         "ngspice ran no analysis: the deck has no .tran or .ac line")
+                # a transient's vectors are real; an .ac run's are complex (frequency included: keep
+                # it real, as the raw file reader of the other backend gives it)
+                vectors = {name: (np.asarray(vec._data) if plot.startswith("ac") else np.real(vec._data))
+                           for name, vec in ng.plot(None, plot).items()}
             finally:
                 os.chdir(old)
         return _result(vectors, load_log + "\n" + log, self.name, deck)

@@ -4,22 +4,24 @@ from designer.pid.report import sections
 
 
 def test_bill_of_materials_lists_every_part_once():
-    # regression: the plant's op-amp U7 was listed twice
+    # regression: the plant's op-amp was listed twice; one designator scheme with the plant's sheet
+    from designer.pid.report import bom
     result = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2), simulate=False)
-    bom = dict(sections(result, with_images=False))["Bill of materials"]
-    refs = [row[0] for row in bom[0][2]]
+    refs = [ref for row in bom(result) for ref in row[0].split(", ")]
     assert len(refs) == len(set(refs))
-    assert {"U1", "U6", "U7", "R3", "R18", "C3", "C4", "R1 (plant)"} <= set(refs)
+    assert {"U1", "U2", "U7", "R1", "R2", "C1", "C2", "R3", "R18", "C3", "C4"} <= set(refs)
+    ics = {row[0]: row for row in bom(result) if row[0].startswith("U")}
+    assert "plant" in ics["U1"][7] and "difference" in ics["U2"][7]
 
 
 def test_a_designed_plant_keeps_its_series_when_the_controller_uses_the_seed_parts():
     # regression: with --seed-parts the plant's parts were listed "as given"
+    from designer.pid.report import bom
     result = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2, kp=45, ti_s=43.215e-6, td_s=10.8037e-6,
                                 controller_parts=seed_parts()), simulate=False)
-    bom = dict(sections(result, with_images=False))["Bill of materials"][0][2]
-    rows = {row[0]: row for row in bom}
-    assert rows["R1 (plant)"][3] == "E24" and rows["C2 (plant)"][3] == "E12"
-    assert rows["R5"][3] == "as given"
+    rows = {ref: row for row in bom(result) for ref in row[0].split(", ")}
+    assert rows["R1"][4] == "E24" and rows["C2"][4] == "E12"
+    assert rows["R5"][4] == "as given"
 
 
 def test_renderers_read_the_typed_result_and_compute_nothing(monkeypatch):
@@ -38,7 +40,7 @@ def test_renderers_read_the_typed_result_and_compute_nothing(monkeypatch):
     for name in ("loop_gain", "assemble", "margins", "waveform_limits"):
         monkeypatch.setattr(model, name, forbidden)
     assert report.summary_text(result) == expected
-    assert set(report.plots(result)) == {"closed-loop.png", "controller.png", "blocks.png", "loop-bode.png",
+    assert set(report.plots(result)) == {"closed-loop.png", "blocks.png", "loop-bode.png",
                                          "reaction-curve.png"}
 
 

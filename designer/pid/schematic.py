@@ -1,0 +1,163 @@
+"""The whole loop's schematic: the seed's six-op-amp PID controller (001,
+Figure 66: the difference amplifier, the proportional, derivative and integral
+branches, the summer and the final gain) driving the Sallen-Key plant
+(Figures 43-45), drawn from the part and net table the deck is written from
+(:func:`designer.pid.netlist.loop_netlist` as built on the bench,
+:func:`designer.spice.deck.board`). The scope probes are the seed's: the
+reference on CH1, the plant output on CH2, and every op-amp output it
+photographs (Figures 79-90).
+"""
+
+from __future__ import annotations
+
+from ..plant.schematic import draw_plant, draw_supplies
+from ..report.schematic import Sheet
+
+#: probe tags: the reference and the output on the scope's two channels, the controller's nodes as test points
+PROBES = {"ref": "CH1", "y": "CH2", "ve": "TP ve", "vp": "TP vp", "vd": "TP vd", "vi": "TP vi", "vs": "TP vs",
+          "u": "TP u"}
+
+
+def _inverting(s, board, amp, inputs, feedback, x_in, row, x_out_min=None):
+    """One inverting stage: ``inputs`` are chains of parts drawn from (x_in, y)
+    rightwards to the inverting input at ``row`` (each chain a list of parts
+    ending on the inverting input's net, with the y of its start), ``feedback``
+    the parts in parallel from the inverting input to the output, stacked above.
+    Returns the output point (after a short lead)."""
+    unit = board.unit_of(amp.ref)
+    xa = x_in + 5.5
+    pts = s.opamp(amp, unit, board.package.part, (xa, row - 1.25), plus_on_top=False)
+    s.wire(pts["inp"], (pts["inp"][0], pts["inp"][1] - 0.6))
+    s.ground((pts["inp"][0], pts["inp"][1] - 0.6))
+    node = (xa - 0.5, row)
+    for chain, y0 in inputs:
+        x = x_in
+        for i, p in enumerate(chain):
+            width = 5.0 / len(chain) if len(chain) > 1 else 3.0
+            end = (x + width, y0)
+            s.part(p, (x, y0), end)
+            if i < len(chain) - 1:
+                s.dot(end)
+            x += width
+        if y0 == row:
+            s.wire((x, y0), pts["inn"])
+        else:
+            s.wire((x, y0), (node[0], y0), node)
+    s.dot(node)
+    out = pts["out"]
+    xo = max(out[0] + 0.6, x_out_min or 0)
+    s.wire(out, (xo, out[1]))
+    level = row
+    for p in feedback:
+        top = level + 1.3
+        s.wire((node[0], level), (node[0], top))
+        s.part(p, (node[0], top), (xo, top))
+        s.wire((xo, top), (xo, level if level != row else out[1]))
+        level = top
+    s.dot((xo, out[1]))
+    return (xo, out[1])
+
+
+def draw_loop(board, opamp, probes: dict = PROBES) -> Sheet:
+    """The closed loop of ``board`` (a :class:`~designer.spice.deck.Board` of
+    :func:`~designer.pid.netlist.loop_netlist`) on a new sheet."""
+    s = Sheet(fontsize=10)
+    n = board.netlist
+    amps = {a.role: a for a in n.amps}
+    P = n.part
+    has_d = "differentiator" in amps
+
+    def tag(pt, net, dy=0.7):
+        if net in probes:
+            s.probe(pt, probes[net], dy)
+
+    # U2 difference amplifier: r through R15 to -in, y through R17 to +in, R18 to ground, R16 feedback
+    d = amps["difference"]
+    unit = board.unit_of(d.ref)
+    pts = s.opamp(d, unit, board.package.part, (3.6, 0.0), plus_on_top=False)
+    s.net_label((0, 1.25), P("R15").a, "r", loc="left")
+    tag((0, 1.25), "ref")
+    s.part(P("R15"), (0, 1.25), (3.0, 1.25))
+    s.wire((3.0, 1.25), pts["inn"])
+    s.dot((3.0, 1.25))
+    s.net_label((0, 0), P("R17").a, "y", loc="left")
+    s.part(P("R17"), (0, 0), (2.4, 0), label_loc="bottom")
+    s.wire((2.4, 0), pts["inp"])
+    s.dot((2.4, 0))
+    s.part(P("R18"), (2.4, 0), (2.4, -2.2), label_loc="bottom")
+    s.ground((2.4, -2.2))
+    ve = (pts["out"][0] + 0.8, pts["out"][1])
+    s.wire((3.0, 1.25), (3.0, 2.8))
+    s.part(P("R16"), (3.0, 2.8), (ve[0], 2.8))
+    s.wire((ve[0], 2.8), ve, pts["out"])
+    s.dot(ve)
+    tag(ve, "ve", 0.5)
+    # the three branches fed from the ve bus
+    x_in = ve[0] + 1.2
+    rows = {"inverter": 7.0, "differentiator": 1.25, "integrator": -4.5}
+    if not has_d:
+        rows = {"inverter": 5.0, "integrator": -2.5}
+    s.wire((ve[0], ve[1]), (x_in, ve[1]))
+    s.wire((x_in, rows["integrator"]), (x_in, rows["inverter"]))
+    s.dot((x_in, ve[1]))
+    outs = {}
+    common_x = x_in + 5.5 + 3.4 + 0.6
+    outs["vp"] = _inverting(s, board, amps["inverter"], [([P("R10")], rows["inverter"])], [P("R9")], x_in,
+                            rows["inverter"], common_x)
+    s.dot((x_in, rows["inverter"]))
+    if has_d:
+        outs["vd"] = _inverting(s, board, amps["differentiator"], [([P("R12"), P("C3")], rows["differentiator"])],
+                                [P("R11")], x_in, rows["differentiator"], common_x)
+    outs["vi"] = _inverting(s, board, amps["integrator"], [([P("R14")], rows["integrator"])],
+                            [P("R13"), P("C4")], x_in, rows["integrator"], common_x)
+    for net, pt in outs.items():
+        tag(pt, net, 0.5)
+    # U6 summer: R6, R7, R8 from the branch outputs into one node
+    xs = common_x
+    summer_in = xs + 3.5
+    refs = {"vp": "R6", "vd": "R7", "vi": "R8"}
+    for net, pt in outs.items():
+        s.part(P(refs[net]), pt, (xs + 3.0, pt[1]))
+        s.wire((xs + 3.0, pt[1]), (summer_in, pt[1]))
+    ys = [pt[1] for pt in outs.values()]
+    s.wire((summer_in, min(ys)), (summer_in, max(ys)))
+    row6 = rows.get("differentiator", 1.25) - 0.625 + 0.625
+    su = amps["summer"]
+    pts = s.opamp(su, board.unit_of(su.ref), board.package.part, (summer_in + 1.4, row6 - 1.25), plus_on_top=False)
+    s.wire((summer_in, row6), pts["inn"])
+    for pt in outs.values():
+        s.dot((summer_in, pt[1])) if pt[1] not in (min(ys), max(ys)) else None
+    s.dot((summer_in, row6))
+    s.wire(pts["inp"], (pts["inp"][0], pts["inp"][1] - 0.6))
+    s.ground((pts["inp"][0], pts["inp"][1] - 0.6))
+    node = (summer_in + 0.7, row6)
+    vs = (pts["out"][0] + 0.6, pts["out"][1])
+    s.wire(node, (node[0], row6 + 2.2))
+    s.part(P("R5"), (node[0], row6 + 2.2), (vs[0], row6 + 2.2))
+    s.wire((vs[0], row6 + 2.2), vs, pts["out"])
+    s.dot(node)
+    s.dot(vs)
+    tag(vs, "vs", 0.5)
+    # U7 final gain
+    g = amps["gain"]
+    x7 = vs[0]
+    pts = s.opamp(g, board.unit_of(g.ref), board.package.part, (x7 + 3.6, vs[1] - 1.25 + 1.25 - 1.25),
+                  plus_on_top=False)
+    s.part(P("R4"), vs, (x7 + 3.0, vs[1]))
+    s.wire((x7 + 3.0, vs[1]), pts["inn"])
+    s.dot((x7 + 3.0, vs[1]))
+    s.wire(pts["inp"], (pts["inp"][0], pts["inp"][1] - 0.6))
+    s.ground((pts["inp"][0], pts["inp"][1] - 0.6))
+    u = (pts["out"][0] + 0.6, pts["out"][1])
+    s.wire((x7 + 3.0, vs[1]), (x7 + 3.0, vs[1] + 2.2))
+    s.part(P("R3"), (x7 + 3.0, vs[1] + 2.2), (u[0], vs[1] + 2.2))
+    s.wire((u[0], vs[1] + 2.2), u, pts["out"])
+    s.dot(u)
+    tag(u, "u", 0.5)
+    # the plant, below, fed from u by its net label
+    s.net_label(u, "u", "u")
+    bottom = min(rows.values()) - 6.5
+    draw_plant(board, opamp, s, origin=(0.0, bottom), inp_label="u", probes={"y": probes.get("y", "CH2")},
+               supplies=False)
+    draw_supplies(s, board, opamp, (17.5, bottom - 1.0), per_row=12)
+    return s

@@ -1,0 +1,129 @@
+"""What a student needs to buy and to wire, from a circuit's part and net table
+as built on the bench (a :class:`designer.spice.deck.Board`, read here by its
+fields): the bill of materials (grouped by value, as a parts order wants it; as
+a sheet table and as ``bom.csv``) and the pin-level wiring table.
+
+The seed built its controller on breadboards and lost time to bad contacts
+(001, end of section V.13): the wiring table lists every connection by pin, so
+that each can be checked with a meter.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+
+from ..core.units import format_eng, value_code
+
+#: bill of materials columns (bom.csv and the sheet)
+BOM_HEADER = ("Ref", "Value", "Code", "Qty", "Series", "Tolerance", "Package", "Description")
+
+
+def _package_of(part) -> str:
+    if part.kind == "R":
+        return "axial, 0.25 W metal film"
+    if part.value >= 1e-6:
+        return "radial electrolytic, 35 V"
+    if part.role.startswith("U") and "pin" in part.role:
+        return "ceramic X7R, 5 mm pitch"
+    return "film or C0G ceramic, 5 mm pitch"
+
+
+def bom_rows(board, source_of, opamp_name: str) -> list:
+    """Bill of materials rows (:data:`BOM_HEADER`), parts of one value, series and
+    package grouped on one row; ``source_of(ref)`` gives (series, tolerance in
+    percent), or None where the part is not from an E-series (decoupling)."""
+    groups, order = {}, []
+    for p in board.parts():
+        src = source_of(p.ref)
+        series, tol = src if src is not None else ("", None)
+        if src is None:   # decoupling: any 20 % part of that value
+            series, tol = "E6", 20.0
+        key = (p.kind, p.value, series, tol, _package_of(p))
+        if key not in groups:
+            groups[key] = []
+            order.append(key)
+        groups[key].append(p)
+    rows = []
+    for key in order:
+        ps = groups[key]
+        kind, value, series, tol, pkg = key
+        roles = [p.role for p in ps]
+        desc = roles[0] if len(ps) == 1 else ("decoupling, at the supply pins" if ps[0].ref[1:2] in "123456789"
+                                             and len(ps[0].ref) == 4 else "; ".join(f"{p.ref}: {p.role}"
+                                                                                   for p in ps))
+        rows.append([", ".join(p.ref for p in ps), format_eng(value, ps[0].unit, 4), value_code(value), len(ps),
+                     series, "" if tol is None else f"{tol:g} %", pkg, desc])
+    pkg = board.package
+    for ic in board.ics:
+        used = [(a, u) for a, u in zip(board.netlist.amps, board.units) if u.ic_ref == ic]
+        what = ", ".join(f"{u.designator} {a.role}" for a, u in used)
+        spare = [u.designator for u in board.spares if u.ic_ref == ic]
+        rows.append([ic, pkg.part, "", 1, "", "", pkg.pinout,
+                     f"{opamp_name} op-amp: {what}" + (f"; spare {', '.join(spare)} tied off" if spare else "")])
+    return rows
+
+
+def bom_csv(rows) -> str:
+    """``bom.csv``: the bill of materials, one header row, comma separated."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(BOM_HEADER)
+    w.writerows(rows)
+    return buf.getvalue()
+
+
+#: pin roles as the wiring table names them
+PIN_NAMES = {"inp": "+in", "inn": "-in", "out": "out"}
+
+
+def _pins_on(board, net) -> list:
+    out = []
+    for a, u in zip(board.netlist.amps, board.units):
+        for term, name in PIN_NAMES.items():
+            if getattr(a, term) == net:
+                out.append(f"{u.designator} pin {u.pins[term]} ({name})")
+    return out
+
+
+def net_text(board, net, labels: dict) -> str:
+    """A net as the wiring table names it: its label, and the op-amp pins on it by number."""
+    pins = _pins_on(board, net)
+    label = labels.get(net)
+    if pins:
+        return (f"{label}: " if label else "") + ", ".join(pins)
+    return label or f"node {net}"
+
+
+def wiring_rows(board, labels: dict, supplies: tuple) -> list:
+    """The pin-level wiring table: one row per part (from its first terminal's
+    net to its second's, each with the op-amp pins it meets), then the wires
+    between op-amp pins that no part joins (a follower's output to its -in),
+    the supply pins of every package with their decoupling, the spare units'
+    tie-off, and the pins left open. ``labels``: net -> what to call it;
+    ``supplies``: (V+, V-) volts."""
+    rows = [[p.ref, value_code(p.value), net_text(board, p.a, labels), net_text(board, p.b, labels)]
+            for p in board.netlist.parts]
+    for a, u in zip(board.netlist.amps, board.units):
+        if a.inn == a.out:
+            rows.append(["wire", "", f"{u.designator} pin {u.pins['out']} (out)",
+                         f"{u.designator} pin {u.pins['inn']} (-in): follower"])
+        if a.inp == "0":
+            rows.append(["wire", "", f"{u.designator} pin {u.pins['inp']} (+in)", "ground"])
+    pkg = board.package
+    vcc, vee = supplies
+    for ic in board.ics:
+        n = ic[1:]
+        rows.append(["wire", "", f"{ic} pin {pkg.vcc} (V+)", f"{vcc:+g} V rail; C{n}01 100n to ground at the pin"])
+        rows.append(["wire", "", f"{ic} pin {pkg.vee} (V-)", f"{vee:+g} V rail; C{n}02 100n to ground at the pin"])
+        if pkg.unused:
+            rows.append(["open", "", f"{ic} pins " + ", ".join(str(k) for k in pkg.unused),
+                         "; ".join(sorted(set(pkg.unused.values())))])
+    for u in board.spares:
+        rows.append(["wire", "", f"{u.designator} pin {u.pins['inp']} (+in)", "ground (spare unit)"])
+        rows.append(["wire", "", f"{u.designator} pin {u.pins['out']} (out)",
+                     f"{u.designator} pin {u.pins['inn']} (-in): spare as a follower, so it cannot oscillate"])
+    rows.append(["wire", "", "supply 0 V, generator ground, scope grounds", "ground (one star point)"])
+    rows.append(["C901, C902", "10u", f"{vcc:+g} V and {vee:+g} V where the supply enters",
+                 "ground (mind the polarity)"])
+    return rows
