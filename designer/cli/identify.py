@@ -28,7 +28,7 @@ from ..core.fileio import (
 from ..core.jsonio import json_safe
 from ..core.ranges import RANGES, help_range, parse_in_range
 from ..core.units import parse_value
-from ..identify.io import FREQ_UNITS, GAIN_UNITS, MAX_POINTS, PHASE_UNITS
+from ..identify.io import FORMAT_NAMES, FORMATS, FREQ_UNITS, GAIN_UNITS, MAX_POINTS, PHASE_UNITS
 from .common import OneLineParser, print_output, run_cli
 
 IDENTIFY_EPILOG = """\
@@ -41,12 +41,25 @@ examples:
         compare fn, zeta, gain and overshoot with the design and its part tolerances
   identify sq330.csv --plot fit.png            # a 330 Hz square wave: steps averaged
   identify capture.csv --methods smith,alfaro,least-squares
+  identify TEK0001.CSV --window 0 7m           # only the stretch from 0 to 7 ms
+  identify scope.csv --format rigol-no-x       # read as that layout, whatever it looks like
 
-input layouts: generic CSV (comma, semicolon with decimal comma, tab), Tektronix
-TDS/TBS and MSO/DPO exports, Rigol X,CH1,Start,Increment exports, design-plant /
-design-pid waveforms (time_s,...). With two signals the first is the input and
-the second the output unless their names say otherwise (u/vin/in, y/vout/out);
+input layouts (--format, recognised when not given): {formats}.
+Generic CSV: comma, semicolon, tab or space separated, decimal commas, CRLF, a
+BOM, '#' comments (non-UTF-8 bytes in them are fine). The format read is printed
+and is "format" in the JSON. With two signals the first is the input and the
+second the output unless their names say otherwise (u/vin/in, y/vout/out);
 --input-column/--output-column choose by name or column number.
+
+data: the step time and amplitude come from the input's edges; without an
+input, from the output's own (the step at its last sample at rest, or t = 0 if
+it is still at rest there; the record cut where its next, opposite edge starts).
+A square wave's full edges are averaged coherently, rising and falling apart,
+and the noise is taken from the averaged plateaus. The baseline is the settled
+stretch just before the edge. A straight ramp or a flat top at a rail marks the
+record non-linear (no model valid); a time constant below the sample interval or
+a least-squares parameter with a confidence interval wider than itself is not
+valid. Quantised (8-bit) data have at least one LSB/sqrt(12) of noise.
 
 methods: first order (ziegler-nichols, hagglund, smith, sundaresan-krishnaswamy,
 nishikawa, alfaro, broida, chen-yang, ho, viteckova), double pole
@@ -56,8 +69,8 @@ peeling, dc-motor), and least-squares fits (fopdt, overdamped, underdamped)
 with 95 % confidence intervals. Parameters: K, tau_s, theta_s; K, wn_rad_s,
 zeta, theta_s; K, tau1_s, tau2_s, theta_s.
 
-limits: a capture of at most {size} and {rows:,} samples; every time
-{t_rng} and the record {span_rng} long; every sample {v_rng}
+limits: a capture of at most {size} and {rows:,} samples; every time (and
+--step-time, --window) {t_rng} and the record {span_rng} long; every sample {v_rng}
 (file units); the output's step {step_rng} in size.
 
 exit status: 0 success, 2 bad input (one line on stderr saying what and why).
@@ -161,7 +174,11 @@ def _output_options(p, plot_help: str, json_first: bool = False) -> None:
 
 def identify_epilog() -> str:
     """The ``identify --help`` epilog with the input limits filled in."""
-    return IDENTIFY_EPILOG.format(size=size_text(MAX_CAPTURE_BYTES), rows=MAX_CAPTURE_ROWS,
+    import textwrap
+    formats = textwrap.fill(", ".join(f"{k} ({v})" for k, v in FORMAT_NAMES.items()), 80,
+                            initial_indent=" " * 48)[48:]
+    return IDENTIFY_EPILOG.format(formats=formats, size=size_text(MAX_CAPTURE_BYTES),
+                                  rows=MAX_CAPTURE_ROWS,
                                   t_rng=RANGES["capture_time_s"].text(),
                                   span_rng=RANGES["capture_span_s"].text(),
                                   v_rng=RANGES["capture_value"].text(),
@@ -192,12 +209,18 @@ def build_parser() -> argparse.ArgumentParser:
                 identify_epilog(), "CSV file with the step response", "capture")
     p.add_argument("--step-time", metavar="T",
                    help="when the input stepped, in seconds " + help_range("capture_time_s")
-                        + " (default: from the input column, else t = 0 if the record spans "
-                          "it, else the first sample)")
+                        + " (default: from the input column, else from the output's own edge: "
+                          "t = 0 if it is still at rest there, else its last sample at rest)")
     p.add_argument("--step-amplitude", metavar="A",
                    help="input step size in input units, either sign, size "
                         + help_range("step_amplitude")
                         + " (default: from the input column, else 1)")
+    p.add_argument("--window", nargs=2, metavar=("T0", "T1"),
+                   help="use only the samples from T0 to T1 seconds, each "
+                        + help_range("capture_time_s") + ", T0 < T1 (default: the whole record)")
+    p.add_argument("--format", choices=("auto",) + FORMATS, default="auto", type=_lower,
+                   help="read the file as this layout (default: auto, recognised from its "
+                        "header)")
     p.add_argument("--input-column", metavar="NAME|N",
                    help="input column by header name or number (time is 1); 'none' ignores it")
     p.add_argument("--output-column", metavar="NAME|N", help="output column by name or number")
@@ -218,11 +241,16 @@ def identify_capture(args):
 
     t_step = None if args.step_time is None else step_time(args.step_time)
     amp = None if args.step_amplitude is None else step_amplitude(args.step_amplitude)
+    window = None
+    if args.window is not None:
+        from ..identify.preprocess import check_window
+        window = check_window([parse_in_range(v, f"--window {which}", "capture_time_s")
+                               for v, which in zip(args.window, ("T0", "T1"))])
     if args.plot:
         check_output_path(args.plot, "--plot")
     # The file is read before scipy is imported, so bad input fails fast.
     cap = read_capture(args.capture, input_column=args.input_column,
-                       output_column=args.output_column)
+                       output_column=args.output_column, fmt=args.format)
     from ..identify.against import compare_with_design, load_design
     from ..identify.step import identify_step
     design = load_design(args.against) if args.against else None
@@ -231,7 +259,7 @@ def identify_capture(args):
         u = None if amp is not None else u
     result = identify_step(cap.t, cap.y, u, step_time=t_step, step_amplitude=amp,
                            methods=args.methods, refine=not args.no_refine,
-                           capture=cap.info())
+                           capture=cap.info(), window=window)
     if design is not None:
         result.comparison = compare_with_design(result, design)
     return result

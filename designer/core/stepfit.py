@@ -164,7 +164,7 @@ class StepFit:
     note: str = ""        #: why not, when it does not
 
 
-def fit_step(model: str, t, y, yf, start: dict | None = None) -> StepFit:
+def fit_step(model: str, t, y, yf, start: dict | None = None, sigma: float | None = None) -> StepFit:
     """Least-squares fit of ``model`` to a step response.
 
     Parameters
@@ -177,6 +177,8 @@ def fit_step(model: str, t, y, yf, start: dict | None = None) -> StepFit:
         Initial parameters ``{"model", "params"}`` (a classical estimate);
         converted when it belongs to another model (FOPDT or double pole ->
         overdamped).
+    sigma : float, optional
+        Noise of ``y`` when the caller measured it (else :func:`noise_sigma`).
 
     Returns
     -------
@@ -220,7 +222,7 @@ def fit_step(model: str, t, y, yf, start: dict | None = None) -> StepFit:
         params["tau1_s"], params["tau2_s"] = params["tau2_s"], params["tau1_s"]
         if "tau1_s" in ci and "tau2_s" in ci:
             ci["tau1_s"], ci["tau2_s"] = ci["tau2_s"], ci["tau1_s"]
-    valid, note = _check(model, params, y, yf, best)
+    valid, note = _check(model, params, y, yf, best, sigma)
     return StepFit(model, {k: float(params[k]) for k in names}, ci, int(tf.size),
                    float(math.sqrt(2 * best.cost / tf.size)) * scale, valid, note)
 
@@ -251,10 +253,10 @@ def _confidence(model, sol, n):
     return out
 
 
-def _check(model, params, y, yf, sol):
+def _check(model, params, y, yf, sol, sigma=None):
     """Validity of the fitted structure against the data."""
     os_pct = 100.0 * (float(np.max(np.sign(yf) * np.asarray(y))) - abs(yf)) / abs(yf)
-    sig_pct = 100.0 * noise_sigma(y) / abs(yf)
+    sig_pct = 100.0 * (noise_sigma(y) if sigma is None else sigma) / abs(yf)
     if model == "underdamped":
         if params["zeta"] >= 0.99:
             return False, ("fitted zeta reached the bound 1: the data are not underdamped; "

@@ -1,8 +1,11 @@
 """First-order-plus-dead-time (and double-pole) methods of seed 000, section 3.1.
 
-Every method has the signature ``method(t, y, yf) -> MethodResult`` where ``t``
-is time since the step (s), ``y`` the response deviation divided by the input
-amplitude and ``yf`` its settled value (the static gain K). Thresholds are
+Every method has the signature ``method(t, y, yf, sigma=None) -> MethodResult``
+where ``t`` is time since the step (s), ``y`` the response deviation divided by
+the input amplitude, ``yf`` its settled value (the static gain K) and ``sigma``
+the noise of ``y`` when the caller measured it (an averaged square wave's
+ripple, which :func:`~designer.core.waveform.noise_sigma` cannot see), else
+estimated here. Thresholds are
 always fractions of the change, y0 + p (yf - y0), with y0 = 0 here because
 ``y`` is already relative to the baseline.
 
@@ -148,12 +151,12 @@ def _points_ok(name, model, times, K):
 
 # --------------------------------------------------------------------------- tangent
 
-def ziegler_nichols(t, y, yf) -> MethodResult:
+def ziegler_nichols(t, y, yf, sigma=None) -> MethodResult:
     """Ziegler-Nichols reaction curve (seed 000 eq. 7, fig. 3).
 
     Validity: monotonic S-shaped response with an identifiable inflection.
     """
-    sigma = noise_sigma(y)
+    sigma = noise_sigma(y) if sigma is None else sigma
     tg = inflection_tangent(t, y, yf, sigma=sigma)
     theta = tg.t_base
     t3 = tg.t_level(yf)
@@ -163,9 +166,9 @@ def ziegler_nichols(t, y, yf) -> MethodResult:
                     "t1_s": theta, "t3_s": t3, "window_s": tg.window_s}, valid, note)
 
 
-def hagglund(t, y, yf) -> MethodResult:
+def hagglund(t, y, yf, sigma=None) -> MethodResult:
     """Hägglund: ZN dead time, tau to the 63.2 % point (seed 000 fig. 3)."""
-    sigma = noise_sigma(y)
+    sigma = noise_sigma(y) if sigma is None else sigma
     tg = inflection_tangent(t, y, yf, sigma=sigma)
     theta = tg.t_base
     t2 = _cross(t, y, yf, 0.632, sigma)
@@ -183,9 +186,9 @@ def _cross(t, y, yf, p, sigma):
     return crossing_time(t, sgn * np.asarray(y), p * abs(yf), sigma=sigma)
 
 
-def two_point(row: TwoPoint, t, y, yf) -> MethodResult:
+def two_point(row: TwoPoint, t, y, yf, sigma=None) -> MethodResult:
     """General two-point method: tau = a t1 + b t2, theta = c t1 + d t2 (seed 000 eq. 16)."""
-    sigma = noise_sigma(y)
+    sigma = noise_sigma(y) if sigma is None else sigma
     t1 = _cross(t, y, yf, row.p1, sigma)
     t2 = _cross(t, y, yf, row.p2, sigma)
     bad = _points_ok(row.name, row.model, [t1, t2], yf)
@@ -202,7 +205,7 @@ def _pct_key(p):
     return f"t{100 * p:g}_s".replace(".", "_")
 
 
-def nishikawa(t, y, yf) -> MethodResult:
+def nishikawa(t, y, yf, sigma=None) -> MethodResult:
     """Nishikawa areas (seed 000 eq. 13-15).
 
     A0 is the signed area between yf and y (the seed writes |.|; for the
@@ -212,7 +215,7 @@ def nishikawa(t, y, yf) -> MethodResult:
     """
     t = np.asarray(t, float)
     y = np.asarray(y, float)
-    sigma = noise_sigma(y)
+    sigma = noise_sigma(y) if sigma is None else sigma
     a0 = float(np.trapezoid(yf - y, t))
     t0 = a0 / yf
     if not (math.isfinite(t0) and t[0] < t0 < t[-1]):
@@ -230,17 +233,17 @@ def nishikawa(t, y, yf) -> MethodResult:
                    valid, note)
 
 
-def smith(t, y, yf):
-    return two_point(TABLE_II[4], t, y, yf)
+def smith(t, y, yf, sigma=None):
+    return two_point(TABLE_II[4], t, y, yf, sigma)
 
 
-def sundaresan_krishnaswamy(t, y, yf):
-    return two_point(SUNDARESAN, t, y, yf)
+def sundaresan_krishnaswamy(t, y, yf, sigma=None):
+    return two_point(SUNDARESAN, t, y, yf, sigma)
 
 
 def _bind(row):
-    def method(t, y, yf):
-        return two_point(row, t, y, yf)
+    def method(t, y, yf, sigma=None):
+        return two_point(row, t, y, yf, sigma)
     method.__name__ = row.name.replace("-", "_")
     method.__doc__ = (f"{row.name}: {100 * row.p1:g} % and {100 * row.p2:g} % points, "
                       f"{row.model} (seed 000 Table {'III' if row.model != 'fopdt' else 'II'}).")

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..core.errors import DesignError
 from ..core.ranges import RANGES
-from ..core.waveform import crossing_time, noise_sigma
+from ..core.waveform import crossing_time, noise_sigma, quantum
 
 #: Fraction of the post-step record used as the settled tail for yf.
 TAIL_FRACTION = 0.1
@@ -40,6 +40,8 @@ SETTLE_TOL = 0.02
 MAX_WORK_SAMPLES = 40000
 #: Fewest samples a step response may have.
 MIN_SAMPLES = 10
+#: Fewest samples at rest before a step for a baseline.
+MIN_REST = 3
 
 
 def number_text(v) -> str:
@@ -124,19 +126,24 @@ class Edge:
     index: int
     before: float
     after: float
+    rest: int = 0     #: the last sample still at the level before the edge (below 25 %)
 
     @property
     def amplitude(self) -> float:
         return self.after - self.before
 
 
-def find_edges(t, u) -> list:
-    """Transitions of a two-level input (a step or a square wave).
+def find_edges(t, u, *, plateaus: bool = False) -> list:
+    """Transitions of a two-level signal (a step or a square wave).
 
-    Levels are the 5th and 95th percentiles; a transition is counted when the
-    signal moves from below 25 % to above 75 % of the span (or back), so noise
-    near a level never makes a false edge. Each edge's time is the interpolated
-    50 % crossing; its levels are the means of the settled parts of the
+    Levels are the record's two ends when they differ (a single step), else
+    the 1st and 99th percentiles (an input's square wave); with ``plateaus``,
+    always the medians of the samples below and above the midrange (an
+    output, whose overshoot would stretch percentiles past its plateaus and
+    whose record may end in the middle of its next edge). A transition is counted when the signal moves from
+    below 25 % to above 75 % of the span (or back), so noise near a level
+    never makes a false edge. Each edge's time is the interpolated 50 %
+    crossing; its levels are the means of the settled parts of the
     neighbouring plateaus.
     """
     t = np.asarray(t, float)
@@ -146,7 +153,12 @@ def find_edges(t, u) -> list:
     # close to either end), else robust extremes (a square wave).
     k = max(3, u.size // 200)
     a, b = float(np.median(u[:k])), float(np.median(u[-k:]))
-    if abs(b - a) > MIN_STEP_SNR * sigma and abs(b - a) > 0:
+    if plateaus:
+        lo, hi = np.percentile(u, [1, 99])
+        if hi > lo:
+            mid = 0.5 * (lo + hi)
+            lo, hi = float(np.median(u[u < mid])), float(np.median(u[u >= mid]))
+    elif abs(b - a) > MIN_STEP_SNR * sigma and abs(b - a) > 0.1 * float(np.ptp(u)):
         lo, hi = min(a, b), max(a, b)
     else:
         lo, hi = np.percentile(u, [1, 99])
@@ -179,7 +191,7 @@ def find_edges(t, u) -> list:
         # Plateau levels from their second halves, where the input has settled.
         before = float(np.mean(prev[prev.size // 2:])) if prev.size else float(a)
         after = float(np.mean(nxt[nxt.size // 2:])) if nxt.size else float(b)
-        edges.append(Edge(time=te, index=j, before=before, after=after))
+        edges.append(Edge(time=te, index=j, before=before, after=after, rest=i_last))
     return edges
 
 
@@ -195,6 +207,52 @@ def baseline(t, y, t_step: float) -> tuple:
     if pre.size == 0:
         return float(y[0]), 0
     return float(np.mean(pre)), int(pre.size)
+
+
+@dataclass(frozen=True)
+class Rest:
+    """The settled stretch of the output just before a step: its ``level``
+    (the baseline), its ``samples``, and how far the whole pre-step record
+    strays from that level (``moved``, output units)."""
+
+    level: float
+    samples: int
+    moved: float
+
+
+def settled_before(y_pre, sigma: float, span: float) -> Rest | None:
+    """The settled stretch at the end of the pre-step samples ``y_pre``.
+
+    Walking back from the edge, the stretch lasts while a 5-sample moving mean
+    stays within max(4 sigma, :data:`SETTLE_TOL` of the step) of the level of
+    the last samples: a pre-trigger record that rings or drifts earlier (a
+    switching node, the previous half period) does not move the baseline.
+    None when there is no sample.
+    """
+    y_pre = np.asarray(y_pre, float)
+    n = y_pre.size
+    if n == 0:
+        return None
+    tol = max(4.0 * sigma, SETTLE_TOL * abs(span))
+    ref = float(np.median(y_pre[-min(n, 5):]))
+    m = min(5, n)
+    c = np.concatenate(([0.0], np.cumsum(y_pre - ref)))
+    ma = (c[m:] - c[:-m]) / m                      # mean of samples i .. i+m-1
+    off = np.abs(ma) > tol
+    k = _last_true(off)
+    start = 0 if k < 0 else k + m
+    start = min(start, n - 1)
+    level = float(np.mean(y_pre[start:]))
+    moved = float(np.max(np.abs(ma))) if ma.size else 0.0
+    return Rest(level=level, samples=n - start, moved=moved)
+
+
+def _last_true(mask) -> int:
+    """Index of the last True of a boolean array, -1 if none."""
+    if not mask.size:
+        return -1
+    k = int(np.argmax(mask[::-1]))
+    return mask.size - 1 - k if mask[mask.size - 1 - k] else -1
 
 
 def final_value(t, y, y0: float, *, sigma: float | None = None) -> float:
@@ -256,6 +314,15 @@ class PreparedStep:
     block-averaged to at most MAX_WORK_SAMPLES. ``t_raw``/``y_raw`` are the
     full-resolution data the IAE/ISE are computed against (original units, the
     step at ``t_step``).
+
+    ``sigma`` is the noise of the output (its units): at least the rounding
+    noise of its quantisation step ``lsb``, and for an averaged square wave
+    the spread of the averaged plateaus (switching ripple, hum).
+    ``work_sigma`` is the noise of ``y`` as the methods must assume it.
+    ``dt`` is the record's sample interval. ``n_steps`` edges were averaged
+    (``rising`` and ``falling`` say which way they went; only one way is
+    averaged, the other is compared with it). ``nonlinear`` says why the
+    record is not a linear plant's response ("" when nothing says so).
     """
 
     t: np.ndarray
@@ -270,6 +337,13 @@ class PreparedStep:
     y_raw: np.ndarray
     n_steps: int = 1
     notes: list = field(default_factory=list)
+    dt: float = math.nan
+    work_sigma: float = 0.0
+    lsb: float = 0.0
+    nonlinear: str = ""
+    rising: int = 0
+    falling: int = 0
+    window: tuple | None = None
 
     @property
     def gain(self) -> float:
@@ -281,8 +355,13 @@ class PreparedStep:
                 "noise_sigma": self.sigma,
                 "noise_pct_of_step": (100.0 * self.sigma / abs(self.y_final - self.y0)
                                       if self.y_final != self.y0 else None),
+                "quantisation_step": self.lsb or None,
+                "sample_interval_s": self.dt,
                 "samples": int(self.t_raw.size), "work_samples": int(self.t.size),
-                "steps_averaged": self.n_steps, "notes": list(self.notes)}
+                "steps_averaged": self.n_steps, "edges_averaged": self.n_steps,
+                "rising_edges": self.rising, "falling_edges": self.falling,
+                "window_s": list(self.window) if self.window else None,
+                "nonlinear": self.nonlinear or None, "notes": list(self.notes)}
 
 
 def _check_step(y0, yf, sigma, what="the response"):
@@ -306,8 +385,27 @@ def _check_amplitude(amp: float, what: str) -> float:
     return float(amp)
 
 
+def check_window(window, t=None) -> tuple:
+    """``(t0, t1)`` of ``--window``: both inside ``RANGES["capture_time_s"]``,
+    t0 < t1, and (given the record's times ``t``) holding at least
+    :data:`MIN_SAMPLES` samples."""
+    t0, t1 = (float(v) for v in window)
+    for v, what in ((t0, "start"), (t1, "end")):
+        RANGES["capture_time_s"].check(v, f"the window's {what} (s)", shown=number_text(v))
+    if not t0 < t1:
+        raise DesignError(f"the window must start before it ends; got {number_text(t0)} s to "
+                          f"{number_text(t1)} s")
+    if t is not None:
+        n = int(np.searchsorted(t, t1, "right") - np.searchsorted(t, t0, "left"))
+        if n < MIN_SAMPLES:
+            raise DesignError(f"the window {number_text(t0)} s to {number_text(t1)} s holds "
+                              f"{n} samples of the record [{t[0]:.6g}, {t[-1]:.6g}] s; at least "
+                              f"{MIN_SAMPLES} are needed")
+    return t0, t1
+
+
 def prepare_step(t, y, u=None, *, step_time: float | None = None,
-                 step_amplitude: float | None = None) -> PreparedStep:
+                 step_amplitude: float | None = None, window=None) -> PreparedStep:
     """Normalise a capture to a unit step response (see module docstring).
 
     Parameters
@@ -316,128 +414,432 @@ def prepare_step(t, y, u=None, *, step_time: float | None = None,
         Time (s, strictly increasing) and output.
     u : array_like, optional
         Input; its edges give the step time(s) and amplitude. Several edges (a
-        square wave) are split into steps, normalised and averaged.
+        square wave) are averaged coherently, rising and falling apart.
     step_time, step_amplitude : float, optional
-        When there is no input column (or to override it). Without either,
-        the step is taken at t = 0 when the record spans it (scope trigger
-        convention), else at the first sample; the amplitude defaults to 1.
+        When there is no input column (or to override it). Without a step
+        time, the output's own edges give it: the last sample at rest before
+        the output moves, or t = 0 when the output is still at rest there (the
+        scope's trigger); the amplitude defaults to 1.
+    window : (float, float), optional
+        Use only the samples from ``window[0]`` to ``window[1]`` seconds.
     """
     t = np.asarray(t, float)
     y = np.asarray(y, float)
     check_samples(t, y, *([] if u is None else [u]))
     notes = []
+    if window is not None:
+        t0, t1 = check_window(window, t)
+        keep = slice(int(np.searchsorted(t, t0, "left")), int(np.searchsorted(t, t1, "right")))
+        t, y = t[keep], y[keep]
+        u = None if u is None else np.asarray(u, float)[keep]
+        window = (t0, t1)
+        notes.append(f"window {t0:.6g} s to {t1:.6g} s: {t.size} samples used")
     if step_amplitude is not None:
         _check_amplitude(step_amplitude, "the step amplitude")
     if step_time is not None:
         RANGES["capture_time_s"].check(step_time, "the step time", shown=number_text(step_time))
-    edges = []
-    if u is not None and step_time is None:
+    lsb = quantum(y)
+    if step_time is not None:
+        prep = _given_step(t, y, u, float(step_time), step_amplitude, notes)
+    elif u is not None:
         edges = find_edges(t, u)
         if not edges:
             raise DesignError("no step in the input column: it never moves between two levels "
                               "by more than the noise; give --step-time (and --step-amplitude) "
                               "or check the column order (t,u,y)")
-    if len(edges) >= 2:
-        return _prepare_square(t, y, edges, step_amplitude, notes)
-    if edges:
-        e = edges[0]
-        t_step = e.time
-        # A given amplitude is a size; the edge says which way it went.
-        amp = math.copysign(step_amplitude, e.amplitude) if step_amplitude is not None \
-            else _check_amplitude(e.amplitude, "the input column's step")
-        notes.append(f"step detected in the input at t = {t_step:.6g} s, amplitude {amp:.6g}")
+        prep = _from_edges(t, y, edges, step_amplitude, notes, source="input",
+                           first_sample_ok=False)
     else:
-        if step_time is not None:
-            if not (math.isfinite(step_time) and t[0] <= step_time < t[-1]):
-                raise DesignError(f"step time {number_text(step_time)} s is outside the record "
-                                  f"[{t[0]:.6g}, {t[-1]:.6g}] s")
-            t_step = float(step_time)
-        elif t[0] < 0.0 <= t[-1]:
-            t_step = 0.0
-            notes.append("no input column: step assumed at t = 0 (the trigger); "
-                         "pass --step-time otherwise")
+        edges = find_edges(t, y, plateaus=True)
+        if edges:
+            prep = _from_edges(t, y, edges, step_amplitude, notes, source="output",
+                               first_sample_ok=window is None)
         else:
-            t_step = float(t[0])
-            notes.append(f"no input column: step assumed at the first sample, t = {t_step:.6g} s; "
-                         "pass --step-time otherwise")
-        if step_amplitude is not None:
-            amp = float(step_amplitude)
-        elif u is not None:
-            amp = _check_amplitude(_amplitude_from_u(t, u, t_step), "the input column's step")
-        else:
-            amp = 1.0
-            notes.append("no input amplitude: gain is per unit input (pass --step-amplitude)")
-    y0, n_pre = baseline(t, y, t_step)
-    if n_pre == 0:
-        notes.append("no samples before the step: baseline taken from the first sample")
-    post = t >= t_step
-    tp, yp = t[post], y[post]
-    tp -= t_step
-    if tp.size < 10:
-        raise DesignError("fewer than 10 samples after the step; capture more of the response")
-    sigma = noise_sigma(yp)
+            prep = _single(t, y, *_trigger_step(t, notes), _amp_or_one(step_amplitude, notes),
+                           t.size, notes)
+    prep.lsb, prep.window = lsb, window
+    if lsb:
+        prep.notes.append(f"quantised output: one step (LSB) is {lsb:.4g}; noise taken as at "
+                          f"least LSB/sqrt(12) = {lsb / math.sqrt(12.0):.3g}")
+    # white noise only: a ripple's spread would pass any shape for a straight line
+    prep.nonlinear = nonlinearity(prep.t, prep.y, prep.yf, noise_sigma(prep.y), prep.lsb
+                                  / abs(prep.amplitude))
+    if prep.nonlinear:
+        prep.notes.append(f"non-linear record: {prep.nonlinear}")
+    return prep
+
+
+def _amp_or_one(step_amplitude, notes) -> float:
+    if step_amplitude is not None:
+        return float(step_amplitude)
+    notes.append("no input amplitude: gain is per unit input (pass --step-amplitude)")
+    return 1.0
+
+
+def _trigger_step(t, notes) -> tuple:
+    """(step time, index) by the scope convention: t = 0, else the first sample."""
+    if t[0] < 0.0 <= t[-1]:
+        notes.append("no input column: step assumed at t = 0 (the trigger); "
+                     "pass --step-time otherwise")
+        return 0.0, int(np.searchsorted(t, 0.0, "left"))
+    notes.append(f"no input column: step assumed at the first sample, t = {t[0]:.6g} s; "
+                 "pass --step-time otherwise")
+    return float(t[0]), 0
+
+
+def _given_step(t, y, u, t_step, step_amplitude, notes) -> PreparedStep:
+    """A step at a given time: the amplitude given, or from the input around it,
+    or 1; without an input the record is cut where the output's next opposite
+    edge starts."""
+    if not (math.isfinite(t_step) and t[0] <= t_step < t[-1]):
+        raise DesignError(f"step time {number_text(t_step)} s is outside the record "
+                          f"[{t[0]:.6g}, {t[-1]:.6g}] s")
+    if step_amplitude is not None:
+        amp = float(step_amplitude)
+    elif u is not None:
+        amp = _check_amplitude(_amplitude_from_u(t, u, t_step), "the input column's step")
+    else:
+        amp = _amp_or_one(None, notes)
+    i0 = int(np.searchsorted(t, t_step, "left"))
+    end = t.size
     if u is None:
-        cut = next_step_time(tp, yp, y0, sigma)
-        if cut is not None:
+        edges = [e for e in find_edges(t, y, plateaus=True) if e.time > t_step]
+        if len(edges) >= 2:
+            # a linear plant's return mirrors its rise: the next input edge is
+            # as far before the return's 50 % crossing as the step is before
+            # the rise's
+            e = edges[0]
+            sgn = 1.0 if e.amplitude > 0 else -1.0
+            i = int(np.searchsorted(t, t_step))
+            # 50 % of the levels actually reached: before the step, and the plateau
+            base = float(np.median(y[:i])) if i else float(y[0])
+            top = float(np.median(y[(e.index + edges[1].rest) // 2:max(edges[1].rest,
+                                                                       e.index + 1)]))
+            half = sgn * 0.5 * (base + top)
+            rise = crossing_time(t, sgn * y, half, start=i)
+            j = int(np.searchsorted(t, rise))
+            back = crossing_time(t, -sgn * y, -half, start=max(j, edges[1].rest))
+            cut = t_step + (back - rise) if math.isfinite(back - rise) else \
+                t_step + (edges[1].time - e.time)
+            end = int(np.searchsorted(t, cut, "left"))
             notes.append(f"the output returns to its baseline: another input edge near "
-                         f"t = {t_step + cut:.6g} s (a square wave?); the record is cut there "
+                         f"t = {cut:.6g} s (a square wave?); the record is cut there "
                          "(give the input column to average every step)")
-            keep = tp < cut
-            tp, yp = tp[keep], yp[keep]
-            t, y = t[t < t_step + cut], y[t < t_step + cut]
-            if tp.size < 10:
+            if end - i0 < MIN_SAMPLES:
                 raise DesignError("fewer than 10 samples between the step and the next edge")
+    return _single(t, y, t_step, i0, amp, end, notes)
+
+
+def _single(t, y, t_step, i0, amp, end, notes, rest: Rest | None = None) -> PreparedStep:
+    """One step at ``t_step`` (first sample after it ``i0``), the record used up
+    to index ``end``: baseline, final value, normalisation."""
+    sigma = noise_sigma(y[i0:end])
+    if rest is None:
+        pre = y[:i0]
+        if pre.size == 0:
+            notes.append("no samples before the step: baseline taken from the first sample")
+            y0 = float(y[0])
+        else:
+            span = float(np.mean(y[max(i0, end - max(4, (end - i0) // 10)):end])) - pre[-1]
+            rest = settled_before(pre, sigma, span)
+    if rest is not None:
+        y0 = rest.level
+        _rest_note(rest, y[:i0].size, t[i0] - t[max(i0 - rest.samples, 0)], notes,
+                   y[i0:end], sigma)
+    tp, yp = t[i0:end] - t_step, y[i0:end]
+    if tp.size < MIN_SAMPLES:
+        raise DesignError("fewer than 10 samples after the step; capture more of the response")
     yf = final_value(tp, yp, y0, sigma=sigma)
     _check_step(y0, yf, sigma)
     yn = (yp - y0) / amp
     tw, yw = block_mean(tp, yn)
     return PreparedStep(t=tw, y=yw, yf=(yf - y0) / amp, t_step=t_step, amplitude=float(amp),
-                        y0=y0, y_final=yf, sigma=sigma, t_raw=t, y_raw=y, notes=notes)
+                        y0=y0, y_final=yf, sigma=sigma, t_raw=t[:end], y_raw=y[:end],
+                        notes=notes, dt=_interval(t), work_sigma=noise_sigma(yw),
+                        rising=int(amp * (yf - y0) > 0), falling=int(amp * (yf - y0) < 0))
 
 
-def next_step_time(t, y, y0: float, sigma: float = 0.0):
-    """Time of the next (opposite) input edge in an output-only square-wave record, or None.
+def _rest_note(rest: Rest, n_pre: int, duration: float, notes, yp, sigma) -> None:
+    """Say so when the pre-step record is not flat, refuse when no stretch of it is."""
+    span = abs(float(np.mean(yp[-max(4, yp.size // 10):])) - rest.level) or 1.0
+    if rest.samples < MIN_REST and n_pre >= MIN_REST:
+        raise DesignError(f"the output is still moving just before the step (no {MIN_REST} "
+                          "samples at rest before it): no settled baseline; start the step "
+                          "from rest, or choose the stretch with --window")
+    if rest.samples < n_pre and rest.moved > max(4.0 * sigma, SETTLE_TOL * span):
+        notes.append(f"the output before the step is not flat (it strays by "
+                     f"{100 * rest.moved / span:.0f} % of the step): baseline from the "
+                     f"{rest.samples} samples ({duration:.3g} s) at rest just before the edge")
 
-    After the response's main excursion (beyond half its largest deviation
-    from ``y0``) the output coming back within 5 % of that deviation of the
-    baseline means the input stepped back. For a linear plant the return
-    mirrors the step response, so the edge is the return's 50 % crossing
-    minus the step's own 50 % crossing time.
+
+def _interval(t) -> float:
+    """The sample interval: the median spacing (of at most 10000 samples)."""
+    return float(np.median(np.diff(t[:10001]))) if t.size > 1 else math.nan
+
+
+@dataclass
+class _Step:
+    """One edge of a square wave: where its response starts (``i0``, at
+    ``t_step``), where the next edge's starts (``end``), its input amplitude
+    (signed), and ``align``, the time it is aligned on for averaging."""
+
+    edge: Edge
+    i0: int
+    end: int
+    amp: float
+    align: float
+    t_step: float
+    rising: bool
+
+
+def _from_edges(t, y, edges, step_amplitude, notes, *, source, first_sample_ok) -> PreparedStep:
+    """One edge or a square wave, from the input's edges or the output's own."""
+    steps = _steps(t, y, edges, step_amplitude, source)
+    if source == "output" and step_amplitude is None:
+        notes.append("no input amplitude: gain is per unit input, the input taken to step the "
+                     "way the output went (pass --step-amplitude)")
+    if len(edges) == 1:
+        s = steps[0]
+        return _single_edge(t, y, s, source, notes, first_sample_ok, t.size)
+    spacing = float(np.median(np.diff([e.time for e in edges])))
+    full = [s for s in steps if _complete(t, s, spacing)]
+    rising = [s for s in full if s.rising]
+    falling = [s for s in full if not s.rising]
+    chosen = rising or falling
+    if not chosen:
+        raise DesignError("the square-wave capture has no complete step with a settled "
+                          "level before it; capture at least one full period")
+    if len(chosen) == 1:
+        s = chosen[0]
+        prep = _single_edge(t, y, s, source, notes, first_sample_ok, s.end)
+        if s.end < t.size:
+            notes.append(f"the record is cut at the next edge, t = {t[s.end]:.6g} s")
+        return prep
+    other = falling if chosen is rising else rising
+    return _average(t, y, chosen, other, source, spacing, notes)
+
+
+def _steps(t, y, edges, step_amplitude, source) -> list:
+    """Every edge as a :class:`_Step`: from the input, the step starts at the
+    edge; from the output, at its last sample at rest before it moves."""
+    out = []
+    for k, e in enumerate(edges):
+        nxt = edges[k + 1] if k + 1 < len(edges) else None
+        if source == "input":
+            amp = (math.copysign(step_amplitude, e.amplitude) if step_amplitude is not None
+                   else e.amplitude)
+            i0, t_step = e.index, e.time
+            end = nxt.index if nxt else t.size
+        else:
+            # no input: a given amplitude as given, else a unit step the way the output went
+            amp = (float(step_amplitude) if step_amplitude is not None
+                   else math.copysign(1.0, e.amplitude))
+            i0 = _departure(t, y, e, edges[k - 1].index if k else 0)
+            t_step = float(t[max(i0 - 1, 0)])
+            end = _departure(t, y, nxt, e.index) if nxt else t.size
+        out.append(_Step(e, i0, end, amp, e.time, t_step, e.amplitude > 0))
+    return out
+
+
+#: Windows (of blocks) compared to find where the output leaves its rest.
+REST_WINDOW = 10
+#: Blocks per 25 %-to-50 % stretch of an edge: the block size scales with the edge.
+BLOCKS_PER_EDGE = 20
+
+
+def _departure(t, y, e: Edge, lo: int) -> int:
+    """The first sample of the output's move at edge ``e`` (searching from ``lo``).
+
+    The samples up to the edge's last one below 25 % are averaged in blocks
+    (a twentieth of the edge's 25-50 % time each, so a slow, noisy edge is
+    judged on a scale where it moves); walking back from the edge, the rest
+    is the last window of :data:`REST_WINDOW` blocks whose mean the next
+    window's does not exceed by 4 noise deviations (of a window's mean, plus
+    half an LSB), and the move starts at the first block after it beyond that
+    rest level. A record that moves all the way back to ``lo`` starts its move there.
+    """
+    sgn = 1.0 if e.amplitude > 0 else -1.0
+    hi = max(e.rest + 1, lo + 1)
+    seg = sgn * y[lo:hi]
+    m = max(1, (e.index - e.rest) // BLOCKS_PER_EDGE)
+    nb = seg.size // m
+    f = min(REST_WINDOW, nb // 3)      # a short pre-step record: shorter windows
+    if f < 2:
+        return lo
+    off = seg.size - nb * m
+    b = seg[off:].reshape(nb, m).mean(axis=1)
+    sigma = noise_sigma(y[lo:hi])
+    q = quantum(y[lo:hi])
+    c = np.concatenate(([0.0], np.cumsum(b)))
+    w = (c[f:] - c[:-f]) / f                        # mean of blocks k .. k+f-1
+    d = w[f:] - w[:-f]
+    band_w = 4.0 * sigma * math.sqrt(2.0 / (f * m)) + 0.5 * q
+    k = _last_true(d <= band_w)
+    if k < 0:
+        return lo
+    level = float(w[k])
+    band_b = 4.0 * sigma / math.sqrt(m) + 0.5 * q
+    moved = np.nonzero(b[k:] > level + band_b)[0]
+    j = k + int(moved[0]) if moved.size else nb
+    return min(lo + off + j * m, e.index)
+
+
+def _complete(t, s: _Step, spacing: float) -> bool:
+    """A full edge: a half period after it in the record, and some rest before it."""
+    after = (t[s.end - 1] if s.end > s.i0 else t[s.i0]) - s.align
+    before = s.align - t[0]
+    return after >= 0.9 * spacing - 2 * _interval(t) and before >= 0.05 * spacing
+
+
+def _single_edge(t, y, s: _Step, source, notes, first_sample_ok, end) -> PreparedStep:
+    """The one step of a record (or the one full edge of a square wave)."""
+    if source == "input":
+        amp = _check_amplitude(s.amp, "the input column's step")
+        notes.append(f"step detected in the input at t = {s.t_step:.6g} s, amplitude {amp:.6g}")
+        return _single(t, y, s.t_step, s.i0, amp, end, notes)
+    # from the output: the trigger (t = 0) when the output is still at rest there
+    amp = s.amp
+    if first_sample_ok and t[0] <= 0.0 <= s.t_step:
+        t_step = 0.0
+        i0 = int(np.searchsorted(t, 0.0, "left"))
+        notes.append("no input column: step assumed at t = 0 (the trigger), where the output "
+                     "is still at rest; pass --step-time otherwise")
+    else:
+        t_step, i0 = s.t_step, s.i0
+        notes.append(f"no input column: step found in the output at t = {t_step:.6g} s (its "
+                     "last sample at rest); pass --step-time otherwise")
+    return _single(t, y, t_step, i0, amp, end, notes)
+
+
+def _average(t, y, chosen, other, source, spacing, notes) -> PreparedStep:
+    """Average the normalised responses of every full edge of one direction,
+    aligned on their input edges (or the output's 50 % crossings), on a
+    common grid; the noise is the spread of the averaged plateau."""
+    dt = _interval(t)
+    length = min(t[s.end - 1] - s.align for s in chosen)
+    pre = 0.0
+    if source == "output":
+        pre = min(min(s.align - t[max(s.i0 - 1, 0)] for s in chosen) * 4.0, 0.25 * spacing,
+                  min(s.align - t[0] for s in chosen))
+    n = int((length + pre) / dt) + 1
+    grid = np.linspace(-pre, length, n)
+    avg, levels = _mean_response(t, y, chosen, grid, spacing)
+    amp0 = chosen[0].amp
+    y0_0 = levels[0]
+    # noise: the spread of the averaged plateau about a straight line
+    tail = avg[-max(8, n // 4):]
+    x = np.arange(tail.size, dtype=float)
+    resid = tail - np.polyval(np.polyfit(x, tail, 1), x)
+    sig_plateau = float(np.std(resid))
+    sig_n = max(noise_sigma(avg), sig_plateau)
+    if source == "output":
+        # the step starts where the average leaves zero
+        i50 = int(np.searchsorted(grid, 0.0))
+        k = _last_true(np.abs(avg[:i50]) <= 4.0 * sig_n)
+        t0 = float(grid[k]) if k >= 0 else float(grid[0])
+    else:
+        t0 = 0.0
+    keep = grid >= t0
+    tp, yn = grid[keep] - t0, avg[keep]
+    try:
+        yf_n = final_value(tp, yn, 0.0, sigma=sig_n)
+    except DesignError:
+        raise DesignError(
+            f"the square wave is too fast: the response averaged over {len(chosen)} edges has "
+            "not settled before the next edge; use a lower frequency (half period >= 5 "
+            "settling times)") from None
+    sigma = sig_n * abs(amp0)
+    _check_step(y0_0, y0_0 + yf_n * amp0, sigma)
+    up = chosen[0].rising
+    kind = "rising" if up else "falling"
+    notes.append(f"square wave: {len(chosen)} {kind} edges aligned on the "
+                 f"{'input edges' if source == 'input' else 'output'} and averaged "
+                 f"({len(other)} {'falling' if up else 'rising'} edges kept apart); "
+                 "IAE/ISE are against the average, scaled to the first edge")
+    if len(other) >= 1:
+        o_avg, _ = _mean_response(t, y, other, grid, spacing)
+        o = o_avg[keep]
+        diff = float(np.sqrt(np.mean((o - yn) ** 2)))
+        if diff > 0.05 * abs(yf_n) + 3.0 * sig_n:
+            notes.append(f"the {'falling' if up else 'rising'} edges' average differs "
+                         f"from this one by {100 * diff / abs(yf_n):.0f} % of the step (rms): "
+                         "the plant is not the same both ways (slew, saturation, asymmetric "
+                         "drive?)")
+    t_step = chosen[0].align + t0
+    t_raw = t_step + tp
+    y_raw = y0_0 + yn * amp0
+    tw, yw = block_mean(tp, yn)
+    work = max(noise_sigma(yw), sig_plateau)
+    return PreparedStep(t=tw, y=yw, yf=yf_n, t_step=t_step, amplitude=float(amp0), y0=y0_0,
+                        y_final=y0_0 + yf_n * amp0, sigma=sigma, t_raw=t_raw, y_raw=y_raw,
+                        n_steps=len(chosen), notes=notes, dt=float(grid[1] - grid[0]),
+                        work_sigma=work, rising=len(chosen) if up else len(other),
+                        falling=len(other) if up else len(chosen))
+
+
+def _mean_response(t, y, steps, grid, spacing) -> tuple:
+    """Mean over ``steps`` of (y - y0) / amp interpolated at align + ``grid``;
+    y0 is each edge's level over the last fifth of the half period before it.
+    Returns (mean, the y0 of each step)."""
+    acc = np.zeros(grid.size)
+    levels = []
+    for s in steps:
+        a = int(np.searchsorted(t, s.align - min(0.2 * spacing, s.align - t[0]), "left"))
+        b = max(min(s.i0, s.edge.index), a + 1)
+        y0 = float(np.mean(y[a:b]))
+        levels.append(y0)
+        lo = int(np.searchsorted(t, s.align + grid[0], "left"))
+        hi = min(int(np.searchsorted(t, s.align + grid[-1], "right")) + 1, t.size)
+        acc += (np.interp(s.align + grid, t[max(lo - 1, 0):hi], y[max(lo - 1, 0):hi]) - y0) \
+            / s.amp
+    return acc / len(steps), levels
+
+
+def nonlinearity(t, y, yf, sigma: float = 0.0, lsb: float = 0.0) -> str:
+    """Why a normalised step response (``y`` settling at ``yf``) cannot be a
+    linear plant's, or "".
+
+    - A straight ramp: from 10 % to 90 % the response stays within 1 % (rms,
+      plus the noise) of a straight line, does not overshoot, and reaches
+      98 % no slower than the ramp would: an output slewing into its final
+      level (or a rail). No linear response of the models here is that
+      straight without overshooting (FOPDT: 6 % rms; an underdamped response
+      straighter than 1 % overshoots over 12 %).
+    - A flat top: the response overshoots and stays at its maximum (within
+      the noise and one LSB) for over 15 % of the time to it: clipped at a rail.
     """
     t = np.asarray(t, float)
-    d = np.asarray(y, float) - y0
-    peak = float(np.max(np.abs(d)))
-    if peak <= MIN_STEP_SNR * sigma or peak == 0:
-        return None
-    sgn = 1.0 if abs(float(np.max(d))) >= abs(float(np.min(d))) else -1.0
-    z = sgn * d / peak
-    half = np.nonzero(z >= 0.5)[0]
-    if half.size == 0:
-        return None
-    i1 = int(half[0])
-    back = np.nonzero(z[i1:] <= 0.05 + 3 * sigma / peak)[0]
-    if back.size == 0:
-        return None
-    i2 = i1 + int(back[0])
-    # 50 % of the settled level (the median of the high plateau, not the
-    # overshoot peak) on both the rise and the return.
-    hi = float(np.median(z[i1:i2]))
-    for _ in range(2):
-        if hi <= 0.25:
-            return None
-        above = np.nonzero(z[:i2] >= 0.5 * hi)[0]
-        j = int(above[-1])       # last sample above 50 % before the return
-        # refine the level on the settled later part of the plateau
-        a, b = i1 + (j - i1) // 2, j - (j - i1) // 10
-        if b > a:
-            hi = float(np.median(z[a:b]))
-    z = z / hi
-    above = np.nonzero(z[:i2] >= 0.5)[0]
-    j = int(above[-1])
-    t50_fall = crossing_time(t[j:i2 + 1], -z[j:i2 + 1], -0.5)
-    t50_rise = crossing_time(t, z, 0.5, sigma=sigma / (peak * hi))
-    edge = t50_fall - (t50_rise - float(t[0]))
-    return edge if math.isfinite(edge) and edge > t[0] else None
+    z = np.asarray(y, float) / yf if yf else np.asarray(y, float)
+    sig = sigma / abs(yf) if yf else sigma
+    q = lsb / abs(yf) if yf else lsb
+    if z.size < 20:
+        return ""
+    t10, t90 = crossing_time(t, z, 0.1, sigma=sig), crossing_time(t, z, 0.9, sigma=sig)
+    t98 = crossing_time(t, z, 0.98, sigma=sig)
+    peak = float(np.max(z))
+    over = peak - 1.0 > 0.02 + 4.0 * sig + q
+    if all(math.isfinite(v) for v in (t10, t90, t98)) and t90 > t10 and not over:
+        sel = (t >= t10) & (t <= t90)
+        if np.count_nonzero(sel) >= 10:
+            tt, zz = t[sel], z[sel]
+            c = np.polyfit(tt - tt[0], zz, 1)
+            rms = float(np.sqrt(np.mean((zz - np.polyval(c, tt - tt[0])) ** 2)))
+            ramp_98 = 0.08 / c[0] if c[0] > 0 else math.inf
+            if rms < 0.01 + 2.0 * sig and (t98 - t90) <= 2.0 * ramp_98:
+                return (f"the response rises in a straight line from 10 % to 90 % ({rms:.2%} rms "
+                        f"from it, {100 * c[0]:.4g} % of the step per second) and stops: a "
+                        "slew-rate limit or a ramp into a rail, not a linear plant")
+    if over:
+        ip = int(np.argmax(z))
+        band = max(2.0 * sig, q) + 1e-12
+        top = z >= peak - band
+        k0 = _last_true(~top[:ip])
+        k1 = ip + int(np.argmax(~top[ip:])) if not top[ip:].all() else z.size
+        held = t[min(k1, z.size - 1)] - t[k0 + 1]
+        if k1 - k0 - 1 >= 5 and held > 0.15 * max(t[ip], 1e-300):
+            return (f"the response stays at its maximum ({100 * (peak - 1):.0f} % over the final "
+                    f"value) for {held:.3g} s: clipped at a rail (a flat top), not a linear plant")
+    return ""
 
 
 def _amplitude_from_u(t, u, t_step):
@@ -450,64 +852,3 @@ def _amplitude_from_u(t, u, t_step):
     if amp == 0 or abs(amp) < MIN_STEP_SNR * noise_sigma(u):
         raise DesignError(f"the input does not step at t = {t_step:.6g} s; give --step-amplitude")
     return amp
-
-
-def _prepare_square(t, y, edges, step_amplitude, notes) -> PreparedStep:
-    """Split a square-wave capture into its steps, normalise each and average.
-
-    Each step runs from one edge to the next; its baseline is the settled end
-    of the step before it (so the first edge, without a settled history, is
-    used only when it has pre-step samples). Every step must settle within
-    its half period.
-    """
-    bounds = [0] + [e.index for e in edges] + [t.size]
-    segs = []
-    sigma_all = noise_sigma(y)
-    first_valid = 0 if edges[0].index > 10 else 1
-    for k in range(first_valid, len(edges)):
-        e = edges[k]
-        i0, i1 = e.index, bounds[k + 2]
-        if k + 1 == len(edges) and (t[-1] - e.time) < 0.9 * (edges[k].time - edges[k - 1].time):
-            break  # last step cut short by the end of the record
-        prev = y[bounds[k]:i0]
-        if prev.size < 4:
-            continue
-        m = max(2, int(prev.size * TAIL_FRACTION))
-        y0 = float(np.mean(prev[-m:]))
-        tp, yp = t[i0:i1] - e.time, y[i0:i1]
-        try:
-            yf = final_value(tp, yp, y0, sigma=sigma_all)
-        except DesignError:
-            raise DesignError(
-                f"the square wave is too fast: the response to the edge at t = {e.time:.6g} s has "
-                "not settled before the next edge; use a lower frequency (half period >= 5 "
-                "settling times)") from None
-        amp = math.copysign(step_amplitude, e.amplitude) if step_amplitude is not None \
-            else _check_amplitude(e.amplitude, "the input column's step")
-        segs.append((e, tp, (yp - y0) / amp, y0, yf, amp))
-    if not segs:
-        raise DesignError("the square-wave capture has no complete step with a settled "
-                          "level before it; capture at least one full period")
-    length = min(s[1][-1] for s in segs)
-    dt = min(float(np.median(np.diff(s[1]))) for s in segs)
-    n = int(length / dt) + 1
-    grid = np.linspace(0.0, length, n)
-    acc = np.zeros(n)
-    for _, tp, yn, *_ in segs:
-        acc += np.interp(grid, tp, yn)
-    yavg = acc / len(segs)
-    e0, _, _, y0, yfirst, amp0 = segs[0]
-    sigma = noise_sigma(yavg) * abs(amp0)
-    yf_n = final_value(grid, yavg, 0.0, sigma=sigma / abs(amp0))
-    _check_step(y0, y0 + yf_n * amp0, sigma / math.sqrt(len(segs)) if len(segs) > 1 else sigma)
-    notes.append(f"square wave: {len(segs)} steps (rising and falling) normalised and averaged; "
-                 f"IAE/ISE are against the average, scaled to the first step")
-    # The "raw" data for the indices: the averaged step in the first step's units.
-    t_raw = e0.time + grid
-    y_raw = y0 + yavg * amp0
-    t_raw = np.concatenate([[t[max(e0.index - 1, 0)]], t_raw]) if e0.index > 0 else t_raw
-    y_raw = np.concatenate([[y0], y_raw]) if e0.index > 0 else y_raw
-    tw, yw = block_mean(grid, yavg)
-    return PreparedStep(t=tw, y=yw, yf=yf_n, t_step=e0.time, amplitude=float(amp0), y0=y0,
-                        y_final=y0 + yf_n * amp0, sigma=sigma, t_raw=t_raw, y_raw=y_raw,
-                        n_steps=len(segs), notes=notes)

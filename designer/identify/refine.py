@@ -17,9 +17,9 @@ from ..core.stepfit import PARAMS, fit_step
 from .structures import MethodResult
 
 
-def fit(model: str, t, y, yf, start: dict | None = None) -> MethodResult:
+def fit(model: str, t, y, yf, start: dict | None = None, sigma=None) -> MethodResult:
     """:func:`~designer.core.stepfit.fit_step` as a :class:`MethodResult` named ``least-squares``."""
-    f = fit_step(model, t, y, yf, start)
+    f = fit_step(model, t, y, yf, start, sigma)
     points = {f"{k}_ci95": v for k, v in f.ci95.items()}
     points["samples_fitted"] = f.samples
     points["rms_residual"] = f.rms_residual
@@ -28,12 +28,13 @@ def fit(model: str, t, y, yf, start: dict | None = None) -> MethodResult:
     return MethodResult("least-squares", model, dict(f.params), valid=f.valid, note=note, points=points)
 
 
-def refine_all(t, y, yf, starts: dict | None = None) -> list:
-    """The three least-squares fits, each from ``starts[model]`` (a MethodResult) if given."""
+def refine_all(t, y, yf, starts: dict | None = None, sigma=None) -> list:
+    """The three least-squares fits, each from ``starts[model]`` (a MethodResult) if given;
+    ``sigma`` is the noise of ``y`` when the caller measured it."""
     starts = starts or {}
     out = []
     for model in PARAMS:
         s = starts.get(model)
         start = {"model": s.model, "params": s.params} if s is not None else None
-        out.append(fit(model, t, y, yf, start))
+        out.append(fit(model, t, y, yf, start, sigma))
     return out

@@ -75,7 +75,15 @@ def step_text(result) -> str:
     noise = f"{100 * s.sigma / abs(span):.2g} %" if span else "n/a"
     lines.append(f"Step at {format_eng(s.t_step, 's')}, amplitude {s.amplitude:.4g}; "
                  f"baseline y0 = {s.y0:.4g}, final value {s.y_final:.4g}, "
-                 f"static gain K = {s.yf:.4g}; noise {noise} of the step")
+                 f"static gain K = {s.yf:.4g}")
+    edges = (f"{s.n_steps} edges averaged (full edges in the record: {s.rising} rising, "
+             f"{s.falling} falling; one way averaged, the other kept apart)"
+             if s.n_steps > 1 else "one edge")
+    lines.append(f"Noise {s.sigma:.3g} ({noise} of the step)"
+                 + (f", quantisation step {s.lsb:.3g}" if s.lsb else "")
+                 + f"; {edges}; sample interval {format_eng(s.dt, 's')}")
+    if s.nonlinear:
+        lines.append(f"NON-LINEAR: {s.nonlinear}; no linear model is marked valid")
     for n in (list(cap.notes) if cap is not None else []) + s.notes:
         lines.append(f"  note: {n}")
     m = result.measured
@@ -84,6 +92,8 @@ def step_text(result) -> str:
                      + (f"{m.overshoot_pct:.2f} %" if not math.isnan(m.overshoot_pct) else "n/a")
                      + f", peak time {format_eng(m.peak_time_s, 's')}"
                      + f", rise time (10-90 %) {format_eng(m.rise_time_s, 's')}"
+                     + ", (0-100 %) " + (format_eng(m.rise_time_0_100_s, 's')
+                                         if math.isfinite(m.rise_time_0_100_s) else "n/a")
                      + f", settling (2 %) {format_eng(m.settling_time_s, 's')}")
     lines += ["", ("Methods ranked by IAE (integral of |data - model| over the response; "
                    "lower is better)")]

@@ -1,11 +1,13 @@
 """Second-order identification from a step response (seeds 000, 002 and 003).
 
-Every method here has the signature ``method(t, y, yf) -> MethodResult``:
+Every method here has the signature ``method(t, y, yf, sigma=None) -> MethodResult``:
 
 - ``t``  time since the step, seconds (t >= 0, increasing);
 - ``y``  the response's deviation from its pre-step baseline divided by the
   input step amplitude (starts near 0, settles at ``yf``);
-- ``yf`` its settled value, i.e. the static gain K.
+- ``yf`` its settled value, i.e. the static gain K;
+- ``sigma`` the noise of ``y`` when the caller measured it (the spread of an
+  averaged square wave's plateaus), else estimated here.
 
 They work on the normalised response ``z = y / yf`` (0 -> 1), so a plant with a
 negative gain is handled like a positive one. They never raise on data outside
@@ -250,8 +252,8 @@ def extrema(t, z, sigma: float = 0.0, count: int = 3):
     return out
 
 
-def _prepare(t, y, yf):
-    """Normalised arrays and noise, or an error note."""
+def _prepare(t, y, yf, sigma=None):
+    """Normalised arrays and noise (``sigma`` of ``y`` when given), or an error note."""
     t = np.asarray(t, float)
     y = np.asarray(y, float)
     if t.ndim != 1 or t.shape != y.shape or t.size < 5:
@@ -261,7 +263,7 @@ def _prepare(t, y, yf):
     z = y / yf
     if not (np.all(np.isfinite(z)) and np.all(np.isfinite(t))):
         return None, None, 0.0, "the record has non-finite samples"
-    return t, z, noise_sigma(z), ""
+    return t, z, (noise_sigma(z) if sigma is None else sigma / abs(yf)), ""
 
 
 def _nan_params(model):
@@ -355,7 +357,7 @@ def _guarded(name, model):
 # --------------------------------------------------------------------------
 
 @_guarded("overshoot", "underdamped")
-def overshoot(t, y, yf) -> MethodResult:
+def overshoot(t, y, yf, sigma=None) -> MethodResult:
     """Overshoot and peak time (seeds 000 eqs 20-23 and 003 eq 2.2.11).
 
     zeta = -ln Mp / sqrt(pi^2 + ln^2 Mp), wn = pi / (tp sqrt(1 - zeta^2)),
@@ -364,7 +366,7 @@ def overshoot(t, y, yf) -> MethodResult:
     no dead time (a dead time adds to tp and lowers wn).
     """
     name, model = "overshoot", "underdamped"
-    t, z, sigma, err = _prepare(t, y, yf)
+    t, z, sigma, err = _prepare(t, y, yf, sigma)
     if err:
         return _fail(name, model, err, yf)
     ext = extrema(t, z, sigma, count=1)
@@ -383,7 +385,7 @@ def overshoot(t, y, yf) -> MethodResult:
 
 
 @_guarded("log-decrement", "underdamped")
-def log_decrement(t, y, yf) -> MethodResult:
+def log_decrement(t, y, yf, sigma=None) -> MethodResult:
     """First and second overshoot and the period (seed 002 eqs 5-7), zeta <= 0.5.
 
     Seed 002 eq 5 has Y1/Y0 = e^{-zeta pi/sqrt(1-zeta^2)} and
@@ -396,7 +398,7 @@ def log_decrement(t, y, yf) -> MethodResult:
     two peaks (twice the peak-to-trough time if the record shows one peak only).
     """
     name, model = "log-decrement", "underdamped"
-    t, z, sigma, err = _prepare(t, y, yf)
+    t, z, sigma, err = _prepare(t, y, yf, sigma)
     if err:
         return _fail(name, model, err, yf)
     ext = extrema(t, z, sigma, count=3)
@@ -428,7 +430,7 @@ def log_decrement(t, y, yf) -> MethodResult:
 
 
 @_guarded("t4-t3", "underdamped")
-def t4_t3(t, y, yf) -> MethodResult:
+def t4_t3(t, y, yf, sigma=None) -> MethodResult:
     """Seed 002's t4/t3 method, 0.5 <= zeta <= 2.
 
     t3 and t4 are the times to 1 - 2/e = 26.4 % and 1 - 4/e^3 = 80.1 % of the
@@ -436,7 +438,7 @@ def t4_t3(t, y, yf) -> MethodResult:
     seed's Table 2, recomputed), and wn = (wn t4)(zeta) / t4.
     """
     name = "t4-t3"
-    t, z, sigma, err = _prepare(t, y, yf)
+    t, z, sigma, err = _prepare(t, y, yf, sigma)
     if err:
         return _fail(name, "underdamped", err, yf)
     t3 = crossing_time(t, z, Y3_LEVEL, sigma=sigma)
@@ -464,7 +466,7 @@ def t4_t3(t, y, yf) -> MethodResult:
 
 
 @_guarded("two-pole", "overdamped")
-def two_pole(t, y, yf, levels=(0.6, 0.9)) -> MethodResult:
+def two_pole(t, y, yf, sigma=None, levels=(0.6, 0.9)) -> MethodResult:
     """Two real poles from the response above 50 % (seed 002 eqs 16-20), zeta > 2.
 
     Above 50 % the slow pole dominates: 1 - z = X e^{-a2 t} with a2 = |p2|.
@@ -477,7 +479,7 @@ def two_pole(t, y, yf, levels=(0.6, 0.9)) -> MethodResult:
     makes eqs 17/18 consistent.
     """
     name, model = "two-pole", "overdamped"
-    t, z, sigma, err = _prepare(t, y, yf)
+    t, z, sigma, err = _prepare(t, y, yf, sigma)
     if err:
         return _fail(name, model, err, yf)
     ta = crossing_time(t, z, levels[0], sigma=sigma)
@@ -518,7 +520,7 @@ def two_pole(t, y, yf, levels=(0.6, 0.9)) -> MethodResult:
 
 
 @_guarded("chen", "underdamped")
-def chen(t, y, yf) -> MethodResult:
+def chen(t, y, yf, sigma=None) -> MethodResult:
     """Cheng-Liang Chen, underdamped with dead time (seed 000 eqs 24-30).
 
     From the first peak (t_p1, c_p1), the first minimum (t_m1, c_m1) and the
@@ -528,7 +530,7 @@ def chen(t, y, yf) -> MethodResult:
     eq 29's estimate of it is reported in ``points``.
     """
     name, model = "chen", "underdamped"
-    t, z, sigma, err = _prepare(t, y, yf)
+    t, z, sigma, err = _prepare(t, y, yf, sigma)
     if err:
         return _fail(name, model, err, yf)
     ext = extrema(t, z, sigma, count=3)
@@ -564,7 +566,7 @@ STARK_RANGE = (0.45, 1.3)
 
 
 @_guarded("stark-mollenkamp", "underdamped")
-def stark_mollenkamp(t, y, yf) -> MethodResult:
+def stark_mollenkamp(t, y, yf, sigma=None) -> MethodResult:
     """Stark-Mollenkamp three points 15/45/75 % (seed 000 eqs 31-37).
 
     x = (t45 - t15)/(t75 - t15); zeta = (0.0805 - 5.547 (0.475 - x)^2)/(x - 0.356);
@@ -573,7 +575,7 @@ def stark_mollenkamp(t, y, yf) -> MethodResult:
     An empirical correlation: within 3 % for 0.45 <= zeta <= 1.3.
     """
     name = "stark-mollenkamp"
-    t, z, sigma, err = _prepare(t, y, yf)
+    t, z, sigma, err = _prepare(t, y, yf, sigma)
     if err:
         return _fail(name, "underdamped", err, yf)
     t15, t45, t75 = (crossing_time(t, z, p, sigma=sigma) for p in (0.15, 0.45, 0.75))
@@ -618,7 +620,7 @@ def _jf_from(theta, t70, t90):
 
 
 @_guarded("jahanmiri-fallahi", "overdamped")
-def jahanmiri_fallahi(t, y, yf) -> MethodResult:
+def jahanmiri_fallahi(t, y, yf, sigma=None) -> MethodResult:
     """Jahanmiri-Fallahi three points (seed 000 eqs 38-42).
 
     theta = t2 or t5 (whichever model has the smaller IAE against the data,
@@ -630,7 +632,7 @@ def jahanmiri_fallahi(t, y, yf) -> MethodResult:
     it is flagged invalid.
     """
     name = "jahanmiri-fallahi"
-    t, z, sigma, err = _prepare(t, y, yf)
+    t, z, sigma, err = _prepare(t, y, yf, sigma)
     if err:
         return _fail(name, "overdamped", err, yf)
     t2, t5, t70, t90 = (crossing_time(t, z, p, sigma=sigma) for p in (0.02, 0.05, 0.70, 0.90))
@@ -666,7 +668,7 @@ def _logfit(t, v):
 
 
 @_guarded("peeling", "overdamped")
-def peeling(t, y, yf, iterations: int = 500) -> MethodResult:
+def peeling(t, y, yf, sigma=None, iterations: int = 500) -> MethodResult:
     """Exponential peeling of two time constants (seed 003 section 2.3).
 
     1 - z(t) = K2 e^{-t/tau2} - K1 e^{-t/tau1}: the straight tail of
@@ -683,7 +685,7 @@ def peeling(t, y, yf, iterations: int = 500) -> MethodResult:
     falling), is reported with valid=False and its amplitudes in ``points``.
     """
     name, model = "peeling", "overdamped"
-    t, z, sigma, err = _prepare(t, y, yf)
+    t, z, sigma, err = _prepare(t, y, yf, sigma)
     if err:
         return _fail(name, model, err, yf)
     if float(np.max(z)) > 1.0 + max(5.0 * sigma, 1e-3):
@@ -770,7 +772,7 @@ def peeling(t, y, yf, iterations: int = 500) -> MethodResult:
 
 
 @_guarded("dc-motor", "fopdt")
-def dc_motor(t, y, yf) -> MethodResult:
+def dc_motor(t, y, yf, sigma=None) -> MethodResult:
     """DC motor velocity from a step of armature voltage (seed 000 eqs 46-55).
 
     Km = W(inf)/a is the final value of the normalised response, and
@@ -781,7 +783,7 @@ def dc_motor(t, y, yf) -> MethodResult:
     the data are one.
     """
     name, model = "dc-motor", "fopdt"
-    t, z, sigma, err = _prepare(t, y, yf)
+    t, z, sigma, err = _prepare(t, y, yf, sigma)
     if err:
         return _fail(name, model, err, yf)
     sel = (z >= 0.2) & (z <= 0.8) & (t > 0.0)

@@ -31,17 +31,19 @@ ALL_STEP_METHODS = list(FIRST_ORDER_METHODS) + list(STEP_METHODS)
 #: Slope noise of the smoothing before the measured metrics (see :func:`_measured`).
 MEASURE_SLOPE_NOISE = 0.02
 #: The measured figures reported (``measured`` in the JSON).
-MEASURED_KEYS = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s", "final_value")
+MEASURED_KEYS = ("overshoot_pct", "peak_time_s", "rise_time_s", "rise_time_0_100_s",
+                 "settling_time_s", "final_value")
 
 
 def _method_name(fn) -> str:
     return getattr(fn, "__name__", "method").replace("_", "-")
 
 
-def run_method(fn, t, y, yf) -> list:
-    """Call one method; never let it crash the run."""
+def run_method(fn, t, y, yf, sigma=None) -> list:
+    """Call one method (with the noise ``sigma`` of ``y`` when given); never let
+    it crash the run."""
     try:
-        out = fn(t, y, yf)
+        out = fn(t, y, yf) if sigma is None else fn(t, y, yf, sigma=sigma)
     except Exception as exc:  # noqa: BLE001 - a method bug must not stop the others
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         return [MethodResult(name=_method_name(fn), model="fopdt", params={}, valid=False,
@@ -136,7 +138,8 @@ def _score_all(results, step, t_eval, y_eval) -> None:
 
 
 def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=None,
-                  refine: bool = True, capture: CaptureInfo | None = None) -> IdentifyResult:
+                  refine: bool = True, capture: CaptureInfo | None = None,
+                  window=None) -> IdentifyResult:
     """Identify plant models from a step response.
 
     Parameters
@@ -154,6 +157,8 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
         Run the least-squares refinements (default True).
     capture : CaptureInfo, optional
         Where the data came from (reported as ``capture``).
+    window : (float, float), optional
+        Use only the samples between these times (s).
 
     Returns
     -------
@@ -162,7 +167,8 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
     want = _check_names(methods)
     clock = time.perf_counter
     t0 = clock()
-    step = prepare_step(t, y, u, step_time=step_time, step_amplitude=step_amplitude)
+    step = prepare_step(t, y, u, step_time=step_time, step_amplitude=step_amplitude,
+                        window=window)
     timings = {"prepare": clock() - t0}
     # Methods assume a rising response; a negative gain is flipped and restored.
     sgn = 1.0 if step.yf >= 0 else -1.0
@@ -171,7 +177,7 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
     for fn in ALL_STEP_METHODS:
         if want is not None and _method_name(fn) in _KNOWN_FIRST and _method_name(fn) not in want:
             continue
-        results.extend(run_method(fn, tw, yw, yfw))
+        results.extend(run_method(fn, tw, yw, yfw, step.work_sigma))
     if want is not None:
         results = [r for r in results if r.name in want]
     timings["methods"] = clock() - t0 - timings["prepare"]
@@ -193,7 +199,7 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
                 c = cands[0]
                 starts[model] = MethodResult(c.name, c.model, {k: (sgn * v if k == "K" else v)
                                                                for k, v in c.params.items()})
-        fits = refine_all(tw, yw, yfw, starts)
+        fits = refine_all(tw, yw, yfw, starts, step.work_sigma)
         for m in fits:
             m.note = "; ".join(s for s in (f"started from {starts[m.model].name}"
                                            if m.model in starts else "", m.note) if s)
@@ -201,6 +207,8 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
         _score_all(fits, step, t_eval, y_eval)
         results.extend(fits)
     timings["refine"] = clock() - t1
+    for m in results:
+        judge(m, step)
     results.sort(key=rank_key)
     best = next((m for m in results if m.valid and math.isfinite(m.iae)), None)
     t1 = clock()
@@ -209,6 +217,46 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
     timings["total"] = clock() - t0
     return IdentifyResult(methods=results, best=best, step=step, capture=capture,
                           measured=measured, timings=timings)
+
+
+#: A least-squares parameter whose 95 % half-width exceeds this fraction of its
+#: value is not determined by the data.
+MAX_CI_FRACTION = 1.0
+_SCALES = ("K", "tau_s", "tau1_s", "tau2_s", "wn_rad_s", "zeta")
+
+
+def judge(m: MethodResult, step: PreparedStep) -> None:
+    """Mark a result invalid (saying why) when the record cannot support it: a
+    non-linear record (no linear model is valid), a time constant (or 1/wn)
+    below the sample interval, or a least-squares parameter whose 95 %
+    confidence interval is wider than the value."""
+    if not m.valid:
+        return
+    why = ""
+    if step.nonlinear:
+        why = f"not a linear plant's response ({step.nonlinear.split(':')[0]})"
+    dt = step.dt
+    if not why and math.isfinite(dt):
+        for k, v in m.params.items():
+            tc = 1.0 / v if k == "wn_rad_s" and v else (v if k.startswith("tau") else None)
+            if tc is not None and math.isfinite(tc) and tc < dt:
+                what = "1/wn" if k == "wn_rad_s" else k[:-2]
+                why = (f"{what} = {tc:.3g} s is below the sample interval ({dt:.3g} s): the "
+                       "record cannot resolve it"
+                       + ("; the fopdt result has this model's real order"
+                          if m.model == "overdamped" else ""))
+                break
+    if not why and m.name == "least-squares":
+        for k in _SCALES:
+            ci = m.points.get(f"{k}_ci95")
+            v = m.params.get(k)
+            if ci is not None and v and math.isfinite(ci) and ci > MAX_CI_FRACTION * abs(v):
+                why = (f"the 95 % confidence interval of {k} (±{ci:.3g}) is wider than its "
+                       f"value ({v:.3g}): not determined by the data")
+                break
+    if why:
+        m.valid = False
+        m.note = "; ".join(x for x in (m.note, why) if x)
 
 
 def _flip(m: MethodResult, sgn: float) -> None:
@@ -256,7 +304,14 @@ def _measured(step: PreparedStep, t_eval, y_eval) -> StepMetrics | None:
                            span=step.y_final - step.y0, slope_noise=MEASURE_SLOPE_NOISE)
         y_eval = savgol(y_eval, w, 2)
     try:
-        return step_metrics(t_eval, y_eval, t_step=step.t_step, initial=step.y0,
-                            final=step.y_final)
+        m = step_metrics(t_eval, y_eval, t_step=step.t_step, initial=step.y0,
+                         final=step.y_final)
     except DesignError:
         return None
+    # an overshoot within one quantisation step is not one: an 8-bit trace
+    # sitting one LSB above its mean
+    over = abs(m.peak_value - step.y_final)
+    if m.overshoot_pct > 0 and over <= step.lsb:
+        from dataclasses import replace
+        m = replace(m, overshoot_pct=0.0, rise_time_0_100_s=math.nan)
+    return m

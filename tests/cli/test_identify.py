@@ -77,7 +77,9 @@ def test_json_shape_and_best_model_for_every_fixture(json_runs):
 def test_rigol_square_wave_is_split(json_runs):
     out = json.loads(json_runs["rigol_square.csv"].stdout)
     pre = out["preprocessing"]
-    assert pre["steps_averaged"] >= 3
+    # two periods: the rising edges at 0 and 3.03 ms averaged, the falling ones
+    # kept apart (the one at 4.5 ms has no full half period after it)
+    assert pre["steps_averaged"] == pre["rising_edges"] == 2 and pre["falling_edges"] == 1
     assert pre["step_amplitude"] == pytest.approx(2.0, rel=0.01)
     # the seed's bench figures: overshoot ~ 52.7 %, peak time ~ 146 us (analytic)
     meas = out["measured"]
