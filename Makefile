@@ -10,13 +10,17 @@ export MPLBACKEND := Agg
 setup: system-deps $(VENV_STAMP)
 	@$(PY) -m compileall -q designer
 
-# ngspice (CLI backend) and libngspice (PySpice's shared backend) come from Debian.
+# ngspice (CLI backend) and libngspice (PySpice's shared backend) come from Debian; so do chromium and
+# poppler-utils, which the print and screenshot tests of the build sheets use (headless printing to PDF,
+# pdfinfo's page count).
+SYSTEM_PACKAGES := ngspice libngspice0-dev chromium poppler-utils
 system-deps:
-	@if ! command -v ngspice >/dev/null 2>&1 || ! dpkg -s libngspice0-dev >/dev/null 2>&1; then \
-	  echo "Installing ngspice and libngspice0-dev from Debian"; \
+	@if ! command -v ngspice >/dev/null 2>&1 || ! dpkg -s libngspice0-dev >/dev/null 2>&1 \
+	    || ! command -v chromium >/dev/null 2>&1 || ! command -v pdfinfo >/dev/null 2>&1; then \
+	  echo "Installing $(SYSTEM_PACKAGES) from Debian"; \
 	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 	  $$SUDO apt-get update -qq && \
-	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq ngspice libngspice0-dev; \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $(SYSTEM_PACKAGES); \
 	fi
 
 $(VENV_STAMP): pyproject.toml
@@ -26,7 +30,8 @@ $(VENV_STAMP): pyproject.toml
 	touch $@
 
 # The main job: the seed's plant, and PID controllers for it with LM741s (ZN tuning done right,
-# the optimiser, and the seed's own final design to show what really happens).
+# the optimiser, and the seed's own final design to show what really happens), and the seed's bench as built
+# (trimmed difference amplifier), predicted against what the thesis measured.
 demo: setup
 	.venv/bin/design-plant --fc 3500 --zeta 0.2 --name plant_fc3500_z0.2 --out .
 	.venv/bin/design-pid --plant-fc 3500 --plant-zeta 0.2 --opamp LM741 --name pid_zn_lm741_fc3500_z0.2 --out .
@@ -34,6 +39,10 @@ demo: setup
 	  --name pid_optimize_os10_lm741_fc3500_z0.2 --out .
 	.venv/bin/design-pid --plant-fc 3500 --plant-zeta 0.2 --opamp LM741 --kp 45 --ti 43.215u --td 10.8037u \
 	  --seed-parts --name pid_seed_kp45_lm741_fc3500_z0.2 --out .
+	.venv/bin/analyze-pid --plant-r1 805 --plant-r2 1k --plant-c1 10n --plant-c2 220n --opamp LM741 --step 2 \
+	  --r3 12k --r4 1.777k --r5 22k --r6 3.3k --r7 14.356k --r8 1.2k --r9 10k --r10 10k --r11 10k --r12 1.026k \
+	  --r13 26.048k --r14 2.528k --r15 10k --r16 3.279k --r17 1.716k --r18 9.98k --c3 4.7n --c4 47n \
+	  --kp 45 --ti 43.215u --td 10.8037u --name pid_seed_bench_lm741 --out .
 
 test: setup
 	$(PY) -m pytest -q -p no:cacheprovider tests

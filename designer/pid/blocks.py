@@ -651,3 +651,25 @@ def continuous_parts(kp: float, ti_s: float, td_s: float, fn_hz: float, *,
                     r12=1.0 / (2 * math.pi * f_d * c3) if has_d else None,
                     r13=1.0 / (2 * math.pi * f_i * c4), r14=r, r15=r, r16=r, r17=r, r18=r,
                     c3=c3, c4=c4)
+
+
+def seed_bench_parts() -> PidParts:
+    """The seed's controller as it was built and measured (001, section V.13):
+    :func:`seed_parts` with the difference amplifier trimmed by hand on the bench
+    to R15 = 10k, R16 = 3.279k, R17 = 1.716k, R18 = 9.98k, in the order the
+    thesis lists them and with this project's names for the four positions (R15
+    from r, R16 feedback, R17 from y, R18 to ground)."""
+    from dataclasses import replace
+    return replace(seed_parts(), r15=10e3, r16=3.279e3, r17=1.716e3, r18=9.98e3)
+
+
+#: what the thesis reports of its bench (001, V.13, Figures 88-90), for the comparison on the sheet
+THESIS_BENCH = {
+    "stable": True,
+    "output_vs_reference": "larger (Fig. 89: 'la magnitud de la salida es mas grande que la senal de entrada')",
+    "overshoot": "suppressed ('se redujo significativamente el valor del sobrepaso maximo', Fig. 89-90)",
+    "scope": "Fig. 88: CH1 1.00 V/div, CH2 5.00 V/div, 500 us/div, trigger CH1, 434 Hz",
+    "amplitude": "not stated for the loop (the plant's own test, IV.9: a 2 V, 330 Hz square wave)",
+    "opamp": "LM741 (V.10 uses 1.5 MHz and 0.7 V/us; TI's typicals are 1 MHz and 0.5 V/us)",
+    "plant": "R1 = 805 Ohm, R2 = 1k, C1 = 10n, C2 = 220n (its list swaps the C1/C2 names)",
+}

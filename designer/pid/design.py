@@ -201,8 +201,63 @@ def _run(spec: PidSpec, simulate: bool, simulator: str, as_built: bool) -> PidRe
     else:
         res.notes.append("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only")
     res.scope = loop_scope(res)
+    res.diff_amp = model.diff_amp_balance(parts, amp, ps.num, ps.den, loop.bode_w, loop.analytic.dc_gain)
+    if simulate and _same(parts, blocks.seed_bench_parts()) and _same(plant, SEED_BENCH_PLANT):
+        res.seed_bench = seed_bench_finding(res, spec, simulator)
     res.timings = clock.laps
     return res
+
+
+def _same(a, b) -> bool:
+    """Two part sets equal to rounding (values typed as text parse to the nearest float)."""
+    from dataclasses import fields
+    for f in fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if (x is None) != (y is None) or (x is not None and not math.isclose(x, y, rel_tol=1e-9)):
+            return False
+    return True
+
+
+#: the seed's plant as built (001, V.13: R1 = 805 Ohm; its list swaps the C1/C2 names)
+SEED_BENCH_PLANT = SallenKeyParts(805.0, 1e3, 10e-9, 220e-9)
+#: the test amplitudes the seed-bench finding simulates (volts): small enough to stay linear, and the seed's 2 V
+SEED_BENCH_STEPS = (0.5, 2.0)
+
+
+@dataclass(frozen=True)
+class SeedBenchFinding:
+    """Why the tool's prediction for the seed's as-built controller (001, V.13)
+    differs from what the thesis measured: the loop as named here, the loop with
+    the trimmed divider on the feedback input instead (R17 and R18 exchanged), the
+    latter with the seed's own LM741 figures, and SPICE runs of it at a small and
+    at the seed's 2 V amplitude. ``runs``: (op-amp, step V) -> (analytic stable,
+    phase margin deg, SPICE stable, SPICE saturated, SPICE final V, expected final V)."""
+
+    thesis: dict
+    runs: dict
+
+    def to_dict(self) -> dict:
+        return {"thesis": self.thesis,
+                "runs": [{"opamp": k[0], "step_v": k[1], "analytic_stable": v[0], "phase_margin_deg": v[1],
+                          "spice_stable": v[2], "spice_saturated": v[3], "spice_final_v": v[4],
+                          "expected_final_v": v[5]} for k, v in self.runs.items()]}
+
+
+def seed_bench_finding(res: PidResult, spec: PidSpec, simulator: str) -> SeedBenchFinding:
+    """The runs behind :class:`SeedBenchFinding`: the divider on the feedback input,
+    with the catalogue's LM741 and with the seed's (``LM741-seed``), at each of
+    :data:`SEED_BENCH_STEPS` (each a full analysis with its SPICE run)."""
+    from dataclasses import replace
+    swapped = replace(res.parts, r17=res.parts.r18, r18=res.parts.r17)
+    runs = {}
+    for amp in dict.fromkeys((res.opamp.name, "LM741-seed")):
+        for step in SEED_BENCH_STEPS:
+            r = _run(replace(spec, controller_parts=swapped, opamp=amp, step_v=step), True, simulator,
+                     as_built=spec.kp is None and spec.tuning is None)
+            s = r.spice
+            runs[(amp, step)] = (r.analytic.stable, r.margins.phase_margin_deg, s.stable, s.saturated,
+                                 s.figures.final_value, r.expected_final_v)
+    return SeedBenchFinding(dict(blocks.THESIS_BENCH), runs)
 
 
 def loop_scope(res: PidResult):

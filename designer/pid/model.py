@@ -438,3 +438,57 @@ def waveform_limits(wave: dict, t, opamp: OpAmp, delay_budget_s: float) -> dict:
                                 bool(opamp.ideal or (vmax <= opamp.vout_max and vmin >= opamp.vout_min)),
                                 bool(opamp.ideal or delay <= delay_budget_s))
     return out
+
+
+@dataclass(frozen=True)
+class DiffAmpBalance:
+    """The difference amplifier as built, when its two weights differ (trimmed
+    resistors, seed 001 V.13): U2's output is g_y y - g_r r, so the loop gain is
+    scaled by g_y and the loop settles where g_y y = g_r r (an integrator that
+    holds the error at zero), y = (g_r/g_y) r. ``swapped`` is the same loop with
+    R17 and R18 exchanged (the divider's two resistors the other way round,
+    which the seed's text does not fix): its weights, margins, stability and
+    final ratio, from the same model."""
+
+    g_y: float
+    g_r: float
+    loop_gain_db: float          #: 20 log10 g_y: the loop gain's change against a balanced amplifier
+    final_ratio: float           #: y/r at DC of the loop as built (the analytic DC gain)
+    swapped: dict                #: g_y, g_r, loop_gain_db, phase_margin_deg, crossover_hz, gain_margin_db,
+    #: stable, final_ratio
+
+    @property
+    def attenuated(self) -> str:
+        """Which input the amplifier weighs less: ``reference`` or ``feedback``."""
+        return "reference" if self.g_r < self.g_y else "feedback"
+
+    def to_dict(self) -> dict:
+        return {"g_y": self.g_y, "g_r": self.g_r, "loop_gain_db": self.loop_gain_db,
+                "final_ratio": self.final_ratio, "attenuated": self.attenuated, "swapped": self.swapped}
+
+
+def dc_gain(lm: LoopModel, output: str = "y") -> float:
+    """The closed loop's DC gain from r to ``output`` (nan when singular)."""
+    i = lm.outputs.index(output)
+    try:
+        return float(-(lm.c[i] @ np.linalg.solve(lm.a, lm.b)).item() + lm.d[i, 0])
+    except np.linalg.LinAlgError:
+        return math.nan
+
+
+def diff_amp_balance(parts: PidParts, opamp: OpAmp, plant_num, plant_den, w, dc: float):
+    """A :class:`DiffAmpBalance` when the difference amplifier's weights differ by
+    more than 0.1 %, else None; ``dc`` is the loop's DC gain y/r as built, ``w`` the
+    frequencies (rad/s) the margins are read on."""
+    from dataclasses import replace as _replace
+    g_y, g_r = difference_weights(parts)
+    if abs(g_y / g_r - 1) <= 1e-3:
+        return None
+    other = _replace(parts, r17=parts.r18, r18=parts.r17)
+    oy, orr = difference_weights(other)
+    m = margins(w, loop_gain(other, opamp, plant_num, plant_den, w))
+    lm = assemble(other, opamp, plant_num, plant_den)
+    swapped = {"g_y": oy, "g_r": orr, "loop_gain_db": 20 * math.log10(oy), "phase_margin_deg": m.phase_margin_deg,
+               "crossover_hz": m.crossover_hz, "gain_margin_db": m.gain_margin_db, "stable": lm.stable(),
+               "final_ratio": dc_gain(lm)}
+    return DiffAmpBalance(g_y, g_r, 20 * math.log10(g_y), dc, swapped)

@@ -105,6 +105,11 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
                                   + ". Kp = R5 R3/(R6 R4), Ti = R8 R14 C4/R6, Td = R6 R11 C3/R7."),
                            R.table(["part", "code", "from", "to"],
                                    wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee)))]))
+    if result.seed_bench is not None:
+        out.append(("The seed's bench: predicted against measured (001, V.13, Figures 88-90)",
+                    _seed_bench_blocks(result)))
+    elif result.diff_amp is not None:
+        out.append(("Difference amplifier as built", _diff_amp_blocks(result)))
     out.append(("Tuning", _tuning_blocks(result)))
     out.append(("Target and achieved", _achieved_blocks(result)))
     out.append(("Checks", [R.table(["check", "result", "detail"],
@@ -186,6 +191,65 @@ def _tuning_blocks(result) -> list:
             f"{_fmt(_pct(b.swing_ratio), '%')} of the rails, worst slew delay {_fmt(_pct(b.slew_ratio), '%')} "
             "of its budget" + ("" if b.stable else " (the best point found is an unstable loop)") + "."))
     return blocks
+
+
+def _diff_amp_blocks(result) -> list:
+    d = result.diff_amp
+    sw = d.swapped
+    other = "feedback" if d.attenuated == "reference" else "reference"
+    return [R.text(
+        f"U2 weighs the plant output y by g_y = (1 + R16/R15) R18/(R17 + R18) = {d.g_y:.4g} and the reference r by "
+        f"g_r = R16/R15 = {d.g_r:.4g}: it attenuates the {d.attenuated} input against the {other}. The loop gain "
+        f"is scaled by g_y ({d.loop_gain_db:+.3g} dB against a balanced amplifier) and the integrator settles the "
+        f"loop where g_y y = g_r r: y = {d.final_ratio:.4g} r (the analytic DC gain). With R17 and R18 the other way "
+        f"round (the divider on the other side), g_y = {sw['g_y']:.4g} ({sw['loop_gain_db']:+.3g} dB), phase "
+        f"margin {_fmt(sw['phase_margin_deg'], 'deg')} at {_v(sw['crossover_hz'], 'Hz')}, "
+        f"{'stable' if sw['stable'] else 'unstable'}, y = {sw['final_ratio']:.4g} r.")]
+
+
+def _seed_bench_blocks(result) -> list:
+    sb, d = result.seed_bench, result.diff_amp
+    th = sb.thesis
+    sw = d.swapped
+    a, s = result.analytic, result.spice
+    amp = result.opamp.name
+    spice_txt = "not simulated" if s is None else ("oscillates" + (", saturated" if s.saturated else "")
+                                                   if not s.stable else "settles")
+    rows = [["loop", "stable" if th["stable"] else "unstable",
+             ("stable" if a.stable else "UNSTABLE") + f" (phase margin {_fmt(result.margins.phase_margin_deg, 'deg')}"
+             f"); SPICE {spice_txt}",
+             ("stable" if sw["stable"] else "unstable") + f" (phase margin {_fmt(sw['phase_margin_deg'], 'deg')})"],
+            ["output against the reference", th["output_vs_reference"], f"y = {d.final_ratio:.3g} r ({'larger' if d.final_ratio > 1 else 'smaller'})",
+             f"y = {sw['final_ratio']:.3g} r ({'larger' if sw['final_ratio'] > 1 else 'smaller'})"],
+            ["loop gain against a balanced U2", "", f"{d.loop_gain_db:+.3g} dB", f"{sw['loop_gain_db']:+.3g} dB"],
+            ["overshoot", th["overshoot"], "", ""]]
+    runs = [[f"{k[0]}, {k[1]:g} V step", "stable" if v[0] else "unstable", _fmt(v[1], "deg"),
+             ("settles" if v[2] else "oscillates") + (", saturated" if v[3] else ""),
+             f"{_v(v[4])} (expected {_v(v[5])})"] for k, v in sb.runs.items()]
+    ok_small = [k for k, v in sb.runs.items() if v[2]]
+    return [
+        R.text(f"The thesis built this controller with {th['opamp']} and trimmed U2 on the bench; it reports "
+               f"a stable loop with the overshoot suppressed and the output larger than the reference. Its plant: "
+               f"{th['plant']}. Its scope: {th['scope']}. Test amplitude: {th['amplitude']}."),
+        R.table(["", "thesis measured", f"predicted, parts as named here ({amp})",
+                 "predicted, divider on y (R17, R18 exchanged)"], rows),
+        R.text(f"Why they disagree. (1) Which input is attenuated: read with this project's names (R17 from y, R18 "
+               f"to ground) the trimmed values attenuate the REFERENCE (g_r = {d.g_r:.3g}, g_y = {d.g_y:.3g}): "
+               f"the loop gain does not fall ({d.loop_gain_db:+.2g} dB), the loop stays unstable, and it would settle "
+               f"at {d.final_ratio:.2g} r, below the reference, against both of the thesis's observations. With the "
+               f"9.98k/1.716k divider on the FEEDBACK input instead (y through 9.98k, 1.716k to ground), y is "
+               f"attenuated to g_y = {sw['g_y']:.3g}: the loop gain falls by {-sw['loop_gain_db']:.3g} dB (Kp = "
+               f"{result.achieved.kp:.3g} acts as {result.achieved.kp * sw['g_y']:.3g}), the crossover drops to {_v(sw['crossover_hz'], 'Hz')}, and the loop "
+               f"settles at y = {sw['final_ratio']:.3g} r, larger than the reference as the thesis saw: the thesis's "
+               "figures fit this wiring, which its text does not name. (2) The op-amp model and (3) the test "
+               "amplitude decide the rest, as the runs below show: with that wiring the loop sits at the edge of "
+               "stability, stable only with the seed's faster LM741 figures, and then only for a step small enough "
+               "that no stage saturates or slews."),
+        R.table(["divider on y, run", "analytic loop", "phase margin", "SPICE", "SPICE final value"], runs),
+        R.text("So the bench result is reproduced only by the divider on the feedback input, an LM741 near the "
+               "seed's 1.5 MHz, and a small test amplitude"
+               + (f" ({', '.join(f'{k[1]:g} V with {k[0]}' for k in ok_small)} settles in SPICE)" if ok_small
+                  else "") + "; at the seed's 2 V the stages saturate and the loop oscillates in SPICE.")]
 
 
 def _achieved_blocks(result) -> list:

@@ -129,6 +129,8 @@ class PidResult:
     spice: SpiceRun | None = None
     verdict: Verdict | None = None
     scope: object = None                #: designer.plant.bench.ScopeSetup of the bench test (CH2 per node)
+    diff_amp: object = None             #: designer.pid.model.DiffAmpBalance when R15..R18 are unbalanced
+    seed_bench: object = None           #: designer.pid.design.SeedBenchFinding for the seed's as-built parts
     package: str | None = None          #: op-amp package kind the sheet wires (None: the op-amp's default)
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
@@ -183,6 +185,8 @@ class PidResult:
             "notes": self.notes,
             "simulator": self.simulator,
             "scope": None if self.scope is None else self.scope.to_dict(),
+            "difference_amplifier": None if self.diff_amp is None else self.diff_amp.to_dict(),
+            "seed_bench": None if self.seed_bench is None else self.seed_bench.to_dict(),
             "files": self.files,
         }
         return json_safe(out)
