@@ -45,7 +45,7 @@ def _bound(value, typ, where: str) -> float | None:
     """``min``/``max``: absolute, or a signed percentage of ``typ``."""
     if value is None:
         return None
-    if isinstance(value, str) and (m := _RELATIVE.match(value)):
+    if isinstance(value, str) and _RELATIVE.match(value):
         if typ is None:
             raise DesignError(f"{where} {value!r} is relative to typ, and there is no typ")
         pct = float(value.strip().replace("%", "").replace(" ", ""))

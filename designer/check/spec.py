@@ -43,7 +43,7 @@ from ..core.errors import DesignError
 from ..core.fileio import MIB, check_plain_name, read_text, shown
 from ..core.units import parse_value
 from . import figures as F
-from .limits import LIMIT_KEYS, Limit, limit_from
+from .limits import LIMIT_KEYS, limit_from
 
 KINDS = ("plant", "pid", "netlist")
 #: the top-level keys of each kind

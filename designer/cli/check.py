@@ -5,13 +5,11 @@ and exit with the run's status."""
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from pathlib import Path
 
-from .. import __version__
-from .common import OneLineParser, print_output, run_cli
+from .common import command_parser, print_output, run_cli
 
 EPILOG = """spec file (YAML; numbers in engineering notation, paths relative to the spec):
   name: lab3-plant                      # default: the file's stem
@@ -44,13 +42,11 @@ allowed); 3 a simulator error or timeout; --no-fail makes it 0 whatever happened
 
 
 def _parser():
-    p = OneLineParser(
-        prog="check-design",
-        description="SPICE regression checks of your own analog designs, for CI: each spec file names a design "
-                    "(a Sallen-Key plant, a PID controller in its loop, or your own ngspice deck), its op-amp "
-                    "corners and the limits it must meet; every check runs for every corner in ngspice.",
-        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    p = command_parser(
+        "check-design",
+        "SPICE regression checks of your own analog designs, for CI: each spec file names a design (a Sallen-Key "
+        "plant, a PID controller in its loop, or your own ngspice deck), its op-amp corners and the limits it "
+        "must meet; every check runs for every corner in ngspice.", EPILOG)
     p.add_argument("specs", nargs="+", metavar="SPEC.yaml", help="spec files (YAML)")
     p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report (one testsuite per spec, one "
                                                   "testcase per check and corner)")

@@ -64,6 +64,16 @@ class OneLineParser(argparse.ArgumentParser):
         raise DesignError(f"{message} (see {self.prog} --help)")
 
 
+def command_parser(prog: str, description: str, epilog: str) -> OneLineParser:
+    """A command's parser: one-line usage errors, ``--help`` with the epilog's
+    examples as written, and ``--version``."""
+    from .. import __version__
+    p = OneLineParser(prog=prog, description=description, epilog=epilog,
+                      formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    return p
+
+
 def print_output(text: str, end: str = "\n") -> None:
     """Print; a pipe closed by the reader (``| head``) is their choice, not an error."""
     try:

@@ -1,16 +1,15 @@
-"""Command-line layer of ``design-pid``: parse, call :func:`designer.pid.design.design_pid`,
-print. Any :class:`~designer.core.errors.DesignError` becomes one line on stderr and exit status 2."""
+"""Command-line layer of ``design-pid`` and ``analyze-pid``: parse, call
+:func:`designer.pid.design.design_pid` / ``analyze_pid``, print. Any
+:class:`~designer.core.errors.DesignError` becomes one line on stderr and exit status 2."""
 
 from __future__ import annotations
 
-import argparse
 import sys
 
-from .. import __version__
 from ..core.errors import DesignError
 from ..core.ranges import help_range
 from . import common
-from .common import OneLineParser, add_opamp_option, add_output_options, add_part_options, emit
+from .common import add_opamp_option, add_output_options, add_part_options, emit
 
 EPILOG = """examples:
   design-pid --plant-fc 3500 --plant-zeta 0.2
@@ -44,13 +43,11 @@ def _r(key: str) -> str:
 
 
 def _parser():
-    p = OneLineParser(
-        prog="design-pid",
-        description="Tune an analog PID controller for a Sallen-Key plant, size its six op-amp stages from "
-                    "E-series parts, check them against the op-amp's bandwidth, slew rate and swing, and verify "
-                    "the whole closed loop (controller + plant circuit) in ngspice.",
-        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    p = common.command_parser(
+        "design-pid",
+        "Tune an analog PID controller for a Sallen-Key plant, size its six op-amp stages from E-series parts, "
+        "check them against the op-amp's bandwidth, slew rate and swing, and verify the whole closed loop "
+        "(controller + plant circuit) in ngspice.", EPILOG)
     _add_plant_options(p)
     t = p.add_argument_group("tuning")
     t.add_argument("--tuning", metavar="RULE",
@@ -187,12 +184,10 @@ failed (with --fail-on-check), 2 bad input (one line on stderr, nothing written)
 
 
 def _analyze_parser():
-    p = OneLineParser(
-        prog="analyze-pid",
-        description="Analyse the seed's six-op-amp PID controller as built from its parts, on its plant: the "
-                    "gains the parts give, the stage checks, the closed loop with the op-amp poles, and ngspice.",
-        epilog=ANALYZE_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    p = common.command_parser(
+        "analyze-pid",
+        "Analyse the seed's six-op-amp PID controller as built from its parts, on its plant: the gains the parts "
+        "give, the stage checks, the closed loop with the op-amp poles, and ngspice.", ANALYZE_EPILOG)
     _add_plant_options(p)
     c = p.add_argument_group("controller as built (every part, or --parts-json)")
     for i in range(3, 19):
