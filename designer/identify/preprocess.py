@@ -452,8 +452,13 @@ def prepare_step(t, y, u=None, *, step_time: float | None = None,
     else:
         edges = find_edges(t, y, plateaus=True)
         if edges:
-            prep = _from_edges(t, y, edges, step_amplitude, notes, source="output",
-                               first_sample_ok=window is None)
+            try:
+                prep = _from_edges(t, y, edges, step_amplitude, notes, source="output",
+                                   first_sample_ok=window is None)
+            except DesignError:
+                if len(edges) >= 2:
+                    _check_periodic_steps(y)
+                raise
         else:
             prep = _single(t, y, *_trigger_step(t, notes), _amp_or_one(step_amplitude, notes),
                            t.size, notes)
@@ -467,6 +472,28 @@ def prepare_step(t, y, u=None, *, step_time: float | None = None,
     if prep.nonlinear:
         prep.notes.append(f"non-linear record: {prep.nonlinear}")
     return prep
+
+
+#: An output that spends more than this fraction of a periodic record between
+#: the quarter and three-quarter levels of its swing is no step response.
+MAX_TRANSITION_FRACTION = 0.25
+
+
+def _check_periodic_steps(y) -> None:
+    """Refuse an output whose repeated swings are not step responses (a sine,
+    a triangle; a sine spends a third of its time there) when none of its
+    edges settles: a square wave's response sits on its plateaus most of the time."""
+    lo, hi = np.percentile(y, [1, 99])
+    span = hi - lo
+    if span <= 0:
+        return
+    between = np.count_nonzero((y > lo + 0.25 * span) & (y < lo + 0.75 * span)) / y.size
+    if between > MAX_TRANSITION_FRACTION:
+        raise DesignError(
+            f"no step found: the output swings back and forth but spends {100 * between:.0f} % "
+            "of the record between a quarter and three quarters of its swing (a sine or a "
+            "triangle wave, not the response to a step or a square wave); capture a step "
+            "response, or give --step-time")
 
 
 def _amp_or_one(step_amplitude, notes) -> float:
@@ -663,24 +690,36 @@ def _departure(t, y, e: Edge, lo: int) -> int:
     seg = sgn * y[lo:hi]
     m = max(1, (e.index - e.rest) // BLOCKS_PER_EDGE)
     nb = seg.size // m
-    f = min(REST_WINDOW, nb // 3)      # a short pre-step record: shorter windows
-    if f < 2:
+    if nb < 4:
         return lo
     off = seg.size - nb * m
     b = seg[off:].reshape(nb, m).mean(axis=1)
     sigma = noise_sigma(y[lo:hi])
     q = quantum(y[lo:hi])
     c = np.concatenate(([0.0], np.cumsum(b)))
-    w = (c[f:] - c[:-f]) / f                        # mean of blocks k .. k+f-1
-    d = w[f:] - w[:-f]
-    band_w = 4.0 * sigma * math.sqrt(2.0 / (f * m)) + 0.5 * q
-    k = _last_true(d <= band_w)
-    if k < 0:
+    # windows as long as the rest allows: a short pre-step record gets short ones
+    for f in (REST_WINDOW, REST_WINDOW // 2):
+        if nb < 2 * f:
+            continue
+        w = (c[f:] - c[:-f]) / f                    # mean of blocks k .. k+f-1
+        d = w[f:] - w[:-f]
+        band_w = 4.0 * sigma * math.sqrt(2.0 / (f * m)) + 0.5 * q
+        k = _last_true(d <= band_w)
+        if k >= 0:
+            break
+    else:
         return lo
     level = float(w[k])
     band_b = 4.0 * sigma / math.sqrt(m) + 0.5 * q
     moved = np.nonzero(b[k:] > level + band_b)[0]
     j = k + int(moved[0]) if moved.size else nb
+    if m > 1 and j < nb:
+        # to the sample: the first one of the block before and this block that
+        # leaves the rest level by 4 deviations (of one sample)
+        a0 = off + max(j - 1, 0) * m
+        first = np.nonzero(seg[a0:off + (j + 1) * m] > level + 4.0 * sigma + 0.5 * q)[0]
+        if first.size:
+            return min(lo + a0 + int(first[0]), e.index)
     return min(lo + off + j * m, e.index)
 
 
@@ -806,7 +845,8 @@ def nonlinearity(t, y, yf, sigma: float = 0.0, lsb: float = 0.0) -> str:
       straight without overshooting (FOPDT: 6 % rms; an underdamped response
       straighter than 1 % overshoots over 12 %).
     - A flat top: the response overshoots and stays at its maximum (within
-      the noise and one LSB) for over 15 % of the time to it: clipped at a rail.
+      the noise and one LSB) for over twice as long as a smooth peak of that
+      height would (and 15 % of the time to it): clipped at a rail.
     """
     t = np.asarray(t, float)
     z = np.asarray(y, float) / yf if yf else np.asarray(y, float)
@@ -836,7 +876,11 @@ def nonlinearity(t, y, yf, sigma: float = 0.0, lsb: float = 0.0) -> str:
         k0 = _last_true(~top[:ip])
         k1 = ip + int(np.argmax(~top[ip:])) if not top[ip:].all() else z.size
         held = t[min(k1, z.size - 1)] - t[k0 + 1]
-        if k1 - k0 - 1 >= 5 and held > 0.15 * max(t[ip], 1e-300):
+        # a smooth peak of this height (curvature of an underdamped one,
+        # overshoot (pi / tp)^2 / 2) stays within the band about
+        # 0.9 sqrt(band / overshoot) tp: a clipped one much longer
+        smooth = 0.9 * math.sqrt(band / (peak - 1.0)) * t[ip]
+        if k1 - k0 - 1 >= 5 and held > max(2.0 * smooth, 0.15 * t[ip]):
             return (f"the response stays at its maximum ({100 * (peak - 1):.0f} % over the final "
                     f"value) for {held:.3g} s: clipped at a rail (a flat top), not a linear plant")
     return ""
