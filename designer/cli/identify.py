@@ -62,11 +62,11 @@ a least-squares parameter with a confidence interval wider than itself is not
 valid. Quantised (8-bit) data have at least one LSB/sqrt(12) of noise.
 
 methods: first order (ziegler-nichols, hagglund, smith, sundaresan-krishnaswamy,
-nishikawa, alfaro, broida, chen-yang, ho, viteckova), double pole
+nishikawa, alfaro, broida, chen-yang, ho, viteckova, alfaro-123c), double pole
 (ho-double-pole, viteckova-double-pole), second order (overshoot,
 log-decrement, t4-t3, two-pole, chen, stark-mollenkamp, jahanmiri-fallahi,
-peeling, dc-motor), and least-squares fits (fopdt, overdamped, underdamped)
-with 95 % confidence intervals. Parameters: K, tau_s, theta_s; K, wn_rad_s,
+peeling, dc-motor, alfaro-123c-overdamped, harriott), and least-squares fits
+(fopdt, overdamped, underdamped) with 95 % confidence intervals. Parameters: K, tau_s, theta_s; K, wn_rad_s,
 zeta, theta_s; K, tau1_s, tau2_s, theta_s.
 
 limits: a capture of at most {size} and {rows:,} samples; every time (and

@@ -26,6 +26,9 @@ Methods
   ``smith`` entry above, with identical coefficients).
 - Double-pole two-point versions (Table III): ``ho-double-pole``,
   ``viteckova-double-pole`` (model ``double-pole``).
+- ``alfaro-123c``: Alfaro's 123c FOPDT, the Table II row with the original's
+  four digits (its overdamped second-order version is
+  :func:`designer.identify.second_order.alfaro_123c_overdamped`).
 
 Validity range (checked, and reported as ``valid=False`` with a note): the
 response must be monotonic, as FOPDT and double-pole models cannot overshoot
@@ -85,6 +88,11 @@ TABLE_III = (
 )
 #: Sundaresan-Krishnaswamy (seed 000 eq. 11-12): same form, its own points.
 SUNDARESAN = TwoPoint("sundaresan-krishnaswamy", 0.353, 0.853, -0.67, 0.67, 1.3, -0.29)
+#: Alfaro's "123c" FOPDT (V. M. Alfaro, Ingenieria 11, 2001; the survey seed 000
+#: cites): the 25 % and 75 % points of seed 000's Table II row with the four
+#: digits of the original, tau = 0.9102 (t75 - t25), theta = 1.2620 t25 - 0.2620 t75
+#: (0.9102 = 1/ln 3: exact on an FOPDT).
+ALFARO_123C = TwoPoint("alfaro-123c", 0.25, 0.75, -0.9102, 0.9102, 1.2620, -0.2620)
 
 
 def exact_coefficients(p1: float, p2: float, model: str = "fopdt") -> tuple:
@@ -241,6 +249,11 @@ def sundaresan_krishnaswamy(t, y, yf, sigma=None):
     return two_point(SUNDARESAN, t, y, yf, sigma)
 
 
+def alfaro_123c(t, y, yf, sigma=None):
+    """Alfaro 123c, FOPDT: 25 % and 75 % points (:data:`ALFARO_123C`)."""
+    return two_point(ALFARO_123C, t, y, yf, sigma)
+
+
 def _bind(row):
     def method(t, y, yf, sigma=None):
         return two_point(row, t, y, yf, sigma)
@@ -250,12 +263,14 @@ def _bind(row):
     return method
 
 
-#: Every first-order and double-pole method, in the seed's order.
+#: Every first-order and double-pole method, in the seed's order (Alfaro 123c last).
 FIRST_ORDER_METHODS = [ziegler_nichols, hagglund, smith, sundaresan_krishnaswamy, nishikawa] + [
-    _bind(r) for r in TABLE_II if r.name != "smith"] + [_bind(r) for r in TABLE_III]
+    _bind(r) for r in TABLE_II if r.name != "smith"] + [_bind(r) for r in TABLE_III] + [
+    alfaro_123c]
 
 #: name -> method, for ``--methods``.
 METHOD_NAMES = {"ziegler-nichols": ziegler_nichols, "hagglund": hagglund, "smith": smith,
                 "sundaresan-krishnaswamy": sundaresan_krishnaswamy, "nishikawa": nishikawa,
                 **{r.name: m for r, m in zip([r for r in TABLE_II if r.name != "smith"]
-                                              + list(TABLE_III), FIRST_ORDER_METHODS[5:])}}
+                                              + list(TABLE_III), FIRST_ORDER_METHODS[5:])},
+                "alfaro-123c": alfaro_123c}

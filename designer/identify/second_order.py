@@ -33,6 +33,12 @@ Methods (``STEP_METHODS``, in this order):
                           semilog plot (seed 003 section 2.3)
 ``dc-motor``              DC motor velocity, Km = W(inf)/a,
                           tau_m = -t0 / ln(1 - w(t0)/W(inf)) (seed 000 eqs 52-55)
+``alfaro-123c-overdamped`` Alfaro's 123c overdamped second order with dead time,
+                          25/50/75 % points (the method of seed 000's Table II
+                          "Alfaro" row, extended to two poles)
+``harriott``              Harriott (1964): tau1 + tau2 from the 73 % time, their
+                          ratio from the response at half that sum (his chart,
+                          computed here from the exact response)
 ========================  =======================================================
 
 :func:`dc_motor_position` (an integrating, never-settling response) is not in
@@ -63,6 +69,7 @@ from .structures import MethodResult, iae_ise, model_step
 __all__ = [
     "STEP_METHODS", "overshoot", "log_decrement", "t4_t3", "two_pole", "chen",
     "stark_mollenkamp", "jahanmiri_fallahi", "peeling", "dc_motor", "dc_motor_position",
+    "alfaro_123c_overdamped", "harriott",
     "zeta_from_overshoot", "wn_from_peak_time", "dc_motor_velocity", "normalized_step",
     "t4_t3_ratio", "t4_t3_table", "zeta_from_t4_t3", "extrema",
 ]
@@ -839,5 +846,116 @@ def dc_motor_position(t, theta, a: float = 1.0, tail: float = 0.3) -> MethodResu
                         valid=valid, note=note, points={"tail_from_s": float(t[k0])})
 
 
+# --------------------------------------------------------------------------
+# Alfaro 123c (overdamped) and Harriott
+# --------------------------------------------------------------------------
+
+@_guarded("alfaro-123c-overdamped", "overdamped")
+def alfaro_123c_overdamped(t, y, yf, sigma=None) -> MethodResult:
+    """Alfaro's 123c method for K e^(-L s) / ((T s + 1)(a T s + 1)), 0 <= a <= 1
+    (V. M. Alfaro, "Identificacion de procesos sobreamortiguados utilizando
+    tecnicas de lazo abierto", Ingenieria 11, 2001, the reference of seed 000's
+    Table II "Alfaro" row).
+
+    From the times to 25, 50 and 75 %:
+    a = (-0.6240 t25 + 0.9866 t50 - 0.3626 t75) / (0.3533 t25 - 0.7036 t50 + 0.3503 t75),
+    T = (t75 - t25) / (0.9866 + 0.7036 a), L = t75 - (1.3421 + 1.3455 a) T.
+    A correlation fitted over 0 <= a <= 1: for a >= 0.3 its model follows the
+    response to about 1 % of the step (checked in the tests), its parameters
+    less closely (T within about 13 %); towards a = 0 it drifts (7-12 % of the
+    step), so a result whose model misses the data by over 2 % rms is invalid.
+    """
+    name, model = "alfaro-123c-overdamped", "overdamped"
+    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    if err:
+        return _fail(name, model, err, yf)
+    t25, t50, t75 = (crossing_time(t, z, p, sigma=sigma) for p in (0.25, 0.5, 0.75))
+    if not all(math.isfinite(v) for v in (t25, t50, t75)) or not t25 < t50 < t75:
+        return _fail(name, model, "the response does not rise through 25, 50 and 75 % of its "
+                     "final value", yf)
+    pts = {"t25_s": t25, "t50_s": t50, "t75_s": t75}
+    den = 0.3533 * t25 - 0.7036 * t50 + 0.3503 * t75
+    a = (-0.6240 * t25 + 0.9866 * t50 - 0.3626 * t75) / den
+    pts["a"] = a
+    if not 0.0 <= a <= 1.0:
+        return _fail(name, model, f"a = {a:.3f} outside 0 <= a <= 1: " + (
+            "one pole dominates (a first-order response: use alfaro-123c)" if a < 0 else
+            "the response is not that of two real poles with dead time"), yf, pts)
+    big = (t75 - t25) / (0.9866 + 0.7036 * a)
+    theta = t75 - (1.3421 + 1.3455 * a) * big
+    note = ""
+    if theta < 0.0:
+        if -theta > 0.02 * (t75 - t25):
+            note = f"L = {theta:.3g} s came out negative and was set to 0"
+        theta = 0.0
+    params = {"K": float(yf), "tau1_s": a * big, "tau2_s": big, "theta_s": theta}
+    valid = float(np.max(z)) <= 1.0 + max(4.0 * sigma, 0.02)
+    if not valid:
+        note = "; ".join(x for x in (note, "the response overshoots: two real poles cannot") if x)
+    # the correlation drifts near a = 0 (one dominant pole): its model must
+    # still follow the data
+    rms = float(np.sqrt(np.mean((z - model_step(model, dict(params, K=1.0), t)) ** 2)))
+    pts["rms_error"] = rms
+    if valid and rms > 0.02 + 3.0 * sigma:
+        valid = False
+        note = "; ".join(x for x in (note, f"the correlation's model misses the data by "
+                                     f"{100 * rms:.2g} % rms (a = {a:.3f}: one pole dominates; "
+                                     "see alfaro-123c)") if x)
+    return MethodResult(name, model, params, valid=valid, note=note, points=pts)
+
+
+#: Harriott's 73 % rule: t73 = 1.3 (tau1 + tau2), the curves' common point.
+HARRIOTT_73 = 1.3
+
+
+@functools.lru_cache(maxsize=1)
+def _harriott_chart():
+    """Harriott's chart, computed: (tau1/(tau1+tau2), y at t = (tau1+tau2)/2) for
+    tau1/(tau1+tau2) from 0 (one pole) to 0.5 (a double pole)."""
+    r = np.linspace(1e-6, 0.5, 2001)
+    h = np.empty_like(r)
+    for i, ri in enumerate(r):
+        h[i] = float(model_step("overdamped", {"K": 1.0, "tau1_s": ri,
+                                               "tau2_s": 1.0 - ri + 1e-9 * (ri == 0.5)},
+                                np.array([0.5]))[0])
+    return r, h
+
+
+@_guarded("harriott", "overdamped")
+def harriott(t, y, yf, sigma=None) -> MethodResult:
+    """Harriott's method for two real poles without dead time (P. Harriott,
+    Process Control, McGraw-Hill 1964; in most process-control texts).
+
+    tau1 + tau2 = t73 / 1.3, the time to 73 % divided by 1.3; the response at
+    half that sum, y(0.5 (tau1 + tau2)) / yf, gives tau1 / (tau1 + tau2) from
+    Harriott's chart, computed here from the exact two-pole response (0.393 for
+    one pole down to 0.264 for a double pole). Valid for responses inside the
+    chart and without dead time.
+    """
+    name, model = "harriott", "overdamped"
+    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    if err:
+        return _fail(name, model, err, yf)
+    t73 = crossing_time(t, z, 0.73, sigma=sigma)
+    if not (math.isfinite(t73) and t73 > 0.0):
+        return _fail(name, model, "the response does not reach 73 % of its final value", yf)
+    total = t73 / HARRIOTT_73
+    th = 0.5 * total
+    zh = float(np.interp(th, t, z))
+    pts = {"t73_s": t73, "tau_sum_s": total, "y_half": zh}
+    r, h = _harriott_chart()
+    if not h[-1] - 0.01 <= zh <= h[0] + 0.01:
+        return _fail(name, model, f"y((tau1 + tau2)/2) = {zh:.3f} is outside Harriott's chart "
+                     f"({h[-1]:.3f} to {h[0]:.3f}): a dead time or not two real poles", yf, pts)
+    ratio = float(np.interp(zh, h[::-1], r[::-1]))
+    pts["tau1_fraction"] = ratio
+    params = {"K": float(yf), "tau1_s": max(ratio * total, 1e-300),
+              "tau2_s": (1.0 - ratio) * total, "theta_s": 0.0}
+    valid = float(np.max(z)) <= 1.0 + max(4.0 * sigma, 0.02)
+    note = "assumes no dead time" if valid else "the response overshoots: two real poles cannot"
+    return _flag_late(MethodResult(name, model, params, valid=valid, note=note, points=pts),
+                      t, z, sigma)
+
+
 STEP_METHODS = [overshoot, log_decrement, t4_t3, two_pole, chen, stark_mollenkamp,
-                jahanmiri_fallahi, peeling, dc_motor]
+                jahanmiri_fallahi, peeling, dc_motor, alfaro_123c_overdamped, harriott]

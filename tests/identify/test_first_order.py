@@ -148,3 +148,14 @@ def test_negative_gain_is_identified_with_its_sign():
     m = r.methods[0]
     assert m.params["K"] == pytest.approx(-2.0, rel=1e-3)  # tail mean 9 tau after the step
     assert m.params["tau_s"] == pytest.approx(1.0, rel=2e-3)
+
+
+def test_alfaro_123c_is_exact_on_an_fopdt():
+    """0.9102 = 1/ln 3 to four digits and 1.2620 = 1 + ln(4/3)/ln 3: on an FOPDT
+    the 123c row is exact where the seed's rounded Alfaro row is 0.02 % off."""
+    p = {"K": 3.0, "tau_s": 2e-3, "theta_s": 5e-4}
+    t = np.linspace(0, 0.03, 60001)
+    r = METHOD_NAMES["alfaro-123c"](t, model_step("fopdt", p, t), 3.0)
+    assert r.params["tau_s"] == pytest.approx(2e-3, rel=2e-4)
+    assert r.params["theta_s"] == pytest.approx(5e-4, rel=1e-3)
+    assert METHOD_NAMES["alfaro-123c"] in FIRST_ORDER_METHODS
