@@ -97,6 +97,12 @@ least-squares (fopdt, underdamped, overdamped, with dead time when there is
 phase; 95 % confidence half-widths). Dead time is read from the phase lag the
 model does not explain.
 
+tables: a Digilent WaveForms network-analyser export (frequency, each channel's
+magnitude, the relative channel's phase) is read as that channel's response.
+The low-frequency slope is a regression over the lowest decade. A loop-gain
+table (gain above 0 dB at the lowest frequency, falling through it) also gets
+its crossover, phase margin and gain margin ("loop" in the JSON).
+
 fit error (the iae/ise columns): e = |G_model/G_data - 1| at each tabulated
 frequency (gain only without phase); iae = mean of e, ise = mean of e^2.
 A model is valid (ok = yes) when its fit error is at most {max_err:g} % and its

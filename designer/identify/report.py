@@ -134,6 +134,16 @@ def freq_text(result) -> str:
              + (f"phase in {d.units['phase']}" if d.phase is not None else "no phase")
              + (" (inverting: K < 0)" if d.sign < 0 else "")]
     lines += [f"  note: {n}" for n in d.notes]
+    lp = result.loop
+    if lp is not None:
+        lines.append(f"Open loop: low-frequency slope {lp.lf_slope_db_dec:+.1f} dB/decade, "
+                     f"crossover {format_eng(lp.crossover_hz, 'Hz')}, phase margin "
+                     + (f"{lp.phase_margin_deg:.1f} deg" if lp.phase_margin_deg is not None
+                        else "n/a")
+                     + ", gain margin "
+                     + (f"{lp.gain_margin_db:.1f} dB at {format_eng(lp.phase_crossover_hz, 'Hz')}"
+                        if lp.gain_margin_db is not None else "n/a")
+                     + (f" ({lp.note})" if lp.note else ""))
     lines += ["", ("Methods ranked by fit error (mean |G_model/G_data - 1| over the table; "
                    "lower is better)")]
     lines += methods_table(result.methods, name_width=15, params_width=84, corners=True,
