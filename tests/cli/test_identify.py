@@ -260,3 +260,29 @@ def test_unphysical_classical_results_are_not_evaluated():
         if any(k.startswith("tau") and v <= 0 for k, v in m.params.items()):
             assert not m.valid and not math.isfinite(m.iae)
     assert res.best.model == "underdamped"
+
+
+# --------------------------------------------------------------------------- issue 9
+
+def test_format_window_and_bench_files_on_the_command_line(tmp_path):
+    fix = FIX / "tds_output_only_square.csv"
+    runs = run_many([[fix, "--json"], [fix, "--json", "--window", "-0.5m", "6.5m"],
+                     [fix, "--format", "tektronix-tds"], [fix, "--format", "rigol"],
+                     [fix, "--window", "7m", "1m"], [fix, "--window", "0", "1e300"],
+                     [fix, "--format", "lecroy"], [FIX / "rigol_nox_slew.csv"]])
+    full, win, forced, wrong, backwards, huge, unknown, slew = runs
+    out = json.loads(full.stdout)
+    assert out["capture"]["format"] == "tektronix-tds"
+    pre = out["preprocessing"]
+    assert pre["noise_sigma"] > 0 and pre["edges_averaged"] == 1 and pre["quantisation_step"]
+    assert "rise_time_0_100_s" in out["measured"]
+    assert json.loads(win.stdout)["preprocessing"]["window_s"] == pytest.approx([-0.5e-3, 6.5e-3])
+    assert forced.returncode == 0 and "(tektronix-tds," in forced.stdout
+    assert "Noise " in forced.stdout and "one edge" in forced.stdout
+    for proc, words in ((wrong, "not a Rigol"), (backwards, "must start before it ends"),
+                        (huge, "--window T1"), (unknown, "invalid choice")):
+        assert proc.returncode == 2, (words, proc.stderr)
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1 and words in lines[0] and "np." not in lines[0], proc.stderr
+    assert slew.returncode == 0 and "NON-LINEAR" in slew.stdout
+    assert "Best: none of the methods is valid" in slew.stdout
