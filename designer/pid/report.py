@@ -304,7 +304,9 @@ def _scope_blocks(result, with_images, b=None) -> list:
         x, y = la.get(role), ls.get(role)
         if x is None and y is None:
             continue
-        amp = next(a for a in b.netlist.amps if a.role == role)
+        amp = next((a for a in b.netlist.amps if a.role == role), None)
+        if amp is None:      # a PI has no differentiator
+            continue
         unit = b.unit_of(amp.ref)
         rail = None if y is None else y.time_high_s + y.time_low_s if y.time_high_s is not None else 0
         ch = vdiv.get(sig)
@@ -383,7 +385,7 @@ def _blocks_plot(result) -> bytes:
     sp = None if result.spice is None else result.spice.waves
     amp = result.opamp
     sigs = [(ref, role, s) for ref, role, s in OPAMP_OUTPUTS if s in w.analytic]
-    fig, axes = figure(7.5, 1.1 * len(sigs) + 0.6, len(sigs), 1, sharex=True)
+    fig, axes = figure(7.5, 0.85 * len(sigs) + 0.6, len(sigs), 1, sharex=True)
     for ax, (ref, role, s) in zip(axes, sigs):
         ax.plot(*decimate(t, w.analytic[s]), "-", lw=1.2, label="analytic")
         if sp is not None and s in sp:

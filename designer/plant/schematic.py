@@ -69,7 +69,7 @@ def draw_plant(board, opamp, sheet: Sheet | None = None, origin=(0.0, 0.0), inp_
         s.part(r19, k, g, label_loc="bottom")
         s.ground(g)
     if supplies:
-        draw_supplies(s, board, opamp, (x0 + 1.0, y0 - 6.5 if amp.inn != amp.out else y0 - 4.2))
+        draw_supplies(s, board, opamp, (x0 + 1.0, y0 - 8.2 if amp.inn != amp.out else y0 - 5.6))
     return s
 
 

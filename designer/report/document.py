@@ -97,7 +97,7 @@ thead{display:table-header-group}tr{break-inside:avoid}table.compact{font-size:1
 .plots{display:grid;grid-template-columns:1fr 1fr;gap:.5rem}.plots img{width:100%}
 @page{margin:11mm 10mm}
 @media print{body{margin:0;max-width:none;padding:0;font-size:9pt}table{font-size:8pt}table.compact{font-size:7.6pt}
-h1{font-size:12.5pt}h2{font-size:10.5pt;margin-top:.5rem}img,.fig{break-inside:avoid}.fig svg{max-height:none}
+h1{font-size:12.5pt}h2{font-size:10.5pt;margin-top:.5rem}img,.fig{break-inside:avoid}.fig svg{max-height:125mm}
 .plots img{break-inside:avoid}}"""
 
 

@@ -55,12 +55,10 @@ def bom_rows(board, source_of, opamp_name: str) -> list:
         rows.append([", ".join(p.ref for p in ps), format_eng(value, ps[0].unit, 4), value_code(value), len(ps),
                      series, "" if tol is None else f"{tol:g} %", pkg, desc])
     pkg = board.package
-    for ic in board.ics:
-        used = [(a, u) for a, u in zip(board.netlist.amps, board.units) if u.ic_ref == ic]
-        what = ", ".join(f"{u.designator} {a.role}" for a, u in used)
-        spare = [u.designator for u in board.spares if u.ic_ref == ic]
-        rows.append([ic, pkg.part, "", 1, "", "", pkg.pinout,
-                     f"{opamp_name} op-amp: {what}" + (f"; spare {', '.join(spare)} tied off" if spare else "")])
+    what = ", ".join(f"{u.designator} {a.role}" for a, u in zip(board.netlist.amps, board.units))
+    spare = [u.designator for u in board.spares]
+    rows.append([", ".join(board.ics), pkg.part, "", len(board.ics), "", "", pkg.pinout,
+                 f"{opamp_name} op-amps: {what}" + (f"; spare {', '.join(spare)} tied off" if spare else "")])
     return rows
 
 
@@ -114,11 +112,10 @@ def wiring_rows(board, labels: dict, supplies: tuple) -> list:
     vcc, vee = supplies
     for ic in board.ics:
         n = ic[1:]
-        rows.append(["wire", "", f"{ic} pin {pkg.vcc} (V+)", f"{vcc:+g} V rail; C{n}01 100n to ground at the pin"])
-        rows.append(["wire", "", f"{ic} pin {pkg.vee} (V-)", f"{vee:+g} V rail; C{n}02 100n to ground at the pin"])
-        if pkg.unused:
-            rows.append(["open", "", f"{ic} pins " + ", ".join(str(k) for k in pkg.unused),
-                         "; ".join(sorted(set(pkg.unused.values())))])
+        opened = (f"; pins {', '.join(str(k) for k in pkg.unused)} open ({', '.join(sorted(set(pkg.unused.values())))})"
+                  if pkg.unused else "")
+        rows.append([ic, pkg.part, f"pin {pkg.vcc} (V+): {vcc:+g} V, C{n}01 100n to ground at the pin",
+                     f"pin {pkg.vee} (V-): {vee:+g} V, C{n}02 100n to ground at the pin" + opened])
     for u in board.spares:
         rows.append(["wire", "", f"{u.designator} pin {u.pins['inp']} (+in)", "ground (spare unit)"])
         rows.append(["wire", "", f"{u.designator} pin {u.pins['out']} (out)",

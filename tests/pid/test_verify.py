@@ -85,9 +85,9 @@ def test_positive_feedback_latches_at_a_rail():
     parts = blocks.select_parts(1.0, 60e-6, 5e-6, SEED_PLANT.fn_hz).parts
     test = SquareTest(1.0, 330.0, 50e-6, 100e-9)
     deck = closed_loop_deck(parts, SEED_PLANT, amp, test, "positive feedback", 1.0)
-    deck = re.sub(r"^R15 ref n1", "R15 y n1", deck, flags=re.M)
-    deck = re.sub(r"^R17 y p1", "R17 ref p1", deck, flags=re.M)
-    assert "R15 y n1" in deck and "R17 ref p1" in deck
+    deck = re.sub(r"^R15 ref n2", "R15 y n2", deck, flags=re.M)
+    deck = re.sub(r"^R17 y p2", "R17 ref p2", deck, flags=re.M)
+    assert "R15 y n2" in deck and "R17 ref p2" in deck
     # the latched loop never crosses the .meas levels: those measurements fail, the run must not
     res = get_simulator("pyspice").run(deck)
     assert "settling_time_s" not in res.measurements
