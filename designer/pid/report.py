@@ -404,7 +404,7 @@ def _blocks_plot(result) -> bytes:
     axes[0].legend(fontsize=7, loc="upper right")
     axes[0].set_title("Every op-amp output (red: output limits, drawn when reached)")
     axes[-1].set_xlabel("time after the step (us)")
-    return png_bytes(fig, dpi=90)
+    return png_bytes(fig, dpi=90, tight=False)
 
 
 def _reaction_plot(result) -> bytes:
@@ -426,7 +426,7 @@ def _reaction_plot(result) -> bytes:
     ax.set_ylabel("output per volt of step")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    return png_bytes(fig, dpi=90)
+    return png_bytes(fig, dpi=90, tight=False)
 
 
 def schematic(result):

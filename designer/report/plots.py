@@ -32,19 +32,22 @@ def decimate(x, *ys, n: int = MAX_POINTS):
 
 
 def figure(w: float, h: float, rows: int = 1, cols: int = 1, **kw):
-    """A figure and its axes without pyplot (Agg canvas)."""
+    """A figure and its axes without pyplot (Agg canvas), with fixed margins: a
+    "tight" bounding box would draw every figure twice to measure it."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     fig = Figure(figsize=(w, h))
     FigureCanvasAgg(fig)
     axes = fig.subplots(rows, cols, **kw)
+    fig.subplots_adjust(left=0.1, right=0.98, top=0.93, bottom=0.1, hspace=0.28)
     return fig, axes
 
 
-def png_bytes(fig, dpi: int = 110) -> bytes:
-    """A matplotlib figure as PNG bytes (the figure is closed if pyplot owns it)."""
+def png_bytes(fig, dpi: int = 110, tight: bool = True) -> bytes:
+    """A matplotlib figure as PNG bytes (the figure is closed if pyplot owns it);
+    ``tight`` crops to what is drawn (one more drawing pass)."""
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
+    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight" if tight else None)
     import sys
     if "matplotlib.pyplot" in sys.modules:
         sys.modules["matplotlib.pyplot"].close(fig)
@@ -87,7 +90,7 @@ def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)", residual:
         ar.grid(True, alpha=0.3)
         last = ar
     last.set_xlabel("time after the step (us)")
-    return png_bytes(fig, dpi=100)
+    return png_bytes(fig, dpi=100, tight=False)
 
 
 def bode_plot(systems: dict, f_lo: float, f_hi: float, title: str, measured: dict | None = None,
@@ -119,7 +122,7 @@ def bode_plot(systems: dict, f_lo: float, f_hi: float, title: str, measured: dic
     for a in (a1, a2):
         a.grid(True, which="both", alpha=0.3)
     a1.legend(fontsize=7.5, loc="lower left")
-    return png_bytes(fig, dpi=100)
+    return png_bytes(fig, dpi=100, tight=False)
 
 
 def loop_gain_plot(f, L, title: str, crossover_hz: float, phase_margin_deg: float,
@@ -158,4 +161,4 @@ def loop_gain_plot(f, L, title: str, crossover_hz: float, phase_margin_deg: floa
     a2.set_xlabel("frequency (Hz)")
     for ax in (a1, a2):
         ax.grid(True, which="both", alpha=0.3)
-    return png_bytes(fig, dpi=100)
+    return png_bytes(fig, dpi=100, tight=False)

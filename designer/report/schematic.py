@@ -160,7 +160,7 @@ class Sheet:
         import io
         fig = self.d.draw(show=False, canvas="matplotlib")
         buf = io.BytesIO()
-        fig.fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
+        fig.fig.savefig(buf, format="png", dpi=dpi)
         import sys
         if "matplotlib.pyplot" in sys.modules:
             sys.modules["matplotlib.pyplot"].close(fig.fig)
