@@ -91,6 +91,7 @@ def main():
     cli = statistics.median(times)
     print(f"\n`design-pid --plant-fc 3500 --plant-zeta 0.2` end to end (new process, files written): "
           f"{cli:.2f} s (goal < {GOAL_S:g} s: {'ok' if cli < GOAL_S else 'MISSED'})\n")
+    optimize_end_to_end(exe)
     search_tables()
 
 
@@ -157,6 +158,29 @@ def search_tables():
             same_obj = all(abs(a - b) <= 1e-9 * abs(b) for a, b in zip(got, best_obj))
             print(f"| {kp:g}, {ti * 1e6:g} us, {td * 1e6:g} us | {tol:g} | {t:.3f} | {tb:.2f} | "
                   f"{sel.best_possible_pct:.4g} % | {'yes' if same_err else 'NO'} | {'yes' if same_obj else 'NO'} |")
+
+
+
+
+#: issue 11: `design-pid --tuning optimize` end to end (schematic, plots, sheets included), seconds
+OPTIMIZE_GOAL_S = 2.5
+
+
+def optimize_end_to_end(exe, repeat: int = 3):
+    """`design-pid --tuning optimize --target-overshoot 10` as a new process, files written, median."""
+    times = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(repeat):
+            tick = time.perf_counter()
+            p = subprocess.run([str(exe), "--plant-fc", "3500", "--plant-zeta", "0.2", "--tuning", "optimize",
+                                "--target-overshoot", "10", "--out", tmp], capture_output=True, text=True)
+            times.append(time.perf_counter() - tick)
+            if p.returncode != 0:
+                raise RuntimeError(p.stderr)
+    t = statistics.median(times)
+    print(f"`design-pid --tuning optimize --target-overshoot 10` end to end (new process, schematic, plots and "
+          f"sheets written, median of {repeat}): {t:.2f} s (goal <= {OPTIMIZE_GOAL_S:g} s: "
+          f"{'ok' if t <= OPTIMIZE_GOAL_S else 'MISSED'})\n")
 
 
 if __name__ == "__main__":

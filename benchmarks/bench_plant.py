@@ -205,6 +205,37 @@ def main():
     print(f"| interpreter start + imports | {statistics.median(imp):.3f} |")
     wall = statistics.median(walls)
     print(f"| whole command (pyspice backend, files written) | {wall:.3f} ({'ok' if wall < 3 else 'MISSED'}) |")
+    against_ngspice(exe)
+
+
+#: issue 11: design-plant end to end (schematic, plots, sheets, .ac check included) within this many
+#: times the bare `ngspice -b` run of its own deck
+NGSPICE_RATIO_GOAL = 7.0
+
+
+def against_ngspice(exe, repeat: int = 5):
+    """design-plant end to end against `ngspice -b` of the deck it writes, both as new processes,
+    medians of ``repeat`` interleaved runs (the machine's load hits both alike)."""
+    print(f"\n### design-plant against its own deck in bare ngspice (median of {repeat}; goal <= "
+          f"{NGSPICE_RATIO_GOAL:g}x)\n")
+    plant, bare = [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(repeat):
+            t = time.perf_counter()
+            subprocess.run([exe, "--fc", "3500", "--zeta", "0.2", "--out", tmp, "--name", "p"], check=True,
+                           capture_output=True)
+            plant.append(time.perf_counter() - t)
+            deck = Path(tmp) / "netlists" / "p.cir"
+            t = time.perf_counter()
+            subprocess.run(["ngspice", "-b", str(deck)], check=True, capture_output=True, cwd=tmp)
+            bare.append(time.perf_counter() - t)
+    p, b = statistics.median(plant), statistics.median(bare)
+    ratio = p / b
+    print("| measure | seconds |")
+    print("|---|---|")
+    print(f"| `ngspice -b netlists/p.cir` | {b:.3f} |")
+    print(f"| `design-plant --fc 3500 --zeta 0.2` (SPICE, .ac, schematic, plots, sheets, bom.csv) | {p:.3f} |")
+    print(f"| ratio (goal <= {NGSPICE_RATIO_GOAL:g}) | {ratio:.1f}x {'ok' if ratio <= NGSPICE_RATIO_GOAL else 'MISSED'} |")
 
 
 if __name__ == "__main__":
