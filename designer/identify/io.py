@@ -44,6 +44,7 @@ Every row's values are checked against their physical ranges
 from __future__ import annotations
 
 import bisect
+import io
 import math
 import re
 from dataclasses import dataclass, field
@@ -194,15 +195,23 @@ def _read_head(fh) -> tuple:
     return decode(buf[bom:cut + 1]).splitlines(), buf[cut + 1:]
 
 
+def _text_flags(text: str) -> tuple:
+    """:func:`_flags` of a block given as text (no list of lines made)."""
+    gaps = "#" in text or "\n\n" in text or "\n\r\n" in text or text.startswith(("\n", "\r"))
+    return gaps, '"' in text
+
+
 def _file_blocks(fh, carry: bytes):
-    """The rest of the file as blocks of decoded lines (about BLOCK_BYTES each),
-    each with its :func:`_flags`; a line longer than MAX_LINE_BYTES is refused."""
+    """The rest of the file as blocks of decoded text (about BLOCK_BYTES each, whole
+    lines), each with its :func:`_flags`; a line longer than MAX_LINE_BYTES is refused.
+    Kept as text: numpy's parser splits the lines itself, a list of a million
+    strings costs a tenth of a second per 50 MB."""
     while True:
         data = fh.read(BLOCK_BYTES)
         if not data:
             if carry.strip():
                 text = decode(carry)
-                yield text.splitlines(), ("#" in text, '"' in text)
+                yield text, _text_flags(text)
             return
         buf = carry + data
         cut = buf.rfind(b"\n")
@@ -214,8 +223,7 @@ def _file_blocks(fh, carry: bytes):
             continue
         carry = buf[cut + 1:]
         text = decode(buf[:cut + 1])
-        lines = text.splitlines()
-        yield lines, ("#" in text or "" in lines, '"' in text)
+        yield text, _text_flags(text)
 
 
 @dataclass
@@ -676,15 +684,36 @@ def _load(head, layout, keep, blocks, name, size_hint) -> _Columns:
             raise DesignError(f"{name}: more than {MAX_CAPTURE_ROWS:,} samples, the most "
                               "identify reads; decimate the record or cut it to the step")
         cols.append(rows, where)
-        line0 += len(lines)
+        line0 += (text_lines(lines) if isinstance(lines, str) else len(lines))
         del lines, rows   # before the next block is read
     return cols
 
 
+def text_lines(text: str) -> int:
+    """Lines in a block of text, as ``str.splitlines`` counts them for a CSV."""
+    return text.count("\n") + (0 if not text or text.endswith("\n") else 1)
+
+
 def _parse_block(lines, line0, delim, usecols, flags, name, comma=False) -> tuple:
-    """Numeric rows of a block of lines and their line numbers (the first one's
-    number when no line was skipped, else an array)."""
+    """Numeric rows of a block of lines (a list, or the block's text) and their
+    line numbers (the first one's number when no line was skipped, else an array)."""
     gaps, quotes = flags
+    if isinstance(lines, str):
+        text = lines
+        if not gaps:
+            if quotes:
+                text = text.replace('"', "")
+            if comma or delim == ";":
+                text = text.replace(",", ".")
+            try:
+                rows = np.loadtxt(io.StringIO(text.replace("\r", "")),
+                                  delimiter=None if delim == "whitespace" else delim,
+                                  usecols=usecols, ndmin=2, dtype=float, comments="#")
+                if rows.shape[0] == text_lines(lines):
+                    return rows, line0
+            except ValueError:
+                pass  # a bad cell: found, with its line, below
+        lines = lines.splitlines()
     if quotes:
         lines = [ln.replace('"', "") for ln in lines]   # spreadsheet-quoted numbers
     if comma or delim == ";":
