@@ -426,30 +426,27 @@ def _read_generic(lines, name, forced=False) -> _Layout:
     return _read_table(lines, name, "generic", forced)
 
 
-def _read_waveform(lines, name, forced=False) -> _Layout:
-    lay = _read_table(lines, name, "waveform", forced)
-    if forced and lay.columns[0].lower() != "time_s":
-        raise _not_this(name, "waveform", max(lay.first_row - 1, 0), lines,
-                        "is not the header time_s,<signal>,...")
-    return lay
+def _headed_table(fmt: str, first_cell, header: str):
+    """The reader of a table layout whose header row's first cell passes
+    ``first_cell`` (checked when the format is forced: ``header`` says what it
+    should be)."""
+    def read(lines, name, forced=False) -> _Layout:
+        lay = _read_table(lines, name, fmt, forced)
+        if forced and not first_cell(lay.columns[0].lower()):
+            raise _not_this(name, fmt, max(lay.first_row - 1, 0), lines,
+                            f"is not the header {header}")
+        return lay
+    read.__doc__ = f"{fmt}: header lines, then {header} and the samples."
+    return read
 
 
-def _read_tektronix_mso(lines, name, forced=False) -> _Layout:
-    """MSO/DPO: ``Model,...`` key/value lines, then ``TIME,CH1,...`` and the samples."""
-    lay = _read_table(lines, name, "tektronix-mso", forced)
-    if forced and lay.columns[0].upper() != "TIME":
-        raise _not_this(name, "tektronix-mso", max(lay.first_row - 1, 0), lines,
-                        "is not the header TIME,CH1,...")
-    return lay
-
-
-def _read_digilent(lines, name, forced=False) -> _Layout:
-    """WaveForms: ``#`` comment lines, then ``Time (s),Channel 1 (V),...``."""
-    lay = _read_table(lines, name, "digilent", forced)
-    if forced and not lay.columns[0].lower().startswith("time"):
-        raise _not_this(name, "digilent", max(lay.first_row - 1, 0), lines,
-                        "is not the header Time (s),Channel 1 (V),...")
-    return lay
+#: This project's waveforms (``time_s,<signal>,...``), Tektronix MSO/DPO
+#: (``Model,...`` key/value lines, then ``TIME,CH1,...``), Digilent WaveForms
+#: (``#`` comment lines, then ``Time (s),Channel 1 (V),...``).
+_read_waveform = _headed_table("waveform", lambda c: c == "time_s", "time_s,<signal>,...")
+_read_tektronix_mso = _headed_table("tektronix-mso", lambda c: c == "time", "TIME,CH1,...")
+_read_digilent = _headed_table("digilent", lambda c: c.startswith("time"),
+                               "Time (s),Channel 1 (V),...")
 
 
 def _is_tds(lines) -> bool:
