@@ -19,7 +19,7 @@ from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import bundle_paths, write_bundle
 from ..report.plots import decimate, figure, loop_gain_plot, png_bytes, step_plot
-from ..report.wiring import bom_csv, bom_rows, wiring_rows
+from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
 from .model import OPAMP_OUTPUTS
 from .netlist import NET_LABELS, loop_netlist
@@ -140,16 +140,7 @@ def bom(result, b=None) -> list:
 
 
 def _settings(result, b) -> list:
-    test, sc = result.test, result.scope
-    a = test.amplitude_v
-    rows = [["generator", f"square {format_eng(test.frequency_hz, 'Hz')}, {format_eng(a, 'V')} pk-pk, offset "
-                          f"{format_eng(a / 2, 'V')} (0 to {format_eng(a, 'V')}), into R15 (r)"]]
-    if sc is not None:
-        rows += [["time base", f"{format_eng(sc.time_per_div_s, 's')}/div, edge {sc.edge_div:g} div from the left"],
-                 ["trigger", f"CH1 rising, {format_eng(sc.trigger_v, 'V')}"]]
-        for c in sc.channels[:2]:
-            rows.append([c.name, f"{format_eng(c.volts_per_div, 'V')}/div DC, 0 V {c.zero_div_below_centre:g} div "
-                                 f"below centre: {c.node}"])
+    rows = bench_rows(result.test, result.scope, "R15 (r)", channels=2)
     return [R.table(["set", "to"], rows, "compact"),
             R.text("Generator output in High-Z mode (in 50-ohm mode it shows half the amplitude it gives into "
                    "R15); check the level on CH1. Move CH2 to each TP in turn with its settings below.")]

@@ -20,7 +20,7 @@ from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import bundle_paths, write_bundle
 from ..report.plots import bode_plot, step_plot
-from ..report.wiring import bom_csv, bom_rows, wiring_rows
+from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
 from .netlist import SEED_NAMES, plant_netlist
 
@@ -86,16 +86,8 @@ def bom(result, b=None) -> list:
 
 def _settings(result) -> list:
     """The generator and the scope as set (1-2-5 steps), and the sine check."""
-    ts, sc, sine = result.test, result.scope, result.sine
-    a = ts.amplitude_v
-    rows = [["generator", f"square {format_eng(ts.frequency_hz, 'Hz')}, {format_eng(a, 'V')} pk-pk, offset "
-                          f"{format_eng(a / 2, 'V')} (0 to {format_eng(a, 'V')}), into R1"]]
-    if sc is not None:
-        rows += [["time base", f"{format_eng(sc.time_per_div_s, 's')}/div, edge {sc.edge_div:g} div from the left"],
-                 ["trigger", f"CH1 rising, {format_eng(sc.trigger_v, 'V')}"]]
-        for c in sc.channels:
-            rows.append([c.name, f"{format_eng(c.volts_per_div, 'V')}/div DC, 0 V {c.zero_div_below_centre:g} div "
-                                 f"below centre: {c.node}"])
+    sine = result.sine
+    rows = bench_rows(result.test, result.scope, "R1")
     if sine is not None:
         rows.append(["sine check", _sine_text(sine)])
     return [R.table(["set", "to"], rows, "compact"),

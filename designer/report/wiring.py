@@ -124,3 +124,22 @@ def wiring_rows(board, labels: dict, supplies: tuple) -> list:
     rows.append(["C901, C902", "10u", f"{vcc:+g} V and {vee:+g} V where the supply enters",
                  "ground (mind the polarity)"])
     return rows
+
+
+def bench_rows(test, scope, into: str, channels=None) -> list:
+    """The generator and scope settings as (set, to) rows: the square wave (``test``:
+    frequency, amplitude, offset) into ``into``, the time base, the trigger and the
+    scope's channels (``scope``: a :class:`designer.plant.bench.ScopeSetup`, read by
+    its fields; ``channels``: how many of its channels, default all)."""
+    a = test.amplitude_v
+    rows = [["generator", f"square {format_eng(test.frequency_hz, 'Hz')}, {format_eng(a, 'V')} pk-pk, offset "
+                          f"{format_eng(a / 2, 'V')} (0 to {format_eng(a, 'V')}), into {into}"]]
+    if scope is None:
+        return rows
+    rows += [["time base", f"{format_eng(scope.time_per_div_s, 's')}/div, edge {scope.edge_div:g} div from the left"],
+             ["trigger", f"CH1 rising, {format_eng(scope.trigger_v, 'V')}"]]
+    for c in scope.channels[:channels]:
+        rows.append([c.name, f"{format_eng(c.volts_per_div, 'V')}/div DC, 0 V {c.zero_div_below_centre:g} div "
+                             f"below centre: {c.node}"])
+    return rows
+
