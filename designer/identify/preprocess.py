@@ -137,10 +137,12 @@ def find_edges(t, u, *, plateaus: bool = False) -> list:
     """Transitions of a two-level signal (a step or a square wave).
 
     Levels are the record's two ends when they differ (a single step), else
-    the 1st and 99th percentiles (an input's square wave); with ``plateaus``,
-    always the medians of the samples below and above the midrange (an
-    output, whose overshoot would stretch percentiles past its plateaus and
-    whose record may end in the middle of its next edge). A transition is counted when the signal moves from
+    the 1st and 99th percentiles (an input's square wave); with ``plateaus``
+    (an output), the ends only when they differ by over half the record's
+    swing (one step, however much it overshoots), else the medians of the
+    samples below and above the midrange (a square wave, whose overshoot
+    would stretch percentiles past its plateaus, or a record that ends in the
+    middle of its next edge). A transition is counted when the signal moves from
     below 25 % to above 75 % of the span (or back), so noise near a level
     never makes a false edge. Each edge's time is the interpolated 50 %
     crossing; its levels are the means of the settled parts of the
@@ -153,12 +155,13 @@ def find_edges(t, u, *, plateaus: bool = False) -> list:
     # close to either end), else robust extremes (a square wave).
     k = max(3, u.size // 200)
     a, b = float(np.median(u[:k])), float(np.median(u[-k:]))
-    if plateaus:
+    ends = abs(b - a) > MIN_STEP_SNR * sigma
+    if plateaus and not (ends and abs(b - a) > 0.5 * float(np.ptp(u))):
         lo, hi = np.percentile(u, [1, 99])
         if hi > lo:
             mid = 0.5 * (lo + hi)
             lo, hi = float(np.median(u[u < mid])), float(np.median(u[u >= mid]))
-    elif abs(b - a) > MIN_STEP_SNR * sigma and abs(b - a) > 0.1 * float(np.ptp(u)):
+    elif ends and abs(b - a) > 0.1 * float(np.ptp(u)):
         lo, hi = min(a, b), max(a, b)
     else:
         lo, hi = np.percentile(u, [1, 99])

@@ -134,12 +134,16 @@ def resistors_for_caps(fc_hz: float, zeta: float, c1, c2, gain: float = 1.0):
     alpha = c1 + c2 * (1.0 - gain)
     beta = 2 * zeta / wn
     gamma = 1.0 / (wn * wn * c2)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         disc = beta * beta - 4 * alpha * gamma
         sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
-        lin = np.abs(alpha) < 1e-30 * np.maximum(c1, c2)
-        ra = np.where(lin, gamma / beta, (beta - sq) / (2 * alpha))
-        rb = np.where(lin, np.nan, (beta + sq) / (2 * alpha))
+        # The cancellation-free form of the quadratic's roots: q = (beta + sq)/2
+        # gives gamma/q and q/alpha, so an alpha near zero (K C2 close to
+        # C1 + C2) leaves the finite root exact and sends the other to infinity.
+        q = 0.5 * (beta + sq)
+        ra = gamma / q
+        rb = np.where(alpha != 0, q / alpha, np.nan)
+        rb = np.where(np.isfinite(rb), rb, np.nan)
     lo = np.fmin(ra, rb)
     hi = np.fmax(ra, rb)
     lo = np.where(lo > 0, lo, np.nan)

@@ -3,7 +3,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from designer.core import opamps
@@ -96,6 +96,10 @@ def test_repeated_poles_in_closed_form_on_any_grid():
 
 
 @settings(max_examples=60)
+# two cases that split np.roots' triple roots wider than a lone triple root
+# splits (found by hypothesis; the clustering once kept them apart)
+@example(rates=[1000.0, 10.0, 30.0], mult=[2, 3, 3], zero=0.0)
+@example(rates=[30.0, 100.0, 300.0], mult=[3, 3, 3], zero=0.5)
 @given(st.lists(st.sampled_from([10.0, 30.0, 100.0, 300.0, 1e3, 3e3]), min_size=1, max_size=3, unique=True),
        st.lists(st.integers(1, 3), min_size=3, max_size=3), st.sampled_from([0.0, 0.5, 2.0]))
 def test_step_response_with_repeated_poles_matches_scipy(rates, mult, zero):
@@ -109,3 +113,12 @@ def test_step_response_with_repeated_poles_matches_scipy(rates, mult, zero):
     ref = signal.step((num, den), T=t)[1]
     got = step_response(num, den, t)
     assert np.max(np.abs(got - ref)) <= 1e-7 * max(1.0, np.max(np.abs(ref)))
+
+
+def test_pole_clusters_never_merge_poles_a_percent_apart():
+    """eps^(1/m) nears 1 for large m: without a cap, nine distinct poles from
+    10 to 1000 were once taken as one ninefold pole."""
+    from designer.core.lti import MAX_CLUSTER, pole_clusters
+    poles = -np.array([10.0, 30.0, 100.0, 300.0, 1e3, 1e3 * (1 + 10 * MAX_CLUSTER), 3e3, 1e4, 3e4])
+    assert [m for _, m in pole_clusters(poles)] == [1] * 9
+    assert [m for _, m in pole_clusters(np.roots(np.poly([-5.0] * 4)))] == [4]

@@ -62,6 +62,20 @@ def test_resistors_for_caps_hit_the_targets(fc, zeta, c1, ratio, gain):
             abs(ratio * zeta ** 2 - 1) < 1e-9
 
 
+def test_resistors_for_caps_when_k_c2_nearly_equals_c1_plus_c2():
+    # found by hypothesis: gain 2 with C2 = C1 (1 + 2e-16) makes the quadratic's
+    # leading coefficient C1 + C2 (1 - K) about -2e-22; the textbook root formula
+    # lost every digit there (zeta 0.61 for 1)
+    c1 = 1e-6 * (1 - 3e-16)
+    c2 = c1 * 1.0000000000000002
+    lo, hi = resistors_for_caps(1.0, 1.0, c1, c2, 2.0)
+    r1 = float(lo)
+    r2 = 1 / ((2 * math.pi) ** 2 * c1 * c2 * r1)
+    f, z = fn_zeta(r1, r2, c1, c2, 2.0)
+    assert f == pytest.approx(1.0, rel=1e-12)
+    assert z == pytest.approx(1.0, rel=1e-9)
+
+
 def test_realizability_suggests_gain():
     notes = realizability_notes(3500, 0.005, 1.0, 1e-9, 1e-5)
     assert notes and "--gain" in notes[0]
