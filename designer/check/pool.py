@@ -62,7 +62,7 @@ class _Worker:
         self.conn.close()
 
 
-def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None) -> list:
+def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, cost=None) -> list:
     """``work(task)`` for every task, at most ``jobs`` at a time, each within
     ``timeout`` seconds; results in task order.
 
@@ -81,10 +81,15 @@ def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None) ->
         died or raised (``reason`` says which).
     setup : callable, optional
         Run once in each worker before its first task.
+    cost : callable, optional
+        ``cost(task)``: a task's expected run time (any scale). Tasks start
+        longest first, so the last to finish is a short one and the workers
+        end close together (results keep the task order).
     """
     ctx = multiprocessing.get_context("fork")
     results = [None] * len(tasks)
-    queue = deque(range(len(tasks)))
+    order = range(len(tasks)) if cost is None else sorted(range(len(tasks)), key=lambda i: -cost(tasks[i]))
+    queue = deque(order)
     workers = []
     try:
         workers = [_Worker(ctx, work, setup) for _ in range(max(1, min(jobs, len(tasks))))]

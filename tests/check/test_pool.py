@@ -1,0 +1,38 @@
+"""designer.check.pool: worker processes for check-design --jobs."""
+
+import os
+import time
+
+from designer.check.pool import run_tasks
+
+
+def _work(task):
+    return task, time.monotonic(), os.getpid()
+
+
+def _lost(task, reason):
+    return task, None, reason
+
+
+def test_results_keep_task_order_and_longest_tasks_start_first():
+    tasks = [1, 5, 2, 9, 3]
+    out = run_tasks(tasks, _work, jobs=1, timeout=60, lost=_lost, cost=lambda t: t)
+    assert [r[0] for r in out] == tasks
+    started = [r[0] for r in sorted(out, key=lambda r: r[1])]
+    assert started == sorted(tasks, reverse=True)
+
+
+def test_without_cost_tasks_start_in_order():
+    tasks = [1, 5, 2]
+    out = run_tasks(tasks, _work, jobs=1, timeout=60, lost=_lost)
+    assert [r[0] for r in sorted(out, key=lambda r: r[1])] == tasks
+
+
+def test_a_task_past_its_timeout_is_lost_and_the_rest_still_run():
+    def work(task):
+        if task == "hang":
+            time.sleep(60)
+        return task
+    out = run_tasks(["hang", "a", "b"], work, jobs=2, timeout=1.0, lost=lambda t, why: ("lost", why))
+    assert out[0][0] == "lost" and "timed out" in out[0][1]
+    assert out[1:] == ["a", "b"]
