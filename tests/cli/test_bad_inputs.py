@@ -8,15 +8,17 @@ from pathlib import Path
 
 import pytest
 
+from designer.cli.check import check_design_main
 from designer.cli.identify import identify_freq_main, identify_main
-from designer.cli.pid import design_pid_main
+from designer.cli.pid import analyze_pid_main, design_pid_main
 from designer.cli.plant import analyze_plant_main, design_plant_main
 
 HERE = Path(__file__).resolve().parent
 CORPUS = HERE / "corpus" / "bad_inputs.tsv"
 FILES = HERE / "corpus" / "files"
 MAINS = {"design-plant": design_plant_main, "analyze-plant": analyze_plant_main, "design-pid": design_pid_main,
-         "identify": identify_main, "identify-freq": identify_freq_main}
+         "identify": identify_main, "identify-freq": identify_freq_main, "analyze-pid": analyze_pid_main,
+         "check-design": check_design_main}
 
 
 def cases():
