@@ -108,14 +108,6 @@ def _add_signal_options(p):
                         "first (LM741 single, the others dual)")
 
 
-def _package(args, spec) -> str | None:
-    """The package kind asked for, refused in one line (exit 2) before any work when the
-    op-amp does not come in it (an NE5532 has no quad)."""
-    from ..core.opamps import get
-    get(spec.opamp).package(args.package)
-    return args.package
-
-
 #: the spec's parameters set from options of the same meaning (their options: FLAGS)
 SPEC_PARAMS = ("plant_fc_hz", "plant_zeta", "plant_json", "tuning", "kp", "ti_s", "td_s", "opamp", "step_v", "edge_s",
                "r_series", "c_series", "r_min", "r_max", "c_min", "c_max", "target_overshoot_pct",
@@ -128,7 +120,7 @@ def _build_spec(args):
     from ..pid.spec import PidSpec
     typed = {p: getattr(args, common.FLAGS[p][2:].replace("-", "_")) for p in SPEC_PARAMS}
     return PidSpec(plant_parts=_plant_parts(args), controller_parts=seed_parts() if args.seed_parts else None,
-                   **typed)
+                   package=args.package, **typed)
 
 
 def _plant_parts(args):
@@ -155,9 +147,7 @@ def _run(args) -> int:
     spec = _build_spec(args)
     # the default name needs the plant as built; its fixed start stands in for it in the check
     common.check_output(args, args.name if args.name is not None else f"pid_{spec.method}")
-    package = _package(args, spec)
     result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
-    result.package = package
     name = args.name or _default_name(spec, result.plant.fn_hz, result.plant.zeta)
     return emit(result, args, name, write_outputs, summary_text)
 
@@ -223,12 +213,10 @@ def _analyze(args) -> int:
         raise DesignError("the controller's parts are needed: --r3 .. --r18, --c3, --c4 (or --parts-json FILE)")
     else:
         parts = PidParts(**typed)
-    spec = PidSpec(plant_parts=_plant_parts(args), controller_parts=parts,
+    spec = PidSpec(plant_parts=_plant_parts(args), controller_parts=parts, package=args.package,
                    **{p: getattr(args, common.FLAGS[p][2:].replace("-", "_")) for p in ANALYZE_PARAMS})
     common.check_output(args, args.name if args.name is not None else "pid_as-built")
-    package = _package(args, spec)
     result = analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
-    result.package = package
     name = args.name or (f"pid_{result.tuning.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}"
                          f"_z{result.plant.zeta:.3g}")
     return emit(result, args, name, write_outputs, summary_text)

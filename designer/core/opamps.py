@@ -98,6 +98,11 @@ class Package:
     vee: int
     unused: dict
 
+    def to_dict(self) -> dict:
+        """The package as the results' JSON gives it: what the build sheet wires."""
+        return {"kind": self.kind, "part": self.part, "pinout": self.pinout, "pins": self.pins,
+                "units_per_package": self.per_package}
+
     @property
     def per_package(self) -> int:
         return len(self.units)

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -193,7 +193,8 @@ def _run(spec: PidSpec, simulate: bool, simulator: str, as_built: bool) -> PidRe
                     plant_fn_opamp_hz=ps.fn_hz, plant_zeta_opamp=ps.zeta, opamp=amp, tuning=tun, rules=rules,
                     optimizer=opt, parts=parts, selection=sel, achieved=Achieved.of(parts, amp, tun), checks=checks,
                     analytic=loop.analytic, ideal_pid=loop.ideal, margins=loop.margins, test=loop.test,
-                    expected_final_v=loop.expected, deck=loop.deck, waveforms=waves, notes=notes)
+                    expected_final_v=loop.expected, deck=loop.deck, waveforms=waves, notes=notes,
+                    package=spec.package)
     clock.lap("analytic_s")
     if simulate:
         run_spice(res, simulator)
@@ -408,8 +409,10 @@ def _analyse(spec, plant, amp, tun, parts, ps, simulate=True) -> _Loop:
     figures = loop_metrics(t, waves["y"], expected)
     ideal = loop_metrics(t, y_ideal, spec.step_v)   # a true integrator: no steady-state error
     rise = figures.rise_time_s if math.isfinite(figures.rise_time_s) and figures.rise_time_s else hp / 20
+    name_of = _designators(parts, plant, amp, spec.package)
     levels = model.waveform_limits(waves, t, amp, model.SLEW_DELAY_FRACTION * rise) if stable else {}
-    checks = _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, spec.step_v, rise, parts)
+    levels = {role: replace(v, opamp=name_of(v.opamp)) for role, v in levels.items() if name_of(v.opamp)}
+    checks = _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, spec.step_v, rise, parts, name_of)
     title = (f"PID closed loop Kp={parts.kp:.4g} Ti={parts.ti_s:.4g}s Td={parts.td_s:.4g}s "
              f"plant fn={plant.fn_hz:.5g}Hz zeta={plant.zeta:.4g} op-amp={amp.name}")
     deck = closed_loop_deck(parts, plant, amp, test, title, expected)
@@ -430,18 +433,29 @@ def _diverging(lm, t, r, limit):
     return w
 
 
-def _kick(parts, amp, step_v) -> str:
+def _designators(parts, plant, amp, package):
+    """The deck's op-amp (``U6``) -> its designator on the bench in ``package``
+    (``U3B`` in duals), so the checks name the op-amp the sheet wires; None
+    for a stage the circuit does not have (a PI has no differentiator)."""
+    from ..spice.deck import board
+    from .netlist import loop_netlist
+    bd = board(loop_netlist(parts, plant), amp, package)
+    refs = {a.ref: u.designator for a, u in zip(bd.netlist.amps, bd.units)}
+    return refs.get
+
+
+def _kick(parts, amp, step_v, name_of=str) -> str:
     """The controller's answer to the step edge alone (ideal op-amps):
     u = Kp (1 + Td/(R12 C3)) x step, the high-frequency gain times the step."""
     hf = parts.kp * (1 + (parts.td_s / (parts.r12 * parts.c3) if parts.has_derivative else 0.0))
     u = hf * step_v
     if amp.ideal or abs(u) <= amp.vout_max:
         return ""
-    return (f"; even before the loop reacts, the step edge alone asks U6 for Kp (1 + Td/(R12 C3)) x "
+    return (f"; even before the loop reacts, the step edge alone asks {name_of('U6')} for Kp (1 + Td/(R12 C3)) x "
             f"{step_v:g} V = {u:.3g} V (the {amp.name} reaches {amp.vout_max:.3g} V)")
 
 
-def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise, parts) -> list:
+def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise, parts, name_of=str) -> list:
     """Stability, phase margin, steady-state error, slew rate and output swing of the analytic loop."""
     out = []
     poles = lm.poles()
@@ -471,7 +485,7 @@ def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise, parts) -> 
     if not stable:
         out.append(Check("slew_rate", False, "unstable loop: no steady waveforms to check"))
         out.append(Check("output_swing", False,
-                         "unstable loop: the outputs run to the rails" + _kick(parts, amp, step_v)))
+                         "unstable loop: the outputs run to the rails" + _kick(parts, amp, step_v, name_of)))
         return out
     if amp.ideal:
         worst_sw = max(levels.values(), key=lambda v: max(abs(v.v_max), abs(v.v_min)))

@@ -166,7 +166,7 @@ class PidResult:
             "tool": tool_info(self.simulator),
             "plant": {"source": self.plant_source, **pl.as_dict(), "q": pl.q, "fn_opamp_hz": self.plant_fn_opamp_hz,
                       "zeta_opamp": self.plant_zeta_opamp},
-            "opamp": self.opamp.to_dict(),
+            "opamp": self.opamp.to_dict(), "package": self.opamp.package(self.package).to_dict(),
             "tuning": self.tuning.to_dict(),
             "rules": [r.to_dict(brief=True) for r in self.rules],
             "optimizer": None if self.optimizer is None else self.optimizer.to_dict(),

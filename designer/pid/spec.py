@@ -79,6 +79,8 @@ class PidSpec(PartBounds):
     square_hz: float | None = None
     controller_parts: PidParts | None = None
     tol: float = 0.01
+    #: how the bench puts the op-amps in packages: single, dual, quad (None: the op-amp's own first)
+    package: str | None = None
     #: the plant read from ``plant_json`` (read and checked on construction, before any work)
     json_plant: SallenKeyParts | None = field(default=None, init=False, repr=False, compare=False)
 
@@ -91,6 +93,10 @@ class PidSpec(PartBounds):
             if value is not None:
                 put(name, parse_in_range(value, name, key))
         self.check_bounds()
+        if self.package is not None:
+            # refused before any work when the op-amp does not come in it (an NE5532 has no quad)
+            from ..core.opamps import get
+            get(self.opamp).package(self.package)
         sources = sum(x is not None for x in (self.plant_fc_hz, self.plant_parts, self.plant_json))
         if sources != 1:
             raise _refused("give the plant one way: {plant_fc_hz}/{plant_zeta}, {plant_r1}..{plant_c2}, "

@@ -255,7 +255,7 @@ class PlantResult:
             "built": built,
             "series": self.sourcing.to_dict(),
             "alternatives": [a.to_dict() for a in self.alternatives],
-            "opamp": self.opamp.to_dict(),
+            "opamp": self.opamp.to_dict(), "package": self.opamp.package(self.package).to_dict(),
             "test_signal": self.test.to_dict(),
             "checks": [c.to_dict() for c in self.checks],
             "notes": self.notes,

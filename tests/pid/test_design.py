@@ -1,0 +1,24 @@
+"""designer.pid.design: what the design itself decides (its checks' wording included)."""
+
+import pytest
+
+from designer.core.errors import DesignError
+from designer.pid.design import design_pid
+from designer.pid.report import build_board
+from designer.pid.spec import PidSpec
+
+
+def test_checks_name_the_opamps_as_the_package_wires_them():
+    """Regression (issue 11): with --package dual the sheet wired U1B, U2A ... while
+    the checks still named the deck's U2 .. U7."""
+    spec = PidSpec(plant_fc_hz=3500, plant_zeta=0.2, kp=2, ti_s=100e-6, td_s=10e-6, opamp="TL072", package="dual")
+    res = design_pid(spec, simulate=False)
+    names = {v.opamp for v in res.analytic.levels.values()}
+    units = {u.designator for u in build_board(res).units}
+    assert names <= units and "U1B" in names
+    slew = next(c for c in res.checks if c.id == "slew_rate")
+    assert "worst: U" in slew.detail and slew.detail.split("worst: ")[1].split()[0] in units
+    d = res.to_dict()
+    assert d["package"]["kind"] == "dual" and d["package"]["part"] == "TL072"
+    with pytest.raises(DesignError, match="no quad package"):
+        PidSpec(plant_fc_hz=3500, plant_zeta=0.2, kp=2, ti_s=100e-6, td_s=10e-6, opamp="NE5532", package="quad")
