@@ -79,25 +79,17 @@ def _design(args) -> int:
     # the spec parses and checks what was typed (once); its errors name parameters, shown as options
     spec = PlantSpec(fc_hz=args.fc, zeta=args.zeta, gain=args.gain, **part_options(args), r=args.r, c=args.c,
                      opamp=args.opamp, compensate_gbw=args.compensate_gbw, amplitude_v=args.amplitude,
-                     square_hz=args.square_freq, alternatives=args.alternatives)
+                     square_hz=args.square_freq, alternatives=args.alternatives, package=args.package)
     name = args.name if args.name is not None else (
         f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
     check_output(args, name)
-    _check_package(args, spec.opamp)
     from ..plant.design import design_plant
     result = design_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
     return _emit(result, args, name)
 
 
-def _check_package(args, opamp: str) -> None:
-    """A --package the op-amp does not come in is refused in one line before any work."""
-    from ..core.opamps import get
-    get(opamp).package(args.package)
-
-
 def _emit(result, args, name) -> int:
     from ..plant.report import summary_text, write_outputs
-    result.package = args.package
     return emit(result, args, name, write_outputs, summary_text)
 
 
@@ -143,12 +135,12 @@ def _analyze(args) -> int:
     # which derives R3/R4 for a bare --gain and refuses unstable parts
     spec = AnalysisSpec(SallenKeyParts(args.r1, args.r2, args.c1, args.c2, args.gain, args.r3, args.r4),
                         opamp=args.opamp, target_fc_hz=args.fc, target_zeta=args.zeta, r_series=args.r_series,
-                        c_series=args.c_series, amplitude_v=args.amplitude, square_hz=args.square_freq)
+                        c_series=args.c_series, amplitude_v=args.amplitude, square_hz=args.square_freq,
+                        package=args.package)
     p = spec.parts
     name = args.name if args.name is not None else "built_" + "_".join(
         f"{k}{value_code(v)}" for k, v in (("r1", p.r1), ("r2", p.r2), ("c1", p.c1), ("c2", p.c2)))
     check_output(args, name)
-    _check_package(args, spec.opamp)
     return _emit(analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, name)
 
 

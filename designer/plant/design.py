@@ -182,7 +182,7 @@ def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspi
     alternatives = [Alternative(c.r1, c.r2, c.c1, c.c2, Figures.against(c.fn_hz, c.zeta, target))
                     for c in choice.ranked]
     result = _analyse("design", target, choice, sourcing, alternatives, amp, spec.amplitude_v, spec.square_hz,
-                      simulate, simulator)
+                      simulate, simulator, spec.package)
     if spec.compensate_gbw:
         result.notes.append(f"--compensate-gbw: designed for fn {choice.fc_target_hz:.5g} Hz, zeta "
                             f"{choice.zeta_target:.4g} so that with the {amp.name}'s {amp.gbw_hz / 1e6:g} MHz GBW "
@@ -210,7 +210,7 @@ def analyze_plant(spec: AnalysisSpec, simulate: bool = True, simulator: str = "p
     labels, r_s, c_s, why = part_series(values, spec.r_series, spec.c_series)
     choice = Choice(parts, None, Ratios(parts.r1 / parts.r2, parts.c2 / parts.c1), [], notes + why)
     return _analyse("analyze", target, choice, Sourcing(r_s, c_s, labels), [], spec.amp, spec.amplitude_v,
-                    spec.square_hz, simulate, simulator)
+                    spec.square_hz, simulate, simulator, spec.package)
 
 
 #: what an unlabelled part is assumed to be: a 5 % resistor, a 10 % capacitor
@@ -334,7 +334,7 @@ def _distinct(ranked, gain):
 
 
 def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternatives, amp: OpAmp, amplitude_v,
-             square_hz, simulate, simulator) -> PlantResult:
+             square_hz, simulate, simulator, package=None) -> PlantResult:
     """The models, bench test, checks, deck and (when ``simulate``) SPICE run of
     a chosen build, as one result."""
     tick = time.perf_counter()
@@ -397,7 +397,8 @@ def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternati
     return PlantResult(mode=mode, target=target, ratios=choice.ratios, ideal=choice.ideal, built=built,
                        sourcing=sourcing, alternatives=alternatives, opamp=amp, analytic=analytic,
                        analytic_opamp=analytic_opamp, time_s=tw, test=test, tolerance=tolerance, checks=checks,
-                       notes=notes, deck=deck, bench=bench, spice=spice, scope=scope, sine=sine, timings=timings)
+                       notes=notes, deck=deck, bench=bench, spice=spice, scope=scope, sine=sine, timings=timings,
+                       package=package)
 
 
 def _title(parts, amp):

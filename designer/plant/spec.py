@@ -31,11 +31,14 @@ from .sallenkey import SallenKeyParts, check_parts
 
 
 def _check_bench(spec, put) -> None:
-    """The op-amp and the bench's square wave, as both specs have them."""
+    """The op-amp (and the package the sheet wires it in) and the bench's square
+    wave, as both specs have them."""
     put("amplitude_v", parse_in_range(spec.amplitude_v, "amplitude_v", "amplitude_v"))
     if spec.square_hz is not None:
         put("square_hz", parse_in_range(spec.square_hz, "square_hz", "square_hz"))
     put("opamp", opamps.get(spec.opamp).name)
+    if spec.package is not None:
+        opamps.get(spec.opamp).package(spec.package)   # refused when the op-amp does not come in it
 
 
 def _whole(value, name: str) -> int:
@@ -91,6 +94,7 @@ class PlantSpec(PartBounds):
     amplitude_v: float = 2.0
     square_hz: float | None = None
     alternatives: int = 5
+    package: str | None = None    #: single, dual, quad for the sheet's wiring (None: the op-amp's first)
 
     def __post_init__(self):
         put = _setter(self)
@@ -143,6 +147,7 @@ class AnalysisSpec:
     c_series: str | None = None
     amplitude_v: float = 2.0
     square_hz: float | None = None
+    package: str | None = None
 
     def __post_init__(self):
         put = _setter(self)

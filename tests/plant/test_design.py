@@ -258,3 +258,16 @@ def test_analyzed_parts_carry_the_series_that_holds_them(value, label):
     assert held == (None if label.startswith("not") else label)
     if held == "E192":
         assert lab.tolerance_pct == 100 * eseries.TOLERANCE["E192"]
+def test_the_package_is_part_of_the_spec_and_checked_on_construction():
+    """One home for the package kind (as for the PID): the spec refuses a package
+    the op-amp does not come in, before any work, and the result carries it."""
+    from designer.core.errors import DesignError
+    from designer.plant.design import design_plant
+    from designer.plant.spec import AnalysisSpec, PlantSpec
+    from designer.plant.sallenkey import SallenKeyParts
+    with pytest.raises(DesignError, match="LM741 has no quad package"):
+        PlantSpec(fc_hz=3500, zeta=0.2, package="quad")
+    with pytest.raises(DesignError, match="unknown package"):
+        AnalysisSpec(SallenKeyParts(820, 1e3, 10e-9, 220e-9), opamp="TL072", package="octal")
+    res = design_plant(PlantSpec(fc_hz=3500, zeta=0.2, opamp="TL072", package="quad"), simulate=False)
+    assert res.package == "quad" and res.to_dict()["package"]["part"] == "TL074"
