@@ -18,6 +18,22 @@ from .errors import DesignError
 from .jsonio import json_safe
 from .waveform import crossing_time, normalised_step, refine_peak
 
+#: Slope noise of the smoothing before figures are measured on noisy data (see
+#: :func:`measure_step`): a value needs less smoothing than a slope's maximum.
+MEASURE_SLOPE_NOISE = 0.02
+#: A ripple under this fraction of the step is left to the smoothing.
+RIPPLE_FLOOR = 1e-3
+#: Standard uncertainties an overshoot may differ by from a model's (or from 0)
+#: and still be the same (see :meth:`Overshoot.differs`).
+OVERSHOOT_SIGMAS = 4.0
+#: A model's overshoot may differ from the measured one by this much (% of the
+#: step) plus :data:`OVERSHOOT_SIGMAS` uncertainties plus
+#: :data:`OVERSHOOT_REL` of the larger of the two: the classical correlations'
+#: own error (a first-order method allows 2 % overshoot, seed 000).
+OVERSHOOT_ABS_PCT = 2.0
+#: See :data:`OVERSHOOT_ABS_PCT`.
+OVERSHOOT_REL = 0.25
+
 
 @dataclass(frozen=True)
 class StepMetrics:
@@ -31,6 +47,38 @@ class StepMetrics:
     rise_time_0_100_s: float      #: 0 % to first reaching 100 % (nan if never overshoots)
     settling_time_s: float        #: 2 % band
     settling_time_5pct_s: float   #: 5 % band
+
+    def to_dict(self) -> dict:
+        return json_safe(asdict(self))
+
+
+@dataclass(frozen=True)
+class Overshoot:
+    """The overshoot measured on a record (% of the change) and its standard
+    uncertainty: the noise left on the record it was measured on (after the
+    smoothing and the ripple removal of :func:`measure_step`), % of the change.
+
+    The one figure every validity check of a model against the data uses."""
+
+    pct: float
+    sigma_pct: float
+
+    def text(self) -> str:
+        """``"9.09 % (noise ±0.15 %)"``."""
+        return f"{self.pct:.2f} % (noise ±{self.sigma_pct:.2g} %)"
+
+    def tolerance(self, model_pct: float = 0.0) -> float:
+        """How far (% of the step) a model's overshoot may lie from this one."""
+        return (OVERSHOOT_ABS_PCT + OVERSHOOT_SIGMAS * self.sigma_pct
+                + OVERSHOOT_REL * max(self.pct, model_pct))
+
+    def differs(self, model_pct: float) -> bool:
+        """True when a model overshooting ``model_pct`` % cannot have made these data."""
+        return abs(model_pct - self.pct) > self.tolerance(model_pct)
+
+    def above_noise(self) -> bool:
+        """True when the overshoot is clearly there (over 4 uncertainties and 0.2 %)."""
+        return self.pct > OVERSHOOT_SIGMAS * self.sigma_pct + 0.2
 
     def to_dict(self) -> dict:
         return json_safe(asdict(self))
@@ -107,3 +155,78 @@ def step_metrics(t, y, *, t_step: float | None = None, initial: float | None = N
         settling_time_s=settling_time(t, z, 1.0, 1.0, 0.02),
         settling_time_5pct_s=settling_time(t, z, 1.0, 1.0, 0.05),
     )
+
+
+def _moving_average(y, m: int) -> np.ndarray:
+    """Centred moving average over ``m`` samples (the ends over what exists)."""
+    if m <= 1:
+        return y
+    c = np.concatenate(([0.0], np.cumsum(y)))
+    i = np.arange(y.size)
+    lo = np.clip(i - m // 2, 0, y.size)
+    hi = np.clip(i + (m - m // 2), 0, y.size)
+    return (c[hi] - c[lo]) / (hi - lo)
+
+
+def measure_step(t, y, *, t_step: float | None = None, initial: float | None = None,
+                 final: float | None = None, lsb: float = 0.0, sigma: float = 0.0) -> tuple:
+    """Step-response figures of a measured record, and its :class:`Overshoot`.
+
+    Noise spikes and switching ripple would read as overshoot, so on a noisy
+    record (``sigma`` > 0) the figures are measured on a cleaned copy: a
+    periodic ripple found on the settled last quarter
+    (:func:`~designer.core.waveform.periodic_ripple`) is subtracted and what is
+    left of it averaged over one of its periods, then a
+    Savitzky-Golay filter smooths what is left (the window of a 2 % slope
+    noise, :data:`MEASURE_SLOPE_NOISE`). The overshoot's uncertainty is the
+    spread of that cleaned record over its settled last quarter, at least the
+    white noise the filter lets through. An overshoot within one quantisation
+    step ``lsb`` is none.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Time (increasing; resampled when not uniform) and response, from the step on.
+    t_step, initial, final : float, optional
+        As for :func:`step_metrics`.
+    lsb : float
+        Quantisation step of ``y`` (0 when it is not quantised).
+    sigma : float
+        Noise of ``y``; 0 measures the record as it is (the uncertainty is then 0).
+
+    Returns
+    -------
+    (StepMetrics, Overshoot)
+    """
+    from .waveform import (noise_sigma, periodic_ripple, savgol, spread, tangent_window,
+                           uniform)
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    y0 = float(y[0]) if initial is None else float(initial)
+    yf = float(y[-1]) if final is None else float(final)
+    span = yf - y0
+    sig_pct = 0.0
+    if sigma > 0 and t.size > 50 and span:
+        t, y = uniform(t, y)
+        tail = t.size - t.size // 4
+        dt = float((t[-1] - t[0]) / (t.size - 1))
+        ripple = periodic_ripple(t, y, tail, floor=RIPPLE_FLOOR * abs(span))
+        if ripple is not None:
+            # what the settled stretch's fit leaves during the transient (the
+            # ripple changes with the duty cycle) averages out over one period
+            y = _moving_average(y - ripple[0], max(1, round(ripple[1] / dt)))
+        white = noise_sigma(y)
+        w = tangent_window(dt, t.size, sigma=white, span=span, slope_noise=MEASURE_SLOPE_NOISE)
+        y = savgol(y, w, 2)
+        # white noise through the filter: sqrt(sum of the centre kernel's squares)
+        h = w // 2
+        x = np.arange(-h, h + 1, dtype=float)
+        gain = math.sqrt(float(np.sum(np.linalg.pinv(np.vander(x, 3, increasing=True))[0] ** 2)))
+        sig_pct = 100.0 * max(spread(y[tail:]), white * gain) / abs(span)
+    m = step_metrics(t, y, t_step=t_step, initial=initial, final=final)
+    # an overshoot within one quantisation step is not one: an 8-bit trace
+    # sitting one LSB above its mean
+    if m.overshoot_pct > 0 and abs(m.peak_value - m.final_value) <= lsb:
+        from dataclasses import replace
+        m = replace(m, overshoot_pct=0.0, rise_time_0_100_s=math.nan)
+    return m, Overshoot(m.overshoot_pct, sig_pct)

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .metrics import Overshoot, measure_step
 from .waveform import crossing_time, noise_sigma
 
 MODELS = ("fopdt", "double-pole", "underdamped", "overdamped")
@@ -74,6 +75,30 @@ def unphysical(model: str, params: dict) -> str:
             return f"zeta = {v:.4g} is negative"
     return ""
 
+
+def model_overshoot_pct(model: str, params: dict) -> float:
+    """Overshoot of ``model``'s step response, % of its change: 0 for the
+    monotonic models, 100 exp(-pi zeta / sqrt(1 - zeta^2)) for the underdamped one."""
+    if model in ("fopdt", "double-pole", "overdamped"):
+        return 0.0
+    if model == "underdamped":
+        z = float(params["zeta"])
+        return 100.0 * math.exp(-math.pi * z / math.sqrt(1.0 - z * z)) if 0.0 <= z < 1.0 else 0.0
+    raise ValueError(f"unknown model {model!r}; allowed: {', '.join(MODELS)}")
+
+
+def data_overshoot(t, y, yf, sigma: float | None = None) -> Overshoot:
+    """The :class:`~designer.core.metrics.Overshoot` of a response from 0 to
+    ``yf`` (:func:`~designer.core.metrics.measure_step`), for callers that were
+    not given the one measured on the whole record."""
+    y = np.asarray(y, float)
+    sig = noise_sigma(y) if sigma is None else sigma
+    return measure_step(t, y, initial=0.0, final=float(yf), sigma=sig)[1]
+
+
+#: A dead time below this fraction of the sample interval is the bound 0 (a
+#: fit pinned there; printing it in femtoseconds would be noise).
+MIN_DEAD_TIME_OF_DT = 1e-3
 
 #: Fits run on at most this many samples (the data are block-averaged upstream).
 MAX_FIT_SAMPLES = 4000
@@ -164,7 +189,8 @@ class StepFit:
     note: str = ""        #: why not, when it does not
 
 
-def fit_step(model: str, t, y, yf, start: dict | None = None, sigma: float | None = None) -> StepFit:
+def fit_step(model: str, t, y, yf, start: dict | None = None, sigma: float | None = None,
+             overshoot: Overshoot | None = None) -> StepFit:
     """Least-squares fit of ``model`` to a step response.
 
     Parameters
@@ -179,10 +205,15 @@ def fit_step(model: str, t, y, yf, start: dict | None = None, sigma: float | Non
         overdamped).
     sigma : float, optional
         Noise of ``y`` when the caller measured it (else :func:`noise_sigma`).
+    overshoot : Overshoot, optional
+        The overshoot measured on the record (else :func:`data_overshoot` of
+        ``t``, ``y``): the validity checks use it.
 
     Returns
     -------
     StepFit
+        A dead time below :data:`MIN_DEAD_TIME_OF_DT` of the sample interval
+        is reported as 0.
     """
     from scipy.optimize import least_squares   # imported on use: model_step users need no scipy
     t = np.asarray(t, float)
@@ -217,12 +248,16 @@ def fit_step(model: str, t, y, yf, start: dict | None = None, sigma: float | Non
             best = sol
     params = _from_x(model, best.x)
     ci = _confidence(model, best, tf.size)
+    if tf.size > 1 and params["theta_s"] < MIN_DEAD_TIME_OF_DT * float(np.median(np.diff(tf))):
+        params["theta_s"] = 0.0
     # the fast time constant is tau1, as in seeds 002 and 003 (and second_order.py)
     if model == "overdamped" and params["tau1_s"] > params["tau2_s"]:
         params["tau1_s"], params["tau2_s"] = params["tau2_s"], params["tau1_s"]
         if "tau1_s" in ci and "tau2_s" in ci:
             ci["tau1_s"], ci["tau2_s"] = ci["tau2_s"], ci["tau1_s"]
-    valid, note = _check(model, params, y, yf, best, sigma)
+    if overshoot is None:
+        overshoot = data_overshoot(t, y, yf, sigma)
+    valid, note = _check(model, params, overshoot, best)
     return StepFit(model, {k: float(params[k]) for k in names}, ci, int(tf.size),
                    float(math.sqrt(2 * best.cost / tf.size)) * scale, valid, note)
 
@@ -253,19 +288,22 @@ def _confidence(model, sol, n):
     return out
 
 
-def _check(model, params, y, yf, sol, sigma=None):
-    """Validity of the fitted structure against the data."""
-    os_pct = 100.0 * (float(np.max(np.sign(yf) * np.asarray(y))) - abs(yf)) / abs(yf)
-    sig_pct = 100.0 * (noise_sigma(y) if sigma is None else sigma) / abs(yf)
+def _check(model, params, overshoot: Overshoot, sol):
+    """Validity of the fitted structure against the data's measured ``overshoot``."""
     if model == "underdamped":
         if params["zeta"] >= 0.99:
             return False, ("fitted zeta reached the bound 1: the data are not underdamped; "
                            "use the overdamped fit")
-        if os_pct < 4 * sig_pct + 0.2:
-            return False, f"the data barely overshoot ({os_pct:.2f} %): underdamped model not identifiable"
-    if model in ("fopdt", "overdamped") and os_pct > 2.0 + 4 * sig_pct:
-        return False, (f"the data overshoot {os_pct:.1f} %: a {model} model cannot; "
-                       "use the underdamped fit")
+        if not overshoot.above_noise():
+            return False, (f"the data's overshoot, {overshoot.text()}, is not above the noise: "
+                           "underdamped model not identifiable")
+    mos = model_overshoot_pct(model, params)
+    if overshoot.differs(mos):
+        if mos == 0.0:
+            return False, (f"the data overshoot {overshoot.text()}: a {model} model cannot; "
+                           "use the underdamped fit")
+        return False, (f"this model overshoots {mos:.2f} %, the data {overshoot.text()}: "
+                       "more apart than the noise explains")
     if not sol.success:
         return False, f"solver did not converge: {sol.message}"
     return True, ""

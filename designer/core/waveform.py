@@ -2,7 +2,8 @@
 metrics, tuning and identification share.
 
 - :func:`noise_sigma`: noise standard deviation of a record (at least the
-  rounding noise of :func:`quantum`, an ADC's step);
+  rounding noise of :func:`quantum`, an ADC's step); :func:`spread`, a
+  robust standard deviation; :func:`periodic_ripple`, a switching ripple;
 - :func:`normalised_step`: a step response as the fraction of its change;
 - :func:`crossing_time`: when a record first rises through a level, robust to
   noise (a threshold is y0 + p (yf - y0), never p yf: seed 000's pitfall);
@@ -94,6 +95,96 @@ def noise_sigma(y) -> float:
     np.abs(d2, out=d2)
     sigma = float(1.4826 * np.median(d2, overwrite_input=True) / math.sqrt(6.0))
     return max(sigma, lsb / math.sqrt(12.0))
+
+
+#: A settled stretch whose spread exceeds this many white-noise sigmas carries
+#: a smooth disturbance (switching ripple, hum) that :func:`periodic_ripple` looks for.
+RIPPLE_SPREAD_RATIO = 3.0
+#: Harmonics of the ripple's fundamental fitted (fewer when above Nyquist).
+RIPPLE_HARMONICS = 5
+#: The fitted ripple must leave at most this fraction of the stretch's variance.
+RIPPLE_MAX_RESIDUAL = 0.25
+#: A ripple's size over the two halves of the settled stretch differs by at most this factor.
+RIPPLE_STEADY = 1.3
+
+
+def spread(y) -> float:
+    """Robust standard deviation of ``y`` about its median (1.4826 x the MAD)."""
+    y = np.asarray(y, float)
+    return float(1.4826 * np.median(np.abs(y - np.median(y)))) if y.size else 0.0
+
+
+def _harmonic_basis(t, f0: float, h: int) -> np.ndarray:
+    w = 2.0 * math.pi * f0 * np.asarray(t, float)
+    cols = [np.ones_like(w)]
+    for k in range(1, h + 1):
+        cols += [np.cos(k * w), np.sin(k * w)]
+    return np.column_stack(cols)
+
+
+def periodic_ripple(t, y, start: int, floor: float = 0.0) -> tuple | None:
+    """A periodic disturbance riding on a record, estimated on its settled
+    stretch ``y[start:]`` and extended over the whole record: ``(ripple,
+    period_s)``, or None.
+
+    A switching converter's ripple is locked to its clock, so averaging edges
+    aligned on a slower square wave keeps it; on the settled stretch it is the
+    whole signal. The fundamental is the highest peak of the stretch's
+    spectrum (Hann window, zero-padded four times), refined to the frequency
+    whose :data:`RIPPLE_HARMONICS` harmonics fit the stretch best (least
+    squares). Returned (without its mean) only when the stretch spreads over
+    :data:`RIPPLE_SPREAD_RATIO` white-noise sigmas (:func:`noise_sigma`) and
+    over ``floor``, the fit leaves at most :data:`RIPPLE_MAX_RESIDUAL` of its
+    variance, and the ripple is as large over the stretch's second half as
+    over its first (within :data:`RIPPLE_STEADY`): a response still ringing
+    as it decays is the response, not a ripple. ``t`` must be uniform, and
+    the stretch must hold three periods.
+    """
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    ts, ys = t[start:], y[start:]
+    n = ys.size
+    if n < 64:
+        return None
+    white = noise_sigma(ys)
+    dev = ys - float(np.mean(ys))
+    var = float(np.mean(dev * dev))
+    if not var > max(RIPPLE_SPREAD_RATIO * white, floor) ** 2:
+        return None
+    dt = float((ts[-1] - ts[0]) / (n - 1))
+    spec = np.abs(np.fft.rfft(dev * np.hanning(n), 4 * n))
+    f = np.fft.rfftfreq(4 * n, dt)
+    span_s = n * dt
+    ok = f >= 3.0 / span_s
+    if not ok.any():
+        return None
+    f0 = float(f[ok][int(np.argmax(spec[ok]))])
+    h = max(1, min(RIPPLE_HARMONICS, int(0.5 / (dt * f0))))
+    step = 0.25 / span_s          # a quarter of the spectrum's bin
+    best = None
+    for _ in range(2):
+        for fc in f0 + step * np.arange(-8, 9):
+            if fc <= 0:
+                continue
+            A = _harmonic_basis(ts, fc, h)
+            c, *_ = np.linalg.lstsq(A, ys, rcond=None)
+            r = A @ c - ys
+            e = float(np.mean(r * r))
+            if best is None or e < best[0]:
+                best = (e, fc, c)
+        f0, step = best[1], step / 8.0
+    e, f0, c = best
+    if e > RIPPLE_MAX_RESIDUAL * var:
+        return None
+    half = n // 2
+    rms = []
+    for a, b in ((0, half), (half, n)):
+        A = _harmonic_basis(ts[a:b], f0, h)
+        ch, *_ = np.linalg.lstsq(A, ys[a:b], rcond=None)
+        rms.append(float(np.std(A[:, 1:] @ ch[1:])))
+    if not (rms[0] > 0 and abs(math.log(max(rms[1], 1e-300) / rms[0])) <= math.log(RIPPLE_STEADY)):
+        return None
+    return _harmonic_basis(t, f0, h)[:, 1:] @ c[1:], 1.0 / f0
 
 
 # --------------------------------------------------------------------------- steps

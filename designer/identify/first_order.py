@@ -1,6 +1,6 @@
 """First-order-plus-dead-time (and double-pole) methods of seed 000, section 3.1.
 
-Every method has the signature ``method(t, y, yf, sigma=None) -> MethodResult``
+Every method has the signature ``method(t, y, yf, sigma=None, overshoot=None) -> MethodResult``
 where ``t`` is time since the step (s), ``y`` the response deviation divided by
 the input amplitude, ``yf`` its settled value (the static gain K) and ``sigma``
 the noise of ``y`` when the caller measured it (an averaged square wave's
@@ -51,13 +51,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.metrics import Overshoot
+from ..core.stepfit import data_overshoot
 from ..core.waveform import crossing_time, inflection_tangent, noise_sigma
 from .structures import MethodResult
-
-#: An FOPDT or double-pole model cannot overshoot; beyond this the data are
-#: outside every method's validity range here.
-MAX_OVERSHOOT_PCT = 2.0
-
 
 @dataclass(frozen=True)
 class TwoPoint:
@@ -119,17 +116,17 @@ def unit_time(p: float, model: str = "fopdt") -> float:
 
 # --------------------------------------------------------------------------- helpers
 
-def _overshoot_pct(y, yf) -> float:
-    return max(0.0, 100.0 * (float(np.max(y)) - yf) / yf) if yf else 0.0
-
-
-def _validity(y, yf, sigma):
-    """(valid, note) common to every first-order method."""
-    # Noise lifts the maximum: allow 4 sigma before calling it overshoot.
-    os_pct = _overshoot_pct(y, yf) - 400.0 * sigma / abs(yf)
-    if os_pct > MAX_OVERSHOOT_PCT:
-        return False, (f"response overshoots {os_pct:.1f} %: first-order and double-pole models "
-                       "only fit monotonic (overdamped) responses; use an underdamped method")
+def _validity(t, y, yf, sigma, overshoot: Overshoot | None = None):
+    """(valid, note) common to every first-order method: the data's measured
+    ``overshoot`` (else :func:`~designer.core.stepfit.data_overshoot` of ``t``,
+    ``y``) must be one a monotonic model can leave
+    (:meth:`~designer.core.metrics.Overshoot.differs` from 0)."""
+    if overshoot is None:
+        overshoot = data_overshoot(t, y, yf, sigma)
+    if overshoot.differs(0.0):
+        return False, (f"the data overshoot {overshoot.text()}: first-order and double-pole "
+                       "models only fit monotonic (overdamped) responses; use an underdamped "
+                       "method")
     return True, ""
 
 
@@ -159,7 +156,7 @@ def _points_ok(name, model, times, K):
 
 # --------------------------------------------------------------------------- tangent
 
-def ziegler_nichols(t, y, yf, sigma=None) -> MethodResult:
+def ziegler_nichols(t, y, yf, sigma=None, overshoot=None) -> MethodResult:
     """Ziegler-Nichols reaction curve (seed 000 eq. 7, fig. 3).
 
     Validity: monotonic S-shaped response with an identifiable inflection.
@@ -168,13 +165,13 @@ def ziegler_nichols(t, y, yf, sigma=None) -> MethodResult:
     tg = inflection_tangent(t, y, yf, sigma=sigma)
     theta = tg.t_base
     t3 = tg.t_level(yf)
-    valid, note = _validity(y, yf, sigma)
+    valid, note = _validity(t, y, yf, sigma, overshoot)
     return _result("ziegler-nichols", "fopdt", yf, t3 - theta, theta,
                    {"t_inflection_s": tg.t, "y_inflection": tg.y, "slope_per_s": tg.slope,
                     "t1_s": theta, "t3_s": t3, "window_s": tg.window_s}, valid, note)
 
 
-def hagglund(t, y, yf, sigma=None) -> MethodResult:
+def hagglund(t, y, yf, sigma=None, overshoot=None) -> MethodResult:
     """Hägglund: ZN dead time, tau to the 63.2 % point (seed 000 fig. 3)."""
     sigma = noise_sigma(y) if sigma is None else sigma
     tg = inflection_tangent(t, y, yf, sigma=sigma)
@@ -183,7 +180,7 @@ def hagglund(t, y, yf, sigma=None) -> MethodResult:
     bad = _points_ok("hagglund", "fopdt", [t2], yf)
     if bad:
         return bad
-    valid, note = _validity(y, yf, sigma)
+    valid, note = _validity(t, y, yf, sigma, overshoot)
     return _result("hagglund", "fopdt", yf, t2 - theta, theta,
                    {"t_inflection_s": tg.t, "slope_per_s": tg.slope, "t1_s": theta,
                     "t2_s": t2, "window_s": tg.window_s}, valid, note)
@@ -194,7 +191,7 @@ def _cross(t, y, yf, p, sigma):
     return crossing_time(t, sgn * np.asarray(y), p * abs(yf), sigma=sigma)
 
 
-def two_point(row: TwoPoint, t, y, yf, sigma=None) -> MethodResult:
+def two_point(row: TwoPoint, t, y, yf, sigma=None, overshoot=None) -> MethodResult:
     """General two-point method: tau = a t1 + b t2, theta = c t1 + d t2 (seed 000 eq. 16)."""
     sigma = noise_sigma(y) if sigma is None else sigma
     t1 = _cross(t, y, yf, row.p1, sigma)
@@ -204,7 +201,7 @@ def two_point(row: TwoPoint, t, y, yf, sigma=None) -> MethodResult:
         return bad
     tau = row.a * t1 + row.b * t2
     theta = row.c * t1 + row.d * t2
-    valid, note = _validity(y, yf, sigma)
+    valid, note = _validity(t, y, yf, sigma, overshoot)
     k1, k2 = _pct_key(row.p1), _pct_key(row.p2)
     return _result(row.name, row.model, yf, tau, theta, {k1: t1, k2: t2}, valid, note)
 
@@ -213,7 +210,7 @@ def _pct_key(p):
     return f"t{100 * p:g}_s".replace(".", "_")
 
 
-def nishikawa(t, y, yf, sigma=None) -> MethodResult:
+def nishikawa(t, y, yf, sigma=None, overshoot=None) -> MethodResult:
     """Nishikawa areas (seed 000 eq. 13-15).
 
     A0 is the signed area between yf and y (the seed writes |.|; for the
@@ -236,27 +233,27 @@ def nishikawa(t, y, yf, sigma=None) -> MethodResult:
     a1 = float(np.trapezoid(yy, tt))
     tau = a1 / (0.368 * yf)
     theta = t0 - tau
-    valid, note = _validity(y, yf, sigma)
+    valid, note = _validity(t, y, yf, sigma, overshoot)
     return _result("nishikawa", "fopdt", yf, tau, theta, {"A0_s": a0, "A1_s": a1, "t0_s": t0},
                    valid, note)
 
 
-def smith(t, y, yf, sigma=None):
-    return two_point(TABLE_II[4], t, y, yf, sigma)
+def smith(t, y, yf, sigma=None, overshoot=None):
+    return two_point(TABLE_II[4], t, y, yf, sigma, overshoot)
 
 
-def sundaresan_krishnaswamy(t, y, yf, sigma=None):
-    return two_point(SUNDARESAN, t, y, yf, sigma)
+def sundaresan_krishnaswamy(t, y, yf, sigma=None, overshoot=None):
+    return two_point(SUNDARESAN, t, y, yf, sigma, overshoot)
 
 
-def alfaro_123c(t, y, yf, sigma=None):
+def alfaro_123c(t, y, yf, sigma=None, overshoot=None):
     """Alfaro 123c, FOPDT: 25 % and 75 % points (:data:`ALFARO_123C`)."""
-    return two_point(ALFARO_123C, t, y, yf, sigma)
+    return two_point(ALFARO_123C, t, y, yf, sigma, overshoot)
 
 
 def _bind(row):
-    def method(t, y, yf, sigma=None):
-        return two_point(row, t, y, yf, sigma)
+    def method(t, y, yf, sigma=None, overshoot=None):
+        return two_point(row, t, y, yf, sigma, overshoot)
     method.__name__ = row.name.replace("-", "_")
     method.__doc__ = (f"{row.name}: {100 * row.p1:g} % and {100 * row.p2:g} % points, "
                       f"{row.model} (seed 000 Table {'III' if row.model != 'fopdt' else 'II'}).")

@@ -17,9 +17,10 @@ from ..core.stepfit import PARAMS, fit_step
 from .structures import MethodResult
 
 
-def fit(model: str, t, y, yf, start: dict | None = None, sigma=None) -> MethodResult:
+def fit(model: str, t, y, yf, start: dict | None = None, sigma=None,
+        overshoot=None) -> MethodResult:
     """:func:`~designer.core.stepfit.fit_step` as a :class:`MethodResult` named ``least-squares``."""
-    f = fit_step(model, t, y, yf, start, sigma)
+    f = fit_step(model, t, y, yf, start, sigma, overshoot)
     points = {f"{k}_ci95": v for k, v in f.ci95.items()}
     points["samples_fitted"] = f.samples
     points["rms_residual"] = f.rms_residual
@@ -28,13 +29,14 @@ def fit(model: str, t, y, yf, start: dict | None = None, sigma=None) -> MethodRe
     return MethodResult("least-squares", model, dict(f.params), valid=f.valid, note=note, points=points)
 
 
-def refine_all(t, y, yf, starts: dict | None = None, sigma=None) -> list:
+def refine_all(t, y, yf, starts: dict | None = None, sigma=None, overshoot=None) -> list:
     """The three least-squares fits, each from ``starts[model]`` (a MethodResult) if given;
-    ``sigma`` is the noise of ``y`` when the caller measured it."""
+    ``sigma`` is the noise of ``y`` and ``overshoot`` the
+    :class:`~designer.core.metrics.Overshoot` of the record when the caller measured them."""
     starts = starts or {}
     out = []
     for model in PARAMS:
         s = starts.get(model)
         start = {"model": s.model, "params": s.params} if s is not None else None
-        out.append(fit(model, t, y, yf, start, sigma))
+        out.append(fit(model, t, y, yf, start, sigma, overshoot))
     return out

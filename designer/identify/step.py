@@ -18,7 +18,8 @@ from dataclasses import dataclass, field
 
 from ..core.errors import DesignError
 from ..core.jsonio import json_safe
-from ..core.metrics import StepMetrics
+from ..core.metrics import Overshoot, StepMetrics
+from ..core.stepfit import model_overshoot_pct
 from .first_order import FIRST_ORDER_METHODS
 from .io import CaptureInfo
 from .preprocess import PreparedStep, prepare_step
@@ -28,8 +29,6 @@ from .structures import MethodResult, iae_ise, model_step, rank_key, unphysical
 
 #: Every classical step method, first order then second order.
 ALL_STEP_METHODS = list(FIRST_ORDER_METHODS) + list(STEP_METHODS)
-#: Slope noise of the smoothing before the measured metrics (see :func:`_measured`).
-MEASURE_SLOPE_NOISE = 0.02
 #: The measured figures reported (``measured`` in the JSON).
 MEASURED_KEYS = ("overshoot_pct", "peak_time_s", "rise_time_s", "rise_time_0_100_s",
                  "settling_time_s", "final_value")
@@ -39,11 +38,15 @@ def _method_name(fn) -> str:
     return getattr(fn, "__name__", "method").replace("_", "-")
 
 
-def run_method(fn, t, y, yf, sigma=None) -> list:
-    """Call one method (with the noise ``sigma`` of ``y`` when given); never let
-    it crash the run."""
+def run_method(fn, t, y, yf, sigma=None, overshoot: Overshoot | None = None) -> list:
+    """Call one method (with the noise ``sigma`` of ``y`` when given, and the
+    measured ``overshoot`` for the first-order methods, which check it); never
+    let it crash the run."""
+    kw = {} if sigma is None else {"sigma": sigma}
+    if overshoot is not None and _method_name(fn) in _KNOWN_FIRST:
+        kw["overshoot"] = overshoot
     try:
-        out = fn(t, y, yf) if sigma is None else fn(t, y, yf, sigma=sigma)
+        out = fn(t, y, yf, **kw)
     except Exception as exc:  # noqa: BLE001 - a method bug must not stop the others
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         return [MethodResult(name=_method_name(fn), model="fopdt", params={}, valid=False,
@@ -57,7 +60,8 @@ def run_method(fn, t, y, yf, sigma=None) -> list:
 class IdentifyResult:
     """Every method's result, ranked by IAE (valid first), the best one, the
     normalised step, the figures measured on the data (None when the data do
-    not allow it) and, for ``--against``, the comparison with a design
+    not allow it) with the overshoot and its uncertainty every validity check
+    used (``overshoot``) and, for ``--against``, the comparison with a design
     (an :class:`~.against.Comparison`)."""
 
     methods: list
@@ -67,6 +71,7 @@ class IdentifyResult:
     comparison: object | None = None
     measured: StepMetrics | None = None
     timings: dict = field(default_factory=dict)
+    overshoot: Overshoot | None = None
 
     def best_of(self, models) -> MethodResult | None:
         """The best valid result whose model is one of ``models``."""
@@ -80,7 +85,10 @@ class IdentifyResult:
         if self.measured is None:
             return {}
         d = self.measured.to_dict()
-        return {k: d.get(k) for k in MEASURED_KEYS}
+        out = {k: d.get(k) for k in MEASURED_KEYS}
+        if self.overshoot is not None:
+            out["overshoot_sigma_pct"] = self.overshoot.sigma_pct
+        return out
 
     def to_dict(self) -> dict:
         d = {"methods": [m.to_dict() for m in self.methods],
@@ -173,16 +181,20 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
     # Methods assume a rising response; a negative gain is flipped and restored.
     sgn = 1.0 if step.yf >= 0 else -1.0
     tw, yw, yfw = step.t, sgn * step.y, sgn * step.yf
+    post = step.t_raw >= step.t_step
+    t_eval, y_eval = step.t_raw[post], step.y_raw[post]
+    t1 = clock()
+    # measured once: the overshoot every validity check below uses
+    measured, overshoot = _measured(step, t_eval, y_eval)
+    timings["measure"] = clock() - t1
     results = []
     for fn in ALL_STEP_METHODS:
         if want is not None and _method_name(fn) in _KNOWN_FIRST and _method_name(fn) not in want:
             continue
-        results.extend(run_method(fn, tw, yw, yfw, step.work_sigma))
+        results.extend(run_method(fn, tw, yw, yfw, step.work_sigma, overshoot))
     if want is not None:
         results = [r for r in results if r.name in want]
-    timings["methods"] = clock() - t0 - timings["prepare"]
-    post = step.t_raw >= step.t_step
-    t_eval, y_eval = step.t_raw[post], step.y_raw[post]
+    timings["methods"] = clock() - t1 - timings["measure"]
     t1 = clock()
     for m in results:
         _flip(m, sgn)
@@ -199,7 +211,7 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
                 c = cands[0]
                 starts[model] = MethodResult(c.name, c.model, {k: (sgn * v if k == "K" else v)
                                                                for k, v in c.params.items()})
-        fits = refine_all(tw, yw, yfw, starts, step.work_sigma)
+        fits = refine_all(tw, yw, yfw, starts, step.work_sigma, overshoot)
         for m in fits:
             m.note = "; ".join(s for s in (f"started from {starts[m.model].name}"
                                            if m.model in starts else "", m.note) if s)
@@ -208,15 +220,12 @@ def identify_step(t, y, u=None, step_time=None, step_amplitude=None, *, methods=
         results.extend(fits)
     timings["refine"] = clock() - t1
     for m in results:
-        judge(m, step)
+        judge(m, step, overshoot)
     results.sort(key=rank_key)
     best = next((m for m in results if m.valid and math.isfinite(m.iae)), None)
-    t1 = clock()
-    measured = _measured(step, t_eval, y_eval)
-    timings["measure"] = clock() - t1
     timings["total"] = clock() - t0
     return IdentifyResult(methods=results, best=best, step=step, capture=capture,
-                          measured=measured, timings=timings)
+                          measured=measured, timings=timings, overshoot=overshoot)
 
 
 #: A least-squares parameter whose 95 % half-width exceeds this fraction of its
@@ -225,16 +234,27 @@ MAX_CI_FRACTION = 1.0
 _SCALES = ("K", "tau_s", "tau1_s", "tau2_s", "wn_rad_s", "zeta")
 
 
-def judge(m: MethodResult, step: PreparedStep) -> None:
+def judge(m: MethodResult, step: PreparedStep, overshoot: Overshoot | None = None) -> None:
     """Mark a result invalid (saying why) when the record cannot support it: a
-    non-linear record (no linear model is valid), a time constant (or 1/wn)
-    below the sample interval, or a least-squares parameter whose 95 %
-    confidence interval is wider than the value."""
+    non-linear record (no linear model is valid), a model whose own overshoot
+    the measured ``overshoot`` rules out (:meth:`~designer.core.metrics.Overshoot.differs`:
+    a monotonic model on an overshooting record, an underdamped one that rings
+    far more or less than the data), a time constant (or 1/wn) below the
+    sample interval, or a least-squares parameter whose 95 % confidence
+    interval is wider than the value."""
     if not m.valid:
         return
     why = ""
     if step.nonlinear:
         why = f"not a linear plant's response ({step.nonlinear.split(':')[0]})"
+    if not why and overshoot is not None:
+        try:
+            mos = model_overshoot_pct(m.model, m.params)
+        except (KeyError, ValueError, TypeError):
+            mos = math.nan
+        if math.isfinite(mos) and overshoot.differs(mos):
+            why = (f"this model overshoots {mos:.2f} %, the data {overshoot.text()}: more "
+                   "apart than the noise and the method's accuracy explain")
     dt = step.dt
     if not why and math.isfinite(dt):
         for k, v in m.params.items():
@@ -288,30 +308,16 @@ def _check_names(methods):
     return want
 
 
-def _measured(step: PreparedStep, t_eval, y_eval) -> StepMetrics | None:
-    """Overshoot, peak, rise and settling times measured on the data."""
-    from ..core.metrics import step_metrics
-    from ..core.waveform import noise_sigma, savgol, tangent_window, uniform
+def _measured(step: PreparedStep, t_eval, y_eval) -> tuple:
+    """The figures measured on the data and the :class:`~designer.core.metrics.Overshoot`
+    every validity check uses, or ``(None, None)`` when the data allow none
+    (:func:`designer.core.metrics.measure_step`, on block means of a long record)."""
+    from ..core.metrics import measure_step
     from .preprocess import block_mean
     if step.sigma > 0 and t_eval.size > 50:
-        # Noise spikes would read as overshoot: measure on the smoothed record
-        # (block means first, so the filter stays short on long records). A
-        # value needs less smoothing than a slope's maximum: the window of a
-        # 2 % slope noise (the tangent's 0.5 % moves an asymmetric peak).
-        t_eval, y_eval = uniform(*block_mean(t_eval, y_eval))
-        dt = float((t_eval[-1] - t_eval[0]) / (t_eval.size - 1))
-        w = tangent_window(dt, t_eval.size, sigma=noise_sigma(y_eval),
-                           span=step.y_final - step.y0, slope_noise=MEASURE_SLOPE_NOISE)
-        y_eval = savgol(y_eval, w, 2)
+        t_eval, y_eval = block_mean(t_eval, y_eval)
     try:
-        m = step_metrics(t_eval, y_eval, t_step=step.t_step, initial=step.y0,
-                         final=step.y_final)
+        return measure_step(t_eval, y_eval, t_step=step.t_step, initial=step.y0,
+                            final=step.y_final, lsb=step.lsb, sigma=step.sigma)
     except DesignError:
-        return None
-    # an overshoot within one quantisation step is not one: an 8-bit trace
-    # sitting one LSB above its mean
-    over = abs(m.peak_value - step.y_final)
-    if m.overshoot_pct > 0 and over <= step.lsb:
-        from dataclasses import replace
-        m = replace(m, overshoot_pct=0.0, rise_time_0_100_s=math.nan)
-    return m
+        return None, None

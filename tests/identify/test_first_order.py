@@ -112,7 +112,7 @@ def test_seed001_ziegler_nichols_tangent():
     assert r.points["t3_s"] == pytest.approx(81.7506e-6, rel=2e-4)
     assert r.params["tau_s"] == pytest.approx(60.143e-6, rel=2e-4)
     # An underdamped response is outside the FOPDT validity range: said, not hidden.
-    assert not r.valid and "overshoots" in r.note
+    assert not r.valid and "the data overshoot" in r.note
 
 
 def test_hagglund_uses_the_63_percent_point():
