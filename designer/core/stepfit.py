@@ -300,7 +300,8 @@ def _check(model, params, overshoot: Overshoot, sol):
     mos = model_overshoot_pct(model, params)
     if overshoot.differs(mos):
         if mos == 0.0:
-            return False, (f"the data overshoot {overshoot.text()}: a {model} model cannot; "
+            article = "an" if model[0] in "aeiou" else "a"
+            return False, (f"the data overshoot {overshoot.text()}: {article} {model} model cannot; "
                            "use the underdamped fit")
         return False, (f"this model overshoots {mos:.2f} %, the data {overshoot.text()}: "
                        "more apart than the noise explains")
