@@ -2,6 +2,7 @@
 (the running interpreter's bin folder, so a clone anywhere, any venv, works)."""
 
 import sys
+import tracemalloc
 from pathlib import Path
 
 TESTS = Path(__file__).resolve().parent
@@ -17,3 +18,13 @@ def script(name: str) -> str:
     path = Path(sys.executable).parent / name
     assert path.exists(), f"console script {name} not installed beside {sys.executable} (run make setup)"
     return str(path)
+
+
+def peak_bytes(fn, *args, **kw):
+    """Peak memory traced (numpy's allocations included) while ``fn`` runs, and its result."""
+    tracemalloc.start()
+    try:
+        out = fn(*args, **kw)
+        return tracemalloc.get_traced_memory()[1], out
+    finally:
+        tracemalloc.stop()

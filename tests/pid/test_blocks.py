@@ -2,10 +2,10 @@
 search against brute force, and the static checks."""
 
 import math
-import tracemalloc
 
 import numpy as np
 import pytest
+from helpers import peak_bytes
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -17,16 +17,6 @@ from designer.pid import blocks
 #: Peak numpy memory the part search may use, whatever the series and bounds
 #: (the benchmark's goal is 500 MB for the whole design-pid process).
 SEARCH_MEMORY_BYTES = 128e6
-
-
-def peak_bytes(fn, *args, **kw):
-    """Peak memory traced (numpy's allocations included) while ``fn`` runs, and its result."""
-    tracemalloc.start()
-    try:
-        out = fn(*args, **kw)
-        return tracemalloc.get_traced_memory()[1], out
-    finally:
-        tracemalloc.stop()
 
 
 def test_seed_part_list_gives_the_seed_gains_and_corners():

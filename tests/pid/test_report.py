@@ -1,6 +1,5 @@
 from designer.pid.blocks import seed_parts
 from designer.pid.design import PidSpec, design_pid
-from designer.pid.report import sections
 
 
 def test_bill_of_materials_lists_every_part_once():

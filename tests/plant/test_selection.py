@@ -1,7 +1,7 @@
-import tracemalloc
 
 import numpy as np
 import pytest
+from helpers import peak_bytes
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -18,16 +18,6 @@ SEARCH_MEMORY_BYTES = 64e6
 
 def parts(cands):
     return [(c.r1, c.r2, c.c1, c.c2) for c in cands]
-
-
-def peak_bytes(fn, *args, **kw):
-    """Peak memory traced (numpy's allocations included) while ``fn`` runs, and its result."""
-    tracemalloc.start()
-    try:
-        out = fn(*args, **kw)
-        return tracemalloc.get_traced_memory()[1], out
-    finally:
-        tracemalloc.stop()
 
 
 @settings(max_examples=60, deadline=None)
