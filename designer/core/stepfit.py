@@ -87,6 +87,20 @@ def model_overshoot_pct(model: str, params: dict) -> float:
     raise ValueError(f"unknown model {model!r}; allowed: {', '.join(MODELS)}")
 
 
+def overshoot_mismatch(model: str, params: dict, overshoot: Overshoot) -> str:
+    """Why a ``model`` with ``params`` cannot have made data that overshoot as
+    measured (:meth:`~designer.core.metrics.Overshoot.differs`), or "" when it
+    can: the one model-against-data overshoot rule of every method."""
+    mos = model_overshoot_pct(model, params)
+    if not overshoot.differs(mos):
+        return ""
+    if mos == 0.0:
+        return (f"the data overshoot {overshoot.text()}, which the {model} model, being monotonic, "
+                "cannot; use an underdamped method")
+    return (f"this model overshoots {mos:.2f} %, the data {overshoot.text()}: more apart than the "
+            "noise and the method's accuracy explain")
+
+
 def data_overshoot(t, y, yf, sigma: float | None = None) -> Overshoot:
     """The :class:`~designer.core.metrics.Overshoot` of a response from 0 to
     ``yf`` (:func:`~designer.core.metrics.measure_step`), for callers that were
@@ -297,14 +311,9 @@ def _check(model, params, overshoot: Overshoot, sol):
         if not overshoot.above_noise():
             return False, (f"the data's overshoot, {overshoot.text()}, is not above the noise: "
                            "underdamped model not identifiable")
-    mos = model_overshoot_pct(model, params)
-    if overshoot.differs(mos):
-        if mos == 0.0:
-            article = "an" if model[0] in "aeiou" else "a"
-            return False, (f"the data overshoot {overshoot.text()}: {article} {model} model cannot; "
-                           "use the underdamped fit")
-        return False, (f"this model overshoots {mos:.2f} %, the data {overshoot.text()}: "
-                       "more apart than the noise explains")
+    why = overshoot_mismatch(model, params, overshoot)
+    if why:
+        return False, why
     if not sol.success:
         return False, f"solver did not converge: {sol.message}"
     return True, ""

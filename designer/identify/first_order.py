@@ -52,7 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.metrics import Overshoot
-from ..core.stepfit import data_overshoot
+from ..core.stepfit import data_overshoot, overshoot_mismatch
 from ..core.waveform import crossing_time, inflection_tangent, noise_sigma
 from .structures import MethodResult
 
@@ -116,18 +116,15 @@ def unit_time(p: float, model: str = "fopdt") -> float:
 
 # --------------------------------------------------------------------------- helpers
 
-def _validity(t, y, yf, sigma, overshoot: Overshoot | None = None):
+def _validity(t, y, yf, sigma, overshoot: Overshoot | None = None, model: str = "fopdt"):
     """(valid, note) common to every first-order method: the data's measured
     ``overshoot`` (else :func:`~designer.core.stepfit.data_overshoot` of ``t``,
-    ``y``) must be one a monotonic model can leave
-    (:meth:`~designer.core.metrics.Overshoot.differs` from 0)."""
+    ``y``) must be one a monotonic ``model`` can leave
+    (:func:`~designer.core.stepfit.overshoot_mismatch`)."""
     if overshoot is None:
         overshoot = data_overshoot(t, y, yf, sigma)
-    if overshoot.differs(0.0):
-        return False, (f"the data overshoot {overshoot.text()}: first-order and double-pole "
-                       "models only fit monotonic (overdamped) responses; use an underdamped "
-                       "method")
-    return True, ""
+    why = overshoot_mismatch(model, {}, overshoot)
+    return not why, why
 
 
 def _result(name, model, K, tau, theta, points, valid, note):
@@ -201,7 +198,7 @@ def two_point(row: TwoPoint, t, y, yf, sigma=None, overshoot=None) -> MethodResu
         return bad
     tau = row.a * t1 + row.b * t2
     theta = row.c * t1 + row.d * t2
-    valid, note = _validity(t, y, yf, sigma, overshoot)
+    valid, note = _validity(t, y, yf, sigma, overshoot, row.model)
     k1, k2 = _pct_key(row.p1), _pct_key(row.p2)
     return _result(row.name, row.model, yf, tau, theta, {k1: t1, k2: t2}, valid, note)
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from ..core.errors import DesignError
 from ..core.jsonio import json_safe
 from ..core.metrics import Overshoot, StepMetrics
-from ..core.stepfit import model_overshoot_pct
+from ..core.stepfit import overshoot_mismatch
 from .first_order import FIRST_ORDER_METHODS
 from .io import CaptureInfo
 from .preprocess import PreparedStep, prepare_step
@@ -249,12 +249,9 @@ def judge(m: MethodResult, step: PreparedStep, overshoot: Overshoot | None = Non
         why = f"not a linear plant's response ({step.nonlinear.split(':')[0]})"
     if not why and overshoot is not None:
         try:
-            mos = model_overshoot_pct(m.model, m.params)
-        except (KeyError, ValueError, TypeError):
-            mos = math.nan
-        if math.isfinite(mos) and overshoot.differs(mos):
-            why = (f"this model overshoots {mos:.2f} %, the data {overshoot.text()}: more "
-                   "apart than the noise and the method's accuracy explain")
+            why = overshoot_mismatch(m.model, m.params, overshoot)
+        except (KeyError, ValueError, TypeError):   # a model without a zeta (a failed method's)
+            why = ""
     dt = step.dt
     if not why and math.isfinite(dt):
         for k, v in m.params.items():
