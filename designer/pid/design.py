@@ -409,10 +409,10 @@ def _analyse(spec, plant, amp, tun, parts, ps, simulate=True) -> _Loop:
     figures = loop_metrics(t, waves["y"], expected)
     ideal = loop_metrics(t, y_ideal, spec.step_v)   # a true integrator: no steady-state error
     rise = figures.rise_time_s if math.isfinite(figures.rise_time_s) and figures.rise_time_s else hp / 20
-    name_of = _designators(parts, plant, amp, spec.package)
+    names = _designators(parts, plant, amp, spec.package)
     levels = model.waveform_limits(waves, t, amp, model.SLEW_DELAY_FRACTION * rise) if stable else {}
-    levels = {role: replace(v, opamp=name_of(v.opamp)) for role, v in levels.items() if name_of(v.opamp)}
-    checks = _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, spec.step_v, rise, parts, name_of)
+    levels = _named(levels, names)
+    checks = _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, spec.step_v, rise, parts, names.get)
     title = (f"PID closed loop Kp={parts.kp:.4g} Ti={parts.ti_s:.4g}s Td={parts.td_s:.4g}s "
              f"plant fn={plant.fn_hz:.5g}Hz zeta={plant.zeta:.4g} op-amp={amp.name}")
     deck = closed_loop_deck(parts, plant, amp, test, title, expected)
@@ -433,15 +433,21 @@ def _diverging(lm, t, r, limit):
     return w
 
 
-def _designators(parts, plant, amp, package):
+def _designators(parts, plant, amp, package) -> dict:
     """The deck's op-amp (``U6``) -> its designator on the bench in ``package``
-    (``U3B`` in duals), so the checks name the op-amp the sheet wires; None
-    for a stage the circuit does not have (a PI has no differentiator)."""
+    (``U3B`` in duals), so that checks, notes and JSON name the op-amp the
+    sheet wires; a stage the circuit does not have (a PI's differentiator) is
+    absent."""
     from ..spice.deck import board
     from .netlist import loop_netlist
     bd = board(loop_netlist(parts, plant), amp, package)
-    refs = {a.ref: u.designator for a, u in zip(bd.netlist.amps, bd.units)}
-    return refs.get
+    return {a.ref: u.designator for a, u in zip(bd.netlist.amps, bd.units)}
+
+
+def _named(levels: dict, names: dict) -> dict:
+    """Per-stage figures (analytic or SPICE, keyed by role, each with the deck's
+    ``opamp``) with their op-amp named as on the bench; stages not built dropped."""
+    return {role: replace(v, opamp=names[v.opamp]) for role, v in levels.items() if v.opamp in names}
 
 
 def _kick(parts, amp, step_v, name_of=str) -> str:
@@ -515,8 +521,10 @@ def run_spice(res: PidResult, simulator: str) -> None:
     """Simulate the deck, compare, detect saturation and oscillation; fills
     ``spice``, ``verdict`` and the notes of ``res``."""
     w = res.waveforms
-    res.spice = sp = run_and_compare(res.deck, simulator, w.t, res.test.delay_s, w.analytic["y"],
-                                     res.test.amplitude_v, res.expected_final_v, res.opamp)
+    sp = run_and_compare(res.deck, simulator, w.t, res.test.delay_s, w.analytic["y"],
+                         res.test.amplitude_v, res.expected_final_v, res.opamp)
+    res.spice = sp = replace(sp, stages=_named(sp.stages, _designators(res.parts, res.plant, res.opamp,
+                                                                      res.package)))
     res.verdict = explain(sp, res.analytic.figures, res.checks)
     sat = [f"{v.opamp} {role}" for role, v in sp.stages.items() if v.saturated]
     if sat:

@@ -8,6 +8,7 @@ from designer.pid.report import build_board
 from designer.pid.spec import PidSpec
 
 
+@pytest.mark.spice
 def test_checks_name_the_opamps_as_the_package_wires_them():
     """Regression (issue 11): with --package dual the sheet wired U1B, U2A ... while
     the checks still named the deck's U2 .. U7."""
@@ -16,6 +17,10 @@ def test_checks_name_the_opamps_as_the_package_wires_them():
     names = {v.opamp for v in res.analytic.levels.values()}
     units = {u.designator for u in build_board(res).units}
     assert names <= units and "U1B" in names
+    # the SPICE stages name them the same way (a verdict note naming U2 would send the student to U1B's twin)
+    from designer.pid.design import run_spice
+    run_spice(res, "ngspice-cli")
+    assert {s.opamp for s in res.spice.stages.values()} == names
     slew = next(c for c in res.checks if c.id == "slew_rate")
     assert "worst: U" in slew.detail and slew.detail.split("worst: ")[1].split()[0] in units
     d = res.to_dict()
