@@ -157,17 +157,6 @@ def step_metrics(t, y, *, t_step: float | None = None, initial: float | None = N
     )
 
 
-def _moving_average(y, m: int) -> np.ndarray:
-    """Centred moving average over ``m`` samples (the ends over what exists)."""
-    if m <= 1:
-        return y
-    c = np.concatenate(([0.0], np.cumsum(y)))
-    i = np.arange(y.size)
-    lo = np.clip(i - m // 2, 0, y.size)
-    hi = np.clip(i + (m - m // 2), 0, y.size)
-    return (c[hi] - c[lo]) / (hi - lo)
-
-
 def measure_step(t, y, *, t_step: float | None = None, initial: float | None = None,
                  final: float | None = None, lsb: float = 0.0, sigma: float = 0.0) -> tuple:
     """Step-response figures of a measured record, and its :class:`Overshoot`.
@@ -198,7 +187,7 @@ def measure_step(t, y, *, t_step: float | None = None, initial: float | None = N
     -------
     (StepMetrics, Overshoot)
     """
-    from .waveform import (noise_sigma, periodic_ripple, savgol, spread, tangent_window,
+    from .waveform import (moving_average, noise_sigma, periodic_ripple, savgol, spread, tangent_window,
                            uniform)
     t = np.asarray(t, float)
     y = np.asarray(y, float)
@@ -214,7 +203,7 @@ def measure_step(t, y, *, t_step: float | None = None, initial: float | None = N
         if ripple is not None:
             # what the settled stretch's fit leaves during the transient (the
             # ripple changes with the duty cycle) averages out over one period
-            y = _moving_average(y - ripple[0], max(1, round(ripple[1] / dt)))
+            y = moving_average(y - ripple[0], max(1, round(ripple[1] / dt)))
         white = noise_sigma(y)
         w = tangent_window(dt, t.size, sigma=white, span=span, slope_noise=MEASURE_SLOPE_NOISE)
         y = savgol(y, w, 2)

@@ -268,6 +268,19 @@ def crossing_time(t, y, level: float, *, sigma: float = 0.0, start: int = 0) -> 
 # --------------------------------------------------------------------------- smoothing
 
 
+def moving_average(y, m: int) -> np.ndarray:
+    """Centred moving average of ``y`` over ``m`` samples (the ends over the
+    samples that exist), from one cumulative sum."""
+    y = np.asarray(y, float)
+    if m <= 1:
+        return y
+    c = np.concatenate(([0.0], np.cumsum(y)))
+    i = np.arange(y.size)
+    lo = np.clip(i - m // 2, 0, y.size)
+    hi = np.clip(i + (m - m // 2), 0, y.size)
+    return (c[hi] - c[lo]) / (hi - lo)
+
+
 def savgol(y, window: int, polyorder: int, deriv: int = 0, delta: float = 1.0) -> np.ndarray:
     """Savitzky-Golay filter (least-squares polynomial over a sliding window).
 

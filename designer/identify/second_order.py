@@ -63,7 +63,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from ..core.waveform import crossing_time, noise_sigma, peak_region, refine_peak
+from ..core.waveform import crossing_time, moving_average, noise_sigma, peak_region, refine_peak
 from .structures import MethodResult, iae_ise, model_step
 
 __all__ = [
@@ -205,17 +205,6 @@ def _refine_extreme(t, z, zs, idx_lo, idx_hi, sign, sigma):
     return float(t[i]), float(zs[i] if noisy else z[i])
 
 
-def _moving_average(z, m):
-    """Centred moving average over ``m`` samples (edges averaged over what exists)."""
-    if m <= 1:
-        return z
-    c = np.concatenate(([0.0], np.cumsum(z)))
-    n = len(z)
-    lo = np.clip(np.arange(n) - m // 2, 0, n)
-    hi = np.clip(np.arange(n) + (m - m // 2), 0, n)
-    return (c[hi] - c[lo]) / (hi - lo)
-
-
 def extrema(t, z, sigma: float = 0.0, count: int = 3):
     """Alternating extrema of an oscillating normalised response about 1.
 
@@ -230,7 +219,7 @@ def extrema(t, z, sigma: float = 0.0, count: int = 3):
     z = np.asarray(z, float)
     n = len(z)
     m = max(1, n // 2000) if sigma > 0.0 else 1
-    zs = _moving_average(z, m)
+    zs = moving_average(z, m)
     h = max(5.0 * sigma / math.sqrt(m), 1e-12)
     d = zs - 1.0
     state = np.zeros(n, np.int8)

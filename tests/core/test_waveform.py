@@ -215,3 +215,16 @@ def test_tangent_of_any_underdamped_response(zeta, fn):
     assert tg.t == pytest.approx(ti, rel=1e-4)
     assert tg.slope == pytest.approx(slope, rel=1e-5)
     assert tg.t_base == pytest.approx(L, rel=1e-5)
+
+
+def test_moving_average_is_the_centred_mean_and_averages_what_exists_at_the_ends():
+    from designer.core.waveform import moving_average
+    rng = np.random.default_rng(3)
+    y = rng.standard_normal(200)
+    for m in (2, 5, 32):
+        got = moving_average(y, m)
+        full = np.convolve(y, np.ones(m) / m, mode="valid")   # windows i - m//2 .. i - m//2 + m - 1
+        assert np.allclose(got[m // 2: m // 2 + full.size], full, rtol=0, atol=1e-12)
+        assert got[0] == pytest.approx(np.mean(y[: m - m // 2]))
+        assert got[-1] == pytest.approx(np.mean(y[y.size - 1 - m // 2:]))
+    assert np.array_equal(moving_average(y, 1), y)
