@@ -106,7 +106,7 @@ def run_specs(specs, simulator: str, *, jobs: int = 1, timeout: float = 600, upd
               out_dir=None) -> list:
     """Every corner of every spec in worker processes; a
     :class:`~designer.check.result.SpecOutcome` per spec, in the order given."""
-    from ..check.pool import run_tasks
+    from ..core.workers import run_tasks
     from ..check.result import ERROR, SIM_ERROR, Case, CornerOutcome, SpecOutcome
     from ..check.run import run_corner
     from ..spice import simulate

@@ -17,6 +17,7 @@ import numpy as np
 from ..core import eseries
 from ..core.units import format_eng
 from ..report import document as R
+from ..report import render
 from ..report.bundle import bundle_paths, write_bundle
 from ..report.plots import decimate, figure, loop_gain_plot, png_bytes, step_plot
 from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
@@ -344,11 +345,14 @@ def summary_text(result) -> str:
 # ---- plots -------------------------------------------------------------------
 
 def plots(result) -> dict:
-    """The sheet's plots: the closed-loop step (SPICE minus the analytic loop below it,
-    the controller output u in its own panel), every op-amp output, the loop gain with
-    its margins, the reaction curve."""
+    """The sheet's plots, by file name (:data:`PLOTS`): the closed-loop step (SPICE minus
+    the analytic loop below it), every op-amp output, the loop gain with its margins,
+    the reaction curve."""
+    return {name: draw(result) for name, draw in PLOTS}
+
+
+def _closed_loop_plot(result) -> bytes:
     w = result.waveforms
-    t = w.t
     a = w.analytic
     sp = None if result.spice is None else result.spice.waves
     amp = result.opamp.name
@@ -359,15 +363,13 @@ def plots(result) -> dict:
     curves["ideal PID, ideal plant"] = w.ideal_pid
     curves["plant alone (open loop)"] = w.open_loop
     resid = None if sp is None else ("residual: SPICE minus the analytic loop", sp["y"], a["y"])
-    images = {"closed-loop.png": step_plot(t, curves, f"Closed-loop step, 0 -> {result.test.amplitude_v:g} V",
-                                           residual=resid)}
-    images["blocks.png"] = _blocks_plot(result)
-    mg = result.margins
-    images["loop-bode.png"] = loop_gain_plot(w.bode_w / (2 * np.pi), w.loop_gain,
-                                             f"Loop gain with {amp} poles", mg.crossover_hz, mg.phase_margin_deg,
-                                             mg.phase_crossover_hz, mg.gain_margin_db)
-    images["reaction-curve.png"] = _reaction_plot(result)
-    return images
+    return step_plot(w.t, curves, f"Closed-loop step, 0 -> {result.test.amplitude_v:g} V", residual=resid)
+
+
+def _loop_gain_plot(result) -> bytes:
+    w, mg = result.waveforms, result.margins
+    return loop_gain_plot(w.bode_w / (2 * np.pi), w.loop_gain, f"Loop gain with {result.opamp.name} poles",
+                          mg.crossover_hz, mg.phase_margin_deg, mg.phase_crossover_hz, mg.gain_margin_db)
 
 
 def _blocks_plot(result) -> bytes:
@@ -426,15 +428,29 @@ def schematic(result):
     return draw_loop(build_board(result), result.opamp)
 
 
+def schematic_pictures(result) -> tuple:
+    """The loop's schematic as (SVG text, PNG bytes)."""
+    sheet = schematic(result)
+    return sheet.svg(), sheet.png()
+
+
+#: the sheet's plots: (file name, drawing function of the result)
+PLOTS = (("closed-loop.png", _closed_loop_plot), ("blocks.png", _blocks_plot),
+         ("loop-bode.png", _loop_gain_plot), ("reaction-curve.png", _reaction_plot))
+
+
 def write_outputs(result, out_dir, name: str) -> dict:
     """``netlists/<name>.cir`` and ``reports/<name>/`` (build sheet, result.json,
     plots, schematic, bom.csv) under ``out_dir``, each written atomically."""
     tick = time.perf_counter()
-    images = plots(result)
-    sheet = schematic(result)
-    images["schematic.png"] = sheet.png()
-    result.files = bundle_paths(out_dir, name, images, {"bom_csv": "bom.csv"})
-    write_bundle(result.files, result.deck, images, title_of(result), sections(result, schematic_svg=sheet.svg()),
-                 result.to_dict(), {"bom_csv": bom_csv(bom(result))})
+    # the pictures in the renderer (when started), side by side, while the data files are written here
+    drawing = render.submit_many([(schematic_pictures, (result,)), *((draw, (result,)) for _, draw in PLOTS)])
+    names = [name for name, _ in PLOTS]
+    result.files = bundle_paths(out_dir, name, [*names, "schematic.png"], {"bom_csv": "bom.csv"})
+    extras, data = {"bom_csv": bom_csv(bom(result))}, result.to_dict()
+    (svg, png), *pngs = drawing.result()
+    images = {**dict(zip(names, pngs)), "schematic.png": png}
+    write_bundle(result.files, result.deck, images, title_of(result), sections(result, schematic_svg=svg), data,
+                 extras)
     result.timings["report_s"] = time.perf_counter() - tick
     return result.files

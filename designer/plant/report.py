@@ -18,6 +18,7 @@ import numpy as np
 
 from ..core.units import format_eng
 from ..report import document as R
+from ..report import render
 from ..report.bundle import bundle_paths, write_bundle
 from ..report.plots import bode_plot, step_plot
 from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
@@ -213,9 +214,17 @@ def summary_text(result) -> str:
     return R.to_text(title_of(result), sections(result, with_images=False))
 
 
+#: the plots' file names, as :func:`plots` keys them
+PLOTS = ("step.png", "bode.png")
+
+
 def plots(result) -> dict:
-    """step.png (the curves, the tolerance band shaded, SPICE minus the op-amp-aware model
-    below) and bode.png (the models, SPICE's .ac points, the peak and -3 dB markers)."""
+    """step.png (:func:`step_png`) and bode.png (:func:`bode_png`)."""
+    return {PLOTS[0]: step_png(result), PLOTS[1]: bode_png(result)}
+
+
+def step_png(result) -> bytes:
+    """The curves, the tolerance band shaded, SPICE minus the op-amp-aware model below."""
     ideal, real = result.analytic, result.analytic_opamp
     amp = result.opamp.name
     a = result.test.amplitude_v
@@ -229,6 +238,13 @@ def plots(result) -> dict:
                                          f"tolerance band (R {tol.r_tolerance_pct:g} %, C {tol.c_tolerance_pct:g} %)")
     resid = None if result.spice is None else (f"residual: SPICE minus the {amp} model",
                                                result.spice.response, real.response)
+    return step_plot(result.time_s, curves, f"Step response, 0 -> {a:g} V", residual=resid, band=band)
+
+
+def bode_png(result) -> bytes:
+    """The models, SPICE's .ac points, the peak and -3 dB markers."""
+    ideal, real = result.analytic, result.analytic_opamp
+    amp = result.opamp.name
     fn = result.built.fn_hz
     sine = result.sine
     measured, marks = {}, []
@@ -241,9 +257,8 @@ def plots(result) -> dict:
             marks.append((sine.spice_f_peak_hz, sine.spice_peak_gain, "", "rv"))
         if sine.spice_f_3db_hz is not None:
             marks.append((sine.spice_f_3db_hz, sine.dc_gain / math.sqrt(2), "", "rs"))
-    return {"step.png": step_plot(result.time_s, curves, f"Step response, 0 -> {a:g} V", residual=resid, band=band),
-            "bode.png": bode_plot({"ideal op-amp": (ideal.num, ideal.den), f"{amp} model": (real.num, real.den)},
-                                  fn / 100, fn * 100, "Plant frequency response", measured, marks)}
+    return bode_plot({"ideal op-amp": (ideal.num, ideal.den), f"{amp} model": (real.num, real.den)},
+                     fn / 100, fn * 100, "Plant frequency response", measured, marks)
 
 
 def waveforms_csv(result) -> str:
@@ -262,6 +277,12 @@ def schematic(result):
     return draw_plant(build_board(result), result.opamp)
 
 
+def schematic_pictures(result) -> tuple:
+    """The schematic as (SVG text, PNG bytes)."""
+    sheet = schematic(result)
+    return sheet.svg(), sheet.png()
+
+
 def write_outputs(result, out_dir, name: str) -> dict:
     """Write ``netlists/<name>.cir`` and ``reports/<name>/`` under ``out_dir``.
 
@@ -269,11 +290,15 @@ def write_outputs(result, out_dir, name: str) -> dict:
     recorded in ``result.files`` before result.json is written, so it lists itself.
     """
     tick = time.perf_counter()
-    images = plots(result)
-    sheet = schematic(result)
-    images["schematic.png"] = sheet.png()
-    result.files = bundle_paths(out_dir, name, images, {"waveforms_csv": "waveforms.csv", "bom_csv": "bom.csv"})
-    write_bundle(result.files, result.deck, images, title_of(result), sections(result, schematic_svg=sheet.svg()),
-                 result.to_dict(), {"waveforms_csv": waveforms_csv(result), "bom_csv": bom_csv(bom(result))})
+    # the pictures in the renderer (when started), side by side, while the data files are written here
+    drawing = render.submit_many([(schematic_pictures, (result,)), (step_png, (result,)), (bode_png, (result,))])
+    result.files = bundle_paths(out_dir, name, [*PLOTS, "schematic.png"],
+                                {"waveforms_csv": "waveforms.csv", "bom_csv": "bom.csv"})
+    extras = {"waveforms_csv": waveforms_csv(result), "bom_csv": bom_csv(bom(result))}
+    data = result.to_dict()
+    (svg, png), step, bode = drawing.result()
+    images = {PLOTS[0]: step, PLOTS[1]: bode, "schematic.png": png}
+    write_bundle(result.files, result.deck, images, title_of(result), sections(result, schematic_svg=svg), data,
+                 extras)
     result.timings["report_s"] = time.perf_counter() - tick
     return result.files

@@ -158,6 +158,9 @@ class Sheet:
     def png(self, dpi: int = 100) -> bytes:
         """The drawing as PNG bytes (beside the Markdown sheet), through matplotlib."""
         import io
+
+        import matplotlib
+        matplotlib.use("Agg")   # schemdraw draws through pyplot: a file, never a GUI window
         fig = self.d.draw(show=False, canvas="matplotlib")
         buf = io.BytesIO()
         fig.fig.savefig(buf, format="png", dpi=dpi)

@@ -1,8 +1,13 @@
-"""Worker processes for ``check-design --jobs N``: each corner runs in a
-process of its own (one ngspice per process, and a crash of the simulator's
-shared library takes down that worker, not the checker), with a deadline.
+"""Forked worker processes: :class:`Worker` (one process that runs the tasks
+sent to it, in order) and :func:`run_tasks` (a batch over N of them, with
+deadlines).
 
-A worker that passes its deadline is killed with its whole process group
+``check-design --jobs N`` runs each corner in a worker (one ngspice per
+process, and a crash of the simulator's shared library takes down that
+worker, not the checker); the build sheets' renderer
+(:mod:`designer.report.render`) is one worker started ahead of its drawing.
+
+In :func:`run_tasks`, a worker that passes its deadline is killed with its whole process group
 (``ngspice -b`` children included) and replaced; one that dies is replaced
 too; either way its task gets the caller's ``lost(task, reason)`` result.
 Results come back in task order whatever order they finish in, so the
@@ -40,8 +45,12 @@ def _serve(conn, work, setup) -> None:
         conn.send(result)
 
 
-class _Worker:
-    def __init__(self, ctx, work, setup):
+class Worker:
+    """One forked process running ``work(task)`` for each task sent to it, in
+    order, after ``setup()``; in its own process group (:meth:`kill` takes any
+    ``ngspice -b`` it started with it)."""
+
+    def __init__(self, ctx, work, setup=None):
         self.conn, child = ctx.Pipe()
         self.proc = ctx.Process(target=_serve, args=(child, work, setup), daemon=True)
         self.proc.start()
@@ -58,6 +67,7 @@ class _Worker:
             os.killpg(self.proc.pid, signal.SIGKILL)
         except (ProcessLookupError, PermissionError):
             pass
+        self.proc.kill()   # not yet in its own group (just forked): the process itself
         self.proc.join(5)
         self.conn.close()
 
@@ -92,7 +102,7 @@ def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, co
     queue = deque(order)
     workers = []
     try:
-        workers = [_Worker(ctx, work, setup) for _ in range(max(1, min(jobs, len(tasks))))]
+        workers = [Worker(ctx, work, setup) for _ in range(max(1, min(jobs, len(tasks))))]
         for w in workers:
             if queue:
                 i = queue.popleft()
@@ -117,11 +127,11 @@ def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, co
                     w.task = None
                     if kind == "dead":
                         w.kill()
-                        workers[k] = w = _Worker(ctx, work, setup)
+                        workers[k] = w = Worker(ctx, work, setup)
                 elif time.monotonic() >= w.deadline:
                     w.kill()
                     results[i] = lost(tasks[i], f"timed out after {timeout:g} s (killed)")
-                    workers[k] = w = _Worker(ctx, work, setup)
+                    workers[k] = w = Worker(ctx, work, setup)
                 if w.task is None and queue:
                     j = queue.popleft()
                     w.give(j, tasks[j], timeout)

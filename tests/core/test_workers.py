@@ -1,9 +1,9 @@
-"""designer.check.pool: worker processes for check-design --jobs."""
+"""designer.core.workers: worker processes (check-design --jobs, the build sheets' renderer)."""
 
 import os
 import time
 
-from designer.check.pool import run_tasks
+from designer.core.workers import run_tasks
 
 
 def _work(task):

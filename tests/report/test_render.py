@@ -1,0 +1,129 @@
+"""designer.report.render: pictures drawn in the renderer process are the ones
+drawn in-process, byte for byte; a renderer that fails, dies or is never
+started leaves the drawing to the caller, and a real error surfaces there with
+its own type. The console scripts (which start the renderer) write the same
+bundle as the commands called in-process (which do not)."""
+
+import filecmp
+import os
+import subprocess
+
+import pytest
+
+from designer.cli.launch import draws
+from designer.cli.plant import design_plant_main
+from designer.plant.design import design_plant
+from designer.plant.report import bode_png, schematic_pictures, step_png
+from designer.plant.spec import PlantSpec
+from designer.report import render
+from helpers import script
+
+
+@pytest.fixture(scope="module")
+def plant():
+    return design_plant(PlantSpec(fc_hz=3500, zeta=0.2), simulate=False)
+
+
+@pytest.fixture
+def renderer():
+    render.start(preload=("designer.plant.report",))
+    assert render.running()
+    yield
+    render.stop()
+
+
+def square(x):
+    return x * x
+
+
+def fails(x):
+    raise ValueError(f"bad {x}")
+
+
+def dies_in_renderer(x):
+    # the renderer's process ends mid-task; in the caller this returns
+    if render._in_renderer:
+        os._exit(7)
+    return x + 1
+
+
+def test_pictures_from_the_renderer_are_those_drawn_here(plant, renderer):
+    here = [schematic_pictures(plant), step_png(plant), bode_png(plant)]
+    there = render.submit_many([(schematic_pictures, (plant,)), (step_png, (plant,)), (bode_png, (plant,))]).result()
+    assert there == here
+    assert there[1][:8] == b"\x89PNG\r\n\x1a\n" and "<svg" in there[0][0]
+
+
+def test_tasks_answer_in_order_whatever_is_asked_first(renderer):
+    pending = [render.submit(square, k) for k in range(5)]
+    assert [p.result() for p in reversed(pending)] == [16, 9, 4, 1, 0]
+
+
+def test_an_error_in_the_renderer_is_raised_in_the_caller_with_its_type(renderer):
+    with pytest.raises(ValueError, match="bad 3"):
+        render.submit(fails, 3).result()
+    assert render.submit(square, 4).result() == 16   # the renderer lives on
+
+
+def test_a_renderer_that_dies_leaves_the_drawing_to_the_caller(renderer):
+    assert render.submit(dies_in_renderer, 1).result() == 2
+    assert not render.running()
+    assert render.submit(square, 3).result() == 9   # no renderer: in-process
+
+
+def test_a_helper_that_dies_is_redrawn_by_the_renderer(renderer):
+    out = render.submit_many([(square, (2,)), (helper_dies_here, (5,)), (square, (3,))]).result()
+    assert out == [4, -5, 9]
+    assert render.running()
+
+
+def helper_dies_here(x):
+    # in a helper, the parent is the renderer; in the renderer, the parent is this test's process
+    if render._in_renderer and os.getppid() != _TEST_PID:
+        os._exit(3)
+    return -x
+
+
+_TEST_PID = os.getpid()
+
+
+def test_without_a_renderer_everything_is_drawn_here():
+    assert not render.running()
+    assert render.submit_many([(square, (2,)), (square, (3,))]).result() == [4, 9]
+    with pytest.raises(ValueError):
+        render.submit(fails, 1).result()
+
+
+def test_stop_ends_the_renderer_at_once_even_while_it_imports():
+    render.start(preload=("designer.plant.report",))
+    proc = render._worker.proc
+    render.stop()
+    assert not proc.is_alive() and not render.running()
+
+
+@pytest.mark.parametrize("argv, drawn", [
+    (["--fc", "3500", "--zeta", "0.2"], True),
+    (["--fc", "3500", "--zeta", "0.2", "--no-files"], False),
+    (["--fc", "3500", "--no-fi", "--zeta", "0.2"], False),   # argparse takes the abbreviation
+    (["--no-sim"], True),
+    (["--help"], False),
+    (["-h"], False),
+    (["--version"], False),
+])
+def test_which_command_lines_draw(argv, drawn):
+    assert draws(argv) is drawn
+
+
+@pytest.mark.spice
+def test_the_console_script_writes_what_the_command_writes_in_process(tmp_path):
+    args = ["--fc", "3500", "--zeta", "0.2", "--name", "p"]
+    run = subprocess.run([script("design-plant"), *args, "--out", str(tmp_path / "a")], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert design_plant_main([*args, "--out", str(tmp_path / "b")]) == 0
+    a, b = tmp_path / "a" / "reports" / "p", tmp_path / "b" / "reports" / "p"
+    names = sorted(p.name for p in a.iterdir())
+    assert names == sorted(p.name for p in b.iterdir())
+    same = [n for n in names if n != "result.json"]   # result.json records the argv
+    match, mismatch, errors = filecmp.cmpfiles(a, b, same, shallow=False)
+    assert not mismatch and not errors, mismatch
+    assert {"step.png", "bode.png", "schematic.png", "build-sheet.html"} <= set(match)
