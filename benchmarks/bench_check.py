@@ -88,10 +88,11 @@ def pool_floor(runs: dict, bare: dict, simulator: str, repeat: int = 3) -> float
     from designer.spice.simulate import get_simulator
     keys = list(runs)
     sim = get_simulator(simulator)
-    first = runs[keys[0]]
+    light = runs[min(keys, key=lambda k: bare[k])]
 
     def setup():
-        _simulate_all(sim, first[0][:1], first[1])   # each worker's ngspice warmed, as in bare_times
+        # each worker's simulator loaded (the shared library's start), with the lightest deck
+        _simulate_all(sim, light[0], light[1])
 
     def work(key):
         corner_decks, cwd = runs[key]

@@ -42,6 +42,12 @@ def _warm(preload=()) -> None:
     and the ``preload`` modules (by name) whose functions and results it will be sent."""
     global _in_renderer
     _in_renderer = True
+    # the terminal is the command's: nothing from here (matplotlib building its font cache on a
+    # fresh machine, a warning) may add a line to a one-line error; what fails is redone there
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    os.dup2(devnull, 2)
+    os.close(devnull)
     for name in preload:
         importlib.import_module(name)
     import matplotlib
@@ -152,11 +158,15 @@ def _many(calls) -> list:
         os.close(w)
         helpers.append((pid, r, fn, args))
     fn, args = calls[0]
-    out = [fn(*args)]
-    for pid, r, fn, args in helpers:
-        with os.fdopen(r, "rb") as f:
-            data = f.read()
-        os.waitpid(pid, 0)
+    try:
+        out = [fn(*args)]
+    finally:   # the helpers are read and reaped even when the first call raises
+        answers = []
+        for pid, r, _, _ in helpers:
+            with os.fdopen(r, "rb") as f:
+                answers.append(f.read())
+            os.waitpid(pid, 0)
+    for (_, _, fn, args), data in zip(helpers, answers):
         try:
             out.append(pickle.loads(data))
         except Exception:   # the helper failed (empty or cut answer): the call again here, errors included

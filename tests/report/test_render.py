@@ -87,6 +87,14 @@ def helper_dies_here(x):
 _TEST_PID = os.getpid()
 
 
+def test_a_failing_first_call_still_reaps_its_helpers_and_raises_here(renderer):
+    big = 1 << 20   # a helper's answer larger than a pipe's buffer: it waits until read
+    with pytest.raises(ValueError, match="bad 1"):
+        render.submit_many([(fails, (1,)), (bytes, (big,)), (square, (2,))]).result()
+    assert render.running()
+    assert render.submit_many([(square, (2,)), (bytes, (big,))]).result() == [4, bytes(big)]
+
+
 def test_without_a_renderer_everything_is_drawn_here():
     assert not render.running()
     assert render.submit_many([(square, (2,)), (square, (3,))]).result() == [4, 9]
@@ -127,3 +135,16 @@ def test_the_console_script_writes_what_the_command_writes_in_process(tmp_path):
     match, mismatch, errors = filecmp.cmpfiles(a, b, same, shallow=False)
     assert not mismatch and not errors, mismatch
     assert {"step.png", "bode.png", "schematic.png", "build-sheet.html"} <= set(match)
+
+
+@pytest.mark.spice
+def test_the_renderer_never_writes_to_the_terminal(tmp_path):
+    # matplotlib warns on stderr when its config folder is unusable (as when it builds its font
+    # cache); the renderer, started before the arguments are read, must not add that to the output
+    env = {**os.environ, "MPLCONFIGDIR": os.path.join(os.devnull, "mpl")}
+    ok = subprocess.run([script("design-plant"), "--fc", "3500", "--zeta", "0.2", "--out", str(tmp_path / "o")],
+                        capture_output=True, text=True, env=env)
+    assert ok.returncode == 0 and ok.stderr == "", ok.stderr
+    bad = subprocess.run([script("design-plant"), "--fc", "3500", "--zeta", "9e9"], capture_output=True, text=True,
+                         env=env)
+    assert bad.returncode == 2 and len(bad.stderr.splitlines()) == 1, bad.stderr
