@@ -10,15 +10,13 @@ HTML and terminal text from one description (:mod:`designer.report`), plus
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 
 from ..core import eseries
 from ..core.units import format_eng
 from ..report import document as R
-from ..report import render
-from ..report.bundle import bundle_paths, write_bundle
+from ..report.bundle import write_design
 from ..report.plots import decimate, figure, loop_gain_plot, png_bytes, step_plot
 from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
@@ -428,6 +426,10 @@ def schematic(result):
     return draw_loop(build_board(result), result.opamp)
 
 
+def _bom_csv(result) -> str:
+    return bom_csv(bom(result))
+
+
 def schematic_pictures(result) -> tuple:
     """The loop's schematic as (SVG text, PNG bytes)."""
     sheet = schematic(result)
@@ -442,15 +444,6 @@ PLOTS = (("closed-loop.png", _closed_loop_plot), ("blocks.png", _blocks_plot),
 def write_outputs(result, out_dir, name: str) -> dict:
     """``netlists/<name>.cir`` and ``reports/<name>/`` (build sheet, result.json,
     plots, schematic, bom.csv) under ``out_dir``, each written atomically."""
-    tick = time.perf_counter()
-    # the pictures in the renderer (when started), side by side, while the data files are written here
-    drawing = render.submit_many([(schematic_pictures, (result,)), *((draw, (result,)) for _, draw in PLOTS)])
-    names = [name for name, _ in PLOTS]
-    result.files = bundle_paths(out_dir, name, [*names, "schematic.png"], {"bom_csv": "bom.csv"})
-    extras, data = {"bom_csv": bom_csv(bom(result))}, result.to_dict()
-    (svg, png), *pngs = drawing.result()
-    images = {**dict(zip(names, pngs)), "schematic.png": png}
-    write_bundle(result.files, result.deck, images, title_of(result), sections(result, schematic_svg=svg), data,
-                 extras)
-    result.timings["report_s"] = time.perf_counter() - tick
-    return result.files
+    return write_design(result, out_dir, name, PLOTS, schematic_pictures,
+                        lambda svg: sections(result, schematic_svg=svg), title_of(result),
+                        {"bom_csv": ("bom.csv", _bom_csv)})

@@ -12,14 +12,12 @@ from __future__ import annotations
 
 import io
 import math
-import time
 
 import numpy as np
 
 from ..core.units import format_eng
 from ..report import document as R
-from ..report import render
-from ..report.bundle import bundle_paths, write_bundle
+from ..report.bundle import write_design
 from ..report.plots import bode_plot, step_plot
 from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
@@ -214,13 +212,9 @@ def summary_text(result) -> str:
     return R.to_text(title_of(result), sections(result, with_images=False))
 
 
-#: the plots' file names, as :func:`plots` keys them
-PLOTS = ("step.png", "bode.png")
-
-
 def plots(result) -> dict:
-    """step.png (:func:`step_png`) and bode.png (:func:`bode_png`)."""
-    return {PLOTS[0]: step_png(result), PLOTS[1]: bode_png(result)}
+    """The sheet's plots, by file name (:data:`PLOTS`): the step response and the Bode plot."""
+    return {name: draw(result) for name, draw in PLOTS}
 
 
 def step_png(result) -> bytes:
@@ -277,10 +271,18 @@ def schematic(result):
     return draw_plant(build_board(result), result.opamp)
 
 
+def _bom_csv(result) -> str:
+    return bom_csv(bom(result))
+
+
 def schematic_pictures(result) -> tuple:
     """The schematic as (SVG text, PNG bytes)."""
     sheet = schematic(result)
     return sheet.svg(), sheet.png()
+
+
+#: the sheet's plots: (file name, drawing function of the result)
+PLOTS = (("step.png", step_png), ("bode.png", bode_png))
 
 
 def write_outputs(result, out_dir, name: str) -> dict:
@@ -289,16 +291,6 @@ def write_outputs(result, out_dir, name: str) -> dict:
     Every file goes through a temporary file and a rename; the paths are
     recorded in ``result.files`` before result.json is written, so it lists itself.
     """
-    tick = time.perf_counter()
-    # the pictures in the renderer (when started), side by side, while the data files are written here
-    drawing = render.submit_many([(schematic_pictures, (result,)), (step_png, (result,)), (bode_png, (result,))])
-    result.files = bundle_paths(out_dir, name, [*PLOTS, "schematic.png"],
-                                {"waveforms_csv": "waveforms.csv", "bom_csv": "bom.csv"})
-    extras = {"waveforms_csv": waveforms_csv(result), "bom_csv": bom_csv(bom(result))}
-    data = result.to_dict()
-    (svg, png), step, bode = drawing.result()
-    images = {PLOTS[0]: step, PLOTS[1]: bode, "schematic.png": png}
-    write_bundle(result.files, result.deck, images, title_of(result), sections(result, schematic_svg=svg), data,
-                 extras)
-    result.timings["report_s"] = time.perf_counter() - tick
-    return result.files
+    texts = {"waveforms_csv": ("waveforms.csv", waveforms_csv), "bom_csv": ("bom.csv", _bom_csv)}
+    return write_design(result, out_dir, name, PLOTS, schematic_pictures,
+                        lambda svg: sections(result, schematic_svg=svg), title_of(result), texts)
