@@ -7,6 +7,7 @@ bundle as the commands called in-process (which do not)."""
 import filecmp
 import os
 import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -148,3 +149,36 @@ def test_the_renderer_never_writes_to_the_terminal(tmp_path):
     bad = subprocess.run([script("design-plant"), "--fc", "3500", "--zeta", "9e9"], capture_output=True, text=True,
                          env=env)
     assert bad.returncode == 2 and len(bad.stderr.splitlines()) == 1, bad.stderr
+
+
+@pytest.mark.spice
+def test_an_interrupt_ends_the_renderer_too(tmp_path):
+    import signal
+    import time
+    out = tmp_path / "interrupted"
+    p = subprocess.Popen([script("design-pid"), "--plant-fc", "3500", "--plant-zeta", "0.2", "--tuning", "optimize",
+                          "--target-overshoot", "10", "--out", str(out)], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    time.sleep(0.6)   # the renderer is started and the tuning runs (the whole run takes over a second)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 130 and err.splitlines() == ["design-pid: error: interrupted"], err
+    # the renderer and its helpers are forks of the command: the same command line
+    deadline = time.monotonic() + 5
+    while running_with(str(out)) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not running_with(str(out))
+    assert not (out / "reports").exists() or not any((out / "reports").iterdir())
+
+
+def running_with(arg: str) -> list:
+    """Processes whose command line has ``arg`` (read from /proc: no ps needed)."""
+    found = []
+    for d in Path("/proc").iterdir():
+        try:
+            if d.name.isdigit() and arg.encode() in (d / "cmdline").read_bytes():
+                found.append(int(d.name))
+        except OSError:   # gone meanwhile
+            pass
+    return found
