@@ -426,16 +426,6 @@ def schematic(result):
     return draw_loop(build_board(result), result.opamp)
 
 
-def _bom_csv(result) -> str:
-    return bom_csv(bom(result))
-
-
-def schematic_pictures(result) -> tuple:
-    """The loop's schematic as (SVG text, PNG bytes)."""
-    sheet = schematic(result)
-    return sheet.svg(), sheet.png()
-
-
 #: the sheet's plots: (file name, drawing function of the result)
 PLOTS = (("closed-loop.png", _closed_loop_plot), ("blocks.png", _blocks_plot),
          ("loop-bode.png", _loop_gain_plot), ("reaction-curve.png", _reaction_plot))
@@ -444,6 +434,6 @@ PLOTS = (("closed-loop.png", _closed_loop_plot), ("blocks.png", _blocks_plot),
 def write_outputs(result, out_dir, name: str) -> dict:
     """``netlists/<name>.cir`` and ``reports/<name>/`` (build sheet, result.json,
     plots, schematic, bom.csv) under ``out_dir``, each written atomically."""
-    return write_design(result, out_dir, name, PLOTS, schematic_pictures,
+    return write_design(result, out_dir, name, PLOTS, schematic,
                         lambda svg: sections(result, schematic_svg=svg), title_of(result),
-                        {"bom_csv": ("bom.csv", _bom_csv)})
+                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r)))})

@@ -271,16 +271,6 @@ def schematic(result):
     return draw_plant(build_board(result), result.opamp)
 
 
-def _bom_csv(result) -> str:
-    return bom_csv(bom(result))
-
-
-def schematic_pictures(result) -> tuple:
-    """The schematic as (SVG text, PNG bytes)."""
-    sheet = schematic(result)
-    return sheet.svg(), sheet.png()
-
-
 #: the sheet's plots: (file name, drawing function of the result)
 PLOTS = (("step.png", step_png), ("bode.png", bode_png))
 
@@ -291,6 +281,6 @@ def write_outputs(result, out_dir, name: str) -> dict:
     Every file goes through a temporary file and a rename; the paths are
     recorded in ``result.files`` before result.json is written, so it lists itself.
     """
-    texts = {"waveforms_csv": ("waveforms.csv", waveforms_csv), "bom_csv": ("bom.csv", _bom_csv)}
-    return write_design(result, out_dir, name, PLOTS, schematic_pictures,
+    texts = {"waveforms_csv": ("waveforms.csv", waveforms_csv), "bom_csv": ("bom.csv", lambda r: bom_csv(bom(r)))}
+    return write_design(result, out_dir, name, PLOTS, schematic,
                         lambda svg: sections(result, schematic_svg=svg), title_of(result), texts)

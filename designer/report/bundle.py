@@ -64,22 +64,29 @@ def write_bundle(files: dict, deck: str, images: dict, title: str, sections, res
         fileio.atomic_write(net, deck)
 
 
-def write_design(result, out_dir, name: str, plots, schematic_pictures, sections, title: str,
-                 texts: dict = None) -> dict:
+def schematic_pictures(schematic, result) -> tuple:
+    """``schematic(result)`` (a wing's drawing of the design) as (SVG text, PNG bytes)."""
+    sheet = schematic(result)
+    return sheet.svg(), sheet.png()
+
+
+def write_design(result, out_dir, name: str, plots, schematic, sections, title: str, texts: dict = None) -> dict:
     """A design's whole bundle under ``out_dir`` (:func:`bundle_paths`, :func:`write_bundle`).
 
-    The pictures (``plots``: ``(file name, draw(result) -> PNG)`` pairs, and
-    ``schematic_pictures(result) -> (SVG, PNG)``) are drawn in the renderer when one
-    is started (:mod:`.render`), side by side, while the data files are made here;
-    ``sections(svg)`` gives the sheet with the schematic inlined; ``texts``: key ->
-    (file name, text(result)). ``result.files`` is set before result.json is
-    written, so it lists itself; it is returned, and ``result.timings["report_s"]`` set.
+    The pictures (``plots``: ``(file name, draw(result) -> PNG)`` pairs, and the
+    schematic, ``schematic(result)`` a drawing, as :func:`schematic_pictures`) are
+    drawn in the renderer when one is started (:mod:`.render`), side by side, while
+    the data files are made here; ``sections(svg)`` gives the sheet with the
+    schematic inlined; ``texts``: key -> (file name, text(result)). ``result.files``
+    is set before result.json is written, so it lists itself; it is returned, and
+    ``result.timings["report_s"]`` set.
     """
     import time
 
     from . import render
     tick = time.perf_counter()
-    drawing = render.submit_many([(schematic_pictures, (result,)), *((draw, (result,)) for _, draw in plots)])
+    drawing = render.submit_many([(schematic_pictures, (schematic, result)),
+                                  *((draw, (result,)) for _, draw in plots)])
     names = [n for n, _ in plots]
     texts = texts or {}
     result.files = bundle_paths(out_dir, name, [*names, "schematic.png"], {k: f for k, (f, _) in texts.items()})

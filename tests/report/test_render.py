@@ -14,9 +14,10 @@ import pytest
 from designer.cli.launch import draws
 from designer.cli.plant import design_plant_main
 from designer.plant.design import design_plant
-from designer.plant.report import bode_png, schematic_pictures, step_png
+from designer.plant.report import bode_png, schematic, step_png
 from designer.plant.spec import PlantSpec
 from designer.report import render
+from designer.report.bundle import schematic_pictures
 from helpers import script
 
 
@@ -49,8 +50,9 @@ def dies_in_renderer(x):
 
 
 def test_pictures_from_the_renderer_are_those_drawn_here(plant, renderer):
-    here = [schematic_pictures(plant), step_png(plant), bode_png(plant)]
-    there = render.submit_many([(schematic_pictures, (plant,)), (step_png, (plant,)), (bode_png, (plant,))]).result()
+    here = [schematic_pictures(schematic, plant), step_png(plant), bode_png(plant)]
+    there = render.submit_many([(schematic_pictures, (schematic, plant)), (step_png, (plant,)),
+                                (bode_png, (plant,))]).result()
     assert there == here
     assert there[1][:8] == b"\x89PNG\r\n\x1a\n" and "<svg" in there[0][0]
 
