@@ -44,7 +44,7 @@ def decks(specs) -> dict:
     for s in specs:
         for k, corner in enumerate(s.corners):
             if s.kind == "netlist":
-                out[(s.name, corner)] = ([s.designs[k]], s.deck_dir)
+                out[(s.name, corner)] = ([s.designs[k]], None)
                 continue
             if s.kind == "plant":
                 from designer.plant.design import analyze_plant as analyze, design_plant as design
@@ -61,7 +61,7 @@ def decks(specs) -> dict:
 
 def _simulate_all(sim, runs, cwd) -> None:
     for deck in runs:
-        sim.run(deck, workdir=cwd)
+        sim.run(deck)
 
 
 def bare_times(runs: dict, simulator: str) -> dict:

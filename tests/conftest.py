@@ -39,7 +39,7 @@ def _path_without_ngspice(tmp_path_factory):
     return os.pathsep.join([str(Path(sys.executable).parent), str(folder)])
 
 
-def _no_simulator(self, deck, workdir=None):
+def _no_simulator(self, deck):
     raise SimulatorError("this test simulates: mark it with @pytest.mark.spice")
 
 

@@ -28,3 +28,38 @@ def peak_bytes(fn, *args, **kw):
         return tracemalloc.get_traced_memory()[1], out
     finally:
         tracemalloc.stop()
+
+
+def tagged_env(tag: str, **extra) -> dict:
+    """The environment for a command under test, marked with ``tag``: every process it
+    starts (workers, the renderer, its helpers, ``ngspice -b``) inherits the mark."""
+    import os
+    return {**os.environ, "DESIGNER_TEST_TAG": tag, **extra}
+
+
+def processes_tagged(tag: str) -> list:
+    """Live processes whose environment carries ``tag`` (read from /proc: no ps needed;
+    zombies, which hold nothing, are left out)."""
+    found, mark = [], f"DESIGNER_TEST_TAG={tag}".encode()
+    for d in Path("/proc").iterdir():
+        if not d.name.isdigit():
+            continue
+        try:
+            if mark in (d / "environ").read_bytes().split(b"\0"):
+                state = (d / "stat").read_text().rsplit(")", 1)[1].split()[0]
+                if state != "Z":
+                    found.append(int(d.name))
+        except OSError:   # gone meanwhile, or not ours to read
+            pass
+    return found
+
+
+def wait_gone(tag: str, seconds: float = 2.0) -> list:
+    """The tagged processes still alive after ``seconds`` (polled; [] as soon as none is)."""
+    import time
+    deadline = time.monotonic() + seconds
+    while True:
+        left = processes_tagged(tag)
+        if not left or time.monotonic() >= deadline:
+            return left
+        time.sleep(0.05)

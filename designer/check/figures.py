@@ -2,27 +2,39 @@
 from in a design's typed result (one corner: the op-amp-aware model and the
 SPICE run with that corner's op-amp).
 
-Names without a prefix are what the bench sees: the SPICE run's step figures
-(``overshoot_pct``), or the circuit's own (``fn_hz``, ``kp``);
-``model_<figure>`` is the analytic model with the corner's op-amp, and for a
-plant ``ideal_<figure>`` the ideal-op-amp model. A ``kind: netlist`` spec limits
+Names without a prefix are what the bench sees with the corner's op-amp: the
+SPICE run's step figures (``overshoot_pct``), or the circuit's own (``fn_hz``,
+``zeta``, ``q`` of the dominant pair with that op-amp, ``kp``), so every corner
+of ``opamp: [LM741, TL072]`` checks its own number; ``model_<figure>`` is the
+analytic model with the corner's op-amp, and for a plant ``ideal_<figure>``
+the ideal-op-amp model (``ideal_fn_hz``, ``ideal_zeta``, ``ideal_q``: the
+passive parts alone, the same in every corner). ``fn_opamp_hz`` and
+``zeta_opamp``, the earlier names of the corner's fn and zeta, stay accepted
+as aliases (:data:`ALIASES`): their meaning never changed, so a spec using
+them keeps checking the number it always did. A ``kind: netlist`` spec limits
 the deck's own ``.meas`` results, by name.
 """
 
 from __future__ import annotations
 
+import itertools
+from dataclasses import replace
+
 STEP = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
 
 #: figure -> (unit, what it is), for a plant
 PLANT = {
-    "fn_hz": ("Hz", "natural frequency of the parts (ideal op-amp)"),
-    "zeta": ("", "damping ratio of the parts (ideal op-amp)"),
-    "q": ("", "quality factor 1/(2 zeta) of the parts"),
+    "fn_hz": ("Hz", "natural frequency with the corner's op-amp (dominant pair)"),
+    "zeta": ("", "damping ratio with the corner's op-amp (dominant pair)"),
+    "q": ("", "quality factor 1/(2 zeta) with the corner's op-amp"),
+    "ideal_fn_hz": ("Hz", "natural frequency of the parts alone (ideal op-amp)"),
+    "ideal_zeta": ("", "damping ratio of the parts alone (ideal op-amp)"),
+    "ideal_q": ("", "quality factor 1/(2 zeta) of the parts alone (ideal op-amp)"),
     "gain": ("", "DC gain K"),
-    "fn_opamp_hz": ("Hz", "natural frequency with the corner's op-amp"),
-    "zeta_opamp": ("", "damping ratio with the corner's op-amp"),
-    "fn_error_pct": ("", "fn against the target, percent (with a target)"),
-    "zeta_error_pct": ("", "zeta against the target, percent (with a target)"),
+    "fn_opamp_hz": ("Hz", "alias of fn_hz (its earlier name)"),
+    "zeta_opamp": ("", "alias of zeta (its earlier name)"),
+    "fn_error_pct": ("", "fn_hz (the corner's, with its op-amp) against the target fc, percent (with a target)"),
+    "zeta_error_pct": ("", "zeta (the corner's, with its op-amp) against the target, percent (with a target)"),
     **{f: ("s" if f.endswith("_s") else "", f"SPICE step figure {f}") for f in STEP},
     **{f"model_{f}": ("s" if f.endswith("_s") else "", f"op-amp-aware model's {f}") for f in STEP},
     **{f"ideal_{f}": ("s" if f.endswith("_s") else "", f"ideal-op-amp model's {f}") for f in STEP},
@@ -46,8 +58,13 @@ PID = {
 
 FIGURES = {"plant": PLANT, "pid": PID}
 
-#: the tolerance band's figures (a plant's build sheet: worst case over its part tolerances)
-BAND = ("fn_hz", "zeta", "overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
+#: accepted alias -> the figure it names (a plant's earlier names, kept so old specs still load)
+ALIASES = {"fn_opamp_hz": "fn_hz", "zeta_opamp": "zeta"}
+
+#: the tolerance band's figures (worst case over the part tolerances): fn and zeta with the corner's
+#: op-amp and of the parts alone, and the step figures (see :func:`band_of`)
+BAND = ("fn_hz", "zeta", "ideal_fn_hz", "ideal_zeta", *ALIASES, "overshoot_pct", "peak_time_s", "rise_time_s",
+        "settling_time_s")
 
 
 def unit_of(kind: str, figure: str) -> str:
@@ -58,9 +75,12 @@ def unit_of(kind: str, figure: str) -> str:
 def plant_figures(res) -> dict:
     """Every :data:`PLANT` figure of a :class:`~designer.plant.result.PlantResult`."""
     a, o = res.analytic, res.analytic_opamp
-    out = {"fn_hz": a.figures.fn_hz, "zeta": a.figures.zeta, "q": a.figures.q, "gain": res.built.gain,
-           "fn_opamp_hz": o.figures.fn_hz, "zeta_opamp": o.figures.zeta,
-           "fn_error_pct": a.figures.fn_error_pct, "zeta_error_pct": a.figures.zeta_error_pct}
+    out = {"fn_hz": float(o.figures.fn_hz), "zeta": float(o.figures.zeta), "q": float(o.figures.q),
+           "ideal_fn_hz": a.figures.fn_hz, "ideal_zeta": a.figures.zeta, "ideal_q": a.figures.q,
+           "gain": res.built.gain,
+           # the error against the target is the corner's, as fn_hz is
+           "fn_error_pct": _float(o.figures.fn_error_pct), "zeta_error_pct": _float(o.figures.zeta_error_pct)}
+    out.update({alias: out[name] for alias, name in ALIASES.items()})
     for f in STEP:
         out[f"model_{f}"] = getattr(o.step, f)
         out[f"ideal_{f}"] = getattr(a.step, f)
@@ -68,6 +88,11 @@ def plant_figures(res) -> dict:
     out["nrms"] = None if res.spice is None else res.spice.nrms
     out["nrms_ideal"] = None if res.spice is None else res.spice.nrms_ideal
     return out
+
+
+def _float(value):
+    """A plain float (the model's figures are numpy scalars), None kept."""
+    return None if value is None else float(value)
 
 
 def pid_figures(res) -> dict:
@@ -84,6 +109,46 @@ def pid_figures(res) -> dict:
 
 
 def band_of(res) -> dict:
-    """figure -> (lo, hi) of a plant's tolerance band (:data:`BAND`)."""
+    """figure -> (lo, hi) of a plant's tolerance band (:data:`BAND`).
+
+    The band is the worst case over the 16 corners of R1, R2, C1, C2 at +/-
+    their tolerance (:func:`~designer.plant.bench.tolerance_band`). ``fn_hz``
+    and ``zeta`` (and their aliases) follow the corner, as their figures do:
+    the dominant pair of the op-amp-aware model at each tolerance corner, with
+    the corner's op-amp, computed exactly rather than by scaling the passive
+    band (the op-amp's shift itself moves a little with the parts).
+    ``ideal_fn_hz`` and ``ideal_zeta`` are the passive band (ideal op-amp).
+    The step figures' band is the ideal-op-amp model's, as the build sheet
+    prints it.
+
+    Parameters
+    ----------
+    res : PlantResult
+        One corner's plant result (its ``built`` parts, ``opamp`` and ``tolerance``).
+
+    Returns
+    -------
+    dict
+        figure -> (lo, hi); (None, None) where no tolerance corner has the figure.
+    """
     t = res.tolerance
-    return {f: (getattr(t, f).lo, getattr(t, f).hi) for f in BAND}
+    out = {f: (getattr(t, f).lo, getattr(t, f).hi) for f in BAND if hasattr(t, f)}
+    out["ideal_fn_hz"], out["ideal_zeta"] = out["fn_hz"], out["zeta"]
+    out["fn_hz"], out["zeta"] = _opamp_band(res.built, res.opamp, t.r_tolerance_pct / 100, t.c_tolerance_pct / 100)
+    out.update({alias: out[name] for alias, name in ALIASES.items()})
+    return out
+
+
+def _opamp_band(parts, opamp, r_tol: float, c_tol: float) -> tuple:
+    """((lo, hi) of fn, (lo, hi) of zeta) with ``opamp`` over the tolerance corners of ``parts``."""
+    # imported here: loading a spec (which reads this module) needs no plant model
+    from ..core.lti import dominant_pair
+    from ..plant.model import plant_tf_opamp
+    fns, zetas = [], []
+    for s in itertools.product((-1, 1), repeat=4):   # the same 16 corners as the passive band
+        p = replace(parts, r1=parts.r1 * (1 + s[0] * r_tol), r2=parts.r2 * (1 + s[1] * r_tol),
+                    c1=parts.c1 * (1 + s[2] * c_tol), c2=parts.c2 * (1 + s[3] * c_tol))
+        fn, z = dominant_pair(plant_tf_opamp(p, opamp)[1])
+        fns.append(float(fn))
+        zetas.append(float(z))
+    return (min(fns), max(fns)), (min(zetas), max(zetas))

@@ -13,12 +13,14 @@ still compares; the difference is a warning (a JUnit property), not a failure.
 from __future__ import annotations
 
 import io
+import warnings
 
 import numpy as np
 
 from ..core.compare import nrms
 from ..core.errors import DesignError
 from ..core.fileio import MAX_TABLE_BYTES, atomic_write, read_text, shown
+from ..core.units import format_eng
 
 TITLE = "designer golden waveform"
 #: the header's keys whose change since recording is worth a warning
@@ -32,7 +34,12 @@ def header_of(tool: dict, spec: str, corner: str) -> dict:
 
 
 def write_golden(path, t, signals: dict, header: dict) -> None:
-    """Record ``signals`` (name -> samples on ``t``) at ``path``, atomically."""
+    """Record ``signals`` (name -> samples on ``t``) at ``path``, atomically; a
+    sample that is not a finite number is refused (the file could never compare)."""
+    t = np.asarray(t, float)
+    _finite(t, "the run's time", t, f" {shown(path)}")
+    for sig, values in signals.items():
+        _finite(np.asarray(values, float), f"the run's {sig}", t, f" {shown(path)}")
     buf = io.StringIO()
     buf.write(f"# {TITLE}\n" + "".join(f"# {k}: {v}\n" for k, v in header.items()))
     cols = np.column_stack([np.asarray(t, float)] + [np.asarray(v, float) for v in signals.values()])
@@ -42,27 +49,43 @@ def write_golden(path, t, signals: dict, header: dict) -> None:
 
 def read_golden(path) -> tuple:
     """(header dict, time, {signal: samples}) of a golden file; a file that is
-    not one is refused in one line naming it."""
+    not one (no ``time_s,...`` line, fewer than 2 samples, a sample that is
+    not a finite number, time not increasing) is refused in one line naming it
+    (and the column and row of a bad sample)."""
     name = shown(path)
     text = read_text(path, "golden file", MAX_TABLE_BYTES * 4)
-    header, body = {}, []
-    for ln in text.splitlines():
+    header, body, lines = {}, [], []
+    for n, ln in enumerate(text.splitlines(), 1):
         if ln.startswith("#"):
             key, sep, value = ln[1:].partition(":")
             if sep:
                 header[key.strip()] = value.strip()
         elif ln.strip():
             body.append(ln)
+            lines.append(n)
     if not body or not body[0].startswith("time_s,"):
         raise DesignError(f"golden file {name} is not a golden waveform (a time_s,... header line, then "
                           "samples); record it with check-design --update-golden")
     names = [c.strip() for c in body[0].split(",")]
+    if len(body) < 3:   # loadtxt warns on no rows; one row is no waveform
+        rows = f"{len(body) - 1} row{'' if len(body) == 2 else 's'}"
+        raise DesignError(f"golden file {name}: {rows} of samples; a golden waveform has at least 2 (record it "
+                          "with check-design --update-golden)")
     try:
-        data = np.loadtxt(body[1:], delimiter=",", ndmin=2)
-    except ValueError as exc:
-        raise DesignError(f"golden file {name}: unreadable samples ({exc})") from None
-    if data.shape[0] < 2 or data.shape[1] != len(names):
-        raise DesignError(f"golden file {name}: expected {len(names)} columns and at least 2 rows")
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")   # whatever numpy would print is a refusal here
+            data = np.loadtxt(body[1:], delimiter=",", ndmin=2)
+    except (ValueError, Warning) as exc:
+        raise DesignError(f"golden file {name}: unreadable samples ({' '.join(str(exc).split())})") from None
+    if data.shape[1] != len(names):
+        raise DesignError(f"golden file {name}: {data.shape[1]} columns of samples under the {len(names)} names of "
+                          f"its header line; they must match")
+    bad = ~np.isfinite(data)
+    if bad.any():
+        row, col = (int(i) for i in np.argwhere(bad)[0])
+        raise DesignError(f"golden file {name}:{lines[row + 1]}: {names[col]} is {float(data[row, col])} in "
+                          f"sample row {row + 1}; a golden waveform holds finite numbers only (record it with "
+                          "check-design --update-golden)")
     t = data[:, 0]
     if not np.all(np.diff(t) > 0):
         raise DesignError(f"golden file {name}: time_s must increase")
@@ -75,16 +98,45 @@ def version_warnings(recorded: dict, now: dict, path) -> list:
     return [f"golden file {shown(path)} was recorded with other versions: " + ", ".join(diff)] if diff else []
 
 
-def compare(t, test: dict, t_gold, gold: dict, tolerances: dict) -> dict:
+def compare(t, test: dict, t_gold, gold: dict, tolerances: dict, path=None) -> dict:
     """signal -> its nrms against the gold (xyce_verify rule), for each signal of ``tolerances``
-    (name -> (reltol, abstol)); the test's time points outside the gold's span are left out."""
-    t = np.asarray(t, float)
-    inside = (t >= t_gold[0]) & (t <= t_gold[-1])
+    (name -> (reltol, abstol)); the test's time points outside the gold's span are left out.
+
+    Raises
+    ------
+    DesignError
+        One line naming the golden file (``path``): fewer than 2 of the test's
+        time points inside the gold's span (the two spans given), or a sample
+        of the run or the gold that is not a finite number.
+    """
+    name = "" if path is None else f" {shown(path)}"
+    t, t_gold = np.asarray(t, float), np.asarray(t_gold, float)
+    _finite(t, "the run's time", t, name)
+    _finite(t_gold, "its time_s", t_gold, name)
+    inside = (t >= t_gold[0]) & (t <= t_gold[-1]) if t_gold.size else np.zeros(t.shape, bool)
+    if np.count_nonzero(inside) < 2:
+        span = f"{format_eng(t_gold[0], 's')} to {format_eng(t_gold[-1], 's')}" if t_gold.size else "no time"
+        run = f"{format_eng(t[0], 's')} to {format_eng(t[-1], 's')}" if t.size else "no time"
+        raise DesignError(f"golden file{name} covers {span}; the run covers {run}: fewer than 2 of the run's time "
+                          "points lie in the golden span, nothing to compare (record it with check-design "
+                          "--update-golden)")
     out = {}
     for sig, (reltol, abstol) in tolerances.items():
-        out[sig] = nrms(gold[sig], np.asarray(test[sig], float)[inside], abstol, reltol=reltol, t=t[inside],
-                        t_gold=t_gold)
+        y = np.asarray(test[sig], float)
+        _finite(y[inside], f"the run's {sig}", t[inside], name)
+        _finite(np.asarray(gold[sig], float), f"its {sig}", t_gold, name)
+        out[sig] = nrms(gold[sig], y[inside], abstol, reltol=reltol, t=t[inside], t_gold=t_gold)
     return out
+
+
+def _finite(values, what: str, t, name: str) -> None:
+    """Refuse the first sample of ``values`` (on times ``t``) that is not a finite number."""
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        i = int(bad[0])
+        when = f" at {format_eng(t[i], 's')}" if i < np.size(t) and np.isfinite(t[i]) else f" at sample {i + 1}"
+        raise DesignError(f"golden file{name}: {what} is {float(values[i])}{when}; only finite samples can be "
+                          "compared")
 
 
 def error_plot(t, test, t_gold, gold, reltol: float, abstol: float, title: str) -> bytes:

@@ -7,14 +7,41 @@ that proved bad while running) an ``<error>``, a report-only check
 ``<skipped>``; the versions (tool, Python, ngspice, simulator) and any golden
 file warnings are ``<properties>`` of the suite. Counts and times are
 attributes, as those readers expect.
+
+The XML stays well-formed whatever the names and messages hold: ``<&>`` and
+quotes are escaped, and the characters XML 1.0 forbids (C0 controls but tab,
+newline and carriage return; lone surrogates, as a file name that is not UTF-8
+decodes to; U+FFFE, U+FFFF) are written as visible escapes (:func:`visible`:
+``\\x01``, ``\\xff`` for the byte 0xff of a file name), not U+FFFD, so that
+the reader still sees which character it was.
 """
 
 from __future__ import annotations
 
+import re
 import time
 import xml.etree.ElementTree as ET
 
 from .result import ERROR, FAIL, SIM_ERROR, SKIP, headline
+
+
+#: a character XML 1.0 does not allow: all but tab, newline, CR, U+0020-U+D7FF, U+E000-U+FFFD, U+10000 up
+_NOT_XML = re.compile("[^\t\n\r\u0020-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+
+
+def visible(text) -> str:
+    """``text`` with every character XML 1.0 forbids as a visible escape: ``\\x01``,
+    ``\\x1b``; a lone surrogate from a byte that is not UTF-8 (surrogateescape) as
+    that byte, ``\\xff``; any other as ``\\udXXX`` (not reversible: a backslash stays
+    as it is)."""
+    return _NOT_XML.sub(_escape, str(text))
+
+
+def _escape(match) -> str:
+    c = ord(match.group())
+    if 0xDC80 <= c <= 0xDCFF:
+        return f"\\x{c - 0xDC00:02x}"
+    return f"\\x{c:02x}" if c < 0x100 else f"\\u{c:04x}"
 
 
 def _seconds(s: float) -> str:
@@ -62,5 +89,10 @@ def junit_xml(outcomes, seconds: float) -> str:
     for key, value in totals.items():
         root.set(key, str(value))
     root.set("time", _seconds(seconds))
+    for el in root.iter():   # names, files, messages and warnings are the user's text
+        for key, value in list(el.attrib.items()):
+            el.set(key, visible(value))
+        if el.text:
+            el.text = visible(el.text)
     ET.indent(root)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"

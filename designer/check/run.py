@@ -2,9 +2,10 @@
 parts as built, or the user's deck) simulated with that corner's op-amp, its
 figures (:mod:`.figures`) held to the spec's limits, the design's own checks,
 the SPICE agreement, the tolerance band and the golden waveforms, each as a
-:class:`~designer.check.result.Case`. With an output folder the corner's build
-sheet and, for every failing golden signal, a plot of gold, test and their
-normalised error are written there.
+:class:`~designer.check.result.Case`. With an output folder (the spec's own:
+``check-design`` stages it, and swaps it in whole when every corner is done)
+the corner's build sheet and, for every failing golden signal, a plot of gold,
+test and their normalised error are written there.
 
 Errors become cases, never exceptions: a :class:`~designer.core.errors.SimulatorError`
 an ERROR case of the simulator (exit 3), any other
@@ -31,7 +32,8 @@ from .spec import CheckSpec
 
 def run_corner(spec: CheckSpec, index: int, simulator: str, *, update_golden: bool = False,
                out_dir=None) -> CornerOutcome:
-    """Run and judge corner ``index`` of ``spec`` (see the module docstring)."""
+    """Run and judge corner ``index`` of ``spec`` (see the module docstring); ``out_dir``
+    is the spec's own output folder (its files go there), None for none."""
     from ..spice.simulate import tool_info
     corner = spec.corners[index]
     tick = time.perf_counter()
@@ -60,7 +62,7 @@ def _simulate(spec: CheckSpec, index: int, simulator: str):
     design = spec.designs[index]
     if spec.kind == "netlist":
         from ..spice.simulate import get_simulator
-        r = get_simulator(simulator).run(design, workdir=spec.deck_dir)
+        r = get_simulator(simulator).run(design)
         vectors = {k: np.real(v) for k, v in r.vectors.items() if k not in ("time", "frequency")}
         waves = (r.vectors["time"], vectors) if "time" in r.vectors else (None, {})
         return dict(r.measurements), None, {"measurements": r.measurements, "simulator": r.backend}, waves
@@ -164,7 +166,7 @@ def _golden_cases(spec, corner, waves, tool, update, out_dir):
     if absent:
         raise DesignError(f"golden file {path}: no column {absent[0]!r}; record it with --update-golden")
     warnings = G.version_warnings(recorded, header, path)
-    errors = G.compare(t, test, t_gold, gold, wanted)
+    errors = G.compare(t, test, t_gold, gold, wanted, path=path)
     cases, files = [], {"golden": str(path)}
     for sig, value in errors.items():
         reltol, abstol = wanted[sig]
@@ -176,15 +178,15 @@ def _golden_cases(spec, corner, waves, tool, update, out_dir):
             png = G.error_plot(t, test[sig], t_gold, gold[sig], reltol, abstol,
                                f"{spec.classname(corner)} {sig}: nrms {value:.3g}")
             name = f"golden-{corner or spec.name}-{sig}.png"
-            files[f"plot_{sig}"] = str(atomic_write(Path(out_dir) / spec.name / name, png))
+            files[f"plot_{sig}"] = str(atomic_write(Path(out_dir) / name, png))
     return cases, warnings, files
 
 
 def _write_design(spec, corner, res, out_dir) -> dict:
-    """The corner's build sheet bundle under ``out_dir/<spec>/`` (reports/<corner>/, netlists/<corner>.cir)."""
+    """The corner's build sheet bundle in the spec's folder ``out_dir`` (reports/<corner>/, netlists/<corner>.cir)."""
     if spec.kind == "plant":
         from ..plant.report import write_outputs
     else:
         from ..pid.report import write_outputs
-    files = write_outputs(res, Path(out_dir) / spec.name, corner or spec.name)
+    files = write_outputs(res, Path(out_dir), corner or spec.name)
     return {"build_sheet": files.get("build_sheet_md"), "design_result": files.get("result_json")}

@@ -1,5 +1,7 @@
-"""A ``check-design`` spec: one YAML file (read with ``yaml.safe_load``),
-validated once, when it is loaded, into a :class:`CheckSpec`.
+"""A ``check-design`` spec: one YAML file (PyYAML's safe loader, with budgets:
+see :func:`parse_yaml`), validated once, when it is loaded, into a :class:`CheckSpec`.
+A spec may come from a stranger (a pull request): it is data, and may reach
+nothing outside its folder (the README's trust boundary).
 
 Three kinds::
 
@@ -19,8 +21,11 @@ and, for every kind: ``checks:`` (figure -> ``{min, typ, max, fail}``), and
 ``golden:``; for plant and pid: ``opamp`` (one name or a list: the corners),
 ``series``, ``bounds``, ``stimulus``, ``design_checks``, ``spice_agreement``;
 a plant also ``tolerance``. Paths (``deck``, ``golden.file``, the ``json``
-files) are relative to the spec file. Numbers may be written in engineering
-notation (``3n3``, ``1m``, ``3.5k``).
+files) are relative to the spec file and must resolve (links followed) inside
+its folder, or the ``root`` given (``--root``), unless ``allow_outside``; a
+deck and every file it includes are read and checked here
+(:func:`designer.spice.trust.expand_deck`) and handed to ngspice inlined.
+Numbers may be written in engineering notation (``3n3``, ``1m``, ``3.5k``).
 
 Every refusal is one line: ``file:line: what is wrong, and what is allowed``;
 an unknown key names the allowed keys and the closest one. The design's own
@@ -33,6 +38,7 @@ the library's parameters (:data:`PLANT_KEYS`, :data:`PID_KEYS`).
 from __future__ import annotations
 
 import difflib
+import functools
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,7 +46,7 @@ from pathlib import Path
 from ..core import opamps
 from ..core.checks import IDS, SPICE_AGREEMENT
 from ..core.errors import DesignError
-from ..core.fileio import MIB, check_plain_name, read_text, shown
+from ..core.fileio import MIB, check_plain_name, read_text, show_cell, shown
 from ..core.units import parse_value
 from . import figures as F
 from .limits import LIMIT_KEYS, limit_from
@@ -138,7 +144,6 @@ class CheckSpec:
     agreement: Agreement | None
     tolerance: tuple            #: figures whose tolerance band must stay inside their limits
     golden: Golden | None
-    deck_dir: Path | None = None
 
     def classname(self, corner: str) -> str:
         """``lab3-plant[TL072]``: the spec and the corner (JUnit's classname)."""
@@ -149,6 +154,9 @@ def closest(key, allowed) -> str:
     """The allowed key nearest to ``key`` (for a typo)."""
     best = difflib.get_close_matches(str(key), list(allowed), n=1, cutoff=0.0)
     return best[0] if best else allowed[0]
+
+
+_WIDER = "check-design --root DIR widens the folder, --allow-outside lifts it for trusted specs"
 
 
 class _Doc:
@@ -188,12 +196,34 @@ class _Doc:
             v = v.get(k)
         return v
 
-    def resolve(self, keys) -> Path:
-        """A path in the spec, relative to the spec file's folder."""
+    #: the folder every path of the spec must resolve inside (the spec's own); None: anywhere
+    root: Path | None = None
+
+    def resolve(self, keys, may_be_missing: bool = False) -> Path:
+        """A path in the spec, relative to the spec file's folder, which it must not
+        leave (symbolic links followed) unless ``--allow-outside`` (:attr:`root` None)."""
         value = self.get(keys)
+        label = ".".join(map(str, keys))
         if not isinstance(value, str) or not value.strip():
-            raise self.error(keys, f"{'.'.join(keys)} must be a file name, got {_kind_of(value)}")
-        return self.path.parent / value
+            raise self.error(keys, f"{label} must be a file name, got {_kind_of(value)}")
+        if self.root is not None and (Path(value).is_absolute() or value.startswith("~")):
+            raise self.error(keys, f"{label} {shown(value)} is an absolute path: paths in a spec are relative "
+                             f"to its folder and stay inside {shown(self.root)} ({_WIDER})")
+        return self.inside(keys, self.path.parent / value)
+
+    def inside(self, keys, path: Path) -> Path:
+        """``path`` (named at ``keys``), refused when it resolves outside :attr:`root`."""
+        if self.root is None:
+            return path
+        label = ".".join(map(str, keys))
+        try:
+            real = path.resolve(strict=False)
+        except (OSError, RuntimeError) as exc:   # a symbolic link loop
+            raise self.error(keys, f"{label} {shown(path)} cannot be resolved ({exc})") from None
+        if not real.is_relative_to(self.root):
+            raise self.error(keys, f"{label} {shown(path)} resolves to {shown(real)}, outside "
+                             f"{shown(self.root)}: paths in a spec stay inside it ({_WIDER})")
+        return path
 
 
 def _kind_of(value) -> str:
@@ -204,20 +234,149 @@ def _kind_of(value) -> str:
     return repr(value) if len(repr(value)) <= 40 else type(value).__name__
 
 
-def _marks(node, keys=(), out=None) -> dict:
-    """key path -> 1-based line, from a composed YAML node tree."""
+#: the YAML of a spec is bounded, whatever the file holds (1 MiB of aliases can stand for a billion
+#: nodes): at most MAX_NODES nodes with every alias expanded (each use of an alias counts its whole
+#: node again, so a few uses of a shared mapping are fine), nested at most MAX_DEPTH deep, and no
+#: scalar longer than MAX_SCALAR characters (the top-level description: MAX_DESCRIPTION)
+MAX_NODES = 10_000
+MAX_DEPTH = 64
+MAX_SCALAR = 4 * 1024
+MAX_DESCRIPTION = 64 * 1024
+_MERGE = "tag:yaml.org,2002:merge"
+
+
+@functools.cache
+def _loader_class():
+    """yaml.SafeLoader refusing, while it composes, what would make the spec unbounded:
+    an alias inside the node it names (a cycle), more than :data:`MAX_NODES`
+    nodes with the aliases expanded, more than :data:`MAX_DEPTH` levels (the
+    composer recurses); each refusal at the line of the alias or node."""
     import yaml
-    out = {} if out is None else out
-    out.setdefault(keys, node.start_mark.line + 1)
-    if isinstance(node, yaml.MappingNode):
-        for k, v in node.value:
-            key = _scalar(k)
-            out[keys + (key,)] = k.start_mark.line + 1
-            _marks(v, keys + (key,), out)
-    elif isinstance(node, yaml.SequenceNode):
-        for i, v in enumerate(node.value):
-            _marks(v, keys + (i,), out)
+
+    class Loader(yaml.SafeLoader):
+        def __init__(self, text, path):
+            super().__init__(text)
+            self.path = path
+            self.total = 0      # nodes of the expanded tree so far (an alias adds its node's size)
+            self.sizes = {}     # id(anchored node) -> its expanded size
+            self.open = set()   # anchors of the nodes being composed: an alias to one is a cycle
+            self.depth = 0
+
+        def refuse(self, mark, message: str) -> DesignError:
+            return DesignError(f"{shown(self.path)}:{mark.line + 1}: {message}")
+
+        def count(self, n: int, mark, alias=None) -> None:
+            self.total += n
+            if self.total > MAX_NODES:
+                what = (f"alias *{alias} makes the spec more than {MAX_NODES} YAML nodes with its aliases expanded "
+                        "(each use repeats its whole node)" if alias else
+                        f"the spec has more than {MAX_NODES} YAML nodes")
+                raise self.refuse(mark, f"{what}; a spec may have at most {MAX_NODES}, aliases expanded")
+
+        def compose_node(self, parent, index):
+            event = self.peek_event()
+            if isinstance(event, yaml.AliasEvent):
+                if event.anchor in self.open:
+                    raise self.refuse(event.start_mark, f"alias *{event.anchor} is inside the node it names "
+                                      "(a recursive structure); an alias may only repeat a node that ends before it")
+                if event.anchor in self.anchors:   # else the composer's own "undefined alias"
+                    self.count(self.sizes[id(self.anchors[event.anchor])], event.start_mark, event.anchor)
+                return super().compose_node(parent, index)
+            if self.depth >= MAX_DEPTH:
+                raise self.refuse(event.start_mark, f"the spec nests more than {MAX_DEPTH} levels deep; a spec "
+                                  f"may nest at most {MAX_DEPTH}")
+            self.count(1, event.start_mark)
+            before, anchor = self.total - 1, event.anchor
+            if anchor is not None:
+                self.open.add(anchor)
+            self.depth += 1
+            try:
+                node = super().compose_node(parent, index)
+            finally:
+                self.depth -= 1
+                self.open.discard(anchor)
+            if anchor is not None:
+                self.sizes[id(node)] = self.total - before
+            return node
+
+        def construct_object(self, node, deep=False):
+            try:
+                return super().construct_object(node, deep)
+            except ValueError as exc:   # a date that is none (2024-02-30), an integer of over 4300 digits
+                why = str(exc).split(";")[0]
+                raise yaml.constructor.ConstructorError(None, None, why, node.start_mark) from None
+
+    return Loader
+
+
+def _label(keys) -> str:
+    return ".".join(map(str, keys)) or "the spec"
+
+
+def _marks(root, path, loader) -> dict:
+    """key path -> 1-based line, from the composed YAML node graph (no cycle,
+    at most :data:`MAX_NODES` nodes expanded: :func:`_loader_class`), walked
+    with a stack, not recursion; a key given twice in one mapping and a scalar
+    over :data:`MAX_SCALAR` are refused. Keys merged in by ``<<`` take the
+    line of their definition unless the mapping gives them itself."""
+    import yaml
+
+    def refuse(node, message):
+        return DesignError(f"{shown(path)}:{node.start_mark.line + 1}: {message}")
+
+    def check_length(node, keys, what):
+        limit = MAX_DESCRIPTION if keys == ("description",) else MAX_SCALAR
+        if isinstance(node, yaml.ScalarNode) and len(node.value) > limit:
+            raise refuse(node, f"{what} is {len(node.value)} characters long; a value may have at most "
+                         f"{MAX_SCALAR} (description: {MAX_DESCRIPTION})")
+
+    out = {}
+    stack = [(root, (), False)]   # (node, key path, merged in by <<: its lines yield to the mapping's own)
+    while stack:
+        node, keys, merged = stack.pop()
+        out.setdefault(keys, node.start_mark.line + 1)
+        check_length(node, keys, _label(keys))
+        todo = []
+        if isinstance(node, yaml.MappingNode):
+            first = {}
+            for k, v in node.value:
+                line = k.start_mark.line + 1
+                check_length(k, (), f"a key in {_label(keys)}")
+                if k.tag == _MERGE:
+                    out.setdefault(keys + ("<<",), line)
+                    items = v.value if isinstance(v, yaml.SequenceNode) else [v]
+                    todo += [(m, keys if isinstance(m, yaml.MappingNode) else keys + ("<<",), True) for m in items]
+                    continue
+                key = _key_of(loader, k)
+                if key is not None and key in first:
+                    where = f" in {_label(keys)}" if keys else ""
+                    raise refuse(k, f"duplicate key {show_cell(k.value)}{where} (first at line {first[key]}); "
+                                 "a key may appear once in a mapping")
+                if key is not None:
+                    first[key] = line
+                child = keys + (_scalar(k),)
+                if merged:
+                    out.setdefault(child, line)
+                else:
+                    out[child] = line
+                todo.append((v, child, merged))
+        elif isinstance(node, yaml.SequenceNode):
+            todo = [(v, keys + (i,), merged) for i, v in enumerate(node.value)]
+        stack.extend(reversed(todo))   # popped in the file's order: the first problem is reported
     return out
+
+
+def _key_of(loader, node):
+    """A scalar key as the mapping will hold it (``1`` and ``0x1`` are one key), None for others."""
+    import yaml
+    if not isinstance(node, yaml.ScalarNode):
+        return None   # a list or mapping as a key: the constructor refuses it (unhashable)
+    key = loader.construct_object(node, deep=True)
+    try:
+        hash(key)
+    except TypeError:
+        return None
+    return key
 
 
 def _scalar(node):
@@ -225,15 +384,33 @@ def _scalar(node):
     return node.value if hasattr(node, "value") and isinstance(node.value, str) else None
 
 
+def _compose(text: str, path):
+    """(data, lines) of a spec's text: composed once with the bounded loader,
+    checked (:func:`_marks`), then constructed from the same nodes."""
+    loader = _loader_class()(text, path)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None, {}
+        lines = _marks(node, path, loader)
+        return loader.construct_document(node), lines
+    finally:
+        loader.dispose()
+
+
 def parse_yaml(path) -> _Doc:
     """Read a spec file: text (at most :data:`MAX_SPEC_BYTES`, UTF-8), YAML
-    (``safe_load``), a mapping; every problem one line naming the file and line."""
+    (PyYAML's SafeLoader, composed once and bounded before anything is built:
+    no recursive alias, at most :data:`MAX_NODES` nodes with the aliases
+    expanded, :data:`MAX_DEPTH` levels, no key twice in a mapping, scalars of
+    at most :data:`MAX_SCALAR` characters, :data:`MAX_DESCRIPTION` for
+    ``description``; merge keys ``<<`` work), a mapping; every problem one
+    line naming the file and line."""
     import yaml
     path = Path(path)
     text = read_text(path, "spec file", MAX_SPEC_BYTES)
     try:
-        data = yaml.safe_load(text)
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
+        data, lines = _compose(text, path)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
         line = mark.line + 1 if mark is not None else 1
@@ -242,10 +419,10 @@ def parse_yaml(path) -> _Doc:
     if not isinstance(data, dict):
         raise DesignError(f"{shown(path)}:1: a spec is a mapping of keys (kind:, checks:, ...); got "
                           f"{_kind_of(data)}")
-    return _Doc(path, data, _marks(node) if node is not None else {})
+    return _Doc(path, data, lines)
 
 
-def load_spec(path, update_golden: bool = False) -> CheckSpec:
+def load_spec(path, update_golden: bool = False, root=None, allow_outside: bool = False) -> CheckSpec:
     """A :class:`CheckSpec` from a YAML file, checked in full (the design's
     own validation for every corner, the deck's ``.meas`` names, the golden
     files exist unless ``update_golden``).
@@ -256,6 +433,7 @@ def load_spec(path, update_golden: bool = False) -> CheckSpec:
         One line: ``file:line: what is wrong``.
     """
     doc = parse_yaml(path)
+    doc.root = None if allow_outside else Path(root if root is not None else doc.path.parent).resolve()
     kind = doc.data.get("kind")
     if kind not in KINDS:
         got = "no kind" if kind is None else f"kind {_kind_of(kind)}"
@@ -523,6 +701,8 @@ def _golden(doc, kind: str, corners, update: bool):
         signals[sig] = (_positive(doc, keys + ("reltol",), reltol) if tol and "reltol" in tol else reltol,
                         _positive(doc, keys + ("abstol",), abstol) if tol and "abstol" in tol else abstol)
     golden = Golden(str(file), signals)
+    for c in corners:   # each corner's own file: one of them may be a link out of the folder
+        doc.inside(("golden", "file"), golden.path(c))
     if not update:
         for c in corners:
             if not golden.path(c).is_file():
@@ -534,23 +714,22 @@ def _golden(doc, kind: str, corners, update: bool):
 # ---- kind: netlist ----------------------------------------------------------------
 
 _ANALYSIS = re.compile(r"^\s*\.(tran|ac)\b", re.I | re.M)
-_CONTROL = re.compile(r"^\s*\.control\b", re.I | re.M)
 
 
 def _netlist(doc, name: str, update: bool) -> CheckSpec:
     from ..spice.simulate import measure_names
+    from ..spice.trust import check_deck_text, expand_deck
     path = doc.resolve(("deck",))
     try:
-        deck = read_text(path, "deck", MAX_SPEC_BYTES * 16)
+        # the deck and everything it includes, read and checked here, inlined: ngspice opens none of them
+        deck = expand_deck(path, doc.root)
+        check_deck_text(deck, shown(path))   # the text ngspice gets, once more: nothing may be left to include
     except DesignError as exc:
         raise doc.error(("deck",), str(exc)) from None
     shown_deck = shown(path)
     lines = [ln for ln in deck.splitlines() if ln.strip()]
     if len(lines) < 2:
         raise doc.error(("deck",), f"deck {shown_deck} is not an ngspice deck: a title line, then the circuit")
-    if _CONTROL.search(deck):
-        raise doc.error(("deck",), f"deck {shown_deck} has a .control block: check-design runs the deck's "
-                        "analysis itself; keep the analysis and .meas lines outside .control")
     if not _ANALYSIS.search(deck):
         raise doc.error(("deck",), f"deck {shown_deck} has no .tran or .ac line: "
                         "nothing to simulate")
@@ -559,4 +738,4 @@ def _netlist(doc, name: str, update: bool) -> CheckSpec:
     golden = _golden(doc, "netlist", ("",), update)
     if not (checks or golden):
         raise doc.error((), "nothing to check: give checks: (the deck's .meas names) or golden:")
-    return CheckSpec(doc.path, name, "netlist", ("",), (deck,), False, checks, None, None, (), golden, path.parent)
+    return CheckSpec(doc.path, name, "netlist", ("",), (deck,), False, checks, None, None, (), golden)

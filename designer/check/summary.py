@@ -5,13 +5,16 @@ warnings, each naming the spec, the corner and the value against its limit."""
 
 from __future__ import annotations
 
+from .junit import visible
 from .result import ERROR, FAIL, PASS, SKIP, headline
 
 _MARK = {PASS: "pass", FAIL: "**FAIL**", ERROR: "**ERROR**"}
 
 
 def _cell(text: str) -> str:
-    return str(text).replace("|", "\\|").replace("\n", " ")
+    # control characters and lone surrogates (a file name that is not UTF-8) as visible escapes, as the JUnit
+    # file has them; a line break (CR too, for Markdown) would end the table row
+    return visible(text).replace("|", "\\|").replace("\r", " ").replace("\n", " ")
 
 
 def summary_markdown(outcomes, seconds: float) -> str:

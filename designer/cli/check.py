@@ -24,7 +24,7 @@ EPILOG = """spec file (YAML; numbers in engineering notation, paths relative to 
   design_checks: all                    # or [slew_rate, output_swing, ...]
   spice_agreement: {nrms_max: 1, against: opamp_model}   # or ideal
   tolerance: [fn_hz]                    # the part-tolerance band must stay inside the limits too
-  golden: {file: golden/lab3-{corner}.csv, signals: {output_v: {reltol: 0.01, abstol: 1m}}}
+  golden: {file: "golden/lab3-{corner}.csv", signals: {output_v: {reltol: 0.01, abstol: 1m}}}
 
   kind: pid     plant: {fc: 3.5k, zeta: 0.2} (or R1..C2, or json: result.json); tuning: zn (a rule),
                 {kp: 3.3, ti: 43u, td: 11u} or {rule: optimize, target_overshoot: 10}; controller: {R3: 12k,
@@ -63,16 +63,25 @@ def _parser():
     p.add_argument("--update-golden", action="store_true",
                    help="record the golden waveform files from this run (on purpose: they are then the reference)")
     p.add_argument("--no-fail", action="store_true", help="exit status 0 whatever the checks say")
+    p.add_argument("--root", metavar="DIR",
+                   help="the folder every path of a spec (deck, its includes, golden files, json) must resolve "
+                        "inside, links followed (default: each spec's own folder; e.g. the repository: --root .)")
+    p.add_argument("--allow-outside", action="store_true",
+                   help="trusted specs only: let a spec's paths go anywhere; decks still may not hold .control "
+                        "blocks or other ngspice commands")
     return p
 
 
 def _whole(text, name: str, lo: int, hi: int) -> int:
+    import math
+
     from ..core.errors import DesignError
     try:
         n = float(text)
     except ValueError:
         n = None
-    if n is None or n != int(n) or not lo <= n <= hi:
+    # nan and inf (1e400 reads as inf) have no int(): refused before it is asked
+    if n is None or not math.isfinite(n) or n != int(n) or not lo <= n <= hi:
         raise DesignError(f"{name} must be a whole number from {lo} to {hi}, got {text!r}")
     return int(n)
 
@@ -82,30 +91,47 @@ def _run(args) -> int:
     from ..core.errors import EXIT_OK, DesignError
     jobs = _whole(args.jobs, "--jobs", 1, 64)
     timeout = _whole(args.timeout, "--timeout", 1, 86400)
-    specs = [load_spec(p, update_golden=args.update_golden) for p in args.specs]
+    from ..core.fileio import check_output_file
+    for value, what in ((args.junit, "--junit"), (args.summary, "--summary")):
+        if value is not None:   # before any work: never a link, FIFO or device, never after the run
+            check_output_file(value, what)
+    if args.root is not None and not Path(args.root).is_dir():
+        raise DesignError(f"--root {args.root!r} is not a folder")
+    specs = [load_spec(p, update_golden=args.update_golden, root=args.root, allow_outside=args.allow_outside)
+             for p in args.specs]
     names = {}
     for s in specs:
         if s.name in names:
             raise DesignError(f"{s.path}: name {s.name!r} is also the name of {names[s.name]}; names must differ "
                               "(they name the JUnit suites and the --out folders)")
         names[s.name] = s.path
-    out_dir = None
-    if args.out is not None:
-        from ..core.fileio import check_can_create
-        out_dir = check_can_create(args.out)
-    tick = time.perf_counter()
-    outcomes = run_specs(specs, args.simulator, jobs=jobs, timeout=timeout, update_golden=args.update_golden,
-                         out_dir=out_dir)
-    seconds = time.perf_counter() - tick
-    _report(outcomes, args, seconds, out_dir)
+    from ..core import fileio
+    out_dir = None if args.out is None else fileio.check_can_create(args.out)
+    stages = {}
+    try:
+        if out_dir is not None:
+            # each spec's folder is written aside and swapped in whole once its run is done: a killed
+            # run leaves the old folder, a rerun with fewer corners leaves none of the old corners
+            fileio.ensure_dir(out_dir)
+            fileio.clean_stale(out_dir)
+            stages = {s.name: fileio.new_folder_beside(out_dir / s.name) for s in specs}
+        tick = time.perf_counter()
+        outcomes = run_specs(specs, args.simulator, jobs=jobs, timeout=timeout, update_golden=args.update_golden,
+                             out_dirs=stages)
+        seconds = time.perf_counter() - tick
+        _report(outcomes, args, seconds, out_dir, stages)
+    finally:
+        for stage in stages.values():   # published ones are gone already
+            fileio.remove_tree(stage)
     from ..check.result import exit_status
     return EXIT_OK if args.no_fail else exit_status(outcomes)
 
 
 def run_specs(specs, simulator: str, *, jobs: int = 1, timeout: float = 600, update_golden: bool = False,
-              out_dir=None) -> list:
+              out_dirs=None) -> list:
     """Every corner of every spec in worker processes; a
-    :class:`~designer.check.result.SpecOutcome` per spec, in the order given."""
+    :class:`~designer.check.result.SpecOutcome` per spec, in the order given.
+    ``out_dirs``: spec name -> the folder its files are written in (none without)."""
     from ..core.workers import run_tasks
     from ..check.result import ERROR, SIM_ERROR, Case, CornerOutcome, SpecOutcome
     from ..check.run import run_corner
@@ -123,7 +149,8 @@ def run_specs(specs, simulator: str, *, jobs: int = 1, timeout: float = 600, upd
 
     def work(task):
         i, k = task
-        return run_corner(specs[i], k, simulator, update_golden=update_golden, out_dir=out_dir)
+        return run_corner(specs[i], k, simulator, update_golden=update_golden,
+                          out_dir=(out_dirs or {}).get(specs[i].name))
 
     def lost(task, reason):
         i, k = task
@@ -149,17 +176,20 @@ def run_specs(specs, simulator: str, *, jobs: int = 1, timeout: float = 600, upd
     return outcomes
 
 
-def _report(outcomes, args, seconds: float, out_dir) -> None:
+def _report(outcomes, args, seconds: float, out_dir, stages: dict) -> None:
     from ..check.junit import junit_xml
     from ..check.result import ERROR, FAIL, headline
     from ..check.summary import summary_markdown
+    from ..core import fileio
     from ..core.fileio import atomic_write
     if out_dir is not None:
         import json
         for o in outcomes:
-            path = Path(out_dir) / o.name / "result.json"
-            o.files["result_json"] = str(path)
-            atomic_write(path, json.dumps(o.to_dict(), indent=2) + "\n")
+            final, stage = Path(out_dir) / o.name, stages[o.name]
+            _relocate(o, stage, final)
+            o.files["result_json"] = str(final / "result.json")
+            atomic_write(stage / "result.json", json.dumps(o.to_dict(), indent=2) + "\n")
+            fileio.publish_folder(stage, final)
     if args.junit:
         atomic_write(args.junit, junit_xml(outcomes, seconds))
     if args.summary:
@@ -177,6 +207,31 @@ def _report(outcomes, args, seconds: float, out_dir) -> None:
                       file=sys.stderr)
         for w in o.warnings:
             print(f"check-design: warning: {o.name}: {w}", file=sys.stderr)
+
+
+def _relocate(outcome, stage: Path, final: Path) -> None:
+    """The paths a spec's run recorded under its staging folder, as they will be once it
+    is swapped in: in the outcome, and in the design bundles' own result.json files."""
+    import json
+    old, new = str(stage), str(final)
+
+    def moved(value):
+        if isinstance(value, str):
+            return new + value[len(old):] if value.startswith(old) else value
+        if isinstance(value, list):
+            return [moved(v) for v in value]
+        if isinstance(value, dict):
+            return {k: moved(v) for k, v in value.items()}
+        return value
+
+    from ..core.fileio import atomic_write
+    for corner in outcome.corners:
+        corner.files = moved(corner.files)
+    for path in stage.glob("reports/*/result.json"):
+        data = json.loads(path.read_text(encoding="utf-8"))
+        if "files" in data:
+            data["files"] = moved(data["files"])
+            atomic_write(path, json.dumps(data, indent=2) + "\n")
 
 
 def check_design_main(argv=None) -> int:

@@ -95,13 +95,20 @@ def _silence_stdout() -> None:
 def run_cli(prog: str, build_parser, action, argv=None) -> int:
     """Run ``action(args)`` with the one-line error convention; returns the exit status:
     0 done, 1 a check failed (when asked), 2 bad input or usage, 3 simulator error,
-    130 interrupted. Every failure is one line on stderr, never a traceback."""
-    from ..core.errors import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_SIMULATOR, SimulatorError
+    130, 143, 129 interrupted by SIGINT, SIGTERM, SIGHUP. Every failure is one line on stderr, never a traceback."""
+    from ..core.errors import EXIT_BAD_INPUT, EXIT_SIMULATOR, SimulatorError
+    from ..core import lifetime
     try:
-        parser = build_parser()
-        args = parser.parse_args(argv)
-        args.prog = prog   # for messages written after the action's own work (see failed_checks_status)
-        return action(args) or 0
+        try:
+            parser = build_parser()
+            args = parser.parse_args(argv)
+            args.prog = prog   # for messages written after the action's own work (see failed_checks_status)
+            return action(args) or 0
+        except BaseException as exc:
+            if lifetime.received() is not None and not isinstance(exc, KeyboardInterrupt):
+                # a stop signal that C code turned into another error (an import failing halfway)
+                raise lifetime.Interrupted(lifetime.received()) from None
+            raise
     except SimulatorError as exc:
         _fail(prog, f"simulator error: {exc}")
         return EXIT_SIMULATOR
@@ -111,9 +118,9 @@ def run_cli(prog: str, build_parser, action, argv=None) -> int:
     except BrokenPipeError:
         _silence_stdout()
         return 0
-    except KeyboardInterrupt:
-        _fail(prog, "interrupted")
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as exc:   # Ctrl-C, or SIGTERM/SIGHUP (designer.core.lifetime): 128 + the signal
+        _fail(prog, lifetime.words_of(exc))
+        return lifetime.status_of(exc)
     except MemoryError:
         _fail(prog, "out of memory: the input is too large for this machine")
         return EXIT_BAD_INPUT

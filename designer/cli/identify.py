@@ -2,11 +2,14 @@
 
 ``identify`` reads a CSV step-response capture (generic, Tektronix, Rigol or
 this project's waveforms), runs every classical method of seeds 000-003 plus
-least squares, and prints them ranked by IAE. ``identify-freq`` reads a table
-of frequency, gain and (optionally) phase, reads asymptotes, resonant peak and
-dead time as seeds 000 and 003 do, fits FOPDT, underdamped and overdamped
-models to the complex response by least squares, and prints them ranked by
-fit error. With ``--json`` either prints one JSON object instead.
+least squares, and prints them ranked by IAE; a frequency-response table given
+to it (a header naming a frequency and a gain column, as identify-freq reads
+it) is analysed as ``identify-freq`` does, never fitted as a step.
+``identify-freq`` reads a table of frequency, gain and (optionally) phase,
+reads asymptotes, resonant peak and dead time as seeds 000 and 003 do, fits
+FOPDT, underdamped and overdamped models to the complex response by least
+squares, and prints them ranked by fit error. With ``--json`` either prints
+one JSON object instead.
 """
 
 from __future__ import annotations
@@ -21,7 +24,10 @@ from ..core.fileio import (
     MAX_CAPTURE_BYTES,
     MAX_CAPTURE_ROWS,
     MAX_TABLE_BYTES,
+    SNIFF_BYTES,
     atomic_write,
+    decode,
+    open_limited,
     shown,
     size_text,
 )
@@ -45,6 +51,11 @@ examples:
   identify scope.csv --format rigol-no-x       # read as that layout, whatever it looks like
 
 input layouts (--format, recognised when not given): {formats}.
+A frequency-response table (header f_hz,gain_db,phase_deg or any other header
+identify-freq reads: f_khz, w_rad_s, gain_ratio, phase_rad, shift_s, shift_us,
+a WaveForms network-analyser export) is analysed as identify-freq does, with
+the same --json and --plot output and "format": "frequency-table"; the step
+options (--step-time, --window, --format ...) are refused with it.
 Generic CSV: comma, semicolon, tab or space separated, decimal commas, CRLF, a
 BOM, '#' comments (non-UTF-8 bytes in them are fine). The format read is printed
 and is "format" in the JSON. With two signals the first is the input and the
@@ -138,6 +149,8 @@ def check_output_path(path, option: str) -> None:
     if blocked:
         raise DesignError(f"{option} {shown(path)}: cannot create directory {shown(blocker)}: "
                           "a file of that name exists")
+    from ..core.fileio import check_output_file
+    check_output_file(path, option)   # a link, FIFO or device there is never written through
 
 
 def write_png(path, png: bytes, option: str = "--plot") -> None:
@@ -271,11 +284,100 @@ def identify_capture(args):
     return result
 
 
+#: what ``identify`` says (``format`` in its JSON) of a frequency-response table it was given
+FREQUENCY_TABLE = "frequency-table"
+#: identify's options that only a step capture has: (argparse dest, its flag)
+STEP_ONLY = (("step_time", "--step-time"), ("step_amplitude", "--step-amplitude"), ("window", "--window"),
+             ("format", "--format"), ("input_column", "--input-column"), ("output_column", "--output-column"),
+             ("methods", "--methods"), ("no_refine", "--no-refine"), ("against", "--against"))
+
+
+def frequency_table_header(path) -> list | None:
+    """The header cells of ``path`` when it is a frequency-response table as
+    ``identify-freq`` reads it, else None.
+
+    Its first row that is not blank or a ``#`` comment must be a header whose
+    first cell names a frequency (``f_hz``, ``f_khz``, ``w_rad_s``,
+    ``Frequency (Hz)``...) and whose second names a gain (``gain_db``,
+    ``gain_ratio``, ``Channel 1 Magnitude (dB)``...), split as identify-freq
+    splits it. Only the head of the file is read; a file that cannot be read
+    gives None, so the capture reader reports it in its own words.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file given to ``identify``.
+
+    Returns
+    -------
+    list of str or None
+        The header's cells, or None for anything else (a step capture, a table
+        without a header: those are read as captures).
+    """
+    from ..identify.io import _NUM, _hint   # identify-freq's own reading of a header
+    try:
+        with open_limited(path, "capture file", MAX_CAPTURE_BYTES) as fh:
+            head = fh.read(SNIFF_BYTES) or b""
+    except DesignError:
+        return None
+    line = next((ln.strip() for ln in decode(head).lstrip("\ufeff").splitlines()
+                 if ln.strip() and not ln.strip().startswith("#")), "")
+    sep = next((c for c in (";", ",", "\t") if c in line), None)
+    cells = [c.strip().strip('"').strip("'") for c in (line.split(sep) if sep else line.split())]
+    while cells and cells[-1] == "":
+        cells.pop()
+    if len(cells) < 2 or all(_NUM.match(c) for c in cells):
+        return None
+    first, second = cells[0], cells[1].lower()
+    is_freq = first.lower().startswith("freq") or _hint(first, "frequency") is not None
+    is_gain = _hint(cells[1], "gain") is not None or "gain" in second or "magnitude" in second
+    return cells if is_freq and is_gain else None
+
+
+def identify_frequency_table(args, header):
+    """``identify`` on a frequency-response table: the step-only options refused
+    in one line, then identify-freq's own analysis of the file (its units from
+    the header). Returns the :class:`~designer.identify.frequency.FreqIdentifyResult`."""
+    defaults = {"format": "auto", "no_refine": False}
+    given = [flag for dest, flag in STEP_ONLY if getattr(args, dest, None) not in (None, defaults.get(dest))]
+    if given:
+        raise DesignError(f"{', '.join(given)} {'is' if len(given) == 1 else 'are'} for a step capture; "
+                          f"{shown(args.capture)} is a frequency-response table (header "
+                          f"{_header_text(header)}), analysed as identify-freq does: drop "
+                          f"{'it' if len(given) == 1 else 'them'}")
+    table_args = argparse.Namespace(table=args.capture, gain_units=None, phase_units=None, freq_units=None,
+                                    plot=args.plot, json=args.json)
+    return identify_table(table_args)
+
+
+def _header_text(header) -> str:
+    text = ",".join(header)
+    return text if len(text) <= 100 else text[:97] + "..."
+
+
+def identify_run(args) -> int:
+    """``identify``'s action: a frequency-response table (:func:`frequency_table_header`)
+    analysed and printed as ``identify-freq`` does, saying so (a first line, and
+    ``"format": "frequency-table"`` in the JSON); anything else through the step methods."""
+    from ..identify.report import bode_fit_plot, fit_plot, freq_text, step_text
+    header = frequency_table_header(args.capture)
+    if header is None:
+        return _run(args, identify_capture, step_text, fit_plot)
+    result = identify_frequency_table(args, header)
+    if args.plot:
+        write_png(args.plot, bode_fit_plot(result))
+    if args.json:
+        print_output(json.dumps(json_safe({"format": FREQUENCY_TABLE, **result.to_dict()}), indent=2,
+                                allow_nan=False))
+    else:
+        print_output(f"Format: frequency table (header {_header_text(header)}), analysed as identify-freq does\n"
+                     + freq_text(result) + (f"\n\nPlot written to {args.plot}" if args.plot else ""))
+    return 0
+
+
 def identify_main(argv=None) -> int:
     """Console entry point ``identify``."""
-    from ..identify.report import fit_plot, step_text
-    return run_cli("identify", build_parser,
-                   lambda args: _run(args, identify_capture, step_text, fit_plot), argv)
+    return run_cli("identify", build_parser, identify_run, argv)
 
 
 # --------------------------------------------------------------------------- identify-freq

@@ -1,11 +1,14 @@
-"""Console entry points of the commands that draw build sheets (design-plant,
-analyze-plant, design-pid, analyze-pid).
+"""Console entry points of every command.
 
-Each forks the renderer (:mod:`designer.report.render`) first, before numpy,
-the design code and PySpice are imported, so that matplotlib's import (longer
-than a plant's design and simulation) runs on the other core from the start;
-then it runs the command's ``main``. Called as functions (``design_plant_main(argv)``)
-the commands draw in-process instead: the files are the same.
+Each first takes over SIGINT, SIGTERM and SIGHUP (:func:`designer.core.lifetime.install`:
+one line and exit 130, 143 or 129 at any instant, the imports included), then
+runs the command's ``main``. The commands that draw build sheets
+(design-plant, analyze-plant, design-pid, analyze-pid) fork the renderer
+(:mod:`designer.report.render`) before numpy, the design code and PySpice are
+imported, so that matplotlib's import (longer than a plant's design and
+simulation) runs on the other core from the start. Called as functions
+(``design_plant_main(argv)``) the commands draw in-process and leave the
+signals alone: the files are the same.
 """
 
 import importlib
@@ -24,23 +27,53 @@ def draws(argv) -> bool:
     return True
 
 
-def _launch(wing: str, main: str) -> int:
-    from ..report import render
-    with render.ahead(draws(sys.argv[1:]), preload=(_REPORTS[wing],)):
-        return getattr(importlib.import_module(f"designer.cli.{wing}"), main)()
+def _run(prog: str, module: str, main: str, wing: str | None = None) -> int:
+    from ..core import lifetime
+    lifetime.install(prog)
+    try:
+        if wing is None:
+            status = getattr(importlib.import_module(module), main)()
+        else:
+            from ..report import render
+            with render.ahead(draws(sys.argv[1:]), preload=(_REPORTS[wing],)):
+                status = getattr(importlib.import_module(module), main)()
+    except BaseException as exc:   # before the command's own handling: an import, the renderer's start
+        if not isinstance(exc, KeyboardInterrupt):
+            if lifetime.received() is None:
+                raise
+            exc = lifetime.Interrupted(lifetime.received())   # turned into an ImportError by C code
+        try:
+            print(f"{prog}: error: {lifetime.words_of(exc)}", file=sys.stderr)
+        except OSError:
+            pass
+        return lifetime.status_of(exc)
+    lifetime.quiet()
+    return status
 
 
 def design_plant() -> int:
-    return _launch("plant", "design_plant_main")
+    return _run("design-plant", "designer.cli.plant", "design_plant_main", "plant")
 
 
 def analyze_plant() -> int:
-    return _launch("plant", "analyze_plant_main")
+    return _run("analyze-plant", "designer.cli.plant", "analyze_plant_main", "plant")
 
 
 def design_pid() -> int:
-    return _launch("pid", "design_pid_main")
+    return _run("design-pid", "designer.cli.pid", "design_pid_main", "pid")
 
 
 def analyze_pid() -> int:
-    return _launch("pid", "analyze_pid_main")
+    return _run("analyze-pid", "designer.cli.pid", "analyze_pid_main", "pid")
+
+
+def check_design() -> int:
+    return _run("check-design", "designer.cli.check", "check_design_main")
+
+
+def identify() -> int:
+    return _run("identify", "designer.cli.identify", "identify_main")
+
+
+def identify_freq() -> int:
+    return _run("identify-freq", "designer.cli.identify", "identify_freq_main")

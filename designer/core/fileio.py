@@ -6,12 +6,13 @@ Reading
 -------
 Captures, frequency tables and design results are files a user names on the
 command line; any path can arrive: a directory, ``/dev/zero``, a FIFO, a
-UTF-16 export, a 5 GB log. Everything here reads through
-:class:`LimitedReader`, which never lets more than a stated number of bytes
-through (``limit + 1`` at most are read, so a non-regular file that never ends
-costs one limit's worth of time, and a regular file above the limit is refused
-from its size before any byte is read), and every problem becomes one
-:class:`~designer.core.errors.DesignError` line naming the file and what is allowed.
+UTF-16 export, a 5 GB log. Only regular files are read: a FIFO (whose
+opening would block), a device or a socket is refused by its kind before it is
+opened. Everything here reads through :class:`LimitedReader`, which never lets
+more than a stated number of bytes through (``limit + 1`` at most are read; a
+regular file above the limit is refused from its size before any byte is read),
+and every problem becomes one :class:`~designer.core.errors.DesignError` line
+naming the file and what is allowed.
 
 Encoding: UTF-8 (with or without a byte-order mark) and ASCII are read. Bytes
 that are not UTF-8 are replaced (Windows instruments write a Latin-1 degree or
@@ -21,7 +22,9 @@ UTF-8 it would show up as ``\\x00-\\x000...`` cells.
 
 Writing
 -------
-- :func:`atomic_write`: one file, through a temporary file beside it and a rename.
+- :func:`atomic_write`: one file, through a temporary file beside it and a
+  rename, over a regular file only (:func:`check_output_file`: a symbolic link,
+  FIFO, device or directory named as an output is refused, before any work).
 - :func:`publish_folder`: a whole folder (a design's report bundle) written
   elsewhere first, then swapped in with one atomic exchange of directories
   (Linux ``renameat2(RENAME_EXCHANGE)``; elsewhere two renames, rolled back on
@@ -140,41 +143,82 @@ class LimitedReader(io.RawIOBase):
 
 
 def open_limited(path, what: str, limit: int) -> LimitedReader:
-    """Open ``path`` for reading at most ``limit`` bytes (see the module docstring).
+    """Open the regular file ``path`` for reading at most ``limit`` bytes (see
+    the module docstring).
+
+    The path is ``os.stat``-ed first (following symbolic links: a link to a
+    regular file is read), and anything but a regular file is refused before it
+    is opened: ``open()`` of a FIFO with no writer blocks forever, and a device
+    or a socket is no saved measurement. The file is then opened without
+    blocking and checked again, so a FIFO put in its place meanwhile is refused
+    too.
+
+    Parameters
+    ----------
+    path : str or Path
+        The input file the user named.
+    what : str
+        What it is, for messages (``"capture file"``, ``"table"``).
+    limit : int
+        The most bytes read from it.
+
+    Returns
+    -------
+    LimitedReader
+        The open file.
 
     Raises
     ------
     DesignError
-        Missing file, a directory, no permission, a regular file above ``limit``.
+        Missing file, a directory, a FIFO, a device, a socket or any other
+        file that is not a regular one, no permission, a file above ``limit``.
     """
     name = shown(path)
     if str(path) == "":
         raise DesignError(f"no {what} given: the name is empty")
     p = Path(path)
+
+    def failed(exc):
+        if isinstance(exc, FileNotFoundError):   # a dangling symbolic link too
+            return DesignError(f"{what} {name} does not exist")
+        if isinstance(exc, ValueError):   # a NUL byte or an unencodable character in the name
+            return DesignError(f"cannot open {what} {name}: not a valid file name")
+        return DesignError(f"cannot open {what} {name}: {exc.strerror or exc}")
+
+    def refuse_irregular(mode):
+        if stat.S_ISREG(mode):
+            return
+        if stat.S_ISDIR(mode):
+            raise DesignError(f"{what} {name} is a directory; give a file")
+        kinds = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+                 (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+        kind = next((k for test, k in kinds if test(mode)), "not a regular file")
+        raise DesignError(f"{what} {name} is {kind}; a regular file is needed (save the data to a file "
+                          "and give that)")
+
     try:
-        fh = open(p, "rb", buffering=0)  # noqa: SIM115 - returned to the caller
-    except FileNotFoundError:
-        raise DesignError(f"{what} {name} does not exist") from None
-    except IsADirectoryError:
-        raise DesignError(f"{what} {name} is a directory; give a file") from None
-    except OSError as exc:
-        raise DesignError(f"cannot open {what} {name}: {exc.strerror or exc}") from None
-    except ValueError:   # a NUL byte or an unencodable character in the name
-        raise DesignError(f"cannot open {what} {name}: not a valid file name") from None
+        st = os.stat(p)   # never blocks, unlike open() of a FIFO
+    except (OSError, ValueError) as exc:
+        raise failed(exc) from None
+    refuse_irregular(st.st_mode)
     try:
-        st = os.fstat(fh.fileno())
-    except OSError as exc:  # pragma: no cover - fstat on an open file does not fail
-        fh.close()
-        raise DesignError(f"cannot open {what} {name}: {exc.strerror or exc}") from None
-    if stat.S_ISDIR(st.st_mode):
-        fh.close()
-        raise DesignError(f"{what} {name} is a directory; give a file")
-    if stat.S_ISREG(st.st_mode) and st.st_size > limit:
+        # O_NONBLOCK: should the path have become a FIFO since the stat, open() still returns
+        fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    except (OSError, ValueError) as exc:
+        raise failed(exc) from None
+    try:
+        st = os.fstat(fd)
+        refuse_irregular(st.st_mode)
+        os.set_blocking(fd, True)
+        fh = io.FileIO(fd, "rb", closefd=True)
+    except BaseException:
+        os.close(fd)   # a refusal (or an interrupt) leaves no descriptor open
+        raise
+    if st.st_size > limit:
         fh.close()
         raise DesignError(f"{what} {name} is {size_text(st.st_size)}; at most "
                           f"{size_text(limit)} is read: cut or decimate it")
-    return LimitedReader(fh, limit, name, what,
-                         size=st.st_size if stat.S_ISREG(st.st_mode) else None)
+    return LimitedReader(fh, limit, name, what, size=st.st_size)
 
 
 def check_encoding(head: bytes, name: str, what: str) -> int:
@@ -262,12 +306,40 @@ def check_can_create(path, subdirs=()) -> Path:
     return path
 
 
+_KINDS = ((stat.S_ISLNK, "a symbolic link"), (stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+          (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
+def check_output_file(path, what: str = "output file") -> Path:
+    """Before any work: ``path`` may be written, through a temporary file and a
+    rename, only over a regular file (or where nothing is); a symbolic link, a
+    FIFO, a device, a socket or a directory there is refused in one line, as is
+    a folder that cannot be created."""
+    path = Path(path)
+    if str(path) == "":
+        raise DesignError(f"no {what} given: the name is empty")
+    try:
+        st = os.lstat(path)
+    except FileNotFoundError:
+        st = None
+    except OSError as exc:
+        raise os_error("write", path, exc) from None
+    except ValueError:   # a NUL byte in the name
+        raise DesignError(f"cannot write {what} {shown(path)}: not a valid file name") from None
+    if st is not None and not stat.S_ISREG(st.st_mode):
+        kind = next((k for test, k in _KINDS if test(st.st_mode)), "not a regular file")
+        raise DesignError(f"cannot write {what} {shown(path)}: it is {kind}; give the name of a regular file "
+                          "(or of none yet), which is replaced whole")
+    check_can_create(path.parent)
+    return path
+
+
 def atomic_write(path, data, mode: str = "w") -> Path:
-    """Write ``data`` (str or bytes) to ``path`` through a temporary file and rename."""
+    """Write ``data`` (str or bytes) to ``path`` through a temporary file and rename,
+    over a regular file only (:func:`check_output_file`)."""
     path = Path(path)
     ensure_dir(path.parent)
-    if path.is_dir():
-        raise DesignError(f"cannot write {str(path)!r}: it is a directory")
+    check_output_file(path, "file")
     binary = isinstance(data, (bytes, bytearray))
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp", dir=path.parent)

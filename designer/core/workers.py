@@ -1,6 +1,7 @@
 """Forked worker processes: :class:`Worker` (one process that runs the tasks
 sent to it, in order) and :func:`run_tasks` (a batch over N of them, with
-deadlines).
+deadlines). Every worker dies with the process that started it, however that
+dies (:mod:`.lifetime`), and an interrupted batch kills its workers at once.
 
 ``check-design --jobs N`` runs each corner in a worker (one ngspice per
 process, and a crash of the simulator's shared library takes down that
@@ -25,10 +26,15 @@ import time
 from collections import deque
 from multiprocessing.connection import wait
 
+from . import lifetime
 
-def _serve(conn, work, setup) -> None:
+
+def _serve(conn, other_end, parent_pid, work, setup) -> None:
     """A worker's loop: receive a task, send back its result; None ends it."""
     os.setpgrp()   # its own process group: the parent kills it with any ngspice it started
+    lifetime.die_with_parent(parent_pid)   # and SIGKILLed with the parent, whatever kills that
+    lifetime.reset_in_child()
+    other_end.close()   # the parent's end: held here too, its closing at the parent's death would go unseen
     if setup is not None:
         setup()
     while True:
@@ -52,7 +58,7 @@ class Worker:
 
     def __init__(self, ctx, work, setup=None):
         self.conn, child = ctx.Pipe()
-        self.proc = ctx.Process(target=_serve, args=(child, work, setup), daemon=True)
+        self.proc = ctx.Process(target=_serve, args=(child, self.conn, os.getpid(), work, setup), daemon=True)
         self.proc.start()
         child.close()
         self.task = None
@@ -135,6 +141,10 @@ def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, co
                 if w.task is None and queue:
                     j = queue.popleft()
                     w.give(j, tasks[j], timeout)
+    except BaseException:   # interrupted, or a bug: the workers and their simulations end now
+        for w in workers:
+            w.kill()
+        raise
     finally:
         for w in workers:
             try:

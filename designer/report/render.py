@@ -25,6 +25,7 @@ import pickle
 import time
 from contextlib import contextmanager
 
+from ..core import lifetime
 from ..core.workers import Worker
 
 #: the longest the caller waits for one picture before drawing it itself
@@ -77,6 +78,8 @@ def start(preload=()) -> None:
         _worker = Worker(multiprocessing.get_context("fork"), _call, functools.partial(_warm, tuple(preload)))
     except OSError:
         _worker = None
+    else:
+        lifetime.on_exit(stop)   # a command ended inside ngspice's library still kills it
 
 
 def stop() -> None:
@@ -85,6 +88,7 @@ def stop() -> None:
     w, _worker = _worker, None
     _sent.clear()
     _replies.clear()
+    lifetime.forget(stop)
     if w is not None:
         w.kill()   # it holds nothing to keep, and may still be importing: no waiting for it
 
@@ -144,12 +148,16 @@ def _many(calls) -> list:
     if not _in_renderer or len(calls) < 2:   # in the caller: one after the other
         return [fn(*args) for fn, args in calls]
     helpers = []
+    me = os.getpid()
     for fn, args in calls[1:]:
         r, w = os.pipe()
         pid = os.fork()
         if pid == 0:   # the helper: its answer through its own pipe, then gone
             os.close(r)
             try:
+                lifetime.die_with_parent(me)   # never outlives the renderer
+                for _, other, _, _ in helpers:   # the other helpers' pipes are theirs
+                    os.close(other)
                 data = pickle.dumps(fn(*args), protocol=pickle.HIGHEST_PROTOCOL)
                 with os.fdopen(w, "wb") as f:
                     f.write(data)

@@ -5,6 +5,13 @@
   binary raw file is read with numpy.
 
 Both take the same standalone deck text and return a :class:`SimResult`.
+Neither lets ngspice read a file we did not write: each run happens in a
+private, empty working folder (removed after it), ``ngspice -b -n`` skips the
+user's ``.spiceinit`` (and ``HOME`` points at that folder), and the shared
+library is started in such a folder too (ngspice 39's library reads
+``.spiceinit`` from its working folder when it starts and has no switch to
+skip it). ``ngspice -b`` dies with the process that started it
+(:mod:`designer.core.lifetime`).
 ngspice writes notes ("Note: ...", "Warning: ...") on stderr during normal
 runs; PySpice 1.5 treats any stderr line as an error (and breaks outright on
 ngspice >= 42), so neither backend trusts stderr alone: a run fails only when
@@ -25,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core import lifetime
 from ..core.errors import DeckError, DesignError, SimulatorError
 
 INSTALL_HINT = "install it with: apt-get install ngspice libngspice0-dev (or run `make setup`)"
@@ -183,19 +191,19 @@ class NgspiceCli:
         self.executable = executable
         self.timeout = timeout
 
-    def run(self, deck: str, workdir=None) -> SimResult:
+    def run(self, deck: str) -> SimResult:
         exe = shutil.which(self.executable)
         if exe is None:
             raise SimulatorError(f"ngspice is not installed ({self.executable!r} not found); {INSTALL_HINT}")
         with tempfile.TemporaryDirectory(prefix="designer-sim-") as tmp:
-            cwd = Path(workdir) if workdir else Path(tmp)
             deck_path = Path(tmp) / "deck.cir"
             raw_path = Path(tmp) / "out.raw"
             deck_path.write_text(with_raw_output(deck, raw_path))
             try:
-                proc = subprocess.run([exe, "-b", str(deck_path)], cwd=cwd,
+                # -n: no .spiceinit; the private folder as working folder and HOME: no init file of anyone's
+                proc = subprocess.run([exe, "-b", "-n", str(deck_path)], cwd=tmp, env=private_env(tmp),
                                       capture_output=True, text=True, timeout=self.timeout,
-                                      stdin=subprocess.DEVNULL)
+                                      stdin=subprocess.DEVNULL, preexec_fn=lifetime.preexec())
             except subprocess.TimeoutExpired:
                 raise SimulatorError(f"ngspice did not finish within {self.timeout:g} s (timed out)") from None
             log = proc.stdout + "\n" + proc.stderr
@@ -227,29 +235,21 @@ class PySpiceShared:
     name = "pyspice"
     _lock = threading.Lock()  # one shared ngspice instance per process
 
-    def run(self, deck: str, workdir=None) -> SimResult:
-        try:
-            from PySpice.Spice.NgSpice.Shared import NgSpiceShared
-        except ImportError as exc:  # pragma: no cover - dependency of the package
-            raise SimulatorError(f"PySpice is not installed: {exc}") from None
-        import logging
-        logging.getLogger("PySpice").setLevel(logging.CRITICAL)
+    def run(self, deck: str) -> SimResult:
         with self._lock:
-            try:
-                ng = NgSpiceShared.new_instance()
-            except (OSError, Exception) as exc:
-                raise SimulatorError(f"cannot load the ngspice shared library ({exc}); {INSTALL_HINT}") from None
+            ng = shared_instance()
             old = os.getcwd()
+            tmp = tempfile.mkdtemp(prefix="designer-sim-")
             try:
-                if workdir:
-                    os.chdir(workdir)
+                os.chdir(tmp)   # whatever ngspice writes lands in a private folder, removed after
                 self._command(ng, "destroy all")
                 self._command(ng, "reset")
                 ng.clear_output()
                 lines = [ln for ln in deck.splitlines() if ln.strip()] + [""]
                 from PySpice.Spice.NgSpice.Shared import FFI, ffi
                 keep = [ffi.new("char[]", ln.encode("utf8")) for ln in lines] + [FFI.NULL]
-                rc = ng._ngspice_shared.ngSpice_Circ(ffi.new("char *[]", keep))
+                with lifetime.native():
+                    rc = ng._ngspice_shared.ngSpice_Circ(ffi.new("char *[]", keep))
                 load_log = ng.stdout + "\n" + ng.stderr
                 errs = error_lines(load_log)
                 if rc or errs:
@@ -269,13 +269,54 @@ class PySpiceShared:
                            for name, vec in ng.plot(None, plot).items()}
             finally:
                 os.chdir(old)
+                shutil.rmtree(tmp, ignore_errors=True)
         return _result(vectors, load_log + "\n" + log, self.name, deck)
 
     @staticmethod
     def _command(ng, command: str) -> str:
         ng.clear_output()
-        ng._ngspice_shared.ngSpice_Command(command.encode("ascii"))
+        with lifetime.native():
+            ng._ngspice_shared.ngSpice_Command(command.encode("ascii"))
         return ng.stdout + "\n" + ng.stderr
+
+
+def private_env(folder) -> dict:
+    """The environment of an ``ngspice -b`` run: ours, with ``HOME`` in its private folder
+    (ngspice reads ``~/.spiceinit``; ``-n`` skips it too: both, in case one is ignored)."""
+    env = dict(os.environ)
+    env["HOME"] = str(folder)
+    return env
+
+
+def shared_instance():
+    """PySpice's one ngspice shared library instance, started (the first time) in a
+    private empty folder with ``HOME`` pointing there, so that the library reads no
+    user's ``.spiceinit``; a :class:`SimulatorError` when it cannot be loaded."""
+    try:
+        from PySpice.Spice.NgSpice.Shared import NgSpiceShared
+    except ImportError as exc:  # pragma: no cover - dependency of the package
+        raise SimulatorError(f"PySpice is not installed: {exc}") from None
+    import logging
+    logging.getLogger("PySpice").setLevel(logging.CRITICAL)   # its "unsupported version" notes
+    if getattr(NgSpiceShared, "_designer_started", False):
+        return NgSpiceShared.new_instance()
+    old, home = os.getcwd(), os.environ.get("HOME")
+    with tempfile.TemporaryDirectory(prefix="designer-init-") as tmp:
+        try:
+            os.chdir(tmp)
+            os.environ["HOME"] = tmp
+            with lifetime.native():
+                ng = NgSpiceShared.new_instance()
+        except Exception as exc:   # OSError, or PySpice's own on a broken library
+            raise SimulatorError(f"cannot load the ngspice shared library ({exc}); {INSTALL_HINT}") from None
+        finally:
+            os.chdir(old)
+            if home is None:
+                os.environ.pop("HOME", None)
+            else:
+                os.environ["HOME"] = home
+    NgSpiceShared._designer_started = True
+    return ng
 
 
 #: the longest one simulation may take, seconds (``ngspice -b``; the shared library runs in the caller's
@@ -324,12 +365,8 @@ def _cli_version() -> str | None:
 
 def _shared_version() -> str | None:
     try:
-        import logging
-
-        from PySpice.Spice.NgSpice.Shared import NgSpiceShared
-        logging.getLogger("PySpice").setLevel(logging.CRITICAL)   # its "unsupported version" notes
         with PySpiceShared._lock:
-            version = NgSpiceShared.new_instance().ngspice_version
+            version = shared_instance().ngspice_version
     except Exception:   # no library, or PySpice could not ask it: unknown, not an error
         return None
     return None if version is None else str(version)

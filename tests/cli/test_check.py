@@ -4,19 +4,24 @@ crash or a hang is exit 3 and an <error>, a bad deck exit 2, golden waveforms
 are recorded and compared, --out holds each spec's files."""
 
 import json
+import math
 import shutil
 import subprocess
+import textwrap
 import xml.etree.ElementTree as ET
 
 import pytest
+import yaml
 from helpers import ROOT, script
+
+from designer.check.spec import SUB, TOP
 
 pytestmark = pytest.mark.spice
 
 SPECS = sorted(str(p) for p in (ROOT / "specs").glob("*.yaml"))
 #: the dogfood specs' verdicts: every check passes but the seed's Kp = 45 design, which fails its
 #: overshoot limit (the loop oscillates: no overshoot to measure) and four design checks (unstable,
-#: phase margin, slew rate, output swing); report-only: zeta_opamp on both plant corners and the ZN
+#: phase margin, slew rate, output swing); report-only: zeta on both plant corners and the ZN
 #: controller's phase margin
 EXPECTED = {"tests": 77, "failures": 5, "errors": 0, "skipped": 3}
 EXPECTED_FAILED = {"overshoot_pct", "closed_loop_stable", "phase_margin", "slew_rate", "output_swing"}
@@ -58,7 +63,7 @@ def validate_junit(path) -> ET.Element:
 @pytest.mark.parametrize("simulator", ["pyspice", "ngspice-cli"])
 def test_dogfood_specs_give_the_expected_counts(simulator, tmp_path):
     junit, summary = tmp_path / "junit.xml", tmp_path / "summary.md"
-    out = check_design(*SPECS, "--junit", junit, "--summary", summary, "--jobs", "2", "--simulator", simulator,
+    out = check_design(*SPECS, "--root", ROOT, "--junit", junit, "--summary", summary, "--jobs", "2", "--simulator", simulator,
                        cwd=ROOT)
     assert out.returncode == 1, out.stderr
     root = validate_junit(junit)
@@ -89,7 +94,7 @@ def test_jobs_do_not_change_the_output(tmp_path):
     runs = []
     for jobs in ("1", "2"):
         junit = tmp_path / f"j{jobs}.xml"
-        check_design(*SPECS, "--junit", junit, "--jobs", jobs, "--no-fail", cwd=ROOT)
+        check_design(*SPECS, "--root", ROOT, "--junit", junit, "--jobs", jobs, "--no-fail", cwd=ROOT)
         root = ET.parse(junit).getroot()
         runs.append([(c.get("classname"), c.get("name"), [k.tag for k in c]) for c in root.iter("testcase")])
     assert runs[0] == runs[1]
@@ -134,7 +139,7 @@ def test_golden_waveforms_are_recorded_compared_and_plotted_when_they_fail(tmp_p
 
 def test_out_holds_each_specs_result_and_build_sheet(tmp_path):
     spec = ROOT / "specs" / "pid_optimize_os10_lm741_fc3500_z0.2.yaml"
-    out = check_design(spec, "--out", tmp_path, cwd=ROOT)
+    out = check_design(spec, "--root", ROOT, "--out", tmp_path, cwd=ROOT)
     assert out.returncode == 0, out.stderr
     folder = tmp_path / "pid_optimize_os10_lm741_fc3500_z0.2"
     result = json.loads((folder / "result.json").read_text())
@@ -194,3 +199,56 @@ def test_fail_on_check_is_exit_1_when_a_check_or_the_spice_agreement_fails(tmp_p
     seed = run("design-pid", "--plant-fc", "3500", "--plant-zeta", "0.2", "--kp", "45", "--ti", "43.215u",
                "--td", "10.8037u", "--seed-parts")
     assert seed.returncode == 1 and "check failed: closed_loop_stable" in seed.stderr
+
+
+#: a 22.9 kHz plant (fn and zeta of the parts alone), fast enough for the 700 kHz LM358 to pull its fn 5 % down
+FAST_PLANT = """\
+name: fast-plant
+kind: plant
+parts: {R1: 1k, R2: 1k, C1: 2n2, C2: 22n}
+opamp: [LM358, TL072]
+stimulus: {amplitude: 0.5}
+checks:
+  fn_hz: {min: 22.2k, max: 26k}
+  ideal_fn_hz: {min: 22k, max: 24k}
+  fn_opamp_hz: {min: 22.2k, max: 26k}
+  q: {min: 1, fail: false}
+  ideal_q: {min: 1, fail: false}
+"""
+
+
+def test_fn_hz_is_each_corners_own_and_ideal_fn_hz_the_parts_alone(tmp_path):
+    spec = tmp_path / "fast.yaml"
+    spec.write_text(FAST_PLANT)
+    out = check_design(spec, "--out", tmp_path / "out")
+    assert out.returncode == 1, out.stderr
+    # the slow op-amp's corner fails on its own fn (and the alias with it), the fast one passes
+    failed = [ln for ln in out.stderr.splitlines() if ln.startswith("check-design: failed:")]
+    assert len(failed) == 2 and all(ln.startswith("check-design: failed: fast-plant [LM358]: fn") for ln in failed)
+    result = json.loads((tmp_path / "out" / "fast-plant" / "result.json").read_text())
+    value = {(c["corner"], k["id"]): k["value"] for c in result["corners"] for k in c["cases"]}
+    fn = {corner: value[(corner, "fn_hz")] for corner in ("LM358", "TL072")}
+    ideal = {corner: value[(corner, "ideal_fn_hz")] for corner in ("LM358", "TL072")}
+    assert ideal["LM358"] == ideal["TL072"] == pytest.approx(1 / (2 * math.pi * math.sqrt(1e3 * 1e3 * 2.2e-9 * 22e-9)))
+    assert fn["LM358"] < 0.97 * ideal["LM358"] and fn["LM358"] < fn["TL072"] < ideal["TL072"]
+    assert all(value[(c, "fn_opamp_hz")] == fn[c] for c in fn)     # the earlier name, still read
+    assert value[("LM358", "q")] > value[("TL072", "q")]     # the slow op-amp lowers zeta too
+    assert value[("LM358", "ideal_q")] == value[("TL072", "ideal_q")]
+    # the corner's fn is the op-amp-aware model's dominant pair, as the design's own JSON gives it
+    design = {c["corner"]: c["design"] for c in result["corners"]}
+    assert all(fn[c] == pytest.approx(design[c]["built"]["fn_opamp_hz"]) for c in fn)
+    assert all(ideal[c] == pytest.approx(design[c]["built"]["fn_hz"]) for c in fn)
+
+
+def test_the_help_spec_example_is_yaml_of_known_keys():
+    text = check_design("--help").stdout
+    lines = text[text.index("\nspec file"):].splitlines()[1:]
+    start = next(i for i, ln in enumerate(lines) if ln.strip().startswith("name:"))
+    end = next(i for i, ln in enumerate(lines) if ln.strip().startswith("golden:"))
+    doc = yaml.safe_load(textwrap.dedent("\n".join(lines[start:end + 1])))   # the trailing # comments are YAML's
+    assert isinstance(doc, dict) and doc["kind"] in TOP
+    assert set(doc) <= set(TOP[doc["kind"]]), set(doc) - set(TOP[doc["kind"]])
+    for key, value in doc.items():
+        if key in SUB and isinstance(value, dict):
+            assert set(value) <= set(SUB[key]), (key, set(value) - set(SUB[key]))
+    assert doc["golden"]["file"] == "golden/lab3-{corner}.csv"

@@ -286,3 +286,144 @@ def test_format_window_and_bench_files_on_the_command_line(tmp_path):
         assert len(lines) == 1 and words in lines[0] and "np." not in lines[0], proc.stderr
     assert slew.returncode == 0 and "NON-LINEAR" in slew.stdout
     assert "Best: none of the methods is valid" in slew.stdout
+
+
+# --------------------------------------------------------------------------- a frequency table given to identify
+
+#: the known responses the tables are written from: a first-order plant and an underdamped second-order one
+FIRST = {"K": 2.0, "tau_s": 1 / (2 * math.pi * 1e3)}
+SECOND = {"K": 1.0, "wn_rad_s": 2 * math.pi * 5e3, "zeta": 0.3}
+
+
+def _response(model, w):
+    s = 1j * w
+    if model == "first":
+        return FIRST["K"] / (FIRST["tau_s"] * s + 1)
+    wn, z = SECOND["wn_rad_s"], SECOND["zeta"]
+    return SECOND["K"] * wn ** 2 / (s ** 2 + 2 * z * wn * s + wn ** 2)
+
+
+def _column(kind, f, g):
+    """One column of the table as its header names it (phase as the output's lag: phase = -w dt)."""
+    w = 2 * math.pi * f
+    phase = np.unwrap(np.angle(g))
+    return {"f_hz": f, "f_khz": f / 1e3, "w_rad_s": w, "gain_db": 20 * np.log10(np.abs(g)),
+            "gain_ratio": np.abs(g), "phase_deg": np.degrees(phase), "phase_rad": phase,
+            "shift_s": -phase / w, "shift_us": -phase / w * 1e6}[kind]
+
+
+def _table(model, header, sep=",", decimal_comma=False, head="", names=None):
+    """A table of ``model`` from 10 Hz to 100 kHz with the columns ``header`` names."""
+    f = np.geomspace(10, 1e5, 61)
+    g = _response(model, 2 * math.pi * f)
+    kinds = header.split(",")
+    cols = [_column(k, f, g) for k in kinds]
+
+    def cell(v):
+        text = repr(float(v))
+        return text.replace(".", ",") if decimal_comma else text
+    rows = [sep.join(cell(v) for v in row) for row in zip(*cols)]
+    return head + sep.join(names or kinds) + "\n" + "\n".join(rows) + "\n"
+
+
+def _waveforms(model):
+    """As a Digilent WaveForms network analyser exports it: comment block, four columns, phase in +-180."""
+    f = np.geomspace(10, 1e5, 61)
+    g = _response(model, 2 * math.pi * f)
+    head = ("#Digilent WaveForms Network Analyzer - Bode\n#Device Name: Discovery2\n#Steps: 61\n\n"
+            "Frequency (Hz),Channel 1 Magnitude (dB),Channel 2 Magnitude (dB),Channel 2 Phase (deg)\n")
+    return head + "".join(f"{a!r},{-0.01 * k!r},{20 * math.log10(abs(b))!r},{math.degrees(np.angle(b))!r}\n"
+                          for k, (a, b) in enumerate(zip(f.tolist(), g.tolist())))
+
+
+#: name -> (the table's text, the model written into it)
+TABLES = {
+    "f_hz,gain_db,phase_deg": (_table("second", "f_hz,gain_db,phase_deg"), SECOND),
+    "f_khz,gain_ratio,phase_rad": (_table("first", "f_khz,gain_ratio,phase_rad"), FIRST),
+    "w_rad_s,gain_db,shift_s": (_table("second", "w_rad_s,gain_db,shift_s"), SECOND),
+    "f_hz,gain_ratio,shift_us": (_table("first", "f_hz,gain_ratio,shift_us"), FIRST),
+    "f_hz,gain_db (no phase)": (_table("first", "f_hz,gain_db"), FIRST),
+    "semicolons and decimal commas": (_table("second", "f_hz,gain_db,phase_deg", sep=";", decimal_comma=True),
+                                      SECOND),
+    "tabs, a BOM and a comment": (_table("first", "f_hz,gain_db,phase_deg", sep="\t",
+                                         head="\ufeff# sweep of the RC plant\n"), FIRST),
+    "Frequency (Hz),Gain (dB),Phase (deg)": (_table("second", "f_hz,gain_db,phase_deg",
+                                                    names=["Frequency (Hz)", "Gain (dB)", "Phase (deg)"]), SECOND),
+    "WaveForms network analyser": (_waveforms("second"), SECOND),
+}
+
+
+@pytest.fixture(scope="module")
+def table_runs(tmp_path_factory):
+    """identify and identify-freq on every table, as JSON, as text and with --plot."""
+    folder = tmp_path_factory.mktemp("tables")
+    freq = script("identify-freq")
+    jobs, paths = [], {}
+    for k, (name, (text, _)) in enumerate(TABLES.items()):
+        path = paths[name] = folder / f"table{k}.csv"
+        path.write_text(text, encoding="utf-8")
+        for exe in (EXE, freq):
+            tag = "i" if exe == EXE else "f"
+            jobs += [[exe, path, "--json"], [exe, path], [exe, path, "--plot", folder / f"{tag}{k}.png"]]
+    with ThreadPoolExecutor(max_workers=4) as ex:
+        procs = list(ex.map(lambda a: subprocess.run(list(map(str, a)), capture_output=True, text=True,
+                                                     timeout=120), jobs))
+    out = {}
+    for k, name in enumerate(TABLES):
+        ij, it, ip, fj, ft, fp = procs[6 * k:6 * k + 6]
+        out[name] = {"identify": (ij, it, ip), "identify-freq": (fj, ft, fp),
+                     "png": (folder / f"i{k}.png", folder / f"f{k}.png"), "path": paths[name]}
+    return out
+
+
+@pytest.mark.parametrize("name", list(TABLES))
+def test_a_frequency_table_given_to_identify_is_analysed_as_identify_freq_does(table_runs, name):
+    runs = table_runs[name]
+    for proc in runs["identify"] + runs["identify-freq"]:
+        assert proc.returncode == 0 and proc.stderr == "", (name, proc.args, proc.stderr)
+    (ij, it, ip), (fj, ft, fp) = runs["identify"], runs["identify-freq"]
+    # the JSON: identify-freq's own, saying it was read as a frequency table
+    got, want = json.loads(ij.stdout), json.loads(fj.stdout)
+    assert got.pop("format") == "frequency-table" and list(got)[:1] == ["methods"]
+    assert got == want and "preprocessing" not in got
+    # the summary: one line saying so, then identify-freq's table; the plot is identify-freq's Bode plot
+    first, rest = it.stdout.split("\n", 1)
+    assert first.startswith("Format: frequency table (header ") and "analysed as identify-freq does" in first
+    assert rest == ft.stdout
+    ipng, fpng = runs["png"]
+    assert ipng.read_bytes()[:4] == b"\x89PNG" and ipng.read_bytes() == fpng.read_bytes()
+    assert ip.stdout.split("\n", 1)[1].replace(str(ipng), "PLOT") == fp.stdout.replace(str(fpng), "PLOT")
+    # and the analysis found the response the table was written from
+    truth = TABLES[name][1]
+    best = got["best"]
+    assert best["params"]["K"] == pytest.approx(truth["K"], rel=0.02), name
+    if "zeta" in truth:
+        assert best["model"] == "underdamped", name
+        assert best["params"]["wn_rad_s"] == pytest.approx(truth["wn_rad_s"], rel=0.02)
+        assert best["params"]["zeta"] == pytest.approx(truth["zeta"], rel=0.05)
+    else:
+        assert best["params"]["tau_s"] == pytest.approx(truth["tau_s"], rel=0.03), name
+
+
+def test_step_options_with_a_frequency_table_are_one_line(tmp_path):
+    path = tmp_path / "bode.csv"
+    path.write_text(TABLES["f_hz,gain_db,phase_deg"][0])
+    plot = tmp_path / "fit.png"
+    cases = [["--step-time", "0"], ["--step-amplitude", "2"], ["--window", "0", "1m"], ["--format", "generic"],
+             ["--input-column", "2"], ["--output-column", "3"], ["--methods", "smith"], ["--no-refine"],
+             ["--against", tmp_path / "result.json"], ["--step-time", "0", "--no-refine", "--json"]]
+    procs = run_many([[path, *opts, "--plot", plot] for opts in cases])
+    for opts, proc in zip(cases, procs):
+        assert proc.returncode == 2 and proc.stdout == "", (opts, proc.stderr)
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("identify: error: "), (opts, proc.stderr)
+        flags = [o for o in opts if str(o).startswith("--") and o != "--json"]
+        assert all(f in lines[0] for f in flags) and "frequency-response table" in lines[0], lines[0]
+        assert "identify-freq" in lines[0] and "f_hz,gain_db,phase_deg" in lines[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bode.csv"]
+    # --format auto is the default, not a step option; a step capture is still a step capture
+    auto = run(path, "--format", "auto", "--json")
+    assert auto.returncode == 0 and json.loads(auto.stdout)["format"] == "frequency-table"
+    step = run(FIX / "generic_ty.csv", "--json")
+    assert step.returncode == 0 and "format" not in json.loads(step.stdout)
+    assert json.loads(step.stdout)["capture"]["format"] == "generic"

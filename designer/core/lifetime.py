@@ -1,0 +1,185 @@
+"""How a command and the processes it starts end: nothing outlives it,
+however it is stopped.
+
+- **Signals** (:func:`install`, done first by every console script): SIGINT,
+  SIGTERM and SIGHUP are handled alike: the first raises :class:`Interrupted`
+  (a :class:`KeyboardInterrupt`, so every ``finally`` on the way removes its
+  temporaries and kills its workers) and the command ends with one line and
+  the status a shell reports for that signal, 128 + its number (130, 143,
+  129). Later signals are ignored while that clean-up runs.
+- **Inside native code** (:func:`native`): ngspice's shared library calls back
+  into Python while it simulates, and an exception raised in such a callback is
+  printed and swallowed by cffi, so the run would go on to write its bundle. A
+  signal that arrives there ends the process at once instead
+  (:func:`emergency`): the one line, the registered clean-ups (:func:`on_exit`:
+  the renderer, worker processes), then ``os._exit``. Nothing is half-written
+  then: no file is being written while ngspice runs.
+- **Children die with their parent** (:func:`die_with_parent`,
+  :func:`exec_dies_with_parent`): every worker, renderer, drawing helper and
+  ``ngspice -b`` asks Linux for SIGKILL when its parent dies
+  (``prctl(PR_SET_PDEATHSIG)``, kept across ``exec``), so a SIGKILLed command
+  leaves no process behind either; a parent that died before the request is
+  noticed by the child, which exits.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import signal
+import sys
+from contextlib import contextmanager
+
+SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+#: what the one line says for each signal
+WORDS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated (SIGTERM)", signal.SIGHUP: "hung up (SIGHUP)"}
+_PR_SET_PDEATHSIG = 1
+
+
+class Interrupted(KeyboardInterrupt):
+    """The command was told to stop by ``signum``; :attr:`status` is 128 + it."""
+
+    def __init__(self, signum: int = signal.SIGINT):
+        super().__init__(WORDS.get(signum, f"signal {signum}"))
+        self.signum = signum
+
+    @property
+    def status(self) -> int:
+        return 128 + self.signum
+
+
+def status_of(exc: BaseException) -> int:
+    """The exit status for an interruption (a plain KeyboardInterrupt is Ctrl-C: 130)."""
+    return exc.status if isinstance(exc, Interrupted) else 128 + signal.SIGINT
+
+
+def words_of(exc: BaseException) -> str:
+    return WORDS.get(getattr(exc, "signum", signal.SIGINT), "interrupted")
+
+
+_prog = None
+_received = None
+_native = 0
+_cleanups: list = []
+
+
+def install(prog: str) -> None:
+    """Handle SIGINT, SIGTERM and SIGHUP as described above, for command ``prog``."""
+    global _prog
+    _prog = prog
+    _resolve_prctl()   # before any fork: a child then only calls it
+    for s in SIGNALS:
+        signal.signal(s, _handler)
+
+
+def quiet() -> None:
+    """The command's work is done: block the signals for the last instants (its files
+    are whole; a signal now changes nothing, and must not print a traceback)."""
+    try:
+        signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    except (AttributeError, OSError, ValueError):   # pragma: no cover - not POSIX
+        pass
+
+
+def received():
+    """The stop signal this command received, or None. Code that catches an error may
+    find that it was one in disguise: a signal raised inside C code (numpy's import
+    of its extension) can come out as an ImportError."""
+    return _received
+
+
+def _handler(signum, frame):
+    global _received
+    _received = signum
+    for s in SIGNALS:   # one stop: the clean-up that follows runs undisturbed
+        signal.signal(s, signal.SIG_IGN)
+    if _native:
+        emergency(signum)
+    raise Interrupted(signum)
+
+
+def on_exit(fn) -> None:
+    """Run ``fn()`` when :func:`emergency` ends the process (kill a renderer, workers)."""
+    if fn not in _cleanups:
+        _cleanups.append(fn)
+
+
+def forget(fn) -> None:
+    if fn in _cleanups:
+        _cleanups.remove(fn)
+
+
+@contextmanager
+def native():
+    """The block runs native code that may call back into Python (ngspice's shared library)."""
+    global _native
+    _native += 1
+    try:
+        yield
+    finally:
+        _native -= 1
+
+
+def emergency(signum: int) -> None:
+    """End the process now: the one line, the clean-ups, exit 128 + ``signum``."""
+    try:
+        os.write(2, f"{_prog or os.path.basename(sys.argv[0])}: error: {WORDS.get(signum, 'interrupted')}\n"
+                 .encode())
+    except OSError:
+        pass
+    for fn in list(_cleanups):
+        try:
+            fn()
+        except BaseException:   # noqa: BLE001 - nothing may stop the exit
+            pass
+    os._exit(128 + signum)
+
+
+def reset_in_child() -> None:
+    """In a forked child: the default dispositions (a kill of the child kills it,
+    without a line from a command it is not) and no inherited clean-ups."""
+    global _native, _received
+    _native, _received = 0, None
+    _cleanups.clear()
+    for s in SIGNALS:
+        signal.signal(s, signal.SIG_DFL)
+    try:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)
+    except (AttributeError, OSError, ValueError):   # pragma: no cover
+        pass
+
+
+_prctl = None
+
+
+def _resolve_prctl():
+    global _prctl
+    if _prctl is None and sys.platform.startswith("linux"):
+        try:
+            _prctl = ctypes.CDLL(None, use_errno=True).prctl
+        except (OSError, AttributeError):   # pragma: no cover - no libc prctl
+            _prctl = False
+    return _prctl
+
+
+def die_with_parent(parent_pid: int) -> None:
+    """In a forked child: be killed when the parent dies; exit now if it already has."""
+    fn = _resolve_prctl()
+    if fn:
+        fn(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if os.getppid() != parent_pid:
+        os._exit(1)
+
+
+def exec_dies_with_parent() -> None:
+    """``preexec_fn`` of a subprocess (``ngspice -b``): killed when we die.
+    Only a call already resolved in the parent (no allocation after the fork)."""
+    if _prctl:
+        _prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if os.getppid() == 1:
+        os._exit(1)
+
+
+def preexec():
+    """The ``preexec_fn`` for a subprocess, with the call resolved now, in the parent."""
+    return exec_dies_with_parent if _resolve_prctl() else None

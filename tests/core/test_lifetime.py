@@ -1,0 +1,108 @@
+"""designer.core.lifetime: stop signals give 128 + the signal and one line, also
+while ngspice's shared library runs; children die with their parent."""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+import uuid
+
+import pytest
+
+from designer.core import lifetime
+from helpers import tagged_env, wait_gone
+
+
+def test_statuses_are_what_a_shell_reports():
+    assert lifetime.Interrupted(signal.SIGTERM).status == 143
+    assert lifetime.Interrupted(signal.SIGHUP).status == 129
+    assert lifetime.status_of(KeyboardInterrupt()) == 130
+    assert lifetime.words_of(lifetime.Interrupted(signal.SIGHUP)) == "hung up (SIGHUP)"
+    assert isinstance(lifetime.Interrupted(), KeyboardInterrupt)   # every `finally` on the way runs
+
+
+def _python(code: str, tag: str, **kw):
+    return subprocess.Popen([sys.executable, "-c", textwrap.dedent(code)], env=tagged_env(tag),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+def test_a_signal_inside_the_shared_library_ends_the_run_at_once(sig):
+    # a transient of seconds that prints as it runs (PySpice's callbacks: Python inside the C call);
+    # KeyboardInterrupt raised there is swallowed by cffi, and the run would go on to the end
+    tag = uuid.uuid4().hex
+    p = _python("""
+        import sys
+        from designer.core import lifetime
+        from designer.spice.simulate import PySpiceShared
+        lifetime.install("probe")
+        deck = ("long\\nV1 in 0 SIN(0 1 1k)\\nR1 in out 1k\\nC1 out 0 100n\\n.tran 100n 2\\n"
+                ".meas tran vmax MAX v(out)\\n.end\\n")
+        PySpiceShared().run("t\\nV1 in 0 1\\nR1 in 0 1k\\n.tran 1u 10u\\n.end\\n")   # loaded and warm
+        print("running", flush=True)
+        PySpiceShared().run(deck)
+        print("finished", flush=True)
+    """, tag)
+    assert p.stdout.readline().strip() == "running"
+    time.sleep(0.5)
+    tick = time.monotonic()
+    p.send_signal(sig)
+    out, err = p.communicate(timeout=120)
+    assert time.monotonic() - tick < 5, "the simulation ran on"
+    assert p.returncode == 128 + sig and "finished" not in out
+    assert err.splitlines() == [f"probe: error: {lifetime.WORDS[sig]}"], err
+
+
+def test_a_child_dies_with_its_parent_however_the_parent_dies():
+    tag = uuid.uuid4().hex
+    # the parent forks a child that asks to die with it, then sleeps; the parent is SIGKILLed
+    p = _python("""
+        import os, time
+        from designer.core import lifetime
+        parent = os.getpid()
+        if os.fork() == 0:
+            lifetime.die_with_parent(parent)
+            time.sleep(60)
+            os._exit(0)
+        print("forked", flush=True)
+        time.sleep(60)
+    """, tag)
+    assert p.stdout.readline().strip() == "forked"
+    time.sleep(0.2)
+    p.kill()
+    p.communicate(timeout=10)
+    assert wait_gone(tag) == []
+
+
+def test_an_ngspice_subprocess_dies_with_its_parent():
+    tag = uuid.uuid4().hex
+    p = _python("""
+        import subprocess, sys
+        from designer.core import lifetime
+        child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"], preexec_fn=lifetime.preexec())
+        print("started", flush=True)
+        child.wait()
+    """, tag)
+    assert p.stdout.readline().strip() == "started"
+    p.kill()
+    p.communicate(timeout=10)
+    assert wait_gone(tag) == []
+
+
+def test_a_worker_pipe_is_not_held_open_by_the_worker_itself():
+    # the renderer used to hold both ends of its pipe: its parent's death went unseen
+    import multiprocessing
+
+    from designer.core.workers import Worker
+    w = Worker(multiprocessing.get_context("fork"), lambda task: task)
+    try:
+        w.give(0, "ping", 10)
+        assert w.conn.recv() == ("ok", "ping")
+        fds = {os.readlink(f"/proc/{w.proc.pid}/fd/{fd}") for fd in os.listdir(f"/proc/{w.proc.pid}/fd")}
+        mine = os.readlink(f"/proc/self/fd/{w.conn.fileno()}")
+        assert mine not in fds
+    finally:
+        w.kill()
