@@ -12,7 +12,8 @@ from helpers import ROOT, script
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from designer.check.spec import MAX_NODES, load_spec, parse_yaml
+from designer.check.spec import load_spec, parse_yaml
+from designer.check.yamlread import MAX_NODES
 from designer.core.errors import DesignError
 
 SPECS = sorted((ROOT / "specs").glob("*.yaml"))
