@@ -109,7 +109,7 @@ def pool_floor(runs: dict, bare: dict, simulator: str, repeat: int = 3) -> float
 def main():
     from designer.check.spec import load_spec
     paths = sorted((ROOT / "specs").glob("*.yaml"))
-    specs = [load_spec(p) for p in paths]
+    specs = [load_spec(p, root=ROOT) for p in paths]   # one reads a reference result in reports/
     print(f"### check-design on {len(specs)} dogfood specs "
           f"({sum(len(s.corners) for s in specs)} corners), --jobs {JOBS}\n")
     print("| simulator | sum of bare times (s) | goal: 1.2 x sum / 2 (s) | floor: the decks alone in 2 workers (s) "
@@ -127,7 +127,7 @@ def main():
         with tempfile.TemporaryDirectory() as tmp:
             for _ in range(3):
                 wall, _mb, code = run_measured([str(ROOT / ".venv" / "bin" / "check-design"), *map(str, paths),
-                                                "--jobs", str(JOBS), "--simulator", simulator,
+                                                "--root", str(ROOT), "--jobs", str(JOBS), "--simulator", simulator,
                                                 "--junit", f"{tmp}/j.xml", "--summary", f"{tmp}/s.md"])
                 assert code == 1, f"check-design exit status {code} (the seed's spec must fail: 1)"
                 walls.append(wall)

@@ -149,7 +149,7 @@ def main():
                       f"{'ok' if ok else 'MISSED'} |")
                 path.unlink()
         wall, peak = peak_rss_mb(["/dev/zero"], expect=2)
-        print(f"| `/dev/zero` (refused: not a text file) | - | - | {wall:.2f} | {peak:.0f} | "
+        print(f"| `/dev/zero` (refused: a character device) | - | - | {wall:.2f} | {peak:.0f} | "
               f"{'ok' if peak <= 150 else 'MISSED'} |")
 
 
