@@ -6,7 +6,10 @@ however it is stopped.
   (a :class:`KeyboardInterrupt`, so every ``finally`` on the way removes its
   temporaries and kills its workers) and the command ends with one line and
   the status a shell reports for that signal, 128 + its number (130, 143,
-  129). Later signals are ignored while that clean-up runs.
+  129). Later signals are ignored while that clean-up runs. A handler that
+  ran where Python cannot raise (a weakref callback inside the import
+  machinery: Python prints "Exception ignored" and goes on) delivers the
+  signal again a millisecond later, through SIGALRM (:func:`_unraisable`).
 - **Inside native code** (:func:`native`): ngspice's shared library calls back
   into Python while it simulates, and an exception raised in such a callback is
   printed and swallowed by cffi, so the run would go on to write its bundle. A
@@ -25,6 +28,7 @@ however it is stopped.
 from __future__ import annotations
 
 import ctypes
+import functools
 import os
 import signal
 import sys
@@ -70,6 +74,24 @@ def install(prog: str) -> None:
     _resolve_prctl()   # before any fork: a child then only calls it
     for s in SIGNALS:
         signal.signal(s, _handler)
+    sys.unraisablehook = functools.partial(_unraisable, sys.unraisablehook)
+
+
+def _unraisable(previous, unraisable) -> None:
+    """A stop signal whose handler ran where Python cannot raise (a weakref callback of the
+    import machinery, a ``__del__``): printed as "Exception ignored" and lost. Deliver it
+    again instead, to be raised at the next ordinary instruction; anything else as before."""
+    exc = unraisable.exc_value
+    if not isinstance(exc, Interrupted):
+        previous(unraisable)
+        return
+    # a timer, not the signal itself: raised now it would land in this hook again
+    signal.signal(signal.SIGALRM, functools.partial(_redeliver, exc.signum))
+    signal.setitimer(signal.ITIMER_REAL, 0.001)
+
+
+def _redeliver(signum, _alarm, _frame):
+    raise Interrupted(signum)
 
 
 def quiet() -> None:
@@ -141,7 +163,7 @@ def reset_in_child() -> None:
     global _native, _received
     _native, _received = 0, None
     _cleanups.clear()
-    for s in SIGNALS:
+    for s in (*SIGNALS, signal.SIGALRM):
         signal.signal(s, signal.SIG_DFL)
     try:
         signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)

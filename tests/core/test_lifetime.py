@@ -106,3 +106,31 @@ def test_a_worker_pipe_is_not_held_open_by_the_worker_itself():
         assert mine not in fds
     finally:
         w.kill()
+
+
+def test_a_signal_lost_in_a_callback_python_cannot_raise_from_is_delivered_again():
+    # the kill tests once caught SIGINT landing in the import machinery's weakref callback: Python
+    # printed "Exception ignored" with a traceback and went on; here a weakref callback is the place
+    tag = uuid.uuid4().hex
+    p = _python("""
+        import gc, os, signal, sys, time, weakref
+        from designer.core import lifetime
+        lifetime.install("probe")
+        class Thing:
+            pass
+        t = Thing()
+        weakref.ref(t, lambda ref: os.kill(os.getpid(), signal.SIGTERM) or time.sleep(0.01) or sum(range(10)))
+        keep = weakref.ref(t, lambda ref: (os.kill(os.getpid(), signal.SIGTERM), [i for i in range(1000)]))
+        try:
+            del t
+            gc.collect()
+            for _ in range(100):
+                time.sleep(0.01)
+            print("went on", flush=True)
+        except KeyboardInterrupt as exc:
+            print(f"probe: error: {lifetime.words_of(exc)}", file=sys.stderr)
+            sys.exit(lifetime.status_of(exc))
+    """, tag)
+    out, err = p.communicate(timeout=60)
+    assert "went on" not in out and "Exception ignored" not in err and "Traceback" not in err, err
+    assert p.returncode == 143 and err.splitlines() == ["probe: error: terminated (SIGTERM)"], err
