@@ -199,7 +199,7 @@ class _Doc:
     #: the folder every path of the spec must resolve inside (the spec's own); None: anywhere
     root: Path | None = None
 
-    def resolve(self, keys, may_be_missing: bool = False) -> Path:
+    def resolve(self, keys) -> Path:
         """A path in the spec, relative to the spec file's folder, which it must not
         leave (symbolic links followed) unless ``--allow-outside`` (:attr:`root` None)."""
         value = self.get(keys)
@@ -554,12 +554,11 @@ _ANALYSIS = re.compile(r"^\s*\.(tran|ac)\b", re.I | re.M)
 
 def _netlist(doc, name: str, update: bool) -> CheckSpec:
     from ..spice.simulate import measure_names
-    from ..spice.trust import check_deck_text, expand_deck
+    from ..spice.trust import expand_deck
     path = doc.resolve(("deck",))
     try:
         # the deck and everything it includes, read and checked here, inlined: ngspice opens none of them
         deck = expand_deck(path, doc.root)
-        check_deck_text(deck, shown(path))   # the text ngspice gets, once more: nothing may be left to include
     except DesignError as exc:
         raise doc.error(("deck",), str(exc)) from None
     shown_deck = shown(path)

@@ -105,9 +105,9 @@ def run_cli(prog: str, build_parser, action, argv=None) -> int:
             args.prog = prog   # for messages written after the action's own work (see failed_checks_status)
             return action(args) or 0
         except BaseException as exc:
-            if lifetime.received() is not None and not isinstance(exc, KeyboardInterrupt):
-                # a stop signal that C code turned into another error (an import failing halfway)
-                raise lifetime.Interrupted(lifetime.received()) from None
+            stop = lifetime.interruption(exc)
+            if stop is not None and stop is not exc:   # a stop signal in another error's clothes
+                raise stop from None
             raise
     except SimulatorError as exc:
         _fail(prog, f"simulator error: {exc}")

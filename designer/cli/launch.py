@@ -38,10 +38,9 @@ def _run(prog: str, module: str, main: str, wing: str | None = None) -> int:
             with render.ahead(draws(sys.argv[1:]), preload=(_REPORTS[wing],)):
                 status = getattr(importlib.import_module(module), main)()
     except BaseException as exc:   # before the command's own handling: an import, the renderer's start
-        if not isinstance(exc, KeyboardInterrupt):
-            if lifetime.received() is None:
-                raise
-            exc = lifetime.Interrupted(lifetime.received())   # turned into an ImportError by C code
+        exc = lifetime.interruption(exc)
+        if exc is None:
+            raise
         try:
             print(f"{prog}: error: {lifetime.words_of(exc)}", file=sys.stderr)
         except OSError:

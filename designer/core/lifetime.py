@@ -17,8 +17,8 @@ however it is stopped.
   (:func:`emergency`): the one line, the registered clean-ups (:func:`on_exit`:
   the renderer, worker processes), then ``os._exit``. Nothing is half-written
   then: no file is being written while ngspice runs.
-- **Children die with their parent** (:func:`die_with_parent`,
-  :func:`exec_dies_with_parent`): every worker, renderer, drawing helper and
+- **Children die with their parent** (:func:`die_with_parent`, :func:`preexec`
+  for a subprocess): every worker, renderer, drawing helper and
   ``ngspice -b`` asks Linux for SIGKILL when its parent dies
   (``prctl(PR_SET_PDEATHSIG)``, kept across ``exec``), so a SIGKILLed command
   leaves no process behind either; a parent that died before the request is
@@ -50,6 +50,15 @@ class Interrupted(KeyboardInterrupt):
     @property
     def status(self) -> int:
         return 128 + self.signum
+
+
+def interruption(exc: BaseException):
+    """The :class:`KeyboardInterrupt` that ``exc`` is or stands for, or None: after a stop
+    signal, an error raised by C code the signal interrupted (numpy's extension import
+    fails with ImportError) is the signal in disguise."""
+    if isinstance(exc, KeyboardInterrupt):
+        return exc
+    return Interrupted(_received) if _received is not None else None
 
 
 def status_of(exc: BaseException) -> int:
@@ -101,13 +110,6 @@ def quiet() -> None:
         signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
     except (AttributeError, OSError, ValueError):   # pragma: no cover - not POSIX
         pass
-
-
-def received():
-    """The stop signal this command received, or None. Code that catches an error may
-    find that it was one in disguise: a signal raised inside C code (numpy's import
-    of its extension) can come out as an ImportError."""
-    return _received
 
 
 def _handler(signum, frame):
@@ -193,15 +195,8 @@ def die_with_parent(parent_pid: int) -> None:
         os._exit(1)
 
 
-def exec_dies_with_parent() -> None:
-    """``preexec_fn`` of a subprocess (``ngspice -b``): killed when we die.
-    Only a call already resolved in the parent (no allocation after the fork)."""
-    if _prctl:
-        _prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
-    if os.getppid() == 1:
-        os._exit(1)
-
-
 def preexec():
-    """The ``preexec_fn`` for a subprocess, with the call resolved now, in the parent."""
-    return exec_dies_with_parent if _resolve_prctl() else None
+    """The ``preexec_fn`` of a subprocess (``ngspice -b``): :func:`die_with_parent`
+    for this process, with the libc call resolved now, in the parent (the child
+    only calls it)."""
+    return functools.partial(die_with_parent, os.getpid()) if _resolve_prctl() else None

@@ -12,6 +12,27 @@ import math
 
 import numpy as np
 
+from .errors import DesignError
+
+
+def coefficients(p, name: str, what: str = "") -> np.ndarray:
+    """A polynomial's coefficients, highest power of s first, as a finite float
+    array with the leading zeros dropped; a :class:`DesignError` naming ``name``
+    (its ``param``; ``what`` before it in the message) when they are not numbers,
+    not finite, none, or all zero."""
+    label = f"{what}: {name}" if what else name
+    try:
+        a = np.atleast_1d(np.asarray(p, float))
+    except (TypeError, ValueError):
+        raise DesignError(f"{label} must be a sequence of numbers (highest power of s first)", param=name) from None
+    if a.ndim != 1 or a.size == 0 or not np.all(np.isfinite(a)):
+        raise DesignError(f"{label} must be a non-empty sequence of finite numbers (highest power of s first)",
+                          param=name)
+    nz = np.flatnonzero(a)
+    if nz.size == 0:
+        raise DesignError(f"{label} is all zeros", param=name)
+    return a[nz[0]:]
+
 
 def dominant_pair(den):
     """Natural frequency (Hz) and damping of the slowest pole pair of ``den``.

@@ -47,7 +47,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..core.errors import DesignError
-from ..core.lti import pole_clusters, step_response
+from ..core.lti import coefficients, pole_clusters, step_response
 from ..core.process import ProcessModel
 from ..core.units import format_eng
 
@@ -163,20 +163,6 @@ class ModelIntegrating:
         return {"kind": self.kind, **asdict(self)}
 
 
-def _poly(what: str, name: str, p) -> tuple:
-    try:
-        a = np.atleast_1d(np.asarray(p, float))
-    except (TypeError, ValueError):
-        raise DesignError(f"{what}: {name} must be a sequence of numbers (highest power of s first)",
-                          param=name) from None
-    if a.ndim != 1 or a.size == 0 or not np.all(np.isfinite(a)):
-        raise DesignError(f"{what}: {name} must be a non-empty sequence of finite numbers", param=name)
-    a = np.trim_zeros(a, "f")
-    if a.size == 0:
-        raise DesignError(f"{what}: {name} is all zeros", param=name)
-    return tuple(float(x) for x in a)
-
-
 @dataclass(frozen=True)
 class ModelTf:
     """num(s)/den(s) e^(-theta s), coefficients highest power of s first."""
@@ -187,8 +173,8 @@ class ModelTf:
     kind: ClassVar[str] = "tf"
 
     def __post_init__(self):
-        num = _poly("tf", "num", self.num)
-        den = _poly("tf", "den", self.den)
+        num = tuple(coefficients(self.num, "num", "tf").tolist())
+        den = tuple(coefficients(self.den, "den", "tf").tolist())
         if len(num) > len(den):
             raise DesignError(f"tf: num has degree {len(num) - 1} > den's {len(den) - 1}; "
                               "a plant model must be proper", param="num")

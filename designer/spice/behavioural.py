@@ -96,6 +96,7 @@ import re
 import numpy as np
 
 from ..core.errors import DesignError
+from ..core.lti import coefficients
 
 #: the realisations of the rational part (see the module's notes)
 FORMS = ("integrators", "s_xfer")
@@ -114,21 +115,6 @@ _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 def _num(x: float) -> str:
     """A number for the deck: plain float text with 12 significant digits."""
     return "%.12g" % x
-
-
-def _poly(coeffs, param: str) -> np.ndarray:
-    """Descending coefficients as a finite float array, leading zeros removed."""
-    try:
-        arr = np.atleast_1d(np.asarray(coeffs, dtype=float))
-    except (TypeError, ValueError):
-        raise DesignError(f"{param}: coefficients must be numbers, highest power first", param=param) from None
-    if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)):
-        raise DesignError(f"{param}: coefficients must be a finite, non-empty list, highest power first",
-                          param=param)
-    nz = np.flatnonzero(arr)
-    if nz.size == 0:
-        raise DesignError(f"{param}: all coefficients are zero", param=param)
-    return arr[nz[0]:]
 
 
 def _theta(theta_s) -> float:
@@ -167,8 +153,8 @@ def normalise(num, den):
     DesignError
         For non-finite or all-zero coefficients, or an improper H (deg N > deg D).
     """
-    b = _poly(num, "num")[::-1]
-    a = _poly(den, "den")[::-1]
+    b = coefficients(num, "num")[::-1]
+    a = coefficients(den, "den")[::-1]
     n = a.size - 1
     if b.size - 1 > n:
         raise DesignError(f"num: the plant is improper (numerator degree {b.size - 1} > denominator degree {n}); "
