@@ -130,27 +130,17 @@ exit status: 0 success, 2 bad input (one line on stderr saying what and why).
 # --------------------------------------------------------------------------- shared
 
 def check_output_path(path, option: str) -> None:
-    """Refuse, before any work, an output file that cannot be written: the path
-    is a directory, or one of its parents is a file. (Nothing is created here:
-    a run refused later must leave no trace.)"""
+    """Refuse, before any work, an output file that cannot be written
+    (:func:`designer.core.fileio.check_output_file`: a directory, a link, FIFO or
+    device there, a parent that is a file). Nothing is created here: a run
+    refused later must leave no trace."""
     if str(path) == "":
         raise DesignError(f"{option} needs a file name, such as fit.png")
-    p = Path(path)
-    try:
-        is_dir = str(path) in (".", "..") or p.is_dir()
-        blocker = next((q for q in p.parents if q.exists()), None)
-        blocked = blocker is not None and not blocker.is_dir()
-    except (OSError, ValueError) as exc:   # a name too long, a NUL byte
-        raise DesignError(f"{option} {shown(path)} is not a usable file name: "
-                          f"{getattr(exc, 'strerror', None) or exc}") from None
-    if is_dir:
-        raise DesignError(f"{option} {shown(path)} is a directory; give a file name such as "
-                          "fit.png")
-    if blocked:
-        raise DesignError(f"{option} {shown(path)}: cannot create directory {shown(blocker)}: "
-                          "a file of that name exists")
     from ..core.fileio import check_output_file
-    check_output_file(path, option)   # a link, FIFO or device there is never written through
+    try:
+        check_output_file(path, option)
+    except OSError as exc:   # a name too long
+        raise DesignError(f"{option} {shown(path)} is not a usable file name: {exc.strerror or exc}") from None
 
 
 def write_png(path, png: bytes, option: str = "--plot") -> None:

@@ -320,7 +320,7 @@ def check_output_file(path, what: str = "output file") -> Path:
         raise DesignError(f"no {what} given: the name is empty")
     try:
         st = os.lstat(path)
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):   # nothing there; a parent that is a file: below
         st = None
     except OSError as exc:
         raise os_error("write", path, exc) from None
