@@ -37,6 +37,10 @@ FLAGS = {
     "step_v": "--step", "edge_s": "--edge", "target_overshoot_pct": "--target-overshoot",
     "target_settling_s": "--target-settling", "f_integrator_hz": "--f-integrator",
     "f_differentiator_hz": "--f-differentiator",
+    "plant_tf": "--plant-tf", "plant_model": "--plant-model", "plant_method": "--plant-method",
+    "plant_capture": "--plant-capture", "plant_input": "--plant-input", "plant_output": "--plant-output",
+    "simc_tauc_s": "--simc-tauc", "imc_lambda_s": "--imc-lambda", "min_phase_margin_deg": "--min-pm",
+    "min_gain_margin_db": "--min-gm", "max_ms": "--max-ms", "robust": "--robust",
     # analyze-pid: the controller as built (r3, r4 as above)
     **{f"r{i}": f"--r{i}" for i in range(5, 19)}, "c3": "--c3", "c4": "--c4", "controller_json": "--parts-json",
     # identify / identify-freq

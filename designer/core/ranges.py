@@ -99,6 +99,13 @@ RANGES = {
     "target_settling_s": Range(1e-9, 1e4, "s"),
     "f_integrator_hz": Range(1e-4, 10e6, "Hz"),
     "f_differentiator_hz": Range(0.01, 1e9, "Hz"),
+    # PID for a model plant (--plant-tf, --plant-model, --plant-capture)
+    "simc_tauc_s": Range(1e-12, 1e6, "s"),
+    "imc_lambda_s": Range(1e-12, 1e6, "s"),
+    "min_phase_margin_deg": Range(0.0, 89.0, "deg"),
+    "min_gain_margin_db": Range(0.0, 40.0, "dB"),
+    "max_ms": Range(1.05, 10.0),
+    "plant_voltage_v": Range(-100.0, 100.0, "V"),
     # identify and identify-freq (add their inputs here)
     # every time in a capture and --step-time: +-10 Gs covers Unix timestamps
     "capture_time_s": Range(-1e10, 1e10, "s"),

@@ -571,10 +571,13 @@ def brute_force(kp: float, ti_s: float, td_s: float, fn_hz: float, *, r_series: 
 
 
 def static_checks(parts: PidParts, fn_hz: float, gbw_hz: float, targets: dict, *,
-                  r_min: float, r_max: float, c_min: float, c_max: float, tol: float = 0.01) -> list:
+                  r_min: float, r_max: float, c_min: float, c_max: float, tol: float = 0.01,
+                  fn_name: str = "fn") -> list:
     """Checks that need only the part values: accuracy of Kp/Ti/Td, the
     integrator and differentiator corners against fn, each stage's bandwidth
     against the highest frequency the controller handles, and the bounds.
+    ``fn_name`` is what the messages call ``fn_hz`` (``fc``, the crossover, for
+    a plant known only as a model).
 
     Returns
     -------
@@ -592,16 +595,16 @@ def static_checks(parts: PidParts, fn_hz: float, gbw_hz: float, targets: dict, *
                             f"({e * 100:+.2f} %, allowed +/-{tol * 100:g} %)"))
     fi = parts.f_integrator_hz
     checks.append(Check("integrator_corner", fi <= fn_hz / CORNER_MARGIN,
-                        f"1/(2 pi R13 C4) = {format_eng(fi, 'Hz')}, must be below fn/{CORNER_MARGIN:g} = "
-                        f"{format_eng(fn_hz / CORNER_MARGIN, 'Hz')} (fn = {format_eng(fn_hz, 'Hz')})"))
+                        f"1/(2 pi R13 C4) = {format_eng(fi, 'Hz')}, must be below {fn_name}/{CORNER_MARGIN:g} = "
+                        f"{format_eng(fn_hz / CORNER_MARGIN, 'Hz')} ({fn_name} = {format_eng(fn_hz, 'Hz')})"))
     if parts.has_derivative:
         fd = parts.f_differentiator_hz
         checks.append(Check("differentiator_corner", fd >= fn_hz * CORNER_MARGIN,
                             f"1/(2 pi R12 C3) = {format_eng(fd, 'Hz')}, must be above "
-                            f"{CORNER_MARGIN:g} fn = {format_eng(fn_hz * CORNER_MARGIN, 'Hz')}"))
+                            f"{CORNER_MARGIN:g} {fn_name} = {format_eng(fn_hz * CORNER_MARGIN, 'Hz')}"))
         f_need, why = fd, "the differentiator corner"
     else:
-        f_need, why = CORNER_MARGIN * fn_hz, f"{CORNER_MARGIN:g} fn"
+        f_need, why = CORNER_MARGIN * fn_hz, f"{CORNER_MARGIN:g} {fn_name}"
     ng = parts.noise_gains()
     for stage, bw in parts.stage_bandwidths(gbw_hz).items():
         checks.append(Check(f"bandwidth_{stage}", bw >= f_need,

@@ -488,6 +488,13 @@ def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise, parts, nam
         out.append(Check("steady_state_error", bool(abs(e) <= MAX_STEADY_STATE_ERROR),
                          f"{100 * e:.3g} % of the step (the integrator leaks through R13; "
                          f"want <= {100 * MAX_STEADY_STATE_ERROR:g} %)"))
+    return out + stage_checks(stable, levels, amp, step_v, rise, parts, name_of)
+
+
+def stage_checks(stable, levels, amp, step_v, rise, parts, name_of=str) -> list:
+    """Slew rate and output swing of every op-amp stage of the analytic loop
+    (``levels``: :func:`designer.pid.model.waveform_limits`), for any plant."""
+    out = []
     if not stable:
         out.append(Check("slew_rate", False, "unstable loop: no steady waveforms to check"))
         out.append(Check("output_swing", False,

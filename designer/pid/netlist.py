@@ -114,3 +114,65 @@ def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test:
                      f".meas tran {node}_min MIN v({node}) FROM={t0:.6g} TO={test.stop_s:.6g}"]
     lines = deck.measure_lines("y", test, expected_final) + extremes
     return deck.finish_deck(circuit, test, lines, points=points)
+
+
+def controller_netlist(parts: PidParts) -> Netlist:
+    """The controller alone (U2..U7 and their parts), for a plant that is only a
+    model: the deck puts the model between ``u`` and ``y``
+    (:func:`designer.spice.behavioural.plant_lines`)."""
+    rows, amps = [], []
+    for amp, passives in controller_stages(parts):
+        rows += passives
+        amps.append(amp)
+    return Netlist(tuple(rows), tuple(amps))
+
+
+def model_loop_deck(parts: PidParts, model, opamp: OpAmp, test: SquareTest, title: str,
+                    expected_final: float, points: int = 20000) -> str:
+    """The controller around a plant known only as a model
+    (:class:`~designer.core.process.ProcessModel`), as a standalone deck: the
+    model as native linear elements and a matched transmission line for its dead
+    time (:mod:`designer.spice.behavioural`), the six op-amp stages as for a
+    Sallen-Key plant, the same reference, ``.tran`` and ``.meas`` lines. The
+    step is at most the plant's own accuracy hint
+    (:func:`~designer.spice.behavioural.max_step_hint_s`)."""
+    import logging
+
+    from PySpice.Spice.Netlist import Circuit
+
+    from ..spice.behavioural import max_step_hint_s, plant_lines
+    logging.getLogger("PySpice").setLevel(logging.ERROR)
+    circuit = Circuit(title)
+    circuit.raw_spice = "\n".join([
+        f"* {title}",
+        f"* op-amps: {opamp.name} ({opamp.description}); supplies {opamp.vcc:g} V / {opamp.vee:g} V",
+        f"* reference: 0 -> {test.amplitude_v:g} V square wave at {test.frequency_hz:g} Hz, edges "
+        f"{test.edge_s:.3g} s, rising step at {test.delay_s:.4g} s",
+        f"* plant (a model, not a circuit): {model.text()}",
+        f"*   from {model.source}; input u (the controller's output), output y",
+        "* controller (seed 001, Fig. 66): U2 difference (ve = y - r), U3 inverter, U4 differentiator,",
+        "*   U5 integrator, U6 summer, U7 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y)",
+        "* Run: ngspice -b <this file>   (prints overshoot_pct, peak_time_s, rise_time_s, settling_time_s,",
+        "*   and the extremes of every op-amp output)",
+        deck.opamp_library_text().rstrip(),
+        *plant_lines(model.num, model.den, model.theta_s, "u", "y", name="plant"),
+    ])
+    deck.add_supplies(circuit, opamp)
+    circuit.V("ref", "ref", circuit.gnd, test.source())
+    controller_netlist(parts).add_to(circuit, opamp)
+    deck.settle_error_source(circuit, "y", expected_final)
+    t0 = test.delay_s
+    extremes = []
+    for node in PROBES:
+        if node == "vd" and not parts.has_derivative:
+            continue
+        extremes += [f".meas tran {node}_max MAX v({node}) FROM={t0:.6g} TO={test.stop_s:.6g}",
+                     f".meas tran {node}_min MIN v({node}) FROM={t0:.6g} TO={test.stop_s:.6g}"]
+    lines = deck.measure_lines("y", test, expected_final) + extremes
+    hint = max_step_hint_s(model.num, model.den, model.theta_s)
+    text = deck.finish_deck(circuit, test, lines, points=points)
+    tmax = test.max_step_s(points)
+    if hint < tmax:   # the plant's dynamics need a shorter step than the test's own
+        text = text.replace(f".tran {tmax:.6g} {test.stop_s:.6g} 0 {tmax:.6g}",
+                            f".tran {hint:.6g} {test.stop_s:.6g} 0 {hint:.6g}")
+    return text

@@ -24,6 +24,7 @@ from ..core.errors import DesignError, ParamError
 from ..core.eseries import PartBounds
 from ..core.fileio import show_cell, shown
 from ..core.jsonio import read_result
+from ..core.process import ProcessModel
 from ..core.ranges import parse_in_range
 from ..plant.sallenkey import SallenKeyParts, check_parts
 from . import tuning as rules
@@ -38,7 +39,17 @@ PLANT_RANGES = {"r1": "resistor_ohm", "r2": "resistor_ohm", "c1": "capacitor_f",
 NUMBERS = (("plant_fc_hz", "fc_hz"), ("plant_zeta", "zeta"), ("kp", "kp"), ("ti_s", "ti_s"), ("td_s", "td_s"),
            ("step_v", "step_v"), ("edge_s", "edge_s"), ("target_overshoot_pct", "target_overshoot_pct"),
            ("target_settling_s", "target_settling_s"), ("f_integrator_hz", "f_integrator_hz"),
-           ("f_differentiator_hz", "f_differentiator_hz"), ("square_hz", "square_hz"))
+           ("f_differentiator_hz", "f_differentiator_hz"), ("square_hz", "square_hz"),
+           ("simc_tauc_s", "simc_tauc_s"), ("imc_lambda_s", "imc_lambda_s"),
+           ("min_phase_margin_deg", "min_phase_margin_deg"), ("min_gain_margin_db", "min_gain_margin_db"),
+           ("max_ms", "max_ms"))
+#: a model plant's loop is held to these unless told otherwise (MATLAB's pidtune aims at 60 deg)
+DEFAULT_MIN_PHASE_MARGIN_DEG = 45.0
+DEFAULT_MIN_GAIN_MARGIN_DB = 6.0
+DEFAULT_MAX_MS = 1.7
+#: the options that only a model plant (--plant-tf, --plant-model, --plant-capture) takes
+MODEL_ONLY = ("plant_input", "plant_output", "simc_tauc_s", "imc_lambda_s", "min_phase_margin_deg",
+              "min_gain_margin_db", "max_ms", "plant_method")
 
 
 @dataclass(frozen=True)
@@ -46,8 +57,18 @@ class PidSpec(PartBounds):
     """A controller design request (SI units), validated on construction.
 
     Give the plant one way: ``plant_fc_hz`` with ``plant_zeta`` (designed as
-    ``design-plant`` would), ``plant_parts`` (as built), or ``plant_json`` (a
-    ``design-plant``/``analyze-plant`` result.json). Gains come from a rule
+    ``design-plant`` would), ``plant_parts`` (as built), ``plant_json`` (a
+    ``design-plant``/``analyze-plant`` result.json), or as a model only:
+    ``plant_tf`` (typed, :func:`~designer.core.process_text.parse_tf`),
+    ``plant_model`` (an ``identify``/``identify-freq`` JSON, its best valid
+    model or ``plant_method``) or ``plant_process`` (a
+    :class:`~designer.core.process.ProcessModel`). A model plant is designed
+    by :mod:`designer.pid.process_loop`: its rules are :data:`designer.pid.rules.RULES`,
+    ``optimize`` holds the loop to ``min_phase_margin_deg``,
+    ``min_gain_margin_db`` and ``max_ms`` (defaults 45 deg, 6 dB, 1.7; with
+    ``robust`` over the model's 95 % corners too), and ``plant_input`` /
+    ``plant_output`` (``"0:10"`` or a pair, volts) are the ranges the plant
+    accepts and delivers. Gains come from a rule
     (``tuning``: one of :data:`designer.pid.tuning.RULES`, default ``zn``),
     from ``tuning="optimize"`` with ``target_overshoot_pct``, or explicitly
     from ``kp``, ``ti_s`` and ``td_s`` together (``td_s = 0`` for a PI).
@@ -81,8 +102,22 @@ class PidSpec(PartBounds):
     tol: float = 0.01
     #: how the bench puts the op-amps in packages: single, dual, quad (None: the op-amp's own first)
     package: str | None = None
+    plant_tf: str | None = None
+    plant_model: str | None = None
+    plant_method: str | None = None
+    plant_process: ProcessModel | None = None
+    plant_input: object = None          #: "lo:hi" (volts) or a (lo, hi) pair: what the plant accepts
+    plant_output: object = None         #: the same for what it delivers
+    simc_tauc_s: float | None = None
+    imc_lambda_s: float | None = None
+    min_phase_margin_deg: float | None = None
+    min_gain_margin_db: float | None = None
+    max_ms: float | None = None
+    robust: bool = False
     #: the plant read from ``plant_json`` (read and checked on construction, before any work)
     json_plant: SallenKeyParts | None = field(default=None, init=False, repr=False, compare=False)
+    #: the model plant, from plant_tf, plant_model or plant_process (None for a Sallen-Key plant)
+    process: ProcessModel | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         def put(name, value):
@@ -97,10 +132,11 @@ class PidSpec(PartBounds):
             # refused before any work when the op-amp does not come in it (an NE5532 has no quad)
             from ..core.opamps import get
             get(self.opamp).package(self.package)
-        sources = sum(x is not None for x in (self.plant_fc_hz, self.plant_parts, self.plant_json))
+        sources = sum(x is not None for x in (self.plant_fc_hz, self.plant_parts, self.plant_json,
+                                              self.plant_tf, self.plant_model, self.plant_process))
         if sources != 1:
             raise _refused("give the plant one way: {plant_fc_hz}/{plant_zeta}, {plant_r1}..{plant_c2}, "
-                           "or {plant_json}")
+                           "{plant_json}, {plant_tf}, {plant_model} or --plant-capture")
         if self.plant_fc_hz is not None and self.plant_zeta is None:
             raise _refused("{plant_fc_hz} needs {plant_zeta}")
         if self.plant_fc_hz is None and self.plant_zeta is not None:
@@ -117,25 +153,95 @@ class PidSpec(PartBounds):
         put("opamp", opamps.get(self.opamp).name)
         if self.tuning is not None:
             put("tuning", str(self.tuning).strip().lower())
+        put("process", self._process())
+        if self.process is not None:
+            self._check_model_plant(put)
+            return
+        given = [k for k in MODEL_ONLY if getattr(self, k) is not None] + (["robust"] if self.robust else [])
+        if given:
+            raise _refused(f"{{{given[0]}}} is for a plant given as a model ({{plant_tf}}, {{plant_model}} or "
+                           "--plant-capture), not a Sallen-Key plant")
         explicit = [v is not None for v in (self.kp, self.ti_s, self.td_s)]
         if any(explicit) and not all(explicit):
             raise _refused("{kp}, {ti_s} and {td_s} go together (give all three)")
         if all(explicit) and self.tuning not in (None, "explicit"):
             raise _refused(f"{{tuning}} {self.tuning} and explicit {{kp}}/{{ti_s}}/{{td_s}} "
                            "exclude each other")
-        if not all(explicit) and self.tuning not in (None, "optimize") and self.tuning not in rules.RULES:
+        if (self.process is None and not all(explicit) and self.tuning not in (None, "optimize")
+                and self.tuning not in rules.RULES):
             raise _refused(f"unknown {{tuning}} {show_cell(self.tuning)}; allowed: {', '.join(rules.RULES)}, "
                            "optimize")
-        if self.tuning == "optimize":
+        if self.tuning == "optimize" and self.process is None:
             if self.target_overshoot_pct is None:
                 raise _refused("{tuning} optimize needs {target_overshoot_pct} P (percent)")
-        elif self.target_overshoot_pct is not None or self.target_settling_s is not None:
+        elif self.process is None and (self.target_overshoot_pct is not None or self.target_settling_s is not None):
             raise _refused("{target_overshoot_pct}/{target_settling_s} only apply to {tuning} optimize")
+
+    def _process(self):
+        """The model plant, read and checked (None for a Sallen-Key plant)."""
+        if self.plant_tf is not None:
+            from ..core.process_text import parse_tf
+            try:
+                return parse_tf(self.plant_tf)
+            except DesignError as exc:
+                raise _refused("{plant_tf} " + str(exc)) from None
+        if self.plant_model is not None:
+            from .plant_source import model_from_json
+            try:
+                return model_from_json(self.plant_model, self.plant_method)
+            except DesignError as exc:
+                raise _refused(str(exc).replace("--plant-model", "{plant_model}")) from None
+        if self.plant_process is not None:
+            if not isinstance(self.plant_process, ProcessModel):
+                raise _refused("{plant_process} must be a designer.core.process.ProcessModel")
+            return self.plant_process
+        if self.plant_method is not None:
+            raise _refused("{plant_method} chooses among the methods of a {plant_model} file")
+        return None
+
+    def _check_model_plant(self, put):
+        """The options of a model plant: rule names, ranges, robust with intervals."""
+        from . import rules as model_rules
+        for name in ("plant_input", "plant_output"):
+            value = getattr(self, name)
+            if value is not None:
+                put(name, voltage_range(value, name))
+        explicit = self.kp is not None
+        if not explicit and self.tuning not in (None, "optimize") and self.tuning not in model_rules.RULES:
+            raise _refused(f"unknown {{tuning}} {show_cell(self.tuning)}; allowed for a model plant: "
+                           f"{', '.join(model_rules.RULES)}, optimize")
+        if self.tuning != "optimize" and self.target_settling_s is not None:
+            raise _refused("{target_settling_s} only applies to {tuning} optimize")
+        if self.tuning not in ("optimize", None) and self.target_overshoot_pct is not None:
+            raise _refused("{target_overshoot_pct} only applies to {tuning} optimize")
+        if self.robust and not self.process.ci95:
+            raise _refused("{robust} checks the loop over the model's 95 % intervals, and this model has none "
+                           "(a typed model; identify's least-squares fits have them)")
 
     @property
     def method(self) -> str:
         """How the gains are chosen: ``explicit``, ``optimize`` or a rule name."""
         return "explicit" if self.kp is not None else (self.tuning or "zn")
+
+
+def voltage_range(value, name: str) -> tuple:
+    """``"0:10"`` (engineering notation either side, ``"-5:5"``, ``"0 : 3.3"``)
+    or a (lo, hi) pair as a (lo, hi) tuple of volts, lo < hi, both inside
+    ``RANGES["plant_voltage_v"]``."""
+    if isinstance(value, str):
+        cells = value.split(":")
+        if len(cells) != 2:
+            raise DesignError(f"{name} is a range LO:HI in volts, such as 0:10 or -5:5; got {show_cell(value)}",
+                              param=name)
+        lo, hi = (parse_in_range(c.strip(), name, "plant_voltage_v") for c in cells)
+    else:
+        try:
+            lo, hi = (parse_in_range(v, name, "plant_voltage_v") for v in value)
+        except (TypeError, ValueError):
+            raise DesignError(f"{name} is a range (lo, hi) in volts", param=name) from None
+    if not lo < hi:
+        raise DesignError(f"{name} needs LO < HI, got {lo:g}:{hi:g} V", param=name)
+    return float(lo), float(hi)
 
 
 #: the names a message of the spec marks as parameters (``{kp}``): its fields and the plant's parts

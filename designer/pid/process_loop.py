@@ -1,0 +1,464 @@
+"""PID for a plant known only as a model, G(s) = N(s)/D(s) e^(-theta s): an
+identified process (``identify``, ``identify-freq``), a typed transfer
+function, or a design-plant result read as its model. The orchestration
+behind ``design-pid --plant-tf/--plant-model/--plant-capture``.
+
+The steps, as for a Sallen-Key plant (:mod:`designer.pid.design`) where the
+plant is a circuit:
+
+1. the rules of :mod:`designer.pid.rules` on the model each intends (every one,
+   side by side, with the reason where one does not apply), or the optimiser
+   (:mod:`designer.pid.process_optimize`), or explicit gains;
+2. the parts (:func:`designer.pid.blocks.select_parts`), the integrator leak at
+   fc/100 and the derivative filter at 10 fc, fc the crossover of the rule's
+   ideal loop (as fn/100 and 10 fn for a Sallen-Key plant);
+3. the loop as built: the realised controller (op-amp poles, leak, filter:
+   :func:`designer.pid.model.controller_tf`) around the model with its exact
+   dead time, in the frequency domain (:func:`designer.pid.delaymargins.loop_margins`:
+   phase, gain and delay margins, Ms, stability by the argument principle) and
+   in time (:func:`designer.pid.delayloop.closed_loop_step`, the reference's
+   edge applied exactly as a moving average of the step response); every
+   op-amp output from the error by each stage's own transfer function;
+4. the checks (parts, margins, Ms, slew and swing, the ranges the plant accepts
+   and delivers), and at the corners of the model's 95 % intervals the worst
+   phase margin and overshoot;
+5. the deck with the model as native elements and a matched line for the dead
+   time (:func:`designer.pid.netlist.model_loop_deck`) and its simulation, judged
+   as for a Sallen-Key plant (:func:`designer.pid.verify.run_and_compare`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..core import opamps
+from ..core.checks import Check
+from ..core.errors import DesignError
+from ..core.units import format_eng
+from ..plant.bench import recommend_square_wave
+from ..spice.deck import SquareTest
+from . import blocks, model as M, rules
+from .delayloop import closed_loop_step, pid_tf, step_figures
+from .delaymargins import loop_margins
+from .netlist import controller_netlist, model_loop_deck
+from .process_result import LoopFigures, ProcessPidResult, RobustCheck, RuleRow
+from .result import Achieved, Waveforms
+from .spec import DEFAULT_MAX_MS, DEFAULT_MIN_GAIN_MARGIN_DB, DEFAULT_MIN_PHASE_MARGIN_DEG, PidSpec
+from .verify import explain, loop_metrics, run_and_compare
+
+#: the rules tried, in order, when none is named: the first that applies is the default
+DEFAULT_RULES = ("amigo", "simc", "imc")
+#: analytic samples over the rising half period (as for a Sallen-Key plant)
+POINTS = 20001
+#: the largest steady-state error of the leaky-integrator loop
+MAX_STEADY_STATE_ERROR = 0.02
+
+
+@dataclass(frozen=True)
+class Gains:
+    """The gains being built, how they were chosen, and the rule's record (or None)."""
+
+    method: str
+    kp: float
+    ti_s: float
+    td_s: float
+    rule: rules.RuleTuning | None = None
+
+
+def limits(spec: PidSpec) -> tuple:
+    """(min phase margin deg, min gain margin dB, max Ms) of the spec, defaults filled in."""
+    return (DEFAULT_MIN_PHASE_MARGIN_DEG if spec.min_phase_margin_deg is None else spec.min_phase_margin_deg,
+            DEFAULT_MIN_GAIN_MARGIN_DB if spec.min_gain_margin_db is None else spec.min_gain_margin_db,
+            DEFAULT_MAX_MS if spec.max_ms is None else spec.max_ms)
+
+
+def plant_of(model):
+    """The (num, den, theta_s) triple the loop functions take."""
+    return (np.asarray(model.num, float), np.asarray(model.den, float), float(model.theta_s))
+
+
+# ---- the loop's figures --------------------------------------------------------
+
+def ideal_crossover_hz(model, kp: float, ti_s: float, td_s: float) -> float:
+    """The gain crossover of the ideal PID (filter N = 10) around the model, or
+    the model's own corner 1/(2 pi time scale) when the loop never crosses."""
+    mg = loop_margins(plant_of(model), pid_tf(kp, ti_s, td_s, 10.0))
+    if math.isfinite(mg.crossover_hz):
+        return mg.crossover_hz
+    return 1.0 / (2 * math.pi * model.time_scale_s)
+
+
+def corner_frequencies(spec: PidSpec, fc_hz: float) -> tuple:
+    """(leak corner, derivative filter corner) in Hz: the spec's, else fc/100 and 10 fc."""
+    f_i = spec.f_integrator_hz if spec.f_integrator_hz is not None else fc_hz * blocks.F_INTEGRATOR_RATIO
+    f_d = spec.f_differentiator_hz if spec.f_differentiator_hz is not None else fc_hz * blocks.F_DIFFERENTIATOR_RATIO
+    return f_i, f_d
+
+
+def edged(t, x, edge_s: float) -> np.ndarray:
+    """The response to a reference ramping over ``edge_s`` from the response ``x``
+    to a step at 0 (an LTI loop: the moving average of the step response over the
+    edge, exactly, from its running integral)."""
+    if edge_s <= 0 or t.size < 2:
+        return x
+    h = t[1] - t[0]
+    cum = np.concatenate([[0.0], np.cumsum(0.5 * (x[1:] + x[:-1]) * h)])
+    earlier = np.interp(t - edge_s, t, cum, left=0.0)
+    # before the edge ends the ramp has covered only part of the step
+    return (cum - earlier) / edge_s
+
+
+def _stage_filter(num, den, t, x):
+    """x filtered by num/den on the uniform grid t (first-order hold: exact for
+    a piecewise-linear input)."""
+    from scipy.signal import cont2discrete, lfilter
+    num, den = np.atleast_1d(np.asarray(num, float)), np.atleast_1d(np.asarray(den, float))
+    if den.size == 1 or np.all(num[:-1] == 0) and den.size == 1:
+        return x * (num[-1] / den[-1])
+    bd, ad, _ = cont2discrete((num, den), t[1] - t[0], method="foh")
+    return lfilter(np.ravel(bd), np.ravel(ad), x)
+
+
+def stage_waves(parts, amp, t, r, y) -> dict:
+    """Every op-amp output of the controller for the reference ``r`` and the plant
+    output ``y`` (the controller is linear from them: each stage's transfer
+    function, :func:`designer.pid.model.stage_tfs`, on its inputs)."""
+    tfs = M.stage_tfs(parts, amp)
+    g_y, g_r = M.difference_weights(parts)
+    w = {"ve": _stage_filter(*tfs["ve"], t, g_y * y - g_r * r)}
+    for sig in ("vp", "vd", "vi"):
+        if sig in tfs:
+            w[sig] = _stage_filter(*tfs[sig], t, w["ve"])
+    sw = M.summer_weights(parts)
+    w["vs"] = _stage_filter(*tfs["vs"], t, sum(sw[k] * w[k] for k in sw))
+    w["u"] = _stage_filter(*tfs["u"], t, w["vs"])
+    w["y"] = y
+    return w
+
+
+def loop_dc_gain(model, controller) -> float:
+    """y/r at DC of the loop as built (an integrating plant: 1)."""
+    if model.integrating:
+        return 1.0
+    c0 = controller[0][-1] / controller[1][-1]
+    l0 = c0 * model.gain
+    return float(l0 / (1 + l0))
+
+
+#: the rule table's and the corners' simulation step (about 6e-4 of the step)
+TABLE_STEP_FRACTION = 0.05
+
+
+def loop_figures(model, controller, kp, ti_s, td_s, t, step_v=1.0) -> LoopFigures:
+    """Margins, Ms and the closed-loop step figures (IAE included) of ``controller``
+    around ``model`` on the grid ``t`` (from the step)."""
+    mg = loop_margins(plant_of(model), controller)
+    if not mg.stable:
+        return LoopFigures(kp, ti_s, td_s, mg, None, math.nan, math.nan)
+    out = closed_loop_step(plant_of(model), controller, t, r_step=step_v, step_fraction=TABLE_STEP_FRACTION)
+    return LoopFigures(kp, ti_s, td_s, mg, step_figures(t, out["y"], step_v), float(out["u"].min()),
+                       float(out["u"].max()))
+
+
+def built_controller(kp, ti_s, td_s, fc_hz, spec, amp):
+    """The controller as it will be built, before any part is rounded
+    (:func:`designer.pid.blocks.continuous_parts` with the spec's corners), as (num, den)."""
+    f_i, f_d = corner_frequencies(spec, fc_hz)
+    parts = blocks.continuous_parts(kp, ti_s, td_s, fc_hz, f_integrator_hz=f_i, f_differentiator_hz=f_d)
+    return M.controller_tf(parts, amp)
+
+
+def response_grid(model, fc_hz: float, points: int = 2001) -> np.ndarray:
+    """A grid long enough to see the loop settle: 40 crossover periods'
+    worth of 1/wc, or three open-loop settling times, whichever is longer."""
+    span = max(40.0 / (2 * math.pi * fc_hz), 3.0 * (model.settling_time_s if not model.integrating
+                                                   else model.time_scale_s + model.theta_s))
+    return np.linspace(0.0, span, points)
+
+
+# ---- the flow -------------------------------------------------------------------
+
+def choose_gains(spec: PidSpec, model, reduced, amp, table) -> tuple:
+    """(Gains, optimizer result or None, notes) for the spec."""
+    if spec.controller_parts is not None and spec.kp is None and spec.tuning is None:
+        p = spec.controller_parts
+        return Gains("as-built", p.kp, p.ti_s, p.td_s), None, []
+    if spec.kp is not None:
+        return Gains("explicit", spec.kp, spec.ti_s, spec.td_s), None, []
+    if spec.tuning == "optimize":
+        from .process_optimize import optimize_model_loop
+        opt = optimize_model_loop(spec, model, amp, table)
+        return (Gains("optimize", opt.kp, opt.ti_s, opt.td_s), opt, [opt.message])
+    if spec.tuning is not None:
+        rt = rules.tune_model(reduced, spec.tuning, tauc_s=spec.simc_tauc_s, lambda_s=spec.imc_lambda_s)
+        return Gains(rt.rule, rt.kp, rt.ti_s, rt.td_s, rt), None, []
+    for row in table:
+        if row.tuning is not None and row.rule in DEFAULT_RULES:
+            rt = row.tuning
+            return (Gains(rt.rule, rt.kp, rt.ti_s, rt.td_s, rt), None,
+                    [f"rule {rt.rule} (the first of {', '.join(DEFAULT_RULES)} that applies to this model; "
+                     "--tuning names another, --tuning optimize meets margins and Ms)"])
+    raise DesignError("no tuning rule applies to this model (" + "; ".join(r.reason for r in table if r.reason)
+                      + "); give --kp, --ti and --td", param="tuning")
+
+
+def rule_table(spec, model, reduced, amp) -> tuple:
+    """Every rule of :data:`designer.pid.rules.RULES` on the model: its gains and
+    the figures of its loop as it would be built (or why it does not apply)."""
+    rows = []
+    for r in rules.all_rules(reduced, tauc_s=spec.simc_tauc_s, lambda_s=spec.imc_lambda_s):
+        if isinstance(r, tuple):
+            rows.append(RuleRow(r[0], None, r[1], None))
+            continue
+        try:
+            fc = ideal_crossover_hz(model, r.kp, r.ti_s, r.td_s)
+            ctrl = built_controller(r.kp, r.ti_s, r.td_s, fc, spec, amp)
+            rows.append(RuleRow(r.rule, r, None, loop_figures(model, ctrl, r.kp, r.ti_s, r.td_s,
+                                                                response_grid(model, fc), spec.step_v)))
+        except DesignError as exc:   # gains outside what the circuit can be sized for
+            rows.append(RuleRow(r.rule, r, str(exc), None))
+    return tuple(rows)
+
+
+def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice") -> ProcessPidResult:
+    """Tune, size, check and (unless ``simulate`` is False) verify in SPICE a PID
+    for ``spec.process``, a plant known only as a model.
+
+    Parameters
+    ----------
+    spec : PidSpec
+        With a model plant (``spec.process`` not None).
+    simulate : bool
+        Run the closed-loop deck in ngspice.
+    simulator : str
+        ``"pyspice"`` or ``"ngspice-cli"``.
+
+    Returns
+    -------
+    ProcessPidResult
+    """
+    from .reduction import from_process
+    tick = time.perf_counter()
+    laps = {}
+
+    def lap(name):
+        nonlocal tick
+        now = time.perf_counter()
+        laps[name], tick = now - tick, now
+
+    model = spec.process
+    amp = opamps.get(spec.opamp)
+    reduced = from_process(model)
+    table = rule_table(spec, model, reduced, amp)
+    gains, opt, notes = choose_gains(spec, model, reduced, amp, table)
+    if gains.rule is not None:
+        notes = notes + list(gains.rule.notes)
+    lap("tuning_s")
+    fc = ideal_crossover_hz(model, gains.kp, gains.ti_s, gains.td_s)
+    f_i, f_d = corner_frequencies(spec, fc)
+    if spec.controller_parts is not None:
+        parts, sel = spec.controller_parts, None
+        targets = {"kp": gains.kp, "ti_s": gains.ti_s, "td_s": gains.td_s}
+    else:
+        sel = blocks.select_parts(gains.kp, gains.ti_s, gains.td_s, fc, r_series=spec.r_series,
+                                  c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max, c_min=spec.c_min,
+                                  c_max=spec.c_max, f_integrator_hz=f_i, f_differentiator_hz=f_d, tol=spec.tol)
+        parts, targets = sel.parts, sel.targets
+        notes += sel.notes + sizing_notes(sel, spec)
+    static = blocks.static_checks(parts, fc, amp.gbw_hz, targets, r_min=spec.r_min, r_max=spec.r_max,
+                                  c_min=spec.c_min, c_max=spec.c_max, tol=spec.tol, fn_name="fc")
+    if gains.method == "as-built":
+        static = [c for c in static if not c.id.endswith("_accuracy") and not c.id.endswith("_bounds")]
+    lap("sizing_s")
+    loop = analyse(spec, model, amp, parts, gains, fc, simulate)
+    robust = robust_check(spec, model, loop.controller, loop.t, gains) if model.ci95 else None
+    checks = tuple(static) + loop.checks + (robust.checks() if robust is not None else ())
+    res = ProcessPidResult(
+        spec=spec, model=model, reduced=reduced, opamp=amp, method=gains.method, kp=gains.kp, ti_s=gains.ti_s,
+        td_s=gains.td_s, rule=gains.rule, rules=table, optimizer=opt, parts=parts, selection=sel,
+        achieved=Achieved.of(parts, amp, gains), fc_ref_hz=fc, checks=checks, margins=loop.margins,
+        ideal_margins=loop.ideal_margins, analytic=loop.figures, stable=loop.margins.stable, dc_gain=loop.dc,
+        levels=loop.levels, robust=robust, test=loop.test, expected_final_v=loop.expected, deck=loop.deck,
+        waveforms=loop.waves, notes=list(notes), package=spec.package, limits=limits(spec))
+    lap("analytic_s")
+    if simulate:
+        run_spice(res, simulator)
+        lap("simulation_s")
+    else:
+        res.notes.append("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only")
+    res.timings = laps
+    return res
+
+
+def sizing_notes(sel, spec) -> list:
+    """One line per part the sizing pinned at a bound, saying which bound to move."""
+    out = []
+    p, t = sel.parts, sel.targets
+    f_i = t.get("f_integrator_hz")
+    if f_i and p.f_integrator_hz > 1.5 * f_i:
+        need = 1 / (2 * math.pi * f_i * p.c4)
+        out.append(f"the integrator leak R13 would need {format_eng(need, 'Ohm')} for a {format_eng(f_i, 'Hz')} "
+                   f"corner with C4 = {format_eng(p.c4, 'F')} and is {format_eng(p.r13, 'Ohm')}: raise --r-max "
+                   f"(now {format_eng(spec.r_max, 'Ohm')}) or --c-max (now {format_eng(spec.c_max, 'F')}, e.g. "
+                   "--c-max 100u)")
+    for key, label, part in (("ti", "Ti = R8 R14 C4/R6", "C4"), ("td", "Td = R6 R11 C3/R7", "C3")):
+        err = sel.errors_pct.get(key)
+        if err is not None and abs(err) > 100 * spec.tol:
+            out.append(f"{label} is {err:+.3g} % off its target: its RC is beyond the part bounds; "
+                       f"{part} and its resistors are limited by --c-max {format_eng(spec.c_max, 'F')} and "
+                       f"--r-max {format_eng(spec.r_max, 'Ohm')}: widen them (e.g. --c-max 100u)")
+    return out
+
+
+@dataclass(frozen=True)
+class _Loop:
+    controller: tuple
+    margins: object
+    ideal_margins: object
+    figures: object
+    dc: float
+    levels: dict
+    checks: tuple
+    test: SquareTest
+    expected: float
+    deck: str
+    t: np.ndarray
+    waves: Waveforms
+
+
+def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
+    """The loop as built around the model: margins, time response, every stage, checks, deck."""
+    from .design import _named, stage_checks
+    ctrl = M.controller_tf(parts, amp)
+    plant = plant_of(model)
+    mg = loop_margins(plant, ctrl)
+    ideal_mg = loop_margins(plant, pid_tf(gains.kp, gains.ti_s, gains.td_s))
+    dc = loop_dc_gain(model, ctrl)
+    expected = spec.step_v * dc
+    # a first look on a long grid, for the settling time that sizes the square wave
+    t_long = response_grid(model, mg.crossover_hz if math.isfinite(mg.crossover_hz) else fc, 4001)
+    ts = None
+    if mg.stable:
+        y_long = closed_loop_step(plant, ctrl, t_long, 1.0, step_fraction=TABLE_STEP_FRACTION)["y"]
+        ts = loop_metrics(t_long, y_long, dc).settling_time_s
+    if ts is None or not math.isfinite(ts):
+        ts = t_long[-1] / 2
+    f_fast = max(fc, mg.crossover_hz if math.isfinite(mg.crossover_hz) else 0.0)
+    time_scale = 1.0 / (2 * math.pi * f_fast)
+    sq = recommend_square_wave(ts, spec.step_v, spec.square_hz, time_scale_s=time_scale)
+    test = SquareTest(spec.step_v, sq.frequency_hz, sq.delay_s, spec.edge_s, time_scale_s=time_scale)
+    if simulate:
+        test.check_simulable()
+    t = np.linspace(0.0, min(test.half_period_s, 10 * max(t_long[-1], ts)), POINTS)
+    r = M.reference(t, spec.step_v, 0.0, spec.edge_s)
+    rails = 2 * max(abs(amp.vcc), abs(amp.vee))
+    if mg.stable:
+        step = closed_loop_step(plant, ctrl, t, spec.step_v)
+        y = edged(t, step["y"], spec.edge_s)
+        waves = stage_waves(parts, amp, t, r, y)
+    else:
+        waves = {k: np.full(t.size, np.nan) for k in M.SIGNALS if k != "vd" or parts.has_derivative}
+    ideal = pid_tf(gains.kp, gains.ti_s, gains.td_s, 10.0 if gains.td_s > 0 else None)
+    y_ideal = (edged(t, closed_loop_step(plant, ideal, t, spec.step_v)["y"], spec.edge_s)
+               if loop_margins(plant, ideal).stable else np.full(t.size, np.nan))
+    y_open = edged(t, spec.step_v * model.step(t), spec.edge_s)
+    figures = loop_metrics(t, waves["y"], expected)
+    rise = figures.rise_time_s if math.isfinite(figures.rise_time_s) and figures.rise_time_s else t[-1] / 20
+    names = _designators_model(parts, amp, spec.package)
+    levels = M.waveform_limits({k: v for k, v in waves.items() if k != "y"}, t, amp,
+                               M.SLEW_DELAY_FRACTION * rise) if mg.stable else {}
+    levels = _named(levels, names)
+    checks = loop_checks(spec, mg, dc, amp, levels, waves, t, parts) + stage_checks(
+        mg.stable, levels, amp, spec.step_v, rise, parts, names.get)
+    title = (f"PID closed loop Kp={parts.kp:.4g} Ti={parts.ti_s:.4g}s Td={parts.td_s:.4g}s "
+             f"plant {model.text()} op-amp={amp.name}")
+    deck = model_loop_deck(parts, model, amp, test, title, expected)
+    lo, hi = min(fc, mg.crossover_hz if math.isfinite(mg.crossover_hz) else fc) / 100, 100 * f_fast
+    bode_w = 2 * np.pi * np.logspace(np.log10(lo), np.log10(hi), 2000)
+    from .delaymargins import loop_response
+    wf = Waveforms(t, r, waves, y_ideal, y_open, bode_w, loop_response(plant, ctrl, bode_w), t_long,
+                   model.step(t_long), None)
+    return _Loop(ctrl, mg, ideal_mg, figures, dc, levels, tuple(checks), test, expected, deck, t, wf)
+
+
+def _designators_model(parts, amp, package) -> dict:
+    """The deck's op-amp -> its designator in ``package`` (the controller's board)."""
+    from ..spice.deck import board
+    bd = board(controller_netlist(parts), amp, package)
+    return {a.ref: u.designator for a, u in zip(bd.netlist.amps, bd.units)}
+
+
+def loop_checks(spec, mg, dc, amp, levels, waves, t, parts) -> list:
+    """Stability, phase and gain margins, Ms, steady-state error and the plant's ranges."""
+    pm_min, gm_min, ms_max = limits(spec)
+    out = [Check("closed_loop_stable", bool(mg.stable),
+                 "no closed-loop root in the right half plane (argument principle, exact dead time)"
+                 if mg.stable else f"{mg.rhp_roots:g} closed-loop roots in the right half plane: the loop "
+                 "oscillates or runs to a rail")]
+    pm = mg.phase_margin_deg
+    out.append(Check("phase_margin", bool(math.isfinite(pm) and pm >= pm_min),
+                     f"{pm:.3g} deg at {format_eng(mg.crossover_hz, 'Hz')} with the op-amp poles and the dead "
+                     f"time (want >= {pm_min:g} deg; delay margin {format_eng(mg.delay_margin_s, 's')})"
+                     if math.isfinite(pm) else "the loop gain never crosses 1"))
+    gm = mg.gain_margin_db
+    out.append(Check("gain_margin", bool(gm >= gm_min),
+                     f"{gm:.3g} dB at {format_eng(mg.phase_crossover_hz, 'Hz')} (want >= {gm_min:g} dB)"
+                     if math.isfinite(gm) else f"the phase never reaches -180 deg (want >= {gm_min:g} dB)"))
+    out.append(Check("max_sensitivity", bool(mg.ms <= ms_max),
+                     f"Ms = {mg.ms:.3g} at {format_eng(mg.ms_hz, 'Hz')} (want <= {ms_max:g}; 1/Ms = "
+                     f"{1 / mg.ms:.3g} is the distance of the Nyquist curve from -1)"))
+    if math.isfinite(dc):
+        e = 1 - dc
+        out.append(Check("steady_state_error", bool(abs(e) <= MAX_STEADY_STATE_ERROR),
+                         f"{100 * e:.3g} % of the step (the integrator leaks through R13; "
+                         f"want <= {100 * MAX_STEADY_STATE_ERROR:g} %)"))
+    for key, sig, what in (("plant_input", "u", "input (the controller's output u)"),
+                           ("plant_output", "y", "output y")):
+        rng = getattr(spec, key)
+        if rng is None or not mg.stable:
+            continue
+        v = np.asarray(waves[sig], float)
+        vf = float(v[-1])
+        vmax, vmin = max(float(v.max()), vf - float(v.min())), min(float(v.min()), vf - float(v.max()))
+        ok = vmin >= rng[0] - 1e-9 and vmax <= rng[1] + 1e-9
+        out.append(Check(f"{key}_range", bool(ok),
+                         f"the plant's {what} spans {vmin:.3g} V to {vmax:.3g} V over the square wave "
+                         f"(rising and falling edge); it accepts {rng[0]:g} V to {rng[1]:g} V"
+                         + ("" if ok else ": lower --step or the gains (a softer rule, --tuning optimize)")))
+    return out
+
+
+def robust_check(spec, model, controller, t, gains) -> RobustCheck:
+    """The loop as built at every corner of the model's 95 % box: the worst phase
+    margin, gain margin, Ms and overshoot, and the corner where each is reached."""
+    pm_min, gm_min, ms_max = limits(spec)
+    rows = []
+    for corner in model.corners():
+        fig = loop_figures(corner, controller, gains.kp, gains.ti_s, gains.td_s, t[:: max(1, t.size // 4000)],
+                           spec.step_v)
+        rows.append((corner.source.rsplit("corner ", 1)[-1], fig))
+    return RobustCheck(tuple(rows), pm_min, gm_min, ms_max)
+
+
+def run_spice(res: ProcessPidResult, simulator: str) -> None:
+    """Simulate the deck, compare with the analytic loop; fills ``spice``,
+    ``verdict`` and the notes."""
+    from .design import _named
+    w = res.waveforms
+    sp = run_and_compare(res.deck, simulator, w.t, res.test.delay_s, w.analytic["y"], res.test.amplitude_v,
+                         res.expected_final_v, res.opamp)
+    stages = {k: v for k, v in sp.stages.items() if k != "plant"}   # y is the model's, not an op-amp's
+    res.spice = sp = replace(sp, stages=_named(stages, _designators_model(res.parts, res.opamp, res.package)))
+    res.verdict = explain(sp, res.analytic, res.checks)
+    sat = [f"{v.opamp} {role}" for role, v in sp.stages.items() if v.saturated]
+    if sat:
+        res.notes.append("SPICE: op-amp output pinned at a rail: " + ", ".join(sat))
+    if sp.oscillation.oscillating:
+        res.notes.append(f"SPICE: the loop is still oscillating at the end of the half period "
+                         f"({sp.oscillation.tail_p2p_v:.3g} V peak to peak)")
+    if res.verdict.unexplained:
+        res.notes.append("SPICE and the analytic loop disagree and no check explains it (please report this)")
