@@ -290,8 +290,33 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
         lap("simulation_s")
     else:
         res.notes.append("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only")
+    res.scope = model_loop_scope(res)
     res.timings = laps
     return res
+
+
+def model_loop_scope(res: ProcessPidResult):
+    """The bench scope for the loop (as :func:`designer.pid.design.loop_scope`): CH1
+    the reference, CH2 the plant output y and then each op-amp output in turn,
+    volts/div fitting what SPICE (else the analytic loop) shows there, 1.2 settling
+    times on screen (at most the half period)."""
+    from ..plant.bench import channel, scope_setup
+    test, amp = res.test, res.opamp
+    rails = (amp.vout_min, amp.vout_max) if not amp.ideal else (amp.vee, amp.vcc)
+    y = res.waveforms.analytic["y"]
+    if res.spice is not None and "y" in res.spice.waves:
+        y = res.spice.waves["y"]
+    y_lo, y_hi = (float(np.nanmin(y)), float(np.nanmax(y))) if np.any(np.isfinite(y)) else rails
+    chans = [channel("CH1", "reference r", 0.0, test.amplitude_v), channel("CH2", "y", y_lo, y_hi)]
+    for ref, role, sig in M.OPAMP_OUTPUTS:
+        got = (res.spice.stages.get(role) if res.spice is not None else None) or res.levels.get(role)
+        if got is not None:
+            chans.append(channel("CH2", sig, got.v_min, got.v_max))
+        elif role != "plant" and (sig != "vd" or res.parts.has_derivative):
+            chans.append(channel("CH2", sig, *rails))
+    ts = res.spice.figures.settling_time_s if res.spice is not None else res.analytic.settling_time_s
+    window = min(1.2 * ts, test.half_period_s) if ts is not None and math.isfinite(ts) else test.half_period_s
+    return scope_setup(window, test.amplitude_v / 2, chans)
 
 
 def sizing_notes(sel, spec) -> list:

@@ -150,6 +150,7 @@ class ProcessPidResult:
     limits: tuple = (45.0, 6.0, 1.7)    #: (min PM deg, min GM dB, max Ms)
     spice: object = None
     verdict: object = None
+    scope: object = None                #: designer.plant.bench.ScopeSetup of the bench test (CH2 per node)
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
@@ -207,6 +208,7 @@ class ProcessPidResult:
                             "expected_final_v": self.expected_final_v},
             "notes": self.notes,
             "simulator": self.simulator,
+            "scope": None if self.scope is None else self.scope.to_dict(),
             "files": self.files,
         }
         return json_safe(out)
