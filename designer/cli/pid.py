@@ -22,6 +22,20 @@ EPILOG = """examples:
         gains that keep every LM741 out of saturation and within its slew rate for a 1 V step
   design-pid --plant-r1 820 --plant-r2 1k --plant-c1 10n --plant-c2 220n --tuning amigo --opamp TL072
   design-pid --plant-json reports/plant_fc3500_z0.2/result.json --tuning chr0 --json --no-sim
+  design-pid --plant-tf "K=2 tau=1m theta=200u" --tuning simc
+        a plant known only as a model (FOPDT), SIMC's PI/PID, the model in the SPICE deck
+  design-pid --plant-model models.json --tuning optimize --robust
+        the best model of an `identify --json` output; gains minimising IAE with PM >= 45 deg, GM >= 6 dB,
+        Ms <= 1.7 at every corner of the identified 95 % intervals
+  design-pid --plant-capture motor.csv --plant-input 0:10 --tuning amigo
+        identify the capture first (as `identify` does, same options), then design for its best model
+
+Model plants (--plant-tf, --plant-model, --plant-capture): {forms}.
+Rules on the model each intends: zn, cohen-coon, chr0, chr20 (on the tangent of the model's own step),
+amigo, simc (--simc-tauc, default theta; SOPDT form on an SOPDT, its series PID converted to Kp, Ti, Td),
+imc (--imc-lambda); default: the first of amigo, simc, imc that applies. Every rule is listed on the sheet
+with its margins, Ms, IAE and overshoot. The deck puts the model in ngspice as native integrators and a
+matched transmission line for the dead time; the analytic loop uses the exact delay.
 
 The controller (seed 001, Fig. 66): U1 difference amp (R15-R18), U2 unity inverter (R9, R10),
 U3 differentiator (R12 + C3 in, R11 feedback), U4 integrator (R14 in, R13 || C4 feedback),
@@ -43,15 +57,18 @@ def _r(key: str) -> str:
 
 
 def _parser():
+    from ..core.process_text import FORMS_TEXT
     p = common.command_parser(
         "design-pid",
         "Tune an analog PID controller for a Sallen-Key plant, size its six op-amp stages from E-series parts, "
         "check them against the op-amp's bandwidth, slew rate and swing, and verify the whole closed loop "
-        "(controller + plant circuit) in ngspice.", EPILOG)
+        "(controller + plant circuit) in ngspice; or for a plant known only as a model (typed, identified "
+        "from a capture, or an identify result).", EPILOG.replace("{forms}", FORMS_TEXT))
     _add_plant_options(p)
     t = p.add_argument_group("tuning")
     t.add_argument("--tuning", metavar="RULE",
-                   help="zn (default), cohen-coon, chr0, chr20, amigo, simc, optimize")
+                   help="zn (default for a Sallen-Key plant), cohen-coon, chr0, chr20, amigo, simc, optimize; "
+                        "for a model plant also imc (default: the first of amigo, simc, imc that applies)")
     t.add_argument("--kp", help=f"explicit proportional gain {_r('kp')} (with --ti and --td)")
     t.add_argument("--ti", metavar="S", help=f"explicit integral time {_r('ti_s')} (e.g. 43.215u)")
     t.add_argument("--td", metavar="S", help=f"explicit derivative time {_r('td_s')}; 0 for a PI")
@@ -59,6 +76,7 @@ def _parser():
                    help=f"--tuning optimize: largest overshoot {_r('target_overshoot_pct')}")
     t.add_argument("--target-settling", metavar="S",
                    help=f"--tuning optimize: largest 2 %% settling time {_r('target_settling_s')}")
+    _add_model_tuning_options(t)
     t.add_argument("--seed-parts", action="store_true",
                    help="use the seed's own controller parts (V.13, difference amp untrimmed) instead of sizing")
     s = p.add_argument_group("parts")
@@ -68,13 +86,44 @@ def _parser():
     s.add_argument("--f-differentiator", metavar="HZ",
                    help=f"derivative filter corner 1/(2 pi R12 C3) {_r('f_differentiator_hz')} (default 10 fn)")
     _add_signal_options(p)
+    _add_capture_options(p)
     add_output_options(p, "pid_<tuning>_<opamp>_fn<fn>_z<zeta>")
     return p
 
 
+def _add_model_tuning_options(t):
+    """Tuning options of a model plant (design-pid and analyze-pid)."""
+    t.add_argument("--simc-tauc", metavar="S", help=f"SIMC's closed-loop time constant tau_c {_r('simc_tauc_s')} "
+                                                     "(default theta, the dead time)")
+    t.add_argument("--imc-lambda", metavar="S", help=f"IMC's closed-loop time constant lambda {_r('imc_lambda_s')} "
+                                                      "(default max(0.25 theta, 0.2 tau))")
+    t.add_argument("--min-pm", metavar="DEG", help=f"model plant: smallest phase margin {_r('min_phase_margin_deg')} "
+                                                    "(default 45; the check, and optimize's constraint)")
+    t.add_argument("--min-gm", metavar="DB", help=f"model plant: smallest gain margin {_r('min_gain_margin_db')} "
+                                                   "(default 6)")
+    t.add_argument("--max-ms", metavar="MS", help=f"model plant: largest maximum sensitivity Ms {_r('max_ms')} "
+                                                   "(default 1.7)")
+    t.add_argument("--robust", action="store_true",
+                   help="model plant with 95 %% intervals (identify's least-squares fits): optimize keeps its "
+                        "constraints at every corner of the interval box")
+
+
+def _add_capture_options(p):
+    """identify's options, for --plant-capture."""
+    g = p.add_argument_group("capture (with --plant-capture; as identify's options, see identify --help)")
+    g.add_argument("--step-time", metavar="T", help="when the input stepped, in seconds")
+    g.add_argument("--step-amplitude", metavar="A", help="input step size in input units (either sign)")
+    g.add_argument("--window", nargs=2, metavar=("T0", "T1"), help="use only the samples from T0 to T1 seconds")
+    g.add_argument("--format", metavar="LAYOUT", default="auto", help="the capture's layout (default auto)")
+    g.add_argument("--input-column", metavar="NAME|N", help="input column by name or number; 'none' ignores it")
+    g.add_argument("--output-column", metavar="NAME|N", help="output column by name or number")
+    g.add_argument("--methods", nargs="+", metavar="NAME", help="only these identification methods")
+    g.add_argument("--no-refine", action="store_true", help="skip the least-squares fits (then no 95 %% intervals)")
+
+
 def _add_plant_options(p):
-    """The plant, one of three ways (design-pid and analyze-pid)."""
-    g = p.add_argument_group("plant (one of three ways)")
+    """The plant, one of the ways (design-pid and analyze-pid)."""
+    g = p.add_argument_group("plant (one way: a Sallen-Key circuit, or a model)")
     g.add_argument("--plant-fc", metavar="HZ",
                    help=f"design the plant as design-plant does: natural frequency {_r('fc_hz')}")
     g.add_argument("--plant-zeta", metavar="Z", help=f"... and damping ratio {_r('zeta')}")
@@ -89,6 +138,20 @@ def _add_plant_options(p):
     g.add_argument("--plant-json", metavar="FILE",
                    help="a result.json written by design-plant or analyze-plant (its 'built' parts, checked "
                         "against the same ranges)")
+    g.add_argument("--plant-tf", metavar="MODEL",
+                   help="a model typed by hand, e.g. \"K=2 tau=1m theta=200u\" (forms below)")
+    g.add_argument("--plant-model", metavar="FILE",
+                   help="an identify or identify-freq --json output (its best valid model), or a design-plant "
+                        "result.json read as its model")
+    g.add_argument("--plant-method", metavar="NAME",
+                   help="with --plant-model/--plant-capture: this method's model instead of the best "
+                        "(e.g. alfaro, least-squares:overdamped)")
+    g.add_argument("--plant-capture", metavar="CSV",
+                   help="a step capture (any layout identify reads) or frequency table: identified first")
+    g.add_argument("--plant-input", metavar="LO:HI",
+                   help=f"model plant: the input range the plant accepts, volts, each {_r('plant_voltage_v')} "
+                        "(e.g. 0:10, an actuator's); the controller's output is checked against it")
+    g.add_argument("--plant-output", metavar="LO:HI", help="model plant: the output range it can deliver, volts")
 
 
 def _add_signal_options(p):
@@ -109,18 +172,62 @@ def _add_signal_options(p):
 
 
 #: the spec's parameters set from options of the same meaning (their options: FLAGS)
+MODEL_PARAMS = ("plant_tf", "plant_model", "plant_method", "plant_input", "plant_output", "simc_tauc_s",
+                "imc_lambda_s", "min_phase_margin_deg", "min_gain_margin_db", "max_ms", "robust")
 SPEC_PARAMS = ("plant_fc_hz", "plant_zeta", "plant_json", "tuning", "kp", "ti_s", "td_s", "opamp", "step_v", "edge_s",
                "r_series", "c_series", "r_min", "r_max", "c_min", "c_max", "target_overshoot_pct",
-               "target_settling_s", "f_integrator_hz", "f_differentiator_hz", "square_hz")
+               "target_settling_s", "f_integrator_hz", "f_differentiator_hz", "square_hz") + MODEL_PARAMS
+
+
+def _typed(args, params) -> dict:
+    return {p: getattr(args, common.FLAGS[p][2:].replace("-", "_")) for p in params}
 
 
 def _build_spec(args):
     """The spec from the options as typed: the spec parses and checks them (the one validation)."""
     from ..pid.blocks import seed_parts
     from ..pid.spec import PidSpec
-    typed = {p: getattr(args, common.FLAGS[p][2:].replace("-", "_")) for p in SPEC_PARAMS}
+    typed = _typed(args, SPEC_PARAMS)
+    process = _captured_model(args, typed)
     return PidSpec(plant_parts=_plant_parts(args), controller_parts=seed_parts() if args.seed_parts else None,
-                   package=args.package, **typed)
+                   package=args.package, plant_process=process, **typed)
+
+
+#: identify's options that --plant-capture passes on: (argparse dest, flag, value when not given)
+CAPTURE_OPTIONS = (("step_time", "--step-time", None), ("step_amplitude", "--step-amplitude", None),
+                   ("window", "--window", None), ("format", "--format", "auto"),
+                   ("input_column", "--input-column", None), ("output_column", "--output-column", None),
+                   ("methods", "--methods", None), ("no_refine", "--no-refine", False))
+
+
+def _captured_model(args, typed):
+    """--plant-capture: the capture identified as ``identify`` does (a frequency
+    table as ``identify-freq``), its best valid model (or --plant-method's); None
+    without it. identify's options without --plant-capture are refused."""
+    given = [flag for dest, flag, unset in CAPTURE_OPTIONS if getattr(args, dest) != unset]
+    if args.plant_capture is None:
+        if given:
+            raise DesignError(f"{given[0]} is an option of --plant-capture (identify's), and no capture is given")
+        return None
+    import argparse
+
+    from ..core.fileio import shown
+    from ..pid.plant_source import model_from_result
+    from . import identify as ident
+    fmt = str(args.format).strip().lower()
+    if fmt not in ("auto",) + ident.FORMATS:
+        raise DesignError(f"--format {fmt!r} unknown; allowed: auto, {', '.join(ident.FORMATS)}")
+    ns = argparse.Namespace(capture=args.plant_capture, step_time=args.step_time,
+                            step_amplitude=args.step_amplitude, window=args.window, format=fmt,
+                            input_column=args.input_column, output_column=args.output_column, methods=args.methods,
+                            no_refine=args.no_refine, against=None, plot=None, json=True)
+    header = ident.frequency_table_header(args.plant_capture)
+    result = ident.identify_capture(ns) if header is None else ident.identify_frequency_table(ns, header)
+    method = typed.pop("plant_method")
+    try:
+        return model_from_result(result.to_dict(), method, name=f"--plant-capture {shown(args.plant_capture)}")
+    except DesignError as exc:
+        raise DesignError(str(exc).replace("plant model --plant-capture", "--plant-capture")) from None
 
 
 def _plant_parts(args):
@@ -141,10 +248,20 @@ def _default_name(spec, fn_hz, zeta) -> str:
     return f"pid_{spec.method}_{spec.opamp.lower()}_fn{fn_hz:.5g}_z{zeta:.3g}{extra}"
 
 
+def _model_name(spec, method: str) -> str:
+    """The default design name of a model plant: ``pid_<rule>_<opamp>_<kind>``."""
+    return f"pid_{method}_{spec.opamp.lower()}_{spec.process.kind}"
+
+
 def _run(args) -> int:
     from ..pid.design import design_pid
     from ..pid.report import summary_text, write_outputs
     spec = _build_spec(args)
+    if spec.process is not None:
+        from ..pid.process_report import summary_text as model_text, write_outputs as model_write
+        common.check_output(args, args.name if args.name is not None else "pid_model")
+        result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
+        return emit(result, args, args.name or _model_name(spec, result.method), model_write, model_text)
     # the default name needs the plant as built; its fixed start stands in for it in the check
     common.check_output(args, args.name if args.name is not None else f"pid_{spec.method}")
     result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
@@ -190,7 +307,9 @@ def _analyze_parser():
     t.add_argument("--kp", help=f"proportional gain {_r('kp')}")
     t.add_argument("--ti", metavar="S", help=f"integral time {_r('ti_s')}")
     t.add_argument("--td", metavar="S", help=f"derivative time {_r('td_s')}; 0 for a PI")
+    _add_model_tuning_options(t)
     _add_signal_options(p)
+    _add_capture_options(p)
     add_output_options(p, "pid_as-built_<opamp>_fn<fn>_z<zeta>")
     return p
 
@@ -213,8 +332,14 @@ def _analyze(args) -> int:
         raise DesignError("the controller's parts are needed: --r3 .. --r18, --c3, --c4 (or --parts-json FILE)")
     else:
         parts = PidParts(**typed)
+    typed = _typed(args, ANALYZE_PARAMS)
     spec = PidSpec(plant_parts=_plant_parts(args), controller_parts=parts, package=args.package,
-                   **{p: getattr(args, common.FLAGS[p][2:].replace("-", "_")) for p in ANALYZE_PARAMS})
+                   plant_process=_captured_model(args, typed), **typed)
+    if spec.process is not None:
+        from ..pid.process_report import summary_text as model_text, write_outputs as model_write
+        common.check_output(args, args.name if args.name is not None else "pid_as-built")
+        result = analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
+        return emit(result, args, args.name or _model_name(spec, result.method), model_write, model_text)
     common.check_output(args, args.name if args.name is not None else "pid_as-built")
     result = analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
     name = args.name or (f"pid_{result.tuning.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}"
@@ -224,7 +349,7 @@ def _analyze(args) -> int:
 
 #: the spec's parameters analyze-pid sets from options of the same meaning
 ANALYZE_PARAMS = ("plant_fc_hz", "plant_zeta", "plant_json", "kp", "ti_s", "td_s", "opamp", "step_v", "edge_s",
-                  "square_hz")
+                  "square_hz") + MODEL_PARAMS
 
 
 def analyze_pid_main(argv=None) -> int:

@@ -116,7 +116,13 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice")
     Returns
     -------
     PidResult
+        Or, for a plant given as a model (``spec.process``), the
+        :class:`~designer.pid.process_result.ProcessPidResult` of
+        :func:`designer.pid.process_loop.design_model_pid`.
     """
+    if spec.process is not None:
+        from .process_loop import design_model_pid
+        return design_model_pid(spec, simulate, simulator)
     return _run(spec, simulate, simulator, as_built=False)
 
 
@@ -137,6 +143,9 @@ def analyze_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice"
     """
     if spec.controller_parts is None:
         raise ParamError("analyze_pid needs the controller's parts ({controller_parts})", ("controller_parts",))
+    if spec.process is not None:
+        from .process_loop import design_model_pid
+        return design_model_pid(spec, simulate, simulator)
     return _run(spec, simulate, simulator, as_built=spec.kp is None and spec.tuning is None)
 
 

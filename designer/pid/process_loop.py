@@ -54,6 +54,8 @@ from .verify import explain, loop_metrics, run_and_compare
 DEFAULT_RULES = ("amigo", "simc", "imc")
 #: analytic samples over the rising half period (as for a Sallen-Key plant)
 POINTS = 20001
+#: the largest capacitor a sizing message suggests (a 1 mF film capacitor is already a brick)
+PRACTICAL_C_MAX_F = 1e-3
 #: the largest steady-state error of the leaky-integrator loop
 MAX_STEADY_STATE_ERROR = 0.02
 
@@ -151,6 +153,26 @@ def loop_dc_gain(model, controller) -> float:
 
 #: the rule table's and the corners' simulation step (about 6e-4 of the step)
 TABLE_STEP_FRACTION = 0.05
+#: the time simulations leave out the controller's poles and zeros this far above the loop's
+#: crossover (an op-amp pole at 1000 wc costs 0.06 deg there): a 100 s plant's controller spans
+#: 1e-4 to 1e6 rad/s, and its companion form (coefficients to 1e39) cannot be integrated
+FAR_FACTOR = 1e3
+
+
+def simulation_controller(controller, fc_hz: float):
+    """``controller`` without its poles and zeros above :data:`FAR_FACTOR` x the
+    crossover ``fc_hz``, its gain matched at the crossover (for the time
+    simulations; the margins use the whole controller)."""
+    num, den = (np.atleast_1d(np.asarray(c, float)) for c in controller)
+    w_keep = FAR_FACTOR * 2 * math.pi * fc_hz
+    z, p = np.roots(num), np.roots(den)
+    zk, pk = z[np.abs(z) <= w_keep], p[np.abs(p) <= w_keep]
+    if zk.size == z.size and pk.size == p.size:
+        return num, den
+    s = 2j * math.pi * fc_hz
+    n_red, d_red = np.real(np.poly(zk)), np.real(np.poly(pk))
+    k = np.polyval(num, s) / np.polyval(den, s) / (np.polyval(n_red, s) / np.polyval(d_red, s))
+    return float(k.real) * n_red, d_red
 
 
 def loop_figures(model, controller, kp, ti_s, td_s, t, step_v=1.0) -> LoopFigures:
@@ -159,7 +181,9 @@ def loop_figures(model, controller, kp, ti_s, td_s, t, step_v=1.0) -> LoopFigure
     mg = loop_margins(plant_of(model), controller)
     if not mg.stable:
         return LoopFigures(kp, ti_s, td_s, mg, None, math.nan, math.nan)
-    out = closed_loop_step(plant_of(model), controller, t, r_step=step_v, step_fraction=TABLE_STEP_FRACTION)
+    fc = mg.crossover_hz if math.isfinite(mg.crossover_hz) else 1.0 / (2 * math.pi * model.time_scale_s)
+    out = closed_loop_step(plant_of(model), simulation_controller(controller, fc), t, r_step=step_v,
+                           step_fraction=TABLE_STEP_FRACTION)
     return LoopFigures(kp, ti_s, td_s, mg, step_figures(t, out["y"], step_v), float(out["u"].min()),
                        float(out["u"].max()))
 
@@ -326,10 +350,18 @@ def sizing_notes(sel, spec) -> list:
     f_i = t.get("f_integrator_hz")
     if f_i and p.f_integrator_hz > 1.5 * f_i:
         need = 1 / (2 * math.pi * f_i * p.c4)
+        r_top = min(spec.r_max, blocks.R_CORNER_MAX)
+        c_need = 1 / (2 * math.pi * f_i * r_top)
+        if c_need > PRACTICAL_C_MAX_F:
+            fix = (f"no practical C4 reaches it (it would take {format_eng(c_need, 'F')}): this loop is too slow for "
+                   f"an analog leak at fc/100; accept a higher corner with --f-integrator (the steady-state error "
+                   "grows) or keep the integral action digital")
+        else:
+            fix = (f"give C4 room with --c-max {format_eng(c_need, '', 2).replace(' ', '')} (now "
+                   f"{format_eng(spec.c_max, 'F')}), or accept a higher leak corner with --f-integrator")
         out.append(f"the integrator leak R13 would need {format_eng(need, 'Ohm')} for a {format_eng(f_i, 'Hz')} "
-                   f"corner with C4 = {format_eng(p.c4, 'F')} and is {format_eng(p.r13, 'Ohm')}: raise --r-max "
-                   f"(now {format_eng(spec.r_max, 'Ohm')}) or --c-max (now {format_eng(spec.c_max, 'F')}, e.g. "
-                   "--c-max 100u)")
+                   f"corner with C4 = {format_eng(p.c4, 'F')}, above its {format_eng(r_top, 'Ohm')} limit, so the "
+                   f"corner is {format_eng(p.f_integrator_hz, 'Hz')}: {fix}")
     for key, label, part in (("ti", "Ti = R8 R14 C4/R6", "C4"), ("td", "Td = R6 R11 C3/R7", "C3")):
         err = sel.errors_pct.get(key)
         if err is not None and abs(err) > 100 * spec.tol:
@@ -364,11 +396,12 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
     ideal_mg = loop_margins(plant, pid_tf(gains.kp, gains.ti_s, gains.td_s))
     dc = loop_dc_gain(model, ctrl)
     expected = spec.step_v * dc
+    sim_ctrl = simulation_controller(ctrl, max(fc, mg.crossover_hz if math.isfinite(mg.crossover_hz) else fc))
     # a first look on a long grid, for the settling time that sizes the square wave
     t_long = response_grid(model, mg.crossover_hz if math.isfinite(mg.crossover_hz) else fc, 4001)
     ts = None
     if mg.stable:
-        y_long = closed_loop_step(plant, ctrl, t_long, 1.0, step_fraction=TABLE_STEP_FRACTION)["y"]
+        y_long = closed_loop_step(plant, sim_ctrl, t_long, 1.0, step_fraction=TABLE_STEP_FRACTION)["y"]
         ts = loop_metrics(t_long, y_long, dc).settling_time_s
     if ts is None or not math.isfinite(ts):
         ts = t_long[-1] / 2
@@ -382,7 +415,7 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
     r = M.reference(t, spec.step_v, 0.0, spec.edge_s)
     rails = 2 * max(abs(amp.vcc), abs(amp.vee))
     if mg.stable:
-        step = closed_loop_step(plant, ctrl, t, spec.step_v)
+        step = closed_loop_step(plant, sim_ctrl, t, spec.step_v)
         y = edged(t, step["y"], spec.edge_s)
         waves = stage_waves(parts, amp, t, r, y)
     else:

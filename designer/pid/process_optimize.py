@@ -66,6 +66,8 @@ class _Problem:
     """Everything one evaluation needs, computed once."""
 
     def __init__(self, spec, model, amp, fc_hz, t, robust):
+        from .process_loop import simulation_controller
+        self.simulation_controller = simulation_controller
         from .process_loop import corner_frequencies, limits, plant_of
         self.spec, self.model, self.amp, self.fc = spec, model, amp, fc_hz
         self.pm_min, self.gm_min, self.ms_max = limits(spec)
@@ -120,7 +122,8 @@ class _Problem:
         self.evaluations += 1
         ctrl = self.controller(kp, ti, td)
         viol = self.frequency_violation(ctrl)
-        out = closed_loop_step(self.plants[0], ctrl, self.t, self.step_v, step_fraction=SEARCH_STEP_FRACTION)
+        out = closed_loop_step(self.plants[0], self.simulation_controller(ctrl, self.fc), self.t, self.step_v,
+                               step_fraction=SEARCH_STEP_FRACTION)
         y, u = out["y"], out["u"]
         if not (np.all(np.isfinite(y)) and np.max(np.abs(y)) < 1e3 * self.step_v):
             return math.inf, math.inf, math.nan, math.inf
