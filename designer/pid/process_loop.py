@@ -54,6 +54,8 @@ from .verify import explain, loop_metrics, run_and_compare
 DEFAULT_RULES = ("amigo", "simc", "imc")
 #: analytic samples over the rising half period (as for a Sallen-Key plant)
 POINTS = 20001
+#: the leaky integrator's DC loop gain at least this (see :func:`corner_frequencies`)
+LEAK_LOOP_GAIN = 100.0
 #: the largest capacitor a sizing message suggests (a 1 mF film capacitor is already a brick)
 PRACTICAL_C_MAX_F = 1e-3
 #: the largest steady-state error of the leaky-integrator loop
@@ -86,19 +88,47 @@ def plant_of(model):
 # ---- the loop's figures --------------------------------------------------------
 
 def ideal_crossover_hz(model, kp: float, ti_s: float, td_s: float) -> float:
-    """The gain crossover of the ideal PID (filter N = 10) around the model, or
-    the model's own corner 1/(2 pi time scale) when the loop never crosses."""
-    mg = loop_margins(plant_of(model), pid_tf(kp, ti_s, td_s, 10.0))
-    if math.isfinite(mg.crossover_hz):
-        return mg.crossover_hz
-    return 1.0 / (2 * math.pi * model.time_scale_s)
+    """The (first) gain crossover of the ideal PID (filter N = 10) around the
+    model, or the model's own corner 1/(2 pi time scale) when the loop never
+    crosses. |C P| needs no phase: a log grid over eight decades about the
+    model's corner, refined between the two samples that straddle 1."""
+    from scipy.optimize import brentq
+    num, den = pid_tf(kp, ti_s, td_s, 10.0)
+    w0 = 1.0 / model.time_scale_s
+
+    def mag(w):
+        s = 1j * np.asarray(w, float)
+        return np.abs(np.polyval(num, s) / np.polyval(den, s) * np.polyval(model.num, s) / np.polyval(model.den, s))
+
+    w = w0 * np.logspace(-4, 4, 1601)
+    with np.errstate(all="ignore"):
+        m = mag(w)
+    down = np.nonzero((m[:-1] >= 1) & (m[1:] < 1))[0]
+    if not down.size:
+        return w0 / (2 * math.pi)
+    k = int(down[0])
+    wc = brentq(lambda x: math.log(mag([x])[0]), w[k], w[k + 1], xtol=1e-12 * w[k])
+    return wc / (2 * math.pi)
 
 
-def corner_frequencies(spec: PidSpec, fc_hz: float) -> tuple:
-    """(leak corner, derivative filter corner) in Hz: the spec's, else fc/100 and 10 fc."""
-    f_i = spec.f_integrator_hz if spec.f_integrator_hz is not None else fc_hz * blocks.F_INTEGRATOR_RATIO
+def corner_frequencies(spec: PidSpec, fc_hz: float, loop_gain_hz: float | None = None) -> tuple:
+    """(leak corner, derivative filter corner) in Hz: the spec's, else fc/100 and
+    10 fc; the leak also at most ``loop_gain_hz`` / :data:`LEAK_LOOP_GAIN` (with
+    ``loop_gain_hz`` = |K| Kp/(2 pi Ti), the leaky integrator's DC loop gain is
+    then at least that: a steady-state error under 1/(1 + 100))."""
+    f_i = spec.f_integrator_hz
+    if f_i is None:
+        f_i = fc_hz * blocks.F_INTEGRATOR_RATIO
+        if loop_gain_hz is not None and math.isfinite(loop_gain_hz) and loop_gain_hz > 0:
+            f_i = min(f_i, loop_gain_hz / LEAK_LOOP_GAIN)
     f_d = spec.f_differentiator_hz if spec.f_differentiator_hz is not None else fc_hz * blocks.F_DIFFERENTIATOR_RATIO
     return f_i, f_d
+
+
+def leak_limit_hz(model, kp: float, ti_s: float) -> float | None:
+    """|K| Kp/(2 pi Ti) of a non-integrating model (None for an integrating one, whose
+    own pole at 0 makes the steady-state error zero whatever the leak)."""
+    return None if model.integrating else abs(model.gain) * kp / (2 * math.pi * ti_s)
 
 
 def edged(t, x, edge_s: float) -> np.ndarray:
@@ -191,16 +221,16 @@ def loop_figures(model, controller, kp, ti_s, td_s, t, step_v=1.0) -> LoopFigure
 def built_controller(kp, ti_s, td_s, fc_hz, spec, amp):
     """The controller as it will be built, before any part is rounded
     (:func:`designer.pid.blocks.continuous_parts` with the spec's corners), as (num, den)."""
-    f_i, f_d = corner_frequencies(spec, fc_hz)
+    f_i, f_d = corner_frequencies(spec, fc_hz, leak_limit_hz(spec.process, kp, ti_s))
     parts = blocks.continuous_parts(kp, ti_s, td_s, fc_hz, f_integrator_hz=f_i, f_differentiator_hz=f_d)
     return M.controller_tf(parts, amp)
 
 
-def response_grid(model, fc_hz: float, points: int = 2001) -> np.ndarray:
-    """A grid long enough to see the loop settle: 40 crossover periods'
-    worth of 1/wc, or three open-loop settling times, whichever is longer."""
-    span = max(40.0 / (2 * math.pi * fc_hz), 3.0 * (model.settling_time_s if not model.integrating
-                                                   else model.time_scale_s + model.theta_s))
+def response_grid(model, fc_hz: float, points: int = 2001, per_crossover: float = 40.0) -> np.ndarray:
+    """A grid long enough to see the loop settle: ``per_crossover`` times 1/wc,
+    or three open-loop settling times, whichever is longer."""
+    span = max(per_crossover / (2 * math.pi * fc_hz), 3.0 * (model.settling_time_s if not model.integrating
+                                                             else model.time_scale_s + model.theta_s))
     return np.linspace(0.0, span, points)
 
 
@@ -282,8 +312,10 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
     if gains.rule is not None:
         notes = notes + list(gains.rule.notes)
     lap("tuning_s")
-    fc = ideal_crossover_hz(model, gains.kp, gains.ti_s, gains.td_s)
-    f_i, f_d = corner_frequencies(spec, fc)
+    # the optimiser sized its loop with the corners of its start's crossover: build those
+    fc = opt.fc_hz if opt is not None else ideal_crossover_hz(model, gains.kp, gains.ti_s, gains.td_s)
+    f_i, f_d = ((opt.f_integrator_hz, opt.f_differentiator_hz) if opt is not None
+                else corner_frequencies(spec, fc, leak_limit_hz(model, gains.kp, gains.ti_s)))
     if spec.controller_parts is not None:
         parts, sel = spec.controller_parts, None
         targets = {"kp": gains.kp, "ti_s": gains.ti_s, "td_s": gains.td_s}
