@@ -60,15 +60,19 @@ def _v(x, unit="V", digits=4):
 
 
 def verdict_text(result) -> str:
-    failed = [c.id for c in result.checks if not c.ok]
-    a = result.analytic
-    s = result.spice
+    return verdict_of(result.analytic.stable, result.analytic.figures, result.spice, result.checks)
+
+
+def verdict_of(stable, figures, s, checks) -> str:
+    """The verdict line: the analytic loop (``stable``, its step ``figures``), the
+    SPICE run ``s`` (or None) and the failed ``checks``."""
+    failed = [c.id for c in checks if not c.ok]
     parts = []
-    if a.stable is False:
+    if stable is False:
         parts.append("the analytic loop with the op-amp poles is UNSTABLE")
-    elif _known(a.figures.overshoot_pct) is not None:
-        parts.append(f"analytic: {a.figures.overshoot_pct:.3g} % overshoot, settles (2 %) in "
-                     f"{_v(a.figures.settling_time_s, 's')}")
+    elif _known(figures.overshoot_pct) is not None:
+        parts.append(f"analytic: {figures.overshoot_pct:.3g} % overshoot, settles (2 %) in "
+                     f"{_v(figures.settling_time_s, 's')}")
     if s is not None:
         what = []
         if s.saturated:
@@ -92,18 +96,9 @@ def build_board(result):
 def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`)."""
     b = build_board(result)
-    first = [R.subhead("Bill of materials"),
-             R.table(["Ref", "Value", "Code", "Qty", "Series", "Tol."], [r[:6] for r in bom(result, b)], "compact"),
-             R.subhead("Generator and scope"), *_settings(result, b)]
-    fig = [R.figure("schematic.png", schematic_svg, "schematic of the loop")] if with_images else []
     out = [("Verdict", [R.text(verdict_text(result))] + [R.text(n) for n in result.notes])]
-    # the loop is wide: the schematic spans the page, the parts and the settings sit under it
-    out.append(("Build", fig + [R.columns(first[:2], first[2:])] if with_images else first))
-    out.append(("Wiring", [R.text(f"{b.package.part} in {b.package.pinout} packages: "
-                                  + ", ".join(f"{u.designator} {a.role}" for a, u in zip(b.netlist.amps, b.units))
-                                  + ". Kp = R5 R3/(R6 R4), Ti = R8 R14 C4/R6, Td = R6 R11 C3/R7."),
-                           R.table(["part", "code", "from", "to"],
-                                   wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee)))]))
+    out.append(("Build", _build_blocks(result, b, bom(result, b), with_images, schematic_svg)))
+    out.append(("Wiring", _wiring_blocks(result, b)))
     if result.seed_bench is not None:
         out.append(("The seed's bench: predicted against measured (001, V.13, Figures 88-90)",
                     _seed_bench_blocks(result)))
@@ -118,23 +113,53 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     return out
 
 
+def _build_blocks(result, b, rows, with_images, schematic_svg) -> list:
+    """The schematic, the bill of materials ``rows`` and the bench settings."""
+    first = [R.subhead("Bill of materials"),
+             R.table(["Ref", "Value", "Code", "Qty", "Series", "Tol."], [r[:6] for r in rows], "compact"),
+             R.subhead("Generator and scope"), *_settings(result, b)]
+    fig = [R.figure("schematic.png", schematic_svg, "schematic of the loop")] if with_images else []
+    # the loop is wide: the schematic spans the page, the parts and the settings sit under it
+    return fig + [R.columns(first[:2], first[2:])] if with_images else first
+
+
+def _wiring_blocks(result, b, first_rows=(), after: str = "") -> list:
+    """The packages and the pin-level wiring table of board ``b``; ``first_rows``
+    (part, code, from, to) go before the board's rows, ``after`` closes the intro."""
+    return [R.text(f"{b.package.part} in {b.package.pinout} packages: "
+                   + ", ".join(f"{u.designator} {a.role}" for a, u in zip(b.netlist.amps, b.units))
+                   + ". Kp = R5 R3/(R6 R4), Ti = R8 R14 C4/R6, Td = R6 R11 C3/R7." + after),
+            R.table(["part", "code", "from", "to"],
+                    [*first_rows, *wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee))])]
+
+
+def controller_source(sel):
+    """``source_of`` for :func:`designer.report.wiring.bom_rows` of the controller's
+    parts chosen by ``sel`` (a :class:`~designer.pid.blocks.Selection`, None for
+    given parts): (series, tolerance %) by kind, None for the decoupling."""
+    r_series, c_series = (sel.r_series, sel.c_series) if sel is not None else ("as given", "as given")
+    rt, ct = sel.tolerances_pct if sel is not None else (None, None)
+
+    def source(ref):
+        if len(ref) == 4 and ref[0] == "C":     # decoupling
+            return None
+        return (r_series, rt) if ref[0] == "R" else (c_series, ct)
+    return source
+
+
 def bom(result, b=None) -> list:
     """The bill of materials rows (:data:`designer.report.wiring.BOM_HEADER`): the
     controller's parts from its series, the plant's from the plant's."""
     b = b or build_board(result)
-    sel = result.selection
-    r_series, c_series = (sel.r_series, sel.c_series) if sel is not None else ("as given", "as given")
-    rt, ct = sel.tolerances_pct if sel is not None else (None, None)
+    controller = controller_source(result.selection)
     prs, pcs = result.plant_series or (None, None)
     prt, pct = ((100 * eseries.TOLERANCE[prs], 100 * eseries.TOLERANCE[pcs]) if prs else (None, None))
     plant_refs = {"R1", "R2", "C1", "C2", "R19", "R20"}
 
     def source(ref):
-        if len(ref) == 4 and ref[0] == "C":     # decoupling
-            return None
         if ref in plant_refs:
             return (prs or "as given", prt) if ref[0] == "R" else (pcs or "as given", pct)
-        return (r_series, rt) if ref[0] == "R" else (c_series, ct)
+        return controller(ref)
     return bom_rows(b, source, result.opamp.name)
 
 
@@ -242,8 +267,10 @@ def _seed_bench_blocks(result) -> list:
                   else "") + "; at the seed's 2 V the stages saturate and the loop oscillates in SPICE.")]
 
 
-def _achieved_blocks(result) -> list:
-    tun, ach = result.tuning, result.achieved
+def _achieved_blocks(result, target=None) -> list:
+    """Target against achieved gains and the stages' corners; ``target`` has the
+    targets' kp, ti_s, td_s (default ``result.tuning``)."""
+    tun, ach = result.tuning if target is None else target, result.achieved
     err = ach.errors_pct
     rows = [["Kp", f"{tun.kp:.4g}", f"{ach.kp:.4g}", R.fmt_pct(err["kp"])],
             ["Ti", _v(tun.ti_s, "s"), _v(ach.ti_s, "s"), R.fmt_pct(err["ti"])],
@@ -269,23 +296,28 @@ def _loop_blocks(result, with_images) -> list:
         f"{_v(mg.crossover_hz, 'Hz')}, gain margin {_fmt(mg.gain_margin_db, 'dB')}. "
         f"Closed-loop DC gain {a.dc_gain:.4g} (steady-state error {_fmt(a.steady_state_error_pct, '%')})."))
     if s:
-        v = result.verdict
-        blocks.append(R.text(
-            f"SPICE vs analytic: overshoot {_fmt(v.overshoot_delta_pp, 'pp', signed=True)}, nrms "
-            f"{_fmt(s.nrms, '')} (below 1 is agreement); "
-            + ("they agree." if v.agree else
-               ("the difference is explained by the failed checks: " + ", ".join(v.explained_by) + "."
-                if v.explained_by else "they disagree and no check explains it."))))
+        blocks.append(R.text(_spice_agreement(result)))
     if with_images:
         blocks.append(R.columns([R.image("closed-loop.png", "closed-loop step and controller output")],
                                 [R.image("loop-bode.png", "loop gain with its margins")]))
     return blocks
 
 
-def _scope_blocks(result, with_images, b=None) -> list:
+def _spice_agreement(result) -> str:
+    v, s = result.verdict, result.spice
+    return (f"SPICE vs analytic: overshoot {_fmt(v.overshoot_delta_pp, 'pp', signed=True)}, nrms "
+            f"{_fmt(s.nrms, '')} (below 1 is agreement); "
+            + ("they agree." if v.agree else
+               ("the difference is explained by the failed checks: " + ", ".join(v.explained_by) + "."
+                if v.explained_by else "they disagree and no check explains it.")))
+
+
+def _scope_blocks(result, with_images, b=None, levels=None) -> list:
+    """The bench test and, per op-amp of board ``b``, its probe, CH2 setting and
+    levels; ``levels``: role -> analytic levels (default ``result.analytic.levels``)."""
     test = result.test
     b = b or build_board(result)
-    la = result.analytic.levels
+    la = result.analytic.levels if levels is None else levels
     ls = {} if result.spice is None else result.spice.stages
     sc = result.scope
     vdiv = {} if sc is None else {c.node: c for c in sc.channels}
@@ -349,7 +381,8 @@ def plots(result) -> dict:
     return {name: draw(result) for name, draw in PLOTS}
 
 
-def _closed_loop_plot(result) -> bytes:
+def _closed_loop_plot(result, open_loop: bool = True) -> bytes:
+    """The closed-loop step; ``open_loop``: the plant alone too (not for a ramp)."""
     w = result.waveforms
     a = w.analytic
     sp = None if result.spice is None else result.spice.waves
@@ -359,7 +392,8 @@ def _closed_loop_plot(result) -> bytes:
         curves["SPICE (ngspice)"] = sp["y"]
     curves[f"realised loop, analytic ({amp})"] = a["y"]
     curves["ideal PID, ideal plant"] = w.ideal_pid
-    curves["plant alone (open loop)"] = w.open_loop
+    if open_loop:
+        curves["plant alone (open loop)"] = w.open_loop
     resid = None if sp is None else ("residual: SPICE minus the analytic loop", sp["y"], a["y"])
     return step_plot(w.t, curves, f"Closed-loop step, 0 -> {result.test.amplitude_v:g} V", residual=resid)
 

@@ -3,9 +3,11 @@ Figure 66: the difference amplifier, the proportional, derivative and integral
 branches, the summer and the final gain) driving the Sallen-Key plant
 (Figures 43-45), drawn from the part and net table the deck is written from
 (:func:`designer.pid.netlist.loop_netlist` as built on the bench,
-:func:`designer.spice.deck.board`). The scope probes are the seed's: the
-reference on CH1, the plant output on CH2, and every op-amp output it
-photographs (Figures 79-90).
+:func:`designer.spice.deck.board`); or, for a plant known only as a model, the
+same controller (:func:`designer.pid.netlist.controller_netlist`) driving a
+block labelled with the model's G(s) (:func:`draw_model_loop`). The scope
+probes are the seed's: the reference on CH1, the plant output on CH2, and every
+op-amp output it photographs (Figures 79-90).
 """
 
 from __future__ import annotations
@@ -62,6 +64,67 @@ def draw_loop(board, opamp, probes: dict = PROBES) -> Sheet:
     """The closed loop of ``board`` (a :class:`~designer.spice.deck.Board` of
     :func:`~designer.pid.netlist.loop_netlist`) on a new sheet."""
     s = Sheet(fontsize=10)
+    bottom = _draw_controller(s, board, probes)
+    # the plant, below, fed from u by its net label
+    draw_plant(board, opamp, s, origin=(0.0, bottom), inp_label="u", probes={"y": probes.get("y", "CH2")},
+               supplies=False)
+    draw_supplies(s, board, opamp, (17.5, bottom - 1.0), per_row=12)
+    return s
+
+
+def draw_model_loop(board, opamp, model_text: str, probes: dict = PROBES) -> Sheet:
+    """The closed loop around a plant known only as a model, on a new sheet: the
+    controller of ``board`` (a :class:`~designer.spice.deck.Board` of
+    :func:`~designer.pid.netlist.controller_netlist`) as for a Sallen-Key plant,
+    and the plant a block labelled ``model_text`` (``G(s) = ...``) from net ``u``
+    to net ``y``, its ground on the common ground. The block's terminals are
+    ``PLANT`` ``in``, ``out`` and ``gnd`` in :meth:`Sheet.connectivity`."""
+    s = Sheet(fontsize=10)
+    bottom = _draw_controller(s, board, probes)
+    low = draw_plant_block(s, model_text, (0.0, bottom), probes.get("y", "CH2"))
+    draw_supplies(s, board, opamp, (1.0, low - 4.2), per_row=16)
+    return s
+
+
+#: the plant block's designator on the sheet (its terminals: in, out, gnd)
+PLANT_BLOCK = "PLANT"
+
+
+def draw_plant_block(s: Sheet, model_text: str, origin, probe: str = "CH2") -> float:
+    """The plant as a block labelled ``model_text`` on ``s``: net ``u`` at
+    ``origin`` into its input, its output to net ``y`` (with the ``probe`` tag),
+    its ground terminal below to ground. Returns the lowest y drawn (the ground's)."""
+    import schemdraw.elements as elm
+    x0, y0 = origin
+    # a long G(s) on two lines, split at its fraction bar
+    lines = model_text.split(" / ", 1) if len(model_text) > 44 and " / " in model_text else [model_text]
+    if len(lines) == 2:
+        lines[0] += " /"
+    width = max(12.0, 0.4 * max(len(t) for t in lines) + 2.5)
+    half = 1.2 + 0.45 * len(lines)
+    inp = (x0 + 1.5, y0)
+    out = (inp[0] + width, y0)
+    gnd = (inp[0] + width / 2, y0 - half)
+    s.net_label((x0, y0), "u", "u", loc="left")
+    s.wire((x0, y0), inp)
+    s.d.add(elm.Rect(corner1=(inp[0], y0 - half), corner2=(out[0], y0 + half), lw=1.3).at((0.0, 0.0)))
+    s.text((gnd[0], y0 + half - 0.55), "plant (a model, not on the board)", size=0.8)
+    for i, t in enumerate(lines):
+        s.text((gnd[0], y0 - 0.2 - 0.9 * i + 0.45 * (len(lines) - 1)), t, size=0.85)
+    for term, pt in (("in", inp), ("out", out), ("gnd", gnd)):
+        s.pins[(PLANT_BLOCK, term)] = pt
+    s.wire(gnd, (gnd[0], gnd[1] - 0.8))
+    s.ground((gnd[0], gnd[1] - 0.8))
+    y = (out[0] + 2.0, y0)
+    s.wire(out, y)
+    s.probe(y, probe)
+    s.net_label(y, "y", "y")
+    return gnd[1] - 0.8
+
+
+def _draw_controller(s: Sheet, board, probes) -> float:
+    """The six controller op-amps of ``board`` on ``s``, from net ``r`` and ``y``
+    labels to the ``u`` label; returns the y where the plant goes, below."""
     n = board.netlist
     amps = {a.role: a for a in n.amps}
     P = n.part
@@ -154,10 +217,5 @@ def draw_loop(board, opamp, probes: dict = PROBES) -> Sheet:
     s.wire((u[0], vs[1] + 2.2), u, pts["out"])
     s.dot(u)
     tag(u, "u", 0.5)
-    # the plant, below, fed from u by its net label
     s.net_label(u, "u", "u")
-    bottom = min(rows.values()) - 6.5
-    draw_plant(board, opamp, s, origin=(0.0, bottom), inp_label="u", probes={"y": probes.get("y", "CH2")},
-               supplies=False)
-    draw_supplies(s, board, opamp, (17.5, bottom - 1.0), per_row=12)
-    return s
+    return min(rows.values()) - 6.5
