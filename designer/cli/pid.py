@@ -77,6 +77,9 @@ def _parser():
     t.add_argument("--target-settling", metavar="S",
                    help=f"--tuning optimize: largest 2 %% settling time {_r('target_settling_s')}")
     _add_model_tuning_options(t)
+    t.add_argument("--rules-spice", action="store_true",
+                   help="model plant: simulate every applicable rule's loop too, for the rule table's SPICE "
+                        "overshoot (one more ngspice run per rule)")
     t.add_argument("--seed-parts", action="store_true",
                    help="use the seed's own controller parts (V.13, difference amp untrimmed) instead of sizing")
     s = p.add_argument_group("parts")
@@ -260,7 +263,7 @@ def _run(args) -> int:
     if spec.process is not None:
         from ..pid.process_report import summary_text as model_text, write_outputs as model_write
         common.check_output(args, args.name if args.name is not None else "pid_model")
-        result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
+        result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator, rules_spice=args.rules_spice)
         return emit(result, args, args.name or _model_name(spec, result.method), model_write, model_text)
     # the default name needs the plant as built; its fixed start stands in for it in the check
     common.check_output(args, args.name if args.name is not None else f"pid_{spec.method}")

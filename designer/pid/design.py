@@ -101,7 +101,7 @@ def plant_step(plant: SallenKeyParts, amp: OpAmp) -> PlantStep:
 
 # ---- the flow ----------------------------------------------------------------
 
-def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice") -> PidResult:
+def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice", rules_spice: bool = False) -> PidResult:
     """Tune, size, check, and (unless ``simulate`` is False) verify in SPICE.
 
     Parameters
@@ -112,6 +112,8 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice")
         Run the closed-loop deck in ngspice.
     simulator : str
         ``"pyspice"`` (ngspice's shared library) or ``"ngspice-cli"``.
+    rules_spice : bool
+        A model plant: simulate every rule's loop too (the rule table's SPICE overshoot).
 
     Returns
     -------
@@ -122,7 +124,7 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice")
     """
     if spec.process is not None:
         from .process_loop import design_model_pid
-        return design_model_pid(spec, simulate, simulator)
+        return design_model_pid(spec, simulate, simulator, rules_spice)
     return _run(spec, simulate, simulator, as_built=False)
 
 

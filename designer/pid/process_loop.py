@@ -278,7 +278,8 @@ def rule_table(spec, model, reduced, amp) -> tuple:
     return tuple(rows)
 
 
-def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice") -> ProcessPidResult:
+def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice",
+                     rules_spice: bool = False) -> ProcessPidResult:
     """Tune, size, check and (unless ``simulate`` is False) verify in SPICE a PID
     for ``spec.process``, a plant known only as a model.
 
@@ -290,6 +291,9 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
         Run the closed-loop deck in ngspice.
     simulator : str
         ``"pyspice"`` or ``"ngspice-cli"``.
+    rules_spice : bool
+        Also simulate every applicable rule's loop, sized as this one is, for the
+        rule table's SPICE overshoot (one more ngspice run per rule).
 
     Returns
     -------
@@ -337,12 +341,14 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
         spec=spec, model=model, reduced=reduced, opamp=amp, method=gains.method, kp=gains.kp, ti_s=gains.ti_s,
         td_s=gains.td_s, rule=gains.rule, rules=table, optimizer=opt, parts=parts, selection=sel,
         achieved=Achieved.of(parts, amp, gains), fc_ref_hz=fc, checks=checks, margins=loop.margins,
-        ideal_margins=loop.ideal_margins, analytic=loop.figures, stable=loop.margins.stable, dc_gain=loop.dc,
+        ideal_margins=loop.ideal_margins, ideal_pid=loop.ideal_figures, analytic=loop.figures, stable=loop.margins.stable, dc_gain=loop.dc,
         levels=loop.levels, robust=robust, test=loop.test, expected_final_v=loop.expected, deck=loop.deck,
         waveforms=loop.waves, notes=list(notes), package=spec.package, limits=limits(spec))
     lap("analytic_s")
     if simulate:
         run_spice(res, simulator)
+        if rules_spice:
+            res.rules = rules_in_spice(res, simulator)
         lap("simulation_s")
     else:
         res.notes.append("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only")
@@ -408,6 +414,7 @@ class _Loop:
     controller: tuple
     margins: object
     ideal_margins: object
+    ideal_figures: object
     figures: object
     dc: float
     levels: dict
@@ -457,6 +464,8 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
                if loop_margins(plant, ideal).stable else np.full(t.size, np.nan))
     y_open = edged(t, spec.step_v * model.step(t), spec.edge_s)
     figures = loop_metrics(t, waves["y"], expected)
+    # the ideal PID has a true integrator: it settles on the step itself
+    ideal_figures = loop_metrics(t, y_ideal, spec.step_v) if np.all(np.isfinite(y_ideal)) else None
     rise = figures.rise_time_s if math.isfinite(figures.rise_time_s) and figures.rise_time_s else t[-1] / 20
     names = _designators_model(parts, amp, spec.package)
     levels = M.waveform_limits({k: v for k, v in waves.items() if k != "y"}, t, amp,
@@ -472,7 +481,7 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
     from .delaymargins import loop_response
     wf = Waveforms(t, r, waves, y_ideal, y_open, bode_w, loop_response(plant, ctrl, bode_w), t_long,
                    model.step(t_long), None)
-    return _Loop(ctrl, mg, ideal_mg, figures, dc, levels, tuple(checks), test, expected, deck, t, wf)
+    return _Loop(ctrl, mg, ideal_mg, ideal_figures, figures, dc, levels, tuple(checks), test, expected, deck, t, wf)
 
 
 def _designators_model(parts, amp, package) -> dict:
@@ -532,6 +541,33 @@ def robust_check(spec, model, controller, t, gains) -> RobustCheck:
                            spec.step_v)
         rows.append((corner.source.rsplit("corner ", 1)[-1], fig))
     return RobustCheck(tuple(rows), pm_min, gm_min, ms_max)
+
+
+def rules_in_spice(res: ProcessPidResult, simulator: str) -> tuple:
+    """The rule table with each applicable, stable rule's SPICE overshoot: its
+    gains sized as the design's were (same series, bounds and corner rules), its
+    deck on the same bench test, the deck's own ``overshoot_pct`` measurement."""
+    from ..spice.simulate import get_simulator
+    spec, sim, out = res.spec, get_simulator(simulator), []
+    for row in res.rules:
+        if row.figures is None or not row.figures.margins.stable:
+            out.append(row)
+            continue
+        r = row.tuning
+        fc = ideal_crossover_hz(res.model, r.kp, r.ti_s, r.td_s)
+        f_i, f_d = corner_frequencies(spec, fc, leak_limit_hz(res.model, r.kp, r.ti_s))
+        try:
+            parts = blocks.select_parts(r.kp, r.ti_s, r.td_s, fc, r_series=spec.r_series, c_series=spec.c_series,
+                                        r_min=spec.r_min, r_max=spec.r_max, c_min=spec.c_min, c_max=spec.c_max,
+                                        f_integrator_hz=f_i, f_differentiator_hz=f_d, tol=spec.tol).parts
+        except DesignError:
+            out.append(row)
+            continue
+        expected = spec.step_v * loop_dc_gain(res.model, M.controller_tf(parts, res.opamp))
+        deck = model_loop_deck(parts, res.model, res.opamp, res.test, f"rule {r.rule}", expected)
+        got = sim.run(deck).measurements.get("overshoot_pct")
+        out.append(replace(row, spice_overshoot_pct=None if got is None else float(got)))
+    return tuple(out)
 
 
 def run_spice(res: ProcessPidResult, simulator: str) -> None:

@@ -218,7 +218,8 @@ def _margin_rows(ideal, built) -> list:
 def _loop_blocks(result, with_images) -> list:
     a, s, amp, mg = result.analytic, result.spice, result.opamp, result.margins
     rows = _margin_rows(result.ideal_margins, mg)
-    rows += [[label, "-", f(_known(getattr(a, key))),
+    i = result.ideal_pid
+    rows += [[label, f(_known(getattr(i, key))) if i is not None else "-", f(_known(getattr(a, key))),
               f(_known(getattr(s.figures, key))) if s else "not simulated"] for key, label, f in METRICS]
     rows.append(["stable", str(result.ideal_margins.stable), str(result.stable), str(s.stable) if s else ""])
     rows.append(["saturated", "", "", str(s.saturated) if s else ""])

@@ -136,6 +136,7 @@ class ProcessPidResult:
     checks: tuple
     margins: object                     #: DelayLoopMargins of the loop as built
     ideal_margins: object               #: of the ideal PID around the model
+    ideal_pid: object                   #: StepMetrics of the ideal PID (filter N = 10) around the model, or None
     analytic: object                    #: StepMetrics of the loop as built (against expected_final_v)
     stable: bool
     dc_gain: float
@@ -198,6 +199,7 @@ class ProcessPidResult:
             "checks": [c.to_dict() for c in self.checks],
             "closed_loop": {"analytic": {**self.analytic.to_dict(), "stable": self.stable, "dc_gain": self.dc_gain,
                                          "steady_state_error_pct": 100 * (1 - self.dc_gain)},
+                            "ideal_pid": None if self.ideal_pid is None else self.ideal_pid.to_dict(),
                             "margins": self.margins.to_dict(), "ideal_pid_margins": self.ideal_margins.to_dict(),
                             "spice": None if self.spice is None else self.spice.to_dict(),
                             "verdict": None if self.verdict is None else self.verdict.to_dict()},
