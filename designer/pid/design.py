@@ -494,12 +494,17 @@ def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise, parts, nam
                      (f"{pm:.3g} deg at {format_eng(mg.crossover_hz, 'Hz')} with the op-amp poles "
                       f"(want >= {MIN_PHASE_MARGIN_DEG:g} deg){near}") if math.isfinite(pm)
                      else "the loop gain never crosses 1"))
-    if math.isfinite(dc_cl):
-        e = 1 - dc_cl
-        out.append(Check("steady_state_error", bool(abs(e) <= MAX_STEADY_STATE_ERROR),
-                         f"{100 * e:.3g} % of the step (the integrator leaks through R13; "
-                         f"want <= {100 * MAX_STEADY_STATE_ERROR:g} %)"))
-    return out + stage_checks(stable, levels, amp, step_v, rise, parts, name_of)
+    return out + steady_state_check(dc_cl) + stage_checks(stable, levels, amp, step_v, rise, parts, name_of)
+
+
+def steady_state_check(dc_gain: float) -> list:
+    """The leaky integrator's steady-state error 1 - y/r at DC (none when unknown)."""
+    if not math.isfinite(dc_gain):
+        return []
+    e = 1 - dc_gain
+    return [Check("steady_state_error", bool(abs(e) <= MAX_STEADY_STATE_ERROR),
+                  f"{100 * e:.3g} % of the step (the integrator leaks through R13; "
+                  f"want <= {100 * MAX_STEADY_STATE_ERROR:g} %)")]
 
 
 def stage_checks(stable, levels, amp, step_v, rise, parts, name_of=str) -> list:
@@ -544,15 +549,23 @@ def run_spice(res: PidResult, simulator: str) -> None:
     res.spice = sp = replace(sp, stages=_named(sp.stages, _designators(res.parts, res.plant, res.opamp,
                                                                       res.package)))
     res.verdict = explain(sp, res.analytic.figures, res.checks)
+    res.notes += spice_notes(sp, res.verdict, res.expected_final_v)
+
+
+def spice_notes(sp, verdict, expected_final_v: float) -> list:
+    """What a SPICE run of a loop says beyond its figures: saturated stages,
+    oscillation, latch-up, a disagreement no check explains."""
+    out = []
     sat = [f"{v.opamp} {role}" for role, v in sp.stages.items() if v.saturated]
     if sat:
-        res.notes.append("SPICE: op-amp output pinned at a rail: " + ", ".join(sat))
+        out.append("SPICE: op-amp output pinned at a rail: " + ", ".join(sat))
     osc = sp.oscillation
     if osc.oscillating:
-        res.notes.append(f"SPICE: the loop is still oscillating at the end of the half period "
-                         f"({osc.tail_p2p_v:.3g} V peak to peak)")
+        out.append(f"SPICE: the loop is still oscillating at the end of the half period "
+                   f"({osc.tail_p2p_v:.3g} V peak to peak)")
     if osc.latched:
-        res.notes.append(f"SPICE: the output is stuck at {osc.tail_mean_v:.3g} V instead of settling near "
-                         f"{res.expected_final_v:.3g} V (latch-up)")
-    if res.verdict.unexplained:
-        res.notes.append("SPICE and the analytic loop disagree and no check explains it (please report this)")
+        out.append(f"SPICE: the output is stuck at {osc.tail_mean_v:.3g} V instead of settling near "
+                   f"{expected_final_v:.3g} V (latch-up)")
+    if verdict.unexplained:
+        out.append("SPICE and the analytic loop disagree and no check explains it (please report this)")
+    return out

@@ -70,6 +70,17 @@ def controller_stages(parts: PidParts, ref="ref", y="y", u="u") -> list:
     return stages
 
 
+def extreme_lines(parts: PidParts, test: SquareTest) -> list:
+    """``.meas`` lines of the extremes of every op-amp output (and y) over the period."""
+    t0, out = test.delay_s, []
+    for node in PROBES:
+        if node == "vd" and not parts.has_derivative:
+            continue
+        out += [f".meas tran {node}_max MAX v({node}) FROM={t0:.6g} TO={test.stop_s:.6g}",
+                f".meas tran {node}_min MIN v({node}) FROM={t0:.6g} TO={test.stop_s:.6g}"]
+    return out
+
+
 def loop_netlist(parts: PidParts, plant: SallenKeyParts) -> Netlist:
     """The whole loop as one table: the plant (U1 and its parts) first, then the
     controller's stages in signal order."""
@@ -105,14 +116,7 @@ def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test:
     circuit.V("ref", "ref", circuit.gnd, test.source())
     loop_netlist(parts, plant).add_to(circuit, opamp)
     deck.settle_error_source(circuit, "y", expected_final)
-    t0 = test.delay_s
-    extremes = []
-    for node in PROBES:
-        if node == "vd" and not parts.has_derivative:
-            continue
-        extremes += [f".meas tran {node}_max MAX v({node}) FROM={t0:.6g} TO={test.stop_s:.6g}",
-                     f".meas tran {node}_min MIN v({node}) FROM={t0:.6g} TO={test.stop_s:.6g}"]
-    lines = deck.measure_lines("y", test, expected_final) + extremes
+    lines = deck.measure_lines("y", test, expected_final) + extreme_lines(parts, test)
     return deck.finish_deck(circuit, test, lines, points=points)
 
 
@@ -161,14 +165,7 @@ def model_loop_deck(parts: PidParts, model, opamp: OpAmp, test: SquareTest, titl
     circuit.V("ref", "ref", circuit.gnd, test.source())
     controller_netlist(parts).add_to(circuit, opamp)
     deck.settle_error_source(circuit, "y", expected_final)
-    t0 = test.delay_s
-    extremes = []
-    for node in PROBES:
-        if node == "vd" and not parts.has_derivative:
-            continue
-        extremes += [f".meas tran {node}_max MAX v({node}) FROM={t0:.6g} TO={test.stop_s:.6g}",
-                     f".meas tran {node}_min MIN v({node}) FROM={t0:.6g} TO={test.stop_s:.6g}"]
-    lines = deck.measure_lines("y", test, expected_final) + extremes
+    lines = deck.measure_lines("y", test, expected_final) + extreme_lines(parts, test)
     hint = max_step_hint_s(model.num, model.den, model.theta_s)
     text = deck.finish_deck(circuit, test, lines, points=points)
     tmax = test.max_step_s(points)

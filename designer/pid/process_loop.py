@@ -58,8 +58,6 @@ POINTS = 20001
 LEAK_LOOP_GAIN = 100.0
 #: the largest capacitor a sizing message suggests (a 1 mF film capacitor is already a brick)
 PRACTICAL_C_MAX_F = 1e-3
-#: the largest steady-state error of the leaky-integrator loop
-MAX_STEADY_STATE_ERROR = 0.02
 
 
 @dataclass(frozen=True)
@@ -493,6 +491,7 @@ def _designators_model(parts, amp, package) -> dict:
 
 def loop_checks(spec, mg, dc, amp, levels, waves, t, parts) -> list:
     """Stability, phase and gain margins, Ms, steady-state error and the plant's ranges."""
+    from .design import steady_state_check
     pm_min, gm_min, ms_max = limits(spec)
     out = [Check("closed_loop_stable", bool(mg.stable),
                  "no closed-loop root in the right half plane (argument principle, exact dead time)"
@@ -510,11 +509,7 @@ def loop_checks(spec, mg, dc, amp, levels, waves, t, parts) -> list:
     out.append(Check("max_sensitivity", bool(mg.ms <= ms_max),
                      f"Ms = {mg.ms:.3g} at {format_eng(mg.ms_hz, 'Hz')} (want <= {ms_max:g}; 1/Ms = "
                      f"{1 / mg.ms:.3g} is the distance of the Nyquist curve from -1)"))
-    if math.isfinite(dc):
-        e = 1 - dc
-        out.append(Check("steady_state_error", bool(abs(e) <= MAX_STEADY_STATE_ERROR),
-                         f"{100 * e:.3g} % of the step (the integrator leaks through R13; "
-                         f"want <= {100 * MAX_STEADY_STATE_ERROR:g} %)"))
+    out += steady_state_check(dc)
     for key, sig, what in (("plant_input", "u", "input (the controller's output u)"),
                            ("plant_output", "y", "output y")):
         rng = getattr(spec, key)
@@ -573,18 +568,11 @@ def rules_in_spice(res: ProcessPidResult, simulator: str) -> tuple:
 def run_spice(res: ProcessPidResult, simulator: str) -> None:
     """Simulate the deck, compare with the analytic loop; fills ``spice``,
     ``verdict`` and the notes."""
-    from .design import _named
+    from .design import _named, spice_notes
     w = res.waveforms
     sp = run_and_compare(res.deck, simulator, w.t, res.test.delay_s, w.analytic["y"], res.test.amplitude_v,
                          res.expected_final_v, res.opamp)
     stages = {k: v for k, v in sp.stages.items() if k != "plant"}   # y is the model's, not an op-amp's
     res.spice = sp = replace(sp, stages=_named(stages, _designators_model(res.parts, res.opamp, res.package)))
     res.verdict = explain(sp, res.analytic, res.checks)
-    sat = [f"{v.opamp} {role}" for role, v in sp.stages.items() if v.saturated]
-    if sat:
-        res.notes.append("SPICE: op-amp output pinned at a rail: " + ", ".join(sat))
-    if sp.oscillation.oscillating:
-        res.notes.append(f"SPICE: the loop is still oscillating at the end of the half period "
-                         f"({sp.oscillation.tail_p2p_v:.3g} V peak to peak)")
-    if res.verdict.unexplained:
-        res.notes.append("SPICE and the analytic loop disagree and no check explains it (please report this)")
+    res.notes += spice_notes(sp, res.verdict, res.expected_final_v)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ..core.checks import SPICE_AGREEMENT, Check
+from ..core.checks import Check
 from ..core.jsonio import SCHEMA_VERSION, json_safe
 from ..spice.simulate import tool_info
 
@@ -164,19 +164,8 @@ class ProcessPidResult:
 
     def verdicts(self) -> list:
         """The design checks and, when simulated, the SPICE agreement (``--fail-on-check``)."""
-        if self.verdict is None:
-            return list(self.checks)
-        v, s = self.verdict, self.spice
-        why = [f"nrms {s.nrms:.3g} (below 1 agrees)"]
-        if v.overshoot_delta_pp is not None:
-            why.append(f"overshoot {v.overshoot_delta_pp:+.3g} pp (allowed +/-1 pp)")
-        if not s.stable:
-            why.append("the SPICE loop oscillates or latches")
-        if s.saturated:
-            why.append("an op-amp saturates in SPICE")
-        if v.explained_by:
-            why.append("explained by the failed checks " + ", ".join(v.explained_by))
-        return list(self.checks) + [Check(SPICE_AGREEMENT, v.agree, "; ".join(why))]
+        from .result import loop_verdicts
+        return loop_verdicts(self.checks, self.verdict, self.spice)
 
     def to_dict(self) -> dict:
         pm_min, gm_min, ms_max = self.limits

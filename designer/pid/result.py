@@ -31,6 +31,23 @@ from .tuning import Tuning
 from .verify import SpiceRun, Verdict
 
 
+def loop_verdicts(checks, verdict, spice) -> list:
+    """The design checks and, when simulated, the SPICE agreement of a loop as one
+    more verdict (:data:`~designer.core.checks.SPICE_AGREEMENT`), with why."""
+    if verdict is None:
+        return list(checks)
+    why = [f"nrms {spice.nrms:.3g} (below 1 agrees)"]
+    if verdict.overshoot_delta_pp is not None:
+        why.append(f"overshoot {verdict.overshoot_delta_pp:+.3g} pp (allowed +/-1 pp)")
+    if not spice.stable:
+        why.append("the SPICE loop oscillates or latches")
+    if spice.saturated:
+        why.append("an op-amp saturates in SPICE")
+    if verdict.explained_by:
+        why.append("explained by the failed checks " + ", ".join(verdict.explained_by))
+    return list(checks) + [Check(SPICE_AGREEMENT, verdict.agree, "; ".join(why))]
+
+
 @dataclass(frozen=True)
 class Achieved:
     """What the chosen parts realise, and how far the gains are from the tuning's."""
@@ -145,19 +162,7 @@ class PidResult:
     def verdicts(self) -> list:
         """Every pass/fail verdict: the design checks and, when simulated, the
         SPICE agreement with the analytic loop (``--fail-on-check``)."""
-        if self.verdict is None:
-            return list(self.checks)
-        v, s = self.verdict, self.spice
-        why = [f"nrms {s.nrms:.3g} (below 1 agrees)"]
-        if v.overshoot_delta_pp is not None:
-            why.append(f"overshoot {v.overshoot_delta_pp:+.3g} pp (allowed +/-1 pp)")
-        if not s.stable:
-            why.append("the SPICE loop oscillates or latches")
-        if s.saturated:
-            why.append("an op-amp saturates in SPICE")
-        if v.explained_by:
-            why.append("explained by the failed checks " + ", ".join(v.explained_by))
-        return list(self.checks) + [Check(SPICE_AGREEMENT, v.agree, "; ".join(why))]
+        return loop_verdicts(self.checks, self.verdict, self.spice)
 
     def to_dict(self) -> dict:
         pl = self.plant
