@@ -31,7 +31,14 @@ $(VENV_STAMP): pyproject.toml
 
 # The main job: the seed's plant, and PID controllers for it with LM741s (ZN tuning done right,
 # the optimiser, and the seed's own final design to show what really happens), and the seed's bench as built
-# (trimmed difference amplifier), predicted against what the thesis measured.
+# (trimmed difference amplifier), predicted against what the thesis measured. Then plants known only as
+# models: seed 000's DC motor (Km = 1.25, tau_m = 124.6 ms), a capture simulated in ngspice as a TBS1022 at
+# 500 mV/div would record it (10 mV noise, 20 mV LSB), identified, and a PID optimised for the model (AMIGO and
+# SIMC divide by the dead time, which the motor has none of; IMC's Ti = tau leaves 2.2 % steady-state error
+# through the integrator's leak at these time constants); and a real TBS1022 RC capture (R C = 762 us, output
+# only: its input step is the output's settled change, 1.72 V, as an RC's gain is 1), skipped when
+# ../shared/ext-captures is not beside this clone (its committed bundle is re-checked by the tests).
+EXT_CAPTURES := ../shared/ext-captures
 demo: setup
 	.venv/bin/design-plant --fc 3500 --zeta 0.2 --name plant_fc3500_z0.2 --out .
 	.venv/bin/design-pid --plant-fc 3500 --plant-zeta 0.2 --opamp LM741 --name pid_zn_lm741_fc3500_z0.2 --out .
@@ -43,6 +50,19 @@ demo: setup
 	  --r3 12k --r4 1.777k --r5 22k --r6 3.3k --r7 14.356k --r8 1.2k --r9 10k --r10 10k --r11 10k --r12 1.026k \
 	  --r13 26.048k --r14 2.528k --r15 10k --r16 3.279k --r17 1.716k --r18 9.98k --c3 4.7n --c4 47n \
 	  --kp 45 --ti 43.215u --td 10.8037u --name pid_seed_bench_lm741 --out .
+	.venv/bin/simulate-capture --plant-tf "K=1.25 tau=124.6m" --step 2 --noise 10m --lsb 20m --seed 0 \
+	  --out captures/motor_seed000.csv
+	.venv/bin/identify captures/motor_seed000.csv --json > captures/.motor_seed000.identify.json.tmp
+	mv captures/.motor_seed000.identify.json.tmp captures/motor_seed000.identify.json
+	.venv/bin/design-pid --plant-model captures/motor_seed000.identify.json --tuning optimize \
+	  --name pid_motor_seed000 --out .
+	@if [ -f $(EXT_CAPTURES)/tom2718_TEK0001.CSV ]; then \
+	  set -x; .venv/bin/design-pid --plant-capture $(EXT_CAPTURES)/tom2718_TEK0001.CSV --step-amplitude 1.72 \
+	    --name pid_rc_tbs1022 --out .; \
+	else \
+	  echo "skipping pid_rc_tbs1022: $(EXT_CAPTURES)/tom2718_TEK0001.CSV (the real TBS1022 RC capture) is not" \
+	    "beside this clone; the committed reports/pid_rc_tbs1022 is kept"; \
+	fi
 
 test: setup
 	$(PY) -m pytest -q -p no:cacheprovider tests

@@ -45,6 +45,8 @@ FLAGS = {
     **{f"r{i}": f"--r{i}" for i in range(5, 19)}, "c3": "--c3", "c4": "--c4", "controller_json": "--parts-json",
     # identify / identify-freq
     "step_time_s": "--step-time", "step_amplitude": "--step-amplitude",
+    # simulate-capture (its step_v, step_time_s as above)
+    "duration_s": "--duration", "points": "--points", "noise_v": "--noise", "lsb_v": "--lsb", "seed": "--seed",
 }
 
 

@@ -76,3 +76,7 @@ def identify() -> int:
 
 def identify_freq() -> int:
     return _run("identify-freq", "designer.cli.identify", "identify_freq_main")
+
+
+def simulate_capture() -> int:
+    return _run("simulate-capture", "designer.cli.capture", "simulate_capture_main")

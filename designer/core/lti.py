@@ -165,3 +165,77 @@ def freq_response(num, den, f_hz):
 def dense_time(t_end: float, n: int = 20001):
     """Uniform grid from 0 to ``t_end`` (dense: crossing times then interpolate well)."""
     return np.linspace(0.0, t_end, n)
+
+
+#: samples per block of :func:`_first_order_scan` (a block's powers a^m stay well inside the floats)
+SCAN_BLOCK = 64
+
+
+def _first_order_scan(a: complex, f: np.ndarray) -> np.ndarray:
+    """z_0 = 0, z_(k+1) = a z_k + f_k: the whole sequence, a block of
+    :data:`SCAN_BLOCK` samples at a time (each block from rest as one matrix
+    product, then the carries block by block)."""
+    n = f.size + 1
+    pad = (-f.size) % SCAN_BLOCK
+    blocks = np.concatenate([f, np.zeros(pad, dtype=f.dtype)]).reshape(-1, SCAN_BLOCK)
+    m = np.arange(SCAN_BLOCK)
+    lag = m[:, None] - m[None, :]
+    with np.errstate(all="ignore"):
+        toeplitz = np.where(lag >= 0, np.power(a, np.maximum(lag, 0)), 0.0)
+    within = blocks @ toeplitz.T               # state after each sample of a block, from rest
+    powers = np.power(a, m + 1)
+    step = a ** SCAN_BLOCK
+    out = np.empty_like(within)
+    carry = 0.0
+    for b in range(within.shape[0]):
+        out[b] = powers * carry + within[b]
+        carry = step * carry + within[b, -1]
+    return np.concatenate([[0.0], out.ravel()[: n - 1]])
+
+
+def filter_foh(num, den, t, x) -> np.ndarray:
+    """The output of num/den (proper, from rest) for the input samples ``x`` on
+    the uniform grid ``t``, the input taken linear between samples (first-order
+    hold: exact for a piecewise-linear input), as ``scipy.signal``'s
+    ``cont2discrete(method="foh")`` and ``lfilter`` give it, without importing
+    scipy.signal (a second of start-up on a loaded machine).
+
+    H = D + sum r_i/(s - p_i) (distinct poles): each pole a mode z' = p z + u,
+    sampled exactly, z_(k+1) = e^(p h) z_k + (I0 - I1) u_k + I1 u_(k+1), with
+    I0 = (e^(p h) - 1)/p and I1 = (e^(p h) - 1 - p h)/(p^2 h), and
+    y = D u + sum r_i z_i. Repeated (or nearly repeated) poles have no such
+    basis: scipy.signal does those.
+    """
+    num = np.atleast_1d(np.asarray(num, float))
+    den = np.atleast_1d(np.asarray(den, float))
+    den = den[np.flatnonzero(den)[0]:]
+    num = num[np.flatnonzero(num)[0]:] if np.any(num) else np.array([0.0])
+    t = np.asarray(t, float)
+    x = np.asarray(x, float)
+    if num.size > den.size:
+        raise DesignError("improper transfer function (numerator of higher degree than the denominator)")
+    num, den = num / den[0], den / den[0]
+    if den.size == 1:
+        return num[-1] * x
+    d = num[0] if num.size == den.size else 0.0
+    rest = np.polysub(num, d * den) if d else num
+    poles = np.roots(den)
+    close = np.abs(poles[:, None] - poles[None, :]) <= 1e-6 * np.maximum(np.abs(poles[:, None]), 1e-300)
+    if np.count_nonzero(close) > poles.size:   # a repeated pole: no modal basis
+        from scipy.signal import cont2discrete, lfilter
+        bd, ad, _ = cont2discrete((num, den), t[1] - t[0], method="foh")
+        return lfilter(np.ravel(bd), np.ravel(ad), x)
+    h = float(t[1] - t[0])
+    dden = np.polyder(den)
+    y = d * x.astype(complex)
+    for p in poles:
+        r = np.polyval(rest, p) / np.polyval(dden, p)
+        ph = p * h
+        a = np.exp(ph)
+        if abs(ph) < 1e-4:   # the series: the closed forms cancel catastrophically
+            i0, i1 = h * (1 + ph / 2 + ph * ph / 6), h * (0.5 + ph / 6 + ph * ph / 24)
+        else:
+            i0, i1 = (a - 1) / p, (a - 1 - ph) / (p * p * h)
+        f = (i0 - i1) * x[:-1] + i1 * x[1:]
+        y = y + r * _first_order_scan(a, f.astype(complex))
+    return y.real

@@ -117,6 +117,11 @@ RANGES = {
     "step_amplitude": Range(1e-12, 1e12),
     # size of the output's change from baseline to final value, in the file's units
     "output_step": Range(1e-15, 2e15),
+    # simulate-capture (its --step is step_v, --duration capture_span_s, --step-time capture_time_s)
+    "capture_points": Range(10, 1e6),
+    "noise_v": Range(0.0, 100.0, "V"),
+    "lsb_v": Range(0.0, 100.0, "V"),
+    "seed": Range(0, 1e9),
     # frequency-response tables (identify-freq): every row
     "freq_hz": Range(1e-9, 1e11, "Hz"),
     "gain_db": Range(-400.0, 400.0, "dB"),

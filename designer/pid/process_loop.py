@@ -38,6 +38,7 @@ import numpy as np
 from ..core import opamps
 from ..core.checks import Check
 from ..core.errors import DesignError
+from ..core.lti import filter_foh
 from ..core.units import format_eng
 from ..plant.bench import recommend_square_wave
 from ..spice.deck import SquareTest
@@ -142,30 +143,19 @@ def edged(t, x, edge_s: float) -> np.ndarray:
     return (cum - earlier) / edge_s
 
 
-def _stage_filter(num, den, t, x):
-    """x filtered by num/den on the uniform grid t (first-order hold: exact for
-    a piecewise-linear input)."""
-    from scipy.signal import cont2discrete, lfilter
-    num, den = np.atleast_1d(np.asarray(num, float)), np.atleast_1d(np.asarray(den, float))
-    if den.size == 1 or np.all(num[:-1] == 0) and den.size == 1:
-        return x * (num[-1] / den[-1])
-    bd, ad, _ = cont2discrete((num, den), t[1] - t[0], method="foh")
-    return lfilter(np.ravel(bd), np.ravel(ad), x)
-
-
 def stage_waves(parts, amp, t, r, y) -> dict:
     """Every op-amp output of the controller for the reference ``r`` and the plant
     output ``y`` (the controller is linear from them: each stage's transfer
     function, :func:`designer.pid.model.stage_tfs`, on its inputs)."""
     tfs = M.stage_tfs(parts, amp)
     g_y, g_r = M.difference_weights(parts)
-    w = {"ve": _stage_filter(*tfs["ve"], t, g_y * y - g_r * r)}
+    w = {"ve": filter_foh(*tfs["ve"], t, g_y * y - g_r * r)}
     for sig in ("vp", "vd", "vi"):
         if sig in tfs:
-            w[sig] = _stage_filter(*tfs[sig], t, w["ve"])
+            w[sig] = filter_foh(*tfs[sig], t, w["ve"])
     sw = M.summer_weights(parts)
-    w["vs"] = _stage_filter(*tfs["vs"], t, sum(sw[k] * w[k] for k in sw))
-    w["u"] = _stage_filter(*tfs["u"], t, w["vs"])
+    w["vs"] = filter_foh(*tfs["vs"], t, sum(sw[k] * w[k] for k in sw))
+    w["u"] = filter_foh(*tfs["u"], t, w["vs"])
     w["y"] = y
     return w
 

@@ -122,3 +122,30 @@ def test_pole_clusters_never_merge_poles_a_percent_apart():
     poles = -np.array([10.0, 30.0, 100.0, 300.0, 1e3, 1e3 * (1 + 10 * MAX_CLUSTER), 3e3, 1e4, 3e4])
     assert [m for _, m in pole_clusters(poles)] == [1] * 9
     assert [m for _, m in pole_clusters(np.roots(np.poly([-5.0] * 4)))] == [4]
+
+
+# ---- filter_foh: the first-order-hold filter without scipy.signal ----------------
+
+import pytest  # noqa: E402
+from scipy.signal import cont2discrete, lfilter  # noqa: E402
+
+from designer.core.lti import filter_foh  # noqa: E402
+
+
+@pytest.mark.parametrize("num, den", [
+    ([1.0], [1e-3, 1.0]),                      # a lag
+    ([2e-4, 0.0], [1e-5, 1.0]),                # a filtered differentiator
+    ([3.0], [1e-12, 1e-6, 1.0]),               # two real poles six decades apart (an op-amp stage)
+    ([1.0, 0.0, 0.0], [1e-8, 2e-4, 1.0]),      # a repeated pole: the scipy fallback
+    ([1.0], [1e-8, 2e-5, 1.0]),                # an underdamped pair
+    ([5.0], [1.0, 0.0]),                       # an integrator
+    ([-1.0], [1.0]),                           # a gain
+    ([2.0, 1.0], [1e-3, 1.0]),                 # biproper: direct feedthrough
+])
+def test_filter_foh_equals_scipy_signal(num, den):
+    t = np.linspace(0.0, 1e-2, 5001)
+    x = np.sin(2e3 * t) + (t > 1e-3)
+    bd, ad, _ = cont2discrete((np.array(num), np.array(den)), t[1] - t[0], method="foh")
+    want = lfilter(np.ravel(bd), np.ravel(ad), x)
+    got = filter_foh(num, den, t, x)
+    assert np.max(np.abs(got - want)) <= 1e-9 * max(1.0, np.max(np.abs(want)))
