@@ -15,7 +15,7 @@ import importlib
 import sys
 
 #: the report module whose pictures each command's renderer draws
-_REPORTS = {"plant": "designer.plant.report", "pid": "designer.pid.report"}
+_REPORTS = {"plant": ("designer.plant.report",), "pid": ("designer.pid.report", "designer.pid.process_report")}
 
 
 def draws(argv) -> bool:
@@ -35,7 +35,7 @@ def _run(prog: str, module: str, main: str, wing: str | None = None) -> int:
             status = getattr(importlib.import_module(module), main)()
         else:
             from ..report import render
-            with render.ahead(draws(sys.argv[1:]), preload=(_REPORTS[wing],)):
+            with render.ahead(draws(sys.argv[1:]), preload=_REPORTS[wing]):
                 status = getattr(importlib.import_module(module), main)()
     except BaseException as exc:   # before the command's own handling: an import, the renderer's start
         exc = lifetime.interruption(exc)
