@@ -96,9 +96,16 @@ class _Problem:
         self.evaluations = 0
 
     def built(self, kp, ti, td):
-        """The controller as built (op-amp poles included), before rounding."""
-        parts = blocks.continuous_parts(kp, ti, td, self.fc, f_integrator_hz=self.f_i,
-                                        f_differentiator_hz=self.f_d)
+        """The controller as built (op-amp poles included): the E-series parts the design
+        selects for these gains (the same call), else before rounding."""
+        s = self.spec
+        try:
+            parts = blocks.select_parts(kp, ti, td, self.fc, r_series=s.r_series, c_series=s.c_series, r_min=s.r_min,
+                                        r_max=s.r_max, c_min=s.c_min, c_max=s.c_max, f_integrator_hz=self.f_i,
+                                        f_differentiator_hz=self.f_d, tol=s.tol).parts
+        except DesignError:
+            parts = blocks.continuous_parts(kp, ti, td, self.fc, f_integrator_hz=self.f_i,
+                                            f_differentiator_hz=self.f_d)
         return M.controller_tf(parts, self.amp)
 
     def controller(self, kp, ti, td):
@@ -228,17 +235,18 @@ def optimize_model_loop(spec, model, amp, table) -> ModelOptimizeResult:
                             "initial_simplex": np.vstack([x1] + [x1 + 0.1 * e for e in np.eye(x1.size)])})
     kp, ti, td = gains(res.x if res.fun <= cost(x1) else x1)
     # the exact margins of the loop as built decide: lower Kp while the search was optimistic
-    backed = 0
+    backed, exact = 0, False
     for backed in range(12):
         ctrl = prob.built(kp, ti, td)
         m = loop_margins(prob.plants[0], ctrl)
         worst = [loop_margins(p, ctrl) for p in prob.plants[1:]]
-        if all(x.stable and x.phase_margin_deg >= pm_min and x.gain_margin_db >= gm_min and x.ms <= ms_max
-               for x in [m] + worst):
+        exact = all(x.stable and x.phase_margin_deg >= pm_min and x.gain_margin_db >= gm_min and x.ms <= ms_max
+                    for x in [m] + worst)
+        if exact:
             break
         kp *= 0.95
     _, iae, os_, viol = prob.evaluate(kp, ti, td)
-    met = viol <= 1e-6 and m.stable
+    met = viol <= 1e-6 and m.stable and exact
     what = (f"optimize: IAE {format_eng(iae, 'V s')} (start {start.rule}: {format_eng(g.step.iae, 'V s')}) with "
             f"phase margin >= {pm_min:g} deg, gain margin >= {gm_min:g} dB, Ms <= {ms_max:g}"
             + (f", overshoot <= {spec.target_overshoot_pct:g} %" if spec.target_overshoot_pct is not None else "")

@@ -1,0 +1,146 @@
+"""``tuning="optimize"`` for a model plant (designer.pid.process_optimize through
+design_model_pid): the limits hold on the loop as built (the E-series parts'
+controller with its op-amp poles, exact margins with the dead time), its IAE is
+no worse than the best rule's that meets the same limits, and the options
+(min_phase_margin_deg, target_overshoot_pct, robust) do what they say."""
+
+import pytest
+
+from designer.core import process
+from designer.pid.delayloop import closed_loop_step, step_figures
+from designer.pid.delaymargins import loop_margins
+from designer.pid.model import controller_tf
+from designer.pid.process_loop import (built_controller, design_model_pid, ideal_crossover_hz, plant_of,
+                                       response_grid)
+from designer.pid.spec import PidSpec
+
+ISSUE_TF = "K=2 tau=1m theta=200u"
+SOPDT_TF = "K=1.5 tau1=1m tau2=300u theta=100u"
+INTEGRATING_TF = "K=500 tau=100u integrator theta=100u"
+#: a double pole with a short dead time: the rule table's fastest loops drive the op-amps past their swing
+DOUBLE_POLE_TF = "K=1 tau1=1m tau2=1m theta=50u"
+
+
+def optimized(**kw):
+    return design_model_pid(PidSpec(tuning="optimize", **kw), simulate=False)
+
+
+def meets(mg, limits) -> bool:
+    pm_min, gm_min, ms_max = limits
+    return bool(mg.stable and mg.phase_margin_deg >= pm_min and mg.gain_margin_db >= gm_min and mg.ms <= ms_max)
+
+
+def built_margins(res):
+    """The exact margins of the loop as built: the parts' controller around the model."""
+    return loop_margins(plant_of(res.model), controller_tf(res.parts, res.opamp))
+
+
+@pytest.mark.parametrize("tf, opamp", [
+    (ISSUE_TF, "LM741"), (SOPDT_TF, "LM741"), ("K=1 fn=200 zeta=0.4", "LM741"), (INTEGRATING_TF, "LM741"),
+    # microsecond plants: the derivative filter's corner is held at 1/(2 pi r_min c_min) by the part bounds
+    ("K=2 tau=10u theta=2u", "LM741"), ("K=2 tau=5u theta=1u", "NE5532"),
+])
+def test_optimize_meets_the_default_limits_on_the_loop_as_built(tf, opamp):
+    res = optimized(plant_tf=tf, opamp=opamp)
+    mg = built_margins(res)
+    assert meets(mg, res.limits), (mg.phase_margin_deg, mg.gain_margin_db, mg.ms, res.limits)
+    assert mg.ms == res.margins.ms and mg.phase_margin_deg == res.margins.phase_margin_deg
+    ok = {c.id: c.ok for c in res.checks}
+    assert ok["closed_loop_stable"] and ok["phase_margin"] and ok["gain_margin"] and ok["max_sensitivity"]
+    assert res.optimizer.met and "NOT all met" not in res.optimizer.message
+
+
+def _iae(model, ctrl, t, step_v):
+    out = closed_loop_step(plant_of(model), ctrl, t, step_v)
+    return step_figures(t, out["y"], step_v).iae, out["u"]
+
+
+def _inside_swing(u, amp) -> bool:
+    """u and its mirror on the falling edge inside the op-amp's output range."""
+    uf = float(u[-1])
+    hi, lo = max(float(u.max()), uf - float(u.min())), min(float(u.min()), uf - float(u.max()))
+    return amp.vout_min <= lo and hi <= amp.vout_max
+
+
+def _compare_with_the_rules(tf):
+    res = optimized(plant_tf=tf)
+    model, amp, spec = res.model, res.opamp, res.spec
+    opt_ctrl = controller_tf(res.parts, amp)
+    candidates = []
+    for row in res.rules:
+        if row.tuning is None:
+            continue
+        g = row.tuning
+        fc = ideal_crossover_hz(model, g.kp, g.ti_s, g.td_s)
+        ctrl = built_controller(g.kp, g.ti_s, g.td_s, fc, spec, amp)      # as the rule table builds it
+        if meets(loop_margins(plant_of(model), ctrl), res.limits):
+            candidates.append((row.rule, ctrl, fc))
+    assert candidates, "no rule meets the limits: nothing to compare with"
+    # one grid for all, long enough for the slowest loop to settle
+    t = response_grid(model, min([fc for _, _, fc in candidates] + [built_margins(res).crossover_hz]), 4001)
+    iae_opt, _ = _iae(model, opt_ctrl, t, spec.step_v)
+    best = None
+    for rule, ctrl, _ in candidates:
+        iae, u = _iae(model, ctrl, t, spec.step_v)
+        if _inside_swing(u, amp) and (best is None or iae < best[1]):
+            best = (rule, iae)
+    assert best is not None
+    return iae_opt, best
+
+
+@pytest.mark.parametrize("tf", [ISSUE_TF, SOPDT_TF, INTEGRATING_TF])
+def test_optimize_is_no_worse_than_the_best_rule_meeting_the_same_limits(tf):
+    iae_opt, (rule, iae_rule) = _compare_with_the_rules(tf)
+    assert iae_opt <= iae_rule, (iae_opt, rule, iae_rule)
+
+
+@pytest.mark.xfail(strict=True, reason="the search's controller has ideal op-amps, so the derivative kick it "
+                   "simulates (u 15.2 V for IMC's gains) is twice the built circuit's (7.4 V): it counts the swing as "
+                   "violated where the circuit is inside it, starts from chr20 (outside the swing as built too) and "
+                   "ends at IAE 1.98 mV s where IMC, meeting every limit, gives 1.22 mV s")
+def test_optimize_on_a_double_pole_is_no_worse_than_imc():
+    iae_opt, (rule, iae_rule) = _compare_with_the_rules(DOUBLE_POLE_TF)
+    assert iae_opt <= iae_rule, (iae_opt, rule, iae_rule)
+
+
+@pytest.mark.parametrize("tf", [ISSUE_TF, INTEGRATING_TF])
+def test_a_higher_phase_margin_is_met_on_the_parts(tf):
+    res = optimized(plant_tf=tf, min_phase_margin_deg=60)
+    assert res.limits[0] == 60
+    mg = built_margins(res)
+    assert meets(mg, res.limits), (mg.phase_margin_deg, mg.gain_margin_db, mg.ms)
+    assert next(c for c in res.checks if c.id == "phase_margin").ok
+
+
+@pytest.mark.parametrize("tf", [SOPDT_TF, pytest.param(INTEGRATING_TF, marks=pytest.mark.xfail(
+    strict=True, reason="the search meets the target on its coarse grid (801 points, step fraction 0.1) and the "
+    "design's fine grid reads 5.02 % for a 5 % target: the target is never checked on the loop as built"))])
+def test_a_target_overshoot_is_met_by_the_analytic_loop(tf):
+    free = optimized(plant_tf=tf)
+    target = 5.0
+    assert free.analytic.overshoot_pct > target            # the target binds
+    res = optimized(plant_tf=tf, target_overshoot_pct=target)
+    assert res.analytic.overshoot_pct <= target, res.analytic.overshoot_pct
+    assert meets(built_margins(res), res.limits)
+
+
+def test_robust_holds_the_limits_at_every_corner_of_the_95_percent_box():
+    nominal = process.fopdt(2.0, 1e-3, 200e-6)
+    # 10 % half-widths on every parameter
+    model = process.fopdt(2.0, 1e-3, 200e-6, ci95={k: 0.1 * v for k, v in nominal.params.items()})
+    plain = optimized(plant_process=model)
+    assert plain.robust is not None and len(plain.robust.corners) == 2 ** 3
+    assert not all(meets(f.margins, plain.limits) for _, f in plain.robust.corners)   # the nominal loop does not
+    res = optimized(plant_process=model, robust=True)
+    assert res.optimizer.robust and res.optimizer.met
+    assert meets(built_margins(res), res.limits)
+    assert len(res.robust.corners) == 2 ** 3
+    ctrl = controller_tf(res.parts, res.opamp)
+    for (label, fig), corner in zip(res.robust.corners, model.corners()):
+        assert corner.source.endswith(label)
+        mg = loop_margins(plant_of(corner), ctrl)
+        assert (mg.phase_margin_deg, mg.gain_margin_db, mg.ms) == (fig.margins.phase_margin_deg,
+                                                                  fig.margins.gain_margin_db, fig.margins.ms)
+        assert meets(fig.margins, res.limits), (label, fig.margins.phase_margin_deg, fig.margins.gain_margin_db,
+                                                fig.margins.ms)
+    assert all(c.ok for c in res.checks if c.id.startswith("robust_"))
