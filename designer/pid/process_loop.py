@@ -383,7 +383,7 @@ def sizing_notes(sel, spec) -> list:
                    f"an analog leak at fc/100; accept a higher corner with --f-integrator (the steady-state error "
                    "grows) or keep the integral action digital")
         else:
-            fix = (f"give C4 room with --c-max {format_eng(c_need, '', 2).replace(' ', '')} (now "
+            fix = (f"give C4 room with --c-max {_cli_value(c_need)} (now "
                    f"{format_eng(spec.c_max, 'F')}), or accept a higher leak corner with --f-integrator")
         out.append(f"the integrator leak R13 would need {format_eng(need, 'Ohm')} for a {format_eng(f_i, 'Hz')} "
                    f"corner with C4 = {format_eng(p.c4, 'F')}, above its {format_eng(r_top, 'Ohm')} limit, so the "
@@ -395,6 +395,13 @@ def sizing_notes(sel, spec) -> list:
                        f"{part} and its resistors are limited by --c-max {format_eng(spec.c_max, 'F')} and "
                        f"--r-max {format_eng(spec.r_max, 'Ohm')}: widen them (e.g. --c-max 100u)")
     return out
+
+
+def _cli_value(x: float) -> str:
+    """``x`` rounded up to an E6 value, as an option takes it (``470u``)."""
+    from ..core.eseries import values
+    up = values("E6", x, 10 * x)
+    return format_eng(float(up[0]) if up.size else x, "", 3).replace(" ", "")
 
 
 @dataclass(frozen=True)
