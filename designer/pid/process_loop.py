@@ -188,7 +188,7 @@ def simulation_controller(controller, fc_hz: float):
     if zk.size == z.size and pk.size == p.size:
         return num, den
     s = 2j * math.pi * fc_hz
-    n_red, d_red = np.real(np.poly(zk)), np.real(np.poly(pk))
+    n_red, d_red = np.atleast_1d(np.real(np.poly(zk))), np.atleast_1d(np.real(np.poly(pk)))
     k = np.polyval(num, s) / np.polyval(den, s) / (np.polyval(n_red, s) / np.polyval(d_red, s))
     return float(k.real) * n_red, d_red
 

@@ -245,3 +245,47 @@ def test_every_numeric_option_states_its_range_in_help(capsys):
     options.update({"--target-overshoot": "target_overshoot_pct", "--target-settling": "target_settling_s"})
     for option, key in options.items():
         assert f"({RANGES[key].text()})" in entries[option], (option, entries[option])
+
+
+# ---- a plant known only as a model (issue 16) -------------------------------------
+
+MODEL_PLANT = ["--plant-tf", "K=2 tau=1m theta=200u"]
+#: the model plant's numeric options and the other arguments they need
+MODEL_NUMERIC = {
+    "--simc-tauc": ("simc_tauc_s", MODEL_PLANT + ["--tuning", "simc"]),
+    "--imc-lambda": ("imc_lambda_s", MODEL_PLANT + ["--tuning", "imc"]),
+    "--min-pm": ("min_phase_margin_deg", MODEL_PLANT),
+    "--min-gm": ("min_gain_margin_db", MODEL_PLANT),
+    "--max-ms": ("max_ms", MODEL_PLANT),
+}
+
+
+@examples(40)
+@given(data=st.data(), option=st.sampled_from(sorted(MODEL_NUMERIC)))
+def test_any_value_of_any_model_plant_option(data, option):
+    key, rest = MODEL_NUMERIC[option]
+    run(rest + flag(option, data.draw(values(key))) + ["--no-sim", "--no-files"])
+
+
+def model_texts():
+    """Typed models: well-formed ones with values from anywhere, and garbage."""
+    value = values()
+    forms = [st.builds(lambda k, t, th: f"K={k} tau={t} theta={th}", value, value, value),
+             st.builds(lambda k, a, b: f"K={k} tau1={a} tau2={b}", value, value, value),
+             st.builds(lambda k, f, z: f"K={k} fn={f} zeta={z}", value, value, value),
+             st.builds(lambda n, d: f"num=[{n}] den=[{d} 1]", value, value),
+             st.builds(lambda k, t: f"K={k} tau={t} integrator", value, value),
+             st.text(max_size=30)]
+    return st.one_of(*forms)
+
+
+@examples(60)
+@given(text=model_texts())
+def test_any_typed_model(text):
+    run(flag("--plant-tf", text) + ["--no-sim", "--no-files"])
+
+
+@examples(20)
+@given(rng=st.builds(lambda a, b: f"{a}:{b}", values(), values()) | st.text(max_size=10))
+def test_any_plant_input_range(rng):
+    run(MODEL_PLANT + flag("--plant-input", rng) + ["--no-sim", "--no-files"])

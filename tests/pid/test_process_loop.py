@@ -253,3 +253,13 @@ def test_a_microsecond_plant_works_in_spice():
     # the derivative filter cannot go above 1/(2 pi r_min c_min): reported, and harmless here
     assert failed <= {"differentiator_corner"}, failed
     assert res.verdict.agree and not res.verdict.unexplained, (res.spice.nrms, res.verdict)
+
+
+def test_a_loop_far_slower_than_its_controller_is_simulated():
+    """Bug fixed (found by the CLI fuzz): IMC with lambda = 10 s on a 1 ms plant puts every pole and zero of
+    the controller above 1000 x the crossover, and the time simulations' reduced controller was a 0-d array."""
+    from designer.pid.process_loop import simulation_controller
+    res = design(plant_tf=ISSUE_TF, tuning="imc", imc_lambda_s=10.0)
+    assert res.analytic.final_value > 0
+    num, den = simulation_controller(([1.0, 1e9], [1.0, 1e8]), 1.0)   # both far above 1 Hz: a gain
+    assert num.shape == den.shape == (1,) and num[0] / den[0] == pytest.approx(10.0, rel=1e-6)
