@@ -1,0 +1,160 @@
+"""design-pid and analyze-pid for a plant known only as a model, from the outside
+(issue 16): the console scripts with --plant-tf, --plant-model and --plant-capture
+(identify's options passed on), their JSON and files, and their one-line
+refusals (exit status 2, nothing written)."""
+
+import json
+import os
+import subprocess
+
+import numpy as np
+import pytest
+from helpers import script
+
+from designer.core.process import fopdt
+
+DESIGN_PID = script("design-pid")
+ANALYZE_PID = script("analyze-pid")
+IDENTIFY = script("identify")
+TF = "K=2 tau=1m theta=200u"
+#: the true plant of the synthetic captures
+TRUE = fopdt(2.0, 1e-3, 2e-4)
+
+pytestmark = pytest.mark.spice
+
+
+def run(exe, *args, cwd=None):
+    env = dict(os.environ, MPLBACKEND="Agg")
+    return subprocess.run([exe, *args], capture_output=True, text=True, cwd=cwd, env=env, timeout=300)
+
+
+def one_line_refusal(p, what):
+    assert p.returncode == 2, (p.returncode, p.stderr)
+    lines = p.stderr.splitlines()
+    assert len(lines) == 1 and "Traceback" not in p.stderr, p.stderr
+    assert what in lines[0], lines[0]
+
+
+@pytest.fixture(scope="module")
+def capture(tmp_path_factory):
+    """A step of the true plant as a scope would record it: 1 V input step at 1 ms, noise, an 8-bit LSB."""
+    t = np.linspace(0.0, 10e-3, 2001)
+    u = np.where(t >= 1e-3, 1.0, 0.0)
+    rng = np.random.default_rng(7)
+    y = TRUE.step(t - 1e-3) + rng.normal(0.0, 0.005, t.size)
+    y = np.round(y / (2.5 / 256)) * (2.5 / 256)
+    path = tmp_path_factory.mktemp("cap") / "fopdt.csv"
+    np.savetxt(path, np.c_[t, u, y], delimiter=",", header="t,u,y", comments="", fmt="%.9g")
+    return path
+
+
+def test_help_names_the_model_sources_and_their_forms():
+    p = run(DESIGN_PID, "--help")
+    assert p.returncode == 0
+    text = " ".join(p.stdout.split())      # argparse wraps the help lines
+    for word in ("--plant-tf", "--plant-model", "--plant-capture", "--plant-input", "--max-ms", "--robust",
+                 "--simc-tauc", "(FOPDT)", "(integrating)", "1.05 to 10"):
+        assert word in text, word
+
+
+def test_plant_tf_writes_the_bundle_and_the_json(tmp_path):
+    p = run(DESIGN_PID, "--plant-tf", TF, "--tuning", "amigo", "--json", "--out", str(tmp_path),
+            "--simulator", "ngspice-cli")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    assert d["plant"]["kind"] == "model" and d["plant"]["model"]["kind"] == "fopdt"
+    assert d["tuning"]["method"] == "amigo"
+    assert {r["rule"] for r in d["rules"]} == {"zn", "cohen-coon", "chr0", "chr20", "amigo", "simc", "imc"}
+    assert d["closed_loop"]["verdict"]["agree"]
+    name = "pid_amigo_lm741_fopdt"
+    for f in ("build-sheet.md", "build-sheet.html", "result.json", "schematic.png", f"{name}.cir"):
+        assert (tmp_path / "reports" / name / f).is_file(), f
+    assert (tmp_path / "netlists" / f"{name}.cir").exists()
+
+
+def test_plant_capture_identifies_then_designs(tmp_path, capture):
+    p = run(DESIGN_PID, "--plant-capture", str(capture), "--json", "--no-files", "--no-sim")
+    assert p.returncode == 0, p.stderr
+    m = json.loads(p.stdout)["plant"]["model"]
+    assert m["source"].startswith("identify ") and "fopdt.csv" in m["source"]
+    assert m["gain"] == pytest.approx(TRUE.gain, rel=0.03)
+    # identify's own options are passed on: a window that cuts the record changes what is identified
+    q = run(DESIGN_PID, "--plant-capture", str(capture), "--window", "0", "6m", "--json", "--no-files", "--no-sim")
+    assert q.returncode == 0, q.stderr
+    assert json.loads(q.stdout)["plant"]["model"] != m
+
+
+def test_plant_model_reads_an_identify_json(tmp_path, capture):
+    ident = run(IDENTIFY, str(capture), "--json")
+    assert ident.returncode == 0, ident.stderr
+    path = tmp_path / "models.json"
+    path.write_text(ident.stdout)
+    p = run(DESIGN_PID, "--plant-model", str(path), "--plant-method", "least-squares", "--json", "--no-files",
+            "--no-sim")
+    assert p.returncode == 0, p.stderr
+    m = json.loads(p.stdout)["plant"]["model"]
+    assert "least-squares" in m["source"] and m["ci95"]     # the fit's intervals come along
+    r = run(DESIGN_PID, "--plant-model", str(path), "--plant-method", "least-squares", "--robust", "--json",
+            "--no-files", "--no-sim")
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["robust"]["corners"]
+
+
+def test_plant_capture_of_a_frequency_table(tmp_path):
+    f = np.logspace(1, 4, 40)
+    g = TRUE.freq(2 * np.pi * f)
+    path = tmp_path / "bode.csv"
+    rows = "\n".join(f"{a:.6g},{20 * np.log10(abs(b)):.6g},{np.degrees(np.angle(b)):.6g}" for a, b in zip(f, g))
+    path.write_text("f_hz,gain_db,phase_deg\n" + rows + "\n")
+    p = run(DESIGN_PID, "--plant-capture", str(path), "--json", "--no-files", "--no-sim")
+    assert p.returncode == 0, p.stderr
+    m = json.loads(p.stdout)["plant"]["model"]
+    assert m["gain"] == pytest.approx(2.0, rel=0.02)
+
+
+def test_analyze_pid_on_a_model_plant(tmp_path):
+    p = run(DESIGN_PID, "--plant-tf", TF, "--out", str(tmp_path), "--name", "d", "--no-sim")
+    assert p.returncode == 0, p.stderr
+    q = run(ANALYZE_PID, "--plant-tf", TF, "--parts-json", str(tmp_path / "reports" / "d" / "result.json"),
+            "--json", "--no-files", "--no-sim")
+    assert q.returncode == 0, q.stderr
+    d = json.loads(q.stdout)
+    assert d["tuning"]["method"] == "as-built"
+    assert d["components"] == json.loads((tmp_path / "reports" / "d" / "result.json").read_text())["components"]
+
+
+def test_fail_on_check_for_a_model_plant(tmp_path):
+    # ZN's quarter-decay loop fails the 45 deg and Ms 1.7 limits of a model plant
+    p = run(DESIGN_PID, "--plant-tf", TF, "--tuning", "zn", "--no-files", "--no-sim", "--fail-on-check")
+    assert p.returncode == 1
+    assert "check failed: phase_margin" in p.stderr or "check failed: max_sensitivity" in p.stderr
+
+
+@pytest.mark.parametrize("args, what", [
+    (["--plant-tf", "K=2 tua=1m"], "unknown key 'tua'"),
+    (["--plant-tf", "K=2 tau=-1m"], "tau must be"),
+    (["--plant-tf", "num=[1] den=[1m -1]"], "right half plane"),
+    (["--plant-tf", "num=[1 1 1] den=[1m 1]"], "proper"),
+    (["--plant-tf", "K=2 tau=1m theta=1"], "theta (dead time) must be"),
+    (["--plant-tf", "K=50 tau=10m integrator", "--tuning", "chr0"], "integrating plant"),
+    (["--plant-tf", TF, "--robust"], "95 % intervals"),
+    (["--plant-tf", TF, "--plant-input", "5"], "--plant-input is a range LO:HI"),
+    (["--plant-tf", TF, "--tuning", "magic"], "unknown --tuning"),
+    (["--plant-fc", "3500", "--plant-zeta", "0.2", "--max-ms", "1.5"], "--max-ms is for a plant given as a model"),
+    (["--plant-tf", TF, "--step-time", "1m"], "--step-time is an option of --plant-capture"),
+    (["--plant-tf", TF, "--plant-fc", "3500", "--plant-zeta", "0.2"], "give the plant one way"),
+])
+def test_refusals_are_one_line_and_write_nothing(tmp_path, args, what):
+    one_line_refusal(run(DESIGN_PID, *args, "--out", str(tmp_path), "--no-sim"), what)
+    assert not any(tmp_path.iterdir())
+
+
+def test_plant_model_of_the_wrong_kind(tmp_path):
+    p = run(DESIGN_PID, "--plant-tf", TF, "--out", str(tmp_path), "--name", "d", "--no-sim")
+    assert p.returncode == 0, p.stderr
+    one_line_refusal(run(DESIGN_PID, "--plant-model", str(tmp_path / "reports" / "d" / "result.json"), "--no-sim",
+                         "--no-files"), "design-pid result")
+    check = tmp_path / "check.json"
+    check.write_text(json.dumps({"schema_version": 1, "specs": [], "passed": True}))
+    q = run(DESIGN_PID, "--plant-model", str(check), "--no-sim", "--no-files")
+    assert q.returncode == 2 and len(q.stderr.splitlines()) == 1, q.stderr
