@@ -56,7 +56,73 @@ result.json, step.png, bode.png. Exit status 2 on bad input.""",
     sel.add_argument("--alternatives", default="5",
                      help=f"how many best combinations to list (default 5) {help_range('alternatives')}")
     _add_bench_options(add_output_options(p, "plant_fc3500_z0.2"))
+    _add_tolerance_options(p)
     return p
+
+
+def _add_tolerance_options(p):
+    """--monte-carlo and its settings (design-plant and analyze-plant)."""
+    from ..tolerance.montecarlo import MAX_SAMPLES, MIN_SAMPLES
+    g = p.add_argument_group("tolerance analysis (Monte Carlo of the parts as built, analytic)")
+    g.add_argument("--monte-carlo", metavar="N",
+                   help=f"draw N builds within the parts' tolerances ({MIN_SAMPLES} to {MAX_SAMPLES:.0e}) and report "
+                        "every figure's spread, the yield within --limit and the part to buy tighter; adds "
+                        "monte_carlo to result.json and monte-carlo.csv (one row per build) to the bundle")
+    g.add_argument("--seed", default="0", metavar="S", help="the draw's seed (default 0): build i depends on (seed, i) "
+                                                            "alone")
+    g.add_argument("--tol", nargs="+", metavar="ITEM",
+                   help="tolerances (default: the series', E24 5 %%, E12 10 %%...): R=1%% C=5%% (a class) or "
+                        "C2=2%% (a part); each above 0 and at most 50 %%")
+    g.add_argument("--dist", default="uniform", choices=("uniform", "normal"),
+                   help="uniform in nominal (1 +- tol) (default), or normal with sigma = tol/3 truncated at +- tol")
+    g.add_argument("--sampler", default="random", choices=("random", "lhs", "sobol"),
+                   help="random (default), lhs (Latin hypercube) or sobol (scrambled)")
+    g.add_argument("--limit", action="append", metavar="FIGURE=MIN:MAX",
+                   help="the window the yield counts (repeatable, both bounds): fn_hz=3.3k:3.7k, "
+                        "overshoot_pct=0:55; figures fn_hz, zeta, q, ideal_fn_hz, ideal_zeta, ideal_q, "
+                        "overshoot_pct, peak_time_s, gain")
+
+
+def _monte_carlo_settings(args):
+    """The Monte Carlo's options checked before any work (None without --monte-carlo)."""
+    given = [f for f, v in (("--tol", args.tol), ("--limit", args.limit)) if v]
+    if args.monte_carlo is None:
+        if given:
+            raise DesignError(f"{given[0]} goes with --monte-carlo N")
+        return None
+    from ..tolerance.montecarlo import MAX_SAMPLES, MIN_SAMPLES
+    from ..tolerance.plant import FIGURES
+    from ..tolerance.stats import parse_limit
+    try:
+        n = int(str(args.monte_carlo).strip())
+    except ValueError:
+        raise DesignError(f"--monte-carlo {args.monte_carlo!r}: give a whole number of builds, {MIN_SAMPLES} to "
+                          f"{MAX_SAMPLES:.0e}") from None
+    if not MIN_SAMPLES <= n <= MAX_SAMPLES:
+        raise DesignError(f"--monte-carlo must be {MIN_SAMPLES} to {MAX_SAMPLES:.0e} builds, got {n}")
+    try:
+        seed = int(str(args.seed).strip())
+        if seed < 0:
+            raise ValueError
+    except ValueError:
+        raise DesignError(f"--seed {args.seed!r}: give a whole number >= 0") from None
+    for item in args.limit or ():
+        parse_limit(item, FIGURES)
+    from ..tolerance.parts import check_items
+    check_items(args.tol or (), ("R1", "R2", "C1", "C2", "R3", "R4"))
+    return n, seed
+
+
+def _with_monte_carlo(result, args, settings):
+    """The tolerance analysis of the result's parts as built, attached to it."""
+    if settings is None:
+        return result
+    from ..tolerance.montecarlo import plant_monte_carlo
+    n, seed = settings
+    s = result.sourcing
+    result.monte_carlo = plant_monte_carlo(result.built, {"R": s.r_series, "C": s.c_series}, result.opamp, n, seed,
+                                           args.sampler, args.dist, args.tol or (), args.limit or ())
+    return result
 
 
 def _add_bench_options(group):
@@ -82,10 +148,11 @@ def _design(args) -> int:
                      square_hz=args.square_freq, alternatives=args.alternatives, package=args.package)
     name = args.name if args.name is not None else (
         f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
+    mc = _monte_carlo_settings(args)
     check_output(args, name)
     from ..plant.design import design_plant
     result = design_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
-    return _emit(result, args, name)
+    return _emit(_with_monte_carlo(result, args, mc), args, name)
 
 
 def _emit(result, args, name) -> int:
@@ -121,6 +188,7 @@ def _analyze_parser():
     g.add_argument("--c-series", default=None, help="series the capacitors come from, for the tolerance band "
                                                     "(default: the smallest series that holds each value)")
     _add_bench_options(add_output_options(p, "built_r1820_r21k_c110n_c2220n"))
+    _add_tolerance_options(p)
     return p
 
 
@@ -140,8 +208,10 @@ def _analyze(args) -> int:
     p = spec.parts
     name = args.name if args.name is not None else "built_" + "_".join(
         f"{k}{value_code(v)}" for k, v in (("r1", p.r1), ("r2", p.r2), ("c1", p.c1), ("c2", p.c2)))
+    mc = _monte_carlo_settings(args)
     check_output(args, name)
-    return _emit(analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, name)
+    result = analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
+    return _emit(_with_monte_carlo(result, args, mc), args, name)
 
 
 def design_plant_main(argv=None) -> int:

@@ -208,8 +208,11 @@ def _n(v):
 
 
 def summary_text(result) -> str:
-    """The terminal summary: the build sheet without plots."""
-    return R.to_text(title_of(result), sections(result, with_images=False))
+    """The terminal summary: the build sheet without plots (and the Monte Carlo's lines when run)."""
+    text = R.to_text(title_of(result), sections(result, with_images=False))
+    if result.monte_carlo is not None:
+        text += "\n" + "\n".join(result.monte_carlo.summary_lines()) + "\n"
+    return text
 
 
 def plots(result) -> dict:
@@ -282,5 +285,7 @@ def write_outputs(result, out_dir, name: str) -> dict:
     recorded in ``result.files`` before result.json is written, so it lists itself.
     """
     texts = {"waveforms_csv": ("waveforms.csv", waveforms_csv), "bom_csv": ("bom.csv", lambda r: bom_csv(bom(r)))}
+    if result.monte_carlo is not None:   # one row per sample: every varied part and every figure
+        texts["monte_carlo_csv"] = ("monte-carlo.csv", lambda r: r.monte_carlo.csv_text())
     return write_design(result, out_dir, name, PLOTS, schematic,
                         lambda svg: sections(result, schematic_svg=svg), title_of(result), texts)

@@ -227,6 +227,8 @@ class PlantResult:
     scope: ScopeSetup | None = None      #: the scope as set for the square-wave test
     sine: SineCheck | None = None        #: the sine check (resonance peak, -3 dB), SPICE .ac when simulated
     package: str | None = None           #: the op-amp package kind the sheet wires (None: the op-amp's default)
+    #: a tolerance analysis of the parts as built (designer.tolerance.montecarlo.MonteCarlo), when asked for
+    monte_carlo: object = None
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
@@ -259,6 +261,7 @@ class PlantResult:
             "test_signal": self.test.to_dict(),
             "checks": [c.to_dict() for c in self.checks],
             "notes": self.notes,
+            "monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
             "analytic": _metrics(self.analytic.step),
             "analytic_opamp": _metrics(self.analytic_opamp.step),
             "spice": None if self.spice is None else self.spice.to_dict(),

@@ -1,0 +1,171 @@
+"""A Monte Carlo of a Sallen-Key plant as built (analytic engine, :mod:`.plant`):
+its parts drawn within their tolerances, every figure of every sample, the
+statistics, the yield against the user's limits with its 95 % Wilson interval,
+each part's share of each limited figure's variance, the samples that fail each
+limit (the worst few), and the part whose tolerance halved raises the yield most.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.errors import DesignError
+from . import plant as engine
+from . import sampling
+from .parts import DISTRIBUTIONS, resolve
+from .stats import figure_stats, parse_limit, variance_shares, wilson
+
+#: the number of samples allowed
+MIN_SAMPLES, MAX_SAMPLES = 10, 10 ** 7
+#: failing samples listed per limit (the worst)
+WORST = 5
+
+
+@dataclass
+class MonteCarlo:
+    """The run's settings and what it found (arrays kept for the CSV; :meth:`to_dict` is the JSON)."""
+
+    n: int
+    seed: int
+    sampler: str
+    dist: str
+    engine: str
+    tolerances: object                 #: parts.Tolerances
+    nominal: dict                      #: designator -> nominal value
+    values: dict = field(repr=False)   #: designator -> sampled values
+    figures: dict = field(repr=False)  #: figure -> array over the samples
+    nominal_figures: dict = field(default_factory=dict)
+    limits: tuple = ()
+    stats: dict = field(default_factory=dict)
+    passed: np.ndarray = field(default=None, repr=False)
+    shares: dict = field(default_factory=dict)
+    failing: dict = field(default_factory=dict)
+    tighten: dict | None = None
+
+    @property
+    def yield_count(self) -> int:
+        return int(np.count_nonzero(self.passed)) if self.passed is not None else self.n
+
+    def yield_interval(self) -> tuple:
+        return wilson(self.yield_count, self.n)
+
+    def to_dict(self) -> dict:
+        lo, hi = self.yield_interval()
+        return {"settings": {"samples": self.n, "seed": self.seed, "sampler": self.sampler, "dist": self.dist,
+                             "engine": self.engine, "tolerances_pct": self.tolerances.to_dict()},
+                "nominal_parts": self.nominal, "nominal_figures": self.nominal_figures,
+                "limits": [lim.to_dict() for lim in self.limits],
+                "statistics": {k: v.to_dict() for k, v in self.stats.items()},
+                "yield": None if not self.limits else {"passed": self.yield_count, "samples": self.n,
+                                                        "fraction": self.yield_count / self.n,
+                                                        "ci95": [lo, hi], "interval": "Wilson"},
+                "variance_shares": {"method": "standardised regression coefficients, squared", **self.shares},
+                "failing_samples": self.failing, "tighten": self.tighten}
+
+    def csv_text(self) -> str:
+        """One row per sample: its index, every varied part's value, every figure."""
+        refs, figs = list(self.values), list(self.figures)
+        out = io.StringIO()
+        out.write(",".join(["sample", *(f"{r}" for r in refs), *figs]) + "\n")
+        cols = [np.arange(self.n)] + [self.values[r] for r in refs] + [self.figures[f] for f in figs]
+        np.savetxt(out, np.column_stack(cols), delimiter=",", fmt=["%d"] + ["%.10g"] * (len(cols) - 1))
+        return out.getvalue()
+
+
+    def summary_lines(self) -> list:
+        """A few lines for the text summary."""
+        mc = self
+        out = [f"Monte Carlo: {mc.n} samples ({mc.sampler}, {mc.dist}, seed {mc.seed}), tolerances "
+               + ", ".join(f"{r} {100 * t:g} %" for r, t in mc.tolerances.of.items())]
+        for k in ("fn_hz", "zeta", "overshoot_pct"):
+            s = mc.stats[k]
+            p = s.percentiles
+            out.append(f"  {k}: nominal {s.nominal:.5g}, mean {s.mean:.5g}, std {s.std:.3g}, 2.5..97.5 % "
+                       f"{p[2.5]:.5g}..{p[97.5]:.5g}")
+        if mc.limits:
+            lo, hi = mc.yield_interval()
+            out.append(f"  yield {100 * mc.yield_count / mc.n:.2f} % ({mc.yield_count}/{mc.n}; 95 % Wilson interval "
+                       f"{100 * lo:.2f}..{100 * hi:.2f} %) within " + ", ".join(lim.text() for lim in mc.limits))
+            if mc.tighten:
+                t = mc.tighten
+                out.append(f"  buy {t['part']} tighter: at {t['tolerance_pct']:g} % the yield is {100 * t['yield']:.2f} %")
+        return out
+
+
+def _figures(values: dict, fixed: dict, opamp) -> dict:
+    return engine.plant_figures({**{k: np.full(next(iter(values.values())).shape, v) for k, v in fixed.items()},
+                                 **values}, opamp)
+
+
+def _yield(figs: dict, limits) -> np.ndarray:
+    ok = np.ones(next(iter(figs.values())).shape, bool)
+    for lim in limits:
+        ok &= lim.inside(figs[lim.figure])
+    return ok
+
+
+def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler: str = "random",
+                      dist: str = "uniform", tol_items=(), limit_items=(), tighten: bool = True) -> MonteCarlo:
+    """A Monte Carlo of the Sallen-Key ``parts`` (:class:`~designer.plant.sallenkey.SallenKeyParts`).
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+    series : dict
+        ``{"R": "E24", "C": "E12"}``: the series the parts come from (their default tolerances;
+        None for a part typed by hand).
+    opamp : OpAmp
+        The op-amp of the op-amp-aware figures (``fn_hz``, ``zeta``, the step).
+    n : int
+        Samples, :data:`MIN_SAMPLES` to :data:`MAX_SAMPLES`.
+    seed : int
+        Sample i is a function of (seed, i) alone.
+    sampler, dist : str
+        :data:`designer.tolerance.sampling.SAMPLERS`; ``uniform`` or ``normal``.
+    tol_items, limit_items : sequence of str
+        ``--tol`` items (``R=1%``, ``C2=2%``) and ``--limit`` items (``fn_hz=3.3k:3.7k``).
+    tighten : bool
+        Also find the part whose tolerance halved raises the yield most (one more run per part).
+    """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_SAMPLES <= n <= MAX_SAMPLES:
+        raise DesignError(f"--monte-carlo must be a whole number of samples from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
+                          f"got {n!r}")
+    if dist not in DISTRIBUTIONS:
+        raise DesignError(f"--dist {dist!r} unknown; allowed: {', '.join(DISTRIBUTIONS)}")
+    if sampler not in sampling.SAMPLERS:
+        raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(sampling.SAMPLERS)}")
+    limits = tuple(parse_limit(t, engine.FIGURES) for t in limit_items or ())
+    nominal = {"R1": parts.r1, "R2": parts.r2, "C1": parts.c1, "C2": parts.c2}
+    if parts.r3 is not None and parts.r4 is not None and parts.gain > 1:
+        nominal.update(R3=parts.r3, R4=parts.r4)
+    tol = resolve(tol_items, nominal, series)
+    values = sampling.values(nominal, tol.of, n, seed, sampler, dist)
+    figs = _figures(values, {}, opamp)
+    nominal_figs = {k: float(v[0]) for k, v in _figures({r: np.array([x]) for r, x in nominal.items()}, {},
+                                                         opamp).items()}
+    by_fig = {lim.figure: lim for lim in limits}
+    stats = {k: figure_stats(k, v, nominal_figs[k], by_fig.get(k)) for k, v in figs.items()}
+    rel = {r: values[r] / nominal[r] - 1 for r in values}
+    shares = {k: variance_shares(rel, figs[k]) for k in (by_fig or ("fn_hz", "zeta", "overshoot_pct"))}
+    mc = MonteCarlo(n, seed, sampler, dist, "analytic", tol, nominal, values, figs, nominal_figs, limits, stats,
+                    _yield(figs, limits) if limits else None, shares)
+    for lim in limits:
+        bad = np.nonzero(~lim.inside(figs[lim.figure]))[0]
+        v = figs[lim.figure][bad]
+        centre = 0.5 * ((lim.min if lim.min is not None else lim.max) + (lim.max if lim.max is not None else lim.min))
+        order = np.argsort(-np.abs(np.nan_to_num(v, nan=np.inf) - centre))[:WORST]
+        mc.failing[lim.figure] = {"count": int(bad.size), "worst": [int(i) for i in bad[order]]}
+    if tighten and limits:
+        best = None
+        for ref in tol.of:
+            halved = dict(tol.of, **{ref: tol.of[ref] / 2})
+            y = float(np.mean(_yield(_figures(sampling.values(nominal, halved, n, seed, sampler, dist), {}, opamp),
+                                     limits)))
+            if best is None or y > best[1]:
+                best = (ref, y)
+        mc.tighten = {"part": best[0], "tolerance_pct": 100 * tol.of[best[0]] / 2, "yield": best[1],
+                      "yield_now": mc.yield_count / n}
+    return mc

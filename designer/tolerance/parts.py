@@ -1,0 +1,106 @@
+"""Each part's tolerance: from its E-series (E24 5 %, E96 1 %, E12 10 %, as the
+build sheet states, :data:`designer.core.eseries.TOLERANCE`) unless the user gives
+it, by class (``R=1%``, ``C=5%``) or by designator (``C2=2%``), which wins.
+
+A :class:`Tolerances` that exists is valid: every value above 0 and at most
+:data:`MAX_TOL`, every designator one the design has.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ..core.errors import DesignError
+from ..core.units import parse_value
+
+#: the largest tolerance accepted (a fraction)
+MAX_TOL = 0.5
+#: distributions: uniform in nominal (1 +- tol), or normal with sigma = tol/3 truncated at +- tol
+DISTRIBUTIONS = ("uniform", "normal")
+_ITEM = re.compile(r"^\s*([A-Za-z][A-Za-z0-9]*)\s*=\s*(.+?)\s*$")
+
+
+def parse_tolerance(text: str, where: str) -> float:
+    """``1%``, ``0.5 %``, ``0.01`` -> a fraction in (0, MAX_TOL]."""
+    t = str(text).strip()
+    pct = t.endswith("%")
+    try:
+        v = parse_value(t[:-1].strip() if pct else t, where)
+    except DesignError:
+        raise DesignError(f"{where}: {text!r} is not a tolerance (give a percentage such as 1% or 0.5%)") from None
+    v = v / 100 if pct else v
+    if not 0 < v <= MAX_TOL:
+        raise DesignError(f"{where}: a tolerance must be above 0 and at most {100 * MAX_TOL:g} %, got {text!r}")
+    return float(v)
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Tolerance (fraction) per designator (``R1``, ``C2``) of the parts that vary."""
+
+    of: dict
+
+    def designators(self) -> tuple:
+        return tuple(self.of)
+
+    def to_dict(self) -> dict:
+        return {k: 100 * v for k, v in self.of.items()}
+
+
+def check_items(items, designators) -> None:
+    """``--tol`` items checked before any work: the shape, the value, a class or one of ``designators``."""
+    for item in items:
+        m = _ITEM.match(str(item))
+        if not m:
+            raise DesignError(f"--tol {item!r}: give CLASS=PCT or DESIGNATOR=PCT, such as R=1% or C2=2%")
+        key = m.group(1).upper()
+        parse_tolerance(m.group(2), f"--tol {key}")
+        if key not in ("R", "C") and key not in designators:
+            raise DesignError(f"--tol {key}: no such part; the parts are {', '.join(designators)} (or R, C for "
+                              "every resistor, every capacitor)")
+
+
+def resolve(items, parts: dict, series: dict) -> Tolerances:
+    """The tolerance of each part of ``parts`` (designator -> value).
+
+    Parameters
+    ----------
+    items : sequence of str
+        ``R=1%`` (every resistor), ``C=5%`` (every capacitor), ``C2=2%`` (one part); later items and
+        designators win over classes.
+    parts : dict
+        Designator -> nominal value of every part that varies.
+    series : dict
+        ``"R"``/``"C"`` -> the E-series the design's resistors and capacitors come from (their default
+        tolerance), or None for parts typed by hand (then the class or the designator must be given).
+    """
+    from ..core.eseries import TOLERANCE
+    classes, singles = {}, {}
+    for item in items or ():
+        m = _ITEM.match(str(item))
+        if not m:
+            raise DesignError(f"--tol {item!r}: give CLASS=PCT or DESIGNATOR=PCT, such as R=1% or C2=2%")
+        key, value = m.group(1).upper(), m.group(2)
+        tol = parse_tolerance(value, f"--tol {key}")
+        if key in ("R", "C"):
+            classes[key] = tol
+        elif key in parts:
+            singles[key] = tol
+        else:
+            known = ", ".join(sorted(parts))
+            raise DesignError(f"--tol {key}: this design has no part {key}; its parts are {known} (or R, C for "
+                              "every resistor, every capacitor)")
+    out = {}
+    for ref in parts:
+        kind = ref[0]
+        if ref in singles:
+            out[ref] = singles[ref]
+        elif kind in classes:
+            out[ref] = classes[kind]
+        elif series.get(kind) is not None:
+            out[ref] = TOLERANCE[series[kind]]
+        else:
+            raise DesignError(f"--tol: {ref} was typed by hand, so its series (and tolerance) is unknown; give "
+                              f"--tol {kind}=PCT or --tol {ref}=PCT")
+    return Tolerances(out)

@@ -1,0 +1,68 @@
+"""design-plant and analyze-plant --monte-carlo from the outside (issue 17, the analytic plant engine)."""
+
+import io
+import json
+import os
+import subprocess
+
+import numpy as np
+import pytest
+from helpers import script
+
+DESIGN_PLANT = script("design-plant")
+ANALYZE_PLANT = script("analyze-plant")
+SEED = ["--fc", "3500", "--zeta", "0.2"]
+
+
+def run(exe, *args):
+    env = dict(os.environ, MPLBACKEND="Agg")
+    return subprocess.run([exe, *args], capture_output=True, text=True, env=env, timeout=300)
+
+
+@pytest.mark.spice
+def test_the_bundle_gains_the_monte_carlo(tmp_path):
+    p = run(DESIGN_PLANT, *SEED, "--monte-carlo", "2000", "--seed", "3", "--limit", "fn_hz=3.3k:3.7k",
+            "--limit", "overshoot_pct=0:55", "--json", "--out", str(tmp_path), "--simulator", "ngspice-cli")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)["monte_carlo"]
+    assert d["settings"]["samples"] == 2000 and d["settings"]["seed"] == 3
+    assert d["settings"]["tolerances_pct"] == {"R1": 5.0, "R2": 5.0, "C1": 10.0, "C2": 10.0}   # E24 / E12
+    rows = np.genfromtxt(io.StringIO((tmp_path / "reports" / "plant_fc3500_z0.2" / "monte-carlo.csv").read_text()),
+                         delimiter=",", names=True)
+    inside = (rows["fn_hz"] >= 3300) & (rows["fn_hz"] <= 3700) & (rows["overshoot_pct"] <= 55)
+    assert d["yield"]["passed"] == int(inside.sum())
+    assert d["tighten"]["part"] in ("R1", "R2", "C1", "C2")
+
+
+def test_the_same_seed_gives_the_same_section():
+    args = [*SEED, "--monte-carlo", "500", "--seed", "11", "--tol", "R=1%", "C2=2%", "--limit", "zeta=0.19:0.21",
+            "--no-sim", "--no-files", "--json"]
+    a, b = run(DESIGN_PLANT, *args), run(DESIGN_PLANT, *args)
+    assert a.returncode == b.returncode == 0, a.stderr
+    ma, mb = json.loads(a.stdout)["monte_carlo"], json.loads(b.stdout)["monte_carlo"]
+    assert ma == mb and ma["settings"]["tolerances_pct"]["C2"] == 2.0 and ma["settings"]["tolerances_pct"]["R1"] == 1.0
+
+
+def test_analyze_plant_parts_typed_by_hand():
+    p = run(ANALYZE_PLANT, "--r1", "1k6", "--r2", "3k9", "--c1", "3n3", "--c2", "100n", "--monte-carlo", "200",
+            "--no-sim", "--no-files")
+    assert p.returncode == 0, p.stderr
+    assert "Monte Carlo: 200 samples" in p.stdout
+
+
+@pytest.mark.parametrize("args, what", [
+    (["--monte-carlo", "5"], "--monte-carlo must be 10 to"),
+    (["--monte-carlo", "ten"], "whole number"),
+    (["--monte-carlo", "100", "--tol", "R=0%"], "above 0"),
+    (["--monte-carlo", "100", "--tol", "R=51%"], "at most 50 %"),
+    (["--monte-carlo", "100", "--tol", "X1=1%"], "no such part"),
+    (["--monte-carlo", "100", "--limit", "fn_hz=3k:"], "both bounds"),
+    (["--monte-carlo", "100", "--limit", "fn_hz=4k:3k"], "above max"),
+    (["--monte-carlo", "100", "--sampler", "magic"], "invalid choice"),
+    (["--monte-carlo", "100", "--seed", "-1"], "--seed"),
+    (["--limit", "fn_hz=3k:4k"], "goes with --monte-carlo"),
+])
+def test_bad_settings_one_line_nothing_written(tmp_path, args, what):
+    p = run(DESIGN_PLANT, *SEED, *args, "--no-sim", "--out", str(tmp_path))
+    assert p.returncode == 2 and len(p.stderr.splitlines()) == 1 and what in p.stderr, p.stderr
+    assert not any(tmp_path.iterdir())

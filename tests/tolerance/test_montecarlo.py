@@ -1,0 +1,80 @@
+"""A plant Monte Carlo: the yield against an independent count, every CSV row's
+figures recomputed from its parts, the part to tighten."""
+
+import io
+
+import numpy as np
+import pytest
+
+from designer.core import opamps
+from designer.core.errors import DesignError
+from designer.plant.sallenkey import SallenKeyParts
+from designer.tolerance.montecarlo import plant_monte_carlo
+from designer.tolerance.plant import plant_figures
+
+PARTS = SallenKeyParts(1.6e3, 3.9e3, 3.3e-9, 100e-9)
+SERIES = {"R": "E24", "C": "E12"}
+LIMITS = ["fn_hz=3.3k:3.7k", "overshoot_pct=0:55"]
+
+
+@pytest.fixture(scope="module")
+def mc():
+    return plant_monte_carlo(PARTS, SERIES, opamps.get("LM741"), 5000, seed=2, limit_items=LIMITS)
+
+
+def test_the_series_tolerances_are_the_default(mc):
+    assert mc.tolerances.of == {"R1": 0.05, "R2": 0.05, "C1": 0.10, "C2": 0.10}
+
+
+def test_yield_and_rows_recomputed_from_the_csv(mc):
+    rows = np.genfromtxt(io.StringIO(mc.csv_text()), delimiter=",", names=True)
+    assert rows.size == 5000 and list(rows["sample"][:3]) == [0, 1, 2]
+    v = {k: rows[k] for k in ("R1", "R2", "C1", "C2")}
+    again = plant_figures(v, opamps.get("LM741"))
+    for k in ("fn_hz", "zeta", "overshoot_pct"):
+        np.testing.assert_allclose(again[k], rows[k], rtol=1e-8)
+    inside = (rows["fn_hz"] >= 3300) & (rows["fn_hz"] <= 3700) & (rows["overshoot_pct"] <= 55)
+    assert mc.yield_count == int(inside.sum())
+    d = mc.to_dict()
+    assert d["yield"]["fraction"] == pytest.approx(inside.mean())
+    assert d["yield"]["ci95"][0] < inside.mean() < d["yield"]["ci95"][1]
+
+
+def test_failing_samples_are_the_worst(mc):
+    fn = mc.figures["fn_hz"]
+    worst = mc.failing["fn_hz"]["worst"]
+    assert mc.failing["fn_hz"]["count"] == int(np.count_nonzero((fn < 3300) | (fn > 3700)))
+    assert abs(fn[worst[0]] - 3500) == pytest.approx(np.max(np.abs(fn[(fn < 3300) | (fn > 3700)] - 3500)))
+
+
+def test_tightening_the_suggested_part_raises_the_yield(mc):
+    t = mc.tighten
+    assert t["yield"] >= t["yield_now"]
+    again = plant_monte_carlo(PARTS, SERIES, opamps.get("LM741"), 5000, seed=2, limit_items=LIMITS,
+                              tol_items=[f"{t['part']}={t['tolerance_pct']}%"], tighten=False)
+    assert again.yield_count / 5000 == pytest.approx(t["yield"])
+
+
+def test_the_same_seed_the_same_run_whatever_the_sampler_settings():
+    a = plant_monte_carlo(PARTS, SERIES, opamps.get("LM741"), 300, seed=9, tighten=False)
+    b = plant_monte_carlo(PARTS, SERIES, opamps.get("LM741"), 300, seed=9, tighten=False)
+    assert a.to_dict() == b.to_dict()
+    c = plant_monte_carlo(PARTS, SERIES, opamps.get("LM741"), 300, seed=9, sampler="sobol", tighten=False)
+    assert c.to_dict()["settings"]["sampler"] == "sobol"
+
+
+@pytest.mark.parametrize("kw, what", [({"n": 5}, "--monte-carlo"), ({"tol_items": ["R9=1%"]}, "no part R9"),
+                                      ({"tol_items": ["R=0"]}, "above 0"), ({"dist": "cauchy"}, "--dist"),
+                                      ({"limit_items": ["fn_hz=3k:"]}, "both bounds")])
+def test_bad_settings_are_one_line(kw, what):
+    args = dict(n=100) | kw
+    with pytest.raises(DesignError, match=what) as e:
+        plant_monte_carlo(PARTS, SERIES, opamps.get("LM741"), args.pop("n"), **args)
+    assert "\n" not in str(e.value)
+
+
+def test_parts_typed_by_hand_need_a_tolerance():
+    with pytest.raises(DesignError, match="typed by hand"):
+        plant_monte_carlo(PARTS, {"R": None, "C": "E12"}, opamps.get("LM741"), 100)
+    ok = plant_monte_carlo(PARTS, {"R": None, "C": "E12"}, opamps.get("LM741"), 100, tol_items=["R=1%"])
+    assert ok.tolerances.of["R1"] == 0.01
