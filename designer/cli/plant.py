@@ -68,6 +68,10 @@ def _add_tolerance_options(p):
                    help=f"draw N builds within the parts' tolerances ({MIN_SAMPLES} to {MAX_SAMPLES:.0e}) and report "
                         "every figure's spread, the yield within --limit and the part to buy tighter; adds "
                         "monte_carlo to result.json and monte-carlo.csv (one row per build) to the bundle")
+    g.add_argument("--worst-case", action="store_true",
+                   help="the true extremes of fn_hz, zeta, q, overshoot_pct and peak_time_s over the tolerance box "
+                        "(every corner, then a bounded search from the worst: an extreme can lie inside); adds "
+                        "worst_case to result.json")
     g.add_argument("--seed", default="0", metavar="S", help="the draw's seed (default 0): build i depends on (seed, i) "
                                                             "alone")
     g.add_argument("--tol", nargs="+", metavar="ITEM",
@@ -87,8 +91,12 @@ def _monte_carlo_settings(args):
     """The Monte Carlo's options checked before any work (None without --monte-carlo)."""
     given = [f for f, v in (("--tol", args.tol), ("--limit", args.limit)) if v]
     if args.monte_carlo is None:
-        if given:
-            raise DesignError(f"{given[0]} goes with --monte-carlo N")
+        if args.limit or (args.tol and not args.worst_case):
+            raise DesignError(f"{'--limit' if args.limit else given[0]} goes with --monte-carlo N"
+                              + ("" if args.limit else " (or --worst-case)"))
+        if args.tol:
+            from ..tolerance.parts import check_items
+            check_items(args.tol, ("R1", "R2", "C1", "C2", "R3", "R4"))
         return None
     from ..tolerance.montecarlo import MAX_SAMPLES, MIN_SAMPLES
     from ..tolerance.plant import FIGURES
@@ -114,12 +122,16 @@ def _monte_carlo_settings(args):
 
 
 def _with_monte_carlo(result, args, settings):
-    """The tolerance analysis of the result's parts as built, attached to it."""
+    """The tolerance analysis of the result's parts as built (--monte-carlo, --worst-case), attached to it."""
+    s = result.sourcing
+    if args.worst_case:
+        from ..tolerance.montecarlo import plant_worst_case
+        result.worst_case = plant_worst_case(result.built, {"R": s.r_series, "C": s.c_series}, result.opamp,
+                                             args.tol or ())
     if settings is None:
         return result
     from ..tolerance.montecarlo import plant_monte_carlo
     n, seed = settings
-    s = result.sourcing
     result.monte_carlo = plant_monte_carlo(result.built, {"R": s.r_series, "C": s.c_series}, result.opamp, n, seed,
                                            args.sampler, args.dist, args.tol or (), args.limit or ())
     return result

@@ -210,8 +210,9 @@ def _n(v):
 def summary_text(result) -> str:
     """The terminal summary: the build sheet without plots (and the Monte Carlo's lines when run)."""
     text = R.to_text(title_of(result), sections(result, with_images=False))
-    if result.monte_carlo is not None:
-        text += "\n" + "\n".join(result.monte_carlo.summary_lines()) + "\n"
+    for extra in (result.monte_carlo, result.worst_case):
+        if extra is not None:
+            text += "\n" + "\n".join(extra.summary_lines()) + "\n"
     return text
 
 

@@ -229,6 +229,8 @@ class PlantResult:
     package: str | None = None           #: the op-amp package kind the sheet wires (None: the op-amp's default)
     #: a tolerance analysis of the parts as built (designer.tolerance.montecarlo.MonteCarlo), when asked for
     monte_carlo: object = None
+    #: the extremes over the tolerance box (designer.tolerance.worstcase.WorstCase), when asked for
+    worst_case: object = None
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
@@ -262,6 +264,7 @@ class PlantResult:
             "checks": [c.to_dict() for c in self.checks],
             "notes": self.notes,
             "monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
+            "worst_case": None if self.worst_case is None else self.worst_case.to_dict(),
             "analytic": _metrics(self.analytic.step),
             "analytic_opamp": _metrics(self.analytic_opamp.step),
             "spice": None if self.spice is None else self.spice.to_dict(),

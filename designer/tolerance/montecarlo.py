@@ -107,6 +107,22 @@ def _yield(figs: dict, limits) -> np.ndarray:
     return ok
 
 
+def plant_parts(parts) -> dict:
+    """Designator -> nominal value of the plant's parts that vary (R3, R4 only for a gain above 1)."""
+    nominal = {"R1": parts.r1, "R2": parts.r2, "C1": parts.c1, "C2": parts.c2}
+    if parts.r3 is not None and parts.r4 is not None and parts.gain > 1:
+        nominal.update(R3=parts.r3, R4=parts.r4)
+    return nominal
+
+
+def plant_worst_case(parts, series: dict, opamp, tol_items=()):
+    """:func:`designer.tolerance.worstcase.worst_case` of the plant's figures over its tolerance box."""
+    from .worstcase import worst_case
+    nominal = plant_parts(parts)
+    tol = resolve(tol_items, nominal, series)
+    return worst_case(lambda v: engine.plant_figures(v, opamp), nominal, tol.of)
+
+
 def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler: str = "random",
                       dist: str = "uniform", tol_items=(), limit_items=(), tighten: bool = True) -> MonteCarlo:
     """A Monte Carlo of the Sallen-Key ``parts`` (:class:`~designer.plant.sallenkey.SallenKeyParts`).
@@ -138,9 +154,7 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     if sampler not in sampling.SAMPLERS:
         raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(sampling.SAMPLERS)}")
     limits = tuple(parse_limit(t, engine.FIGURES) for t in limit_items or ())
-    nominal = {"R1": parts.r1, "R2": parts.r2, "C1": parts.c1, "C2": parts.c2}
-    if parts.r3 is not None and parts.r4 is not None and parts.gain > 1:
-        nominal.update(R3=parts.r3, R4=parts.r4)
+    nominal = plant_parts(parts)
     tol = resolve(tol_items, nominal, series)
     values = sampling.values(nominal, tol.of, n, seed, sampler, dist)
     figs = _figures(values, {}, opamp)

@@ -61,8 +61,20 @@ def test_analyze_plant_parts_typed_by_hand():
     (["--monte-carlo", "100", "--sampler", "magic"], "invalid choice"),
     (["--monte-carlo", "100", "--seed", "-1"], "--seed"),
     (["--limit", "fn_hz=3k:4k"], "goes with --monte-carlo"),
+    (["--worst-case", "--tol", "Q1=1%"], "no such part"),
 ])
 def test_bad_settings_one_line_nothing_written(tmp_path, args, what):
     p = run(DESIGN_PLANT, *SEED, *args, "--no-sim", "--out", str(tmp_path))
     assert p.returncode == 2 and len(p.stderr.splitlines()) == 1 and what in p.stderr, p.stderr
     assert not any(tmp_path.iterdir())
+
+
+def test_worst_case_from_the_command_line():
+    p = run(DESIGN_PLANT, *SEED, "--worst-case", "--tol", "R=1%", "--no-sim", "--no-files", "--json")
+    assert p.returncode == 0, p.stderr
+    w = json.loads(p.stdout)["worst_case"]
+    assert w["corners"] == 16 and w["fn_hz"]["min"]["value"] < w["fn_hz"]["max"]["value"]
+    q = run(DESIGN_PLANT, *SEED, "--worst-case", "--no-sim", "--no-files")
+    assert q.returncode == 0 and "Worst case over the tolerance box" in q.stdout
+    r = run(DESIGN_PLANT, *SEED, "--tol", "R=1%", "--no-sim", "--no-files")
+    assert r.returncode == 2 and "--tol goes with --monte-carlo N (or --worst-case)" in r.stderr

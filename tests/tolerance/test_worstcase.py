@@ -1,0 +1,38 @@
+"""Worst case against brute force: a grid over the whole tolerance box."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+from designer.core import opamps
+from designer.tolerance.plant import plant_figures
+from designer.tolerance.worstcase import worst_case
+
+NOMINAL = {"R1": 1.6e3, "R2": 3.9e3, "C1": 3.3e-9, "C2": 100e-9}
+TOL = {"R1": 0.05, "R2": 0.05, "C1": 0.10, "C2": 0.10}
+
+
+def test_plant_extremes_equal_a_brute_force_grid():
+    amp = opamps.get("LM741")
+    wc = worst_case(lambda v: plant_figures(v, amp), NOMINAL, TOL)
+    grid = np.array(list(itertools.product(np.linspace(-1, 1, 9), repeat=4)))
+    v = {r: NOMINAL[r] * (1 + TOL[r] * grid[:, k]) for k, r in enumerate(NOMINAL)}
+    f = plant_figures(v, amp)
+    for fig, (lo, hi) in wc.extremes.items():
+        x = f[fig][np.isfinite(f[fig])]
+        # the grid holds every corner, so it can only be as extreme as the search
+        assert lo.value <= x.min() * (1 + 1e-9) and hi.value >= x.max() * (1 - 1e-9), fig
+        assert lo.value == pytest.approx(x.min(), rel=1e-6) and hi.value == pytest.approx(x.max(), rel=1e-6), fig
+
+
+def test_an_extreme_inside_the_box_is_found():
+    # y = -(a - 0.3)^2: its maximum is inside the box, at a deviation of 0.3, not at a corner
+    def evaluate(v):
+        a = v["A"] / 10.0 - 1.0
+        return {"y": -(a / 0.1 - 0.3) ** 2}
+    wc = worst_case(evaluate, {"A": 10.0}, {"A": 0.1}, figures=("y",))
+    lo, hi = wc.extremes["y"]
+    assert lo.at_corner and lo.value == pytest.approx(-1.69)
+    assert not hi.at_corner and hi.value == pytest.approx(0.0, abs=1e-9)
+    assert hi.deviations["A"] == pytest.approx(0.3, abs=1e-4)
