@@ -91,7 +91,34 @@ def _parser():
     _add_signal_options(p)
     _add_capture_options(p)
     add_output_options(p, "pid_<tuning>_<opamp>_fn<fn>_z<zeta>")
+    _add_monte_carlo(p)
     return p
+
+
+#: the loop's parts a --tol may name: the plant's and the controller's
+LOOP_PARTS = ("R1", "R2", "C1", "C2", *(f"R{i}" for i in range(3, 19)), "C3", "C4")
+
+
+def _add_monte_carlo(p):
+    from .plant import add_monte_carlo_options
+    add_monte_carlo_options(p, "the probability that the loop is unstable or an op-amp leaves its swing, with "
+                               "95 %% intervals, and the spread of its margins and step figures (a Sallen-Key plant; "
+                               "its parts and the controller's vary together)")
+
+
+def _loop_monte_carlo(result, args, settings):
+    """The loop's tolerance analysis, attached to the result (None settings: none)."""
+    if settings is None:
+        return result
+    from ..tolerance.loop import loop_monte_carlo
+    n, seed = settings
+    sel = result.selection
+    # the plant's parts take the plant's series when designed here, else the controller's
+    r, c = (sel.r_series, sel.c_series) if sel is not None else (None, None)
+    if result.plant_series is not None:
+        r, c = r or result.plant_series[0], c or result.plant_series[1]
+    result.monte_carlo = loop_monte_carlo(result, {"R": r, "C": c}, n, seed, args.sampler, args.dist, args.tol or ())
+    return result
 
 
 def _add_model_tuning_options(t):
@@ -256,10 +283,19 @@ def _model_name(spec, method: str) -> str:
     return f"pid_{method}_{spec.opamp.lower()}_{spec.process.kind}"
 
 
+def _monte_carlo_settings(args, spec):
+    from .plant import monte_carlo_settings
+    settings = monte_carlo_settings(args, LOOP_PARTS)
+    if settings is not None and spec.process is not None:
+        raise DesignError("--monte-carlo analyses a Sallen-Key plant's loop for now, not a plant given as a model")
+    return settings
+
+
 def _run(args) -> int:
     from ..pid.design import design_pid
     from ..pid.report import summary_text, write_outputs
     spec = _build_spec(args)
+    mc = _monte_carlo_settings(args, spec)
     if spec.process is not None:
         from ..pid.process_report import summary_text as model_text, write_outputs as model_write
         common.check_output(args, args.name if args.name is not None else "pid_model")
@@ -267,7 +303,7 @@ def _run(args) -> int:
         return emit(result, args, args.name or _model_name(spec, result.method), model_write, model_text)
     # the default name needs the plant as built; its fixed start stands in for it in the check
     common.check_output(args, args.name if args.name is not None else f"pid_{spec.method}")
-    result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
+    result = _loop_monte_carlo(design_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
     name = args.name or _default_name(spec, result.plant.fn_hz, result.plant.zeta)
     return emit(result, args, name, write_outputs, summary_text)
 
@@ -314,6 +350,7 @@ def _analyze_parser():
     _add_signal_options(p)
     _add_capture_options(p)
     add_output_options(p, "pid_as-built_<opamp>_fn<fn>_z<zeta>")
+    _add_monte_carlo(p)
     return p
 
 
@@ -338,13 +375,14 @@ def _analyze(args) -> int:
     typed = _typed(args, ANALYZE_PARAMS)
     spec = PidSpec(plant_parts=_plant_parts(args), controller_parts=parts, package=args.package,
                    plant_process=_captured_model(args, typed), **typed)
+    mc = _monte_carlo_settings(args, spec)
     if spec.process is not None:
         from ..pid.process_report import summary_text as model_text, write_outputs as model_write
         common.check_output(args, args.name if args.name is not None else "pid_as-built")
         result = analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
         return emit(result, args, args.name or _model_name(spec, result.method), model_write, model_text)
     common.check_output(args, args.name if args.name is not None else "pid_as-built")
-    result = analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
+    result = _loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
     name = args.name or (f"pid_{result.tuning.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}"
                          f"_z{result.plant.zeta:.3g}")
     return emit(result, args, name, write_outputs, summary_text)

@@ -60,18 +60,14 @@ result.json, step.png, bode.png. Exit status 2 on bad input.""",
     return p
 
 
-def _add_tolerance_options(p):
-    """--monte-carlo and its settings (design-plant and analyze-plant)."""
+def add_monte_carlo_options(p, what: str):
+    """--monte-carlo, --seed, --tol, --dist, --sampler (the plant's and the loop's); returns the group."""
     from ..tolerance.montecarlo import MAX_SAMPLES, MIN_SAMPLES
     g = p.add_argument_group("tolerance analysis (Monte Carlo of the parts as built, analytic)")
     g.add_argument("--monte-carlo", metavar="N",
                    help=f"draw N builds within the parts' tolerances ({MIN_SAMPLES} to {MAX_SAMPLES:.0e}) and report "
-                        "every figure's spread, the yield within --limit and the part to buy tighter; adds "
-                        "monte_carlo to result.json and monte-carlo.csv (one row per build) to the bundle")
-    g.add_argument("--worst-case", action="store_true",
-                   help="the true extremes of fn_hz, zeta, q, overshoot_pct and peak_time_s over the tolerance box "
-                        "(every corner, then a bounded search from the worst: an extreme can lie inside); adds "
-                        "worst_case to result.json")
+                        f"{what}; adds monte_carlo to result.json and monte-carlo.csv (one row per build) to the "
+                        "bundle")
     g.add_argument("--seed", default="0", metavar="S", help="the draw's seed (default 0): build i depends on (seed, i) "
                                                             "alone")
     g.add_argument("--tol", nargs="+", metavar="ITEM",
@@ -81,13 +77,28 @@ def _add_tolerance_options(p):
                    help="uniform in nominal (1 +- tol) (default), or normal with sigma = tol/3 truncated at +- tol")
     g.add_argument("--sampler", default="random", choices=("random", "lhs", "sobol"),
                    help="random (default), lhs (Latin hypercube) or sobol (scrambled)")
+    g.set_defaults(limit=None, worst_case=False)
+    return g
+
+
+def _add_tolerance_options(p):
+    """--monte-carlo and its settings, --limit and --worst-case (design-plant and analyze-plant)."""
+    g = add_monte_carlo_options(p, "every figure's spread, the yield within --limit and the part to buy tighter")
+    g.add_argument("--worst-case", action="store_true",
+                   help="the true extremes of fn_hz, zeta, q, overshoot_pct and peak_time_s over the tolerance box "
+                        "(every corner, then a bounded search from the worst: an extreme can lie inside); adds "
+                        "worst_case to result.json")
     g.add_argument("--limit", action="append", metavar="FIGURE=MIN:MAX",
                    help="the window the yield counts (repeatable, both bounds): fn_hz=3.3k:3.7k, "
                         "overshoot_pct=0:55; figures fn_hz, zeta, q, ideal_fn_hz, ideal_zeta, ideal_q, "
                         "overshoot_pct, peak_time_s, gain")
 
 
-def _monte_carlo_settings(args):
+#: the designators a plant's --tol may name
+PLANT_PARTS = ("R1", "R2", "C1", "C2", "R3", "R4")
+
+
+def monte_carlo_settings(args, designators=PLANT_PARTS):
     """The Monte Carlo's options checked before any work (None without --monte-carlo)."""
     given = [f for f, v in (("--tol", args.tol), ("--limit", args.limit)) if v]
     if args.monte_carlo is None:
@@ -96,7 +107,7 @@ def _monte_carlo_settings(args):
                               + ("" if args.limit else " (or --worst-case)"))
         if args.tol:
             from ..tolerance.parts import check_items
-            check_items(args.tol, ("R1", "R2", "C1", "C2", "R3", "R4"))
+            check_items(args.tol, designators)
         return None
     from ..tolerance.montecarlo import MAX_SAMPLES, MIN_SAMPLES
     from ..tolerance.plant import FIGURES
@@ -117,7 +128,7 @@ def _monte_carlo_settings(args):
     for item in args.limit or ():
         parse_limit(item, FIGURES)
     from ..tolerance.parts import check_items
-    check_items(args.tol or (), ("R1", "R2", "C1", "C2", "R3", "R4"))
+    check_items(args.tol or (), designators)
     return n, seed
 
 
@@ -160,7 +171,7 @@ def _design(args) -> int:
                      square_hz=args.square_freq, alternatives=args.alternatives, package=args.package)
     name = args.name if args.name is not None else (
         f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
-    mc = _monte_carlo_settings(args)
+    mc = monte_carlo_settings(args)
     check_output(args, name)
     from ..plant.design import design_plant
     result = design_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
@@ -220,7 +231,7 @@ def _analyze(args) -> int:
     p = spec.parts
     name = args.name if args.name is not None else "built_" + "_".join(
         f"{k}{value_code(v)}" for k, v in (("r1", p.r1), ("r2", p.r2), ("c1", p.c1), ("c2", p.c2)))
-    mc = _monte_carlo_settings(args)
+    mc = monte_carlo_settings(args)
     check_output(args, name)
     result = analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
     return _emit(_with_monte_carlo(result, args, mc), args, name)

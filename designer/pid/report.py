@@ -369,7 +369,10 @@ def _fmt(v, unit, signed=False):
 
 
 def summary_text(result) -> str:
-    return R.to_text(title_of(result), sections(result, with_images=False))
+    text = R.to_text(title_of(result), sections(result, with_images=False))
+    if result.monte_carlo is not None:
+        text += "\n" + "\n".join(result.monte_carlo.summary_lines()) + "\n"
+    return text
 
 
 # ---- plots -------------------------------------------------------------------
@@ -470,4 +473,6 @@ def write_outputs(result, out_dir, name: str) -> dict:
     plots, schematic, bom.csv) under ``out_dir``, each written atomically."""
     return write_design(result, out_dir, name, PLOTS, schematic,
                         lambda svg: sections(result, schematic_svg=svg), title_of(result),
-                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r)))})
+                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))),
+                         **({"monte_carlo_csv": ("monte-carlo.csv", lambda r: r.monte_carlo.csv_text())}
+                            if result.monte_carlo is not None else {})})

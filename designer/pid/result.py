@@ -149,6 +149,8 @@ class PidResult:
     diff_amp: object = None             #: designer.pid.model.DiffAmpBalance when R15..R18 are unbalanced
     seed_bench: object = None           #: designer.pid.design.SeedBenchFinding for the seed's as-built parts
     package: str | None = None          #: op-amp package kind the sheet wires (None: the op-amp's default)
+    #: a tolerance analysis of the loop (designer.tolerance.loop.LoopMonteCarlo), when asked for
+    monte_carlo: object = None
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
@@ -192,6 +194,7 @@ class PidResult:
             "scope": None if self.scope is None else self.scope.to_dict(),
             "difference_amplifier": None if self.diff_amp is None else self.diff_amp.to_dict(),
             "seed_bench": None if self.seed_bench is None else self.seed_bench.to_dict(),
+            "monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
             "files": self.files,
         }
         return json_safe(out)

@@ -23,7 +23,8 @@ def wilson(k: int, n: int, z: float = Z95) -> tuple:
     den = 1 + z * z / n
     mid = (p + z * z / (2 * n)) / den
     half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
-    return (max(0.0, mid - half), min(1.0, mid + half))
+    # at k = 0 (k = n) the interval starts at 0 (ends at 1) exactly, not at a rounding error from it
+    return (0.0 if k == 0 else max(0.0, mid - half), 1.0 if k == n else min(1.0, mid + half))
 
 
 @dataclass(frozen=True)

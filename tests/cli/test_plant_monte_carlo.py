@@ -78,3 +78,26 @@ def test_worst_case_from_the_command_line():
     assert q.returncode == 0 and "Worst case over the tolerance box" in q.stdout
     r = run(DESIGN_PLANT, *SEED, "--tol", "R=1%", "--no-sim", "--no-files")
     assert r.returncode == 2 and "--tol goes with --monte-carlo N (or --worst-case)" in r.stderr
+
+
+DESIGN_PID = script("design-pid")
+
+
+def test_design_pid_monte_carlo_of_the_loop():
+    p = run(DESIGN_PID, "--plant-fc", "3500", "--plant-zeta", "0.2", "--monte-carlo", "50", "--seed", "2",
+            "--no-sim", "--no-files", "--json")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)["monte_carlo"]
+    assert d["settings"]["samples"] == 50 and "p_unstable" in d and "p_saturated" in d
+    assert set(d["settings"]["tolerances_pct"]) >= {"R1", "C2", "R3", "R18", "C4"}
+
+
+@pytest.mark.parametrize("args, what", [
+    (["--plant-tf", "K=2 tau=1m", "--monte-carlo", "50"], "Sallen-Key plant's loop for now"),
+    (["--plant-fc", "3500", "--plant-zeta", "0.2", "--monte-carlo", "50", "--tol", "C9=1%"], "no such part"),
+    (["--plant-fc", "3500", "--plant-zeta", "0.2", "--tol", "R=1%"], "goes with --monte-carlo"),
+])
+def test_design_pid_monte_carlo_refusals(tmp_path, args, what):
+    p = run(DESIGN_PID, *args, "--no-sim", "--out", str(tmp_path))
+    assert p.returncode == 2 and len(p.stderr.splitlines()) == 1 and what in p.stderr, p.stderr
+    assert not any(tmp_path.iterdir())
