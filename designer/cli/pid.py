@@ -288,6 +288,8 @@ def _monte_carlo_settings(args, spec):
     settings = monte_carlo_settings(args, LOOP_PARTS)
     if settings is not None and spec.process is not None:
         raise DesignError("--monte-carlo analyses a Sallen-Key plant's loop for now, not a plant given as a model")
+    if any(str(t).strip().upper().startswith("GBW") for t in args.tol or ()):
+        raise DesignError("--tol GBW spreads a plant's op-amp (design-plant); a loop's op-amps do not vary yet")
     return settings
 
 

@@ -72,7 +72,8 @@ def add_monte_carlo_options(p, what: str):
                                                             "alone")
     g.add_argument("--tol", nargs="+", metavar="ITEM",
                    help="tolerances (default: the series', E24 5 %%, E12 10 %%...): R=1%% C=5%% (a class) or "
-                        "C2=2%% (a part); each above 0 and at most 50 %%")
+                        "C2=2%% (a part), GBW=30%% (the op-amp's gain-bandwidth, a plant's); each above 0 and at "
+                        "most 50 %%")
     g.add_argument("--dist", default="uniform", choices=("uniform", "normal"),
                    help="uniform in nominal (1 +- tol) (default), or normal with sigma = tol/3 truncated at +- tol")
     g.add_argument("--sampler", default="random", choices=("random", "lhs", "sobol"),

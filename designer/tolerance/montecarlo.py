@@ -155,6 +155,10 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
         raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(sampling.SAMPLERS)}")
     limits = tuple(parse_limit(t, engine.FIGURES) for t in limit_items or ())
     nominal = plant_parts(parts)
+    if any(str(t).strip().upper().startswith("GBW") for t in tol_items or ()):
+        if opamp.ideal:
+            raise DesignError("--tol GBW: the ideal op-amp has no gain-bandwidth to spread")
+        nominal["GBW"] = opamp.gbw_hz     # varies only when asked: a datasheet's typical is not a tolerance
     tol = resolve(tol_items, nominal, series)
     values = sampling.values(nominal, tol.of, n, seed, sampler, dist)
     figs = _figures(values, {}, opamp)

@@ -18,6 +18,8 @@ from ..core.units import parse_value
 MAX_TOL = 0.5
 #: distributions: uniform in nominal (1 +- tol), or normal with sigma = tol/3 truncated at +- tol
 DISTRIBUTIONS = ("uniform", "normal")
+#: the op-amp's figures a --tol may spread (only when named: no series gives them)
+OPAMP_FIGURES = ("GBW",)
 _ITEM = re.compile(r"^\s*([A-Za-z][A-Za-z0-9]*)\s*=\s*(.+?)\s*$")
 
 
@@ -56,7 +58,7 @@ def check_items(items, designators) -> None:
             raise DesignError(f"--tol {item!r}: give CLASS=PCT or DESIGNATOR=PCT, such as R=1% or C2=2%")
         key = m.group(1).upper()
         parse_tolerance(m.group(2), f"--tol {key}")
-        if key not in ("R", "C") and key not in designators:
+        if key not in ("R", "C") and key not in designators and key not in OPAMP_FIGURES:
             raise DesignError(f"--tol {key}: no such part; the parts are {', '.join(designators)} (or R, C for "
                               "every resistor, every capacitor)")
 
@@ -98,6 +100,8 @@ def resolve(items, parts: dict, series: dict) -> Tolerances:
             out[ref] = singles[ref]
         elif kind in classes:
             out[ref] = classes[kind]
+        elif ref in OPAMP_FIGURES:
+            raise DesignError(f"--tol {ref}: give its spread (such as {ref}=30%)")
         elif series.get(kind) is not None:
             out[ref] = TOLERANCE[series[kind]]
         else:

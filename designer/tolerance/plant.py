@@ -1,7 +1,8 @@
 """The analytic engine for a Sallen-Key plant: every figure of every sample at
 once, vectorised in numpy.
 
-Per sample (arrays of R1, R2, C1, C2 and, for a gain above 1, R3, R4):
+Per sample (arrays of R1, R2, C1, C2, for a gain above 1 R3, R4, and optionally
+GBW, the op-amp's gain-bandwidth in Hz):
 
 - ``ideal_fn_hz``, ``ideal_zeta``, ``ideal_q``: K/(a s^2 + b s + 1) of the parts alone
   (:func:`designer.plant.sallenkey.fn_zeta`, seed 001's formulas);
@@ -45,7 +46,8 @@ def _cubic(v: dict, opamp):
         b = c1 * (r1 + r2) + r1 * c2 * (1 - k)
         return np.zeros_like(r1), i2 / k, b / k, 1 / k
     a0 = opamp.a0
-    wp = 2 * math.pi * opamp.gbw_hz / a0
+    # the op-amp's own spread (--tol GBW=30%): a gain-bandwidth per sample
+    wp = 2 * math.pi * v.get("GBW", opamp.gbw_hz) / a0
     n1, n0 = 1.0 / (wp * a0), (1.0 + a0 / k) / a0
     return n1 * i2, n1 * i1 + n0 * i2, n1 + n0 * i1 - r1 * c2, n0 * np.ones_like(r1)
 

@@ -96,8 +96,15 @@ def test_design_pid_monte_carlo_of_the_loop():
     (["--plant-tf", "K=2 tau=1m", "--monte-carlo", "50"], "Sallen-Key plant's loop for now"),
     (["--plant-fc", "3500", "--plant-zeta", "0.2", "--monte-carlo", "50", "--tol", "C9=1%"], "no such part"),
     (["--plant-fc", "3500", "--plant-zeta", "0.2", "--tol", "R=1%"], "goes with --monte-carlo"),
+    (["--plant-fc", "3500", "--plant-zeta", "0.2", "--monte-carlo", "50", "--tol", "GBW=30%"], "do not vary yet"),
 ])
 def test_design_pid_monte_carlo_refusals(tmp_path, args, what):
     p = run(DESIGN_PID, *args, "--no-sim", "--out", str(tmp_path))
     assert p.returncode == 2 and len(p.stderr.splitlines()) == 1 and what in p.stderr, p.stderr
     assert not any(tmp_path.iterdir())
+
+
+def test_design_plant_spreads_the_opamp_when_asked():
+    p = run(DESIGN_PLANT, *SEED, "--monte-carlo", "200", "--tol", "GBW=30%", "--no-sim", "--no-files", "--json")
+    assert p.returncode == 0, p.stderr
+    assert json.loads(p.stdout)["monte_carlo"]["settings"]["tolerances_pct"]["GBW"] == 30.0

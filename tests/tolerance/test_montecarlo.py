@@ -78,3 +78,21 @@ def test_parts_typed_by_hand_need_a_tolerance():
         plant_monte_carlo(PARTS, {"R": None, "C": "E12"}, opamps.get("LM741"), 100)
     ok = plant_monte_carlo(PARTS, {"R": None, "C": "E12"}, opamps.get("LM741"), 100, tol_items=["R=1%"])
     assert ok.tolerances.of["R1"] == 0.01
+
+
+def test_the_opamps_gain_bandwidth_spreads_when_asked():
+    amp = opamps.get("LM741")
+    fixed = plant_monte_carlo(PARTS, SERIES, amp, 400, seed=1, tighten=False)
+    spread = plant_monte_carlo(PARTS, SERIES, amp, 400, seed=1, tol_items=["GBW=30%"], tighten=False)
+    assert "GBW" not in fixed.values and spread.tolerances.of["GBW"] == 0.3
+    gbw = spread.values["GBW"]
+    assert gbw.min() >= 0.7 * amp.gbw_hz and gbw.max() <= 1.3 * amp.gbw_hz
+    # a row recomputed with its own GBW: the op-amp's catalogue entry with that gain-bandwidth
+    from dataclasses import replace
+    i = int(np.argmin(gbw))
+    one = {k: v[i:i + 1] for k, v in spread.values.items() if k != "GBW"}
+    again = plant_figures(one, replace(amp, gbw_hz=float(gbw[i])))
+    assert again["fn_hz"][0] == pytest.approx(spread.figures["fn_hz"][i], rel=1e-12)
+    assert spread.stats["fn_hz"].std > fixed.stats["fn_hz"].std
+    with pytest.raises(DesignError, match="ideal op-amp"):
+        plant_monte_carlo(PARTS, SERIES, opamps.get("ideal"), 100, tol_items=["GBW=30%"])
