@@ -17,7 +17,7 @@ from ..core import eseries
 from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import write_design
-from ..report.plots import decimate, figure, loop_gain_plot, png_bytes, step_plot
+from ..report.plots import decimate, figure, loop_gain_plot, png_bytes, step_plot, time_unit
 from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
 from .model import OPAMP_OUTPUTS
@@ -409,7 +409,8 @@ def _loop_gain_plot(result) -> bytes:
 
 def _blocks_plot(result) -> bytes:
     w = result.waveforms
-    t = w.t * 1e6
+    scale, unit = time_unit(float(w.t[-1]))
+    t = w.t * scale
     sp = None if result.spice is None else result.spice.waves
     amp = result.opamp
     sigs = [(ref, role, s) for ref, role, s in OPAMP_OUTPUTS if s in w.analytic]
@@ -431,7 +432,7 @@ def _blocks_plot(result) -> bytes:
         ax.grid(True, alpha=0.3)
     axes[0].legend(fontsize=7, loc="upper right")
     axes[0].set_title("Every op-amp output (red: output limits, drawn when reached)")
-    axes[-1].set_xlabel("time after the step (us)")
+    axes[-1].set_xlabel(f"time after the step ({unit})")
     return png_bytes(fig, dpi=90, tight=False)
 
 

@@ -68,6 +68,14 @@ def png_bytes(fig, dpi: int = 110, tight: bool = True) -> bytes:
     return buf.getvalue()
 
 
+def time_unit(span_s: float) -> tuple:
+    """(scale, unit) of a time axis: microseconds below 100 ms (every sheet so far), milliseconds below
+    100 s, else seconds (a slow model plant's loop)."""
+    if span_s < 0.1:
+        return 1e6, "us"
+    return (1e3, "ms") if span_s < 100 else (1.0, "s")
+
+
 def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)", residual: tuple | None = None,
               band: tuple | None = None) -> bytes:
     """Overlaid step responses; ``curves`` maps a label to an array on ``t``.
@@ -78,11 +86,12 @@ def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)", residual:
         fig, (ax, ar) = figure(7.5, 4.6, 2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.1]})
     else:
         fig, ax = figure(7.5, 3.8)
-    tus = np.asarray(t) * 1e6
+    scale, unit = time_unit(float(np.nanmax(np.asarray(t, float))) if np.size(t) else 0.0)
+    tus = np.asarray(t) * scale
     if band is not None:
         bt, lo, hi, label = band
         bt, lo, hi = decimate(bt, lo, hi)
-        ax.fill_between(np.asarray(bt) * 1e6, lo, hi, color="#f4c27a", alpha=0.45, lw=0, label=label)
+        ax.fill_between(np.asarray(bt) * scale, lo, hi, color="#f4c27a", alpha=0.45, lw=0, label=label)
     styles = ["-", "--", ":", "-."]
     widths = [2.6, 1.4, 1.4, 1.2]
     for i, (label, y) in enumerate(curves.items()):
@@ -103,7 +112,7 @@ def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)", residual:
         ar.set_title(label, fontsize=8, loc="left")
         ar.grid(True, alpha=0.3)
         last = ar
-    last.set_xlabel("time after the step (us)")
+    last.set_xlabel(f"time after the step ({unit})")
     return png_bytes(fig, dpi=100, tight=False)
 
 
