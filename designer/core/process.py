@@ -138,6 +138,10 @@ def _check_theta(theta, slowest: float, name: str) -> float:
         limit, why = MAX_DEAD_TIME_S, "a plant without a time constant"
     if not 0.0 <= theta <= limit * (1 + 1e-12):
         raise DesignError(f"{name} (dead time) must be 0 to {_g(limit, 's')} ({why}), got {_g(theta, 's')}")
+    if 0.0 < theta < TAU_RANGE.lo:
+        # as short as the shortest time constant at least: a 1e-144 s delay is a typing slip, and the rules
+        # that divide by it give gains of 1e143
+        raise DesignError(f"{name} (dead time) must be 0 or at least {_g(TAU_RANGE.lo, 's')}, got {_g(theta, 's')}")
     return theta
 
 

@@ -53,6 +53,8 @@ LOOP_FLOOR = 1e-4
 MAX_PHASE_CROSSOVERS = 10
 #: most points of the dense grid
 MAX_GRID = 2_000_000
+#: a dead time counts as a corner only within this factor above the loop's fastest other corner (:func:`_corners`)
+DELAY_CORNER_SPAN = 1e8
 
 
 @dataclass(frozen=True)
@@ -175,7 +177,9 @@ def _corners(lp: LoopParts) -> np.ndarray:
     and the crossover of the low-frequency asymptote |K0|/w^m."""
     r = np.abs(np.concatenate([lp.zeros, lp.poles]))
     c = list(r[r > 0])
-    if lp.theta > 0:
+    # a dead time whose 1/theta lies beyond DELAY_CORNER_SPAN x the fastest other corner turns the phase by
+    # under 1e-6 rad anywhere in the band: no corner (1/theta of a 1e-144 s delay overflowed the band's polyval)
+    if lp.theta > 0 and (not c or 1 / lp.theta <= DELAY_CORNER_SPAN * max(c)):
         c.append(1 / lp.theta)
     if lp.m > 0:
         c.append(abs(lp.k0) ** (1 / lp.m))

@@ -236,16 +236,29 @@ def choose_gains(spec: PidSpec, model, reduced, amp, table) -> tuple:
         opt = optimize_model_loop(spec, model, amp, table)
         return (Gains("optimize", opt.kp, opt.ti_s, opt.td_s), opt, [opt.message])
     if spec.tuning is not None:
-        rt = rules.tune_model(reduced, spec.tuning, tauc_s=spec.simc_tauc_s, lambda_s=spec.imc_lambda_s)
+        rt = check_gains(rules.tune_model(reduced, spec.tuning, tauc_s=spec.simc_tauc_s, lambda_s=spec.imc_lambda_s))
         return Gains(rt.rule, rt.kp, rt.ti_s, rt.td_s, rt), None, []
     for row in table:
-        if row.tuning is not None and row.rule in DEFAULT_RULES:
+        if row.tuning is not None and row.reason is None and row.rule in DEFAULT_RULES:
             rt = row.tuning
             return (Gains(rt.rule, rt.kp, rt.ti_s, rt.td_s, rt), None,
                     [f"rule {rt.rule} (the first of {', '.join(DEFAULT_RULES)} that applies to this model; "
                      "--tuning names another, --tuning optimize meets margins and Ms)"])
     raise DesignError("no tuning rule applies to this model (" + "; ".join(r.reason for r in table if r.reason)
                       + "); give --kp, --ti and --td", param="tuning")
+
+
+def check_gains(rt):
+    """A rule's gains inside what the circuit takes (:data:`designer.core.ranges.RANGES` of kp, ti_s,
+    td_s), else a one-line refusal naming the rule (a dead time of 1e-144 s makes SIMC's Kp 1e143)."""
+    from ..core.ranges import RANGES
+    for key, value, label in (("kp", rt.kp, "Kp"), ("ti_s", rt.ti_s, "Ti"), ("td_s", rt.td_s, "Td")):
+        try:
+            RANGES[key].check(value, label)
+        except DesignError as exc:
+            raise DesignError(f"{rt.rule}: its {exc} (the circuit's range): this model is outside what the "
+                              "rule is for") from None
+    return rt
 
 
 def rule_table(spec, model, reduced, amp) -> tuple:
@@ -257,6 +270,7 @@ def rule_table(spec, model, reduced, amp) -> tuple:
             rows.append(RuleRow(r[0], None, r[1], None))
             continue
         try:
+            check_gains(r)
             fc = ideal_crossover_hz(model, r.kp, r.ti_s, r.td_s)
             ctrl = built_controller(r.kp, r.ti_s, r.td_s, fc, spec, amp)
             rows.append(RuleRow(r.rule, r, None, loop_figures(model, ctrl, r.kp, r.ti_s, r.td_s,

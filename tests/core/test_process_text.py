@@ -125,6 +125,13 @@ def test_every_refusal_is_one_line_naming_the_key(text, words):
         assert w in msg, (w, msg)
 
 
+def test_a_dead_time_is_zero_or_at_least_a_picosecond():
+    """Bug fixed (the CLI fuzz): theta = 2e-144 s passed, and the rules that divide by it gave Kp = 1e143."""
+    assert parse_tf("K=1 tau=1 theta=1p").theta_s == 1e-12
+    with pytest.raises(DesignError, match="must be 0 or at least 1 ps"):
+        parse_tf("K=1 tau=1 theta=2e-144")
+
+
 def test_the_dead_time_limit_is_the_documented_ratio():
     parse_tf(f"K=1 tau=1m theta={MAX_DEAD_TIME_RATIO * 1e-3}")
     with pytest.raises(DesignError):
@@ -140,6 +147,7 @@ _TAU = st.floats(-9, 3).map(lambda e: 10.0 ** e)
 def test_format_eng_printed_models_parse_back(K, negative, tau1, tau2, ratio):
     K = -K if negative else K
     theta = ratio * max(tau1, tau2 or 0.0)
+    theta = 0.0 if theta < 1e-12 else theta     # a dead time is 0 or at least 1 ps
     if tau2 is None:
         model, text = fopdt(K, tau1, theta), f"K={format_eng(K)} tau={format_eng(tau1, 's')}"
     else:

@@ -256,10 +256,18 @@ def test_a_microsecond_plant_works_in_spice():
 
 
 def test_a_loop_far_slower_than_its_controller_is_simulated():
-    """Bug fixed (found by the CLI fuzz): IMC with lambda = 10 s on a 1 ms plant puts every pole and zero of
-    the controller above 1000 x the crossover, and the time simulations' reduced controller was a 0-d array."""
+    """Bug fixed (found by the CLI fuzz): IMC with a long lambda on a 1 ms plant puts the controller's poles
+    and zeros far above the crossover, and the time simulations' reduced controller was a 0-d array."""
     from designer.pid.process_loop import simulation_controller
-    res = design(plant_tf=ISSUE_TF, tuning="imc", imc_lambda_s=10.0)
+    res = design(plant_tf=ISSUE_TF, tuning="imc", imc_lambda_s=1.0)
     assert res.analytic.final_value > 0
     num, den = simulation_controller(([1.0, 1e9], [1.0, 1e8]), 1.0)   # both far above 1 Hz: a gain
     assert num.shape == den.shape == (1,) and num[0] / den[0] == pytest.approx(10.0, rel=1e-6)
+
+
+def test_a_rule_whose_gains_the_circuit_cannot_take_is_refused():
+    """Bug fixed (the CLI fuzz): a 1 ps dead time on a 1 s plant gives ZN a Kp of 1e12; the rule is refused
+    in one line, and the table says why for each rule."""
+    with pytest.raises(DesignError, match=r"zn: its Kp must be 0.0001 to 10000") as e:
+        design(plant_tf="K=1 tau=1 theta=1p", tuning="zn")
+    assert "\n" not in str(e.value)
