@@ -84,18 +84,22 @@ def extreme_lines(parts: PidParts, test: SquareTest) -> list:
 def loop_netlist(parts: PidParts, plant: SallenKeyParts) -> Netlist:
     """The whole loop as one table: the plant (U1 and its parts) first, then the
     controller's stages in signal order."""
-    pl = plant_netlist(plant, "u", "y", prefix="p", amp_ref="U1")
-    rows, amps = list(pl.parts), list(pl.amps)
-    for amp, passives in controller_stages(parts):
-        rows += passives
-        amps.append(amp)
-    return Netlist(tuple(rows), tuple(amps))
+    pl, ctl = plant_netlist(plant, "u", "y", prefix="p", amp_ref="U1"), controller_netlist(parts)
+    return Netlist(pl.parts + ctl.parts, pl.amps + ctl.amps)
 
 
 def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test: SquareTest,
                      title: str, expected_final: float, points: int = 20000) -> str:
     """The whole loop as a standalone deck; ``expected_final`` (V) is the settled
     plant output the ``.meas`` levels refer to (the analytic closed loop's)."""
+    about = ["* plant (seed 001, Fig. 43-45): XU1 Sallen-Key; controller (Fig. 66): U2 difference (ve = y - r),",
+             "*   U3 inverter, U4 differentiator, U5 integrator, U6 summer, U7 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y)"]
+    return _loop_deck(parts, opamp, test, title, expected_final, about, [], loop_netlist(parts, plant), points)
+
+
+def _loop_deck(parts, opamp, test, title, expected_final, about, plant_lines, netlist, points, max_step_s=None):
+    """The loop deck either plant gives: header comments (``about``: the plant and controller), the op-amp
+    library, raw ``plant_lines``, supplies, the reference, ``netlist``, the .meas lines, .tran, .end."""
     import logging
 
     from PySpice.Spice.Netlist import Circuit
@@ -106,19 +110,18 @@ def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test:
         f"* op-amps: {opamp.name} ({opamp.description}); supplies {opamp.vcc:g} V / {opamp.vee:g} V",
         f"* reference: 0 -> {test.amplitude_v:g} V square wave at {test.frequency_hz:g} Hz, edges "
         f"{test.edge_s:.3g} s, rising step at {test.delay_s:.4g} s",
-        "* plant (seed 001, Fig. 43-45): XU1 Sallen-Key; controller (Fig. 66): U2 difference (ve = y - r),",
-        "*   U3 inverter, U4 differentiator, U5 integrator, U6 summer, U7 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y)",
+        *about,
         "* Run: ngspice -b <this file>   (prints overshoot_pct, peak_time_s, rise_time_s, settling_time_s,",
         "*   and the extremes of every op-amp output)",
         deck.opamp_library_text().rstrip(),
+        *plant_lines,
     ])
     deck.add_supplies(circuit, opamp)
     circuit.V("ref", "ref", circuit.gnd, test.source())
-    loop_netlist(parts, plant).add_to(circuit, opamp)
+    netlist.add_to(circuit, opamp)
     deck.settle_error_source(circuit, "y", expected_final)
     lines = deck.measure_lines("y", test, expected_final) + extreme_lines(parts, test)
-    return deck.finish_deck(circuit, test, lines, points=points)
-
+    return deck.finish_deck(circuit, test, lines, points=points, max_step_s=max_step_s)
 
 def controller_netlist(parts: PidParts) -> Netlist:
     """The controller alone (U2..U7 and their parts), for a plant that is only a
@@ -140,36 +143,11 @@ def model_loop_deck(parts: PidParts, model, opamp: OpAmp, test: SquareTest, titl
     Sallen-Key plant, the same reference, ``.tran`` and ``.meas`` lines. The
     step is at most the plant's own accuracy hint
     (:func:`~designer.spice.behavioural.max_step_hint_s`)."""
-    import logging
-
-    from PySpice.Spice.Netlist import Circuit
-
     from ..spice.behavioural import max_step_hint_s, plant_lines
-    logging.getLogger("PySpice").setLevel(logging.ERROR)
-    circuit = Circuit(title)
-    circuit.raw_spice = "\n".join([
-        f"* {title}",
-        f"* op-amps: {opamp.name} ({opamp.description}); supplies {opamp.vcc:g} V / {opamp.vee:g} V",
-        f"* reference: 0 -> {test.amplitude_v:g} V square wave at {test.frequency_hz:g} Hz, edges "
-        f"{test.edge_s:.3g} s, rising step at {test.delay_s:.4g} s",
-        f"* plant (a model, not a circuit): {model.text()}",
-        f"*   from {model.source}; input u (the controller's output), output y",
-        "* controller (seed 001, Fig. 66): U2 difference (ve = y - r), U3 inverter, U4 differentiator,",
-        "*   U5 integrator, U6 summer, U7 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y)",
-        "* Run: ngspice -b <this file>   (prints overshoot_pct, peak_time_s, rise_time_s, settling_time_s,",
-        "*   and the extremes of every op-amp output)",
-        deck.opamp_library_text().rstrip(),
-        *plant_lines(model.num, model.den, model.theta_s, "u", "y", name="plant"),
-    ])
-    deck.add_supplies(circuit, opamp)
-    circuit.V("ref", "ref", circuit.gnd, test.source())
-    controller_netlist(parts).add_to(circuit, opamp)
-    deck.settle_error_source(circuit, "y", expected_final)
-    lines = deck.measure_lines("y", test, expected_final) + extreme_lines(parts, test)
-    hint = max_step_hint_s(model.num, model.den, model.theta_s)
-    text = deck.finish_deck(circuit, test, lines, points=points)
-    tmax = test.max_step_s(points)
-    if hint < tmax:   # the plant's dynamics need a shorter step than the test's own
-        text = text.replace(f".tran {tmax:.6g} {test.stop_s:.6g} 0 {tmax:.6g}",
-                            f".tran {hint:.6g} {test.stop_s:.6g} 0 {hint:.6g}")
-    return text
+    about = [f"* plant (a model, not a circuit): {model.text()}",
+             f"*   from {model.source}; input u (the controller's output), output y",
+             "* controller (seed 001, Fig. 66): U2 difference (ve = y - r), U3 inverter, U4 differentiator,",
+             "*   U5 integrator, U6 summer, U7 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y)"]
+    return _loop_deck(parts, opamp, test, title, expected_final, about,
+                      plant_lines(model.num, model.den, model.theta_s, "u", "y", name="plant"),
+                      controller_netlist(parts), points, max_step_hint_s(model.num, model.den, model.theta_s))

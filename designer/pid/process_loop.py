@@ -326,9 +326,7 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
         parts, sel = spec.controller_parts, None
         targets = {"kp": gains.kp, "ti_s": gains.ti_s, "td_s": gains.td_s}
     else:
-        sel = blocks.select_parts(gains.kp, gains.ti_s, gains.td_s, fc, r_series=spec.r_series,
-                                  c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max, c_min=spec.c_min,
-                                  c_max=spec.c_max, f_integrator_hz=f_i, f_differentiator_hz=f_d, tol=spec.tol)
+        sel = size(spec, gains.kp, gains.ti_s, gains.td_s, fc, f_i, f_d)
         parts, targets = sel.parts, sel.targets
         notes += sel.notes + sizing_notes(sel, spec)
     static = blocks.static_checks(parts, fc, amp.gbw_hz, targets, r_min=spec.r_min, r_max=spec.r_max,
@@ -381,6 +379,15 @@ def model_loop_scope(res: ProcessPidResult):
     ts = res.spice.figures.settling_time_s if res.spice is not None else res.analytic.settling_time_s
     window = min(1.2 * ts, test.half_period_s) if ts is not None and math.isfinite(ts) else test.half_period_s
     return scope_setup(window, test.amplitude_v / 2, chans)
+
+
+def size(spec: PidSpec, kp: float, ti_s: float, td_s: float, fc_hz: float, f_i: float, f_d: float):
+    """The E-series parts for these gains with the spec's series, bounds and tolerance, the leak and
+    filter at ``f_i`` and ``f_d`` (:func:`designer.pid.blocks.select_parts`): the design's, the rule
+    table's SPICE runs' and the optimiser's final check's one call."""
+    return blocks.select_parts(kp, ti_s, td_s, fc_hz, r_series=spec.r_series, c_series=spec.c_series,
+                               r_min=spec.r_min, r_max=spec.r_max, c_min=spec.c_min, c_max=spec.c_max,
+                               f_integrator_hz=f_i, f_differentiator_hz=f_d, tol=spec.tol)
 
 
 def sizing_notes(sel, spec) -> list:
@@ -563,9 +570,7 @@ def rules_in_spice(res: ProcessPidResult, simulator: str) -> tuple:
         fc = ideal_crossover_hz(res.model, r.kp, r.ti_s, r.td_s)
         f_i, f_d = corner_frequencies(spec, fc, leak_limit_hz(res.model, r.kp, r.ti_s))
         try:
-            parts = blocks.select_parts(r.kp, r.ti_s, r.td_s, fc, r_series=spec.r_series, c_series=spec.c_series,
-                                        r_min=spec.r_min, r_max=spec.r_max, c_min=spec.c_min, c_max=spec.c_max,
-                                        f_integrator_hz=f_i, f_differentiator_hz=f_d, tol=spec.tol).parts
+            parts = size(spec, r.kp, r.ti_s, r.td_s, fc, f_i, f_d).parts
         except DesignError:
             out.append(row)
             continue

@@ -98,11 +98,9 @@ class _Problem:
     def built(self, kp, ti, td):
         """The controller as built (op-amp poles included): the E-series parts the design
         selects for these gains (the same call), else before rounding."""
-        s = self.spec
+        from .process_loop import size
         try:
-            parts = blocks.select_parts(kp, ti, td, self.fc, r_series=s.r_series, c_series=s.c_series, r_min=s.r_min,
-                                        r_max=s.r_max, c_min=s.c_min, c_max=s.c_max, f_integrator_hz=self.f_i,
-                                        f_differentiator_hz=self.f_d, tol=s.tol).parts
+            parts = size(self.spec, kp, ti, td, self.fc, self.f_i, self.f_d).parts
         except DesignError:
             parts = blocks.continuous_parts(kp, ti, td, self.fc, f_integrator_hz=self.f_i,
                                             f_differentiator_hz=self.f_d)

@@ -283,9 +283,12 @@ def ac_lines(f_lo: float, f_hi: float, points_per_decade: int = 200) -> list:
     return [f".ac dec {points_per_decade} {f_lo:.6g} {f_hi:.6g}"]
 
 
-def finish_deck(circuit, test: SquareTest, extra_lines=(), points: int = 20000) -> str:
-    """Circuit text plus ``.tran`` (max step: see :meth:`SquareTest.max_step_s`), extra lines and ``.end``."""
+def finish_deck(circuit, test: SquareTest, extra_lines=(), points: int = 20000, max_step_s: float | None = None) -> str:
+    """Circuit text plus ``.tran`` (max step: :meth:`SquareTest.max_step_s`, or ``max_step_s`` when
+    that is shorter: a behavioural plant's own accuracy), extra lines and ``.end``."""
     tmax = test.max_step_s(points)
+    if max_step_s is not None and max_step_s < tmax:
+        tmax = max_step_s
     lines = [str(circuit).rstrip(),
              f".tran {tmax:.6g} {test.stop_s:.6g} 0 {tmax:.6g}",
              *extra_lines, ".end"]

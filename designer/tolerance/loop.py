@@ -118,14 +118,8 @@ class LoopMonteCarlo:
 
     def csv_text(self) -> str:
         """One row per sample: its index, every varied part's value, every figure."""
-        import io
-        refs, figs = list(self.values), list(self.figures)
-        n = len(next(iter(self.values.values())))
-        out = io.StringIO()
-        out.write(",".join(["sample", *refs, *figs]) + "\n")
-        cols = [np.arange(n)] + [self.values[r] for r in refs] + [self.figures[f] for f in figs]
-        np.savetxt(out, np.column_stack(cols), delimiter=",", fmt=["%d"] + ["%.10g"] * (len(cols) - 1))
-        return out.getvalue()
+        from .stats import samples_csv
+        return samples_csv(self.values, self.figures)
 
     def summary_lines(self) -> list:
         s = self.summary

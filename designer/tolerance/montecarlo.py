@@ -7,7 +7,6 @@ limit (the worst few), and the part whose tolerance halved raises the yield most
 
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -16,7 +15,7 @@ from ..core.errors import DesignError
 from . import plant as engine
 from . import sampling
 from .parts import DISTRIBUTIONS, resolve
-from .stats import figure_stats, parse_limit, variance_shares, wilson
+from .stats import figure_stats, parse_limit, samples_csv, variance_shares, wilson
 
 #: the number of samples allowed
 MIN_SAMPLES, MAX_SAMPLES = 10, 10 ** 7
@@ -67,13 +66,7 @@ class MonteCarlo:
 
     def csv_text(self) -> str:
         """One row per sample: its index, every varied part's value, every figure."""
-        refs, figs = list(self.values), list(self.figures)
-        out = io.StringIO()
-        out.write(",".join(["sample", *(f"{r}" for r in refs), *figs]) + "\n")
-        cols = [np.arange(self.n)] + [self.values[r] for r in refs] + [self.figures[f] for f in figs]
-        np.savetxt(out, np.column_stack(cols), delimiter=",", fmt=["%d"] + ["%.10g"] * (len(cols) - 1))
-        return out.getvalue()
-
+        return samples_csv(self.values, self.figures)
 
     def summary_lines(self) -> list:
         """A few lines for the text summary."""

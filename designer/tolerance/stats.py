@@ -118,3 +118,16 @@ def variance_shares(x: dict, y) -> dict:
     yz = (yy - yy.mean()) / yy.std()
     beta, *_ = np.linalg.lstsq(az, yz, rcond=None)
     return {r: float(b * b) for r, b in zip(refs, beta)}
+
+
+def samples_csv(values: dict, figures: dict) -> str:
+    """One row per sample: its index, every varied part's value, every figure (a reader can recompute
+    any figure from a row)."""
+    import io
+    refs, figs = list(values), list(figures)
+    n = len(next(iter(values.values())))
+    out = io.StringIO()
+    out.write(",".join(["sample", *refs, *figs]) + "\n")
+    cols = [np.arange(n)] + [values[r] for r in refs] + [figures[f] for f in figs]
+    np.savetxt(out, np.column_stack(cols), delimiter=",", fmt=["%d"] + ["%.10g"] * (len(cols) - 1))
+    return out.getvalue()
