@@ -448,10 +448,10 @@ def _designators(parts, plant, amp, package) -> dict:
     """The deck's op-amp (``U6``) -> its designator on the bench in ``package``
     (``U3B`` in duals), so that checks, notes and JSON name the op-amp the
     sheet wires; a stage the circuit does not have (a PI's differentiator) is
-    absent."""
+    absent. ``plant`` None: the controller alone (a plant known only as a model)."""
     from ..spice.deck import board
-    from .netlist import loop_netlist
-    bd = board(loop_netlist(parts, plant), amp, package)
+    from .netlist import controller_netlist, loop_netlist
+    bd = board(controller_netlist(parts) if plant is None else loop_netlist(parts, plant), amp, package)
     return {a.ref: u.designator for a, u in zip(bd.netlist.amps, bd.units)}
 
 

@@ -444,7 +444,7 @@ class _Loop:
 
 def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
     """The loop as built around the model: margins, time response, every stage, checks, deck."""
-    from .design import _named, stage_checks
+    from .design import _designators, _named, stage_checks
     ctrl = M.controller_tf(parts, amp)
     plant = plant_of(model)
     mg = loop_margins(plant, ctrl)
@@ -483,7 +483,7 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
     # the ideal PID has a true integrator: it settles on the step itself
     ideal_figures = loop_metrics(t, y_ideal, spec.step_v) if np.all(np.isfinite(y_ideal)) else None
     rise = figures.rise_time_s if math.isfinite(figures.rise_time_s) and figures.rise_time_s else t[-1] / 20
-    names = _designators_model(parts, amp, spec.package)
+    names = _designators(parts, None, amp, spec.package)
     levels = M.waveform_limits({k: v for k, v in waves.items() if k != "y"}, t, amp,
                                M.SLEW_DELAY_FRACTION * rise) if mg.stable else {}
     levels = _named(levels, names)
@@ -498,13 +498,6 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
     wf = Waveforms(t, r, waves, y_ideal, y_open, bode_w, loop_response(plant, ctrl, bode_w), t_long,
                    model.step(t_long), None)
     return _Loop(ctrl, mg, ideal_mg, ideal_figures, figures, dc, levels, tuple(checks), test, expected, deck, t, wf)
-
-
-def _designators_model(parts, amp, package) -> dict:
-    """The deck's op-amp -> its designator in ``package`` (the controller's board)."""
-    from ..spice.deck import board
-    bd = board(controller_netlist(parts), amp, package)
-    return {a.ref: u.designator for a, u in zip(bd.netlist.amps, bd.units)}
 
 
 def loop_checks(spec, mg, dc, amp, levels, waves, t, parts) -> list:
@@ -584,11 +577,11 @@ def rules_in_spice(res: ProcessPidResult, simulator: str) -> tuple:
 def run_spice(res: ProcessPidResult, simulator: str) -> None:
     """Simulate the deck, compare with the analytic loop; fills ``spice``,
     ``verdict`` and the notes."""
-    from .design import _named, spice_notes
+    from .design import _designators, _named, spice_notes
     w = res.waveforms
     sp = run_and_compare(res.deck, simulator, w.t, res.test.delay_s, w.analytic["y"], res.test.amplitude_v,
                          res.expected_final_v, res.opamp)
     stages = {k: v for k, v in sp.stages.items() if k != "plant"}   # y is the model's, not an op-amp's
-    res.spice = sp = replace(sp, stages=_named(stages, _designators_model(res.parts, res.opamp, res.package)))
+    res.spice = sp = replace(sp, stages=_named(stages, _designators(res.parts, None, res.opamp, res.package)))
     res.verdict = explain(sp, res.analytic, res.checks)
     res.notes += spice_notes(sp, res.verdict, res.expected_final_v)

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from ..core.checks import Check
 from ..core.jsonio import SCHEMA_VERSION, json_safe
 from ..spice.simulate import tool_info
+from .result import LoopVerdicts
 
 
 @dataclass(frozen=True)
@@ -115,7 +116,7 @@ class RobustCheck:
 
 
 @dataclass
-class ProcessPidResult:
+class ProcessPidResult(LoopVerdicts):
     """Everything known about one controller design for a model plant; :meth:`to_dict` is the JSON."""
 
     spec: object
@@ -154,18 +155,6 @@ class ProcessPidResult:
     scope: object = None                #: designer.plant.bench.ScopeSetup of the bench test (CH2 per node)
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
-
-    @property
-    def simulator(self) -> str | None:
-        return None if self.spice is None else self.spice.backend
-
-    def failed_checks(self) -> list:
-        return [c for c in self.checks if not c.ok]
-
-    def verdicts(self) -> list:
-        """The design checks and, when simulated, the SPICE agreement (``--fail-on-check``)."""
-        from .result import loop_verdicts
-        return loop_verdicts(self.checks, self.verdict, self.spice)
 
     def to_dict(self) -> dict:
         pm_min, gm_min, ms_max = self.limits

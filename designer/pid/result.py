@@ -114,8 +114,25 @@ class Waveforms:
     fopdt_y: np.ndarray | None          #: the least-squares FOPDT's step on reaction_t
 
 
+class LoopVerdicts:
+    """What a loop's result (a Sallen-Key plant's or a model's) says of its checks and its SPICE run;
+    the result has ``checks``, ``spice`` and ``verdict``."""
+
+    @property
+    def simulator(self) -> str | None:
+        return None if self.spice is None else self.spice.backend
+
+    def failed_checks(self) -> list:
+        return [c for c in self.checks if not c.ok]
+
+    def verdicts(self) -> list:
+        """Every pass/fail verdict: the design checks and, when simulated, the
+        SPICE agreement with the analytic loop (``--fail-on-check``)."""
+        return loop_verdicts(self.checks, self.verdict, self.spice)
+
+
 @dataclass
-class PidResult:
+class PidResult(LoopVerdicts):
     """Everything known about one controller design; :meth:`to_dict` is the JSON.
 
     ``files`` and ``timings`` are filled in as the bundle is written.
@@ -154,17 +171,6 @@ class PidResult:
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
-    @property
-    def simulator(self) -> str | None:
-        return None if self.spice is None else self.spice.backend
-
-    def failed_checks(self) -> list:
-        return [c for c in self.checks if not c.ok]
-
-    def verdicts(self) -> list:
-        """Every pass/fail verdict: the design checks and, when simulated, the
-        SPICE agreement with the analytic loop (``--fail-on-check``)."""
-        return loop_verdicts(self.checks, self.verdict, self.spice)
 
     def to_dict(self) -> dict:
         pl = self.plant
