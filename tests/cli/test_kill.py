@@ -177,3 +177,29 @@ def test_a_sheet_command_killed_leaves_nothing_running_and_a_whole_bundle(tmp_pa
         files = result["files"]
         for path in [files["netlist"], files["build_sheet_html"], *files["plots"]]:
             assert Path(path).is_file(), path
+
+
+#: this session's long runs (issues 16, 17): a model plant's loop, a Monte Carlo, a simulated capture
+LONG_RUNS = {
+    "design-pid": ["--plant-tf", "K=2 tau=1m theta=200u", "--tuning", "optimize", "--rules-spice"],
+    "design-plant": ["--fc", "3500", "--zeta", "0.2", "--monte-carlo", "200000", "--limit", "fn_hz=3.3k:3.7k"],
+    "simulate-capture": ["--plant-tf", "K=1.25 tau=124.6m", "--points", "200000", "--noise", "10m"],
+}
+
+
+@pytest.mark.parametrize("command", sorted(LONG_RUNS))
+@pytest.mark.parametrize("sig", (signal.SIGKILL, signal.SIGTERM), ids=lambda s: signal.Signals(s).name)
+def test_the_long_runs_killed_leave_nothing_running_and_nothing_half_written(tmp_path, command, sig):
+    out = tmp_path / "out"
+    out.mkdir()
+    where = ["--out", str(out / "capture.csv")] if command == "simulate-capture" else ["--out", str(out)]
+    tag = uuid.uuid4().hex
+    code, err = stop([script(command), *LONG_RUNS[command], *where], sig, 0.9, tag)
+    assert_ended_by(code, err, sig, command)
+    assert wait_gone(tag) == [], f"a renderer, helper or ngspice outlived {command}"
+    left = [p for p in out.rglob("*") if p.is_file() and not any(q.startswith(".") for q in p.relative_to(out).parts)]
+    if command == "simulate-capture":
+        assert left in ([], [out / "capture.csv"]) and (not left or left[0].read_text().count("\n") > 200000)
+    elif left:   # a whole bundle or none
+        result = json.loads(next(p for p in left if p.name == "result.json").read_text())
+        assert all(Path(f).is_file() for f in [result["files"]["netlist"], *result["files"]["plots"]])
