@@ -4,7 +4,7 @@ PY := .venv/bin/python
 VENV_STAMP := .venv/.installed
 export MPLBACKEND := Agg
 
-.PHONY: setup system-deps demo test bench clean
+.PHONY: setup system-deps demo test bench web clean
 
 # compileall: the environment may set PYTHONDONTWRITEBYTECODE, and every command would recompile the package
 setup: system-deps $(VENV_STAMP)
@@ -66,6 +66,10 @@ demo: setup
 	  echo "skipping pid_rc_tbs1022: $(EXT_CAPTURES)/tom2718_TEK0001.CSV (the real TBS1022 RC capture) is not" \
 	    "beside this clone; the committed reports/pid_rc_tbs1022 is kept"; \
 	fi
+
+# the lab's page: http://127.0.0.1:8000/ (designer-web --help: --host, --port, --jobs)
+web: setup
+	.venv/bin/designer-web
 
 test: setup
 	$(PY) -m pytest -q -p no:cacheprovider tests

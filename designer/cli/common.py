@@ -11,6 +11,7 @@ typed: the specs check them, once.
 from __future__ import annotations
 
 import argparse
+import contextvars
 import json
 import os
 import re
@@ -205,12 +206,20 @@ def check_output(args, name: str) -> None:
         check_can_create(args.out, ("netlists", "reports"))
 
 
+#: a front end's hook (the web page, :mod:`designer.web.jobs`): called with each result :func:`emit` is given,
+#: after its files are written, so that the page draws its plots from the typed result the command printed
+RESULT_HOOK = contextvars.ContextVar("designer_result_hook", default=None)
+
+
 def emit(result, args, name, write_outputs, summary_text) -> int:
     """Write the files (unless --no-files), then print JSON or the summary and the file list.
     Returns the exit status: 1 with ``--fail-on-check`` when a verdict failed
     (:meth:`verdicts` of the result: the checks and the SPICE agreement), else 0."""
     if not args.no_files:
         write_outputs(result, args.out, name)
+    hook = RESULT_HOOK.get()
+    if hook is not None:
+        hook(result, name)
     if args.json:
         print_output(json.dumps(result.to_dict(), indent=2))
     else:

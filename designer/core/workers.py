@@ -54,11 +54,13 @@ def _serve(conn, other_end, parent_pid, work, setup) -> None:
 class Worker:
     """One forked process running ``work(task)`` for each task sent to it, in
     order, after ``setup()``; in its own process group (:meth:`kill` takes any
-    ``ngspice -b`` it started with it)."""
+    ``ngspice -b`` it started with it). ``daemon=False`` lets a task start
+    workers of its own (the web page's workers run check-design, which does);
+    it dies with its parent all the same (:func:`.lifetime.die_with_parent`)."""
 
-    def __init__(self, ctx, work, setup=None):
+    def __init__(self, ctx, work, setup=None, daemon: bool = True):
         self.conn, child = ctx.Pipe()
-        self.proc = ctx.Process(target=_serve, args=(child, self.conn, os.getpid(), work, setup), daemon=True)
+        self.proc = ctx.Process(target=_serve, args=(child, self.conn, os.getpid(), work, setup), daemon=daemon)
         self.proc.start()
         child.close()
         self.task = None

@@ -1,0 +1,388 @@
+"""The web page's server: the pages (plain HTML and JavaScript, no build
+step, every file served from this package: the lab may be offline) and the
+JSON API under them.
+
+``POST /api/plant``, ``/api/pid``, ``/api/identify``, ``/api/check`` take the
+commands' options by name (:mod:`.request`) and answer what the command's
+``--json`` prints; ``?view=page`` adds what the page draws
+(``{"result": ..., "page": ...}``). ``/api/plant/sheet`` and ``/bundle`` (and
+the PID's) answer the printable build sheet and the design's files as a zip.
+Bad input is a 400 whose ``error`` is the command's one line; an upload over
+the command's file limits a 413; a run past its deadline a 504. Every command
+runs in the worker pool (:mod:`.pool`), each request in its own private
+folder, removed when it is answered.
+
+Starlette (routing, requests, responses) on uvicorn: see the README for why.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import tempfile
+from contextlib import asynccontextmanager
+from pathlib import Path
+
+from starlette.applications import Starlette
+from starlette.requests import Request
+from starlette.responses import JSONResponse, Response
+from starlette.routing import Route
+
+from ..core.errors import DesignError
+from ..core.fileio import MAX_CAPTURE_BYTES, check_plain_name
+from . import request as req
+
+STATIC = Path(__file__).parent / "static"
+MEDIA = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=utf-8",
+         ".css": "text/css; charset=utf-8", ".txt": "text/plain; charset=utf-8", ".svg": "image/svg+xml",
+         ".png": "image/png", "": "text/plain; charset=utf-8"}
+#: the pages, by path
+PAGES = {"/": "plant.html", "/plant": "plant.html", "/pid": "pid.html", "/identify": "identify.html",
+         "/check": "check.html"}
+#: multipart framing around an upload (boundaries, part headers) allowed over the file's own limit
+FRAMING_BYTES = 64 * 1024
+
+
+def _check_limit() -> int:
+    """check-design's inputs: a spec and the decks it includes (their own limits)."""
+    from ..check.spec import MAX_SPEC_BYTES
+    from ..spice.trust import MAX_TOTAL_BYTES
+    return MAX_SPEC_BYTES + MAX_TOTAL_BYTES + FRAMING_BYTES
+
+
+class TooLarge(Exception):
+    """A request body over its limit: answered 413."""
+
+
+def _parsers() -> dict:
+    """Each command's parser traits (switches, appended options), from the CLI's own parsers."""
+    from ..cli import check, identify, pid, plant
+    builders = {"design-plant": plant._design_parser, "analyze-plant": plant._analyze_parser,
+                "design-pid": pid._parser, "analyze-pid": pid._analyze_parser, "identify": identify.build_parser,
+                "identify-freq": identify.build_freq_parser, "check-design": check._parser}
+    return {prog: req.parser_traits(build()) for prog, build in builders.items()}
+
+
+def create_app(pool) -> Starlette:
+    """The application, its commands run by ``pool`` (a :class:`.pool.Pool`)."""
+    traits = _parsers()
+    static = {p.relative_to(STATIC).as_posix(): (p.read_bytes(), MEDIA.get(p.suffix, MEDIA[""]))
+              for p in STATIC.rglob("*") if p.is_file()}
+
+    @asynccontextmanager
+    async def lifespan(app):
+        pool.attach()
+        try:
+            yield
+        finally:
+            pool.close()
+
+    def page(name):
+        body, media = static[name]
+
+        async def endpoint(request):
+            return Response(body, media_type=media)
+        return endpoint
+
+    async def static_file(request):
+        found = static.get(request.path_params["path"])
+        if found is None:
+            return JSONResponse({"error": "not found"}, status_code=404)
+        return Response(found[0], media_type=found[1], headers={"Cache-Control": "no-cache"})
+
+    async def health(request):
+        return JSONResponse({"ok": True, "jobs": pool.jobs, "timeout_s": pool.timeout})
+
+    choices = _choices()
+
+    async def choices_endpoint(request):
+        return JSONResponse(choices)
+
+    async def run(prog: str, argv: list, want: str, tmp: str, upload_name: str | None = None):
+        kind, value = await pool.submit({"prog": prog, "argv": argv, "want": want, "tmp": tmp})
+        if kind == "timeout":
+            return _error(504, f"{prog}: error: simulator error: {value}")
+        if kind != "ok":
+            return _error(500 if kind == "crash" else 502, f"{prog}: error: {value}")
+        status = value["status"]
+        if value["error"] is not None:
+            line = _hide(value["error"], tmp, upload_name)
+            code = 400 if status == 2 else 502 if status == 3 else 503
+            if status == 2 and "the most this command reads" in line:
+                code = 413
+            return _error(code, line)
+        if want in ("sheet", "bundle"):
+            return Response(value["body"], media_type=value["media"],
+                            headers={"Content-Disposition": f'attachment; filename="{value["filename"]}"'})
+        if want == "page":
+            answer = {"result": value["json"], "page": value.get("page"), "status": status}
+        elif prog == "check-design":
+            answer = {"status": status, **value["json"], "junit": value["junit"], "summary": value["summary"],
+                      "lines": value["stdout"].splitlines(), "messages": value["stderr"].splitlines()}
+        else:
+            answer = value["json"]
+        # the request's private folder is nobody's business: the upload by its own name
+        return Response(_hide(json.dumps(answer), tmp, upload_name), media_type="application/json")
+
+    def designing(prog: str, want: str | None = None):
+        async def endpoint(request: Request):
+            how = want or _view(request)
+            with _private_folder() as tmp:
+                try:
+                    options = json.loads(await _body(request, req.MAX_JSON_BYTES) or b"{}")
+                except TooLarge:
+                    return _error(413, f"{prog}: error: the request is larger than "
+                                       f"{req.MAX_JSON_BYTES // (1024 * 1024)} MiB")
+                except ValueError as exc:
+                    return _error(400, f"{prog}: error: the request's body is not JSON: {exc}")
+                try:
+                    argv = req.build_argv(options, tmp, *traits[prog])
+                except DesignError as exc:
+                    return _error(400, f"{prog}: error: {exc}")
+                argv += ["--json"] + (["--out", tmp] if how in ("sheet", "bundle") else ["--no-files"])
+                return await run(prog, argv, how, tmp)
+        return endpoint
+
+    async def identify(request: Request):
+        prog = "identify"
+        with _private_folder() as tmp:
+            try:
+                path, name, options = await _upload(request, tmp, MAX_CAPTURE_BYTES + FRAMING_BYTES, "capture")
+            except TooLarge:
+                return _error(413, f"{prog}: error: the capture is larger than "
+                                   f"{MAX_CAPTURE_BYTES // (1024 * 1024)} MiB, the most identify reads; "
+                                   "cut or decimate it")
+            except DesignError as exc:
+                return _error(400, f"{prog}: error: {exc}")
+            try:
+                argv = [path] + req.build_argv(options, tmp, *traits[prog]) + ["--json"]
+            except DesignError as exc:
+                return _error(400, f"{prog}: error: {exc}")
+            return await run(prog, argv, _view(request), tmp, name)
+
+    async def check(request: Request):
+        prog = "check-design"
+        with _private_folder() as tmp:
+            try:
+                files, options = await _check_inputs(request, tmp, _check_limit())
+            except TooLarge:
+                return _error(413, f"{prog}: error: the spec and its decks are larger than check-design reads")
+            except DesignError as exc:
+                return _error(400, f"{prog}: error: {exc}")
+            try:
+                argv = [files["spec"]] + req.build_argv(options, None, *traits[prog])
+            except DesignError as exc:
+                return _error(400, f"{prog}: error: {exc}")
+            argv += ["--junit", os.path.join(tmp, "junit.xml"), "--summary", os.path.join(tmp, "summary.md"),
+                     "--out", os.path.join(tmp, "out"), "--root", os.path.join(tmp, "in")]
+            return await run(prog, argv, "check", tmp)
+
+    routes = [Route(path, page(name)) for path, name in PAGES.items()]
+    routes += [Route("/static/{path:path}", static_file), Route("/api/health", health),
+               Route("/api/choices", choices_endpoint),
+               Route("/api/plant", designing("design-plant"), methods=["POST"]),
+               Route("/api/plant/sheet", designing("design-plant", "sheet"), methods=["POST"]),
+               Route("/api/plant/bundle", designing("design-plant", "bundle"), methods=["POST"]),
+               Route("/api/analyze-plant", designing("analyze-plant"), methods=["POST"]),
+               Route("/api/pid", designing("design-pid"), methods=["POST"]),
+               Route("/api/pid/sheet", designing("design-pid", "sheet"), methods=["POST"]),
+               Route("/api/pid/bundle", designing("design-pid", "bundle"), methods=["POST"]),
+               Route("/api/analyze-pid", designing("analyze-pid"), methods=["POST"]),
+               Route("/api/identify", identify, methods=["POST"]),
+               Route("/api/check", check, methods=["POST"])]
+    return Starlette(routes=routes, lifespan=lifespan)
+
+
+def _choices() -> dict:
+    """What the forms offer in their lists: the op-amp catalogue, the E-series, the tuning rules."""
+    from ..cli.identify import FORMATS
+    from ..core import opamps
+    from ..core.eseries import SERIES
+    return {"opamps": opamps.names(), "series": list(SERIES), "formats": list(FORMATS),
+            "tunings": ["zn", "cohen-coon", "chr0", "chr20", "amigo", "simc", "imc", "optimize"],
+            "packages": ["single", "dual", "quad"]}
+
+
+def _view(request) -> str:
+    return "page" if request.query_params.get("view") == "page" else "json"
+
+
+def _error(code: int, line: str) -> JSONResponse:
+    """An error answer: the command's one line, its message, and the option it names (for the page)."""
+    line = " ".join(str(line).split())
+    message = re.sub(r"^[a-z-]+: error: ", "", line)
+    found = re.search(r"--[a-z][a-z0-9-]*", message)
+    return JSONResponse({"error": line, "message": message, "option": found.group(0) if found else None},
+                        status_code=code)
+
+
+def _hide(text: str, tmp: str, upload_name: str | None) -> str:
+    """A message without the request's private folder: the upload by its own name."""
+    text = text.replace(os.path.join(tmp, "in") + os.sep, "").replace(tmp + os.sep, "")
+    return text if upload_name is None else text.replace("upload-" + upload_name, upload_name)
+
+
+class _private_folder:
+    """A folder only this process can read (mkdtemp: mode 0700), removed with all it holds."""
+
+    def __enter__(self) -> str:
+        self.path = tempfile.mkdtemp(prefix="designer-web-")
+        return self.path
+
+    def __exit__(self, *exc) -> None:
+        shutil.rmtree(self.path, ignore_errors=True)
+
+
+async def _body(request: Request, limit: int) -> bytes:
+    """The whole body, refused (:class:`TooLarge`) as soon as it passes ``limit`` bytes."""
+    declared = request.headers.get("content-length")
+    if declared is not None and declared.isdigit() and int(declared) > limit:
+        raise TooLarge()
+    chunks, n = [], 0
+    async for chunk in request.stream():
+        n += len(chunk)
+        if n > limit:
+            raise TooLarge()
+        chunks.append(chunk)
+    return b"".join(chunks)
+
+
+def _plain(name, fallback: str) -> str:
+    """An uploaded file's own name when it is a plain one, else ``fallback``."""
+    base = os.path.basename(str(name or "").replace("\\", "/"))
+    try:
+        return check_plain_name(base, "file name")
+    except DesignError:
+        return fallback
+
+
+async def _stream_to(request: Request, path: str, limit: int) -> None:
+    declared = request.headers.get("content-length")
+    if declared is not None and declared.isdigit() and int(declared) > limit:
+        raise TooLarge()
+    n = 0
+    with open(path, "wb") as fh:
+        async for chunk in request.stream():
+            n += len(chunk)
+            if n > limit:
+                raise TooLarge()
+            fh.write(chunk)
+
+
+async def _multipart(request: Request, tmp: str, limit: int) -> tuple:
+    """A multipart form streamed into ``tmp``: (files: field -> [(name, path)], fields: name -> text)."""
+    from python_multipart import FormParser
+    from python_multipart.multipart import parse_options_header
+    declared = request.headers.get("content-length")
+    if declared is not None and declared.isdigit() and int(declared) > limit:
+        raise TooLarge()
+    ctype, params = parse_options_header(request.headers.get("content-type", ""))
+    boundary = params.get(b"boundary")
+    if not boundary:
+        raise DesignError("a multipart upload needs its boundary in the Content-Type header")
+    files, fields = {}, {}
+    uploads = os.path.join(tmp, "parts")
+    os.mkdir(uploads)
+
+    def on_field(field):
+        key = field.field_name.decode("utf-8", "replace")
+        fields[key] = (field.value or b"").decode("utf-8", "replace")
+
+    def on_file(f):
+        files.setdefault(f.field_name.decode("utf-8", "replace"), []).append(f)
+
+    parser = FormParser(ctype.decode("latin-1"), on_field, on_file, boundary=boundary,
+                        config={"UPLOAD_DIR": uploads, "MAX_MEMORY_FILE_SIZE": 1024 * 1024,
+                                "UPLOAD_KEEP_FILENAME": False, "UPLOAD_KEEP_EXTENSIONS": False})
+    n = 0
+    try:
+        async for chunk in request.stream():
+            n += len(chunk)
+            if n > limit:
+                raise TooLarge()
+            parser.write(chunk)
+        parser.finalize()
+    except TooLarge:
+        raise
+    except Exception as exc:   # python-multipart's own errors (a malformed form): the client's mistake
+        raise DesignError(f"the multipart form cannot be read: {exc}") from None
+    return files, fields
+
+
+def _save(f, path: str) -> None:
+    """A part python-multipart kept (in memory or in the request's folder) as ``path``."""
+    obj = f.file_object
+    obj.seek(0)
+    with open(path, "wb") as out:
+        shutil.copyfileobj(obj, out)
+    f.close()
+
+
+async def _upload(request: Request, tmp: str, limit: int, field: str) -> tuple:
+    """The capture (the body itself, options in the query string; or a multipart
+    form whose first file is the capture, options in its other fields) written in
+    ``tmp``: (path, its name as uploaded, options)."""
+    ctype = request.headers.get("content-type", "")
+    if ctype.startswith("multipart/form-data"):
+        files, options = await _multipart(request, tmp, limit)
+        parts = files.get(field) or next(iter(files.values()), None)
+        if not parts:
+            raise DesignError(f"the form has no file: send the capture as the field {field!r}")
+        name = _plain(parts[0].file_name.decode("utf-8", "replace") if parts[0].file_name else "", "capture.csv")
+        path = os.path.join(tmp, "upload-" + name)
+        _save(parts[0], path)
+    else:
+        name = _plain(request.query_params.get("filename"), "capture.csv")
+        path = os.path.join(tmp, "upload-" + name)
+        options = {k: v for k, v in request.query_params.items() if k not in ("view", "filename")}
+        await _stream_to(request, path, limit)
+    if os.path.getsize(path) == 0:
+        raise DesignError("the capture is empty: send the file as the request's body or as a form's file")
+    return path, name, options
+
+
+async def _check_inputs(request: Request, tmp: str, limit: int) -> tuple:
+    """check-design's spec and the files it names, in ``tmp/in``: a multipart form
+    (a ``spec`` file, any other files by their own plain names, options as fields)
+    or JSON ``{"spec": text, "files": {name: text}, "options": {...}}``."""
+    inside = os.path.join(tmp, "in")
+    os.mkdir(inside)
+    ctype = request.headers.get("content-type", "")
+    written = {}
+    if ctype.startswith("multipart/form-data"):
+        files, fields = await _multipart(request, tmp, limit)
+        spec = files.pop("spec", None)
+        if not spec:
+            raise DesignError("the form has no spec: send the spec file as the field 'spec'")
+        written["spec"] = os.path.join(inside, _plain(spec[0].file_name and spec[0].file_name.decode(), "spec.yaml"))
+        _save(spec[0], written["spec"])
+        for parts in files.values():
+            for f in parts:
+                name = _plain(f.file_name and f.file_name.decode("utf-8", "replace"), "")
+                if not name:
+                    raise DesignError("an uploaded file's name must be plain (letters, digits and . _ - + = , @), "
+                                      "as the spec names it")
+                _save(f, os.path.join(inside, name))
+        options = {k: v for k, v in fields.items() if k != "spec"}
+        spec_text = fields.get("spec")
+        if spec_text is not None:
+            raise DesignError("send the spec as a file, not a text field")
+        return written, options
+    try:
+        body = json.loads(await _body(request, limit) or b"{}")
+    except ValueError as exc:
+        raise DesignError(f"the request's body is not JSON: {exc}") from None
+    if not isinstance(body, dict) or not isinstance(body.get("spec"), str):
+        raise DesignError('the body must be {"spec": "<the spec file\'s text>", "files": {"deck.cir": "..."}}')
+    name = _plain(body.get("spec_name"), "spec.yaml")
+    written["spec"] = os.path.join(inside, name)
+    Path(written["spec"]).write_text(body["spec"], encoding="utf-8")
+    for fname, text in (body.get("files") or {}).items():
+        plain = _plain(fname, "")
+        if not plain or not isinstance(text, str):
+            raise DesignError(f"file {str(fname)[:60]!r}: a plain name and its text")
+        Path(inside, plain).write_text(text, encoding="utf-8")
+    options = body.get("options") or {}
+    return written, options

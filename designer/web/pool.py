@@ -1,0 +1,151 @@
+"""The web page's worker processes: every command runs in one of them,
+queued, each run within a deadline.
+
+The server (an asyncio event loop) never forks: at start-up, before it binds
+its socket or starts a thread, it forks one *pool* process
+(:func:`start`), which owns ``jobs`` :class:`designer.core.workers.Worker`
+processes (the workers check-design uses) and forks their replacements. A
+worker runs one task at a time (:func:`designer.web.jobs.run`); one that
+passes its deadline is killed with its process group (an ``ngspice -b``
+included) and replaced, and its request answered "timed out"; one that dies
+is replaced too. Requests beyond the workers wait in the pool's queue, in
+order: none is lost, and each answer carries its request's number, so none is
+mixed with another's. The pool and the workers die with the server
+(:func:`designer.core.lifetime.die_with_parent`).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import itertools
+import multiprocessing
+import os
+import time
+from collections import deque
+from multiprocessing.connection import wait
+
+from ..core import lifetime
+from ..core.workers import Worker
+
+#: seconds a worker may take over one request before it is killed (design-pid's optimiser takes a few)
+DEFAULT_TIMEOUT_S = 120.0
+
+
+def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work, setup) -> None:
+    """The pool process: requests ``(id, task)`` in from the server, ``(id, kind, value)`` out."""
+    lifetime.die_with_parent(parent_pid)
+    lifetime.reset_in_child()
+    other_end.close()
+    ctx = multiprocessing.get_context("fork")
+    workers = [Worker(ctx, work, setup, daemon=False) for _ in range(jobs)]
+    queue = deque()
+    try:
+        while True:
+            busy = [w for w in workers if w.task is not None]
+            left = None if not busy else max(0.0, min(w.deadline for w in busy) - time.monotonic())
+            ready = wait([conn] + [w.conn for w in busy], timeout=left)
+            if conn in ready:
+                try:
+                    msg = conn.recv()
+                except (EOFError, OSError):
+                    return
+                if msg is None:
+                    return
+                queue.append(msg)
+            for k, w in enumerate(workers):
+                if w.task is None:
+                    continue
+                if w.conn in ready:
+                    try:
+                        kind, value = w.conn.recv()
+                    except (EOFError, OSError):
+                        kind, value = "dead", "the worker running it died: the simulator crashed"
+                    conn.send((w.task, kind, value))
+                    w.task = None
+                    if kind == "dead":
+                        w.kill()
+                        workers[k] = Worker(ctx, work, setup, daemon=False)
+                elif time.monotonic() >= w.deadline:
+                    w.kill()
+                    conn.send((w.task, "timeout", f"timed out after {timeout:g} s (killed)"))
+                    workers[k] = Worker(ctx, work, setup, daemon=False)
+            for w in workers:
+                if w.task is None and queue:
+                    rid, task = queue.popleft()
+                    w.give(rid, task, timeout)
+    finally:
+        for w in workers:
+            try:
+                w.conn.send(None)
+            except (OSError, ValueError):
+                pass
+        for w in workers:
+            w.proc.join(2)
+            if w.proc.is_alive():
+                w.kill()
+
+
+class Pool:
+    """The server's end of the pool process: :meth:`submit` a task, await its
+    answer ``(kind, value)``: kind "ok" (value: what ``work`` returned),
+    "crash" (a bug in the task, its words), "dead" or "timeout"."""
+
+    def __init__(self, jobs: int, timeout: float = DEFAULT_TIMEOUT_S, work=None, setup=None):
+        from . import jobs as job
+        ctx = multiprocessing.get_context("fork")
+        self.conn, child = ctx.Pipe()
+        self.timeout = timeout
+        self.jobs = jobs
+        self.proc = ctx.Process(target=_pool_main, args=(child, self.conn, os.getpid(), jobs, timeout,
+                                                         work or job.run, setup or job.warm_up))
+        self.proc.start()
+        child.close()
+        self._ids = itertools.count(1)
+        self._waiting = {}
+        self._loop = None
+
+    def attach(self) -> None:
+        """Read the pool's answers on the running event loop."""
+        self._loop = asyncio.get_running_loop()
+        self._loop.add_reader(self.conn.fileno(), self._answer)
+
+    def _answer(self) -> None:
+        try:
+            rid, kind, value = self.conn.recv()
+        except (EOFError, OSError):   # the pool is gone: every waiting request gets its answer
+            self._loop.remove_reader(self.conn.fileno())
+            for fut in self._waiting.values():
+                if not fut.done():
+                    fut.set_result(("dead", "the worker pool stopped"))
+            self._waiting.clear()
+            return
+        fut = self._waiting.pop(rid, None)
+        if fut is not None and not fut.done():
+            fut.set_result((kind, value))
+
+    async def submit(self, task) -> tuple:
+        rid = next(self._ids)
+        fut = self._loop.create_future()
+        self._waiting[rid] = fut
+        self.conn.send((rid, task))
+        try:
+            return await fut
+        finally:
+            self._waiting.pop(rid, None)
+
+    def close(self) -> None:
+        """Stop the workers and the pool (they die with this process anyway)."""
+        if self._loop is not None:
+            try:
+                self._loop.remove_reader(self.conn.fileno())
+            except (ValueError, OSError):
+                pass
+        try:
+            self.conn.send(None)
+        except (OSError, ValueError):
+            pass
+        self.proc.join(10)
+        if self.proc.is_alive():
+            self.proc.kill()
+            self.proc.join(5)
+        self.conn.close()

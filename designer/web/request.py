@@ -1,0 +1,123 @@
+"""A request's inputs as the command line its command parses.
+
+``{"fc": 3500, "zeta": "0.2", "r-series": "E24"}`` becomes ``--fc 3500 --zeta
+0.2 --r-series E24``: every key is an option's name (dashes or underscores),
+every value what a user types after it (numbers, engineering notation in
+strings; ``true`` for a switch, a list for an option that takes several
+values). The command's own parser then checks them, so a refusal is its one
+line. What a page must not choose is refused here in one line: where files go
+and how output is printed (the server sets those), the trust settings of
+check-design. An option that names a file on the command line (``plant-model``,
+``plant-json``...) takes the file's *content* here, written into the request's
+private folder under a fixed name: no path a user gives is ever opened.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+
+from ..core.errors import DesignError
+
+#: options the server sets itself (files, output form) or that would reach past a request's folder
+REFUSED = ("out", "json", "no-files", "plot", "help", "version", "junit", "summary", "root", "allow-outside",
+           "jobs", "update-golden", "timeout", "fail-on-check", "no-fail")
+#: options whose value is a file's content -> the name it is written under in the request's folder
+FILE_OPTIONS = {"plant-json": "plant-result.json", "plant-model": "plant-model.json",
+                "parts-json": "parts-result.json", "plant-capture": "plant-capture.csv",
+                "against": "design-result.json"}
+#: most bytes of a request's JSON body (its options; a model or result.json given inline included)
+MAX_JSON_BYTES = 4 * 1024 * 1024
+_KEY = re.compile(r"^[a-z][a-z0-9-]{0,40}$")
+
+
+def option_name(key) -> str:
+    """``"r_series"`` -> ``"--r-series"``, after checking it is an option's name at all."""
+    name = str(key).strip().lstrip("-").replace("_", "-").lower()
+    if not _KEY.match(name):
+        raise DesignError(f"{str(key)[:60]!r} is not an option name (letters, digits and dashes, as --help lists "
+                          "them)")
+    if name in REFUSED:
+        raise DesignError(f"--{name} is set by the web page itself, not by a request")
+    return "--" + name
+
+
+def build_argv(options: dict, tmp: str | None, switches=(), appended=()) -> list:
+    """The argument list of ``options`` (see the module docstring).
+
+    Parameters
+    ----------
+    options : dict
+        Option name -> value, as the request gave them.
+    tmp : str or None
+        The request's private folder, for the options of :data:`FILE_OPTIONS`.
+    switches : collection of str
+        The command's switches (``--no-sim``...): ``true`` gives the option alone,
+        ``false`` leaves it out.
+    appended : collection of str
+        The options given once per value (``--limit``); any other takes a list as
+        its values after one flag (``--window 0 7m``).
+    """
+    if not isinstance(options, dict):
+        raise DesignError("the request's body must be a JSON object of option names and values, "
+                          'e.g. {"fc": 3500, "zeta": 0.2}')
+    argv = []
+    for key, value in options.items():
+        opt = option_name(key)
+        if value is None or value is False and opt in switches:
+            continue
+        if opt in switches:
+            if value is not True:
+                raise DesignError(f"{opt} is a switch: true or false, got {json.dumps(value)[:40]}")
+            argv.append(opt)
+            continue
+        if opt[2:] in FILE_OPTIONS:
+            argv += [opt, write_content(tmp, FILE_OPTIONS[opt[2:]], value, opt)]
+            continue
+        values = value if isinstance(value, list) else [value]
+        words = [_word(v, opt) for v in values]
+        if opt in appended:
+            for w in words:
+                argv += [opt, w]
+        else:
+            argv += [opt, *words]
+    return argv
+
+
+def _word(value, opt: str) -> str:
+    """One value as typed: a string as it is, a number as Python writes it."""
+    if isinstance(value, bool) or isinstance(value, (dict, list)):
+        raise DesignError(f"{opt} takes a number or a text such as 4k7, got {json.dumps(value)[:40]}")
+    if isinstance(value, float):
+        return repr(value)
+    return str(value)
+
+
+def write_content(tmp: str | None, name: str, value, opt: str) -> str:
+    """A file option's content (text, or a JSON object or list written as JSON) in the
+    request's folder; returns its path."""
+    if tmp is None:
+        raise DesignError(f"{opt} is not taken by this request")
+    if isinstance(value, (dict, list)):
+        value = json.dumps(value)
+    if not isinstance(value, str):
+        raise DesignError(f"{opt} takes the file's content: a JSON object or a text")
+    path = os.path.join(tmp, name)
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write(value)
+    return path
+
+
+def parser_traits(parser) -> tuple:
+    """(switches, appended options) of an argparse parser: the options taking no value, and
+    those given once per value."""
+    import argparse
+    switches, appended = set(), set()
+    for action in parser._actions:   # argparse has no public list of its actions
+        for opt in action.option_strings:
+            if action.nargs == 0:
+                switches.add(opt)
+            elif isinstance(action, argparse._AppendAction):
+                appended.add(opt)
+    return switches, appended

@@ -1,0 +1,108 @@
+"""``designer-web``: the lab's page on this machine.
+
+One process keeps the library imported and answers the pages and the API
+(:mod:`.app`); its commands run in worker processes started before it
+serves (:mod:`.pool`), warm (ngspice loaded), so an answer has no start-up
+cost. It binds to 127.0.0.1 unless told otherwise, and says so when it is
+reachable from other machines.
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import sys
+
+from ..cli.common import OneLineParser, run_cli
+
+EPILOG = """examples:
+  designer-web                          http://127.0.0.1:8000/ on this machine only
+  designer-web --port 8080 --jobs 2     another port; two designs at once (one per core)
+  designer-web --host 0.0.0.0           the lab's network too: anyone who reaches it can run designs here
+
+Pages: /plant, /pid, /identify, /check. API: POST /api/plant, /api/pid, /api/identify, /api/check with
+the commands' options by name (see the README). Stop it with Ctrl-C."""
+
+
+def _parser():
+    from .. import __version__
+    p = OneLineParser(prog="designer-web", description="Serve the design, PID, identify and check pages and their "
+                      "JSON API to a browser.", epilog=EPILOG)
+    import argparse
+    p.formatter_class = argparse.RawDescriptionHelpFormatter
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1: this machine only)")
+    p.add_argument("--port", default="8000", help="TCP port, 1 to 65535 (default 8000; 0: any free one)")
+    p.add_argument("--jobs", default="2", help="worker processes running the commands, 1 to 16 (default 2)")
+    p.add_argument("--timeout", default="120", help="seconds one run may take before it is killed and reported, "
+                                                    "1 to 3600 (default 120)")
+    return p
+
+
+def _whole(text, option: str, lo: int, hi: int) -> int:
+    from ..core.errors import DesignError
+    try:
+        n = int(str(text).strip())
+    except ValueError:
+        raise DesignError(f"{option} {text!r}: give a whole number, {lo} to {hi}") from None
+    if not lo <= n <= hi:
+        raise DesignError(f"{option} must be {lo} to {hi}, got {n}")
+    return n
+
+
+def is_local(host: str) -> bool:
+    """Whether ``host`` is a loopback address (only this machine can connect)."""
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def _serve(args) -> int:
+    import socket
+
+    import uvicorn
+
+    from .app import create_app
+    from .pool import Pool
+    port = _whole(args.port, "--port", 0, 65535)
+    jobs = _whole(args.jobs, "--jobs", 1, 16)
+    timeout = _whole(args.timeout, "--timeout", 1, 3600)
+    family = socket.AF_INET6 if ":" in args.host else socket.AF_INET
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.bind((args.host, port))
+    except OSError as exc:
+        sock.close()
+        from ..core.errors import DesignError
+        raise DesignError(f"cannot listen on {args.host}:{port}: {exc.strerror or exc}") from None
+    host, port = sock.getsockname()[:2]
+    # the pool is forked before the server binds its connections or starts a thread: no socket of a
+    # client and no lock of a thread is ever copied into a worker
+    sock.set_inheritable(False)
+    pool = Pool(jobs, float(timeout))
+    shown = f"[{host}]" if family == socket.AF_INET6 else host
+    print(f"designer-web: serving on http://{shown}:{port}/ ({jobs} workers, {timeout} s per run; Ctrl-C stops)",
+          flush=True)
+    if not is_local(args.host):
+        print(f"designer-web: warning: {args.host} is not this machine's loopback address: anyone who can reach "
+              f"port {port} on this network can use the page and run designs here", flush=True)
+    config = uvicorn.Config(create_app(pool), log_level="warning", lifespan="on")
+    server = uvicorn.Server(config)
+    try:
+        server.run(sockets=[sock])
+    finally:
+        sock.close()
+        pool.close()
+    return 0
+
+
+def main(argv=None) -> int:
+    """Console entry point ``designer-web``."""
+    return run_cli("designer-web", _parser, _serve, argv)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

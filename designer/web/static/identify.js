@@ -1,0 +1,73 @@
+// The identify page: a dropped capture goes as the body of POST /api/identify?view=page (its options in
+// the query string); the answer is identify's JSON with the data and the best models' traces.
+"use strict";
+D.nav("/identify");
+const form = document.getElementById("form");
+const status = document.getElementById("status");
+let file = null, seq = 0, last = null;
+
+function params(p) {
+  return Object.entries(p || {}).map(([k, v]) => `${k} = ${D.eng(v, "", 4)}`).join(", ");
+}
+
+function show(answer) {
+  const r = answer.result, p = answer.page;
+  const cap = r.capture || {};
+  const fmt = r.format === "frequency-table" ? "frequency table (analysed as identify-freq does)" : cap.format;
+  document.getElementById("format").innerHTML = "";
+  const line = document.createElement("p");
+  line.id = "format-line";
+  line.textContent = `Format: ${fmt}` + (cap.samples ? `, ${cap.samples} samples` : "") +
+    (cap.output ? `, output ${cap.output}` : "") + (cap.input ? `, input ${cap.input}` : ", no input column");
+  document.getElementById("format").append(line);
+  const best = r.best;
+  const b = document.createElement("p");
+  b.id = "best";
+  b.innerHTML = "<b>Best model:</b> ";
+  b.append(best ? `${best.name} (${best.model}): ${params(best.params)}` : "none valid");
+  document.getElementById("format").append(b);
+  const ph = document.getElementById("phase");
+  if (p.kind === "step") {
+    D.plot(document.getElementById("plot"), p.plot, {xUnit: "s", yLabel: cap.output || "output"});
+    if (ph._plot) { ph._plot.destroy(); ph._plot = null; } ph.innerHTML = "";
+  } else {
+    D.plot(document.getElementById("plot"), p.plot, {xUnit: "Hz", yLabel: "gain (dB)"});
+    if (p.phase) D.plot(ph, p.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 220});
+  }
+  document.getElementById("methods").replaceChildren(D.table(
+    ["#", "method", "model", "parameters", "IAE", "valid", "note"],
+    r.methods.map((m, i) => [i + 1, m.name, m.model, params(m.params), m.iae === null ? "" : (+m.iae).toPrecision(3),
+                             m.valid ? "yes" : "no", m.note || ""])));
+}
+
+async function identify() {
+  if (!file) return;
+  const mine = ++seq;
+  const q = new URLSearchParams({view: "page", filename: file.name});
+  for (const [k, v] of Object.entries(D.options(form))) q.set(k, v === true ? "true" : v);
+  D.busy(true, status);
+  const r = await D.api(`/api/identify?${q}`, file);
+  if (mine !== seq) return;
+  D.busy(false, status);
+  document.getElementById("topid").disabled = true;
+  if (!r.ok) { D.showError(form, r.data); document.body.dataset.state = "error"; return; }
+  D.clearError(form);
+  last = r.data;
+  show(r.data);
+  document.getElementById("topid").disabled = !r.data.result.best;
+  status.textContent = `identified ${file.name}`;
+  document.body.dataset.state = "done";
+}
+
+(async function () {
+  const c = await D.loadChoices();
+  D.fill(form.querySelector("select[name=format]"), ["", ...c.formats], "");
+  form.querySelector("select[name=format]").options[0].textContent = "auto";
+  D.dropZone(document.getElementById("drop"), document.getElementById("file"), files => { file = files[0]; identify(); });
+  const later = D.debounce(identify, 400);
+  form.addEventListener("input", e => { if (e.target.id !== "file") later(); });
+  document.getElementById("topid").onclick = () => {
+    sessionStorage.setItem("identify-result", JSON.stringify(last.result));
+    location.href = "/pid?plant=identify";
+  };
+})();

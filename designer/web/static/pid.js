@@ -1,0 +1,110 @@
+// The PID page: the plant one of four ways (fn and zeta, its parts, a typed model, the identify page's
+// result), the tuning, the op-amps; POST /api/pid?view=page as they change. The answer is design-pid's
+// JSON with the closed-loop and loop-gain traces, the schematic and the build sheet without its pictures.
+"use strict";
+D.nav("/pid");
+const form = document.getElementById("form");
+const status = document.getElementById("status");
+let seq = 0, last = null;
+const identified = JSON.parse(sessionStorage.getItem("identify-result") || "null");
+
+function plantKind() { return form.querySelector("input[name=plant]:checked").value; }
+
+function showPlantKind() {
+  for (const d of form.querySelectorAll("[data-plant]")) d.hidden = d.dataset.plant !== plantKind();
+}
+
+function request() {
+  const o = D.options(form);
+  delete o.plant;
+  if (plantKind() === "identify") {
+    if (!identified) return null;
+    o["plant-model"] = identified;   // identify's own --json, as design-pid --plant-model reads it
+  }
+  return o;
+}
+
+function fig(label, value) {
+  const d = document.createElement("div");
+  d.className = "figure";
+  d.innerHTML = "<b></b><span></span>";
+  d.querySelector("b").textContent = value;
+  d.querySelector("span").textContent = label;
+  return d;
+}
+
+function show(answer) {
+  const r = answer.result, p = answer.page;
+  document.getElementById("title").textContent = p.title;
+  const t = r.tuning || {};
+  const a = (r.spice && r.spice.overshoot_pct !== undefined) ? r.spice : (r.achieved || {});
+  document.getElementById("figures").replaceChildren(
+    fig("method", r.method || t.method || ""),
+    fig("Kp", t.kp !== undefined ? (+t.kp).toPrecision(4) : ""),
+    fig("Ti", D.eng(t.ti_s, "s")), fig("Td", D.eng(t.td_s, "s")),
+    fig("overshoot", a.overshoot_pct !== undefined && a.overshoot_pct !== null ? `${(+a.overshoot_pct).toPrecision(3)} %` : "n/a"),
+    fig("checks failed", String((r.checks || []).filter(c => !c.ok).length)));
+  D.plot(document.getElementById("closed"), p.closed_loop, {xUnit: "s", yLabel: "output (V)"});
+  D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 220});
+  D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 180});
+  document.getElementById("schematic").innerHTML = p.schematic_svg;
+  // the sheet is our own HTML (the build sheet's renderer escapes every text); shown in a shadow root so its
+  // styles stay inside
+  const host = document.getElementById("sheet-html");
+  const root = host.shadowRoot || host.attachShadow({mode: "open"});
+  root.innerHTML = p.sheet_html;
+}
+
+async function design() {
+  const opts = request();
+  if (opts === null) return;
+  const mine = ++seq;
+  D.busy(true, status);
+  const r = await D.api("/api/pid?view=page", opts);
+  if (mine !== seq) return;
+  D.busy(false, status);
+  if (!r.ok) { D.showError(form, r.data); document.body.dataset.state = "error"; return; }
+  D.clearError(form);
+  last = {opts, answer: r.data};
+  show(r.data);
+  status.textContent = "designed and simulated";
+  document.body.dataset.state = "done";
+}
+
+async function file(kind) {
+  if (!last) return;
+  D.busy(true, status);
+  const r = await D.api(`/api/pid/${kind}`, last.opts, true);
+  D.busy(false, status);
+  if (!r.ok) { D.showError(form, r.data); return; }
+  if (kind === "sheet") window.open(URL.createObjectURL(r.blob), "_blank");
+  else D.download(r.blob, "pid.zip");
+}
+
+(async function () {
+  const c = await D.loadChoices();
+  for (const s of form.querySelectorAll("select[data-choices]")) {
+    const keepFirst = s.options.length ? [s.options[0].value] : [];
+    D.fill(s, [...keepFirst, ...c[s.dataset.choices]], s.dataset.default || keepFirst[0]);
+    if (keepFirst.length && s.options[0].value === "") s.options[0].textContent = "default";
+  }
+  const q = new URLSearchParams(location.search);
+  for (const [k, v] of q) {
+    if (k === "plant") { const r = form.querySelector(`input[name=plant][value="${CSS.escape(v)}"]`); if (r) r.checked = true; continue; }
+    const el = form.querySelector(`[name="${CSS.escape(k)}"]`);
+    if (el) el.value = v;
+  }
+  if (identified) {
+    const b = identified.best || {};
+    document.getElementById("model-text").textContent =
+      `From ${identified.capture ? identified.capture.source : "the identify page"}: ${b.name} (${b.model}) ` +
+      Object.entries(b.params || {}).map(([k, v]) => `${k} = ${D.eng(v, "", 4)}`).join(", ");
+  }
+  showPlantKind();
+  const later = D.debounce(design, 400);
+  form.addEventListener("input", later);
+  form.addEventListener("change", e => { if (e.target.name === "plant") showPlantKind(); later(); });
+  document.getElementById("sheet").onclick = () => file("sheet");
+  document.getElementById("bundle").onclick = () => file("bundle");
+  design();
+})();

@@ -1,0 +1,92 @@
+// The plant page: the form's options go to POST /api/plant?view=page as they change (debounced); the
+// answer is design-plant's JSON with the plots' data, the schematic (SVG), the bench settings and the BOM.
+"use strict";
+D.nav("/plant");
+const form = document.getElementById("form");
+const status = document.getElementById("status");
+let seq = 0, last = null;
+
+function fig(label, value) {
+  const d = document.createElement("div");
+  d.className = "figure";
+  d.innerHTML = "<b></b><span></span>";
+  d.querySelector("b").textContent = value;
+  d.querySelector("span").textContent = label;
+  return d;
+}
+
+function show(answer) {
+  const r = answer.result, p = answer.page, b = r.built;
+  document.getElementById("title").textContent = p.title;
+  const figs = document.getElementById("figures");
+  figs.replaceChildren(
+    fig("R1", D.eng(b.R1_ohm, "Ohm", 3)), fig("R2", D.eng(b.R2_ohm, "Ohm", 3)),
+    fig("C1", D.eng(b.C1_f, "F", 3)), fig("C2", D.eng(b.C2_f, "F", 3)),
+    fig(`fn as built (${r.opamp.name})`, D.eng(b.fn_opamp_hz, "Hz", 4)),
+    fig(`zeta as built (${r.opamp.name})`, b.zeta_opamp.toPrecision(4)),
+    fig("overshoot (model)", `${r.analytic_opamp.overshoot_pct.toPrecision(4)} %`),
+    fig("overshoot (SPICE)", r.spice ? `${r.spice.overshoot_pct.toPrecision(4)} %` : "not simulated"),
+    fig("peak time", D.eng((r.spice || r.analytic_opamp).peak_time_s, "s", 4)),
+    fig("settling time (2 %)", D.eng((r.spice || r.analytic_opamp).settling_time_s, "s", 4)),
+    fig("SPICE agrees with the model", r.comparison.pass === undefined ? "n/a" : (r.comparison.pass ? "yes" : "NO")));
+  document.getElementById("notes").replaceChildren(...r.notes.map(n => { const e = document.createElement("p"); e.textContent = n; return e; }));
+  document.getElementById("schematic").innerHTML = p.schematic_svg;
+  document.getElementById("bench").replaceChildren(D.table(["set", "to"], p.bench));
+  document.getElementById("bomtable").replaceChildren(D.table(p.bom.header.slice(0, 7), p.bom.rows.map(x => x.slice(0, 7))));
+  document.getElementById("checks").replaceChildren(D.checksTable(r.checks));
+  D.plot(document.getElementById("step"), p.step, {xUnit: "s", yLabel: "output (V)"});
+  D.plot(document.getElementById("bode-gain"), p.bode.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 240});
+  D.plot(document.getElementById("bode-phase"), p.bode.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 200});
+}
+
+async function design() {
+  const mine = ++seq;
+  const opts = D.options(form);
+  D.busy(true, status);
+  const r = await D.api("/api/plant?view=page", opts);
+  if (mine !== seq) return;          // a newer request is on its way: this answer is stale
+  D.busy(false, status);
+  if (!r.ok) { D.showError(form, r.data); document.body.dataset.state = "error"; return; }
+  D.clearError(form);
+  last = {opts, answer: r.data};
+  show(r.data);
+  status.textContent = `designed and simulated (${r.data.result.simulator || "no simulator"})`;
+  document.body.dataset.state = "done";
+}
+
+async function file(kind) {
+  if (!last) return;
+  if (kind === "bom") {
+    D.download(new Blob([last.answer.page.bom_csv], {type: "text/csv"}), "bom.csv");
+    return;
+  }
+  D.busy(true, status);
+  const r = await D.api(`/api/plant/${kind}`, last.opts, true);
+  D.busy(false, status);
+  if (!r.ok) { D.showError(form, r.data); return; }
+  if (kind === "sheet") window.open(URL.createObjectURL(r.blob), "_blank");
+  else D.download(r.blob, `plant_fc${last.opts.fc}_z${last.opts.zeta}.zip`);
+}
+
+(async function () {
+  const c = await D.loadChoices();
+  for (const s of form.querySelectorAll("select[data-choices]")) D.fill(s, c[s.dataset.choices], s.dataset.default);
+  const q = new URLSearchParams(location.search);
+  for (const [k, v] of q) { const el = form.querySelector(`[name="${CSS.escape(k)}"]`); if (el) el.value = v; }
+  const later = D.debounce(design, 350);
+  form.addEventListener("input", later);
+  form.addEventListener("change", later);
+  document.getElementById("sheet").onclick = () => file("sheet");
+  document.getElementById("bundle").onclick = () => file("bundle");
+  document.getElementById("bom").onclick = () => file("bom");
+  document.getElementById("topid").onclick = () => {
+    if (!last) return;
+    const o = last.opts, b = last.answer.result.built;
+    // the plant as built, by its parts: the PID is designed for the circuit on the bench
+    const q = new URLSearchParams({"plant": "parts", "plant-r1": b.R1_ohm, "plant-r2": b.R2_ohm, "plant-c1": b.C1_f,
+                                   "plant-c2": b.C2_f, "opamp": o.opamp || "LM741"});
+    if (b.gain !== 1) q.set("plant-gain", b.gain);
+    location.href = "/pid?" + q.toString();
+  };
+  design();
+})();
