@@ -41,6 +41,8 @@ MEDIA = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=u
 #: the pages, by path
 PAGES = {"/": "plant.html", "/plant": "plant.html", "/pid": "pid.html", "/identify": "identify.html",
          "/check": "check.html"}
+#: the commands' refusals of a file over their size limits (designer.core.fileio): answered 413
+_TOO_LARGE = re.compile(r"the most this command reads|; at most [0-9.]+ [KMG]?i?B is read")
 #: multipart framing around an upload (boundaries, part headers) allowed over the file's own limit
 FRAMING_BYTES = 64 * 1024
 
@@ -110,7 +112,7 @@ def create_app(pool) -> Starlette:
         if value["error"] is not None:
             line = _hide(value["error"], tmp, upload_name)
             code = 400 if status == 2 else 502 if status == 3 else 503
-            if status == 2 and "the most this command reads" in line:
+            if status == 2 and _TOO_LARGE.search(line):
                 code = 413
             return _error(code, line)
         if want in ("sheet", "bundle"):
@@ -180,7 +182,11 @@ def create_app(pool) -> Starlette:
             return await run(prog, argv, "check", tmp)
 
     routes = [Route(path, page(name)) for path, name in PAGES.items()]
+    async def no_icon(request):
+        return Response(status_code=204)
+
     routes += [Route("/static/{path:path}", static_file), Route("/api/health", health),
+               Route("/favicon.ico", no_icon),
                Route("/api/choices", choices_endpoint),
                Route("/api/plant", designing("design-plant"), methods=["POST"]),
                Route("/api/plant/sheet", designing("design-plant", "sheet"), methods=["POST"]),

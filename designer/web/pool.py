@@ -29,15 +29,26 @@ from ..core.workers import Worker
 
 #: seconds a worker may take over one request before it is killed (design-pid's optimiser takes a few)
 DEFAULT_TIMEOUT_S = 120.0
+#: a new worker's first task (:func:`designer.web.jobs.run` warms up: ngspice loaded, modules imported), its own
+#: deadline: a request's deadline counts its own run only
+WARM_UP = {"prog": "warm-up"}
+WARM_UP_TIMEOUT_S = 300.0
 
 
-def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work, setup) -> None:
-    """The pool process: requests ``(id, task)`` in from the server, ``(id, kind, value)`` out."""
+def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work) -> None:
+    """The pool process: requests ``(id, task)`` in from the server, ``(id, kind, value)`` out
+    (ids from 1: 0 is a worker's warm-up, answered to nobody)."""
     lifetime.die_with_parent(parent_pid)
     lifetime.reset_in_child()
     other_end.close()
     ctx = multiprocessing.get_context("fork")
-    workers = [Worker(ctx, work, setup, daemon=False) for _ in range(jobs)]
+
+    def fresh():
+        w = Worker(ctx, work, None, daemon=False)
+        w.give(0, WARM_UP, WARM_UP_TIMEOUT_S)
+        return w
+
+    workers = [fresh() for _ in range(jobs)]
     queue = deque()
     try:
         while True:
@@ -60,15 +71,17 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                         kind, value = w.conn.recv()
                     except (EOFError, OSError):
                         kind, value = "dead", "the worker running it died: the simulator crashed"
-                    conn.send((w.task, kind, value))
+                    if w.task:
+                        conn.send((w.task, kind, value))
                     w.task = None
                     if kind == "dead":
                         w.kill()
-                        workers[k] = Worker(ctx, work, setup, daemon=False)
+                        workers[k] = fresh()
                 elif time.monotonic() >= w.deadline:
                     w.kill()
-                    conn.send((w.task, "timeout", f"timed out after {timeout:g} s (killed)"))
-                    workers[k] = Worker(ctx, work, setup, daemon=False)
+                    if w.task:
+                        conn.send((w.task, "timeout", f"timed out after {timeout:g} s (killed)"))
+                    workers[k] = fresh()
             for w in workers:
                 if w.task is None and queue:
                     rid, task = queue.popleft()
@@ -90,14 +103,14 @@ class Pool:
     answer ``(kind, value)``: kind "ok" (value: what ``work`` returned),
     "crash" (a bug in the task, its words), "dead" or "timeout"."""
 
-    def __init__(self, jobs: int, timeout: float = DEFAULT_TIMEOUT_S, work=None, setup=None):
+    def __init__(self, jobs: int, timeout: float = DEFAULT_TIMEOUT_S, work=None):
         from . import jobs as job
         ctx = multiprocessing.get_context("fork")
         self.conn, child = ctx.Pipe()
         self.timeout = timeout
         self.jobs = jobs
         self.proc = ctx.Process(target=_pool_main, args=(child, self.conn, os.getpid(), jobs, timeout,
-                                                         work or job.run, setup or job.warm_up))
+                                                         work or job.run))
         self.proc.start()
         child.close()
         self._ids = itertools.count(1)

@@ -65,12 +65,15 @@ def build_argv(options: dict, tmp: str | None, switches=(), appended=()) -> list
     argv = []
     for key, value in options.items():
         opt = option_name(key)
-        if value is None or value is False and opt in switches:
+        if value is None:
             continue
         if opt in switches:
-            if value is not True:
+            # a form's field or a query string says it in words
+            word = value if isinstance(value, bool) else str(value).strip().lower() if isinstance(value, str) else None
+            if word not in (True, False, "true", "false", "on", "off", ""):
                 raise DesignError(f"{opt} is a switch: true or false, got {json.dumps(value)[:40]}")
-            argv.append(opt)
+            if word in (True, "true", "on"):
+                argv.append(opt)
             continue
         if opt[2:] in FILE_OPTIONS:
             argv += [opt, write_content(tmp, FILE_OPTIONS[opt[2:]], value, opt)]

@@ -74,6 +74,7 @@ def _serve(args) -> int:
     try:
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         sock.bind((args.host, port))
+        sock.listen(2048)   # connections wait in the backlog from now on, until the server accepts them
     except OSError as exc:
         sock.close()
         from ..core.errors import DesignError

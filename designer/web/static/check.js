@@ -23,14 +23,18 @@ function show(answer) {
   for (const line of answer.lines) { const p = document.createElement("p"); p.textContent = line; v.append(p); }
   const rows = [];
   for (const s of answer.specs) {
-    for (const c of s.cases || []) {
-      const st = document.createElement("span");
-      st.className = c.status === "pass" ? "ok" : c.status === "skipped" ? "" : "fail";
-      st.textContent = c.status;
-      rows.push([s.name, c.corner, c.check || c.name, st, c.detail || c.message || ""]);
+    for (const corner of s.corners || []) {
+      for (const c of corner.cases || []) {
+        const st = document.createElement("span");
+        st.className = c.status === "pass" ? "ok" : c.status === "skipped" ? "" : "fail";
+        st.textContent = c.status;
+        rows.push([s.spec.name, c.corner || corner.corner || "-", c.id, st, c.message || ""]);
+      }
     }
   }
-  document.getElementById("cases").replaceChildren(D.table(["spec", "corner", "check", "status", "detail"], rows));
+  const t = D.table(["spec", "corner", "check", "status", "detail"], rows);
+  t.id = "cases-table";
+  document.getElementById("cases").replaceChildren(t);
   document.getElementById("summary").textContent = answer.summary || "";
 }
 

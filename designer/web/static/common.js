@@ -134,7 +134,9 @@ D.plot = function (el, trace, opts) {
   const u = new uPlot({
     title: opts.title || "", width, height: opts.height || 300, series,
     scales: {x: trace.log_x ? {time: false, distr: 3} : {time: false}},
-    axes: [{label: trace.x_label, values: (u, ticks) => ticks.map(t => D.eng(t, opts.xUnit || "", 3))},
+    // a log axis labels its decades only (uPlot gives null for the ticks it leaves bare)
+    axes: [{label: trace.x_label, values: (u, ticks) => ticks.map(t => t === null || (trace.log_x &&
+              Math.abs(Math.log10(t) - Math.round(Math.log10(t))) > 1e-9) ? "" : D.eng(t, opts.xUnit || "", 3))},
            {label: opts.yLabel || ""}],
     cursor: {drag: {x: true, y: false}},
     legend: {live: true},

@@ -37,12 +37,13 @@ function show(answer) {
   const r = answer.result, p = answer.page;
   document.getElementById("title").textContent = p.title;
   const t = r.tuning || {};
-  const a = (r.spice && r.spice.overshoot_pct !== undefined) ? r.spice : (r.achieved || {});
+  const cl = r.closed_loop || {};
+  const a = cl.spice || cl.analytic || {};
   document.getElementById("figures").replaceChildren(
     fig("method", r.method || t.method || ""),
     fig("Kp", t.kp !== undefined ? (+t.kp).toPrecision(4) : ""),
     fig("Ti", D.eng(t.ti_s, "s")), fig("Td", D.eng(t.td_s, "s")),
-    fig("overshoot", a.overshoot_pct !== undefined && a.overshoot_pct !== null ? `${(+a.overshoot_pct).toPrecision(3)} %` : "n/a"),
+    fig(cl.spice ? "overshoot (SPICE)" : "overshoot (analytic)", a.overshoot_pct !== undefined && a.overshoot_pct !== null ? `${(+a.overshoot_pct).toPrecision(3)} %` : "n/a"),
     fig("checks failed", String((r.checks || []).filter(c => !c.ok).length)));
   D.plot(document.getElementById("closed"), p.closed_loop, {xUnit: "s", yLabel: "output (V)"});
   D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 220});
