@@ -14,6 +14,12 @@ import urllib.request
 ENV = dict(os.environ)
 
 
+def cli(prog, *argv):
+    """A console script run as a user runs it (beside this interpreter), with the run's environment."""
+    from helpers import ROOT, script
+    return subprocess.run([script(prog), *argv], capture_output=True, text=True, env=ENV, cwd=ROOT)
+
+
 class Server:
     """A running ``designer-web`` and the way to talk to it."""
 

@@ -5,23 +5,17 @@ killed at its deadline."""
 
 import io
 import json
-import subprocess
 import zipfile
 from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
-from webserver import ENV, Server
-from helpers import EXT_CAPTURES, FIXTURES, ROOT, script
+from webserver import Server, cli
+from helpers import EXT_CAPTURES, FIXTURES, ROOT
 
 pytestmark = pytest.mark.spice
 
 CAPTURE = FIXTURES / "identify" / "tektronix_mso.csv"
-
-
-def cli(prog, *argv):
-    """A console script run as a user runs it."""
-    return subprocess.run([script(prog), *argv], capture_output=True, text=True, env=ENV, cwd=ROOT)
 
 
 def cli_json(*argv) -> dict:

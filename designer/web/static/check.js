@@ -44,13 +44,13 @@ async function run() {
                 options: D.options(form)};
   const r = await D.api("/api/check", body);
   D.busy(false, status);
-  if (!r.ok) { D.showError(form, r.data); document.body.dataset.state = "error"; return; }
+  if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
   D.clearError(form);
   last = r.data;
   show(r.data);
   document.getElementById("junit").disabled = !r.data.junit;
   status.textContent = r.data.status === 0 ? "every check passed" : "a check failed";
-  document.body.dataset.state = "done";
+  D.answered("done");
 }
 
 D.dropZone(document.getElementById("drop"), document.getElementById("files"), addFiles);

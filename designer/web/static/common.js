@@ -62,6 +62,12 @@ D.showError = function (form, data) {
   }
 };
 
+// Each answer shown: the page's state ("done" or "error") and how many answers it has shown (for its tests).
+D.answered = function (state) {
+  document.body.dataset.state = state;
+  document.body.dataset.answers = String(+(document.body.dataset.answers || 0) + 1);
+};
+
 D.busy = function (on, el) {
   document.body.classList.toggle("busy", on);
   if (el) el.textContent = on ? "working..." : "";

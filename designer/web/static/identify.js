@@ -50,13 +50,13 @@ async function identify() {
   if (mine !== seq) return;
   D.busy(false, status);
   document.getElementById("topid").disabled = true;
-  if (!r.ok) { D.showError(form, r.data); document.body.dataset.state = "error"; return; }
+  if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
   D.clearError(form);
   last = r.data;
   show(r.data);
   document.getElementById("topid").disabled = !r.data.result.best;
   status.textContent = `identified ${file.name}`;
-  document.body.dataset.state = "done";
+  D.answered("done");
 }
 
 (async function () {

@@ -46,12 +46,12 @@ async function design() {
   const r = await D.api("/api/plant?view=page", opts);
   if (mine !== seq) return;          // a newer request is on its way: this answer is stale
   D.busy(false, status);
-  if (!r.ok) { D.showError(form, r.data); document.body.dataset.state = "error"; return; }
+  if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
   D.clearError(form);
   last = {opts, answer: r.data};
   show(r.data);
   status.textContent = `designed and simulated (${r.data.result.simulator || "no simulator"})`;
-  document.body.dataset.state = "done";
+  D.answered("done");
 }
 
 async function file(kind) {

@@ -1,0 +1,168 @@
+"""The pages in a real browser: Playwright driving Debian's chromium (headless,
+its own executable: nothing is downloaded) against a designer-web server on a
+free local port. What a student does: type a plant and read the parts off the
+schematic, change the op-amp, mistype, drop a scope export, go from its model
+to a PID, download the bundle."""
+
+import io
+import shutil
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from helpers import EXT_CAPTURES, FIXTURES
+from webserver import cli
+
+pytestmark = [pytest.mark.chromium, pytest.mark.spice]
+
+SYNTHETIC_TEK = FIXTURES / "identify" / "tektronix_mso.csv"   # a Tektronix MSO export of a first-order plant
+REAL_TEK = EXT_CAPTURES / "tom2718_TEK0001.CSV"                  # a real TBS1022 RC capture
+
+
+@pytest.fixture(scope="module")
+def browser():
+    sync_api = pytest.importorskip("playwright.sync_api")
+    exe = shutil.which("chromium")
+    assert exe, "chromium is not installed (make setup installs it)"
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=exe, headless=True)
+        yield b
+        b.close()
+
+
+@pytest.fixture
+def page(browser):
+    context = browser.new_context(viewport={"width": 1400, "height": 1400}, accept_downloads=True)
+    pg = context.new_page()
+    errors = []
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    yield pg
+    context.close()
+    assert not errors, errors   # no script error on any page
+
+
+def answers(pg) -> int:
+    return int(pg.evaluate("+(document.body.dataset.answers || 0)"))
+
+
+def after(pg, action, timeout=60000):
+    """Do ``action`` and wait for the page's next answer (the form is debounced); returns its state."""
+    before = answers(pg)
+    action()
+    pg.wait_for_function(f"+(document.body.dataset.answers || 0) > {before}", timeout=timeout)
+    return pg.evaluate("document.body.dataset.state")
+
+
+def open_page(pg, server, path):
+    pg.goto(server.url + path)
+    if path in ("/plant", "/pid"):
+        pg.wait_for_function("+(document.body.dataset.answers || 0) > 0", timeout=60000)
+
+
+def figure(pg, label: str) -> str:
+    return pg.locator(".figure", has_text=label).locator("b").inner_text()
+
+
+def test_plant_typed_shows_the_parts_in_the_schematic_and_the_overshoot(page, server):
+    open_page(page, server, "/plant")
+    assert after(page, lambda: page.fill("input[name=fc]", "1000")) == "done"
+    assert after(page, lambda: (page.fill("input[name=fc]", "3500"), page.fill("input[name=zeta]", "0.2"))) == "done"
+    svg = page.inner_html("#schematic")
+    for code in ("1k6", "3k9", "3n3", "100n"):
+        assert f">{code}<" in svg, code
+    status, want = server.post_json("/api/plant", {"fc": 3500, "zeta": 0.2})
+    assert figure(page, "overshoot (SPICE)") == f"{want['spice']['overshoot_pct']:.4g} %"
+    assert figure(page, "overshoot (model)") == f"{want['analytic_opamp']['overshoot_pct']:.4g} %"
+    # the step and Bode plots are drawn, with the SPICE trace among them (a legend entry: click hides it)
+    assert page.locator("#step canvas").count() == 1
+    legend = page.locator("#step .u-legend .u-series", has_text="SPICE (ngspice)")
+    legend.click()
+    assert "u-off" in legend.get_attribute("class")
+
+
+def test_changing_the_opamp_moves_the_figures(page, server):
+    open_page(page, server, "/plant")
+    fn_741, os_741 = figure(page, "fn as built"), figure(page, "overshoot (SPICE)")
+    assert after(page, lambda: page.select_option("select[name=opamp]", "LM358")) == "done"
+    assert "LM358" in page.locator(".figure", has_text="fn as built").inner_text()
+    assert (figure(page, "fn as built"), figure(page, "overshoot (SPICE)")) != (fn_741, os_741)
+
+
+def test_a_bad_zeta_is_one_inline_message_beside_its_field(page, server):
+    open_page(page, server, "/plant")
+    assert after(page, lambda: page.fill("input[name=zeta]", "-1")) == "error"
+    errors = page.locator(".field-error")
+    assert errors.count() == 1
+    status, want = server.post_json("/api/plant", {"fc": 3500, "zeta": -1})
+    assert errors.inner_text() == want["message"]                       # the CLI's own words
+    # beside the field at fault
+    assert page.evaluate("document.querySelector('input[name=zeta]').closest('label').nextElementSibling"
+                         ".classList.contains('field-error')")
+    assert after(page, lambda: page.fill("input[name=zeta]", "0.2")) == "done"
+    assert page.locator(".field-error").count() == 0
+
+
+def drop(page, path):
+    """Give the identify page a file as a user does (its file chooser: the drop zone's twin)."""
+    return after(page, lambda: page.set_input_files("#file", str(path)))
+
+
+def test_identify_a_synthetic_tektronix_export_then_design_a_pid_for_its_model(page, server):
+    open_page(page, server, "/identify")
+    assert drop(page, SYNTHETIC_TEK) == "done"
+    assert "tektronix-mso" in page.inner_text("#format-line")
+    rows = page.locator("#methods tbody tr")
+    assert rows.count() > 5
+    first_order = [r for r in rows.all_inner_texts() if "\tfopdt\t" in r and "\tyes\t" in r]
+    assert first_order, "no valid first-order model in the ranked table"
+    assert page.locator("#plot canvas").count() == 1
+    # on to a PID for this model: the closed loop is drawn with SPICE's trace
+    page.click("#topid")
+    page.wait_for_url("**/pid?plant=identify")
+    page.wait_for_function("+(document.body.dataset.answers || 0) > 0", timeout=120000)
+    assert page.evaluate("document.body.dataset.state") == "done", page.inner_text(".form-foot")
+    assert page.locator("#closed canvas").count() == 1
+    assert page.locator("#closed .u-legend", has_text="SPICE (ngspice)").count() == 1
+    assert "model plant" in page.inner_text("#title")
+
+
+@pytest.mark.skipif(not REAL_TEK.exists(), reason="../shared/ext-captures (real scope exports) is not beside this clone")
+def test_identify_a_real_tbs1022_capture(page, server):
+    open_page(page, server, "/identify")
+    page.fill("input[name=step-amplitude]", "1.72")
+    assert drop(page, REAL_TEK) == "done"
+    assert "tektronix-tds" in page.inner_text("#format-line")
+    assert "(fopdt)" in page.inner_text("#best")
+
+
+def test_the_bundle_zip_holds_the_files_design_plant_writes(page, server, tmp_path):
+    open_page(page, server, "/plant")
+    with page.expect_download(timeout=120000) as dl:
+        page.click("#bundle")
+    names = set(zipfile.ZipFile(io.BytesIO(Path(dl.value.path()).read_bytes())).namelist())
+    out = cli("design-plant", "--fc", "3500", "--zeta", "0.2", "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    written = {p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*") if p.is_file()}
+    assert names == written
+    with page.expect_download() as dl:
+        page.click("#bom")
+    bom = Path(dl.value.path()).read_text(encoding="utf-8")
+    assert bom == (tmp_path / "reports" / "plant_fc3500_z0.2" / "bom.csv").read_text(encoding="utf-8")
+
+
+def test_check_page_runs_a_pasted_spec(page, server):
+    open_page(page, server, "/check")
+    page.fill("#spec", "name: lab3\nkind: plant\ntarget: {fc: 3.5k, zeta: 0.2}\nopamp: [LM741]\n"
+                       "checks:\n  overshoot_pct: {max: 60}\n  fn_hz: {typ: 3500, min: '-2%', max: '+2%'}\n")
+    assert after(page, lambda: page.click("#run"), timeout=120000) == "done"
+    table = page.inner_text("#cases-table")
+    assert "overshoot_pct" in table and "pass" in table
+    with page.expect_download() as dl:
+        page.click("#junit")
+    assert '<testsuite name="lab3"' in Path(dl.value.path()).read_text(encoding="utf-8")
+    # a spec naming a deck that was not given is refused in check-design's one line
+    page.fill("#spec", "name: evil\nkind: netlist\ndeck: nothere.cir\nchecks:\n  v: {max: 1}\n")
+    assert after(page, lambda: page.click("#run")) == "error"
+    assert page.locator(".field-error").count() == 1
+    assert "nothere.cir" in page.inner_text(".field-error")
