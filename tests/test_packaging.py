@@ -41,6 +41,10 @@ def test_the_wheel_carries_the_model_library_and_the_opamp_data(installed):
     names = zipfile.ZipFile(wheel).namelist()
     assert "designer/spice/circuits/opamp_behavioural.lib" in names
     assert "designer/core/data/opamps.json" in names
+    # designer-web's pages and the plotting library they load from the server, with its licence (no CDN)
+    for name in ("plant.html", "pid.html", "identify.html", "check.html", "common.js", "style.css",
+                 "vendor/uplot/uPlot.iife.min.js", "vendor/uplot/uPlot.min.css", "vendor/uplot/LICENSE"):
+        assert f"designer/web/static/{name}" in names, name
 
 
 def test_installed_commands_work_from_any_folder(installed, tmp_path):
