@@ -17,6 +17,7 @@ Starlette (routing, requests, responses) on uvicorn: see the README for why.
 
 from __future__ import annotations
 
+import asyncio
 import json
 import os
 import re
@@ -95,15 +96,23 @@ def create_app(pool) -> Starlette:
         return Response(found[0], media_type=found[1], headers={"Cache-Control": "no-cache"})
 
     async def health(request):
-        return JSONResponse({"ok": True, "jobs": pool.jobs, "timeout_s": pool.timeout})
+        return JSONResponse({"ok": True, "jobs": pool.jobs, "timeout_s": pool.timeout, "dropped": pool.dropped})
 
     choices = _choices()
 
     async def choices_endpoint(request):
         return JSONResponse(choices)
 
-    async def run(prog: str, argv: list, want: str, tmp: str, upload_name: str | None = None):
-        kind, value = await pool.submit({"prog": prog, "argv": argv, "want": want, "tmp": tmp})
+    async def run(request, prog: str, argv: list, want: str, tmp: str, upload_name: str | None = None):
+        rid, answer = pool.start({"prog": prog, "argv": argv, "want": want, "tmp": tmp})
+        # a page typing ahead drops its older requests: one whose client has gone leaves the queue
+        while not answer.done():
+            await asyncio.wait({answer}, timeout=0.25)
+            if not answer.done() and await request.is_disconnected():
+                pool.cancel(rid)
+                await answer   # dropped from the queue at once, or its run finished: the folder is free
+                return Response(status_code=204)
+        kind, value = answer.result()
         if kind == "timeout":
             return _error(504, f"{prog}: error: simulator error: {value}")
         if kind != "ok":
@@ -144,7 +153,7 @@ def create_app(pool) -> Starlette:
                 except DesignError as exc:
                     return _error(400, f"{prog}: error: {exc}")
                 argv += ["--json"] + (["--out", tmp] if how in ("sheet", "bundle") else ["--no-files"])
-                return await run(prog, argv, how, tmp)
+                return await run(request, prog, argv, how, tmp)
         return endpoint
 
     async def identify(request: Request):
@@ -162,7 +171,7 @@ def create_app(pool) -> Starlette:
                 argv = [path] + req.build_argv(options, tmp, *traits[prog]) + ["--json"]
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
-            return await run(prog, argv, _view(request), tmp, name)
+            return await run(request, prog, argv, _view(request), tmp, name)
 
     async def check(request: Request):
         prog = "check-design"
@@ -179,7 +188,7 @@ def create_app(pool) -> Starlette:
                 return _error(400, f"{prog}: error: {exc}")
             argv += ["--junit", os.path.join(tmp, "junit.xml"), "--summary", os.path.join(tmp, "summary.md"),
                      "--out", os.path.join(tmp, "out"), "--root", os.path.join(tmp, "in")]
-            return await run(prog, argv, "check", tmp)
+            return await run(request, prog, argv, "check", tmp)
 
     routes = [Route(path, page(name)) for path, name in PAGES.items()]
     async def no_icon(request):

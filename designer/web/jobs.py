@@ -24,6 +24,7 @@ import io
 import json
 import math
 import os
+import sys
 from contextlib import redirect_stderr, redirect_stdout
 
 import numpy as np
@@ -75,6 +76,8 @@ def run(task: dict) -> dict:
     seen = {}
     out, err = io.StringIO(), io.StringIO()
     token = RESULT_HOOK.set(lambda result, name: seen.update(result=result, name=name))
+    argv0 = sys.argv
+    sys.argv = [prog, *argv]   # the JSON's tool.argv: the command line this request stands for
     try:
         with redirect_stdout(out), redirect_stderr(err):
             if prog in ("identify", "identify-freq"):
@@ -83,6 +86,7 @@ def run(task: dict) -> dict:
                 status = MAINS[prog](argv)
     finally:
         RESULT_HOOK.reset(token)
+        sys.argv = argv0
     answer = {"status": status, "error": _error_line(err.getvalue(), status), "json": None,
               "stderr": err.getvalue()}
     if status not in (0, 1):

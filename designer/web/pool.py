@@ -62,7 +62,12 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                     return
                 if msg is None:
                     return
-                queue.append(msg)
+                if msg[0] < 0:   # (-id, None): its client has gone; dropped (and so answered) if not started
+                    if any(m[0] == -msg[0] for m in queue):
+                        queue = deque(m for m in queue if m[0] != -msg[0])
+                        conn.send((-msg[0], "cancelled", None))
+                else:
+                    queue.append(msg)
             for k, w in enumerate(workers):
                 if w.task is None:
                     continue
@@ -101,7 +106,7 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
 class Pool:
     """The server's end of the pool process: :meth:`submit` a task, await its
     answer ``(kind, value)``: kind "ok" (value: what ``work`` returned),
-    "crash" (a bug in the task, its words), "dead" or "timeout"."""
+    "crash" (a bug in the task, its words), "dead", "timeout" or "cancelled"."""
 
     def __init__(self, jobs: int, timeout: float = DEFAULT_TIMEOUT_S, work=None):
         from . import jobs as job
@@ -116,6 +121,7 @@ class Pool:
         self._ids = itertools.count(1)
         self._waiting = {}
         self._loop = None
+        self.dropped = 0   #: requests whose client left while they were queued (never run)
 
     def attach(self) -> None:
         """Read the pool's answers on the running event loop."""
@@ -132,15 +138,30 @@ class Pool:
                     fut.set_result(("dead", "the worker pool stopped"))
             self._waiting.clear()
             return
+        if kind == "cancelled":
+            self.dropped += 1
         fut = self._waiting.pop(rid, None)
         if fut is not None and not fut.done():
             fut.set_result((kind, value))
 
-    async def submit(self, task) -> tuple:
+    def start(self, task) -> tuple:
+        """Queue ``task``; returns (its id, the future of its answer)."""
         rid = next(self._ids)
         fut = self._loop.create_future()
         self._waiting[rid] = fut
         self.conn.send((rid, task))
+        return rid, fut
+
+    def cancel(self, rid: int) -> None:
+        """Its client has gone: drop the task if it waits in the queue (answered "cancelled"); a run
+        already started finishes (and is answered as usual: its folder is in use until then)."""
+        try:
+            self.conn.send((-rid, None))
+        except (OSError, ValueError):
+            pass
+
+    async def submit(self, task) -> tuple:
+        rid, fut = self.start(task)
         try:
             return await fut
         finally:

@@ -70,6 +70,17 @@ def test_identify_answers_identifys_json_body_or_multipart(server):
     assert not any(m["name"] == "least-squares" for m in form["methods"])   # --no-refine reached identify
 
 
+def test_identify_takes_a_frequency_table_as_identify_does(server):
+    table = FIXTURES / "identify_freq" / "seed003_table31.csv"
+    status, got = server.post_json("/api/identify?filename=table31.csv", table.read_bytes())
+    assert status == 200
+    want = cli_json("identify", str(table), "--json")
+    assert got["format"] == want["format"] == "frequency-table"
+    assert got["data"].pop("source") == "table31.csv"   # its own name, not the server's folder
+    want["data"].pop("source")
+    assert without_run_details(got) == without_run_details(want)
+
+
 @pytest.mark.parametrize("path, body, argv", [
     ("/api/plant", {"fc": 3500, "zeta": -1}, ["design-plant", "--fc", "3500", "--zeta", "-1"]),
     ("/api/plant", {"fc": "3.5q", "zeta": 0.2}, ["design-plant", "--fc", "3.5q", "--zeta", "0.2"]),
@@ -200,6 +211,33 @@ def test_a_run_past_its_deadline_is_killed_and_reported_then_the_next_is_answere
     finally:
         err = s.stop()
     assert "Traceback" not in err
+
+
+def test_a_queued_request_whose_client_left_is_never_run():
+    """A page typing on aborts its older requests: those still queued are dropped, not run."""
+    import socket
+    import threading
+    import time
+    import urllib.parse
+    import urllib.request
+    s = Server("--jobs", "1")
+    try:
+        slow = threading.Thread(target=s.post_json, args=("/api/pid", {"plant-fc": 3500, "plant-zeta": 0.2,
+                                                                        "tuning": "optimize", "target-overshoot": 10}))
+        slow.start()
+        time.sleep(1.0)   # the slow one reaches the one worker first (its optimiser takes seconds)
+        u = urllib.parse.urlsplit(s.url)
+        body = json.dumps({"fc": 3500, "zeta": 0.2}).encode()
+        for _ in range(3):   # sent while the one worker is busy, then the client goes away
+            with socket.create_connection((u.hostname, u.port)) as sock:
+                sock.sendall(f"POST /api/plant HTTP/1.1\r\nHost: {u.netloc}\r\nContent-Length: {len(body)}\r\n"
+                             "Content-Type: application/json\r\n\r\n".encode() + body)
+        slow.join()
+        with urllib.request.urlopen(s.url + "/api/health", timeout=60) as r:
+            health = json.loads(r.read())
+        assert health["dropped"] == 3
+    finally:
+        s.stop()
 
 
 def test_binds_to_localhost_unless_told_and_says_so(server):

@@ -136,6 +136,14 @@ def test_identify_a_real_tbs1022_capture(page, server):
     assert "(fopdt)" in page.inner_text("#best")
 
 
+def test_identify_a_frequency_table_as_identify_freq_does(page, server):
+    open_page(page, server, "/identify")
+    assert drop(page, FIXTURES / "identify_freq" / "seed000_table4_deg.csv") == "done"
+    assert "frequency table" in page.inner_text("#format-line")
+    assert page.locator("#plot canvas").count() == 1 and page.locator("#phase canvas").count() == 1
+    assert page.locator("#methods tbody tr").count() > 1
+
+
 def test_the_bundle_zip_holds_the_files_design_plant_writes(page, server, tmp_path):
     open_page(page, server, "/plant")
     with page.expect_download(timeout=120000) as dl:

@@ -10,12 +10,24 @@ D.loadChoices = async function () {
   return D.choices;
 };
 
-// POST a JSON body (or a FormData, or a File as the body); resolves {ok, status, data, blob}.
-D.api = async function (path, body, asBlob) {
+// POST a JSON body (or a FormData, or a File as the body); resolves {ok, status, data, blob}. A call with a
+// ``channel`` aborts the one before it on that channel (the form typed on: the server drops it if queued),
+// and resolves {aborted: true} when it is itself aborted.
+const channels = {};
+D.api = async function (path, body, asBlob, channel) {
   const init = {method: "POST"};
   if (body instanceof FormData || body instanceof Blob) init.body = body;
   else { init.body = JSON.stringify(body || {}); init.headers = {"Content-Type": "application/json"}; }
-  const r = await fetch(path, init);
+  if (channel) {
+    if (channels[channel]) channels[channel].abort();
+    channels[channel] = new AbortController();
+    init.signal = channels[channel].signal;
+  }
+  let r;
+  try { r = await fetch(path, init); } catch (e) {
+    if (e.name === "AbortError") return {aborted: true};
+    return {ok: false, status: 0, data: {error: `the server does not answer: ${e.message}`, message: "the server does not answer"}};
+  }
   if (r.ok && asBlob) return {ok: true, status: r.status, blob: await r.blob()};
   let data = null;
   try { data = await r.json(); } catch (e) { data = {error: `HTTP ${r.status}`, message: `HTTP ${r.status}`}; }

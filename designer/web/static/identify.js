@@ -46,8 +46,8 @@ async function identify() {
   const q = new URLSearchParams({view: "page", filename: file.name});
   for (const [k, v] of Object.entries(D.options(form))) q.set(k, v === true ? "true" : v);
   D.busy(true, status);
-  const r = await D.api(`/api/identify?${q}`, file);
-  if (mine !== seq) return;
+  const r = await D.api(`/api/identify?${q}`, file, false, "form");
+  if (r.aborted || mine !== seq) return;
   D.busy(false, status);
   document.getElementById("topid").disabled = true;
   if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }

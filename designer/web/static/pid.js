@@ -61,8 +61,8 @@ async function design() {
   if (opts === null) return;
   const mine = ++seq;
   D.busy(true, status);
-  const r = await D.api("/api/pid?view=page", opts);
-  if (mine !== seq) return;
+  const r = await D.api("/api/pid?view=page", opts, false, "form");
+  if (r.aborted || mine !== seq) return;
   D.busy(false, status);
   if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
   D.clearError(form);

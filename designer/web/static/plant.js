@@ -43,8 +43,8 @@ async function design() {
   const mine = ++seq;
   const opts = D.options(form);
   D.busy(true, status);
-  const r = await D.api("/api/plant?view=page", opts);
-  if (mine !== seq) return;          // a newer request is on its way: this answer is stale
+  const r = await D.api("/api/plant?view=page", opts, false, "form");
+  if (r.aborted || mine !== seq) return;          // a newer request is on its way: this answer is stale
   D.busy(false, status);
   if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
   D.clearError(form);
