@@ -59,6 +59,14 @@ def is_local(host: str) -> bool:
         return False
 
 
+def exposure_warning(host: str, port: int) -> str | None:
+    """The line said at start-up when ``host`` lets other machines in (None for a loopback address)."""
+    if is_local(host):
+        return None
+    return (f"designer-web: warning: {host} is not this machine's loopback address: anyone who can reach port {port} "
+            "on this network can use the page and run designs here")
+
+
 def _serve(args) -> int:
     import socket
 
@@ -87,9 +95,9 @@ def _serve(args) -> int:
     shown = f"[{host}]" if family == socket.AF_INET6 else host
     print(f"designer-web: serving on http://{shown}:{port}/ ({jobs} workers, {timeout} s per run; Ctrl-C stops)",
           flush=True)
-    if not is_local(args.host):
-        print(f"designer-web: warning: {args.host} is not this machine's loopback address: anyone who can reach "
-              f"port {port} on this network can use the page and run designs here", flush=True)
+    warning = exposure_warning(args.host, port)
+    if warning:
+        print(warning, flush=True)
     config = uvicorn.Config(create_app(pool), log_level="warning", lifespan="on")
     server = uvicorn.Server(config)
     try:
