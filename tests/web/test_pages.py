@@ -89,6 +89,18 @@ def test_changing_the_opamp_moves_the_figures(page, server):
     assert (figure(page, "fn as built"), figure(page, "overshoot (SPICE)")) != (fn_741, os_741)
 
 
+def test_a_pid_for_this_plant_takes_its_parts(page, server):
+    open_page(page, server, "/plant")
+    page.click("#topid")
+    page.wait_for_url("**/pid?**")
+    page.wait_for_function("+(document.body.dataset.answers || 0) > 0", timeout=120000)
+    assert page.evaluate("document.body.dataset.state") == "done", page.inner_text(".form-foot")
+    assert [page.input_value(f"input[name=plant-{k}]") for k in ("r1", "r2", "c1", "c2")] == \
+        ["1.6k", "3.9k", "3.3n", "100n"]
+    assert page.locator("#closed canvas").count() == 1
+    assert "fn 3507.3 Hz, zeta 0.2" in page.inner_text("#title")   # the plant as built: 1k6 / 3k9 / 3n3 / 100n
+
+
 def test_a_bad_zeta_is_one_inline_message_beside_its_field(page, server):
     open_page(page, server, "/plant")
     assert after(page, lambda: page.fill("input[name=zeta]", "-1")) == "error"

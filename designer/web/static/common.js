@@ -77,6 +77,8 @@ D.showError = function (form, data) {
 // Each answer shown: the page's state ("done" or "error") and how many answers it has shown (for its tests).
 D.answered = function (state) {
   document.body.dataset.state = state;
+  // after a refusal the results shown are the last good input's: dimmed until the form is right again
+  for (const r of document.querySelectorAll(".results")) r.classList.toggle("stale", state === "error");
   document.body.dataset.answers = String(+(document.body.dataset.answers || 0) + 1);
 };
 

@@ -83,8 +83,9 @@ async function file(kind) {
     if (!last) return;
     const o = last.opts, b = last.answer.result.built;
     // the plant as built, by its parts: the PID is designed for the circuit on the bench
-    const q = new URLSearchParams({"plant": "parts", "plant-r1": b.R1_ohm, "plant-r2": b.R2_ohm, "plant-c1": b.C1_f,
-                                   "plant-c2": b.C2_f, "opamp": o.opamp || "LM741"});
+    const code = v => D.eng(v, "", 6).replace(" ", "");   // 1.6k, 3.3n: engineering notation as typed
+    const q = new URLSearchParams({"plant": "parts", "plant-r1": code(b.R1_ohm), "plant-r2": code(b.R2_ohm),
+                                   "plant-c1": code(b.C1_f), "plant-c2": code(b.C2_f), "opamp": o.opamp || "LM741"});
     if (b.gain !== 1) q.set("plant-gain", b.gain);
     location.href = "/pid?" + q.toString();
   };
