@@ -20,6 +20,7 @@ import asyncio
 import itertools
 import multiprocessing
 import os
+import signal
 import time
 from collections import deque
 from multiprocessing.connection import wait
@@ -40,6 +41,9 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
     (ids from 1: 0 is a worker's warm-up, answered to nobody)."""
     lifetime.die_with_parent(parent_pid)
     lifetime.reset_in_child()
+    # a Ctrl-C in the terminal reaches the whole process group: the server stops this pool itself, once the
+    # requests under way are answered (or this pool dies with it)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     other_end.close()
     ctx = multiprocessing.get_context("fork")
 
