@@ -149,7 +149,7 @@ def create_app(pool) -> Starlette:
                 except ValueError as exc:
                     return _error(400, f"{prog}: error: the request's body is not JSON: {exc}")
                 try:
-                    argv = req.build_argv(options, tmp, *traits[prog])
+                    argv = req.build_argv(options, tmp, traits[prog])
                 except DesignError as exc:
                     return _error(400, f"{prog}: error: {exc}")
                 argv += ["--json"] + (["--out", tmp] if how in ("sheet", "bundle") else ["--no-files"])
@@ -168,7 +168,7 @@ def create_app(pool) -> Starlette:
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
             try:
-                argv = [path] + req.build_argv(options, tmp, *traits[prog]) + ["--json"]
+                argv = [path] + req.build_argv(options, tmp, traits[prog]) + ["--json"]
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
             return await run(request, prog, argv, _view(request), tmp, name)
@@ -183,7 +183,7 @@ def create_app(pool) -> Starlette:
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
             try:
-                argv = [files["spec"]] + req.build_argv(options, None, *traits[prog])
+                argv = [files["spec"]] + req.build_argv(options, None, traits[prog])
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
             argv += ["--junit", os.path.join(tmp, "junit.xml"), "--summary", os.path.join(tmp, "summary.md"),

@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 import os
 import re
+from typing import NamedTuple
 
 from ..core.errors import DesignError
 
@@ -43,7 +44,7 @@ def option_name(key) -> str:
     return "--" + name
 
 
-def build_argv(options: dict, tmp: str | None, switches=(), appended=()) -> list:
+def build_argv(options: dict, tmp: str | None, traits: "Traits | None" = None) -> list:
     """The argument list of ``options`` (see the module docstring).
 
     Parameters
@@ -52,22 +53,22 @@ def build_argv(options: dict, tmp: str | None, switches=(), appended=()) -> list
         Option name -> value, as the request gave them.
     tmp : str or None
         The request's private folder, for the options of :data:`FILE_OPTIONS`.
-    switches : collection of str
-        The command's switches (``--no-sim``...): ``true`` gives the option alone,
-        ``false`` leaves it out.
-    appended : collection of str
-        The options given once per value (``--limit``); any other takes a list as
-        its values after one flag (``--window 0 7m``).
+    traits : Traits, optional
+        The command's options (:func:`parser_traits`): only those, spelt out in full (argparse
+        would take ``--o`` for ``--out``), each with the values it takes. None: any name.
     """
     if not isinstance(options, dict):
         raise DesignError("the request's body must be a JSON object of option names and values, "
                           'e.g. {"fc": 3500, "zeta": 0.2}')
+    t = traits or Traits(set(), set(), set(), None)
     argv = []
     for key, value in options.items():
         opt = option_name(key)
+        if t.known is not None and opt not in t.known:
+            raise DesignError(f"unrecognized arguments: {opt} (options by their full names, as --help lists them)")
         if value is None:
             continue
-        if opt in switches:
+        if opt in t.switches:
             # a form's field or a query string says it in words
             word = value if isinstance(value, bool) else str(value).strip().lower() if isinstance(value, str) else None
             if word not in (True, False, "true", "false", "on", "off", ""):
@@ -79,8 +80,10 @@ def build_argv(options: dict, tmp: str | None, switches=(), appended=()) -> list
             argv += [opt, write_content(tmp, FILE_OPTIONS[opt[2:]], value, opt)]
             continue
         values = value if isinstance(value, list) else [value]
+        if len(values) != 1 and t.known is not None and opt not in t.appended and opt not in t.multi:
+            raise DesignError(f"{opt} takes one value, got {len(values)}")
         words = [_word(v, opt) for v in values]
-        if opt in appended:
+        if opt in t.appended:
             for w in words:
                 argv += [opt, w]
         else:
@@ -112,15 +115,26 @@ def write_content(tmp: str | None, name: str, value, opt: str) -> str:
     return path
 
 
-def parser_traits(parser) -> tuple:
-    """(switches, appended options) of an argparse parser: the options taking no value, and
-    those given once per value."""
+class Traits(NamedTuple):
+    """A command's options as its parser defines them."""
+
+    switches: set    #: taking no value (``--no-sim``)
+    appended: set    #: given once per value (``--limit``)
+    multi: set       #: taking several values after one flag (``--window T0 T1``, ``--methods``)
+    known: set | None  #: every option string (None: not checked)
+
+
+def parser_traits(parser) -> Traits:
+    """The :class:`Traits` of an argparse parser."""
     import argparse
-    switches, appended = set(), set()
+    switches, appended, multi, known = set(), set(), set(), set()
     for action in parser._actions:   # argparse has no public list of its actions
         for opt in action.option_strings:
+            known.add(opt)
             if action.nargs == 0:
                 switches.add(opt)
             elif isinstance(action, argparse._AppendAction):
                 appended.add(opt)
-    return switches, appended
+            elif action.nargs not in (None, "?"):
+                multi.add(opt)
+    return Traits(switches, appended, multi, known)

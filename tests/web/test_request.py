@@ -16,10 +16,10 @@ def traits():
 
 
 def test_options_become_the_command_line_a_user_types():
-    switches, appended = traits()
+    t = traits()
     argv = build_argv({"fc": 3500, "zeta": "0.2", "r_series": "E24", "no-sim": True, "compensate-gbw": False,
                        "limit": ["fn_hz=3.3k:3.7k", "overshoot_pct=0:55"], "gain": 1.5, "tol": ["R=1%", "C=5%"]},
-                      None, switches, appended)
+                      None, t)
     assert argv == ["--fc", "3500", "--zeta", "0.2", "--r-series", "E24", "--no-sim",
                     "--limit", "fn_hz=3.3k:3.7k", "--limit", "overshoot_pct=0:55", "--gain", "1.5",
                     "--tol", "R=1%", "C=5%"]
@@ -31,11 +31,27 @@ def test_options_become_the_command_line_a_user_types():
 
 
 def test_switches_in_words_as_forms_send_them():
-    switches, appended = traits()
-    assert build_argv({"no-sim": "on"}, None, switches, appended) == ["--no-sim"]
-    assert build_argv({"no-sim": "false"}, None, switches, appended) == []
+    t = traits()
+    assert build_argv({"no-sim": "on"}, None, t) == ["--no-sim"]
+    assert build_argv({"no-sim": "false"}, None, t) == []
     with pytest.raises(DesignError, match="--no-sim is a switch"):
-        build_argv({"no-sim": 2}, None, switches, appended)
+        build_argv({"no-sim": 2}, None, t)
+
+
+@pytest.mark.parametrize("key", ["o", "ou", "no-f", "js", "plo"])
+def test_an_abbreviation_argparse_would_complete_is_refused(key):
+    """argparse takes --o for --out: a request names every option in full, so none reaches a refused one."""
+    with pytest.raises(DesignError, match="unrecognized arguments"):
+        build_argv({key: "x"}, None, traits())
+
+
+def test_one_value_options_take_one_value():
+    """A second value would be a positional argument (another file for check-design, another capture)."""
+    with pytest.raises(DesignError, match="--fc takes one value, got 2"):
+        build_argv({"fc": [3500, "/etc/passwd"]}, None, traits())
+    from designer.cli import check
+    with pytest.raises(DesignError, match="--simulator takes one value"):
+        build_argv({"simulator": ["pyspice", "evil.yaml"]}, None, parser_traits(check._parser()))
 
 
 @pytest.mark.parametrize("name", REFUSED)
@@ -68,9 +84,9 @@ json_values = st.recursive(st.none() | st.booleans() | st.integers() | st.floats
 
 @given(st.dictionaries(st.text(max_size=12), json_values, max_size=6) | json_values)
 def test_any_json_is_an_argument_list_or_one_line(body):
-    switches, appended = traits()
+    t = traits()
     try:
-        argv = build_argv(body, None, switches, appended)
+        argv = build_argv(body, None, t)
     except DesignError as exc:
         assert "\n" not in str(exc)
         return
