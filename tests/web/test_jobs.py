@@ -1,0 +1,50 @@
+"""What a worker does for one request (designer.web.jobs), in this process: the
+command's own output, and traces that are the result's own arrays."""
+
+import json
+
+import numpy as np
+import pytest
+
+from designer.web import jobs
+
+
+def test_measured_points_land_on_their_nearest_grid_frequency():
+    grid = np.geomspace(10, 1e5, 41)   # 10 points a decade
+    f = np.array([10.0, 99.0, 1010.0, 1e5])
+    got = jobs._on_grid(f, np.array([1.0, 2.0, 3.0, 4.0]), grid)
+    assert np.count_nonzero(np.isfinite(got)) == 4
+    for fi, v in zip(f, [1.0, 2.0, 3.0, 4.0]):
+        assert got[np.argmin(np.abs(np.log(grid / fi)))] == v
+    h = jobs._complex_on_grid(np.array([5.0, 100.0, 2e5]), np.array([1 + 1j, 2j, 3.0]), grid)
+    assert np.count_nonzero(np.isfinite(h)) == 1 and h[10] == 2j   # 100 Hz; outside the grid: left out
+
+
+def test_a_trace_is_json_with_nan_as_null_and_at_most_its_points():
+    x = np.linspace(0, 1, 10_000)
+    y = np.where(x > 0.5, np.nan, x)
+    t = jobs._trace(x, {"y": y}, "time (s)")
+    assert len(t["x"]) <= jobs.TRACE_POINTS and t["x"][0] == 0.0 and t["x"][-1] == 1.0
+    assert None in t["series"][0]["y"] and json.dumps(t)
+
+
+@pytest.mark.spice
+def test_a_plant_page_is_the_commands_json_and_its_own_arrays():
+    out = jobs.run({"prog": "design-plant", "argv": ["--fc", "3500", "--zeta", "0.2", "--json", "--no-files"],
+                    "want": "page"})
+    assert out["status"] == 0 and out["error"] is None
+    assert out["json"]["tool"]["argv"] == ["design-plant", "--fc", "3500", "--zeta", "0.2", "--json", "--no-files"]
+    step = out["page"]["step"]
+    labels = [s["label"] for s in step["series"]]
+    assert labels[:3] == ["SPICE (ngspice)", "analytic (LM741 model)", "analytic (ideal op-amp)"]
+    spice = np.array(step["series"][0]["y"], float)
+    # the SPICE output settles on the amplitude (2 V) and peaks at the overshoot the JSON gives
+    assert spice[-1] == pytest.approx(2.0, abs=0.01)
+    assert spice.max() / 2 - 1 == pytest.approx(out["json"]["spice"]["overshoot_pct"] / 100, abs=0.01)
+    assert "<svg" in out["page"]["schematic_svg"] and out["page"]["bom"]["rows"][0][:3] == ["R1", "1.6 kOhm", "1k6"]
+
+
+def test_a_refusal_is_the_commands_one_line():
+    out = jobs.run({"prog": "design-plant", "argv": ["--fc", "3500", "--zeta", "-1", "--json", "--no-files"],
+                    "want": "page"})
+    assert out["status"] == 2 and out["error"] == "design-plant: error: --zeta must be 0.01 to 10, got '-1'"
