@@ -339,7 +339,6 @@ def check_files(tmp: str) -> dict:
 
 
 def warm_up() -> None:
-    """A worker's setup: one small plant designed and simulated, so that the
-    first request finds ngspice loaded and every module imported."""
-    with redirect_stdout(io.StringIO()), redirect_stderr(io.StringIO()):
-        cli_plant.design_plant_main(["--fc", "3500", "--zeta", "0.2", "--json", "--no-files"])
+    """A worker's first task: one plant designed, simulated and drawn for the page, so that the
+    first request finds ngspice loaded, every module imported and schemdraw's fonts measured."""
+    run({"prog": "design-plant", "argv": ["--fc", "3500", "--zeta", "0.2", "--json", "--no-files"], "want": "page"})
