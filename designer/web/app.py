@@ -33,6 +33,7 @@ from starlette.routing import Route
 
 from ..core.errors import DesignError
 from ..core.fileio import MAX_CAPTURE_BYTES, check_plain_name
+from . import pool as pool_module
 from . import request as req
 
 STATIC = Path(__file__).parent / "static"
@@ -104,7 +105,15 @@ def create_app(pool) -> Starlette:
         return JSONResponse(choices)
 
     async def run(request, prog: str, argv: list, want: str, tmp: str, upload_name: str | None = None):
-        rid, answer = pool.start({"prog": prog, "argv": argv, "want": want, "tmp": tmp})
+        # the task goes to the pool as its file's name: a message of a hundred bytes, so that the pipe to the
+        # pool never fills while the pool is sending a long answer the other way (each would wait on the other)
+        task_file = os.path.join(tmp, "task.json")
+        with open(task_file, "w", encoding="utf-8") as fh:
+            json.dump({"prog": prog, "argv": argv, "want": want, "tmp": tmp}, fh)
+        try:
+            rid, answer = pool.start({"task_file": task_file})
+        except pool_module.Busy as exc:
+            return _error(503, f"{prog}: error: {exc}")
         # a page typing ahead drops its older requests: one whose client has gone leaves the queue
         while not answer.done():
             await asyncio.wait({answer}, timeout=0.25)

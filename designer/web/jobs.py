@@ -57,7 +57,8 @@ def run(task: dict) -> dict:
     Parameters
     ----------
     task : dict
-        ``prog`` (a command), ``argv`` (its arguments, ``--json`` among them
+        ``task_file`` (the name of a JSON file holding the task, as the server sends it), or the
+        task itself: ``prog`` (a command), ``argv`` (its arguments, ``--json`` among them
         for the designing commands), ``want``: "page" (the JSON and the page's
         extras), "json", "sheet" (the printable build sheet), "bundle" (the
         design's files as a zip) or "check" (check-design's files); ``tmp``:
@@ -70,6 +71,9 @@ def run(task: dict) -> dict:
         stderr, or None), ``json`` (what ``--json`` printed), and per ``want``:
         ``page``, ``body`` (bytes) with ``media`` and ``filename``.
     """
+    if "task_file" in task:   # the server's requests come as a file in their private folder (see .app)
+        with open(task["task_file"], encoding="utf-8") as fh:
+            task = json.load(fh)
     if task["prog"] == "warm-up":
         return warm_up()
     prog, argv, want, tmp = task["prog"], list(task["argv"]), task.get("want", "json"), task.get("tmp")

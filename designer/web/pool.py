@@ -34,6 +34,12 @@ DEFAULT_TIMEOUT_S = 120.0
 #: deadline: a request's deadline counts its own run only
 WARM_UP = {"prog": "warm-up"}
 WARM_UP_TIMEOUT_S = 300.0
+#: most requests queued or running at once (each a message of ~100 bytes to the pool: 64 KiB of pipe holds them)
+MAX_WAITING = 256
+
+
+class Busy(Exception):
+    """More requests than :data:`MAX_WAITING` at once: answered 503."""
 
 
 def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work) -> None:
@@ -149,7 +155,10 @@ class Pool:
             fut.set_result((kind, value))
 
     def start(self, task) -> tuple:
-        """Queue ``task``; returns (its id, the future of its answer)."""
+        """Queue ``task``; returns (its id, the future of its answer). Refused (:class:`Busy`) past
+        :data:`MAX_WAITING` requests: the messages on the pipe stay within its buffer."""
+        if len(self._waiting) >= MAX_WAITING:
+            raise Busy(f"{MAX_WAITING} requests are already waiting for the workers; try again shortly")
         rid = next(self._ids)
         fut = self._loop.create_future()
         self._waiting[rid] = fut
