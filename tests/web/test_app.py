@@ -9,6 +9,8 @@ import zipfile
 from concurrent.futures import ThreadPoolExecutor
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from webserver import Server, cli
 from helpers import EXT_CAPTURES, FIXTURES, ROOT
@@ -113,6 +115,18 @@ def test_what_a_request_may_not_choose_is_refused(server, body, words):
     assert status == 400 and words in got["error"], got
 
 
+@settings(max_examples=25)
+@given(st.dictionaries(st.sampled_from(["fc", "zeta", "gain", "r-series", "opamp", "amplitude", "alternatives",
+                                        "r", "c", "package", "fcx", "out"]),
+                       st.one_of(st.integers(-10**6, 10**6), st.floats(allow_nan=True), st.text(max_size=8),
+                                 st.booleans(), st.none(), st.lists(st.integers(), max_size=2)), max_size=5))
+def test_any_body_is_answered_or_refused_in_one_line_never_a_500(server, body):
+    status, got = server.post_json("/api/plant", {**body, "no-sim": True})
+    assert status in (200, 400), got
+    if status == 400:
+        assert got["error"].startswith("design-plant: error: ") and "\n" not in got["error"]
+
+
 def test_not_json_is_a_400_not_a_500(server):
     status, got = server.post_json("/api/plant", b"{not json", headers={"Content-Type": "application/json"})
     assert status == 400 and "not JSON" in got["error"]
@@ -176,6 +190,38 @@ def test_bundle_has_the_files_design_plant_writes(server, tmp_path):
     assert out.returncode == 0, out.stderr
     written = {p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*") if p.is_file() or p.is_symlink()}
     assert names == written
+
+
+def multipart(fields: dict, files: dict) -> tuple:
+    """(body, headers) of a multipart form: ``fields`` name -> text, ``files`` field -> (file name, bytes)."""
+    boundary = "----designer-test-7d1"
+    parts = [f"--{boundary}\r\nContent-Disposition: form-data; name=\"{k}\"\r\n\r\n{v}\r\n".encode()
+             for k, v in fields.items()]
+    for field, (name, data) in files.items():
+        parts.append(f"--{boundary}\r\nContent-Disposition: form-data; name=\"{field}\"; filename=\"{name}\"\r\n"
+                     "Content-Type: application/octet-stream\r\n\r\n".encode() + data + b"\r\n")
+    return b"".join(parts) + f"--{boundary}--\r\n".encode(), {"Content-Type": f"multipart/form-data; boundary={boundary}"}
+
+
+def test_check_takes_a_form_too(server):
+    deck = (ROOT / "specs" / "decks" / "rc_ladder.cir").read_bytes()
+    spec = b"name: ladder2\nkind: netlist\ndeck: rc_ladder.cir\nchecks:\n  v_final: {min: 0.99, max: 1.01}\n"
+    body, headers = multipart({"simulator": "ngspice-cli"}, {"spec": ("ladder2.yaml", spec),
+                                                             "deck": ("rc_ladder.cir", deck)})
+    status, got = server.post_json("/api/check", body, headers=headers)
+    assert status == 200, got
+    assert got["specs"][0]["status"] == "pass" and got["specs"][0]["tool"]["simulator"] == "ngspice-cli"
+
+
+def test_analyze_plant_and_the_pid_sheet(server):
+    status, got = server.post_json("/api/analyze-plant", {"r1": 820, "r2": "1k", "c1": "10n", "c2": "220n",
+                                                          "no-sim": True})
+    want = cli_json("analyze-plant", "--r1", "820", "--r2", "1k", "--c1", "10n", "--c2", "220n", "--no-sim", "--json",
+                    "--no-files")
+    assert status == 200 and without_run_details(got) == without_run_details(want)
+    status, headers, raw = server.post("/api/pid/sheet", {"plant-fc": 3500, "plant-zeta": 0.2, "no-sim": True})
+    assert status == 200 and headers["content-type"].startswith("text/html")
+    assert raw.startswith(b"<!DOCTYPE html>") and b"Op-amp PID" in raw
 
 
 def test_check_runs_a_spec_and_its_deck(server):
