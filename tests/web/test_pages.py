@@ -116,8 +116,18 @@ def test_a_bad_zeta_is_one_inline_message_beside_its_field(page, server):
 
 
 def drop(page, path):
-    """Give the identify page a file as a user does (its file chooser: the drop zone's twin)."""
-    return after(page, lambda: page.set_input_files("#file", str(path)))
+    """Drop a file on the identify page's drop zone, as a user drags it from a USB stick."""
+    import base64
+
+    def action():
+        dt = page.evaluate_handle("""([name, b64]) => {
+            const bytes = Uint8Array.from(atob(b64), c => c.charCodeAt(0));
+            const dt = new DataTransfer();
+            dt.items.add(new File([bytes], name, {type: "text/csv"}));
+            return dt;
+        }""", [path.name, base64.b64encode(path.read_bytes()).decode()])
+        page.dispatch_event("#drop", "drop", {"dataTransfer": dt})
+    return after(page, action)
 
 
 def test_identify_a_synthetic_tektronix_export_then_design_a_pid_for_its_model(page, server):
@@ -150,7 +160,9 @@ def test_identify_a_real_tbs1022_capture(page, server):
 
 def test_identify_a_frequency_table_as_identify_freq_does(page, server):
     open_page(page, server, "/identify")
-    assert drop(page, FIXTURES / "identify_freq" / "seed000_table4_deg.csv") == "done"
+    # chosen with the file chooser this time (the drop zone's twin)
+    table = FIXTURES / "identify_freq" / "seed000_table4_deg.csv"
+    assert after(page, lambda: page.set_input_files("#file", str(table))) == "done"
     assert "frequency table" in page.inner_text("#format-line")
     assert page.locator("#plot canvas").count() == 1 and page.locator("#phase canvas").count() == 1
     assert page.locator("#methods tbody tr").count() > 1
