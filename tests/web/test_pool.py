@@ -1,0 +1,72 @@
+"""The web page's worker pool (designer.web.pool) with a work function of the test's own:
+answers in their requests' order whatever order they finish in, a worker that dies or
+passes its deadline replaced, a bug reported as that task's, a closed pool gone."""
+
+import asyncio
+import os
+import time
+
+from designer.web.pool import Pool
+
+
+def work(task):
+    if task.get("prog") == "warm-up":
+        return None
+    if task["do"] == "die":
+        os._exit(3)
+    if task["do"] == "hang":
+        time.sleep(60)
+    if task["do"] == "raise":
+        raise ValueError("boom")
+    time.sleep(task.get("s", 0))
+    return (task["do"], os.getpid())
+
+
+def run_with_pool(jobs, timeout, body):
+    async def main():
+        pool = Pool(jobs, timeout, work=work)
+        pool.attach()
+        try:
+            return await body(pool)
+        finally:
+            pool.close()
+            assert not pool.proc.is_alive()
+    return asyncio.run(main())
+
+
+def test_every_answer_is_its_own_requests_in_any_order():
+    async def body(pool):
+        # later requests finish first: each still gets its own answer
+        return await asyncio.gather(*(pool.submit({"do": f"task{i}", "s": 0.05 * (10 - i)}) for i in range(10)))
+    answers = run_with_pool(2, 30, body)
+    assert [a[1][0] for a in answers] == [f"task{i}" for i in range(10)]
+    assert all(kind == "ok" for kind, _ in answers)
+    assert len({pid for _, (_, pid) in answers}) == 2   # both workers served
+
+
+def test_a_dead_or_hung_worker_is_replaced_and_a_bug_is_its_tasks_alone():
+    async def body(pool):
+        dead = await pool.submit({"do": "die"})
+        after_dead = await pool.submit({"do": "echo"})
+        hung = await pool.submit({"do": "hang"})
+        after_hung = await pool.submit({"do": "echo"})
+        bug = await pool.submit({"do": "raise"})
+        after_bug = await pool.submit({"do": "echo"})
+        return dead, after_dead, hung, after_hung, bug, after_bug
+    dead, after_dead, hung, after_hung, bug, after_bug = run_with_pool(1, 1.5, body)
+    assert dead[0] == "dead" and after_dead[0] == "ok"
+    assert hung == ("timeout", "timed out after 1.5 s (killed)") and after_hung[0] == "ok"
+    assert bug == ("crash", "ValueError: boom") and after_bug[0] == "ok"
+    assert after_dead[1][1] != after_hung[1][1]   # a new worker took over from the hung one
+    assert after_hung[1][1] == after_bug[1][1]    # a bug does not cost the worker
+
+
+def test_a_cancelled_request_still_queued_is_answered_cancelled():
+    async def body(pool):
+        busy = asyncio.ensure_future(pool.submit({"do": "slow", "s": 1.0}))
+        await asyncio.sleep(0.3)
+        rid, fut = pool.start({"do": "never"})
+        pool.cancel(rid)
+        return await fut, await busy, pool.dropped
+    cancelled, busy, dropped = run_with_pool(1, 30, body)
+    assert cancelled == ("cancelled", None) and busy[0] == "ok" and dropped == 1
