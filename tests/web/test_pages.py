@@ -183,6 +183,16 @@ def test_the_bundle_zip_holds_the_files_design_plant_writes(page, server, tmp_pa
     assert bom == (tmp_path / "reports" / "plant_fc3500_z0.2" / "bom.csv").read_text(encoding="utf-8")
 
 
+def test_the_printable_sheet_opens_in_a_new_tab(page, server):
+    open_page(page, server, "/plant")
+    with page.context.expect_page(timeout=120000) as tab:
+        page.click("#sheet")
+    sheet = tab.value
+    sheet.wait_for_load_state()
+    assert sheet.title() == "Sallen-Key plant: fc 3500 Hz, zeta 0.2, gain 1"
+    assert sheet.locator("svg").count() >= 1 and sheet.locator("img").count() >= 2   # schematic, step, Bode
+
+
 def test_check_page_runs_a_pasted_spec(page, server):
     open_page(page, server, "/check")
     page.fill("#spec", "name: lab3\nkind: plant\ntarget: {fc: 3.5k, zeta: 0.2}\nopamp: [LM741]\n"

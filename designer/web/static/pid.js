@@ -78,7 +78,8 @@ async function file(kind) {
   const r = await D.api(`/api/pid/${kind}`, last.opts, true);
   D.busy(false, status);
   if (!r.ok) { D.showError(form, r.data); return; }
-  if (kind === "sheet") window.open(URL.createObjectURL(r.blob), "_blank");
+  // the sheet in a new tab to print; a browser that blocks the tab gets it as a file
+  if (kind === "sheet") { if (!window.open(URL.createObjectURL(r.blob), "_blank")) D.download(r.blob, "build-sheet.html"); }
   else D.download(r.blob, "pid.zip");
 }
 
