@@ -220,11 +220,14 @@ def plant_page(result) -> dict:
     if sine is not None and sine.h_spice is not None:
         resp["SPICE .ac"] = _complex_on_grid(sine.spice_f_hz, sine.h_spice, f)
     bom = rep.bom(result)
+    bench = bench_rows(result.test, result.scope, "R1")
+    if result.sine is not None:   # as the sheet's settings table gives it
+        bench.append(["sine check", rep._sine_text(result.sine)])
     return {"step": _trace(result.time_s, step, "time from the edge (s)"),
             "bode": _bode(f, resp),
             "schematic_svg": _schematic_svg(rep, result, (result.built.as_dict(), result.package)),
             "bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
-            "bench": bench_rows(result.test, result.scope, "R1"),
+            "bench": bench,
             "title": rep.title_of(result)}
 
 
