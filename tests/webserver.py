@@ -24,7 +24,8 @@ class Server:
     """A running ``designer-web`` and the way to talk to it."""
 
     def __init__(self, *args):
-        self.proc = subprocess.Popen([sys.executable, "-m", "designer.web.server", "--port", "0", *args],
+        # -W error: a warning in the server, its pool or a worker is an error there, as in the tests themselves
+        self.proc = subprocess.Popen([sys.executable, "-W", "error", "-m", "designer.web.server", "--port", "0", *args],
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV)
         line = self.proc.stdout.readline()
         if "serving on" not in line:

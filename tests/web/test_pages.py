@@ -149,7 +149,8 @@ def test_identify_a_synthetic_tektronix_export_then_design_a_pid_for_its_model(p
     assert "model plant" in page.inner_text("#title")
 
 
-@pytest.mark.skipif(not REAL_TEK.exists(), reason="../shared/ext-captures (real scope exports) is not beside this clone")
+@pytest.mark.skipif(not REAL_TEK.exists(),
+                    reason="../shared/ext-captures (real scope exports) is not beside this clone")
 def test_identify_a_real_tbs1022_capture(page, server):
     open_page(page, server, "/identify")
     page.fill("input[name=step-amplitude]", "1.72")
