@@ -173,6 +173,7 @@ def test_the_bundle_zip_holds_the_files_design_plant_writes(page, server, tmp_pa
     open_page(page, server, "/plant")
     with page.expect_download(timeout=120000) as dl:
         page.click("#bundle")
+    assert dl.value.suggested_filename == "plant_fc3500_z0.2.zip"   # the design's name, as design-plant gives it
     names = set(zipfile.ZipFile(io.BytesIO(Path(dl.value.path()).read_bytes())).namelist())
     out = cli("design-plant", "--fc", "3500", "--zeta", "0.2", "--out", str(tmp_path))
     assert out.returncode == 0, out.stderr

@@ -28,7 +28,10 @@ D.api = async function (path, body, asBlob, channel) {
     if (e.name === "AbortError") return {aborted: true};
     return {ok: false, status: 0, data: {error: `the server does not answer: ${e.message}`, message: "the server does not answer"}};
   }
-  if (r.ok && asBlob) return {ok: true, status: r.status, blob: await r.blob()};
+  if (r.ok && asBlob) {
+    const named = /filename="([^"]+)"/.exec(r.headers.get("Content-Disposition") || "");
+    return {ok: true, status: r.status, blob: await r.blob(), filename: named ? named[1] : null};
+  }
   let data = null;
   try { data = await r.json(); } catch (e) { data = {error: `HTTP ${r.status}`, message: `HTTP ${r.status}`}; }
   return {ok: r.ok, status: r.status, data};

@@ -80,7 +80,7 @@ async function file(kind) {
   if (!r.ok) { D.showError(form, r.data); return; }
   // the sheet in a new tab to print; a browser that blocks the tab gets it as a file
   if (kind === "sheet") { if (!window.open(URL.createObjectURL(r.blob), "_blank")) D.download(r.blob, "build-sheet.html"); }
-  else D.download(r.blob, "pid.zip");
+  else D.download(r.blob, r.filename || "pid.zip");
 }
 
 (async function () {
