@@ -184,3 +184,22 @@ def running_with(arg: str) -> list:
         except OSError:   # gone meanwhile
             pass
     return found
+
+
+@pytest.mark.spice
+def test_pictures_drawn_during_the_spice_run_are_those_drawn_after_it(tmp_path):
+    # design-pid for a model plant sends the schematic, loop-bode.png and reaction-curve.png to the
+    # renderer before its SPICE run (they read none of it): the console script's bundle, drawn so, is
+    # the bundle of the command called in-process, which draws everything after the run
+    from designer.cli.pid import design_pid_main
+    args = ["--plant-tf", "K=2 tau=1m theta=200u", "--tuning", "simc", "--simulator", "ngspice-cli", "--name", "m"]
+    run = subprocess.run([script("design-pid"), *args, "--out", str(tmp_path / "a")], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert design_pid_main([*args, "--out", str(tmp_path / "b")]) == 0
+    a, b = tmp_path / "a" / "reports" / "m", tmp_path / "b" / "reports" / "m"
+    names = sorted(p.name for p in a.iterdir())
+    assert names == sorted(p.name for p in b.iterdir())
+    same = [n for n in names if n != "result.json"]
+    match, mismatch, errors = filecmp.cmpfiles(a, b, same, shallow=False)
+    assert not mismatch and not errors, mismatch
+    assert {"schematic.png", "loop-bode.png", "reaction-curve.png", "closed-loop.png", "build-sheet.html"} <= set(match)
