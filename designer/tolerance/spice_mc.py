@@ -136,15 +136,15 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
     mc = plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist, tol_items, limit_items,
                            engine_name=engine, evaluate=spice_evaluate(ctx, amp))
     mc.spice = settings
+    model = _figures(mc.values, {}, amp)
+    if mc.tighten:       # the tightening search runs the model: its yield now is the model's
+        mc.tighten["yield_now"] = float(np.mean(_passes(model, mc.limits)))
     if engine == "both":
-        model = _figures(mc.values, {}, amp)
         mc.spice["disagreement"] = disagreement(mc.figures, model, np.arange(n))
         if mc.limits:
             y_model = int(np.count_nonzero(_passes(model, mc.limits)))
             mc.spice.update(yield_model=y_model / n, yield_with_spice=mc.yield_count / n,
                             yield_shift_pp=100 * (mc.yield_count - y_model) / n)
-            if mc.tighten:
-                mc.tighten["yield_now"] = y_model / n      # the tightening search runs the model
         for k in spice_engine.SHARED:
             mc.figures[f"model_{k}"] = model[k]
     return mc
