@@ -176,3 +176,41 @@ def test_replay_refuses_no_sim(tmp_path):
     p = run(DESIGN_PLANT, *SEED, "--monte-carlo", "100", "--replay", "3", "--no-sim", "--out", str(tmp_path))
     assert p.returncode == 2 and "drop --no-sim" in p.stderr and len(p.stderr.splitlines()) == 1
     assert not any(tmp_path.iterdir())
+
+
+@pytest.mark.spice
+def test_spice_options_never_crash(tmp_path_factory):
+    """Whatever is typed for --engine, --spice-samples, --replay and --monte-carlo: exit 0 or 2 (3 never:
+    the deck is ours), a refusal one line and nothing written."""
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    from designer.cli.plant import design_plant_main
+    text = st.one_of(st.sampled_from(["0", "1", "3", "9", "10", "19", "20", "-1", "1e3", "2.5", "", " ", "x", "nan",
+                                      "99999999999999999999"]), st.text(max_size=6))
+
+    @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+    @given(st.sampled_from(["analytic", "spice", "both", "xyce"]), st.none() | text, st.none() | text,
+           st.none() | st.sampled_from(["10", "20", "5", "x", ""]), st.booleans(), st.booleans())
+    def check(engine, k, replay, n, limit, no_sim):
+        import contextlib
+        import io as _io
+        out = tmp_path_factory.mktemp("out")
+        argv = [*SEED, "--engine", engine, "--out", str(out), "--simulator", "ngspice-cli", "--no-files"]
+        argv += [] if k is None else ["--spice-samples", k]
+        argv += [] if replay is None else ["--replay", replay]
+        argv += [] if n is None else ["--monte-carlo", n]
+        argv += ["--limit", "overshoot_pct=0:53"] if limit else []
+        argv += ["--no-sim"] if no_sim else []
+        err = _io.StringIO()
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(_io.StringIO()):
+            try:
+                status = design_plant_main(argv)
+            except SystemExit as exc:
+                status = exc.code
+        assert status in (0, 2), (argv, status, err.getvalue())
+        assert "Traceback" not in err.getvalue()
+        if status == 2:
+            assert len(err.getvalue().strip().splitlines()) == 1, (argv, err.getvalue())
+        assert not any(out.iterdir())
+    check()
