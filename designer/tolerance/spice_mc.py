@@ -29,15 +29,18 @@ ENGINES = ("analytic", "spice", "both")
 RANDOM_KEY = 2 ** 31
 
 
-def spice_evaluate(ctx, opamp):
-    """``evaluate(values) -> figures``: the model's figures with SPICE's in place of those it measures,
-    and the SPICE-only figures (rise and settling time) added."""
+def plant_chunk(ctx, opamp, values: dict, start: int = 0) -> dict:
+    """The figures of a chunk of samples with the SPICE engine: the model's, with SPICE's in place
+    of those it measures and the SPICE-only ones (rise and settling time) added. Pure, of
+    picklable arguments: a chunk runner can send it to workers."""
     from .montecarlo import _figures
+    return {**_figures(values, {}, opamp), **spice_engine.evaluate(ctx, values, start)}
 
-    def evaluate(values):
-        model = _figures(values, {}, opamp)
-        return {**model, **spice_engine.evaluate(ctx, values)}
-    return evaluate
+
+def spice_evaluate(ctx, opamp):
+    """``evaluate(values) -> figures`` (:func:`plant_chunk` bound to a design; picklable)."""
+    import functools
+    return functools.partial(plant_chunk, ctx, opamp)
 
 
 def disagreement(spice: dict, model: dict, index) -> dict:

@@ -110,3 +110,17 @@ def test_sampling_matches_replay_offsets():
     whole = sampling.values(nominal, tol, 10000, 4)
     part = sampling.values(nominal, tol, 10000, 4, start=4095, stop=4098)
     assert all(np.array_equal(part[k], whole[k][4095:4098]) for k in nominal)
+
+
+def test_the_engine_pickles_for_workers(seed_plant):
+    import pickle
+
+    from designer.tolerance import spice_engine
+    from designer.tolerance.spice_mc import spice_evaluate
+    f = pickle.loads(pickle.dumps(spice_evaluate(spice_engine.context(seed_plant.deck, seed_plant.built,
+                                                                      seed_plant.opamp, seed_plant.test),
+                                                 seed_plant.opamp)))
+    v = sampling.values({"R1": 1.6e3, "R2": 3.9e3, "C1": 3.3e-9, "C2": 100e-9},
+                        {"R1": .05, "R2": .05, "C1": .1, "C2": .1}, 4, 1)
+    figs = f(v)
+    assert set(figs) >= set(plant_figures(v, seed_plant.opamp)) | {"rise_time_s", "settling_time_s"}
