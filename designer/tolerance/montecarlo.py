@@ -43,6 +43,7 @@ class MonteCarlo:
     shares: dict = field(default_factory=dict)
     failing: dict = field(default_factory=dict)
     tighten: dict | None = None
+    spice: dict | None = None          #: SPICE beside the model (designer.tolerance.spice_mc), when asked
 
     @property
     def yield_count(self) -> int:
@@ -62,7 +63,8 @@ class MonteCarlo:
                                                         "fraction": self.yield_count / self.n,
                                                         "ci95": [lo, hi], "interval": "Wilson"},
                 "variance_shares": {"method": "standardised regression coefficients, squared", **self.shares},
-                "failing_samples": self.failing, "tighten": self.tighten}
+                "failing_samples": self.failing, "tighten": self.tighten,
+                **({} if self.spice is None else {"spice": self.spice})}
 
     def csv_text(self) -> str:
         """One row per sample: its index, every varied part's value, every figure."""
@@ -85,6 +87,9 @@ class MonteCarlo:
             if mc.tighten:
                 t = mc.tighten
                 out.append(f"  buy {t['part']} tighter: at {t['tolerance_pct']:g} % the yield is {100 * t['yield']:.2f} %")
+        if mc.spice is not None:
+            from .spice_mc import spice_lines
+            out += spice_lines(mc)
         return out
 
 
@@ -117,7 +122,8 @@ def plant_worst_case(parts, series: dict, opamp, tol_items=()):
 
 
 def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler: str = "random",
-                      dist: str = "uniform", tol_items=(), limit_items=(), tighten: bool = True) -> MonteCarlo:
+                      dist: str = "uniform", tol_items=(), limit_items=(), tighten: bool = True,
+                      engine_name: str = "analytic", evaluate=None) -> MonteCarlo:
     """A Monte Carlo of the Sallen-Key ``parts`` (:class:`~designer.plant.sallenkey.SallenKeyParts`).
 
     Parameters
@@ -137,7 +143,11 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     tol_items, limit_items : sequence of str
         ``--tol`` items (``R=1%``, ``C2=2%``) and ``--limit`` items (``fn_hz=3.3k:3.7k``).
     tighten : bool
-        Also find the part whose tolerance halved raises the yield most (one more run per part).
+        Also find the part whose tolerance halved raises the yield most (one more run per part,
+        always with the analytic model).
+    engine_name, evaluate : str, callable
+        The engine's name and, for another engine than the analytic one, its
+        ``evaluate(values) -> {figure: array}`` (:mod:`designer.tolerance.spice_mc`).
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_SAMPLES <= n <= MAX_SAMPLES:
         raise DesignError(f"--monte-carlo must be a whole number of samples from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
@@ -154,14 +164,14 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
         nominal["GBW"] = opamp.gbw_hz     # varies only when asked: a datasheet's typical is not a tolerance
     tol = resolve(tol_items, nominal, series)
     values = sampling.values(nominal, tol.of, n, seed, sampler, dist)
-    figs = _figures(values, {}, opamp)
-    nominal_figs = {k: float(v[0]) for k, v in _figures({r: np.array([x]) for r, x in nominal.items()}, {},
-                                                         opamp).items()}
+    figure_of = evaluate or (lambda v: _figures(v, {}, opamp))
+    figs = figure_of(values)
+    nominal_figs = {k: float(v[0]) for k, v in figure_of({r: np.array([x]) for r, x in nominal.items()}).items()}
     by_fig = {lim.figure: lim for lim in limits}
     stats = {k: figure_stats(k, v, nominal_figs[k], by_fig.get(k)) for k, v in figs.items()}
     rel = {r: values[r] / nominal[r] - 1 for r in values}
     shares = {k: variance_shares(rel, figs[k]) for k in (by_fig or ("fn_hz", "zeta", "overshoot_pct"))}
-    mc = MonteCarlo(n, seed, sampler, dist, "analytic", tol, nominal, values, figs, nominal_figs, limits, stats,
+    mc = MonteCarlo(n, seed, sampler, dist, engine_name, tol, nominal, values, figs, nominal_figs, limits, stats,
                     _yield(figs, limits) if limits else None, shares)
     for lim in limits:
         bad = np.nonzero(~lim.inside(figs[lim.figure]))[0]
@@ -178,5 +188,5 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
             if best is None or y > best[1]:
                 best = (ref, y)
         mc.tighten = {"part": best[0], "tolerance_pct": 100 * tol.of[best[0]] / 2, "yield": best[1],
-                      "yield_now": mc.yield_count / n}
+                      "yield_now": mc.yield_count / n, **({} if engine_name == "analytic" else {"engine": "analytic"})}
     return mc
