@@ -120,6 +120,19 @@ def variance_shares(x: dict, y) -> dict:
     return {r: float(b * b) for r, b in zip(refs, beta)}
 
 
+def failing_samples(figs: dict, limits, worst: int = 5) -> dict:
+    """figure -> {count, worst}: how many samples fall outside each limit and the indices of the
+    ``worst`` farthest from the window's centre (a sample without the figure, NaN, first)."""
+    out = {}
+    for lim in limits:
+        bad = np.nonzero(~lim.inside(figs[lim.figure]))[0]
+        v = np.asarray(figs[lim.figure], float)[bad]
+        centre = 0.5 * ((lim.min if lim.min is not None else lim.max) + (lim.max if lim.max is not None else lim.min))
+        order = np.argsort(-np.abs(np.nan_to_num(v, nan=np.inf) - centre))[:worst]
+        out[lim.figure] = {"count": int(bad.size), "worst": [int(i) for i in bad[order]]}
+    return out
+
+
 def samples_csv(values: dict, figures: dict) -> str:
     """One row per sample: its index, every varied part's value, every figure (a reader can recompute
     any figure from a row)."""
