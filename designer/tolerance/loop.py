@@ -71,8 +71,8 @@ def loop_series(result) -> dict:
 def parse_loop_limit(text: str):
     """A ``--limit`` on a loop figure (:data:`LIMITABLE`, or a SPICE name of :data:`STANDS_IN`),
     named by the figure this engine computes."""
-    from .stats import parse_limit
-    lim = parse_limit(text, LIMITABLE + tuple(STANDS_IN))
+    from .stats import Limit, parse_limit
+    lim = text if isinstance(text, Limit) else parse_limit(text, LIMITABLE + tuple(STANDS_IN))
     return replace(lim, figure=STANDS_IN.get(lim.figure, lim.figure))
 
 

@@ -15,7 +15,7 @@ from ..core.errors import DesignError
 from . import plant as engine
 from . import sampling
 from .parts import DISTRIBUTIONS, resolve
-from .stats import failing_samples, figure_stats, parse_limit, samples_csv, variance_shares, wilson
+from .stats import Limit, failing_samples, figure_stats, parse_limit, samples_csv, variance_shares, wilson
 
 #: the number of samples allowed
 MIN_SAMPLES, MAX_SAMPLES = 10, 10 ** 7
@@ -145,7 +145,8 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     sampler, dist : str
         :data:`designer.tolerance.sampling.SAMPLERS`; ``uniform`` or ``normal``.
     tol_items, limit_items : sequence of str
-        ``--tol`` items (``R=1%``, ``C2=2%``) and ``--limit`` items (``fn_hz=3.3k:3.7k``).
+        ``--tol`` items (``R=1%``, ``C2=2%``) and ``--limit`` items (``fn_hz=3.3k:3.7k``; or
+        :class:`~designer.tolerance.stats.Limit` objects, one-sided ones too).
     tighten : bool
         Also find the part whose tolerance halved raises the yield most (one more run per part).
     """
@@ -156,7 +157,7 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
         raise DesignError(f"--dist {dist!r} unknown; allowed: {', '.join(DISTRIBUTIONS)}")
     if sampler not in sampling.SAMPLERS:
         raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(sampling.SAMPLERS)}")
-    limits = tuple(parse_limit(t, engine.FIGURES) for t in limit_items or ())
+    limits = tuple(t if isinstance(t, Limit) else parse_limit(t, engine.FIGURES) for t in limit_items or ())
     nominal = plant_parts(parts)
     if any(str(t).strip().upper().startswith("GBW") for t in tol_items or ()):
         if opamp.ideal:
