@@ -233,5 +233,6 @@ def histogram_plot(values, name: str, nominal: float | None = None, lo: float | 
     ax.set_ylabel("builds")
     ax.set_title(title or f"{name} over {v.size} builds", fontsize=10)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7.5)
+    if ax.get_legend_handles_labels()[0]:   # nothing to name without a limit or a nominal
+        ax.legend(fontsize=7.5)
     return png_bytes(fig, dpi=100, tight=False)
