@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import functools
 
+from ..core.units import format_eng
 from . import document as R
-from .plots import histogram_plot
+from .plots import figure_unit, histogram_plot
 
 
 def histogram_name(figure: str) -> str:
@@ -38,6 +39,20 @@ def histogram_plots(result) -> tuple:
     return tuple((histogram_name(f), functools.partial(histogram_png, figure=f)) for f in names)
 
 
+def _value(figure: str, v) -> str:
+    """A figure's value with its unit (engineering notation for Hz and s)."""
+    if v is None:
+        return "open"
+    unit = figure_unit(figure)
+    return format_eng(v, unit, 4) if unit in ("Hz", "s") else f"{v:.4g}" + (f" {unit}" if unit else "")
+
+
+def _window(lim) -> str:
+    if lim.min is not None and lim.max is not None:
+        return f"{lim.figure} {_value(lim.figure, lim.min)} to {_value(lim.figure, lim.max)}"
+    return f"{lim.figure} {'>= ' + _value(lim.figure, lim.min) if lim.min is not None else '<= ' + _value(lim.figure, lim.max)}"
+
+
 def _pct(x: float) -> str:
     return f"{100 * x:.3g} %" if x < 0.9995 or x == 1 else f"{100 * x:.4g} %"
 
@@ -53,7 +68,7 @@ def section(result, with_images: bool = True) -> list:
     if mc.limits:
         lo, hi = mc.yield_interval()
         lines.append(f"Yield {_pct(mc.yield_count / mc.n)} ({mc.yield_count} of {mc.n}; 95 % Wilson interval "
-                     f"{_pct(lo)} to {_pct(hi)}) within " + "; ".join(lim.text() for lim in mc.limits) + ".")
+                     f"{_pct(lo)} to {_pct(hi)}) within " + "; ".join(_window(lim) for lim in mc.limits) + ".")
         lost = sorted(mc.failing.items(), key=lambda kv: -kv[1]["count"])
         if lost and lost[0][1]["count"]:
             lines.append("Lost builds: " + ", ".join(f"{k} {v['count']}" for k, v in lost if v["count"])
@@ -73,7 +88,9 @@ def section(result, with_images: bool = True) -> list:
     s = mc.stats.get(mc.headline)
     if s is not None and s.percentiles:
         p = s.percentiles
-        lines.append(f"{mc.headline}: nominal {s.nominal:.4g}, 95 % of builds {p[2.5]:.4g} to {p[97.5]:.4g}.")
+        h = mc.headline
+        lines.append(f"{h}: nominal {_value(h, s.nominal)}, 95 % of builds {_value(h, p[2.5])} to "
+                     f"{_value(h, p[97.5])}.")
     text = [R.text(" ".join(lines))]
     if not with_images:
         return text
