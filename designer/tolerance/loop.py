@@ -209,8 +209,8 @@ class LoopMonteCarlo(MonteCarlo):
 
     def to_dict(self) -> dict:
         out = super().to_dict()
-        out["variance_shares"]["note"] = "a build is in the yield when its loop is stable and inside every limit"
-        return {**out, "p_unstable": self.p_unstable, "p_saturated": self.p_saturated,
+        return {**out, "yield_rule": "a build is in the yield when its loop is stable and inside every limit",
+                "p_unstable": self.p_unstable, "p_saturated": self.p_saturated,
                 "unstable_samples": self.unstable_samples}
 
     def summary_lines(self) -> list:
