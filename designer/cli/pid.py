@@ -95,8 +95,10 @@ def _parser():
     return p
 
 
+#: the controller's parts a --tol may name
+CONTROLLER_PARTS = (*(f"R{i}" for i in range(3, 19)), "C3", "C4")
 #: the loop's parts a --tol may name: the plant's and the controller's
-LOOP_PARTS = ("R1", "R2", "C1", "C2", *(f"R{i}" for i in range(3, 19)), "C3", "C4")
+LOOP_PARTS = ("R1", "R2", "C1", "C2", *CONTROLLER_PARTS)
 
 
 def _add_monte_carlo(p):
@@ -296,10 +298,8 @@ def _model_name(spec, method: str) -> str:
 def _monte_carlo_settings(args, spec):
     from ..tolerance.loop import parse_loop_limit
     from .plant import monte_carlo_settings
-    settings = monte_carlo_settings(args, LOOP_PARTS, parse_loop_limit)
-    if (settings is not None or args.worst_case) and spec.process is not None:
-        flag = "--monte-carlo" if settings is not None else "--worst-case"
-        raise DesignError(f"{flag} analyses a Sallen-Key plant's loop for now, not a plant given as a model")
+    # a model plant's parameters stay as identified: only the controller's parts vary
+    settings = monte_carlo_settings(args, LOOP_PARTS if spec.process is None else CONTROLLER_PARTS, parse_loop_limit)
     if any(str(t).strip().upper().startswith("GBW") for t in args.tol or ()):
         raise DesignError("--tol GBW spreads a plant's op-amp (design-plant); a loop's op-amps do not vary yet")
     return settings
@@ -313,7 +313,8 @@ def _run(args) -> int:
     if spec.process is not None:
         from ..pid.process_report import summary_text as model_text, write_outputs as model_write
         common.check_output(args, args.name if args.name is not None else "pid_model")
-        result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator, rules_spice=args.rules_spice)
+        result = _loop_monte_carlo(design_pid(spec, simulate=not args.no_sim, simulator=args.simulator,
+                                              rules_spice=args.rules_spice), args, mc)
         return emit(result, args, args.name or _model_name(spec, result.method), model_write, model_text)
     # the default name needs the plant as built; its fixed start stands in for it in the check
     common.check_output(args, args.name if args.name is not None else f"pid_{spec.method}")
@@ -393,7 +394,7 @@ def _analyze(args) -> int:
     if spec.process is not None:
         from ..pid.process_report import summary_text as model_text, write_outputs as model_write
         common.check_output(args, args.name if args.name is not None else "pid_as-built")
-        result = analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
+        result = _loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
         return emit(result, args, args.name or _model_name(spec, result.method), model_write, model_text)
     common.check_output(args, args.name if args.name is not None else "pid_as-built")
     result = _loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)

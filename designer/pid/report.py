@@ -18,7 +18,7 @@ from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import write_design
 from ..report.plots import decimate, figure, loop_gain_plot, png_bytes, step_plot, time_unit
-from ..report.tolerance import histogram_plots
+from ..report.tolerance import csv_texts, histogram_plots
 from ..report.tolerance import section as tolerance_section
 from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
@@ -479,6 +479,4 @@ def write_outputs(result, out_dir, name: str) -> dict:
     plots, schematic, bom.csv) under ``out_dir``, each written atomically."""
     return write_design(result, out_dir, name, PLOTS + histogram_plots(result), schematic,
                         lambda svg: sections(result, schematic_svg=svg), title_of(result),
-                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))),
-                         **({"monte_carlo_csv": ("monte-carlo.csv", lambda r: r.monte_carlo.csv_text())}
-                            if result.monte_carlo is not None else {})})
+                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))), **csv_texts(result)})

@@ -39,6 +39,16 @@ def histogram_plots(result) -> tuple:
     return tuple((histogram_name(f), functools.partial(histogram_png, figure=f)) for f in names)
 
 
+def _samples_csv(result) -> str:
+    return result.monte_carlo.csv_text()
+
+
+def csv_texts(result) -> dict:
+    """The bundle's ``monte-carlo.csv`` (one row per build: every varied part, every figure), as
+    :func:`designer.report.bundle.write_design` takes its texts; none without a Monte Carlo."""
+    return {} if result.monte_carlo is None else {"monte_carlo_csv": ("monte-carlo.csv", _samples_csv)}
+
+
 def _value(figure: str, v) -> str:
     """A figure's value with its unit (engineering notation for Hz and s)."""
     if v is None:

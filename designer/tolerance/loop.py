@@ -12,8 +12,11 @@ name (``overshoot_pct``) counts the model's figure, this engine's estimate of
 it (:data:`STANDS_IN`). A build is in the yield when its loop is stable and
 every limited figure is inside its window.
 
-One sample at a time (a state-space model per sample, a few milliseconds
-each): the loop's figures have no closed form. Sample i is a function of
+A plant given as a model (``--plant-tf``, ``--plant-model``, ``--plant-capture``)
+keeps its parameters as identified; only the controller's parts vary
+(:func:`model_loop_figures`). One sample at a time (a state-space model per
+sample, a few milliseconds each; a model plant's loop with its exact dead time
+about 0.2 s): the loop's figures have no closed form. Sample i is a function of
 (seed, i) alone, as for the plant (:mod:`.sampling`).
 """
 
@@ -47,10 +50,17 @@ TIGHTEN_CANDIDATES = 3
 WORST_FIGURES = ("phase_margin_deg", "gain_margin_db", "model_overshoot_pct")
 
 
+def is_model_loop(result) -> bool:
+    """Whether ``result`` is a model plant's loop (:class:`~designer.pid.process_result.ProcessPidResult`)."""
+    return getattr(result, "model", None) is not None
+
+
 def loop_parts(result) -> dict:
-    """Designator -> nominal value of the loop's parts: the plant's (R1, R2, C1, C2) and the controller's."""
-    p, c = result.plant, result.parts
-    out = {"R1": p.r1, "R2": p.r2, "C1": p.c1, "C2": p.c2}
+    """Designator -> nominal value of the loop's parts: the plant's (R1, R2, C1, C2; none for a plant
+    given as a model, whose parameters stay as identified) and the controller's."""
+    c = result.parts
+    p = None if is_model_loop(result) else result.plant
+    out = {} if p is None else {"R1": p.r1, "R2": p.r2, "C1": p.c1, "C2": p.c2}
     for f in fields(c):
         v = getattr(c, f.name)
         if v is not None:
@@ -63,7 +73,7 @@ def loop_series(result) -> dict:
     controller's series; the plant's where the controller's parts were given (None: typed by hand)."""
     sel = result.selection
     r, c = (sel.r_series, sel.c_series) if sel is not None else (None, None)
-    if result.plant_series is not None:
+    if getattr(result, "plant_series", None) is not None:
         r, c = r or result.plant_series[0], c or result.plant_series[1]
     return {"R": r, "C": c}
 
@@ -76,11 +86,62 @@ def parse_loop_limit(text: str):
     return replace(lim, figure=STANDS_IN.get(lim.figure, lim.figure))
 
 
+def _step_and_swing(out: dict, i: int, t, waves: dict, expected: float, amp) -> None:
+    """Sample ``i``'s step figures (against the ``expected`` settled output) and whether an op-amp
+    output leaves the swing, from a stable loop's waves."""
+    from ..pid.verify import loop_metrics
+    fig = loop_metrics(t, waves["y"], expected)
+    for f in STEP:
+        out[f"model_{f}"][i] = getattr(fig, f)
+    if amp.ideal:
+        out["saturated"][i] = 0.0
+    else:
+        peak = max(max(float(np.max(v)), float(v[-1] - np.min(v))) for k, v in waves.items() if k != "y")
+        low = min(min(float(np.min(v)), float(v[-1] - np.max(v))) for k, v in waves.items() if k != "y")
+        out["saturated"][i] = float(peak > amp.vout_max or low < amp.vout_min)
+
+
+def model_loop_figures(values: dict, result) -> dict:
+    """:data:`FIGURES` of the controller's sampled parts around a plant given as a model (its
+    parameters as identified), each loop analysed as design-pid analyses it
+    (:func:`designer.pid.process_loop.analyse`: exact dead time, its margins by the argument
+    principle, the step on the result's grid; about 0.2 s a build)."""
+    from ..pid import model as M
+    from ..pid.blocks import PidParts
+    from ..pid.delaymargins import loop_margins
+    from ..pid.process_loop import closed_loop_step, edged, loop_dc_gain, plant_of, simulation_controller, stage_waves
+    amp, model = result.opamp, result.model
+    plant = plant_of(model)
+    n = next(iter(values.values())).size
+    out = {k: np.full(n, np.nan) for k in FIGURES}
+    names = [f.name for f in fields(PidParts)]
+    t, step, edge = result.waveforms.t, result.test.amplitude_v, result.test.edge_s
+    r = M.reference(t, step, 0.0, edge)
+    for i in range(n):
+        parts = PidParts(**{k: (values[k.upper()][i] if k.upper() in values else None) for k in names})
+        out["kp"][i], out["ti_s"][i], out["td_s"][i] = parts.kp, parts.ti_s, parts.td_s
+        ctrl = M.controller_tf(parts, amp)
+        mg = loop_margins(plant, ctrl)
+        out["stable"][i] = float(mg.stable)
+        out["phase_margin_deg"][i], out["gain_margin_db"][i] = mg.phase_margin_deg, mg.gain_margin_db
+        out["crossover_hz"][i] = mg.crossover_hz
+        if not mg.stable:
+            out["saturated"][i] = 1.0
+            continue
+        dc = loop_dc_gain(model, ctrl)
+        out["steady_state_error_pct"][i] = 100 * (1 - dc)
+        fc = max(result.fc_ref_hz, mg.crossover_hz if math.isfinite(mg.crossover_hz) else result.fc_ref_hz)
+        y = edged(t, closed_loop_step(plant, simulation_controller(ctrl, fc), t, step)["y"], edge)
+        _step_and_swing(out, i, t, stage_waves(parts, amp, t, r, y), step * dc, amp)
+    return out
+
+
 def loop_figures(values: dict, result) -> dict:
     """Every figure of :data:`FIGURES` for each sample (arrays over the samples)."""
+    if is_model_loop(result):
+        return model_loop_figures(values, result)
     from ..pid import model
     from ..pid.blocks import PidParts
-    from ..pid.verify import loop_metrics
     from ..plant.model import plant_tf, plant_tf_opamp
     from ..plant.sallenkey import SallenKeyParts
     amp = result.opamp
@@ -111,15 +172,7 @@ def loop_figures(values: dict, result) -> dict:
         waves = lm.simulate(t, r)
         dc = model.dc_gain(lm)
         out["steady_state_error_pct"][i] = 100 * (1 - dc)
-        fig = loop_metrics(t, waves["y"], step * dc)
-        for f in STEP:
-            out[f"model_{f}"][i] = getattr(fig, f)
-        if amp.ideal:
-            out["saturated"][i] = 0.0
-        else:
-            peak = max(max(float(np.max(v)), float(v[-1] - np.min(v))) for k, v in waves.items() if k != "y")
-            low = min(min(float(np.min(v)), float(v[-1] - np.max(v))) for k, v in waves.items() if k != "y")
-            out["saturated"][i] = float(peak > amp.vout_max or low < amp.vout_min)
+        _step_and_swing(out, i, t, waves, step * dc, amp)
     return out
 
 

@@ -58,6 +58,15 @@ def test_bad_loop_tolerance_options_are_one_line(args, words):
     assert len(p.stderr.strip().splitlines()) == 1
 
 
-def test_a_model_plants_worst_case_is_refused_in_one_line():
-    p = run("--plant-tf", "K=2 tau=1m theta=200u", "--worst-case", "--no-sim", "--no-files")
-    assert p.returncode == 2 and "--worst-case analyses a Sallen-Key plant's loop" in p.stderr, p.stderr
+def test_a_model_plants_loop_varies_the_controllers_parts():
+    p = run("--plant-tf", "K=2 tau=1m theta=200u", "--tuning", "simc", "--monte-carlo", "10", "--limit",
+            "phase_margin_deg=50:90", "--no-sim", "--no-files", "--json")
+    assert p.returncode == 0, p.stderr
+    mc = json.loads(p.stdout)["monte_carlo"]
+    assert "R1" not in mc["settings"]["tolerances_pct"] and mc["settings"]["tolerances_pct"]["C4"] == 10.0
+    assert mc["yield"]["samples"] == 10
+
+
+def test_a_model_plant_has_no_plant_parts_to_spread():
+    p = run("--plant-tf", "K=2 tau=1m theta=200u", "--monte-carlo", "10", "--tol", "R1=1%", "--no-sim", "--no-files")
+    assert p.returncode == 2 and "--tol R1: no such part" in p.stderr, p.stderr

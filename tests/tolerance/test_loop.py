@@ -137,3 +137,22 @@ def test_the_loops_worst_case_meets_brute_force_on_a_small_box(designed):
         # each extreme is where it says it is
         at = evaluate({r: np.array([nominal[r] * (1 + tol[r] * lo.deviations[r])]) for r in tol})
         assert at[fig][0] == pytest.approx(lo.value, rel=1e-9)
+
+
+def test_a_model_plants_loop_varies_the_controller_alone_as_analyze_pid_sees_it():
+    model = "K=2 tau=1m theta=200u"
+    res = design_pid(PidSpec(plant_tf=model, tuning="simc"), simulate=False)
+    mc = loop_monte_carlo(res, {"R": "E24", "C": "E12"}, 12, seed=2, limit_items=["phase_margin_deg=55:90"])
+    assert set(mc.values) == {p.upper() for p in PidParts.__dataclass_fields__ if getattr(res.parts, p) is not None}
+    assert mc.nominal_figures["phase_margin_deg"] == pytest.approx(res.margins.phase_margin_deg, rel=1e-9)
+    assert mc.nominal_figures["model_overshoot_pct"] == pytest.approx(res.analytic.overshoot_pct, rel=1e-9)
+    rows = np.genfromtxt(io.StringIO(mc.csv_text()), delimiter=",", names=True)
+    for row in rows[:2]:
+        parts = PidParts(**{f: (row[f.upper()] if f.upper() in rows.dtype.names else None)   # a PI: no R7..C3
+                            for f in PidParts.__dataclass_fields__})
+        got = analyze_pid(PidSpec(plant_tf=model, controller_parts=parts), simulate=False)
+        assert bool(row["stable"]) == got.stable
+        assert row["phase_margin_deg"] == pytest.approx(got.margins.phase_margin_deg, rel=1e-6)
+        assert row["kp"] == pytest.approx(got.achieved.kp, rel=1e-9)
+    good = (rows["stable"] == 1) & (rows["phase_margin_deg"] >= 55) & (rows["phase_margin_deg"] <= 90)
+    assert mc.yield_count == int(good.sum())
