@@ -8,13 +8,15 @@ import itertools
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from designer.pid.blocks import PidParts
 from designer.pid.design import analyze_pid, design_pid
 from designer.pid.spec import PidSpec
 from designer.plant.sallenkey import SallenKeyParts
 from designer.core.errors import DesignError
-from designer.tolerance.loop import loop_figures, loop_monte_carlo, loop_parts, parse_loop_limit
+from designer.tolerance.loop import LIMITABLE, loop_figures, loop_monte_carlo, loop_parts, parse_loop_limit
 from designer.tolerance.worstcase import worst_case
 
 LIMITS = ["phase_margin_deg=27:90", "overshoot_pct=0:12"]
@@ -156,3 +158,18 @@ def test_a_model_plants_loop_varies_the_controller_alone_as_analyze_pid_sees_it(
         assert row["kp"] == pytest.approx(got.achieved.kp, rel=1e-9)
     good = (rows["stable"] == 1) & (rows["phase_margin_deg"] >= 55) & (rows["phase_margin_deg"] <= 90)
     assert mc.yield_count == int(good.sum())
+
+
+@settings(max_examples=150, deadline=None)
+@given(name=st.sampled_from(["phase_margin_deg", "overshoot_pct", "kp", "crossover_hz", "stable", "fn_hz", ""]),
+       lo=st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=6)),
+       hi=st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=6)),
+       sep=st.sampled_from([":", "", "::", "="]))
+def test_any_loop_limit_is_a_window_or_one_line(name, lo, hi, sep):
+    text = f"{name}={lo}{sep}{hi}"
+    try:
+        lim = parse_loop_limit(text)
+    except DesignError as exc:
+        assert "\n" not in str(exc) and str(exc).startswith("--limit")
+        return
+    assert lim.figure in LIMITABLE and lim.min <= lim.max
