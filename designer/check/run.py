@@ -119,8 +119,7 @@ def _yield_case(spec, corner, res) -> Case:
     from ..tolerance.yields import spec_yield
     y = spec.yield_spec
     try:
-        v = spec_yield(spec.kind, res, spec.checks, y.min, y.samples, y.seed, y.tolerances, y.sampler, y.dist,
-                       {lim.figure: lim.unit for lim in spec.checks})
+        v = spec_yield(spec.kind, res, spec.checks, y.min, y.samples, y.seed, y.tolerances, y.sampler, y.dist)
     except DesignError as exc:   # a part the spec's tolerances name that this design has not, say
         raise DesignError(f"{spec.name}: yield: {str(exc).replace('--tol', 'tolerances:')}") from None
     res.monte_carlo = v.mc

@@ -189,22 +189,13 @@ def loop_gain_plot(f, L, title: str, crossover_hz: float, phase_margin_deg: floa
     return png_bytes(fig, dpi=100, tight=False)
 
 
-#: a figure's unit from its name's suffix (the figures of designer.check.figures)
-_SUFFIX_UNITS = (("_hz", "Hz"), ("_s", "s"), ("_pct", "%"), ("_deg", "deg"), ("_db", "dB"))
-
-
-def figure_unit(name: str) -> str:
-    """``fn_hz`` -> Hz, ``peak_time_s`` -> s, ``overshoot_pct`` -> %, ``phase_margin_deg`` -> deg; else none."""
-    return next((u for s, u in _SUFFIX_UNITS if name.endswith(s)), "")
-
-
 def histogram_plot(values, name: str, nominal: float | None = None, lo: float | None = None,
                    hi: float | None = None, title: str = "", bins: int = 60) -> bytes:
     """A histogram of a figure over Monte Carlo samples (NaN left out), the limits ``lo``/``hi``
     drawn as red lines with the region outside shaded, the nominal design as a dashed line."""
     from matplotlib.ticker import FuncFormatter
 
-    from ..core.units import format_eng, value_code
+    from ..core.units import figure_unit, format_eng, value_code
     v = np.asarray(values, float)
     v = v[np.isfinite(v)]
     unit = figure_unit(name)

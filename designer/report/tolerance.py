@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import functools
 
-from ..core.units import format_eng
+from ..core.units import format_figure
 from . import document as R
-from .plots import figure_unit, histogram_plot
+from .plots import histogram_plot
 
 
 def histogram_name(figure: str) -> str:
@@ -50,17 +50,9 @@ def csv_texts(result) -> dict:
 
 
 def _value(figure: str, v) -> str:
-    """A figure's value with its unit (engineering notation for Hz and s)."""
-    if v is None:
-        return "open"
-    unit = figure_unit(figure)
-    return format_eng(v, unit, 4) if unit in ("Hz", "s") else f"{v:.4g}" + (f" {unit}" if unit else "")
+    return format_figure(figure, v)
 
 
-def _window(lim) -> str:
-    if lim.min is not None and lim.max is not None:
-        return f"{lim.figure} {_value(lim.figure, lim.min)} to {_value(lim.figure, lim.max)}"
-    return f"{lim.figure} {'>= ' + _value(lim.figure, lim.min) if lim.min is not None else '<= ' + _value(lim.figure, lim.max)}"
 
 
 def _pct(x: float) -> str:
@@ -78,7 +70,7 @@ def section(result, with_images: bool = True) -> list:
     if mc.limits:
         lo, hi = mc.yield_interval()
         lines.append(f"Yield {_pct(mc.yield_count / mc.n)} ({mc.yield_count} of {mc.n}; 95 % Wilson interval "
-                     f"{_pct(lo)} to {_pct(hi)}) within " + "; ".join(_window(lim) for lim in mc.limits) + ".")
+                     f"{_pct(lo)} to {_pct(hi)}) within " + "; ".join(lim.text() for lim in mc.limits) + ".")
         lost = sorted(mc.failing.items(), key=lambda kv: -kv[1]["count"])
         if lost and lost[0][1]["count"]:
             lines.append("Lost builds: " + ", ".join(f"{k} {v['count']}" for k, v in lost if v["count"])

@@ -44,10 +44,17 @@ class Limit:
             ok &= v <= self.max
         return ok
 
+    def window(self) -> str:
+        """``3.3 kHz to 3.7 kHz``, ``>= 45 deg``: the window with its units."""
+        from ..core.units import format_figure
+        f = self.figure
+        if self.min is not None and self.max is not None:
+            return f"{format_figure(f, self.min)} to {format_figure(f, self.max)}"
+        return f">= {format_figure(f, self.min)}" if self.min is not None else f"<= {format_figure(f, self.max)}"
+
     def text(self) -> str:
-        lo = "-inf" if self.min is None else f"{self.min:g}"
-        hi = "+inf" if self.max is None else f"{self.max:g}"
-        return f"{self.figure} in [{lo}, {hi}]"
+        """``fn_hz 3.3 kHz to 3.7 kHz``: the figure and its window."""
+        return f"{self.figure} {self.window()}"
 
     def to_dict(self) -> dict:
         return {"figure": self.figure, "min": self.min, "max": self.max}

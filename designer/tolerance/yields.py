@@ -45,7 +45,6 @@ class YieldVerdict:
     required: float             #: the fraction the spec requires
     names: dict                 #: engine figure -> the spec's name of it
     skipped: tuple              #: the spec's figures not counted
-    units: dict                 #: the spec's figure -> unit
 
     @property
     def fraction(self) -> float:
@@ -91,7 +90,7 @@ class YieldVerdict:
             return text
         fig, count = self.losses()[0]
         lim = next((lim for lim in mc.limits if self.names[lim.figure] == fig), None)
-        where = "unstable" if lim is None else f"outside {_window(lim, self.units.get(fig, ''))}"
+        where = "unstable" if lim is None else f"outside {lim.window()}"
         i, parts = self.corner()
         corner = ", ".join(f"{r} {format_eng(v, _unit(r), 4)} ({100 * d:+.2f} %)" for r, (v, d) in parts.items())
         return f"{text}; {fig} loses most: {count} builds {where}; the corner (build {i}, its worst): {corner}"
@@ -101,15 +100,8 @@ def _unit(ref: str) -> str:
     return "Ohm" if ref.startswith("R") else "F" if ref.startswith("C") else "Hz"
 
 
-def _window(lim: Limit, unit: str) -> str:
-    f = (lambda v: format_eng(v, unit, 5)) if unit else (lambda v: f"{v:.6g}")
-    if lim.min is not None and lim.max is not None:
-        return f"{f(lim.min)} .. {f(lim.max)}"
-    return f">= {f(lim.min)}" if lim.min is not None else f"<= {f(lim.max)}"
-
-
 def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int, tol_items=(),
-               sampler: str = "random", dist: str = "uniform", units=None) -> YieldVerdict:
+               sampler: str = "random", dist: str = "uniform") -> YieldVerdict:
     """The yield of one corner's design ``res`` (a PlantResult or a PidResult) over ``checks``
     (:class:`designer.check.limits.Limit`, the spec's), required to reach ``required``.
 
@@ -126,4 +118,4 @@ def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int,
                                dist, tol_items, limits, tighten=False)
     else:
         mc = loop_monte_carlo(res, loop_series(res), samples, seed, sampler, dist, tol_items, limits, tighten=False)
-    return YieldVerdict(mc, required, names, skipped, dict(units or {}))
+    return YieldVerdict(mc, required, names, skipped)

@@ -64,7 +64,7 @@ def test_a_yield_missed_fails_naming_the_figure_the_interval_and_the_corner(tmp_
     assert msg.startswith(f"yplant [LM741]: yield: {100 * passed / 2000:.4g} % ({passed}/2000 builds; 95 % Wilson "
                           "interval ")
     assert "below min 95 %" in msg and "not counted, no engine figure: nrms" in msg
-    assert f"fn_hz loses most: {int((~fn_in).sum())} builds outside 3.4 kHz .. 3.6 kHz" in msg
+    assert f"fn_hz loses most: {int((~fn_in).sum())} builds outside 3.4 kHz to 3.6 kHz" in msg
     worst = int(np.argmax(np.where(fn_in, -1, np.abs(rows["fn_hz"] - 3500))))
     assert f"the corner (build {worst}, its worst): R1 " in msg and "C2 " in msg
     assert (folder / "mc-fn_hz.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -15,7 +15,8 @@ from designer.pid.spec import PidSpec
 from designer.plant.design import design_plant
 from designer.plant.report import write_outputs as write_plant
 from designer.plant.spec import PlantSpec
-from designer.report.plots import figure_unit, histogram_plot
+from designer.core.units import figure_unit
+from designer.report.plots import histogram_plot
 from designer.report.tolerance import histogram_plots, section
 from designer.tolerance.loop import loop_monte_carlo
 from designer.tolerance.montecarlo import plant_monte_carlo

@@ -30,7 +30,7 @@ def test_only_failing_checks_on_engine_figures_count():
 
 
 def test_the_yield_is_the_count_of_rows_inside_the_checks(plant):
-    v = spec_yield("plant", plant, CHECKS, 0.99, 3000, 1, ("R=1%", "C=5%", "C2=2%"), units={"fn_hz": "Hz"})
+    v = spec_yield("plant", plant, CHECKS, 0.99, 3000, 1, ("R=1%", "C=5%", "C2=2%"))
     rows = np.genfromtxt(io.StringIO(v.mc.csv_text()), delimiter=",", names=True)
     inside = (rows["fn_hz"] >= 3400) & (rows["fn_hz"] <= 3600) & (rows["overshoot_pct"] <= 60)
     assert v.mc.yield_count == int(inside.sum()) and v.fraction == pytest.approx(inside.mean())
@@ -42,7 +42,7 @@ def test_the_yield_is_the_count_of_rows_inside_the_checks(plant):
                           f"{100 * lo:.4g} % to {100 * hi:.4g} %) below min 99 %")
     assert "not counted, no engine figure: nrms" in msg
     assert f"fn_hz loses most: {int((~((rows['fn_hz'] >= 3400) & (rows['fn_hz'] <= 3600))).sum())} builds " \
-           "outside 3.4 kHz .. 3.6 kHz" in msg
+           "outside 3.4 kHz to 3.6 kHz" in msg
     i, parts = v.corner()
     far = np.argmax(np.where(inside, -1, np.abs(rows["fn_hz"] - 3500)))
     assert i == far and f"(build {i}, its worst): R1 " in msg
