@@ -116,8 +116,9 @@ def _add_spice_options(g):
 PLANT_PARTS = ("R1", "R2", "C1", "C2", "R3", "R4")
 
 
-def monte_carlo_settings(args, designators=PLANT_PARTS):
-    """The Monte Carlo's options checked before any work (None without --monte-carlo)."""
+def monte_carlo_settings(args, designators=PLANT_PARTS, parse_limit_item=None):
+    """The Monte Carlo's options checked before any work (None without --monte-carlo);
+    ``parse_limit_item(text)`` checks a --limit (default: a plant figure's)."""
     given = [f for f, v in (("--tol", args.tol), ("--limit", args.limit)) if v]
     if args.monte_carlo is None:
         if args.limit or (args.tol and not args.worst_case):
@@ -144,7 +145,7 @@ def monte_carlo_settings(args, designators=PLANT_PARTS):
     except ValueError:
         raise DesignError(f"--seed {args.seed!r}: give a whole number >= 0") from None
     for item in args.limit or ():
-        parse_limit(item, FIGURES)
+        parse_limit(item, FIGURES) if parse_limit_item is None else parse_limit_item(item)
     from ..tolerance.parts import check_items
     check_items(args.tol or (), designators)
     return n, seed

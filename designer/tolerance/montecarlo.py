@@ -15,7 +15,7 @@ from ..core.errors import DesignError
 from . import plant as engine
 from . import sampling
 from .parts import DISTRIBUTIONS, resolve
-from .stats import figure_stats, parse_limit, samples_csv, variance_shares, wilson
+from .stats import Limit, failing_samples, figure_stats, parse_limit, samples_csv, variance_shares, wilson
 
 #: the number of samples allowed
 MIN_SAMPLES, MAX_SAMPLES = 10, 10 ** 7
@@ -44,6 +44,11 @@ class MonteCarlo:
     failing: dict = field(default_factory=dict)
     tighten: dict | None = None
     spice: dict | None = None          #: SPICE beside the model (designer.tolerance.spice_mc), when asked
+
+    @property
+    def headline(self) -> str:
+        """The figure a sheet shows first: the first limited one, else fn_hz."""
+        return self.limits[0].figure if self.limits else "fn_hz"
 
     @property
     def yield_count(self) -> int:
@@ -80,6 +85,11 @@ class MonteCarlo:
             p = s.percentiles
             out.append(f"  {k}: nominal {s.nominal:.5g}, mean {s.mean:.5g}, std {s.std:.3g}, 2.5..97.5 % "
                        f"{p[2.5]:.5g}..{p[97.5]:.5g}")
+        return out + self.yield_lines()
+
+    def yield_lines(self) -> list:
+        """The yield with its interval and the part to buy tighter (none without limits)."""
+        mc, out = self, []
         if mc.limits:
             lo, hi = mc.yield_interval()
             out.append(f"  yield {100 * mc.yield_count / mc.n:.2f} % ({mc.yield_count}/{mc.n}; 95 % Wilson interval "
@@ -141,7 +151,8 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     sampler, dist : str
         :data:`designer.tolerance.sampling.SAMPLERS`; ``uniform`` or ``normal``.
     tol_items, limit_items : sequence of str
-        ``--tol`` items (``R=1%``, ``C2=2%``) and ``--limit`` items (``fn_hz=3.3k:3.7k``).
+        ``--tol`` items (``R=1%``, ``C2=2%``) and ``--limit`` items (``fn_hz=3.3k:3.7k``; or
+        :class:`~designer.tolerance.stats.Limit` objects, one-sided ones too).
     tighten : bool
         Also find the part whose tolerance halved raises the yield most (one more run per part,
         always with the analytic model).
@@ -156,7 +167,7 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
         raise DesignError(f"--dist {dist!r} unknown; allowed: {', '.join(DISTRIBUTIONS)}")
     if sampler not in sampling.SAMPLERS:
         raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(sampling.SAMPLERS)}")
-    limits = tuple(parse_limit(t, engine.FIGURES) for t in limit_items or ())
+    limits = tuple(t if isinstance(t, Limit) else parse_limit(t, engine.FIGURES) for t in limit_items or ())
     nominal = plant_parts(parts)
     if any(str(t).strip().upper().startswith("GBW") for t in tol_items or ()):
         if opamp.ideal:
@@ -173,12 +184,7 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     shares = {k: variance_shares(rel, figs[k]) for k in (by_fig or ("fn_hz", "zeta", "overshoot_pct"))}
     mc = MonteCarlo(n, seed, sampler, dist, engine_name, tol, nominal, values, figs, nominal_figs, limits, stats,
                     _yield(figs, limits) if limits else None, shares)
-    for lim in limits:
-        bad = np.nonzero(~lim.inside(figs[lim.figure]))[0]
-        v = figs[lim.figure][bad]
-        centre = 0.5 * ((lim.min if lim.min is not None else lim.max) + (lim.max if lim.max is not None else lim.min))
-        order = np.argsort(-np.abs(np.nan_to_num(v, nan=np.inf) - centre))[:WORST]
-        mc.failing[lim.figure] = {"count": int(bad.size), "worst": [int(i) for i in bad[order]]}
+    mc.failing.update(failing_samples(figs, limits, WORST))
     if tighten and limits:
         best = None
         for ref in tol.of:
