@@ -33,7 +33,7 @@ def histogram_plots(result) -> tuple:
     """(file name, draw(result)) of every histogram of the result's Monte Carlo (none without one):
     the headline figure's, then each limited figure's."""
     mc = result.monte_carlo
-    if mc is None:
+    if mc is None or mc.headline is None:   # none, or one build replayed: no spread
         return ()
     names = dict.fromkeys([mc.headline, *(lim.figure for lim in mc.limits)])
     return tuple((histogram_name(f), functools.partial(histogram_png, figure=f)) for f in names)
@@ -53,8 +53,6 @@ def _value(figure: str, v) -> str:
     return format_figure(figure, v)
 
 
-
-
 def _pct(x: float) -> str:
     return f"{100 * x:.3g} %" if x < 0.9995 or x == 1 else f"{100 * x:.4g} %"
 
@@ -64,6 +62,8 @@ def section(result, with_images: bool = True) -> list:
     mc = result.monte_carlo
     if mc is None:
         return []
+    if mc.headline is None:   # one build replayed (--replay I): what it is, no spread
+        return [R.text(" ".join(mc.summary_lines()))]
     head = (f"{mc.n} builds drawn within the parts' tolerances ({mc.dist}, {mc.sampler} sampler, seed {mc.seed}; "
             "each build's parts are in monte-carlo.csv).")
     lines = [head]

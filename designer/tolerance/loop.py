@@ -214,10 +214,11 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
     saturated = int(np.count_nonzero(figs["saturated"] == 1))
     mc = LoopMonteCarlo(n, seed, sampler, dist, "analytic", tol, nominal, values, figs, nominal_figs, limits, stats,
                         _passed(figs, limits) if limits else None, shares,
-                        failing_samples(figs, limits), None,
-                        {"count": unstable, "fraction": unstable / n, "ci95": list(wilson(unstable, n))},
-                        {"count": saturated, "fraction": saturated / n, "ci95": list(wilson(saturated, n))},
-                        [int(i) for i in np.nonzero(figs["stable"] == 0)[0][:5]])
+                        failing_samples(figs, limits),
+                        p_unstable={"count": unstable, "fraction": unstable / n, "ci95": list(wilson(unstable, n))},
+                        p_saturated={"count": saturated, "fraction": saturated / n,
+                                     "ci95": list(wilson(saturated, n))},
+                        unstable_samples=[int(i) for i in np.nonzero(figs["stable"] == 0)[0][:5]])
     if tighten and limits and mc.yield_count < n:
         weight = {r: sum(shares[k][r] for k in by_fig) for r in tol.of}
         best = None

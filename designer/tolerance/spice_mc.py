@@ -174,6 +174,9 @@ class Replay:
     """One Monte Carlo sample replayed (``--replay I``): its index, the draw's settings, its parts'
     values and its figures from the SPICE engine and the model (the result's ``monte_carlo``)."""
 
+    #: no spread to draw: the sheet shows the build itself (designer.report.tolerance)
+    headline = None
+
     def __init__(self, index: int, settings: dict, values: dict, spice: dict, model: dict):
         self.index, self.settings, self.values, self.spice, self.model = index, settings, values, spice, model
 
