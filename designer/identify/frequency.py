@@ -1,6 +1,6 @@
 """Identification from a measured frequency response (seed 000 section 5, seed 003 section 3.1).
 
-Input is a validated table, :class:`~designer.identify.io.FreqData` (read
+Input is a validated table, :class:`~designer.identify.io.freqtable.FreqData` (read
 by :func:`designer.identify.io.read_freq_table`).
 
 Methods (all return :class:`~designer.identify.structures.MethodResult`):
