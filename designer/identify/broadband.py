@@ -332,7 +332,7 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
         raise DesignError(f"{name}: the input repeats every {ex.n} intervals, which is not "
                           "2^n - 1: the correlation method needs a maximum-length sequence; use "
                           "--method spectral")
-    res.method = method or ("correlation" if ex.kind == "mls" else "spectral")
+    res.method = method or "spectral"
     ts = ex.ts
     f_nyq = 0.5 / ts
     if ex.kind == "noise":
@@ -376,11 +376,11 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
             res.spectrum = banded
             res.freq_result = identify_freq(spec.to_freq_data(banded, name))
         timings["spectral_models"] = clock() - t1
-    if res.best is None:
-        other = "spectral" if res.method == "correlation" else "correlation"
-        alt = res.freq_result if other == "spectral" else res.step_result
-        if method is None and alt is not None and alt.best is not None:
-            res.method = other
+    if method is None:
+        # the spectral fit first: it divides by the input's own spectrum, where the
+        # correlation's step is smoothed by the sequence's autocorrelation triangle
+        spectral_ok = res.freq_result is not None and res.freq_result.best is not None
+        res.method = "spectral" if spectral_ok or res.step_result is None else "correlation"
     timings["total"] = clock() - t0
     res.timings = timings
     return res
@@ -388,6 +388,8 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
 
 #: samples at rest put before the step response given to the step methods, as a fraction of it
 REST_FRACTION = 0.1
+#: the step methods get the step response up to this many times its settling time
+STEP_SETTLINGS = 3.0
 #: the step methods get at most this many samples of the step response (block means beyond)
 MAX_STEP_SAMPLES = 20_000
 
@@ -397,6 +399,10 @@ def _step_methods(est: corr.ImpulseEstimate, refine: bool, methods):
     response, preceded by a stretch at rest, as a unit step at t = 0."""
     from .step import identify_step
     t, s = est.t, est.step
+    if not est.wrapped:
+        # a few settling times: a long settled tail only blurs what the methods measure
+        keep = t <= t[0] + max(STEP_SETTLINGS * (est.settling_s - t[0]), 0.2 * (t[-1] - t[0]))
+        t, s = t[keep], s[keep]
     k = max(1, int(math.ceil(t.size / MAX_STEP_SAMPLES)))
     if k > 1:
         n = (t.size // k) * k

@@ -45,6 +45,10 @@ import numpy as np
 TAIL_FRACTION = 0.1
 #: the step response counts as settled inside +-this fraction of its final value
 SETTLE_BAND = 0.02
+#: the impulse response must be flat over this last fraction of the period
+TAIL_CHECK = 0.3
+#: within this fraction of its peak
+FLAT_FRACTION = 0.005
 #: a response that settles later than this fraction of the period has wrapped around
 WRAP_FRACTION = 0.8
 
@@ -109,7 +113,7 @@ def mls_impulse(x, y, *, n: int, dt_s: float, ts: float, amplitude: float) -> Im
     h = scale * (phi - dc)
     step = np.cumsum(h) * ts
     est = ImpulseEstimate(t, h, step, dc * scale, p * ts, dt_s, math.nan)
-    settling_check(est)
+    settling_check(est, m)
     return est
 
 
@@ -141,35 +145,58 @@ def settling_time(t, step, band: float = SETTLE_BAND) -> float:
     return float(t[min(i + 1, t.size - 1)])
 
 
-def tail_time_constant(t, h) -> float:
-    """The time constant of the decay of ``h`` over the second half of the record,
-    from three window means (a wrapped exponential plus a constant keeps its
-    time constant); nan when the tail does not decay monotonically."""
-    n = h.size
-    a = n // 2
-    w = max((n - a) // 3, 1)
-    m1, m2, m3 = (float(np.mean(h[a + i * w:a + (i + 1) * w])) for i in range(3))
+def _window_means(h, start: int, parts: int = 3) -> list:
+    w = max((h.size - start) // parts, 1)
+    return [float(np.mean(h[start + i * w:start + (i + 1) * w])) for i in range(parts)], w
+
+
+def tail_time_constant(t, h, start: int) -> float:
+    """The time constant of the decay of ``h`` from sample ``start`` on, from three
+    window means (a wrapped exponential plus a constant keeps its time
+    constant); nan when the tail does not decay monotonically."""
+    (m1, m2, m3), w = _window_means(h, start)
     d1, d2 = m1 - m2, m2 - m3
     if d1 == 0 or d2 == 0 or (d1 > 0) != (d2 > 0) or abs(d2) >= abs(d1):
         return math.nan
     return float(w * (t[1] - t[0]) / math.log(d1 / d2))
 
 
-def settling_check(est: ImpulseEstimate) -> None:
-    """Fill ``settling_s``, ``wrapped`` and ``tail_tau_s`` of an estimate."""
+def tail_drift(h, start: int, per_bit: int) -> tuple:
+    """(change of ``h`` across its tail from sample ``start``, the noise of that
+    change): the first and last of three window means, and their standard
+    error from the tail's sample-to-sample noise (correlated over ``per_bit``
+    samples, the sequence's interval)."""
+    (m1, _, m3), w = _window_means(h, start)
+    tail = h[start:]
+    d2 = np.diff(tail, 2)
+    sigma = float(np.std(d2) / math.sqrt(6.0)) if d2.size > 2 else 0.0
+    se = sigma * math.sqrt(2.0 * max(per_bit, 1) / w)
+    return m1 - m3, se
+
+
+def settling_check(est: ImpulseEstimate, per_bit: int = 1) -> None:
+    """Fill ``settling_s``, ``wrapped`` and ``tail_tau_s`` of an estimate: it has
+    wrapped around when its step response settles late in the period, or when
+    the impulse response still drifts over the period's last :data:`TAIL_CHECK`
+    (by more than :data:`FLAT_FRACTION` of its peak and three times its noise)."""
     est.settling_s = settling_time(est.t, est.step)
     span = est.t[-1] - est.t[0]
-    est.wrapped = bool(est.settling_s - est.t[0] > WRAP_FRACTION * span)
+    start = int((1.0 - TAIL_CHECK) * est.h.size)
+    drift, se = tail_drift(est.h, start, per_bit)
+    peak = float(np.max(np.abs(est.h)))
+    flat = abs(drift) <= max(FLAT_FRACTION * peak, 3.0 * se)
+    est.wrapped = bool(est.settling_s - est.t[0] > WRAP_FRACTION * span or not flat)
     if est.wrapped:
-        est.tail_tau_s = tail_time_constant(est.t, est.h)
+        est.tail_tau_s = tail_time_constant(est.t, est.h, start)
 
 
 def needed_period(est: ImpulseEstimate) -> float:
-    """The period a wrapped estimate would have needed: its settling time, or
-    four tail time constants (the slowest mode's 2 % band), whichever is longer."""
+    """At least the period a wrapped estimate would have needed: its settling
+    time, or the period plus four time constants of its tail (what is left of
+    the response at the period's end dies out in about that), the longer."""
     need = est.settling_s
     if math.isfinite(est.tail_tau_s):
-        need = max(need, 4.0 * est.tail_tau_s)
+        need = max(need, est.period_s + 4.0 * est.tail_tau_s)
     return need
 
 
