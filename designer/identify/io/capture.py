@@ -437,10 +437,12 @@ def _assemble(cols: _Columns, layout: _Layout, keep, tentative, name) -> Capture
     # An input chosen by position only is used only if it looks like one
     # (e.g. time_s,analytic,spice has no input column).
     if tentative and not looks_like_step_input(u, y):
-        notes.append(f"column {columns[j_in]!r} does not look like a step input "
-                     "(its transitions are not much faster than the output's); "
-                     "no input column used (see --input-column)")
-        u, j_in = None, None
+        from ..broadband import looks_broadband   # a PRBS or noise input is one too
+        if not looks_broadband(u):
+            notes.append(f"column {columns[j_in]!r} does not look like a step input "
+                         "(its transitions are not much faster than the output's) nor a "
+                         "broadband one; no input column used (see --input-column)")
+            u, j_in = None, None
     return Capture(t=t, y=y, u=u, fmt=layout.fmt, columns=list(columns),
                    output_name=columns[j_out],
                    input_name=None if j_in is None else columns[j_in], source=name,
