@@ -13,7 +13,8 @@ f = :data:`HALF_POWER` / Dt, so the clock is chosen to put that frequency at
 :data:`BAND_FACTOR` times the plant's bandwidth; and the period N Dt must
 outlast the plant's settling time (seed 003, 2.4.5: "only a little longer than
 the settling time"), by :data:`SETTLE_MARGIN`, or the impulse response wraps
-around (:func:`.correlation.impulse_response` says so).
+around (:func:`.correlation.settling_check` finds it), and put
+:data:`LINES_IN_BAND` spectral lines below the bandwidth for the spectral fit.
 
 Writers: the waveform as a bench generator's arbitrary-waveform CSV (one value
 per clock interval, the sample rate stated), a ``time_s,value`` CSV, and an
@@ -36,6 +37,8 @@ HALF_POWER = 0.4429
 BAND_FACTOR = 3.0
 #: one period outlasts the plant's settling time by this factor
 SETTLE_MARGIN = 1.2
+#: one period puts at least this many spectral lines (1/period apart) below the bandwidth
+LINES_IN_BAND = 10
 #: the ngspice PWL source's edge time, as a fraction of the clock interval
 EDGE_FRACTION = 1e-3
 
@@ -154,17 +157,22 @@ def plan_for_plant(settling_s: float, bandwidth_hz: float, *, amplitude=1.0, off
                        f"band, {_hz(HALF_POWER / dt_s)}, covers {BAND_FACTOR:g}x the plant's "
                        f"bandwidth of {_hz(bandwidth_hz)}")
     need = SETTLE_MARGIN * settling_s
+    lines = LINES_IN_BAND / bandwidth_hz
     if bits is None:
-        n = bits_for(need, dt_s)
+        n = bits_for(max(need, lines), dt_s)
         if n is None:
             n = MAX_BITS
             reasons.append(f"{MAX_BITS} bits, the most: a period of {_sec(((1 << n) - 1) * dt_s)} "
                            f"is shorter than {SETTLE_MARGIN:g}x the settling time "
-                           f"({_sec(need)}); a slower clock would be needed")
+                           f"({_sec(need)}) or {LINES_IN_BAND} spectral lines in the bandwidth "
+                           f"({_sec(lines)}); a slower clock would be needed")
         else:
+            why = (f"outlasts {SETTLE_MARGIN:g}x the plant's 2 % settling time of {_sec(settling_s)}"
+                   if need >= lines else
+                   f"puts {LINES_IN_BAND} spectral lines (1/period apart) in the plant's bandwidth "
+                   f"(and outlasts {SETTLE_MARGIN:g}x its settling time of {_sec(settling_s)})")
             reasons.append(f"{n} bits (N = {(1 << n) - 1}): one period, "
-                           f"{_sec(((1 << n) - 1) * dt_s)}, outlasts {SETTLE_MARGIN:g}x the "
-                           f"plant's 2 % settling time of {_sec(settling_s)}")
+                           f"{_sec(((1 << n) - 1) * dt_s)}, {why}")
     else:
         n = check_bits(bits)
         if ((1 << n) - 1) * dt_s < need:
