@@ -49,6 +49,8 @@ MIN_SAMPLES = 256
 #: bits that disagree with the sequence one period later, at most (noise on the input)
 PERIOD_MISMATCH = 0.01
 METHODS = ("correlation", "spectral")
+#: bits whose linear complexity tells an m-sequence shorter than two periods
+LFSR_BITS = 200
 
 
 @dataclass
@@ -211,6 +213,18 @@ def examine_input(t, u, *, name: str = "capture") -> Excitation | None:
     centres = np.arange(phase + m // 2, u.size, m)
     bits = 2 * state[centres].astype(np.int8) - 1
     L = _period(bits)
+    if L is None:
+        # fewer than two periods of an m-sequence? its first 2n bits give n away
+        from .prbs import linear_complexity
+        head = bits[:LFSR_BITS]
+        nb = linear_complexity((head > 0).astype(np.int8))
+        if head.size >= 4 * nb and MIN_BITS <= nb <= MAX_BITS:
+            period = ((1 << nb) - 1) * m
+            raise DesignError(f"{name}: the input is a maximum-length sequence of {nb} bits "
+                              f"(N = {(1 << nb) - 1}), but the record holds "
+                              f"{u.size / period:.2f} of its periods ({period} samples each); at "
+                              "least 2 whole ones are needed (the first settles the plant, the "
+                              "second is measured)")
     hi_level = float(np.median(u[state == 1]))
     lo_level = float(np.median(u[state == 0]))
     ex = Excitation("noise", ts, int(edges.size), 0.5 * (hi_level + lo_level),
@@ -246,6 +260,8 @@ class BroadbandResult:
     notes: list = field(default_factory=list)
     capture: object | None = None
     timings: dict = field(default_factory=dict)
+    #: for a wrapped impulse response: the period, bits or clock interval that would do
+    advice: dict | None = None
 
     @property
     def best(self):
@@ -258,6 +274,8 @@ class BroadbandResult:
              "timings_s": dict(self.timings)}
         if self.impulse is not None:
             d["impulse"] = self.impulse.to_dict()
+            if self.advice:
+                d["impulse"]["advice"] = dict(self.advice)
         if self.step_result is not None:
             d["correlation"] = self.step_result.to_dict()
         if self.spectrum is not None:
@@ -270,18 +288,22 @@ class BroadbandResult:
         return d
 
 
-def _wrap_note(est: corr.ImpulseEstimate, ex: Excitation) -> str:
+def _wrap_advice(est: corr.ImpulseEstimate, ex: Excitation) -> tuple:
+    """(the note, the advice: the period needed, the bits at this clock, the clock
+    interval at these bits) of a wrapped impulse estimate."""
     from ..core.units import format_eng as fe
     need = corr.needed_period(est)
     text = (f"the impulse response has not settled within one period ({fe(est.period_s, 's')}; "
             f"settling at least {fe(need, 's')}): it wraps around, and the DC term removes part "
             "of it")
+    advice = {"period_s": need}
     if ex.kind == "mls" and ex.n:
         nb = bits_for(SETTLE_MARGIN * need, ex.dt_s)
         dt = SETTLE_MARGIN * need / ex.n
+        advice.update({"bits": nb, "dt_s": dt})
         text += (f"; {nb} bits at this clock would be enough" if nb else "") + \
             f" (or a clock interval of {fe(dt, 's')} with {ex.bits} bits)"
-    return text
+    return text, advice
 
 
 def check_method(method) -> str | None:
@@ -357,10 +379,16 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
                                               ts=ts, f_max=f_max)
     timings = {"estimate": clock() - t0}
     if res.impulse is not None and res.impulse.wrapped:
-        res.notes.append(_wrap_note(res.impulse, ex))
+        note, res.advice = _wrap_advice(res.impulse, ex)
+        res.notes.append(note)
     if res.impulse is not None and method != "spectral":
         t1 = clock()
-        res.step_result = _step_methods(res.impulse, refine, methods)
+        try:
+            res.step_result = _step_methods(res.impulse, refine, methods)
+        except DesignError as exc:
+            if method == "correlation":
+                raise DesignError(f"{name}: the step response from the correlation: {exc}") from None
+            res.notes.append(f"no step methods on the correlation's step response: {exc}")
         timings["correlation_models"] = clock() - t1
     if method != "correlation":
         t1 = clock()

@@ -247,3 +247,25 @@ def pwl_subcircuit(plan: PrbsPlan, name: str = "prbs_source") -> str:
         lines.append("+ " + " ".join(pairs[i:i + 6]))
     lines += ["+ )", f".ends {name}"]
     return "\n".join(lines) + "\n"
+
+
+def linear_complexity(bits) -> int:
+    """The length of the shortest linear feedback shift register that generates
+    the 0/1 sequence ``bits`` (Berlekamp-Massey over GF(2)): the bits n of an
+    m-sequence once 2n of its bits are seen; about half the length for random bits."""
+    s = [int(b) & 1 for b in bits]
+    n = len(s)
+    c, b = [1] + [0] * n, [1] + [0] * n
+    L, m = 0, -1
+    for i in range(n):
+        d = s[i]
+        for j in range(1, L + 1):
+            d ^= c[j] & s[i - j]
+        if d:
+            t = c[:]
+            shift = i - m
+            for j in range(n + 1 - shift):
+                c[j + shift] ^= b[j]
+            if 2 * L <= i:
+                L, m, b = i + 1 - L, i, t
+    return L
