@@ -49,8 +49,6 @@ SETTLE_BAND = 0.02
 TAIL_CHECK = 0.3
 #: within this fraction of its peak
 FLAT_FRACTION = 0.005
-#: a response that settles later than this fraction of the period has wrapped around
-WRAP_FRACTION = 0.8
 
 
 def period_mean(x, start: int, period: int, count: int) -> np.ndarray:
@@ -176,16 +174,17 @@ def tail_drift(h, start: int, per_bit: int) -> tuple:
 
 def settling_check(est: ImpulseEstimate, per_bit: int = 1) -> None:
     """Fill ``settling_s``, ``wrapped`` and ``tail_tau_s`` of an estimate: it has
-    wrapped around when its step response settles late in the period, or when
-    the impulse response still drifts over the period's last :data:`TAIL_CHECK`
-    (by more than :data:`FLAT_FRACTION` of its peak and three times its noise)."""
+    wrapped around when the impulse response still drifts over the period's
+    last :data:`TAIL_CHECK` (by more than :data:`FLAT_FRACTION` of its peak and
+    three times its noise). (The step response's own settling time is no test:
+    its noise is the running sum of h's, a random walk that leaves a 2 % band
+    on a noisy record however long the period.)"""
     est.settling_s = settling_time(est.t, est.step)
-    span = est.t[-1] - est.t[0]
     start = int((1.0 - TAIL_CHECK) * est.h.size)
     drift, se = tail_drift(est.h, start, per_bit)
     peak = float(np.max(np.abs(est.h)))
     flat = abs(drift) <= max(FLAT_FRACTION * peak, 3.0 * se)
-    est.wrapped = bool(est.settling_s - est.t[0] > WRAP_FRACTION * span or not flat)
+    est.wrapped = not flat
     if est.wrapped:
         est.tail_tau_s = tail_time_constant(est.t, est.h, start)
 
