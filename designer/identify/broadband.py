@@ -38,12 +38,17 @@ from .prbs import MAX_BITS, MIN_BITS, SETTLE_MARGIN, bits_for, is_mls_length
 
 #: at least this many transitions make an input broadband
 MIN_TRANSITIONS = 20
-#: a square wave's intervals between transitions vary less than this (std / mean)
+#: a square wave's (a PWM's) intervals between transitions, high and low apart,
+#: vary less than this (std / mean)
 REGULAR_CV = 0.2
 #: no single spectral line of a broadband input holds this share of its AC power
 MAX_LINE_SHARE = 0.5
 #: a two-level input spends less than this fraction of its samples between its levels
 TWO_LEVEL_FRACTION = 0.1
+#: ... in every one of this many equal parts of the record (two transitions at least)
+SPREAD_PARTS = 8
+#: a broadband input spans at least this many quantisation steps
+MIN_LSB = 16
 #: fewest samples for any broadband identification
 MIN_SAMPLES = 256
 #: bits that disagree with the sequence one period later, at most (noise on the input)
@@ -143,11 +148,19 @@ def looks_broadband(u) -> bool:
     u = np.asarray(u, float)
     if u.size < MIN_SAMPLES:
         return False
-    edges, _, _ = _transitions(u)
+    edges, lo, hi = _transitions(u)
     if edges.size < MIN_TRANSITIONS:
         return False
+    from ..core.waveform import quantum
+    lsb = quantum(u[: 1 << 16])
+    if lsb > 0 and hi - lo < MIN_LSB * lsb:
+        return False            # a quiet channel's noise, a few quantisation steps wide
+    # an excitation toggles all through the record, not in a burst (ringing, a glitch)
+    if np.min(np.bincount(edges * SPREAD_PARTS // u.size, minlength=SPREAD_PARTS)) < 2:
+        return False
     runs = np.diff(edges)
-    if runs.std() < REGULAR_CV * runs.mean():
+    # a square wave or a PWM: its high runs alike and its low runs alike
+    if all(r.std() < REGULAR_CV * r.mean() for r in (runs[0::2], runs[1::2])):
         return False
     return _line_share(u) < MAX_LINE_SHARE
 

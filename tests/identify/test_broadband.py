@@ -162,3 +162,15 @@ def test_noise_input_spectral():
     res = identify_broadband(np.arange(n) * TS, y, u)
     assert res.excitation.kind == "noise" and res.method == "spectral"
     _within(res.best.params, {"K": 1.5, "wn_rad_s": 2.0, "zeta": 0.2}, 0.05)
+
+
+def test_a_quiet_channel_or_a_burst_is_not_broadband():
+    """Found on bench captures: a scope channel of noise a few LSB wide, and a
+    switch node's ringing burst, toggle often but excite nothing."""
+    rng = np.random.default_rng(0)
+    quiet = np.round(rng.normal(0, 0.01, 12000) / 0.0078) * 0.0078
+    assert not looks_broadband(quiet)
+    t = np.arange(12000) * 2e-9
+    burst = np.where((t > 5e-6) & (t < 6e-6), np.sin(2 * np.pi * 30e6 * t) * np.exp(-(t - 5e-6) / 3e-7), 0.0)
+    burst += rng.normal(0, 1e-3, t.size)
+    assert not looks_broadband(burst)
