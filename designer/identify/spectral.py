@@ -33,8 +33,9 @@ INPUT_DB = 10.0
 MIN_COHERENCE = 0.5
 #: a band whose standard error exceeds this fraction of its |H| is left out
 MAX_REL_ERROR = 0.05
-#: bands per decade of the table given to identify-freq
-BANDS_PER_DECADE = 20
+#: bands per decade of the table given to identify-freq (20 flattened a zeta = 0.2
+#: peak by 3 %: a band then spans a third of its half-power width)
+BANDS_PER_DECADE = 40
 
 
 @dataclass
