@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.signal as sig
 
-from designer.identify.prbs import mls
+from designer.core.prbs import mls
 
 
 def prbs_capture(num, den, *, bits, per_bit, periods, ts, amplitude=1.0, offset=0.0,

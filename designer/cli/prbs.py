@@ -3,7 +3,7 @@ plays for identification (seed 003, section 2.4), as files the generator's
 software, a spreadsheet and ngspice read.
 
 The maths (the m-sequence, the clock and bits chosen for a plant, the file
-texts) is :mod:`designer.identify.prbs`; this module reads the command line
+texts) is :mod:`designer.core.prbs`; this module reads the command line
 and the plant model (``--plant-tf`` as design-pid reads it,
 :func:`designer.core.process_text.parse_tf`; ``--plant-model``, an identify
 or identify-freq JSON, :func:`designer.pid.plant_source.model_from_json`)
@@ -142,7 +142,7 @@ def bandwidth_hz(model) -> float:
 
 
 def make_plan(args):
-    from ..identify.prbs import PrbsPlan, check_bits, plan_for_plant
+    from ..core.prbs import PrbsPlan, check_bits, plan_for_plant
     amplitude = parse_in_range(args.amplitude, "--amplitude", "prbs_amplitude_v")
     offset = parse_in_range(args.offset, "--offset", "prbs_offset_v")
     periods = parse_in_range(args.periods, "--periods", "prbs_periods")
@@ -171,7 +171,7 @@ def write_bundle(plan, out) -> list:
     """The three files in folder ``out``, all or none (a staging folder renamed into place)."""
     from pathlib import Path
     from ..core import fileio
-    from ..identify.prbs import awg_csv, pwl_subcircuit, time_value_csv
+    from ..core.prbs import awg_csv, pwl_subcircuit, time_value_csv
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise DesignError(f"--out {fileio.shown(out)} is a file, not a folder")

@@ -34,7 +34,7 @@ import numpy as np
 from ..core.errors import DesignError
 from . import correlation as corr
 from . import spectral as spec
-from .prbs import MAX_BITS, MIN_BITS, SETTLE_MARGIN, bits_for, is_mls_length
+from ..core.prbs import MAX_BITS, MIN_BITS, SETTLE_MARGIN, bits_for, is_mls_length
 
 #: at least this many transitions make an input broadband
 MIN_TRANSITIONS = 20
@@ -228,7 +228,7 @@ def examine_input(t, u, *, name: str = "capture") -> Excitation | None:
     L = _period(bits)
     if L is None:
         # fewer than two periods of an m-sequence? its first 2n bits give n away
-        from .prbs import linear_complexity
+        from ..core.prbs import linear_complexity
         head = bits[:LFSR_BITS]
         nb = linear_complexity((head > 0).astype(np.int8))
         if head.size >= 4 * nb and MIN_BITS <= nb <= MAX_BITS:

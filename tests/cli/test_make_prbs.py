@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from designer.cli.prbs import make_prbs_main
-from designer.identify.prbs import mls
+from designer.core.prbs import mls
 
 EXE = script("make-prbs")
 

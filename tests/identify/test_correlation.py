@@ -9,7 +9,7 @@ import pytest
 
 from designer.identify import correlation as corr
 from designer.identify.broadband import identify_broadband
-from designer.identify.prbs import mls
+from designer.core.prbs import mls
 from prbs_capture import prbs_capture
 
 # C(s)/R(s) = (0.464 + 44.735 s)/((s + 0.054)(s + 0.0095)), time in minutes (eq. 2.4.21)

@@ -7,7 +7,7 @@ import scipy.signal as sig
 
 from designer.identify import spectral as spec
 from designer.identify.io import parse_freq_table
-from designer.identify.prbs import mls
+from designer.core.prbs import mls
 
 TS = 1e-3
 

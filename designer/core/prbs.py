@@ -4,7 +4,7 @@ A maximum-length sequence (m-sequence, the seed's "s.b.l.m.", eq. 2.4.5) of
 ``n`` bits has period N = 2^n - 1 intervals of the clock Dt and takes the
 levels offset +- a. Its circular autocorrelation is a^2 at lag 0 and
 -a^2/N at every other lag (eq. 2.4.6), which is what makes the correlation
-method of :mod:`.correlation` exact over whole periods. The sequence itself
+method of :mod:`designer.identify.correlation` exact over whole periods. The sequence itself
 is :func:`scipy.signal.max_len_seq`'s.
 
 Choosing the sequence for a plant (:func:`plan_for_plant`): the power of a
@@ -13,7 +13,7 @@ f = :data:`HALF_POWER` / Dt, so the clock is chosen to put that frequency at
 :data:`BAND_FACTOR` times the plant's bandwidth; and the period N Dt must
 outlast the plant's settling time (seed 003, 2.4.5: "only a little longer than
 the settling time"), by :data:`SETTLE_MARGIN`, or the impulse response wraps
-around (:func:`.correlation.settling_check` finds it), and put
+around (:func:`designer.identify.correlation.settling_check` finds it), and put
 :data:`LINES_IN_BAND` spectral lines below the bandwidth for the spectral fit.
 
 Writers: the waveform as a bench generator's arbitrary-waveform CSV (one value

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designer.core.errors import DesignError
-from designer.identify import prbs
+from designer.core import prbs
 
 
 @pytest.mark.parametrize("bits", [3, 5, 8, 12])
