@@ -298,6 +298,14 @@ class BroadbandResult:
             d["spectral"] = self.freq_result.to_dict()
         if self.capture is not None:
             d["capture"] = self.capture.to_dict()
+        # the ranking ``best`` comes from, laid out as identify's (correlation) or
+        # identify-freq's (spectral) JSON, so design-pid --plant-model reads it
+        chosen = d.get(self.method)
+        if isinstance(chosen, dict):
+            d["methods"] = chosen["methods"]
+            for key in ("preprocessing", "error_definition", "data"):
+                if key in chosen:
+                    d[key] = chosen[key]
         return d
 
 

@@ -111,3 +111,19 @@ def test_bad_broadband_input(capture, tmp_path):
     full = capture_csv(tmp_path / "full.csv", t, u, y)
     one_line_error(run(full, "--step-time", "1"), "--step-time is for a step capture")
     one_line_error(run(full, "--method", "fourier"), "--method")
+
+
+def test_json_is_a_plant_model_for_design_pid_and_make_prbs(capture, tmp_path):
+    t, u, y, d = capture
+    path = capture_csv(tmp_path / "c.csv", t, u, y)
+    proc = run(path, "--json")
+    assert proc.returncode == 0, proc.stderr
+    models = tmp_path / "models.json"
+    models.write_text(proc.stdout)
+    from designer.pid.plant_source import model_from_json
+    m = model_from_json(models)
+    assert m.kind == "underdamped" and m.params["zeta"] == pytest.approx(0.2, rel=0.03)
+    again = subprocess.run([script("make-prbs"), "--for-plant", "--plant-model", str(models), "--no-files"],
+                           capture_output=True, text=True, timeout=60)
+    assert again.returncode == 0, again.stderr
+    assert "Plant: G(s)" in again.stdout
