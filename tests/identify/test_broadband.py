@@ -204,3 +204,10 @@ def test_spice_prbs_run_of_the_seeds_plant_recovers_fn_and_zeta(tmp_path):
     assert best.model == "underdamped"
     assert best.params["wn_rad_s"] / (2 * math.pi) == pytest.approx(fn, rel=0.01)
     assert best.params["zeta"] == pytest.approx(zeta, rel=0.01)
+
+
+def test_too_few_samples_of_noise_refused():
+    rng = np.random.default_rng(8)
+    u = rng.normal(size=400)
+    with pytest.raises(DesignError, match="at least 512"):
+        identify_broadband(np.arange(400) * TS, np.convolve(u, [0.5, 0.3, 0.2])[:400], u)
