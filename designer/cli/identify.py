@@ -166,14 +166,55 @@ def write_png(path, png: bytes, option: str = "--plot") -> None:
 
 def _run(args, identify, text, plot) -> int:
     """Either command: its result printed as JSON or as its table (and the plot written)."""
+    out = getattr(args, "out", None)
+    if out is not None:
+        check_sheet_folder(out)
     result = identify(args)
     if args.plot:
         write_png(args.plot, plot(result))
+    if out is not None:
+        write_sheet(out, result, text, plot)
     if args.json:
         print_output(json.dumps(json_safe(result.to_dict()), indent=2, allow_nan=False))
     else:
-        print_output(text(result) + (f"\n\nPlot written to {args.plot}" if args.plot else ""))
+        print_output(text(result) + (f"\n\nPlot written to {args.plot}" if args.plot else "")
+                     + (f"\n\nBuild sheet written to {out}" if out is not None else ""))
     return 0
+
+
+def check_sheet_folder(out) -> None:
+    """Refuse, before any work, an ``--out`` that is a file."""
+    if str(out) == "":
+        raise DesignError("--out needs a folder name, such as ident")
+    if Path(out).exists() and not Path(out).is_dir():
+        raise DesignError(f"--out {shown(out)} is a file, not a folder")
+
+
+def write_sheet(out, result, text, plot) -> None:
+    """The identification's build sheet in folder ``out``, all files or none:
+    ``build-sheet.md`` (the table and the figure), ``identify.png`` (for a
+    broadband capture: the impulse response, the step it integrates to, the
+    spectral estimate with its coherence, the models' fits), ``result.json``,
+    and for a broadband capture ``spectrum.csv`` (the spectral estimate as a
+    table identify-freq reads)."""
+    from ..core import fileio
+    out = Path(out)
+    files = {"identify.png": plot(result),
+             "result.json": json.dumps(json_safe(result.to_dict()), indent=2, allow_nan=False) + "\n"}
+    spectrum = getattr(result, "spectrum", None)
+    if spectrum is not None and spectrum.f.size:
+        from ..identify.spectral import table_text
+        files["spectrum.csv"] = table_text(spectrum)
+    files["build-sheet.md"] = ("# Identification\n\n![data and models](identify.png)\n\n```\n" + text(result)
+                               + "\n```\n\nFiles: " + ", ".join(f"[{n}]({n})" for n in files) + "\n")
+    stage = fileio.new_folder_beside(out)
+    try:
+        for name, data in files.items():
+            (stage / name).write_bytes(data if isinstance(data, bytes) else data.encode("utf-8"))
+    except OSError as exc:
+        fileio.remove_tree(stage)
+        raise fileio.os_error("write", out, exc) from None
+    fileio.publish_folder(stage, out)
 
 
 def _parser(prog: str, description: str, epilog: str, data_help: str, data_name: str):
@@ -255,6 +296,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--against", metavar="RESULT_JSON",
                    help="a design-plant result.json to compare fn, zeta, gain and overshoot with")
     _output_options(p, "write a PNG of the data against the best models")
+    p.add_argument("--out", metavar="DIR",
+                   help="write a build sheet folder: build-sheet.md, identify.png, result.json (and for a "
+                        "broadband capture spectrum.csv, identify-freq's table), all or none")
     return p
 
 
@@ -332,7 +376,7 @@ FREQUENCY_TABLE = "frequency-table"
 STEP_ONLY = (("step_time", "--step-time"), ("step_amplitude", "--step-amplitude"), ("window", "--window"),
              ("format", "--format"), ("input_column", "--input-column"), ("output_column", "--output-column"),
              ("methods", "--methods"), ("no_refine", "--no-refine"), ("against", "--against"),
-             ("method", "--method"))
+             ("method", "--method"), ("out", "--out"))
 
 
 def frequency_table_header(path) -> list | None:

@@ -127,3 +127,21 @@ def test_json_is_a_plant_model_for_design_pid_and_make_prbs(capture, tmp_path):
                            capture_output=True, text=True, timeout=60)
     assert again.returncode == 0, again.stderr
     assert "Plant: G(s)" in again.stdout
+
+
+def test_build_sheet_folder(capture, tmp_path):
+    t, u, y, d = capture
+    path = capture_csv(tmp_path / "c.csv", t, u, y)
+    out = tmp_path / "sheet"
+    proc = run(path, "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["build-sheet.md", "identify.png", "result.json", "spectrum.csv"]
+    assert "![data and models](identify.png)" in (out / "build-sheet.md").read_text()
+    assert json.loads((out / "result.json").read_text())["format"] == "broadband"
+    # the spectral estimate is a table identify-freq reads
+    freq = subprocess.run([script("identify-freq"), str(out / "spectrum.csv"), "--json"], capture_output=True,
+                          text=True, timeout=120)
+    assert freq.returncode == 0, freq.stderr
+    assert json.loads(freq.stdout)["best"]["params"]["zeta"] == pytest.approx(0.2, rel=0.03)
+    (tmp_path / "afile").write_text("x")
+    one_line_error(run(path, "--out", tmp_path / "afile"), "is a file, not a folder")
