@@ -211,3 +211,22 @@ def test_too_few_samples_of_noise_refused():
     u = rng.normal(size=400)
     with pytest.raises(DesignError, match="at least 512"):
         identify_broadband(np.arange(400) * TS, np.convolve(u, [0.5, 0.3, 0.2])[:400], u)
+
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+
+@given(bits=st.integers(4, 9), per_bit=st.integers(1, 12), extra=st.integers(2, 4),
+       amplitude=st.floats(1e-3, 50.0), offset=st.floats(-50.0, 50.0))
+@settings(max_examples=30, deadline=None)
+def test_any_sequence_is_recognised_with_its_clock_and_period(bits, per_bit, extra, amplitude, offset):
+    from designer.core.prbs import mls
+    n = 2 ** bits - 1
+    periods = max(extra, -(-600 // (n * per_bit)))      # 600 samples at least
+    u = offset + amplitude * np.repeat(np.tile(mls(bits).astype(float), periods), per_bit)
+    ex = examine_input(np.arange(u.size) * TS, u)
+    assert ex is not None and ex.kind == "mls"
+    assert (ex.bits, ex.samples_per_bit) == (bits, per_bit)
+    assert ex.count >= 1 and ex.start + ex.count * ex.period <= u.size
+    assert ex.offset == pytest.approx(offset, abs=1e-9 * max(1.0, abs(offset)))
