@@ -175,7 +175,7 @@ def prbs_capture(n: int = N, seed: int = 0):
     """(t, u, y) of a PRBS experiment on the seed 001 plant: 12 bits, 20
     samples an interval, sampled halfway between clock edges, 10 dB SNR."""
     import scipy.signal as sig
-    from designer.identify.prbs import mls
+    from designer.core.prbs import mls
     per_bit = 20
     ts = 1e-6
     seq = mls(12).astype(float)
