@@ -46,7 +46,8 @@ demo: setup
 	  --limit overshoot_pct=0:55 --worst-case --name plant_fc3500_z0.2 --out .
 	.venv/bin/design-pid --plant-fc 3500 --plant-zeta 0.2 --opamp LM741 --name pid_zn_lm741_fc3500_z0.2 --out .
 	.venv/bin/design-pid --plant-fc 3500 --plant-zeta 0.2 --opamp LM741 --tuning optimize --target-overshoot 10 \
-	  --monte-carlo 1000 --seed 1 --name pid_optimize_os10_lm741_fc3500_z0.2 --out .
+	  --monte-carlo 1000 --seed 1 --limit phase_margin_deg=25:90 --limit overshoot_pct=0:15 \
+	  --name pid_optimize_os10_lm741_fc3500_z0.2 --out .
 	.venv/bin/design-pid --plant-fc 3500 --plant-zeta 0.2 --opamp LM741 --kp 45 --ti 43.215u --td 10.8037u \
 	  --seed-parts --name pid_seed_kp45_lm741_fc3500_z0.2 --out .
 	.venv/bin/analyze-pid --plant-r1 805 --plant-r2 1k --plant-c1 10n --plant-c2 220n --opamp LM741 --step 2 \

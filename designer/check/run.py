@@ -1,7 +1,7 @@
 """One corner of one spec, run and judged: the design (or the analysis of the
 parts as built, or the user's deck) simulated with that corner's op-amp, its
 figures (:mod:`.figures`) held to the spec's limits, the design's own checks,
-the SPICE agreement, the tolerance band and the golden waveforms, each as a
+the SPICE agreement, the tolerance band, the Monte Carlo yield and the golden waveforms, each as a
 :class:`~designer.check.result.Case`. With an output folder (the spec's own:
 ``check-design`` stages it, and swaps it in whole when every corner is done)
 the corner's build sheet and, for every failing golden signal, a plot of gold,
@@ -42,6 +42,8 @@ def run_corner(spec: CheckSpec, index: int, simulator: str, *, update_golden: bo
         ran = _simulate(spec, index, simulator)
         figures, res, design, waves = ran
         cases, warnings, files = _judge(spec, corner, figures, res, waves, tool, update_golden, out_dir)
+        if spec.yield_spec is not None and res is not None:
+            design = res.to_dict()   # with the yield's Monte Carlo (monte_carlo)
         if out_dir is not None and res is not None:
             files.update(_write_design(spec, corner, res, out_dir))
     except SimulatorError as exc:
@@ -102,11 +104,26 @@ def _judge(spec, corner, figures, res, waves, tool, update_golden, out_dir):
                               f"tolerance_{fig}: the part-tolerance band {span} is "
                               f"{'inside' if ok else 'outside'} {lim.text()}",
                               None, lim.text()))
+    if spec.yield_spec is not None:
+        cases.append(_yield_case(spec, corner, res))
     warnings, files = [], {}
     if spec.golden is not None:
         g_cases, warnings, files = _golden_cases(spec, corner, waves, tool, update_golden, out_dir)
         cases += g_cases
     return cases, warnings, files
+
+
+def _yield_case(spec, corner, res) -> Case:
+    """The yield over the spec's checks (:func:`designer.tolerance.yields.spec_yield`); its Monte Carlo
+    goes on the result (the corner's sheet and result.json show it)."""
+    from ..tolerance.yields import spec_yield
+    y = spec.yield_spec
+    try:
+        v = spec_yield(spec.kind, res, spec.checks, y.min, y.samples, y.seed, y.tolerances, y.sampler, y.dist)
+    except DesignError as exc:   # a part the spec's tolerances name that this design has not, say
+        raise DesignError(f"{spec.name}: yield: {str(exc).replace('--tol', 'tolerances:')}") from None
+    res.monte_carlo = v.mc
+    return Case("yield", corner, PASS if v.ok else FAIL, v.message(), v.fraction, f">= {100 * y.min:g} %")
 
 
 def _num(value):

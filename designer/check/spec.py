@@ -20,7 +20,9 @@ Three kinds::
 and, for every kind: ``checks:`` (figure -> ``{min, typ, max, fail}``), and
 ``golden:``; for plant and pid: ``opamp`` (one name or a list: the corners),
 ``series``, ``bounds``, ``stimulus``, ``design_checks``, ``spice_agreement``;
-a plant also ``tolerance``. Paths (``deck``, ``golden.file``, the ``json``
+a plant also ``tolerance``; for plant and pid ``yield: {min: 95%, samples: 2000, seed: 1, engine:
+analytic}`` with ``tolerances: {R: 1%, C: 5%, C2: 2%}`` (default: the series'), the Monte Carlo
+yield over the spec's own checks (:mod:`designer.tolerance.yields`). Paths (``deck``, ``golden.file``, the ``json``
 files) are relative to the spec file and must resolve (links followed) inside
 its folder, or the ``root`` given (``--root``), unless ``allow_outside``; a
 deck and every file it includes are read and checked here
@@ -55,9 +57,9 @@ KINDS = ("plant", "pid", "netlist")
 #: the top-level keys of each kind
 TOP = {
     "plant": ("name", "kind", "description", "target", "parts", "series", "bounds", "opamp", "stimulus", "checks",
-              "design_checks", "spice_agreement", "tolerance", "golden"),
+              "design_checks", "spice_agreement", "tolerance", "tolerances", "yield", "golden"),
     "pid": ("name", "kind", "description", "plant", "tuning", "controller", "series", "bounds", "opamp", "stimulus",
-            "checks", "design_checks", "spice_agreement", "golden"),
+            "checks", "design_checks", "spice_agreement", "tolerances", "yield", "golden"),
     "netlist": ("name", "kind", "description", "deck", "checks", "golden"),
 }
 CONTROLLER_PARTS = tuple(f"R{i}" for i in range(3, 19)) + ("C3", "C4")
@@ -72,7 +74,12 @@ SUB = {
     "controller": CONTROLLER_PARTS + ("json",),
     "spice_agreement": ("nrms_max", "against"),
     "golden": ("file", "signals", "reltol", "abstol"),
+    "yield": ("min", "samples", "seed", "engine", "sampler", "dist"),
 }
+#: the parts a ``tolerances:`` may name besides the classes R and C
+TOLERANCE_PARTS = {"plant": ("R1", "R2", "C1", "C2", "R3", "R4"), "pid": ("R1", "R2", "C1", "C2") + CONTROLLER_PARTS}
+#: a yield's builds: at least, at most, and by default
+YIELD_SAMPLES = (10, 10 ** 6, 2000)
 STIMULUS = {"plant": ("amplitude", "frequency"), "pid": ("amplitude", "frequency", "edge")}
 AGAINST = ("opamp_model", "ideal")
 #: golden signals each kind records (a netlist's are the deck's vectors, named in the spec)
@@ -124,6 +131,21 @@ class Golden:
 
 
 @dataclass(frozen=True)
+class YieldSpec:
+    """``yield:`` (and ``tolerances:``): the fraction of builds that must pass the spec's checks,
+    over ``samples`` builds drawn from ``seed`` by the engine; ``tolerances`` as ``--tol`` items
+    (``R=1%``; the series' own for a part not named)."""
+
+    min: float                  #: a fraction, above 0 and at most 1
+    samples: int = YIELD_SAMPLES[2]
+    seed: int = 0
+    engine: str = "analytic"
+    sampler: str = "random"
+    dist: str = "uniform"
+    tolerances: tuple = ()
+
+
+@dataclass(frozen=True)
 class CheckSpec:
     """One spec file, valid by construction (:func:`load_spec`).
 
@@ -144,6 +166,7 @@ class CheckSpec:
     agreement: Agreement | None
     tolerance: tuple            #: figures whose tolerance band must stay inside their limits
     golden: Golden | None
+    yield_spec: YieldSpec | None = None   #: the Monte Carlo yield the checks must reach
 
     def classname(self, corner: str) -> str:
         """``lab3-plant[TL072]``: the spec and the corner (JUnit's classname)."""
@@ -290,10 +313,11 @@ def load_spec(path, update_golden: bool = False, root=None, allow_outside: bool 
     agreement = _agreement(doc)
     tolerance = _tolerance(doc, checks) if kind == "plant" else ()
     golden = _golden(doc, kind, corners, update_golden)
+    yield_spec = _yield(doc, kind, checks)
     if not (checks or design_checks or agreement or golden):
         raise doc.error((), "nothing to check: give checks:, design_checks:, spice_agreement: or golden:")
     return CheckSpec(doc.path, name, kind, corners, tuple(designs), analyze, checks, design_checks, agreement,
-                     tolerance, golden)
+                     tolerance, golden, yield_spec)
 
 
 def _corners(doc) -> tuple:
@@ -507,6 +531,86 @@ def _tolerance(doc, checks) -> tuple:
         if v not in limited:
             raise doc.error(("tolerance", i), f"tolerance: {v} needs a check on {v} (checks.{v}: its limits)")
     return tuple(dict.fromkeys(value))
+
+
+def _tolerances(doc, kind: str) -> tuple:
+    """``tolerances: {R: 1%, C: 5%, C2: 2%}`` as ``--tol`` items, each checked (a class or one of the
+    kind's parts, above 0 and at most 50 %)."""
+    from ..tolerance.parts import MAX_TOL, parse_tolerance
+    allowed = ("R", "C") + TOLERANCE_PARTS[kind]
+    value = doc.mapping(("tolerances",), allowed)
+    out = []
+    for key, tol in value.items():
+        if isinstance(tol, bool) or not isinstance(tol, (str, int, float)):
+            raise doc.error(("tolerances", key), f"tolerances.{key} must be a percentage such as 1% (above 0, at "
+                            f"most {100 * MAX_TOL:g} %), got {_kind_of(tol)}")
+        try:
+            f = parse_tolerance(str(tol), f"tolerances.{key}")
+        except DesignError as exc:
+            raise doc.error(("tolerances", key), str(exc)) from None
+        out.append(f"{key}={100 * f!r}%")
+    return tuple(out)
+
+
+def _fraction(doc, keys) -> float:
+    """``yield.min``: 95% or 0.95, above 0 and at most 100 %."""
+    value = doc.get(keys)
+    label = ".".join(keys)
+    shape = f"{label} must be a percentage above 0 and at most 100 % (such as 95% or 0.95), got {_kind_of(value)}"
+    if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+        raise doc.error(keys, shape)
+    text = str(value).strip()
+    pct = text.endswith("%")
+    try:
+        out = parse_value(text[:-1].strip() if pct else text, label)
+    except DesignError:
+        raise doc.error(keys, shape) from None
+    out = out / 100 if pct else out
+    if not 0 < out <= 1:
+        raise doc.error(keys, shape + ("" if pct or out <= 1 else f" (for {text} % write {text}%)"))
+    return float(out)
+
+
+def _whole(doc, keys, lo: int, hi: int, default: int) -> int:
+    value = doc.get(keys)
+    if value is None:
+        return default
+    label = ".".join(keys)
+    if isinstance(value, bool) or not isinstance(value, (int, str)) or not str(value).strip().isdigit() \
+            or not lo <= int(str(value).strip()) <= hi:
+        span = f"from {lo} to {hi:g}" if hi < 2 ** 32 else f">= {lo}"
+        raise doc.error(keys, f"{label} must be a whole number {span}, got {_kind_of(value)}")
+    return int(str(value).strip())
+
+
+def _yield(doc, kind: str, checks):
+    """``yield:`` with ``tolerances:`` (None without ``yield:``; ``tolerances:`` alone is refused)."""
+    from ..tolerance import sampling, yields
+    from ..tolerance.parts import DISTRIBUTIONS
+    if doc.data.get("yield") is None:
+        if doc.data.get("tolerances") is not None:
+            raise doc.error(("tolerances",), "tolerances: set the parts' spread of a yield: give yield: {min: "
+                            "95%} too (the tolerance: band uses the series' tolerances)")
+        return None
+    y = doc.mapping(("yield",), SUB["yield"])
+    if "min" not in y:
+        raise doc.error(("yield",), "yield needs min: the fraction of builds that must pass (such as 95%)")
+    engine = y.get("engine", "analytic")
+    if engine == "spice":
+        raise doc.error(("yield", "engine"), "yield.engine spice is not available yet (the SPICE Monte Carlo comes "
+                        "later); allowed: analytic")
+    for key, allowed in (("engine", yields.ENGINES), ("sampler", sampling.SAMPLERS), ("dist", DISTRIBUTIONS)):
+        if key in y and y[key] not in allowed:
+            raise doc.error(("yield", key), f"yield.{key} {_kind_of(y[key])} unknown; allowed: {', '.join(allowed)}")
+    use, skipped = yields.counted(kind, checks)
+    if not use:
+        known = ", ".join(yields.BY_KIND[kind])
+        raise doc.error(("yield",), "yield counts the builds inside checks:, and none of them limits a figure the "
+                        f"analytic engine computes ({known})" + (f"; not: {', '.join(skipped)}" if skipped else ""))
+    lo, hi, default = YIELD_SAMPLES
+    return YieldSpec(_fraction(doc, ("yield", "min")), _whole(doc, ("yield", "samples"), lo, hi, default),
+                     _whole(doc, ("yield", "seed"), 0, 2 ** 63 - 1, 0), engine, y.get("sampler", "random"),
+                     y.get("dist", "uniform"), _tolerances(doc, kind))
 
 
 def _golden(doc, kind: str, corners, update: bool):

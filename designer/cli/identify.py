@@ -84,6 +84,18 @@ limits: a capture of at most {size} and {rows:,} samples; every time (and
 --step-time, --window) {t_rng} and the record {span_rng} long; every sample {v_rng}
 (file units); the output's step {step_rng} in size.
 
+broadband input (seed 003 sections 2.4 and 3.2): an input column that is a
+pseudo-random binary sequence (make-prbs writes one) or noise - many
+transitions at irregular intervals, no dominant frequency - is recognised and
+identified by correlation (the impulse response over whole periods, eq.
+2.4.19, and the step methods on its running integral) and by spectral analysis
+(H = S_yu/S_uu with coherence, analysed as identify-freq does). A sequence
+needs two whole periods at least (the first settles the plant) and a clock
+that is a whole number of sample intervals; a period shorter than the plant's
+settling is said so, with the bits or clock that would be enough.
+--method correlation|spectral keeps one; --step-time, --step-amplitude and
+--against are for steps.
+
 exit status: 0 success, 2 bad input (one line on stderr saying what and why).
 """
 
@@ -154,14 +166,55 @@ def write_png(path, png: bytes, option: str = "--plot") -> None:
 
 def _run(args, identify, text, plot) -> int:
     """Either command: its result printed as JSON or as its table (and the plot written)."""
+    out = getattr(args, "out", None)
+    if out is not None:
+        check_sheet_folder(out)
     result = identify(args)
     if args.plot:
         write_png(args.plot, plot(result))
+    if out is not None:
+        write_sheet(out, result, text, plot)
     if args.json:
         print_output(json.dumps(json_safe(result.to_dict()), indent=2, allow_nan=False))
     else:
-        print_output(text(result) + (f"\n\nPlot written to {args.plot}" if args.plot else ""))
+        print_output(text(result) + (f"\n\nPlot written to {args.plot}" if args.plot else "")
+                     + (f"\n\nBuild sheet written to {out}" if out is not None else ""))
     return 0
+
+
+def check_sheet_folder(out) -> None:
+    """Refuse, before any work, an ``--out`` that is a file."""
+    if str(out) == "":
+        raise DesignError("--out needs a folder name, such as ident")
+    if Path(out).exists() and not Path(out).is_dir():
+        raise DesignError(f"--out {shown(out)} is a file, not a folder")
+
+
+def write_sheet(out, result, text, plot) -> None:
+    """The identification's build sheet in folder ``out``, all files or none:
+    ``build-sheet.md`` (the table and the figure), ``identify.png`` (for a
+    broadband capture: the impulse response, the step it integrates to, the
+    spectral estimate with its coherence, the models' fits), ``result.json``,
+    and for a broadband capture ``spectrum.csv`` (the spectral estimate as a
+    table identify-freq reads)."""
+    from ..core import fileio
+    out = Path(out)
+    files = {"identify.png": plot(result),
+             "result.json": json.dumps(json_safe(result.to_dict()), indent=2, allow_nan=False) + "\n"}
+    spectrum = getattr(result, "spectrum", None)
+    if spectrum is not None and spectrum.f.size:
+        from ..identify.spectral import table_text
+        files["spectrum.csv"] = table_text(spectrum)
+    files["build-sheet.md"] = ("# Identification\n\n![data and models](identify.png)\n\n```\n" + text(result)
+                               + "\n```\n\nFiles: " + ", ".join(f"[{n}]({n})" for n in files) + "\n")
+    stage = fileio.new_folder_beside(out)
+    try:
+        for name, data in files.items():
+            (stage / name).write_bytes(data if isinstance(data, bytes) else data.encode("utf-8"))
+    except OSError as exc:
+        fileio.remove_tree(stage)
+        raise fileio.os_error("write", out, exc) from None
+    fileio.publish_folder(stage, out)
 
 
 def _parser(prog: str, description: str, epilog: str, data_help: str, data_name: str):
@@ -237,9 +290,15 @@ def build_parser() -> argparse.ArgumentParser:
                    help="only these methods (space or comma separated), e.g. smith alfaro "
                         "least-squares")
     p.add_argument("--no-refine", action="store_true", help="skip the least-squares fits")
+    p.add_argument("--method", choices=("correlation", "spectral"), type=_lower,
+                   help="broadband input (PRBS or noise) only: the models of this estimate alone "
+                        "(default: both; the best from the spectral fit when it has a valid one)")
     p.add_argument("--against", metavar="RESULT_JSON",
                    help="a design-plant result.json to compare fn, zeta, gain and overshoot with")
     _output_options(p, "write a PNG of the data against the best models")
+    p.add_argument("--out", metavar="DIR",
+                   help="write a build sheet folder: build-sheet.md, identify.png, result.json (and for a "
+                        "broadband capture spectrum.csv, identify-freq's table), all or none")
     return p
 
 
@@ -260,6 +319,9 @@ def identify_capture(args):
     # The file is read before scipy is imported, so bad input fails fast.
     cap = read_capture(args.capture, input_column=args.input_column,
                        output_column=args.output_column, fmt=args.format)
+    broadband = identify_broadband_capture(args, cap, window)
+    if broadband is not None:
+        return broadband
     from ..identify.against import compare_with_design, load_design
     from ..identify.step import identify_step
     design = load_design(args.against) if args.against else None
@@ -271,7 +333,41 @@ def identify_capture(args):
                            capture=cap.info(), window=window)
     if design is not None:
         result.comparison = compare_with_design(result, design)
+    if getattr(args, "method", None):
+        result.step.notes.append(f"--method {args.method} ignored: the input is not broadband "
+                                 "(a step or square wave), identified by the step methods")
     return result
+
+
+#: identify's options a broadband capture does not take: (argparse dest, its flag)
+STEP_EDGE_ONLY = (("step_time", "--step-time"), ("step_amplitude", "--step-amplitude"),
+                  ("against", "--against"))
+
+
+def identify_broadband_capture(args, cap, window):
+    """``identify`` on a capture whose input is broadband (a PRBS or noise:
+    :func:`~designer.identify.broadband.examine_input`): the
+    :class:`~designer.identify.broadband.BroadbandResult`; None for any other
+    capture (the step methods' own)."""
+    from ..identify.broadband import check_method, examine_input, identify_broadband
+    method = check_method(getattr(args, "method", None))
+    if cap.u is None:
+        return None
+    t, u, y = cap.t, cap.u, cap.y
+    if window is not None:
+        keep = (t >= window[0]) & (t <= window[1])
+        t, u, y = t[keep], u[keep], y[keep]
+    name = shown(args.capture)
+    ex = examine_input(t, u, name=name)
+    if ex is None:
+        return None
+    given = [flag for dest, flag in STEP_EDGE_ONLY if getattr(args, dest, None) is not None]
+    if given:
+        raise DesignError(f"{', '.join(given)} {'is' if len(given) == 1 else 'are'} for a step capture; "
+                          f"the input of {name} is broadband ({ex.kind}): drop "
+                          f"{'it' if len(given) == 1 else 'them'}")
+    return identify_broadband(t, y, u, excitation=ex, method=method, refine=not args.no_refine,
+                              methods=args.methods, capture=cap.info(), name=name)
 
 
 #: what ``identify`` says (``format`` in its JSON) of a frequency-response table it was given
@@ -279,7 +375,8 @@ FREQUENCY_TABLE = "frequency-table"
 #: identify's options that only a step capture has: (argparse dest, its flag)
 STEP_ONLY = (("step_time", "--step-time"), ("step_amplitude", "--step-amplitude"), ("window", "--window"),
              ("format", "--format"), ("input_column", "--input-column"), ("output_column", "--output-column"),
-             ("methods", "--methods"), ("no_refine", "--no-refine"), ("against", "--against"))
+             ("methods", "--methods"), ("no_refine", "--no-refine"), ("against", "--against"),
+             ("method", "--method"), ("out", "--out"))
 
 
 def frequency_table_header(path) -> list | None:
@@ -349,10 +446,15 @@ def identify_run(args) -> int:
     """``identify``'s action: a frequency-response table (:func:`frequency_table_header`)
     analysed and printed as ``identify-freq`` does, saying so (a first line, and
     ``"format": "frequency-table"`` in the JSON); anything else through the step methods."""
-    from ..identify.report import bode_fit_plot, fit_plot, freq_text, step_text
+    from ..identify.report import bode_fit_plot, broadband_plot, broadband_text, fit_plot, freq_text, step_text
     header = frequency_table_header(args.capture)
     if header is None:
-        return _run(args, identify_capture, step_text, fit_plot)
+        def text(r):
+            return broadband_text(r) if hasattr(r, "excitation") else step_text(r)
+
+        def plot(r):
+            return broadband_plot(r) if hasattr(r, "excitation") else fit_plot(r)
+        return _run(args, identify_capture, text, plot)
     result = identify_frequency_table(args, header)
     if args.plot:
         write_png(args.plot, bode_fit_plot(result))

@@ -80,3 +80,7 @@ def identify_freq() -> int:
 
 def simulate_capture() -> int:
     return _run("simulate-capture", "designer.cli.capture", "simulate_capture_main")
+
+
+def make_prbs() -> int:
+    return _run("make-prbs", "designer.cli.prbs", "make_prbs_main")

@@ -95,29 +95,41 @@ def _parser():
     return p
 
 
+#: the controller's parts a --tol may name
+CONTROLLER_PARTS = (*(f"R{i}" for i in range(3, 19)), "C3", "C4")
 #: the loop's parts a --tol may name: the plant's and the controller's
-LOOP_PARTS = ("R1", "R2", "C1", "C2", *(f"R{i}" for i in range(3, 19)), "C3", "C4")
+LOOP_PARTS = ("R1", "R2", "C1", "C2", *CONTROLLER_PARTS)
 
 
 def _add_monte_carlo(p):
+    from ..tolerance.loop import LIMITABLE
     from .plant import add_monte_carlo_options
-    add_monte_carlo_options(p, "the probability that the loop is unstable or an op-amp leaves its swing, with "
-                               "95 %% intervals, and the spread of its margins and step figures (a Sallen-Key plant; "
-                               "its parts and the controller's vary together)")
+    g = add_monte_carlo_options(p, "the probability that the loop is unstable or an op-amp leaves its swing, with "
+                                   "95 %% intervals, the spread of its gains, margins and step figures, the yield "
+                                   "within --limit and the part to buy tighter (a Sallen-Key plant; its parts and "
+                                   "the controller's vary together)")
+    g.add_argument("--limit", action="append", metavar="FIGURE=MIN:MAX",
+                   help="the window the yield counts (repeatable, both bounds, engineering notation): "
+                        "phase_margin_deg=45:90, model_overshoot_pct=0:15; a build counts when its loop is stable "
+                        "and inside every window; figures (check-design's names) " + ", ".join(LIMITABLE)
+                        + " (overshoot_pct, peak_time_s, rise_time_s, settling_time_s: the analytic loop's stand in)")
+    g.add_argument("--worst-case", action="store_true",
+                   help="the extremes of phase_margin_deg, gain_margin_db, model_overshoot_pct (and every --limit "
+                        "figure) over the tolerance box: each part alone at +-tol, the corners its slopes point to, "
+                        "then a bounded search (22 parts: 4 million corners are too many); adds worst_case to "
+                        "result.json (about a minute)")
 
 
 def _loop_monte_carlo(result, args, settings):
-    """The loop's tolerance analysis, attached to the result (None settings: none)."""
+    """The loop's tolerance analysis (--monte-carlo, --worst-case), attached to the result."""
+    from ..tolerance.loop import loop_monte_carlo, loop_series, loop_worst_case
+    if args.worst_case:
+        result.worst_case = loop_worst_case(result, loop_series(result), args.tol or (), args.limit or ())
     if settings is None:
         return result
-    from ..tolerance.loop import loop_monte_carlo
     n, seed = settings
-    sel = result.selection
-    # the plant's parts take the plant's series when designed here, else the controller's
-    r, c = (sel.r_series, sel.c_series) if sel is not None else (None, None)
-    if result.plant_series is not None:
-        r, c = r or result.plant_series[0], c or result.plant_series[1]
-    result.monte_carlo = loop_monte_carlo(result, {"R": r, "C": c}, n, seed, args.sampler, args.dist, args.tol or ())
+    result.monte_carlo = loop_monte_carlo(result, loop_series(result), n, seed, args.sampler, args.dist,
+                                          args.tol or (), args.limit or ())
     return result
 
 
@@ -284,10 +296,10 @@ def _model_name(spec, method: str) -> str:
 
 
 def _monte_carlo_settings(args, spec):
+    from ..tolerance.loop import parse_loop_limit
     from .plant import monte_carlo_settings
-    settings = monte_carlo_settings(args, LOOP_PARTS)
-    if settings is not None and spec.process is not None:
-        raise DesignError("--monte-carlo analyses a Sallen-Key plant's loop for now, not a plant given as a model")
+    # a model plant's parameters stay as identified: only the controller's parts vary
+    settings = monte_carlo_settings(args, LOOP_PARTS if spec.process is None else CONTROLLER_PARTS, parse_loop_limit)
     if any(str(t).strip().upper().startswith("GBW") for t in args.tol or ()):
         raise DesignError("--tol GBW spreads a plant's op-amp (design-plant); a loop's op-amps do not vary yet")
     return settings
@@ -301,8 +313,13 @@ def _run(args) -> int:
     if spec.process is not None:
         from ..pid.process_report import summary_text as model_text, write_outputs as model_write
         common.check_output(args, args.name if args.name is not None else "pid_model")
-        result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator, rules_spice=args.rules_spice)
-        return emit(result, args, args.name or _model_name(spec, result.method), model_write, model_text)
+        from ..pid.process_report import draw_early
+        early = []   # the pictures that need no SPICE, drawn in the renderer while ngspice runs
+        result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator, rules_spice=args.rules_spice,
+                            before_spice=None if args.no_files else lambda r: early.append(draw_early(r)))
+        result = _loop_monte_carlo(result, args, mc)
+        return emit(result, args, args.name or _model_name(spec, result.method),
+                    lambda *a: model_write(*a, early=early[0] if early else None), model_text)
     # the default name needs the plant as built; its fixed start stands in for it in the check
     common.check_output(args, args.name if args.name is not None else f"pid_{spec.method}")
     result = _loop_monte_carlo(design_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
@@ -381,7 +398,7 @@ def _analyze(args) -> int:
     if spec.process is not None:
         from ..pid.process_report import summary_text as model_text, write_outputs as model_write
         common.check_output(args, args.name if args.name is not None else "pid_as-built")
-        result = analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator)
+        result = _loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
         return emit(result, args, args.name or _model_name(spec, result.method), model_write, model_text)
     common.check_output(args, args.name if args.name is not None else "pid_as-built")
     result = _loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)

@@ -127,6 +127,11 @@ RANGES = {
     "gain_db": Range(-400.0, 400.0, "dB"),
     "gain_ratio": Range(1e-20, 1e20),
     "phase_deg": Range(-1e5, 1e5),   # degrees
+    # make-prbs: the sequence's clock (--clock, or 1/--dt), levels and periods
+    "prbs_clock_hz": Range(1e-6, 1e9, "Hz"),
+    "prbs_amplitude_v": Range(1e-6, 100.0, "V"),
+    "prbs_offset_v": Range(-100.0, 100.0, "V"),
+    "prbs_periods": Range(1, 1000),
 }
 
 

@@ -137,3 +137,22 @@ def value_code(value: float) -> str:
         whole, frac = text.split(".")
         return f"{whole}{prefix or 'R'}{frac}"
     return f"{text}{prefix}"
+
+
+#: a figure's unit from its name's suffix (the figures of designer.check.figures and the tolerance engines)
+_SUFFIX_UNITS = (("_hz", "Hz"), ("_s", "s"), ("_pct", "%"), ("_deg", "deg"), ("_db", "dB"))
+
+
+def figure_unit(name: str) -> str:
+    """``fn_hz`` -> Hz, ``peak_time_s`` -> s, ``overshoot_pct`` -> %, ``phase_margin_deg`` -> deg,
+    ``gain_margin_db`` -> dB; a figure without a unit (``zeta``, ``kp``) -> ""."""
+    return next((u for s, u in _SUFFIX_UNITS if name.endswith(s)), "")
+
+
+def format_figure(name: str, value: float, digits: int = 4) -> str:
+    """A figure's value with its unit: engineering notation for Hz and s (``3.3 kHz``), else the number
+    and the unit (``25 deg``, ``15 %``, ``0.2``)."""
+    unit = figure_unit(name)
+    if unit in ("Hz", "s"):
+        return format_eng(value, unit, digits)
+    return f"{value:.{digits}g}" + (f" {unit}" if unit else "")

@@ -4,6 +4,10 @@
 into a normalised step; ``first_order``, ``second_order`` and ``refine``
 (least squares) are the step methods on the shared ``structures``;
 ``step`` runs and ranks them, ``frequency`` does the same for a Bode table;
+``correlation`` and ``spectral`` estimate the impulse and frequency
+responses from a broadband input (a PRBS, :mod:`designer.core.prbs`, or
+noise: seed 003, 2.4 and 3.2) and ``broadband`` recognises such an input and
+runs both, with the step and frequency methods on their results;
 ``against`` compares an identified plant with its design (the one use of the
 plant wing) and ``report`` prints and plots the results. The waveform
 readings they share (noise, crossings, derivative, tangent) are

@@ -1,6 +1,6 @@
 """Identification from a measured frequency response (seed 000 section 5, seed 003 section 3.1).
 
-Input is a validated table, :class:`~designer.identify.io.FreqData` (read
+Input is a validated table, :class:`~designer.identify.io.freqtable.FreqData` (read
 by :func:`designer.identify.io.read_freq_table`).
 
 Methods (all return :class:`~designer.identify.structures.MethodResult`):
@@ -78,6 +78,9 @@ BAND_FACTOR = 10.0
 #: this factor (far wider than BAND_FACTOR, so a fit that runs out of the band
 #: is seen and flagged, yet every exp() of a log-parameter stays finite).
 FIT_BAND = 1e3
+
+#: a fitted dead time below this is none (core.process refuses 0 < theta < 1 ps)
+MIN_DEAD_TIME_S = 1e-12
 
 PARAMS = {
     "fopdt": ("K", "tau_s", "theta_s"),
@@ -423,6 +426,10 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     if best is None:
         return _invalid(name, model, "the fit did not converge from any starting point")
     params = _x_to_params(model, best.x, fit_delay)
+    if params["theta_s"] < MIN_DEAD_TIME_S:
+        # the bound at 0 reached in floating point (1e-25 s): no dead time, which
+        # a model's consumers accept, where they refuse one below 1 ps
+        params["theta_s"] = 0.0
     pts = {}
     m, n = best.fun.size, best.x.size
     note = ("" if fit_delay else

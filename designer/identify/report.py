@@ -217,3 +217,84 @@ def bode_fit_plot(result, n_models: int = 3) -> bytes:
     axes[-1][0].set_xlabel("frequency (Hz)")
     fig.tight_layout()
     return png_bytes(fig)
+
+
+# --------------------------------------------------------------------------- broadband
+
+def broadband_text(result) -> str:
+    """The ``identify`` text of a :class:`~.broadband.BroadbandResult`: the
+    excitation, the impulse estimate, then the correlation's step methods and
+    the spectral estimate's frequency methods, each table as it is for a step
+    or a frequency table."""
+    ex, cap = result.excitation, result.capture
+    lines = []
+    if cap is not None:
+        lines.append(f"Capture: {cap.source} ({cap.fmt}, {cap.samples} samples, output "
+                     f"{cap.output_name!r}" + (f", input {cap.input_name!r}" if cap.input_name else "")
+                     + ")")
+    lines.append(f"Broadband input: {ex.text()}")
+    for n in (list(cap.notes) if cap is not None else []) + list(result.notes):
+        lines.append(f"  note: {n}")
+    est = result.impulse
+    if est is not None:
+        k = int(np.argmax(np.abs(est.h)))
+        lines.append(f"Impulse response (correlation, seed 003 eq. 2.4.19): peak {est.h[k]:.4g} /s "
+                     f"at {format_eng(est.t[k], 's')}, step response's final value "
+                     f"(static gain) {est.step[-1]:.4g}, settling (2 %) "
+                     f"{format_eng(est.settling_s, 's')}, period {format_eng(est.period_s, 's')}"
+                     + (" - WRAPPED AROUND" if est.wrapped else ""))
+    if result.step_result is not None:
+        lines += ["", "== correlation: step methods on the integrated impulse response =="]
+        lines += step_text(result.step_result).splitlines()[2:]
+    if result.freq_result is not None:
+        sp = result.spectrum
+        lines += ["", f"== spectral: H = S_yu/S_uu ({sp.how}), coherence "
+                      f"{sp.coh.min():.2f} .. {sp.coh.max():.2f} ==",
+                  freq_text(result.freq_result)]
+    best = result.best
+    lines += ["", f"Best ({result.method}): " + (f"{best.name} ({best.model}): "
+                                                 f"{format_params(best.params, True)}"
+                                                 if best else "none valid")]
+    return "\n".join(lines)
+
+
+def broadband_plot(result, n_models: int = 3) -> bytes:
+    """PNG of a broadband identification: the impulse response, the step it
+    integrates to with the best step models, the spectral estimate (gain and
+    phase) with the best frequency models, and its coherence."""
+    from .frequency import model_response
+    from .structures import model_step
+    plt = _pyplot()
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7), dpi=100)
+    (ax_h, ax_s), (ax_g, ax_c) = axes
+    est = result.impulse
+    if est is not None:
+        ax_h.plot(est.t, est.h, color="k", lw=1)
+        ax_s.plot(est.t, est.step, color="k", lw=2.2, alpha=0.35, label="integrated h")
+        if result.step_result is not None:
+            for m in [m for m in result.step_result.methods if m.valid][:n_models]:
+                ax_s.plot(est.t, model_step(m.model, m.params, est.t), lw=1.1,
+                          label=f"{m.name} ({m.model})")
+    ax_h.set_title("Impulse response (cross-correlation)")
+    ax_h.set_xlabel("time (s)")
+    ax_s.set_title("Step response: its running integral, and step models")
+    ax_s.set_xlabel("time (s)")
+    ax_s.legend(fontsize=7)
+    sp = result.spectrum
+    if sp is not None and sp.f.size:
+        ax_g.semilogx(sp.f, 20 * np.log10(np.abs(sp.h)), "o", ms=3, color="k", label="S_yu/S_uu")
+        ax_c.semilogx(sp.f, sp.coh, ".-", color="k")
+        if result.freq_result is not None:
+            for m in [m for m in result.freq_result.methods if m.valid][:n_models]:
+                g = model_response(m.model, m.params, 2 * math.pi * sp.f)
+                ax_g.semilogx(sp.f, 20 * np.log10(np.abs(g)), lw=1.1, label=f"{m.name} ({m.model})")
+    ax_g.set_title("Spectral estimate: gain (dB)")
+    ax_g.set_xlabel("frequency (Hz)")
+    ax_g.legend(fontsize=7)
+    ax_c.set_title("Coherence")
+    ax_c.set_ylim(0, 1.05)
+    ax_c.set_xlabel("frequency (Hz)")
+    for a in axes.flat:
+        a.grid(True, alpha=0.3)
+    fig.tight_layout()
+    return png_bytes(fig)

@@ -23,8 +23,10 @@ import numpy as np
 
 from ..core.units import format_eng
 from ..report import document as R
-from ..report.bundle import write_design
+from ..report.bundle import draw_early as bundle_early, write_design
 from ..report.plots import decimate, figure, png_bytes
+from ..report.tolerance import csv_texts, histogram_plots
+from ..report.tolerance import section as tolerance_section
 from ..report.wiring import bom_csv, bom_rows, net_text
 from ..spice.deck import board
 from .netlist import NET_LABELS, controller_netlist
@@ -98,6 +100,8 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     out.append(("Checks", [R.table(["check", "result", "detail"],
                                    [[c.id, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]))
     out.append(("Closed loop", _loop_blocks(result, with_images)))
+    if result.monte_carlo is not None:
+        out.append(("Tolerance analysis (Monte Carlo)", tolerance_section(result, with_images)))
     out.append(("Expected scope readings", _scope(result, with_images, b)))
     return out
 
@@ -275,7 +279,11 @@ def _scope(result, with_images, b) -> list:
 
 
 def summary_text(result) -> str:
-    return R.to_text(title_of(result), sections(result, with_images=False))
+    text = R.to_text(title_of(result), sections(result, with_images=False))
+    for extra in (result.monte_carlo, result.worst_case):
+        if extra is not None:
+            text += "\n" + "\n".join(extra.summary_lines()) + "\n"
+    return text
 
 
 # ---- plots -------------------------------------------------------------------
@@ -328,9 +336,20 @@ PLOTS = (("closed-loop.png", _closed_loop), ("blocks.png", _blocks_plot),
          ("loop-bode.png", _loop_gain_plot), ("reaction-curve.png", _model_step_plot))
 
 
-def write_outputs(result, out_dir, name: str) -> dict:
+#: the plots that read nothing of the SPICE run: drawn during it (:func:`draw_early`)
+BEFORE_SPICE = ("loop-bode.png", "reaction-curve.png")
+
+
+def draw_early(result):
+    """Start drawing the schematic and :data:`BEFORE_SPICE` (``before_spice`` of
+    :func:`~designer.pid.process_loop.design_model_pid`); give it to :func:`write_outputs`."""
+    return bundle_early(result, PLOTS, schematic, BEFORE_SPICE)
+
+
+def write_outputs(result, out_dir, name: str, early=None) -> dict:
     """``netlists/<name>.cir`` and ``reports/<name>/`` (build sheet, result.json,
-    plots, schematic, bom.csv) under ``out_dir``, each written atomically."""
-    return write_design(result, out_dir, name, PLOTS, schematic,
+    plots, schematic, bom.csv, and the Monte Carlo's files) under ``out_dir``, each written
+    atomically; the pictures ``early`` (:func:`draw_early`) started are not drawn again."""
+    return write_design(result, out_dir, name, PLOTS + histogram_plots(result), schematic,
                         lambda svg: sections(result, schematic_svg=svg), title_of(result),
-                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r)))})
+                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))), **csv_texts(result)}, early)

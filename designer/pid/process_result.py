@@ -153,6 +153,10 @@ class ProcessPidResult(LoopVerdicts):
     spice: object = None
     verdict: object = None
     scope: object = None                #: designer.plant.bench.ScopeSetup of the bench test (CH2 per node)
+    #: the controller's tolerance analysis around the model (designer.tolerance.loop.LoopMonteCarlo), when asked for
+    monte_carlo: object = None
+    #: the loop's worst case over the controller's tolerance box (designer.tolerance.worstcase.WorstCase)
+    worst_case: object = None
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
@@ -189,6 +193,8 @@ class ProcessPidResult(LoopVerdicts):
             "notes": self.notes,
             "simulator": self.simulator,
             "scope": None if self.scope is None else self.scope.to_dict(),
+            "monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
+            "worst_case": None if self.worst_case is None else self.worst_case.to_dict(),
             "files": self.files,
         }
         return json_safe(out)

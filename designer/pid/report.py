@@ -18,6 +18,8 @@ from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import write_design
 from ..report.plots import decimate, figure, loop_gain_plot, png_bytes, step_plot, time_unit
+from ..report.tolerance import csv_texts, histogram_plots
+from ..report.tolerance import section as tolerance_section
 from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
 from .model import OPAMP_OUTPUTS
@@ -109,6 +111,8 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     out.append(("Checks", [R.table(["check", "result", "detail"],
                                    [[c.id, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]))
     out.append(("Closed loop", _loop_blocks(result, with_images)))
+    if result.monte_carlo is not None:
+        out.append(("Tolerance analysis (Monte Carlo)", tolerance_section(result, with_images)))
     out.append(("Expected scope readings", _scope_blocks(result, with_images, b)))
     return out
 
@@ -370,8 +374,9 @@ def _fmt(v, unit, signed=False):
 
 def summary_text(result) -> str:
     text = R.to_text(title_of(result), sections(result, with_images=False))
-    if result.monte_carlo is not None:
-        text += "\n" + "\n".join(result.monte_carlo.summary_lines()) + "\n"
+    for extra in (result.monte_carlo, result.worst_case):
+        if extra is not None:
+            text += "\n" + "\n".join(extra.summary_lines()) + "\n"
     return text
 
 
@@ -472,8 +477,6 @@ PLOTS = (("closed-loop.png", _closed_loop_plot), ("blocks.png", _blocks_plot),
 def write_outputs(result, out_dir, name: str) -> dict:
     """``netlists/<name>.cir`` and ``reports/<name>/`` (build sheet, result.json,
     plots, schematic, bom.csv) under ``out_dir``, each written atomically."""
-    return write_design(result, out_dir, name, PLOTS, schematic,
+    return write_design(result, out_dir, name, PLOTS + histogram_plots(result), schematic,
                         lambda svg: sections(result, schematic_svg=svg), title_of(result),
-                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))),
-                         **({"monte_carlo_csv": ("monte-carlo.csv", lambda r: r.monte_carlo.csv_text())}
-                            if result.monte_carlo is not None else {})})
+                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))), **csv_texts(result)})

@@ -168,6 +168,8 @@ class PidResult(LoopVerdicts):
     package: str | None = None          #: op-amp package kind the sheet wires (None: the op-amp's default)
     #: a tolerance analysis of the loop (designer.tolerance.loop.LoopMonteCarlo), when asked for
     monte_carlo: object = None
+    #: the loop's worst case over the tolerance box (designer.tolerance.worstcase.WorstCase), when asked for
+    worst_case: object = None
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
@@ -201,6 +203,7 @@ class PidResult(LoopVerdicts):
             "difference_amplifier": None if self.diff_amp is None else self.diff_amp.to_dict(),
             "seed_bench": None if self.seed_bench is None else self.seed_bench.to_dict(),
             "monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
+            "worst_case": None if self.worst_case is None else self.worst_case.to_dict(),
             "files": self.files,
         }
         return json_safe(out)

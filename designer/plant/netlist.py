@@ -90,3 +90,26 @@ def plant_ac_deck(parts: SallenKeyParts, opamp: OpAmp, f_lo: float, f_hi: float,
     circuit.V("in", "input", circuit.gnd, "DC 0 AC 1")
     plant_netlist(parts).add_to(circuit, opamp)
     return "\n".join([str(circuit).rstrip(), *ac_lines(f_lo, f_hi), ".end"]) + "\n"
+
+
+def plant_prbs_deck(parts: SallenKeyParts, opamp: OpAmp, plan, title: str, samples_per_interval: int = 10) -> str:
+    """The Sallen-Key plant driven by the pseudo-random binary sequence of
+    ``plan`` (a :class:`~designer.core.prbs.PrbsPlan`, as ``make-prbs``
+    writes it: its ngspice PWL subcircuit on the input), every period of it,
+    the maximum time step a ``samples_per_interval``-th of the clock interval
+    (and at most 1/100 of 1/wn): the prediction a bench capture of the plant
+    under that sequence is compared with, and what ``identify`` reads."""
+    import math
+
+    from ..core.prbs import pwl_subcircuit
+    from .sallenkey import fn_zeta
+    fn, _ = fn_zeta(parts.r1, parts.r2, parts.c1, parts.c2, parts.gain)
+    step = min(plan.dt_s / samples_per_interval, 1.0 / (2 * math.pi * fn) / 100)
+    circuit = _circuit(title, opamp, [
+        f"* op-amp: {opamp.name} ({opamp.description}); supplies {opamp.vcc:g} V / {opamp.vee:g} V",
+        f"* stimulus: PRBS of {plan.bits} bits (N = {plan.n}), clock {plan.clock_hz:.6g} Hz, "
+        f"{plan.periods} period(s), levels {plan.offset - plan.amplitude:.6g} V and {plan.offset + plan.amplitude:.6g} V",
+        pwl_subcircuit(plan).rstrip(), "Xgen input prbs_source"])
+    plant_netlist(parts).add_to(circuit, opamp)
+    stop = plan.periods * plan.period_s
+    return "\n".join([str(circuit).rstrip(), f".tran {step:.6g} {stop:.6g} 0 {step:.6g}", ".end"]) + "\n"

@@ -19,6 +19,8 @@ from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import write_design
 from ..report.plots import bode_plot, step_plot
+from ..report.tolerance import csv_texts, histogram_plots
+from ..report.tolerance import section as tolerance_section
 from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
 from .netlist import SEED_NAMES, plant_netlist
@@ -64,6 +66,8 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     if with_images:
         out.append(("Plots", [R.columns([R.image("step.png", "step response: analytic and SPICE, residual")],
                                         [R.image("bode.png", "Bode plot with the sine check's points")])]))
+    if result.monte_carlo is not None:
+        out.append(("Tolerance analysis (Monte Carlo)", tolerance_section(result, with_images)))
     out.append(("Sensitivity", _sensitivity(result)))
     if result.alternatives:
         out.append(("Alternatives (best first)", [_alternatives(result.alternatives)]))
@@ -286,7 +290,6 @@ def write_outputs(result, out_dir, name: str) -> dict:
     recorded in ``result.files`` before result.json is written, so it lists itself.
     """
     texts = {"waveforms_csv": ("waveforms.csv", waveforms_csv), "bom_csv": ("bom.csv", lambda r: bom_csv(bom(r)))}
-    if result.monte_carlo is not None:   # one row per sample: every varied part and every figure
-        texts["monte_carlo_csv"] = ("monte-carlo.csv", lambda r: r.monte_carlo.csv_text())
-    return write_design(result, out_dir, name, PLOTS, schematic,
+    texts.update(csv_texts(result))   # monte-carlo.csv: one row per sample, every varied part and figure
+    return write_design(result, out_dir, name, PLOTS + histogram_plots(result), schematic,
                         lambda svg: sections(result, schematic_svg=svg), title_of(result), texts)

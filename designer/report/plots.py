@@ -187,3 +187,43 @@ def loop_gain_plot(f, L, title: str, crossover_hz: float, phase_margin_deg: floa
     for ax in (a1, a2):
         ax.grid(True, which="both", alpha=0.3)
     return png_bytes(fig, dpi=100, tight=False)
+
+
+def histogram_plot(values, name: str, nominal: float | None = None, lo: float | None = None,
+                   hi: float | None = None, title: str = "", bins: int = 60) -> bytes:
+    """A histogram of a figure over Monte Carlo samples (NaN left out), the limits ``lo``/``hi``
+    drawn as red lines with the region outside shaded, the nominal design as a dashed line."""
+    from matplotlib.ticker import FuncFormatter
+
+    from ..core.units import figure_unit, format_eng, value_code
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    unit = figure_unit(name)
+    fig, ax = figure(7.5, 3.0)
+    fig.subplots_adjust(bottom=0.16, top=0.9)
+    if v.size:
+        k = int(np.clip(2 * math.sqrt(v.size), 10, bins)) if np.ptp(v) > 0 else 1
+        ax.hist(v, bins=k, color="#6b8fc7", edgecolor="white", lw=0.3)
+    shown = [x for x in (nominal, lo, hi) if x is not None and math.isfinite(x)] + ([v.min(), v.max()] if v.size else [])
+    if shown:
+        a, b = min(shown), max(shown)
+        pad = 0.05 * (b - a) if b > a else 0.05 * max(abs(a), 1e-30)
+        ax.set_xlim(a - pad, b + pad)
+    left, right = ax.get_xlim()
+    fmt = (lambda x: format_eng(x, unit, 4)) if unit in ("Hz", "s") else (lambda x: f"{x:.4g}{' ' + unit if unit else ''}")
+    for x, side in ((lo, "min"), (hi, "max")):
+        if x is not None and math.isfinite(x):
+            ax.axvline(x, color="C3", lw=1.6, label=f"{side} {fmt(x)}")
+            ax.axvspan(*((left, x) if side == "min" else (x, right)), color="C3", alpha=0.08, lw=0)
+    if nominal is not None and math.isfinite(nominal):
+        ax.axvline(nominal, color="k", lw=1.2, ls="--", label=f"nominal {fmt(nominal)}")
+    ax.set_xlim(left, right)
+    if unit in ("Hz", "s"):
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _pos: value_code(x) if x else "0"))
+    ax.set_xlabel(f"{name} ({unit})" if unit else name)
+    ax.set_ylabel("builds")
+    ax.set_title(title or f"{name} over {v.size} builds", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    if ax.get_legend_handles_labels()[0]:   # nothing to name without a limit or a nominal
+        ax.legend(fontsize=7.5)
+    return png_bytes(fig, dpi=100, tight=False)

@@ -1,32 +1,66 @@
 """The analytic engine for a PID loop around a Sallen-Key plant (issue 17): the
 plant's parts and the controller's eighteen vary together, and each sample's
 loop as built (op-amp poles, leak, filter: :func:`designer.pid.model.assemble`)
-gives whether it is stable, its phase and gain margins, its step figures for
-the design's test step, and whether any op-amp leaves its output swing.
+gives whether it is stable, the gains its parts realise, its phase and gain
+margins, its step figures for the design's test step (measured as the deck
+measures them, :func:`designer.pid.verify.loop_metrics`), and whether any
+op-amp leaves its output swing.
 
-One sample at a time (a state-space model per sample, a few milliseconds
-each): the loop's figures have no closed form. Sample i is a function of
+The figures carry check-design's names for a loop (:data:`designer.check.figures.PID`):
+``model_overshoot_pct`` is the analytic loop's overshoot; a limit on the SPICE
+name (``overshoot_pct``) counts the model's figure, this engine's estimate of
+it (:data:`STANDS_IN`). A build is in the yield when its loop is stable and
+every limited figure is inside its window.
+
+A plant given as a model (``--plant-tf``, ``--plant-model``, ``--plant-capture``)
+keeps its parameters as identified; only the controller's parts vary
+(:func:`model_loop_figures`). One sample at a time (a state-space model per
+sample, a few milliseconds each; a model plant's loop with its exact dead time
+about 0.2 s): the loop's figures have no closed form. Sample i is a function of
 (seed, i) alone, as for the plant (:mod:`.sampling`).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-FIGURES = ("stable", "phase_margin_deg", "gain_margin_db", "overshoot_pct", "settling_time_s", "saturated")
+from ..core.errors import DesignError
+from .montecarlo import MonteCarlo
+
+STEP = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
+#: every figure of each sampled loop (check-design's names); ``stable`` and ``saturated`` are 1 or 0
+FIGURES = ("stable", "saturated", "kp", "ti_s", "td_s", "phase_margin_deg", "crossover_hz", "gain_margin_db",
+           "steady_state_error_pct", *(f"model_{f}" for f in STEP))
+#: the figures a --limit may name (with the names of :data:`STANDS_IN`)
+LIMITABLE = FIGURES[2:]
+#: a SPICE figure's name -> the analytic figure that stands in for it
+STANDS_IN = {f: f"model_{f}" for f in STEP}
+#: the figures whose spread the summary prints, with their units
+SHOWN = (("phase_margin_deg", "deg"), ("gain_margin_db", "dB"), ("model_overshoot_pct", "%"))
 #: frequency points of each sample's loop gain (log, from the leak corner / 20 to the op-amp's GBW)
 BODE_POINTS = 1500
 #: time points of each sample's step
 STEP_POINTS = 2001
+#: parts tried for "buy this part tighter" (those with the largest variance shares; one more run each)
+TIGHTEN_CANDIDATES = 3
+#: the figures whose extremes --worst-case reports for a loop (with every limited one)
+WORST_FIGURES = ("phase_margin_deg", "gain_margin_db", "model_overshoot_pct")
+
+
+def is_model_loop(result) -> bool:
+    """Whether ``result`` is a model plant's loop (:class:`~designer.pid.process_result.ProcessPidResult`)."""
+    return getattr(result, "model", None) is not None
 
 
 def loop_parts(result) -> dict:
-    """Designator -> nominal value of the loop's parts: the plant's (R1, R2, C1, C2) and the controller's."""
-    p, c = result.plant, result.parts
-    out = {"R1": p.r1, "R2": p.r2, "C1": p.c1, "C2": p.c2}
+    """Designator -> nominal value of the loop's parts: the plant's (R1, R2, C1, C2; none for a plant
+    given as a model, whose parameters stay as identified) and the controller's."""
+    c = result.parts
+    p = None if is_model_loop(result) else result.plant
+    out = {} if p is None else {"R1": p.r1, "R2": p.r2, "C1": p.c1, "C2": p.c2}
     for f in fields(c):
         v = getattr(c, f.name)
         if v is not None:
@@ -34,11 +68,80 @@ def loop_parts(result) -> dict:
     return out
 
 
+def loop_series(result) -> dict:
+    """``{"R": series, "C": series}`` of a design-pid result's parts (their default tolerances): the
+    controller's series; the plant's where the controller's parts were given (None: typed by hand)."""
+    sel = result.selection
+    r, c = (sel.r_series, sel.c_series) if sel is not None else (None, None)
+    if getattr(result, "plant_series", None) is not None:
+        r, c = r or result.plant_series[0], c or result.plant_series[1]
+    return {"R": r, "C": c}
+
+
+def parse_loop_limit(text: str):
+    """A ``--limit`` on a loop figure (:data:`LIMITABLE`, or a SPICE name of :data:`STANDS_IN`),
+    named by the figure this engine computes."""
+    from .stats import Limit, parse_limit
+    lim = text if isinstance(text, Limit) else parse_limit(text, LIMITABLE + tuple(STANDS_IN))
+    return replace(lim, figure=STANDS_IN.get(lim.figure, lim.figure))
+
+
+def _step_and_swing(out: dict, i: int, t, waves: dict, expected: float, amp) -> None:
+    """Sample ``i``'s step figures (against the ``expected`` settled output) and whether an op-amp
+    output leaves the swing, from a stable loop's waves."""
+    from ..pid.verify import loop_metrics
+    fig = loop_metrics(t, waves["y"], expected)
+    for f in STEP:
+        out[f"model_{f}"][i] = getattr(fig, f)
+    if amp.ideal:
+        out["saturated"][i] = 0.0
+    else:
+        peak = max(max(float(np.max(v)), float(v[-1] - np.min(v))) for k, v in waves.items() if k != "y")
+        low = min(min(float(np.min(v)), float(v[-1] - np.max(v))) for k, v in waves.items() if k != "y")
+        out["saturated"][i] = float(peak > amp.vout_max or low < amp.vout_min)
+
+
+def model_loop_figures(values: dict, result) -> dict:
+    """:data:`FIGURES` of the controller's sampled parts around a plant given as a model (its
+    parameters as identified), each loop analysed as design-pid analyses it
+    (:func:`designer.pid.process_loop.analyse`: exact dead time, its margins by the argument
+    principle, the step on the result's grid; about 0.2 s a build)."""
+    from ..pid import model as M
+    from ..pid.blocks import PidParts
+    from ..pid.delaymargins import loop_margins
+    from ..pid.process_loop import closed_loop_step, edged, loop_dc_gain, plant_of, simulation_controller, stage_waves
+    amp, model = result.opamp, result.model
+    plant = plant_of(model)
+    n = next(iter(values.values())).size
+    out = {k: np.full(n, np.nan) for k in FIGURES}
+    names = [f.name for f in fields(PidParts)]
+    t, step, edge = result.waveforms.t, result.test.amplitude_v, result.test.edge_s
+    r = M.reference(t, step, 0.0, edge)
+    for i in range(n):
+        parts = PidParts(**{k: (values[k.upper()][i] if k.upper() in values else None) for k in names})
+        out["kp"][i], out["ti_s"][i], out["td_s"][i] = parts.kp, parts.ti_s, parts.td_s
+        ctrl = M.controller_tf(parts, amp)
+        mg = loop_margins(plant, ctrl)
+        out["stable"][i] = float(mg.stable)
+        out["phase_margin_deg"][i], out["gain_margin_db"][i] = mg.phase_margin_deg, mg.gain_margin_db
+        out["crossover_hz"][i] = mg.crossover_hz
+        if not mg.stable:
+            out["saturated"][i] = 1.0
+            continue
+        dc = loop_dc_gain(model, ctrl)
+        out["steady_state_error_pct"][i] = 100 * (1 - dc)
+        fc = max(result.fc_ref_hz, mg.crossover_hz if math.isfinite(mg.crossover_hz) else result.fc_ref_hz)
+        y = edged(t, closed_loop_step(plant, simulation_controller(ctrl, fc), t, step)["y"], edge)
+        _step_and_swing(out, i, t, stage_waves(parts, amp, t, r, y), step * dc, amp)
+    return out
+
+
 def loop_figures(values: dict, result) -> dict:
     """Every figure of :data:`FIGURES` for each sample (arrays over the samples)."""
+    if is_model_loop(result):
+        return model_loop_figures(values, result)
     from ..pid import model
     from ..pid.blocks import PidParts
-    from ..pid.verify import loop_metrics
     from ..plant.model import plant_tf, plant_tf_opamp
     from ..plant.sallenkey import SallenKeyParts
     amp = result.opamp
@@ -52,6 +155,7 @@ def loop_figures(values: dict, result) -> dict:
     for i in range(n):
         plant = SallenKeyParts(values["R1"][i], values["R2"][i], values["C1"][i], values["C2"][i])
         parts = PidParts(**{k: (values[k.upper()][i] if k.upper() in values else None) for k in names})
+        out["kp"][i], out["ti_s"][i], out["td_s"][i] = parts.kp, parts.ti_s, parts.td_s
         pn, pd = plant_tf(plant) if amp.ideal else plant_tf_opamp(plant, amp)
         lm = model.assemble(parts, amp, pn, pd)
         stable = lm.stable()
@@ -61,78 +165,119 @@ def loop_figures(values: dict, result) -> dict:
         w = 2 * np.pi * np.logspace(math.log10(f_lo), math.log10(f_hi), BODE_POINTS)
         mg = model.margins(w, model.loop_gain(parts, amp, pn, pd, w))
         out["phase_margin_deg"][i], out["gain_margin_db"][i] = mg.phase_margin_deg, mg.gain_margin_db
+        out["crossover_hz"][i] = mg.crossover_hz
         if not stable:
             out["saturated"][i] = 1.0
             continue
         waves = lm.simulate(t, r)
         dc = model.dc_gain(lm)
-        fig = loop_metrics(t, waves["y"], step * dc)
-        out["overshoot_pct"][i], out["settling_time_s"][i] = fig.overshoot_pct, fig.settling_time_s
-        if amp.ideal:
-            out["saturated"][i] = 0.0
-        else:
-            peak = max(max(float(np.max(v)), float(v[-1] - np.min(v))) for k, v in waves.items() if k != "y")
-            low = min(min(float(np.min(v)), float(v[-1] - np.max(v))) for k, v in waves.items() if k != "y")
-            out["saturated"][i] = float(peak > amp.vout_max or low < amp.vout_min)
+        out["steady_state_error_pct"][i] = 100 * (1 - dc)
+        _step_and_swing(out, i, t, waves, step * dc, amp)
     return out
 
 
+def _passed(figs: dict, limits) -> np.ndarray:
+    """Stable and inside every limit."""
+    from .montecarlo import _yield
+    return (figs["stable"] == 1) & _yield(figs, limits)
+
+
 def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str = "random", dist: str = "uniform",
-                     tol_items=()):
+                     tol_items=(), limit_items=(), tighten: bool = True):
     """A Monte Carlo of a design-pid result's loop: the probabilities of instability and of
-    saturation with their Wilson intervals, and the statistics of the margins and step figures.
+    saturation with their Wilson intervals, the statistics of every figure and, with
+    ``limit_items`` (``--limit`` texts such as ``phase_margin_deg=45:90``), the yield with its
+    interval, each part's share of each limited figure's variance, the worst failing samples per
+    limit and the part whose tolerance halved raises the yield most (tried on the
+    :data:`TIGHTEN_CANDIDATES` parts with the largest shares, one more run each).
 
     Returns a :class:`LoopMonteCarlo`."""
     from . import sampling
+    from .montecarlo import MAX_SAMPLES, MIN_SAMPLES
     from .parts import resolve
-    from .stats import PERCENTILES, wilson
+    from .stats import failing_samples, figure_stats, variance_shares, wilson
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_SAMPLES <= n <= MAX_SAMPLES:
+        raise DesignError(f"--monte-carlo must be a whole number of samples from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
+                          f"got {n!r}")
+    limits = tuple(parse_loop_limit(t) for t in limit_items or ())
     nominal = loop_parts(result)
     tol = resolve(tol_items, nominal, series)
     values = sampling.values(nominal, tol.of, n, seed, sampler, dist)
     figs = loop_figures(values, result)
+    nominal_figs = {k: float(v[0]) for k, v in loop_figures({r: np.array([x]) for r, x in nominal.items()},
+                                                            result).items()}
+    by_fig = {lim.figure: lim for lim in limits}
+    stats = {k: figure_stats(k, figs[k], nominal_figs[k], by_fig.get(k)) for k in LIMITABLE}
+    rel = {r: values[r] / nominal[r] - 1 for r in values}
+    shares = {k: variance_shares(rel, figs[k]) for k in (by_fig or dict(SHOWN))}
     unstable = int(np.count_nonzero(figs["stable"] == 0))
     saturated = int(np.count_nonzero(figs["saturated"] == 1))
-    stats = {}
-    for k in ("phase_margin_deg", "gain_margin_db", "overshoot_pct", "settling_time_s"):
-        v = figs[k][np.isfinite(figs[k])]
-        stats[k] = None if not v.size else {"mean": float(v.mean()), "std": float(v.std(ddof=1)) if v.size > 1 else 0.0,
-                                            "percentiles": {f"{p:g}": float(x) for p, x in
-                                                            zip(PERCENTILES, np.percentile(v, PERCENTILES))}}
-    summary = {"settings": {"samples": n, "seed": seed, "sampler": sampler, "dist": dist, "engine": "analytic",
-                            "tolerances_pct": tol.to_dict()},
-               "p_unstable": {"count": unstable, "fraction": unstable / n, "ci95": list(wilson(unstable, n))},
-               "p_saturated": {"count": saturated, "fraction": saturated / n, "ci95": list(wilson(saturated, n))},
-               "statistics": stats,
-               "unstable_samples": [int(i) for i in np.nonzero(figs["stable"] == 0)[0][:5]]}
-    return LoopMonteCarlo(summary, values, figs)
+    mc = LoopMonteCarlo(n, seed, sampler, dist, "analytic", tol, nominal, values, figs, nominal_figs, limits, stats,
+                        _passed(figs, limits) if limits else None, shares,
+                        failing_samples(figs, limits),
+                        p_unstable={"count": unstable, "fraction": unstable / n, "ci95": list(wilson(unstable, n))},
+                        p_saturated={"count": saturated, "fraction": saturated / n,
+                                     "ci95": list(wilson(saturated, n))},
+                        unstable_samples=[int(i) for i in np.nonzero(figs["stable"] == 0)[0][:5]])
+    if tighten and limits and mc.yield_count < n:
+        weight = {r: sum(shares[k][r] for k in by_fig) for r in tol.of}
+        best = None
+        for ref in sorted(tol.of, key=lambda r: -weight[r])[:TIGHTEN_CANDIDATES]:
+            halved = dict(tol.of, **{ref: tol.of[ref] / 2})
+            y = float(np.mean(_passed(loop_figures(sampling.values(nominal, halved, n, seed, sampler, dist),
+                                                   result), limits)))
+            if best is None or y > best[1]:
+                best = (ref, y)
+        mc.tighten = {"part": best[0], "tolerance_pct": 100 * tol.of[best[0]] / 2, "yield": best[1],
+                      "yield_now": mc.yield_count / n,
+                      "tried": sorted(tol.of, key=lambda r: -weight[r])[:TIGHTEN_CANDIDATES]}
+    return mc
 
 
-class LoopMonteCarlo:
-    """A loop's Monte Carlo: its JSON section, the sampled values and figures (for the CSV)."""
+def loop_worst_case(result, series: dict, tol_items=(), limit_items=(), max_corners: int = 4096):
+    """:func:`designer.tolerance.worstcase.worst_case` of the loop's figures (:data:`WORST_FIGURES` and
+    every limited one) over its tolerance box: with 22 parts, the corners the sensitivities point to,
+    then a bounded search from the worst."""
+    from .parts import resolve
+    from .worstcase import worst_case
+    nominal = loop_parts(result)
+    tol = resolve(tol_items, nominal, series)
+    figs = tuple(dict.fromkeys([*WORST_FIGURES, *(parse_loop_limit(t).figure for t in limit_items or ())]))
+    return worst_case(lambda v: loop_figures(v, result), nominal, tol.of, figs, max_corners=max_corners,
+                      maxiter=15)
 
-    def __init__(self, summary: dict, values: dict, figures: dict):
-        self.summary, self.values, self.figures = summary, values, figures
+
+@dataclass
+class LoopMonteCarlo(MonteCarlo):
+    """A loop's Monte Carlo: :class:`~designer.tolerance.montecarlo.MonteCarlo` and the
+    probabilities of instability and saturation (count, fraction, 95 % Wilson interval)."""
+
+    p_unstable: dict = None
+    p_saturated: dict = None
+    unstable_samples: list = None
+
+    @property
+    def headline(self) -> str:
+        """The first limited figure, else the phase margin."""
+        return self.limits[0].figure if self.limits else "phase_margin_deg"
 
     def to_dict(self) -> dict:
-        return self.summary
-
-    def csv_text(self) -> str:
-        """One row per sample: its index, every varied part's value, every figure."""
-        from .stats import samples_csv
-        return samples_csv(self.values, self.figures)
+        out = super().to_dict()
+        return {**out, "yield_rule": "a build is in the yield when its loop is stable and inside every limit",
+                "p_unstable": self.p_unstable, "p_saturated": self.p_saturated,
+                "unstable_samples": self.unstable_samples}
 
     def summary_lines(self) -> list:
-        s = self.summary
-        st = s["settings"]
-        pu, ps = s["p_unstable"], s["p_saturated"]
-        out = [f"Monte Carlo of the loop: {st['samples']} builds ({st['sampler']}, {st['dist']}, seed {st['seed']}), "
+        pu, ps = self.p_unstable, self.p_saturated
+        out = [f"Monte Carlo of the loop: {self.n} builds ({self.sampler}, {self.dist}, seed {self.seed}), "
                "the plant's and the controller's parts varying together",
                f"  unstable: {100 * pu['fraction']:.2f} % (95 % Wilson {100 * pu['ci95'][0]:.2f}..{100 * pu['ci95'][1]:.2f} %)",
                f"  an op-amp beyond its swing: {100 * ps['fraction']:.2f} % (95 % Wilson "
                f"{100 * ps['ci95'][0]:.2f}..{100 * ps['ci95'][1]:.2f} %)"]
-        for k, unit in (("phase_margin_deg", "deg"), ("overshoot_pct", "%")):
-            v = s["statistics"].get(k)
-            if v:
-                p = v["percentiles"]
-                out.append(f"  {k}: mean {v['mean']:.4g} {unit}, 2.5..97.5 % {p['2.5']:.4g}..{p['97.5']:.4g} {unit}")
-        return out
+        for k, unit in SHOWN:
+            s = self.stats.get(k)
+            if s is not None and s.percentiles:
+                p = s.percentiles
+                out.append(f"  {k}: nominal {s.nominal:.4g} {unit}, mean {s.mean:.4g} {unit}, 2.5..97.5 % "
+                           f"{p[2.5]:.4g}..{p[97.5]:.4g} {unit}")
+        return out + self.yield_lines()

@@ -15,7 +15,7 @@ from ..core.errors import DesignError
 from . import plant as engine
 from . import sampling
 from .parts import DISTRIBUTIONS, resolve
-from .stats import figure_stats, parse_limit, samples_csv, variance_shares, wilson
+from .stats import Limit, failing_samples, figure_stats, parse_limit, samples_csv, variance_shares, wilson
 
 #: the number of samples allowed
 MIN_SAMPLES, MAX_SAMPLES = 10, 10 ** 7
@@ -43,6 +43,12 @@ class MonteCarlo:
     shares: dict = field(default_factory=dict)
     failing: dict = field(default_factory=dict)
     tighten: dict | None = None
+    spice: dict | None = None          #: SPICE beside the model (designer.tolerance.spice_mc), when asked
+
+    @property
+    def headline(self) -> str:
+        """The figure a sheet shows first: the first limited one, else fn_hz."""
+        return self.limits[0].figure if self.limits else "fn_hz"
 
     @property
     def yield_count(self) -> int:
@@ -62,7 +68,8 @@ class MonteCarlo:
                                                         "fraction": self.yield_count / self.n,
                                                         "ci95": [lo, hi], "interval": "Wilson"},
                 "variance_shares": {"method": "standardised regression coefficients, squared", **self.shares},
-                "failing_samples": self.failing, "tighten": self.tighten}
+                "failing_samples": self.failing, "tighten": self.tighten,
+                **({} if self.spice is None else {"spice": self.spice})}
 
     def csv_text(self) -> str:
         """One row per sample: its index, every varied part's value, every figure."""
@@ -78,6 +85,11 @@ class MonteCarlo:
             p = s.percentiles
             out.append(f"  {k}: nominal {s.nominal:.5g}, mean {s.mean:.5g}, std {s.std:.3g}, 2.5..97.5 % "
                        f"{p[2.5]:.5g}..{p[97.5]:.5g}")
+        return out + self.yield_lines()
+
+    def yield_lines(self) -> list:
+        """The yield with its interval and the part to buy tighter (none without limits)."""
+        mc, out = self, []
         if mc.limits:
             lo, hi = mc.yield_interval()
             out.append(f"  yield {100 * mc.yield_count / mc.n:.2f} % ({mc.yield_count}/{mc.n}; 95 % Wilson interval "
@@ -85,6 +97,9 @@ class MonteCarlo:
             if mc.tighten:
                 t = mc.tighten
                 out.append(f"  buy {t['part']} tighter: at {t['tolerance_pct']:g} % the yield is {100 * t['yield']:.2f} %")
+        if mc.spice is not None:
+            from .spice_mc import spice_lines
+            out += spice_lines(mc)
         return out
 
 
@@ -117,7 +132,8 @@ def plant_worst_case(parts, series: dict, opamp, tol_items=()):
 
 
 def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler: str = "random",
-                      dist: str = "uniform", tol_items=(), limit_items=(), tighten: bool = True) -> MonteCarlo:
+                      dist: str = "uniform", tol_items=(), limit_items=(), tighten: bool = True,
+                      engine_name: str = "analytic", evaluate=None) -> MonteCarlo:
     """A Monte Carlo of the Sallen-Key ``parts`` (:class:`~designer.plant.sallenkey.SallenKeyParts`).
 
     Parameters
@@ -135,9 +151,14 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     sampler, dist : str
         :data:`designer.tolerance.sampling.SAMPLERS`; ``uniform`` or ``normal``.
     tol_items, limit_items : sequence of str
-        ``--tol`` items (``R=1%``, ``C2=2%``) and ``--limit`` items (``fn_hz=3.3k:3.7k``).
+        ``--tol`` items (``R=1%``, ``C2=2%``) and ``--limit`` items (``fn_hz=3.3k:3.7k``; or
+        :class:`~designer.tolerance.stats.Limit` objects, one-sided ones too).
     tighten : bool
-        Also find the part whose tolerance halved raises the yield most (one more run per part).
+        Also find the part whose tolerance halved raises the yield most (one more run per part,
+        always with the analytic model).
+    engine_name, evaluate : str, callable
+        The engine's name and, for another engine than the analytic one, its
+        ``evaluate(values) -> {figure: array}`` (:mod:`designer.tolerance.spice_mc`).
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_SAMPLES <= n <= MAX_SAMPLES:
         raise DesignError(f"--monte-carlo must be a whole number of samples from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
@@ -146,7 +167,7 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
         raise DesignError(f"--dist {dist!r} unknown; allowed: {', '.join(DISTRIBUTIONS)}")
     if sampler not in sampling.SAMPLERS:
         raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(sampling.SAMPLERS)}")
-    limits = tuple(parse_limit(t, engine.FIGURES) for t in limit_items or ())
+    limits = tuple(t if isinstance(t, Limit) else parse_limit(t, engine.FIGURES) for t in limit_items or ())
     nominal = plant_parts(parts)
     if any(str(t).strip().upper().startswith("GBW") for t in tol_items or ()):
         if opamp.ideal:
@@ -154,21 +175,16 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
         nominal["GBW"] = opamp.gbw_hz     # varies only when asked: a datasheet's typical is not a tolerance
     tol = resolve(tol_items, nominal, series)
     values = sampling.values(nominal, tol.of, n, seed, sampler, dist)
-    figs = _figures(values, {}, opamp)
-    nominal_figs = {k: float(v[0]) for k, v in _figures({r: np.array([x]) for r, x in nominal.items()}, {},
-                                                         opamp).items()}
+    figure_of = evaluate or (lambda v: _figures(v, {}, opamp))
+    figs = figure_of(values)
+    nominal_figs = {k: float(v[0]) for k, v in figure_of({r: np.array([x]) for r, x in nominal.items()}).items()}
     by_fig = {lim.figure: lim for lim in limits}
     stats = {k: figure_stats(k, v, nominal_figs[k], by_fig.get(k)) for k, v in figs.items()}
     rel = {r: values[r] / nominal[r] - 1 for r in values}
     shares = {k: variance_shares(rel, figs[k]) for k in (by_fig or ("fn_hz", "zeta", "overshoot_pct"))}
-    mc = MonteCarlo(n, seed, sampler, dist, "analytic", tol, nominal, values, figs, nominal_figs, limits, stats,
+    mc = MonteCarlo(n, seed, sampler, dist, engine_name, tol, nominal, values, figs, nominal_figs, limits, stats,
                     _yield(figs, limits) if limits else None, shares)
-    for lim in limits:
-        bad = np.nonzero(~lim.inside(figs[lim.figure]))[0]
-        v = figs[lim.figure][bad]
-        centre = 0.5 * ((lim.min if lim.min is not None else lim.max) + (lim.max if lim.max is not None else lim.min))
-        order = np.argsort(-np.abs(np.nan_to_num(v, nan=np.inf) - centre))[:WORST]
-        mc.failing[lim.figure] = {"count": int(bad.size), "worst": [int(i) for i in bad[order]]}
+    mc.failing.update(failing_samples(figs, limits, WORST))
     if tighten and limits:
         best = None
         for ref in tol.of:
@@ -178,5 +194,5 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
             if best is None or y > best[1]:
                 best = (ref, y)
         mc.tighten = {"part": best[0], "tolerance_pct": 100 * tol.of[best[0]] / 2, "yield": best[1],
-                      "yield_now": mc.yield_count / n}
+                      "yield_now": mc.yield_count / n, **({} if engine_name == "analytic" else {"engine": "analytic"})}
     return mc

@@ -44,10 +44,17 @@ class Limit:
             ok &= v <= self.max
         return ok
 
+    def window(self) -> str:
+        """``3.3 kHz to 3.7 kHz``, ``>= 45 deg``: the window with its units."""
+        from ..core.units import format_figure
+        f = self.figure
+        if self.min is not None and self.max is not None:
+            return f"{format_figure(f, self.min)} to {format_figure(f, self.max)}"
+        return f">= {format_figure(f, self.min)}" if self.min is not None else f"<= {format_figure(f, self.max)}"
+
     def text(self) -> str:
-        lo = "-inf" if self.min is None else f"{self.min:g}"
-        hi = "+inf" if self.max is None else f"{self.max:g}"
-        return f"{self.figure} in [{lo}, {hi}]"
+        """``fn_hz 3.3 kHz to 3.7 kHz``: the figure and its window."""
+        return f"{self.figure} {self.window()}"
 
     def to_dict(self) -> dict:
         return {"figure": self.figure, "min": self.min, "max": self.max}
@@ -118,6 +125,19 @@ def variance_shares(x: dict, y) -> dict:
     yz = (yy - yy.mean()) / yy.std()
     beta, *_ = np.linalg.lstsq(az, yz, rcond=None)
     return {r: float(b * b) for r, b in zip(refs, beta)}
+
+
+def failing_samples(figs: dict, limits, worst: int = 5) -> dict:
+    """figure -> {count, worst}: how many samples fall outside each limit and the indices of the
+    ``worst`` farthest from the window's centre (a sample without the figure, NaN, first)."""
+    out = {}
+    for lim in limits:
+        bad = np.nonzero(~lim.inside(figs[lim.figure]))[0]
+        v = np.asarray(figs[lim.figure], float)[bad]
+        centre = 0.5 * ((lim.min if lim.min is not None else lim.max) + (lim.max if lim.max is not None else lim.min))
+        order = np.argsort(-np.abs(np.nan_to_num(v, nan=np.inf) - centre))[:worst]
+        out[lim.figure] = {"count": int(bad.size), "worst": [int(i) for i in bad[order]]}
+    return out
 
 
 def samples_csv(values: dict, figures: dict) -> str:

@@ -38,20 +38,38 @@ class WorstCase:
 
     extremes: dict
     corners: int
+    method: str = "every corner, then L-BFGS-B from the worst corner"
 
     def to_dict(self) -> dict:
-        return {"corners": self.corners, "method": "every corner, then L-BFGS-B from the worst corner",
+        return {"corners": self.corners, "method": self.method,
                 **{k: {"min": lo.to_dict(), "max": hi.to_dict()} for k, (lo, hi) in self.extremes.items()}}
 
     def summary_lines(self) -> list:
-        out = [f"Worst case over the tolerance box ({self.corners} corners, then a bounded search):"]
+        what = "corners" if self.method.startswith("every") else "corners the sensitivities point to"
+        out = [f"Worst case over the tolerance box ({self.corners} {what}, then a bounded search):"]
         for k, (lo, hi) in self.extremes.items():
             out.append(f"  {k}: {lo.value:.5g} to {hi.value:.5g}"
                        + ("" if lo.at_corner and hi.at_corner else " (an extreme inside the box)"))
         return out
 
 
-def worst_case(evaluate, nominal: dict, tol: dict, figures=FIGURES) -> WorstCase:
+def sensitivity_corners(evaluate, values, d: int, figures) -> np.ndarray:
+    """The corners a box too large to enumerate is searched from: each part alone at -tol
+    and +tol (2d runs), and for each figure the corner every part's slope points up and
+    the one it points down (a linear model's extremes, exact for a monotone figure)."""
+    probes = np.vstack([-np.eye(d), np.eye(d)])
+    at = evaluate(values(probes))
+    out = [np.ones(d), -np.ones(d)]
+    for fig in figures:
+        v = np.nan_to_num(np.asarray(at[fig], float), nan=0.0, posinf=0.0, neginf=0.0)
+        slope = np.sign(v[d:] - v[:d])
+        slope[slope == 0] = 1.0
+        out += [slope, -slope]
+    return np.unique(np.array(out), axis=0)
+
+
+def worst_case(evaluate, nominal: dict, tol: dict, figures=FIGURES, max_corners: int = 4096,
+               maxiter: int = 60) -> WorstCase:
     """The extremes of ``figures`` of ``evaluate(values) -> {figure: array}`` over the box.
 
     Parameters
@@ -61,16 +79,27 @@ def worst_case(evaluate, nominal: dict, tol: dict, figures=FIGURES) -> WorstCase
         :func:`designer.tolerance.plant.plant_figures` with its op-amp bound).
     nominal, tol : dict
         Designator -> nominal value and -> tolerance (fraction).
+    max_corners : int
+        Every corner is evaluated up to this many (2^d); a larger box (a loop's 22 parts: 4 million
+        corners) starts from the corners the parts' slopes point to (:func:`sensitivity_corners`).
+    maxiter : int
+        The bounded search's iterations per figure and direction.
     """
     from scipy.optimize import minimize
     refs = list(tol)
     d = len(refs)
-    signs = np.array(list(itertools.product((-1.0, 1.0), repeat=d)))
 
     def values(dev):
         dev = np.atleast_2d(dev)
         return {r: nominal[r] * (1 + tol[r] * dev[:, k]) for k, r in enumerate(refs)}
 
+    if 2 ** d <= max_corners:
+        signs = np.array(list(itertools.product((-1.0, 1.0), repeat=d)))
+        method = WorstCase.method
+    else:
+        signs = sensitivity_corners(evaluate, values, d, figures)
+        method = ("each part alone at -tol and +tol, the corners their slopes point to, then L-BFGS-B from the "
+                  f"worst ({2 ** d} corners are too many to enumerate)")
     at_corners = evaluate(values(signs))
     out = {}
     for fig in figures:
@@ -86,9 +115,9 @@ def worst_case(evaluate, nominal: dict, tol: dict, figures=FIGURES) -> WorstCase
                 return sign * y if np.isfinite(y) else np.inf
 
             res = minimize(f, signs[k] * 0.999, method="L-BFGS-B", bounds=[(-1.0, 1.0)] * d,
-                           options={"maxiter": 60})
+                           options={"maxiter": maxiter})
             if np.isfinite(res.fun) and sign * res.fun < sign * best - 1e-12 * max(1.0, abs(best)):
                 best, x_best, corner = float(sign * res.fun), np.clip(res.x, -1, 1), False
             pair.append(Extreme(best, {r: float(x_best[i]) for i, r in enumerate(refs)}, corner))
         out[fig] = tuple(pair)
-    return WorstCase(out, len(signs))
+    return WorstCase(out, len(signs), method)

@@ -329,3 +329,21 @@ def test_no_spiceinit_runs_for_any_command(bench, backend):
         assert "Traceback" not in done.stderr
     bench.assert_clean(before)
     assert not processes_tagged(bench.tag)
+
+
+# ---- a yield's keys are data too (issue 17) -------------------------------------------------
+
+_YIELD_SPEC = "kind: plant\ntarget: {fc: 3.5k, zeta: 0.2}\nchecks: {fn_hz: {min: 3k, max: 4k}}\n"
+
+
+@pytest.mark.parametrize("extra, words", [
+    ("yield: {min: 95%, engine: spice}", ("spec.yaml:4:", "not available yet")),
+    ("yield: {min: 95%, samples: 99999999999}", ("spec.yaml:4:", "yield.samples")),
+    ("yield: {min: '$(touch x)'}", ("spec.yaml:4:", "yield.min")),
+    ("yield: {min: 95%}\ntolerances: {R: 1e999%}", ("spec.yaml:5:", "tolerances.R")),
+    ("yield: {min: 95%}\ntolerances: {'../R': 1%}", ("spec.yaml:5:", "unknown key")),
+])
+def test_a_bad_yield_is_refused_before_any_work(bench, extra, words):
+    bench.write("spec.yaml", _YIELD_SPEC + extra + "\n")
+    refused(bench, "spec.yaml", "--out", bench.tmp / "out", words=words)
+    assert not (bench.tmp / "out").exists()

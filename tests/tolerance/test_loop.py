@@ -1,16 +1,25 @@
 """The loop's Monte Carlo: every sampled loop's figures equal analyze-pid's for
-those parts (sample by sample, from the CSV rows), the same seed the same run."""
+those parts (sample by sample, from the CSV rows), the same seed the same run;
+the yield, the failing samples and the part to tighten against an independent
+count of the rows; the worst case against brute force on a small box."""
 
 import io
+import itertools
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from designer.pid.blocks import PidParts
 from designer.pid.design import analyze_pid, design_pid
 from designer.pid.spec import PidSpec
 from designer.plant.sallenkey import SallenKeyParts
-from designer.tolerance.loop import loop_monte_carlo
+from designer.core.errors import DesignError
+from designer.tolerance.loop import LIMITABLE, loop_figures, loop_monte_carlo, loop_parts, parse_loop_limit
+from designer.tolerance.worstcase import worst_case
+
+LIMITS = ["phase_margin_deg=27:90", "overshoot_pct=0:12"]
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +42,9 @@ def test_each_row_is_the_loop_analyze_pid_finds(designed, mc):
                                   square_hz=designed.test.frequency_hz), simulate=False)
         assert bool(row["stable"]) == res.analytic.stable
         assert row["phase_margin_deg"] == pytest.approx(res.margins.phase_margin_deg, abs=0.05)
-        assert row["overshoot_pct"] == pytest.approx(res.analytic.figures.overshoot_pct, abs=0.3)
+        assert row["model_overshoot_pct"] == pytest.approx(res.analytic.figures.overshoot_pct, abs=0.3)
+        assert row["kp"] == pytest.approx(res.achieved.kp, rel=1e-9)
+        assert row["crossover_hz"] == pytest.approx(res.margins.crossover_hz, rel=1e-3)
 
 
 def test_probabilities_count_the_samples(mc):
@@ -56,3 +67,109 @@ def test_a_tight_build_of_a_fragile_loop_can_go_unstable():
                      simulate=False)
     got = loop_monte_carlo(res, {"R": "E24", "C": "E12"}, 20, seed=0).to_dict()
     assert got["p_unstable"]["fraction"] == 1.0 and got["p_unstable"]["ci95"][1] == 1.0
+
+
+@pytest.fixture(scope="module")
+def limited(designed):
+    return loop_monte_carlo(designed, {"R": "E24", "C": "E12"}, 60, seed=5, limit_items=LIMITS)
+
+
+def test_the_yield_counts_the_rows_inside_every_limit_of_a_stable_loop(limited):
+    rows = np.genfromtxt(io.StringIO(limited.csv_text()), delimiter=",", names=True)
+    pm, os_ = rows["phase_margin_deg"], rows["model_overshoot_pct"]
+    good = (rows["stable"] == 1) & (pm >= 27) & (pm <= 90) & (os_ >= 0) & (os_ <= 12)
+    d = limited.to_dict()
+    assert d["yield"]["passed"] == int(good.sum()) and d["yield"]["samples"] == 60
+    assert 0 < d["yield"]["passed"] < 60        # the window is chosen to lose some builds
+    lo, hi = d["yield"]["ci95"]
+    assert lo < d["yield"]["fraction"] < hi
+    # the SPICE name counts the analytic loop's figure
+    assert [lim["figure"] for lim in d["limits"]] == ["phase_margin_deg", "model_overshoot_pct"]
+    bad_pm = np.nonzero(~((pm >= 27) & (pm <= 90)))[0]
+    assert d["failing_samples"]["phase_margin_deg"]["count"] == bad_pm.size
+    worst = d["failing_samples"]["phase_margin_deg"]["worst"]
+    assert set(worst) <= set(bad_pm) and worst[0] == bad_pm[np.argmax(np.abs(pm[bad_pm] - 58.5))]
+    assert set(d["variance_shares"]) >= {"phase_margin_deg", "model_overshoot_pct", "method"}
+    shares = d["variance_shares"]["phase_margin_deg"]
+    assert set(shares) == set(limited.values) and min(shares.values()) >= 0
+
+
+def test_the_part_to_tighten_gives_the_yield_it_claims(designed, limited):
+    t = limited.to_dict()["tighten"]
+    assert t["part"] in t["tried"] and len(t["tried"]) == 3
+    again = loop_monte_carlo(designed, {"R": "E24", "C": "E12"}, 60, seed=5, limit_items=LIMITS,
+                             tol_items=[f"{t['part']}={t['tolerance_pct']}%"], tighten=False)
+    assert again.yield_count / 60 == pytest.approx(t["yield"])
+    assert again.tolerances.of[t["part"]] == pytest.approx(t["tolerance_pct"] / 100)
+
+
+@pytest.mark.parametrize("text, figure", [("overshoot_pct=0:12", "model_overshoot_pct"),
+                                          ("phase_margin_deg=45:90", "phase_margin_deg"),
+                                          ("crossover_hz=1k:20k", "crossover_hz"), ("kp=2:3", "kp")])
+def test_a_loop_limit_names_the_engines_figure(text, figure):
+    assert parse_loop_limit(text).figure == figure
+
+
+@pytest.mark.parametrize("text", ["stable=0:1", "fn_hz=1k:2k", "nrms=0:1", "phase_margin_deg=90:45"])
+def test_a_loop_limit_on_no_loop_figure_is_refused(text):
+    with pytest.raises(DesignError) as info:
+        parse_loop_limit(text)
+    assert "\n" not in str(info.value)
+
+
+def test_the_loops_worst_case_meets_brute_force_on_a_small_box(designed):
+    # three parts vary (the others nominal): the sensitivity corners and the bounded search, forced by
+    # max_corners=4, reach the extremes of a 5 x 5 x 5 grid over the box
+    nominal = loop_parts(designed)
+    tol = {"C2": 0.10, "C4": 0.10, "R5": 0.05}
+    fixed = {r: v for r, v in nominal.items() if r not in tol}
+
+    def evaluate(v):
+        n = next(iter(v.values())).size
+        return loop_figures({**{r: np.full(n, x) for r, x in fixed.items()}, **v}, designed)
+
+    figs = ("phase_margin_deg", "gain_margin_db")
+    wc = worst_case(evaluate, {r: nominal[r] for r in tol}, tol, figs, max_corners=4, maxiter=15)
+    assert wc.method.startswith("each part alone")
+    grid = np.array(list(itertools.product(np.linspace(-1, 1, 5), repeat=3)))
+    f = evaluate({r: nominal[r] * (1 + tol[r] * grid[:, k]) for k, r in enumerate(tol)})
+    for fig in figs:
+        lo, hi = wc.extremes[fig]
+        assert lo.value <= f[fig].min() + 1e-6 and hi.value >= f[fig].max() - 1e-6, fig
+        # each extreme is where it says it is
+        at = evaluate({r: np.array([nominal[r] * (1 + tol[r] * lo.deviations[r])]) for r in tol})
+        assert at[fig][0] == pytest.approx(lo.value, rel=1e-9)
+
+
+def test_a_model_plants_loop_varies_the_controller_alone_as_analyze_pid_sees_it():
+    model = "K=2 tau=1m theta=200u"
+    res = design_pid(PidSpec(plant_tf=model, tuning="simc"), simulate=False)
+    mc = loop_monte_carlo(res, {"R": "E24", "C": "E12"}, 12, seed=2, limit_items=["phase_margin_deg=55:90"])
+    assert set(mc.values) == {p.upper() for p in PidParts.__dataclass_fields__ if getattr(res.parts, p) is not None}
+    assert mc.nominal_figures["phase_margin_deg"] == pytest.approx(res.margins.phase_margin_deg, rel=1e-9)
+    assert mc.nominal_figures["model_overshoot_pct"] == pytest.approx(res.analytic.overshoot_pct, rel=1e-9)
+    rows = np.genfromtxt(io.StringIO(mc.csv_text()), delimiter=",", names=True)
+    for row in rows[:2]:
+        parts = PidParts(**{f: (row[f.upper()] if f.upper() in rows.dtype.names else None)   # a PI: no R7..C3
+                            for f in PidParts.__dataclass_fields__})
+        got = analyze_pid(PidSpec(plant_tf=model, controller_parts=parts), simulate=False)
+        assert bool(row["stable"]) == got.stable
+        assert row["phase_margin_deg"] == pytest.approx(got.margins.phase_margin_deg, rel=1e-6)
+        assert row["kp"] == pytest.approx(got.achieved.kp, rel=1e-9)
+    good = (rows["stable"] == 1) & (rows["phase_margin_deg"] >= 55) & (rows["phase_margin_deg"] <= 90)
+    assert mc.yield_count == int(good.sum())
+
+
+@settings(max_examples=150, deadline=None)
+@given(name=st.sampled_from(["phase_margin_deg", "overshoot_pct", "kp", "crossover_hz", "stable", "fn_hz", ""]),
+       lo=st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=6)),
+       hi=st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=6)),
+       sep=st.sampled_from([":", "", "::", "="]))
+def test_any_loop_limit_is_a_window_or_one_line(name, lo, hi, sep):
+    text = f"{name}={lo}{sep}{hi}"
+    try:
+        lim = parse_loop_limit(text)
+    except DesignError as exc:
+        assert "\n" not in str(exc) and str(exc).startswith("--limit")
+        return
+    assert lim.figure in LIMITABLE and lim.min <= lim.max

@@ -36,3 +36,15 @@ def test_an_extreme_inside_the_box_is_found():
     assert lo.at_corner and lo.value == pytest.approx(-1.69)
     assert not hi.at_corner and hi.value == pytest.approx(0.0, abs=1e-9)
     assert hi.deviations["A"] == pytest.approx(0.3, abs=1e-4)
+
+
+def test_the_sensitivity_corners_find_a_monotone_plants_extremes():
+    # a box too large to enumerate (max_corners below 2^4) starts from the corners the slopes point
+    # to: for fn and zeta, monotone in every part, they are the extremes every corner gives
+    amp = opamps.get("LM741")
+    full = worst_case(lambda v: plant_figures(v, amp), NOMINAL, TOL, ("fn_hz", "zeta"))
+    fast = worst_case(lambda v: plant_figures(v, amp), NOMINAL, TOL, ("fn_hz", "zeta"), max_corners=8)
+    assert fast.corners < full.corners == 16 and "slopes" in fast.method
+    for fig in ("fn_hz", "zeta"):
+        for a, b in zip(full.extremes[fig], fast.extremes[fig]):
+            assert b.value == pytest.approx(a.value, rel=1e-9)

@@ -1,0 +1,467 @@
+"""Identification from a broadband input: a pseudo-random binary sequence or
+noise (seed 003, sections 2.4 and 3.2).
+
+:func:`examine_input` recognises the excitation: many transitions, at
+irregular intervals (a square wave's are regular), no spectral line holding
+most of the power (a sine's or a square wave's fundamental does). A two-level
+input is then read as a sequence: its clock interval from the transitions
+(which must be a whole number of sample intervals), its period from the bits
+(an m-sequence when it is 2^n - 1 intervals). Anything else broadband is noise.
+
+:func:`identify_broadband` then estimates, on the periods after the first
+(the seed's "establishment sequence": the plant must be in periodic steady
+state, 2.4.2),
+
+- ``correlation`` (:mod:`.correlation`): the impulse response from the
+  cross-correlation (eq. 2.4.19; for noise eq. 2.4.4), the step response as its
+  running integral, and the settling check; the step methods of
+  :func:`~.step.identify_step` run on that step response;
+- ``spectral`` (:mod:`.spectral`): H = S_yu/S_uu with its coherence, as a
+  frequency table (:class:`~.io.FreqData`) on which identify-freq's analysis
+  (:func:`~.frequency.identify_freq`) runs;
+
+each ranked as it is today. ``method`` forces one of them.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.errors import DesignError
+from . import correlation as corr
+from . import spectral as spec
+from ..core.prbs import MAX_BITS, MIN_BITS, SETTLE_MARGIN, bits_for, is_mls_length
+
+#: at least this many transitions make an input broadband
+MIN_TRANSITIONS = 20
+#: a square wave's (a PWM's) intervals between transitions, high and low apart,
+#: vary less than this (std / mean)
+REGULAR_CV = 0.2
+#: no single spectral line of a broadband input holds this share of its AC power
+MAX_LINE_SHARE = 0.5
+#: a two-level input spends less than this fraction of its samples between its levels
+TWO_LEVEL_FRACTION = 0.1
+#: ... in every one of this many equal parts of the record (two transitions at least)
+SPREAD_PARTS = 8
+#: a broadband input spans at least this many quantisation steps
+MIN_LSB = 16
+#: fewest samples for any broadband identification
+MIN_SAMPLES = 256
+#: bits that disagree with the sequence one period later, at most (noise on the input)
+PERIOD_MISMATCH = 0.01
+METHODS = ("correlation", "spectral")
+#: bits whose linear complexity tells an m-sequence shorter than two periods
+LFSR_BITS = 200
+
+
+@dataclass
+class Excitation:
+    """What the input is: ``kind`` ``"mls"`` (a maximum-length sequence),
+    ``"periodic"`` (a periodic binary sequence of another length) or
+    ``"noise"``; sample interval ``ts``; for a sequence its clock interval
+    (``samples_per_bit`` samples), levels ``offset +- amplitude``, period
+    (``n`` intervals, ``period`` samples), ``bits`` for an m-sequence; the
+    whole periods used (``count`` from sample ``start``)."""
+
+    kind: str
+    ts: float
+    transitions: int
+    offset: float = 0.0
+    amplitude: float = 0.0
+    samples_per_bit: int = 0
+    n: int = 0
+    bits: int | None = None
+    start: int = 0
+    count: int = 0
+
+    @property
+    def dt_s(self) -> float:
+        return self.samples_per_bit * self.ts
+
+    @property
+    def period(self) -> int:
+        return self.n * self.samples_per_bit
+
+    def text(self) -> str:
+        from ..core.units import format_eng as fe
+        if self.kind == "noise":
+            return (f"noise input ({self.transitions} transitions), sampled every "
+                    f"{fe(self.ts, 's')}")
+        what = (f"maximum-length sequence, {self.bits} bits (N = {self.n})" if self.kind == "mls"
+                else f"periodic binary sequence of {self.n} intervals (not an m-sequence)")
+        return (f"{what}, clock {fe(1 / self.dt_s, 'Hz')} (Dt = {fe(self.dt_s, 's')}, "
+                f"{self.samples_per_bit} samples), levels {self.offset:.4g} +- "
+                f"{self.amplitude:.4g}; {self.count} whole period(s) of "
+                f"{fe(self.period * self.ts, 's')} used after the first")
+
+    def to_dict(self) -> dict:
+        d = {"kind": self.kind, "sample_interval_s": self.ts, "transitions": self.transitions}
+        if self.kind != "noise":
+            d.update({"clock_hz": 1 / self.dt_s, "dt_s": self.dt_s,
+                      "samples_per_interval": self.samples_per_bit, "N": self.n,
+                      "bits": self.bits, "offset": self.offset, "amplitude": self.amplitude,
+                      "period_s": self.period * self.ts, "periods_used": self.count,
+                      "first_sample": self.start})
+        return d
+
+
+# --------------------------------------------------------------------------- recognition
+
+def _schmitt(u, lo, hi) -> np.ndarray:
+    """0/1 state of ``u`` with hysteresis between ``lo`` and ``hi`` (the first
+    undecided samples take the first decided state)."""
+    s = np.where(u >= hi, 1, np.where(u <= lo, 0, -1)).astype(np.int8)
+    idx = np.where(s >= 0, np.arange(s.size), 0)
+    np.maximum.accumulate(idx, out=idx)
+    out = s[idx]
+    first = int(np.argmax(s >= 0)) if np.any(s >= 0) else 0
+    out[:first] = s[first]
+    return out
+
+
+def _transitions(u) -> tuple:
+    """(indices where the Schmitt state changes, low level, high level)."""
+    lo, hi = np.percentile(u, [1, 99])
+    span = hi - lo
+    if not span > 0:
+        return np.empty(0, np.int64), lo, hi
+    state = _schmitt(u, lo + 0.35 * span, lo + 0.65 * span)
+    return np.nonzero(np.diff(state))[0] + 1, lo, hi
+
+
+def _line_share(u) -> float:
+    """The largest share of the AC power of ``u`` in one DFT bin."""
+    x = np.asarray(u[: 1 << 20], float)
+    x = x - x.mean()
+    p = np.abs(np.fft.rfft(x)) ** 2
+    total = p[1:].sum()
+    return float(p[1:].max() / total) if total > 0 else 1.0
+
+
+def looks_broadband(u) -> bool:
+    """True for a PRBS or noise: at least MIN_TRANSITIONS transitions at
+    irregular intervals and no spectral line holding MAX_LINE_SHARE of the power."""
+    u = np.asarray(u, float)
+    if u.size < MIN_SAMPLES:
+        return False
+    edges, lo, hi = _transitions(u)
+    if edges.size < MIN_TRANSITIONS:
+        return False
+    from ..core.waveform import quantum
+    lsb = quantum(u[: 1 << 16])
+    if lsb > 0 and hi - lo < MIN_LSB * lsb:
+        return False            # a quiet channel's noise, a few quantisation steps wide
+    # an excitation toggles all through the record, not in a burst (ringing, a glitch)
+    if np.min(np.bincount(edges * SPREAD_PARTS // u.size, minlength=SPREAD_PARTS)) < 2:
+        return False
+    runs = np.diff(edges)
+    # a square wave or a PWM: its high runs alike and its low runs alike
+    if all(r.std() < REGULAR_CV * r.mean() for r in (runs[0::2], runs[1::2])):
+        return False
+    return _line_share(u) < MAX_LINE_SHARE
+
+
+def _clock(edges, ts, name) -> int:
+    """Samples per interval of a binary sequence from its transition indices."""
+    runs = np.diff(edges).astype(float)
+    short = runs[runs <= 1.5 * np.percentile(runs, 10)]
+    b0 = float(np.mean(short))     # the single intervals: 2 and 3 samples mean 2.5
+    k = np.round((edges - edges[0]) / b0)
+    kk = k - k.mean()
+    dt = float(np.sum(kk * (edges - edges.mean())) / np.sum(kk * kk))   # samples per interval
+    m = int(round(dt))
+    drift = abs(dt - m) * (edges[-1] - edges[0]) / dt
+    if m < 1 or drift > 0.25 * max(m, 1):
+        from ..core.units import format_eng as fe
+        raise DesignError(f"{name}: the sequence's clock interval ({fe(dt * ts, 's')}) is not a "
+                          f"whole number of sample intervals ({fe(ts, 's')}: ratio {dt:.4g}); "
+                          "play a clock that is a multiple of the scope's sample interval, or "
+                          "sample at a multiple of the clock")
+    return m
+
+
+def _period(bits: np.ndarray) -> int | None:
+    """The period of a +-1 bit sequence (m-sequence lengths tried first), or None."""
+    n = bits.size
+    for nb in range(MIN_BITS, MAX_BITS + 1):
+        L = (1 << nb) - 1
+        if 2 * L > n:
+            break
+        if np.mean(bits[L:] != bits[:-L]) <= PERIOD_MISMATCH:
+            return L
+    x = bits.astype(float)
+    nfft = 1 << int(math.ceil(math.log2(2 * n)))
+    r = np.fft.irfft(np.abs(np.fft.rfft(x, nfft)) ** 2, nfft)[:n // 2 + 1]
+    overlap = n - np.arange(r.size)
+    r = r / overlap
+    cand = np.nonzero(r[2:] >= 1 - 2 * PERIOD_MISMATCH)[0]
+    return int(cand[0] + 2) if cand.size else None
+
+
+def examine_input(t, u, *, name: str = "capture") -> Excitation | None:
+    """The excitation of a capture, or None when ``u`` is not broadband (a step,
+    a square wave, a sine: the step methods' input)."""
+    u = np.asarray(u, float)
+    if not looks_broadband(u):
+        return None
+    t = np.asarray(t, float)
+    ts = float((t[-1] - t[0]) / (t.size - 1))
+    d = np.diff(t)
+    if np.max(np.abs(d - ts)) > 0.01 * ts:
+        raise DesignError(f"{name}: the samples are not evenly spaced (intervals from "
+                          f"{d.min():.4g} s to {d.max():.4g} s): broadband identification needs a "
+                          "uniformly sampled record")
+    edges, lo, hi = _transitions(u)
+    span = hi - lo
+    between = np.count_nonzero((u > lo + 0.1 * span) & (u < lo + 0.9 * span)) / u.size
+    if between > TWO_LEVEL_FRACTION:
+        return Excitation("noise", ts, int(edges.size))
+    m = _clock(edges, ts, name)
+    state = _schmitt(u, lo + 0.35 * span, lo + 0.65 * span)
+    phase = int(edges[0] % m)
+    centres = np.arange(phase + m // 2, u.size, m)
+    bits = 2 * state[centres].astype(np.int8) - 1
+    L = _period(bits)
+    if L is None:
+        # fewer than two periods of an m-sequence? its first 2n bits give n away
+        from ..core.prbs import linear_complexity
+        head = bits[:LFSR_BITS]
+        nb = linear_complexity((head > 0).astype(np.int8))
+        if head.size >= 4 * nb and MIN_BITS <= nb <= MAX_BITS:
+            period = ((1 << nb) - 1) * m
+            raise DesignError(f"{name}: the input is a maximum-length sequence of {nb} bits "
+                              f"(N = {(1 << nb) - 1}), but the record holds "
+                              f"{u.size / period:.2f} of its periods ({period} samples each); at "
+                              "least 2 whole ones are needed (the first settles the plant, the "
+                              "second is measured)")
+    hi_level = float(np.median(u[state == 1]))
+    lo_level = float(np.median(u[state == 0]))
+    ex = Excitation("noise", ts, int(edges.size), 0.5 * (hi_level + lo_level),
+                    0.5 * (hi_level - lo_level), m)
+    if L is None:
+        return ex                      # a random binary signal: read as noise
+    nb = is_mls_length(L)
+    ex.kind = "mls" if nb else "periodic"
+    ex.n, ex.bits = L, nb
+    p = L * m
+    # the sequence starts at most `bits` intervals before its first transition
+    first = max(0, int(edges[0]) - (nb or MAX_BITS) * m)
+    ex.start = first + p
+    ex.count = max(0, (u.size - ex.start) // p)
+    return ex
+
+
+# --------------------------------------------------------------------------- identification
+
+@dataclass
+class BroadbandResult:
+    """The excitation, the impulse estimate (None for spectral only), the
+    step methods' :class:`~.step.IdentifyResult` on its step response, the
+    spectral estimate and identify-freq's :class:`~.frequency.FreqIdentifyResult`
+    on it, which of the two ``best`` comes from, notes."""
+
+    excitation: Excitation
+    impulse: corr.ImpulseEstimate | None = None
+    step_result: object | None = None
+    spectrum: spec.Spectrum | None = None
+    freq_result: object | None = None
+    method: str = ""
+    notes: list = field(default_factory=list)
+    capture: object | None = None
+    timings: dict = field(default_factory=dict)
+    #: for a wrapped impulse response: the period, bits or clock interval that would do
+    advice: dict | None = None
+
+    @property
+    def best(self):
+        r = self.step_result if self.method == "correlation" else self.freq_result
+        return None if r is None else r.best
+
+    def to_dict(self) -> dict:
+        d = {"format": "broadband", "excitation": self.excitation.to_dict(), "method": self.method,
+             "best": self.best.to_dict() if self.best else None, "notes": list(self.notes),
+             "timings_s": dict(self.timings)}
+        if self.impulse is not None:
+            d["impulse"] = self.impulse.to_dict()
+            if self.advice:
+                d["impulse"]["advice"] = dict(self.advice)
+        if self.step_result is not None:
+            d["correlation"] = self.step_result.to_dict()
+        if self.spectrum is not None:
+            d["spectrum"] = self.spectrum.to_dict()
+            d["spectrum"]["coherence"] = [float(c) for c in self.spectrum.coh]
+        if self.freq_result is not None:
+            d["spectral"] = self.freq_result.to_dict()
+        if self.capture is not None:
+            d["capture"] = self.capture.to_dict()
+        # the ranking ``best`` comes from, laid out as identify's (correlation) or
+        # identify-freq's (spectral) JSON, so design-pid --plant-model reads it
+        chosen = d.get(self.method)
+        if isinstance(chosen, dict):
+            d["methods"] = chosen["methods"]
+            for key in ("preprocessing", "error_definition", "data"):
+                if key in chosen:
+                    d[key] = chosen[key]
+        return d
+
+
+def _wrap_advice(est: corr.ImpulseEstimate, ex: Excitation) -> tuple:
+    """(the note, the advice: the period needed, the bits at this clock, the clock
+    interval at these bits) of a wrapped impulse estimate."""
+    from ..core.units import format_eng as fe
+    need = corr.needed_period(est)
+    text = (f"the impulse response has not settled within one period ({fe(est.period_s, 's')}; "
+            f"settling at least {fe(need, 's')}): it wraps around, and the DC term removes part "
+            "of it")
+    advice = {"period_s": need}
+    if ex.kind == "mls" and ex.n:
+        nb = bits_for(SETTLE_MARGIN * need, ex.dt_s)
+        dt = SETTLE_MARGIN * need / ex.n
+        advice.update({"bits": nb, "dt_s": dt})
+        text += (f"; {nb} bits at this clock would be enough" if nb else "") + \
+            f" (or a clock interval of {fe(dt, 's')} with {ex.bits} bits)"
+    return text, advice
+
+
+def check_method(method) -> str | None:
+    if method is None:
+        return None
+    m = str(method).strip().lower()
+    if m not in METHODS:
+        raise DesignError(f"--method {method!r} unknown; allowed: {', '.join(METHODS)}")
+    return m
+
+
+def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=None,
+                       refine: bool = True, methods=None, capture=None,
+                       name: str = "capture") -> BroadbandResult:
+    """Identify from a broadband capture (see the module docstring).
+
+    Raises
+    ------
+    DesignError
+        The input is not broadband; input and output of different lengths; too
+        few periods (an m-sequence needs two whole ones: one to settle, one to
+        measure) or samples; correlation forced on a sequence that is no
+        m-sequence.
+    """
+    method = check_method(method)
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    u = np.asarray(u, float)
+    if u.shape != y.shape or t.shape != y.shape:
+        raise DesignError(f"{name}: the input ({u.size} samples) and the output ({y.size}) "
+                          "must have the same length")
+    if y.size < MIN_SAMPLES:
+        raise DesignError(f"{name}: {y.size} samples; broadband identification needs at least "
+                          f"{MIN_SAMPLES}")
+    clock = time.perf_counter
+    t0 = clock()
+    ex = excitation or examine_input(t, u, name=name)
+    if ex is None:
+        raise DesignError(f"{name}: the input is not broadband (few or regular transitions, or "
+                          "one dominant frequency): a step or square wave, for the step methods")
+    res = BroadbandResult(ex, capture=capture)
+    if ex.kind != "noise" and ex.count < 1:
+        raise DesignError(f"{name}: {(y.size - ex.start + ex.period) / ex.period:.2f} periods "
+                          f"of the sequence ({ex.period} samples each) in the record; at least "
+                          "2 whole ones are needed (the first settles the plant, the second is "
+                          "measured)")
+    if method == "correlation" and ex.kind == "periodic":
+        raise DesignError(f"{name}: the input repeats every {ex.n} intervals, which is not "
+                          "2^n - 1: the correlation method needs a maximum-length sequence; use "
+                          "--method spectral")
+    res.method = method or "spectral"
+    ts = ex.ts
+    f_nyq = 0.5 / ts
+    if ex.kind == "noise":
+        nseg = min(1 << int(math.floor(math.log2(max(y.size // 8, 64)))), 1 << 16)
+        if y.size < 8 * 64:
+            raise DesignError(f"{name}: {y.size} samples of a noise input; the spectral method "
+                              "needs at least 512 (8 segments of 64)")
+        max_lag = nseg
+        res.impulse = corr.white_impulse(u, y, ts=ts, max_lag=max_lag)
+        res.spectrum = spec.welch_response(u, y, ts=ts, nperseg=nseg, f_max=f_nyq)
+        res.notes.append("noise input: the correlation assumes it white over the plant's band "
+                         "(eq. 2.4.4)")
+    else:
+        p = ex.period
+        if ex.kind == "mls":
+            x = corr.period_mean(u, ex.start, p, ex.count) - ex.offset
+            yy = corr.period_mean(y, ex.start, p, ex.count)
+            res.impulse = corr.mls_impulse(x, yy, n=ex.n, dt_s=ex.dt_s, ts=ts,
+                                           amplitude=ex.amplitude)
+        f_max = min(f_nyq, 0.9 / ex.dt_s)
+        res.spectrum = spec.periodic_response(u, y, start=ex.start, period=p, count=ex.count,
+                                              ts=ts, f_max=f_max)
+    timings = {"estimate": clock() - t0}
+    if res.impulse is not None and res.impulse.wrapped:
+        note, res.advice = _wrap_advice(res.impulse, ex)
+        res.notes.append(note)
+    if res.impulse is not None and method != "spectral":
+        t1 = clock()
+        try:
+            res.step_result = _step_methods(res.impulse, refine, methods)
+        except DesignError as exc:
+            if method == "correlation":
+                raise DesignError(f"{name}: the step response from the correlation: {exc}") from None
+            res.notes.append(f"no step methods on the correlation's step response: {exc}")
+        timings["correlation_models"] = clock() - t1
+    if method != "correlation":
+        t1 = clock()
+        banded = spec.log_bands(res.spectrum)
+        if banded.f.size < 5:
+            if method == "spectral" or res.impulse is None:
+                raise DesignError(f"{name}: the spectral estimate has {banded.f.size} usable "
+                                  "frequencies (input power and coherence too low): at least 5 "
+                                  "are needed; a longer record or more periods")
+            res.notes.append("spectral estimate skipped: fewer than 5 usable frequencies")
+        else:
+            from .frequency import identify_freq
+            res.spectrum = banded
+            res.freq_result = identify_freq(spec.to_freq_data(banded, name))
+        timings["spectral_models"] = clock() - t1
+    if method is None:
+        # the spectral fit first: it divides by the input's own spectrum, where the
+        # correlation's step is smoothed by the sequence's autocorrelation triangle
+        spectral_ok = res.freq_result is not None and res.freq_result.best is not None
+        res.method = "spectral" if spectral_ok or res.step_result is None else "correlation"
+    timings["total"] = clock() - t0
+    res.timings = timings
+    return res
+
+
+#: samples at rest put before the step response given to the step methods, as a fraction of it
+REST_FRACTION = 0.1
+#: the step methods get the step response up to this many times its settling time
+STEP_SETTLINGS = 3.0
+#: the step methods get at most this many samples of the step response (block means
+#: beyond: the estimate is smooth over a clock interval, and 2e4 samples cost 0.7 s of ripple search)
+MAX_STEP_SAMPLES = 4_000
+
+
+def _step_methods(est: corr.ImpulseEstimate, refine: bool, methods):
+    """The step methods (:func:`~.step.identify_step`) on the estimate's step
+    response, preceded by a stretch at rest, as a unit step at t = 0."""
+    from .step import identify_step
+    t, s = est.t, est.step
+    if not est.wrapped:
+        # a few settling times: a long settled tail only blurs what the methods measure
+        keep = t <= t[0] + max(STEP_SETTLINGS * (est.settling_s - t[0]), 0.2 * (t[-1] - t[0]))
+        t, s = t[keep], s[keep]
+    k = max(1, int(math.ceil(t.size / MAX_STEP_SAMPLES)))
+    if k > 1:
+        n = (t.size // k) * k
+        t = t[:n].reshape(-1, k).mean(axis=1)
+        s = s[:n].reshape(-1, k).mean(axis=1)
+    dt = t[1] - t[0]
+    pad = max(16, int(REST_FRACTION * t.size))
+    tt = np.concatenate((t[0] - dt * np.arange(pad, 0, -1), t))
+    ss = np.concatenate((np.zeros(pad), s))
+    uu = (tt >= 0).astype(float)
+    return identify_step(tt, ss, uu, step_time=0.0, step_amplitude=1.0, methods=methods,
+                         refine=refine)

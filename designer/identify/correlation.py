@@ -1,0 +1,206 @@
+"""The impulse response from the input-output cross-correlation (seed 003,
+section 2.4): small pure functions on arrays.
+
+For a maximum-length sequence of levels +-a, N intervals of Dt per period,
+the circular autocorrelation over a whole period is an impulse of area
+(N + 1) a^2 Dt / N on a floor of -a^2/N (eq. 2.4.6), so the cross-correlation
+of input and output over whole periods (eq. 2.4.9, here with the sum of eq.
+2.4.18 over every sample of a period, computed by FFT) is
+
+    phi_xy(tau) = a^2 (N + 1) Dt / N h(tau) - a^2/N int_0^T h(s) ds    (2.4.7)
+
+and the impulse response (eq. 2.4.19)
+
+    h(tau) = N / (a^2 (N + 1) Dt) [phi_xy(tau) - phi_xy((N - 1) Dt)]
+
+where phi_xy late in the period, once h has died out, is the constant
+("DC") term. Here that constant is the mean of phi_xy over the last stretch of
+the period (:data:`TAIL_FRACTION`, at least one interval) rather than the one
+point the seed takes, so the noise of one sample does not shift the whole
+curve; an output offset, and the input's offset, only add constants and are
+removed with it. (Seed misprints: eq. 2.4.13 writes N - 1 for N + 1, and eq.
+2.4.14 phi_xx for phi_xy; the seed's own program used N = 33, which is no
+m-sequence length.)
+
+The sequence is a zero-order hold of the bits, so its true autocorrelation
+is a triangle of half-width Dt, not an impulse: the estimate is h smoothed by
+that triangle (a jump of h at t = 0 is spread over +-Dt, the first interval
+before t = 0 included: the estimate starts at t = -Dt).
+
+Settling (:func:`settling_check`): a period shorter than the response's
+settling time wraps the impulse response around (its tail is added to its
+head, and the DC term then removes part of the response): said so, with the
+bits or clock that would have been enough, estimated from the decay of the
+tail (a wrapped exponential keeps its time constant).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: the DC term is the mean of phi_xy over this last fraction of the period
+TAIL_FRACTION = 0.1
+#: the step response counts as settled inside +-this fraction of its final value
+SETTLE_BAND = 0.02
+#: the impulse response must be flat over this last fraction of the period
+TAIL_CHECK = 0.3
+#: within this fraction of its peak
+FLAT_FRACTION = 0.005
+
+
+def period_mean(x, start: int, period: int, count: int) -> np.ndarray:
+    """Mean of ``count`` consecutive periods of ``period`` samples from ``start``."""
+    seg = np.asarray(x, float)[start:start + period * count]
+    return seg.reshape(count, period).mean(axis=0)
+
+
+def circular_xcorr(x, y) -> np.ndarray:
+    """phi[k] = (1/P) sum_i x[i] y[(i + k) mod P] over one period (eq. 2.4.18), by FFT."""
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
+    p = x.size
+    return np.fft.irfft(np.conj(np.fft.rfft(x)) * np.fft.rfft(y), n=p) / p
+
+
+@dataclass
+class ImpulseEstimate:
+    """The impulse response ``h`` (output units per input unit per second) at
+    times ``t`` (from -Dt), the step response ``step`` (its running integral),
+    the DC term removed, the settling time of ``step`` and the period."""
+
+    t: np.ndarray
+    h: np.ndarray
+    step: np.ndarray
+    dc: float
+    period_s: float
+    dt_s: float
+    settling_s: float
+    wrapped: bool = False
+    tail_tau_s: float = math.nan
+
+    def to_dict(self) -> dict:
+        return {"dt_s": self.dt_s, "period_s": self.period_s, "dc_term": self.dc,
+                "settling_time_s": self.settling_s, "wrapped": self.wrapped,
+                "tail_time_constant_s": self.tail_tau_s, "samples": int(self.t.size),
+                "peak": float(self.h[np.argmax(np.abs(self.h))]),
+                "gain": float(self.step[-1])}
+
+
+def mls_impulse(x, y, *, n: int, dt_s: float, ts: float, amplitude: float) -> ImpulseEstimate:
+    """The impulse response from one period (averaged) of an MLS input ``x``
+    (offset removed: +-``amplitude``) and the output ``y``, sampled every
+    ``ts`` with ``dt_s`` = m ts per interval and ``n`` intervals per period.
+
+    Eq. 2.4.19 with the DC term from the tail (see the module docstring).
+    """
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
+    p = x.size
+    m = max(int(round(dt_s / ts)), 1)
+    phi = circular_xcorr(x, y - y.mean())
+    # lags from -Dt: the triangle's leading half sits at the end of the period
+    phi = np.roll(phi, m)
+    t = (np.arange(p) - m) * ts
+    w = max(m, int(TAIL_FRACTION * p))
+    tail = slice(max(p - w, m + 1), p)
+    dc = float(phi[tail].mean())
+    scale = n / (amplitude * amplitude * (n + 1) * dt_s)
+    h = scale * (phi - dc)
+    step = np.cumsum(h) * ts
+    est = ImpulseEstimate(t, h, step, dc * scale, p * ts, dt_s, math.nan)
+    settling_check(est, m)
+    return est
+
+
+def white_impulse(x, y, *, ts: float, max_lag: int) -> ImpulseEstimate:
+    """The impulse response for a white (noise) input of variance s^2: phi_xy = s^2 ts h
+    (eq. 2.4.4 with k = s^2 ts), over lags 0..``max_lag`` (linear, not circular)."""
+    x = np.asarray(x, float) - np.mean(x)
+    y = np.asarray(y, float) - np.mean(y)
+    n = x.size
+    nfft = 1 << int(math.ceil(math.log2(2 * n)))
+    phi = np.fft.irfft(np.conj(np.fft.rfft(x, nfft)) * np.fft.rfft(y, nfft), nfft)[:max_lag] / n
+    var = float(np.mean(x * x))
+    h = phi / (var * ts)
+    t = np.arange(max_lag) * ts
+    step = np.cumsum(h) * ts
+    est = ImpulseEstimate(t, h, step, 0.0, max_lag * ts, ts, math.nan)
+    settling_check(est)
+    return est
+
+
+def settling_time(t, step, band: float = SETTLE_BAND) -> float:
+    """The last time ``step`` is outside +-band of its final value (the mean of its last tenth)."""
+    k = max(int(0.1 * step.size), 1)
+    final = float(np.mean(step[-k:]))
+    out = np.nonzero(np.abs(step - final) > band * abs(final))[0]
+    if out.size == 0 or final == 0:
+        return float(t[0])
+    i = int(out[-1])
+    return float(t[min(i + 1, t.size - 1)])
+
+
+def _window_means(h, start: int, parts: int = 3) -> list:
+    w = max((h.size - start) // parts, 1)
+    return [float(np.mean(h[start + i * w:start + (i + 1) * w])) for i in range(parts)], w
+
+
+def tail_time_constant(t, h, start: int) -> float:
+    """The time constant of the decay of ``h`` from sample ``start`` on, from three
+    window means (a wrapped exponential plus a constant keeps its time
+    constant); nan when the tail does not decay monotonically."""
+    (m1, m2, m3), w = _window_means(h, start)
+    d1, d2 = m1 - m2, m2 - m3
+    if d1 == 0 or d2 == 0 or (d1 > 0) != (d2 > 0) or abs(d2) >= abs(d1):
+        return math.nan
+    return float(w * (t[1] - t[0]) / math.log(d1 / d2))
+
+
+def tail_drift(h, start: int, per_bit: int) -> tuple:
+    """(change of ``h`` across its tail from sample ``start``, the noise of that
+    change): the first and last of three window means, and their standard
+    error from the tail's sample-to-sample noise (correlated over ``per_bit``
+    samples, the sequence's interval)."""
+    (m1, _, m3), w = _window_means(h, start)
+    tail = h[start:]
+    d2 = np.diff(tail, 2)
+    sigma = float(np.std(d2) / math.sqrt(6.0)) if d2.size > 2 else 0.0
+    se = sigma * math.sqrt(2.0 * max(per_bit, 1) / w)
+    return m1 - m3, se
+
+
+def settling_check(est: ImpulseEstimate, per_bit: int = 1) -> None:
+    """Fill ``settling_s``, ``wrapped`` and ``tail_tau_s`` of an estimate: it has
+    wrapped around when the impulse response still drifts over the period's
+    last :data:`TAIL_CHECK` (by more than :data:`FLAT_FRACTION` of its peak and
+    three times its noise). (The step response's own settling time is no test:
+    its noise is the running sum of h's, a random walk that leaves a 2 % band
+    on a noisy record however long the period.)"""
+    est.settling_s = settling_time(est.t, est.step)
+    start = int((1.0 - TAIL_CHECK) * est.h.size)
+    drift, se = tail_drift(est.h, start, per_bit)
+    peak = float(np.max(np.abs(est.h)))
+    flat = abs(drift) <= max(FLAT_FRACTION * peak, 3.0 * se)
+    est.wrapped = not flat
+    if est.wrapped:
+        est.tail_tau_s = tail_time_constant(est.t, est.h, start)
+
+
+def needed_period(est: ImpulseEstimate) -> float:
+    """At least the period a wrapped estimate would have needed: its settling
+    time, or the period plus four time constants of its tail (what is left of
+    the response at the period's end dies out in about that), the longer."""
+    need = est.settling_s
+    if math.isfinite(est.tail_tau_s):
+        need = max(need, est.period_s + 4.0 * est.tail_tau_s)
+    return need
+
+
+def rms_error(t, h_est, h_true, t0: float, t1: float) -> float:
+    """RMS of ``h_est - h_true`` over t0 <= t <= t1, relative to the peak of |h_true|."""
+    sel = (t >= t0) & (t <= t1)
+    err = np.asarray(h_est)[sel] - np.asarray(h_true)[sel]
+    return float(np.sqrt(np.mean(err * err)) / np.max(np.abs(np.asarray(h_true)[sel])))

@@ -1,0 +1,22 @@
+"""Writing captures: the generic ``t,[u,]y`` CSV (fixtures and round-trip tests).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def format_generic(t, y, u=None, *, delimiter=",", header=True, decimal_comma=False) -> str:
+    """Text of a generic ``t,[u,]y`` CSV (used by fixtures and round-trip tests)."""
+    cols = [np.asarray(t, float)] + ([np.asarray(u, float)] if u is not None else []) \
+        + [np.asarray(y, float)]
+    names = ["t", "u", "y"] if u is not None else ["t", "y"]
+    rows = []
+    if header:
+        rows.append(delimiter.join(names))
+    for vals in zip(*cols):
+        cells = [f"{v:.9g}" for v in vals]
+        if decimal_comma:
+            cells = [c.replace(".", ",") for c in cells]
+        rows.append(delimiter.join(cells))
+    return "\n".join(rows) + "\n"

@@ -1,0 +1,99 @@
+"""The tolerance analysis on a build sheet and in its bundle (issue 17), for any
+wing's Monte Carlo (a plant's or a loop's: :class:`designer.tolerance.montecarlo.MonteCarlo`,
+read as it is, nothing recomputed): a histogram per limited figure and of the
+headline figure (``mc-<figure>.png``, the limits and the nominal marked), and
+the sheet's section: the yield with its interval, the headline's histogram, the
+part to buy tighter and, for a loop, the probabilities of instability and
+saturation."""
+
+from __future__ import annotations
+
+import functools
+
+from ..core.units import format_figure
+from . import document as R
+from .plots import histogram_plot
+
+
+def histogram_name(figure: str) -> str:
+    return f"mc-{figure}.png"
+
+
+def histogram_png(result, figure: str) -> bytes:
+    """The histogram of ``figure`` over ``result.monte_carlo``'s samples, its limit and nominal marked."""
+    mc = result.monte_carlo
+    lim = next((lim for lim in mc.limits if lim.figure == figure), None)
+    inside = "" if lim is None else f", {mc.failing[figure]['count']} outside the limits"
+    return histogram_plot(mc.figures[figure], figure, mc.nominal_figures.get(figure),
+                          None if lim is None else lim.min, None if lim is None else lim.max,
+                          f"{figure} over {mc.n} builds{inside}")
+
+
+def histogram_plots(result) -> tuple:
+    """(file name, draw(result)) of every histogram of the result's Monte Carlo (none without one):
+    the headline figure's, then each limited figure's."""
+    mc = result.monte_carlo
+    if mc is None or mc.headline is None:   # none, or one build replayed: no spread
+        return ()
+    names = dict.fromkeys([mc.headline, *(lim.figure for lim in mc.limits)])
+    return tuple((histogram_name(f), functools.partial(histogram_png, figure=f)) for f in names)
+
+
+def _samples_csv(result) -> str:
+    return result.monte_carlo.csv_text()
+
+
+def csv_texts(result) -> dict:
+    """The bundle's ``monte-carlo.csv`` (one row per build: every varied part, every figure), as
+    :func:`designer.report.bundle.write_design` takes its texts; none without a Monte Carlo."""
+    return {} if result.monte_carlo is None else {"monte_carlo_csv": ("monte-carlo.csv", _samples_csv)}
+
+
+def _value(figure: str, v) -> str:
+    return format_figure(figure, v)
+
+
+def _pct(x: float) -> str:
+    return f"{100 * x:.3g} %" if x < 0.9995 or x == 1 else f"{100 * x:.4g} %"
+
+
+def section(result, with_images: bool = True) -> list:
+    """The sheet's tolerance section (blocks); empty without a Monte Carlo."""
+    mc = result.monte_carlo
+    if mc is None:
+        return []
+    if mc.headline is None:   # one build replayed (--replay I): what it is, no spread
+        return [R.text(" ".join(mc.summary_lines()))]
+    head = (f"{mc.n} builds drawn within the parts' tolerances ({mc.dist}, {mc.sampler} sampler, seed {mc.seed}; "
+            "each build's parts are in monte-carlo.csv).")
+    lines = [head]
+    if mc.limits:
+        lo, hi = mc.yield_interval()
+        lines.append(f"Yield {_pct(mc.yield_count / mc.n)} ({mc.yield_count} of {mc.n}; 95 % Wilson interval "
+                     f"{_pct(lo)} to {_pct(hi)}) within " + "; ".join(lim.text() for lim in mc.limits) + ".")
+        lost = sorted(mc.failing.items(), key=lambda kv: -kv[1]["count"])
+        if lost and lost[0][1]["count"]:
+            lines.append("Lost builds: " + ", ".join(f"{k} {v['count']}" for k, v in lost if v["count"])
+                         + f" (the worst: build {lost[0][1]['worst'][0]}).")
+        if mc.tighten:
+            t = mc.tighten
+            better = t["yield"] > t["yield_now"]
+            lines.append(f"Buy {t['part']} tighter: at {t['tolerance_pct']:g} % the yield is {_pct(t['yield'])}"
+                         + ("." if better else " (no part tried raises it: the design, not the parts, limits it)."))
+    else:
+        lines.append("No limits given (--limit FIGURE=MIN:MAX), so no yield: the spread alone.")
+    for key, what in (("p_unstable", "unstable"), ("p_saturated", "an op-amp beyond its swing")):
+        p = getattr(mc, key, None)
+        if p is not None:
+            lines.append(f"{what.capitalize()}: {_pct(p['fraction'])} (95 % Wilson {_pct(p['ci95'][0])} to "
+                         f"{_pct(p['ci95'][1])}).")
+    s = mc.stats.get(mc.headline)
+    if s is not None and s.percentiles:
+        p = s.percentiles
+        h = mc.headline
+        lines.append(f"{h}: nominal {_value(h, s.nominal)}, 95 % of builds {_value(h, p[2.5])} to "
+                     f"{_value(h, p[97.5])}.")
+    text = [R.text(" ".join(lines))]
+    if not with_images:
+        return text
+    return [R.columns([R.image(histogram_name(mc.headline), f"histogram of {mc.headline}")], text)]

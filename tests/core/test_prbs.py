@@ -1,0 +1,91 @@
+"""The m-sequence, the choice of clock and bits for a plant, and the writers."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from designer.core.errors import DesignError
+from designer.core import prbs
+
+
+@pytest.mark.parametrize("bits", [3, 5, 8, 12])
+def test_mls_period_balance_and_autocorrelation(bits):
+    x = prbs.mls(bits).astype(float)
+    n = 2 ** bits - 1
+    assert x.size == n and np.sum(x == 1) == (n + 1) // 2
+    # eq. 2.4.6: a^2 at lag 0, -a^2/N elsewhere (circularly)
+    r = np.real(np.fft.ifft(np.abs(np.fft.fft(x)) ** 2)) / n
+    assert r[0] == pytest.approx(1.0)
+    assert np.allclose(r[1:], -1.0 / n)
+    assert prbs.is_mls_length(n) == bits and prbs.is_mls_length(n + 2) is None
+
+
+@pytest.mark.parametrize("bad", [2, 21, 0, -3, 7.5, "x", None])
+def test_bits_outside_3_to_20_refused(bad):
+    with pytest.raises(DesignError, match="from 3 to 20"):
+        prbs.check_bits(bad)
+
+
+@given(bits=st.integers(3, 16))
+@settings(max_examples=20, deadline=None)
+def test_linear_complexity_finds_the_bits(bits):
+    x = prbs.mls(bits)
+    assert prbs.linear_complexity((x[:4 * bits] > 0).astype(int)) == bits
+
+
+def test_linear_complexity_of_random_bits_is_about_half():
+    bits = np.random.default_rng(1).integers(0, 2, 200)
+    assert 80 <= prbs.linear_complexity(bits) <= 120
+
+
+@given(settling=st.floats(1e-6, 1e4), ratio=st.floats(0.3, 30.0))
+@settings(max_examples=60, deadline=None)
+def test_plan_for_plant_covers_the_band_and_outlasts_settling(settling, ratio):
+    bw = ratio / settling
+    plan = prbs.plan_for_plant(settling, bw)
+    assert plan.band_hz >= prbs.BAND_FACTOR * bw * (1 - 1e-9)
+    assert plan.band_hz <= 2.5 * prbs.BAND_FACTOR * bw * (1 + 1e-9)   # a 1-2-5 step at most
+    if plan.bits < prbs.MAX_BITS:
+        assert plan.period_s >= prbs.SETTLE_MARGIN * settling
+        assert plan.period_s >= prbs.LINES_IN_BAND / bw * (1 - 1e-9)
+        if plan.bits > prbs.MIN_BITS:     # the fewest bits that do
+            shorter = (2 ** (plan.bits - 1) - 1) * plan.dt_s
+            assert shorter < max(prbs.SETTLE_MARGIN * settling, prbs.LINES_IN_BAND / bw)
+    assert plan.reasons
+
+
+def test_plan_with_too_few_bits_says_so():
+    plan = prbs.plan_for_plant(10.0, 1.0, bits=4, dt_s=0.1)
+    assert plan.bits == 4 and "wrap around" in plan.reasons[-1]
+
+
+def test_unstable_or_empty_plant_refused():
+    with pytest.raises(DesignError, match="stable plant"):
+        prbs.plan_for_plant(math.inf, 1.0)
+
+
+def test_nice_interval():
+    assert prbs.nice_interval(0.0037) == pytest.approx(0.002)
+    assert prbs.nice_interval(7.0) == pytest.approx(5.0)
+    assert prbs.nice_interval(1.0) == pytest.approx(1.0)
+
+
+def test_writers_round_trip():
+    plan = prbs.PrbsPlan(5, 1e-3, amplitude=0.5, offset=2.0, periods=2)
+    awg = prbs.awg_csv(plan).splitlines()
+    assert awg[0] == "sample_rate_hz,1000"
+    vals = np.array([float(v) for v in awg[1:]])
+    assert vals.size == 62 and set(vals) == {1.5, 2.5}
+    assert np.array_equal(vals[:31], 2.0 + 0.5 * prbs.mls(5))
+    tv = np.loadtxt(prbs.time_value_csv(plan).splitlines()[1:], delimiter=",")
+    assert tv.shape == (63, 2) and tv[-1, 0] == pytest.approx(0.062)
+    t, v = prbs.pwl_points(plan)
+    assert np.all(np.diff(t) > 0) and t[-1] == pytest.approx(0.062)
+    # the level at the middle of every interval is the sequence's
+    mid = (np.arange(62) + 0.5) * 1e-3
+    assert np.array_equal(np.interp(mid, t, v), vals)
+    cir = prbs.pwl_subcircuit(plan)
+    assert ".subckt prbs_source out" in cir and cir.rstrip().endswith(".ends prbs_source")
