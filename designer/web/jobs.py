@@ -158,7 +158,11 @@ def _identify(prog: str, argv: list, seen: dict) -> int:
 
 def identify_page(result) -> dict:
     """The data with the best three valid models over them (a step capture: time
-    since the step; a frequency table: gain and phase against frequency)."""
+    since the step; a frequency table: gain and phase against frequency; a
+    broadband capture, PRBS or noise: the step its impulse estimate integrates
+    to, and its spectral estimate's gain, each with its own ranking's models)."""
+    if hasattr(result, "excitation"):
+        return _broadband_page(result)
     shown = [m for m in result.methods if m.valid][:3]
     if hasattr(result, "step"):
         from ..core.stepfit import model_step
@@ -181,6 +185,27 @@ def identify_page(result) -> dict:
         phase = {"data": _on_grid(d.f_hz, np.rad2deg(d.phase), w / (2 * math.pi))}
         phase.update({f"{m.name} ({m.model})": np.rad2deg(model_phase(m.model, dict(m.params), w)) for m in shown})
         page["phase"] = _trace(w / (2 * math.pi), phase, "frequency (Hz)", log_x=True)
+    return page
+
+
+def _broadband_page(result) -> dict:
+    """A broadband identification's two views (as ``identify --plot`` draws them)."""
+    from ..core.stepfit import model_step
+    from ..identify.frequency import model_response
+    page = {"kind": "broadband"}
+    est = result.impulse
+    if est is not None:
+        series = {"integrated impulse response": est.step}
+        for m in [m for m in (result.step_result.methods if result.step_result else []) if m.valid][:3]:
+            series[f"{m.name} ({m.model})"] = model_step(m.model, m.params, est.t)
+        page["plot"] = _trace(est.t, series, "time (s)")
+    sp = result.spectrum
+    if sp is not None and sp.f.size:
+        gain = {"data": 20 * np.log10(np.abs(sp.h))}
+        for m in [m for m in (result.freq_result.methods if result.freq_result else []) if m.valid][:3]:
+            gain[f"{m.name} ({m.model})"] = 20 * np.log10(np.abs(model_response(m.model, m.params,
+                                                                                2 * math.pi * sp.f)))
+        page["plot" if "plot" not in page else "second"] = _trace(sp.f, gain, "frequency (Hz)", log_x=True)
     return page
 
 

@@ -48,3 +48,24 @@ def test_a_refusal_is_the_commands_one_line():
     out = jobs.run({"prog": "design-plant", "argv": ["--fc", "3500", "--zeta", "-1", "--json", "--no-files"],
                     "want": "page"})
     assert out["status"] == 2 and out["error"] == "design-plant: error: --zeta must be 0.01 to 10, got '-1'"
+
+
+def test_a_broadband_capture_gives_its_step_and_spectrum_traces(tmp_path):
+    """A PRBS (a 7-bit m-sequence, 4 periods) through a first-order lag, as identify reads it (t,u,y)."""
+    from scipy.signal import lfilter
+
+    from designer.core.prbs import mls
+    ts, tau = 1e-4, 2e-3
+    u = np.repeat(np.tile(mls(7).astype(float), 4), 10)
+    a = np.exp(-ts / tau)
+    y = lfilter([1 - a], [1, -a], u)
+    path = tmp_path / "prbs.csv"
+    np.savetxt(path, np.column_stack([np.arange(u.size) * ts, u, y]), delimiter=",", header="t,u,y", comments="")
+    out = jobs.run({"prog": "identify", "argv": [str(path), "--json"], "want": "page"})
+    assert out["status"] == 0, out["error"]
+    assert out["json"]["format"] == "broadband" and out["json"]["best"]["model"] in ("fopdt", "overdamped")
+    page = out["page"]
+    assert page["kind"] == "broadband" and page["plot"]["series"][0]["y"]
+    traces = [page["plot"]] + ([page["second"]] if "second" in page else [])
+    assert any(t["log_x"] for t in traces) or out["json"]["method"] == "correlation"
+    json.dumps(page)

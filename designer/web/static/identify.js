@@ -13,7 +13,8 @@ function params(p) {
 function show(answer) {
   const r = answer.result, p = answer.page;
   const cap = r.capture || {};
-  const fmt = r.format === "frequency-table" ? "frequency table (analysed as identify-freq does)" : cap.format;
+  const fmt = r.format === "frequency-table" ? "frequency table (analysed as identify-freq does)" :
+    r.format === "broadband" ? `${cap.format}, broadband input (${r.excitation.kind}: ${r.method} analysis)` : cap.format;
   document.getElementById("format").innerHTML = "";
   const line = document.createElement("p");
   line.id = "format-line";
@@ -30,9 +31,13 @@ function show(answer) {
   if (p.kind === "step") {
     D.plot(document.getElementById("plot"), p.plot, {xUnit: "s", yLabel: cap.output || "output"});
     if (ph._plot) { ph._plot.destroy(); ph._plot = null; } ph.innerHTML = "";
-  } else {
+  } else if (p.kind === "frequency") {
     D.plot(document.getElementById("plot"), p.plot, {xUnit: "Hz", yLabel: "gain (dB)"});
     if (p.phase) D.plot(ph, p.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 220});
+  } else {   // broadband: the integrated impulse response and the spectral estimate's gain
+    const unit = t => t.log_x ? ["Hz", "gain (dB)"] : ["s", cap.output || "output"];
+    if (p.plot) D.plot(document.getElementById("plot"), p.plot, {xUnit: unit(p.plot)[0], yLabel: unit(p.plot)[1]});
+    if (p.second) D.plot(ph, p.second, {xUnit: "Hz", yLabel: "gain (dB)", height: 240});
   }
   document.getElementById("methods").replaceChildren(D.table(
     ["#", "method", "model", "parameters", "IAE", "valid", "note"],
