@@ -117,7 +117,10 @@ def _loop_monte_carlo(result, args, settings):
     r, c = (sel.r_series, sel.c_series) if sel is not None else (None, None)
     if result.plant_series is not None:
         r, c = r or result.plant_series[0], c or result.plant_series[1]
-    result.monte_carlo = loop_monte_carlo(result, {"R": r, "C": c}, n, seed, args.sampler, args.dist, args.tol or ())
+    from .plant import scale_settings
+    scale, _ = scale_settings(args)
+    result.monte_carlo = loop_monte_carlo(result, {"R": r, "C": c}, n, seed, args.sampler, args.dist, args.tol or (),
+                                          scale=scale)
     return result
 
 

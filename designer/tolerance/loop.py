@@ -12,7 +12,7 @@ each): the loop's figures have no closed form. Sample i is a function of
 from __future__ import annotations
 
 import math
-from dataclasses import fields
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -34,21 +34,41 @@ def loop_parts(result) -> dict:
     return out
 
 
+@dataclass(frozen=True)
+class LoopContext:
+    """What the loop engine needs of a design-pid result besides the parts (small and
+    picklable: it travels with every chunk, :mod:`.runner`)."""
+
+    opamp: object        #: the op-amp of every stage
+    step_v: float        #: the design's test step
+    edge_s: float        #: its rise time
+    t_end: float         #: the step's duration
+
+    @classmethod
+    def of(cls, result) -> "LoopContext":
+        return cls(result.opamp, float(result.test.amplitude_v), float(result.test.edge_s),
+                   float(result.waveforms.t[-1]))
+
+
 def loop_figures(values: dict, result) -> dict:
     """Every figure of :data:`FIGURES` for each sample (arrays over the samples)."""
+    return evaluate(LoopContext.of(result), values)
+
+
+def evaluate(context: LoopContext, values: dict) -> dict:
+    """The engine's chunk function (:mod:`.runner`): every figure of :data:`FIGURES` of each sample."""
     from ..pid import model
     from ..pid.blocks import PidParts
     from ..pid.verify import loop_metrics
     from ..plant.model import plant_tf, plant_tf_opamp
     from ..plant.sallenkey import SallenKeyParts
-    amp = result.opamp
+    amp = context.opamp
     n = next(iter(values.values())).size
     out = {k: np.full(n, np.nan) for k in FIGURES}
-    step = result.test.amplitude_v
+    step = context.step_v
     names = [f.name for f in fields(PidParts)]
-    t_end = result.waveforms.t[-1]
-    t = np.linspace(0.0, t_end, STEP_POINTS)
-    r = model.reference(t, step, 0.0, result.test.edge_s)
+    t = np.linspace(0.0, context.t_end, STEP_POINTS)
+    r = model.reference(t, step, 0.0, context.edge_s)
     for i in range(n):
         plant = SallenKeyParts(values["R1"][i], values["R2"][i], values["C1"][i], values["C2"][i])
         parts = PidParts(**{k: (values[k.upper()][i] if k.upper() in values else None) for k in names})
@@ -78,18 +98,19 @@ def loop_figures(values: dict, result) -> dict:
 
 
 def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str = "random", dist: str = "uniform",
-                     tol_items=()):
+                     tol_items=(), scale=None):
     """A Monte Carlo of a design-pid result's loop: the probabilities of instability and of
     saturation with their Wilson intervals, and the statistics of the margins and step figures.
+    ``scale``: where the samples run (:class:`designer.tolerance.runner.Scale`; default here).
 
     Returns a :class:`LoopMonteCarlo`."""
-    from . import sampling
     from .parts import resolve
+    from .runner import Draw, Runner, Scale
     from .stats import PERCENTILES, wilson
     nominal = loop_parts(result)
     tol = resolve(tol_items, nominal, series)
-    values = sampling.values(nominal, tol.of, n, seed, sampler, dist)
-    figs = loop_figures(values, result)
+    values, figs, _ = Runner(scale or Scale()).run(evaluate, LoopContext.of(result),
+                                                   Draw(nominal, tol.of, n, seed, sampler, dist))
     unstable = int(np.count_nonzero(figs["stable"] == 0))
     saturated = int(np.count_nonzero(figs["saturated"] == 1))
     stats = {}
