@@ -135,8 +135,13 @@ def _progress(total: int, show: bool):
     if not show:
         return None
     from tqdm import tqdm
-    return tqdm(total=total, unit="build", file=sys.stderr, delay=PROGRESS_DELAY, leave=False, dynamic_ncols=True,
-                desc="Monte Carlo")
+    try:
+        width, height = os.get_terminal_size(sys.stderr.fileno())
+    except (OSError, ValueError, AttributeError):
+        width = height = 0
+    # a terminal that gives no size (a bare pseudo-terminal) would get no bar at all from tqdm
+    return tqdm(total=total, unit="build", file=sys.stderr, delay=PROGRESS_DELAY, leave=False,
+                ncols=width if width > 0 else 80, nrows=height if height > 0 else 24, desc="Monte Carlo")
 
 
 class Runner:
@@ -289,6 +294,37 @@ def _adopt(parent_pid: int) -> None:
     lifetime.die_with_parent(parent_pid)
 
 
+def _start_cluster(start):
+    """``start()`` (a LocalCluster) in a thread of its own: an interruption reaches the main
+    thread only, so the cluster is never left half started; when one comes, the start is
+    waited for (a few seconds at most) and the cluster closed before it propagates."""
+    import threading
+    box = {}
+
+    def run():
+        try:
+            box["cluster"] = start()
+        except BaseException as exc:   # noqa: BLE001 - handed to the main thread
+            box["error"] = exc
+
+    th = threading.Thread(target=run, name="start-local-cluster", daemon=True)
+    th.start()
+    try:
+        while th.is_alive():
+            th.join(0.05)
+    except BaseException:
+        th.join(60)
+        if "cluster" in box:
+            try:
+                box["cluster"].close(timeout=CONNECT_TIMEOUT)
+            except Exception:   # noqa: BLE001 - the interruption wins
+                pass
+        raise
+    if "error" in box:
+        raise box["error"]
+    return box["cluster"]
+
+
 class _DaskPool:
     """A dask.distributed client: of a running scheduler, or of a LocalCluster started here
     (``n_workers`` processes of one thread each). Imported only here: ``import dask.distributed``
@@ -312,8 +348,9 @@ class _DaskPool:
         self._config.__enter__()
         try:
             if address == "local":
-                self.cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                                        silence_logs=logging.CRITICAL, dashboard_address=None)
+                self.cluster = _start_cluster(lambda: distributed.LocalCluster(
+                    n_workers=workers, threads_per_worker=1, processes=True, silence_logs=logging.CRITICAL,
+                    dashboard_address=None))
                 self.client = distributed.Client(self.cluster)
                 self.client.run(_adopt, os.getpid())
             else:
