@@ -3,8 +3,6 @@ chunk run once more (then exit 3), --target-ci's rounds against an independent
 Wilson interval, and the CLI inputs it parses."""
 
 import math
-import os
-import signal
 
 import numpy as np
 import pytest
@@ -22,6 +20,7 @@ from designer.tolerance.montecarlo import (
     plant_monte_carlo,
 )
 from designer.tolerance.runner import MAX_JOBS, Draw, Runner, Scale, parse_dask, parse_jobs
+from mc_engines import always_dies, dies_once
 
 AMP = opamps.get("LM741")
 NOMINAL = {"R1": 1.6e3, "R2": 3.9e3, "C1": 3.3e-9, "C2": 100e-9}
@@ -63,18 +62,6 @@ def test_the_monte_carlo_section_is_the_same_with_two_workers():
     assert a.to_dict() == b.to_dict() and a.csv_text() == b.csv_text()
 
 
-def dies_once(marker, values):
-    """An engine whose worker is killed the first time (the marker file says it was)."""
-    if not os.path.exists(marker):
-        open(marker, "w").close()
-        os.kill(os.getpid(), signal.SIGKILL)
-    return plant.evaluate(AMP, values)
-
-
-def always_dies(_context, values):
-    os.kill(os.getpid(), signal.SIGKILL)
-
-
 def test_a_chunk_whose_worker_dies_runs_once_more(tmp_path):
     draw = Draw(NOMINAL, TOL, 400, 1)
     v, f, _ = Runner(Scale(jobs=2, chunk=100)).run(dies_once, str(tmp_path / "died"), draw)
@@ -88,6 +75,19 @@ def test_a_chunk_lost_twice_is_a_simulator_error_naming_it():
     with pytest.raises(SimulatorError, match=r"samples 0\.\.99 was lost twice") as e:
         Runner(Scale(jobs=2, chunk=100)).run(always_dies, None, draw)
     assert "\n" not in str(e.value)
+
+
+def test_on_a_local_cluster_a_dying_worker_s_chunk_runs_once_more_then_exit_3(tmp_path):
+    """One LocalCluster (kept short: 400 builds): a chunk whose worker is killed once gives
+    the same figures; a chunk that kills every worker it meets is a simulator error."""
+    draw = Draw(NOMINAL, TOL, 400, 1)
+    _, ref, _ = Runner().run(plant.evaluate, AMP, draw)
+    with Runner(Scale(dask="local", chunk=100)) as run:
+        _, f, _ = run.run(dies_once, str(tmp_path / "died"), draw)
+        assert (tmp_path / "died").exists()
+        assert_same(f, ref)
+        with pytest.raises(SimulatorError, match=r"samples 0\.\.99 was lost twice \(its Dask worker died"):
+            run.run(always_dies, None, Draw(NOMINAL, TOL, 100, 1))
 
 
 def wilson_half_width(k, n, z=1.959963984540054):
