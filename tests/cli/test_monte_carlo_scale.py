@@ -45,6 +45,34 @@ def test_the_same_section_and_csv_whatever_the_workers(tmp_path):
     assert got["jobs2"] == ref and got["dask"] == ref
 
 
+def test_a_running_scheduler_and_its_worker_give_the_same_section(tmp_path):
+    """`dask scheduler` and `dask worker` started as the README says (on this machine), then --dask ADDRESS."""
+    dask = os.path.join(os.path.dirname(DESIGN_PLANT), "dask")
+    started = []
+    try:
+        started.append(subprocess.Popen([dask, "scheduler", "--port", "0", "--no-dashboard", "--scheduler-file",
+                                         str(tmp_path / "s.json")], stdout=subprocess.DEVNULL,
+                                        stderr=subprocess.DEVNULL))
+        deadline = time.monotonic() + 60
+        while not (tmp_path / "s.json").exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        address = json.loads((tmp_path / "s.json").read_text())["address"]
+        started.append(subprocess.Popen([dask, "worker", address, "--nworkers", "1", "--nthreads", "1",
+                                         "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        args = [*SEED, *MC, "--no-files", "--json"]
+        there, here = run(DESIGN_PLANT, *args, "--dask", address), run(DESIGN_PLANT, *args)
+        assert there.returncode == 0 and there.stderr == "", there.stderr
+        assert json.loads(there.stdout)["monte_carlo"] == json.loads(here.stdout)["monte_carlo"]
+    finally:
+        for p in reversed(started):
+            p.terminate()
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+
+
 def test_the_loop_on_two_workers_is_the_same():
     a = run(DESIGN_PID, *PID, "--monte-carlo", "40", "--seed", "2", "--no-files", "--json")
     b = run(DESIGN_PID, *PID, "--monte-carlo", "40", "--seed", "2", "--no-files", "--json", "--jobs", "2")
