@@ -160,7 +160,7 @@ class Runner:
 
     def __enter__(self):
         if self.scale.dask is not None:
-            self._pool = _DaskPool(self.scale.dask, self.scale.workers)
+            self._pool = DaskPool(self.scale.dask, self.scale.workers)
         elif self.scale.jobs > 1:
             self._pool = _ProcessPool(self.scale.jobs)
         else:
@@ -325,7 +325,7 @@ def _start_cluster(start):
     return box["cluster"]
 
 
-class _DaskPool:
+class DaskPool:
     """A dask.distributed client: of a running scheduler, or of a LocalCluster started here
     (``n_workers`` processes of one thread each). Imported only here: ``import dask.distributed``
     takes about 0.35 s."""
@@ -365,31 +365,49 @@ class _DaskPool:
             raise
 
     def map(self, evaluate, context, draw, tasks, bar):
+        def lost(i, why):
+            raise _die_twice(*tasks[i], why)
+
+        def done(i, _result):
+            if bar is not None:
+                bar.update(tasks[i][1] - tasks[i][0])
+
+        return self.calls(run_chunk, [(evaluate, context, draw, a, b) for a, b in tasks], lost, done, errors=False)
+
+    def calls(self, fn, args: list, lost, done=None, errors: bool = True) -> list:
+        """``fn(*a)`` for each ``a`` of ``args`` on the cluster, results in order. A call whose
+        worker dies is submitted once more; lost again, its result is ``lost(index, reason)``
+        (which may raise). ``errors``: an exception raised by ``fn`` is ``lost`` too (else it
+        is raised here). ``done(index, result)`` as each arrives. An interruption cancels
+        every call not yet done."""
         d = self._distributed
-        futures = {}
-        tries = {}
+        futures, tries = {}, {}
         try:
-            for i, (a, b) in enumerate(tasks):
-                futures[self.client.submit(run_chunk, evaluate, context, draw, a, b, pure=False)] = i
+            for i, a in enumerate(args):
+                futures[self.client.submit(fn, *a, pure=False)] = i
                 tries[i] = 1
-            out = [None] * len(tasks)
+            out = [None] * len(args)
             pending = d.as_completed(list(futures))
             for fut in pending:
                 i = futures[fut]
                 if fut.status == "error":
                     exc = fut.exception()
                     if not isinstance(exc, d.KilledWorker):
-                        fut.result()          # the engine's own error, raised here
-                    if tries[i] > 1:
-                        raise _die_twice(*tasks[i], f"its Dask worker died: {exc}")
-                    tries[i] += 1
-                    again = self.client.submit(run_chunk, evaluate, context, draw, *tasks[i], pure=False)
-                    futures[again] = i
-                    pending.add(again)
-                    continue
-                out[i] = fut.result()
-                if bar is not None:
-                    bar.update(tasks[i][1] - tasks[i][0])
+                        if not errors:
+                            fut.result()          # the engine's own error, raised here
+                        out[i] = lost(i, f"{type(exc).__name__}: {exc}")
+                    elif tries[i] > 1:
+                        out[i] = lost(i, f"its Dask worker died: {exc}")
+                    else:
+                        tries[i] += 1
+                        again = self.client.submit(fn, *args[i], pure=False)
+                        futures[again] = i
+                        pending.add(again)
+                        continue
+                else:
+                    out[i] = fut.result()
+                if done is not None:
+                    done(i, out[i])
             return out
         except BaseException:
             if futures:
@@ -401,6 +419,13 @@ class _DaskPool:
         finally:
             for fut in futures:
                 fut.release()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
 
     def close(self):
         try:
