@@ -126,11 +126,12 @@ def test_target_ci_from_the_command_line():
     assert (hi - lo) / 2 < 0.02
 
 
-@pytest.mark.parametrize("when", ["starting", "working"])
+@pytest.mark.parametrize("where, when", [("--dask local", "starting"), ("--dask local", "working"),
+                                         ("--jobs 2", "working")])
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=lambda s: signal.Signals(s).name)
-def test_a_stopped_cluster_run_leaves_no_process_and_no_file(tmp_path, sig, when):
+def test_a_stopped_run_leaves_no_process_and_no_file(tmp_path, sig, where, when):
     tag = uuid.uuid4().hex
-    argv = [DESIGN_PID, *PID, "--monte-carlo", "3000", "--dask", "local", "--out", str(tmp_path / "out")]
+    argv = [DESIGN_PID, *PID, "--monte-carlo", "3000", *where.split(), "--out", str(tmp_path / "out")]
     p = subprocess.Popen(argv, env=tagged_env(tag, MPLBACKEND="Agg"), stdout=subprocess.DEVNULL,
                          stderr=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
     deadline = time.monotonic() + 60
@@ -143,7 +144,7 @@ def test_a_stopped_cluster_run_leaves_no_process_and_no_file(tmp_path, sig, when
     assert p.returncode == 128 + sig, err
     words = "terminated (SIGTERM)" if sig == signal.SIGTERM else "interrupted"
     assert err.splitlines() == [f"design-pid: error: {words}"], err
-    assert wait_gone(tag, 5.0) == [], "a Dask worker outlived design-pid"
+    assert wait_gone(tag, 5.0) == [], "a worker outlived design-pid"
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.json"))
 
 
