@@ -8,12 +8,18 @@ The loop's Monte Carlo (one state-space model per build, not vectorised): the
 optimised LM741 loop for the seed's plant, 1000 builds, its time per build (no goal
 in the issue for it; the README states it).
 
+The SPICE engine (``--engine spice``): the same plant, 400 builds simulated (the whole
+Monte Carlo: draw, ngspice, figures, statistics), with each backend; goal: at least
+0.8x the throughput of ONE bare ngspice process that loops ``alter``/``tran``/``meas``
+over the same samples on the same deck by itself (a ``while`` loop in its own control
+block, written here; no Python while it runs), measured in the same run, best of three.
+
 Samplers (:func:`samplers`): how many builds random, lhs and sobol need for the yield of the
 seed's plant (limits fn_hz 3.3k..3.7k, overshoot 0..55 %, as `make demo`) to be known within
 +- 1 pp: the spread of the yield estimate over repeated seeds, against n.
 
-Scale-out (:func:`scale_out`, :mod:`designer.tolerance.runner`), on the loop engine (about 4 ms
-a build; the issue states these goals for the SPICE engine, not merged here yet): 2 worker
+Scale-out (:func:`scale_out`, :mod:`designer.tolerance.runner`), on the loop engine (about 2-4 ms
+a build) and on the SPICE engine (the issue's goals are for it): 2 worker
 processes at least 1.7x one; ``--dask local`` with 2 workers within 1.3x the wall time of
 ``--jobs 2`` for 500 builds, the commands timed whole (the cluster's start included), and for a
 run of the size of 500 SPICE samples.
@@ -66,6 +72,7 @@ def main():
           f"{1e3 * took / 1000:.1f} ms a build; unstable {loop.to_dict()['p_unstable']['count']} of 1000.")
     print("\nThe yield of the 10^6 run: "
           f"{100 * mc.yield_count / mc.n:.2f} % (95 % Wilson {', '.join(f'{100 * x:.2f}' for x in mc.yield_interval())} %).")
+    spice_section()
     samplers()
     scale_out(res)
 
@@ -224,6 +231,90 @@ def scale_out(res):
     print("\nThe two runs' monte_carlo sections were identical every time. The LocalCluster's start (workers "
           "spawned, each importing the package) is the difference at 500 loop builds; the issue's goal is for "
           "500 SPICE samples, whose work the second row matches.")
+
+
+SPICE_BUILDS = 400
+SPICE_GOAL = 0.8
+
+
+def floor_deck(ctx, values: dict) -> str:
+    """The plant deck with a control block that loops over the samples by itself: the values in
+    vectors, per pass ``alter``, ``tran`` over the rising half and the engine's five ``meas``."""
+    n = len(values["R1"])
+    f = ctx.final_v({}, 1)[0]
+    win = f"FROM={ctx.t0:.10g} TO={ctx.t1:.10g}"
+    elem = dict(ctx.elements)
+    lines = ctx.circuit.rstrip().splitlines()[:-1] + [".control", "set noaskquit"]
+    for d, v in values.items():
+        lines.append(f"let v{d} = vector({n})")
+        lines += [f"let v{d}[{i}] = {x:.12g}" for i, x in enumerate(v)]
+    lines += ["let i = 0", f"while i < {n}"]
+    for d in values:
+        lines += [f"let x = v{d}[i]", f"alter {elem[d]} = $&x"]
+    lines += [f"tran {ctx.max_step_s:.6g} {ctx.t1:.10g} 0 {ctx.max_step_s:.6g}",
+              f"meas tran mcpeak MAX v(out) {win}",
+              "let mcdv = deriv(v(out))",
+              f"meas tran mctpk WHEN mcdv=0 FALL=1 {win}",
+              f"meas tran mct10 WHEN v(out)={0.1 * f:.10g} CROSS=1 {win}",
+              f"meas tran mct90 WHEN v(out)={0.9 * f:.10g} CROSS=1 {win}",
+              f"let mcerr = abs(v(out)-{f:.10g})/{f:.10g}",
+              f"meas tran mcts WHEN mcerr=0.02 CROSS=LAST {win}",
+              "destroy all", "let i = i + 1", "end", "quit", ".endc", ".end"]
+    return "\n".join(lines) + "\n"
+
+
+def spice_section():
+    import shutil
+    import subprocess
+    import tempfile
+    from pathlib import Path
+
+    from designer.plant.design import design_plant
+    from designer.plant.spec import PlantSpec
+    from designer.tolerance import sampling, spice_engine
+    from designer.tolerance.montecarlo import plant_parts
+    from designer.tolerance.spice_mc import plant_monte_carlo_engine
+    res = design_plant(PlantSpec(fc_hz=3500, zeta=0.2), simulate=False)
+    series, n = {"R": "E24", "C": "E12"}, SPICE_BUILDS
+    values = sampling.values(plant_parts(res.built), {"R1": .05, "R2": .05, "C1": .1, "C2": .1}, n, 1)
+    ctx = spice_engine.context(res.deck, res.built, res.opamp, res.test)
+    exe = shutil.which("ngspice")
+
+    def floor():
+        with tempfile.TemporaryDirectory() as tmp:
+            deck = Path(tmp) / "floor.cir"
+            deck.write_text(floor_deck(ctx, values))
+            t = time.perf_counter()
+            out = subprocess.run([exe, "-b", "-n", str(deck)], cwd=tmp, capture_output=True, text=True).stdout
+            took = time.perf_counter() - t
+        assert out.count("mcpeak") == n, "the floor's loop did not run every sample"
+        return took
+
+    def engine(sim):
+        t = time.perf_counter()
+        mc = plant_monte_carlo_engine(res, series, n, seed=1, limit_items=["overshoot_pct=0:55"], engine="spice",
+                                      simulator=sim)
+        took = time.perf_counter() - t
+        assert np.all(np.isfinite(mc.figures["overshoot_pct"]))
+        return took
+
+    engine("pyspice"), engine("ngspice-cli")          # warm: imports, the shared library
+    runs = {"floor": [], "ngspice-cli": [], "pyspice": []}
+    for _ in range(3):                                  # interleaved: the shared machine's load hits all alike
+        runs["floor"].append(floor())
+        for sim in ("ngspice-cli", "pyspice"):
+            runs[sim].append(engine(sim))
+    best = {k: min(v) for k, v in runs.items()}
+    print(f"\nThe SPICE engine ({n} builds of the seed's plant, rising half, max step "
+          f"{ctx.max_step_s * 1e6:.3g} us; best of 3, interleaved):\n")
+    print("| route | seconds | builds/s | against the floor | goal | verdict |")
+    print("|---|---|---|---|---|---|")
+    print(f"| floor: one bare `ngspice -b`, its own `while` loop of alter/tran/meas | {best['floor']:.2f} | "
+          f"{n / best['floor']:.0f} | 1 | | |")
+    for sim in ("ngspice-cli", "pyspice"):
+        ratio = best["floor"] / best[sim]
+        print(f"| `--engine spice --simulator {sim}` (the whole Monte Carlo) | {best[sim]:.2f} | "
+              f"{n / best[sim]:.0f} | {ratio:.2f}x | >= {SPICE_GOAL:g}x | {'ok' if ratio >= SPICE_GOAL else 'MISSED'} |")
 
 
 if __name__ == "__main__":

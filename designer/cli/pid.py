@@ -304,8 +304,12 @@ def _run(args) -> int:
     if spec.process is not None:
         from ..pid.process_report import summary_text as model_text, write_outputs as model_write
         common.check_output(args, args.name if args.name is not None else "pid_model")
-        result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator, rules_spice=args.rules_spice)
-        return emit(result, args, args.name or _model_name(spec, result.method), model_write, model_text)
+        from ..pid.process_report import draw_early
+        early = []   # the pictures that need no SPICE, drawn in the renderer while ngspice runs
+        result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator, rules_spice=args.rules_spice,
+                            before_spice=None if args.no_files else lambda r: early.append(draw_early(r)))
+        return emit(result, args, args.name or _model_name(spec, result.method),
+                    lambda *a: model_write(*a, early=early[0] if early else None), model_text)
     # the default name needs the plant as built; its fixed start stands in for it in the check
     common.check_output(args, args.name if args.name is not None else f"pid_{spec.method}")
     result = _loop_monte_carlo(design_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)

@@ -130,6 +130,23 @@ def _add_tolerance_options(p):
                    help="the window the yield counts (repeatable, both bounds): fn_hz=3.3k:3.7k, "
                         "overshoot_pct=0:55; figures fn_hz, zeta, q, ideal_fn_hz, ideal_zeta, ideal_q, "
                         "overshoot_pct, peak_time_s, gain")
+    _add_spice_options(g)
+
+
+def _add_spice_options(g):
+    """--engine, --spice-samples and --replay (the plant Monte Carlo in SPICE)."""
+    g.add_argument("--engine", default="analytic", choices=("analytic", "spice", "both"),
+                   help="analytic (default: the op-amp-aware model, vectorised), spice (every build simulated in "
+                        "ngspice with --simulator's backend, many builds per ngspice process: fn_hz, zeta, q from "
+                        "the step's overshoot and peak time, rise_time_s and settling_time_s too) or both (SPICE "
+                        "and the model on every build, their disagreement per figure and the yield each gives)")
+    g.add_argument("--spice-samples", metavar="K",
+                   help="with --engine both and --limit: the model on every build, SPICE only on the K nearest "
+                        "each limit (the tails) plus K random ones; reports the verdicts SPICE flips and the "
+                        "yield with them (K from 1 to N)")
+    g.add_argument("--replay", metavar="I",
+                   help="re-run build I (0 to N-1) of --monte-carlo N (same --seed, --sampler, --dist, --tol) "
+                        "alone in SPICE and write its bundle: sheet, deck with its exact values, waveforms")
 
 
 #: the designators a plant's --tol may name
@@ -172,7 +189,48 @@ def monte_carlo_settings(args, designators=PLANT_PARTS):
     return n, seed
 
 
-def _with_monte_carlo(result, args, settings):
+def spice_settings(args, settings):
+    """--engine, --spice-samples and --replay checked before any work: (engine, K or None, I or None)."""
+    def whole(opt, text, lo, hi):
+        try:
+            v = int(str(text).strip())
+        except ValueError:
+            v = None
+        if v is None or not lo <= v <= hi:
+            raise DesignError(f"{opt} {text!r}: give a whole number from {lo} to {hi}")
+        return v
+    k = i = None
+    if args.replay is not None:
+        if settings is None:
+            raise DesignError("--replay I goes with --monte-carlo N (and the run's --seed, --sampler, --dist, --tol)")
+        if args.no_sim:
+            raise DesignError("--replay simulates the build in SPICE: drop --no-sim")
+        i = whole("--replay", args.replay, 0, settings[0] - 1)
+    if args.spice_samples is not None:
+        if args.engine != "both":
+            raise DesignError("--spice-samples K goes with --engine both")
+        if settings is None:
+            raise DesignError("--spice-samples K goes with --monte-carlo N")
+        if not args.limit:
+            raise DesignError("--spice-samples needs --limit: its samples are the tails of each limited figure")
+        k = whole("--spice-samples", args.spice_samples, 1, settings[0])
+    if args.engine != "analytic" and settings is None:
+        raise DesignError(f"--engine {args.engine} goes with --monte-carlo N")
+    return args.engine, k, i
+
+
+def _replay(result, args, settings, spice, name):
+    """--replay I: the sample's own bundle (analyze-plant of its exact values), written under ``name``_sample<I>."""
+    from ..tolerance.spice_mc import replay, replay_result
+    s = result.sourcing
+    n, seed = settings
+    rep = replay(result, {"R": s.r_series, "C": s.c_series}, spice[2], n, seed, args.sampler, args.dist,
+                 args.tol or (), args.simulator)
+    out = replay_result(result, rep, args.simulator, s.r_series, s.c_series, args.package)
+    return _emit(out, args, f"{name}_sample{spice[2]}")
+
+
+def _with_monte_carlo(result, args, settings, spice=("analytic", None, None)):
     """The tolerance analysis of the result's parts as built (--monte-carlo, --worst-case), attached to it."""
     s = result.sourcing
     if args.worst_case:
@@ -184,6 +242,13 @@ def _with_monte_carlo(result, args, settings):
     from ..tolerance.montecarlo import plant_monte_carlo
     n, seed = settings
     scale, target = scale_settings(args)
+    if spice[0] != "analytic":
+        from ..tolerance.spice_mc import plant_monte_carlo_engine
+        result.monte_carlo = plant_monte_carlo_engine(result, {"R": s.r_series, "C": s.c_series}, n, seed,
+                                                      args.sampler, args.dist, args.tol or (), args.limit or (),
+                                                      spice[0], spice[1], args.simulator, scale=scale,
+                                                      target_ci=target)
+        return result
     result.monte_carlo = plant_monte_carlo(result.built, {"R": s.r_series, "C": s.c_series}, result.opamp, n, seed,
                                            args.sampler, args.dist, args.tol or (), args.limit or (), scale=scale,
                                            target_ci=target)
@@ -214,10 +279,13 @@ def _design(args) -> int:
     name = args.name if args.name is not None else (
         f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
     mc = monte_carlo_settings(args)
-    check_output(args, name)
+    spice = spice_settings(args, mc)
+    check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
     from ..plant.design import design_plant
+    if spice[2] is not None:     # the design is the draw's nominal; the sample's own run is the simulation
+        return _replay(design_plant(spec, simulate=False), args, mc, spice, name)
     result = design_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
-    return _emit(_with_monte_carlo(result, args, mc), args, name)
+    return _emit(_with_monte_carlo(result, args, mc, spice), args, name)
 
 
 def _emit(result, args, name) -> int:
@@ -274,9 +342,12 @@ def _analyze(args) -> int:
     name = args.name if args.name is not None else "built_" + "_".join(
         f"{k}{value_code(v)}" for k, v in (("r1", p.r1), ("r2", p.r2), ("c1", p.c1), ("c2", p.c2)))
     mc = monte_carlo_settings(args)
-    check_output(args, name)
+    spice = spice_settings(args, mc)
+    check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
+    if spice[2] is not None:
+        return _replay(analyze_plant(spec, simulate=False), args, mc, spice, name)
     result = analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
-    return _emit(_with_monte_carlo(result, args, mc), args, name)
+    return _emit(_with_monte_carlo(result, args, mc, spice), args, name)
 
 
 def design_plant_main(argv=None) -> int:

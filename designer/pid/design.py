@@ -101,7 +101,8 @@ def plant_step(plant: SallenKeyParts, amp: OpAmp) -> PlantStep:
 
 # ---- the flow ----------------------------------------------------------------
 
-def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice", rules_spice: bool = False) -> PidResult:
+def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice", rules_spice: bool = False,
+               before_spice=None) -> PidResult:
     """Tune, size, check, and (unless ``simulate`` is False) verify in SPICE.
 
     Parameters
@@ -114,6 +115,9 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice",
         ``"pyspice"`` (ngspice's shared library) or ``"ngspice-cli"``.
     rules_spice : bool
         A model plant: simulate every rule's loop too (the rule table's SPICE overshoot).
+    before_spice : callable, optional
+        A model plant: called with the result just before its SPICE run
+        (:func:`designer.pid.process_loop.design_model_pid`).
 
     Returns
     -------
@@ -124,7 +128,7 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice",
     """
     if spec.process is not None:
         from .process_loop import design_model_pid
-        return design_model_pid(spec, simulate, simulator, rules_spice)
+        return design_model_pid(spec, simulate, simulator, rules_spice, before_spice)
     return _run(spec, simulate, simulator, as_built=False)
 
 

@@ -281,7 +281,7 @@ def rule_table(spec, model, reduced, amp) -> tuple:
 
 
 def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice",
-                     rules_spice: bool = False) -> ProcessPidResult:
+                     rules_spice: bool = False, before_spice=None) -> ProcessPidResult:
     """Tune, size, check and (unless ``simulate`` is False) verify in SPICE a PID
     for ``spec.process``, a plant known only as a model.
 
@@ -296,6 +296,9 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
     rules_spice : bool
         Also simulate every applicable rule's loop, sized as this one is, for the
         rule table's SPICE overshoot (one more ngspice run per rule).
+    before_spice : callable, optional
+        Called with the result, analysed but not yet simulated, just before the
+        SPICE run (a command starts drawing the pictures that need no SPICE then).
 
     Returns
     -------
@@ -345,6 +348,8 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
         levels=loop.levels, robust=robust, test=loop.test, expected_final_v=loop.expected, deck=loop.deck,
         waveforms=loop.waves, notes=list(notes), package=spec.package, limits=limits(spec))
     lap("analytic_s")
+    if before_spice is not None:
+        before_spice(res)
     if simulate:
         run_spice(res, simulator)
         if rules_spice:

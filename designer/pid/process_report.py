@@ -23,7 +23,7 @@ import numpy as np
 
 from ..core.units import format_eng
 from ..report import document as R
-from ..report.bundle import write_design
+from ..report.bundle import draw_early as bundle_early, write_design
 from ..report.plots import decimate, figure, png_bytes
 from ..report.wiring import bom_csv, bom_rows, net_text
 from ..spice.deck import board
@@ -328,9 +328,20 @@ PLOTS = (("closed-loop.png", _closed_loop), ("blocks.png", _blocks_plot),
          ("loop-bode.png", _loop_gain_plot), ("reaction-curve.png", _model_step_plot))
 
 
-def write_outputs(result, out_dir, name: str) -> dict:
+#: the plots that read nothing of the SPICE run: drawn during it (:func:`draw_early`)
+BEFORE_SPICE = ("loop-bode.png", "reaction-curve.png")
+
+
+def draw_early(result):
+    """Start drawing the schematic and :data:`BEFORE_SPICE` (``before_spice`` of
+    :func:`~designer.pid.process_loop.design_model_pid`); give it to :func:`write_outputs`."""
+    return bundle_early(result, PLOTS, schematic, BEFORE_SPICE)
+
+
+def write_outputs(result, out_dir, name: str, early=None) -> dict:
     """``netlists/<name>.cir`` and ``reports/<name>/`` (build sheet, result.json,
-    plots, schematic, bom.csv) under ``out_dir``, each written atomically."""
+    plots, schematic, bom.csv) under ``out_dir``, each written atomically; the
+    pictures ``early`` (:func:`draw_early`) started are not drawn again."""
     return write_design(result, out_dir, name, PLOTS, schematic,
                         lambda svg: sections(result, schematic_svg=svg), title_of(result),
-                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r)))})
+                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r)))}, early)

@@ -70,13 +70,36 @@ def schematic_pictures(schematic, result) -> tuple:
     return sheet.svg(), sheet.png()
 
 
-def write_design(result, out_dir, name: str, plots, schematic, sections, title: str, texts: dict = None) -> dict:
+class Early:
+    """A design's pictures that do not depend on its SPICE run (the schematic and
+    ``names``), sent to the renderer before that run (:func:`draw_early`), so that
+    they are drawn on the other core while ngspice runs on this one."""
+
+    def __init__(self, plots, schematic, result, names):
+        from . import render
+        self.names = tuple(n for n, _ in plots if n in names)
+        draws = dict(plots)
+        # the result is pickled now, before the SPICE run fills it: these pictures read none of that
+        self.drawing = render.submit_many([(schematic_pictures, (schematic, result)),
+                                           *((draws[n], (result,)) for n in self.names)])
+
+
+def draw_early(result, plots, schematic, names) -> Early:
+    """Start drawing the schematic and the ``names`` among ``plots`` (those that read
+    nothing of the SPICE run); :func:`write_design` takes the :class:`Early` and
+    draws the rest. The pictures are the same as when drawn after the run."""
+    return Early(plots, schematic, result, names)
+
+
+def write_design(result, out_dir, name: str, plots, schematic, sections, title: str, texts: dict = None,
+                 early: Early = None) -> dict:
     """A design's whole bundle under ``out_dir`` (:func:`bundle_paths`, :func:`write_bundle`).
 
     The pictures (``plots``: ``(file name, draw(result) -> PNG)`` pairs, and the
     schematic, ``schematic(result)`` a drawing, as :func:`schematic_pictures`) are
     drawn in the renderer when one is started (:mod:`.render`), side by side, while
-    the data files are made here; ``sections(svg)`` gives the sheet with the
+    the data files are made here; those started by :func:`draw_early` (``early``)
+    are not drawn again. ``sections(svg)`` gives the sheet with the
     schematic inlined; ``texts``: key -> (file name, text(result)). ``result.files``
     is set before result.json is written, so it lists itself; it is returned, and
     ``result.timings["report_s"]`` set.
@@ -85,15 +108,25 @@ def write_design(result, out_dir, name: str, plots, schematic, sections, title: 
 
     from . import render
     tick = time.perf_counter()
-    drawing = render.submit_many([(schematic_pictures, (schematic, result)),
-                                  *((draw, (result,)) for _, draw in plots)])
+    done = early.names if early is not None else ()
+    late = [(n, draw) for n, draw in plots if n not in done]
+    calls = [(draw, (result,)) for _, draw in late]
+    if early is None:
+        calls.insert(0, (schematic_pictures, (schematic, result)))
+    drawing = render.submit_many(calls)
     names = [n for n, _ in plots]
     texts = texts or {}
     result.files = bundle_paths(out_dir, name, [*names, "schematic.png"], {k: f for k, (f, _) in texts.items()})
     extras = {k: text(result) for k, (_, text) in texts.items()}
     data = result.to_dict()
-    (svg, png), *pngs = drawing.result()
-    images = {**dict(zip(names, pngs)), "schematic.png": png}
+    drawn = drawing.result()
+    if early is None:
+        (svg, png), *drawn = drawn
+    else:
+        (svg, png), *first = early.drawing.result()
+        drawn = first + drawn
+    pngs = dict(zip([*done, *(n for n, _ in late)], drawn))
+    images = {**{n: pngs[n] for n in names}, "schematic.png": png}
     write_bundle(result.files, result.deck, images, title, sections(svg), data, extras)
     result.timings["report_s"] = time.perf_counter() - tick
     return result.files

@@ -224,6 +224,35 @@ class NgspiceCli:
             return _result(vectors, log, self.name, deck)
 
 
+    def run_script(self, circuit: str, commands) -> str:
+        """``circuit`` (a deck without analyses) with a ``.control`` block of ``commands``
+        (``alter``, ``tran``, ``meas``...: a Monte Carlo's loop) in one ``ngspice -b``; its stdout."""
+        exe = shutil.which(self.executable)
+        if exe is None:
+            raise SimulatorError(f"ngspice is not installed ({self.executable!r} not found); {INSTALL_HINT}")
+        lines = circuit.rstrip().splitlines()
+        if lines and lines[-1].strip().lower() == ".end":
+            lines = lines[:-1]
+        text = "\n".join([*lines, ".control", "set noaskquit", *commands, "quit", ".endc", ".end"]) + "\n"
+        with tempfile.TemporaryDirectory(prefix="designer-sim-") as tmp:
+            deck_path = Path(tmp) / "deck.cir"
+            deck_path.write_text(text)
+            try:
+                proc = subprocess.run([exe, "-b", "-n", str(deck_path)], cwd=tmp, env=private_env(tmp),
+                                      capture_output=True, text=True, timeout=self.timeout,
+                                      stdin=subprocess.DEVNULL, preexec_fn=lifetime.preexec())
+            except subprocess.TimeoutExpired:
+                raise SimulatorError(f"ngspice did not finish within {self.timeout:g} s (timed out)") from None
+        log = proc.stdout + "\n" + proc.stderr
+        errs = error_lines(log) or [ln for ln in proc.stderr.splitlines() if ln.strip()][-1:]
+        if deck_refused(log):
+            raise DeckError("ngspice cannot read the deck: " + "; ".join(errs[:3]))
+        if proc.returncode != 0:
+            raise SimulatorError(("ngspice crashed (signal %d)" % -proc.returncode if proc.returncode < 0 else
+                                  "ngspice failed") + (": " + "; ".join(errs[:3]) if errs else ""))
+        return proc.stdout
+
+
 class PySpiceShared:
     """ngspice as a shared library through PySpice.
 
@@ -242,21 +271,7 @@ class PySpiceShared:
             tmp = tempfile.mkdtemp(prefix="designer-sim-")
             try:
                 os.chdir(tmp)   # whatever ngspice writes lands in a private folder, removed after
-                self._command(ng, "destroy all")
-                self._command(ng, "reset")
-                ng.clear_output()
-                lines = [ln for ln in deck.splitlines() if ln.strip()] + [""]
-                from PySpice.Spice.NgSpice.Shared import FFI, ffi
-                keep = [ffi.new("char[]", ln.encode("utf8")) for ln in lines] + [FFI.NULL]
-                with lifetime.native():
-                    rc = ng._ngspice_shared.ngSpice_Circ(ffi.new("char *[]", keep))
-                load_log = ng.stdout + "\n" + ng.stderr
-                errs = error_lines(load_log)
-                if rc or errs:
-                    why = "; ".join(errs[:3]) or f"code {rc}"
-                    if deck_refused(load_log):
-                        raise DeckError("ngspice cannot read the deck: " + why)
-                    raise SimulatorError("ngspice failed to load the deck: " + why)
+                load_log = self._load(ng, deck)
                 log = self._command(ng, "run")
                 errs = error_lines(log)
                 plot = ng.last_plot
@@ -271,6 +286,50 @@ class PySpiceShared:
                 os.chdir(old)
                 shutil.rmtree(tmp, ignore_errors=True)
         return _result(vectors, load_log + "\n" + log, self.name, deck)
+
+    def _load(self, ng, deck: str) -> str:
+        """Load ``deck`` as the one circuit of the library (the last one destroyed); its log."""
+        self._command(ng, "destroy all")
+        self._command(ng, "reset")
+        ng.clear_output()
+        lines = [ln for ln in deck.splitlines() if ln.strip()] + [""]
+        from PySpice.Spice.NgSpice.Shared import FFI, ffi
+        keep = [ffi.new("char[]", ln.encode("utf8")) for ln in lines] + [FFI.NULL]
+        with lifetime.native():
+            rc = ng._ngspice_shared.ngSpice_Circ(ffi.new("char *[]", keep))
+        load_log = ng.stdout + "\n" + ng.stderr
+        errs = error_lines(load_log)
+        if rc or errs:
+            why = "; ".join(errs[:3]) or f"code {rc}"
+            if deck_refused(load_log):
+                raise DeckError("ngspice cannot read the deck: " + why)
+            raise SimulatorError("ngspice failed to load the deck: " + why)
+        return load_log
+
+    def run_script(self, circuit: str, commands) -> str:
+        """Load ``circuit`` (a deck without analyses) once and send it ``commands`` one by one
+        (``alter``, ``tran``, ``meas``...: a Monte Carlo's loop); ngspice's output (stdout)."""
+        with self._lock:
+            ng = shared_instance()
+            old = os.getcwd()
+            tmp = tempfile.mkdtemp(prefix="designer-sim-")
+            out = []
+            try:
+                os.chdir(tmp)
+                self._load(ng, circuit)
+                ng.clear_output()
+                for cmd in commands:
+                    with lifetime.native():
+                        ng._ngspice_shared.ngSpice_Command(cmd.encode("ascii"))
+                    if len(ng._stdout) > 4096:      # bound the callback's buffer on long loops
+                        out.append(ng.stdout)
+                        ng.clear_output()
+                out.append(ng.stdout)
+                self._command(ng, "destroy all")
+            finally:
+                os.chdir(old)
+                shutil.rmtree(tmp, ignore_errors=True)
+        return "\n".join(out)
 
     @staticmethod
     def _command(ng, command: str) -> str:

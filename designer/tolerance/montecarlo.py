@@ -48,6 +48,7 @@ class MonteCarlo:
     failing: dict = field(default_factory=dict)
     tighten: dict | None = None
     target: dict | None = None         #: --target-ci: the half-width asked, whether reached, each round's end
+    spice: dict | None = None          #: SPICE beside the model (designer.tolerance.spice_mc), when asked
 
     @property
     def yield_count(self) -> int:
@@ -70,7 +71,8 @@ class MonteCarlo:
                                                         "fraction": self.yield_count / self.n,
                                                         "ci95": [lo, hi], "interval": "Wilson"},
                 "variance_shares": {"method": "standardised regression coefficients, squared", **self.shares},
-                "failing_samples": self.failing, "tighten": self.tighten}
+                "failing_samples": self.failing, "tighten": self.tighten,
+                **({} if self.spice is None else {"spice": self.spice})}
 
     def csv_text(self) -> str:
         """One row per sample: its index, every varied part's value, every figure."""
@@ -93,6 +95,9 @@ class MonteCarlo:
             if mc.tighten:
                 t = mc.tighten
                 out.append(f"  buy {t['part']} tighter: at {t['tolerance_pct']:g} % the yield is {100 * t['yield']:.2f} %")
+        if mc.spice is not None:
+            from .spice_mc import spice_lines
+            out += spice_lines(mc)
         return out
 
 
@@ -126,7 +131,7 @@ def plant_worst_case(parts, series: dict, opamp, tol_items=()):
 
 def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler: str = "random",
                       dist: str = "uniform", tol_items=(), limit_items=(), tighten: bool = True, scale=None,
-                      target_ci: float | None = None) -> MonteCarlo:
+                      target_ci: float | None = None, engine_name: str = "analytic", evaluate=None) -> MonteCarlo:
     """A Monte Carlo of the Sallen-Key ``parts`` (:class:`~designer.plant.sallenkey.SallenKeyParts`).
 
     Parameters
@@ -146,7 +151,11 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     tol_items, limit_items : sequence of str
         ``--tol`` items (``R=1%``, ``C2=2%``) and ``--limit`` items (``fn_hz=3.3k:3.7k``).
     tighten : bool
-        Also find the part whose tolerance halved raises the yield most (one more run per part).
+        Also find the part whose tolerance halved raises the yield most (one more run per part,
+        always with the analytic model).
+    engine_name, evaluate : str, callable
+        The engine's name and, for another engine than the analytic one, its
+        ``evaluate(values) -> {figure: array}`` (:mod:`designer.tolerance.spice_mc`).
     scale : designer.tolerance.runner.Scale, optional
         Where the samples run (``--jobs``, ``--dask``, a progress bar); default in this process.
         The result is the same wherever they run.
@@ -172,17 +181,27 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     if target_ci is not None:
         check_target_ci(target_ci, limits, sampler)
         until, first = target_rounds(limits, target_ci, n), min(n, TARGET_ROUND)
+    # another engine's evaluate(values) travels to the workers as the context of _apply
+    chunk_fn, context = (engine.evaluate, opamp) if evaluate is None else (_apply, evaluate)
     with runner.Runner(scale or runner.Scale()) as run:
-        values, figs, ends = run.run(engine.evaluate, opamp, runner.Draw(nominal, tol.of, n, seed, sampler, dist),
+        values, figs, ends = run.run(chunk_fn, context, runner.Draw(nominal, tol.of, n, seed, sampler, dist),
                                      first, until)
-        mc = _analyse(seed, sampler, dist, tol, nominal, values, figs, limits, opamp)
+        mc = _analyse(seed, sampler, dist, tol, nominal, values, figs, limits,
+                      evaluate or (lambda v: _figures(v, {}, opamp)), engine_name)
         if target_ci is not None:
             lo, hi = mc.yield_interval()
             mc.target = {"half_width_pct": 100 * target_ci, "max_samples": n, "reached": (hi - lo) / 2 < target_ci,
                          "rounds": ends}
         if tighten and limits:
             mc.tighten = _tighten(run, mc, opamp, n)
+            if engine_name != "analytic":
+                mc.tighten["engine"] = "analytic"
     return mc
+
+
+def _apply(evaluate, values: dict) -> dict:
+    """The runner's chunk function for an engine given as ``evaluate(values)`` (a picklable partial)."""
+    return evaluate(values)
 
 
 def parse_target_ci(text) -> float:
@@ -244,16 +263,15 @@ def target_rounds(limits, target: float, n_max: int):
     return until
 
 
-def _analyse(seed, sampler, dist, tol, nominal, values, figs, limits, opamp) -> MonteCarlo:
-    """The statistics of the samples drawn."""
+def _analyse(seed, sampler, dist, tol, nominal, values, figs, limits, figure_of, engine_name) -> MonteCarlo:
+    """The statistics of the samples drawn (``figure_of(values)``: the nominal's figures)."""
     n = len(next(iter(figs.values())))
-    nominal_figs = {k: float(v[0]) for k, v in _figures({r: np.array([x]) for r, x in nominal.items()}, {},
-                                                         opamp).items()}
+    nominal_figs = {k: float(v[0]) for k, v in figure_of({r: np.array([x]) for r, x in nominal.items()}).items()}
     by_fig = {lim.figure: lim for lim in limits}
     stats = {k: figure_stats(k, v, nominal_figs[k], by_fig.get(k)) for k, v in figs.items()}
     rel = {r: values[r] / nominal[r] - 1 for r in values}
     shares = {k: variance_shares(rel, figs[k]) for k in (by_fig or ("fn_hz", "zeta", "overshoot_pct"))}
-    mc = MonteCarlo(n, seed, sampler, dist, "analytic", tol, nominal, values, figs, nominal_figs, limits, stats,
+    mc = MonteCarlo(n, seed, sampler, dist, engine_name, tol, nominal, values, figs, nominal_figs, limits, stats,
                     _yield(figs, limits) if limits else None, shares)
     for lim in limits:
         bad = np.nonzero(~lim.inside(figs[lim.figure]))[0]

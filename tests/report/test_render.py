@@ -127,17 +127,24 @@ def test_which_command_lines_draw(argv, drawn):
 
 @pytest.mark.spice
 def test_the_console_script_writes_what_the_command_writes_in_process(tmp_path):
-    args = ["--fc", "3500", "--zeta", "0.2", "--name", "p"]
-    run = subprocess.run([script("design-plant"), *args, "--out", str(tmp_path / "a")], capture_output=True, text=True)
+    match = same_bundles(tmp_path, "design-plant", design_plant_main, ["--fc", "3500", "--zeta", "0.2", "--name", "p"])
+    assert {"step.png", "bode.png", "schematic.png", "build-sheet.html"} <= match
+
+
+def same_bundles(tmp_path, command: str, main, args) -> set:
+    """The files of the console script's bundle (renderer started) that equal the in-process
+    command's, byte for byte; asserts that every file but result.json (which records the argv) does."""
+    run = subprocess.run([script(command), *args, "--out", str(tmp_path / "a")], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
-    assert design_plant_main([*args, "--out", str(tmp_path / "b")]) == 0
-    a, b = tmp_path / "a" / "reports" / "p", tmp_path / "b" / "reports" / "p"
+    assert main([*args, "--out", str(tmp_path / "b")]) == 0
+    name = args[args.index("--name") + 1]
+    a, b = tmp_path / "a" / "reports" / name, tmp_path / "b" / "reports" / name
     names = sorted(p.name for p in a.iterdir())
     assert names == sorted(p.name for p in b.iterdir())
-    same = [n for n in names if n != "result.json"]   # result.json records the argv
+    same = [n for n in names if n != "result.json"]
     match, mismatch, errors = filecmp.cmpfiles(a, b, same, shallow=False)
     assert not mismatch and not errors, mismatch
-    assert {"step.png", "bode.png", "schematic.png", "build-sheet.html"} <= set(match)
+    return set(match)
 
 
 @pytest.mark.spice
@@ -184,3 +191,14 @@ def running_with(arg: str) -> list:
         except OSError:   # gone meanwhile
             pass
     return found
+
+
+@pytest.mark.spice
+def test_pictures_drawn_during_the_spice_run_are_those_drawn_after_it(tmp_path):
+    # design-pid for a model plant sends the schematic, loop-bode.png and reaction-curve.png to the
+    # renderer before its SPICE run (they read none of it): the console script's bundle, drawn so, is
+    # the bundle of the command called in-process, which draws everything after the run
+    from designer.cli.pid import design_pid_main
+    args = ["--plant-tf", "K=2 tau=1m theta=200u", "--tuning", "simc", "--simulator", "ngspice-cli", "--name", "m"]
+    assert {"schematic.png", "loop-bode.png", "reaction-curve.png", "closed-loop.png",
+            "build-sheet.html"} <= same_bundles(tmp_path, "design-pid", design_pid_main, args)

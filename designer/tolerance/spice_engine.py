@@ -1,0 +1,214 @@
+"""The SPICE engine of the plant Monte Carlo (issue 17): every sample simulated
+in ngspice, many samples per ngspice process.
+
+The plant deck design-plant writes (:func:`designer.plant.netlist.plant_deck`)
+is loaded once, without its ``.tran`` and ``.meas`` lines; a loop of control
+commands then, per sample, ``alter``\\ s R1 R2 C1 C2 (and the gain resistors, the
+deck's R19/R20 for the seed's R3/R4; the op-amp's integrating capacitor for
+``--tol GBW``), runs ``tran`` over the rising half of the bench period only, and
+``meas``\\ ures from the control block (in ngspice 39 a deck's own ``.meas`` lines
+print the first pass's value on every pass of an ``alter`` loop). Both backends
+of :mod:`designer.spice.simulate` run the loop (``run_script``): ``ngspice -b``
+with a ``.control`` block, or the shared library fed the commands one by one.
+
+Measured per sample: the peak of v(out) (MAX), the first peak's time (where
+d v(out)/dt falls through 0: MAX_AT is quantised to the time grid), the 10 % and
+90 % crossings and the last time |v(out) - final|/final crosses 2 %. From them,
+with the final value final = amplitude x K A0/(K + A0) (the closed-loop DC gain
+of the op-amp model, K = 1 + R4/R3):
+
+- ``overshoot_pct`` = 100 (peak - final)/final, ``peak_time_s`` (from the step's edge),
+  ``rise_time_s`` (10-90 %), ``settling_time_s`` (2 %);
+- ``zeta``, ``fn_hz``, ``q``: the second-order equivalents of the step, zeta from the
+  overshoot (zeta = -ln(OS)/sqrt(pi^2 + ln^2 OS)) and fn from the peak time
+  (tp = pi/(wn sqrt(1 - zeta^2))), seed 001's step relations inverted. The analytic
+  engine's fn/zeta are the third-order model's dominant pair: with an LM741
+  (GBW 1 MHz) under the seed's 3.5 kHz plant the two definitions differ by about
+  0.1 % in fn. Without an overshoot (below :data:`OVERSHOOT_FLOOR_PCT`) the step has
+  no peak: peak time, fn, zeta and Q are NaN.
+
+The maximum step is :data:`MAX_STEP_FACTOR` times the deck's (at most 1/30 of the
+response's time scale): /work/shared/FACTS.md measured 0.007 pp of overshoot and
+0.015 % of peak time against the deck's own step, ten times faster.
+
+:func:`evaluate` is a pure function of picklable arguments (a :class:`SpiceContext`
+and a chunk of samples), so a scale-out runner can map it over chunks on workers.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.errors import SimulatorError
+
+#: the figures the SPICE engine gives
+FIGURES = ("fn_hz", "zeta", "q", "overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
+#: the figures both engines give (their disagreement is reported by ``--engine both``)
+SHARED = ("fn_hz", "zeta", "q", "overshoot_pct", "peak_time_s")
+#: the loop's maximum time step against the plant deck's (FACTS.md: x10, 0.007 pp of overshoot)
+MAX_STEP_FACTOR = 10
+#: ... and at most this fraction of the response's time scale (1/wn)
+MIN_STEPS_PER_TIME_SCALE = 30
+#: an overshoot below this (percent) is no peak: the step is taken as monotone
+OVERSHOOT_FLOOR_PCT = 0.01
+#: samples per ngspice run (bounds one run's output and time; a chunk larger than this takes several)
+BATCH = 1000
+#: seconds allowed per sample of a batch, on top of the simulator's fixed timeout
+SECONDS_PER_SAMPLE = 1.0
+#: the measurements of one sample, by the name ngspice prints
+_MEASURES = ("mcpeak", "mctpk", "mct10", "mct90", "mcts")
+_LINE = re.compile(r"^\s*(mcpeak|mctpk|mct10|mct90|mcts)\s*=\s*([-+]?[\d.]+(?:[eE][-+]?\d+)?)", re.M)
+_ROW = re.compile(r"^\s*MCROW (\d+)\s*$", re.M)
+
+
+@dataclass(frozen=True)
+class SpiceContext:
+    """What every sample of one design shares (picklable: strings and numbers).
+
+    ``circuit`` is the plant deck without its analyses; ``elements`` maps each
+    designator that may vary to its element in the deck (``R3`` -> ``r19``);
+    ``cint`` names the op-amp's integrating capacitor and ``rint`` its resistor
+    (``GBW`` varies through C = A0/(2 pi GBW RINT); the model's slew current is fixed
+    at the nominal one, so the slew rate follows the gain-bandwidth, as a real
+    op-amp's compensation capacitor moves both)."""
+
+    circuit: str
+    elements: tuple
+    t0: float
+    t1: float
+    max_step_s: float
+    amplitude_v: float
+    a0: float
+    nominal: tuple                    #: (designator, nominal value) of every part that may vary
+    cint: str | None = None
+    rint: float | None = None
+    simulator: str = "ngspice-cli"
+
+    def final_v(self, values: dict, n: int) -> np.ndarray:
+        """Each sample's settled output: amplitude x K A0/(K + A0)."""
+        nom = dict(self.nominal)
+        r3 = np.asarray(values.get("R3", nom.get("R3", np.nan)), float)
+        r4 = np.asarray(values.get("R4", nom.get("R4", np.nan)), float)
+        k = np.where(np.isfinite(r3) & np.isfinite(r4), 1.0 + r4 / r3, 1.0) * np.ones(n)
+        return self.amplitude_v * k * self.a0 / (k + self.a0)
+
+
+def context(deck: str, parts, opamp, test, simulator: str = "ngspice-cli") -> SpiceContext:
+    """The :class:`SpiceContext` of a plant deck (a :class:`~designer.plant.result.PlantResult`'s
+    ``deck``, ``built``, ``opamp`` and ``test``) for the backend ``simulator``."""
+    from ..plant.netlist import plant_netlist
+    keep = [ln for ln in deck.splitlines()
+            if not re.match(r"\s*\.(meas\w*|tran|end)\b", ln, re.I)]
+    net = plant_netlist(parts)
+    elements = tuple((d, p.ref.lower()) for d, p in zip(("R1", "R2", "C1", "C2", "R3", "R4"), net.parts))
+    nominal = (("R1", parts.r1), ("R2", parts.r2), ("C1", parts.c1), ("C2", parts.c2))
+    if parts.r3 is not None:
+        nominal += (("R3", parts.r3), ("R4", parts.r4))
+    step = MAX_STEP_FACTOR * test.max_step_s()
+    if test.time_scale_s is not None:
+        step = min(step, test.time_scale_s / MIN_STEPS_PER_TIME_SCALE)
+    cint = rint = None
+    if not opamp.ideal:
+        m = re.search(r"^\.param\s+RINT\s*=\s*(\S+)", deck, re.M | re.I)
+        from ..core.units import parse_value
+        rint = parse_value(m.group(1), "RINT") if m else None
+        cint = f"c.x{net.amps[0].ref.lower()}.cint"
+        nominal += (("GBW", opamp.gbw_hz),)
+    from ..spice.simulate import get_simulator
+    return SpiceContext("\n".join(keep) + "\n.end\n", elements, test.delay_s, test.delay_s + test.half_period_s,
+                        step, test.amplitude_v, opamp.a0, nominal, cint, rint, get_simulator(simulator).name)
+
+
+def commands(ctx: SpiceContext, values: dict, start: int = 0) -> list:
+    """The control commands of samples ``start``.. (their values ``values``): per sample its
+    ``alter`` lines, ``tran`` over the rising half, a row marker, the ``meas`` lines, ``destroy all``."""
+    n = len(next(iter(values.values())))
+    final = ctx.final_v(values, n)
+    elem = dict(ctx.elements)
+    unknown = [d for d in values if d not in elem and d != "GBW"]
+    if unknown:
+        raise ValueError(f"the plant deck has no part {unknown[0]}")
+    if "GBW" in values and ctx.cint is None:
+        raise ValueError("the ideal op-amp has no gain-bandwidth to vary")
+    win = f"FROM={ctx.t0:.10g} TO={ctx.t1:.10g}"
+    tran = f"tran {ctx.max_step_s:.6g} {ctx.t1:.10g} 0 {ctx.max_step_s:.6g}"
+    out = []
+    for i in range(n):
+        for d, v in values.items():
+            if d == "GBW":
+                a0 = ctx.a0
+                out.append(f"alter {ctx.cint} = {a0 / (2 * math.pi * float(v[i]) * ctx.rint):.12g}")
+            else:
+                out.append(f"alter {elem[d]} = {float(v[i]):.12g}")
+        f = float(final[i])
+        out += [tran, f"echo MCROW {start + i}",
+                f"meas tran mcpeak MAX v(out) {win}",
+                "let mcdv = deriv(v(out))",
+                f"meas tran mctpk WHEN mcdv=0 FALL=1 {win}",
+                f"meas tran mct10 WHEN v(out)={0.1 * f:.10g} CROSS=1 {win}",
+                f"meas tran mct90 WHEN v(out)={0.9 * f:.10g} CROSS=1 {win}",
+                f"let mcerr = abs(v(out)-{f:.10g})/{f:.10g}",
+                f"meas tran mcts WHEN mcerr=0.02 CROSS=LAST {win}",
+                "destroy all"]
+    return out
+
+
+def parse(output: str, start: int, n: int) -> dict:
+    """Measurement -> array over samples ``start`` .. ``start + n - 1`` (NaN where a ``meas``
+    failed); a :class:`SimulatorError` when a sample's row is missing (ngspice stopped)."""
+    raw = {k: np.full(n, np.nan) for k in _MEASURES}
+    marks = list(_ROW.finditer(output))
+    seen = set()
+    for j, m in enumerate(marks):
+        i = int(m.group(1)) - start
+        if not 0 <= i < n:
+            continue
+        seen.add(i)
+        seg = output[m.end():marks[j + 1].start() if j + 1 < len(marks) else len(output)]
+        for name, value in _LINE.findall(seg):
+            raw[name][i] = float(value)
+    if len(seen) < n:
+        missing = min(set(range(n)) - seen) + start
+        raise SimulatorError(f"ngspice stopped before Monte Carlo sample {missing} (of {start}..{start + n - 1})")
+    return raw
+
+
+def figures(ctx: SpiceContext, values: dict, raw: dict) -> dict:
+    """The figures of :data:`FIGURES` from each sample's measurements (module docstring)."""
+    n = len(raw["mcpeak"])
+    final = ctx.final_v(values, n)
+    over = np.maximum(0.0, 100.0 * (raw["mcpeak"] - final) / final)
+    peaked = over > OVERSHOOT_FLOOR_PCT
+    tp = np.where(peaked, raw["mctpk"] - ctx.t0, np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ln = np.log(np.where(peaked, over / 100.0, np.nan))
+        zeta = -ln / np.sqrt(math.pi ** 2 + ln * ln)
+        wn = math.pi / (tp * np.sqrt(1.0 - zeta * zeta))
+        return {"fn_hz": wn / (2 * math.pi), "zeta": zeta, "q": 1.0 / (2.0 * zeta), "overshoot_pct": over,
+                "peak_time_s": tp, "rise_time_s": raw["mct90"] - raw["mct10"],
+                "settling_time_s": raw["mcts"] - ctx.t0}
+
+
+def evaluate(ctx: SpiceContext, values: dict, start: int = 0) -> dict:
+    """Every figure of :data:`FIGURES` for a chunk of samples (designator -> array), each
+    simulated in ngspice: one loaded circuit per :data:`BATCH` samples.
+
+    Pure: the same context and values give the same figures in any process
+    (``start`` only labels the samples in ngspice's output and its messages)."""
+    from ..spice.simulate import DEFAULT_TIMEOUT_S, get_simulator
+    values = {k: np.atleast_1d(np.asarray(v, float)) for k, v in values.items()}
+    n = len(next(iter(values.values())))
+    out = {k: np.full(n, np.nan) for k in FIGURES}
+    for lo in range(0, n, BATCH):
+        hi = min(n, lo + BATCH)
+        chunk = {k: v[lo:hi] for k, v in values.items()}
+        sim = get_simulator(ctx.simulator, timeout=DEFAULT_TIMEOUT_S + SECONDS_PER_SAMPLE * (hi - lo))
+        text = sim.run_script(ctx.circuit, commands(ctx, chunk, start + lo))
+        figs = figures(ctx, chunk, parse(text, start + lo, hi - lo))
+        for k in FIGURES:
+            out[k][lo:hi] = figs[k]
+    return out

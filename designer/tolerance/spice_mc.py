@@ -1,0 +1,264 @@
+"""The plant Monte Carlo with SPICE (issue 17): ``--engine spice|both``,
+``--spice-samples K`` and ``--replay I``.
+
+- ``spice``: every sample simulated (:mod:`.spice_engine`); the figures SPICE
+  measures replace the model's, the others (``ideal_*``, the parts' own closed
+  forms, and ``gain``, the DC gain K A0/(K + A0)) stay the model's.
+- ``both``: the same, with the model's figures of every sample beside SPICE's, and
+  their disagreement per figure (SPICE minus the model: mean, largest, the sample
+  where it is largest) and the yield each gives.
+- ``both`` with ``--spice-samples K``: the model on every sample; SPICE on the K
+  samples nearest or furthest beyond each limited figure's window (its tails) plus
+  K drawn at random from the rest (a generator seeded from (seed, 1), so the choice
+  is reproducible); how many verdicts SPICE flips, and the yield with those flips
+  applied (the worst samples are where flips happen; the random ones estimate the
+  flip rate in the bulk).
+- replay: sample I alone, its values drawn again from (seed, I) with the same
+  sampler, distribution and tolerances, simulated by the same engine.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.errors import DesignError
+from . import spice_engine
+
+ENGINES = ("analytic", "spice", "both")
+#: the seed of the random part of --spice-samples: SeedSequence(seed, spawn_key=(RANDOM_KEY,)) (chunks use (c,))
+RANDOM_KEY = 2 ** 31
+
+
+def plant_chunk(ctx, opamp, values: dict, start: int = 0) -> dict:
+    """The figures of a chunk of samples with the SPICE engine: the model's, with SPICE's in place
+    of those it measures and the SPICE-only ones (rise and settling time) added. Pure, of
+    picklable arguments: a chunk runner can send it to workers."""
+    from .montecarlo import _figures
+    return {**_figures(values, {}, opamp), **spice_engine.evaluate(ctx, values, start)}
+
+
+def spice_evaluate(ctx, opamp):
+    """``evaluate(values) -> figures`` (:func:`plant_chunk` bound to a design; picklable)."""
+    import functools
+    return functools.partial(plant_chunk, ctx, opamp)
+
+
+def disagreement(spice: dict, model: dict, index) -> dict:
+    """Per figure both engines give: SPICE minus the model over the samples ``index``
+    (absolute and relative), the sample where it is largest, and how many samples only
+    one engine gives a value for (a peak SPICE cannot resolve)."""
+    out = {}
+    index = np.asarray(index)
+    for k in spice_engine.SHARED:
+        s, m = np.asarray(spice[k], float), np.asarray(model[k], float)
+        both = np.isfinite(s) & np.isfinite(m)
+        if not both.any():
+            out[k] = {"compared": 0, "only_one": int(np.count_nonzero(np.isfinite(s) ^ np.isfinite(m)))}
+            continue
+        d = s[both] - m[both]
+        rel = d / np.where(m[both] != 0, np.abs(m[both]), np.nan)
+        j = int(np.argmax(np.abs(d)))
+        out[k] = {"compared": int(both.sum()), "mean": float(d.mean()), "max_abs": float(np.abs(d[j])),
+                  "max_abs_rel": float(np.nanmax(np.abs(rel))) if np.isfinite(rel).any() else None,
+                  "worst_sample": int(index[both][j]),
+                  "only_one": int(np.count_nonzero(np.isfinite(s) ^ np.isfinite(m)))}
+    return out
+
+
+def _passes(figs: dict, limits) -> np.ndarray:
+    from .montecarlo import _yield
+    return _yield(figs, limits)
+
+
+def spice_samples(figs: dict, limits, k: int, seed: int) -> tuple:
+    """(worst, random) sample indices: per limited figure the ``k`` samples with the least room
+    inside (most beyond) its window, and ``k`` others drawn at random."""
+    n = len(next(iter(figs.values())))
+    worst = []
+    for lim in limits:
+        v = np.asarray(figs[lim.figure], float)
+        room = np.minimum(v - lim.min, lim.max - v) / max(lim.max - lim.min, 1e-300)
+        room = np.where(np.isfinite(room), room, -np.inf)       # no value: outside, the worst
+        worst += [int(i) for i in np.argsort(room, kind="stable")[:k]]
+    worst = sorted(set(worst))
+    rest = np.setdiff1d(np.arange(n), worst)
+    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(RANDOM_KEY,)))
+    rand = sorted(int(i) for i in rng.choice(rest, size=min(k, rest.size), replace=False))
+    return worst, rand
+
+
+def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler: str = "random",
+                             dist: str = "uniform", tol_items=(), limit_items=(), engine: str = "analytic",
+                             spice_k: int | None = None, simulator: str = "ngspice-cli", scale=None,
+                             target_ci: float | None = None):
+    """:func:`designer.tolerance.montecarlo.plant_monte_carlo` of a plant result (its parts as
+    built, op-amp and deck) with the engine ``engine`` (:data:`ENGINES`); ``spice_k``: SPICE on
+    the tails and ``spice_k`` random samples only (``both``). ``scale``, ``target_ci``: where the
+    samples run and ``--target-ci`` (:mod:`designer.tolerance.runner`)."""
+    where = {"scale": scale, "target_ci": target_ci}
+    from .montecarlo import _figures, plant_monte_carlo
+    if engine not in ENGINES:
+        raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
+    amp = result.opamp
+    if engine == "analytic":
+        return plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist, tol_items, limit_items, **where)
+    ctx = spice_engine.context(result.deck, result.built, amp, result.test, simulator)
+    settings = {"engine": engine, "simulator": ctx.simulator, "max_step_s": ctx.max_step_s,
+                "rising_half_s": [ctx.t0, ctx.t1],
+                "fn_zeta": "second-order equivalents of the simulated step (zeta from the overshoot, fn from "
+                           "the peak time); the model's are its dominant pole pair",
+                "measured": list(spice_engine.FIGURES)}
+    if spice_k is not None:
+        mc = plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist, tol_items, limit_items,
+                               engine_name="both", **where)
+        n = mc.n       # the builds drawn (--target-ci may stop before --monte-carlo N)
+        if not mc.limits:
+            raise DesignError("--spice-samples needs --limit: its samples are the tails of each limited figure")
+        worst, rand = spice_samples(mc.figures, mc.limits, spice_k, seed)
+        idx = np.array(worst + rand, int)
+        order = np.argsort(idx)
+        idx = idx[order]
+        sub = {r: v[idx] for r, v in mc.values.items()}
+        sp = spice_evaluate(ctx, amp)(sub)
+        model_pass = mc.passed[idx]
+        spice_pass = _passes(sp, mc.limits)
+        to_fail = idx[model_pass & ~spice_pass]
+        to_pass = idx[~model_pass & spice_pass]
+        corrected = mc.yield_count - to_fail.size + to_pass.size
+        from .stats import wilson
+        is_rand = np.isin(idx, rand)
+        flips_rand = int(np.count_nonzero(model_pass[is_rand] != spice_pass[is_rand]))
+        mc.spice = {**settings, "samples_checked": int(idx.size), "worst": worst, "random": rand,
+                    "disagreement": disagreement(sp, {k: v[idx] for k, v in mc.figures.items()}, idx),
+                    "flipped": {"pass_to_fail": [int(i) for i in to_fail], "fail_to_pass": [int(i) for i in to_pass]},
+                    "random_flip_rate": {"count": flips_rand, "of": int(is_rand.sum()),
+                                         "ci95": list(wilson(flips_rand, int(is_rand.sum())))},
+                    "yield_model": mc.yield_count / n, "yield_with_spice": corrected / n,
+                    "yield_shift_pp": 100 * (corrected - mc.yield_count) / n}
+        for k in spice_engine.FIGURES:          # the CSV: SPICE's figures where simulated
+            col = np.full(n, np.nan)
+            col[idx] = sp[k]
+            mc.figures[f"spice_{k}"] = col
+        return mc
+    mc = plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist, tol_items, limit_items,
+                           engine_name=engine, evaluate=spice_evaluate(ctx, amp), **where)
+    n = mc.n
+    mc.spice = settings
+    model = _figures(mc.values, {}, amp)
+    if mc.tighten:       # the tightening search runs the model: its yield now is the model's
+        mc.tighten["yield_now"] = float(np.mean(_passes(model, mc.limits)))
+    if engine == "both":
+        mc.spice["disagreement"] = disagreement(mc.figures, model, np.arange(n))
+        if mc.limits:
+            y_model = int(np.count_nonzero(_passes(model, mc.limits)))
+            mc.spice.update(yield_model=y_model / n, yield_with_spice=mc.yield_count / n,
+                            yield_shift_pp=100 * (mc.yield_count - y_model) / n)
+        for k in spice_engine.SHARED:
+            mc.figures[f"model_{k}"] = model[k]
+    return mc
+
+
+def spice_lines(mc) -> list:
+    """The summary's lines on SPICE's part of a Monte Carlo."""
+    s = mc.spice
+    out = [f"  engine {s['engine']}: ngspice ({s['simulator']}), rising half, max step {s['max_step_s']:.3g} s"
+           + (f"; SPICE on {s['samples_checked']} samples ({len(s['worst'])} from the tails, "
+              f"{len(s['random'])} random)" if "samples_checked" in s else "")]
+    for k, d in (s.get("disagreement") or {}).items():
+        if d.get("compared"):
+            rel = "" if d["max_abs_rel"] is None else f" ({100 * d['max_abs_rel']:.3g} %)"
+            out.append(f"    SPICE - model, {k}: mean {d['mean']:.3g}, largest {d['max_abs']:.3g}{rel} "
+                       f"at sample {d['worst_sample']}")
+    if "yield_shift_pp" in s:
+        out.append(f"    yield: model {100 * s['yield_model']:.2f} %, with SPICE {100 * s['yield_with_spice']:.2f} % "
+                   f"({s['yield_shift_pp']:+.2f} pp)")
+    return out
+
+
+class Replay:
+    """One Monte Carlo sample replayed (``--replay I``): its index, the draw's settings, its parts'
+    values and its figures from the SPICE engine and the model (the result's ``monte_carlo``)."""
+
+    def __init__(self, index: int, settings: dict, values: dict, spice: dict, model: dict):
+        self.index, self.settings, self.values, self.spice, self.model = index, settings, values, spice, model
+
+    def to_dict(self) -> dict:
+        f = lambda d: {k: (None if not np.isfinite(v) else float(v)) for k, v in d.items()}  # noqa: E731
+        return {"replay": {"sample": self.index, "settings": self.settings, "values": dict(self.values),
+                           "spice_figures": f(self.spice), "model_figures": f(self.model)}}
+
+    def csv_text(self) -> str:
+        from .stats import samples_csv
+        text = samples_csv({k: np.array([v]) for k, v in self.values.items()},
+                           {**{k: np.array([v]) for k, v in self.spice.items()},
+                            **{f"model_{k}": np.array([self.model[k]]) for k in spice_engine.SHARED}})
+        head, row = text.split("\n", 1)
+        return head + "\n" + str(self.index) + row[row.index(","):]
+
+    def summary_lines(self) -> list:
+        st = self.settings
+        return [f"Replay of Monte Carlo sample {self.index} (of {st['samples']}, {st['sampler']}, {st['dist']}, "
+                f"seed {st['seed']}): " + ", ".join(f"{k} {v:.6g}" for k, v in self.values.items()),
+                "  SPICE engine: " + ", ".join(f"{k} {self.spice[k]:.5g}" for k in spice_engine.FIGURES),
+                "  model: " + ", ".join(f"{k} {self.model[k]:.5g}" for k in spice_engine.SHARED)]
+
+
+def replay_values(parts, series: dict, opamp, index: int, n: int, seed: int, sampler: str, dist: str,
+                  tol_items=()) -> tuple:
+    """(nominal, tolerances, values) of sample ``index`` of an ``n``-sample draw: exactly the
+    values :func:`designer.tolerance.montecarlo.plant_monte_carlo` drew for it."""
+    from . import sampling
+    from .montecarlo import plant_parts
+    from .parts import resolve
+    if not 0 <= index < n:
+        raise DesignError(f"--replay {index}: the Monte Carlo has samples 0 to {n - 1}")
+    nominal = plant_parts(parts)
+    if any(str(t).strip().upper().startswith("GBW") for t in tol_items or ()):
+        if opamp.ideal:
+            raise DesignError("--tol GBW: the ideal op-amp has no gain-bandwidth to spread")
+        nominal["GBW"] = opamp.gbw_hz
+    tol = resolve(tol_items, nominal, series)
+    v = sampling.values(nominal, tol.of, n, seed, sampler, dist, start=index, stop=index + 1)
+    return nominal, tol, {k: float(a[0]) for k, a in v.items()}
+
+
+def replay(result, series: dict, index: int, n: int, seed: int, sampler: str, dist: str, tol_items=(),
+           simulator: str = "ngspice-cli") -> Replay:
+    """Sample ``index`` of the draw on ``result``'s parts, through the SPICE engine and the model."""
+    from .montecarlo import _figures
+    _, tol, v = replay_values(result.built, series, result.opamp, index, n, seed, sampler, dist, tol_items)
+    arr = {k: np.array([x]) for k, x in v.items()}
+    ctx = spice_engine.context(result.deck, result.built, result.opamp, result.test, simulator)
+    sp = spice_engine.evaluate(ctx, arr, start=index)
+    model = _figures(arr, {}, result.opamp)
+    settings = {"samples": n, "seed": seed, "sampler": sampler, "dist": dist, "engine": "spice",
+                "simulator": ctx.simulator, "tolerances_pct": tol.to_dict()}
+    return Replay(index, settings, v, {k: float(a[0]) for k, a in sp.items()},
+                  {k: float(model[k][0]) for k in spice_engine.SHARED})
+
+
+def replay_result(result, rep: Replay, simulator: str, r_series=None, c_series=None, package=None):
+    """The full analyze-plant result (sheet, deck, waveforms) of the replayed sample's parts, exact
+    values (no E-series rounding), on the design's op-amp (with the sample's gain-bandwidth when it
+    varies) and square wave; its ``monte_carlo`` is the :class:`Replay`."""
+    import dataclasses
+
+    from ..plant.design import analyze_plant
+    from ..plant.sallenkey import SallenKeyParts
+    from ..plant.spec import AnalysisSpec
+    v = rep.values
+    parts = SallenKeyParts(v["R1"], v["R2"], v["C1"], v["C2"], None, v.get("R3", result.built.r3),
+                           v.get("R4", result.built.r4))
+    amp = result.opamp if "GBW" not in v else dataclasses.replace(result.opamp, gbw_hz=v["GBW"])
+
+    class _SampleSpec(AnalysisSpec):
+        @property
+        def amp(self):            # the sample's op-amp (its GBW drawn), not the catalogue's
+            return amp
+    spec = _SampleSpec(parts, opamp=result.opamp.name, r_series=r_series, c_series=c_series,
+                       amplitude_v=result.test.amplitude_v, square_hz=result.test.frequency_hz, package=package)
+    out = analyze_plant(spec, simulate=True, simulator=simulator)
+    out.notes.append(f"Monte Carlo sample {rep.index} replayed (seed {rep.settings['seed']}, "
+                     f"{rep.settings['sampler']}, {rep.settings['dist']}): these are its exact drawn values")
+    out.monte_carlo = rep
+    return out
