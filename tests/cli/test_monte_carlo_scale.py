@@ -73,6 +73,17 @@ def test_a_running_scheduler_and_its_worker_give_the_same_section(tmp_path):
                 p.wait()
 
 
+@pytest.mark.spice
+@pytest.mark.parametrize("simulator", ["ngspice-cli", "pyspice"])
+def test_the_spice_engine_gives_the_same_section_whatever_the_workers(simulator):
+    args = [*SEED, *MC, "--monte-carlo", "120", "--engine", "spice", "--simulator", simulator, "--no-files", "--json"]
+    got = [run(DESIGN_PLANT, *args, *where) for where in ([], ["--jobs", "2"], ["--dask", "local"])]
+    assert all(p.returncode == 0 and p.stderr == "" for p in got), [p.stderr for p in got]
+    sections = [json.loads(p.stdout)["monte_carlo"] for p in got]
+    assert sections[0]["settings"]["engine"] == "spice" and sections[0]["settings"]["samples"] == 120
+    assert sections[1] == sections[0] and sections[2] == sections[0]
+
+
 def test_the_loop_on_two_workers_is_the_same():
     a = run(DESIGN_PID, *PID, "--monte-carlo", "40", "--seed", "2", "--no-files", "--json")
     b = run(DESIGN_PID, *PID, "--monte-carlo", "40", "--seed", "2", "--no-files", "--json", "--jobs", "2")
