@@ -348,9 +348,11 @@ class DaskPool:
         self._config.__enter__()
         try:
             if address == "local":
+                # no dashboard; the scheduler's HTTP server (health routes) on a free local port: its
+                # default, 8787, may be another cluster's, and taking another port prints a warning
                 self.cluster = _start_cluster(lambda: distributed.LocalCluster(
                     n_workers=workers, threads_per_worker=1, processes=True, silence_logs=logging.CRITICAL,
-                    dashboard_address=None))
+                    dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}))
                 self.client = distributed.Client(self.cluster)
                 self.client.run(_adopt, os.getpid())
             else:

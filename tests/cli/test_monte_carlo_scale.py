@@ -84,6 +84,18 @@ def test_the_spice_engine_gives_the_same_section_whatever_the_workers(simulator)
     assert sections[1] == sections[0] and sections[2] == sections[0]
 
 
+def test_a_local_cluster_beside_another_prints_nothing():
+    """Dask's scheduler serves HTTP on 8787 by default and warns on stderr when another cluster holds it."""
+    with socket.socket() as other:
+        try:
+            other.bind(("0.0.0.0", 8787))
+            other.listen()
+        except OSError:   # held already: the same case
+            pass
+        p = run(DESIGN_PLANT, *SEED, "--monte-carlo", "300", "--no-sim", "--no-files", "--dask", "local")
+    assert p.returncode == 0 and p.stderr == "", p.stderr
+
+
 def test_the_loop_on_two_workers_is_the_same():
     a = run(DESIGN_PID, *PID, "--monte-carlo", "40", "--seed", "2", "--no-files", "--json")
     b = run(DESIGN_PID, *PID, "--monte-carlo", "40", "--seed", "2", "--no-files", "--json", "--jobs", "2")
