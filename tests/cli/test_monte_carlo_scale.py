@@ -13,6 +13,8 @@ import time
 import uuid
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from helpers import processes_tagged, script, tagged_env, wait_gone
 
 DESIGN_PLANT = script("design-plant")
@@ -211,3 +213,23 @@ def test_a_progress_bar_on_a_terminal_for_a_long_run_only():
     assert code == 0 and shown == ""
     code, shown = on_a_terminal(DESIGN_PLANT, *SEED, "--monte-carlo", "1000", "--no-sim", "--no-files")
     assert code == 0 and shown == ""     # done in well under a second: no bar
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(jobs=st.one_of(st.none(), st.text(max_size=6), st.integers(-3, 70).map(str)),
+       target=st.one_of(st.none(), st.text(max_size=8), st.floats(allow_nan=True).map(lambda x: f"{x}%")),
+       limit=st.booleans())
+def test_whatever_is_typed_for_jobs_and_target_ci_ends_in_0_or_one_line_2(tmp_path, capsys, jobs, target, limit):
+    """In-process: every --jobs and --target-ci text gives a run or one line and status 2, no file."""
+    from designer.cli.plant import design_plant_main
+    out = tmp_path / uuid.uuid4().hex    # tmp_path is shared by the examples
+    argv = [*SEED, "--monte-carlo", "40", "--no-sim", "--out", str(out)]
+    argv += ["--limit", "fn_hz=3k:4k"] if limit else []
+    argv += [] if jobs is None else [f"--jobs={jobs}"]
+    argv += [] if target is None else [f"--target-ci={target}"]
+    status = design_plant_main(argv)
+    err = capsys.readouterr().err
+    assert status in (0, 2), (argv, err)
+    if status == 2:
+        assert len(err.splitlines()) == 1 and "Traceback" not in err, (argv, err)
+        assert not out.exists() or not any(out.rglob("*.json"))
