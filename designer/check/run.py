@@ -53,6 +53,14 @@ def run_corner(spec: CheckSpec, index: int, simulator: str, *, update_golden: bo
     return CornerOutcome(corner, tuple(cases), design, tool, tuple(warnings), files, time.perf_counter() - tick)
 
 
+def corner_task(spec: CheckSpec, index: int, simulator: str, update_golden: bool, out_dir, timeout: float):
+    """:func:`run_corner` as a task of a Dask worker (``check-design --dask``): its ``ngspice -b``
+    runs get the command's ``--timeout`` (a cluster cannot kill a running task)."""
+    from ..spice import simulate
+    simulate.DEFAULT_TIMEOUT_S = float(timeout)
+    return run_corner(spec, index, simulator, update_golden=update_golden, out_dir=out_dir)
+
+
 def _failed(corner, kind, exc, tool, tick) -> CornerOutcome:
     what = "simulator error" if kind == SIM_ERROR else "bad spec"
     case = Case("simulation", corner, ERROR, f"simulation: {what}: {' '.join(str(exc).split())}", error_kind=kind)

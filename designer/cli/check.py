@@ -59,6 +59,12 @@ def _parser():
                                                 "every failing golden waveform under DIR/<spec>/")
     p.add_argument("--jobs", default="1", metavar="N", help="worker processes, one ngspice each (1 to 64, "
                                                             "default 1); the output order stays the same")
+    p.add_argument("--dask", metavar="ADDRESS",
+                   help="run each corner as a task of a running dask.distributed scheduler (tcp://host:8786), or "
+                        "'local' for a LocalCluster of --jobs workers (default 2); the workers need this package, "
+                        "ngspice, and the specs' files and --out at the same paths (a shared folder); a corner "
+                        "running on a cluster cannot be killed: --timeout bounds each `ngspice -b` run "
+                        "(--simulator ngspice-cli); a scheduler that does not answer within 3 s is exit status 3")
     p.add_argument("--simulator", default="pyspice", choices=("pyspice", "ngspice-cli"),
                    help="pyspice: ngspice's shared library (default); ngspice-cli: `ngspice -b`")
     p.add_argument("--timeout", default="600", metavar="S",
@@ -95,6 +101,8 @@ def _run(args) -> int:
     from ..core.errors import EXIT_OK, DesignError
     jobs = _whole(args.jobs, "--jobs", 1, 64)
     timeout = _whole(args.timeout, "--timeout", 1, 86400)
+    from ..tolerance.runner import parse_dask
+    dask = None if args.dask is None else parse_dask(args.dask)
     from ..core.fileio import check_output_file
     for value, what in ((args.junit, "--junit"), (args.summary, "--summary")):
         if value is not None:   # before any work: never a link, FIFO or device, never after the run
@@ -121,7 +129,7 @@ def _run(args) -> int:
             stages = {s.name: fileio.new_folder_beside(out_dir / s.name) for s in specs}
         tick = time.perf_counter()
         outcomes = run_specs(specs, args.simulator, jobs=jobs, timeout=timeout, update_golden=args.update_golden,
-                             out_dirs=stages)
+                             out_dirs=stages, dask=dask)
         seconds = time.perf_counter() - tick
         _report(outcomes, args, seconds, out_dir, stages)
     finally:
@@ -132,9 +140,9 @@ def _run(args) -> int:
 
 
 def run_specs(specs, simulator: str, *, jobs: int = 1, timeout: float = 600, update_golden: bool = False,
-              out_dirs=None) -> list:
-    """Every corner of every spec in worker processes; a
-    :class:`~designer.check.result.SpecOutcome` per spec, in the order given.
+              out_dirs=None, dask: str | None = None) -> list:
+    """Every corner of every spec in worker processes (or as tasks of a Dask cluster: ``dask``, an
+    address or ``"local"``); a :class:`~designer.check.result.SpecOutcome` per spec, in the order given.
     ``out_dirs``: spec name -> the folder its files are written in (none without)."""
     from ..core.workers import run_tasks
     from ..check.result import ERROR, SIM_ERROR, Case, CornerOutcome, SpecOutcome
@@ -170,7 +178,10 @@ def run_specs(specs, simulator: str, *, jobs: int = 1, timeout: float = 600, upd
         # longer than a plant; a user's deck is unknown, taken as a plant
         return 4.0 if specs[task[0]].kind == "pid" else 1.0
 
-    results = run_tasks(tasks, work, jobs, timeout, lost, setup, cost)
+    if dask is None:
+        results = run_tasks(tasks, work, jobs, timeout, lost, setup, cost)
+    else:
+        results = _on_dask(dask, jobs, tasks, specs, simulator, update_golden, out_dirs, timeout, lost, cost)
     outcomes, at = [], 0
     for s in specs:
         corners = results[at: at + len(s.corners)]
@@ -178,6 +189,22 @@ def run_specs(specs, simulator: str, *, jobs: int = 1, timeout: float = 600, upd
         tool = next((c.tool for c in corners if c.tool.get("ngspice")), corners[0].tool)
         outcomes.append(SpecOutcome(s.name, str(s.path), s.kind, list(corners), tool))
     return outcomes
+
+
+def _on_dask(address, jobs, tasks, specs, simulator, update_golden, out_dirs, timeout, lost, cost) -> list:
+    """The corners as tasks of a Dask cluster, longest first (:class:`designer.tolerance.runner.DaskPool`:
+    a corner whose worker dies runs once more, then is ``lost``); results in task order."""
+    from ..check.run import corner_task
+    from ..tolerance.runner import DaskPool
+    order = sorted(range(len(tasks)), key=lambda j: -cost(tasks[j]))
+    calls = [(specs[tasks[j][0]], tasks[j][1], simulator, update_golden, (out_dirs or {}).get(specs[tasks[j][0]].name),
+              timeout) for j in order]
+    with DaskPool(address, jobs if jobs > 1 else 2) as pool:
+        got = pool.calls(corner_task, calls, lambda i, why: lost(tasks[order[i]], why))
+    results = [None] * len(tasks)
+    for pos, j in enumerate(order):
+        results[j] = got[pos]
+    return results
 
 
 def _report(outcomes, args, seconds: float, out_dir, stages: dict) -> None:

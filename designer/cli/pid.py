@@ -128,8 +128,10 @@ def _loop_monte_carlo(result, args, settings):
     if settings is None:
         return result
     n, seed = settings
+    from .plant import scale_settings
+    scale, _ = scale_settings(args)
     result.monte_carlo = loop_monte_carlo(result, loop_series(result), n, seed, args.sampler, args.dist,
-                                          args.tol or (), args.limit or ())
+                                          args.tol or (), args.limit or (), scale=scale)
     return result
 
 
@@ -302,6 +304,10 @@ def _monte_carlo_settings(args, spec):
     settings = monte_carlo_settings(args, LOOP_PARTS if spec.process is None else CONTROLLER_PARTS, parse_loop_limit)
     if any(str(t).strip().upper().startswith("GBW") for t in args.tol or ()):
         raise DesignError("--tol GBW spreads a plant's op-amp (design-plant); a loop's op-amps do not vary yet")
+    from .plant import scale_settings
+    if scale_settings(args)[1] is not None:   # --jobs and --dask checked before any work too
+        raise DesignError("--target-ci draws a plant's builds in rounds (design-plant, analyze-plant); for a loop "
+                          "give the number of builds with --monte-carlo N")
     return settings
 
 

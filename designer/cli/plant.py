@@ -61,8 +61,10 @@ result.json, step.png, bode.png. Exit status 2 on bad input.""",
 
 
 def add_monte_carlo_options(p, what: str):
-    """--monte-carlo, --seed, --tol, --dist, --sampler (the plant's and the loop's); returns the group."""
+    """--monte-carlo, --seed, --tol, --dist, --sampler, --target-ci, and where the builds run (--jobs, --dask)
+    (the plant's and the loop's); returns the Monte Carlo's group."""
     from ..tolerance.montecarlo import MAX_SAMPLES, MIN_SAMPLES
+    from ..tolerance.runner import CONNECT_TIMEOUT
     g = p.add_argument_group("tolerance analysis (Monte Carlo of the parts as built, analytic)")
     g.add_argument("--monte-carlo", metavar="N",
                    help=f"draw N builds within the parts' tolerances ({MIN_SAMPLES} to {MAX_SAMPLES:.0e}) and report "
@@ -78,8 +80,43 @@ def add_monte_carlo_options(p, what: str):
                    help="uniform in nominal (1 +- tol) (default), or normal with sigma = tol/3 truncated at +- tol")
     g.add_argument("--sampler", default="random", choices=("random", "lhs", "sobol"),
                    help="random (default), lhs (Latin hypercube) or sobol (scrambled)")
+    g.add_argument("--target-ci", metavar="PCT",
+                   help="draw in rounds until the yield's 95 %% Wilson half-width is below PCT (above 0, at most "
+                        "50 %%, e.g. 1%%), --monte-carlo N builds at most; needs --limit, and random or sobol "
+                        "(result.json records the builds drawn)")
+    s = p.add_argument_group("where the builds run (the same result wherever they run)")
+    s.add_argument("--jobs", metavar="N", help="local worker processes, 1 to 64 (default 1: this process); with "
+                                               "--dask local, the LocalCluster's workers (default 2)")
+    s.add_argument("--dask", metavar="ADDRESS",
+                   help="send the builds, in chunks, to a running dask.distributed scheduler (tcp://host:8786; "
+                        "see the README for starting one), or 'local' for a LocalCluster on this machine; a "
+                        f"scheduler that does not answer within {CONNECT_TIMEOUT:g} s is exit status 3")
     g.set_defaults(limit=None, worst_case=False)
     return g
+
+
+def scale_settings(args):
+    """--jobs, --dask, --target-ci checked (before any work): (Scale, target half-width or None).
+    A progress bar on stderr when it is a terminal and the output is not --json."""
+    from ..tolerance.runner import Scale, parse_dask, parse_jobs
+    if args.monte_carlo is None:
+        given = [f for f, v in (("--jobs", args.jobs), ("--dask", args.dask), ("--target-ci", args.target_ci))
+                 if v is not None]
+        if given:
+            raise DesignError(f"{given[0]} goes with --monte-carlo N")
+        return None, None
+    jobs = 1 if args.jobs is None else parse_jobs(args.jobs)
+    dask = None if args.dask is None else parse_dask(args.dask)
+    target = None
+    if args.target_ci is not None:
+        from ..tolerance.montecarlo import check_target_ci, parse_target_ci
+        target = parse_target_ci(args.target_ci)
+        check_target_ci(target, args.limit, args.sampler)
+    try:
+        tty = sys.stderr.isatty()
+    except (AttributeError, ValueError):
+        tty = False
+    return Scale(jobs=jobs, dask=dask, progress=tty and not getattr(args, "json", False)), target
 
 
 def _add_tolerance_options(p):
@@ -127,6 +164,7 @@ def monte_carlo_settings(args, designators=PLANT_PARTS, parse_limit_item=None):
         if args.tol:
             from ..tolerance.parts import check_items
             check_items(args.tol, designators)
+        scale_settings(args)
         return None
     from ..tolerance.montecarlo import MAX_SAMPLES, MIN_SAMPLES
     from ..tolerance.plant import FIGURES
@@ -148,6 +186,7 @@ def monte_carlo_settings(args, designators=PLANT_PARTS, parse_limit_item=None):
         parse_limit(item, FIGURES) if parse_limit_item is None else parse_limit_item(item)
     from ..tolerance.parts import check_items
     check_items(args.tol or (), designators)
+    scale_settings(args)
     return n, seed
 
 
@@ -203,14 +242,17 @@ def _with_monte_carlo(result, args, settings, spice=("analytic", None, None)):
         return result
     from ..tolerance.montecarlo import plant_monte_carlo
     n, seed = settings
+    scale, target = scale_settings(args)
     if spice[0] != "analytic":
         from ..tolerance.spice_mc import plant_monte_carlo_engine
         result.monte_carlo = plant_monte_carlo_engine(result, {"R": s.r_series, "C": s.c_series}, n, seed,
                                                       args.sampler, args.dist, args.tol or (), args.limit or (),
-                                                      spice[0], spice[1], args.simulator)
+                                                      spice[0], spice[1], args.simulator, scale=scale,
+                                                      target_ci=target)
         return result
     result.monte_carlo = plant_monte_carlo(result.built, {"R": s.r_series, "C": s.c_series}, result.opamp, n, seed,
-                                           args.sampler, args.dist, args.tol or (), args.limit or ())
+                                           args.sampler, args.dist, args.tol or (), args.limit or (), scale=scale,
+                                           target_ci=target)
     return result
 
 

@@ -80,7 +80,7 @@ class Worker:
         self.conn.close()
 
 
-def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, cost=None) -> list:
+def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, cost=None, done=None) -> list:
     """``work(task)`` for every task, at most ``jobs`` at a time, each within
     ``timeout`` seconds; results in task order.
 
@@ -103,6 +103,8 @@ def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, co
         ``cost(task)``: a task's expected run time (any scale). Tasks start
         longest first, so the last to finish is a short one and the workers
         end close together (results keep the task order).
+    done : callable, optional
+        ``done(index, result)``, called as each task's result arrives (a progress bar).
     """
     ctx = multiprocessing.get_context("fork")
     results = [None] * len(tasks)
@@ -133,6 +135,8 @@ def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, co
                         kind, value = "dead", f"the worker running it died ({why}): the simulator crashed"
                     results[i] = value if kind == "ok" else lost(tasks[i], value)
                     w.task = None
+                    if done is not None:
+                        done(i, results[i])
                     if kind == "dead":
                         w.kill()
                         workers[k] = w = Worker(ctx, work, setup)
@@ -140,6 +144,8 @@ def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, co
                     w.kill()
                     results[i] = lost(tasks[i], f"timed out after {timeout:g} s (killed)")
                     workers[k] = w = Worker(ctx, work, setup)
+                    if done is not None:
+                        done(i, results[i])
                 if w.task is None and queue:
                     j = queue.popleft()
                     w.give(j, tasks[j], timeout)

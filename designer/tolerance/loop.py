@@ -136,22 +136,43 @@ def model_loop_figures(values: dict, result) -> dict:
     return out
 
 
+@dataclass(frozen=True)
+class LoopContext:
+    """What the loop engine needs of a design-pid result besides the parts (small and
+    picklable: it travels with every chunk, :mod:`.runner`)."""
+
+    opamp: object        #: the op-amp of every stage
+    step_v: float        #: the design's test step
+    edge_s: float        #: its rise time
+    t_end: float         #: the step's duration
+
+    @classmethod
+    def of(cls, result) -> "LoopContext":
+        return cls(result.opamp, float(result.test.amplitude_v), float(result.test.edge_s),
+                   float(result.waveforms.t[-1]))
+
+
 def loop_figures(values: dict, result) -> dict:
     """Every figure of :data:`FIGURES` for each sample (arrays over the samples)."""
     if is_model_loop(result):
         return model_loop_figures(values, result)
+    return evaluate(LoopContext.of(result), values)
+
+
+def evaluate(context: LoopContext, values: dict) -> dict:
+    """The engine's chunk function for a Sallen-Key plant's loop (:mod:`.runner`): every figure of
+    :data:`FIGURES` of each sample."""
     from ..pid import model
     from ..pid.blocks import PidParts
     from ..plant.model import plant_tf, plant_tf_opamp
     from ..plant.sallenkey import SallenKeyParts
-    amp = result.opamp
+    amp = context.opamp
     n = next(iter(values.values())).size
     out = {k: np.full(n, np.nan) for k in FIGURES}
-    step = result.test.amplitude_v
+    step = context.step_v
     names = [f.name for f in fields(PidParts)]
-    t_end = result.waveforms.t[-1]
-    t = np.linspace(0.0, t_end, STEP_POINTS)
-    r = model.reference(t, step, 0.0, result.test.edge_s)
+    t = np.linspace(0.0, context.t_end, STEP_POINTS)
+    r = model.reference(t, step, 0.0, context.edge_s)
     for i in range(n):
         plant = SallenKeyParts(values["R1"][i], values["R2"][i], values["C1"][i], values["C2"][i])
         parts = PidParts(**{k: (values[k.upper()][i] if k.upper() in values else None) for k in names})
@@ -182,19 +203,31 @@ def _passed(figs: dict, limits) -> np.ndarray:
     return (figs["stable"] == 1) & _yield(figs, limits)
 
 
+def _model_evaluate(result, values: dict) -> dict:
+    """The engine's chunk function for a plant given as a model (the result travels as the context)."""
+    return model_loop_figures(values, result)
+
+
+def engine_of(result) -> tuple:
+    """(chunk function, context) of the result's loop engine (:mod:`.runner`)."""
+    return (_model_evaluate, result) if is_model_loop(result) else (evaluate, LoopContext.of(result))
+
+
 def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str = "random", dist: str = "uniform",
-                     tol_items=(), limit_items=(), tighten: bool = True):
+                     tol_items=(), limit_items=(), tighten: bool = True, scale=None):
     """A Monte Carlo of a design-pid result's loop: the probabilities of instability and of
     saturation with their Wilson intervals, the statistics of every figure and, with
     ``limit_items`` (``--limit`` texts such as ``phase_margin_deg=45:90``), the yield with its
     interval, each part's share of each limited figure's variance, the worst failing samples per
     limit and the part whose tolerance halved raises the yield most (tried on the
-    :data:`TIGHTEN_CANDIDATES` parts with the largest shares, one more run each).
+    :data:`TIGHTEN_CANDIDATES` parts with the largest shares, one more run each). ``scale``: where
+    the samples run (:class:`designer.tolerance.runner.Scale`; default here); the result is the
+    same wherever they run.
 
     Returns a :class:`LoopMonteCarlo`."""
-    from . import sampling
     from .montecarlo import MAX_SAMPLES, MIN_SAMPLES
     from .parts import resolve
+    from .runner import Draw, Runner, Scale
     from .stats import failing_samples, figure_stats, variance_shares, wilson
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_SAMPLES <= n <= MAX_SAMPLES:
         raise DesignError(f"--monte-carlo must be a whole number of samples from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
@@ -202,35 +235,37 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
     limits = tuple(parse_loop_limit(t) for t in limit_items or ())
     nominal = loop_parts(result)
     tol = resolve(tol_items, nominal, series)
-    values = sampling.values(nominal, tol.of, n, seed, sampler, dist)
-    figs = loop_figures(values, result)
-    nominal_figs = {k: float(v[0]) for k, v in loop_figures({r: np.array([x]) for r, x in nominal.items()},
-                                                            result).items()}
-    by_fig = {lim.figure: lim for lim in limits}
-    stats = {k: figure_stats(k, figs[k], nominal_figs[k], by_fig.get(k)) for k in LIMITABLE}
-    rel = {r: values[r] / nominal[r] - 1 for r in values}
-    shares = {k: variance_shares(rel, figs[k]) for k in (by_fig or dict(SHOWN))}
-    unstable = int(np.count_nonzero(figs["stable"] == 0))
-    saturated = int(np.count_nonzero(figs["saturated"] == 1))
-    mc = LoopMonteCarlo(n, seed, sampler, dist, "analytic", tol, nominal, values, figs, nominal_figs, limits, stats,
-                        _passed(figs, limits) if limits else None, shares,
-                        failing_samples(figs, limits),
-                        p_unstable={"count": unstable, "fraction": unstable / n, "ci95": list(wilson(unstable, n))},
-                        p_saturated={"count": saturated, "fraction": saturated / n,
-                                     "ci95": list(wilson(saturated, n))},
-                        unstable_samples=[int(i) for i in np.nonzero(figs["stable"] == 0)[0][:5]])
-    if tighten and limits and mc.yield_count < n:
-        weight = {r: sum(shares[k][r] for k in by_fig) for r in tol.of}
-        best = None
-        for ref in sorted(tol.of, key=lambda r: -weight[r])[:TIGHTEN_CANDIDATES]:
-            halved = dict(tol.of, **{ref: tol.of[ref] / 2})
-            y = float(np.mean(_passed(loop_figures(sampling.values(nominal, halved, n, seed, sampler, dist),
-                                                   result), limits)))
-            if best is None or y > best[1]:
-                best = (ref, y)
-        mc.tighten = {"part": best[0], "tolerance_pct": 100 * tol.of[best[0]] / 2, "yield": best[1],
-                      "yield_now": mc.yield_count / n,
-                      "tried": sorted(tol.of, key=lambda r: -weight[r])[:TIGHTEN_CANDIDATES]}
+    chunk_fn, context = engine_of(result)
+    with Runner(scale or Scale()) as run:
+        values, figs, _ = run.run(chunk_fn, context, Draw(nominal, tol.of, n, seed, sampler, dist))
+        nominal_figs = {k: float(v[0]) for k, v in loop_figures({r: np.array([x]) for r, x in nominal.items()},
+                                                                result).items()}
+        by_fig = {lim.figure: lim for lim in limits}
+        stats = {k: figure_stats(k, figs[k], nominal_figs[k], by_fig.get(k)) for k in LIMITABLE}
+        rel = {r: values[r] / nominal[r] - 1 for r in values}
+        shares = {k: variance_shares(rel, figs[k]) for k in (by_fig or dict(SHOWN))}
+        unstable = int(np.count_nonzero(figs["stable"] == 0))
+        saturated = int(np.count_nonzero(figs["saturated"] == 1))
+        mc = LoopMonteCarlo(n, seed, sampler, dist, "analytic", tol, nominal, values, figs, nominal_figs, limits,
+                            stats, _passed(figs, limits) if limits else None, shares,
+                            failing_samples(figs, limits),
+                            p_unstable={"count": unstable, "fraction": unstable / n,
+                                        "ci95": list(wilson(unstable, n))},
+                            p_saturated={"count": saturated, "fraction": saturated / n,
+                                         "ci95": list(wilson(saturated, n))},
+                            unstable_samples=[int(i) for i in np.nonzero(figs["stable"] == 0)[0][:5]])
+        if tighten and limits and mc.yield_count < n:
+            weight = {r: sum(shares[k][r] for k in by_fig) for r in tol.of}
+            tried = sorted(tol.of, key=lambda r: -weight[r])[:TIGHTEN_CANDIDATES]
+            best = None
+            for ref in tried:
+                halved = dict(tol.of, **{ref: tol.of[ref] / 2})
+                _, f, _ = run.run(chunk_fn, context, Draw(nominal, halved, n, seed, sampler, dist), progress=False)
+                y = float(np.mean(_passed(f, limits)))
+                if best is None or y > best[1]:
+                    best = (ref, y)
+            mc.tighten = {"part": best[0], "tolerance_pct": 100 * tol.of[best[0]] / 2, "yield": best[1],
+                          "yield_now": mc.yield_count / n, "tried": tried}
     return mc
 
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..core.errors import DesignError
 from . import plant as engine
-from . import sampling
+from . import runner, sampling
 from .parts import DISTRIBUTIONS, resolve
 from .stats import Limit, failing_samples, figure_stats, parse_limit, samples_csv, variance_shares, wilson
 
@@ -21,6 +21,10 @@ from .stats import Limit, failing_samples, figure_stats, parse_limit, samples_cs
 MIN_SAMPLES, MAX_SAMPLES = 10, 10 ** 7
 #: failing samples listed per limit (the worst)
 WORST = 5
+#: --target-ci: the samples of the first round, and the fewest a round adds
+TARGET_ROUND = 500
+#: --target-ci: the widest half-width accepted (a fraction)
+MAX_TARGET_CI = 0.5
 
 
 @dataclass
@@ -43,6 +47,7 @@ class MonteCarlo:
     shares: dict = field(default_factory=dict)
     failing: dict = field(default_factory=dict)
     tighten: dict | None = None
+    target: dict | None = None         #: --target-ci: the half-width asked, whether reached, each round's end
     spice: dict | None = None          #: SPICE beside the model (designer.tolerance.spice_mc), when asked
 
     @property
@@ -59,8 +64,11 @@ class MonteCarlo:
 
     def to_dict(self) -> dict:
         lo, hi = self.yield_interval()
-        return {"settings": {"samples": self.n, "seed": self.seed, "sampler": self.sampler, "dist": self.dist,
-                             "engine": self.engine, "tolerances_pct": self.tolerances.to_dict()},
+        settings = {"samples": self.n, "seed": self.seed, "sampler": self.sampler, "dist": self.dist,
+                    "engine": self.engine, "tolerances_pct": self.tolerances.to_dict()}
+        if self.target is not None:
+            settings["target_ci"] = self.target
+        return {"settings": settings,
                 "nominal_parts": self.nominal, "nominal_figures": self.nominal_figures,
                 "limits": [lim.to_dict() for lim in self.limits],
                 "statistics": {k: v.to_dict() for k, v in self.stats.items()},
@@ -132,8 +140,8 @@ def plant_worst_case(parts, series: dict, opamp, tol_items=()):
 
 
 def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler: str = "random",
-                      dist: str = "uniform", tol_items=(), limit_items=(), tighten: bool = True,
-                      engine_name: str = "analytic", evaluate=None) -> MonteCarlo:
+                      dist: str = "uniform", tol_items=(), limit_items=(), tighten: bool = True, scale=None,
+                      target_ci: float | None = None, engine_name: str = "analytic", evaluate=None) -> MonteCarlo:
     """A Monte Carlo of the Sallen-Key ``parts`` (:class:`~designer.plant.sallenkey.SallenKeyParts`).
 
     Parameters
@@ -159,6 +167,12 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     engine_name, evaluate : str, callable
         The engine's name and, for another engine than the analytic one, its
         ``evaluate(values) -> {figure: array}`` (:mod:`designer.tolerance.spice_mc`).
+    scale : designer.tolerance.runner.Scale, optional
+        Where the samples run (``--jobs``, ``--dask``, a progress bar); default in this process.
+        The result is the same wherever they run.
+    target_ci : float, optional
+        ``--target-ci``: draw in rounds until the yield's 95 % Wilson half-width is below it
+        (a fraction), ``n`` samples at most (:func:`target_rounds`); needs limits.
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_SAMPLES <= n <= MAX_SAMPLES:
         raise DesignError(f"--monte-carlo must be a whole number of samples from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
@@ -174,9 +188,95 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
             raise DesignError("--tol GBW: the ideal op-amp has no gain-bandwidth to spread")
         nominal["GBW"] = opamp.gbw_hz     # varies only when asked: a datasheet's typical is not a tolerance
     tol = resolve(tol_items, nominal, series)
-    values = sampling.values(nominal, tol.of, n, seed, sampler, dist)
-    figure_of = evaluate or (lambda v: _figures(v, {}, opamp))
-    figs = figure_of(values)
+    until, first = None, n
+    if target_ci is not None:
+        check_target_ci(target_ci, limits, sampler)
+        until, first = target_rounds(limits, target_ci, n), min(n, TARGET_ROUND)
+    # another engine's evaluate(values) travels to the workers as the context of _apply
+    chunk_fn, context = (engine.evaluate, opamp) if evaluate is None else (_apply, evaluate)
+    with runner.Runner(scale or runner.Scale()) as run:
+        values, figs, ends = run.run(chunk_fn, context, runner.Draw(nominal, tol.of, n, seed, sampler, dist),
+                                     first, until)
+        mc = _analyse(seed, sampler, dist, tol, nominal, values, figs, limits,
+                      evaluate or (lambda v: _figures(v, {}, opamp)), engine_name)
+        if target_ci is not None:
+            lo, hi = mc.yield_interval()
+            mc.target = {"half_width_pct": 100 * target_ci, "max_samples": n, "reached": (hi - lo) / 2 < target_ci,
+                         "rounds": ends}
+        if tighten and limits:
+            mc.tighten = _tighten(run, mc, opamp, n)
+            if engine_name != "analytic":
+                mc.tighten["engine"] = "analytic"
+    return mc
+
+
+def _apply(evaluate, values: dict) -> dict:
+    """The runner's chunk function for an engine given as ``evaluate(values)`` (a picklable partial)."""
+    return evaluate(values)
+
+
+def parse_target_ci(text) -> float:
+    """``--target-ci``: ``1%``, ``0.5 %`` or a fraction (``0.01``)."""
+    from ..core.units import parse_value
+    t = str(text).strip()
+    pct = t.endswith("%")
+    try:
+        v = parse_value(t[:-1].strip() if pct else t, "--target-ci")
+    except DesignError:
+        v = None
+    if v is None or not np.isfinite(v):
+        raise DesignError(f"--target-ci {text!r}: give the yield interval's half-width as a percentage, such as "
+                          f"1% (above 0, at most {100 * MAX_TARGET_CI:g} %)")
+    v = v / 100 if pct else v
+    if not 0 < v <= MAX_TARGET_CI:
+        raise DesignError(f"--target-ci must be a half-width above 0 and at most {100 * MAX_TARGET_CI:g} %, got "
+                          f"{text!r}")
+    return float(v)
+
+
+def check_target_ci(target_ci, limits, sampler) -> None:
+    """``--target-ci``'s value and what it needs, checked before any work."""
+    if not isinstance(target_ci, (int, float)) or not 0 < target_ci <= MAX_TARGET_CI:
+        raise DesignError(f"--target-ci must be a half-width above 0 and at most {100 * MAX_TARGET_CI:g} %, got "
+                          f"{target_ci!r}")
+    if not limits:
+        raise DesignError("--target-ci sets the yield's interval: it needs --limit FIGURE=MIN:MAX")
+    if sampler == "lhs":
+        raise DesignError("--target-ci draws in rounds, and a Latin hypercube's strata depend on the final N: "
+                          "use --sampler random or sobol")
+
+
+def half_width(k: int, n: int) -> float:
+    """The 95 % Wilson interval's half-width of k in n."""
+    lo, hi = wilson(k, n)
+    return (hi - lo) / 2
+
+
+def target_rounds(limits, target: float, n_max: int):
+    """``until`` of :meth:`designer.tolerance.runner.Runner.run` for ``--target-ci``: after a
+    round of n samples with k inside every limit, None when the Wilson half-width is below
+    ``target``, else the next total: where the half-width would reach it at the same yield,
+    at least :data:`TARGET_ROUND` more and at most twice n (a first estimate is rough)."""
+    def until(figs):
+        ok = _yield(figs, limits)
+        n = ok.size
+        k = int(np.count_nonzero(ok))
+        if half_width(k, n) < target:
+            return None
+        m = n
+        while m < n_max and half_width(round(k / n * m), m) >= target:   # the n that would do at this yield
+            m = min(n_max, 2 * m)
+        lo = n
+        while lo < m - 1:
+            mid = (lo + m) // 2
+            lo, m = (lo, mid) if half_width(round(k / n * mid), mid) < target else (mid, m)
+        return min(n_max, max(n + TARGET_ROUND, min(2 * n, -(-m // TARGET_ROUND) * TARGET_ROUND)))
+    return until
+
+
+def _analyse(seed, sampler, dist, tol, nominal, values, figs, limits, figure_of, engine_name) -> MonteCarlo:
+    """The statistics of the samples drawn (``figure_of(values)``: the nominal's figures)."""
+    n = len(next(iter(figs.values())))
     nominal_figs = {k: float(v[0]) for k, v in figure_of({r: np.array([x]) for r, x in nominal.items()}).items()}
     by_fig = {lim.figure: lim for lim in limits}
     stats = {k: figure_stats(k, v, nominal_figs[k], by_fig.get(k)) for k, v in figs.items()}
@@ -185,14 +285,18 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     mc = MonteCarlo(n, seed, sampler, dist, engine_name, tol, nominal, values, figs, nominal_figs, limits, stats,
                     _yield(figs, limits) if limits else None, shares)
     mc.failing.update(failing_samples(figs, limits, WORST))
-    if tighten and limits:
-        best = None
-        for ref in tol.of:
-            halved = dict(tol.of, **{ref: tol.of[ref] / 2})
-            y = float(np.mean(_yield(_figures(sampling.values(nominal, halved, n, seed, sampler, dist), {}, opamp),
-                                     limits)))
-            if best is None or y > best[1]:
-                best = (ref, y)
-        mc.tighten = {"part": best[0], "tolerance_pct": 100 * tol.of[best[0]] / 2, "yield": best[1],
-                      "yield_now": mc.yield_count / n, **({} if engine_name == "analytic" else {"engine": "analytic"})}
     return mc
+
+
+def _tighten(run, mc: MonteCarlo, opamp, n_max: int) -> dict:
+    """The part whose tolerance halved raises the yield most (the same samples' deviations, each
+    part's halved in turn), and the yield it gives."""
+    best = None
+    for ref, t in mc.tolerances.of.items():
+        draw = runner.Draw(mc.nominal, dict(mc.tolerances.of, **{ref: t / 2}), n_max, mc.seed, mc.sampler, mc.dist)
+        _, figs, _ = run.run(engine.evaluate, opamp, draw, mc.n, progress=False)
+        y = float(np.mean(_yield(figs, mc.limits)))
+        if best is None or y > best[1]:
+            best = (ref, y)
+    return {"part": best[0], "tolerance_pct": 100 * mc.tolerances.of[best[0]] / 2, "yield": best[1],
+            "yield_now": mc.yield_count / mc.n}

@@ -118,3 +118,8 @@ def plant_figures(v: dict, opamp=None) -> dict:
         return {"fn_hz": wn / (2 * np.pi), "zeta": z, "q": 1 / (2 * z), "ideal_fn_hz": np.asarray(fn_i, float),
                 "ideal_zeta": np.asarray(z_i, float), "ideal_q": 1 / (2 * np.asarray(z_i, float)),
                 "overshoot_pct": over, "peak_time_s": tpk, "gain": 1.0 / d0}
+
+
+def evaluate(opamp, values: dict) -> dict:
+    """The engine's chunk function (:mod:`.runner`): :func:`plant_figures` of ``values`` with ``opamp``."""
+    return plant_figures(values, opamp)

@@ -12,6 +12,8 @@ tolerance: uniform, or normal with sigma = tol/3 truncated at +- tol.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ..core.errors import DesignError
@@ -46,7 +48,16 @@ def unit_samples(n: int, dims: int, seed: int, sampler: str = "random", start: i
             # any n is allowed: a power of 2 balances the points best, which the benchmark measures
             warnings.filterwarnings("ignore", "The balance properties of Sobol", UserWarning)
             return eng.random(stop - start)
-    return qmc.LatinHypercube(dims, seed=seed).random(n)[start:stop]
+    return _hypercube(n, dims, seed)[start:stop]
+
+
+@functools.lru_cache(maxsize=1)
+def _hypercube(n: int, dims: int, seed: int) -> np.ndarray:
+    """The whole Latin hypercube, drawn once per process for all its chunks (:mod:`.runner`)."""
+    from scipy.stats import qmc
+    u = qmc.LatinHypercube(dims, seed=seed).random(n)
+    u.flags.writeable = False      # shared by every chunk's slice
+    return u
 
 
 def deviations(u, dist: str = "uniform") -> np.ndarray:

@@ -89,16 +89,19 @@ def spice_samples(figs: dict, limits, k: int, seed: int) -> tuple:
 
 def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler: str = "random",
                              dist: str = "uniform", tol_items=(), limit_items=(), engine: str = "analytic",
-                             spice_k: int | None = None, simulator: str = "ngspice-cli"):
+                             spice_k: int | None = None, simulator: str = "ngspice-cli", scale=None,
+                             target_ci: float | None = None):
     """:func:`designer.tolerance.montecarlo.plant_monte_carlo` of a plant result (its parts as
     built, op-amp and deck) with the engine ``engine`` (:data:`ENGINES`); ``spice_k``: SPICE on
-    the tails and ``spice_k`` random samples only (``both``)."""
+    the tails and ``spice_k`` random samples only (``both``). ``scale``, ``target_ci``: where the
+    samples run and ``--target-ci`` (:mod:`designer.tolerance.runner`)."""
+    where = {"scale": scale, "target_ci": target_ci}
     from .montecarlo import _figures, plant_monte_carlo
     if engine not in ENGINES:
         raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
     amp = result.opamp
     if engine == "analytic":
-        return plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist, tol_items, limit_items)
+        return plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist, tol_items, limit_items, **where)
     ctx = spice_engine.context(result.deck, result.built, amp, result.test, simulator)
     settings = {"engine": engine, "simulator": ctx.simulator, "max_step_s": ctx.max_step_s,
                 "rising_half_s": [ctx.t0, ctx.t1],
@@ -107,7 +110,8 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
                 "measured": list(spice_engine.FIGURES)}
     if spice_k is not None:
         mc = plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist, tol_items, limit_items,
-                               engine_name="both")
+                               engine_name="both", **where)
+        n = mc.n       # the builds drawn (--target-ci may stop before --monte-carlo N)
         if not mc.limits:
             raise DesignError("--spice-samples needs --limit: its samples are the tails of each limited figure")
         worst, rand = spice_samples(mc.figures, mc.limits, spice_k, seed)
@@ -137,7 +141,8 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
             mc.figures[f"spice_{k}"] = col
         return mc
     mc = plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist, tol_items, limit_items,
-                           engine_name=engine, evaluate=spice_evaluate(ctx, amp))
+                           engine_name=engine, evaluate=spice_evaluate(ctx, amp), **where)
+    n = mc.n
     mc.spice = settings
     model = _figures(mc.values, {}, amp)
     if mc.tighten:       # the tightening search runs the model: its yield now is the model's

@@ -36,3 +36,15 @@ def test_a_task_past_its_timeout_is_lost_and_the_rest_still_run():
     out = run_tasks(["hang", "a", "b"], work, jobs=2, timeout=1.0, lost=lambda t, why: ("lost", why))
     assert out[0][0] == "lost" and "timed out" in out[0][1]
     assert out[1:] == ["a", "b"]
+
+
+def test_done_is_called_once_per_task_as_it_finishes_lost_ones_included():
+    def work(task):
+        if task == "hang":
+            time.sleep(60)
+        return task * 2
+    seen = []
+    out = run_tasks(["hang", "a", "b", "c"], work, jobs=2, timeout=1.0, lost=lambda t, why: "lost",
+                    done=lambda i, r: seen.append((i, r)))
+    assert out == ["lost", "aa", "bb", "cc"]
+    assert sorted(seen) == [(0, "lost"), (1, "aa"), (2, "bb"), (3, "cc")]

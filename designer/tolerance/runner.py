@@ -1,0 +1,446 @@
+"""Runs an engine over the samples of a Monte Carlo, chunk by chunk, in this
+process, in ``--jobs N`` local processes or on a Dask cluster (``--dask
+ADDRESS``, ``--dask local``): one code path, the same chunks, the same results.
+
+A chunk is a sample range [start, stop). Its task draws those samples
+(:func:`designer.tolerance.sampling.values`: sample i is a function of (seed, i)
+alone) and evaluates the engine on them; the results are concatenated in chunk
+order. So the figures, and everything computed from them, are the same whatever
+the workers and whatever the chunking (tested): only the draw settings and the
+seed travel, never the samples ("send chunks, not samples": /work/shared/FACTS.md
+measured Dask at about 4 ms a task).
+
+An engine is a pure, picklable function ``evaluate(context, values) -> {figure:
+array}`` (``values``: designator -> array over the chunk's samples) with a
+picklable ``context`` (the op-amp, the loop's test, a deck): the analytic plant
+(:func:`designer.tolerance.plant.evaluate`), the PID loop
+(:func:`designer.tolerance.loop.evaluate`), the SPICE engine.
+
+Failures: a chunk whose worker dies (or, in a local process, raises) is run once
+more; a second loss is a :class:`~designer.core.errors.SimulatorError` naming the
+chunk (exit status 3). A Dask scheduler that does not answer within
+:data:`CONNECT_TIMEOUT` seconds is one too. An interruption (Ctrl-C, SIGTERM)
+kills the local workers, cancels the cluster's tasks and closes a LocalCluster
+before it propagates (:mod:`designer.core.lifetime`).
+
+``--target-ci``: :meth:`Runner.run` draws in rounds; after each round ``until``
+(a function of the figures so far) gives the next total or None to stop. The
+rounds' ends depend on the figures only, so they too are the same whatever the
+workers.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import sys
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.errors import DesignError, SimulatorError
+from . import sampling
+
+#: the most local worker processes
+MAX_JOBS = 64
+#: seconds a Dask scheduler has to answer
+CONNECT_TIMEOUT = 3.0
+#: the fewest samples in a chunk (a task's overhead is about 4 ms on Dask)
+MIN_CHUNK = 16
+#: chunks per worker (a finer split evens the workers' ends and moves the progress bar)
+CHUNKS_PER_WORKER = 8
+#: seconds before the progress bar appears (a shorter run shows none)
+PROGRESS_DELAY = 1.0
+_ADDRESS = re.compile(r"^(?:(tcp|tls|ws|wss|ucx)://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):(\d{1,5})$")
+
+
+@dataclass(frozen=True)
+class Draw:
+    """How the samples are drawn: sample i of ``n`` is a function of these and i alone."""
+
+    nominal: dict        #: designator -> nominal value
+    tol: dict            #: designator -> tolerance (fraction)
+    n: int               #: the samples the draw is defined over (the most that may be drawn)
+    seed: int
+    sampler: str = "random"
+    dist: str = "uniform"
+
+    def values(self, start: int = 0, stop: int | None = None) -> dict:
+        return sampling.values(self.nominal, self.tol, self.n, self.seed, self.sampler, self.dist, start, stop)
+
+
+@dataclass(frozen=True)
+class Scale:
+    """Where the chunks run: ``jobs`` local processes, or ``dask`` (an address, or
+    ``"local"`` for a LocalCluster of ``jobs`` workers, default 2); a progress bar or not."""
+
+    jobs: int = 1
+    dask: str | None = None
+    progress: bool = False
+    chunk: int | None = None     #: samples per chunk (None: chosen from the samples and the workers)
+
+    @property
+    def workers(self) -> int:
+        if self.dask == "local":
+            return self.jobs if self.jobs > 1 else 2
+        return self.jobs
+
+    def chunk_size(self, n: int) -> int:
+        if self.chunk is not None:
+            return self.chunk
+        return max(MIN_CHUNK, min(sampling.CHUNK, math.ceil(n / (CHUNKS_PER_WORKER * self.workers))))
+
+
+def parse_jobs(text) -> int:
+    """``--jobs N``: a whole number, 1 to :data:`MAX_JOBS`."""
+    try:
+        jobs = int(str(text).strip())
+    except ValueError:
+        jobs = None
+    if jobs is None or not 1 <= jobs <= MAX_JOBS:
+        raise DesignError(f"--jobs {text!r}: give a whole number of worker processes, 1 to {MAX_JOBS}")
+    return jobs
+
+
+def parse_dask(text) -> str:
+    """``--dask ADDRESS``: ``local``, or a scheduler's ``[tcp://]host:port``."""
+    t = str(text).strip()
+    if t.lower() == "local":
+        return "local"
+    m = _ADDRESS.match(t)
+    if not m or not 0 < int(m.group(3)) < 65536:
+        raise DesignError(f"--dask {text!r}: give a scheduler's address, such as tcp://10.0.0.5:8786 or "
+                          "host:8786, or 'local' for a LocalCluster on this machine")
+    return t if m.group(1) else f"tcp://{t}"
+
+
+def run_chunk(evaluate, context, draw: Draw, start: int, stop: int) -> dict:
+    """One chunk's task: samples start .. stop - 1 drawn, then evaluated.
+    Returns ``{"values": {designator: array}, "figures": {figure: array}}``."""
+    values = draw.values(start, stop)
+    return {"values": values, "figures": evaluate(context, values)}
+
+
+def _die_twice(start: int, stop: int, why: str):
+    return SimulatorError(f"Monte Carlo: the chunk of samples {start}..{stop - 1} was lost twice ({why})")
+
+
+class _Lost:
+    def __init__(self, reason: str):
+        self.reason = reason
+
+
+def _progress(total: int, show: bool):
+    if not show:
+        return None
+    from tqdm import tqdm
+    try:
+        width, height = os.get_terminal_size(sys.stderr.fileno())
+    except (OSError, ValueError, AttributeError):
+        width = height = 0
+    # a terminal that gives no size (a bare pseudo-terminal) would get no bar at all from tqdm
+    return tqdm(total=total, unit="build", file=sys.stderr, delay=PROGRESS_DELAY, leave=False,
+                ncols=width if width > 0 else 80, nrows=height if height > 0 else 24, desc="Monte Carlo")
+
+
+class Runner:
+    """A pool the chunks run on (a context manager: a LocalCluster starts once and is closed
+    at the end, whatever ends the run).
+
+    Parameters
+    ----------
+    scale : Scale
+        Where the chunks run.
+    """
+
+    def __init__(self, scale: Scale = Scale()):
+        self.scale = scale
+        self._pool = None
+
+    def __enter__(self):
+        if self.scale.dask is not None:
+            self._pool = DaskPool(self.scale.dask, self.scale.workers)
+        elif self.scale.jobs > 1:
+            self._pool = _ProcessPool(self.scale.jobs)
+        else:
+            self._pool = _LocalPool()
+        return self
+
+    def __exit__(self, *exc):
+        pool, self._pool = self._pool, None
+        if pool is not None:
+            pool.close()
+        return False
+
+    def run(self, evaluate, context, draw: Draw, n: int | None = None, until=None, progress: bool | None = None):
+        """The values and figures of samples 0 .. ``n`` - 1 (default ``draw.n``).
+
+        Parameters
+        ----------
+        evaluate, context
+            The engine and what it needs besides the values (both picklable).
+        draw : Draw
+        n : int, optional
+            The samples of the first round (all of them without ``until``).
+        until : callable, optional
+            ``until(figures) -> int | None``: after each round, the total to reach next (at
+            most ``draw.n``), or None to stop.
+        progress : bool, optional
+            A progress bar (default: the scale's).
+
+        Returns
+        -------
+        (values, figures, ends)
+            designator -> array, figure -> array over the samples drawn, and each round's end.
+        """
+        if self._pool is None:
+            with self:
+                return self.run(evaluate, context, draw, n, until, progress)
+        total = draw.n if n is None else n
+        size = self.scale.chunk_size(draw.n if until is not None else total)
+        bar = _progress(draw.n if until is not None else total,
+                        self.scale.progress if progress is None else progress)
+        parts, ends, done = [], [], 0
+        try:
+            while True:
+                tasks = [(a, min(a + size, total)) for a in range(done, total, size)]
+                parts += self._pool.map(evaluate, context, draw, tasks, bar)
+                done = total
+                ends.append(done)
+                nxt = None if until is None else until(_concat([p["figures"] for p in parts]))
+                if nxt is None or done >= draw.n:
+                    break
+                total = min(draw.n, max(int(nxt), done + 1))
+        finally:
+            if bar is not None:
+                bar.close()
+        return _concat([p["values"] for p in parts]), _concat([p["figures"] for p in parts]), ends
+
+
+def _concat(dicts: list) -> dict:
+    if len(dicts) == 1:
+        return dict(dicts[0])
+    return {k: np.concatenate([d[k] for d in dicts]) for k in dicts[0]}
+
+
+class _LocalPool:
+    """In this process, chunk after chunk (``--jobs 1``)."""
+
+    def map(self, evaluate, context, draw, tasks, bar):
+        out = []
+        for a, b in tasks:
+            out.append(run_chunk(evaluate, context, draw, a, b))
+            if bar is not None:
+                bar.update(b - a)
+        return out
+
+    def close(self):
+        pass
+
+
+def _run_task(job, task):
+    evaluate, context, draw = job
+    return run_chunk(evaluate, context, draw, *task)
+
+
+class _ProcessPool:
+    """``--jobs N`` forked worker processes (:func:`designer.core.workers.run_tasks`: they die
+    with this process, and an interruption kills them)."""
+
+    #: seconds a chunk may take (a hung simulator is the SPICE engine's own timeout)
+    TIMEOUT = 24 * 3600.0
+
+    def __init__(self, jobs: int):
+        self.jobs = jobs
+
+    def map(self, evaluate, context, draw, tasks, bar):
+        import functools
+
+        from ..core.workers import run_tasks
+        work = functools.partial(_run_task, (evaluate, context, draw))
+
+        def done(_i, result):
+            if bar is not None and not isinstance(result, _Lost):
+                bar.update(result_size(result))
+
+        out = run_tasks(tasks, work, self.jobs, self.TIMEOUT, lambda _t, why: _Lost(why), done=done)
+        again = [i for i, r in enumerate(out) if isinstance(r, _Lost)]
+        if again:   # once more, each lost chunk (a worker killed by the system, a crash of the simulator)
+            redo = run_tasks([tasks[i] for i in again], work, self.jobs, self.TIMEOUT,
+                             lambda _t, why: _Lost(why), done=done)
+            for i, r in zip(again, redo):
+                if isinstance(r, _Lost):
+                    raise _die_twice(*tasks[i], r.reason)
+                out[i] = r
+        return out
+
+    def close(self):
+        pass
+
+
+def result_size(result: dict) -> int:
+    return len(next(iter(result["values"].values()))) if result["values"] else 0
+
+
+def _adopt(parent_pid: int) -> None:
+    """In a LocalCluster's worker: its own process group (a terminal's Ctrl-C reaches only
+    the command, which stops the cluster itself) and killed with the command, however it dies."""
+    from ..core import lifetime
+    try:
+        os.setpgrp()
+    except OSError:
+        pass
+    lifetime.die_with_parent(parent_pid)
+
+
+def _start_cluster(start):
+    """``start()`` (a LocalCluster) in a thread of its own: an interruption reaches the main
+    thread only, so the cluster is never left half started; when one comes, the start is
+    waited for (a few seconds at most) and the cluster closed before it propagates."""
+    import threading
+    box = {}
+
+    def run():
+        try:
+            box["cluster"] = start()
+        except BaseException as exc:   # noqa: BLE001 - handed to the main thread
+            box["error"] = exc
+
+    th = threading.Thread(target=run, name="start-local-cluster", daemon=True)
+    th.start()
+    try:
+        while th.is_alive():
+            th.join(0.05)
+    except BaseException:
+        th.join(60)
+        if "cluster" in box:
+            try:
+                box["cluster"].close(timeout=CONNECT_TIMEOUT)
+            except Exception:   # noqa: BLE001 - the interruption wins
+                pass
+        raise
+    if "error" in box:
+        raise box["error"]
+    return box["cluster"]
+
+
+class DaskPool:
+    """A dask.distributed client: of a running scheduler, or of a LocalCluster started here
+    (``n_workers`` processes of one thread each). Imported only here: ``import dask.distributed``
+    takes about 0.35 s."""
+
+    def __init__(self, address: str, workers: int):
+        import logging
+        import warnings
+        self.cluster = self.client = None
+        self.address = address
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)   # a third party's, at import
+            import dask
+            import distributed
+        self._distributed = distributed
+        # our one-line errors say what went wrong; the cluster's own log lines would add to them
+        for name in ("distributed", "tornado", "asyncio"):
+            logging.getLogger(name).setLevel(logging.CRITICAL)
+        # a killed worker's task is not retried by the scheduler: the runner retries it once itself
+        self._config = dask.config.set({"distributed.scheduler.allowed-failures": 0})
+        self._config.__enter__()
+        try:
+            if address == "local":
+                # no dashboard; the scheduler's HTTP server (health routes) on a free local port: its
+                # default, 8787, may be another cluster's, and taking another port prints a warning
+                self.cluster = _start_cluster(lambda: distributed.LocalCluster(
+                    n_workers=workers, threads_per_worker=1, processes=True, silence_logs=logging.CRITICAL,
+                    dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}))
+                self.client = distributed.Client(self.cluster)
+                self.client.run(_adopt, os.getpid())
+            else:
+                try:
+                    self.client = distributed.Client(address, timeout=CONNECT_TIMEOUT)
+                except Exception as exc:   # noqa: BLE001 - refused, timed out, or something else answered
+                    what = (f"nothing answered within {CONNECT_TIMEOUT:g} s" if isinstance(exc, (OSError, TimeoutError))
+                            else f"something else answered: {type(exc).__name__}")
+                    raise SimulatorError(f"--dask {address}: no Dask scheduler there ({what})") from None
+        except BaseException:
+            self.close()
+            raise
+
+    def map(self, evaluate, context, draw, tasks, bar):
+        def lost(i, why):
+            raise _die_twice(*tasks[i], why)
+
+        def done(i, _result):
+            if bar is not None:
+                bar.update(tasks[i][1] - tasks[i][0])
+
+        return self.calls(run_chunk, [(evaluate, context, draw, a, b) for a, b in tasks], lost, done, errors=False)
+
+    def calls(self, fn, args: list, lost, done=None, errors: bool = True) -> list:
+        """``fn(*a)`` for each ``a`` of ``args`` on the cluster, results in order. A call whose
+        worker dies is submitted once more; lost again, its result is ``lost(index, reason)``
+        (which may raise). ``errors``: an exception raised by ``fn`` is ``lost`` too (else it
+        is raised here). ``done(index, result)`` as each arrives. An interruption cancels
+        every call not yet done."""
+        d = self._distributed
+        futures, tries = {}, {}
+        try:
+            for i, a in enumerate(args):
+                futures[self.client.submit(fn, *a, pure=False)] = i
+                tries[i] = 1
+            out = [None] * len(args)
+            pending = d.as_completed(list(futures))
+            for fut in pending:
+                i = futures[fut]
+                if fut.status == "error":
+                    exc = fut.exception()
+                    if not isinstance(exc, d.KilledWorker):
+                        if not errors:
+                            fut.result()          # the engine's own error, raised here
+                        out[i] = lost(i, f"{type(exc).__name__}: {exc}")
+                    elif tries[i] > 1:
+                        out[i] = lost(i, f"its Dask worker died: {exc}")
+                    else:
+                        tries[i] += 1
+                        again = self.client.submit(fn, *args[i], pure=False)
+                        futures[again] = i
+                        pending.add(again)
+                        continue
+                else:
+                    out[i] = fut.result()
+                if done is not None:
+                    done(i, out[i])
+            return out
+        except BaseException:
+            if futures:
+                try:
+                    self.client.cancel(list(futures), force=True)
+                except Exception:   # noqa: BLE001 - the interruption or error that brought us here wins
+                    pass
+            raise
+        finally:
+            for fut in futures:
+                fut.release()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def close(self):
+        try:
+            if self.client is not None:
+                self.client.close(timeout=CONNECT_TIMEOUT)
+            if self.cluster is not None:
+                self.cluster.close(timeout=CONNECT_TIMEOUT)
+        except Exception:   # noqa: BLE001 - closing what may be half started or gone
+            pass
+        finally:
+            self.client = self.cluster = None
+            if self._config is not None:
+                self._config.__exit__(None, None, None)
+                self._config = None
+
+    _config = None

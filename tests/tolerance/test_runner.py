@@ -1,0 +1,181 @@
+"""The chunk runner: the same figures whatever the chunking and the workers, a lost
+chunk run once more (then exit 3), --target-ci's rounds against an independent
+Wilson interval, and the CLI inputs it parses."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from designer.core import opamps
+from designer.core.errors import DesignError, SimulatorError
+from designer.plant.sallenkey import SallenKeyParts
+from designer.tolerance import plant
+from designer.tolerance.montecarlo import (
+    MAX_TARGET_CI,
+    TARGET_ROUND,
+    parse_target_ci,
+    plant_monte_carlo,
+)
+from designer.tolerance.runner import MAX_JOBS, Draw, Runner, Scale, parse_dask, parse_jobs
+from mc_engines import always_dies, dies_once
+
+AMP = opamps.get("LM741")
+NOMINAL = {"R1": 1.6e3, "R2": 3.9e3, "C1": 3.3e-9, "C2": 100e-9}
+TOL = {"R1": 0.05, "R2": 0.05, "C1": 0.10, "C2": 0.10}
+PARTS = SallenKeyParts(1.6e3, 3.9e3, 3.3e-9, 100e-9)
+SERIES = {"R": "E24", "C": "E12"}
+LIMITS = ["fn_hz=3.3k:3.7k", "overshoot_pct=0:55"]
+
+
+def assert_same(a: dict, b: dict):
+    assert list(a) == list(b)
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
+
+
+@pytest.mark.parametrize("sampler", ["random", "sobol", "lhs"])
+def test_any_chunking_gives_the_same_samples_and_figures(sampler):
+    draw = Draw(NOMINAL, TOL, 5000, 7, sampler)
+    whole_v, whole_f, _ = Runner(Scale(chunk=5000)).run(plant.evaluate, AMP, draw)
+    # the samples are those the sampler draws for the whole run at once
+    assert_same(whole_v, draw.values())
+    for chunk in (16, 999, 4096, None):
+        v, f, _ = Runner(Scale(chunk=chunk)).run(plant.evaluate, AMP, draw)
+        assert_same(v, whole_v)
+        assert_same(f, whole_f)
+
+
+def test_two_worker_processes_give_the_same_result():
+    draw = Draw(NOMINAL, TOL, 3000, 3)
+    v1, f1, _ = Runner(Scale(jobs=1)).run(plant.evaluate, AMP, draw)
+    v2, f2, _ = Runner(Scale(jobs=2, chunk=300)).run(plant.evaluate, AMP, draw)
+    assert_same(v1, v2)
+    assert_same(f1, f2)
+
+
+def test_the_monte_carlo_section_is_the_same_with_two_workers():
+    a = plant_monte_carlo(PARTS, SERIES, AMP, 2000, seed=5, limit_items=LIMITS)
+    b = plant_monte_carlo(PARTS, SERIES, AMP, 2000, seed=5, limit_items=LIMITS, scale=Scale(jobs=2, chunk=128))
+    assert a.to_dict() == b.to_dict() and a.csv_text() == b.csv_text()
+
+
+def test_a_chunk_whose_worker_dies_runs_once_more(tmp_path):
+    draw = Draw(NOMINAL, TOL, 400, 1)
+    v, f, _ = Runner(Scale(jobs=2, chunk=100)).run(dies_once, str(tmp_path / "died"), draw)
+    assert (tmp_path / "died").exists()
+    _, ref, _ = Runner().run(plant.evaluate, AMP, draw)
+    assert_same(f, ref)
+
+
+def test_a_chunk_lost_twice_is_a_simulator_error_naming_it():
+    draw = Draw(NOMINAL, TOL, 100, 1)
+    with pytest.raises(SimulatorError, match=r"samples 0\.\.99 was lost twice") as e:
+        Runner(Scale(jobs=2, chunk=100)).run(always_dies, None, draw)
+    assert "\n" not in str(e.value)
+
+
+def test_on_a_local_cluster_a_dying_worker_s_chunk_runs_once_more_then_exit_3(tmp_path):
+    """One LocalCluster (kept short: 400 builds): a chunk whose worker is killed once gives
+    the same figures; a chunk that kills every worker it meets is a simulator error."""
+    draw = Draw(NOMINAL, TOL, 400, 1)
+    _, ref, _ = Runner().run(plant.evaluate, AMP, draw)
+    with Runner(Scale(dask="local", chunk=100)) as run:
+        _, f, _ = run.run(dies_once, str(tmp_path / "died"), draw)
+        assert (tmp_path / "died").exists()
+        assert_same(f, ref)
+        with pytest.raises(SimulatorError, match=r"samples 0\.\.99 was lost twice \(its Dask worker died"):
+            run.run(always_dies, None, Draw(NOMINAL, TOL, 100, 1))
+
+
+def wilson_half_width(k, n, z=1.959963984540054):
+    """The Wilson score interval's half-width, written out here (not the package's)."""
+    p = k / n
+    lo = (p + z * z / (2 * n) - z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))) / (1 + z * z / n)
+    hi = (p + z * z / (2 * n) + z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))) / (1 + z * z / n)
+    return ((1.0 if k == n else hi) - (0.0 if k == 0 else lo)) / 2
+
+
+def inside(figs, n):
+    fn, os_ = figs["fn_hz"][:n], figs["overshoot_pct"][:n]
+    return int(np.count_nonzero((fn >= 3300) & (fn <= 3700) & (os_ >= 0) & (os_ <= 55)))
+
+
+@pytest.mark.parametrize("target", [0.01, 0.02])
+def test_target_ci_stops_at_the_first_round_below_it(target):
+    mc = plant_monte_carlo(PARTS, SERIES, AMP, 200000, seed=3, limit_items=LIMITS, target_ci=target, tighten=False)
+    t = mc.to_dict()["settings"]["target_ci"]
+    rounds = t["rounds"]
+    assert t["reached"] and rounds[-1] == mc.n == mc.to_dict()["settings"]["samples"] < 200000
+    assert rounds[0] == TARGET_ROUND and rounds == sorted(rounds)
+    assert wilson_half_width(inside(mc.figures, mc.n), mc.n) < target
+    for end in rounds[:-1]:   # every earlier round was still too wide
+        assert wilson_half_width(inside(mc.figures, end), end) >= target
+    # the samples drawn are the first of the same run at its full size: sample i is f(seed, i)
+    full = plant_monte_carlo(PARTS, SERIES, AMP, mc.n, seed=3, limit_items=LIMITS, tighten=False)
+    assert_same(full.figures, mc.figures)
+    # and the same with two workers
+    again = plant_monte_carlo(PARTS, SERIES, AMP, 200000, seed=3, limit_items=LIMITS, target_ci=target,
+                              tighten=False, scale=Scale(jobs=2))
+    assert again.to_dict() == mc.to_dict()
+
+
+def test_target_ci_bounded_by_the_samples_asked():
+    mc = plant_monte_carlo(PARTS, SERIES, AMP, 1200, seed=3, limit_items=LIMITS, target_ci=0.001, tighten=False)
+    t = mc.to_dict()["settings"]["target_ci"]
+    assert mc.n == 1200 and not t["reached"] and t["max_samples"] == 1200
+    assert wilson_half_width(inside(mc.figures, 1200), 1200) >= 0.001
+
+
+@pytest.mark.parametrize("kw, what", [({"target_ci": 0.01}, "needs --limit"),
+                                      ({"target_ci": 0.6, "limit_items": LIMITS}, "at most 50 %"),
+                                      ({"target_ci": 0.0, "limit_items": LIMITS}, "above 0"),
+                                      ({"target_ci": 0.01, "limit_items": LIMITS, "sampler": "lhs"}, "random or sobol")])
+def test_target_ci_refusals(kw, what):
+    with pytest.raises(DesignError, match=what):
+        plant_monte_carlo(PARTS, SERIES, AMP, 1000, **kw)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.one_of(st.text(max_size=12), st.integers(-5, 100).map(str)))
+def test_jobs_input_is_a_whole_number_in_range_or_one_line(text):
+    try:
+        jobs = parse_jobs(text)
+    except DesignError as exc:
+        assert "\n" not in str(exc) and "--jobs" in str(exc)
+    else:
+        assert 1 <= jobs <= MAX_JOBS and jobs == int(text.strip())
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.one_of(st.text(max_size=12), st.floats(allow_nan=True).map(lambda x: f"{x}%"),
+                 st.floats(0, 1).map(str)))
+def test_target_ci_input_is_a_half_width_in_range_or_one_line(text):
+    try:
+        v = parse_target_ci(text)
+    except DesignError as exc:
+        assert "\n" not in str(exc) and "--target-ci" in str(exc)
+    else:
+        assert 0 < v <= MAX_TARGET_CI
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text(max_size=30))
+def test_dask_address_input_is_an_address_or_one_line(text):
+    try:
+        a = parse_dask(text)
+    except DesignError as exc:
+        assert "\n" not in str(exc) and "--dask" in str(exc)
+    else:
+        assert a == "local" or "://" in a
+
+
+def test_dask_addresses():
+    assert parse_dask("10.0.0.5:8786") == "tcp://10.0.0.5:8786"
+    assert parse_dask(" tls://sched.lab:8786 ") == "tls://sched.lab:8786"
+    assert parse_dask("LOCAL") == "local"
+    for bad in ("sched", "host:0", "host:70000", "http://host:8786", ":8786"):
+        with pytest.raises(DesignError):
+            parse_dask(bad)
