@@ -33,6 +33,7 @@ def _design_parser():
   design-plant --fc 1k --zeta 0.05 --gain 2          low damping needs a gain K > 1 (C2/C1 >= 1/zeta^2 at K = 1)
   design-plant --fc 20k --zeta 0.5 --opamp LM358 --compensate-gbw
   design-plant --fc 3500 --zeta 0.2 --json --no-sim
+  design-plant --fc 3500 --zeta 0.2 --stimulus prbs  also the bench's PRBS in ngspice: prbs.csv, waveforms.csv
 
 Outputs: netlists/<name>.cir (run it alone with `ngspice -b`), reports/<name>/build-sheet.md and .html,
 result.json, step.png, bode.png. Exit status 2 on bad input.""",
