@@ -67,6 +67,8 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     if with_images:
         out.append(("Plots", [R.columns([R.image("step.png", "step response: analytic and SPICE, residual")],
                                         [R.image("bode.png", "Bode plot with the sine check's points")])]))
+        if result.prbs is not None:
+            out[-1][1].append(R.image("prbs.png", "the last period of the PRBS: generator, SPICE and the model"))
     if result.monte_carlo is not None:
         out.append(("Tolerance analysis (Monte Carlo)", tolerance_section(result, with_images)))
     out.append(("Sensitivity", _sensitivity(result)))
@@ -270,6 +272,23 @@ def step_png(result) -> bytes:
     return step_plot(result.time_s, curves, f"Step response, 0 -> {a:g} V", residual=resid, band=band)
 
 
+def prbs_png(result) -> bytes:
+    """The last period of the PRBS run: the generator, the output (SPICE when
+    simulated) and the op-amp-aware model, their difference below."""
+    run = result.prbs
+    c, p = run.capture, run.plan
+    last = c.time_s >= (p.periods - 1) * p.period_s
+    t = c.time_s[last]
+    out = "SPICE (ngspice)" if run.simulator is not None else f"analytic ({result.opamp.name} model)"
+    curves = {out: c.output_v[last], "generator (CH1)": c.input_v[last]}
+    if run.simulator is not None:
+        curves[f"analytic ({result.opamp.name} model)"] = c.analytic_opamp_v[last]
+    resid = None if run.simulator is None else (f"residual: SPICE minus the {result.opamp.name} model",
+                                                c.output_v[last], c.analytic_opamp_v[last])
+    return step_plot(t, curves, f"PRBS of {p.bits} bits at {format_eng(p.clock_hz, 'Hz')}: its last period",
+                     ylabel="voltage (V)", residual=resid, xlabel="time from the start of the sequence")
+
+
 def bode_png(result) -> bytes:
     """The models, SPICE's .ac points, the peak and -3 dB markers."""
     ideal, real = result.analytic, result.analytic_opamp
@@ -333,5 +352,6 @@ def write_outputs(result, out_dir, name: str) -> dict:
                       "prbs_awg_csv": ("prbs_awg.csv", lambda r: awg_csv(r.prbs.plan)),
                       "prbs_deck": ("prbs-test.cir", lambda r: r.prbs.deck)})
     texts.update(csv_texts(result))   # monte-carlo.csv: one row per sample, every varied part and figure
-    return write_design(result, out_dir, name, PLOTS + histogram_plots(result), schematic,
+    prbs_plots = (("prbs.png", prbs_png),) if result.prbs is not None else ()
+    return write_design(result, out_dir, name, PLOTS + prbs_plots + histogram_plots(result), schematic,
                         lambda svg: sections(result, schematic_svg=svg), title_of(result), texts)

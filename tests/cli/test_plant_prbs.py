@@ -35,7 +35,8 @@ def test_identify_recovers_the_seed_plant_from_its_prbs_run(tmp_path):
     assert p["simulator"] == "ngspice-cli" and p["spice_vs_model_nrms"] < 1e-3
     md = Path(files["build_sheet_md"]).read_text()
     assert "under a PRBS" in md and "Bench test" in md
-    assert f"{p['bits']} bits" in md
+    assert f"{p['bits']} bits" in md and "(prbs.png)" in md
+    assert any(f.endswith("prbs.png") and Path(f).stat().st_size > 0 for f in files["plots"])
     # identify on the run recovers the op-amp-aware design
     ident = run("identify", files["waveforms_csv"], "--json")
     assert ident.returncode == 0, ident.stderr
