@@ -33,6 +33,7 @@ def _design_parser():
   design-plant --fc 1k --zeta 0.05 --gain 2          low damping needs a gain K > 1 (C2/C1 >= 1/zeta^2 at K = 1)
   design-plant --fc 20k --zeta 0.5 --opamp LM358 --compensate-gbw
   design-plant --fc 3500 --zeta 0.2 --json --no-sim
+  design-plant --fc 3500 --zeta 0.2 --stimulus prbs  also the bench's PRBS in ngspice: prbs.csv, waveforms.csv
 
 Outputs: netlists/<name>.cir (run it alone with `ngspice -b`), reports/<name>/build-sheet.md and .html,
 result.json, step.png, bode.png. Exit status 2 on bad input.""",
@@ -57,6 +58,7 @@ result.json, step.png, bode.png. Exit status 2 on bad input.""",
                      help=f"how many best combinations to list (default 5) {help_range('alternatives')}")
     _add_bench_options(add_output_options(p, "plant_fc3500_z0.2"))
     _add_tolerance_options(p)
+    _add_stimulus_options(p)
     return p
 
 
@@ -271,6 +273,56 @@ def _add_bench_options(group):
                             "others dual)")
 
 
+def _add_stimulus_options(p):
+    """--stimulus and the PRBS's --prbs-bits, --prbs-clock (design-plant and analyze-plant)."""
+    from ..core.prbs import MAX_BITS, MIN_BITS
+    g = p.add_argument_group("stimulus (what the bench plays besides the square wave)")
+    g.add_argument("--stimulus", default="step", choices=("step", "prbs"),
+                   help="step (default): the square-wave bench test alone; prbs: also a pseudo-random binary "
+                        "sequence (seed 003) between 0 V and --amplitude, 4 periods, simulated in ngspice: adds "
+                        "prbs.csv and prbs_awg.csv (the generator's files, as make-prbs writes them), "
+                        "prbs-test.cir, and waveforms.csv becomes that run (input, SPICE output, model), which "
+                        "identify reads")
+    g.add_argument("--prbs-bits", metavar="N",
+                   help=f"with --stimulus prbs: the sequence's bits, {MIN_BITS} to {MAX_BITS} (default: the fewest "
+                        "whose period outlasts 1.2x the plant's 2 %% settling time and holds 10 spectral lines "
+                        "of its bandwidth)")
+    g.add_argument("--prbs-clock", metavar="HZ",
+                   help="with --stimulus prbs: the generator's clock (sample rate), Hz "
+                        + help_range("prbs_clock_hz") + " (default: a 1-2-5 interval whose half-power band "
+                        "covers 3x the plant's bandwidth)")
+
+
+def stimulus_settings(args):
+    """--stimulus and its PRBS options checked before any work: None (the square
+    wave alone) or (bits or None, clock Hz or None)."""
+    given = [o for o, v in (("--prbs-bits", args.prbs_bits), ("--prbs-clock", args.prbs_clock)) if v is not None]
+    if args.stimulus != "prbs":
+        if given:
+            raise DesignError(f"{given[0]} goes with --stimulus prbs")
+        return None
+    if args.replay is not None:
+        raise DesignError("--stimulus prbs does not go with --replay (a replayed build plays the square wave)")
+    from ..core.prbs import check_bits
+    from ..core.ranges import parse_in_range
+    bits = None
+    if args.prbs_bits is not None:
+        try:
+            bits = check_bits(args.prbs_bits)
+        except DesignError as exc:
+            raise DesignError(str(exc).replace("--bits", "--prbs-bits", 1)) from None
+    clock = None if args.prbs_clock is None else parse_in_range(args.prbs_clock, "--prbs-clock", "prbs_clock_hz")
+    return bits, clock
+
+
+def _with_stimulus(result, args, stim):
+    """The result with its PRBS bench test when --stimulus prbs (``stim``)."""
+    if stim is None:
+        return result
+    from ..plant.prbs import with_prbs
+    return with_prbs(result, result.test.amplitude_v, stim[0], stim[1], not args.no_sim, args.simulator)
+
+
 def _design(args) -> int:
     from ..plant.spec import PlantSpec
     # the spec parses and checks what was typed (once); its errors name parameters, shown as options
@@ -281,11 +333,12 @@ def _design(args) -> int:
         f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
     mc = monte_carlo_settings(args)
     spice = spice_settings(args, mc)
+    stim = stimulus_settings(args)
     check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
     from ..plant.design import design_plant
     if spice[2] is not None:     # the design is the draw's nominal; the sample's own run is the simulation
         return _replay(design_plant(spec, simulate=False), args, mc, spice, name)
-    result = design_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
+    result = _with_stimulus(design_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, stim)
     return _emit(_with_monte_carlo(result, args, mc, spice), args, name)
 
 
@@ -323,6 +376,7 @@ def _analyze_parser():
                                                     "(default: the smallest series that holds each value)")
     _add_bench_options(add_output_options(p, "built_r1820_r21k_c110n_c2220n"))
     _add_tolerance_options(p)
+    _add_stimulus_options(p)
     return p
 
 
@@ -344,10 +398,11 @@ def _analyze(args) -> int:
         f"{k}{value_code(v)}" for k, v in (("r1", p.r1), ("r2", p.r2), ("c1", p.c1), ("c2", p.c2)))
     mc = monte_carlo_settings(args)
     spice = spice_settings(args, mc)
+    stim = stimulus_settings(args)
     check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
     if spice[2] is not None:
         return _replay(analyze_plant(spec, simulate=False), args, mc, spice, name)
-    result = analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
+    result = _with_stimulus(analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, stim)
     return _emit(_with_monte_carlo(result, args, mc, spice), args, name)
 
 

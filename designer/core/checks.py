@@ -10,6 +10,8 @@ from dataclasses import dataclass
 TITLES = {
     "slew_rate": "slew rate",
     "output_swing": "output swing",
+    "prbs_slew_rate": "slew rate under the PRBS",
+    "prbs_output_swing": "output swing under the PRBS",
     "square_wave_period": "square-wave period",
     "spice_agreement": "SPICE agreement",
     "closed_loop_stable": "closed loop stable",

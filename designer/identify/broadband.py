@@ -313,17 +313,20 @@ def _wrap_advice(est: corr.ImpulseEstimate, ex: Excitation) -> tuple:
     """(the note, the advice: the period needed, the bits at this clock, the clock
     interval at these bits) of a wrapped impulse estimate."""
     from ..core.units import format_eng as fe
-    need = corr.needed_period(est)
-    text = (f"the impulse response has not settled within one period ({fe(est.period_s, 's')}; "
-            f"settling at least {fe(need, 's')}): it wraps around, and the DC term removes part "
-            "of it")
-    advice = {"period_s": need}
+    need, lower = corr.needed_period(est)
+    least = "at least " if lower else ""
+    why = (f"its slowest mode (time constant {fe(est.tail_tau_s, 's')}) decays to 2 % in {fe(need, 's')}"
+           if not lower else f"settling {least}{fe(need, 's')}")
+    text = (f"the impulse response has not settled within one period ({fe(est.period_s, 's')}; {why}): "
+            "it wraps around, and the DC term removes part of it")
+    advice = {"period_s": SETTLE_MARGIN * need, "lower_bound": lower}
     if ex.kind == "mls" and ex.n:
         nb = bits_for(SETTLE_MARGIN * need, ex.dt_s)
         dt = SETTLE_MARGIN * need / ex.n
         advice.update({"bits": nb, "dt_s": dt})
-        text += (f"; {nb} bits at this clock would be enough" if nb else "") + \
-            f" (or a clock interval of {fe(dt, 's')} with {ex.bits} bits)"
+        text += (f"; {least}{nb} bits at this clock" if nb else "; more than 20 bits at this clock") + \
+            f" (or a clock interval of {least}{fe(dt, 's')} with {ex.bits} bits)" + \
+            (" would be enough" if not lower else ": run again with them, the check measures again")
     return text, advice
 
 

@@ -58,6 +58,7 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
            ("Wiring", [R.table(["part", "code", "from", "to"], wiring_rows(b, NET_LABELS, (result.opamp.vcc,
                                                                                       result.opamp.vee)))]),
            ("Bench test: what the scope shows", _bench(result)),
+           *([("Bench test under a PRBS (--stimulus prbs)", _prbs(result))] if result.prbs is not None else []),
            ("Target and achieved", _targets(result)),
            ("Checks", [R.table(["check", "result", "detail"],
                                [[c.title, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])])]
@@ -66,6 +67,8 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     if with_images:
         out.append(("Plots", [R.columns([R.image("step.png", "step response: analytic and SPICE, residual")],
                                         [R.image("bode.png", "Bode plot with the sine check's points")])]))
+        if result.prbs is not None:
+            out[-1][1].append(R.image("prbs.png", "the last period of the PRBS: generator, SPICE and the model"))
     if result.monte_carlo is not None:
         out.append(("Tolerance analysis (Monte Carlo)", tolerance_section(result, with_images)))
     out.append(("Sensitivity", _sensitivity(result)))
@@ -148,6 +151,32 @@ def _bench(result):
                           "frequency and read the output's amplitude on CH2 against CH1 (gain relative to the "
                           "DC gain). SPICE's figures come from an .ac run of the same circuit."),
                    R.table(["sine", f"{result.opamp.name} model", "SPICE (.ac)"], srows)]
+    return blocks
+
+
+def _prbs(result):
+    """The generator's settings for the sequence, why they were chosen, and what to compare."""
+    run = result.prbs
+    p = run.plan
+    lo, hi = p.offset - p.amplitude, p.offset + p.amplitude
+    y = run.capture.output_v
+    rows = [["waveform", "arbitrary: prbs.csv (time_s,value) or prbs_awg.csv (one value per clock interval)"],
+            ["sequence", f"maximum-length, {p.bits} bits (N = {p.n} intervals a period)"],
+            ["clock (sample rate)", f"{format_eng(p.clock_hz, 'Hz')} (Dt = {format_eng(p.dt_s, 's')})"],
+            ["levels", f"{format_eng(lo, 'V')} and {format_eng(hi, 'V')}"],
+            ["amplitude", f"{format_eng(p.amplitude, 'V')} (+-, {format_eng(2 * p.amplitude, 'V')} pk-pk)"],
+            ["offset", format_eng(p.offset, "V")],
+            ["period", f"{format_eng(p.period_s, 's')}; play {p.periods} ({format_eng(p.periods * p.period_s, 's')})"],
+            ["output range", f"{format_eng(float(y.min()), 'V')} to {format_eng(float(y.max()), 'V')}"
+                             + ("" if run.simulator is None else " (SPICE)")]]
+    blocks = [R.table(["set", "to"], rows, "compact")]
+    blocks += [R.text("Why: " + r) for r in p.reasons]
+    pred = ("ngspice's output, and the op-amp-aware model's" if run.simulator is not None
+            else "the op-amp-aware model's output (not simulated)")
+    blocks.append(R.text(f"waveforms.csv holds the prediction: the sequence (input_v), {pred}, sampled every "
+                         f"{format_eng(float(run.capture.time_s[1] - run.capture.time_s[0]), 's')}. Capture "
+                         "CH1 (generator) and CH2 (output) for all the periods and compare, or run identify on "
+                         "the capture: it uses the periods after the first."))
     return blocks
 
 
@@ -243,6 +272,23 @@ def step_png(result) -> bytes:
     return step_plot(result.time_s, curves, f"Step response, 0 -> {a:g} V", residual=resid, band=band)
 
 
+def prbs_png(result) -> bytes:
+    """The last period of the PRBS run: the generator, the output (SPICE when
+    simulated) and the op-amp-aware model, their difference below."""
+    run = result.prbs
+    c, p = run.capture, run.plan
+    last = c.time_s >= (p.periods - 1) * p.period_s
+    t = c.time_s[last]
+    out = "SPICE (ngspice)" if run.simulator is not None else f"analytic ({result.opamp.name} model)"
+    curves = {out: c.output_v[last], "generator (CH1)": c.input_v[last]}
+    if run.simulator is not None:
+        curves[f"analytic ({result.opamp.name} model)"] = c.analytic_opamp_v[last]
+    resid = None if run.simulator is None else (f"residual: SPICE minus the {result.opamp.name} model",
+                                                c.output_v[last], c.analytic_opamp_v[last])
+    return step_plot(t, curves, f"PRBS of {p.bits} bits at {format_eng(p.clock_hz, 'Hz')}: its last period",
+                     ylabel="voltage (V)", residual=resid, xlabel="time from the start of the sequence")
+
+
 def bode_png(result) -> bytes:
     """The models, SPICE's .ac points, the peak and -3 dB markers."""
     ideal, real = result.analytic, result.analytic_opamp
@@ -266,7 +312,16 @@ def bode_png(result) -> bytes:
 def waveforms_csv(result) -> str:
     """The bench period as CSV (``time_s,input_v,output_v,...``; output is SPICE when
     simulated), the format ``identify`` reads: the tool's own scope capture."""
-    cols = result.bench.columns()
+    return _columns_csv(result.bench.columns())
+
+
+def prbs_waveforms_csv(result) -> str:
+    """The plant under the PRBS as CSV (``time_s,input_v,output_v,analytic_opamp_v``;
+    output is SPICE when simulated): what ``identify`` reads and a capture is compared with."""
+    return _columns_csv(result.prbs.capture.columns())
+
+
+def _columns_csv(cols: dict) -> str:
     buf = io.StringIO()
     np.savetxt(buf, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols), comments="",
                fmt="%.9g")
@@ -290,6 +345,13 @@ def write_outputs(result, out_dir, name: str) -> dict:
     recorded in ``result.files`` before result.json is written, so it lists itself.
     """
     texts = {"waveforms_csv": ("waveforms.csv", waveforms_csv), "bom_csv": ("bom.csv", lambda r: bom_csv(bom(r)))}
+    if result.prbs is not None:
+        from ..core.prbs import awg_csv, time_value_csv
+        texts.update({"waveforms_csv": ("waveforms.csv", prbs_waveforms_csv),
+                      "prbs_csv": ("prbs.csv", lambda r: time_value_csv(r.prbs.plan)),
+                      "prbs_awg_csv": ("prbs_awg.csv", lambda r: awg_csv(r.prbs.plan)),
+                      "prbs_deck": ("prbs-test.cir", lambda r: r.prbs.deck)})
     texts.update(csv_texts(result))   # monte-carlo.csv: one row per sample, every varied part and figure
-    return write_design(result, out_dir, name, PLOTS + histogram_plots(result), schematic,
+    prbs_plots = (("prbs.png", prbs_png),) if result.prbs is not None else ()
+    return write_design(result, out_dir, name, PLOTS + prbs_plots + histogram_plots(result), schematic,
                         lambda svg: sections(result, schematic_svg=svg), title_of(result), texts)

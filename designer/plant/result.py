@@ -231,6 +231,8 @@ class PlantResult:
     monte_carlo: object = None
     #: the extremes over the tolerance box (designer.tolerance.worstcase.WorstCase), when asked for
     worst_case: object = None
+    #: the bench test under a PRBS (designer.plant.prbs.PrbsRun), with --stimulus prbs
+    prbs: object = None
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
@@ -245,6 +247,13 @@ class PlantResult:
         return list(self.checks) + [Check(SPICE_AGREEMENT, cmp_.passed, detail)]
 
     def to_dict(self) -> dict:
+        d = self._to_dict()
+        if self.prbs is not None:   # only then: a step design's JSON stays as it was
+            files = d.pop("files")
+            d = {**d, "prbs": json_safe(self.prbs.to_dict()), "files": files}
+        return d
+
+    def _to_dict(self) -> dict:
         target, fig, opa = self.target, self.analytic.figures, self.analytic_opamp.figures
         built = {**parts_dict(self.built), "fn_error_pct": fig.fn_error_pct, "zeta_error_pct": fig.zeta_error_pct,
                  "fn_opamp_hz": opa.fn_hz, "zeta_opamp": opa.zeta, "fn_opamp_error_pct": opa.fn_error_pct,

@@ -77,11 +77,12 @@ def time_unit(span_s: float) -> tuple:
 
 
 def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)", residual: tuple | None = None,
-              band: tuple | None = None) -> bytes:
+              band: tuple | None = None, xlabel: str = "time after the step") -> bytes:
     """Overlaid step responses; ``curves`` maps a label to an array on ``t``.
 
     ``residual``: (label, measured, model) drawn as measured - model in a panel
-    below; ``band``: (t, lo, hi, label) shaded behind the curves."""
+    below; ``band``: (t, lo, hi, label) shaded behind the curves; ``xlabel``: what
+    the time axis counts (its unit is added)."""
     if residual is not None:
         fig, (ax, ar) = figure(7.5, 4.6, 2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.1]})
     else:
@@ -112,7 +113,7 @@ def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)", residual:
         ar.set_title(label, fontsize=8, loc="left")
         ar.grid(True, alpha=0.3)
         last = ar
-    last.set_xlabel(f"time after the step ({unit})")
+    last.set_xlabel(f"{xlabel} ({unit})")
     return png_bytes(fig, dpi=100, tight=False)
 
 

@@ -126,3 +126,21 @@ def test_names_are_plain_file_names_in_both_commands(capsys, name, ok):
         assert (status == 0) is ok, err
         if not ok:
             assert "--name" in err and len(err.strip().splitlines()) == 1
+
+
+stimuli = st.one_of(st.sampled_from(["prbs", "prbs", "step", "PRBS", "noise", ""]), numbers)
+prbs_bits = st.one_of(st.none(), st.integers(-1, 25).map(str), numbers)
+prbs_clocks = st.one_of(st.none(), st.sampled_from(["50k", "1k", "1meg", "10", "2.5k"]), numbers)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(stimuli, prbs_bits, prbs_clocks, st.booleans())
+def test_stimulus_options_never_crash(capsys, tmp_path_factory, stimulus, bits, clock, analyze):
+    """Whatever is typed for --stimulus, --prbs-bits and --prbs-clock: exit 0, 1 or 2,
+    a refusal one line and no file."""
+    out = tmp_path_factory.mktemp("out")
+    argv = (["--r1", "820", "--r2", "1k", "--c1", "10n", "--c2", "220n"] if analyze
+            else ["--fc", "3500", "--zeta", "0.2"]) + ["--stimulus", stimulus]
+    argv += [x for k, v in (("--prbs-bits", bits), ("--prbs-clock", clock)) if v is not None for x in (k, v)]
+    _check(analyze_plant_main if analyze else design_plant_main,
+           argv + ["--no-sim", "--no-files", "--out", str(out)], capsys, out)
