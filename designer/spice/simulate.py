@@ -196,25 +196,8 @@ class NgspiceCli:
         if exe is None:
             raise SimulatorError(f"ngspice is not installed ({self.executable!r} not found); {INSTALL_HINT}")
         with tempfile.TemporaryDirectory(prefix="designer-sim-") as tmp:
-            deck_path = Path(tmp) / "deck.cir"
             raw_path = Path(tmp) / "out.raw"
-            deck_path.write_text(with_raw_output(deck, raw_path))
-            try:
-                # -n: no .spiceinit; the private folder as working folder and HOME: no init file of anyone's
-                proc = subprocess.run([exe, "-b", "-n", str(deck_path)], cwd=tmp, env=private_env(tmp),
-                                      capture_output=True, text=True, timeout=self.timeout,
-                                      stdin=subprocess.DEVNULL, preexec_fn=lifetime.preexec())
-            except subprocess.TimeoutExpired:
-                raise SimulatorError(f"ngspice did not finish within {self.timeout:g} s (timed out)") from None
-            log = proc.stdout + "\n" + proc.stderr
-            errs = error_lines(log) or [ln for ln in proc.stderr.splitlines() if ln.strip()][-1:]
-            if deck_refused(log):
-                raise DeckError("ngspice cannot read the deck: " + "; ".join(errs[:3]))
-            if proc.returncode < 0:
-                raise SimulatorError(f"ngspice crashed (signal {-proc.returncode})"
-                                     + (f": {'; '.join(errs[:3])}" if errs else ""))
-            if proc.returncode != 0:
-                raise SimulatorError("ngspice failed: " + ("; ".join(errs[:3]) or f"exit status {proc.returncode}"))
+            _, log, errs = self._batch(exe, tmp, with_raw_output(deck, raw_path))
             if not raw_path.exists() or raw_path.stat().st_size == 0:
                 raise SimulatorError("ngspice exited without writing any results"
                                      + (f" ({'; '.join(errs[:3])})" if errs else " (no analysis ran?)"))
@@ -222,7 +205,6 @@ class NgspiceCli:
             if "time" not in vectors and "frequency" not in vectors:
                 raise SimulatorError("ngspice ran no analysis: the deck has no .tran or .ac line")
             return _result(vectors, log, self.name, deck)
-
 
     def run_script(self, circuit: str, commands) -> str:
         """``circuit`` (a deck without analyses) with a ``.control`` block of ``commands``
@@ -235,22 +217,30 @@ class NgspiceCli:
             lines = lines[:-1]
         text = "\n".join([*lines, ".control", "set noaskquit", *commands, "quit", ".endc", ".end"]) + "\n"
         with tempfile.TemporaryDirectory(prefix="designer-sim-") as tmp:
-            deck_path = Path(tmp) / "deck.cir"
-            deck_path.write_text(text)
-            try:
-                proc = subprocess.run([exe, "-b", "-n", str(deck_path)], cwd=tmp, env=private_env(tmp),
-                                      capture_output=True, text=True, timeout=self.timeout,
-                                      stdin=subprocess.DEVNULL, preexec_fn=lifetime.preexec())
-            except subprocess.TimeoutExpired:
-                raise SimulatorError(f"ngspice did not finish within {self.timeout:g} s (timed out)") from None
+            return self._batch(exe, tmp, text)[0].stdout
+
+    def _batch(self, exe: str, tmp: str, text: str) -> tuple:
+        """``ngspice -b`` of the deck ``text`` in the private folder ``tmp``: (process, log, error lines),
+        the errors a failed run reports raised (a deck it cannot read, a crash, a failure)."""
+        deck_path = Path(tmp) / "deck.cir"
+        deck_path.write_text(text)
+        try:
+            # -n: no .spiceinit; the private folder as working folder and HOME: no init file of anyone's
+            proc = subprocess.run([exe, "-b", "-n", str(deck_path)], cwd=tmp, env=private_env(tmp),
+                                  capture_output=True, text=True, timeout=self.timeout,
+                                  stdin=subprocess.DEVNULL, preexec_fn=lifetime.preexec())
+        except subprocess.TimeoutExpired:
+            raise SimulatorError(f"ngspice did not finish within {self.timeout:g} s (timed out)") from None
         log = proc.stdout + "\n" + proc.stderr
         errs = error_lines(log) or [ln for ln in proc.stderr.splitlines() if ln.strip()][-1:]
         if deck_refused(log):
             raise DeckError("ngspice cannot read the deck: " + "; ".join(errs[:3]))
+        if proc.returncode < 0:
+            raise SimulatorError(f"ngspice crashed (signal {-proc.returncode})"
+                                 + (f": {'; '.join(errs[:3])}" if errs else ""))
         if proc.returncode != 0:
-            raise SimulatorError(("ngspice crashed (signal %d)" % -proc.returncode if proc.returncode < 0 else
-                                  "ngspice failed") + (": " + "; ".join(errs[:3]) if errs else ""))
-        return proc.stdout
+            raise SimulatorError("ngspice failed: " + ("; ".join(errs[:3]) or f"exit status {proc.returncode}"))
+        return proc, log, errs
 
 
 class PySpiceShared:
