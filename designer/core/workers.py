@@ -154,13 +154,18 @@ def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, co
             w.kill()
         raise
     finally:
-        for w in workers:
-            try:
-                w.conn.send(None)
-            except (OSError, ValueError):
-                pass
-        for w in workers:
-            w.proc.join(2)
-            if w.proc.is_alive():
-                w.kill()
+        close_all(workers)
     return results
+
+
+def close_all(workers) -> None:
+    """Ask every worker to end, give them two seconds, then kill what is left."""
+    for w in workers:
+        try:
+            w.conn.send(None)
+        except (OSError, ValueError):
+            pass
+    for w in workers:
+        w.proc.join(2)
+        if w.proc.is_alive():
+            w.kill()

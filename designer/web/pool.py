@@ -26,7 +26,7 @@ from collections import deque
 from multiprocessing.connection import wait
 
 from ..core import lifetime
-from ..core.workers import Worker
+from ..core.workers import Worker, close_all
 
 #: seconds a worker may take over one request before it is killed (design-pid's optimiser takes a few)
 DEFAULT_TIMEOUT_S = 120.0
@@ -102,15 +102,7 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                     rid, task = queue.popleft()
                     w.give(rid, task, timeout)
     finally:
-        for w in workers:
-            try:
-                w.conn.send(None)
-            except (OSError, ValueError):
-                pass
-        for w in workers:
-            w.proc.join(2)
-            if w.proc.is_alive():
-                w.kill()
+        close_all(workers)
 
 
 class Pool:
