@@ -47,6 +47,19 @@ def test_the_same_section_and_csv_whatever_the_workers(tmp_path):
     assert got["jobs2"] == ref and got["dask"] == ref
 
 
+def scheduler_address(path, wait_s: float = 60.0) -> str:
+    """The address in a scheduler file, once the scheduler has written it whole (it creates the file
+    before it writes it: an empty or cut file is read again)."""
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            return json.loads(path.read_text())["address"]
+        except (OSError, ValueError, KeyError):
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.1)
+
+
 def test_a_running_scheduler_and_its_worker_give_the_same_section(tmp_path):
     """`dask scheduler` and `dask worker` started as the README says (on this machine), then --dask ADDRESS."""
     dask = os.path.join(os.path.dirname(DESIGN_PLANT), "dask")
@@ -55,10 +68,7 @@ def test_a_running_scheduler_and_its_worker_give_the_same_section(tmp_path):
         started.append(subprocess.Popen([dask, "scheduler", "--port", "0", "--no-dashboard", "--scheduler-file",
                                          str(tmp_path / "s.json")], stdout=subprocess.DEVNULL,
                                         stderr=subprocess.DEVNULL))
-        deadline = time.monotonic() + 60
-        while not (tmp_path / "s.json").exists() and time.monotonic() < deadline:
-            time.sleep(0.1)
-        address = json.loads((tmp_path / "s.json").read_text())["address"]
+        address = scheduler_address(tmp_path / "s.json")
         started.append(subprocess.Popen([dask, "worker", address, "--nworkers", "1", "--nthreads", "1",
                                          "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
         args = [*SEED, *MC, "--no-files", "--json"]
