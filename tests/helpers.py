@@ -63,3 +63,12 @@ def wait_gone(tag: str, seconds: float = 2.0) -> list:
         if not left or time.monotonic() >= deadline:
             return left
         time.sleep(0.05)
+
+
+def wilson_half_width(k: int, n: int, z: float = 1.959963984540054) -> float:
+    """The 95 % Wilson score interval's half-width of k in n, written out here (not the package's)."""
+    import math
+    p = k / n
+    lo = (p + z * z / (2 * n) - z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))) / (1 + z * z / n)
+    hi = (p + z * z / (2 * n) + z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))) / (1 + z * z / n)
+    return ((1.0 if k == n else hi) - (0.0 if k == 0 else lo)) / 2

@@ -10,6 +10,7 @@ from ..core.errors import DesignError
 from ..core.ranges import help_range
 from . import common
 from .common import add_opamp_option, add_output_options, add_part_options, emit
+from .plant import cluster_ahead
 
 EPILOG = """examples:
   design-pid --plant-fc 3500 --plant-zeta 0.2
@@ -129,9 +130,9 @@ def _loop_monte_carlo(result, args, settings):
         return result
     n, seed = settings
     from .plant import scale_settings
-    scale, _ = scale_settings(args)
+    scale, target = scale_settings(args)
     result.monte_carlo = loop_monte_carlo(result, loop_series(result), n, seed, args.sampler, args.dist,
-                                          args.tol or (), args.limit or (), scale=scale)
+                                          args.tol or (), args.limit or (), scale=scale, target_ci=target)
     return result
 
 
@@ -304,10 +305,6 @@ def _monte_carlo_settings(args, spec):
     settings = monte_carlo_settings(args, LOOP_PARTS if spec.process is None else CONTROLLER_PARTS, parse_loop_limit)
     if any(str(t).strip().upper().startswith("GBW") for t in args.tol or ()):
         raise DesignError("--tol GBW spreads a plant's op-amp (design-plant); a loop's op-amps do not vary yet")
-    from .plant import scale_settings
-    if scale_settings(args)[1] is not None:   # --jobs and --dask checked before any work too
-        raise DesignError("--target-ci draws a plant's builds in rounds (design-plant, analyze-plant); for a loop "
-                          "give the number of builds with --monte-carlo N")
     return settings
 
 
@@ -321,14 +318,17 @@ def _run(args) -> int:
         common.check_output(args, args.name if args.name is not None else "pid_model")
         from ..pid.process_report import draw_early
         early = []   # the pictures that need no SPICE, drawn in the renderer while ngspice runs
-        result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator, rules_spice=args.rules_spice,
-                            before_spice=None if args.no_files else lambda r: early.append(draw_early(r)))
-        result = _loop_monte_carlo(result, args, mc)
+        with cluster_ahead(args):
+            result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator,
+                                rules_spice=args.rules_spice,
+                                before_spice=None if args.no_files else lambda r: early.append(draw_early(r)))
+            result = _loop_monte_carlo(result, args, mc)
         return emit(result, args, args.name or _model_name(spec, result.method),
                     lambda *a: model_write(*a, early=early[0] if early else None), model_text)
     # the default name needs the plant as built; its fixed start stands in for it in the check
     common.check_output(args, args.name if args.name is not None else f"pid_{spec.method}")
-    result = _loop_monte_carlo(design_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
+    with cluster_ahead(args):
+        result = _loop_monte_carlo(design_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
     name = args.name or _default_name(spec, result.plant.fn_hz, result.plant.zeta)
     return emit(result, args, name, write_outputs, summary_text)
 
@@ -404,10 +404,13 @@ def _analyze(args) -> int:
     if spec.process is not None:
         from ..pid.process_report import summary_text as model_text, write_outputs as model_write
         common.check_output(args, args.name if args.name is not None else "pid_as-built")
-        result = _loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
+        with cluster_ahead(args):
+            result = _loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args,
+                                       mc)
         return emit(result, args, args.name or _model_name(spec, result.method), model_write, model_text)
     common.check_output(args, args.name if args.name is not None else "pid_as-built")
-    result = _loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
+    with cluster_ahead(args):
+        result = _loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
     name = args.name or (f"pid_{result.tuning.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}"
                          f"_z{result.plant.zeta:.3g}")
     return emit(result, args, name, write_outputs, summary_text)

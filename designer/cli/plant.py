@@ -121,6 +121,13 @@ def scale_settings(args):
     return Scale(jobs=jobs, dask=dask, progress=tty and not getattr(args, "json", False)), target
 
 
+def cluster_ahead(args):
+    """A context: with ``--dask local`` (checked), the LocalCluster starts now, in its thread, while
+    the command designs and simulates; the Monte Carlo takes it (:func:`designer.tolerance.runner.cluster_ahead`)."""
+    from ..tolerance.runner import cluster_ahead as ahead
+    return ahead(scale_settings(args)[0])
+
+
 def _add_tolerance_options(p):
     """--monte-carlo and its settings, --limit and --worst-case (design-plant and analyze-plant)."""
     g = add_monte_carlo_options(p, "every figure's spread, the yield within --limit and the part to buy tighter")
@@ -338,8 +345,10 @@ def _design(args) -> int:
     from ..plant.design import design_plant
     if spice[2] is not None:     # the design is the draw's nominal; the sample's own run is the simulation
         return _replay(design_plant(spec, simulate=False), args, mc, spice, name)
-    result = _with_stimulus(design_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, stim)
-    return _emit(_with_monte_carlo(result, args, mc, spice), args, name)
+    with cluster_ahead(args):
+        result = _with_stimulus(design_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, stim)
+        result = _with_monte_carlo(result, args, mc, spice)
+    return _emit(result, args, name)
 
 
 def _emit(result, args, name) -> int:
@@ -402,8 +411,10 @@ def _analyze(args) -> int:
     check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
     if spice[2] is not None:
         return _replay(analyze_plant(spec, simulate=False), args, mc, spice, name)
-    result = _with_stimulus(analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, stim)
-    return _emit(_with_monte_carlo(result, args, mc, spice), args, name)
+    with cluster_ahead(args):
+        result = _with_stimulus(analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, stim)
+        result = _with_monte_carlo(result, args, mc, spice)
+    return _emit(result, args, name)
 
 
 def design_plant_main(argv=None) -> int:

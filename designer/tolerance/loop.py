@@ -214,7 +214,7 @@ def engine_of(result) -> tuple:
 
 
 def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str = "random", dist: str = "uniform",
-                     tol_items=(), limit_items=(), tighten: bool = True, scale=None):
+                     tol_items=(), limit_items=(), tighten: bool = True, scale=None, target_ci: float | None = None):
     """A Monte Carlo of a design-pid result's loop: the probabilities of instability and of
     saturation with their Wilson intervals, the statistics of every figure and, with
     ``limit_items`` (``--limit`` texts such as ``phase_margin_deg=45:90``), the yield with its
@@ -222,10 +222,12 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
     limit and the part whose tolerance halved raises the yield most (tried on the
     :data:`TIGHTEN_CANDIDATES` parts with the largest shares, one more run each). ``scale``: where
     the samples run (:class:`designer.tolerance.runner.Scale`; default here); the result is the
-    same wherever they run.
+    same wherever they run. ``target_ci``: ``--target-ci``, builds drawn in rounds until the
+    yield's 95 % Wilson half-width is below it, ``n`` at most, as the plant's
+    (:func:`designer.tolerance.montecarlo.target_plan`; needs limits).
 
     Returns a :class:`LoopMonteCarlo`."""
-    from .montecarlo import MAX_SAMPLES, MIN_SAMPLES
+    from .montecarlo import MAX_SAMPLES, MIN_SAMPLES, target_plan
     from .parts import resolve
     from .runner import Draw, Runner, Scale
     from .stats import failing_samples, figure_stats, variance_shares, wilson
@@ -235,9 +237,13 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
     limits = tuple(parse_loop_limit(t) for t in limit_items or ())
     nominal = loop_parts(result)
     tol = resolve(tol_items, nominal, series)
+    until, first = target_plan(target_ci, limits, sampler, n, lambda figs: _passed(figs, limits))
     chunk_fn, context = engine_of(result)
+    n_max, n = n, first
     with Runner(scale or Scale()) as run:
-        values, figs, _ = run.run(chunk_fn, context, Draw(nominal, tol.of, n, seed, sampler, dist))
+        values, figs, ends = run.run(chunk_fn, context, Draw(nominal, tol.of, n_max, seed, sampler, dist), first,
+                                     until)
+        n = ends[-1]     # the builds drawn (--target-ci may stop before n_max)
         nominal_figs = {k: float(v[0]) for k, v in loop_figures({r: np.array([x]) for r, x in nominal.items()},
                                                                 result).items()}
         by_fig = {lim.figure: lim for lim in limits}
@@ -254,13 +260,15 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
                             p_saturated={"count": saturated, "fraction": saturated / n,
                                          "ci95": list(wilson(saturated, n))},
                             unstable_samples=[int(i) for i in np.nonzero(figs["stable"] == 0)[0][:5]])
+        mc.record_target(target_ci, n_max, ends)
         if tighten and limits and mc.yield_count < n:
             weight = {r: sum(shares[k][r] for k in by_fig) for r in tol.of}
             tried = sorted(tol.of, key=lambda r: -weight[r])[:TIGHTEN_CANDIDATES]
             best = None
             for ref in tried:
                 halved = dict(tol.of, **{ref: tol.of[ref] / 2})
-                _, f, _ = run.run(chunk_fn, context, Draw(nominal, halved, n, seed, sampler, dist), progress=False)
+                _, f, _ = run.run(chunk_fn, context, Draw(nominal, halved, n_max, seed, sampler, dist), n,
+                                  progress=False)
                 y = float(np.mean(_passed(f, limits)))
                 if best is None or y > best[1]:
                     best = (ref, y)

@@ -62,6 +62,14 @@ class MonteCarlo:
     def yield_interval(self) -> tuple:
         return wilson(self.yield_count, self.n)
 
+    def record_target(self, target_ci: float | None, n_max: int, ends: list) -> None:
+        """``--target-ci``: the half-width asked, whether the yield's interval reached it, the
+        most builds allowed and each round's end (:func:`target_plan`); nothing without it."""
+        if target_ci is not None:
+            lo, hi = self.yield_interval()
+            self.target = {"half_width_pct": 100 * target_ci, "max_samples": n_max,
+                           "reached": (hi - lo) / 2 < target_ci, "rounds": ends}
+
     def to_dict(self) -> dict:
         lo, hi = self.yield_interval()
         settings = {"samples": self.n, "seed": self.seed, "sampler": self.sampler, "dist": self.dist,
@@ -188,10 +196,7 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
             raise DesignError("--tol GBW: the ideal op-amp has no gain-bandwidth to spread")
         nominal["GBW"] = opamp.gbw_hz     # varies only when asked: a datasheet's typical is not a tolerance
     tol = resolve(tol_items, nominal, series)
-    until, first = None, n
-    if target_ci is not None:
-        check_target_ci(target_ci, limits, sampler)
-        until, first = target_rounds(limits, target_ci, n), min(n, TARGET_ROUND)
+    until, first = target_plan(target_ci, limits, sampler, n, lambda figs: _yield(figs, limits))
     # another engine's evaluate(values) travels to the workers as the context of _apply
     chunk_fn, context = (engine.evaluate, opamp) if evaluate is None else (_apply, evaluate)
     with runner.Runner(scale or runner.Scale()) as run:
@@ -199,10 +204,7 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
                                      first, until)
         mc = _analyse(seed, sampler, dist, tol, nominal, values, figs, limits,
                       evaluate or (lambda v: _figures(v, {}, opamp)), engine_name)
-        if target_ci is not None:
-            lo, hi = mc.yield_interval()
-            mc.target = {"half_width_pct": 100 * target_ci, "max_samples": n, "reached": (hi - lo) / 2 < target_ci,
-                         "rounds": ends}
+        mc.record_target(target_ci, n, ends)
         if tighten and limits:
             mc.tighten = _tighten(run, mc, opamp, n)
             if engine_name != "analytic":
@@ -252,13 +254,24 @@ def half_width(k: int, n: int) -> float:
     return (hi - lo) / 2
 
 
-def target_rounds(limits, target: float, n_max: int):
+def target_plan(target_ci, limits, sampler, n: int, passed) -> tuple:
+    """``(until, first)`` of :meth:`designer.tolerance.runner.Runner.run`: without ``--target-ci``
+    (None) every one of the ``n`` samples at once; with it (checked, :func:`check_target_ci`),
+    :data:`TARGET_ROUND` first, then :func:`target_rounds` of ``passed``."""
+    if target_ci is None:
+        return None, n
+    check_target_ci(target_ci, limits, sampler)
+    return target_rounds(passed, target_ci, n), min(n, TARGET_ROUND)
+
+
+def target_rounds(passed, target: float, n_max: int):
     """``until`` of :meth:`designer.tolerance.runner.Runner.run` for ``--target-ci``: after a
-    round of n samples with k inside every limit, None when the Wilson half-width is below
+    round of n samples with k in the yield (``passed(figures)``: a boolean array, the plant's
+    inside every limit, the loop's stable too), None when the Wilson half-width is below
     ``target``, else the next total: where the half-width would reach it at the same yield,
     at least :data:`TARGET_ROUND` more and at most twice n (a first estimate is rough)."""
     def until(figs):
-        ok = _yield(figs, limits)
+        ok = passed(figs)
         n = ok.size
         k = int(np.count_nonzero(ok))
         if half_width(k, n) < target:

@@ -31,6 +31,7 @@ workers.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import re
@@ -294,70 +295,140 @@ def _adopt(parent_pid: int) -> None:
     lifetime.die_with_parent(parent_pid)
 
 
-def _start_cluster(start):
-    """``start()`` (a LocalCluster) in a thread of its own: an interruption reaches the main
-    thread only, so the cluster is never left half started; when one comes, the start is
-    waited for (a few seconds at most) and the cluster closed before it propagates."""
-    import threading
-    box = {}
+def _dask():
+    """``dask.distributed``, imported (about 0.35 s), with the Monte Carlo's setting entered
+    (returned: left on closing): a killed worker's task is not retried by the scheduler, the
+    runner retries it once itself. The cluster's own log lines are silenced: our one-line
+    errors say what went wrong."""
+    import logging
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)   # a third party's, at import
+        import dask
+        import distributed
+    for name in ("distributed", "tornado", "asyncio"):
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+    config = dask.config.set({"distributed.scheduler.allowed-failures": 0})
+    config.__enter__()
+    return distributed, config
 
-    def run():
-        try:
-            box["cluster"] = start()
-        except BaseException as exc:   # noqa: BLE001 - handed to the main thread
-            box["error"] = exc
 
-    th = threading.Thread(target=run, name="start-local-cluster", daemon=True)
-    th.start()
+def _local_cluster(workers: int, box: dict) -> None:
+    """A LocalCluster of ``workers`` processes of one thread each and its client, into ``box``
+    (``config``, ``cluster``, ``client``, each as it is made); its workers adopted at once
+    (:func:`_adopt`). No dashboard; the scheduler's HTTP server (health routes) on a free local
+    port: its default, 8787, may be another cluster's, and taking another port prints a warning."""
+    import logging
+    distributed, box["config"] = _dask()
+    box["cluster"] = distributed.LocalCluster(
+        n_workers=workers, threads_per_worker=1, processes=True, silence_logs=logging.CRITICAL,
+        dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
+    box["client"] = distributed.Client(box["cluster"])
+    box["client"].run(_adopt, os.getpid())
+
+
+def _close(client=None, cluster=None, config=None) -> None:
+    """Close what a pool holds (any may be None: half started, or gone)."""
     try:
-        while th.is_alive():
-            th.join(0.05)
-    except BaseException:
-        th.join(60)
-        if "cluster" in box:
-            try:
-                box["cluster"].close(timeout=CONNECT_TIMEOUT)
-            except Exception:   # noqa: BLE001 - the interruption wins
-                pass
-        raise
-    if "error" in box:
-        raise box["error"]
-    return box["cluster"]
+        if client is not None:
+            client.close(timeout=CONNECT_TIMEOUT)
+        if cluster is not None:
+            cluster.close(timeout=CONNECT_TIMEOUT)
+    except Exception:   # noqa: BLE001 - an interruption or another error may have brought us here: it wins
+        pass
+    finally:
+        if config is not None:
+            config.__exit__(None, None, None)
+
+
+class ClusterStart:
+    """A LocalCluster of ``workers`` starting in a thread of its own (the imports, the spawned
+    workers importing the package: a second or more). An interruption reaches the main thread
+    only, so the cluster is never left half started: :meth:`close` waits for the start (a few
+    seconds at most) and closes what it started, unless :meth:`take` handed it over."""
+
+    def __init__(self, workers: int):
+        import threading
+        self.workers = workers
+        self._box = {}
+        self._thread = threading.Thread(target=self._run, name="start-local-cluster", daemon=True)
+        self._thread.start()
+
+    def _run(self):
+        try:
+            _local_cluster(self.workers, self._box)
+        except BaseException as exc:   # noqa: BLE001 - handed to the main thread
+            self._box["error"] = exc
+
+    def take(self) -> tuple:
+        """``(client, cluster, config)`` once started, now the caller's to close; the start's
+        error raised."""
+        while self._thread.is_alive():
+            self._thread.join(0.05)
+        if "error" in self._box:
+            raise self._box["error"]
+        box, self._box = self._box, {}
+        return box["client"], box["cluster"], box["config"]
+
+    def close(self) -> None:
+        """Wait for the start and close what it started, unless it was taken."""
+        self._thread.join(60)
+        box, self._box = self._box, {}
+        _close(box.get("client"), box.get("cluster"), box.get("config"))
+
+
+#: the LocalCluster :func:`cluster_ahead` started, for the next ``--dask local`` pool to take
+_ahead = None
+
+
+@contextlib.contextmanager
+def cluster_ahead(scale: Scale | None):
+    """For ``--dask local`` (``scale``; anything else: nothing), start the LocalCluster now, in
+    its thread, while the command does other work (its design, its SPICE run), so that the
+    Monte Carlo's :class:`Runner` finds it started (``bench_tolerance``: the start is most of
+    what a LocalCluster adds to a short run). Whatever ends the block, a cluster no runner took
+    is waited for and closed."""
+    global _ahead
+    if scale is None or scale.dask != "local" or _ahead is not None:
+        yield
+        return
+    start = _ahead = ClusterStart(scale.workers)
+    try:
+        yield
+    finally:
+        _ahead = None
+        start.close()
+
+
+def _cluster_start(workers: int) -> ClusterStart:
+    """The start :func:`cluster_ahead` began for as many workers, handed over; else a new one."""
+    global _ahead
+    start, _ahead = (_ahead, None) if _ahead is not None and _ahead.workers == workers else (None, _ahead)
+    return start or ClusterStart(workers)
 
 
 class DaskPool:
     """A dask.distributed client: of a running scheduler, or of a LocalCluster started here
-    (``n_workers`` processes of one thread each). Imported only here: ``import dask.distributed``
-    takes about 0.35 s."""
+    (``n_workers`` processes of one thread each), or ahead (:func:`cluster_ahead`). Imported
+    only here: ``import dask.distributed`` takes about 0.35 s."""
 
     def __init__(self, address: str, workers: int):
-        import logging
-        import warnings
         self.cluster = self.client = None
         self.address = address
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", DeprecationWarning)   # a third party's, at import
-            import dask
-            import distributed
-        self._distributed = distributed
-        # our one-line errors say what went wrong; the cluster's own log lines would add to them
-        for name in ("distributed", "tornado", "asyncio"):
-            logging.getLogger(name).setLevel(logging.CRITICAL)
-        # a killed worker's task is not retried by the scheduler: the runner retries it once itself
-        self._config = dask.config.set({"distributed.scheduler.allowed-failures": 0})
-        self._config.__enter__()
         try:
             if address == "local":
-                # no dashboard; the scheduler's HTTP server (health routes) on a free local port: its
-                # default, 8787, may be another cluster's, and taking another port prints a warning
-                self.cluster = _start_cluster(lambda: distributed.LocalCluster(
-                    n_workers=workers, threads_per_worker=1, processes=True, silence_logs=logging.CRITICAL,
-                    dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}))
-                self.client = distributed.Client(self.cluster)
-                self.client.run(_adopt, os.getpid())
-            else:
+                start = _cluster_start(workers)
                 try:
-                    self.client = distributed.Client(address, timeout=CONNECT_TIMEOUT)
+                    self.client, self.cluster, self._config = start.take()
+                except BaseException:
+                    start.close()
+                    raise
+                import distributed
+                self._distributed = distributed
+            else:
+                self._distributed, self._config = _dask()
+                try:
+                    self.client = self._distributed.Client(address, timeout=CONNECT_TIMEOUT)
                 except Exception as exc:   # noqa: BLE001 - refused, timed out, or something else answered
                     what = (f"nothing answered within {CONNECT_TIMEOUT:g} s" if isinstance(exc, (OSError, TimeoutError))
                             else f"something else answered: {type(exc).__name__}")
@@ -430,17 +501,7 @@ class DaskPool:
         return False
 
     def close(self):
-        try:
-            if self.client is not None:
-                self.client.close(timeout=CONNECT_TIMEOUT)
-            if self.cluster is not None:
-                self.cluster.close(timeout=CONNECT_TIMEOUT)
-        except Exception:   # noqa: BLE001 - closing what may be half started or gone
-            pass
-        finally:
-            self.client = self.cluster = None
-            if self._config is not None:
-                self._config.__exit__(None, None, None)
-                self._config = None
+        held, (self.client, self.cluster, self._config) = (self.client, self.cluster, self._config), (None,) * 3
+        _close(*held)
 
     _config = None

@@ -45,8 +45,23 @@ def test_the_loops_worst_case():
     assert all(abs(d) <= 1 for d in pm["min"]["deviations"].values()) and len(pm["min"]["deviations"]) == 22
 
 
+def test_target_ci_on_the_loop_draws_in_rounds():
+    p = run(*LOOP, "--monte-carlo", "20000", "--seed", "7", "--limit", "phase_margin_deg=27:90",
+            "--limit", "overshoot_pct=0:12", "--target-ci", "3%", "--json")
+    assert p.returncode == 0, p.stderr
+    mc = json.loads(p.stdout)["monte_carlo"]
+    t = mc["settings"]["target_ci"]
+    assert t["reached"] and t["half_width_pct"] == 3 and t["max_samples"] == 20000
+    assert mc["settings"]["samples"] == mc["yield"]["samples"] == t["rounds"][-1] < 20000
+    lo, hi = mc["yield"]["ci95"]
+    assert (hi - lo) / 2 < 0.03
+
+
 @pytest.mark.parametrize("args, words", [
     (["--monte-carlo", "20", "--limit", "fn_hz=3k:4k"], "unknown figure"),
+    (["--monte-carlo", "100", "--target-ci", "1%"], "needs --limit"),
+    (["--monte-carlo", "100", "--limit", "phase_margin_deg=27:90", "--target-ci", "1%", "--sampler", "lhs"],
+     "random or sobol"),
     (["--monte-carlo", "20", "--limit", "phase_margin_deg=45:"], "both bounds"),
     (["--monte-carlo", "20", "--limit", "phase_margin_deg=90:45"], "above max"),
     (["--limit", "phase_margin_deg=45:90"], "goes with --monte-carlo"),

@@ -1,7 +1,8 @@
 """The loop's Monte Carlo: every sampled loop's figures equal analyze-pid's for
 those parts (sample by sample, from the CSV rows), the same seed the same run;
 the yield, the failing samples and the part to tighten against an independent
-count of the rows; the worst case against brute force on a small box."""
+count of the rows; --target-ci's rounds against an independent Wilson interval, the same on two
+workers; the worst case against brute force on a small box."""
 
 import io
 import itertools
@@ -17,7 +18,10 @@ from designer.pid.spec import PidSpec
 from designer.plant.sallenkey import SallenKeyParts
 from designer.core.errors import DesignError
 from designer.tolerance.loop import LIMITABLE, loop_figures, loop_monte_carlo, loop_parts, parse_loop_limit
+from designer.tolerance.montecarlo import TARGET_ROUND
+from designer.tolerance.runner import Scale
 from designer.tolerance.worstcase import worst_case
+from helpers import wilson_half_width
 
 LIMITS = ["phase_margin_deg=27:90", "overshoot_pct=0:12"]
 
@@ -101,6 +105,40 @@ def test_the_part_to_tighten_gives_the_yield_it_claims(designed, limited):
                              tol_items=[f"{t['part']}={t['tolerance_pct']}%"], tighten=False)
     assert again.yield_count / 60 == pytest.approx(t["yield"])
     assert again.tolerances.of[t["part"]] == pytest.approx(t["tolerance_pct"] / 100)
+
+
+#: --target-ci on the loop: a half-width LIMITS' yield reaches in a few rounds
+TARGET = 0.03
+
+
+def test_target_ci_on_a_loop_stops_at_the_first_round_below_it(designed):
+    def in_yield(figs, n):   # stable and inside every window, counted here
+        pm, os_ = figs["phase_margin_deg"][:n], figs["model_overshoot_pct"][:n]
+        return int(np.count_nonzero((figs["stable"][:n] == 1) & (pm >= 27) & (pm <= 90) & (os_ >= 0) & (os_ <= 12)))
+
+    mc = loop_monte_carlo(designed, {"R": "E24", "C": "E12"}, 20000, seed=7, limit_items=LIMITS, target_ci=TARGET,
+                          tighten=False)
+    d = mc.to_dict()
+    t, rounds = d["settings"]["target_ci"], d["settings"]["target_ci"]["rounds"]
+    assert t["reached"] and t["half_width_pct"] == 100 * TARGET and t["max_samples"] == 20000
+    assert rounds[0] == TARGET_ROUND and len(rounds) >= 2 and rounds == sorted(rounds)
+    assert rounds[-1] == mc.n == d["settings"]["samples"] == d["yield"]["samples"] == len(mc.figures["stable"])
+    assert d["yield"]["passed"] == in_yield(mc.figures, mc.n)
+    assert wilson_half_width(in_yield(mc.figures, mc.n), mc.n) < TARGET
+    for end in rounds[:-1]:   # every earlier round was still too wide
+        assert wilson_half_width(in_yield(mc.figures, end), end) >= TARGET
+    # the builds drawn are the first of the same run at its full size (build i is f(seed, i))
+    full = loop_monte_carlo(designed, {"R": "E24", "C": "E12"}, mc.n, seed=7, limit_items=LIMITS, tighten=False)
+    np.testing.assert_array_equal(full.figures["phase_margin_deg"], mc.figures["phase_margin_deg"])
+    # and the same on two worker processes
+    again = loop_monte_carlo(designed, {"R": "E24", "C": "E12"}, 20000, seed=7, limit_items=LIMITS,
+                             target_ci=TARGET, tighten=False, scale=Scale(jobs=2))
+    assert again.to_dict() == d and again.csv_text() == mc.csv_text()
+
+
+def test_target_ci_on_a_loop_needs_a_limit(designed):
+    with pytest.raises(DesignError, match="needs --limit"):
+        loop_monte_carlo(designed, {"R": "E24", "C": "E12"}, 1000, target_ci=0.01)
 
 
 @pytest.mark.parametrize("text, figure", [("overshoot_pct=0:12", "model_overshoot_pct"),

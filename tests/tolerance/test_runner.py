@@ -2,7 +2,7 @@
 chunk run once more (then exit 3), --target-ci's rounds against an independent
 Wilson interval, and the CLI inputs it parses."""
 
-import math
+import contextlib
 
 import numpy as np
 import pytest
@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from designer.core import opamps
 from designer.core.errors import DesignError, SimulatorError
 from designer.plant.sallenkey import SallenKeyParts
-from designer.tolerance import plant
+from designer.tolerance import plant, runner
 from designer.tolerance.montecarlo import (
     MAX_TARGET_CI,
     TARGET_ROUND,
@@ -20,6 +20,7 @@ from designer.tolerance.montecarlo import (
     plant_monte_carlo,
 )
 from designer.tolerance.runner import MAX_JOBS, Draw, Runner, Scale, parse_dask, parse_jobs
+from helpers import wilson_half_width
 from mc_engines import always_dies, dies_once
 
 AMP = opamps.get("LM741")
@@ -90,17 +91,74 @@ def test_on_a_local_cluster_a_dying_worker_s_chunk_runs_once_more_then_exit_3(tm
             run.run(always_dies, None, Draw(NOMINAL, TOL, 100, 1))
 
 
-def wilson_half_width(k, n, z=1.959963984540054):
-    """The Wilson score interval's half-width, written out here (not the package's)."""
-    p = k / n
-    lo = (p + z * z / (2 * n) - z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))) / (1 + z * z / n)
-    hi = (p + z * z / (2 * n) + z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))) / (1 + z * z / n)
-    return ((1.0 if k == n else hi) - (0.0 if k == 0 else lo)) / 2
-
-
 def inside(figs, n):
     fn, os_ = figs["fn_hz"][:n], figs["overshoot_pct"][:n]
     return int(np.count_nonzero((fn >= 3300) & (fn <= 3700) & (os_ >= 0) & (os_ <= 55)))
+
+
+def _children() -> set:
+    """This process's children, but multiprocessing's resource tracker (it lives as long as we do)."""
+    import psutil
+    out = set()
+    for p in psutil.Process().children(recursive=True):
+        try:
+            if not any("resource_tracker" in a for a in p.cmdline()):
+                out.add(p.pid)
+        except psutil.Error:   # gone meanwhile
+            pass
+    return out
+
+
+def _gone(pids: set, seconds: float = 10.0) -> set:
+    """Those of ``pids`` still running after ``seconds`` (polled)."""
+    import time
+
+    import psutil
+    deadline = time.monotonic() + seconds
+    while True:
+        left = {p for p in pids if psutil.pid_exists(p) and psutil.Process(p).status() != psutil.STATUS_ZOMBIE}
+        if not left or time.monotonic() >= deadline:
+            return left
+        time.sleep(0.05)
+
+
+def test_a_cluster_started_ahead_is_the_one_the_runner_takes():
+    """--dask local: the LocalCluster a command starts ahead (while it designs) is the one the
+    Monte Carlo runs on, with the same figures; the block's end leaves no worker."""
+    draw = Draw(NOMINAL, TOL, 400, 1)
+    _, ref, _ = Runner().run(plant.evaluate, AMP, draw)
+    scale = Scale(dask="local", chunk=100)
+    before = _children()
+    with runner.cluster_ahead(scale):
+        start = runner._ahead
+        assert isinstance(start, runner.ClusterStart) and start.workers == 2
+        with Runner(scale) as run:
+            assert runner._ahead is None and start._box == {}     # handed over, not started again
+            _, f, _ = run.run(plant.evaluate, AMP, draw)
+    assert_same(f, ref)
+    assert _gone(_children() - before) == set()
+
+
+@pytest.mark.parametrize("how", ["unused", "interrupted"])
+def test_a_cluster_started_ahead_and_not_taken_is_closed(how):
+    """A cluster no runner took (the design failed, or Ctrl-C came while it started) is waited
+    for and closed when the block ends: no worker is left."""
+    before = _children()
+    with pytest.raises(KeyboardInterrupt) if how == "interrupted" else contextlib.nullcontext():
+        with runner.cluster_ahead(Scale(dask="local")):
+            start = runner._ahead
+            if how == "interrupted":
+                raise KeyboardInterrupt
+            start._thread.join(60)      # started, then left alone
+            assert "cluster" in start._box
+    assert runner._ahead is None and not start._thread.is_alive() and start._box == {}
+    assert _gone(_children() - before) == set()
+
+
+def test_without_dask_local_nothing_starts_ahead():
+    for scale in (None, Scale(), Scale(jobs=2), Scale(dask="tcp://127.0.0.1:1")):
+        with runner.cluster_ahead(scale):
+            assert runner._ahead is None
 
 
 @pytest.mark.parametrize("target", [0.01, 0.02])
