@@ -280,6 +280,7 @@ SPICE_GOAL = 0.8
 def floor_deck(ctx, values: dict) -> str:
     """The plant deck with a control block that loops over the samples by itself: the values in
     vectors, per pass ``alter``, ``tran`` over the rising half and the engine's five ``meas``."""
+    from designer.tolerance import spice_engine
     n = len(values["R1"])
     f = ctx.final_v({}, 1)[0]
     win = f"FROM={ctx.t0:.10g} TO={ctx.t1:.10g}"
@@ -292,13 +293,7 @@ def floor_deck(ctx, values: dict) -> str:
     for d in values:
         lines += [f"let x = v{d}[i]", f"alter {elem[d]} = $&x"]
     lines += [f"tran {ctx.max_step_s:.6g} {ctx.t1:.10g} 0 {ctx.max_step_s:.6g}",
-              f"meas tran mcpeak MAX v(out) {win}",
-              "let mcdv = deriv(v(out))",
-              f"meas tran mctpk WHEN mcdv=0 FALL=1 {win}",
-              f"meas tran mct10 WHEN v(out)={0.1 * f:.10g} CROSS=1 {win}",
-              f"meas tran mct90 WHEN v(out)={0.9 * f:.10g} CROSS=1 {win}",
-              f"let mcerr = abs(v(out)-{f:.10g})/{f:.10g}",
-              f"meas tran mcts WHEN mcerr=0.02 CROSS=LAST {win}",
+              *spice_engine.measures(win, f),   # the same measurements as the engine's
               "destroy all", "let i = i + 1", "end", "quit", ".endc", ".end"]
     return "\n".join(lines) + "\n"
 

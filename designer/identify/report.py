@@ -63,14 +63,17 @@ def _best_line(best, corners: bool = False) -> str:
     return f"Best: {best.name} ({best.model}): {format_params(best.params, corners)}"
 
 
+def _capture_line(cap) -> str:
+    return (f"Capture: {cap.source} ({cap.fmt}, {cap.samples} samples, output {cap.output_name!r}"
+            + (f", input {cap.input_name!r}" if cap.input_name else "") + ")")
+
+
 def step_text(result) -> str:
     """The ``identify`` table of an :class:`~.step.IdentifyResult`."""
     s, cap = result.step, result.capture
     lines = []
     if cap is not None:
-        lines.append(f"Capture: {cap.source} ({cap.fmt}, {cap.samples} samples, output "
-                     f"{cap.output_name!r}" + (f", input {cap.input_name!r}" if cap.input_name else "")
-                     + ")")
+        lines.append(_capture_line(cap))
     span = s.y_final - s.y0
     noise = f"{100 * s.sigma / abs(span):.2g} %" if span else "n/a"
     lines.append(f"Step at {format_eng(s.t_step, 's')}, amplitude {s.amplitude:.4g}; "
@@ -229,9 +232,7 @@ def broadband_text(result) -> str:
     ex, cap = result.excitation, result.capture
     lines = []
     if cap is not None:
-        lines.append(f"Capture: {cap.source} ({cap.fmt}, {cap.samples} samples, output "
-                     f"{cap.output_name!r}" + (f", input {cap.input_name!r}" if cap.input_name else "")
-                     + ")")
+        lines.append(_capture_line(cap))
     lines.append(f"Broadband input: {ex.text()}")
     for n in (list(cap.notes) if cap is not None else []) + list(result.notes):
         lines.append(f"  note: {n}")

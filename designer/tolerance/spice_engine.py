@@ -145,16 +145,21 @@ def commands(ctx: SpiceContext, values: dict, start: int = 0) -> list:
             else:
                 out.append(f"alter {elem[d]} = {float(v[i]):.12g}")
         f = float(final[i])
-        out += [tran, f"echo MCROW {start + i}",
-                f"meas tran mcpeak MAX v(out) {win}",
-                "let mcdv = deriv(v(out))",
-                f"meas tran mctpk WHEN mcdv=0 FALL=1 {win}",
-                f"meas tran mct10 WHEN v(out)={0.1 * f:.10g} CROSS=1 {win}",
-                f"meas tran mct90 WHEN v(out)={0.9 * f:.10g} CROSS=1 {win}",
-                f"let mcerr = abs(v(out)-{f:.10g})/{f:.10g}",
-                f"meas tran mcts WHEN mcerr=0.02 CROSS=LAST {win}",
-                "destroy all"]
+        out += [tran, f"echo MCROW {start + i}", *measures(win, f), "destroy all"]
     return out
+
+
+def measures(win: str, final: float) -> list:
+    """The control block's measurements of one run (peak, peak time, 10-90 % and 2 % settling
+    crossings) within ``win`` (``FROM=.. TO=..``), ``final`` the settled output."""
+    f = final
+    return [f"meas tran mcpeak MAX v(out) {win}",
+            "let mcdv = deriv(v(out))",
+            f"meas tran mctpk WHEN mcdv=0 FALL=1 {win}",
+            f"meas tran mct10 WHEN v(out)={0.1 * f:.10g} CROSS=1 {win}",
+            f"meas tran mct90 WHEN v(out)={0.9 * f:.10g} CROSS=1 {win}",
+            f"let mcerr = abs(v(out)-{f:.10g})/{f:.10g}",
+            f"meas tran mcts WHEN mcerr=0.02 CROSS=LAST {win}"]
 
 
 def parse(output: str, start: int, n: int) -> dict:

@@ -118,6 +118,16 @@ D.table = function (header, rows, cls) {
   return t;
 };
 
+// one figure of a result: its value large, its label below
+D.fig = function (label, value) {
+  const d = document.createElement("div");
+  d.className = "figure";
+  d.innerHTML = "<b></b><span></span>";
+  d.querySelector("b").textContent = value;
+  d.querySelector("span").textContent = label;
+  return d;
+};
+
 D.checksTable = function (checks) {
   return D.table(["check", "result", "detail"], checks.map(c => {
     const s = document.createElement("span");

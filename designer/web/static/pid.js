@@ -24,15 +24,6 @@ function request() {
   return o;
 }
 
-function fig(label, value) {
-  const d = document.createElement("div");
-  d.className = "figure";
-  d.innerHTML = "<b></b><span></span>";
-  d.querySelector("b").textContent = value;
-  d.querySelector("span").textContent = label;
-  return d;
-}
-
 function show(answer) {
   const r = answer.result, p = answer.page;
   document.getElementById("title").textContent = p.title;
@@ -40,11 +31,11 @@ function show(answer) {
   const cl = r.closed_loop || {};
   const a = cl.spice || cl.analytic || {};
   document.getElementById("figures").replaceChildren(
-    fig("method", r.method || t.method || ""),
-    fig("Kp", t.kp !== undefined ? (+t.kp).toPrecision(4) : ""),
-    fig("Ti", D.eng(t.ti_s, "s")), fig("Td", D.eng(t.td_s, "s")),
-    fig(cl.spice ? "overshoot (SPICE)" : "overshoot (analytic)", a.overshoot_pct !== undefined && a.overshoot_pct !== null ? `${(+a.overshoot_pct).toPrecision(3)} %` : "n/a"),
-    fig("checks failed", String((r.checks || []).filter(c => !c.ok).length)));
+    D.fig("method", r.method || t.method || ""),
+    D.fig("Kp", t.kp !== undefined ? (+t.kp).toPrecision(4) : ""),
+    D.fig("Ti", D.eng(t.ti_s, "s")), D.fig("Td", D.eng(t.td_s, "s")),
+    D.fig(cl.spice ? "overshoot (SPICE)" : "overshoot (analytic)", a.overshoot_pct !== undefined && a.overshoot_pct !== null ? `${(+a.overshoot_pct).toPrecision(3)} %` : "n/a"),
+    D.fig("checks failed", String((r.checks || []).filter(c => !c.ok).length)));
   D.plot(document.getElementById("closed"), p.closed_loop, {xUnit: "s", yLabel: "output (V)"});
   D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 220});
   D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 180});

@@ -6,29 +6,20 @@ const form = document.getElementById("form");
 const status = document.getElementById("status");
 let seq = 0, last = null;
 
-function fig(label, value) {
-  const d = document.createElement("div");
-  d.className = "figure";
-  d.innerHTML = "<b></b><span></span>";
-  d.querySelector("b").textContent = value;
-  d.querySelector("span").textContent = label;
-  return d;
-}
-
 function show(answer) {
   const r = answer.result, p = answer.page, b = r.built;
   document.getElementById("title").textContent = p.title;
   const figs = document.getElementById("figures");
   figs.replaceChildren(
-    fig("R1", D.eng(b.R1_ohm, "Ohm", 3)), fig("R2", D.eng(b.R2_ohm, "Ohm", 3)),
-    fig("C1", D.eng(b.C1_f, "F", 3)), fig("C2", D.eng(b.C2_f, "F", 3)),
-    fig(`fn as built (${r.opamp.name})`, D.eng(b.fn_opamp_hz, "Hz", 4)),
-    fig(`zeta as built (${r.opamp.name})`, b.zeta_opamp.toPrecision(4)),
-    fig("overshoot (model)", `${r.analytic_opamp.overshoot_pct.toPrecision(4)} %`),
-    fig("overshoot (SPICE)", r.spice ? `${r.spice.overshoot_pct.toPrecision(4)} %` : "not simulated"),
-    fig("peak time", D.eng((r.spice || r.analytic_opamp).peak_time_s, "s", 4)),
-    fig("settling time (2 %)", D.eng((r.spice || r.analytic_opamp).settling_time_s, "s", 4)),
-    fig("SPICE agrees with the model", r.comparison.pass === undefined ? "n/a" : (r.comparison.pass ? "yes" : "NO")));
+    D.fig("R1", D.eng(b.R1_ohm, "Ohm", 3)), D.fig("R2", D.eng(b.R2_ohm, "Ohm", 3)),
+    D.fig("C1", D.eng(b.C1_f, "F", 3)), D.fig("C2", D.eng(b.C2_f, "F", 3)),
+    D.fig(`fn as built (${r.opamp.name})`, D.eng(b.fn_opamp_hz, "Hz", 4)),
+    D.fig(`zeta as built (${r.opamp.name})`, b.zeta_opamp.toPrecision(4)),
+    D.fig("overshoot (model)", `${r.analytic_opamp.overshoot_pct.toPrecision(4)} %`),
+    D.fig("overshoot (SPICE)", r.spice ? `${r.spice.overshoot_pct.toPrecision(4)} %` : "not simulated"),
+    D.fig("peak time", D.eng((r.spice || r.analytic_opamp).peak_time_s, "s", 4)),
+    D.fig("settling time (2 %)", D.eng((r.spice || r.analytic_opamp).settling_time_s, "s", 4)),
+    D.fig("SPICE agrees with the model", r.comparison.pass === undefined ? "n/a" : (r.comparison.pass ? "yes" : "NO")));
   document.getElementById("notes").replaceChildren(...r.notes.map(n => { const e = document.createElement("p"); e.textContent = n; return e; }));
   document.getElementById("schematic").innerHTML = p.schematic_svg;
   document.getElementById("bench").replaceChildren(D.table(["set", "to"], p.bench));
