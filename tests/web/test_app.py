@@ -251,8 +251,8 @@ def test_check_design_trust_boundary_applies_unchanged(server, deck, spec_deck, 
 def test_a_run_past_its_deadline_is_killed_and_reported_then_the_next_is_answered():
     s = Server("--timeout", "1", "--jobs", "1")
     try:
-        status, got = s.post_json("/api/pid", {"plant-fc": 3500, "plant-zeta": 0.2, "tuning": "optimize",
-                                            "target-overshoot": 10})
+        # a million-build Monte Carlo takes seconds on any machine
+        status, got = s.post_json("/api/plant", {"fc": 3500, "zeta": 0.2, "no-sim": True, "monte-carlo": 1000000})
         assert status == 504 and "timed out after 1 s (killed)" in got["error"]
         status, got = s.post_json("/api/plant", {"fc": 2000, "zeta": 0.5, "no-sim": True})
         assert status == 200 and got["spec"]["fc_hz"] == 2000
@@ -270,10 +270,12 @@ def test_a_queued_request_whose_client_left_is_never_run():
     import urllib.request
     s = Server("--jobs", "1")
     try:
-        slow = threading.Thread(target=s.post_json, args=("/api/pid", {"plant-fc": 3500, "plant-zeta": 0.2,
-                                                                        "tuning": "optimize", "target-overshoot": 10}))
+        # the slow one reaches the one worker first and holds it for seconds (a million-build Monte Carlo),
+        # far longer than the server takes to see the three clients below go (it looks every 0.25 s)
+        slow = threading.Thread(target=s.post_json, args=("/api/plant", {"fc": 3500, "zeta": 0.2, "no-sim": True,
+                                                                          "monte-carlo": 1000000}))
         slow.start()
-        time.sleep(1.0)   # the slow one reaches the one worker first (its optimiser takes seconds)
+        time.sleep(0.5)
         u = urllib.parse.urlsplit(s.url)
         body = json.dumps({"fc": 3500, "zeta": 0.2}).encode()
         for _ in range(3):   # sent while the one worker is busy, then the client goes away
