@@ -15,7 +15,12 @@ the margins and Ms on a fixed frequency grid, the dead time's phase -w theta
 added exactly to the rational part's unwrapped phase; milliseconds an
 evaluation), then Nelder-Mead on the IAE of the simulated reference step from
 there (:func:`designer.pid.delayloop.closed_loop_step`, a coarse grid), with
-the overshoot target and the controller's output range. The search's
+the overshoot target, the controller's output range and, with a real op-amp,
+every op-amp output inside its swing and slewing for at most 5 % of the rise
+time (the design's own ``slew_rate`` and ``output_swing`` checks, on the
+stages of the unrounded circuit, as the Sallen-Key optimiser holds them,
+:mod:`designer.pid.optimize`); a rule whose loop beats the search's IAE wins
+only when it holds them too. The search's
 controller is the circuit's with ideal op-amps in closed form; the result is
 checked on the exact margins of the loop as built, op-amp poles included
 (:func:`designer.pid.delaymargins.loop_margins`); where the search was
@@ -47,6 +52,24 @@ SEARCH_POINTS = 801
 SEARCH_STEP_FRACTION = 0.1
 #: the search's record: this many times 1/wc (a loop with 45 deg of margin has settled by 10/wc)
 SEARCH_SPAN = 20.0
+#: the stage limits' penalties start at these fractions of the swing and the slew budget (a margin for
+#: the coarse grid and the parts' rounding), as the Sallen-Key optimiser's
+SWING_LIMIT, SLEW_LIMIT = 0.98, 0.95
+#: points of the fine grid over the reference's kick (:meth:`_Problem.stage_violation`)
+KICK_POINTS = 401
+
+
+def slew_delay_stages(t_fine, v_fine, t, v, slew_v_per_s: float, edge_s: float) -> float:
+    """The slew delay (:func:`designer.pid.model.slew_delay`) of a stage output known on
+    a fine grid ``t_fine`` over the kick and on the coarse ``t`` after it; the fine grid's
+    first step, which holds the reference's edge, counts as the edge's length."""
+    dv = np.abs(np.diff(v_fine))
+    dt = np.diff(t_fine)
+    if edge_s > 0:
+        dt[0] = min(dt[0], edge_s)
+    k = int(np.searchsorted(t, t_fine[-1], side="right"))
+    kick = float(np.sum(np.maximum(0.0, dv - slew_v_per_s * dt))) / slew_v_per_s
+    return kick + M.slew_delay(np.r_[t_fine[-1], t[k:]], np.r_[v_fine[-1], v[k:]], slew_v_per_s)
 
 
 @dataclass
@@ -94,6 +117,7 @@ class _Problem:
             lo, hi = max(lo, spec.plant_input[0]), min(hi, spec.plant_input[1])
         self.u_range = (lo, hi)
         self.evaluations = 0
+        self.reference = M.reference(t, spec.step_v, 0.0, spec.edge_s)
 
     def built(self, kp, ti, td):
         """The controller as built (op-amp poles included): the E-series parts the design
@@ -143,6 +167,55 @@ class _Problem:
                 total += max(0.0, (self.gm_min - gm) / max(self.gm_min, 1.0))
         return total
 
+    def stage_violation(self, kp, ti, td, y, rise_s, corners=None) -> float:
+        """How far the op-amp outputs pass their swing and slew budgets (0: within; an ideal
+        op-amp has none): every stage of the unrounded circuit
+        (:func:`designer.pid.blocks.continuous_parts`) for the plant output ``y``.
+
+        The reference's edge kicks the stages faster than the search's grid resolves (its
+        step is a few derivative-filter time constants; on it the slew delay reads half
+        the true one), so the stages' first ten derivative time constants are redone on a
+        grid 400 steps long, the plant's output (smooth there) interpolated; the grid's
+        first step is read as the edge it holds (:func:`slew_delay_stages`). ``corners``:
+        (fc, f_i, f_d) of another build than the search's (a rule's own)."""
+        from .process_loop import edged, stage_waves
+        amp = self.amp
+        if amp.ideal:
+            return 0.0
+        fc, f_i, f_d = corners if corners is not None else (self.fc, self.f_i, self.f_d)
+        parts = blocks.continuous_parts(kp, ti, td, fc, f_integrator_hz=f_i, f_differentiator_hz=f_d)
+        t, edge = self.t, self.spec.edge_s
+        ye = edged(t, y, edge)
+        waves = stage_waves(parts, amp, t, self.reference, ye)
+        tw = max(10.0 / (2 * math.pi * f_d), 20.0 * edge, 3.0 * (t[1] - t[0]))
+        t_fine = np.linspace(0.0, tw, KICK_POINTS)
+        fine = stage_waves(parts, amp, t_fine, M.reference(t_fine, self.step_v, 0.0, edge), np.interp(t_fine, t, ye))
+        rise = rise_s if math.isfinite(rise_s) and rise_s > 0 else t[-1] / 20
+        budget = M.SLEW_DELAY_FRACTION * rise
+        lim = M.waveform_limits({k: v for k, v in waves.items() if k != "y"}, t, amp, budget)
+        if not lim:
+            return 0.0
+        swing = max(max(v.v_max / amp.vout_max, v.v_min / amp.vout_min) for v in lim.values())
+        slew = max(slew_delay_stages(t_fine, fine[v.signal], t, waves[v.signal], amp.slew_v_per_s, edge)
+                   for v in lim.values()) / budget
+        return max(0.0, swing - SWING_LIMIT) + max(0.0, slew - SLEW_LIMIT)
+
+    def rule_within_stages(self, f) -> bool:
+        """Whether a rule's loop (:class:`~designer.pid.process_result.LoopFigures` ``f``), built
+        as the design builds it (its own crossover's corners, the op-amp poles), keeps every
+        op-amp output within its swing and slew (its row holds its margins and u only)."""
+        from .process_loop import (built_controller, corner_frequencies, ideal_crossover_hz, leak_limit_hz,
+                                   simulation_controller)
+        if self.amp.ideal:
+            return True
+        fc = ideal_crossover_hz(self.model, f.kp, f.ti_s, f.td_s)
+        f_i, f_d = corner_frequencies(self.spec, fc, leak_limit_hz(self.model, f.kp, f.ti_s))
+        ctrl = built_controller(f.kp, f.ti_s, f.td_s, fc, self.spec, self.amp)
+        out = closed_loop_step(self.plants[0], simulation_controller(ctrl, fc), self.t, self.step_v,
+                               step_fraction=SEARCH_STEP_FRACTION)
+        rise = step_figures(self.t, out["y"], self.step_v).rise_time_s
+        return self.stage_violation(f.kp, f.ti_s, f.td_s, out["y"], rise, (fc, f_i, f_d)) <= 1e-6
+
     def evaluate(self, kp, ti, td):
         """(cost, iae, overshoot %, violation) of the gains."""
         self.evaluations += 1
@@ -160,6 +233,7 @@ class _Problem:
         target = self.spec.target_overshoot_pct
         if target is not None and math.isfinite(fig.overshoot_pct):
             viol += max(0.0, fig.overshoot_pct - target) / max(target, 1.0)
+        viol += self.stage_violation(kp, ti, td, y, fig.rise_time_s)
         # an unsettled tail (the record cut while the loop still moves) counts as error too
         return fig.iae, fig.iae, fig.overshoot_pct, viol
 
@@ -275,7 +349,8 @@ def optimize_model_loop(spec, model, amp, table) -> ModelOptimizeResult:
                 or (target is not None and f.step.overshoot_pct > target)):
             continue
         if f.step.iae < iae * (1 - 1e-3) and (beaten is None or f.step.iae < beaten.figures.step.iae):
-            beaten = r
+            if prob.rule_within_stages(f):
+                beaten = r
     f_i, f_d = prob.f_i, prob.f_d
     if beaten is not None:
         # built as the rule's row was: its own crossover sets the corners
@@ -287,6 +362,7 @@ def optimize_model_loop(spec, model, amp, table) -> ModelOptimizeResult:
     what = (f"optimize: IAE {format_eng(iae, 'V s')} (start {start.rule}: {format_eng(g.step.iae, 'V s')}) with "
             f"phase margin >= {pm_min:g} deg, gain margin >= {gm_min:g} dB, Ms <= {ms_max:g}"
             + (f", overshoot <= {target:g} %" if target is not None else "")
+            + ("" if amp.ideal else f", every {amp.name} output within its swing and slew")
             + (f" at all {len(prob.plants) - 1} corners of the 95 % box too" if spec.robust else "")
             + f", after {prob.evaluations} evaluations"
             + (f": rule {beaten.rule}'s gains, which meet every limit as built with the smallest IAE, beat the "

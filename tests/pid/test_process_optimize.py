@@ -4,6 +4,7 @@ controller with its op-amp poles, exact margins with the dead time), its IAE is
 no worse than the best rule's that meets the same limits, and the options
 (min_phase_margin_deg, target_overshoot_pct, robust) do what they say."""
 
+import numpy as np
 import pytest
 
 from designer.core import process
@@ -37,19 +38,65 @@ def built_margins(res):
     return loop_margins(plant_of(res.model), controller_tf(res.parts, res.opamp))
 
 
-@pytest.mark.parametrize("tf, opamp", [
-    (ISSUE_TF, "LM741"), (SOPDT_TF, "LM741"), ("K=1 fn=200 zeta=0.4", "LM741"), (INTEGRATING_TF, "LM741"),
-    # microsecond plants: the derivative filter's corner is held at 1/(2 pi r_min c_min) by the part bounds
-    ("K=2 tau=10u theta=2u", "LM741"), ("K=2 tau=5u theta=1u", "NE5532"),
+@pytest.mark.parametrize("tf, opamp, stages", [
+    (ISSUE_TF, "LM741", True), (SOPDT_TF, "LM741", True), ("K=1 fn=200 zeta=0.4", "LM741", True),
+    (INTEGRATING_TF, "LM741", True),
+    # microsecond plants: the derivative filter's corner is held at 1/(2 pi r_min c_min) by the part bounds;
+    # the LM741's difference amplifier slews on the 1 V reference step itself (2 us) whatever the gains
+    ("K=2 tau=10u theta=2u", "LM741", False), ("K=2 tau=5u theta=1u", "NE5532", True),
 ])
-def test_optimize_meets_the_default_limits_on_the_loop_as_built(tf, opamp):
+def test_optimize_meets_the_default_limits_on_the_loop_as_built(tf, opamp, stages):
     res = optimized(plant_tf=tf, opamp=opamp)
     mg = built_margins(res)
     assert meets(mg, res.limits), (mg.phase_margin_deg, mg.gain_margin_db, mg.ms, res.limits)
     assert mg.ms == res.margins.ms and mg.phase_margin_deg == res.margins.phase_margin_deg
     ok = {c.id: c.ok for c in res.checks}
     assert ok["closed_loop_stable"] and ok["phase_margin"] and ok["gain_margin"] and ok["max_sensitivity"]
+    assert ok["output_swing"] and (ok["slew_rate"] or not stages), [c.detail for c in res.checks if not c.ok]
     assert res.optimizer.met and "NOT all met" not in res.optimizer.message
+
+
+#: a fast underdamped plant (a lab's 3.9 kHz second-order filter as identified): every rule's loop makes
+#: the LM741 slew past its budget
+FAST_TF = "K=1.02 fn=3.913k zeta=0.374 theta=0"
+
+
+def test_optimize_keeps_every_op_amp_within_its_slew_and_swing():
+    """Bug fixed: the model plant's optimiser held the margins, Ms and u's range but not the op-amps' slew:
+    on this plant its LM741 loop failed the design's own slew_rate check (U6 slewing 11 us against a
+    2.3 us budget); the search now holds every stage's swing and slew as the Sallen-Key optimiser does."""
+    res = optimized(plant_tf=FAST_TF)
+    ok = {c.id: c for c in res.checks}
+    assert ok["slew_rate"].ok and ok["output_swing"].ok, ok["slew_rate"].detail
+    assert res.optimizer.met and "every LM741 output within its swing and slew" in res.optimizer.message
+    rules = {c.id: c.ok for c in design_model_pid(PidSpec(plant_tf=FAST_TF, tuning="chr20"), simulate=False).checks}
+    assert not rules["slew_rate"]      # the limit binds: the starting rule slews
+
+
+def test_the_searchs_slew_delay_equals_a_fine_grids():
+    """The search's slew delay (its coarse grid, the kick redone finely) against the stages simulated
+    on a grid 250 times finer: within 5 %."""
+    from designer.core import opamps
+    from designer.pid import blocks, model as M
+    from designer.pid.process_loop import edged, stage_waves
+    from designer.pid.process_optimize import KICK_POINTS, SEARCH_POINTS, SEARCH_STEP_FRACTION, _Problem
+    spec = PidSpec(plant_tf=FAST_TF, tuning="optimize")
+    model, amp = spec.process, opamps.get(spec.opamp)
+    kp, ti, td, fc = 1.6, 200e-6, 10e-6, 8e3
+    t = response_grid(model, fc, SEARCH_POINTS, per_crossover=20.0)
+    prob = _Problem(spec, model, amp, fc, t, False)
+    out = closed_loop_step(plant_of(model), prob.controller(kp, ti, td), t, spec.step_v,
+                           step_fraction=SEARCH_STEP_FRACTION)
+    rise = step_figures(t, out["y"], spec.step_v).rise_time_s
+    budget = M.SLEW_DELAY_FRACTION * rise
+    got = (prob.stage_violation(kp, ti, td, out["y"], rise) + 0.95) * budget   # slew above its budget
+    parts = blocks.continuous_parts(kp, ti, td, fc, f_integrator_hz=prob.f_i, f_differentiator_hz=prob.f_d)
+    tf = np.linspace(0.0, t[-1], 250 * (t.size - 1) + 1)
+    yf = np.interp(tf, t, edged(t, out["y"], spec.edge_s))
+    fine = stage_waves(parts, amp, tf, M.reference(tf, spec.step_v, 0.0, spec.edge_s), yf)
+    want = max(M.slew_delay(tf, v, amp.slew_v_per_s) for k, v in fine.items() if k != "y")
+    assert want > 2 * budget and KICK_POINTS < SEARCH_POINTS
+    assert got == pytest.approx(want, rel=0.05)
 
 
 def _iae(model, ctrl, t, step_v):
@@ -124,8 +171,9 @@ def test_a_target_overshoot_is_met_by_the_analytic_loop(tf):
     """Bug fixed: the search met the target on its coarse grid and the design's read 5.02 % for a 5 % target
     on the integrating plant; the target is now checked on the loop as built, Kp lowered until it holds."""
     free = optimized(plant_tf=tf)
-    target = 5.0
-    assert free.analytic.overshoot_pct > target            # the target binds
+    # 5 %, or below the free optimum where the op-amp's slew already holds it lower: the target binds
+    target = min(5.0, round(0.6 * free.analytic.overshoot_pct, 1))
+    assert free.analytic.overshoot_pct > target
     res = optimized(plant_tf=tf, target_overshoot_pct=target)
     assert res.analytic.overshoot_pct <= target, res.analytic.overshoot_pct
     assert meets(built_margins(res), res.limits)
