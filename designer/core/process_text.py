@@ -1,5 +1,5 @@
-"""Process models typed by hand: :func:`parse_tf` reads space-separated
-``key=value`` words into a :class:`~designer.core.process.ProcessModel`.
+"""Process models typed by hand: :func:`parse_tf` reads ``key=value`` words
+separated by spaces, commas or semicolons into a :class:`~designer.core.process.ProcessModel`.
 
 Forms (:data:`FORMS`; keys case-insensitive, :data:`KEYS` for their spellings,
 values in engineering notation, theta 0 when not given):
@@ -66,8 +66,10 @@ FORMS_TEXT = "; ".join(_form_text(f) for f in FORMS)
 _KEYS_TEXT = "K, tau, tau1, tau2, fn, zeta, theta, num, den and the word integrator"
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*", re.ASCII)
-_VALUE = re.compile(r"[^\s\[\]=]+")
-_SPACE = re.compile(r"\s*")
+_VALUE = re.compile(r"[^\s\[\]=,;]+")
+# words are separated by spaces, commas or semicolons ("K=2, tau=1m")
+_SPACE = re.compile(r"[\s,;]*")
+_DECIMAL_COMMA = re.compile(r"(\d),(\d)")
 # a prefix or unit standing alone after a number ("1.5 ms", "200 u", "3.5 kHz"): format_eng's
 # own output; an upper-case K alone is the gain key, never kilo, here
 _UNIT_WORD = re.compile(r"(?:(?i:meg)|[fpnuµμmkMGT])?(?:s|(?i:hz)|(?i:ohms?))?")
@@ -82,6 +84,13 @@ def _tokens(text: str) -> list:
     """``[(word, value), ...]``: value is None for a bare word, a str for
     ``key=value`` and a list of str for ``key=[a b, c]``."""
     s, pos, out = text, 0, []
+    m = _DECIMAL_COMMA.search(s)
+    if m and "[" not in s[:m.start()][s[:m.start()].rfind("]") + 1:]:   # outside a list, where commas separate
+        word = (s[:m.start()].split() or [""])[-1] if s[:m.start()][-1:].strip() else ""
+        word += s[m.start():].split()[0]   # the whole word the comma is in
+        point = _DECIMAL_COMMA.sub(r"\1.\2", word)
+        raise DesignError(f"{_show(word)}: write the decimal point as a point ({point}); commas only "
+                          "separate words and list items")
 
     def garbage(at: int):
         chunk = s[at:].split()[0] if s[at:].split() else s[at:]
@@ -124,7 +133,7 @@ def _tokens(text: str) -> list:
                 out.append((word, value))
         else:
             out.append((word, None))
-        if pos < len(s) and not s[pos].isspace():
+        if pos < len(s) and not (s[pos].isspace() or s[pos] in ",;"):
             raise garbage(start)
 
 

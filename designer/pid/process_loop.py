@@ -244,7 +244,9 @@ def choose_gains(spec: PidSpec, model, reduced, amp, table) -> tuple:
             return (Gains(rt.rule, rt.kp, rt.ti_s, rt.td_s, rt), None,
                     [f"rule {rt.rule} (the first of {', '.join(DEFAULT_RULES)} that applies to this model; "
                      "--tuning names another, --tuning optimize meets margins and Ms)"])
-    raise DesignError("no tuning rule applies to this model (" + "; ".join(r.reason for r in table if r.reason)
+    # the tangent rules share one reason: each said once
+    reasons = list(dict.fromkeys(r.reason for r in table if r.reason))
+    raise DesignError("no tuning rule applies to this model (" + "; ".join(reasons)
                       + "); give --kp, --ti and --td", param="tuning")
 
 

@@ -59,6 +59,9 @@ def test_parse_tf_reads_engineering_notation_and_list_spellings():
     assert _same(spelled[0], rational([2e-3, 1], [1e-6, 2e-3, 1]))
     assert _same(parse_tf("num=1 den=[1m 1]"), rational([1], [1e-3, 1]))
     assert _same(parse_tf("K=1 tau_s=1m theta_s=1u"), fopdt(1, 1e-3, 1e-6))
+    # commas or semicolons between words, as MATLAB users type them
+    assert _same(parse_tf("K=2, tau=1.5 ms; theta=200u"), fopdt(2, 1.5e-3, 200e-6))
+    assert _same(parse_tf("K=2,tau=1m,"), fopdt(2, 1e-3, 0.0))
 
 
 REFUSALS = [
@@ -112,6 +115,9 @@ REFUSALS = [
     ("K=2 tau=[1m 2m]", ["tau", "one number"]),
     ("K=2 tau:1m", ["tau:1m", "key=value"]),
     ("K=2 %", ["%", "key=value"]),
+    # a decimal comma (the seeds' Spanish notation) is refused with the number it meant, never read as two words
+    ("K=1,25 tau=124,6m", ["K=1,25", "K=1.25", "decimal point"]),
+    ("K=2 tau=1m theta=0,2m", ["theta=0,2m", "theta=0.2m"]),
 ]
 
 

@@ -271,3 +271,11 @@ def test_a_rule_whose_gains_the_circuit_cannot_take_is_refused():
     with pytest.raises(DesignError, match=r"zn: its Kp must be 0.0001 to 10000") as e:
         design(plant_tf="K=1 tau=1 theta=1p", tuning="zn")
     assert "\n" not in str(e.value)
+
+
+def test_no_rule_applies_names_each_reason_once():
+    """Bug fixed: a biproper plant's refusal repeated the tangent rules' one reason five times."""
+    with pytest.raises(DesignError) as e:
+        design_model_pid(PidSpec(plant_tf="num=[1 5] den=[1 1]"), simulate=False)
+    msg = str(e.value)
+    assert msg.count("it has no reaction curve") == 1 and "give --kp, --ti and --td" in msg, msg
