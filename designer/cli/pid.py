@@ -31,7 +31,8 @@ EPILOG = """examples:
   design-pid --plant-capture motor.csv --plant-input 0:10 --tuning amigo
         identify the capture first (as `identify` does, same options), then design for its best model
 
-Model plants (--plant-tf, --plant-model, --plant-capture): {forms}.
+Model plants (--plant-tf, --plant-model, --plant-capture): {forms}. Type them as key=value words separated by
+spaces or commas, values in engineering notation with a decimal point (1.25, 124.6m, 200u, 1.5 ms).
 Rules on the model each intends: zn, cohen-coon, chr0, chr20 (on the tangent of the model's own step),
 amigo, simc (--simc-tauc, default theta; SOPDT form on an SOPDT, its series PID converted to Kp, Ti, Td),
 imc (--imc-lambda); default: the first of amigo, simc, imc that applies. Every rule is listed on the sheet
