@@ -340,6 +340,7 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
         static = [c for c in static if not c.id.endswith("_accuracy") and not c.id.endswith("_bounds")]
     lap("sizing_s")
     loop = analyse(spec, model, amp, parts, gains, fc, simulate)
+    notes += opamp_speed_notes(amp, loop.margins, loop.ideal_margins, limits(spec)[0], gains.method == "optimize")
     robust = robust_check(spec, model, loop.controller, loop.t, gains) if model.ci95 else None
     checks = tuple(static) + loop.checks + (robust.checks() if robust is not None else ())
     res = ProcessPidResult(
@@ -362,6 +363,40 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
     res.scope = model_loop_scope(res)
     res.timings = laps
     return res
+
+
+#: an op-amp keeps a loop's phase when its GBW is about this many times the crossover (four stages in
+#: the path, each at GBW over a noise gain of 2 to 4: a few degrees each)
+GBW_PER_CROSSOVER = 30.0
+
+
+def opamp_speed_notes(amp, built, ideal, pm_min: float, optimized: bool = False) -> list:
+    """One line when the op-amps, not the gains, lose the loop: its phase margin
+    (``built``, the op-amps' poles included) below ``pm_min`` where the same gains
+    with ideal op-amps (``ideal``) meet it; it names the library's slowest op-amp
+    fast enough (GBW :data:`GBW_PER_CROSSOVER` times the crossover), else says none is."""
+    def ok(m):
+        return m.stable and math.isfinite(m.phase_margin_deg) and m.phase_margin_deg >= pm_min
+    if amp.ideal or ok(built) or not ok(ideal):
+        return []
+    fc = ideal.crossover_hz
+    need = GBW_PER_CROSSOVER * fc
+    real = [opamps.get(n) for n in opamps.names() if not opamps.get(n).ideal]
+    fast = sorted((a for a in real if a.gbw_hz >= need), key=lambda a: a.gbw_hz)
+    slower = ("the optimiser found no slower loop that meets the limits with it" if optimized
+              else "--tuning optimize counts the op-amps' poles")
+    lost = ("is unstable" if not built.stable else f"has {built.phase_margin_deg:.3g} deg of phase margin")
+    head = (f"the {amp.name} (GBW {format_eng(amp.gbw_hz, 'Hz')}) is too slow for this loop: with ideal op-amps "
+            f"these gains give {ideal.phase_margin_deg:.3g} deg of phase margin at {format_eng(fc, 'Hz')}, with "
+            f"its poles the loop {lost}; ")
+    if fast:
+        return [head + f"an op-amp of about {format_eng(need, 'Hz')} GBW keeps it (--opamp {fast[0].name}, "
+                       f"{format_eng(fast[0].gbw_hz, 'Hz')})" + ("" if optimized else f", or slow the loop ({slower})")]
+    top = max(real, key=lambda a: a.gbw_hz)
+    return [head + f"it needs about {format_eng(need, 'Hz')} of GBW and the library's fastest, the {top.name}, "
+                   f"has {format_eng(top.gbw_hz, 'Hz')}: "
+                   + (f"{slower}; lower --min-pm or --max-ms, or slow the plant" if optimized
+                      else f"slow the loop down ({slower}, or a larger --simc-tauc or --imc-lambda)")]
 
 
 def model_loop_scope(res: ProcessPidResult):

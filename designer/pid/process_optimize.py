@@ -55,6 +55,8 @@ SEARCH_SPAN = 20.0
 #: the stage limits' penalties start at these fractions of the swing and the slew budget (a margin for
 #: the coarse grid and the parts' rounding), as the Sallen-Key optimiser's
 SWING_LIMIT, SLEW_LIMIT = 0.98, 0.95
+#: the op-amps' phase lag (deg) up to 3 fc from which the frequency constraints count it (:meth:`_Problem.opamp_poles_at`)
+OPAMP_LAG_DEG = 2.0
 #: points of the fine grid over the reference's kick (:meth:`_Problem.stage_violation`)
 KICK_POINTS = 401
 
@@ -118,6 +120,7 @@ class _Problem:
         self.u_range = (lo, hi)
         self.evaluations = 0
         self.reference = M.reference(t, spec.step_v, 0.0, spec.edge_s)
+        self.opamp_lag = 1.0   #: the op-amps' part of the controller's response (:meth:`opamp_poles_at`)
 
     def built(self, kp, ti, td):
         """The controller as built (op-amp poles included): the E-series parts the design
@@ -140,9 +143,27 @@ class _Problem:
         num = np.array([1.0 / b + td, 1.0 + a / b + 1.0 / (ti * b) + td * a, a + 1.0 / ti])
         return kp * num, np.array([1.0 / b, 1.0 + a / b, a])
 
+    def opamp_poles_at(self, kp, ti, td) -> None:
+        """Let the frequency constraints see the op-amps' poles as they are at these gains:
+        the ratio of the circuit's controller with its real op-amps to the closed form on
+        the grid, applied to every later candidate (the lag barely moves with the gains
+        nearby; the exact margins of the loop as built decide at the end). Without it a
+        plant within a decade of the op-amp's bandwidth gets a loop its op-amps make
+        unstable."""
+        if self.amp.ideal:
+            return
+        parts = blocks.continuous_parts(kp, ti, td, self.fc, f_integrator_hz=self.f_i, f_differentiator_hz=self.f_d)
+        real, ideal = M.controller_tf(parts, self.amp), self.controller(kp, ti, td)
+        lag = ((np.polyval(real[0], self.s) / np.polyval(real[1], self.s))
+               / (np.polyval(ideal[0], self.s) / np.polyval(ideal[1], self.s)))
+        # where the op-amps cost under OPAMP_LAG_DEG up to 3 fc the closed form stands (the search's
+        # path stays the one it was for every plant well below the op-amps' bandwidth)
+        near = self.w <= 3 * 2 * math.pi * self.fc
+        self.opamp_lag = lag if np.max(np.abs(np.degrees(np.angle(lag[near])))) >= OPAMP_LAG_DEG else 1.0
+
     def frequency_violation(self, ctrl) -> float:
         """Sum of the relative violations of PM, GM and Ms over every plant (0: all met)."""
-        c = np.polyval(ctrl[0], self.s) / np.polyval(ctrl[1], self.s)
+        c = np.polyval(ctrl[0], self.s) / np.polyval(ctrl[1], self.s) * self.opamp_lag
         total = 0.0
         for (_, _, theta), pr in zip(self.plants, self.p_rat):
             lr = c * pr
@@ -272,6 +293,7 @@ def optimize_model_loop(spec, model, amp, table) -> ModelOptimizeResult:
     prob = _Problem(spec, model, amp, fc, t, spec.robust, None if leak is None else leak / 10)
     pid = g.td_s > 0
     x0 = np.log([g.kp, g.ti_s] + ([g.td_s] if pid else []))
+    prob.opamp_poles_at(g.kp, g.ti_s, g.td_s)
     base = prob.evaluate(g.kp, g.ti_s, g.td_s)
     scale = base[1] if math.isfinite(base[1]) and base[1] > 0 else 1.0
 
@@ -306,6 +328,7 @@ def optimize_model_loop(spec, model, amp, table) -> ModelOptimizeResult:
                      options={"maxfev": FREQUENCY_EVALUATIONS, "xatol": 1e-3, "fatol": 1e-5,
                               "initial_simplex": simplex(x0)})
     x1 = first.x if cost(first.x) <= cost(x0) else x0
+    prob.opamp_poles_at(*gains(x1))
     res = minimize(cost, x1, method="Nelder-Mead",
                    options={"maxfev": MAX_EVALUATIONS, "xatol": 1e-3, "fatol": 1e-4,
                             "initial_simplex": np.vstack([x1] + [x1 + 0.1 * e for e in np.eye(x1.size)])})

@@ -34,6 +34,7 @@ from designer.pid.model import controller_tf
 from designer.pid.plant_source import model_from_result
 from designer.pid.process_loop import design_model_pid, edged, loop_dc_gain, plant_of
 from designer.pid.spec import PidSpec
+from designer.core.units import format_eng
 from designer.pid.verify import loop_metrics
 from designer.spice.simulate import NgspiceCli
 
@@ -279,3 +280,25 @@ def test_no_rule_applies_names_each_reason_once():
         design_model_pid(PidSpec(plant_tf="num=[1 5] den=[1 1]"), simulate=False)
     msg = str(e.value)
     assert msg.count("it has no reaction curve") == 1 and "give --kp, --ti and --td" in msg, msg
+
+
+def test_a_plant_too_fast_for_the_op_amp_is_told_which_op_amp_keeps_it():
+    """A lab's 5.7 MHz second-order step (as identified): the rule's gains meet the phase margin with ideal
+    op-amps and the LM741's poles make the loop unstable; the note says so and names what would do."""
+    model = process.underdamped(18.0, 5.7e6, 0.64, theta_s=47.5e-9)
+    res = design_model_pid(PidSpec(plant_process=model, tuning="amigo"), simulate=False)
+    assert res.ideal_margins.stable and not res.margins.stable
+    note = next(n for n in res.notes if "is too slow for this loop" in n)
+    need = 30 * res.ideal_margins.crossover_hz
+    assert f"{format_eng(need, 'Hz')} of GBW" in note and "NE5532" in note and "is unstable" in note
+    # a plant thirty times slower: an op-amp of the library is named, and it does keep the loop
+    slow_plant = process.underdamped(18.0, 2e5, 0.64, theta_s=1e-6)
+    slower = design_model_pid(PidSpec(plant_process=slow_plant, tuning="amigo"), simulate=False)
+    notes = [n for n in slower.notes if "is too slow for this loop" in n]
+    named = re.search(r"--opamp (\S+),", notes[0]).group(1)
+    kept = design_model_pid(PidSpec(plant_process=slow_plant, tuning="amigo", opamp=named), simulate=False)
+    assert kept.margins.stable and kept.margins.phase_margin_deg >= kept.limits[0], (named, kept.margins)
+    assert not [n for n in kept.notes if "too slow" in n]
+    # and an ideal op-amp or a slow plant: no such note
+    assert not [n for n in design_model_pid(PidSpec(plant_tf="K=2 tau=1m theta=200u"), simulate=False).notes
+                if "too slow" in n]
