@@ -21,7 +21,7 @@ and, for every kind: ``checks:`` (figure -> ``{min, typ, max, fail}``), and
 ``golden:``; for plant and pid: ``opamp`` (one name or a list: the corners),
 ``series``, ``bounds``, ``stimulus``, ``design_checks``, ``spice_agreement``;
 a plant also ``tolerance``; for plant and pid ``yield: {min: 95%, samples: 2000, seed: 1, engine:
-analytic}`` with ``tolerances: {R: 1%, C: 5%, C2: 2%}`` (default: the series'), the Monte Carlo
+analytic|spice}`` with ``tolerances: {R: 1%, C: 5%, C2: 2%, SR: 20%}`` (default: the series'), the Monte Carlo
 yield over the spec's own checks (:mod:`designer.tolerance.yields`). Paths (``deck``, ``golden.file``, the ``json``
 files) are relative to the spec file and must resolve (links followed) inside
 its folder, or the ``root`` given (``--root``), unless ``allow_outside``; a
