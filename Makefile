@@ -33,7 +33,7 @@ $(VENV_STAMP): pyproject.toml
 # the optimiser, and the seed's own final design to show what really happens), and the seed's bench as built
 # (trimmed difference amplifier), predicted against what the thesis measured; the plant and the optimised loop
 # with a Monte Carlo of their parts' E-series tolerances (the plant's yield within 3.3-3.7 kHz and 55 %
-# overshoot, its worst case; the loop's probability of instability). Then plants known only as
+# overshoot, its worst case; the loop's probability of instability, and its worst case on the sheet). Then plants known only as
 # models: seed 000's DC motor (Km = 1.25, tau_m = 124.6 ms), a capture simulated in ngspice as a TBS1022 at
 # 500 mV/div would record it (10 mV noise, 20 mV LSB), identified, and a PID optimised for the model (AMIGO and
 # SIMC divide by the dead time, which the motor has none of; IMC's Ti = tau leaves 2.2 % steady-state error
@@ -46,7 +46,7 @@ demo: setup
 	  --limit overshoot_pct=0:55 --worst-case --name plant_fc3500_z0.2 --out .
 	.venv/bin/design-pid --plant-fc 3500 --plant-zeta 0.2 --opamp LM741 --name pid_zn_lm741_fc3500_z0.2 --out .
 	.venv/bin/design-pid --plant-fc 3500 --plant-zeta 0.2 --opamp LM741 --tuning optimize --target-overshoot 10 \
-	  --monte-carlo 1000 --seed 1 --limit phase_margin_deg=25:90 --limit overshoot_pct=0:15 \
+	  --monte-carlo 1000 --seed 1 --limit phase_margin_deg=25:90 --limit overshoot_pct=0:15 --worst-case \
 	  --name pid_optimize_os10_lm741_fc3500_z0.2 --out .
 	.venv/bin/design-pid --plant-fc 3500 --plant-zeta 0.2 --opamp LM741 --kp 45 --ti 43.215u --td 10.8037u \
 	  --seed-parts --name pid_seed_kp45_lm741_fc3500_z0.2 --out .

@@ -113,7 +113,7 @@ def _judge(spec, corner, figures, res, waves, tool, update_golden, out_dir):
                               f"{'inside' if ok else 'outside'} {lim.text()}",
                               None, lim.text()))
     if spec.yield_spec is not None:
-        cases.append(_yield_case(spec, corner, res))
+        cases.append(_yield_case(spec, corner, res, tool["simulator"]))
     warnings, files = [], {}
     if spec.golden is not None:
         g_cases, warnings, files = _golden_cases(spec, corner, waves, tool, update_golden, out_dir)
@@ -121,13 +121,15 @@ def _judge(spec, corner, figures, res, waves, tool, update_golden, out_dir):
     return cases, warnings, files
 
 
-def _yield_case(spec, corner, res) -> Case:
-    """The yield over the spec's checks (:func:`designer.tolerance.yields.spec_yield`); its Monte Carlo
-    goes on the result (the corner's sheet and result.json show it)."""
+def _yield_case(spec, corner, res, simulator: str) -> Case:
+    """The yield over the spec's checks (:func:`designer.tolerance.yields.spec_yield`, with the spec's
+    engine; the SPICE engine on the backend ``simulator``); its Monte Carlo goes on the result (the
+    corner's sheet and result.json show it)."""
     from ..tolerance.yields import spec_yield
     y = spec.yield_spec
     try:
-        v = spec_yield(spec.kind, res, spec.checks, y.min, y.samples, y.seed, y.tolerances, y.sampler, y.dist)
+        v = spec_yield(spec.kind, res, spec.checks, y.min, y.samples, y.seed, y.tolerances, y.sampler, y.dist,
+                       y.engine, simulator)
     except DesignError as exc:   # a part the spec's tolerances name that this design has not, say
         raise DesignError(f"{spec.name}: yield: {str(exc).replace('--tol', 'tolerances:')}") from None
     res.monte_carlo = v.mc

@@ -21,7 +21,7 @@ and, for every kind: ``checks:`` (figure -> ``{min, typ, max, fail}``), and
 ``golden:``; for plant and pid: ``opamp`` (one name or a list: the corners),
 ``series``, ``bounds``, ``stimulus``, ``design_checks``, ``spice_agreement``;
 a plant also ``tolerance``; for plant and pid ``yield: {min: 95%, samples: 2000, seed: 1, engine:
-analytic}`` with ``tolerances: {R: 1%, C: 5%, C2: 2%}`` (default: the series'), the Monte Carlo
+analytic|spice}`` with ``tolerances: {R: 1%, C: 5%, C2: 2%, SR: 20%}`` (default: the series'), the Monte Carlo
 yield over the spec's own checks (:mod:`designer.tolerance.yields`). Paths (``deck``, ``golden.file``, the ``json``
 files) are relative to the spec file and must resolve (links followed) inside
 its folder, or the ``root`` given (``--root``), unless ``allow_outside``; a
@@ -77,7 +77,8 @@ SUB = {
     "yield": ("min", "samples", "seed", "engine", "sampler", "dist"),
 }
 #: the parts a ``tolerances:`` may name besides the classes R and C
-TOLERANCE_PARTS = {"plant": ("R1", "R2", "C1", "C2", "R3", "R4"), "pid": ("R1", "R2", "C1", "C2") + CONTROLLER_PARTS}
+TOLERANCE_PARTS = {"plant": ("R1", "R2", "C1", "C2", "R3", "R4", "GBW", "SR"),
+                   "pid": ("R1", "R2", "C1", "C2") + CONTROLLER_PARTS + ("GBW", "SR")}
 #: a yield's builds: at least, at most, and by default
 YIELD_SAMPLES = (10, 10 ** 6, 2000)
 STIMULUS = {"plant": ("amplitude", "frequency"), "pid": ("amplitude", "frequency", "edge")}
@@ -596,21 +597,22 @@ def _yield(doc, kind: str, checks):
     if "min" not in y:
         raise doc.error(("yield",), "yield needs min: the fraction of builds that must pass (such as 95%)")
     engine = y.get("engine", "analytic")
-    if engine == "spice":
-        raise doc.error(("yield", "engine"), "yield.engine spice is not available yet (the SPICE Monte Carlo comes "
-                        "later); allowed: analytic")
     for key, allowed in (("engine", yields.ENGINES), ("sampler", sampling.SAMPLERS), ("dist", DISTRIBUTIONS)):
         if key in y and y[key] not in allowed:
             raise doc.error(("yield", key), f"yield.{key} {_kind_of(y[key])} unknown; allowed: {', '.join(allowed)}")
-    use, skipped = yields.counted(kind, checks)
+    use, skipped = yields.counted(kind, checks, engine)
     if not use:
-        known = ", ".join(yields.BY_KIND[kind])
+        known = ", ".join(yields.TABLES[engine][kind])
         raise doc.error(("yield",), "yield counts the builds inside checks:, and none of them limits a figure the "
-                        f"analytic engine computes ({known})" + (f"; not: {', '.join(skipped)}" if skipped else ""))
+                        f"{engine} engine computes ({known})" + (f"; not: {', '.join(skipped)}" if skipped else ""))
+    tolerances = _tolerances(doc, kind)
+    if kind == "plant" and engine == "analytic" and any(t.startswith("SR=") for t in tolerances):
+        raise doc.error(("tolerances", "SR"), "tolerances.SR: the plant's analytic model is linear, no figure of it "
+                        "depends on the slew rate; give yield.engine: spice (ngspice's op-amp slews)")
     lo, hi, default = YIELD_SAMPLES
     return YieldSpec(_fraction(doc, ("yield", "min")), _whole(doc, ("yield", "samples"), lo, hi, default),
                      _whole(doc, ("yield", "seed"), 0, 2 ** 63 - 1, 0), engine, y.get("sampler", "random"),
-                     y.get("dist", "uniform"), _tolerances(doc, kind))
+                     y.get("dist", "uniform"), tolerances)
 
 
 def _golden(doc, kind: str, corners, update: bool):

@@ -24,10 +24,11 @@ EPILOG = """spec file (YAML; numbers in engineering notation, paths relative to 
   design_checks: all                    # or [slew_rate, output_swing, ...]
   spice_agreement: {nrms_max: 1, against: opamp_model}   # or ideal
   tolerance: [fn_hz]                    # the part-tolerance band must stay inside the limits too
-  tolerances: {R: 1%, C: 5%, C2: 2%}    # a class or a part (default: the series', E24 5 %, E12 10 %) ...
+  tolerances: {R: 1%, C: 5%, C2: 2%}    # a class or a part, GBW or SR (default: the series', E24 5 %) ...
   yield: {min: 95%, samples: 2000, seed: 1, engine: analytic}   # ... that fraction of builds inside checks:
                                         # (samples 10 to 1e6; sampler: random|lhs|sobol, dist: uniform|normal;
-                                        # engine spice not yet); the failure names the figure losing most
+                                        # engine: analytic, the models, or spice, every build in ngspice, SPICE's
+                                        # step figures counted); the failure names the figure losing most
   golden: {file: "golden/lab3-{corner}.csv", signals: {output_v: {reltol: 0.01, abstol: 1m}}}
 
   kind: pid     plant: {fc: 3.5k, zeta: 0.2} (or R1..C2, or json: result.json); tuning: zn (a rule),

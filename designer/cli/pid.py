@@ -304,8 +304,10 @@ def _monte_carlo_settings(args, spec):
     from .plant import monte_carlo_settings
     # a model plant's parameters stay as identified: only the controller's parts vary
     settings = monte_carlo_settings(args, LOOP_PARTS if spec.process is None else CONTROLLER_PARTS, parse_loop_limit)
-    if any(str(t).strip().upper().startswith("GBW") for t in args.tol or ()):
-        raise DesignError("--tol GBW spreads a plant's op-amp (design-plant); a loop's op-amps do not vary yet")
+    if args.tol:      # the op-amps' spread (GBW, SR): the ideal op-amp has none, refused before any work
+        from ..core import opamps
+        from ..tolerance.parts import opamp_nominal
+        opamp_nominal(args.tol, opamps.get(spec.opamp))
     return settings
 
 

@@ -76,8 +76,9 @@ def add_monte_carlo_options(p, what: str):
                                                             "alone")
     g.add_argument("--tol", nargs="+", metavar="ITEM",
                    help="tolerances (default: the series', E24 5 %%, E12 10 %%...): R=1%% C=5%% (a class) or "
-                        "C2=2%% (a part), GBW=30%% (the op-amp's gain-bandwidth, a plant's); each above 0 and at "
-                        "most 50 %%")
+                        "C2=2%% (a part), GBW=30%% (the op-amps' gain-bandwidth) and SR=20%% (their slew rate: a loop's "
+                        "slew check; a plant's with --engine spice or both), one per build, the slew rate following "
+                        "the gain-bandwidth unless spread itself; each above 0 and at most 50 %%")
     g.add_argument("--dist", default="uniform", choices=("uniform", "normal"),
                    help="uniform in nominal (1 +- tol) (default), or normal with sigma = tol/3 truncated at +- tol")
     g.add_argument("--sampler", default="random", choices=("random", "lhs", "sobol"),
@@ -226,7 +227,22 @@ def spice_settings(args, settings):
         k = whole("--spice-samples", args.spice_samples, 1, settings[0])
     if args.engine != "analytic" and settings is None:
         raise DesignError(f"--engine {args.engine} goes with --monte-carlo N")
+    _check_opamp_spread(args, i)
     return args.engine, k, i
+
+
+def _check_opamp_spread(args, replay) -> None:
+    """``--tol GBW``/``SR`` before any work: the ideal op-amp has neither, and the plant's analytic model
+    (the analytic engine, --worst-case) has no slew rate in it."""
+    if not args.tol:
+        return
+    from ..core import opamps
+    from ..tolerance.montecarlo import NO_SLEW
+    from ..tolerance.parts import opamp_nominal
+    spread = opamp_nominal(args.tol, opamps.get(args.opamp))
+    if "SR" in spread and (args.worst_case or (args.engine == "analytic" and replay is None)):
+        raise DesignError(NO_SLEW if not args.worst_case else NO_SLEW.split(";")[0] + ", and --worst-case "
+                          "searches that model: drop SR from --tol")
 
 
 def _replay(result, args, settings, spice, name):

@@ -27,6 +27,7 @@ from ..report.bundle import draw_early as bundle_early, write_design
 from ..report.plots import decimate, figure, png_bytes
 from ..report.tolerance import csv_texts, histogram_plots
 from ..report.tolerance import section as tolerance_section
+from ..report.tolerance import title as tolerance_title
 from ..report.wiring import bom_csv, bom_rows, net_text
 from ..spice.deck import board
 from .netlist import NET_LABELS, controller_netlist
@@ -100,8 +101,9 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     out.append(("Checks", [R.table(["check", "result", "detail"],
                                    [[c.id, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]))
     out.append(("Closed loop", _loop_blocks(result, with_images)))
-    if result.monte_carlo is not None:
-        out.append(("Tolerance analysis (Monte Carlo)", tolerance_section(result, with_images)))
+    heading = tolerance_title(result, worst=True)
+    if heading is not None:
+        out.append((heading, tolerance_section(result, with_images, worst=True)))
     out.append(("Expected scope readings", _scope(result, with_images, b)))
     return out
 

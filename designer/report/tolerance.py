@@ -3,8 +3,11 @@ wing's Monte Carlo (a plant's or a loop's: :class:`designer.tolerance.montecarlo
 read as it is, nothing recomputed): a histogram per limited figure and of the
 headline figure (``mc-<figure>.png``, the limits and the nominal marked), and
 the sheet's section: the yield with its interval, the headline's histogram, the
-part to buy tighter and, for a loop, the probabilities of instability and
-saturation."""
+part to buy tighter and, for a loop, the probabilities of instability,
+saturation and of failing the slew check; and, where asked (the PID sheet), the
+worst case (``--worst-case``, :class:`designer.tolerance.worstcase.WorstCase`): each
+figure's extremes over the tolerance box and the corner (or the point inside the
+box) that gives each, as one compact table."""
 
 from __future__ import annotations
 
@@ -57,8 +60,50 @@ def _pct(x: float) -> str:
     return f"{100 * x:.3g} %" if x < 0.9995 or x == 1 else f"{100 * x:.4g} %"
 
 
-def section(result, with_images: bool = True) -> list:
-    """The sheet's tolerance section (blocks); empty without a Monte Carlo."""
+def title(result, worst: bool = False) -> str | None:
+    """The tolerance section's heading (None: no section): what the result carries, the Monte Carlo
+    and (with ``worst``) the worst case."""
+    what = [w for w, x in (("Monte Carlo", result.monte_carlo),
+                           ("worst case", getattr(result, "worst_case", None) if worst else None)) if x is not None]
+    return f"Tolerance analysis ({', '.join(what)})" if what else None
+
+
+#: a part at its bound: the deviation (in tolerances) at least this far out
+AT_BOUND = 0.995
+
+
+def corner_text(deviations: dict) -> str:
+    """Where an extreme is reached: each part's sign at its bound (``R1+ C2-``), a part inside the box
+    with its deviation in tolerances (``R7 +0.43``); the parts grouped by sign."""
+    up = [r for r, d in deviations.items() if d >= AT_BOUND]
+    down = [r for r, d in deviations.items() if d <= -AT_BOUND]
+    inside = [f"{r} {d:+.2f}" for r, d in deviations.items() if -AT_BOUND < d < AT_BOUND]
+    out = ([f"+tol: {' '.join(up)}"] if up else []) + ([f"-tol: {' '.join(down)}"] if down else [])
+    return "; ".join(out + ([f"inside: {', '.join(inside)}"] if inside else []))
+
+
+def worst_case_blocks(wc) -> list:
+    """The worst case as the sheet shows it: how it was searched, and per figure its lowest and
+    highest value and the corner that gives each (:func:`corner_text`)."""
+    rows = []
+    for fig, (lo, hi) in wc.extremes.items():
+        for which, e in (("lowest", lo), ("highest", hi)):
+            rows.append([fig if which == "lowest" else "", which, _value(fig, e.value),
+                         ("corner: " if e.at_corner else "inside the box: ") + corner_text(e.deviations)])
+    head = (f"Worst case over the tolerance box: {wc.corners} corners evaluated ({wc.method}); each part at "
+            "+tol or -tol of its nominal, in tolerances where an extreme lies inside.")
+    return [R.text(head), R.table(["figure", "extreme", "value", "where (parts)"], rows)]
+
+
+def section(result, with_images: bool = True, worst: bool = False) -> list:
+    """The sheet's tolerance section (blocks): the Monte Carlo's (empty without one) and, with
+    ``worst``, the worst case's (:func:`worst_case_blocks`) when the result has one."""
+    wc = getattr(result, "worst_case", None) if worst else None
+    tail = [] if wc is None else worst_case_blocks(wc)
+    return _monte_carlo_blocks(result, with_images) + tail
+
+
+def _monte_carlo_blocks(result, with_images: bool) -> list:
     mc = result.monte_carlo
     if mc is None:
         return []
@@ -82,7 +127,8 @@ def section(result, with_images: bool = True) -> list:
                          + ("." if better else " (no part tried raises it: the design, not the parts, limits it)."))
     else:
         lines.append("No limits given (--limit FIGURE=MIN:MAX), so no yield: the spread alone.")
-    for key, what in (("p_unstable", "unstable"), ("p_saturated", "an op-amp beyond its swing")):
+    for key, what in (("p_unstable", "unstable"), ("p_saturated", "an op-amp beyond its swing"),
+                      ("p_slewing", "failing the slew check")):
         p = getattr(mc, key, None)
         if p is not None:
             lines.append(f"{what.capitalize()}: {_pct(p['fraction'])} (95 % Wilson {_pct(p['ci95'][0])} to "

@@ -12,6 +12,22 @@ name (``overshoot_pct``) counts the model's figure, this engine's estimate of
 it (:data:`STANDS_IN`). A build is in the yield when its loop is stable and
 every limited figure is inside its window.
 
+The op-amp's own spread (``--tol GBW=30% SR=20%``, :func:`designer.tolerance.parts.opamp_nominal`):
+each build's seven op-amps share one drawn gain-bandwidth and slew rate
+(:func:`designer.tolerance.parts.sample_opamp`). The gain-bandwidth moves every
+op-amp pole of the loop (margins, step). The loop as analysed is linear, so
+nothing in its margins or step depends on the slew rate; where a real op-amp's
+slew rate matters is whether each stage can follow its linear waveform, design-pid's
+``slew_rate`` check (:func:`designer.pid.model.waveform_limits`): a stage slews for
+sum(max(0, |dv| - SR dt))/SR longer than its linear waveform takes
+(:func:`designer.pid.model.slew_delay`), accepted up to
+:data:`designer.pid.model.SLEW_DELAY_FRACTION` of the build's rise time. Per build:
+``slew_delay_s``, the worst stage's delay, and ``slewing`` (1 when it is over that
+budget, or the loop is unstable, as the check fails then); over the builds the
+probability of failing the slew check with its Wilson interval (``p_slewing``).
+The step is sampled at :data:`STEP_POINTS` points (design-pid's grid is finer:
+a delay of a few time steps reads a little shorter here).
+
 A plant given as a model (``--plant-tf``, ``--plant-model``, ``--plant-capture``)
 keeps its parameters as identified; only the controller's parts vary
 (:func:`model_loop_figures`). One sample at a time (a state-space model per
@@ -31,11 +47,13 @@ from ..core.errors import DesignError
 from .montecarlo import MonteCarlo
 
 STEP = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
-#: every figure of each sampled loop (check-design's names); ``stable`` and ``saturated`` are 1 or 0
+#: the figures of each sampled loop that are 1 or 0
+FLAGS = ("stable", "saturated", "slewing")
+#: every figure of each sampled loop (check-design's names, and the worst stage's slew delay)
 FIGURES = ("stable", "saturated", "kp", "ti_s", "td_s", "phase_margin_deg", "crossover_hz", "gain_margin_db",
-           "steady_state_error_pct", *(f"model_{f}" for f in STEP))
+           "steady_state_error_pct", *(f"model_{f}" for f in STEP), "slewing", "slew_delay_s")
 #: the figures a --limit may name (with the names of :data:`STANDS_IN`)
-LIMITABLE = FIGURES[2:]
+LIMITABLE = tuple(f for f in FIGURES if f not in FLAGS)
 #: a SPICE figure's name -> the analytic figure that stands in for it
 STANDS_IN = {f: f"model_{f}" for f in STEP}
 #: the figures whose spread the summary prints, with their units
@@ -46,6 +64,9 @@ BODE_POINTS = 1500
 STEP_POINTS = 2001
 #: parts tried for "buy this part tighter" (those with the largest variance shares; one more run each)
 TIGHTEN_CANDIDATES = 3
+#: how a build fails the slew check (the JSON's slew_rule)
+SLEW_RULE = ("a build slews when a stage's slew delay sum(max(0, |dv| - SR dt))/SR exceeds 5 % of its rise "
+             "time (design-pid's slew_rate check), or its loop is unstable")
 #: the figures whose extremes --worst-case reports for a loop (with every limited one)
 WORST_FIGURES = ("phase_margin_deg", "gain_margin_db", "model_overshoot_pct")
 
@@ -55,9 +76,11 @@ def is_model_loop(result) -> bool:
     return getattr(result, "model", None) is not None
 
 
-def loop_parts(result) -> dict:
+def loop_parts(result, tol_items=()) -> dict:
     """Designator -> nominal value of the loop's parts: the plant's (R1, R2, C1, C2; none for a plant
-    given as a model, whose parameters stay as identified) and the controller's."""
+    given as a model, whose parameters stay as identified) and the controller's, and the op-amp's
+    ``GBW`` (Hz) and ``SR`` (V/s) when the ``--tol`` items ``tol_items`` spread them."""
+    from .parts import opamp_nominal
     c = result.parts
     p = None if is_model_loop(result) else result.plant
     out = {} if p is None else {"R1": p.r1, "R2": p.r2, "C1": p.c1, "C2": p.c2}
@@ -65,7 +88,7 @@ def loop_parts(result) -> dict:
         v = getattr(c, f.name)
         if v is not None:
             out[f.name.upper()] = v
-    return out
+    return {**out, **opamp_nominal(tol_items, result.opamp)}
 
 
 def loop_series(result) -> dict:
@@ -86,19 +109,31 @@ def parse_loop_limit(text: str):
     return replace(lim, figure=STANDS_IN.get(lim.figure, lim.figure))
 
 
+def _unstable(out: dict, i: int) -> None:
+    """An unstable build fails the swing and slew checks (its outputs run to the rails)."""
+    out["saturated"][i] = out["slewing"][i] = 1.0
+
+
 def _step_and_swing(out: dict, i: int, t, waves: dict, expected: float, amp) -> None:
-    """Sample ``i``'s step figures (against the ``expected`` settled output) and whether an op-amp
-    output leaves the swing, from a stable loop's waves."""
+    """Sample ``i``'s step figures (against the ``expected`` settled output), whether an op-amp
+    output leaves the swing, and its stages' slew delay against the budget (module docstring),
+    from a stable loop's waves."""
+    from ..pid.model import SLEW_DELAY_FRACTION, slew_delay
     from ..pid.verify import loop_metrics
     fig = loop_metrics(t, waves["y"], expected)
     for f in STEP:
         out[f"model_{f}"][i] = getattr(fig, f)
     if amp.ideal:
-        out["saturated"][i] = 0.0
-    else:
-        peak = max(max(float(np.max(v)), float(v[-1] - np.min(v))) for k, v in waves.items() if k != "y")
-        low = min(min(float(np.min(v)), float(v[-1] - np.max(v))) for k, v in waves.items() if k != "y")
-        out["saturated"][i] = float(peak > amp.vout_max or low < amp.vout_min)
+        out["saturated"][i] = out["slewing"][i] = out["slew_delay_s"][i] = 0.0
+        return
+    stages = [v for k, v in waves.items() if k != "y"]
+    peak = max(max(float(np.max(v)), float(v[-1] - np.min(v))) for v in stages)
+    low = min(min(float(np.min(v)), float(v[-1] - np.max(v))) for v in stages)
+    out["saturated"][i] = float(peak > amp.vout_max or low < amp.vout_min)
+    delay = max(slew_delay(t, v, amp.slew_v_per_s) for v in stages)
+    rise = fig.rise_time_s if math.isfinite(fig.rise_time_s) and fig.rise_time_s else t[-1] / 20
+    out["slew_delay_s"][i] = delay
+    out["slewing"][i] = float(delay > SLEW_DELAY_FRACTION * rise)
 
 
 def model_loop_figures(values: dict, result) -> dict:
@@ -110,7 +145,8 @@ def model_loop_figures(values: dict, result) -> dict:
     from ..pid.blocks import PidParts
     from ..pid.delaymargins import loop_margins
     from ..pid.process_loop import closed_loop_step, edged, loop_dc_gain, plant_of, simulation_controller, stage_waves
-    amp, model = result.opamp, result.model
+    from .parts import sample_opamp
+    model = result.model
     plant = plant_of(model)
     n = next(iter(values.values())).size
     out = {k: np.full(n, np.nan) for k in FIGURES}
@@ -119,6 +155,7 @@ def model_loop_figures(values: dict, result) -> dict:
     r = M.reference(t, step, 0.0, edge)
     for i in range(n):
         parts = PidParts(**{k: (values[k.upper()][i] if k.upper() in values else None) for k in names})
+        amp = sample_opamp(result.opamp, values, i)
         out["kp"][i], out["ti_s"][i], out["td_s"][i] = parts.kp, parts.ti_s, parts.td_s
         ctrl = M.controller_tf(parts, amp)
         mg = loop_margins(plant, ctrl)
@@ -126,7 +163,7 @@ def model_loop_figures(values: dict, result) -> dict:
         out["phase_margin_deg"][i], out["gain_margin_db"][i] = mg.phase_margin_deg, mg.gain_margin_db
         out["crossover_hz"][i] = mg.crossover_hz
         if not mg.stable:
-            out["saturated"][i] = 1.0
+            _unstable(out, i)
             continue
         dc = loop_dc_gain(model, ctrl)
         out["steady_state_error_pct"][i] = 100 * (1 - dc)
@@ -166,7 +203,7 @@ def evaluate(context: LoopContext, values: dict) -> dict:
     from ..pid.blocks import PidParts
     from ..plant.model import plant_tf, plant_tf_opamp
     from ..plant.sallenkey import SallenKeyParts
-    amp = context.opamp
+    from .parts import sample_opamp
     n = next(iter(values.values())).size
     out = {k: np.full(n, np.nan) for k in FIGURES}
     step = context.step_v
@@ -176,6 +213,7 @@ def evaluate(context: LoopContext, values: dict) -> dict:
     for i in range(n):
         plant = SallenKeyParts(values["R1"][i], values["R2"][i], values["C1"][i], values["C2"][i])
         parts = PidParts(**{k: (values[k.upper()][i] if k.upper() in values else None) for k in names})
+        amp = sample_opamp(context.opamp, values, i)
         out["kp"][i], out["ti_s"][i], out["td_s"][i] = parts.kp, parts.ti_s, parts.td_s
         pn, pd = plant_tf(plant) if amp.ideal else plant_tf_opamp(plant, amp)
         lm = model.assemble(parts, amp, pn, pd)
@@ -188,7 +226,7 @@ def evaluate(context: LoopContext, values: dict) -> dict:
         out["phase_margin_deg"][i], out["gain_margin_db"][i] = mg.phase_margin_deg, mg.gain_margin_db
         out["crossover_hz"][i] = mg.crossover_hz
         if not stable:
-            out["saturated"][i] = 1.0
+            _unstable(out, i)
             continue
         waves = lm.simulate(t, r)
         dc = model.dc_gain(lm)
@@ -214,9 +252,10 @@ def engine_of(result) -> tuple:
 
 
 def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str = "random", dist: str = "uniform",
-                     tol_items=(), limit_items=(), tighten: bool = True, scale=None, target_ci: float | None = None):
-    """A Monte Carlo of a design-pid result's loop: the probabilities of instability and of
-    saturation with their Wilson intervals, the statistics of every figure and, with
+                     tol_items=(), limit_items=(), tighten: bool = True, scale=None, target_ci: float | None = None,
+                     engine=None):
+    """A Monte Carlo of a design-pid result's loop: the probabilities of instability, of
+    saturation and of failing the slew check with their Wilson intervals, the statistics of every figure and, with
     ``limit_items`` (``--limit`` texts such as ``phase_margin_deg=45:90``), the yield with its
     interval, each part's share of each limited figure's variance, the worst failing samples per
     limit and the part whose tolerance halved raises the yield most (tried on the
@@ -224,7 +263,10 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
     the samples run (:class:`designer.tolerance.runner.Scale`; default here); the result is the
     same wherever they run. ``target_ci``: ``--target-ci``, builds drawn in rounds until the
     yield's 95 % Wilson half-width is below it, ``n`` at most, as the plant's
-    (:func:`designer.tolerance.montecarlo.target_plan`; needs limits).
+    (:func:`designer.tolerance.montecarlo.target_plan`; needs limits). ``engine``: (name, chunk
+    function, context) of another engine than the analytic one (the SPICE engine's,
+    :mod:`designer.tolerance.spice_loop`, whose figures include the analytic ones); the part to
+    tighten is then searched with it too.
 
     Returns a :class:`LoopMonteCarlo`."""
     from .montecarlo import MAX_SAMPLES, MIN_SAMPLES, target_plan
@@ -235,31 +277,31 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
         raise DesignError(f"--monte-carlo must be a whole number of samples from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
                           f"got {n!r}")
     limits = tuple(parse_loop_limit(t) for t in limit_items or ())
-    nominal = loop_parts(result)
+    nominal = loop_parts(result, tol_items)
     tol = resolve(tol_items, nominal, series)
     until, first = target_plan(target_ci, limits, sampler, n, lambda figs: _passed(figs, limits))
-    chunk_fn, context = engine_of(result)
+    name, chunk_fn, context = engine or ("analytic", *engine_of(result))
     n_max, n = n, first
     with Runner(scale or Scale()) as run:
         values, figs, ends = run.run(chunk_fn, context, Draw(nominal, tol.of, n_max, seed, sampler, dist), first,
                                      until)
         n = ends[-1]     # the builds drawn (--target-ci may stop before n_max)
-        nominal_figs = {k: float(v[0]) for k, v in loop_figures({r: np.array([x]) for r, x in nominal.items()},
-                                                                result).items()}
+        nominal_figs = {k: float(v[0]) for k, v in chunk_fn(context, {r: np.array([x]) for r, x in
+                                                                      nominal.items()}).items()}
         by_fig = {lim.figure: lim for lim in limits}
-        stats = {k: figure_stats(k, figs[k], nominal_figs[k], by_fig.get(k)) for k in LIMITABLE}
+        stats = {k: figure_stats(k, figs[k], nominal_figs[k], by_fig.get(k)) for k in figs if k not in FLAGS}
         rel = {r: values[r] / nominal[r] - 1 for r in values}
         shares = {k: variance_shares(rel, figs[k]) for k in (by_fig or dict(SHOWN))}
-        unstable = int(np.count_nonzero(figs["stable"] == 0))
-        saturated = int(np.count_nonzero(figs["saturated"] == 1))
-        mc = LoopMonteCarlo(n, seed, sampler, dist, "analytic", tol, nominal, values, figs, nominal_figs, limits,
+
+        def share(flag, value):
+            k = int(np.count_nonzero(figs[flag] == value))
+            return {"count": k, "fraction": k / n, "ci95": list(wilson(k, n))}
+        mc = LoopMonteCarlo(n, seed, sampler, dist, name, tol, nominal, values, figs, nominal_figs, limits,
                             stats, _passed(figs, limits) if limits else None, shares,
                             failing_samples(figs, limits),
-                            p_unstable={"count": unstable, "fraction": unstable / n,
-                                        "ci95": list(wilson(unstable, n))},
-                            p_saturated={"count": saturated, "fraction": saturated / n,
-                                         "ci95": list(wilson(saturated, n))},
-                            unstable_samples=[int(i) for i in np.nonzero(figs["stable"] == 0)[0][:5]])
+                            p_unstable=share("stable", 0), p_saturated=share("saturated", 1),
+                            unstable_samples=[int(i) for i in np.nonzero(figs["stable"] == 0)[0][:5]],
+                            p_slewing=share("slewing", 1))
         mc.record_target(target_ci, n_max, ends)
         if tighten and limits and mc.yield_count < n:
             weight = {r: sum(shares[k][r] for k in by_fig) for r in tol.of}
@@ -278,14 +320,15 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
 
 
 def loop_worst_case(result, series: dict, tol_items=(), limit_items=(), max_corners: int = 4096):
-    """:func:`designer.tolerance.worstcase.worst_case` of the loop's figures (:data:`WORST_FIGURES` and
-    every limited one) over its tolerance box: with 22 parts, the corners the sensitivities point to,
+    """:func:`designer.tolerance.worstcase.worst_case` of the loop's figures (:data:`WORST_FIGURES`, the
+    slew delay when ``--tol SR`` spreads the slew rate, and every limited one) over its tolerance box: with 22 parts, the corners the sensitivities point to,
     then a bounded search from the worst."""
     from .parts import resolve
     from .worstcase import worst_case
-    nominal = loop_parts(result)
+    nominal = loop_parts(result, tol_items)
     tol = resolve(tol_items, nominal, series)
-    figs = tuple(dict.fromkeys([*WORST_FIGURES, *(parse_loop_limit(t).figure for t in limit_items or ())]))
+    slew = ("slew_delay_s",) if "SR" in nominal else ()
+    figs = tuple(dict.fromkeys([*WORST_FIGURES, *slew, *(parse_loop_limit(t).figure for t in limit_items or ())]))
     return worst_case(lambda v: loop_figures(v, result), nominal, tol.of, figs, max_corners=max_corners,
                       maxiter=15)
 
@@ -293,11 +336,13 @@ def loop_worst_case(result, series: dict, tol_items=(), limit_items=(), max_corn
 @dataclass
 class LoopMonteCarlo(MonteCarlo):
     """A loop's Monte Carlo: :class:`~designer.tolerance.montecarlo.MonteCarlo` and the
-    probabilities of instability and saturation (count, fraction, 95 % Wilson interval)."""
+    probabilities of instability, saturation and of failing the slew check (count, fraction,
+    95 % Wilson interval)."""
 
     p_unstable: dict = None
     p_saturated: dict = None
     unstable_samples: list = None
+    p_slewing: dict = None
 
     @property
     def headline(self) -> str:
@@ -308,15 +353,18 @@ class LoopMonteCarlo(MonteCarlo):
         out = super().to_dict()
         return {**out, "yield_rule": "a build is in the yield when its loop is stable and inside every limit",
                 "p_unstable": self.p_unstable, "p_saturated": self.p_saturated,
-                "unstable_samples": self.unstable_samples}
+                "p_slewing": self.p_slewing, "slew_rule": SLEW_RULE, "unstable_samples": self.unstable_samples}
 
     def summary_lines(self) -> list:
-        pu, ps = self.p_unstable, self.p_saturated
         out = [f"Monte Carlo of the loop: {self.n} builds ({self.sampler}, {self.dist}, seed {self.seed}), "
-               "the plant's and the controller's parts varying together",
-               f"  unstable: {100 * pu['fraction']:.2f} % (95 % Wilson {100 * pu['ci95'][0]:.2f}..{100 * pu['ci95'][1]:.2f} %)",
-               f"  an op-amp beyond its swing: {100 * ps['fraction']:.2f} % (95 % Wilson "
-               f"{100 * ps['ci95'][0]:.2f}..{100 * ps['ci95'][1]:.2f} %)"]
+               "the plant's and the controller's parts varying together"
+               + (f", the op-amps' {' and '.join(k for k in ('GBW', 'SR') if k in self.values)} too"
+                  if "GBW" in self.values or "SR" in self.values else "")]
+        for what, p in (("unstable", self.p_unstable), ("an op-amp beyond its swing", self.p_saturated),
+                        ("a stage slewing past the slew check's budget", self.p_slewing)):
+            if p is not None:
+                out.append(f"  {what}: {100 * p['fraction']:.2f} % (95 % Wilson {100 * p['ci95'][0]:.2f}.."
+                           f"{100 * p['ci95'][1]:.2f} %)")
         for k, unit in SHOWN:
             s = self.stats.get(k)
             if s is not None and s.percentiles:

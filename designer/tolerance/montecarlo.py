@@ -14,7 +14,7 @@ import numpy as np
 from ..core.errors import DesignError
 from . import plant as engine
 from . import runner, sampling
-from .parts import DISTRIBUTIONS, resolve
+from .parts import DISTRIBUTIONS, opamp_nominal, resolve
 from .stats import Limit, failing_samples, figure_stats, parse_limit, samples_csv, variance_shares, wilson
 
 #: the number of samples allowed
@@ -25,6 +25,9 @@ WORST = 5
 TARGET_ROUND = 500
 #: --target-ci: the widest half-width accepted (a fraction)
 MAX_TARGET_CI = 0.5
+#: --tol SR on the analytic plant engine (a linear model: nothing in it slews)
+NO_SLEW = ("--tol SR: the plant's analytic model is linear, no figure of it depends on the slew rate; spread SR "
+           "with --engine spice or both (ngspice's op-amp slews)")
 
 
 @dataclass
@@ -190,11 +193,9 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     if sampler not in sampling.SAMPLERS:
         raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(sampling.SAMPLERS)}")
     limits = tuple(t if isinstance(t, Limit) else parse_limit(t, engine.FIGURES) for t in limit_items or ())
-    nominal = plant_parts(parts)
-    if any(str(t).strip().upper().startswith("GBW") for t in tol_items or ()):
-        if opamp.ideal:
-            raise DesignError("--tol GBW: the ideal op-amp has no gain-bandwidth to spread")
-        nominal["GBW"] = opamp.gbw_hz     # varies only when asked: a datasheet's typical is not a tolerance
+    nominal = {**plant_parts(parts), **opamp_nominal(tol_items, opamp)}
+    if "SR" in nominal and evaluate is None:
+        raise DesignError(NO_SLEW)
     tol = resolve(tol_items, nominal, series)
     until, first = target_plan(target_ci, limits, sampler, n, lambda figs: _yield(figs, limits))
     # another engine's evaluate(values) travels to the workers as the context of _apply

@@ -4,12 +4,21 @@ it, by class (``R=1%``, ``C=5%``) or by designator (``C2=2%``), which wins.
 
 A :class:`Tolerances` that exists is valid: every value above 0 and at most
 :data:`MAX_TOL`, every designator one the design has.
+
+The op-amp's own spread (``--tol GBW=30% SR=20%``) varies only when named (a
+datasheet's typical is not a tolerance): one gain-bandwidth and one slew rate per
+build, shared by every op-amp of it (one lot). A build's slew rate follows its
+gain-bandwidth (SR x GBW/GBW_nominal: the compensation capacitor that sets the
+one sets the other, I/C with the input stage's current fixed) unless SR is
+spread itself, then it is drawn on its own (:func:`opamp_arrays`).
 """
 
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+
+import numpy as np
 
 from ..core.errors import DesignError
 from ..core.units import parse_value
@@ -19,7 +28,9 @@ MAX_TOL = 0.5
 #: distributions: uniform in nominal (1 +- tol), or normal with sigma = tol/3 truncated at +- tol
 DISTRIBUTIONS = ("uniform", "normal")
 #: the op-amp's figures a --tol may spread (only when named: no series gives them)
-OPAMP_FIGURES = ("GBW",)
+OPAMP_FIGURES = ("GBW", "SR")
+#: what each op-amp figure is, for messages
+OPAMP_WHAT = {"GBW": "gain-bandwidth", "SR": "slew rate"}
 _ITEM = re.compile(r"^\s*([A-Za-z][A-Za-z0-9]*)\s*=\s*(.+?)\s*$")
 
 
@@ -108,3 +119,45 @@ def resolve(items, parts: dict, series: dict) -> Tolerances:
             raise DesignError(f"--tol: {ref} was typed by hand, so its series (and tolerance) is unknown; give "
                               f"--tol {kind}=PCT or --tol {ref}=PCT")
     return Tolerances(out)
+
+
+def opamp_nominal(items, opamp) -> dict:
+    """The op-amp figures the ``--tol`` ``items`` name (``GBW=30%``, ``SR=20%``) -> their nominal
+    values (Hz, V/s) of ``opamp``; empty when none is named.
+
+    Raises
+    ------
+    DesignError
+        When one is named for the ideal op-amp (it has neither).
+    """
+    named = set()
+    for item in items or ():
+        m = _ITEM.match(str(item))
+        if m and m.group(1).upper() in OPAMP_FIGURES:
+            named.add(m.group(1).upper())
+    if named and opamp.ideal:
+        f = next(f for f in OPAMP_FIGURES if f in named)
+        raise DesignError(f"--tol {f}: the ideal op-amp has no {OPAMP_WHAT[f]} to spread")
+    nominal = {"GBW": opamp.gbw_hz, "SR": opamp.slew_v_per_s}
+    return {f: nominal[f] for f in OPAMP_FIGURES if f in named}
+
+
+def opamp_arrays(opamp, values: dict, n: int) -> tuple:
+    """(gain-bandwidth, slew rate) of each of ``n`` builds, arrays: the drawn ``GBW`` and ``SR``
+    where ``values`` has them, else the nominal, SR scaled with GBW when only GBW is drawn
+    (module docstring)."""
+    gbw = np.broadcast_to(np.asarray(values.get("GBW", opamp.gbw_hz), float), (n,))
+    if "SR" in values:
+        sr = np.broadcast_to(np.asarray(values["SR"], float), (n,))
+    else:
+        sr = opamp.slew_v_per_s * gbw / opamp.gbw_hz
+    return gbw, sr
+
+
+def sample_opamp(opamp, values: dict, i: int):
+    """The op-amp of build ``i`` (:func:`opamp_arrays`; ``opamp`` itself when neither figure varies)."""
+    if "GBW" not in values and "SR" not in values:
+        return opamp
+    import dataclasses
+    gbw, sr = opamp_arrays(opamp, {k: values[k][i:i + 1] for k in OPAMP_FIGURES if k in values}, 1)
+    return dataclasses.replace(opamp, gbw_hz=float(gbw[0]), slew_v_per_s=float(sr[0]))

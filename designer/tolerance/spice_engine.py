@@ -5,7 +5,9 @@ The plant deck design-plant writes (:func:`designer.plant.netlist.plant_deck`)
 is loaded once, without its ``.tran`` and ``.meas`` lines; a loop of control
 commands then, per sample, ``alter``\\ s R1 R2 C1 C2 (and the gain resistors, the
 deck's R19/R20 for the seed's R3/R4; the op-amp's integrating capacitor for
-``--tol GBW``), runs ``tran`` over the rising half of the bench period only, and
+``--tol GBW``; for ``--tol SR`` the op-amp subcircuit's own ``SR`` parameter,
+made a global ``.param`` of the loaded copy, is changed by ``alterparam`` and the
+circuit ``reset`` before the other alters, :func:`opamp_commands`), runs ``tran`` over the rising half of the bench period only, and
 ``meas``\\ ures from the control block (in ngspice 39 a deck's own ``.meas`` lines
 print the first pass's value on every pass of an ``alter`` loop). Both backends
 of :mod:`designer.spice.simulate` run the loop (``run_script``): ``ngspice -b``
@@ -63,6 +65,10 @@ SECONDS_PER_SAMPLE = 1.0
 _MEASURES = ("mcpeak", "mctpk", "mct10", "mct90", "mcts")
 _LINE = re.compile(r"^\s*(mcpeak|mctpk|mct10|mct90|mcts)\s*=\s*([-+]?[\d.]+(?:[eE][-+]?\d+)?)", re.M)
 _ROW = re.compile(r"^\s*MCROW (\d+)\s*$", re.M)
+#: the op-amp figures an engine may vary (designer.tolerance.parts.OPAMP_FIGURES)
+OPAMP = ("GBW", "SR")
+#: the global parameter the loaded circuit gives every op-amp's slew rate (:func:`slew_parametrised`)
+SLEW_PARAM = "mcsr"
 
 
 @dataclass(frozen=True)
@@ -74,7 +80,8 @@ class SpiceContext:
     ``cint`` names the op-amp's integrating capacitor and ``rint`` its resistor
     (``GBW`` varies through C = A0/(2 pi GBW RINT); the model's slew current is fixed
     at the nominal one, so the slew rate follows the gain-bandwidth, as a real
-    op-amp's compensation capacitor moves both)."""
+    op-amp's compensation capacitor moves both, unless ``SR`` varies too:
+    :func:`opamp_commands`, :func:`designer.tolerance.parts.opamp_arrays`)."""
 
     circuit: str
     elements: tuple
@@ -112,14 +119,14 @@ def context(deck: str, parts, opamp, test, simulator: str = "ngspice-cli") -> Sp
     if test.time_scale_s is not None:
         step = min(step, test.time_scale_s / MIN_STEPS_PER_TIME_SCALE)
     cint = rint = None
+    circuit = "\n".join(keep) + "\n.end\n"
     if not opamp.ideal:
-        m = re.search(r"^\.param\s+RINT\s*=\s*(\S+)", deck, re.M | re.I)
-        from ..core.units import parse_value
-        rint = parse_value(m.group(1), "RINT") if m else None
+        rint = deck_rint(deck)
         cint = f"c.x{net.amps[0].ref.lower()}.cint"
-        nominal += (("GBW", opamp.gbw_hz),)
+        nominal += (("GBW", opamp.gbw_hz), ("SR", opamp.slew_v_per_s))
+        circuit = slew_parametrised(circuit)
     from ..spice.simulate import get_simulator
-    return SpiceContext("\n".join(keep) + "\n.end\n", elements, test.delay_s, test.delay_s + test.half_period_s,
+    return SpiceContext(circuit, elements, test.delay_s, test.delay_s + test.half_period_s,
                         step, test.amplitude_v, opamp.a0, nominal, cint, rint, get_simulator(simulator).name)
 
 
@@ -129,36 +136,84 @@ def commands(ctx: SpiceContext, values: dict, start: int = 0) -> list:
     n = len(next(iter(values.values())))
     final = ctx.final_v(values, n)
     elem = dict(ctx.elements)
-    unknown = [d for d in values if d not in elem and d != "GBW"]
+    unknown = [d for d in values if d not in elem and d not in OPAMP]
     if unknown:
         raise ValueError(f"the plant deck has no part {unknown[0]}")
-    if "GBW" in values and ctx.cint is None:
-        raise ValueError("the ideal op-amp has no gain-bandwidth to vary")
+    if any(d in values for d in OPAMP) and ctx.cint is None:
+        raise ValueError("the ideal op-amp has no gain-bandwidth or slew rate to vary")
     win = f"FROM={ctx.t0:.10g} TO={ctx.t1:.10g}"
     tran = f"tran {ctx.max_step_s:.6g} {ctx.t1:.10g} 0 {ctx.max_step_s:.6g}"
+    nom = dict(ctx.nominal)
     out = []
     for i in range(n):
+        if ctx.cint is not None:
+            out += opamp_commands(values, i, (ctx.cint,), ctx.a0, ctx.rint, nom["GBW"], nom["SR"])
         for d, v in values.items():
-            if d == "GBW":
-                a0 = ctx.a0
-                out.append(f"alter {ctx.cint} = {a0 / (2 * math.pi * float(v[i]) * ctx.rint):.12g}")
-            else:
+            if d not in OPAMP:
                 out.append(f"alter {elem[d]} = {float(v[i]):.12g}")
         f = float(final[i])
         out += [tran, f"echo MCROW {start + i}", *measures(win, f), "destroy all"]
     return out
 
 
-def measures(win: str, final: float) -> list:
+def deck_rint(deck: str) -> float:
+    """The behavioural op-amp's integrating resistor RINT (ohm), as the deck's library sets it."""
+    from ..core.units import parse_value
+    m = re.search(r"^\.param\s+RINT\s*=\s*(\S+)", deck, re.M | re.I)
+    if m is None:
+        raise ValueError("the deck's op-amp library sets no RINT")
+    return parse_value(m.group(1), "RINT")
+
+
+def slew_parametrised(circuit: str) -> str:
+    """``circuit`` with every behavioural op-amp instance's ``SR=`` value replaced by the global
+    parameter :data:`SLEW_PARAM` (its nominal, the first instance's), which ``alterparam`` can
+    change per build (a subcircuit's parameters are fixed once it is expanded; a B source's
+    expression is out of ``alter``'s reach). The same circuit at the nominal."""
+    inst = re.compile(r"^(X\S*\s.*\bOPAMP_BEH\b.*\bSR=)(\S+)", re.M | re.I)
+    m = inst.search(circuit)
+    if m is None:
+        return circuit
+    body = inst.sub(lambda k: k.group(1) + "{" + SLEW_PARAM + "}", circuit)
+    first, rest = body.split("\n", 1)         # the title line stays first
+    return f"{first}\n.param {SLEW_PARAM}={m.group(2)}\n{rest}"
+
+
+def opamp_commands(values: dict, i: int, cints, a0: float, rint: float, gbw_nominal: float,
+                   sr_nominal: float) -> list:
+    """Build ``i``'s op-amp commands: with a drawn ``SR``, ``alterparam`` of :data:`SLEW_PARAM` and
+    ``reset`` (first: a reset re-expands the circuit, undoing earlier alters); with a drawn ``GBW``,
+    every integrating capacitor ``cints`` altered to A0/(2 pi GBW RINT).
+
+    The subcircuit's slew current is IMAX = SR x CINT of the parsed values; with CINT then altered
+    for the build's GBW its slew rate is IMAX/CINT, so the parameter is set to
+    SR_build x GBW_nominal/GBW_build, which gives SR_build exactly. Without a drawn SR the slew rate
+    follows the GBW (:func:`designer.tolerance.parts.opamp_arrays`)."""
+    out = []
+    gbw = float(values["GBW"][i]) if "GBW" in values else gbw_nominal
+    if "SR" in values:
+        out += [f"alterparam {SLEW_PARAM} = {float(values['SR'][i]) * gbw_nominal / gbw:.12g}", "reset"]
+    if "GBW" in values:
+        c = a0 / (2 * math.pi * gbw * rint)
+        out += [f"alter {ref} = {c:.12g}" for ref in cints]
+    return out
+
+
+def measures(win: str, final: float, node: str = "out", first_peak: bool = True) -> list:
     """The control block's measurements of one run (peak, peak time, 10-90 % and 2 % settling
-    crossings) within ``win`` (``FROM=.. TO=..``), ``final`` the settled output."""
-    f = final
-    return [f"meas tran mcpeak MAX v(out) {win}",
-            "let mcdv = deriv(v(out))",
-            f"meas tran mctpk WHEN mcdv=0 FALL=1 {win}",
-            f"meas tran mct10 WHEN v(out)={0.1 * f:.10g} CROSS=1 {win}",
-            f"meas tran mct90 WHEN v(out)={0.9 * f:.10g} CROSS=1 {win}",
-            f"let mcerr = abs(v(out)-{f:.10g})/{f:.10g}",
+    crossings) of ``v(node)`` within ``win`` (``FROM=.. TO=..``), ``final`` the settled output.
+    The peak's time: ``first_peak``, where the slope first falls through 0 (a plant's second-order
+    step, whose first peak is its highest; not quantised to the time grid), else where the
+    highest value is (``MAX_AT``, as a loop deck's own ``.meas`` reads it: a loop's first ripple
+    need not be its peak)."""
+    f, v = final, f"v({node})"
+    peak = ([f"let mcdv = deriv({v})", f"meas tran mctpk WHEN mcdv=0 FALL=1 {win}"] if first_peak else
+            [f"meas tran mctpk MAX_AT {v} {win}"])
+    return [f"meas tran mcpeak MAX {v} {win}",
+            *peak,
+            f"meas tran mct10 WHEN {v}={0.1 * f:.10g} CROSS=1 {win}",
+            f"meas tran mct90 WHEN {v}={0.9 * f:.10g} CROSS=1 {win}",
+            f"let mcerr = abs({v}-{f:.10g})/{f:.10g}",
             f"meas tran mcts WHEN mcerr=0.02 CROSS=LAST {win}"]
 
 
@@ -184,18 +239,22 @@ def parse(output: str, start: int, n: int) -> dict:
 
 def figures(ctx: SpiceContext, values: dict, raw: dict) -> dict:
     """The figures of :data:`FIGURES` from each sample's measurements (module docstring)."""
-    n = len(raw["mcpeak"])
-    final = ctx.final_v(values, n)
+    return step_figures(raw, ctx.final_v(values, len(raw["mcpeak"])), ctx.t0)
+
+
+def step_figures(raw: dict, final, t0: float) -> dict:
+    """The figures of :data:`FIGURES` from each sample's measurements ``raw`` (:data:`_MEASURES`,
+    arrays), its settled output ``final`` and the step's time ``t0`` (module docstring)."""
     over = np.maximum(0.0, 100.0 * (raw["mcpeak"] - final) / final)
     peaked = over > OVERSHOOT_FLOOR_PCT
-    tp = np.where(peaked, raw["mctpk"] - ctx.t0, np.nan)
+    tp = np.where(peaked, raw["mctpk"] - t0, np.nan)
     with np.errstate(divide="ignore", invalid="ignore"):
         ln = np.log(np.where(peaked, over / 100.0, np.nan))
         zeta = -ln / np.sqrt(math.pi ** 2 + ln * ln)
         wn = math.pi / (tp * np.sqrt(1.0 - zeta * zeta))
         return {"fn_hz": wn / (2 * math.pi), "zeta": zeta, "q": 1.0 / (2.0 * zeta), "overshoot_pct": over,
                 "peak_time_s": tp, "rise_time_s": raw["mct90"] - raw["mct10"],
-                "settling_time_s": raw["mcts"] - ctx.t0}
+                "settling_time_s": raw["mcts"] - t0}
 
 
 def evaluate(ctx: SpiceContext, values: dict, start: int = 0) -> dict:

@@ -37,6 +37,24 @@ def plant_chunk(ctx, opamp, values: dict, start: int = 0) -> dict:
     return {**_figures(values, {}, opamp), **spice_engine.evaluate(ctx, values, start)}
 
 
+def step_chunk(ctx, opamp, values: dict, start: int = 0) -> dict:
+    """The figures of a chunk of samples with the model's figures under their own names and
+    SPICE's as ``spice_<figure>`` (:data:`designer.tolerance.spice_engine.FIGURES`), so that a
+    check on the model's ``fn_hz`` and one on SPICE's ``overshoot_pct`` each count their own
+    (check-design's yield, :mod:`designer.tolerance.yields`). Pure, of picklable arguments."""
+    from .montecarlo import _figures
+    sp = spice_engine.evaluate(ctx, values, start)
+    return {**_figures(values, {}, opamp), **{f"spice_{k}": v for k, v in sp.items()}}
+
+
+def spice_step_evaluate(result, simulator: str = "ngspice-cli"):
+    """``evaluate(values) -> figures`` of :func:`step_chunk` for a plant result (its deck, parts
+    as built, op-amp and test) on the backend ``simulator`` (picklable)."""
+    import functools
+    ctx = spice_engine.context(result.deck, result.built, result.opamp, result.test, simulator)
+    return functools.partial(step_chunk, ctx, result.opamp)
+
+
 def spice_evaluate(ctx, opamp):
     """``evaluate(values) -> figures`` (:func:`plant_chunk` bound to a design; picklable)."""
     import functools
@@ -212,14 +230,10 @@ def replay_values(parts, series: dict, opamp, index: int, n: int, seed: int, sam
     values :func:`designer.tolerance.montecarlo.plant_monte_carlo` drew for it."""
     from . import sampling
     from .montecarlo import plant_parts
-    from .parts import resolve
+    from .parts import opamp_nominal, resolve
     if not 0 <= index < n:
         raise DesignError(f"--replay {index}: the Monte Carlo has samples 0 to {n - 1}")
-    nominal = plant_parts(parts)
-    if any(str(t).strip().upper().startswith("GBW") for t in tol_items or ()):
-        if opamp.ideal:
-            raise DesignError("--tol GBW: the ideal op-amp has no gain-bandwidth to spread")
-        nominal["GBW"] = opamp.gbw_hz
+    nominal = {**plant_parts(parts), **opamp_nominal(tol_items, opamp)}
     tol = resolve(tol_items, nominal, series)
     v = sampling.values(nominal, tol.of, n, seed, sampler, dist, start=index, stop=index + 1)
     return nominal, tol, {k: float(a[0]) for k, a in v.items()}
@@ -242,21 +256,20 @@ def replay(result, series: dict, index: int, n: int, seed: int, sampler: str, di
 
 def replay_result(result, rep: Replay, simulator: str, r_series=None, c_series=None, package=None):
     """The full analyze-plant result (sheet, deck, waveforms) of the replayed sample's parts, exact
-    values (no E-series rounding), on the design's op-amp (with the sample's gain-bandwidth when it
-    varies) and square wave; its ``monte_carlo`` is the :class:`Replay`."""
-    import dataclasses
-
+    values (no E-series rounding), on the design's op-amp (with the sample's gain-bandwidth and slew
+    rate when they vary, :func:`designer.tolerance.parts.sample_opamp`) and square wave; its ``monte_carlo`` is the :class:`Replay`."""
     from ..plant.design import analyze_plant
     from ..plant.sallenkey import SallenKeyParts
     from ..plant.spec import AnalysisSpec
+    from .parts import sample_opamp
     v = rep.values
     parts = SallenKeyParts(v["R1"], v["R2"], v["C1"], v["C2"], None, v.get("R3", result.built.r3),
                            v.get("R4", result.built.r4))
-    amp = result.opamp if "GBW" not in v else dataclasses.replace(result.opamp, gbw_hz=v["GBW"])
+    amp = sample_opamp(result.opamp, {k: np.array([x]) for k, x in v.items()}, 0)
 
     class _SampleSpec(AnalysisSpec):
         @property
-        def amp(self):            # the sample's op-amp (its GBW drawn), not the catalogue's
+        def amp(self):            # the sample's op-amp (its GBW, SR drawn), not the catalogue's
             return amp
     spec = _SampleSpec(parts, opamp=result.opamp.name, r_series=r_series, c_series=c_series,
                        amplitude_v=result.test.amplitude_v, square_hz=result.test.frequency_hz, package=package)

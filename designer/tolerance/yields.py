@@ -7,6 +7,13 @@ figure (``overshoot_pct``), the op-amp-aware model's figure stands in for it
 (:data:`PLANT`, :data:`LOOP`); a check on a figure no engine computes (``nrms``,
 ``rise_time_s`` of a plant) is not counted, and the verdict says so. A report-only
 check (``fail: false``) is never counted.
+
+The SPICE engine (``engine: spice``) simulates every build in ngspice (a plant:
+:mod:`.spice_engine`; a loop: :mod:`.spice_loop`) and counts the SPICE step
+figures a check names (``overshoot_pct``, ``peak_time_s``, ``rise_time_s``,
+``settling_time_s``) from those runs (:data:`PLANT_SPICE`, :data:`LOOP_SPICE`); the
+other figures (``fn_hz``, the gains, the margins, ``model_*``) stay the models',
+as check-design reads them on the nominal build.
 """
 
 from __future__ import annotations
@@ -25,14 +32,21 @@ PLANT = {**{f: f for f in ("fn_hz", "zeta", "q", "ideal_fn_hz", "ideal_zeta", "i
 #: check-design's loop figure -> the analytic loop engine's (designer.tolerance.loop.FIGURES)
 LOOP = {**{f: f for f in LIMITABLE}, **STANDS_IN}
 BY_KIND = {"plant": PLANT, "pid": LOOP}
-#: the engines a spec's yield may use (``spice`` comes with the SPICE engine)
-ENGINES = ("analytic",)
+#: the SPICE step figures a check may name, counted from each build's ngspice run
+SPICE_STEP = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
+#: check-design's plant figure -> the SPICE engine's (the models' besides SPICE's ``spice_*``)
+PLANT_SPICE = {**PLANT, **{f: f"spice_{f}" for f in SPICE_STEP}}
+#: check-design's loop figure -> the SPICE engine's (the analytic loop's besides SPICE's ``spice_*``)
+LOOP_SPICE = {**{f: f for f in LIMITABLE}, **{f: f"spice_{f}" for f in SPICE_STEP}}
+TABLES = {"analytic": BY_KIND, "spice": {"plant": PLANT_SPICE, "pid": LOOP_SPICE}}
+#: the engines a spec's yield may use
+ENGINES = ("analytic", "spice")
 
 
-def counted(kind: str, checks) -> tuple:
+def counted(kind: str, checks, engine: str = "analytic") -> tuple:
     """(the checks the yield counts, the names of those it cannot): failing checks whose figure the
-    analytic engine computes, and the others'."""
-    table = BY_KIND[kind]
+    ``engine`` computes, and the others'."""
+    table = TABLES[engine][kind]
     live = [c for c in checks if c.fail]
     return tuple(c for c in live if c.figure in table), tuple(c.figure for c in live if c.figure not in table)
 
@@ -97,25 +111,47 @@ class YieldVerdict:
 
 
 def _unit(ref: str) -> str:
-    return "Ohm" if ref.startswith("R") else "F" if ref.startswith("C") else "Hz"
+    return {"R": "Ohm", "C": "F", "G": "Hz", "S": "V/s"}[ref[0]]
 
 
 def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int, tol_items=(),
-               sampler: str = "random", dist: str = "uniform") -> YieldVerdict:
+               sampler: str = "random", dist: str = "uniform", engine: str = "analytic",
+               simulator: str = "ngspice-cli") -> YieldVerdict:
     """The yield of one corner's design ``res`` (a PlantResult or a PidResult) over ``checks``
     (:class:`designer.check.limits.Limit`, the spec's), required to reach ``required``.
 
-    The spec's tolerance items (``R=1%``) win over the series' defaults, as ``--tol`` does."""
+    Parameters
+    ----------
+    kind : str
+        ``plant`` or ``pid``.
+    tol_items : sequence of str
+        The spec's ``tolerances:`` as ``--tol`` items (``R=1%``, ``SR=20%``); they win over the
+        series' defaults, as ``--tol`` does.
+    engine : str
+        :data:`ENGINES`: ``analytic`` (the models) or ``spice`` (every build simulated in ngspice
+        on the backend ``simulator``, the module docstring).
+    """
     from .loop import loop_monte_carlo, loop_series
     from .montecarlo import plant_monte_carlo
-    use, skipped = counted(kind, checks)
-    table = BY_KIND[kind]
+    use, skipped = counted(kind, checks, engine)
+    table = TABLES[engine][kind]
     limits = tuple(Limit(table[c.figure], c.min, c.max) for c in use)
     names = {table[c.figure]: c.figure for c in use}
     if kind == "plant":
         s = res.sourcing
+        evaluate = None
+        if engine == "spice":
+            from .spice_mc import spice_step_evaluate
+            evaluate = spice_step_evaluate(res, simulator)
         mc = plant_monte_carlo(res.built, {"R": s.r_series, "C": s.c_series}, res.opamp, samples, seed, sampler,
-                               dist, tol_items, limits, tighten=False)
+                               dist, tol_items, limits, tighten=False, engine_name=engine, evaluate=evaluate)
     else:
-        mc = loop_monte_carlo(res, loop_series(res), samples, seed, sampler, dist, tol_items, limits, tighten=False)
+        spice = None
+        if engine == "spice":
+            from . import spice_loop
+            from .loop import loop_parts
+            spice = ("spice", spice_loop.evaluate,
+                     spice_loop.context(res, tuple(loop_parts(res, tol_items)), simulator))
+        mc = loop_monte_carlo(res, loop_series(res), samples, seed, sampler, dist, tol_items, limits, tighten=False,
+                              engine=spice)
     return YieldVerdict(mc, required, names, skipped)

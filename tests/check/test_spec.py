@@ -314,8 +314,8 @@ def test_a_pid_spec_names_the_loops_parts(tmp_path):
 
 
 @pytest.mark.parametrize("extra, line, words", [
-    ("yield: {min: 95%, engine: spice}", 5, "yield.engine spice is not available yet"),
-    ("yield: {min: 95%, engine: magic}", 5, "allowed: analytic"),
+    ("yield: {min: 95%}\ntolerances: {SR: 20%}", 6, "give yield.engine: spice"),
+    ("yield: {min: 95%, engine: magic}", 5, "allowed: analytic, spice"),
     ("yield: {min: 95}", 5, "write 95%"),
     ("yield: {min: 0%}", 5, "above 0 and at most 100 %"),
     ("yield: {samples: 100}", 5, "yield needs min"),

@@ -337,7 +337,7 @@ _YIELD_SPEC = "kind: plant\ntarget: {fc: 3.5k, zeta: 0.2}\nchecks: {fn_hz: {min:
 
 
 @pytest.mark.parametrize("extra, words", [
-    ("yield: {min: 95%, engine: spice}", ("spec.yaml:4:", "not available yet")),
+    ("yield: {min: 95%, engine: '$(ngspice)'}", ("spec.yaml:4:", "yield.engine")),
     ("yield: {min: 95%, samples: 99999999999}", ("spec.yaml:4:", "yield.samples")),
     ("yield: {min: '$(touch x)'}", ("spec.yaml:4:", "yield.min")),
     ("yield: {min: 95%}\ntolerances: {R: 1e999%}", ("spec.yaml:5:", "tolerances.R")),

@@ -85,3 +85,34 @@ def test_a_model_plants_loop_varies_the_controllers_parts():
 def test_a_model_plant_has_no_plant_parts_to_spread():
     p = run("--plant-tf", "K=2 tau=1m theta=200u", "--monte-carlo", "10", "--tol", "R1=1%", "--no-sim", "--no-files")
     assert p.returncode == 2 and "--tol R1: no such part" in p.stderr, p.stderr
+
+
+def test_the_opamps_spread_in_the_loop():
+    p = run(*LOOP, "--monte-carlo", "20", "--seed", "3", "--tol", "GBW=30%", "SR=20%", "--json")
+    assert p.returncode == 0, p.stderr
+    mc = json.loads(p.stdout)["monte_carlo"]
+    assert mc["settings"]["tolerances_pct"]["GBW"] == 30.0 and mc["settings"]["tolerances_pct"]["SR"] == 20.0
+    assert mc["nominal_parts"]["SR"] == 0.5e6 and mc["nominal_parts"]["GBW"] == 1e6      # the LM741's
+    ps = mc["p_slewing"]
+    assert 0 <= ps["ci95"][0] <= ps["fraction"] <= ps["ci95"][1] and ps["count"] == round(20 * ps["fraction"])
+    assert "slew_delay_s" in mc["statistics"]
+
+
+@pytest.mark.parametrize("items, words", [
+    (["SR=0"], "--tol SR: a tolerance must be above 0 and at most 50 %"),
+    (["SR=-5%"], "--tol SR: a tolerance must be above 0 and at most 50 %"),
+    (["SR=60%"], "--tol SR: a tolerance must be above 0 and at most 50 %"),
+    (["GBW=0%"], "--tol GBW: a tolerance must be above 0"),
+    (["SR=fast"], "is not a tolerance"),
+])
+def test_a_bad_opamp_spread_is_one_line(items, words):
+    p = run(*LOOP, "--monte-carlo", "20", "--tol", *items)
+    assert p.returncode == 2 and words in p.stderr, p.stderr
+    assert len(p.stderr.strip().splitlines()) == 1
+
+
+def test_the_ideal_opamps_have_no_spread(tmp_path):
+    p = run("--plant-fc", "3500", "--plant-zeta", "0.2", "--opamp", "ideal", "--monte-carlo", "20", "--tol",
+            "SR=20%", "--no-sim", "--out", str(tmp_path))
+    assert p.returncode == 2 and "the ideal op-amp has no slew rate to spread" in p.stderr, p.stderr
+    assert len(p.stderr.strip().splitlines()) == 1 and not any(tmp_path.iterdir())

@@ -97,7 +97,8 @@ def test_design_pid_monte_carlo_of_the_loop():
     (["--plant-tf", "K=2 tau=1m", "--monte-carlo", "50", "--tol", "C2=1%"], "no such part"),
     (["--plant-fc", "3500", "--plant-zeta", "0.2", "--monte-carlo", "50", "--tol", "C9=1%"], "no such part"),
     (["--plant-fc", "3500", "--plant-zeta", "0.2", "--tol", "R=1%"], "goes with --monte-carlo"),
-    (["--plant-fc", "3500", "--plant-zeta", "0.2", "--monte-carlo", "50", "--tol", "GBW=30%"], "do not vary yet"),
+    (["--plant-fc", "3500", "--plant-zeta", "0.2", "--opamp", "ideal", "--monte-carlo", "50", "--tol", "GBW=30%"],
+     "the ideal op-amp has no gain-bandwidth"),
 ])
 def test_design_pid_monte_carlo_refusals(tmp_path, args, what):
     p = run(DESIGN_PID, *args, "--no-sim", "--out", str(tmp_path))
@@ -215,3 +216,16 @@ def test_spice_options_never_crash(tmp_path_factory):
             assert len(err.getvalue().strip().splitlines()) == 1, (argv, err.getvalue())
         assert not any(out.iterdir())
     check()
+
+
+@pytest.mark.parametrize("args, what", [
+    (["--monte-carlo", "50", "--tol", "SR=20%"], "--engine spice or both"),
+    (["--worst-case", "--tol", "SR=20%"], "drop SR from --tol"),
+    (["--monte-carlo", "50", "--tol", "SR=0", "--engine", "spice"], "above 0 and at most 50 %"),
+    (["--opamp", "ideal", "--monte-carlo", "50", "--tol", "SR=20%", "--engine", "spice"],
+     "the ideal op-amp has no slew rate"),
+])
+def test_a_plants_slew_spread_is_refused_where_nothing_slews(tmp_path, args, what):
+    p = run(DESIGN_PLANT, *SEED, *args, "--out", str(tmp_path))
+    assert p.returncode == 2 and len(p.stderr.splitlines()) == 1 and what in p.stderr, p.stderr
+    assert not any(tmp_path.iterdir())

@@ -73,3 +73,31 @@ def test_the_pid_sheet_shows_the_loops_tolerance_section(tmp_path):
     assert (folder / "mc-phase_margin_deg.png").exists() and (folder / "monte-carlo.csv").exists()
     md = (folder / "build-sheet.md").read_text()
     assert "Unstable: " in md and "an op-amp beyond its swing" in md.lower() and "Yield " in md
+
+
+def test_a_loops_worst_case_is_on_its_sheet(tmp_path):
+    """--worst-case on a loop: the PID sheet's tolerance section lists each figure's lowest and highest
+    value and the corner that gives it, as the WorstCase found them (a real search, on a box of four
+    parts to keep it short)."""
+    from designer.tolerance.loop import loop_figures, loop_parts
+    from designer.tolerance.worstcase import worst_case
+    res = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2, tuning="optimize", target_overshoot_pct=10),
+                     simulate=False)
+    parts = loop_parts(res)
+    varied = {"R3": 0.05, "C4": 0.10, "R1": 0.05, "C3": 0.10}
+
+    def evaluate(v):
+        n = next(iter(v.values())).size
+        return loop_figures({**{k: np.full(n, x) for k, x in parts.items()}, **v}, res)
+    res.worst_case = worst_case(evaluate, parts, varied, ("phase_margin_deg", "model_overshoot_pct"), maxiter=3)
+    write_pid(res, tmp_path, "wc")
+    md = (tmp_path / "reports" / "wc" / "build-sheet.md").read_text()
+    assert "## Tolerance analysis (worst case)" in md and "| figure | extreme | value | where (parts) |" in md
+    pm_lo, pm_hi = res.worst_case.extremes["phase_margin_deg"]
+    assert f"| phase_margin_deg | lowest | {pm_lo.value:.4g} deg |" in md
+    assert f"|  | highest | {pm_hi.value:.4g} deg |" in md
+    for e in (pm_lo, pm_hi):
+        up = [r for r, d in e.deviations.items() if d >= 0.995]
+        if e.at_corner and up:
+            assert f"+tol: {' '.join(up)}" in md
+    assert f"{res.worst_case.corners} corners evaluated" in md

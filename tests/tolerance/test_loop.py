@@ -211,3 +211,83 @@ def test_any_loop_limit_is_a_window_or_one_line(name, lo, hi, sep):
         assert "\n" not in str(exc) and str(exc).startswith("--limit")
         return
     assert lim.figure in LIMITABLE and lim.min <= lim.max
+
+
+# ---- the op-amps' spread (--tol GBW SR): one lot per build ---------------------------------------
+
+@pytest.fixture(scope="module")
+def spread(designed):
+    return loop_monte_carlo(designed, {"R": "E24", "C": "E12"}, 24, seed=9, tol_items=["GBW=30%", "SR=50%"],
+                            limit_items=LIMITS, tighten=False)
+
+
+def _row_loop(designed, row, amp):
+    """A row's loop rebuilt from the pid wing's own model with the row's op-amp: margins and each
+    stage's slew delay (design-pid's slew check, on the engine's time grid)."""
+    from designer.pid import model
+    from designer.plant.model import plant_tf_opamp
+    from designer.tolerance.loop import STEP_POINTS
+    plant = SallenKeyParts(row["R1"], row["R2"], row["C1"], row["C2"])
+    parts = PidParts(**{f: row[f.upper()] for f in PidParts.__dataclass_fields__ if f.upper() in row.dtype.names})
+    pn, pd = plant_tf_opamp(plant, amp)
+    t = np.linspace(0.0, designed.waveforms.t[-1], STEP_POINTS)
+    waves = model.assemble(parts, amp, pn, pd).simulate(t, model.reference(t, designed.test.amplitude_v, 0.0,
+                                                                           designed.test.edge_s))
+    delay = max(model.slew_delay(t, v, amp.slew_v_per_s) for k, v in waves.items() if k != "y")
+    w = 2 * np.pi * np.logspace(np.log10(min(parts.f_integrator_hz, plant.fn_hz) / 20),
+                                np.log10(max(amp.gbw_hz, 100 * plant.fn_hz)), 1500)
+    return model.margins(w, model.loop_gain(parts, amp, pn, pd, w)), delay
+
+
+def test_each_row_is_its_loop_with_its_own_opamp(designed, spread):
+    import dataclasses
+    rows = np.genfromtxt(io.StringIO(spread.csv_text()), delimiter=",", names=True)
+    assert {"GBW", "SR", "slewing", "slew_delay_s"} <= set(rows.dtype.names)
+    amp = designed.opamp
+    assert spread.nominal["GBW"] == amp.gbw_hz and spread.nominal["SR"] == amp.slew_v_per_s
+    assert np.all(np.abs(rows["SR"] / amp.slew_v_per_s - 1) <= 0.5)
+    for row in rows[:4]:
+        mine = dataclasses.replace(amp, gbw_hz=row["GBW"], slew_v_per_s=row["SR"])
+        mg, delay = _row_loop(designed, row, mine)
+        assert row["phase_margin_deg"] == pytest.approx(mg.phase_margin_deg, abs=1e-6)
+        assert row["slew_delay_s"] == pytest.approx(delay, rel=1e-9)
+        budget = 0.05 * row["model_rise_time_s"]
+        assert row["slewing"] == float(delay > budget)
+
+
+def test_the_slew_check_fails_as_often_as_the_rows_say(spread):
+    rows = np.genfromtxt(io.StringIO(spread.csv_text()), delimiter=",", names=True)
+    fails = (rows["stable"] == 0) | (rows["slew_delay_s"] > 0.05 * rows["model_rise_time_s"])
+    d = spread.to_dict()
+    assert d["p_slewing"]["count"] == int(fails.sum()) and 0 < fails.sum() < 24   # SR 50 % at the budget's edge
+    lo, hi = d["p_slewing"]["ci95"]
+    assert lo <= fails.mean() <= hi and (lo, hi) == pytest.approx(wilson_interval(int(fails.sum()), 24))
+    assert "slew" in d["slew_rule"] and "a stage slewing" in "\n".join(spread.summary_lines())
+    # the slew rate alone explains most of the delay's spread
+    assert d["statistics"]["slew_delay_s"]["nominal"] > 0
+
+
+def wilson_interval(k, n, z=1.959963984540054):
+    p = k / n
+    c = (p + z * z / (2 * n)) / (1 + z * z / n)
+    h = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return max(0.0, c - h), min(1.0, c + h)
+
+
+def test_without_its_own_spread_the_slew_rate_follows_the_gain_bandwidth(designed):
+    """--tol GBW alone: each build's slew rate is SR x GBW/GBW_nominal (one compensation capacitor),
+    which the slew delay of the row's loop with that op-amp confirms."""
+    import dataclasses
+    mc = loop_monte_carlo(designed, {"R": "E24", "C": "E12"}, 10, seed=1, tol_items=["GBW=40%"], tighten=False)
+    assert "SR" not in mc.values
+    rows = np.genfromtxt(io.StringIO(mc.csv_text()), delimiter=",", names=True)
+    amp = designed.opamp
+    for row in rows[:2]:
+        mine = dataclasses.replace(amp, gbw_hz=row["GBW"], slew_v_per_s=amp.slew_v_per_s * row["GBW"] / amp.gbw_hz)
+        assert row["slew_delay_s"] == pytest.approx(_row_loop(designed, row, mine)[1], rel=1e-9)
+
+
+def test_the_ideal_opamp_has_no_spread():
+    res = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2, opamp="ideal"), simulate=False)
+    with pytest.raises(DesignError, match="the ideal op-amp has no slew rate"):
+        loop_monte_carlo(res, {"R": "E24", "C": "E12"}, 10, tol_items=["SR=20%"])

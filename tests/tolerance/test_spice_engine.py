@@ -142,3 +142,39 @@ def test_commands_refuse_a_part_the_deck_lacks(seed_plant):
     ctx = spice_engine.context(seed_plant.deck, seed_plant.built, seed_plant.opamp, seed_plant.test)
     with pytest.raises(ValueError, match="no part R9"):
         spice_engine.commands(ctx, {"R9": np.array([1.0])})
+
+
+def test_the_slew_rate_varies_in_spice_as_a_deck_with_that_opamp_says():
+    """--tol SR: the op-amp subcircuit's SR parameter changed per build (alterparam + reset) with
+    its GBW altered too; each build measures what a standalone deck written with that op-amp
+    measures (a 20 kHz plant under a 5 V step, which slews: SR/2 rises half as fast again)."""
+    import dataclasses
+
+    from designer.plant.netlist import plant_deck
+    from designer.spice.simulate import get_simulator
+    res = design_plant(PlantSpec(fc_hz=20000, zeta=0.3, amplitude_v=5), simulate=False)
+    amp = res.opamp
+    v = {k: np.full(3, x) for k, x in plant_parts(res.built).items()}
+    v["GBW"] = amp.gbw_hz * np.array([0.8, 1.0, 1.2])
+    v["SR"] = amp.slew_v_per_s * np.array([0.5, 1.0, 1.5])
+    ctx = spice_engine.context(res.deck, res.built, amp, res.test)
+    assert dict(ctx.nominal)["SR"] == amp.slew_v_per_s and "{mcsr}" in ctx.circuit
+    got = spice_engine.evaluate(ctx, v)
+    for i in range(3):
+        mine = dataclasses.replace(amp, gbw_hz=v["GBW"][i], slew_v_per_s=v["SR"][i])
+        m = get_simulator("ngspice-cli").run(plant_deck(res.built, mine, res.test, "build")).measurements
+        assert got["overshoot_pct"][i] == pytest.approx(m["overshoot_pct"], abs=0.02)
+        assert got["rise_time_s"][i] == pytest.approx(m["rise_time_s"], rel=2e-3)
+        assert got["peak_time_s"][i] == pytest.approx(m["peak_time_s"], rel=1e-3)
+    assert got["rise_time_s"][0] > 1.4 * got["rise_time_s"][1]        # slewing, not the linear model
+    # the nominal of the parametrised circuit is the deck itself
+    nominal = {k: a[1:2] for k, a in v.items() if k not in ("GBW", "SR")}
+    again = spice_engine.evaluate(ctx, nominal)
+    assert again["overshoot_pct"][0] == pytest.approx(got["overshoot_pct"][1], abs=1e-9)
+
+
+def test_the_plants_analytic_model_refuses_a_slew_spread(seed_plant):
+    from designer.core.errors import DesignError
+    from designer.tolerance.montecarlo import plant_monte_carlo
+    with pytest.raises(DesignError, match="no figure of it depends on the slew rate"):
+        plant_monte_carlo(seed_plant.built, {"R": "E24", "C": "E12"}, seed_plant.opamp, 20, tol_items=["SR=20%"])

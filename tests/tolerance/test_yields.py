@@ -54,3 +54,49 @@ def test_a_yield_met_says_so(plant):
     v = spec_yield("plant", plant, wide, 0.5, 200, 1)     # the series' tolerances: E24 5 %, E12 10 %
     assert v.mc.tolerances.of == pytest.approx({"R1": 0.05, "R2": 0.05, "C1": 0.10, "C2": 0.10})
     assert v.ok and "at or above min 50 %" in v.message() and "loses" not in v.message()
+
+
+# ---- engine: spice --------------------------------------------------------------------------------
+
+SPICE_CHECKS = (CheckLimit("fn_hz", 3.4e3, None, 3.6e3, unit="Hz"), CheckLimit("overshoot_pct", None, None, 54.0),
+                CheckLimit("settling_time_s", None, None, 1.5e-3, unit="s"), CheckLimit("nrms", None, None, 1.0))
+
+
+@pytest.mark.spice
+def test_the_spice_engine_counts_spices_step_figures_and_the_models_others(plant):
+    """engine: spice counts overshoot_pct and settling_time_s (which the analytic engine cannot) from
+    each build's ngspice run, and fn_hz from the model, against an independent count of the rows;
+    a SPICE row is the build's own run (spice_engine.evaluate of its parts)."""
+    from designer.tolerance import spice_engine
+    use, skipped = counted("plant", SPICE_CHECKS, "spice")
+    assert [c.figure for c in use] == ["fn_hz", "overshoot_pct", "settling_time_s"] and skipped == ("nrms",)
+    v = spec_yield("plant", plant, SPICE_CHECKS, 0.99, 30, 3, ("R=1%", "C=5%", "SR=20%"), engine="spice")
+    rows = np.genfromtxt(io.StringIO(v.mc.csv_text()), delimiter=",", names=True)
+    assert {"SR", "spice_overshoot_pct", "spice_settling_time_s", "fn_hz"} <= set(rows.dtype.names)
+    inside = ((rows["fn_hz"] >= 3400) & (rows["fn_hz"] <= 3600) & (rows["spice_overshoot_pct"] <= 54)
+              & (rows["spice_settling_time_s"] <= 1.5e-3))
+    assert v.mc.yield_count == int(inside.sum()) and v.mc.engine == "spice"
+    ctx = spice_engine.context(plant.deck, plant.built, plant.opamp, plant.test)
+    parts = ("R1", "R2", "C1", "C2", "SR")
+    again = spice_engine.evaluate(ctx, {k: rows[k][:3] for k in parts})
+    np.testing.assert_allclose(again["overshoot_pct"], rows["spice_overshoot_pct"][:3], rtol=1e-9)
+    msg = v.message()
+    assert "over fn_hz, overshoot_pct, settling_time_s (spice engine" in msg
+    if not v.ok:
+        fig, count = v.losses()[0]
+        assert f"{fig} loses most: {count} builds" in msg and "SR " in msg and "kV/s" in msg
+
+
+@pytest.mark.spice
+def test_a_loops_spice_yield_counts_spices_overshoot():
+    from designer.pid.design import design_pid
+    from designer.pid.spec import PidSpec
+    res = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2, tuning="optimize", target_overshoot_pct=10),
+                     simulate=False)
+    checks = (CheckLimit("phase_margin_deg", 27.0, None, None), CheckLimit("overshoot_pct", None, None, 8.0))
+    v = spec_yield("pid", res, checks, 0.99, 10, 2, ("GBW=30%", "SR=40%"), engine="spice")
+    rows = np.genfromtxt(io.StringIO(v.mc.csv_text()), delimiter=",", names=True)
+    inside = (rows["stable"] == 1) & (rows["phase_margin_deg"] >= 27) & (rows["spice_overshoot_pct"] <= 8)
+    assert v.mc.yield_count == int(inside.sum()) and 0 < inside.sum() < 10
+    assert v.names == {"phase_margin_deg": "phase_margin_deg", "spice_overshoot_pct": "overshoot_pct"}
+    assert "GBW " in v.message() and "SR " in v.message() and "(spice engine" in v.message()
