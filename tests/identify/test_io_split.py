@@ -130,3 +130,19 @@ def test_no_helper_for_a_short_file_or_beside_other_threads(tmp_path, monkeypatc
         stop.set()
         other.join()
     assert helpers == []
+
+
+@pytest.mark.parametrize("helper", [False, True])
+def test_a_block_of_blank_lines_is_no_warning(tmp_path, monkeypatch, helper):
+    """A run of blank lines long enough to be a block of its own (at the end of a file, or in
+    the helper's half): read without a warning line (numpy warns on a text with no number,
+    and the tests turn warnings into errors)."""
+    monkeypatch.setattr(split, "BLOCK_BYTES", 16 * 1024)
+    monkeypatch.setattr(split, "SPLIT_BYTES", 64 * 1024 if helper else 1 << 62)
+    lines = _lines()
+    lines[15000] += "\n" * 40000
+    path = tmp_path / "c.csv"
+    path.write_text("\n".join(lines) + "\n" * 300000)
+    cap = read_capture(path)
+    assert cap.t.size == len(lines) - 1
+    assert np.array_equal(cap.y, _one_process(monkeypatch, path).y)

@@ -74,14 +74,16 @@ def text_blocks(read, carry: bytes, name: str):
 
 
 def _flags(text: str, data: bytes) -> tuple:
-    """(may hold comment lines, has quotes, lines) of a block, its text and its bytes.
-    Only the one-character searches: a blank line is found by the parsed rows falling
-    short of the lines (:func:`.capture._parse_block`), where searching every block for
-    a two-character run (a newline twice) took longer than reading it. The lines as
+    """(may hold comment or blank lines, has quotes, lines) of a block, its text and its
+    bytes. Only the one-character searches, and whether the block is blank (numpy's
+    parser warns on a block without a number; ``isspace`` stops at the first number): a
+    blank line among numbers is found by the parsed rows falling short of the lines
+    (:func:`.capture._parse_block`), where searching every block for a two-character
+    run (a newline twice) took longer than reading it. The lines as
     :func:`.capture.text_lines` counts them, counted by numpy, 8x faster than
     ``str.count`` (a newline is one byte in UTF-8, never part of another character)."""
     n = int(np.count_nonzero(np.frombuffer(data, dtype=np.uint8) == 10))
-    return "#" in text, '"' in text, n + (0 if not data or data.endswith(b"\n") else 1)
+    return "#" in text or data.isspace(), '"' in text, n + (0 if not data or data.endswith(b"\n") else 1)
 
 
 def _cores() -> int:
@@ -235,9 +237,9 @@ def _helper(fd: int, start: int, limit: int, name: str, parse, w: int) -> None:
             return
         for rows, where, lines in out:
             f.write(_BLOCK.pack(rows.shape[0], rows.shape[1], lines, where is not None))
-            f.write(memoryview(rows).cast("B"))
-            if where is not None:
-                f.write(memoryview(where).cast("B"))
+            for arr in (rows, where):
+                if arr is not None and arr.size:   # (a block of comments has no rows)
+                    f.write(memoryview(arr).cast("B"))
         f.write(_BLOCK.pack(-1, 0, 0, 0))
 
 
@@ -247,5 +249,7 @@ def _exactly(f, n: int) -> bytes | None:
 
 
 def _fill(f, arr) -> bool:
+    if arr.size == 0:
+        return True
     view = memoryview(arr).cast("B")
-    return arr.size == 0 or f.readinto(view) == len(view)
+    return f.readinto(view) == len(view)
