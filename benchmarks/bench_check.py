@@ -21,6 +21,7 @@ leaves no room for a Python process at all, and the floor says so.
 
 from __future__ import annotations
 
+import os
 import statistics
 import sys
 import tempfile
@@ -140,6 +141,8 @@ def main():
         details.append((simulator, bare))
     for simulator, bare in details:
         print(f"\nBare times, {simulator}: " + ", ".join(f"{n}[{c or '-'}] {t:.2f} s" for (n, c), t in bare.items()))
+    print(f"\nLoad average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores when it ended (a shared machine: "
+          "the per-spec overhead is seconds, and grows with the load as the simulations do).")
 
 
 if __name__ == "__main__":

@@ -17,6 +17,7 @@ included.
 
 from __future__ import annotations
 
+import os
 import statistics
 import subprocess
 import sys
@@ -236,6 +237,10 @@ def against_ngspice(exe, repeat: int = 5):
     print(f"| `ngspice -b netlists/p.cir` | {b:.3f} |")
     print(f"| `design-plant --fc 3500 --zeta 0.2` (SPICE, .ac, schematic, plots, sheets, bom.csv) | {p:.3f} |")
     print(f"| ratio (goal <= {NGSPICE_RATIO_GOAL:g}) | {ratio:.1f}x {'ok' if ratio <= NGSPICE_RATIO_GOAL else 'MISSED'} |")
+    print(f"\nEach run (s): design-plant {', '.join(f'{x:.2f}' for x in plant)}; ngspice -b "
+          f"{', '.join(f'{x:.3f}' for x in bare)}. Load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores "
+          "when it ended: design-plant draws its pictures on the second core while it designs and simulates on "
+          "the first, ngspice uses one, so on a shared machine the ratio grows with the load.")
 
 
 if __name__ == "__main__":

@@ -131,6 +131,22 @@ class LimitedReader(io.RawIOBase):
             self._too_big()
         return n
 
+    def fileno(self) -> int:
+        return self._fh.fileno()
+
+    def seekable(self) -> bool:
+        return self._fh.seekable()
+
+    def seek(self, offset: int, whence: int = io.SEEK_SET) -> int:
+        """Go to byte ``offset`` from the start (a file read in parts: see
+        :mod:`designer.identify.io.split`); the bytes before it count as read."""
+        if whence != io.SEEK_SET:
+            raise io.UnsupportedOperation("only seeks from the start")
+        self.count = self._fh.seek(offset)
+        if self.count > self.limit:
+            self._too_big()
+        return self.count
+
     def _too_big(self):
         raise DesignError(f"{self.what} {self.name} is larger than {size_text(self.limit)}, "
                           f"the most this command reads; cut or decimate it")

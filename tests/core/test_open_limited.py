@@ -65,3 +65,17 @@ def test_sockets_directories_links_and_missing_files(tmp_path):
         with open_limited(p, "capture file", 1 << 20) as fh:
             assert fh.size == 8 and fh.read() == b"0,1\n1,2\n"
     assert "is 8 bytes; at most 4 bytes is read" in str(pytest.raises(DesignError, open_limited, real, "x", 4).value)
+
+
+def test_a_seek_counts_the_bytes_before_it_as_read(tmp_path):
+    """LimitedReader.seek (a capture read in two parts, designer.identify.io.split): the
+    bytes before the offset count toward the limit, as if read."""
+    path = tmp_path / "c.csv"
+    path.write_bytes(b"0123456789" * 10)
+    with open_limited(path, "capture file", 100) as fh:
+        assert fh.seek(95) == 95 and fh.count == 95
+        assert fh.read() == b"56789" and os.pread(fh.fileno(), 2, 0) == b"01"
+        fh.seek(10)
+        assert fh.read(3) == b"012" and fh.count == 13
+        with pytest.raises(DesignError, match="larger than 100 bytes"):
+            fh.seek(101)

@@ -3,7 +3,8 @@ excitation and its response): the one code path every layout goes through.
 
 :func:`read_capture` streams the file: the layout is recognised from the first
 lines (:mod:`.formats`), then the samples are parsed a block at a time by
-numpy's C parser, keeping only the (at most three) columns used.
+numpy's C parser, keeping only the (at most three) columns used; the second half
+of a long file by a forked helper on the other core meanwhile (:mod:`.split`).
 """
 
 from __future__ import annotations
@@ -17,7 +18,6 @@ import numpy as np
 
 from ...core.errors import DesignError
 from ...core.fileio import (
-    BLOCK_BYTES,
     MAX_CAPTURE_BYTES,
     MAX_CAPTURE_ROWS,
     MAX_LINE_BYTES,
@@ -31,6 +31,7 @@ from ...core.fileio import (
 from ..preprocess import check_samples
 from .formats import _layout
 from .layout import _is_number, _Layout, _split
+from .split import PARSED, FileBlocks
 
 
 INPUT_NAMES = ("u", "vin", "v_in", "in", "input", "uin", "u_in", "v(in)", "ve", "step", "source")
@@ -113,8 +114,12 @@ def read_capture(path, *, input_column=None, output_column=None, fmt=None) -> Ca
     """
     with open_limited(path, "capture file", MAX_CAPTURE_BYTES) as fh:
         head, carry = _read_head(fh)
-        cap = _parse(head, _file_blocks(fh, carry), fh.name, input_column, output_column,
-                     size_hint=fh.size, fmt=fmt)
+        blocks = FileBlocks(fh, carry)
+        try:
+            cap = _parse(head, blocks, fh.name, input_column, output_column,
+                         size_hint=fh.size, fmt=fmt)
+        finally:
+            blocks.close()
     cap.source = str(path)
     return cap
 
@@ -133,9 +138,9 @@ def parse_capture_text(text: str, *, name: str = "capture", input_column=None,
 # --------------------------------------------------------------------------- streaming
 
 def _flags(lines) -> tuple:
-    """(may hold comment or blank lines, has quotes) of a block of lines."""
+    """(may hold comment or blank lines, has quotes, lines) of a block of lines."""
     text = "\n".join(lines)
-    return ("#" in text or "" in lines), '"' in text
+    return ("#" in text or "" in lines), '"' in text, len(lines)
 
 
 def _read_head(fh) -> tuple:
@@ -157,38 +162,6 @@ def _read_head(fh) -> tuple:
     return decode(buf[bom:cut + 1]).splitlines(), buf[cut + 1:]
 
 
-def _text_flags(text: str) -> tuple:
-    """:func:`_flags` of a block given as text (no list of lines made)."""
-    gaps = "#" in text or "\n\n" in text or "\n\r\n" in text or text.startswith(("\n", "\r"))
-    return gaps, '"' in text
-
-
-def _file_blocks(fh, carry: bytes):
-    """The rest of the file as blocks of decoded text (about BLOCK_BYTES each, whole
-    lines), each with its :func:`_flags`; a line longer than MAX_LINE_BYTES is refused.
-    Kept as text: numpy's parser splits the lines itself, a list of a million
-    strings costs a tenth of a second per 50 MB."""
-    while True:
-        data = fh.read(BLOCK_BYTES)
-        if not data:
-            if carry.strip():
-                text = decode(carry)
-                yield text, _text_flags(text)
-            return
-        buf = carry + data
-        cut = buf.rfind(b"\n")
-        if cut < 0:
-            if len(buf) > MAX_LINE_BYTES:
-                raise DesignError(f"capture file {fh.name} has a line longer than "
-                                  f"{size_text(MAX_LINE_BYTES)}: not a CSV text file")
-            carry = buf
-            continue
-        carry = buf[cut + 1:]
-        text = decode(buf[:cut + 1])
-        yield text, _text_flags(text)
-
-
-
 def _parse(head, blocks, name, input_column, output_column, size_hint=None,
            fmt=None) -> Capture:
     first = next(blocks, None)
@@ -205,7 +178,7 @@ def _parse(head, blocks, name, input_column, output_column, size_hint=None,
     keep = [0, j_out] + ([j_in] if j_in is not None else [])
     more = _then(first, blocks) if first is not None else iter(())
     del first   # the block is the generator's now: freed once parsed
-    cols = _load(lines, layout, keep, more, name, size_hint)
+    cols = _load(lines, layout, keep, more, name, size_hint, getattr(blocks, "ahead", None))
     return _assemble(cols, layout, keep, tentative, name)
 
 
@@ -257,8 +230,10 @@ class _Columns:
         return d.copy() if self.n < 0.8 * self.data.shape[1] else d
 
 
-def _load(head, layout, keep, blocks, name, size_hint) -> _Columns:
-    """Parse the samples of the kept columns: the head's data lines, then ``blocks``."""
+def _load(head, layout, keep, blocks, name, size_hint, ahead=None) -> _Columns:
+    """Parse the samples of the kept columns: the head's data lines, then ``blocks``;
+    ``ahead(parse)``, when given, may have a helper parse the second half of the
+    blocks meanwhile (:mod:`.split`: the same samples and messages either way)."""
     generated = layout.file_cols[0] is None      # no time column: made from the row
     usecols = [layout.file_cols[j] for j in keep[generated:]]
     body = head[layout.first_row:]
@@ -271,14 +246,20 @@ def _load(head, layout, keep, blocks, name, size_hint) -> _Columns:
         hint = len(body)
     cols = _Columns(len(keep), hint, skip=int(generated))
     line0 = layout.first_row + 1
+    if ahead is not None:
+        ahead(lambda text, flags: _parse_block(text, 0, layout.delim, usecols, flags, name, layout.comma))
     for lines, flags in _then((body, _flags(body)), blocks):
-        rows, where = _parse_block(lines, line0, layout.delim, usecols, flags, name,
-                                   layout.comma)
+        if lines is PARSED:   # the helper's block: its line offsets from this block's first line
+            rows, where, count = flags
+            where, flags = (line0 if where is None else where + line0), (False, False, count)
+        else:
+            rows, where = _parse_block(lines, line0, layout.delim, usecols, flags, name,
+                                       layout.comma)
         if cols.n + rows.shape[0] > MAX_CAPTURE_ROWS:
             raise DesignError(f"{name}: more than {MAX_CAPTURE_ROWS:,} samples, the most "
                               "identify reads; decimate the record or cut it to the step")
         cols.append(rows, where)
-        line0 += (text_lines(lines) if isinstance(lines, str) else len(lines))
+        line0 += flags[2]
         del lines, rows   # before the next block is read
     return cols
 
@@ -291,7 +272,7 @@ def text_lines(text: str) -> int:
 def _parse_block(lines, line0, delim, usecols, flags, name, comma=False) -> tuple:
     """Numeric rows of a block of lines (a list, or the block's text) and their
     line numbers (the first one's number when no line was skipped, else an array)."""
-    gaps, quotes = flags
+    gaps, quotes, count = flags
     if isinstance(lines, str):
         text = lines
         if not gaps:
@@ -299,12 +280,14 @@ def _parse_block(lines, line0, delim, usecols, flags, name, comma=False) -> tupl
                 text = text.replace('"', "")
             if comma or delim == ";":
                 text = text.replace(",", ".")
+            if "\r" in text:   # (replace copies the text even when there is none)
+                text = text.replace("\r", "")
             try:
-                rows = np.loadtxt(io.StringIO(text.replace("\r", "")),
-                                  delimiter=None if delim == "whitespace" else delim,
+                rows = np.loadtxt(io.StringIO(text), delimiter=None if delim == "whitespace" else delim,
                                   usecols=usecols, ndmin=2, dtype=float, comments="#")
-                if rows.shape[0] == text_lines(lines):
+                if rows.shape[0] == count:
                     return rows, line0
+                gaps = True   # numpy skipped blank or comment lines: every line's number kept below
             except ValueError:
                 pass  # a bad cell: found, with its line, below
         lines = lines.splitlines()
