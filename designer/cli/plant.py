@@ -125,7 +125,9 @@ def cluster_ahead(args):
     """A context: with ``--dask local`` (checked), the LocalCluster starts now, in its thread, while
     the command designs and simulates; the Monte Carlo takes it (:func:`designer.tolerance.runner.cluster_ahead`)."""
     from ..tolerance.runner import cluster_ahead as ahead
-    return ahead(scale_settings(args)[0])
+    # the plant's commands have --engine; the PID commands' Monte Carlo is the loop's
+    engine = {"analytic": "analytic", "spice": "spice", "both": "spice"}.get(getattr(args, "engine", None), "loop")
+    return ahead(scale_settings(args)[0], engine)
 
 
 def _add_tolerance_options(p):

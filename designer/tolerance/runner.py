@@ -199,12 +199,15 @@ class Runner:
             with self:
                 return self.run(evaluate, context, draw, n, until, progress)
         total = draw.n if n is None else n
-        size = self.scale.chunk_size(draw.n if until is not None else total)
         bar = _progress(draw.n if until is not None else total,
                         self.scale.progress if progress is None else progress)
         parts, ends, done = [], [], 0
         try:
             while True:
+                # each round split for the workers by its own size (a --target-ci round of 500 of
+                # 10^5 builds is as many chunks as a whole run of 500): the samples are the same
+                # whatever the chunking, only the split changes
+                size = self.scale.chunk_size(total - done)
                 tasks = [(a, min(a + size, total)) for a in range(done, total, size)]
                 parts += self._pool.map(evaluate, context, draw, tasks, bar)
                 done = total
@@ -284,22 +287,67 @@ def result_size(result: dict) -> int:
     return len(next(iter(result["values"].values()))) if result["values"] else 0
 
 
-def _adopt(parent_pid: int) -> None:
+def _adopt(command_pid: int) -> None:
     """In a LocalCluster's worker: its own process group (a terminal's Ctrl-C reaches only
-    the command, which stops the cluster itself) and killed with the command, however it dies."""
+    the command, which stops the cluster itself) and killed with the command, however it dies:
+    its parent is the fork server (:func:`_fork_server`), which ends when the command does
+    (multiprocessing's "alive" pipe reads its end), and the worker asks for SIGKILL when its
+    parent dies; a command already gone is noticed here."""
     from ..core import lifetime
     try:
         os.setpgrp()
     except OSError:
         pass
-    lifetime.die_with_parent(parent_pid)
+    lifetime.die_with_parent(os.getppid())
+    try:
+        os.kill(command_pid, 0)
+    except ProcessLookupError:
+        os._exit(1)
+    except OSError:     # alive, owned by another user: not ours to judge
+        pass
 
 
-def _dask():
+#: the modules a LocalCluster's workers start with, per engine (:func:`cluster_ahead`): imported
+#: once, in the fork server, instead of by each worker at its first task (a loop's take about 1 s)
+WORKER_MODULES = {
+    "analytic": ("designer.tolerance.plant", "designer.tolerance.montecarlo"),
+    "spice": ("designer.tolerance.spice_mc", "designer.tolerance.montecarlo", "designer.spice.simulate"),
+    "loop": ("designer.tolerance.loop", "designer.pid.model", "designer.pid.blocks", "designer.pid.verify",
+             "designer.plant.model"),
+}
+
+
+def _fork_server(preload=()) -> None:
+    """Start multiprocessing's fork server (once per process: later calls find it running; the
+    preload is the first start's) with
+    ``distributed``, this module and ``preload`` imported in it. A LocalCluster's worker processes
+    are forked from it (``distributed.worker.multiprocessing-method: forkserver``): Dask's default,
+    spawn, starts each worker as a new interpreter that imports ``distributed`` and, at its first
+    task, the engine (about 0.6 s of a core each for the SPICE engine, 1 s for the loop's), which
+    on a machine of two cores lengthened a short run by more than a second (bench_tolerance).
+    Forking from the fork server, a process of one thread, is safe where forking this one (its
+    cluster and design threads) is not. Started from the main thread with SIGINT ignored: a
+    terminal's Ctrl-C reaches the command's process group, and the server (and the workers it
+    forks, which keep its handlers) leave stopping to the command."""
+    import signal
+    import threading
+    from multiprocessing import forkserver, get_context
+    get_context("forkserver").set_forkserver_preload(
+        ["__main__", "distributed", __name__, *preload])
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        forkserver.ensure_running()
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, previous)
+
+
+def _dask(**settings):
     """``dask.distributed``, imported (about 0.35 s), with the Monte Carlo's setting entered
     (returned: left on closing): a killed worker's task is not retried by the scheduler, the
-    runner retries it once itself. The cluster's own log lines are silenced: our one-line
-    errors say what went wrong."""
+    runner retries it once itself; and ``settings`` (more configuration). The cluster's own log
+    lines are silenced: our one-line errors say what went wrong."""
     import logging
     import warnings
     with warnings.catch_warnings():
@@ -308,18 +356,19 @@ def _dask():
         import distributed
     for name in ("distributed", "tornado", "asyncio"):
         logging.getLogger(name).setLevel(logging.CRITICAL)
-    config = dask.config.set({"distributed.scheduler.allowed-failures": 0})
+    config = dask.config.set({"distributed.scheduler.allowed-failures": 0, **settings})
     config.__enter__()
     return distributed, config
 
 
 def _local_cluster(workers: int, box: dict) -> None:
     """A LocalCluster of ``workers`` processes of one thread each and its client, into ``box``
-    (``config``, ``cluster``, ``client``, each as it is made); its workers adopted at once
-    (:func:`_adopt`). No dashboard; the scheduler's HTTP server (health routes) on a free local
-    port: its default, 8787, may be another cluster's, and taking another port prints a warning."""
+    (``config``, ``cluster``, ``client``, each as it is made); its workers forked from the fork
+    server (:func:`_fork_server`, started already) and adopted at once (:func:`_adopt`). No
+    dashboard; the scheduler's HTTP server (health routes) on a free local port: its default,
+    8787, may be another cluster's, and taking another port prints a warning."""
     import logging
-    distributed, box["config"] = _dask()
+    distributed, box["config"] = _dask(**{"distributed.worker.multiprocessing-method": "forkserver"})
     box["cluster"] = distributed.LocalCluster(
         n_workers=workers, threads_per_worker=1, processes=True, silence_logs=logging.CRITICAL,
         dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
@@ -345,12 +394,15 @@ class ClusterStart:
     """A LocalCluster of ``workers`` starting in a thread of its own (the imports, the spawned
     workers importing the package: a second or more). An interruption reaches the main thread
     only, so the cluster is never left half started: :meth:`close` waits for the start (a few
-    seconds at most) and closes what it started, unless :meth:`take` handed it over."""
+    seconds at most) and closes what it started, unless :meth:`take` handed it over. The fork
+    server its workers come from starts first, in the caller's thread, with ``preload``
+    (:data:`WORKER_MODULES`)."""
 
-    def __init__(self, workers: int):
+    def __init__(self, workers: int, preload=()):
         import threading
         self.workers = workers
         self._box = {}
+        _fork_server(preload)
         self._thread = threading.Thread(target=self._run, name="start-local-cluster", daemon=True)
         self._thread.start()
 
@@ -382,17 +434,18 @@ _ahead = None
 
 
 @contextlib.contextmanager
-def cluster_ahead(scale: Scale | None):
+def cluster_ahead(scale: Scale | None, engine: str | None = None):
     """For ``--dask local`` (``scale``; anything else: nothing), start the LocalCluster now, in
     its thread, while the command does other work (its design, its SPICE run), so that the
     Monte Carlo's :class:`Runner` finds it started (``bench_tolerance``: the start is most of
     what a LocalCluster adds to a short run). Whatever ends the block, a cluster no runner took
-    is waited for and closed."""
+    is waited for and closed. ``engine`` (a key of :data:`WORKER_MODULES`): what the workers
+    import before they start."""
     global _ahead
     if scale is None or scale.dask != "local" or _ahead is not None:
         yield
         return
-    start = _ahead = ClusterStart(scale.workers)
+    start = _ahead = ClusterStart(scale.workers, WORKER_MODULES.get(engine, ()))
     try:
         yield
     finally:

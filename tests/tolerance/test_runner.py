@@ -97,12 +97,16 @@ def inside(figs, n):
 
 
 def _children() -> set:
-    """This process's children, but multiprocessing's resource tracker (it lives as long as we do)."""
+    """This process's children, but multiprocessing's resource tracker and fork server (they live
+    as long as we do; the workers forked from the server, its children, are counted)."""
+    import os
+
     import psutil
     out = set()
     for p in psutil.Process().children(recursive=True):
         try:
-            if not any("resource_tracker" in a for a in p.cmdline()):
+            cmd = " ".join(p.cmdline())
+            if not ("resource_tracker" in cmd or ("forkserver" in cmd and p.ppid() == os.getpid())):
                 out.add(p.pid)
         except psutil.Error:   # gone meanwhile
             pass
@@ -178,6 +182,35 @@ def test_target_ci_stops_at_the_first_round_below_it(target):
     again = plant_monte_carlo(PARTS, SERIES, AMP, 200000, seed=3, limit_items=LIMITS, target_ci=target,
                               tighten=False, scale=Scale(jobs=2))
     assert again.to_dict() == mc.to_dict()
+
+
+def test_every_target_ci_round_is_split_among_the_workers(monkeypatch):
+    """--target-ci's first round (TARGET_ROUND builds of up to 10^5) was one chunk, so --jobs
+    ran it on one worker: every round is now split by its own size, and the output (the rounds'
+    ends, the samples, the section and the CSV) is the same with --jobs 1 and --jobs 2."""
+    rounds = []
+    real = runner._ProcessPool.map
+
+    def spy(self, evaluate, context, draw, tasks, bar):
+        rounds.append(list(tasks))
+        return real(self, evaluate, context, draw, tasks, bar)
+
+    monkeypatch.setattr(runner._ProcessPool, "map", spy)
+    kw = dict(seed=3, limit_items=LIMITS, target_ci=0.01, tighten=False)
+    one = plant_monte_carlo(PARTS, SERIES, AMP, 100000, **kw)
+    two = plant_monte_carlo(PARTS, SERIES, AMP, 100000, scale=Scale(jobs=2), **kw)
+    ends = two.to_dict()["settings"]["target_ci"]["rounds"]
+    assert len(ends) >= 2 and ends[0] == TARGET_ROUND
+    assert len(rounds) == len(ends)
+    done = 0
+    for tasks, end in zip(rounds, ends):
+        # each round's samples, in order, in chunks of about end - done over 8 chunks per worker
+        assert tasks[0][0] == done and tasks[-1][1] == end
+        assert all(b == c for (_, b), (c, _) in zip(tasks, tasks[1:]))
+        assert len(tasks) >= 2 * runner.CHUNKS_PER_WORKER - 1
+        done = end
+    assert one.to_dict() == two.to_dict() and one.csv_text() == two.csv_text()
+    assert_same(one.values, two.values)
 
 
 def test_target_ci_bounded_by_the_samples_asked():
