@@ -74,12 +74,14 @@ class Draw:
 @dataclass(frozen=True)
 class Scale:
     """Where the chunks run: ``jobs`` local processes, or ``dask`` (an address, or
-    ``"local"`` for a LocalCluster of ``jobs`` workers, default 2); a progress bar or not."""
+    ``"local"`` for a LocalCluster of ``jobs`` workers, default 2); a progress bar or not;
+    ``work``, what the chunks do (a key of :data:`WORKERS`: how a LocalCluster's workers start)."""
 
     jobs: int = 1
     dask: str | None = None
     progress: bool = False
     chunk: int | None = None     #: samples per chunk (None: chosen from the samples and the workers)
+    work: str | None = None      #: a key of :data:`WORKERS` (None: worker processes that import nothing ahead)
 
     @property
     def workers(self) -> int:
@@ -161,7 +163,7 @@ class Runner:
 
     def __enter__(self):
         if self.scale.dask is not None:
-            self._pool = DaskPool(self.scale.dask, self.scale.workers)
+            self._pool = DaskPool(self.scale.dask, self.scale.workers, self.scale.work)
         elif self.scale.jobs > 1:
             self._pool = _ProcessPool(self.scale.jobs)
         else:
@@ -307,13 +309,20 @@ def _adopt(command_pid: int) -> None:
         pass
 
 
-#: the modules a LocalCluster's workers start with, per engine (:func:`cluster_ahead`): imported
-#: once, in the fork server, instead of by each worker at its first task (a loop's take about 1 s)
-WORKER_MODULES = {
-    "analytic": ("designer.tolerance.plant", "designer.tolerance.montecarlo"),
-    "spice": ("designer.tolerance.spice_mc", "designer.tolerance.montecarlo", "designer.spice.simulate"),
-    "loop": ("designer.tolerance.loop", "designer.pid.model", "designer.pid.blocks", "designer.pid.verify",
-             "designer.plant.model"),
+#: A LocalCluster's workers for what the chunks do (:attr:`Scale.work`): ``threads`` (bool), and the
+#: modules worker processes start with, imported once in the fork server (:func:`_fork_server`)
+#: instead of by each worker at its first task (the loop's take about 1 s of a core). Threads of
+#: this process where a chunk's work is a subprocess (``ngspice -b``: the SPICE engine with the
+#: ngspice-cli backend; Python only writes its commands and reads its output): processes would only
+#: add their start and their messages (bench_tolerance measured 1.66x the wall of --jobs 2 with them).
+#: Processes for Python's own work (the analytic and loop engines hold the GIL) and for the shared
+#: library (ngspice's, one instance per process, not thread-safe).
+WORKERS = {
+    "analytic": (False, ("designer.tolerance.plant", "designer.tolerance.montecarlo")),
+    "loop": (False, ("designer.tolerance.loop", "designer.pid.model", "designer.pid.blocks", "designer.pid.verify",
+                     "designer.plant.model")),
+    "spice": (False, ("designer.tolerance.spice_mc", "designer.tolerance.montecarlo", "designer.spice.simulate")),
+    "ngspice-cli": (True, ()),
 }
 
 
@@ -361,19 +370,21 @@ def _dask(**settings):
     return distributed, config
 
 
-def _local_cluster(workers: int, box: dict) -> None:
-    """A LocalCluster of ``workers`` processes of one thread each and its client, into ``box``
-    (``config``, ``cluster``, ``client``, each as it is made); its workers forked from the fork
-    server (:func:`_fork_server`, started already) and adopted at once (:func:`_adopt`). No
-    dashboard; the scheduler's HTTP server (health routes) on a free local port: its default,
-    8787, may be another cluster's, and taking another port prints a warning."""
+def _local_cluster(workers: int, box: dict, threads: bool = False) -> None:
+    """A LocalCluster of ``workers`` workers of one thread each and its client, into ``box``
+    (``config``, ``cluster``, ``client``, each as it is made). The workers are processes forked
+    from the fork server (:func:`_fork_server`, started already) and adopted at once
+    (:func:`_adopt`), or with ``threads`` threads of this process. No dashboard; the scheduler's
+    HTTP server (health routes) on a free local port: its default, 8787, may be another
+    cluster's, and taking another port prints a warning."""
     import logging
     distributed, box["config"] = _dask(**{"distributed.worker.multiprocessing-method": "forkserver"})
     box["cluster"] = distributed.LocalCluster(
-        n_workers=workers, threads_per_worker=1, processes=True, silence_logs=logging.CRITICAL,
+        n_workers=workers, threads_per_worker=1, processes=not threads, silence_logs=logging.CRITICAL,
         dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
     box["client"] = distributed.Client(box["cluster"])
-    box["client"].run(_adopt, os.getpid())
+    if not threads:
+        box["client"].run(_adopt, os.getpid())
 
 
 def _close(client=None, cluster=None, config=None) -> None:
@@ -391,24 +402,26 @@ def _close(client=None, cluster=None, config=None) -> None:
 
 
 class ClusterStart:
-    """A LocalCluster of ``workers`` starting in a thread of its own (the imports, the spawned
-    workers importing the package: a second or more). An interruption reaches the main thread
-    only, so the cluster is never left half started: :meth:`close` waits for the start (a few
-    seconds at most) and closes what it started, unless :meth:`take` handed it over. The fork
-    server its workers come from starts first, in the caller's thread, with ``preload``
-    (:data:`WORKER_MODULES`)."""
+    """A LocalCluster of ``workers`` for the chunks' ``work`` (a key of :data:`WORKERS`) starting
+    in a thread of its own (importing ``distributed``, starting the scheduler and the workers:
+    about a second). An interruption reaches the main thread only, so the cluster is never left
+    half started: :meth:`close` waits for the start (a few seconds at most) and closes what it
+    started, unless :meth:`take` handed it over. For worker processes, the fork server they come
+    from starts first, in the caller's thread."""
 
-    def __init__(self, workers: int, preload=()):
+    def __init__(self, workers: int, work: str | None = None):
         import threading
-        self.workers = workers
+        self.workers, self.work = workers, work
+        self._threads, preload = WORKERS.get(work, (False, ()))
         self._box = {}
-        _fork_server(preload)
+        if not self._threads:
+            _fork_server(preload)
         self._thread = threading.Thread(target=self._run, name="start-local-cluster", daemon=True)
         self._thread.start()
 
     def _run(self):
         try:
-            _local_cluster(self.workers, self._box)
+            _local_cluster(self.workers, self._box, self._threads)
         except BaseException as exc:   # noqa: BLE001 - handed to the main thread
             self._box["error"] = exc
 
@@ -434,18 +447,17 @@ _ahead = None
 
 
 @contextlib.contextmanager
-def cluster_ahead(scale: Scale | None, engine: str | None = None):
+def cluster_ahead(scale: Scale | None):
     """For ``--dask local`` (``scale``; anything else: nothing), start the LocalCluster now, in
     its thread, while the command does other work (its design, its SPICE run), so that the
     Monte Carlo's :class:`Runner` finds it started (``bench_tolerance``: the start is most of
     what a LocalCluster adds to a short run). Whatever ends the block, a cluster no runner took
-    is waited for and closed. ``engine`` (a key of :data:`WORKER_MODULES`): what the workers
-    import before they start."""
+    is waited for and closed."""
     global _ahead
     if scale is None or scale.dask != "local" or _ahead is not None:
         yield
         return
-    start = _ahead = ClusterStart(scale.workers, WORKER_MODULES.get(engine, ()))
+    start = _ahead = ClusterStart(scale.workers, scale.work)
     try:
         yield
     finally:
@@ -453,24 +465,27 @@ def cluster_ahead(scale: Scale | None, engine: str | None = None):
         start.close()
 
 
-def _cluster_start(workers: int) -> ClusterStart:
-    """The start :func:`cluster_ahead` began for as many workers, handed over; else a new one."""
+def _cluster_start(workers: int, work: str | None = None) -> ClusterStart:
+    """The start :func:`cluster_ahead` began for as many workers and the same work, handed over;
+    else a new one."""
     global _ahead
-    start, _ahead = (_ahead, None) if _ahead is not None and _ahead.workers == workers else (None, _ahead)
-    return start or ClusterStart(workers)
+    ahead = _ahead is not None and (_ahead.workers, _ahead.work) == (workers, work)
+    start, _ahead = (_ahead, None) if ahead else (None, _ahead)
+    return start or ClusterStart(workers, work)
 
 
 class DaskPool:
     """A dask.distributed client: of a running scheduler, or of a LocalCluster started here
-    (``n_workers`` processes of one thread each), or ahead (:func:`cluster_ahead`). Imported
-    only here: ``import dask.distributed`` takes about 0.35 s."""
+    (``workers`` workers of one thread each, for the chunks' ``work``: :data:`WORKERS`), or
+    ahead (:func:`cluster_ahead`). Imported only here: ``import dask.distributed`` takes about
+    0.35 s."""
 
-    def __init__(self, address: str, workers: int):
+    def __init__(self, address: str, workers: int, work: str | None = None):
         self.cluster = self.client = None
         self.address = address
         try:
             if address == "local":
-                start = _cluster_start(workers)
+                start = _cluster_start(workers, work)
                 try:
                     self.client, self.cluster, self._config = start.take()
                 except BaseException:

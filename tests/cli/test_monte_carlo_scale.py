@@ -183,6 +183,41 @@ def test_a_stopped_run_leaves_no_process_and_no_file(tmp_path, sig, where, when)
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.json"))
 
 
+@pytest.mark.spice
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=lambda s: signal.Signals(s).name)
+def test_a_stopped_spice_run_on_thread_workers_leaves_no_process_and_no_file(tmp_path, sig):
+    """--engine spice --simulator ngspice-cli --dask local: the LocalCluster's workers are threads
+    (each chunk is an ngspice -b process); stopped while ngspice runs, the command still ends with
+    one line and its status, and no ngspice outlives it."""
+    tag = uuid.uuid4().hex
+    argv = [DESIGN_PLANT, *SEED, "--monte-carlo", "3000", "--engine", "spice", "--simulator", "ngspice-cli",
+            "--no-sim", "--dask", "local", "--out", str(tmp_path / "out")]
+    p = subprocess.Popen(argv, env=tagged_env(tag, MPLBACKEND="Agg"), stdout=subprocess.DEVNULL,
+                         stderr=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+
+    def ngspice_running():
+        for pid in processes_tagged(tag):
+            try:
+                with open(f"/proc/{pid}/cmdline", "rb") as f:
+                    if b"ngspice" in f.read():
+                        return True
+            except OSError:
+                pass
+        return False
+
+    while not ngspice_running() and time.monotonic() < deadline:
+        time.sleep(0.02)
+    time.sleep(0.5)
+    p.send_signal(sig)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 128 + sig, err
+    words = "terminated (SIGTERM)" if sig == signal.SIGTERM else "interrupted"
+    assert err.splitlines() == [f"design-plant: error: {words}"], err
+    assert wait_gone(tag, 5.0) == [], "a process outlived design-plant"
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.json"))
+
+
 def test_a_killed_cluster_run_leaves_no_process(tmp_path):
     tag = uuid.uuid4().hex
     argv = [DESIGN_PID, *PID, "--monte-carlo", "3000", "--dask", "local", "--no-files"]

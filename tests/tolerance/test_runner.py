@@ -143,6 +143,33 @@ def test_a_cluster_started_ahead_is_the_one_the_runner_takes():
     assert _gone(_children() - before) == set()
 
 
+@pytest.mark.spice
+def test_spice_chunks_of_ngspice_processes_run_on_thread_workers():
+    """The SPICE engine with ngspice-cli (each chunk an ``ngspice -b`` process): the LocalCluster's
+    workers are threads of this process (no worker process starts), with the same figures as here;
+    every other work gets worker processes."""
+    import distributed
+
+    from designer.plant.design import design_plant
+    from designer.plant.spec import PlantSpec
+    from designer.tolerance import spice_engine
+    from designer.tolerance.montecarlo import _apply, plant_parts
+    from designer.tolerance.spice_mc import spice_evaluate
+    res = design_plant(PlantSpec(fc_hz=3500, zeta=0.2), simulate=False)
+    nominal = plant_parts(res.built)
+    ctx = spice_evaluate(spice_engine.context(res.deck, res.built, res.opamp, res.test, "ngspice-cli"), res.opamp)
+    draw = Draw(nominal, {k: 0.05 for k in nominal}, 48, 2)
+    _, ref, _ = Runner().run(_apply, ctx, draw)
+    before = _children()
+    with Runner(Scale(dask="local", chunk=8, work="ngspice-cli")) as run:
+        workers = run._pool.cluster.workers.values()
+        assert len(workers) == 2 and all(isinstance(w, distributed.Worker) for w in workers)
+        _, f, _ = run.run(_apply, ctx, draw)
+        assert _children() - before == set()     # ngspice ended with each chunk; no worker process
+    assert_same(f, ref)
+    assert [w for w, (threads, _) in runner.WORKERS.items() if threads] == ["ngspice-cli"]
+
+
 @pytest.mark.parametrize("how", ["unused", "interrupted"])
 def test_a_cluster_started_ahead_and_not_taken_is_closed(how):
     """A cluster no runner took (the design failed, or Ctrl-C came while it started) is waited
