@@ -370,6 +370,19 @@ def _dask(**settings):
     return distributed, config
 
 
+#: A LocalCluster's settings: worker processes forked from the fork server (:func:`_fork_server`);
+#: no statistical profiler sampling the workers' threads every 10 ms, no system monitor polling
+#: the host every 0.5 s, the event loop's health checked every second, not 50 times: they feed
+#: a dashboard this command has none of, and took CPU from the chunks on a machine of two cores
+LOCAL_CONFIG = {
+    "distributed.worker.multiprocessing-method": "forkserver",
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.system-monitor.interval": "60s",
+    "distributed.admin.system-monitor.disk": False,
+    "distributed.admin.tick.interval": "1s",
+}
+
+
 def _local_cluster(workers: int, box: dict, threads: bool = False) -> None:
     """A LocalCluster of ``workers`` workers of one thread each and its client, into ``box``
     (``config``, ``cluster``, ``client``, each as it is made). The workers are processes forked
@@ -378,7 +391,7 @@ def _local_cluster(workers: int, box: dict, threads: bool = False) -> None:
     HTTP server (health routes) on a free local port: its default, 8787, may be another
     cluster's, and taking another port prints a warning."""
     import logging
-    distributed, box["config"] = _dask(**{"distributed.worker.multiprocessing-method": "forkserver"})
+    distributed, box["config"] = _dask(**LOCAL_CONFIG)
     box["cluster"] = distributed.LocalCluster(
         n_workers=workers, threads_per_worker=1, processes=not threads, silence_logs=logging.CRITICAL,
         dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
