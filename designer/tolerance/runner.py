@@ -320,8 +320,9 @@ def _adopt(command_pid: int) -> None:
 WORKERS = {
     "analytic": (False, ("designer.tolerance.plant", "designer.tolerance.montecarlo")),
     "loop": (False, ("designer.tolerance.loop", "designer.pid.model", "designer.pid.blocks", "designer.pid.verify",
-                     "designer.plant.model")),
-    "spice": (False, ("designer.tolerance.spice_mc", "designer.tolerance.montecarlo", "designer.spice.simulate")),
+                     "designer.plant.model", "scipy.linalg")),
+    "spice": (False, ("designer.tolerance.spice_mc", "designer.tolerance.montecarlo", "designer.spice.simulate",
+                      "designer.core.opamps")),
     "ngspice-cli": (True, ()),
 }
 

@@ -170,6 +170,14 @@ def test_spice_chunks_of_ngspice_processes_run_on_thread_workers():
     assert [w for w, (threads, _) in runner.WORKERS.items() if threads] == ["ngspice-cli"]
 
 
+def test_the_modules_worker_processes_start_with_exist():
+    """The fork server skips a module it cannot import: a misspelt name would only slow the workers."""
+    import importlib
+    for work, (_, modules) in runner.WORKERS.items():
+        for name in modules:
+            assert importlib.import_module(name), (work, name)
+
+
 @pytest.mark.parametrize("how", ["unused", "interrupted"])
 def test_a_cluster_started_ahead_and_not_taken_is_closed(how):
     """A cluster no runner took (the design failed, or Ctrl-C came while it started) is waited
