@@ -329,21 +329,25 @@ WORKERS = {
 
 def _fork_server(preload=()) -> None:
     """Start multiprocessing's fork server (once per process: later calls find it running; the
-    preload is the first start's) with
-    ``distributed``, this module and ``preload`` imported in it. A LocalCluster's worker processes
-    are forked from it (``distributed.worker.multiprocessing-method: forkserver``): Dask's default,
-    spawn, starts each worker as a new interpreter that imports ``distributed`` and, at its first
-    task, the engine (about 0.6 s of a core each for the SPICE engine, 1 s for the loop's), which
-    on a machine of two cores lengthened a short run by more than a second (bench_tolerance).
-    Forking from the fork server, a process of one thread, is safe where forking this one (its
-    cluster and design threads) is not. Started from the main thread with SIGINT ignored: a
-    terminal's Ctrl-C reaches the command's process group, and the server (and the workers it
-    forks, which keep its handlers) leave stopping to the command."""
+    preload is the first start's) with ``distributed``, this module and ``preload`` imported in
+    it. A LocalCluster's worker processes are forked from it
+    (``distributed.worker.multiprocessing-method: forkserver``): Dask's default, spawn, starts
+    each worker as a new interpreter that imports ``distributed`` and, at its first task, the
+    engine (about 0.6 s of a core each for the SPICE engine, 1 s for the loop's), which on a
+    machine of two cores lengthened a short run by more than a second (bench_tolerance). Forking
+    from the fork server, a process of one thread, is safe where forking this one (its cluster
+    and design threads) is not.
+
+    Started from the main thread with SIGINT ignored: a terminal's Ctrl-C reaches the command's
+    process group, and the server (and the workers it forks, which keep its handlers) leave
+    stopping to the command. It would end by itself when the command does, but only after
+    tearing down its imports (0.3 s), holding the command's stdout and stderr meanwhile (a
+    pipe's reader waits for it): the command kills it as it exits (:func:`_stop_fork_server`)."""
+    import atexit
     import signal
     import threading
     from multiprocessing import forkserver, get_context
-    get_context("forkserver").set_forkserver_preload(
-        ["__main__", "distributed", __name__, *preload])
+    get_context("forkserver").set_forkserver_preload(["__main__", "distributed", __name__, *preload])
     main = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:
@@ -351,6 +355,21 @@ def _fork_server(preload=()) -> None:
     finally:
         if main:
             signal.signal(signal.SIGINT, previous)
+    atexit.unregister(_stop_fork_server)
+    atexit.register(_stop_fork_server)
+
+
+def _stop_fork_server() -> None:
+    """At exit: the fork server killed (it holds nothing: its workers went with their cluster)."""
+    import signal
+    from multiprocessing import forkserver
+    pid = getattr(forkserver._forkserver, "_forkserver_pid", None)   # CPython's, since 3.4
+    if pid:
+        try:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+        except OSError:   # gone already, or reaped
+            pass
 
 
 def _dask(**settings):

@@ -223,6 +223,17 @@ def test_a_stopped_spice_run_on_thread_workers_leaves_no_process_and_no_file(tmp
     stop_when(argv, sig, _after(0.5, _ngspice_among), tmp_path / "out")
 
 
+def test_nothing_of_a_local_cluster_outlives_the_command():
+    """The fork server the workers came from is gone when the command has exited, not a moment
+    later: it held the command's stdout, so a pipe's reader (`| jq`) waited for it too."""
+    tag = uuid.uuid4().hex
+    p = subprocess.Popen([DESIGN_PID, *PID, "--monte-carlo", "100", "--dask", "local", "--no-files", "--json"],
+                         env=tagged_env(tag, MPLBACKEND="Agg"), stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL)
+    assert p.wait(timeout=300) == 0
+    assert processes_tagged(tag) == []
+
+
 def test_a_killed_cluster_run_leaves_no_process(tmp_path):
     tag = uuid.uuid4().hex
     argv = [DESIGN_PID, *PID, "--monte-carlo", "3000", "--dask", "local", "--no-files"]
