@@ -425,6 +425,12 @@ def _close(client=None, cluster=None, config=None) -> None:
     try:
         if client is not None:
             client.close(timeout=CONNECT_TIMEOUT)
+        if cluster is not None and getattr(cluster, "processes", True) is False:
+            # thread workers closed without waiting for a chunk still running (interrupted): its
+            # ngspice would hold the command up to a chunk's end (40 s for 1250 builds); at exit
+            # the thread goes with the process, and its ngspice with it (PR_SET_PDEATHSIG)
+            for worker in list(cluster.workers.values()):
+                cluster.sync(worker.close, executor_wait=False, timeout=CONNECT_TIMEOUT)
         if cluster is not None:
             cluster.close(timeout=CONNECT_TIMEOUT)
     except Exception:   # noqa: BLE001 - an interruption or another error may have brought us here: it wins
