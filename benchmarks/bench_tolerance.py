@@ -138,6 +138,8 @@ SPEEDUP_BUILDS = 600
 #: at about 4.5 ms a build, the loop engine does that work in about 4000 builds
 SPICE_SIZED_BUILDS = 4000
 REPEATS = 3
+#: interleaved runs of each whole command (a shared machine's load comes and goes: medians of more)
+WALL_REPEATS = 5
 
 
 #: SPICE builds of the in-process scale-out row (the whole-command rows' number)
@@ -241,9 +243,9 @@ def scale_out(res):
         return took, json.loads(p.stdout)["monte_carlo"]
 
     def pairs(base, n, a, b):
-        """Medians of REPEATS interleaved runs of the command with options a and b, and of their ratios b/a."""
+        """Medians of WALL_REPEATS interleaved runs of the command with options a and b, and of their ratios b/a."""
         ta, tb = [], []
-        for _ in range(REPEATS):
+        for _ in range(WALL_REPEATS):
             x, mx = wall(base, "--monte-carlo", str(n), *a)
             y, my = wall(base, "--monte-carlo", str(n), *b)
             assert mx == my, f"{' '.join(b)} gave another monte_carlo section than {' '.join(a)}"
@@ -251,8 +253,8 @@ def scale_out(res):
             tb.append(y)
         return float(np.median(ta)), float(np.median(tb)), float(np.median(np.array(tb) / np.array(ta)))
 
-    print(f"\nWhole commands (imports, design, a LocalCluster's start included), medians of {REPEATS} interleaved "
-          "runs and of their ratios:\n")
+    print(f"\nWhole commands (imports, design, a LocalCluster's start included), medians of {WALL_REPEATS} "
+          f"interleaved runs and of their ratios (load average {os.getloadavg()[0]:.1f} at the start):\n")
     print("| command | first (s) | second (s) | ratio | goal | verdict |")
     print("|---|---|---|---|---|---|")
     a, b, r = pairs(spice, 500, ["--jobs", "1"], ["--jobs", "2"])
@@ -268,9 +270,11 @@ def scale_out(res):
     print(f"\nThe monte_carlo sections were identical in every pair. Load average {os.getloadavg()[0]:.1f} on "
           f"{os.cpu_count()} cores at the end (the machine is shared with other jobs; a speed-up needs a free "
           "second core). A whole command's imports and design run on one core whatever --jobs, so its speed-up "
-          "stays below the Monte Carlo's. A LocalCluster's start (two workers spawned, each importing the package: "
-          "a second or more) starts with the command, beside its design; what is left of it is what --dask local "
-          "adds to short runs.")
+          "stays below the Monte Carlo's. A LocalCluster starts with the command, beside its design (importing "
+          "distributed, about 0.5 s of a core, is most of it); its workers are threads of the command for the "
+          "SPICE engine with ngspice-cli (each chunk is an ngspice process), and processes forked from a fork "
+          "server that imported distributed and the engine once for the loop; what is left of the start is what "
+          "--dask local adds to short runs.")
 
 
 SPICE_BUILDS = 400

@@ -119,7 +119,17 @@ def scale_settings(args):
         tty = sys.stderr.isatty()
     except (AttributeError, ValueError):
         tty = False
-    return Scale(jobs=jobs, dask=dask, progress=tty and not getattr(args, "json", False)), target
+    return Scale(jobs=jobs, dask=dask, progress=tty and not getattr(args, "json", False), work=_work(args)), target
+
+
+def _work(args) -> str:
+    """What the Monte Carlo's chunks do (:data:`designer.tolerance.runner.WORKERS`: how a LocalCluster's
+    workers start): the plant's commands have --engine; the PID commands' Monte Carlo is the loop's."""
+    engine = getattr(args, "engine", None)
+    if engine is None or engine == "analytic":
+        return engine or "loop"
+    from ..spice.simulate import get_simulator
+    return "ngspice-cli" if get_simulator(args.simulator).name == "ngspice-cli" else "spice"
 
 
 def cluster_ahead(args):

@@ -302,9 +302,17 @@ def _analyse(seed, sampler, dist, tol, nominal, values, figs, limits, figure_of,
     return mc
 
 
+#: builds up to which the tightening's runs (the analytic model, vectorised: 20000 builds in about
+#: 0.1 s) stay in this process: a pool's round trips (forks, a cluster's tasks) cost more than them
+TIGHTEN_HERE = 20000
+
+
 def _tighten(run, mc: MonteCarlo, opamp, n_max: int) -> dict:
     """The part whose tolerance halved raises the yield most (the same samples' deviations, each
-    part's halved in turn), and the yield it gives."""
+    part's halved in turn), and the yield it gives (on ``run``'s workers, or here for a few builds:
+    the same figures either way)."""
+    if mc.n <= TIGHTEN_HERE:
+        run = runner.Runner()
     best = None
     for ref, t in mc.tolerances.of.items():
         draw = runner.Draw(mc.nominal, dict(mc.tolerances.of, **{ref: t / 2}), n_max, mc.seed, mc.sampler, mc.dist)

@@ -74,12 +74,14 @@ class Draw:
 @dataclass(frozen=True)
 class Scale:
     """Where the chunks run: ``jobs`` local processes, or ``dask`` (an address, or
-    ``"local"`` for a LocalCluster of ``jobs`` workers, default 2); a progress bar or not."""
+    ``"local"`` for a LocalCluster of ``jobs`` workers, default 2); a progress bar or not;
+    ``work``, what the chunks do (a key of :data:`WORKERS`: how a LocalCluster's workers start)."""
 
     jobs: int = 1
     dask: str | None = None
     progress: bool = False
     chunk: int | None = None     #: samples per chunk (None: chosen from the samples and the workers)
+    work: str | None = None      #: a key of :data:`WORKERS` (None: worker processes that import nothing ahead)
 
     @property
     def workers(self) -> int:
@@ -161,7 +163,7 @@ class Runner:
 
     def __enter__(self):
         if self.scale.dask is not None:
-            self._pool = DaskPool(self.scale.dask, self.scale.workers)
+            self._pool = DaskPool(self.scale.dask, self.scale.workers, self.scale.work)
         elif self.scale.jobs > 1:
             self._pool = _ProcessPool(self.scale.jobs)
         else:
@@ -199,12 +201,15 @@ class Runner:
             with self:
                 return self.run(evaluate, context, draw, n, until, progress)
         total = draw.n if n is None else n
-        size = self.scale.chunk_size(draw.n if until is not None else total)
         bar = _progress(draw.n if until is not None else total,
                         self.scale.progress if progress is None else progress)
         parts, ends, done = [], [], 0
         try:
             while True:
+                # each round split for the workers by its own size (a --target-ci round of 500 of
+                # 10^5 builds is as many chunks as a whole run of 500): the samples are the same
+                # whatever the chunking, only the split changes
+                size = self.scale.chunk_size(total - done)
                 tasks = [(a, min(a + size, total)) for a in range(done, total, size)]
                 parts += self._pool.map(evaluate, context, draw, tasks, bar)
                 done = total
@@ -284,22 +289,94 @@ def result_size(result: dict) -> int:
     return len(next(iter(result["values"].values()))) if result["values"] else 0
 
 
-def _adopt(parent_pid: int) -> None:
+def _adopt(command_pid: int) -> None:
     """In a LocalCluster's worker: its own process group (a terminal's Ctrl-C reaches only
-    the command, which stops the cluster itself) and killed with the command, however it dies."""
+    the command, which stops the cluster itself) and killed with the command, however it dies:
+    its parent is the fork server (:func:`_fork_server`), which ends when the command does
+    (multiprocessing's "alive" pipe reads its end), and the worker asks for SIGKILL when its
+    parent dies; a command already gone is noticed here."""
     from ..core import lifetime
     try:
         os.setpgrp()
     except OSError:
         pass
-    lifetime.die_with_parent(parent_pid)
+    lifetime.die_with_parent(os.getppid())
+    try:
+        os.kill(command_pid, 0)
+    except ProcessLookupError:
+        os._exit(1)
+    except OSError:     # alive, owned by another user: not ours to judge
+        pass
 
 
-def _dask():
+#: A LocalCluster's workers for what the chunks do (:attr:`Scale.work`): ``threads`` (bool), and the
+#: modules worker processes start with, imported once in the fork server (:func:`_fork_server`)
+#: instead of by each worker at its first task (the loop's take about 1 s of a core). Threads of
+#: this process where a chunk's work is a subprocess (``ngspice -b``: the SPICE engine with the
+#: ngspice-cli backend; Python only writes its commands and reads its output): processes would only
+#: add their start and their messages (bench_tolerance measured 1.66x the wall of --jobs 2 with them).
+#: Processes for Python's own work (the analytic and loop engines hold the GIL) and for the shared
+#: library (ngspice's, one instance per process, not thread-safe).
+WORKERS = {
+    "analytic": (False, ("designer.tolerance.plant", "designer.tolerance.montecarlo")),
+    "loop": (False, ("designer.tolerance.loop", "designer.pid.model", "designer.pid.blocks", "designer.pid.verify",
+                     "designer.plant.model", "scipy.linalg")),
+    "spice": (False, ("designer.tolerance.spice_mc", "designer.tolerance.montecarlo", "designer.spice.simulate",
+                      "designer.core.opamps")),
+    "ngspice-cli": (True, ()),
+}
+
+
+def _fork_server(preload=()) -> None:
+    """Start multiprocessing's fork server (once per process: later calls find it running; the
+    preload is the first start's) with ``distributed``, this module and ``preload`` imported in
+    it. A LocalCluster's worker processes are forked from it
+    (``distributed.worker.multiprocessing-method: forkserver``): Dask's default, spawn, starts
+    each worker as a new interpreter that imports ``distributed`` and, at its first task, the
+    engine (about 0.6 s of a core each for the SPICE engine, 1 s for the loop's), which on a
+    machine of two cores lengthened a short run by more than a second (bench_tolerance). Forking
+    from the fork server, a process of one thread, is safe where forking this one (its cluster
+    and design threads) is not.
+
+    Started from the main thread with SIGINT ignored: a terminal's Ctrl-C reaches the command's
+    process group, and the server (and the workers it forks, which keep its handlers) leave
+    stopping to the command. It would end by itself when the command does, but only after
+    tearing down its imports (0.3 s), holding the command's stdout and stderr meanwhile (a
+    pipe's reader waits for it): the command kills it as it exits (:func:`_stop_fork_server`)."""
+    import atexit
+    import signal
+    import threading
+    from multiprocessing import forkserver, get_context
+    get_context("forkserver").set_forkserver_preload(["__main__", "distributed", __name__, *preload])
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        forkserver.ensure_running()
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, previous)
+    atexit.unregister(_stop_fork_server)
+    atexit.register(_stop_fork_server)
+
+
+def _stop_fork_server() -> None:
+    """At exit: the fork server killed (it holds nothing: its workers went with their cluster)."""
+    import signal
+    from multiprocessing import forkserver
+    pid = getattr(forkserver._forkserver, "_forkserver_pid", None)   # CPython's, since 3.4
+    if pid:
+        try:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+        except OSError:   # gone already, or reaped
+            pass
+
+
+def _dask(**settings):
     """``dask.distributed``, imported (about 0.35 s), with the Monte Carlo's setting entered
     (returned: left on closing): a killed worker's task is not retried by the scheduler, the
-    runner retries it once itself. The cluster's own log lines are silenced: our one-line
-    errors say what went wrong."""
+    runner retries it once itself; and ``settings`` (more configuration). The cluster's own log
+    lines are silenced: our one-line errors say what went wrong."""
     import logging
     import warnings
     with warnings.catch_warnings():
@@ -308,23 +385,39 @@ def _dask():
         import distributed
     for name in ("distributed", "tornado", "asyncio"):
         logging.getLogger(name).setLevel(logging.CRITICAL)
-    config = dask.config.set({"distributed.scheduler.allowed-failures": 0})
+    config = dask.config.set({"distributed.scheduler.allowed-failures": 0, **settings})
     config.__enter__()
     return distributed, config
 
 
-def _local_cluster(workers: int, box: dict) -> None:
-    """A LocalCluster of ``workers`` processes of one thread each and its client, into ``box``
-    (``config``, ``cluster``, ``client``, each as it is made); its workers adopted at once
-    (:func:`_adopt`). No dashboard; the scheduler's HTTP server (health routes) on a free local
-    port: its default, 8787, may be another cluster's, and taking another port prints a warning."""
+#: A LocalCluster's settings: worker processes forked from the fork server (:func:`_fork_server`);
+#: no statistical profiler sampling the workers' threads every 10 ms, no system monitor polling
+#: the host every 0.5 s, the event loop's health checked every second, not 50 times: they feed
+#: a dashboard this command has none of, and took CPU from the chunks on a machine of two cores
+LOCAL_CONFIG = {
+    "distributed.worker.multiprocessing-method": "forkserver",
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.system-monitor.interval": "60s",
+    "distributed.admin.system-monitor.disk": False,
+    "distributed.admin.tick.interval": "1s",
+}
+
+
+def _local_cluster(workers: int, box: dict, threads: bool = False) -> None:
+    """A LocalCluster of ``workers`` workers of one thread each and its client, into ``box``
+    (``config``, ``cluster``, ``client``, each as it is made). The workers are processes forked
+    from the fork server (:func:`_fork_server`, started already) and adopted at once
+    (:func:`_adopt`), or with ``threads`` threads of this process. No dashboard; the scheduler's
+    HTTP server (health routes) on a free local port: its default, 8787, may be another
+    cluster's, and taking another port prints a warning."""
     import logging
-    distributed, box["config"] = _dask()
+    distributed, box["config"] = _dask(**LOCAL_CONFIG)
     box["cluster"] = distributed.LocalCluster(
-        n_workers=workers, threads_per_worker=1, processes=True, silence_logs=logging.CRITICAL,
+        n_workers=workers, threads_per_worker=1, processes=not threads, silence_logs=logging.CRITICAL,
         dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
     box["client"] = distributed.Client(box["cluster"])
-    box["client"].run(_adopt, os.getpid())
+    if not threads:
+        box["client"].run(_adopt, os.getpid())
 
 
 def _close(client=None, cluster=None, config=None) -> None:
@@ -332,6 +425,12 @@ def _close(client=None, cluster=None, config=None) -> None:
     try:
         if client is not None:
             client.close(timeout=CONNECT_TIMEOUT)
+        if cluster is not None and getattr(cluster, "processes", True) is False:
+            # thread workers closed without waiting for a chunk still running (interrupted): its
+            # ngspice would hold the command up to a chunk's end (40 s for 1250 builds); at exit
+            # the thread goes with the process, and its ngspice with it (PR_SET_PDEATHSIG)
+            for worker in list(cluster.workers.values()):
+                cluster.sync(worker.close, executor_wait=False, timeout=CONNECT_TIMEOUT)
         if cluster is not None:
             cluster.close(timeout=CONNECT_TIMEOUT)
     except Exception:   # noqa: BLE001 - an interruption or another error may have brought us here: it wins
@@ -342,21 +441,26 @@ def _close(client=None, cluster=None, config=None) -> None:
 
 
 class ClusterStart:
-    """A LocalCluster of ``workers`` starting in a thread of its own (the imports, the spawned
-    workers importing the package: a second or more). An interruption reaches the main thread
-    only, so the cluster is never left half started: :meth:`close` waits for the start (a few
-    seconds at most) and closes what it started, unless :meth:`take` handed it over."""
+    """A LocalCluster of ``workers`` for the chunks' ``work`` (a key of :data:`WORKERS`) starting
+    in a thread of its own (importing ``distributed``, starting the scheduler and the workers:
+    about a second). An interruption reaches the main thread only, so the cluster is never left
+    half started: :meth:`close` waits for the start (a few seconds at most) and closes what it
+    started, unless :meth:`take` handed it over. For worker processes, the fork server they come
+    from starts first, in the caller's thread."""
 
-    def __init__(self, workers: int):
+    def __init__(self, workers: int, work: str | None = None):
         import threading
-        self.workers = workers
+        self.workers, self.work = workers, work
+        self._threads, preload = WORKERS.get(work, (False, ()))
         self._box = {}
+        if not self._threads:
+            _fork_server(preload)
         self._thread = threading.Thread(target=self._run, name="start-local-cluster", daemon=True)
         self._thread.start()
 
     def _run(self):
         try:
-            _local_cluster(self.workers, self._box)
+            _local_cluster(self.workers, self._box, self._threads)
         except BaseException as exc:   # noqa: BLE001 - handed to the main thread
             self._box["error"] = exc
 
@@ -392,7 +496,7 @@ def cluster_ahead(scale: Scale | None):
     if scale is None or scale.dask != "local" or _ahead is not None:
         yield
         return
-    start = _ahead = ClusterStart(scale.workers)
+    start = _ahead = ClusterStart(scale.workers, scale.work)
     try:
         yield
     finally:
@@ -400,24 +504,27 @@ def cluster_ahead(scale: Scale | None):
         start.close()
 
 
-def _cluster_start(workers: int) -> ClusterStart:
-    """The start :func:`cluster_ahead` began for as many workers, handed over; else a new one."""
+def _cluster_start(workers: int, work: str | None = None) -> ClusterStart:
+    """The start :func:`cluster_ahead` began for as many workers and the same work, handed over;
+    else a new one."""
     global _ahead
-    start, _ahead = (_ahead, None) if _ahead is not None and _ahead.workers == workers else (None, _ahead)
-    return start or ClusterStart(workers)
+    ahead = _ahead is not None and (_ahead.workers, _ahead.work) == (workers, work)
+    start, _ahead = (_ahead, None) if ahead else (None, _ahead)
+    return start or ClusterStart(workers, work)
 
 
 class DaskPool:
     """A dask.distributed client: of a running scheduler, or of a LocalCluster started here
-    (``n_workers`` processes of one thread each), or ahead (:func:`cluster_ahead`). Imported
-    only here: ``import dask.distributed`` takes about 0.35 s."""
+    (``workers`` workers of one thread each, for the chunks' ``work``: :data:`WORKERS`), or
+    ahead (:func:`cluster_ahead`). Imported only here: ``import dask.distributed`` takes about
+    0.35 s."""
 
-    def __init__(self, address: str, workers: int):
+    def __init__(self, address: str, workers: int, work: str | None = None):
         self.cluster = self.client = None
         self.address = address
         try:
             if address == "local":
-                start = _cluster_start(workers)
+                start = _cluster_start(workers, work)
                 try:
                     self.client, self.cluster, self._config = start.take()
                 except BaseException:

@@ -161,26 +161,80 @@ def test_target_ci_from_the_command_line():
     assert (hi - lo) / 2 < 0.02
 
 
+def stop_when(argv, sig, ready, out, within: float = 60) -> None:
+    """Start ``argv`` (tagged), send it ``sig`` once ``ready(tagged pids)``; it ends (within
+    ``within`` seconds) with its one line and 128 + sig, leaves no process and no result.json
+    under ``out``."""
+    tag = uuid.uuid4().hex
+    p = subprocess.Popen(argv, env=tagged_env(tag, MPLBACKEND="Agg"), stdout=subprocess.DEVNULL,
+                         stderr=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    while not ready(processes_tagged(tag)) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    p.send_signal(sig)
+    _, err = p.communicate(timeout=within)
+    assert p.returncode == 128 + sig, err
+    words = "terminated (SIGTERM)" if sig == signal.SIGTERM else "interrupted"
+    prog = os.path.basename(argv[0])
+    assert err.splitlines() == [f"{prog}: error: {words}"], err
+    assert wait_gone(tag, 5.0) == [], f"a process outlived {prog}"
+    assert not out.exists() or not any(out.rglob("*.json"))
+
+
+def _after(seconds: float, ready):
+    """``ready``, then ``seconds`` more."""
+    since = []
+
+    def check(pids):
+        if not since and ready(pids):
+            since.append(time.monotonic())
+        return bool(since) and time.monotonic() - since[0] >= seconds
+    return check
+
+
 @pytest.mark.parametrize("where, when", [("--dask local", "starting"), ("--dask local", "working"),
                                          ("--jobs 2", "working")])
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=lambda s: signal.Signals(s).name)
 def test_a_stopped_run_leaves_no_process_and_no_file(tmp_path, sig, where, when):
-    tag = uuid.uuid4().hex
     argv = [DESIGN_PID, *PID, "--monte-carlo", "3000", *where.split(), "--out", str(tmp_path / "out")]
-    p = subprocess.Popen(argv, env=tagged_env(tag, MPLBACKEND="Agg"), stdout=subprocess.DEVNULL,
-                         stderr=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
-    deadline = time.monotonic() + 60
     # starting: as the first worker process appears; working: the command and two workers, a second later
-    while len(processes_tagged(tag)) < (2 if when == "starting" else 3) and time.monotonic() < deadline:
-        time.sleep(0.02)
-    time.sleep(0.0 if when == "starting" else 1.0)
-    p.send_signal(sig)
-    _, err = p.communicate(timeout=60)
-    assert p.returncode == 128 + sig, err
-    words = "terminated (SIGTERM)" if sig == signal.SIGTERM else "interrupted"
-    assert err.splitlines() == [f"design-pid: error: {words}"], err
-    assert wait_gone(tag, 5.0) == [], "a worker outlived design-pid"
-    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.json"))
+    stop_when(argv, sig, _after(0.0 if when == "starting" else 1.0,
+                                lambda pids: len(pids) >= (2 if when == "starting" else 3)), tmp_path / "out")
+
+
+def _ngspice_among(pids) -> bool:
+    """An ``ngspice`` program among ``pids`` (the command's own arguments name ngspice-cli)."""
+    for pid in pids:
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as f:
+                if os.path.basename(f.read().split(b"\0")[0]) == b"ngspice":
+                    return True
+        except OSError:   # gone meanwhile
+            pass
+    return False
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=lambda s: signal.Signals(s).name)
+def test_a_stopped_spice_run_on_thread_workers_leaves_no_process_and_no_file(tmp_path, sig):
+    """--engine spice --simulator ngspice-cli --dask local: the LocalCluster's workers are threads
+    (each chunk is an ngspice -b process); stopped while ngspice runs, the command still ends at
+    once with one line and its status, not when the running chunks would (1250 builds each here,
+    half a minute), and no ngspice outlives it."""
+    argv = [DESIGN_PLANT, *SEED, "--monte-carlo", "20000", "--engine", "spice", "--simulator", "ngspice-cli",
+            "--no-sim", "--dask", "local", "--out", str(tmp_path / "out")]
+    stop_when(argv, sig, _after(0.5, _ngspice_among), tmp_path / "out", within=15)
+
+
+def test_nothing_of_a_local_cluster_outlives_the_command():
+    """The fork server the workers came from is gone when the command has exited, not a moment
+    later: it held the command's stdout, so a pipe's reader (`| jq`) waited for it too."""
+    tag = uuid.uuid4().hex
+    p = subprocess.Popen([DESIGN_PID, *PID, "--monte-carlo", "100", "--dask", "local", "--no-files", "--json"],
+                         env=tagged_env(tag, MPLBACKEND="Agg"), stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL)
+    assert p.wait(timeout=300) == 0
+    assert processes_tagged(tag) == []
 
 
 def test_a_killed_cluster_run_leaves_no_process(tmp_path):

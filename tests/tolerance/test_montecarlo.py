@@ -96,3 +96,25 @@ def test_the_opamps_gain_bandwidth_spreads_when_asked():
     assert spread.stats["fn_hz"].std > fixed.stats["fn_hz"].std
     with pytest.raises(DesignError, match="ideal op-amp"):
         plant_monte_carlo(PARTS, SERIES, opamps.get("ideal"), 100, tol_items=["GBW=30%"])
+
+
+def test_the_tightening_here_or_on_the_workers_gives_the_same_part_and_yield(monkeypatch):
+    """A few builds' tightening runs (the analytic model, four parts) stay in this process: the
+    pool sees the Monte Carlo's run only; on the workers they give the same section."""
+    from designer.tolerance import montecarlo, runner
+    calls = []
+    real = runner._ProcessPool.map
+
+    def spy(self, *a):
+        calls.append(len(a[3]))
+        return real(self, *a)
+
+    monkeypatch.setattr(runner._ProcessPool, "map", spy)
+    amp = opamps.get("LM741")
+    scale = runner.Scale(jobs=2, chunk=128)
+    here = plant_monte_carlo(PARTS, SERIES, amp, 2000, seed=5, limit_items=LIMITS, scale=scale)
+    assert len(calls) == 1 and here.tighten["part"] in ("R1", "R2", "C1", "C2")
+    monkeypatch.setattr(montecarlo, "TIGHTEN_HERE", 0)
+    there = plant_monte_carlo(PARTS, SERIES, amp, 2000, seed=5, limit_items=LIMITS, scale=scale)
+    assert len(calls) == 1 + 1 + 4
+    assert there.to_dict() == here.to_dict()

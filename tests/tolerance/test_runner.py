@@ -97,12 +97,16 @@ def inside(figs, n):
 
 
 def _children() -> set:
-    """This process's children, but multiprocessing's resource tracker (it lives as long as we do)."""
+    """This process's children, but multiprocessing's resource tracker and fork server (they live
+    as long as we do; the workers forked from the server, its children, are counted)."""
+    import os
+
     import psutil
     out = set()
     for p in psutil.Process().children(recursive=True):
         try:
-            if not any("resource_tracker" in a for a in p.cmdline()):
+            cmd = " ".join(p.cmdline())
+            if not ("resource_tracker" in cmd or ("forkserver" in cmd and p.ppid() == os.getpid())):
                 out.add(p.pid)
         except psutil.Error:   # gone meanwhile
             pass
@@ -137,6 +141,41 @@ def test_a_cluster_started_ahead_is_the_one_the_runner_takes():
             _, f, _ = run.run(plant.evaluate, AMP, draw)
     assert_same(f, ref)
     assert _gone(_children() - before) == set()
+
+
+@pytest.mark.spice
+def test_spice_chunks_of_ngspice_processes_run_on_thread_workers():
+    """The SPICE engine with ngspice-cli (each chunk an ``ngspice -b`` process): the LocalCluster's
+    workers are threads of this process (no worker process starts), with the same figures as here;
+    every other work gets worker processes."""
+    import distributed
+
+    from designer.plant.design import design_plant
+    from designer.plant.spec import PlantSpec
+    from designer.tolerance import spice_engine
+    from designer.tolerance.montecarlo import _apply, plant_parts
+    from designer.tolerance.spice_mc import spice_evaluate
+    res = design_plant(PlantSpec(fc_hz=3500, zeta=0.2), simulate=False)
+    nominal = plant_parts(res.built)
+    ctx = spice_evaluate(spice_engine.context(res.deck, res.built, res.opamp, res.test, "ngspice-cli"), res.opamp)
+    draw = Draw(nominal, {k: 0.05 for k in nominal}, 48, 2)
+    _, ref, _ = Runner().run(_apply, ctx, draw)
+    before = _children()
+    with Runner(Scale(dask="local", chunk=8, work="ngspice-cli")) as run:
+        workers = run._pool.cluster.workers.values()
+        assert len(workers) == 2 and all(isinstance(w, distributed.Worker) for w in workers)
+        _, f, _ = run.run(_apply, ctx, draw)
+        assert _children() - before == set()     # ngspice ended with each chunk; no worker process
+    assert_same(f, ref)
+    assert [w for w, (threads, _) in runner.WORKERS.items() if threads] == ["ngspice-cli"]
+
+
+def test_the_modules_worker_processes_start_with_exist():
+    """The fork server skips a module it cannot import: a misspelt name would only slow the workers."""
+    import importlib
+    for work, (_, modules) in runner.WORKERS.items():
+        for name in modules:
+            assert importlib.import_module(name), (work, name)
 
 
 @pytest.mark.parametrize("how", ["unused", "interrupted"])
@@ -178,6 +217,35 @@ def test_target_ci_stops_at_the_first_round_below_it(target):
     again = plant_monte_carlo(PARTS, SERIES, AMP, 200000, seed=3, limit_items=LIMITS, target_ci=target,
                               tighten=False, scale=Scale(jobs=2))
     assert again.to_dict() == mc.to_dict()
+
+
+def test_every_target_ci_round_is_split_among_the_workers(monkeypatch):
+    """--target-ci's first round (TARGET_ROUND builds of up to 10^5) was one chunk, so --jobs
+    ran it on one worker: every round is now split by its own size, and the output (the rounds'
+    ends, the samples, the section and the CSV) is the same with --jobs 1 and --jobs 2."""
+    rounds = []
+    real = runner._ProcessPool.map
+
+    def spy(self, evaluate, context, draw, tasks, bar):
+        rounds.append(list(tasks))
+        return real(self, evaluate, context, draw, tasks, bar)
+
+    monkeypatch.setattr(runner._ProcessPool, "map", spy)
+    kw = dict(seed=3, limit_items=LIMITS, target_ci=0.01, tighten=False)
+    one = plant_monte_carlo(PARTS, SERIES, AMP, 100000, **kw)
+    two = plant_monte_carlo(PARTS, SERIES, AMP, 100000, scale=Scale(jobs=2), **kw)
+    ends = two.to_dict()["settings"]["target_ci"]["rounds"]
+    assert len(ends) >= 2 and ends[0] == TARGET_ROUND
+    assert len(rounds) == len(ends)
+    done = 0
+    for tasks, end in zip(rounds, ends):
+        # each round's samples, in order, in chunks of about end - done over 8 chunks per worker
+        assert tasks[0][0] == done and tasks[-1][1] == end
+        assert all(b == c for (_, b), (c, _) in zip(tasks, tasks[1:]))
+        assert len(tasks) >= 2 * runner.CHUNKS_PER_WORKER - 1
+        done = end
+    assert one.to_dict() == two.to_dict() and one.csv_text() == two.csv_text()
+    assert_same(one.values, two.values)
 
 
 def test_target_ci_bounded_by_the_samples_asked():
