@@ -253,7 +253,7 @@ def engine_of(result) -> tuple:
 
 def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str = "random", dist: str = "uniform",
                      tol_items=(), limit_items=(), tighten: bool = True, scale=None, target_ci: float | None = None,
-                     engine=None):
+                     engine=None, tighten_with=None):
     """A Monte Carlo of a design-pid result's loop: the probabilities of instability, of
     saturation and of failing the slew check with their Wilson intervals, the statistics of every figure and, with
     ``limit_items`` (``--limit`` texts such as ``phase_margin_deg=45:90``), the yield with its
@@ -266,7 +266,9 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
     (:func:`designer.tolerance.montecarlo.target_plan`; needs limits). ``engine``: (name, chunk
     function, context) of another engine than the analytic one (the SPICE engine's,
     :mod:`designer.tolerance.spice_loop`, whose figures include the analytic ones); the part to
-    tighten is then searched with it too.
+    tighten is then searched with it too, unless ``tighten_with`` (chunk function, context,
+    limits) names another (the analytic engine with the model's limits: ``yield_now`` is then
+    theirs, counted on the engine's figures, which must include them).
 
     Returns a :class:`LoopMonteCarlo`."""
     from .montecarlo import MAX_SAMPLES, MIN_SAMPLES, target_plan
@@ -306,16 +308,17 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
         if tighten and limits and mc.yield_count < n:
             weight = {r: sum(shares[k][r] for k in by_fig) for r in tol.of}
             tried = sorted(tol.of, key=lambda r: -weight[r])[:TIGHTEN_CANDIDATES]
+            t_fn, t_ctx, t_lim = tighten_with or (chunk_fn, context, limits)
             best = None
             for ref in tried:
                 halved = dict(tol.of, **{ref: tol.of[ref] / 2})
-                _, f, _ = run.run(chunk_fn, context, Draw(nominal, halved, n_max, seed, sampler, dist), n,
+                _, f, _ = run.run(t_fn, t_ctx, Draw(nominal, halved, n_max, seed, sampler, dist), n,
                                   progress=False)
-                y = float(np.mean(_passed(f, limits)))
+                y = float(np.mean(_passed(f, t_lim)))
                 if best is None or y > best[1]:
                     best = (ref, y)
             mc.tighten = {"part": best[0], "tolerance_pct": 100 * tol.of[best[0]] / 2, "yield": best[1],
-                          "yield_now": mc.yield_count / n, "tried": tried}
+                          "yield_now": float(np.mean(_passed(figs, t_lim))), "tried": tried}
     return mc
 
 
