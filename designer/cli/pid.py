@@ -10,6 +10,7 @@ from ..core.errors import DesignError
 from ..core.ranges import help_range
 from . import common
 from .common import add_opamp_option, add_output_options, add_part_options, emit
+from .pid_tolerance import add_monte_carlo, loop_monte_carlo, monte_carlo_settings, replay, replay_name
 from .plant import cluster_ahead
 
 EPILOG = """examples:
@@ -93,48 +94,8 @@ def _parser():
     _add_signal_options(p)
     _add_capture_options(p)
     add_output_options(p, "pid_<tuning>_<opamp>_fn<fn>_z<zeta>")
-    _add_monte_carlo(p)
+    add_monte_carlo(p)
     return p
-
-
-#: the controller's parts a --tol may name
-CONTROLLER_PARTS = (*(f"R{i}" for i in range(3, 19)), "C3", "C4")
-#: the loop's parts a --tol may name: the plant's and the controller's
-LOOP_PARTS = ("R1", "R2", "C1", "C2", *CONTROLLER_PARTS)
-
-
-def _add_monte_carlo(p):
-    from ..tolerance.loop import LIMITABLE
-    from .plant import add_monte_carlo_options
-    g = add_monte_carlo_options(p, "the probability that the loop is unstable or an op-amp leaves its swing, with "
-                                   "95 %% intervals, the spread of its gains, margins and step figures, the yield "
-                                   "within --limit and the part to buy tighter (a Sallen-Key plant; its parts and "
-                                   "the controller's vary together)")
-    g.add_argument("--limit", action="append", metavar="FIGURE=MIN:MAX",
-                   help="the window the yield counts (repeatable, both bounds, engineering notation): "
-                        "phase_margin_deg=45:90, model_overshoot_pct=0:15; a build counts when its loop is stable "
-                        "and inside every window; figures (check-design's names) " + ", ".join(LIMITABLE)
-                        + " (overshoot_pct, peak_time_s, rise_time_s, settling_time_s: the analytic loop's stand in)")
-    g.add_argument("--worst-case", action="store_true",
-                   help="the extremes of phase_margin_deg, gain_margin_db, model_overshoot_pct (and every --limit "
-                        "figure) over the tolerance box: each part alone at +-tol, the corners its slopes point to, "
-                        "then a bounded search (22 parts: 4 million corners are too many); adds worst_case to "
-                        "result.json (about a minute)")
-
-
-def _loop_monte_carlo(result, args, settings):
-    """The loop's tolerance analysis (--monte-carlo, --worst-case), attached to the result."""
-    from ..tolerance.loop import loop_monte_carlo, loop_series, loop_worst_case
-    if args.worst_case:
-        result.worst_case = loop_worst_case(result, loop_series(result), args.tol or (), args.limit or ())
-    if settings is None:
-        return result
-    n, seed = settings
-    from .plant import scale_settings
-    scale, target = scale_settings(args)
-    result.monte_carlo = loop_monte_carlo(result, loop_series(result), n, seed, args.sampler, args.dist,
-                                          args.tol or (), args.limit or (), scale=scale, target_ci=target)
-    return result
 
 
 def _add_model_tuning_options(t):
@@ -299,39 +260,38 @@ def _model_name(spec, method: str) -> str:
     return f"pid_{method}_{spec.opamp.lower()}_{spec.process.kind}"
 
 
-def _monte_carlo_settings(args, spec):
-    from ..tolerance.loop import parse_loop_limit
-    from .plant import monte_carlo_settings
-    # a model plant's parameters stay as identified: only the controller's parts vary
-    settings = monte_carlo_settings(args, LOOP_PARTS if spec.process is None else CONTROLLER_PARTS, parse_loop_limit)
-    if args.tol:      # the op-amps' spread (GBW, SR): the ideal op-amp has none, refused before any work
-        from ..core import opamps
-        from ..tolerance.parts import opamp_nominal
-        opamp_nominal(args.tol, opamps.get(spec.opamp))
-    return settings
-
-
 def _run(args) -> int:
     from ..pid.design import design_pid
     from ..pid.report import summary_text, write_outputs
     spec = _build_spec(args)
-    mc = _monte_carlo_settings(args, spec)
+    mc, spice = monte_carlo_settings(args, spec)
     if spec.process is not None:
         from ..pid.process_report import summary_text as model_text, write_outputs as model_write
-        common.check_output(args, args.name if args.name is not None else "pid_model")
+        common.check_output(args, replay_name(args.name if args.name is not None else "pid_model", spice))
+        if spice[2] is not None:    # the design is the draw's nominal; the build's own run is the simulation
+            result = design_pid(spec, simulate=False, simulator=args.simulator)
+            name = args.name or _model_name(spec, result.method)
+            return emit(replay(spec, result, args, mc, spice), args, replay_name(name, spice), model_write,
+                        model_text)
         from ..pid.process_report import draw_early
         early = []   # the pictures that need no SPICE, drawn in the renderer while ngspice runs
         with cluster_ahead(args):
             result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator,
                                 rules_spice=args.rules_spice,
                                 before_spice=None if args.no_files else lambda r: early.append(draw_early(r)))
-            result = _loop_monte_carlo(result, args, mc)
+            result = loop_monte_carlo(result, args, mc, spice)
         return emit(result, args, args.name or _model_name(spec, result.method),
                     lambda *a: model_write(*a, early=early[0] if early else None), model_text)
     # the default name needs the plant as built; its fixed start stands in for it in the check
-    common.check_output(args, args.name if args.name is not None else f"pid_{spec.method}")
+    common.check_output(args, replay_name(args.name if args.name is not None else f"pid_{spec.method}", spice))
+    if spice[2] is not None:
+        result = design_pid(spec, simulate=False, simulator=args.simulator)
+        name = args.name or _default_name(spec, result.plant.fn_hz, result.plant.zeta)
+        return emit(replay(spec, result, args, mc, spice), args, replay_name(name, spice), write_outputs,
+                    summary_text)
     with cluster_ahead(args):
-        result = _loop_monte_carlo(design_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
+        result = loop_monte_carlo(design_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc,
+                                  spice)
     name = args.name or _default_name(spec, result.plant.fn_hz, result.plant.zeta)
     return emit(result, args, name, write_outputs, summary_text)
 
@@ -378,7 +338,7 @@ def _analyze_parser():
     _add_signal_options(p)
     _add_capture_options(p)
     add_output_options(p, "pid_as-built_<opamp>_fn<fn>_z<zeta>")
-    _add_monte_carlo(p)
+    add_monte_carlo(p)
     return p
 
 
@@ -403,20 +363,27 @@ def _analyze(args) -> int:
     typed = _typed(args, ANALYZE_PARAMS)
     spec = PidSpec(plant_parts=_plant_parts(args), controller_parts=parts, package=args.package,
                    plant_process=_captured_model(args, typed), **typed)
-    mc = _monte_carlo_settings(args, spec)
+    mc, spice = monte_carlo_settings(args, spec)
     if spec.process is not None:
-        from ..pid.process_report import summary_text as model_text, write_outputs as model_write
-        common.check_output(args, args.name if args.name is not None else "pid_as-built")
-        with cluster_ahead(args):
-            result = _loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args,
-                                       mc)
-        return emit(result, args, args.name or _model_name(spec, result.method), model_write, model_text)
-    common.check_output(args, args.name if args.name is not None else "pid_as-built")
+        from ..pid.process_report import summary_text, write_outputs
+    common.check_output(args, replay_name(args.name if args.name is not None else "pid_as-built", spice))
+    if spice[2] is not None:    # the parts as given are the draw's nominal; the build's own run is the simulation
+        result = analyze_pid(spec, simulate=False, simulator=args.simulator)
+        return emit(replay(spec, result, args, mc, spice), args, replay_name(_analyzed_name(args, spec, result),
+                                                                             spice), write_outputs, summary_text)
     with cluster_ahead(args):
-        result = _loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
-    name = args.name or (f"pid_{result.tuning.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}"
-                         f"_z{result.plant.zeta:.3g}")
-    return emit(result, args, name, write_outputs, summary_text)
+        result = loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc,
+                                  spice)
+    return emit(result, args, _analyzed_name(args, spec, result), write_outputs, summary_text)
+
+
+def _analyzed_name(args, spec, result) -> str:
+    """analyze-pid's bundle name: --name, else from the tuning, the op-amp and the plant."""
+    if args.name:
+        return args.name
+    if spec.process is not None:
+        return _model_name(spec, result.method)
+    return f"pid_{result.tuning.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}_z{result.plant.zeta:.3g}"
 
 
 #: the spec's parameters analyze-pid sets from options of the same meaning

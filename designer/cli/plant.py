@@ -210,8 +210,9 @@ def monte_carlo_settings(args, designators=PLANT_PARTS, parse_limit_item=None):
     return n, seed
 
 
-def spice_settings(args, settings):
-    """--engine, --spice-samples and --replay checked before any work: (engine, K or None, I or None)."""
+def spice_settings(args, settings, plant: bool = True):
+    """--engine, --spice-samples and --replay checked before any work: (engine, K or None, I or None);
+    ``plant``: the plant's op-amp spread checked too (a loop's analytic engine has a slew check)."""
     def whole(opt, text, lo, hi):
         try:
             v = int(str(text).strip())
@@ -237,7 +238,8 @@ def spice_settings(args, settings):
         k = whole("--spice-samples", args.spice_samples, 1, settings[0])
     if args.engine != "analytic" and settings is None:
         raise DesignError(f"--engine {args.engine} goes with --monte-carlo N")
-    _check_opamp_spread(args, i)
+    if plant:
+        _check_opamp_spread(args, i)
     return args.engine, k, i
 
 

@@ -132,7 +132,7 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice",
     return _run(spec, simulate, simulator, as_built=False)
 
 
-def analyze_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice") -> PidResult:
+def analyze_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice", opamp=None) -> PidResult:
     """The controller as built from its parts (``spec.controller_parts``), on
     its plant: what Kp, Ti and Td the parts give, the same checks, analytic
     loop and SPICE verification as :func:`design_pid`, and the same result.
@@ -140,7 +140,9 @@ def analyze_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice"
     Without gains in the spec (``kp``/``ti_s``/``td_s`` or a ``tuning``
     rule) the parts' own gains are the tuning (method ``as-built``) and the
     Kp/Ti/Td accuracy checks, which would compare the parts with themselves,
-    are left out; with them, the parts are held to those gains.
+    are left out; with them, the parts are held to those gains. ``opamp``: an
+    :class:`~designer.core.opamps.OpAmp` in place of ``spec.opamp``'s catalogue entry (a
+    Monte Carlo build's, its gain-bandwidth and slew rate drawn: ``--replay``).
 
     Raises
     ------
@@ -151,13 +153,13 @@ def analyze_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice"
         raise ParamError("analyze_pid needs the controller's parts ({controller_parts})", ("controller_parts",))
     if spec.process is not None:
         from .process_loop import design_model_pid
-        return design_model_pid(spec, simulate, simulator)
-    return _run(spec, simulate, simulator, as_built=spec.kp is None and spec.tuning is None)
+        return design_model_pid(spec, simulate, simulator, opamp=opamp)
+    return _run(spec, simulate, simulator, as_built=spec.kp is None and spec.tuning is None, opamp=opamp)
 
 
-def _run(spec: PidSpec, simulate: bool, simulator: str, as_built: bool) -> PidResult:
+def _run(spec: PidSpec, simulate: bool, simulator: str, as_built: bool, opamp=None) -> PidResult:
     clock = _Clock()
-    amp = opamps.get(spec.opamp)
+    amp = opamp or opamps.get(spec.opamp)
     plant, source, plant_series = resolve_plant(spec)
     ps = plant_step(plant, amp)
     curve = ps.curve

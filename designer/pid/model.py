@@ -137,18 +137,41 @@ class LoopModel:
         p = self.poles()
         return bool(np.all(p.real < 0)) if p.size else True
 
-    def simulate(self, t, r) -> dict:
-        """Outputs for the reference samples ``r`` at uniform times ``t`` (from rest)."""
-        t = np.asarray(t, float)
-        r = np.asarray(r, float)
+    def propagator(self, dt: float) -> np.ndarray:
+        """The first-order-hold discretisation over ``dt``: expm of [[A dt, B dt, 0], [0, 0, 1], [0, 0, 0]]
+        (exact for a piecewise-linear reference)."""
         n = self.a.shape[0]
-        dt = t[1] - t[0]
-        # first-order hold discretisation (exact for a piecewise-linear reference)
         m = np.zeros((n + 2, n + 2))
         m[:n, :n] = self.a * dt
         m[:n, n:n + 1] = self.b * dt
         m[n, n + 1] = 1.0
-        em = _expm(m)
+        return _expm(m)
+
+    def simulate_with_kick(self, t, r, t_fine, r_fine) -> tuple:
+        """(:meth:`simulate` on ``t``, on ``t_fine``) with one matrix exponential: the fine grid's step is
+        the coarse one's / 2^j, and the coarse propagator is the fine one to the 2^j (j squarings) with
+        the ramp's increment rescaled by 2^j: expm(M_c) = D expm(M_f)^(2^j) D^-1, D = diag(1.., 1, 2^j)."""
+        ratio = (t[1] - t[0]) / (t_fine[1] - t_fine[0])
+        j = int(round(math.log2(ratio)))
+        if j < 0 or abs(ratio - 2 ** j) > 1e-6 * ratio:
+            raise ValueError("the fine grid's step must be the coarse one's over a power of two")
+        fine = self.propagator(t_fine[1] - t_fine[0])
+        em = fine
+        for _ in range(j):
+            em = em @ em
+        em = em.copy()
+        em[:, -1] *= 2.0 ** -j
+        em[-1, :] *= 2.0 ** j
+        return self.simulate(t, r, em), self.simulate(t_fine, r_fine, fine)
+
+    def simulate(self, t, r, em=None) -> dict:
+        """Outputs for the reference samples ``r`` at uniform times ``t`` (from rest); ``em``: the
+        step's :meth:`propagator`, when known."""
+        t = np.asarray(t, float)
+        r = np.asarray(r, float)
+        n = self.a.shape[0]
+        if em is None:
+            em = self.propagator(t[1] - t[0])
         phi, g1, g2 = em[:n, :n], em[:n, n:n + 1], em[:n, n + 1:n + 2]
         bd0 = (g1 - g2).ravel()
         bd1 = g2.ravel()

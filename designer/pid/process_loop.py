@@ -282,7 +282,7 @@ def rule_table(spec, model, reduced, amp) -> tuple:
 
 
 def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice",
-                     rules_spice: bool = False, before_spice=None) -> ProcessPidResult:
+                     rules_spice: bool = False, before_spice=None, opamp=None) -> ProcessPidResult:
     """Tune, size, check and (unless ``simulate`` is False) verify in SPICE a PID
     for ``spec.process``, a plant known only as a model.
 
@@ -315,7 +315,7 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
         laps[name], tick = now - tick, now
 
     model = spec.process
-    amp = opamps.get(spec.opamp)
+    amp = opamp or opamps.get(spec.opamp)   # a Monte Carlo build's own (--replay), or the catalogue's
     reduced = from_process(model)
     table = rule_table(spec, model, reduced, amp)
     gains, opt, notes = choose_gains(spec, model, reduced, amp, table)

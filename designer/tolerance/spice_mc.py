@@ -61,13 +61,13 @@ def spice_evaluate(ctx, opamp):
     return functools.partial(plant_chunk, ctx, opamp)
 
 
-def disagreement(spice: dict, model: dict, index) -> dict:
-    """Per figure both engines give: SPICE minus the model over the samples ``index``
-    (absolute and relative), the sample where it is largest, and how many samples only
-    one engine gives a value for (a peak SPICE cannot resolve)."""
+def disagreement(spice: dict, model: dict, index, figures=spice_engine.SHARED) -> dict:
+    """Per figure both engines give (``figures``, named alike in both): SPICE minus the model
+    over the samples ``index`` (absolute and relative), the sample where it is largest, and
+    how many samples only one engine gives a value for (a peak SPICE cannot resolve)."""
     out = {}
     index = np.asarray(index)
-    for k in spice_engine.SHARED:
+    for k in figures:
         s, m = np.asarray(spice[k], float), np.asarray(model[k], float)
         both = np.isfinite(s) & np.isfinite(m)
         if not both.any():

@@ -153,3 +153,21 @@ def test_realised_controller_tf_is_the_pid_between_its_corners():
     _, c7 = signal.freqs(num7, den7, worN=w)
     _, p7 = signal.freqs(PN, PD, worN=w)
     assert np.allclose(c7 * p7, model.loop_gain(parts, LM741, PN, PD, w), rtol=1e-6)
+
+
+def test_the_kicks_fine_grid_and_the_coarse_one_from_one_exponential():
+    """simulate_with_kick (the coarse propagator squared up from the fine one, the ramp's increment
+    rescaled) gives what simulate gives on each grid by its own matrix exponential."""
+    parts = blocks.select_parts(3.34, 43.215e-6, 10.8037e-6, 3500).parts
+    lm = model.assemble(parts, LM741, PN, PD)
+    t = np.linspace(0.0, 1e-3, 2001)
+    h = (t[1] - t[0]) / 8
+    t_fine = h * np.arange(400)
+    r, r_fine = (model.reference(x, 1.0, 0.0, 1e-7) for x in (t, t_fine))
+    coarse, fine = lm.simulate_with_kick(t, r, t_fine, r_fine)
+    for k, v in lm.simulate(t, r).items():
+        np.testing.assert_allclose(coarse[k], v, rtol=1e-7, atol=1e-9 * max(1.0, np.abs(v).max()))
+    for k, v in lm.simulate(t_fine, r_fine).items():
+        np.testing.assert_array_equal(fine[k], v)
+    with pytest.raises(ValueError, match="power of two"):
+        lm.simulate_with_kick(t, r, t_fine[:10] * 1.5, r_fine[:10])
