@@ -271,12 +271,13 @@ def on_a_terminal(*args):
 
 
 def test_a_progress_bar_on_a_terminal_for_a_long_run_only():
-    code, shown = on_a_terminal(DESIGN_PID, *PID, "--monte-carlo", "500", "--no-files")
-    assert code == 0 and "Monte Carlo" in shown and "500/500" in shown and "build" in shown, shown
-    code, shown = on_a_terminal(DESIGN_PID, *PID, "--monte-carlo", "500", "--no-files", "--json")
+    # sizes far from the one-second threshold on any machine, loaded or not
+    code, shown = on_a_terminal(DESIGN_PID, *PID, "--monte-carlo", "2000", "--no-files")
+    assert code == 0 and "Monte Carlo" in shown and "2000/2000" in shown and "build" in shown, shown
+    code, shown = on_a_terminal(DESIGN_PID, *PID, "--monte-carlo", "2000", "--no-files", "--json")
     assert code == 0 and shown == ""
-    code, shown = on_a_terminal(DESIGN_PLANT, *SEED, "--monte-carlo", "1000", "--no-sim", "--no-files")
-    assert code == 0 and shown == ""     # done in well under a second: no bar
+    code, shown = on_a_terminal(DESIGN_PLANT, *SEED, "--monte-carlo", "100", "--no-sim", "--no-files")
+    assert code == 0 and shown == ""     # done in milliseconds: no bar
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
