@@ -94,8 +94,7 @@ def loop_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler
     (its ``spice``: the module docstring)."""
     from .loop import _passed, engine_of, loop_monte_carlo, loop_parts
     from .runner import Runner, Scale
-    from .spice_mc import ENGINES, disagreement, spice_samples
-    from .stats import wilson
+    from .spice_mc import ENGINES, disagreement, spice_checked, spice_samples
     if engine not in ENGINES:
         raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
     where = {"scale": scale, "target_ci": target_ci}
@@ -119,18 +118,10 @@ def loop_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler
             _, sp, _ = run.run(spice_loop.evaluate, ctx, draw)
         model_pass = mc.passed[idx]
         spice_pass = _passed(sp, limits)
-        to_fail, to_pass = idx[model_pass & ~spice_pass], idx[~model_pass & spice_pass]
-        corrected = mc.yield_count - to_fail.size + to_pass.size
-        is_rand = np.isin(idx, rand)
-        flips = int(np.count_nonzero(model_pass[is_rand] != spice_pass[is_rand]))
-        mc.spice = {**settings, "samples_checked": int(idx.size), "worst": worst, "random": rand,
-                    "disagreement": disagreement(_spice_figures(sp), {f: v[idx] for f, v in _model_figures(mc.figures).items()},
-                                                 idx, STEP),
-                    "flipped": {"pass_to_fail": [int(i) for i in to_fail], "fail_to_pass": [int(i) for i in to_pass]},
-                    "random_flip_rate": {"count": flips, "of": int(is_rand.sum()),
-                                         "ci95": list(wilson(flips, int(is_rand.sum())))},
-                    "yield_model": mc.yield_count / n, "yield_with_spice": corrected / n,
-                    "yield_shift_pp": 100 * (corrected - mc.yield_count) / n}
+        disagree = disagreement(_spice_figures(sp), {f: v[idx] for f, v in _model_figures(mc.figures).items()},
+                                idx, STEP)
+        mc.spice = {**settings, **spice_checked(idx, worst, rand, model_pass, spice_pass, mc.yield_count, n,
+                                                disagree)}
         for k in spice_loop.FIGURES:        # the CSV: SPICE's figures where simulated
             col = np.full(n, np.nan)
             col[idx] = sp[k]

@@ -88,6 +88,23 @@ def _passes(figs: dict, limits) -> np.ndarray:
     return _yield(figs, limits)
 
 
+def spice_checked(idx, worst, rand, model_pass, spice_pass, yield_count: int, n: int, disagree: dict) -> dict:
+    """What SPICE on the builds ``idx`` (the tails ``worst`` and the random ``rand``) did to the
+    model's verdicts (``model_pass``, against SPICE's ``spice_pass``): the builds it flipped, the flip
+    rate among the random ones with its Wilson interval, and the yield of ``n`` builds with the flips
+    (``monte_carlo.spice`` of a plant's or a loop's ``--engine both --spice-samples``)."""
+    from .stats import wilson
+    to_fail, to_pass = idx[model_pass & ~spice_pass], idx[~model_pass & spice_pass]
+    corrected = yield_count - to_fail.size + to_pass.size
+    is_rand = np.isin(idx, rand)
+    flips, of = int(np.count_nonzero(model_pass[is_rand] != spice_pass[is_rand])), int(is_rand.sum())
+    return {"samples_checked": int(idx.size), "worst": worst, "random": rand, "disagreement": disagree,
+            "flipped": {"pass_to_fail": [int(i) for i in to_fail], "fail_to_pass": [int(i) for i in to_pass]},
+            "random_flip_rate": {"count": flips, "of": of, "ci95": list(wilson(flips, of))},
+            "yield_model": yield_count / n, "yield_with_spice": corrected / n,
+            "yield_shift_pp": 100 * (corrected - yield_count) / n}
+
+
 def spice_samples(figs: dict, limits, k: int, seed: int) -> tuple:
     """(worst, random) sample indices: per limited figure the ``k`` samples with the least room
     inside (most beyond) its window, and ``k`` others drawn at random."""
@@ -140,19 +157,8 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
         sp = spice_evaluate(ctx, amp)(sub)
         model_pass = mc.passed[idx]
         spice_pass = _passes(sp, mc.limits)
-        to_fail = idx[model_pass & ~spice_pass]
-        to_pass = idx[~model_pass & spice_pass]
-        corrected = mc.yield_count - to_fail.size + to_pass.size
-        from .stats import wilson
-        is_rand = np.isin(idx, rand)
-        flips_rand = int(np.count_nonzero(model_pass[is_rand] != spice_pass[is_rand]))
-        mc.spice = {**settings, "samples_checked": int(idx.size), "worst": worst, "random": rand,
-                    "disagreement": disagreement(sp, {k: v[idx] for k, v in mc.figures.items()}, idx),
-                    "flipped": {"pass_to_fail": [int(i) for i in to_fail], "fail_to_pass": [int(i) for i in to_pass]},
-                    "random_flip_rate": {"count": flips_rand, "of": int(is_rand.sum()),
-                                         "ci95": list(wilson(flips_rand, int(is_rand.sum())))},
-                    "yield_model": mc.yield_count / n, "yield_with_spice": corrected / n,
-                    "yield_shift_pp": 100 * (corrected - mc.yield_count) / n}
+        mc.spice = {**settings, **spice_checked(idx, worst, rand, model_pass, spice_pass, mc.yield_count, n,
+                                                disagreement(sp, {k: v[idx] for k, v in mc.figures.items()}, idx))}
         for k in spice_engine.FIGURES:          # the CSV: SPICE's figures where simulated
             col = np.full(n, np.nan)
             col[idx] = sp[k]
