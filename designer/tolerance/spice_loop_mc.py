@@ -29,13 +29,12 @@ them. A build is in the yield when its loop is stable and inside every limit.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..core.errors import DesignError
 from . import spice_loop
-from .runner import Draw
+from .runner import Picked
 
 #: the SPICE step figures a --limit may name (the analytic loop's ``model_*`` stand in for them)
 STEP = spice_loop.STEP
@@ -53,17 +52,6 @@ def model_limit(lim):
     """The same window on the analytic loop's figure (``spice_x`` -> ``model_x``)."""
     f = lim.figure
     return dataclasses.replace(lim, figure="model_" + f[6:]) if f.startswith("spice_") else lim
-
-
-@dataclass(frozen=True)
-class Picked(Draw):
-    """The builds SPICE checks (``--spice-samples``): their values, already drawn, chunked by
-    the runner as any draw (``n``: how many)."""
-
-    picked: dict = None      #: designator -> the chosen builds' values
-
-    def values(self, start: int = 0, stop: int | None = None) -> dict:
-        return {k: v[start:stop] for k, v in self.picked.items()}
 
 
 def _settings(ctx, engine: str) -> dict:

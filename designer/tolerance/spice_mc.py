@@ -12,7 +12,8 @@
   K drawn at random from the rest (a generator seeded from (seed, 1), so the choice
   is reproducible); how many verdicts SPICE flips, and the yield with those flips
   applied (the worst samples are where flips happen; the random ones estimate the
-  flip rate in the bulk).
+  flip rate in the bulk). Those SPICE samples run through the same runner as the
+  model's (``--jobs``, ``--dask``: :class:`designer.tolerance.runner.Picked`).
 - replay: sample I alone, its values drawn again from (seed, I) with the same
   sampler, distribution and tolerances, simulated by the same engine.
 """
@@ -131,7 +132,8 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
     the tails and ``spice_k`` random samples only (``both``). ``scale``, ``target_ci``: where the
     samples run and ``--target-ci`` (:mod:`designer.tolerance.runner`)."""
     where = {"scale": scale, "target_ci": target_ci}
-    from .montecarlo import _figures, plant_monte_carlo
+    from .montecarlo import _apply, _figures, plant_monte_carlo
+    from .runner import Picked, Runner, Scale
     if engine not in ENGINES:
         raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
     amp = result.opamp
@@ -154,7 +156,9 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
         order = np.argsort(idx)
         idx = idx[order]
         sub = {r: v[idx] for r, v in mc.values.items()}
-        sp = spice_evaluate(ctx, amp)(sub)
+        draw = Picked(mc.nominal, mc.tolerances.of, idx.size, seed, sampler, dist, picked=sub)
+        with Runner(scale or Scale()) as run:     # the same workers (--jobs, --dask) as the model's run
+            _, sp, _ = run.run(_apply, spice_evaluate(ctx, amp), draw)
         model_pass = mc.passed[idx]
         spice_pass = _passes(sp, mc.limits)
         mc.spice = {**settings, **spice_checked(idx, worst, rand, model_pass, spice_pass, mc.yield_count, n,

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from designer.core import opamps
 from designer.core.errors import DesignError, SimulatorError
 from designer.plant.sallenkey import SallenKeyParts
-from designer.tolerance import plant, runner
+from designer.tolerance import plant, runner, sampling
 from designer.tolerance.montecarlo import (
     MAX_TARGET_CI,
     TARGET_ROUND,
@@ -305,3 +305,19 @@ def test_dask_addresses():
     for bad in ("sched", "host:0", "host:70000", "http://host:8786", ":8786"):
         with pytest.raises(DesignError):
             parse_dask(bad)
+
+
+@settings(max_examples=200, deadline=None)
+@given(n=st.integers(1, 10 ** 6), workers=st.integers(1, 16), work=st.sampled_from(runner.SPICE_WORK))
+def test_spice_chunks_are_long_but_every_worker_gets_one(n, workers, work):
+    size = Scale(jobs=workers, work=work).chunk_size(n)
+    chunks = -(-n // size)
+    # a simulator's start is paid per chunk: at least SPICE_MIN_CHUNK builds each, unless that
+    # would leave a worker idle (then at least MIN_CHUNK); never more than a sampler's block
+    assert runner.MIN_CHUNK <= size <= sampling.CHUNK
+    if n >= workers * runner.SPICE_MIN_CHUNK:
+        assert size >= runner.SPICE_MIN_CHUNK
+    if n >= workers * runner.MIN_CHUNK:
+        assert chunks >= workers
+    # the other engines keep their finer split
+    assert Scale(jobs=workers, work="loop").chunk_size(n) <= size

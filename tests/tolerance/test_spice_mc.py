@@ -124,3 +124,22 @@ def test_the_engine_pickles_for_workers(seed_plant):
                         {"R1": .05, "R2": .05, "C1": .1, "C2": .1}, 4, 1)
     figs = f(v)
     assert set(figs) >= set(plant_figures(v, seed_plant.opamp)) | {"rise_time_s", "settling_time_s"}
+
+
+def test_spice_samples_run_on_the_runners_workers(seed_plant, monkeypatch):
+    """--spice-samples' SPICE builds go through the runner (--jobs, --dask), with the same result."""
+    from designer.tolerance import runner
+    seen = []
+    real = runner._ProcessPool.map
+
+    def spy(self, evaluate, context, draw, tasks, bar):
+        seen.append((type(draw).__name__, list(tasks)))
+        return real(self, evaluate, context, draw, tasks, bar)
+
+    monkeypatch.setattr(runner._ProcessPool, "map", spy)
+    kw = dict(seed=5, limit_items=LIMITS, engine="both", spice_k=4)
+    one = plant_monte_carlo_engine(seed_plant, SERIES, 400, **kw)
+    two = plant_monte_carlo_engine(seed_plant, SERIES, 400, scale=runner.Scale(jobs=2, chunk=5), **kw)
+    picked = [tasks for kind, tasks in seen if kind == "Picked"]
+    assert len(picked) == 1 and len(picked[0]) >= 2     # the checked builds, in chunks on two workers
+    assert one.to_dict() == two.to_dict() and one.csv_text() == two.csv_text()
