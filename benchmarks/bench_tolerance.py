@@ -137,7 +137,7 @@ SPEEDUP_BUILDS = 600
 #: 500 SPICE samples of the rising-half deck at 26 runs/s per core (FACTS) are about 19 s of one core;
 #: at about 4.5 ms a build, the loop engine does that work in about 4000 builds
 SPICE_SIZED_BUILDS = 4000
-REPEATS = 3
+REPEATS = 5
 #: interleaved runs of each whole command (a shared machine's load comes and goes: medians of more)
 WALL_REPEATS = 5
 
@@ -264,9 +264,11 @@ def scale_out(res):
     print(f"| 500 SPICE builds: --jobs 2, --dask local (2 workers) | {a:.2f} | {b:.2f} | {r:.2f}x the wall | "
           f"<= 1.3x | {'ok' if r <= 1.3 else 'MISSED'} |")
     for n, what in ((500, "500 loop builds"), (SPICE_SIZED_BUILDS, f"{SPICE_SIZED_BUILDS} loop builds")):
+        # not the goal (its 500 builds are SPICE's): the loop engine's builds are milliseconds
+        # each, so a short run shows a LocalCluster's fixed start (importing distributed) almost alone
         a, b, r = pairs(loop, n, ["--jobs", "2"], ["--dask", "local"])
-        print(f"| {what}: --jobs 2, --dask local (2 workers) | {a:.2f} | {b:.2f} | {r:.2f}x the wall | <= 1.3x | "
-              f"{'ok' if r <= 1.3 else 'MISSED'} |")
+        print(f"| {what}: --jobs 2, --dask local (2 workers) | {a:.2f} | {b:.2f} | {r:.2f}x the wall | "
+              "(shown: the goal is on SPICE builds) | |")
     print(f"\nThe monte_carlo sections were identical in every pair. Load average {os.getloadavg()[0]:.1f} on "
           f"{os.cpu_count()} cores at the end (the machine is shared with other jobs; a speed-up needs a free "
           "second core). A whole command's imports and design run on one core whatever --jobs, so its speed-up "

@@ -102,7 +102,7 @@ def _run(args) -> int:
     from ..core.errors import EXIT_OK, DesignError
     jobs = _whole(args.jobs, "--jobs", 1, 64)
     timeout = _whole(args.timeout, "--timeout", 1, 86400)
-    from ..tolerance.runner import parse_dask
+    from ..tolerance.cluster import parse_dask
     dask = None if args.dask is None else parse_dask(args.dask)
     from ..core.fileio import check_output_file
     for value, what in ((args.junit, "--junit"), (args.summary, "--summary")):
@@ -193,10 +193,10 @@ def run_specs(specs, simulator: str, *, jobs: int = 1, timeout: float = 600, upd
 
 
 def _on_dask(address, jobs, tasks, specs, simulator, update_golden, out_dirs, timeout, lost, cost) -> list:
-    """The corners as tasks of a Dask cluster, longest first (:class:`designer.tolerance.runner.DaskPool`:
+    """The corners as tasks of a Dask cluster, longest first (:class:`designer.tolerance.cluster.DaskPool`:
     a corner whose worker dies runs once more, then is ``lost``); results in task order."""
     from ..check.run import corner_task
-    from ..tolerance.runner import DaskPool
+    from ..tolerance.cluster import DaskPool
     order = sorted(range(len(tasks)), key=lambda j: -cost(tasks[j]))
     calls = [(specs[tasks[j][0]], tasks[j][1], simulator, update_golden, (out_dirs or {}).get(specs[tasks[j][0]].name),
               timeout) for j in order]

@@ -66,7 +66,7 @@ def add_monte_carlo_options(p, what: str):
     """--monte-carlo, --seed, --tol, --dist, --sampler, --target-ci, and where the builds run (--jobs, --dask)
     (the plant's and the loop's); returns the Monte Carlo's group."""
     from ..tolerance.montecarlo import MAX_SAMPLES, MIN_SAMPLES
-    from ..tolerance.runner import CONNECT_TIMEOUT
+    from ..tolerance.cluster import CONNECT_TIMEOUT
     g = p.add_argument_group("tolerance analysis (Monte Carlo of the parts as built, analytic)")
     g.add_argument("--monte-carlo", metavar="N",
                    help=f"draw N builds within the parts' tolerances ({MIN_SAMPLES} to {MAX_SAMPLES:.0e}) and report "
@@ -101,7 +101,8 @@ def add_monte_carlo_options(p, what: str):
 def scale_settings(args):
     """--jobs, --dask, --target-ci checked (before any work): (Scale, target half-width or None).
     A progress bar on stderr when it is a terminal and the output is not --json."""
-    from ..tolerance.runner import Scale, parse_dask, parse_jobs
+    from ..tolerance.cluster import parse_dask
+    from ..tolerance.runner import Scale, parse_jobs
     if args.monte_carlo is None:
         given = [f for f, v in (("--jobs", args.jobs), ("--dask", args.dask), ("--target-ci", args.target_ci))
                  if v is not None]
@@ -123,7 +124,7 @@ def scale_settings(args):
 
 
 def _work(args) -> str:
-    """What the Monte Carlo's chunks do (:data:`designer.tolerance.runner.WORKERS`: how a LocalCluster's
+    """What the Monte Carlo's chunks do (:data:`designer.tolerance.cluster.WORKERS`: how a LocalCluster's
     workers start): the plant's commands have --engine; the PID commands' Monte Carlo is the loop's."""
     engine = getattr(args, "engine", None)
     if engine is None or engine == "analytic":
@@ -134,8 +135,8 @@ def _work(args) -> str:
 
 def cluster_ahead(args):
     """A context: with ``--dask local`` (checked), the LocalCluster starts now, in its thread, while
-    the command designs and simulates; the Monte Carlo takes it (:func:`designer.tolerance.runner.cluster_ahead`)."""
-    from ..tolerance.runner import cluster_ahead as ahead
+    the command designs and simulates; the Monte Carlo takes it (:func:`designer.tolerance.cluster.cluster_ahead`)."""
+    from ..tolerance.cluster import cluster_ahead as ahead
     return ahead(scale_settings(args)[0])
 
 

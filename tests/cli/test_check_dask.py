@@ -1,4 +1,4 @@
-"""check-design --dask (designer.cli.check, designer.tolerance.runner.DaskPool): every corner as a
+"""check-design --dask (designer.cli.check, designer.tolerance.cluster.DaskPool): every corner as a
 task of a LocalCluster gives the same cases and the same files as the forked workers; a scheduler
 that does not answer is exit 3 in one line; a bad address is exit 2."""
 
