@@ -8,7 +8,8 @@ runs the command's ``main``. The commands that draw build sheets
 imported, so that matplotlib's import (longer than a plant's design and
 simulation) runs on the other core from the start. Called as functions
 (``design_plant_main(argv)``) the commands draw in-process and leave the
-signals alone: the files are the same.
+signals alone: the files are the same. A command that returned ends through
+:func:`designer.core.lifetime.finish` (the interpreter's teardown skipped).
 """
 
 import importlib
@@ -47,7 +48,7 @@ def _run(prog: str, module: str, main: str, wing: str | None = None) -> int:
             pass
         return lifetime.status_of(exc)
     lifetime.quiet()
-    return status
+    lifetime.finish(status)     # never returns: exits with the status, without the modules' teardown
 
 
 def design_plant() -> int:

@@ -23,6 +23,10 @@ however it is stopped.
   (``prctl(PR_SET_PDEATHSIG)``, kept across ``exec``), so a SIGKILLed command
   leaves no process behind either; a parent that died before the request is
   noticed by the child, which exits.
+- **A short end** (:func:`finish`, every console script once its command returned): the
+  streams flushed, Python's own exit steps (threads joined, ``atexit``), then ``os._exit``,
+  without the teardown of every imported module (0.15 s of a short run after ``import
+  distributed``; bench_tolerance).
 """
 
 from __future__ import annotations
@@ -110,6 +114,36 @@ def quiet() -> None:
         signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
     except (AttributeError, OSError, ValueError):   # pragma: no cover - not POSIX
         pass
+
+
+def finish(status: int):
+    """End the process with ``status`` once the command returned: its files are whole (written
+    to temporaries and renamed) and closed. Does what a normal exit does that matters (flush
+    stdout and stderr, join the threads that are not daemons and the thread pools, run the
+    ``atexit`` handlers: multiprocessing's children, the fork server's kill), then ``os._exit``,
+    skipping only the interpreter's teardown of its modules and objects. A reader that closed
+    the pipe early (``| head``) is their choice: stdout goes to /dev/null first, as at a
+    normal exit."""
+    import atexit
+    import threading
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):   # a closed pipe or stream: nothing more can reach it
+            try:
+                os.dup2(os.open(os.devnull, os.O_WRONLY), stream.fileno())
+            except (OSError, ValueError):
+                pass
+    shutdown = getattr(threading, "_shutdown", None)    # what Python runs first at exit (CPython's)
+    if shutdown is not None and threading.current_thread() is threading.main_thread():
+        shutdown()
+    atexit._run_exitfuncs()     # prints a failing handler's error, as Python does, and goes on
+    for stream in (sys.stdout, sys.stderr):   # what the handlers printed
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(status)
 
 
 def _handler(signum, frame):

@@ -134,3 +134,41 @@ def test_a_signal_lost_in_a_callback_python_cannot_raise_from_is_delivered_again
     out, err = p.communicate(timeout=60)
     assert "went on" not in out and "Exception ignored" not in err and "Traceback" not in err, err
     assert p.returncode == 143 and err.splitlines() == ["probe: error: terminated (SIGTERM)"], err
+
+
+def test_finish_exits_with_the_status_after_what_a_normal_exit_does(tmp_path):
+    """finish(): the status, buffered output flushed, a thread that is not a daemon joined,
+    the atexit handlers run (multiprocessing's among them), and a closed pipe stays silent."""
+    script = textwrap.dedent(f"""
+        import atexit, sys, threading, time
+        from designer.core import lifetime
+        def late():
+            time.sleep(0.3)
+            open({str(tmp_path / "thread")!r}, "w").write("joined")
+        threading.Thread(target=late).start()
+        atexit.register(lambda: open({str(tmp_path / "atexit")!r}, "w").write("ran"))
+        sys.stdout.write("x" * 100000)       # more than a pipe holds: flushed by finish
+        lifetime.finish(3)
+        print("never")
+    """)
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 3 and p.stderr == ""
+    assert p.stdout == "x" * 100000
+    assert (tmp_path / "thread").read_text() == "joined" and (tmp_path / "atexit").read_text() == "ran"
+    # a reader that stopped early (| head): no "Exception ignored" line, the status kept
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.read(10)
+    proc.stdout.close()
+    with proc.stderr:
+        err = proc.stderr.read().decode()
+    assert proc.wait(60) == 3 and "Exception" not in err and "Error" not in err
+
+
+def test_a_console_command_ends_through_finish():
+    """The console scripts exit through finish (the status, the output whole)."""
+    exe = os.path.join(os.path.dirname(sys.executable), "design-plant")
+    p = subprocess.run([exe, "--fc", "3500", "--zeta", "0.2", "--no-sim", "--no-files", "--json"],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0 and p.stderr == "" and p.stdout.rstrip().endswith("}")
+    bad = subprocess.run([exe, "--fc", "-1", "--zeta", "0.2"], capture_output=True, text=True, timeout=120)
+    assert bad.returncode == 2 and bad.stdout == "" and len(bad.stderr.strip().splitlines()) == 1
