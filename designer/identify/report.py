@@ -164,7 +164,7 @@ def _pyplot():
 
 def fit_plot(result, n_models: int = 3) -> bytes:
     """PNG of the step data against the best ``n_models`` valid models, with the residuals."""
-    from .preprocess import block_mean
+    from .settle import block_mean
     from .structures import model_step
     plt = _pyplot()
     s = result.step

@@ -22,7 +22,8 @@ from ..core.metrics import Overshoot, StepMetrics
 from ..core.stepfit import overshoot_mismatch
 from .first_order import FIRST_ORDER_METHODS
 from .io import CaptureInfo
-from .preprocess import PreparedStep, prepare_step
+from .normalise import PreparedStep
+from .preprocess import prepare_step
 from .refine import refine_all
 from .second_order import STEP_METHODS
 from .structures import MethodResult, iae_ise, model_step, rank_key, unphysical
@@ -310,7 +311,7 @@ def _measured(step: PreparedStep, t_eval, y_eval) -> tuple:
     every validity check uses, or ``(None, None)`` when the data allow none
     (:func:`designer.core.metrics.measure_step`, on block means of a long record)."""
     from ..core.metrics import measure_step
-    from .preprocess import block_mean
+    from .settle import block_mean
     if step.sigma > 0 and t_eval.size > 50:
         t_eval, y_eval = block_mean(t_eval, y_eval)
     try:

@@ -166,7 +166,7 @@ def identify_page(result) -> dict:
     shown = [m for m in result.methods if m.valid][:3]
     if hasattr(result, "step"):
         from ..core.stepfit import model_step
-        from ..identify.preprocess import block_mean
+        from ..identify.settle import block_mean
         s = result.step
         t, y = block_mean(s.t_raw, s.y_raw, TRACE_POINTS)
         tt = np.asarray(t) - s.t_step

@@ -35,7 +35,7 @@ only the (at most three) columns used are kept, so memory is about 8 bytes per
 kept value however long the file is. Size, encoding and non-regular files
 (a directory, ``/dev/zero``, a FIFO) are handled by :mod:`designer.core.fileio`; the
 checks on the samples themselves (finite, increasing time, physical ranges)
-are :func:`.preprocess.check_samples`.
+are :func:`designer.identify.edges.check_samples`.
 
 Frequency-response tables
 -------------------------

@@ -28,7 +28,7 @@ from ...core.fileio import (
     show_cell,
     size_text,
 )
-from ..preprocess import check_samples
+from ..edges import check_samples
 from .formats import _layout
 from .layout import _is_number, _Layout, _split
 from .split import PARSED, FileBlocks

@@ -17,7 +17,7 @@ import numpy as np
 from ...core.errors import DesignError
 from ...core.fileio import MAX_TABLE_BYTES, read_text, show_cell, shown
 from ...core.ranges import RANGES
-from ..preprocess import number_text
+from ..edges import number_text
 
 
 GAIN_UNITS = ("db", "ratio")

@@ -8,7 +8,7 @@ import numpy as np
 
 from ...core.errors import DesignError
 from ...core.fileio import show_cell
-from ..preprocess import number_text
+from ..edges import number_text
 from .layout import _cells, _first_cells, _Layout, _not_this
 
 
