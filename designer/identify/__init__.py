@@ -1,8 +1,9 @@
 """Classical identification from step and frequency responses (seeds 000, 002, 003).
 
 ``io`` reads scope captures and Bode tables; ``preprocess`` turns a capture
-into a normalised step; ``first_order``, ``second_order`` and ``refine``
-(least squares) are the step methods on the shared ``structures``;
+into a normalised step; ``first_order``, the second-order families
+``underdamped``, ``overdamped`` and ``dc_motor`` (listed in ``second_order``)
+and ``refine`` (least squares) are the step methods on the shared ``structures``;
 ``step`` runs and ranks them, ``frequency`` does the same for a Bode table;
 ``correlation`` and ``spectral`` estimate the impulse and frequency
 responses from a broadband input (a PRBS, :mod:`designer.core.prbs`, or
