@@ -264,7 +264,7 @@ def fit_step(model: str, t, y, yf, start: dict | None = None, sigma: float | Non
     ci = _confidence(model, best, tf.size)
     if tf.size > 1 and params["theta_s"] < MIN_DEAD_TIME_OF_DT * float(np.median(np.diff(tf))):
         params["theta_s"] = 0.0
-    # the fast time constant is tau1, as in seeds 002 and 003 (and second_order.py)
+    # the fast time constant is tau1, as in seeds 002 and 003 (and identify/overdamped.py)
     if model == "overdamped" and params["tau1_s"] > params["tau2_s"]:
         params["tau1_s"], params["tau2_s"] = params["tau2_s"], params["tau1_s"]
         if "tau1_s" in ci and "tau2_s" in ci:

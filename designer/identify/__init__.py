@@ -3,8 +3,10 @@
 ``io`` reads scope captures and Bode tables; ``preprocess`` turns a capture
 into a normalised step, by stages: ``edges`` (the record checked, its steps
 found), ``settle`` (baseline, final value), ``normalise`` (one step) and
-``averaging`` (a square wave's steps); ``first_order``, ``second_order`` and
-``refine`` (least squares) are the step methods on the shared ``structures``;
+``averaging`` (a square wave's steps); ``first_order``, the second-order
+families ``underdamped``, ``overdamped`` and ``dc_motor`` (listed in
+``second_order``) and ``refine`` (least squares) are the step methods on the
+shared ``structures``;
 ``step`` runs and ranks them, ``frequency`` does the same for a Bode table;
 ``correlation`` and ``spectral`` estimate the impulse and frequency
 responses from a broadband input (a PRBS, :mod:`designer.core.prbs`, or

@@ -28,7 +28,7 @@ Methods
   ``viteckova-double-pole`` (model ``double-pole``).
 - ``alfaro-123c``: Alfaro's 123c FOPDT, the Table II row with the original's
   four digits (its overdamped second-order version is
-  :func:`designer.identify.second_order.alfaro_123c_overdamped`).
+  :func:`designer.identify.overdamped.alfaro_123c_overdamped`).
 
 Validity range (checked, and reported as ``valid=False`` with a note): the
 response must be monotonic, as FOPDT and double-pole models cannot overshoot

@@ -2,7 +2,8 @@
 
 :func:`identify_step` normalises the capture (:mod:`.preprocess`), runs the
 first-order methods (:mod:`.first_order`) and the second-order ones
-(:mod:`.second_order`), and the least-squares refinements (:mod:`.refine`)
+(:mod:`.second_order`'s list of :mod:`.underdamped`, :mod:`.overdamped` and
+:mod:`.dc_motor`), and the least-squares refinements (:mod:`.refine`)
 started from the best classical estimate of each structure. Every model is
 then driven by the real input amplitude and step time and scored against the
 data with IAE and ISE; methods are ranked by IAE, valid ones first, and the
