@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 from helpers import FIXTURES
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from designer.identify import frequency as fr
@@ -136,6 +136,7 @@ W = np.geomspace(1e-2, 1e2, 60)     # two decades each side of the corner (scale
 
 @FAST
 @given(K=st.floats(0.1, 100.0), tau=st.floats(1e-6, 1e3), dead=st.floats(0.0, 1.0))
+@example(K=17.0, tau=1e-6, dead=1e-6)     # a 1 ps dead time: reported as none (found by hypothesis)
 def test_least_squares_fopdt_exact(K, tau, dead):
     p = {"K": K, "tau_s": tau, "theta_s": dead * tau}
     d = table("fopdt", p, W / tau)
@@ -144,7 +145,10 @@ def test_least_squares_fopdt_exact(K, tau, dead):
     for k in ("K", "tau_s"):
         assert r.params[k] == pytest.approx(p[k], rel=1e-6)
     assert r.params["theta_s"] == pytest.approx(p["theta_s"], abs=1e-6 * tau)
-    assert r.iae < 1e-6
+    # a dead time near MIN_DEAD_TIME_S may be reported as none: its phase, |e^(-j w theta) - 1|
+    # = 2 sin(w theta / 2) per point, is then the error left
+    dropped = p["theta_s"] if r.params["theta_s"] == 0.0 else 0.0
+    assert r.iae < 1e-6 + np.mean(2 * np.abs(np.sin(W / tau * dropped / 2)))
 
 
 @FAST
