@@ -139,7 +139,7 @@ SPEEDUP_BUILDS = 600
 SPICE_SIZED_BUILDS = 4000
 REPEATS = 5
 #: interleaved runs of each whole command (a shared machine's load comes and goes: medians of more)
-WALL_REPEATS = 5
+WALL_REPEATS = 9
 
 
 #: SPICE builds of the in-process scale-out row (the whole-command rows' number)
