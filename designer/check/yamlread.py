@@ -6,7 +6,7 @@ PyYAML's SafeLoader, refuses all of that while composing and walking the node
 graph (without recursion), then builds the data from the same nodes; every
 refusal is one :class:`~designer.core.errors.DesignError` line ``file:line:
 what``. It also gives the line of every key path, for the spec's own refusals
-(:mod:`designer.check.spec`).
+(:class:`designer.check.yamldoc._Doc`).
 """
 
 from __future__ import annotations

@@ -51,7 +51,7 @@ FRAMING_BYTES = 64 * 1024
 
 def _check_limit() -> int:
     """check-design's inputs: a spec and the decks it includes (their own limits)."""
-    from ..check.spec import MAX_SPEC_BYTES
+    from ..check.yamldoc import MAX_SPEC_BYTES
     from ..spice.trust import MAX_TOTAL_BYTES
     return MAX_SPEC_BYTES + MAX_TOTAL_BYTES + FRAMING_BYTES
 

@@ -14,7 +14,8 @@ import pytest
 import yaml
 from helpers import ROOT, script
 
-from designer.check.spec import SUB, TOP
+from designer.check.sections import SUB
+from designer.check.spec import TOP
 
 pytestmark = pytest.mark.spice
 

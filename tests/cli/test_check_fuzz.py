@@ -22,7 +22,8 @@ from fuzzing import ODD, sci
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from designer.check.spec import SUB, TOP
+from designer.check.sections import SUB
+from designer.check.spec import TOP
 from designer.cli.check import check_design_main
 from designer.cli.pid import analyze_pid_main
 
