@@ -10,7 +10,7 @@ end-to-end run under 10 s.
 Part search (issue 7): for every series pair up to E192/E192 with the default
 bounds, ``select_parts`` and the whole ``design-pid --no-sim --no-files``
 process under 5 s and 500 MB peak; the same best error and objective as the
-exhaustive :func:`designer.pid.blocks.brute_force` where that is feasible (E3
+exhaustive :func:`designer.pid.selection.brute_force` where that is feasible (E3
 on narrow bounds); with the widest bounds the CLI accepts, the same 500 MB
 (time bounded, no goal). Memory: "sizing peak" is tracemalloc's peak during
 ``select_parts`` (numpy's allocations), "process peak" the command's peak
@@ -98,7 +98,7 @@ def main():
 def search_tables():
     from designer.core.eseries import SERIES
     from designer.core.ranges import RANGES
-    from designer.pid import blocks
+    from designer.pid import selection
     exe = str(Path(sys.executable).parent / "design-pid")
     print(f"### Part search for every series pair: Kp {ZN[0]}, Ti {ZN[1] * 1e6:g} us, Td {ZN[2] * 1e6:g} us "
           "(ZN for the seed plant), default bounds (R 1k..1M, C 1n..10u)\n")
@@ -111,7 +111,7 @@ def search_tables():
     for rs in SERIES:
         for cs in SERIES:
             def size():
-                return blocks.select_parts(*ZN, 3500, r_series=rs, c_series=cs)
+                return selection.select_parts(*ZN, 3500, r_series=rs, c_series=cs)
             t, sel = timed(size)
             peak = traced_peak_mb(size)
             wall, rss, code = run_measured([exe, "--plant-fc", "3500", "--plant-zeta", "0.2", "--r-series", rs,
@@ -134,7 +134,7 @@ def search_tables():
     for rs, cs in (("E24", "E12"), ("E96", "E96"), ("E192", "E192")):
         for label, gains in (("PID (ZN)", ZN), ("PI", (1.4, 60e-6, 0.0))):
             def size():
-                return blocks.select_parts(*gains, 3500, r_series=rs, c_series=cs, **wide)
+                return selection.select_parts(*gains, 3500, r_series=rs, c_series=cs, **wide)
             t, sel = timed(size, repeat=1)
             peak = traced_peak_mb(size)
             argv = [exe, "--plant-fc", "3500", "--plant-zeta", "0.2", "--kp", str(gains[0]), "--ti", str(gains[1]),
@@ -151,9 +151,10 @@ def search_tables():
     print("|---|---|---:|---:|---:|---|---|")
     for kp, ti, td in (ZN, (45, 43.215e-6, 10.8037e-6), (1.7, 60e-6, 5e-6), (0.8, 70e-6, 15e-6)):
         for tol in (0.01, 0.0):
-            t, sel = timed(lambda: blocks.select_parts(kp, ti, td, 3500, tol=tol, **SMALL), repeat=1)
-            tb, (best_err, best_obj) = timed(lambda: blocks.brute_force(kp, ti, td, 3500, tol=tol, **SMALL), repeat=1)
-            got = blocks.objective(sel.parts, sel.targets, sel.best_possible_pct / 100, tol)
+            t, sel = timed(lambda: selection.select_parts(kp, ti, td, 3500, tol=tol, **SMALL), repeat=1)
+            tb, (best_err, best_obj) = timed(lambda: selection.brute_force(kp, ti, td, 3500, tol=tol, **SMALL),
+                                             repeat=1)
+            got = selection.objective(sel.parts, sel.targets, sel.best_possible_pct / 100, tol)
             same_err = abs(sel.best_possible_pct / 100 - best_err) <= 1e-9 * best_err
             same_obj = all(abs(a - b) <= 1e-9 * abs(b) for a, b in zip(got, best_obj))
             print(f"| {kp:g}, {ti * 1e6:g} us, {td * 1e6:g} us | {tol:g} | {t:.3f} | {tb:.2f} | "

@@ -4,8 +4,9 @@ realised controller's transfer function, a closed-loop ngspice deck and its
 verification, and the ``design-pid`` build sheet.
 
 Modules: :mod:`.spec` (the request, validated once), :mod:`.tuning`
-(reaction-curve and FOPDT rules), :mod:`.blocks` (topology, part selection,
-checks), :mod:`.model` (realised controller and closed loop), :mod:`.optimize`
+(reaction-curve and FOPDT rules), :mod:`.blocks` (topology, formulas, static
+checks), :mod:`.selection` (joint E-series part selection), :mod:`.model`
+(realised controller and closed loop), :mod:`.optimize`
 (gains within the op-amps' limits), :mod:`.netlist` (closed-loop deck),
 :mod:`.verify` (SPICE run and failure detection), :mod:`.design`
 (orchestration), :mod:`.result` (the typed result and its JSON),

@@ -6,9 +6,9 @@ construction) and returns a :class:`~designer.pid.result.PidResult`; its
 ``to_dict`` is the JSON of ``design-pid --json`` and ``result.json``. The
 steps: the plant as built (designed, given or read), its reaction curve, the
 gains (a rule, explicit, or optimised on the loop as built), the parts
-(:mod:`.blocks`), the analytic closed loop with the op-amp poles
-(:mod:`.model`), the checks, the deck (:mod:`.netlist`) and its simulation
-(:mod:`.verify`).
+(:mod:`.blocks`, chosen by :mod:`.selection`), the analytic closed loop with
+the op-amp poles (:mod:`.model`), the checks, the deck (:mod:`.netlist`) and
+its simulation (:mod:`.verify`).
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from ..plant.bench import recommend_square_wave
 from ..plant.model import plant_tf, plant_tf_opamp
 from ..plant.sallenkey import SallenKeyParts
 from ..spice.deck import SquareTest
-from . import blocks, model, tuning
+from . import blocks, model, selection, tuning
 from .netlist import closed_loop_deck
 from .result import Achieved, AnalyticLoop, PidResult, Waveforms
 from .spec import PidSpec, check_plant
@@ -314,7 +314,7 @@ class _Clock:
 
 
 def _select(spec, tun, plant):
-    return blocks.select_parts(tun.kp, tun.ti_s, tun.td_s, plant.fn_hz, r_series=spec.r_series,
+    return selection.select_parts(tun.kp, tun.ti_s, tun.td_s, plant.fn_hz, r_series=spec.r_series,
                                c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
                                c_min=spec.c_min, c_max=spec.c_max, f_integrator_hz=spec.f_integrator_hz,
                                f_differentiator_hz=spec.f_differentiator_hz, tol=spec.tol)

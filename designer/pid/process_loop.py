@@ -9,7 +9,7 @@ plant is a circuit:
 1. the rules of :mod:`designer.pid.rules` on the model each intends (every one,
    side by side, with the reason where one does not apply), or the optimiser
    (:mod:`designer.pid.process_optimize`), or explicit gains;
-2. the parts (:func:`designer.pid.blocks.select_parts`), the integrator leak at
+2. the parts (:func:`designer.pid.selection.select_parts`), the integrator leak at
    fc/100 and the derivative filter at 10 fc, fc the crossover of the rule's
    ideal loop (as fn/100 and 10 fn for a Sallen-Key plant);
 3. the loop as built: the realised controller (op-amp poles, leak, filter:
@@ -42,7 +42,7 @@ from ..core.lti import filter_foh
 from ..core.units import format_eng
 from ..plant.bench import recommend_square_wave
 from ..spice.deck import SquareTest
-from . import blocks, model as M, rules
+from . import blocks, model as M, rules, selection
 from .delayloop import closed_loop_step, pid_tf, step_figures
 from .delaymargins import loop_margins
 from .netlist import controller_netlist, model_loop_deck
@@ -390,9 +390,9 @@ def model_loop_scope(res: ProcessPidResult):
 
 def size(spec: PidSpec, kp: float, ti_s: float, td_s: float, fc_hz: float, f_i: float, f_d: float):
     """The E-series parts for these gains with the spec's series, bounds and tolerance, the leak and
-    filter at ``f_i`` and ``f_d`` (:func:`designer.pid.blocks.select_parts`): the design's, the rule
+    filter at ``f_i`` and ``f_d`` (:func:`designer.pid.selection.select_parts`): the design's, the rule
     table's SPICE runs' and the optimiser's final check's one call."""
-    return blocks.select_parts(kp, ti_s, td_s, fc_hz, r_series=spec.r_series, c_series=spec.c_series,
+    return selection.select_parts(kp, ti_s, td_s, fc_hz, r_series=spec.r_series, c_series=spec.c_series,
                                r_min=spec.r_min, r_max=spec.r_max, c_min=spec.c_min, c_max=spec.c_max,
                                f_integrator_hz=f_i, f_differentiator_hz=f_d, tol=spec.tol)
 

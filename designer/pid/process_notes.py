@@ -9,7 +9,7 @@ import math
 
 from ..core import opamps
 from ..core.units import format_eng
-from . import blocks
+from . import selection
 
 #: the largest capacitor a sizing message suggests (a 1 mF film capacitor is already a brick)
 PRACTICAL_C_MAX_F = 1e-3
@@ -22,7 +22,7 @@ def sizing_notes(sel, spec) -> list:
     f_i = t.get("f_integrator_hz")
     if f_i and p.f_integrator_hz > 1.5 * f_i:
         need = 1 / (2 * math.pi * f_i * p.c4)
-        r_top = min(spec.r_max, blocks.R_CORNER_MAX)
+        r_top = min(spec.r_max, selection.R_CORNER_MAX)
         c_need = 1 / (2 * math.pi * f_i * r_top)
         if c_need > PRACTICAL_C_MAX_F:
             fix = (f"no practical C4 reaches it (it would take {format_eng(c_need, 'F')}): this loop is too slow for "

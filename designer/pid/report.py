@@ -141,7 +141,7 @@ def _wiring_blocks(result, b, first_rows=(), after: str = "") -> list:
 
 def controller_source(sel):
     """``source_of`` for :func:`designer.report.wiring.bom_rows` of the controller's
-    parts chosen by ``sel`` (a :class:`~designer.pid.blocks.Selection`, None for
+    parts chosen by ``sel`` (a :class:`~designer.pid.selection.Selection`, None for
     given parts): (series, tolerance %) by kind, None for the decoupling."""
     r_series, c_series = (sel.r_series, sel.c_series) if sel is not None else ("as given", "as given")
     rt, ct = sel.tolerances_pct if sel is not None else (None, None)

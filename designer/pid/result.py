@@ -23,9 +23,10 @@ from ..core.opamps import OpAmp
 from ..plant.sallenkey import SallenKeyParts
 from ..spice.deck import SquareTest
 from ..spice.simulate import tool_info
-from .blocks import PidParts, Selection
+from .blocks import PidParts
 from .model import Margins
 from .optimize import OptimizeResult
+from .selection import Selection
 from .spec import PidSpec
 from .tuning import Tuning
 from .verify import SpiceRun, Verdict

@@ -10,7 +10,7 @@ from scipy import signal
 
 from designer.core import opamps
 from designer.core.metrics import step_metrics
-from designer.pid import blocks, model, optimize, tuning
+from designer.pid import blocks, model, optimize, selection, tuning
 
 A, B = 2.0677e-9, 1.8189e-5      # seed plant 1/(A s^2 + B s + 1)
 PN, PD = np.array([1.0]), np.array([A, B, 1.0])
@@ -33,7 +33,7 @@ def test_realised_loop_tends_to_the_ideal_pid():
 
 
 def test_simulator_matches_scipy_lsim():
-    parts = blocks.select_parts(3.34, 43.215e-6, 10.8037e-6, 3500).parts
+    parts = selection.select_parts(3.34, 43.215e-6, 10.8037e-6, 3500).parts
     lm = model.assemble(parts, LM741, PN, PD)
     t = np.linspace(0, 1e-3, 4001)
     r = model.reference(t, 1.0, 20e-6, 3e-6)
@@ -45,7 +45,7 @@ def test_simulator_matches_scipy_lsim():
 
 def test_dc_loop_gain_closed_form():
     # at DC: L(0) = Kp (1 + R13 C4 / Ti) x plant gain, with ideal op-amps
-    parts = blocks.select_parts(3.34, 43.215e-6, 10.8037e-6, 3500).parts
+    parts = selection.select_parts(3.34, 43.215e-6, 10.8037e-6, 3500).parts
     L0 = model.loop_gain(parts, IDEAL, PN, PD, np.array([1e-6]))[0]
     assert L0.real == pytest.approx(parts.kp * (1 + parts.integrator_dc_gain), rel=1e-6)
     assert abs(L0.imag) < 1e-6 * abs(L0)
@@ -158,7 +158,7 @@ def test_realised_controller_tf_is_the_pid_between_its_corners():
 def test_the_kicks_fine_grid_and_the_coarse_one_from_one_exponential():
     """simulate_with_kick (the coarse propagator squared up from the fine one, the ramp's increment
     rescaled) gives what simulate gives on each grid by its own matrix exponential."""
-    parts = blocks.select_parts(3.34, 43.215e-6, 10.8037e-6, 3500).parts
+    parts = selection.select_parts(3.34, 43.215e-6, 10.8037e-6, 3500).parts
     lm = model.assemble(parts, LM741, PN, PD)
     t = np.linspace(0.0, 1e-3, 2001)
     h = (t[1] - t[0]) / 8

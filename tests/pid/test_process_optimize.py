@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from designer.core import process
-from designer.pid.blocks import select_parts
 from designer.pid.delayloop import closed_loop_step, step_figures
 from designer.pid.delaymargins import loop_margins
 from designer.pid.model import controller_tf
 from designer.pid.process_loop import (built_controller, corner_frequencies, design_model_pid, ideal_crossover_hz,
                                        leak_limit_hz, plant_of,
                                        response_grid)
+from designer.pid.selection import select_parts
 from designer.pid.spec import PidSpec
 
 ISSUE_TF = "K=2 tau=1m theta=200u"

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from designer.core import opamps
-from designer.pid import blocks, verify
+from designer.pid import blocks, selection, verify
 from designer.pid.design import PidSpec, design_pid
 from designer.pid.netlist import closed_loop_deck
 from designer.plant.sallenkey import SallenKeyParts
@@ -82,7 +82,7 @@ def test_large_step_saturates_a_stable_loop():
 def test_positive_feedback_latches_at_a_rail():
     # swap the reference and the plant output at the difference amplifier: positive feedback
     amp = opamps.get("LM741")
-    parts = blocks.select_parts(1.0, 60e-6, 5e-6, SEED_PLANT.fn_hz).parts
+    parts = selection.select_parts(1.0, 60e-6, 5e-6, SEED_PLANT.fn_hz).parts
     test = SquareTest(1.0, 330.0, 50e-6, 100e-9)
     deck = closed_loop_deck(parts, SEED_PLANT, amp, test, "positive feedback", 1.0)
     deck = re.sub(r"^R15 ref n2", "R15 y n2", deck, flags=re.M)
