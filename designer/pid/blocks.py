@@ -231,7 +231,7 @@ def continuous_parts(kp: float, ti_s: float, td_s: float, fn_hz: float, *,
                      r: float = 10e3) -> PidParts:
     """Exact (unrounded) parts with a fixed, balanced structure, for searching
     gains before any part is chosen: R6 = R7 = R8 = R9 = R10 = R14 = R15..R18 = r,
-    R11 C3 = Td, R14 C4 = Ti, corners as in :func:`select_parts`, and Kp split
+    R11 C3 = Td, R14 C4 = Ti, corners as in :func:`designer.pid.selection.select_parts`, and Kp split
     between the summer and the final gain so that their noise gains match
     (1 + 3 g = 1 + Kp/g, g = sqrt(Kp/3); 1 + 2 g and g = sqrt(Kp/2) for a PI)."""
     _check_targets(kp, ti_s, td_s)
