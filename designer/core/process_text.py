@@ -13,11 +13,11 @@ values in engineering notation, theta 0 when not given):
   power first, commas or spaces inside the brackets (``num=[1] den=[1m 1]``)
 - ``K [tau] integrator [theta]``  integrating, K e^(-theta s) / (s (tau s + 1)) (no tau: K/s)
 
-Each form is built by the builder of :mod:`designer.core.process` that its
+Each form is built by the builder of :mod:`designer.core.process_build` that its
 constructor uses, with the typed key names, so a typed model is checked
-against the same ranges (:data:`~designer.core.process.TAU_RANGE`,
-:data:`~designer.core.process.GAIN_RANGE`, :data:`~designer.core.process.FN_RANGE`,
-0 < zeta < 1, :data:`~designer.core.process.MAX_DEAD_TIME_RATIO`, a proper
+against the same ranges (:data:`~designer.core.process_build.TAU_RANGE`,
+:data:`~designer.core.process_build.GAIN_RANGE`, :data:`~designer.core.process_build.FN_RANGE`,
+0 < zeta < 1, :data:`~designer.core.process_build.MAX_DEAD_TIME_RATIO`, a proper
 and stable rational part) and a refusal names the key as typed. What cannot
 be read (an unknown key, with the closest one; a key given twice; a key
 missing for its form; a mix of forms; a value that is not a number) is
@@ -31,7 +31,8 @@ import re
 
 from .errors import DesignError
 # the builders behind the constructors: they take the names a refusal uses
-from .process import ProcessModel, _fopdt, _integrating, _rational, _sopdt, _underdamped
+from .process import ProcessModel
+from .process_build import _fopdt, _integrating, _rational, _sopdt, _underdamped
 from .units import parse_value
 
 #: what a key of a typed model may be written as (lower case) -> the key
@@ -237,9 +238,9 @@ def parse_tf(text: str) -> ProcessModel:
         One line naming the key at fault and what is allowed: an unknown key
         (with the closest one), a key given twice, a key missing for the form,
         a mix of forms, a value that is not a number, or a value outside the
-        ranges of :mod:`designer.core.process` (:data:`~designer.core.process.TAU_RANGE`,
-        :data:`~designer.core.process.GAIN_RANGE`, :data:`~designer.core.process.FN_RANGE`,
-        0 < zeta < 1, :data:`~designer.core.process.MAX_DEAD_TIME_RATIO`, a
+        ranges of :mod:`designer.core.process_build` (:data:`~designer.core.process_build.TAU_RANGE`,
+        :data:`~designer.core.process_build.GAIN_RANGE`, :data:`~designer.core.process_build.FN_RANGE`,
+        0 < zeta < 1, :data:`~designer.core.process_build.MAX_DEAD_TIME_RATIO`, a
         proper and stable rational part).
     """
     if not isinstance(text, str):

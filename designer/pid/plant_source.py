@@ -19,12 +19,12 @@ Three kinds of file are read, each as the command that wrote it lays it out:
   zeta >= 1, the SOPDT with tau1,2 = (b +- sqrt(b^2 - 4 a))/2.
 
 Identification's parameter names (:mod:`designer.core.stepfit`) map to the
-constructors of :mod:`designer.core.process`: ``fopdt`` (K, tau_s, theta_s)
--> :func:`~designer.core.process.fopdt`; ``overdamped`` (K, tau1_s, tau2_s,
+constructors of :mod:`designer.core.process_build`: ``fopdt`` (K, tau_s, theta_s)
+-> :func:`~designer.core.process_build.fopdt`; ``overdamped`` (K, tau1_s, tau2_s,
 theta_s, fast one first) and ``double-pole`` (K, tau_s, theta_s: tau1 = tau2)
--> :func:`~designer.core.process.sopdt` (which sorts, slow first);
+-> :func:`~designer.core.process_build.sopdt` (which sorts, slow first);
 ``underdamped`` (K, wn_rad_s, zeta, theta_s) ->
-:func:`~designer.core.process.underdamped` with fn = wn / 2 pi (its
+:func:`~designer.core.process_build.underdamped` with fn = wn / 2 pi (its
 half-width too). Every other file (a ``check-design`` or ``design-pid``
 result, anything else) is refused in one line saying what it is and what is
 accepted. This module reads identification's JSON, never its code (``pid``
@@ -40,7 +40,8 @@ import re
 
 from ..core.errors import DesignError
 from ..core.fileio import shown
-from ..core.process import ProcessModel, fopdt, sopdt, underdamped
+from ..core.process import ProcessModel
+from ..core.process_build import fopdt, sopdt, underdamped
 from ..plant.model import plant_tf
 from ..plant.sallenkey import SallenKeyParts, check_parts
 
@@ -98,7 +99,7 @@ def model_from_json(path, method: str | None = None) -> ProcessModel:
         One line: the file unreadable or not JSON; a check-design, design-pid
         or other result; no valid best model, or ``method`` unknown or not
         valid (listing the valid methods); parameters outside the ranges of
-        :mod:`designer.core.process`; a plant's parts out of range.
+        :mod:`designer.core.process_build`; a plant's parts out of range.
     """
     from ..core.jsonio import read_result
     data = read_result(path, "--plant-model", what=ACCEPTED)   # the one reader of result files: bounded, one line

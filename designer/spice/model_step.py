@@ -31,7 +31,7 @@ Example: seed 000's DC motor (course notes, UNaM: Km = W(inf)/a and
 tau_m = -t0 / ln(1 - w(t0)/W(inf)); a = 2 V, W(inf) = 2.5, w(0.15 s) = 1.75,
 so Km = 1.25 and tau_m = 0.1246 s)::
 
-    from designer.core.process import fopdt
+    from designer.core.process_build import fopdt
     from designer.spice.model_step import simulate_step
     t, u, y = simulate_step(fopdt(1.25, 0.1246), step_v=2.0, noise_v=0.01, seed=0)
     # y settles at 2.5 (W(inf)), y(t_step + 0.15 s) = 1.75
@@ -261,7 +261,7 @@ def simulate_step(model: ProcessModel, step_v: float = 1.0, step_time_s: float |
     --------
     Seed 000's DC motor, Km = 1.25, tau_m = 0.1246 s, driven with a = 2 V:
 
-    >>> from designer.core.process import fopdt
+    >>> from designer.core.process_build import fopdt
     >>> t, u, y = simulate_step(fopdt(1.25, 0.1246), step_v=2.0)   # doctest: +SKIP
     >>> round(float(y[-1]), 3)                                      # doctest: +SKIP
     2.5

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from helpers import script
 
-from designer.core.process import fopdt
+from designer.core.process_build import fopdt
 
 DESIGN_PID = script("design-pid")
 ANALYZE_PID = script("analyze-pid")

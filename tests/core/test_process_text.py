@@ -9,9 +9,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designer.core.errors import DesignError
-from designer.core.process import (
+from designer.core.process import ProcessModel
+from designer.core.process_build import (
     MAX_DEAD_TIME_RATIO,
-    ProcessModel,
     fopdt,
     integrating,
     rational,

@@ -12,7 +12,7 @@ import pytest
 from helpers import REPORTS, script
 
 from designer.core.errors import DesignError
-from designer.core.process import fopdt, sopdt, underdamped
+from designer.core.process_build import fopdt, sopdt, underdamped
 from designer.pid.plant_source import model_from_json, result_kind, sallen_key_model
 from designer.plant.sallenkey import SallenKeyParts
 

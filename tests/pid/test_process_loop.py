@@ -24,7 +24,7 @@ import re
 import numpy as np
 import pytest
 
-from designer.core import process
+from designer.core import process_build
 from designer.core.errors import DesignError
 from designer.identify.step import identify_step
 from designer.pid import rules
@@ -61,9 +61,9 @@ POINTS, SETTLING_TIMES, PRE, STEP_V, NOISE, BITS = 4000, 5.0, 0.2, 1.0, 0.005, 8
 OVERSHOOT_PP, SETTLING_REL = 2.0, 0.10
 
 TRUE_PLANTS = {
-    "fopdt": process.fopdt(2.0, 1e-3, 200e-6),
-    "sopdt": process.sopdt(1.5, 1e-3, 300e-6, 100e-6),
-    "underdamped": process.underdamped(1.0, 200.0, 0.4, 100e-6),
+    "fopdt": process_build.fopdt(2.0, 1e-3, 200e-6),
+    "sopdt": process_build.sopdt(1.5, 1e-3, 300e-6, 100e-6),
+    "underdamped": process_build.underdamped(1.0, 200.0, 0.4, 100e-6),
 }
 
 
@@ -211,7 +211,7 @@ def test_the_plant_input_range_is_checked_on_both_edges():
     ({"plant_tf": "K=2 tau=-1m theta=200u"}, "plant_tf", "positive"),
     ({"plant_tf": "num=[1] den=[1m -1]"}, "plant_tf", "right half plane"),
     ({"plant_tf": "num=[1m 1 1] den=[1m 1]"}, "plant_tf", "proper"),
-    ({"plant_tf": f"K=1 tau=1m theta={process.MAX_DEAD_TIME_RATIO * 1.01e-3!r}"}, "plant_tf", "dead time"),
+    ({"plant_tf": f"K=1 tau=1m theta={process_build.MAX_DEAD_TIME_RATIO * 1.01e-3!r}"}, "plant_tf", "dead time"),
     ({"plant_tf": ISSUE_TF, "robust": True}, "robust", "95 %"),
     ({"plant_fc_hz": 3500, "plant_zeta": 0.2, "max_ms": 1.5}, "max_ms", "Sallen-Key"),
 ], ids=["unknown-key", "zero-tau", "negative-tau", "unstable", "improper", "dead-time", "robust-no-ci95",
@@ -285,14 +285,14 @@ def test_no_rule_applies_names_each_reason_once():
 def test_a_plant_too_fast_for_the_op_amp_is_told_which_op_amp_keeps_it():
     """A lab's 5.7 MHz second-order step (as identified): the rule's gains meet the phase margin with ideal
     op-amps and the LM741's poles make the loop unstable; the note says so and names what would do."""
-    model = process.underdamped(18.0, 5.7e6, 0.64, theta_s=47.5e-9)
+    model = process_build.underdamped(18.0, 5.7e6, 0.64, theta_s=47.5e-9)
     res = design_model_pid(PidSpec(plant_process=model, tuning="amigo"), simulate=False)
     assert res.ideal_margins.stable and not res.margins.stable
     note = next(n for n in res.notes if "is too slow for this loop" in n)
     need = 30 * res.ideal_margins.crossover_hz
     assert f"{format_eng(need, 'Hz')} of GBW" in note and "NE5532" in note and "is unstable" in note
     # a plant thirty times slower: an op-amp of the library is named, and it does keep the loop
-    slow_plant = process.underdamped(18.0, 2e5, 0.64, theta_s=1e-6)
+    slow_plant = process_build.underdamped(18.0, 2e5, 0.64, theta_s=1e-6)
     slower = design_model_pid(PidSpec(plant_process=slow_plant, tuning="amigo"), simulate=False)
     notes = [n for n in slower.notes if "is too slow for this loop" in n]
     named = re.search(r"--opamp (\S+),", notes[0]).group(1)

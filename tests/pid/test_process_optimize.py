@@ -7,7 +7,7 @@ no worse than the best rule's that meets the same limits, and the options
 import numpy as np
 import pytest
 
-from designer.core import process
+from designer.core import process_build
 from designer.pid.delayloop import closed_loop_step, step_figures
 from designer.pid.delaymargins import loop_margins
 from designer.pid.model import controller_tf
@@ -180,9 +180,9 @@ def test_a_target_overshoot_is_met_by_the_analytic_loop(tf):
 
 
 def test_robust_holds_the_limits_at_every_corner_of_the_95_percent_box():
-    nominal = process.fopdt(2.0, 1e-3, 200e-6)
+    nominal = process_build.fopdt(2.0, 1e-3, 200e-6)
     # 10 % half-widths on every parameter
-    model = process.fopdt(2.0, 1e-3, 200e-6, ci95={k: 0.1 * v for k, v in nominal.params.items()})
+    model = process_build.fopdt(2.0, 1e-3, 200e-6, ci95={k: 0.1 * v for k, v in nominal.params.items()})
     plain = optimized(plant_process=model)
     assert plain.robust is not None and len(plain.robust.corners) == 2 ** 3
     assert not all(meets(f.margins, plain.limits) for _, f in plain.robust.corners)   # the nominal loop does not

@@ -12,7 +12,7 @@ import pytest
 
 from designer.core import opamps
 from designer.core.errors import DesignError
-from designer.core.process import fopdt
+from designer.core.process_build import fopdt
 from designer.pid import process_report as P
 from designer.pid.blocks import seed_parts
 from designer.pid.netlist import controller_netlist, model_loop_deck

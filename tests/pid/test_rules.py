@@ -11,7 +11,7 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from designer.core import process
+from designer.core import process_build
 from designer.core.errors import DesignError
 from designer.pid import reduction as M
 from designer.pid import rules as R
@@ -308,16 +308,16 @@ def _wn(fn):
 
 
 EQUIVALENT = [
-    (process.fopdt(2.0, 1e-3, 200e-6), M.ModelFopdt(2.0, 1e-3, 200e-6)),
-    (process.fopdt(2.0, 1e-3, 0.0), M.ModelFopdt(2.0, 1e-3, 0.0)),
-    (process.fopdt(-2.0, 1e-3, 200e-6), M.ModelFopdt(-2.0, 1e-3, 200e-6)),
-    (process.sopdt(1.5, 0.5e-3, 2e-3, 1e-4), M.ModelSopdt(1.5, 2e-3, 0.5e-3, 1e-4)),
-    (process.integrating(20.0, 1e-3, 0.5e-3), M.ModelIntegrating(20.0, 1e-3, 0.5e-3)),
-    (process.integrating(3.0, 0.0, 1e-3), M.ModelIntegrating(3.0, 0.0, 1e-3)),
-    (process.underdamped(1.0, 3500.0, 0.2, 20e-6),
+    (process_build.fopdt(2.0, 1e-3, 200e-6), M.ModelFopdt(2.0, 1e-3, 200e-6)),
+    (process_build.fopdt(2.0, 1e-3, 0.0), M.ModelFopdt(2.0, 1e-3, 0.0)),
+    (process_build.fopdt(-2.0, 1e-3, 200e-6), M.ModelFopdt(-2.0, 1e-3, 200e-6)),
+    (process_build.sopdt(1.5, 0.5e-3, 2e-3, 1e-4), M.ModelSopdt(1.5, 2e-3, 0.5e-3, 1e-4)),
+    (process_build.integrating(20.0, 1e-3, 0.5e-3), M.ModelIntegrating(20.0, 1e-3, 0.5e-3)),
+    (process_build.integrating(3.0, 0.0, 1e-3), M.ModelIntegrating(3.0, 0.0, 1e-3)),
+    (process_build.underdamped(1.0, 3500.0, 0.2, 20e-6),
      M.ModelTf((1.0,), (1 / _wn(3500.0) ** 2, 2 * 0.2 / _wn(3500.0), 1.0), 20e-6)),
-    (process.rational(E1.num, E1.den), E1),
-    (process.rational([4.0], [2e-3, 2.0], 200e-6), M.ModelTf((2.0,), (1e-3, 1.0), 200e-6)),
+    (process_build.rational(E1.num, E1.den), E1),
+    (process_build.rational([4.0], [2e-3, 2.0], 200e-6), M.ModelTf((2.0,), (1e-3, 1.0), 200e-6)),
 ]
 
 

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from helpers import EXT_CAPTURES, ROOT, script
 
-from designer.core.process import fopdt
+from designer.core.process_build import fopdt
 from designer.pid.design import PidSpec, design_pid
 
 pytestmark = pytest.mark.spice

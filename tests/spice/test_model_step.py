@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from designer.core.errors import DesignError
-from designer.core.process import fopdt, integrating, sopdt, underdamped
+from designer.core.process_build import fopdt, integrating, sopdt, underdamped
 from designer.spice.model_step import (DURATION_SETTLING_TIMES, MAX_POINTS, default_duration_s,
                                        default_step_time_s, simulate_step, step_deck)
 
