@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from designer.identify import bode_readings as br
 from designer.identify import frequency as fr
 from designer.identify import io as tio
 from designer.identify import second_order as so
@@ -55,8 +56,8 @@ def noisy_table(n=200, seed=1):
     rng = np.random.default_rng(seed)
     p = {"K": 1.0, "wn_rad_s": 2 * math.pi * 3500, "zeta": 0.2, "theta_s": 2e-6}
     w = np.geomspace(0.01, 30, n) * p["wn_rad_s"]
-    g = fr.model_response("underdamped", p, w) * (1 + 0.01 * rng.standard_normal(n))
-    ph = fr.model_phase("underdamped", p, w) + np.deg2rad(0.5) * rng.standard_normal(n)
+    g = br.model_response("underdamped", p, w) * (1 + 0.01 * rng.standard_normal(n))
+    ph = br.model_phase("underdamped", p, w) + np.deg2rad(0.5) * rng.standard_normal(n)
     return tio.freq_data(w, np.abs(g), ph, gain_units="ratio", phase_units="rad",
                         freq_units="rad/s"), p
 

@@ -7,7 +7,9 @@ found), ``settle`` (baseline, final value), ``normalise`` (one step) and
 families ``underdamped``, ``overdamped`` and ``dc_motor`` (listed in
 ``second_order``) and ``refine`` (least squares) are the step methods on the
 shared ``structures``;
-``step`` runs and ranks them, ``frequency`` does the same for a Bode table;
+``step`` runs and ranks them, ``frequency`` does the same for a Bode table
+(the model responses and classical readings of ``bode_readings``, the
+least-squares fit of ``freqfit``, the loop margins of ``bode_margins``);
 ``correlation`` and ``spectral`` estimate the impulse and frequency
 responses from a broadband input (a PRBS, :mod:`designer.core.prbs`, or
 noise: seed 003, 2.4 and 3.2) and ``broadband`` recognises such an input and

@@ -192,7 +192,7 @@ def fit_plot(result, n_models: int = 3) -> bytes:
 
 def bode_fit_plot(result, n_models: int = 3) -> bytes:
     """PNG Bode plot of a frequency table and the best ``n_models`` valid models."""
-    from .frequency import model_phase, model_response
+    from .bode_readings import model_phase, model_response
     plt = _pyplot()
     d = result.data
     w = np.geomspace(d.w[0] / 2.0, d.w[-1] * 2.0, 400)
@@ -263,7 +263,7 @@ def broadband_plot(result, n_models: int = 3) -> bytes:
     """PNG of a broadband identification: the impulse response, the step it
     integrates to with the best step models, the spectral estimate (gain and
     phase) with the best frequency models, and its coherence."""
-    from .frequency import model_response
+    from .bode_readings import model_response
     from .structures import model_step
     plt = _pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(11, 7), dpi=100)

@@ -174,7 +174,7 @@ def identify_page(result) -> dict:
         for m in shown:
             series[f"{m.name} ({m.model})"] = s.y0 + s.amplitude * model_step(m.model, m.params, tt)
         return {"kind": "step", "plot": _trace(tt, series, "time since the step (s)")}
-    from ..identify.frequency import model_phase, model_response
+    from ..identify.bode_readings import model_phase, model_response
     d = result.data
     w = np.geomspace(d.w[0] / 2.0, d.w[-1] * 2.0, BODE_POINTS)
     models = {f"{m.name} ({m.model})": model_response(m.model, m.params, w) for m in shown}
@@ -191,7 +191,7 @@ def identify_page(result) -> dict:
 def _broadband_page(result) -> dict:
     """A broadband identification's two views (as ``identify --plot`` draws them)."""
     from ..core.stepfit import model_step
-    from ..identify.frequency import model_response
+    from ..identify.bode_readings import model_response
     page = {"kind": "broadband"}
     est = result.impulse
     if est is not None:

@@ -36,7 +36,7 @@ from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 
 from designer.cli.identify import identify_freq_main, identify_main
-from designer.identify.frequency import model_phase, model_response
+from designer.identify.bode_readings import model_phase, model_response
 from designer.identify.structures import model_step
 
 #: examples per property; IDENTIFY_FUZZ_EXAMPLES=2000 for a deep local run
