@@ -74,7 +74,8 @@ _PEAK = ("import resource, sys\n"
          "hwm = [ln for ln in open('/proc/self/status') if ln.startswith('VmHWM')][0]\n"
          "helper = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss\n"
          "print((int(hwm.split()[1]) + helper) / 1024.0, file=sys.stderr)\n"
-         "sys.exit(rc)\n")
+         "from designer.core import lifetime\n"
+         "lifetime.finish(rc)\n")     # as the console script ends
 
 
 def peak_rss_mb(args, expect: int = 0) -> tuple:
