@@ -5,10 +5,11 @@ LocalCluster started by the command, ahead of its Monte Carlo while it designs).
 A LocalCluster's workers are threads of the command where a chunk's work is a
 simulator subprocess, else processes forked from a fork server that imported
 the engine once (:data:`WORKERS`); they are adopted so that nothing of the
-cluster outlives the command. Tasks are the runner's chunks (:func:`designer.
-tolerance.runner.run_chunk`): a chunk whose worker dies is submitted once more,
-then it is a :class:`~designer.core.errors.SimulatorError` naming it. A
-scheduler that does not answer within :data:`CONNECT_TIMEOUT` seconds is one too.
+cluster outlives the command. Tasks are the runner's chunks
+(:func:`designer.tolerance.runner.run_chunk`): a chunk whose worker dies is
+submitted once more, then it is a :class:`~designer.core.errors.SimulatorError`
+naming it. A scheduler that does not answer within :data:`CONNECT_TIMEOUT`
+seconds is one too.
 """
 
 from __future__ import annotations
