@@ -13,7 +13,6 @@ from __future__ import annotations
 import argparse
 import contextvars
 import json
-import os
 import re
 import sys
 
@@ -91,12 +90,8 @@ def print_output(text: str, end: str = "\n") -> None:
 
 
 def _silence_stdout() -> None:
-    # the interpreter flushes stdout again at exit: point it at /dev/null so that
-    # a reader who stopped early (| head) gets no "Exception ignored" message
-    try:
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-    except (OSError, ValueError):
-        pass
+    from ..core.lifetime import to_devnull
+    to_devnull(sys.stdout)
 
 
 def run_cli(prog: str, build_parser, action, argv=None) -> int:

@@ -126,24 +126,30 @@ def finish(status: int):
     normal exit."""
     import atexit
     import threading
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.flush()
-        except (OSError, ValueError):   # a closed pipe or stream: nothing more can reach it
+
+    def flush():
+        for stream in (sys.stdout, sys.stderr):
             try:
-                os.dup2(os.open(os.devnull, os.O_WRONLY), stream.fileno())
-            except (OSError, ValueError):
-                pass
+                stream.flush()
+            except (OSError, ValueError):   # a closed pipe or stream: nothing more can reach it
+                to_devnull(stream)
+
+    flush()
     shutdown = getattr(threading, "_shutdown", None)    # what Python runs first at exit (CPython's)
     if shutdown is not None and threading.current_thread() is threading.main_thread():
         shutdown()
     atexit._run_exitfuncs()     # prints a failing handler's error, as Python does, and goes on
-    for stream in (sys.stdout, sys.stderr):   # what the handlers printed
-        try:
-            stream.flush()
-        except (OSError, ValueError):
-            pass
+    flush()                     # what the handlers printed
     os._exit(status)
+
+
+def to_devnull(stream) -> None:
+    """Point ``stream``'s file descriptor at /dev/null: its reader left (``| head``), and a later
+    flush (Python's own at exit) must not print "Exception ignored"."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), stream.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 def _handler(signum, frame):

@@ -121,7 +121,6 @@ def parse_jobs(text) -> int:
     return jobs
 
 
-
 def run_chunk(evaluate, context, draw: Draw, start: int, stop: int) -> dict:
     """One chunk's task: samples start .. stop - 1 drawn, then evaluated.
     Returns ``{"values": {designator: array}, "figures": {figure: array}}``."""

@@ -34,7 +34,6 @@ import numpy as np
 
 from ..core.errors import DesignError
 from . import spice_loop
-from .runner import Picked
 
 #: the SPICE step figures a --limit may name (the analytic loop's ``model_*`` stand in for them)
 STEP = spice_loop.STEP
@@ -81,8 +80,7 @@ def loop_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler
     ``--target-ci`` (:mod:`designer.tolerance.runner`). Returns a :class:`~designer.tolerance.loop.LoopMonteCarlo`
     (its ``spice``: the module docstring)."""
     from .loop import _passed, engine_of, loop_monte_carlo, loop_parts
-    from .runner import Runner, Scale
-    from .spice_mc import ENGINES, disagreement, spice_checked, spice_samples
+    from .spice_mc import ENGINES, disagreement, run_picked, spice_checked, spice_samples
     if engine not in ENGINES:
         raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
     where = {"scale": scale, "target_ci": target_ci}
@@ -100,10 +98,7 @@ def loop_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler
         n = mc.n
         worst, rand = spice_samples(mc.figures, mc.limits, spice_k, seed)
         idx = np.array(sorted(worst + rand), int)
-        sub = {r: v[idx] for r, v in mc.values.items()}
-        draw = Picked(mc.nominal, mc.tolerances.of, idx.size, seed, sampler, dist, picked=sub)
-        with Runner(scale or Scale()) as run:
-            _, sp, _ = run.run(spice_loop.evaluate, ctx, draw)
+        sp = run_picked(mc, idx, spice_loop.evaluate, ctx, scale)
         model_pass = mc.passed[idx]
         spice_pass = _passed(sp, limits)
         disagree = disagreement(_spice_figures(sp), {f: v[idx] for f, v in _model_figures(mc.figures).items()},

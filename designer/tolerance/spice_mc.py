@@ -123,6 +123,17 @@ def spice_samples(figs: dict, limits, k: int, seed: int) -> tuple:
     return worst, rand
 
 
+def run_picked(mc, idx, evaluate, context, scale=None) -> dict:
+    """The figures of the builds ``idx`` of the Monte Carlo ``mc`` (``--spice-samples``: the
+    ones SPICE checks), their values taken from the run, chunked through the runner on the same
+    workers as the run (``scale``: ``--jobs``, ``--dask``)."""
+    from .runner import Picked, Runner, Scale
+    picked = {r: v[idx] for r, v in mc.values.items()}
+    draw = Picked(mc.nominal, mc.tolerances.of, idx.size, mc.seed, mc.sampler, mc.dist, picked=picked)
+    with Runner(scale or Scale()) as run:
+        return run.run(evaluate, context, draw)[1]
+
+
 def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler: str = "random",
                              dist: str = "uniform", tol_items=(), limit_items=(), engine: str = "analytic",
                              spice_k: int | None = None, simulator: str = "ngspice-cli", scale=None,
@@ -133,7 +144,6 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
     samples run and ``--target-ci`` (:mod:`designer.tolerance.runner`)."""
     where = {"scale": scale, "target_ci": target_ci}
     from .montecarlo import _apply, _figures, plant_monte_carlo
-    from .runner import Picked, Runner, Scale
     if engine not in ENGINES:
         raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
     amp = result.opamp
@@ -155,10 +165,7 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
         idx = np.array(worst + rand, int)
         order = np.argsort(idx)
         idx = idx[order]
-        sub = {r: v[idx] for r, v in mc.values.items()}
-        draw = Picked(mc.nominal, mc.tolerances.of, idx.size, seed, sampler, dist, picked=sub)
-        with Runner(scale or Scale()) as run:     # the same workers (--jobs, --dask) as the model's run
-            _, sp, _ = run.run(_apply, spice_evaluate(ctx, amp), draw)
+        sp = run_picked(mc, idx, _apply, spice_evaluate(ctx, amp), scale)
         model_pass = mc.passed[idx]
         spice_pass = _passes(sp, mc.limits)
         mc.spice = {**settings, **spice_checked(idx, worst, rand, model_pass, spice_pass, mc.yield_count, n,
