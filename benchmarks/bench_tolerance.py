@@ -269,6 +269,23 @@ def scale_out(res):
         a, b, r = pairs(loop, n, ["--jobs", "2"], ["--dask", "local"])
         print(f"| {what}: --jobs 2, --dask local (2 workers) | {a:.2f} | {b:.2f} | {r:.2f}x the wall | "
               "(shown: the goal is on SPICE builds) | |")
+    # the short end of every console script (designer.core.lifetime.finish) against Python's normal exit,
+    # the same --dask local command: the console script's entry, once as it is, once with finish replaced
+    # by sys.exit (the interpreter's teardown of distributed, tornado, numpy... after the work)
+    run_as = ("import sys; from designer.core import lifetime; {patch}from designer.cli.launch import design_plant; "
+              "sys.argv = ['design-plant'] + {argv!r}; sys.exit(design_plant())")
+    argv = spice[1:] + ["--monte-carlo", "500", "--dask", "local"]
+    ends = {"finish": [], "normal": []}
+    for _ in range(WALL_REPEATS):
+        for key, patch in (("finish", ""), ("normal", "lifetime.finish = lambda s: sys.exit(s); ")):
+            t = time.perf_counter()
+            p = subprocess.run([sys.executable, "-c", run_as.format(patch=patch, argv=argv)], capture_output=True,
+                               text=True, env=env, timeout=1800)
+            ends[key].append(time.perf_counter() - t)
+            assert p.returncode == 0, p.stderr
+    f, n_ = float(np.median(ends["finish"])), float(np.median(ends["normal"]))
+    print(f"| 500 SPICE builds, --dask local: the console script's short end (lifetime.finish), Python's normal "
+          f"exit | {f:.2f} | {n_:.2f} | {n_ - f:.2f} s saved | (shown) | |")
     print(f"\nThe monte_carlo sections were identical in every pair. Load average {os.getloadavg()[0]:.1f} on "
           f"{os.cpu_count()} cores at the end (the machine is shared with other jobs; a speed-up needs a free "
           "second core). A whole command's imports and design run on one core whatever --jobs, so its speed-up "

@@ -25,7 +25,7 @@ however it is stopped.
   noticed by the child, which exits.
 - **A short end** (:func:`finish`, every console script once its command returned): the
   streams flushed, Python's own exit steps (threads joined, ``atexit``), then ``os._exit``,
-  without the teardown of every imported module (0.15 s of a short run after ``import
+  without the teardown of every imported module (0.12 s of a short run after ``import
   distributed``; bench_tolerance).
 """
 
