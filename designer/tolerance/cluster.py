@@ -8,8 +8,9 @@ the engine once (:data:`WORKERS`); they are adopted so that nothing of the
 cluster outlives the command. Tasks are the runner's chunks
 (:func:`designer.tolerance.runner.run_chunk`): a chunk whose worker dies is
 submitted once more, then it is a :class:`~designer.core.errors.SimulatorError`
-naming it. A scheduler that does not answer within :data:`CONNECT_TIMEOUT`
-seconds is one too.
+naming it. An address where no Dask scheduler answers within :data:`CONNECT_TIMEOUT`
+seconds is one too (:func:`probe`: nothing listening, nothing answering, or something else, such
+as a web server, answering), said in one line within those seconds.
 """
 
 from __future__ import annotations
@@ -17,17 +18,24 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import socket
+import struct
+import time
 
 from ..core.errors import DesignError, SimulatorError
 from .runner import Scale, _die_twice, run_chunk
 
 #: seconds a Dask scheduler has to answer
 CONNECT_TIMEOUT = 3.0
-_ADDRESS = re.compile(r"^(?:(tcp|tls|ws|wss|ucx)://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):(\d{1,5})$")
+_ADDRESS = re.compile(r"^(?:([A-Za-z][A-Za-z0-9+.-]*)://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):(\d{1,5})$")
+#: the largest first message a scheduler's handshake can be (its settings: a few hundred bytes)
+_HANDSHAKE_MAX = 1 << 20
 
 
 def parse_dask(text) -> str:
-    """``--dask ADDRESS``: ``local``, or a scheduler's ``[tcp://]host:port``."""
+    """``--dask ADDRESS``: ``local``, or a scheduler's ``[tcp://]host:port``. Other schemes
+    (``tls://`` needs certificates, ``ws://``, ``ucx://`` other transports: none of them is
+    given to this command) are refused in one line."""
     t = str(text).strip()
     if t.lower() == "local":
         return "local"
@@ -35,7 +43,63 @@ def parse_dask(text) -> str:
     if not m or not 0 < int(m.group(3)) < 65536:
         raise DesignError(f"--dask {text!r}: give a scheduler's address, such as tcp://10.0.0.5:8786 or "
                           "host:8786, or 'local' for a LocalCluster on this machine")
-    return t if m.group(1) else f"tcp://{t}"
+    if m.group(1) is not None and m.group(1).lower() != "tcp":
+        raise DesignError(f"--dask {text!r}: only a tcp:// scheduler address is taken (a {m.group(1)}:// one "
+                          "needs certificates or a transport this command has no options for)")
+    return f"tcp://{m.group(2)}:{m.group(3)}"
+
+
+def _recv_exactly(sock, n: int, deadline: float) -> bytes:
+    """``n`` bytes from ``sock`` before ``deadline`` (monotonic); fewer if it closed; TimeoutError."""
+    data = b""
+    while len(data) < n:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            raise TimeoutError
+        sock.settimeout(left)
+        chunk = sock.recv(min(n - len(data), 65536))
+        if not chunk:
+            break
+        data += chunk
+    return data
+
+
+def probe(address: str, timeout: float = CONNECT_TIMEOUT) -> str | None:
+    """Why no Dask scheduler answers at ``address`` (``tcp://host:port``), or None when one does,
+    told within ``timeout`` seconds. A scheduler speaks first: on each connection it sends its
+    handshake, one message of distributed's TCP framing (an 8-byte little-endian length, then
+    that many bytes: ``distributed/comm/tcp.py``, ``TCP.read``). Anything else is not a scheduler:
+    a web server waits for a request (silent), others send text (an implausible length) or
+    close. Distributed's own client, given such a peer, reads the text as a length (MemoryError)
+    or waits for ever; this probe is asked first."""
+    m = _ADDRESS.match(address)
+    host, port = m.group(2).strip("[]"), int(m.group(3))
+    deadline = time.monotonic() + timeout
+    try:
+        sock = socket.create_connection((host, port), timeout=timeout)
+    except socket.gaierror:
+        return f"the host {host!r} is unknown"
+    except ConnectionRefusedError:
+        return "nothing listens there (connection refused)"
+    except (TimeoutError, socket.timeout):
+        return f"nothing answered within {timeout:g} s"
+    except OSError as exc:
+        return f"it cannot be reached ({exc.strerror or exc})"
+    with sock:
+        try:
+            head = _recv_exactly(sock, 8, deadline)
+            if len(head) < 8:
+                return "something else answered: it closed the connection without a scheduler's handshake"
+            (size,) = struct.unpack("<Q", head)
+            if not 0 < size <= _HANDSHAKE_MAX:
+                return "something else answered: what it sent is not a scheduler's handshake"
+            if len(_recv_exactly(sock, size, deadline)) < size:
+                return "something else answered: it closed the connection within a scheduler's handshake"
+        except (TimeoutError, socket.timeout):
+            return f"something else answered: it accepted the connection but sent no handshake within {timeout:g} s"
+        except OSError as exc:
+            return f"something else answered: the connection failed ({exc.strerror or exc})"
+    return None
 
 
 def _adopt(command_pid: int) -> None:
@@ -76,6 +140,11 @@ WORKERS = {
 }
 
 
+#: the warning filter the resource tracker starts with: its "leaked semaphore objects" lines after a
+#: SIGKILL of the command are its own clean-up, done, not the user's business (:func:`_fork_server`)
+QUIET_TRACKER = "ignore::UserWarning:multiprocessing.resource_tracker"
+
+
 def _fork_server(preload=()) -> None:
     """Start multiprocessing's fork server (once per process: later calls find it running; the
     preload is the first start's) with ``distributed``, this module and ``preload`` imported in
@@ -91,11 +160,20 @@ def _fork_server(preload=()) -> None:
     process group, and the server (and the workers it forks, which keep its handlers) leave
     stopping to the command. It would end by itself when the command does, but only after
     tearing down its imports (0.3 s), holding the command's stdout and stderr meanwhile (a
-    pipe's reader waits for it): the command kills it as it exits (:func:`_stop_fork_server`)."""
+    pipe's reader waits for it): the command kills it as it exits (:func:`_stop_fork_server`).
+
+    The fork server needs multiprocessing's resource tracker, started here too: a process of
+    its own that unlinks the semaphores the workers made once every holder is gone. After a
+    SIGKILL of the command (its workers die with it) it still does that, but says so in two
+    warning lines on the command's stderr; it is started with those warnings ignored
+    (:data:`QUIET_TRACKER`: the tracker takes its warning options from this process's)."""
     import atexit
     import signal
+    import sys
     import threading
     from multiprocessing import forkserver, get_context
+    if QUIET_TRACKER not in sys.warnoptions:
+        sys.warnoptions.append(QUIET_TRACKER)   # read when the tracker starts (multiprocessing.util)
     get_context("forkserver").set_forkserver_preload(["__main__", "distributed", __name__, *preload])
     main = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
@@ -282,13 +360,18 @@ class DaskPool:
                 import distributed
                 self._distributed = distributed
             else:
-                self._distributed, self._config = _dask()
-                try:
-                    self.client = self._distributed.Client(address, timeout=CONNECT_TIMEOUT)
-                except Exception as exc:   # noqa: BLE001 - refused, timed out, or something else answered
-                    what = (f"nothing answered within {CONNECT_TIMEOUT:g} s" if isinstance(exc, (OSError, TimeoutError))
-                            else f"something else answered: {type(exc).__name__}")
-                    raise SimulatorError(f"--dask {address}: no Dask scheduler there ({what})") from None
+                tick = time.monotonic()
+                why = probe(address)
+                if why is None:
+                    self._distributed, self._config = _dask()
+                    left = max(0.5, CONNECT_TIMEOUT - (time.monotonic() - tick))
+                    try:
+                        self.client = self._distributed.Client(address, timeout=left)
+                    except Exception as exc:   # noqa: BLE001 - it answered the probe, then failed the client
+                        why = (f"nothing answered within {CONNECT_TIMEOUT:g} s" if isinstance(exc, (OSError, TimeoutError))
+                               else f"something else answered: {type(exc).__name__}")
+                if why is not None:
+                    raise SimulatorError(f"--dask {address}: no Dask scheduler there ({why})")
         except BaseException:
             self.close()
             raise
