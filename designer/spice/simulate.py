@@ -195,7 +195,7 @@ class NgspiceCli:
         exe = shutil.which(self.executable)
         if exe is None:
             raise SimulatorError(f"ngspice is not installed ({self.executable!r} not found); {INSTALL_HINT}")
-        with tempfile.TemporaryDirectory(prefix="designer-sim-") as tmp:
+        with tempfile.TemporaryDirectory(prefix=lifetime.owned_prefix("sim")) as tmp:
             raw_path = Path(tmp) / "out.raw"
             _, log, errs = self._batch(exe, tmp, with_raw_output(deck, raw_path))
             if not raw_path.exists() or raw_path.stat().st_size == 0:
@@ -216,7 +216,7 @@ class NgspiceCli:
         if lines and lines[-1].strip().lower() == ".end":
             lines = lines[:-1]
         text = "\n".join([*lines, ".control", "set noaskquit", *commands, "quit", ".endc", ".end"]) + "\n"
-        with tempfile.TemporaryDirectory(prefix="designer-sim-") as tmp:
+        with tempfile.TemporaryDirectory(prefix=lifetime.owned_prefix("sim")) as tmp:
             return self._batch(exe, tmp, text)[0].stdout
 
     def _batch(self, exe: str, tmp: str, text: str) -> tuple:
@@ -258,7 +258,7 @@ class PySpiceShared:
         with self._lock:
             ng = shared_instance()
             old = os.getcwd()
-            tmp = tempfile.mkdtemp(prefix="designer-sim-")
+            tmp = tempfile.mkdtemp(prefix=lifetime.owned_prefix("sim"))
             try:
                 os.chdir(tmp)   # whatever ngspice writes lands in a private folder, removed after
                 load_log = self._load(ng, deck)
@@ -302,7 +302,7 @@ class PySpiceShared:
         with self._lock:
             ng = shared_instance()
             old = os.getcwd()
-            tmp = tempfile.mkdtemp(prefix="designer-sim-")
+            tmp = tempfile.mkdtemp(prefix=lifetime.owned_prefix("sim"))
             out = []
             try:
                 os.chdir(tmp)
@@ -350,7 +350,7 @@ def shared_instance():
     if getattr(NgSpiceShared, "_designer_started", False):
         return NgSpiceShared.new_instance()
     old, home = os.getcwd(), os.environ.get("HOME")
-    with tempfile.TemporaryDirectory(prefix="designer-init-") as tmp:
+    with tempfile.TemporaryDirectory(prefix=lifetime.owned_prefix("init")) as tmp:
         try:
             os.chdir(tmp)
             os.environ["HOME"] = tmp

@@ -125,7 +125,7 @@ def create_app(pool) -> Starlette:
         if kind == "timeout":
             return _error(504, f"{prog}: error: simulator error: {value}")
         if kind != "ok":
-            return _error(500 if kind == "crash" else 502, f"{prog}: error: {value}")
+            return _error(500 if kind == "crash" else 503 if kind == "stopped" else 502, f"{prog}: error: {value}")
         status = value["status"]
         if value["error"] is not None:
             line = _hide(value["error"], tmp, upload_name)

@@ -25,7 +25,8 @@ import json
 import math
 import os
 import sys
-from contextlib import redirect_stderr, redirect_stdout
+import tempfile
+from contextlib import contextmanager, redirect_stderr, redirect_stdout
 
 import numpy as np
 
@@ -83,7 +84,7 @@ def run(task: dict) -> dict:
     argv0 = sys.argv
     sys.argv = [prog, *argv]   # the JSON's tool.argv: the command line this request stands for
     try:
-        with redirect_stdout(out), redirect_stderr(err):
+        with redirect_stdout(out), redirect_stderr(err), temporaries_in(tmp):
             if prog in ("identify", "identify-freq"):
                 status = _identify(prog, argv, seen)
             else:
@@ -114,6 +115,26 @@ def run(task: dict) -> dict:
     elif want == "bundle":
         answer.update(body=bundle_zip(tmp, name), media="application/zip", filename=f"{name}.zip")
     return answer
+
+
+@contextmanager
+def temporaries_in(folder: str | None):
+    """Every temporary file of the block (the simulator's ``designer-sim-*``, ``ngspice -b``'s own,
+    through ``TMPDIR``) made in ``folder`` (the request's private folder; None: where they were), so
+    that removing the folder removes them, a run killed at its deadline included."""
+    if folder is None:
+        yield
+        return
+    before, env = tempfile.tempdir, os.environ.get("TMPDIR")
+    tempfile.tempdir = os.environ["TMPDIR"] = folder
+    try:
+        yield
+    finally:
+        tempfile.tempdir = before
+        if env is None:
+            os.environ.pop("TMPDIR", None)
+        else:
+            os.environ["TMPDIR"] = env
 
 
 def _error_line(stderr: str, status: int) -> str | None:

@@ -12,6 +12,13 @@ is replaced too. Requests beyond the workers wait in the pool's queue, in
 order: none is lost, and each answer carries its request's number, so none is
 mixed with another's. The pool and the workers die with the server
 (:func:`designer.core.lifetime.die_with_parent`).
+
+A worker that has served ``recycle`` requests (:data:`RECYCLE_AFTER`) is replaced by a fresh
+one between two requests, so that what a long-lived process accumulates (each request left
+40-80 kB in a worker: caches of the libraries it runs) stays bounded. When the server stops
+(:meth:`Pool.stop_now`, from its signal handler), the pool kills every worker with its process
+group (its ngspice) at once and exits: every request still waiting, queued or running, is
+answered "stopped" (a 503) in the same instant.
 """
 
 from __future__ import annotations
@@ -36,13 +43,18 @@ WARM_UP = {"prog": "warm-up"}
 WARM_UP_TIMEOUT_S = 300.0
 #: most requests queued or running at once (each a message of ~100 bytes to the pool: 64 KiB of pipe holds them)
 MAX_WAITING = 256
+#: requests a worker serves before a fresh one replaces it (designer-web --recycle)
+RECYCLE_AFTER = 200
+#: what a request still waiting when the server stops is answered
+STOPPED = "the server is stopping: the request was cancelled; send it again once the server is back"
 
 
 class Busy(Exception):
-    """More requests than :data:`MAX_WAITING` at once: answered 503."""
+    """More requests than :data:`MAX_WAITING` at once, or the server stopping: answered 503."""
 
 
-def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work) -> None:
+def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work,
+               recycle: int = RECYCLE_AFTER) -> None:
     """The pool process: requests ``(id, task)`` in from the server, ``(id, kind, value)`` out
     (ids from 1: 0 is a worker's warm-up, answered to nobody)."""
     lifetime.die_with_parent(parent_pid)
@@ -59,6 +71,15 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
         return w
 
     workers = [fresh() for _ in range(jobs)]
+    served = {}   # requests each worker (by pid) has answered
+
+    def stop(_signum, _frame):
+        # the server stops (Pool.stop_now): every run ends now, with its ngspice; the server answers
+        # everything it waits for when this process's end of the pipe closes
+        for w in workers:
+            w.kill()
+        os._exit(0)
+    signal.signal(signal.SIGTERM, stop)
     queue = deque()
     try:
         while True:
@@ -88,11 +109,14 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                         kind, value = "dead", "the worker running it died: the simulator crashed"
                     if w.task:
                         conn.send((w.task, kind, value))
+                        served[w.proc.pid] = served.get(w.proc.pid, 0) + 1
                     w.task = None
-                    if kind == "dead":
+                    if kind == "dead" or served.get(w.proc.pid, 0) >= recycle:   # dead, or recycled
+                        served.pop(w.proc.pid, None)
                         w.kill()
                         workers[k] = fresh()
                 elif time.monotonic() >= w.deadline:
+                    served.pop(w.proc.pid, None)
                     w.kill()
                     if w.task:
                         conn.send((w.task, "timeout", f"timed out after {timeout:g} s (killed)"))
@@ -108,22 +132,24 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
 class Pool:
     """The server's end of the pool process: :meth:`submit` a task, await its
     answer ``(kind, value)``: kind "ok" (value: what ``work`` returned),
-    "crash" (a bug in the task, its words), "dead", "timeout" or "cancelled"."""
+    "crash" (a bug in the task, its words), "dead", "timeout", "cancelled" or "stopped" (the
+    server is stopping: :meth:`stop_now`). A worker is replaced after ``recycle`` requests."""
 
-    def __init__(self, jobs: int, timeout: float = DEFAULT_TIMEOUT_S, work=None):
+    def __init__(self, jobs: int, timeout: float = DEFAULT_TIMEOUT_S, work=None, recycle: int = RECYCLE_AFTER):
         from . import jobs as job
         ctx = multiprocessing.get_context("fork")
         self.conn, child = ctx.Pipe()
         self.timeout = timeout
         self.jobs = jobs
         self.proc = ctx.Process(target=_pool_main, args=(child, self.conn, os.getpid(), jobs, timeout,
-                                                         work or job.run))
+                                                         work or job.run, recycle))
         self.proc.start()
         child.close()
         self._ids = itertools.count(1)
         self._waiting = {}
         self._loop = None
         self.dropped = 0   #: requests whose client left while they were queued (never run)
+        self.stopping = False
 
     def attach(self) -> None:
         """Read the pool's answers on the running event loop."""
@@ -135,9 +161,10 @@ class Pool:
             rid, kind, value = self.conn.recv()
         except (EOFError, OSError):   # the pool is gone: every waiting request gets its answer
             self._loop.remove_reader(self.conn.fileno())
+            answer = ("stopped", STOPPED) if self.stopping else ("dead", "the worker pool stopped")
             for fut in self._waiting.values():
                 if not fut.done():
-                    fut.set_result(("dead", "the worker pool stopped"))
+                    fut.set_result(answer)
             self._waiting.clear()
             return
         if kind == "cancelled":
@@ -149,13 +176,29 @@ class Pool:
     def start(self, task) -> tuple:
         """Queue ``task``; returns (its id, the future of its answer). Refused (:class:`Busy`) past
         :data:`MAX_WAITING` requests: the messages on the pipe stay within its buffer."""
+        if self.stopping:
+            raise Busy(STOPPED)
         if len(self._waiting) >= MAX_WAITING:
             raise Busy(f"{MAX_WAITING} requests are already waiting for the workers; try again shortly")
         rid = next(self._ids)
+        try:
+            self.conn.send((rid, task))
+        except (OSError, ValueError):   # the pool is gone (stopping, or killed)
+            raise Busy(STOPPED if self.stopping else "the worker pool stopped") from None
         fut = self._loop.create_future()
         self._waiting[rid] = fut
-        self.conn.send((rid, task))
         return rid, fut
+
+    def stop_now(self) -> None:
+        """The server is stopping (called from its signal handler: nothing here waits): the pool kills
+        every worker with its process group and exits, and every request waiting for it, queued or
+        running, is answered ("stopped", :data:`STOPPED`) as its end of the pipe closes; later ones
+        are refused (:class:`Busy`)."""
+        self.stopping = True
+        try:
+            os.kill(self.proc.pid, signal.SIGTERM)
+        except (OSError, TypeError):   # gone already, or never started
+            pass
 
     def cancel(self, rid: int) -> None:
         """Its client has gone: drop the task if it waits in the queue (answered "cancelled"); a run

@@ -5,11 +5,20 @@ One process keeps the library imported and answers the pages and the API
 serves (:mod:`.pool`), warm (ngspice loaded), so an answer has no start-up
 cost. It binds to 127.0.0.1 unless told otherwise, and says so when it is
 reachable from other machines.
+
+Its temporary files live in one folder of its own, ``designer-web-PID-*`` in the
+temporary folder (each request's private folder inside it, and each run's
+temporary files inside that: :mod:`.jobs`), removed when it stops; those of a
+server that was SIGKILLed are removed by the next one
+(:func:`designer.core.lifetime.remove_stale`). SIGTERM and SIGINT answer every
+request still waiting 503, kill the runs, and end it within seconds, with the
+status a shell reports for the signal (143, 130: :mod:`.connections`).
 """
 
 from __future__ import annotations
 
 import ipaddress
+import os
 import sys
 
 from ..cli.common import OneLineParser, run_cli
@@ -35,6 +44,8 @@ def _parser():
     p.add_argument("--jobs", default="2", help="worker processes running the commands, 1 to 16 (default 2)")
     p.add_argument("--timeout", default="120", help="seconds one run may take before it is killed and reported, "
                                                     "1 to 3600 (default 120)")
+    p.add_argument("--recycle", default="200", help="requests a worker serves before a fresh one replaces it "
+                                                    "(its memory stays bounded), 1 to 1000000 (default 200)")
     return p
 
 
@@ -68,15 +79,34 @@ def exposure_warning(host: str, port: int) -> str | None:
 
 
 def _serve(args) -> int:
+    import shutil
+    import tempfile
+
+    from ..core import lifetime
+    port = _whole(args.port, "--port", 0, 65535)
+    jobs = _whole(args.jobs, "--jobs", 1, 16)
+    timeout = _whole(args.timeout, "--timeout", 1, 3600)
+    recycle = _whole(args.recycle, "--recycle", 1, 1000000)
+    lifetime.install("designer-web")   # a stop before uvicorn takes the signals over: one line, 128 + signal
+    # what earlier servers and commands that were killed left, then this server's own folder: every
+    # temporary file of a request or a run is made in it (TMPDIR, inherited by the pool and ngspice)
+    lifetime.remove_stale(tempfile.gettempdir())
+    root = tempfile.mkdtemp(prefix=lifetime.owned_prefix("web"))
+    tempfile.tempdir = os.environ["TMPDIR"] = root
+    try:
+        return _serve_in(args, port, jobs, timeout, recycle)
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+
+
+def _serve_in(args, port: int, jobs: int, timeout: int, recycle: int) -> int:
     import socket
 
     import uvicorn
 
     from .app import create_app
+    from .connections import STOP_GRACE_S, GuardedH11, StoppingServer, quiet_disconnects
     from .pool import Pool
-    port = _whole(args.port, "--port", 0, 65535)
-    jobs = _whole(args.jobs, "--jobs", 1, 16)
-    timeout = _whole(args.timeout, "--timeout", 1, 3600)
     family = socket.AF_INET6 if ":" in args.host else socket.AF_INET
     sock = socket.socket(family, socket.SOCK_STREAM)
     try:
@@ -91,15 +121,16 @@ def _serve(args) -> int:
     # the pool is forked before the server binds its connections or starts a thread: no socket of a
     # client and no lock of a thread is ever copied into a worker
     sock.set_inheritable(False)
-    pool = Pool(jobs, float(timeout))
+    pool = Pool(jobs, float(timeout), recycle=recycle)
     shown = f"[{host}]" if family == socket.AF_INET6 else host
     print(f"designer-web: serving on http://{shown}:{port}/ ({jobs} workers, {timeout} s per run; Ctrl-C stops)",
           flush=True)
     warning = exposure_warning(args.host, port)
     if warning:
         print(warning, flush=True)
-    config = uvicorn.Config(create_app(pool), log_level="warning", lifespan="on")
-    server = uvicorn.Server(config)
+    config = uvicorn.Config(quiet_disconnects(create_app(pool)), log_level="warning", lifespan="on", http=GuardedH11,
+                            timeout_graceful_shutdown=STOP_GRACE_S)
+    server = StoppingServer(config, pool)
     try:
         server.run(sockets=[sock])
     finally:
