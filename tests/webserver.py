@@ -23,10 +23,11 @@ def cli(prog, *argv):
 class Server:
     """A running ``designer-web`` and the way to talk to it."""
 
-    def __init__(self, *args):
+    def __init__(self, *args, env=None):
         # -W error: a warning in the server, its pool or a worker is an error there, as in the tests themselves
         self.proc = subprocess.Popen([sys.executable, "-W", "error", "-m", "designer.web.server", "--port", "0", *args],
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV)
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                     env={**ENV, **(env or {})})
         line = self.proc.stdout.readline()
         if "serving on" not in line:
             self.stop()

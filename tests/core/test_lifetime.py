@@ -172,3 +172,24 @@ def test_a_console_command_ends_through_finish():
     assert p.returncode == 0 and p.stderr == "" and p.stdout.rstrip().endswith("}")
     bad = subprocess.run([exe, "--fc", "-1", "--zeta", "0.2"], capture_output=True, text=True, timeout=120)
     assert bad.returncode == 2 and bad.stdout == "" and len(bad.stderr.strip().splitlines()) == 1
+
+
+def test_stale_folders_are_those_of_gone_owners_only(tmp_path):
+    """Issue 25: what a SIGKILLed server or command left was never removed."""
+    gone = subprocess.Popen(["true"])
+    gone.wait()
+    stale = [f"designer-web-{gone.pid}-a", f"designer-sim-{gone.pid}-b", f"designer-init-{gone.pid}-c"]
+    alive = [f"designer-web-{os.getppid()}-d", f"designer-sim-{os.getpid()}-e", "designer-sim-f00", "other-1-x"]
+    for name in stale + alive:
+        (tmp_path / name / "sub").mkdir(parents=True)
+    (tmp_path / f"designer-web-{gone.pid}-file").write_text("a file, not a folder")
+    (tmp_path / f"designer-web-{gone.pid}-link").symlink_to(tmp_path / alive[0])
+    alive += [f"designer-web-{gone.pid}-file", f"designer-web-{gone.pid}-link"]
+    if os.getuid() == 0:
+        (tmp_path / f"designer-web-{gone.pid}-theirs").mkdir()
+        os.chown(tmp_path / f"designer-web-{gone.pid}-theirs", 65534, 65534)
+        alive.append(f"designer-web-{gone.pid}-theirs")
+    assert sorted(lifetime.remove_stale(str(tmp_path))) == sorted(stale)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(alive)
+    assert lifetime.owned_prefix("sim") == f"designer-sim-{os.getpid()}-"
+    assert lifetime.remove_stale(str(tmp_path / "nowhere")) == []

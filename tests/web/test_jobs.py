@@ -69,3 +69,19 @@ def test_a_broadband_capture_gives_its_step_and_spectrum_traces(tmp_path):
     traces = [page["plot"]] + ([page["second"]] if "second" in page else [])
     assert any(t["log_x"] for t in traces) or out["json"]["method"] == "correlation"
     json.dumps(page)
+
+
+def test_a_runs_temporaries_are_made_in_its_requests_folder(tmp_path):
+    """Issue 25: a run killed at its deadline left its simulator's designer-sim-* folder behind; made in the
+    request's folder, they go with it (ngspice -b through TMPDIR, the shared library through tempfile)."""
+    import os
+    import tempfile
+
+    from designer.spice.simulate import private_env
+    before, env = tempfile.gettempdir(), os.environ.get("TMPDIR")
+    with jobs.temporaries_in(str(tmp_path)):
+        made = tempfile.mkdtemp(prefix="designer-sim-")
+        assert os.path.dirname(made) == str(tmp_path) and private_env(made)["TMPDIR"] == str(tmp_path)
+    assert tempfile.gettempdir() == before and os.environ.get("TMPDIR") == env
+    with jobs.temporaries_in(None):
+        assert tempfile.gettempdir() == before

@@ -1,6 +1,7 @@
 """The web page's worker pool (designer.web.pool) with a work function of the test's own:
 answers in their requests' order whatever order they finish in, a worker that dies or
-passes its deadline replaced, a bug reported as that task's, a closed pool gone."""
+passes its deadline replaced, a bug reported as that task's, a closed pool gone; a worker
+recycled after N requests; a stop answering every request at once."""
 
 import asyncio
 import os
@@ -22,9 +23,9 @@ def work(task):
     return (task["do"], os.getpid())
 
 
-def run_with_pool(jobs, timeout, body):
+def run_with_pool(jobs, timeout, body, **kw):
     async def main():
-        pool = Pool(jobs, timeout, work=work)
+        pool = Pool(jobs, timeout, work=work, **kw)
         pool.attach()
         try:
             return await body(pool)
@@ -70,3 +71,48 @@ def test_a_cancelled_request_still_queued_is_answered_cancelled():
         return await fut, await busy, pool.dropped
     cancelled, busy, dropped = run_with_pool(1, 30, body)
     assert cancelled == ("cancelled", None) and busy[0] == "ok" and dropped == 1
+
+
+def test_a_worker_is_replaced_after_recycle_requests():
+    async def body(pool):
+        return [await pool.submit({"do": f"task{i}"}) for i in range(7)]
+    answers = [value for _, value in run_with_pool(1, 30, body, recycle=3)]
+    assert [a[0] for a in answers] == [f"task{i}" for i in range(7)]
+    pids = [a[1] for a in answers]
+    assert pids[0] == pids[1] == pids[2] != pids[3] == pids[4] == pids[5] != pids[6] and pids[0] != pids[6]
+
+
+def test_a_stop_answers_queued_and_running_requests_at_once_and_kills_the_workers():
+    from designer.web.pool import STOPPED, Busy
+
+    async def body(pool):
+        running = asyncio.ensure_future(pool.submit({"do": "hang"}))
+        queued = [asyncio.ensure_future(pool.submit({"do": "echo"})) for _ in range(3)]
+        await asyncio.sleep(0.5)
+        workers = children(pool.proc.pid)
+        tick = time.monotonic()
+        pool.stop_now()
+        answers = await asyncio.wait_for(asyncio.gather(running, *queued), 5)
+        took = time.monotonic() - tick
+        try:
+            pool.start({"do": "echo"})
+        except Busy as exc:
+            later = str(exc)
+        return answers, took, workers, later
+    answers, took, workers, later = run_with_pool(1, 30, body)
+    assert answers == [("stopped", STOPPED)] * 4 and took < 1.0 and later == STOPPED
+    assert len(workers) == 1 and not any(os.path.exists(f"/proc/{p}") for p in workers)
+
+
+def children(pid: int) -> set:
+    found = set()
+    for d in os.listdir("/proc"):
+        if d.isdigit():
+            try:
+                with open(f"/proc/{d}/stat") as fh:
+                    fields = fh.read().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if fields[0] != "Z" and int(fields[1]) == pid:
+                found.add(int(d))
+    return found

@@ -47,3 +47,217 @@ def test_any_value_of_the_numeric_options_is_served_or_one_line(values):
             assert "\n" not in str(exc) and str(exc).startswith("--port")
         else:
             assert 0 <= n <= 65535
+
+
+# --------------------------------------------------------------------------- lifetime (issue 25, item 9)
+
+import json  # noqa: E402
+import os  # noqa: E402
+import signal  # noqa: E402
+import socket  # noqa: E402
+import subprocess  # noqa: E402
+import threading  # noqa: E402
+import time  # noqa: E402
+import urllib.error  # noqa: E402
+import urllib.request  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from designer.web.connections import BODY_GRACE_S, HEADER_TIMEOUT_S  # noqa: E402
+from webserver import Server  # noqa: E402
+
+JSON = {"Content-Type": "application/json"}
+#: a run that takes far longer than any test waits (a three-million-build Monte Carlo)
+LONG = {"fc": 3500, "zeta": 0.2, "no-sim": True, "monte-carlo": 3000000}
+
+
+def post(url, body, answers, key):
+    """POST ``body`` as JSON; ``answers[key]`` = (status, error line or None, seconds)."""
+    req = urllib.request.Request(url + "/api/plant", data=json.dumps(body).encode(), method="POST", headers=JSON)
+    tick = time.monotonic()
+    try:
+        with urllib.request.urlopen(req, timeout=120) as r:
+            answers[key] = (r.status, None, time.monotonic() - tick)
+    except urllib.error.HTTPError as e:
+        with e:
+            answers[key] = (e.code, json.loads(e.read())["error"], time.monotonic() - tick)
+    except OSError as e:   # no answer at all: the failure this test is for
+        answers[key] = (None, repr(e), time.monotonic() - tick)
+
+
+def everything_under(folder: Path) -> list:
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*"))
+
+
+def children(pid: int) -> set:
+    """The live processes whose parent is ``pid`` (from /proc)."""
+    found = set()
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                fields = (d / "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if fields[0] != "Z" and int(fields[1]) == pid:
+                found.add(int(d.name))
+    return found
+
+
+def descendants(pid: int) -> set:
+    found, todo = set(), [pid]
+    while todo:
+        for c in children(todo.pop()):
+            found.add(c)
+            todo.append(c)
+    return found
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=lambda s: signal.Signals(s).name)
+def test_a_stop_answers_every_request_503_and_ends_within_5_s(tmp_path, sig):
+    """SIGTERM with a run under way took 58 s (the run's end) and the queued client got no answer."""
+    s = Server("--jobs", "1", env={"TMPDIR": str(tmp_path)})
+    answers, clients = {}, []
+    try:
+        family = descendants(s.proc.pid)
+        clients.append(threading.Thread(target=post, args=(s.url, LONG, answers, "running")))
+        clients[0].start()
+        time.sleep(1.0)   # it has reached the one worker
+        for i in range(3):
+            clients.append(threading.Thread(target=post, args=(s.url, {"fc": 3000 + i, "zeta": 0.3}, answers, i)))
+            clients[-1].start()
+        time.sleep(1.0)   # they wait in the queue
+        family |= descendants(s.proc.pid)
+        tick = time.monotonic()
+        s.proc.send_signal(sig)
+        code = s.proc.wait(10)
+        took = time.monotonic() - tick
+        for c in clients:
+            c.join(30)
+    finally:
+        err = s.stop()
+    print(f"stopped by {signal.Signals(sig).name} in {took:.2f} s")
+    assert code == 128 + sig and took < 5
+    assert err.splitlines() == ["designer-web: error: " + ("terminated (SIGTERM)" if sig == signal.SIGTERM
+                                                           else "interrupted")], err
+    assert set(answers) == {"running", 0, 1, 2}
+    for status, error, _ in answers.values():
+        assert status == 503 and error == ("design-plant: error: the server is stopping: the request was cancelled; "
+                                           "send it again once the server is back")
+    time.sleep(0.5)
+    assert not [p for p in family if Path(f"/proc/{p}").exists()], "a worker outlived the server"
+    assert everything_under(tmp_path) == []
+
+
+def test_the_folders_of_gone_servers_and_commands_are_removed_at_start(tmp_path):
+    """Request folders of a SIGKILLed server were never removed, not even by a restart."""
+    gone = subprocess.Popen(["true"])
+    gone.wait()
+    dead = gone.pid
+    left = [f"designer-web-{dead}-abc/designer-web-x", f"designer-sim-{dead}-def", f"designer-init-{dead}-ghi"]
+    kept = [f"designer-web-{os.getpid()}-alive", "designer-web-oldstyle", f"designer-sim-{dead}-a-file"]
+    for name in left + kept[:2]:
+        (tmp_path / name).mkdir(parents=True)
+        (tmp_path / name / "deck.cir").write_text("* a deck\n")
+    (tmp_path / kept[2]).write_text("not a folder")
+    if os.getuid() == 0:   # another user's folder: never ours to remove
+        other = tmp_path / f"designer-web-{dead}-nobody"
+        other.mkdir()
+        os.chown(other, 65534, 65534)
+        kept.append(other.name)
+    s = Server("--jobs", "1", env={"TMPDIR": str(tmp_path)})
+    try:
+        names = {p.name for p in tmp_path.iterdir()}
+        own = [n for n in names if n.startswith(f"designer-web-{s.proc.pid}-")]
+        assert names == set(kept) | set(own) and len(own) == 1
+    finally:
+        s.stop()
+    assert {p.name for p in tmp_path.iterdir()} == set(kept)   # its own folder went with it
+
+
+@pytest.mark.spice
+def test_a_run_killed_at_its_deadline_leaves_nothing(tmp_path):
+    """Its simulator's designer-sim-* folder (a 320 KB deck) was left in the temporary folder."""
+    s = Server("--jobs", "1", "--timeout", "4", env={"TMPDIR": str(tmp_path)})
+    answers, seen = {}, set()
+    try:
+        body = {"fc": 3500, "zeta": 0.2, "monte-carlo": 100000, "engine": "spice", "simulator": "ngspice-cli"}
+        client = threading.Thread(target=post, args=(s.url, body, answers, "long"))
+        client.start()
+        while client.is_alive():   # where the run's temporaries are made while it runs
+            seen |= {str(p.relative_to(tmp_path)) for p in tmp_path.rglob("designer-sim-*")}
+            time.sleep(0.05)
+        # the next request waits for the killed worker's replacement to warm up (its own simulation)
+        status, _ = s.post_json("/api/plant", {"fc": 2000, "zeta": 0.5, "no-sim": True}, headers=JSON)
+        after = everything_under(tmp_path)
+    finally:
+        s.stop()
+    assert answers["long"][0] == 504 and status == 200, answers
+    assert seen, "no simulator folder was seen: the run did not simulate"
+    # each inside a request's private folder (server folder / request folder / designer-sim-*)
+    assert all(len(Path(p).parts) == 3 and Path(p).parts[1].startswith("designer-web-") for p in seen), seen
+    assert len(after) == 1 and after[0].startswith("designer-web-"), after   # the server's own, empty
+    assert everything_under(tmp_path) == []
+
+
+def _closed(sock) -> bool:
+    sock.settimeout(0.01)
+    try:
+        return sock.recv(1) == b""
+    except socket.timeout:
+        return False
+    except OSError:
+        return True
+
+
+def test_slow_headers_and_bodies_are_closed_and_others_still_served():
+    """500 sockets sending half a header were held 25 s and more, none closed."""
+    s = Server("--jobs", "1")
+    try:
+        host, port = s.url.split("//")[1].rsplit(":", 1)
+        tick = time.monotonic()
+        socks = [socket.create_connection((host, int(port))) for _ in range(50)]
+        for sock in socks:
+            sock.sendall(b"POST /api/plant HTTP/1.1\r\nHost: " + host.encode() + b"\r\n")   # half a header
+        socks.append(socket.create_connection((host, int(port))))                         # nothing at all
+        slow = socket.create_connection((host, int(port)))                                 # a byte a quarter second
+        slow.sendall(f"POST /api/plant HTTP/1.1\r\nHost: {host}\r\nContent-Type: application/json\r\n"
+                     "Content-Length: 1000\r\n\r\n{".encode())
+        status, got = s.post_json("/api/plant", {"fc": 2000, "zeta": 0.5, "no-sim": True}, headers=JSON)
+        assert status == 200 and got["spec"]["fc_hz"] == 2000   # served meanwhile
+        closed = {}
+        while len(closed) < len(socks) + 1 and time.monotonic() - tick < 20:
+            for i, sock in enumerate(socks + [slow]):
+                if i not in closed and _closed(sock):
+                    closed[i] = time.monotonic() - tick
+            if len(socks) not in closed:
+                slow.send(b" ")
+            time.sleep(0.25)
+        for sock in socks + [slow]:
+            sock.close()
+        print(f"{len(closed)} slow sockets closed after {min(closed.values()):.2f} to {max(closed.values()):.2f} s")
+        assert len(closed) == len(socks) + 1
+        assert max(closed.values()) < max(HEADER_TIMEOUT_S, BODY_GRACE_S) + 3
+    finally:
+        err = s.stop()
+    assert "Traceback" not in err and "ERROR" not in err, err
+
+
+def test_a_worker_is_replaced_after_recycle_requests_and_answers_stay_right():
+    """A worker's memory grew 40-80 kB a request, for ever: now it serves --recycle requests, then a fresh one."""
+    s = Server("--jobs", "1", "--recycle", "2")
+    try:
+        (pool,) = children(s.proc.pid)
+        seen = []
+        for fc in (1100, 1200, 1300, 1400, 1500):   # the server's first request (Server waits for it) was one
+            status, got = s.post_json("/api/plant", {"fc": fc, "zeta": 0.5, "no-sim": True}, headers=JSON)
+            assert status == 200 and got["spec"]["fc_hz"] == fc
+            time.sleep(0.3)
+            seen.append(children(pool))
+    finally:
+        s.stop()
+    # six requests, two a worker: the first worker and three fresh ones, each in turn the pool's only one
+    assert all(len(w) == 1 for w in seen) and len(set.union(*seen)) == 3 and seen[0] != seen[2] != seen[4], seen
+
+
+def test_bad_recycle_is_one_line(capsys):
+    assert main(["--recycle", "0"]) == 2
+    assert capsys.readouterr().err == "designer-web: error: --recycle must be 1 to 1000000, got 0\n"
