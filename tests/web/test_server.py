@@ -1,11 +1,26 @@
 """designer-web's command line: its options checked in one line before anything
-starts, and what it says about who can reach it."""
+starts, and what it says about who can reach it; its lifetime against a real server:
+a stop answers every request 503 and ends within 5 s, no temporary folder outlives a
+run or a server, slow clients are closed, workers are recycled."""
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import threading
+import time
+import urllib.error
+import urllib.request
+from pathlib import Path
 
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from designer.web.connections import BODY_GRACE_S, HEADER_TIMEOUT_S
 from designer.web.server import exposure_warning, is_local, main
+from webserver import Server
 
 
 @pytest.mark.parametrize("argv, words", [
@@ -51,19 +66,6 @@ def test_any_value_of_the_numeric_options_is_served_or_one_line(values):
 
 # --------------------------------------------------------------------------- lifetime (issue 25, item 9)
 
-import json  # noqa: E402
-import os  # noqa: E402
-import signal  # noqa: E402
-import socket  # noqa: E402
-import subprocess  # noqa: E402
-import threading  # noqa: E402
-import time  # noqa: E402
-import urllib.error  # noqa: E402
-import urllib.request  # noqa: E402
-from pathlib import Path  # noqa: E402
-
-from designer.web.connections import BODY_GRACE_S, HEADER_TIMEOUT_S  # noqa: E402
-from webserver import Server  # noqa: E402
 
 JSON = {"Content-Type": "application/json"}
 #: a run that takes far longer than any test waits (a three-million-build Monte Carlo)
