@@ -301,9 +301,23 @@ PEAK_MIN_DB = 0.1
 
 
 def no_peak_reason(zeta: float, peak_gain, dc_gain: float) -> str | None:
-    """Why a response with damping ``zeta`` (its dominant pair) and a measured
-    peak ``peak_gain`` (None: none found) shows no resonance peak; None when it
-    shows one of at least :data:`PEAK_MIN_DB`."""
+    """Why a response shows no resonance peak, or None when it shows one.
+
+    Parameters
+    ----------
+    zeta : float
+        Damping of the response's dominant pole pair.
+    peak_gain : float or None
+        The highest gain found in the sweep (None: it never rises above its DC value).
+    dc_gain : float
+        The gain the rise is measured from.
+
+    Returns
+    -------
+    str or None
+        "no resonance peak (zeta >= 0.707)", or, for a rise under :data:`PEAK_MIN_DB`,
+        the same with the damping; None for a peak of at least :data:`PEAK_MIN_DB`.
+    """
     if zeta >= ZETA_NO_PEAK:
         return "no resonance peak (zeta >= 0.707)"
     if peak_gain is None or 20 * math.log10(peak_gain / dc_gain) < PEAK_MIN_DB:

@@ -382,7 +382,22 @@ def listed(ranked, gain: float, top: int, band: bool = True) -> list:
     impedance-scaled copy is the same design): at the level whose resistors stray
     least outside :data:`R_BAND`, nearest 10 kOhm when several lie inside. With
     ``band``, the builds in the band within :data:`NOTE_ERROR` of the target
-    come first (the module docstring says why). At most ``top``.
+    come first (the module docstring says why).
+
+    Parameters
+    ----------
+    ranked : list of Candidate
+        Combinations, best error first (:func:`~designer.plant.selection.joint_search`).
+    gain : float
+        The amplifier gain K (at 1, R1 and R2 may swap).
+    top : int
+        How many to list at most.
+    band : bool
+        Put the builds in the resistor band first (False: the user fixed R, keep the error order).
+
+    Returns
+    -------
+    list of Candidate
     """
     groups = []
     for c in _distinct(ranked, gain):
