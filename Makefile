@@ -4,7 +4,7 @@ PY := .venv/bin/python
 VENV_STAMP := .venv/.installed
 export MPLBACKEND := Agg
 
-.PHONY: setup system-deps demo test bench web clean
+.PHONY: setup system-deps lock demo test bench web clean
 
 # compileall: the environment may set PYTHONDONTWRITEBYTECODE, and every command would recompile the package
 setup: system-deps $(VENV_STAMP)
@@ -12,10 +12,12 @@ setup: system-deps $(VENV_STAMP)
 
 # ngspice (CLI backend) and libngspice (PySpice's shared backend) come from Debian; so do chromium and
 # poppler-utils, which the print and screenshot tests of the build sheets use (headless printing to PDF,
-# pdfinfo's page count).
-SYSTEM_PACKAGES := ngspice libngspice0-dev chromium poppler-utils
+# pdfinfo's page count). A bare Debian 12 or 13 has no python3, and its python3 cannot make a venv without
+# python3-venv (Debian moves ensurepip there): importing ensurepip is the check that matters.
+SYSTEM_PACKAGES := python3 python3-venv ngspice libngspice0-dev chromium poppler-utils
 system-deps:
-	@if ! command -v ngspice >/dev/null 2>&1 || ! dpkg -s libngspice0-dev >/dev/null 2>&1 \
+	@if ! command -v python3 >/dev/null 2>&1 || ! python3 -c 'import ensurepip' >/dev/null 2>&1 \
+	    || ! command -v ngspice >/dev/null 2>&1 || ! dpkg -s libngspice0-dev >/dev/null 2>&1 \
 	    || ! command -v chromium >/dev/null 2>&1 || ! command -v pdfinfo >/dev/null 2>&1; then \
 	  echo "Installing $(SYSTEM_PACKAGES) from Debian"; \
 	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
@@ -23,11 +25,28 @@ system-deps:
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $(SYSTEM_PACKAGES); \
 	fi
 
-$(VENV_STAMP): pyproject.toml
-	python3 -m venv .venv
+# The dependencies come from the lock (every one pinned, with its hashes, for Python 3.11 to 3.13), the
+# package itself without them; a changed lock or pyproject.toml makes the venv anew (--clear), so what is
+# installed is exactly the lock, nothing left over from an earlier one. setuptools' "Editable installation"
+# notice (information only: a folder named designer/ in the working directory would shadow the package) is
+# silenced, so that a set-up that prints anything has something to say.
+LOCK := requirements-lock.txt
+$(VENV_STAMP): pyproject.toml $(LOCK)
+	python3 -m venv --clear .venv
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e '.[test]'
+	$(PY) -m pip install -q --require-hashes -r $(LOCK)
+	PYTHONWARNINGS='ignore:Editable installation' $(PY) -m pip install -q --no-deps -e .
 	touch $@
+
+# The lock, made anew from pyproject.toml by uv (in a throwaway venv: uv is no dependency of the project) for
+# every platform and Python 3.11 to 3.13; the versions already in the lock are kept unless UPGRADE=1 (all to
+# the newest) or UPGRADE=name (that one). Then `make setup test` checks the new versions.
+lock:
+	@set -e; tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; \
+	python3 -m venv "$$tmp/uv" && "$$tmp/uv/bin/python" -m pip install -q uv && \
+	"$$tmp/uv/bin/uv" pip compile -q pyproject.toml --extra test --universal --python-version 3.11 \
+	  --generate-hashes --custom-compile-command "make lock" -o $(LOCK) \
+	  $(if $(filter 1,$(UPGRADE)),--upgrade,$(if $(UPGRADE),--upgrade-package $(UPGRADE)))
 
 # The main job: the seed's plant, and PID controllers for it with LM741s (ZN tuning done right,
 # the optimiser, and the seed's own final design to show what really happens), and the seed's bench as built

@@ -272,6 +272,7 @@ class BroadbandResult:
     method: str = ""
     notes: list = field(default_factory=list)
     capture: object | None = None
+    #: seconds per phase, for the benchmarks; not in :meth:`to_dict` (the JSON is the same on every run)
     timings: dict = field(default_factory=dict)
     #: for a wrapped impulse response: the period, bits or clock interval that would do
     advice: dict | None = None
@@ -283,8 +284,7 @@ class BroadbandResult:
 
     def to_dict(self) -> dict:
         d = {"format": "broadband", "excitation": self.excitation.to_dict(), "method": self.method,
-             "best": self.best.to_dict() if self.best else None, "notes": list(self.notes),
-             "timings_s": dict(self.timings)}
+             "best": self.best.to_dict() if self.best else None, "notes": list(self.notes)}
         if self.impulse is not None:
             d["impulse"] = self.impulse.to_dict()
             if self.advice:

@@ -1,7 +1,15 @@
 """The lab bench: the recommended square wave (the seed's 330 Hz, 2 V test of
 section IV.9), the slew, swing and period checks for it, the band of the
 readings that part tolerances allow (worst case over the tolerance corners),
-and the whole bench period as a scope would capture it."""
+the whole bench period as a scope would capture it, and the sine check.
+
+The sine check's resonance peak: a second-order low-pass peaks only for
+zeta < 1/sqrt(2) = 0.707, by Mr = 1 / (2 zeta sqrt(1 - zeta^2)) at
+fn sqrt(1 - 2 zeta^2) (seed 000, eq 79; Ogata, *Modern Control Engineering*,
+5th ed., 7-2). Just below 0.707 the rise is a few millionths of the DC gain at a
+frequency far below fn (0.00005 dB at 58 Hz for a 1 kHz Butterworth built at zeta
+0.7059; 0.1 dB needs zeta 0.652): no scope shows it, so a rise under
+:data:`PEAK_MIN_DB` is reported as no peak, with the reason."""
 
 from __future__ import annotations
 
@@ -13,7 +21,7 @@ import numpy as np
 
 from ..core.checks import Check
 from ..core.compare import resample
-from ..core.lti import dense_time, step_response
+from ..core.lti import dense_time, dominant_pair, step_response
 from ..core.metrics import step_metrics
 from ..core.opamps import OpAmp
 from ..spice.deck import SquareTest
@@ -265,7 +273,7 @@ class SineCheck:
 
     amplitude_v: float                  #: generator amplitude (peak) that keeps the output in the op-amp's limits
     dc_gain: float
-    f_peak_hz: float | None             #: None: no resonance peak (zeta >= 0.707)
+    f_peak_hz: float | None             #: None: no resonance peak (``no_peak`` says why)
     peak_gain: float | None             #: |H| at the peak, V/V
     f_3db_hz: float
     spice_f_peak_hz: float | None = None
@@ -275,11 +283,46 @@ class SineCheck:
     h_model: np.ndarray | None = None
     spice_f_hz: np.ndarray | None = None
     h_spice: np.ndarray | None = None
+    no_peak: str | None = None          #: why the model shows no peak (None: it does)
+    spice_no_peak: str | None = None    #: why SPICE's .ac shows none (None: it does, or not simulated)
 
     def to_dict(self) -> dict:
         return {"amplitude_v": self.amplitude_v, "dc_gain": self.dc_gain, "f_peak_hz": self.f_peak_hz,
-                "peak_gain": self.peak_gain, "f_3db_hz": self.f_3db_hz, "spice_f_peak_hz": self.spice_f_peak_hz,
-                "spice_peak_gain": self.spice_peak_gain, "spice_f_3db_hz": self.spice_f_3db_hz}
+                "peak_gain": self.peak_gain, "no_peak_reason": self.no_peak, "f_3db_hz": self.f_3db_hz,
+                "spice_f_peak_hz": self.spice_f_peak_hz, "spice_peak_gain": self.spice_peak_gain,
+                "spice_no_peak_reason": self.spice_no_peak, "spice_f_3db_hz": self.spice_f_3db_hz}
+
+
+#: the damping at and above which a second-order low-pass has no resonance peak (Mr = 1 there)
+ZETA_NO_PEAK = 1 / math.sqrt(2)
+#: a rise of the gain above its DC value smaller than this is not shown as a peak: 0.1 dB is 1.2 %,
+#: below what a scope's amplitude reading tells apart (a TBS1000's vertical accuracy is +-3 %)
+PEAK_MIN_DB = 0.1
+
+
+def no_peak_reason(zeta: float, peak_gain, dc_gain: float) -> str | None:
+    """Why a response shows no resonance peak, or None when it shows one.
+
+    Parameters
+    ----------
+    zeta : float
+        Damping of the response's dominant pole pair.
+    peak_gain : float or None
+        The highest gain found in the sweep (None: it never rises above its DC value).
+    dc_gain : float
+        The gain the rise is measured from.
+
+    Returns
+    -------
+    str or None
+        "no resonance peak (zeta >= 0.707)", or, for a rise under :data:`PEAK_MIN_DB`,
+        the same with the damping; None for a peak of at least :data:`PEAK_MIN_DB`.
+    """
+    if zeta >= ZETA_NO_PEAK:
+        return "no resonance peak (zeta >= 0.707)"
+    if peak_gain is None or 20 * math.log10(peak_gain / dc_gain) < PEAK_MIN_DB:
+        return f"no resonance peak (zeta {zeta:.4g}, near 0.707: under {PEAK_MIN_DB:g} dB)"
+    return None
 
 
 def peak_and_corner(f, h) -> tuple:
@@ -320,18 +363,27 @@ def sine_check(num, den, opamp: OpAmp, amplitude_v: float, fn_hz: float, spice=N
     f = np.logspace(math.log10(fn_hz / 100), math.log10(fn_hz * 100), 1201)
     h = freq_response(num, den, f)
     fp, gp, f3 = peak_and_corner(f, h)
+    dc = float(abs(h[0]))
+    zeta = dominant_pair(den)[1]
+    why = no_peak_reason(zeta, gp, dc)
+    if why is not None:
+        fp = gp = None
     top = float(np.max(np.abs(h)))
     amp = amplitude_v / 2
     if not opamp.ideal:
         fmax = fp or fn_hz
         amp = min(amp, 0.9 * opamp.vout_max / top, 0.5 * opamp.slew_v_per_s / (2 * math.pi * fmax * top))
     amp = _one_two_five_below(amp)
-    dc = float(abs(h[0]))
     if spice is None:
-        return SineCheck(amp, dc, fp, gp, f3, f_hz=f, h_model=h)
+        return SineCheck(amp, dc, fp, gp, f3, f_hz=f, h_model=h, no_peak=why)
     fs, hs = spice
     sfp, sgp, sf3 = peak_and_corner(fs, hs)
-    return SineCheck(amp, dc, fp, gp, f3, sfp, sgp, sf3, f, h, np.asarray(fs, float), np.asarray(hs))
+    # SPICE's own DC gain (its sweep's first point, fn/100): the rise is judged against what it starts from
+    spice_why = no_peak_reason(zeta, sgp, float(np.abs(np.asarray(hs))[0]))
+    if spice_why is not None:
+        sfp = sgp = None
+    return SineCheck(amp, dc, fp, gp, f3, sfp, sgp, sf3, f, h, np.asarray(fs, float), np.asarray(hs),
+                     no_peak=why, spice_no_peak=spice_why)
 
 
 def _one_two_five_below(x: float) -> float:

@@ -7,6 +7,28 @@ jointly and its LM741 modelled).
 :class:`~designer.plant.result.PlantResult`, typed; its ``to_dict`` is the
 JSON of ``design-plant --json`` and ``result.json``, and the report module
 renders the same object as text, Markdown and HTML.
+
+Which builds are listed (:func:`listed`). The search ranks combinations by
+their error alone, and the same response comes back at other impedance levels:
+R1, R2 times ten with C1, C2 over ten has the same ratios and time constants,
+so the same fn and zeta (30k/120k/1n5/4n7 and 3k/12k/15n/47n). Each response is
+listed once, at the level whose resistors lie in :data:`R_BAND`, 1 kOhm to
+100 kOhm (nearest its middle, 10 kOhm, otherwise), and among the builds within
+:data:`NOTE_ERROR` of the target (well inside what the parts' own tolerance
+moves: a 5 % resistor moves fn 2.5 %) those in the band come first. Why the band:
+
+- below 1 kOhm the op-amp's output drives R1 (through C2) and R2 with C1
+  (the LM741 is specified into 2 kOhm, TI SNOSC25), and the generator's 50 Ohm
+  output adds to R1: 5 % of 1 kOhm already;
+- above 100 kOhm the resistors' thermal noise, sqrt(4 k T R) = 41 nV/sqrt(Hz)
+  at 100 kOhm and 300 K (Johnson-Nyquist; Horowitz and Hill, *The Art of
+  Electronics*, 3rd ed., 8.1.1), and the op-amp's input bias current through
+  R1 + R2 (LM741: 80 nA typical, 500 nA max, TI SNOSC25: 8 mV to 50 mV of
+  output offset at 100 kOhm) grow, and a few pF of board and input capacitance
+  and leakage become part of the circuit.
+
+The ``--r-min``/``--r-max`` bounds still decide what the search may use (a
+design the band cannot reach is built outside it, best error first).
 """
 
 from __future__ import annotations
@@ -59,7 +81,8 @@ from .sallenkey import (
 from .selection import around, brute_force, joint_search
 from .spec import AnalysisSpec, PlantSpec
 
-__all__ = ["PlantSpec", "AnalysisSpec", "PlantResult", "choose_parts", "design_plant", "analyze_plant"]
+__all__ = ["PlantSpec", "AnalysisSpec", "PlantResult", "choose_parts", "design_plant", "analyze_plant", "listed",
+           "R_BAND"]
 
 
 def candidates(series: str, lo: float, hi: float, what: str) -> np.ndarray:
@@ -124,22 +147,24 @@ def choose_parts(spec: PlantSpec) -> Choice:
 
     fc_t, z_t = spec.fc_hz, spec.zeta
     ranked, ideal, ratios = rank(fc_t, z_t)
+    # with R and C fixed (the seed's procedure) the level is the user's: each response once, best error first
+    band = spec.r is None
     if spec.compensate_gbw:
         # aim off by the shift the op-amp causes on the parts chosen, and choose again;
         # the shift hardly depends on the parts, so two or three rounds settle it
         for _ in range(4):
-            b = ranked[0]
+            b = listed(ranked, k, 1, band)[0]
             sf, sz = gbw_shift(SallenKeyParts(b.r1, b.r2, b.c1, b.c2, k, r3, r4), spec.amp)
             new = (spec.fc_hz * sf, spec.zeta * sz)
             if abs(new[0] / fc_t - 1) < 1e-9 and abs(new[1] / z_t - 1) < 1e-9:
                 break
             fc_t, z_t = new
             ranked, ideal, ratios = rank(fc_t, z_t)
+    ranked = listed(ranked, k, top, band)
+    best = ranked[0]
     if spec.r is None:
         # solved once, for the target finally aimed at
-        ideal, ratios = _exact_design(ranked[0], fc_t, z_t, k, r3, r4)
-    ranked = _distinct(ranked, k)[:top]
-    best = ranked[0]
+        ideal, ratios = _exact_design(best, fc_t, z_t, k, r3, r4)
     built = SallenKeyParts(best.r1, best.r2, best.c1, best.c2, k, r3, r4)
     if best.worst > MAX_ERROR:
         raise _unreachable(spec, fc_t, best.worst)
@@ -331,6 +356,61 @@ def _distinct(ranked, gain):
             seen.add(key)
             out.append(c)
     return out
+
+
+#: the resistors' preferred band, Ohm (see the module docstring: loading below, noise and offset above)
+R_BAND = (1e3, 100e3)
+
+
+def _outside_band(c) -> float:
+    """How far (decades) a build's resistors stray outside :data:`R_BAND` (0: inside)."""
+    lo, hi = R_BAND
+    return max(0.0, math.log10(lo / min(c.r1, c.r2)), math.log10(max(c.r1, c.r2) / hi))
+
+
+def _same_response(a, b) -> bool:
+    """The same ratios R1/R2 and C2/C1 and the same time constant R1 C1: one build scaled in
+    impedance (R times s, C over s), with the same fn and zeta."""
+    return all(math.isclose(x, y, rel_tol=1e-9) for x, y in
+               ((a.r1 / a.r2, b.r1 / b.r2), (a.c2 / a.c1, b.c2 / b.c1), (a.r1 * a.c1, b.r1 * b.c1)))
+
+
+def listed(ranked, gain: float, top: int, band: bool = True) -> list:
+    """The builds a design lists, best first, from candidates ranked by error.
+
+    Each build once (R1, R2 swapped at unity gain), each response once (an
+    impedance-scaled copy is the same design): at the level whose resistors stray
+    least outside :data:`R_BAND`, nearest 10 kOhm when several lie inside. With
+    ``band``, the builds in the band within :data:`NOTE_ERROR` of the target
+    come first (the module docstring says why).
+
+    Parameters
+    ----------
+    ranked : list of Candidate
+        Combinations, best error first (:func:`~designer.plant.selection.joint_search`).
+    gain : float
+        The amplifier gain K (at 1, R1 and R2 may swap).
+    top : int
+        How many to list at most.
+    band : bool
+        Put the builds in the resistor band first (False: the user fixed R, keep the error order).
+
+    Returns
+    -------
+    list of Candidate
+    """
+    groups = []
+    for c in _distinct(ranked, gain):
+        home = next((g for g in groups if _same_response(g[0], c)), None)
+        if home is None:
+            groups.append([c])
+        else:
+            home.append(c)
+    # a group's members have the same errors: its place in the ranking is its first member's
+    reps = [min(g, key=lambda c: (_outside_band(c), abs(math.log10(math.sqrt(c.r1 * c.r2) / 1e4)))) for g in groups]
+    if band:
+        reps.sort(key=lambda c: not (_outside_band(c) == 0 and c.worst <= NOTE_ERROR))   # stable: by error within
+    return reps[:top]
 
 
 def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternatives, amp: OpAmp, amplitude_v,

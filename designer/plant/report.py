@@ -73,7 +73,7 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
         out.append(("Tolerance analysis (Monte Carlo)", tolerance_section(result, with_images)))
     out.append(("Sensitivity", _sensitivity(result)))
     if result.alternatives:
-        out.append(("Alternatives (best first)", [_alternatives(result.alternatives)]))
+        out.append(("Alternatives (best first)", [_alternatives(result.alternatives), R.text(ALTERNATIVES_NOTE)]))
     if result.notes:
         out.append(("Notes", [R.text(n) for n in result.notes]))
     return out
@@ -108,6 +108,8 @@ def _sine_text(sine) -> str:
         g = sine.spice_peak_gain if sine.spice_peak_gain is not None else sine.peak_gain
         f = sine.spice_f_peak_hz if sine.spice_f_peak_hz is not None else sine.f_peak_hz
         parts.append(f"peak x{g / sine.dc_gain:.3g} at {format_eng(f, 'Hz', 3)}")
+    elif sine.no_peak:
+        parts.append(sine.no_peak)
     f3 = sine.spice_f_3db_hz if sine.spice_f_3db_hz is not None else sine.f_3db_hz
     if f3 is not None:
         parts.append(f"-3 dB (x0.707) at {format_eng(f3, 'Hz', 3)}")
@@ -144,8 +146,9 @@ def _bench(result):
                        f"band (R {tol.r_tolerance_pct:g} %, C {tol.c_tolerance_pct:g} %)"], rows)]
     sine = result.sine
     if sine is not None:
-        srows = [["resonance peak", _fg(sine.f_peak_hz, sine.peak_gain, sine.dc_gain),
-                  _fg(sine.spice_f_peak_hz, sine.spice_peak_gain, sine.dc_gain) if spice else "not simulated"],
+        srows = [["resonance peak", _fg(sine.f_peak_hz, sine.peak_gain, sine.dc_gain, sine.no_peak),
+                  _fg(sine.spice_f_peak_hz, sine.spice_peak_gain, sine.dc_gain, sine.spice_no_peak)
+                  if spice else "not simulated"],
                  ["-3 dB point", _f(sine.f_3db_hz, "Hz"), _f(sine.spice_f_3db_hz, "Hz") if spice else ""]]
         blocks += [R.text(f"Sine check: a {format_eng(sine.amplitude_v, 'V')} peak sine, no offset; sweep the "
                           "frequency and read the output's amplitude on CH2 against CH1 (gain relative to the "
@@ -180,9 +183,10 @@ def _prbs(result):
     return blocks
 
 
-def _fg(f, g, dc):
-    return "none (no peak)" if f is None or g is None else f"x{g / dc:.4g} ({20 * math.log10(g / dc):+.2f} dB) at " \
-        f"{format_eng(f, 'Hz', 4)}"
+def _fg(f, g, dc, why=None):
+    if f is None or g is None:
+        return why or "none (no peak)"
+    return f"x{g / dc:.4g} ({20 * math.log10(g / dc):+.2f} dB) at {format_eng(f, 'Hz', 4)}"
 
 
 def _sensitivity(result):
@@ -194,6 +198,15 @@ def _sensitivity(result):
     rows += [[k, "", "", f"{v.wn:+.4f}", f"{v.zeta:+.4f}"] for k, v in sens_o.items() if k not in sens]
     return [R.text("Relative sensitivity S = d ln(y) / d ln(x): a 1 % change in the part changes y by S %."),
             R.table(["part", "S(wn)", "S(zeta)", f"S(wn) with {amp}", f"S(zeta) with {amp}"], rows)]
+
+
+#: how the alternatives are chosen (designer.plant.design's module docstring has the sources)
+ALTERNATIVES_NOTE = ("Each response is listed once (the same parts at ten times the resistance and a tenth of "
+                     "the capacitance give the same fn and zeta), with resistors from 1 kOhm to 100 kOhm where it "
+                     "can: below, they load the op-amp's output and the generator's 50 Ohm adds to R1; above, "
+                     "their thermal noise (41 nV/sqrt(Hz) at 100 kOhm) and the op-amp's input bias current "
+                     "through them (LM741: 80 nA, 8 mV at 100 kOhm) grow. Builds within 0.5 % of the target "
+                     "with resistors in that band come first.")
 
 
 def _alternatives(alternatives):

@@ -271,3 +271,107 @@ def test_the_package_is_part_of_the_spec_and_checked_on_construction():
         AnalysisSpec(SallenKeyParts(820, 1e3, 10e-9, 220e-9), opamp="TL072", package="octal")
     res = design_plant(PlantSpec(fc_hz=3500, zeta=0.2, opamp="TL072", package="quad"), simulate=False)
     assert res.package == "quad" and res.to_dict()["package"]["part"] == "TL074"
+
+
+# --------------------------------------------------------------------------- the sine check's resonance peak
+
+def _mr_db(zeta):
+    """A second-order low-pass's resonance peak above its DC gain (seed 000 eq 79)."""
+    return -20 * math.log10(2 * zeta * math.sqrt(1 - zeta * zeta))
+
+
+def test_no_peak_reason_follows_the_closed_form():
+    from designer.plant.bench import PEAK_MIN_DB, no_peak_reason
+    assert no_peak_reason(0.7072, None, 1.0) == "no resonance peak (zeta >= 0.707)"
+    assert no_peak_reason(1 / math.sqrt(2), None, 1.0) == "no resonance peak (zeta >= 0.707)"
+    # 0.70: a 0.0017 dB rise, far under what a scope tells apart
+    z = 0.70
+    assert _mr_db(z) < PEAK_MIN_DB
+    assert no_peak_reason(z, 10 ** (_mr_db(z) / 20), 1.0) == "no resonance peak (zeta 0.7, near 0.707: under 0.1 dB)"
+    for z in (0.2, 0.5, 0.6):
+        assert _mr_db(z) > PEAK_MIN_DB and no_peak_reason(z, 10 ** (_mr_db(z) / 20), 1.0) is None
+
+
+@pytest.mark.parametrize("zeta", [0.707, 0.75, 1.0])
+def test_a_butterworth_or_slower_plant_has_no_resonance_peak_and_says_why(zeta):
+    """design-plant --fc 1k --zeta 0.707 once printed 'resonance peak x1 (+0.00 dB) at 59.36 Hz'."""
+    r = design_plant(PlantSpec(1000, zeta), simulate=False)
+    s = r.sine
+    assert s.f_peak_hz is None and s.peak_gain is None
+    assert s.no_peak.startswith("no resonance peak (zeta ")
+    if r.analytic_opamp.figures.zeta >= 1 / math.sqrt(2):
+        assert s.no_peak == "no resonance peak (zeta >= 0.707)"
+    d = r.to_dict()["sine_check"]
+    assert d["f_peak_hz"] is None and d["no_peak_reason"] == s.no_peak
+    from designer.plant.report import _sine_text
+    assert s.no_peak in _sine_text(s) and "x1 " not in _sine_text(s)
+
+
+def test_an_underdamped_plant_keeps_its_peak_where_the_closed_form_puts_it():
+    r = design_plant(PlantSpec(3500, 0.2, opamp="ideal"), simulate=False)
+    s, z, fn = r.sine, r.built.zeta, r.built.fn_hz
+    assert s.no_peak is None and s.to_dict()["no_peak_reason"] is None
+    assert 20 * math.log10(s.peak_gain / s.dc_gain) == pytest.approx(_mr_db(z), abs=0.01)
+    assert s.f_peak_hz == pytest.approx(fn * math.sqrt(1 - 2 * z * z), rel=1e-3)
+
+
+@pytest.mark.spice
+def test_the_butterworth_plants_sheet_says_no_resonance_peak_in_both_columns():
+    import subprocess
+
+    from helpers import script
+    out = subprocess.run([script("design-plant"), "--fc", "1k", "--zeta", "0.707", "--no-files"],
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    row = next(ln for ln in out.stdout.splitlines() if ln.startswith("resonance peak"))
+    assert row.count("no resonance peak (zeta ") == 2 and "dB) at" not in row
+    assert "+0.00 dB" not in out.stdout
+
+
+# --------------------------------------------------------------------------- the alternatives
+
+def _same_response(a, b):
+    return all(math.isclose(x, y, rel_tol=1e-9) for x, y in
+               ((a.r1 / a.r2, b.r1 / b.r2), (a.c2 / a.c1, b.c2 / b.c1), (a.r1 * a.c1, b.r1 * b.c1)))
+
+
+@pytest.mark.parametrize("fc, zeta", [(1000, 0.707), (3500, 0.2), (250, 0.5), (20e3, 0.9), (2e3, 0.3)])
+def test_alternatives_differ_and_sit_in_the_resistor_band(fc, zeta):
+    """No alternative is an impedance-scaled copy of another (1k/0.707 once listed
+    30k/120k/1n5/4n7 then 3k/12k/15n/47n); the build is the best the search finds
+    with every resistor in 1k..100k when that is within 0.5 %."""
+    from designer.core import eseries
+    from designer.plant.design import NOTE_ERROR, R_BAND
+    from designer.plant.selection import joint_search
+    r = design_plant(PlantSpec(fc, zeta, alternatives=8), simulate=False)
+    alts = r.alternatives
+    assert len(alts) >= 3
+    for i, a in enumerate(alts):
+        for b in alts[:i]:
+            assert not _same_response(a, b), (a, b)
+    spec = PlantSpec(fc, zeta)
+    in_band = joint_search(fc, zeta, eseries.values(spec.r_series, *R_BAND),
+                           eseries.values(spec.c_series, spec.c_min, spec.c_max), top=1)[0]
+    b = r.built
+    worst = max(abs(b.fn_hz / fc - 1), abs(b.zeta / zeta - 1))
+    if in_band.worst <= NOTE_ERROR:
+        assert R_BAND[0] <= min(b.r1, b.r2) and max(b.r1, b.r2) <= R_BAND[1]
+        assert worst == pytest.approx(in_band.worst, abs=1e-12)
+    else:   # the band cannot reach 0.5 %: the best error within the bounds, wherever it is
+        assert worst <= in_band.worst
+
+
+def test_listed_keeps_one_build_per_response_at_the_level_in_the_band():
+    from designer.plant.design import listed
+    from designer.plant.selection import Candidate
+
+    def cand(r1, r2, c1, c2, err):
+        return Candidate(r1, r2, c1, c2, 0.0, 0.0, err, 0.0)
+
+    far = cand(30e3, 120e3, 1.5e-9, 4.7e-9, 0.001)       # R2 above 100k
+    near = cand(3e3, 12e3, 15e-9, 47e-9, 0.001)          # the same response, ten times lower
+    other = cand(18e3, 30e3, 4.7e-9, 10e-9, 0.002)
+    assert listed([far, near, other], 1.0, 5) == [near, other]
+    # an out-of-band build with a better error ranks after an in-band one within 0.5 %
+    assert listed([far, other], 1.0, 5) == [other, far]
+    assert listed([far, other], 1.0, 5, band=False) == [far, other]

@@ -79,6 +79,17 @@ def test_motor_capture_regenerates():
         assert off.max() <= 0.02 + 1e-9 and np.count_nonzero(off > 1e-9) <= got.size // 1000
 
 
+def test_motor_identify_json_regenerates_byte_for_byte():
+    """make demo's identify line gives the committed JSON exactly (it once carried the run's
+    timings, so every make demo left the file modified)."""
+    if not MOTOR_MODEL.exists():
+        pytest.skip(f"{MOTOR_MODEL} not generated (run make demo)")
+    out = subprocess.run([script("identify"), "captures/motor_seed000.csv", "--json"], capture_output=True, text=True,
+                         cwd=ROOT, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout == MOTOR_MODEL.read_text()
+
+
 def test_motor_reference_reproduces():
     ref = committed("pid_motor_seed000")
     res = design_pid(PidSpec(plant_model=str(MOTOR_MODEL), tuning="optimize")).to_dict()
