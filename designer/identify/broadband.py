@@ -56,6 +56,9 @@ PERIOD_MISMATCH = 0.01
 METHODS = ("correlation", "spectral")
 #: bits whose linear complexity tells an m-sequence shorter than two periods
 LFSR_BITS = 200
+#: the output's mean may move by at most this fraction of its span a period (and
+#: three standard errors) for the record to be in periodic steady state (eq. 2.4.2)
+MAX_PERIOD_DRIFT = 0.01
 
 
 @dataclass
@@ -275,6 +278,8 @@ class BroadbandResult:
     timings: dict = field(default_factory=dict)
     #: for a wrapped impulse response: the period, bits or clock interval that would do
     advice: dict | None = None
+    #: why no model is valid when the estimates' own assumption failed ("" when it held)
+    refused: str = ""
 
     @property
     def best(self):
@@ -285,6 +290,8 @@ class BroadbandResult:
         d = {"format": "broadband", "excitation": self.excitation.to_dict(), "method": self.method,
              "best": self.best.to_dict() if self.best else None, "notes": list(self.notes),
              "timings_s": dict(self.timings)}
+        if self.refused:
+            d["refused"] = self.refused
         if self.impulse is not None:
             d["impulse"] = self.impulse.to_dict()
             if self.advice:
@@ -428,6 +435,7 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
             res.spectrum = banded
             res.freq_result = identify_freq(spec.to_freq_data(banded, name))
         timings["spectral_models"] = clock() - t1
+    _refuse_unsettled(res, y)
     if method is None:
         # the spectral fit first: it divides by the input's own spectrum, where the
         # correlation's step is smoothed by the sequence's autocorrelation triangle
@@ -436,6 +444,66 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
     timings["total"] = clock() - t0
     res.timings = timings
     return res
+
+
+def period_drift(y, ex: Excitation) -> tuple:
+    """(the change of the output's mean from one period to the next, its
+    standard error) over the periods used: the least-squares slope of the
+    period means (0, inf for fewer than two periods or a noise input). The
+    standard error is from the output's sample-to-sample noise (the second
+    difference's spread / sqrt 6, as :func:`.correlation.tail_drift` takes it)."""
+    if ex.kind == "noise" or ex.count < 2:
+        return 0.0, math.inf
+    seg = np.asarray(y, float)[ex.start:ex.start + ex.period * ex.count]
+    means = seg.reshape(ex.count, ex.period).mean(axis=1)
+    k = np.arange(ex.count) - 0.5 * (ex.count - 1)
+    slope = float(np.sum(k * means) / np.sum(k * k))
+    sigma = float(np.std(np.diff(seg, 2)) / math.sqrt(6.0))
+    se = sigma * math.sqrt(ex.samples_per_bit / ex.period) / math.sqrt(float(np.sum(k * k)))
+    return slope, se
+
+
+def _invalidate(result, why: str) -> None:
+    """Mark every valid model of a step or frequency ranking invalid, saying why."""
+    if result is None:
+        return
+    from .structures import rank_key
+    for m in result.methods:
+        if m.valid:
+            m.valid = False
+            m.note = why + (f"; {m.note}" if m.note else "")
+    result.methods.sort(key=rank_key)
+    result.best = None
+
+
+def _refuse_unsettled(res: BroadbandResult, y) -> None:
+    """No valid model when the method's assumption failed: a wrapped impulse
+    response (the response outlasts a period) gives no valid step model, and an
+    output whose mean drifts from period to period (an integrating plant, a pole
+    at the origin, never settles) is in no periodic steady state (seed 003
+    eq. 2.4.2, which both the correlation and the spectral estimate assume)."""
+    from ..core.units import format_eng as fe
+    ex = res.excitation
+    drift, se = period_drift(y, ex)
+    span = float(np.ptp(y)) if y.size else 0.0
+    if math.isfinite(se) and abs(drift) > max(MAX_PERIOD_DRIFT * span, 3.0 * se):
+        res.refused = (f"the output's mean moves {drift:+.4g} a period ({100 * abs(drift) / span:.1f} % of "
+                       "its span) over the periods used: no periodic steady state, which the correlation "
+                       "and spectral estimates assume (seed 003 eq. 2.4.2), as an integrating plant (a "
+                       "pole at the origin) or one slower than the record gives; no model from them is "
+                       "valid (a self-regulating plant: more periods, or a longer one; an integrating "
+                       "one: a step test)")
+        why = "no periodic steady state (the output's mean drifts period to period)"
+        _invalidate(res.step_result, why)
+        _invalidate(res.freq_result, why)
+    elif res.impulse is not None and res.impulse.wrapped and res.step_result is not None:
+        why = ("the impulse response wrapped around (it has not settled within one period): its step "
+               "response is cut short, so no model from it is the plant's")
+        _invalidate(res.step_result, why)
+        if res.freq_result is None or res.freq_result.best is None:
+            res.refused = why + " (the notes say what period would do)"
+    if res.refused:
+        res.notes.append(res.refused)
 
 
 #: samples at rest put before the step response given to the step methods, as a fraction of it

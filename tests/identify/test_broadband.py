@@ -10,7 +10,7 @@ import pytest
 
 from designer.core.errors import DesignError
 from designer.identify import correlation as corr
-from designer.identify.broadband import examine_input, identify_broadband, looks_broadband
+from designer.identify.broadband import examine_input, identify_broadband, looks_broadband, period_drift
 from prbs_capture import prbs_capture
 
 TS = 0.01        # sample interval, s
@@ -230,3 +230,40 @@ def test_any_sequence_is_recognised_with_its_clock_and_period(bits, per_bit, ext
     assert (ex.bits, ex.samples_per_bit) == (bits, per_bit)
     assert ex.count >= 1 and ex.start + ex.count * ex.period <= u.size
     assert ex.offset == pytest.approx(offset, abs=1e-9 * max(1.0, abs(offset)))
+
+
+# ------------------------------------------------------------------ no periodic steady state (issue 25, 5b)
+
+INTEGRATING = ([50.0], [10e-3, 1.0, 0.0])      # 50/(s (10 ms s + 1)): a pole at the origin
+
+
+@pytest.mark.parametrize("periods,offset", [(3, 0.0), (4, 0.0), (6, 0.5)])
+def test_an_integrating_plant_gives_no_valid_model(periods, offset):
+    """A PRBS into an integrator never reaches a periodic steady state (the
+    sequence's mean, a/N, and any offset ramp the output): the correlation's
+    impulse response wraps around and the spectral table has no flat gain, and
+    neither may hand a stable model on as valid (it did: K 0.27 or 1.76, "yes")."""
+    t, u, y = prbs_capture(*INTEGRATING, bits=8, per_bit=4, periods=periods, ts=1e-4, snr_db=40,
+                           seed=1, offset=offset)
+    res = identify_broadband(t, y, u)
+    assert res.best is None
+    for r in (res.step_result, res.freq_result):
+        assert r is not None and r.best is None and not any(m.valid for m in r.methods)
+    assert "no periodic steady state" in res.refused and "integrating plant" in res.refused
+    d = res.to_dict()
+    assert d["best"] is None and d["refused"] == res.refused
+    # the drift measured is the integrator's: K x (the input's mean about its levels) x the period
+    ex = res.excitation
+    drift, se = period_drift(y, ex)
+    mean_u = float(np.mean(u[ex.start:ex.start + ex.period * ex.count])) - offset
+    assert drift == pytest.approx(50.0 * mean_u * ex.period * ex.ts, rel=0.05)
+
+
+def test_a_self_regulating_plant_is_in_periodic_steady_state():
+    """The same sequence into 2/(20 ms s + 1): the period means agree within
+    their noise, nothing is refused, the models stay valid."""
+    t, u, y = prbs_capture([2.0], [20e-3, 1.0], bits=8, per_bit=4, periods=4, ts=1e-4, snr_db=40,
+                           seed=1, offset=0.5)
+    res = identify_broadband(t, y, u)
+    assert not res.refused and res.best is not None
+    assert res.best.params["K"] == pytest.approx(2.0, rel=0.03)
