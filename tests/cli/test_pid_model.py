@@ -177,3 +177,11 @@ def test_a_prbs_capture_of_an_integrating_plant_is_refused_saying_why(tmp_path):
     assert json.loads(ident.stdout)["best"] is None
     one_line_refusal(run(DESIGN_PID, "--plant-model", str(models), "--out", str(out)), "integrating plant")
     assert not out.exists()
+
+
+def test_the_issue_25_plant_designs_without_warnings(tmp_path):
+    """``design-pid --plant-tf "K=2 tau=20m theta=50u"`` exited 2 with two scipy warning lines and
+    "...; shorten t" (a library parameter); it designs now, with nothing on stderr."""
+    p = run(DESIGN_PID, "--plant-tf", "K=2 tau=20m theta=50u", "--no-sim", "--no-files")
+    assert p.returncode == 0 and p.stderr == "", (p.returncode, p.stderr)
+    assert "G(s) = 2 e^(-50 us s) / (20 ms s + 1)" in p.stdout
