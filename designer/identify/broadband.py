@@ -34,7 +34,7 @@ import numpy as np
 from ..core.errors import DesignError
 from . import correlation as corr
 from . import spectral as spec
-from ..core.prbs import MAX_BITS, MIN_BITS, SETTLE_MARGIN, bits_for, is_mls_length
+from ..core.prbs import MAX_BITS, MIN_BITS, SETTLE_MARGIN, bits_for, is_mls_length, mls_bit_errors
 
 #: at least this many transitions make an input broadband
 MIN_TRANSITIONS = 20
@@ -80,6 +80,8 @@ class Excitation:
     bits: int | None = None
     start: int = 0
     count: int = 0
+    #: of a period of an m-sequence's length: its values that differ from the nearest m-sequence
+    bit_errors: int = 0
 
     @property
     def dt_s(self) -> float:
@@ -95,7 +97,10 @@ class Excitation:
             return (f"noise input ({self.transitions} transitions), sampled every "
                     f"{fe(self.ts, 's')}")
         what = (f"maximum-length sequence, {self.bits} bits (N = {self.n})" if self.kind == "mls"
-                else f"periodic binary sequence of {self.n} intervals (not an m-sequence)")
+                else f"periodic binary sequence of {self.n} intervals (not an m-sequence)"
+                if not self.bit_errors else
+                f"a binary sequence of {self.n} intervals a period, not maximum-length ({self.bit_errors} "
+                f"bits of each period differ from the nearest {is_mls_length(self.n)}-bit m-sequence)")
         return (f"{what}, clock {fe(1 / self.dt_s, 'Hz')} (Dt = {fe(self.dt_s, 's')}, "
                 f"{self.samples_per_bit} samples), levels {self.offset:.4g} +- "
                 f"{self.amplitude:.4g}; {self.count} whole period(s) of "
@@ -109,6 +114,8 @@ class Excitation:
                       "bits": self.bits, "offset": self.offset, "amplitude": self.amplitude,
                       "period_s": self.period * self.ts, "periods_used": self.count,
                       "first_sample": self.start})
+            if self.bit_errors:
+                d["bits_differing_from_mls"] = self.bit_errors
         return d
 
 
@@ -248,8 +255,12 @@ def examine_input(t, u, *, name: str = "capture") -> Excitation | None:
     if L is None:
         return ex                      # a random binary signal: read as noise
     nb = is_mls_length(L)
-    ex.kind = "mls" if nb else "periodic"
-    ex.n, ex.bits = L, nb
+    if nb:
+        # the length is an m-sequence's: is the sequence one? (each period voted bit by bit)
+        whole = bits[:bits.size // L * L].reshape(-1, L).astype(int)
+        ex.bit_errors = mls_bit_errors(np.where(whole.sum(axis=0) >= 0, 1, -1), nb)
+    ex.kind = "mls" if nb and not ex.bit_errors else "periodic"
+    ex.n, ex.bits = L, (nb if ex.kind == "mls" else None)
     p = L * m
     # the sequence starts at most `bits` intervals before its first transition
     first = max(0, int(edges[0]) - (nb or MAX_BITS) * m)
@@ -382,9 +393,10 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
                           "2 whole ones are needed (the first settles the plant, the second is "
                           "measured)")
     if method == "correlation" and ex.kind == "periodic":
-        raise DesignError(f"{name}: the input repeats every {ex.n} intervals, which is not "
-                          "2^n - 1: the correlation method needs a maximum-length sequence; use "
-                          "--method spectral")
+        why = (f"{ex.bit_errors} bits of each period differ from the nearest m-sequence" if ex.bit_errors
+               else "which is not 2^n - 1")
+        raise DesignError(f"{name}: the input repeats every {ex.n} intervals, {why}: the correlation "
+                          "method needs a maximum-length sequence; use --method spectral")
     res.method = method or "spectral"
     ts = ex.ts
     f_nyq = 0.5 / ts

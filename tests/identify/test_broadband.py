@@ -267,3 +267,26 @@ def test_a_self_regulating_plant_is_in_periodic_steady_state():
     res = identify_broadband(t, y, u)
     assert not res.refused and res.best is not None
     assert res.best.params["K"] == pytest.approx(2.0, rel=0.03)
+
+
+def test_a_corrupted_m_sequence_is_not_called_maximum_length():
+    """Issue 25, 5c: 3 values of every period of a 9-bit m-sequence flipped were still
+    "a maximum-length sequence, 9 bits": the floor of its autocorrelation is no longer
+    constant (each flip moves the other lags by 0 or +-4, against the floor's -1), so the
+    correlation would be biased. It is a periodic binary sequence, its errors counted;
+    the spectral method (any periodic input) identifies the plant, correlation is refused."""
+    t, u, y = prbs_capture([2.0], [20e-3, 1.0], bits=9, per_bit=4, periods=4, ts=1e-4, snr_db=40, seed=1,
+                           flip=(17, 200, 401))
+    ex = examine_input(t, u)
+    assert ex.kind == "periodic" and ex.n == 511 and ex.bit_errors == 3 and ex.bits is None
+    assert "not maximum-length (3 bits of each period differ from the nearest 9-bit m-sequence)" in ex.text()
+    res = identify_broadband(t, y, u)
+    assert res.impulse is None and res.method == "spectral"
+    assert res.best.params["K"] == pytest.approx(2.0, rel=0.03)
+    assert res.best.params["tau_s"] == pytest.approx(20e-3, rel=0.03)
+    with pytest.raises(DesignError, match="3 bits of each period differ"):
+        identify_broadband(t, y, u, method="correlation")
+    # unflipped, the same record is the m-sequence
+    t, u, y = prbs_capture([2.0], [20e-3, 1.0], bits=9, per_bit=4, periods=4, ts=1e-4, snr_db=40, seed=1)
+    ex = examine_input(t, u)
+    assert ex.kind == "mls" and ex.bits == 9 and ex.bit_errors == 0
