@@ -175,6 +175,67 @@ def looks_broadband(u) -> bool:
     return _line_share(u) < MAX_LINE_SHARE
 
 
+#: a multi-level sequence has at most this many levels (more: a staircase of noise, a sine's samples)
+MAX_LEVELS = 9
+#: each of its levels holds at least this share of the samples
+LEVEL_SHARE = 0.05
+#: histogram bins over the input's span when the levels are sought
+LEVEL_BINS = 100
+
+
+def multilevel_levels(u) -> list | None:
+    """The levels of a sequence of 3 to :data:`MAX_LEVELS` levels (a three-level
+    PRBS, a multi-level random sequence), else None: the samples fall in separate
+    clusters (histogram bins holding at least 0.5 % of them, runs of such bins), each
+    holding :data:`LEVEL_SHARE`, and the level changes at least
+    :data:`MIN_TRANSITIONS` times, spread through the record, held for at least two
+    samples at a time in most runs (a clocked sequence, not a quiet channel's
+    noise a few quantisation steps wide, which moves nearly every sample)."""
+    u = np.asarray(u, float)
+    if u.size < MIN_SAMPLES or not np.all(np.isfinite(u)):
+        return None
+    lo, hi = np.percentile(u, [0.5, 99.5])
+    span = hi - lo
+    if not span > 0:
+        return None
+    counts, edges = np.histogram(u, LEVEL_BINS, range=(lo - 0.02 * span, hi + 0.02 * span))
+    full = counts >= 0.005 * u.size
+    # runs of populated bins are the clusters
+    starts = np.flatnonzero(full & ~np.r_[False, full[:-1]])
+    ends = np.flatnonzero(full & ~np.r_[full[1:], False]) + 1
+    levels = []
+    for a, b in zip(starts, ends):
+        sel = (u >= edges[a]) & (u < edges[b])
+        if np.count_nonzero(sel) >= LEVEL_SHARE * u.size:
+            levels.append(float(np.median(u[sel])))
+    if not 3 <= len(levels) <= MAX_LEVELS:
+        return None
+    lv = np.asarray(levels)
+    idx = np.argmin(np.abs(u[:, None] - lv[None, :]), axis=1)
+    change = np.flatnonzero(np.diff(idx)) + 1
+    if change.size < MIN_TRANSITIONS:
+        return None
+    if np.min(np.bincount(change * SPREAD_PARTS // u.size, minlength=SPREAD_PARTS)) < 2:
+        return None
+    runs = np.diff(change)
+    if np.mean(runs >= 2) < 0.8:
+        return None
+    return levels
+
+
+def _refuse_multilevel(u, name) -> None:
+    """One line for an input of 3 or more levels (:func:`multilevel_levels`)."""
+    levels = multilevel_levels(u)
+    if levels is None:
+        return
+    words = {3: "three", 4: "four", 5: "five"}
+    k = len(levels)
+    raise DesignError(f"{name}: the input is a {words.get(k, str(k))}-level sequence (levels "
+                      f"{', '.join(f'{v:.4g}' for v in levels)}): neither a step or square wave (the "
+                      "step methods) nor a two-level sequence (a PRBS, see make-prbs) or noise (the "
+                      "correlation and spectral methods); capture the plant under one of those")
+
+
 def _clock(edges, ts, name) -> int:
     """Samples per interval of a binary sequence from its transition indices."""
     runs = np.diff(edges).astype(float)
@@ -216,6 +277,7 @@ def examine_input(t, u, *, name: str = "capture") -> Excitation | None:
     """The excitation of a capture, or None when ``u`` is not broadband (a step,
     a square wave, a sine: the step methods' input)."""
     u = np.asarray(u, float)
+    _refuse_multilevel(u, name)       # before the noise test, which its middle levels would pass
     if not looks_broadband(u):
         return None
     t = np.asarray(t, float)

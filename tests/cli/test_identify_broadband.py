@@ -160,3 +160,15 @@ def test_a_corrupted_m_sequence_is_named_for_what_it_is(tmp_path):
     out = json.loads(run(path, "--json").stdout)
     assert out["excitation"]["kind"] == "periodic" and out["excitation"]["bits_differing_from_mls"] == 3
     one_line_error(run(path, "--method", "correlation"), "3 bits of each period differ", "--method spectral")
+
+
+def test_a_three_level_sequence_is_named(tmp_path):
+    """Issue 25, item 10: a three-level sequence into a plant was "no step in the input column: it
+    never moves"; one line now says what it is and what identify takes, input named or by position."""
+    rng = np.random.default_rng(0)
+    u = np.repeat(np.tile(rng.integers(-1, 2, 242).astype(float), 4), 4)
+    y = np.convolve(u, np.full(40, 1 / 40))[:u.size]
+    t = np.arange(u.size) * 1e-4
+    for header in ("t,u,y", "t,CH1,CH2"):
+        path = capture_csv(tmp_path / f"{header[2:4]}.csv", t, u, y, header=header)
+        one_line_error(run(path), "the input is a three-level sequence (levels -1, 0, 1)", "two-level sequence")

@@ -10,7 +10,8 @@ import pytest
 
 from designer.core.errors import DesignError
 from designer.identify import correlation as corr
-from designer.identify.broadband import examine_input, identify_broadband, looks_broadband, period_drift
+from designer.identify.broadband import (examine_input, identify_broadband, looks_broadband, multilevel_levels,
+                                         period_drift)
 from prbs_capture import prbs_capture
 
 TS = 0.01        # sample interval, s
@@ -290,3 +291,41 @@ def test_a_corrupted_m_sequence_is_not_called_maximum_length():
     t, u, y = prbs_capture([2.0], [20e-3, 1.0], bits=9, per_bit=4, periods=4, ts=1e-4, snr_db=40, seed=1)
     ex = examine_input(t, u)
     assert ex.kind == "mls" and ex.bits == 9 and ex.bit_errors == 0
+
+
+# ------------------------------------------------------------------ a multi-level input (issue 25, item 10)
+
+def _three_level(seed=0, per=4, periods=4, noise=0.0):
+    """A periodic sequence of levels -1, 0, 1 (242 values a period, drawn from a seeded
+    generator), ``per`` samples a value, into 2/(20 ms s + 1) sampled every 100 us."""
+    import scipy.signal as sig
+    rng = np.random.default_rng(seed)
+    u = np.repeat(np.tile(rng.integers(-1, 2, 242).astype(float), periods), per)
+    b, a, _ = sig.cont2discrete(([2.0], [20e-3, 1.0]), 1e-4, method="zoh")
+    y = sig.lfilter(np.squeeze(b), a, u)
+    u = u + noise * rng.standard_normal(u.size)
+    return np.arange(u.size) * 1e-4, u, y
+
+
+@pytest.mark.parametrize("noise", [0.0, 0.02])
+def test_a_three_level_sequence_is_named_and_refused(noise):
+    """It was "no step in the input column: it never moves" (its three levels look like a quiet
+    channel's few quantisation steps to the broadband test; with noise on it, it passed for
+    noise): now one line naming it and what is taken."""
+    t, u, y = _three_level(noise=noise)
+    assert looks_broadband(u) == (noise > 0)        # noiseless, it looked like a quiet channel
+    levels = multilevel_levels(u)
+    assert levels is not None and np.allclose(levels, [-1.0, 0.0, 1.0], atol=0.05)
+    with pytest.raises(DesignError, match="three-level sequence .*two-level sequence"):
+        examine_input(t, u, name="c.csv")
+
+
+def test_a_quiet_channel_and_a_step_are_not_multi_level():
+    """A channel's white noise a few quantisation steps wide moves nearly every sample; a
+    noisy step has two levels: neither is refused as a multi-level sequence."""
+    from designer.identify.broadband import multilevel_levels
+    rng = np.random.default_rng(4)
+    quiet = np.round(rng.normal(0.0, 1.0, 5000))
+    step = (np.arange(5000) > 1000) + 0.01 * rng.standard_normal(5000)
+    assert multilevel_levels(quiet) is None and multilevel_levels(step) is None
+    assert examine_input(np.arange(5000) * 1e-3, step) is None
