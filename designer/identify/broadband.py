@@ -6,7 +6,11 @@ irregular intervals (a square wave's are regular), no spectral line holding
 most of the power (a sine's or a square wave's fundamental does). A two-level
 input is then read as a sequence: its clock interval from the transitions
 (which must be a whole number of sample intervals), its period from the bits
-(an m-sequence when it is 2^n - 1 intervals). Anything else broadband is noise.
+(an m-sequence when it is 2^n - 1 intervals and every period is the nearest
+m-sequence bit for bit, :func:`~designer.core.prbs.mls_bit_errors`; else a
+periodic binary sequence, for the spectral method). Anything else broadband is
+noise; an input of 3 to :data:`MAX_LEVELS` levels held at a clock (a
+three-level PRBS) is refused, named (:func:`multilevel_levels`).
 
 :func:`identify_broadband` then estimates, on the periods after the first
 (the seed's "establishment sequence": the plant must be in periodic steady
@@ -20,7 +24,11 @@ state, 2.4.2),
   frequency table (:class:`~.io.FreqData`) on which identify-freq's analysis
   (:func:`~.frequency.identify_freq`) runs;
 
-each ranked as it is today. ``method`` forces one of them.
+each ranked as it is today. ``method`` forces one of them. A method whose
+assumption failed gives no valid model (:func:`_refuse_unsettled`): a wrapped
+impulse response none from the correlation, and an output whose mean drifts
+from period to period (no periodic steady state, eq. 2.4.2: an integrating
+plant) none at all, ``refused`` saying why.
 """
 
 from __future__ import annotations
