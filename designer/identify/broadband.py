@@ -64,6 +64,8 @@ PERIOD_MISMATCH = 0.01
 METHODS = ("correlation", "spectral")
 #: bits whose linear complexity tells an m-sequence shorter than two periods
 LFSR_BITS = 200
+#: periods of the record compared with the nearest m-sequence (the last ones; the fewest errors count)
+MLS_ROWS = 4
 #: the output's mean may move by at most this fraction of its span a period (and
 #: three standard errors) for the record to be in periodic steady state (eq. 2.4.2)
 MAX_PERIOD_DRIFT = 0.01
@@ -326,9 +328,14 @@ def examine_input(t, u, *, name: str = "capture") -> Excitation | None:
         return ex                      # a random binary signal: read as noise
     nb = is_mls_length(L)
     if nb:
-        # the length is an m-sequence's: is the sequence one? (each period voted bit by bit)
-        whole = bits[:bits.size // L * L].reshape(-1, L).astype(int)
-        ex.bit_errors = mls_bit_errors(np.where(whole.sum(axis=0) >= 0, 1, -1), nb)
+        # the length is an m-sequence's: is the sequence one? The fewest errors of the last
+        # MLS_ROWS stretches of a period (a generator's idle lead-in, a misread bit, spoil one)
+        whole = bits[:bits.size // L * L].reshape(-1, L)
+        ex.bit_errors = L
+        for row in whole[::-1][:MLS_ROWS]:
+            ex.bit_errors = min(ex.bit_errors, mls_bit_errors(row, nb))
+            if not ex.bit_errors:
+                break
     ex.kind = "mls" if nb and not ex.bit_errors else "periodic"
     ex.n, ex.bits = L, (nb if ex.kind == "mls" else None)
     p = L * m
@@ -579,11 +586,11 @@ def _refuse_unsettled(res: BroadbandResult, y) -> None:
         _invalidate(res.step_result, why)
         _invalidate(res.freq_result, why)
     elif res.impulse is not None and res.impulse.wrapped and res.step_result is not None:
-        why = ("the impulse response wrapped around (it has not settled within one period): its step "
-               "response is cut short, so no model from it is the plant's")
+        why = ("the impulse response wrapped around (it has not settled within one period; an integrating "
+               "plant never does): its step response is cut short, so no model from it is the plant's")
         _invalidate(res.step_result, why)
         if res.freq_result is None or res.freq_result.best is None:
-            res.refused = why + " (the notes say what period would do)"
+            res.refused = why + " (identify's notes say what period would do)"
     if res.refused:
         res.notes.append(res.refused)
 

@@ -329,3 +329,15 @@ def test_a_quiet_channel_and_a_step_are_not_multi_level():
     step = (np.arange(5000) > 1000) + 0.01 * rng.standard_normal(5000)
     assert multilevel_levels(quiet) is None and multilevel_levels(step) is None
     assert examine_input(np.arange(5000) * 1e-3, step) is None
+
+
+def test_an_idle_lead_in_does_not_spoil_the_m_sequence_check():
+    """A generator idle at its low level for 5 intervals before two periods: the first stretch of a
+    period read holds the idle bits, the last is the
+    sequence itself: an m-sequence, no errors."""
+    from designer.core.prbs import mls
+    per = 4
+    one = mls(8).astype(float)
+    u = np.repeat(np.concatenate((-np.ones(5), one, one, one[:20])), per)
+    ex = examine_input(np.arange(u.size) * 1e-3, u)
+    assert ex.kind == "mls" and ex.bits == 8 and ex.bit_errors == 0
