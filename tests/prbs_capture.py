@@ -14,9 +14,12 @@ from designer.core.prbs import mls
 
 
 def prbs_capture(num, den, *, bits, per_bit, periods, ts, amplitude=1.0, offset=0.0,
-                 delay_samples=0, snr_db=None, adc_bits=None, seed=1, y_offset=0.0):
-    """(t, u, y) of a PRBS experiment on N(s)/D(s) (see the module docstring)."""
-    seq = np.tile(mls(bits).astype(float), periods)
+                 delay_samples=0, snr_db=None, adc_bits=None, seed=1, y_offset=0.0, flip=()):
+    """(t, u, y) of a PRBS experiment on N(s)/D(s) (see the module docstring);
+    the values at the indices ``flip`` of every period inverted (a corrupted sequence)."""
+    one = mls(bits).astype(float)
+    one[list(flip)] *= -1.0
+    seq = np.tile(one, periods)
     u2 = offset + amplitude * np.repeat(seq, 2 * per_bit)
     b, a, _ = sig.cont2discrete((num, den), ts / 2, method="zoh")
     y2 = sig.lfilter(np.squeeze(b), a, u2 - offset)

@@ -249,10 +249,9 @@ def pwl_subcircuit(plan: PrbsPlan, name: str = "prbs_source") -> str:
     return "\n".join(lines) + "\n"
 
 
-def linear_complexity(bits) -> int:
-    """The length of the shortest linear feedback shift register that generates
-    the 0/1 sequence ``bits`` (Berlekamp-Massey over GF(2)): the bits n of an
-    m-sequence once 2n of its bits are seen; about half the length for random bits."""
+def _berlekamp_massey(bits) -> tuple:
+    """(L, c): the shortest linear feedback shift register that generates the 0/1
+    sequence ``bits`` over GF(2), s_i = c_1 s_(i-1) + ... + c_L s_(i-L) (Massey 1969)."""
     s = [int(b) & 1 for b in bits]
     n = len(s)
     c, b = [1] + [0] * n, [1] + [0] * n
@@ -268,4 +267,59 @@ def linear_complexity(bits) -> int:
                 c[j + shift] ^= b[j]
             if 2 * L <= i:
                 L, m, b = i + 1 - L, i, t
-    return L
+    return L, c[:L + 1]
+
+
+def linear_complexity(bits) -> int:
+    """The length of the shortest linear feedback shift register that generates
+    the 0/1 sequence ``bits`` (Berlekamp-Massey over GF(2)): the bits n of an
+    m-sequence once 2n of its bits are seen; about half the length for random bits."""
+    return _berlekamp_massey(bits)[0]
+
+
+#: windows of 2n bits tried for the register of a period with bit errors
+MLS_WINDOWS = 16
+
+
+def mls_bit_errors(period, bits: int) -> int:
+    """How many of the values of one period (+-1 or 0/1, 2^bits - 1 of them) differ
+    from the nearest m-sequence of ``bits`` bits (any register, any phase): 0 for a
+    maximum-length sequence.
+
+    The register comes from Berlekamp-Massey on 2n consecutive bits (n bits
+    determine it: an error-free window of the period gives the right one, so
+    windows spread over the period are tried, :data:`MLS_WINDOWS` of them); its
+    m-sequence (:func:`scipy.signal.max_len_seq` with the register's taps, read in
+    either direction) is aligned by the circular cross-correlation, whose peak
+    C gives the agreements: (N + C)/2 of N. The count matters because an
+    m-sequence's autocorrelation is N at lag 0 and -1 at every other lag (eq.
+    2.4.6), and each flipped value moves every other lag's by 0 or +-4: k flips
+    leave a floor that is no longer constant, up to 4k/N of the peak at each lag,
+    which the correlation's DC term does not remove (seed 003, 2.4)."""
+    from scipy.signal import max_len_seq
+    x = np.asarray(period)
+    n = (1 << bits) - 1
+    if x.size != n:
+        raise DesignError(f"a period of {x.size} values is not 2^{bits} - 1 = {n}")
+    b01 = (x > 0).astype(np.int8)
+    pm = 2.0 * b01 - 1.0
+    spec = np.conj(np.fft.rfft(pm))
+    best = n
+    seen = set()
+    for o in np.linspace(0, n, MLS_WINDOWS, endpoint=False).astype(int):
+        window = np.roll(b01, -int(o))[:2 * bits]
+        L, c = _berlekamp_massey(window)
+        key = tuple(c)
+        if L != bits or key in seen:
+            continue
+        seen.add(key)
+        taps = [j for j in range(1, bits) if c[j]]
+        for t in (taps, [bits - j for j in taps]):
+            if not t:
+                continue
+            seq = max_len_seq(bits, taps=t)[0].astype(float) * 2.0 - 1.0
+            corr = np.fft.irfft(spec * np.fft.rfft(seq), n)
+            best = min(best, int(round((n - float(corr.max())) / 2)))
+        if best == 0:
+            break
+    return best

@@ -6,7 +6,11 @@ irregular intervals (a square wave's are regular), no spectral line holding
 most of the power (a sine's or a square wave's fundamental does). A two-level
 input is then read as a sequence: its clock interval from the transitions
 (which must be a whole number of sample intervals), its period from the bits
-(an m-sequence when it is 2^n - 1 intervals). Anything else broadband is noise.
+(an m-sequence when it is 2^n - 1 intervals and every period is the nearest
+m-sequence bit for bit, :func:`~designer.core.prbs.mls_bit_errors`; else a
+periodic binary sequence, for the spectral method). Anything else broadband is
+noise; an input of 3 to :data:`MAX_LEVELS` levels held at a clock (a
+three-level PRBS) is refused, named (:func:`multilevel_levels`).
 
 :func:`identify_broadband` then estimates, on the periods after the first
 (the seed's "establishment sequence": the plant must be in periodic steady
@@ -20,7 +24,11 @@ state, 2.4.2),
   frequency table (:class:`~.io.FreqData`) on which identify-freq's analysis
   (:func:`~.frequency.identify_freq`) runs;
 
-each ranked as it is today. ``method`` forces one of them.
+each ranked as it is today. ``method`` forces one of them. A method whose
+assumption failed gives no valid model (:func:`_refuse_unsettled`): a wrapped
+impulse response none from the correlation, and an output whose mean drifts
+from period to period (no periodic steady state, eq. 2.4.2: an integrating
+plant) none at all, ``refused`` saying why.
 """
 
 from __future__ import annotations
@@ -34,7 +42,7 @@ import numpy as np
 from ..core.errors import DesignError
 from . import correlation as corr
 from . import spectral as spec
-from ..core.prbs import MAX_BITS, MIN_BITS, SETTLE_MARGIN, bits_for, is_mls_length
+from ..core.prbs import MAX_BITS, MIN_BITS, SETTLE_MARGIN, bits_for, is_mls_length, mls_bit_errors
 
 #: at least this many transitions make an input broadband
 MIN_TRANSITIONS = 20
@@ -56,6 +64,11 @@ PERIOD_MISMATCH = 0.01
 METHODS = ("correlation", "spectral")
 #: bits whose linear complexity tells an m-sequence shorter than two periods
 LFSR_BITS = 200
+#: periods of the record compared with the nearest m-sequence (the last ones; the fewest errors count)
+MLS_ROWS = 4
+#: the output's mean may move by at most this fraction of its span a period (and
+#: three standard errors) for the record to be in periodic steady state (eq. 2.4.2)
+MAX_PERIOD_DRIFT = 0.01
 
 
 @dataclass
@@ -77,6 +90,8 @@ class Excitation:
     bits: int | None = None
     start: int = 0
     count: int = 0
+    #: of a period of an m-sequence's length: its values that differ from the nearest m-sequence
+    bit_errors: int = 0
 
     @property
     def dt_s(self) -> float:
@@ -92,7 +107,10 @@ class Excitation:
             return (f"noise input ({self.transitions} transitions), sampled every "
                     f"{fe(self.ts, 's')}")
         what = (f"maximum-length sequence, {self.bits} bits (N = {self.n})" if self.kind == "mls"
-                else f"periodic binary sequence of {self.n} intervals (not an m-sequence)")
+                else f"periodic binary sequence of {self.n} intervals (not an m-sequence)"
+                if not self.bit_errors else
+                f"a binary sequence of {self.n} intervals a period, not maximum-length ({self.bit_errors} "
+                f"bits of each period differ from the nearest {is_mls_length(self.n)}-bit m-sequence)")
         return (f"{what}, clock {fe(1 / self.dt_s, 'Hz')} (Dt = {fe(self.dt_s, 's')}, "
                 f"{self.samples_per_bit} samples), levels {self.offset:.4g} +- "
                 f"{self.amplitude:.4g}; {self.count} whole period(s) of "
@@ -106,6 +124,8 @@ class Excitation:
                       "bits": self.bits, "offset": self.offset, "amplitude": self.amplitude,
                       "period_s": self.period * self.ts, "periods_used": self.count,
                       "first_sample": self.start})
+            if self.bit_errors:
+                d["bits_differing_from_mls"] = self.bit_errors
         return d
 
 
@@ -165,6 +185,67 @@ def looks_broadband(u) -> bool:
     return _line_share(u) < MAX_LINE_SHARE
 
 
+#: a multi-level sequence has at most this many levels (more: a staircase of noise, a sine's samples)
+MAX_LEVELS = 9
+#: each of its levels holds at least this share of the samples
+LEVEL_SHARE = 0.05
+#: histogram bins over the input's span when the levels are sought
+LEVEL_BINS = 100
+
+
+def multilevel_levels(u) -> list | None:
+    """The levels of a sequence of 3 to :data:`MAX_LEVELS` levels (a three-level
+    PRBS, a multi-level random sequence), else None: the samples fall in separate
+    clusters (histogram bins holding at least 0.5 % of them, runs of such bins), each
+    holding :data:`LEVEL_SHARE`, and the level changes at least
+    :data:`MIN_TRANSITIONS` times, spread through the record, held for at least two
+    samples at a time in most runs (a clocked sequence, not a quiet channel's
+    noise a few quantisation steps wide, which moves nearly every sample)."""
+    u = np.asarray(u, float)
+    if u.size < MIN_SAMPLES or not np.all(np.isfinite(u)):
+        return None
+    lo, hi = np.percentile(u, [0.5, 99.5])
+    span = hi - lo
+    if not span > 0:
+        return None
+    counts, edges = np.histogram(u, LEVEL_BINS, range=(lo - 0.02 * span, hi + 0.02 * span))
+    full = counts >= 0.005 * u.size
+    # runs of populated bins are the clusters
+    starts = np.flatnonzero(full & ~np.r_[False, full[:-1]])
+    ends = np.flatnonzero(full & ~np.r_[full[1:], False]) + 1
+    levels = []
+    for a, b in zip(starts, ends):
+        sel = (u >= edges[a]) & (u < edges[b])
+        if np.count_nonzero(sel) >= LEVEL_SHARE * u.size:
+            levels.append(float(np.median(u[sel])))
+    if not 3 <= len(levels) <= MAX_LEVELS:
+        return None
+    lv = np.asarray(levels)
+    idx = np.argmin(np.abs(u[:, None] - lv[None, :]), axis=1)
+    change = np.flatnonzero(np.diff(idx)) + 1
+    if change.size < MIN_TRANSITIONS:
+        return None
+    if np.min(np.bincount(change * SPREAD_PARTS // u.size, minlength=SPREAD_PARTS)) < 2:
+        return None
+    runs = np.diff(change)
+    if np.mean(runs >= 2) < 0.8:
+        return None
+    return levels
+
+
+def _refuse_multilevel(u, name) -> None:
+    """One line for an input of 3 or more levels (:func:`multilevel_levels`)."""
+    levels = multilevel_levels(u)
+    if levels is None:
+        return
+    words = {3: "three", 4: "four", 5: "five"}
+    k = len(levels)
+    raise DesignError(f"{name}: the input is a {words.get(k, str(k))}-level sequence (levels "
+                      f"{', '.join(f'{v:.4g}' for v in levels)}): neither a step or square wave (the "
+                      "step methods) nor a two-level sequence (a PRBS, see make-prbs) or noise (the "
+                      "correlation and spectral methods); capture the plant under one of those")
+
+
 def _clock(edges, ts, name) -> int:
     """Samples per interval of a binary sequence from its transition indices."""
     runs = np.diff(edges).astype(float)
@@ -206,6 +287,7 @@ def examine_input(t, u, *, name: str = "capture") -> Excitation | None:
     """The excitation of a capture, or None when ``u`` is not broadband (a step,
     a square wave, a sine: the step methods' input)."""
     u = np.asarray(u, float)
+    _refuse_multilevel(u, name)       # before the noise test, which its middle levels would pass
     if not looks_broadband(u):
         return None
     t = np.asarray(t, float)
@@ -245,8 +327,17 @@ def examine_input(t, u, *, name: str = "capture") -> Excitation | None:
     if L is None:
         return ex                      # a random binary signal: read as noise
     nb = is_mls_length(L)
-    ex.kind = "mls" if nb else "periodic"
-    ex.n, ex.bits = L, nb
+    if nb:
+        # the length is an m-sequence's: is the sequence one? The fewest errors of the last
+        # MLS_ROWS stretches of a period (a generator's idle lead-in, a misread bit, spoil one)
+        whole = bits[:bits.size // L * L].reshape(-1, L)
+        ex.bit_errors = L
+        for row in whole[::-1][:MLS_ROWS]:
+            ex.bit_errors = min(ex.bit_errors, mls_bit_errors(row, nb))
+            if not ex.bit_errors:
+                break
+    ex.kind = "mls" if nb and not ex.bit_errors else "periodic"
+    ex.n, ex.bits = L, (nb if ex.kind == "mls" else None)
     p = L * m
     # the sequence starts at most `bits` intervals before its first transition
     first = max(0, int(edges[0]) - (nb or MAX_BITS) * m)
@@ -276,6 +367,8 @@ class BroadbandResult:
     timings: dict = field(default_factory=dict)
     #: for a wrapped impulse response: the period, bits or clock interval that would do
     advice: dict | None = None
+    #: why no model is valid when the estimates' own assumption failed ("" when it held)
+    refused: str = ""
 
     @property
     def best(self):
@@ -285,6 +378,8 @@ class BroadbandResult:
     def to_dict(self) -> dict:
         d = {"format": "broadband", "excitation": self.excitation.to_dict(), "method": self.method,
              "best": self.best.to_dict() if self.best else None, "notes": list(self.notes)}
+        if self.refused:
+            d["refused"] = self.refused
         if self.impulse is not None:
             d["impulse"] = self.impulse.to_dict()
             if self.advice:
@@ -375,9 +470,10 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
                           "2 whole ones are needed (the first settles the plant, the second is "
                           "measured)")
     if method == "correlation" and ex.kind == "periodic":
-        raise DesignError(f"{name}: the input repeats every {ex.n} intervals, which is not "
-                          "2^n - 1: the correlation method needs a maximum-length sequence; use "
-                          "--method spectral")
+        why = (f"{ex.bit_errors} bits of each period differ from the nearest m-sequence" if ex.bit_errors
+               else "which is not 2^n - 1")
+        raise DesignError(f"{name}: the input repeats every {ex.n} intervals, {why}: the correlation "
+                          "method needs a maximum-length sequence; use --method spectral")
     res.method = method or "spectral"
     ts = ex.ts
     f_nyq = 0.5 / ts
@@ -428,6 +524,7 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
             res.spectrum = banded
             res.freq_result = identify_freq(spec.to_freq_data(banded, name))
         timings["spectral_models"] = clock() - t1
+    _refuse_unsettled(res, y)
     if method is None:
         # the spectral fit first: it divides by the input's own spectrum, where the
         # correlation's step is smoothed by the sequence's autocorrelation triangle
@@ -436,6 +533,66 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
     timings["total"] = clock() - t0
     res.timings = timings
     return res
+
+
+def period_drift(y, ex: Excitation) -> tuple:
+    """(the change of the output's mean from one period to the next, its
+    standard error) over the periods used: the least-squares slope of the
+    period means (0, inf for fewer than two periods or a noise input). The
+    standard error is from the output's sample-to-sample noise (the second
+    difference's spread / sqrt 6, as :func:`.correlation.tail_drift` takes it)."""
+    if ex.kind == "noise" or ex.count < 2:
+        return 0.0, math.inf
+    seg = np.asarray(y, float)[ex.start:ex.start + ex.period * ex.count]
+    means = seg.reshape(ex.count, ex.period).mean(axis=1)
+    k = np.arange(ex.count) - 0.5 * (ex.count - 1)
+    slope = float(np.sum(k * means) / np.sum(k * k))
+    sigma = float(np.std(np.diff(seg, 2)) / math.sqrt(6.0))
+    se = sigma * math.sqrt(ex.samples_per_bit / ex.period) / math.sqrt(float(np.sum(k * k)))
+    return slope, se
+
+
+def _invalidate(result, why: str) -> None:
+    """Mark every valid model of a step or frequency ranking invalid, saying why."""
+    if result is None:
+        return
+    from .structures import rank_key
+    for m in result.methods:
+        if m.valid:
+            m.valid = False
+            m.note = why + (f"; {m.note}" if m.note else "")
+    result.methods.sort(key=rank_key)
+    result.best = None
+
+
+def _refuse_unsettled(res: BroadbandResult, y) -> None:
+    """No valid model when the method's assumption failed: a wrapped impulse
+    response (the response outlasts a period) gives no valid step model, and an
+    output whose mean drifts from period to period (an integrating plant, a pole
+    at the origin, never settles) is in no periodic steady state (seed 003
+    eq. 2.4.2, which both the correlation and the spectral estimate assume)."""
+    from ..core.units import format_eng as fe
+    ex = res.excitation
+    drift, se = period_drift(y, ex)
+    span = float(np.ptp(y)) if y.size else 0.0
+    if math.isfinite(se) and abs(drift) > max(MAX_PERIOD_DRIFT * span, 3.0 * se):
+        res.refused = (f"the output's mean moves {drift:+.4g} a period ({100 * abs(drift) / span:.1f} % of "
+                       "its span) over the periods used: no periodic steady state, which the correlation "
+                       "and spectral estimates assume (seed 003 eq. 2.4.2), as an integrating plant (a "
+                       "pole at the origin) or one slower than the record gives; no model from them is "
+                       "valid (a self-regulating plant: more periods, or a longer one; an integrating "
+                       "one: a step test)")
+        why = "no periodic steady state (the output's mean drifts period to period)"
+        _invalidate(res.step_result, why)
+        _invalidate(res.freq_result, why)
+    elif res.impulse is not None and res.impulse.wrapped and res.step_result is not None:
+        why = ("the impulse response wrapped around (it has not settled within one period; an integrating "
+               "plant never does): its step response is cut short, so no model from it is the plant's")
+        _invalidate(res.step_result, why)
+        if res.freq_result is None or res.freq_result.best is None:
+            res.refused = why + " (identify's notes say what period would do)"
+    if res.refused:
+        res.notes.append(res.refused)
 
 
 #: samples at rest put before the step response given to the step methods, as a fraction of it

@@ -18,7 +18,9 @@ the controller is ``(num, den)``: C(s) = Nc(s)/Dc(s), with any extra factors
   (matrix exponential), and dt = theta/M so that the delay is a whole number
   of steps (the delay line exact; only the hold's O(dt^2) error is left). The
   step dt is set from the loop's gain crossovers and corners
-  (:func:`_simulation_step`).
+  (:func:`_simulation_step`), and never below the record over
+  :data:`STEP_BUDGET` steps (fast modes are integrated exactly: only the delayed
+  plant output must be followed, and the plant's lag smooths it).
 * :func:`step_figures`: the classical figures (:func:`designer.core.metrics.step_metrics`),
   IAE = integral |r - y| dt and the steady-state error.
 """
@@ -45,6 +47,13 @@ SIM_N_FILTER = 10.0
 STEP_FRACTION = 0.02
 #: no simulation takes more steps than this
 MAX_STEPS = 2_000_000
+#: the time step is never below the record's length over this many steps: the
+#: matrix exponential integrates the loop's fast modes (op-amp poles, the
+#: derivative filter) exactly whatever the step, and the step only has to follow
+#: the delayed plant output, which the plant's own lag smooths; so an op-amp pole
+#: 100 times the crossover does not need 1e7 steps (issue 25: K=2 tau=20m
+#: theta=50u, whose crossover of 2.6e4 rad/s let the LM741's 2.3e6 rad/s zero in)
+STEP_BUDGET = 100_000
 #: the closed-loop recursion is solved this many steps at a time (at most the delay)
 BLOCK_MAX = 256
 #: a delay of at most this many steps is simulated as a delay line of states (:func:`_delay_line_states`)
@@ -337,7 +346,7 @@ def closed_loop_step(plant, controller, t, r_step: float = 1.0, step_fraction: f
         return {"y": out["y"], "u": out["u"], "e": out["e"]}
     if not 0 < step_fraction <= 1:
         raise DesignError(f"step_fraction must be in (0, 1], got {step_fraction}", "step_fraction")
-    dt_max = _simulation_step(lp, step_fraction)
+    dt_max = max(_simulation_step(lp, step_fraction), float(t[-1]) / STEP_BUDGET)
     sub = max(1, int(math.ceil(h / dt_max)))          # substeps per step of t
     q = lp.theta / h
     frac = 0.0
@@ -351,8 +360,9 @@ def closed_loop_step(plant, controller, t, r_step: float = 1.0, step_fraction: f
         dt = lp.theta / m_delay
     n_steps = (t.size - 1) * sub + 1 if on_grid else int(math.ceil(t[-1] / dt)) + 1
     if n_steps > MAX_STEPS:
-        raise DesignError(f"the simulation would take {n_steps} steps (over {MAX_STEPS}): "
-                          "a record this long against the loop's speed; shorten t")
+        raise DesignError(f"the closed loop's step response would take {n_steps} simulation steps (over "
+                          f"{MAX_STEPS}): a dead time of {lp.theta:.3g} s is too short against a response "
+                          f"{t[-1]:.3g} s long to simulate exactly")
     if m_delay <= SHORT_DELAY and dy == 0:
         ep, cux = _delay_line_states(a, b, cy, cu, dt, m_delay, n_steps, r, frac)
     else:

@@ -220,7 +220,12 @@ def _expm(m):
     from 1e2 to 1e7 rad/s make badly scaled matrices that expm squares many
     times (slow and less accurate)."""
     from scipy.linalg import expm, matrix_balance
-    b, tr = matrix_balance(m, permute=False, separate=True)
+    # scipy casts the balancing's scale factors to int for the permutation it also
+    # returns (unused here: permute=False); a factor of 2^63 or more overflows that
+    # cast and numpy warns "invalid value encountered in cast", though the scale
+    # factors themselves are right (a loop with op-amp poles 1e5 times the plant's)
+    with np.errstate(invalid="ignore"):
+        b, tr = matrix_balance(m, permute=False, separate=True)
     scale = tr[0]
     return (expm(b) * scale[:, None]) / scale[None, :]
 

@@ -196,6 +196,9 @@ def model_from_identify(data: dict, method: str | None = None, *, name: str = "r
     or the one ``method`` names (see :func:`model_from_json`)."""
     where = f"plant model {name}"
     methods = _entries(data, where)
+    if method is None and data.get("best") is None and isinstance(data.get("refused"), str):
+        # a broadband estimate whose own assumption failed: say which, not just "none valid"
+        raise DesignError(f"{where}: {tool} found no valid model: {data['refused']}")
     m = _chosen(methods, data.get("best"), method, where, tool)
     source = f"{tool} {m.get('name', '?')} {m.get('model', '?')} ({_data_name(data, tool, name)})"
     try:

@@ -145,3 +145,30 @@ def test_build_sheet_folder(capture, tmp_path):
     assert json.loads(freq.stdout)["best"]["params"]["zeta"] == pytest.approx(0.2, rel=0.03)
     (tmp_path / "afile").write_text("x")
     one_line_error(run(path, "--out", tmp_path / "afile"), "is a file, not a folder")
+
+
+def test_a_corrupted_m_sequence_is_named_for_what_it_is(tmp_path):
+    """Issue 25, 5c: 3 bits flipped in every period: not "a maximum-length sequence, 9 bits"."""
+    t, u, y = prbs_capture([2.0], [20e-3, 1.0], bits=9, per_bit=4, periods=4, ts=1e-4, snr_db=40, seed=1,
+                           flip=(17, 200, 401))
+    path = capture_csv(tmp_path / "flipped.csv", t, u, y)
+    proc = run(path)
+    assert proc.returncode == 0, proc.stderr
+    assert "maximum-length sequence, 9 bits" not in proc.stdout
+    assert ("Broadband input: a binary sequence of 511 intervals a period, not maximum-length (3 bits of each "
+            "period differ from the nearest 9-bit m-sequence)") in proc.stdout
+    out = json.loads(run(path, "--json").stdout)
+    assert out["excitation"]["kind"] == "periodic" and out["excitation"]["bits_differing_from_mls"] == 3
+    one_line_error(run(path, "--method", "correlation"), "3 bits of each period differ", "--method spectral")
+
+
+def test_a_three_level_sequence_is_named(tmp_path):
+    """Issue 25, item 10: a three-level sequence into a plant was "no step in the input column: it
+    never moves"; one line now says what it is and what identify takes, input named or by position."""
+    rng = np.random.default_rng(0)
+    u = np.repeat(np.tile(rng.integers(-1, 2, 242).astype(float), 4), 4)
+    y = np.convolve(u, np.full(40, 1 / 40))[:u.size]
+    t = np.arange(u.size) * 1e-4
+    for header in ("t,u,y", "t,CH1,CH2"):
+        path = capture_csv(tmp_path / f"{header[2:4]}.csv", t, u, y, header=header)
+        one_line_error(run(path), "the input is a three-level sequence (levels -1, 0, 1)", "two-level sequence")

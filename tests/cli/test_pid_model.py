@@ -158,3 +158,30 @@ def test_plant_model_of_the_wrong_kind(tmp_path):
     check.write_text(json.dumps({"schema_version": 1, "specs": [], "passed": True}))
     q = run(DESIGN_PID, "--plant-model", str(check), "--no-sim", "--no-files")
     assert q.returncode == 2 and len(q.stderr.splitlines()) == 1, q.stderr
+
+
+def test_a_prbs_capture_of_an_integrating_plant_is_refused_saying_why(tmp_path):
+    """Issue 25, 5b: identify marked a stable model of an integrating plant's PRBS
+    capture valid, and design-pid designed for it (exit 0, no mention). Now
+    neither --plant-capture nor --plant-model of identify's JSON designs: one
+    line, exit 2, naming the missing periodic steady state; nothing written."""
+    from prbs_capture import capture_csv, prbs_capture
+    t, u, y = prbs_capture([50.0], [10e-3, 1.0, 0.0], bits=8, per_bit=4, periods=3, ts=1e-4, snr_db=40, seed=1)
+    cap = capture_csv(tmp_path / "integrating.csv", t, u, y)
+    out = tmp_path / "out"
+    one_line_refusal(run(DESIGN_PID, "--plant-capture", str(cap), "--out", str(out)), "no periodic steady state")
+    ident = run(IDENTIFY, str(cap), "--json")
+    assert ident.returncode == 0, ident.stderr
+    models = tmp_path / "models.json"
+    models.write_text(ident.stdout)
+    assert json.loads(ident.stdout)["best"] is None
+    one_line_refusal(run(DESIGN_PID, "--plant-model", str(models), "--out", str(out)), "integrating plant")
+    assert not out.exists()
+
+
+def test_the_issue_25_plant_designs_without_warnings(tmp_path):
+    """``design-pid --plant-tf "K=2 tau=20m theta=50u"`` exited 2 with two scipy warning lines and
+    "...; shorten t" (a library parameter); it designs now, with nothing on stderr."""
+    p = run(DESIGN_PID, "--plant-tf", "K=2 tau=20m theta=50u", "--no-sim", "--no-files")
+    assert p.returncode == 0 and p.stderr == "", (p.returncode, p.stderr)
+    assert "G(s) = 2 e^(-50 us s) / (20 ms s + 1)" in p.stdout

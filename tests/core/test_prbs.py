@@ -89,3 +89,26 @@ def test_writers_round_trip():
     assert np.array_equal(np.interp(mid, t, v), vals)
     cir = prbs.pwl_subcircuit(plan)
     assert ".subckt prbs_source out" in cir and cir.rstrip().endswith(".ends prbs_source")
+
+
+# ------------------------------------------------------------------ is it really an m-sequence? (issue 25, 5c)
+
+@given(bits=st.integers(4, 12), shift=st.integers(0, 4094), k=st.integers(0, 3), seed=st.integers(0, 2 ** 32 - 1),
+       reverse=st.booleans())
+@settings(max_examples=40, deadline=None)
+def test_mls_bit_errors_counts_the_flipped_values(bits, shift, k, seed, reverse):
+    """Any phase of either direction of the m-sequence (another register) is one (0 errors);
+    k values flipped are k errors (k small against N: the nearest m-sequence is the original)."""
+    m = prbs.mls(bits)
+    x = np.roll(m[::-1] if reverse else m, shift).copy()
+    idx = np.random.default_rng(seed).choice(x.size, k, replace=False)
+    x[idx] *= -1
+    assert prbs.mls_bit_errors(x, bits) == k
+
+
+def test_a_sequence_of_an_m_sequence_length_that_is_none_is_far_from_one():
+    """A random +-1 sequence of 511 values: about a quarter to a half differ (random agreement)."""
+    x = np.where(np.random.default_rng(5).random(511) < 0.5, 1, -1)
+    assert prbs.mls_bit_errors(x, 9) > 100
+    with pytest.raises(DesignError, match="2\\^9 - 1 = 511"):
+        prbs.mls_bit_errors(x[:500], 9)

@@ -10,7 +10,8 @@ import pytest
 
 from designer.core.errors import DesignError
 from designer.identify import correlation as corr
-from designer.identify.broadband import examine_input, identify_broadband, looks_broadband
+from designer.identify.broadband import (examine_input, identify_broadband, looks_broadband, multilevel_levels,
+                                         period_drift)
 from prbs_capture import prbs_capture
 
 TS = 0.01        # sample interval, s
@@ -230,3 +231,113 @@ def test_any_sequence_is_recognised_with_its_clock_and_period(bits, per_bit, ext
     assert (ex.bits, ex.samples_per_bit) == (bits, per_bit)
     assert ex.count >= 1 and ex.start + ex.count * ex.period <= u.size
     assert ex.offset == pytest.approx(offset, abs=1e-9 * max(1.0, abs(offset)))
+
+
+# ------------------------------------------------------------------ no periodic steady state (issue 25, 5b)
+
+INTEGRATING = ([50.0], [10e-3, 1.0, 0.0])      # 50/(s (10 ms s + 1)): a pole at the origin
+
+
+@pytest.mark.parametrize("periods,offset", [(3, 0.0), (4, 0.0), (6, 0.5)])
+def test_an_integrating_plant_gives_no_valid_model(periods, offset):
+    """A PRBS into an integrator never reaches a periodic steady state (the
+    sequence's mean, a/N, and any offset ramp the output): the correlation's
+    impulse response wraps around and the spectral table has no flat gain, and
+    neither may hand a stable model on as valid (it did: K 0.27 or 1.76, "yes")."""
+    t, u, y = prbs_capture(*INTEGRATING, bits=8, per_bit=4, periods=periods, ts=1e-4, snr_db=40,
+                           seed=1, offset=offset)
+    res = identify_broadband(t, y, u)
+    assert res.best is None
+    for r in (res.step_result, res.freq_result):
+        assert r is not None and r.best is None and not any(m.valid for m in r.methods)
+    assert "no periodic steady state" in res.refused and "integrating plant" in res.refused
+    d = res.to_dict()
+    assert d["best"] is None and d["refused"] == res.refused
+    # the drift measured is the integrator's: K x (the input's mean about its levels) x the period
+    ex = res.excitation
+    drift, se = period_drift(y, ex)
+    mean_u = float(np.mean(u[ex.start:ex.start + ex.period * ex.count])) - offset
+    assert drift == pytest.approx(50.0 * mean_u * ex.period * ex.ts, rel=0.05)
+
+
+def test_a_self_regulating_plant_is_in_periodic_steady_state():
+    """The same sequence into 2/(20 ms s + 1): the period means agree within
+    their noise, nothing is refused, the models stay valid."""
+    t, u, y = prbs_capture([2.0], [20e-3, 1.0], bits=8, per_bit=4, periods=4, ts=1e-4, snr_db=40,
+                           seed=1, offset=0.5)
+    res = identify_broadband(t, y, u)
+    assert not res.refused and res.best is not None
+    assert res.best.params["K"] == pytest.approx(2.0, rel=0.03)
+
+
+def test_a_corrupted_m_sequence_is_not_called_maximum_length():
+    """Issue 25, 5c: 3 values of every period of a 9-bit m-sequence flipped were still
+    "a maximum-length sequence, 9 bits": the floor of its autocorrelation is no longer
+    constant (each flip moves the other lags by 0 or +-4, against the floor's -1), so the
+    correlation would be biased. It is a periodic binary sequence, its errors counted;
+    the spectral method (any periodic input) identifies the plant, correlation is refused."""
+    t, u, y = prbs_capture([2.0], [20e-3, 1.0], bits=9, per_bit=4, periods=4, ts=1e-4, snr_db=40, seed=1,
+                           flip=(17, 200, 401))
+    ex = examine_input(t, u)
+    assert ex.kind == "periodic" and ex.n == 511 and ex.bit_errors == 3 and ex.bits is None
+    assert "not maximum-length (3 bits of each period differ from the nearest 9-bit m-sequence)" in ex.text()
+    res = identify_broadband(t, y, u)
+    assert res.impulse is None and res.method == "spectral"
+    assert res.best.params["K"] == pytest.approx(2.0, rel=0.03)
+    assert res.best.params["tau_s"] == pytest.approx(20e-3, rel=0.03)
+    with pytest.raises(DesignError, match="3 bits of each period differ"):
+        identify_broadband(t, y, u, method="correlation")
+    # unflipped, the same record is the m-sequence
+    t, u, y = prbs_capture([2.0], [20e-3, 1.0], bits=9, per_bit=4, periods=4, ts=1e-4, snr_db=40, seed=1)
+    ex = examine_input(t, u)
+    assert ex.kind == "mls" and ex.bits == 9 and ex.bit_errors == 0
+
+
+# ------------------------------------------------------------------ a multi-level input (issue 25, item 10)
+
+def _three_level(seed=0, per=4, periods=4, noise=0.0):
+    """A periodic sequence of levels -1, 0, 1 (242 values a period, drawn from a seeded
+    generator), ``per`` samples a value, into 2/(20 ms s + 1) sampled every 100 us."""
+    import scipy.signal as sig
+    rng = np.random.default_rng(seed)
+    u = np.repeat(np.tile(rng.integers(-1, 2, 242).astype(float), periods), per)
+    b, a, _ = sig.cont2discrete(([2.0], [20e-3, 1.0]), 1e-4, method="zoh")
+    y = sig.lfilter(np.squeeze(b), a, u)
+    u = u + noise * rng.standard_normal(u.size)
+    return np.arange(u.size) * 1e-4, u, y
+
+
+@pytest.mark.parametrize("noise", [0.0, 0.02])
+def test_a_three_level_sequence_is_named_and_refused(noise):
+    """It was "no step in the input column: it never moves" (its three levels look like a quiet
+    channel's few quantisation steps to the broadband test; with noise on it, it passed for
+    noise): now one line naming it and what is taken."""
+    t, u, y = _three_level(noise=noise)
+    assert looks_broadband(u) == (noise > 0)        # noiseless, it looked like a quiet channel
+    levels = multilevel_levels(u)
+    assert levels is not None and np.allclose(levels, [-1.0, 0.0, 1.0], atol=0.05)
+    with pytest.raises(DesignError, match="three-level sequence .*two-level sequence"):
+        examine_input(t, u, name="c.csv")
+
+
+def test_a_quiet_channel_and_a_step_are_not_multi_level():
+    """A channel's white noise a few quantisation steps wide moves nearly every sample; a
+    noisy step has two levels: neither is refused as a multi-level sequence."""
+    from designer.identify.broadband import multilevel_levels
+    rng = np.random.default_rng(4)
+    quiet = np.round(rng.normal(0.0, 1.0, 5000))
+    step = (np.arange(5000) > 1000) + 0.01 * rng.standard_normal(5000)
+    assert multilevel_levels(quiet) is None and multilevel_levels(step) is None
+    assert examine_input(np.arange(5000) * 1e-3, step) is None
+
+
+def test_an_idle_lead_in_does_not_spoil_the_m_sequence_check():
+    """A generator idle at its low level for 5 intervals before two periods: the first stretch of a
+    period read holds the idle bits, the last is the
+    sequence itself: an m-sequence, no errors."""
+    from designer.core.prbs import mls
+    per = 4
+    one = mls(8).astype(float)
+    u = np.repeat(np.concatenate((-np.ones(5), one, one, one[:20])), per)
+    ex = examine_input(np.arange(u.size) * 1e-3, u)
+    assert ex.kind == "mls" and ex.bits == 8 and ex.bit_errors == 0

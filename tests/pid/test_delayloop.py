@@ -227,3 +227,38 @@ def test_simc_pi_on_random_fopdt_plants_is_stable_and_settles(k, log_tau, ratio)
     f = dl.step_figures(t, out["y"], 1.0)
     assert abs(f.steady_state_error) < 1e-3
     assert f.settling_time_s < 0.8 * t[-1]
+
+
+# ------------------------------------------------------------------ the step budget (issue 25, item 6)
+
+#: K=2 tau=20m theta=50u under AMIGO's PID (Kp 90.1, Ti 390.7 us, Td 25 us) built with an LM741: its
+#: crossover, 2.6e4 rad/s, let the op-amp stages' poles at 2.3e6 and 6.3e6 rad/s into the step's choice
+FAST_PLANT = ([2.0], [20e-3, 1.0], 50e-6)
+
+
+def _fast_controller():
+    num, den = dl.pid_tf(90.1, 390.7e-6, 24.98e-6, 10.0)
+    for p in (2.3e6, 6.3e6):
+        den = np.polymul(den, [1.0 / p, 1.0])
+    return num, den
+
+
+def test_a_long_record_of_a_loop_with_fast_poles_keeps_to_the_step_budget(monkeypatch):
+    """A record of 0.235 s (the leak's slow mode) with op-amp poles at 6e6 rad/s
+    needed 1e7 steps of 22 ns and was refused ("shorten t"); the matrix exponential
+    integrates those modes exactly, so the step only has to follow the delayed plant
+    output: at the budget's step (2.35 us) the response is the fine step's."""
+    ctrl = _fast_controller()
+    lp = dl.parse_loop(FAST_PLANT, ctrl)
+    assert dl._simulation_step(lp) * dl.MAX_STEPS < 0.235       # the old choice could not take the record
+    t_long = np.linspace(0.0, 0.235, 2001)
+    y_long = dl.closed_loop_step(FAST_PLANT, ctrl, t_long)["y"]
+    # the first 3 ms at the fine step (136k steps of 22 ns) and at the budget's step
+    t = np.linspace(0.0, 3e-3, 3001)
+    fine = dl.closed_loop_step(FAST_PLANT, ctrl, t)["y"]
+    monkeypatch.setattr(dl, "STEP_BUDGET", t[-1] / (t_long[-1] / dl.STEP_BUDGET))
+    coarse = dl.closed_loop_step(FAST_PLANT, ctrl, t)["y"]
+    assert np.max(np.abs(coarse - fine)) < 1e-3
+    first = t_long <= t[-1]
+    assert np.max(np.abs(y_long[first] - np.interp(t_long[first], t, fine))) < 1e-3
+    assert np.max(fine) > 1.05                                 # an overshoot the comparison sees

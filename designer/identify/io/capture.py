@@ -420,8 +420,8 @@ def _assemble(cols: _Columns, layout: _Layout, keep, tentative, name) -> Capture
     # An input chosen by position only is used only if it looks like one
     # (e.g. time_s,analytic,spice has no input column).
     if tentative and not looks_like_step_input(u, y):
-        from ..broadband import looks_broadband   # a PRBS or noise input is one too
-        if not looks_broadband(u):
+        from ..broadband import looks_broadband, multilevel_levels   # a PRBS or noise input is one too
+        if not looks_broadband(u) and multilevel_levels(u) is None:   # a multi-level one is refused as such
             notes.append(f"column {columns[j_in]!r} does not look like a step input "
                          "(its transitions are not much faster than the output's) nor a "
                          "broadband one; no input column used (see --input-column)")
