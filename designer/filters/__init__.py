@@ -1,0 +1,24 @@
+"""Active-filter sections as plug-ins: the :class:`Topology` abstraction (its
+parts declared once, its transfer function vectorised, ideal and with the
+op-amp's finite gain, its synthesis, realisability limits and netlist), the
+registry of sections (Sallen-Key low- and high-pass, MFB low-, high- and
+band-pass, first-order RC and inverting sections) and the :class:`Cascade` of
+sections. Below the wings: it imports ``core`` and ``spice`` only."""
+
+from .cascade import Cascade, Stage
+from .deck import ac_deck, simulate_ac
+from .inverting_lowpass import InvertingLowPass
+from .mfb_bandpass import MfbBandPass
+from .mfb_highpass import MfbHighPass
+from .mfb_lowpass import MfbLowPass
+from .rc_highpass import RcHighPass
+from .rc_lowpass import RcLowPass
+from .registry import REGISTRY, get, names, register
+from .sallen_key_highpass import SallenKeyHighPass
+from .sallen_key_lowpass import SallenKeyLowPass
+from .topology import Figures, PartSpec, SectionTarget, Topology, nodal_response, open_loop_gain
+
+__all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "InvertingLowPass", "MfbBandPass", "MfbHighPass",
+           "MfbLowPass", "RcHighPass", "RcLowPass", "REGISTRY", "get", "names", "register", "SallenKeyHighPass",
+           "SallenKeyLowPass", "Figures", "PartSpec", "SectionTarget", "Topology", "nodal_response",
+           "open_loop_gain"]
