@@ -24,7 +24,8 @@ the op-amp is a voltage source at its output,
 (the single-pole model of :mod:`designer.core.opamps` and of the project's
 ``OPAMP_BEH`` subcircuit), and every other node obeys Kirchhoff's current law,
 sum over parts of Y_part (V_node - V_other) = 0 with Y = 1/R or s C, the input
-node driven at 1 V. The section modules write their node equations out.
+node driven at 1 V (the op-amp's row is solved as V_out / A(s) - (V+ - V-) = 0,
+well conditioned at any gain). The section modules write their node equations out.
 """
 
 from __future__ import annotations
@@ -206,7 +207,8 @@ def nodal_response(netlist: Netlist, values: dict, s, opamp, inp: str = "vin", o
     Unknowns: every net but ground and the input. Rows: Kirchhoff's current law
     at each net that no op-amp drives, sum Y (V_net - V_other) = 0 (Y = 1/R,
     s C; a part to the input puts Y * 1 V on the right-hand side), and
-    V_out - A (V+ - V-) = 0 for each op-amp's output.
+    V_out / A - (V+ - V-) = 0 for each op-amp's output (divided by A so that
+    the system stays well conditioned however large A is).
 
     Parameters
     ----------
@@ -251,15 +253,16 @@ def nodal_response(netlist: Netlist, values: dict, s, opamp, inp: str = "vin", o
                 y_mat[..., i, idx[there]] -= y
             elif there == inp:
                 rhs[..., i] += y
-    gain = np.broadcast_to(open_loop_gain(opamp, s), shape)
+    # the op-amp's row divided by A(s): V_out / A - V+ + V- = 0 stays well conditioned at any gain
+    inverse_gain = np.broadcast_to(1 / open_loop_gain(opamp, s), shape)
     for a in netlist.amps:
         i = idx[a.out]
-        y_mat[..., i, i] += 1
+        y_mat[..., i, i] += inverse_gain
         for net, sign in ((a.inp, -1.0), (a.inn, 1.0)):
             if net in idx:
-                y_mat[..., i, idx[net]] += sign * gain
+                y_mat[..., i, idx[net]] += sign
             elif net == inp:
-                rhs[..., i] -= sign * gain
+                rhs[..., i] -= sign
     return np.linalg.solve(y_mat, rhs[..., None])[..., idx[out], 0]
 
 
