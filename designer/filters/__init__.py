@@ -15,10 +15,22 @@ from .rc_highpass import RcHighPass
 from .rc_lowpass import RcLowPass
 from .registry import REGISTRY, get, names, register
 from .sallen_key_highpass import SallenKeyHighPass
-from .sallen_key_lowpass import SallenKeyLowPass
-from .topology import Figures, PartSpec, SectionTarget, Topology, nodal_response, open_loop_gain
+from .sallen_key_lowpass import SallenKeyLowPass, sallen_key_ratio_min
+from .topology import (
+    DEFAULT_IMPEDANCE_OHM,
+    KINDS,
+    Figures,
+    PartSpec,
+    SectionTarget,
+    Topology,
+    nodal_response,
+    open_loop_gain,
+    polynomial,
+    polyval,
+    quadratic_root,
+)
 
 __all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "InvertingLowPass", "MfbBandPass", "MfbHighPass",
            "MfbLowPass", "RcHighPass", "RcLowPass", "REGISTRY", "get", "names", "register", "SallenKeyHighPass",
-           "SallenKeyLowPass", "Figures", "PartSpec", "SectionTarget", "Topology", "nodal_response",
-           "open_loop_gain"]
+           "SallenKeyLowPass", "sallen_key_ratio_min", "DEFAULT_IMPEDANCE_OHM", "KINDS", "Figures", "PartSpec",
+           "SectionTarget", "Topology", "nodal_response", "open_loop_gain", "polynomial", "polyval", "quadratic_root"]

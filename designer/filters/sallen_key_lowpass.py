@@ -42,10 +42,10 @@ from ..core.errors import DesignError
 from ..spice.deck import GROUND, Amp, Netlist
 from .topology import PartSpec, SectionTarget, Topology, polynomial, quadratic_root
 
-__all__ = ["SallenKeyLowPass", "ratio_min"]
+__all__ = ["SallenKeyLowPass", "sallen_key_ratio_min"]
 
 
-def ratio_min(q: float, gain: float) -> float:
+def sallen_key_ratio_min(q: float, gain: float) -> float:
     """The least C2/C1 of a Sallen-Key low-pass of quality factor ``q`` and gain ``gain``.
 
     Parameters
@@ -114,7 +114,7 @@ class SallenKeyLowPass(Topology):
         return num, den
 
     def limits(self, target: SectionTarget) -> dict:
-        return {"ratio_min": ratio_min(target.q, target.gain)}
+        return {"ratio_min": sallen_key_ratio_min(target.q, target.gain)}
 
     def _check_limits(self, target: SectionTarget, choices: dict) -> None:
         if not self.with_gain:
@@ -122,7 +122,7 @@ class SallenKeyLowPass(Topology):
         if self.with_gain and target.gain <= 1.0:
             raise DesignError(f"gain: {self.name} needs a gain above 1 (R4/R3 = K - 1), got {target.gain:.4g}; "
                               "use sallen-key-lowpass for unity gain", param="gain")
-        bound = ratio_min(target.q, target.gain)
+        bound = sallen_key_ratio_min(target.q, target.gain)
         m = choices.get("ratio")
         if m is not None and m < bound * (1 - 1e-12):
             rule = "4 Q^2" if not self.with_gain else "1/(1/(4 Q^2) + K - 1)"
@@ -134,7 +134,7 @@ class SallenKeyLowPass(Topology):
     def synthesize(self, target: SectionTarget, **choices) -> dict:
         self.check_realisable(target, **choices)
         q, k, w = target.q, target.gain, target.wn
-        bound = ratio_min(q, k)
+        bound = sallen_key_ratio_min(q, k)
         m = choices.get("ratio", bound if not self.with_gain else max(1.0, bound))
         c1 = self.scale(target, 1.0 / m ** 0.5)
         c2 = m * c1

@@ -68,7 +68,8 @@ def test_netlist_designators_unique_per_stage_and_stages_chained():
     outs = [a.out for a in net.amps]
     assert outs == ["s1", "s2", "s3", "s4", "vout"]
     for i, out in enumerate(outs[:-1], 2):   # each stage output feeds (only) the next stage
-        users = {p.ref[1] for p in net.parts if out in (p.a, p.b)} | {a.ref[1] for a in net.amps if out in (a.inp, a.inn)}
+        users = ({p.ref[1] for p in net.parts if out in (p.a, p.b)}
+                 | {a.ref[1] for a in net.amps if out in (a.inp, a.inn)})
         assert str(i) in users, (out, users)
 
 

@@ -48,7 +48,8 @@ def test_nodal_response_of_a_non_inverting_amplifier_is_the_finite_gain_closed_f
 
 
 def test_nodal_response_of_an_inverting_integrator_with_the_input_on_the_inverting_side():
-    net = Netlist((Part("R1", "vin", "n", 1e3), Part("C1", "n", "vout", 1e-6)), (Amp("U1", "amp", GROUND, "n", "vout"),))
+    net = Netlist((Part("R1", "vin", "n", 1e3), Part("C1", "n", "vout", 1e-6)),
+                  (Amp("U1", "amp", GROUND, "n", "vout"),))
     amp = get_opamp("TL072")
     s = 2j * math.pi * np.array([1.0, 100.0])
     a = open_loop_gain(amp, s)
