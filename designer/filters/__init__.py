@@ -14,6 +14,7 @@ from .mfb_lowpass import MfbLowPass
 from .rc_highpass import RcHighPass
 from .rc_lowpass import RcLowPass
 from .registry import REGISTRY, get, names, register
+from .sallen_key import GAIN_PARTS, SallenKeySection
 from .sallen_key_highpass import SallenKeyHighPass
 from .sallen_key_lowpass import SallenKeyLowPass, sallen_key_ratio_min
 from .topology import (
@@ -31,6 +32,6 @@ from .topology import (
 )
 
 __all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "InvertingLowPass", "MfbBandPass", "MfbHighPass",
-           "MfbLowPass", "RcHighPass", "RcLowPass", "REGISTRY", "get", "names", "register", "SallenKeyHighPass",
+           "MfbLowPass", "RcHighPass", "RcLowPass", "REGISTRY", "get", "names", "register", "GAIN_PARTS", "SallenKeySection", "SallenKeyHighPass",
            "SallenKeyLowPass", "sallen_key_ratio_min", "DEFAULT_IMPEDANCE_OHM", "KINDS", "Figures", "PartSpec",
            "SectionTarget", "Topology", "nodal_response", "open_loop_gain", "polynomial", "polyval", "quadratic_root"]

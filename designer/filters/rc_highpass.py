@@ -17,16 +17,18 @@ reachable; the gain is 1.
 from __future__ import annotations
 
 from ..spice.deck import GROUND, Amp, Netlist
-from .topology import PartSpec, SectionTarget, Topology, polynomial
+from .rc_lowpass import RcLowPass
+from .topology import PartSpec, SectionTarget, polynomial
 
 __all__ = ["RcHighPass"]
 
 
-class RcHighPass(Topology):
-    """The first-order CR high-pass with a follower (parts R1 C1)."""
+class RcHighPass(RcLowPass):
+    """The first-order CR high-pass with a follower (parts R1 C1); its design is the
+    low-pass's (:class:`~designer.filters.rc_lowpass.RcLowPass`)."""
 
     name, title = "rc-highpass", "First-order high-pass (CR and follower)"
-    kind, order, inverting = "highpass", 1, False
+    kind = "highpass"
     parts = (PartSpec("R1", "R", "non-inverting input to ground"),
              PartSpec("C1", "C", "input capacitor"))
     example = SectionTarget("highpass", 1e3)
@@ -35,14 +37,6 @@ class RcHighPass(Topology):
         v = self.values_of(values)
         tau = v["R1"] * v["C1"]
         return polynomial(tau, 0.0), polynomial(tau, 1.0)
-
-    def _check_limits(self, target: SectionTarget, choices: dict) -> None:
-        self.require_unity_gain(target, "add the gain in another stage")
-
-    def synthesize(self, target: SectionTarget, **choices) -> dict:
-        self.check_realisable(target, **choices)
-        c = self.scale(target)
-        return {"R1": 1.0 / (target.wn * c), "C1": c}
 
     def netlist(self, values: dict, prefix: str = "", amp_ref: str = "U1", inp: str = "vin",
                 out: str = "vout") -> Netlist:

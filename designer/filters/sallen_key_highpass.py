@@ -32,21 +32,13 @@ positive); the cost is the resistor spread, R2/R1 >= 4 Q^2 at unity gain.
 
 from __future__ import annotations
 
-from ..core.errors import DesignError
-from ..spice.deck import GROUND, Amp, Netlist
-from .topology import PartSpec, SectionTarget, Topology, polynomial, quadratic_root
+from ..spice.deck import GROUND, Netlist
+from .sallen_key import SallenKeySection
+from .topology import PartSpec, SectionTarget, polynomial, quadratic_root
 
 __all__ = ["SallenKeyHighPass"]
 
-_BASE = (PartSpec("R1", "R", "C1-C2 node to the output (feedback)"),
-         PartSpec("R2", "R", "non-inverting input to ground"),
-         PartSpec("C1", "C", "input capacitor"),
-         PartSpec("C2", "C", "to the non-inverting input"))
-_GAIN = (PartSpec("R3", "R", "gain: inverting input to ground"),
-         PartSpec("R4", "R", "gain: output to inverting input"))
-
-
-class SallenKeyHighPass(Topology):
+class SallenKeyHighPass(SallenKeySection):
     """The Sallen-Key high-pass section (unity gain, or gain K with ``with_gain``).
 
     Parameters
@@ -55,30 +47,18 @@ class SallenKeyHighPass(Topology):
         False: a follower (parts R1 R2 C1 C2); True: K = 1 + R4/R3 (R3, R4 added).
     """
 
-    kind, order, inverting = "highpass", 2, False
-
-    def __init__(self, with_gain: bool = False):
-        self.with_gain = with_gain
-        self.name = "sallen-key-highpass-gain" if with_gain else "sallen-key-highpass"
-        self.title = "Sallen-Key high-pass, gain K" if with_gain else "Sallen-Key high-pass, unity gain"
-        self.parts = _BASE + (_GAIN if with_gain else ())
-        self.choices = ("ratio", "r3") if with_gain else ("ratio",)
-        self.example = SectionTarget("highpass", 1e3, q=1.3 if with_gain else 0.7071,
-                                     gain=2.5 if with_gain else 1.0)
+    kind, base_name = "highpass", "sallen-key-highpass"
+    network = (PartSpec("R1", "R", "C1-C2 node to the output (feedback)"),
+               PartSpec("R2", "R", "non-inverting input to ground"),
+               PartSpec("C1", "C", "input capacitor"),
+               PartSpec("C2", "C", "to the non-inverting input"))
 
     def coefficients(self, values: dict) -> tuple:
         v = self.values_of(values)
-        k = 1.0 + v["R4"] / v["R3"] if self.with_gain else 1.0
+        k = self.gain_of(v)
         den = polynomial(v["R1"] * v["R2"] * v["C1"] * v["C2"],
                          v["R1"] * (v["C1"] + v["C2"]) + v["R2"] * v["C2"] * (1 - k), 1.0)
         return polynomial(k * den[0], 0.0, 0.0), den
-
-    def _check_limits(self, target: SectionTarget, choices: dict) -> None:
-        if not self.with_gain:
-            self.require_unity_gain(target, "use sallen-key-highpass-gain")
-        if self.with_gain and target.gain <= 1.0:
-            raise DesignError(f"gain: {self.name} needs a gain above 1 (R4/R3 = K - 1), got {target.gain:.4g}; "
-                              "use sallen-key-highpass for unity gain", param="gain")
 
     def synthesize(self, target: SectionTarget, **choices) -> dict:
         self.check_realisable(target, **choices)
@@ -88,14 +68,10 @@ class SallenKeyHighPass(Topology):
         c2 = m * c1
         p = 1.0 / (w * w * c1 * c2)
         r1 = quadratic_root(c1 + c2, 1.0 / (w * q), p * c2 * (1 - k))
-        out = {"R1": r1, "R2": p / r1, "C1": c1, "C2": c2}
-        if self.with_gain:
-            r3 = choices.get("r3", target.impedance_ohm or 10e3)
-            out.update(R3=r3, R4=(k - 1) * r3)
-        return out
+        return {"R1": r1, "R2": p / r1, "C1": c1, "C2": c2, **self.gain_values(target, choices)}
 
     def netlist(self, values: dict, prefix: str = "", amp_ref: str = "U1", inp: str = "vin",
                 out: str = "vout") -> Netlist:
         x, p, n = self.internal(amp_ref, "x", "p", "n")
-        ends = {"C1": (inp, x), "C2": (x, p), "R2": (p, GROUND), "R1": (x, out), "R3": (n, GROUND), "R4": (out, n)}
-        return self.assemble(values, prefix, ends, Amp(amp_ref, self.title, p, n if self.with_gain else out, out))
+        ends = {"C1": (inp, x), "C2": (x, p), "R2": (p, GROUND), "R1": (x, out)}
+        return self.amplified(values, prefix, ends, amp_ref, p, n, out)

@@ -39,8 +39,9 @@ gain when the bound allows it.
 from __future__ import annotations
 
 from ..core.errors import DesignError
-from ..spice.deck import GROUND, Amp, Netlist
-from .topology import PartSpec, SectionTarget, Topology, polynomial, quadratic_root
+from ..spice.deck import GROUND, Netlist
+from .sallen_key import SallenKeySection
+from .topology import PartSpec, SectionTarget, polynomial, quadratic_root
 
 __all__ = ["SallenKeyLowPass", "sallen_key_ratio_min"]
 
@@ -63,15 +64,7 @@ def sallen_key_ratio_min(q: float, gain: float) -> float:
     return 1.0 / (1.0 / (4 * q * q) + gain - 1.0)
 
 
-_BASE = (PartSpec("R1", "R", "input resistor"),
-         PartSpec("R2", "R", "to the non-inverting input"),
-         PartSpec("C1", "C", "non-inverting input to ground"),
-         PartSpec("C2", "C", "R1-R2 node to the output (feedback)"))
-_GAIN = (PartSpec("R3", "R", "gain: inverting input to ground"),
-         PartSpec("R4", "R", "gain: output to inverting input"))
-
-
-class SallenKeyLowPass(Topology):
+class SallenKeyLowPass(SallenKeySection):
     """The Sallen-Key low-pass section (unity gain, or gain K with ``with_gain``).
 
     Parameters
@@ -80,30 +73,11 @@ class SallenKeyLowPass(Topology):
         False: a follower (parts R1 R2 C1 C2); True: K = 1 + R4/R3 (R3, R4 added).
     """
 
-    kind, order, inverting = "lowpass", 2, False
-
-    def __init__(self, with_gain: bool = False):
-        self.with_gain = with_gain
-        self.name = "sallen-key-lowpass-gain" if with_gain else "sallen-key-lowpass"
-        self.title = "Sallen-Key low-pass, gain K" if with_gain else "Sallen-Key low-pass, unity gain"
-        self.parts = _BASE + (_GAIN if with_gain else ())
-        self.choices = ("ratio", "r3") if with_gain else ("ratio",)
-        self.example = SectionTarget("lowpass", 1e3, q=1.3 if with_gain else 0.7071, gain=2.0 if with_gain else 1.0)
-
-    def gain_of(self, v: dict):
-        """K = 1 + R4/R3 (1 for the follower).
-
-        Parameters
-        ----------
-        v : dict
-            Designator -> value (arrays allowed).
-
-        Returns
-        -------
-        float or ndarray
-            The gain.
-        """
-        return 1.0 + v["R4"] / v["R3"] if self.with_gain else 1.0
+    kind, base_name = "lowpass", "sallen-key-lowpass"
+    network = (PartSpec("R1", "R", "input resistor"),
+               PartSpec("R2", "R", "to the non-inverting input"),
+               PartSpec("C1", "C", "non-inverting input to ground"),
+               PartSpec("C2", "C", "R1-R2 node to the output (feedback)"))
 
     def coefficients(self, values: dict) -> tuple:
         v = self.values_of(values)
@@ -117,11 +91,7 @@ class SallenKeyLowPass(Topology):
         return {"ratio_min": sallen_key_ratio_min(target.q, target.gain)}
 
     def _check_limits(self, target: SectionTarget, choices: dict) -> None:
-        if not self.with_gain:
-            self.require_unity_gain(target, "use sallen-key-lowpass-gain")
-        if self.with_gain and target.gain <= 1.0:
-            raise DesignError(f"gain: {self.name} needs a gain above 1 (R4/R3 = K - 1), got {target.gain:.4g}; "
-                              "use sallen-key-lowpass for unity gain", param="gain")
+        self.check_gain(target)
         bound = sallen_key_ratio_min(target.q, target.gain)
         m = choices.get("ratio")
         if m is not None and m < bound * (1 - 1e-12):
@@ -140,14 +110,10 @@ class SallenKeyLowPass(Topology):
         c2 = m * c1
         p = 1.0 / (w * w * c1 * c2)
         r1 = quadratic_root(c1 * (1 + m * (1 - k)), 1.0 / (w * q), c1 * p)
-        out = {"R1": r1, "R2": p / r1, "C1": c1, "C2": c2}
-        if self.with_gain:
-            r3 = choices.get("r3", target.impedance_ohm or 10e3)
-            out.update(R3=r3, R4=(k - 1) * r3)
-        return out
+        return {"R1": r1, "R2": p / r1, "C1": c1, "C2": c2, **self.gain_values(target, choices)}
 
     def netlist(self, values: dict, prefix: str = "", amp_ref: str = "U1", inp: str = "vin",
                 out: str = "vout") -> Netlist:
         x, p, n = self.internal(amp_ref, "x", "p", "n")
-        ends = {"R1": (inp, x), "R2": (x, p), "C1": (p, GROUND), "C2": (x, out), "R3": (n, GROUND), "R4": (out, n)}
-        return self.assemble(values, prefix, ends, Amp(amp_ref, self.title, p, n if self.with_gain else out, out))
+        ends = {"R1": (inp, x), "R2": (x, p), "C1": (p, GROUND), "C2": (x, out)}
+        return self.amplified(values, prefix, ends, amp_ref, p, n, out)
