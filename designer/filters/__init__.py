@@ -32,6 +32,7 @@ from .topology import (
 )
 
 __all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "InvertingLowPass", "MfbBandPass", "MfbHighPass",
-           "MfbLowPass", "RcHighPass", "RcLowPass", "REGISTRY", "get", "names", "register", "GAIN_PARTS", "SallenKeySection", "SallenKeyHighPass",
-           "SallenKeyLowPass", "sallen_key_ratio_min", "DEFAULT_IMPEDANCE_OHM", "KINDS", "Figures", "PartSpec",
-           "SectionTarget", "Topology", "nodal_response", "open_loop_gain", "polynomial", "polyval", "quadratic_root"]
+           "MfbLowPass", "RcHighPass", "RcLowPass", "REGISTRY", "get", "names", "register", "GAIN_PARTS",
+           "SallenKeySection", "SallenKeyHighPass", "SallenKeyLowPass", "sallen_key_ratio_min",
+           "DEFAULT_IMPEDANCE_OHM", "KINDS", "Figures", "PartSpec", "SectionTarget", "Topology", "nodal_response",
+           "open_loop_gain", "polynomial", "polyval", "quadratic_root"]
