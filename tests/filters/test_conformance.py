@@ -20,6 +20,8 @@ import dataclasses
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
 from scipy import signal
 
 from designer.core.errors import DesignError
@@ -62,6 +64,28 @@ def test_synthesis_meets_the_target(topology):
             assert fig.q is None
         if target.c_f is not None:
             assert target.c_f in values.values()
+
+
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+@settings(max_examples=60, suppress_health_check=[HealthCheck.filter_too_much])
+@given(fn=st.floats(0.5, 2e6), q=st.floats(0.2, 30), gain=st.one_of(st.just(1.0), st.floats(1.01, 20)),
+       stretch=st.floats(1.0, 10.0), scale=st.sampled_from([None, ("c_f", 1e-9), ("impedance_ohm", 1e5)]))
+def test_synthesis_of_any_realisable_target_meets_it(topology, fn, q, gain, stretch, scale):
+    """Any target the topology accepts (and any choice above its bound) is met to 1e-9."""
+    target = SectionTarget(topology.kind, fn, q=q if topology.order == 2 else None, gain=gain,
+                           **({scale[0]: scale[1]} if scale else {}))
+    try:
+        topology.check_realisable(target)
+    except DesignError:
+        assume(False)
+    choices = {n.removesuffix("_min"): stretch * b for n, b in topology.limits(target).items()
+               if n.endswith("_min") and n.removesuffix("_min") in topology.choices}
+    values = topology.synthesize(target, **choices)
+    assert all(v > 0 and np.isfinite(v) for v in values.values()), values
+    fig = topology.figures(values)
+    assert (fig.fn_hz, fig.gain) == pytest.approx((fn, gain), rel=1e-9)
+    if topology.order == 2:
+        assert fig.q == pytest.approx(q, rel=1e-9)
 
 
 @pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
