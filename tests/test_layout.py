@@ -1,6 +1,7 @@
 """The dependency rule of the package, checked on every import statement:
 ``{cli, web} -> {plant, pid, identify} -> {spice, report} -> core`` (``web -> cli``), ``pid -> plant``,
-and ``identify -> plant`` only for the comparison with a design; ``tolerance``
+and ``identify -> plant`` only for the comparison with a design; ``filters``
+(the circuits as plug-ins) stands on ``spice`` and ``core`` only; ``tolerance``
 (Monte Carlo) runs the wings' models; ``check`` (the CI checker of users'
 designs) runs the wings and tolerance, and only ``cli`` uses it."""
 
@@ -15,6 +16,8 @@ ALLOWED = {
     "core": set(),
     "spice": {"core"},
     "report": {"core"},
+    # the circuits as plug-ins (Topology, its sections, the cascade): below the wings
+    "filters": {"core", "spice"},
     "plant": {"core", "spice", "report"},
     "pid": {"core", "spice", "report", "plant"},
     "identify": {"core", "spice", "report"},

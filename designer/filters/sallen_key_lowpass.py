@@ -1,0 +1,119 @@
+"""Sallen-Key low-pass section, unity gain (a follower) or gain K (a
+non-inverting amplifier, K = 1 + R4/R3).
+
+Parts (the seed's names, as :mod:`designer.plant.sallenkey`, which are TI's:
+C1 the capacitor to ground): R1 from the input to node x, R2 from x to the
+non-inverting input p, C1 from p to ground, C2 from x to the output (the
+positive feedback); with gain, R3 from the inverting input to ground and R4
+from the output to it.
+
+Transfer function (TI, "Op Amps for Everyone", ch. 16, SLOA088: the second-order
+low-pass, Sallen-Key topology, in the general and the unity-gain form)::
+
+    H(s) = K / (R1 R2 C1 C2 s^2 + (C1 (R1 + R2) + R1 C2 (1 - K)) s + 1)
+
+    wn = 1 / sqrt(R1 R2 C1 C2),   Q = sqrt(R1 R2 C1 C2) / (C1 (R1 + R2) + R1 C2 (1 - K))
+
+Node equations (p: the non-inverting input, Vo = K Vp):
+x: (Vi - Vx)/R1 = (Vx - Vp)/R2 + (Vx - Vo) s C2;  p: (Vx - Vp)/R2 = Vp s C1.
+With a finite-gain op-amp the amplifier is Vo = K' Vp, K' = A/(1 + A/K): the same
+H(s) with K replaced by K'(s) (what :func:`~designer.filters.topology.nodal_response`
+computes from the netlist).
+
+Design (continuous): C1 from the target (its capacitor, or the one that puts
+R1 = R2 near its impedance), C2 = ratio C1, then R1 R2 = 1/(wn^2 C1 C2) and
+R1 from the s coefficient, the root of
+
+    C1 (1 + m (1 - K)) R1^2 - R1 / (wn Q) + 1 / (wn^2 m C1) = 0,   m = C2/C1
+
+(the smaller one; R2 = 1/(wn^2 C1 C2 R1)); with gain, R3 = the target's impedance
+and R4 = (K - 1) R3.
+
+Realisability: the quadratic has a real root only when
+m (1/(4 Q^2) + K - 1) >= 1, i.e. at unity gain C2/C1 >= 4 Q^2 (SLOA088's
+"C2 >= C1 4 b1 / a1^2"), with gain C2/C1 >= 1 / (1/(4 Q^2) + K - 1). The default
+ratio is the bound at unity gain (then R1 = R2) and 1 (equal capacitors) with
+gain when the bound allows it.
+"""
+
+from __future__ import annotations
+
+from ..core.errors import DesignError
+from ..spice.deck import GROUND, Netlist
+from .sallen_key import SallenKeySection
+from .topology import PartSpec, SectionTarget, polynomial, quadratic_root
+
+__all__ = ["SallenKeyLowPass", "sallen_key_ratio_min"]
+
+
+def sallen_key_ratio_min(q: float, gain: float) -> float:
+    """The least C2/C1 of a Sallen-Key low-pass of quality factor ``q`` and gain ``gain``.
+
+    Parameters
+    ----------
+    q : float
+        Quality factor.
+    gain : float
+        K >= 1.
+
+    Returns
+    -------
+    float
+        1 / (1/(4 Q^2) + K - 1); 4 Q^2 at unity gain.
+    """
+    return 1.0 / (1.0 / (4 * q * q) + gain - 1.0)
+
+
+class SallenKeyLowPass(SallenKeySection):
+    """The Sallen-Key low-pass section (unity gain, or gain K with ``with_gain``).
+
+    Parameters
+    ----------
+    with_gain : bool
+        False: a follower (parts R1 R2 C1 C2); True: K = 1 + R4/R3 (R3, R4 added).
+    """
+
+    kind, base_name = "lowpass", "sallen-key-lowpass"
+    network = (PartSpec("R1", "R", "input resistor"),
+               PartSpec("R2", "R", "to the non-inverting input"),
+               PartSpec("C1", "C", "non-inverting input to ground"),
+               PartSpec("C2", "C", "R1-R2 node to the output (feedback)"))
+
+    def coefficients(self, values: dict) -> tuple:
+        v = self.values_of(values)
+        k = self.gain_of(v)
+        den = polynomial(v["R1"] * v["R2"] * v["C1"] * v["C2"],
+                         v["C1"] * (v["R1"] + v["R2"]) + v["R1"] * v["C2"] * (1 - k), 1.0)
+        num = polynomial(0.0, 0.0, k * den[2])
+        return num, den
+
+    def limits(self, target: SectionTarget) -> dict:
+        return {"ratio_min": sallen_key_ratio_min(target.q, target.gain)}
+
+    def _check_limits(self, target: SectionTarget, choices: dict) -> None:
+        self.check_gain(target)
+        bound = sallen_key_ratio_min(target.q, target.gain)
+        m = choices.get("ratio")
+        if m is not None and m < bound * (1 - 1e-12):
+            rule = "4 Q^2" if not self.with_gain else "1/(1/(4 Q^2) + K - 1)"
+            raise DesignError(f"ratio: C2/C1 = {m:.4g} is below the bound {rule} = {bound:.4g} of {self.name} "
+                              f"at Q = {target.q:.4g}, K = {target.gain:.4g}; use a ratio of at least {bound:.4g}, "
+                              "a lower Q" + (", or a higher gain" if self.with_gain else ", or the gain-K section"),
+                              param="ratio")
+
+    def synthesize(self, target: SectionTarget, **choices) -> dict:
+        self.check_realisable(target, **choices)
+        q, k, w = target.q, target.gain, target.wn
+        bound = sallen_key_ratio_min(q, k)
+        m = choices.get("ratio", bound if not self.with_gain else max(1.0, bound))
+        c1 = self.scale(target, 1.0 / m ** 0.5)
+        c2 = m * c1
+        p = 1.0 / (w * w * c1 * c2)
+        r1 = quadratic_root(c1 * (1 + m * (1 - k)), 1.0 / (w * q), c1 * p)
+        return {"R1": r1, "R2": p / r1, "C1": c1, "C2": c2, **self.gain_values(target, choices)}
+
+    def netlist(self, values: dict, prefix: str = "", amp_ref: str = "U1", inp: str = "vin",
+                out: str = "vout") -> Netlist:
+        x, p, n = self.internal(amp_ref, "x", "p", "n")
+        ends = {"R1": (inp, x), "R2": (x, p), "C1": (p, GROUND), "C2": (x, out)}
+        return self.amplified(values, prefix, ends, amp_ref, p, n, out)

@@ -1,0 +1,621 @@
+"""The :class:`Topology` abstraction: one active-filter section (a circuit of
+resistors, capacitors and one op-amp) described once, in the style of
+scikit-rf's ``Media`` (a small abstract base; everything else inherited).
+
+A topology declares its parts (:class:`PartSpec`: designator, kind R or C, the
+role shown on a sheet) and implements four things:
+
+- :meth:`Topology.coefficients`: the ideal transfer function as polynomials in
+  s (closed forms, vectorised over arrays of part values);
+- :meth:`Topology.synthesize`: continuous part values from a
+  :class:`SectionTarget` and the free choices the topology offers;
+- :meth:`Topology.check_realisable`: its realisability limits, refused in one
+  line naming the limit and what to change;
+- :meth:`Topology.netlist`: its :class:`~designer.spice.deck.Netlist` with a
+  designator prefix, an op-amp reference and the nets it sits between.
+
+Inherited from the base: the figures (fn, Q, gain) from the coefficients, the
+ideal response H(s) from them, and the op-amp-aware response by nodal analysis
+of the topology's own netlist with a finite-gain op-amp (:func:`nodal_response`):
+the op-amp is a voltage source at its output,
+
+    V_out = A(s) (V+ - V-),   A(s) = A0 / (1 + s A0 / (2 pi GBW))
+
+(the single-pole model of :mod:`designer.core.opamps` and of the project's
+``OPAMP_BEH`` subcircuit), and every other node obeys Kirchhoff's current law,
+sum over parts of Y_part (V_node - V_other) = 0 with Y = 1/R or s C, the input
+node driven at 1 V (the op-amp's row is solved as V_out / A(s) - (V+ - V-) = 0,
+well conditioned at any gain). The section modules write their node equations out.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.errors import DesignError
+from ..spice.deck import GROUND, Netlist, Part
+
+__all__ = ["KINDS", "DEFAULT_IMPEDANCE_OHM", "PartSpec", "SectionTarget", "Figures", "Topology",
+           "open_loop_gain", "nodal_response", "polynomial", "polyval", "quadratic_root"]
+
+#: the section responses a target may ask for
+KINDS = ("lowpass", "highpass", "bandpass")
+#: the resistor scale of a synthesis given neither an impedance nor a capacitor (ohm)
+DEFAULT_IMPEDANCE_OHM = 10e3
+
+
+@dataclass(frozen=True)
+class PartSpec:
+    """One part of a topology, declared once.
+
+    Parameters
+    ----------
+    ref : str
+        Designator within the section (``R1``, ``C2``).
+    kind : str
+        ``"R"`` or ``"C"``.
+    role : str
+        What it does, as a sheet shows it ("input resistor", "feedback capacitor").
+    """
+
+    ref: str
+    kind: str
+    role: str
+
+
+@dataclass(frozen=True)
+class SectionTarget:
+    """What one section must realise.
+
+    Parameters
+    ----------
+    kind : str
+        ``lowpass``, ``highpass`` or ``bandpass``.
+    fn_hz : float
+        Natural (centre, for a band-pass; corner, for a first-order section) frequency, Hz.
+    q : float or None
+        Quality factor of a second-order section; None for a first-order one.
+    gain : float
+        Passband gain magnitude (V/V): at DC for a low-pass, at high frequency for a
+        high-pass, at fn for a band-pass. An inverting topology realises -gain.
+    impedance_ohm : float or None
+        The resistor scale the synthesis aims at (default :data:`DEFAULT_IMPEDANCE_OHM`).
+    c_f : float or None
+        The reference capacitor (farad), instead of ``impedance_ohm``.
+    """
+
+    kind: str
+    fn_hz: float
+    q: float | None = None
+    gain: float = 1.0
+    impedance_ohm: float | None = None
+    c_f: float | None = None
+
+    @property
+    def wn(self) -> float:
+        """Angular natural frequency, rad/s."""
+        return 2 * math.pi * self.fn_hz
+
+
+@dataclass(frozen=True)
+class Figures:
+    """A section's figures from its part values (numbers, or arrays for arrays of values).
+
+    Parameters
+    ----------
+    fn_hz : float or ndarray
+        Natural (centre, corner) frequency, Hz.
+    q : float or ndarray or None
+        Quality factor; None for a first-order section.
+    gain : float or ndarray
+        Passband gain magnitude (V/V).
+    """
+
+    fn_hz: object
+    q: object
+    gain: object
+
+
+def polynomial(*coeffs) -> np.ndarray:
+    """Coefficients (highest power of s first; numbers or arrays) stacked into one
+    array of shape ``(len(coeffs), *batch)``, broadcast against each other.
+
+    Parameters
+    ----------
+    *coeffs : float or ndarray
+        The coefficients.
+
+    Returns
+    -------
+    ndarray
+        ``poly[k]`` is the coefficient of s**(len(coeffs) - 1 - k).
+    """
+    return np.stack(np.broadcast_arrays(*(np.asarray(c, dtype=float) for c in coeffs)))
+
+
+def polyval(poly: np.ndarray, s) -> np.ndarray:
+    """A :func:`polynomial` at ``s`` by Horner's rule, its batch broadcast against ``s``.
+
+    Parameters
+    ----------
+    poly : ndarray
+        Shape ``(n + 1, *batch)``.
+    s : complex or ndarray
+        Where to evaluate it.
+
+    Returns
+    -------
+    ndarray
+        The polynomial's values, shape ``broadcast(batch, s)``.
+    """
+    out = np.zeros((), dtype=complex)
+    for c in poly:
+        out = out * s + c
+    return out
+
+
+def quadratic_root(a: float, b: float, c: float) -> float:
+    """The positive root of a x^2 - b x + c = 0 (b > 0) that a synthesis takes:
+    for c > 0 the smaller one, 2 c / (b + sqrt(D)) (also the positive one when
+    a < 0, and exact as a -> 0), for c <= 0 the only positive one,
+    (b + sqrt(D)) / (2 a); D = b^2 - 4 a c. A discriminant negative by rounding
+    only (a double root at a realisability bound) counts as zero.
+
+    Parameters
+    ----------
+    a, b, c : float
+        The coefficients.
+
+    Returns
+    -------
+    float
+        The root.
+    """
+    d = b * b - 4 * a * c
+    if d < 0:
+        d = 0.0 if d > -1e-9 * b * b else math.nan
+    return 2 * c / (b + math.sqrt(d)) if c > 0 else (b + math.sqrt(d)) / (2 * a)
+
+
+def open_loop_gain(opamp, s) -> np.ndarray:
+    """The single-pole open-loop gain A(s) = A0 / (1 + s A0 / (2 pi GBW)).
+
+    Parameters
+    ----------
+    opamp : designer.core.opamps.OpAmp
+        Supplies ``a0`` (V/V) and ``gbw_hz``.
+    s : complex or ndarray
+        Laplace variable, rad/s.
+
+    Returns
+    -------
+    ndarray
+        A(s).
+    """
+    s = np.asarray(s, dtype=complex)
+    return opamp.a0 / (1 + s * opamp.a0 / (2 * math.pi * opamp.gbw_hz))
+
+
+def nodal_response(netlist: Netlist, values: dict, s, opamp, inp: str = "vin", out: str = "vout") -> np.ndarray:
+    """V(out)/V(inp) of a circuit by nodal analysis, each op-amp a finite-gain
+    voltage source V_out = A(s) (V+ - V-); vectorised.
+
+    Unknowns: every net but ground and the input. Rows: Kirchhoff's current law
+    at each net that no op-amp drives, sum Y (V_net - V_other) = 0 (Y = 1/R,
+    s C; a part to the input puts Y * 1 V on the right-hand side), and
+    V_out / A - (V+ - V-) = 0 for each op-amp's output (divided by A so that
+    the system stays well conditioned however large A is).
+
+    Parameters
+    ----------
+    netlist : Netlist
+        The circuit (designators are the keys of ``values``).
+    values : dict
+        Designator -> value (ohm, farad), numbers or arrays.
+    s : complex or ndarray
+        Laplace variable, rad/s; broadcast against the value arrays.
+    opamp : designer.core.opamps.OpAmp
+        Its A0 and GBW give A(s) of every op-amp.
+    inp, out : str
+        The input net (driven at 1 V) and the output net.
+
+    Returns
+    -------
+    ndarray
+        The transfer function, shape ``broadcast(values..., s)``.
+    """
+    s = np.asarray(s, dtype=complex)
+    vals = {p.ref: np.asarray(values[p.ref], dtype=float) for p in netlist.parts}
+    nets = []
+    for p in netlist.parts:
+        nets += [p.a, p.b]
+    for a in netlist.amps:
+        nets += [a.inp, a.inn, a.out]
+    nets = [n for n in dict.fromkeys(nets) if n not in (GROUND, inp)]
+    idx = {n: i for i, n in enumerate(nets)}
+    shape = np.broadcast_shapes(s.shape, *(v.shape for v in vals.values()))
+    y_mat = np.zeros(shape + (len(nets), len(nets)), dtype=complex)
+    rhs = np.zeros(shape + (len(nets),), dtype=complex)
+    driven = {idx[a.out] for a in netlist.amps}
+    for p in netlist.parts:
+        y = 1 / vals[p.ref] if p.kind == "R" else s * vals[p.ref]
+        y = np.broadcast_to(y, shape)
+        for here, there in ((p.a, p.b), (p.b, p.a)):
+            if here not in idx or idx[here] in driven:
+                continue
+            i = idx[here]
+            y_mat[..., i, i] += y
+            if there in idx:
+                y_mat[..., i, idx[there]] -= y
+            elif there == inp:
+                rhs[..., i] += y
+    # the op-amp's row divided by A(s): V_out / A - V+ + V- = 0 stays well conditioned at any gain
+    inverse_gain = np.broadcast_to(1 / open_loop_gain(opamp, s), shape)
+    for a in netlist.amps:
+        i = idx[a.out]
+        y_mat[..., i, i] += inverse_gain
+        for net, sign in ((a.inp, -1.0), (a.inn, 1.0)):
+            if net in idx:
+                y_mat[..., i, idx[net]] += sign
+            elif net == inp:
+                rhs[..., i] -= sign
+    return np.linalg.solve(y_mat, rhs[..., None])[..., idx[out], 0]
+
+
+class Topology(ABC):
+    """One filter section: a subclass sets the class attributes and implements
+    :meth:`coefficients`, :meth:`synthesize`, :meth:`netlist` and (when it has
+    limits) :meth:`limits` and the realisability check; the rest is inherited.
+
+    Attributes
+    ----------
+    name : str
+        The registry's name (``sallen-key-lowpass``).
+    title : str
+        A human name ("Sallen-Key low-pass, unity gain").
+    kind : str
+        ``lowpass``, ``highpass`` or ``bandpass``.
+    order : int
+        1 or 2.
+    inverting : bool
+        Whether the passband gain is negative.
+    parts : tuple of PartSpec
+        The parts, in the order a sheet lists them.
+    choices : tuple of str
+        The free choices :meth:`synthesize` takes (besides the target).
+    example : SectionTarget
+        A typical target (the documentation's and the conformance suite's).
+    """
+
+    name: str = ""
+    title: str = ""
+    kind: str = "lowpass"
+    order: int = 2
+    inverting: bool = False
+    parts: tuple = ()
+    choices: tuple = ()
+    example: SectionTarget | None = None
+
+    # ---- what every section implements ------------------------------------------------------
+    @abstractmethod
+    def coefficients(self, values: dict) -> tuple:
+        """The ideal transfer function as (num, den) polynomials in s.
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value (ohm, farad), numbers or arrays.
+
+        Returns
+        -------
+        tuple of ndarray
+            (num, den), each of shape ``(order + 1, *batch)``, highest power first
+            (num padded with zeros to the length of den).
+        """
+
+    @abstractmethod
+    def synthesize(self, target: SectionTarget, **choices) -> dict:
+        """Continuous part values realising ``target`` exactly.
+
+        Parameters
+        ----------
+        target : SectionTarget
+            The section's kind, fn, Q, gain and reference impedance or capacitor.
+        **choices
+            The topology's free choices (:attr:`choices`).
+
+        Returns
+        -------
+        dict
+            Designator -> value (ohm, farad).
+        """
+
+    @abstractmethod
+    def netlist(self, values: dict, prefix: str = "", amp_ref: str = "U1", inp: str = "vin",
+                out: str = "vout") -> Netlist:
+        """The section as parts and one op-amp between nets ``inp`` and ``out``.
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value (ohm, farad), numbers.
+        prefix : str
+            Put after each designator's letter (``"10"``: R1 -> R101), for chaining.
+        amp_ref : str
+            The op-amp's designator; internal nets are named after it (``u1_x``).
+        inp, out : str
+            The nets the section sits between.
+
+        Returns
+        -------
+        Netlist
+            Its parts (roles from :attr:`parts`) and op-amp.
+        """
+
+    def limits(self, target: SectionTarget) -> dict:
+        """The bounds ``target`` puts on the free choices (none by default).
+
+        Parameters
+        ----------
+        target : SectionTarget
+            The section target.
+
+        Returns
+        -------
+        dict
+            Name -> bound (``{"ratio_min": 2.0}``).
+        """
+        return {}
+
+    # ---- inherited ---------------------------------------------------------------------------
+    @property
+    def designators(self) -> tuple:
+        """The designators of :attr:`parts`, in order."""
+        return tuple(p.ref for p in self.parts)
+
+    def values_of(self, values: dict) -> dict:
+        """``values`` checked against the declared parts, as float arrays.
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value.
+
+        Returns
+        -------
+        dict
+            The same keys, values as numpy arrays.
+
+        Raises
+        ------
+        DesignError
+            A designator missing or unknown (one line, naming the parts).
+        """
+        missing = [r for r in self.designators if r not in values]
+        extra = [r for r in values if r not in self.designators]
+        if missing or extra:
+            what = f"no part {', '.join(extra)}" if extra else f"missing {', '.join(missing)}"
+            raise DesignError(f"values: {self.name} has {what}; its parts are {', '.join(self.designators)}",
+                              param="values")
+        return {r: np.asarray(values[r], dtype=float) for r in self.designators}
+
+    def part_role(self, ref: str) -> str:
+        """The declared role of designator ``ref``.
+
+        Parameters
+        ----------
+        ref : str
+            A designator of :attr:`parts`.
+
+        Returns
+        -------
+        str
+            Its role.
+        """
+        return next(p.role for p in self.parts if p.ref == ref)
+
+    def prefixed(self, ref: str, prefix: str) -> str:
+        """``ref`` with ``prefix`` after its letter (R1, "10" -> R101).
+
+        Parameters
+        ----------
+        ref : str
+            A designator.
+        prefix : str
+            The stage's prefix.
+
+        Returns
+        -------
+        str
+            The prefixed designator.
+        """
+        return ref[0] + prefix + ref[1:]
+
+    def assemble(self, values: dict, prefix: str, ends: dict, amp) -> Netlist:
+        """The section's :class:`Netlist`: each declared part between the nets
+        ``ends[ref]``, designator prefixed, value from ``values``, and the op-amp.
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value.
+        prefix : str
+            The stage's prefix (:meth:`prefixed`).
+        ends : dict
+            Designator -> (net a, net b).
+        amp : designer.spice.deck.Amp
+            The section's op-amp.
+
+        Returns
+        -------
+        Netlist
+            The section.
+        """
+        parts = tuple(Part(self.prefixed(s.ref, prefix), *ends[s.ref], float(values[s.ref]), s.role)
+                      for s in self.parts)
+        return Netlist(parts, (amp,))
+
+    @staticmethod
+    def internal(amp_ref: str, *names: str) -> tuple:
+        """Internal net names of a section, unique per op-amp (``u1_x``).
+
+        Parameters
+        ----------
+        amp_ref : str
+            The section's op-amp designator.
+        *names : str
+            Short names.
+
+        Returns
+        -------
+        tuple of str
+            The nets.
+        """
+        return tuple(f"{amp_ref.lower()}_{n}" for n in names)
+
+    def response(self, values: dict, s, opamp=None) -> np.ndarray:
+        """H(s), vectorised: the part arrays broadcast against ``s``.
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value (ohm, farad), numbers or arrays.
+        s : complex or ndarray
+            Laplace variable (``2j * pi * f``), rad/s.
+        opamp : designer.core.opamps.OpAmp, optional
+            None: the ideal op-amp (:meth:`coefficients`); else its finite gain and
+            gain-bandwidth by nodal analysis of :meth:`netlist` (:func:`nodal_response`).
+
+        Returns
+        -------
+        ndarray
+            The complex transfer function.
+        """
+        if opamp is None:
+            num, den = self.coefficients(values)
+            return polyval(num, s) / polyval(den, s)
+        vals = self.values_of(values)
+        net = self.netlist({r: 1.0 for r in self.designators})
+        return nodal_response(net, vals, s, opamp)
+
+    def figures(self, values: dict) -> Figures:
+        """fn, Q and the passband gain magnitude from the ideal coefficients.
+
+        Second order, den = d2 s^2 + d1 s + d0: wn = sqrt(d0/d2), Q = sqrt(d0 d2)/d1;
+        gain num/den at DC (low-pass), at infinity (high-pass), at wn (band-pass, n1/d1).
+        First order, den = d1 s + d0: wn = d0/d1.
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value, numbers or arrays.
+
+        Returns
+        -------
+        Figures
+            Numbers for numbers, arrays for arrays.
+        """
+        num, den = self.coefficients(values)
+        wn = np.sqrt(den[-1] / den[0]) if self.order == 2 else den[-1] / den[0]
+        q = np.sqrt(den[-1] * den[0]) / den[1] if self.order == 2 else None
+        if self.kind == "lowpass":
+            gain = num[-1] / den[-1]
+        elif self.kind == "highpass":
+            gain = num[0] / den[0]
+        else:
+            gain = num[1] / den[1]
+        scalar = lambda x: float(x) if x is not None and np.ndim(x) == 0 else x  # noqa: E731
+        return Figures(scalar(wn / (2 * math.pi)), scalar(q), scalar(np.abs(gain)))
+
+    def check_realisable(self, target: SectionTarget, **choices) -> None:
+        """Refuse a target or choices the topology cannot realise, in one line that
+        names the limit and what to change.
+
+        Parameters
+        ----------
+        target : SectionTarget
+            The section target.
+        **choices
+            The free choices (:attr:`choices`).
+
+        Raises
+        ------
+        DesignError
+            The first limit broken.
+        """
+        unknown = [c for c in choices if c not in self.choices]
+        if unknown:
+            raise DesignError(f"{unknown[0]}: {self.name} has no choice {unknown[0]!r}; it takes "
+                              f"{', '.join(self.choices) or 'none'}", param=unknown[0])
+        if target.kind != self.kind:
+            raise DesignError(f"kind: {self.name} is a {self.kind} section, the target asks for a {target.kind}; "
+                              f"use a {target.kind} section", param="kind")
+        if not (math.isfinite(target.fn_hz) and target.fn_hz > 0):
+            raise DesignError(f"fn_hz must be a positive frequency, got {target.fn_hz!r}", param="fn_hz")
+        if self.order == 2 and not (target.q is not None and math.isfinite(target.q) and target.q > 0):
+            raise DesignError(f"q: {self.name} is second-order and needs a positive Q, got {target.q!r}",
+                              param="q")
+        if self.order == 1 and target.q is not None:
+            raise DesignError(f"q: {self.name} is first-order and has no Q (got {target.q!r}); leave q unset "
+                              "or use a second-order section", param="q")
+        if not (math.isfinite(target.gain) and target.gain > 0):
+            raise DesignError(f"gain must be a positive magnitude, got {target.gain!r}", param="gain")
+        for name in ("impedance_ohm", "c_f"):
+            v = getattr(target, name)
+            if v is not None and not (math.isfinite(v) and v > 0):
+                raise DesignError(f"{name} must be positive, got {v!r}", param=name)
+        for name, v in choices.items():
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise DesignError(f"{name} must be a positive number, got {v!r}", param=name)
+        self._check_limits(target, choices)
+
+    def _check_limits(self, target: SectionTarget, choices: dict) -> None:
+        """The topology's own limits (none by default); subclasses raise DesignError."""
+
+    def require_unity_gain(self, target: SectionTarget, instead: str) -> None:
+        """Refuse a gain other than 1 for a follower section.
+
+        Parameters
+        ----------
+        target : SectionTarget
+            The target.
+        instead : str
+            What to do instead ("use sallen-key-lowpass-gain").
+
+        Raises
+        ------
+        DesignError
+            The gain is not 1 (one line).
+        """
+        if abs(target.gain - 1.0) > 1e-12:
+            raise DesignError(f"gain: {self.name} is a follower (gain 1), the target asks for {target.gain:.4g}; "
+                              f"{instead}", param="gain")
+
+    def scale(self, target: SectionTarget, c_over_r: float = 1.0) -> float:
+        """The reference capacitor (farad) of a synthesis: ``target.c_f``, or the one
+        that puts the resistors near ``target.impedance_ohm`` (default
+        :data:`DEFAULT_IMPEDANCE_OHM`) at wn: C = c_over_r / (wn R).
+
+        Parameters
+        ----------
+        target : SectionTarget
+            The section target.
+        c_over_r : float
+            The section's C wn R at its design point (1 for an RC pole).
+
+        Returns
+        -------
+        float
+            Farad.
+        """
+        if target.c_f is not None:
+            return float(target.c_f)
+        r = target.impedance_ohm or DEFAULT_IMPEDANCE_OHM
+        return c_over_r / (target.wn * r)
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name!r}>"
