@@ -18,9 +18,14 @@ EPILOG = """examples:
   designer-web                          http://127.0.0.1:8000/ on this machine only
   designer-web --port 8080 --jobs 2     another port; two designs at once (one per core)
   designer-web --host 0.0.0.0           the lab's network too: anyone who reaches it can run designs here
+  designer-web --host 0.0.0.0 --allow-origin http://lab-pc.example.edu:8000
+                                        ... and its page opened by the lab's own name for this machine
 
 Pages: /plant, /pid, /identify, /check. API: POST /api/plant, /api/pid, /api/identify, /api/check with
-the commands' options by name (see the README). Stop it with Ctrl-C."""
+the commands' options by name (see the README); the JSON ones take Content-Type: application/json. A request
+is answered only when its Host is this server's address (on 127.0.0.1 also localhost) or a name given with
+--allow-origin, and its Origin, when a browser sends one, is this server's page: no other site's page can use
+it. Stop it with Ctrl-C."""
 
 
 def _parser():
@@ -35,6 +40,11 @@ def _parser():
     p.add_argument("--jobs", default="2", help="worker processes running the commands, 1 to 16 (default 2)")
     p.add_argument("--timeout", default="120", help="seconds one run may take before it is killed and reported, "
                                                     "1 to 3600 (default 120)")
+    p.add_argument("--allow-origin", action="append", default=[], metavar="URL",
+                   help="a page origin to answer besides this server's own address, e.g. http://lab-pc:8000 or "
+                        "https://lab.example.edu behind a proxy: its name is then accepted as Host too "
+                        "(repeatable; for --host 0.0.0.0, which otherwise accepts this machine's own names and "
+                        "addresses only)")
     return p
 
 
@@ -73,10 +83,12 @@ def _serve(args) -> int:
     import uvicorn
 
     from .app import create_app
+    from .guard import origin_of, trust_for
     from .pool import Pool
     port = _whole(args.port, "--port", 0, 65535)
     jobs = _whole(args.jobs, "--jobs", 1, 16)
     timeout = _whole(args.timeout, "--timeout", 1, 3600)
+    allowed = [origin_of(u) for u in args.allow_origin]   # checked before anything starts
     family = socket.AF_INET6 if ":" in args.host else socket.AF_INET
     sock = socket.socket(family, socket.SOCK_STREAM)
     try:
@@ -98,7 +110,11 @@ def _serve(args) -> int:
     warning = exposure_warning(args.host, port)
     if warning:
         print(warning, flush=True)
-    config = uvicorn.Config(create_app(pool), log_level="warning", lifespan="on")
+    also = " (and localhost)" if is_local(host) else \
+        " (and this machine's other names and addresses)" if ipaddress.ip_address(host).is_unspecified else ""
+    print(f"designer-web: answering pages at {', '.join([f'http://{shown}:{port}{also}'] + allowed)}; "
+          "requests from any other site's pages are refused", flush=True)
+    config = uvicorn.Config(create_app(pool, trust_for(host, port, allowed)), log_level="warning", lifespan="on")
     server = uvicorn.Server(config)
     try:
         server.run(sockets=[sock])
