@@ -75,9 +75,11 @@ class Trust(NamedTuple):
     """What the server answers: its Host names and origins (see the module docstring)."""
 
     port: int                #: the port it serves
-    hosts: frozenset         #: accepted ``Host`` values, lowercase (``127.0.0.1:8000``, ``lab.example:8000``)
-    origins: frozenset       #: accepted ``Origin`` values besides ``http://`` and an accepted Host
-    any_local_address: bool  #: a wildcard bind: a Host that is an address of this machine is accepted too
+    hosts: frozenset         #: its own names as a ``Host`` gives them, lowercase (``127.0.0.1:8000``); its page's
+                             #: origins are ``http://`` and one of them
+    origins: frozenset       #: ``--allow-origin``'s origins (``https://lab.example.edu``)
+    named: frozenset         #: their names as a ``Host`` gives them (``lab.example.edu``, ``lab.example.edu:8000``)
+    any_local_address: bool  #: a wildcard bind: a Host that is an address of this machine is its own too
 
 
 def origin_of(url: str) -> str:
@@ -130,12 +132,13 @@ def trust_for(bind: str, port: int, allow_origins=()) -> Trust:
         for name in {socket.gethostname(), socket.getfqdn()}:
             if name:
                 hosts |= _with_port(name.lower(), port)
+    named = set()
     for origin in origins:
         u = urlsplit(origin)
-        hosts.add(u.netloc)                                 # as the browser sends it (through a proxy too)
+        named.add(u.netloc)                                 # as the browser sends it (through a proxy too)
         name = f"[{u.hostname}]" if ":" in u.hostname else u.hostname
-        hosts |= _with_port(name, port)                     # the same name at this server's own port
-    return Trust(port, frozenset(hosts), origins, wildcard)
+        named |= _with_port(name, port)                     # the same name at this server's own port
+    return Trust(port, frozenset(hosts), origins, frozenset(named), wildcard)
 
 
 class _LocalAddresses:
@@ -209,10 +212,11 @@ class Guard:
             return
         await self.app(scope, receive, send_with_headers)
 
-    def host_ok(self, host: str) -> bool:
-        """Whether ``host`` (a Host header's value, or an origin's host and port) names this server."""
+    def host_ok(self, host: str, allowed_names: bool = True) -> bool:
+        """Whether ``host`` (a Host header's value, or an origin's host and port) names this server
+        (``allowed_names``: a name given with ``--allow-origin`` too)."""
         host = host.lower()
-        if host in self.trust.hosts:
+        if host in self.trust.hosts or (allowed_names and host in self.trust.named):
             return True
         if not self.trust.any_local_address:
             return False
@@ -237,7 +241,8 @@ class Guard:
         origin = headers.get(b"origin")
         if origin is not None:
             own = origin.lower().rstrip("/")
-            ok = own in self.trust.origins or (own.startswith("http://") and self.host_ok(own[len("http://"):]))
+            ok = own in self.trust.origins or (own.startswith("http://") and
+                                               self.host_ok(own[len("http://"):], allowed_names=False))
             if not ok:
                 return 403, (f"designer-web: error: Origin {origin[:80]!r} is not this server's page: refused "
                              "(a lab's own name is allowed with designer-web --allow-origin)")
