@@ -34,8 +34,8 @@ from typing import NamedTuple
 
 from ..core.errors import DesignError
 
-__all__ = ["FILE_OPTIONS", "MAX_DEPTH", "MAX_JSON_BYTES", "REFUSED", "SERVERS_OWN", "Traits", "build_argv", "check_text",
-           "check_value", "option_name", "parse_json", "parser_traits", "write_content"]
+__all__ = ["FILE_OPTIONS", "MAX_DEPTH", "MAX_JSON_BYTES", "REFUSED", "SERVERS_OWN", "Traits", "build_argv",
+           "check_text", "check_value", "option_name", "parse_json", "parser_traits", "write_content"]
 
 #: options the server sets itself (files, output form) or that would reach past a request's folder
 REFUSED = ("out", "json", "no-files", "plot", "help", "version", "junit", "summary", "root", "allow-outside",
@@ -178,7 +178,7 @@ def build_argv(options: dict, tmp: str | None, traits: "Traits | None" = None) -
             raise DesignError(f"{opt} takes at least one value, got an empty list")
         if opt in t.appended or len(words) == 1:
             # joined to its option: a value that begins with "-" (--help, -x) is a value, never an option
-            argv += [f"{opt}={w}" for w in words] if opt in t.appended else [f"{opt}={words[0]}"]
+            argv += [f"{opt}={w}" for w in words]
         else:
             for w in words:
                 if w.startswith("-") and not _NEGATIVE.match(w):

@@ -132,14 +132,14 @@ def test_not_json_is_a_400_not_a_500(server):
     assert status == 400 and "not JSON" in got["error"]
 
 
-def declared(server, path: str, length: int) -> tuple:
+def declared(server, path: str, length: int, ctype: str = "text/csv") -> tuple:
     """A request whose headers declare ``length`` bytes, of which a few are sent: (status, JSON answer).
     (A client sending the whole body would see the server close the connection under it.)"""
     import socket
     import urllib.parse
     u = urllib.parse.urlsplit(server.url)
     with socket.create_connection((u.hostname, u.port), timeout=60) as sock:
-        sock.sendall(f"POST {path} HTTP/1.1\r\nHost: {u.netloc}\r\nContent-Type: text/csv\r\n"
+        sock.sendall(f"POST {path} HTTP/1.1\r\nHost: {u.netloc}\r\nContent-Type: {ctype}\r\n"
                      f"Content-Length: {length}\r\nConnection: close\r\n\r\n".encode() + b"t,y\n" * 10)
         raw = b""
         while chunk := sock.recv(65536):
@@ -155,7 +155,7 @@ def test_uploads_over_the_clis_limits_are_413(server):
     assert status == 413 and "256 MiB" in got["error"]
     status, got = declared(server, "/api/check", 40 * 1024 * 1024)
     assert status == 413 and "check-design" in got["error"]
-    status, got = declared(server, "/api/plant", 40 * 1024 * 1024)
+    status, got = declared(server, "/api/plant", 40 * 1024 * 1024, "application/json")
     assert status == 413
     # a frequency table over identify-freq's 16 MiB: the command's own refusal, as a 413
     table = b"f_hz,gain_db\n" + b"1000,0\n" * (17 * 1024 * 1024 // 7)
@@ -317,7 +317,8 @@ RUNNING = [("/api/plant", {"fc": 1000, "zeta": 0.5, "no-sim": True}),
            ("/api/pid", {"plant-fc": 3500, "plant-zeta": 0.2, "no-sim": True}),
            ("/api/pid/sheet", {"plant-fc": 3500, "plant-zeta": 0.2, "no-sim": True}),
            ("/api/pid/bundle", {"plant-fc": 3500, "plant-zeta": 0.2, "no-sim": True}),
-           ("/api/analyze-pid", {"plant-fc": 3500, "plant-zeta": 0.2, "kp": 2, "ti": "1m", "td": "10u", "no-sim": True}),
+           ("/api/analyze-pid", {"plant-fc": 3500, "plant-zeta": 0.2, "kp": 2, "ti": "1m", "td": "10u",
+                                 "no-sim": True}),
            ("/api/identify", CAPTURE.read_bytes()),
            ("/api/check", {"spec": "name: x\nkind: plant\ntarget: {fc: 1k, zeta: 0.5}\nchecks:\n  fn_hz: {max: 2k}\n"})]
 
