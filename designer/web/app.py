@@ -323,7 +323,7 @@ async def _multipart(request: Request, tmp: str, limit: int) -> tuple:
 
     def on_field(field):
         key = field.field_name.decode("utf-8", "replace")
-        fields[key] = (field.value or b"").decode("utf-8", "replace")
+        _gather(fields, key, (field.value or b"").decode("utf-8", "replace"))
 
     def on_file(f):
         files.setdefault(f.field_name.decode("utf-8", "replace"), []).append(f)
@@ -344,6 +344,17 @@ async def _multipart(request: Request, tmp: str, limit: int) -> tuple:
     except Exception as exc:   # python-multipart's own errors (a malformed form): the client's mistake
         raise DesignError(f"the multipart form cannot be read: {exc}") from None
     return files, fields
+
+
+def _gather(options: dict, key: str, value: str) -> None:
+    """A query's or form's field into ``options``: a name given twice or more is a list of its values, as an
+    option that takes several (``?window=0&window=2m``) or repeats wants them."""
+    if key not in options:
+        options[key] = value
+    elif isinstance(options[key], list):
+        options[key].append(value)
+    else:
+        options[key] = [options[key], value]
 
 
 def _save(f, path: str) -> None:
@@ -371,7 +382,10 @@ async def _upload(request: Request, tmp: str, limit: int, field: str) -> tuple:
     else:
         name = _plain(request.query_params.get("filename"), "capture.csv")
         path = os.path.join(tmp, "upload-" + name)
-        options = {k: v for k, v in request.query_params.items() if k not in ("view", "filename")}
+        options = {}
+        for k, v in request.query_params.multi_items():
+            if k not in ("view", "filename"):
+                _gather(options, k, v)
         await _stream_to(request, path, limit)
     if os.path.getsize(path) == 0:
         raise DesignError("the capture is empty: send the file as the request's body or as a form's file")

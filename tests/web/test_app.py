@@ -383,6 +383,15 @@ def test_an_upload_by_form_needs_the_pages_header(server, path):
     assert status == 200, raw
 
 
+def test_a_query_gives_an_option_of_several_values_by_repeating_its_name(server):
+    want = cli_json("identify", str(CAPTURE), "--window", "-0.1m", "1.5m", "--json")
+    status, _, raw = server.post("/api/identify?window=-0.1m&window=1.5m", CAPTURE.read_bytes())
+    assert status == 200, raw
+    got = json.loads(raw)
+    assert got["best"]["params"] == want["best"]["params"]
+    assert got["best"]["params"] != cli_json("identify", str(CAPTURE), "--json")["best"]["params"]   # it took effect
+
+
 def test_a_capture_as_the_body_with_its_own_type_needs_no_header(server):
     """text/csv or octet-stream are not types a foreign page can send unasked: a script's curl works as before."""
     for ctype in ("text/csv", "application/octet-stream"):
@@ -482,7 +491,9 @@ MALFORMED = [
     ("/api/plant", b'{"fc": 1e999, "zeta": 0.5}', {}, "finite number"),
     ("/api/plant", b'{"fc": NaN, "zeta": 0.5}', {}, "finite number"),
     ("/api/identify?window=%ff%fe&x=%00", CAPTURE.read_bytes(), {}, "error"),
-    ("/api/identify?window=1&window=2", CAPTURE.read_bytes(), {}, "--window takes 2 values"),
+    ("/api/identify?window=1", CAPTURE.read_bytes(), {}, "--window takes 2 values, got 1"),
+    ("/api/identify?window=1&window=2&window=3", CAPTURE.read_bytes(), {}, "--window takes 2 values, got 3"),
+    ("/api/identify?step-time=1&step-time=2", CAPTURE.read_bytes(), {}, "--step-time takes one value, got 2"),
     ("/api/identify?help=1", CAPTURE.read_bytes(), {}, "--help is set by the web page"),
     ("/api/identify?methods=-h", CAPTURE.read_bytes(), {}, "error"),
     ("/api/identify?%80=1", CAPTURE.read_bytes(), {}, "is not an option name"),
@@ -579,3 +590,24 @@ def test_fuzz_every_endpoint_answers_below_500_and_logs_no_traceback():
         err = s.stop()
     assert logged(err) == [], err
     assert len(set(seen)) >= 3   # answered, refused and refused otherwise: the fuzz reached past the guard
+
+
+def test_allow_origin_lets_a_labs_own_name_in_and_says_so():
+    """--allow-origin (repeatable): that page's Origin and its name as Host are answered; the start-up lines say
+    which pages are answered; a page at another name still is not."""
+    s = Server("--jobs", "1", "--allow-origin", "https://lab.example.edu", "--allow-origin", "http://lab-pc:8000")
+    try:
+        said = s.proc.stdout.readline()
+        assert said.startswith("designer-web: answering pages at http://127.0.0.1:") and "(and localhost)" in said
+        assert "https://lab.example.edu, http://lab-pc:8000;" in said
+        body = {"fc": 1000, "zeta": 0.5, "no-sim": True}
+        for host, origin in [("lab.example.edu", "https://lab.example.edu"), ("lab-pc:8000", "http://lab-pc:8000")]:
+            status, _, raw = s.post("/api/plant", body, headers={"Host": host, "Origin": origin})
+            assert status == 200, raw
+        for host, origin in [("lab.example.edu", "http://lab.example.edu"), ("evil.example", "https://lab.example.edu"),
+                             ("lab.example.edu", "https://evil.example")]:
+            status, _, raw = s.post("/api/plant", body, headers={"Host": host, "Origin": origin})
+            assert status == 403, raw
+    finally:
+        err = s.stop()
+    assert logged(err) == [], err
