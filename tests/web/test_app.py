@@ -463,10 +463,6 @@ def test_a_value_never_becomes_an_option_and_no_worker_exits(server, body, words
     assert status == 200   # the worker is alive
 
 
-def check_form(boundary_header: str, body: bytes) -> tuple:
-    return body, {"Content-Type": boundary_header}
-
-
 #: malformed requests (issue 25, item 4, and their neighbours): path, body bytes, headers, words of the one line
 MALFORMED = [
     ("/api/plant", b"[" * 100000 + b"]" * 100000, {}, "nested too deeply"),
