@@ -43,10 +43,16 @@ class Server:
             raise
 
     def post(self, path, body=None, headers=None, timeout=180):
-        """(status, headers, body bytes); a dict body is sent as JSON."""
+        """(status, headers, body bytes) of a POST as the page sends it: a dict or list body as JSON
+        (``Content-Type: application/json``), bytes as a file (``application/octet-stream``), the
+        page's ``X-Designer`` header; ``headers`` add to or replace those (a None value: left out)."""
         data = json.dumps(body).encode() if isinstance(body, (dict, list)) else body
+        sent = {"Content-Type": "application/json" if isinstance(body, (dict, list)) else "application/octet-stream",
+                "X-Designer": "1"}
+        sent.update(headers or {})
+        sent = {k: v for k, v in sent.items() if v is not None}   # (urllib gives a body without a type a form's)
         req = urllib.request.Request(self.url + path, data=data if data is not None else b"", method="POST",
-                                     headers=headers or {})
+                                     headers=sent)
         try:
             with urllib.request.urlopen(req, timeout=timeout) as r:
                 return r.status, dict(r.headers), r.read()

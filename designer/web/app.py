@@ -7,10 +7,12 @@ commands' options by name (:mod:`.request`) and answer what the command's
 ``--json`` prints; ``?view=page`` adds what the page draws
 (``{"result": ..., "page": ...}``). ``/api/plant/sheet`` and ``/bundle`` (and
 the PID's) answer the printable build sheet and the design's files as a zip.
-Bad input is a 400 whose ``error`` is the command's one line; an upload over
-the command's file limits a 413; a run past its deadline a 504. Every command
-runs in the worker pool (:mod:`.pool`), each request in its own private
-folder, removed when it is answered.
+Bad input is a 400 whose ``error`` is the command's one line (a body that is
+not UTF-8 JSON, nested too deeply, or a value of the wrong type: one line too);
+an upload over the command's file limits a 413; a run past its deadline a 504.
+Every command runs in the worker pool (:mod:`.pool`), each request in its own
+private folder, removed when it is answered. Which requests are answered at all
+(Host, Origin, content type) and the headers on every answer: :mod:`.guard`.
 
 Starlette (routing, requests, responses) on uvicorn: see the README for why.
 """
@@ -19,6 +21,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import logging
 import os
 import re
 import shutil
@@ -27,7 +30,7 @@ from contextlib import asynccontextmanager
 from pathlib import Path
 
 from starlette.applications import Starlette
-from starlette.requests import Request
+from starlette.requests import ClientDisconnect, Request
 from starlette.responses import JSONResponse, Response
 from starlette.routing import Route
 
@@ -35,6 +38,7 @@ from ..core.errors import DesignError
 from ..core.fileio import MAX_CAPTURE_BYTES, check_plain_name
 from . import pool as pool_module
 from . import request as req
+from .guard import Guard, Trust, error_response
 
 STATIC = Path(__file__).parent / "static"
 MEDIA = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=utf-8",
@@ -69,9 +73,15 @@ def _parsers() -> dict:
     return {prog: req.parser_traits(build()) for prog, build in builders.items()}
 
 
-def create_app(pool) -> Starlette:
-    """The application, its commands run by ``pool`` (a :class:`.pool.Pool`)."""
+def create_app(pool, trust: Trust):
+    """The application, its commands run by ``pool`` (a :class:`.pool.Pool`), answering the requests
+    ``trust`` (:func:`.guard.trust_for`) lets in: an ASGI application."""
     traits = _parsers()
+    # python-multipart logs a malformed form before it raises: the raise is the client's 400, the log line
+    # would be noise on the server's stderr for every broken upload
+    quiet = logging.getLogger("python_multipart")
+    quiet.addHandler(logging.NullHandler())
+    quiet.propagate = False
     static = {p.relative_to(STATIC).as_posix(): (p.read_bytes(), MEDIA.get(p.suffix, MEDIA[""]))
               for p in STATIC.rglob("*") if p.is_file()}
 
@@ -151,12 +161,12 @@ def create_app(pool) -> Starlette:
             how = want or _view(request)
             with _private_folder() as tmp:
                 try:
-                    options = json.loads(await _body(request, req.MAX_JSON_BYTES) or b"{}")
+                    options = req.parse_json(await _body(request, req.MAX_JSON_BYTES))
                 except TooLarge:
                     return _error(413, f"{prog}: error: the request is larger than "
                                        f"{req.MAX_JSON_BYTES // (1024 * 1024)} MiB")
-                except ValueError as exc:
-                    return _error(400, f"{prog}: error: the request's body is not JSON: {exc}")
+                except DesignError as exc:
+                    return _error(400, f"{prog}: error: {exc}")
                 try:
                     argv = req.build_argv(options, tmp, traits[prog])
                 except DesignError as exc:
@@ -216,7 +226,12 @@ def create_app(pool) -> Starlette:
                Route("/api/analyze-pid", designing("analyze-pid"), methods=["POST"]),
                Route("/api/identify", identify, methods=["POST"]),
                Route("/api/check", check, methods=["POST"])]
-    return Starlette(routes=routes, lifespan=lifespan)
+    async def client_left(request, exc):
+        # the client went away in the middle of its body: nobody reads an answer, and it is no error of ours
+        return Response(status_code=400)
+
+    app = Starlette(routes=routes, lifespan=lifespan, exception_handlers={ClientDisconnect: client_left})
+    return Guard(app, trust)
 
 
 def _choices() -> dict:
@@ -235,11 +250,7 @@ def _view(request) -> str:
 
 def _error(code: int, line: str) -> JSONResponse:
     """An error answer: the command's one line, its message, and the option it names (for the page)."""
-    line = " ".join(str(line).split())
-    message = re.sub(r"^[a-z-]+: error: ", "", line)
-    found = re.search(r"--[a-z][a-z0-9-]*", message)
-    return JSONResponse({"error": line, "message": message, "option": found.group(0) if found else None},
-                        status_code=code)
+    return error_response(code, line)
 
 
 def _hide(text: str, tmp: str, upload_name: str | None) -> str:
@@ -312,7 +323,7 @@ async def _multipart(request: Request, tmp: str, limit: int) -> tuple:
 
     def on_field(field):
         key = field.field_name.decode("utf-8", "replace")
-        fields[key] = (field.value or b"").decode("utf-8", "replace")
+        _gather(fields, key, (field.value or b"").decode("utf-8", "replace"))
 
     def on_file(f):
         files.setdefault(f.field_name.decode("utf-8", "replace"), []).append(f)
@@ -333,6 +344,17 @@ async def _multipart(request: Request, tmp: str, limit: int) -> tuple:
     except Exception as exc:   # python-multipart's own errors (a malformed form): the client's mistake
         raise DesignError(f"the multipart form cannot be read: {exc}") from None
     return files, fields
+
+
+def _gather(options: dict, key: str, value: str) -> None:
+    """A query's or form's field into ``options``: a name given twice or more is a list of its values, as an
+    option that takes several (``?window=0&window=2m``) or repeats wants them."""
+    if key not in options:
+        options[key] = value
+    elif isinstance(options[key], list):
+        options[key].append(value)
+    else:
+        options[key] = [options[key], value]
 
 
 def _save(f, path: str) -> None:
@@ -360,7 +382,10 @@ async def _upload(request: Request, tmp: str, limit: int, field: str) -> tuple:
     else:
         name = _plain(request.query_params.get("filename"), "capture.csv")
         path = os.path.join(tmp, "upload-" + name)
-        options = {k: v for k, v in request.query_params.items() if k not in ("view", "filename")}
+        options = {}
+        for k, v in request.query_params.multi_items():
+            if k not in ("view", "filename"):
+                _gather(options, k, v)
         await _stream_to(request, path, limit)
     if os.path.getsize(path) == 0:
         raise DesignError("the capture is empty: send the file as the request's body or as a form's file")
@@ -380,7 +405,8 @@ async def _check_inputs(request: Request, tmp: str, limit: int) -> tuple:
         spec = files.pop("spec", None)
         if not spec:
             raise DesignError("the form has no spec: send the spec file as the field 'spec'")
-        written["spec"] = os.path.join(inside, _plain(spec[0].file_name and spec[0].file_name.decode(), "spec.yaml"))
+        written["spec"] = os.path.join(inside, _plain(spec[0].file_name and
+                                                      spec[0].file_name.decode("utf-8", "replace"), "spec.yaml"))
         _save(spec[0], written["spec"])
         for parts in files.values():
             for f in parts:
@@ -394,16 +420,18 @@ async def _check_inputs(request: Request, tmp: str, limit: int) -> tuple:
         if spec_text is not None:
             raise DesignError("send the spec as a file, not a text field")
         return written, options
-    try:
-        body = json.loads(await _body(request, limit) or b"{}")
-    except ValueError as exc:
-        raise DesignError(f"the request's body is not JSON: {exc}") from None
+    body = req.parse_json(await _body(request, limit))
+    form = 'the body must be {"spec": "<the spec file\'s text>", "files": {"deck.cir": "..."}, "options": {...}}'
     if not isinstance(body, dict) or not isinstance(body.get("spec"), str):
-        raise DesignError('the body must be {"spec": "<the spec file\'s text>", "files": {"deck.cir": "..."}}')
+        raise DesignError(form)
+    files = body.get("files") or {}
+    if not isinstance(files, dict) or not isinstance(body.get("options") or {}, dict) \
+            or not isinstance(body.get("spec_name", ""), (str, type(None))):
+        raise DesignError(form)
     name = _plain(body.get("spec_name"), "spec.yaml")
     written["spec"] = os.path.join(inside, name)
     Path(written["spec"]).write_text(body["spec"], encoding="utf-8")
-    for fname, text in (body.get("files") or {}).items():
+    for fname, text in files.items():
         plain = _plain(fname, "")
         if not plain or not isinstance(text, str):
             raise DesignError(f"file {str(fname)[:60]!r}: a plain name and its text")

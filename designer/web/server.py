@@ -27,9 +27,14 @@ EPILOG = """examples:
   designer-web                          http://127.0.0.1:8000/ on this machine only
   designer-web --port 8080 --jobs 2     another port; two designs at once (one per core)
   designer-web --host 0.0.0.0           the lab's network too: anyone who reaches it can run designs here
+  designer-web --host 0.0.0.0 --allow-origin http://lab-pc.example.edu:8000
+                                        ... and its page opened by the lab's own name for this machine
 
 Pages: /plant, /pid, /identify, /check. API: POST /api/plant, /api/pid, /api/identify, /api/check with
-the commands' options by name (see the README). Stop it with Ctrl-C."""
+the commands' options by name (see the README); the JSON ones take Content-Type: application/json. A request
+is answered only when its Host is this server's address (on 127.0.0.1 also localhost) or a name given with
+--allow-origin, and its Origin, when a browser sends one, is this server's page: no other site's page can use
+it. Stop it with Ctrl-C."""
 
 
 def _parser():
@@ -46,6 +51,11 @@ def _parser():
                                                     "1 to 3600 (default 120)")
     p.add_argument("--recycle", default="200", help="requests a worker serves before a fresh one replaces it "
                                                     "(its memory stays bounded), 1 to 1000000 (default 200)")
+    p.add_argument("--allow-origin", action="append", default=[], metavar="URL",
+                   help="a page origin to answer besides this server's own address, e.g. http://lab-pc:8000 or "
+                        "https://lab.example.edu behind a proxy: its name is then accepted as Host too "
+                        "(repeatable; for --host 0.0.0.0, which otherwise accepts this machine's own names and "
+                        "addresses only)")
     return p
 
 
@@ -83,10 +93,12 @@ def _serve(args) -> int:
     import tempfile
 
     from ..core import lifetime
+    from .guard import origin_of
     port = _whole(args.port, "--port", 0, 65535)
     jobs = _whole(args.jobs, "--jobs", 1, 16)
     timeout = _whole(args.timeout, "--timeout", 1, 3600)
     recycle = _whole(args.recycle, "--recycle", 1, 1000000)
+    allowed = [origin_of(u) for u in args.allow_origin]   # checked before anything starts
     lifetime.install("designer-web")   # a stop before uvicorn takes the signals over: one line, 128 + signal
     # what earlier servers and commands that were killed left, then this server's own folder: every
     # temporary file of a request or a run is made in it (TMPDIR, inherited by the pool and ngspice)
@@ -94,18 +106,19 @@ def _serve(args) -> int:
     root = tempfile.mkdtemp(prefix=lifetime.owned_prefix("web"))
     tempfile.tempdir = os.environ["TMPDIR"] = root
     try:
-        return _serve_in(args, port, jobs, timeout, recycle)
+        return _serve_in(args, port, jobs, timeout, recycle, allowed)
     finally:
         shutil.rmtree(root, ignore_errors=True)
 
 
-def _serve_in(args, port: int, jobs: int, timeout: int, recycle: int) -> int:
+def _serve_in(args, port: int, jobs: int, timeout: int, recycle: int, allowed: list) -> int:
     import socket
 
     import uvicorn
 
     from .app import create_app
     from .connections import STOP_GRACE_S, GuardedH11, StoppingServer, quiet_disconnects
+    from .guard import trust_for
     from .pool import Pool
     family = socket.AF_INET6 if ":" in args.host else socket.AF_INET
     sock = socket.socket(family, socket.SOCK_STREAM)
@@ -128,8 +141,12 @@ def _serve_in(args, port: int, jobs: int, timeout: int, recycle: int) -> int:
     warning = exposure_warning(args.host, port)
     if warning:
         print(warning, flush=True)
-    config = uvicorn.Config(quiet_disconnects(create_app(pool)), log_level="warning", lifespan="on", http=GuardedH11,
-                            timeout_graceful_shutdown=STOP_GRACE_S)
+    also = " (and localhost)" if is_local(host) else \
+        " (and this machine's other names and addresses)" if ipaddress.ip_address(host).is_unspecified else ""
+    print(f"designer-web: answering pages at {', '.join([f'http://{shown}:{port}{also}'] + allowed)}; "
+          "requests from any other site's pages are refused", flush=True)
+    config = uvicorn.Config(quiet_disconnects(create_app(pool, trust_for(host, port, allowed))), log_level="warning",
+                            lifespan="on", http=GuardedH11, timeout_graceful_shutdown=STOP_GRACE_S)
     server = StoppingServer(config, pool)
     try:
         server.run(sockets=[sock])

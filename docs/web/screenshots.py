@@ -25,7 +25,7 @@ checks:
 
 
 def wait_answer(pg, before=0, timeout=120000):
-    pg.wait_for_function(f"+(document.body.dataset.answers || 0) > {before}", timeout=timeout)
+    pg.wait_for_function("n => +(document.body.dataset.answers || 0) > n", arg=before, timeout=timeout)
 
 
 def main() -> int:

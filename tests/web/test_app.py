@@ -132,14 +132,14 @@ def test_not_json_is_a_400_not_a_500(server):
     assert status == 400 and "not JSON" in got["error"]
 
 
-def declared(server, path: str, length: int) -> tuple:
+def declared(server, path: str, length: int, ctype: str = "text/csv") -> tuple:
     """A request whose headers declare ``length`` bytes, of which a few are sent: (status, JSON answer).
     (A client sending the whole body would see the server close the connection under it.)"""
     import socket
     import urllib.parse
     u = urllib.parse.urlsplit(server.url)
     with socket.create_connection((u.hostname, u.port), timeout=60) as sock:
-        sock.sendall(f"POST {path} HTTP/1.1\r\nHost: {u.netloc}\r\nContent-Type: text/csv\r\n"
+        sock.sendall(f"POST {path} HTTP/1.1\r\nHost: {u.netloc}\r\nContent-Type: {ctype}\r\n"
                      f"Content-Length: {length}\r\nConnection: close\r\n\r\n".encode() + b"t,y\n" * 10)
         raw = b""
         while chunk := sock.recv(65536):
@@ -155,7 +155,7 @@ def test_uploads_over_the_clis_limits_are_413(server):
     assert status == 413 and "256 MiB" in got["error"]
     status, got = declared(server, "/api/check", 40 * 1024 * 1024)
     assert status == 413 and "check-design" in got["error"]
-    status, got = declared(server, "/api/plant", 40 * 1024 * 1024)
+    status, got = declared(server, "/api/plant", 40 * 1024 * 1024, "application/json")
     assert status == 413
     # a frequency table over identify-freq's 16 MiB: the command's own refusal, as a 413
     table = b"f_hz,gain_db\n" + b"1000,0\n" * (17 * 1024 * 1024 // 7)
@@ -305,3 +305,305 @@ def test_a_real_tbs1022_capture_gives_a_first_order_model(server):
     status, got = server.post_json("/api/identify?filename=TEK0001.CSV&step-amplitude=1.72", raw)
     assert status == 200
     assert got["capture"]["format"] == "tektronix-tds" and got["best"]["model"] == "fopdt"
+
+
+# --------------------------------------------------------------------------- the trust boundary (issue 25)
+
+#: every endpoint that runs a command, with a body it would answer
+RUNNING = [("/api/plant", {"fc": 1000, "zeta": 0.5, "no-sim": True}),
+           ("/api/plant/sheet", {"fc": 1000, "zeta": 0.5, "no-sim": True}),
+           ("/api/plant/bundle", {"fc": 1000, "zeta": 0.5, "no-sim": True}),
+           ("/api/analyze-plant", {"r1": 820, "r2": "1k", "c1": "10n", "c2": "220n", "no-sim": True}),
+           ("/api/pid", {"plant-fc": 3500, "plant-zeta": 0.2, "no-sim": True}),
+           ("/api/pid/sheet", {"plant-fc": 3500, "plant-zeta": 0.2, "no-sim": True}),
+           ("/api/pid/bundle", {"plant-fc": 3500, "plant-zeta": 0.2, "no-sim": True}),
+           ("/api/analyze-pid", {"plant-fc": 3500, "plant-zeta": 0.2, "kp": 2, "ti": "1m", "td": "10u",
+                                 "no-sim": True}),
+           ("/api/identify", CAPTURE.read_bytes()),
+           ("/api/check", {"spec": "name: x\nkind: plant\ntarget: {fc: 1k, zeta: 0.5}\nchecks:\n  fn_hz: {max: 2k}\n"})]
+
+SECURITY = {"x-frame-options": "DENY", "x-content-type-options": "nosniff", "referrer-policy": "no-referrer"}
+
+
+def netloc(server) -> str:
+    return server.url.split("://")[1]
+
+
+def assert_refused(status, headers, raw, code, words):
+    got = json.loads(raw)
+    assert status == code and words in got["error"] and "\n" not in got["error"], (status, got)
+    h = {k.lower(): v for k, v in headers.items()}
+    assert "frame-ancestors 'none'" in h["content-security-policy"]
+    assert all(h[k] == v for k, v in SECURITY.items())
+
+
+@pytest.mark.parametrize("path, body", RUNNING)
+@pytest.mark.parametrize("headers, code, words", [
+    ({"Origin": "http://evil.example"}, 403, "Origin 'http://evil.example' is not this server's page"),
+    ({"Origin": "null"}, 403, "Origin 'null' is not this server's page"),
+    ({"Host": "evil.example"}, 403, "Host 'evil.example' is not this server's name"),
+    # DNS rebinding: a page at evil.example:PORT re-pointed at 127.0.0.1 sends its own name as Host and Origin
+    ({"Host": "evil.example:{port}", "Origin": "http://evil.example:{port}"}, 403, "is not this server's name"),
+    ({"Host": "localhost.evil.example:{port}"}, 403, "is not this server's name"),
+    # a CORS "simple request": no preflight, so a foreign page could send it were it answered
+    ({"Content-Type": "text/plain", "X-Designer": None}, 415, "Content-Type"),
+    ({"Content-Type": "application/x-www-form-urlencoded", "X-Designer": None}, 415, "Content-Type"),
+])
+def test_no_other_page_or_name_can_drive_the_server(server, path, body, headers, code, words):
+    """Issue 25, item 1: a POST from Origin evil.example or null, with Host evil.example, or as a text/plain
+    simple request, ran and answered 200 on every endpoint."""
+    port = netloc(server).rsplit(":", 1)[1]
+    headers = {k: v.format(port=port) if isinstance(v, str) else v for k, v in headers.items()}
+    status, got_headers, raw = server.post(path, body, headers=headers)
+    assert_refused(status, got_headers, raw, code, words)
+
+
+@pytest.mark.parametrize("host", ["127.0.0.1", "localhost", "LocalHost", "[::1]"])
+def test_the_servers_own_names_and_page_are_answered(server, host):
+    own = f"{host}:{netloc(server).rsplit(':', 1)[1]}"
+    status, headers, raw = server.post("/api/plant", {"fc": 1000, "zeta": 0.5, "no-sim": True},
+                                       headers={"Host": own, "Origin": f"http://{own}"})
+    assert status == 200, raw
+    assert json.loads(raw)["spec"]["fc_hz"] == 1000
+
+
+@pytest.mark.parametrize("path", ["/api/identify", "/api/check"])
+def test_an_upload_by_form_needs_the_pages_header(server, path):
+    """A cross-site <form enctype=multipart/form-data> sends no custom header: it is refused; the page's
+    X-Designer lets the same form through."""
+    if path == "/api/identify":
+        body, headers = multipart({}, {"capture": ("scope.csv", CAPTURE.read_bytes())})
+    else:
+        deck = (ROOT / "specs" / "decks" / "rc_ladder.cir").read_bytes()
+        spec = b"name: l3\nkind: netlist\ndeck: rc_ladder.cir\nchecks:\n  v_final: {min: 0.99, max: 1.01}\n"
+        body, headers = multipart({}, {"spec": ("l3.yaml", spec), "deck": ("rc_ladder.cir", deck)})
+    status, got_headers, raw = server.post(path, body, headers={**headers, "X-Designer": None})
+    assert_refused(status, got_headers, raw, 415, "X-Designer: 1")
+    status, _, raw = server.post(path, body, headers=headers)
+    assert status == 200, raw
+
+
+def test_a_query_gives_an_option_of_several_values_by_repeating_its_name(server):
+    want = cli_json("identify", str(CAPTURE), "--window", "-0.1m", "1.5m", "--json")
+    status, _, raw = server.post("/api/identify?window=-0.1m&window=1.5m", CAPTURE.read_bytes())
+    assert status == 200, raw
+    got = json.loads(raw)
+    assert got["best"]["params"] == want["best"]["params"]
+    assert got["best"]["params"] != cli_json("identify", str(CAPTURE), "--json")["best"]["params"]   # it took effect
+
+
+def test_a_capture_as_the_body_with_its_own_type_needs_no_header(server):
+    """text/csv or octet-stream are not types a foreign page can send unasked: a script's curl works as before."""
+    for ctype in ("text/csv", "application/octet-stream"):
+        status, _, raw = server.post("/api/identify", CAPTURE.read_bytes(),
+                                     headers={"Content-Type": ctype, "X-Designer": None})
+        assert status == 200, raw
+
+
+@pytest.mark.parametrize("path", ["/", "/plant", "/check", "/static/common.js", "/static/style.css",
+                                  "/static/vendor/uplot/uPlot.iife.min.js", "/static/nothere.js", "/api/health",
+                                  "/api/choices", "/favicon.ico", "/api/plant"])
+def test_every_answer_has_the_security_headers(server, path):
+    import urllib.error
+    import urllib.request
+    try:
+        with urllib.request.urlopen(server.url + path, timeout=60) as r:
+            headers = {k.lower(): v for k, v in r.headers.items()}
+    except urllib.error.HTTPError as e:   # the 404 and the 405 (a GET of a POST endpoint) too
+        with e:
+            headers = {k.lower(): v for k, v in e.headers.items()}
+    csp = headers["content-security-policy"]
+    assert "default-src 'self'" in csp and "frame-ancestors 'none'" in csp and "script-src 'self'" in csp
+    assert "http" not in csp and "*" not in csp   # no outside source
+    assert all(headers[k] == v for k, v in SECURITY.items())
+
+
+def test_a_request_never_chooses_processes_or_addresses(server):
+    """Issue 25, item 2: "dask": "tcp://HOST:PORT" made the worker connect there (a port scanner for any page).
+    A listening socket on this machine sees no connection."""
+    import socket
+    with socket.create_server(("127.0.0.1", 0)) as listener:
+        listener.settimeout(1.0)
+        address = f"tcp://127.0.0.1:{listener.getsockname()[1]}"
+        for path, body in [("/api/plant", {"fc": 1000, "zeta": 0.5, "monte-carlo": 100, "dask": address}),
+                           ("/api/pid", {"plant-fc": 3500, "plant-zeta": 0.2, "monte-carlo": 100, "dask": "local"}),
+                           ("/api/plant", {"fc": 1000, "zeta": 0.5, "monte-carlo": 100, "dask_": address}),
+                           ("/api/plant", {"fc": 1000, "zeta": 0.5, "monte-carlo": 100, "jobs": 64}),
+                           ("/api/check", {"spec": "x", "options": {"dask": address}}),
+                           ("/api/check", {"spec": "x", "options": {"timeout": 3600}}),
+                           ("/api/check", {"spec": "x", "options": {"jobs": 2}})]:
+            status, got = server.post_json(path, body)
+            assert status == 400 and "\n" not in got["error"], got
+            assert "the server's own setting" in got["error"] or "unrecognized arguments" in got["error"], got
+        with pytest.raises(socket.timeout):
+            listener.accept()
+
+
+@pytest.mark.parametrize("body, words", [
+    ({"tol": ["R=1%", "--jobs=3"]}, "--tol '--jobs=3': a value of an option that takes several"),
+    ({"tol": ["R=1%", "--help"]}, "--tol '--help'"),
+    ({"tol": ["R=1%", "-h"]}, "--tol '-h'"),
+    ({"limit": ["--help"]}, "--limit"),
+    ({"zeta": "--help"}, "--zeta: '--help' is not a number"),
+    ({"zeta": "--version"}, "--zeta: '--version' is not a number"),
+    ({"opamp": "--help"}, "unknown op-amp '--help'"),
+    ({"name": "--help"}, None),   # a plain name, the design's: a value, answered
+    ({"tol": "--help"}, "--tol"),
+])
+def test_a_value_never_becomes_an_option_and_no_worker_exits(server, body, words):
+    """Issue 25, item 3: ["R=1%", "--jobs=3"] ran the refused --jobs (64 forked processes a request) and
+    ["R=1%", "--help"] killed a worker (502 "simulator crashed")."""
+    status, got = server.post_json("/api/plant", {"fc": 1000, "zeta": 0.5, "no-sim": True, "monte-carlo": 20,
+                                                  **body})
+    if words is None:
+        assert status == 200 and "--name=--help" in got["tool"]["argv"], got
+    else:
+        assert status == 400 and words in got["error"] and "\n" not in got["error"], got
+    status, got = server.post_json("/api/plant", {"fc": 1000, "zeta": 0.5, "no-sim": True})
+    assert status == 200   # the worker is alive
+
+
+#: malformed requests (issue 25, item 4, and their neighbours): path, body bytes, headers, words of the one line
+MALFORMED = [
+    ("/api/plant", b"[" * 100000 + b"]" * 100000, {}, "nested too deeply"),
+    ("/api/check", b'{"spec": ' + b"[" * 5000 + b"]" * 5000 + b"}", {}, "nested too deeply"),
+    ("/api/check", b'{"spec": "name: x", "files": ["d.cir"]}', {}, "the body must be"),
+    ("/api/check", b'{"spec": "name: x", "files": {"d.cir": 3}}', {}, "a plain name and its text"),
+    ("/api/check", b'{"spec": "name: x", "files": {"d.cir": {"a": 1}}}', {}, "a plain name and its text"),
+    ("/api/check", b'{"spec": 3}', {}, "the body must be"),
+    ("/api/check", b'{"spec": "name: x", "options": [1]}', {}, "the body must be"),
+    ("/api/check", b'{"spec": "name: x", "spec_name": {"a": 1}}', {}, "the body must be"),
+    ("/api/check", b'{"spec": "name: x\\ud800"}', {}, "lone surrogate"),
+    ("/api/check", b'{"spec": "name: x", "files": {"d\\udc00.cir": "x"}}', {}, "lone surrogate"),
+    ("/api/plant", b'{"fc": "1k\\ud800", "zeta": 0.5}', {}, "lone surrogate"),
+    ("/api/pid", b'{"plant-model": {"best": "\\udfff"}}', {}, "lone surrogate"),
+    ("/api/plant", b'{"fc": "\xff\xfe", "zeta": 0.5}', {}, "not UTF-8"),
+    ("/api/plant", b"", {}, "the following arguments are required"),
+    ("/api/plant", b"[1, 2]", {}, "must be a JSON object"),
+    ("/api/plant", b"3", {}, "must be a JSON object"),
+    ("/api/plant", b'"fc"', {}, "must be a JSON object"),
+    ("/api/plant", b"null", {}, "must be a JSON object"),
+    ("/api/plant", b"{not json", {}, "not JSON"),
+    ("/api/plant", b'{"fc": 1e999, "zeta": 0.5}', {}, "finite number"),
+    ("/api/plant", b'{"fc": NaN, "zeta": 0.5}', {}, "finite number"),
+    ("/api/identify?window=%ff%fe&x=%00", CAPTURE.read_bytes(), {}, "error"),
+    ("/api/identify?window=1", CAPTURE.read_bytes(), {}, "--window takes 2 values, got 1"),
+    ("/api/identify?window=1&window=2&window=3", CAPTURE.read_bytes(), {}, "--window takes 2 values, got 3"),
+    ("/api/identify?step-time=1&step-time=2", CAPTURE.read_bytes(), {}, "--step-time takes one value, got 2"),
+    ("/api/identify?help=1", CAPTURE.read_bytes(), {}, "--help is set by the web page"),
+    ("/api/identify?methods=-h", CAPTURE.read_bytes(), {}, "error"),
+    ("/api/identify?%80=1", CAPTURE.read_bytes(), {}, "is not an option name"),
+    ("/api/check", b"junk", {"Content-Type": "multipart/form-data"}, "boundary"),
+    ("/api/check", b"junk", {"Content-Type": "multipart/form-data; boundary=zz"}, "cannot be read"),
+    ("/api/identify", b"--zz\r\nContent-Disposition: form-data; name=capture; filename=\"\xff.csv\"\r\n\r\nt,y\n",
+     {"Content-Type": "multipart/form-data; boundary=zz"}, "error"),
+    ("/api/check", b"--zz\r\nContent-Disposition: form-data; name=spec; filename=\"\xff\xfe.yaml\"\r\n\r\nname: x\r\n"
+     b"--zz--\r\n", {"Content-Type": "multipart/form-data; boundary=zz"}, "error"),
+]
+
+
+@pytest.mark.parametrize("path, body, headers, words", MALFORMED)
+def test_a_malformed_request_is_a_400_with_one_line_never_a_500(server, path, body, headers, words):
+    """Issue 25, item 4: deep JSON (RecursionError), "files" as a list, a lone surrogate in a spec were 500s.
+    (The session's server is checked for a traceback on its stderr when it stops.)"""
+    status, got = server.post_json(path, body, headers={"Content-Type": "application/json", **headers}
+                                   if path != "/api/identify" or headers else {})
+    assert status == 400 and words in got["error"] and "\n" not in got["error"], got
+
+
+def logged(err: str) -> list:
+    """What a server printed on stderr besides the line of its Ctrl-C stop."""
+    return [ln for ln in err.splitlines() if ln.strip() and ln != "designer-web: error: interrupted"]
+
+
+def test_a_client_that_leaves_mid_body_is_no_error():
+    """Issue 25, item 4: a client that left in the middle of its body logged a traceback."""
+    import socket
+    import time
+    s = Server("--jobs", "1")
+    try:
+        host, port = netloc(s).rsplit(":", 1)
+        for path, ctype in [("/api/plant", "application/json"), ("/api/check", "application/json"),
+                            ("/api/identify", "text/csv"), ("/api/check", "multipart/form-data; boundary=zz")]:
+            with socket.create_connection((host, int(port))) as sock:
+                sock.sendall(f"POST {path} HTTP/1.1\r\nHost: {host}:{port}\r\nContent-Type: {ctype}\r\n"
+                             "X-Designer: 1\r\nContent-Length: 100000\r\n\r\n".encode() + b'{"fc": 1\r\n--zz\r\n')
+                time.sleep(0.3)
+        time.sleep(0.5)
+        status, _ = s.post_json("/api/plant", {"fc": 1000, "zeta": 0.5, "no-sim": True})
+        assert status == 200
+    finally:
+        err = s.stop()
+    assert logged(err) == [], err
+
+
+def fuzz_requests():
+    """Random requests to every endpoint: bodies of random bytes, broken or deep JSON, JSON of any shape,
+    content types and query strings of any kind."""
+    paths = [p for p, _ in RUNNING] + ["/api/health", "/api/choices", "/", "/static/x"]
+    json_values = st.recursive(st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=12),
+                               lambda inner: st.lists(inner, max_size=3)
+                               | st.dictionaries(st.text(max_size=8), inner, max_size=3), max_leaves=10)
+    keys = st.sampled_from(["fc", "zeta", "tol", "limit", "window", "methods", "spec", "files", "options",
+                            "plant-model", "no-sim", "dask", "jobs", "help", "name", "x"])
+    bodies = st.one_of(
+        st.binary(max_size=200),
+        st.dictionaries(keys, json_values, max_size=4).map(lambda d: json.dumps(d).encode()),
+        json_values.map(lambda v: json.dumps(v).encode()),
+        st.integers(1, 3000).map(lambda n: b"[" * n + b"]" * n),
+        st.text(max_size=40).map(lambda t: ('{"spec": "' + t + '"}').encode("utf-8", "surrogatepass")),
+        st.binary(max_size=100).map(lambda b: b"--zz\r\nContent-Disposition: form-data; name=spec; "
+                                    b"filename=\"a.yaml\"\r\n\r\n" + b))
+    types = st.sampled_from(["application/json", "text/plain", "text/csv", "multipart/form-data",
+                             "multipart/form-data; boundary=zz", "application/json; charset=latin-1", None])
+    queries = st.lists(st.tuples(st.sampled_from(["view", "filename", "window", "fc", "--help", "%ff", "a b"]),
+                                 st.text(max_size=6)), max_size=3)
+    return st.tuples(st.sampled_from(paths), bodies, types, queries, st.booleans())
+
+
+def test_fuzz_every_endpoint_answers_below_500_and_logs_no_traceback():
+    """Issue 25, item 4: posted at random, every endpoint answers with a status below 500 and the server's
+    stderr stays empty (no traceback, no log line)."""
+    import urllib.parse
+    from hypothesis import HealthCheck
+    s = Server("--jobs", "1")
+    seen = []
+
+    @settings(max_examples=150, deadline=None, derandomize=True,
+              suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+    @given(fuzz_requests())
+    def one(request):
+        path, body, ctype, query, page_header = request
+        q = "?" + urllib.parse.urlencode(query) if query else ""
+        status, _, raw = s.post(path + q, body, headers={"Content-Type": ctype,
+                                                         "X-Designer": "1" if page_header else None})
+        seen.append(status)
+        assert status < 500, (path, q, body[:80], ctype, raw[:300])
+
+    try:
+        one()
+    finally:
+        err = s.stop()
+    assert logged(err) == [], err
+    assert len(set(seen)) >= 3   # answered, refused and refused otherwise: the fuzz reached past the guard
+
+
+def test_allow_origin_lets_a_labs_own_name_in_and_says_so():
+    """--allow-origin (repeatable): that page's Origin and its name as Host are answered; the start-up lines say
+    which pages are answered; a page at another name still is not."""
+    s = Server("--jobs", "1", "--allow-origin", "https://lab.example.edu", "--allow-origin", "http://lab-pc:8000")
+    try:
+        said = s.proc.stdout.readline()
+        assert said.startswith("designer-web: answering pages at http://127.0.0.1:") and "(and localhost)" in said
+        assert "https://lab.example.edu, http://lab-pc:8000;" in said
+        body = {"fc": 1000, "zeta": 0.5, "no-sim": True}
+        for host, origin in [("lab.example.edu", "https://lab.example.edu"), ("lab-pc:8000", "http://lab-pc:8000")]:
+            status, _, raw = s.post("/api/plant", body, headers={"Host": host, "Origin": origin})
+            assert status == 200, raw
+        for host, origin in [("lab.example.edu", "http://lab.example.edu"), ("evil.example", "https://lab.example.edu"),
+                             ("lab.example.edu", "https://evil.example")]:
+            status, _, raw = s.post("/api/plant", body, headers={"Host": host, "Origin": origin})
+            assert status == 403, raw
+    finally:
+        err = s.stop()
+    assert logged(err) == [], err

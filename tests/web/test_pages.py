@@ -37,9 +37,12 @@ def page(browser):
     pg = context.new_page()
     errors = []
     pg.on("pageerror", lambda e: errors.append(str(e)))
+    # the server's Content-Security-Policy (no inline script, nothing from outside) blocks nothing the pages do
+    # (the context's console: the build sheet's tab too)
+    context.on("console", lambda m: errors.append(m.text) if "Content Security Policy" in m.text else None)
     yield pg
     context.close()
-    assert not errors, errors   # no script error on any page
+    assert not errors, errors   # no script error on any page, nothing refused by the CSP
 
 
 def answers(pg) -> int:
@@ -50,14 +53,14 @@ def after(pg, action, timeout=60000):
     """Do ``action`` and wait for the page's next answer (the form is debounced); returns its state."""
     before = answers(pg)
     action()
-    pg.wait_for_function(f"+(document.body.dataset.answers || 0) > {before}", timeout=timeout)
+    pg.wait_for_function("n => +(document.body.dataset.answers || 0) > n", arg=before, timeout=timeout)
     return pg.evaluate("document.body.dataset.state")
 
 
 def open_page(pg, server, path):
     pg.goto(server.url + path)
     if path in ("/plant", "/pid"):
-        pg.wait_for_function("+(document.body.dataset.answers || 0) > 0", timeout=60000)
+        pg.wait_for_function("() => +(document.body.dataset.answers || 0) > 0", timeout=60000)
 
 
 def figure(pg, label: str) -> str:
@@ -93,12 +96,34 @@ def test_a_pid_for_this_plant_takes_its_parts(page, server):
     open_page(page, server, "/plant")
     page.click("#topid")
     page.wait_for_url("**/pid?**")
-    page.wait_for_function("+(document.body.dataset.answers || 0) > 0", timeout=120000)
+    page.wait_for_function("() => +(document.body.dataset.answers || 0) > 0", timeout=120000)
     assert page.evaluate("document.body.dataset.state") == "done", page.inner_text(".form-foot")
     assert [page.input_value(f"input[name=plant-{k}]") for k in ("r1", "r2", "c1", "c2")] == \
         ["1.6k", "3.9k", "3.3n", "100n"]
     assert page.locator("#closed canvas").count() == 1
     assert "fn 3507.3 Hz, zeta 0.2" in page.inner_text("#title")   # the plant as built: 1k6 / 3k9 / 3n3 / 100n
+
+
+def test_enter_in_a_field_never_submits_the_form(page, server):
+    """The forms answer as they are typed; their submit is stopped by common.js now that the CSP forbids the
+    inline onsubmit they had (the page must not reload, losing what was typed)."""
+    open_page(page, server, "/plant")
+    page.evaluate("window.stillHere = true")
+    assert after(page, lambda: (page.fill("input[name=fc]", "2000"), page.press("input[name=fc]", "Enter"))) == "done"
+    assert page.evaluate("window.stillHere === true") and page.input_value("input[name=fc]") == "2000"
+
+
+def test_every_answer_carries_the_security_headers(page, server):
+    """What the browser gets: the pages, their scripts and styles, and the API (issue 25, item 1)."""
+    seen = {}
+    page.on("response", lambda r: seen.setdefault(r.url.split("?")[0].replace(server.url, ""), r.all_headers()))
+    open_page(page, server, "/plant")
+    for path in ("/plant", "/static/common.js", "/static/style.css", "/api/choices", "/api/plant"):
+        h = seen[path]
+        assert "default-src 'self'" in h["content-security-policy"], path
+        assert "frame-ancestors 'none'" in h["content-security-policy"], path
+        assert (h["x-frame-options"], h["x-content-type-options"], h["referrer-policy"]) == \
+            ("DENY", "nosniff", "no-referrer"), path
 
 
 def test_a_bad_zeta_is_one_inline_message_beside_its_field(page, server):
@@ -142,7 +167,7 @@ def test_identify_a_synthetic_tektronix_export_then_design_a_pid_for_its_model(p
     # on to a PID for this model: the closed loop is drawn with SPICE's trace
     page.click("#topid")
     page.wait_for_url("**/pid?plant=identify")
-    page.wait_for_function("+(document.body.dataset.answers || 0) > 0", timeout=120000)
+    page.wait_for_function("() => +(document.body.dataset.answers || 0) > 0", timeout=120000)
     assert page.evaluate("document.body.dataset.state") == "done", page.inner_text(".form-foot")
     assert page.locator("#closed canvas").count() == 1
     assert page.locator("#closed .u-legend", has_text="SPICE (ngspice)").count() == 1

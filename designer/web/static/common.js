@@ -13,11 +13,13 @@ D.loadChoices = async function () {
 // POST a JSON body (or a FormData, or a File as the body); resolves {ok, status, data, blob}. A call with a
 // ``channel`` aborts the one before it on that channel (the form typed on: the server drops it if queued),
 // and resolves {aborted: true} when it is itself aborted.
+// Every call says it is this page's (X-Designer): the server takes an upload's form or file only with it, which
+// a page of another site cannot send without asking the server first (a CORS preflight it never approves).
 const channels = {};
 D.api = async function (path, body, asBlob, channel) {
-  const init = {method: "POST"};
+  const init = {method: "POST", headers: {"X-Designer": "1"}};
   if (body instanceof FormData || body instanceof Blob) init.body = body;
-  else { init.body = JSON.stringify(body || {}); init.headers = {"Content-Type": "application/json"}; }
+  else { init.body = JSON.stringify(body || {}); init.headers["Content-Type"] = "application/json"; }
   if (channel) {
     if (channels[channel]) channels[channel].abort();
     channels[channel] = new AbortController();
@@ -36,6 +38,10 @@ D.api = async function (path, body, asBlob, channel) {
   try { data = await r.json(); } catch (e) { data = {error: `HTTP ${r.status}`, message: `HTTP ${r.status}`}; }
   return {ok: r.ok, status: r.status, data};
 };
+
+// A form answers as it is typed: Enter never submits it (the pages' Content-Security-Policy has no inline script,
+// so this is not an onsubmit attribute).
+document.addEventListener("submit", e => e.preventDefault());
 
 D.debounce = function (fn, ms) {
   let timer = null;
