@@ -258,11 +258,16 @@ def check_name(name) -> str:
 def check_output(args, name: str) -> None:
     """Before any work: the design name is a plain file name and, unless
     ``--no-files``, ``netlists/`` and ``reports/`` can be created under ``--out``
-    (a refusal after the work would waste it, and must write nothing)."""
+    and ``reports/<name>`` is no link or file (a refusal after the work would
+    waste it, and must write nothing)."""
     check_name(name)
     if not args.no_files:
-        from ..core.fileio import check_can_create
+        import os
+
+        from ..core.fileio import check_can_create, check_output_folder
         check_can_create(args.out, ("netlists", "reports"))
+        # the report folder is replaced whole: a link or a file of its name refused now, not after the work
+        check_output_folder(os.path.join(args.out, "reports", name), "report folder")
 
 
 #: a front end's hook (the web page, :mod:`designer.web.jobs`): called with each result :func:`emit` is given,

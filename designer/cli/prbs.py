@@ -168,13 +168,11 @@ def make_plan(args):
 
 
 def write_bundle(plan, out) -> list:
-    """The three files in folder ``out``, all or none (a staging folder renamed into place)."""
-    from pathlib import Path
+    """The three files in folder ``out``, all or none (a staging folder renamed into place); an
+    existing folder (or a link to one) keeps its other files, each of these replaced atomically."""
     from ..core import fileio
     from ..core.prbs import awg_csv, pwl_subcircuit, time_value_csv
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise DesignError(f"--out {fileio.shown(out)} is a file, not a folder")
+    out = fileio.check_output_folder(out, "--out", whole=False)
     texts = {"prbs_awg.csv": awg_csv(plan), "prbs.csv": time_value_csv(plan), "prbs.cir": pwl_subcircuit(plan)}
     if out.is_dir():
         for name, text in texts.items():   # an existing folder: each file replaced atomically
@@ -211,6 +209,9 @@ def plan_text(plan, model, files) -> str:
 
 
 def run(args) -> int:
+    if not args.no_files:   # before any work: a folder there, or a link to one, or nothing yet
+        from ..core.fileio import check_output_folder
+        check_output_folder(args.out, "--out", whole=False)
     plan, model = make_plan(args)
     files = [] if args.no_files else write_bundle(plan, args.out)
     if args.json:
