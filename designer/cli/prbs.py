@@ -129,6 +129,16 @@ def plant_model(args):
     return model
 
 
+def _time_constants(model) -> str:
+    """``, time constant 1 ps``, ``, time constants 1 ms to 5 ms``, or nothing, for a message."""
+    tc = sorted(model.time_constants_s)
+    if not tc:
+        return ""
+    if len(tc) == 1 or tc[0] == tc[-1]:
+        return f", time constant {format_eng(tc[0], 's')}"
+    return f", time constants {format_eng(tc[0], 's')} to {format_eng(tc[-1], 's')}"
+
+
 def bandwidth_hz(model) -> float:
     """The -3 dB bandwidth of a settling model: the highest frequency where its
     gain is still within 3 dB of its static gain (after any resonant peak)."""
@@ -154,7 +164,8 @@ def make_plan(args):
     if args.for_plant:
         model = plant_model(args)
         plan = plan_for_plant(model.settling_time_s, bandwidth_hz(model), amplitude=amplitude,
-                              offset=offset, periods=int(periods), dt_s=dt, bits=bits)
+                              offset=offset, periods=int(periods), dt_s=dt, bits=bits,
+                              plant=f"--for-plant: the plant {model.text()}{_time_constants(model)}")
     else:
         if args.plant_tf is not None or args.plant_model is not None:
             raise DesignError("--plant-tf and --plant-model go with --for-plant")
