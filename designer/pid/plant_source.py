@@ -47,9 +47,9 @@ from ..plant.sallenkey import SallenKeyParts, check_parts
 
 #: what ``--plant-model`` reads, for messages
 ACCEPTED = ("an identify or identify-freq --json output, or a design-plant/analyze-plant result.json")
-#: the ``format`` of what ``identify`` prints for a broadband capture and for a frequency table (a step
-#: capture's has none): identify's own layouts, the ranking laid out as identify-freq's or not at all
-IDENTIFY_FORMATS = ("broadband", "frequency-table")
+#: the ``format`` of what ``identify`` prints for a broadband capture (a PRBS or noise input): its ranking
+#: laid out as identify's or identify-freq's (``--method``), or none at all when nothing fitted
+IDENTIFY_FORMATS = ("broadband",)
 #: identification's models this module maps (stepfit's and identify-freq's names)
 IDENTIFIED_MODELS = ("fopdt", "double-pole", "overdamped", "underdamped")
 #: ``built`` keys of a plant result -> :class:`SallenKeyParts` fields
@@ -66,7 +66,7 @@ def result_kind(data) -> str | None:
     if data.get("format") in IDENTIFY_FORMATS and "best" in data:
         return "identify"    # identify wrote it, whatever ranking it carries (or none, when nothing fitted)
     if isinstance(data.get("methods"), list) and ({"best", "preprocessing", "error_definition"} & set(data)):
-        freq = "error_definition" in data or "data" in data
+        freq = "error_definition" in data or "data" in data or data.get("format") == "frequency-table"
         return "identify-freq" if freq else "identify"
     if isinstance(data.get("built"), dict) and data.get("mode") in ("design", "analyze", None):
         return "plant"
