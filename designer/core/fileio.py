@@ -327,26 +327,36 @@ _KINDS = ((stat.S_ISLNK, "a symbolic link"), (stat.S_ISDIR, "a directory"), (sta
           (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
 
 
+def _kind(mode: int) -> str:
+    """What a file system entry is, for a message: ``a file``, ``a directory``, ``a FIFO (named pipe)``..."""
+    return "a file" if stat.S_ISREG(mode) else next((k for test, k in _KINDS if test(mode)), "not a regular file")
+
+
+def _output_stat(path, what: str) -> tuple:
+    """(``path`` as a Path, its ``os.lstat`` or None where nothing is), or one line: no name, not a
+    valid name (a NUL byte), or a system error; a parent that is a file is the caller's (None here)."""
+    path = Path(path)
+    if str(path) == "":
+        raise DesignError(f"no {what} given: the name is empty")
+    try:
+        return path, os.lstat(path)
+    except (FileNotFoundError, NotADirectoryError):   # nothing there; a parent that is a file: the caller's
+        return path, None
+    except OSError as exc:
+        raise os_error("write", path, exc) from None
+    except ValueError:   # a NUL byte in the name
+        raise DesignError(f"cannot write {what} {shown(path)}: not a valid file name") from None
+
+
 def check_output_file(path, what: str = "output file") -> Path:
     """Before any work: ``path`` may be written, through a temporary file and a
     rename, only over a regular file (or where nothing is); a symbolic link, a
     FIFO, a device, a socket or a directory there is refused in one line, as is
     a folder that cannot be created."""
-    path = Path(path)
-    if str(path) == "":
-        raise DesignError(f"no {what} given: the name is empty")
-    try:
-        st = os.lstat(path)
-    except (FileNotFoundError, NotADirectoryError):   # nothing there; a parent that is a file: below
-        st = None
-    except OSError as exc:
-        raise os_error("write", path, exc) from None
-    except ValueError:   # a NUL byte in the name
-        raise DesignError(f"cannot write {what} {shown(path)}: not a valid file name") from None
+    path, st = _output_stat(path, what)
     if st is not None and not stat.S_ISREG(st.st_mode):
-        kind = next((k for test, k in _KINDS if test(st.st_mode)), "not a regular file")
-        raise DesignError(f"cannot write {what} {shown(path)}: it is {kind}; give the name of a regular file "
-                          "(or of none yet), which is replaced whole")
+        raise DesignError(f"cannot write {what} {shown(path)}: it is {_kind(st.st_mode)}; give the name of a "
+                          "regular file (or of none yet), which is replaced whole")
     check_can_create(path.parent)
     return path
 
@@ -359,17 +369,7 @@ def check_output_folder(path, what: str = "output folder", whole: bool = True) -
     link to a directory is written through. A file, a FIFO or a device there is
     refused; so is a parent that cannot be created (:func:`check_can_create`).
     Each refusal is one line naming ``what``."""
-    path = Path(path)
-    if str(path) == "":
-        raise DesignError(f"no {what} given: the name is empty")
-    try:
-        st = os.lstat(path)
-    except (FileNotFoundError, NotADirectoryError):   # nothing there; a parent that is a file: below
-        st = None
-    except OSError as exc:
-        raise os_error("write", path, exc) from None
-    except ValueError:   # a NUL byte in the name
-        raise DesignError(f"cannot write {what} {shown(path)}: not a valid file name") from None
+    path, st = _output_stat(path, what)
     if st is not None and stat.S_ISLNK(st.st_mode):
         dest = shown(os.readlink(path))
         if not path.exists():
@@ -380,9 +380,7 @@ def check_output_folder(path, what: str = "output folder", whole: bool = True) -
                               + ("the folder is replaced whole: give a folder's name" if whole else
                                  "give a folder's name, or a link to a folder"))
     elif st is not None and not stat.S_ISDIR(st.st_mode):
-        kind = next((k for test, k in _KINDS if test(st.st_mode)), "a file")
-        raise DesignError(f"cannot write {what} {shown(path)}: it is {'a file' if stat.S_ISREG(st.st_mode) else kind}, "
-                          "not a folder")
+        raise DesignError(f"cannot write {what} {shown(path)}: it is {_kind(st.st_mode)}, not a folder")
     check_can_create(path.parent)
     return path
 
