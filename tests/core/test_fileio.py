@@ -253,3 +253,18 @@ def test_atomic_write_refused_creates_nothing(tmp_path, what):
     with pytest.raises(DesignError, match="not a valid file name"):   # checked before its folder is made
         atomic_write(tmp_path / "new" / "a\0b.csv", "data")
     assert not (tmp_path / "new").exists()
+
+
+@pytest.mark.parametrize("what", ["dangling link", "link to a folder"])
+def test_link_into_replaces_a_link_there_and_leaves_no_temporary(tmp_path, what):
+    """The netlist beside a bundle is our link: one already there (dangling, or to a folder) is replaced
+    atomically, what it pointed to untouched, no ``.name.PID.link.tmp`` left."""
+    from designer.core.fileio import link_into
+    (tmp_path / "real").mkdir()
+    (tmp_path / "bundle").mkdir()
+    (tmp_path / "bundle" / "x.cir").write_text("deck")
+    link = tmp_path / "x.cir"
+    link.symlink_to("nowhere" if what == "dangling link" else "real")
+    assert link_into(link, tmp_path / "bundle" / "x.cir")
+    assert os.readlink(link) == os.path.join("bundle", "x.cir") and link.read_text() == "deck"
+    assert _ours(tmp_path) == [] and (tmp_path / "real").is_dir()
