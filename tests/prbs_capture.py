@@ -48,3 +48,21 @@ def capture_csv(path, t, u, y, header="t,CH1,CH2"):
         for row in zip(t, u, y):
             fh.write(",".join(f"{v:.9g}" for v in row) + "\n")
     return path
+
+
+def noise_identify_json(folder, seed=2):
+    """identify's own ``--json`` of a PRBS capture (7 bits, 10 samples a bit, 2 periods, 0.1 ms apart)
+    whose output is white noise alone (``seed``): a broadband result that identified nothing, its best
+    none (seed 2). Returns the JSON file's path (``noise.json`` in ``folder``)."""
+    import subprocess
+
+    from helpers import script
+    u = np.repeat(np.tile(mls(7).astype(float), 2), 10)
+    y = np.random.default_rng(seed).standard_normal(u.size)
+    capture = folder / "noise.csv"
+    np.savetxt(capture, np.c_[np.arange(u.size) * 1e-4, u, y], delimiter=",", header="t,u,y", comments="")
+    out = subprocess.run([script("identify"), str(capture), "--json"], capture_output=True, text=True,
+                         check=True, cwd=folder).stdout
+    path = folder / "noise.json"
+    path.write_text(out)
+    return path

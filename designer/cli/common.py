@@ -40,6 +40,8 @@ FLAGS = {
     "plant_tf": "--plant-tf", "plant_model": "--plant-model", "plant_method": "--plant-method",
     "plant_capture": "--plant-capture", "plant_input": "--plant-input", "plant_output": "--plant-output",
     "simc_tauc_s": "--simc-tauc", "imc_lambda_s": "--imc-lambda", "min_phase_margin_deg": "--min-pm",
+    # the tuning rules' own names (designer.pid.rules.tune_model) for the same two settings
+    "tauc_s": "--simc-tauc", "lambda_s": "--imc-lambda",
     "min_gain_margin_db": "--min-gm", "max_ms": "--max-ms", "robust": "--robust",
     # analyze-pid: the controller as built (r3, r4 as above)
     **{f"r{i}": f"--r{i}" for i in range(5, 19)}, "c3": "--c3", "c4": "--c4", "controller_json": "--parts-json",
@@ -50,21 +52,83 @@ FLAGS = {
 }
 
 
+#: a library parameter's name inside a message's text (``give tauc_s``; a rule's reason quoted in
+#: another message): the names with an underscore, which are no English word; not part of a longer
+#: name, a dotted key, a ``{marker}``, an option or a ``key=value``
+_NAME_IN_TEXT = re.compile(r"(?<![\w.{-])(" + "|".join(sorted((re.escape(k) for k in FLAGS if "_" in k),
+                                                               key=len, reverse=True)) + r")(?![\w=])")
+
+
 def flag_message(exc: DesignError) -> str:
     """The error's message with the options the user typed for the parameters it
     names (:meth:`DesignError.naming`: every ``{name}`` marker of a
-    :class:`~designer.core.errors.ParamError`, else the parameter it starts with)."""
-    return exc.naming(FLAGS) if callable(getattr(exc, "naming", None)) else str(exc)
+    :class:`~designer.core.errors.ParamError`, else the parameter it starts with),
+    and for a library name anywhere in its text (``simc: ... give tauc_s``, said
+    by the tuning rules, reads ``give --simc-tauc``)."""
+    text = exc.naming(FLAGS) if callable(getattr(exc, "naming", None)) else str(exc)
+    return _NAME_IN_TEXT.sub(lambda m: FLAGS[m.group(1)], text)
+
+
+#: where the options given so far are noted during one parse (removed from the namespace after it)
+_GIVEN = "_designer_options_given"
+
+
+def _shown_value(values) -> str:
+    """An option's value(s) as typed, cut to a readable length, for a message."""
+    text = " ".join(map(str, values)) if isinstance(values, (list, tuple)) else str(values)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+class StoreOnce(argparse.Action):
+    """argparse's ``store`` for an option that takes one value (or a fixed number):
+    given twice, it is refused in one line naming both values, where argparse
+    would keep the last and drop the first without a word (``--fc 1k --fc 2k``)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        given = namespace.__dict__.setdefault(_GIVEN, {})
+        if self.dest in given:
+            flag = next((s for s in self.option_strings if s.startswith("--")), option_string or self.dest)
+            parser.error(f"{flag} given twice: {given[self.dest]} and {_shown_value(values)}; give it once")
+        given[self.dest] = _shown_value(values)
+        setattr(namespace, self.dest, values)
+
+
+class ExtendList(argparse.Action):
+    """argparse's ``store`` for an option that takes a list (``nargs="+"``): given
+    again, its values are added to the earlier ones (``--tol R=1% --tol C=5%`` is
+    ``--tol R=1% C=5%``), never dropped."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, list(getattr(namespace, self.dest, None) or []) + list(values))
+
+
+class _Store(argparse.Action):
+    """What ``action="store"`` (argparse's default) makes: :class:`ExtendList` for a list, else :class:`StoreOnce`."""
+
+    def __new__(cls, option_strings, dest, nargs=None, **kwargs):
+        kind = ExtendList if nargs in ("+", "*") and option_strings else StoreOnce
+        return kind(option_strings, dest, nargs=nargs, **kwargs)
 
 
 class OneLineParser(argparse.ArgumentParser):
-    """argparse, but a usage mistake is one line (and exit status 2), and option
+    """argparse, but a usage mistake is one line (and exit status 2), option
     values such as ``-1e-3`` or ``-2m`` are values, not unknown options (argparse
-    before Python 3.13 takes only ``-2`` and ``-.5`` for numbers)."""
+    before Python 3.13 takes only ``-2`` and ``-.5`` for numbers), and no option
+    given twice is silently dropped: a single-valued one is refused
+    (:class:`StoreOnce`), a list's values accumulate (:class:`ExtendList`);
+    ``append`` options (``--limit``) repeat as before."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = re.compile(r"^-\.?\d")
+        # argparse's own hook for the action classes; argument groups share this registry
+        self.register("action", None, _Store)
+        self.register("action", "store", _Store)
+
+    def parse_known_args(self, args=None, namespace=None):
+        namespace, extras = super().parse_known_args(args, namespace)
+        namespace.__dict__.pop(_GIVEN, None)
+        return namespace, extras
 
     def error(self, message):
         raise DesignError(f"{message} (see {self.prog} --help)")
@@ -194,11 +258,16 @@ def check_name(name) -> str:
 def check_output(args, name: str) -> None:
     """Before any work: the design name is a plain file name and, unless
     ``--no-files``, ``netlists/`` and ``reports/`` can be created under ``--out``
-    (a refusal after the work would waste it, and must write nothing)."""
+    and ``reports/<name>`` is no link or file (a refusal after the work would
+    waste it, and must write nothing)."""
     check_name(name)
     if not args.no_files:
-        from ..core.fileio import check_can_create
+        import os
+
+        from ..core.fileio import check_can_create, check_output_folder
         check_can_create(args.out, ("netlists", "reports"))
+        # the report folder is replaced whole: a link or a file of its name refused now, not after the work
+        check_output_folder(os.path.join(args.out, "reports", name), "report folder")
 
 
 #: a front end's hook (the web page, :mod:`designer.web.jobs`): called with each result :func:`emit` is given,

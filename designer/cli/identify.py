@@ -183,11 +183,12 @@ def _run(args, identify, text, plot) -> int:
 
 
 def check_sheet_folder(out) -> None:
-    """Refuse, before any work, an ``--out`` that is a file."""
+    """Refuse, before any work, an ``--out`` that is a file or a symbolic link (the folder is
+    replaced whole: :func:`designer.core.fileio.check_output_folder`)."""
     if str(out) == "":
         raise DesignError("--out needs a folder name, such as ident")
-    if Path(out).exists() and not Path(out).is_dir():
-        raise DesignError(f"--out {shown(out)} is a file, not a folder")
+    from ..core.fileio import check_output_folder
+    check_output_folder(out, "--out")
 
 
 def write_sheet(out, result, text, plot) -> None:

@@ -129,6 +129,16 @@ def plant_model(args):
     return model
 
 
+def _time_constants(model) -> str:
+    """``, time constant 1 ps``, ``, time constants 1 ms to 5 ms``, or nothing, for a message."""
+    tc = sorted(model.time_constants_s)
+    if not tc:
+        return ""
+    if len(tc) == 1 or tc[0] == tc[-1]:
+        return f", time constant {format_eng(tc[0], 's')}"
+    return f", time constants {format_eng(tc[0], 's')} to {format_eng(tc[-1], 's')}"
+
+
 def bandwidth_hz(model) -> float:
     """The -3 dB bandwidth of a settling model: the highest frequency where its
     gain is still within 3 dB of its static gain (after any resonant peak)."""
@@ -154,7 +164,8 @@ def make_plan(args):
     if args.for_plant:
         model = plant_model(args)
         plan = plan_for_plant(model.settling_time_s, bandwidth_hz(model), amplitude=amplitude,
-                              offset=offset, periods=int(periods), dt_s=dt, bits=bits)
+                              offset=offset, periods=int(periods), dt_s=dt, bits=bits,
+                              plant=f"--for-plant: the plant {model.text()}{_time_constants(model)}")
     else:
         if args.plant_tf is not None or args.plant_model is not None:
             raise DesignError("--plant-tf and --plant-model go with --for-plant")
@@ -168,13 +179,11 @@ def make_plan(args):
 
 
 def write_bundle(plan, out) -> list:
-    """The three files in folder ``out``, all or none (a staging folder renamed into place)."""
-    from pathlib import Path
+    """The three files in folder ``out``, all or none (a staging folder renamed into place); an
+    existing folder (or a link to one) keeps its other files, each of these replaced atomically."""
     from ..core import fileio
     from ..core.prbs import awg_csv, pwl_subcircuit, time_value_csv
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise DesignError(f"--out {fileio.shown(out)} is a file, not a folder")
+    out = fileio.check_output_folder(out, "--out", whole=False)
     texts = {"prbs_awg.csv": awg_csv(plan), "prbs.csv": time_value_csv(plan), "prbs.cir": pwl_subcircuit(plan)}
     if out.is_dir():
         for name, text in texts.items():   # an existing folder: each file replaced atomically
@@ -211,6 +220,9 @@ def plan_text(plan, model, files) -> str:
 
 
 def run(args) -> int:
+    if not args.no_files:   # before any work: a folder there, or a link to one, or nothing yet
+        from ..core.fileio import check_output_folder
+        check_output_folder(args.out, "--out", whole=False)
     plan, model = make_plan(args)
     files = [] if args.no_files else write_bundle(plan, args.out)
     if args.json:

@@ -26,7 +26,8 @@ Writing
   rename, over a regular file only (:func:`check_output_file`: a symbolic link,
   FIFO, device or directory named as an output is refused, before any work).
 - :func:`publish_folder`: a whole folder (a design's report bundle) written
-  elsewhere first, then swapped in with one atomic exchange of directories
+  elsewhere first (:func:`check_output_folder` before any work: never over a
+  symbolic link or a file), then swapped in with one atomic exchange of directories
   (Linux ``renameat2(RENAME_EXCHANGE)``; elsewhere two renames, rolled back on
   the next run if interrupted), so readers see the old bundle or the new one.
 - :func:`link_into`: a relative symbolic link put in place atomically; the
@@ -326,36 +327,70 @@ _KINDS = ((stat.S_ISLNK, "a symbolic link"), (stat.S_ISDIR, "a directory"), (sta
           (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
 
 
+def _kind(mode: int) -> str:
+    """What a file system entry is, for a message: ``a file``, ``a directory``, ``a FIFO (named pipe)``..."""
+    return "a file" if stat.S_ISREG(mode) else next((k for test, k in _KINDS if test(mode)), "not a regular file")
+
+
+def _output_stat(path, what: str) -> tuple:
+    """(``path`` as a Path, its ``os.lstat`` or None where nothing is), or one line: no name, not a
+    valid name (a NUL byte), or a system error; a parent that is a file is the caller's (None here)."""
+    path = Path(path)
+    if str(path) == "":
+        raise DesignError(f"no {what} given: the name is empty")
+    try:
+        return path, os.lstat(path)
+    except (FileNotFoundError, NotADirectoryError):   # nothing there; a parent that is a file: the caller's
+        return path, None
+    except OSError as exc:
+        raise os_error("write", path, exc) from None
+    except ValueError:   # a NUL byte in the name
+        raise DesignError(f"cannot write {what} {shown(path)}: not a valid file name") from None
+
+
 def check_output_file(path, what: str = "output file") -> Path:
     """Before any work: ``path`` may be written, through a temporary file and a
     rename, only over a regular file (or where nothing is); a symbolic link, a
     FIFO, a device, a socket or a directory there is refused in one line, as is
     a folder that cannot be created."""
-    path = Path(path)
-    if str(path) == "":
-        raise DesignError(f"no {what} given: the name is empty")
-    try:
-        st = os.lstat(path)
-    except (FileNotFoundError, NotADirectoryError):   # nothing there; a parent that is a file: below
-        st = None
-    except OSError as exc:
-        raise os_error("write", path, exc) from None
-    except ValueError:   # a NUL byte in the name
-        raise DesignError(f"cannot write {what} {shown(path)}: not a valid file name") from None
+    path, st = _output_stat(path, what)
     if st is not None and not stat.S_ISREG(st.st_mode):
-        kind = next((k for test, k in _KINDS if test(st.st_mode)), "not a regular file")
-        raise DesignError(f"cannot write {what} {shown(path)}: it is {kind}; give the name of a regular file "
-                          "(or of none yet), which is replaced whole")
+        raise DesignError(f"cannot write {what} {shown(path)}: it is {_kind(st.st_mode)}; give the name of a "
+                          "regular file (or of none yet), which is replaced whole")
+    check_can_create(path.parent)
+    return path
+
+
+def check_output_folder(path, what: str = "output folder", whole: bool = True) -> Path:
+    """Before any work: a folder may be written at ``path``: nothing there yet, or
+    a directory. A symbolic link is refused when the folder is replaced ``whole``
+    (:func:`publish_folder` would swap the link, not what it points to), and when
+    it points to nothing (dangling) or to no directory; with ``whole`` False a
+    link to a directory is written through. A file, a FIFO or a device there is
+    refused; so is a parent that cannot be created (:func:`check_can_create`).
+    Each refusal is one line naming ``what``."""
+    path, st = _output_stat(path, what)
+    if st is not None and stat.S_ISLNK(st.st_mode):
+        dest = shown(os.readlink(path))
+        if not path.exists():
+            raise DesignError(f"cannot write {what} {shown(path)}: it is a symbolic link to nothing ({dest}); "
+                              "remove it, or give a folder's name")
+        if whole or not path.is_dir():
+            raise DesignError(f"cannot write {what} {shown(path)}: it is a symbolic link (to {dest}); "
+                              + ("the folder is replaced whole: give a folder's name" if whole else
+                                 "give a folder's name, or a link to a folder"))
+    elif st is not None and not stat.S_ISDIR(st.st_mode):
+        raise DesignError(f"cannot write {what} {shown(path)}: it is {_kind(st.st_mode)}, not a folder")
     check_can_create(path.parent)
     return path
 
 
 def atomic_write(path, data, mode: str = "w") -> Path:
     """Write ``data`` (str or bytes) to ``path`` through a temporary file and rename,
-    over a regular file only (:func:`check_output_file`)."""
+    over a regular file only (:func:`check_output_file`, before any folder is made)."""
     path = Path(path)
-    ensure_dir(path.parent)
     check_output_file(path, "file")
+    ensure_dir(path.parent)
     binary = isinstance(data, (bytes, bytearray))
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp", dir=path.parent)
@@ -393,6 +428,11 @@ def publish_folder(staged, target) -> None:
     """Put the finished folder ``staged`` at ``target``, replacing what is there
     in one atomic step where the system allows it; the old content is deleted."""
     staged, target = Path(staged), Path(target)
+    if os.path.islink(target) or (os.path.lexists(target) and not os.path.isdir(target)):
+        # the exchange below would swap a link or a file with the folder, and leave it under the stage's name
+        remove_tree(staged)
+        check_output_folder(target, "folder")   # says what is there, in one line
+        raise DesignError(f"cannot write folder {shown(target)}: it is not a folder")
     try:
         if not os.path.lexists(target):
             os.rename(staged, target)
@@ -499,4 +539,9 @@ def _remove(path) -> None:
 
 
 def remove_tree(path) -> None:
+    """Remove a folder of ours and everything in it; a symbolic link or a file there is
+    unlinked (``rmtree`` refuses a link, and would leave it)."""
+    if os.path.islink(path) or (os.path.lexists(path) and not os.path.isdir(path)):
+        _remove(path)
+        return
     shutil.rmtree(path, ignore_errors=True)

@@ -64,13 +64,16 @@ def read_result(path, option: str, needs: dict | None = None,
     Raises
     ------
     DesignError
-        Unreadable file, not JSON, nested too deeply, not an object, or a
-        needed section or key missing.
+        Unreadable file, not JSON, a key twice in one object, nested too
+        deeply, not an object, or a needed section or key missing.
     """
     name = shown(path)
     text = read_text(path, f"{option} file", MAX_TABLE_BYTES)
     try:
-        data = json.loads(text)
+        data = json.loads(text, object_pairs_hook=_once_each)
+    except _KeyTwice as exc:
+        raise DesignError(f"{option}: {name} has the key {exc.key!r} twice in one object, so which one counts is "
+                          f"a guess; expected {what} as the command wrote it (each key once)") from None
     except json.JSONDecodeError as exc:
         raise DesignError(f"{option}: {name} is not JSON ({exc.msg} at line {exc.lineno}); "
                           f"expected {what}") from None
@@ -84,6 +87,25 @@ def read_result(path, option: str, needs: dict | None = None,
         raise DesignError(f"{option}: {name} is not {what}"
                           + (f" (needs {need})" if need else " (expected a JSON object)"))
     return data
+
+
+class _KeyTwice(Exception):
+    """A key given twice in one JSON object (:func:`_once_each`)."""
+
+    def __init__(self, key: str):
+        super().__init__(key)
+        self.key = key
+
+
+def _once_each(pairs) -> dict:
+    """``json.loads``'s ``object_pairs_hook``: the object, unless a key repeats (where
+    ``json`` keeps the last without a word, RFC 8259 section 4 leaves it to the reader)."""
+    out = {}
+    for key, value in pairs:
+        if key in out:
+            raise _KeyTwice(key)
+        out[key] = value
+    return out
 
 
 def _and(keys) -> str:

@@ -136,7 +136,7 @@ def bits_for(period_s: float, dt_s: float) -> int | None:
 
 
 def plan_for_plant(settling_s: float, bandwidth_hz: float, *, amplitude=1.0, offset=0.0,
-                   periods=3, dt_s=None, bits=None) -> PrbsPlan:
+                   periods=3, dt_s=None, bits=None, plant: str = "the plant") -> PrbsPlan:
     """Choose the clock and bits for a plant of 2 % settling time ``settling_s``
     and -3 dB bandwidth ``bandwidth_hz``.
 
@@ -144,7 +144,9 @@ def plan_for_plant(settling_s: float, bandwidth_hz: float, *, amplitude=1.0, off
     bandwidth) (the sequence's half-power band covers the plant to three times
     its bandwidth); the bits the fewest whose period lasts SETTLE_MARGIN times
     the settling time. ``dt_s`` or ``bits`` given are kept (a given ``bits``
-    too short for the plant is said so in ``reasons``).
+    too short for the plant is said so in ``reasons``). A clock chosen here
+    lies in the range a given one must (``RANGES["prbs_clock_hz"]``, 1 uHz to
+    1 GHz), else the plant (``plant``, its words in the message) is refused.
     """
     if not (math.isfinite(settling_s) and settling_s > 0 and math.isfinite(bandwidth_hz)
             and bandwidth_hz > 0):
@@ -153,6 +155,7 @@ def plan_for_plant(settling_s: float, bandwidth_hz: float, *, amplitude=1.0, off
     reasons = []
     if dt_s is None:
         dt_s = nice_interval(HALF_POWER / (BAND_FACTOR * bandwidth_hz))
+        _check_chosen_clock(1.0 / dt_s, bandwidth_hz, plant)
         reasons.append(f"clock {_hz(1 / dt_s)} (Dt = {_sec(dt_s)}): the sequence's half-power "
                        f"band, {_hz(HALF_POWER / dt_s)}, covers {BAND_FACTOR:g}x the plant's "
                        f"bandwidth of {_hz(bandwidth_hz)}")
@@ -182,6 +185,16 @@ def plan_for_plant(settling_s: float, bandwidth_hz: float, *, amplitude=1.0, off
                            "the impulse response will wrap around"
                            + (f"; {enough} bits would be enough" if enough else ""))
     return PrbsPlan(n, float(dt_s), float(amplitude), float(offset), int(periods), tuple(reasons))
+
+
+def _check_chosen_clock(clock_hz: float, bandwidth_hz: float, plant: str) -> None:
+    """The clock chosen for a plant, refused outside the range of a clock given by hand."""
+    from .ranges import RANGES
+    allowed = RANGES["prbs_clock_hz"]
+    if not allowed.contains(clock_hz):
+        raise DesignError(f"{plant}, -3 dB bandwidth {_hz(bandwidth_hz)}, would need a PRBS clock of "
+                          f"{_hz(clock_hz)} for a half-power band of {BAND_FACTOR:g}x its bandwidth; a clock is "
+                          f"{allowed.text()}: this plant is outside what a PRBS bench identifies")
 
 
 # --------------------------------------------------------------------------- writers

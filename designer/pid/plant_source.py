@@ -47,6 +47,9 @@ from ..plant.sallenkey import SallenKeyParts, check_parts
 
 #: what ``--plant-model`` reads, for messages
 ACCEPTED = ("an identify or identify-freq --json output, or a design-plant/analyze-plant result.json")
+#: the ``format`` of what ``identify`` prints for a broadband capture (a PRBS or noise input): its ranking
+#: laid out as identify's or identify-freq's (``--method``), or none at all when nothing fitted
+IDENTIFY_FORMATS = ("broadband",)
 #: identification's models this module maps (stepfit's and identify-freq's names)
 IDENTIFIED_MODELS = ("fopdt", "double-pole", "overdamped", "underdamped")
 #: ``built`` keys of a plant result -> :class:`SallenKeyParts` fields
@@ -60,6 +63,8 @@ def result_kind(data) -> str | None:
     ``"design-pid"``, or None (none of these)."""
     if not isinstance(data, dict):
         return None
+    if data.get("format") in IDENTIFY_FORMATS and "best" in data:
+        return "identify"    # identify wrote it, whatever ranking it carries (or none, when nothing fitted)
     if isinstance(data.get("methods"), list) and ({"best", "preprocessing", "error_definition"} & set(data)):
         freq = "error_definition" in data or "data" in data or data.get("format") == "frequency-table"
         return "identify-freq" if freq else "identify"
@@ -130,7 +135,7 @@ def model_from_result(data, method: str | None = None, *, name: str = "result") 
 def _entries(data: dict, where: str) -> list:
     """The methods, each checked to have the fields read here."""
     out = []
-    for i, m in enumerate(data["methods"]):
+    for i, m in enumerate(data.get("methods") or ()):   # none in a broadband result that found nothing
         if not (isinstance(m, dict) and isinstance(m.get("name"), str) and isinstance(m.get("model"), str)
                 and isinstance(m.get("params"), dict) and isinstance(m.get("valid"), bool)):
             raise DesignError(f"{where}: methods[{i}] is not a method result (it needs name, model, params "
@@ -155,8 +160,8 @@ def _chosen(methods: list, best, method, where: str, tool: str) -> dict:
     labels = _labels(methods)
     if method is None:
         if not isinstance(best, dict):
-            raise DesignError(f"{where}: {tool} found no valid model (its best is none or missing); "
-                              f"{_valid_text(methods, labels)}")
+            raise DesignError(f"{where}: this {tool} result has no valid model (best: none): nothing to design "
+                              f"for; {_valid_text(methods, labels)}")
         label = best.get("name", "?") if not isinstance(best.get("model"), str) else \
             f"{best.get('name', '?')}:{best['model']}"
         if best.get("valid") is not True:
@@ -183,9 +188,9 @@ def _chosen(methods: list, best, method, where: str, tool: str) -> dict:
     return valid[0]
 
 
-def _data_name(data: dict, tool: str, name: str) -> str:
+def _data_name(data: dict, name: str) -> str:
     """The capture or table the result was identified from (its file name), else ``name``."""
-    section = data.get("data" if tool == "identify-freq" else "capture")
+    section = data.get("capture", data.get("data"))
     src = section.get("source") if isinstance(section, dict) else None
     return os.path.basename(src) if isinstance(src, str) and src else os.path.basename(name) or name
 
@@ -200,7 +205,7 @@ def model_from_identify(data: dict, method: str | None = None, *, name: str = "r
         # a broadband estimate whose own assumption failed: say which, not just "none valid"
         raise DesignError(f"{where}: {tool} found no valid model: {data['refused']}")
     m = _chosen(methods, data.get("best"), method, where, tool)
-    source = f"{tool} {m.get('name', '?')} {m.get('model', '?')} ({_data_name(data, tool, name)})"
+    source = f"{tool} {m.get('name', '?')} {m.get('model', '?')} ({_data_name(data, name)})"
     try:
         return method_model(m, source)
     except DesignError as exc:

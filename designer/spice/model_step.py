@@ -24,8 +24,9 @@ zeta = 0.05, drifts to 0.08 % over its long record of many periods).
 Noise and quantisation, as a scope's two channels: Gaussian noise of standard
 deviation ``noise_v`` is added to the input and to the output, each its own
 draws (the input's first), from ``numpy.random.default_rng(seed)``; then
-each channel is rounded to a multiple of ``lsb_v`` (an ADC's step). The same
-seed gives the same samples.
+each channel is rounded to a multiple of ``lsb_v`` (an ADC's step), which
+must be at most a quarter of the step's swing on each channel (:data:`MIN_CODES`).
+The same seed gives the same samples.
 
 Example: seed 000's DC motor (course notes, UNaM: Km = W(inf)/a and
 tau_m = -t0 / ln(1 - w(t0)/W(inf)); a = 2 V, W(inf) = 2.5, w(0.15 s) = 1.75,
@@ -44,7 +45,7 @@ import numbers
 
 import numpy as np
 
-from ..core.errors import DesignError
+from ..core.errors import DesignError, ParamError
 from ..core.process import ProcessModel
 from ..core.units import format_eng
 from .behavioural import max_step_hint_s, plant_lines
@@ -63,6 +64,9 @@ EDGE_FRACTION = 1e-3
 MAX_VOLTS = 1e6
 #: the largest seed (numpy takes any non-negative integer; a command line needs a bound)
 MAX_SEED = 10**9
+#: the fewest quantisation steps (LSBs) the step must span on each channel, input and output: below,
+#: the record cannot show it (an LSB above the swing rounds a 1 V step to a record of zeros)
+MIN_CODES = 4
 
 
 def default_duration_s(model: ProcessModel) -> float:
@@ -145,6 +149,8 @@ def _checked(model, step_v, step_time_s, duration_s, points, noise_v, lsb_v, see
             raise DesignError(f"{name} must be 0 to {MAX_VOLTS:g} V, got {v:g}", param=name)
     if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, numbers.Integral) or not 0 <= seed <= MAX_SEED:
         raise DesignError(f"seed must be a whole number 0 to {MAX_SEED}, got {seed!r}", param="seed")
+    if lsb_v:
+        _check_codes(abs(step_v), float(lsb_v), "the input's step")
     steps = duration_s / max_step_s(model, duration_s, points)
     if steps > MAX_SIM_POINTS:
         hint = max_step_hint_s(model.num, model.den, model.theta_s)
@@ -152,6 +158,15 @@ def _checked(model, step_v, step_time_s, duration_s, points, noise_v, lsb_v, see
                           f"{_eng(hint, 's')} (the model's fastest pole), more than {MAX_SIM_POINTS:g}: give a "
                           f"record of at most {_eng(MAX_SIM_POINTS * hint, 's')}", param="duration_s")
     return step_v, step_time_s, duration_s, int(points)
+
+
+def _check_codes(swing: float, lsb_v: float, what: str) -> None:
+    """A channel's swing spans at least :data:`MIN_CODES` LSBs, else one line saying the largest LSB that does."""
+    if swing < MIN_CODES * lsb_v * (1 - 1e-3):   # (within the simulation's 0.1 % of the step)
+        raise ParamError(f"{{lsb_v}} {_eng(lsb_v, 'V')} is too coarse for {what} of {_eng(swing, 'V')}: the record "
+                         f"would show it in {swing / lsb_v:.3g} quantisation steps, and it needs at least "
+                         f"{MIN_CODES}; give {{lsb_v}} at most {_eng(swing / MIN_CODES, 'V')} (0: none), or a larger "
+                         "{step_v}", params=("lsb_v", "step_v"))
 
 
 def max_step_s(model: ProcessModel, duration_s: float, points: int) -> float:
@@ -236,7 +251,10 @@ def simulate_step(model: ProcessModel, step_v: float = 1.0, step_time_s: float |
     noise_v : float
         Standard deviation of Gaussian noise added to each channel, volts (0: none).
     lsb_v : float
-        Quantisation step of each channel, volts (0: none); applied after the noise.
+        Quantisation step of each channel, volts (0: none); applied after the
+        noise. The step must span at least :data:`MIN_CODES` of them on the
+        input (``step_v``) and on the output (its noiseless swing over the
+        record), else the record could not show it: refused.
     seed : int
         Seed of the ``numpy.random.default_rng`` the noise is drawn from
         (0 to :data:`MAX_SEED`).
@@ -276,6 +294,8 @@ def simulate_step(model: ProcessModel, step_v: float = 1.0, step_time_s: float |
     # placed within its tolerance, and interpolating them puts a sliver of the edge on the sample at t0)
     u = np.interp(t, [t0, t0 + EDGE_FRACTION * duration / (points - 1)], [0.0, step_v])
     y = np.interp(t, ts, res["y"])
+    if lsb_v > 0:   # the output's swing over the record, noiseless (the input's was checked before the run)
+        _check_codes(float(np.ptp(y)), lsb_v, "the output's swing")
     if noise_v > 0:
         rng = np.random.default_rng(seed)
         u = u + noise_v * rng.standard_normal(points)

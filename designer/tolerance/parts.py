@@ -61,14 +61,27 @@ class Tolerances:
         return {k: 100 * v for k, v in self.of.items()}
 
 
-def check_items(items, designators) -> None:
-    """``--tol`` items checked before any work: the shape, the value, a class or one of ``designators``."""
-    for item in items:
+def split_items(items) -> list:
+    """``--tol`` items as (KEY, value text) pairs, each key at most once: ``R=1%`` and
+    ``R=2%`` (or ``r=2%``) are refused in one line rather than the last one winning."""
+    out, seen = [], {}
+    for item in items or ():
         m = _ITEM.match(str(item))
         if not m:
             raise DesignError(f"--tol {item!r}: give CLASS=PCT or DESIGNATOR=PCT, such as R=1% or C2=2%")
-        key = m.group(1).upper()
-        parse_tolerance(m.group(2), f"--tol {key}")
+        key, value = m.group(1).upper(), m.group(2)
+        if key in seen:
+            raise DesignError(f"--tol {key} given twice: {seen[key]} and {value}; give each class or part once")
+        seen[key] = value
+        out.append((key, value))
+    return out
+
+
+def check_items(items, designators) -> None:
+    """``--tol`` items checked before any work: the shape, the value, a class or one of ``designators``,
+    each once (:func:`split_items`)."""
+    for key, value in split_items(items):
+        parse_tolerance(value, f"--tol {key}")
         if key not in ("R", "C") and key not in designators and key not in OPAMP_FIGURES:
             raise DesignError(f"--tol {key}: no such part; the parts are {', '.join(designators)} (or R, C for "
                               "every resistor, every capacitor)")
@@ -80,8 +93,8 @@ def resolve(items, parts: dict, series: dict) -> Tolerances:
     Parameters
     ----------
     items : sequence of str
-        ``R=1%`` (every resistor), ``C=5%`` (every capacitor), ``C2=2%`` (one part); later items and
-        designators win over classes.
+        ``R=1%`` (every resistor), ``C=5%`` (every capacitor), ``C2=2%`` (one part), each
+        once; a designator wins over its class.
     parts : dict
         Designator -> nominal value of every part that varies.
     series : dict
@@ -90,11 +103,7 @@ def resolve(items, parts: dict, series: dict) -> Tolerances:
     """
     from ..core.eseries import TOLERANCE
     classes, singles = {}, {}
-    for item in items or ():
-        m = _ITEM.match(str(item))
-        if not m:
-            raise DesignError(f"--tol {item!r}: give CLASS=PCT or DESIGNATOR=PCT, such as R=1% or C2=2%")
-        key, value = m.group(1).upper(), m.group(2)
+    for key, value in split_items(items):
         tol = parse_tolerance(value, f"--tol {key}")
         if key in ("R", "C"):
             classes[key] = tol

@@ -64,6 +64,10 @@ def test_a_pid_spec_names_the_loops_parts(tmp_path):
     ("yield: {min: 95%}\ntolerances: {C: lots}", 6, "is not a tolerance"),
     ("yield: {min: 95%}\ntolerances: {C: [1]}", 6, "got a list"),
     ("tolerances: {R: 1%}", 5, "give yield:"),
+    # a key twice is refused, not the last one kept (as --tol R=1% --tol R=2% is on the command line)
+    ("yield: {min: 95%}\ntolerances: {R: 1%, C: 5%, R: 2%}", 6, "duplicate key 'R' in tolerances (first at line 6)"),
+    ("yield: {min: 95%}\ntolerances:\n  C2: 1%\n  C2: 2%", 8, "duplicate key 'C2' in tolerances (first at line 7)"),
+    ("yield: {min: 95%}\ntolerances: {r: 1%}", 6, "unknown key 'r' in tolerances"),
 ])
 def test_a_bad_yield_or_tolerances_is_one_line_at_its_key(tmp_path, extra, line, words):
     msg = refusal(write(tmp_path, YIELD_BASE + extra + "\n"))

@@ -157,3 +157,36 @@ def test_help_states_every_range():
         assert RANGES[key].text() in text, key
     assert "0 or later" in text and "simulation steps" in text and "examples:" in text
     assert "K tau [theta] (FOPDT)" in text   # the model forms, as design-pid's
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("tf, step, lsb, what", [
+    ("K=1 tau=1m", "1", "10", "the input's step of 1 V"),       # the issue's case: a record of zeros
+    ("K=1 tau=1m", "1", "260m", "the input's step of 1 V"),     # 3.85 steps across it
+    ("K=0.1 tau=1m", "1", "50m", "the output's swing of"),      # the input shows it, the output 2 steps
+])
+def test_an_lsb_too_coarse_for_the_step_is_refused(tmp_path, tf, step, lsb, what):
+    """--lsb 10 on a 1 V step wrote a capture of zeros without a note: refused, one line saying the largest
+    LSB that shows the step, nothing written."""
+    from designer.spice.model_step import MIN_CODES
+    out = tmp_path / "c.csv"
+    proc = run("--plant-tf", tf, "--step", step, "--lsb", lsb, "--out", out)
+    assert proc.returncode == 2 and proc.stdout == ""
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert lines[0].startswith(f"simulate-capture: error: --lsb ") and what in lines[0], lines[0]
+    assert f"at least {MIN_CODES}" in lines[0] and "give --lsb at most" in lines[0] and "lsb_v" not in lines[0]
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.spice
+def test_an_lsb_of_a_quarter_of_the_step_is_taken_and_shows_it(tmp_path):
+    from designer.spice.model_step import MIN_CODES
+    out = tmp_path / "c.csv"
+    proc = run("--plant-tf", "K=1 tau=1m", "--step", "1", "--lsb", repr(1 / MIN_CODES), "--out", out)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    head, header = _comments(out)
+    assert header == "t,u,y"
+    _, u, y = np.loadtxt(out, delimiter=",", comments="#", skiprows=len(head) + 1).T
+    for ch in (u, y):
+        assert np.ptp(np.round(ch * MIN_CODES)) == MIN_CODES   # the step spans MIN_CODES codes

@@ -2,6 +2,7 @@
 and its input handling (hypothesis: exit 0 or 2, one line, no file on refusal)."""
 
 import json
+import os
 import subprocess
 import warnings
 
@@ -116,3 +117,47 @@ def test_fuzz_inputs(bits, clock, amp, off, per, tmp_path, capsys):
         assert len(lines) == 1 and lines[0].startswith("make-prbs: error:"), captured.err
         assert "Traceback" not in captured.err and "array(" not in captured.err
     assert not out.exists()
+
+
+def _ours(folder) -> list:
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith("."))
+
+
+def test_out_at_a_dangling_link_is_refused_and_nothing_left(tmp_path):
+    """--out at a dangling link turned it into a folder and left a stray .out.new-PID-* link."""
+    (tmp_path / "out").symlink_to("nowhere")
+    proc = run("--bits", "5", "--clock", "1k", "--out", tmp_path / "out")
+    assert proc.returncode == 2 and proc.stdout == ""
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "a symbolic link to nothing (nowhere)" in lines[0], proc.stderr
+    assert (tmp_path / "out").is_symlink() and os.readlink(tmp_path / "out") == "nowhere"
+    assert _ours(tmp_path) == [] and sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def test_out_at_a_link_to_a_folder_writes_through_it(tmp_path):
+    (tmp_path / "bench").mkdir()
+    (tmp_path / "out").symlink_to("bench")
+    proc = run("--bits", "5", "--clock", "1k", "--out", tmp_path / "out")
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "out").is_symlink()
+    assert sorted(p.name for p in (tmp_path / "bench").iterdir()) == ["prbs.cir", "prbs.csv", "prbs_awg.csv"]
+    assert _ours(tmp_path) == [] and _ours(tmp_path / "bench") == []
+
+
+@pytest.mark.parametrize("tf, tau", [("K=1 tau=1p", "1 ps"), ("K=2 tau=100p theta=0", "100 ps")])
+def test_for_plant_clock_stays_in_the_clock_range(tf, tau, tmp_path):
+    """tau = 1 ps chose a 2000 GHz clock where --clock stops at 1 GHz: refused, naming the time constant
+    and the range."""
+    from designer.core.prbs import BAND_FACTOR, HALF_POWER
+    from designer.core.ranges import RANGES
+    proc = run("--for-plant", "--plant-tf", tf, "--out", tmp_path / "x")
+    assert proc.returncode == 2 and proc.stdout == ""
+    line = proc.stderr.strip()
+    assert "\n" not in line and f"time constant {tau}" in line and RANGES["prbs_clock_hz"].text() in line, line
+    assert not (tmp_path / "x").exists()
+    # the boundary: the fastest first-order plant whose chosen clock is within range is taken
+    hi = RANGES["prbs_clock_hz"].hi
+    tau_ok = BAND_FACTOR / (2 * np.pi * HALF_POWER * hi) * 2   # its clock before rounding: hi / 2
+    ok = run("--for-plant", "--plant-tf", f"K=1 tau={tau_ok!r}", "--no-files", "--json")
+    assert ok.returncode == 0, ok.stderr
+    assert json.loads(ok.stdout)["prbs"]["clock_hz"] <= hi

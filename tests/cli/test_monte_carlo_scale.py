@@ -27,6 +27,11 @@ MC = ["--monte-carlo", "3000", "--seed", "4", "--limit", "fn_hz=3.3k:3.7k", "--l
       "--no-sim"]
 
 
+def builds(n: str) -> list:
+    """:data:`MC` with ``n`` builds (an option is given once)."""
+    return ["--monte-carlo", n, *MC[2:]]
+
+
 def run(exe, *args, timeout=300, **kw):
     env = dict(os.environ, MPLBACKEND="Agg")
     return subprocess.run([exe, *args], capture_output=True, text=True, env=env, timeout=timeout, **kw)
@@ -90,7 +95,7 @@ def test_a_running_scheduler_and_its_worker_give_the_same_section(tmp_path):
 @pytest.mark.spice
 @pytest.mark.parametrize("simulator", ["ngspice-cli", "pyspice"])
 def test_the_spice_engine_gives_the_same_section_whatever_the_workers(simulator):
-    args = [*SEED, *MC, "--monte-carlo", "120", "--engine", "spice", "--simulator", simulator, "--no-files", "--json"]
+    args = [*SEED, *builds("120"), "--engine", "spice", "--simulator", simulator, "--no-files", "--json"]
     got = [run(DESIGN_PLANT, *args, *where) for where in ([], ["--jobs", "2"], ["--dask", "local"])]
     assert all(p.returncode == 0 and p.stderr == "" for p in got), [p.stderr for p in got]
     sections = [json.loads(p.stdout)["monte_carlo"] for p in got]
@@ -153,7 +158,7 @@ def test_bad_scale_settings_one_line_nothing_written(tmp_path, args, what):
 
 
 def test_target_ci_from_the_command_line():
-    p = run(DESIGN_PLANT, *SEED, *MC, "--monte-carlo", "100000", "--target-ci", "2%", "--no-files", "--json")
+    p = run(DESIGN_PLANT, *SEED, *builds("100000"), "--target-ci", "2%", "--no-files", "--json")
     assert p.returncode == 0, p.stderr
     d = json.loads(p.stdout)["monte_carlo"]
     t = d["settings"]["target_ci"]

@@ -33,6 +33,7 @@ def one_line_refusal(p, what):
     lines = p.stderr.splitlines()
     assert len(lines) == 1 and "Traceback" not in p.stderr, p.stderr
     assert what in lines[0], lines[0]
+    return lines[0]
 
 
 @pytest.fixture(scope="module")
@@ -185,3 +186,30 @@ def test_the_issue_25_plant_designs_without_warnings(tmp_path):
     p = run(DESIGN_PID, "--plant-tf", "K=2 tau=20m theta=50u", "--no-sim", "--no-files")
     assert p.returncode == 0 and p.stderr == "", (p.returncode, p.stderr)
     assert "G(s) = 2 e^(-50 us s) / (20 ms s + 1)" in p.stdout
+
+@pytest.fixture(scope="module")
+def noise_json(tmp_path_factory):
+    from prbs_capture import noise_identify_json
+    path = noise_identify_json(tmp_path_factory.mktemp("noise"))
+    assert json.loads(path.read_text())["best"] is None    # identify found nothing in noise
+    return path
+
+
+def test_identify_json_of_noise_is_said_to_have_no_model(noise_json, tmp_path):
+    """It was refused as "not a plant model: expected an identify ... --json output" (it is one)."""
+    for exe, args in ((DESIGN_PID, ["--no-sim", "--out", str(tmp_path)]), (script("make-prbs"), ["--for-plant",
+                                                                             "--out", str(tmp_path / "p")])):
+        line = one_line_refusal(run(exe, "--plant-model", str(noise_json), *args),
+                                "has no valid model (best: none): nothing to design for")
+        assert "this identify result" in line and "not a plant model" not in line, line
+    assert not any(tmp_path.iterdir())
+
+
+def test_a_model_file_with_a_key_twice_is_refused_naming_it(tmp_path, capture):
+    p = run(script("identify"), str(capture), "--json")
+    assert p.returncode == 0, p.stderr
+    twice = tmp_path / "twice.json"
+    twice.write_text(p.stdout.replace('"best": {', '"best": {"name": "x", "valid": false},\n  "best": {', 1))
+    line = one_line_refusal(run(DESIGN_PID, "--plant-model", str(twice), "--no-sim", "--no-files"),
+                            "has the key 'best' twice in one object")
+    assert "?" not in line

@@ -164,3 +164,107 @@ def test_publish_into_an_empty_place(tmp_path):
     (stage / "f").write_text("1")
     publish_folder(stage, tmp_path / "x")
     assert (tmp_path / "x" / "f").read_text() == "1" and not stage.exists()
+
+
+def _ours(folder) -> list:
+    """Our temporaries left in ``folder`` (a staging folder, a moved-aside one, a temporary file or link)."""
+    return [p.name for p in Path(folder).iterdir() if p.name.startswith(".")]
+
+
+@pytest.mark.parametrize("what", ["dangling link", "link to a folder", "link to a file", "file"])
+def test_publish_never_swaps_a_link_or_a_file_into_a_stray_temporary(tmp_path, what):
+    """publish_folder swapped a dangling link at the target with the new folder, and left the link as
+    ``.name.new-PID-*`` (rmtree refuses a link): each is refused in one line, nothing left behind."""
+    from designer.core.fileio import new_folder_beside
+    (tmp_path / "real").mkdir()
+    (tmp_path / "afile").write_text("x")
+    target = tmp_path / "out"
+    if what == "file":
+        target.write_text("mine")
+    else:
+        target.symlink_to({"dangling link": "nowhere", "link to a folder": "real", "link to a file": "afile"}[what])
+    before = os.readlink(target) if target.is_symlink() else target.read_text()
+    stage = new_folder_beside(target)
+    (stage / "a.txt").write_text("new")
+    with pytest.raises(DesignError) as exc:
+        publish_folder(stage, target)
+    assert "\n" not in str(exc.value) and str(target) in str(exc.value)
+    assert _ours(tmp_path) == []
+    assert (os.readlink(target) if target.is_symlink() else target.read_text()) == before
+    assert sorted(p.name for p in (tmp_path / "real").iterdir()) == []
+
+
+@pytest.mark.parametrize("what, whole, words", [
+    ("dangling link", False, "a symbolic link to nothing (nowhere)"),
+    ("link to a file", False, "a symbolic link (to afile)"),
+    ("link to a folder", True, "the folder is replaced whole"),
+    ("file", False, "it is a file, not a folder"),
+    ("fifo", False, "it is a FIFO"),
+])
+def test_check_output_folder_refuses_before_any_work(tmp_path, what, whole, words):
+    from designer.core.fileio import check_output_folder
+    (tmp_path / "real").mkdir()
+    (tmp_path / "afile").write_text("x")
+    target = tmp_path / "out"
+    if what == "file":
+        target.write_text("mine")
+    elif what == "fifo":
+        os.mkfifo(target)
+    else:
+        target.symlink_to({"dangling link": "nowhere", "link to a folder": "real", "link to a file": "afile"}[what])
+    with pytest.raises(DesignError) as exc:
+        check_output_folder(target, "--out", whole=whole)
+    assert words in str(exc.value) and str(exc.value).startswith(f"cannot write --out {target}")
+
+
+def test_check_output_folder_takes_a_folder_nothing_or_a_link_to_a_folder(tmp_path):
+    from designer.core.fileio import check_output_folder
+    (tmp_path / "real").mkdir()
+    (tmp_path / "link").symlink_to("real")
+    for name in ("real", "new", "link"):
+        check_output_folder(tmp_path / name, whole=name != "link")
+    check_output_folder(tmp_path / "link", whole=False)    # written through
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link", "real"]
+
+
+def test_remove_tree_unlinks_a_link_and_leaves_its_target(tmp_path):
+    from designer.core.fileio import remove_tree
+    (tmp_path / "real").mkdir()
+    (tmp_path / "real" / "keep").write_text("x")
+    (tmp_path / "link").symlink_to("real")
+    (tmp_path / "dangling").symlink_to("nowhere")
+    remove_tree(tmp_path / "link")
+    remove_tree(tmp_path / "dangling")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["real"] and (tmp_path / "real" / "keep").exists()
+
+
+@pytest.mark.parametrize("what", ["dangling link", "link to a folder", "folder"])
+def test_atomic_write_refused_creates_nothing(tmp_path, what):
+    """Every kind of refused target: one line, no temporary file, and no parent folder made on the way."""
+    (tmp_path / "real").mkdir()
+    target = tmp_path / "out.csv"
+    if what == "folder":
+        target.mkdir()
+    else:
+        target.symlink_to("nowhere" if what == "dangling link" else "real")
+    with pytest.raises(DesignError):
+        atomic_write(target, "data")
+    assert _ours(tmp_path) == [] and sorted(os.listdir(tmp_path / "real")) == []
+    with pytest.raises(DesignError, match="not a valid file name"):   # checked before its folder is made
+        atomic_write(tmp_path / "new" / "a\0b.csv", "data")
+    assert not (tmp_path / "new").exists()
+
+
+@pytest.mark.parametrize("what", ["dangling link", "link to a folder"])
+def test_link_into_replaces_a_link_there_and_leaves_no_temporary(tmp_path, what):
+    """The netlist beside a bundle is our link: one already there (dangling, or to a folder) is replaced
+    atomically, what it pointed to untouched, no ``.name.PID.link.tmp`` left."""
+    from designer.core.fileio import link_into
+    (tmp_path / "real").mkdir()
+    (tmp_path / "bundle").mkdir()
+    (tmp_path / "bundle" / "x.cir").write_text("deck")
+    link = tmp_path / "x.cir"
+    link.symlink_to("nowhere" if what == "dangling link" else "real")
+    assert link_into(link, tmp_path / "bundle" / "x.cir")
+    assert os.readlink(link) == os.path.join("bundle", "x.cir") and link.read_text() == "deck"
+    assert _ours(tmp_path) == [] and (tmp_path / "real").is_dir()

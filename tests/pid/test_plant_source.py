@@ -221,3 +221,45 @@ def test_a_failed_method_has_no_model(identified, tmp_path):
     best["params"]["tau_s"] = None
     data["best"] = best
     _one_line_refusal(_write(tmp_path, data), "tau_s", "not a number")
+
+
+@pytest.fixture(scope="module")
+def noise_identified(tmp_path_factory):
+    """identify's own --json of a PRBS capture whose output is white noise alone (nothing identified)."""
+    from prbs_capture import noise_identify_json
+    return noise_identify_json(tmp_path_factory.mktemp("noise"))
+
+
+def test_identify_json_of_noise_has_no_model_to_design_for(noise_identified):
+    data = json.loads(noise_identified.read_text())
+    assert data["format"] == "broadband" and data["best"] is None    # what identify wrote: nothing fitted
+    assert result_kind(data) == "identify"
+    msg = _one_line_refusal(noise_identified, "this identify result has no valid model (best: none): nothing to "
+                            "design for")
+    assert "identify-freq" not in msg and "not a plant model" not in msg
+
+
+def test_the_command_named_is_the_one_that_wrote_the_file(identified, tmp_path):
+    """A best of none in an identify (step) result and in identify's broadband spectral layout (which carries
+    identify-freq's keys) is said of identify; in identify-freq's own, of identify-freq."""
+    step = json.loads(identified["fopdt"].read_text())
+    step["best"] = None
+    for m in step["methods"]:
+        m["valid"] = False
+    _one_line_refusal(_write(tmp_path, step, "step.json"), "this identify result has no valid model")
+    broadband = dict(step, format="broadband", error_definition="...", data={})
+    msg = _one_line_refusal(_write(tmp_path, broadband, "bb.json"), "this identify result has no valid model")
+    assert "identify-freq" not in msg
+    freq = {k: v for k, v in broadband.items() if k not in ("format", "preprocessing")}
+    _one_line_refusal(_write(tmp_path, freq, "freq.json"), "this identify-freq result has no valid model")
+
+
+def test_a_key_twice_in_the_file_is_refused_naming_it(identified, tmp_path):
+    """json keeps the last of a repeated key: a model file whose best is given twice was read as the
+    second ("the best model, ?, is not valid"); it is refused, naming the key."""
+    text = identified["fopdt"].read_text()
+    path = tmp_path / "twice.json"
+    path.write_text(text.replace('"best": {', '"best": {"valid": false},\n  "best": {', 1))
+    assert json.loads(path.read_text())["best"]["valid"] is True     # what a plain reader makes of it
+    msg = _one_line_refusal(path, "has the key 'best' twice in one object")
+    assert "?" not in msg

@@ -134,3 +134,18 @@ def test_bad_inputs_are_one_line_naming_the_parameter(kwargs, param, words):
 def test_a_model_is_required():
     with pytest.raises(DesignError, match="model must be a ProcessModel"):
         simulate_step("K=1 tau=1m")
+
+
+@pytest.mark.parametrize("kw, what", [
+    ({"step_v": 1.0, "lsb_v": 10.0}, "the input's step"),
+    ({"step_v": -2.0, "lsb_v": 0.6}, "the input's step"),
+])
+def test_an_lsb_too_coarse_for_the_step_names_the_parameter(kw, what):
+    from designer.core.errors import ParamError
+    from designer.spice.model_step import MIN_CODES
+    with pytest.raises(ParamError) as exc:
+        simulate_step(MODELS["motor_seed000"], **kw)
+    msg = str(exc.value)
+    assert exc.value.param == "lsb_v" and msg.startswith(f"lsb_v ") and what in msg
+    swing = abs(kw["step_v"])
+    assert f"{swing / kw['lsb_v']:.3g} quantisation steps" in msg and f"at least {MIN_CODES}" in msg
