@@ -17,18 +17,30 @@ Conventions, chosen so that every model is judged the same way:
 
 - :func:`split_record`: the estimation part is the first ``fraction`` of the
   record (default half, as Ljung's dryer example), validation the rest.
-- :func:`validate` (``how="detrend"``, the default): each part has its own
-  means removed (``detrend(z, 0)``, as the toolbox's dryer example does), and
-  the model's response to the validation input's deviations is simulated from
-  rest, with no access to the validation output. ``how="continue"``: the model
+- :func:`validate` (``how="detrend"``, the default): the validation part's
+  output and the model's simulation each have their mean removed
+  (``detrend(z, 0)``, as the toolbox's dryer example does: a level is not the
+  model's to know), and the model is driven by the record's input from the
+  record's start (at rest at its first level), so its state at the
+  validation start is the one the recorded past input left it in; the
+  validation output is never used (``compare`` estimates that state from it
+  instead). A separate validation record is simulated from rest at its
+  first input level. A start from
+  rest on the validation part alone leaves a transient that fails the
+  whiteness test of a true model (tests/identify/test_validation.py).
+  ``how="continue"``: the model
   simulated over the whole record from its start (its own offset and initial
   state), scored on the validation samples only; this is the one that suits an
   integrating plant, whose validation output depends on everything before it.
-- Residual bands (Ljung eqs. 16.59-16.66): a white residual's normalised
+- Residual bands (Ljung section 16.6): a white residual's normalised
   autocorrelation at lag k != 0 is about N(0, 1/N), so the 99 % band is
   +-2.576/sqrt(N); the cross-correlation of input and residual at lag k is
   about N(0, P/N), P = sum_m r_ee(m) r_uu(m) (the two normalised
-  autocorrelations), so its band is +-2.576 sqrt(P/N).
+  autocorrelations), so its band is +-2.576 sqrt(P/N). The bands are per lag,
+  as ``resid`` draws them: a perfectly white residual has every one of 25
+  lags inside with probability 0.99^25 = 0.78 (51 cross-correlation lags:
+  0.60), so :attr:`Correlation.worst` (the largest |r| over its band) says by
+  how much a lag is out.
 """
 
 from __future__ import annotations
@@ -195,7 +207,7 @@ def whiteness(e, lags: int = RESID_LAGS) -> Correlation:
     Returns
     -------
     Correlation
-        Band +-2.576/sqrt(N) (Ljung eq. 16.61, at 99 %).
+        Band +-2.576/sqrt(N) (Ljung section 16.6, at 99 %).
     """
     e = np.asarray(e, float) - np.mean(e)
     ks = np.arange(1, lags + 1)
@@ -219,7 +231,7 @@ def cross_correlation(u, e, lags: int = RESID_LAGS) -> Correlation:
     -------
     Correlation
         Band +-2.576 sqrt(P/N), P = sum_m r_ee(m) r_uu(m) over |m| <= ``lags``
-        (Ljung eq. 16.64): a coloured input widens it.
+        (Ljung section 16.6): a coloured input widens it.
     """
     u = np.asarray(u, float) - np.mean(u)
     e = np.asarray(e, float) - np.mean(e)
@@ -297,7 +309,13 @@ def validate(model, u, y, split: Split | None = None, *, how: str = "detrend",
     if how == "detrend":
         uv = u[val] - u[val].mean()
         yv = y[val] - y[val].mean()
-        yhat = np.asarray(model.response(uv), float)
+        # the model starts at rest at the first input level of what drives it:
+        # a separate record, or the whole record when it is split, so that its
+        # state at the validation start is the one the recorded past input
+        # left it in, not a made-up rest
+        drive = u[val] if split is None else u
+        yhat = np.asarray(model.response(drive - drive[0]), float)[val if split is not None else slice(None)]
+        yhat = yhat - yhat.mean()
     elif how == "continue":
         uv, yv = u[val], y[val]
         yhat = np.asarray(model.simulate(u), float)[val]
