@@ -20,6 +20,7 @@ _API = {
     "design_pid": "designer.pid.design", "analyze_pid": "designer.pid.design", "PidSpec": "designer.pid.spec",
     "identify_step": "designer.identify.step", "identify_freq": "designer.identify.frequency",
     "read_capture": "designer.identify.io", "DesignError": "designer.core.errors",
+    "identify_output_error": "designer.identify.outputerror",
 }
 
 __all__ = ["__version__", *_API]

@@ -14,6 +14,9 @@ least-squares fit of ``freqfit``, the loop margins of ``bode_margins``);
 responses from a broadband input (a PRBS, :mod:`designer.core.prbs`, or
 noise: seed 003, 2.4 and 3.2) and ``broadband`` recognises such an input and
 runs both, with the step and frequency methods on their results;
+``outputerror`` fits continuous-time models with dead time to any recorded
+input by output error, and ``validation`` judges a model on data it was not
+fitted to (fit percentage, residual tests, an ARX reference);
 ``against`` compares an identified plant with its design (the one use of the
 plant wing) and ``report`` prints and plots the results. The waveform
 readings they share (noise, crossings, derivative, tangent) are

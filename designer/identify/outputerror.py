@@ -97,7 +97,7 @@ FIT_KINDS = {
 HOLDS = ("zoh", "foh")
 INITIALS = ("rest", "estimate")
 #: the ARX start is fitted on at most this many samples (block means of longer records)
-START_SAMPLES = 20000
+START_SAMPLES = 5000
 #: input delays (samples of the start's record) tried by the ARX start, at most
 MAX_START_DELAY = 150
 #: the damping ratio's bounds (zeta >= 1 is the SOPDT)
