@@ -356,26 +356,59 @@ class OEFit:
         return float(self.params["K"])
 
     def sampled(self) -> Sampled:
-        """The model sampled at the record's interval and hold."""
+        """The model sampled at the record's interval and hold.
+
+        Returns
+        -------
+        Sampled
+        """
         num, den = _rational(self.kind, self.params)
         return sample_model(num, den, self.params["theta_s"], self.sample_time_s, self.hold)
 
     def response(self, u) -> np.ndarray:
-        """Output deviation from rest under input deviations ``u`` (one per sample)."""
+        """Output deviation from rest under input deviations ``u``.
+
+        Parameters
+        ----------
+        u : array_like
+            Input deviations from the rest level, one per sample.
+
+        Returns
+        -------
+        numpy.ndarray
+            The output deviation at each sample.
+        """
         from scipy.signal import lfilter
         s = self.sampled()
         return lfilter(s.b, s.a, np.asarray(u, float))
 
     def simulate(self, u) -> np.ndarray:
-        """The output over a record ``u`` from its start, as fitted: the record
-        at rest at u[0] plus the estimated level (and initial free response)."""
+        """The output over a record from its start, as fitted.
+
+        Parameters
+        ----------
+        u : array_like
+            The record's input (absolute), at rest at u[0] before it.
+
+        Returns
+        -------
+        numpy.ndarray
+            The estimated output level plus the response to u - u[0] (and,
+            with ``initial="estimate"``, the estimated free response).
+        """
         u = np.asarray(u, float)
         s = self.sampled()
         X = _columns(s, u.size, self.kind.startswith("integrating"), self.initial)
         return self.response(u - u[0]) + X @ np.asarray(self.linear)
 
     def to_dict(self) -> dict:
-        """JSON-ready."""
+        """JSON-ready.
+
+        Returns
+        -------
+        dict
+            Every attribute, the process model as its own ``to_dict``.
+        """
         return {"kind": self.kind, "params": dict(self.params), "ci95": dict(self.ci95),
                 "model": None if self.model is None else self.model.to_dict(), "valid": self.valid,
                 "note": self.note, "sample_time_s": self.sample_time_s, "hold": self.hold,
@@ -616,6 +649,8 @@ class OEResult:
         The split of one record (None with a separate validation record).
     best : int or None
         Index of the best valid fit by validation fit (None: none valid).
+    notes : list of str
+        What the reader should know (no valid model).
     """
 
     fits: list
@@ -630,7 +665,13 @@ class OEResult:
         return None if self.best is None else self.fits[self.best]
 
     def to_dict(self) -> dict:
-        """JSON-ready."""
+        """JSON-ready.
+
+        Returns
+        -------
+        dict
+            The split, the best index, each model with its validation.
+        """
         return {"split": None if self.split is None else self.split.to_dict(), "best": self.best,
                 "models": [{**f.to_dict(), "validation": v.to_dict()}
                            for f, v in zip(self.fits, self.validations)], "notes": list(self.notes)}

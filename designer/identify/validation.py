@@ -91,7 +91,13 @@ class Split:
         return slice(self.n_est, self.n)
 
     def to_dict(self) -> dict:
-        """JSON-ready: the sample ranges."""
+        """JSON-ready.
+
+        Returns
+        -------
+        dict
+            ``samples``, ``estimation`` and ``validation`` ([start, stop)).
+        """
         return {"samples": self.n, "estimation": [0, self.n_est], "validation": [self.n_est, self.n]}
 
 
@@ -180,7 +186,13 @@ class Correlation:
         return float(np.max(np.abs(self.r)) / self.band)
 
     def to_dict(self) -> dict:
-        """JSON-ready: lags, r, band, inside, worst."""
+        """JSON-ready.
+
+        Returns
+        -------
+        dict
+            ``lags``, ``r``, ``band``, ``inside``, ``worst_over_band``.
+        """
         return {"lags": [int(k) for k in self.lags], "r": [float(v) for v in self.r],
                 "band": self.band, "inside": self.inside, "worst_over_band": self.worst}
 
@@ -272,7 +284,13 @@ class Validation:
     samples: int
 
     def to_dict(self) -> dict:
-        """JSON-ready."""
+        """JSON-ready.
+
+        Returns
+        -------
+        dict
+            The fit, how it was simulated, the samples and both correlations.
+        """
         return {"fit_percent": self.fit_percent, "how": self.how, "samples": self.samples,
                 "whiteness": self.whiteness.to_dict(), "cross_correlation": self.cross.to_dict()}
 
@@ -360,16 +378,44 @@ class ARXModel:
         return math.inf if den == 0 else float(np.sum(self.b)) / den
 
     def response(self, u) -> np.ndarray:
-        """Simulated (not predicted) output deviation from rest under input deviations ``u``."""
+        """Simulated (not predicted) output deviation from rest.
+
+        Parameters
+        ----------
+        u : array_like
+            Input deviations, one per sample.
+
+        Returns
+        -------
+        numpy.ndarray
+            B(q)/A(q) u from zero initial conditions.
+        """
         from scipy.signal import lfilter
         return lfilter(self.b, self.a, np.asarray(u, float))
 
     def simulate(self, u) -> np.ndarray:
-        """Simulated output of the whole record ``u`` around the estimation means."""
+        """Simulated output of a whole record around the estimation means.
+
+        Parameters
+        ----------
+        u : array_like
+            The record's input (absolute).
+
+        Returns
+        -------
+        numpy.ndarray
+            y_mean + B(q)/A(q) (u - u_mean).
+        """
         return self.y_mean + self.response(np.asarray(u, float) - self.u_mean)
 
     def to_dict(self) -> dict:
-        """JSON-ready."""
+        """JSON-ready.
+
+        Returns
+        -------
+        dict
+            Orders, coefficients, static gain, loss.
+        """
         return {"orders": list(self.orders), "a": [float(v) for v in self.a], "b": [float(v) for v in self.b],
                 "static_gain": self.static_gain, "loss": self.loss}
 

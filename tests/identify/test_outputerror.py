@@ -182,6 +182,41 @@ def test_noiseless_records_give_the_parameters_back(kind, tau, ratio, theta, see
         assert fit.params[k] == pytest.approx(v, rel=1e-3, abs=1e-5), (k, fit.params, want)
 
 
+def test_a_first_order_hold_record_is_fitted_under_that_hold():
+    # a smooth input the plant saw interpolated between samples (a generator
+    # whose samples the scope took): lsim on a grid of T/16, the dead time a
+    # multiple of T/16 so the reference is exact
+    _, model = PLANTS["sopdt"]
+    M = 16
+    theta = (6 + 11 / M) * T
+    u = chirp(n=2000, f0=0.02, f1=1.0)
+    tf = np.arange(u.size * M) * T / M
+    uf = np.interp(tf - theta, np.arange(u.size) * T, u - u[0], left=0.0)
+    _, yf, _ = lsim((model.num, model.den), uf, tf)
+    y = 0.5 + yf[::M]
+    want = {**model.params, "theta_s": theta}
+    foh = oe.fit_output_error(u, y, T, "sopdt", hold="foh")
+    for k, v in want.items():
+        assert foh.params[k] == pytest.approx(v, rel=1e-3), k
+    zoh = oe.fit_output_error(u, y, T, "sopdt", hold="zoh")
+    # the held input lags the interpolated one by half a sample: the zero-order
+    # hold's fit absorbs it in its dead time
+    assert abs(zoh.params["theta_s"] - theta) > 10 * abs(foh.params["theta_s"] - theta)
+    assert zoh.params["theta_s"] == pytest.approx(theta - T / 2, abs=0.1 * T)
+
+
+def test_a_record_not_at_rest_needs_its_initial_state_estimated():
+    # a capture that begins in the middle of a response: its first 137 samples cut off
+    _, model = PLANTS["sopdt"]
+    u = random_binary(np.random.default_rng(4), n=2137, p_switch=0.1)
+    y = Y_REST + exact_response(model, u)
+    u, y = u[137:], y[137:]
+    est = oe.fit_output_error(u, y, T, "sopdt", initial="estimate")
+    rest = oe.fit_output_error(u, y, T, "sopdt", initial="rest")
+    err = {f.initial: max(abs(f.params[k] / v - 1) for k, v in model.params.items()) for f in (est, rest)}
+    assert err["estimate"] < 0.01 and err["estimate"] < err["rest"] / 5, err
+
+
 # --------------------------------------------------------------------------- the result and bad input
 
 def test_the_fit_is_a_process_model_with_its_intervals():
