@@ -96,6 +96,16 @@ def test_the_sampled_model_is_continuous_in_the_dead_time():
     assert np.allclose(np.pad(below.b, (0, n - below.b.size)), np.pad(at.b, (0, n - at.b.size)), atol=1e-12)
 
 
+def test_a_long_dead_time_is_run_as_a_shift():
+    # the same numbers as lfilter over the whole numerator, without its zero taps
+    from scipy.signal import lfilter
+    u = np.random.default_rng(2).standard_normal(3000)
+    s = oe.sample_model([2.0], [1.3, 1.0], 1234.4 * T, T)
+    assert s.b.size > 1234 and not np.any(s.b[:1234])
+    assert np.allclose(s.run(u), lfilter(s.b, s.a, u), rtol=0, atol=1e-12)
+    assert not np.any(s.run(u[:1000]))   # shorter than the dead time: nothing arrives
+
+
 # --------------------------------------------------------------------------- known plants
 
 CASES = [(name, inp) for name in PLANTS for inp in ("random binary", "chirp", "step")]
