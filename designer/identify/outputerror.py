@@ -60,8 +60,10 @@ equal those of the joint problem, Golub and Pereyra 1973).
 bounds, parameters scaled by their start so each moves on the order of 1),
 started from an ARX estimate (:func:`~designer.identify.validation.arx_fit`,
 with the dead time from a grid over the ARX input delay, then converted to
-continuous time) and from a second start at half its dead time; the lower
-cost wins. 95 % half-widths from the Jacobian at the optimum,
+continuous time), from a second start at half its dead time, and from the
+caller's ``start`` when given (a classical method's estimate); the lower cost
+wins. The start is fitted on at most :data:`START_SAMPLES` block means of a
+long record; the output-error fit itself always uses every sample. 95 % half-widths from the Jacobian at the optimum,
 t(0.975, N - p) sqrt(diag((J^T J)^-1) s^2), s^2 = SSE/(N - p) (they assume
 white output noise: with coloured noise or a wrong structure they are
 optimistic). A parameter held at its bound has no interval (a dead time at
