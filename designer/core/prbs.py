@@ -291,6 +291,8 @@ def linear_complexity(bits) -> int:
 
 
 #: windows of 2n bits tried for the register of a period with bit errors
+#: up to this many bits every register is tried (2^(bits-1) of them, a few ms at 10 bits)
+MLS_EXHAUSTIVE_BITS = 10
 MLS_WINDOWS = 16
 
 
@@ -299,7 +301,9 @@ def mls_bit_errors(period, bits: int) -> int:
     from the nearest m-sequence of ``bits`` bits (any register, any phase): 0 for a
     maximum-length sequence.
 
-    The register comes from Berlekamp-Massey on 2n consecutive bits (n bits
+    Up to :data:`MLS_EXHAUSTIVE_BITS` bits every register is tried (a short period
+    with a few flips may hold no error-free window). Above, the register comes
+    from Berlekamp-Massey on 2n consecutive bits (n bits
     determine it: an error-free window of the period gives the right one, so
     windows spread over the period are tried, :data:`MLS_WINDOWS` of them); its
     m-sequence (:func:`scipy.signal.max_len_seq` with the register's taps, read in
@@ -318,21 +322,35 @@ def mls_bit_errors(period, bits: int) -> int:
     pm = 2.0 * b01 - 1.0
     spec = np.conj(np.fft.rfft(pm))
     best = n
-    seen = set()
-    for o in np.linspace(0, n, MLS_WINDOWS, endpoint=False).astype(int):
-        window = np.roll(b01, -int(o))[:2 * bits]
-        L, c = _berlekamp_massey(window)
-        key = tuple(c)
-        if L != bits or key in seen:
-            continue
-        seen.add(key)
-        taps = [j for j in range(1, bits) if c[j]]
-        for t in (taps, [bits - j for j in taps]):
-            if not t:
+    if bits <= MLS_EXHAUSTIVE_BITS:
+        # a short period may hold no error-free window of 2n bits (2 flips in 15 values can leave none), so
+        # every register is tried: 2^(bits-1) tap sets, those whose sequence is maximum-length counted
+        candidates = [[j for j in range(1, bits) if mask >> (j - 1) & 1] for mask in range(1, 1 << (bits - 1))]
+    else:
+        candidates, seen = [], set()
+        for o in np.linspace(0, n, MLS_WINDOWS, endpoint=False).astype(int):
+            window = np.roll(b01, -int(o))[:2 * bits]
+            L, c = _berlekamp_massey(window)
+            key = tuple(c)
+            if L != bits or key in seen:
                 continue
-            seq = max_len_seq(bits, taps=t)[0].astype(float) * 2.0 - 1.0
-            corr = np.fft.irfft(spec * np.fft.rfft(seq), n)
-            best = min(best, int(round((n - float(corr.max())) / 2)))
+            seen.add(key)
+            taps = [j for j in range(1, bits) if c[j]]
+            candidates += [t for t in (taps, [bits - j for j in taps]) if t]
+    for t in candidates:
+        seq = max_len_seq(bits, taps=t)[0].astype(float) * 2.0 - 1.0
+        fs = np.fft.rfft(seq)
+        if bits <= MLS_EXHAUSTIVE_BITS and not _is_mls(fs, n):
+            continue
+        corr = np.fft.irfft(spec * fs, n)
+        best = min(best, int(round((n - float(corr.max())) / 2)))
         if best == 0:
             break
     return best
+
+
+def _is_mls(spectrum, n: int) -> bool:
+    """Whether the +-1 sequence of ``spectrum`` (its rfft) is maximum-length: its circular
+    autocorrelation is n at lag 0 and -1 at every other lag (eq. 2.4.6)."""
+    acf = np.fft.irfft(spectrum * np.conj(spectrum), n)
+    return bool(np.all(np.abs(acf[1:] + 1.0) < 0.5))

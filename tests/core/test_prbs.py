@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from designer.core.errors import DesignError
@@ -95,6 +95,8 @@ def test_writers_round_trip():
 
 @given(bits=st.integers(4, 12), shift=st.integers(0, 4094), k=st.integers(0, 3), seed=st.integers(0, 2 ** 32 - 1),
        reverse=st.booleans())
+# hypothesis found it: 2 flips in 15 values left no error-free window of 8 for Berlekamp-Massey
+@example(bits=4, shift=0, k=2, seed=2, reverse=False)
 @settings(max_examples=40, deadline=None)
 def test_mls_bit_errors_counts_the_flipped_values(bits, shift, k, seed, reverse):
     """Any phase of either direction of the m-sequence (another register) is one (0 errors);
