@@ -1,0 +1,591 @@
+"""A filter from a specification (:class:`~designer.filters.spec.FilterSpec`):
+the prototype's sections (:mod:`designer.filters.prototype`), each synthesised
+on a registered topology, the gain split, every stage checked against its
+op-amp, the parts chosen jointly from the E-series (:mod:`designer.filters.joint`)
+and, on request, the cascade proven against ngspice's ``.ac``.
+
+Sources: TI, "Op Amps for Everyone", ch. 16 (SLOA088): the cascade of
+second-order sections (plus a first-order one for an odd order), stages built
+in rising Q so that a high-Q stage does not clip, the rule of thumb that a
+stage's op-amp needs a gain-bandwidth of 100 x fn x Q x gain; Zverev,
+"Handbook of Filter Synthesis": the normalised prototypes; scipy.signal: the
+poles and the order functions.
+
+Choices made here, and why:
+
+- each section's capacitors are series values from the start (C1 a neighbour
+  of the value that puts the resistors near ``impedance_ohm``, C2 the least series
+  value above the topology's ratio bound), so the synthesis stays exact with only
+  the resistors continuous; then each part's two neighbouring series values are its
+  candidates (a part already on the series keeps its value);
+- the objective of the joint choice is the whole cascade's response with the
+  op-amp's finite gain and GBW, against the ideal response, over the passband and
+  the transition band, so that the choice also absorbs part of the op-amp's error;
+- the gain is split evenly in dB over the second-order stages (a first-order
+  section here is a unity-gain buffer); if that clips an internal node at the bench
+  amplitude, all the gain goes to the last stage instead; if that still clips, refuse.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core import opamps
+from ..core.errors import DesignError
+from ..core.eseries import values as series_values
+from ..core.units import format_eng
+from .cascade import Cascade
+from .deck import ac_deck, simulate_ac
+from .joint import joint_search, objective, per_stage
+from .prototype import SectionPlan, order_from_mask, plan_sections, reference_response
+from .registry import get as get_topology
+from .spec import FilterSpec
+from .topology import SectionTarget
+
+__all__ = ["StageDesign", "FilterDesign", "design", "section_name", "stage_candidates", "verify_spice",
+           "analysis_grid"]
+
+#: the capacitor values (C1, nearest first) each stage offers the joint search
+C_CHOICES = 3
+#: points of the objective's frequency grid
+GRID_POINTS = 160
+#: how far below the passband gain the transition band ends without a mask (dB)
+TRANSITION_DB = 20.0
+
+
+@dataclass
+class StageDesign:
+    """One designed stage.
+
+    Parameters
+    ----------
+    number : int
+        1-based position in the cascade.
+    plan : SectionPlan
+        The section's kind, order, fn and Q.
+    topology : str
+        Registry name of its section.
+    gain : float
+        Its passband gain magnitude.
+    continuous : dict
+        Exact part values.
+    candidates : list of dict
+        The E-series candidate sets.
+    errors : ndarray
+        (n_candidates, n_f) dB error of each candidate on the objective grid.
+    nearest : int
+        The candidate with every part rounded to its nearest series value.
+    chosen : int
+        The jointly chosen candidate.
+    peak_gain : float
+        max |H_i| of the stage alone (V/V).
+    node_peak_v : float
+        The stage output's peak at the bench amplitude (the cascade up to it).
+    gbw_needed_hz : float
+        margin x fn x Q x noise gain.
+    """
+
+    number: int
+    plan: SectionPlan
+    topology: str
+    gain: float
+    continuous: dict
+    candidates: list
+    errors: np.ndarray
+    nearest: int
+    chosen: int = 0
+    peak_gain: float = 1.0
+    node_peak_v: float = 0.0
+    gbw_needed_hz: float = 0.0
+
+    @property
+    def values(self) -> dict:
+        """The chosen E-series values."""
+        return self.candidates[self.chosen]
+
+    def to_dict(self) -> dict:
+        """The stage as JSON."""
+        return {"stage": self.number, "topology": self.topology, "kind": self.plan.kind, "order": self.plan.order,
+                "fn_hz": self.plan.fn_hz, "q": self.plan.q, "gain": self.gain,
+                "inverting": get_topology(self.topology).inverting, "peak_gain": self.peak_gain,
+                "peak_gain_db": 20 * math.log10(self.peak_gain), "node_peak_v": self.node_peak_v,
+                "gbw_needed_hz": self.gbw_needed_hz, "candidates": len(self.candidates),
+                "parts_continuous": {k: float(v) for k, v in self.continuous.items()},
+                "parts": {k: float(v) for k, v in self.values.items()}}
+
+
+@dataclass
+class FilterDesign:
+    """The designed filter: its stages and every figure reported.
+
+    Attributes
+    ----------
+    spec : FilterSpec
+        What was asked.
+    order, fc_hz : int, float
+        The order and cut-off (from the mask when one was given).
+    stages : list of StageDesign
+        In build order.
+    figures : dict
+        Achieved figures against the target (see :func:`design`).
+    spice : dict or None
+        :func:`verify_spice`'s figures when run.
+    """
+
+    spec: FilterSpec
+    order: int
+    fc_hz: float
+    stages: list
+    figures: dict = field(default_factory=dict)
+    spice: dict | None = None
+
+    @property
+    def opamp(self):
+        """The op-amp model of every stage."""
+        return opamps.get(self.spec.opamp)
+
+    def cascade(self, which: str = "chosen") -> Cascade:
+        """The cascade of ``chosen`` E-series values, or of the ``continuous`` ones.
+
+        Parameters
+        ----------
+        which : str
+            ``chosen`` or ``continuous``.
+
+        Returns
+        -------
+        Cascade
+            The circuit.
+        """
+        return Cascade([(get_topology(st.topology), st.values if which == "chosen" else st.continuous)
+                        for st in self.stages])
+
+    def deck(self) -> str:
+        """The ngspice ``.ac`` deck of the chosen cascade (standalone)."""
+        lo, hi = self.figures["sweep_hz"]
+        return ac_deck(self.cascade().netlist(), self.opamp, lo, hi,
+                       title=f"{self.spec.family} {self.spec.response} order {self.order}")
+
+    def to_dict(self) -> dict:
+        """Everything as JSON-ready data."""
+        s = self.spec
+        return {"spec": {"response": s.response, "family": s.family, "order": self.order, "fc_hz": self.fc_hz,
+                         "ripple_db": s.ripple_db, "bessel_norm": s.bessel_norm,
+                         "chebyshev_cutoff": s.chebyshev_cutoff, "gain": s.gain,
+                         "mask": ({"passband_hz": s.passband_hz, "max_loss_db": s.max_loss_db,
+                                   "stopband_hz": s.stopband_hz, "min_attenuation_db": s.min_attenuation_db}
+                                  if s.has_mask else None),
+                         "r_series": s.r_series, "c_series": s.c_series, "amplitude_v": s.amplitude_v,
+                         "gbw_margin": s.gbw_margin},
+                "opamp": self.opamp.to_dict(), "stages": [st.to_dict() for st in self.stages],
+                "figures": {k: v for k, v in self.figures.items()}, "spice": self.spice}
+
+
+def section_name(kind: str, order: int, family: str, gain: float) -> str:
+    """The registry name of a section of ``family`` (``sallen-key`` or ``mfb``).
+
+    Parameters
+    ----------
+    kind : str
+        ``lowpass`` or ``highpass``.
+    order : int
+        1 or 2.
+    family : str
+        ``sallen-key`` or ``mfb``.
+    gain : float
+        The stage's gain (a Sallen-Key with gain above 1 is the ``-gain`` section).
+
+    Returns
+    -------
+    str
+        A registered name.
+
+    Raises
+    ------
+    DesignError
+        A first-order stage with gain that no section realises (one line).
+    """
+    if order == 1:
+        if kind == "lowpass" and (family == "mfb" or gain > 1 + 1e-12):
+            return "inverting-lowpass"
+        if gain > 1 + 1e-12:
+            raise DesignError("gain: a first-order high-pass section (rc-highpass) has unity gain; use gain 1 or "
+                              "an order of 2 or more", param="gain")
+        return "rc-lowpass" if kind == "lowpass" else "rc-highpass"
+    if family == "mfb":
+        return f"mfb-{kind}"
+    return f"sallen-key-{kind}" + ("-gain" if gain > 1 + 1e-12 else "")
+
+
+def _neighbours(value: float, series: str, lo: float, hi: float) -> list:
+    """The series values either side of ``value`` within [lo, hi] (itself when on the series)."""
+    vals = series_values(series, lo / 10, hi * 10)
+    on = np.abs(vals / value - 1) < 1e-9
+    if np.any(on):
+        near = [float(vals[on][0])]
+    else:
+        below, above = vals[vals < value], vals[vals > value]
+        near = ([float(below[-1])] if below.size else []) + ([float(above[0])] if above.size else [])
+    return [v for v in near if lo * (1 - 1e-9) <= v <= hi * (1 + 1e-9)]
+
+
+def _bound_words(ref: str, value: float, spec: FilterSpec) -> str:
+    kind = "r" if ref.startswith("R") else "c"
+    unit = "Ohm" if kind == "r" else "F"
+    lo, hi = getattr(spec, f"{kind}_min"), getattr(spec, f"{kind}_max")
+    if value < lo:
+        return f"{ref} = {format_eng(value, unit)} is below --{kind}-min {format_eng(lo, unit)}"
+    return f"{ref} = {format_eng(value, unit)} is above --{kind}-max {format_eng(hi, unit)}"
+
+
+def stage_candidates(topology, target: SectionTarget, spec: FilterSpec, where: str) -> tuple:
+    """The continuous design and the E-series candidate sets of one stage.
+
+    Parameters
+    ----------
+    topology : Topology
+        The stage's section.
+    target : SectionTarget
+        Its fn, Q, gain (``impedance_ohm`` the resistor scale).
+    spec : FilterSpec
+        The series and bounds.
+    where : str
+        How the stage is named in a refusal ("stage 2 (sallen-key-lowpass, fn 1 kHz, Q 1.31)").
+
+    Returns
+    -------
+    tuple
+        (continuous values at the first capacitor choice, list of candidate dicts,
+        index of the all-nearest candidate).
+
+    Raises
+    ------
+    DesignError
+        No candidate within the part bounds (one line naming the part and the bound).
+    """
+    free = topology.synthesize(target)
+    c_free = min(max(free["C1"], spec.c_min), spec.c_max)
+    # the neighbours of the free value and one more either side: the joint search's freedom per stage
+    near = series_values(spec.c_series, spec.c_min, spec.c_max)
+    c_choices = [float(c) for c in near[np.argsort(np.abs(np.log(near / c_free)))[:C_CHOICES]]] if near.size else []
+    if not c_choices:
+        raise DesignError(f"c_min: {where}: no {spec.c_series} capacitor between --c-min and --c-max", param="c_min")
+    # nearest-in-log first: the continuous design shown is on it
+    c_choices.sort(key=lambda c: abs(math.log(c / c_free)))
+    choices = {}
+    if "r3" in topology.choices:
+        rs = series_values(spec.r_series, spec.r_min, spec.r_max)
+        choices["r3"] = float(rs[np.argmin(np.abs(np.log(rs / target.impedance_ohm)))])
+    index, cands, continuous, nearest, problem = {}, [], None, None, None
+    for c1 in c_choices:
+        tgt = SectionTarget(target.kind, target.fn_hz, target.q, target.gain, c_f=c1)
+        ch = dict(choices)
+        if "ratio" in topology.choices:
+            bound = topology.limits(tgt).get("ratio_min", 1.0)
+            # C2 the least series value at or above the bound: the synthesis stays exact, both capacitors standard
+            c2 = series_values(spec.c_series, c1 * max(bound, 1.0) * (1 - 1e-9), c1 * max(bound, 1.0) * 20)
+            if c2.size == 0 or c2[0] > spec.c_max * (1 + 1e-9):
+                problem = problem or f"C2 = {format_eng(c1 * max(bound, 1.0), 'F')} (C2/C1 >= {bound:.4g}) is above " \
+                                     f"--c-max {format_eng(spec.c_max, 'F')}"
+                continue
+            ch["ratio"] = float(c2[0]) / c1
+        vals = topology.synthesize(tgt, **ch)
+        per_part = {}
+        for ref, v in vals.items():
+            kind = "r" if ref.startswith("R") else "c"
+            series = spec.r_series if kind == "r" else spec.c_series
+            per_part[ref] = _neighbours(v, series, getattr(spec, f"{kind}_min"), getattr(spec, f"{kind}_max"))
+            if not per_part[ref]:
+                problem = problem or _bound_words(ref, v, spec)
+        if any(not c for c in per_part.values()):
+            continue
+        if continuous is None:
+            continuous = vals
+            nearest = tuple(min(per_part[r], key=lambda x, v=vals[r]: abs(math.log(x / v))) for r in vals)
+        for combo in itertools.product(*per_part.values()):
+            if combo not in index:
+                index[combo] = len(cands)
+                cands.append(dict(zip(vals, combo)))
+    if not cands:
+        raise DesignError(f"topology: {where} is not realisable within the part bounds: {problem}; change --fc, "
+                          "--impedance or the part bounds", param="topology")
+    return continuous, cands, index[nearest]
+
+
+def analysis_grid(spec: FilterSpec, order: int, fc_hz: float) -> dict:
+    """The frequencies the design is judged on.
+
+    Parameters
+    ----------
+    spec : FilterSpec
+        The specification.
+    order, fc_hz : int, float
+        The order and cut-off.
+
+    Returns
+    -------
+    dict
+        ``passband_edge_hz`` (the mask's, or the ideal's -3 dB point; a Chebyshev's ripple
+        edge in the ripple convention), ``transition_end_hz`` (the mask's stopband edge, or
+        where the ideal is 20 dB down), ``objective`` and ``passband`` (Hz arrays) and
+        ``sweep_hz`` (the SPICE sweep).
+    """
+    low = spec.response == "lowpass"
+    wide = np.geomspace(fc_hz / 1000, fc_hz * 1000, 6001)
+    db = 20 * np.log10(np.abs(_reference(spec, order, fc_hz, wide)))
+    f3 = _crossing(wide, db, -10 * math.log10(2), low)
+    if spec.has_mask:
+        fp, ft = spec.passband_hz, spec.stopband_hz
+    else:
+        fp = fc_hz if spec.family == "chebyshev" and spec.chebyshev_cutoff == "ripple" else f3
+        ft = _crossing(wide, db, -TRANSITION_DB, low)
+    if low:
+        obj, pb = np.geomspace(fp / 10, ft, GRID_POINTS), np.geomspace(fp / 10, fp, GRID_POINTS // 2)
+        sweep = (fp / 30, max(ft, fp) * 30)
+    else:
+        obj, pb = np.geomspace(ft, fp * 10, GRID_POINTS), np.geomspace(fp, fp * 10, GRID_POINTS // 2)
+        sweep = (min(ft, fp) / 30, fp * 30)
+    return {"passband_edge_hz": float(fp), "transition_end_hz": float(ft), "f3_target_hz": float(f3),
+            "objective": obj, "passband": pb, "sweep_hz": (float(sweep[0]), float(sweep[1]))}
+
+
+def _reference(spec: FilterSpec, order: int, fc_hz: float, f) -> np.ndarray:
+    """The target H(j 2 pi f): scipy's design at passband gain ``spec.gain``."""
+    return spec.gain * reference_response(f, spec.response, spec.family, order, fc_hz, spec.ripple_db or 1.0,
+                                          spec.bessel_norm, spec.chebyshev_cutoff)
+
+
+def _crossing(f: np.ndarray, db: np.ndarray, level: float, low: bool) -> float:
+    """Where ``db`` (relative to the passband) last stays above ``level`` coming from the passband:
+    the highest such f for a low-pass, the lowest for a high-pass; linear in log f between samples."""
+    above = np.flatnonzero(db >= level)
+    if above.size == 0:
+        return float("nan")
+    i = above[-1] if low else above[0]
+    j = i + 1 if low else i - 1
+    if j < 0 or j >= len(f):
+        return float(f[i])
+    t = (db[i] - level) / (db[i] - db[j])
+    return float(math.exp(math.log(f[i]) + t * (math.log(f[j]) - math.log(f[i]))))
+
+
+def _split_gains(plans: list, gain: float, strategy: str) -> list:
+    """Stage gains: ``even`` (equal dB over the second-order stages) or ``last`` (all in the last one)."""
+    second = [i for i, p in enumerate(plans) if p.order == 2]
+    gains = [1.0] * len(plans)
+    if not second:
+        gains[-1] = gain
+    elif strategy == "even":
+        for i in second:
+            gains[i] = gain ** (1 / len(second))
+    else:
+        gains[second[-1]] = gain
+    return gains
+
+
+def _node_peaks(plans: list, gains: list, amplitude: float, fc_hz: float) -> tuple:
+    """Each stage's peak gain alone and its output's peak at ``amplitude`` (ideal sections)."""
+    f = np.geomspace(fc_hz / 1000, fc_hz * 1000, 4001)
+    s = 2j * math.pi * f
+    h_cum = np.ones_like(s)
+    peaks, nodes = [], []
+    for p, g in zip(plans, gains):
+        wn = 2 * math.pi * p.fn_hz
+        if p.order == 1:
+            h = wn / (s + wn) if p.kind == "lowpass" else s / (s + wn)
+        else:
+            den = s * s + s * wn / p.q + wn * wn
+            h = wn * wn / den if p.kind == "lowpass" else s * s / den
+        h = g * h
+        h_cum = h_cum * h
+        peaks.append(float(np.max(np.abs(h))))
+        nodes.append(float(amplitude * np.max(np.abs(h_cum))))
+    return peaks, nodes
+
+
+def _noise_gain(topology, gain: float) -> float:
+    return 1.0 + gain if topology.inverting else gain
+
+
+def _check_gbw(stages: list, spec: FilterSpec, opamp) -> None:
+    for st in stages:
+        if st.gbw_needed_hz > opamp.gbw_hz:
+            faster = sorted((opamps.get(n) for n in opamps.names() if n != "ideal"), key=lambda o: o.gbw_hz)
+            ok = [o.name for o in faster if o.gbw_hz >= st.gbw_needed_hz]
+            instead = f"use {ok[0]} ({format_eng(opamps.get(ok[0]).gbw_hz, 'Hz')})" if ok else \
+                "no catalogue op-amp is fast enough: lower fc, Q or the gain"
+            q = f", Q {st.plan.q:.3g}" if st.plan.q else ""
+            raise DesignError(
+                f"opamp: {opamp.name} (GBW {format_eng(opamp.gbw_hz, 'Hz')}) is too slow for stage {st.number} "
+                f"({st.topology}, fn {format_eng(st.plan.fn_hz, 'Hz')}{q}, gain {st.gain:.3g}): it needs GBW >= "
+                f"{spec.gbw_margin:g} x fn x Q x noise gain = {format_eng(st.gbw_needed_hz, 'Hz')}; {instead}, or "
+                "lower --gbw-margin", param="opamp")
+
+
+def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-cli") -> FilterDesign:
+    """Design the filter ``spec`` asks for.
+
+    Parameters
+    ----------
+    spec : FilterSpec
+        The specification.
+    simulate : bool
+        Also run :func:`verify_spice` (ngspice ``.ac`` of the chosen cascade).
+    simulator : str
+        ``ngspice-cli`` or ``pyspice``.
+
+    Returns
+    -------
+    FilterDesign
+        Stages in build order, parts chosen jointly, and the figures: ``error_joint_db``,
+        ``error_per_stage_db``, ``error_nearest_db``, ``error_continuous_db`` (the worst
+        deviation from the ideal over the objective grid, op-amp included, of each
+        choice), ``passband_deviation_db``, ``f3_hz`` against ``f3_target_hz``, the
+        search's size and time, and the mask's margins when a mask was given.
+
+    Raises
+    ------
+    DesignError
+        Anything unrealisable, one line: the order a mask needs above 10, a stage no
+        section realises within the bounds, an op-amp too slow, a node that clips.
+    """
+    opamp = opamps.get(spec.opamp)
+    if spec.has_mask:
+        order, fc = order_from_mask(spec.response, spec.family, spec.passband_hz, spec.max_loss_db,
+                                    spec.stopband_hz, spec.min_attenuation_db, spec.bessel_norm)
+    else:
+        order, fc = spec.order, spec.fc_hz
+    plans = plan_sections(spec.response, spec.family, order, fc, spec.ripple_db or 1.0, spec.bessel_norm,
+                          spec.chebyshev_cutoff)
+    n = len(plans)
+    if spec.stage_order is not None:
+        if sorted(spec.stage_order) != list(range(1, n + 1)):
+            raise DesignError(f"stage_order must list the stages 1 to {n} (in rising Q) once each, got "
+                              f"{','.join(map(str, spec.stage_order))}", param="stage_order")
+        plans = [plans[i - 1] for i in spec.stage_order]
+    if len(spec.topology) not in (1, n):
+        raise DesignError(f"topology: give one topology or one per stage ({n} stages), got {len(spec.topology)}",
+                          param="topology")
+    families = list(spec.topology) * n if len(spec.topology) == 1 else list(spec.topology)
+    swing = min(opamp.vout_max, -opamp.vout_min)
+    for strategy in ("even", "last"):
+        gains = _split_gains(plans, spec.gain, strategy)
+        peaks, nodes = _node_peaks(plans, gains, spec.amplitude_v, fc)
+        if max(nodes) <= swing:
+            break
+    else:
+        worst = int(np.argmax(nodes))
+        raise DesignError(f"amplitude_v: stage {worst + 1}'s output peaks at {nodes[worst]:.3g} V at --amplitude "
+                          f"{spec.amplitude_v:g} V, beyond {opamp.name}'s swing of +-{swing:.3g} V; lower "
+                          "--amplitude or --gain", param="amplitude_v")
+    grid = analysis_grid(spec, order, fc)
+    f_obj = grid["objective"]
+    s_obj = 2j * math.pi * f_obj
+    stages = []
+    t0 = time.perf_counter()
+    for i, (p, g, fam) in enumerate(zip(plans, gains, families), 1):
+        target = SectionTarget(p.kind, p.fn_hz, p.q, g, impedance_ohm=spec.impedance_ohm)
+        tries = ["sallen-key", "mfb"] if fam == "auto" else [fam]
+        for k, fam_try in enumerate(tries):
+            name = section_name(p.kind, p.order, fam_try, g)
+            topo = get_topology(name)
+            q = f", Q {p.q:.4g}" if p.q else ""
+            where = f"stage {i} ({name}, fn {format_eng(p.fn_hz, 'Hz')}{q}, gain {g:.4g})"
+            try:
+                continuous, cands, nearest = stage_candidates(topo, target, spec, where)
+                break
+            except DesignError:
+                if k == len(tries) - 1:
+                    raise
+        ideal_db = 20 * np.log10(np.abs(topo.response(continuous, s_obj)))
+        arrays = {r: np.array([c[r] for c in cands])[:, None] for r in topo.designators}
+        cand_db = 20 * np.log10(np.abs(topo.response(arrays, s_obj[None, :], opamp)))
+        stages.append(StageDesign(i, p, name, g, continuous, cands, cand_db - ideal_db[None, :], nearest,
+                                  peak_gain=peaks[i - 1], node_peak_v=nodes[i - 1],
+                                  gbw_needed_hz=spec.gbw_margin * p.fn_hz * (p.q or 1.0) * _noise_gain(topo, g)))
+    _check_gbw(stages, spec, opamp)
+    errors = [st.errors for st in stages]
+    t_cand = time.perf_counter() - t0
+    t1 = time.perf_counter()
+    choice, j_joint, examined = joint_search(errors)
+    t_search = time.perf_counter() - t1
+    for st, c in zip(stages, choice):
+        st.chosen = c
+    result = FilterDesign(spec, order, fc, stages)
+    result.figures = _figures(result, grid, errors, choice, j_joint, examined, t_cand, t_search)
+    if simulate:
+        result.spice = verify_spice(result, simulator)
+    return result
+
+
+def _figures(result: FilterDesign, grid: dict, errors, choice, j_joint, examined, t_cand, t_search) -> dict:
+    spec, opamp, stages = result.spec, result.opamp, result.stages
+    low = spec.response == "lowpass"
+    cont = result.cascade("continuous")
+    chosen = result.cascade()
+    f_obj = grid["objective"]
+    ideal_obj = 20 * np.log10(np.abs(_reference(spec, result.order, result.fc_hz, f_obj)))
+    cont_db = 20 * np.log10(np.abs(cont.response(2j * math.pi * f_obj, opamp)))
+    pb = grid["passband"]
+    dev_pb = np.abs(20 * np.log10(np.abs(chosen.response(2j * math.pi * pb, opamp)))
+                    - 20 * np.log10(np.abs(_reference(spec, result.order, result.fc_hz, pb))))
+    wide = np.geomspace(result.fc_hz / 1000, result.fc_hz * 1000, 6001)
+    g_db = 20 * math.log10(spec.gain)
+    got_db = 20 * np.log10(np.abs(chosen.response(2j * math.pi * wide, opamp))) - g_db
+    figs = {
+        "order": result.order, "fc_hz": result.fc_hz,
+        "passband_edge_hz": grid["passband_edge_hz"], "transition_end_hz": grid["transition_end_hz"],
+        "f3_target_hz": grid["f3_target_hz"], "f3_hz": _crossing(wide, got_db, -10 * math.log10(2), low),
+        "passband_deviation_db": float(np.max(dev_pb)),
+        "error_joint_db": j_joint,
+        "error_per_stage_db": objective(errors, per_stage(errors)),
+        "error_nearest_db": objective(errors, [st.nearest for st in stages]),
+        "error_continuous_db": float(np.max(np.abs(cont_db - ideal_obj))),
+        "combinations": int(np.prod([len(e) for e in errors], dtype=float)),
+        "examined": int(examined), "candidates_s": t_cand, "search_s": t_search,
+        "inverting": sum(get_topology(st.topology).inverting for st in stages) % 2 == 1,
+        "sweep_hz": grid["sweep_hz"],
+    }
+    if spec.has_mask:
+        h = lambda f: 20 * math.log10(abs(complex(chosen.response(2j * math.pi * f, opamp)))) - g_db  # noqa: E731
+        figs["mask_passband_margin_db"] = spec.max_loss_db + h(spec.passband_hz)
+        figs["mask_stopband_margin_db"] = -h(spec.stopband_hz) - spec.min_attenuation_db
+    return figs
+
+
+def verify_spice(result: FilterDesign, simulator: str = "ngspice-cli") -> dict:
+    """ngspice ``.ac`` of the chosen cascade against its analytic response with the
+    op-amp-aware model (the same A0 and GBW as the deck's behavioural op-amp).
+
+    Parameters
+    ----------
+    result : FilterDesign
+        The design.
+    simulator : str
+        ``ngspice-cli`` or ``pyspice``.
+
+    Returns
+    -------
+    dict
+        ``max_deviation_passband_db`` (over the passband grid's span) and
+        ``max_deviation_60db_db`` (wherever the response is within 60 dB of the
+        passband gain), ``points``.
+    """
+    lo, hi = result.figures["sweep_hz"]
+    opamp = result.opamp
+    chosen = result.cascade()
+    f, h = simulate_ac(chosen.netlist(), opamp, lo, hi, simulator=simulator)
+    an = chosen.response(2j * math.pi * f, opamp)
+    dev = np.abs(20 * np.log10(np.abs(h)) - 20 * np.log10(np.abs(an)))
+    fp = result.figures["passband_edge_hz"]
+    low = result.spec.response == "lowpass"
+    in_pb = (f >= fp / 10) & (f <= fp) if low else (f >= fp) & (f <= fp * 10)
+    within = 20 * np.log10(np.abs(an)) >= 20 * math.log10(result.spec.gain) - 60
+    return {"simulator": simulator, "points": int(f.size),
+            "max_deviation_passband_db": float(np.max(dev[in_pb])),
+            "max_deviation_60db_db": float(np.max(dev[within]))}
