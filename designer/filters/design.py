@@ -337,7 +337,7 @@ def analysis_grid(spec: FilterSpec, order: int, fc_hz: float) -> dict:
     """
     low = spec.response == "lowpass"
     wide = np.geomspace(fc_hz / 1000, fc_hz * 1000, 6001)
-    db = 20 * np.log10(np.abs(_reference(spec, order, fc_hz, wide)))
+    db = 20 * np.log10(np.abs(_reference(spec, order, fc_hz, wide)) / spec.gain)
     f3 = _crossing(wide, db, -10 * math.log10(2), low)
     if spec.has_mask:
         fp, ft = spec.passband_hz, spec.stopband_hz
@@ -412,19 +412,20 @@ def _noise_gain(topology, gain: float) -> float:
     return 1.0 + gain if topology.inverting else gain
 
 
-def _check_gbw(stages: list, spec: FilterSpec, opamp) -> None:
-    for st in stages:
-        if st.gbw_needed_hz > opamp.gbw_hz:
-            faster = sorted((opamps.get(n) for n in opamps.names() if n != "ideal"), key=lambda o: o.gbw_hz)
-            ok = [o.name for o in faster if o.gbw_hz >= st.gbw_needed_hz]
-            instead = f"use {ok[0]} ({format_eng(opamps.get(ok[0]).gbw_hz, 'Hz')})" if ok else \
-                "no catalogue op-amp is fast enough: lower fc, Q or the gain"
-            q = f", Q {st.plan.q:.3g}" if st.plan.q else ""
-            raise DesignError(
-                f"opamp: {opamp.name} (GBW {format_eng(opamp.gbw_hz, 'Hz')}) is too slow for stage {st.number} "
-                f"({st.topology}, fn {format_eng(st.plan.fn_hz, 'Hz')}{q}, gain {st.gain:.3g}): it needs GBW >= "
-                f"{spec.gbw_margin:g} x fn x Q x noise gain = {format_eng(st.gbw_needed_hz, 'Hz')}; {instead}, or "
-                "lower --gbw-margin", param="opamp")
+def _check_gbw(number: int, plan: SectionPlan, name: str, gain: float, need: float, spec: FilterSpec,
+               opamp) -> None:
+    """Refuse a stage whose op-amp is too slow (one line naming the catalogue's op-amp that is fast enough)."""
+    if need <= opamp.gbw_hz:
+        return
+    faster = sorted((opamps.get(n) for n in opamps.names() if n != "ideal"), key=lambda o: o.gbw_hz)
+    ok = [o for o in faster if o.gbw_hz >= need]
+    instead = f"use {ok[0].name} ({format_eng(ok[0].gbw_hz, 'Hz')})" if ok else \
+        "no catalogue op-amp is fast enough: lower fc, Q or the gain"
+    q = f", Q {plan.q:.3g}" if plan.q else ""
+    raise DesignError(
+        f"opamp: {opamp.name} (GBW {format_eng(opamp.gbw_hz, 'Hz')}) is too slow for stage {number} ({name}, fn "
+        f"{format_eng(plan.fn_hz, 'Hz')}{q}, gain {gain:.3g}): it needs GBW >= {spec.gbw_margin:g} x fn x Q x "
+        f"noise gain = {format_eng(need, 'Hz')}; {instead}, or lower --gbw-margin", param="opamp")
 
 
 def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-cli") -> FilterDesign:
@@ -496,6 +497,8 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
             topo = get_topology(name)
             q = f", Q {p.q:.4g}" if p.q else ""
             where = f"stage {i} ({name}, fn {format_eng(p.fn_hz, 'Hz')}{q}, gain {g:.4g})"
+            need = spec.gbw_margin * p.fn_hz * (p.q or 1.0) * _noise_gain(topo, g)
+            _check_gbw(i, p, name, g, need, spec, opamp)
             try:
                 continuous, cands, nearest = stage_candidates(topo, target, spec, where)
                 break
@@ -507,8 +510,7 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         cand_db = 20 * np.log10(np.abs(topo.response(arrays, s_obj[None, :], opamp)))
         stages.append(StageDesign(i, p, name, g, continuous, cands, cand_db - ideal_db[None, :], nearest,
                                   peak_gain=peaks[i - 1], node_peak_v=nodes[i - 1],
-                                  gbw_needed_hz=spec.gbw_margin * p.fn_hz * (p.q or 1.0) * _noise_gain(topo, g)))
-    _check_gbw(stages, spec, opamp)
+                                  gbw_needed_hz=need))
     errors = [st.errors for st in stages]
     t_cand = time.perf_counter() - t0
     t1 = time.perf_counter()
