@@ -166,10 +166,23 @@ class FilterDesign:
                         for st in self.stages])
 
     def deck(self) -> str:
-        """The ngspice ``.ac`` deck of the chosen cascade (standalone)."""
+        """The ngspice ``.ac`` deck of the chosen cascade, standalone: ``ngspice -b`` prints its
+        ``.meas`` of the passband gain and the -3 dB frequency (dB relative to 1 V in)."""
         lo, hi = self.figures["sweep_hz"]
-        return ac_deck(self.cascade().netlist(), self.opamp, lo, hi,
+        text = ac_deck(self.cascade().netlist(), self.opamp, lo, hi,
                        title=f"{self.spec.family} {self.spec.response} order {self.order}")
+        low = self.spec.response == "lowpass"
+        fp = self.figures["passband_edge_hz"]
+        level = 20 * math.log10(self.spec.gain) - 10 * math.log10(2)
+        lines = text.rstrip().splitlines()
+        ac = next(i for i, line in enumerate(lines) if line.startswith(".ac "))
+        # the sweep and its measurements in a .control block: ngspice's batch-mode .meas cannot parse vdb()
+        # (no vector is saved for it), and `quit 0` ends a batch run without dot analyses with status 0
+        control = [".control", lines[ac][1:], f"meas ac passband_db find vdb(vout) at={fp / 10 if low else fp * 10:.6g}",
+                   # the last crossing for a low-pass, the first for a high-pass: a Chebyshev's ripple stays above it
+                   f"meas ac f3db_hz when vdb(vout)={level:.6g} " + ("cross=last" if low else "cross=1"),
+                   "quit 0", ".endc"]
+        return "\n".join(lines[:ac] + lines[ac + 1:-1] + control + [".end"]) + "\n"
 
     def to_dict(self) -> dict:
         """Everything as JSON-ready data."""
