@@ -47,7 +47,7 @@ FLAGS = {
     "step_time_s": "--step-time", "step_amplitude": "--step-amplitude",
     # simulate-capture (its step_v, step_time_s as above)
     # design-filter
-    "response": "--type", "family": "--family", "order": "--order", "ripple_db": "--ripple",
+    "filter_type": "--type", "family": "--family", "order": "--order", "ripple_db": "--ripple",
     "passband_hz": "--passband", "max_loss_db": "--max-loss", "stopband_hz": "--stopband",
     "min_attenuation_db": "--min-attenuation", "topology": "--topology", "stage_order": "--stage-order",
     "bessel_norm": "--bessel-norm", "chebyshev_cutoff": "--chebyshev-cutoff", "gbw_margin": "--gbw-margin",

@@ -37,7 +37,7 @@ def _parser():
                        "scipy's prototypes, Sallen-Key or MFB stages in rising Q, E-series parts chosen jointly "
                        "across the stages, each stage's op-amp checked, the cascade checked in ngspice.", EPILOG)
     r = p.add_argument_group("response")
-    r.add_argument("--type", dest="response", default="lowpass", metavar="TYPE",
+    r.add_argument("--type", dest="filter_type", default="lowpass", metavar="TYPE",
                    help="lowpass or highpass (default lowpass)")
     r.add_argument("--family", default="butterworth",
                    help="butterworth (maximally flat), bessel (flat group delay) or chebyshev (equiripple "
@@ -91,7 +91,7 @@ def _parser():
 
 def _spec(args):
     from ..filters.spec import FilterSpec
-    keys = ("response", "family", "order", "fc_hz", "ripple_db", "bessel_norm", "chebyshev_cutoff", "passband_hz",
+    keys = ("filter_type", "family", "order", "fc_hz", "ripple_db", "bessel_norm", "chebyshev_cutoff", "passband_hz",
             "max_loss_db", "stopband_hz", "min_attenuation_db", "topology", "stage_order", "gain", "opamp",
             "amplitude_v", "gbw_margin", "impedance_ohm", "r_series", "c_series", "r_min", "r_max", "c_min",
             "c_max")
@@ -125,7 +125,7 @@ def summary_text(result) -> str:
         conv = f"{s.ripple_db:g} dB ripple, " + ("ripple edge" if s.chebyshev_cutoff == "ripple" else "-3 dB")
     else:
         conv = "-3 dB" if s.family == "butterworth" or s.bessel_norm == "mag" else "delay-normalised"
-    kind = "low-pass" if s.response == "lowpass" else "high-pass"
+    kind = "low-pass" if s.filter_type == "lowpass" else "high-pass"
     lines = [f"{_ordinal(result.order)}-order {s.family.capitalize()} {kind}, fc {format_eng(result.fc_hz, 'Hz')} "
              f"({conv}), gain {s.gain:g}" + (" (inverting)" if f["inverting"] else "")
              + f"; op-amp {op.name} (GBW {format_eng(op.gbw_hz, 'Hz')})"]
@@ -146,7 +146,7 @@ def summary_text(result) -> str:
             parts.append(f"{topo.prefixed(ref, str(st.number) + '0')} {format_eng(st.values[ref], unit)} "
                          f"({format_eng(st.continuous[ref], unit)})")
         lines.append("     " + ", ".join(parts))
-    lo, hi = (f["passband_edge_hz"] / 10, f["transition_end_hz"]) if s.response == "lowpass" else \
+    lo, hi = (f["passband_edge_hz"] / 10, f["transition_end_hz"]) if s.filter_type == "lowpass" else \
         (f["transition_end_hz"], f["passband_edge_hz"] * 10)
     lines += [f"Achieved with the chosen parts and the {op.name} model:",
               f"  max passband deviation from the ideal  {f['passband_deviation_db']:.3g} dB",

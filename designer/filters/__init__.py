@@ -9,7 +9,12 @@ stages, the ngspice proof). Below the wings: it imports ``core`` and ``spice`` o
 
 from .cascade import Cascade, Stage
 from .deck import ac_deck, simulate_ac
-from .design import FilterDesign, StageDesign, design, verify_spice
+from .design import (FilterDesign, StageDesign, analysis_grid, design, section_name, stage_candidates,
+                     verify_spice)
+from .joint import brute_force, descend, joint_search, objective, per_stage
+from .prototype import (BESSEL_NORMS, CHEBYSHEV_CUTOFFS, FAMILIES, MAX_ORDER, RESPONSE_TYPES, SectionPlan,
+                        chebyshev_3db_factor, order_from_mask, plan_sections, prototype_zpk, reference_ba,
+                        reference_response)
 from .inverting_lowpass import InvertingLowPass
 from .mfb_bandpass import MfbBandPass
 from .mfb_highpass import MfbHighPass
@@ -20,7 +25,7 @@ from .registry import REGISTRY, get, names, register
 from .sallen_key import GAIN_PARTS, SallenKeySection
 from .sallen_key_highpass import SallenKeyHighPass
 from .sallen_key_lowpass import SallenKeyLowPass, sallen_key_ratio_min
-from .spec import FilterSpec
+from .spec import TOPOLOGY_CHOICES, FilterSpec
 from .topology import (
     DEFAULT_IMPEDANCE_OHM,
     KINDS,
@@ -35,8 +40,11 @@ from .topology import (
     quadratic_root,
 )
 
-__all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "FilterDesign", "StageDesign", "design", "verify_spice",
-           "FilterSpec", "InvertingLowPass", "MfbBandPass", "MfbHighPass",
+__all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "FilterDesign", "StageDesign", "analysis_grid", "design",
+           "section_name", "stage_candidates", "verify_spice", "brute_force", "descend", "joint_search", "objective",
+           "per_stage", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER", "RESPONSE_TYPES", "SectionPlan",
+           "chebyshev_3db_factor", "order_from_mask", "plan_sections", "prototype_zpk", "reference_ba",
+           "reference_response", "TOPOLOGY_CHOICES", "FilterSpec", "InvertingLowPass", "MfbBandPass", "MfbHighPass",
            "MfbLowPass", "RcHighPass", "RcLowPass", "REGISTRY", "get", "names", "register", "GAIN_PARTS",
            "SallenKeySection", "SallenKeyHighPass", "SallenKeyLowPass", "sallen_key_ratio_min",
            "DEFAULT_IMPEDANCE_OHM", "KINDS", "Figures", "PartSpec", "SectionTarget", "Topology", "nodal_response",

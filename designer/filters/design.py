@@ -109,7 +109,13 @@ class StageDesign:
         return self.candidates[self.chosen]
 
     def to_dict(self) -> dict:
-        """The stage as JSON."""
+        """The stage as JSON.
+
+        Returns
+        -------
+        dict
+            Its figures, its continuous and its chosen part values.
+        """
         return {"stage": self.number, "topology": self.topology, "kind": self.plan.kind, "order": self.plan.order,
                 "fn_hz": self.plan.fn_hz, "q": self.plan.q, "gain": self.gain,
                 "inverting": get_topology(self.topology).inverting, "peak_gain": self.peak_gain,
@@ -167,11 +173,17 @@ class FilterDesign:
 
     def deck(self) -> str:
         """The ngspice ``.ac`` deck of the chosen cascade, standalone: ``ngspice -b`` prints its
-        ``.meas`` of the passband gain and the -3 dB frequency (dB relative to 1 V in)."""
+        ``.meas`` of the passband gain and the -3 dB frequency (dB relative to 1 V in).
+
+        Returns
+        -------
+        str
+            The deck's text.
+        """
         lo, hi = self.figures["sweep_hz"]
         text = ac_deck(self.cascade().netlist(), self.opamp, lo, hi,
-                       title=f"{self.spec.family} {self.spec.response} order {self.order}")
-        low = self.spec.response == "lowpass"
+                       title=f"{self.spec.family} {self.spec.filter_type} order {self.order}")
+        low = self.spec.filter_type == "lowpass"
         fp = self.figures["passband_edge_hz"]
         level = 20 * math.log10(self.spec.gain) - 10 * math.log10(2)
         lines = text.rstrip().splitlines()
@@ -185,9 +197,15 @@ class FilterDesign:
         return "\n".join(lines[:ac] + lines[ac + 1:-1] + control + [".end"]) + "\n"
 
     def to_dict(self) -> dict:
-        """Everything as JSON-ready data."""
+        """Everything as JSON-ready data.
+
+        Returns
+        -------
+        dict
+            ``spec``, ``opamp``, ``stages``, ``figures`` and ``spice``.
+        """
         s = self.spec
-        return {"spec": {"response": s.response, "family": s.family, "order": self.order, "fc_hz": self.fc_hz,
+        return {"spec": {"filter_type": s.filter_type, "family": s.family, "order": self.order, "fc_hz": self.fc_hz,
                          "ripple_db": s.ripple_db, "bessel_norm": s.bessel_norm,
                          "chebyshev_cutoff": s.chebyshev_cutoff, "gain": s.gain,
                          "mask": ({"passband_hz": s.passband_hz, "max_loss_db": s.max_loss_db,
@@ -348,7 +366,7 @@ def analysis_grid(spec: FilterSpec, order: int, fc_hz: float) -> dict:
         where the ideal is 20 dB down), ``objective`` and ``passband`` (Hz arrays) and
         ``sweep_hz`` (the SPICE sweep).
     """
-    low = spec.response == "lowpass"
+    low = spec.filter_type == "lowpass"
     wide = np.geomspace(fc_hz / 1000, fc_hz * 1000, 6001)
     db = 20 * np.log10(np.abs(_reference(spec, order, fc_hz, wide)) / spec.gain)
     f3 = _crossing(wide, db, -10 * math.log10(2), low)
@@ -369,7 +387,7 @@ def analysis_grid(spec: FilterSpec, order: int, fc_hz: float) -> dict:
 
 def _reference(spec: FilterSpec, order: int, fc_hz: float, f) -> np.ndarray:
     """The target H(j 2 pi f): scipy's design at passband gain ``spec.gain``."""
-    return spec.gain * reference_response(f, spec.response, spec.family, order, fc_hz, spec.ripple_db or 1.0,
+    return spec.gain * reference_response(f, spec.filter_type, spec.family, order, fc_hz, spec.ripple_db or 1.0,
                                           spec.bessel_norm, spec.chebyshev_cutoff)
 
 
@@ -470,11 +488,11 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
     """
     opamp = opamps.get(spec.opamp)
     if spec.has_mask:
-        order, fc = order_from_mask(spec.response, spec.family, spec.passband_hz, spec.max_loss_db,
+        order, fc = order_from_mask(spec.filter_type, spec.family, spec.passband_hz, spec.max_loss_db,
                                     spec.stopband_hz, spec.min_attenuation_db, spec.bessel_norm)
     else:
         order, fc = spec.order, spec.fc_hz
-    plans = plan_sections(spec.response, spec.family, order, fc, spec.ripple_db or 1.0, spec.bessel_norm,
+    plans = plan_sections(spec.filter_type, spec.family, order, fc, spec.ripple_db or 1.0, spec.bessel_norm,
                           spec.chebyshev_cutoff)
     n = len(plans)
     if spec.stage_order is not None:
@@ -540,7 +558,7 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
 
 def _figures(result: FilterDesign, grid: dict, errors, choice, j_joint, examined, t_cand, t_search) -> dict:
     spec, opamp, stages = result.spec, result.opamp, result.stages
-    low = spec.response == "lowpass"
+    low = spec.filter_type == "lowpass"
     cont = result.cascade("continuous")
     chosen = result.cascade()
     f_obj = grid["objective"]
@@ -598,7 +616,7 @@ def verify_spice(result: FilterDesign, simulator: str = "ngspice-cli") -> dict:
     an = chosen.response(2j * math.pi * f, opamp)
     dev = np.abs(20 * np.log10(np.abs(h)) - 20 * np.log10(np.abs(an)))
     fp = result.figures["passband_edge_hz"]
-    low = result.spec.response == "lowpass"
+    low = result.spec.filter_type == "lowpass"
     in_pb = (f >= fp / 10) & (f <= fp) if low else (f >= fp) & (f <= fp * 10)
     within = 20 * np.log10(np.abs(an)) >= 20 * math.log10(result.spec.gain) - 60
     return {"simulator": simulator, "points": int(f.size),

@@ -47,7 +47,7 @@ class FilterSpec(PartBounds):
 
     Parameters
     ----------
-    response : str
+    filter_type : str
         ``lowpass`` or ``highpass``.
     family : str
         ``butterworth``, ``bessel`` or ``chebyshev``.
@@ -79,7 +79,7 @@ class FilterSpec(PartBounds):
         Part series and bounds (:class:`~designer.core.eseries.PartBounds`).
     """
 
-    response: str = "lowpass"
+    filter_type: str = "lowpass"
     family: str = "butterworth"
     order: int | None = None
     fc_hz: float | None = None
@@ -101,7 +101,7 @@ class FilterSpec(PartBounds):
     def __post_init__(self):
         self.check_bounds()
         put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731  (frozen: set once, here)
-        put("response", _word(self.response, RESPONSE_TYPES, "response"))
+        put("filter_type", _word(self.filter_type, RESPONSE_TYPES, "filter_type"))
         put("family", _word(self.family, FAMILIES, "family"))
         put("bessel_norm", _word(self.bessel_norm, BESSEL_NORMS, "bessel_norm"))
         put("chebyshev_cutoff", _word(self.chebyshev_cutoff, CHEBYSHEV_CUTOFFS, "chebyshev_cutoff"))
@@ -158,10 +158,10 @@ class FilterSpec(PartBounds):
                 not math.isclose(float(self.ripple_db), self.max_loss_db):
             raise DesignError("ripple_db: with a mask the chebyshev ripple is the mask's max_loss_db; leave "
                               "--ripple out", param="ripple_db")
-        low = self.response == "lowpass"
+        low = self.filter_type == "lowpass"
         if (self.passband_hz >= self.stopband_hz) == low:
             need = "below" if low else "above"
-            raise DesignError(f"stopband_hz: a {self.response}'s passband edge ({self.passband_hz:g} Hz) must be "
+            raise DesignError(f"stopband_hz: a {self.filter_type}'s passband edge ({self.passband_hz:g} Hz) must be "
                               f"{need} its stopband edge ({self.stopband_hz:g} Hz)", param="stopband_hz")
         if self.min_attenuation_db <= self.max_loss_db:
             raise DesignError(f"min_attenuation_db ({self.min_attenuation_db:g} dB) must exceed max_loss_db "

@@ -30,7 +30,7 @@ def test_butterworth_4th_order_lowpass_figures():
 
 
 @pytest.mark.parametrize("kw", [dict(order=6, fc_hz=10e3, family="bessel", gain=4.0, opamp="NE5532"),
-                                dict(order=5, fc_hz=1e3, family="chebyshev", ripple_db=0.5, response="highpass",
+                                dict(order=5, fc_hz=1e3, family="chebyshev", ripple_db=0.5, filter_type="highpass",
                                      topology="mfb"),
                                 dict(order=3, fc_hz=200.0, family="butterworth", topology="auto", gain=2.0)])
 def test_gain_split_and_node_peaks(kw):
@@ -39,7 +39,7 @@ def test_gain_split_and_node_peaks(kw):
     swing = min(d.opamp.vout_max, -d.opamp.vout_min)
     assert all(st.node_peak_v <= swing for st in d.stages)
     # the chosen parts' passband gain is the asked one
-    f_pass = np.array([d.fc_hz / 100 if d.spec.response == "lowpass" else d.fc_hz * 30])
+    f_pass = np.array([d.fc_hz / 100 if d.spec.filter_type == "lowpass" else d.fc_hz * 30])
     h = d.cascade().response(2j * math.pi * f_pass)
     assert abs(h[0]) == pytest.approx(kw.get("gain", 1.0), rel=0.1)
 
@@ -80,7 +80,7 @@ def test_mask_design_meets_the_mask():
     (dict(order=4, fc_hz=1e3, gain=50.0, amplitude_v=1.0), "peaks at .* beyond LM741's swing"),
     (dict(order=3, fc_hz=1e3, stage_order=(1, 1)), "must list the stages 1 to 2"),
     (dict(order=4, fc_hz=1e3, topology=("mfb", "mfb", "mfb")), "one per stage"),
-    (dict(order=1, fc_hz=1e3, gain=2.0, response="highpass"), "unity gain"),
+    (dict(order=1, fc_hz=1e3, gain=2.0, filter_type="highpass"), "unity gain"),
 ])
 def test_refusals_are_one_line(kw, words):
     with pytest.raises(DesignError, match=words) as e:
@@ -90,7 +90,7 @@ def test_refusals_are_one_line(kw, words):
 
 @pytest.mark.spice
 @pytest.mark.parametrize("kw", [dict(order=4, fc_hz=1e3, family="butterworth"),
-                                dict(order=5, fc_hz=1e3, family="chebyshev", ripple_db=0.5, response="highpass")])
+                                dict(order=5, fc_hz=1e3, family="chebyshev", ripple_db=0.5, filter_type="highpass")])
 def test_spice_ac_agrees_with_the_analytic_cascade(kw):
     d = design(FilterSpec(**kw), simulate=True)
     assert d.spice["max_deviation_passband_db"] < 0.05

@@ -31,7 +31,7 @@ def test_joint_equals_brute_force_on_random_tables(seed, stages, smooth):
     assert objective(errors, descend(errors, per_stage(errors))) <= objective(errors, per_stage(errors)) + 1e-12
 
 
-@pytest.mark.parametrize("kw", [dict(order=3, fc_hz=1e3, family="bessel", response="highpass"),
+@pytest.mark.parametrize("kw", [dict(order=3, fc_hz=1e3, family="bessel", filter_type="highpass"),
                                 dict(order=4, fc_hz=2e3, family="chebyshev", ripple_db=1.0),
                                 dict(order=5, fc_hz=500.0, family="butterworth", gain=2.0)])
 def test_joint_equals_brute_force_on_a_real_cascade(kw):
