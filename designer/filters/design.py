@@ -21,9 +21,10 @@ Choices made here, and why:
 - the objective of the joint choice is the whole cascade's response with the
   op-amp's finite gain and GBW, against the ideal response, over the passband and
   the transition band, so that the choice also absorbs part of the op-amp's error;
-- the gain is split evenly in dB over the second-order stages (a first-order
-  section here is a unity-gain buffer); if that clips an internal node at the bench
-  amplitude, all the gain goes to the last stage instead; if that still clips, refuse.
+- the gain goes to the lowest-Q second-order stage (a Sallen-Key's Q is the more
+  sensitive to its gain resistors the higher Q is; a first-order section here is a
+  unity-gain buffer); if that clips a stage's output at the bench amplitude, it is
+  split evenly in dB, then all put in the last stage; if every split clips, refuse.
 """
 
 from __future__ import annotations
@@ -300,7 +301,12 @@ def stage_candidates(topology, target: SectionTarget, spec: FilterSpec, where: s
         No candidate within the part bounds (one line naming the part and the bound).
     """
     free = topology.synthesize(target)
-    c_free = min(max(free["C1"], spec.c_min), spec.c_max)
+    # the resistors scale as 1/C at fixed ratios: move C1 so that they all sit inside the bounds when their
+    # spread allows (a high-Q section spreads them by about 4 Q^2 around the impedance)
+    rs = [v for r, v in free.items() if r.startswith("R") and not (r in ("R3", "R4") and "r3" in topology.choices)]
+    k_lo, k_hi = spec.r_min / min(rs), spec.r_max / max(rs)
+    k = 1.0 if k_lo <= 1.0 <= k_hi else math.sqrt(k_lo * k_hi) if k_lo <= k_hi else 1.0
+    c_free = min(max(free["C1"] / k, spec.c_min), spec.c_max)
     # the neighbours of the free value and one more either side: the joint search's freedom per stage
     near = series_values(spec.c_series, spec.c_min, spec.c_max)
     c_choices = [float(c) for c in near[np.argsort(np.abs(np.log(near / c_free)))[:C_CHOICES]]] if near.size else []
@@ -405,8 +411,14 @@ def _crossing(f: np.ndarray, db: np.ndarray, level: float, low: bool) -> float:
     return float(math.exp(math.log(f[i]) + t * (math.log(f[j]) - math.log(f[i]))))
 
 
+#: the gain splits tried in turn until no stage output clips (see :func:`_split_gains`)
+GAIN_STRATEGIES = ("lowest-q", "even", "last")
+
+
 def _split_gains(plans: list, gain: float, strategy: str) -> list:
-    """Stage gains: ``even`` (equal dB over the second-order stages) or ``last`` (all in the last one)."""
+    """Stage gains: ``lowest-q`` (all in the lowest-Q second-order stage: a Sallen-Key's Q is
+    the more sensitive to its gain resistors the higher Q is, SLOA088), ``even`` (equal dB over
+    the second-order stages) or ``last`` (all in the last one)."""
     second = [i for i, p in enumerate(plans) if p.order == 2]
     gains = [1.0] * len(plans)
     if not second:
@@ -414,6 +426,8 @@ def _split_gains(plans: list, gain: float, strategy: str) -> list:
     elif strategy == "even":
         for i in second:
             gains[i] = gain ** (1 / len(second))
+    elif strategy == "lowest-q":
+        gains[min(second, key=lambda i: plans[i].q)] = gain
     else:
         gains[second[-1]] = gain
     return gains
@@ -505,7 +519,7 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
                           param="topology")
     families = list(spec.topology) * n if len(spec.topology) == 1 else list(spec.topology)
     swing = min(opamp.vout_max, -opamp.vout_min)
-    for strategy in ("even", "last"):
+    for strategy in GAIN_STRATEGIES:
         gains = _split_gains(plans, spec.gain, strategy)
         peaks, nodes = _node_peaks(plans, gains, spec.amplitude_v, fc)
         if max(nodes) <= swing:
