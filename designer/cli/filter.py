@@ -38,12 +38,17 @@ def _parser():
                        "across the stages, each stage's op-amp checked, the cascade checked in ngspice.", EPILOG)
     r = p.add_argument_group("response")
     r.add_argument("--type", dest="filter_type", default="lowpass", metavar="TYPE",
-                   help="lowpass or highpass (default lowpass)")
+                   help="lowpass, highpass or bandpass (default lowpass)")
     r.add_argument("--family", default="butterworth",
                    help="butterworth (maximally flat), bessel (flat group delay) or chebyshev (equiripple "
                         "passband, steeper) (default butterworth)")
     r.add_argument("--order", help="filter order, 1 to 10 (or give the mask instead)")
     r.add_argument("--fc", dest="fc_hz", help=f"cut-off frequency, e.g. 1k {help_range('fc_hz')}")
+    r.add_argument("--f-low", dest="f_low_hz", help=f"band-pass: lower band edge {help_range('fc_hz')}")
+    r.add_argument("--f-high", dest="f_high_hz", help=f"band-pass: upper band edge {help_range('fc_hz')}")
+    r.add_argument("--bandpass-method", default="auto", help="band-pass: wide (a high-pass at --f-low then a "
+                   "low-pass at --f-high, order --order each), narrow (the band-pass transformation into --order "
+                   "MFB band-pass sections) or auto (wide from f-high/f-low >= 2; default)")
     r.add_argument("--ripple", dest="ripple_db", help=f"Chebyshev passband ripple in dB {help_range('ripple_db')}, "
                    "default 1 (with a mask: the mask's --max-loss)")
     r.add_argument("--bessel-norm", default="mag", help="Bessel cut-off: mag (-3 dB at --fc, default) or delay")
@@ -92,7 +97,7 @@ def _parser():
 def _spec(args):
     from ..filters.spec import FilterSpec
     keys = ("filter_type", "family", "order", "fc_hz", "ripple_db", "bessel_norm", "chebyshev_cutoff", "passband_hz",
-            "max_loss_db", "stopband_hz", "min_attenuation_db", "topology", "stage_order", "gain", "opamp",
+            "max_loss_db", "stopband_hz", "min_attenuation_db", "f_low_hz", "f_high_hz", "bandpass_method", "topology", "stage_order", "gain", "opamp",
             "amplitude_v", "gbw_margin", "impedance_ohm", "r_series", "c_series", "r_min", "r_max", "c_min",
             "c_max")
     kw = {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
@@ -125,8 +130,14 @@ def summary_text(result) -> str:
         conv = f"{s.ripple_db:g} dB ripple, " + ("ripple edge" if s.chebyshev_cutoff == "ripple" else "-3 dB")
     else:
         conv = "-3 dB" if s.family == "butterworth" or s.bessel_norm == "mag" else "delay-normalised"
-    kind = "low-pass" if s.filter_type == "lowpass" else "high-pass"
-    lines = [f"{_ordinal(result.order)}-order {s.family.capitalize()} {kind}, fc {format_eng(result.fc_hz, 'Hz')} "
+    kind = {"lowpass": "low-pass", "highpass": "high-pass", "bandpass": "band-pass"}[s.filter_type]
+    where = f"fc {format_eng(result.fc_hz, 'Hz')}"
+    if s.filter_type == "bandpass":
+        method = result.to_dict()["spec"]["bandpass_method"]
+        where = f"band {format_eng(s.f_low_hz, 'Hz')} to {format_eng(s.f_high_hz, 'Hz')} ({method}: " + \
+            ("high-pass then low-pass, each" if method == "wide" else "band-pass sections from an") + \
+            f" order-{result.order} prototype)"
+    lines = [f"{_ordinal(result.order)}-order {s.family.capitalize()} {kind}, {where} "
              f"({conv}), gain {s.gain:g}" + (" (inverting)" if f["inverting"] else "")
              + f"; op-amp {op.name} (GBW {format_eng(op.gbw_hz, 'Hz')})"]
     if s.has_mask:
@@ -146,12 +157,12 @@ def summary_text(result) -> str:
             parts.append(f"{topo.prefixed(ref, str(st.number) + '0')} {format_eng(st.values[ref], unit)} "
                          f"({format_eng(st.continuous[ref], unit)})")
         lines.append("     " + ", ".join(parts))
-    lo, hi = (f["passband_edge_hz"] / 10, f["transition_end_hz"]) if s.filter_type == "lowpass" else \
-        (f["transition_end_hz"], f["passband_edge_hz"] * 10)
+    lo, hi = f["objective_range_hz"]
+    f3 = lambda v: " and ".join(format_eng(x, "Hz") for x in v) if isinstance(v, (list, tuple)) \
+        else format_eng(v, "Hz")  # noqa: E731
     lines += [f"Achieved with the chosen parts and the {op.name} model:",
               f"  max passband deviation from the ideal  {f['passband_deviation_db']:.3g} dB",
-              f"  -3 dB frequency                        {format_eng(f['f3_hz'], 'Hz')} (target "
-              f"{format_eng(f['f3_target_hz'], 'Hz')})"]
+              f"  -3 dB frequency                        {f3(f['f3_hz'])} (target {f3(f['f3_target_hz'])})"]
     if s.has_mask:
         lines += [f"  mask margins: passband {f['mask_passband_margin_db']:.3g} dB, stopband "
                   f"{f['mask_stopband_margin_db']:.3g} dB"]

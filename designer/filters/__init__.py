@@ -12,8 +12,9 @@ from .deck import ac_deck, simulate_ac
 from .design import (FilterDesign, StageDesign, analysis_grid, design, section_name, stage_candidates,
                      verify_spice)
 from .joint import brute_force, descend, joint_search, objective, per_stage
-from .prototype import (BESSEL_NORMS, CHEBYSHEV_CUTOFFS, FAMILIES, MAX_ORDER, RESPONSE_TYPES, SectionPlan,
-                        chebyshev_3db_factor, order_from_mask, plan_sections, prototype_zpk, reference_ba,
+from .prototype import (BANDPASS_METHODS, BESSEL_NORMS, CHEBYSHEV_CUTOFFS, FAMILIES, MAX_ORDER, RESPONSE_TYPES,
+                        WIDE_RATIO, SectionPlan, bandpass_method, chebyshev_3db_factor, order_from_mask,
+                        plan_bandpass, plan_sections, prototype_zpk, reference_ba, reference_bandpass,
                         reference_response)
 from .inverting_lowpass import InvertingLowPass
 from .mfb_bandpass import MfbBandPass
@@ -42,7 +43,8 @@ from .topology import (
 
 __all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "FilterDesign", "StageDesign", "analysis_grid", "design",
            "section_name", "stage_candidates", "verify_spice", "brute_force", "descend", "joint_search", "objective",
-           "per_stage", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER", "RESPONSE_TYPES", "SectionPlan",
+           "per_stage", "BANDPASS_METHODS", "WIDE_RATIO", "bandpass_method", "plan_bandpass", "reference_bandpass",
+           "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER", "RESPONSE_TYPES", "SectionPlan",
            "chebyshev_3db_factor", "order_from_mask", "plan_sections", "prototype_zpk", "reference_ba",
            "reference_response", "TOPOLOGY_CHOICES", "FilterSpec", "InvertingLowPass", "MfbBandPass", "MfbHighPass",
            "MfbLowPass", "RcHighPass", "RcLowPass", "REGISTRY", "get", "names", "register", "GAIN_PARTS",

@@ -43,7 +43,8 @@ from ..core.units import format_eng
 from .cascade import Cascade
 from .deck import ac_deck, simulate_ac
 from .joint import joint_search, objective, per_stage
-from .prototype import SectionPlan, order_from_mask, plan_sections, reference_response
+from .prototype import (SectionPlan, bandpass_method, order_from_mask, plan_bandpass, plan_sections,
+                        reference_bandpass, reference_response)
 from .registry import get as get_topology
 from .spec import FilterSpec
 from .topology import SectionTarget
@@ -184,16 +185,19 @@ class FilterDesign:
         lo, hi = self.figures["sweep_hz"]
         text = ac_deck(self.cascade().netlist(), self.opamp, lo, hi,
                        title=f"{self.spec.family} {self.spec.filter_type} order {self.order}")
-        low = self.spec.filter_type == "lowpass"
-        fp = self.figures["passband_edge_hz"]
+        kind = self.spec.filter_type
+        a, b = self.figures["passband_range_hz"]
+        at = {"lowpass": a, "highpass": b, "bandpass": self.fc_hz}[kind]
         level = 20 * math.log10(self.spec.gain) - 10 * math.log10(2)
+        crossings = {"lowpass": [("f3db_hz", "last")], "highpass": [("f3db_hz", "1")],
+                     "bandpass": [("f3db_low_hz", "1"), ("f3db_high_hz", "last")]}[kind]
         lines = text.rstrip().splitlines()
         ac = next(i for i, line in enumerate(lines) if line.startswith(".ac "))
         # the sweep and its measurements in a .control block: ngspice's batch-mode .meas cannot parse vdb()
         # (no vector is saved for it), and `quit 0` ends a batch run without dot analyses with status 0
-        control = [".control", lines[ac][1:], f"meas ac passband_db find vdb(vout) at={fp / 10 if low else fp * 10:.6g}",
-                   # the last crossing for a low-pass, the first for a high-pass: a Chebyshev's ripple stays above it
-                   f"meas ac f3db_hz when vdb(vout)={level:.6g} " + ("cross=last" if low else "cross=1"),
+        # the last crossing for a low-pass, the first for a high-pass: a Chebyshev's ripple stays above it
+        control = [".control", lines[ac][1:], f"meas ac passband_db find vdb(vout) at={at:.6g}",
+                   *(f"meas ac {name} when vdb(vout)={level:.6g} cross={cross}" for name, cross in crossings),
                    "quit 0", ".endc"]
         return "\n".join(lines[:ac] + lines[ac + 1:-1] + control + [".end"]) + "\n"
 
@@ -212,6 +216,9 @@ class FilterDesign:
                          "mask": ({"passband_hz": s.passband_hz, "max_loss_db": s.max_loss_db,
                                    "stopband_hz": s.stopband_hz, "min_attenuation_db": s.min_attenuation_db}
                                   if s.has_mask else None),
+                         "f_low_hz": s.f_low_hz, "f_high_hz": s.f_high_hz,
+                         "bandpass_method": (bandpass_method(s.f_low_hz, s.f_high_hz, s.bandpass_method)
+                                             if s.filter_type == "bandpass" else None),
                          "r_series": s.r_series, "c_series": s.c_series, "amplitude_v": s.amplitude_v,
                          "gbw_margin": s.gbw_margin},
                 "opamp": self.opamp.to_dict(), "stages": [st.to_dict() for st in self.stages],
@@ -242,6 +249,8 @@ def section_name(kind: str, order: int, family: str, gain: float) -> str:
     DesignError
         A first-order stage with gain that no section realises (one line).
     """
+    if kind == "bandpass":
+        return "mfb-bandpass"   # the registry's one band-pass section, whatever the topology asked
     if order == 1:
         if kind == "lowpass" and (family == "mfb" or gain > 1 + 1e-12):
             return "inverting-lowpass"
@@ -362,37 +371,48 @@ def analysis_grid(spec: FilterSpec, order: int, fc_hz: float) -> dict:
     spec : FilterSpec
         The specification.
     order, fc_hz : int, float
-        The order and cut-off.
+        The order and cut-off (a band-pass's centre).
 
     Returns
     -------
     dict
         ``passband_edge_hz`` (the mask's, or the ideal's -3 dB point; a Chebyshev's ripple
-        edge in the ripple convention), ``transition_end_hz`` (the mask's stopband edge, or
-        where the ideal is 20 dB down), ``objective`` and ``passband`` (Hz arrays) and
-        ``sweep_hz`` (the SPICE sweep).
+        edge in the ripple convention; a band-pass's two edges), ``transition_end_hz`` (the
+        mask's stopband edge, or where the ideal is 20 dB down; two for a band-pass),
+        ``f3_target_hz``, ``passband_range_hz`` and ``objective_range_hz`` (Hz pairs),
+        ``objective`` and ``passband`` (Hz arrays) and ``sweep_hz`` (the SPICE sweep).
     """
-    low = spec.filter_type == "lowpass"
+    kind = spec.filter_type
     wide = np.geomspace(fc_hz / 1000, fc_hz * 1000, 6001)
     db = 20 * np.log10(np.abs(_reference(spec, order, fc_hz, wide)) / spec.gain)
-    f3 = _crossing(wide, db, -10 * math.log10(2), low)
-    if spec.has_mask:
-        fp, ft = spec.passband_hz, spec.stopband_hz
+    level3 = -10 * math.log10(2)
+    if kind == "bandpass":
+        f3 = [_crossing(wide, db, level3, False), _crossing(wide, db, level3, True)]
+        fp = [spec.f_low_hz, spec.f_high_hz]
+        ft = [_crossing(wide, db, -TRANSITION_DB, False), _crossing(wide, db, -TRANSITION_DB, True)]
+        pb_range, obj_range = (fp[0], fp[1]), (ft[0], ft[1])
     else:
-        fp = fc_hz if spec.family == "chebyshev" and spec.chebyshev_cutoff == "ripple" else f3
-        ft = _crossing(wide, db, -TRANSITION_DB, low)
-    if low:
-        obj, pb = np.geomspace(fp / 10, ft, GRID_POINTS), np.geomspace(fp / 10, fp, GRID_POINTS // 2)
-        sweep = (fp / 30, max(ft, fp) * 30)
-    else:
-        obj, pb = np.geomspace(ft, fp * 10, GRID_POINTS), np.geomspace(fp, fp * 10, GRID_POINTS // 2)
-        sweep = (min(ft, fp) / 30, fp * 30)
-    return {"passband_edge_hz": float(fp), "transition_end_hz": float(ft), "f3_target_hz": float(f3),
-            "objective": obj, "passband": pb, "sweep_hz": (float(sweep[0]), float(sweep[1]))}
+        low = kind == "lowpass"
+        f3 = _crossing(wide, db, level3, low)
+        if spec.has_mask:
+            fp, ft = spec.passband_hz, spec.stopband_hz
+        else:
+            fp = fc_hz if spec.family == "chebyshev" and spec.chebyshev_cutoff == "ripple" else f3
+            ft = _crossing(wide, db, -TRANSITION_DB, low)
+        pb_range = (fp / 10, fp) if low else (fp, fp * 10)
+        obj_range = (fp / 10, ft) if low else (ft, fp * 10)
+    return {"passband_edge_hz": fp, "transition_end_hz": ft, "f3_target_hz": f3,
+            "passband_range_hz": tuple(map(float, pb_range)), "objective_range_hz": tuple(map(float, obj_range)),
+            "objective": np.geomspace(*obj_range, GRID_POINTS), "passband": np.geomspace(*pb_range, GRID_POINTS // 2),
+            "sweep_hz": (float(min(obj_range[0], pb_range[0]) / 30), float(max(obj_range[1], pb_range[1]) * 30))}
 
 
 def _reference(spec: FilterSpec, order: int, fc_hz: float, f) -> np.ndarray:
     """The target H(j 2 pi f): scipy's design at passband gain ``spec.gain``."""
+    if spec.filter_type == "bandpass":
+        return spec.gain * reference_bandpass(f, spec.family, order, spec.f_low_hz, spec.f_high_hz,
+                                              spec.ripple_db or 1.0, spec.bessel_norm, spec.chebyshev_cutoff,
+                                              spec.bandpass_method)
     return spec.gain * reference_response(f, spec.filter_type, spec.family, order, fc_hz, spec.ripple_db or 1.0,
                                           spec.bessel_norm, spec.chebyshev_cutoff)
 
@@ -433,9 +453,10 @@ def _split_gains(plans: list, gain: float, strategy: str) -> list:
     return gains
 
 
-def _node_peaks(plans: list, gains: list, amplitude: float, fc_hz: float) -> tuple:
-    """Each stage's peak gain alone and its output's peak at ``amplitude`` (ideal sections)."""
-    f = np.geomspace(fc_hz / 1000, fc_hz * 1000, 4001)
+def _node_peaks(plans: list, gains: list, amplitude: float, fc_hz: float, at_hz=None) -> tuple:
+    """Each stage's peak gain alone and its output's peak at ``amplitude`` (ideal sections); at one
+    frequency ``at_hz`` instead of the peak when given."""
+    f = np.geomspace(fc_hz / 1000, fc_hz * 1000, 4001) if at_hz is None else np.array([at_hz])
     s = 2j * math.pi * f
     h_cum = np.ones_like(s)
     peaks, nodes = [], []
@@ -445,7 +466,7 @@ def _node_peaks(plans: list, gains: list, amplitude: float, fc_hz: float) -> tup
             h = wn / (s + wn) if p.kind == "lowpass" else s / (s + wn)
         else:
             den = s * s + s * wn / p.q + wn * wn
-            h = wn * wn / den if p.kind == "lowpass" else s * s / den
+            h = {"lowpass": wn * wn, "highpass": s * s, "bandpass": s * wn / p.q}[p.kind] / den
         h = g * h
         h_cum = h_cum * h
         peaks.append(float(np.max(np.abs(h))))
@@ -506,8 +527,18 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
                                     spec.stopband_hz, spec.min_attenuation_db, spec.bessel_norm)
     else:
         order, fc = spec.order, spec.fc_hz
-    plans = plan_sections(spec.filter_type, spec.family, order, fc, spec.ripple_db or 1.0, spec.bessel_norm,
-                          spec.chebyshev_cutoff)
+    conv = (spec.ripple_db or 1.0, spec.bessel_norm, spec.chebyshev_cutoff)
+    total_gain, strategies = spec.gain, GAIN_STRATEGIES
+    if spec.filter_type == "bandpass":
+        fc = math.sqrt(spec.f_low_hz * spec.f_high_hz)
+        plans = plan_bandpass(spec.family, order, spec.f_low_hz, spec.f_high_hz, *conv, spec.bandpass_method)
+        if plans[0].kind == "bandpass":
+            # band-pass sections peak at their own fn: the product of the section gains that gives spec.gain at
+            # the centre; spread evenly first (an MFB band-pass section's gain must stay below 2 Q^2)
+            _, at_centre = _node_peaks(plans, [1.0] * len(plans), 1.0, fc, at_hz=fc)
+            total_gain, strategies = spec.gain / at_centre[-1], ("even", "lowest-q", "last")
+    else:
+        plans = plan_sections(spec.filter_type, spec.family, order, fc, *conv)
     n = len(plans)
     if spec.stage_order is not None:
         if sorted(spec.stage_order) != list(range(1, n + 1)):
@@ -519,8 +550,8 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
                           param="topology")
     families = list(spec.topology) * n if len(spec.topology) == 1 else list(spec.topology)
     swing = min(opamp.vout_max, -opamp.vout_min)
-    for strategy in GAIN_STRATEGIES:
-        gains = _split_gains(plans, spec.gain, strategy)
+    for strategy in strategies:
+        gains = _split_gains(plans, total_gain, strategy)
         peaks, nodes = _node_peaks(plans, gains, spec.amplitude_v, fc)
         if max(nodes) <= swing:
             break
@@ -572,7 +603,6 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
 
 def _figures(result: FilterDesign, grid: dict, errors, choice, j_joint, examined, t_cand, t_search) -> dict:
     spec, opamp, stages = result.spec, result.opamp, result.stages
-    low = spec.filter_type == "lowpass"
     cont = result.cascade("continuous")
     chosen = result.cascade()
     f_obj = grid["objective"]
@@ -584,10 +614,16 @@ def _figures(result: FilterDesign, grid: dict, errors, choice, j_joint, examined
     wide = np.geomspace(result.fc_hz / 1000, result.fc_hz * 1000, 6001)
     g_db = 20 * math.log10(spec.gain)
     got_db = 20 * np.log10(np.abs(chosen.response(2j * math.pi * wide, opamp))) - g_db
+    level3 = -10 * math.log10(2)
+    if spec.filter_type == "bandpass":
+        f3 = [_crossing(wide, got_db, level3, False), _crossing(wide, got_db, level3, True)]
+    else:
+        f3 = _crossing(wide, got_db, level3, spec.filter_type == "lowpass")
     figs = {
         "order": result.order, "fc_hz": result.fc_hz,
         "passband_edge_hz": grid["passband_edge_hz"], "transition_end_hz": grid["transition_end_hz"],
-        "f3_target_hz": grid["f3_target_hz"], "f3_hz": _crossing(wide, got_db, -10 * math.log10(2), low),
+        "f3_target_hz": grid["f3_target_hz"], "f3_hz": f3,
+        "passband_range_hz": grid["passband_range_hz"], "objective_range_hz": grid["objective_range_hz"],
         "passband_deviation_db": float(np.max(dev_pb)),
         "error_joint_db": j_joint,
         "error_per_stage_db": objective(errors, per_stage(errors)),
@@ -629,9 +665,8 @@ def verify_spice(result: FilterDesign, simulator: str = "ngspice-cli") -> dict:
     f, h = simulate_ac(chosen.netlist(), opamp, lo, hi, simulator=simulator)
     an = chosen.response(2j * math.pi * f, opamp)
     dev = np.abs(20 * np.log10(np.abs(h)) - 20 * np.log10(np.abs(an)))
-    fp = result.figures["passband_edge_hz"]
-    low = result.spec.filter_type == "lowpass"
-    in_pb = (f >= fp / 10) & (f <= fp) if low else (f >= fp) & (f <= fp * 10)
+    a, b = result.figures["passband_range_hz"]
+    in_pb = (f >= a * (1 - 1e-9)) & (f <= b * (1 + 1e-9))
     within = 20 * np.log10(np.abs(an)) >= 20 * math.log10(result.spec.gain) - 60
     return {"simulator": simulator, "points": int(f.size),
             "max_deviation_passband_db": float(np.max(dev[in_pb])),

@@ -32,12 +32,17 @@ from scipy import signal
 
 from ..core.errors import DesignError
 
-__all__ = ["FAMILIES", "RESPONSE_TYPES", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "MAX_ORDER", "SectionPlan",
-           "prototype_zpk", "plan_sections", "reference_ba", "reference_response", "order_from_mask",
-           "chebyshev_3db_factor"]
+__all__ = ["FAMILIES", "RESPONSE_TYPES", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "BANDPASS_METHODS", "MAX_ORDER",
+           "WIDE_RATIO", "SectionPlan", "prototype_zpk", "plan_sections", "reference_ba", "reference_response",
+           "order_from_mask", "chebyshev_3db_factor", "bandpass_method", "plan_bandpass", "reference_bandpass"]
 
 FAMILIES = ("butterworth", "bessel", "chebyshev")
-RESPONSE_TYPES = ("lowpass", "highpass")
+RESPONSE_TYPES = ("lowpass", "highpass", "bandpass")
+#: how a band-pass is built: ``wide`` a high-pass at the lower edge then a low-pass at the upper one,
+#: ``narrow`` the band-pass transformation of the prototype into band-pass sections; ``auto`` by :data:`WIDE_RATIO`
+BANDPASS_METHODS = ("auto", "wide", "narrow")
+#: the edge ratio f_high / f_low from which ``auto`` builds a band-pass as a low-pass and high-pass cascade
+WIDE_RATIO = 2.0
 BESSEL_NORMS = ("mag", "delay")
 CHEBYSHEV_CUTOFFS = ("ripple", "3db")
 MAX_ORDER = 10
@@ -274,3 +279,100 @@ def order_from_mask(kind: str, family: str, passband_hz: float, max_loss_db: flo
                           "widen the transition band, allow more passband loss or less stopband attenuation",
                           param="order")
     return n, fc
+
+
+def bandpass_method(f_low_hz: float, f_high_hz: float, method: str = "auto") -> str:
+    """``wide`` or ``narrow``: ``method`` itself, or for ``auto`` wide from an edge ratio of :data:`WIDE_RATIO`.
+
+    Parameters
+    ----------
+    f_low_hz, f_high_hz : float
+        The band edges.
+    method : str
+        One of :data:`BANDPASS_METHODS`.
+
+    Returns
+    -------
+    str
+        ``wide`` or ``narrow``.
+    """
+    if method != "auto":
+        return method
+    return "wide" if f_high_hz / f_low_hz >= WIDE_RATIO else "narrow"
+
+
+def plan_bandpass(family: str, order: int, f_low_hz: float, f_high_hz: float, ripple_db: float = 1.0,
+                  bessel_norm: str = "mag", chebyshev_cutoff: str = "ripple", method: str = "auto") -> list:
+    """The sections of a band-pass from the order-``order`` prototype, in rising Q.
+
+    Wide: the high-pass at ``f_low_hz`` and the low-pass at ``f_high_hz`` (order ``order`` each).
+    Narrow: the band-pass transformation s -> (s^2 + w0^2) / (B s), w0 = 2 pi sqrt(f_low f_high),
+    B = 2 pi (f_high - f_low) (scipy's ``lp2bp``): each prototype pole p gives the roots of
+    s^2 - p B s + w0^2 = 0, and each root in the upper half plane is a band-pass section
+    (wn = |r|, Q = wn / (-2 Re r)); a real pole gives the one section s^2 - p B s + w0^2:
+    ``order`` sections, filter order 2 x ``order``.
+
+    Parameters
+    ----------
+    family, order, ripple_db, bessel_norm, chebyshev_cutoff
+        As :func:`prototype_zpk`.
+    f_low_hz, f_high_hz : float
+        The band edges (in the family's cut-off convention).
+    method : str
+        One of :data:`BANDPASS_METHODS`.
+
+    Returns
+    -------
+    list of SectionPlan
+        Sorted by Q (first-order sections first).
+    """
+    conv = (ripple_db, bessel_norm, chebyshev_cutoff)
+    if bandpass_method(f_low_hz, f_high_hz, method) == "wide":
+        plans = plan_sections("highpass", family, order, f_low_hz, *conv) + \
+            plan_sections("lowpass", family, order, f_high_hz, *conv)
+        return sorted(plans, key=lambda s: (s.order == 2, s.q or 0.0))
+    _, poles, _ = prototype_zpk(family, order, *conv)
+    w0 = 2 * math.pi * math.sqrt(f_low_hz * f_high_hz)
+    bw = 2 * math.pi * (f_high_hz - f_low_hz)
+    plans = []
+    for p in poles:
+        if abs(p.imag) <= 1e-9 * abs(p):
+            # a real pole: s^2 - p B s + w0^2 is one section (wn = w0, Q = w0 / (-p B)), even when its roots
+            # are real (Q < 1/2, a wide band)
+            plans.append(SectionPlan("bandpass", 2, float(w0 / (2 * math.pi)), float(w0 / (-p.real * bw))))
+            continue
+        d = np.sqrt(complex(p * bw) ** 2 - 4 * w0 * w0)
+        for r in ((p * bw + d) / 2, (p * bw - d) / 2):
+            if r.imag > 1e-12 * abs(r):
+                wn = abs(r)
+                plans.append(SectionPlan("bandpass", 2, float(wn / (2 * math.pi)), float(wn / (-2 * r.real))))
+    return sorted(plans, key=lambda s: s.q)
+
+
+def reference_bandpass(f_hz, family: str, order: int, f_low_hz: float, f_high_hz: float, ripple_db: float = 1.0,
+                       bessel_norm: str = "mag", chebyshev_cutoff: str = "ripple", method: str = "auto") -> np.ndarray:
+    """The band-pass target at ``f_hz``: wide, the product of :func:`reference_response`'s high-pass and
+    low-pass (each passband gain 1); narrow, scipy's ``lp2bp_zpk`` of the prototype, gain 1 at the centre.
+
+    Parameters
+    ----------
+    f_hz : ndarray
+        Frequencies, Hz.
+    family, order, f_low_hz, f_high_hz, ripple_db, bessel_norm, chebyshev_cutoff, method
+        As :func:`plan_bandpass`.
+
+    Returns
+    -------
+    ndarray
+        Complex H(j 2 pi f).
+    """
+    f = np.asarray(f_hz, dtype=float)
+    conv = (ripple_db, bessel_norm, chebyshev_cutoff)
+    if bandpass_method(f_low_hz, f_high_hz, method) == "wide":
+        return reference_response(f, "highpass", family, order, f_low_hz, *conv) * \
+            reference_response(f, "lowpass", family, order, f_high_hz, *conv)
+    z, p, k = prototype_zpk(family, order, *conv)
+    w0 = 2 * math.pi * math.sqrt(f_low_hz * f_high_hz)
+    z, p, k = signal.lp2bp_zpk(z, p, k, w0, 2 * math.pi * (f_high_hz - f_low_hz))
+    h = signal.freqs_zpk(z, p, k, 2 * math.pi * np.append(f, math.sqrt(f_low_hz * f_high_hz)))[1]
+    return h[:-1] / abs(h[-1])

@@ -21,10 +21,10 @@ import math
 from dataclasses import dataclass
 
 from ..core import opamps
-from ..core.errors import DesignError
+from ..core.errors import DesignError, ParamError
 from ..core.eseries import PartBounds
 from ..core.ranges import parse_in_range
-from .prototype import BESSEL_NORMS, CHEBYSHEV_CUTOFFS, FAMILIES, RESPONSE_TYPES
+from .prototype import BANDPASS_METHODS, BESSEL_NORMS, CHEBYSHEV_CUTOFFS, FAMILIES, RESPONSE_TYPES
 
 __all__ = ["TOPOLOGY_CHOICES", "FilterSpec"]
 
@@ -48,7 +48,7 @@ class FilterSpec(PartBounds):
     Parameters
     ----------
     filter_type : str
-        ``lowpass`` or ``highpass``.
+        ``lowpass``, ``highpass`` or ``bandpass``.
     family : str
         ``butterworth``, ``bessel`` or ``chebyshev``.
     order : int or None
@@ -60,7 +60,11 @@ class FilterSpec(PartBounds):
     bessel_norm, chebyshev_cutoff : str
         The cut-off conventions (module docstring).
     passband_hz, max_loss_db, stopband_hz, min_attenuation_db : float or None
-        The mask, all four or none.
+        The mask, all four or none (low- and high-pass).
+    f_low_hz, f_high_hz : float or None
+        A band-pass's edges (in the family's cut-off convention), instead of ``fc_hz``.
+    bandpass_method : str
+        ``auto``, ``wide`` (high-pass then low-pass) or ``narrow`` (band-pass sections).
     topology : str or tuple of str
         ``sallen-key``, ``mfb`` or ``auto``; a tuple gives one per stage.
     stage_order : tuple of int or None
@@ -90,6 +94,9 @@ class FilterSpec(PartBounds):
     max_loss_db: float | None = None
     stopband_hz: float | None = None
     min_attenuation_db: float | None = None
+    f_low_hz: float | None = None
+    f_high_hz: float | None = None
+    bandpass_method: str = "auto"
     topology: object = "sallen-key"
     stage_order: tuple | None = None
     gain: float = 1.0
@@ -114,7 +121,13 @@ class FilterSpec(PartBounds):
         opamps.get(self.opamp)
         mask = {k: getattr(self, k) for k in ("passband_hz", "max_loss_db", "stopband_hz", "min_attenuation_db")}
         given = [k for k, v in mask.items() if v is not None]
-        if given:
+        put("bandpass_method", _word(self.bandpass_method, BANDPASS_METHODS, "bandpass_method"))
+        if self.filter_type == "bandpass":
+            self._check_band(given)
+        elif self.f_low_hz is not None or self.f_high_hz is not None:
+            raise DesignError(f"f_low_hz: band edges are for a bandpass; a {self.filter_type} takes fc_hz",
+                              param="f_low_hz")
+        elif given:
             self._check_mask(mask, given)
         else:
             if self.order is None or self.fc_hz is None:
@@ -140,6 +153,21 @@ class FilterSpec(PartBounds):
             except ValueError:
                 raise DesignError(f"stage_order must be stage numbers such as 2,1,3, got {so!r}",
                                   param="stage_order") from None
+
+    def _check_band(self, given: list) -> None:
+        put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
+        if given:
+            raise DesignError(f"{given[0]}: a mask for a band-pass is not in this slice; give --order, --f-low "
+                              "and --f-high", param=given[0])
+        if self.fc_hz is not None:
+            raise DesignError("fc_hz: a bandpass takes its edges f_low_hz and f_high_hz, not fc_hz", param="fc_hz")
+        if self.order is None or self.f_low_hz is None or self.f_high_hz is None:
+            raise DesignError("order: a bandpass needs --order, --f-low and --f-high", param="order")
+        for k in ("f_low_hz", "f_high_hz"):
+            put(k, parse_in_range(getattr(self, k), k, "fc_hz"))
+        if self.f_low_hz >= self.f_high_hz:
+            raise ParamError(f"the band's edges cross: {{f_low_hz}} ({self.f_low_hz:g} Hz) is not below "
+                             f"{{f_high_hz}} ({self.f_high_hz:g} Hz)")
 
     def _check_mask(self, mask: dict, given: list) -> None:
         missing = [k for k, v in mask.items() if v is None]

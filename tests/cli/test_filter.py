@@ -16,7 +16,7 @@ from designer.cli.filter import design_filter_main
     (["--order", "2.5", "--fc", "1k"], "--order must be a whole number"),
     (["--order", "4", "--fc", "1k", "--family", "elliptic"], "allowed: butterworth, bessel, chebyshev"),
     (["--order", "4", "--fc", "1k", "--topology", "tow-thomas"], "allowed: sallen-key, mfb, auto"),
-    (["--order", "4", "--fc", "1k", "--type", "notch"], "allowed: lowpass, highpass"),
+    (["--order", "4", "--fc", "1k", "--type", "notch"], "allowed: lowpass, highpass, bandpass"),
     (["--order", "4", "--fc", "1k", "--family", "chebyshev", "--ripple", "5"], "--ripple must be 0.01 dB to 3 dB"),
     (["--order", "4", "--fc", "1k", "--ripple", "1"], "only a chebyshev filter has a ripple"),
     (["--order", "4"], "give --order and --fc"),
@@ -30,6 +30,10 @@ from designer.cli.filter import design_filter_main
     (["--order", "4", "--fc", "1k", "--opamp", "uA709"], "uA709"),
     (["--order", "4", "--fc", "abc"], "--fc"),
     (["--order", "4", "--fc", "1k", "--bogus"], "unrecognized arguments"),
+    (["--type", "bandpass", "--order", "2", "--f-low", "1.1k", "--f-high", "900"],
+     "the band's edges cross: --f-low (1100 Hz) is not below --f-high (900 Hz)"),
+    (["--type", "bandpass", "--order", "2", "--fc", "1k"], "a bandpass takes its edges"),
+    (["--order", "2", "--fc", "1k", "--f-low", "900"], "band edges are for a bandpass"),
 ])
 def test_bad_input_is_one_line_exit_2(argv, words, capsys):
     assert design_filter_main(argv + ["--no-sim"]) == 2

@@ -95,3 +95,19 @@ def test_spice_ac_agrees_with_the_analytic_cascade(kw):
     d = design(FilterSpec(**kw), simulate=True)
     assert d.spice["max_deviation_passband_db"] < 0.05
     assert d.spice["max_deviation_60db_db"] < 0.5
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("kw", [dict(filter_type="bandpass", order=2, f_low_hz=900.0, f_high_hz=1.1e3,
+                                     family="bessel", opamp="TL072"),
+                                dict(filter_type="bandpass", order=3, f_low_hz=300.0, f_high_hz=3e3,
+                                     family="chebyshev", ripple_db=0.5)])
+def test_bandpass_narrow_and_wide(kw):
+    d = design(FilterSpec(**kw), simulate=True)
+    narrow = kw["f_high_hz"] / kw["f_low_hz"] < 2
+    assert all(st.topology == "mfb-bandpass" for st in d.stages) == narrow
+    lo, hi = d.figures["f3_hz"]
+    assert lo == pytest.approx(d.figures["f3_target_hz"][0], rel=0.03)
+    assert hi == pytest.approx(d.figures["f3_target_hz"][1], rel=0.03)
+    assert d.figures["error_joint_db"] <= d.figures["error_per_stage_db"] + 1e-12
+    assert d.spice["max_deviation_passband_db"] < 0.05

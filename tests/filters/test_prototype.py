@@ -14,8 +14,8 @@ from scipy import signal
 from designer.core.errors import DesignError
 from designer.filters import Cascade, SectionTarget, get
 from designer.filters.design import section_name
-from designer.filters.prototype import (chebyshev_3db_factor, order_from_mask, plan_sections,
-                                        reference_response)
+from designer.filters.prototype import (chebyshev_3db_factor, order_from_mask, plan_bandpass, plan_sections,
+                                        reference_bandpass, reference_response)
 
 
 def scipy_design(kind, family, order, fc, ripple=1.0, norm="mag"):
@@ -148,3 +148,38 @@ def test_bessel_mask_order_is_the_least_that_meets_it(mask):
 def test_bessel_mask_beyond_order_10_says_so():
     with pytest.raises(DesignError, match=r"above order 10 \(order 10 gives .* dB"):
         order_from_mask("lowpass", "bessel", 3e3, 1.0, 12e3, 40.0)
+
+
+@given(order=st.integers(1, 5), f_low=st.floats(50.0, 5e4), ratio=st.floats(1.05, 1.9),
+       family=st.sampled_from(["butterworth", "bessel", "chebyshev"]), ripple=st.sampled_from([0.1, 0.5, 1.0, 3.0]))
+def test_narrow_bandpass_sections_equal_scipy_bandpass_design(order, f_low, ratio, family, ripple):
+    f_high = f_low * ratio
+    wn = [2 * math.pi * f_low, 2 * math.pi * f_high]
+    if family == "butterworth":
+        b, a = signal.butter(order, wn, "bandpass", analog=True)
+    elif family == "bessel":
+        b, a = signal.bessel(order, wn, "bandpass", analog=True, norm="mag")
+    else:
+        b, a = signal.cheby1(order, ripple, wn, "bandpass", analog=True)
+    f0 = math.sqrt(f_low * f_high)
+    f = f0 * np.geomspace(0.3, 3, 120)
+    _, h_ref = signal.freqs(b, a, 2 * math.pi * np.append(f, f0))
+    plans = plan_bandpass(family, order, f_low, f_high, ripple, method="narrow")
+    assert len(plans) == order and all(p.kind == "bandpass" for p in plans)
+    topo = get("mfb-bandpass")
+    # each section's gain well inside the MFB band-pass's bound 2 Q^2 (the comparison is normalised at f0)
+    cascade = Cascade([(topo, topo.synthesize(SectionTarget("bandpass", p.fn_hz, p.q, min(1.0, p.q ** 2))))
+                       for p in plans])
+    h = cascade.response(2j * math.pi * np.append(f, f0))
+    np.testing.assert_allclose(h[:-1] / h[-1], h_ref[:-1] / h_ref[-1], rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(reference_bandpass(f, family, order, f_low, f_high, ripple, method="narrow"),
+                               h_ref[:-1] / abs(h_ref[-1]), rtol=1e-6, atol=1e-9)
+
+
+def test_wide_bandpass_is_the_highpass_then_lowpass():
+    plans = plan_bandpass("butterworth", 4, 300.0, 3e3)
+    assert sorted(p.kind for p in plans) == ["highpass"] * 2 + ["lowpass"] * 2
+    f = np.geomspace(30, 30e3, 50)
+    want = reference_response(f, "highpass", "butterworth", 4, 300.0) * reference_response(f, "lowpass", "butterworth",
+                                                                                          4, 3e3)
+    np.testing.assert_allclose(reference_bandpass(f, "butterworth", 4, 300.0, 3e3), want, rtol=1e-12)
