@@ -76,6 +76,8 @@ def _parser():
                    f"{help_range('gbw_margin')} (default 100, TI's rule of thumb)")
     s.add_argument("--impedance", dest="impedance_ohm", default="10k",
                    help=f"the resistor scale of the synthesis {help_range('impedance_ohm')} (default 10k)")
+    s.add_argument("--compensate-gbw", action="store_true", help="pre-distort each stage's fn and Q so that its "
+                   "response with the op-amp's finite gain and GBW matches the ideal one")
     k = p.add_argument_group("parts")
     k.add_argument("--series", dest="r_series", default="E24", help=f"resistor series: {', '.join(SERIES)} "
                    "(default E24)")
@@ -101,6 +103,7 @@ def _spec(args):
             "amplitude_v", "gbw_margin", "impedance_ohm", "r_series", "c_series", "r_min", "r_max", "c_min",
             "c_max")
     kw = {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
+    kw["compensate_gbw"] = args.compensate_gbw
     if "order" in kw:
         from ..core.ranges import parse_in_range
         kw["order"] = parse_in_range(kw["order"], "order", "filter_order")

@@ -9,7 +9,7 @@ stages, the ngspice proof). Below the wings: it imports ``core`` and ``spice`` o
 
 from .cascade import Cascade, Stage
 from .deck import ac_deck, simulate_ac
-from .design import (FilterDesign, StageDesign, analysis_grid, design, section_name, stage_candidates,
+from .design import (FilterDesign, StageDesign, analysis_grid, design, predistort, section_name, stage_candidates,
                      verify_spice)
 from .joint import brute_force, descend, joint_search, objective, per_stage
 from .prototype import (BANDPASS_METHODS, BESSEL_NORMS, CHEBYSHEV_CUTOFFS, FAMILIES, MAX_ORDER, RESPONSE_TYPES,
@@ -41,7 +41,7 @@ from .topology import (
     quadratic_root,
 )
 
-__all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "FilterDesign", "StageDesign", "analysis_grid", "design",
+__all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "FilterDesign", "StageDesign", "analysis_grid", "design", "predistort",
            "section_name", "stage_candidates", "verify_spice", "brute_force", "descend", "joint_search", "objective",
            "per_stage", "BANDPASS_METHODS", "WIDE_RATIO", "bandpass_method", "plan_bandpass", "reference_bandpass",
            "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER", "RESPONSE_TYPES", "SectionPlan",

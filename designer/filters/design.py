@@ -49,7 +49,7 @@ from .registry import get as get_topology
 from .spec import FilterSpec
 from .topology import SectionTarget
 
-__all__ = ["StageDesign", "FilterDesign", "design", "section_name", "stage_candidates", "verify_spice",
+__all__ = ["StageDesign", "FilterDesign", "design", "section_name", "stage_candidates", "verify_spice", "predistort",
            "analysis_grid"]
 
 #: the capacitor values (C1, nearest first) each stage offers the joint search
@@ -104,6 +104,8 @@ class StageDesign:
     peak_gain: float = 1.0
     node_peak_v: float = 0.0
     gbw_needed_hz: float = 0.0
+    fn_design_hz: float | None = None
+    q_design: float | None = None
 
     @property
     def values(self) -> dict:
@@ -123,6 +125,7 @@ class StageDesign:
                 "inverting": get_topology(self.topology).inverting, "peak_gain": self.peak_gain,
                 "peak_gain_db": 20 * math.log10(self.peak_gain), "node_peak_v": self.node_peak_v,
                 "gbw_needed_hz": self.gbw_needed_hz, "candidates": len(self.candidates),
+                "fn_design_hz": self.fn_design_hz, "q_design": self.q_design,
                 "parts_continuous": {k: float(v) for k, v in self.continuous.items()},
                 "parts": {k: float(v) for k, v in self.values.items()}}
 
@@ -474,6 +477,49 @@ def _node_peaks(plans: list, gains: list, amplitude: float, fc_hz: float, at_hz=
     return peaks, nodes
 
 
+def predistort(topology, target: SectionTarget, opamp) -> SectionTarget:
+    """The target whose synthesis, with ``opamp``'s finite gain and GBW, best matches ``target``'s
+    ideal response: fn and Q (fn alone for a first-order section) moved by least squares on the
+    complex log-ratio of the responses over fn/10 .. 10 fn (gain and phase; scipy.optimize.least_squares).
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    target : SectionTarget
+        What the section must realise with an ideal op-amp.
+    opamp : designer.core.opamps.OpAmp
+        The op-amp (A0, GBW).
+
+    Returns
+    -------
+    SectionTarget
+        The pre-distorted target (``target`` itself when the fit cannot improve it).
+    """
+    from scipy.optimize import least_squares
+
+    s = 2j * math.pi * np.geomspace(target.fn_hz / 10, target.fn_hz * 10, 61)
+    ideal = topology.response(topology.synthesize(target), s)
+
+    def moved(x):
+        q = None if target.q is None else target.q * math.exp(x[1])
+        return SectionTarget(target.kind, target.fn_hz * math.exp(x[0]), q, target.gain, target.impedance_ohm,
+                             target.c_f)
+
+    def residual(x):
+        try:
+            h = topology.response(topology.synthesize(moved(x)), s, opamp)
+        except DesignError:   # outside the topology's limits: a large, smooth penalty
+            return np.full(2 * s.size, 10.0)
+        r = np.log(h / ideal)
+        return np.concatenate([r.real, r.imag])
+
+    x0 = np.zeros(1 if target.q is None else 2)
+    fit = least_squares(residual, x0, x_scale=0.1)
+    better = np.sum(residual(fit.x) ** 2) < np.sum(residual(x0) ** 2)
+    return moved(fit.x) if better else target
+
+
 def _noise_gain(topology, gain: float) -> float:
     return 1.0 + gain if topology.inverting else gain
 
@@ -576,17 +622,19 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
             need = spec.gbw_margin * p.fn_hz * (p.q or 1.0) * _noise_gain(topo, g)
             _check_gbw(i, p, name, g, need, spec, opamp)
             try:
-                continuous, cands, nearest = stage_candidates(topo, target, spec, where)
+                built = predistort(topo, target, opamp) if spec.compensate_gbw else target
+                continuous, cands, nearest = stage_candidates(topo, built, spec, where)
                 break
             except DesignError:
                 if k == len(tries) - 1:
                     raise
-        ideal_db = 20 * np.log10(np.abs(topo.response(continuous, s_obj)))
+        # the stage's ideal: the asked target's (a pre-distorted design aims its op-amp-aware response at it)
+        ideal_db = 20 * np.log10(np.abs(topo.response(topo.synthesize(target), s_obj)))
         arrays = {r: np.array([c[r] for c in cands])[:, None] for r in topo.designators}
         cand_db = 20 * np.log10(np.abs(topo.response(arrays, s_obj[None, :], opamp)))
         stages.append(StageDesign(i, p, name, g, continuous, cands, cand_db - ideal_db[None, :], nearest,
                                   peak_gain=peaks[i - 1], node_peak_v=nodes[i - 1],
-                                  gbw_needed_hz=need))
+                                  gbw_needed_hz=need, fn_design_hz=built.fn_hz, q_design=built.q))
     errors = [st.errors for st in stages]
     t_cand = time.perf_counter() - t0
     t1 = time.perf_counter()

@@ -79,6 +79,8 @@ class FilterSpec(PartBounds):
         Required GBW = margin x fn x Q x noise gain per stage (TI's rule of thumb: 100).
     impedance_ohm : float
         The resistor scale of the synthesis.
+    compensate_gbw : bool
+        Pre-distort each stage's fn and Q for its op-amp's finite gain and GBW.
     r_series, c_series, r_min, r_max, c_min, c_max
         Part series and bounds (:class:`~designer.core.eseries.PartBounds`).
     """
@@ -104,6 +106,7 @@ class FilterSpec(PartBounds):
     amplitude_v: float = 1.0
     gbw_margin: float = 100.0
     impedance_ohm: float = 10e3
+    compensate_gbw: bool = False
 
     def __post_init__(self):
         self.check_bounds()

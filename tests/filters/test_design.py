@@ -111,3 +111,13 @@ def test_bandpass_narrow_and_wide(kw):
     assert hi == pytest.approx(d.figures["f3_target_hz"][1], rel=0.03)
     assert d.figures["error_joint_db"] <= d.figures["error_per_stage_db"] + 1e-12
     assert d.spice["max_deviation_passband_db"] < 0.05
+
+
+def test_gbw_predistortion_reduces_the_op_amp_error():
+    kw = dict(order=6, fc_hz=5e3, family="chebyshev", ripple_db=0.5, opamp="LM741", gbw_margin=10.0)
+    plain = design(FilterSpec(**kw))
+    comp = design(FilterSpec(**kw, compensate_gbw=True))
+    assert comp.figures["error_continuous_db"] < 0.5 * plain.figures["error_continuous_db"]
+    assert comp.figures["error_joint_db"] < plain.figures["error_joint_db"]
+    top = comp.stages[-1]
+    assert top.fn_design_hz != top.plan.fn_hz and top.q_design != top.plan.q
