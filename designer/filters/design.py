@@ -38,6 +38,7 @@ import numpy as np
 
 from ..core import opamps
 from ..core.errors import DesignError
+from ..core.jsonio import SCHEMA_VERSION, json_safe
 from ..core.eseries import values as series_values
 from ..core.units import format_eng
 from .cascade import Cascade
@@ -213,19 +214,20 @@ class FilterDesign:
             ``spec``, ``opamp``, ``stages``, ``figures`` and ``spice``.
         """
         s = self.spec
-        return {"spec": {"filter_type": s.filter_type, "family": s.family, "order": self.order, "fc_hz": self.fc_hz,
-                         "ripple_db": s.ripple_db, "bessel_norm": s.bessel_norm,
-                         "chebyshev_cutoff": s.chebyshev_cutoff, "gain": s.gain,
-                         "mask": ({"passband_hz": s.passband_hz, "max_loss_db": s.max_loss_db,
-                                   "stopband_hz": s.stopband_hz, "min_attenuation_db": s.min_attenuation_db}
-                                  if s.has_mask else None),
-                         "f_low_hz": s.f_low_hz, "f_high_hz": s.f_high_hz,
-                         "bandpass_method": (bandpass_method(s.f_low_hz, s.f_high_hz, s.bandpass_method)
-                                             if s.filter_type == "bandpass" else None),
-                         "r_series": s.r_series, "c_series": s.c_series, "amplitude_v": s.amplitude_v,
-                         "gbw_margin": s.gbw_margin},
-                "opamp": self.opamp.to_dict(), "stages": [st.to_dict() for st in self.stages],
-                "figures": {k: v for k, v in self.figures.items()}, "spice": self.spice}
+        spec = {"filter_type": s.filter_type, "family": s.family, "order": self.order, "fc_hz": self.fc_hz,
+                "ripple_db": s.ripple_db, "bessel_norm": s.bessel_norm,
+                "chebyshev_cutoff": s.chebyshev_cutoff, "gain": s.gain,
+                "mask": ({"passband_hz": s.passband_hz, "max_loss_db": s.max_loss_db,
+                          "stopband_hz": s.stopband_hz, "min_attenuation_db": s.min_attenuation_db}
+                         if s.has_mask else None),
+                "f_low_hz": s.f_low_hz, "f_high_hz": s.f_high_hz,
+                "bandpass_method": (bandpass_method(s.f_low_hz, s.f_high_hz, s.bandpass_method)
+                                    if s.filter_type == "bandpass" else None),
+                "r_series": s.r_series, "c_series": s.c_series, "amplitude_v": s.amplitude_v,
+                "gbw_margin": s.gbw_margin, "compensate_gbw": s.compensate_gbw}
+        return json_safe({"tool": "design-filter", "schema_version": SCHEMA_VERSION, "spec": spec,
+                          "opamp": self.opamp.to_dict(), "stages": [st.to_dict() for st in self.stages],
+                          "figures": dict(self.figures), "spice": self.spice})
 
 
 def section_name(kind: str, order: int, family: str, gain: float) -> str:
