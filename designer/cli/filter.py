@@ -127,6 +127,7 @@ def summary_text(result) -> str:
     str
         Lines ending in newline.
     """
+    from ..filters.design import MAX_COMBINATIONS
     from ..filters.registry import get as get_topology
     s, f, op = result.spec, result.figures, result.opamp
     if s.family == "chebyshev":
@@ -172,7 +173,9 @@ def summary_text(result) -> str:
     lines += [f"E-series choice: worst deviation from the ideal over {format_eng(lo, 'Hz')} to "
               f"{format_eng(hi, 'Hz')} (passband and transition band):",
               f"  joint across the stages   {f['error_joint_db']:.3g} dB  (exact over {f['combinations']} "
-              f"combinations; {f['examined']} partial choices examined in {f['search_s']:.3g} s)",
+              f"combinations; {f['examined']} partial choices examined in {f['search_s']:.3g} s"
+              + (f"; {f['candidates_dropped']} stage candidates worst on their own dropped to stay within "
+                 f"{MAX_COMBINATIONS}" if f.get("candidates_dropped") else "") + ")",
               f"  per-stage rounding        {f['error_per_stage_db']:.3g} dB",
               f"  nearest values            {f['error_nearest_db']:.3g} dB",
               f"  continuous parts          {f['error_continuous_db']:.3g} dB  (the op-amp's share)"]

@@ -55,6 +55,8 @@ __all__ = ["StageDesign", "FilterDesign", "design", "section_name", "stage_candi
 
 #: the capacitor values (C1, nearest first) each stage offers the joint search
 C_CHOICES = 3
+#: the largest product of the stages' candidate counts searched (beyond it each stage keeps its best candidates)
+MAX_COMBINATIONS = 500_000
 #: points of the objective's frequency grid
 GRID_POINTS = 160
 #: how far below the passband gain the transition band ends without a mask (dB)
@@ -637,6 +639,7 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         stages.append(StageDesign(i, p, name, g, continuous, cands, cand_db - ideal_db[None, :], nearest,
                                   peak_gain=peaks[i - 1], node_peak_v=nodes[i - 1],
                                   gbw_needed_hz=need, fn_design_hz=built.fn_hz, q_design=built.q))
+    pruned = _prune(stages)
     errors = [st.errors for st in stages]
     t_cand = time.perf_counter() - t0
     t1 = time.perf_counter()
@@ -646,9 +649,28 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         st.chosen = c
     result = FilterDesign(spec, order, fc, stages)
     result.figures = _figures(result, grid, errors, choice, j_joint, examined, t_cand, t_search)
+    result.figures["candidates_dropped"] = pruned
     if simulate:
         result.spice = verify_spice(result, simulator)
     return result
+
+
+def _prune(stages: list) -> int:
+    """Keep the search within :data:`MAX_COMBINATIONS`: while the product of the candidate counts is
+    above it, the stage with the most candidates drops its worst one by its own error (its all-nearest
+    and its own best candidates are kept). Returns the number dropped."""
+    dropped = 0
+    while np.prod([len(st.candidates) for st in stages], dtype=float) > MAX_COMBINATIONS:
+        st = max(stages, key=lambda x: len(x.candidates))
+        own = np.max(np.abs(st.errors), axis=1)
+        own[st.nearest] = -1.0   # never drop the all-nearest choice: the report compares with it
+        worst = int(np.argmax(own))
+        keep = [i for i in range(len(st.candidates)) if i != worst]
+        st.candidates = [st.candidates[i] for i in keep]
+        st.errors = st.errors[keep]
+        st.nearest = keep.index(st.nearest)
+        dropped += 1
+    return dropped
 
 
 def _figures(result: FilterDesign, grid: dict, errors, choice, j_joint, examined, t_cand, t_search) -> dict:
