@@ -179,6 +179,9 @@ def summary_text(result) -> str:
               f"  per-stage rounding        {f['error_per_stage_db']:.3g} dB",
               f"  nearest values            {f['error_nearest_db']:.3g} dB",
               f"  continuous parts          {f['error_continuous_db']:.3g} dB  (the op-amp's share)"]
+    if s.has_mask:
+        broken = [f[f"mask_violation_{k}_db"] for k in ("joint", "per_stage", "nearest")]
+        lines.append("  mask broken by (0: met): joint {:.3g} dB, per-stage {:.3g} dB, nearest {:.3g} dB".format(*broken))
     if result.spice:
         sp = result.spice
         lines.append(f"SPICE (.ac, {sp['simulator']}) against the analytic response of these parts: max deviation "

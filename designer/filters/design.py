@@ -611,6 +611,18 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
                           f"{spec.amplitude_v:g} V, beyond {opamp.name}'s swing of +-{swing:.3g} V; lower "
                           "--amplitude or --gain", param="amplitude_v")
     grid = analysis_grid(spec, order, fc)
+    limits = None
+    if spec.has_mask:
+        # the mask's edges as two more columns of the objective, with one-sided limits (joint.py): the sum S of
+        # the stages' dB errors may lower the passband edge's gain, or raise the stopband edge's, by the ideal
+        # response's own margin there and no more
+        ideal = 20 * np.log10(np.abs(_reference(spec, order, fc, np.array([spec.passband_hz, spec.stopband_hz]))
+                                     / spec.gain))
+        margin_pass = spec.max_loss_db + ideal[0]
+        margin_stop = -ideal[1] - spec.min_attenuation_db
+        grid["objective"] = np.append(grid["objective"], [spec.passband_hz, spec.stopband_hz])
+        n = grid["objective"].size
+        limits = [(n - 2, -1.0, -margin_pass), (n - 1, 1.0, -margin_stop)]
     f_obj = grid["objective"]
     s_obj = 2j * math.pi * f_obj
     stages = []
@@ -643,13 +655,18 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
     errors = [st.errors for st in stages]
     t_cand = time.perf_counter() - t0
     t1 = time.perf_counter()
-    choice, j_joint, examined = joint_search(errors)
+    choice, j_joint, examined = joint_search(errors, limits=limits)
     t_search = time.perf_counter() - t1
     for st, c in zip(stages, choice):
         st.chosen = c
     result = FilterDesign(spec, order, fc, stages)
     result.figures = _figures(result, grid, errors, choice, j_joint, examined, t_cand, t_search)
     result.figures["candidates_dropped"] = pruned
+    if limits:
+        # how far each choice breaks the mask (0: met), on the same columns
+        for key, ch in (("joint", choice), ("per_stage", per_stage(errors)), ("nearest", [st.nearest for st in stages])):
+            total = sum(e[c] for e, c in zip(errors, ch))
+            result.figures[f"mask_violation_{key}_db"] = max(0.0, *(o + sg * total[col] for col, sg, o in limits))
     if simulate:
         result.spice = verify_spice(result, simulator)
     return result
@@ -697,7 +714,7 @@ def _figures(result: FilterDesign, grid: dict, errors, choice, j_joint, examined
         "f3_target_hz": grid["f3_target_hz"], "f3_hz": f3,
         "passband_range_hz": grid["passband_range_hz"], "objective_range_hz": grid["objective_range_hz"],
         "passband_deviation_db": float(np.max(dev_pb)),
-        "error_joint_db": j_joint,
+        "error_joint_db": objective(errors, choice),
         "error_per_stage_db": objective(errors, per_stage(errors)),
         "error_nearest_db": objective(errors, [st.nearest for st in stages]),
         "error_continuous_db": float(np.max(np.abs(cont_db - ideal_obj))),

@@ -17,7 +17,12 @@ lower bound on every completion's J, and a partial whose bound exceeds the
 best complete J known (initially the per-stage choice's) is dropped. Nothing
 better than the best can be dropped, so the result is the exhaustive
 enumeration's (:func:`brute_force`, the test's reference) at a fraction of its
-cost. Per-stage rounding (:func:`per_stage`, each stage minimising its own
+cost. A mask adds one-sided limits at single frequencies (the loss at the
+passband edge, the attenuation at the stopband edge): ``limits`` of
+(column k, sign, offset) whose violation offset + sign * S(f_k) > 0 costs
+:data:`PENALTY` dB per dB in J, so a choice that meets the mask wins over any
+that does not; its bound is the violation at the best end of the reachable
+interval. Per-stage rounding (:func:`per_stage`, each stage minimising its own
 error alone: what the filter design tools do) is a point of the same product,
 so the joint choice is never worse.
 """
@@ -30,12 +35,22 @@ import numpy as np
 
 __all__ = ["objective", "per_stage", "descend", "joint_search", "brute_force"]
 
+#: dB of objective per dB of mask violation: a mask met is worth more than any deviation
+PENALTY = 1000.0
 #: the partial sums processed at once (elements of the (partials x candidates x f) block)
 _BLOCK = 4_000_000
 
 
-def objective(errors: list, choice) -> float:
-    """J of one choice: the cascade's worst deviation in dB.
+def _score(total: np.ndarray, limits) -> np.ndarray:
+    """J of sums ``total`` (rows): max_f |S|, and PENALTY x the worst mask violation."""
+    j = np.max(np.abs(total), axis=-1)
+    for col, sign, offset in limits or ():
+        j = np.maximum(j, PENALTY * (offset + sign * total[..., col]))
+    return j
+
+
+def objective(errors: list, choice, limits=None) -> float:
+    """J of one choice: the cascade's worst deviation in dB (and its mask violation, weighted).
 
     Parameters
     ----------
@@ -43,14 +58,16 @@ def objective(errors: list, choice) -> float:
         Per stage, shape (n_candidates_i, n_f): candidate's dB error at each f.
     choice : sequence of int
         One candidate index per stage.
+    limits : list of tuple, optional
+        (column, sign, offset): the violation offset + sign * S[column] must stay <= 0.
 
     Returns
     -------
     float
-        max_f |sum_i errors[i][choice[i]]|.
+        max(max_f |sum_i errors[i][choice[i]]|, PENALTY x the worst violation).
     """
     total = sum(e[c] for e, c in zip(errors, choice))
-    return float(np.max(np.abs(total)))
+    return float(_score(total, limits))
 
 
 def per_stage(errors: list) -> list:
@@ -69,12 +86,14 @@ def per_stage(errors: list) -> list:
     return [int(np.argmin(np.max(np.abs(e), axis=1))) for e in errors]
 
 
-def brute_force(errors: list) -> tuple:
+def brute_force(errors: list, limits=None) -> tuple:
     """Exhaustive enumeration of every combination (for tests and small cases).
 
     Parameters
     ----------
     errors : list of ndarray
+        As :func:`objective`.
+    limits : list of tuple, optional
         As :func:`objective`.
 
     Returns
@@ -84,13 +103,13 @@ def brute_force(errors: list) -> tuple:
     """
     best, best_j = None, np.inf
     for choice in itertools.product(*(range(len(e)) for e in errors)):
-        j = objective(errors, choice)
+        j = objective(errors, choice, limits)
         if j < best_j:
             best, best_j = list(choice), j
     return best, best_j
 
 
-def descend(errors: list, choice) -> list:
+def descend(errors: list, choice, limits=None) -> list:
     """Coordinate descent from ``choice``: each stage in turn moved to its best
     candidate with the others held, until no move helps. A local optimum whose J
     bounds :func:`joint_search` tightly from the start.
@@ -101,6 +120,8 @@ def descend(errors: list, choice) -> list:
         As :func:`objective`.
     choice : sequence of int
         The starting choice.
+    limits : list of tuple, optional
+        As :func:`objective`.
 
     Returns
     -------
@@ -109,20 +130,20 @@ def descend(errors: list, choice) -> list:
     """
     choice = list(choice)
     total = sum(e[c] for e, c in zip(errors, choice))
-    best = float(np.max(np.abs(total)))
+    best = float(_score(total, limits))
     improved = True
     while improved:
         improved = False
         for i, e in enumerate(errors):
             others = total - e[choice[i]]
-            j = np.max(np.abs(others[None, :] + e), axis=1)
+            j = _score(others[None, :] + e, limits)
             c = int(np.argmin(j))
             if j[c] < best - 1e-15:
                 best, choice[i], total, improved = float(j[c]), c, others + e[c], True
     return choice
 
 
-def joint_search(errors: list, start=None) -> tuple:
+def joint_search(errors: list, start=None, limits=None) -> tuple:
     """The exact minimiser of :func:`objective` over the product of the candidate sets.
 
     Parameters
@@ -131,6 +152,8 @@ def joint_search(errors: list, start=None) -> tuple:
         As :func:`objective`.
     start : sequence of int, optional
         A known choice whose J bounds the search (default: :func:`per_stage`).
+    limits : list of tuple, optional
+        As :func:`objective`.
 
     Returns
     -------
@@ -138,8 +161,8 @@ def joint_search(errors: list, start=None) -> tuple:
         (choice as a list of int, J, number of partial choices examined).
     """
     n = len(errors)
-    start = descend(errors, per_stage(errors) if start is None else start)
-    best_j = objective(errors, start)
+    start = descend(errors, per_stage(errors) if start is None else start, limits)
+    best_j = objective(errors, start, limits)
     # the stages whose candidates differ most first: their choice decides most, and the
     # narrow remainder [L, U] then bounds tightly
     order = sorted(range(n), key=lambda i: -float(np.max(np.ptp(errors[i], axis=0))))
@@ -164,7 +187,11 @@ def joint_search(errors: list, start=None) -> tuple:
             block = block.reshape(-1, nf)
             examined += len(block)
             # distance from 0 of the interval every completion can still reach, at each f
-            bound = np.max(np.maximum(np.maximum(block + rest_lo[k + 1], -(block + rest_hi[k + 1])), 0.0), axis=1)
+            low, high = block + rest_lo[k + 1], block + rest_hi[k + 1]
+            bound = np.max(np.maximum(np.maximum(low, -high), 0.0), axis=1)
+            for col, sign, offset in limits or ():
+                best_end = low[:, col] if sign > 0 else high[:, col]
+                bound = np.maximum(bound, PENALTY * (offset + sign * best_end))
             keep = bound <= best_j + slack
             if np.any(keep):
                 base = np.repeat(picks[a:a + step], len(e), axis=0)
@@ -173,7 +200,7 @@ def joint_search(errors: list, start=None) -> tuple:
                 kept_picks.append(np.hstack([base, cand])[keep])
         partial = np.vstack(kept_sums)
         picks = np.vstack(kept_picks)
-    j = np.max(np.abs(partial), axis=1)
+    j = _score(partial, limits)
     w = int(np.argmin(j))
     choice = [0] * n
     for k, i in enumerate(order):

@@ -42,3 +42,25 @@ def test_joint_equals_brute_force_on_a_real_cascade(kw):
     assert d.figures["error_joint_db"] == pytest.approx(j_brute, abs=1e-12)
     assert d.figures["error_joint_db"] <= d.figures["error_per_stage_db"] + 1e-12
     assert d.figures["error_joint_db"] <= d.figures["error_nearest_db"] + 1e-12
+
+
+@given(seed=st.integers(0, 2 ** 32 - 1), stages=st.integers(1, 4))
+def test_joint_with_mask_limits_equals_brute_force(seed, stages):
+    rng = np.random.default_rng(seed)
+    errors = [rng.normal(0, 0.2, (int(rng.integers(1, 6)), 12)) for _ in range(stages)]
+    # the passband edge may lose at most 0.05 dB, the stopband edge gain at most 0.1 dB
+    limits = [(10, -1.0, -0.05), (11, 1.0, -0.1)]
+    choice, j, _ = joint_search(errors, limits=limits)
+    _, j_brute = brute_force(errors, limits)
+    assert j == pytest.approx(j_brute, abs=1e-9)
+    assert objective(errors, choice, limits) == pytest.approx(j, abs=1e-9)
+
+
+def test_mask_design_joint_choice_meets_the_mask():
+    d = design(FilterSpec(family="butterworth", passband_hz=1e3, max_loss_db=0.5, stopband_hz=3e3,
+                          min_attenuation_db=50.0))
+    f = d.figures
+    assert f["mask_violation_joint_db"] == 0.0
+    assert f["mask_passband_margin_db"] >= -1e-9 and f["mask_stopband_margin_db"] >= -1e-9
+    # per-stage rounding breaks this mask (the reason the joint objective carries it)
+    assert f["mask_violation_per_stage_db"] > 0.1
