@@ -93,6 +93,8 @@ class StageDesign:
         The stage output's peak at the bench amplitude (the cascade up to it).
     gbw_needed_hz : float
         margin x fn x Q x noise gain.
+    fn_design_hz, q_design : float or None
+        The fn and Q the parts were synthesised for (the plan's, or pre-distorted for the op-amp).
     """
 
     number: int
@@ -563,7 +565,8 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         ``error_per_stage_db``, ``error_nearest_db``, ``error_continuous_db`` (the worst
         deviation from the ideal over the objective grid, op-amp included, of each
         choice), ``passband_deviation_db``, ``f3_hz`` against ``f3_target_hz``, the
-        search's size and time, and the mask's margins when a mask was given.
+        search's size and time; with a mask, its margins (``mask_passband_margin_db``,
+        ``mask_stopband_margin_db``) and how far each choice breaks it (``mask_violation_*_db``).
 
     Raises
     ------
