@@ -121,3 +121,19 @@ def test_gbw_predistortion_reduces_the_op_amp_error():
     assert comp.figures["error_joint_db"] < plain.figures["error_joint_db"]
     top = comp.stages[-1]
     assert top.fn_design_hz != top.plan.fn_hz and top.q_design != top.plan.q
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("family", ["butterworth", "bessel", "chebyshev"])
+@pytest.mark.parametrize("filter_type", ["lowpass", "highpass"])
+@pytest.mark.parametrize("order", [1, 4, 7, 10])
+def test_every_family_type_and_order_span_agrees_with_spice(family, filter_type, order):
+    kw = dict(order=order, fc_hz=1e3, family=family, filter_type=filter_type, opamp="NE5532", topology="auto",
+              r_min=100.0, r_max=10e6)
+    if family == "chebyshev":
+        kw["ripple_db"] = 0.5
+    d = design(FilterSpec(**kw), simulate=True)
+    assert d.spice["max_deviation_passband_db"] < 0.1
+    assert d.spice["max_deviation_60db_db"] < 0.5
+    assert d.figures["error_joint_db"] <= d.figures["error_per_stage_db"] + 1e-12
+    assert d.figures["error_joint_db"] < 1.0
