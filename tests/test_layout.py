@@ -23,7 +23,7 @@ ALLOWED = {
     "identify": {"core", "spice", "report"},
     "tolerance": {"core", "spice", "report", "plant", "pid"},
     "check": {"core", "spice", "report", "plant", "pid", "identify", "tolerance"},
-    "cli": {"core", "spice", "report", "plant", "pid", "identify", "check", "tolerance"},
+    "cli": {"core", "spice", "report", "plant", "pid", "identify", "check", "tolerance", "filters"},
     # the web page: a front end beside cli, whose parsers and checks it shares
     "web": {"core", "spice", "report", "plant", "pid", "identify", "check", "tolerance", "cli"},
 }

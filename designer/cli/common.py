@@ -48,6 +48,13 @@ FLAGS = {
     # identify / identify-freq
     "step_time_s": "--step-time", "step_amplitude": "--step-amplitude",
     # simulate-capture (its step_v, step_time_s as above)
+    # design-filter
+    "filter_type": "--type", "family": "--family", "order": "--order", "ripple_db": "--ripple",
+    "passband_hz": "--passband", "max_loss_db": "--max-loss", "stopband_hz": "--stopband",
+    "min_attenuation_db": "--min-attenuation", "topology": "--topology", "stage_order": "--stage-order",
+    "bessel_norm": "--bessel-norm", "chebyshev_cutoff": "--chebyshev-cutoff", "gbw_margin": "--gbw-margin",
+    "impedance_ohm": "--impedance", "series": "--series",
+    "f_low_hz": "--f-low", "f_high_hz": "--f-high", "bandpass_method": "--bandpass-method",
     "duration_s": "--duration", "points": "--points", "noise_v": "--noise", "lsb_v": "--lsb", "seed": "--seed",
 }
 

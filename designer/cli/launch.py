@@ -83,5 +83,9 @@ def simulate_capture() -> int:
     return _run("simulate-capture", "designer.cli.capture", "simulate_capture_main")
 
 
+def design_filter() -> int:
+    return _run("design-filter", "designer.cli.filter", "design_filter_main")
+
+
 def make_prbs() -> int:
     return _run("make-prbs", "designer.cli.prbs", "make_prbs_main")

@@ -61,7 +61,7 @@ class Range:
 
 
 def _fmt(v: float, unit: str) -> str:
-    if unit in ("", "%") or v == 0 or (unit == "s" and abs(v) >= 1e3):   # "10000 s", not "10 ks"
+    if unit in ("", "%", "dB") or v == 0 or (unit == "s" and abs(v) >= 1e3):   # "10000 s", not "10 ks"
         return f"{v:g}" + (f" {unit}" if unit else "")
     return format_eng(v, unit, 4)
 
@@ -132,6 +132,13 @@ RANGES = {
     "prbs_amplitude_v": Range(1e-6, 100.0, "V"),
     "prbs_offset_v": Range(-100.0, 100.0, "V"),
     "prbs_periods": Range(1, 1000),
+    # design-filter (designer.filters.spec): the mask's edges use fc_hz's range
+    "filter_order": Range(1, 10),
+    "ripple_db": Range(0.01, 3.0, "dB"),
+    "max_loss_db": Range(0.01, 20.0, "dB"),
+    "min_attenuation_db": Range(1.0, 200.0, "dB"),
+    "gbw_margin": Range(1.0, 1000.0),
+    "impedance_ohm": Range(10.0, 1e8, "Ohm"),
 }
 
 

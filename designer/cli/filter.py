@@ -1,0 +1,235 @@
+"""``design-filter``: an active filter from a specification (low- or high-pass;
+Butterworth, Bessel or Chebyshev; an order and cut-off, or a mask), as a
+cascade of Sallen-Key or MFB stages with E-series parts chosen jointly across
+the stages, every stage checked against its op-amp, and the cascade proven
+with ngspice's ``.ac`` (:mod:`designer.filters.design`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+
+from ..core.eseries import SERIES
+from ..core.opamps import names as opamp_names
+from ..core.ranges import help_range
+from ..core.units import format_eng
+from .common import command_parser, print_output, run_cli
+
+__all__ = ["design_filter_main", "summary_text"]
+
+EPILOG = """examples:
+  design-filter --family butterworth --order 4 --fc 1k
+  design-filter --type highpass --family chebyshev --ripple 0.5 --order 5 --fc 1k --topology mfb
+  design-filter --family chebyshev --passband 3k --max-loss 1 --stopband 12k --min-attenuation 40
+  design-filter --family bessel --order 6 --fc 10k --gain 4 --opamp NE5532 --json --out build/aa
+
+conventions: --fc is the -3 dB frequency (Butterworth; Bessel with --bessel-norm mag), the frequency whose
+period is 2 pi times the DC group delay (Bessel, --bessel-norm delay), or the ripple edge (Chebyshev, unless
+--chebyshev-cutoff 3db). --gain is the passband gain at DC (low-pass) or high frequency (high-pass).
+"""
+
+
+def _parser():
+    p = command_parser("design-filter", "Design an active low- or high-pass filter from a specification: "
+                       "scipy's prototypes, Sallen-Key or MFB stages in rising Q, E-series parts chosen jointly "
+                       "across the stages, each stage's op-amp checked, the cascade checked in ngspice.", EPILOG)
+    r = p.add_argument_group("response")
+    r.add_argument("--type", dest="filter_type", default="lowpass", metavar="TYPE",
+                   help="lowpass, highpass or bandpass (default lowpass)")
+    r.add_argument("--family", default="butterworth",
+                   help="butterworth (maximally flat), bessel (flat group delay) or chebyshev (equiripple "
+                        "passband, steeper) (default butterworth)")
+    r.add_argument("--order", help="filter order, 1 to 10 (or give the mask instead)")
+    r.add_argument("--fc", dest="fc_hz", help=f"cut-off frequency, e.g. 1k {help_range('fc_hz')}")
+    r.add_argument("--f-low", dest="f_low_hz", help=f"band-pass: lower band edge {help_range('fc_hz')}")
+    r.add_argument("--f-high", dest="f_high_hz", help=f"band-pass: upper band edge {help_range('fc_hz')}")
+    r.add_argument("--bandpass-method", default="auto", help="band-pass: wide (a high-pass at --f-low then a "
+                   "low-pass at --f-high, order --order each), narrow (the band-pass transformation into --order "
+                   "MFB band-pass sections) or auto (wide from f-high/f-low >= 2; default)")
+    r.add_argument("--ripple", dest="ripple_db", help=f"Chebyshev passband ripple in dB {help_range('ripple_db')}, "
+                   "default 1 (with a mask: the mask's --max-loss)")
+    r.add_argument("--bessel-norm", default="mag", help="Bessel cut-off: mag (-3 dB at --fc, default) or delay")
+    r.add_argument("--chebyshev-cutoff", default="ripple", help="Chebyshev cut-off: ripple (the ripple edge at "
+                   "--fc, default) or 3db")
+    m = p.add_argument_group("mask (instead of --order and --fc: picks the least order that meets it)")
+    m.add_argument("--passband", dest="passband_hz", help=f"passband edge frequency {help_range('fc_hz')}")
+    m.add_argument("--max-loss", dest="max_loss_db", help=f"largest loss in the passband, dB "
+                   f"{help_range('max_loss_db')}")
+    m.add_argument("--stopband", dest="stopband_hz", help=f"stopband edge frequency {help_range('fc_hz')}")
+    m.add_argument("--min-attenuation", dest="min_attenuation_db", help="least attenuation in the stopband, dB "
+                   f"{help_range('min_attenuation_db')}")
+    s = p.add_argument_group("stages")
+    s.add_argument("--topology", default="sallen-key", help="sallen-key, mfb (inverting multiple feedback) or auto "
+                   "(Sallen-Key, MFB where it cannot); a comma list gives one per stage (default sallen-key)")
+    s.add_argument("--stage-order", help="the stages (numbered 1.. in rising Q) in build order, e.g. 2,1 "
+                   "(default: rising Q, so that a high-Q stage does not clip)")
+    s.add_argument("--gain", default="1", help=f"passband gain, V/V {help_range('gain')} (default 1), split "
+                   "evenly in dB over the second-order stages")
+    s.add_argument("--opamp", default="LM741", metavar="NAME",
+                   help=f"op-amp of every stage: {', '.join(opamp_names())} (default LM741)")
+    s.add_argument("--amplitude", dest="amplitude_v", default="1", help="bench input amplitude, peak volts "
+                   f"{help_range('amplitude_v')} (default 1): no stage output may exceed the op-amp's swing")
+    s.add_argument("--gbw-margin", default="100", help="a stage needs GBW >= margin x fn x Q x noise gain "
+                   f"{help_range('gbw_margin')} (default 100, TI's rule of thumb)")
+    s.add_argument("--impedance", dest="impedance_ohm", default="10k",
+                   help=f"the resistor scale of the synthesis {help_range('impedance_ohm')} (default 10k)")
+    s.add_argument("--compensate-gbw", action="store_true", help="pre-distort each stage's fn and Q so that its "
+                   "response with the op-amp's finite gain and GBW matches the ideal one")
+    k = p.add_argument_group("parts")
+    k.add_argument("--series", dest="r_series", default="E24", help=f"resistor series: {', '.join(SERIES)} "
+                   "(default E24)")
+    k.add_argument("--c-series", default="E12", help="capacitor series (default E12)")
+    k.add_argument("--r-min", default="1k", help=f"smallest resistor (default 1k) {help_range('resistor_ohm')}")
+    k.add_argument("--r-max", default="1M", help=f"largest resistor (default 1M) {help_range('resistor_ohm')}")
+    k.add_argument("--c-min", default="1n", help=f"smallest capacitor (default 1n) {help_range('capacitor_f')}")
+    k.add_argument("--c-max", default="10u", help=f"largest capacitor (default 10u) {help_range('capacitor_f')}")
+    o = p.add_argument_group("output")
+    o.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    o.add_argument("--out", metavar="DIR", help="write DIR/filter.cir (the ngspice .ac deck of the cascade) and "
+                   "DIR/result.json")
+    o.add_argument("--no-sim", action="store_true", help="skip the ngspice check")
+    o.add_argument("--simulator", default="ngspice-cli", choices=("ngspice-cli", "pyspice"),
+                   help="ngspice-cli: `ngspice -b` (default); pyspice: the shared library")
+    return p
+
+
+def _spec(args):
+    from ..filters.spec import FilterSpec
+    keys = ("filter_type", "family", "order", "fc_hz", "ripple_db", "bessel_norm", "chebyshev_cutoff", "passband_hz",
+            "max_loss_db", "stopband_hz", "min_attenuation_db", "f_low_hz", "f_high_hz", "bandpass_method", "topology", "stage_order", "gain", "opamp",
+            "amplitude_v", "gbw_margin", "impedance_ohm", "r_series", "c_series", "r_min", "r_max", "c_min",
+            "c_max")
+    kw = {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
+    kw["compensate_gbw"] = args.compensate_gbw
+    if "order" in kw:
+        from ..core.ranges import parse_in_range
+        kw["order"] = parse_in_range(kw["order"], "order", "filter_order")
+    return FilterSpec(**kw)
+
+
+def _ordinal(n: int) -> str:
+    return f"{n}{'th' if 10 <= n % 100 <= 20 else {1: 'st', 2: 'nd', 3: 'rd'}.get(n % 10, 'th')}"
+
+
+def summary_text(result) -> str:
+    """The design as text, in engineering notation with units.
+
+    Parameters
+    ----------
+    result : designer.filters.FilterDesign
+        The design.
+
+    Returns
+    -------
+    str
+        Lines ending in newline.
+    """
+    from ..filters.design import MAX_COMBINATIONS
+    from ..filters.registry import get as get_topology
+    s, f, op = result.spec, result.figures, result.opamp
+    if s.family == "chebyshev":
+        conv = f"{s.ripple_db:g} dB ripple, " + ("ripple edge" if s.chebyshev_cutoff == "ripple" else "-3 dB")
+    else:
+        conv = "-3 dB" if s.family == "butterworth" or s.bessel_norm == "mag" else "delay-normalised"
+    kind = {"lowpass": "low-pass", "highpass": "high-pass", "bandpass": "band-pass"}[s.filter_type]
+    where = f"fc {format_eng(result.fc_hz, 'Hz')}"
+    if s.filter_type == "bandpass":
+        method = result.to_dict()["spec"]["bandpass_method"]
+        where = f"band {format_eng(s.f_low_hz, 'Hz')} to {format_eng(s.f_high_hz, 'Hz')} ({method}: " + \
+            ("high-pass then low-pass, each" if method == "wide" else "band-pass sections from an") + \
+            f" order-{result.order} prototype)"
+    lines = [f"{_ordinal(result.order)}-order {s.family.capitalize()} {kind}, {where} "
+             f"({conv}), gain {s.gain:g}" + (" (inverting)" if f["inverting"] else "")
+             + f"; op-amp {op.name} (GBW {format_eng(op.gbw_hz, 'Hz')})"]
+    if s.has_mask:
+        lines.append(f"  from the mask: at most {s.max_loss_db:g} dB loss to {format_eng(s.passband_hz, 'Hz')}, at "
+                     f"least {s.min_attenuation_db:g} dB from {format_eng(s.stopband_hz, 'Hz')}")
+    lines.append(f"Stages, in build order ({s.r_series} resistors, {s.c_series} capacitors; in brackets the "
+                 "continuous design at the nearest capacitor):")
+    for st in result.stages:
+        topo = get_topology(st.topology)
+        q = f"Q {st.plan.q:.4g}" if st.plan.q else "first order"
+        lines.append(f"  {st.number}  {st.topology:<24} fn {format_eng(st.plan.fn_hz, 'Hz'):<10} {q:<12} gain "
+                     f"{st.gain:.4g}  peak gain {20 * math.log10(st.peak_gain):.3g} dB  output peak "
+                     f"{format_eng(st.node_peak_v, 'V')}  GBW needed {format_eng(st.gbw_needed_hz, 'Hz')}")
+        parts = []
+        for ref in topo.designators:
+            unit = "Ohm" if ref.startswith("R") else "F"
+            parts.append(f"{topo.prefixed(ref, str(st.number) + '0')} {format_eng(st.values[ref], unit)} "
+                         f"({format_eng(st.continuous[ref], unit)})")
+        lines.append("     " + ", ".join(parts))
+    lo, hi = f["objective_range_hz"]
+    f3 = lambda v: " and ".join(format_eng(x, "Hz") for x in v) if isinstance(v, (list, tuple)) \
+        else format_eng(v, "Hz")  # noqa: E731
+    lines += [f"Achieved with the chosen parts and the {op.name} model:",
+              f"  max passband deviation from the ideal  {f['passband_deviation_db']:.3g} dB",
+              f"  -3 dB frequency                        {f3(f['f3_hz'])} (target {f3(f['f3_target_hz'])})"]
+    if s.has_mask:
+        lines += [f"  mask margins: passband {f['mask_passband_margin_db']:.3g} dB, stopband "
+                  f"{f['mask_stopband_margin_db']:.3g} dB"]
+    lines += [f"E-series choice: worst deviation from the ideal over {format_eng(lo, 'Hz')} to "
+              f"{format_eng(hi, 'Hz')} (passband and transition band):",
+              f"  joint across the stages   {f['error_joint_db']:.3g} dB  (exact over {f['combinations']} "
+              f"combinations; {f['examined']} partial choices examined in {f['search_s']:.3g} s"
+              + (f"; {f['candidates_dropped']} stage candidates worst on their own dropped to stay within "
+                 f"{MAX_COMBINATIONS}" if f.get("candidates_dropped") else "") + ")",
+              f"  per-stage rounding        {f['error_per_stage_db']:.3g} dB",
+              f"  nearest values            {f['error_nearest_db']:.3g} dB",
+              f"  continuous parts          {f['error_continuous_db']:.3g} dB  (the op-amp's share)"]
+    if s.has_mask:
+        broken = [f[f"mask_violation_{k}_db"] for k in ("joint", "per_stage", "nearest")]
+        lines.append("  mask broken by (0: met): joint {:.3g} dB, per-stage {:.3g} dB, nearest {:.3g} dB".format(*broken))
+    if result.spice:
+        sp = result.spice
+        lines.append(f"SPICE (.ac, {sp['simulator']}) against the analytic response of these parts: max deviation "
+                     f"{sp['max_deviation_passband_db']:.2g} dB in the passband, {sp['max_deviation_60db_db']:.2g} "
+                     "dB down to -60 dB")
+    return "\n".join(lines) + "\n"
+
+
+def _write(result, folder) -> dict:
+    from ..core.fileio import atomic_write, ensure_dir
+    folder = ensure_dir(Path(folder))
+    files = {"deck": str(folder / "filter.cir"), "result_json": str(folder / "result.json")}
+    atomic_write(files["deck"], result.deck())
+    data = {**result.to_dict(), "files": files}
+    atomic_write(files["result_json"], json.dumps(data, indent=2) + "\n")
+    return files
+
+
+def _design(args) -> int:
+    from ..filters.design import design
+    spec = _spec(args)
+    result = design(spec, simulate=not args.no_sim, simulator=args.simulator)
+    files = _write(result, args.out) if args.out else {}
+    if args.json:
+        print_output(json.dumps({**result.to_dict(), "files": files}, indent=2))
+    else:
+        text = summary_text(result)
+        if files:
+            text += "Files:\n" + "".join(f"  {k}: {v}\n" for k, v in files.items())
+        print_output(text, end="")
+    return 0
+
+
+def design_filter_main(argv=None) -> int:
+    """``design-filter``'s entry point.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit status (0 done, 2 bad input, 3 simulator error).
+    """
+    return run_cli("design-filter", _parser, _design, argv)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(design_filter_main())

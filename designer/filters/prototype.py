@@ -1,0 +1,378 @@
+"""Normalised low-pass prototypes from scipy.signal, their poles paired into
+sections, and the order a mask needs.
+
+The poles come from scipy.signal's analog prototypes, never from hand-typed
+tables (scipy.signal docs: ``buttap``, ``besselap``, ``cheb1ap``, ``buttord``,
+``cheb1ord``; the section tables of TI's "Op Amps for Everyone", ch. 16,
+SLOA088, and Zverev's "Handbook of Filter Synthesis" are what they reproduce):
+
+- Butterworth: ``buttap(n)``, -3 dB at 1 rad/s;
+- Bessel: ``besselap(n, norm)``, ``norm="mag"`` (-3 dB at 1 rad/s, the
+  convention of scipy's ``bessel`` default and of most tables) or
+  ``norm="delay"`` (group delay 1 s at DC; the cut-off then names the delay
+  1 / (2 pi fc)) -- the literature mixes them, so the caller chooses;
+- Chebyshev type I: ``cheb1ap(n, rp)``, the ripple edge at 1 rad/s (scipy's
+  ``cheby1`` convention), or rescaled so that 1 rad/s is the -3 dB point:
+  |H|^2 = 1 / (1 + eps^2 T_n(w)^2) is -3 dB where T_n(w) = 1/eps, i.e. at
+  w3 = cosh(acosh(1/eps) / n), eps = sqrt(10^(rp/10) - 1) (valid for rp < 3.01 dB).
+
+Pairing: a complex pair p, p* is the section s^2 + (wn/Q) s + wn^2 with
+wn = |p| and Q = wn / (-2 Re p); a real pole -wn is a first-order section.
+A high-pass is the low-pass transformation s -> wc/s: each section keeps its Q
+and its wn becomes 1/wn (SLOA088: the high-pass uses the low-pass coefficients).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import signal
+
+from ..core.errors import DesignError
+
+__all__ = ["FAMILIES", "RESPONSE_TYPES", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "BANDPASS_METHODS", "MAX_ORDER",
+           "WIDE_RATIO", "SectionPlan", "prototype_zpk", "plan_sections", "reference_ba", "reference_response",
+           "order_from_mask", "chebyshev_3db_factor", "bandpass_method", "plan_bandpass", "reference_bandpass"]
+
+FAMILIES = ("butterworth", "bessel", "chebyshev")
+RESPONSE_TYPES = ("lowpass", "highpass", "bandpass")
+#: how a band-pass is built: ``wide`` a high-pass at the lower edge then a low-pass at the upper one,
+#: ``narrow`` the band-pass transformation of the prototype into band-pass sections; ``auto`` by :data:`WIDE_RATIO`
+BANDPASS_METHODS = ("auto", "wide", "narrow")
+#: the edge ratio f_high / f_low from which ``auto`` builds a band-pass as a low-pass and high-pass cascade
+WIDE_RATIO = 2.0
+BESSEL_NORMS = ("mag", "delay")
+CHEBYSHEV_CUTOFFS = ("ripple", "3db")
+MAX_ORDER = 10
+
+
+@dataclass(frozen=True)
+class SectionPlan:
+    """One section of the normalised design.
+
+    Parameters
+    ----------
+    kind : str
+        ``lowpass`` or ``highpass``.
+    order : int
+        1 or 2.
+    fn_hz : float
+        Natural (corner) frequency, Hz, after scaling to the cut-off.
+    q : float or None
+        Quality factor (None for first order).
+    """
+
+    kind: str
+    order: int
+    fn_hz: float
+    q: float | None
+
+
+def chebyshev_3db_factor(order: int, ripple_db: float) -> float:
+    """w3: the -3 dB frequency of the Chebyshev prototype whose ripple edge is 1 rad/s.
+
+    Parameters
+    ----------
+    order : int
+        Filter order.
+    ripple_db : float
+        Passband ripple, dB (below 3.01 dB).
+
+    Returns
+    -------
+    float
+        cosh(acosh(1/eps) / n), eps = sqrt(10^(rp/10) - 1).
+    """
+    eps = math.sqrt(10 ** (ripple_db / 10) - 1)
+    return math.cosh(math.acosh(1 / eps) / order)
+
+
+def prototype_zpk(family: str, order: int, ripple_db: float = 1.0, bessel_norm: str = "mag",
+                  chebyshev_cutoff: str = "ripple") -> tuple:
+    """The normalised analog low-pass prototype (cut-off 1 rad/s in the chosen convention).
+
+    Parameters
+    ----------
+    family : str
+        One of :data:`FAMILIES`.
+    order : int
+        1..:data:`MAX_ORDER`.
+    ripple_db : float
+        Chebyshev passband ripple, dB.
+    bessel_norm : str
+        ``mag`` or ``delay`` (scipy's ``besselap`` normalisations).
+    chebyshev_cutoff : str
+        ``ripple`` (the ripple edge at 1 rad/s) or ``3db``.
+
+    Returns
+    -------
+    tuple
+        (zeros, poles, k) as scipy returns them (poles rescaled for ``3db``).
+    """
+    if family == "butterworth":
+        return signal.buttap(order)
+    if family == "bessel":
+        return signal.besselap(order, norm=bessel_norm)
+    z, p, k = signal.cheb1ap(order, ripple_db)
+    if chebyshev_cutoff == "3db":
+        # s -> s w3 moves the -3 dB point from w3 to 1: poles / w3, and k / w3^n keeps the gain
+        w3 = chebyshev_3db_factor(order, ripple_db)
+        p, k = p / w3, k / w3 ** order
+    return z, p, k
+
+
+def plan_sections(kind: str, family: str, order: int, fc_hz: float, ripple_db: float = 1.0,
+                  bessel_norm: str = "mag", chebyshev_cutoff: str = "ripple") -> list:
+    """The prototype's poles as sections scaled to ``fc_hz``, in rising Q
+    (the first-order section first; it has no peak).
+
+    Parameters
+    ----------
+    kind : str
+        ``lowpass`` or ``highpass``.
+    family, order, ripple_db, bessel_norm, chebyshev_cutoff
+        As :func:`prototype_zpk`.
+    fc_hz : float
+        The cut-off, Hz.
+
+    Returns
+    -------
+    list of SectionPlan
+        Sections sorted by Q (first order first).
+    """
+    _, poles, _ = prototype_zpk(family, order, ripple_db, bessel_norm, chebyshev_cutoff)
+    plans = []
+    for p in poles:
+        if abs(p.imag) <= 1e-9 * abs(p):
+            wn, q, n = -p.real, None, 1
+        elif p.imag > 0:
+            wn = abs(p)
+            q, n = wn / (-2 * p.real), 2
+        else:
+            continue   # the conjugate of one already taken
+        fn = fc_hz * wn if kind == "lowpass" else fc_hz / wn
+        plans.append(SectionPlan(kind, n, float(fn), None if q is None else float(q)))
+    return sorted(plans, key=lambda s: (s.order == 2, s.q or 0.0))
+
+
+def reference_ba(kind: str, family: str, order: int, fc_hz: float, ripple_db: float = 1.0,
+                 bessel_norm: str = "mag", chebyshev_cutoff: str = "ripple") -> tuple:
+    """The target transfer function by scipy's own analog designers (``butter``,
+    ``bessel``, ``cheby1``; ``analog=True``), its passband gain (DC for a
+    low-pass, infinite frequency for a high-pass) normalised to 1.
+
+    Parameters
+    ----------
+    kind, family, order, fc_hz, ripple_db, bessel_norm, chebyshev_cutoff
+        As :func:`plan_sections`.
+
+    Returns
+    -------
+    tuple of ndarray
+        (b, a), polynomials in s (rad/s).
+    """
+    wc = 2 * math.pi * fc_hz
+    btype = "low" if kind == "lowpass" else "high"
+    if family == "butterworth":
+        b, a = signal.butter(order, wc, btype, analog=True)
+    elif family == "bessel":
+        b, a = signal.bessel(order, wc, btype, analog=True, norm=bessel_norm)
+    else:
+        if chebyshev_cutoff == "3db":
+            w3 = chebyshev_3db_factor(order, ripple_db)
+            wc = wc / w3 if kind == "lowpass" else wc * w3
+        b, a = signal.cheby1(order, ripple_db, wc, btype, analog=True)
+    # the passband gain: b/a at s = 0 (low-pass) or the leading coefficients' ratio (high-pass)
+    g = b[-1] / a[-1] if kind == "lowpass" else b[np.flatnonzero(b)[0]] / a[0] if len(b) == len(a) else \
+        b[0] / a[0]
+    return np.asarray(b) / g, np.asarray(a)
+
+
+def reference_response(f_hz, *args, **kwargs) -> np.ndarray:
+    """:func:`reference_ba` evaluated at ``f_hz`` (``scipy.signal.freqs``).
+
+    Parameters
+    ----------
+    f_hz : ndarray
+        Frequencies, Hz.
+    *args, **kwargs
+        As :func:`reference_ba`.
+
+    Returns
+    -------
+    ndarray
+        Complex H(j 2 pi f), passband gain 1.
+    """
+    b, a = reference_ba(*args, **kwargs)
+    return signal.freqs(b, a, 2 * math.pi * np.asarray(f_hz, dtype=float))[1]
+
+
+def _loss_db(kind, family, order, fc_hz, f_hz, ripple_db, bessel_norm):
+    h = reference_response(np.atleast_1d(f_hz), kind, family, order, fc_hz, ripple_db, bessel_norm)
+    return -20 * np.log10(np.abs(h))
+
+
+def order_from_mask(kind: str, family: str, passband_hz: float, max_loss_db: float, stopband_hz: float,
+                    min_attenuation_db: float, bessel_norm: str = "mag") -> tuple:
+    """The least order meeting the mask, and the cut-off it gives.
+
+    Butterworth and Chebyshev by scipy's ``buttord`` and ``cheb1ord`` (``analog=True``;
+    the Chebyshev's ripple is the mask's loss and its cut-off the passband edge);
+    Bessel (no closed form) by search: for n = 1, 2, ... the cut-off that puts the
+    loss at the passband edge at exactly ``max_loss_db`` (bisection on log fc,
+    the loss falling monotonically as fc rises for a low-pass), then the
+    attenuation at the stopband edge checked.
+
+    Parameters
+    ----------
+    kind : str
+        ``lowpass`` (passband below stopband) or ``highpass``.
+    family : str
+        One of :data:`FAMILIES`.
+    passband_hz, max_loss_db, stopband_hz, min_attenuation_db : float
+        The mask.
+    bessel_norm : str
+        The Bessel normalisation the cut-off is given in.
+
+    Returns
+    -------
+    tuple
+        (order, fc_hz): the cut-off in the family's convention (Butterworth -3 dB,
+        Bessel per ``bessel_norm``, Chebyshev the ripple edge).
+
+    Raises
+    ------
+    DesignError
+        The mask needs more than :data:`MAX_ORDER` (naming the order it needs).
+    """
+    wp, ws = 2 * math.pi * passband_hz, 2 * math.pi * stopband_hz
+    if family in ("butterworth", "chebyshev"):
+        fn = signal.buttord if family == "butterworth" else signal.cheb1ord
+        n, wn = fn(wp, ws, max_loss_db, min_attenuation_db, analog=True)
+        n, fc = int(n), float(wn) / (2 * math.pi)
+    else:
+        n, fc, att = None, None, 0.0
+        for order in range(1, MAX_ORDER + 1):
+            lo, hi = math.log(passband_hz) - 12, math.log(passband_hz) + 12
+            for _ in range(100):
+                mid = 0.5 * (lo + hi)
+                loss = _loss_db(kind, family, order, math.exp(mid), passband_hz, 1.0, bessel_norm)[0]
+                # low-pass: a higher fc, less loss at the passband edge; high-pass the other way
+                if (loss > max_loss_db) == (kind == "lowpass"):
+                    lo = mid
+                else:
+                    hi = mid
+            fc_try = math.exp(hi if kind == "lowpass" else lo)
+            att = _loss_db(kind, family, order, fc_try, stopband_hz, 1.0, bessel_norm)[0]
+            if att >= min_attenuation_db:
+                n, fc = order, fc_try
+                break
+        if n is None:
+            # a Bessel's attenuation grows slowly (near-Gaussian), so there is no closed form to name the order
+            raise DesignError(f"order: the mask needs a Bessel filter above order {MAX_ORDER} (order {MAX_ORDER} "
+                              f"gives {att:.3g} dB at the stopband edge, {min_attenuation_db:.3g} dB asked); widen "
+                              "the transition band, or use butterworth or chebyshev", param="order")
+    if n > MAX_ORDER:
+        raise DesignError(f"order: the mask needs a {family} filter of order {n}, above the limit {MAX_ORDER}; "
+                          "widen the transition band, allow more passband loss or less stopband attenuation",
+                          param="order")
+    return n, fc
+
+
+def bandpass_method(f_low_hz: float, f_high_hz: float, method: str = "auto") -> str:
+    """``wide`` or ``narrow``: ``method`` itself, or for ``auto`` wide from an edge ratio of :data:`WIDE_RATIO`.
+
+    Parameters
+    ----------
+    f_low_hz, f_high_hz : float
+        The band edges.
+    method : str
+        One of :data:`BANDPASS_METHODS`.
+
+    Returns
+    -------
+    str
+        ``wide`` or ``narrow``.
+    """
+    if method != "auto":
+        return method
+    return "wide" if f_high_hz / f_low_hz >= WIDE_RATIO else "narrow"
+
+
+def plan_bandpass(family: str, order: int, f_low_hz: float, f_high_hz: float, ripple_db: float = 1.0,
+                  bessel_norm: str = "mag", chebyshev_cutoff: str = "ripple", method: str = "auto") -> list:
+    """The sections of a band-pass from the order-``order`` prototype, in rising Q.
+
+    Wide: the high-pass at ``f_low_hz`` and the low-pass at ``f_high_hz`` (order ``order`` each).
+    Narrow: the band-pass transformation s -> (s^2 + w0^2) / (B s), w0 = 2 pi sqrt(f_low f_high),
+    B = 2 pi (f_high - f_low) (scipy's ``lp2bp``): each prototype pole p gives the roots of
+    s^2 - p B s + w0^2 = 0, and each root in the upper half plane is a band-pass section
+    (wn = |r|, Q = wn / (-2 Re r)); a real pole gives the one section s^2 - p B s + w0^2:
+    ``order`` sections, filter order 2 x ``order``.
+
+    Parameters
+    ----------
+    family, order, ripple_db, bessel_norm, chebyshev_cutoff
+        As :func:`prototype_zpk`.
+    f_low_hz, f_high_hz : float
+        The band edges (in the family's cut-off convention).
+    method : str
+        One of :data:`BANDPASS_METHODS`.
+
+    Returns
+    -------
+    list of SectionPlan
+        Sorted by Q (first-order sections first).
+    """
+    conv = (ripple_db, bessel_norm, chebyshev_cutoff)
+    if bandpass_method(f_low_hz, f_high_hz, method) == "wide":
+        plans = plan_sections("highpass", family, order, f_low_hz, *conv) + \
+            plan_sections("lowpass", family, order, f_high_hz, *conv)
+        return sorted(plans, key=lambda s: (s.order == 2, s.q or 0.0))
+    _, poles, _ = prototype_zpk(family, order, *conv)
+    w0 = 2 * math.pi * math.sqrt(f_low_hz * f_high_hz)
+    bw = 2 * math.pi * (f_high_hz - f_low_hz)
+    plans = []
+    for p in poles:
+        if abs(p.imag) <= 1e-9 * abs(p):
+            # a real pole: s^2 - p B s + w0^2 is one section (wn = w0, Q = w0 / (-p B)), even when its roots
+            # are real (Q < 1/2, a wide band)
+            plans.append(SectionPlan("bandpass", 2, float(w0 / (2 * math.pi)), float(w0 / (-p.real * bw))))
+            continue
+        d = np.sqrt(complex(p * bw) ** 2 - 4 * w0 * w0)
+        for r in ((p * bw + d) / 2, (p * bw - d) / 2):
+            if r.imag > 1e-12 * abs(r):
+                wn = abs(r)
+                plans.append(SectionPlan("bandpass", 2, float(wn / (2 * math.pi)), float(wn / (-2 * r.real))))
+    return sorted(plans, key=lambda s: s.q)
+
+
+def reference_bandpass(f_hz, family: str, order: int, f_low_hz: float, f_high_hz: float, ripple_db: float = 1.0,
+                       bessel_norm: str = "mag", chebyshev_cutoff: str = "ripple", method: str = "auto") -> np.ndarray:
+    """The band-pass target at ``f_hz``: wide, the product of :func:`reference_response`'s high-pass and
+    low-pass (each passband gain 1); narrow, scipy's ``lp2bp_zpk`` of the prototype, gain 1 at the centre.
+
+    Parameters
+    ----------
+    f_hz : ndarray
+        Frequencies, Hz.
+    family, order, f_low_hz, f_high_hz, ripple_db, bessel_norm, chebyshev_cutoff, method
+        As :func:`plan_bandpass`.
+
+    Returns
+    -------
+    ndarray
+        Complex H(j 2 pi f).
+    """
+    f = np.asarray(f_hz, dtype=float)
+    conv = (ripple_db, bessel_norm, chebyshev_cutoff)
+    if bandpass_method(f_low_hz, f_high_hz, method) == "wide":
+        return reference_response(f, "highpass", family, order, f_low_hz, *conv) * \
+            reference_response(f, "lowpass", family, order, f_high_hz, *conv)
+    z, p, k = prototype_zpk(family, order, *conv)
+    w0 = 2 * math.pi * math.sqrt(f_low_hz * f_high_hz)
+    z, p, k = signal.lp2bp_zpk(z, p, k, w0, 2 * math.pi * (f_high_hz - f_low_hz))
+    h = signal.freqs_zpk(z, p, k, 2 * math.pi * np.append(f, math.sqrt(f_low_hz * f_high_hz)))[1]
+    return h[:-1] / abs(h[-1])

@@ -1,0 +1,139 @@
+"""A filter from a specification (designer.filters.design): gain split and
+clipping, the op-amp check, stage order and topology choices, the chosen
+parts' response against the target, refusals in one line, and the ngspice
+.ac proof of the whole cascade (the analytic op-amp-aware response of the
+chosen parts within 0.05 dB over the passband)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from designer.core.errors import DesignError
+from designer.core.opamps import get as get_opamp
+from designer.filters import FilterSpec, design
+from designer.filters.prototype import reference_response
+
+
+def test_butterworth_4th_order_lowpass_figures():
+    d = design(FilterSpec(order=4, fc_hz=1e3))
+    assert [st.topology for st in d.stages] == ["sallen-key-lowpass"] * 2
+    assert [round(st.plan.q, 4) for st in d.stages] == [0.5412, 1.3066]
+    f = d.figures
+    assert f["f3_hz"] == pytest.approx(1e3, rel=0.02)
+    assert f["passband_deviation_db"] < 0.3
+    assert f["error_joint_db"] <= f["error_per_stage_db"] <= f["error_nearest_db"] + 1e-12 or \
+        f["error_joint_db"] <= f["error_nearest_db"]
+    for st in d.stages:   # every chosen part a series value within the bounds
+        for ref, v in st.values.items():
+            assert (1e3 <= v <= 1e6) if ref.startswith("R") else (1e-9 <= v <= 1e-5)
+
+
+@pytest.mark.parametrize("kw", [dict(order=6, fc_hz=10e3, family="bessel", gain=4.0, opamp="NE5532"),
+                                dict(order=5, fc_hz=1e3, family="chebyshev", ripple_db=0.5, filter_type="highpass",
+                                     topology="mfb"),
+                                dict(order=3, fc_hz=200.0, family="butterworth", topology="auto", gain=2.0)])
+def test_gain_split_and_node_peaks(kw):
+    d = design(FilterSpec(**kw))
+    assert math.prod(st.gain for st in d.stages) == pytest.approx(kw.get("gain", 1.0))
+    swing = min(d.opamp.vout_max, -d.opamp.vout_min)
+    assert all(st.node_peak_v <= swing for st in d.stages)
+    # the chosen parts' passband gain is the asked one
+    f_pass = np.array([d.fc_hz / 100 if d.spec.filter_type == "lowpass" else d.fc_hz * 30])
+    h = d.cascade().response(2j * math.pi * f_pass)
+    assert abs(h[0]) == pytest.approx(kw.get("gain", 1.0), rel=0.1)
+
+
+def test_chosen_parts_follow_the_target():
+    d = design(FilterSpec(order=6, fc_hz=2e3, family="chebyshev", ripple_db=1.0, opamp="TL072"))
+    f = np.geomspace(200, 2e3, 50)
+    got = 20 * np.log10(np.abs(d.cascade().response(2j * math.pi * f, get_opamp("TL072"))))
+    want = 20 * np.log10(np.abs(reference_response(f, "lowpass", "chebyshev", 6, 2e3, 1.0)))
+    # off the objective's grid points the deviation may exceed the grid's maximum slightly
+    assert np.max(np.abs(got - want)) <= d.figures["error_joint_db"] + 0.02
+
+
+def test_stage_order_override_and_default_rising_q():
+    d = design(FilterSpec(order=6, fc_hz=1e3))
+    qs = [st.plan.q for st in d.stages]
+    assert qs == sorted(qs)
+    d2 = design(FilterSpec(order=6, fc_hz=1e3, stage_order="3,1,2"))
+    assert [st.plan.q for st in d2.stages] == [qs[2], qs[0], qs[1]]
+
+
+def test_topology_per_stage():
+    d = design(FilterSpec(order=4, fc_hz=1e3, topology=("mfb", "sallen-key")))
+    assert [st.topology for st in d.stages] == ["mfb-lowpass", "sallen-key-lowpass"]
+    assert d.figures["inverting"]
+
+
+def test_mask_design_meets_the_mask():
+    d = design(FilterSpec(family="chebyshev", passband_hz=3e3, max_loss_db=1.0, stopband_hz=12e3,
+                          min_attenuation_db=40.0))
+    assert d.order == 3
+    assert d.figures["mask_stopband_margin_db"] > 0
+
+
+@pytest.mark.parametrize("kw, words", [
+    (dict(order=10, fc_hz=1e3, family="chebyshev", ripple_db=3.0), "too slow for stage 5.*use NE5532"),
+    (dict(order=4, fc_hz=1e6, opamp="ideal"), "not realisable within the part bounds: R1 = .* below --r-min"),
+    (dict(order=4, fc_hz=1e3, gain=50.0, amplitude_v=1.0), "peaks at .* beyond LM741's swing"),
+    (dict(order=3, fc_hz=1e3, stage_order=(1, 1)), "must list the stages 1 to 2"),
+    (dict(order=4, fc_hz=1e3, topology=("mfb", "mfb", "mfb")), "one per stage"),
+    (dict(order=1, fc_hz=1e3, gain=2.0, filter_type="highpass"), "unity gain"),
+])
+def test_refusals_are_one_line(kw, words):
+    with pytest.raises(DesignError, match=words) as e:
+        design(FilterSpec(**kw))
+    assert "\n" not in str(e.value)
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("kw", [dict(order=4, fc_hz=1e3, family="butterworth"),
+                                dict(order=5, fc_hz=1e3, family="chebyshev", ripple_db=0.5, filter_type="highpass")])
+def test_spice_ac_agrees_with_the_analytic_cascade(kw):
+    d = design(FilterSpec(**kw), simulate=True)
+    assert d.spice["max_deviation_passband_db"] < 0.05
+    assert d.spice["max_deviation_60db_db"] < 0.5
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("kw", [dict(filter_type="bandpass", order=2, f_low_hz=900.0, f_high_hz=1.1e3,
+                                     family="bessel", opamp="TL072"),
+                                dict(filter_type="bandpass", order=3, f_low_hz=300.0, f_high_hz=3e3,
+                                     family="chebyshev", ripple_db=0.5)])
+def test_bandpass_narrow_and_wide(kw):
+    d = design(FilterSpec(**kw), simulate=True)
+    narrow = kw["f_high_hz"] / kw["f_low_hz"] < 2
+    assert all(st.topology == "mfb-bandpass" for st in d.stages) == narrow
+    lo, hi = d.figures["f3_hz"]
+    assert lo == pytest.approx(d.figures["f3_target_hz"][0], rel=0.03)
+    assert hi == pytest.approx(d.figures["f3_target_hz"][1], rel=0.03)
+    assert d.figures["error_joint_db"] <= d.figures["error_per_stage_db"] + 1e-12
+    assert d.spice["max_deviation_passband_db"] < 0.05
+
+
+def test_gbw_predistortion_reduces_the_op_amp_error():
+    kw = dict(order=6, fc_hz=5e3, family="chebyshev", ripple_db=0.5, opamp="LM741", gbw_margin=10.0)
+    plain = design(FilterSpec(**kw))
+    comp = design(FilterSpec(**kw, compensate_gbw=True))
+    assert comp.figures["error_continuous_db"] < 0.5 * plain.figures["error_continuous_db"]
+    assert comp.figures["error_joint_db"] < plain.figures["error_joint_db"]
+    top = comp.stages[-1]
+    assert top.fn_design_hz != top.plan.fn_hz and top.q_design != top.plan.q
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("family", ["butterworth", "bessel", "chebyshev"])
+@pytest.mark.parametrize("filter_type", ["lowpass", "highpass"])
+@pytest.mark.parametrize("order", [1, 4, 7, 10])
+def test_every_family_type_and_order_span_agrees_with_spice(family, filter_type, order):
+    kw = dict(order=order, fc_hz=1e3, family=family, filter_type=filter_type, opamp="NE5532", topology="auto",
+              r_min=100.0, r_max=10e6)
+    if family == "chebyshev":
+        kw["ripple_db"] = 0.5
+    d = design(FilterSpec(**kw), simulate=True)
+    assert d.spice["max_deviation_passband_db"] < 0.1
+    assert d.spice["max_deviation_60db_db"] < 0.5
+    assert d.figures["error_joint_db"] <= d.figures["error_per_stage_db"] + 1e-12
+    assert d.figures["error_joint_db"] < 1.0

@@ -1,0 +1,185 @@
+"""The prototypes (designer.filters.prototype): the ideal cascade of the
+synthesised sections equals scipy's own analog designs (butter, bessel,
+cheby1 with freqs) for every order 1..10; the conventions; the section tables
+of TI SLOA088 reproduced; the mask's order equals buttord/cheb1ord."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from scipy import signal
+
+from designer.core.errors import DesignError
+from designer.filters import Cascade, SectionTarget, get
+from designer.filters.design import section_name
+from designer.filters.prototype import (chebyshev_3db_factor, order_from_mask, plan_bandpass, plan_sections,
+                                        reference_bandpass, reference_response)
+
+
+def scipy_design(kind, family, order, fc, ripple=1.0, norm="mag"):
+    wc = 2 * math.pi * fc
+    btype = "low" if kind == "lowpass" else "high"
+    if family == "butterworth":
+        return signal.butter(order, wc, btype, analog=True)
+    if family == "bessel":
+        return signal.bessel(order, wc, btype, analog=True, norm=norm)
+    return signal.cheby1(order, ripple, wc, btype, analog=True)
+
+
+def ideal_cascade(kind, family, order, fc, ripple=1.0, norm="mag"):
+    stages = []
+    for p in plan_sections(kind, family, order, fc, ripple, norm):
+        topo = get(section_name(kind, p.order, "sallen-key", 1.0))
+        stages.append((topo, topo.synthesize(SectionTarget(kind, p.fn_hz, p.q, 1.0))))
+    return Cascade(stages)
+
+
+@given(order=st.integers(1, 10), fc=st.floats(10.0, 1e5), family=st.sampled_from(["butterworth", "bessel", "chebyshev"]),
+       kind=st.sampled_from(["lowpass", "highpass"]), ripple=st.sampled_from([0.1, 0.5, 1.0, 2.0, 3.0]),
+       norm=st.sampled_from(["mag", "delay"]))
+def test_ideal_cascade_equals_scipy_design(order, fc, family, kind, ripple, norm):
+    b, a = scipy_design(kind, family, order, fc, ripple, norm)
+    f = fc * np.geomspace(0.05, 20, 200)
+    _, h_ref = signal.freqs(b, a, 2 * math.pi * f)
+    h = ideal_cascade(kind, family, order, fc, ripple, norm).response(2j * math.pi * f)
+    # unity-gain sections: the cascade's passband gain is 1, scipy's b[-1]/a[-1] (low-pass) or b[0]/a[0]
+    passband = b[-1] / a[-1] if kind == "lowpass" else b[0] / a[0] if len(b) == len(a) else None
+    np.testing.assert_allclose(h * passband, h_ref, rtol=1e-7, atol=1e-12)
+
+
+@pytest.mark.parametrize("order", range(1, 11))
+@pytest.mark.parametrize("kind", ["lowpass", "highpass"])
+def test_chebyshev_3db_convention_puts_minus_3db_at_fc(order, kind):
+    h = reference_response([1e3], kind, "chebyshev", order, 1e3, 0.5, chebyshev_cutoff="3db")
+    # -3 dB below the ripple's peak; the reference is normalised to its DC (or high-frequency) gain, which an
+    # even order puts 0.5 dB below the peak
+    peak_over_passband = 0.5 if order % 2 == 0 else 0.0
+    assert 20 * math.log10(abs(h[0])) == pytest.approx(-10 * math.log10(2) + peak_over_passband, abs=1e-9)
+    assert chebyshev_3db_factor(order, 0.5) > 1
+
+
+@pytest.mark.parametrize("order", range(1, 11))
+def test_bessel_delay_norm_gives_the_delay_at_dc(order):
+    f = np.array([1.0, 2.0])   # far below fc = 1 kHz: the group delay is flat there
+    h = reference_response(f, "lowpass", "bessel", order, 1e3, bessel_norm="delay")
+    delay = -np.diff(np.unwrap(np.angle(h))) / (2 * math.pi * np.diff(f))
+    assert delay[0] == pytest.approx(1 / (2 * math.pi * 1e3), rel=1e-5)
+
+
+# TI SLOA088 ("Op Amps for Everyone", ch. 16), the coefficient tables: each second-order section as
+# 1 + a s + b s^2 in s normalised to the cut-off, so fn/fc = 1/sqrt(b) and Q = sqrt(b)/a (Bessel at -3 dB);
+# for the Chebyshev tables, whose frequency normalisation differs between sources, the Q only
+SLOA088 = {
+    ("butterworth", 4, None): [(0.7654, 1.0), (1.8478, 1.0)],
+    ("butterworth", 6, None): [(0.5176, 1.0), (1.4142, 1.0), (1.9319, 1.0)],
+    ("bessel", 2, None): [(1.3617, 0.6180)],
+    ("bessel", 4, None): [(1.3397, 0.4889), (0.7743, 0.3890)],
+}
+SLOA088_CHEBYSHEV_Q = {(2, 1.0): [0.9565], (4, 1.0): [0.7845, 3.5590], (4, 3.0): [1.0765, 5.5797]}
+
+
+@pytest.mark.parametrize("key", list(SLOA088))
+def test_sections_reproduce_sloa088_tables(key):
+    family, order, _ = key
+    plans = [p for p in plan_sections("lowpass", family, order, 1.0) if p.order == 2]
+    want = sorted(((1 / math.sqrt(b), math.sqrt(b) / a) for a, b in SLOA088[key]), key=lambda x: x[1])
+    assert len(plans) == len(want)
+    for p, (fn, q) in zip(plans, want):
+        assert p.fn_hz == pytest.approx(fn, rel=5e-4) and p.q == pytest.approx(q, rel=5e-4)
+
+
+@pytest.mark.parametrize("key", list(SLOA088_CHEBYSHEV_Q))
+def test_chebyshev_q_reproduces_sloa088(key):
+    order, ripple = key
+    qs = [p.q for p in plan_sections("lowpass", "chebyshev", order, 1.0, ripple) if p.order == 2]
+    assert qs == pytest.approx(SLOA088_CHEBYSHEV_Q[key], rel=5e-4)
+
+
+@pytest.mark.parametrize("family", ["butterworth", "bessel", "chebyshev"])
+@pytest.mark.parametrize("order", range(1, 11))
+def test_stages_in_rising_q_first_order_first(family, order):
+    plans = plan_sections("lowpass", family, order, 1e3, 0.5)
+    qs = [p.q for p in plans if p.order == 2]
+    assert qs == sorted(qs)
+    assert sum(p.order for p in plans) == order
+    assert all(p.order == 2 for p in plans[1:])
+
+
+MASKS = [("lowpass", 3e3, 1.0, 12e3, 40.0), ("lowpass", 1e3, 0.5, 2e3, 60.0), ("highpass", 10e3, 1.0, 2e3, 50.0),
+         ("highpass", 500.0, 3.0, 100.0, 30.0)]
+
+
+@pytest.mark.parametrize("mask", MASKS)
+def test_mask_order_equals_buttord_and_cheb1ord(mask):
+    kind, fp, ap, fs, as_ = mask
+    for family, fn in (("butterworth", signal.buttord), ("chebyshev", signal.cheb1ord)):
+        n, wn = fn(2 * math.pi * fp, 2 * math.pi * fs, ap, as_, analog=True)
+        if n > 10:
+            with pytest.raises(DesignError, match=f"order {n}"):
+                order_from_mask(kind, family, fp, ap, fs, as_)
+            continue
+        order, fc = order_from_mask(kind, family, fp, ap, fs, as_)
+        assert order == n and fc == pytest.approx(wn / (2 * math.pi))
+
+
+@pytest.mark.parametrize("mask", [("lowpass", 1e3, 3.0, 10e3, 40.0), ("highpass", 10e3, 1.0, 1e3, 50.0),
+                                  ("lowpass", 1e3, 0.5, 8e3, 30.0)])
+def test_bessel_mask_order_is_the_least_that_meets_it(mask):
+    kind, fp, ap, fs, as_ = mask
+    order, fc = order_from_mask(kind, "bessel", fp, ap, fs, as_)
+    loss = lambda n, f, c: -20 * math.log10(abs(reference_response([f], kind, "bessel", n, c)[0]))  # noqa: E731
+    assert loss(order, fp, fc) == pytest.approx(ap, abs=1e-6)
+    assert loss(order, fs, fc) >= as_
+    if order > 1:   # one order less cannot: with its loss at fp set to the limit, fs is not attenuated enough
+        n1, fc1 = order - 1, fc
+        lo, hi = math.log(fp) - 12, math.log(fp) + 12
+        for _ in range(100):
+            mid = 0.5 * (lo + hi)
+            if (loss(n1, fp, math.exp(mid)) > ap) == (kind == "lowpass"):
+                lo = mid
+            else:
+                hi = mid
+        fc1 = math.exp(hi if kind == "lowpass" else lo)
+        assert loss(n1, fs, fc1) < as_
+
+
+def test_bessel_mask_beyond_order_10_says_so():
+    with pytest.raises(DesignError, match=r"above order 10 \(order 10 gives .* dB"):
+        order_from_mask("lowpass", "bessel", 3e3, 1.0, 12e3, 40.0)
+
+
+@given(order=st.integers(1, 5), f_low=st.floats(50.0, 5e4), ratio=st.floats(1.05, 1.9),
+       family=st.sampled_from(["butterworth", "bessel", "chebyshev"]), ripple=st.sampled_from([0.1, 0.5, 1.0, 3.0]))
+def test_narrow_bandpass_sections_equal_scipy_bandpass_design(order, f_low, ratio, family, ripple):
+    f_high = f_low * ratio
+    wn = [2 * math.pi * f_low, 2 * math.pi * f_high]
+    if family == "butterworth":
+        b, a = signal.butter(order, wn, "bandpass", analog=True)
+    elif family == "bessel":
+        b, a = signal.bessel(order, wn, "bandpass", analog=True, norm="mag")
+    else:
+        b, a = signal.cheby1(order, ripple, wn, "bandpass", analog=True)
+    f0 = math.sqrt(f_low * f_high)
+    f = f0 * np.geomspace(0.3, 3, 120)
+    _, h_ref = signal.freqs(b, a, 2 * math.pi * np.append(f, f0))
+    plans = plan_bandpass(family, order, f_low, f_high, ripple, method="narrow")
+    assert len(plans) == order and all(p.kind == "bandpass" for p in plans)
+    topo = get("mfb-bandpass")
+    # each section's gain well inside the MFB band-pass's bound 2 Q^2 (the comparison is normalised at f0)
+    cascade = Cascade([(topo, topo.synthesize(SectionTarget("bandpass", p.fn_hz, p.q, min(1.0, p.q ** 2))))
+                       for p in plans])
+    h = cascade.response(2j * math.pi * np.append(f, f0))
+    np.testing.assert_allclose(h[:-1] / h[-1], h_ref[:-1] / h_ref[-1], rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(reference_bandpass(f, family, order, f_low, f_high, ripple, method="narrow"),
+                               h_ref[:-1] / abs(h_ref[-1]), rtol=1e-6, atol=1e-9)
+
+
+def test_wide_bandpass_is_the_highpass_then_lowpass():
+    plans = plan_bandpass("butterworth", 4, 300.0, 3e3)
+    assert sorted(p.kind for p in plans) == ["highpass"] * 2 + ["lowpass"] * 2
+    f = np.geomspace(30, 30e3, 50)
+    want = reference_response(f, "highpass", "butterworth", 4, 300.0) * reference_response(f, "lowpass", "butterworth",
+                                                                                          4, 3e3)
+    np.testing.assert_allclose(reference_bandpass(f, "butterworth", 4, 300.0, 3e3), want, rtol=1e-12)
