@@ -12,7 +12,7 @@ from helpers import ROOT, script
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from designer.cli import capture, check, identify, pid, plant, prbs
+from designer.cli import capture, check, filter as filter_cli, identify, pid, plant, prbs
 from designer.cli.common import ExtendList, StoreOnce
 from designer.core.errors import DesignError
 from designer.web import server
@@ -21,7 +21,8 @@ from designer.web import server
 PARSERS = {"design-plant": plant._design_parser, "analyze-plant": plant._analyze_parser,
            "design-pid": pid._parser, "analyze-pid": pid._analyze_parser, "check-design": check._parser,
            "identify": identify.build_parser, "identify-freq": identify.build_freq_parser,
-           "simulate-capture": capture.build_parser, "make-prbs": prbs.build_parser, "designer-web": server._parser}
+           "simulate-capture": capture.build_parser, "make-prbs": prbs.build_parser, "designer-web": server._parser,
+           "design-filter": filter_cli._parser}
 
 
 def run(exe, *args):
