@@ -398,3 +398,27 @@ def test_dimensionless_numbers_have_no_si_prefix(page, server):
     assert "_s =" not in table and "_s =" not in best                        # units on values, not names
     assert page.evaluate("D.num(0.98869)") == "0.9887" and page.evaluate("D.param('tau_s', 758.5e-6)") == \
         "tau = 758.5 us"
+
+
+def test_a_superseded_request_leaves_the_server_queue(page, server):
+    """The page's cancel (a newer keystroke) closes the request's connection: the server, its workers busy,
+    drops it from the queue, never running it (a room of students does not queue behind designs nobody sees)."""
+    import threading
+    open_page(page, server, "/check")                    # a page that sends nothing by itself
+    # both workers busy for ~3 s (the optimiser, with SPICE)
+    slow = [threading.Thread(target=server.post, args=("/api/pid", {"plant-fc": 3500, "plant-zeta": 0.2,
+            "tuning": "optimize", "target-overshoot": 10 + i})) for i in range(2)]
+    for t in slow:
+        t.start()
+    try:
+        page.wait_for_timeout(400)
+        before = health(server)
+        page.evaluate("() => { D.api('/api/plant', {fc: '1000', zeta: '0.5'}, false, 'form');"
+                      "        setTimeout(() => D.cancel('form'), 300); }")
+        page.wait_for_timeout(1200)
+        after_ = health(server)
+        assert after_["dropped"] == before["dropped"] + 1, (before, after_)
+        assert after_["ran"] == before["ran"]            # the slow ones are still running; the dropped never ran
+    finally:
+        for t in slow:
+            t.join(120)
