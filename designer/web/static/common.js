@@ -86,12 +86,18 @@ D.labelOf = function (form, name) {
 // becomes the label of the field that sets it (the API names the flag in its `option`; the form's labels name
 // the fields), one with no field on this page its plain name; references to the seed documents are left out
 // (they mean nothing beside a form).
-D.inPageWords = function (form, text) {
-  text = String(text || "").replace(/--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?(?: \((?:percent|s|Hz|V)\))?/g, (all, name) => {
-    const label = form ? D.labelOf(form, name) : null;
-    return `"${label || name.replace(/-/g, " ")}"`;
+D.inPageWords = function (form, text, keepRefs) {
+  const label = name => (form && D.labelOf(form, name)) || name.replace(/-/g, " ");
+  // the optimiser's two sentences say what to do: in the page, with its menu and field
+  text = String(text || "")
+    .replace(/--tuning (\S+) needs --target-overshoot P \(percent\)/g,
+             (all, rule) => `the rule "${rule}" needs a target: fill in "${label("target-overshoot")}"`)
+    .replace(/--tuning (\S+) --target-overshoot P\b/g,
+             (all, rule) => `choose the rule "${rule}" and fill in "${label("target-overshoot")}"`);
+  text = text.replace(/--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?(?: \((?:percent|s|Hz|V)\))?/g, (all, name) => {
+    return `"${label(name)}"`;
   });
-  return D.plainText(text);
+  return keepRefs ? text : D.plainText(text);
 };
 D.plainText = function (text) {
   return String(text || "").replace(/,?\s*seed \d{3}[^,;:)]*/gi, "").replace(/\s*\(\s*\)/g, "").replace(/\(\s*,\s*/g, "(");

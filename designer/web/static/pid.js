@@ -65,6 +65,11 @@ function show(answer) {
   const host = document.getElementById("sheet-html");
   const root = host.shadowRoot || host.attachShadow({mode: "open"});
   root.innerHTML = p.sheet_html;
+  // its advice in the page's words (the printed sheet keeps the command's: it goes with the bundle's files)
+  const walk = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
+  for (let n = walk.nextNode(); n; n = walk.nextNode()) {
+    if (n.textContent.includes("--")) n.textContent = D.inPageWords(form, n.textContent, true);
+  }
 }
 
 async function design() {
