@@ -360,6 +360,10 @@ def test_the_pid_page_opens_on_a_design_that_passes_with_its_margins(page, serve
     pm = want["closed_loop"]["margins"]["phase_margin_deg"]
     assert figure(page, "phase margin") == f"{float(f'{pm:.3g}'):g} deg"
     assert figure(page, "gain margin").endswith(" dB") and figure(page, "crossover").endswith("Hz")
+    # marked on the loop-gain plots where they are read
+    for plot in ("#lg-gain", "#lg-phase"):
+        marks = page.get_attribute(plot, "data-marks")
+        assert f"crossover: PM {float(f'{pm:.3g}'):g} deg" in marks and "GM" in marks, marks
     # a rule that fails says which checks, by their titles
     assert after(page, lambda: page.select_option("select[name=tuning]", "zn"), timeout=120000) == "done"
     failed = page.inner_text("#failed")

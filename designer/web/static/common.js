@@ -316,6 +316,7 @@ D.plot = function (el, trace, opts) {
               Math.abs(Math.log10(t) - Math.round(Math.log10(t))) > 1e-9) ? "" : D.eng(t, opts.xUnit || "", 3))},
            {label: opts.yLabel || ""}],
     cursor: {drag: {x: true, y: false}},
+    hooks: {draw: [u => D.drawMarks(u, opts.marks || [])]},
     legend: {live: true},
   }, data, el);
   el._plot = u;
@@ -327,7 +328,28 @@ D.plot = function (el, trace, opts) {
     el._resize.observe(el);
   }
   el.dataset.series = trace.series.map(s => s.label).join("|");
+  el.dataset.marks = (opts.marks || []).map(m => m.label).join("|");
   return u;
+};
+
+// Vertical marks on a plot ({x, label}: the crossover, the phase-crossover), drawn over the traces with their
+// label at the top; one off the axis's range is left out (zoomed away).
+D.drawMarks = function (u, marks) {
+  const ctx = u.ctx, top = u.bbox.top, bottom = u.bbox.top + u.bbox.height;
+  ctx.save();
+  ctx.font = `${Math.round(11 * devicePixelRatio)}px system-ui, sans-serif`;
+  ctx.fillStyle = ctx.strokeStyle = "#555";
+  ctx.textAlign = "left";          // (uPlot leaves its axes' alignment set)
+  ctx.textBaseline = "top";
+  ctx.setLineDash([5 * devicePixelRatio, 4 * devicePixelRatio]);
+  ctx.lineWidth = devicePixelRatio;
+  for (const m of marks) {
+    if (!isFinite(m.x) || m.x < u.scales.x.min || m.x > u.scales.x.max) continue;
+    const x = Math.round(u.valToPos(m.x, "x", true));
+    ctx.beginPath(); ctx.moveTo(x, top); ctx.lineTo(x, bottom); ctx.stroke();
+    ctx.fillText(m.label, x + 4 * devicePixelRatio, top + 2 * devicePixelRatio);
+  }
+  ctx.restore();
 };
 
 D.nav = function (current) {

@@ -57,8 +57,12 @@ function show(answer) {
     f.append(line);
   }
   D.plot(document.getElementById("closed"), p.closed_loop, {xUnit: "s", yLabel: "output (V)"});
-  D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 220});
-  D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 180});
+  // the margins where they are read: the gain crossover (phase margin) and the phase crossover (gain margin)
+  const marks = [];
+  if (isFinite(m.crossover_hz)) marks.push({x: m.crossover_hz, label: `crossover: PM ${D.num(m.phase_margin_deg, 3)} deg`});
+  if (isFinite(m.phase_crossover_hz)) marks.push({x: m.phase_crossover_hz, label: `-180 deg: GM ${D.num(m.gain_margin_db, 3)} dB`});
+  D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 220, marks});
+  D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 180, marks});
   document.getElementById("schematic").innerHTML = p.schematic_svg;
   // the sheet is our own HTML (the build sheet's renderer escapes every text); shown in a shadow root so its
   // styles stay inside
