@@ -49,11 +49,6 @@ D.api = async function (path, body, asBlob, channel) {
 // so this is not an onsubmit attribute).
 document.addEventListener("submit", e => e.preventDefault());
 
-D.debounce = function (fn, ms) {
-  let timer = null;
-  return function (...args) { clearTimeout(timer); timer = setTimeout(() => fn(...args), ms); };
-};
-
 // The form's options by name: empty fields left out (the command's defaults), checkboxes as switches.
 D.options = function (form) {
   const out = {};
@@ -159,14 +154,15 @@ D.markCurrent = function () {
 // A form answering as it is typed: a keystroke cancels the request in flight (browser and server: its answer
 // would be of the inputs before it) and waits for a pause (`wait` ms: no refusal of the "0." on the way to
 // "0.05", no design per key); leaving a field or choosing from a menu asks at once. `key()` is what the request
-// would send: the same inputs as the last answer are not asked again (leaving the field just typed).
+// would send: the inputs last asked for are not asked again when nothing was typed since (leaving the field
+// whose pause already sent them).
 D.liveForm = function (form, run, key, wait) {
   wait = wait || 600;
   let timer = null, asked = null;
   const now = () => {
     clearTimeout(timer); timer = null;
     const k = key();
-    if (k !== null && k === asked) { D.markCurrentIfAnswered(); return; }
+    if (k !== null && k === asked) return;   // nothing typed since: its answer is shown or on its way
     asked = k;
     run();
   };
@@ -180,11 +176,6 @@ D.liveForm = function (form, run, key, wait) {
   });
   form.addEventListener("change", e => { if (e.target.type !== "file") now(); });
   return {now, forget: () => { asked = null; }};
-};
-// the inputs came back to those of the answer shown (and it was not refused): it is current again
-D.markCurrentIfAnswered = function () {
-  if (document.body.dataset.state === "done") D.markCurrent();
-  else if (document.body.dataset.state === "error") D.markStale("refused");
 };
 
 // Each answer shown: the page's state ("done" or "error") and how many answers it has shown (for its tests).

@@ -78,7 +78,11 @@ function show(answer) {
 
 async function design() {
   const opts = request();
-  if (opts === null) return;
+  if (opts === null) {   // "identified" chosen with no model: what is shown is another plant's
+    D.markStale("No identified model yet (drop a capture on the Identify page): what is shown below is of the " +
+                "plant chosen before, not of the current inputs.");
+    return;
+  }
   const mine = ++seq;
   D.markStale("pending");
   D.busy(true, status);
