@@ -156,6 +156,7 @@ D.markCurrent = function () {
 // "0.05", no design per key); leaving a field or choosing from a menu asks at once. `key()` is what the request
 // would send: the inputs last asked for are not asked again when nothing was typed since (leaving the field
 // whose pause already sent them).
+D.UNFINISHED = /(^\s*[-+]?\s*$)|(\d\.|\d[eE][-+]?|[-+])\s*$/;
 D.liveForm = function (form, run, key, wait) {
   wait = wait || 600;
   let timer = null, asked = null;
@@ -172,7 +173,8 @@ D.liveForm = function (form, run, key, wait) {
     D.cancel("form");
     asked = null;
     D.markStale("pending");
-    timer = setTimeout(now, wait);
+    // a number still being typed ("0.", "1e", "-") is not asked about on a pause, only when the field is left
+    if (!(e.target.tagName === "INPUT" && D.UNFINISHED.test(e.target.value))) timer = setTimeout(now, wait);
   });
   form.addEventListener("change", e => { if (e.target.type !== "file") now(); });
   return {now, forget: () => { asked = null; }};
