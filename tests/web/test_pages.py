@@ -5,7 +5,11 @@ schematic, change the op-amp, mistype, drop a scope export, go from its model
 to a PID, download the bundle."""
 
 import io
+import json
+import re
 import shutil
+import threading
+import urllib.request
 import zipfile
 from pathlib import Path
 
@@ -257,8 +261,7 @@ def stale_note(pg) -> str:
 
 
 def health(server) -> dict:
-    import json
-    import urllib.request
+    """The server's counts: ``ran`` (requests its workers ran), ``dropped`` (left the queue unrun)."""
     with urllib.request.urlopen(server.url + "/api/health", timeout=60) as r:
         return json.loads(r.read())
 
@@ -320,6 +323,7 @@ def test_pid_messages_name_the_fields_not_the_flags(page, server):
     assert after(page, lambda: (page.fill("input[name=target-overshoot]", ""),
                                 page.press("input[name=target-overshoot]", "Tab"))) == "error"
     msg = page.inner_text(".field-error")
+    assert disabled(page, DOWNLOADS["/pid"]) == [True, True] and "not of the current inputs" in stale_note(page)
     status, want = server.post_json("/api/pid", {"plant-fc": 3500, "plant-zeta": 0.2, "tuning": "optimize"})
     assert status == 400 and "--target-overshoot" in want["message"]   # the command's words...
     assert msg == 'the rule "optimize" needs a target: fill in "target overshoot (%)"', msg   # ... the page's
@@ -396,7 +400,6 @@ def test_no_page_is_wider_than_a_phone(browser, server, path):
 
 
 def test_dimensionless_numbers_have_no_si_prefix(page, server):
-    import re
     open_page(page, server, "/identify")
     assert drop(page, SYNTHETIC_TEK) == "done"
     best = page.inner_text("#best")
@@ -411,7 +414,6 @@ def test_dimensionless_numbers_have_no_si_prefix(page, server):
 def test_a_superseded_request_leaves_the_server_queue(page, server):
     """The page's cancel (a newer keystroke) closes the request's connection: the server, its workers busy,
     drops it from the queue, never running it (a room of students does not queue behind designs nobody sees)."""
-    import threading
     open_page(page, server, "/check")                    # a page that sends nothing by itself
     # both workers busy for ~3 s (the optimiser, with SPICE)
     slow = [threading.Thread(target=server.post, args=("/api/pid", {"plant-fc": 3500, "plant-zeta": 0.2,
