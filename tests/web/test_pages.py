@@ -63,7 +63,7 @@ def after(pg, action, timeout=60000):
 
 def open_page(pg, server, path):
     pg.goto(server.url + path)
-    if path in ("/plant", "/pid"):
+    if path.split("?")[0] in ("/plant", "/pid"):
         pg.wait_for_function("() => +(document.body.dataset.answers || 0) > 0", timeout=60000)
 
 
@@ -444,3 +444,21 @@ def test_a_number_still_being_typed_is_not_sent_on_a_pause(page, server):
     assert page.locator("#bom").is_disabled()                 # the 0.2 design shown is not of "0." either
     assert after(page, lambda: page.locator("input[name=zeta]").press_sequentially("3")) == "done"
     assert "zeta 0.3" in page.inner_text("#title")
+
+
+def test_the_design_shown_is_in_the_address_a_reload_keeps_it(page, server):
+    open_page(page, server, "/plant")
+    assert after(page, lambda: (page.fill("input[name=fc]", "2000"), page.select_option("select[name=opamp]",
+                                                                                         "TL072"))) == "done"
+    assert "fc=2000" in page.url and "opamp=TL072" in page.url
+    shared = page.url
+    page.goto(server.url + "/pid")               # elsewhere, then the link as a classmate opens it
+    open_page(page, server, shared.replace(server.url, ""))
+    assert "fc 2000 Hz" in page.inner_text("#title") and page.input_value("select[name=opamp]") == "TL072"
+    # the PID page too, with its plant's kind
+    open_page(page, server, "/pid")
+    assert after(page, lambda: page.select_option("select[name=tuning]", "zn"), timeout=120000) == "done"
+    assert "tuning=zn" in page.url and "plant=design" in page.url and "target-overshoot" not in page.url
+    page.reload()
+    page.wait_for_function("() => +(document.body.dataset.answers || 0) > 0", timeout=60000)
+    assert page.input_value("select[name=tuning]") == "zn" and "(zn:" in page.inner_text("#title")

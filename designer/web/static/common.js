@@ -191,6 +191,14 @@ D.answered = function (state) {
   document.body.dataset.answers = String(+(document.body.dataset.answers || 0) + 1);
 };
 
+// The inputs of the design shown, in the address bar: a link to share, a reload that keeps them (the pages
+// read their fields from the query string as they open). Replaced, not pushed: one history entry a page.
+D.remember = function (opts) {
+  const q = new URLSearchParams();
+  for (const [k, v] of Object.entries(opts)) if (typeof v !== "object") q.set(k, v === true ? "true" : v);
+  history.replaceState(null, "", `${location.pathname}?${q}`);
+};
+
 D.busy = function (on, el) {
   document.body.classList.toggle("busy", on);
   if (el) el.textContent = on ? "working..." : "";

@@ -92,6 +92,8 @@ async function design() {
   if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
   D.clearError(form);
   last = {opts, answer: r.data};
+  // an identified model lives in this browser's session only: no link for it
+  if (plantKind() !== "identify") D.remember({plant: plantKind(), ...opts});
   show(r.data);
   status.textContent = "designed and simulated";
   D.answered("done");

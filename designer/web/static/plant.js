@@ -41,6 +41,7 @@ async function design() {
   if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
   D.clearError(form);
   last = {opts, answer: r.data};   // the downloads are of these inputs (D.answered turns them on)
+  D.remember(opts);
   show(r.data);
   status.textContent = `designed and simulated (${r.data.result.simulator || "no simulator"})`;
   D.answered("done");
