@@ -144,6 +144,11 @@ D.markStale = function (why) {
   results.classList.add("stale");
   if (D.onStale) D.onStale(why);
 };
+// whether what is shown is not of the current inputs (a result control's handler does nothing then: a
+// script's click reaches it even when it is disabled)
+D.isStale = function () {
+  return document.querySelector(".results.stale") !== null;
+};
 D.markCurrent = function () {
   for (const el of document.querySelectorAll("[data-current]")) el.disabled = false;
   const note = document.getElementById("stale-note");

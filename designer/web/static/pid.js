@@ -100,7 +100,7 @@ async function design() {
 }
 
 async function file(kind) {
-  if (!last || document.body.dataset.state !== "done") return;
+  if (!last || D.isStale()) return;
   D.busy(true, status);
   const r = await D.api(`/api/pid/${kind}`, last.opts, true);
   D.busy(false, status);

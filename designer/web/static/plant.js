@@ -48,7 +48,7 @@ async function design() {
 }
 
 async function file(kind) {
-  if (!last || document.body.dataset.state !== "done") return;
+  if (!last || D.isStale()) return;
   if (kind === "bom") {
     D.download(new Blob([last.answer.page.bom_csv], {type: "text/csv"}), "bom.csv");
     return;
@@ -72,7 +72,7 @@ async function file(kind) {
   document.getElementById("bundle").onclick = () => file("bundle");
   document.getElementById("bom").onclick = () => file("bom");
   document.getElementById("topid").onclick = () => {
-    if (!last) return;
+    if (!last || D.isStale()) return;
     const o = last.opts, b = last.answer.result.built;
     // the plant as built, by its parts: the PID is designed for the circuit on the bench
     const code = v => D.eng(v, "", 6).replace(" ", "");   // 1.6k, 3.3n: engineering notation as typed
