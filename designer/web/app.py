@@ -107,7 +107,8 @@ def create_app(pool, trust: Trust):
         return Response(found[0], media_type=found[1], headers={"Cache-Control": "no-cache"})
 
     async def health(request):
-        return JSONResponse({"ok": True, "jobs": pool.jobs, "timeout_s": pool.timeout, "dropped": pool.dropped})
+        return JSONResponse({"ok": True, "jobs": pool.jobs, "timeout_s": pool.timeout, "dropped": pool.dropped,
+                             "ran": pool.ran})
 
     choices = _choices()
 

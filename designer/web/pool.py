@@ -149,6 +149,7 @@ class Pool:
         self._waiting = {}
         self._loop = None
         self.dropped = 0   #: requests whose client left while they were queued (never run)
+        self.ran = 0       #: requests a worker ran (answered, whatever the answer): what a page's typing cost
         self.stopping = False
 
     def attach(self) -> None:
@@ -169,6 +170,8 @@ class Pool:
             return
         if kind == "cancelled":
             self.dropped += 1
+        else:
+            self.ran += 1
         fut = self._waiting.pop(rid, None)
         if fut is not None and not fut.done():
             fut.set_result((kind, value))

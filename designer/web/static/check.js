@@ -38,7 +38,15 @@ function show(answer) {
   document.getElementById("summary").textContent = answer.summary || "";
 }
 
+// a refused run leaves no result to read: the previous run's table, summary and junit.xml are cleared
+D.onStale = function (why) {
+  if (why !== "refused") return;
+  last = null;
+  for (const id of ["verdict", "cases", "summary"]) document.getElementById(id).replaceChildren();
+};
+
 async function run() {
+  D.markStale("pending");
   D.busy(true, status);
   const body = {spec: document.getElementById("spec").value, spec_name: specName, files: decks,
                 options: D.options(form)};
@@ -48,11 +56,11 @@ async function run() {
   D.clearError(form);
   last = r.data;
   show(r.data);
-  document.getElementById("junit").disabled = !r.data.junit;
   status.textContent = r.data.status === 0 ? "every check passed" : "a check failed";
   D.answered("done");
+  document.getElementById("junit").disabled = !r.data.junit;
 }
 
 D.dropZone(document.getElementById("drop"), document.getElementById("files"), addFiles);
 document.getElementById("run").onclick = run;
-document.getElementById("junit").onclick = () => D.download(new Blob([last.junit], {type: "application/xml"}), "junit.xml");
+document.getElementById("junit").onclick = () => last && D.download(new Blob([last.junit], {type: "application/xml"}), "junit.xml");

@@ -16,6 +16,11 @@ D.loadChoices = async function () {
 // Every call says it is this page's (X-Designer): the server takes an upload's form or file only with it, which
 // a page of another site cannot send without asking the server first (a CORS preflight it never approves).
 const channels = {};
+// Abort the request in flight on a channel: the browser closes its connection, which the server sees (a queued
+// request leaves the queue, its worker never starts it).
+D.cancel = function (channel) {
+  if (channels[channel]) { channels[channel].abort(); delete channels[channel]; }
+};
 D.api = async function (path, body, asBlob, channel) {
   const init = {method: "POST", headers: {"X-Designer": "1"}};
   if (body instanceof FormData || body instanceof Blob) init.body = body;
@@ -28,6 +33,7 @@ D.api = async function (path, body, asBlob, channel) {
   let r;
   try { r = await fetch(path, init); } catch (e) {
     if (e.name === "AbortError") return {aborted: true};
+    if (channel) delete channels[channel];
     return {ok: false, status: 0, data: {error: `the server does not answer: ${e.message}`, message: "the server does not answer"}};
   }
   if (r.ok && asBlob) {
@@ -42,11 +48,6 @@ D.api = async function (path, body, asBlob, channel) {
 // A form answers as it is typed: Enter never submits it (the pages' Content-Security-Policy has no inline script,
 // so this is not an onsubmit attribute).
 document.addEventListener("submit", e => e.preventDefault());
-
-D.debounce = function (fn, ms) {
-  let timer = null;
-  return function (...args) { clearTimeout(timer); timer = setTimeout(() => fn(...args), ms); };
-};
 
 // The form's options by name: empty fields left out (the command's defaults), checkboxes as switches.
 D.options = function (form) {
@@ -66,13 +67,44 @@ D.clearError = function (form) {
   for (const el of form.querySelectorAll(".field-error")) el.remove();
   for (const el of form.querySelectorAll(".bad")) el.classList.remove("bad");
 };
+// A field's label as the page shows it ("zeta", "target overshoot (%)"): its <label>'s own text, not the hint.
+D.labelOf = function (form, name) {
+  const field = form.querySelector(`[name="${CSS.escape(name)}"]`);
+  const label = field && field.closest("label");
+  if (!label) return null;
+  let text = "";
+  for (const n of label.childNodes) if (n.nodeType === Node.TEXT_NODE) text += n.textContent;
+  return text.replace(/\s+/g, " ").trim() || null;
+};
+
+// A command's message in the page's words: each "--flag" (with its metavariable, "--target-overshoot P (percent)")
+// becomes the label of the field that sets it (the API names the flag in its `option`; the form's labels name
+// the fields), one with no field on this page its plain name; references to the seed documents are left out
+// (they mean nothing beside a form).
+D.inPageWords = function (form, text, keepRefs) {
+  const label = name => (form && D.labelOf(form, name)) || name.replace(/-/g, " ");
+  // the optimiser's two sentences say what to do: in the page, with its menu and field
+  text = String(text || "")
+    .replace(/--tuning (\S+) needs --target-overshoot P \(percent\)/g,
+             (all, rule) => `the rule "${rule}" needs a target: fill in "${label("target-overshoot")}"`)
+    .replace(/--tuning (\S+) --target-overshoot P\b/g,
+             (all, rule) => `choose the rule "${rule}" and fill in "${label("target-overshoot")}"`);
+  text = text.replace(/--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?(?: \((?:percent|s|Hz|V)\))?/g, (all, name) => {
+    return `"${label(name)}"`;
+  });
+  return keepRefs ? text : D.plainText(text);
+};
+D.plainText = function (text) {
+  return String(text || "").replace(/,?\s*seed \d{3}[^,;:)]*/gi, "").replace(/\s*\(\s*\)/g, "").replace(/\(\s*,\s*/g, "(");
+};
+
 D.showError = function (form, data) {
   D.clearError(form);
   const msg = document.createElement("div");
   msg.className = "field-error";
   msg.setAttribute("role", "alert");
-  msg.textContent = data.message || data.error;
-  msg.title = data.error || "";
+  msg.textContent = D.inPageWords(form, data.message || data.error);
+  msg.title = data.error || "";    // the command's own line, for whoever reports it
   const name = data.option ? data.option.replace(/^--/, "") : null;
   const field = name ? form.querySelector(`[name="${CSS.escape(name)}"]`) : null;
   if (field && !field.closest("[hidden]")) {
@@ -83,12 +115,93 @@ D.showError = function (form, data) {
   }
 };
 
+// What the results show is of the inputs as they were: while a newer request is on its way, or after the
+// current inputs were refused, every result control (data-current: downloads, "a PID for this plant"...) is
+// off and one note above the results says why. A page clears what must not be read at all (a check table)
+// in its own onStale.
+D.STALE = {
+  refused: "The inputs are refused (see the form): what is shown below is the last design that worked, not of " +
+           "the current inputs. Its downloads are off until the form is right again.",
+  pending: "Working on the new inputs: what is shown below is of the previous ones.",
+};
+D.onStale = null;
+D.markStale = function (why) {
+  for (const el of document.querySelectorAll("[data-current]")) el.disabled = true;
+  const results = document.querySelector(".results");
+  // before the first answer there is nothing shown to warn about
+  if (!results || (why === "pending" && !+(document.body.dataset.answers || 0))) return;
+  let note = document.getElementById("stale-note");
+  if (!note) {
+    note = document.createElement("p");
+    note.id = "stale-note";
+    note.className = "stale-note";
+    note.setAttribute("role", "status");
+    results.prepend(note);
+  }
+  note.textContent = D.STALE[why] || why;
+  note.dataset.why = why;
+  note.hidden = false;
+  results.classList.add("stale");
+  if (D.onStale) D.onStale(why);
+};
+// whether what is shown is not of the current inputs (a result control's handler does nothing then: a
+// script's click reaches it even when it is disabled)
+D.isStale = function () {
+  return document.querySelector(".results.stale") !== null;
+};
+D.markCurrent = function () {
+  for (const el of document.querySelectorAll("[data-current]")) el.disabled = false;
+  const note = document.getElementById("stale-note");
+  if (note) note.hidden = true;
+  for (const r of document.querySelectorAll(".results")) r.classList.remove("stale");
+};
+
+// A form answering as it is typed: a keystroke cancels the request in flight (browser and server: its answer
+// would be of the inputs before it) and waits for a pause (`wait` ms: no refusal of the "0." on the way to
+// "0.05", no design per key); leaving a field or choosing from a menu asks at once. `key()` is what the request
+// would send: the inputs last asked for are not asked again when nothing was typed since (leaving the field
+// whose pause already sent them).
+D.UNFINISHED = /(^\s*[-+]?\s*$)|(\d\.|\d[eE][-+]?|[-+])\s*$/;
+D.liveForm = function (form, run, key, wait) {
+  wait = wait || 600;
+  let timer = null, asked = null;
+  const now = () => {
+    clearTimeout(timer); timer = null;
+    const k = key();
+    if (k !== null && k === asked) return;   // nothing typed since: its answer is shown or on its way
+    asked = k;
+    run();
+  };
+  form.addEventListener("input", e => {
+    if (e.target.type === "file") return;
+    clearTimeout(timer);
+    D.cancel("form");
+    asked = null;
+    D.markStale("pending");
+    // a number still being typed ("0.", "1e", "-") is not asked about on a pause, only when the field is left
+    if (!(e.target.tagName === "INPUT" && D.UNFINISHED.test(e.target.value))) timer = setTimeout(now, wait);
+  });
+  form.addEventListener("change", e => { if (e.target.type !== "file") now(); });
+  return {now, forget: () => { asked = null; }};
+};
+
 // Each answer shown: the page's state ("done" or "error") and how many answers it has shown (for its tests).
 D.answered = function (state) {
   document.body.dataset.state = state;
-  // after a refusal the results shown are the last good input's: dimmed until the form is right again
-  for (const r of document.querySelectorAll(".results")) r.classList.toggle("stale", state === "error");
+  // after a refusal the results shown are the last good input's: off until the form is right again
+  if (state === "error") {
+    D.markStale("refused");
+    document.body.dataset.refusals = String(+(document.body.dataset.refusals || 0) + 1);
+  } else D.markCurrent();
   document.body.dataset.answers = String(+(document.body.dataset.answers || 0) + 1);
+};
+
+// The inputs of the design shown, in the address bar: a link to share, a reload that keeps them (the pages
+// read their fields from the query string as they open). Replaced, not pushed: one history entry a page.
+D.remember = function (opts) {
+  const q = new URLSearchParams();
+  for (const [k, v] of Object.entries(opts)) if (typeof v !== "object") q.set(k, v === true ? "true" : v);
+  history.replaceState(null, "", `${location.pathname}?${q}`);
 };
 
 D.busy = function (on, el) {
@@ -106,6 +219,35 @@ D.eng = function (v, unit, digits) {
   const a = Math.abs(v);
   for (const [f, p] of pre) if (a >= f * 0.9995) return `${+(v / f).toPrecision(digits)} ${p}${unit || ""}`.trim();
   return `${v.toPrecision(digits)} ${unit || ""}`.trim();
+};
+
+// A number without a unit (a gain, a damping ratio): plain digits, never an SI prefix ("0.9887", not "988.7 m").
+D.num = function (v, digits) {
+  if (v === null || v === undefined || !isFinite(v)) return "n/a";
+  const a = Math.abs(v);
+  return a !== 0 && (a < 1e-3 || a >= 1e6) ? (+v).toExponential((digits || 4) - 1) : String(+(+v).toPrecision(digits || 4));
+};
+
+// A model's parameter as "name = value unit": the unit the name carries (tau_s, wn_rad_s) goes on the value.
+D.param = function (name, v, digits) {
+  const units = [[/_rad_s$/, "rad/s"], [/_hz$/i, "Hz"], [/_s$/, "s"], [/_ohm$/, "Ohm"], [/_f$/, "F"], [/_v$/i, "V"]];
+  for (const [re, unit] of units) if (re.test(name)) return `${name.replace(re, "")} = ${D.eng(v, unit, digits || 4)}`;
+  return `${name} = ${D.num(v, digits)}`;
+};
+
+// A check by its title: the plant's checks carry one; the PID's (design-pid --json) only an id.
+D.CHECK_TITLES = {
+  kp_accuracy: "Kp as built", ti_accuracy: "Ti as built", td_accuracy: "Td as built",
+  integrator_corner: "integrator corner", differentiator_corner: "differentiator corner",
+  bandwidth_difference: "difference amplifier bandwidth", bandwidth_inverter: "inverter bandwidth",
+  bandwidth_integrator: "integrator bandwidth", bandwidth_summer: "summer bandwidth", bandwidth_gain: "gain stage bandwidth",
+  bandwidth_differentiator: "differentiator bandwidth", resistor_bounds: "resistors within their range",
+  capacitor_bounds: "capacitors within their range", closed_loop_stable: "closed loop stable",
+  phase_margin: "phase margin", steady_state_error: "steady-state error", slew_rate: "op-amp slew rate",
+  output_swing: "op-amp output swing",
+};
+D.checkTitle = function (c) {
+  return c.title || D.CHECK_TITLES[c.id] || String(c.id || c.name || "").replace(/_/g, " ");
 };
 
 D.table = function (header, rows, cls) {
@@ -139,7 +281,7 @@ D.checksTable = function (checks) {
     const s = document.createElement("span");
     s.className = c.ok ? "ok" : "fail";
     s.textContent = c.ok ? "ok" : "FAILED";
-    return [c.title || c.id, s, c.detail];
+    return [D.checkTitle(c), s, c.detail];
   }));
 };
 
@@ -158,9 +300,11 @@ const COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b
 D.plot = function (el, trace, opts) {
   opts = opts || {};
   if (el._plot) { el._plot.destroy(); el._plot = null; }
+  if (el._resize) { el._resize.disconnect(); el._resize = null; }
   el.innerHTML = "";
   const data = [trace.x, ...trace.series.map(s => s.y)];
-  const width = Math.max(320, el.clientWidth || 640);
+  // as wide as its box (a phone's 390 px too), and redrawn at the box's width when that changes
+  const width = Math.max(200, el.clientWidth || 640);
   const series = [{label: trace.x_label}];
   trace.series.forEach((s, i) => {
     const band = /^tolerance band/.test(s.label);
@@ -178,11 +322,40 @@ D.plot = function (el, trace, opts) {
               Math.abs(Math.log10(t) - Math.round(Math.log10(t))) > 1e-9) ? "" : D.eng(t, opts.xUnit || "", 3))},
            {label: opts.yLabel || ""}],
     cursor: {drag: {x: true, y: false}},
+    hooks: {draw: [u => D.drawMarks(u, opts.marks || [])]},
     legend: {live: true},
   }, data, el);
   el._plot = u;
+  if (window.ResizeObserver) {
+    el._resize = new ResizeObserver(() => {
+      const w = Math.max(200, el.clientWidth);
+      if (el._plot && Math.abs(w - el._plot.width) > 1) el._plot.setSize({width: w, height: el._plot.height});
+    });
+    el._resize.observe(el);
+  }
   el.dataset.series = trace.series.map(s => s.label).join("|");
+  el.dataset.marks = (opts.marks || []).map(m => m.label).join("|");
   return u;
+};
+
+// Vertical marks on a plot ({x, label}: the crossover, the phase-crossover), drawn over the traces with their
+// label at the top; one off the axis's range is left out (zoomed away).
+D.drawMarks = function (u, marks) {
+  const ctx = u.ctx, top = u.bbox.top, bottom = u.bbox.top + u.bbox.height;
+  ctx.save();
+  ctx.font = `${Math.round(11 * devicePixelRatio)}px system-ui, sans-serif`;
+  ctx.fillStyle = ctx.strokeStyle = "#555";
+  ctx.textAlign = "left";          // (uPlot leaves its axes' alignment set)
+  ctx.textBaseline = "top";
+  ctx.setLineDash([5 * devicePixelRatio, 4 * devicePixelRatio]);
+  ctx.lineWidth = devicePixelRatio;
+  for (const m of marks) {
+    if (!isFinite(m.x) || m.x < u.scales.x.min || m.x > u.scales.x.max) continue;
+    const x = Math.round(u.valToPos(m.x, "x", true));
+    ctx.beginPath(); ctx.moveTo(x, top); ctx.lineTo(x, bottom); ctx.stroke();
+    ctx.fillText(m.label, x + 4 * devicePixelRatio, top + 2 * devicePixelRatio);
+  }
+  ctx.restore();
 };
 
 D.nav = function (current) {

@@ -7,8 +7,20 @@ const status = document.getElementById("status");
 let file = null, seq = 0, last = null;
 
 function params(p) {
-  return Object.entries(p || {}).map(([k, v]) => `${k} = ${D.eng(v, "", 4)}`).join(", ");
+  return Object.entries(p || {}).map(([k, v]) => D.param(k, v)).join(", ");
 }
+
+// a refused input leaves no model to read nor to design a PID for: the previous capture's are cleared
+D.onStale = function (why) {
+  if (why !== "refused") return;
+  last = null;
+  for (const id of ["format", "methods"]) document.getElementById(id).replaceChildren();
+  for (const id of ["plot", "phase"]) {
+    const el = document.getElementById(id);
+    if (el._plot) { el._plot.destroy(); el._plot = null; }
+    el.replaceChildren();
+  }
+};
 
 function show(answer) {
   const r = answer.result, p = answer.page;
@@ -42,7 +54,7 @@ function show(answer) {
   document.getElementById("methods").replaceChildren(D.table(
     ["#", "method", "model", "parameters", "IAE", "valid", "note"],
     r.methods.map((m, i) => [i + 1, m.name, m.model, params(m.params), m.iae === null ? "" : (+m.iae).toPrecision(3),
-                             m.valid ? "yes" : "no", m.note || ""])));
+                             m.valid ? "yes" : "no", D.inPageWords(form, m.note || "")])));
 }
 
 async function identify() {
@@ -50,18 +62,18 @@ async function identify() {
   const mine = ++seq;
   const q = new URLSearchParams({view: "page", filename: file.name});
   for (const [k, v] of Object.entries(D.options(form))) q.set(k, v === true ? "true" : v);
+  D.markStale("pending");
   D.busy(true, status);
   const r = await D.api(`/api/identify?${q}`, file, false, "form");
   if (r.aborted || mine !== seq) return;
   D.busy(false, status);
-  document.getElementById("topid").disabled = true;
   if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
   D.clearError(form);
   last = r.data;
   show(r.data);
-  document.getElementById("topid").disabled = !r.data.result.best;
   status.textContent = `identified ${file.name}`;
   D.answered("done");
+  document.getElementById("topid").disabled = !r.data.result.best;   // a PID needs a valid model
 }
 
 (async function () {
@@ -69,9 +81,9 @@ async function identify() {
   D.fill(form.querySelector("select[name=format]"), ["", ...c.formats], "");
   form.querySelector("select[name=format]").options[0].textContent = "auto";
   D.dropZone(document.getElementById("drop"), document.getElementById("file"), files => { file = files[0]; identify(); });
-  const later = D.debounce(identify, 400);
-  form.addEventListener("input", e => { if (e.target.id !== "file") later(); });
+  D.liveForm(form, identify, () => file ? JSON.stringify([file.name, file.size, file.lastModified, D.options(form)]) : null);
   document.getElementById("topid").onclick = () => {
+    if (!last) return;
     sessionStorage.setItem("identify-result", JSON.stringify(last.result));
     location.href = "/pid?plant=identify";
   };

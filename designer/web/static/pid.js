@@ -14,6 +14,12 @@ function showPlantKind() {
   for (const d of form.querySelectorAll("[data-plant]")) d.hidden = d.dataset.plant !== plantKind();
 }
 
+// the targets are the optimiser's: with a rule chosen they are off (and not sent, which design-pid would refuse)
+function showTargets() {
+  const optimize = form.querySelector("select[name=tuning]").value === "optimize";
+  for (const name of ["target-overshoot", "target-settling"]) form.querySelector(`[name=${name}]`).disabled = !optimize;
+}
+
 function request() {
   const o = D.options(form);
   delete o.plant;
@@ -30,27 +36,55 @@ function show(answer) {
   const t = r.tuning || {};
   const cl = r.closed_loop || {};
   const a = cl.spice || cl.analytic || {};
+  const m = cl.margins || {};
+  const failed = (r.checks || []).filter(c => !c.ok);
   document.getElementById("figures").replaceChildren(
     D.fig("method", r.method || t.method || ""),
-    D.fig("Kp", t.kp !== undefined ? (+t.kp).toPrecision(4) : ""),
+    D.fig("Kp", t.kp !== undefined ? D.num(t.kp, 4) : ""),
     D.fig("Ti", D.eng(t.ti_s, "s")), D.fig("Td", D.eng(t.td_s, "s")),
     D.fig(cl.spice ? "overshoot (SPICE)" : "overshoot (analytic)", a.overshoot_pct !== undefined && a.overshoot_pct !== null ? `${(+a.overshoot_pct).toPrecision(3)} %` : "n/a"),
-    D.fig("checks failed", String((r.checks || []).filter(c => !c.ok).length)));
+    D.fig("phase margin", m.phase_margin_deg === undefined || m.phase_margin_deg === null ? "n/a" : `${D.num(m.phase_margin_deg, 3)} deg`),
+    D.fig("gain margin", m.gain_margin_db === undefined || m.gain_margin_db === null ? "n/a" : `${D.num(m.gain_margin_db, 3)} dB`),
+    D.fig("crossover", D.eng(m.crossover_hz, "Hz", 4)),
+    D.fig("checks failed", String(failed.length)));
+  // the failing checks by their titles, first thing under the heading (the sheet below has their details)
+  const f = document.getElementById("failed");
+  f.replaceChildren();
+  if (failed.length) {
+    const line = document.createElement("p");
+    line.className = "fail";
+    line.textContent = `Checks failed: ${failed.map(D.checkTitle).join(", ")}`;
+    f.append(line);
+  }
   D.plot(document.getElementById("closed"), p.closed_loop, {xUnit: "s", yLabel: "output (V)"});
-  D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 220});
-  D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 180});
+  // the margins where they are read: the gain crossover (phase margin) and the phase crossover (gain margin)
+  const marks = [];
+  if (isFinite(m.crossover_hz)) marks.push({x: m.crossover_hz, label: `crossover: PM ${D.num(m.phase_margin_deg, 3)} deg`});
+  if (isFinite(m.phase_crossover_hz)) marks.push({x: m.phase_crossover_hz, label: `-180 deg: GM ${D.num(m.gain_margin_db, 3)} dB`});
+  D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 220, marks});
+  D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 180, marks});
   document.getElementById("schematic").innerHTML = p.schematic_svg;
   // the sheet is our own HTML (the build sheet's renderer escapes every text); shown in a shadow root so its
   // styles stay inside
   const host = document.getElementById("sheet-html");
   const root = host.shadowRoot || host.attachShadow({mode: "open"});
   root.innerHTML = p.sheet_html;
+  // its advice in the page's words (the printed sheet keeps the command's: it goes with the bundle's files)
+  const walk = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
+  for (let n = walk.nextNode(); n; n = walk.nextNode()) {
+    if (n.textContent.includes("--")) n.textContent = D.inPageWords(form, n.textContent, true);
+  }
 }
 
 async function design() {
   const opts = request();
-  if (opts === null) return;
+  if (opts === null) {   // "identified" chosen with no model: what is shown is another plant's
+    D.markStale("No identified model yet (drop a capture on the Identify page): what is shown below is of the " +
+                "plant chosen before, not of the current inputs.");
+    return;
+  }
   const mine = ++seq;
+  D.markStale("pending");
   D.busy(true, status);
   const r = await D.api("/api/pid?view=page", opts, false, "form");
   if (r.aborted || mine !== seq) return;
@@ -58,13 +92,15 @@ async function design() {
   if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
   D.clearError(form);
   last = {opts, answer: r.data};
+  // an identified model lives in this browser's session only: no link for it
+  if (plantKind() !== "identify") D.remember({plant: plantKind(), ...opts});
   show(r.data);
   status.textContent = "designed and simulated";
   D.answered("done");
 }
 
 async function file(kind) {
-  if (!last) return;
+  if (!last || D.isStale()) return;
   D.busy(true, status);
   const r = await D.api(`/api/pid/${kind}`, last.opts, true);
   D.busy(false, status);
@@ -91,12 +127,16 @@ async function file(kind) {
     const b = identified.best || {};
     document.getElementById("model-text").textContent =
       `From ${identified.capture ? identified.capture.source : "the identify page"}: ${b.name} (${b.model}) ` +
-      Object.entries(b.params || {}).map(([k, v]) => `${k} = ${D.eng(v, "", 4)}`).join(", ");
+      Object.entries(b.params || {}).map(([k, v]) => D.param(k, v)).join(", ");
   }
   showPlantKind();
-  const later = D.debounce(design, 400);
-  form.addEventListener("input", later);
-  form.addEventListener("change", e => { if (e.target.name === "plant") showPlantKind(); later(); });
+  showTargets();
+  // the plant's kind shows its fields before the form is read
+  form.addEventListener("change", e => {
+    if (e.target.name === "plant") showPlantKind();
+    if (e.target.name === "tuning") showTargets();
+  });
+  D.liveForm(form, design, () => JSON.stringify(request()));
   document.getElementById("sheet").onclick = () => file("sheet");
   document.getElementById("bundle").onclick = () => file("bundle");
   design();

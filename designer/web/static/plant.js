@@ -14,13 +14,13 @@ function show(answer) {
     D.fig("R1", D.eng(b.R1_ohm, "Ohm", 3)), D.fig("R2", D.eng(b.R2_ohm, "Ohm", 3)),
     D.fig("C1", D.eng(b.C1_f, "F", 3)), D.fig("C2", D.eng(b.C2_f, "F", 3)),
     D.fig(`fn as built (${r.opamp.name})`, D.eng(b.fn_opamp_hz, "Hz", 4)),
-    D.fig(`zeta as built (${r.opamp.name})`, b.zeta_opamp.toPrecision(4)),
+    D.fig(`zeta as built (${r.opamp.name})`, D.num(b.zeta_opamp, 4)),
     D.fig("overshoot (model)", `${r.analytic_opamp.overshoot_pct.toPrecision(4)} %`),
     D.fig("overshoot (SPICE)", r.spice ? `${r.spice.overshoot_pct.toPrecision(4)} %` : "not simulated"),
     D.fig("peak time", D.eng((r.spice || r.analytic_opamp).peak_time_s, "s", 4)),
     D.fig("settling time (2 %)", D.eng((r.spice || r.analytic_opamp).settling_time_s, "s", 4)),
     D.fig("SPICE agrees with the model", r.comparison.pass === undefined ? "n/a" : (r.comparison.pass ? "yes" : "NO")));
-  document.getElementById("notes").replaceChildren(...r.notes.map(n => { const e = document.createElement("p"); e.textContent = n; return e; }));
+  document.getElementById("notes").replaceChildren(...r.notes.map(n => { const e = document.createElement("p"); e.textContent = D.inPageWords(form, n); return e; }));
   document.getElementById("schematic").innerHTML = p.schematic_svg;
   document.getElementById("bench").replaceChildren(D.table(["set", "to"], p.bench));
   document.getElementById("bomtable").replaceChildren(D.table(p.bom.header.slice(0, 7), p.bom.rows.map(x => x.slice(0, 7))));
@@ -33,20 +33,22 @@ function show(answer) {
 async function design() {
   const mine = ++seq;
   const opts = D.options(form);
+  D.markStale("pending");
   D.busy(true, status);
   const r = await D.api("/api/plant?view=page", opts, false, "form");
   if (r.aborted || mine !== seq) return;          // a newer request is on its way: this answer is stale
   D.busy(false, status);
   if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
   D.clearError(form);
-  last = {opts, answer: r.data};
+  last = {opts, answer: r.data};   // the downloads are of these inputs (D.answered turns them on)
+  D.remember(opts);
   show(r.data);
   status.textContent = `designed and simulated (${r.data.result.simulator || "no simulator"})`;
   D.answered("done");
 }
 
 async function file(kind) {
-  if (!last) return;
+  if (!last || D.isStale()) return;
   if (kind === "bom") {
     D.download(new Blob([last.answer.page.bom_csv], {type: "text/csv"}), "bom.csv");
     return;
@@ -65,14 +67,12 @@ async function file(kind) {
   for (const s of form.querySelectorAll("select[data-choices]")) D.fill(s, c[s.dataset.choices], s.dataset.default);
   const q = new URLSearchParams(location.search);
   for (const [k, v] of q) { const el = form.querySelector(`[name="${CSS.escape(k)}"]`); if (el) el.value = v; }
-  const later = D.debounce(design, 350);
-  form.addEventListener("input", later);
-  form.addEventListener("change", later);
+  D.liveForm(form, design, () => JSON.stringify(D.options(form)));
   document.getElementById("sheet").onclick = () => file("sheet");
   document.getElementById("bundle").onclick = () => file("bundle");
   document.getElementById("bom").onclick = () => file("bom");
   document.getElementById("topid").onclick = () => {
-    if (!last) return;
+    if (!last || D.isStale()) return;
     const o = last.opts, b = last.answer.result.built;
     // the plant as built, by its parts: the PID is designed for the circuit on the bench
     const code = v => D.eng(v, "", 6).replace(" ", "");   // 1.6k, 3.3n: engineering notation as typed
