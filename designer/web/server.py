@@ -136,7 +136,7 @@ def _serve_in(args, port: int, jobs: int, timeout: int, recycle: int, allowed: l
     sock.set_inheritable(False)
     pool = Pool(jobs, float(timeout), recycle=recycle)
     shown = f"[{host}]" if family == socket.AF_INET6 else host
-    print(f"designer-web: serving on http://{shown}:{port}/ ({jobs} workers, {timeout} s per run; Ctrl-C stops)",
+    print(f"designer-web: serving on http://{shown}:{port}/ ({jobs} worker{'s' if jobs != 1 else ''}, {timeout} s per run; Ctrl-C stops)",
           flush=True)
     warning = exposure_warning(args.host, port)
     if warning:
