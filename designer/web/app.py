@@ -228,7 +228,8 @@ def create_app(pool, trust: Trust):
                Route("/api/identify", identify, methods=["POST"]),
                Route("/api/check", check, methods=["POST"])]
     async def client_left(request, exc):
-        # the client went away in the middle of its body: nobody reads an answer, and it is no error of ours
+        # the client went away in the middle of its body (or its body deadline, connections.GuardedH11, closed
+        # it): nobody reads an answer, and it is no error of ours (uvicorn would log a traceback)
         return Response(status_code=400)
 
     app = Starlette(routes=routes, lifespan=lifespan, exception_handlers={ClientDisconnect: client_left})

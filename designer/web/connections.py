@@ -21,10 +21,6 @@ client sends, and a stop that answers every request at once.
   (:meth:`designer.web.pool.Pool.stop_now`): every run is killed with its
   ngspice and every request waiting, queued or running, is answered 503 at
   once; uvicorn's graceful wait is bounded by :data:`STOP_GRACE_S`.
-- **A client gone mid-body** (:func:`quiet_disconnects`): a connection closed
-  by its deadline (or by its client) while the page's code reads the body ends
-  that request without an answer; uvicorn would log it as an error with a
-  traceback.
 """
 
 from __future__ import annotations
@@ -33,8 +29,7 @@ import h11
 import uvicorn
 from uvicorn.protocols.http.h11_impl import H11Protocol
 
-__all__ = ["BODY_GRACE_S", "GuardedH11", "HEADER_TIMEOUT_S", "MIN_BODY_RATE", "STOP_GRACE_S", "StoppingServer",
-           "quiet_disconnects"]
+__all__ = ["BODY_GRACE_S", "GuardedH11", "HEADER_TIMEOUT_S", "MIN_BODY_RATE", "STOP_GRACE_S", "StoppingServer"]
 
 #: seconds a request's headers may take to arrive, from the connection (or the previous answer)
 HEADER_TIMEOUT_S = 5.0
@@ -109,15 +104,3 @@ class StoppingServer(uvicorn.Server):
             self.pool.stop_now()
         super().handle_exit(sig, frame)
 
-
-def quiet_disconnects(app):
-    """``app`` (ASGI) with a request whose client left while its body was read ended quietly: nobody
-    is there to answer, and it is not the server's error."""
-    from starlette.requests import ClientDisconnect
-
-    async def guarded(scope, receive, send):
-        try:
-            await app(scope, receive, send)
-        except ClientDisconnect:
-            pass
-    return guarded

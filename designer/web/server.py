@@ -117,7 +117,7 @@ def _serve_in(args, port: int, jobs: int, timeout: int, recycle: int, allowed: l
     import uvicorn
 
     from .app import create_app
-    from .connections import STOP_GRACE_S, GuardedH11, StoppingServer, quiet_disconnects
+    from .connections import STOP_GRACE_S, GuardedH11, StoppingServer
     from .guard import trust_for
     from .pool import Pool
     family = socket.AF_INET6 if ":" in args.host else socket.AF_INET
@@ -145,7 +145,7 @@ def _serve_in(args, port: int, jobs: int, timeout: int, recycle: int, allowed: l
         " (and this machine's other names and addresses)" if ipaddress.ip_address(host).is_unspecified else ""
     print(f"designer-web: answering pages at {', '.join([f'http://{shown}:{port}{also}'] + allowed)}; "
           "requests from any other site's pages are refused", flush=True)
-    config = uvicorn.Config(quiet_disconnects(create_app(pool, trust_for(host, port, allowed))), log_level="warning",
+    config = uvicorn.Config(create_app(pool, trust_for(host, port, allowed)), log_level="warning",
                             lifespan="on", http=GuardedH11, timeout_graceful_shutdown=STOP_GRACE_S)
     server = StoppingServer(config, pool)
     try:
