@@ -321,10 +321,11 @@ def stage_candidates(topology, target: SectionTarget, spec: FilterSpec, where: s
     free = topology.synthesize(target)
     # the resistors scale as 1/C at fixed ratios: move C1 so that they all sit inside the bounds when their
     # spread allows (a high-Q section spreads them by about 4 Q^2 around the impedance)
-    rs = [v for r, v in free.items() if r.startswith("R") and not (r in ("R3", "R4") and "r3" in topology.choices)]
+    rs = [v for r, v in free.items() if r.startswith("R") and r not in topology.choice_parts]
     k_lo, k_hi = spec.r_min / min(rs), spec.r_max / max(rs)
     k = 1.0 if k_lo <= 1.0 <= k_hi else math.sqrt(k_lo * k_hi) if k_lo <= k_hi else 1.0
-    c_free = min(max(free["C1"] / k, spec.c_min), spec.c_max)
+    ref = topology.reference_capacitor
+    c_free = min(max(free[ref] / k, spec.c_min), spec.c_max)
     # the neighbours of the free value and one more either side: the joint search's freedom per stage
     near = series_values(spec.c_series, spec.c_min, spec.c_max)
     c_choices = [float(c) for c in near[np.argsort(np.abs(np.log(near / c_free)))[:C_CHOICES]]] if near.size else []
@@ -345,8 +346,9 @@ def stage_candidates(topology, target: SectionTarget, spec: FilterSpec, where: s
             # C2 the least series value at or above the bound: the synthesis stays exact, both capacitors standard
             c2 = series_values(spec.c_series, c1 * max(bound, 1.0) * (1 - 1e-9), c1 * max(bound, 1.0) * 20)
             if c2.size == 0 or c2[0] > spec.c_max * (1 + 1e-9):
-                problem = problem or f"C2 = {format_eng(c1 * max(bound, 1.0), 'F')} (C2/C1 >= {bound:.4g}) is above " \
-                                     f"--c-max {format_eng(spec.c_max, 'F')}"
+                problem = problem or f"the capacitor ratio over {ref} (at least {bound:.4g}) puts the other at " \
+                                     f"{format_eng(c1 * max(bound, 1.0), 'F')}, above --c-max " \
+                                     f"{format_eng(spec.c_max, 'F')}"
                 continue
             ch["ratio"] = float(c2[0]) / c1
         vals = topology.synthesize(tgt, **ch)

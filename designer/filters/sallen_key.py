@@ -51,6 +51,7 @@ class SallenKeySection(Topology):
         self.title = f"Sallen-Key {kind}, " + ("gain K" if with_gain else "unity gain")
         self.parts = self.network + (GAIN_PARTS if with_gain else ())
         self.choices = ("ratio", "r3") if with_gain else ("ratio",)
+        self.choice_parts = tuple(p.ref for p in GAIN_PARTS) if with_gain else ()
         self.example = SectionTarget(self.kind, 1e3, q=1.3 if with_gain else 0.7071, gain=2.0 if with_gain else 1.0)
 
     def gain_of(self, v: dict):

@@ -289,6 +289,10 @@ class Topology(ABC):
         The free choices :meth:`synthesize` takes (besides the target).
     example : SectionTarget
         A typical target (the documentation's and the conformance suite's).
+    reference_capacitor : str
+        The part :attr:`SectionTarget.c_f` sets (the one the others scale from).
+    choice_parts : tuple of str
+        Parts set by a free choice (a gain pair), not by the impedance scale.
     """
 
     name: str = ""
@@ -299,6 +303,8 @@ class Topology(ABC):
     parts: tuple = ()
     choices: tuple = ()
     example: SectionTarget | None = None
+    reference_capacitor: str = "C1"
+    choice_parts: tuple = ()
 
     # ---- what every section implements ------------------------------------------------------
     @abstractmethod
