@@ -91,7 +91,9 @@ demo: setup
 web: setup
 	.venv/bin/designer-web
 
+# ruff first (the rules in pyproject.toml: pyflakes and pycodestyle's errors), in seconds, then the tests
 test: setup
+	$(PY) -m ruff check --quiet --no-cache designer tests benchmarks
 	$(PY) -m pytest -q -p no:cacheprovider tests
 
 bench: setup

@@ -201,7 +201,7 @@ def prbs_capture(n: int = N, seed: int = 0):
 
 
 def prbs_section():
-    print(f"\n### `identify` on a PRBS capture against a numpy floor (new processes, median of 3)\n")
+    print("\n### `identify` on a PRBS capture against a numpy floor (new processes, median of 3)\n")
     print(f"Goal: within {PRBS_RATIO:g}x the floor (np.loadtxt of the file and one FFT "
           f"cross-correlation, in a fresh interpreter) and {PRBS_MB:g} MiB.\n")
     print("| capture | samples | file MB | floor s | identify s | ratio | peak MiB | fn, zeta against the "

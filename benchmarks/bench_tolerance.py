@@ -158,7 +158,7 @@ def _speedups() -> dict:
     from designer.plant.design import design_plant
     from designer.plant.spec import PlantSpec
     from designer.tolerance import loop, spice_engine
-    from designer.tolerance.montecarlo import _apply, plant_parts
+    from designer.tolerance.montecarlo import apply_engine, plant_parts
     from designer.tolerance.parts import resolve
     from designer.tolerance.runner import Draw, Runner, Scale
     from designer.tolerance.spice_mc import spice_evaluate
@@ -171,7 +171,7 @@ def _speedups() -> dict:
     engines = {   # engine -> (chunk function, context, draw)
         "loop": (loop.evaluate, loop.LoopContext.of(res),
                  Draw(nominal, resolve((), nominal, series).of, SPEEDUP_BUILDS, 1)),
-        "spice": (_apply, spice_evaluate(spice_engine.context(plant.deck, plant.built, plant.opamp, plant.test,
+        "spice": (apply_engine, spice_evaluate(spice_engine.context(plant.deck, plant.built, plant.opamp, plant.test,
                                                               "ngspice-cli"), plant.opamp),
                   Draw(p_nominal, resolve((), p_nominal, series).of, SPICE_SCALE_BUILDS, 1))}
     out = {}

@@ -31,7 +31,7 @@ from ..core.fileio import shown
 from ..core.units import parse_value
 from . import figures as F
 from .limits import LIMIT_KEYS, limit_from
-from .yamldoc import _kind_of, closest
+from .yamldoc import kind_of, closest
 
 CONTROLLER_PARTS = tuple(f"R{i}" for i in range(3, 19)) + ("C3", "C4")
 #: the keys of each mapping below the top level
@@ -115,7 +115,7 @@ class YieldSpec:
     tolerances: tuple = ()
 
 
-def _corners(doc) -> tuple:
+def read_corners(doc) -> tuple:
     value = doc.data.get("opamp", "LM741")
     items = value if isinstance(value, list) else [value]
     if not items:
@@ -128,7 +128,7 @@ def _corners(doc) -> tuple:
         except DesignError:
             amp = None
         if amp is None:
-            raise doc.error(keys, f"unknown op-amp {_kind_of(v)}; allowed: {', '.join(opamps.names())}"
+            raise doc.error(keys, f"unknown op-amp {kind_of(v)}; allowed: {', '.join(opamps.names())}"
                             + (f"; closest: {closest(v, opamps.names())!r}" if isinstance(v, str) else ""))
         if amp.name in out:
             raise doc.error(keys, f"op-amp {amp.name} is listed twice")
@@ -161,7 +161,7 @@ def _common(doc, kind: str) -> dict:
     return out
 
 
-def _plant_designs(doc, corners):
+def read_plant_designs(doc, corners):
     from ..plant.sallenkey import SallenKeyParts
     from ..plant.spec import AnalysisSpec, PlantSpec
     target = doc.mapping(("target",), SUB["target"])
@@ -197,7 +197,7 @@ def _plant_designs(doc, corners):
     return designs, False
 
 
-def _pid_designs(doc, corners):
+def read_pid_designs(doc, corners):
     from ..pid.blocks import PidParts
     from ..pid.spec import PidSpec, controller_from_json
     from ..plant.sallenkey import SallenKeyParts
@@ -238,7 +238,7 @@ def _pid_designs(doc, corners):
     return designs, analyze
 
 
-def _checks(doc, kind: str, known, unit_kind: str | None = None) -> tuple:
+def read_checks(doc, kind: str, known, unit_kind: str | None = None) -> tuple:
     entries = doc.get(("checks",))
     if entries is None:
         return ()
@@ -265,7 +265,7 @@ def _checks(doc, kind: str, known, unit_kind: str | None = None) -> tuple:
     return tuple(out)
 
 
-def _design_checks(doc, kind: str):
+def read_design_checks(doc, kind: str):
     value = doc.data.get("design_checks")
     if value is None or value is False:
         return None
@@ -276,7 +276,7 @@ def _design_checks(doc, kind: str):
         raise doc.error(("design_checks",), f"design_checks: all, or a list of {', '.join(ids)}")
     for i, v in enumerate(value):
         if v not in ids:
-            raise doc.error(("design_checks", i), f"unknown design check {_kind_of(v)}; allowed: "
+            raise doc.error(("design_checks", i), f"unknown design check {kind_of(v)}; allowed: "
                             f"{', '.join(ids)}; closest: {closest(v, ids)!r}")
     return tuple(dict.fromkeys(value))
 
@@ -293,22 +293,22 @@ def _positive(doc, keys, default=None) -> float:
     except DesignError:
         out = None
     if out is None or not out > 0:
-        raise doc.error(keys, f"{label} must be a positive number, got {_kind_of(value)}")
+        raise doc.error(keys, f"{label} must be a positive number, got {kind_of(value)}")
     return out
 
 
-def _agreement(doc):
+def read_agreement(doc):
     if doc.data.get("spice_agreement") is None:
         return None
     a = doc.mapping(("spice_agreement",), SUB["spice_agreement"])
     against = a.get("against", "opamp_model")
     if against not in AGAINST:
-        raise doc.error(("spice_agreement", "against"), f"spice_agreement.against {_kind_of(against)}; "
+        raise doc.error(("spice_agreement", "against"), f"spice_agreement.against {kind_of(against)}; "
                         f"allowed: {', '.join(AGAINST)}")
     return Agreement(_positive(doc, ("spice_agreement", "nrms_max")), against)
 
 
-def _tolerance(doc, checks) -> tuple:
+def read_tolerance(doc, checks) -> tuple:
     value = doc.data.get("tolerance")
     if value is None or value is False:
         return ()
@@ -321,7 +321,7 @@ def _tolerance(doc, checks) -> tuple:
         raise doc.error(("tolerance",), f"tolerance: true, or a list of {', '.join(F.BAND)}")
     for i, v in enumerate(value):
         if v not in F.BAND:
-            raise doc.error(("tolerance", i), f"tolerance: {_kind_of(v)} has no tolerance band; allowed: "
+            raise doc.error(("tolerance", i), f"tolerance: {kind_of(v)} has no tolerance band; allowed: "
                             f"{', '.join(F.BAND)}; closest: {closest(v, F.BAND)!r}")
         if v not in limited:
             raise doc.error(("tolerance", i), f"tolerance: {v} needs a check on {v} (checks.{v}: its limits)")
@@ -338,7 +338,7 @@ def _tolerances(doc, kind: str) -> tuple:
     for key, tol in value.items():
         if isinstance(tol, bool) or not isinstance(tol, (str, int, float)):
             raise doc.error(("tolerances", key), f"tolerances.{key} must be a percentage such as 1% (above 0, at "
-                            f"most {100 * MAX_TOL:g} %), got {_kind_of(tol)}")
+                            f"most {100 * MAX_TOL:g} %), got {kind_of(tol)}")
         try:
             f = parse_tolerance(str(tol), f"tolerances.{key}")
         except DesignError as exc:
@@ -351,7 +351,7 @@ def _fraction(doc, keys) -> float:
     """``yield.min``: 95% or 0.95, above 0 and at most 100 %."""
     value = doc.get(keys)
     label = ".".join(keys)
-    shape = f"{label} must be a percentage above 0 and at most 100 % (such as 95% or 0.95), got {_kind_of(value)}"
+    shape = f"{label} must be a percentage above 0 and at most 100 % (such as 95% or 0.95), got {kind_of(value)}"
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
         raise doc.error(keys, shape)
     text = str(value).strip()
@@ -374,11 +374,11 @@ def _whole(doc, keys, lo: int, hi: int, default: int) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, str)) or not str(value).strip().isdigit() \
             or not lo <= int(str(value).strip()) <= hi:
         span = f"from {lo} to {hi:g}" if hi < 2 ** 32 else f">= {lo}"
-        raise doc.error(keys, f"{label} must be a whole number {span}, got {_kind_of(value)}")
+        raise doc.error(keys, f"{label} must be a whole number {span}, got {kind_of(value)}")
     return int(str(value).strip())
 
 
-def _yield(doc, kind: str, checks):
+def read_yield(doc, kind: str, checks):
     """``yield:`` with ``tolerances:`` (None without ``yield:``; ``tolerances:`` alone is refused)."""
     from ..tolerance import sampling, yields
     from ..tolerance.parts import DISTRIBUTIONS
@@ -393,7 +393,7 @@ def _yield(doc, kind: str, checks):
     engine = y.get("engine", "analytic")
     for key, allowed in (("engine", yields.ENGINES), ("sampler", sampling.SAMPLERS), ("dist", DISTRIBUTIONS)):
         if key in y and y[key] not in allowed:
-            raise doc.error(("yield", key), f"yield.{key} {_kind_of(y[key])} unknown; allowed: {', '.join(allowed)}")
+            raise doc.error(("yield", key), f"yield.{key} {kind_of(y[key])} unknown; allowed: {', '.join(allowed)}")
     use, skipped = yields.counted(kind, checks, engine)
     if not use:
         known = ", ".join(yields.TABLES[engine][kind])
@@ -409,7 +409,7 @@ def _yield(doc, kind: str, checks):
                      y.get("dist", "uniform"), tolerances)
 
 
-def _golden(doc, kind: str, corners, update: bool):
+def read_golden(doc, kind: str, corners, update: bool):
     if doc.data.get("golden") is None:
         return None
     g = doc.mapping(("golden",), SUB["golden"])
@@ -431,7 +431,7 @@ def _golden(doc, kind: str, corners, update: bool):
         keys = ("golden", "signals", sig)
         if not isinstance(sig, str) or (known is not None and sig not in known):
             allowed = known or ("a vector name",)
-            raise doc.error(keys, f"unknown golden signal {_kind_of(sig)}; allowed: {', '.join(allowed)}; "
+            raise doc.error(keys, f"unknown golden signal {kind_of(sig)}; allowed: {', '.join(allowed)}; "
                             f"closest: {closest(sig, allowed)!r}")
         doc.mapping(keys, ("reltol", "abstol"), tol if tol is not None else {})
         signals[sig] = (_positive(doc, keys + ("reltol",), reltol) if tol and "reltol" in tol else reltol,

@@ -50,9 +50,9 @@ from pathlib import Path
 from ..core.errors import DesignError
 from ..core.fileio import check_plain_name, shown
 from . import figures as F
-from .sections import (Agreement, Golden, YieldSpec, _agreement, _checks, _corners, _design_checks, _golden,
-                       _pid_designs, _plant_designs, _tolerance, _yield)
-from .yamldoc import _kind_of, closest, parse_yaml
+from .sections import (Agreement, Golden, YieldSpec, read_agreement, read_checks, read_corners, read_design_checks, read_golden,
+                       read_pid_designs, read_plant_designs, read_tolerance, read_yield)
+from .yamldoc import kind_of, closest, parse_yaml
 
 KINDS = ("plant", "pid", "netlist")
 #: the top-level keys of each kind
@@ -107,7 +107,7 @@ def load_spec(path, update_golden: bool = False, root=None, allow_outside: bool 
     doc.root = None if allow_outside else Path(root if root is not None else doc.path.parent).resolve()
     kind = doc.data.get("kind")
     if kind not in KINDS:
-        got = "no kind" if kind is None else f"kind {_kind_of(kind)}"
+        got = "no kind" if kind is None else f"kind {kind_of(kind)}"
         raise doc.error(("kind",), f"{got}; allowed: {', '.join(KINDS)}"
                         + (f"; closest: {closest(kind, KINDS)!r}" if isinstance(kind, str) else ""))
     doc.mapping((), TOP[kind])
@@ -118,14 +118,14 @@ def load_spec(path, update_golden: bool = False, root=None, allow_outside: bool 
         raise doc.error(("name",), str(exc)) from None
     if kind == "netlist":
         return _netlist(doc, name, update_golden)
-    corners = _corners(doc)
-    designs, analyze = (_plant_designs if kind == "plant" else _pid_designs)(doc, corners)
-    checks = _checks(doc, kind, set(F.FIGURES[kind]))
-    design_checks = _design_checks(doc, kind)
-    agreement = _agreement(doc)
-    tolerance = _tolerance(doc, checks) if kind == "plant" else ()
-    golden = _golden(doc, kind, corners, update_golden)
-    yield_spec = _yield(doc, kind, checks)
+    corners = read_corners(doc)
+    designs, analyze = (read_plant_designs if kind == "plant" else read_pid_designs)(doc, corners)
+    checks = read_checks(doc, kind, set(F.FIGURES[kind]))
+    design_checks = read_design_checks(doc, kind)
+    agreement = read_agreement(doc)
+    tolerance = read_tolerance(doc, checks) if kind == "plant" else ()
+    golden = read_golden(doc, kind, corners, update_golden)
+    yield_spec = read_yield(doc, kind, checks)
     if not (checks or design_checks or agreement or golden):
         raise doc.error((), "nothing to check: give checks:, design_checks:, spice_agreement: or golden:")
     return CheckSpec(doc.path, name, kind, corners, tuple(designs), analyze, checks, design_checks, agreement,
@@ -154,8 +154,8 @@ def _netlist(doc, name: str, update: bool) -> CheckSpec:
         raise doc.error(("deck",), f"deck {shown_deck} has no .tran or .ac line: "
                         "nothing to simulate")
     measures = measure_names(deck)
-    checks = _checks(doc, "netlist", set(measures))
-    golden = _golden(doc, "netlist", ("",), update)
+    checks = read_checks(doc, "netlist", set(measures))
+    golden = read_golden(doc, "netlist", ("",), update)
     if not (checks or golden):
         raise doc.error((), "nothing to check: give checks: (the deck's .meas names) or golden:")
     return CheckSpec(doc.path, name, "netlist", ("",), (deck,), False, checks, None, None, (), golden)

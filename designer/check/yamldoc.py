@@ -59,7 +59,7 @@ class _Doc:
             return {}
         label = ".".join(map(str, keys)) or "the spec"
         if not isinstance(value, dict):
-            raise self.error(keys, f"{label} must be a mapping of {', '.join(allowed)}; got {_kind_of(value)}")
+            raise self.error(keys, f"{label} must be a mapping of {', '.join(allowed)}; got {kind_of(value)}")
         for k in value:
             if k not in allowed:
                 raise self.error(tuple(keys) + (k,), f"unknown key {str(k)!r} in {label}; allowed: "
@@ -83,7 +83,7 @@ class _Doc:
         value = self.get(keys)
         label = ".".join(map(str, keys))
         if not isinstance(value, str) or not value.strip():
-            raise self.error(keys, f"{label} must be a file name, got {_kind_of(value)}")
+            raise self.error(keys, f"{label} must be a file name, got {kind_of(value)}")
         if self.root is not None and (Path(value).is_absolute() or value.startswith("~")):
             raise self.error(keys, f"{label} {shown(value)} is an absolute path: paths in a spec are relative "
                              f"to its folder and stay inside {shown(self.root)} ({_WIDER})")
@@ -104,7 +104,7 @@ class _Doc:
         return path
 
 
-def _kind_of(value) -> str:
+def kind_of(value) -> str:
     if value is None:
         return "nothing"
     if isinstance(value, (dict, list)):
@@ -132,5 +132,5 @@ def parse_yaml(path) -> _Doc:
         raise DesignError(f"{shown(path)}:{line}: not valid YAML ({what})") from None
     if not isinstance(data, dict):
         raise DesignError(f"{shown(path)}:1: a spec is a mapping of keys (kind:, checks:, ...); got "
-                          f"{_kind_of(data)}")
+                          f"{kind_of(data)}")
     return _Doc(path, data, lines)

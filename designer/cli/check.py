@@ -46,7 +46,7 @@ Exit status: 0 every check passed; 1 a check failed; 2 a bad spec or usage (one 
 allowed); 3 a simulator error or timeout; --no-fail makes it 0 whatever happened (the files say what)."""
 
 
-def _parser():
+def check_parser():
     p = command_parser(
         "check-design",
         "SPICE regression checks of your own analog designs, for CI: each spec file names a design (a Sallen-Key "
@@ -267,7 +267,7 @@ def _relocate(outcome, stage: Path, final: Path) -> None:
 
 
 def check_design_main(argv=None) -> int:
-    return run_cli("check-design", _parser, _run, argv)
+    return run_cli("check-design", check_parser, _run, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

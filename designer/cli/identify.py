@@ -402,7 +402,7 @@ def frequency_table_header(path) -> list | None:
         The header's cells, or None for anything else (a step capture, a table
         without a header: those are read as captures).
     """
-    from ..identify.io import _NUM, _hint   # identify-freq's own reading of a header
+    from ..identify.io.freqtable import NUMBER, unit_hint   # identify-freq's own reading of a header
     try:
         with open_limited(path, "capture file", MAX_CAPTURE_BYTES) as fh:
             head = fh.read(SNIFF_BYTES) or b""
@@ -414,11 +414,11 @@ def frequency_table_header(path) -> list | None:
     cells = [c.strip().strip('"').strip("'") for c in (line.split(sep) if sep else line.split())]
     while cells and cells[-1] == "":
         cells.pop()
-    if len(cells) < 2 or all(_NUM.match(c) for c in cells):
+    if len(cells) < 2 or all(NUMBER.match(c) for c in cells):
         return None
     first, second = cells[0], cells[1].lower()
-    is_freq = first.lower().startswith("freq") or _hint(first, "frequency") is not None
-    is_gain = _hint(cells[1], "gain") is not None or "gain" in second or "magnitude" in second
+    is_freq = first.lower().startswith("freq") or unit_hint(first, "frequency") is not None
+    is_gain = unit_hint(cells[1], "gain") is not None or "gain" in second or "magnitude" in second
     return cells if is_freq and is_gain else None
 
 

@@ -59,7 +59,7 @@ def _r(key: str) -> str:
     return help_range(key).replace("%", "%%")
 
 
-def _parser():
+def pid_parser():
     from ..core.process_text import FORMS_TEXT
     p = common.command_parser(
         "design-pid",
@@ -297,7 +297,7 @@ def _run(args) -> int:
 
 
 def design_pid_main(argv=None) -> int:
-    return common.run_cli("design-pid", _parser, _run, argv)
+    return common.run_cli("design-pid", pid_parser, _run, argv)
 
 
 ANALYZE_EPILOG = """examples:
@@ -317,7 +317,7 @@ the accuracy and part-bound checks are left out. Exit status: 0 done, 1 a check 
 failed (with --fail-on-check), 2 bad input (one line on stderr, nothing written), 3 simulator error."""
 
 
-def _analyze_parser():
+def analyze_pid_parser():
     p = common.command_parser(
         "analyze-pid",
         "Analyse the seed's six-op-amp PID controller as built from its parts, on its plant: the gains the parts "
@@ -392,7 +392,7 @@ ANALYZE_PARAMS = ("plant_fc_hz", "plant_zeta", "plant_json", "kp", "ti_s", "td_s
 
 
 def analyze_pid_main(argv=None) -> int:
-    return common.run_cli("analyze-pid", _analyze_parser, _analyze, argv)
+    return common.run_cli("analyze-pid", analyze_pid_parser, _analyze, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

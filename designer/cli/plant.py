@@ -21,7 +21,7 @@ from .common import (
 )
 
 
-def _design_parser():
+def design_plant_parser():
     p = OneLineParser(
         prog="design-plant",
         description="Design a unity-gain (or gain K) Sallen-Key low-pass that realises the second-order plant "
@@ -385,7 +385,7 @@ def _emit(result, args, name) -> int:
     return emit(result, args, name, write_outputs, summary_text)
 
 
-def _analyze_parser():
+def analyze_plant_parser():
     p = OneLineParser(
         prog="analyze-plant",
         description="Analyse a Sallen-Key low-pass as built from its parts: fn, zeta and Q it really gives, step "
@@ -447,11 +447,11 @@ def _analyze(args) -> int:
 
 
 def design_plant_main(argv=None) -> int:
-    return run_cli("design-plant", _design_parser, _design, argv)
+    return run_cli("design-plant", design_plant_parser, _design, argv)
 
 
 def analyze_plant_main(argv=None) -> int:
-    return run_cli("analyze-plant", _analyze_parser, _analyze, argv)
+    return run_cli("analyze-plant", analyze_plant_parser, _analyze, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

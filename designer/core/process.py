@@ -70,7 +70,7 @@ CORNER_MAX_ZETA = 0.999
 
 # --------------------------------------------------------------------------- text
 
-def _g(v: float, unit: str = "") -> str:
+def format_g(v: float, unit: str = "") -> str:
     return format_eng(v, unit) if unit else f"{v:.4g}"
 
 
@@ -210,17 +210,17 @@ class ProcessModel:
     def text(self) -> str:
         """One line, with units: ``G(s) = 2 e^(-200 us s) / (1 ms s + 1)``."""
         p = self.params
-        delay = f" e^(-{_g(self.theta_s, 's')} s)" if self.theta_s > 0 else ""
+        delay = f" e^(-{format_g(self.theta_s, 's')} s)" if self.theta_s > 0 else ""
         if self.kind == "fopdt":
-            return f"G(s) = {p['K']:.4g}{delay} / ({_g(p['tau_s'], 's')} s + 1)"
+            return f"G(s) = {p['K']:.4g}{delay} / ({format_g(p['tau_s'], 's')} s + 1)"
         if self.kind == "sopdt":
-            return (f"G(s) = {p['K']:.4g}{delay} / (({_g(p['tau1_s'], 's')} s + 1)"
-                    f"({_g(p['tau2_s'], 's')} s + 1))")
+            return (f"G(s) = {p['K']:.4g}{delay} / (({format_g(p['tau1_s'], 's')} s + 1)"
+                    f"({format_g(p['tau2_s'], 's')} s + 1))")
         if self.kind == "underdamped":
             return (f"G(s) = {p['K']:.4g} wn^2{delay} / (s^2 + 2 zeta wn s + wn^2), "
-                    f"fn = {_g(p['fn_hz'], 'Hz')}, zeta = {p['zeta']:.4g}")
+                    f"fn = {format_g(p['fn_hz'], 'Hz')}, zeta = {p['zeta']:.4g}")
         if self.kind == "integrating":
-            lag = f"(s ({_g(p['tau_s'], 's')} s + 1))" if p["tau_s"] > 0 else "s"
+            lag = f"(s ({format_g(p['tau_s'], 's')} s + 1))" if p["tau_s"] > 0 else "s"
             return f"G(s) = {p['K']:.4g}{delay} / {lag}"
         num, den = _poly_text(self.num), _poly_text(self.den)
         num = num if len(self.num) == 1 else f"({num})"
@@ -279,27 +279,27 @@ def _unchecked(model: ProcessModel, p: dict, source: str) -> ProcessModel:
     elif kind == "sopdt":
         t1, t2 = sorted((p["tau1_s"], p["tau2_s"]), reverse=True)
         p = {"K": p["K"], "tau1_s": t1, "tau2_s": t2, "theta_s": th}
-        num, den = (p["K"],), _sopdt_den(t1, t2)
+        num, den = (p["K"],), sopdt_den(t1, t2)
     elif kind == "underdamped":
-        num, den = (p["K"],), _pair_den(p["fn_hz"], p["zeta"])
+        num, den = (p["K"],), pair_den(p["fn_hz"], p["zeta"])
     elif kind == "integrating":
-        num, den = (p["K"],), _integ_den(p["tau_s"])
+        num, den = (p["K"],), integ_den(p["tau_s"])
     else:
         num, den = model.num, model.den
     return ProcessModel(kind, p, num, den, th, source, None)
 
 
-def _sopdt_den(t1: float, t2: float) -> tuple:
+def sopdt_den(t1: float, t2: float) -> tuple:
     return (t1 * t2, t1 + t2, 1.0)
 
 
-def _pair_den(fn: float, zeta: float) -> tuple:
+def pair_den(fn: float, zeta: float) -> tuple:
     # K wn^2/(s^2 + 2 zeta wn s + wn^2) = K/(s^2/wn^2 + 2 zeta s/wn + 1)
     wn = 2 * math.pi * fn
     return (1.0 / (wn * wn), 2.0 * zeta / wn, 1.0)
 
 
-def _integ_den(tau: float) -> tuple:
+def integ_den(tau: float) -> tuple:
     return (tau, 1.0, 0.0) if tau > 0 else (1.0, 0.0)
 
 

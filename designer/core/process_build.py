@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from .errors import DesignError
-from .process import KINDS, PARAMS, ProcessModel, _g, _integ_den, _pair_den, _sopdt_den
+from .process import KINDS, PARAMS, ProcessModel, format_g, integ_den, pair_den, sopdt_den
 from .ranges import Range
 
 #: every time constant (tau, tau1, tau2; 1/|p| of a rational plant's poles): 1 ps
@@ -76,7 +76,7 @@ def _check_tau(tau, name: str, zero_ok: bool = False) -> float:
     if not TAU_RANGE.contains(tau):
         why = " (a time constant is positive)" if tau <= 0 else ""
         zero = "0 (none) or " if zero_ok else ""
-        raise DesignError(f"{name} must be {zero}{TAU_RANGE.text()}{why}, got {_g(tau, 's')}")
+        raise DesignError(f"{name} must be {zero}{TAU_RANGE.text()}{why}, got {format_g(tau, 's')}")
     return tau
 
 
@@ -86,22 +86,22 @@ def _check_theta(theta, slowest: float, name: str) -> float:
     theta = _real(theta, name)
     if slowest > 0:
         limit = MAX_DEAD_TIME_RATIO * slowest
-        why = f"{MAX_DEAD_TIME_RATIO:g} times the slowest time constant, {_g(slowest, 's')}"
+        why = f"{MAX_DEAD_TIME_RATIO:g} times the slowest time constant, {format_g(slowest, 's')}"
     else:
         limit, why = MAX_DEAD_TIME_S, "a plant without a time constant"
     if not 0.0 <= theta <= limit * (1 + 1e-12):
-        raise DesignError(f"{name} (dead time) must be 0 to {_g(limit, 's')} ({why}), got {_g(theta, 's')}")
+        raise DesignError(f"{name} (dead time) must be 0 to {format_g(limit, 's')} ({why}), got {format_g(theta, 's')}")
     if 0.0 < theta < TAU_RANGE.lo:
         # as short as the shortest time constant at least: a 1e-144 s delay is a typing slip, and the rules
         # that divide by it give gains of 1e143
-        raise DesignError(f"{name} (dead time) must be 0 or at least {_g(TAU_RANGE.lo, 's')}, got {_g(theta, 's')}")
+        raise DesignError(f"{name} (dead time) must be 0 or at least {format_g(TAU_RANGE.lo, 's')}, got {format_g(theta, 's')}")
     return theta
 
 
 def _check_fn(fn, name: str) -> float:
     fn = _real(fn, name)
     if not FN_RANGE.contains(fn):
-        raise DesignError(f"{name} must be {FN_RANGE.text()}, got {_g(fn, 'Hz')}")
+        raise DesignError(f"{name} must be {FN_RANGE.text()}, got {format_g(fn, 'Hz')}")
     return fn
 
 
@@ -115,8 +115,8 @@ def _check_zeta(zeta, fn: float, names: dict) -> float:
             # tau1 = (zeta + r)/wn, as 1/(zeta - r) cancels for a large zeta
             wn, r = 2 * math.pi * fn, math.sqrt(zeta * zeta - 1.0)
             t1, t2 = (zeta + r) / wn, 1.0 / (wn * (zeta + r))
-            hint = (f"; for zeta >= 1 use the SOPDT form, here {names['tau1_s']} = {_g(t1, 's')} and "
-                    f"{names['tau2_s']} = {_g(t2, 's')}")
+            hint = (f"; for zeta >= 1 use the SOPDT form, here {names['tau1_s']} = {format_g(t1, 's')} and "
+                    f"{names['tau2_s']} = {format_g(t2, 's')}")
         raise DesignError(f"{name} must be above 0 and below 1 (an underdamped pair), got {zeta:.4g}{hint}")
     return zeta
 
@@ -146,7 +146,7 @@ _LIB_NAMES = {k: k for k in ("K", "tau_s", "tau1_s", "tau2_s", "fn_hz", "zeta", 
 # shared by the constructors (``_LIB_NAMES``) and designer.core.process_text.parse_tf
 # (its typed keys): ``names`` maps each parameter to the name its refusal uses
 
-def _fopdt(K, tau, theta, names, source, ci95) -> ProcessModel:
+def build_fopdt(K, tau, theta, names, source, ci95) -> ProcessModel:
     K = _check_gain(K, names["K"])
     tau = _check_tau(tau, names["tau_s"])
     theta = _check_theta(theta, tau, names["theta_s"])
@@ -154,7 +154,7 @@ def _fopdt(K, tau, theta, names, source, ci95) -> ProcessModel:
                         _check_ci95(ci95, "fopdt"))
 
 
-def _sopdt(K, tau1, tau2, theta, names, source, ci95) -> ProcessModel:
+def build_sopdt(K, tau1, tau2, theta, names, source, ci95) -> ProcessModel:
     K = _check_gain(K, names["K"])
     tau1 = _check_tau(tau1, names["tau1_s"])
     tau2 = _check_tau(tau2, names["tau2_s"])
@@ -167,25 +167,25 @@ def _sopdt(K, tau1, tau2, theta, names, source, ci95) -> ProcessModel:
             ci.update({k: v for k, v in (("tau1_s", b), ("tau2_s", a)) if v is not None})
     theta = _check_theta(theta, tau1, names["theta_s"])
     params = {"K": K, "tau1_s": tau1, "tau2_s": tau2, "theta_s": theta}
-    return ProcessModel("sopdt", params, (K,), _sopdt_den(tau1, tau2), theta, source,
+    return ProcessModel("sopdt", params, (K,), sopdt_den(tau1, tau2), theta, source,
                         {k: ci[k] for k in PARAMS["sopdt"] if k in ci} if ci else None)
 
 
-def _underdamped(K, fn, zeta, theta, names, source, ci95) -> ProcessModel:
+def build_underdamped(K, fn, zeta, theta, names, source, ci95) -> ProcessModel:
     K = _check_gain(K, names["K"])
     fn = _check_fn(fn, names["fn_hz"])
     zeta = _check_zeta(zeta, fn, names)
     theta = _check_theta(theta, 1.0 / (2 * math.pi * fn), names["theta_s"])
     params = {"K": K, "fn_hz": fn, "zeta": zeta, "theta_s": theta}
-    return ProcessModel("underdamped", params, (K,), _pair_den(fn, zeta), theta, source,
+    return ProcessModel("underdamped", params, (K,), pair_den(fn, zeta), theta, source,
                         _check_ci95(ci95, "underdamped"))
 
 
-def _integrating(K, tau, theta, names, source, ci95) -> ProcessModel:
+def build_integrating(K, tau, theta, names, source, ci95) -> ProcessModel:
     K = _check_gain(K, names["K"])
     tau = _check_tau(tau, names["tau_s"], zero_ok=True)
     theta = _check_theta(theta, tau, names["theta_s"])
-    return ProcessModel("integrating", {"K": K, "tau_s": tau, "theta_s": theta}, (K,), _integ_den(tau), theta,
+    return ProcessModel("integrating", {"K": K, "tau_s": tau, "theta_s": theta}, (K,), integ_den(tau), theta,
                         source, _check_ci95(ci95, "integrating"))
 
 
@@ -211,7 +211,7 @@ def _pole_text(p: complex) -> str:
     return f"s = {p.real:+.4g} rad/s"
 
 
-def _rational(num, den, theta, names, source, ci95) -> ProcessModel:
+def build_rational(num, den, theta, names, source, ci95) -> ProcessModel:
     nn, dn = names["num"], names["den"]
     n = _coefficients(num, nn)
     d = _coefficients(den, dn)
@@ -244,7 +244,7 @@ def _rational(num, den, theta, names, source, ci95) -> ProcessModel:
     for p in poles:
         tc = 1.0 / abs(p)
         if not TAU_RANGE.contains(tc):
-            raise DesignError(f"{dn} has a pole at {_pole_text(p)}: its time constant 1/|p| = {_g(tc, 's')} "
+            raise DesignError(f"{dn} has a pole at {_pole_text(p)}: its time constant 1/|p| = {format_g(tc, 's')} "
                               f"must be {TAU_RANGE.text()}")
     with np.errstate(all="ignore"):
         n, d = n / d[-1], d / d[-1]
@@ -287,7 +287,7 @@ def fopdt(K, tau_s, theta_s=0.0, *, source: str = "typed", ci95=None) -> Process
     DesignError
         A value outside its range, in one line naming the parameter.
     """
-    return _fopdt(K, tau_s, theta_s, _LIB_NAMES, source, ci95)
+    return build_fopdt(K, tau_s, theta_s, _LIB_NAMES, source, ci95)
 
 
 def sopdt(K, tau1_s, tau2_s, theta_s=0.0, *, source: str = "typed", ci95=None) -> ProcessModel:
@@ -297,7 +297,7 @@ def sopdt(K, tau1_s, tau2_s, theta_s=0.0, *, source: str = "typed", ci95=None) -
     tau1 = tau2 is a double pole. Ranges and refusals as :func:`fopdt`, theta
     against tau1.
     """
-    return _sopdt(K, tau1_s, tau2_s, theta_s, _LIB_NAMES, source, ci95)
+    return build_sopdt(K, tau1_s, tau2_s, theta_s, _LIB_NAMES, source, ci95)
 
 
 def underdamped(K, fn_hz, zeta, theta_s=0.0, *, source: str = "typed", ci95=None) -> ProcessModel:
@@ -307,7 +307,7 @@ def underdamped(K, fn_hz, zeta, theta_s=0.0, *, source: str = "typed", ci95=None
     with the equivalent :func:`sopdt` time constants,
     tau = 1/(wn (zeta -+ sqrt(zeta^2 - 1)))); theta against 1/wn.
     """
-    return _underdamped(K, fn_hz, zeta, theta_s, _LIB_NAMES, source, ci95)
+    return build_underdamped(K, fn_hz, zeta, theta_s, _LIB_NAMES, source, ci95)
 
 
 def rational(num, den, theta_s=0.0, *, source: str = "typed", ci95=None) -> ProcessModel:
@@ -319,7 +319,7 @@ def rational(num, den, theta_s=0.0, *, source: str = "typed", ci95=None) -> Proc
     1/|p| in :data:`TAU_RANGE`, N(0) != 0. Stored scaled so that D(0) = 1;
     theta against the slowest 1/|p|. ``params`` holds theta_s only.
     """
-    return _rational(num, den, theta_s, _LIB_NAMES, source, ci95)
+    return build_rational(num, den, theta_s, _LIB_NAMES, source, ci95)
 
 
 def integrating(K, tau_s=0.0, theta_s=0.0, *, source: str = "typed", ci95=None) -> ProcessModel:
@@ -328,7 +328,7 @@ def integrating(K, tau_s=0.0, theta_s=0.0, *, source: str = "typed", ci95=None) 
     K is the velocity gain (1/s); tau 0 or in :data:`TAU_RANGE`; theta against
     tau (without it: up to :data:`MAX_DEAD_TIME_S`).
     """
-    return _integrating(K, tau_s, theta_s, _LIB_NAMES, source, ci95)
+    return build_integrating(K, tau_s, theta_s, _LIB_NAMES, source, ci95)
 
 
 def model_from_dict(d: dict) -> ProcessModel:

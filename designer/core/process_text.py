@@ -32,7 +32,7 @@ import re
 from .errors import DesignError
 # the builders behind the constructors: they take the names a refusal uses
 from .process import ProcessModel
-from .process_build import _fopdt, _integrating, _rational, _sopdt, _underdamped
+from .process_build import build_fopdt, build_integrating, build_rational, build_sopdt, build_underdamped
 from .units import parse_value
 
 #: what a key of a typed model may be written as (lower case) -> the key
@@ -252,11 +252,11 @@ def parse_tf(text: str) -> ProcessModel:
     theta = got.get("theta", 0.0)
     n = _TYPED_NAMES
     if form == "fopdt":
-        return _fopdt(got["K"], got["tau"], theta, n, "typed", None)
+        return build_fopdt(got["K"], got["tau"], theta, n, "typed", None)
     if form == "sopdt":
-        return _sopdt(got["K"], got["tau1"], got["tau2"], theta, n, "typed", None)
+        return build_sopdt(got["K"], got["tau1"], got["tau2"], theta, n, "typed", None)
     if form == "underdamped":
-        return _underdamped(got["K"], got["fn"], got["zeta"], theta, n, "typed", None)
+        return build_underdamped(got["K"], got["fn"], got["zeta"], theta, n, "typed", None)
     if form == "rational":
-        return _rational(got["num"], got["den"], theta, n, "typed", None)
-    return _integrating(got["K"], got.get("tau", 0.0), theta, n, "typed", None)
+        return build_rational(got["num"], got["den"], theta, n, "typed", None)
+    return build_integrating(got["K"], got.get("tau", 0.0), theta, n, "typed", None)

@@ -13,17 +13,17 @@ Every method has the signature ``method(t, y, yf, sigma=None) -> MethodResult``:
 - ``sigma`` the noise of ``y`` when the caller measured it (the spread of an
   averaged square wave's plateaus), else estimated here.
 
-They work on the normalised response ``z = y / yf`` (0 -> 1, :func:`_prepare`),
+They work on the normalised response ``z = y / yf`` (0 -> 1, :func:`prepare`),
 so a plant with a negative gain is handled like a positive one. They never
 raise on data outside their range: they return ``valid=False`` with a note
-naming the range and why (:func:`_fail`, :func:`_guarded`).
+naming the range and why (:func:`fail`, :func:`guarded`).
 ``iae``/``ise`` are left nan (the orchestrator computes them against the data).
 A method that assumes no dead time has its result refused when the data start
-later than its model (:func:`_flag_late`).
+later than its model (:func:`flag_late`).
 
 Overdamped results name the *fast* time constant ``tau1_s`` and the slow one
 ``tau2_s`` (tau1 <= tau2), as seed 003 (tau1 = 5, tau2 = 100) and seed 002
-(p1 fast, p2 slow) do (:func:`_second_order_params`).
+(p1 fast, p2 slow) do (:func:`second_order_params`).
 
 Crossing times are robust on noisy data: the samples within a few noise
 standard deviations of the level are fitted with a straight line, which on
@@ -42,7 +42,7 @@ from ..core.waveform import crossing_time, noise_sigma
 from .structures import MethodResult, model_step
 
 
-def _prepare(t, y, yf, sigma=None):
+def prepare(t, y, yf, sigma=None):
     """Normalised arrays and noise (``sigma`` of ``y`` when given), or an error note."""
     t = np.asarray(t, float)
     y = np.asarray(y, float)
@@ -63,13 +63,13 @@ def _nan_params(model):
     return {k: math.nan for k in names}
 
 
-def _fail(name, model, note, yf=math.nan, points=None):
+def fail(name, model, note, yf=math.nan, points=None):
     p = _nan_params(model)
     p["K"] = float(yf) if yf is not None else math.nan
     return MethodResult(name, model, p, valid=False, note=note, points=points or {})
 
 
-def _second_order_params(K, wn, zeta, theta):
+def second_order_params(K, wn, zeta, theta):
     """(model, params) for a K wn^2 e^{-theta s}/(s^2 + 2 zeta wn s + wn^2):
     underdamped below zeta = 1, otherwise two real time constants."""
     if zeta < 1.0:
@@ -97,7 +97,7 @@ def _late_start(t, z, sigma, model, params):
     return lag if lag > 0.1 * t50 else 0.0
 
 
-def _flag_late(result, t, z, sigma):
+def flag_late(result, t, z, sigma):
     """Mark a no-dead-time method's result invalid when the data start late
     (the dead time is then the first thing to tell, before any range note)."""
     if not all(math.isfinite(v) for v in result.params.values()):
@@ -114,7 +114,7 @@ def _flag_late(result, t, z, sigma):
 _POSITIVE = ("tau_s", "tau1_s", "tau2_s", "wn_rad_s", "zeta")
 
 
-def _guarded(name, model):
+def guarded(name, model):
     """Decorator: run a method with numpy's warnings silenced (degenerate data
     give inf/nan, handled here), turn an arithmetic failure on degenerate data
     into valid=False, and likewise any non-finite or non-physical parameter
@@ -126,7 +126,7 @@ def _guarded(name, model):
                 with np.errstate(all="ignore"):
                     r = method(t, y, yf, *args, **kwargs)
             except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-                return _fail(name, model, "the data do not have this method's shape "
+                return fail(name, model, "the data do not have this method's shape "
                              f"({type(exc).__name__}: {exc})",
                              math.nan if name == "dc-motor-position" else yf)
             bad = [k for k, v in r.params.items()

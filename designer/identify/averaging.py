@@ -1,7 +1,7 @@
 """Square-wave captures split into their steps and averaged (a stage of
 :mod:`designer.identify.preprocess`).
 
-:func:`_from_edges` takes the edges of the input, or of the output when there
+:func:`from_edges` takes the edges of the input, or of the output when there
 is no input column: one edge is a single step; of several, each becomes a
 :class:`_Step` (from the output, starting at its last sample at rest before it
 moves, :func:`_departure`), and every full edge of one direction (a half period
@@ -9,7 +9,7 @@ after it, some rest before it) is normalised and averaged on a common grid,
 aligned on the input edges (or the output's 50 % crossings), the other
 direction kept apart and compared with it (:func:`_average`); the noise is the
 spread of the averaged plateau. An output that swings back and forth without a
-settled edge, a sine or a triangle, is refused (:func:`_check_periodic_steps`).
+settled edge, a sine or a triangle, is refused (:func:`check_periodic_steps`).
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ import numpy as np
 from ..core.errors import DesignError
 from ..core.waveform import noise_sigma, quantum
 from .edges import Edge
-from .normalise import PreparedStep, _check_amplitude, _check_step, _interval, _single
-from .settle import _last_true, block_mean, final_value
+from .normalise import PreparedStep, check_amplitude, check_step, sample_interval, single_step
+from .settle import last_true, block_mean, final_value
 
 
 @dataclass
@@ -41,7 +41,7 @@ class _Step:
     rising: bool
 
 
-def _from_edges(t, y, edges, step_amplitude, notes, *, source, first_sample_ok) -> PreparedStep:
+def from_edges(t, y, edges, step_amplitude, notes, *, source, first_sample_ok) -> PreparedStep:
     """One edge or a square wave, from the input's edges or the output's own."""
     steps = _steps(t, y, edges, step_amplitude, source)
     if source == "output" and step_amplitude is None:
@@ -126,7 +126,7 @@ def _departure(t, y, e: Edge, lo: int) -> int:
         w = (c[f:] - c[:-f]) / f                    # mean of blocks k .. k+f-1
         d = w[f:] - w[:-f]
         band_w = 4.0 * sigma * math.sqrt(2.0 / (f * m)) + 0.5 * q
-        k = _last_true(d <= band_w)
+        k = last_true(d <= band_w)
         if k >= 0:
             break
     else:
@@ -149,15 +149,15 @@ def _complete(t, s: _Step, spacing: float) -> bool:
     """A full edge: a half period after it in the record, and some rest before it."""
     after = (t[s.end - 1] if s.end > s.i0 else t[s.i0]) - s.align
     before = s.align - t[0]
-    return after >= 0.9 * spacing - 2 * _interval(t) and before >= 0.05 * spacing
+    return after >= 0.9 * spacing - 2 * sample_interval(t) and before >= 0.05 * spacing
 
 
 def _single_edge(t, y, s: _Step, source, notes, first_sample_ok, end) -> PreparedStep:
     """The one step of a record (or the one full edge of a square wave)."""
     if source == "input":
-        amp = _check_amplitude(s.amp, "the input column's step")
+        amp = check_amplitude(s.amp, "the input column's step")
         notes.append(f"step detected in the input at t = {s.t_step:.6g} s, amplitude {amp:.6g}")
-        return _single(t, y, s.t_step, s.i0, amp, end, notes)
+        return single_step(t, y, s.t_step, s.i0, amp, end, notes)
     # from the output: the trigger (t = 0) when the output is still at rest there
     amp = s.amp
     if first_sample_ok and t[0] <= 0.0 <= s.t_step:
@@ -169,14 +169,14 @@ def _single_edge(t, y, s: _Step, source, notes, first_sample_ok, end) -> Prepare
         t_step, i0 = s.t_step, s.i0
         notes.append(f"no input column: step found in the output at t = {t_step:.6g} s (its "
                      "last sample at rest); pass --step-time otherwise")
-    return _single(t, y, t_step, i0, amp, end, notes)
+    return single_step(t, y, t_step, i0, amp, end, notes)
 
 
 def _average(t, y, chosen, other, source, spacing, notes) -> PreparedStep:
     """Average the normalised responses of every full edge of one direction,
     aligned on their input edges (or the output's 50 % crossings), on a
     common grid; the noise is the spread of the averaged plateau."""
-    dt = _interval(t)
+    dt = sample_interval(t)
     length = min(t[s.end - 1] - s.align for s in chosen)
     pre = 0.0
     if source == "output":
@@ -196,7 +196,7 @@ def _average(t, y, chosen, other, source, spacing, notes) -> PreparedStep:
     if source == "output":
         # the step starts where the average leaves zero
         i50 = int(np.searchsorted(grid, 0.0))
-        k = _last_true(np.abs(avg[:i50]) <= 4.0 * sig_n)
+        k = last_true(np.abs(avg[:i50]) <= 4.0 * sig_n)
         t0 = float(grid[k]) if k >= 0 else float(grid[0])
     else:
         t0 = 0.0
@@ -210,7 +210,7 @@ def _average(t, y, chosen, other, source, spacing, notes) -> PreparedStep:
             "not settled before the next edge; use a lower frequency (half period >= 5 "
             "settling times)") from None
     sigma = sig_n * abs(amp0)
-    _check_step(y0_0, y0_0 + yf_n * amp0, sigma)
+    check_step(y0_0, y0_0 + yf_n * amp0, sigma)
     up = chosen[0].rising
     kind = "rising" if up else "falling"
     notes.append(f"square wave: {len(chosen)} {kind} edges aligned on the "
@@ -261,7 +261,7 @@ def _mean_response(t, y, steps, grid, spacing) -> tuple:
 MAX_TRANSITION_FRACTION = 0.25
 
 
-def _check_periodic_steps(y) -> None:
+def check_periodic_steps(y) -> None:
     """Refuse an output whose repeated swings are not step responses (a sine,
     a triangle; a sine spends a third of its time there) when none of its
     edges settles: a square wave's response sits on its plateaus most of the time."""

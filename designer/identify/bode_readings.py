@@ -129,7 +129,7 @@ def dead_time_from_phase(w, phase_data, phase_model, w_min: float = 0.0) -> floa
 # classical readings
 # --------------------------------------------------------------------------
 
-def _interp_logf(w, y, level):
+def interp_logf(w, y, level):
     """First w (interpolated in log w) where the decreasing y falls to ``level``."""
     below = np.nonzero(y <= level)[0]
     if below.size == 0:
@@ -193,7 +193,7 @@ def _with_delay(name, model, params, data, w_corner, points, note=""):
     return MethodResult(name, model, params, iae, ise, True, note, points)
 
 
-def _invalid(name, model, note, points=None):
+def invalid_result(name, model, note, points=None):
     return MethodResult(name, model, {k: math.nan for k in PARAMS[model]}, valid=False,
                         note=note, points=points or {})
 
@@ -212,7 +212,7 @@ def asymptotes(data: FreqData) -> MethodResult:
     name = "asymptotes"
     lf = low_frequency_slope(data)
     if lf < -10.0:
-        return _invalid(name, "fopdt", f"the gain already falls {-lf:.0f} dB/decade at the "
+        return invalid_result(name, "fopdt", f"the gain already falls {-lf:.0f} dB/decade at the "
                         "lowest frequencies: a pole at the origin (integrator, seed 000 "
                         "examples 3-4) or a table that starts above the corner; the models "
                         "here need a flat low-frequency gain", {"lf_slope_db_dec": lf})
@@ -222,15 +222,15 @@ def asymptotes(data: FreqData) -> MethodResult:
     n = int(round(-slope / 20.0))
     pts = {"K_points": run, "hf_slope_db_dec": slope, "order": n}
     if n < 1:
-        return _invalid(name, "fopdt", f"the gain does not roll off (high-frequency slope "
+        return invalid_result(name, "fopdt", f"the gain does not roll off (high-frequency slope "
                         f"{slope:.1f} dB/decade): no low-pass model to read", pts)
     # n equal poles are 10 log10(2) = 3.01 dB down per pole at their corner
-    wc = _interp_logf(data.w, data.gain_db, k_db - DB_PER_POLE * n)
+    wc = interp_logf(data.w, data.gain_db, k_db - DB_PER_POLE * n)
     # where the -20 n dB/decade line through the high-frequency points meets K
     b = float(np.mean(data.gain_db[sel] + 20.0 * n * np.log10(data.w[sel])))
     pts["w_intersection_rad_s"] = 10.0 ** ((b - k_db) / (20.0 * n))
     if not math.isfinite(wc):
-        return _invalid(name, "fopdt" if n == 1 else "double-pole",
+        return invalid_result(name, "fopdt" if n == 1 else "double-pole",
                         f"the gain never falls {DB_PER_POLE * n:.1f} dB below K in the table: "
                         "extend it to higher frequencies", pts)
     pts["wc_rad_s"] = wc
@@ -239,7 +239,7 @@ def asymptotes(data: FreqData) -> MethodResult:
         if data.phase is not None:
             ph0 = -n * np.arctan(data.w / wc)
             pts["theta_s"] = dead_time_from_phase(data.w, data.phase, ph0, 0.1 * wc)
-        return _invalid(name, "double-pole", f"high-frequency slope {slope:.0f} dB/decade means "
+        return invalid_result(name, "double-pole", f"high-frequency slope {slope:.0f} dB/decade means "
                         f"order {n}; the models here have at most two poles (the seed's "
                         f"reading: {n} equal poles at {wc:.4g} rad/s"
                         + (f", dead time {pts['theta_s']:.4g} s" if "theta_s" in pts else "")
@@ -278,7 +278,7 @@ def resonant_peak(data: FreqData, min_db: float = 0.1) -> MethodResult:
     name, model = "resonant-peak", "underdamped"
     lf = low_frequency_slope(data)
     if lf < -10.0:
-        return _invalid(name, model, f"the gain already falls {-lf:.0f} dB/decade at the "
+        return invalid_result(name, model, f"the gain already falls {-lf:.0f} dB/decade at the "
                         "lowest frequencies: no flat low-frequency gain to measure the peak "
                         "against", {"lf_slope_db_dec": lf})
     K, _ = low_frequency_gain(data)
@@ -286,7 +286,7 @@ def resonant_peak(data: FreqData, min_db: float = 0.1) -> MethodResult:
     db = data.gain_db
     i = int(np.argmax(db))
     if db[i] - k_db < min_db or i == 0 or i == db.size - 1:
-        return _invalid(name, model, f"no resonant peak {min_db} dB above the low-frequency gain "
+        return invalid_result(name, model, f"no resonant peak {min_db} dB above the low-frequency gain "
                         "inside the table: zeta >= 0.707 or the peak was not measured")
     # For a second-order system (K/|G|)^2 = (1 - u^2)^2 + 4 zeta^2 u^2 is a
     # quadratic in w^2: a parabola through the three points around the highest

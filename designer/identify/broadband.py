@@ -571,7 +571,6 @@ def _refuse_unsettled(res: BroadbandResult, y) -> None:
     output whose mean drifts from period to period (an integrating plant, a pole
     at the origin, never settles) is in no periodic steady state (seed 003
     eq. 2.4.2, which both the correlation and the spectral estimate assume)."""
-    from ..core.units import format_eng as fe
     ex = res.excitation
     drift, se = period_drift(y, ex)
     span = float(np.ptp(y)) if y.size else 0.0

@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from ..core.waveform import crossing_time
-from ._step_methods import _fail, _guarded, _prepare
+from ._step_methods import fail, guarded, prepare
 from .structures import MethodResult
 
 __all__ = ["dc_motor", "dc_motor_position", "dc_motor_velocity"]
@@ -40,7 +40,7 @@ def dc_motor_velocity(a, w_inf, t0, w_t0):
 
 
 
-@_guarded("dc-motor", "fopdt")
+@guarded("dc-motor", "fopdt")
 def dc_motor(t, y, yf, sigma=None) -> MethodResult:
     """DC motor velocity from a step of armature voltage (seed 000 eqs 46-55).
 
@@ -52,9 +52,9 @@ def dc_motor(t, y, yf, sigma=None) -> MethodResult:
     the data are one.
     """
     name, model = "dc-motor", "fopdt"
-    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    t, z, sigma, err = prepare(t, y, yf, sigma)
     if err:
-        return _fail(name, model, err, yf)
+        return fail(name, model, err, yf)
     sel = (z >= 0.2) & (z <= 0.8) & (t > 0.0)
     # only the first rise: a later return into the band (oscillation) is not first order
     if sel.any():
@@ -62,7 +62,7 @@ def dc_motor(t, y, yf, sigma=None) -> MethodResult:
         if first_out.size:
             sel[first_out[0]:] = False
     if sel.sum() < 2:
-        return _fail(name, model, "too few samples between 20 % and 80 % of the final value", yf)
+        return fail(name, model, "too few samples between 20 % and 80 % of the final value", yf)
     taus = -t[sel] / np.log(1.0 - z[sel])
     tau = float(np.median(taus))
     q10, q90 = np.percentile(taus, [10, 90])
@@ -77,7 +77,7 @@ def dc_motor(t, y, yf, sigma=None) -> MethodResult:
                         valid=valid, note=note, points=pts)
 
 
-@_guarded("dc-motor-position", "fopdt")
+@guarded("dc-motor-position", "fopdt")
 def dc_motor_position(t, theta, a: float = 1.0, tail: float = 0.3) -> MethodResult:
     """DC motor from its shaft *position* step response (seed 000 eq 45/57).
 
@@ -92,11 +92,11 @@ def dc_motor_position(t, theta, a: float = 1.0, tail: float = 0.3) -> MethodResu
     th = np.asarray(theta, float) / a
     n = len(t)
     if n < 10 or not (np.all(np.isfinite(t)) and np.all(np.isfinite(th))):
-        return _fail(name, model, "needs at least 10 finite samples", math.nan)
+        return fail(name, model, "needs at least 10 finite samples", math.nan)
     k0 = int(n * (1.0 - tail))
     slope, icpt = np.polyfit(t[k0:], th[k0:], 1)
     if slope == 0.0:
-        return _fail(name, model, "the position does not ramp: not an integrating response", 0.0)
+        return fail(name, model, "the position does not ramp: not an integrating response", 0.0)
     tau = -icpt / slope
     # the asymptote is reached only if the fitted tail starts several tau_m after the step
     valid = tau > 0.0 and t[k0] >= 5.0 * tau

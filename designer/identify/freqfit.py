@@ -4,7 +4,7 @@
                    ``overdamped`` with dead time (scipy least_squares on the log
                    of G_model/G_data: gain error in nepers, phase error in
                    radians), started from the classical estimates
-                   (:func:`_starts`, from the readings of :mod:`.bode_readings`),
+                   (:func:`start_points`, from the readings of :mod:`.bode_readings`),
                    with 95 % confidence half-widths in ``points`` (``<param>_ci95``).
 
 The fits search time constants and wn within the measured band widened
@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from ..core.ranges import RANGES
-from .bode_readings import _invalid, fit_error, model_phase, model_response
+from .bode_readings import invalid_result, fit_error, model_phase, model_response
 from .io import FreqData
 from .structures import MethodResult
 
@@ -116,7 +116,7 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
         if np.all(np.isfinite(sol.x)) and (best is None or sol.cost < best.cost):
             best = sol
     if best is None:
-        return _invalid(name, model, "the fit did not converge from any starting point")
+        return invalid_result(name, model, "the fit did not converge from any starting point")
     params = _x_to_params(model, best.x, fit_delay)
     if params["theta_s"] < MIN_DEAD_TIME_S:
         # the bound at 0 reached in floating point (1e-25 s): no dead time, which
@@ -160,7 +160,7 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     return MethodResult(name, model, params, iae, ise, valid, note, pts)
 
 
-def _starts(model, classical, K, wc):
+def start_points(model, classical, K, wc):
     """Starting points: the classical results of compatible models, then a small grid."""
     out = []
     for m in classical:

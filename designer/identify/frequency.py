@@ -35,8 +35,8 @@ import math
 from dataclasses import dataclass
 
 from .bode_margins import LoopMargins, loop_margins
-from .bode_readings import _interp_logf, asymptotes, low_frequency_gain, resonant_peak
-from .freqfit import _starts, least_squares_fit
+from .bode_readings import interp_logf, asymptotes, low_frequency_gain, resonant_peak
+from .freqfit import start_points, least_squares_fit
 from .io import FreqData
 from .structures import MethodResult, rank_key
 
@@ -117,10 +117,10 @@ def identify_freq(data: FreqData) -> FreqIdentifyResult:
     """Run the classical readings and the least-squares fits; rank by fit error."""
     classical = [asymptotes(data), resonant_peak(data)]
     K, _ = low_frequency_gain(data)
-    wc = _interp_logf(data.w, data.gain_db, 20.0 * math.log10(K) - 3.0)
+    wc = interp_logf(data.w, data.gain_db, 20.0 * math.log10(K) - 3.0)
     if not math.isfinite(wc):
         wc = float(data.w[-1])
-    fits = [least_squares_fit(data, model, _starts(model, classical, K, wc))
+    fits = [least_squares_fit(data, model, start_points(model, classical, K, wc))
             for model in ("fopdt", "underdamped", "overdamped")]
     for m in classical + fits:
         judge(m, data)

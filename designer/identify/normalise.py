@@ -5,11 +5,11 @@ average of all of them).
 
 A step at ``t_step`` becomes ``t`` (time since the step), ``y`` (deviation
 from the pre-step baseline divided by the input step amplitude) and ``yf``
-(its settled value = static gain): :func:`_single` takes the baseline from the
+(its settled value = static gain): :func:`single_step` takes the baseline from the
 output's rest before the step and the final value from its settled tail
 (:mod:`designer.identify.settle`), and refuses a step lost in the noise
 (:data:`~designer.identify.edges.MIN_STEP_SNR`) or outside its physical range
-(:func:`_check_step`, :func:`_check_amplitude`).
+(:func:`check_step`, :func:`check_amplitude`).
 """
 
 from __future__ import annotations
@@ -88,7 +88,7 @@ class PreparedStep:
                 "nonlinear": self.nonlinear or None, "notes": list(self.notes)}
 
 
-def _check_step(y0, yf, sigma, what="the response"):
+def check_step(y0, yf, sigma, what="the response"):
     span = yf - y0
     if span == 0 or abs(span) < MIN_STEP_SNR * sigma:
         ratio = abs(span) / sigma if sigma > 0 else 0.0
@@ -100,7 +100,7 @@ def _check_step(y0, yf, sigma, what="the response"):
                                 "baseline)", shown=number_text(span))
 
 
-def _check_amplitude(amp: float, what: str) -> float:
+def check_amplitude(amp: float, what: str) -> float:
     """``amp`` if its size is inside ``RANGES["step_amplitude"]`` (either sign)."""
     if not (math.isfinite(amp) and amp != 0):
         raise DesignError(f"{what} must be a non-zero number; got {number_text(amp)}")
@@ -109,7 +109,7 @@ def _check_amplitude(amp: float, what: str) -> float:
     return float(amp)
 
 
-def _single(t, y, t_step, i0, amp, end, notes, rest: Rest | None = None) -> PreparedStep:
+def single_step(t, y, t_step, i0, amp, end, notes, rest: Rest | None = None) -> PreparedStep:
     """One step at ``t_step`` (first sample after it ``i0``), the record used up
     to index ``end``: baseline, final value, normalisation."""
     sigma = noise_sigma(y[i0:end])
@@ -129,12 +129,12 @@ def _single(t, y, t_step, i0, amp, end, notes, rest: Rest | None = None) -> Prep
     if tp.size < MIN_SAMPLES:
         raise DesignError("fewer than 10 samples after the step; capture more of the response")
     yf = final_value(tp, yp, y0, sigma=sigma)
-    _check_step(y0, yf, sigma)
+    check_step(y0, yf, sigma)
     yn = (yp - y0) / amp
     tw, yw = block_mean(tp, yn)
     return PreparedStep(t=tw, y=yw, yf=(yf - y0) / amp, t_step=t_step, amplitude=float(amp),
                         y0=y0, y_final=yf, sigma=sigma, t_raw=t[:end], y_raw=y[:end],
-                        notes=notes, dt=_interval(t), work_sigma=noise_sigma(yw),
+                        notes=notes, dt=sample_interval(t), work_sigma=noise_sigma(yw),
                         rising=int(amp * (yf - y0) > 0), falling=int(amp * (yf - y0) < 0))
 
 
@@ -151,6 +151,6 @@ def _rest_note(rest: Rest, n_pre: int, duration: float, notes, yp, sigma) -> Non
                      f"{rest.samples} samples ({duration:.3g} s) at rest just before the edge")
 
 
-def _interval(t) -> float:
+def sample_interval(t) -> float:
     """The sample interval: the median spacing (of at most 10000 samples)."""
     return float(np.median(np.diff(t[:10001]))) if t.size > 1 else math.nan

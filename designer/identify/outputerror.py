@@ -83,7 +83,7 @@ import numpy as np
 from ..core import process_build as pb
 from ..core.errors import DesignError
 from ..core.process import ProcessModel
-from .validation import DEFAULT_FRACTION, Split, Validation, arx_fit, split_record, validate
+from .validation import DEFAULT_FRACTION, Split, arx_fit, split_record, validate
 
 __all__ = ["FIT_KINDS", "HOLDS", "INITIALS", "Sampled", "sample_model", "simulate", "OEFit", "OEResult",
            "fit_output_error", "identify_output_error"]

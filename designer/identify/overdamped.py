@@ -33,14 +33,14 @@ import math
 import numpy as np
 
 from ..core.waveform import crossing_time
-from ._step_methods import _fail, _flag_late, _guarded, _prepare, _second_order_params
+from ._step_methods import fail, flag_late, guarded, prepare, second_order_params
 from .structures import MethodResult, iae_ise, model_step
 
 __all__ = ["two_pole", "stark_mollenkamp", "jahanmiri_fallahi", "peeling",
            "alfaro_123c_overdamped", "harriott"]
 
 
-@_guarded("two-pole", "overdamped")
+@guarded("two-pole", "overdamped")
 def two_pole(t, y, yf, sigma=None, levels=(0.6, 0.9)) -> MethodResult:
     """Two real poles from the response above 50 % (seed 002 eqs 16-20), zeta > 2.
 
@@ -54,13 +54,13 @@ def two_pole(t, y, yf, sigma=None, levels=(0.6, 0.9)) -> MethodResult:
     makes eqs 17/18 consistent.
     """
     name, model = "two-pole", "overdamped"
-    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    t, z, sigma, err = prepare(t, y, yf, sigma)
     if err:
-        return _fail(name, model, err, yf)
+        return fail(name, model, err, yf)
     ta = crossing_time(t, z, levels[0], sigma=sigma)
     tb = crossing_time(t, z, levels[1], sigma=sigma)
     if not (math.isfinite(ta) and math.isfinite(tb)) or tb <= ta:
-        return _fail(name, model, f"the response does not rise through {levels[0]:.0%} and "
+        return fail(name, model, f"the response does not rise through {levels[0]:.0%} and "
                      f"{levels[1]:.0%} of its final value", yf)
     sel = (t >= ta) & (t <= tb)
     r = 1.0 - z[sel]
@@ -74,7 +74,7 @@ def two_pole(t, y, yf, sigma=None, levels=(0.6, 0.9)) -> MethodResult:
         a2 = abs((math.log(1.0 - levels[1]) - math.log(1.0 - levels[0])) / (ta - tb))
         x = 0.5 * ((1.0 - levels[0]) * math.exp(a2 * ta) + (1.0 - levels[1]) * math.exp(a2 * tb))
     if a2 <= 0.0 or x <= 1.0:
-        return _fail(name, model, "the late response is not the tail of two real poles "
+        return fail(name, model, "the late response is not the tail of two real poles "
                      "(X <= 1 in eqs 17/18): zeta too low or dead time; valid for zeta > 2",
                      yf, pts)
     a1 = a2 * x / (x - 1.0)
@@ -90,7 +90,7 @@ def two_pole(t, y, yf, sigma=None, levels=(0.6, 0.9)) -> MethodResult:
     if valid and x < 1.0 + 20.0 * sigma:
         note += (f"; X = {x:.4f} is within the noise of 1, so the fast pole "
                  f"({fast:.4g} rad/s) is poorly determined")
-    return _flag_late(MethodResult(name, model, params, valid=valid, note=note, points=pts),
+    return flag_late(MethodResult(name, model, params, valid=valid, note=note, points=pts),
                       t, z, sigma)
 
 
@@ -100,7 +100,7 @@ def two_pole(t, y, yf, sigma=None, levels=(0.6, 0.9)) -> MethodResult:
 STARK_RANGE = (0.45, 1.3)
 
 
-@_guarded("stark-mollenkamp", "underdamped")
+@guarded("stark-mollenkamp", "underdamped")
 def stark_mollenkamp(t, y, yf, sigma=None) -> MethodResult:
     """Stark-Mollenkamp three points 15/45/75 % (seed 000 eqs 31-37).
 
@@ -110,18 +110,18 @@ def stark_mollenkamp(t, y, yf, sigma=None) -> MethodResult:
     An empirical correlation: within 3 % for 0.45 <= zeta <= 1.3.
     """
     name = "stark-mollenkamp"
-    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    t, z, sigma, err = prepare(t, y, yf, sigma)
     if err:
-        return _fail(name, "underdamped", err, yf)
+        return fail(name, "underdamped", err, yf)
     t15, t45, t75 = (crossing_time(t, z, p, sigma=sigma) for p in (0.15, 0.45, 0.75))
     if not all(math.isfinite(v) for v in (t15, t45, t75)) or not t15 < t45 < t75:
-        return _fail(name, "underdamped", "the response does not rise through 15, 45 and 75 % "
+        return fail(name, "underdamped", "the response does not rise through 15, 45 and 75 % "
                      "of its final value", yf)
     x = (t45 - t15) / (t75 - t15)
     pts = {"t15_s": t15, "t45_s": t45, "t75_s": t75, "x": x}
     num = 0.0805 - 5.547 * (0.475 - x) ** 2
     if x <= 0.356 or num <= 0.0:
-        return _fail(name, "underdamped", f"x = {x:.4f}: eq 32 needs x > 0.356 and gives no "
+        return fail(name, "underdamped", f"x = {x:.4f}: eq 32 needs x > 0.356 and gives no "
                      "positive "
                      "zeta (the correlation covers about 0.45 <= zeta <= 1.3)", yf, pts)
     zeta = num / (x - 0.356)
@@ -133,7 +133,7 @@ def stark_mollenkamp(t, y, yf, sigma=None) -> MethodResult:
         if -theta > 0.02 * (t75 - t15):
             note = f"eq 36 gives a negative dead time ({theta:.3g} s), set to 0; "
         theta = 0.0
-    model, params = _second_order_params(float(yf), wn, zeta, theta)
+    model, params = second_order_params(float(yf), wn, zeta, theta)
     pts.update({"zeta": zeta, "wn_rad_s": wn})
     valid = STARK_RANGE[0] <= zeta <= STARK_RANGE[1]
     if not valid:
@@ -154,7 +154,7 @@ def _jf_from(theta, t70, t90):
     return eta, zeta, tau
 
 
-@_guarded("jahanmiri-fallahi", "overdamped")
+@guarded("jahanmiri-fallahi", "overdamped")
 def jahanmiri_fallahi(t, y, yf, sigma=None) -> MethodResult:
     """Jahanmiri-Fallahi three points (seed 000 eqs 38-42).
 
@@ -167,17 +167,17 @@ def jahanmiri_fallahi(t, y, yf, sigma=None) -> MethodResult:
     it is flagged invalid.
     """
     name = "jahanmiri-fallahi"
-    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    t, z, sigma, err = prepare(t, y, yf, sigma)
     if err:
-        return _fail(name, "overdamped", err, yf)
+        return fail(name, "overdamped", err, yf)
     t2, t5, t70, t90 = (crossing_time(t, z, p, sigma=sigma) for p in (0.02, 0.05, 0.70, 0.90))
     if not all(math.isfinite(v) for v in (t2, t5, t70, t90)) or not t5 < t70 < t90:
-        return _fail(name, "overdamped", "the response does not rise through 2/5, 70 and 90 % "
+        return fail(name, "overdamped", "the response does not rise through 2/5, 70 and 90 % "
                      "of its final value", yf)
     best = None
     for label, theta in (("t2", t2), ("t5", t5)):
         eta, zeta, tau = _jf_from(theta, t70, t90)
-        model, params = _second_order_params(float(yf), 1.0 / tau, zeta, theta)
+        model, params = second_order_params(float(yf), 1.0 / tau, zeta, theta)
         iae, ise = iae_ise(t, z * yf, model_step(model, params, t))
         if best is None or iae < best[0]:
             best = (iae, ise, label, eta, zeta, model, params)
@@ -206,7 +206,7 @@ def _logfit(t, v):
 PEEL_SAMPLES = 4000
 
 
-@_guarded("peeling", "overdamped")
+@guarded("peeling", "overdamped")
 def peeling(t, y, yf, sigma=None, iterations: int = 500) -> MethodResult:
     """Exponential peeling of two time constants (seed 003 section 2.3).
 
@@ -224,11 +224,11 @@ def peeling(t, y, yf, sigma=None, iterations: int = 500) -> MethodResult:
     falling), is reported with valid=False and its amplitudes in ``points``.
     """
     name, model = "peeling", "overdamped"
-    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    t, z, sigma, err = prepare(t, y, yf, sigma)
     if err:
-        return _fail(name, model, err, yf)
+        return fail(name, model, err, yf)
     if float(np.max(z)) > 1.0 + max(5.0 * sigma, 1e-3):
-        return _fail(name, model, "the response overshoots: two real time constants "
+        return fail(name, model, "the response overshoots: two real time constants "
                      "cannot produce it (valid for overdamped responses)", yf)
     if t.size > PEEL_SAMPLES:
         # the log-lines are refitted up to `iterations` times: on a dense record
@@ -245,13 +245,13 @@ def peeling(t, y, yf, sigma=None, iterations: int = 500) -> MethodResult:
     # past the dead time: exactly 0 before it on clean data, 5 sigma on noisy data
     fast_sel_base = z > 5.0 * sigma
     if slow_sel.sum() < 3:
-        return _fail(name, model, "too few samples in the tail (1 - y/yf between "
+        return fail(name, model, "too few samples in the tail (1 - y/yf between "
                      f"{r_lo:.3g} and 0.35) to fit the slow exponential", yf)
     ts = t[slow_sel]
     k1, tau1 = 0.0, math.nan
     k2, tau2 = _logfit(ts, r[slow_sel])
     if not math.isfinite(tau2):
-        return _fail(name, model, "the tail of 1 - y/yf does not decay", yf)
+        return fail(name, model, "the tail of 1 - y/yf does not decay", yf)
     negative = 0
     for _ in range(max(1, iterations)):
         f = k2 * np.exp(-t / tau2) - r             # = K1 e^{-t/tau1}
@@ -292,10 +292,10 @@ def peeling(t, y, yf, sigma=None, iterations: int = 500) -> MethodResult:
     pts = {"K1": k1, "K2": k2, "tau_fast_s": tau1, "tau_slow_s": tau2,
            "tail_from_s": float(ts[0]), "tail_to_s": float(ts[-1])}
     if not math.isfinite(tau1):
-        return _fail(name, model, "no fast exponential above the noise to peel: the response "
+        return fail(name, model, "no fast exponential above the noise to peel: the response "
                      "is first order (use a FOPDT method)", yf, pts)
     if k1 <= 0.0:
-        return _fail(name, model, "the fast exponential has the sign of a sum of lags "
+        return fail(name, model, "the fast exponential has the sign of a sum of lags "
                      "(a zero), not of two cascaded poles: K1 = %.4g, K2 = %.4g, tau1 = %.4g s, "
                      "tau2 = %.4g s" % (k1, k2, tau1, tau2), yf, pts)
     # the two-pole step response leaves its start with zero slope, so the dead
@@ -326,7 +326,7 @@ def peeling(t, y, yf, sigma=None, iterations: int = 500) -> MethodResult:
 # Alfaro 123c (overdamped) and Harriott
 # --------------------------------------------------------------------------
 
-@_guarded("alfaro-123c-overdamped", "overdamped")
+@guarded("alfaro-123c-overdamped", "overdamped")
 def alfaro_123c_overdamped(t, y, yf, sigma=None) -> MethodResult:
     """Alfaro's 123c method for K e^(-L s) / ((T s + 1)(a T s + 1)), 0 <= a <= 1
     (V. M. Alfaro, "Identificacion de procesos sobreamortiguados utilizando
@@ -342,19 +342,19 @@ def alfaro_123c_overdamped(t, y, yf, sigma=None) -> MethodResult:
     step), so a result whose model misses the data by over 2 % rms is invalid.
     """
     name, model = "alfaro-123c-overdamped", "overdamped"
-    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    t, z, sigma, err = prepare(t, y, yf, sigma)
     if err:
-        return _fail(name, model, err, yf)
+        return fail(name, model, err, yf)
     t25, t50, t75 = (crossing_time(t, z, p, sigma=sigma) for p in (0.25, 0.5, 0.75))
     if not all(math.isfinite(v) for v in (t25, t50, t75)) or not t25 < t50 < t75:
-        return _fail(name, model, "the response does not rise through 25, 50 and 75 % of its "
+        return fail(name, model, "the response does not rise through 25, 50 and 75 % of its "
                      "final value", yf)
     pts = {"t25_s": t25, "t50_s": t50, "t75_s": t75}
     den = 0.3533 * t25 - 0.7036 * t50 + 0.3503 * t75
     a = (-0.6240 * t25 + 0.9866 * t50 - 0.3626 * t75) / den
     pts["a"] = a
     if not 0.0 <= a <= 1.0:
-        return _fail(name, model, f"a = {a:.3f} outside 0 <= a <= 1: " + (
+        return fail(name, model, f"a = {a:.3f} outside 0 <= a <= 1: " + (
             "one pole dominates (a first-order response: use alfaro-123c)" if a < 0 else
             "the response is not that of two real poles with dead time"), yf, pts)
     big = (t75 - t25) / (0.9866 + 0.7036 * a)
@@ -397,7 +397,7 @@ def _harriott_chart():
     return r, h
 
 
-@_guarded("harriott", "overdamped")
+@guarded("harriott", "overdamped")
 def harriott(t, y, yf, sigma=None) -> MethodResult:
     """Harriott's method for two real poles without dead time (P. Harriott,
     Process Control, McGraw-Hill 1964; in most process-control texts).
@@ -409,19 +409,19 @@ def harriott(t, y, yf, sigma=None) -> MethodResult:
     chart and without dead time.
     """
     name, model = "harriott", "overdamped"
-    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    t, z, sigma, err = prepare(t, y, yf, sigma)
     if err:
-        return _fail(name, model, err, yf)
+        return fail(name, model, err, yf)
     t73 = crossing_time(t, z, 0.73, sigma=sigma)
     if not (math.isfinite(t73) and t73 > 0.0):
-        return _fail(name, model, "the response does not reach 73 % of its final value", yf)
+        return fail(name, model, "the response does not reach 73 % of its final value", yf)
     total = t73 / HARRIOTT_73
     th = 0.5 * total
     zh = float(np.interp(th, t, z))
     pts = {"t73_s": t73, "tau_sum_s": total, "y_half": zh}
     r, h = _harriott_chart()
     if not h[-1] - 0.01 <= zh <= h[0] + 0.01:
-        return _fail(name, model, f"y((tau1 + tau2)/2) = {zh:.3f} is outside Harriott's chart "
+        return fail(name, model, f"y((tau1 + tau2)/2) = {zh:.3f} is outside Harriott's chart "
                      f"({h[-1]:.3f} to {h[0]:.3f}): a dead time or not two real poles", yf, pts)
     ratio = float(np.interp(zh, h[::-1], r[::-1]))
     pts["tau1_fraction"] = ratio
@@ -429,6 +429,6 @@ def harriott(t, y, yf, sigma=None) -> MethodResult:
               "tau2_s": (1.0 - ratio) * total, "theta_s": 0.0}
     valid = float(np.max(z)) <= 1.0 + max(4.0 * sigma, 0.02)
     note = "assumes no dead time" if valid else "the response overshoots: two real poles cannot"
-    return _flag_late(MethodResult(name, model, params, valid=valid, note=note, points=pts),
+    return flag_late(MethodResult(name, model, params, valid=valid, note=note, points=pts),
                       t, z, sigma)
 

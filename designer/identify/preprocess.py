@@ -32,9 +32,9 @@ import numpy as np
 from ..core.errors import DesignError
 from ..core.ranges import RANGES
 from ..core.waveform import crossing_time, noise_sigma, quantum
-from .averaging import _check_periodic_steps, _from_edges
+from .averaging import check_periodic_steps, from_edges
 from .edges import MIN_SAMPLES, MIN_STEP_SNR, check_samples, find_edges, number_text
-from .normalise import PreparedStep, _check_amplitude, _single
+from .normalise import PreparedStep, check_amplitude, single_step
 from .settle import nonlinearity
 
 
@@ -88,7 +88,7 @@ def prepare_step(t, y, u=None, *, step_time: float | None = None,
         window = (t0, t1)
         notes.append(f"window {t0:.6g} s to {t1:.6g} s: {t.size} samples used")
     if step_amplitude is not None:
-        _check_amplitude(step_amplitude, "the step amplitude")
+        check_amplitude(step_amplitude, "the step amplitude")
     if step_time is not None:
         RANGES["capture_time_s"].check(step_time, "the step time", shown=number_text(step_time))
     lsb = quantum(y)
@@ -100,20 +100,20 @@ def prepare_step(t, y, u=None, *, step_time: float | None = None,
             raise DesignError("no step in the input column: it never moves between two levels "
                               "by more than the noise; give --step-time (and --step-amplitude) "
                               "or check the column order (t,u,y)")
-        prep = _from_edges(t, y, edges, step_amplitude, notes, source="input",
+        prep = from_edges(t, y, edges, step_amplitude, notes, source="input",
                            first_sample_ok=False)
     else:
         edges = find_edges(t, y, plateaus=True)
         if edges:
             try:
-                prep = _from_edges(t, y, edges, step_amplitude, notes, source="output",
+                prep = from_edges(t, y, edges, step_amplitude, notes, source="output",
                                    first_sample_ok=window is None)
             except DesignError:
                 if len(edges) >= 2:
-                    _check_periodic_steps(y)
+                    check_periodic_steps(y)
                 raise
         else:
-            prep = _single(t, y, *_trigger_step(t, notes), _amp_or_one(step_amplitude, notes),
+            prep = single_step(t, y, *_trigger_step(t, notes), _amp_or_one(step_amplitude, notes),
                            t.size, notes)
     prep.lsb, prep.window = lsb, window
     if lsb:
@@ -155,7 +155,7 @@ def _given_step(t, y, u, t_step, step_amplitude, notes) -> PreparedStep:
     if step_amplitude is not None:
         amp = float(step_amplitude)
     elif u is not None:
-        amp = _check_amplitude(_amplitude_from_u(t, u, t_step), "the input column's step")
+        amp = check_amplitude(_amplitude_from_u(t, u, t_step), "the input column's step")
     else:
         amp = _amp_or_one(None, notes)
     i0 = int(np.searchsorted(t, t_step, "left"))
@@ -185,7 +185,7 @@ def _given_step(t, y, u, t_step, step_amplitude, notes) -> PreparedStep:
                          "(give the input column to average every step)")
             if end - i0 < MIN_SAMPLES:
                 raise DesignError("fewer than 10 samples between the step and the next edge")
-    return _single(t, y, t_step, i0, amp, end, notes)
+    return single_step(t, y, t_step, i0, amp, end, notes)
 
 
 def _amplitude_from_u(t, u, t_step):

@@ -74,7 +74,7 @@ def settled_before(y_pre, sigma: float, span: float) -> Rest | None:
     c = np.concatenate(([0.0], np.cumsum(y_pre - ref)))
     ma = (c[m:] - c[:-m]) / m                      # mean of samples i .. i+m-1
     off = np.abs(ma) > tol
-    k = _last_true(off)
+    k = last_true(off)
     start = 0 if k < 0 else k + m
     start = min(start, n - 1)
     level = float(np.mean(y_pre[start:]))
@@ -82,7 +82,7 @@ def settled_before(y_pre, sigma: float, span: float) -> Rest | None:
     return Rest(level=level, samples=n - start, moved=moved)
 
 
-def _last_true(mask) -> int:
+def last_true(mask) -> int:
     """Index of the last True of a boolean array, -1 if none."""
     if not mask.size:
         return -1
@@ -179,7 +179,7 @@ def nonlinearity(t, y, yf, sigma: float = 0.0, lsb: float = 0.0) -> str:
         ip = int(np.argmax(z))
         band = max(2.0 * sig, q) + 1e-12
         top = z >= peak - band
-        k0 = _last_true(~top[:ip])
+        k0 = last_true(~top[:ip])
         k1 = ip + int(np.argmax(~top[ip:])) if not top[ip:].all() else z.size
         held = t[min(k1, z.size - 1)] - t[k0 + 1]
         # a smooth peak of this height (curvature of an underdamped one,

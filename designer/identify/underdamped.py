@@ -33,7 +33,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..core.waveform import crossing_time, moving_average, peak_region, refine_peak
-from ._step_methods import _fail, _flag_late, _guarded, _prepare, _second_order_params
+from ._step_methods import fail, flag_late, guarded, prepare, second_order_params
 from .structures import MethodResult
 
 __all__ = [
@@ -214,7 +214,7 @@ def extrema(t, z, sigma: float = 0.0, count: int = 3):
 # the methods
 # --------------------------------------------------------------------------
 
-@_guarded("overshoot", "underdamped")
+@guarded("overshoot", "underdamped")
 def overshoot(t, y, yf, sigma=None) -> MethodResult:
     """Overshoot and peak time (seeds 000 eqs 20-23 and 003 eq 2.2.11).
 
@@ -224,25 +224,25 @@ def overshoot(t, y, yf, sigma=None) -> MethodResult:
     no dead time (a dead time adds to tp and lowers wn).
     """
     name, model = "overshoot", "underdamped"
-    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    t, z, sigma, err = prepare(t, y, yf, sigma)
     if err:
-        return _fail(name, model, err, yf)
+        return fail(name, model, err, yf)
     ext = extrema(t, z, sigma, count=1)
     if not ext or ext[0][0] != "max":
-        return _fail(name, model, "no overshoot above the noise: valid only for "
+        return fail(name, model, "no overshoot above the noise: valid only for "
                      "underdamped responses (0 < zeta < 1); use t4-t3 or two-pole", yf)
     _, tp, zp = ext[0]
     mp = zp - 1.0
     zeta = float(zeta_from_overshoot(mp))
     wn = float(wn_from_peak_time(tp, zeta))
-    return _flag_late(MethodResult(name, model, {"K": float(yf), "wn_rad_s": wn, "zeta": zeta,
+    return flag_late(MethodResult(name, model, {"K": float(yf), "wn_rad_s": wn, "zeta": zeta,
                                                  "theta_s": 0.0},
                                    points={"tp_s": tp, "overshoot": mp, "peak": zp * yf},
                                    note="assumes no dead time (peak time measured from the step)"),
                       t, z, sigma)
 
 
-@_guarded("log-decrement", "underdamped")
+@guarded("log-decrement", "underdamped")
 def log_decrement(t, y, yf, sigma=None) -> MethodResult:
     """First and second overshoot and the period (seed 002 eqs 5-7), zeta <= 0.5.
 
@@ -256,17 +256,17 @@ def log_decrement(t, y, yf, sigma=None) -> MethodResult:
     two peaks (twice the peak-to-trough time if the record shows one peak only).
     """
     name, model = "log-decrement", "underdamped"
-    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    t, z, sigma, err = prepare(t, y, yf, sigma)
     if err:
-        return _fail(name, model, err, yf)
+        return fail(name, model, err, yf)
     ext = extrema(t, z, sigma, count=3)
     if len(ext) < 2 or ext[0][0] != "max" or ext[1][0] != "min":
-        return _fail(name, model, "needs a first overshoot and an undershoot above the noise: "
+        return fail(name, model, "needs a first overshoot and an undershoot above the noise: "
                      "valid for zeta <= 0.5", yf)
     (_, t1, z1), (_, tm, zm) = ext[0], ext[1]
     y1, y2 = z1 - 1.0, 1.0 - zm
     if y2 <= 0.0 or y1 <= 0.0 or y2 >= y1:
-        return _fail(name, model, "the undershoot is not smaller than the overshoot: not a "
+        return fail(name, model, "the undershoot is not smaller than the overshoot: not a "
                      "decaying second-order oscillation (valid for zeta <= 0.5)", yf)
     period = ext[2][1] - t1 if len(ext) >= 3 and ext[2][0] == "max" else 2.0 * (tm - t1)
     l1, l2 = abs(math.log(y1)), abs(math.log(y2))
@@ -278,7 +278,7 @@ def log_decrement(t, y, yf, sigma=None) -> MethodResult:
     note = "assumes no dead time" if valid else (
         f"zeta = {zeta:.3f} > 0.5: outside the method's range (zeta <= 0.5, seed 002); "
         "use t4-t3")
-    return _flag_late(MethodResult(name, model, {"K": float(yf), "wn_rad_s": wn, "zeta": zeta,
+    return flag_late(MethodResult(name, model, {"K": float(yf), "wn_rad_s": wn, "zeta": zeta,
                                                  "theta_s": 0.0},
                                    valid=valid, note=note,
                                    points={"t1_s": t1, "y1": y1, "t_min_s": tm, "y2": y2,
@@ -287,7 +287,7 @@ def log_decrement(t, y, yf, sigma=None) -> MethodResult:
                       t, z, sigma)
 
 
-@_guarded("t4-t3", "underdamped")
+@guarded("t4-t3", "underdamped")
 def t4_t3(t, y, yf, sigma=None) -> MethodResult:
     """Seed 002's t4/t3 method, 0.5 <= zeta <= 2.
 
@@ -296,22 +296,22 @@ def t4_t3(t, y, yf, sigma=None) -> MethodResult:
     seed's Table 2, recomputed), and wn = (wn t4)(zeta) / t4.
     """
     name = "t4-t3"
-    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    t, z, sigma, err = prepare(t, y, yf, sigma)
     if err:
-        return _fail(name, "underdamped", err, yf)
+        return fail(name, "underdamped", err, yf)
     t3 = crossing_time(t, z, Y3_LEVEL, sigma=sigma)
     t4 = crossing_time(t, z, Y4_LEVEL, sigma=sigma)
     if not (math.isfinite(t3) and math.isfinite(t4)) or t3 <= 0.0 or t4 <= t3:
-        return _fail(name, "underdamped", "the response does not rise through 26.4 % and 80.1 % "
+        return fail(name, "underdamped", "the response does not rise through 26.4 % and 80.1 % "
                      "of its final value after the step", yf)
     ratio = t4 / t3
     zeta = zeta_from_t4_t3(ratio)
     pts = {"t3_s": t3, "t4_s": t4, "t4_t3": ratio}
     if not math.isfinite(zeta):
-        return _fail(name, "underdamped", f"t4/t3 = {ratio:.3f} is outside what a second-order "
+        return fail(name, "underdamped", f"t4/t3 = {ratio:.3f} is outside what a second-order "
                      "system gives (1.84 to 5.26); dead time or higher order", yf, pts)
     wn = _t3_t4(zeta)[1] / t4
-    model, params = _second_order_params(float(yf), wn, zeta, 0.0)
+    model, params = second_order_params(float(yf), wn, zeta, 0.0)
     lo, hi = t4_t3_ratio(0.5), t4_t3_ratio(2.0)
     valid = 0.5 - 1e-9 <= zeta <= 2.0 + 1e-9
     note = "assumes no dead time"
@@ -319,12 +319,12 @@ def t4_t3(t, y, yf, sigma=None) -> MethodResult:
         note = (f"t4/t3 = {ratio:.3f} gives zeta = {zeta:.3f}, outside the method's range "
                 f"0.5 <= zeta <= 2 (t4/t3 {lo:.3f} to {hi:.3f}); use "
                 + ("log-decrement" if zeta < 0.5 else "two-pole"))
-    return _flag_late(MethodResult(name, model, params, valid=valid, note=note, points=pts),
+    return flag_late(MethodResult(name, model, params, valid=valid, note=note, points=pts),
                       t, z, sigma)
 
 
 
-@_guarded("chen", "underdamped")
+@guarded("chen", "underdamped")
 def chen(t, y, yf, sigma=None) -> MethodResult:
     """Cheng-Liang Chen, underdamped with dead time (seed 000 eqs 24-30).
 
@@ -335,12 +335,12 @@ def chen(t, y, yf, sigma=None) -> MethodResult:
     eq 29's estimate of it is reported in ``points``.
     """
     name, model = "chen", "underdamped"
-    t, z, sigma, err = _prepare(t, y, yf, sigma)
+    t, z, sigma, err = prepare(t, y, yf, sigma)
     if err:
-        return _fail(name, model, err, yf)
+        return fail(name, model, err, yf)
     ext = extrema(t, z, sigma, count=3)
     if len(ext) < 3 or [e[0] for e in ext] != ["max", "min", "max"]:
-        return _fail(name, model, "needs a first peak, a minimum and a second peak above the "
+        return fail(name, model, "needs a first peak, a minimum and a second peak above the "
                      "noise: valid for clearly underdamped responses (zeta below about 0.6)", yf)
     (_, tp1, cp1), (_, tm1, cm1), (_, _tp2, cp2) = ext
     den = cp1 + cp2 - 2.0 * cm1
@@ -350,7 +350,7 @@ def chen(t, y, yf, sigma=None) -> MethodResult:
     pts = {"tp1_s": tp1, "tm1_s": tm1, "cp1": cp1 * yf, "cm1": cm1 * yf, "cp2": cp2 * yf,
            "y_inf_eq29": y_inf * yf, "mp": mp}
     if not 0.0 < mp < 1.0:
-        return _fail(name, model, f"decay ratio {mp:.3f} outside (0, 1): not an underdamped "
+        return fail(name, model, f"decay ratio {mp:.3f} outside (0, 1): not an underdamped "
                      "second-order response", yf, pts)
     zeta = float(zeta_from_overshoot(mp))
     tau = (tm1 - tp1) * math.sqrt(1.0 - zeta * zeta) / math.pi

@@ -152,7 +152,7 @@ def unity_resistor(series: str, lo: float, hi: float) -> float:
     return float(vals[np.argmin(np.abs(np.log(vals / target)))])
 
 
-def _check_targets(kp, ti, td):
+def check_targets(kp, ti, td):
     """The sizing's precondition on gains from any source (a rule, the optimiser, a
     caller of this module); a user's gains were checked against their ranges by the spec."""
     for name, v, above, what in (("kp", kp, kp > 0, "a finite gain above 0"),
@@ -234,7 +234,7 @@ def continuous_parts(kp: float, ti_s: float, td_s: float, fn_hz: float, *,
     R11 C3 = Td, R14 C4 = Ti, corners as in :func:`designer.pid.selection.select_parts`, and Kp split
     between the summer and the final gain so that their noise gains match
     (1 + 3 g = 1 + Kp/g, g = sqrt(Kp/3); 1 + 2 g and g = sqrt(Kp/2) for a PI)."""
-    _check_targets(kp, ti_s, td_s)
+    check_targets(kp, ti_s, td_s)
     f_i = fn_hz * F_INTEGRATOR_RATIO if f_integrator_hz is None else f_integrator_hz
     f_d = fn_hz * F_DIFFERENTIATOR_RATIO if f_differentiator_hz is None else f_differentiator_hz
     has_d = td_s > 0

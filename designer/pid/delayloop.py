@@ -35,8 +35,8 @@ import numpy as np
 from ..core.errors import DesignError
 from ..core.jsonio import json_safe
 from ..core.metrics import step_metrics
-from .delaymargins import LoopParts, _band, _corners, _gain_crossovers, _log_grid, parse_loop
-from .model import LoopModel, _expm, _ss
+from .delaymargins import LoopParts, loop_band, corner_frequencies, gain_crossovers, log_grid, parse_loop
+from .model import LoopModel, balanced_expm, tf_to_ss
 
 #: derivative filter N to simulate an ideal PID with (an ideal PID is improper,
 #: so :func:`closed_loop_step` refuses it): ``pid_tf(kp, ti, td, SIM_N_FILTER)``
@@ -121,8 +121,8 @@ def _series(lp: LoopParts):
                           f"pid_tf(kp, ti, td, n_filter={SIM_N_FILTER:g})", "n_filter")
     if lp.np_.size > lp.dp.size:
         raise DesignError("the plant's rational part is improper (numerator of higher degree)")
-    ac, bc, cc, dc = _ss(lp.nc, lp.dc)
-    ap, bp, cp, dp = _ss(lp.np_, lp.dp)
+    ac, bc, cc, dc = tf_to_ss(lp.nc, lp.dc)
+    ap, bp, cp, dp = tf_to_ss(lp.np_, lp.dp)
     nc_, np_ = ac.shape[0], ap.shape[0]
     a = np.zeros((nc_ + np_, nc_ + np_))
     a[:nc_, :nc_] = ac
@@ -138,9 +138,9 @@ def _simulation_step(lp: LoopParts, fraction: float = STEP_FRACTION) -> float:
     """Largest time step (s) for a response accurate to about 1e-4 of the step:
     :data:`STEP_FRACTION`/w_ref (see there; ``fraction`` instead of it: the
     error goes as its square); the delay itself needs no resolution."""
-    lo, hi = _band(lp)
-    wc = _gain_crossovers(lp, _log_grid(lp, lo, hi))
-    c = _corners(lp)
+    lo, hi = loop_band(lp)
+    wc = gain_crossovers(lp, log_grid(lp, lo, hi))
+    c = corner_frequencies(lp)
     rates = np.abs(np.concatenate([lp.zeros, lp.poles]))
     rates = rates[rates > 0]
     base = float(wc.max()) if wc.size else float(c.min())
@@ -155,7 +155,7 @@ def _foh(a, b, dt):
     m[:n, :n] = a * dt
     m[:n, n] = b * dt
     m[n, n + 1] = 1.0
-    em = _expm(m)
+    em = balanced_expm(m)
     g1, g2 = em[:n, n], em[:n, n + 1]
     return em[:n, :n], g1 - g2, g2
 

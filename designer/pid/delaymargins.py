@@ -39,7 +39,7 @@ import numpy as np
 
 from ..core.errors import DesignError
 from ..core.jsonio import json_safe
-from .model import _trim
+from .model import trim_leading
 
 #: log-grid density (points per decade) of the crossing search
 POINTS_PER_DECADE = 200
@@ -53,7 +53,7 @@ LOOP_FLOOR = 1e-4
 MAX_PHASE_CROSSOVERS = 10
 #: most points of the dense grid
 MAX_GRID = 2_000_000
-#: a dead time counts as a corner only within this factor above the loop's fastest other corner (:func:`_corners`)
+#: a dead time counts as a corner only within this factor above the loop's fastest other corner (:func:`corner_frequencies`)
 DELAY_CORNER_SPAN = 1e8
 
 
@@ -79,7 +79,7 @@ class LoopParts:
 
 
 def _poly(p, what):
-    p = _trim(np.asarray(p, float))
+    p = trim_leading(np.asarray(p, float))
     if not np.all(np.isfinite(p)):
         raise DesignError(f"{what} has non-finite coefficients")
     return p
@@ -172,7 +172,7 @@ def _magnitude_bound(lp: LoopParts, w):
                  / np.prod(1 - np.abs(lp.poles) / w))
 
 
-def _corners(lp: LoopParts) -> np.ndarray:
+def corner_frequencies(lp: LoopParts) -> np.ndarray:
     """Frequencies (rad/s) where the loop's shape changes: |roots| (not at 0), 1/theta,
     and the crossover of the low-frequency asymptote |K0|/w^m."""
     r = np.abs(np.concatenate([lp.zeros, lp.poles]))
@@ -188,14 +188,14 @@ def _corners(lp: LoopParts) -> np.ndarray:
 
 def frequency_band(plant, controller) -> tuple:
     """Default band (w_lo, w_hi) in rad/s: two decades either side of the loop's
-    corners (:func:`_corners`), widened until every gain crossover is inside
+    corners (:func:`corner_frequencies`), widened until every gain crossover is inside
     (above w_hi the bound :func:`_magnitude_bound` is below 1; below w_lo the
     low-frequency asymptote is above 1)."""
-    return _band(parse_loop(plant, controller))
+    return loop_band(parse_loop(plant, controller))
 
 
-def _band(lp: LoopParts):
-    c = _corners(lp)
+def loop_band(lp: LoopParts):
+    c = corner_frequencies(lp)
     lo, hi = float(c.min()) / 100, float(c.max()) * 100
     for _ in range(30):
         if lp.degree_gap < 0 or (lp.degree_gap == 0 and abs(lp.lead) >= 1) or _magnitude_bound(lp, hi) < 1:
@@ -217,7 +217,7 @@ def _extra_frequencies(lp: LoopParts, lo, hi):
     return f[(f > lo) & (f < hi)]
 
 
-def _log_grid(lp: LoopParts, lo, hi):
+def log_grid(lp: LoopParts, lo, hi):
     n = max(2, int(math.ceil(math.log10(hi / lo) * POINTS_PER_DECADE)) + 1)
     return np.unique(np.concatenate([np.geomspace(lo, hi, n), _extra_frequencies(lp, lo, hi)]))
 
@@ -225,7 +225,7 @@ def _log_grid(lp: LoopParts, lo, hi):
 def _dense_grid(lp: LoopParts, lo, hi, lin_top):
     """Log grid on [lo, hi] and, with a delay, a linear grid up to ``lin_top`` fine
     enough that the delay turns the phase by at most :data:`PHASE_STEP` per step."""
-    w = _log_grid(lp, lo, hi)
+    w = log_grid(lp, lo, hi)
     if lp.theta > 0 and lin_top > lo:
         top = min(lin_top, hi)
         n = int(math.ceil(top * lp.theta / PHASE_STEP)) + 1
@@ -242,7 +242,7 @@ def _brentq(f, a, b):
     return brentq(f, a, b, xtol=1e-14 * b, rtol=1e-13)
 
 
-def _gain_crossovers(lp: LoopParts, w) -> np.ndarray:
+def gain_crossovers(lp: LoopParts, w) -> np.ndarray:
     """Every w (rad/s) in the grid's span where |L(jw)| = 1: sign changes of log|L|
     on ``w``, refined with brentq (|L| does not depend on the delay)."""
     with np.errstate(divide="ignore"):
@@ -306,14 +306,14 @@ def _rhp_roots(lp: LoopParts) -> float:
         return float(np.sum(r.real > 0))
     if lp.degree_gap < 0 or (lp.degree_gap == 0 and abs(lp.lead) >= 1):
         return math.inf
-    lo, hi = _band(lp)
+    lo, hi = loop_band(lp)
     # a top where |L| < 1 for good (the bound on the axis and the arc), then the last crossing below it
     top = max(hi, 2 * float(np.max(np.abs(lp.poles))) if lp.poles.size else hi)
     for _ in range(200):
         if _magnitude_bound(lp, top) < 1:
             break
         top *= 2
-    w = _log_grid(lp, lo, top)
+    w = log_grid(lp, lo, top)
     big = np.nonzero(np.abs(_response(lp, w)) >= 1)[0]
     wb = float(w[big[-1] + 1]) if big.size else lo
     grid = _dense_grid(lp, lo, wb, wb)
@@ -416,18 +416,18 @@ def loop_margins(plant, controller, w_min: float | None = None, w_max: float | N
     only lags).
     """
     lp = parse_loop(plant, controller)
-    lo, hi = _band(lp)
+    lo, hi = loop_band(lp)
     lo = float(w_min) if w_min is not None else lo
     hi = float(w_max) if w_max is not None else hi
     if not (0 < lo < hi and math.isfinite(hi)):
         raise DesignError(f"the band must satisfy 0 < w_min < w_max, got {lo}, {hi}", "w_min")
-    wl = _log_grid(lp, lo, hi)
+    wl = log_grid(lp, lo, hi)
     live = wl[np.abs(_response(lp, wl)) >= LOOP_FLOOR]
     lin_top = min(hi, 1.05 * float(live.max())) if live.size else lo
     w = _dense_grid(lp, lo, hi, lin_top)
     rhp = _rhp_roots(lp)
     stable = rhp == 0
-    wc = _gain_crossovers(lp, w)
+    wc = gain_crossovers(lp, w)
     if wc.size:
         pm = np.degrees(math.pi + _phase(lp, wc))
         i = int(np.argmin(pm))

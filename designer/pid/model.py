@@ -117,7 +117,7 @@ def controller_tf(parts: PidParts, opamp: OpAmp | None):
         num, den = np.polymul(num, n), np.polymul(den, d)
     g_y, g_r = difference_weights(parts)
     # ve = F (g_y y - g_r r) = -F g_r (r - y) when g_y = g_r
-    return _trim(-g_r * num), _trim(den)
+    return trim_leading(-g_r * num), trim_leading(den)
 
 
 @dataclass
@@ -145,7 +145,7 @@ class LoopModel:
         m[:n, :n] = self.a * dt
         m[:n, n:n + 1] = self.b * dt
         m[n, n + 1] = 1.0
-        return _expm(m)
+        return balanced_expm(m)
 
     def simulate_with_kick(self, t, r, t_fine, r_fine) -> tuple:
         """(:meth:`simulate` on ``t``, on ``t_fine``) with one matrix exponential: the fine grid's step is
@@ -215,7 +215,7 @@ def _constant_tail(phi, bsum, x0, rc, count):
     return blk[:, :count].T + xss
 
 
-def _expm(m):
+def balanced_expm(m):
     """expm with diagonal balancing first: companion-form blocks with poles
     from 1e2 to 1e7 rad/s make badly scaled matrices that expm squares many
     times (slow and less accurate)."""
@@ -230,12 +230,12 @@ def _expm(m):
     return (expm(b) * scale[:, None]) / scale[None, :]
 
 
-def _ss(num, den):
+def tf_to_ss(num, den):
     """(A, B, C, D) of num/den in controller canonical form, as ``scipy.signal.tf2ss``
     gives it (same arithmetic, so the same numbers), without importing scipy.signal."""
     num = np.atleast_1d(np.asarray(num, float))
     den = np.atleast_1d(np.asarray(den, float))
-    num, den = _trim(num), _trim(den)
+    num, den = trim_leading(num), trim_leading(den)
     if np.all(num == 0) or den.size == 1:   # a static gain has no states
         k = 0.0 if np.all(num == 0) else num[-1] / den[0]
         return np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.full((1, 1), k)
@@ -255,7 +255,7 @@ def _ss(num, den):
 def state_space(num, den, output: str = "y") -> LoopModel:
     """One transfer function as a :class:`LoopModel` with one output (for
     responses to the edged reference, which a closed-form step does not give)."""
-    return LoopModel(*_ss(num, den), (output,))
+    return LoopModel(*tf_to_ss(num, den), (output,))
 
 
 def assemble(parts: PidParts, opamp: OpAmp | None, plant_num, plant_den) -> LoopModel:
@@ -283,10 +283,10 @@ def assemble(parts: PidParts, opamp: OpAmp | None, plant_num, plant_den) -> Loop
     nx = 0
     for name in names:
         if name not in blocks:
-            mats.append((name, *_ss([0.0], [1.0]), {}))
+            mats.append((name, *tf_to_ss([0.0], [1.0]), {}))
             continue
         (num, den), ins = blocks[name]
-        a, b, c, d = _ss(num, den)
+        a, b, c, d = tf_to_ss(num, den)
         mats.append((name, a, b, c, d, ins))
         nx += a.shape[0]
     A = np.zeros((nx, nx))
@@ -386,10 +386,10 @@ def ideal_closed_loop(kp, ti, td, plant_num, plant_den):
     cn, cd = ideal_pid_tf(kp, ti, td)
     n = np.polymul(cn, plant_num)
     d = np.polyadd(np.polymul(cd, plant_den), n)
-    return _trim(n), _trim(d)
+    return trim_leading(n), trim_leading(d)
 
 
-def _trim(p):
+def trim_leading(p):
     p = np.atleast_1d(np.asarray(p, float))
     nz = np.nonzero(np.abs(p) > 1e-300)[0]
     return p[nz[0]:] if nz.size else np.array([0.0])

@@ -45,7 +45,7 @@ from ..spice.deck import SquareTest
 from . import blocks, model as M, rules, selection
 from .delayloop import closed_loop_step, pid_tf, step_figures
 from .delaymargins import loop_margins
-from .netlist import controller_netlist, model_loop_deck
+from .netlist import model_loop_deck
 from .process_notes import opamp_speed_notes, sizing_notes
 from .process_result import LoopFigures, ProcessPidResult, RobustCheck, RuleRow
 from .result import Achieved, Waveforms
@@ -440,7 +440,6 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
         test.check_simulable()
     t = np.linspace(0.0, min(test.half_period_s, 10 * max(t_long[-1], ts)), POINTS)
     r = M.reference(t, spec.step_v, 0.0, spec.edge_s)
-    rails = 2 * max(abs(amp.vcc), abs(amp.vee))
     if mg.stable:
         step = closed_loop_step(plant, sim_ctrl, t, spec.step_v)
         y = edged(t, step["y"], spec.edge_s)

@@ -55,15 +55,15 @@ from ..core.units import format_eng
 F63 = 1.0 - math.exp(-1.0)
 
 
-def _t(x: float) -> str:
+def format_seconds(x: float) -> str:
     return format_eng(x, "s")
 
 
-def _n(x: float) -> str:
+def format_number(x: float) -> str:
     return f"{x:.4g}"
 
 
-def _number(what: str, name: str, v, *, positive: bool = False, nonzero: bool = False) -> float:
+def check_number(what: str, name: str, v, *, positive: bool = False, nonzero: bool = False) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
         raise DesignError(f"{what}: {name} must be a number (got {v!r})", param=name)
     v = float(v)
@@ -91,17 +91,17 @@ class ModelFopdt:
     kind: ClassVar[str] = "fopdt"
 
     def __post_init__(self):
-        object.__setattr__(self, "K", _number("fopdt", "K", self.K, nonzero=True))
+        object.__setattr__(self, "K", check_number("fopdt", "K", self.K, nonzero=True))
         # a pure delay (tau = 0) has no FOPDT lag for the rules to divide by
-        object.__setattr__(self, "tau_s", _number("fopdt", "tau_s", self.tau_s, positive=True))
-        object.__setattr__(self, "theta_s", _number("fopdt", "theta_s", self.theta_s))
+        object.__setattr__(self, "tau_s", check_number("fopdt", "tau_s", self.tau_s, positive=True))
+        object.__setattr__(self, "theta_s", check_number("fopdt", "theta_s", self.theta_s))
 
     def tf(self):
         """(num, den, theta_s)."""
         return (self.K,), (self.tau_s, 1.0), self.theta_s
 
     def describe(self) -> str:
-        return f"FOPDT K {_n(self.K)}, tau {_t(self.tau_s)}, theta {_t(self.theta_s)}"
+        return f"FOPDT K {format_number(self.K)}, tau {format_seconds(self.tau_s)}, theta {format_seconds(self.theta_s)}"
 
     def to_dict(self) -> dict:
         return {"kind": self.kind, **asdict(self)}
@@ -118,20 +118,20 @@ class ModelSopdt:
     kind: ClassVar[str] = "sopdt"
 
     def __post_init__(self):
-        object.__setattr__(self, "K", _number("sopdt", "K", self.K, nonzero=True))
-        object.__setattr__(self, "tau1_s", _number("sopdt", "tau1_s", self.tau1_s, positive=True))
-        object.__setattr__(self, "tau2_s", _number("sopdt", "tau2_s", self.tau2_s))
-        object.__setattr__(self, "theta_s", _number("sopdt", "theta_s", self.theta_s))
+        object.__setattr__(self, "K", check_number("sopdt", "K", self.K, nonzero=True))
+        object.__setattr__(self, "tau1_s", check_number("sopdt", "tau1_s", self.tau1_s, positive=True))
+        object.__setattr__(self, "tau2_s", check_number("sopdt", "tau2_s", self.tau2_s))
+        object.__setattr__(self, "theta_s", check_number("sopdt", "theta_s", self.theta_s))
         if self.tau2_s > self.tau1_s:
-            raise DesignError(f"sopdt: tau1_s must be the larger time constant (got tau1 {_t(self.tau1_s)} "
-                              f"< tau2 {_t(self.tau2_s)}); swap them", param="tau1_s")
+            raise DesignError(f"sopdt: tau1_s must be the larger time constant (got tau1 {format_seconds(self.tau1_s)} "
+                              f"< tau2 {format_seconds(self.tau2_s)}); swap them", param="tau1_s")
 
     def tf(self):
         return (self.K,), tuple(np.polymul([self.tau1_s, 1.0], [self.tau2_s, 1.0]).tolist()), self.theta_s
 
     def describe(self) -> str:
-        return (f"SOPDT K {_n(self.K)}, tau1 {_t(self.tau1_s)}, tau2 {_t(self.tau2_s)}, "
-                f"theta {_t(self.theta_s)}")
+        return (f"SOPDT K {format_number(self.K)}, tau1 {format_seconds(self.tau1_s)}, tau2 {format_seconds(self.tau2_s)}, "
+                f"theta {format_seconds(self.theta_s)}")
 
     def to_dict(self) -> dict:
         return {"kind": self.kind, **asdict(self)}
@@ -147,17 +147,17 @@ class ModelIntegrating:
     kind: ClassVar[str] = "integrating"
 
     def __post_init__(self):
-        object.__setattr__(self, "K", _number("integrating", "K", self.K, nonzero=True))
-        object.__setattr__(self, "tau_s", _number("integrating", "tau_s", self.tau_s))
-        object.__setattr__(self, "theta_s", _number("integrating", "theta_s", self.theta_s))
+        object.__setattr__(self, "K", check_number("integrating", "K", self.K, nonzero=True))
+        object.__setattr__(self, "tau_s", check_number("integrating", "tau_s", self.tau_s))
+        object.__setattr__(self, "theta_s", check_number("integrating", "theta_s", self.theta_s))
 
     def tf(self):
         den = np.polymul([self.tau_s, 1.0], [1.0, 0.0]) if self.tau_s > 0 else np.array([1.0, 0.0])
         return (self.K,), tuple(den.tolist()), self.theta_s
 
     def describe(self) -> str:
-        return (f"integrating K {format_eng(self.K, '/s')}, tau {_t(self.tau_s)}, "
-                f"theta {_t(self.theta_s)}")
+        return (f"integrating K {format_eng(self.K, '/s')}, tau {format_seconds(self.tau_s)}, "
+                f"theta {format_seconds(self.theta_s)}")
 
     def to_dict(self) -> dict:
         return {"kind": self.kind, **asdict(self)}
@@ -180,7 +180,7 @@ class ModelTf:
                               "a plant model must be proper", param="num")
         object.__setattr__(self, "num", num)
         object.__setattr__(self, "den", den)
-        object.__setattr__(self, "theta_s", _number("tf", "theta_s", self.theta_s))
+        object.__setattr__(self, "theta_s", check_number("tf", "theta_s", self.theta_s))
 
     @classmethod
     def from_factors(cls, K: float, den_tc, num_tc=(), theta_s: float = 0.0,
@@ -204,7 +204,7 @@ class ModelTf:
         return self.num, self.den, self.theta_s
 
     def describe(self) -> str:
-        return f"model num {list(self.num)}, den {list(self.den)}, theta {_t(self.theta_s)}"
+        return f"model num {list(self.num)}, den {list(self.den)}, theta {format_seconds(self.theta_s)}"
 
     def to_dict(self) -> dict:
         return {"kind": self.kind, "num": list(self.num), "den": list(self.den), "theta_s": self.theta_s}
@@ -259,7 +259,7 @@ def from_process(model: ProcessModel) -> ModelFopdt | ModelSopdt | ModelIntegrat
 
 
 @dataclass(frozen=True)
-class _Factors:
+class Factors:
     gain: float               # static gain, or the velocity gain with one integrator
     integrators: int
     lags: tuple               # real stable time constants, descending, with multiplicity
@@ -272,7 +272,7 @@ class _Factors:
 
 
 @lru_cache(maxsize=512)
-def _factors(num: tuple, den: tuple) -> _Factors:
+def _factors(num: tuple, den: tuple) -> Factors:
     num_a, den_a = np.array(num), np.array(den)
     # exact trailing zeros are integrators (a typed 1/s), never a rounding artefact
     m = len(den_a) - len(np.trim_zeros(den_a, "b"))
@@ -297,11 +297,11 @@ def _factors(num: tuple, den: tuple) -> _Factors:
                 lhp.extend([-1.0 / z.real] * mult)
             else:
                 rhp.extend([1.0 / z.real] * mult)
-    return _Factors(gain, m, tuple(sorted(lags, reverse=True)), tuple(cplx), unstable,
+    return Factors(gain, m, tuple(sorted(lags, reverse=True)), tuple(cplx), unstable,
                     tuple(sorted(lhp, reverse=True)), tuple(sorted(rhp, reverse=True)), czero, z0)
 
 
-def _check_plant(model, what: str) -> _Factors:
+def check_plant(model, what: str) -> Factors:
     """Refusals that hold for every rule: unstable, double integrator, no gain, negative gain."""
     num, den, _ = model.tf()
     f = _factors(tuple(num), tuple(den))
@@ -313,7 +313,7 @@ def _check_plant(model, what: str) -> _Factors:
     if f.zeros_at_origin:
         raise DesignError(f"{what}: the model has a zero at s = 0 (no static gain): nothing to regulate")
     if f.gain < 0:
-        raise DesignError(f"{what}: the model's gain {_n(f.gain)} is negative; the rules are written for "
+        raise DesignError(f"{what}: the model's gain {format_number(f.gain)} is negative; the rules are written for "
                           "K > 0: tune the model with -K and reverse the controller's action")
     return f
 
@@ -348,12 +348,12 @@ class ModelTangent:
         """How L and T were read, with numbers."""
         if self.integrating:
             return [f"the steepest slope of an integrating step is its final one, Kv = {format_eng(self.K, '/s')}: "
-                    f"the tangent is the ramp asymptote Kv (t - L), L = {_t(self.L_s)}"]
-        out = [f"steepest point of the step at t = {_t(self.t_steepest_s)}, y = {_n(self.y_steepest)}, "
+                    f"the tangent is the ramp asymptote Kv (t - L), L = {format_seconds(self.L_s)}"]
+        out = [f"steepest point of the step at t = {format_seconds(self.t_steepest_s)}, y = {format_number(self.y_steepest)}, "
                f"slope {format_eng(self.slope_per_s, '/s')}",
-               f"L = t - y/slope = {_t(self.t_steepest_s)} - {_n(self.y_steepest)} / "
-               f"{format_eng(self.slope_per_s, '/s')} = {_t(self.L_s)}",
-               f"T = K/slope = {_n(self.K)} / {format_eng(self.slope_per_s, '/s')} = {_t(self.T_s)}"]
+               f"L = t - y/slope = {format_seconds(self.t_steepest_s)} - {format_number(self.y_steepest)} / "
+               f"{format_eng(self.slope_per_s, '/s')} = {format_seconds(self.L_s)}",
+               f"T = K/slope = {format_number(self.K)} / {format_eng(self.slope_per_s, '/s')} = {format_seconds(self.T_s)}"]
         return out
 
     def to_dict(self) -> dict:
@@ -376,7 +376,7 @@ def model_tangent(model) -> ModelTangent:
     """
     if not isinstance(model, MODEL_TYPES):
         raise DesignError(f"tangent: not a plant model ({type(model).__name__})")
-    f = _check_plant(model, "tangent")
+    f = check_plant(model, "tangent")
     if isinstance(model, ModelFopdt):
         K, tau, th = model.K, model.tau_s, model.theta_s
         return ModelTangent(K, th, tau, K / tau, th, 0.0, th + tau, 0.0)
@@ -493,15 +493,15 @@ def half_rule(model, order: int = 1) -> HalfRule:
         Complex poles or zeros (the rule takes real time constants), an
         unstable model, or nothing left after the cancellations.
     """
-    return _half_rule(model, order, "half rule")
+    return half_rule_of(model, order, "half rule")
 
 
-def _half_rule(model, order: int, what: str) -> HalfRule:
+def half_rule_of(model, order: int, what: str) -> HalfRule:
     if order not in (1, 2):
         raise DesignError(f"{what}: order must be 1 (FOPDT) or 2 (SOPDT), got {order!r}", param="order")
     if not isinstance(model, MODEL_TYPES):
         raise DesignError(f"{what}: not a plant model ({type(model).__name__})")
-    f = _check_plant(model, what)
+    f = check_plant(model, what)
     if f.complex_poles:
         wn, z = f.complex_poles[0]
         raise DesignError(f"{what}: the model has complex poles (zeta {z:.3g}, fn "
@@ -513,17 +513,17 @@ def _half_rule(model, order: int, what: str) -> HalfRule:
     return _half(f, float(theta0), order, what)
 
 
-def _half(f: _Factors, theta0: float, order: int, what: str) -> HalfRule:
+def _half(f: Factors, theta0: float, order: int, what: str) -> HalfRule:
     integ = f.integrators == 1
     steps = []
     lags = list(f.lags)
     if lags:
-        steps.append("denominator time constants " + ", ".join(_t(x) for x in lags)
+        steps.append("denominator time constants " + ", ".join(format_seconds(x) for x in lags)
                      + (" and an integrator" if integ else ""))
     theta_x = theta0 + sum(f.rhp_zeros)
     if f.rhp_zeros:
         steps.append("inverse-response zeros (-T0 s + 1) ~ e^(-T0 s): delay += "
-                     + " + ".join(_t(x) for x in f.rhp_zeros))
+                     + " + ".join(format_seconds(x) for x in f.rhp_zeros))
     gain = f.gain
     converged = True
     if f.lhp_zeros:
@@ -532,7 +532,7 @@ def _half(f: _Factors, theta0: float, order: int, what: str) -> HalfRule:
             cur, g, log = list(lags), 1.0, []
             for T0 in f.lhp_zeros:
                 if not cur:
-                    raise DesignError(f"{what}: the zero (T0 = {_t(T0)}) has no denominator time "
+                    raise DesignError(f"{what}: the zero (T0 = {format_seconds(T0)}) has no denominator time "
                                       "constant left to cancel against")
                 above = [x for x in cur if x >= T0]
                 tau0 = min(above) if above else max(cur)
@@ -541,9 +541,9 @@ def _half(f: _Factors, theta0: float, order: int, what: str) -> HalfRule:
                 g *= k
                 if new is not None:
                     cur.append(new)
-                log.append(f"zero T0 = {_t(T0)} against the lag tau0 = {_t(tau0)}, rule {name}: "
-                           + (f"lag {_t(new)}" if new is not None else "cancelled")
-                           + (f", gain x {_n(k)}" if k != 1.0 else ""))
+                log.append(f"zero T0 = {format_seconds(T0)} against the lag tau0 = {format_seconds(tau0)}, rule {name}: "
+                           + (f"lag {format_seconds(new)}" if new is not None else "cancelled")
+                           + (f", gain x {format_number(k)}" if k != 1.0 else ""))
             cur.sort(reverse=True)
             new_theta = _theta_of(cur, order, integ, theta_x)
             if math.isclose(new_theta, theta, rel_tol=1e-12, abs_tol=1e-15):
@@ -553,7 +553,7 @@ def _half(f: _Factors, theta0: float, order: int, what: str) -> HalfRule:
             converged = False
         lags, gain = cur, gain * g
         steps.extend(log)
-        steps.append(f"with the effective delay {_t(theta)} the zero rules use"
+        steps.append(f"with the effective delay {format_seconds(theta)} the zero rules use"
                      + ("" if converged else " (did not settle: the rules switch regime)"))
     if not lags and not integ:
         raise DesignError(f"{what}: after the half rule cancels the zeros no time constant is left: "
@@ -562,8 +562,8 @@ def _half(f: _Factors, theta0: float, order: int, what: str) -> HalfRule:
     keep = order - 1 if integ else order
     neglected = lags[keep:]
     if neglected:
-        steps.append(f"theta = {_t(theta_x)} + {_t(neglected[0])}/2"
-                     + ("".join(f" + {_t(x)}" for x in neglected[1:])) + f" = {_t(theta)}")
+        steps.append(f"theta = {format_seconds(theta_x)} + {format_seconds(neglected[0])}/2"
+                     + ("".join(f" + {format_seconds(x)}" for x in neglected[1:])) + f" = {format_seconds(theta)}")
     half = neglected[0] / 2.0 if neglected else 0.0
     if integ:
         if order == 1:
@@ -571,18 +571,18 @@ def _half(f: _Factors, theta0: float, order: int, what: str) -> HalfRule:
         else:
             tau = (lags[0] if lags else 0.0) + (half if lags else 0.0)
             if lags and len(lags) > 1:
-                steps.append(f"tau = {_t(lags[0])} + {_t(lags[1])}/2 = {_t(tau)}")
+                steps.append(f"tau = {format_seconds(lags[0])} + {format_seconds(lags[1])}/2 = {format_seconds(tau)}")
             m = ModelIntegrating(gain, tau, theta)
     elif order == 1:
         tau = lags[0] + half
         if len(lags) > 1:
-            steps.append(f"tau = {_t(lags[0])} + {_t(lags[1])}/2 = {_t(tau)}")
+            steps.append(f"tau = {format_seconds(lags[0])} + {format_seconds(lags[1])}/2 = {format_seconds(tau)}")
         m = ModelFopdt(gain, tau, theta)
     else:
         t1 = lags[0]
         t2 = (lags[1] if len(lags) > 1 else 0.0) + half
         if len(lags) > 2:
-            steps.append(f"tau2 = {_t(lags[1])} + {_t(lags[2])}/2 = {_t(t2)}")
+            steps.append(f"tau2 = {format_seconds(lags[1])} + {format_seconds(lags[2])}/2 = {format_seconds(t2)}")
         if t2 > t1:
             steps.append("tau2 came out larger than tau1: swapped")
             t1, t2 = t2, t1

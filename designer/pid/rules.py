@@ -79,8 +79,8 @@ from dataclasses import dataclass, field
 from ..core.errors import DesignError
 from ..core.process import ProcessModel
 from ..core.units import format_eng
-from .reduction import (MODEL_TYPES, ModelFopdt, ModelIntegrating, ModelSopdt, ModelTangent, _check_plant,
-                        _Factors, _half_rule, _n, _number, _t, from_process, model_tangent)
+from .reduction import (MODEL_TYPES, ModelFopdt, ModelIntegrating, ModelSopdt, ModelTangent, check_plant,
+                        Factors, half_rule_of, format_number, check_number, format_seconds, from_process, model_tangent)
 
 RULES = ("zn", "cohen-coon", "chr0", "chr20", "amigo", "simc", "imc")
 #: the rules read off the reaction curve (K, L and T of the tangent)
@@ -155,7 +155,7 @@ def parallel_to_series(kp: float, ti: float, td: float) -> tuple:
     if -1e-12 < disc < 0:   # Ti = 4 Td (tauI = tauD) up to rounding: a double real zero
         disc = 0.0
     if disc < 0:
-        raise DesignError(f"series form: Ti = {_t(ti)} < 4 Td = {_t(4 * td)}: the controller's zeros are "
+        raise DesignError(f"series form: Ti = {format_seconds(ti)} < 4 Td = {format_seconds(4 * td)}: the controller's zeros are "
                           "complex, there is no series (interacting) form")
     r = math.sqrt(disc)
     return kp * (1.0 + r) / 2.0, ti * (1.0 + r) / 2.0, ti * (1.0 - r) / 2.0
@@ -163,9 +163,9 @@ def parallel_to_series(kp: float, ti: float, td: float) -> tuple:
 
 def _conversion(kc, tau_i, tau_d):
     kp, ti, td = series_to_parallel(kc, tau_i, tau_d)
-    return (f"series -> parallel: Kp = Kc (1 + tauD/tauI) = {_n(kc)} x (1 + {_t(tau_d)} / {_t(tau_i)}) = {_n(kp)}; "
-            f"Ti = tauI + tauD = {_t(tau_i)} + {_t(tau_d)} = {_t(ti)}; "
-            f"Td = tauI tauD/(tauI + tauD) = {_t(tau_i)} x {_t(tau_d)} / {_t(ti)} = {_t(td)}")
+    return (f"series -> parallel: Kp = Kc (1 + tauD/tauI) = {format_number(kc)} x (1 + {format_seconds(tau_d)} / {format_seconds(tau_i)}) = {format_number(kp)}; "
+            f"Ti = tauI + tauD = {format_seconds(tau_i)} + {format_seconds(tau_d)} = {format_seconds(ti)}; "
+            f"Td = tauI tauD/(tauI + tauD) = {format_seconds(tau_i)} x {format_seconds(tau_d)} / {format_seconds(ti)} = {format_seconds(td)}")
 
 
 # ----------------------------------------------------------------------------- rules
@@ -176,7 +176,7 @@ def _no_L(rule, formula):
                        "use simc with tauc_s, or imc")
 
 
-def _oscillation_notes(rule, tg: ModelTangent | None, f: _Factors | None):
+def _oscillation_notes(rule, tg: ModelTangent | None, f: Factors | None):
     out = []
     if tg is not None and tg.overshoot_pct > 2.0:
         what = "slope" if tg.integrating else "step"
@@ -223,34 +223,34 @@ def _tune_reaction(model, rule, f):
     if T is None:   # zn on an integrating plant: a = Kv L
         a = K * L
         kp, ti, td = 1.2 / a, 2.0 * L, 0.5 * L
-        formulas = [f"a = Kv L = {format_eng(K, '/s')} x {_t(L)} = {_n(a)}",
-                    f"Kp = 1.2/a = 1.2 / {_n(a)} = {_n(kp)}",
-                    f"Ti = 2 L = 2 x {_t(L)} = {_t(ti)}", f"Td = 0.5 L = 0.5 x {_t(L)} = {_t(td)}"]
+        formulas = [f"a = Kv L = {format_eng(K, '/s')} x {format_seconds(L)} = {format_number(a)}",
+                    f"Kp = 1.2/a = 1.2 / {format_number(a)} = {format_number(kp)}",
+                    f"Ti = 2 L = 2 x {format_seconds(L)} = {format_seconds(ti)}", f"Td = 0.5 L = 0.5 x {format_seconds(L)} = {format_seconds(td)}"]
         notes.append("zn: Ziegler-Nichols' reaction curve needs only the steepest slope and L (a = slope x L), "
                      "so it applies to an integrating plant")
         return RuleTuning(rule, kp, ti, td, used, formulas, notes)
     r = L / T
-    kl = f"({_n(K)} x {_t(L)})"
+    kl = f"({format_number(K)} x {format_seconds(L)})"
     if rule == "zn":
         kp, ti, td = 1.2 * T / (K * L), 2.0 * L, 0.5 * L
-        formulas = [f"Kp = 1.2 T/(K L) = 1.2 x {_t(T)} / {kl} = {_n(kp)}",
-                    f"Ti = 2 L = 2 x {_t(L)} = {_t(ti)}", f"Td = 0.5 L = 0.5 x {_t(L)} = {_t(td)}"]
+        formulas = [f"Kp = 1.2 T/(K L) = 1.2 x {format_seconds(T)} / {kl} = {format_number(kp)}",
+                    f"Ti = 2 L = 2 x {format_seconds(L)} = {format_seconds(ti)}", f"Td = 0.5 L = 0.5 x {format_seconds(L)} = {format_seconds(td)}"]
     elif rule == "cohen-coon":
         kp = (T / (K * L)) * (4.0 / 3.0 + r / 4.0)
         ti = L * (32.0 + 6.0 * r) / (13.0 + 8.0 * r)
         td = 4.0 * L / (11.0 + 2.0 * r)
-        formulas = [f"Kp = (T/(K L)) (4/3 + L/(4 T)) = ({_t(T)} / {kl}) x (4/3 + {_n(r)}/4) = {_n(kp)}",
-                    f"Ti = L (32 + 6 L/T)/(13 + 8 L/T) = {_t(L)} x (32 + 6 x {_n(r)}) / (13 + 8 x {_n(r)}) "
-                    f"= {_t(ti)}",
-                    f"Td = 4 L/(11 + 2 L/T) = 4 x {_t(L)} / (11 + 2 x {_n(r)}) = {_t(td)}"]
+        formulas = [f"Kp = (T/(K L)) (4/3 + L/(4 T)) = ({format_seconds(T)} / {kl}) x (4/3 + {format_number(r)}/4) = {format_number(kp)}",
+                    f"Ti = L (32 + 6 L/T)/(13 + 8 L/T) = {format_seconds(L)} x (32 + 6 x {format_number(r)}) / (13 + 8 x {format_number(r)}) "
+                    f"= {format_seconds(ti)}",
+                    f"Td = 4 L/(11 + 2 L/T) = 4 x {format_seconds(L)} / (11 + 2 x {format_number(r)}) = {format_seconds(td)}"]
     elif rule == "chr0":
         kp, ti, td = 0.6 * T / (K * L), T, 0.5 * L
-        formulas = [f"Kp = 0.6 T/(K L) = 0.6 x {_t(T)} / {kl} = {_n(kp)}",
-                    f"Ti = T = {_t(ti)}", f"Td = 0.5 L = 0.5 x {_t(L)} = {_t(td)}"]
+        formulas = [f"Kp = 0.6 T/(K L) = 0.6 x {format_seconds(T)} / {kl} = {format_number(kp)}",
+                    f"Ti = T = {format_seconds(ti)}", f"Td = 0.5 L = 0.5 x {format_seconds(L)} = {format_seconds(td)}"]
     else:
         kp, ti, td = 0.95 * T / (K * L), 1.4 * T, 0.47 * L
-        formulas = [f"Kp = 0.95 T/(K L) = 0.95 x {_t(T)} / {kl} = {_n(kp)}",
-                    f"Ti = 1.4 T = 1.4 x {_t(T)} = {_t(ti)}", f"Td = 0.47 L = 0.47 x {_t(L)} = {_t(td)}"]
+        formulas = [f"Kp = 0.95 T/(K L) = 0.95 x {format_seconds(T)} / {kl} = {format_number(kp)}",
+                    f"Ti = 1.4 T = 1.4 x {format_seconds(T)} = {format_seconds(ti)}", f"Td = 0.47 L = 0.47 x {format_seconds(L)} = {format_seconds(td)}"]
     notes.extend(_range_note(rule, L, T))
     return RuleTuning(rule, kp, ti, td, used, formulas, notes)
 
@@ -269,27 +269,27 @@ def _tune_amigo(model, f):
         else:
             K, L, T = tg.K, max(tg.L_s, 0.0), tg.t63_s - max(tg.L_s, 0.0)
             if T <= 0:
-                raise DesignError(f"amigo: the step reaches 63 % (t = {_t(tg.t63_s)}) before the tangent's L "
-                                  f"= {_t(L)}: no FOTD model for the rule")
+                raise DesignError(f"amigo: the step reaches 63 % (t = {format_seconds(tg.t63_s)}) before the tangent's L "
+                                  f"= {format_seconds(L)}: no FOTD model for the rule")
             steps = tuple(tg.steps()[:2]) + (
-                f"t63 = {_t(tg.t63_s)} (63.2 % of K), T = t63 - L = {_t(tg.t63_s)} - {_t(L)} = {_t(T)}",)
+                f"t63 = {format_seconds(tg.t63_s)} (63.2 % of K), T = t63 - L = {format_seconds(tg.t63_s)} - {format_seconds(L)} = {format_seconds(T)}",)
             used = ModelUsed(ModelFopdt(K, T, L), TANGENT_T63, steps)
     if L <= 0:
         raise _no_L("amigo", "Kp = 0.45/(Kv L)" if T is None else "Kp = (0.2 + 0.45 T/L)/K")
     notes = _oscillation_notes("amigo", tg, f)
     if T is None:
         kp, ti, td = 0.45 / (K * L), 8.0 * L, 0.5 * L
-        formulas = [f"Kp = 0.45/(Kv L) = 0.45 / ({format_eng(K, '/s')} x {_t(L)}) = {_n(kp)}",
-                    f"Ti = 8 L = 8 x {_t(L)} = {_t(ti)}", f"Td = 0.5 L = 0.5 x {_t(L)} = {_t(td)}"]
+        formulas = [f"Kp = 0.45/(Kv L) = 0.45 / ({format_eng(K, '/s')} x {format_seconds(L)}) = {format_number(kp)}",
+                    f"Ti = 8 L = 8 x {format_seconds(L)} = {format_seconds(ti)}", f"Td = 0.5 L = 0.5 x {format_seconds(L)} = {format_seconds(td)}"]
         notes.append("amigo: the integrating-process form (the T -> infinity limit of the FOTD rule)")
     else:
         kp = (0.2 + 0.45 * T / L) / K
         ti = L * (0.4 * L + 0.8 * T) / (L + 0.1 * T)
         td = 0.5 * L * T / (0.3 * L + T)
-        formulas = [f"Kp = (0.2 + 0.45 T/L)/K = (0.2 + 0.45 x {_t(T)} / {_t(L)}) / {_n(K)} = {_n(kp)}",
-                    f"Ti = L (0.4 L + 0.8 T)/(L + 0.1 T) = {_t(L)} x (0.4 x {_t(L)} + 0.8 x {_t(T)}) / "
-                    f"({_t(L)} + 0.1 x {_t(T)}) = {_t(ti)}",
-                    f"Td = 0.5 L T/(0.3 L + T) = 0.5 x {_t(L)} x {_t(T)} / (0.3 x {_t(L)} + {_t(T)}) = {_t(td)}"]
+        formulas = [f"Kp = (0.2 + 0.45 T/L)/K = (0.2 + 0.45 x {format_seconds(T)} / {format_seconds(L)}) / {format_number(K)} = {format_number(kp)}",
+                    f"Ti = L (0.4 L + 0.8 T)/(L + 0.1 T) = {format_seconds(L)} x (0.4 x {format_seconds(L)} + 0.8 x {format_seconds(T)}) / "
+                    f"({format_seconds(L)} + 0.1 x {format_seconds(T)}) = {format_seconds(ti)}",
+                    f"Td = 0.5 L T/(0.3 L + T) = 0.5 x {format_seconds(L)} x {format_seconds(T)} / (0.3 x {format_seconds(L)} + {format_seconds(T)}) = {format_seconds(td)}"]
     return RuleTuning("amigo", kp, ti, td, used, formulas, notes)
 
 
@@ -297,15 +297,15 @@ def _simc_model(model):
     """The model SIMC is applied to: given, or the half rule's (SOPDT when tau2 > theta)."""
     if isinstance(model, (ModelFopdt, ModelSopdt, ModelIntegrating)):
         return ModelUsed(model, GIVEN), []
-    hr2 = _half_rule(model, 2, "simc")
+    hr2 = half_rule_of(model, 2, "simc")
     m2 = hr2.model
     tau2 = m2.tau2_s if isinstance(m2, ModelSopdt) else m2.tau_s
     if tau2 > m2.theta_s:
-        why = (f"simc: the half rule's second-order model has tau2 = {_t(tau2)} > theta = {_t(m2.theta_s)}, "
+        why = (f"simc: the half rule's second-order model has tau2 = {format_seconds(tau2)} > theta = {format_seconds(m2.theta_s)}, "
                "so derivative action pays (Skogestad 2003): PID on it")
         return ModelUsed(m2, HALF_RULE, hr2.steps), [why]
-    hr1 = _half_rule(model, 1, "simc")
-    why = (f"simc: the half rule's second-order model has tau2 = {_t(tau2)} <= theta = {_t(m2.theta_s)}: "
+    hr1 = half_rule_of(model, 1, "simc")
+    why = (f"simc: the half rule's second-order model has tau2 = {format_seconds(tau2)} <= theta = {format_seconds(m2.theta_s)}: "
            "PI on the first-order model (Skogestad 2003)")
     return ModelUsed(hr1.model, HALF_RULE, hr1.steps), [why]
 
@@ -320,28 +320,28 @@ def _tune_simc(model, f, tauc_s):
                               "theta)) divides by zero; give tauc_s (the closed-loop time constant wanted), "
                               "or use imc", param="tauc_s")
         tc = theta
-        tc_line = f"tauc = theta = {_t(tc)} (Skogestad's default: tight control, good robustness)"
+        tc_line = f"tauc = theta = {format_seconds(tc)} (Skogestad's default: tight control, good robustness)"
     else:
-        tc = _number("simc", "tauc_s", tauc_s, positive=True)
-        tc_line = f"tauc = {_t(tc)} (given)"
+        tc = check_number("simc", "tauc_s", tauc_s, positive=True)
+        tc_line = f"tauc = {format_seconds(tc)} (given)"
     s = tc + theta
     formulas = [tc_line]
     if isinstance(m, ModelIntegrating):
         kc, tau_i = 1.0 / (m.K * s), 4.0 * s
         tau_d = m.tau_s
-        formulas += [f"Kc = 1/(K' (tauc + theta)) = 1 / ({format_eng(m.K, '/s')} x ({_t(tc)} + {_t(theta)})) "
-                     f"= {_n(kc)}",
-                     f"tauI = 4 (tauc + theta) = 4 x ({_t(tc)} + {_t(theta)}) = {_t(tau_i)}"]
-        formulas.append(f"tauD = tau = {_t(tau_d)}" if tau_d > 0 else "tauD = 0 (a PI)")
+        formulas += [f"Kc = 1/(K' (tauc + theta)) = 1 / ({format_eng(m.K, '/s')} x ({format_seconds(tc)} + {format_seconds(theta)})) "
+                     f"= {format_number(kc)}",
+                     f"tauI = 4 (tauc + theta) = 4 x ({format_seconds(tc)} + {format_seconds(theta)}) = {format_seconds(tau_i)}"]
+        formulas.append(f"tauD = tau = {format_seconds(tau_d)}" if tau_d > 0 else "tauD = 0 (a PI)")
     else:
         tau1 = m.tau1_s if isinstance(m, ModelSopdt) else m.tau_s
         tau_d = m.tau2_s if isinstance(m, ModelSopdt) else 0.0
         kc, tau_i = tau1 / (m.K * s), min(tau1, 4.0 * s)
         t1 = "tau1" if isinstance(m, ModelSopdt) else "tau"
-        formulas += [f"Kc = {t1}/(K (tauc + theta)) = {_t(tau1)} / ({_n(m.K)} x ({_t(tc)} + {_t(theta)})) "
-                     f"= {_n(kc)}",
-                     f"tauI = min({t1}, 4 (tauc + theta)) = min({_t(tau1)}, {_t(4.0 * s)}) = {_t(tau_i)}"]
-        formulas.append(f"tauD = tau2 = {_t(tau_d)}" if isinstance(m, ModelSopdt) else "tauD = 0 (a PI)")
+        formulas += [f"Kc = {t1}/(K (tauc + theta)) = {format_seconds(tau1)} / ({format_number(m.K)} x ({format_seconds(tc)} + {format_seconds(theta)})) "
+                     f"= {format_number(kc)}",
+                     f"tauI = min({t1}, 4 (tauc + theta)) = min({format_seconds(tau1)}, {format_seconds(4.0 * s)}) = {format_seconds(tau_i)}"]
+        formulas.append(f"tauD = tau2 = {format_seconds(tau_d)}" if isinstance(m, ModelSopdt) else "tauD = 0 (a PI)")
     kp, ti, td = series_to_parallel(kc, tau_i, tau_d)
     notes += _oscillation_notes("simc", None, f)
     return RuleTuning("simc", kp, ti, td, used, formulas, notes, (kc, tau_i, tau_d),
@@ -355,33 +355,33 @@ def _tune_imc(model, f, lambda_s):
     if isinstance(model, ModelFopdt):
         used = ModelUsed(model, GIVEN)
     else:
-        hr = _half_rule(model, 1, "imc")
+        hr = half_rule_of(model, 1, "imc")
         used = ModelUsed(hr.model, HALF_RULE, hr.steps)
     m = used.model
     K, tau, theta = m.K, m.tau_s, m.theta_s
     if lambda_s is None:
         lam = max(0.25 * theta, 0.2 * tau)
-        lam_line = (f"lambda = max(0.25 theta, 0.2 tau) = max({_t(0.25 * theta)}, {_t(0.2 * tau)}) = {_t(lam)} "
+        lam_line = (f"lambda = max(0.25 theta, 0.2 tau) = max({format_seconds(0.25 * theta)}, {format_seconds(0.2 * tau)}) = {format_seconds(lam)} "
                     "(default)")
     else:
-        lam = _number("imc", "lambda_s", lambda_s, positive=True)
-        lam_line = f"lambda = {_t(lam)} (given)"
+        lam = check_number("imc", "lambda_s", lambda_s, positive=True)
+        lam_line = f"lambda = {format_seconds(lam)} (given)"
     kp = (2.0 * tau + theta) / (2.0 * K * (lam + theta))
     ti = tau + theta / 2.0
     td = tau * theta / (2.0 * tau + theta)
     formulas = [lam_line,
-                f"Kp = (2 tau + theta)/(2 K (lambda + theta)) = (2 x {_t(tau)} + {_t(theta)}) / (2 x {_n(K)} x "
-                f"({_t(lam)} + {_t(theta)})) = {_n(kp)}",
-                f"Ti = tau + theta/2 = {_t(tau)} + {_t(theta)}/2 = {_t(ti)}",
-                f"Td = tau theta/(2 tau + theta) = {_t(tau)} x {_t(theta)} / (2 x {_t(tau)} + {_t(theta)}) "
-                f"= {_t(td)}"]
+                f"Kp = (2 tau + theta)/(2 K (lambda + theta)) = (2 x {format_seconds(tau)} + {format_seconds(theta)}) / (2 x {format_number(K)} x "
+                f"({format_seconds(lam)} + {format_seconds(theta)})) = {format_number(kp)}",
+                f"Ti = tau + theta/2 = {format_seconds(tau)} + {format_seconds(theta)}/2 = {format_seconds(ti)}",
+                f"Td = tau theta/(2 tau + theta) = {format_seconds(tau)} x {format_seconds(theta)} / (2 x {format_seconds(tau)} + {format_seconds(theta)}) "
+                f"= {format_seconds(td)}"]
     notes = _oscillation_notes("imc", None, f)
     if theta > 0:
         tf_ = lam * theta / (2.0 * (lam + theta))
         notes.append(f"imc: the rule's PID comes with a filter 1/(tauF s + 1), tauF = lambda theta/(2 (lambda + "
-                     f"theta)) = {_t(tf_)}, not part of Kp, Ti, Td")
+                     f"theta)) = {format_seconds(tf_)}, not part of Kp, Ti, Td")
         if lam < 0.25 * theta:
-            notes.append(f"imc: lambda = {_t(lam)} is below 0.25 theta = {_t(0.25 * theta)}, the table's bound "
+            notes.append(f"imc: lambda = {format_seconds(lam)} is below 0.25 theta = {format_seconds(0.25 * theta)}, the table's bound "
                          "for this PID: expect a poorly damped loop")
     else:
         notes.append("imc: theta = 0, so the PID is a PI (Td = 0) with Kp = tau/(K lambda), Ti = tau")
@@ -424,7 +424,7 @@ def tune_model(model, rule: str, *, tauc_s: float | None = None,
     if not isinstance(model, MODEL_TYPES):
         raise DesignError(f"{key}: not a plant model ({type(model).__name__}); use ModelFopdt, ModelSopdt, "
                           "ModelIntegrating, ModelTf or a ProcessModel")
-    f = _check_plant(model, key)
+    f = check_plant(model, key)
     if key in REACTION_CURVE_RULES:
         return _tune_reaction(model, key, f)
     if key == "amigo":

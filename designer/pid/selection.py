@@ -30,7 +30,7 @@ import numpy as np
 
 from ..core import eseries
 from ..core.errors import DesignError
-from .blocks import F_DIFFERENTIATOR_RATIO, F_INTEGRATOR_RATIO, PidParts, _check_targets, unity_resistor
+from .blocks import F_DIFFERENTIATOR_RATIO, F_INTEGRATOR_RATIO, PidParts, check_targets, unity_resistor
 
 
 #: R12 and R13 (set only by the corners) stay at or below this: with bipolar
@@ -161,7 +161,7 @@ def select_parts(kp: float, ti_s: float, td_s: float, fn_hz: float, *,
     -------
     Selection
     """
-    _check_targets(kp, ti_s, td_s)
+    check_targets(kp, ti_s, td_s)
     r_series = eseries.series_name(r_series)
     c_series = eseries.series_name(c_series)
     if not (0 < r_min <= r_max) or not (0 < c_min <= c_max):

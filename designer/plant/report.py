@@ -95,13 +95,13 @@ def _settings(result) -> list:
     sine = result.sine
     rows = bench_rows(result.test, result.scope, "R1")
     if sine is not None:
-        rows.append(["sine check", _sine_text(sine)])
+        rows.append(["sine check", sine_text(sine)])
     return [R.table(["set", "to"], rows, "compact"),
             R.text("Set the generator's output to High-Z (not 50 ohm): in 50-ohm mode it shows half the amplitude "
                    "it really gives into this circuit's high input impedance; check the level on CH1.")]
 
 
-def _sine_text(sine) -> str:
+def sine_text(sine) -> str:
     head = f"sine {format_eng(sine.amplitude_v, 'V')} pk"
     parts = []
     if sine.f_peak_hz is not None:

@@ -6,7 +6,7 @@ A LocalCluster's workers are threads of the command where a chunk's work is a
 simulator subprocess, else processes forked from a fork server that imported
 the engine once (:data:`WORKERS`); they are adopted so that nothing of the
 cluster outlives the command. Tasks are the runner's chunks
-(:func:`designer.tolerance.runner.run_chunk`): a chunk whose worker dies is
+(:func:`designer.tolerance.chunks.run_chunk`): a chunk whose worker dies is
 submitted once more, then it is a :class:`~designer.core.errors.SimulatorError`
 naming it. An address where no Dask scheduler answers within :data:`CONNECT_TIMEOUT`
 seconds is one too (:func:`probe`: nothing listening, nothing answering, or something else, such
@@ -23,7 +23,7 @@ import struct
 import time
 
 from ..core.errors import DesignError, SimulatorError
-from .runner import Scale, _die_twice, run_chunk
+from .chunks import lost_twice, run_chunk
 
 #: seconds a Dask scheduler has to answer
 CONNECT_TIMEOUT = 3.0
@@ -313,8 +313,8 @@ _ahead = None
 
 
 @contextlib.contextmanager
-def cluster_ahead(scale: Scale | None):
-    """For ``--dask local`` (``scale``; anything else: nothing), start the LocalCluster now, in
+def cluster_ahead(scale):
+    """For ``--dask local`` (``scale``, a :class:`~designer.tolerance.runner.Scale`; anything else: nothing), start the LocalCluster now, in
     its thread, while the command does other work (its design, its SPICE run), so that the
     Monte Carlo's :class:`Runner` finds it started (``bench_tolerance``: the start is most of
     what a LocalCluster adds to a short run). Whatever ends the block, a cluster no runner took
@@ -378,7 +378,7 @@ class DaskPool:
 
     def map(self, evaluate, context, draw, tasks, bar):
         def lost(i, why):
-            raise _die_twice(*tasks[i], why)
+            raise lost_twice(*tasks[i], why)
 
         def done(i, _result):
             if bar is not None:

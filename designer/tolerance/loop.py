@@ -265,10 +265,10 @@ def evaluate(context: LoopContext, values: dict) -> dict:
     return out
 
 
-def _passed(figs: dict, limits) -> np.ndarray:
+def stable_and_inside(figs: dict, limits) -> np.ndarray:
     """Stable and inside every limit."""
-    from .montecarlo import _yield
-    return (figs["stable"] == 1) & _yield(figs, limits)
+    from .montecarlo import inside_limits
+    return (figs["stable"] == 1) & inside_limits(figs, limits)
 
 
 def _model_evaluate(result, values: dict) -> dict:
@@ -311,7 +311,7 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
     limits = tuple(parse_loop_limit(t) for t in limit_items or ())
     nominal = loop_parts(result, tol_items)
     tol = resolve(tol_items, nominal, series)
-    until, first = target_plan(target_ci, limits, sampler, n, lambda figs: _passed(figs, limits))
+    until, first = target_plan(target_ci, limits, sampler, n, lambda figs: stable_and_inside(figs, limits))
     name, chunk_fn, context = engine or ("analytic", *engine_of(result))
     n_max, n = n, first
     with Runner(scale or Scale()) as run:
@@ -329,7 +329,7 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
             k = int(np.count_nonzero(figs[flag] == value))
             return {"count": k, "fraction": k / n, "ci95": list(wilson(k, n))}
         mc = LoopMonteCarlo(n, seed, sampler, dist, name, tol, nominal, values, figs, nominal_figs, limits,
-                            stats, _passed(figs, limits) if limits else None, shares,
+                            stats, stable_and_inside(figs, limits) if limits else None, shares,
                             failing_samples(figs, limits),
                             p_unstable=share("stable", 0), p_saturated=share("saturated", 1),
                             unstable_samples=[int(i) for i in np.nonzero(figs["stable"] == 0)[0][:5]],
@@ -344,11 +344,11 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
                 halved = dict(tol.of, **{ref: tol.of[ref] / 2})
                 _, f, _ = run.run(t_fn, t_ctx, Draw(nominal, halved, n_max, seed, sampler, dist), n,
                                   progress=False)
-                y = float(np.mean(_passed(f, t_lim)))
+                y = float(np.mean(stable_and_inside(f, t_lim)))
                 if best is None or y > best[1]:
                     best = (ref, y)
             mc.tighten = {"part": best[0], "tolerance_pct": 100 * tol.of[best[0]] / 2, "yield": best[1],
-                          "yield_now": float(np.mean(_passed(figs, t_lim))), "tried": tried}
+                          "yield_now": float(np.mean(stable_and_inside(figs, t_lim))), "tried": tried}
     return mc
 
 

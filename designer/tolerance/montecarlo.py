@@ -117,17 +117,33 @@ class MonteCarlo:
                 t = mc.tighten
                 out.append(f"  buy {t['part']} tighter: at {t['tolerance_pct']:g} % the yield is {100 * t['yield']:.2f} %")
         if mc.spice is not None:
-            from .spice_mc import spice_lines
             out += spice_lines(mc)
         return out
 
 
-def _figures(values: dict, fixed: dict, opamp) -> dict:
+def spice_lines(mc) -> list:
+    """The summary's lines on SPICE's part of a Monte Carlo."""
+    s = mc.spice
+    out = [f"  engine {s['engine']}: ngspice ({s['simulator']}), rising half, max step {s['max_step_s']:.3g} s"
+           + (f"; SPICE on {s['samples_checked']} samples ({len(s['worst'])} from the tails, "
+              f"{len(s['random'])} random)" if "samples_checked" in s else "")]
+    for k, d in (s.get("disagreement") or {}).items():
+        if d.get("compared"):
+            rel = "" if d["max_abs_rel"] is None else f" ({100 * d['max_abs_rel']:.3g} %)"
+            out.append(f"    SPICE - model, {k}: mean {d['mean']:.3g}, largest {d['max_abs']:.3g}{rel} "
+                       f"at sample {d['worst_sample']}")
+    if "yield_shift_pp" in s:
+        out.append(f"    yield: model {100 * s['yield_model']:.2f} %, with SPICE {100 * s['yield_with_spice']:.2f} % "
+                   f"({s['yield_shift_pp']:+.2f} pp)")
+    return out
+
+
+def figures_with_fixed(values: dict, fixed: dict, opamp) -> dict:
     return engine.plant_figures({**{k: np.full(next(iter(values.values())).shape, v) for k, v in fixed.items()},
                                  **values}, opamp)
 
 
-def _yield(figs: dict, limits) -> np.ndarray:
+def inside_limits(figs: dict, limits) -> np.ndarray:
     ok = np.ones(next(iter(figs.values())).shape, bool)
     for lim in limits:
         ok &= lim.inside(figs[lim.figure])
@@ -197,14 +213,14 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     if "SR" in nominal and evaluate is None:
         raise DesignError(NO_SLEW)
     tol = resolve(tol_items, nominal, series)
-    until, first = target_plan(target_ci, limits, sampler, n, lambda figs: _yield(figs, limits))
+    until, first = target_plan(target_ci, limits, sampler, n, lambda figs: inside_limits(figs, limits))
     # another engine's evaluate(values) travels to the workers as the context of _apply
-    chunk_fn, context = (engine.evaluate, opamp) if evaluate is None else (_apply, evaluate)
+    chunk_fn, context = (engine.evaluate, opamp) if evaluate is None else (apply_engine, evaluate)
     with runner.Runner(scale or runner.Scale()) as run:
         values, figs, ends = run.run(chunk_fn, context, runner.Draw(nominal, tol.of, n, seed, sampler, dist),
                                      first, until)
         mc = _analyse(seed, sampler, dist, tol, nominal, values, figs, limits,
-                      evaluate or (lambda v: _figures(v, {}, opamp)), engine_name)
+                      evaluate or (lambda v: figures_with_fixed(v, {}, opamp)), engine_name)
         mc.record_target(target_ci, n, ends)
         if tighten and limits:
             mc.tighten = _tighten(run, mc, opamp, n)
@@ -213,7 +229,7 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     return mc
 
 
-def _apply(evaluate, values: dict) -> dict:
+def apply_engine(evaluate, values: dict) -> dict:
     """The runner's chunk function for an engine given as ``evaluate(values)`` (a picklable partial)."""
     return evaluate(values)
 
@@ -297,7 +313,7 @@ def _analyse(seed, sampler, dist, tol, nominal, values, figs, limits, figure_of,
     rel = {r: values[r] / nominal[r] - 1 for r in values}
     shares = {k: variance_shares(rel, figs[k]) for k in (by_fig or ("fn_hz", "zeta", "overshoot_pct"))}
     mc = MonteCarlo(n, seed, sampler, dist, engine_name, tol, nominal, values, figs, nominal_figs, limits, stats,
-                    _yield(figs, limits) if limits else None, shares)
+                    inside_limits(figs, limits) if limits else None, shares)
     mc.failing.update(failing_samples(figs, limits, WORST))
     return mc
 
@@ -317,7 +333,7 @@ def _tighten(run, mc: MonteCarlo, opamp, n_max: int) -> dict:
     for ref, t in mc.tolerances.of.items():
         draw = runner.Draw(mc.nominal, dict(mc.tolerances.of, **{ref: t / 2}), n_max, mc.seed, mc.sampler, mc.dist)
         _, figs, _ = run.run(engine.evaluate, opamp, draw, mc.n, progress=False)
-        y = float(np.mean(_yield(figs, mc.limits)))
+        y = float(np.mean(inside_limits(figs, mc.limits)))
         if best is None or y > best[1]:
             best = (ref, y)
     return {"part": best[0], "tolerance_pct": 100 * mc.tolerances.of[best[0]] / 2, "yield": best[1],

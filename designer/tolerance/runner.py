@@ -38,8 +38,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.errors import DesignError, SimulatorError
+from ..core.errors import DesignError
 from . import sampling
+from .chunks import lost_twice, run_chunk
 
 #: the most local worker processes
 MAX_JOBS = 64
@@ -119,17 +120,6 @@ def parse_jobs(text) -> int:
     if jobs is None or not 1 <= jobs <= MAX_JOBS:
         raise DesignError(f"--jobs {text!r}: give a whole number of worker processes, 1 to {MAX_JOBS}")
     return jobs
-
-
-def run_chunk(evaluate, context, draw: Draw, start: int, stop: int) -> dict:
-    """One chunk's task: samples start .. stop - 1 drawn, then evaluated.
-    Returns ``{"values": {designator: array}, "figures": {figure: array}}``."""
-    values = draw.values(start, stop)
-    return {"values": values, "figures": evaluate(context, values)}
-
-
-def _die_twice(start: int, stop: int, why: str):
-    return SimulatorError(f"Monte Carlo: the chunk of samples {start}..{stop - 1} was lost twice ({why})")
 
 
 class _Lost:
@@ -281,7 +271,7 @@ class _ProcessPool:
                              lambda _t, why: _Lost(why), done=done)
             for i, r in zip(again, redo):
                 if isinstance(r, _Lost):
-                    raise _die_twice(*tasks[i], r.reason)
+                    raise lost_twice(*tasks[i], r.reason)
                 out[i] = r
         return out
 

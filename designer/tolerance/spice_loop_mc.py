@@ -79,7 +79,7 @@ def loop_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler
     and ``spice_k`` random builds only (``both``). ``scale``, ``target_ci``: where the builds run and
     ``--target-ci`` (:mod:`designer.tolerance.runner`). Returns a :class:`~designer.tolerance.loop.LoopMonteCarlo`
     (its ``spice``: the module docstring)."""
-    from .loop import _passed, engine_of, loop_monte_carlo, loop_parts
+    from .loop import stable_and_inside, engine_of, loop_monte_carlo, loop_parts
     from .spice_mc import ENGINES, disagreement, run_picked, spice_checked, spice_samples
     if engine not in ENGINES:
         raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
@@ -100,7 +100,7 @@ def loop_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler
         idx = np.array(sorted(worst + rand), int)
         sp = run_picked(mc, idx, spice_loop.evaluate, ctx, scale)
         model_pass = mc.passed[idx]
-        spice_pass = _passed(sp, limits)
+        spice_pass = stable_and_inside(sp, limits)
         disagree = disagreement(_spice_figures(sp), {f: v[idx] for f, v in _model_figures(mc.figures).items()},
                                 idx, STEP)
         mc.spice = {**settings, **spice_checked(idx, worst, rand, model_pass, spice_pass, mc.yield_count, n,
@@ -120,7 +120,7 @@ def loop_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler
         mc.spice["disagreement"] = disagreement(_spice_figures(mc.figures), _model_figures(mc.figures),
                                                 np.arange(mc.n), STEP)
         if limits:
-            y_model = int(np.count_nonzero(_passed(mc.figures, models)))
+            y_model = int(np.count_nonzero(stable_and_inside(mc.figures, models)))
             mc.spice.update(yield_model=y_model / mc.n, yield_with_spice=mc.yield_count / mc.n,
                             yield_shift_pp=100 * (mc.yield_count - y_model) / mc.n)
     return mc

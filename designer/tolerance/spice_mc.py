@@ -34,8 +34,8 @@ def plant_chunk(ctx, opamp, values: dict, start: int = 0) -> dict:
     """The figures of a chunk of samples with the SPICE engine: the model's, with SPICE's in place
     of those it measures and the SPICE-only ones (rise and settling time) added. Pure, of
     picklable arguments: a chunk runner can send it to workers."""
-    from .montecarlo import _figures
-    return {**_figures(values, {}, opamp), **spice_engine.evaluate(ctx, values, start)}
+    from .montecarlo import figures_with_fixed
+    return {**figures_with_fixed(values, {}, opamp), **spice_engine.evaluate(ctx, values, start)}
 
 
 def step_chunk(ctx, opamp, values: dict, start: int = 0) -> dict:
@@ -43,9 +43,9 @@ def step_chunk(ctx, opamp, values: dict, start: int = 0) -> dict:
     SPICE's as ``spice_<figure>`` (:data:`designer.tolerance.spice_engine.FIGURES`), so that a
     check on the model's ``fn_hz`` and one on SPICE's ``overshoot_pct`` each count their own
     (check-design's yield, :mod:`designer.tolerance.yields`). Pure, of picklable arguments."""
-    from .montecarlo import _figures
+    from .montecarlo import figures_with_fixed
     sp = spice_engine.evaluate(ctx, values, start)
-    return {**_figures(values, {}, opamp), **{f"spice_{k}": v for k, v in sp.items()}}
+    return {**figures_with_fixed(values, {}, opamp), **{f"spice_{k}": v for k, v in sp.items()}}
 
 
 def spice_step_evaluate(result, simulator: str = "ngspice-cli"):
@@ -85,8 +85,8 @@ def disagreement(spice: dict, model: dict, index, figures=spice_engine.SHARED) -
 
 
 def _passes(figs: dict, limits) -> np.ndarray:
-    from .montecarlo import _yield
-    return _yield(figs, limits)
+    from .montecarlo import inside_limits
+    return inside_limits(figs, limits)
 
 
 def spice_checked(idx, worst, rand, model_pass, spice_pass, yield_count: int, n: int, disagree: dict) -> dict:
@@ -143,7 +143,7 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
     the tails and ``spice_k`` random samples only (``both``). ``scale``, ``target_ci``: where the
     samples run and ``--target-ci`` (:mod:`designer.tolerance.runner`)."""
     where = {"scale": scale, "target_ci": target_ci}
-    from .montecarlo import _apply, _figures, plant_monte_carlo
+    from .montecarlo import apply_engine, figures_with_fixed, plant_monte_carlo
     if engine not in ENGINES:
         raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
     amp = result.opamp
@@ -165,7 +165,7 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
         idx = np.array(worst + rand, int)
         order = np.argsort(idx)
         idx = idx[order]
-        sp = run_picked(mc, idx, _apply, spice_evaluate(ctx, amp), scale)
+        sp = run_picked(mc, idx, apply_engine, spice_evaluate(ctx, amp), scale)
         model_pass = mc.passed[idx]
         spice_pass = _passes(sp, mc.limits)
         mc.spice = {**settings, **spice_checked(idx, worst, rand, model_pass, spice_pass, mc.yield_count, n,
@@ -179,7 +179,7 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
                            engine_name=engine, evaluate=spice_evaluate(ctx, amp), **where)
     n = mc.n
     mc.spice = settings
-    model = _figures(mc.values, {}, amp)
+    model = figures_with_fixed(mc.values, {}, amp)
     if mc.tighten:       # the tightening search runs the model: its yield now is the model's
         mc.tighten["yield_now"] = float(np.mean(_passes(model, mc.limits)))
     if engine == "both":
@@ -191,23 +191,6 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
         for k in spice_engine.SHARED:
             mc.figures[f"model_{k}"] = model[k]
     return mc
-
-
-def spice_lines(mc) -> list:
-    """The summary's lines on SPICE's part of a Monte Carlo."""
-    s = mc.spice
-    out = [f"  engine {s['engine']}: ngspice ({s['simulator']}), rising half, max step {s['max_step_s']:.3g} s"
-           + (f"; SPICE on {s['samples_checked']} samples ({len(s['worst'])} from the tails, "
-              f"{len(s['random'])} random)" if "samples_checked" in s else "")]
-    for k, d in (s.get("disagreement") or {}).items():
-        if d.get("compared"):
-            rel = "" if d["max_abs_rel"] is None else f" ({100 * d['max_abs_rel']:.3g} %)"
-            out.append(f"    SPICE - model, {k}: mean {d['mean']:.3g}, largest {d['max_abs']:.3g}{rel} "
-                       f"at sample {d['worst_sample']}")
-    if "yield_shift_pp" in s:
-        out.append(f"    yield: model {100 * s['yield_model']:.2f} %, with SPICE {100 * s['yield_with_spice']:.2f} % "
-                   f"({s['yield_shift_pp']:+.2f} pp)")
-    return out
 
 
 class Replay:
@@ -259,12 +242,12 @@ def replay_values(parts, series: dict, opamp, index: int, n: int, seed: int, sam
 def replay(result, series: dict, index: int, n: int, seed: int, sampler: str, dist: str, tol_items=(),
            simulator: str = "ngspice-cli") -> Replay:
     """Sample ``index`` of the draw on ``result``'s parts, through the SPICE engine and the model."""
-    from .montecarlo import _figures
+    from .montecarlo import figures_with_fixed
     _, tol, v = replay_values(result.built, series, result.opamp, index, n, seed, sampler, dist, tol_items)
     arr = {k: np.array([x]) for k, x in v.items()}
     ctx = spice_engine.context(result.deck, result.built, result.opamp, result.test, simulator)
     sp = spice_engine.evaluate(ctx, arr, start=index)
-    model = _figures(arr, {}, result.opamp)
+    model = figures_with_fixed(arr, {}, result.opamp)
     settings = {"samples": n, "seed": seed, "sampler": sampler, "dist": dist, "engine": "spice",
                 "simulator": ctx.simulator, "tolerances_pct": tol.to_dict()}
     return Replay(index, settings, v, {k: float(a[0]) for k, a in sp.items()},

@@ -67,9 +67,9 @@ class TooLarge(Exception):
 def _parsers() -> dict:
     """Each command's parser traits (switches, appended options), from the CLI's own parsers."""
     from ..cli import check, identify, pid, plant
-    builders = {"design-plant": plant._design_parser, "analyze-plant": plant._analyze_parser,
-                "design-pid": pid._parser, "analyze-pid": pid._analyze_parser, "identify": identify.build_parser,
-                "identify-freq": identify.build_freq_parser, "check-design": check._parser}
+    builders = {"design-plant": plant.design_plant_parser, "analyze-plant": plant.analyze_plant_parser,
+                "design-pid": pid.pid_parser, "analyze-pid": pid.analyze_pid_parser, "identify": identify.build_parser,
+                "identify-freq": identify.build_freq_parser, "check-design": check.check_parser}
     return {prog: req.parser_traits(build()) for prog, build in builders.items()}
 
 

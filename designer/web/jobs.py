@@ -268,7 +268,7 @@ def plant_page(result) -> dict:
     bom = rep.bom(result)
     bench = bench_rows(result.test, result.scope, "R1")
     if result.sine is not None:   # as the sheet's settings table gives it
-        bench.append(["sine check", rep._sine_text(result.sine)])
+        bench.append(["sine check", rep.sine_text(result.sine)])
     return {"step": _trace(result.time_s, step, "time from the edge (s)"),
             "bode": _bode(f, resp),
             "schematic_svg": _schematic_svg(rep, result, (result.built.as_dict(), result.package)),

@@ -174,7 +174,7 @@ def test_an_lsb_too_coarse_for_the_step_is_refused(tmp_path, tf, step, lsb, what
     assert proc.returncode == 2 and proc.stdout == ""
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
-    assert lines[0].startswith(f"simulate-capture: error: --lsb ") and what in lines[0], lines[0]
+    assert lines[0].startswith("simulate-capture: error: --lsb ") and what in lines[0], lines[0]
     assert f"at least {MIN_CODES}" in lines[0] and "give --lsb at most" in lines[0] and "lsb_v" not in lines[0]
     assert list(tmp_path.iterdir()) == []
 

@@ -18,8 +18,8 @@ from designer.core.errors import DesignError
 from designer.web import server
 
 #: every console script's parser (pyproject's [project.scripts])
-PARSERS = {"design-plant": plant._design_parser, "analyze-plant": plant._analyze_parser,
-           "design-pid": pid._parser, "analyze-pid": pid._analyze_parser, "check-design": check._parser,
+PARSERS = {"design-plant": plant.design_plant_parser, "analyze-plant": plant.analyze_plant_parser,
+           "design-pid": pid.pid_parser, "analyze-pid": pid.analyze_pid_parser, "check-design": check.check_parser,
            "identify": identify.build_parser, "identify-freq": identify.build_freq_parser,
            "simulate-capture": capture.build_parser, "make-prbs": prbs.build_parser, "designer-web": server._parser,
            "design-filter": filter_cli._parser}
@@ -106,7 +106,7 @@ def test_tol_items_split_over_repeats_equal_one_list(keys, cut):
     cut = min(cut, len(items))
     split = ["--tol", *items[:cut]] + (["--tol", *items[cut:]] if items[cut:] else [])
     base = ["--fc", "1k", "--zeta", "0.5"]
-    p = plant._design_parser()
+    p = plant.design_plant_parser()
     assert p.parse_args(base + split).tol == p.parse_args(base + ["--tol", *items]).tol == items
 
 

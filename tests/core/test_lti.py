@@ -126,7 +126,6 @@ def test_pole_clusters_never_merge_poles_a_percent_apart():
 
 # ---- filter_foh: the first-order-hold filter without scipy.signal ----------------
 
-import pytest  # noqa: E402
 from scipy.signal import cont2discrete, lfilter  # noqa: E402
 
 from designer.core.lti import filter_foh  # noqa: E402

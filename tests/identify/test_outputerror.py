@@ -19,7 +19,7 @@ from designer.core.errors import DesignError
 from designer.identify import outputerror as oe
 from designer.identify.validation import arx_fit, split_record, validate
 from helpers import EXT_CAPTURES
-from oe_captures import (N, PLANTS, T, U_HIGH, U_LOW, Y_REST, capture, chirp, exact_response, random_binary,
+from oe_captures import (PLANTS, T, U_HIGH, U_LOW, Y_REST, capture, chirp, exact_response, random_binary,
                          step)
 
 DRYER = EXT_CAPTURES / "daisy_dryer.dat"

@@ -303,8 +303,8 @@ def test_a_butterworth_or_slower_plant_has_no_resonance_peak_and_says_why(zeta):
         assert s.no_peak == "no resonance peak (zeta >= 0.707)"
     d = r.to_dict()["sine_check"]
     assert d["f_peak_hz"] is None and d["no_peak_reason"] == s.no_peak
-    from designer.plant.report import _sine_text
-    assert s.no_peak in _sine_text(s) and "x1 " not in _sine_text(s)
+    from designer.plant.report import sine_text
+    assert s.no_peak in sine_text(s) and "x1 " not in sine_text(s)
 
 
 def test_an_underdamped_plant_keeps_its_peak_where_the_closed_form_puts_it():

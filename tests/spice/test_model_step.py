@@ -146,6 +146,6 @@ def test_an_lsb_too_coarse_for_the_step_names_the_parameter(kw, what):
     with pytest.raises(ParamError) as exc:
         simulate_step(MODELS["motor_seed000"], **kw)
     msg = str(exc.value)
-    assert exc.value.param == "lsb_v" and msg.startswith(f"lsb_v ") and what in msg
+    assert exc.value.param == "lsb_v" and msg.startswith("lsb_v ") and what in msg
     swing = abs(kw["step_v"])
     assert f"{swing / kw['lsb_v']:.3g} quantisation steps" in msg and f"at least {MIN_CODES}" in msg

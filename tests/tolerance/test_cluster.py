@@ -107,18 +107,18 @@ def test_spice_chunks_of_ngspice_processes_run_on_thread_workers():
     from designer.plant.design import design_plant
     from designer.plant.spec import PlantSpec
     from designer.tolerance import spice_engine
-    from designer.tolerance.montecarlo import _apply, plant_parts
+    from designer.tolerance.montecarlo import apply_engine, plant_parts
     from designer.tolerance.spice_mc import spice_evaluate
     res = design_plant(PlantSpec(fc_hz=3500, zeta=0.2), simulate=False)
     nominal = plant_parts(res.built)
     ctx = spice_evaluate(spice_engine.context(res.deck, res.built, res.opamp, res.test, "ngspice-cli"), res.opamp)
     draw = Draw(nominal, {k: 0.05 for k in nominal}, 48, 2)
-    _, ref, _ = Runner().run(_apply, ctx, draw)
+    _, ref, _ = Runner().run(apply_engine, ctx, draw)
     before = _children()
     with Runner(Scale(dask="local", chunk=8, work="ngspice-cli")) as run:
         workers = run._pool.cluster.workers.values()
         assert len(workers) == 2 and all(isinstance(w, distributed.Worker) for w in workers)
-        _, f, _ = run.run(_apply, ctx, draw)
+        _, f, _ = run.run(apply_engine, ctx, draw)
         assert _children() - before == set()     # ngspice ended with each chunk; no worker process
     assert_same(f, ref)
     assert [w for w, (threads, _) in cluster.WORKERS.items() if threads] == ["ngspice-cli"]

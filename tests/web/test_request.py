@@ -12,7 +12,7 @@ from designer.web.request import FILE_OPTIONS, REFUSED, SERVERS_OWN, build_argv,
 
 def traits():
     from designer.cli import plant
-    return parser_traits(plant._design_parser())
+    return parser_traits(plant.design_plant_parser())
 
 
 def test_options_become_the_command_line_a_user_types():
@@ -25,7 +25,7 @@ def test_options_become_the_command_line_a_user_types():
                     "--tol", "R=1%", "C=5%"]
     # the command's parser reads it back as typed
     from designer.cli import plant
-    args = plant._design_parser().parse_args(argv)
+    args = plant.design_plant_parser().parse_args(argv)
     assert (args.fc, args.r_series, args.no_sim, args.limit) == ("3500", "E24", True,
                                                                  ["fn_hz=3.3k:3.7k", "overshoot_pct=0:55"])
 
@@ -51,7 +51,7 @@ def test_one_value_options_take_one_value():
         build_argv({"fc": [3500, "/etc/passwd"]}, None, traits())
     from designer.cli import check
     with pytest.raises(DesignError, match="--simulator takes one value"):
-        build_argv({"simulator": ["pyspice", "evil.yaml"]}, None, parser_traits(check._parser()))
+        build_argv({"simulator": ["pyspice", "evil.yaml"]}, None, parser_traits(check.check_parser()))
 
 
 @pytest.mark.parametrize("name", REFUSED)
@@ -68,9 +68,9 @@ def all_traits() -> dict:
 
 def command_parsers() -> dict:
     from designer.cli import check, identify, pid, plant
-    return {"design-plant": plant._design_parser, "analyze-plant": plant._analyze_parser, "design-pid": pid._parser,
-            "analyze-pid": pid._analyze_parser, "identify": identify.build_parser,
-            "identify-freq": identify.build_freq_parser, "check-design": check._parser}
+    return {"design-plant": plant.design_plant_parser, "analyze-plant": plant.analyze_plant_parser, "design-pid": pid.pid_parser,
+            "analyze-pid": pid.analyze_pid_parser, "identify": identify.build_parser,
+            "identify-freq": identify.build_freq_parser, "check-design": check.check_parser}
 
 
 #: the metavars of an option that names a file or folder on the command line

@@ -70,8 +70,6 @@ from .freqtable import (
     MIN_POINTS,
     PHASE_UNITS,
     FreqData,
-    _hint,
-    _NUM,
     freq_data,
     parse_freq_table,
     read_freq_table,

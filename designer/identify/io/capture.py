@@ -29,8 +29,8 @@ from ...core.fileio import (
     size_text,
 )
 from ..edges import check_samples
-from .formats import _layout
-from .layout import _is_number, _Layout, _split
+from .formats import detect_layout
+from .layout import is_number, Layout, split_line
 from .split import PARSED, FileBlocks
 
 
@@ -173,7 +173,7 @@ def _parse(head, blocks, name, input_column, output_column, size_hint=None,
     if not lines:
         raise DesignError(f"{name}: the file is empty; expected CSV rows of time and output "
                           "(t,y or t,u,y)")
-    layout = _layout(lines, name, fmt)
+    layout = detect_layout(lines, name, fmt)
     j_out, j_in, tentative = _choose_columns(layout.columns, input_column, output_column, name)
     keep = [0, j_out] + ([j_in] if j_in is not None else [])
     more = _then(first, blocks) if first is not None else iter(())
@@ -317,12 +317,12 @@ def _parse_block(lines, line0, delim, usecols, flags, name, comma=False) -> tupl
 
 def _raise_bad_cell(rows, where, delim, name, usecols, comma=False):
     for line, lineno in zip(rows, where):
-        cells = _split(line, delim, comma)
+        cells = split_line(line, delim, comma)
         for j in usecols:
             if j >= len(cells) or cells[j] == "":
                 raise DesignError(f"{name}: line {lineno} has no value in column "
                                   f"{j + 1}; every data row needs all columns")
-            if not _is_number(cells[j]):
+            if not is_number(cells[j]):
                 raise DesignError(f"{name}: line {lineno}, column {j + 1}: "
                                   f"{show_cell(cells[j])} is not a number; data cells must "
                                   "be numbers like 1.5e-3")
@@ -386,7 +386,7 @@ def _choose_columns(columns, input_column, output_column, name) -> tuple:
     return j_out, j_in, tentative
 
 
-def _assemble(cols: _Columns, layout: _Layout, keep, tentative, name) -> Capture:
+def _assemble(cols: _Columns, layout: Layout, keep, tentative, name) -> Capture:
     if cols.n == 0:
         raise DesignError(f"{name}: the file has no data rows")
     data = cols.columns()

@@ -3,9 +3,9 @@
 
 from __future__ import annotations
 
-from .layout import _headed_table
+from .layout import headed_table
 
 
 #: Digilent WaveForms: ``#`` comment lines, then ``Time (s),Channel 1 (V),...``.
-_read_digilent = _headed_table("digilent", lambda c: c.startswith("time"),
+read_digilent = headed_table("digilent", lambda c: c.startswith("time"),
                                "Time (s),Channel 1 (V),...")

@@ -198,14 +198,14 @@ def _unwrap_lag(ph: np.ndarray) -> np.ndarray:
     return np.concatenate(([ph[0]], ph[0] + np.cumsum(d + jumps)))
 
 
-_NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
+NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
 
 
 def _tokens(name: str) -> set:
     return set(re.split(r"[^a-z0-9/µμ°]+", name.lower().replace("µ", "u").replace("μ", "u"))) - {""}
 
 
-def _hint(name: str, kind: str):
+def unit_hint(name: str, kind: str):
     """Units named in a header cell, or None."""
     tk = _tokens(name)
     low = name.lower()
@@ -280,7 +280,7 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
 
     header = None
     c0 = cells(first)
-    if not all(_NUM.match(c) or c.lower() in ("nan", "inf", "-inf") for c in c0):
+    if not all(NUMBER.match(c) or c.lower() in ("nan", "inf", "-inf") for c in c0):
         header = c0
         lines = lines[1:]
     if not lines:
@@ -305,7 +305,7 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
         for c in cs:
             if c.lower() in ("nan", "inf", "-inf", "+inf"):
                 raise DesignError(f"{pre}line {lineno}: {show_cell(c)} is not a finite number")
-            if not _NUM.match(c):
+            if not NUMBER.match(c):
                 raise DesignError(f"{pre}line {lineno}: {show_cell(c)} is not a number (plain "
                                   "decimal or 1e3 notation)")
             vals.append(float(c))
@@ -321,7 +321,7 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
     default = {"frequency": "hz", "gain": "db", "phase": "deg"}
     defaulted = set()
     for k, name in zip(kinds, names):
-        h = _hint(name, k) if name else None
+        h = unit_hint(name, k) if name else None
         if given[k] is not None:
             units[k], scale[k] = given[k], 1.0
             if h and h[0] == given[k]:

@@ -1,9 +1,9 @@
 """The table layouts every capture reader builds on.
 
 A reader turns the first lines of a file (its header block) into a
-:class:`_Layout`: which file columns hold time and the signals, where the
+:class:`Layout`: which file columns hold time and the signals, where the
 samples start, the delimiter and decimal mark. The generic reader
-(:func:`_read_table`: header or comment lines, then rows of numbers) is the
+(:func:`read_table`: header or comment lines, then rows of numbers) is the
 base of the vendor readers of this package (:mod:`.tektronix`, :mod:`.rigol`,
 :mod:`.siglent`, :mod:`.keysight`, :mod:`.picoscope`, :mod:`.digilent`); this
 project's own waveforms (``time_s,<signal>,...``) are read here too.
@@ -29,7 +29,7 @@ FORMAT_NAMES = {"tektronix-tds": "Tektronix TDS/TBS", "tektronix-mso": "Tektroni
 
 
 @dataclass
-class _Layout:
+class Layout:
     """Where the samples are: ``columns`` names time and the signals;
     ``file_cols`` the file column of each; ``first_row`` the head line where the
     samples start; ``time_axis`` (start, increment) when the time column is a
@@ -48,14 +48,14 @@ class _Layout:
 
 
 
-def _cells(line: str, delim: str) -> list:
+def split_cells(line: str, delim: str) -> list:
     cells = [c.strip().strip('"').strip() for c in line.split(delim)]
     while cells and cells[-1] == "":
         cells.pop()
     return cells
 
 
-def _is_number(cell: str) -> bool:
+def is_number(cell: str) -> bool:
     try:
         float(cell)
     except ValueError:
@@ -63,12 +63,12 @@ def _is_number(cell: str) -> bool:
     return True
 
 
-def _first_cells(lines, k: int = 0) -> list:
+def first_cells(lines, k: int = 0) -> list:
     """The comma-separated cells of line ``k``, lowercase ([] past the end)."""
-    return [c.lower() for c in _cells(lines[k], ",")] if k < len(lines) else []
+    return [c.lower() for c in split_cells(lines[k], ",")] if k < len(lines) else []
 
 
-def _delimiter(lines: list) -> str:
+def delimiter_of(lines: list) -> str:
     # the last lines are samples; comment and blank lines say nothing
     sample = [ln for ln in lines if ln.strip() and not ln.lstrip().startswith("#")][-20:]
     counts = {d: sum(line.count(d) for line in sample) for d in (";", "\t", ",")}
@@ -90,17 +90,17 @@ def _decimal_comma(lines: list, delim: str) -> bool:
     return any("," in ln for ln in sample)
 
 
-def _split(line: str, delim: str, comma: bool = False) -> list:
+def split_line(line: str, delim: str, comma: bool = False) -> list:
     line = line.split("#", 1)[0]
-    cells = line.split() if delim == "whitespace" else _cells(line, delim)
+    cells = line.split() if delim == "whitespace" else split_cells(line, delim)
     if comma or delim == ";":
         cells = [c.replace(",", ".") for c in cells]
     return cells
 
 
 def _numeric_row(line: str, delim: str, comma: bool) -> bool:
-    cells = _split(line, delim, comma)
-    return len(cells) >= 2 and all(_is_number(c) for c in cells)
+    cells = split_line(line, delim, comma)
+    return len(cells) >= 2 and all(is_number(c) for c in cells)
 
 
 def _data_start(lines, delim, comma, limit: int = 400):
@@ -113,7 +113,7 @@ def _data_start(lines, delim, comma, limit: int = 400):
     return None
 
 
-def _not_this(name, fmt, k, lines, what) -> DesignError:
+def not_this(name, fmt, k, lines, what) -> DesignError:
     """The one line of a file that does not fit a forced (or recognised) format."""
     line = lines[k] if k < len(lines) else ""
     return DesignError(f"{name}: not a {FORMAT_NAMES[fmt]} export: line {k + 1} "
@@ -135,30 +135,30 @@ def _fit_failure(lines, delim, comma) -> tuple:
     return rows[0] if rows else 0, lines[rows[0]] if rows else ""
 
 
-def _read_table(lines, name, fmt: str | None = None, forced: bool = False) -> _Layout:
+def read_table(lines, name, fmt: str | None = None, forced: bool = False) -> Layout:
     """Generic table, project waveforms, Tektronix MSO/DPO, Digilent WaveForms:
     header or comment lines, then rows of numbers."""
-    delim = _delimiter(lines)
+    delim = delimiter_of(lines)
     comma = _decimal_comma(lines, delim)
     first_row = _data_start(lines, delim, comma)
     if first_row is None:
-        probe = _split(lines[min(len(lines) - 1, 1)], delim, comma)
-        if len(lines) <= 1 and probe and not all(_is_number(c) for c in probe):
+        probe = split_line(lines[min(len(lines) - 1, 1)], delim, comma)
+        if len(lines) <= 1 and probe and not all(is_number(c) for c in probe):
             raise DesignError(f"{name}: the file has a header but no data rows")
-        if len(probe) < 2 and all(_is_number(c) for c in probe):
+        if len(probe) < 2 and all(is_number(c) for c in probe):
             raise DesignError(f"{name}: rows need at least two columns (time and output); "
                               f"line {min(len(lines), 2)} has {len(probe)}")
         k, line = _fit_failure(lines, delim, comma)
         if forced and fmt:
-            raise _not_this(name, fmt, k, lines, "is not a row of numbers, and no numeric "
+            raise not_this(name, fmt, k, lines, "is not a row of numbers, and no numeric "
                             "table follows the header")
         raise DesignError(f"{name}: not a capture in a known format (tried "
                           f"{', '.join(FORMATS)}): line {k + 1} ({show_cell(line)}) fits "
                           "none of them; expected rows of numbers t,y or t,u,y after at most "
                           "a header")
-    ncols = len(_split(lines[first_row], delim, comma))
-    header = _split(lines[first_row - 1], delim) if first_row > 0 else []
-    if len(header) >= ncols and not all(_is_number(c) for c in header):
+    ncols = len(split_line(lines[first_row], delim, comma))
+    header = split_line(lines[first_row - 1], delim) if first_row > 0 else []
+    if len(header) >= ncols and not all(is_number(c) for c in header):
         columns = header[:ncols]
     else:
         columns = ["t"] + [f"col{j + 1}" for j in range(1, ncols)]
@@ -170,7 +170,7 @@ def _read_table(lines, name, fmt: str | None = None, forced: bool = False) -> _L
         raise DesignError(f"{name}: a frequency-response (Bode) table, not a time capture: its "
                           f"first column is {show_cell(columns[0])}; read it with identify-freq")
     if fmt is None:
-        if any(_first_cells(lines, k)[:1] == ["model"] for k in range(first_row)):
+        if any(first_cells(lines, k)[:1] == ["model"] for k in range(first_row)):
             fmt = "tektronix-mso"
         elif columns and columns[0].lower() == "time_s":
             fmt = "waveform"
@@ -178,21 +178,21 @@ def _read_table(lines, name, fmt: str | None = None, forced: bool = False) -> _L
             fmt = "digilent"
         else:
             fmt = "generic"
-    return _Layout(columns, fmt, first_row, delim, list(range(ncols)), comma=comma)
+    return Layout(columns, fmt, first_row, delim, list(range(ncols)), comma=comma)
 
 
-def _read_generic(lines, name, forced=False) -> _Layout:
-    return _read_table(lines, name, "generic", forced)
+def read_generic(lines, name, forced=False) -> Layout:
+    return read_table(lines, name, "generic", forced)
 
 
-def _headed_table(fmt: str, first_cell, header: str):
+def headed_table(fmt: str, first_cell, header: str):
     """The reader of a table layout whose header row's first cell passes
     ``first_cell`` (checked when the format is forced: ``header`` says what it
     should be)."""
-    def read(lines, name, forced=False) -> _Layout:
-        lay = _read_table(lines, name, fmt, forced)
+    def read(lines, name, forced=False) -> Layout:
+        lay = read_table(lines, name, fmt, forced)
         if forced and not first_cell(lay.columns[0].lower()):
-            raise _not_this(name, fmt, max(lay.first_row - 1, 0), lines,
+            raise not_this(name, fmt, max(lay.first_row - 1, 0), lines,
                             f"is not the header {header}")
         return lay
     read.__doc__ = f"{fmt}: header lines, then {header} and the samples."
@@ -200,4 +200,4 @@ def _headed_table(fmt: str, first_cell, header: str):
 
 
 #: This project's waveforms (``time_s,<signal>,...``).
-_read_waveform = _headed_table("waveform", lambda c: c == "time_s", "time_s,<signal>,...")
+read_waveform = headed_table("waveform", lambda c: c == "time_s", "time_s,<signal>,...")

@@ -3,18 +3,18 @@
 
 from __future__ import annotations
 
-from .layout import _cells, _first_cells, _Layout, _not_this, _read_table
+from .layout import split_cells, first_cells, Layout, not_this, read_table
 
 
-def _read_siglent(lines, name, forced=False) -> _Layout:
+def read_siglent(lines, name, forced=False) -> Layout:
     """Siglent SDS: ``Record Length,Analog:N`` and other ``key,value`` lines,
     ``Second,Volt[,Volt...]``, then time and values."""
-    if forced and _first_cells(lines)[:1] != ["record length"]:
-        raise _not_this(name, "siglent", 0, lines, "is not 'Record Length,Analog:<n>'")
-    lay = _read_table(lines, name, "siglent", forced)
+    if forced and first_cells(lines)[:1] != ["record length"]:
+        raise not_this(name, "siglent", 0, lines, "is not 'Record Length,Analog:<n>'")
+    lay = read_table(lines, name, "siglent", forced)
     names = []
     for k in range(lay.first_row):
-        c = _cells(lines[k], ",")
+        c = split_cells(lines[k], ",")
         if c and c[0].lower() == "source":
             names = c[1:]
     n = len(lay.columns) - 1
