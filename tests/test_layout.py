@@ -307,3 +307,39 @@ def test_ruff_passes():
     out = subprocess.run([sys.executable, "-m", "ruff", "check", "--quiet", "--no-cache", "designer", "tests",
                           "benchmarks"], cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stdout + out.stderr
+
+
+def test_every_module_declares_all():
+    missing = modules_without_all(ROOT, "designer")
+    assert not missing, "modules without __all__ (the names the rest of the code and the tests import):\n" + \
+        "\n".join(missing)
+
+
+def test_the_all_check_fails_on_a_planted_module_without_all(tmp_path):
+    plant(tmp_path, {"pkg/__init__.py": "__all__ = []\n", "pkg/a.py": '__all__ = ["f"]\n\n\ndef f():\n    pass\n',
+                     "pkg/b.py": "def g():\n    pass\n"})
+    assert modules_without_all(tmp_path, "pkg") == ["pkg/b.py"]
+
+
+def test_each_package_reexports_its_modules_public_names():
+    problems = api_problems(ROOT, "designer")
+    assert not problems, "\n".join(problems)
+
+
+def test_the_api_check_fails_on_planted_gaps(tmp_path):
+    """A subpackage that re-exports one of its module's two names, a module whose ``__all__`` names what it
+    does not have; two modules sharing a name (a protocol) and a module's own name are exempt."""
+    import sys
+    plant(tmp_path, {"plantedapi/__init__.py": "__all__ = []\n",
+                     "plantedapi/sub/__init__.py": 'from .a import f\n\n__all__ = ["f"]\n',
+                     "plantedapi/sub/a.py": '__all__ = ["f", "g", "evaluate"]\n\n\ndef f():\n    pass\n\n\n'
+                                            'def g():\n    pass\n\n\ndef evaluate():\n    pass\n',
+                     "plantedapi/sub/b.py": '__all__ = ["missing", "evaluate", "a"]\na = 1\n\n\n'
+                                            'def evaluate():\n    pass\n'})
+    try:
+        assert sorted(api_problems(tmp_path, "plantedapi")) == [
+            "plantedapi.sub does not re-export plantedapi.sub.a.g (its __init__'s __all__)",
+            "plantedapi.sub.b.__all__ names 'missing', which it does not have"]
+    finally:
+        for name in [m for m in sys.modules if m.split(".")[0] == "plantedapi"]:
+            del sys.modules[name]

@@ -10,3 +10,23 @@ waveforms (:mod:`.golden`). :mod:`.run` runs and judges one corner,
 (:mod:`.result`) are rendered as JUnit XML (:mod:`.junit`) and a Markdown
 summary (:mod:`.summary`). The command is :mod:`designer.cli.check`.
 """
+
+from ..core.exports import lazy_exports
+
+#: module -> the names of its ``__all__`` re-exported here, each module imported on first use (a command
+#: pays only for what it runs); a name several modules share, or a module's own name, is reached through
+#: its module (designer.core.exports)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "figures": ("ALIASES", "BAND", "PID", "PLANT", "band_of", "plant_figures"),
+    "golden": ("compare", "read_golden", "write_golden"),
+    "junit": ("junit_xml", "visible"),
+    "limits": ("Limit", "limit_from"),
+    "result": ("Case", "CornerOutcome", "ERROR", "FAIL", "PASS", "SIM_ERROR", "SKIP", "SPEC_ERROR", "SpecOutcome",
+               "exit_status", "headline"),
+    "run": ("corner_task", "run_corner"),
+    "sections": ("SUB",),
+    "spec": ("TOP", "load_spec"),
+    "summary": ("summary_markdown",),
+    "yamldoc": ("MAX_SPEC_BYTES", "parse_yaml"),
+    "yamlread": ("MAX_NODES",),
+})

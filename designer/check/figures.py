@@ -20,6 +20,8 @@ from __future__ import annotations
 import itertools
 from dataclasses import replace
 
+__all__ = ["ALIASES", "BAND", "PID", "PLANT", "band_of", "plant_figures"]
+
 STEP = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
 
 #: figure -> (unit, what it is), for a plant

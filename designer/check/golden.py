@@ -22,6 +22,8 @@ from ..core.errors import DesignError
 from ..core.fileio import MAX_TABLE_BYTES, atomic_write, read_text, shown
 from ..core.units import format_eng
 
+__all__ = ["compare", "read_golden", "write_golden"]
+
 TITLE = "designer golden waveform"
 #: the header's keys whose change since recording is worth a warning
 VERSIONED = ("tool", "ngspice", "simulator")

@@ -24,6 +24,8 @@ import xml.etree.ElementTree as ET
 
 from .result import ERROR, FAIL, SIM_ERROR, SKIP, headline
 
+__all__ = ["junit_xml", "visible"]
+
 
 #: a character XML 1.0 does not allow: all but tab, newline, CR, U+0020-U+D7FF, U+E000-U+FFFD, U+10000 up
 _NOT_XML = re.compile("[^\t\n\r\u0020-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")

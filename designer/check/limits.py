@@ -15,6 +15,8 @@ from dataclasses import dataclass
 from ..core.errors import DesignError
 from ..core.units import format_eng, parse_value
 
+__all__ = ["Limit", "limit_from"]
+
 #: a bound relative to typ: a sign, a number, a percent sign
 _RELATIVE = re.compile(r"^\s*([+-])\s*(\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?\s*%\s*$")
 

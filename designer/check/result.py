@@ -16,6 +16,9 @@ from dataclasses import dataclass, field
 from ..core.errors import EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK, EXIT_SIMULATOR
 from ..core.jsonio import SCHEMA_VERSION, json_safe
 
+__all__ = ["Case", "CornerOutcome", "ERROR", "FAIL", "PASS", "SIM_ERROR", "SKIP", "SPEC_ERROR", "SpecOutcome",
+           "exit_status", "headline"]
+
 PASS, FAIL, SKIP, ERROR = "pass", "fail", "skipped", "error"
 #: what went wrong in an ERROR case: the spec (exit 2) or the simulator (exit 3)
 SPEC_ERROR, SIM_ERROR = "spec", "simulator"

@@ -29,6 +29,8 @@ from . import golden as G
 from .result import ERROR, FAIL, PASS, SIM_ERROR, SKIP, SPEC_ERROR, Case, CornerOutcome
 from .spec import CheckSpec
 
+__all__ = ["corner_task", "run_corner"]
+
 
 def run_corner(spec: CheckSpec, index: int, simulator: str, *, update_golden: bool = False,
                out_dir=None) -> CornerOutcome:

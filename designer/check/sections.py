@@ -33,6 +33,8 @@ from . import figures as F
 from .limits import LIMIT_KEYS, limit_from
 from .yamldoc import kind_of, closest
 
+__all__ = ["SUB"]
+
 CONTROLLER_PARTS = tuple(f"R{i}" for i in range(3, 19)) + ("C3", "C4")
 #: the keys of each mapping below the top level
 SUB = {

@@ -54,6 +54,8 @@ from .sections import (Agreement, Golden, YieldSpec, read_agreement, read_checks
                        read_pid_designs, read_plant_designs, read_tolerance, read_yield)
 from .yamldoc import kind_of, closest, parse_yaml
 
+__all__ = ["TOP", "load_spec"]
+
 KINDS = ("plant", "pid", "netlist")
 #: the top-level keys of each kind
 TOP = {

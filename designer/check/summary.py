@@ -8,6 +8,8 @@ from __future__ import annotations
 from .junit import visible
 from .result import ERROR, FAIL, PASS, SKIP, headline
 
+__all__ = ["summary_markdown"]
+
 _MARK = {PASS: "pass", FAIL: "**FAIL**", ERROR: "**ERROR**"}
 
 

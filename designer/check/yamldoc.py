@@ -24,6 +24,8 @@ from ..core.errors import DesignError
 from ..core.fileio import MIB, read_text, shown
 from .yamlread import compose
 
+__all__ = ["MAX_SPEC_BYTES", "parse_yaml"]
+
 #: a spec file is small: at most this many bytes are read
 MAX_SPEC_BYTES = 1 * MIB
 

@@ -16,6 +16,8 @@ import functools
 from ..core.errors import DesignError
 from ..core.fileio import show_cell, shown
 
+__all__ = ["MAX_NODES"]
+
 #: the YAML of a spec is bounded, whatever the file holds (1 MiB of aliases can stand for a billion
 #: nodes): at most MAX_NODES nodes with every alias expanded (each use of an alias counts its whole
 #: node again, so a few uses of a shared mapping are fine), nested at most MAX_DEPTH deep, and no

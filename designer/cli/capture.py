@@ -17,6 +17,8 @@ from ..core.ranges import RANGES, help_range, parse_in_range
 from ..core.units import format_eng
 from .common import command_parser, print_output, run_cli
 
+__all__ = ["build_parser"]
+
 EPILOG = """\
 examples:
   simulate-capture --plant-tf "K=1.25 tau=124.6m" --step 2 --out motor.csv

@@ -11,6 +11,8 @@ from pathlib import Path
 
 from .common import command_parser, print_output, run_cli
 
+__all__ = ["check_design_main", "check_parser"]
+
 EPILOG = """spec file (YAML; numbers in engineering notation, paths relative to the spec):
   name: lab3-plant                      # default: the file's stem
   kind: plant                           # plant | pid | netlist

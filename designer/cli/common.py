@@ -21,6 +21,8 @@ from ..core.errors import DesignError
 from ..core.eseries import SERIES
 from ..core.ranges import help_range
 
+__all__ = ["ExtendList", "FLAGS", "OneLineParser", "RESULT_HOOK", "StoreOnce", "flag_message", "run_cli"]
+
 #: library parameter -> the option a user types; errors naming a parameter
 #: (:attr:`DesignError.param`) are shown with the option instead
 FLAGS = {

@@ -37,6 +37,8 @@ from ..core.units import parse_value
 from ..identify.io import FORMAT_NAMES, FORMATS, FREQ_UNITS, GAIN_UNITS, MAX_POINTS, PHASE_UNITS
 from .common import OneLineParser, print_output, run_cli
 
+__all__ = ["FORMATS", "build_freq_parser", "build_parser", "identify_freq_main", "identify_main", "identify_run"]
+
 IDENTIFY_EPILOG = """\
 examples:
   identify capture.csv                         # t,y or t,u,y (header optional)

@@ -15,6 +15,9 @@ signals alone: the files are the same. A command that returned ends through
 import importlib
 import sys
 
+__all__ = ["analyze_pid", "analyze_plant", "check_design", "design_filter", "design_pid", "design_plant", "draws",
+           "identify", "identify_freq", "make_prbs", "simulate_capture"]
+
 #: the report module whose pictures each command's renderer draws
 _REPORTS = {"plant": ("designer.plant.report",), "pid": ("designer.pid.report", "designer.pid.process_report")}
 

@@ -13,6 +13,8 @@ from .common import add_opamp_option, add_output_options, add_part_options, emit
 from .pid_tolerance import add_monte_carlo, loop_monte_carlo, monte_carlo_settings, replay, replay_name
 from .plant import cluster_ahead
 
+__all__ = ["analyze_pid_main", "analyze_pid_parser", "design_pid_main", "pid_parser"]
+
 EPILOG = """examples:
   design-pid --plant-fc 3500 --plant-zeta 0.2
         the seed's plant, Ziegler-Nichols reaction curve done right (T from L, not from 0), LM741s

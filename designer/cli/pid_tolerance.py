@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from ..core.errors import DesignError
 
+__all__ = []
+
 #: the controller's parts a --tol may name
 CONTROLLER_PARTS = (*(f"R{i}" for i in range(3, 19)), "C3", "C4")
 #: the loop's parts a --tol may name: the plant's and the controller's

@@ -20,6 +20,8 @@ from .common import (
     run_cli,
 )
 
+__all__ = ["analyze_plant_main", "analyze_plant_parser", "design_plant_main", "design_plant_parser"]
+
 
 def design_plant_parser():
     p = OneLineParser(

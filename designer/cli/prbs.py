@@ -23,6 +23,8 @@ from ..core.ranges import help_range, parse_in_range
 from ..core.units import format_eng, parse_value
 from .common import OneLineParser, print_output, run_cli
 
+__all__ = ["build_parser", "make_prbs_main"]
+
 #: the files of the bundle: name -> what it is
 FILES = {"prbs_awg.csv": "arbitrary-waveform CSV for the generator's software (sample_rate_hz line, "
                          "then one value per clock interval)",

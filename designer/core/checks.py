@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+__all__ = ["Check", "IDS", "SPICE_AGREEMENT"]
+
 #: what each check id means, for the build sheets (ids not listed print as themselves)
 TITLES = {
     "slew_rate": "slew rate",

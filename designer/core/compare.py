@@ -9,6 +9,8 @@ import numpy as np
 
 from .metrics import StepMetrics
 
+__all__ = ["AGREEMENT", "disagreements", "metric_deltas", "nrms", "resample", "trapezoid_weights"]
+
 #: metrics compared, with how the delta is expressed
 COMPARED = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
 

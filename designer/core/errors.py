@@ -11,6 +11,9 @@
 
 import re
 
+__all__ = ["DeckError", "DesignError", "EXIT_BAD_INPUT", "EXIT_CHECK_FAILED", "EXIT_OK", "EXIT_SIMULATOR",
+           "ParamError", "SimulatorError"]
+
 
 class DesignError(ValueError):
     """Bad input or an impossible request, with a message that says what is

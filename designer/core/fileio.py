@@ -52,6 +52,12 @@ from pathlib import Path
 
 from .errors import DesignError
 
+__all__ = ["BLOCK_BYTES", "LimitedReader", "MAX_CAPTURE_BYTES", "MAX_CAPTURE_ROWS", "MAX_LINE_BYTES",
+           "MAX_TABLE_BYTES", "MIB", "SNIFF_BYTES", "atomic_write", "check_can_create", "check_encoding",
+           "check_output_file", "check_output_folder", "check_plain_name", "clean_stale", "decode", "ensure_dir",
+           "link_into", "new_folder_beside", "open_limited", "os_error", "publish_folder", "read_text", "remove_tree",
+           "show_cell", "shown", "size_text"]
+
 # --------------------------------------------------------------------------- reading
 
 MIB = 1 << 20

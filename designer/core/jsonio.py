@@ -13,6 +13,8 @@ import numpy as np
 from .errors import DesignError
 from .fileio import MAX_TABLE_BYTES, read_text, shown
 
+__all__ = ["SCHEMA_VERSION", "json_safe", "read_result"]
+
 
 #: the layout version of every result.json (``schema_version``; 2 added it and ``tool``, the
 #: program that wrote the file); raised when a key changes meaning or goes

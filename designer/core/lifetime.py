@@ -44,6 +44,10 @@ import signal
 import sys
 from contextlib import contextmanager
 
+__all__ = ["Interrupted", "WORDS", "die_with_parent", "finish", "forget", "install", "interruption", "native",
+           "on_exit", "owned_prefix", "preexec", "quiet", "remove_stale", "reset_in_child", "status_of", "to_devnull",
+           "words_of"]
+
 SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 #: what the one line says for each signal
 WORDS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated (SIGTERM)", signal.SIGHUP: "hung up (SIGHUP)"}

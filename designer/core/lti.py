@@ -14,6 +14,9 @@ import numpy as np
 
 from .errors import DesignError
 
+__all__ = ["MAX_CLUSTER", "coefficients", "dense_time", "dominant_pair", "filter_foh", "freq_response",
+           "pole_clusters", "response_span", "step_response"]
+
 
 def coefficients(p, name: str, what: str = "") -> np.ndarray:
     """A polynomial's coefficients, highest power of s first, as a finite float

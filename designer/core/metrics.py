@@ -18,6 +18,8 @@ from .errors import DesignError
 from .jsonio import json_safe
 from .waveform import crossing_time, normalised_step, refine_peak
 
+__all__ = ["Overshoot", "StepMetrics", "measure_step", "step_metrics"]
+
 #: Slope noise of the smoothing before figures are measured on noisy data (see
 #: :func:`measure_step`): a value needs less smoothing than a slope's maximum.
 MEASURE_SLOPE_NOISE = 0.02

@@ -19,6 +19,8 @@ from importlib import resources
 
 from .errors import DesignError
 
+__all__ = ["OpAmp", "PACKAGE_KINDS", "Unit", "assign", "get", "names", "spare_units"]
+
 
 @dataclass(frozen=True)
 class OpAmp:

@@ -30,6 +30,10 @@ import numpy as np
 
 from ..core.errors import DesignError
 
+__all__ = ["BAND_FACTOR", "HALF_POWER", "LINES_IN_BAND", "MAX_BITS", "MIN_BITS", "PrbsPlan", "SETTLE_MARGIN",
+           "awg_csv", "bits_for", "check_bits", "is_mls_length", "linear_complexity", "mls", "mls_bit_errors",
+           "nice_interval", "plan_for_plant", "pwl_points", "pwl_subcircuit", "time_value_csv"]
+
 MIN_BITS, MAX_BITS = 3, 20
 #: sinc^2(x) = 1/2 at x = 0.4429: the PRBS spectrum's half-power frequency times Dt
 HALF_POWER = 0.4429

@@ -46,6 +46,8 @@ from .errors import DesignError
 from .lti import pole_clusters, step_response
 from .units import format_eng
 
+__all__ = ["ProcessModel"]
+
 KINDS = ("fopdt", "sopdt", "underdamped", "rational", "integrating")
 #: the parameters each kind records (``params``), in this order
 PARAMS = {

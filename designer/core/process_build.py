@@ -28,6 +28,8 @@ from .errors import DesignError
 from .process import KINDS, PARAMS, ProcessModel, format_g, integ_den, pair_den, sopdt_den
 from .ranges import Range
 
+__all__ = ["MAX_DEAD_TIME_RATIO", "fopdt", "integrating", "model_from_dict", "rational", "sopdt", "underdamped"]
+
 #: every time constant (tau, tau1, tau2; 1/|p| of a rational plant's poles): 1 ps
 #: (a 160 GHz pole) to 1e6 s (eleven days): beyond either, the numbers are a typo
 TAU_RANGE = Range(1e-12, 1e6, "s")

@@ -35,6 +35,8 @@ from .process import ProcessModel
 from .process_build import build_fopdt, build_integrating, build_rational, build_sopdt, build_underdamped
 from .units import parse_value
 
+__all__ = ["FORMS_TEXT", "parse_tf"]
+
 #: what a key of a typed model may be written as (lower case) -> the key
 KEYS = {"k": "K", "tau": "tau", "tau_s": "tau", "tau1": "tau1", "tau1_s": "tau1", "tau2": "tau2",
         "tau2_s": "tau2", "fn": "fn", "fn_hz": "fn", "zeta": "zeta", "theta": "theta", "theta_s": "theta",

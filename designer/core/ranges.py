@@ -26,6 +26,8 @@ import numpy as np
 from .errors import DesignError
 from .units import format_eng, parse_value
 
+__all__ = ["RANGES", "Range", "help_range", "parse_in_range"]
+
 
 @dataclass(frozen=True)
 class Range:

@@ -32,6 +32,9 @@ import numpy as np
 from .metrics import Overshoot, measure_step
 from .waveform import crossing_time, noise_sigma
 
+__all__ = ["MODELS", "PARAMS", "data_overshoot", "fit_step", "model_overshoot_pct", "model_step",
+           "overshoot_mismatch", "unphysical"]
+
 MODELS = ("fopdt", "double-pole", "underdamped", "overdamped")
 
 

@@ -12,6 +12,8 @@ import re
 
 from .errors import DesignError
 
+__all__ = ["figure_unit", "format_eng", "format_figure", "parse_value", "value_code"]
+
 # SI multipliers; "u" and "µ" both mean micro, "M" mega and "m" milli as in engineering
 # notation, and SPICE's "meg" (any case: MEG, Meg) mega too.
 _PREFIX = {

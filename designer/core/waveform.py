@@ -27,6 +27,10 @@ import numpy as np
 
 from .errors import DesignError
 
+__all__ = ["crossing_time", "inflection_tangent", "moving_average", "noise_sigma", "normalised_step",
+           "parabola_vertex", "peak_region", "quantum", "refine_peak", "savgol", "smooth_derivative",
+           "tangent_window"]
+
 # --------------------------------------------------------------------------- noise
 
 

@@ -28,6 +28,8 @@ from multiprocessing.connection import wait
 
 from . import lifetime
 
+__all__ = ["Worker", "close_all", "run_tasks"]
+
 
 def _serve(conn, other_end, parent_pid, work, setup) -> None:
     """A worker's loop: receive a task, send back its result; None ends it."""

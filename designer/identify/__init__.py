@@ -22,3 +22,44 @@ plant wing) and ``report`` prints and plots the results. The waveform
 readings they share (noise, crossings, derivative, tangent) are
 :mod:`designer.core.waveform`.
 """
+
+from ..core.exports import lazy_exports
+
+#: module -> the names of its ``__all__`` re-exported here, each module imported on first use (a command
+#: pays only for what it runs); a name several modules share, or a module's own name, is reached through
+#: its module (designer.core.exports)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "against": ("agreement_band", "compare_with_design", "load_design", "model_fn_zeta", "overshoot_from_zeta"),
+    "bode_readings": ("asymptotes", "low_frequency_slope", "model_phase", "model_response", "peak_gain_db",
+                      "resonant_peak", "zeta_from_peak"),
+    "broadband": ("BroadbandResult", "check_method", "examine_input", "identify_broadband", "looks_broadband",
+                  "multilevel_levels", "period_drift"),
+    "correlation": ("DECAY", "circular_xcorr", "mls_impulse", "rms_error", "settling_check", "settling_time"),
+    "dc_motor": ("dc_motor_position", "dc_motor_velocity"),
+    "edges": ("check_samples", "find_edges", "number_text"),
+    "first_order": ("FIRST_ORDER_METHODS", "METHOD_NAMES", "SUNDARESAN", "TABLE_II", "TABLE_III",
+                    "exact_coefficients", "hagglund", "nishikawa", "two_point", "unit_time", "ziegler_nichols"),
+    "freqfit": ("least_squares_fit",),
+    "frequency": ("BAND_FACTOR", "FreqIdentifyResult", "MAX_FIT_ERROR", "corner_frequencies", "identify_freq"),
+    "io": ("BLOCK_LINES", "Capture", "CaptureInfo", "FORMATS", "FORMAT_NAMES", "FREQ_UNITS", "FileBlocks", "FreqData",
+           "GAIN_UNITS", "HEAD_LINES", "INPUT_NAMES", "MAX_POINTS", "MIN_POINTS", "NUMBER", "OUTPUT_NAMES", "PARSED",
+           "PHASE_UNITS", "TIME_NAMES", "check_format", "format_generic", "freq_data", "looks_like_step_input",
+           "parse_capture_text", "parse_freq_table", "read_capture", "read_freq_table", "text_lines", "unit_hint"),
+    "outputerror": ("FIT_KINDS", "HOLDS", "INITIALS", "OEFit", "OEResult", "Sampled", "fit_output_error",
+                    "identify_output_error", "sample_model", "simulate"),
+    "overdamped": ("alfaro_123c_overdamped", "harriott", "jahanmiri_fallahi", "peeling", "stark_mollenkamp",
+                   "two_pole"),
+    "preprocess": ("check_window", "prepare_step"),
+    "refine": ("fit", "refine_all"),
+    "report": ("bode_fit_plot", "broadband_plot", "broadband_text", "fit_plot", "freq_text", "step_text"),
+    "second_order": ("STEP_METHODS",),
+    "settle": ("block_mean", "final_value"),
+    "spectral": ("BANDS_PER_DECADE", "MAX_REL_ERROR", "MIN_COHERENCE", "log_bands", "periodic_response", "table_text",
+                 "to_freq_data", "welch_response"),
+    "step": ("IdentifyResult", "identify_step", "judge"),
+    "structures": ("MODELS", "MethodResult", "iae_ise", "model_step"),
+    "underdamped": ("chen", "extrema", "log_decrement", "normalized_step", "overshoot", "t4_t3", "t4_t3_ratio",
+                    "t4_t3_table", "wn_from_peak_time", "zeta_from_overshoot", "zeta_from_t4_t3"),
+    "validation": ("ARXModel", "Correlation", "DEFAULT_FRACTION", "RESID_LAGS", "Split", "Validation", "Z99",
+                   "arx_fit", "compare_fit", "cross_correlation", "split_record", "validate", "whiteness"),
+})

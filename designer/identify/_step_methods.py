@@ -41,6 +41,8 @@ import numpy as np
 from ..core.waveform import crossing_time, noise_sigma
 from .structures import MethodResult, model_step
 
+__all__ = []
+
 
 def prepare(t, y, yf, sigma=None):
     """Normalised arrays and noise (``sigma`` of ``y`` when given), or an error note."""

@@ -23,6 +23,8 @@ from ..core.fileio import shown
 from ..core.jsonio import json_safe, read_result
 from ..plant.sallenkey import SallenKeyParts, fn_zeta
 
+__all__ = ["agreement_band", "compare_with_design", "load_design", "model_fn_zeta", "overshoot_from_zeta"]
+
 #: Part tolerances assumed when the design's ``built`` has no ``tolerance_band``.
 DEFAULT_R_TOL = 0.05
 DEFAULT_C_TOL = 0.10

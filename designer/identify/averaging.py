@@ -25,6 +25,8 @@ from .edges import Edge
 from .normalise import PreparedStep, check_amplitude, check_step, sample_interval, single_step
 from .settle import last_true, block_mean, final_value
 
+__all__ = []
+
 
 @dataclass
 class _Step:

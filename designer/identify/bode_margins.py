@@ -23,6 +23,8 @@ import numpy as np
 from .bode_readings import low_frequency_slope
 from .io import FreqData
 
+__all__ = []
+
 
 @dataclass(frozen=True)
 class LoopMargins:

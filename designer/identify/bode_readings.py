@@ -48,6 +48,9 @@ from ..core.waveform import parabola_vertex
 from .io import FreqData
 from .structures import MethodResult
 
+__all__ = ["asymptotes", "low_frequency_slope", "model_phase", "model_response", "peak_gain_db", "resonant_peak",
+           "zeta_from_peak"]
+
 DB_PER_POLE = 10.0 * math.log10(2.0)
 
 PARAMS = {

@@ -44,6 +44,9 @@ from . import correlation as corr
 from . import spectral as spec
 from ..core.prbs import MAX_BITS, MIN_BITS, SETTLE_MARGIN, bits_for, is_mls_length, mls_bit_errors
 
+__all__ = ["BroadbandResult", "check_method", "examine_input", "identify_broadband", "looks_broadband",
+           "multilevel_levels", "period_drift"]
+
 #: at least this many transitions make an input broadband
 MIN_TRANSITIONS = 20
 #: a square wave's (a PWM's) intervals between transitions, high and low apart,

@@ -51,6 +51,8 @@ import numpy as np
 
 from ..core.prbs import SETTLE_MARGIN
 
+__all__ = ["DECAY", "circular_xcorr", "mls_impulse", "rms_error", "settling_check", "settling_time"]
+
 #: the DC term is the mean of phi_xy over this last fraction of the period
 TAIL_FRACTION = 0.1
 #: the step response counts as settled inside +-this fraction of its final value

@@ -20,6 +20,8 @@ from ..core.errors import DesignError
 from ..core.ranges import RANGES
 from ..core.waveform import noise_sigma
 
+__all__ = ["check_samples", "find_edges", "number_text"]
+
 #: Steps smaller than this many noise standard deviations are refused.
 MIN_STEP_SNR = 8.0
 #: Fewest samples a step response may have.

@@ -56,6 +56,9 @@ from ..core.stepfit import data_overshoot, overshoot_mismatch
 from ..core.waveform import crossing_time, inflection_tangent, noise_sigma
 from .structures import MethodResult
 
+__all__ = ["FIRST_ORDER_METHODS", "METHOD_NAMES", "SUNDARESAN", "TABLE_II", "TABLE_III", "exact_coefficients",
+           "hagglund", "nishikawa", "two_point", "unit_time", "ziegler_nichols"]
+
 @dataclass(frozen=True)
 class TwoPoint:
     """One row of seed 000 Table II/III: percentages and tau/theta coefficients."""

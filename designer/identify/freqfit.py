@@ -27,6 +27,8 @@ from .bode_readings import invalid_result, fit_error, model_phase, model_respons
 from .io import FreqData
 from .structures import MethodResult
 
+__all__ = ["least_squares_fit"]
+
 #: The fits search time constants and wn within the measured band widened by
 #: this factor (far wider than BAND_FACTOR, so a fit that runs out of the band
 #: is seen and flagged, yet every exp() of a log-parameter stays finite).

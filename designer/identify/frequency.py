@@ -40,6 +40,8 @@ from .freqfit import start_points, least_squares_fit
 from .io import FreqData
 from .structures import MethodResult, rank_key
 
+__all__ = ["BAND_FACTOR", "FreqIdentifyResult", "MAX_FIT_ERROR", "corner_frequencies", "identify_freq"]
+
 ERROR_DEFINITION = ("iae = mean over the table's frequencies of |G_model/G_data - 1| "
                     "(relative complex error; gain only when there is no phase), "
                     "ise = mean of its square; dimensionless")

@@ -25,6 +25,8 @@ from ..core.waveform import noise_sigma
 from .edges import MIN_SAMPLES, MIN_STEP_SNR, number_text
 from .settle import SETTLE_TOL, Rest, block_mean, final_value, settled_before
 
+__all__ = []
+
 #: Fewest samples at rest before a step for a baseline.
 MIN_REST = 3
 

@@ -37,6 +37,8 @@ from .edges import MIN_SAMPLES, MIN_STEP_SNR, check_samples, find_edges, number_
 from .normalise import PreparedStep, check_amplitude, single_step
 from .settle import nonlinearity
 
+__all__ = ["check_window", "prepare_step"]
+
 
 def check_window(window, t=None) -> tuple:
     """``(t0, t1)`` of ``--window``: both inside ``RANGES["capture_time_s"]``,

@@ -16,6 +16,8 @@ import math
 from ..core.stepfit import PARAMS, fit_step
 from .structures import MethodResult
 
+__all__ = ["fit", "refine_all"]
+
 
 def fit(model: str, t, y, yf, start: dict | None = None, sigma=None,
         overshoot=None) -> MethodResult:

@@ -13,6 +13,8 @@ import numpy as np
 from ..core.units import format_eng
 from ..report.plots import png_bytes
 
+__all__ = ["bode_fit_plot", "broadband_plot", "broadband_text", "fit_plot", "freq_text", "step_text"]
+
 
 def format_params(p: dict, corners: bool = False) -> str:
     """Parameters with units: K 2, tau 1.5 ms, theta 200 us, wn 2.2e4 rad/s (3.5 kHz), zeta 0.21;

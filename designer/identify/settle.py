@@ -22,6 +22,8 @@ import numpy as np
 from ..core.errors import DesignError
 from ..core.waveform import crossing_time, noise_sigma
 
+__all__ = ["block_mean", "final_value"]
+
 #: Fraction of the post-step record used as the settled tail for yf.
 TAIL_FRACTION = 0.1
 #: A tail drifting by more than this fraction of the step is "not settled".

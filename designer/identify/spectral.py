@@ -27,6 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+__all__ = ["BANDS_PER_DECADE", "MAX_REL_ERROR", "MIN_COHERENCE", "log_bands", "periodic_response", "table_text",
+           "to_freq_data", "welch_response"]
+
 #: keep frequencies where the input's power is within this of its low-frequency level
 INPUT_DB = 10.0
 #: and where the coherence is at least this

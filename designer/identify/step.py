@@ -29,6 +29,8 @@ from .refine import refine_all
 from .second_order import STEP_METHODS
 from .structures import MethodResult, iae_ise, model_step, rank_key, unphysical
 
+__all__ = ["IdentifyResult", "identify_step", "judge"]
+
 #: Every classical step method, first order then second order.
 ALL_STEP_METHODS = list(FIRST_ORDER_METHODS) + list(STEP_METHODS)
 #: The measured figures reported (``measured`` in the JSON).

@@ -12,6 +12,8 @@ import numpy as np
 from ..core.jsonio import json_safe
 from ..core.stepfit import MODELS, model_step, unphysical  # noqa: F401  (the methods' vocabulary)
 
+__all__ = ["MODELS", "MethodResult", "iae_ise", "model_step"]
+
 
 def iae_ise(t, y, y_model):
     """Integral of |error| and of error^2 over the record (trapezoid rule)."""

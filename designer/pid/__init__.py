@@ -12,3 +12,37 @@ checks), :mod:`.selection` (joint E-series part selection), :mod:`.model`
 (orchestration), :mod:`.result` (the typed result and its JSON),
 :mod:`.report` (build sheet).
 """
+
+from ..core.exports import lazy_exports
+
+#: module -> the names of its ``__all__`` re-exported here, each module imported on first use (a command
+#: pays only for what it runs); a name several modules share, or a module's own name, is reached through
+#: its module (designer.core.exports)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "blocks": ("PidParts", "THESIS_BENCH", "continuous_parts", "seed_bench_parts", "seed_parts", "static_checks"),
+    "delayloop": ("MAX_STEPS", "STEP_BUDGET", "closed_loop_step", "parse_loop", "pid_tf", "step_figures"),
+    "delaymargins": ("loop_margins", "loop_response"),
+    "design": ("SEED_BENCH_PLANT", "analyze_pid", "design_pid", "run_spice"),
+    "model": ("SLEW_DELAY_FRACTION", "assemble", "controller_tf", "dc_gain", "ideal_loop", "inverting_stage",
+              "loop_gain", "margins", "reference", "slew_delay", "waveform_limits"),
+    "netlist": ("closed_loop_deck", "controller_netlist", "loop_netlist", "model_loop_deck"),
+    "optimize": ("Context", "evaluate"),
+    "plant_source": ("model_from_json", "model_from_result", "result_kind", "sallen_key_model"),
+    "process_loop": ("analyse", "built_controller", "corner_frequencies", "design_model_pid", "edged",
+                     "ideal_crossover_hz", "leak_limit_hz", "loop_dc_gain", "plant_of", "response_grid",
+                     "simulation_controller", "stage_waves"),
+    "process_optimize": ("KICK_POINTS", "SEARCH_POINTS", "SEARCH_STEP_FRACTION", "slew_delay_stages"),
+    "process_report": ("PLOTS", "draw_early"),
+    "process_result": ("ProcessPidResult",),
+    "reduction": ("ModelFopdt", "ModelIntegrating", "ModelSopdt", "ModelTf", "from_process", "half_rule",
+                  "model_step", "model_tangent"),
+    "report": ("bom", "build_board", "sections", "title_of"),
+    "result": ("PidResult",),
+    "rules": ("GIVEN", "HALF_RULE", "REACTION_CURVE_RULES", "RuleTuning", "TANGENT", "TANGENT_T63", "applicable",
+              "parallel_to_series", "series_to_parallel", "tune_model"),
+    "schematic": ("PLANT_BLOCK", "draw_loop", "draw_model_loop"),
+    "selection": ("R_CORNER_MAX", "brute_force", "objective", "select_parts"),
+    "spec": ("PidSpec", "controller_from_json"),
+    "tuning": ("Fopdt", "RULE_MODEL", "reaction_curve", "tune"),
+    "verify": ("loop_metrics", "oscillation", "stages"),
+})

@@ -39,6 +39,8 @@ from ..core.checks import Check
 from ..core.errors import DesignError
 from ..core.units import format_eng
 
+__all__ = ["PidParts", "THESIS_BENCH", "continuous_parts", "seed_bench_parts", "seed_parts", "static_checks"]
+
 #: "Well below / well above" the plant's fn for the check (factor).
 CORNER_MARGIN = 5.0
 #: Default corner targets relative to fn (the seed used 130 Hz and 33 kHz for fn = 3.5 kHz).

@@ -38,6 +38,8 @@ from ..core.metrics import step_metrics
 from .delaymargins import LoopParts, loop_band, corner_frequencies, gain_crossovers, log_grid, parse_loop
 from .model import LoopModel, balanced_expm, tf_to_ss
 
+__all__ = ["MAX_STEPS", "STEP_BUDGET", "closed_loop_step", "parse_loop", "pid_tf", "step_figures"]
+
 #: derivative filter N to simulate an ideal PID with (an ideal PID is improper,
 #: so :func:`closed_loop_step` refuses it): ``pid_tf(kp, ti, td, SIM_N_FILTER)``
 SIM_N_FILTER = 10.0

@@ -41,6 +41,8 @@ from ..core.errors import DesignError
 from ..core.jsonio import json_safe
 from .model import trim_leading
 
+__all__ = ["loop_margins", "loop_response"]
+
 #: log-grid density (points per decade) of the crossing search
 POINTS_PER_DECADE = 200
 #: the delay turns the phase by at most this much between neighbouring grid points (rad)

@@ -36,6 +36,8 @@ from .result import Achieved, AnalyticLoop, PidResult, Waveforms
 from .spec import PidSpec, check_plant
 from .verify import explain, loop_metrics, run_and_compare
 
+__all__ = ["PidSpec", "SEED_BENCH_PLANT", "analyze_pid", "design_pid", "run_spice"]
+
 #: phase margin below which the loop is called under-damped on the bench
 MIN_PHASE_MARGIN_DEG = 30.0
 #: largest acceptable steady-state error of the leaky-integrator loop

@@ -28,6 +28,9 @@ from ..core.errors import DesignError
 from ..core.opamps import OpAmp
 from .blocks import PidParts
 
+__all__ = ["SLEW_DELAY_FRACTION", "assemble", "controller_tf", "dc_gain", "ideal_loop", "inverting_stage",
+           "loop_gain", "margins", "reference", "slew_delay", "waveform_limits"]
+
 SIGNALS = ("ve", "vp", "vd", "vi", "vs", "u", "y")
 #: op-amp designator, role and output signal, in signal order; U1 is the plant's Sallen-Key
 #: op-amp, as on the plant's own sheet (one designator scheme: :mod:`designer.pid.netlist`)

@@ -29,6 +29,8 @@ from ..spice import deck
 from ..spice.deck import GROUND, Amp, Netlist, Part, SquareTest
 from .blocks import PidParts
 
+__all__ = ["closed_loop_deck", "controller_netlist", "loop_netlist", "model_loop_deck"]
+
 #: signals whose extremes the deck measures (one per op-amp output)
 PROBES = ("ve", "vp", "vd", "vi", "vs", "u", "y")
 #: what the nets are called on the sheet (wiring table, schematic labels)

@@ -33,6 +33,8 @@ from ..core.opamps import OpAmp
 from ..core.ranges import RANGES
 from . import blocks, model
 
+__all__ = ["Context", "evaluate", "optimize"]
+
 #: the search box, log(Kp, Ti, Td): the ranges design-pid accepts for given gains
 BOX_LO = np.log([RANGES["kp"].lo, RANGES["ti_s"].lo, RANGES["td_s"].lo])
 BOX_HI = np.log([RANGES["kp"].hi, RANGES["ti_s"].hi, RANGES["td_s"].hi])

@@ -45,6 +45,8 @@ from ..core.process_build import fopdt, sopdt, underdamped
 from ..plant.model import plant_tf
 from ..plant.sallenkey import SallenKeyParts, check_parts
 
+__all__ = ["model_from_json", "model_from_result", "result_kind", "sallen_key_model"]
+
 #: what ``--plant-model`` reads, for messages
 ACCEPTED = ("an identify or identify-freq --json output, or a design-plant/analyze-plant result.json")
 #: the ``format`` of what ``identify`` prints for a broadband capture (a PRBS or noise input): its ranking

@@ -52,6 +52,10 @@ from .result import Achieved, Waveforms
 from .spec import DEFAULT_MAX_MS, DEFAULT_MIN_GAIN_MARGIN_DB, DEFAULT_MIN_PHASE_MARGIN_DEG, PidSpec
 from .verify import explain, loop_metrics, run_and_compare
 
+__all__ = ["analyse", "built_controller", "closed_loop_step", "corner_frequencies", "design_model_pid", "edged",
+           "ideal_crossover_hz", "leak_limit_hz", "loop_dc_gain", "plant_of", "response_grid",
+           "simulation_controller", "stage_waves"]
+
 #: the rules tried, in order, when none is named: the first that applies is the default
 DEFAULT_RULES = ("amigo", "simc", "imc")
 #: analytic samples over the rising half period (as for a Sallen-Key plant)

@@ -11,6 +11,8 @@ from ..core import opamps
 from ..core.units import format_eng
 from . import selection
 
+__all__ = []
+
 #: the largest capacitor a sizing message suggests (a 1 mF film capacitor is already a brick)
 PRACTICAL_C_MAX_F = 1e-3
 

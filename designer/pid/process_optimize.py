@@ -40,6 +40,8 @@ from . import blocks, model as M
 from .delayloop import closed_loop_step, step_figures
 from .delaymargins import loop_margins
 
+__all__ = ["KICK_POINTS", "SEARCH_POINTS", "SEARCH_STEP_FRACTION", "slew_delay_stages"]
+
 #: evaluations of the search at most
 MAX_EVALUATIONS = 30
 #: evaluations of the frequency-only first stage at most

@@ -35,6 +35,8 @@ from .report import (METRICS, _achieved_blocks, _blocks_plot, _build_blocks, _cl
                      _loop_gain_plot, _scope_blocks, _spice_agreement, _v, _wiring_blocks, controller_source,
                      verdict_of)
 
+__all__ = ["PLOTS", "draw_early", "plots", "schematic", "summary_text", "write_outputs"]
+
 #: the rule table's columns
 RULE_HEADER = ("rule", "Kp", "Ti", "Td", "phase margin", "gain margin", "delay margin", "Ms", "crossover", "IAE",
                "overshoot", "SPICE overshoot", "note")

@@ -19,6 +19,8 @@ from ..core.jsonio import SCHEMA_VERSION, json_safe
 from ..spice.simulate import tool_info
 from .result import LoopVerdicts
 
+__all__ = ["ProcessPidResult"]
+
 
 @dataclass(frozen=True)
 class LoopFigures:

@@ -51,6 +51,9 @@ from ..core.lti import coefficients, pole_clusters, step_response
 from ..core.process import ProcessModel
 from ..core.units import format_eng
 
+__all__ = ["ModelFopdt", "ModelIntegrating", "ModelSopdt", "ModelTf", "from_process", "half_rule", "model_step",
+           "model_tangent"]
+
 #: 1 - 1/e: the fraction of the final value an FOPDT reaches one time constant after L
 F63 = 1.0 - math.exp(-1.0)
 

@@ -27,6 +27,8 @@ from .model import OPAMP_OUTPUTS
 from .netlist import NET_LABELS, loop_netlist
 from .tuning import MODEL_NAMES
 
+__all__ = ["bom", "build_board", "plots", "schematic", "sections", "summary_text", "title_of", "write_outputs"]
+
 #: what each block's output looks like on the scope for a square-wave reference
 SHAPES = {
     "difference": "error y - r: a spike of -step at each rising edge that decays as the plant catches up "

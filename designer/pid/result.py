@@ -31,6 +31,8 @@ from .spec import PidSpec
 from .tuning import Tuning
 from .verify import SpiceRun, Verdict
 
+__all__ = ["PidResult"]
+
 
 def loop_verdicts(checks, verdict, spice) -> list:
     """The design checks and, when simulated, the SPICE agreement of a loop as one

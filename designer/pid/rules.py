@@ -82,6 +82,9 @@ from ..core.units import format_eng
 from .reduction import (MODEL_TYPES, ModelFopdt, ModelIntegrating, ModelSopdt, ModelTangent, check_plant,
                         Factors, half_rule_of, format_number, check_number, format_seconds, from_process, model_tangent)
 
+__all__ = ["GIVEN", "HALF_RULE", "REACTION_CURVE_RULES", "RULES", "RuleTuning", "TANGENT", "TANGENT_T63", "all_rules",
+           "applicable", "parallel_to_series", "series_to_parallel", "tune_model"]
+
 RULES = ("zn", "cohen-coon", "chr0", "chr20", "amigo", "simc", "imc")
 #: the rules read off the reaction curve (K, L and T of the tangent)
 REACTION_CURVE_RULES = ("zn", "cohen-coon", "chr0", "chr20")

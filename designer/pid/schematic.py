@@ -15,6 +15,8 @@ from __future__ import annotations
 from ..plant.schematic import draw_plant, draw_supplies
 from ..report.schematic import Sheet
 
+__all__ = ["PLANT_BLOCK", "draw_loop", "draw_model_loop"]
+
 #: probe tags: the reference and the output on the scope's two channels, the controller's nodes as test points
 PROBES = {"ref": "CH1", "y": "CH2", "ve": "TP ve", "vp": "TP vp", "vd": "TP vd", "vi": "TP vi", "vs": "TP vs",
           "u": "TP u"}

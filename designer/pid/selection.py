@@ -32,6 +32,8 @@ from ..core import eseries
 from ..core.errors import DesignError
 from .blocks import F_DIFFERENTIATOR_RATIO, F_INTEGRATOR_RATIO, PidParts, check_targets, unity_resistor
 
+__all__ = ["R_CORNER_MAX", "brute_force", "objective", "select_parts"]
+
 
 #: R12 and R13 (set only by the corners) stay at or below this: with bipolar
 #: op-amps (LM741 bias current ~80 nA) larger feedback resistors add offsets.

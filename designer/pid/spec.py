@@ -30,6 +30,8 @@ from ..plant.sallenkey import SallenKeyParts, check_parts
 from . import tuning as rules
 from .blocks import PidParts
 
+__all__ = ["PidSpec", "controller_from_json"]
+
 #: what the plant validation calls the fields of ``plant_parts`` (markers: see ParamError)
 PLANT_NAMES = {"r1": "{plant_r1}", "r2": "{plant_r2}", "c1": "{plant_c1}", "c2": "{plant_c2}",
                "gain": "{plant_gain}", "r3": "R3", "r4": "R4", "plant": "{plant_r1}..{plant_c2}"}

@@ -42,6 +42,8 @@ from ..core.errors import DesignError
 from ..core.stepfit import fit_step, model_step
 from ..core.waveform import inflection_tangent, normalised_step
 
+__all__ = ["Fopdt", "RULES", "RULE_MODEL", "all_rules", "reaction_curve", "tune"]
+
 RULES = ("zn", "cohen-coon", "chr0", "chr20", "amigo", "simc")
 #: the model each rule was derived on: the ZN tangent, or a fitted FOPDT
 RULE_MODEL = {"zn": "tangent", "cohen-coon": "least-squares", "chr0": "least-squares",

@@ -29,6 +29,8 @@ from ..core.opamps import OpAmp
 from ..spice.simulate import get_simulator
 from .model import OPAMP_OUTPUTS
 
+__all__ = ["loop_metrics", "oscillation", "stages"]
+
 PIN_FRACTION = 0.01
 PIN_MIN_TIME_S = 0.5e-6
 #: the failed checks that can explain SPICE disagreeing with the analytic loop (besides every bandwidth_*)

@@ -4,3 +4,25 @@ given capacitors, the unity-gain capacitor-ratio rule), the joint E-series
 selection, the analytic models, the lab bench (test signal, slew/swing checks,
 tolerance band), the netlist, the design orchestration
 (``design-plant``/``analyze-plant``), its typed result and the build sheet."""
+
+from ..core.exports import lazy_exports
+
+#: module -> the names of its ``__all__`` re-exported here, each module imported on first use (a command
+#: pays only for what it runs); a name several modules share, or a module's own name, is reached through
+#: its module (designer.core.exports)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "bench": ("PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",
+              "tolerance_band"),
+    "design": ("R_BAND", "analyze_plant", "choose_parts", "design_plant", "listed"),
+    "model": ("plant_tf", "plant_tf_opamp", "sensitivities"),
+    "netlist": ("plant_ac_deck", "plant_deck", "plant_netlist", "plant_prbs_deck"),
+    "prbs": ("MAX_INTERVALS", "PERIODS", "SAMPLES_PER_INTERVAL", "model_response", "op_amp_checks", "plan_for_result",
+             "prbs_run", "with_prbs"),
+    "report": ("bode_png", "sine_text", "step_png", "summary_text", "waveforms_csv", "write_outputs"),
+    "result": ("PlantResult",),
+    "sallenkey": ("DEFAULT_R3_OHM", "GAIN_TOLERANCE", "SallenKeyParts", "check_parts", "coefficients", "fn_zeta",
+                  "ratios_from_rc", "realizability_notes", "resistors_for_caps"),
+    "schematic": ("draw_plant", "draw_supplies"),
+    "selection": ("Candidate", "brute_force", "joint_search"),
+    "spec": ("AnalysisSpec", "PlantSpec"),
+})

@@ -28,6 +28,9 @@ from ..spice.deck import SquareTest
 from .model import plant_tf
 from .sallenkey import SallenKeyParts
 
+__all__ = ["PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",
+           "tolerance_band"]
+
 
 def recommend_square_wave(settling_time_s: float, amplitude_v: float, frequency_hz=None,
                           delay_s=None, time_scale_s=None) -> SquareTest:

@@ -15,6 +15,8 @@ from ..core.lti import dominant_pair
 from ..core.opamps import OpAmp
 from .sallenkey import SallenKeyParts
 
+__all__ = ["plant_tf", "plant_tf_opamp", "sensitivities"]
+
 
 def plant_tf(parts: SallenKeyParts):
     """Ideal op-amp: K / (a s^2 + b s + 1)."""

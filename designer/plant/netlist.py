@@ -32,6 +32,8 @@ from ..spice.deck import (
 )
 from .sallenkey import SallenKeyParts
 
+__all__ = ["plant_ac_deck", "plant_deck", "plant_netlist", "plant_prbs_deck"]
+
 #: the seed's name of each plant part (its R3, R4 of the gain are R19, R20 here), by designator
 SEED_NAMES = {"R1": "R1", "R2": "R2", "C1": "C1", "C2": "C2", "R19": "R3", "R20": "R4"}
 #: designators of the gain resistors (to ground, feedback): the seed's R3 and R4

@@ -25,6 +25,9 @@ import numpy as np
 from ..core.checks import Check
 from ..core.prbs import PrbsPlan, plan_for_plant
 
+__all__ = ["MAX_INTERVALS", "PERIODS", "SAMPLES_PER_INTERVAL", "model_response", "op_amp_checks", "plan_for_result",
+           "prbs_run", "with_prbs"]
+
 #: periods played: the first settles the plant, the other three are identified
 PERIODS = 4
 #: samples of the capture per clock interval

@@ -25,6 +25,8 @@ from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
 from .netlist import SEED_NAMES, plant_netlist
 
+__all__ = ["bode_png", "schematic", "sine_text", "step_png", "summary_text", "waveforms_csv", "write_outputs"]
+
 METRIC_ROWS = (("overshoot_pct", "overshoot Mp", lambda v: "n/a" if v is None else f"{v:.4g} %"),
                ("peak_time_s", "peak time tp", R.fmt_time),
                ("rise_time_s", "rise time tr (10-90 %)", R.fmt_time),

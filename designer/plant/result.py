@@ -25,6 +25,8 @@ from ..spice.simulate import tool_info
 from .bench import BenchPeriod, ScopeSetup, SineCheck, ToleranceBand
 from .sallenkey import SallenKeyParts
 
+__all__ = ["PlantResult"]
+
 #: the step metrics a result gives, in the order of its JSON
 METRICS = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s", "settling_time_5pct_s",
            "rise_time_0_100_s", "peak_value", "final_value")

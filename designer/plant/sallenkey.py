@@ -24,6 +24,9 @@ import numpy as np
 from ..core.errors import DesignError
 from ..core.ranges import RANGES, parse_in_range
 
+__all__ = ["DEFAULT_R3_OHM", "GAIN_TOLERANCE", "SallenKeyParts", "check_parts", "coefficients", "fn_zeta",
+           "ratios_from_rc", "realizability_notes", "resistors_for_caps"]
+
 
 @dataclass(frozen=True)
 class SallenKeyParts:

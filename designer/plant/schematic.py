@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from ..report.schematic import Sheet
 
+__all__ = ["draw_plant", "draw_supplies"]
+
 #: the scope probes of the plant's bench test (seed IV.9: input on CH1, output on CH2)
 PROBES = {"input": "CH1", "out": "CH2"}
 

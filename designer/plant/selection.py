@@ -50,6 +50,8 @@ import numpy as np
 
 from .sallenkey import fn_zeta, resistors_for_caps
 
+__all__ = ["Candidate", "brute_force", "joint_search"]
+
 
 @dataclass(frozen=True)
 class Candidate:

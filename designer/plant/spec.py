@@ -29,6 +29,8 @@ from ..core.opamps import OpAmp
 from ..core.ranges import RANGES, parse_in_range
 from .sallenkey import SallenKeyParts, check_parts
 
+__all__ = ["AnalysisSpec", "PlantSpec"]
+
 
 def _check_bench(spec, put) -> None:
     """The op-amp (and the package the sheet wires it in) and the bench's square

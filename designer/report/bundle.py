@@ -8,6 +8,8 @@ import json
 
 from .document import to_html, to_markdown
 
+__all__ = ["draw_early", "schematic_pictures", "write_design"]
+
 
 def bundle_paths(out_dir, name: str, images, extra: dict = None) -> dict:
     """Name every file of a design's bundle under ``out_dir``: ``reports/<name>/``

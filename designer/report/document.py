@@ -17,6 +17,8 @@ import math
 
 from ..core.units import format_eng, value_code
 
+__all__ = ["columns", "figure", "fmt_pct", "fmt_time", "image", "subhead", "table", "text", "to_html", "to_text"]
+
 # ---- content blocks ---------------------------------------------------------
 
 def table(header, rows, cls: str = ""):

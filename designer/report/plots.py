@@ -18,6 +18,9 @@ import math
 
 import numpy as np
 
+__all__ = ["bode_plot", "decimate", "figure", "histogram_plot", "loop_gain_plot", "png_bytes", "step_plot",
+           "time_unit"]
+
 #: the most points a curve is drawn with
 MAX_POINTS = 1500
 

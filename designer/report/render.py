@@ -28,6 +28,8 @@ from contextlib import contextmanager
 from ..core import lifetime
 from ..core.workers import Worker
 
+__all__ = ["ahead", "running", "start", "stop", "submit", "submit_many"]
+
 #: the longest the caller waits for one picture before drawing it itself
 TIMEOUT_S = 60.0
 

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 from ..core.units import value_code
 
+__all__ = ["Sheet", "check_connectivity"]
+
 #: coordinates are compared on this grid (schemdraw works in floats)
 _GRID = 1e-6
 

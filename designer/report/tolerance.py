@@ -17,6 +17,8 @@ from ..core.units import format_figure
 from . import document as R
 from .plots import histogram_plot
 
+__all__ = ["csv_texts", "histogram_plots", "section", "title"]
+
 
 def histogram_name(figure: str) -> str:
     return f"mc-{figure}.png"

@@ -15,6 +15,8 @@ import io
 
 from ..core.units import format_eng, value_code
 
+__all__ = ["BOM_HEADER", "bench_rows", "bom_csv", "bom_rows", "net_text", "wiring_rows"]
+
 #: bill of materials columns (bom.csv and the sheet)
 BOM_HEADER = ("Ref", "Value", "Code", "Qty", "Series", "Tolerance", "Package", "Description")
 

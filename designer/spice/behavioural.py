@@ -98,6 +98,8 @@ import numpy as np
 from ..core.errors import DesignError
 from ..core.lti import coefficients
 
+__all__ = ["FORMS", "HINT_WH", "max_step_hint_s", "normalise", "plant_lines", "poles"]
+
 #: the realisations of the rational part (see the module's notes)
 FORMS = ("integrators", "s_xfer")
 #: characteristic impedance of the dead-time line, and its two terminations (ohm)

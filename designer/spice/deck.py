@@ -21,6 +21,10 @@ from ..core.opamps import OpAmp
 from ..core.units import format_eng
 from .library import library_text
 
+__all__ = ["Amp", "Board", "GROUND", "MAX_SIM_POINTS", "Netlist", "Part", "STEPS_PER_TIME_SCALE", "SquareTest",
+           "ac_lines", "add_supplies", "board", "finish_deck", "measure_lines", "opamp_library_text",
+           "settle_error_source"]
+
 #: the simulation's maximum step is at most this fraction of the response's time scale
 STEPS_PER_TIME_SCALE = 50
 #: a bench period needing more simulation steps than this is refused (minutes of ngspice, GBs of data)

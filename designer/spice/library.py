@@ -10,6 +10,8 @@ from __future__ import annotations
 from functools import lru_cache
 from importlib import resources
 
+__all__ = []
+
 
 @lru_cache(maxsize=None)
 def library_text(name: str) -> str:

@@ -51,6 +51,9 @@ from ..core.units import format_eng
 from .behavioural import max_step_hint_s, plant_lines
 from .deck import MAX_SIM_POINTS
 
+__all__ = ["DURATION_SETTLING_TIMES", "MAX_POINTS", "MIN_CODES", "default_duration_s", "default_step_time_s",
+           "simulate_step", "step_deck"]
+
 #: the default record: this many 2 % settling times of the model (:attr:`ProcessModel.settling_time_s`)
 DURATION_SETTLING_TIMES = 5.0
 #: the default step time: this fraction of the record (a pre-trigger stretch at rest)

@@ -35,6 +35,9 @@ import numpy as np
 from ..core import lifetime
 from ..core.errors import DeckError, DesignError, SimulatorError
 
+__all__ = ["DEFAULT_TIMEOUT_S", "NgspiceCli", "PySpiceShared", "error_lines", "get_simulator", "measure_names",
+           "ngspice_version", "private_env", "read_raw", "tool_info", "with_raw_output"]
+
 INSTALL_HINT = "install it with: apt-get install ngspice libngspice0-dev (or run `make setup`)"
 BACKENDS = ("pyspice", "ngspice-cli")
 

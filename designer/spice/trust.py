@@ -40,6 +40,8 @@ from pathlib import Path
 from ..core.errors import DesignError
 from ..core.fileio import MIB, read_text, shown
 
+__all__ = ["MAX_TOTAL_BYTES", "check_deck_text", "expand_deck"]
+
 #: the most files one deck may reach, the deepest nesting, and their text in all
 MAX_FILES, MAX_DEPTH, MAX_TOTAL_BYTES = 256, 16, 16 * MIB
 #: model and instance parameters of ngspice's XSPICE code models that name a file to read

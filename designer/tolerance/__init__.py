@@ -8,3 +8,29 @@ them are drawn reproducibly, sample i a function of (seed, i) alone
 interval, variance shares and the part to buy tighter. Imports go
 front ends -> check -> tolerance -> wings.
 """
+
+from ..core.exports import lazy_exports
+
+#: module -> the names of its ``__all__`` re-exported here, each module imported on first use (a command
+#: pays only for what it runs); a name several modules share, or a module's own name, is reached through
+#: its module (designer.core.exports)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "chunks": ("lost_twice", "run_chunk"),
+    "cluster": ("CONNECT_TIMEOUT", "ClusterStart", "DaskPool", "WORKERS", "cluster_ahead", "parse_dask", "probe"),
+    "loop": ("LIMITABLE", "LoopContext", "STEP_POINTS", "kick_grid", "loop_figures", "loop_monte_carlo", "loop_parts",
+             "loop_series", "loop_worst_case", "parse_loop_limit"),
+    "montecarlo": ("MAX_SAMPLES", "MAX_TARGET_CI", "MIN_SAMPLES", "MonteCarlo", "NO_SLEW", "TARGET_ROUND",
+                   "apply_engine", "check_target_ci", "parse_target_ci", "plant_monte_carlo", "plant_parts",
+                   "plant_worst_case"),
+    "parts": ("DISTRIBUTIONS", "MAX_TOL", "check_items", "opamp_nominal", "parse_tolerance", "resolve"),
+    "plant": ("plant_figures",),
+    "runner": ("CHUNKS_PER_WORKER", "Draw", "MAX_JOBS", "MIN_CHUNK", "Runner", "SPICE_MIN_CHUNK", "SPICE_WORK",
+               "Scale", "parse_jobs"),
+    "sampling": ("CHUNK", "SAMPLERS", "deviations", "unit_samples", "values"),
+    "spice_engine": ("commands", "measures", "parse"),
+    "spice_loop_mc": ("loop_monte_carlo_engine",),
+    "spice_mc": ("plant_monte_carlo_engine", "replay_values", "spice_evaluate", "spice_samples"),
+    "stats": ("Limit", "Z95", "figure_stats", "variance_shares", "wilson"),
+    "worstcase": ("WorstCase", "worst_case"),
+    "yields": ("ENGINES", "LOOP", "PLANT", "TABLES", "counted", "spec_yield"),
+})

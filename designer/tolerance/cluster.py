@@ -25,6 +25,8 @@ import time
 from ..core.errors import DesignError, SimulatorError
 from .chunks import lost_twice, run_chunk
 
+__all__ = ["CONNECT_TIMEOUT", "ClusterStart", "DaskPool", "WORKERS", "cluster_ahead", "parse_dask", "probe"]
+
 #: seconds a Dask scheduler has to answer
 CONNECT_TIMEOUT = 3.0
 _ADDRESS = re.compile(r"^(?:([A-Za-z][A-Za-z0-9+.-]*)://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):(\d{1,5})$")

@@ -49,6 +49,9 @@ import numpy as np
 from ..core.errors import DesignError
 from .montecarlo import MonteCarlo
 
+__all__ = ["LIMITABLE", "LoopContext", "STEP_POINTS", "evaluate", "kick_grid", "loop_figures", "loop_monte_carlo",
+           "loop_parts", "loop_series", "loop_worst_case", "parse_loop_limit"]
+
 STEP = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
 #: the figures of each sampled loop that are 1 or 0
 FLAGS = ("stable", "saturated", "slewing")

@@ -17,6 +17,9 @@ from . import runner, sampling
 from .parts import DISTRIBUTIONS, opamp_nominal, resolve
 from .stats import Limit, failing_samples, figure_stats, parse_limit, samples_csv, variance_shares, wilson
 
+__all__ = ["MAX_SAMPLES", "MAX_TARGET_CI", "MIN_SAMPLES", "MonteCarlo", "NO_SLEW", "TARGET_ROUND", "apply_engine",
+           "check_target_ci", "parse_target_ci", "plant_monte_carlo", "plant_parts", "plant_worst_case"]
+
 #: the number of samples allowed
 MIN_SAMPLES, MAX_SAMPLES = 10, 10 ** 7
 #: failing samples listed per limit (the worst)

@@ -23,6 +23,8 @@ import numpy as np
 from ..core.errors import DesignError
 from ..core.units import parse_value
 
+__all__ = ["DISTRIBUTIONS", "MAX_TOL", "check_items", "opamp_nominal", "parse_tolerance", "resolve"]
+
 #: the largest tolerance accepted (a fraction)
 MAX_TOL = 0.5
 #: distributions: uniform in nominal (1 +- tol), or normal with sigma = tol/3 truncated at +- tol

@@ -24,6 +24,8 @@ import numpy as np
 
 from ..plant.sallenkey import fn_zeta
 
+__all__ = ["FIGURES", "evaluate", "plant_figures"]
+
 FIGURES = ("fn_hz", "zeta", "q", "ideal_fn_hz", "ideal_zeta", "ideal_q", "overshoot_pct", "peak_time_s", "gain")
 #: Newton steps on the first peak of the step (quadratic convergence from pi/wd)
 NEWTON_STEPS = 8

@@ -42,6 +42,9 @@ from ..core.errors import DesignError
 from . import sampling
 from .chunks import lost_twice, run_chunk
 
+__all__ = ["CHUNKS_PER_WORKER", "Draw", "MAX_JOBS", "MIN_CHUNK", "Runner", "SPICE_MIN_CHUNK", "SPICE_WORK", "Scale",
+           "parse_jobs"]
+
 #: the most local worker processes
 MAX_JOBS = 64
 #: the fewest samples in a chunk (a task's overhead is about 4 ms on Dask)

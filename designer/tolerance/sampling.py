@@ -18,6 +18,8 @@ import numpy as np
 
 from ..core.errors import DesignError
 
+__all__ = ["CHUNK", "SAMPLERS", "deviations", "unit_samples", "values"]
+
 SAMPLERS = ("random", "lhs", "sobol")
 #: samples per chunk of the random sampler (fixed: the chunks, and so the samples, do not depend on workers)
 CHUNK = 4096

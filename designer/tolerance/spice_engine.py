@@ -47,6 +47,8 @@ import numpy as np
 
 from ..core.errors import SimulatorError
 
+__all__ = ["FIGURES", "commands", "context", "evaluate", "measures", "parse"]
+
 #: the figures the SPICE engine gives
 FIGURES = ("fn_hz", "zeta", "q", "overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
 #: the figures both engines give (their disagreement is reported by ``--engine both``)

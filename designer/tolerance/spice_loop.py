@@ -41,6 +41,8 @@ import numpy as np
 
 from . import spice_engine
 
+__all__ = ["FIGURES", "context", "evaluate"]
+
 #: the SPICE step figures of a loop (the analytic ones keep their names beside them)
 STEP = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
 FIGURES = tuple(f"spice_{f}" for f in STEP)

@@ -35,6 +35,8 @@ import numpy as np
 from ..core.errors import DesignError
 from . import spice_loop
 
+__all__ = ["loop_monte_carlo_engine", "parse_limit", "replay", "replay_result"]
+
 #: the SPICE step figures a --limit may name (the analytic loop's ``model_*`` stand in for them)
 STEP = spice_loop.STEP
 

@@ -25,6 +25,8 @@ import numpy as np
 from ..core.errors import DesignError
 from . import spice_engine
 
+__all__ = ["plant_monte_carlo_engine", "replay", "replay_result", "replay_values", "spice_evaluate", "spice_samples"]
+
 ENGINES = ("analytic", "spice", "both")
 #: the seed of the random part of --spice-samples: SeedSequence(seed, spawn_key=(RANDOM_KEY,)) (chunks use (c,))
 RANDOM_KEY = 2 ** 31

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+__all__ = ["Limit", "Z95", "figure_stats", "parse_limit", "variance_shares", "wilson"]
+
 #: the percentiles reported: +-3 sigma, +-2 sigma (95 %) and the median of a normal figure
 PERCENTILES = (0.135, 2.5, 50.0, 97.5, 99.865)
 #: z of a two-sided 95 % interval

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+__all__ = ["WorstCase", "worst_case"]
+
 #: figures whose extremes are reported
 FIGURES = ("fn_hz", "zeta", "q", "overshoot_pct", "peak_time_s")
 

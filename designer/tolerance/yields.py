@@ -24,6 +24,8 @@ from ..core.units import format_eng
 from .loop import LIMITABLE, STANDS_IN
 from .stats import Limit
 
+__all__ = ["ENGINES", "LOOP", "PLANT", "TABLES", "counted", "spec_yield"]
+
 #: check-design's plant figure -> the analytic plant engine's (designer.tolerance.plant.FIGURES)
 PLANT = {**{f: f for f in ("fn_hz", "zeta", "q", "ideal_fn_hz", "ideal_zeta", "ideal_q", "gain", "overshoot_pct",
                             "peak_time_s")},

@@ -1,0 +1,18 @@
+
+
+from ..core.exports import lazy_exports
+
+#: module -> the names of its ``__all__`` re-exported here, each module imported on first use (a command
+#: pays only for what it runs); a name several modules share, or a module's own name, is reached through
+#: its module (designer.core.exports)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "connections": ("BODY_GRACE_S", "GuardedH11", "HEADER_TIMEOUT_S", "MIN_BODY_RATE", "STOP_GRACE_S",
+                    "StoppingServer"),
+    "guard": ("CSP", "Guard", "JSON_PATHS", "PAGE_HEADER", "SECURITY_HEADERS", "Trust", "UPLOAD_PATHS",
+              "error_response", "origin_of", "trust_for"),
+    "jobs": ("TRACE_POINTS", "run", "temporaries_in", "warm_up"),
+    "pool": ("Busy", "Pool", "STOPPED"),
+    "request": ("FILE_OPTIONS", "MAX_DEPTH", "MAX_JSON_BYTES", "REFUSED", "SERVERS_OWN", "Traits", "build_argv",
+                "check_text", "check_value", "option_name", "parse_json", "parser_traits", "write_content"),
+    "server": ("exposure_warning", "is_local", "main"),
+})

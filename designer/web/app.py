@@ -40,6 +40,8 @@ from . import pool as pool_module
 from . import request as req
 from .guard import Guard, Trust, error_response
 
+__all__ = []
+
 STATIC = Path(__file__).parent / "static"
 MEDIA = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=utf-8",
          ".css": "text/css; charset=utf-8", ".txt": "text/plain; charset=utf-8", ".svg": "image/svg+xml",

@@ -37,6 +37,8 @@ from ..cli import plant as cli_plant
 from ..cli.common import RESULT_HOOK, run_cli
 from ..core.jsonio import json_safe
 
+__all__ = ["TRACE_POINTS", "run", "temporaries_in", "warm_up"]
+
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
 #: frequency points of a Bode trace

@@ -23,6 +23,8 @@ import sys
 
 from ..cli.common import OneLineParser, run_cli
 
+__all__ = ["exposure_warning", "is_local", "main"]
+
 EPILOG = """examples:
   designer-web                          http://127.0.0.1:8000/ on this machine only
   designer-web --port 8080 --jobs 2     another port; two designs at once (one per core)

@@ -69,16 +69,19 @@ from .freqtable import (
     MAX_POINTS,
     MIN_POINTS,
     PHASE_UNITS,
+    NUMBER,
     FreqData,
     freq_data,
     parse_freq_table,
     read_freq_table,
+    unit_hint,
 )
 from .layout import FORMAT_NAMES, FORMATS
+from .split import PARSED, FileBlocks
 from .writers import format_generic
 
-__all__ = ["BLOCK_LINES", "HEAD_LINES", "INPUT_NAMES", "OUTPUT_NAMES", "TIME_NAMES", "Capture",
-           "CaptureInfo", "looks_like_step_input", "parse_capture_text", "read_capture",
-           "text_lines", "check_format", "FREQ_UNITS", "GAIN_UNITS", "MAX_POINTS", "MIN_POINTS",
-           "PHASE_UNITS", "FreqData", "freq_data", "parse_freq_table", "read_freq_table",
-           "FORMAT_NAMES", "FORMATS", "format_generic"]
+__all__ = ["BLOCK_LINES", "HEAD_LINES", "INPUT_NAMES", "OUTPUT_NAMES", "TIME_NAMES", "Capture", "CaptureInfo",
+           "looks_like_step_input", "parse_capture_text", "read_capture", "text_lines", "check_format", "FREQ_UNITS",
+           "GAIN_UNITS", "MAX_POINTS", "MIN_POINTS", "PHASE_UNITS", "FreqData", "freq_data", "parse_freq_table",
+           "read_freq_table", "FORMAT_NAMES", "FORMATS", "format_generic", "NUMBER", "unit_hint", "FileBlocks",
+           "PARSED"]

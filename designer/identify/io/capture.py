@@ -33,6 +33,9 @@ from .formats import detect_layout
 from .layout import is_number, Layout, split_line
 from .split import PARSED, FileBlocks
 
+__all__ = ["BLOCK_LINES", "HEAD_LINES", "INPUT_NAMES", "OUTPUT_NAMES", "TIME_NAMES", "Capture", "CaptureInfo",
+           "looks_like_step_input", "parse_capture_text", "read_capture", "text_lines"]
+
 
 INPUT_NAMES = ("u", "vin", "v_in", "in", "input", "uin", "u_in", "v(in)", "ve", "step", "source")
 OUTPUT_NAMES = ("y", "vout", "v_out", "out", "output", "yout", "y_out", "v(out)", "vs", "response")

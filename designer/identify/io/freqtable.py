@@ -19,6 +19,9 @@ from ...core.fileio import MAX_TABLE_BYTES, read_text, show_cell, shown
 from ...core.ranges import RANGES
 from ..edges import number_text
 
+__all__ = ["FreqData", "NUMBER", "unit_hint", "FREQ_UNITS", "GAIN_UNITS", "MAX_POINTS", "MIN_POINTS", "PHASE_UNITS",
+           "freq_data", "parse_freq_table", "read_freq_table"]
+
 
 GAIN_UNITS = ("db", "ratio")
 PHASE_UNITS = ("deg", "rad", "s")

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from .layout import split_cells, first_cells, Layout, not_this, read_table
 
+__all__ = []
+
 
 def read_keysight(lines, name, forced=False) -> Layout:
     """Keysight/Agilent InfiniiVision: ``x-axis,1[,2...]`` / ``second,Volt[,Volt...]``,

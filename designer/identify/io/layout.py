@@ -16,6 +16,8 @@ from dataclasses import dataclass
 from ...core.errors import DesignError
 from ...core.fileio import show_cell
 
+__all__ = ["FORMAT_NAMES", "FORMATS"]
+
 
 #: Every layout recognised, in the order they are tried (generic last).
 FORMATS = ("tektronix-tds", "tektronix-mso", "rigol", "rigol-no-x", "siglent", "keysight",

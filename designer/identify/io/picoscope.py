@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from .layout import split_cells, delimiter_of, Layout, not_this, read_table
 
+__all__ = []
+
 
 #: A PicoScope units cell, in seconds or volts per unit.
 _PICO_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6, "ns": 1e-9,

@@ -11,6 +11,8 @@ from ...core.fileio import show_cell
 from ..edges import number_text
 from .layout import split_cells, first_cells, Layout, not_this
 
+__all__ = []
+
 
 def _rigol_header(lines, name, fmt, forced):
     head = split_cells(lines[0], ",")

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from .layout import split_cells, first_cells, Layout, not_this, read_table
 
+__all__ = []
+
 
 def read_siglent(lines, name, forced=False) -> Layout:
     """Siglent SDS: ``Record Length,Analog:N`` and other ``key,value`` lines,

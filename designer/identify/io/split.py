@@ -38,6 +38,8 @@ from ...core import lifetime
 from ...core.errors import DesignError
 from ...core.fileio import BLOCK_BYTES, MAX_LINE_BYTES, MIB, decode, size_text
 
+__all__ = ["FileBlocks", "PARSED"]
+
 #: the least left to read for a helper: below it, the fork and the pipe cost more than half the parse saves
 SPLIT_BYTES = 8 * MIB
 #: marks a block the helper parsed: ``(PARSED, (rows, where, lines))`` (``where``: the line

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from .layout import split_cells, headed_table, is_number, Layout, not_this
 
+__all__ = []
+
 
 #: Tektronix MSO/DPO: ``Model,...`` key/value lines, then ``TIME,CH1,...``.
 read_tektronix_mso = headed_table("tektronix-mso", lambda c: c == "time", "TIME,CH1,...")

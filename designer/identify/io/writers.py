@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+__all__ = ["format_generic"]
+
 
 def format_generic(t, y, u=None, *, delimiter=",", header=True, decimal_comma=False) -> str:
     """Text of a generic ``t,[u,]y`` CSV (used by fixtures and round-trip tests)."""
