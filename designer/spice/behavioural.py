@@ -285,7 +285,18 @@ def _s_xfer_lines(alpha, rest, T, inp, y, name) -> list:
 
 
 def poles(num, den) -> np.ndarray:
-    """The poles of N(s)/D(s), rad/s (roots found in normalised frequency, for conditioning)."""
+    """The poles of N(s)/D(s), rad/s (roots found in normalised frequency, for conditioning).
+
+    Parameters
+    ----------
+    num, den : array_like
+        The numerator and denominator coefficients, highest power first.
+
+    Returns
+    -------
+    numpy.ndarray
+        The poles (complex, rad/s); empty for a constant denominator.
+    """
     T, alpha, _ = normalise(num, den)
     if alpha.size < 2:
         return np.zeros(0, dtype=complex)

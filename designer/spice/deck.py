@@ -143,7 +143,22 @@ class Board:
 def board(netlist: Netlist, opamp: OpAmp, package: str | None = None) -> Board:
     """The bench build of ``netlist`` with ``opamp`` in ``package`` (``single``,
     ``dual``, ``quad``; None: the op-amp's default). A kind the op-amp does not
-    come in is a :class:`~designer.core.errors.DesignError` (one line)."""
+    come in is a :class:`~designer.core.errors.DesignError` (one line).
+
+    Parameters
+    ----------
+    netlist : Netlist
+        The circuit's parts and op-amps.
+    opamp : designer.core.opamps.OpAmp
+        The op-amp built with.
+    package : str or None
+        ``single``, ``dual`` or ``quad``; None: the op-amp's default.
+
+    Returns
+    -------
+    Board
+        The op-amps assigned to packages, with their decoupling and bulk capacitors.
+    """
     from ..core.opamps import assign, spare_units
     pkg = opamp.package(package)
     units = assign(len(netlist.amps), pkg)
@@ -223,7 +238,13 @@ class SquareTest:
 
 
 def opamp_library_text() -> str:
-    """The project's behavioural op-amp subcircuits, for inlining."""
+    """The project's behavioural op-amp subcircuits, for inlining.
+
+    Returns
+    -------
+    str
+        The text of ``opamp_behavioural.lib``.
+    """
     return library_text("opamp_behavioural.lib")
 
 
@@ -245,6 +266,15 @@ def add_opamp(circuit, name: str, inp, inn, out, opamp: OpAmp, vcc="vcc", vee="v
 
 
 def add_supplies(circuit, opamp: OpAmp):
+    """The op-amps' supplies: sources ``Vcc`` and ``Vee`` from ground to the ``vcc`` and ``vee`` rails.
+
+    Parameters
+    ----------
+    circuit : PySpice.Spice.Netlist.Circuit
+        The circuit the sources are added to.
+    opamp : designer.core.opamps.OpAmp
+        Whose rail voltages they are.
+    """
     circuit.V("cc", "vcc", circuit.gnd, f"{opamp.vcc:.6g}")
     circuit.V("ee", "vee", circuit.gnd, f"{opamp.vee:.6g}")
 
@@ -254,6 +284,20 @@ def measure_lines(node: str, test: SquareTest, final: float, initial: float = 0.
 
     Levels are literal numbers (ngspice cannot use one measurement as another's
     level): ``final`` and ``initial`` are the expected settled values.
+
+    Parameters
+    ----------
+    node : str
+        The node measured.
+    test : SquareTest
+        The square-wave test (its delay, half period and edge).
+    final, initial : float
+        The expected settled values after and before the step (V).
+
+    Returns
+    -------
+    list of str
+        The ``.meas tran`` lines.
     """
     t0 = test.delay_s
     t1 = test.delay_s + test.half_period_s
@@ -276,20 +320,62 @@ def measure_lines(node: str, test: SquareTest, final: float, initial: float = 0.
 
 
 def settle_error_source(circuit, node: str, final: float, initial: float = 0.0):
-    """A probe node ``settle_err`` = |v(node) - final| / |span|, for the settling-time measure."""
+    """A probe node ``settle_err`` = |v(node) - final| / |span|, for the settling-time measure.
+
+    Parameters
+    ----------
+    circuit : PySpice.Spice.Netlist.Circuit
+        The circuit the behavioural source is added to.
+    node : str
+        The node whose settling is measured.
+    final, initial : float
+        The expected settled values after and before the step (V).
+    """
     span = abs(final - initial)
     circuit.B("settle", "settle_err", circuit.gnd,
               voltage_expression=f"abs(V({node})-{final:.6g})/{span:.6g}")
 
 
 def ac_lines(f_lo: float, f_hi: float, points_per_decade: int = 200) -> list:
-    """The ``.ac`` analysis of the sine check: a decade sweep from ``f_lo`` to ``f_hi``."""
+    """The ``.ac`` analysis of the sine check: a decade sweep from ``f_lo`` to ``f_hi``.
+
+    Parameters
+    ----------
+    f_lo, f_hi : float
+        The sweep's ends (Hz).
+    points_per_decade : int
+        The frequencies per decade.
+
+    Returns
+    -------
+    list of str
+        The deck's ``.ac`` line.
+    """
     return [f".ac dec {points_per_decade} {f_lo:.6g} {f_hi:.6g}"]
 
 
 def finish_deck(circuit, test: SquareTest, extra_lines=(), points: int = 20000, max_step_s: float | None = None) -> str:
     """Circuit text plus ``.tran`` (max step: :meth:`SquareTest.max_step_s`, or ``max_step_s`` when
-    that is shorter: a behavioural plant's own accuracy), extra lines and ``.end``."""
+    that is shorter: a behavioural plant's own accuracy), extra lines and ``.end``.
+
+    Parameters
+    ----------
+    circuit : PySpice.Spice.Netlist.Circuit
+        The circuit.
+    test : SquareTest
+        The square-wave test whose rising step is simulated.
+    extra_lines : iterable of str
+        Lines after ``.tran`` (the ``.meas`` statements).
+    points : int
+        The time points the test's max step aims at.
+    max_step_s : float or None
+        A shorter max step (s), or None.
+
+    Returns
+    -------
+    str
+        The deck, ending in ``.end`` and a newline.
+    """
     tmax = test.max_step_s(points)
     if max_step_s is not None and max_step_s < tmax:
         tmax = max_step_s

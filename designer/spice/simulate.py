@@ -75,7 +75,18 @@ _LOAD_ERROR = re.compile(r"error on line|unknown subckt|bad syntax|no circuit lo
 
 
 def measure_names(deck: str) -> list:
-    """The names of a deck's ``.meas`` statements, lower case (as ngspice prints them)."""
+    """The names of a deck's ``.meas`` statements, lower case (as ngspice prints them).
+
+    Parameters
+    ----------
+    deck : str
+        The deck's text.
+
+    Returns
+    -------
+    list of str
+        The names, in the deck's order, each once.
+    """
     return list(dict.fromkeys(m.lower() for m in _MEAS_DEF.findall(deck)))
 
 
@@ -96,14 +107,36 @@ def parse_measurements(text: str, deck: str) -> dict:
 
 
 def error_lines(text: str) -> list:
-    """ngspice's real error lines, notes and warnings left out."""
+    """ngspice's real error lines, notes and warnings left out.
+
+    Parameters
+    ----------
+    text : str
+        ngspice's output.
+
+    Returns
+    -------
+    list of str
+        Its error lines, stripped.
+    """
     lines = [ln.strip() for ln in _ERROR.findall(text)]
     return [ln for ln in lines if ln and not _NOT_ERROR.match(ln)]
 
 
 def read_raw(path) -> dict:
     """Read an ngspice raw file (binary or ASCII, real or complex data) into a
-    dict of arrays; a missing, truncated or corrupt file is a :class:`SimulatorError`."""
+    dict of arrays; a missing, truncated or corrupt file is a :class:`SimulatorError`.
+
+    Parameters
+    ----------
+    path : path-like
+        The raw file.
+
+    Returns
+    -------
+    dict
+        Vector name -> numpy array.
+    """
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
@@ -176,6 +209,18 @@ def with_raw_output(deck: str, raw_path) -> str:
     """The deck with a ``.control`` block that runs it and writes a binary raw file.
 
     ``ngspice -b -r file`` would be simpler but disables ``.meas`` in batch mode.
+
+    Parameters
+    ----------
+    deck : str
+        The deck's text (its ``.end`` line is replaced).
+    raw_path : path-like
+        Where ngspice writes the raw file.
+
+    Returns
+    -------
+    str
+        The deck with its ``.control`` block and ``.end``.
     """
     lines = deck.rstrip().splitlines()
     if lines and lines[-1].strip().lower() == ".end":
@@ -334,7 +379,18 @@ class PySpiceShared:
 
 def private_env(folder) -> dict:
     """The environment of an ``ngspice -b`` run: ours, with ``HOME`` in its private folder
-    (ngspice reads ``~/.spiceinit``; ``-n`` skips it too: both, in case one is ignored)."""
+    (ngspice reads ``~/.spiceinit``; ``-n`` skips it too: both, in case one is ignored).
+
+    Parameters
+    ----------
+    folder : path-like
+        The run's private folder.
+
+    Returns
+    -------
+    dict
+        The environment variables.
+    """
     env = dict(os.environ)
     env["HOME"] = str(folder)
     return env
@@ -378,7 +434,20 @@ DEFAULT_TIMEOUT_S = 120.0
 
 def get_simulator(name: str = "pyspice", timeout: float | None = None):
     """A backend by name: ``pyspice`` or ``ngspice-cli``; ``timeout`` (seconds)
-    bounds each ``ngspice -b`` run (default :data:`DEFAULT_TIMEOUT_S`)."""
+    bounds each ``ngspice -b`` run (default :data:`DEFAULT_TIMEOUT_S`).
+
+    Parameters
+    ----------
+    name : str
+        ``pyspice`` (also ``shared``, ``ngspice-shared``) or ``ngspice-cli`` (also ``cli``, ``ngspice``).
+    timeout : float or None
+        Seconds each ``ngspice -b`` run may take; None: :data:`DEFAULT_TIMEOUT_S`.
+
+    Returns
+    -------
+    PySpiceShared or NgspiceCli
+        The backend; an unknown name is a :class:`~designer.core.errors.DesignError`.
+    """
     key = str(name).strip().lower()
     if key in ("pyspice", "shared", "ngspice-shared"):
         return PySpiceShared()
@@ -393,7 +462,18 @@ _VERSIONS: dict = {}
 def ngspice_version(simulator: str | None) -> str | None:
     """The version of ngspice behind a backend (``"39"``; the shared library
     and the program can differ), None when it cannot be told. Asked once per
-    process and backend."""
+    process and backend.
+
+    Parameters
+    ----------
+    simulator : str or None
+        The backend's name (:func:`get_simulator`); None: no simulation.
+
+    Returns
+    -------
+    str or None
+        The version.
+    """
     if simulator is None:
         return None
     key = get_simulator(simulator).name
@@ -427,7 +507,20 @@ def _shared_version() -> str | None:
 def tool_info(simulator: str | None, argv=None) -> dict:
     """What produced a result, for ``result.json``'s ``tool`` and the JUnit
     properties: this tool's name and version, Python's, ngspice's (None
-    without a simulation) and the backend, and the command line."""
+    without a simulation) and the backend, and the command line.
+
+    Parameters
+    ----------
+    simulator : str or None
+        The backend's name; None: no simulation.
+    argv : list of str, optional
+        The command line; default ``sys.argv``.
+
+    Returns
+    -------
+    dict
+        ``name``, ``version``, ``python``, ``ngspice``, ``simulator`` and ``argv``.
+    """
     from .. import __version__
     return {"name": "designer", "version": __version__, "python": sys.version.split()[0],
             "ngspice": ngspice_version(simulator), "simulator": simulator,

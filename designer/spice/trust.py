@@ -238,6 +238,11 @@ def expand_deck(path, root=None) -> str:
         The folder every file the deck reaches must resolve inside (the spec's
         folder); None: anywhere (``check-design --allow-outside``, trusted use).
 
+    Returns
+    -------
+    str
+        The expanded deck, ending in a newline ("" for an empty file).
+
     Raises
     ------
     DesignError
@@ -258,7 +263,20 @@ def expand_deck(path, root=None) -> str:
 
 def check_deck_text(text: str, name: str = "deck") -> None:
     """Refuse a deck's text that would run a command or open a file (the same
-    rules, for a deck already in memory: no file may be included)."""
+    rules, for a deck already in memory: no file may be included).
+
+    Parameters
+    ----------
+    text : str
+        The deck's text.
+    name : str
+        What the deck is called in an error message.
+
+    Raises
+    ------
+    DesignError
+        One line: the line at fault and why.
+    """
     lines = [_Line(Path(name), i, t) for i, t in enumerate(text.splitlines(), 1)]
     reader = _Reader(None, None)
     check_lines(lines, reader, title=True)
