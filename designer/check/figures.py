@@ -75,7 +75,18 @@ def unit_of(kind: str, figure: str) -> str:
 
 
 def plant_figures(res) -> dict:
-    """Every :data:`PLANT` figure of a :class:`~designer.plant.result.PlantResult`."""
+    """Every :data:`PLANT` figure of a :class:`~designer.plant.result.PlantResult`.
+
+    Parameters
+    ----------
+    res : designer.plant.result.PlantResult
+        The designed or analysed plant.
+
+    Returns
+    -------
+    dict
+        Figure name -> value.
+    """
     a, o = res.analytic, res.analytic_opamp
     out = {"fn_hz": float(o.figures.fn_hz), "zeta": float(o.figures.zeta), "q": float(o.figures.q),
            "ideal_fn_hz": a.figures.fn_hz, "ideal_zeta": a.figures.zeta, "ideal_q": a.figures.q,

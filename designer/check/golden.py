@@ -37,7 +37,19 @@ def header_of(tool: dict, spec: str, corner: str) -> dict:
 
 def write_golden(path, t, signals: dict, header: dict) -> None:
     """Record ``signals`` (name -> samples on ``t``) at ``path``, atomically; a
-    sample that is not a finite number is refused (the file could never compare)."""
+    sample that is not a finite number is refused (the file could never compare).
+
+    Parameters
+    ----------
+    path : path-like
+        The golden file written.
+    t : array_like
+        The time points (s).
+    signals : dict
+        Signal name -> samples on ``t``.
+    header : dict
+        What the file's header records (the spec, the corner, the tool).
+    """
     t = np.asarray(t, float)
     _finite(t, "the run's time", t, f" {shown(path)}")
     for sig, values in signals.items():
@@ -53,7 +65,18 @@ def read_golden(path) -> tuple:
     """(header dict, time, {signal: samples}) of a golden file; a file that is
     not one (no ``time_s,...`` line, fewer than 2 samples, a sample that is
     not a finite number, time not increasing) is refused in one line naming it
-    (and the column and row of a bad sample)."""
+    (and the column and row of a bad sample).
+
+    Parameters
+    ----------
+    path : path-like
+        The golden file.
+
+    Returns
+    -------
+    tuple
+        (header dict, time array, {signal: samples}).
+    """
     name = shown(path)
     text = read_text(path, "golden file", MAX_TABLE_BYTES * 4)
     header, body, lines = {}, [], []
@@ -103,6 +126,26 @@ def version_warnings(recorded: dict, now: dict, path) -> list:
 def compare(t, test: dict, t_gold, gold: dict, tolerances: dict, path=None) -> dict:
     """signal -> its nrms against the gold (xyce_verify rule), for each signal of ``tolerances``
     (name -> (reltol, abstol)); the test's time points outside the gold's span are left out.
+
+    Parameters
+    ----------
+    t : array_like
+        The test run's time points (s).
+    test : dict
+        Signal -> the run's samples on ``t``.
+    t_gold : array_like
+        The gold's time points (s).
+    gold : dict
+        Signal -> the gold's samples on ``t_gold``.
+    tolerances : dict
+        Signal -> (reltol, abstol): the signals compared.
+    path : path-like, optional
+        The golden file, named in an error.
+
+    Returns
+    -------
+    dict
+        Signal -> its nrms against the gold.
 
     Raises
     ------

@@ -35,7 +35,18 @@ def visible(text) -> str:
     """``text`` with every character XML 1.0 forbids as a visible escape: ``\\x01``,
     ``\\x1b``; a lone surrogate from a byte that is not UTF-8 (surrogateescape) as
     that byte, ``\\xff``; any other as ``\\udXXX`` (not reversible: a backslash stays
-    as it is)."""
+    as it is).
+
+    Parameters
+    ----------
+    text : str
+        Any text.
+
+    Returns
+    -------
+    str
+        The text XML 1.0 can hold.
+    """
     return _NOT_XML.sub(_escape, str(text))
 
 
@@ -51,7 +62,20 @@ def _seconds(s: float) -> str:
 
 
 def junit_xml(outcomes, seconds: float) -> str:
-    """The XML document (text) for a run's :class:`~designer.check.result.SpecOutcome` list."""
+    """The XML document (text) for a run's :class:`~designer.check.result.SpecOutcome` list.
+
+    Parameters
+    ----------
+    outcomes : list of designer.check.result.SpecOutcome
+        The run's specs and their corners.
+    seconds : float
+        The run's duration.
+
+    Returns
+    -------
+    str
+        The JUnit XML document.
+    """
     root = ET.Element("testsuites", name="check-design")
     totals = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
     stamp = time.strftime("%Y-%m-%dT%H:%M:%S", time.gmtime())

@@ -109,7 +109,24 @@ def limit_from(figure: str, entry: dict, where: str, unit: str = "") -> Limit:
     """A :class:`Limit` from a spec's mapping ``{min, typ, max, fail}`` (keys
     already checked), refusing in one line, prefixed with ``where``: a bound
     that is no number, a relative bound without typ, no bound at all, min above
-    max, typ outside them, a ``fail`` that is not true or false."""
+    max, typ outside them, a ``fail`` that is not true or false.
+
+    Parameters
+    ----------
+    figure : str
+        The figure limited.
+    entry : dict
+        The spec's ``{min, typ, max, fail}`` mapping.
+    where : str
+        What an error message starts with (the spec's file and line).
+    unit : str
+        The figure's unit, for the messages.
+
+    Returns
+    -------
+    Limit
+        The limit.
+    """
     typ = None if entry.get("typ") is None else _number(entry["typ"], f"{where}.typ")
     lo = _bound(entry.get("min"), typ, f"{where}.min")
     hi = _bound(entry.get("max"), typ, f"{where}.max")

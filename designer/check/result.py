@@ -109,7 +109,18 @@ class SpecOutcome:
 
 
 def exit_status(outcomes) -> int:
-    """2 a spec proved bad, 3 a simulator error or timeout, 1 a check failed, 0 all passed."""
+    """2 a spec proved bad, 3 a simulator error or timeout, 1 a check failed, 0 all passed.
+
+    Parameters
+    ----------
+    outcomes : list of SpecOutcome
+        The run's specs and their corners.
+
+    Returns
+    -------
+    int
+        The command's exit status.
+    """
     cases = [c for o in outcomes for c in o.cases]
     if any(c.status == ERROR and c.error_kind == SPEC_ERROR for c in cases):
         return EXIT_BAD_INPUT
@@ -123,6 +134,19 @@ def exit_status(outcomes) -> int:
 def headline(outcome: SpecOutcome, case: Case) -> str:
     """One line naming the spec, the corner and the value against its limit:
     ``lab3-plant [TL072]: overshoot_pct = 55.2 above max 55`` (every case's
-    message starts with what it checks)."""
+    message starts with what it checks).
+
+    Parameters
+    ----------
+    outcome : SpecOutcome
+        The spec's outcome.
+    case : Case
+        The check (a corner's figure against its limit).
+
+    Returns
+    -------
+    str
+        The line.
+    """
     corner = f" [{case.corner}]" if case.corner else ""
     return f"{outcome.name}{corner}: {case.message}"

@@ -35,7 +35,26 @@ __all__ = ["corner_task", "run_corner"]
 def run_corner(spec: CheckSpec, index: int, simulator: str, *, update_golden: bool = False,
                out_dir=None) -> CornerOutcome:
     """Run and judge corner ``index`` of ``spec`` (see the module docstring); ``out_dir``
-    is the spec's own output folder (its files go there), None for none."""
+    is the spec's own output folder (its files go there), None for none.
+
+    Parameters
+    ----------
+    spec : CheckSpec
+        The spec.
+    index : int
+        The corner's index in ``spec``.
+    simulator : str
+        The backend's name.
+    update_golden : bool
+        Record the golden waveforms instead of comparing with them.
+    out_dir : path-like or None
+        The spec's output folder.
+
+    Returns
+    -------
+    CornerOutcome
+        The corner's checks and what became of them.
+    """
     from ..spice.simulate import tool_info
     corner = spec.corners[index]
     tick = time.perf_counter()
@@ -57,7 +76,28 @@ def run_corner(spec: CheckSpec, index: int, simulator: str, *, update_golden: bo
 
 def corner_task(spec: CheckSpec, index: int, simulator: str, update_golden: bool, out_dir, timeout: float):
     """:func:`run_corner` as a task of a Dask worker (``check-design --dask``): its ``ngspice -b``
-    runs get the command's ``--timeout`` (a cluster cannot kill a running task)."""
+    runs get the command's ``--timeout`` (a cluster cannot kill a running task).
+
+    Parameters
+    ----------
+    spec : CheckSpec
+        The spec.
+    index : int
+        The corner's index in ``spec``.
+    simulator : str
+        The backend's name.
+    update_golden : bool
+        Record the golden waveforms instead of comparing with them.
+    out_dir : path-like or None
+        The spec's output folder.
+    timeout : float
+        Seconds each ``ngspice -b`` run may take.
+
+    Returns
+    -------
+    CornerOutcome
+        As :func:`run_corner`.
+    """
     from ..spice import simulate
     simulate.DEFAULT_TIMEOUT_S = float(timeout)
     return run_corner(spec, index, simulator, update_golden=update_golden, out_dir=out_dir)

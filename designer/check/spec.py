@@ -100,6 +100,22 @@ def load_spec(path, update_golden: bool = False, root=None, allow_outside: bool 
     own validation for every corner, the deck's ``.meas`` names, the golden
     files exist unless ``update_golden``).
 
+    Parameters
+    ----------
+    path : path-like
+        The YAML spec file.
+    update_golden : bool
+        The golden files are to be recorded (they need not exist).
+    root : path-like, optional
+        The folder the files the spec names must resolve inside (``--root``); None: the spec's folder.
+    allow_outside : bool
+        Files outside ``root`` are allowed (``--allow-outside``, trusted use).
+
+    Returns
+    -------
+    CheckSpec
+        The spec.
+
     Raises
     ------
     DesignError

@@ -20,7 +20,20 @@ def _cell(text: str) -> str:
 
 
 def summary_markdown(outcomes, seconds: float) -> str:
-    """The summary (text) for a run's :class:`~designer.check.result.SpecOutcome` list."""
+    """The summary (text) for a run's :class:`~designer.check.result.SpecOutcome` list.
+
+    Parameters
+    ----------
+    outcomes : list of designer.check.result.SpecOutcome
+        The run's specs and their corners.
+    seconds : float
+        The run's duration.
+
+    Returns
+    -------
+    str
+        The Markdown summary.
+    """
     tot = {PASS: 0, FAIL: 0, SKIP: 0, ERROR: 0}
     for o in outcomes:
         for k, v in o.counts().items():

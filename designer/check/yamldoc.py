@@ -121,7 +121,18 @@ def parse_yaml(path) -> _Doc:
     expanded, 64 levels, no key twice in a mapping, scalars of
     at most 4096 characters, 65536 for
     ``description``; merge keys ``<<`` work), a mapping; every problem one
-    line naming the file and line."""
+    line naming the file and line.
+
+    Parameters
+    ----------
+    path : path-like
+        The spec file.
+
+    Returns
+    -------
+    _Doc
+        The document: its mapping, with the line of every key.
+    """
     import yaml
     path = Path(path)
     text = read_text(path, "spec file", MAX_SPEC_BYTES)
