@@ -67,7 +67,20 @@ def write_bundle(files: dict, deck: str, images: dict, title: str, sections, res
 
 
 def schematic_pictures(schematic, result) -> tuple:
-    """``schematic(result)`` (a wing's drawing of the design) as (SVG text, PNG bytes)."""
+    """``schematic(result)`` (a wing's drawing of the design) as (SVG text, PNG bytes).
+
+    Parameters
+    ----------
+    schematic : callable
+        ``schematic(result)``: the wing's drawing of the design.
+    result
+        The design's typed result.
+
+    Returns
+    -------
+    tuple
+        (SVG text, PNG bytes).
+    """
     sheet = schematic(result)
     return sheet.svg(), sheet.png()
 
@@ -89,7 +102,24 @@ class Early:
 def draw_early(result, plots, schematic, names) -> Early:
     """Start drawing the schematic and the ``names`` among ``plots`` (those that read
     nothing of the SPICE run); :func:`write_design` takes the :class:`Early` and
-    draws the rest. The pictures are the same as when drawn after the run."""
+    draws the rest. The pictures are the same as when drawn after the run.
+
+    Parameters
+    ----------
+    result
+        The design's typed result.
+    plots : list of tuple
+        ``(file name, draw(result) -> PNG)`` pairs.
+    schematic : callable
+        ``schematic(result)``: the wing's drawing of the design.
+    names : iterable of str
+        The file names among ``plots`` drawn now.
+
+    Returns
+    -------
+    Early
+        The pictures started.
+    """
     return Early(plots, schematic, result, names)
 
 
@@ -105,6 +135,32 @@ def write_design(result, out_dir, name: str, plots, schematic, sections, title: 
     schematic inlined; ``texts``: key -> (file name, text(result)). ``result.files``
     is set before result.json is written, so it lists itself; it is returned, and
     ``result.timings["report_s"]`` set.
+
+    Parameters
+    ----------
+    result
+        The design's typed result (its ``files`` and ``timings`` are set).
+    out_dir : path-like
+        The folder the bundle goes under.
+    name : str
+        The design's name (the bundle's file names).
+    plots : list of tuple
+        ``(file name, draw(result) -> PNG)`` pairs.
+    schematic : callable
+        ``schematic(result)``: the wing's drawing of the design.
+    sections : callable
+        ``sections(svg)``: the sheet's sections with the schematic inlined.
+    title : str
+        The sheet's title.
+    texts : dict, optional
+        Key -> (file name, text(result)): more files of the bundle.
+    early : Early, optional
+        The pictures :func:`draw_early` started.
+
+    Returns
+    -------
+    dict
+        The bundle's files (``result.files``).
     """
     import time
 

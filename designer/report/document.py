@@ -22,37 +22,142 @@ __all__ = ["columns", "figure", "fmt_pct", "fmt_time", "image", "subhead", "tabl
 # ---- content blocks ---------------------------------------------------------
 
 def table(header, rows, cls: str = ""):
-    """A table; ``cls`` is an HTML class (``compact`` for the narrow first-page tables)."""
+    """A table; ``cls`` is an HTML class (``compact`` for the narrow first-page tables).
+
+    Parameters
+    ----------
+    header : list of str
+        The column headings.
+    rows : list of list
+        The rows' cells.
+    cls : str
+        The HTML class.
+
+    Returns
+    -------
+    tuple
+        The block.
+    """
     return ("table", list(header), [list(r) for r in rows], cls)
 
 
 def text(s):
+    """A paragraph block.
+
+    Parameters
+    ----------
+    s : str
+        The paragraph.
+
+    Returns
+    -------
+    tuple
+        The block.
+    """
     return ("text", s)
 
 
 def image(name, alt):
+    """A picture block: the PNG ``name`` (embedded in the HTML, beside the Markdown).
+
+    Parameters
+    ----------
+    name : str
+        The PNG's file name in the bundle.
+    alt : str
+        Its alternative text.
+
+    Returns
+    -------
+    tuple
+        The block.
+    """
     return ("image", name, alt)
 
 
 def figure(name, svg, alt):
-    """A schematic: inline SVG in the HTML, the PNG ``name`` beside the Markdown."""
+    """A schematic: inline SVG in the HTML, the PNG ``name`` beside the Markdown.
+
+    Parameters
+    ----------
+    name : str
+        The PNG's file name in the bundle.
+    svg : str
+        The schematic's SVG text.
+    alt : str
+        Its alternative text.
+
+    Returns
+    -------
+    tuple
+        The block.
+    """
     return ("figure", name, svg, alt)
 
 
 def columns(*cols):
-    """Blocks side by side (each argument a list of blocks); one after the other in Markdown and text."""
+    """Blocks side by side (each argument a list of blocks); one after the other in Markdown and text.
+
+    Parameters
+    ----------
+    *cols : list
+        Each a list of blocks.
+
+    Returns
+    -------
+    tuple
+        The block.
+    """
     return ("columns", [list(c) for c in cols])
 
 
 def subhead(s):
+    """A subheading block.
+
+    Parameters
+    ----------
+    s : str
+        The subheading.
+
+    Returns
+    -------
+    tuple
+        The block.
+    """
     return ("subhead", s)
 
 
 def fmt_pct(v, digits=3):
+    """A signed percentage to ``digits`` significant digits (``+1.5 %``), ``n/a`` for None or NaN.
+
+    Parameters
+    ----------
+    v : float or None
+        The percentage.
+    digits : int
+        Significant digits.
+
+    Returns
+    -------
+    str
+        The text.
+    """
     return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:+.{digits}g} %"
 
 
 def fmt_time(v):
+    """A time in engineering notation (``43.2 us``), ``n/a`` for None.
+
+    Parameters
+    ----------
+    v : float or None
+        The time (s).
+
+    Returns
+    -------
+    str
+        The text.
+    """
     return "n/a" if v is None else format_eng(v, "s")
 
 
@@ -145,7 +250,22 @@ def _html_blocks(blocks, images, out):
 
 
 def to_html(title, sections, images: dict) -> str:
-    """Self-contained HTML: images embedded as data URIs, schematics as inline SVG."""
+    """Self-contained HTML: images embedded as data URIs, schematics as inline SVG.
+
+    Parameters
+    ----------
+    title : str
+        The document's title.
+    sections : list
+        (heading, blocks) pairs.
+    images : dict
+        PNG file name -> bytes.
+
+    Returns
+    -------
+    str
+        The HTML document.
+    """
     e = html.escape
     out = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{e(title)}</title>",
            f"<style>{_CSS}</style></head><body>", f"<h1>{e(title)}</h1>"]
@@ -158,7 +278,20 @@ def to_html(title, sections, images: dict) -> str:
 
 
 def to_text(title, sections) -> str:
-    """Plain terminal rendering (tables aligned, images and schematics listed by name)."""
+    """Plain terminal rendering (tables aligned, images and schematics listed by name).
+
+    Parameters
+    ----------
+    title : str
+        The document's title.
+    sections : list
+        (heading, blocks) pairs.
+
+    Returns
+    -------
+    str
+        The text.
+    """
     out = [title, "=" * len(title)]
     for heading, blocks in sections:
         if heading:

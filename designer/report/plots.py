@@ -26,7 +26,22 @@ MAX_POINTS = 1500
 
 
 def decimate(x, *ys, n: int = MAX_POINTS):
-    """``x`` and the ``ys`` at most ``n`` evenly spaced samples (the ends kept)."""
+    """``x`` and the ``ys`` at most ``n`` evenly spaced samples (the ends kept).
+
+    Parameters
+    ----------
+    x : array_like
+        The abscissa.
+    *ys : array_like
+        The ordinates on ``x``.
+    n : int
+        The most samples kept.
+
+    Returns
+    -------
+    tuple
+        ``x`` and each of ``ys``, decimated alike.
+    """
     x = np.asarray(x)
     if x.size <= n:
         return (x, *[None if y is None else np.asarray(y) for y in ys])
@@ -36,7 +51,22 @@ def decimate(x, *ys, n: int = MAX_POINTS):
 
 def figure(w: float, h: float, rows: int = 1, cols: int = 1, **kw):
     """A figure and its axes without pyplot (Agg canvas), with fixed margins: a
-    "tight" bounding box would draw every figure twice to measure it."""
+    "tight" bounding box would draw every figure twice to measure it.
+
+    Parameters
+    ----------
+    w, h : float
+        The size (inches).
+    rows, cols : int
+        The grid of axes.
+    **kw
+        Passed to ``Figure.subplots``.
+
+    Returns
+    -------
+    tuple
+        (figure, axes).
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     fig = Figure(figsize=(w, h))
@@ -62,7 +92,22 @@ def log_frequency_axis(ax) -> None:
 
 def png_bytes(fig, dpi: int = 110, tight: bool = True) -> bytes:
     """A matplotlib figure as PNG bytes (the figure is closed if pyplot owns it);
-    ``tight`` crops to what is drawn (one more drawing pass)."""
+    ``tight`` crops to what is drawn (one more drawing pass).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    dpi : int
+        The resolution.
+    tight : bool
+        Crop to what is drawn.
+
+    Returns
+    -------
+    bytes
+        The PNG.
+    """
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight" if tight else None)
     import sys
@@ -73,7 +118,18 @@ def png_bytes(fig, dpi: int = 110, tight: bool = True) -> bytes:
 
 def time_unit(span_s: float) -> tuple:
     """(scale, unit) of a time axis: microseconds below 100 ms (every sheet so far), milliseconds below
-    100 s, else seconds (a slow model plant's loop)."""
+    100 s, else seconds (a slow model plant's loop).
+
+    Parameters
+    ----------
+    span_s : float
+        The axis' span (s).
+
+    Returns
+    -------
+    tuple
+        (scale, unit): seconds times scale in unit.
+    """
     if span_s < 0.1:
         return 1e6, "us"
     return (1e3, "ms") if span_s < 100 else (1.0, "s")
@@ -85,7 +141,30 @@ def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)", residual:
 
     ``residual``: (label, measured, model) drawn as measured - model in a panel
     below; ``band``: (t, lo, hi, label) shaded behind the curves; ``xlabel``: what
-    the time axis counts (its unit is added)."""
+    the time axis counts (its unit is added).
+
+    Parameters
+    ----------
+    t : array_like
+        Time points (s).
+    curves : dict
+        Label -> samples on ``t``.
+    title : str
+        The plot's title.
+    ylabel : str
+        The vertical axis' label.
+    residual : tuple, optional
+        (label, measured, model).
+    band : tuple, optional
+        (t, lo, hi, label).
+    xlabel : str
+        What the time axis counts.
+
+    Returns
+    -------
+    bytes
+        The PNG.
+    """
     if residual is not None:
         fig, (ax, ar) = figure(7.5, 4.6, 2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.1]})
     else:
@@ -124,7 +203,26 @@ def bode_plot(systems: dict, f_lo: float, f_hi: float, title: str, measured: dic
               markers: list | None = None) -> bytes:
     """Magnitude (dB) and phase (deg) of transfer functions ``{label: (num, den)}``;
     ``measured``: {label: (f, complex H)} drawn as points (SPICE's .ac run);
-    ``markers``: (f, gain V/V, text, style) points marked on the magnitude."""
+    ``markers``: (f, gain V/V, text, style) points marked on the magnitude.
+
+    Parameters
+    ----------
+    systems : dict
+        Label -> (num, den), coefficients highest power first.
+    f_lo, f_hi : float
+        The frequency axis' ends (Hz).
+    title : str
+        The plot's title.
+    measured : dict, optional
+        Label -> (f, complex H): points drawn.
+    markers : list, optional
+        (f, gain V/V, text, style) points marked on the magnitude.
+
+    Returns
+    -------
+    bytes
+        The PNG.
+    """
     from ..core.lti import freq_response
     f = np.logspace(np.log10(f_lo), np.log10(f_hi), 500)
     fig, (a1, a2) = figure(7.5, 4.6, 2, 1, sharex=True)
@@ -156,7 +254,30 @@ def bode_plot(systems: dict, f_lo: float, f_hi: float, title: str, measured: dic
 def loop_gain_plot(f, L, title: str, crossover_hz: float, phase_margin_deg: float,
                    phase_crossover_hz: float, gain_margin_db: float) -> bytes:
     """Loop gain |L| (dB) and phase with the margins marked: the phase margin at
-    the gain crossover, the gain margin at the -180 deg crossing."""
+    the gain crossover, the gain margin at the -180 deg crossing.
+
+    Parameters
+    ----------
+    f : array_like
+        Frequencies (Hz).
+    L : array_like
+        The complex loop gain on ``f``.
+    title : str
+        The plot's title.
+    crossover_hz : float
+        The gain crossover.
+    phase_margin_deg : float
+        The phase margin there.
+    phase_crossover_hz : float
+        The -180 deg crossing.
+    gain_margin_db : float
+        The gain margin there.
+
+    Returns
+    -------
+    bytes
+        The PNG.
+    """
     f, L = decimate(f, L)
     mag = 20 * np.log10(np.abs(L))
     ph = np.degrees(np.unwrap(np.angle(L)))
@@ -196,7 +317,28 @@ def loop_gain_plot(f, L, title: str, crossover_hz: float, phase_margin_deg: floa
 def histogram_plot(values, name: str, nominal: float | None = None, lo: float | None = None,
                    hi: float | None = None, title: str = "", bins: int = 60) -> bytes:
     """A histogram of a figure over Monte Carlo samples (NaN left out), the limits ``lo``/``hi``
-    drawn as red lines with the region outside shaded, the nominal design as a dashed line."""
+    drawn as red lines with the region outside shaded, the nominal design as a dashed line.
+
+    Parameters
+    ----------
+    values : array_like
+        The figure's value in each sample.
+    name : str
+        The figure's name (the axis label).
+    nominal : float, optional
+        The nominal design's value.
+    lo, hi : float, optional
+        The limits.
+    title : str
+        The plot's title.
+    bins : int
+        The histogram's bins.
+
+    Returns
+    -------
+    bytes
+        The PNG.
+    """
     from matplotlib.ticker import FuncFormatter
 
     from ..core.units import figure_unit, format_eng, value_code

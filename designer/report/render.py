@@ -72,7 +72,13 @@ def _call(task):
 
 def start(preload=()) -> None:
     """Fork the renderer (once; a failure to fork leaves drawing in the caller). It
-    imports the ``preload`` modules (names) before the plotting libraries."""
+    imports the ``preload`` modules (names) before the plotting libraries.
+
+    Parameters
+    ----------
+    preload : iterable of str
+        Names of the modules the renderer imports first.
+    """
     global _worker
     if _worker is not None:
         return
@@ -97,7 +103,15 @@ def stop() -> None:
 
 @contextmanager
 def ahead(enabled: bool = True, preload=()):
-    """``with ahead():`` the renderer runs for the block (started when ``enabled``), then ends."""
+    """``with ahead():`` the renderer runs for the block (started when ``enabled``), then ends.
+
+    Parameters
+    ----------
+    enabled : bool
+        Start the renderer (else the block runs without one).
+    preload : iterable of str
+        Modules the renderer imports first (:func:`start`).
+    """
     if enabled:
         start(preload)
     try:
@@ -107,7 +121,13 @@ def ahead(enabled: bool = True, preload=()):
 
 
 def running() -> bool:
-    """Whether a renderer is started (tasks go to it)."""
+    """Whether a renderer is started (tasks go to it).
+
+    Returns
+    -------
+    bool
+        A renderer is started.
+    """
     return _worker is not None
 
 
@@ -134,7 +154,20 @@ class Pending:
 
 
 def submit(fn, *args) -> Pending:
-    """``fn(*args)`` in the renderer when one is started; :meth:`Pending.result` gives it."""
+    """``fn(*args)`` in the renderer when one is started; :meth:`Pending.result` gives it.
+
+    Parameters
+    ----------
+    fn : callable
+        What draws (picklable).
+    *args
+        Its arguments.
+
+    Returns
+    -------
+    Pending
+        The picture being drawn.
+    """
     return Pending(fn, args)
 
 
@@ -142,7 +175,18 @@ def submit_many(calls) -> Pending:
     """``[(fn, args), ...]`` drawn side by side: the renderer, already warm, forks a
     helper for every call but the first (the pictures of one sheet then take the
     longest one's time on two cores, not their sum). :meth:`Pending.result` gives
-    the list of return values, in order."""
+    the list of return values, in order.
+
+    Parameters
+    ----------
+    calls : list of tuple
+        ``(fn, args)`` pairs.
+
+    Returns
+    -------
+    Pending
+        The pictures being drawn.
+    """
     return Pending(_many, (tuple(calls),))
 
 

@@ -185,7 +185,20 @@ def check_connectivity(sheet: Sheet, terminals: dict) -> list:
     """Where the drawing disagrees with the deck: ``terminals`` maps (designator,
     terminal) -> the deck's net. Every drawn terminal must land on a drawing net
     that holds exactly the terminals of one deck net, and every label on it must
-    name that net. Returns the disagreements (empty: the drawing is the deck)."""
+    name that net. Returns the disagreements (empty: the drawing is the deck).
+
+    Parameters
+    ----------
+    sheet : Sheet
+        The drawing.
+    terminals : dict
+        (designator, terminal) -> the deck's net.
+
+    Returns
+    -------
+    list of str
+        The disagreements.
+    """
     nets, named = sheet.connectivity()
     problems = []
     deck_to_drawn, drawn_to_deck = {}, {}

@@ -36,7 +36,18 @@ def histogram_png(result, figure: str) -> bytes:
 
 def histogram_plots(result) -> tuple:
     """(file name, draw(result)) of every histogram of the result's Monte Carlo (none without one):
-    the headline figure's, then each limited figure's."""
+    the headline figure's, then each limited figure's.
+
+    Parameters
+    ----------
+    result
+        A design's typed result.
+
+    Returns
+    -------
+    tuple
+        (file name, draw(result)) pairs.
+    """
     mc = result.monte_carlo
     if mc is None or mc.headline is None:   # none, or one build replayed: no spread
         return ()
@@ -50,7 +61,18 @@ def _samples_csv(result) -> str:
 
 def csv_texts(result) -> dict:
     """The bundle's ``monte-carlo.csv`` (one row per build: every varied part, every figure), as
-    :func:`designer.report.bundle.write_design` takes its texts; none without a Monte Carlo."""
+    :func:`designer.report.bundle.write_design` takes its texts; none without a Monte Carlo.
+
+    Parameters
+    ----------
+    result
+        A design's typed result.
+
+    Returns
+    -------
+    dict
+        Key -> (file name, text(result)); empty without a Monte Carlo.
+    """
     return {} if result.monte_carlo is None else {"monte_carlo_csv": ("monte-carlo.csv", _samples_csv)}
 
 
@@ -64,7 +86,20 @@ def _pct(x: float) -> str:
 
 def title(result, worst: bool = False) -> str | None:
     """The tolerance section's heading (None: no section): what the result carries, the Monte Carlo
-    and (with ``worst``) the worst case."""
+    and (with ``worst``) the worst case.
+
+    Parameters
+    ----------
+    result
+        A design's typed result.
+    worst : bool
+        Count the worst case.
+
+    Returns
+    -------
+    str or None
+        The heading.
+    """
     what = [w for w, x in (("Monte Carlo", result.monte_carlo),
                            ("worst case", getattr(result, "worst_case", None) if worst else None)) if x is not None]
     return f"Tolerance analysis ({', '.join(what)})" if what else None
@@ -99,7 +134,22 @@ def worst_case_blocks(wc) -> list:
 
 def section(result, with_images: bool = True, worst: bool = False) -> list:
     """The sheet's tolerance section (blocks): the Monte Carlo's (empty without one) and, with
-    ``worst``, the worst case's (:func:`worst_case_blocks`) when the result has one."""
+    ``worst``, the worst case's (:func:`worst_case_blocks`) when the result has one.
+
+    Parameters
+    ----------
+    result
+        A design's typed result.
+    with_images : bool
+        Show the histograms.
+    worst : bool
+        Add the worst case.
+
+    Returns
+    -------
+    list
+        The blocks.
+    """
     wc = getattr(result, "worst_case", None) if worst else None
     tail = [] if wc is None else worst_case_blocks(wc)
     return _monte_carlo_blocks(result, with_images) + tail

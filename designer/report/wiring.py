@@ -34,7 +34,22 @@ def _package_of(part) -> str:
 def bom_rows(board, source_of, opamp_name: str) -> list:
     """Bill of materials rows (:data:`BOM_HEADER`), parts of one value, series and
     package grouped on one row; ``source_of(ref)`` gives (series, tolerance in
-    percent), or None where the part is not from an E-series (decoupling)."""
+    percent), or None where the part is not from an E-series (decoupling).
+
+    Parameters
+    ----------
+    board : designer.spice.deck.Board
+        The bench build.
+    source_of : callable
+        ``source_of(ref)`` -> (series, tolerance in percent) or None.
+    opamp_name : str
+        The op-amp's name.
+
+    Returns
+    -------
+    list
+        The rows.
+    """
     groups, order = {}, []
     for p in board.parts():
         src = source_of(p.ref)
@@ -65,7 +80,18 @@ def bom_rows(board, source_of, opamp_name: str) -> list:
 
 
 def bom_csv(rows) -> str:
-    """``bom.csv``: the bill of materials, one header row, comma separated."""
+    """``bom.csv``: the bill of materials, one header row, comma separated.
+
+    Parameters
+    ----------
+    rows : list
+        The bill of materials' rows (:func:`bom_rows`).
+
+    Returns
+    -------
+    str
+        The CSV text.
+    """
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(BOM_HEADER)
@@ -87,7 +113,22 @@ def _pins_on(board, net) -> list:
 
 
 def net_text(board, net, labels: dict) -> str:
-    """A net as the wiring table names it: its label, and the op-amp pins on it by number."""
+    """A net as the wiring table names it: its label, and the op-amp pins on it by number.
+
+    Parameters
+    ----------
+    board : designer.spice.deck.Board
+        The bench build.
+    net : str
+        The deck's net.
+    labels : dict
+        Net -> what to call it.
+
+    Returns
+    -------
+    str
+        The text.
+    """
     pins = _pins_on(board, net)
     label = labels.get(net)
     if pins:
@@ -101,7 +142,22 @@ def wiring_rows(board, labels: dict, supplies: tuple) -> list:
     between op-amp pins that no part joins (a follower's output to its -in),
     the supply pins of every package with their decoupling, the spare units'
     tie-off, and the pins left open. ``labels``: net -> what to call it;
-    ``supplies``: (V+, V-) volts."""
+    ``supplies``: (V+, V-) volts.
+
+    Parameters
+    ----------
+    board : designer.spice.deck.Board
+        The bench build.
+    labels : dict
+        Net -> what to call it.
+    supplies : tuple
+        (V+, V-) volts.
+
+    Returns
+    -------
+    list
+        The rows.
+    """
     rows = [[p.ref, value_code(p.value), net_text(board, p.a, labels), net_text(board, p.b, labels)]
             for p in board.netlist.parts]
     for a, u in zip(board.netlist.amps, board.units):
@@ -132,7 +188,24 @@ def bench_rows(test, scope, into: str, channels=None) -> list:
     """The generator and scope settings as (set, to) rows: the square wave (``test``:
     frequency, amplitude, offset) into ``into``, the time base, the trigger and the
     scope's channels (``scope``: a :class:`designer.plant.bench.ScopeSetup`, read by
-    its fields; ``channels``: how many of its channels, default all)."""
+    its fields; ``channels``: how many of its channels, default all).
+
+    Parameters
+    ----------
+    test : designer.spice.deck.SquareTest
+        The square wave.
+    scope : designer.plant.bench.ScopeSetup
+        The scope's settings.
+    into : str
+        Where the generator connects.
+    channels : int, optional
+        How many of the scope's channels.
+
+    Returns
+    -------
+    list
+        (set, to) rows.
+    """
     a = test.amplitude_v
     rows = [["generator", f"square {format_eng(test.frequency_hz, 'Hz')}, {format_eng(a, 'V')} pk-pk, offset "
                           f"{format_eng(a / 2, 'V')} (0 to {format_eng(a, 'V')}), into {into}"]]
