@@ -16,7 +16,20 @@ COMPARED = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
 
 
 def resample(t_src, y_src, t_dst):
-    """Linear interpolation of (t_src, y_src) onto ``t_dst`` (inside the source span)."""
+    """Linear interpolation of (t_src, y_src) onto ``t_dst`` (inside the source span).
+
+    Parameters
+    ----------
+    t_src, y_src : array_like
+        The source samples.
+    t_dst : array_like
+        Where they are wanted.
+
+    Returns
+    -------
+    numpy.ndarray
+        The values on ``t_dst``.
+    """
     return np.interp(np.asarray(t_dst, float), np.asarray(t_src, float), np.asarray(y_src, float))
 
 
@@ -24,7 +37,18 @@ def trapezoid_weights(t) -> np.ndarray:
     """Each sample's share of the span of ``t`` under the trapezoidal rule
     (half an interval on each side; the ends get half of one), so that
     ``sum(w * f)`` integrates ``f`` over a grid whether its steps are uniform or
-    adaptive (ngspice's are)."""
+    adaptive (ngspice's are).
+
+    Parameters
+    ----------
+    t : array_like
+        The grid, increasing.
+
+    Returns
+    -------
+    numpy.ndarray
+        The weights.
+    """
     t = np.asarray(t, float)
     dt = np.diff(t)
     w = np.zeros_like(t)
@@ -84,7 +108,18 @@ def nrms(gold, test, abstol: float, *, reltol: float = 0.01, t=None, t_gold=None
 
 def metric_deltas(reference: StepMetrics, other: StepMetrics) -> dict:
     """``other - reference`` for each compared metric: percentage points for
-    overshoot, seconds and percent for times."""
+    overshoot, seconds and percent for times.
+
+    Parameters
+    ----------
+    reference, other : StepMetrics
+        The metrics compared.
+
+    Returns
+    -------
+    dict
+        Metric -> difference.
+    """
     out = {}
     for name in COMPARED:
         a, b = getattr(reference, name), getattr(other, name)
@@ -108,6 +143,20 @@ def disagreements(deltas: dict, reference: StepMetrics, half_ring_period_s: floa
 
     ``deltas`` from :func:`metric_deltas`; a metric the reference has and the other
     lacks (e.g. an overshoot the simulation does not show) is a disagreement.
+
+    Parameters
+    ----------
+    deltas : dict
+        Metric -> difference (:func:`metric_deltas`).
+    reference : StepMetrics
+        The reference's metrics.
+    half_ring_period_s : float
+        Half the ringing period (s): the settling times may differ by that much (one ring).
+
+    Returns
+    -------
+    list of str
+        The disagreements.
     """
     out = []
     for name, (kind, limit) in AGREEMENT.items():

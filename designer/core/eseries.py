@@ -45,7 +45,18 @@ TOLERANCE = {"E3": 0.40, "E6": 0.20, "E12": 0.10, "E24": 0.05,
 
 
 def series_name(name: str) -> str:
-    """Normalise ``"e24"``/``"24"`` to ``"E24"``; a :class:`DesignError` if unknown."""
+    """Normalise ``"e24"``/``"24"`` to ``"E24"``; a :class:`DesignError` if unknown.
+
+    Parameters
+    ----------
+    name : str
+        A series name as typed.
+
+    Returns
+    -------
+    str
+        The series name.
+    """
     key = str(name).strip().upper()
     if not key.startswith("E"):
         key = "E" + key
@@ -92,7 +103,22 @@ class PartBounds:
 
 
 def check_bounds(r_series: str, c_series: str, r_min: float, r_max: float, c_min: float, c_max: float):
-    """The normalised series names of valid bounds (see :class:`PartBounds`)."""
+    """The normalised series names of valid bounds (see :class:`PartBounds`).
+
+    Parameters
+    ----------
+    r_series, c_series : str
+        The resistors' and the capacitors' series.
+    r_min, r_max : float
+        The resistors' range (Ohm).
+    c_min, c_max : float
+        The capacitors' range (F).
+
+    Returns
+    -------
+    tuple of str
+        The normalised (r_series, c_series).
+    """
     b = PartBounds(r_series=r_series, c_series=c_series, r_min=r_min, r_max=r_max, c_min=c_min, c_max=c_max)
     return b.r_series, b.c_series
 
@@ -102,6 +128,18 @@ def values(series: str, lo: float, hi: float) -> np.ndarray:
 
     A relative slack of 1e-9 keeps the bounds themselves (1 kOhm, 1 MOhm) in
     despite floating-point decades.
+
+    Parameters
+    ----------
+    series : str
+        The E-series.
+    lo, hi : float
+        The range.
+
+    Returns
+    -------
+    numpy.ndarray
+        The values.
     """
     key = series_name(series)
     if not (lo > 0 and hi > 0):
@@ -120,7 +158,18 @@ def values(series: str, lo: float, hi: float) -> np.ndarray:
 
 def smallest_series(value: float):
     """The coarsest series (E3 first) that holds ``value`` (any decade), or None
-    for a value no series has (e.g. 1k26 is E192 only; 1.234k is none)."""
+    for a value no series has (e.g. 1k26 is E192 only; 1.234k is none).
+
+    Parameters
+    ----------
+    value : float
+        A part's value.
+
+    Returns
+    -------
+    str or None
+        The series name.
+    """
     if not (value > 0 and np.isfinite(value)):
         return None
     mant = value / 10.0 ** np.floor(np.log10(value))
@@ -131,7 +180,20 @@ def smallest_series(value: float):
 
 
 def nearest(value: float, series: str = "E24") -> float:
-    """The series value nearest to ``value`` by log distance (no bounds)."""
+    """The series value nearest to ``value`` by log distance (no bounds).
+
+    Parameters
+    ----------
+    value : float
+        The value.
+    series : str
+        The E-series.
+
+    Returns
+    -------
+    float
+        The nearest series value.
+    """
     if not value > 0:
         raise DesignError(f"cannot round {value!r} to a series value: must be positive")
     cands = values(series, value / 20, value * 20)
@@ -141,7 +203,22 @@ def nearest(value: float, series: str = "E24") -> float:
 def nearest_ratio_pair(ratio: float, series: str, lo: float, hi: float):
     """Two values a, b of ``series`` in [lo, hi] whose ratio a/b is nearest to ``ratio``
     (log distance); ties go to the pair with the larger b (lower noise gain error
-    does not depend on it, but larger resistors load op-amps less)."""
+    does not depend on it, but larger resistors load op-amps less).
+
+    Parameters
+    ----------
+    ratio : float
+        The ratio wanted.
+    series : str
+        The E-series.
+    lo, hi : float
+        The range of the values.
+
+    Returns
+    -------
+    tuple of float
+        (a, b).
+    """
     v = values(series, lo, hi)
     if v.size == 0:
         raise DesignError(f"no {series} value between {lo:g} and {hi:g}")

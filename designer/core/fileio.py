@@ -77,13 +77,35 @@ BLOCK_BYTES = 4 * MIB
 
 def shown(path) -> str:
     """The path as messages print it: as typed, or quoted with escapes when it
-    holds characters (a newline, a tab) that would break the one-line message."""
+    holds characters (a newline, a tab) that would break the one-line message.
+
+    Parameters
+    ----------
+    path : path-like
+        The path.
+
+    Returns
+    -------
+    str
+        The path as the message shows it.
+    """
     s = str(path)
     return s if s.isprintable() else repr(s)
 
 
 def show_cell(cell: str) -> str:
-    """A cell of the user's file for a message: quoted, escaped, cut to a readable length."""
+    """A cell of the user's file for a message: quoted, escaped, cut to a readable length.
+
+    Parameters
+    ----------
+    cell : str
+        The cell.
+
+    Returns
+    -------
+    str
+        The cell as the message shows it.
+    """
     return repr(cell if len(cell) <= 40 else cell[:37] + "...")
 
 
@@ -93,7 +115,20 @@ _PLAIN_NAME = re.compile(r"^[A-Za-z0-9_+=,@-][A-Za-z0-9._+=,@-]{0,119}$")
 def check_plain_name(name, what: str) -> str:
     """A name that becomes a file or folder name (a design's ``--name``, a check
     spec's ``name:``): letters, digits and ``. _ - + = , @``, not starting with
-    '.', at most 120 characters; else a :class:`DesignError` naming ``what``."""
+    '.', at most 120 characters; else a :class:`DesignError` naming ``what``.
+
+    Parameters
+    ----------
+    name : str
+        The name.
+    what : str
+        Where it was given (``--name``), for the message.
+
+    Returns
+    -------
+    str
+        The name.
+    """
     if not isinstance(name, str) or not _PLAIN_NAME.match(name):
         what_is = ("must not be empty" if not name else
                    f"{show_cell(str(name))} is not a plain file name")
@@ -103,7 +138,18 @@ def check_plain_name(name, what: str) -> str:
 
 
 def size_text(n: int) -> str:
-    """``256 MiB``, ``1.5 GiB``, ``300 bytes``."""
+    """``256 MiB``, ``1.5 GiB``, ``300 bytes``.
+
+    Parameters
+    ----------
+    n : int
+        A size in bytes.
+
+    Returns
+    -------
+    str
+        The text.
+    """
     for unit, scale in (("GiB", 1 << 30), ("MiB", MIB), ("KiB", 1024)):
         if n >= scale:
             return f"{n / scale:.4g} {unit}"
@@ -245,7 +291,22 @@ def open_limited(path, what: str, limit: int) -> LimitedReader:
 
 
 def check_encoding(head: bytes, name: str, what: str) -> int:
-    """Refuse UTF-16/UTF-32 and binary data; return the length of a UTF-8 BOM (0 or 3)."""
+    """Refuse UTF-16/UTF-32 and binary data; return the length of a UTF-8 BOM (0 or 3).
+
+    Parameters
+    ----------
+    head : bytes
+        The file's first bytes.
+    name : str
+        The file, as messages show it.
+    what : str
+        What the file is (``capture``).
+
+    Returns
+    -------
+    int
+        The length of the BOM.
+    """
     boms = ((b"\x00\x00\xfe\xff", "UTF-32"), (b"\xff\xfe\x00\x00", "UTF-32"),
             (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16"))
     for bom, enc in boms:
@@ -268,13 +329,39 @@ def _not_utf8(name, what, enc):
 
 
 def decode(data: bytes) -> str:
-    """UTF-8 text; undecodable bytes (a Latin-1 degree sign in a header) replaced."""
+    """UTF-8 text; undecodable bytes (a Latin-1 degree sign in a header) replaced.
+
+    Parameters
+    ----------
+    data : bytes
+        The bytes.
+
+    Returns
+    -------
+    str
+        The text.
+    """
     return data.decode("utf-8", errors="replace")
 
 
 def read_text(path, what: str, limit: int = MAX_TABLE_BYTES) -> str:
     """The whole text of a small input file (a table, a JSON result), with every
-    check of this module."""
+    check of this module.
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+    what : str
+        What it is, for the messages.
+    limit : int
+        The most bytes it may have.
+
+    Returns
+    -------
+    str
+        Its text.
+    """
     with open_limited(path, what, limit) as fh:
         head = fh.read(SNIFF_BYTES) or b""
         skip = check_encoding(head, fh.name, what)   # /dev/zero stops here
@@ -290,6 +377,23 @@ _TMP_DIR = re.compile(r"^\.(?P<name>.+)\.(?P<kind>new|old)-(?P<pid>\d+)-[^.]+$")
 
 
 def os_error(action: str, path, exc: OSError) -> DesignError:
+    """The one-line error for an ``OSError`` met while doing ``action`` on ``path``: a directory where
+    a file was expected, a file where a folder was, else the system's own words.
+
+    Parameters
+    ----------
+    action : str
+        What was being done (``write``, ``read``).
+    path : path-like
+        Where.
+    exc : OSError
+        What the system raised.
+
+    Returns
+    -------
+    DesignError
+        The error to raise.
+    """
     if isinstance(exc, IsADirectoryError) or exc.errno == errno.EISDIR:
         why = "it is a directory"
     elif isinstance(exc, NotADirectoryError) or exc.errno == errno.ENOTDIR:
@@ -300,7 +404,18 @@ def os_error(action: str, path, exc: OSError) -> DesignError:
 
 
 def ensure_dir(path) -> Path:
-    """Create a directory (and parents); a clear :class:`DesignError` if not possible."""
+    """Create a directory (and parents); a clear :class:`DesignError` if not possible.
+
+    Parameters
+    ----------
+    path : path-like
+        The directory.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     path = Path(path)
     try:
         path.mkdir(parents=True, exist_ok=True)
@@ -316,7 +431,20 @@ def ensure_dir(path) -> Path:
 def check_can_create(path, subdirs=()) -> Path:
     """Fail early, creating nothing, when ``path`` (and ``path/<subdir>``) could
     not be made directories: the nearest existing ancestor must be a writable
-    directory, and whatever exists on the way must be a directory."""
+    directory, and whatever exists on the way must be a directory.
+
+    Parameters
+    ----------
+    path : path-like
+        The folder to be made.
+    subdirs : iterable of str
+        Folders to be made inside it.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     path = Path(path)
     for p in [path / d for d in subdirs] + [path] + list(path.parents):
         if os.path.lexists(p):
@@ -358,7 +486,20 @@ def check_output_file(path, what: str = "output file") -> Path:
     """Before any work: ``path`` may be written, through a temporary file and a
     rename, only over a regular file (or where nothing is); a symbolic link, a
     FIFO, a device, a socket or a directory there is refused in one line, as is
-    a folder that cannot be created."""
+    a folder that cannot be created.
+
+    Parameters
+    ----------
+    path : path-like
+        The file to be written.
+    what : str
+        What it is, for the message.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     path, st = _output_stat(path, what)
     if st is not None and not stat.S_ISREG(st.st_mode):
         raise DesignError(f"cannot write {what} {shown(path)}: it is {_kind(st.st_mode)}; give the name of a "
@@ -374,7 +515,22 @@ def check_output_folder(path, what: str = "output folder", whole: bool = True) -
     it points to nothing (dangling) or to no directory; with ``whole`` False a
     link to a directory is written through. A file, a FIFO or a device there is
     refused; so is a parent that cannot be created (:func:`check_can_create`).
-    Each refusal is one line naming ``what``."""
+    Each refusal is one line naming ``what``.
+
+    Parameters
+    ----------
+    path : path-like
+        The folder to be written.
+    what : str
+        What it is, for the message.
+    whole : bool
+        The folder is replaced whole (:func:`publish_folder`), not written into.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     path, st = _output_stat(path, what)
     if st is not None and stat.S_ISLNK(st.st_mode):
         dest = shown(os.readlink(path))
@@ -393,7 +549,22 @@ def check_output_folder(path, what: str = "output folder", whole: bool = True) -
 
 def atomic_write(path, data, mode: str = "w") -> Path:
     """Write ``data`` (str or bytes) to ``path`` through a temporary file and rename,
-    over a regular file only (:func:`check_output_file`, before any folder is made)."""
+    over a regular file only (:func:`check_output_file`, before any folder is made).
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+    data : str or bytes
+        Its content.
+    mode : str
+        ``"w"`` (text) or ``"wb"`` (bytes).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
     path = Path(path)
     check_output_file(path, "file")
     ensure_dir(path.parent)
@@ -417,7 +588,18 @@ def atomic_write(path, data, mode: str = "w") -> Path:
 
 def new_folder_beside(target) -> Path:
     """A private, empty staging folder next to ``target`` (same file system, so it
-    can be renamed into place), named so that :func:`clean_stale` recognises it."""
+    can be renamed into place), named so that :func:`clean_stale` recognises it.
+
+    Parameters
+    ----------
+    target : path-like
+        The folder the staged one will replace.
+
+    Returns
+    -------
+    pathlib.Path
+        The staging folder.
+    """
     target = Path(target)
     ensure_dir(target.parent)
     try:
@@ -432,7 +614,15 @@ def new_folder_beside(target) -> Path:
 
 def publish_folder(staged, target) -> None:
     """Put the finished folder ``staged`` at ``target``, replacing what is there
-    in one atomic step where the system allows it; the old content is deleted."""
+    in one atomic step where the system allows it; the old content is deleted.
+
+    Parameters
+    ----------
+    staged : path-like
+        The finished folder.
+    target : path-like
+        Where it goes.
+    """
     staged, target = Path(staged), Path(target)
     if os.path.islink(target) or (os.path.lexists(target) and not os.path.isdir(target)):
         # the exchange below would swap a link or a file with the folder, and leave it under the stage's name
@@ -459,7 +649,20 @@ def publish_folder(staged, target) -> None:
 
 def link_into(link, target) -> bool:
     """Make ``link`` a relative symbolic link to ``target`` (atomically); False
-    where the file system has no symbolic links (the caller then copies)."""
+    where the file system has no symbolic links (the caller then copies).
+
+    Parameters
+    ----------
+    link : path-like
+        The link made.
+    target : path-like
+        What it points to.
+
+    Returns
+    -------
+    bool
+        The link was made.
+    """
     link, target = Path(link), Path(target)
     rel = os.path.relpath(target, link.parent)
     if link.is_symlink() and os.readlink(link) == rel:
@@ -484,7 +687,13 @@ def link_into(link, target) -> bool:
 
 def clean_stale(folder) -> None:
     """Remove our temporaries in ``folder`` whose writing process is gone; an
-    interrupted two-rename swap (old moved aside, new not in place) is rolled back."""
+    interrupted two-rename swap (old moved aside, new not in place) is rolled back.
+
+    Parameters
+    ----------
+    folder : path-like
+        The folder our temporaries may be in.
+    """
     folder = Path(folder)
     try:
         entries = list(os.scandir(folder))
@@ -546,7 +755,13 @@ def _remove(path) -> None:
 
 def remove_tree(path) -> None:
     """Remove a folder of ours and everything in it; a symbolic link or a file there is
-    unlinked (``rmtree`` refuses a link, and would leave it)."""
+    unlinked (``rmtree`` refuses a link, and would leave it).
+
+    Parameters
+    ----------
+    path : path-like
+        The folder.
+    """
     if os.path.islink(path) or (os.path.lexists(path) and not os.path.isdir(path)):
         _remove(path)
         return

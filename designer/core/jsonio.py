@@ -23,7 +23,18 @@ SCHEMA_VERSION = 2
 
 def json_safe(obj):
     """JSON-ready copy: numpy scalars and arrays to Python numbers and lists,
-    tuples to lists, nan/inf to None (the one cleaner of every result)."""
+    tuples to lists, nan/inf to None (the one cleaner of every result).
+
+    Parameters
+    ----------
+    obj
+        Any result (dicts, lists, numbers, numpy values).
+
+    Returns
+    -------
+    object
+        The JSON-ready copy.
+    """
     if isinstance(obj, dict):
         return {k: json_safe(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):

@@ -69,18 +69,52 @@ class Interrupted(KeyboardInterrupt):
 def interruption(exc: BaseException):
     """The :class:`KeyboardInterrupt` that ``exc`` is or stands for, or None: after a stop
     signal, an error raised by C code the signal interrupted (numpy's extension import
-    fails with ImportError) is the signal in disguise."""
+    fails with ImportError) is the signal in disguise.
+
+    Parameters
+    ----------
+    exc : BaseException
+        What was raised.
+
+    Returns
+    -------
+    KeyboardInterrupt or None
+        The interruption.
+    """
     if isinstance(exc, KeyboardInterrupt):
         return exc
     return Interrupted(_received) if _received is not None else None
 
 
 def status_of(exc: BaseException) -> int:
-    """The exit status for an interruption (a plain KeyboardInterrupt is Ctrl-C: 130)."""
+    """The exit status for an interruption (a plain KeyboardInterrupt is Ctrl-C: 130).
+
+    Parameters
+    ----------
+    exc : BaseException
+        The interruption.
+
+    Returns
+    -------
+    int
+        The exit status (128 + the signal's number).
+    """
     return exc.status if isinstance(exc, Interrupted) else 128 + signal.SIGINT
 
 
 def words_of(exc: BaseException) -> str:
+    """How an interruption is told: the stop signal's words (``interrupted`` for Ctrl-C).
+
+    Parameters
+    ----------
+    exc : BaseException
+        The interruption.
+
+    Returns
+    -------
+    str
+        The words.
+    """
     return WORDS.get(getattr(exc, "signum", signal.SIGINT), "interrupted")
 
 
@@ -91,7 +125,13 @@ _cleanups: list = []
 
 
 def install(prog: str) -> None:
-    """Handle SIGINT, SIGTERM and SIGHUP as described above, for command ``prog``."""
+    """Handle SIGINT, SIGTERM and SIGHUP as described above, for command ``prog``.
+
+    Parameters
+    ----------
+    prog : str
+        The command's name, for the message.
+    """
     global _prog
     _prog = prog
     _resolve_prctl()   # before any fork: a child then only calls it
@@ -133,7 +173,13 @@ def finish(status: int):
     ``atexit`` handlers: multiprocessing's children, the fork server's kill), then ``os._exit``,
     skipping only the interpreter's teardown of its modules and objects. A reader that closed
     the pipe early (``| head``) is their choice: stdout goes to /dev/null first, as at a
-    normal exit."""
+    normal exit.
+
+    Parameters
+    ----------
+    status : int
+        The exit status.
+    """
     import atexit
     import threading
 
@@ -155,7 +201,13 @@ def finish(status: int):
 
 def to_devnull(stream) -> None:
     """Point ``stream``'s file descriptor at /dev/null: its reader left (``| head``), and a later
-    flush (Python's own at exit) must not print "Exception ignored"."""
+    flush (Python's own at exit) must not print "Exception ignored".
+
+    Parameters
+    ----------
+    stream : file object
+        ``sys.stdout`` or ``sys.stderr``.
+    """
     try:
         os.dup2(os.open(os.devnull, os.O_WRONLY), stream.fileno())
     except (OSError, ValueError):
@@ -173,12 +225,25 @@ def _handler(signum, frame):
 
 
 def on_exit(fn) -> None:
-    """Run ``fn()`` when :func:`emergency` ends the process (kill a renderer, workers)."""
+    """Run ``fn()`` when :func:`emergency` ends the process (kill a renderer, workers).
+
+    Parameters
+    ----------
+    fn : callable
+        Called without arguments.
+    """
     if fn not in _cleanups:
         _cleanups.append(fn)
 
 
 def forget(fn) -> None:
+    """No longer run ``fn`` at an emergency exit (:func:`on_exit`).
+
+    Parameters
+    ----------
+    fn : callable
+        A function :func:`on_exit` was given.
+    """
     if fn in _cleanups:
         _cleanups.remove(fn)
 
@@ -237,7 +302,13 @@ def _resolve_prctl():
 
 
 def die_with_parent(parent_pid: int) -> None:
-    """In a forked child: be killed when the parent dies; exit now if it already has."""
+    """In a forked child: be killed when the parent dies; exit now if it already has.
+
+    Parameters
+    ----------
+    parent_pid : int
+        The parent's process id.
+    """
     fn = _resolve_prctl()
     if fn:
         fn(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
@@ -248,7 +319,13 @@ def die_with_parent(parent_pid: int) -> None:
 def preexec():
     """The ``preexec_fn`` of a subprocess (``ngspice -b``): :func:`die_with_parent`
     for this process, with the libc call resolved now, in the parent (the child
-    only calls it)."""
+    only calls it).
+
+    Returns
+    -------
+    callable or None
+        The function the child calls, or None where the libc call is not found.
+    """
     return functools.partial(die_with_parent, os.getpid()) if _resolve_prctl() else None
 
 
@@ -258,7 +335,18 @@ _OWNED = re.compile(r"^designer-(?:web|sim|init)-(\d+)-")
 
 def owned_prefix(kind: str) -> str:
     """The prefix of a temporary folder of this process (``tempfile.mkdtemp(prefix=...)``):
-    ``designer-KIND-PID-``, so that :func:`remove_stale` can tell when its owner is gone."""
+    ``designer-KIND-PID-``, so that :func:`remove_stale` can tell when its owner is gone.
+
+    Parameters
+    ----------
+    kind : str
+        What the folder is for.
+
+    Returns
+    -------
+    str
+        The prefix.
+    """
     return f"designer-{kind}-{os.getpid()}-"
 
 
@@ -276,7 +364,18 @@ def remove_stale(folder: str) -> list:
     """Remove the folders of ``folder`` named by :func:`owned_prefix` whose owner process is gone
     (left by a SIGKILL, a crash, a power cut), this user's only; returns their names. A folder
     whose pid is alive is kept, whoever has that pid now: a reused pid keeps it until that
-    process is gone too."""
+    process is gone too.
+
+    Parameters
+    ----------
+    folder : str
+        The folder (the system's temporary folder).
+
+    Returns
+    -------
+    list of str
+        The names of the folders removed.
+    """
     removed = []
     try:
         entries = list(os.scandir(folder))

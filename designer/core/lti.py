@@ -22,7 +22,22 @@ def coefficients(p, name: str, what: str = "") -> np.ndarray:
     """A polynomial's coefficients, highest power of s first, as a finite float
     array with the leading zeros dropped; a :class:`DesignError` naming ``name``
     (its ``param``; ``what`` before it in the message) when they are not numbers,
-    not finite, none, or all zero."""
+    not finite, none, or all zero.
+
+    Parameters
+    ----------
+    p : array_like
+        The coefficients.
+    name : str
+        The parameter's name (the error's ``param``).
+    what : str
+        What the message says before the name.
+
+    Returns
+    -------
+    numpy.ndarray
+        The coefficients.
+    """
     label = f"{what}: {name}" if what else name
     try:
         a = np.atleast_1d(np.asarray(p, float))
@@ -42,6 +57,16 @@ def dominant_pair(den):
 
     For a complex pair: fn = |p| / 2 pi and zeta = -Re p / |p|. For real poles
     the two slowest define fn = sqrt(p1 p2) / 2 pi, zeta = (p1 + p2) / (2 sqrt(p1 p2)).
+
+    Parameters
+    ----------
+    den : array_like
+        The denominator, highest power first.
+
+    Returns
+    -------
+    tuple of float
+        (fn in Hz, zeta).
     """
     poles = np.roots(den)
     cplx = poles[np.abs(poles.imag) > 1e-9 * np.abs(poles)]
@@ -56,7 +81,20 @@ def dominant_pair(den):
 
 def response_span(fn_hz: float, zeta: float) -> float:
     """A simulation/plot length that shows the whole step response settling:
-    about twice the 2 % settling time of the dominant pair."""
+    about twice the 2 % settling time of the dominant pair.
+
+    Parameters
+    ----------
+    fn_hz : float
+        The dominant pair's natural frequency.
+    zeta : float
+        Its damping.
+
+    Returns
+    -------
+    float
+        The span (s).
+    """
     wn = 2 * math.pi * fn_hz
     if zeta < 1:
         ts = 4.0 / (zeta * wn)
@@ -75,6 +113,18 @@ def step_response(num, den, t):
     with the Laurent coefficients c_k from Taylor series at p. Exact and
     vectorised, on any grid, uniform or not (scipy's lsim steps through a
     uniform grid in a loop, and importing scipy.signal costs half a second).
+
+    Parameters
+    ----------
+    num, den : array_like
+        The transfer function, highest power first.
+    t : array_like
+        The times (s).
+
+    Returns
+    -------
+    numpy.ndarray
+        The response on ``t``.
     """
     t = np.asarray(t, float)
     num = np.trim_zeros(np.atleast_1d(np.asarray(num, float)), "f")
@@ -116,6 +166,18 @@ def pole_clusters(poles, spread: float = 100.0):
     Merging genuinely distinct poles that close changes the response by
     O((dp t)^2) only, while keeping them apart cancels catastrophically: their
     residues grow as 1/dp^(m-1).
+
+    Parameters
+    ----------
+    poles : array_like
+        The poles.
+    spread : float
+        How many times the expected split of a repeated root still counts as one.
+
+    Returns
+    -------
+    list of tuple
+        (mean pole, multiplicity).
     """
     eps = np.finfo(float).eps
     rest = [complex(p) for p in np.asarray(poles, complex)]
@@ -160,13 +222,39 @@ def _series_ratio(a, b):
 
 
 def freq_response(num, den, f_hz):
-    """Complex H(j 2 pi f) at the frequencies ``f_hz``."""
+    """Complex H(j 2 pi f) at the frequencies ``f_hz``.
+
+    Parameters
+    ----------
+    num, den : array_like
+        The transfer function, highest power first.
+    f_hz : array_like
+        The frequencies (Hz).
+
+    Returns
+    -------
+    numpy.ndarray
+        The complex response.
+    """
     s = 2j * np.pi * np.asarray(f_hz, float)
     return np.polyval(num, s) / np.polyval(den, s)
 
 
 def dense_time(t_end: float, n: int = 20001):
-    """Uniform grid from 0 to ``t_end`` (dense: crossing times then interpolate well)."""
+    """Uniform grid from 0 to ``t_end`` (dense: crossing times then interpolate well).
+
+    Parameters
+    ----------
+    t_end : float
+        The grid's end (s).
+    n : int
+        Its points.
+
+    Returns
+    -------
+    numpy.ndarray
+        The grid.
+    """
     return np.linspace(0.0, t_end, n)
 
 
@@ -208,6 +296,20 @@ def filter_foh(num, den, t, x) -> np.ndarray:
     I0 = (e^(p h) - 1)/p and I1 = (e^(p h) - 1 - p h)/(p^2 h), and
     y = D u + sum r_i z_i. Repeated (or nearly repeated) poles have no such
     basis: scipy.signal does those.
+
+    Parameters
+    ----------
+    num, den : array_like
+        The transfer function, highest power first.
+    t : array_like
+        The uniform grid (s).
+    x : array_like
+        The input on ``t``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The output on ``t``.
     """
     num = np.atleast_1d(np.asarray(num, float))
     den = np.atleast_1d(np.asarray(den, float))

@@ -128,7 +128,20 @@ class Unit:
 
 def assign(count: int, package: Package) -> list:
     """The first ``count`` units of as many packages as needed, in order: U1 (or
-    U1A, U1B, ...), U2 (U2A ...): a circuit's op-amps in the order it lists them."""
+    U1A, U1B, ...), U2 (U2A ...): a circuit's op-amps in the order it lists them.
+
+    Parameters
+    ----------
+    count : int
+        The circuit's op-amps.
+    package : Package
+        The package they come in.
+
+    Returns
+    -------
+    list
+        The units.
+    """
     letters = list(package.units)
     out = []
     for i in range(count):
@@ -139,7 +152,20 @@ def assign(count: int, package: Package) -> list:
 
 
 def spare_units(count: int, package: Package) -> list:
-    """The units of the last package that ``count`` op-amps leave free (to be tied off)."""
+    """The units of the last package that ``count`` op-amps leave free (to be tied off).
+
+    Parameters
+    ----------
+    count : int
+        The circuit's op-amps.
+    package : Package
+        The package they come in.
+
+    Returns
+    -------
+    list
+        The free units.
+    """
     per = package.per_package
     used = count % per
     if used == 0:
@@ -161,12 +187,29 @@ def _catalogue() -> dict:
 
 
 def names() -> list:
-    """Catalogue names, as ``--opamp`` accepts them."""
+    """Catalogue names, as ``--opamp`` accepts them.
+
+    Returns
+    -------
+    list of str
+        The names.
+    """
     return list(_catalogue())
 
 
 def get(name: str) -> OpAmp:
-    """Look up an op-amp by name (case-insensitive)."""
+    """Look up an op-amp by name (case-insensitive).
+
+    Parameters
+    ----------
+    name : str
+        The op-amp's name.
+
+    Returns
+    -------
+    OpAmp
+        Its data.
+    """
     for key, amp in _catalogue().items():
         if key.lower() == str(name).strip().lower():
             return amp

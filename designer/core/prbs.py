@@ -48,7 +48,18 @@ EDGE_FRACTION = 1e-3
 
 
 def check_bits(bits) -> int:
-    """``bits`` as an int in MIN_BITS..MAX_BITS, else one line."""
+    """``bits`` as an int in MIN_BITS..MAX_BITS, else one line.
+
+    Parameters
+    ----------
+    bits
+        The bits as given.
+
+    Returns
+    -------
+    int
+        The bits.
+    """
     try:
         n = int(bits)
         ok = n == float(bits)
@@ -62,14 +73,36 @@ def check_bits(bits) -> int:
 
 def mls(bits: int) -> np.ndarray:
     """One period of the maximum-length sequence of ``bits`` bits as +-1 (int8),
-    N = 2^bits - 1 values, (N + 1)/2 of them +1 (scipy's taps, state all ones)."""
+    N = 2^bits - 1 values, (N + 1)/2 of them +1 (scipy's taps, state all ones).
+
+    Parameters
+    ----------
+    bits : int
+        The register's length.
+
+    Returns
+    -------
+    numpy.ndarray
+        The period.
+    """
     from scipy.signal import max_len_seq
     seq, _ = max_len_seq(check_bits(bits))
     return (2 * seq.astype(np.int8) - 1).astype(np.int8)
 
 
 def is_mls_length(n: int) -> int | None:
-    """The bits of a period of ``n`` intervals when n = 2^bits - 1 (3..20), else None."""
+    """The bits of a period of ``n`` intervals when n = 2^bits - 1 (3..20), else None.
+
+    Parameters
+    ----------
+    n : int
+        A period's length.
+
+    Returns
+    -------
+    int or None
+        The bits.
+    """
     b = int(n + 1).bit_length() - 1
     return b if (1 << b) == n + 1 and MIN_BITS <= b <= MAX_BITS else None
 
@@ -122,7 +155,18 @@ class PrbsPlan:
 
 
 def nice_interval(dt: float) -> float:
-    """The largest 1-2-5 value (1, 2, 5 x 10^k) at most ``dt``."""
+    """The largest 1-2-5 value (1, 2, 5 x 10^k) at most ``dt``.
+
+    Parameters
+    ----------
+    dt : float
+        An interval (s).
+
+    Returns
+    -------
+    float
+        The 1-2-5 value.
+    """
     e = math.floor(math.log10(dt))
     for m in (5.0, 2.0, 1.0):
         if m * 10.0 ** e <= dt * (1 + 1e-9):
@@ -131,7 +175,20 @@ def nice_interval(dt: float) -> float:
 
 
 def bits_for(period_s: float, dt_s: float) -> int | None:
-    """The fewest bits whose period (2^n - 1) dt lasts ``period_s``; None past MAX_BITS."""
+    """The fewest bits whose period (2^n - 1) dt lasts ``period_s``; None past MAX_BITS.
+
+    Parameters
+    ----------
+    period_s : float
+        The period wanted (s).
+    dt_s : float
+        The clock interval (s).
+
+    Returns
+    -------
+    int or None
+        The bits.
+    """
     need = period_s / dt_s
     for n in range(MIN_BITS, MAX_BITS + 1):
         if (1 << n) - 1 >= need:
@@ -151,6 +208,28 @@ def plan_for_plant(settling_s: float, bandwidth_hz: float, *, amplitude=1.0, off
     too short for the plant is said so in ``reasons``). A clock chosen here
     lies in the range a given one must (``RANGES["prbs_clock_hz"]``, 1 uHz to
     1 GHz), else the plant (``plant``, its words in the message) is refused.
+
+    Parameters
+    ----------
+    settling_s : float
+        The plant's 2 % settling time (s).
+    bandwidth_hz : float
+        Its bandwidth.
+    amplitude, offset : float
+        The levels: offset +- amplitude.
+    periods : int
+        The periods played.
+    dt_s : float, optional
+        The clock interval; None: chosen.
+    bits : int, optional
+        The register's length; None: chosen.
+    plant : str
+        What the messages call the plant.
+
+    Returns
+    -------
+    PrbsPlan
+        The sequence to play.
     """
     if not (math.isfinite(settling_s) and settling_s > 0 and math.isfinite(bandwidth_hz)
             and bandwidth_hz > 0):
@@ -222,7 +301,18 @@ def _head(plan: PrbsPlan) -> list:
 
 def awg_csv(plan: PrbsPlan) -> str:
     """An arbitrary-waveform CSV: ``sample_rate_hz,<clock>`` then one value per
-    line, one per clock interval (the generator holds each for Dt)."""
+    line, one per clock interval (the generator holds each for Dt).
+
+    Parameters
+    ----------
+    plan : PrbsPlan
+        The sequence.
+
+    Returns
+    -------
+    str
+        The CSV text.
+    """
     vals = plan.values()
     return (f"sample_rate_hz,{plan.clock_hz:.12g}\n"
             + "\n".join(f"{v:.6g}" for v in vals) + "\n")
@@ -230,7 +320,18 @@ def awg_csv(plan: PrbsPlan) -> str:
 
 def time_value_csv(plan: PrbsPlan) -> str:
     """``time_s,value`` rows: each level at the start of its clock interval, and
-    the last level again at the end of the record."""
+    the last level again at the end of the record.
+
+    Parameters
+    ----------
+    plan : PrbsPlan
+        The sequence.
+
+    Returns
+    -------
+    str
+        The CSV text.
+    """
     vals = plan.values()
     t = np.arange(vals.size + 1) * plan.dt_s
     v = np.append(vals, vals[-1])
@@ -239,7 +340,20 @@ def time_value_csv(plan: PrbsPlan) -> str:
 
 def pwl_points(plan: PrbsPlan, edge_s: float | None = None) -> tuple:
     """(t, v) corners of the sequence as a piecewise-linear source: a level
-    change takes ``edge_s`` (default EDGE_FRACTION Dt) from the clock edge."""
+    change takes ``edge_s`` (default EDGE_FRACTION Dt) from the clock edge.
+
+    Parameters
+    ----------
+    plan : PrbsPlan
+        The sequence.
+    edge_s : float, optional
+        A level change's duration (s).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (t, v).
+    """
     vals = plan.values()
     edge = plan.dt_s * EDGE_FRACTION if edge_s is None else float(edge_s)
     change = np.nonzero(np.diff(vals))[0] + 1
@@ -255,7 +369,20 @@ def pwl_points(plan: PrbsPlan, edge_s: float | None = None) -> tuple:
 
 def pwl_subcircuit(plan: PrbsPlan, name: str = "prbs_source") -> str:
     """An ngspice ``.subckt <name> out`` whose voltage source plays the sequence
-    (``X1 in <name>`` puts it on node ``in``)."""
+    (``X1 in <name>`` puts it on node ``in``).
+
+    Parameters
+    ----------
+    plan : PrbsPlan
+        The sequence.
+    name : str
+        The subcircuit's name.
+
+    Returns
+    -------
+    str
+        The subcircuit's text.
+    """
     t, v = pwl_points(plan)
     pairs = [f"{a:.12g} {b:.6g}" for a, b in zip(t, v)]
     lines = ["* " + h for h in _head(plan)]
@@ -290,7 +417,18 @@ def _berlekamp_massey(bits) -> tuple:
 def linear_complexity(bits) -> int:
     """The length of the shortest linear feedback shift register that generates
     the 0/1 sequence ``bits`` (Berlekamp-Massey over GF(2)): the bits n of an
-    m-sequence once 2n of its bits are seen; about half the length for random bits."""
+    m-sequence once 2n of its bits are seen; about half the length for random bits.
+
+    Parameters
+    ----------
+    bits : array_like
+        The 0/1 sequence.
+
+    Returns
+    -------
+    int
+        The linear complexity.
+    """
     return _berlekamp_massey(bits)[0]
 
 
@@ -316,7 +454,20 @@ def mls_bit_errors(period, bits: int) -> int:
     m-sequence's autocorrelation is N at lag 0 and -1 at every other lag (eq.
     2.4.6), and each flipped value moves every other lag's by 0 or +-4: k flips
     leave a floor that is no longer constant, up to 4k/N of the peak at each lag,
-    which the correlation's DC term does not remove (seed 003, 2.4)."""
+    which the correlation's DC term does not remove (seed 003, 2.4).
+
+    Parameters
+    ----------
+    period : array_like
+        The values of one period.
+    bits : int
+        The register's length.
+
+    Returns
+    -------
+    int
+        The values that differ.
+    """
     from scipy.signal import max_len_seq
     x = np.asarray(period)
     n = (1 << bits) - 1

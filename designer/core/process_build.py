@@ -298,6 +298,24 @@ def sopdt(K, tau1_s, tau2_s, theta_s=0.0, *, source: str = "typed", ci95=None) -
     The time constants are sorted, tau1 >= tau2 (their ``ci95`` with them);
     tau1 = tau2 is a double pole. Ranges and refusals as :func:`fopdt`, theta
     against tau1.
+
+    Parameters
+    ----------
+    K : float
+        The static gain.
+    tau1_s, tau2_s : float
+        The time constants (s).
+    theta_s : float
+        The dead time (s).
+    source : str
+        ``"typed"``, or where the model came from.
+    ci95 : dict, optional
+        95 % confidence half-widths by parameter name (an identified model's).
+
+    Returns
+    -------
+    ProcessModel
+        The model.
     """
     return build_sopdt(K, tau1_s, tau2_s, theta_s, _LIB_NAMES, source, ci95)
 
@@ -308,6 +326,26 @@ def underdamped(K, fn_hz, zeta, theta_s=0.0, *, source: str = "typed", ci95=None
     wn = 2 pi fn, fn in :data:`FN_RANGE`, 0 < zeta < 1 (zeta >= 1 is refused
     with the equivalent :func:`sopdt` time constants,
     tau = 1/(wn (zeta -+ sqrt(zeta^2 - 1)))); theta against 1/wn.
+
+    Parameters
+    ----------
+    K : float
+        The static gain.
+    fn_hz : float
+        The natural frequency.
+    zeta : float
+        The damping ratio.
+    theta_s : float
+        The dead time (s).
+    source : str
+        ``"typed"``, or where the model came from.
+    ci95 : dict, optional
+        95 % confidence half-widths by parameter name (an identified model's).
+
+    Returns
+    -------
+    ProcessModel
+        The model.
     """
     return build_underdamped(K, fn_hz, zeta, theta_s, _LIB_NAMES, source, ci95)
 
@@ -320,6 +358,22 @@ def rational(num, den, theta_s=0.0, *, source: str = "typed", ci95=None) -> Proc
     -:data:`AXIS_TOL` |p|; a pole at 0 is :func:`integrating`'s), every pole's
     1/|p| in :data:`TAU_RANGE`, N(0) != 0. Stored scaled so that D(0) = 1;
     theta against the slowest 1/|p|. ``params`` holds theta_s only.
+
+    Parameters
+    ----------
+    num, den : array_like
+        N and D, highest power of s first.
+    theta_s : float
+        The dead time (s).
+    source : str
+        ``"typed"``, or where the model came from.
+    ci95 : dict, optional
+        95 % confidence half-widths by parameter name (an identified model's).
+
+    Returns
+    -------
+    ProcessModel
+        The model.
     """
     return build_rational(num, den, theta_s, _LIB_NAMES, source, ci95)
 
@@ -329,12 +383,41 @@ def integrating(K, tau_s=0.0, theta_s=0.0, *, source: str = "typed", ci95=None) 
 
     K is the velocity gain (1/s); tau 0 or in :data:`TAU_RANGE`; theta against
     tau (without it: up to :data:`MAX_DEAD_TIME_S`).
+
+    Parameters
+    ----------
+    K : float
+        The velocity gain (1/s).
+    tau_s : float
+        The lag's time constant (s), 0 for none.
+    theta_s : float
+        The dead time (s).
+    source : str
+        ``"typed"``, or where the model came from.
+    ci95 : dict, optional
+        95 % confidence half-widths by parameter name (an identified model's).
+
+    Returns
+    -------
+    ProcessModel
+        The model.
     """
     return build_integrating(K, tau_s, theta_s, _LIB_NAMES, source, ci95)
 
 
 def model_from_dict(d: dict) -> ProcessModel:
-    """The model :meth:`ProcessModel.to_dict` wrote, rebuilt (and checked) by its constructor."""
+    """The model :meth:`ProcessModel.to_dict` wrote, rebuilt (and checked) by its constructor.
+
+    Parameters
+    ----------
+    d : dict
+        What :meth:`ProcessModel.to_dict` wrote.
+
+    Returns
+    -------
+    ProcessModel
+        The model.
+    """
     if not isinstance(d, dict) or not isinstance(d.get("params"), dict) or "kind" not in d:
         raise DesignError("a process model is an object with 'kind' and 'params'")
     kind, p = d["kind"], d["params"]

@@ -150,12 +150,38 @@ def parse_in_range(value, name: str, key: str) -> float:
 
     What a user typed is handed over as typed, so that a refusal quotes it
     (``fc_hz must be 10 mHz to 10 MHz, got '1e-300'``); errors start with
-    ``name`` and carry it as their ``param``."""
+    ``name`` and carry it as their ``param``.
+
+    Parameters
+    ----------
+    value : float or str
+        The value as given.
+    name : str
+        The parameter's name, for the message (and the error's ``param``).
+    key : str
+        The range's key in ``RANGES``.
+
+    Returns
+    -------
+    float
+        The value.
+    """
     if isinstance(value, str):
         return RANGES[key].check(parse_value(value, name), name, shown=repr(value))
     return RANGES[key].check(value, name)
 
 
 def help_range(key: str) -> str:
-    """``"(1 mHz to 10 MHz)"`` for a --help line."""
+    """``"(1 mHz to 10 MHz)"`` for a --help line.
+
+    Parameters
+    ----------
+    key : str
+        The range's key in ``RANGES``.
+
+    Returns
+    -------
+    str
+        The text.
+    """
     return f"({RANGES[key].text()})"

@@ -39,7 +39,22 @@ MODELS = ("fopdt", "double-pole", "underdamped", "overdamped")
 
 
 def model_step(model: str, params: dict, t) -> np.ndarray:
-    """Unit-input step response (0 -> K) of ``model`` at times ``t`` (step at t = 0)."""
+    """Unit-input step response (0 -> K) of ``model`` at times ``t`` (step at t = 0).
+
+    Parameters
+    ----------
+    model : str
+        The model's kind.
+    params : dict
+        Its parameters.
+    t : array_like
+        The times (s).
+
+    Returns
+    -------
+    numpy.ndarray
+        The response on ``t``.
+    """
     t = np.asarray(t, float)
     K = params["K"]
     theta = params.get("theta_s", 0.0) or 0.0
@@ -70,7 +85,20 @@ def model_step(model: str, params: dict, t) -> np.ndarray:
 def unphysical(model: str, params: dict) -> str:
     """Why ``params`` are not a stable, causal ``model`` ("" when they are): a
     time constant or wn that is not positive, a negative zeta. Their step
-    response grows without bound (exp overflows), so it is never evaluated."""
+    response grows without bound (exp overflows), so it is never evaluated.
+
+    Parameters
+    ----------
+    model : str
+        The model's kind.
+    params : dict
+        Its parameters.
+
+    Returns
+    -------
+    str
+        Why not, or "".
+    """
     for k, v in params.items():
         if (k.startswith("tau") or k == "wn_rad_s") and not v > 0:
             return f"{k} = {v:.4g} is not positive"
@@ -81,7 +109,20 @@ def unphysical(model: str, params: dict) -> str:
 
 def model_overshoot_pct(model: str, params: dict) -> float:
     """Overshoot of ``model``'s step response, % of its change: 0 for the
-    monotonic models, 100 exp(-pi zeta / sqrt(1 - zeta^2)) for the underdamped one."""
+    monotonic models, 100 exp(-pi zeta / sqrt(1 - zeta^2)) for the underdamped one.
+
+    Parameters
+    ----------
+    model : str
+        The model's kind.
+    params : dict
+        Its parameters.
+
+    Returns
+    -------
+    float
+        The overshoot (%).
+    """
     if model in ("fopdt", "double-pole", "overdamped"):
         return 0.0
     if model == "underdamped":
@@ -93,7 +134,22 @@ def model_overshoot_pct(model: str, params: dict) -> float:
 def overshoot_mismatch(model: str, params: dict, overshoot: Overshoot) -> str:
     """Why a ``model`` with ``params`` cannot have made data that overshoot as
     measured (:meth:`~designer.core.metrics.Overshoot.differs`), or "" when it
-    can: the one model-against-data overshoot rule of every method."""
+    can: the one model-against-data overshoot rule of every method.
+
+    Parameters
+    ----------
+    model : str
+        The model's kind.
+    params : dict
+        Its parameters.
+    overshoot : Overshoot
+        The overshoot measured.
+
+    Returns
+    -------
+    str
+        Why not, or "".
+    """
     mos = model_overshoot_pct(model, params)
     if not overshoot.differs(mos):
         return ""
@@ -107,7 +163,22 @@ def overshoot_mismatch(model: str, params: dict, overshoot: Overshoot) -> str:
 def data_overshoot(t, y, yf, sigma: float | None = None) -> Overshoot:
     """The :class:`~designer.core.metrics.Overshoot` of a response from 0 to
     ``yf`` (:func:`~designer.core.metrics.measure_step`), for callers that were
-    not given the one measured on the whole record."""
+    not given the one measured on the whole record.
+
+    Parameters
+    ----------
+    t, y : array_like
+        The response.
+    yf : float
+        Its final value.
+    sigma : float, optional
+        The noise's standard deviation; None: estimated.
+
+    Returns
+    -------
+    Overshoot
+        The overshoot.
+    """
     y = np.asarray(y, float)
     sig = noise_sigma(y) if sigma is None else sigma
     return measure_step(t, y, initial=0.0, final=float(yf), sigma=sig)[1]

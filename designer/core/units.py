@@ -119,7 +119,22 @@ def _split(value: float):
 
 
 def format_eng(value: float, unit: str = "", digits: int = 4) -> str:
-    """``format_eng(4700, "Ohm")`` -> ``"4.7 kOhm"``; ``digits`` significant."""
+    """``format_eng(4700, "Ohm")`` -> ``"4.7 kOhm"``; ``digits`` significant.
+
+    Parameters
+    ----------
+    value : float
+        The value.
+    unit : str
+        Its unit.
+    digits : int
+        Significant digits.
+
+    Returns
+    -------
+    str
+        The text.
+    """
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "n/a"
     mant, prefix = _split(float(value))
@@ -130,7 +145,18 @@ def format_eng(value: float, unit: str = "", digits: int = 4) -> str:
 
 def value_code(value: float) -> str:
     """Part marking style: 4700 -> ``4k7``, 820 -> ``820``, 1e-8 -> ``10n``,
-    2.2e-6 -> ``2u2``, 4.7 -> ``4R7``, 1e6 -> ``1M``."""
+    2.2e-6 -> ``2u2``, 4.7 -> ``4R7``, 1e6 -> ``1M``.
+
+    Parameters
+    ----------
+    value : float
+        A part's value.
+
+    Returns
+    -------
+    str
+        Its marking.
+    """
     mant, prefix = _split(float(value))
     text = f"{mant:.3g}"
     if "e" in text:  # mantissa always < 1000, but be safe
@@ -147,13 +173,39 @@ _SUFFIX_UNITS = (("_hz", "Hz"), ("_s", "s"), ("_pct", "%"), ("_deg", "deg"), ("_
 
 def figure_unit(name: str) -> str:
     """``fn_hz`` -> Hz, ``peak_time_s`` -> s, ``overshoot_pct`` -> %, ``phase_margin_deg`` -> deg,
-    ``gain_margin_db`` -> dB; a figure without a unit (``zeta``, ``kp``) -> ""."""
+    ``gain_margin_db`` -> dB; a figure without a unit (``zeta``, ``kp``) -> "".
+
+    Parameters
+    ----------
+    name : str
+        The figure's name.
+
+    Returns
+    -------
+    str
+        Its unit.
+    """
     return next((u for s, u in _SUFFIX_UNITS if name.endswith(s)), "")
 
 
 def format_figure(name: str, value: float, digits: int = 4) -> str:
     """A figure's value with its unit: engineering notation for Hz and s (``3.3 kHz``), else the number
-    and the unit (``25 deg``, ``15 %``, ``0.2``)."""
+    and the unit (``25 deg``, ``15 %``, ``0.2``).
+
+    Parameters
+    ----------
+    name : str
+        The figure's name.
+    value : float
+        Its value.
+    digits : int
+        Significant digits.
+
+    Returns
+    -------
+    str
+        The text.
+    """
     unit = figure_unit(name)
     if unit in ("Hz", "s"):
         return format_eng(value, unit, digits)

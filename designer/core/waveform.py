@@ -48,6 +48,16 @@ def quantum(y) -> float:
     between neighbouring levels must be a whole number of the smallest gap
     (within 1 %, for values printed in decimal). An 8-bit scope's record
     passes; a simulated or averaged one, whose values never repeat, does not.
+
+    Parameters
+    ----------
+    y : array_like
+        The record.
+
+    Returns
+    -------
+    float
+        The step, or 0.
     """
     y = np.asarray(y, float)
     if y.size < 20:
@@ -85,6 +95,16 @@ def noise_sigma(y) -> float:
     its step, LSB / sqrt(12): an 8-bit scope's settled trace often sits on one
     level, where the differences alone would say "no noise" and one LSB would
     pass for a signal.
+
+    Parameters
+    ----------
+    y : array_like
+        The record.
+
+    Returns
+    -------
+    float
+        The noise's standard deviation.
     """
     y = np.asarray(y, float)
     if y.size < 5:
@@ -204,6 +224,22 @@ def normalised_step(t, y, *, t_step: float | None = None, initial: float | None 
     a rounding error early counts as at the step), ``initial`` to the first
     sample kept, ``final`` to the last. A step that does not change the output
     is refused (:class:`~designer.core.errors.DesignError` naming ``what``).
+
+    Parameters
+    ----------
+    t, y : array_like
+        The step response.
+    t_step : float, optional
+        When the step is applied (s).
+    initial, final : float, optional
+        The output before and after the step.
+    what : str
+        What the record is, for the message.
+
+    Returns
+    -------
+    tuple
+        (t, z, y0, yf).
     """
     t = np.asarray(t, float)
     y = np.asarray(y, float)
@@ -245,6 +281,22 @@ def crossing_time(t, y, level: float, *, sigma: float = 0.0, start: int = 0) -> 
     (under level - 3 sigma) before it to the first one clearly above (over
     level + 3 sigma) after it are fitted with a straight line, which crosses
     the level at the time returned.
+
+    Parameters
+    ----------
+    t, y : array_like
+        The record.
+    level : float
+        The level crossed.
+    sigma : float
+        The noise's standard deviation (0: clean).
+    start : int
+        The first index searched.
+
+    Returns
+    -------
+    float
+        The time (s), or nan.
     """
     t = np.asarray(t, float)
     y = np.asarray(y, float)
@@ -274,7 +326,20 @@ def crossing_time(t, y, level: float, *, sigma: float = 0.0, start: int = 0) -> 
 
 def moving_average(y, m: int) -> np.ndarray:
     """Centred moving average of ``y`` over ``m`` samples (the ends over the
-    samples that exist), from one cumulative sum."""
+    samples that exist), from one cumulative sum.
+
+    Parameters
+    ----------
+    y : array_like
+        The record.
+    m : int
+        The samples averaged.
+
+    Returns
+    -------
+    numpy.ndarray
+        The averages.
+    """
     y = np.asarray(y, float)
     if m <= 1:
         return y
@@ -292,6 +357,24 @@ def savgol(y, window: int, polyorder: int, deriv: int = 0, delta: float = 1.0) -
     samples by convolution, the first and last half-windows from one
     polynomial fitted to the edge window. Written here because importing
     scipy.signal costs about a second on every command-line run.
+
+    Parameters
+    ----------
+    y : array_like
+        The record.
+    window : int
+        The window's samples (odd).
+    polyorder : int
+        The polynomial's order.
+    deriv : int
+        The derivative's order (0: the smoothed record).
+    delta : float
+        The sample interval (for a derivative).
+
+    Returns
+    -------
+    numpy.ndarray
+        The filtered record.
     """
     y = np.asarray(y, float)
     w, p = int(window), int(polyorder)
@@ -360,6 +443,26 @@ def smooth_derivative(t, y, *, window_s: float | None = None, sigma: float = 0.0
     (from the noise ``sigma``, the step ``span`` and the 10-90 % ``rise_s``).
     Returns ``(t, ys, dy)`` on a uniform grid (resampled when the input grid is
     not uniform).
+
+    Parameters
+    ----------
+    t, y : array_like
+        The record.
+    window_s : float, optional
+        The window (s).
+    sigma : float
+        The noise's standard deviation.
+    span : float
+        The step's change.
+    rise_s : float, optional
+        The 10-90 % rise time (s).
+    polyorder : int
+        The polynomial's order.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (t, ys, dy).
     """
     tu, yu = uniform(t, y)
     dt = float((tu[-1] - tu[0]) / max(tu.size - 1, 1))
@@ -374,7 +477,18 @@ def smooth_derivative(t, y, *, window_s: float | None = None, sigma: float = 0.0
 def parabola_vertex(x, y) -> tuple:
     """Vertex of the parabola through three points, or of the least-squares
     parabola through more: ``(x_vertex, y_vertex, a)`` with ``a`` the
-    coefficient of x^2 (negative for a maximum); nan, nan, 0 for a line."""
+    coefficient of x^2 (negative for a maximum); nan, nan, 0 for a line.
+
+    Parameters
+    ----------
+    x, y : array_like
+        Three points or more.
+
+    Returns
+    -------
+    tuple of float
+        (x_vertex, y_vertex, a).
+    """
     x = np.asarray(x, float)
     y = np.asarray(y, float)
     xc = float(x[x.size // 2])          # centred, so the fit stays well conditioned
@@ -396,7 +510,26 @@ def peak_region(y, i: int, drop: float, *, lo: int = 0, hi: int | None = None,
     """``(j0, j1)``: the samples of ``y[lo:hi]`` around the peak sample ``i``
     that stay within ``drop`` of it (contiguous), widened to at least
     ``min_half`` each side (inside the record): the top of a noisy peak, which
-    a least-squares parabola averages over."""
+    a least-squares parabola averages over.
+
+    Parameters
+    ----------
+    y : array_like
+        The record.
+    i : int
+        The peak sample.
+    drop : float
+        How far below the peak a sample of the top may be.
+    lo, hi : int
+        The part of the record searched (``hi`` None: its end).
+    min_half : int
+        The fewest samples each side.
+
+    Returns
+    -------
+    tuple of int
+        (j0, j1).
+    """
     y = np.asarray(y, float)
     hi = y.size if hi is None else hi
     top = y[lo:hi] >= y[i] - drop
@@ -421,6 +554,22 @@ def refine_peak(t, y, i: int, *, lo: int | None = None, hi: int | None = None,
     ``smooth_only`` also keeps the sample at a kink (a neighbour well below
     the top: an FOPDT's slope jumps at its dead time), where a parabola would
     overshoot the true maximum.
+
+    Parameters
+    ----------
+    t, y : array_like
+        The record.
+    i : int
+        The highest sample.
+    lo, hi : int, optional
+        The samples the parabola goes through.
+    smooth_only : bool
+        Keep the sample at a kink.
+
+    Returns
+    -------
+    tuple of float
+        (t, y, a).
     """
     lo = i - 1 if lo is None else lo
     hi = i + 1 if hi is None else hi
@@ -459,6 +608,26 @@ def tangent_window(dt: float, n: int, *, sigma: float = 0.0, span: float = 1.0,
     corner an FOPDT response has at its dead time, whose slope the tangent
     needs (a smooth peak would take a wider one). Clean data get 5 samples,
     so tangents stay exact.
+
+    Parameters
+    ----------
+    dt : float
+        The sample interval (s).
+    n : int
+        The record's samples.
+    sigma : float
+        The noise's standard deviation.
+    span : float
+        The step's change.
+    rise_s : float, optional
+        The 10-90 % rise time (s).
+    slope_noise : float
+        The slope's noise allowed, as a fraction of the typical slope.
+
+    Returns
+    -------
+    int
+        The window (samples).
     """
     if sigma > 0 and span:
         if not (rise_s and math.isfinite(rise_s) and rise_s > 0):

@@ -107,6 +107,11 @@ def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, co
         end close together (results keep the task order).
     done : callable, optional
         ``done(index, result)``, called as each task's result arrives (a progress bar).
+
+    Returns
+    -------
+    list
+        The results, in task order.
     """
     ctx = multiprocessing.get_context("fork")
     results = [None] * len(tasks)
@@ -161,7 +166,13 @@ def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, co
 
 
 def close_all(workers) -> None:
-    """Ask every worker to end, give them two seconds, then kill what is left."""
+    """Ask every worker to end, give them two seconds, then kill what is left.
+
+    Parameters
+    ----------
+    workers : iterable
+        The worker processes.
+    """
     for w in workers:
         try:
             w.conn.send(None)
