@@ -37,7 +37,18 @@ _HANDSHAKE_MAX = 1 << 20
 def parse_dask(text) -> str:
     """``--dask ADDRESS``: ``local``, or a scheduler's ``[tcp://]host:port``. Other schemes
     (``tls://`` needs certificates, ``ws://``, ``ucx://`` other transports: none of them is
-    given to this command) are refused in one line."""
+    given to this command) are refused in one line.
+
+    Parameters
+    ----------
+    text : str
+        ``--dask``'s value.
+
+    Returns
+    -------
+    str
+        ``local`` or the address.
+    """
     t = str(text).strip()
     if t.lower() == "local":
         return "local"
@@ -73,7 +84,20 @@ def probe(address: str, timeout: float = CONNECT_TIMEOUT) -> str | None:
     that many bytes: ``distributed/comm/tcp.py``, ``TCP.read``). Anything else is not a scheduler:
     a web server waits for a request (silent), others send text (an implausible length) or
     close. Distributed's own client, given such a peer, reads the text as a length (MemoryError)
-    or waits for ever; this probe is asked first."""
+    or waits for ever; this probe is asked first.
+
+    Parameters
+    ----------
+    address : str
+        ``tcp://host:port``.
+    timeout : float
+        Seconds to tell.
+
+    Returns
+    -------
+    str or None
+        Why not, or None.
+    """
     m = _ADDRESS.match(address)
     host, port = m.group(2).strip("[]"), int(m.group(3))
     deadline = time.monotonic() + timeout
@@ -320,7 +344,13 @@ def cluster_ahead(scale):
     its thread, while the command does other work (its design, its SPICE run), so that the
     Monte Carlo's :class:`Runner` finds it started (``bench_tolerance``: the start is most of
     what a LocalCluster adds to a short run). Whatever ends the block, a cluster no runner took
-    is waited for and closed."""
+    is waited for and closed.
+
+    Parameters
+    ----------
+    scale : designer.tolerance.runner.Scale or None
+        Where the Monte Carlo will run.
+    """
     global _ahead
     if scale is None or scale.dask != "local" or _ahead is not None:
         yield

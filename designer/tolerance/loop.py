@@ -85,7 +85,20 @@ def is_model_loop(result) -> bool:
 def loop_parts(result, tol_items=()) -> dict:
     """Designator -> nominal value of the loop's parts: the plant's (R1, R2, C1, C2; none for a plant
     given as a model, whose parameters stay as identified) and the controller's, and the op-amp's
-    ``GBW`` (Hz) and ``SR`` (V/s) when the ``--tol`` items ``tol_items`` spread them."""
+    ``GBW`` (Hz) and ``SR`` (V/s) when the ``--tol`` items ``tol_items`` spread them.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design.
+    tol_items : sequence of str
+        The ``--tol`` items.
+
+    Returns
+    -------
+    dict
+        Designator -> nominal value.
+    """
     from .parts import opamp_nominal
     c = result.parts
     p = None if is_model_loop(result) else result.plant
@@ -99,7 +112,18 @@ def loop_parts(result, tol_items=()) -> dict:
 
 def loop_series(result) -> dict:
     """``{"R": series, "C": series}`` of a design-pid result's parts (their default tolerances): the
-    controller's series; the plant's where the controller's parts were given (None: typed by hand)."""
+    controller's series; the plant's where the controller's parts were given (None: typed by hand).
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design.
+
+    Returns
+    -------
+    dict
+        ``{"R": series, "C": series}``.
+    """
     sel = result.selection
     r, c = (sel.r_series, sel.c_series) if sel is not None else (None, None)
     if getattr(result, "plant_series", None) is not None:
@@ -109,7 +133,18 @@ def loop_series(result) -> dict:
 
 def parse_loop_limit(text: str):
     """A ``--limit`` on a loop figure (:data:`LIMITABLE`, or a SPICE name of :data:`STANDS_IN`),
-    named by the figure this engine computes."""
+    named by the figure this engine computes.
+
+    Parameters
+    ----------
+    text : str
+        The ``--limit`` item.
+
+    Returns
+    -------
+    designer.tolerance.stats.Limit
+        The limit.
+    """
     from .stats import Limit, parse_limit
     lim = text if isinstance(text, Limit) else parse_limit(text, LIMITABLE + tuple(STANDS_IN))
     return replace(lim, figure=STANDS_IN.get(lim.figure, lim.figure))
@@ -125,7 +160,22 @@ def kick_grid(parts, t, edge_s: float) -> np.ndarray:
     (:func:`designer.pid.process_optimize.slew_delay_stages`): ten derivative-filter time constants
     (twenty edges, three coarse steps at least) in about :data:`designer.pid.process_optimize.KICK_POINTS`
     points, its step the coarse grid's over a power of two (one matrix exponential for both grids,
-    :meth:`designer.pid.model.LoopModel.simulate_with_kick`)."""
+    :meth:`designer.pid.model.LoopModel.simulate_with_kick`).
+
+    Parameters
+    ----------
+    parts
+        The controller's parts (its derivative filter's time constant).
+    t : array_like
+        The coarse grid (s).
+    edge_s : float
+        The reference's edge (s).
+
+    Returns
+    -------
+    numpy.ndarray
+        The fine grid (s).
+    """
     from ..pid.process_optimize import KICK_POINTS
     f_d = parts.f_differentiator_hz if parts.td_s else math.inf
     dt = t[1] - t[0]
@@ -217,7 +267,20 @@ class LoopContext:
 
 
 def loop_figures(values: dict, result) -> dict:
-    """Every figure of :data:`FIGURES` for each sample (arrays over the samples)."""
+    """Every figure of :data:`FIGURES` for each sample (arrays over the samples).
+
+    Parameters
+    ----------
+    values : dict
+        Designator -> array over the samples.
+    result : designer.pid.result.PidResult
+        The design whose loop is varied.
+
+    Returns
+    -------
+    dict
+        Figure -> array over the samples.
+    """
     if is_model_loop(result):
         return model_loop_figures(values, result)
     return evaluate(LoopContext.of(result), values)
@@ -225,7 +288,20 @@ def loop_figures(values: dict, result) -> dict:
 
 def evaluate(context: LoopContext, values: dict) -> dict:
     """The engine's chunk function for a Sallen-Key plant's loop (:mod:`.runner`): every figure of
-    :data:`FIGURES` of each sample."""
+    :data:`FIGURES` of each sample.
+
+    Parameters
+    ----------
+    context : LoopContext
+        The loop's design and test.
+    values : dict
+        Designator -> array over the chunk's samples.
+
+    Returns
+    -------
+    dict
+        Figure -> array over the samples.
+    """
     from ..pid import model
     from ..pid.blocks import PidParts
     from ..plant.model import plant_tf, plant_tf_opamp
@@ -303,7 +379,40 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
     limits) names another (the analytic engine with the model's limits: ``yield_now`` is then
     theirs, counted on the engine's figures, which must include them).
 
-    Returns a :class:`LoopMonteCarlo`."""
+    Returns a :class:`LoopMonteCarlo`.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design.
+    series : dict
+        ``{"R": series, "C": series}`` (:func:`loop_series`).
+    n : int
+        The samples.
+    seed : int
+        The seed.
+    sampler, dist : str
+        How the samples are drawn (:mod:`designer.tolerance.sampling`).
+    tol_items : sequence of str
+        The ``--tol`` items.
+    limit_items : sequence of str
+        The ``--limit`` items.
+    tighten : bool
+        Find the part to buy tighter.
+    scale : designer.tolerance.runner.Scale, optional
+        Where the chunks run.
+    target_ci : float, optional
+        ``--target-ci``: draw until the yield's interval is this narrow.
+    engine : callable, optional
+        Another engine (the SPICE one); None: :func:`evaluate`.
+    tighten_with : callable, optional
+        The engine the part to buy tighter is found with.
+
+    Returns
+    -------
+    designer.tolerance.montecarlo.MonteCarlo
+        The Monte Carlo.
+    """
     from .montecarlo import MAX_SAMPLES, MIN_SAMPLES, target_plan
     from .parts import resolve
     from .runner import Draw, Runner, Scale
@@ -358,7 +467,26 @@ def loop_monte_carlo(result, series: dict, n: int, seed: int = 0, sampler: str =
 def loop_worst_case(result, series: dict, tol_items=(), limit_items=(), max_corners: int = 4096):
     """:func:`designer.tolerance.worstcase.worst_case` of the loop's figures (:data:`WORST_FIGURES`, the
     slew delay when ``--tol SR`` spreads the slew rate, and every limited one) over its tolerance box: with 22 parts, the corners the sensitivities point to,
-    then a bounded search from the worst."""
+    then a bounded search from the worst.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design.
+    series : dict
+        ``{"R": series, "C": series}``.
+    tol_items : sequence of str
+        The ``--tol`` items.
+    limit_items : sequence of str
+        The ``--limit`` items.
+    max_corners : int
+        Every corner is evaluated up to this many.
+
+    Returns
+    -------
+    designer.tolerance.worstcase.WorstCase
+        The extremes.
+    """
     from .parts import resolve
     from .worstcase import worst_case
     nominal = loop_parts(result, tol_items)

@@ -154,7 +154,18 @@ def inside_limits(figs: dict, limits) -> np.ndarray:
 
 
 def plant_parts(parts) -> dict:
-    """Designator -> nominal value of the plant's parts that vary (R3, R4 only for a gain above 1)."""
+    """Designator -> nominal value of the plant's parts that vary (R3, R4 only for a gain above 1).
+
+    Parameters
+    ----------
+    parts : designer.plant.sallenkey.SallenKeyParts
+        The plant's parts.
+
+    Returns
+    -------
+    dict
+        Designator -> nominal value.
+    """
     nominal = {"R1": parts.r1, "R2": parts.r2, "C1": parts.c1, "C2": parts.c2}
     if parts.r3 is not None and parts.r4 is not None and parts.gain > 1:
         nominal.update(R3=parts.r3, R4=parts.r4)
@@ -162,7 +173,24 @@ def plant_parts(parts) -> dict:
 
 
 def plant_worst_case(parts, series: dict, opamp, tol_items=()):
-    """:func:`designer.tolerance.worstcase.worst_case` of the plant's figures over its tolerance box."""
+    """:func:`designer.tolerance.worstcase.worst_case` of the plant's figures over its tolerance box.
+
+    Parameters
+    ----------
+    parts : designer.plant.sallenkey.SallenKeyParts
+        The plant's parts.
+    series : dict
+        ``{"R": series, "C": series}``.
+    opamp : designer.core.opamps.OpAmp
+        The op-amp.
+    tol_items : sequence of str
+        The ``--tol`` items.
+
+    Returns
+    -------
+    designer.tolerance.worstcase.WorstCase
+        The extremes.
+    """
     from .worstcase import worst_case
     nominal = plant_parts(parts)
     tol = resolve(tol_items, nominal, series)
@@ -203,6 +231,11 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     target_ci : float, optional
         ``--target-ci``: draw in rounds until the yield's 95 % Wilson half-width is below it
         (a fraction), ``n`` samples at most (:func:`target_rounds`); needs limits.
+
+    Returns
+    -------
+    MonteCarlo
+        The Monte Carlo.
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_SAMPLES <= n <= MAX_SAMPLES:
         raise DesignError(f"--monte-carlo must be a whole number of samples from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
@@ -233,12 +266,36 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
 
 
 def apply_engine(evaluate, values: dict) -> dict:
-    """The runner's chunk function for an engine given as ``evaluate(values)`` (a picklable partial)."""
+    """The runner's chunk function for an engine given as ``evaluate(values)`` (a picklable partial).
+
+    Parameters
+    ----------
+    evaluate : callable
+        ``evaluate(values) -> figures``.
+    values : dict
+        Designator -> array over the chunk's samples.
+
+    Returns
+    -------
+    dict
+        Figure -> array over the samples.
+    """
     return evaluate(values)
 
 
 def parse_target_ci(text) -> float:
-    """``--target-ci``: ``1%``, ``0.5 %`` or a fraction (``0.01``)."""
+    """``--target-ci``: ``1%``, ``0.5 %`` or a fraction (``0.01``).
+
+    Parameters
+    ----------
+    text : str
+        ``--target-ci``'s value.
+
+    Returns
+    -------
+    float
+        The width (fraction).
+    """
     from ..core.units import parse_value
     t = str(text).strip()
     pct = t.endswith("%")
@@ -257,7 +314,17 @@ def parse_target_ci(text) -> float:
 
 
 def check_target_ci(target_ci, limits, sampler) -> None:
-    """``--target-ci``'s value and what it needs, checked before any work."""
+    """``--target-ci``'s value and what it needs, checked before any work.
+
+    Parameters
+    ----------
+    target_ci : float or None
+        ``--target-ci``'s value.
+    limits : list
+        The ``--limit`` items parsed (a yield needs one).
+    sampler : str
+        The sampler.
+    """
     if not isinstance(target_ci, (int, float)) or not 0 < target_ci <= MAX_TARGET_CI:
         raise DesignError(f"--target-ci must be a half-width above 0 and at most {100 * MAX_TARGET_CI:g} %, got "
                           f"{target_ci!r}")

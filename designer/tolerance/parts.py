@@ -37,7 +37,20 @@ _ITEM = re.compile(r"^\s*([A-Za-z][A-Za-z0-9]*)\s*=\s*(.+?)\s*$")
 
 
 def parse_tolerance(text: str, where: str) -> float:
-    """``1%``, ``0.5 %``, ``0.01`` -> a fraction in (0, MAX_TOL]."""
+    """``1%``, ``0.5 %``, ``0.01`` -> a fraction in (0, MAX_TOL].
+
+    Parameters
+    ----------
+    text : str
+        The tolerance as given.
+    where : str
+        What the message names.
+
+    Returns
+    -------
+    float
+        The fraction.
+    """
     t = str(text).strip()
     pct = t.endswith("%")
     try:
@@ -81,7 +94,15 @@ def split_items(items) -> list:
 
 def check_items(items, designators) -> None:
     """``--tol`` items checked before any work: the shape, the value, a class or one of ``designators``,
-    each once (:func:`split_items`)."""
+    each once (:func:`split_items`).
+
+    Parameters
+    ----------
+    items : sequence of str
+        The ``--tol`` items.
+    designators : iterable of str
+        The parts they may name.
+    """
     for key, value in split_items(items):
         parse_tolerance(value, f"--tol {key}")
         if key not in ("R", "C") and key not in designators and key not in OPAMP_FIGURES:
@@ -102,6 +123,11 @@ def resolve(items, parts: dict, series: dict) -> Tolerances:
     series : dict
         ``"R"``/``"C"`` -> the E-series the design's resistors and capacitors come from (their default
         tolerance), or None for parts typed by hand (then the class or the designator must be given).
+
+    Returns
+    -------
+    Tolerances
+        Each part's tolerance and where it came from.
     """
     from ..core.eseries import TOLERANCE
     classes, singles = {}, {}
@@ -135,6 +161,18 @@ def resolve(items, parts: dict, series: dict) -> Tolerances:
 def opamp_nominal(items, opamp) -> dict:
     """The op-amp figures the ``--tol`` ``items`` name (``GBW=30%``, ``SR=20%``) -> their nominal
     values (Hz, V/s) of ``opamp``; empty when none is named.
+
+    Parameters
+    ----------
+    items : sequence of str
+        The ``--tol`` items.
+    opamp : designer.core.opamps.OpAmp
+        The op-amp.
+
+    Returns
+    -------
+    dict
+        ``GBW`` and ``SR`` -> nominal value.
 
     Raises
     ------

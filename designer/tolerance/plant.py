@@ -107,7 +107,20 @@ def _step_peak(poles, dcoef, wn, zeta):
 
 
 def plant_figures(v: dict, opamp=None) -> dict:
-    """Every figure of :data:`FIGURES` for the sampled parts ``v`` (designator -> array)."""
+    """Every figure of :data:`FIGURES` for the sampled parts ``v`` (designator -> array).
+
+    Parameters
+    ----------
+    v : dict
+        Designator -> array over the samples.
+    opamp : designer.core.opamps.OpAmp, optional
+        The op-amp (None: ideal).
+
+    Returns
+    -------
+    dict
+        Figure -> array over the samples.
+    """
     k = _gain(v)
     fn_i, z_i = fn_zeta(v["R1"], v["R2"], v["C1"], v["C2"], k)
     d3, d2, d1, d0 = _cubic(v, opamp)
@@ -123,5 +136,18 @@ def plant_figures(v: dict, opamp=None) -> dict:
 
 
 def evaluate(opamp, values: dict) -> dict:
-    """The engine's chunk function (:mod:`.runner`): :func:`plant_figures` of ``values`` with ``opamp``."""
+    """The engine's chunk function (:mod:`.runner`): :func:`plant_figures` of ``values`` with ``opamp``.
+
+    Parameters
+    ----------
+    opamp : designer.core.opamps.OpAmp or None
+        The op-amp (None: ideal).
+    values : dict
+        Designator -> array over the chunk's samples.
+
+    Returns
+    -------
+    dict
+        Figure -> array over the samples.
+    """
     return plant_figures(values, opamp)

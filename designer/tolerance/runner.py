@@ -115,7 +115,18 @@ class Scale:
 
 
 def parse_jobs(text) -> int:
-    """``--jobs N``: a whole number, 1 to :data:`MAX_JOBS`."""
+    """``--jobs N``: a whole number, 1 to :data:`MAX_JOBS`.
+
+    Parameters
+    ----------
+    text : str
+        ``--jobs``'s value.
+
+    Returns
+    -------
+    int
+        The worker processes.
+    """
     try:
         jobs = int(str(text).strip())
     except ValueError:

@@ -26,7 +26,26 @@ CHUNK = 4096
 
 
 def unit_samples(n: int, dims: int, seed: int, sampler: str = "random", start: int = 0, stop: int | None = None):
-    """Samples ``start`` .. ``stop`` - 1 (default all ``n``) of ``n``, points of [0, 1)^dims."""
+    """Samples ``start`` .. ``stop`` - 1 (default all ``n``) of ``n``, points of [0, 1)^dims.
+
+    Parameters
+    ----------
+    n : int
+        The draw's samples.
+    dims : int
+        The dimensions (the parts varied).
+    seed : int
+        The seed.
+    sampler : str
+        ``random``, ``lhs`` or ``sobol``.
+    start, stop : int
+        The samples wanted.
+
+    Returns
+    -------
+    numpy.ndarray
+        (samples, dims).
+    """
     stop = n if stop is None else stop
     if sampler not in SAMPLERS:
         raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(SAMPLERS)}")
@@ -63,7 +82,20 @@ def _hypercube(n: int, dims: int, seed: int) -> np.ndarray:
 
 
 def deviations(u, dist: str = "uniform") -> np.ndarray:
-    """Relative deviations in [-1, 1] (times the tolerance) from unit samples."""
+    """Relative deviations in [-1, 1] (times the tolerance) from unit samples.
+
+    Parameters
+    ----------
+    u : array_like
+        Unit samples in [0, 1).
+    dist : str
+        ``uniform`` or ``normal``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The deviations.
+    """
     u = np.asarray(u, float)
     if dist == "uniform":
         return 2.0 * u - 1.0
@@ -76,7 +108,28 @@ def deviations(u, dist: str = "uniform") -> np.ndarray:
 def values(nominal: dict, tol: dict, n: int, seed: int, sampler: str = "random", dist: str = "uniform",
            start: int = 0, stop: int | None = None) -> dict:
     """Designator -> array of its sampled values (samples start .. stop - 1), each
-    nominal x (1 + tol x deviation)."""
+    nominal x (1 + tol x deviation).
+
+    Parameters
+    ----------
+    nominal : dict
+        Designator -> nominal value.
+    tol : dict
+        Designator -> tolerance (fraction).
+    n : int
+        The draw's samples.
+    seed : int
+        The seed.
+    sampler, dist : str
+        How the samples are drawn.
+    start, stop : int
+        The samples wanted.
+
+    Returns
+    -------
+    dict
+        Designator -> array of values.
+    """
     refs = list(tol)
     d = deviations(unit_samples(n, len(refs), seed, sampler, start, stop), dist)
     return {r: nominal[r] * (1.0 + tol[r] * d[:, k]) for k, r in enumerate(refs)}

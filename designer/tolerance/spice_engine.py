@@ -108,7 +108,26 @@ class SpiceContext:
 
 def context(deck: str, parts, opamp, test, simulator: str = "ngspice-cli") -> SpiceContext:
     """The :class:`SpiceContext` of a plant deck (a :class:`~designer.plant.result.PlantResult`'s
-    ``deck``, ``built``, ``opamp`` and ``test``) for the backend ``simulator``."""
+    ``deck``, ``built``, ``opamp`` and ``test``) for the backend ``simulator``.
+
+    Parameters
+    ----------
+    deck : str
+        The plant's deck.
+    parts : designer.plant.sallenkey.SallenKeyParts
+        Its parts.
+    opamp : designer.core.opamps.OpAmp
+        Its op-amp.
+    test : designer.spice.deck.SquareTest
+        Its square-wave test.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    SpiceContext
+        The context.
+    """
     from ..plant.netlist import plant_netlist
     keep = [ln for ln in deck.splitlines()
             if not re.match(r"\s*\.(meas\w*|tran|end)\b", ln, re.I)]
@@ -134,7 +153,22 @@ def context(deck: str, parts, opamp, test, simulator: str = "ngspice-cli") -> Sp
 
 def commands(ctx: SpiceContext, values: dict, start: int = 0) -> list:
     """The control commands of samples ``start``.. (their values ``values``): per sample its
-    ``alter`` lines, ``tran`` over the rising half, a row marker, the ``meas`` lines, ``destroy all``."""
+    ``alter`` lines, ``tran`` over the rising half, a row marker, the ``meas`` lines, ``destroy all``.
+
+    Parameters
+    ----------
+    ctx : SpiceContext
+        The deck and its test.
+    values : dict
+        Designator -> array over the samples.
+    start : int
+        The first sample's index.
+
+    Returns
+    -------
+    list of str
+        The commands.
+    """
     n = len(next(iter(values.values())))
     final = ctx.final_v(values, n)
     elem = dict(ctx.elements)
@@ -207,7 +241,24 @@ def measures(win: str, final: float, node: str = "out", first_peak: bool = True)
     The peak's time: ``first_peak``, where the slope first falls through 0 (a plant's second-order
     step, whose first peak is its highest; not quantised to the time grid), else where the
     highest value is (``MAX_AT``, as a loop deck's own ``.meas`` reads it: a loop's first ripple
-    need not be its peak)."""
+    need not be its peak).
+
+    Parameters
+    ----------
+    win : str
+        The window, ``FROM=.. TO=..``.
+    final : float
+        The settled output (V).
+    node : str
+        The node measured.
+    first_peak : bool
+        The peak's time where the slope first falls through 0.
+
+    Returns
+    -------
+    list of str
+        The ``meas`` commands.
+    """
     f, v = final, f"v({node})"
     peak = ([f"let mcdv = deriv({v})", f"meas tran mctpk WHEN mcdv=0 FALL=1 {win}"] if first_peak else
             [f"meas tran mctpk MAX_AT {v} {win}"])
@@ -221,7 +272,22 @@ def measures(win: str, final: float, node: str = "out", first_peak: bool = True)
 
 def parse(output: str, start: int, n: int) -> dict:
     """Measurement -> array over samples ``start`` .. ``start + n - 1`` (NaN where a ``meas``
-    failed); a :class:`SimulatorError` when a sample's row is missing (ngspice stopped)."""
+    failed); a :class:`SimulatorError` when a sample's row is missing (ngspice stopped).
+
+    Parameters
+    ----------
+    output : str
+        ngspice's output.
+    start : int
+        The first sample's index.
+    n : int
+        The samples.
+
+    Returns
+    -------
+    dict
+        Measurement -> array over the samples.
+    """
     raw = {k: np.full(n, np.nan) for k in _MEASURES}
     marks = list(_ROW.finditer(output))
     seen = set()
@@ -264,7 +330,22 @@ def evaluate(ctx: SpiceContext, values: dict, start: int = 0) -> dict:
     simulated in ngspice: one loaded circuit per :data:`BATCH` samples.
 
     Pure: the same context and values give the same figures in any process
-    (``start`` only labels the samples in ngspice's output and its messages)."""
+    (``start`` only labels the samples in ngspice's output and its messages).
+
+    Parameters
+    ----------
+    ctx : SpiceContext
+        The deck and its test.
+    values : dict
+        Designator -> array over the chunk's samples.
+    start : int
+        The first sample's index.
+
+    Returns
+    -------
+    dict
+        Figure -> array over the samples.
+    """
     from ..spice.simulate import DEFAULT_TIMEOUT_S, get_simulator
     values = {k: np.atleast_1d(np.asarray(v, float)) for k, v in values.items()}
     n = len(next(iter(values.values())))

@@ -82,7 +82,22 @@ class LoopSpiceContext:
 def context(result, designators, simulator: str = "ngspice-cli") -> LoopSpiceContext:
     """The :class:`LoopSpiceContext` of a design-pid or analyze-pid ``result`` (its deck, test,
     op-amp) for the parts ``designators`` (those that may vary; :func:`designer.tolerance.loop.loop_parts`),
-    on the backend ``simulator``."""
+    on the backend ``simulator``.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design.
+    designators : iterable of str
+        The parts that may vary.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    LoopSpiceContext
+        The context.
+    """
     from ..core.errors import DesignError
     from ..spice.simulate import get_simulator
     from .loop import engine_of
@@ -142,7 +157,22 @@ def evaluate(ctx: LoopSpiceContext, values: dict, start: int = 0) -> dict:
     """Every figure of a chunk of builds (designator -> array): the analytic loop engine's
     and SPICE's :data:`FIGURES`, one loaded circuit per :data:`BATCH` builds. Pure: the same
     context and values give the same figures in any process (``start`` labels the builds in
-    ngspice's output only)."""
+    ngspice's output only).
+
+    Parameters
+    ----------
+    ctx : LoopSpiceContext
+        The loop's deck and test.
+    values : dict
+        Designator -> array over the chunk's builds.
+    start : int
+        The first build's index.
+
+    Returns
+    -------
+    dict
+        Figure -> array over the builds.
+    """
     from ..spice.simulate import DEFAULT_TIMEOUT_S, get_simulator
     values = {k: np.atleast_1d(np.asarray(v, float)) for k, v in values.items()}
     fn, analytic_ctx = ctx.analytic

@@ -42,7 +42,18 @@ STEP = spice_loop.STEP
 
 
 def parse_limit(text):
-    """A ``--limit`` on a loop figure for the SPICE engines: a SPICE name counts ``spice_<figure>``."""
+    """A ``--limit`` on a loop figure for the SPICE engines: a SPICE name counts ``spice_<figure>``.
+
+    Parameters
+    ----------
+    text : str
+        The ``--limit`` item.
+
+    Returns
+    -------
+    designer.tolerance.stats.Limit
+        The limit.
+    """
     from .loop import LIMITABLE
     from .stats import Limit, parse_limit as parse
     lim = text if isinstance(text, Limit) else parse(text, LIMITABLE + STEP)
@@ -80,7 +91,40 @@ def loop_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler
     engine ``engine`` (:data:`designer.tolerance.spice_mc.ENGINES`); ``spice_k``: SPICE on the tails
     and ``spice_k`` random builds only (``both``). ``scale``, ``target_ci``: where the builds run and
     ``--target-ci`` (:mod:`designer.tolerance.runner`). Returns a :class:`~designer.tolerance.loop.LoopMonteCarlo`
-    (its ``spice``: the module docstring)."""
+    (its ``spice``: the module docstring).
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design.
+    series : dict
+        ``{"R": series, "C": series}``.
+    n : int
+        The samples.
+    seed : int
+        The seed.
+    sampler, dist : str
+        How the samples are drawn.
+    tol_items : sequence of str
+        The ``--tol`` items.
+    limit_items : sequence of str
+        The ``--limit`` items.
+    engine : str
+        ``analytic``, or a SPICE engine.
+    spice_k : int, optional
+        The samples SPICE checks from each tail and at random.
+    simulator : str
+        The backend.
+    scale : designer.tolerance.runner.Scale, optional
+        Where the chunks run.
+    target_ci : float, optional
+        ``--target-ci``.
+
+    Returns
+    -------
+    designer.tolerance.montecarlo.MonteCarlo
+        The Monte Carlo.
+    """
     from .loop import stable_and_inside, engine_of, loop_monte_carlo, loop_parts
     from .spice_mc import ENGINES, disagreement, run_picked, spice_checked, spice_samples
     if engine not in ENGINES:
@@ -180,7 +224,32 @@ def replay_values(result, series: dict, index: int, n: int, seed: int, sampler: 
 
 def replay(result, series: dict, index: int, n: int, seed: int, sampler: str, dist: str, tol_items=(),
            simulator: str = "ngspice-cli") -> LoopReplay:
-    """Build ``index`` of the draw on ``result``'s loop, through the loop's SPICE engine."""
+    """Build ``index`` of the draw on ``result``'s loop, through the loop's SPICE engine.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design.
+    series : dict
+        ``{"R": series, "C": series}``.
+    index : int
+        The build replayed.
+    n : int
+        The draw's samples.
+    seed : int
+        The seed.
+    sampler, dist : str
+        How the samples are drawn.
+    tol_items : sequence of str
+        The ``--tol`` items.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    LoopReplay
+        The build's values and figures.
+    """
     tol, v = replay_values(result, series, index, n, seed, sampler, dist, tol_items)
     ctx = spice_loop.context(result, tuple(v), simulator)
     figs = spice_loop.evaluate(ctx, {k: np.array([x]) for k, x in v.items()}, start=index)
@@ -210,7 +279,24 @@ def replay_spec(spec, result, values: dict):
 def replay_result(spec, result, rep: LoopReplay, simulator: str):
     """The full analyze-pid result (sheet, deck, waveforms) of the replayed build: its exact parts,
     on the design's op-amp with the build's gain-bandwidth and slew rate when they vary, and the
-    run's square wave; its ``monte_carlo`` is the :class:`LoopReplay`."""
+    run's square wave; its ``monte_carlo`` is the :class:`LoopReplay`.
+
+    Parameters
+    ----------
+    spec : designer.pid.spec.PidSpec
+        The design's request.
+    result : designer.pid.result.PidResult
+        The design.
+    rep : LoopReplay
+        The build replayed.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    designer.pid.result.PidResult
+        The analysis of the build.
+    """
     from ..pid.design import analyze_pid
     from .parts import sample_opamp
     amp = sample_opamp(result.opamp, {k: np.array([x]) for k, x in rep.values.items()}, 0)

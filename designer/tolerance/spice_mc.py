@@ -59,7 +59,20 @@ def spice_step_evaluate(result, simulator: str = "ngspice-cli"):
 
 
 def spice_evaluate(ctx, opamp):
-    """``evaluate(values) -> figures`` (:func:`plant_chunk` bound to a design; picklable)."""
+    """``evaluate(values) -> figures`` (:func:`plant_chunk` bound to a design; picklable).
+
+    Parameters
+    ----------
+    ctx : designer.tolerance.spice_engine.SpiceContext
+        The deck and its test.
+    opamp : designer.core.opamps.OpAmp
+        The op-amp.
+
+    Returns
+    -------
+    functools.partial
+        ``evaluate(values) -> figures``.
+    """
     import functools
     return functools.partial(plant_chunk, ctx, opamp)
 
@@ -110,7 +123,24 @@ def spice_checked(idx, worst, rand, model_pass, spice_pass, yield_count: int, n:
 
 def spice_samples(figs: dict, limits, k: int, seed: int) -> tuple:
     """(worst, random) sample indices: per limited figure the ``k`` samples with the least room
-    inside (most beyond) its window, and ``k`` others drawn at random."""
+    inside (most beyond) its window, and ``k`` others drawn at random.
+
+    Parameters
+    ----------
+    figs : dict
+        Figure -> array over the samples.
+    limits : list
+        The limits.
+    k : int
+        The samples taken from each tail and at random.
+    seed : int
+        The seed of the random ones.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (worst, random).
+    """
     n = len(next(iter(figs.values())))
     worst = []
     for lim in limits:
@@ -143,7 +173,40 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
     """:func:`designer.tolerance.montecarlo.plant_monte_carlo` of a plant result (its parts as
     built, op-amp and deck) with the engine ``engine`` (:data:`ENGINES`); ``spice_k``: SPICE on
     the tails and ``spice_k`` random samples only (``both``). ``scale``, ``target_ci``: where the
-    samples run and ``--target-ci`` (:mod:`designer.tolerance.runner`)."""
+    samples run and ``--target-ci`` (:mod:`designer.tolerance.runner`).
+
+    Parameters
+    ----------
+    result : designer.plant.result.PlantResult
+        The design.
+    series : dict
+        ``{"R": series, "C": series}``.
+    n : int
+        The samples.
+    seed : int
+        The seed.
+    sampler, dist : str
+        How the samples are drawn.
+    tol_items : sequence of str
+        The ``--tol`` items.
+    limit_items : sequence of str
+        The ``--limit`` items.
+    engine : str
+        ``analytic``, or a SPICE engine.
+    spice_k : int, optional
+        The samples SPICE checks from each tail and at random.
+    simulator : str
+        The backend.
+    scale : designer.tolerance.runner.Scale, optional
+        Where the chunks run.
+    target_ci : float, optional
+        ``--target-ci``.
+
+    Returns
+    -------
+    designer.tolerance.montecarlo.MonteCarlo
+        The Monte Carlo.
+    """
     where = {"scale": scale, "target_ci": target_ci}
     from .montecarlo import apply_engine, figures_with_fixed, plant_monte_carlo
     if engine not in ENGINES:
@@ -229,7 +292,32 @@ class Replay:
 def replay_values(parts, series: dict, opamp, index: int, n: int, seed: int, sampler: str, dist: str,
                   tol_items=()) -> tuple:
     """(nominal, tolerances, values) of sample ``index`` of an ``n``-sample draw: exactly the
-    values :func:`designer.tolerance.montecarlo.plant_monte_carlo` drew for it."""
+    values :func:`designer.tolerance.montecarlo.plant_monte_carlo` drew for it.
+
+    Parameters
+    ----------
+    parts : designer.plant.sallenkey.SallenKeyParts
+        The plant's parts.
+    series : dict
+        ``{"R": series, "C": series}``.
+    opamp : designer.core.opamps.OpAmp
+        The op-amp.
+    index : int
+        The sample.
+    n : int
+        The draw's samples.
+    seed : int
+        The seed.
+    sampler, dist : str
+        How the samples are drawn.
+    tol_items : sequence of str
+        The ``--tol`` items.
+
+    Returns
+    -------
+    tuple
+        (nominal, tolerances, values).
+    """
     from . import sampling
     from .montecarlo import plant_parts
     from .parts import opamp_nominal, resolve
@@ -243,7 +331,32 @@ def replay_values(parts, series: dict, opamp, index: int, n: int, seed: int, sam
 
 def replay(result, series: dict, index: int, n: int, seed: int, sampler: str, dist: str, tol_items=(),
            simulator: str = "ngspice-cli") -> Replay:
-    """Sample ``index`` of the draw on ``result``'s parts, through the SPICE engine and the model."""
+    """Sample ``index`` of the draw on ``result``'s parts, through the SPICE engine and the model.
+
+    Parameters
+    ----------
+    result : designer.plant.result.PlantResult
+        The design.
+    series : dict
+        ``{"R": series, "C": series}``.
+    index : int
+        The sample replayed.
+    n : int
+        The draw's samples.
+    seed : int
+        The seed.
+    sampler, dist : str
+        How the samples are drawn.
+    tol_items : sequence of str
+        The ``--tol`` items.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    Replay
+        The sample's values and figures.
+    """
     from .montecarlo import figures_with_fixed
     _, tol, v = replay_values(result.built, series, result.opamp, index, n, seed, sampler, dist, tol_items)
     arr = {k: np.array([x]) for k, x in v.items()}
@@ -259,7 +372,26 @@ def replay(result, series: dict, index: int, n: int, seed: int, sampler: str, di
 def replay_result(result, rep: Replay, simulator: str, r_series=None, c_series=None, package=None):
     """The full analyze-plant result (sheet, deck, waveforms) of the replayed sample's parts, exact
     values (no E-series rounding), on the design's op-amp (with the sample's gain-bandwidth and slew
-    rate when they vary, :func:`designer.tolerance.parts.sample_opamp`) and square wave; its ``monte_carlo`` is the :class:`Replay`."""
+    rate when they vary, :func:`designer.tolerance.parts.sample_opamp`) and square wave; its ``monte_carlo`` is the :class:`Replay`.
+
+    Parameters
+    ----------
+    result : designer.plant.result.PlantResult
+        The design.
+    rep : Replay
+        The sample replayed.
+    simulator : str
+        The backend.
+    r_series, c_series : str, optional
+        The parts' series, shown on the sheet.
+    package : str, optional
+        The op-amp's package.
+
+    Returns
+    -------
+    designer.plant.result.PlantResult
+        The analysis of the sample.
+    """
     from ..plant.design import analyze_plant
     from ..plant.sallenkey import SallenKeyParts
     from ..plant.spec import AnalysisSpec

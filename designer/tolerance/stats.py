@@ -18,7 +18,22 @@ Z95 = 1.959963984540054
 
 
 def wilson(k: int, n: int, z: float = Z95) -> tuple:
-    """The Wilson score interval (lo, hi) of a proportion k/n (Wilson 1927)."""
+    """The Wilson score interval (lo, hi) of a proportion k/n (Wilson 1927).
+
+    Parameters
+    ----------
+    k : int
+        The successes.
+    n : int
+        The trials.
+    z : float
+        The normal quantile (95 %: 1.96).
+
+    Returns
+    -------
+    tuple of float
+        (lo, hi).
+    """
     if n <= 0:
         return (math.nan, math.nan)
     p = k / n
@@ -63,7 +78,20 @@ class Limit:
 
 
 def parse_limit(text: str, figures) -> Limit:
-    """``FIGURE=MIN:MAX`` in engineering notation, both bounds given (``overshoot_pct=0:55``)."""
+    """``FIGURE=MIN:MAX`` in engineering notation, both bounds given (``overshoot_pct=0:55``).
+
+    Parameters
+    ----------
+    text : str
+        The ``--limit`` item.
+    figures : iterable of str
+        The figures that may be limited.
+
+    Returns
+    -------
+    Limit
+        The limit.
+    """
     from ..core.errors import DesignError
     from ..core.units import parse_value
     t = str(text)
@@ -99,6 +127,25 @@ class FigureStats:
 
 
 def figure_stats(name: str, v, nominal: float, limit: Limit | None = None) -> FigureStats:
+    """A figure's statistics over the samples (NaN left out): mean, standard deviation, percentiles,
+    and the process capability Cpk against ``limit`` (None without one or without spread).
+
+    Parameters
+    ----------
+    name : str
+        The figure.
+    v : array_like
+        Its value in each sample.
+    nominal : float
+        The nominal design's value.
+    limit : Limit, optional
+        The figure's limit.
+
+    Returns
+    -------
+    FigureStats
+        The statistics.
+    """
     v = np.asarray(v, float)
     v = v[np.isfinite(v)]
     mean = float(v.mean()) if v.size else math.nan
@@ -115,7 +162,20 @@ def figure_stats(name: str, v, nominal: float, limit: Limit | None = None) -> Fi
 def variance_shares(x: dict, y) -> dict:
     """Each part's share of the variance of ``y``: the squared standardised
     regression coefficients of y on the parts' relative deviations (their sum is the
-    linear model's R^2; a part absent from the figure gets ~0)."""
+    linear model's R^2; a part absent from the figure gets ~0).
+
+    Parameters
+    ----------
+    x : dict
+        Part -> relative deviations over the samples.
+    y : array_like
+        The figure over the samples.
+
+    Returns
+    -------
+    dict
+        Part -> share.
+    """
     y = np.asarray(y, float)
     keep = np.isfinite(y)
     refs = list(x)

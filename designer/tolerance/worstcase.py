@@ -81,11 +81,18 @@ def worst_case(evaluate, nominal: dict, tol: dict, figures=FIGURES, max_corners:
         :func:`designer.tolerance.plant.plant_figures` with its op-amp bound).
     nominal, tol : dict
         Designator -> nominal value and -> tolerance (fraction).
+    figures : sequence of str
+        The figures whose extremes are sought.
     max_corners : int
         Every corner is evaluated up to this many (2^d); a larger box (a loop's 22 parts: 4 million
         corners) starts from the corners the parts' slopes point to (:func:`sensitivity_corners`).
     maxiter : int
         The bounded search's iterations per figure and direction.
+
+    Returns
+    -------
+    WorstCase
+        Each figure's extremes and the corners evaluated.
     """
     from scipy.optimize import minimize
     refs = list(tol)

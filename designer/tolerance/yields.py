@@ -47,7 +47,22 @@ ENGINES = ("analytic", "spice")
 
 def counted(kind: str, checks, engine: str = "analytic") -> tuple:
     """(the checks the yield counts, the names of those it cannot): failing checks whose figure the
-    ``engine`` computes, and the others'."""
+    ``engine`` computes, and the others'.
+
+    Parameters
+    ----------
+    kind : str
+        ``plant`` or ``pid``.
+    checks : sequence of designer.check.limits.Limit
+        The spec's checks.
+    engine : str
+        The yield's engine.
+
+    Returns
+    -------
+    tuple
+        (the checks counted, the names of the others).
+    """
     table = TABLES[engine][kind]
     live = [c for c in checks if c.fail]
     return tuple(c for c in live if c.figure in table), tuple(c.figure for c in live if c.figure not in table)
@@ -126,12 +141,31 @@ def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int,
     ----------
     kind : str
         ``plant`` or ``pid``.
+    res : designer.plant.result.PlantResult or designer.pid.result.PidResult
+        The corner's design.
+    checks : sequence of designer.check.limits.Limit
+        The spec's checks.
+    required : float
+        The yield required (fraction).
+    samples : int
+        The Monte Carlo's samples.
+    seed : int
+        Its seed.
     tol_items : sequence of str
         The spec's ``tolerances:`` as ``--tol`` items (``R=1%``, ``SR=20%``); they win over the
         series' defaults, as ``--tol`` does.
     engine : str
         :data:`ENGINES`: ``analytic`` (the models) or ``spice`` (every build simulated in ngspice
         on the backend ``simulator``, the module docstring).
+    sampler, dist : str
+        How the samples are drawn (:mod:`designer.tolerance.sampling`).
+    simulator : str
+        The SPICE engine's backend.
+
+    Returns
+    -------
+    YieldVerdict
+        The Monte Carlo, the limits counted and the verdict.
     """
     from .loop import loop_monte_carlo, loop_series
     from .montecarlo import plant_monte_carlo
