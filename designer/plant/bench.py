@@ -36,7 +36,26 @@ def recommend_square_wave(settling_time_s: float, amplitude_v: float, frequency_
                           delay_s=None, time_scale_s=None) -> SquareTest:
     """A square wave whose half period leaves the response 1.5 settling times
     (2 %) to settle, rounded down to a round generator setting (the seed used
-    330 Hz for its 891 us settling time). ``time_scale_s``: see :class:`SquareTest`."""
+    330 Hz for its 891 us settling time). ``time_scale_s``: see :class:`SquareTest`.
+
+    Parameters
+    ----------
+    settling_time_s : float
+        The response's 2 % settling time (s).
+    amplitude_v : float
+        The step (V).
+    frequency_hz : float, optional
+        The frequency given (``--test-frequency``); None: chosen.
+    delay_s : float, optional
+        The first edge's delay (s); None: chosen.
+    time_scale_s : float, optional
+        The response's time scale (s), for the edge; None: from the settling time.
+
+    Returns
+    -------
+    designer.spice.deck.SquareTest
+        The square wave.
+    """
     if frequency_hz is None:
         frequency_hz = nice_frequency_below(1.0 / (2 * 1.5 * settling_time_s))
     half = 0.5 / frequency_hz
@@ -119,7 +138,22 @@ class ToleranceBand:
 
 def tolerance_band(parts: SallenKeyParts, r_tol: float, c_tol: float, t_end: float) -> ToleranceBand:
     """Min and max of fn, zeta and the step metrics over the 16 corners of
-    R1, R2, C1, C2 at +/- their tolerance (ideal op-amp), for the scope readings."""
+    R1, R2, C1, C2 at +/- their tolerance (ideal op-amp), for the scope readings.
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        The parts.
+    r_tol, c_tol : float
+        The resistors' and capacitors' tolerances (fractions).
+    t_end : float
+        The step response's span (s).
+
+    Returns
+    -------
+    ToleranceBand
+        The extremes and the band of step responses.
+    """
     t = dense_time(t_end, 8001)
     rows = []
     lo = hi = None
@@ -243,7 +277,22 @@ class ScopeSetup:
 
 def channel(name: str, node: str, lo: float, hi: float) -> Channel:
     """The 1-2-5 volts/div and 0 V position that fit ``lo``..``hi`` on 6 of the 8
-    divisions (a division of headroom at each edge of the screen)."""
+    divisions (a division of headroom at each edge of the screen).
+
+    Parameters
+    ----------
+    name : str
+        The channel (``CH1``).
+    node : str
+        The node it probes.
+    lo, hi : float
+        The range of the signal (V).
+
+    Returns
+    -------
+    Channel
+        The channel's settings.
+    """
     lo, hi = min(lo, 0.0), max(hi, 0.0)
     vdiv = one_two_five(max(hi - lo, 1e-6) / (V_DIVS - 2))
     # centre the swing on the screen: 0 V this many divisions below the centre
@@ -252,7 +301,22 @@ def channel(name: str, node: str, lo: float, hi: float) -> Channel:
 
 
 def scope_setup(window_s: float, trigger_v: float, channels) -> ScopeSetup:
-    """Time/div showing ``window_s`` after the edge (the edge :data:`EDGE_DIV` in)."""
+    """Time/div showing ``window_s`` after the edge (the edge :data:`EDGE_DIV` in).
+
+    Parameters
+    ----------
+    window_s : float
+        The time shown after the edge (s).
+    trigger_v : float
+        The trigger level (V).
+    channels : sequence of Channel
+        The channels.
+
+    Returns
+    -------
+    ScopeSetup
+        The scope's settings.
+    """
     return ScopeSetup(one_two_five(window_s / (H_DIVS - EDGE_DIV)), EDGE_DIV, trigger_v, tuple(channels))
 
 

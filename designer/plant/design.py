@@ -124,7 +124,18 @@ class Choice:
 
 def choose_parts(spec: PlantSpec) -> Choice:
     """The E-series parts for a spec, without any analysis: what
-    ``design-plant`` builds, and what ``design-pid`` needs of a designed plant."""
+    ``design-plant`` builds, and what ``design-pid`` needs of a designed plant.
+
+    Parameters
+    ----------
+    spec : PlantSpec
+        The request.
+
+    Returns
+    -------
+    Choice
+        The build and its alternatives.
+    """
     rv = candidates(spec.r_series, spec.r_min, spec.r_max, "resistor")
     cv = candidates(spec.c_series, spec.c_min, spec.c_max, "capacitor")
     r3, r4, k = gain_resistors(spec.gain, spec)
@@ -190,7 +201,22 @@ def _exact_design(best, fc_hz: float, zeta: float, k: float, r3, r4):
 
 
 def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspice") -> PlantResult:
-    """Design, analyse and (unless ``simulate`` is False) verify a plant."""
+    """Design, analyse and (unless ``simulate`` is False) verify a plant.
+
+    Parameters
+    ----------
+    spec : PlantSpec
+        The request.
+    simulate : bool
+        Verify in ngspice.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    PlantResult
+        The design, its analysis and its verification.
+    """
     tick = time.perf_counter()
     amp = spec.amp
     choice = choose_parts(spec)
@@ -225,7 +251,22 @@ def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspi
 
 def analyze_plant(spec: AnalysisSpec, simulate: bool = True, simulator: str = "pyspice") -> PlantResult:
     """Analyse parts as built (e.g. the seed's rounded 820/1k/10n/220n): what
-    they really give, and (unless ``simulate`` is False) SPICE's verdict."""
+    they really give, and (unless ``simulate`` is False) SPICE's verdict.
+
+    Parameters
+    ----------
+    spec : AnalysisSpec
+        The parts as built.
+    simulate : bool
+        Verify in ngspice.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    PlantResult
+        The analysis and its verification.
+    """
     parts = spec.parts
     target = Target(spec.target_fc_hz, spec.target_zeta, parts.gain)
     notes = [f"these parts give fn = {parts.fn_hz:.5g} Hz and zeta = {parts.zeta:.4g} (Q = {parts.q:.4g})"]

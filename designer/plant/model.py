@@ -19,7 +19,18 @@ __all__ = ["plant_tf", "plant_tf_opamp", "sensitivities"]
 
 
 def plant_tf(parts: SallenKeyParts):
-    """Ideal op-amp: K / (a s^2 + b s + 1)."""
+    """Ideal op-amp: K / (a s^2 + b s + 1).
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        The parts.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (num, den), highest power first.
+    """
     return np.array([parts.gain]), np.array([parts.a, parts.b, 1.0])
 
 
@@ -29,6 +40,18 @@ def plant_tf_opamp(parts: SallenKeyParts, opamp: OpAmp):
     Node equations with Vp = Vo (1/A + 1/K) and V1 = Vp (1 + s R2 C1) give
     Vo/Vin = 1/D(s),  D = (N/A0) [(1 + s R2 C1)(1 + R1/R2 + s R1 C2) - R1/R2] - s R1 C2,
     N = 1 + A0/K + s/wp. As A0, wp -> inf this is the ideal K/(a s^2 + b s + 1).
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        The parts.
+    opamp : OpAmp
+        The op-amp.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (num, den), highest power first.
     """
     r1, r2, c1, c2, k = parts.r1, parts.r2, parts.c1, parts.c2, parts.gain
     a0 = opamp.a0
@@ -57,6 +80,15 @@ def sensitivities(parts: SallenKeyParts, opamp: OpAmp | None = None, rel_step: f
     x runs over R1, R2, C1, C2, the gain K (when not a follower) and, with an
     op-amp, its GBW and DC gain A0 (through the op-amp-aware model). Central
     differences in log space.
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        The parts.
+    opamp : OpAmp, optional
+        The op-amp (its GBW and A0 join the list).
+    rel_step : float
+        The central differences' relative step.
 
     Returns
     -------

@@ -48,7 +48,24 @@ def plant_netlist(parts: SallenKeyParts, inp: str = "input", out: str = "out", p
     ``v1``, ``vp``, ``vn`` with ``prefix``): R1 from the input to v1, R2 from v1
     to the non-inverting input, C1 from there to ground, C2 from v1 to the output
     (the positive feedback); a follower at K = 1, else R19 (inverting input to
-    ground) and R20 (output to inverting input)."""
+    ground) and R20 (output to inverting input).
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        The parts.
+    inp, out : str
+        The input and output nets.
+    prefix : str
+        Prepended to the internal nets and designators (for chaining).
+    amp_ref : str
+        The op-amp's reference.
+
+    Returns
+    -------
+    Netlist
+        The circuit.
+    """
     v1, vp, vn = f"{prefix}v1", f"{prefix}vp", f"{prefix}vn"
     rows = [Part("R1", inp, v1, parts.r1, "input resistor"),
             Part("R2", v1, vp, parts.r2, "to the non-inverting input"),
@@ -73,7 +90,24 @@ def _circuit(title: str, opamp: OpAmp, header: list):
 
 
 def plant_deck(parts: SallenKeyParts, opamp: OpAmp, test: SquareTest, title: str) -> str:
-    """Standalone deck of the Sallen-Key plant under the square-wave test."""
+    """Standalone deck of the Sallen-Key plant under the square-wave test.
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        The parts.
+    opamp : OpAmp
+        The op-amp.
+    test : SquareTest
+        The square-wave test.
+    title : str
+        The deck's title line.
+
+    Returns
+    -------
+    str
+        The deck.
+    """
     circuit = _circuit(title, opamp, [
         f"* op-amp: {opamp.name} ({opamp.description}); supplies {opamp.vcc:g} V / {opamp.vee:g} V",
         f"* test: 0 -> {test.amplitude_v:g} V square wave at {test.frequency_hz:g} Hz, step at {test.delay_s:.4g} s",
@@ -87,7 +121,24 @@ def plant_deck(parts: SallenKeyParts, opamp: OpAmp, test: SquareTest, title: str
 
 def plant_ac_deck(parts: SallenKeyParts, opamp: OpAmp, f_lo: float, f_hi: float, title: str) -> str:
     """The sine check as an ngspice deck: the same circuit driven by a 1 V AC
-    source, an ``.ac`` sweep from ``f_lo`` to ``f_hi`` (v(out) is the gain)."""
+    source, an ``.ac`` sweep from ``f_lo`` to ``f_hi`` (v(out) is the gain).
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        The parts.
+    opamp : OpAmp
+        The op-amp.
+    f_lo, f_hi : float
+        The sweep's ends (Hz).
+    title : str
+        The deck's title line.
+
+    Returns
+    -------
+    str
+        The deck.
+    """
     circuit = _circuit(title, opamp, ["* sine check: 1 V AC at the input, v(out) = gain and phase"])
     circuit.V("in", "input", circuit.gnd, "DC 0 AC 1")
     plant_netlist(parts).add_to(circuit, opamp)
@@ -100,7 +151,26 @@ def plant_prbs_deck(parts: SallenKeyParts, opamp: OpAmp, plan, title: str, sampl
     writes it: its ngspice PWL subcircuit on the input), every period of it,
     the maximum time step a ``samples_per_interval``-th of the clock interval
     (and at most 1/100 of 1/wn): the prediction a bench capture of the plant
-    under that sequence is compared with, and what ``identify`` reads."""
+    under that sequence is compared with, and what ``identify`` reads.
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        The parts.
+    opamp : OpAmp
+        The op-amp.
+    plan : designer.core.prbs.PrbsPlan
+        The sequence.
+    title : str
+        The deck's title line.
+    samples_per_interval : int
+        Output samples per clock interval.
+
+    Returns
+    -------
+    str
+        The deck.
+    """
     import math
 
     from ..core.prbs import pwl_subcircuit

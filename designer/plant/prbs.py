@@ -41,7 +41,24 @@ MAX_SPICE_STEPS = 2_000_000
 def plan_for_result(result, amplitude_v: float, bits=None, clock_hz=None) -> PrbsPlan:
     """The sequence for a :class:`~designer.plant.result.PlantResult`: levels
     0 V and ``amplitude_v``; ``bits`` and ``clock_hz`` chosen for the plant's
-    op-amp-aware model unless given (a given clock is kept as is)."""
+    op-amp-aware model unless given (a given clock is kept as is).
+
+    Parameters
+    ----------
+    result : PlantResult
+        The plant.
+    amplitude_v : float
+        The sequence's amplitude (V).
+    bits : int, optional
+        The register's length; None: chosen.
+    clock_hz : float, optional
+        The clock; None: chosen.
+
+    Returns
+    -------
+    PrbsPlan
+        The sequence.
+    """
     settling = result.analytic_opamp.step.settling_time_s
     sine = result.sine
     band = sine.f_3db_hz if sine is not None and sine.f_3db_hz is not None else result.built.fn_hz
@@ -111,7 +128,22 @@ class PrbsRun:
 def model_response(num, den, plan: PrbsPlan, per_interval: int = SAMPLES_PER_INTERVAL) -> tuple:
     """(t, u, y): the held sequence and the exact response of N(s)/D(s) to it,
     at t = (k + 1/2) ts, ts = Dt / ``per_interval``, from the steady state of
-    its first level (as ngspice's operating point starts the transient)."""
+    its first level (as ngspice's operating point starts the transient).
+
+    Parameters
+    ----------
+    num, den : array_like
+        The model, highest power first.
+    plan : PrbsPlan
+        The sequence.
+    per_interval : int
+        Samples per clock interval.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (t, u, y).
+    """
     import scipy.signal as sig
     ts = plan.dt_s / per_interval
     u2 = np.repeat(plan.values(), 2 * per_interval)
@@ -123,7 +155,20 @@ def model_response(num, den, plan: PrbsPlan, per_interval: int = SAMPLES_PER_INT
 
 
 def op_amp_checks(t, y, opamp) -> tuple:
-    """The swing and slew the op-amp needs to follow ``y`` (the model's output)."""
+    """The swing and slew the op-amp needs to follow ``y`` (the model's output).
+
+    Parameters
+    ----------
+    t, y : array_like
+        The model's output.
+    opamp : designer.core.opamps.OpAmp or None
+        The op-amp (None: ideal).
+
+    Returns
+    -------
+    tuple of designer.core.checks.Check
+        The swing and slew checks.
+    """
     lo, hi = float(np.min(y)), float(np.max(y))
     slope = float(np.max(np.abs(np.diff(y)))) / float(t[1] - t[0])
     span = f"output spans {lo:.3g} V to {hi:.3g} V"
@@ -141,7 +186,24 @@ def op_amp_checks(t, y, opamp) -> tuple:
 
 def prbs_run(result, plan: PrbsPlan, simulate: bool = True, simulator: str = "pyspice") -> PrbsRun:
     """The plant of ``result`` under ``plan``: the model's response and, when
-    ``simulate``, ngspice's (see the module docstring)."""
+    ``simulate``, ngspice's (see the module docstring).
+
+    Parameters
+    ----------
+    result : PlantResult
+        The plant.
+    plan : PrbsPlan
+        The sequence.
+    simulate : bool
+        Run it in ngspice too.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    PrbsRun
+        The responses, the deck and the checks.
+    """
     from ..core.compare import resample
     from ..spice.simulate import get_simulator
     from .netlist import plant_prbs_deck
@@ -170,7 +232,28 @@ NRMS_LIMIT = 0.01
 def with_prbs(result, amplitude_v: float, bits=None, clock_hz=None, simulate: bool = True,
               simulator: str = "pyspice"):
     """``result`` with its PRBS bench test (:attr:`PlantResult.prbs`), the
-    op-amp's checks under it added to its checks; returned."""
+    op-amp's checks under it added to its checks; returned.
+
+    Parameters
+    ----------
+    result : PlantResult
+        The plant.
+    amplitude_v : float
+        The sequence's amplitude (V).
+    bits : int, optional
+        The register's length; None: chosen.
+    clock_hz : float, optional
+        The clock; None: chosen.
+    simulate : bool
+        Run it in ngspice too.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    PlantResult
+        ``result``.
+    """
     plan = plan_for_result(result, amplitude_v, bits, clock_hz)
     run = prbs_run(result, plan, simulate, simulator)
     result.prbs = run

@@ -104,6 +104,20 @@ def _settings(result) -> list:
 
 
 def sine_text(sine) -> str:
+    """The sine check in one line, as the sheet's settings table and the page give it: the amplitude,
+    the peak (its gain over DC, its frequency; SPICE's when it ran) or why there is none, and the
+    -3 dB frequency.
+
+    Parameters
+    ----------
+    sine : designer.plant.bench.SineCheck
+        The sine check.
+
+    Returns
+    -------
+    str
+        The line.
+    """
     head = f"sine {format_eng(sine.amplitude_v, 'V')} pk"
     parts = []
     if sine.f_peak_hz is not None:
@@ -256,7 +270,18 @@ def _n(v):
 
 
 def summary_text(result) -> str:
-    """The terminal summary: the build sheet without plots (and the Monte Carlo's lines when run)."""
+    """The terminal summary: the build sheet without plots (and the Monte Carlo's lines when run).
+
+    Parameters
+    ----------
+    result : PlantResult
+        The plant.
+
+    Returns
+    -------
+    str
+        The summary.
+    """
     text = R.to_text(title_of(result), sections(result, with_images=False))
     for extra in (result.monte_carlo, result.worst_case):
         if extra is not None:
@@ -270,7 +295,18 @@ def plots(result) -> dict:
 
 
 def step_png(result) -> bytes:
-    """The curves, the tolerance band shaded, SPICE minus the op-amp-aware model below."""
+    """The curves, the tolerance band shaded, SPICE minus the op-amp-aware model below.
+
+    Parameters
+    ----------
+    result : PlantResult
+        The plant.
+
+    Returns
+    -------
+    bytes
+        The PNG.
+    """
     ideal, real = result.analytic, result.analytic_opamp
     amp = result.opamp.name
     a = result.test.amplitude_v
@@ -305,7 +341,18 @@ def prbs_png(result) -> bytes:
 
 
 def bode_png(result) -> bytes:
-    """The models, SPICE's .ac points, the peak and -3 dB markers."""
+    """The models, SPICE's .ac points, the peak and -3 dB markers.
+
+    Parameters
+    ----------
+    result : PlantResult
+        The plant.
+
+    Returns
+    -------
+    bytes
+        The PNG.
+    """
     ideal, real = result.analytic, result.analytic_opamp
     amp = result.opamp.name
     fn = result.built.fn_hz
@@ -326,7 +373,18 @@ def bode_png(result) -> bytes:
 
 def waveforms_csv(result) -> str:
     """The bench period as CSV (``time_s,input_v,output_v,...``; output is SPICE when
-    simulated), the format ``identify`` reads: the tool's own scope capture."""
+    simulated), the format ``identify`` reads: the tool's own scope capture.
+
+    Parameters
+    ----------
+    result : PlantResult
+        The plant.
+
+    Returns
+    -------
+    str
+        The CSV text.
+    """
     return _columns_csv(result.bench.columns())
 
 
@@ -344,7 +402,18 @@ def _columns_csv(cols: dict) -> str:
 
 
 def schematic(result):
-    """The plant's schematic (:mod:`designer.plant.schematic`) as a drawing."""
+    """The plant's schematic (:mod:`designer.plant.schematic`) as a drawing.
+
+    Parameters
+    ----------
+    result : PlantResult
+        The plant.
+
+    Returns
+    -------
+    designer.report.schematic.Sheet
+        The drawing.
+    """
     from .schematic import draw_plant
     return draw_plant(build_board(result), result.opamp)
 
@@ -358,6 +427,20 @@ def write_outputs(result, out_dir, name: str) -> dict:
 
     Every file goes through a temporary file and a rename; the paths are
     recorded in ``result.files`` before result.json is written, so it lists itself.
+
+    Parameters
+    ----------
+    result : PlantResult
+        The plant.
+    out_dir : path-like
+        The folder.
+    name : str
+        The design's name.
+
+    Returns
+    -------
+    dict
+        The files written.
     """
     texts = {"waveforms_csv": ("waveforms.csv", waveforms_csv), "bom_csv": ("bom.csv", lambda r: bom_csv(bom(r)))}
     if result.prbs is not None:

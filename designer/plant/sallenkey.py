@@ -73,13 +73,39 @@ class SallenKeyParts:
 
 
 def coefficients(r1, r2, c1, c2, gain=1.0):
-    """a and b of K / (a s^2 + b s + 1), for numbers or arrays of them."""
+    """a and b of K / (a s^2 + b s + 1), for numbers or arrays of them.
+
+    Parameters
+    ----------
+    r1, r2, c1, c2 : float or array_like
+        The parts (Ohm, F).
+    gain : float or array_like
+        The gain K.
+
+    Returns
+    -------
+    tuple
+        (a, b).
+    """
     return r1 * r2 * c1 * c2, c1 * (r1 + r2) + r1 * c2 * (1.0 - gain)
 
 
 def fn_zeta(r1, r2, c1, c2, gain=1.0):
     """Natural frequency (Hz) and damping of the Sallen-Key low-pass, for numbers
-    or arrays of them (the joint search evaluates millions at once)."""
+    or arrays of them (the joint search evaluates millions at once).
+
+    Parameters
+    ----------
+    r1, r2, c1, c2 : float or array_like
+        The parts (Ohm, F).
+    gain : float or array_like
+        The gain K.
+
+    Returns
+    -------
+    tuple
+        (fn in Hz, zeta).
+    """
     a, b = coefficients(r1, r2, c1, c2, gain)
     sa = np.sqrt(a)
     # wn = 1/sqrt(a) first, then fn: the rounding the designs' figures have always had
@@ -97,6 +123,19 @@ def ratios_from_rc(fc_hz: float, zeta: float, r: float, c: float, gain: float = 
 
     With R1 = m R, R2 = R, C1 = C, C2 = n C:  m n = 1/(wn R C)^2 and
     m = 2 zeta sqrt(mn) - 1 + mn (K - 1),  n = mn / m.
+
+    Parameters
+    ----------
+    fc_hz : float
+        The natural frequency.
+    zeta : float
+        The damping.
+    r : float
+        R (Ohm).
+    c : float
+        C (F).
+    gain : float
+        The gain K.
 
     Returns
     -------
@@ -130,6 +169,22 @@ def resistors_for_caps(fc_hz: float, zeta: float, c1, c2, gain: float = 1.0):
     Vectorised over c1, c2. Returns two arrays (R1 roots, smaller first); a
     root is nan where it is not a positive real number (for unity gain that is
     C2/C1 < 1/zeta^2).
+
+    Parameters
+    ----------
+    fc_hz : float
+        The natural frequency.
+    zeta : float
+        The damping.
+    c1, c2 : float or array_like
+        The capacitors (F).
+    gain : float
+        The gain K.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        The R1 roots, smaller first (nan where not a positive real number).
     """
     c1 = np.asarray(c1, float)
     c2 = np.asarray(c2, float)
@@ -157,7 +212,24 @@ def resistors_for_caps(fc_hz: float, zeta: float, c1, c2, gain: float = 1.0):
 
 
 def realizability_notes(fc_hz: float, zeta: float, gain: float, c_lo: float, c_hi: float) -> list:
-    """Plain-language warnings about a spec, with a suggested fix."""
+    """Plain-language warnings about a spec, with a suggested fix.
+
+    Parameters
+    ----------
+    fc_hz : float
+        The natural frequency.
+    zeta : float
+        The damping.
+    gain : float
+        The gain K.
+    c_lo, c_hi : float
+        The capacitors' range (F).
+
+    Returns
+    -------
+    list of str
+        The warnings.
+    """
     notes = []
     if gain == 1.0:
         need = unity_gain_c2_min(1.0, zeta)

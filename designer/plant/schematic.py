@@ -22,7 +22,30 @@ def draw_plant(board, opamp, sheet: Sheet | None = None, origin=(0.0, 0.0), inp_
     whose netlist is :func:`~designer.plant.netlist.plant_netlist`'s) on
     ``sheet`` (a new one by default) at ``origin``; its input net is labelled
     ``inp_label`` and the ``probes`` nets get scope tags. With ``supplies``, the
-    decoupling of every package is drawn too."""
+    decoupling of every package is drawn too.
+
+    Parameters
+    ----------
+    board : designer.spice.deck.Board
+        The bench build.
+    opamp : designer.core.opamps.OpAmp
+        The op-amp.
+    sheet : Sheet, optional
+        The sheet drawn on; None: a new one.
+    origin : tuple of float
+        Where the plant starts.
+    inp_label : str
+        What drives the input.
+    probes : dict
+        Net -> the scope channel on it.
+    supplies : bool
+        Draw the supplies.
+
+    Returns
+    -------
+    Sheet
+        The sheet.
+    """
     s = sheet or Sheet()
     n = board.netlist
     amp = n.amps[0]
@@ -77,7 +100,21 @@ def draw_plant(board, opamp, sheet: Sheet | None = None, origin=(0.0, 0.0), inp_
 
 def draw_supplies(s: Sheet, board, opamp, at, per_row: int = 16) -> None:
     """Every package's supply pins with their 100n ceramics, and the bulk capacitors
-    at the supply entry, in rows of ``per_row`` capacitors starting at ``at``."""
+    at the supply entry, in rows of ``per_row`` capacitors starting at ``at``.
+
+    Parameters
+    ----------
+    s : Sheet
+        The sheet.
+    board : designer.spice.deck.Board
+        The bench build.
+    opamp : designer.core.opamps.OpAmp
+        The op-amp.
+    at : tuple of float
+        Where they are drawn.
+    per_row : int
+        Parts per row.
+    """
     x0, y = at
     vcc, vee = f"{opamp.vcc:+g}V", f"{opamp.vee:+g}V"
     dec = {p.ref: p for p in board.decoupling}

@@ -417,7 +417,26 @@ def joint_search(fn0: float, zeta0: float, r_values, c_values, gain: float = 1.0
 
 def brute_force(fn0: float, zeta0: float, r_values, c_values, gain: float = 1.0,
                 top: int = 5) -> list:
-    """Every combination, evaluated: the reference :func:`joint_search` must match."""
+    """Every combination, evaluated: the reference :func:`joint_search` must match.
+
+    Parameters
+    ----------
+    fn0 : float
+        The natural frequency wanted.
+    zeta0 : float
+        The damping wanted.
+    r_values, c_values : array_like
+        The candidate values.
+    gain : float
+        The gain K.
+    top : int
+        The best kept.
+
+    Returns
+    -------
+    list of Candidate
+        The best, ranked.
+    """
     rv = np.unique(np.asarray(r_values, float))
     cv = np.unique(np.asarray(c_values, float))
     r1, r2, c1, c2 = (g.ravel() for g in np.meshgrid(rv, rv, cv, cv, indexing="ij"))
