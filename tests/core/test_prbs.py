@@ -97,15 +97,22 @@ def test_writers_round_trip():
        reverse=st.booleans())
 # hypothesis found it: 2 flips in 15 values left no error-free window of 8 for Berlekamp-Massey
 @example(bits=4, shift=0, k=2, seed=2, reverse=False)
+# hypothesis found it: in 15 values, 3 flips of one m-sequence can come within 1 of its reverse (a sequence of
+# another register), so the nearest m-sequence is no longer the original
+@example(bits=4, shift=0, k=3, seed=43912, reverse=False)
 @settings(max_examples=40, deadline=None)
 def test_mls_bit_errors_counts_the_flipped_values(bits, shift, k, seed, reverse):
     """Any phase of either direction of the m-sequence (another register) is one (0 errors);
-    k values flipped are k errors (k small against N: the nearest m-sequence is the original)."""
+    k values flipped are at most k errors, and exactly k from 7 bits up (k small against N = 127: the nearest
+    m-sequence is the original; in 15 or 31 values another register's sequence can be nearer)."""
     m = prbs.mls(bits)
     x = np.roll(m[::-1] if reverse else m, shift).copy()
     idx = np.random.default_rng(seed).choice(x.size, k, replace=False)
     x[idx] *= -1
-    assert prbs.mls_bit_errors(x, bits) == k
+    errors = prbs.mls_bit_errors(x, bits)
+    assert errors <= k
+    if bits >= 7:
+        assert errors == k
 
 
 def test_a_sequence_of_an_m_sequence_length_that_is_none_is_far_from_one():
