@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import math
 import sys
-from pathlib import Path
 
 from ..core.eseries import SERIES
 from ..core.opamps import names as opamp_names
@@ -200,20 +199,22 @@ def _check_sheet_args(args) -> None:
         check_name(args.name)
 
 
-def _write(result, folder, name=None) -> dict:
+def _write(result, folder, name=None):
     return _write_sheet(result, folder, name)
 
 
-def _write_sheet(result, folder, name) -> dict:
+def _write_sheet(result, folder, name):
     """The build sheet: into ``folder`` (filter.cir, result.json and the sheet's files), or with ``name``
-    the bundle under ``folder`` (default .): reports/NAME/ and netlists/NAME.cir."""
+    the bundle under ``folder`` (default .): reports/NAME/ and netlists/NAME.cir. Returns the
+    :class:`~designer.filters.report.FilterSheet` written (its ``files`` set)."""
     from ..filters.report import sheet_of, write_folder, write_outputs
     data = sheet_of(result)
     if name is None:
-        return write_folder(data, folder)
-    from .common import check_name
-    files = write_outputs(data, folder or ".", check_name(name))
-    return {k: v for k, v in files.items()}
+        write_folder(data, folder)
+    else:
+        from .common import check_name
+        write_outputs(data, folder or ".", check_name(name))
+    return data
 
 
 def _design(args) -> int:
@@ -221,13 +222,17 @@ def _design(args) -> int:
     spec = _spec(args)
     _check_sheet_args(args)
     result = design(spec, simulate=not args.no_sim, simulator=args.simulator)
-    files = _write(result, args.out, args.name) if args.out or args.name else {}
+    sheet = _write(result, args.out, args.name) if args.out or args.name else None
+    files = sheet.files if sheet is not None else {}
     if args.json:
-        print_output(json.dumps({**result.to_dict(), "files": files}, indent=2))
+        # what result.json holds when written (the bench test too)
+        print_output(json.dumps(sheet.to_dict() if sheet is not None else {**result.to_dict(), "files": files},
+                                indent=2))
     else:
         text = summary_text(result)
         if files:
-            text += "Files:\n" + "".join(f"  {k}: {v}\n" for k, v in files.items())
+            text += "Files:\n" + "".join(f"  {k}: {', '.join(v) if isinstance(v, list) else v}\n"
+                                          for k, v in files.items())
         print_output(text, end="")
     return 0
 
