@@ -38,6 +38,8 @@ __all__ = ["FilterSheet", "sheet_of", "build_board", "draw_cascade", "net_label"
 
 #: the decoupling's middle digit (C191, C192, ..): the stages' own capacitors are C101, C201, ..
 DECOUPLING_DIGIT = "9"
+#: the design's figures that are times measured on the clock
+WALL_CLOCK = ("search_s", "candidates_s")
 #: the sheet's files besides the deck and result.json, in a --out folder
 SHEET_FILES = ("build-sheet.md", "build-sheet.html", "schematic.png", "bode.png", "time-test.png", "bom.csv")
 
@@ -56,12 +58,16 @@ class FilterSheet:
         Paths written (set when written).
     timings : dict
         Seconds spent (``report_s``).
+    wall_clock : bool
+        Keep the search's wall-clock figures (``search_s``, ``candidates_s``) in the JSON; a bundle
+        leaves them out, so that it regenerates byte for byte.
     """
 
     design: object
     bench: FilterBench
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
+    wall_clock: bool = True
 
     @property
     def deck(self) -> str:
@@ -76,7 +82,10 @@ class FilterSheet:
         dict
             JSON-ready.
         """
-        return {**self.design.to_dict(), "bench": self.bench.to_dict(), "files": dict(self.files)}
+        data = {**self.design.to_dict(), "bench": self.bench.to_dict(), "files": dict(self.files)}
+        if not self.wall_clock:
+            data["figures"] = {k: v for k, v in data["figures"].items() if k not in WALL_CLOCK}
+        return data
 
 
 def sheet_of(result) -> FilterSheet:
@@ -582,6 +591,7 @@ def write_outputs(data: FilterSheet, out_dir, name: str) -> dict:
         The files written.
     """
     from ..report.bundle import write_design
+    data.wall_clock = False
     return write_design(data, out_dir, name, plots(data), schematic,
                         lambda svg: sections(data, schematic_svg=svg), title_of(data.design), _texts())
 
