@@ -54,7 +54,7 @@ from .sections import (Agreement, Golden, YieldSpec, _agreement, _checks, _corne
                        _pid_designs, _plant_designs, _tolerance, _yield)
 from .yamldoc import _kind_of, closest, parse_yaml
 
-KINDS = ("plant", "pid", "netlist")
+KINDS = ("plant", "pid", "netlist", "filter")
 #: the top-level keys of each kind
 TOP = {
     "plant": ("name", "kind", "description", "target", "parts", "series", "bounds", "opamp", "stimulus", "checks",
@@ -62,6 +62,7 @@ TOP = {
     "pid": ("name", "kind", "description", "plant", "tuning", "controller", "series", "bounds", "opamp", "stimulus",
             "checks", "design_checks", "spice_agreement", "tolerances", "yield", "golden"),
     "netlist": ("name", "kind", "description", "deck", "checks", "golden"),
+    "filter": ("name", "kind", "description", "filter", "stages", "mask", "series", "bounds", "opamp", "checks"),
 }
 
 
@@ -119,6 +120,8 @@ def load_spec(path, update_golden: bool = False, root=None, allow_outside: bool 
     if kind == "netlist":
         return _netlist(doc, name, update_golden)
     corners = _corners(doc)
+    if kind == "filter":
+        return _filter(doc, name, corners)
     designs, analyze = (_plant_designs if kind == "plant" else _pid_designs)(doc, corners)
     checks = _checks(doc, kind, set(F.FIGURES[kind]))
     design_checks = _design_checks(doc, kind)
@@ -159,3 +162,14 @@ def _netlist(doc, name: str, update: bool) -> CheckSpec:
     if not (checks or golden):
         raise doc.error((), "nothing to check: give checks: (the deck's .meas names) or golden:")
     return CheckSpec(doc.path, name, "netlist", ("",), (deck,), False, checks, None, None, (), golden)
+
+
+# ---- kind: filter -----------------------------------------------------------------
+
+def _filter(doc, name: str, corners) -> CheckSpec:
+    from .filter_kind import filter_designs, mask_limits
+    designs, analyze = filter_designs(doc, corners)
+    checks = _checks(doc, "filter", set(F.FIGURES["filter"])) + mask_limits(designs[0].mask)
+    if not checks:
+        raise doc.error((), "nothing to check: give checks: (figures) or mask:")
+    return CheckSpec(doc.path, name, "filter", corners, tuple(designs), analyze, checks, None, None, (), None)
