@@ -174,10 +174,11 @@ def draw_cascade(b, result, sheet: Sheet | None = None) -> Sheet:
         The drawing, its connectivity recorded.
     """
     import schemdraw.elements as elm
-    s = sheet or CascadeSheet(fontsize=10, unit=2.0)
+    # large labels: the drawing spans the printed page's width, two stages side by side
+    s = sheet or CascadeSheet(fontsize=18, unit=2.0)
     parts = b.netlist.parts
-    width, pitch = 21.0, 3.0
-    heights = [max(sum(1 for p in parts if p.ref[1:-1] == f"{st.number}0"), 2) * pitch + 3.0 for st in result.stages]
+    width, pitch = 27.0, 3.8
+    heights = [max(sum(1 for p in parts if p.ref[1:-1] == f"{st.number}0"), 2) * pitch + 4.6 for st in result.stages]
     y, row_h = 0.0, 0.0
     for i, (st, amp) in enumerate(zip(result.stages, b.netlist.amps)):
         col = i % 2
@@ -186,23 +187,23 @@ def draw_cascade(b, result, sheet: Sheet | None = None) -> Sheet:
             row_h = max(heights[i:i + 2])
         x0 = col * width
         q = f"Q {st.plan.q:.3g}" if st.plan.q else "first order"
-        s.text((x0, y + 2.6), f"Stage {st.number}: {st.topology}", size=1.05, halign="left")
-        s.text((x0, y + 1.8), f"fn {format_eng(st.plan.fn_hz, 'Hz', 4)}, {q}, gain {st.gain:.3g}", size=0.95,
+        s.text((x0, y + 3.9), f"Stage {st.number}: {st.topology}", size=1.05, halign="left")
+        s.text((x0, y + 2.9), f"fn {format_eng(st.plan.fn_hz, 'Hz', 4)}, {q}, gain {st.gain:.3g}", size=0.95,
                halign="left")
         # the drawing's extent: matplotlib crops the picture to its elements, not to the labels' text
-        s.d.add(elm.Line().at((x0 - 0.6, y + 3.2)).to((x0 + width - 0.6, y + 3.2)).color("white"))
+        s.d.add(elm.Line().at((x0 - 0.6, y + 4.5)).to((x0 + width - 0.6, y + 4.5)).color("white"))
         mine = [p for p in parts if p.ref[1:-1] == f"{st.number}0"]
         for k, p in enumerate(mine):
             yy = y - k * pitch
-            a, c = (x0 + 3.0, yy), (x0 + 6.0, yy)
+            a, c = (x0 + 4.2, yy), (x0 + 8.2, yy)
             s.part(p, a, c, label_loc="top")
             _end(s, a, p.a, "left")
             _end(s, c, p.b, "right")
         unit = b.unit_of(amp.ref)
-        pts = s.opamp(amp, unit, b.package.part, (x0 + 14.5, y - 0.6), plus_on_top=True)
+        pts = s.opamp(amp, unit, b.package.part, (x0 + 19.5, y - 0.6), plus_on_top=True)
         for term, loc in (("inp", "left"), ("inn", "left"), ("out", "right")):
             pt = pts[term]
-            end = (pt[0] + (0.8 if term == "out" else -2.2), pt[1])
+            end = (pt[0] + (1.0 if term == "out" else -3.0), pt[1])
             s.wire(pt, end)
             _end(s, end, getattr(amp, term), loc)
     return s
@@ -211,8 +212,8 @@ def draw_cascade(b, result, sheet: Sheet | None = None) -> Sheet:
 class CascadeSheet(Sheet):
     """A :class:`Sheet` whose PNG is sized to the drawing (a cascade is larger than matplotlib's default figure)."""
 
-    def png(self, dpi: int = 100, inches_per_unit: float | None = 0.32) -> bytes:
-        """The drawing as PNG bytes, 0.32 inch a unit (readable when printed at the sheet's width).
+    def png(self, dpi: int = 100, inches_per_unit: float | None = 0.3) -> bytes:
+        """The drawing as PNG bytes, 0.3 inch a unit (readable when printed at the sheet's width).
 
         Parameters
         ----------
@@ -443,8 +444,10 @@ def sections(data: FilterSheet, with_images: bool = True, schematic_svg: str = "
              R.table(["Ref", "Value", "Code", "Qty", "Series", "Tol.", "Package"], [x[:7] for x in bom(r, b)],
                      "compact"),
              R.text(f"Supplies {op.vcc:+g} V and {op.vee:+g} V. Set the generator's output to High-Z.")]
-    fig = [R.figure("schematic.png", schematic_svg, "the cascade's schematic, stage by stage")] if with_images else []
-    out = [("Build", [R.columns(fig, first)] if with_images else first),
+    # the cascade is wider than the plant: its schematic takes the page's width, the parts list follows
+    fig = [("Schematic", [R.figure("schematic.png", schematic_svg, "the cascade's schematic, stage by stage")])] \
+        if with_images else []
+    out = [*fig, ("Build", first),
            ("Stages and their op-amp checks", _stages(data)),
            ("Wiring", [R.text("Nets by name: a label on the schematic is that net; S1, S2 .. are the stages' "
                               "outputs, each the next stage's input."),

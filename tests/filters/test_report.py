@@ -119,3 +119,31 @@ def test_bad_name_writes_nothing(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--name" in err
     assert list(tmp_path.iterdir()) == []
+
+
+def _print_helpers():
+    """tests/report/test_print.py's headless Chromium and page count (one way to print, shared)."""
+    import importlib.util
+
+    from helpers import TESTS
+    spec = importlib.util.spec_from_file_location("report_print_helpers", TESTS / "report" / "test_print.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.chromium
+@pytest.mark.parametrize("paper", ["A4", "letter"])
+@pytest.mark.parametrize("name", ["filter_butterworth_lp4_sk_1k", "filter_chebyshev0.5_lp5_mfb_mask1k"])
+def test_reference_sheet_prints_on_three_pages(name, paper, tmp_path):
+    from helpers import REPORTS
+    path = REPORTS / name / "build-sheet.html"
+    if not path.exists():
+        pytest.skip(f"{path} not generated (run make demo)")
+    h = _print_helpers()
+    page = tmp_path / f"{paper}.html"
+    page.write_text(path.read_text().replace("<style>", f"<style>@page{{size:{paper}}}", 1))
+    pdf = tmp_path / f"{paper}.pdf"
+    out = h.chromium(tmp_path, f"--print-to-pdf={pdf}", "--no-pdf-header-footer", page.as_uri())
+    assert pdf.exists() and pdf.stat().st_size > 0, out.stderr[-2000:]
+    assert 1 <= h.pages(pdf) <= 3
