@@ -45,6 +45,15 @@ R_TOL_PCT, C_TOL_PCT = 1.0, 5.0
 FLOOR_DB = 60.0
 
 
+def _nice(x: float, up: bool) -> float:
+    """The least 1-2-5 value at or above ``x`` (``up``), or the largest at or below it."""
+    e = math.floor(math.log10(x))
+    near = [m * 10.0 ** k for k in (e - 1, e, e + 1) for m in (1, 2, 5)]
+    if up:
+        return float(min(v for v in near if v >= x * (1 - 1e-12)))
+    return float(max(v for v in near if v <= x * (1 + 1e-12)))
+
+
 def nice_up(x: float) -> float:
     """The least 1-2-5 value (1, 2, 5 x 10^k) at or above ``x``.
 
@@ -58,11 +67,7 @@ def nice_up(x: float) -> float:
     float
         The 1-2-5 value.
     """
-    e = math.floor(math.log10(x))
-    for m in (1, 2, 5, 10):
-        if m * 10 ** e >= x * (1 - 1e-12):
-            return float(m * 10 ** e)
-    return float(10 ** (e + 1))
+    return _nice(x, True)
 
 
 def nice_down(x: float) -> float:
@@ -78,11 +83,7 @@ def nice_down(x: float) -> float:
     float
         The 1-2-5 value.
     """
-    e = math.floor(math.log10(x))
-    for m in (10, 5, 2, 1):
-        if m * 10 ** e <= x * (1 + 1e-12):
-            return float(m * 10 ** e)
-    return float(5 * 10 ** (e - 1))
+    return _nice(x, False)
 
 
 @dataclass(frozen=True)
