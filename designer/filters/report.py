@@ -488,7 +488,8 @@ def bode_png(data: FilterSheet) -> bytes:
     a1.plot([p.f_hz for p in bench.sweep], [p.gain_db for p in bench.sweep], "o", ms=3.5, mfc="none",
             color="C3", label="sweep points")
     ref = 20 * math.log10(s.gain)
-    lo_db = max(float(np.min(20 * np.log10(np.abs(h)))), ref - 100)
+    # down to 30 dB below the mask's stopband (80 dB without a mask), or the response's floor if higher
+    lo_db = max(float(np.min(20 * np.log10(np.abs(h)))), ref - (s.min_attenuation_db + 30 if s.has_mask else 80))
     if s.has_mask:
         # the forbidden regions: more loss than allowed in the passband, less attenuation in the stopband
         if s.filter_type == "lowpass":
@@ -507,7 +508,7 @@ def bode_png(data: FilterSheet) -> bytes:
     a1.set_title(title_of(r), fontsize=10)
     for a in (a1, a2):
         a.grid(True, which="both", alpha=0.3)
-    a1.legend(fontsize=7.5, loc="lower left" if s.filter_type == "highpass" else "lower left")
+    a1.legend(fontsize=7.5, loc="lower right" if s.filter_type == "highpass" else "lower left")
     return png_bytes(fig, dpi=100, tight=False)
 
 
