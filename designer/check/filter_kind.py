@@ -99,8 +99,6 @@ class FilterRun:
     design: object
     figures: dict
     stages: list = field(default_factory=list)
-    checks: tuple = ()
-    monte_carlo: object = None
 
     def to_dict(self) -> dict:
         """The corner as JSON.
