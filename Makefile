@@ -79,6 +79,14 @@ demo: setup
 	mv captures/.motor_seed000.identify.json.tmp captures/motor_seed000.identify.json
 	.venv/bin/design-pid --plant-model captures/motor_seed000.identify.json --tuning optimize \
 	  --name pid_motor_seed000 --out .
+	.venv/bin/design-filter --family butterworth --order 4 --fc 1k --topology sallen-key --opamp TL072 \
+	  --name filter_butterworth_lp4_sk_1k --out .
+	.venv/bin/design-filter --family chebyshev --passband 1k --max-loss 0.5 --stopband 2k --min-attenuation 40 \
+	  --topology mfb --opamp TL072 --name filter_chebyshev0.5_lp5_mfb_mask1k --out .
+	.venv/bin/design-filter --type highpass --family bessel --order 3 --fc 1k --opamp TL072 \
+	  --name filter_bessel_hp3_1k --out .
+	.venv/bin/design-filter --type bandpass --family butterworth --order 2 --f-low 900 --f-high 1100 --opamp TL072 \
+	  --name filter_butterworth_bp2_900-1100 --out .
 	@if [ -f $(EXT_CAPTURES)/tom2718_TEK0001.CSV ]; then \
 	  set -x; .venv/bin/design-pid --plant-capture $(EXT_CAPTURES)/tom2718_TEK0001.CSV --step-amplitude 1.72 \
 	    --name pid_rc_tbs1022 --out .; \

@@ -58,7 +58,29 @@ PID = {
     "nrms": ("", "SPICE against the analytic loop (xyce_verify rule, 1 % + 1 % of the step)"),
 }
 
-FIGURES = {"plant": PLANT, "pid": PID}
+#: figure -> (unit, what it is), for an active filter (designer.check.filter_kind): the corner's op-amp model,
+#: and ngspice's .ac run (``spice_``); the mask's figures need ``mask:``, the design's a designed filter
+FILTER = {
+    "f3_hz": ("Hz", "-3 dB frequency below the passband gain (low- or high-pass), with the corner's op-amp"),
+    "f3_low_hz": ("Hz", "a band-pass's lower -3 dB frequency, with the corner's op-amp"),
+    "f3_high_hz": ("Hz", "a band-pass's upper -3 dB frequency, with the corner's op-amp"),
+    "passband_gain_db": ("", "the passband gain, dB (the design's, or as built the cascade's own)"),
+    "passband_loss_db": ("", "the largest loss below the passband gain over the mask's passband, dB"),
+    "stopband_attenuation_db": ("", "the least attenuation over the mask's stopband, dB"),
+    **{f"spice_{k}": (u, f"SPICE .ac: {w}") for k, (u, w) in (
+        ("f3_hz", ("Hz", "-3 dB frequency")), ("f3_low_hz", ("Hz", "lower -3 dB frequency")),
+        ("f3_high_hz", ("Hz", "upper -3 dB frequency")), ("passband_loss_db", ("", "passband loss, dB")),
+        ("stopband_attenuation_db", ("", "stopband attenuation, dB")))},
+    "spice_max_deviation_db": ("", "SPICE .ac against the op-amp-aware model, largest |difference| down to -60 dB"),
+    "stages": ("", "number of stages"),
+    "order": ("", "filter order (designed)"),
+    "passband_deviation_db": ("", "largest passband deviation from the ideal response, dB (designed)"),
+    "error_joint_db": ("", "the joint E-series choice's worst deviation from the ideal, dB (designed)"),
+    "error_per_stage_db": ("", "per-stage rounding's worst deviation from the ideal, dB (designed)"),
+    "gbw_ratio_min": ("", "the op-amp's GBW over the most a stage needs, the smallest over the stages (designed)"),
+}
+
+FIGURES = {"plant": PLANT, "pid": PID, "filter": FILTER}
 
 #: accepted alias -> the figure it names (a plant's earlier names, kept so old specs still load)
 ALIASES = {"fn_opamp_hz": "fn_hz", "zeta_opamp": "zeta"}

@@ -118,6 +118,10 @@ def _simulate(spec: CheckSpec, index: int, simulator: str):
         vectors = {k: np.real(v) for k, v in r.vectors.items() if k not in ("time", "frequency")}
         waves = (r.vectors["time"], vectors) if "time" in r.vectors else (None, {})
         return dict(r.measurements), None, {"measurements": r.measurements, "simulator": r.backend}, waves
+    if spec.kind == "filter":
+        from .filter_kind import run_filter
+        res = run_filter(design, simulator)
+        return res.figures, res, res.to_dict(), (None, {})
     if spec.kind == "plant":
         from ..plant.design import analyze_plant, design_plant
         res = (analyze_plant if spec.analyze else design_plant)(design, simulate=True, simulator=simulator)
@@ -253,6 +257,13 @@ def _golden_cases(spec, corner, waves, tool, update, out_dir):
 
 def _write_design(spec, corner, res, out_dir) -> dict:
     """The corner's build sheet bundle in the spec's folder ``out_dir`` (reports/<corner>/, netlists/<corner>.cir)."""
+    if spec.kind == "filter":
+        if res.design is None:
+            return {}   # as built: no design to draw a sheet from
+        from ..filters.report import sheet_of
+        from ..filters.report import write_outputs as write_filter
+        files = write_filter(sheet_of(res.design), Path(out_dir), corner or spec.name)
+        return {"build_sheet": files.get("build_sheet_md"), "design_result": files.get("result_json")}
     if spec.kind == "plant":
         from ..plant.report import write_outputs
     else:

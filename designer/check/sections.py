@@ -138,8 +138,23 @@ def read_corners(doc) -> tuple:
     return tuple(out)
 
 
-def _library(doc, table: dict, build):
-    """``build()`` with the library's refusal shown in the spec's words, at the key's line."""
+def built_in_spec_words(doc, table: dict, build):
+    """``build()`` with the library's refusal shown in the spec's words, at the key's line.
+
+    Parameters
+    ----------
+    doc : designer.check.yamldoc.YamlDoc
+        The spec document.
+    table : dict
+        Library parameter -> the spec's key path (dotted).
+    build : callable
+        Builds the library object; its DesignError is re-raised at the key.
+
+    Returns
+    -------
+    object
+        What ``build()`` returned.
+    """
     try:
         return build()
     except DesignError as exc:
@@ -181,7 +196,7 @@ def read_plant_designs(doc, corners):
                 raise doc.error((k,), "bounds: limit a design's part search; parts: are already chosen")
         sk = SallenKeyParts(*(parts.get(k) for k in ("R1", "R2", "C1", "C2", "gain", "R3", "R4")))
         kw = {k: v for k, v in common.items() if k in ("r_series", "c_series", "amplitude_v", "square_hz")}
-        designs = [_library(doc, PLANT_KEYS, lambda amp=amp: AnalysisSpec(
+        designs = [built_in_spec_words(doc, PLANT_KEYS, lambda amp=amp: AnalysisSpec(
             sk, opamp=amp, target_fc_hz=target.get("fc"), target_zeta=target.get("zeta"), **kw))
             for amp in corners]
         return designs, True
@@ -193,7 +208,7 @@ def read_plant_designs(doc, corners):
         if not isinstance(target["compensate_gbw"], bool):
             raise doc.error(("target", "compensate_gbw"), "target.compensate_gbw must be true or false")
         extra["compensate_gbw"] = target["compensate_gbw"]
-    designs = [_library(doc, PLANT_KEYS, lambda amp=amp: PlantSpec(
+    designs = [built_in_spec_words(doc, PLANT_KEYS, lambda amp=amp: PlantSpec(
         fc_hz=target["fc"], zeta=target["zeta"], opamp=amp, alternatives=1, **extra, **common))
         for amp in corners]
     return designs, False
@@ -233,10 +248,10 @@ def read_pid_designs(doc, corners):
             if len(c) > 1:
                 raise doc.error(("controller",), "controller: give json: or the parts, not both")
             path = str(doc.resolve(("controller", "json")))
-            kw["controller_parts"] = _library(doc, PID_KEYS, lambda: controller_from_json(path))
+            kw["controller_parts"] = built_in_spec_words(doc, PID_KEYS, lambda: controller_from_json(path))
         else:
             kw["controller_parts"] = PidParts(**{p.lower(): c.get(p) for p in CONTROLLER_PARTS})
-    designs = [_library(doc, PID_KEYS, lambda amp=amp: PidSpec(opamp=amp, **kw)) for amp in corners]
+    designs = [built_in_spec_words(doc, PID_KEYS, lambda amp=amp: PidSpec(opamp=amp, **kw)) for amp in corners]
     return designs, analyze
 
 
@@ -283,7 +298,23 @@ def read_design_checks(doc, kind: str):
     return tuple(dict.fromkeys(value))
 
 
-def _positive(doc, keys, default=None) -> float:
+def read_positive(doc, keys, default=None) -> float:
+    """The positive number at ``keys``, or ``default`` when the key is absent.
+
+    Parameters
+    ----------
+    doc : designer.check.yamldoc.YamlDoc
+        The spec document (its refusals point at the key's line).
+    keys : tuple
+        The key path.
+    default : float or None
+        The value of an absent key; None: the key is required.
+
+    Returns
+    -------
+    float
+        The number.
+    """
     value = doc.get(keys)
     label = ".".join(map(str, keys))
     if value is None:
@@ -307,7 +338,7 @@ def read_agreement(doc):
     if against not in AGAINST:
         raise doc.error(("spice_agreement", "against"), f"spice_agreement.against {kind_of(against)}; "
                         f"allowed: {', '.join(AGAINST)}")
-    return Agreement(_positive(doc, ("spice_agreement", "nrms_max")), against)
+    return Agreement(read_positive(doc, ("spice_agreement", "nrms_max")), against)
 
 
 def read_tolerance(doc, checks) -> tuple:
@@ -419,8 +450,8 @@ def read_golden(doc, kind: str, corners, update: bool):
     if len(corners) > 1 and "{corner}" not in str(file):
         raise doc.error(("golden", "file"), "golden.file needs {corner} in its name with several op-amps "
                         f"(one golden waveform per corner: {', '.join(corners)})")
-    reltol = _positive(doc, ("golden", "reltol"), RELTOL) if "reltol" in g else RELTOL
-    abstol = _positive(doc, ("golden", "abstol"), ABSTOL) if "abstol" in g else ABSTOL
+    reltol = read_positive(doc, ("golden", "reltol"), RELTOL) if "reltol" in g else RELTOL
+    abstol = read_positive(doc, ("golden", "abstol"), ABSTOL) if "abstol" in g else ABSTOL
     raw = g.get("signals", list(DEFAULT_SIGNALS.get(kind, ())))
     if not raw:
         raise doc.error(("golden",), "golden.signals: name the deck's vectors to compare (e.g. [out])")
@@ -436,8 +467,8 @@ def read_golden(doc, kind: str, corners, update: bool):
             raise doc.error(keys, f"unknown golden signal {kind_of(sig)}; allowed: {', '.join(allowed)}; "
                             f"closest: {closest(sig, allowed)!r}")
         doc.mapping(keys, ("reltol", "abstol"), tol if tol is not None else {})
-        signals[sig] = (_positive(doc, keys + ("reltol",), reltol) if tol and "reltol" in tol else reltol,
-                        _positive(doc, keys + ("abstol",), abstol) if tol and "abstol" in tol else abstol)
+        signals[sig] = (read_positive(doc, keys + ("reltol",), reltol) if tol and "reltol" in tol else reltol,
+                        read_positive(doc, keys + ("abstol",), abstol) if tol and "abstol" in tol else abstol)
     golden = Golden(str(file), signals)
     for c in corners:   # each corner's own file: one of them may be a link out of the folder
         doc.inside(("golden", "file"), golden.path(c))

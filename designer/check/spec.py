@@ -56,7 +56,7 @@ from .yamldoc import kind_of, closest, parse_yaml
 
 __all__ = ["TOP", "load_spec"]
 
-KINDS = ("plant", "pid", "netlist")
+KINDS = ("plant", "pid", "netlist", "filter")
 #: the top-level keys of each kind
 TOP = {
     "plant": ("name", "kind", "description", "target", "parts", "series", "bounds", "opamp", "stimulus", "checks",
@@ -64,6 +64,7 @@ TOP = {
     "pid": ("name", "kind", "description", "plant", "tuning", "controller", "series", "bounds", "opamp", "stimulus",
             "checks", "design_checks", "spice_agreement", "tolerances", "yield", "golden"),
     "netlist": ("name", "kind", "description", "deck", "checks", "golden"),
+    "filter": ("name", "kind", "description", "filter", "stages", "mask", "series", "bounds", "opamp", "checks"),
 }
 
 
@@ -137,6 +138,8 @@ def load_spec(path, update_golden: bool = False, root=None, allow_outside: bool 
     if kind == "netlist":
         return _netlist(doc, name, update_golden)
     corners = read_corners(doc)
+    if kind == "filter":
+        return _filter(doc, name, corners)
     designs, analyze = (read_plant_designs if kind == "plant" else read_pid_designs)(doc, corners)
     checks = read_checks(doc, kind, set(F.FIGURES[kind]))
     design_checks = read_design_checks(doc, kind)
@@ -177,3 +180,14 @@ def _netlist(doc, name: str, update: bool) -> CheckSpec:
     if not (checks or golden):
         raise doc.error((), "nothing to check: give checks: (the deck's .meas names) or golden:")
     return CheckSpec(doc.path, name, "netlist", ("",), (deck,), False, checks, None, None, (), golden)
+
+
+# ---- kind: filter -----------------------------------------------------------------
+
+def _filter(doc, name: str, corners) -> CheckSpec:
+    from .filter_kind import filter_designs, mask_limits
+    designs, analyze = filter_designs(doc, corners)
+    checks = _checks(doc, "filter", set(F.FIGURES["filter"])) + mask_limits(designs[0].mask)
+    if not checks:
+        raise doc.error((), "nothing to check: give checks: (figures) or mask:")
+    return CheckSpec(doc.path, name, "filter", corners, tuple(designs), analyze, checks, None, None, (), None)

@@ -15,7 +15,7 @@ __all__ = ["check_design_main", "check_parser"]
 
 EPILOG = """spec file (YAML; numbers in engineering notation, paths relative to the spec):
   name: lab3-plant                      # default: the file's stem
-  kind: plant                           # plant | pid | netlist
+  kind: plant                           # plant | pid | netlist | filter
   target: {fc: 3.5k, zeta: 0.2}         # designed as design-plant does; or parts: {R1: 1k6, R2: 3k9, ...}
   opamp: [LM741, TL072]                 # the corners: every check runs for each
   stimulus: {amplitude: 2}              # square wave 0 -> amplitude V (frequency: default as design-plant)
@@ -37,6 +37,10 @@ EPILOG = """spec file (YAML; numbers in engineering notation, paths relative to 
                 {kp: 3.3, ti: 43u, td: 11u} or {rule: optimize, target_overshoot: 10}; controller: {R3: 12k,
                 .., C4: 47n} or {json: result.json} (the parts as built, checked with analyze-pid)
   kind: netlist deck: my_filter.cir (your own ngspice deck with .tran or .ac); checks: its .meas names
+  kind: filter  filter: {type: lowpass, family: chebyshev, ripple: 0.5, order: 5, fc: 1k, topology: mfb}
+                (design-filter's options) or stages: [{topology: sallen-key-lowpass, parts: {R1: 6k2, ..}}]
+                (as built); mask: {passband: 1k, max_loss: 1, stopband: 2k, min_attenuation: 40} (checked on
+                the op-amp model and on SPICE's .ac); checks: f3_hz, spice_f3_hz, spice_max_deviation_db, ..
 
 examples:
   check-design specs/*.yaml --junit junit.xml --summary summary.md --out check-out --jobs 2
@@ -52,7 +56,7 @@ def check_parser():
     p = command_parser(
         "check-design",
         "SPICE regression checks of your own analog designs, for CI: each spec file names a design (a Sallen-Key "
-        "plant, a PID controller in its loop, or your own ngspice deck), its op-amp corners and the limits it "
+        "plant, a PID controller in its loop, an active filter, or your own ngspice deck), its op-amp corners and the limits it "
         "must meet; every check runs for every corner in ngspice.", EPILOG)
     p.add_argument("specs", nargs="+", metavar="SPEC.yaml", help="spec files (YAML)")
     p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report (one testsuite per spec, one "
@@ -160,6 +164,9 @@ def run_specs(specs, simulator: str, *, jobs: int = 1, timeout: float = 600, upd
     if "pid" in kinds:
         import designer.pid.design  # noqa: F401
         import designer.pid.report  # noqa: F401
+    if "filter" in kinds:
+        import designer.filters.design  # noqa: F401
+        import designer.filters.report  # noqa: F401
     tasks = [(i, k) for i, s in enumerate(specs) for k in range(len(s.corners))]
 
     def work(task):

@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import math
 import sys
-from pathlib import Path
 
 from ..core.eseries import SERIES
 from ..core.opamps import names as opamp_names
@@ -88,8 +87,11 @@ def _parser():
     k.add_argument("--c-max", default="10u", help=f"largest capacitor (default 10u) {help_range('capacitor_f')}")
     o = p.add_argument_group("output")
     o.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
-    o.add_argument("--out", metavar="DIR", help="write DIR/filter.cir (the ngspice .ac deck of the cascade) and "
-                   "DIR/result.json")
+    o.add_argument("--out", metavar="DIR", help="write DIR/filter.cir (the ngspice .ac deck of the cascade), "
+                   "DIR/result.json and the build sheet (build-sheet.html and .md, schematic, plots, bom.csv); with "
+                   "--name, the bundle DIR/reports/NAME/ and DIR/netlists/NAME.cir instead")
+    o.add_argument("--name", help="design name of the bundle under --out (default .): letters, digits and "
+                   ". _ - + = , @")
     o.add_argument("--no-sim", action="store_true", help="skip the ngspice check")
     o.add_argument("--simulator", default="ngspice-cli", choices=("ngspice-cli", "pyspice"),
                    help="ngspice-cli: `ngspice -b` (default); pyspice: the shared library")
@@ -190,27 +192,47 @@ def summary_text(result) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _write(result, folder) -> dict:
-    from ..core.fileio import atomic_write, ensure_dir
-    folder = ensure_dir(Path(folder))
-    files = {"deck": str(folder / "filter.cir"), "result_json": str(folder / "result.json")}
-    atomic_write(files["deck"], result.deck())
-    data = {**result.to_dict(), "files": files}
-    atomic_write(files["result_json"], json.dumps(data, indent=2) + "\n")
-    return files
+def _check_sheet_args(args) -> None:
+    """Before the work: --name a plain name, its report folder no link or file."""
+    if args.name is not None:
+        from .common import check_name
+        check_name(args.name)
+
+
+def _write(result, folder, name=None):
+    return _write_sheet(result, folder, name)
+
+
+def _write_sheet(result, folder, name):
+    """The build sheet: into ``folder`` (filter.cir, result.json and the sheet's files), or with ``name``
+    the bundle under ``folder`` (default .): reports/NAME/ and netlists/NAME.cir. Returns the
+    :class:`~designer.filters.report.FilterSheet` written (its ``files`` set)."""
+    from ..filters.report import sheet_of, write_folder, write_outputs
+    data = sheet_of(result)
+    if name is None:
+        write_folder(data, folder)
+    else:
+        from .common import check_name
+        write_outputs(data, folder or ".", check_name(name))
+    return data
 
 
 def _design(args) -> int:
     from ..filters.design import design
     spec = _spec(args)
+    _check_sheet_args(args)
     result = design(spec, simulate=not args.no_sim, simulator=args.simulator)
-    files = _write(result, args.out) if args.out else {}
+    sheet = _write(result, args.out, args.name) if args.out or args.name else None
+    files = sheet.files if sheet is not None else {}
     if args.json:
-        print_output(json.dumps({**result.to_dict(), "files": files}, indent=2))
+        # what result.json holds when written (the bench test too)
+        print_output(json.dumps(sheet.to_dict() if sheet is not None else {**result.to_dict(), "files": files},
+                                indent=2))
     else:
         text = summary_text(result)
         if files:
-            text += "Files:\n" + "".join(f"  {k}: {v}\n" for k, v in files.items())
+            text += "Files:\n" + "".join(f"  {k}: {', '.join(v) if isinstance(v, list) else v}\n"
+                                          for k, v in files.items())
         print_output(text, end="")
     return 0
 

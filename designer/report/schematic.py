@@ -157,13 +157,18 @@ class Sheet:
         self.d.draw(show=False, canvas="svg")
         return self.d.get_imagedata("svg").decode("utf-8")
 
-    def png(self, dpi: int = 100) -> bytes:
-        """The drawing as PNG bytes (beside the Markdown sheet), through matplotlib."""
+    def png(self, dpi: int = 100, inches_per_unit: float | None = None) -> bytes:
+        """The drawing as PNG bytes (beside the Markdown sheet), through matplotlib;
+        ``inches_per_unit``: the picture sized to the drawing (None: matplotlib's default figure)."""
         import io
 
         import matplotlib
         matplotlib.use("Agg")   # schemdraw draws through pyplot: a file, never a GUI window
         fig = self.d.draw(show=False, canvas="matplotlib")
+        if inches_per_unit is not None:
+            bb = self.d.get_bbox()
+            fig.fig.set_size_inches((bb.xmax - bb.xmin + 1) * inches_per_unit,
+                                    (bb.ymax - bb.ymin + 1) * inches_per_unit)
         buf = io.BytesIO()
         fig.fig.savefig(buf, format="png", dpi=dpi)
         import sys

@@ -168,18 +168,19 @@ def wiring_rows(board, labels: dict, supplies: tuple) -> list:
             rows.append(["wire", "", f"{u.designator} pin {u.pins['inp']} (+in)", "ground"])
     pkg = board.package
     vcc, vee = supplies
-    for ic in board.ics:
-        n = ic[1:]
+    # the decoupling as the board names it: two per package in package order, then the two bulk ones
+    dec = board.decoupling
+    for i, ic in enumerate(board.ics):
         opened = (f"; pins {', '.join(str(k) for k in pkg.unused)} open ({', '.join(sorted(set(pkg.unused.values())))})"
                   if pkg.unused else "")
-        rows.append([ic, pkg.part, f"pin {pkg.vcc} (V+): {vcc:+g} V, C{n}01 100n to ground at the pin",
-                     f"pin {pkg.vee} (V-): {vee:+g} V, C{n}02 100n to ground at the pin" + opened])
+        rows.append([ic, pkg.part, f"pin {pkg.vcc} (V+): {vcc:+g} V, {dec[2 * i].ref} 100n to ground at the pin",
+                     f"pin {pkg.vee} (V-): {vee:+g} V, {dec[2 * i + 1].ref} 100n to ground at the pin" + opened])
     for u in board.spares:
         rows.append(["wire", "", f"{u.designator} pin {u.pins['inp']} (+in)", "ground (spare unit)"])
         rows.append(["wire", "", f"{u.designator} pin {u.pins['out']} (out)",
                      f"{u.designator} pin {u.pins['inn']} (-in): spare as a follower, so it cannot oscillate"])
     rows.append(["wire", "", "supply 0 V, generator ground, scope grounds", "ground (one star point)"])
-    rows.append(["C901, C902", "10u", f"{vcc:+g} V and {vee:+g} V where the supply enters",
+    rows.append([f"{dec[-2].ref}, {dec[-1].ref}", "10u", f"{vcc:+g} V and {vee:+g} V where the supply enters",
                  "ground (mind the polarity)"])
     return rows
 

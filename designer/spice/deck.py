@@ -140,10 +140,13 @@ class Board:
         return self.netlist.parts + self.decoupling
 
 
-def board(netlist: Netlist, opamp: OpAmp, package: str | None = None) -> Board:
+def board(netlist: Netlist, opamp: OpAmp, package: str | None = None, decoupling_digit: str = "0") -> Board:
     """The bench build of ``netlist`` with ``opamp`` in ``package`` (``single``,
     ``dual``, ``quad``; None: the op-amp's default). A kind the op-amp does not
     come in is a :class:`~designer.core.errors.DesignError` (one line).
+    ``decoupling_digit`` is the decoupling designators' middle digit (``"0"``:
+    C101, C102 .. C901, C902): a filter cascade names its stages' parts C101,
+    C201 .. and takes ``"9"`` (C191, C192 .., the bulk pair C9991, C9992).
 
     Parameters
     ----------
@@ -153,6 +156,8 @@ def board(netlist: Netlist, opamp: OpAmp, package: str | None = None) -> Board:
         The op-amp built with.
     package : str or None
         ``single``, ``dual`` or ``quad``; None: the op-amp's default.
+    decoupling_digit : str
+        The decoupling designators' middle digit.
 
     Returns
     -------
@@ -161,14 +166,17 @@ def board(netlist: Netlist, opamp: OpAmp, package: str | None = None) -> Board:
     """
     from ..core.opamps import assign, spare_units
     pkg = opamp.package(package)
+    d = decoupling_digit
     units = assign(len(netlist.amps), pkg)
     ics = sorted({u.ic for u in units})
     dec = []
     for ic in ics:
-        dec += [Part(f"C{ic}01", "vcc", GROUND, DECOUPLING_F, f"U{ic} V+ (pin {pkg.vcc}) to ground, at the pin"),
-                Part(f"C{ic}02", "vee", GROUND, DECOUPLING_F, f"U{ic} V- (pin {pkg.vee}) to ground, at the pin")]
-    dec += [Part("C901", "vcc", GROUND, BULK_F, "+supply entry to ground (bulk, + to the rail)"),
-            Part("C902", GROUND, "vee", BULK_F, "-supply entry to ground (bulk, + to ground)")]
+        dec += [Part(f"C{ic}{d}1", "vcc", GROUND, DECOUPLING_F, f"U{ic} V+ (pin {pkg.vcc}) to ground, at the pin"),
+                Part(f"C{ic}{d}2", "vee", GROUND, DECOUPLING_F, f"U{ic} V- (pin {pkg.vee}) to ground, at the pin")]
+    # the bulk pair: C901, C902; with another digit C99d1, C99d2, clear of package 9's pair (C9d1)
+    bulk = "C90" if d == "0" else f"C99{d}"
+    dec += [Part(f"{bulk}1", "vcc", GROUND, BULK_F, "+supply entry to ground (bulk, + to the rail)"),
+            Part(f"{bulk}2", GROUND, "vee", BULK_F, "-supply entry to ground (bulk, + to ground)")]
     return Board(netlist, tuple(units), tuple(spare_units(len(units), pkg)), tuple(dec), pkg)
 
 

@@ -1,0 +1,652 @@
+"""A designed filter's build sheet, rendered from the typed design
+(:class:`~designer.filters.design.FilterDesign`) and its bench test
+(:class:`~designer.filters.bench.FilterBench`) as they are: nothing here
+computes a figure of the design.
+
+The sheet follows the plant's (:mod:`designer.plant.report`, the same
+:mod:`designer.report` blocks, wiring, bill of materials and bundle): the
+cascade's schematic stage by stage (each stage a row of its parts between
+labelled nets and its op-amp with pin numbers: labels of one name are one net,
+checked against the deck by :func:`designer.report.schematic.check_connectivity`),
+the bill of materials of all stages (the op-amps in the op-amp's default
+package: a dual or quad package takes two or four stages), the wiring by pin,
+each stage's figures and op-amp checks, the sine sweep with its tolerance band
+and the generator and scope settings, the step or tone-burst test, the Bode plot
+with the mask drawn, the Bessel's group delay, and why the values differ from a
+table's (the tables' corner convention, the op-amp pre-distortion, the joint
+E-series choice).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.units import format_eng
+from ..report import document as R
+from ..report.plots import figure, log_frequency_axis, png_bytes, step_plot
+from ..report.schematic import Sheet
+from ..report.wiring import bom_csv, bom_rows, wiring_rows
+from ..spice.deck import GROUND, board
+from .bench import FilterBench, bench_of
+from .registry import get as get_topology
+
+__all__ = ["FilterSheet", "sheet_of", "build_board", "draw_cascade", "net_label", "sections", "title_of",
+           "bom", "plots", "schematic", "write_outputs", "write_folder", "SHEET_FILES"]
+
+#: the decoupling's middle digit (C191, C192, ..): the stages' own capacitors are C101, C201, ..
+DECOUPLING_DIGIT = "9"
+#: the design's figures that are times measured on the clock
+WALL_CLOCK = ("search_s", "candidates_s")
+#: the sheet's files besides the deck and result.json, in a --out folder
+SHEET_FILES = ("build-sheet.md", "build-sheet.html", "schematic.png", "bode.png", "time-test.png", "bom.csv")
+
+
+@dataclass
+class FilterSheet:
+    """A design with its bench test: what the sheet and the bundle are written from.
+
+    Parameters
+    ----------
+    design : FilterDesign
+        The design.
+    bench : FilterBench
+        Its bench test.
+    files : dict
+        Paths written (set when written).
+    timings : dict
+        Seconds spent (``report_s``).
+    wall_clock : bool
+        Keep the search's wall-clock figures (``search_s``, ``candidates_s``) in the JSON; a bundle
+        leaves them out, so that it regenerates byte for byte.
+    """
+
+    design: object
+    bench: FilterBench
+    files: dict = field(default_factory=dict)
+    timings: dict = field(default_factory=dict)
+    wall_clock: bool = True
+
+    @property
+    def deck(self) -> str:
+        """The design's ngspice deck (:meth:`FilterDesign.deck`)."""
+        return self.design.deck()
+
+    def to_dict(self) -> dict:
+        """The design's JSON with the bench's under ``bench`` and the files.
+
+        Returns
+        -------
+        dict
+            JSON-ready.
+        """
+        data = {**self.design.to_dict(), "bench": self.bench.to_dict(), "files": dict(self.files)}
+        if not self.wall_clock:
+            data["figures"] = {k: v for k, v in data["figures"].items() if k not in WALL_CLOCK}
+        return data
+
+
+def sheet_of(result) -> FilterSheet:
+    """The sheet's typed content for ``result``.
+
+    Parameters
+    ----------
+    result : FilterDesign
+        The design.
+
+    Returns
+    -------
+    FilterSheet
+        With :func:`designer.filters.bench.bench_of`'s bench.
+    """
+    return FilterSheet(result, bench_of(result))
+
+
+def build_board(result):
+    """The cascade as built: its netlist in the op-amp's default package.
+
+    Parameters
+    ----------
+    result : FilterDesign
+        The design.
+
+    Returns
+    -------
+    designer.spice.deck.Board
+        Stages in package units in order (U1A, U1B, U2A ...).
+    """
+    return board(result.cascade().netlist(), result.opamp, decoupling_digit=DECOUPLING_DIGIT)
+
+
+def net_label(net: str) -> str:
+    """What a cascade net is called on the sheet.
+
+    Parameters
+    ----------
+    net : str
+        The deck's net (``vin``, ``s1``, ``vout``, ``u2_x``, ``0``).
+
+    Returns
+    -------
+    str
+        ``IN (CH1)``, ``S1``, ``OUT (CH2)``, ``U2 x``, ``ground``.
+    """
+    if net == "vin":
+        return "IN (CH1)"
+    if net == "vout":
+        return "OUT (CH2)"
+    if net == GROUND:
+        return "ground"
+    if net.startswith("s") and net[1:].isdigit():
+        return f"S{net[1:]}"
+    amp, _, node = net.partition("_")
+    return f"{amp.upper()} {node}" if node else net
+
+
+def _end(s: Sheet, at, net: str, loc: str) -> None:
+    """A part's or pin's end: the ground symbol on ground, else its net's label."""
+    if net == GROUND:
+        s.ground(at)
+    else:
+        s.net_label(at, net, net_label(net), loc=loc)
+
+
+def draw_cascade(b, result, sheet: Sheet | None = None) -> Sheet:
+    """The cascade of ``b`` (:func:`build_board`) stage by stage, two stages a row:
+    each stage titled with its section, fn, Q and gain, its parts one under the
+    other between their nets' labels, its op-amp (package unit and pins) with
+    its pins on their nets' labels.
+
+    Parameters
+    ----------
+    b : designer.spice.deck.Board
+        The board.
+    result : FilterDesign
+        The design (the stages' titles).
+    sheet : Sheet, optional
+        Draw on this sheet (a new one by default).
+
+    Returns
+    -------
+    Sheet
+        The drawing, its connectivity recorded.
+    """
+    import schemdraw.elements as elm
+    # large labels: the drawing spans the printed page's width, two stages side by side
+    s = sheet or CascadeSheet(fontsize=18, unit=2.0)
+    parts = b.netlist.parts
+    width, pitch = 27.0, 3.8
+    heights = [max(sum(1 for p in parts if p.ref[1:-1] == f"{st.number}0"), 2) * pitch + 4.6 for st in result.stages]
+    y, row_h = 0.0, 0.0
+    for i, (st, amp) in enumerate(zip(result.stages, b.netlist.amps)):
+        col = i % 2
+        if col == 0:
+            y = y - row_h
+            row_h = max(heights[i:i + 2])
+        x0 = col * width
+        q = f"Q {st.plan.q:.3g}" if st.plan.q else "first order"
+        s.text((x0, y + 3.9), f"Stage {st.number}: {st.topology}", size=1.05, halign="left")
+        s.text((x0, y + 2.9), f"fn {format_eng(st.plan.fn_hz, 'Hz', 4)}, {q}, gain {st.gain:.3g}", size=0.95,
+               halign="left")
+        # the drawing's extent: matplotlib crops the picture to its elements, not to the labels' text
+        s.d.add(elm.Line().at((x0 - 0.6, y + 4.5)).to((x0 + width - 0.6, y + 4.5)).color("white"))
+        mine = [p for p in parts if p.ref[1:-1] == f"{st.number}0"]
+        for k, p in enumerate(mine):
+            yy = y - k * pitch
+            a, c = (x0 + 4.2, yy), (x0 + 8.2, yy)
+            s.part(p, a, c, label_loc="top")
+            _end(s, a, p.a, "left")
+            _end(s, c, p.b, "right")
+        unit = b.unit_of(amp.ref)
+        pts = s.opamp(amp, unit, b.package.part, (x0 + 19.5, y - 0.6), plus_on_top=True)
+        for term, loc in (("inp", "left"), ("inn", "left"), ("out", "right")):
+            pt = pts[term]
+            end = (pt[0] + (1.0 if term == "out" else -3.0), pt[1])
+            s.wire(pt, end)
+            _end(s, end, getattr(amp, term), loc)
+    return s
+
+
+class CascadeSheet(Sheet):
+    """A :class:`Sheet` whose PNG is sized to the drawing (a cascade is larger than matplotlib's default figure)."""
+
+    def png(self, dpi: int = 100, inches_per_unit: float | None = 0.3) -> bytes:
+        """The drawing as PNG bytes, 0.3 inch a unit (readable when printed at the sheet's width).
+
+        Parameters
+        ----------
+        dpi : int
+            Resolution.
+        inches_per_unit : float
+            Scale.
+
+        Returns
+        -------
+        bytes
+            PNG.
+        """
+        return super().png(dpi, inches_per_unit)
+
+
+def schematic(sheet_data: FilterSheet) -> Sheet:
+    """The cascade's drawing (:func:`draw_cascade`) of a :class:`FilterSheet`.
+
+    Parameters
+    ----------
+    sheet_data : FilterSheet
+        The sheet.
+
+    Returns
+    -------
+    Sheet
+        The drawing.
+    """
+    return draw_cascade(build_board(sheet_data.design), sheet_data.design)
+
+
+def title_of(result) -> str:
+    """The sheet's title.
+
+    Parameters
+    ----------
+    result : FilterDesign
+        The design.
+
+    Returns
+    -------
+    str
+        ``4th-order Butterworth low-pass, fc 1 kHz ...``.
+    """
+    s = result.spec
+    kind = {"lowpass": "low-pass", "highpass": "high-pass", "bandpass": "band-pass"}[s.filter_type]
+    where = (f"band {format_eng(s.f_low_hz, 'Hz')} to {format_eng(s.f_high_hz, 'Hz')}"
+             if s.filter_type == "bandpass" else f"fc {format_eng(result.fc_hz, 'Hz')}")
+    fam = s.family.capitalize() + (f" {s.ripple_db:g} dB" if s.family == "chebyshev" else "")
+    return f"Order-{result.order} {fam} {kind}, {where}, gain {s.gain:g}, {result.opamp.name}"
+
+
+def bom(result, b=None) -> list:
+    """The bill of materials rows (:data:`designer.report.wiring.BOM_HEADER`).
+
+    Parameters
+    ----------
+    result : FilterDesign
+        The design.
+    b : Board, optional
+        :func:`build_board`'s board.
+
+    Returns
+    -------
+    list
+        Rows; resistors of the design's series at the bench's 1 %, capacitors at 5 %.
+    """
+    from .bench import C_TOL_PCT, R_TOL_PCT
+    b = b or build_board(result)
+    stage_refs = {p.ref for p in b.netlist.parts}
+    s = result.spec
+
+    def source(ref):
+        if ref not in stage_refs:
+            return None
+        return (s.r_series, R_TOL_PCT) if ref.startswith("R") else (s.c_series, C_TOL_PCT)
+    return bom_rows(b, source, result.opamp.name)
+
+
+def _deg(v) -> str:
+    return f"{v:+.1f}"
+
+
+def _sweep(data: FilterSheet) -> list:
+    bench, amp = data.bench, data.bench.amplitude_v
+    rows = [[format_eng(p.f_hz, "Hz", 4), f"{p.gain_db:+.2f}", f"{p.gain_lo_db:+.2f} .. {p.gain_hi_db:+.2f}",
+             _deg(p.phase_deg), f"{_deg(p.phase_lo_deg)} .. {_deg(p.phase_hi_deg)}",
+             format_eng(p.out_pk_v, "V", 3), format_eng(p.time_per_div_s, "s") + "/div",
+             format_eng(p.ch1_v_per_div, "V") + "/div", format_eng(p.ch2_v_per_div, "V") + "/div", p.note]
+            for p in bench.sweep]
+    return [R.text(f"Generator: sine, {format_eng(amp, 'V')} peak ({format_eng(2 * amp, 'V')} pk-pk), no offset, "
+                   "output High-Z, into IN; scope CH1 on IN, CH2 on OUT, DC coupled, trigger CH1 rising at 0 V. "
+                   "At each frequency read the gain 20 log10(CH2 pk-pk / CH1 pk-pk) and the phase -360 x f x (the "
+                   "delay from CH1's rising zero crossing to CH2's); the phase is shown within -180..+180 deg, as "
+                   "the scope shows it."),
+            R.text(f"Band: {bench.builds} builds of the parts drawn within R {bench.r_tol_pct:g} %, C "
+                   f"{bench.c_tol_pct:g} % (seed {bench.seed}), 0.5th to 99.5th percentile, with the "
+                   f"{data.design.opamp.name} model."),
+            R.table(["f", "gain (dB)", "band (dB)", "phase (deg)", "band (deg)", "CH2 peak", "time base", "CH1",
+                     "CH2", ""], rows, "compact")]
+
+
+def _time_test(data: FilterSheet) -> list:
+    tt = data.bench.time_test
+    m = tt.metrics
+    if tt.kind == "step":
+        gen = (f"square {format_eng(tt.frequency_hz, 'Hz')}, 0 to {format_eng(tt.amplitude_v, 'V')} (offset "
+               f"{format_eng(tt.amplitude_v / 2, 'V')}), into IN")
+        rows = [["overshoot", f"{m['overshoot_pct']:.3g} %"], ["rise time (10-90 %)", format_eng(m["rise_time_s"], "s")],
+                ["settling time (2 %)", format_eng(m["settling_time_s"], "s")],
+                ["output peak", format_eng(m["peak_v"], "V")], ["final value", format_eng(m["final_v"], "V")]]
+        what = "the step: the rising edge of a square wave whose half period is five settling times"
+    else:
+        gen = (f"burst of {tt.cycles} cycles of a {format_eng(tt.frequency_hz, 'Hz')} sine, "
+               f"{format_eng(tt.amplitude_v, 'V')} peak, repeated at {format_eng(tt.repeat_hz, 'Hz')}, into IN")
+        rows = [["steady output peak", format_eng(m["steady_pk_v"], "V")], ["largest output peak",
+                                                                           format_eng(m["peak_v"], "V")],
+                ["within 2 % of the steady peak after", format_eng(m["settle_s"], "s")]]
+        what = "the tone burst at the passband's centre: the output builds up and rings out"
+    settings = [["generator", gen], ["time base", f"{format_eng(tt.time_per_div_s, 's')}/div, trigger CH1 rising"],
+                ["CH2", f"{format_eng(tt.ch2_v_per_div, 'V')}/div DC on OUT"]]
+    return [R.text(f"Test: {what} (the chosen parts, ideal op-amps)."), R.table(["set", "to"], settings, "compact"),
+            R.table(["reading", "expected"], rows, "compact")]
+
+
+def _stages(data: FilterSheet) -> list:
+    r = data.design
+    op = r.opamp
+    rows = []
+    for st, c in zip(r.stages, data.bench.checks):
+        rows.append([st.number, st.topology, format_eng(st.plan.fn_hz, "Hz", 4),
+                     "" if st.plan.q is None else f"{st.plan.q:.4g}", f"{st.gain:.4g}",
+                     f"{20 * math.log10(st.peak_gain):+.2f} dB", format_eng(c.out_peak_v, "V", 3),
+                     f"{format_eng(c.gbw_needed_hz, 'Hz', 3)} of {format_eng(c.gbw_hz, 'Hz', 3)}",
+                     f"{format_eng(c.slew_needed_v_per_s, 'V/s', 3)} of {format_eng(c.slew_v_per_s, 'V/s', 3)}",
+                     "ok" if c.ok else "FAILED"])
+    return [R.text(f"Each stage against the {op.name} at {format_eng(data.bench.amplitude_v, 'V')} peak in: GBW "
+                   f"needed = {r.spec.gbw_margin:g} x fn x Q x noise gain; the output's peak (the cascade up to it, "
+                   f"at its worst frequency) within the swing {format_eng(data.bench.checks[0].swing_v, 'V')}; the "
+                   "slew a sine of that peak needs at fn, 2 pi fn Vpk."),
+            R.table(["stage", "section", "fn", "Q", "gain", "peak gain", "output peak", "GBW needed", "slew needed",
+                     "check"], rows)]
+
+
+def _tables(data: FilterSheet) -> list:
+    r, bench = data.design, data.bench
+    s, f = r.spec, r.figures
+    rows = []
+    for t in bench.tables:
+        rows.append([t.stage, "" if t.table_fn_ratio is None else f"{t.table_fn_ratio:.4f}",
+                     "" if t.table_q is None else f"{t.table_q:.4f}", "" if t.table_k is None else f"{t.table_k:.3f}",
+                     "" if t.design_fn_ratio is None else f"{t.design_fn_ratio:.4f}",
+                     format_eng(t.fn_hz, "Hz", 5), "" if t.q is None else f"{t.q:.4f}",
+                     format_eng(t.fn_design_hz, "Hz", 5), "" if t.q_design is None else f"{t.q_design:.4f}",
+                     format_eng(t.fn_built_hz, "Hz", 5), "" if t.q_built is None else f"{t.q_built:.4f}"])
+    text = []
+    if s.filter_type == "bandpass":
+        text.append("A band-pass has no row in the low-pass tables: its sections come from the prototype "
+                    "transformed (or a high-pass and a low-pass cascade).")
+    elif abs(bench.table_corner - 1) > 1e-9:
+        text.append(f"The tables (TI SLOA088, section 16.9) put the corner fC 3 dB below the DC gain; this design's "
+                    f"fc is the {'ripple edge' if s.chebyshev_cutoff == 'ripple' else '-3 dB point below the ripple top'}"
+                    f": fC = {bench.table_corner:.4f} x the ripple edge, so the table's fn/fC differ from this "
+                    "design's fn/fc by that factor; Q is the same.")
+    else:
+        text.append("The tables (TI SLOA088, section 16.9) and this design share the corner: fn/fc and Q agree with "
+                    "the table's; k = fCi/fC is each section's own -3 dB point, not its fn.")
+    if s.filter_type == "highpass":
+        text.append("A high-pass uses the low-pass table with each fn mirrored about fc: fn = fc / (table fn/fC).")
+    if s.compensate_gbw:
+        text.append("--compensate-gbw: each stage's parts are synthesised for a pre-distorted fn and Q (the "
+                    "'synthesised for' columns) so that with the op-amp's finite GBW it gives the table's.")
+    text.append(f"The parts are E-series values chosen jointly across the stages against the whole response: the "
+                f"worst deviation from the ideal is {f['error_joint_db']:.3g} dB, against {f['error_per_stage_db']:.3g}"
+                f" dB when each stage is rounded on its own and {f['error_nearest_db']:.3g} dB with every part at its "
+                "nearest value; so a stage's built fn and Q may sit further from its target than rounding would "
+                "put them, when that makes the whole response closer.")
+    return [R.table(["stage", "table fn/fC", "table Q", "table k", "design fn/fc", "fn", "Q", "synthesised for fn",
+                     "and Q", "built fn", "built Q"], rows, "compact"), *[R.text(t) for t in text]]
+
+
+def _achieved(r) -> list:
+    f, s = r.figures, r.spec
+    f3 = f["f3_hz"]
+    f3t = f["f3_target_hz"]
+    show = lambda v: " and ".join(format_eng(x, "Hz", 5) for x in v) if isinstance(v, (list, tuple)) \
+        else format_eng(v, "Hz", 5)  # noqa: E731
+    rows = [["-3 dB frequency", show(f3t), show(f3)],
+            ["max passband deviation from the ideal", "0 dB", f"{f['passband_deviation_db']:.3g} dB"]]
+    if s.has_mask:
+        rows += [["mask: passband margin", f">= 0 (loss <= {s.max_loss_db:g} dB to {format_eng(s.passband_hz, 'Hz')})",
+                  f"{f['mask_passband_margin_db']:.3g} dB"],
+                 ["mask: stopband margin", f">= 0 (>= {s.min_attenuation_db:g} dB from "
+                                          f"{format_eng(s.stopband_hz, 'Hz')})", f"{f['mask_stopband_margin_db']:.3g} dB"]]
+    out = [R.table(["figure", "target", f"chosen parts, {r.opamp.name} model"], rows)]
+    if r.spice:
+        sp = r.spice
+        out.append(R.text(f"SPICE (.ac, {sp['simulator']}) against the analytic response of these parts: max "
+                          f"deviation {sp['max_deviation_passband_db']:.2g} dB in the passband, "
+                          f"{sp['max_deviation_60db_db']:.2g} dB down to -60 dB."))
+    return out
+
+
+def sections(data: FilterSheet, with_images: bool = True, schematic_svg: str = "") -> list:
+    """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`).
+
+    Parameters
+    ----------
+    data : FilterSheet
+        The design and its bench.
+    with_images : bool
+        Include the schematic and plots (False: the terminal text).
+    schematic_svg : str
+        The schematic inlined in the HTML.
+
+    Returns
+    -------
+    list
+        (heading, blocks) pairs.
+    """
+    r = data.design
+    b = build_board(r)
+    op = r.opamp
+    labels = {net: net_label(net) for net in {p.a for p in b.netlist.parts} | {p.b for p in b.netlist.parts}
+              | {a.out for a in b.netlist.amps}}
+    first = [R.subhead("Bill of materials"),
+             R.table(["Ref", "Value", "Code", "Qty", "Series", "Tol.", "Package"], [x[:7] for x in bom(r, b)],
+                     "compact"),
+             R.text(f"Supplies {op.vcc:+g} V and {op.vee:+g} V. Set the generator's output to High-Z.")]
+    # the cascade is wider than the plant: its schematic takes the page's width, the parts list follows
+    fig = [("Schematic", [R.figure("schematic.png", schematic_svg, "the cascade's schematic, stage by stage")])] \
+        if with_images else []
+    out = [*fig, ("Build", first),
+           ("Stages and their op-amp checks", _stages(data)),
+           ("Wiring", [R.text("Nets by name: a label on the schematic is that net; S1, S2 .. are the stages' "
+                              "outputs, each the next stage's input."),
+                       R.table(["part", "code", "from", "to"], wiring_rows(b, labels, (op.vcc, op.vee)))]),
+           ("Bench test: sine sweep", _sweep(data)),
+           ("Bench test: " + ("step" if data.bench.time_test.kind == "step" else "tone burst"), _time_test(data)),
+           ("Target and achieved", _achieved(r)),
+           ("Why the values differ from a table's", _tables(data))]
+    if with_images:
+        imgs = [R.image("bode.png", "Bode plot with the mask and the sweep's points"),
+                R.image("time-test.png", "the step or burst test")]
+        if data.bench.group_delay is not None:
+            imgs.append(R.image("group-delay.png", "group delay"))
+        out.append(("Plots", [R.columns(imgs[:2]), *imgs[2:]]))
+    return out
+
+
+def bode_png(data: FilterSheet) -> bytes:
+    """Gain (the builds' band shaded, the mask drawn, the sweep's points) and phase.
+
+    Parameters
+    ----------
+    data : FilterSheet
+        The sheet.
+
+    Returns
+    -------
+    bytes
+        PNG.
+    """
+    r, bench = data.design, data.bench
+    s = r.spec
+    f, h = bench.f_hz, bench.h
+    fig, (a1, a2) = figure(7.5, 4.8, 2, 1, sharex=True)
+    a1.fill_between(f, bench.h_lo_db, bench.h_hi_db, color="#f4c27a", alpha=0.5, lw=0,
+                    label=f"{bench.builds} builds (R {bench.r_tol_pct:g} %, C {bench.c_tol_pct:g} %)")
+    a1.plot(f, 20 * np.log10(np.abs(h)), "-", lw=1.6, label=f"chosen parts, {r.opamp.name} model")
+    a1.plot([p.f_hz for p in bench.sweep], [p.gain_db for p in bench.sweep], "o", ms=3.5, mfc="none",
+            color="C3", label="sweep points")
+    ref = 20 * math.log10(s.gain)
+    # down to 30 dB below the mask's stopband (80 dB without a mask), or the response's floor if higher
+    lo_db = max(float(np.min(20 * np.log10(np.abs(h)))), ref - (s.min_attenuation_db + 30 if s.has_mask else 80))
+    if s.has_mask:
+        # the forbidden regions: more loss than allowed in the passband, less attenuation in the stopband
+        if s.filter_type == "lowpass":
+            pb, sb = (f[0], s.passband_hz), (s.stopband_hz, f[-1])
+        else:
+            pb, sb = (s.passband_hz, f[-1]), (f[0], s.stopband_hz)
+        a1.fill_between(pb, [lo_db] * 2, [ref - s.max_loss_db] * 2, color="#d33", alpha=0.15, lw=0, label="mask")
+        a1.fill_between(sb, [ref - s.min_attenuation_db] * 2, [ref + 10] * 2, color="#d33", alpha=0.15, lw=0)
+    a1.axhline(ref - 10 * math.log10(2), color="0.5", lw=0.6, ls=":")
+    a1.set_ylim(lo_db, ref + 6)
+    a2.plot(f, np.degrees(np.unwrap(np.angle(h))), "-", lw=1.4)
+    log_frequency_axis(a2)
+    a1.set_ylabel("gain (dB)")
+    a2.set_ylabel("phase (deg)")
+    a2.set_xlabel("frequency (Hz)")
+    a1.set_title(title_of(r), fontsize=10)
+    for a in (a1, a2):
+        a.grid(True, which="both", alpha=0.3)
+    a1.legend(fontsize=7.5, loc="lower right" if s.filter_type == "highpass" else "lower left")
+    return png_bytes(fig, dpi=100, tight=False)
+
+
+def time_png(data: FilterSheet) -> bytes:
+    """The step or burst: generator and output.
+
+    Parameters
+    ----------
+    data : FilterSheet
+        The sheet.
+
+    Returns
+    -------
+    bytes
+        PNG.
+    """
+    tt = data.bench.time_test
+    title = "Step response" if tt.kind == "step" else f"Tone burst at {format_eng(tt.frequency_hz, 'Hz')}"
+    return step_plot(tt.t_s, {"output (chosen parts)": tt.output_v, "generator (CH1)": tt.input_v}, title,
+                     ylabel="voltage (V)", xlabel="time from the " + ("step" if tt.kind == "step" else "burst's start"))
+
+
+def group_delay_png(data: FilterSheet) -> bytes:
+    """The group delay of the chosen parts with the op-amp's model.
+
+    Parameters
+    ----------
+    data : FilterSheet
+        The sheet.
+
+    Returns
+    -------
+    bytes
+        PNG.
+    """
+    f, tau = data.bench.group_delay
+    fig, ax = figure(7.5, 3.2)
+    ax.plot(f, np.asarray(tau) * 1e6, "-", lw=1.6)
+    log_frequency_axis(ax)
+    ax.set_xlabel("frequency (Hz)")
+    ax.set_ylabel("group delay (us)")
+    ax.set_title("Group delay (flat in the passband: a Bessel's purpose)", fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    return png_bytes(fig, dpi=100, tight=False)
+
+
+def plots(data: FilterSheet) -> tuple:
+    """The sheet's plots: (file name, drawing function) pairs.
+
+    Parameters
+    ----------
+    data : FilterSheet
+        The sheet.
+
+    Returns
+    -------
+    tuple
+        ``bode.png``, ``time-test.png`` and, for a Bessel, ``group-delay.png``.
+    """
+    out = (("bode.png", bode_png), ("time-test.png", time_png))
+    return out + ((("group-delay.png", group_delay_png),) if data.bench.group_delay is not None else ())
+
+
+def _texts() -> dict:
+    return {"bom_csv": ("bom.csv", lambda d: bom_csv(bom(d.design)))}
+
+
+def write_outputs(data: FilterSheet, out_dir, name: str) -> dict:
+    """The bundle: ``reports/<name>/`` (build sheets, result.json, plots, bom.csv, the deck) and
+    ``netlists/<name>.cir`` under ``out_dir`` (:func:`designer.report.bundle.write_design`).
+
+    Parameters
+    ----------
+    data : FilterSheet
+        The sheet.
+    out_dir : str or Path
+        Where ``reports/`` and ``netlists/`` go.
+    name : str
+        The design's name.
+
+    Returns
+    -------
+    dict
+        The files written.
+    """
+    from ..report.bundle import write_design
+    data.wall_clock = False
+    return write_design(data, out_dir, name, plots(data), schematic,
+                        lambda svg: sections(data, schematic_svg=svg), title_of(data.design), _texts())
+
+
+def write_folder(data: FilterSheet, folder) -> dict:
+    """A ``--out`` folder: ``filter.cir`` (the deck), ``result.json`` and the sheet's files
+    (:data:`SHEET_FILES`, ``group-delay.png`` for a Bessel), all made in a staging folder beside it and then
+    moved in (each by an atomic rename), so that a failure leaves the folder as it was.
+
+    Parameters
+    ----------
+    data : FilterSheet
+        The sheet.
+    folder : str or Path
+        The folder (created if missing; other files in it are left alone).
+
+    Returns
+    -------
+    dict
+        Key -> path of every file written.
+    """
+    import json
+    import os
+    from pathlib import Path
+
+    from ..core import fileio
+    from ..report.bundle import schematic_pictures
+    from ..report.document import to_html, to_markdown
+    folder = fileio.ensure_dir(Path(folder))
+    names = {"deck": "filter.cir", "result_json": "result.json", "build_sheet_md": "build-sheet.md",
+             "build_sheet_html": "build-sheet.html", "bom_csv": "bom.csv", "schematic": "schematic.png"}
+    pics = dict((n, draw(data)) for n, draw in plots(data))
+    names.update({n.replace(".png", "").replace("-", "_"): n for n in pics})
+    data.files = {k: str(folder / v) for k, v in names.items()}
+    svg, png = schematic_pictures(schematic, data)
+    secs = sections(data, schematic_svg=svg)
+    title = title_of(data.design)
+    images = {**pics, "schematic.png": png}
+    contents = {"filter.cir": data.deck, "result.json": json.dumps(data.to_dict(), indent=2) + "\n",
+                "build-sheet.md": to_markdown(title, secs), "build-sheet.html": to_html(title, secs, images),
+                "bom.csv": bom_csv(bom(data.design)), **images}
+    fileio.clean_stale(folder.parent)
+    stage = fileio.new_folder_beside(folder)
+    try:
+        try:
+            for fname, d in contents.items():
+                (stage / fname).write_bytes(d if isinstance(d, bytes) else d.encode("utf-8"))
+            for fname in contents:
+                os.replace(stage / fname, folder / fname)
+        except OSError as exc:
+            raise fileio.os_error("write", folder, exc) from None
+    finally:
+        fileio.remove_tree(stage)
+    return dict(data.files)

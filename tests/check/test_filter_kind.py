@@ -1,0 +1,123 @@
+"""check-design ``kind: filter`` (designer.check.filter_kind): a filter designed from
+``filter:`` or as built from ``stages:``, in every op-amp corner, its mask as checks
+on the op-amp model and on SPICE's .ac; the figures against brute force on the
+response and against the design's own; the refusals one line at the key's line."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from helpers import ROOT
+from specfiles import refusal, write
+
+from designer.check.filter_kind import filter_figures, run_filter
+from designer.check.run import run_corner
+from designer.check.spec import load_spec
+from designer.core import opamps
+from designer.filters import get
+
+DESIGNED = """\
+    name: f4
+    kind: filter
+    filter: {type: lowpass, family: butterworth, order: 4, fc: 1k}
+    opamp: [TL072, NE5532]
+    mask: {passband: 500, max_loss: 0.5, stopband: 4k, min_attenuation: 40}
+    checks:
+      f3_hz: {min: 950, max: 1050}
+    """
+
+REF = ROOT / "reports" / "filter_butterworth_lp4_sk_1k" / "result.json"
+
+
+def as_built_text():
+    stages = json.loads(REF.read_text())["stages"]
+    lines = [f"  - {{topology: {s['topology']}, parts: {{{', '.join(f'{k}: {v!r}' for k, v in s['parts'].items())}}}}}"
+             for s in stages]
+    return "name: built\nkind: filter\nopamp: TL072\nstages:\n" + "\n".join(lines) + \
+        "\nmask: {passband: 500, max_loss: 0.5, stopband: 4k, min_attenuation: 40}\n"
+
+
+def test_designed_spec_loads_a_design_per_corner_and_the_mask_as_checks(tmp_path):
+    spec = load_spec(write(tmp_path, DESIGNED))
+    assert spec.corners == ("TL072", "NE5532") and not spec.analyze
+    assert [d.spec.opamp for d in spec.designs] == ["TL072", "NE5532"]
+    figs = [c.figure for c in spec.checks]
+    assert figs == ["f3_hz", "passband_loss_db", "stopband_attenuation_db", "spice_passband_loss_db",
+                    "spice_stopband_attenuation_db"]
+    limits = {c.figure: c for c in spec.checks}
+    assert limits["passband_loss_db"].max == 0.5 and limits["stopband_attenuation_db"].min == 40
+
+
+@pytest.mark.parametrize("text, words", [
+    ("kind: filter\nopamp: TL072\nchecks: {f3_hz: {max: 1k}}\n", "filter: {type, family, order, fc, ..} (designed)"),
+    ("kind: filter\nfilter: {order: 4, fc: 1k, famly: bessel}\nchecks: {f3_hz: {max: 1k}}\n", "closest: 'family'"),
+    ("kind: filter\nfilter: {order: 4, fc: abc}\nchecks: {f3_hz: {max: 1k}}\n", "filter.fc"),
+    ("kind: filter\nfilter: {order: 12, fc: 1k}\nchecks: {f3_hz: {max: 1k}}\n", "filter.order must be 1 to 10"),
+    ("kind: filter\nfilter: {order: 4, fc: 1k}\nmask: {passband: 1k}\n", "mask needs passband, max_loss"),
+    ("kind: filter\nfilter: {order: 4, fc: 1k}\n", "nothing to check"),
+    ("kind: filter\nfilter: {order: 4, fc: 1k}\nchecks: {f3: {max: 1k}}\n", "closest: 'f3_hz'"),
+    ("kind: filter\nstages:\n  - {topology: sallen-key-lowpas, parts: {R1: 1k}}\nchecks: {f3_hz: {max: 1k}}\n",
+     "unknown section 'sallen-key-lowpas'"),
+    ("kind: filter\nstages:\n  - {topology: rc-lowpass, parts: {R1: 1k}}\nchecks: {f3_hz: {max: 1k}}\n",
+     "missing C1"),
+    ("kind: filter\nstages:\n  - {topology: rc-lowpass, parts: {R1: 1k, C1: -1n}}\nchecks: {f3_hz: {max: 1k}}\n",
+     "must be positive"),
+    ("kind: filter\nfilter: {order: 4, fc: 1k}\nstages: []\nchecks: {f3_hz: {max: 1k}}\n", "one of them"),
+])
+def test_refusals_are_one_line(tmp_path, text, words):
+    msg = refusal(write(tmp_path, text))
+    assert words in msg, msg
+    assert msg.startswith(str(tmp_path / "spec.yaml") + ":")
+
+
+def test_figures_by_brute_force():
+    # a Butterworth-like as-built cascade: the -3 dB point and the mask figures from a dense grid
+    stages = [("sallen-key-lowpass", {"R1": 10e3, "R2": 10e3, "C1": 10e-9, "C2": 22e-9}),
+              ("rc-lowpass", {"R1": 15e3, "C1": 10e-9})]
+    mask = {"passband": 300.0, "max_loss": 1.0, "stopband": 5e3, "min_attenuation": 20.0}
+    amp = opamps.get("TL072")
+    figs = filter_figures(stages, amp, None, mask, None)
+    f = np.logspace(0, 6, 600_001)
+    h = np.ones_like(f, dtype=complex)
+    for t, v in stages:
+        h = h * get(t).response(v, 2j * math.pi * f, amp)
+    g = 20 * np.log10(np.abs(h))
+    assert figs["passband_gain_db"] == pytest.approx(0.0, abs=1e-12)   # DC gain 1 (ideal coefficients)
+    f3 = f[np.flatnonzero(g >= -10 * math.log10(2))[-1]]
+    assert figs["f3_hz"] == pytest.approx(f3, rel=1e-4)
+    assert figs["passband_loss_db"] == pytest.approx(-g[f <= 300].min(), abs=1e-4)
+    assert figs["stopband_attenuation_db"] == pytest.approx(-g[(f >= 5e3) & (f <= figs_hi(stages))].max(), abs=1e-3)
+
+
+def figs_hi(stages):
+    from designer.check.filter_kind import _grid
+    return _grid(stages)[-1]
+
+
+@pytest.mark.spice
+def test_as_built_reference_equals_its_design(tmp_path):
+    if not REF.exists():
+        pytest.skip(f"{REF} not generated (run make demo)")
+    built = load_spec(write(tmp_path, as_built_text(), "built.yaml"))
+    designed = load_spec(write(tmp_path, DESIGNED.replace("[TL072, NE5532]", "TL072")))
+    assert built.analyze and built.corners == ("TL072",)
+    a = run_filter(built.designs[0], "ngspice-cli").figures
+    b = run_filter(designed.designs[0], "ngspice-cli").figures
+    for k in ("f3_hz", "passband_loss_db", "stopband_attenuation_db", "spice_f3_hz"):
+        assert a[k] == pytest.approx(b[k], rel=1e-9), k
+    ref = json.loads(REF.read_text())
+    assert a["f3_hz"] == pytest.approx(ref["figures"]["f3_hz"], rel=1e-3)
+    # SPICE's .ac agrees with the model: the same figures within a hundredth of a dB
+    assert a["spice_passband_loss_db"] == pytest.approx(a["passband_loss_db"], abs=0.01)
+    assert a["spice_max_deviation_db"] < 0.01
+
+
+@pytest.mark.spice
+def test_a_broken_mask_fails_on_the_model_and_on_spice(tmp_path):
+    spec = load_spec(write(tmp_path, DESIGNED.replace("min_attenuation: 40", "min_attenuation: 60")))
+    out = run_corner(spec, 0, "ngspice-cli")
+    status = {c.id: c.status for c in out.cases}
+    assert status["stopband_attenuation_db"] == "fail" and status["spice_stopband_attenuation_db"] == "fail"
+    assert status["passband_loss_db"] == "pass" and status["f3_hz"] == "pass"
+    assert out.design["figures"]["stopband_attenuation_db"] < 60
