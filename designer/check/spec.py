@@ -187,7 +187,7 @@ def _netlist(doc, name: str, update: bool) -> CheckSpec:
 def _filter(doc, name: str, corners) -> CheckSpec:
     from .filter_kind import filter_designs, mask_limits
     designs, analyze = filter_designs(doc, corners)
-    checks = _checks(doc, "filter", set(F.FIGURES["filter"])) + mask_limits(designs[0].mask)
+    checks = read_checks(doc, "filter", set(F.FIGURES["filter"])) + mask_limits(designs[0].mask)
     if not checks:
         raise doc.error((), "nothing to check: give checks: (figures) or mask:")
     return CheckSpec(doc.path, name, "filter", corners, tuple(designs), analyze, checks, None, None, (), None)

@@ -31,7 +31,6 @@ from ..report.schematic import Sheet
 from ..report.wiring import bom_csv, bom_rows, wiring_rows
 from ..spice.deck import GROUND, board
 from .bench import FilterBench, bench_of
-from .registry import get as get_topology
 
 __all__ = ["FilterSheet", "sheet_of", "build_board", "draw_cascade", "net_label", "sections", "title_of",
            "bom", "plots", "schematic", "write_outputs", "write_folder", "SHEET_FILES"]
