@@ -17,16 +17,18 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    "figures": ("ALIASES", "BAND", "PID", "PLANT", "band_of", "plant_figures"),
-    "golden": ("compare", "read_golden", "write_golden"),
-    "junit": ("junit_xml", "visible"),
-    "limits": ("Limit", "limit_from"),
+    "figures": ("ALIASES", "BAND", "PID", "PLANT", "band_of", "plant_figures",),
+    "filter_kind": ("FILTER_KEYS", "FilterCase", "MASK_FIGURES", "MASK_KEYS", "SUB_FILTER", "filter_designs",
+                    "filter_figures", "mask_limits", "run_filter",),
+    "golden": ("compare", "read_golden", "write_golden",),
+    "junit": ("junit_xml", "visible",),
+    "limits": ("Limit", "limit_from",),
     "result": ("Case", "CornerOutcome", "ERROR", "FAIL", "PASS", "SIM_ERROR", "SKIP", "SPEC_ERROR", "SpecOutcome",
-               "exit_status", "headline"),
-    "run": ("corner_task", "run_corner"),
+               "exit_status", "headline",),
+    "run": ("corner_task", "run_corner",),
     "sections": ("SUB",),
-    "spec": ("TOP", "load_spec"),
+    "spec": ("TOP", "load_spec",),
     "summary": ("summary_markdown",),
-    "yamldoc": ("MAX_SPEC_BYTES", "parse_yaml"),
+    "yamldoc": ("MAX_SPEC_BYTES", "parse_yaml",),
     "yamlread": ("MAX_NODES",),
 })
