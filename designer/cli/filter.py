@@ -187,7 +187,13 @@ def summary_text(result) -> str:
         lines.append(f"SPICE (.ac, {sp['simulator']}) against the analytic response of these parts: max deviation "
                      f"{sp['max_deviation_passband_db']:.2g} dB in the passband, {sp['max_deviation_60db_db']:.2g} "
                      "dB down to -60 dB")
+    lines += _proof_lines(result)
     return "\n".join(lines) + "\n"
+
+
+def _proof_lines(result) -> list:
+    """The SPICE proof's lines (NRMS against both models, the mask on SPICE's .ac, slew and swing per stage)."""
+    return result.proof.lines() if getattr(result, "proof", None) is not None else []
 
 
 def _write(result, folder) -> dict:

@@ -42,13 +42,14 @@ from ..core.jsonio import SCHEMA_VERSION, json_safe
 from ..core.eseries import values as series_values
 from ..core.units import format_eng
 from .cascade import Cascade
-from .deck import ac_deck, simulate_ac
+from .deck import simulate_ac
 from .joint import joint_search, objective, per_stage
 from .prototype import (SectionPlan, bandpass_method, order_from_mask, plan_bandpass, plan_sections,
                         reference_bandpass, reference_response)
 from .registry import get as get_topology
 from .spec import FilterSpec
 from .topology import SectionTarget
+from .verify import proof_deck, prove
 
 __all__ = ["StageDesign", "FilterDesign", "design", "section_name", "stage_candidates", "verify_spice", "predistort",
            "analysis_grid"]
@@ -150,7 +151,9 @@ class FilterDesign:
     figures : dict
         Achieved figures against the target (see :func:`design`).
     spice : dict or None
-        :func:`verify_spice`'s figures when run.
+        The SPICE proof's figures when run (:meth:`designer.filters.verify.Proof.to_dict`).
+    proof : designer.filters.verify.Proof or None
+        The SPICE proof itself (:func:`designer.filters.verify.prove`).
     """
 
     spec: FilterSpec
@@ -159,6 +162,7 @@ class FilterDesign:
     stages: list
     figures: dict = field(default_factory=dict)
     spice: dict | None = None
+    proof: object = None
 
     @property
     def opamp(self):
@@ -182,32 +186,16 @@ class FilterDesign:
                         for st in self.stages])
 
     def deck(self) -> str:
-        """The ngspice ``.ac`` deck of the chosen cascade, standalone: ``ngspice -b`` prints its
-        ``.meas`` of the passband gain and the -3 dB frequency (dB relative to 1 V in).
+        """The standalone ngspice proof deck of the chosen cascade (:func:`designer.filters.verify.proof_deck`):
+        ``ngspice -b`` runs its ``.ac`` and bench ``.tran`` and prints their measurements (the passband
+        gain ``passband_db`` and the -3 dB frequency ``f3db_hz``, dB relative to 1 V in, among them).
 
         Returns
         -------
         str
             The deck's text.
         """
-        lo, hi = self.figures["sweep_hz"]
-        text = ac_deck(self.cascade().netlist(), self.opamp, lo, hi,
-                       title=f"{self.spec.family} {self.spec.filter_type} order {self.order}")
-        kind = self.spec.filter_type
-        a, b = self.figures["passband_range_hz"]
-        at = {"lowpass": a, "highpass": b, "bandpass": self.fc_hz}[kind]
-        level = 20 * math.log10(self.spec.gain) - 10 * math.log10(2)
-        crossings = {"lowpass": [("f3db_hz", "last")], "highpass": [("f3db_hz", "1")],
-                     "bandpass": [("f3db_low_hz", "1"), ("f3db_high_hz", "last")]}[kind]
-        lines = text.rstrip().splitlines()
-        ac = next(i for i, line in enumerate(lines) if line.startswith(".ac "))
-        # the sweep and its measurements in a .control block: ngspice's batch-mode .meas cannot parse vdb()
-        # (no vector is saved for it), and `quit 0` ends a batch run without dot analyses with status 0
-        # the last crossing for a low-pass, the first for a high-pass: a Chebyshev's ripple stays above it
-        control = [".control", lines[ac][1:], f"meas ac passband_db find vdb(vout) at={at:.6g}",
-                   *(f"meas ac {name} when vdb(vout)={level:.6g} cross={cross}" for name, cross in crossings),
-                   "quit 0", ".endc"]
-        return "\n".join(lines[:ac] + lines[ac + 1:-1] + control + [".end"]) + "\n"
+        return proof_deck(self)
 
     def to_dict(self) -> dict:
         """Everything as JSON-ready data.
@@ -556,7 +544,8 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
     spec : FilterSpec
         The specification.
     simulate : bool
-        Also run :func:`verify_spice` (ngspice ``.ac`` of the chosen cascade).
+        Also run the SPICE proof (:func:`designer.filters.verify.prove`: ngspice ``.ac`` and ``.tran``
+        of the chosen cascade against the analytic one).
     simulator : str
         ``ngspice-cli`` or ``pyspice``.
 
@@ -673,7 +662,8 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
             total = sum(e[c] for e, c in zip(errors, ch))
             result.figures[f"mask_violation_{key}_db"] = max(0.0, *(o + sg * total[col] for col, sg, o in limits))
     if simulate:
-        result.spice = verify_spice(result, simulator)
+        result.proof = prove(result, simulator)
+        result.spice = result.proof.to_dict()
     return result
 
 
