@@ -617,6 +617,12 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         grid["objective"] = np.append(grid["objective"], [spec.passband_hz, spec.stopband_hz])
         n = grid["objective"].size
         limits = [(n - 2, -1.0, -margin_pass), (n - 1, 1.0, -margin_stop)]
+        # the loss is limited over the whole passband, not at its edge only (a Chebyshev's ripple troughs
+        # inside it sit at the ideal's full ripple: the parts may not deepen them past --max-loss)
+        f_obj = grid["objective"][:n - 2]
+        inside = f_obj <= spec.passband_hz if spec.filter_type == "lowpass" else f_obj >= spec.passband_hz
+        ideal_in = 20 * np.log10(np.abs(_reference(spec, order, fc, f_obj[inside]) / spec.gain))
+        limits += [(int(c), -1.0, -(spec.max_loss_db + d)) for c, d in zip(np.flatnonzero(inside), ideal_in)]
     f_obj = grid["objective"]
     s_obj = 2j * math.pi * f_obj
     stages = []
