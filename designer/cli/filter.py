@@ -17,8 +17,9 @@ from ..core.opamps import names as opamp_names
 from ..core.ranges import help_range
 from ..core.units import format_eng
 from .common import command_parser, print_output, run_cli
+from .filter_tolerance import add_filter_tolerance, run_tolerance, tolerance_json, tolerance_lines, tolerance_settings
 
-__all__ = ["design_filter_main", "summary_text"]
+__all__ = ["design_filter_main", "analyze_filter_main", "summary_text"]
 
 EPILOG = """examples:
   design-filter --family butterworth --order 4 --fc 1k
@@ -86,6 +87,7 @@ def _parser():
     k.add_argument("--r-max", default="1M", help=f"largest resistor (default 1M) {help_range('resistor_ohm')}")
     k.add_argument("--c-min", default="1n", help=f"smallest capacitor (default 1n) {help_range('capacitor_f')}")
     k.add_argument("--c-max", default="10u", help=f"largest capacitor (default 10u) {help_range('capacitor_f')}")
+    add_filter_tolerance(p, optimize=True)
     o = p.add_argument_group("output")
     o.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     o.add_argument("--out", metavar="DIR", help="write DIR/filter.cir (the ngspice .ac deck of the cascade) and "
@@ -196,12 +198,12 @@ def _proof_lines(result) -> list:
     return result.proof.lines() if getattr(result, "proof", None) is not None else []
 
 
-def _write(result, folder) -> dict:
+def _write(result, folder, extra=None) -> dict:
     from ..core.fileio import atomic_write, ensure_dir
     folder = ensure_dir(Path(folder))
     files = {"deck": str(folder / "filter.cir"), "result_json": str(folder / "result.json")}
     atomic_write(files["deck"], result.deck())
-    data = {**result.to_dict(), "files": files}
+    data = {**result.to_dict(), **(extra or {}), "files": files}
     atomic_write(files["result_json"], json.dumps(data, indent=2) + "\n")
     return files
 
@@ -209,12 +211,19 @@ def _write(result, folder) -> dict:
 def _design(args) -> int:
     from ..filters.design import design
     spec = _spec(args)
+    settings = tolerance_settings(args)
     result = design(spec, simulate=not args.no_sim, simulator=args.simulator)
-    files = _write(result, args.out) if args.out else {}
+    return _emit(result, args, run_tolerance(result, args, settings))
+
+
+def _emit(result, args, extras: dict) -> int:
+    """The result (and its tolerance analyses) printed, and written with --out."""
+    extra = tolerance_json(extras)
+    files = _write(result, args.out, extra) if args.out else {}
     if args.json:
-        print_output(json.dumps({**result.to_dict(), "files": files}, indent=2))
+        print_output(json.dumps({**result.to_dict(), **extra, "files": files}, indent=2))
     else:
-        text = summary_text(result)
+        text = summary_text(result) + "".join(line + "\n" for line in tolerance_lines(extras))
         if files:
             text += "Files:\n" + "".join(f"  {k}: {v}\n" for k, v in files.items())
         print_output(text, end="")
@@ -235,6 +244,116 @@ def design_filter_main(argv=None) -> int:
         The exit status (0 done, 2 bad input, 3 simulator error).
     """
     return run_cli("design-filter", _parser, _design, argv)
+
+
+ANALYZE_EPILOG = """examples:
+  design-filter --order 4 --fc 1k --json --out build/lp      then, the parts as built:
+  analyze-filter --from build/lp/result.json --part R101=10.2k --part C202=4.6n
+  analyze-filter --from build/lp/result.json --monte-carlo 10000 --limit f3_hz=950:1050 --spice-samples 50
+
+--part DESIGNATOR=VALUE names a part as the cascade does: stage i's R1 is Ri01 (R101, R201...).
+"""
+
+
+def _analyze_parser():
+    from ..core.opamps import names as opamp_names
+    p = command_parser("analyze-filter", "Analyze an active filter's parts as built (a design-filter result.json, "
+                       "parts changed with --part): the achieved response against its target and mask, the SPICE "
+                       "proof, the tolerance yield against the mask.", ANALYZE_EPILOG)
+    g = p.add_argument_group("the filter")
+    g.add_argument("--from", dest="from_json", required=True, metavar="RESULT_JSON",
+                   help="a design-filter result.json (its --out folder's): the target, the stages and their parts")
+    g.add_argument("--part", action="append", metavar="DESIGNATOR=VALUE",
+                   help="a part as built, e.g. R101=10.2k or C202=4.7n (repeatable)")
+    g.add_argument("--opamp", metavar="NAME", help=f"another op-amp for every stage: {', '.join(opamp_names())}")
+    add_filter_tolerance(p)
+    o = p.add_argument_group("output")
+    o.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    o.add_argument("--out", metavar="DIR", help="write DIR/filter.cir (the proof deck) and DIR/result.json")
+    o.add_argument("--no-sim", action="store_true", help="skip the ngspice proof")
+    o.add_argument("--simulator", default="ngspice-cli", choices=("ngspice-cli", "pyspice"),
+                   help="ngspice-cli: `ngspice -b` (default); pyspice: the shared library")
+    return p
+
+
+def _read_design(path: str) -> dict:
+    from ..core.errors import DesignError
+    try:
+        data = json.loads(Path(path).read_text())
+    except OSError as exc:
+        raise DesignError(f"--from {path!r}: cannot read it ({exc.strerror or exc})") from None
+    except ValueError:
+        raise DesignError(f"--from {path!r}: not JSON; give a design-filter result.json") from None
+    if not isinstance(data, dict) or data.get("tool") != "design-filter" or "stages" not in data:
+        raise DesignError(f"--from {path!r}: not a design-filter result.json (no tool design-filter and stages)")
+    return data
+
+
+def _as_built_inputs(data: dict, parts, opamp) -> tuple:
+    """(FilterSpec, order, fc, stages) of a design-filter result.json with --part changes."""
+    from ..core.errors import DesignError
+    from ..core.units import parse_value
+    from ..filters.prototype import SectionPlan
+    from ..filters.registry import get as get_topology
+    from ..filters.spec import FilterSpec
+    sp, mask = data["spec"], data["spec"].get("mask")
+    kw = {k: sp[k] for k in ("filter_type", "family", "bessel_norm", "chebyshev_cutoff", "gain", "r_series",
+                              "c_series", "amplitude_v", "gbw_margin") if sp.get(k) is not None}
+    if sp.get("ripple_db") is not None and sp["family"] == "chebyshev" and not mask:
+        kw["ripple_db"] = sp["ripple_db"]
+    if sp["filter_type"] == "bandpass":
+        kw.update(order=sp["order"], f_low_hz=sp["f_low_hz"], f_high_hz=sp["f_high_hz"],
+                  bandpass_method=sp["bandpass_method"])
+    elif mask:
+        kw.update(mask)
+    else:
+        kw.update(order=sp["order"], fc_hz=sp["fc_hz"])
+    kw["opamp"] = opamp or data["opamp"]["name"]
+    spec = FilterSpec(**kw)
+    stages, refs = [], {}
+    for i, st in enumerate(data["stages"], 1):
+        topo = get_topology(st["topology"])
+        values = dict(st["parts"])
+        for r in values:
+            refs[topo.prefixed(r, f"{i}0")] = (len(stages), r)
+        stages.append([SectionPlan(st["kind"], st["order"], st["fn_hz"], st["q"]), st["topology"], st["gain"], values])
+    for item in parts or ():
+        ref, _, text = str(item).partition("=")
+        ref = ref.strip().upper()
+        if not text or ref not in refs:
+            raise DesignError(f"--part {item!r}: give DESIGNATOR=VALUE with one of this filter's parts: "
+                              f"{', '.join(refs)}")
+        k, r = refs[ref]
+        value = parse_value(text.strip(), f"--part {ref}")
+        if not value > 0:
+            raise DesignError(f"--part {ref} must be above 0, got {text.strip()!r}")
+        stages[k][3][r] = value
+    return spec, int(sp["order"]), float(sp["fc_hz"]), [tuple(s) for s in stages]
+
+
+def _analyze(args) -> int:
+    from ..filters.design import as_built
+    data = _read_design(args.from_json)
+    spec, order, fc, stages = _as_built_inputs(data, args.part, args.opamp)
+    settings = tolerance_settings(args)
+    result = as_built(spec, order, fc, stages, simulate=not args.no_sim, simulator=args.simulator)
+    return _emit(result, args, run_tolerance(result, args, settings))
+
+
+def analyze_filter_main(argv=None) -> int:
+    """``analyze-filter``'s entry point.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit status (0 done, 2 bad input, 3 simulator error).
+    """
+    return run_cli("analyze-filter", _analyze_parser, _analyze, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

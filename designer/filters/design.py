@@ -51,7 +51,7 @@ from .spec import FilterSpec
 from .topology import SectionTarget
 from .verify import proof_deck, prove
 
-__all__ = ["StageDesign", "FilterDesign", "design", "section_name", "stage_candidates", "verify_spice", "predistort",
+__all__ = ["StageDesign", "FilterDesign", "design", "as_built", "section_name", "stage_candidates", "verify_spice", "predistort",
            "analysis_grid"]
 
 #: the capacitor values (C1, nearest first) each stage offers the joint search
@@ -645,10 +645,8 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
                 if k == len(tries) - 1:
                     raise
         # the stage's ideal: the asked target's (a pre-distorted design aims its op-amp-aware response at it)
-        ideal_db = 20 * np.log10(np.abs(topo.response(topo.synthesize(target), s_obj)))
-        arrays = {r: np.array([c[r] for c in cands])[:, None] for r in topo.designators}
-        cand_db = 20 * np.log10(np.abs(topo.response(arrays, s_obj[None, :], opamp)))
-        stages.append(StageDesign(i, p, name, g, continuous, cands, cand_db - ideal_db[None, :], nearest,
+        stages.append(StageDesign(i, p, name, g, continuous, cands, _stage_errors(topo, target, cands, s_obj, opamp),
+                                  nearest,
                                   peak_gain=peaks[i - 1], node_peak_v=nodes[i - 1],
                                   gbw_needed_hz=need, fn_design_hz=built.fn_hz, q_design=built.q))
     pruned = _prune(stages)
@@ -667,6 +665,77 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         for key, ch in (("joint", choice), ("per_stage", per_stage(errors)), ("nearest", [st.nearest for st in stages])):
             total = sum(e[c] for e, c in zip(errors, ch))
             result.figures[f"mask_violation_{key}_db"] = max(0.0, *(o + sg * total[col] for col, sg, o in limits))
+    if simulate:
+        result.proof = prove(result, simulator)
+        result.spice = result.proof.to_dict()
+    return result
+
+
+def _stage_errors(topo, target: SectionTarget, cands: list, s_obj, opamp) -> np.ndarray:
+    """(candidates, f) dB error of each candidate's op-amp-aware response against the stage's ideal:
+    the asked target's (a pre-distorted design aims its op-amp-aware response at it)."""
+    ideal_db = 20 * np.log10(np.abs(topo.response(topo.synthesize(target), s_obj)))
+    arrays = {r: np.array([c[r] for c in cands])[:, None] for r in topo.designators}
+    cand_db = 20 * np.log10(np.abs(topo.response(arrays, s_obj[None, :], opamp)))
+    return cand_db - ideal_db[None, :]
+
+
+def as_built(spec: FilterSpec, order: int, fc_hz: float, stages: list, simulate: bool = False,
+             simulator: str = "ngspice-cli") -> FilterDesign:
+    """A filter of given parts (as built, or as a design-filter result lists them), judged as
+    :func:`design` judges its choice: the achieved response against ``spec``'s target, its mask.
+
+    Parameters
+    ----------
+    spec : FilterSpec
+        What the filter should do.
+    order, fc_hz : int, float
+        Its order and cut-off (a band-pass: its centre).
+    stages : list of tuple
+        Per stage, input first: (SectionPlan, registry name, gain, part values).
+    simulate : bool
+        Also run the SPICE proof.
+    simulator : str
+        ``ngspice-cli`` or ``pyspice``.
+
+    Returns
+    -------
+    FilterDesign
+        One candidate per stage (its parts); the figures of :func:`design` (the joint, per-stage
+        and nearest errors are this one set's).
+
+    Raises
+    ------
+    DesignError
+        A stage's parts not matching its topology's (one line).
+    """
+    opamp = opamps.get(spec.opamp)
+    grid = analysis_grid(spec, order, fc_hz)
+    s_obj = 2j * math.pi * grid["objective"]
+    built = []
+    for i, (plan, name, gain, values) in enumerate(stages, 1):
+        topo = get_topology(name)
+        vals = {r: float(v) for r, v in topo.values_of(values).items()}
+        target = SectionTarget(plan.kind, plan.fn_hz, plan.q, gain, impedance_ohm=spec.impedance_ohm)
+        errors = _stage_errors(topo, target, [vals], s_obj, opamp)
+        need = spec.gbw_margin * plan.fn_hz * (plan.q or 1.0) * _noise_gain(topo, gain)
+        built.append(StageDesign(i, plan, name, gain, vals, [vals], errors, 0, gbw_needed_hz=need))
+    result = FilterDesign(spec, order, fc_hz, built)
+    errors = [st.errors for st in built]
+    result.figures = _figures(result, grid, errors, [0] * len(built), objective(errors, [0] * len(built)), 1, 0.0, 0.0)
+    result.figures["candidates_dropped"] = 0
+    if spec.has_mask:
+        for key in ("joint", "per_stage", "nearest"):
+            result.figures[f"mask_violation_{key}_db"] = max(0.0, -result.figures["mask_passband_margin_db"],
+                                                             -result.figures["mask_stopband_margin_db"])
+    # each stage's peak gain and its output's peak at the bench amplitude, from its own parts (op-amp-aware)
+    f = np.geomspace(fc_hz / 1000, fc_hz * 1000, 4001)
+    h_cum = np.ones(f.size, complex)
+    for st in built:
+        h = get_topology(st.topology).response(st.values, 2j * math.pi * f, opamp)
+        h_cum = h_cum * h
+        st.peak_gain = float(np.max(np.abs(h)))
+        st.node_peak_v = float(spec.amplitude_v * np.max(np.abs(h_cum)))
     if simulate:
         result.proof = prove(result, simulator)
         result.spice = result.proof.to_dict()
