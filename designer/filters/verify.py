@@ -44,7 +44,7 @@ __all__ = ["PROOF_POINTS_PER_DECADE", "TRAN_POINTS", "NRMS_PASS", "BenchSignal",
            "prove"]
 
 #: the proof's ``.ac`` density (points per decade)
-PROOF_POINTS_PER_DECADE = 50
+PROOF_POINTS_PER_DECADE = 200
 #: the analytic transient's uniform grid
 TRAN_POINTS = 4000
 #: an NRMS below this passes (Xyce's rule)
@@ -257,10 +257,12 @@ def _meas_lines(result) -> list:
                  "bandpass": [("f3db_low_hz", "1"), ("f3db_high_hz", "last")]}[kind]
     out = [f"meas ac passband_db find vdb(vout) at={at:.6g}",
            *(f"meas ac {name} when vdb(vout)={level:.6g} cross={cross}" for name, cross in crossings)]
-    for i, f in enumerate(fp, 1):
-        out += [f"meas ac pass{i}_db find vdb(vout) at={f:.6g}", f"meas ac pass{i}_rad find vp(vout) at={f:.6g}"]
-    for i, f in enumerate(ft, 1):
-        out += [f"meas ac stop{i}_db find vdb(vout) at={f:.6g}", f"meas ac stop{i}_rad find vp(vout) at={f:.6g}"]
+    # the phase from the real and imaginary parts: vp() wraps at +-180 degrees, where `find` would
+    # interpolate across the jump
+    for name, freqs in (("pass", fp), ("stop", ft)):
+        for i, f in enumerate(freqs, 1):
+            out += [f"meas ac {name}{i}_db find vdb(vout) at={f:.6g}", f"meas ac {name}{i}_re find vr(vout) at={f:.6g}",
+                    f"meas ac {name}{i}_im find vi(vout) at={f:.6g}"]
     # the stopband's largest gain: beyond the stopband edge (a band-pass: below the lower, above the upper)
     if kind == "lowpass":
         spans = [(ft[0], hi)]
@@ -540,9 +542,9 @@ def prove(result, simulator: str = "ngspice-cli") -> Proof:
         ac_v, tran_v = read_raw(ac_raw), read_raw(tran_raw)
     names = "\n".join(f".meas x {ln.split()[2]}" for ln in meas)
     measured = parse_measurements(text, names)
-    for k in list(measured):
-        if k.endswith("_rad"):
-            measured[k.replace("_rad", "_deg")] = math.degrees(measured.pop(k))
+    for k in [k for k in measured if k.endswith("_re")]:
+        im = measured.pop(k[:-3] + "_im", math.nan)
+        measured[k[:-3] + "_deg"] = math.degrees(math.atan2(im, measured.pop(k)))
     f = np.real(ac_v["frequency"])
     h = np.asarray(_vector(ac_v, "vout"), complex)
     chosen, op = result.cascade(), result.opamp

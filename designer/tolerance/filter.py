@@ -396,7 +396,7 @@ def spice_context(result, simulator: str = "ngspice-cli") -> SpiceFilterContext:
 
 
 _ROW = re.compile(r"^\s*MCROW (\d+)\s*$", re.M)
-_MEAS = re.compile(r"^\s*(m[gp]\d+)\s*=\s*([-+]?[\d.]+(?:[eE][-+]?\d+)?)", re.M)
+_MEAS = re.compile(r"^\s*(mg\d+|mp[ri]\d+)\s*=\s*([-+]?[\d.]+(?:[eE][-+]?\d+)?)", re.M)
 
 
 def _spice_commands(sctx: SpiceFilterContext, values: dict, start: int) -> list:
@@ -408,7 +408,8 @@ def _spice_commands(sctx: SpiceFilterContext, values: dict, start: int) -> list:
         out += [f"ac dec 100 {lo:.6g} {hi:.6g}", f"echo MCROW {start + i}"]
         out += [f"meas ac mg{k} find vdb(vout) at={f:.10g}" for k, f in enumerate(sctx.ctx.f)]
         a, b = sctx.ctx.sl["gd"]
-        out += [f"meas ac mp{k} find vp(vout) at={sctx.ctx.f[k]:.10g}" for k in range(a, b)]
+        # the phase from the real and imaginary parts (vp() wraps at +-180 degrees)
+        out += [f"meas ac m{p}{k} find v{p[-1]}(vout) at={sctx.ctx.f[k]:.10g}" for k in range(a, b) for p in ("pr", "pi")]
         out.append("destroy all")
     return out
 
@@ -454,11 +455,9 @@ def spice_evaluate(sctx: SpiceFilterContext, values: dict, start: int = 0) -> di
             i = int(m.group(1)) - start - lo
             seg = text[m.end():marks[j + 1].start() if j + 1 < len(marks) else len(text)]
             got = {k: float(v) for k, v in _MEAS.findall(seg)}
-            mag = np.array([10 ** (got.get(f"mg{k}", np.nan) / 20) for k in range(nf)])
-            ph = np.zeros(nf)
+            h[lo + i] = [10 ** (got.get(f"mg{k}", np.nan) / 20) for k in range(nf)]
             for k in range(a, b):
-                ph[k] = got.get(f"mp{k}", np.nan)
-            h[lo + i] = mag * np.exp(1j * ph)
+                h[lo + i, k] = got.get(f"mpr{k}", np.nan) + 1j * got.get(f"mpi{k}", np.nan)
             seen.add(i)
         if len(seen) < hi - lo:
             missing = min(set(range(hi - lo)) - seen) + start + lo
