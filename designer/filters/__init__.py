@@ -9,8 +9,10 @@ stages, the ngspice proof). Below the wings: it imports ``core`` and ``spice`` o
 
 from .cascade import Cascade, Stage
 from .deck import ac_deck, simulate_ac
-from .design import (FilterDesign, StageDesign, analysis_grid, design, predistort, section_name, stage_candidates,
-                     verify_spice)
+from .design import (FilterDesign, StageDesign, analysis_grid, as_built, design, predistort, section_name,
+                     stage_candidates, verify_spice)
+from .verify import (NRMS_PASS, PROOF_POINTS_PER_DECADE, TRAN_POINTS, BenchSignal, Proof, StageDrive, analytic_tran,
+                     bench_signal, opamp_aware_polys, proof_deck, prove, stage_drive, stage_polys)
 from .joint import brute_force, descend, joint_search, objective, per_stage
 from .prototype import (BANDPASS_METHODS, BESSEL_NORMS, CHEBYSHEV_CUTOFFS, FAMILIES, MAX_ORDER, RESPONSE_TYPES,
                         WIDE_RATIO, SectionPlan, bandpass_method, chebyshev_3db_factor, order_from_mask,
@@ -41,7 +43,9 @@ from .topology import (
     quadratic_root,
 )
 
-__all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "FilterDesign", "StageDesign", "analysis_grid", "design", "predistort",
+__all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "FilterDesign", "StageDesign", "analysis_grid", "as_built", "design", "predistort",
+           "NRMS_PASS", "PROOF_POINTS_PER_DECADE", "TRAN_POINTS", "BenchSignal", "Proof", "StageDrive", "analytic_tran",
+           "bench_signal", "opamp_aware_polys", "proof_deck", "prove", "stage_drive", "stage_polys",
            "section_name", "stage_candidates", "verify_spice", "brute_force", "descend", "joint_search", "objective",
            "per_stage", "BANDPASS_METHODS", "WIDE_RATIO", "bandpass_method", "plan_bandpass", "reference_bandpass",
            "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER", "RESPONSE_TYPES", "SectionPlan",

@@ -82,20 +82,43 @@ class BenchSignal:
     rise_s: float
 
     def source(self) -> str:
-        """The input source's transient part in SPICE syntax."""
+        """The input source's transient part in SPICE syntax.
+
+        Returns
+        -------
+        str
+            ``PULSE(...)`` or ``SIN(...)``.
+        """
         if self.kind == "step":
             return f"PULSE(0 {self.amplitude_v:.6g} 0 {self.rise_s:.6g} {self.rise_s:.6g} 1e3 2e3)"
         return f"SIN(0 {self.amplitude_v:.6g} {self.f_hz:.6g} 0)"
 
     def waveform(self, t) -> np.ndarray:
-        """The input at times ``t`` (s)."""
+        """The input at times ``t``.
+
+        Parameters
+        ----------
+        t : ndarray
+            Times, s.
+
+        Returns
+        -------
+        ndarray
+            Volts.
+        """
         t = np.asarray(t, float)
         if self.kind == "step":
             return self.amplitude_v * np.clip(t / self.rise_s, 0.0, 1.0)
         return self.amplitude_v * np.sin(2 * math.pi * self.f_hz * t)
 
     def to_dict(self) -> dict:
-        """The signal as JSON."""
+        """The signal as JSON.
+
+        Returns
+        -------
+        dict
+            Its fields.
+        """
         return {"kind": self.kind, "amplitude_v": self.amplitude_v, "f_hz": self.f_hz, "t_stop_s": self.t_stop_s,
                 "rise_s": self.rise_s}
 
@@ -135,11 +158,23 @@ class StageDrive:
     instead: str | None = None
 
     def to_dict(self) -> dict:
-        """The check as JSON."""
+        """The check as JSON.
+
+        Returns
+        -------
+        dict
+            Its fields.
+        """
         return dict(self.__dict__)
 
     def text(self) -> str:
-        """One line: the stage's slew and swing against the op-amp's."""
+        """One line: the stage's slew and swing against the op-amp's.
+
+        Returns
+        -------
+        str
+            The line (what to use instead when the op-amp cannot).
+        """
         line = (f"  stage {self.stage}: swing {format_eng(self.bench_swing_v, 'V')} bench, "
                 f"{format_eng(self.peak_swing_v, 'V')} at its peak ({format_eng(self.peak_hz, 'Hz')}) of "
                 f"+-{format_eng(self.swing_v, 'V')}; slew {format_eng(self.bench_slew_v_per_s, 'V/s')} bench, "
@@ -180,19 +215,31 @@ class Proof:
     ac: dict = field(default_factory=dict)
 
     @property
-    def passed(self) -> bool:
+    def passed(self) -> bool:  # noqa: D401
         """SPICE agrees with the op-amp-aware model (NRMS below 1 on both analyses) and meets the mask."""
         agree = self.nrms["ac_opamp"] < NRMS_PASS and self.nrms["tran_opamp"] < NRMS_PASS
         return agree and (self.mask is None or self.mask["met"])
 
     def to_dict(self) -> dict:
-        """The proof as JSON."""
+        """The proof as JSON.
+
+        Returns
+        -------
+        dict
+            The earlier check's keys (``max_deviation_*``) and every figure of the proof.
+        """
         return {**self.ac, "signal": self.signal.to_dict(), "measurements": self.measurements,
                 "nrms": self.nrms, "nrms_pass_below": NRMS_PASS, "fit_error": self.fit_error, "mask": self.mask,
                 "stages": [s.to_dict() for s in self.stages], "passed": self.passed}
 
     def lines(self) -> list:
-        """The summary's lines."""
+        """The summary's lines.
+
+        Returns
+        -------
+        list of str
+            NRMS, the mask on SPICE's .ac, each stage's slew and swing.
+        """
         n = self.nrms
         out = [f"SPICE proof ({self.signal.kind} test, NRMS below {NRMS_PASS:g} agrees): .ac NRMS "
                f"{n['ac_opamp']:.3g} against the op-amp-aware cascade ({n['ac_ideal']:.3g} ideal), .tran "

@@ -11,10 +11,11 @@ Engines (both ``evaluate(context, values) -> {figure: array}``, chunked by
 - analytic (:func:`evaluate`), vectorised over the builds and the stages: each
   stage's ideal H(s) from its closed-form coefficients
   (:meth:`designer.filters.topology.Topology.coefficients`, arrays of part values),
-  times the nominal parts' op-amp factor H_opamp(nominal) / H_ideal(nominal) of
-  that stage (the op-amp's finite gain and GBW barely depend on a 5 % change of a
-  part: the factor is exact at the nominal and first-order accurate around it;
-  the SPICE engine has no such approximation and the disagreement is reported);
+  times its op-amp factor H_opamp / H_ideal (the nodal analysis'), expanded to first
+  order in the log of each part around the nominal (the factor and its derivatives
+  computed once, by central differences): exact at the nominal, its error second
+  order in the parts' deviations; the SPICE engine has no such approximation and
+  the disagreement is reported;
 - SPICE (:func:`spice_evaluate`): the cascade's deck loaded once per chunk and, per
   build, ``alter`` of every part by its designator (R101 is stage 1's R1), an
   ``.ac`` sweep and ``meas`` of the gain at the same frequencies.
@@ -86,7 +87,11 @@ class FilterContext:
     sl : dict
         Name -> (start, stop) of each group in ``f``.
     correction : tuple of ndarray
-        Per stage, H_opamp/H_ideal of its nominal parts on ``f`` (ones for the ideal op-amp).
+        Per stage, ln(H_opamp/H_ideal) of its nominal parts on ``f`` (zeros for the ideal op-amp).
+    sensitivity : tuple of ndarray
+        Per stage, d ln(H_opamp/H_ideal) / d ln(part), shape (its parts, ``f``).
+    nominal : tuple of ndarray
+        Per stage, its nominal part values (designator order).
     """
 
     kind: str
@@ -95,6 +100,8 @@ class FilterContext:
     f: np.ndarray
     sl: dict
     correction: tuple
+    sensitivity: tuple
+    nominal: tuple
 
     @property
     def figures(self) -> tuple:
@@ -171,20 +178,39 @@ def context(result, stage_values=None) -> FilterContext:
     f = np.concatenate(list(groups.values()))
     op = result.opamp
     stage_values = stage_values or [st.values for st in result.stages]
-    stages, corr = [], []
+    stages, corr, sens, nom = [], [], [], []
     s = 2j * math.pi * f
     for i, (st, vals) in enumerate(zip(result.stages, stage_values), 1):
         topo = get_topology(st.topology)
         stages.append((st.topology, f"{i}0", topo.designators))
-        corr.append(_correction(topo, vals, s, op))
-    return FilterContext(kind, tuple(stages), 20 * math.log10(result.spec.gain), f, sl, tuple(corr))
+        c, d = _correction(topo, vals, s, op)
+        corr.append(c)
+        sens.append(d)
+        nom.append(np.array([vals[r] for r in topo.designators], float))
+    return FilterContext(kind, tuple(stages), 20 * math.log10(result.spec.gain), f, sl, tuple(corr), tuple(sens),
+                         tuple(nom))
 
 
-def _correction(topo, values: dict, s, opamp) -> np.ndarray:
-    """H_opamp / H_ideal of one stage's parts on ``s`` (ones for the ideal op-amp)."""
+#: the relative step of the op-amp factor's sensitivities (central differences)
+SENS_STEP = 1e-4
+
+
+def _correction(topo, values: dict, s, opamp) -> tuple:
+    """ln(H_opamp / H_ideal) of one stage's parts on ``s`` and its derivative in the log of each part
+    (central differences; zeros for the ideal op-amp): the factor is then first-order in each build's
+    deviation, its error second-order (about (tol)^2 of the factor's own size)."""
+    refs = topo.designators
     if opamp.ideal:
-        return np.ones(s.shape, complex)
-    return topo.response(values, s, opamp) / topo.response(values, s)
+        return np.zeros(s.shape, complex), np.zeros((len(refs),) + s.shape, complex)
+    def log_factor(vals):
+        return np.log(topo.response(vals, s, opamp) / topo.response(vals, s))
+    base = log_factor(values)
+    rows = []
+    for r in refs:
+        up = log_factor({**values, r: values[r] * (1 + SENS_STEP)})
+        down = log_factor({**values, r: values[r] * (1 - SENS_STEP)})
+        rows.append((up - down) / math.log((1 + SENS_STEP) / (1 - SENS_STEP)))
+    return base, np.array(rows)
 
 
 def _at_jw(coef: np.ndarray, f: np.ndarray) -> tuple:
@@ -231,14 +257,18 @@ def stage_responses(ctx: FilterContext, values: dict) -> list:
     n = len(next(iter(values.values())))
     out = []
     a, b = ctx.sl["gd"]
-    for (name, prefix, refs), corr in zip(ctx.stages, ctx.correction):
+    for (name, prefix, refs), corr, sens, nom in zip(ctx.stages, ctx.correction, ctx.sensitivity, ctx.nominal):
         topo = get_topology(name)
         vals = {r: np.broadcast_to(np.asarray(values[topo.prefixed(r, prefix)], float), (n,)) for r in refs}
         num, den = (np.asarray(p, float).reshape(p.shape[0], n).T for p in topo.coefficients(vals))
         nr, ni = _at_jw(num, ctx.f)
         dr, di = _at_jw(den, ctx.f)
-        mag2 = (nr * nr + ni * ni) / (dr * dr + di * di) * (np.abs(corr) ** 2)[None, :]
-        h_gd = (nr[:, a:b] + 1j * ni[:, a:b]) / (dr[:, a:b] + 1j * di[:, a:b]) * corr[None, a:b]
+        # the op-amp factor, first order in the log of each part (_correction): its log magnitude is real
+        dev = np.log(np.column_stack([vals[r] for r in refs]) / nom[None, :])
+        log_mag = corr.real[None, :] + sum(dev[:, k, None] * sens[k].real[None, :] for k in range(len(refs)))
+        log_gd = corr[None, a:b] + dev @ sens[:, a:b]
+        mag2 = (nr * nr + ni * ni) / (dr * dr + di * di) * np.exp(2 * log_mag)
+        h_gd = (nr[:, a:b] + 1j * ni[:, a:b]) / (dr[:, a:b] + 1j * di[:, a:b]) * np.exp(log_gd)
         out.append((mag2, h_gd))
     return out
 
@@ -795,8 +825,9 @@ def optimize_yield(result, n: int = 2000, seed: int = 0, sampler: str = "random"
             name, prefix, refs = ctx.stages[i]
             topo = get_topology(name)
             cand = result.stages[i].candidates[c]
-            one = FilterContext(ctx.kind, (ctx.stages[i],), ctx.gain_db, ctx.f, ctx.sl,
-                                (_correction(topo, cand, s, op),))
+            corr, sens = _correction(topo, cand, s, op)
+            one = FilterContext(ctx.kind, (ctx.stages[i],), ctx.gain_db, ctx.f, ctx.sl, (corr,), (sens,),
+                                (np.array([cand[r] for r in refs], float),))
             vals = {topo.prefixed(r, prefix): cand[r] * rel[topo.prefixed(r, prefix)] for r in refs}
             cache[(i, c)] = stage_responses(one, vals)[0]
         return cache[(i, c)]
