@@ -61,7 +61,7 @@ LOWHIGH_FIGURES = ("passband_loss_db", "ripple_db", "f3_hz", "stopband_attenuati
 BANDPASS_FIGURES = ("passband_loss_db", "ripple_db", "f3_low_hz", "f3_high_hz", "stopband_attenuation_db",
                     "group_delay_s")
 #: points over the passband and the stopband, and around each -3 dB point (within a factor F3_SPAN)
-PASS_POINTS, STOP_POINTS, F3_POINTS, F3_SPAN = 24, 16, 64, 1.6
+PASS_POINTS, STOP_POINTS, F3_POINTS, F3_SPAN = 24, 16, 32, 1.6
 #: the relative step of the group delay's phase difference
 GD_STEP = 1e-3
 #: SPICE builds per ngspice run
@@ -213,34 +213,34 @@ def _correction(topo, values: dict, s, opamp) -> tuple:
     return base, np.array(rows)
 
 
-def _at_jw(coef: np.ndarray, f: np.ndarray) -> tuple:
-    """Re and Im of a polynomial at s = j 2 pi f for every build: ``coef`` (builds, k), highest power
-    first. (j w)^p is real for an even p and imaginary for an odd one, so each term adds to one part
-    only; a sum of at most three terms by broadcasting (a BLAS product this thin loses to its threads'
-    start-up), a coefficient zero for every build skipped."""
-    w = 2 * math.pi * f
-    k = coef.shape[1]
-    re = np.zeros((coef.shape[0], f.size))
-    im = np.zeros((coef.shape[0], f.size))
-    for i in range(k):
-        p = k - 1 - i
-        c = coef[:, i]
-        if not np.any(c):
-            continue
-        term = c[:, None] * ((-1.0) ** (p // 2) * w ** p)[None, :]
-        if p % 2 == 0:
-            re += term
-        else:
-            im += term
-    return re, im
+def _squared_magnitude(coef: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """|P(j w)|^2 of a polynomial of degree at most 2 for every build, at x = w^2: with
+    P = c2 s^2 + c1 s + c0 (``coef`` (builds, k), highest power first),
+
+        |P(j w)|^2 = (c0 - c2 w^2)^2 + (c1 w)^2 = c0^2 + (c1^2 - 2 c0 c2) x + c2^2 x^2,
+
+    a polynomial in x whose coefficients are per build (Horner's rule over the frequencies); a
+    coefficient zero for every build (a low-pass numerator's s terms) costs nothing."""
+    c = np.zeros((coef.shape[0], 3))
+    c[:, 3 - coef.shape[1]:] = coef
+    c2, c1, c0 = c[:, 0], c[:, 1], c[:, 2]
+    e = [c0 * c0, c1 * c1 - 2 * c0 * c2, c2 * c2]
+    top = max([k for k in range(3) if np.any(e[k])], default=0)
+    if top == 0:
+        return e[0][:, None]
+    out = e[top][:, None] * x[None, :]
+    for k in range(top - 1, -1, -1):
+        if np.any(e[k]):
+            out += e[k][:, None]
+        if k:
+            out *= x[None, :]
+    return out
 
 
 def stage_responses(ctx: FilterContext, values: dict) -> list:
-    """Each stage's op-amp-aware response on ``ctx.f`` for every build (module docstring): its
-    squared magnitude, and H itself at the group delay's two frequencies.
-
-    The polynomials at s = j w are real sums (coefficients x the real and imaginary parts of
-    (j w)^p): the builds' arrays stay real until the two group-delay columns.
+    """Each stage's op-amp-aware response on ``ctx.f`` for every build (module docstring): the
+    ideal section's squared magnitude, the op-amp factor's log magnitude, and H itself at the
+    group delay's two frequencies.
 
     Parameters
     ----------
@@ -252,33 +252,41 @@ def stage_responses(ctx: FilterContext, values: dict) -> list:
     Returns
     -------
     list of tuple
-        Per stage (|H|^2 of shape (builds, frequencies), H at the group-delay pair (builds, 2)).
+        Per stage (ideal |H|^2 and the op-amp factor's ln |.|, each of shape (builds, frequencies),
+        H at the group-delay pair (builds, 2)).
     """
     n = len(next(iter(values.values())))
     out = []
     a, b = ctx.sl["gd"]
+    x = (2 * math.pi * ctx.f) ** 2
+    s_gd = 2j * math.pi * ctx.f[a:b]
     for (name, prefix, refs), corr, sens, nom in zip(ctx.stages, ctx.correction, ctx.sensitivity, ctx.nominal):
         topo = get_topology(name)
         vals = {r: np.broadcast_to(np.asarray(values[topo.prefixed(r, prefix)], float), (n,)) for r in refs}
         num, den = (np.asarray(p, float).reshape(p.shape[0], n).T for p in topo.coefficients(vals))
-        nr, ni = _at_jw(num, ctx.f)
-        dr, di = _at_jw(den, ctx.f)
+        ratio = _squared_magnitude(num, x) / _squared_magnitude(den, x)
         # the op-amp factor, first order in the log of each part (_correction): its log magnitude is real
         dev = np.log(np.column_stack([vals[r] for r in refs]) / nom[None, :])
-        log_mag = corr.real[None, :] + sum(dev[:, k, None] * sens[k].real[None, :] for k in range(len(refs)))
-        log_gd = corr[None, a:b] + dev @ sens[:, a:b]
-        mag2 = (nr * nr + ni * ni) / (dr * dr + di * di) * np.exp(2 * log_mag)
-        h_gd = (nr[:, a:b] + 1j * ni[:, a:b]) / (dr[:, a:b] + 1j * di[:, a:b]) * np.exp(log_gd)
-        out.append((mag2, h_gd))
+        # a sum of (at most four) terms by broadcasting: a BLAS product this thin loses to its threads' start-up
+        log_mag = dev[:, 0, None] * sens[0].real[None, :]
+        for k in range(1, len(refs)):
+            log_mag += dev[:, k, None] * sens[k].real[None, :]
+        log_mag += corr.real[None, :]
+        h_gd = (sum(num[:, i, None] * s_gd ** (num.shape[1] - 1 - i) for i in range(num.shape[1]))
+                / sum(den[:, i, None] * s_gd ** (den.shape[1] - 1 - i) for i in range(den.shape[1])))
+        h_gd = h_gd * np.exp(corr[None, a:b] + dev @ sens[:, a:b])
+        out.append((ratio, log_mag, h_gd))
     return out
 
 
 def _combine(parts: list) -> tuple:
-    """The cascade's |H|^2 and group-delay pair from the stages' (:func:`stage_responses`)."""
-    mag2, h_gd = parts[0]
-    for m, h in parts[1:]:
-        mag2, h_gd = mag2 * m, h_gd * h
-    return mag2, h_gd
+    """The cascade's dB (relative to nothing) and group-delay pair from the stages'
+    (:func:`stage_responses`): the ideal ratios multiplied, the op-amp factors' logs added, one
+    logarithm at the end."""
+    ratio, log_mag, h_gd = parts[0]
+    for r, m, h in parts[1:]:
+        ratio, log_mag, h_gd = ratio * r, log_mag + m, h_gd * h
+    return 10 * np.log10(ratio) + (20 / math.log(10)) * log_mag, h_gd
 
 
 def _crossing(f: np.ndarray, db: np.ndarray, level: float, low: bool) -> np.ndarray:
@@ -303,15 +311,15 @@ def _crossing(f: np.ndarray, db: np.ndarray, level: float, low: bool) -> np.ndar
     return np.where(ok, out, np.nan)
 
 
-def figures_of(ctx: FilterContext, mag2: np.ndarray, h_gd: np.ndarray) -> dict:
+def figures_of(ctx: FilterContext, db: np.ndarray, h_gd: np.ndarray) -> dict:
     """The figures (module docstring) of the cascade's responses.
 
     Parameters
     ----------
     ctx : FilterContext
         The design's context.
-    mag2 : ndarray
-        |H|^2, shape (builds, ``ctx.f``).
+    db : ndarray
+        20 log10 |H|, shape (builds, ``ctx.f``).
     h_gd : ndarray
         H at the group delay's two frequencies, shape (builds, 2).
 
@@ -320,7 +328,7 @@ def figures_of(ctx: FilterContext, mag2: np.ndarray, h_gd: np.ndarray) -> dict:
     dict
         Figure -> array over the builds.
     """
-    db = 10 * np.log10(mag2) - ctx.gain_db
+    db = db - ctx.gain_db
     part = lambda k: db[:, slice(*ctx.sl[k])]  # noqa: E731
     out = {"passband_loss_db": -np.min(part("pass"), axis=1),
            "ripple_db": np.ptp(part("pass"), axis=1),
@@ -492,7 +500,7 @@ def spice_evaluate(sctx: SpiceFilterContext, values: dict, start: int = 0) -> di
         if len(seen) < hi - lo:
             missing = min(set(range(hi - lo)) - seen) + start + lo
             raise SimulatorError(f"ngspice stopped before filter Monte Carlo build {missing}")
-    return figures_of(sctx.ctx, np.abs(h) ** 2, h[:, a:b])
+    return figures_of(sctx.ctx, 20 * np.log10(np.abs(h)), h[:, a:b])
 
 
 def _spice_chunk(sctx, values: dict) -> dict:
