@@ -443,7 +443,8 @@ def stage_polys(result, opamp=None) -> tuple:
 
 def analytic_tran(polys: list, t, x) -> list:
     """Every stage's output for the input ``x`` on the uniform grid ``t``: each stage driven by
-    the one before it (``scipy.signal.lsim``, zero initial state).
+    the one before it, zero initial state (the bilinear transform by ``scipy.signal.bilinear`` on the
+    polynomials, then ``lfilter``).
 
     Parameters
     ----------
@@ -459,10 +460,13 @@ def analytic_tran(polys: list, t, x) -> list:
     """
     from scipy import signal as sig
     out, y = [], np.asarray(x, float)
+    dt = float(t[1] - t[0])
     for num, den in polys:
         num = _trim(np.asarray(num, float), np.asarray(den, float))
-        _, y, _ = sig.lsim((num, den), y, t)
-        y = np.asarray(y, float)
+        # the bilinear (Tustin) discretisation, run by lfilter in C rather than lsim's Python loop over the
+        # samples: its error is about (w dt)^2 / 12 of the response, 2e-5 at 400 points per period of fc
+        numd, dend = sig.bilinear(num, den, fs=1.0 / dt)
+        y = sig.lfilter(numd, dend, y)
         out.append(y)
     return out
 
