@@ -77,8 +77,7 @@ def joint_section(d):
           f"{peak:.1f} | {JOINT_GOAL_S:g} s, {JOINT_GOAL_MB:g} MB | {python:.3f} | {python / took:.0f}x | "
           f"{brute:.3f} | {brute / took:.1f}x | {'yes' if same else 'NO'} ({j:.4f} dB) | {'ok' if ok else 'MISSED'} |")
     print("\nAt this size (four stages of 12 candidates) a vectorised exhaustive enumeration is faster than the "
-          "branch and bound; the search's pruning pays as the product grows (its examined partial choices grow "
-          "far slower than the product).")
+          "branch and bound.")
     print(f"\nPer-stage rounding gives {d.figures['error_per_stage_db']:.4f} dB, the nearest values "
           f"{d.figures['error_nearest_db']:.4f} dB, the joint choice {j:.4f} dB.")
 
