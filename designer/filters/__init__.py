@@ -12,7 +12,7 @@ from .deck import ac_deck, simulate_ac
 from .design import (FilterDesign, StageDesign, analysis_grid, as_built, design, predistort, section_name,
                      stage_candidates, verify_spice)
 from .verify import (NRMS_PASS, PROOF_POINTS_PER_DECADE, TRAN_POINTS, BenchSignal, Proof, StageDrive, analytic_tran,
-                     bench_signal, opamp_aware_polys, proof_deck, prove, stage_drive, stage_polys)
+                     bench_signal, mask_edges, opamp_aware_polys, proof_deck, prove, stage_drive, stage_polys)
 from .joint import brute_force, descend, joint_search, objective, per_stage
 from .prototype import (BANDPASS_METHODS, BESSEL_NORMS, CHEBYSHEV_CUTOFFS, FAMILIES, MAX_ORDER, RESPONSE_TYPES,
                         WIDE_RATIO, SectionPlan, bandpass_method, chebyshev_3db_factor, order_from_mask,
@@ -45,7 +45,7 @@ from .topology import (
 
 __all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "FilterDesign", "StageDesign", "analysis_grid", "as_built", "design", "predistort",
            "NRMS_PASS", "PROOF_POINTS_PER_DECADE", "TRAN_POINTS", "BenchSignal", "Proof", "StageDrive", "analytic_tran",
-           "bench_signal", "opamp_aware_polys", "proof_deck", "prove", "stage_drive", "stage_polys",
+           "bench_signal", "mask_edges", "opamp_aware_polys", "proof_deck", "prove", "stage_drive", "stage_polys",
            "section_name", "stage_candidates", "verify_spice", "brute_force", "descend", "joint_search", "objective",
            "per_stage", "BANDPASS_METHODS", "WIDE_RATIO", "bandpass_method", "plan_bandpass", "reference_bandpass",
            "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER", "RESPONSE_TYPES", "SectionPlan",

@@ -40,7 +40,7 @@ from .deck import ac_deck
 from .registry import get as get_topology
 
 __all__ = ["PROOF_POINTS_PER_DECADE", "TRAN_POINTS", "NRMS_PASS", "BenchSignal", "StageDrive", "Proof",
-           "bench_signal", "proof_deck", "opamp_aware_polys", "stage_polys", "analytic_tran", "stage_drive",
+           "mask_edges", "bench_signal", "proof_deck", "opamp_aware_polys", "stage_polys", "analytic_tran", "stage_drive",
            "prove"]
 
 #: the proof's ``.ac`` density (points per decade)
@@ -253,15 +253,31 @@ class Proof:
         return out
 
 
-def _edges(result) -> tuple:
-    """(passband frequencies, stopband frequencies, sweep) the proof measures at: the mask's edges,
-    else the design's passband edge(s) and transition end(s)."""
+def mask_edges(result) -> tuple:
+    """The passband and stopband edges a design is judged at: its mask's, else its own passband
+    edge and transition end (a band-pass: a pair of each).
+
+    Parameters
+    ----------
+    result : designer.filters.FilterDesign
+        The design.
+
+    Returns
+    -------
+    tuple
+        (passband edge, stopband edge): Hz, or [low, high] pairs for a band-pass.
+    """
     s, f = result.spec, result.figures
     if s.has_mask:
-        return [s.passband_hz], [s.stopband_hz], f["sweep_hz"]
-    fp, ft = f["passband_edge_hz"], f["transition_end_hz"]
+        return s.passband_hz, s.stopband_hz
+    return f["passband_edge_hz"], f["transition_end_hz"]
+
+
+def _edges(result) -> tuple:
+    """(passband frequencies, stopband frequencies, sweep) the proof measures at (:func:`mask_edges`, as lists)."""
     as_list = lambda v: list(v) if isinstance(v, (list, tuple)) else [v]  # noqa: E731
-    return as_list(fp), as_list(ft), f["sweep_hz"]
+    fp, ft = mask_edges(result)
+    return as_list(fp), as_list(ft), result.figures["sweep_hz"]
 
 
 def bench_signal(result) -> BenchSignal:

@@ -47,8 +47,10 @@ import numpy as np
 
 from ..core.errors import DesignError
 from ..filters.registry import get as get_topology
+from ..filters.verify import mask_edges
 from . import runner, sampling
-from .parts import DISTRIBUTIONS, resolve
+from .montecarlo import check_draw
+from .parts import resolve
 from .stats import Limit, figure_stats, parse_limit, variance_shares, wilson
 
 __all__ = ["LOWHIGH_FIGURES", "BANDPASS_FIGURES", "FilterContext", "FilterMonteCarlo", "YieldOptimum", "figures_of",
@@ -130,13 +132,6 @@ def series_of(result) -> dict:
     return {"R": result.spec.r_series, "C": result.spec.c_series}
 
 
-def _edges(result) -> tuple:
-    s, f = result.spec, result.figures
-    if s.has_mask:
-        return s.passband_hz, s.stopband_hz
-    return f["passband_edge_hz"], f["transition_end_hz"]
-
-
 def context(result, stage_values=None) -> FilterContext:
     """The analytic engine's context of ``result`` (its chosen parts, or ``stage_values``: one
     designator -> value dict per stage, for another candidate set).
@@ -154,7 +149,7 @@ def context(result, stage_values=None) -> FilterContext:
         Frequencies and each stage's op-amp factor.
     """
     kind = result.spec.filter_type
-    fp, fs = _edges(result)
+    fp, fs = mask_edges(result)
     f3 = result.figures["f3_target_hz"]
     groups = {}
     if kind == "bandpass":
@@ -608,17 +603,6 @@ class FilterMonteCarlo:
         return out
 
 
-def _check(n, dist, sampler) -> None:
-    from .montecarlo import MAX_SAMPLES, MIN_SAMPLES
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_SAMPLES <= n <= MAX_SAMPLES:
-        raise DesignError(f"--monte-carlo must be a whole number of builds from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
-                          f"got {n!r}")
-    if dist not in DISTRIBUTIONS:
-        raise DesignError(f"--dist {dist!r} unknown; allowed: {', '.join(DISTRIBUTIONS)}")
-    if sampler not in sampling.SAMPLERS:
-        raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(sampling.SAMPLERS)}")
-
-
 def filter_monte_carlo(result, n: int, seed: int = 0, sampler: str = "random", dist: str = "uniform",
                        tol_items=(), limit_items=(), tighten: bool = True, scale=None, spice_samples: int = 0,
                        simulator: str = "ngspice-cli") -> FilterMonteCarlo:
@@ -649,7 +633,7 @@ def filter_monte_carlo(result, n: int, seed: int = 0, sampler: str = "random", d
     FilterMonteCarlo
         The run.
     """
-    _check(n, dist, sampler)
+    check_draw(n, dist, sampler, "builds")
     limits = mask_limits(result, limit_items)
     nominal = nominal_parts(result)
     tol = resolve(tol_items, nominal, series_of(result))
@@ -812,7 +796,7 @@ def optimize_yield(result, n: int = 2000, seed: int = 0, sampler: str = "random"
     DesignError
         No mask and no limit to count a yield against.
     """
-    _check(n, dist, sampler)
+    check_draw(n, dist, sampler, "builds")
     limits = mask_limits(result, limit_items)
     if not limits:
         raise DesignError("--optimize yield needs a mask (--passband, --max-loss, --stopband, --min-attenuation) or "

@@ -185,13 +185,7 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
         ``--target-ci``: draw in rounds until the yield's 95 % Wilson half-width is below it
         (a fraction), ``n`` samples at most (:func:`target_rounds`); needs limits.
     """
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_SAMPLES <= n <= MAX_SAMPLES:
-        raise DesignError(f"--monte-carlo must be a whole number of samples from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
-                          f"got {n!r}")
-    if dist not in DISTRIBUTIONS:
-        raise DesignError(f"--dist {dist!r} unknown; allowed: {', '.join(DISTRIBUTIONS)}")
-    if sampler not in sampling.SAMPLERS:
-        raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(sampling.SAMPLERS)}")
+    check_draw(n, dist, sampler)
     limits = tuple(t if isinstance(t, Limit) else parse_limit(t, engine.FIGURES) for t in limit_items or ())
     nominal = {**plant_parts(parts), **opamp_nominal(tol_items, opamp)}
     if "SR" in nominal and evaluate is None:
@@ -211,6 +205,18 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
             if engine_name != "analytic":
                 mc.tighten["engine"] = "analytic"
     return mc
+
+
+def check_draw(n, dist: str, sampler: str, what: str = "samples") -> None:
+    """A Monte Carlo's draw settings checked before any work: ``n`` a whole number from
+    :data:`MIN_SAMPLES` to :data:`MAX_SAMPLES`, a known distribution and sampler (one line each)."""
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_SAMPLES <= n <= MAX_SAMPLES:
+        raise DesignError(f"--monte-carlo must be a whole number of {what} from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
+                          f"got {n!r}")
+    if dist not in DISTRIBUTIONS:
+        raise DesignError(f"--dist {dist!r} unknown; allowed: {', '.join(DISTRIBUTIONS)}")
+    if sampler not in sampling.SAMPLERS:
+        raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(sampling.SAMPLERS)}")
 
 
 def _apply(evaluate, values: dict) -> dict:
