@@ -766,9 +766,15 @@ class YieldOptimum:
 
     def lines(self) -> list:
         """The summary's lines."""
-        return [f"Yield-optimal parts ({self.n} builds, seed {self.seed}, the same draws for both): joint choice "
-                f"{100 * self.yield_nominal:.2f} %, optimized {100 * self.yield_optimum:.2f} % "
-                f"(stages changed: {', '.join(map(str, self.changed)) or 'none'}; {self.tried} sets tried)"]
+        from ..core.units import format_eng
+        out = [f"Yield-optimal parts ({self.n} builds, seed {self.seed}, the same draws for both): joint choice "
+               f"{100 * self.yield_nominal:.2f} %, optimized {100 * self.yield_optimum:.2f} % "
+               f"(stages changed: {', '.join(map(str, self.changed)) or 'none'}; {self.tried} sets tried)"]
+        for i in self.changed:
+            parts = self.values[i - 1]
+            out.append(f"  stage {i}: " + ", ".join(
+                f"{r[0]}{i}0{r[1:]} {format_eng(v, 'Ohm' if r.startswith('R') else 'F')}" for r, v in parts.items()))
+        return out
 
 
 def optimize_yield(result, n: int = 2000, seed: int = 0, sampler: str = "random", dist: str = "uniform",
