@@ -173,3 +173,27 @@ def test_spice_engine_on_the_same_builds(lowpass):
     assert sp["max_abs_difference"]["f3_hz"] < 0.01 * 3.3e3
     assert sp["disagree"] == round(abs(sp["yield_spice"] - sp["yield_analytic"]) * 12) or sp["disagree"] >= 0
     assert sp["ci95_spice"] == list(wilson(round(sp["yield_spice"] * 12), 12))
+
+
+@pytest.mark.parametrize("kw", [dict(filter_type="bandpass", order=2, f_low_hz=900.0, f_high_hz=1.1e3, family="bessel",
+                                     opamp="TL072"),
+                                dict(filter_type="bandpass", order=3, f_low_hz=300.0, f_high_hz=3e3,
+                                     family="chebyshev", ripple_db=0.5)], ids=["narrow", "wide"])
+def test_bandpass_figures_are_the_designs(kw):
+    """A band-pass's builds have both -3 dB points; at the nominal parts they are the design's own (its
+    6001-point search), and a --limit on them counts."""
+    d = design(FilterSpec(**kw))
+    mc = filter_monte_carlo(d, 300, seed=2, tighten=False, limit_items=["f3_low_hz=0:1e9", "f3_high_hz=0:1e9"])
+    lo, hi = d.figures["f3_hz"]
+    assert mc.nominal_figures["f3_low_hz"] == pytest.approx(lo, rel=2e-3)
+    assert mc.nominal_figures["f3_high_hz"] == pytest.approx(hi, rel=2e-3)
+    assert set(mc.figures) == {"passband_loss_db", "ripple_db", "f3_low_hz", "f3_high_hz", "stopband_attenuation_db",
+                               "group_delay_s"}
+    # a build counts when both its -3 dB points exist (a narrow band's build whose peak falls 3 dB below the
+    # nominal gain has none: NaN, outside any window); the wide band's always do
+    found = np.isfinite(mc.figures["f3_low_hz"]) & np.isfinite(mc.figures["f3_high_hz"])
+    assert mc.yield_count == int(np.sum(found))
+    if kw["f_high_hz"] / kw["f_low_hz"] >= 2:
+        assert mc.yield_count == 300
+    else:
+        assert np.all(mc.figures["passband_loss_db"][~found] > 3.0)
