@@ -594,10 +594,17 @@ class FilterMonteCarlo:
             out.append(f"  yield {100 * self.yield_count / self.n:.2f} % ({self.yield_count}/{self.n}; 95 % Wilson "
                        f"interval {100 * lo:.2f}..{100 * hi:.2f} %) within "
                        + ", ".join(lim.text() for lim in self.limits))
-        if self.tighten:
-            t = self.tighten
-            out.append(f"  tighten stage {t['stage']} (every part at half its tolerance: yield {100 * t['stage_yield']:.2f}"
-                       f" %); the part: {t['part']} at {t['tolerance_pct']:g} % (yield {100 * t['yield']:.2f} %)")
+        t = self.tighten
+        if t and max(t["yield"], t["stage_yield"]) <= t["yield_now"]:
+            out.append("  no part's (or stage's) tolerance halved raises the yield: the nominal parts themselves "
+                       "sit outside the limits, change them (--optimize yield)")
+        elif t:
+            words = []
+            if t["stage_yield"] > t["yield_now"]:
+                words.append(f"stage {t['stage']} (every part at half its tolerance: yield {100 * t['stage_yield']:.2f} %)")
+            if t["yield"] > t["yield_now"]:
+                words.append(f"the part {t['part']} at {t['tolerance_pct']:g} % (yield {100 * t['yield']:.2f} %)")
+            out.append("  tighten " + "; or ".join(words))
         if self.spice:
             sp = self.spice
             out.append(f"  SPICE on builds 0..{sp['samples'] - 1}: yield {100 * sp['yield_spice']:.2f} % against "
