@@ -250,8 +250,13 @@ ANALYZE_EPILOG = """examples:
   design-filter --order 4 --fc 1k --json --out build/lp      then, the parts as built:
   analyze-filter --from build/lp/result.json --part R101=10.2k --part C202=4.6n
   analyze-filter --from build/lp/result.json --monte-carlo 10000 --limit f3_hz=950:1050 --spice-samples 50
+  analyze-filter --target "--order 4 --fc 1k" --stage sallen-key-lowpass --stage sallen-key-lowpass \
+      --part R101=10k --part R102=20k --part C101=10n --part C102=12n \
+      --part R201=5.1k --part R202=36k --part C201=10n --part C202=47n
 
---part DESIGNATOR=VALUE names a part as the cascade does: stage i's R1 is Ri01 (R101, R201...).
+--part DESIGNATOR=VALUE names a part as the cascade does: stage i's R1 is Ri01 (R101, R201...). Without
+--from, --target takes design-filter's response options (the order and cut-off or the mask, --type, --family,
+--gain, --opamp, the series) and --stage each section's registry name, input first; every part is given.
 """
 
 
@@ -261,8 +266,13 @@ def _analyze_parser():
                        "parts changed with --part): the achieved response against its target and mask, the SPICE "
                        "proof, the tolerance yield against the mask.", ANALYZE_EPILOG)
     g = p.add_argument_group("the filter")
-    g.add_argument("--from", dest="from_json", required=True, metavar="RESULT_JSON",
+    g.add_argument("--from", dest="from_json", metavar="RESULT_JSON",
                    help="a design-filter result.json (its --out folder's): the target, the stages and their parts")
+    g.add_argument("--target", metavar="OPTIONS",
+                   help="without --from: the response as design-filter's options, quoted, e.g. \"--order 4 --fc 1k\" "
+                        "or \"--family chebyshev --passband 3k --max-loss 1 --stopband 12k --min-attenuation 40\"")
+    g.add_argument("--stage", action="append", metavar="SECTION",
+                   help="without --from: each stage's section, input first (repeatable): " + _section_names())
     g.add_argument("--part", action="append", metavar="DESIGNATOR=VALUE",
                    help="a part as built, e.g. R101=10.2k or C202=4.7n (repeatable)")
     g.add_argument("--opamp", metavar="NAME", help=f"another op-amp for every stage: {', '.join(opamp_names())}")
@@ -331,10 +341,74 @@ def _as_built_inputs(data: dict, parts, opamp) -> tuple:
     return spec, int(sp["order"]), float(sp["fc_hz"]), [tuple(s) for s in stages]
 
 
+def _section_names() -> str:
+    from ..filters.registry import names
+    return ", ".join(names())
+
+
+def _target_inputs(args) -> tuple:
+    """(FilterSpec, order, fc, stages) of --target, --stage and --part: each stage matched to the
+    target's section of its kind and order nearest its parts' fn and Q."""
+    import shlex
+
+    from ..core.errors import DesignError
+    from ..core.units import parse_value
+    from ..filters.design import section_plans
+    from ..filters.registry import get as get_topology
+    if not args.target or not args.stage:
+        raise DesignError("give --from RESULT_JSON, or --target \"OPTIONS\" with one --stage per section and every "
+                          "--part")
+    try:
+        targs = _parser().parse_args(shlex.split(args.target))
+    except ValueError as exc:
+        raise DesignError(f"--target {args.target!r}: {exc}") from None
+    if args.opamp:
+        targs.opamp = args.opamp
+    spec = _spec(targs)
+    order, fc, plans = section_plans(spec)
+    topos = [get_topology(name.strip()) for name in args.stage]
+    if len(topos) != len(plans):
+        raise DesignError(f"--stage: the target is {len(plans)} sections (" + ", ".join(
+            f"{p.kind} order {p.order}" for p in plans) + f"), --stage gave {len(topos)}")
+    given = {}
+    for item in args.part or ():
+        ref, _, text = str(item).partition("=")
+        given[ref.strip().upper()] = (item, text.strip())
+    stages, left = [], list(plans)
+    for i, topo in enumerate(topos, 1):
+        same = [p for p in left if p.kind == topo.kind and p.order == topo.order]
+        if not same:
+            raise DesignError(f"--stage {i}: {topo.name} is a {topo.kind} section of order {topo.order}; the target "
+                              "has none left (" + ", ".join(f"{p.kind} order {p.order}" for p in left) + ")")
+        values = {}
+        for r in topo.designators:
+            ref = topo.prefixed(r, f"{i}0")
+            if ref not in given:
+                raise DesignError(f"--part: stage {i} ({topo.name}) needs {ref} (its parts: "
+                                  + ", ".join(topo.prefixed(x, f"{i}0") for x in topo.designators) + ")")
+            item, text = given.pop(ref)
+            values[r] = parse_value(text, f"--part {ref}")
+            if not values[r] > 0:
+                raise DesignError(f"--part {ref} must be above 0, got {text!r}")
+        fig = topo.figures(values)
+        plan = min(same, key=lambda p: abs(math.log(fig.fn_hz / p.fn_hz))
+                   + (abs(math.log(fig.q / p.q)) if p.q else 0.0))
+        left.remove(plan)
+        stages.append((plan, topo.name, float(fig.gain), values))
+    if given:
+        raise DesignError(f"--part {next(iter(given.values()))[0]!r}: no such part in these stages")
+    return spec, order, fc, stages
+
+
 def _analyze(args) -> int:
+    from ..core.errors import DesignError
     from ..filters.design import as_built
-    data = _read_design(args.from_json)
-    spec, order, fc, stages = _as_built_inputs(data, args.part, args.opamp)
+    if args.from_json:
+        if args.target or args.stage:
+            raise DesignError("--target and --stage describe a filter without --from; give one or the other")
+        spec, order, fc, stages = _as_built_inputs(_read_design(args.from_json), args.part, args.opamp)
+    else:
+        spec, order, fc, stages = _target_inputs(args)
     settings = tolerance_settings(args)
     result = as_built(spec, order, fc, stages, simulate=not args.no_sim, simulator=args.simulator)
     return _emit(result, args, run_tolerance(result, args, settings))

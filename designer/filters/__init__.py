@@ -10,7 +10,7 @@ stages, the ngspice proof). Below the wings: it imports ``core`` and ``spice`` o
 from .cascade import Cascade, Stage
 from .deck import ac_deck, simulate_ac
 from .design import (FilterDesign, StageDesign, analysis_grid, as_built, design, predistort, section_name,
-                     stage_candidates, verify_spice)
+                     section_plans, stage_candidates, verify_spice)
 from .verify import (NRMS_PASS, PROOF_POINTS_PER_DECADE, TRAN_POINTS, BenchSignal, Proof, StageDrive, analytic_tran,
                      bench_signal, mask_edges, opamp_aware_polys, proof_deck, prove, stage_drive, stage_polys)
 from .joint import brute_force, descend, joint_search, objective, per_stage
@@ -43,7 +43,7 @@ from .topology import (
     quadratic_root,
 )
 
-__all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "FilterDesign", "StageDesign", "analysis_grid", "as_built", "design", "predistort",
+__all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "FilterDesign", "StageDesign", "analysis_grid", "as_built", "section_plans", "design", "predistort",
            "NRMS_PASS", "PROOF_POINTS_PER_DECADE", "TRAN_POINTS", "BenchSignal", "Proof", "StageDrive", "analytic_tran",
            "bench_signal", "mask_edges", "opamp_aware_polys", "proof_deck", "prove", "stage_drive", "stage_polys",
            "section_name", "stage_candidates", "verify_spice", "brute_force", "descend", "joint_search", "objective",

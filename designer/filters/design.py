@@ -51,7 +51,7 @@ from .spec import FilterSpec
 from .topology import SectionTarget
 from .verify import proof_deck, prove
 
-__all__ = ["StageDesign", "FilterDesign", "design", "as_built", "section_name", "stage_candidates", "verify_spice", "predistort",
+__all__ = ["StageDesign", "FilterDesign", "design", "as_built", "section_plans", "section_name", "stage_candidates", "verify_spice", "predistort",
            "analysis_grid"]
 
 #: the capacitor values (C1, nearest first) each stage offers the joint search
@@ -566,23 +566,14 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         section realises within the bounds, an op-amp too slow, a node that clips.
     """
     opamp = opamps.get(spec.opamp)
-    if spec.has_mask:
-        order, fc = order_from_mask(spec.filter_type, spec.family, spec.passband_hz, spec.max_loss_db,
-                                    spec.stopband_hz, spec.min_attenuation_db, spec.bessel_norm)
-    else:
-        order, fc = spec.order, spec.fc_hz
-    conv = (spec.ripple_db or 1.0, spec.bessel_norm, spec.chebyshev_cutoff)
+    order, fc, plans = section_plans(spec)
     total_gain, strategies = spec.gain, GAIN_STRATEGIES
     if spec.filter_type == "bandpass":
-        fc = math.sqrt(spec.f_low_hz * spec.f_high_hz)
-        plans = plan_bandpass(spec.family, order, spec.f_low_hz, spec.f_high_hz, *conv, spec.bandpass_method)
         if plans[0].kind == "bandpass":
             # band-pass sections peak at their own fn: the product of the section gains that gives spec.gain at
             # the centre; spread evenly first (an MFB band-pass section's gain must stay below 2 Q^2)
             _, at_centre = _node_peaks(plans, [1.0] * len(plans), 1.0, fc, at_hz=fc)
             total_gain, strategies = spec.gain / at_centre[-1], ("even", "lowest-q", "last")
-    else:
-        plans = plan_sections(spec.filter_type, spec.family, order, fc, *conv)
     n = len(plans)
     if spec.stage_order is not None:
         if sorted(spec.stage_order) != list(range(1, n + 1)):
@@ -669,6 +660,38 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         result.proof = prove(result, simulator)
         result.spice = result.proof.to_dict()
     return result
+
+
+def section_plans(spec: FilterSpec) -> tuple:
+    """The order, cut-off (a band-pass: its centre) and sections, in rising Q, that ``spec`` asks for
+    (from its mask when it has one).
+
+    Parameters
+    ----------
+    spec : FilterSpec
+        The specification.
+
+    Returns
+    -------
+    tuple
+        (order, fc in Hz, list of SectionPlan).
+
+    Raises
+    ------
+    DesignError
+        A mask that needs more than order 10 (one line).
+    """
+    if spec.has_mask:
+        order, fc = order_from_mask(spec.filter_type, spec.family, spec.passband_hz, spec.max_loss_db,
+                                    spec.stopband_hz, spec.min_attenuation_db, spec.bessel_norm)
+    else:
+        order, fc = spec.order, spec.fc_hz
+    conv = (spec.ripple_db or 1.0, spec.bessel_norm, spec.chebyshev_cutoff)
+    if spec.filter_type == "bandpass":
+        fc = math.sqrt(spec.f_low_hz * spec.f_high_hz)
+        return order, fc, plan_bandpass(spec.family, order, spec.f_low_hz, spec.f_high_hz, *conv,
+                                        spec.bandpass_method)
+    return order, fc, plan_sections(spec.filter_type, spec.family, order, fc, *conv)
 
 
 def _stage_errors(topo, target: SectionTarget, cands: list, s_obj, opamp) -> np.ndarray:

@@ -180,3 +180,49 @@ def test_analyze_filter_proof_and_spice_engine(designed, capsys):
     assert a["spice"]["nrms"]["ac_opamp"] < 1 and a["spice"]["nrms"]["tran_opamp"] < 1
     assert a["spice"]["mask"]["met"] is True
     assert a["monte_carlo"]["spice"]["samples"] == 5
+
+
+def _stage_args(d: dict) -> list:
+    """--stage and --part options of a design-filter result's stages (stage i's R1 is Ri01)."""
+    argv = []
+    for i, st in enumerate(d["stages"], 1):
+        argv += ["--stage", st["topology"]]
+        argv += [f"--part={r[0]}{i}0{r[1:]}={v!r}" for r, v in st["parts"].items()]
+    return argv
+
+
+def test_analyze_filter_per_stage_is_the_result_json(designed, capsys):
+    """The same parts typed per stage (--target, --stage, --part) give what --from gives."""
+    capsys.readouterr()
+    d = json.loads(designed.read_text())
+    target = "--family chebyshev --passband 3k --max-loss 1 --stopband 12k --min-attenuation 40"
+    assert analyze_filter_main(["--target", target, *_stage_args(d), "--no-sim", "--json"]) == 0
+    a = json.loads(capsys.readouterr().out)
+    assert analyze_filter_main(["--from", str(designed), "--no-sim", "--json"]) == 0
+    b = json.loads(capsys.readouterr().out)
+    assert [s["parts"] for s in a["stages"]] == [s["parts"] for s in b["stages"]]
+    assert [s["q"] for s in a["stages"]] == [s["q"] for s in b["stages"]]
+    for k in ("f3_hz", "passband_deviation_db", "mask_passband_margin_db", "mask_stopband_margin_db"):
+        assert a["figures"][k] == pytest.approx(b["figures"][k], rel=1e-9), k
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--stage", "sallen-key-lowpass"], "give --from RESULT_JSON, or --target"),
+    (["--target", "--order 4 --fc 1k", "--stage", "sallen-key-lowpass"], "the target is 2 sections"),
+    (["--target", "--order 2 --fc 1k", "--stage", "sallen-key-lowpass", "--part", "R101=1k"],
+     "stage 1 (sallen-key-lowpass) needs R102"),
+    (["--target", "--order 2 --fc 1k", "--stage", "mfb-highpass"], "the target has none left"),
+    (["--target", "--order 2 --fc 1k", "--stage", "tow-thomas"], "tow-thomas"),
+    (["--target", "--order 2 --bogus", "--stage", "sallen-key-lowpass"], "unrecognized arguments: --bogus"),
+    (["--target", "--order 2 --fc 1k", "--stage", "rc-lowpass", "--stage", "rc-lowpass"], "the target is 1 sections"),
+])
+def test_analyze_filter_per_stage_bad_input(argv, words, capsys):
+    assert analyze_filter_main(argv + ["--no-sim"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("analyze-filter: error: "), err
+    assert words in err, err
+
+
+def test_analyze_filter_from_and_target_exclude_each_other(designed, capsys):
+    assert analyze_filter_main(["--from", str(designed), "--target", "--order 2 --fc 1k", "--no-sim"]) == 2
+    assert "give one or the other" in capsys.readouterr().err
