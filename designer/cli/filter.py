@@ -302,7 +302,6 @@ def _read_design(path: str) -> dict:
 def _as_built_inputs(data: dict, parts, opamp) -> tuple:
     """(FilterSpec, order, fc, stages) of a design-filter result.json with --part changes."""
     from ..core.errors import DesignError
-    from ..core.units import parse_value
     from ..filters.prototype import SectionPlan
     from ..filters.registry import get as get_topology
     from ..filters.spec import FilterSpec
@@ -334,11 +333,18 @@ def _as_built_inputs(data: dict, parts, opamp) -> tuple:
             raise DesignError(f"--part {item!r}: give DESIGNATOR=VALUE with one of this filter's parts: "
                               f"{', '.join(refs)}")
         k, r = refs[ref]
-        value = parse_value(text.strip(), f"--part {ref}")
-        if not value > 0:
-            raise DesignError(f"--part {ref} must be above 0, got {text.strip()!r}")
-        stages[k][3][r] = value
+        stages[k][3][r] = _part_value(ref, text)
     return spec, int(sp["order"]), float(sp["fc_hz"]), [tuple(s) for s in stages]
+
+
+def _part_value(ref: str, text: str) -> float:
+    """--part REF=TEXT's value: engineering notation, above 0 (one line otherwise)."""
+    from ..core.errors import DesignError
+    from ..core.units import parse_value
+    value = parse_value(text.strip(), f"--part {ref}")
+    if not value > 0:
+        raise DesignError(f"--part {ref} must be above 0, got {text.strip()!r}")
+    return value
 
 
 def _section_names() -> str:
@@ -352,7 +358,6 @@ def _target_inputs(args) -> tuple:
     import shlex
 
     from ..core.errors import DesignError
-    from ..core.units import parse_value
     from ..filters.design import section_plans
     from ..filters.registry import get as get_topology
     if not args.target or not args.stage:
@@ -386,10 +391,7 @@ def _target_inputs(args) -> tuple:
             if ref not in given:
                 raise DesignError(f"--part: stage {i} ({topo.name}) needs {ref} (its parts: "
                                   + ", ".join(topo.prefixed(x, f"{i}0") for x in topo.designators) + ")")
-            item, text = given.pop(ref)
-            values[r] = parse_value(text, f"--part {ref}")
-            if not values[r] > 0:
-                raise DesignError(f"--part {ref} must be above 0, got {text!r}")
+            values[r] = _part_value(ref, given.pop(ref)[1])
         fig = topo.figures(values)
         plan = min(same, key=lambda p: abs(math.log(fig.fn_hz / p.fn_hz))
                    + (abs(math.log(fig.q / p.q)) if p.q else 0.0))
