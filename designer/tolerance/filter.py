@@ -665,7 +665,11 @@ def filter_monte_carlo(result, n: int, seed: int = 0, sampler: str = "random", d
         k = min(int(spice_samples), n)
         sctx = spice_context(result, simulator)
         picked = runner.Picked(nominal, tol.of, k, seed, sampler, dist, picked={r: v[:k] for r, v in values.items()})
-        with runner.Runner(scale or runner.Scale()) as run:
+        # the SPICE builds in the longer chunks of a SPICE engine (each chunk starts ngspice once)
+        import dataclasses
+        spice_scale = dataclasses.replace(scale or runner.Scale(), work="ngspice-cli" if sctx.simulator == "ngspice-cli"
+                                          else "spice")
+        with runner.Runner(spice_scale) as run:
             _, sfigs, _ = run.run(_spice_chunk, sctx, picked)
         mc.spice = _disagreement(sfigs, {f: v[:k] for f, v in figs.items()}, limits, k)
     return mc
