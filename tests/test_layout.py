@@ -22,7 +22,7 @@ ALLOWED = {
     "plant": {"core", "spice", "report"},
     "pid": {"core", "spice", "report", "plant"},
     "identify": {"core", "spice", "report"},
-    "tolerance": {"core", "spice", "report", "plant", "pid"},
+    "tolerance": {"core", "spice", "report", "plant", "pid", "filters"},
     "check": {"core", "spice", "report", "plant", "pid", "identify", "tolerance", "filters"},
     "cli": {"core", "spice", "report", "plant", "pid", "identify", "check", "tolerance", "filters"},
     # the web page: a front end beside cli, whose parsers and checks it shares

@@ -70,7 +70,7 @@ def test_installed_commands_work_from_any_folder(installed, tmp_path):
     assert d["comparison"]["pass"] is True and d["spice"]["overshoot_pct"] > 50
     assert "OPAMP_BEH" in (tmp_path / "netlists" / "plant_fc3500_z0.2.cir").read_text()   # the model inlined
     for cmd in ("analyze-plant", "design-pid", "analyze-pid", "check-design", "identify", "identify-freq",
-                "simulate-capture", "make-prbs", "designer-web", "design-filter"):
+                "simulate-capture", "make-prbs", "designer-web", "design-filter", "analyze-filter"):
         assert subprocess.run([str(venv / "bin" / cmd), "--help"], capture_output=True, cwd=tmp_path,
                               env=env).returncode == 0, cmd
 

@@ -10,14 +10,16 @@ from __future__ import annotations
 import json
 import math
 import sys
+from pathlib import Path
 
 from ..core.eseries import SERIES
 from ..core.opamps import names as opamp_names
 from ..core.ranges import help_range
 from ..core.units import format_eng
 from .common import command_parser, print_output, run_cli
+from .filter_tolerance import add_filter_tolerance, run_tolerance, tolerance_json, tolerance_lines, tolerance_settings
 
-__all__ = ["design_filter_main", "summary_text"]
+__all__ = ["design_filter_main", "analyze_filter_main", "summary_text"]
 
 EPILOG = """examples:
   design-filter --family butterworth --order 4 --fc 1k
@@ -85,6 +87,7 @@ def _parser():
     k.add_argument("--r-max", default="1M", help=f"largest resistor (default 1M) {help_range('resistor_ohm')}")
     k.add_argument("--c-min", default="1n", help=f"smallest capacitor (default 1n) {help_range('capacitor_f')}")
     k.add_argument("--c-max", default="10u", help=f"largest capacitor (default 10u) {help_range('capacitor_f')}")
+    add_filter_tolerance(p, optimize=True)
     o = p.add_argument_group("output")
     o.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     o.add_argument("--out", metavar="DIR", help="write DIR/filter.cir (the ngspice .ac deck of the cascade), "
@@ -189,26 +192,30 @@ def summary_text(result) -> str:
         lines.append(f"SPICE (.ac, {sp['simulator']}) against the analytic response of these parts: max deviation "
                      f"{sp['max_deviation_passband_db']:.2g} dB in the passband, {sp['max_deviation_60db_db']:.2g} "
                      "dB down to -60 dB")
+    lines += _proof_lines(result)
     return "\n".join(lines) + "\n"
 
 
 def _check_sheet_args(args) -> None:
     """Before the work: --name a plain name, its report folder no link or file."""
-    if args.name is not None:
+    if getattr(args, "name", None) is not None:
         from .common import check_name
         check_name(args.name)
 
 
-def _write(result, folder, name=None):
-    return _write_sheet(result, folder, name)
+def _proof_lines(result) -> list:
+    """The SPICE proof's lines (NRMS against both models, the mask on SPICE's .ac, slew and swing per stage)."""
+    return result.proof.lines() if getattr(result, "proof", None) is not None else []
 
 
-def _write_sheet(result, folder, name):
+def _write_sheet(result, folder, name, extra=None):
     """The build sheet: into ``folder`` (filter.cir, result.json and the sheet's files), or with ``name``
-    the bundle under ``folder`` (default .): reports/NAME/ and netlists/NAME.cir. Returns the
-    :class:`~designer.filters.report.FilterSheet` written (its ``files`` set)."""
+    the bundle under ``folder`` (default .): reports/NAME/ and netlists/NAME.cir; ``extra`` (the tolerance
+    analyses' JSON) joins result.json. Returns the :class:`~designer.filters.report.FilterSheet` written (its
+    ``files`` set)."""
     from ..filters.report import sheet_of, write_folder, write_outputs
     data = sheet_of(result)
+    data.extra = dict(extra or {})
     if name is None:
         write_folder(data, folder)
     else:
@@ -221,15 +228,23 @@ def _design(args) -> int:
     from ..filters.design import design
     spec = _spec(args)
     _check_sheet_args(args)
+    settings = tolerance_settings(args)
     result = design(spec, simulate=not args.no_sim, simulator=args.simulator)
-    sheet = _write(result, args.out, args.name) if args.out or args.name else None
+    return _emit(result, args, run_tolerance(result, args, settings))
+
+
+def _emit(result, args, extras: dict) -> int:
+    """The result (and its tolerance analyses) printed, and written with --out (or --name)."""
+    extra = tolerance_json(extras)
+    name = getattr(args, "name", None)
+    sheet = _write_sheet(result, args.out, name, extra) if args.out or name else None
     files = sheet.files if sheet is not None else {}
     if args.json:
         # what result.json holds when written (the bench test too)
-        print_output(json.dumps(sheet.to_dict() if sheet is not None else {**result.to_dict(), "files": files},
+        print_output(json.dumps(sheet.to_dict() if sheet is not None else {**result.to_dict(), **extra, "files": {}},
                                 indent=2))
     else:
-        text = summary_text(result)
+        text = summary_text(result) + "".join(line + "\n" for line in tolerance_lines(extras))
         if files:
             text += "Files:\n" + "".join(f"  {k}: {', '.join(v) if isinstance(v, list) else v}\n"
                                           for k, v in files.items())
@@ -251,6 +266,192 @@ def design_filter_main(argv=None) -> int:
         The exit status (0 done, 2 bad input, 3 simulator error).
     """
     return run_cli("design-filter", _parser, _design, argv)
+
+
+ANALYZE_EPILOG = """examples:
+  design-filter --order 4 --fc 1k --json --out build/lp      then, the parts as built:
+  analyze-filter --from build/lp/result.json --part R101=10.2k --part C202=4.6n
+  analyze-filter --from build/lp/result.json --monte-carlo 10000 --limit f3_hz=950:1050 --spice-samples 50
+  analyze-filter --target "--order 4 --fc 1k" --stage sallen-key-lowpass --stage sallen-key-lowpass \
+      --part R101=10k --part R102=20k --part C101=10n --part C102=12n \
+      --part R201=5.1k --part R202=36k --part C201=10n --part C202=47n
+
+--part DESIGNATOR=VALUE names a part as the cascade does: stage i's R1 is Ri01 (R101, R201...). Without
+--from, --target takes design-filter's response options (the order and cut-off or the mask, --type, --family,
+--gain, --opamp, the series) and --stage each section's registry name, input first; every part is given.
+"""
+
+
+def _analyze_parser():
+    from ..core.opamps import names as opamp_names
+    p = command_parser("analyze-filter", "Analyze an active filter's parts as built (a design-filter result.json, "
+                       "parts changed with --part): the achieved response against its target and mask, the SPICE "
+                       "proof, the tolerance yield against the mask.", ANALYZE_EPILOG)
+    g = p.add_argument_group("the filter")
+    g.add_argument("--from", dest="from_json", metavar="RESULT_JSON",
+                   help="a design-filter result.json (its --out folder's): the target, the stages and their parts")
+    g.add_argument("--target", metavar="OPTIONS",
+                   help="without --from: the response as design-filter's options, quoted, e.g. \"--order 4 --fc 1k\" "
+                        "or \"--family chebyshev --passband 3k --max-loss 1 --stopband 12k --min-attenuation 40\"")
+    g.add_argument("--stage", action="append", metavar="SECTION",
+                   help="without --from: each stage's section, input first (repeatable): " + _section_names())
+    g.add_argument("--part", action="append", metavar="DESIGNATOR=VALUE",
+                   help="a part as built, e.g. R101=10.2k or C202=4.7n (repeatable)")
+    g.add_argument("--opamp", metavar="NAME", help=f"another op-amp for every stage: {', '.join(opamp_names())}")
+    add_filter_tolerance(p)
+    o = p.add_argument_group("output")
+    o.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    o.add_argument("--out", metavar="DIR", help="write DIR/filter.cir (the proof deck) and DIR/result.json")
+    o.add_argument("--no-sim", action="store_true", help="skip the ngspice proof")
+    o.add_argument("--simulator", default="ngspice-cli", choices=("ngspice-cli", "pyspice"),
+                   help="ngspice-cli: `ngspice -b` (default); pyspice: the shared library")
+    return p
+
+
+def _read_design(path: str) -> dict:
+    from ..core.errors import DesignError
+    try:
+        data = json.loads(Path(path).read_text())
+    except OSError as exc:
+        raise DesignError(f"--from {path!r}: cannot read it ({exc.strerror or exc})") from None
+    except ValueError:
+        raise DesignError(f"--from {path!r}: not JSON; give a design-filter result.json") from None
+    if not isinstance(data, dict) or data.get("tool") != "design-filter" or "stages" not in data:
+        raise DesignError(f"--from {path!r}: not a design-filter result.json (no tool design-filter and stages)")
+    return data
+
+
+def _as_built_inputs(data: dict, parts, opamp) -> tuple:
+    """(FilterSpec, order, fc, stages) of a design-filter result.json with --part changes."""
+    from ..core.errors import DesignError
+    from ..filters.prototype import SectionPlan
+    from ..filters.registry import get as get_topology
+    from ..filters.spec import FilterSpec
+    sp, mask = data["spec"], data["spec"].get("mask")
+    kw = {k: sp[k] for k in ("filter_type", "family", "bessel_norm", "chebyshev_cutoff", "gain", "r_series",
+                              "c_series", "amplitude_v", "gbw_margin") if sp.get(k) is not None}
+    if sp.get("ripple_db") is not None and sp["family"] == "chebyshev" and not mask:
+        kw["ripple_db"] = sp["ripple_db"]
+    if sp["filter_type"] == "bandpass":
+        kw.update(order=sp["order"], f_low_hz=sp["f_low_hz"], f_high_hz=sp["f_high_hz"],
+                  bandpass_method=sp["bandpass_method"])
+    elif mask:
+        kw.update(mask)
+    else:
+        kw.update(order=sp["order"], fc_hz=sp["fc_hz"])
+    kw["opamp"] = opamp or data["opamp"]["name"]
+    spec = FilterSpec(**kw)
+    stages, refs = [], {}
+    for i, st in enumerate(data["stages"], 1):
+        topo = get_topology(st["topology"])
+        values = dict(st["parts"])
+        for r in values:
+            refs[topo.prefixed(r, f"{i}0")] = (len(stages), r)
+        stages.append([SectionPlan(st["kind"], st["order"], st["fn_hz"], st["q"]), st["topology"], st["gain"], values])
+    for item in parts or ():
+        ref, _, text = str(item).partition("=")
+        ref = ref.strip().upper()
+        if not text or ref not in refs:
+            raise DesignError(f"--part {item!r}: give DESIGNATOR=VALUE with one of this filter's parts: "
+                              f"{', '.join(refs)}")
+        k, r = refs[ref]
+        stages[k][3][r] = _part_value(ref, text)
+    return spec, int(sp["order"]), float(sp["fc_hz"]), [tuple(s) for s in stages]
+
+
+def _part_value(ref: str, text: str) -> float:
+    """--part REF=TEXT's value: engineering notation, above 0 (one line otherwise)."""
+    from ..core.errors import DesignError
+    from ..core.units import parse_value
+    value = parse_value(text.strip(), f"--part {ref}")
+    if not value > 0:
+        raise DesignError(f"--part {ref} must be above 0, got {text.strip()!r}")
+    return value
+
+
+def _section_names() -> str:
+    from ..filters.registry import names
+    return ", ".join(names())
+
+
+def _target_inputs(args) -> tuple:
+    """(FilterSpec, order, fc, stages) of --target, --stage and --part: each stage matched to the
+    target's section of its kind and order nearest its parts' fn and Q."""
+    import shlex
+
+    from ..core.errors import DesignError
+    from ..filters.design import section_plans
+    from ..filters.registry import get as get_topology
+    if not args.target or not args.stage:
+        raise DesignError("give --from RESULT_JSON, or --target \"OPTIONS\" with one --stage per section and every "
+                          "--part")
+    try:
+        targs = _parser().parse_args(shlex.split(args.target))
+    except ValueError as exc:
+        raise DesignError(f"--target {args.target!r}: {exc}") from None
+    if args.opamp:
+        targs.opamp = args.opamp
+    spec = _spec(targs)
+    order, fc, plans = section_plans(spec)
+    topos = [get_topology(name.strip()) for name in args.stage]
+    if len(topos) != len(plans):
+        raise DesignError(f"--stage: the target is {len(plans)} sections (" + ", ".join(
+            f"{p.kind} order {p.order}" for p in plans) + f"), --stage gave {len(topos)}")
+    given = {}
+    for item in args.part or ():
+        ref, _, text = str(item).partition("=")
+        given[ref.strip().upper()] = (item, text.strip())
+    stages, left = [], list(plans)
+    for i, topo in enumerate(topos, 1):
+        same = [p for p in left if p.kind == topo.kind and p.order == topo.order]
+        if not same:
+            raise DesignError(f"--stage {i}: {topo.name} is a {topo.kind} section of order {topo.order}; the target "
+                              "has none left (" + ", ".join(f"{p.kind} order {p.order}" for p in left) + ")")
+        values = {}
+        for r in topo.designators:
+            ref = topo.prefixed(r, f"{i}0")
+            if ref not in given:
+                raise DesignError(f"--part: stage {i} ({topo.name}) needs {ref} (its parts: "
+                                  + ", ".join(topo.prefixed(x, f"{i}0") for x in topo.designators) + ")")
+            values[r] = _part_value(ref, given.pop(ref)[1])
+        fig = topo.figures(values)
+        plan = min(same, key=lambda p: abs(math.log(fig.fn_hz / p.fn_hz))
+                   + (abs(math.log(fig.q / p.q)) if p.q else 0.0))
+        left.remove(plan)
+        stages.append((plan, topo.name, float(fig.gain), values))
+    if given:
+        raise DesignError(f"--part {next(iter(given.values()))[0]!r}: no such part in these stages")
+    return spec, order, fc, stages
+
+
+def _analyze(args) -> int:
+    from ..core.errors import DesignError
+    from ..filters.design import as_built
+    if args.from_json:
+        if args.target or args.stage:
+            raise DesignError("--target and --stage describe a filter without --from; give one or the other")
+        spec, order, fc, stages = _as_built_inputs(_read_design(args.from_json), args.part, args.opamp)
+    else:
+        spec, order, fc, stages = _target_inputs(args)
+    settings = tolerance_settings(args)
+    result = as_built(spec, order, fc, stages, simulate=not args.no_sim, simulator=args.simulator)
+    return _emit(result, args, run_tolerance(result, args, settings))
+
+
+def analyze_filter_main(argv=None) -> int:
+    """``analyze-filter``'s entry point.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit status (0 done, 2 bad input, 3 simulator error).
+    """
+    return run_cli("analyze-filter", _analyze_parser, _analyze, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -90,5 +90,9 @@ def design_filter() -> int:
     return _run("design-filter", "designer.cli.filter", "design_filter_main")
 
 
+def analyze_filter() -> int:
+    return _run("analyze-filter", "designer.cli.filter", "analyze_filter_main")
+
+
 def make_prbs() -> int:
     return _run("make-prbs", "designer.cli.prbs", "make_prbs_main")

@@ -7,47 +7,40 @@ sections; filters from a specification (:func:`design`: scipy's prototypes,
 the gain split, the op-amp check, E-series parts chosen jointly across the
 stages, the ngspice proof). Below the wings: it imports ``core`` and ``spice`` only."""
 
-from .cascade import Cascade, Stage
-from .deck import ac_deck, simulate_ac
-from .design import (FilterDesign, StageDesign, analysis_grid, design, predistort, section_name, stage_candidates,
-                     verify_spice)
-from .joint import brute_force, descend, joint_search, objective, per_stage
-from .prototype import (BANDPASS_METHODS, BESSEL_NORMS, CHEBYSHEV_CUTOFFS, FAMILIES, MAX_ORDER, RESPONSE_TYPES,
-                        WIDE_RATIO, SectionPlan, bandpass_method, chebyshev_3db_factor, order_from_mask,
-                        plan_bandpass, plan_sections, prototype_zpk, reference_ba, reference_bandpass,
-                        reference_response)
-from .inverting_lowpass import InvertingLowPass
-from .mfb_bandpass import MfbBandPass
-from .mfb_highpass import MfbHighPass
-from .mfb_lowpass import MfbLowPass
-from .rc_highpass import RcHighPass
-from .rc_lowpass import RcLowPass
-from .registry import REGISTRY, get, names, register
-from .sallen_key import GAIN_PARTS, SallenKeySection
-from .sallen_key_highpass import SallenKeyHighPass
-from .sallen_key_lowpass import SallenKeyLowPass, sallen_key_ratio_min
-from .spec import TOPOLOGY_CHOICES, FilterSpec
-from .topology import (
-    DEFAULT_IMPEDANCE_OHM,
-    KINDS,
-    Figures,
-    PartSpec,
-    SectionTarget,
-    Topology,
-    nodal_response,
-    open_loop_gain,
-    polynomial,
-    polyval,
-    quadratic_root,
-)
+from ..core.exports import lazy_exports
 
-__all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "FilterDesign", "StageDesign", "analysis_grid", "design", "predistort",
-           "section_name", "stage_candidates", "verify_spice", "brute_force", "descend", "joint_search", "objective",
-           "per_stage", "BANDPASS_METHODS", "WIDE_RATIO", "bandpass_method", "plan_bandpass", "reference_bandpass",
-           "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER", "RESPONSE_TYPES", "SectionPlan",
-           "chebyshev_3db_factor", "order_from_mask", "plan_sections", "prototype_zpk", "reference_ba",
-           "reference_response", "TOPOLOGY_CHOICES", "FilterSpec", "InvertingLowPass", "MfbBandPass", "MfbHighPass",
-           "MfbLowPass", "RcHighPass", "RcLowPass", "REGISTRY", "get", "names", "register", "GAIN_PARTS",
-           "SallenKeySection", "SallenKeyHighPass", "SallenKeyLowPass", "sallen_key_ratio_min",
-           "DEFAULT_IMPEDANCE_OHM", "KINDS", "Figures", "PartSpec", "SectionTarget", "Topology", "nodal_response",
-           "open_loop_gain", "polynomial", "polyval", "quadratic_root"]
+#: module -> the names of its ``__all__`` re-exported here, each module imported on first use (a command
+#: pays only for what it runs); a name several modules share, or a module's own name, is reached through
+#: its module (designer.core.exports)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "bench": ("BUILDS", "C_TOL_PCT", "FilterBench", "R_TOL_PCT", "SEED", "StageCheck", "SweepPoint", "TableCompare",
+              "TimeTest", "bench_of", "nice_down", "nice_up", "passband_gain",),
+    "cascade": ("Cascade", "Stage",),
+    "deck": ("ac_deck", "simulate_ac",),
+    "design": ("FilterDesign", "StageDesign", "analysis_grid", "as_built", "predistort", "section_name",
+               "section_plans", "stage_candidates", "verify_spice",),
+    "inverting_lowpass": ("InvertingLowPass",),
+    "joint": ("brute_force", "descend", "joint_search", "objective", "per_stage",),
+    "mfb_bandpass": ("MfbBandPass",),
+    "mfb_highpass": ("MfbHighPass",),
+    "mfb_lowpass": ("MfbLowPass",),
+    "prototype": ("BANDPASS_METHODS", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER",
+                  "RESPONSE_TYPES", "SectionPlan", "WIDE_RATIO", "bandpass_method", "chebyshev_3db_factor",
+                  "order_from_mask", "plan_bandpass", "plan_sections", "prototype_zpk", "reference_ba",
+                  "reference_bandpass", "reference_response",),
+    "rc_highpass": ("RcHighPass",),
+    "rc_lowpass": ("RcLowPass",),
+    "registry": ("REGISTRY", "get", "names", "register",),
+    "report": ("FilterSheet", "SHEET_FILES", "bom", "build_board", "draw_cascade", "net_label", "plots",
+               "schematic", "sections", "sheet_of", "title_of", "write_folder", "write_outputs",),
+    "sallen_key": ("GAIN_PARTS", "SallenKeySection",),
+    "sallen_key_highpass": ("SallenKeyHighPass",),
+    "sallen_key_lowpass": ("SallenKeyLowPass", "sallen_key_ratio_min",),
+    "spec": ("FilterSpec", "TOPOLOGY_CHOICES",),
+    "tables": ("TableRow", "coefficient_table", "section_3db_ratio", "table_corner",),
+    "topology": ("DEFAULT_IMPEDANCE_OHM", "Figures", "KINDS", "PartSpec", "SectionTarget", "Topology",
+                 "nodal_response", "open_loop_gain", "polynomial", "polyval", "quadratic_root",),
+    "verify": ("BenchSignal", "NRMS_PASS", "PROOF_POINTS_PER_DECADE", "Proof", "StageDrive", "TRAN_POINTS",
+               "analytic_tran", "bench_signal", "mask_edges", "opamp_aware_polys", "proof_deck", "prove",
+               "stage_drive", "stage_polys",),
+})

@@ -42,15 +42,16 @@ from ..core.jsonio import SCHEMA_VERSION, json_safe
 from ..core.eseries import values as series_values
 from ..core.units import format_eng
 from .cascade import Cascade
-from .deck import ac_deck, simulate_ac
+from .deck import simulate_ac
 from .joint import joint_search, objective, per_stage
 from .prototype import (SectionPlan, bandpass_method, order_from_mask, plan_bandpass, plan_sections,
                         reference_bandpass, reference_response)
 from .registry import get as get_topology
 from .spec import FilterSpec
 from .topology import SectionTarget
+from .verify import proof_deck, prove
 
-__all__ = ["StageDesign", "FilterDesign", "design", "section_name", "stage_candidates", "verify_spice", "predistort",
+__all__ = ["StageDesign", "FilterDesign", "design", "as_built", "section_plans", "section_name", "stage_candidates", "verify_spice", "predistort",
            "analysis_grid"]
 
 #: the capacitor values (C1, nearest first) each stage offers the joint search
@@ -150,7 +151,9 @@ class FilterDesign:
     figures : dict
         Achieved figures against the target (see :func:`design`).
     spice : dict or None
-        :func:`verify_spice`'s figures when run.
+        The SPICE proof's figures when run (:meth:`designer.filters.verify.Proof.to_dict`).
+    proof : designer.filters.verify.Proof or None
+        The SPICE proof itself (:func:`designer.filters.verify.prove`).
     """
 
     spec: FilterSpec
@@ -159,6 +162,7 @@ class FilterDesign:
     stages: list
     figures: dict = field(default_factory=dict)
     spice: dict | None = None
+    proof: object = None
 
     @property
     def opamp(self):
@@ -182,32 +186,16 @@ class FilterDesign:
                         for st in self.stages])
 
     def deck(self) -> str:
-        """The ngspice ``.ac`` deck of the chosen cascade, standalone: ``ngspice -b`` prints its
-        ``.meas`` of the passband gain and the -3 dB frequency (dB relative to 1 V in).
+        """The standalone ngspice proof deck of the chosen cascade (:func:`designer.filters.verify.proof_deck`):
+        ``ngspice -b`` runs its ``.ac`` and bench ``.tran`` and prints their measurements (the passband
+        gain ``passband_db`` and the -3 dB frequency ``f3db_hz``, dB relative to 1 V in, among them).
 
         Returns
         -------
         str
             The deck's text.
         """
-        lo, hi = self.figures["sweep_hz"]
-        text = ac_deck(self.cascade().netlist(), self.opamp, lo, hi,
-                       title=f"{self.spec.family} {self.spec.filter_type} order {self.order}")
-        kind = self.spec.filter_type
-        a, b = self.figures["passband_range_hz"]
-        at = {"lowpass": a, "highpass": b, "bandpass": self.fc_hz}[kind]
-        level = 20 * math.log10(self.spec.gain) - 10 * math.log10(2)
-        crossings = {"lowpass": [("f3db_hz", "last")], "highpass": [("f3db_hz", "1")],
-                     "bandpass": [("f3db_low_hz", "1"), ("f3db_high_hz", "last")]}[kind]
-        lines = text.rstrip().splitlines()
-        ac = next(i for i, line in enumerate(lines) if line.startswith(".ac "))
-        # the sweep and its measurements in a .control block: ngspice's batch-mode .meas cannot parse vdb()
-        # (no vector is saved for it), and `quit 0` ends a batch run without dot analyses with status 0
-        # the last crossing for a low-pass, the first for a high-pass: a Chebyshev's ripple stays above it
-        control = [".control", lines[ac][1:], f"meas ac passband_db find vdb(vout) at={at:.6g}",
-                   *(f"meas ac {name} when vdb(vout)={level:.6g} cross={cross}" for name, cross in crossings),
-                   "quit 0", ".endc"]
-        return "\n".join(lines[:ac] + lines[ac + 1:-1] + control + [".end"]) + "\n"
+        return proof_deck(self)
 
     def to_dict(self) -> dict:
         """Everything as JSON-ready data.
@@ -556,7 +544,8 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
     spec : FilterSpec
         The specification.
     simulate : bool
-        Also run :func:`verify_spice` (ngspice ``.ac`` of the chosen cascade).
+        Also run the SPICE proof (:func:`designer.filters.verify.prove`: ngspice ``.ac`` and ``.tran``
+        of the chosen cascade against the analytic one).
     simulator : str
         ``ngspice-cli`` or ``pyspice``.
 
@@ -577,23 +566,14 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         section realises within the bounds, an op-amp too slow, a node that clips.
     """
     opamp = opamps.get(spec.opamp)
-    if spec.has_mask:
-        order, fc = order_from_mask(spec.filter_type, spec.family, spec.passband_hz, spec.max_loss_db,
-                                    spec.stopband_hz, spec.min_attenuation_db, spec.bessel_norm)
-    else:
-        order, fc = spec.order, spec.fc_hz
-    conv = (spec.ripple_db or 1.0, spec.bessel_norm, spec.chebyshev_cutoff)
+    order, fc, plans = section_plans(spec)
     total_gain, strategies = spec.gain, GAIN_STRATEGIES
     if spec.filter_type == "bandpass":
-        fc = math.sqrt(spec.f_low_hz * spec.f_high_hz)
-        plans = plan_bandpass(spec.family, order, spec.f_low_hz, spec.f_high_hz, *conv, spec.bandpass_method)
         if plans[0].kind == "bandpass":
             # band-pass sections peak at their own fn: the product of the section gains that gives spec.gain at
             # the centre; spread evenly first (an MFB band-pass section's gain must stay below 2 Q^2)
             _, at_centre = _node_peaks(plans, [1.0] * len(plans), 1.0, fc, at_hz=fc)
             total_gain, strategies = spec.gain / at_centre[-1], ("even", "lowest-q", "last")
-    else:
-        plans = plan_sections(spec.filter_type, spec.family, order, fc, *conv)
     n = len(plans)
     if spec.stage_order is not None:
         if sorted(spec.stage_order) != list(range(1, n + 1)):
@@ -628,6 +608,12 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         grid["objective"] = np.append(grid["objective"], [spec.passband_hz, spec.stopband_hz])
         n = grid["objective"].size
         limits = [(n - 2, -1.0, -margin_pass), (n - 1, 1.0, -margin_stop)]
+        # the loss is limited over the whole passband, not at its edge only (a Chebyshev's ripple troughs
+        # inside it sit at the ideal's full ripple: the parts may not deepen them past --max-loss)
+        f_obj = grid["objective"][:n - 2]
+        inside = f_obj <= spec.passband_hz if spec.filter_type == "lowpass" else f_obj >= spec.passband_hz
+        ideal_in = 20 * np.log10(np.abs(_reference(spec, order, fc, f_obj[inside]) / spec.gain))
+        limits += [(int(c), -1.0, -(spec.max_loss_db + d)) for c, d in zip(np.flatnonzero(inside), ideal_in)]
     f_obj = grid["objective"]
     s_obj = 2j * math.pi * f_obj
     stages = []
@@ -650,10 +636,8 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
                 if k == len(tries) - 1:
                     raise
         # the stage's ideal: the asked target's (a pre-distorted design aims its op-amp-aware response at it)
-        ideal_db = 20 * np.log10(np.abs(topo.response(topo.synthesize(target), s_obj)))
-        arrays = {r: np.array([c[r] for c in cands])[:, None] for r in topo.designators}
-        cand_db = 20 * np.log10(np.abs(topo.response(arrays, s_obj[None, :], opamp)))
-        stages.append(StageDesign(i, p, name, g, continuous, cands, cand_db - ideal_db[None, :], nearest,
+        stages.append(StageDesign(i, p, name, g, continuous, cands, _stage_errors(topo, target, cands, s_obj, opamp),
+                                  nearest,
                                   peak_gain=peaks[i - 1], node_peak_v=nodes[i - 1],
                                   gbw_needed_hz=need, fn_design_hz=built.fn_hz, q_design=built.q))
     pruned = _prune(stages)
@@ -673,7 +657,111 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
             total = sum(e[c] for e, c in zip(errors, ch))
             result.figures[f"mask_violation_{key}_db"] = max(0.0, *(o + sg * total[col] for col, sg, o in limits))
     if simulate:
-        result.spice = verify_spice(result, simulator)
+        result.proof = prove(result, simulator)
+        result.spice = result.proof.to_dict()
+    return result
+
+
+def section_plans(spec: FilterSpec) -> tuple:
+    """The order, cut-off (a band-pass: its centre) and sections, in rising Q, that ``spec`` asks for
+    (from its mask when it has one).
+
+    Parameters
+    ----------
+    spec : FilterSpec
+        The specification.
+
+    Returns
+    -------
+    tuple
+        (order, fc in Hz, list of SectionPlan).
+
+    Raises
+    ------
+    DesignError
+        A mask that needs more than order 10 (one line).
+    """
+    if spec.has_mask:
+        order, fc = order_from_mask(spec.filter_type, spec.family, spec.passband_hz, spec.max_loss_db,
+                                    spec.stopband_hz, spec.min_attenuation_db, spec.bessel_norm)
+    else:
+        order, fc = spec.order, spec.fc_hz
+    conv = (spec.ripple_db or 1.0, spec.bessel_norm, spec.chebyshev_cutoff)
+    if spec.filter_type == "bandpass":
+        fc = math.sqrt(spec.f_low_hz * spec.f_high_hz)
+        return order, fc, plan_bandpass(spec.family, order, spec.f_low_hz, spec.f_high_hz, *conv,
+                                        spec.bandpass_method)
+    return order, fc, plan_sections(spec.filter_type, spec.family, order, fc, *conv)
+
+
+def _stage_errors(topo, target: SectionTarget, cands: list, s_obj, opamp) -> np.ndarray:
+    """(candidates, f) dB error of each candidate's op-amp-aware response against the stage's ideal:
+    the asked target's (a pre-distorted design aims its op-amp-aware response at it)."""
+    ideal_db = 20 * np.log10(np.abs(topo.response(topo.synthesize(target), s_obj)))
+    arrays = {r: np.array([c[r] for c in cands])[:, None] for r in topo.designators}
+    cand_db = 20 * np.log10(np.abs(topo.response(arrays, s_obj[None, :], opamp)))
+    return cand_db - ideal_db[None, :]
+
+
+def as_built(spec: FilterSpec, order: int, fc_hz: float, stages: list, simulate: bool = False,
+             simulator: str = "ngspice-cli") -> FilterDesign:
+    """A filter of given parts (as built, or as a design-filter result lists them), judged as
+    :func:`design` judges its choice: the achieved response against ``spec``'s target, its mask.
+
+    Parameters
+    ----------
+    spec : FilterSpec
+        What the filter should do.
+    order, fc_hz : int, float
+        Its order and cut-off (a band-pass: its centre).
+    stages : list of tuple
+        Per stage, input first: (SectionPlan, registry name, gain, part values).
+    simulate : bool
+        Also run the SPICE proof.
+    simulator : str
+        ``ngspice-cli`` or ``pyspice``.
+
+    Returns
+    -------
+    FilterDesign
+        One candidate per stage (its parts); the figures of :func:`design` (the joint, per-stage
+        and nearest errors are this one set's).
+
+    Raises
+    ------
+    DesignError
+        A stage's parts not matching its topology's (one line).
+    """
+    opamp = opamps.get(spec.opamp)
+    grid = analysis_grid(spec, order, fc_hz)
+    s_obj = 2j * math.pi * grid["objective"]
+    built = []
+    for i, (plan, name, gain, values) in enumerate(stages, 1):
+        topo = get_topology(name)
+        vals = {r: float(v) for r, v in topo.values_of(values).items()}
+        target = SectionTarget(plan.kind, plan.fn_hz, plan.q, gain, impedance_ohm=spec.impedance_ohm)
+        errors = _stage_errors(topo, target, [vals], s_obj, opamp)
+        need = spec.gbw_margin * plan.fn_hz * (plan.q or 1.0) * _noise_gain(topo, gain)
+        built.append(StageDesign(i, plan, name, gain, vals, [vals], errors, 0, gbw_needed_hz=need))
+    result = FilterDesign(spec, order, fc_hz, built)
+    errors = [st.errors for st in built]
+    result.figures = _figures(result, grid, errors, [0] * len(built), objective(errors, [0] * len(built)), 1, 0.0, 0.0)
+    result.figures["candidates_dropped"] = 0
+    if spec.has_mask:
+        for key in ("joint", "per_stage", "nearest"):
+            result.figures[f"mask_violation_{key}_db"] = max(0.0, -result.figures["mask_passband_margin_db"],
+                                                             -result.figures["mask_stopband_margin_db"])
+    # each stage's peak gain and its output's peak at the bench amplitude, from its own parts (op-amp-aware)
+    f = np.geomspace(fc_hz / 1000, fc_hz * 1000, 4001)
+    h_cum = np.ones(f.size, complex)
+    for st in built:
+        h = get_topology(st.topology).response(st.values, 2j * math.pi * f, opamp)
+        h_cum = h_cum * h
+        st.peak_gain = float(np.max(np.abs(h)))
+        st.node_peak_v = float(spec.amplitude_v * np.max(np.abs(h_cum)))
+    if simulate:
+        result.proof = prove(result, simulator)
+        result.spice = result.proof.to_dict()
     return result
 
 

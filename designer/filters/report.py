@@ -60,6 +60,8 @@ class FilterSheet:
     wall_clock : bool
         Keep the search's wall-clock figures (``search_s``, ``candidates_s``) in the JSON; a bundle
         leaves them out, so that it regenerates byte for byte.
+    extra : dict
+        More of the JSON (the tolerance analyses'), beside the design's.
     """
 
     design: object
@@ -67,6 +69,7 @@ class FilterSheet:
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
     wall_clock: bool = True
+    extra: dict = field(default_factory=dict)
 
     @property
     def deck(self) -> str:
@@ -81,7 +84,7 @@ class FilterSheet:
         dict
             JSON-ready.
         """
-        data = {**self.design.to_dict(), "bench": self.bench.to_dict(), "files": dict(self.files)}
+        data = {**self.design.to_dict(), **self.extra, "bench": self.bench.to_dict(), "files": dict(self.files)}
         if not self.wall_clock:
             data["figures"] = {k: v for k, v in data["figures"].items() if k not in WALL_CLOCK}
         return data

@@ -237,13 +237,7 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     MonteCarlo
         The Monte Carlo.
     """
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_SAMPLES <= n <= MAX_SAMPLES:
-        raise DesignError(f"--monte-carlo must be a whole number of samples from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
-                          f"got {n!r}")
-    if dist not in DISTRIBUTIONS:
-        raise DesignError(f"--dist {dist!r} unknown; allowed: {', '.join(DISTRIBUTIONS)}")
-    if sampler not in sampling.SAMPLERS:
-        raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(sampling.SAMPLERS)}")
+    check_draw(n, dist, sampler)
     limits = tuple(t if isinstance(t, Limit) else parse_limit(t, engine.FIGURES) for t in limit_items or ())
     nominal = {**plant_parts(parts), **opamp_nominal(tol_items, opamp)}
     if "SR" in nominal and evaluate is None:
@@ -263,6 +257,30 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
             if engine_name != "analytic":
                 mc.tighten["engine"] = "analytic"
     return mc
+
+
+def check_draw(n, dist: str, sampler: str, what: str = "samples") -> None:
+    """A Monte Carlo's draw settings checked before any work: ``n`` a whole number from
+    :data:`MIN_SAMPLES` to :data:`MAX_SAMPLES`, a known distribution and sampler (one line each).
+
+    Parameters
+    ----------
+    n : int
+        The number of draws.
+    dist : str
+        The distribution's name.
+    sampler : str
+        The sampler's name.
+    what : str
+        What is drawn, for the message.
+    """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_SAMPLES <= n <= MAX_SAMPLES:
+        raise DesignError(f"--monte-carlo must be a whole number of {what} from {MIN_SAMPLES} to {MAX_SAMPLES:.0e}, "
+                          f"got {n!r}")
+    if dist not in DISTRIBUTIONS:
+        raise DesignError(f"--dist {dist!r} unknown; allowed: {', '.join(DISTRIBUTIONS)}")
+    if sampler not in sampling.SAMPLERS:
+        raise DesignError(f"--sampler {sampler!r} unknown; allowed: {', '.join(sampling.SAMPLERS)}")
 
 
 def apply_engine(evaluate, values: dict) -> dict:

@@ -22,7 +22,7 @@ PARSERS = {"design-plant": plant.design_plant_parser, "analyze-plant": plant.ana
            "design-pid": pid.pid_parser, "analyze-pid": pid.analyze_pid_parser, "check-design": check.check_parser,
            "identify": identify.build_parser, "identify-freq": identify.build_freq_parser,
            "simulate-capture": capture.build_parser, "make-prbs": prbs.build_parser, "designer-web": server._parser,
-           "design-filter": filter_cli._parser}
+           "design-filter": filter_cli._parser, "analyze-filter": filter_cli._analyze_parser}
 
 
 def run(exe, *args):

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from helpers import script
 
-from designer.cli.filter import design_filter_main
+from designer.cli.filter import analyze_filter_main, design_filter_main
 
 
 @pytest.mark.parametrize("argv, words", [
@@ -79,3 +79,150 @@ def test_json_deck_and_result_written(tmp_path):
                                                         if line.startswith(("f3db_hz", "passband_db")))}
     f3 = meas["f3db_hz"]
     assert f3 == pytest.approx(d["figures"]["f3_hz"], rel=0.01)
+
+
+# ---- analyze-filter and the tolerance options ---------------------------------------------------
+@pytest.fixture(scope="module")
+def designed(tmp_path_factory):
+    """A mask design's result.json (no SPICE: fast), the parts analyze-filter starts from."""
+    folder = tmp_path_factory.mktemp("mask")
+    assert design_filter_main(["--family", "chebyshev", "--passband", "3k", "--max-loss", "1", "--stopband", "12k",
+                               "--min-attenuation", "40", "--no-sim", "--json", "--out", str(folder)]) == 0
+    return folder / "result.json"
+
+
+def test_analyze_filter_of_the_designed_parts_is_the_design(designed, capsys):
+    capsys.readouterr()
+    d = json.loads(designed.read_text())
+    assert analyze_filter_main(["--from", str(designed), "--no-sim", "--json"]) == 0
+    a = json.loads(capsys.readouterr().out)
+    assert a["stages"][0]["parts"] == d["stages"][0]["parts"]
+    for k in ("f3_hz", "passband_deviation_db", "mask_passband_margin_db", "mask_stopband_margin_db",
+              "error_joint_db"):
+        assert a["figures"][k] == pytest.approx(d["figures"][k], rel=1e-9, abs=1e-12), k
+
+
+def test_analyze_filter_part_as_built_moves_the_response(designed, capsys):
+    capsys.readouterr()
+    d = json.loads(designed.read_text())
+    r = d["stages"][0]["parts"]["R1"]
+    assert analyze_filter_main(["--from", str(designed), "--no-sim", "--json", "--part", f"R101={1.2 * r}"]) == 0
+    a = json.loads(capsys.readouterr().out)
+    assert a["stages"][0]["parts"]["R1"] == pytest.approx(1.2 * r)
+    # stage 1 is the first-order section: its corner moves down by 1.2, and so does the -3 dB point
+    assert a["figures"]["f3_hz"] < d["figures"]["f3_hz"]
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--part", "R909=1k"], "--part 'R909=1k': give DESIGNATOR=VALUE with one of this filter's parts: R101"),
+    (["--part", "R101=-1k"], "--part R101 must be above 0"),
+    (["--tol", "R=1%"], "--tol goes with --monte-carlo N"),
+    (["--monte-carlo", "5"], "--monte-carlo '5': give a whole number, 10 to"),
+    (["--monte-carlo", "100", "--spice-samples", "101"], "--spice-samples '101': give a whole number, 1 to 100"),
+    (["--monte-carlo", "100", "--limit", "bogus_hz=1:2"], "unknown figure"),
+    (["--monte-carlo", "100", "--tol", "R=80%"], "at most 50 %"),
+    (["--monte-carlo", "100", "--tol", "Q7=1%"], "this design has no part Q7"),
+    (["--jobs", "2"], "--jobs goes with --monte-carlo N"),
+])
+def test_analyze_filter_bad_input_is_one_line_exit_2(designed, argv, words, capsys):
+    capsys.readouterr()
+    assert analyze_filter_main(["--from", str(designed), "--no-sim"] + argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("analyze-filter: error: "), err
+    assert words in err, err
+
+
+@pytest.mark.parametrize("content, words", [(None, "cannot read it"), ("{", "not JSON"),
+                                            ('{"tool": "design-plant"}', "not a design-filter result.json")])
+def test_analyze_filter_refuses_what_is_not_a_result(tmp_path, content, words, capsys):
+    path = tmp_path / "r.json"
+    if content is not None:
+        path.write_text(content)
+    assert analyze_filter_main(["--from", str(path), "--no-sim"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err, err
+
+
+def test_design_filter_yield_and_its_optimum_in_json(capsys):
+    argv = ["--family", "chebyshev", "--passband", "3k", "--max-loss", "1", "--stopband", "12k", "--min-attenuation",
+            "40", "--no-sim", "--json", "--monte-carlo", "400", "--seed", "3", "--optimize", "yield"]
+    assert design_filter_main(argv) == 0
+    d = json.loads(capsys.readouterr().out)
+    y = d["monte_carlo"]["yield"]
+    assert y["samples"] == 400 and y["ci95"][0] <= y["fraction"] <= y["ci95"][1]
+    o = d["optimize_yield"]
+    # the same draws: the joint choice's yield is the Monte Carlo's
+    assert o["yield_joint"] == pytest.approx(y["fraction"])
+    assert o["yield_optimized"] >= o["yield_joint"]
+    assert d["monte_carlo"]["tighten"]["part"] in d["monte_carlo"]["nominal_parts"]
+
+
+def test_design_filter_optimize_needs_a_mask(capsys):
+    assert design_filter_main(["--order", "4", "--fc", "1k", "--no-sim", "--optimize", "yield"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--optimize yield needs a mask" in err
+
+
+def test_summary_shows_yield_and_worst_case(designed, capsys):
+    capsys.readouterr()
+    assert analyze_filter_main(["--from", str(designed), "--no-sim", "--monte-carlo", "200", "--worst-case"]) == 0
+    out = capsys.readouterr().out
+    for words in ("Monte Carlo: 200 builds", "95 % Wilson interval", "tighten stage", "Worst case over the tolerance"):
+        assert words in out, words
+
+
+@pytest.mark.spice
+def test_analyze_filter_proof_and_spice_engine(designed, capsys):
+    capsys.readouterr()
+    assert analyze_filter_main(["--from", str(designed), "--json", "--monte-carlo", "100", "--spice-samples",
+                                "5"]) == 0
+    a = json.loads(capsys.readouterr().out)
+    assert a["spice"]["nrms"]["ac_opamp"] < 1 and a["spice"]["nrms"]["tran_opamp"] < 1
+    assert a["spice"]["mask"]["met"] is True
+    assert a["monte_carlo"]["spice"]["samples"] == 5
+
+
+def _stage_args(d: dict) -> list:
+    """--stage and --part options of a design-filter result's stages (stage i's R1 is Ri01)."""
+    argv = []
+    for i, st in enumerate(d["stages"], 1):
+        argv += ["--stage", st["topology"]]
+        argv += [f"--part={r[0]}{i}0{r[1:]}={v!r}" for r, v in st["parts"].items()]
+    return argv
+
+
+def test_analyze_filter_per_stage_is_the_result_json(designed, capsys):
+    """The same parts typed per stage (--target, --stage, --part) give what --from gives."""
+    capsys.readouterr()
+    d = json.loads(designed.read_text())
+    target = "--family chebyshev --passband 3k --max-loss 1 --stopband 12k --min-attenuation 40"
+    assert analyze_filter_main(["--target", target, *_stage_args(d), "--no-sim", "--json"]) == 0
+    a = json.loads(capsys.readouterr().out)
+    assert analyze_filter_main(["--from", str(designed), "--no-sim", "--json"]) == 0
+    b = json.loads(capsys.readouterr().out)
+    assert [s["parts"] for s in a["stages"]] == [s["parts"] for s in b["stages"]]
+    assert [s["q"] for s in a["stages"]] == [s["q"] for s in b["stages"]]
+    for k in ("f3_hz", "passband_deviation_db", "mask_passband_margin_db", "mask_stopband_margin_db"):
+        assert a["figures"][k] == pytest.approx(b["figures"][k], rel=1e-9), k
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--stage", "sallen-key-lowpass"], "give --from RESULT_JSON, or --target"),
+    (["--target", "--order 4 --fc 1k", "--stage", "sallen-key-lowpass"], "the target is 2 sections"),
+    (["--target", "--order 2 --fc 1k", "--stage", "sallen-key-lowpass", "--part", "R101=1k"],
+     "stage 1 (sallen-key-lowpass) needs R102"),
+    (["--target", "--order 2 --fc 1k", "--stage", "mfb-highpass"], "the target has none left"),
+    (["--target", "--order 2 --fc 1k", "--stage", "tow-thomas"], "tow-thomas"),
+    (["--target", "--order 2 --bogus", "--stage", "sallen-key-lowpass"], "unrecognized arguments: --bogus"),
+    (["--target", "--order 2 --fc 1k", "--stage", "rc-lowpass", "--stage", "rc-lowpass"], "the target is 1 sections"),
+])
+def test_analyze_filter_per_stage_bad_input(argv, words, capsys):
+    assert analyze_filter_main(argv + ["--no-sim"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("analyze-filter: error: "), err
+    assert words in err, err
+
+
+def test_analyze_filter_from_and_target_exclude_each_other(designed, capsys):
+    assert analyze_filter_main(["--from", str(designed), "--target", "--order 2 --fc 1k", "--no-sim"]) == 2
+    assert "give one or the other" in capsys.readouterr().err
