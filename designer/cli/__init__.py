@@ -14,13 +14,15 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    "check": ("check_design_main", "check_parser"),
-    "common": ("ExtendList", "FLAGS", "OneLineParser", "RESULT_HOOK", "StoreOnce", "flag_message", "run_cli"),
-    "filter": ("design_filter_main", "summary_text"),
-    "identify": ("FORMATS", "build_freq_parser", "identify_freq_main", "identify_main", "identify_run"),
-    "launch": ("analyze_pid", "analyze_plant", "check_design", "design_filter", "design_pid", "design_plant", "draws",
-               "identify_freq", "make_prbs", "simulate_capture"),
-    "pid": ("analyze_pid_main", "analyze_pid_parser", "design_pid_main", "pid_parser"),
-    "plant": ("analyze_plant_main", "analyze_plant_parser", "design_plant_main", "design_plant_parser"),
+    "check": ("check_design_main", "check_parser",),
+    "common": ("ExtendList", "FLAGS", "OneLineParser", "RESULT_HOOK", "StoreOnce", "flag_message", "run_cli",),
+    "filter": ("analyze_filter_main", "design_filter_main", "summary_text",),
+    "filter_tolerance": ("OPTIMIZE_DEFAULT_BUILDS", "add_filter_tolerance", "run_tolerance", "tolerance_json",
+                         "tolerance_lines", "tolerance_settings",),
+    "identify": ("FORMATS", "build_freq_parser", "identify_freq_main", "identify_main", "identify_run",),
+    "launch": ("analyze_pid", "analyze_plant", "check_design", "design_filter", "design_pid", "design_plant",
+               "draws", "identify_freq", "make_prbs", "simulate_capture",),
+    "pid": ("analyze_pid_main", "analyze_pid_parser", "design_pid_main", "pid_parser",),
+    "plant": ("analyze_plant_main", "analyze_plant_parser", "design_plant_main", "design_plant_parser",),
     "prbs": ("make_prbs_main",),
 })
