@@ -128,7 +128,18 @@ def nominal_parts(result) -> dict:
 
 
 def series_of(result) -> dict:
-    """``{"R": series, "C": series}`` of a design (its parts' default tolerances)."""
+    """``{"R": series, "C": series}`` of a design (its parts' default tolerances).
+
+    Parameters
+    ----------
+    result : designer.filters.design.FilterDesign
+        The design.
+
+    Returns
+    -------
+    dict
+        ``"R"`` and ``"C"`` -> the E-series name.
+    """
     return {"R": result.spec.r_series, "C": result.spec.c_series}
 
 
