@@ -117,6 +117,8 @@ RANGES = {
     "step_amplitude": Range(1e-12, 1e12),
     # size of the output's change from baseline to final value, in the file's units
     "output_step": Range(1e-15, 2e15),
+    # a capture without a time column (--sample-time): the interval between its rows
+    "sample_time_s": Range(1e-12, 1e6, "s"),
     # simulate-capture (its --step is step_v, --duration capture_span_s, --step-time capture_time_s)
     "capture_points": Range(10, 1e6),
     "noise_v": Range(0.0, 100.0, "V"),

@@ -45,6 +45,7 @@ class _Layout:
     time_axis: tuple | None = None
     comma: bool = False
     scales: list | None = None
+    named: bool = True   # False when the file has no header: the column names were made up
 
 
 
@@ -158,7 +159,8 @@ def _read_table(lines, name, fmt: str | None = None, forced: bool = False) -> _L
                           "a header")
     ncols = len(_split(lines[first_row], delim, comma))
     header = _split(lines[first_row - 1], delim) if first_row > 0 else []
-    if len(header) >= ncols and not all(_is_number(c) for c in header):
+    named = len(header) >= ncols and not all(_is_number(c) for c in header)
+    if named:
         columns = header[:ncols]
     else:
         columns = ["t"] + [f"col{j + 1}" for j in range(1, ncols)]
@@ -178,7 +180,7 @@ def _read_table(lines, name, fmt: str | None = None, forced: bool = False) -> _L
             fmt = "digilent"
         else:
             fmt = "generic"
-    return _Layout(columns, fmt, first_row, delim, list(range(ncols)), comma=comma)
+    return _Layout(columns, fmt, first_row, delim, list(range(ncols)), comma=comma, named=named)
 
 
 def _read_generic(lines, name, forced=False) -> _Layout:
