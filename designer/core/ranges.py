@@ -124,6 +124,10 @@ RANGES = {
     "noise_v": Range(0.0, 100.0, "V"),
     "lsb_v": Range(0.0, 100.0, "V"),
     "seed": Range(0, 1e9),
+    # simulate-capture --input random-binary: the chance of a switch at each clock tick
+    "switch_probability": Range(0.01, 1.0),
+    # simulate-capture --input chirp: --f-start, --f-stop
+    "chirp_hz": Range(1e-9, 1e9, "Hz"),
     # frequency-response tables (identify-freq): every row
     "freq_hz": Range(1e-9, 1e11, "Hz"),
     "gain_db": Range(-400.0, 400.0, "dB"),
