@@ -54,13 +54,14 @@ make-prbs --for-plant chooses them (or --clock, --bits), the record 3 periods;
 random-binary, between 0 and --step V, switching with probability
 --switch-prob (default 0.2) at each tick of --clock (default: the prbs clock
 for the plant), the switches drawn from numpy default_rng([--seed, 1]), the
-record 25 settling times; chirp, a logarithmic sine sweep between 0 and --step V
+record 25 settling times (whole ticks); chirp, a logarithmic sine sweep between 0 and --step V
 from --f-start to --f-stop (default: a hundredth of the plant's bandwidth to 3
 times it), the record 25 settling times; or a CSV of time,value rows (a
 recorded input, any layout identify reads), each value held from its time on,
 the record to its last time. Each starts from rest at 0 V; the '#' lines
-record it. Default --points for them: at least 10 samples a clock tick (20
-a period of the sweep's top), at least 2001.
+record it. Default --points for them: a whole number of samples a clock tick,
+at least 10 (every tick on a sample: u holds each level from its sample on),
+or 20 a period of the sweep's top; at least 2001.
 
 limits: --step {step}; --step-time 0 or later, before the end of the record;
 --duration {span}, and at most {sim_steps:g} simulation steps (a fast model in a
@@ -264,17 +265,27 @@ def excitation(model, args, opts: dict):
         if opts["duration_s"] is None:
             opts["duration_s"] = duration
         if opts["points"] is None:
-            opts["points"] = int(min(1_000_000, max(2001, math.ceil(per_s * opts["duration_s"]) + 1)))
+            opts["points"] = int(min(1_000_000, max(DEFAULT_POINTS, math.ceil(per_s * opts["duration_s"]) + 1)))
+
+    def fill_clocked(duration, clock):
+        """A record of whole clock ticks, each a whole number of samples (at least SAMPLES_PER_TICK):
+        every tick on a sample."""
+        if opts["duration_s"] is None:
+            opts["duration_s"] = math.ceil(duration / clock * (1 - 1e-12)) * clock
+        if opts["points"] is None:
+            ticks = max(1, round(opts["duration_s"] / clock))
+            each = max(SAMPLES_PER_TICK, math.ceil((DEFAULT_POINTS - 1) / ticks))
+            opts["points"] = int(min(ticks * each, (1_000_000 - 1) // ticks * ticks) + 1)
 
     if kind == "prbs":
         plan = _plan(model, args, level)
-        fill(plan.periods * plan.period_s, SAMPLES_PER_TICK / plan.dt_s)
+        fill_clocked(plan.periods * plan.period_s, plan.dt_s)
         return ex.prbs_input(plan, level, opts["duration_s"], opts["points"])
     if kind == "random-binary":
         p = 0.2 if args.switch_prob is None else parse_in_range(args.switch_prob, "--switch-prob",
                                                                  "switch_probability")
         clock = _plan(model, args, level).dt_s
-        fill(EXPERIMENT_SETTLING_TIMES / 5.0 * default_duration_s(model), SAMPLES_PER_TICK / clock)
+        fill_clocked(EXPERIMENT_SETTLING_TIMES / 5.0 * default_duration_s(model), clock)
         return ex.random_binary_input(p, clock, level, opts["duration_s"], opts["points"], opts["seed"])
     if kind == "chirp":
         from .prbs import bandwidth_hz

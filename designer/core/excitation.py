@@ -18,10 +18,13 @@ record samples.
 - a recorded input: ``time,value`` rows, each value held from its time on
   (make-prbs' ``prbs.csv`` reads as it plays).
 
-A held level changes in :data:`EDGE_FRACTION` of the sample interval (an edge to
-the grid, as the step's); every input starts from 0 (the plant at rest) and the
-first level begins half a sample interval after t = 0 (edges fall between two
-samples, where ``identify`` puts an edge it sees between them).
+A held level changes in :data:`EDGE_FRACTION` of the sample interval, ending on
+its clock tick; every input starts from 0 (the plant at rest), a clocked one's
+first level reached at the second sample, and its ticks fall on samples when
+the clock is a whole number of sample intervals (the default): each sample of
+u is the level held from it on, the zero-order hold an output-error fit
+assumes (:func:`designer.identify.outputerror.simulate`). The chirp's corners
+are its samples (a first-order hold between them).
 """
 
 from __future__ import annotations
@@ -69,9 +72,9 @@ def held(levels, starts, edge_s: float, end_s: float) -> tuple:
     levels : array_like
         Each level, volts.
     starts : array_like
-        When each begins, seconds, increasing, the first after 0.
+        When each is reached, seconds, increasing, the first at ``edge_s`` or later.
     edge_s : float
-        How long a change takes.
+        How long a change takes (it ends at the level's start).
     end_s : float
         The end of the record (the last level held to it).
 
@@ -87,19 +90,19 @@ def held(levels, starts, edge_s: float, end_s: float) -> tuple:
     t = np.empty(2 * k.size + 2)
     v = np.empty(2 * k.size + 2)
     t[0], v[0] = 0.0, 0.0
-    t[1:-1:2], v[1:-1:2] = st[k], prev[k]
-    t[2:-1:2], v[2:-1:2] = st[k] + edge_s, lv[k]
+    t[1:-1:2], v[1:-1:2] = st[k] - edge_s, prev[k]
+    t[2:-1:2], v[2:-1:2] = st[k], lv[k]
     t[-1], v[-1] = max(end_s, t[-2] + edge_s), lv[-1] if lv.size else 0.0
     return t, v
 
 
 def _clocked(levels, clock_s: float, duration_s: float, points: int) -> tuple:
     dt = duration_s / (points - 1)
-    n = min(levels.size, int(np.ceil((duration_s - 0.5 * dt) / clock_s)))
+    n = min(levels.size, int(np.ceil((duration_s - dt) / clock_s)))
     if 2 * n + 2 > MAX_CORNERS:
         raise DesignError(f"the input changes up to {n:,} times in the record, more than a source of "
                           f"{MAX_CORNERS:,} corners holds: a shorter record or a slower clock")
-    return held(levels[:n], 0.5 * dt + clock_s * np.arange(n), EDGE_FRACTION * dt, duration_s)
+    return held(levels[:n], dt + clock_s * np.arange(n), EDGE_FRACTION * dt, duration_s)
 
 
 def prbs_input(plan, level_v: float, duration_s: float, points: int) -> Excitation:
@@ -181,16 +184,13 @@ def chirp_input(f_start_hz: float, f_stop_hz: float, level_v: float, duration_s:
     -------
     Excitation
     """
-    dt = duration_s / (points - 1)
-    t0 = 0.5 * dt
-    tau = np.linspace(0.0, duration_s - t0, points)
-    span = duration_s - t0
+    tau = np.linspace(0.0, duration_s, points)
     rate = np.log(f_stop_hz / f_start_hz)
-    phase = 2 * np.pi * f_start_hz * span * np.expm1(tau * rate / span) / rate
+    phase = 2 * np.pi * f_start_hz * duration_s * np.expm1(tau * rate / duration_s) / rate
     v = 0.5 * level_v * (1.0 - np.cos(phase))
-    return Excitation("chirp", np.r_[0.0, t0 + tau], np.r_[0.0, v],
+    return Excitation("chirp", tau, v,
                       f"chirp: logarithmic sweep {format_eng(f_start_hz, 'Hz')} to {format_eng(f_stop_hz, 'Hz')} "
-                      f"from {format_eng(t0, 's')} to the end, between 0 V and {format_eng(level_v, 'V')}")
+                      f"over the record, between 0 V and {format_eng(level_v, 'V')} (linear between samples)")
 
 
 def file_input(t, v, name: str, max_v: float) -> Excitation:
@@ -229,9 +229,7 @@ def file_input(t, v, name: str, max_v: float) -> Excitation:
     if 2 * t.size + 2 > MAX_CORNERS:
         raise DesignError(f"{name}: {t.size:,} rows, more than a source of {MAX_CORNERS:,} corners holds")
     edge = EDGE_FRACTION * float(np.min(np.diff(t)))
-    starts = t.copy()
-    if starts[0] == 0:
-        starts[0] = edge   # the first level from rest, as every other input
+    starts = np.maximum(t, edge)   # the first level from rest at 0, as every other input
     ct, cv = held(v, starts, edge, float(t[-1]))
     return Excitation("file", ct, cv, f"file: {name}, {t.size} rows of time,value, each value held from its time "
                                       f"on, {t[0]:.6g} s to {t[-1]:.6g} s")
