@@ -320,6 +320,7 @@ def capture_run(args) -> int:
         raise DesignError("--out needs a file name, such as capture.csv")
     check_output_path(args.out, "--out")
     exc = excitation(model, args, opts)
+    opts.pop("input")
     if exc is not None:
         from ..spice.model_step import simulate_input
         t, u, y = simulate_input(model, exc, opts["duration_s"], opts["points"], noise_v=opts["noise_v"],
