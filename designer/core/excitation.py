@@ -113,12 +113,8 @@ def prbs_input(plan, level_v: float, duration_s: float, points: int) -> Excitati
     ----------
     plan : PrbsPlan
         Bits and clock (its levels are not used).
-    level_v : float
-        The high level, volts (the low one is 0).
-    duration_s : float
-        The record, seconds.
-    points : int
-        Its samples.
+    level_v, duration_s, points : float, float, int
+        The high level (V; the low one is 0), the record (s) and its samples.
 
     Returns
     -------
@@ -173,12 +169,8 @@ def chirp_input(f_start_hz: float, f_stop_hz: float, level_v: float, duration_s:
     ----------
     f_start_hz, f_stop_hz : float
         The sweep's first and last frequency, Hz (f_start < f_stop).
-    level_v : float
-        Its peak, volts.
-    duration_s : float
-        The record, seconds.
-    points : int
-        Its samples.
+    level_v, duration_s, points : float, float, int
+        Its peak (V), the record (s) and its samples (the corners).
 
     Returns
     -------

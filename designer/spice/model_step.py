@@ -363,15 +363,13 @@ def simulate_input(model: ProcessModel, excitation, duration_s: float, points: i
 
     Returns
     -------
-    t, u, y : ndarray
-        Time (s, uniform), input and output (V), ``points`` samples each.
+    tuple of ndarray
+        ``(t, u, y)`` on the uniform grid, as :func:`simulate_step` returns them.
 
     Raises
     ------
-    DesignError
-        An input outside its range, in one line naming the parameter.
-    SimulatorError
-        ngspice missing or failed.
+    DesignError, SimulatorError
+        As :func:`simulate_step` (the input's swing checked against ``lsb_v`` as its step is).
     """
     from .simulate import get_simulator
     swing = float(np.ptp(excitation.v))

@@ -466,7 +466,11 @@ def test_plain_columns_without_a_sample_time_are_refused_naming_the_option():
      ("first column ('t') is a time column", "drop it")),
     ({"sample_time_s": 0.08}, "Record Length,20,Points,0.0,0.5\n", ("Tektronix",)),
     ({"sample_time_s": 0.08}, "".join(f"{i % 2} {i}\n" for i in range(20)) + "1\n",
-     ("line 21 has no value in column 2",)),
+     ("line 21 has no value in column 2, nor any line after it", "different lengths")),
+    ({"sample_time_s": 0.08}, "".join(f"{i % 2} {i}\n" for i in range(20)) + "1\n1\n1\n",
+     ("line 21 has no value in column 2, nor any line after it", "different lengths")),
+    ({}, "".join(f"{i},{i % 2},{i}\n" for i in range(20)) + "20,1\n21,1,2\n",
+     ("line 21 has no value in column 3; every data row",)),
     ({"sample_time_s": 0.08, "column_names": "u,y"}, "".join(f"2.5 {i}\n" for i in range(20)),
      ("input column 'u' never moves", "every sample 2.5", "{input_column} none")),
 ])

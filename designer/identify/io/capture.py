@@ -434,10 +434,19 @@ def _parse_block(lines, line0, delim, usecols, flags, name, comma=False) -> tupl
 
 
 def _raise_bad_cell(rows, where, delim, name, usecols, comma=False):
-    for line, lineno in zip(rows, where):
+    def missing(line, j):
+        cells = _split(line, delim, comma)
+        return j >= len(cells) or cells[j] == ""
+
+    for k, (line, lineno) in enumerate(zip(rows, where)):
         cells = _split(line, delim, comma)
         for j in usecols:
-            if j >= len(cells) or cells[j] == "":
+            if missing(line, j):
+                if all(missing(rest, j) for rest in rows[k + 1:k + 1000]):
+                    # every row from here on lacks it: the signals were recorded to different lengths
+                    raise DesignError(f"{name}: line {lineno} has no value in column {j + 1}, nor any line "
+                                      f"after it: the columns have different lengths (input and output "
+                                      "need a sample at every time); every data row needs all columns")
                 raise DesignError(f"{name}: line {lineno} has no value in column "
                                   f"{j + 1}; every data row needs all columns")
             if not _is_number(cells[j]):
