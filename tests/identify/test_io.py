@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from helpers import FIXTURES
 
 from designer.core.errors import DesignError
@@ -509,3 +511,16 @@ def test_the_dryer_data_set_reads_as_daisy_describes_it():
     assert sorted(set(np.round(cap.u, 6))) == [3.41, 6.41]   # SOURCES.md: between 3.41 and 6.41 V
     switch = np.mean(np.diff(cap.u) != 0)
     assert 0.15 < switch < 0.25                              # "switches with probability about 0.2"
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.one_of(st.none(), st.text(max_size=20), st.lists(st.text(max_size=5), max_size=4)),
+       st.one_of(st.none(), st.floats(allow_nan=True, allow_infinity=True), st.just(0.08)))
+def test_plain_column_options_only_ever_refuse_in_one_line(names, dt):
+    u, y = _plain_data(60)
+    try:
+        cap = parse_capture_text(_daisy_text(u, y), name="d.dat", sample_time_s=dt, column_names=names)
+    except DesignError as exc:
+        assert "\n" not in str(exc)
+    else:
+        assert cap.t.size == 60 and cap.t[1] == pytest.approx(dt)
