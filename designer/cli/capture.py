@@ -54,9 +54,10 @@ make-prbs --for-plant chooses them (or --clock, --bits), the record 3 periods;
 random-binary, between 0 and --step V, switching with probability
 --switch-prob (default 0.2) at each tick of --clock (default: the prbs clock
 for the plant), the switches drawn from numpy default_rng([--seed, 1]), the
-record 25 settling times (whole ticks); chirp, a logarithmic sine sweep between 0 and --step V
-from --f-start to --f-stop (default: a hundredth of the plant's bandwidth to 3
-times it), the record 25 settling times; or a CSV of time,value rows (a
+record 25 settling times (whole ticks); chirp, a logarithmic sine sweep
+between 0 and --step V from --f-start to --f-stop (default: a hundredth of
+the plant's bandwidth to 3 times it), the record 25 settling times; or a
+CSV of time,value rows (a
 recorded input, any layout identify reads), each value held from its time on,
 the record to its last time. Each starts from rest at 0 V; the '#' lines
 record it. Default --points for them: a whole number of samples a clock tick,
