@@ -3,6 +3,7 @@ frequency-response tables."""
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -524,3 +525,20 @@ def test_plain_column_options_only_ever_refuse_in_one_line(names, dt):
         assert "\n" not in str(exc)
     else:
         assert cap.t.size == 60 and cap.t[1] == pytest.approx(dt)
+
+
+@pytest.mark.parametrize("header, shift, words", [
+    ("t_u,u,t_y,y", 2.0, "column 3 ('t_y') is a second time column"),
+    ("time,u,time,y", 1.0, "from line 2 on"),
+    ("time_in,vin,time_out,vout", 1.0, "sampled at different times or rates"),
+])
+def test_input_and_output_on_different_time_axes_are_refused(header, shift, words):
+    t = np.arange(30) * 1e-3
+    rows = "".join(f"{a},{i % 2},{a * shift + (0.5e-3 if shift == 1.0 else 0)},{i}\n" for i, a in enumerate(t))
+    with pytest.raises(DesignError, match=re.escape(words)):
+        parse_capture_text(header + "\n" + rows, name="two.csv")
+    same = "".join(f"{a},{i % 2},{a},{i}\n" for i, a in enumerate(t))
+    cap = parse_capture_text(header + "\n" + same)
+    assert cap.u is not None and np.array_equal(cap.t, t)
+    thermo = parse_capture_text("time,t1,t2\n" + "".join(f"{a},{20 + i},{21 + i}\n" for i, a in enumerate(t)))
+    assert thermo.output_name == "t2"   # t1, t2: temperatures, not times

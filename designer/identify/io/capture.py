@@ -296,8 +296,44 @@ def _parse(head, blocks, name, input_column, output_column, size_hint=None,
     keep = [0, j_out] + ([j_in] if j_in is not None else [])
     more = _then(first, blocks) if first is not None else iter(())
     del first   # the block is the generator's now: freed once parsed
-    cols = _load(lines, layout, keep, more, name, size_hint, getattr(blocks, "ahead", None))
+    t2 = _second_time(layout, keep) if plain is None else None
+    cols = _load(lines, layout, keep + ([t2] if t2 is not None else []), more, name, size_hint,
+                 getattr(blocks, "ahead", None))
+    if t2 is not None:
+        _check_one_time_axis(cols, layout, t2, len(keep), name)
+        cols.data = cols.data[:len(keep)]
     return _assemble(cols, layout, keep, tentative, name, plain is not None)
+
+
+# another channel's own time: t_y, time_out, time-ch2, time2 (not t1: a thermocouple's name as often)
+_TIME_OF = re.compile(r"(t|time)[ _-](u|y|in|out|input|output|ch\d+|\d+)|time\d+|t|time|times")
+
+
+def _second_time(layout: _Layout, keep) -> int | None:
+    """A column the header names as another time (``t_y``, ``time_out``, a second ``time``) beside
+    the first: each channel's own time axis, which must be the first's."""
+    if not layout.named or layout.file_cols[0] is None:
+        return None
+    for j in range(1, len(layout.columns)):
+        n = _norm(layout.columns[j])
+        if j not in keep and _TIME_OF.fullmatch(n):
+            return j
+    return None
+
+
+def _check_one_time_axis(cols: _Columns, layout: _Layout, j: int, row: int, name: str) -> None:
+    """Refuse a second time column that is not the first: the input and output sampled at
+    different times (or rates), which no method here takes."""
+    a, b = cols.data[0, :cols.n], cols.data[row, :cols.n]
+    with np.errstate(invalid="ignore"):
+        off = ~(np.abs(a - b) <= 1e-9 * np.maximum(np.abs(a), np.abs(b)) + 1e-300)
+    if off.any():
+        i = int(np.argmax(off))
+        raise DesignError(f"{name}: column {layout.file_cols[j] + 1} ({show_cell(layout.columns[j])}) is a second "
+                          f"time column and differs from column 1 ({show_cell(layout.columns[0])}) from line "
+                          f"{cols.line(i)} on ({a[i]:.6g} s and {b[i]:.6g} s): the signals were sampled at "
+                          "different times or rates; put them on one time axis (resample one onto the other's "
+                          "times)")
 
 
 def _then(first, rest):
