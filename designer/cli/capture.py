@@ -217,7 +217,18 @@ SAMPLES_PER_PERIOD = 20
 
 def input_kind(text: str) -> str:
     """``--input``: one of :data:`~designer.core.excitation.INPUT_KINDS`, or ``file`` for a path
-    that exists; anything else refused in one line."""
+    that exists; anything else refused in one line.
+
+    Parameters
+    ----------
+    text : str
+        The option as typed.
+
+    Returns
+    -------
+    str
+        The kind, or ``"file"``.
+    """
     from pathlib import Path
 
     from ..core.excitation import INPUT_KINDS
@@ -249,7 +260,22 @@ def _plan(model, args, level_v):
 
 def excitation(model, args, opts: dict):
     """The input of ``--input`` other than a step (:mod:`designer.core.excitation`), ``opts``'s
-    duration and points filled when not given; None for a step."""
+    duration and points filled when not given; an option of another kind refused in one line.
+
+    Parameters
+    ----------
+    model : ProcessModel
+        The plant (its settling time and bandwidth set the defaults).
+    args : argparse.Namespace
+        The parsed options.
+    opts : dict
+        The checked options (:func:`_options`); ``duration_s`` and ``points`` filled in place.
+
+    Returns
+    -------
+    Excitation or None
+        None for a step.
+    """
     from ..core import excitation as ex
     from ..spice.model_step import default_duration_s
     kind = opts["input"]

@@ -309,7 +309,17 @@ def build_parser() -> argparse.ArgumentParser:
 def add_plain_columns_options(group) -> None:
     """``--sample-time`` and ``--columns``, a capture without a time column, on a parser or group:
     the one registration of every command that reads captures (identify, design-pid and
-    analyze-pid ``--plant-capture``)."""
+    analyze-pid ``--plant-capture``).
+
+    Parameters
+    ----------
+    group : argparse.ArgumentParser or argument group
+        Where the two options go.
+
+    Returns
+    -------
+    None
+    """
     group.add_argument("--sample-time", metavar="S",
                        help="the file has no time column (plain signal columns, as DaISy's u y): the sample "
                             "interval, seconds " + help_range("sample_time_s") + ", e.g. 0.08 or 80m")
