@@ -49,6 +49,8 @@ FLAGS = {
     **{f"r{i}": f"--r{i}" for i in range(5, 19)}, "c3": "--c3", "c4": "--c4", "controller_json": "--parts-json",
     # identify / identify-freq
     "step_time_s": "--step-time", "step_amplitude": "--step-amplitude",
+    "input_column": "--input-column", "output_column": "--output-column", "sample_time_s": "--sample-time",
+    "column_names": "--columns",
     # simulate-capture (its step_v, step_time_s as above)
     # design-filter
     "filter_type": "--type", "family": "--family", "order": "--order", "ripple_db": "--ripple",

@@ -51,6 +51,8 @@ examples:
   identify capture.csv --methods smith,alfaro,least-squares
   identify TEK0001.CSV --window 0 7m           # only the stretch from 0 to 7 ms
   identify scope.csv --format rigol-no-x       # read as that layout, whatever it looks like
+  identify dryer.dat --sample-time 0.08 --columns u,y
+        plain columns without a time column (DaISy's u y): sample k at k x 0.08 s
 
 input layouts (--format, recognised when not given): {formats}.
 A frequency-response table (header f_hz,gain_db,phase_deg or any other header
@@ -289,6 +291,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--input-column", metavar="NAME|N",
                    help="input column by header name or number (time is 1); 'none' ignores it")
     p.add_argument("--output-column", metavar="NAME|N", help="output column by name or number")
+    add_plain_columns_options(p)
     p.add_argument("--methods", nargs="+", metavar="NAME",
                    help="only these methods (space or comma separated), e.g. smith alfaro "
                         "least-squares")
@@ -303,6 +306,52 @@ def build_parser() -> argparse.ArgumentParser:
                    help="write a build sheet folder: build-sheet.md, identify.png, result.json (and for a "
                         "broadband capture spectrum.csv, identify-freq's table), all or none")
     return p
+
+
+def add_plain_columns_options(group) -> None:
+    """``--sample-time`` and ``--columns``, a capture without a time column, on a parser or group:
+    the one registration of every command that reads captures (identify, design-pid and
+    analyze-pid ``--plant-capture``).
+
+    Parameters
+    ----------
+    group : argparse.ArgumentParser or argument group
+        Where the two options go.
+
+    Returns
+    -------
+    None
+    """
+    group.add_argument("--sample-time", metavar="S",
+                       help="the file has no time column (plain signal columns, as DaISy's u y): the sample "
+                            "interval, seconds " + help_range("sample_time_s") + ", e.g. 0.08 or 80m")
+    group.add_argument("--columns", metavar="NAMES",
+                       help="with --sample-time: every column's name in order, e.g. u,y or y,u,x (u the input, "
+                            "y the output; default: the header's names, else the first column the input and "
+                            "the second the output)")
+
+
+def capture_read_options(args) -> dict:
+    """:func:`~designer.identify.io.read_capture`'s keyword arguments from a command's reading
+    options (``--format``, ``--input-column``, ``--output-column``, ``--sample-time``,
+    ``--columns``; any not registered reads as not given), ``--sample-time`` checked.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options.
+
+    Returns
+    -------
+    dict
+        ``input_column``, ``output_column``, ``fmt``, ``sample_time_s``, ``column_names``.
+    """
+    sample = getattr(args, "sample_time", None)
+    return {"input_column": getattr(args, "input_column", None),
+            "output_column": getattr(args, "output_column", None),
+            "fmt": getattr(args, "format", None),
+            "sample_time_s": None if sample is None else parse_in_range(sample, "--sample-time", "sample_time_s"),
+            "column_names": getattr(args, "columns", None)}
 
 
 def identify_capture(args):
@@ -320,8 +369,8 @@ def identify_capture(args):
     if args.plot:
         check_output_path(args.plot, "--plot")
     # The file is read before scipy is imported, so bad input fails fast.
-    cap = read_capture(args.capture, input_column=args.input_column,
-                       output_column=args.output_column, fmt=args.format)
+    from ..identify.broadband import positional_input
+    cap = positional_input(read_capture(args.capture, **capture_read_options(args)))
     broadband = identify_broadband_capture(args, cap, window)
     if broadband is not None:
         return broadband
@@ -378,6 +427,7 @@ FREQUENCY_TABLE = "frequency-table"
 #: identify's options that only a step capture has: (argparse dest, its flag)
 STEP_ONLY = (("step_time", "--step-time"), ("step_amplitude", "--step-amplitude"), ("window", "--window"),
              ("format", "--format"), ("input_column", "--input-column"), ("output_column", "--output-column"),
+             ("sample_time", "--sample-time"), ("columns", "--columns"),
              ("methods", "--methods"), ("no_refine", "--no-refine"), ("against", "--against"),
              ("method", "--method"), ("out", "--out"))
 

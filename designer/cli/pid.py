@@ -126,6 +126,8 @@ def _add_capture_options(p):
     g.add_argument("--format", metavar="LAYOUT", default="auto", help="the capture's layout (default auto)")
     g.add_argument("--input-column", metavar="NAME|N", help="input column by name or number; 'none' ignores it")
     g.add_argument("--output-column", metavar="NAME|N", help="output column by name or number")
+    from .identify import add_plain_columns_options
+    add_plain_columns_options(g)
     g.add_argument("--methods", nargs="+", metavar="NAME", help="only these identification methods")
     g.add_argument("--no-refine", action="store_true", help="skip the least-squares fits (then no 95 %% intervals)")
 
@@ -206,6 +208,7 @@ def _build_spec(args):
 CAPTURE_OPTIONS = (("step_time", "--step-time", None), ("step_amplitude", "--step-amplitude", None),
                    ("window", "--window", None), ("format", "--format", "auto"),
                    ("input_column", "--input-column", None), ("output_column", "--output-column", None),
+                   ("sample_time", "--sample-time", None), ("columns", "--columns", None),
                    ("methods", "--methods", None), ("no_refine", "--no-refine", False))
 
 
@@ -229,6 +232,7 @@ def _captured_model(args, typed):
     ns = argparse.Namespace(capture=args.plant_capture, step_time=args.step_time,
                             step_amplitude=args.step_amplitude, window=args.window, format=fmt,
                             input_column=args.input_column, output_column=args.output_column, methods=args.methods,
+                            sample_time=args.sample_time, columns=args.columns,
                             no_refine=args.no_refine, against=None, plot=None, json=True)
     header = ident.frequency_table_header(args.plant_capture)
     result = ident.identify_capture(ns) if header is None else ident.identify_frequency_table(ns, header)

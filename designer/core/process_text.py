@@ -12,6 +12,11 @@ values in engineering notation, theta 0 when not given):
 - ``num den [theta]``             rational, N(s) e^(-theta s) / D(s), coefficients highest
   power first, commas or spaces inside the brackets (``num=[1] den=[1m 1]``)
 - ``K [tau] integrator [theta]``  integrating, K e^(-theta s) / (s (tau s + 1)) (no tau: K/s)
+- ``K [zeros] poles [theta]``     factored, as papers print a plant (e.g. Astrom and Hagglund,
+  *Advanced PID Control*, 2006, the test batch of section 7.2):
+  ``K=1 zeros=[-0.3s+1, 0.08s+1] poles=[2s+1, s+1, (0.05s+1)^3]``, K times the product of the
+  zeros' factors over the product of the poles' (:func:`factor_list`; printed back by
+  :func:`factored_text`), built as the rational form
 
 Each form is built by the builder of :mod:`designer.core.process_build` that its
 constructor uses, with the typed key names, so a typed model is checked
@@ -29,18 +34,23 @@ from __future__ import annotations
 import difflib
 import re
 
+import numpy as np
+
 from .errors import DesignError
 # the builders behind the constructors: they take the names a refusal uses
 from .process import ProcessModel
-from .process_build import build_fopdt, build_integrating, build_rational, build_sopdt, build_underdamped
+from .process_build import MAX_ORDER, build_fopdt, build_integrating, build_rational, build_sopdt, build_underdamped
 from .units import parse_value
 
-__all__ = ["FORMS_TEXT", "parse_tf"]
+__all__ = ["KEYS", "INTEGRATOR", "FACTOR_KEYS", "FORMS", "FORMS_TEXT", "FACTORS_TEXT", "parse_tf",
+           "factor_list", "factored_text"]
 
 #: what a key of a typed model may be written as (lower case) -> the key
 KEYS = {"k": "K", "tau": "tau", "tau_s": "tau", "tau1": "tau1", "tau1_s": "tau1", "tau2": "tau2",
         "tau2_s": "tau2", "fn": "fn", "fn_hz": "fn", "zeta": "zeta", "theta": "theta", "theta_s": "theta",
-        "num": "num", "den": "den"}
+        "num": "num", "den": "den", "zeros": "zeros", "poles": "poles"}
+#: the keys whose lists are factors (polynomials in s), not coefficients
+FACTOR_KEYS = ("zeros", "poles")
 #: the bare word of the integrating form
 INTEGRATOR = "integrator"
 #: form -> (required keys, optional keys) of :func:`parse_tf`
@@ -50,10 +60,11 @@ FORMS = {
     "underdamped": (("K", "fn", "zeta"), ("theta",)),
     "rational": (("num", "den"), ("theta",)),
     "integrating": (("K", INTEGRATOR), ("tau", "theta")),
+    "factored": (("K", "poles"), ("zeros", "theta")),
 }
 _FORM_NAMES = {"fopdt": "FOPDT", "sopdt": "SOPDT", "underdamped": "underdamped", "rational": "rational",
-               "integrating": "integrating"}
-_ORDER = ("K", "tau", "tau1", "tau2", "fn", "zeta", "num", "den", INTEGRATOR, "theta")
+               "integrating": "integrating", "factored": "factored"}
+_ORDER = ("K", "tau", "tau1", "tau2", "fn", "zeta", "num", "den", "zeros", "poles", INTEGRATOR, "theta")
 #: the typed key of each library parameter name
 _TYPED_NAMES = {"K": "K", "tau_s": "tau", "tau1_s": "tau1", "tau2_s": "tau2", "fn_hz": "fn", "zeta": "zeta",
                 "theta_s": "theta", "num": "num", "den": "den"}
@@ -66,7 +77,10 @@ def _form_text(form: str, label: bool = True) -> str:
 
 
 FORMS_TEXT = "; ".join(_form_text(f) for f in FORMS)
-_KEYS_TEXT = "K, tau, tau1, tau2, fn, zeta, theta, num, den and the word integrator"
+_KEYS_TEXT = "K, tau, tau1, tau2, fn, zeta, theta, num, den, zeros, poles and the word integrator"
+#: the accepted syntax of a factor list, for messages
+FACTORS_TEXT = "poles=[2s+1, s+1, (0.05s+1)^3] (factors: polynomials in s such as 0.4s+1 or s^2+0.2s+1, " \
+               "a power on a bracketed factor, factors separated by commas)"
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*", re.ASCII)
 _VALUE = re.compile(r"[^\s\[\]=,;]+")
@@ -97,6 +111,9 @@ def _tokens(text: str) -> list:
 
     def garbage(at: int):
         chunk = s[at:].split()[0] if s[at:].split() else s[at:]
+        if chunk[:1] in ("]", ")"):
+            return DesignError(f"unbalanced bracket: {_show(chunk)} closes a bracket never opened; write lists "
+                               "as num=[1m 1] or " + FACTORS_TEXT)
         return DesignError(f"cannot read {_show(chunk)}: write the plant as key=value words, e.g. "
                            "K=2 tau=1m theta=200u")
 
@@ -113,13 +130,16 @@ def _tokens(text: str) -> list:
             pos = _SPACE.match(s, j + 1).end()
             if pos < len(s) and s[pos] == "[":
                 close = s.find("]", pos)
+                factors = word.lower() in FACTOR_KEYS
+                example = f"{word}=[2s+1, (0.05s+1)^3]" if factors else f"{word}=[1m 1]"
                 if close < 0:
-                    raise DesignError(f"{word}=[ has no closing ]: write lists as {word}=[1m 1]")
-                items = [x for x in re.split(r"[,\s]+", s[pos + 1:close]) if x]
-                if any("=" in x or "[" in x for x in items):
-                    raise DesignError(f"{word}=[ has no closing ] before the next key: write lists as "
-                                      f"{word}=[1m 1]")
-                out.append((word, items))
+                    raise DesignError(f"unbalanced bracket: {word}=[ has no closing ]; write lists as {example}")
+                inside = s[pos + 1:close]
+                if "=" in inside or "[" in inside:
+                    raise DesignError(f"unbalanced bracket: {word}=[ has no closing ] before the next key; "
+                                      f"write lists as {example}")
+                # a factor list is read whole (its factors hold brackets and spaces), a coefficient list by items
+                out.append((word, _Factors(inside) if factors else [x for x in re.split(r"[,\s]+", inside) if x]))
                 pos = close + 1
             else:
                 v = _VALUE.match(s, pos)
@@ -137,7 +157,7 @@ def _tokens(text: str) -> list:
         else:
             out.append((word, None))
         if pos < len(s) and not (s[pos].isspace() or s[pos] in ",;"):
-            raise garbage(start)
+            raise garbage(pos if s[pos] in "])" else start)
 
 
 def _values(tokens) -> dict:
@@ -164,6 +184,8 @@ def _values(tokens) -> dict:
         raw[key] = value
         if key == INTEGRATOR:
             got[key] = True
+        elif key in FACTOR_KEYS:
+            got[key] = factor_list(value, key)
         elif key in ("num", "den"):
             items = value if isinstance(value, list) else [value]
             got[key] = [parse_value(x, key) for x in items]
@@ -221,6 +243,8 @@ def parse_tf(text: str) -> ProcessModel:
     - ``num=[1] den=[1m 1] theta=0``             rational, highest power first,
       commas or spaces inside the brackets
     - ``K=50 tau=10m integrator``, ``K=50 integrator theta=1m``  integrating
+    - ``K=1 zeros=[-0.3s+1] poles=[2s+1, (0.05s+1)^3] theta=0.1``  factored:
+      K times the zeros' factors over the poles' (:func:`factor_list`)
 
     A value may carry its unit or prefix after a space, as
     :func:`~designer.core.units.format_eng` prints it (``tau=1.5 ms``).
@@ -239,7 +263,9 @@ def parse_tf(text: str) -> ProcessModel:
     DesignError
         One line naming the key at fault and what is allowed: an unknown key
         (with the closest one), a key given twice, a key missing for the form,
-        a mix of forms, a value that is not a number, or a value outside the
+        a mix of forms, a value that is not a number, a factor list with an
+        unbalanced bracket, an unknown word, a power that is not a positive
+        whole number or no factor (:func:`factor_list`), or a value outside the
         ranges of :mod:`designer.core.process_build` (:data:`~designer.core.process_build.TAU_RANGE`,
         :data:`~designer.core.process_build.GAIN_RANGE`, :data:`~designer.core.process_build.FN_RANGE`,
         0 < zeta < 1, :data:`~designer.core.process_build.MAX_DEAD_TIME_RATIO`, a
@@ -261,4 +287,196 @@ def parse_tf(text: str) -> ProcessModel:
         return build_underdamped(got["K"], got["fn"], got["zeta"], theta, n, "typed", None)
     if form == "rational":
         return build_rational(got["num"], got["den"], theta, n, "typed", None)
+    if form == "factored":
+        num = got["K"] * np.asarray(got.get("zeros", [1.0]), float)
+        return build_rational(num, got["poles"], theta, {**n, "num": "zeros", "den": "poles"}, "typed", None)
     return build_integrating(got["K"], got.get("tau", 0.0), theta, n, "typed", None)
+
+
+# --------------------------------------------------------------------------- factored forms
+
+class _Factors(str):
+    """The text inside a factor list's brackets, kept whole for :func:`factor_list`."""
+
+
+# a coefficient: a decimal number, then an engineering prefix or none ("50ms+1" is 50m s + 1)
+_COEF = re.compile(r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(?:meg|MEG|[fpnuµmkMGT](?![a-rt-zA-Z]))?")
+
+
+def _factor_error(what: str, factor: str, key: str) -> DesignError:
+    return DesignError(f"{key}: {what} in the factor {_show(factor)}; write {FACTORS_TEXT}")
+
+
+def _poly(text: str, factor: str, key: str) -> np.ndarray:
+    """The coefficients (highest power first) of a polynomial in s written without spaces."""
+    terms, i, n = {}, 0, len(text)
+    if n == 0:
+        raise _factor_error("an empty bracket", factor, key)
+    while i < n:
+        sign = 1.0
+        if text[i] in "+-":
+            sign, i = (-1.0 if text[i] == "-" else 1.0), i + 1
+        elif terms:
+            raise _factor_error(f"{_show(text[i:])} follows a term with no + or - between", factor, key)
+        start = i
+        m = _COEF.match(text, i)
+        coef = 1.0
+        if m:
+            coef, i = parse_value(m.group(), key), m.end()
+            if i < n and text[i] == "*":
+                i += 1
+        deg = 0
+        if i < n and text[i] == "s":
+            deg, i = 1, i + 1
+            if i < n and text[i] == "^":
+                p = re.match(r"[^+\-*()]*", text[i + 1:]).group()
+                deg, i = _power(p, f"s^{p}", factor, key), i + 1 + len(p)
+        if i == start or (m is None and deg == 0):
+            word = re.match(r"[^+\-*()]*", text[start:]).group() or text[start:start + 1]
+            raise _factor_error(f"unknown word {_show(word)}", factor, key)
+        if i < n and text[i] == "^":
+            raise _factor_error("a power on a term that is not s (a power goes on a bracketed factor, "
+                                "(0.05s+1)^3)", factor, key)
+        if i < n and text[i] not in "+-":
+            word = re.match(r"[^+\-*()]*", text[i:]).group() or text[i]
+            raise _factor_error(f"unknown word {_show(word)}", factor, key)
+        if deg in terms:
+            raise _factor_error(f"two terms in s^{deg} (separate factors with commas)", factor, key)
+        terms[deg] = sign * coef
+    c = np.zeros(max(terms) + 1)
+    for deg, v in terms.items():
+        c[-1 - deg] = v
+    c = np.trim_zeros(c, "f")
+    if c.size == 0:
+        raise _factor_error("a factor that is zero", factor, key)
+    return c
+
+
+def _power(text: str, shown: str, factor: str, key: str) -> int:
+    """A power: a whole number 1 to :data:`MAX_ORDER` (the highest order a plant may have)."""
+    if not (text.isascii() and text.isdigit()) or not 1 <= int(text) <= MAX_ORDER:
+        raise _factor_error(f"the power {_show(shown)} is not a positive whole number up to {MAX_ORDER}",
+                            factor, key)
+    return int(text)
+
+
+def _factor(text: str, key: str) -> np.ndarray:
+    """One factor: a polynomial in s, or bracketed ones multiplied (``(s+1)(2s+1)``, ``*`` allowed), each
+    with an optional power."""
+    f = re.sub(r"\)\s+([(*])", r")\1", text.strip())   # (2s+1) (s+1): a product, as without the space
+    if re.search(r"[\w.)]\s+[\w.(]", f):
+        raise _factor_error("two terms with only a space between them (separate factors with commas; "
+                            "write a term as 0.4s)", text, key)
+    f = "".join(f.split())
+    if "(" not in f and ")" not in f:
+        return _poly(f, text, key)
+    out, i = np.ones(1), 0
+    while i < len(f):
+        if f[i] == "*" and i > 0:
+            i += 1
+        if i >= len(f) or f[i] != "(":
+            what = ("unbalanced bracket: a ')' with no '('" if ")" in f[i:] and "(" not in f[i:f.find(")", i)]
+                    else f"{_show(f[i:])} outside the brackets (write a bracketed factor whole: (0.05s+1)^3)")
+            raise _factor_error(what, text, key)
+        close = f.find(")", i + 1)
+        if close < 0 or "(" in f[i + 1:close]:
+            raise _factor_error("unbalanced bracket: a '(' with no ')'", text, key)
+        poly, i = _poly(f[i + 1:close], text, key), close + 1
+        power = 1
+        if i < len(f) and f[i] == "^":
+            p = re.match(r"[^(*]*", f[i + 1:]).group()
+            power, i = _power(p, "^" + p, text, key), i + 1 + len(p)
+        for _ in range(power):
+            out = np.polymul(out, poly)
+        if out.size - 1 > MAX_ORDER:
+            break   # refused, naming the list, by the rational form's own check of its degree
+    return out
+
+
+def factor_list(value, key: str = "poles") -> np.ndarray:
+    """The product of a typed factor list, as polynomial coefficients (highest power of s first).
+
+    Parameters
+    ----------
+    value : str
+        The text inside the brackets of ``poles=[...]`` or ``zeros=[...]``:
+        factors separated by commas, each a polynomial in s (``0.4s+1``,
+        ``-0.3s+1``, ``s^2+0.2s+1``, ``50ms+1``: coefficients in engineering
+        notation, an optional ``*``), a bracketed polynomial with a power
+        (``(0.05s+1)^3``), or bracketed ones multiplied (``(s+1)(2s+1)``).
+        Spaces may stand around signs and brackets; two terms with only a
+        space between them (``[2s+1 s+1]``, ``0.4 s``) are refused, never
+        guessed.
+    key : str
+        The list's key, for messages.
+
+    Returns
+    -------
+    ndarray
+        The coefficients of the product, highest power first.
+
+    Raises
+    ------
+    DesignError
+        One line naming the list and the factor: no factor, an unbalanced
+        bracket, an unknown word, a power that is not a whole number 1 to
+        :data:`~designer.core.process_build.MAX_ORDER`, two terms with no sign
+        between them, a factor that is zero.
+    """
+    text = str(value)
+    items = [x.strip() for x in text.split(",")]
+    if not any(items):
+        raise DesignError(f"{key}=[] has no factor: give at least one"
+                          + (" (or leave zeros out)" if key == "zeros" else "") + f", e.g. {FACTORS_TEXT}")
+    if not all(items):
+        raise DesignError(f"{key}: an empty factor between two commas in {_show('[' + text + ']')}; "
+                          f"write {FACTORS_TEXT}")
+    out = np.ones(1)
+    for item in items:
+        f = _factor(item, key)
+        if f.size == 1:
+            raise _factor_error("a constant factor (the gain goes in K)", item, key)
+        out = np.polymul(out, f)
+        if out.size - 1 > MAX_ORDER:
+            raise DesignError(f"{key} has degree {out.size - 1}; at most {MAX_ORDER} is allowed")
+    return out
+
+
+def _poly_text(c) -> str:
+    """A polynomial in s as :func:`factor_list` reads it back exactly (repr of each coefficient)."""
+    c = [float(x) for x in c]
+    deg = len(c) - 1
+    parts = []
+    for k, v in enumerate(c):
+        p = deg - k
+        if v == 0 and p > 0:
+            continue
+        mag = repr(abs(v))
+        s_part = "" if p == 0 else ("s" if p == 1 else f"s^{p}")
+        body = mag + s_part if (p == 0 or abs(v) != 1.0) else s_part
+        parts.append(("-" if v < 0 else ("+" if parts else "")) + body)
+    return "".join(parts)
+
+
+def factored_text(K: float, poles, zeros=(), theta_s: float = 0.0) -> str:
+    """A factored model as :func:`parse_tf` reads it: ``K=.. zeros=[..] poles=[..] theta=..``.
+
+    Parameters
+    ----------
+    K : float
+        The gain multiplying the zeros' factors.
+    poles, zeros : sequence of (coefficients, power)
+        Each factor's polynomial (highest power of s first) and how many times it is repeated.
+    theta_s : float
+        Dead time, seconds (written when non-zero).
+
+    Returns
+    -------
+    str
+        The model's text; parsed back it gives the same numerator and denominator (every
+        number written as Python's repr, exactly).
+    """
+    def items(factors):
+        return ", ".join(f"({_poly_text(c)})^{p}" if p > 1 else _poly_text(c) for c, p in factors)
+    words = [f"K={float(K)!r}"] + ([f"zeros=[{items(zeros)}]"] if len(zeros) else []) + [f"poles=[{items(poles)}]"]
+    return " ".join(words + ([f"theta={float(theta_s)!r}"] if theta_s else []))

@@ -119,11 +119,17 @@ RANGES = {
     "step_amplitude": Range(1e-12, 1e12),
     # size of the output's change from baseline to final value, in the file's units
     "output_step": Range(1e-15, 2e15),
+    # a capture without a time column (--sample-time): the interval between its rows
+    "sample_time_s": Range(1e-12, 1e6, "s"),
     # simulate-capture (its --step is step_v, --duration capture_span_s, --step-time capture_time_s)
     "capture_points": Range(10, 1e6),
     "noise_v": Range(0.0, 100.0, "V"),
     "lsb_v": Range(0.0, 100.0, "V"),
     "seed": Range(0, 1e9),
+    # simulate-capture --input random-binary: the chance of a switch at each clock tick
+    "switch_probability": Range(0.01, 1.0),
+    # simulate-capture --input chirp: --f-start, --f-stop
+    "chirp_hz": Range(1e-9, 1e9, "Hz"),
     # frequency-response tables (identify-freq): every row
     "freq_hz": Range(1e-9, 1e11, "Hz"),
     "gain_db": Range(-400.0, 400.0, "dB"),

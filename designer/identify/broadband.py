@@ -165,6 +165,36 @@ def _line_share(u) -> float:
     return float(p[1:].max() / total) if total > 0 else 1.0
 
 
+def positional_input(cap):
+    """The capture with its input kept only if it is one, when the reader chose it by position
+    alone (:attr:`~designer.identify.io.Capture.input_by_position`): a step
+    (:func:`~designer.identify.io.looks_like_step_input`), a broadband excitation
+    (:func:`looks_broadband`) or a multi-level sequence (refused later, named); anything else (a
+    second output, as ``time_s,analytic,spice``) is dropped with a note.
+
+    Parameters
+    ----------
+    cap : Capture
+        As :func:`~designer.identify.io.read_capture` returned it (changed in place).
+
+    Returns
+    -------
+    Capture
+        The same capture.
+    """
+    from .io import looks_like_step_input
+    if not cap.input_by_position or cap.u is None:
+        return cap
+    cap.input_by_position = False
+    if looks_like_step_input(cap.u, cap.y) or looks_broadband(cap.u) or multilevel_levels(cap.u) is not None:
+        return cap
+    cap.notes.append(f"column {cap.input_name!r} does not look like a step input (its transitions are not "
+                     "much faster than the output's) nor a broadband one; no input column used (see "
+                     "--input-column)")
+    cap.u, cap.input_name = None, None
+    return cap
+
+
 def looks_broadband(u) -> bool:
     """True for a PRBS or noise: at least MIN_TRANSITIONS transitions at
     irregular intervals and no spectral line holding MAX_LINE_SHARE of the power."""

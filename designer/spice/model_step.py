@@ -297,6 +297,12 @@ def simulate_step(model: ProcessModel, step_v: float = 1.0, step_time_s: float |
     # placed within its tolerance, and interpolating them puts a sliver of the edge on the sample at t0)
     u = np.interp(t, [t0, t0 + EDGE_FRACTION * duration / (points - 1)], [0.0, step_v])
     y = np.interp(t, ts, res["y"])
+    return t, *_recorded(u, y, points, noise_v, lsb_v, seed)
+
+
+def _recorded(u, y, points, noise_v, lsb_v, seed) -> tuple:
+    """(u, y) as the scope records them: the output's swing checked against the LSB, noise from
+    ``default_rng(seed)`` (the input's draws first), then quantisation."""
     if lsb_v > 0:   # the output's swing over the record, noiseless (the input's was checked before the run)
         _check_codes(float(np.ptp(y)), lsb_v, "the output's swing")
     if noise_v > 0:
@@ -306,4 +312,74 @@ def simulate_step(model: ProcessModel, step_v: float = 1.0, step_time_s: float |
     if lsb_v > 0:
         u = lsb_v * np.round(u / lsb_v)
         y = lsb_v * np.round(y / lsb_v)
-    return t, u, y
+    return u, y
+
+
+def input_deck(model: ProcessModel, corners_t, corners_v, duration_s: float, points: int) -> str:
+    """The standalone deck of the model under a piecewise-linear input: the source ``u`` (its
+    corners on continuation lines), the plant from ``u`` to ``y`` and the ``.tran`` line.
+
+    Parameters
+    ----------
+    model : ProcessModel
+        The plant.
+    corners_t, corners_v : array_like
+        The source's corners (s, increasing; V).
+    duration_s : float
+        The record, seconds.
+    points : int
+        Its samples (they set the largest time step).
+
+    Returns
+    -------
+    str
+        Deck text ending in ``.end``.
+    """
+    pairs = [f"{_num(a)} {_num(b)}" for a, b in zip(corners_t, corners_v)]
+    src = ["Vu u 0 PWL("] + ["+ " + " ".join(pairs[i:i + 8]) for i in range(0, len(pairs), 8)] + ["+ )"]
+    h = max_step_s(model, duration_s, points)
+    return "\n".join([f"simulated capture: {model.text()}", *src,
+                      *plant_lines(model.num, model.den, model.theta_s, "u", "y", name="plant"),
+                      f".tran {_num(h)} {_num(duration_s)} 0 {_num(h)}", ".end"]) + "\n"
+
+
+def simulate_input(model: ProcessModel, excitation, duration_s: float, points: int = DEFAULT_POINTS, *,
+                   noise_v: float = 0.0, lsb_v: float = 0.0, seed: int = 0, simulator: str = "pyspice",
+                   timeout_s: float | None = None) -> tuple:
+    """Simulate the model's response to any input (a PRBS, a random binary signal, a chirp, a
+    recorded signal: :mod:`designer.core.excitation`) in ngspice, sampled on a uniform grid and
+    recorded as :func:`simulate_step` records a step (the same noise, quantisation and checks,
+    the input's swing in place of the step).
+
+    Parameters
+    ----------
+    model : ProcessModel
+        The plant.
+    excitation : Excitation
+        The input's corners (:class:`designer.core.excitation.Excitation`).
+    duration_s : float
+        The record, from t = 0, seconds.
+    points : int
+        Samples, :data:`MIN_POINTS` to :data:`MAX_POINTS`.
+    noise_v, lsb_v, seed, simulator, timeout_s
+        As :func:`simulate_step`'s.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``(t, u, y)`` on the uniform grid, as :func:`simulate_step` returns them.
+
+    Raises
+    ------
+    DesignError, SimulatorError
+        As :func:`simulate_step` (the input's swing checked against ``lsb_v`` as its step is).
+    """
+    from .simulate import get_simulator
+    swing = float(np.ptp(excitation.v))
+    _, _, duration, points = _checked(model, swing or 1.0, 0.0, duration_s, points, noise_v, lsb_v, seed)
+    sim = get_simulator(simulator, timeout=timeout_s)
+    res = sim.run(input_deck(model, excitation.t, excitation.v, duration, points))
+    t = np.linspace(0.0, duration, points)
+    u = excitation.at(t)
+    y = np.interp(t, res["time"], res["y"])
+    return t, *_recorded(u, y, points, noise_v, lsb_v, seed)

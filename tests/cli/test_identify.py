@@ -427,3 +427,27 @@ def test_step_options_with_a_frequency_table_are_one_line(tmp_path):
     step = run(FIX / "generic_ty.csv", "--json")
     assert step.returncode == 0 and "format" not in json.loads(step.stdout)
     assert json.loads(step.stdout)["capture"]["format"] == "generic"
+
+
+def test_plain_columns_need_and_take_a_sample_time(tmp_path):
+    """Issue 28: a file of u y columns without time (DaISy's layout) is read with --sample-time
+    (engineering notation) and --columns; without --sample-time it is refused naming the option."""
+    t = np.arange(1500) * 2e-5
+    u = np.where(t >= 3e-3, 1.0, 0.0)
+    y = model_step("fopdt", {"K": 2.0, "tau_s": 2e-3, "theta_s": 0.0}, t - 3e-3)
+    plain = tmp_path / "plain.dat"
+    plain.write_text("".join(f"{a:15.7e}\t{b:15.7e}\t\n" for a, b in zip(u, y)))
+    p = run(plain, "--sample-time", "20u", "--columns", "u,y", "--json")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    assert d["capture"]["samples"] == 1500 and d["capture"]["input"] == "u"
+    assert any("no time column" in n for n in d["capture"]["notes"])
+    best = d["best"]["params"]
+    assert best["K"] == pytest.approx(2.0, rel=0.02) and best["tau_s"] == pytest.approx(2e-3, rel=0.05)
+    for args, words in (([], "give --sample-time"), (["--columns", "u,y"], "give --sample-time with it"),
+                        (["--sample-time", "0"], "--sample-time must be 1 ps to 1e+06 s"),
+                        (["--sample-time", "20u", "--columns", "u,y,x"], "--columns names 3 columns")):
+        q = run(plain, *args)
+        assert q.returncode == 2 and len(q.stderr.splitlines()) == 1 and words in q.stderr, q.stderr
+    helptext = " ".join(run("--help").stdout.split())
+    assert "--sample-time S" in helptext and "seconds (1 ps to 1e+06 s)" in helptext

@@ -161,3 +161,16 @@ def test_for_plant_clock_stays_in_the_clock_range(tf, tau, tmp_path):
     ok = run("--for-plant", "--plant-tf", f"K=1 tau={tau_ok!r}", "--no-files", "--json")
     assert ok.returncode == 0, ok.stderr
     assert json.loads(ok.stdout)["prbs"]["clock_hz"] <= hi
+
+
+def test_for_plant_takes_the_factored_form():
+    """Issue 28: --plant-tf typed as papers print it plans as its expanded rational form does."""
+    a = run("--for-plant", "--plant-tf", "K=1 zeros=[-0.3s+1] poles=[2s+1, s+1, (0.05s+1)^3]", "--no-files", "--json")
+    b = run("--for-plant", "--plant-tf", "num=[-0.3 1] den=[0.00025 0.015375 0.322625 2.4575 3.15 1]",
+            "--no-files", "--json")
+    assert a.returncode == 0 and b.returncode == 0, a.stderr
+    pa, pb = json.loads(a.stdout), json.loads(b.stdout)
+    assert pa["prbs"] == pb["prbs"]
+    assert pa["plant"]["settling_time_s"] == pytest.approx(pb["plant"]["settling_time_s"], rel=1e-9)
+    bad = run("--for-plant", "--plant-tf", "K=1 poles=[(2s+1]", "--no-files")
+    assert bad.returncode == 2 and len(bad.stderr.splitlines()) == 1 and "unbalanced bracket" in bad.stderr

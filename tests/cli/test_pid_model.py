@@ -213,3 +213,34 @@ def test_a_model_file_with_a_key_twice_is_refused_naming_it(tmp_path, capture):
     line = one_line_refusal(run(DESIGN_PID, "--plant-model", str(twice), "--no-sim", "--no-files"),
                             "has the key 'best' twice in one object")
     assert "?" not in line
+
+
+def test_plant_capture_of_plain_columns_with_a_sample_time(tmp_path, capture):
+    """Issue 28: the same record as u y columns without time (as DaISy keeps data), read with
+    --sample-time (engineering notation) and --columns, identifies the same model."""
+    t, u, y = np.loadtxt(capture, delimiter=",", skiprows=1, unpack=True)
+    plain = tmp_path / "plain.dat"
+    plain.write_text("".join(f"{b:.9g}\t{a:.9g}\n" for a, b in zip(u, y)))
+    ref = run(DESIGN_PID, "--plant-capture", str(capture), "--json", "--no-files", "--no-sim")
+    p = run(DESIGN_PID, "--plant-capture", str(plain), "--sample-time", "5u", "--columns", "y,u", "--json",
+            "--no-files", "--no-sim")
+    assert ref.returncode == 0 and p.returncode == 0, p.stderr
+    a, b = json.loads(ref.stdout)["plant"]["model"], json.loads(p.stdout)["plant"]["model"]
+    assert a["kind"] == b["kind"] and a["num"] == pytest.approx(b["num"], rel=1e-9)
+    assert a["den"] == pytest.approx(b["den"], rel=1e-9) and a["theta_s"] == pytest.approx(b["theta_s"], rel=1e-9)
+    one_line_refusal(run(DESIGN_PID, "--plant-capture", str(plain), "--no-files", "--no-sim"),
+                     "give --sample-time")
+    one_line_refusal(run(DESIGN_PID, "--plant-tf", TF, "--sample-time", "1m", "--no-files", "--no-sim"),
+                     "--sample-time is an option of --plant-capture")
+
+
+def test_plant_tf_takes_the_factored_form(tmp_path):
+    """Issue 28: a plant typed as papers print it designs as its expanded rational form does."""
+    a = run(DESIGN_PID, "--plant-tf", "K=2 zeros=[-0.1ms+1] poles=[(1ms+1)^2] theta=100u", "--json",
+            "--no-files", "--no-sim")
+    b = run(DESIGN_PID, "--plant-tf", "num=[-0.2m 2] den=[1u 2m 1] theta=100u", "--json", "--no-files", "--no-sim")
+    assert a.returncode == 0 and b.returncode == 0, a.stderr
+    ma, mb = json.loads(a.stdout)["plant"]["model"], json.loads(b.stdout)["plant"]["model"]
+    assert ma["num"] == pytest.approx(mb["num"], rel=1e-12) and ma["den"] == pytest.approx(mb["den"], rel=1e-12)
+    one_line_refusal(run(DESIGN_PID, "--plant-tf", "K=2 poles=[(1ms+1)^2", "--no-files", "--no-sim"),
+                     "--plant-tf")

@@ -188,3 +188,128 @@ def test_garbage_only_ever_raises_design_error(text):
 def test_parse_tf_refuses_what_is_not_text():
     with pytest.raises(DesignError, match="text"):
         parse_tf(None)
+
+
+# --------------------------------------------------------------------------- factored forms (issue 28)
+
+from designer.core.process_text import factor_list, factored_text  # noqa: E402
+
+
+def _expanded(K, zeros, poles):
+    """num, den of a factored model by numpy's own products (independent of the parser)."""
+    import numpy as np
+    num, den = np.array([float(K)]), np.array([1.0])
+    for c, p in zeros:
+        for _ in range(p):
+            num = np.polymul(num, c)
+    for c, p in poles:
+        for _ in range(p):
+            den = np.polymul(den, c)
+    return num / den[-1], den / den[-1]
+
+
+def test_the_issue_s_factored_plant_is_the_product_of_its_factors():
+    import numpy as np
+    m = parse_tf("K=1 zeros=[-0.3s+1, 0.08s+1] poles=[2s+1, s+1, 0.4s+1, 0.2s+1, (0.05s+1)^3] theta=0.1")
+    num, den = _expanded(1.0, [([-0.3, 1], 1), ([0.08, 1], 1)],
+                         [([2, 1], 1), ([1, 1], 1), ([0.4, 1], 1), ([0.2, 1], 1), ([0.05, 1], 3)])
+    assert m.kind == "rational" and m.theta_s == 0.1 and m.gain == pytest.approx(1.0, rel=1e-15)
+    assert np.allclose(m.num, num, rtol=1e-14) and np.allclose(m.den, den, rtol=1e-14)
+    assert sorted(m.time_constants_s) == pytest.approx(sorted([2, 1, 0.4, 0.2, 0.05, 0.05, 0.05]), rel=1e-4)
+
+
+@pytest.mark.parametrize("text, same_as", [
+    ("K=2 poles=[2s+1, s+1]", "K=2 poles=[( 2s + 1 )(s+1)]"),
+    ("K=2 poles=[2s+1, s+1]", "K=2 poles=[(2s+1) * (s+1)]"),
+    ("K=2 poles=[2s+1, s+1]", "K=2 poles=[(2s+1) (s+1)]"),
+    ("K=2 poles=[2s+1, s+1]", "K=2 poles=[2*s+1, 1s+1]"),
+    ("K=2 poles=[2s+1, s+1]", "k=2 POLES=[2s +1, s + 1]"),
+    ("K=2 poles=[0.05s+1, 0.05s+1, 0.05s+1]", "K=2 poles=[(50ms+1)^3]"),
+    ("K=2 poles=[s^2+0.2s+1]", "K=2 poles=[s^2 + 200m*s + 1]"),
+    ("K=2 poles=[0.4s+1]", "K=2 poles=0.4s+1"),
+    ("K=2 poles=[0.4s+1]", "num=[2] den=[0.4 1]"),
+    ("K=2 zeros=[-0.3s+1] poles=[2s+1, s+1] theta=1", "num=[-0.6 2] den=[2 3 1] theta=1"),
+])
+def test_factored_spellings_give_the_same_model(text, same_as):
+    import numpy as np
+    a, b = parse_tf(text), parse_tf(same_as)
+    assert np.allclose(a.num, b.num, rtol=1e-14) and np.allclose(a.den, b.den, rtol=1e-14)
+    assert a.theta_s == b.theta_s
+
+
+@pytest.mark.parametrize("text, words", [
+    ("K=1 poles=[2s+1", ("unbalanced bracket", "no closing ]", "poles=[")),
+    ("K=1 poles=[(2s+1]", ("unbalanced bracket", "'(' with no ')'", "poles=[2s+1")),
+    ("K=1 poles=[2s+1)]", ("unbalanced bracket", "')' with no '('")),
+    ("K=1 poles=[2s+1]]", ("unbalanced bracket", "never opened")),
+    ("K=1 poles=[]", ("no factor", "poles=[2s+1")),
+    ("K=1 zeros=[ ] poles=[s+1]", ("zeros=[] has no factor", "leave zeros out")),
+    ("K=1 poles=[2s+1,,s+1]", ("empty factor",)),
+    ("K=1 poles=[2x+1]", ("unknown word 'x'", "'2x+1'", "polynomials in s")),
+    ("K=1 poles=[(s+1)x]", ("'x' outside the brackets",)),
+    ("K=1 poles=[(s+1)^0]", ("'^0'", "positive whole number")),
+    ("K=1 poles=[(s+1)^1.5]", ("'^1.5'", "positive whole number")),
+    ("K=1 poles=[(s+1)^-2]", ("'^-2'", "positive whole number")),
+    ("K=1 poles=[(s+1)^99999999999]", ("positive whole number up to 10",)),
+    ("K=1 poles=[s^x+1]", ("'s^x'", "positive whole number")),
+    ("K=1 poles=[s+1^2]", ("bracketed factor",)),
+    ("K=1 poles=[2s + s]", ("two terms in s^1",)),
+    ("K=1 poles=[0.4 s+1]", ("only a space between",)),
+    ("K=1 poles=[2s+1 s+1]", ("only a space between", "separate factors with commas")),
+    ("K=1 poles=[s^2 + 200m s + 1]", ("only a space between",)),
+    ("K=1 poles=[2, s+1]", ("constant factor",)),
+    ("K=1 poles=[s+1] pole=2", ("unknown key 'pole'", "did you mean poles", "zeros, poles")),
+    ("K=1 zeros=[s+1, s+2] poles=[s+1]", ("proper",)),
+    ("K=1 poles=[-s+1]", ("right half plane",)),
+    ("zeros=[s+1] poles=[s+1, s+2]", ("missing K", "K [zeros] poles [theta]")),
+    ("K=1 tau=2 poles=[s+1]", ("different forms", "(factored)")),
+    ("K=1 poles=[(s+1)^6, (s+1)^5]", ("degree 11", "at most 10")),
+])
+def test_every_factored_refusal_is_one_line(text, words):
+    with pytest.raises(DesignError) as err:
+        parse_tf(text)
+    msg = str(err.value)
+    assert "\n" not in msg and all(w in msg for w in words), msg
+
+
+_TAUS = st.floats(1e-3, 1e3, allow_nan=False, allow_infinity=False)
+
+
+@st.composite
+def _factored(draw):
+    """A random proper, stable factored model: first-order factors (zeros of either sign) and
+    underdamped pairs, with powers."""
+    poles = [([draw(_TAUS), 1.0], draw(st.integers(1, 3))) for _ in range(draw(st.integers(1, 2)))]
+    if draw(st.booleans()):
+        wn, zeta = 1.0 / draw(_TAUS), draw(st.floats(0.05, 0.95))
+        poles.append(([1.0 / wn ** 2, 2 * zeta / wn, 1.0], 1))
+    order = sum((len(c) - 1) * p for c, p in poles)
+    zeros = []
+    for _ in range(draw(st.integers(0, min(2, order)))):
+        zeros.append(([draw(_TAUS) * draw(st.sampled_from([1.0, -1.0])), 1.0], 1))
+    K = draw(st.floats(1e-3, 1e3)) * draw(st.sampled_from([1.0, -1.0]))
+    theta = draw(st.sampled_from([0.0, 0.5, 1.25])) * poles[0][0][0]   # within the dead-time limit
+    return K, zeros, poles, theta
+
+
+@settings(max_examples=150, deadline=None)
+@given(_factored())
+def test_a_printed_factored_model_parses_back_to_the_same_num_and_den(model):
+    import numpy as np
+    K, zeros, poles, theta = model
+    text = factored_text(K, poles, zeros, theta)
+    parsed = parse_tf(text)
+    num, den = _expanded(K, zeros, poles)
+    assert np.allclose(parsed.num, num, rtol=1e-12, atol=0) and np.allclose(parsed.den, den, rtol=1e-12, atol=0), text
+    assert parsed.theta_s == theta
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text(alphabet="s0123456789.+-*^() ,xK", max_size=30))
+def test_factor_lists_only_ever_raise_design_error(text):
+    try:
+        c = factor_list(text)
+    except DesignError as exc:
+        assert "\n" not in str(exc)
+    else:
+        assert c.size >= 1

@@ -19,13 +19,21 @@ from helpers import EXT_CAPTURES, FIXTURES
 from designer.core.errors import DesignError
 from designer.core.stepfit import model_overshoot_pct
 from designer.core.waveform import noise_sigma, quantum
-from designer.identify.io import FORMATS, parse_capture_text, read_capture
+from designer.identify.broadband import positional_input
+from designer.identify.io import FORMATS, parse_capture_text
+from designer.identify.io import read_capture as read_file
 from designer.identify.preprocess import prepare_step
 from designer.identify.step import identify_step
 from designer.identify.structures import model_step
 
 FIX = FIXTURES / "identify"
 BENCH = json.loads((FIX / "bench_truth.json").read_text())
+
+
+def read_capture(path, **kw):
+    """A capture as identify reads it: the reader, then the analysis' decision on an input chosen
+    by position only (:func:`designer.identify.broadband.positional_input`)."""
+    return positional_input(read_file(path, **kw))
 
 
 def _identify(path, **kw):

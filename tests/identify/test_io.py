@@ -3,13 +3,17 @@ frequency-response tables."""
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from helpers import FIXTURES
 
 from designer.core.errors import DesignError
 from designer.identify import io as tio
+from designer.identify.broadband import positional_input
 from designer.identify.io import format_generic, parse_capture_text, read_capture
 from designer.identify.structures import model_step
 
@@ -129,9 +133,12 @@ def test_input_by_position_only_when_it_looks_like_a_step():
     u = np.where(t >= 0, 1.0, 0.0)
     waves = "time_s,analytic,spice\n" + "".join(f"{a},{b},{c}\n" for a, b, c in zip(t, y1, y2))
     cap = parse_capture_text(waves)
+    # the reader keeps it, marked; the analysis decides it is no input
+    assert cap.input_by_position and cap.input_name == "analytic" and not cap.notes
+    cap = positional_input(cap)
     assert cap.u is None and cap.output_name == "spice" and "does not look like" in cap.notes[0]
     tuy = "".join(f"{a},{b},{c}\n" for a, b, c in zip(t, u, y2))
-    cap = parse_capture_text(tuy)
+    cap = positional_input(parse_capture_text(tuy))
     assert cap.input_name == "u" and np.array_equal(cap.u, u)
 
 
@@ -395,3 +402,143 @@ def test_table_limits(tmp_path):
     (tmp_path / "u16.csv").write_text("f,g\n1,0\n2,-1\n3,-2\n4,-3\n5,-4\n", encoding="utf-16")
     with pytest.raises(DesignError, match="UTF-16 text, not UTF-8"):
         tio.read_freq_table(tmp_path / "u16.csv")
+
+
+# --------------------------------------------------------------------------- plain columns (issue 28)
+
+from helpers import EXT_CAPTURES  # noqa: E402
+
+from designer.cli.common import flag_message  # noqa: E402
+
+DRYER = EXT_CAPTURES / "daisy_dryer.dat"
+
+
+def _daisy_text(u, y):
+    """Columns as DaISy writes them: right-aligned %.7e, tab separated, a trailing tab, no header."""
+    return "".join(f"{a:15.7e}\t{b:15.7e}\t\n" for a, b in zip(u, y))
+
+
+def _plain_data(n=400, seed=28):
+    rng = np.random.default_rng(seed)
+    flips = rng.random(n) < 0.2
+    u = 3.41 + 3.0 * (np.cumsum(flips) % 2)
+    y = np.round(4.0 + 0.1 * np.cumsum(rng.standard_normal(n)), 7)
+    return u, y
+
+
+def test_plain_columns_are_read_with_a_sample_time_by_order_or_by_name():
+    u, y = _plain_data()
+    text = _daisy_text(u, y)
+    cap = parse_capture_text(text, name="dryer.dat", sample_time_s=0.08)
+    assert np.array_equal(cap.t, np.arange(u.size) * 0.08)
+    assert np.array_equal(cap.u, u) and np.array_equal(cap.y, y)
+    assert (cap.input_name, cap.output_name, cap.fmt) == ("u", "y", "generic") and not cap.input_by_position
+    assert "no time column" in cap.notes[0]
+    swapped = parse_capture_text(text, name="dryer.dat", sample_time_s=0.08, column_names="y,u")
+    assert np.array_equal(swapped.u, y) and np.array_equal(swapped.y, u)
+    three = "".join(f"{a},{b},{c}\n" for a, b, c in zip(y, u, -y))
+    cap3 = parse_capture_text(three, sample_time_s=1e-3, column_names=["y", "u", "other"])
+    assert np.array_equal(cap3.u, u) and np.array_equal(cap3.y, y)
+    headed = "heater temp\n" + "".join(f"{a} {b}\n" for a, b in zip(u, y))
+    caph = parse_capture_text(headed, sample_time_s=0.5)
+    assert (caph.input_name, caph.output_name) == ("heater", "temp") and np.array_equal(caph.u, u)
+
+
+def test_plain_columns_without_a_sample_time_are_refused_naming_the_option():
+    u, y = _plain_data()
+    with pytest.raises(DesignError) as err:
+        parse_capture_text(_daisy_text(u, y), name="dryer.dat")
+    msg = str(err.value)
+    assert "column 1 is not a time" in msg and "sample_time_s" in msg and "\n" not in msg
+    shown = flag_message(err.value)
+    assert "--sample-time" in shown and "--columns" in shown and "sample_time_s" not in shown
+    # a time column with one glitch is still named as such (its line), not taken for a signal
+    glitch = "".join(f"{i * 1e-3 if i != 60 else 0.0},{b}\n" for i, b in enumerate(y))
+    with pytest.raises(DesignError, match="time is not increasing at line 61"):
+        parse_capture_text(glitch)
+
+
+@pytest.mark.parametrize("kwargs, text, words", [
+    ({"column_names": "u,y"}, None, ("{column_names}", "give {sample_time_s}")),
+    ({"sample_time_s": 0.08, "column_names": "u"}, None, ("names 1 column", "has 2", "e.g. u,y")),
+    ({"sample_time_s": 0.08, "column_names": "u,U"}, None, ("two columns 'u'",)),
+    ({"sample_time_s": 0.08, "column_names": "u,"}, None, ("an empty name",)),
+    ({"sample_time_s": 0.0}, None, ("sample_time_s must be 1 ps to 1e+06 s",)),
+    ({"sample_time_s": 2e6}, None, ("sample_time_s must be 1 ps to 1e+06 s",)),
+    ({"sample_time_s": 0.08}, "t,u,y\n" + "".join(f"{i},{i % 2},{i}\n" for i in range(20)),
+     ("first column ('t') is a time column", "drop it")),
+    ({"sample_time_s": 0.08}, "Record Length,20,Points,0.0,0.5\n", ("Tektronix",)),
+    ({"sample_time_s": 0.08}, "".join(f"{i % 2} {i}\n" for i in range(20)) + "1\n",
+     ("line 21 has no value in column 2, nor any line after it", "different lengths")),
+    ({"sample_time_s": 0.08}, "".join(f"{i % 2} {i}\n" for i in range(20)) + "1\n1\n1\n",
+     ("line 21 has no value in column 2, nor any line after it", "different lengths")),
+    ({}, "".join(f"{i},{i % 2},{i}\n" for i in range(20)) + "20,1\n21,1,2\n",
+     ("line 21 has no value in column 3; every data row",)),
+    ({"sample_time_s": 0.08, "column_names": "u,y"}, "".join(f"2.5 {i}\n" for i in range(20)),
+     ("input column 'u' never moves", "every sample 2.5", "{input_column} none")),
+])
+def test_plain_column_refusals_are_one_line_naming_the_parameter(kwargs, text, words):
+    u, y = _plain_data()
+    if text is None:
+        text = _daisy_text(u, y)
+    elif text.startswith("Record Length"):
+        text = "".join(f"Record Length,20,,{i * 0.1},{i % 2}\n" if i == 0 else f",,,{i * 0.1},{i % 2}\n"
+                       for i in range(20))
+    with pytest.raises(DesignError) as err:
+        parse_capture_text(text, name="c.dat", **kwargs)
+    marked = getattr(err.value, "marked", str(err.value))
+    assert "\n" not in marked and all(w in marked for w in words), marked
+
+
+def test_a_named_input_that_never_moves_is_refused_and_a_positional_one_dropped():
+    t = np.arange(50) * 1e-3
+    flat = "t,u,y\n" + "".join(f"{a},1.0,{np.tanh(a * 100)}\n" for a in t)
+    with pytest.raises(DesignError, match="never moves"):
+        parse_capture_text(flat)
+    unnamed = "".join(f"{a},1.0,{np.tanh(a * 100)}\n" for a in t).replace("\n", "\n", 1)
+    cap = parse_capture_text("t,a,b\n" + unnamed)
+    assert cap.input_by_position and positional_input(cap).u is None
+    cap = parse_capture_text(flat, input_column="none")
+    assert cap.u is None
+
+
+def test_the_dryer_data_set_reads_as_daisy_describes_it():
+    if not DRYER.is_file():
+        pytest.skip(f"the DaISy dryer data is not at {DRYER} (../shared/ext-captures beside the repository)")
+    with pytest.raises(DesignError, match="column 1 is not a time"):
+        read_capture(DRYER)
+    cap = read_capture(DRYER, sample_time_s=0.08, column_names="u,y")
+    assert cap.t.size == 1000 and cap.t[-1] == pytest.approx(999 * 0.08, rel=1e-12)
+    assert sorted(set(np.round(cap.u, 6))) == [3.41, 6.41]   # SOURCES.md: between 3.41 and 6.41 V
+    switch = np.mean(np.diff(cap.u) != 0)
+    assert 0.15 < switch < 0.25                              # "switches with probability about 0.2"
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.one_of(st.none(), st.text(max_size=20), st.lists(st.text(max_size=5), max_size=4)),
+       st.one_of(st.none(), st.floats(allow_nan=True, allow_infinity=True), st.just(0.08)))
+def test_plain_column_options_only_ever_refuse_in_one_line(names, dt):
+    u, y = _plain_data(60)
+    try:
+        cap = parse_capture_text(_daisy_text(u, y), name="d.dat", sample_time_s=dt, column_names=names)
+    except DesignError as exc:
+        assert "\n" not in str(exc)
+    else:
+        assert cap.t.size == 60 and cap.t[1] == pytest.approx(dt)
+
+
+@pytest.mark.parametrize("header, shift, words", [
+    ("t_u,u,t_y,y", 2.0, "column 3 ('t_y') is a second time column"),
+    ("time,u,time,y", 1.0, "from line 2 on"),
+    ("time_in,vin,time_out,vout", 1.0, "sampled at different times or rates"),
+])
+def test_input_and_output_on_different_time_axes_are_refused(header, shift, words):
+    t = np.arange(30) * 1e-3
+    rows = "".join(f"{a},{i % 2},{a * shift + (0.5e-3 if shift == 1.0 else 0)},{i}\n" for i, a in enumerate(t))
+    with pytest.raises(DesignError, match=re.escape(words)):
+        parse_capture_text(header + "\n" + rows, name="two.csv")
+    same = "".join(f"{a},{i % 2},{a},{i}\n" for i, a in enumerate(t))
+    cap = parse_capture_text(header + "\n" + same)
+    assert cap.u is not None and np.array_equal(cap.t, t)
+    thermo = parse_capture_text("time,t1,t2\n" + "".join(f"{a},{20 + i},{21 + i}\n" for i, a in enumerate(t)))
+    assert thermo.output_name == "t2"   # t1, t2: temperatures, not times

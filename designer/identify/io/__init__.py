@@ -28,6 +28,14 @@ Which signal is the input and which the output: by name when the header names
 them (``u``, ``vin``, ``in``... and ``y``, ``vout``, ``out``...), otherwise by
 position (``t,u,y``: the first signal is the input, the last the output; one
 signal is the output). ``input_column``/``output_column`` override both.
+An input chosen by position only is kept and marked (``input_by_position``):
+whether it is one is the analysis' decision
+(:func:`designer.identify.broadband.positional_input`), not the reader's.
+
+Plain signal columns without a time column (a data set as DaISy keeps it,
+``u y``): ``sample_time_s`` gives the time (sample k at k * sample_time_s) and
+``column_names`` names the columns (:func:`plain_columns`); such a file read
+without it is refused naming them (its first column is no time).
 
 Files are streamed, never read whole: the layout is recognised from the first
 lines, then the samples are parsed a block at a time by numpy's C parser, and
@@ -59,6 +67,7 @@ from .capture import (
     CaptureInfo,
     looks_like_step_input,
     parse_capture_text,
+    plain_columns,
     read_capture,
     text_lines,
 )
@@ -81,7 +90,7 @@ from .split import PARSED, FileBlocks
 from .writers import format_generic
 
 __all__ = ["BLOCK_LINES", "HEAD_LINES", "INPUT_NAMES", "OUTPUT_NAMES", "TIME_NAMES", "Capture", "CaptureInfo",
-           "looks_like_step_input", "parse_capture_text", "read_capture", "text_lines", "check_format", "FREQ_UNITS",
+           "looks_like_step_input", "parse_capture_text", "plain_columns", "read_capture", "text_lines", "check_format", "FREQ_UNITS",
            "GAIN_UNITS", "MAX_POINTS", "MIN_POINTS", "PHASE_UNITS", "FreqData", "freq_data", "parse_freq_table",
            "read_freq_table", "FORMAT_NAMES", "FORMATS", "format_generic", "NUMBER", "unit_hint", "FileBlocks",
            "PARSED"]

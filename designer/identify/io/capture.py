@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...core.errors import DesignError
+from ...core.errors import DesignError, ParamError
 from ...core.fileio import (
     MAX_CAPTURE_BYTES,
     MAX_CAPTURE_ROWS,
@@ -29,12 +29,10 @@ from ...core.fileio import (
     size_text,
 )
 from ..edges import check_samples
+from ...core.ranges import RANGES
 from .formats import detect_layout
-from .layout import is_number, Layout, split_line
+from .layout import FORMAT_NAMES, is_number, Layout, split_line
 from .split import PARSED, FileBlocks
-
-__all__ = ["BLOCK_LINES", "HEAD_LINES", "INPUT_NAMES", "OUTPUT_NAMES", "TIME_NAMES", "Capture", "CaptureInfo",
-           "looks_like_step_input", "parse_capture_text", "read_capture", "text_lines"]
 
 
 INPUT_NAMES = ("u", "vin", "v_in", "in", "input", "uin", "u_in", "v(in)", "ve", "step", "source")
@@ -65,6 +63,9 @@ class Capture:
     input_name: str | None = None
     source: str = ""
     notes: list = field(default_factory=list)
+    #: the input was chosen by position only (no name, no option): the analysis decides whether
+    #: it is one (:func:`designer.identify.broadband.positional_input`)
+    input_by_position: bool = False
 
     def info(self) -> CaptureInfo:
         """What the capture is, without its samples (kept with a result)."""
@@ -91,7 +92,90 @@ class CaptureInfo:
                 "notes": list(self.notes)}
 
 
-def read_capture(path, *, input_column=None, output_column=None, fmt=None) -> Capture:
+__all__ = ["INPUT_NAMES", "OUTPUT_NAMES", "TIME_NAMES", "HEAD_LINES", "BLOCK_LINES", "Capture", "CaptureInfo",
+           "read_capture", "parse_capture_text", "plain_columns", "text_lines", "looks_like_step_input"]
+
+
+def plain_columns(sample_time_s=None, column_names=None) -> tuple | None:
+    """The options of a file of signal columns without a time column, checked:
+    ``(sample_time_s, names)``, or None when neither is given.
+
+    Parameters
+    ----------
+    sample_time_s : float, optional
+        The sample interval, seconds, inside ``RANGES["sample_time_s"]``; sample
+        k is at k * sample_time_s.
+    column_names : str or sequence of str, optional
+        The name of every column, in order (``"u,y"``, ``["y", "u", "x"]``):
+        ``u`` (or another of :data:`INPUT_NAMES`) is the input, ``y`` (or
+        another of :data:`OUTPUT_NAMES`) the output, other names are not used.
+        Default: the file's header, else by order (the first column the input,
+        the second the output; a single column the output).
+
+    Returns
+    -------
+    tuple or None
+        ``(sample_time_s, names or None)``.
+
+    Raises
+    ------
+    DesignError
+        A sample time outside its range, ``column_names`` without
+        ``sample_time_s``, an empty or repeated name.
+    """
+    if sample_time_s is None and column_names is None:
+        return None
+    if sample_time_s is None:
+        raise ParamError("{column_names} names the columns of a file without a time column; give "
+                         "{sample_time_s} with it (the sample interval, e.g. 0.08); a file with a time column "
+                         "chooses its signals with {input_column} and {output_column}",
+                         params=("column_names", "sample_time_s", "input_column", "output_column"))
+    dt = RANGES["sample_time_s"].check(sample_time_s, "sample_time_s")
+    if column_names is None:
+        return dt, None
+    names = ([c.strip() for c in column_names.split(",")] if isinstance(column_names, str)
+             else [str(c).strip() for c in column_names])
+    example = "u,y (or y,u, or u,y,x with a third column unused)"
+    if not names or not all(names):
+        raise ParamError(f"{{column_names}} {show_cell(str(column_names))} has an empty name: name every "
+                         f"column, in order, separated by commas, e.g. {example}", params=("column_names",))
+    low = [n.lower() for n in names]
+    twice = next((n for n in names if low.count(n.lower()) > 1), None)
+    if twice is not None:
+        raise ParamError(f"{{column_names}} names two columns {show_cell(twice)}: name each column once, "
+                         f"e.g. {example}", params=("column_names",))
+    return dt, names
+
+
+def _plain_layout(layout: Layout, plain: tuple, name: str) -> Layout:
+    """The layout of a file of signal columns without a time column: every file
+    column a signal, time k * sample_time_s (the Rigol-without-X path)."""
+    dt, names = plain
+    if layout.fmt != "generic" or layout.time_axis is not None:
+        raise ParamError(f"{name} is a {FORMAT_NAMES[layout.fmt]} export with its own time axis; "
+                         "{sample_time_s} is for a file of signal columns without a time column: drop it",
+                         params=("sample_time_s",))
+    ncols = len(layout.file_cols)
+    if layout.named and _norm(layout.columns[0]) in TIME_NAMES:
+        raise ParamError(f"{name}: its first column ({show_cell(layout.columns[0])}) is a time column; "
+                         "{sample_time_s} is for a file without one: drop it", params=("sample_time_s",))
+    if names is not None and len(names) != ncols:
+        raise ParamError(f"{{column_names}} names {len(names)} column{'s' if len(names) > 1 else ''} "
+                         f"({','.join(names)}) and {name} has {ncols}: name every column, in order, e.g. "
+                         + ",".join((["u", "y"] + [f"x{j}" for j in range(3, ncols + 1)])[:max(ncols, 1)]),
+                         params=("column_names",))
+    if names is not None:
+        signals = list(names)
+    elif layout.named:
+        signals = list(layout.columns)
+    else:   # by order: the input, then the output (identification's u y)
+        signals = ["y"] if ncols == 1 else ["u", "y"] + [f"col{j + 1}" for j in range(2, ncols)]
+    return Layout(["t"] + signals, layout.fmt, layout.first_row, layout.delim, [None] + list(range(ncols)),
+                   time_axis=(0.0, dt), comma=layout.comma, named=layout.named)
+
+
+def read_capture(path, *, input_column=None, output_column=None, fmt=None, sample_time_s=None,
+                 column_names=None) -> Capture:
     """Read a step-response capture from ``path``, streaming it.
 
     Parameters
@@ -106,21 +190,34 @@ def read_capture(path, *, input_column=None, output_column=None, fmt=None) -> Ca
     fmt : str, optional
         One of :data:`FORMATS` to read the file as that layout instead of
         recognising it (``auto``, the default, recognises it).
+    sample_time_s : float, optional
+        The file has no time column: every column is a signal, sampled every
+        ``sample_time_s`` seconds from t = 0 (a data set as identification
+        keeps it, DaISy's ``u y`` columns). See :func:`plain_columns`.
+    column_names : str or sequence of str, optional
+        With ``sample_time_s``: the name of every column, in order (``"u,y"``).
+
+    Returns
+    -------
+    Capture
+        Time, output and input (None without an input column).
 
     Raises
     ------
     DesignError
         Missing, unreadable, too large, binary or UTF-16 file, empty file,
         non-numeric cells, NaN or infinite values, values outside their
-        physical ranges, time not strictly increasing, the same column asked
-        for as input and output.
+        physical ranges, time not strictly increasing (a first column that is
+        no time at all: give ``sample_time_s``), the same column asked for as
+        input and output, an input column that never moves.
     """
+    plain = plain_columns(sample_time_s, column_names)
     with open_limited(path, "capture file", MAX_CAPTURE_BYTES) as fh:
         head, carry = _read_head(fh)
         blocks = FileBlocks(fh, carry)
         try:
             cap = _parse(head, blocks, fh.name, input_column, output_column,
-                         size_hint=fh.size, fmt=fmt)
+                         size_hint=fh.size, fmt=fmt, plain=plain)
         finally:
             blocks.close()
     cap.source = str(path)
@@ -128,14 +225,29 @@ def read_capture(path, *, input_column=None, output_column=None, fmt=None) -> Ca
 
 
 def parse_capture_text(text: str, *, name: str = "capture", input_column=None,
-                       output_column=None, fmt=None) -> Capture:
-    """Parse the text of a capture file; see :func:`read_capture`."""
+                       output_column=None, fmt=None, sample_time_s=None, column_names=None) -> Capture:
+    """Parse the text of a capture file; see :func:`read_capture`.
+
+    Parameters
+    ----------
+    text : str
+        The file's text.
+    name : str
+        The file's name, for messages.
+    input_column, output_column, fmt, sample_time_s, column_names
+        As :func:`read_capture`'s.
+
+    Returns
+    -------
+    Capture
+    """
+    plain = plain_columns(sample_time_s, column_names)
     lines = text.lstrip("\ufeff").splitlines()
     head, rest = lines[:HEAD_LINES], lines[HEAD_LINES:]
     blocks = ((b, _flags(b)) for b in (rest[i:i + BLOCK_LINES]
                                        for i in range(0, len(rest), BLOCK_LINES)))
     return _parse(head, blocks, name, input_column, output_column,
-                  size_hint=None if not rest else len(text), fmt=fmt)
+                  size_hint=None if not rest else len(text), fmt=fmt, plain=plain)
 
 
 # --------------------------------------------------------------------------- streaming
@@ -166,7 +278,7 @@ def _read_head(fh) -> tuple:
 
 
 def _parse(head, blocks, name, input_column, output_column, size_hint=None,
-           fmt=None) -> Capture:
+           fmt=None, plain=None) -> Capture:
     first = next(blocks, None)
     lines = list(head)
     if first is None:
@@ -177,12 +289,51 @@ def _parse(head, blocks, name, input_column, output_column, size_hint=None,
         raise DesignError(f"{name}: the file is empty; expected CSV rows of time and output "
                           "(t,y or t,u,y)")
     layout = detect_layout(lines, name, fmt)
+    if plain is not None:
+        layout = _plain_layout(layout, plain, name)
     j_out, j_in, tentative = _choose_columns(layout.columns, input_column, output_column, name)
+    tentative = tentative and plain is None   # a file declared as signal columns: its input by order
     keep = [0, j_out] + ([j_in] if j_in is not None else [])
     more = _then(first, blocks) if first is not None else iter(())
     del first   # the block is the generator's now: freed once parsed
-    cols = _load(lines, layout, keep, more, name, size_hint, getattr(blocks, "ahead", None))
-    return _assemble(cols, layout, keep, tentative, name)
+    t2 = _second_time(layout, keep) if plain is None else None
+    cols = _load(lines, layout, keep + ([t2] if t2 is not None else []), more, name, size_hint,
+                 getattr(blocks, "ahead", None))
+    if t2 is not None:
+        _check_one_time_axis(cols, layout, t2, len(keep), name)
+        cols.data = cols.data[:len(keep)]
+    return _assemble(cols, layout, keep, tentative, name, plain is not None)
+
+
+# another channel's own time: t_y, time_out, time-ch2, time2 (not t1: a thermocouple's name as often)
+_TIME_OF = re.compile(r"(t|time)[ _-](u|y|in|out|input|output|ch\d+|\d+)|time\d+|t|time|times")
+
+
+def _second_time(layout: Layout, keep) -> int | None:
+    """A column the header names as another time (``t_y``, ``time_out``, a second ``time``) beside
+    the first: each channel's own time axis, which must be the first's."""
+    if not layout.named or layout.file_cols[0] is None:
+        return None
+    for j in range(1, len(layout.columns)):
+        n = _norm(layout.columns[j])
+        if j not in keep and _TIME_OF.fullmatch(n):
+            return j
+    return None
+
+
+def _check_one_time_axis(cols: _Columns, layout: Layout, j: int, row: int, name: str) -> None:
+    """Refuse a second time column that is not the first: the input and output sampled at
+    different times (or rates), which no method here takes."""
+    a, b = cols.data[0, :cols.n], cols.data[row, :cols.n]
+    with np.errstate(invalid="ignore"):
+        off = ~(np.abs(a - b) <= 1e-9 * np.maximum(np.abs(a), np.abs(b)) + 1e-300)
+    if off.any():
+        i = int(np.argmax(off))
+        raise DesignError(f"{name}: column {layout.file_cols[j] + 1} ({show_cell(layout.columns[j])}) is a second "
+                          f"time column and differs from column 1 ({show_cell(layout.columns[0])}) from line "
+                          f"{cols.line(i)} on ({a[i]:.6g} s and {b[i]:.6g} s): the signals were sampled at "
+                          "different times or rates; put them on one time axis (resample one onto the other's "
+                          "times)")
 
 
 def _then(first, rest):
@@ -319,10 +470,19 @@ def _parse_block(lines, line0, delim, usecols, flags, name, comma=False) -> tupl
 
 
 def _raise_bad_cell(rows, where, delim, name, usecols, comma=False):
-    for line, lineno in zip(rows, where):
+    def missing(line, j):
+        cells = split_line(line, delim, comma)
+        return j >= len(cells) or cells[j] == ""
+
+    for k, (line, lineno) in enumerate(zip(rows, where)):
         cells = split_line(line, delim, comma)
         for j in usecols:
-            if j >= len(cells) or cells[j] == "":
+            if missing(line, j):
+                if all(missing(rest, j) for rest in rows[k + 1:k + 1000]):
+                    # every row from here on lacks it: the signals were recorded to different lengths
+                    raise DesignError(f"{name}: line {lineno} has no value in column {j + 1}, nor any line "
+                                      f"after it: the columns have different lengths (input and output "
+                                      "need a sample at every time); every data row needs all columns")
                 raise DesignError(f"{name}: line {lineno} has no value in column "
                                   f"{j + 1}; every data row needs all columns")
             if not is_number(cells[j]):
@@ -389,10 +549,40 @@ def _choose_columns(columns, input_column, output_column, name) -> tuple:
     return j_out, j_in, tentative
 
 
-def _assemble(cols: _Columns, layout: Layout, keep, tentative, name) -> Capture:
+def _not_a_time(t, layout: Layout, cols: _Columns, name: str) -> None:
+    """Refuse a generic table whose first column is no time at all (it falls at most of its
+    rows: a signal, as in a data set of ``u y`` columns), saying which options read it."""
+    if layout.fmt != "generic" or (layout.named and _norm(layout.columns[0]) in TIME_NAMES):
+        return
+    if t.size < 2 or not np.isfinite(t).all():
+        return   # check_samples names the sample
+    up = np.diff(t) > 0
+    if np.mean(up) >= 0.5:
+        return   # a time column with a glitch: check_samples names the line
+    i = int(np.argmin(up))
+    raise ParamError(f"{name}: column 1 is not a time (it goes from {t[i]:.6g} to {t[i + 1]:.6g} at line "
+                     f"{cols.line(i + 1)}, and rises at only {100 * np.mean(up):.0f} % of its rows): for a file "
+                     "of signals without a time column give {sample_time_s} (the sample interval, e.g. 0.08) "
+                     "and, unless the first column is the input and the second the output, {column_names} "
+                     "(e.g. y,u)", params=("sample_time_s", "column_names"))
+
+
+def _check_input_moves(u, layout: Layout, j_in: int, name: str) -> None:
+    """Refuse an input column that never moves: no identification can use it (an input chosen by
+    position only and flat is dropped with a note instead, as any that is not an input)."""
+    if u is not None and u.size and np.ptp(u) == 0:
+        raise ParamError(f"{name}: the input column {show_cell(layout.columns[j_in])} never moves (every sample "
+                         f"{u[0]:.6g}): there is nothing to identify from it; choose the input with "
+                         "{input_column}, or give {input_column} none to use the output alone",
+                         params=("input_column",))
+
+
+def _assemble(cols: _Columns, layout: Layout, keep, tentative, name, plain=False) -> Capture:
     if cols.n == 0:
         raise DesignError(f"{name}: the file has no data rows")
     data = cols.columns()
+    if not plain:
+        _not_a_time(data[0], layout, cols, name)
     what = ["time", "output", "input"]
     if layout.file_cols[0] is None:
         data[0] = np.arange(cols.n)        # Rigol without X: the row is the index
@@ -419,20 +609,18 @@ def _assemble(cols: _Columns, layout: Layout, keep, tentative, name) -> Capture:
     u = data[2] if len(keep) == 3 else None
     columns = layout.columns
     j_out, j_in = keep[1], (keep[2] if u is not None else None)
+    if not tentative:
+        _check_input_moves(u, layout, j_in, name)
     notes = []
-    # An input chosen by position only is used only if it looks like one
-    # (e.g. time_s,analytic,spice has no input column).
-    if tentative and not looks_like_step_input(u, y):
-        from ..broadband import looks_broadband, multilevel_levels   # a PRBS or noise input is one too
-        if not looks_broadband(u) and multilevel_levels(u) is None:   # a multi-level one is refused as such
-            notes.append(f"column {columns[j_in]!r} does not look like a step input "
-                         "(its transitions are not much faster than the output's) nor a "
-                         "broadband one; no input column used (see --input-column)")
-            u, j_in = None, None
+    if plain:
+        notes.append(f"no time column: sample k at k x {layout.time_axis[1]:.6g} s (the sample time given)")
+    # An input chosen by position only is kept, marked: whether it is one (a step, a
+    # broadband excitation) is the analysis' decision, not the reader's (e.g.
+    # time_s,analytic,spice has no input column).
     return Capture(t=t, y=y, u=u, fmt=layout.fmt, columns=list(columns),
                    output_name=columns[j_out],
                    input_name=None if j_in is None else columns[j_in], source=name,
-                   notes=notes)
+                   notes=notes, input_by_position=bool(tentative and u is not None))
 
 
 def _transition_fraction(x) -> float:

@@ -47,6 +47,7 @@ class Layout:
     time_axis: tuple | None = None
     comma: bool = False
     scales: list | None = None
+    named: bool = True   # False when the file has no header: the column names were made up
 
 
 
@@ -160,7 +161,8 @@ def read_table(lines, name, fmt: str | None = None, forced: bool = False) -> Lay
                           "a header")
     ncols = len(split_line(lines[first_row], delim, comma))
     header = split_line(lines[first_row - 1], delim) if first_row > 0 else []
-    if len(header) >= ncols and not all(is_number(c) for c in header):
+    named = len(header) >= ncols and not all(is_number(c) for c in header)
+    if named:
         columns = header[:ncols]
     else:
         columns = ["t"] + [f"col{j + 1}" for j in range(1, ncols)]
@@ -180,7 +182,7 @@ def read_table(lines, name, fmt: str | None = None, forced: bool = False) -> Lay
             fmt = "digilent"
         else:
             fmt = "generic"
-    return Layout(columns, fmt, first_row, delim, list(range(ncols)), comma=comma)
+    return Layout(columns, fmt, first_row, delim, list(range(ncols)), comma=comma, named=named)
 
 
 def read_generic(lines, name, forced=False) -> Layout:
@@ -202,4 +204,4 @@ def headed_table(fmt: str, first_cell, header: str):
 
 
 #: This project's waveforms (``time_s,<signal>,...``).
-read_waveform = headed_table("waveform", lambda c: c == "time_s", "time_s,<signal>,...")
+_read_waveform = headed_table("waveform", lambda c: c == "time_s", "time_s,<signal>,...")
