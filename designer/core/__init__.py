@@ -8,6 +8,7 @@ from .exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "excitation": ("EDGE_FRACTION", "Excitation", "INPUT_KINDS", "MAX_CORNERS", "chirp_input", "file_input", "held", "prbs_input", "random_binary_input"),
     "checks": ("Check", "IDS", "SPICE_AGREEMENT"),
     "compare": ("AGREEMENT", "disagreements", "metric_deltas", "nrms", "resample", "trapezoid_weights"),
     "errors": ("DeckError", "DesignError", "EXIT_BAD_INPUT", "EXIT_CHECK_FAILED", "EXIT_OK", "EXIT_SIMULATOR",
@@ -34,7 +35,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "process": ("ProcessModel",),
     "process_build": ("MAX_DEAD_TIME_RATIO", "fopdt", "integrating", "model_from_dict", "rational", "sopdt",
                       "underdamped"),
-    "process_text": ("FORMS_TEXT", "parse_tf"),
+    "process_text": ("FACTORS_TEXT", "FACTOR_KEYS", "FORMS", "FORMS_TEXT", "INTEGRATOR", "KEYS", "factor_list",
+                     "factored_text", "parse_tf"),
     "ranges": ("RANGES", "Range", "help_range", "parse_in_range"),
     "stepfit": ("MODELS", "PARAMS", "data_overshoot", "fit_step", "model_overshoot_pct", "model_step",
                 "overshoot_mismatch", "unphysical"),

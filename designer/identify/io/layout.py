@@ -204,4 +204,4 @@ def headed_table(fmt: str, first_cell, header: str):
 
 
 #: This project's waveforms (``time_s,<signal>,...``).
-_read_waveform = headed_table("waveform", lambda c: c == "time_s", "time_s,<signal>,...")
+read_waveform = headed_table("waveform", lambda c: c == "time_s", "time_s,<signal>,...")
