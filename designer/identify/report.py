@@ -106,7 +106,46 @@ def step_text(result) -> str:
     if result.comparison is not None:
         lines.append("")
         lines.extend(comparison_text(result.comparison))
+    if getattr(result, "assessment", None) is not None:
+        lines += [""] + validation_text(result.assessment)
     return "\n".join(lines)
+
+
+def _verdict(c) -> str:
+    if c.validation is None:
+        return "-"
+    w, x = c.validation.whiteness, c.validation.cross
+    return f"{'white' if w.inside else f'{w.worst:.1f}x'}/{'ok' if x.inside else f'{x.worst:.1f}x'}"
+
+
+def validation_text(a) -> list:
+    """The validation table of an :class:`~.assess.Assessment`: the split, each
+    route's models by validation fit, the residual tests' verdicts, the skipped
+    routes and why, the best across routes."""
+    lines = [f"== validation: every route's models simulated under the recorded input ({a.scope}) ==",
+             f"Data: {a.note}"]
+    for route, why in a.skipped.items():
+        lines.append(f"  skipped: {route}: {why}")
+    lines.append("Fit % = 100 (1 - |y - yhat| / |y - mean y|) on the validation data (MATLAB compare); "
+                 "residuals: autocorrelation / cross-correlation with past input inside the 99 % band "
+                 "('white'/'ok', else the worst lag over the band)")
+    lines.append(f"{'route':13s} {'method':24s} {'model':12s} {'fit %':>8s} {'residuals':>11s} {'ok':3s} "
+                 "parameters")
+    order = sorted(range(len(a.candidates)),
+                   key=lambda i: (not a.candidates[i].valid,
+                                  -a.candidates[i].fit_percent if math.isfinite(a.candidates[i].fit_percent)
+                                  else math.inf))
+    for i in order:
+        c = a.candidates[i]
+        fit = f"{c.fit_percent:8.2f}" if math.isfinite(c.fit_percent) else f"{'-':>8s}"
+        lines.append(f"{c.route:13s} {c.name[:24]:24s} {c.kind[:12]:12s} {fit} {_verdict(c):>11s} "
+                     f"{'yes' if c.valid else 'no ':3s} {format_params(c.params, False)}"
+                     + (f"  ({c.note})" if c.note and not c.valid else ""))
+    best = a.best_candidate
+    lines.append("Best by validation fit: " + (f"{best.label}, fit {best.fit_percent:.2f} %: "
+                                                f"{format_params(best.params, False)}" if best else
+                                                "none valid"))
+    return lines
 
 
 def comparison_text(c) -> list:
@@ -256,6 +295,10 @@ def broadband_text(result) -> str:
     lines += ["", f"Best ({result.method}): " + (f"{best.name} ({best.model}): "
                                                  f"{format_params(best.params, True)}"
                                                  if best else "none valid")]
+    if result.segment_length:
+        lines.append(f"Welch segment: {result.segment_note}")
+    if result.assessment is not None:
+        lines += [""] + validation_text(result.assessment)
     return "\n".join(lines)
 
 

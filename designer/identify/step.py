@@ -27,7 +27,7 @@ from .normalise import PreparedStep
 from .preprocess import prepare_step
 from .refine import refine_all
 from .second_order import STEP_METHODS
-from .structures import MethodResult, iae_ise, model_step, rank_key, unphysical
+from .structures import MethodResult, assessment_dict, iae_ise, model_step, rank_key, unphysical
 
 #: Every classical step method, first order then second order.
 ALL_STEP_METHODS = list(FIRST_ORDER_METHODS) + list(STEP_METHODS)
@@ -76,6 +76,8 @@ class IdentifyResult:
     #: JSON of a capture is the same on every run (the committed references regenerate byte for byte)
     timings: dict = field(default_factory=dict)
     overshoot: Overshoot | None = None
+    #: every route's models scored on validation data (:class:`~.assess.Assessment`), when assessed
+    assessment: object | None = None
 
     def best_of(self, models) -> MethodResult | None:
         """The best valid result whose model is one of ``models``."""
@@ -103,6 +105,8 @@ class IdentifyResult:
             d["capture"] = self.capture.to_dict()
         if self.comparison is not None:
             d["comparison"] = self.comparison.to_dict()
+        if self.assessment is not None:
+            d.update(assessment_dict(self.assessment))
         return d
 
 
