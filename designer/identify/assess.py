@@ -33,7 +33,7 @@ interval is narrower than the parameter, and it is a process model
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -480,8 +480,9 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
             res.skipped.setdefault("output-error", str(exc))
             continue
         res.output_error.append(f)
+        model = None if f.model is None else replace(f.model, source=f"identify output-error oe {kind} ({source})")
         c = Candidate("output-error", "oe", kind, dict(f.params), {k2: v for k2, v in f.ci95.items() if v is not None},
-                      f.model, f.valid and f.model is not None, f.note)
+                      model, f.valid and model is not None, f.note)
         res.candidates.append(c)
     drive = (vu, vy, None) if validation is not None else (uu, yy, split)
     for c in res.candidates:

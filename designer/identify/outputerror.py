@@ -125,6 +125,7 @@ def _rational(kind: str, p: dict) -> tuple:
         return [K], [1.0, 0.0]
     if kind == "integrating-lag":
         return [K], [p["tau_s"], 1.0, 0.0]
+
     raise DesignError(f"kind {kind!r} unknown; allowed: {', '.join(FIT_KINDS)}")
 
 
@@ -608,6 +609,8 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     sol, sc = best
     x = sol.x * sc
     params = dict(zip(names, (float(v) for v in x)))
+    if params["theta_s"] < 1e-9 * T:    # the solver's round-off at the bound: no dead time
+        params["theta_s"] = 0.0
     r, sim, beta = _evaluate(kind, params, ud, y, T, hold, initial)
     n_lin = beta.size
     # intervals from the Jacobian over the parameters not held at a bound
