@@ -55,7 +55,7 @@ ESTIMATION_FRACTION = 2.0 / 3.0
 #: records longer than this are block-averaged to it for the output-error fit and the scoring
 MAX_SAMPLES = 20_000
 #: the output-error route's model structures
-OE_KINDS = ("fopdt", "sopdt", "underdamped")
+OE_KINDS = ("fopdt", "sopdt", "underdamped", "lead-lag")
 #: evenly sampled: every interval within this fraction of the mean one
 SPACING_TOLERANCE = 0.01
 
@@ -106,11 +106,11 @@ def method_process(model: str, params: dict, ci95: dict | None = None, source: s
 class _Simulated:
     """A process model as :func:`~.validation.validate` drives it."""
 
-    def __init__(self, model: ProcessModel, ts: float):
-        self.model, self.ts = model, ts
+    def __init__(self, model: ProcessModel, ts: float, hold: str = "zoh"):
+        self.model, self.ts, self.hold = model, ts, hold
 
     def response(self, u):
-        return simulate(self.model, u, self.ts)
+        return simulate(self.model, u, self.ts, self.hold)
 
 
 @dataclass
@@ -195,6 +195,11 @@ class Assessment:
         Route -> why it gave no model.
     output_error : list
         The output-error fits (:class:`~.outputerror.OEFit`).
+    hold : str
+        The input between samples every model is simulated with (``zoh`` or
+        ``foh``): the one under which the output-error FOPDT fits the
+        estimation data better (a sequence switching between the scope's
+        samples is a ramp to a first-order hold, centred where it switched).
     """
 
     scope: str
@@ -206,6 +211,7 @@ class Assessment:
     best: int | None = None
     skipped: dict = field(default_factory=dict)
     output_error: list = field(default_factory=list)
+    hold: str = "zoh"
 
     @property
     def best_candidate(self) -> Candidate | None:
@@ -228,7 +234,7 @@ class Assessment:
             The split, every candidate, the best, the skipped routes.
         """
         return {"scope": self.scope, "split": None if self.split is None else self.split.to_dict(),
-                "split_note": self.note, "sample_time_s": self.sample_time_s, "decimated_by": self.decimated_by,
+                "split_note": self.note, "sample_time_s": self.sample_time_s, "decimated_by": self.decimated_by, "hold": self.hold,
                 "best": None if self.best_candidate is None else self.best_candidate.to_dict(),
                 "skipped": dict(self.skipped), "models": [c.to_dict() for c in self.candidates]}
 
@@ -390,11 +396,11 @@ def judge_candidate(route: str, m, ts: float, source: str) -> Candidate:
                      "; ".join(n for n in notes if n))
 
 
-def _score(c: Candidate, ts: float, u, y, split: Split | None) -> None:
+def _score(c: Candidate, ts: float, hold: str, u, y, split: Split | None) -> None:
     if c.model is None:
         return
     try:
-        v = validate(_Simulated(c.model, ts), u, y, split)
+        v = validate(_Simulated(c.model, ts, hold), u, y, split)
     except (DesignError, ValueError, np.linalg.LinAlgError) as exc:
         c.valid = False
         c.note = "; ".join(n for n in (c.note, f"not simulated: {exc}") if n)
@@ -473,9 +479,18 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
     for route, methods in route_results.items():
         for m in methods:
             res.candidates.append(judge_candidate(route, m, T, source))
-    for kind in kinds:
+    fits = {}
+    for hold in ("zoh", "foh"):
         try:
-            f = fit_output_error(uu[est], yy[est], T, kind, initial="estimate")
+            fits[hold] = fit_output_error(uu[est], yy[est], T, "fopdt", hold=hold, initial="estimate")
+        except DesignError as exc:
+            res.skipped.setdefault("output-error", str(exc))
+    if fits:
+        res.hold = min(fits, key=lambda h: fits[h].rms_residual)
+    for kind in kinds if fits else ():
+        try:
+            f = fits[res.hold] if kind == "fopdt" else fit_output_error(uu[est], yy[est], T, kind, hold=res.hold,
+                                                                         initial="estimate")
         except DesignError as exc:
             res.skipped.setdefault("output-error", str(exc))
             continue
@@ -486,7 +501,7 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
         res.candidates.append(c)
     drive = (vu, vy, None) if validation is not None else (uu, yy, split)
     for c in res.candidates:
-        _score(c, T, *drive)
+        _score(c, T, res.hold, *drive)
     ok = [i for i, c in enumerate(res.candidates) if c.valid and math.isfinite(c.fit_percent)]
     res.best = max(ok, key=lambda i: res.candidates[i].fit_percent) if ok else None
     return res

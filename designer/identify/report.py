@@ -123,7 +123,8 @@ def validation_text(a) -> list:
     route's models by validation fit, the residual tests' verdicts, the skipped
     routes and why, the best across routes."""
     lines = [f"== validation: every route's models simulated under the recorded input ({a.scope}) ==",
-             f"Data: {a.note}"]
+             f"Data: {a.note}; simulated with a {'first' if a.hold == 'foh' else 'zero'}-order hold "
+             f"({a.hold}, the better of the two for the output-error FOPDT)"]
     for route, why in a.skipped.items():
         lines.append(f"  skipped: {route}: {why}")
     lines.append("Fit % = 100 (1 - |y - yhat| / |y - mean y|) on the validation data (MATLAB compare); "

@@ -81,8 +81,6 @@ def test_wiener_hopf_recovers_the_pulse_response_under_a_coloured_input():
     assert corr.input_whiteness(rng.normal(size=n)).kind == "white"
 
 
-@pytest.mark.xfail(strict=True, reason="issue 28 not done here: the furnace has a zero (a lead-lag) that no "
-                   "fitted structure has; the best validation fit is the output-error FOPDT, its gain 8 % low")
 def test_furnace_under_an_8_bit_m_sequence():
     """Seed 003's furnace, 8-bit m-sequence at the seed's a = 0.1 and Dt = 3 min,
     sampled every minute, four periods: the best model by validation fit has the
