@@ -303,15 +303,34 @@ def broadband_text(result) -> str:
     return "\n".join(lines)
 
 
+def residual_axes(pair, c) -> None:
+    """The residual tests of a validated model on two axes (as ``resid`` draws
+    them): the residuals' autocorrelation and their cross-correlation with the
+    input, each lag against its 99 % band."""
+    v = c.validation
+    for ax, corr_, title in ((pair[0], v.whiteness, "Residuals: autocorrelation"),
+                             (pair[1], v.cross, "Residuals: cross-correlation with the input")):
+        ax.vlines(corr_.lags, 0, corr_.r, color="k", lw=1)
+        ax.axhspan(-corr_.band, corr_.band, color="tab:blue", alpha=0.15, label="99 % band")
+        ax.set_title(f"{title} ({c.route} {c.name} {c.kind}, validation fit {v.fit_percent:.1f} %)", fontsize=8)
+        ax.set_xlabel("lag (samples)")
+        ax.legend(fontsize=7)
+
+
 def broadband_plot(result, n_models: int = 3) -> bytes:
     """PNG of a broadband identification: the impulse response, the step it
     integrates to with the best step models, the spectral estimate (gain and
-    phase) with the best frequency models, and its coherence."""
+    phase) with the best frequency models, and its coherence; when validated,
+    the residual tests of the best model by validation fit."""
     from .bode_readings import model_response
     from .structures import model_step
     plt = _pyplot()
-    fig, axes = plt.subplots(2, 2, figsize=(11, 7), dpi=100)
-    (ax_h, ax_s), (ax_g, ax_c) = axes
+    best = getattr(result.assessment, "best_candidate", None)
+    rows = 3 if best is not None and best.validation is not None else 2
+    fig, axes = plt.subplots(rows, 2, figsize=(11, 3.5 * rows), dpi=100)
+    (ax_h, ax_s), (ax_g, ax_c) = axes[:2]
+    if rows == 3:
+        residual_axes(axes[2], best)
     est = result.impulse
     if est is not None:
         ax_h.plot(est.t, est.h, color="k", lw=1)
