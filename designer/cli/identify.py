@@ -96,6 +96,16 @@ settling is said so, with the bits or clock that would be enough.
 --method correlation|spectral keeps one; --step-time, --step-amplitude and
 --against are for steps.
 
+validation (issue 28): a capture with an input channel also gets output-error
+fits (fopdt, sopdt, underdamped, lead-lag, dead time not a whole number of
+samples), and every route's models are simulated under the recorded input of
+validation data (a broadband capture's last third, whole periods of a sequence;
+--validate OTHER.csv; a step capture on itself, said so) and scored by the
+compare fit % and the residual tests; the best by validation fit across routes
+is "validation.best" in the JSON and what design-pid --plant-capture tunes for.
+A model is valid only if every 95 % interval is narrower than its parameter. An
+input that never moves is refused (nothing to identify).
+
 exit status: 0 success, 2 bad input (one line on stderr saying what and why).
 """
 

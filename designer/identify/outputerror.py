@@ -1,6 +1,6 @@
 """Continuous-time process models fitted by output error to any recorded
-input: FOPDT, SOPDT (overdamped), underdamped and integrating (with or
-without a lag), each with a dead time, simulated under the recorded input
+input: FOPDT, SOPDT (overdamped), underdamped, integrating (with or
+without a lag) and a lead-lag (two lags and a zero), each with a dead time, simulated under the recorded input
 exactly and fitted by bounded nonlinear least squares.
 
 Sources: L. Ljung, *System Identification: Theory for the User*, 2nd ed.
