@@ -304,7 +304,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--method", choices=("correlation", "spectral"), type=_lower,
                    help="broadband input (PRBS or noise) only: the models of this estimate alone "
                         "(default: both; the best from the spectral fit when it has a valid one)")
-    p.add_argument("--validate", metavar="OTHER_CSV",
+    p.add_argument("--validate", metavar="CSV",
                    help="a second capture of the same plant, same layout and columns, to score every model on "
                         "(default: the capture's last third, whole periods of a sequence; a step capture is "
                         "scored on itself); resampled when its sample interval is a whole multiple or divisor")

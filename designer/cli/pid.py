@@ -227,7 +227,10 @@ def _captured_model(args, typed):
     result = _identified(args, fmt, given, ident)
     best = getattr(getattr(result, "assessment", None), "best_candidate", None)
     if method is None and best is not None and not getattr(result, "refused", ""):
-        return best.model      # the best validation fit across every route (identify's "validation")
+        # the best validation fit across every route (identify's "validation"), named with its capture
+        import dataclasses
+        import os
+        return dataclasses.replace(best.model, source=f"{best.model.source} ({os.path.basename(args.plant_capture)})")
     try:
         return model_from_result(result.to_dict(), method, name=where)
     except DesignError as exc:

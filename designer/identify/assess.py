@@ -338,7 +338,7 @@ def choose_split(n: int, excitation=None, fraction: float = ESTIMATION_FRACTION)
     """
     if excitation is None:
         return None, ("a step capture: its edge is needed whole by every step method, so every model is scored "
-                      "on the whole record it was fitted to (no room for a split: give --validate for fresh data)")
+                      "on the whole record it was fitted to (no room for a split: a second capture of the plant gives fresh data)")
     if excitation.kind == "noise":
         k = int(round(fraction * n))
         from .broadband import MIN_SAMPLES
@@ -370,7 +370,8 @@ def judge_candidate(route: str, m, ts: float, source: str) -> Candidate:
     ts : float
         Sample interval it will be simulated at.
     source : str
-        The data's name.
+        The data's name (kept out of the model's ``source``: the JSON of a
+        capture is the same whatever its file is called).
 
     Returns
     -------
@@ -388,7 +389,7 @@ def judge_candidate(route: str, m, ts: float, source: str) -> Candidate:
             notes.append(wide)
     model = None
     try:
-        model = method_process(m.model, m.params, ci, f"identify {route} {m.name} {m.model} ({source})")
+        model = method_process(m.model, m.params, ci, f"identify {route} {m.name} {m.model}")
     except (DesignError, KeyError, TypeError, ValueError) as exc:
         valid = False
         notes.append(f"not a process model: {exc}")
@@ -495,7 +496,7 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
             res.skipped.setdefault("output-error", str(exc))
             continue
         res.output_error.append(f)
-        model = None if f.model is None else replace(f.model, source=f"identify output-error oe {kind} ({source})")
+        model = None if f.model is None else replace(f.model, source=f"identify output-error oe {kind}")
         c = Candidate("output-error", "oe", kind, dict(f.params), {k2: v for k2, v in f.ci95.items() if v is not None},
                       model, f.valid and model is not None, f.note)
         res.candidates.append(c)
@@ -575,7 +576,7 @@ def assess_result(result, t, u, y, *, validation: tuple | None = None, segment_l
         from .broadband import identify_broadband
         try:
             est = identify_broadband(t[:split_at], y[:split_at], u[:split_at], method=method, refine=refine,
-                                     methods=methods, name=f"{name} (estimation part)", segment_length=segment_length)
+                                     methods=methods, name="the estimation part", segment_length=segment_length)
         except DesignError as exc:
             split_at, note = None, f"no split ({exc}); scored on the whole record"
         else:

@@ -156,7 +156,7 @@ def test_design_pid_on_the_dryer_agrees_with_the_arx_loop(dryer, tmp_path):
     assert p.returncode == 0, p.stderr
     d = json.loads(p.stdout)
     # it tunes for identify's best validation fit across every route
-    assert d["plant"]["model"]["source"] == v["best"]["process_model"]["source"]
+    assert d["plant"]["model"]["source"] == v["best"]["process_model"]["source"] + " (dryer.csv)"
     tun = d["tuning"]
     ctrl = pid_tf(tun["kp"], tun["ti_s"], tun["td_s"], SIM_N_FILTER)
     k = v["split"]["estimation"][1]
