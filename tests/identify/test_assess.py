@@ -100,3 +100,16 @@ def test_bad_input_one_line_each():
         match_validation(0.1, np.arange(100) * 0.25, np.zeros(100), np.zeros(100))
     uv, yv, how = match_validation(0.1, np.arange(300) * 0.05, np.arange(300.0), np.arange(300.0))
     assert uv.size == 150 and uv[1] == 2.0 and "every 2" in how
+
+
+def test_a_record_too_short_for_the_plants_settling_is_refused():
+    """K 1, tau 100 s under a random binary signal for 10 s (seeded): no model can be
+    valid, and the best-fitting one's dead time plus settling outlasts the record."""
+    rng = np.random.default_rng(3)
+    n, ts = 1500, 0.01
+    u = np.where(np.cumsum(rng.random(n) < 0.2) % 2 == 0, 1.0, -1.0)
+    b, a, _ = sig.cont2discrete(([1.0], [100.0, 1.0]), ts, method="zoh")
+    y = sig.lfilter(np.squeeze(b), a, u - u[0]) + rng.normal(0, 0.02, n)
+    t = np.arange(n) * ts
+    with pytest.raises(DesignError, match="too short for the plant's dead time plus settling"):
+        identify_record(t[:1000], y[:1000], u[:1000])
