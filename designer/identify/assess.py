@@ -46,7 +46,7 @@ from .validation import Split, Validation, validate
 
 __all__ = ["ROUTES", "ESTIMATION_FRACTION", "MAX_SAMPLES", "OE_KINDS", "Candidate", "Assessment",
            "method_process", "choose_split", "judge_candidate", "assess", "regular_interval",
-           "match_validation"]
+           "match_validation", "assess_result", "identify_record"]
 
 #: the routes, in the order the table shows them
 ROUTES = ("step", "correlation", "spectral", "output-error")
