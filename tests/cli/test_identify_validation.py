@@ -14,6 +14,7 @@ from scipy.linalg import logm
 
 from designer.identify.validation import arx_fit
 from helpers import EXT_CAPTURES, script
+from cli.test_identify_broadband import one_line_error
 
 IDENTIFY = script("identify")
 DESIGN_PID = script("design-pid")
@@ -23,15 +24,6 @@ TS = 0.08
 
 def run(exe, *args):
     return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, timeout=300)
-
-
-def one_line_error(proc, *words):
-    assert proc.returncode == 2, proc.stderr
-    assert proc.stdout == ""
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
-    for w in words:
-        assert w in lines[0], lines[0]
 
 
 def write_csv(path, t, u, y):
