@@ -100,6 +100,16 @@ settling is said so, with the bits or clock that would be enough.
 --method correlation|spectral keeps one; --step-time, --step-amplitude and
 --against are for steps.
 
+validation (issue 28): a capture with an input channel also gets output-error
+fits (fopdt, sopdt, underdamped, lead-lag, dead time not a whole number of
+samples), and every route's models are simulated under the recorded input of
+validation data (a broadband capture's last third, whole periods of a sequence;
+--validate OTHER.csv; a step capture on itself, said so) and scored by the
+compare fit % and the residual tests; the best by validation fit across routes
+is "validation.best" in the JSON and what design-pid --plant-capture tunes for.
+A model is valid only if every 95 % interval is narrower than its parameter. An
+input that never moves is refused (nothing to identify).
+
 exit status: 0 success, 2 bad input (one line on stderr saying what and why).
 """
 
@@ -299,6 +309,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--method", choices=("correlation", "spectral"), type=_lower,
                    help="broadband input (PRBS or noise) only: the models of this estimate alone "
                         "(default: both; the best from the spectral fit when it has a valid one)")
+    p.add_argument("--validate", metavar="CSV",
+                   help="a second capture of the same plant, same layout and columns, to score every model on "
+                        "(default: the capture's last third, whole periods of a sequence; a step capture is "
+                        "scored on itself); resampled when its sample interval is a whole multiple or divisor")
+    p.add_argument("--segment-length", metavar="N",
+                   help="noise or random input: the Welch segment in samples, " + help_range("segment_length")
+                        + " and at most half the record (default: reaching a decade below the slowest corner "
+                          "the first estimate shows, at most a quarter of the record)")
     p.add_argument("--against", metavar="RESULT_JSON",
                    help="a design-plant result.json to compare fn, zeta, gain and overshoot with")
     _output_options(p, "write a PNG of the data against the best models")
@@ -369,57 +387,48 @@ def identify_capture(args):
     if args.plot:
         check_output_path(args.plot, "--plot")
     # The file is read before scipy is imported, so bad input fails fast.
+    seg = getattr(args, "segment_length", None)
+    seg = None if seg is None else int(parse_in_range(seg, "--segment-length", "segment_length"))
     from ..identify.broadband import positional_input
     cap = positional_input(read_capture(args.capture, **capture_read_options(args)))
-    broadband = identify_broadband_capture(args, cap, window)
-    if broadband is not None:
-        return broadband
-    from ..identify.against import compare_with_design, load_design
-    from ..identify.step import identify_step
-    design = load_design(args.against) if args.against else None
-    u = cap.u
-    if t_step is not None:
-        u = None if amp is not None else u
-    result = identify_step(cap.t, cap.y, u, step_time=t_step, step_amplitude=amp,
-                           methods=args.methods, refine=not args.no_refine,
-                           capture=cap.info(), window=window)
-    if design is not None:
+    validation = read_validation(args, cap)
+    from ..identify.assess import identify_record
+    from ..identify.broadband import check_method
+    method = check_method(getattr(args, "method", None))
+    given = [flag for dest, flag in STEP_EDGE_ONLY if getattr(args, dest, None) is not None]
+    design = None
+    if args.against:
+        from ..identify.against import load_design
+        design = load_design(args.against)
+    result = identify_record(cap.t, cap.y, cap.u, step_time=t_step, step_amplitude=amp, window=window,
+                             methods=args.methods, refine=not args.no_refine, method=method, capture=cap.info(),
+                             name=shown(args.capture), validation=validation, segment_length=seg,
+                             step_only_given=given)
+    if design is not None and not hasattr(result, "excitation"):
+        from ..identify.against import compare_with_design
         result.comparison = compare_with_design(result, design)
-    if getattr(args, "method", None):
-        result.step.notes.append(f"--method {args.method} ignored: the input is not broadband "
-                                 "(a step or square wave), identified by the step methods")
     return result
+
+
+def read_validation(args, cap):
+    """``--validate OTHER.csv``: the second capture (t, u, y), read as the first
+    (its format and columns), or None. It needs an input channel."""
+    path = getattr(args, "validate", None)
+    if path is None:
+        return None
+    from ..identify.io import read_capture
+    from ..identify.broadband import positional_input
+    other = positional_input(read_capture(path, **capture_read_options(args)))
+    if other.u is None or cap.u is None:
+        which = shown(path) if other.u is None else shown(args.capture)
+        raise DesignError(f"--validate: {which} has no input column; validation simulates each model under the "
+                          "recorded input, so both captures need one (t,u,y)")
+    return other.t, other.u, other.y
 
 
 #: identify's options a broadband capture does not take: (argparse dest, its flag)
 STEP_EDGE_ONLY = (("step_time", "--step-time"), ("step_amplitude", "--step-amplitude"),
                   ("against", "--against"))
-
-
-def identify_broadband_capture(args, cap, window):
-    """``identify`` on a capture whose input is broadband (a PRBS or noise:
-    :func:`~designer.identify.broadband.examine_input`): the
-    :class:`~designer.identify.broadband.BroadbandResult`; None for any other
-    capture (the step methods' own)."""
-    from ..identify.broadband import check_method, examine_input, identify_broadband
-    method = check_method(getattr(args, "method", None))
-    if cap.u is None:
-        return None
-    t, u, y = cap.t, cap.u, cap.y
-    if window is not None:
-        keep = (t >= window[0]) & (t <= window[1])
-        t, u, y = t[keep], u[keep], y[keep]
-    name = shown(args.capture)
-    ex = examine_input(t, u, name=name)
-    if ex is None:
-        return None
-    given = [flag for dest, flag in STEP_EDGE_ONLY if getattr(args, dest, None) is not None]
-    if given:
-        raise DesignError(f"{', '.join(given)} {'is' if len(given) == 1 else 'are'} for a step capture; "
-                          f"the input of {name} is broadband ({ex.kind}): drop "
-                          f"{'it' if len(given) == 1 else 'them'}")
-    return identify_broadband(t, y, u, excitation=ex, method=method, refine=not args.no_refine,
-                              methods=args.methods, capture=cap.info(), name=name)
 
 
 #: what ``identify`` says (``format`` in its JSON) of a frequency-response table it was given
@@ -429,7 +438,8 @@ STEP_ONLY = (("step_time", "--step-time"), ("step_amplitude", "--step-amplitude"
              ("format", "--format"), ("input_column", "--input-column"), ("output_column", "--output-column"),
              ("sample_time", "--sample-time"), ("columns", "--columns"),
              ("methods", "--methods"), ("no_refine", "--no-refine"), ("against", "--against"),
-             ("method", "--method"), ("out", "--out"))
+             ("method", "--method"), ("out", "--out"), ("validate", "--validate"),
+             ("segment_length", "--segment-length"))
 
 
 def frequency_table_header(path) -> list | None:

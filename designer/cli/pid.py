@@ -221,26 +221,55 @@ def _captured_model(args, typed):
         if given:
             raise DesignError(f"{given[0]} is an option of --plant-capture (identify's), and no capture is given")
         return None
-    import argparse
-
     from ..core.fileio import shown
     from ..pid.plant_source import model_from_result
     from . import identify as ident
     fmt = str(args.format).strip().lower()
     if fmt not in ("auto",) + ident.FORMATS:
         raise DesignError(f"--format {fmt!r} unknown; allowed: auto, {', '.join(ident.FORMATS)}")
-    ns = argparse.Namespace(capture=args.plant_capture, step_time=args.step_time,
-                            step_amplitude=args.step_amplitude, window=args.window, format=fmt,
-                            input_column=args.input_column, output_column=args.output_column, methods=args.methods,
-                            sample_time=args.sample_time, columns=args.columns,
-                            no_refine=args.no_refine, against=None, plot=None, json=True)
-    header = ident.frequency_table_header(args.plant_capture)
-    result = ident.identify_capture(ns) if header is None else ident.identify_frequency_table(ns, header)
     method = typed.pop("plant_method")
+    where = f"--plant-capture {shown(args.plant_capture)}"
+    result = _identified(args, fmt, given, ident)
+    best = getattr(getattr(result, "assessment", None), "best_candidate", None)
+    if method is None and best is not None and not getattr(result, "refused", ""):
+        # the best validation fit across every route (identify's "validation"), named with its capture
+        import dataclasses
+        import os
+        return dataclasses.replace(best.model, source=f"{best.model.source} ({os.path.basename(args.plant_capture)})")
     try:
-        return model_from_result(result.to_dict(), method, name=f"--plant-capture {shown(args.plant_capture)}")
+        return model_from_result(result.to_dict(), method, name=where)
     except DesignError as exc:
         raise DesignError(str(exc).replace("plant model --plant-capture", "--plant-capture")) from None
+
+
+def _identified(args, fmt: str, given: list, ident):
+    """The capture (or frequency table) of --plant-capture identified by the
+    library calls ``identify`` makes, with identify's option names in its messages."""
+    from ..core.fileio import shown
+    path = args.plant_capture
+    header = ident.frequency_table_header(path)
+    if header is not None:
+        if given:
+            raise DesignError(f"{', '.join(given)} {'is' if len(given) == 1 else 'are'} for a step capture; "
+                              f"{shown(path)} is a frequency-response table, analysed as identify-freq does: drop "
+                              f"{'it' if len(given) == 1 else 'them'}")
+        from ..identify.frequency import identify_freq
+        from ..identify.io import read_freq_table
+        return identify_freq(read_freq_table(path))
+    from ..core.ranges import parse_in_range
+    from ..identify.assess import identify_record
+    from ..identify.io import read_capture
+    from ..identify.preprocess import check_window
+    t_step = None if args.step_time is None else ident.step_time(args.step_time)
+    amp = None if args.step_amplitude is None else ident.step_amplitude(args.step_amplitude)
+    window = None if args.window is None else check_window(
+        [parse_in_range(v, f"--window {which}", "capture_time_s") for v, which in zip(args.window, ("T0", "T1"))])
+    from ..identify.broadband import positional_input
+    cap = positional_input(read_capture(path, **{**ident.capture_read_options(args), "fmt": fmt}))
+    edge_only = [flag for dest, flag in ident.STEP_EDGE_ONLY if dest != "against" and getattr(args, dest) is not None]
+    return identify_record(cap.t, cap.y, cap.u, step_time=t_step, step_amplitude=amp, window=window,
+                           methods=args.methods, refine=not args.no_refine, capture=cap.info(), name=shown(path),
+                           step_only_given=edge_only)
 
 
 def _plant_parts(args):

@@ -117,6 +117,8 @@ RANGES = {
     "capture_value": Range(-1e15, 1e15),
     # size of the input step (--step-amplitude, or measured on the input column), either sign
     "step_amplitude": Range(1e-12, 1e12),
+    # identify --segment-length: a noise input's Welch segment (samples)
+    "segment_length": Range(16, 1 << 20),
     # size of the output's change from baseline to final value, in the file's units
     "output_step": Range(1e-15, 2e15),
     # a capture without a time column (--sample-time): the interval between its rows

@@ -402,6 +402,15 @@ class BroadbandResult:
     advice: dict | None = None
     #: why no model is valid when the estimates' own assumption failed ("" when it held)
     refused: str = ""
+    #: the input's autocorrelation against a white sequence's band (the correlation route's assumption)
+    whiteness: corr.InputWhiteness | None = None
+    #: the impulse response was solved from the Wiener-Hopf equations (a coloured input)
+    prewhitened: bool = False
+    #: Welch segment length of a noise input's spectral estimate (samples; 0 for a sequence), and why
+    segment_length: int = 0
+    segment_note: str = ""
+    #: every route's models scored on validation data (:class:`~.assess.Assessment`), when assessed
+    assessment: object | None = None
 
     @property
     def best(self):
@@ -413,6 +422,10 @@ class BroadbandResult:
              "best": self.best.to_dict() if self.best else None, "notes": list(self.notes)}
         if self.refused:
             d["refused"] = self.refused
+        if self.whiteness is not None:
+            d["input_whiteness"] = {**self.whiteness.to_dict(), "prewhitened": self.prewhitened}
+        if self.segment_length:
+            d["segment_length"] = {"samples": self.segment_length, "note": self.segment_note}
         if self.impulse is not None:
             d["impulse"] = self.impulse.to_dict()
             if self.advice:
@@ -426,6 +439,9 @@ class BroadbandResult:
             d["spectral"] = self.freq_result.to_dict()
         if self.capture is not None:
             d["capture"] = self.capture.to_dict()
+        if self.assessment is not None:
+            from .structures import assessment_dict
+            d.update(assessment_dict(self.assessment))
         # the ranking ``best`` comes from, laid out as identify's (correlation) or
         # identify-freq's (spectral) JSON, so design-pid --plant-model reads it
         chosen = d.get(self.method)
@@ -469,8 +485,16 @@ def check_method(method) -> str | None:
 
 def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=None,
                        refine: bool = True, methods=None, capture=None,
-                       name: str = "capture") -> BroadbandResult:
+                       name: str = "capture", segment_length: int | None = None) -> BroadbandResult:
     """Identify from a broadband capture (see the module docstring).
+
+    A noise input's whiteness is checked first
+    (:func:`~.correlation.input_whiteness`): a coloured one (a random binary
+    signal held for several samples, filtered noise) has its impulse response
+    solved from the Wiener-Hopf equations with its own autocorrelation
+    (:func:`~.correlation.wiener_impulse`), never read as white. Its Welch
+    segments are sized from the data (:func:`welch_segment`) unless
+    ``segment_length`` (samples) is given.
 
     Raises
     ------
@@ -510,16 +534,28 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
     res.method = method or "spectral"
     ts = ex.ts
     f_nyq = 0.5 / ts
+    if segment_length is not None and ex.kind != "noise":
+        raise DesignError(f"{name}: a segment length is for a noise or random input's Welch estimate; this "
+                          "input is a periodic sequence, whose spectrum is taken over its whole periods")
     if ex.kind == "noise":
         nseg = min(1 << int(math.floor(math.log2(max(y.size // 8, 64)))), 1 << 16)
         if y.size < 8 * 64:
             raise DesignError(f"{name}: {y.size} samples of a noise input; the spectral method "
                               "needs at least 512 (8 segments of 64)")
         max_lag = nseg
-        res.impulse = corr.white_impulse(u, y, ts=ts, max_lag=max_lag)
+        res.whiteness = corr.input_whiteness(u)
+        if res.whiteness.kind == "white":
+            res.impulse = corr.white_impulse(u, y, ts=ts, max_lag=max_lag)
+            res.notes.append("noise input, checked white (" + res.whiteness.text() + "): the correlation "
+                             "reads the impulse response from the cross-correlation (eq. 2.4.4)")
+        else:
+            res.impulse = corr.wiener_impulse(u, y, ts=ts, max_lag=max_lag)
+            res.prewhitened = True
+            res.notes.append(res.whiteness.text() + ": the correlation's impulse response is prewhitened "
+                             "(solved from the Wiener-Hopf equations with the input's own autocorrelation)")
+        nseg, res.segment_note = welch_segment(y.size, ts, res.impulse, segment_length)
+        res.segment_length = nseg
         res.spectrum = spec.welch_response(u, y, ts=ts, nperseg=nseg, f_max=f_nyq)
-        res.notes.append("noise input: the correlation assumes it white over the plant's band "
-                         "(eq. 2.4.4)")
     else:
         p = ex.period
         if ex.kind == "mls":
@@ -530,6 +566,7 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
         f_max = min(f_nyq, 0.9 / ex.dt_s)
         res.spectrum = spec.periodic_response(u, y, start=ex.start, period=p, count=ex.count,
                                               ts=ts, f_max=f_max)
+        res.whiteness = corr.input_whiteness(u[ex.start:ex.start + p * ex.count], mls=ex.kind == "mls")
     timings = {"estimate": clock() - t0}
     if res.impulse is not None and res.impulse.wrapped:
         note, res.advice = _wrap_advice(res.impulse, ex)
@@ -566,6 +603,66 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
     timings["total"] = clock() - t0
     res.timings = timings
     return res
+
+
+#: a Welch segment reaches this factor below the slowest corner the first estimate shows
+DECADE = 10.0
+#: Welch segments: at least this many samples, and at most the record over this
+#: (7 half-overlapped segments or more, so the coherence means something)
+MIN_SEGMENT, RECORD_PER_SEGMENT = 64, 4
+#: the segment lengths ``--segment-length`` takes (samples)
+SEGMENT_RANGE = (16, 1 << 20)
+
+
+def welch_segment(n: int, ts: float, impulse: corr.ImpulseEstimate | None,
+                  given: int | None = None) -> tuple:
+    """The Welch segment length of a noise input's spectral estimate, and why.
+
+    The lowest frequency a segment of L samples shows is 1/(L ts); it should
+    reach a decade below the slowest corner, 1/(2 pi tau), tau the slowest time
+    constant of the first estimate (the correlation's step response settles to
+    2 % in ln(50) tau): L >= 10 2 pi tau / ts, a power of two, at most the
+    record over :data:`RECORD_PER_SEGMENT`.
+
+    Parameters
+    ----------
+    n : int
+        Samples in the record.
+    ts : float
+        Sample interval (s).
+    impulse : ImpulseEstimate or None
+        The correlation's first estimate.
+    given : int, optional
+        The caller's length (``--segment-length``), used as is when the record holds two segments.
+
+    Returns
+    -------
+    tuple of (int, str)
+        The length and a sentence saying how it was chosen.
+    """
+    from ..core.units import format_eng as fe
+    top = max(MIN_SEGMENT, 1 << int(math.floor(math.log2(max(n // RECORD_PER_SEGMENT, 1)))))
+    if given is not None:
+        lo, hi = SEGMENT_RANGE
+        if not lo <= given <= min(hi, n // 2):
+            raise DesignError(f"segment length {given} is outside {lo} to {min(hi, n // 2)} samples (at most "
+                              f"half the record of {n}, so that two segments or more are averaged)")
+        return int(given), f"given: {given} samples, lowest frequency {fe(1 / (given * ts), 'Hz')}"
+    settle = impulse.settling_s if impulse is not None else math.nan
+    if not (math.isfinite(settle) and settle > 0):
+        nseg = min(1 << int(math.floor(math.log2(max(n // 8, MIN_SEGMENT)))), 1 << 16)
+        return nseg, f"{nseg} samples (the record over 8: the first estimate shows no settling time)"
+    tau = settle / corr.DECAY
+    need = DECADE * 2 * math.pi * tau / ts
+    nseg = max(MIN_SEGMENT, 1 << int(math.ceil(math.log2(max(need, 1.0)))))
+    why = (f"{nseg} samples: lowest frequency {fe(1 / (nseg * ts), 'Hz')}, a decade below the slowest corner "
+           f"({fe(1 / (2 * math.pi * tau), 'Hz')}, tau {fe(tau, 's')} from the correlation's settling)")
+    if nseg > top:
+        nseg = top
+        why = (f"{nseg} samples (a quarter of the record at most): lowest frequency "
+               f"{fe(1 / (nseg * ts), 'Hz')}, less than a decade below the slowest corner "
+               f"({fe(1 / (2 * math.pi * tau), 'Hz')}): a longer record would show the flat gain better")
+    return nseg, why
 
 
 def period_drift(y, ex: Excitation) -> tuple:

@@ -110,9 +110,40 @@ def judge(m: MethodResult, data: FreqData) -> None:
                        f"measured band widened {BAND_FACTOR:g} times ({w_lo:.4g} to "
                        f"{w_hi:.4g} rad/s): the table cannot place it")
                 break
+    if why is None:
+        why = wide_interval(m)
     if why:
         m.valid = False
         m.note = "; ".join(x for x in (m.note, why) if x)
+
+
+def wide_interval(m: MethodResult) -> str | None:
+    """Why a result is not valid by its confidence intervals, or None: a 95 %
+    half-width (``<param>_ci95`` in ``points``) not narrower than its parameter
+    (a spectral fit whose tau is 0.187 s +-160,703 s says nothing about tau).
+    The dead time is exempt: an interval reaching 0 says the plant has none
+    that the data show.
+
+    Parameters
+    ----------
+    m : MethodResult
+        A least-squares result (others carry no intervals and pass).
+
+    Returns
+    -------
+    str or None
+        The sentence, or None when every interval is narrower than its parameter.
+    """
+    for key, h in m.points.items():
+        k = key[:-5] if key.endswith("_ci95") else None
+        v = m.params.get(k) if k else None
+        if k == "theta_s":
+            # a dead time whose interval reaches 0 is a plant without a measurable one (the nested model,
+            # theta = 0, fits as well), not an undetermined model: its other parameters still hold
+            continue
+        if isinstance(v, (int, float)) and isinstance(h, (int, float)) and not h < abs(v):
+            return f"{k}'s 95 % interval +-{h:.4g} is not narrower than {k} = {v:.4g}"
+    return None
 
 
 def identify_freq(data: FreqData) -> FreqIdentifyResult:

@@ -1,6 +1,6 @@
 """Continuous-time process models fitted by output error to any recorded
-input: FOPDT, SOPDT (overdamped), underdamped and integrating (with or
-without a lag), each with a dead time, simulated under the recorded input
+input: FOPDT, SOPDT (overdamped), underdamped, integrating (with or
+without a lag) and a lead-lag (two lags and a zero), each with a dead time, simulated under the recorded input
 exactly and fitted by bounded nonlinear least squares.
 
 Sources: L. Ljung, *System Identification: Theory for the User*, 2nd ed.
@@ -95,6 +95,9 @@ FIT_KINDS = {
     "underdamped": ("K", "wn_rad_s", "zeta", "theta_s"),
     "integrating": ("K", "theta_s"),
     "integrating-lag": ("K", "tau_s", "theta_s"),
+    # two lags and a zero, K (tz s + 1)/((tau1 s + 1)(tau2 s + 1)) e^(-theta s): a rational model of low
+    # order (tfest's np = 2, nz = 1), as seed 003's furnace (a lead-lag, eq. 2.4.21)
+    "lead-lag": ("K", "tau1_s", "tau2_s", "tz_s", "theta_s"),
 }
 HOLDS = ("zoh", "foh")
 INITIALS = ("rest", "estimate")
@@ -125,6 +128,10 @@ def _rational(kind: str, p: dict) -> tuple:
         return [K], [1.0, 0.0]
     if kind == "integrating-lag":
         return [K], [p["tau_s"], 1.0, 0.0]
+    if kind == "lead-lag":
+        t1, t2 = p["tau1_s"], p["tau2_s"]
+        return [K * p["tz_s"], K], [t1 * t2, t1 + t2, 1.0]
+
     raise DesignError(f"kind {kind!r} unknown; allowed: {', '.join(FIT_KINDS)}")
 
 
@@ -462,7 +469,7 @@ def _arx_start(kind: str, ud, y, T: float) -> dict:
         # the mean input stands for the unknown balance input (a bounded output
         # needs the input to average to it)
         us = np.cumsum(us - us.mean()) * Ts
-    na = {"fopdt": 1, "sopdt": 2, "underdamped": 2, "integrating": 0, "integrating-lag": 1}[kind]
+    na = {"fopdt": 1, "sopdt": 2, "underdamped": 2, "integrating": 0, "integrating-lag": 1, "lead-lag": 2}[kind]
     top = max(2, min(MAX_START_DELAY, us.size // 10))
     best = None
     for nk in range(1, top):
@@ -485,11 +492,13 @@ def _arx_start(kind: str, ud, y, T: float) -> dict:
     p["K"] = gain
     if kind in ("fopdt", "integrating-lag"):
         p["tau_s"] = tau_of(s[0])
-    elif kind == "sopdt":
+    elif kind in ("sopdt", "lead-lag"):
         taus = sorted((tau_of(x) for x in s), reverse=True)
         if abs(s[0].imag) > 0:   # complex ARX poles: a double pole of the same size
             taus = [1.0 / abs(s[0])] * 2
         p["tau1_s"], p["tau2_s"] = taus[0], 0.5 * taus[1] if taus[0] == taus[1] else taus[1]
+        if kind == "lead-lag":
+            p["K"], p["tz_s"] = _zero_start(p, ud, y, T)
     elif kind == "underdamped":
         if abs(s[0].imag) > 0 and s[0].real < 0:
             wn = float(abs(s[0]))
@@ -500,10 +509,24 @@ def _arx_start(kind: str, ud, y, T: float) -> dict:
     return p
 
 
+def _zero_start(p: dict, ud, y, T: float) -> tuple:
+    """(K, tz) of K (tz s + 1)/D(s) for the start's poles and dead time: the
+    output is linear in K and K tz (the responses of 1/D and s/D), so one
+    linear least squares, with an output level, gives both."""
+    den = [p["tau1_s"] * p["tau2_s"], p["tau1_s"] + p["tau2_s"], 1.0]
+    a = sample_model([1.0], den, p["theta_s"], T).run(ud)
+    b = sample_model([1.0, 0.0], den, p["theta_s"], T).run(ud)
+    X = np.column_stack((a, b, np.ones(ud.size)))
+    (k, ktz, _), *_ = np.linalg.lstsq(X, y, rcond=None)
+    if not (np.isfinite(k) and k != 0 and np.isfinite(ktz)):
+        return float(p["K"]), 0.5 * p["tau1_s"]
+    return float(k), float(ktz / k)
+
+
 def _bounds(kind: str, T: float, duration: float) -> dict:
     lo_tau, hi_tau = MIN_TAU_OF_T * T, 10.0 * duration
     return {"K": (-np.inf, np.inf), "tau_s": (lo_tau, hi_tau), "tau1_s": (lo_tau, hi_tau),
-            "tau2_s": (lo_tau, hi_tau), "wn_rad_s": (1.0 / hi_tau, math.pi / T), "zeta": ZETA_BOUNDS,
+            "tau2_s": (lo_tau, hi_tau), "tz_s": (-hi_tau, hi_tau), "wn_rad_s": (1.0 / hi_tau, math.pi / T), "zeta": ZETA_BOUNDS,
             "theta_s": (0.0, 0.5 * duration)}
 
 
@@ -608,6 +631,8 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     sol, sc = best
     x = sol.x * sc
     params = dict(zip(names, (float(v) for v in x)))
+    if params["theta_s"] < 1e-9 * T:    # the solver's round-off at the bound: no dead time
+        params["theta_s"] = 0.0
     r, sim, beta = _evaluate(kind, params, ud, y, T, hold, initial)
     n_lin = beta.size
     # intervals from the Jacobian over the parameters not held at a bound
@@ -631,7 +656,7 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     for k, h in ci.items():
         if h is not None and not h < abs(params[k]):
             notes.append(f"{k}'s 95 % interval +-{h:.3g} is not narrower than {k} = {params[k]:.4g}")
-    if kind == "sopdt" and params["tau1_s"] < params["tau2_s"]:   # the slow time constant first
+    if kind in ("sopdt", "lead-lag") and params["tau1_s"] < params["tau2_s"]:   # the slow time constant first
         params["tau1_s"], params["tau2_s"] = params["tau2_s"], params["tau1_s"]
         ci["tau1_s"], ci["tau2_s"] = ci["tau2_s"], ci["tau1_s"]
     model, why = _process_model(kind, params, ci)
@@ -654,6 +679,9 @@ def _process_model(kind: str, p: dict, ci: dict) -> tuple:
             tp = 2 * math.pi
             cf = {("fn_hz" if k == "wn_rad_s" else k): (v / tp if k == "wn_rad_s" else v) for k, v in c.items()}
             return pb.underdamped(p["K"], p["wn_rad_s"] / tp, p["zeta"], p["theta_s"], source=src, ci95=cf), ""
+        if kind == "lead-lag":
+            num, den = _rational(kind, p)
+            return pb.rational(num, den, p["theta_s"], source=src), ""
         return pb.integrating(p["K"], p.get("tau_s", 0.0), p["theta_s"], source=src, ci95=c), ""
     except DesignError as exc:
         return None, f"not a process model: {exc}"

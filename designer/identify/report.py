@@ -108,7 +108,47 @@ def step_text(result) -> str:
     if result.comparison is not None:
         lines.append("")
         lines.extend(comparison_text(result.comparison))
+    if getattr(result, "assessment", None) is not None:
+        lines += [""] + validation_text(result.assessment)
     return "\n".join(lines)
+
+
+def _verdict(c) -> str:
+    if c.validation is None:
+        return "-"
+    w, x = c.validation.whiteness, c.validation.cross
+    return f"{'white' if w.inside else f'{w.worst:.1f}x'}/{'ok' if x.inside else f'{x.worst:.1f}x'}"
+
+
+def validation_text(a) -> list:
+    """The validation table of an :class:`~.assess.Assessment`: the split, each
+    route's models by validation fit, the residual tests' verdicts, the skipped
+    routes and why, the best across routes."""
+    lines = [f"== validation: every route's models simulated under the recorded input ({a.scope}) ==",
+             f"Data: {a.note}; simulated with a {'first' if a.hold == 'foh' else 'zero'}-order hold "
+             f"({a.hold}, the better of the two for the output-error FOPDT)"]
+    for route, why in a.skipped.items():
+        lines.append(f"  skipped: {route}: {why}")
+    lines.append("Fit % = 100 (1 - |y - yhat| / |y - mean y|) on the validation data (MATLAB compare); "
+                 "residuals: autocorrelation / cross-correlation with past input inside the 99 % band "
+                 "('white'/'ok', else the worst lag over the band)")
+    lines.append(f"{'route':13s} {'method':24s} {'model':12s} {'fit %':>8s} {'residuals':>11s} {'ok':3s} "
+                 "parameters")
+    order = sorted(range(len(a.candidates)),
+                   key=lambda i: (not a.candidates[i].valid,
+                                  -a.candidates[i].fit_percent if math.isfinite(a.candidates[i].fit_percent)
+                                  else math.inf))
+    for i in order:
+        c = a.candidates[i]
+        fit = f"{c.fit_percent:8.2f}" if math.isfinite(c.fit_percent) else f"{'-':>8s}"
+        lines.append(f"{c.route:13s} {c.name[:24]:24s} {c.kind[:12]:12s} {fit} {_verdict(c):>11s} "
+                     f"{'yes' if c.valid else 'no ':3s} {format_params(c.params, False)}"
+                     + (f"  ({c.note})" if c.note and not c.valid else ""))
+    best = a.best_candidate
+    lines.append("Best by validation fit: " + (f"{best.label}, fit {best.fit_percent:.2f} %: "
+                                                f"{format_params(best.params, False)}" if best else
+                                                "none valid"))
+    return lines
 
 
 def comparison_text(c) -> list:
@@ -258,18 +298,41 @@ def broadband_text(result) -> str:
     lines += ["", f"Best ({result.method}): " + (f"{best.name} ({best.model}): "
                                                  f"{format_params(best.params, True)}"
                                                  if best else "none valid")]
+    if result.segment_length:
+        lines.append(f"Welch segment: {result.segment_note}")
+    if result.assessment is not None:
+        lines += [""] + validation_text(result.assessment)
     return "\n".join(lines)
+
+
+def residual_axes(pair, c) -> None:
+    """The residual tests of a validated model on two axes (as ``resid`` draws
+    them): the residuals' autocorrelation and their cross-correlation with the
+    input, each lag against its 99 % band."""
+    v = c.validation
+    for ax, corr_, title in ((pair[0], v.whiteness, "Residuals: autocorrelation"),
+                             (pair[1], v.cross, "Residuals: cross-correlation with the input")):
+        ax.vlines(corr_.lags, 0, corr_.r, color="k", lw=1)
+        ax.axhspan(-corr_.band, corr_.band, color="tab:blue", alpha=0.15, label="99 % band")
+        ax.set_title(f"{title} ({c.route} {c.name} {c.kind}, validation fit {v.fit_percent:.1f} %)", fontsize=8)
+        ax.set_xlabel("lag (samples)")
+        ax.legend(fontsize=7)
 
 
 def broadband_plot(result, n_models: int = 3) -> bytes:
     """PNG of a broadband identification: the impulse response, the step it
     integrates to with the best step models, the spectral estimate (gain and
-    phase) with the best frequency models, and its coherence."""
+    phase) with the best frequency models, and its coherence; when validated,
+    the residual tests of the best model by validation fit."""
     from .bode_readings import model_response
     from .structures import model_step
     plt = _pyplot()
-    fig, axes = plt.subplots(2, 2, figsize=(11, 7), dpi=100)
-    (ax_h, ax_s), (ax_g, ax_c) = axes
+    best = getattr(result.assessment, "best_candidate", None)
+    rows = 3 if best is not None and best.validation is not None else 2
+    fig, axes = plt.subplots(rows, 2, figsize=(11, 3.5 * rows), dpi=100)
+    (ax_h, ax_s), (ax_g, ax_c) = axes[:2]
+    if rows == 3:
+        residual_axes(axes[2], best)
     est = result.impulse
     if est is not None:
         ax_h.plot(est.t, est.h, color="k", lw=1)

@@ -27,7 +27,7 @@ from .normalise import PreparedStep
 from .preprocess import prepare_step
 from .refine import refine_all
 from .second_order import STEP_METHODS
-from .structures import MethodResult, iae_ise, model_step, rank_key, unphysical
+from .structures import MethodResult, assessment_dict, iae_ise, model_step, rank_key, unphysical
 
 __all__ = ["IdentifyResult", "identify_step", "judge"]
 
@@ -78,6 +78,8 @@ class IdentifyResult:
     #: JSON of a capture is the same on every run (the committed references regenerate byte for byte)
     timings: dict = field(default_factory=dict)
     overshoot: Overshoot | None = None
+    #: every route's models scored on validation data (:class:`~.assess.Assessment`), when assessed
+    assessment: object | None = None
 
     def best_of(self, models) -> MethodResult | None:
         """The best valid result whose model is one of ``models``."""
@@ -105,6 +107,8 @@ class IdentifyResult:
             d["capture"] = self.capture.to_dict()
         if self.comparison is not None:
             d["comparison"] = self.comparison.to_dict()
+        if self.assessment is not None:
+            d.update(assessment_dict(self.assessment))
         return d
 
 

@@ -51,3 +51,12 @@ def rank_key(m: MethodResult) -> tuple:
     """Sort key of a ranking: valid results first, then by ``iae`` (nan last)."""
     iae = m.iae if m.iae is not None and math.isfinite(m.iae) else math.inf
     return (not m.valid, iae)
+
+
+def assessment_dict(assessment) -> dict:
+    """The JSON keys an assessed result adds (:class:`~designer.identify.assess.Assessment`):
+    ``validation`` (the split, every route's models with their validation fit and
+    residual tests, the best by validation fit) and ``output_error`` (the
+    output-error fits, route ``"output-error"``)."""
+    return {"validation": assessment.to_dict(),
+            "output_error": [{"route": "output-error", **f.to_dict()} for f in assessment.output_error]}

@@ -45,7 +45,7 @@ SERVERS_OWN = ("jobs", "dask", "spice-jobs", "timeout")
 #: options whose value is a file's content -> the name it is written under in the request's folder
 FILE_OPTIONS = {"plant-json": "plant-result.json", "plant-model": "plant-model.json",
                 "parts-json": "parts-result.json", "plant-capture": "plant-capture.csv",
-                "against": "design-result.json"}
+                "against": "design-result.json", "validate": "validation-capture.csv"}
 #: most bytes of a request's JSON body (its options; a model or result.json given inline included)
 MAX_JSON_BYTES = 4 * 1024 * 1024
 #: deepest nesting of a request's JSON (a model's JSON is 4 deep; Python's own parser fails near 1000)

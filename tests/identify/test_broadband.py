@@ -341,3 +341,21 @@ def test_an_idle_lead_in_does_not_spoil_the_m_sequence_check():
     u = np.repeat(np.concatenate((-np.ones(5), one, one, one[:20])), per)
     ex = examine_input(np.arange(u.size) * 1e-3, u)
     assert ex.kind == "mls" and ex.bits == 8 and ex.bit_errors == 0
+
+
+def test_welch_segment_reaches_a_decade_below_the_corner_or_says_why():
+    """Issue 28: fixed 64-sample segments started the dryer's table above its
+    corner. The segment is a power of two reaching a decade below 1/(2 pi tau),
+    tau from the first estimate's settling (ln 50 tau), at most a quarter of the
+    record; a given length is used as is, inside its range."""
+    from designer.identify.broadband import welch_segment
+    from designer.identify.correlation import DECAY, ImpulseEstimate
+    tau, ts = 0.5, 0.01
+    est = ImpulseEstimate(np.zeros(2), np.zeros(2), np.zeros(2), 0.0, 1.0, ts, DECAY * tau)
+    n, why = welch_segment(1 << 16, ts, est)
+    assert 1 / (n * ts) <= 0.1 / (2 * np.pi * tau) < 2 / (n * ts) and "decade below" in why
+    short, why = welch_segment(1000, ts, est)
+    assert short == 128 and "less than a decade" in why
+    assert welch_segment(1000, ts, est, 300)[0] == 300
+    with pytest.raises(DesignError, match="segment length 600"):
+        welch_segment(1000, ts, est, 600)

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from scipy import signal as sig
 
 from designer.identify import correlation as corr
 from designer.identify.broadband import identify_broadband
@@ -160,3 +161,19 @@ def test_a_wrapped_impulse_response_gives_no_valid_step_model(bits):
     assert any(m.note.startswith(("the impulse response wrapped around", "no periodic steady state"))
                for m in res.step_result.methods)
     assert res.refused and res.to_dict()["best"] is None
+
+
+def test_wiener_hopf_recovers_the_pulse_response_under_a_coloured_input():
+    rng = np.random.default_rng(28)
+    n, ts = 20000, 0.1
+    u = sig.lfilter([1.0], [1.0, -0.8], rng.normal(size=n))          # coloured: r(1) = 0.8
+    g = 0.2 * 0.9 ** np.arange(80)
+    y = sig.lfilter(g, [1.0], u)
+    w = corr.input_whiteness(u)
+    assert w.kind == "coloured" and w.r[0] == pytest.approx(0.8, abs=0.03)
+    est = corr.wiener_impulse(u, y, ts=ts, max_lag=80)
+    assert np.allclose(est.h * ts, g, atol=2e-3)
+    # read as white it is the pulse response smeared by the input's own correlation
+    white = corr.white_impulse(u, y, ts=ts, max_lag=80)
+    assert white.step[-1] > 3 * est.step[-1]
+    assert corr.input_whiteness(rng.normal(size=n)).kind == "white"

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from designer.identify import bode_readings as br
 from designer.identify import frequency as fr
 from designer.identify import io as tio
-from designer.identify.structures import MODELS
+from designer.identify.structures import MODELS, MethodResult
 
 
 def by(result, name, model):
@@ -263,3 +263,15 @@ def test_tall_peak_gives_a_small_zeta_not_zero():
         d = tio.freq_data(np.geomspace(1, 1e5, 5), [-92.0, 0.0, 0.0, 71.0, 0.0],
                          freq_units="rad/s")
         fr.identify_freq(d)
+
+
+def test_an_interval_wider_than_its_parameter_is_not_valid():
+    """Issue 28: a spectral fit with tau 0.187 s +-160,703 s was listed valid."""
+    m = MethodResult("least-squares", "overdamped", {"K": 0.9, "tau1_s": 0.187, "tau2_s": 0.19, "theta_s": 0.2},
+                     points={"K_ci95": 0.01, "tau1_s_ci95": 160703.0, "tau2_s_ci95": 0.01})
+    assert "tau1_s" in fr.wide_interval(m)
+    m.points["tau1_s_ci95"] = 0.05
+    assert fr.wide_interval(m) is None
+    # a dead time whose interval reaches 0: a plant without a measurable one, the model still valid
+    m.params["theta_s"], m.points["theta_s_ci95"] = 7e-8, 1.2e-6
+    assert fr.wide_interval(m) is None

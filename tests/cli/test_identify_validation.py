@@ -1,0 +1,159 @@
+"""``identify`` scores every route's models on validation data (issue 28): the
+JSON's ``validation`` and ``output_error``, the text's table, ``--validate``,
+``--segment-length``, their bad input in one line (exit 2); ``design-pid
+--plant-capture`` tunes for the best validation fit, and on the dryer its loop
+agrees with the same controller around an ARX[2 2 3] within 2 pp of overshoot."""
+
+import json
+import subprocess
+
+import numpy as np
+import pytest
+from scipy import signal as sig
+from scipy.linalg import logm
+
+from designer.identify.validation import arx_fit
+from helpers import EXT_CAPTURES, script
+from cli.test_identify_broadband import one_line_error
+
+IDENTIFY = script("identify")
+DESIGN_PID = script("design-pid")
+DRYER = EXT_CAPTURES / "daisy_dryer.dat"
+TS = 0.08
+
+
+def run(exe, *args):
+    return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, timeout=300)
+
+
+def write_csv(path, t, u, y):
+    path.write_text("t,u,y\n" + "\n".join(f"{a:.9g},{b:.9g},{c:.9g}" for a, b, c in zip(t, u, y)) + "\n")
+    return path
+
+
+def random_binary(n, p, seed):
+    """A random binary signal switching with probability ``p`` each sample (seeded)."""
+    rng = np.random.default_rng(seed)
+    return np.where(np.cumsum(rng.random(n) < p) % 2 == 0, 1.0, -1.0)
+
+
+@pytest.fixture(scope="module")
+def fopdt_rbs(tmp_path_factory):
+    """K 2, tau 0.5 s, theta 0.15 s under a random binary input switching with
+    probability 0.2, sampled every 20 ms, noise at about 30 dB SNR (seed 28)."""
+    n, ts = 3000, 0.02
+    u = 1.0 + random_binary(n, 0.2, 28)
+    b, a, _ = sig.cont2discrete(([2.0], [0.5, 1.0]), ts, method="zoh")
+    d = int(round(0.15 / ts))
+    y = sig.lfilter(np.squeeze(b), a, np.r_[np.full(d, u[0]), u[:-d]] - u[0])
+    y += np.random.default_rng(29).normal(0.0, 0.03 * np.std(y), n)
+    t = np.arange(n) * ts
+    folder = tmp_path_factory.mktemp("val")
+    return t, u, y, folder
+
+
+def test_every_route_in_the_json_and_the_text(fopdt_rbs):
+    t, u, y, folder = fopdt_rbs
+    path = write_csv(folder / "rbs.csv", t, u, y)
+    p = run(IDENTIFY, path, "--json")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    v = d["validation"]
+    assert v["scope"] == "split" and v["split"]["estimation"] == [0, 2000]
+    assert {m["route"] for m in v["models"]} >= {"correlation", "output-error"}
+    assert all(f["route"] == "output-error" for f in d["output_error"])
+    best = v["best"]
+    assert best["valid"] and best["validation"]["fit_percent"] > 90
+    assert best["process_model"]["gain"] == pytest.approx(2.0, rel=0.03)
+    # the older keys stay
+    for key in ("format", "excitation", "methods", "best", "notes"):
+        assert key in d
+    assert d["input_whiteness"]["kind"] == "coloured" and d["input_whiteness"]["prewhitened"]
+    text = run(IDENTIFY, path)
+    assert text.returncode == 0, text.stderr
+    assert "== validation" in text.stdout and "Best by validation fit: " in text.stdout
+    assert "estimation samples 0-1999" in text.stdout and "output-error" in text.stdout
+
+
+def test_validate_with_a_second_record(fopdt_rbs):
+    t, u, y, folder = fopdt_rbs
+    first = write_csv(folder / "first.csv", t[:1500], u[:1500], y[:1500])
+    # the second record sampled twice as fast (every other sample is the capture's)
+    tt = np.arange(2 * 1500) * 0.01
+    uu, yy = np.repeat(u[1500:], 2), np.repeat(y[1500:], 2)
+    second = write_csv(folder / "second.csv", tt, uu, yy)
+    p = run(IDENTIFY, first, "--validate", second, "--json")
+    assert p.returncode == 0, p.stderr
+    v = json.loads(p.stdout)["validation"]
+    assert v["scope"] == "separate" and "every 2" in v["split_note"]
+    assert v["best"]["validation"]["samples"] == 1500
+    # another rate that is no whole multiple: refused in one line
+    odd = write_csv(folder / "odd.csv", np.arange(1000) * 0.03, u[:1000], y[:1000])
+    one_line_error(run(IDENTIFY, first, "--validate", odd), "not a whole multiple")
+
+
+def test_bad_input_one_line(fopdt_rbs, tmp_path):
+    t, u, y, _ = fopdt_rbs
+    flat = write_csv(tmp_path / "flat.csv", t, np.full(t.size, 1.5), y)
+    one_line_error(run(IDENTIFY, flat), "nothing to identify")
+    rbs = write_csv(tmp_path / "rbs.csv", t, u, y)
+    one_line_error(run(IDENTIFY, rbs, "--segment-length", "5"), "--segment-length")
+    step = write_csv(tmp_path / "step.csv", t, np.where(t > 1, 1.0, 0.0), np.where(t > 1, 1 - np.exp(-(t - 1)), 0))
+    one_line_error(run(IDENTIFY, step, "--segment-length", "256"), "segment length")
+
+
+def test_segment_length_chooses_the_welch_segment(fopdt_rbs):
+    t, u, y, folder = fopdt_rbs
+    path = write_csv(folder / "seg.csv", t, u, y)
+    p = run(IDENTIFY, path, "--segment-length", "512", "--json")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    assert d["segment_length"]["samples"] == 512 and "given" in d["segment_length"]["note"]
+    # the lowest frequency kept: the segment's first or second bin (log bands, coherence)
+    assert d["spectrum"]["f_min_hz"] <= 1.01 * 2 / (512 * 0.02)
+    assert len(d["spectrum"]["coherence"]) == d["spectrum"]["points"]
+
+
+@pytest.fixture(scope="module")
+def dryer(tmp_path_factory):
+    if not DRYER.exists():
+        pytest.skip(f"the DaISy dryer data is not at {DRYER} (../shared/ext-captures beside the repository)")
+    d = np.loadtxt(DRYER)
+    u, y = d[:, 0], d[:, 1]
+    t = np.arange(u.size) * TS
+    return u, y, write_csv(tmp_path_factory.mktemp("dryer") / "dryer.csv", t, u, y)
+
+
+def arx_continuous(arx, ts: float, hold: str):
+    """An ARX model as N(s)/D(s) e^(-theta s): the rational part from its
+    sampled form by the zero-order-hold inverse (A = logm(Phi)/T, B = (Phi -
+    I)^-1 A Gamma), theta its nk - 1 whole samples, plus half a sample when the
+    record was read with a first-order hold (its ramp is centred half a sample
+    later than the held step)."""
+    na, nb, nk = arx.orders
+    Ad, Bd, Cd, _ = sig.tf2ss(arx.b[nk:nk + nb], arx.a)
+    Ac = np.real(logm(Ad)) / ts
+    Bc = np.linalg.solve(Ad - np.eye(Ad.shape[0]), Ac @ Bd)
+    num, den = sig.ss2tf(Ac, Bc, Cd, np.zeros((1, 1)))
+    return np.trim_zeros(np.squeeze(num), "f"), den, (nk - 1) * ts + (0.5 * ts if hold == "foh" else 0.0)
+
+
+def test_design_pid_on_the_dryer_agrees_with_the_arx_loop(dryer, tmp_path):
+    from designer.pid.delayloop import SIM_N_FILTER, closed_loop_step, pid_tf
+    u, y, path = dryer
+    ident = run(IDENTIFY, path, "--json")
+    assert ident.returncode == 0, ident.stderr
+    v = json.loads(ident.stdout)["validation"]
+    p = run(DESIGN_PID, "--plant-capture", path, "--json", "--no-files", "--no-sim")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    # it tunes for identify's best validation fit across every route
+    assert d["plant"]["model"]["source"] == v["best"]["process_model"]["source"] + " (dryer.csv)"
+    tun = d["tuning"]
+    ctrl = pid_tf(tun["kp"], tun["ti_s"], tun["td_s"], SIM_N_FILTER)
+    k = v["split"]["estimation"][1]
+    arx = arx_fit(u[:k], y[:k], 2, 2, 3)
+    t = np.linspace(0.0, 8.0, 4001)
+    yy = closed_loop_step(arx_continuous(arx, TS, v["hold"]), ctrl, t, 1.0)["y"]
+    arx_overshoot = 100.0 * (yy.max() - 1.0)
+    assert d["closed_loop"]["ideal_pid"]["overshoot_pct"] == pytest.approx(arx_overshoot, abs=2.0)
