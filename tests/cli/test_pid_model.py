@@ -226,8 +226,10 @@ def test_plant_capture_of_plain_columns_with_a_sample_time(tmp_path, capture):
             "--no-files", "--no-sim")
     assert ref.returncode == 0 and p.returncode == 0, p.stderr
     a, b = json.loads(ref.stdout)["plant"]["model"], json.loads(p.stdout)["plant"]["model"]
-    assert a["kind"] == b["kind"] and a["num"] == pytest.approx(b["num"], rel=1e-9)
-    assert a["den"] == pytest.approx(b["den"], rel=1e-9) and a["theta_s"] == pytest.approx(b["theta_s"], rel=1e-9)
+    # the best model is an output-error fit (issue 28): an optimiser's answer, which the times k * 5 us against
+    # the file's 9-digit times move in the 9th digit
+    assert a["kind"] == b["kind"] and a["num"] == pytest.approx(b["num"], rel=1e-6)
+    assert a["den"] == pytest.approx(b["den"], rel=1e-6) and a["theta_s"] == pytest.approx(b["theta_s"], rel=1e-6)
     one_line_refusal(run(DESIGN_PID, "--plant-capture", str(plain), "--no-files", "--no-sim"),
                      "give --sample-time")
     one_line_refusal(run(DESIGN_PID, "--plant-tf", TF, "--sample-time", "1m", "--no-files", "--no-sim"),

@@ -161,7 +161,7 @@ def _plain_layout(layout: Layout, plain: tuple, name: str) -> Layout:
                          "{sample_time_s} is for a file without one: drop it", params=("sample_time_s",))
     if names is not None and len(names) != ncols:
         raise ParamError(f"{{column_names}} names {len(names)} column{'s' if len(names) > 1 else ''} "
-                         f"({','.join(names)}) and {name} has {ncols}: name every column, in order, e.g. "
+                         f"({show_cell(','.join(names))}) and {name} has {ncols}: name every column, in order, e.g. "
                          + ",".join((["u", "y"] + [f"x{j}" for j in range(3, ncols + 1)])[:max(ncols, 1)]),
                          params=("column_names",))
     if names is not None:
