@@ -33,7 +33,7 @@ from ..spice.deck import SquareTest
 from . import blocks, model, selection, tuning
 from .netlist import closed_loop_deck
 from .result import Achieved, AnalyticLoop, PidResult, Waveforms
-from .spec import PidSpec, check_plant
+from .spec import PidSpec
 from .verify import explain, loop_metrics, run_and_compare
 
 #: phase margin below which the loop is called under-damped on the bench
@@ -48,25 +48,11 @@ LIMITS = ("closed_loop_stable", "phase_margin", "slew_rate", "output_swing")
 # ---- plant ------------------------------------------------------------------
 
 def resolve_plant(spec: PidSpec):
-    """(parts, description, series) of the plant, designed, given or read;
-    every way through :func:`designer.plant.sallenkey.check_parts`. ``series``
-    is the (R, C) pair of a plant designed here, else None."""
-    if spec.plant_parts is not None:
-        return spec.plant_parts, "parts", None
-    if spec.json_plant is not None:
-        return spec.json_plant, f"json:{spec.plant_json}", None
-    from ..plant.design import choose_parts
-    from ..plant.spec import PlantSpec
-    ps = PlantSpec(fc_hz=spec.plant_fc_hz, zeta=spec.plant_zeta, opamp=spec.opamp,
-                   r_series=spec.r_series, c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
-                   c_min=spec.c_min, c_max=spec.c_max, alternatives=1)
-    res = choose_parts(ps)   # the parts only: no analysis, no deck
-    what = f"the plant designed for {{plant_fc_hz}} {spec.plant_fc_hz:g} {{plant_zeta}} {spec.plant_zeta:g}"
-    names = {k: f"{what}: {v}" for k, v in (("r1", "R1"), ("r2", "R2"), ("c1", "C1"), ("c2", "C2"),
-                                               ("r3", "R3"), ("r4", "R4"), ("gain", "gain K"))}
-    built = check_plant(res.built, names | {"plant": what})
-    return (built, f"design-plant fc={spec.plant_fc_hz:g} Hz zeta={spec.plant_zeta:g}",
-            (spec.r_series, spec.c_series))
+    """(parts, description, series) of the Sallen-Key plant
+    (:func:`designer.pid.plant.sallen_key_parts`; every plant source as a
+    :class:`~designer.pid.plant.Plant`: :func:`designer.pid.plant.resolve_plant`)."""
+    from .plant import sallen_key_parts
+    return sallen_key_parts(spec)
 
 
 def plant_model(parts: SallenKeyParts, amp: OpAmp):
@@ -450,14 +436,17 @@ def _diverging(lm, t, r, limit):
     return w
 
 
-def _designators(parts, plant, amp, package) -> dict:
+def _designators(parts, plant, amp, package, netlist=None) -> dict:
     """The deck's op-amp (``U6``) -> its designator on the bench in ``package``
     (``U3B`` in duals), so that checks, notes and JSON name the op-amp the
     sheet wires; a stage the circuit does not have (a PI's differentiator) is
-    absent. ``plant`` None: the controller alone (a plant known only as a model)."""
+    absent. ``plant`` None: the controller alone (a plant known only as a model);
+    ``netlist``: the loop's table as given (a circuit plant's)."""
     from ..spice.deck import board
     from .netlist import controller_netlist, loop_netlist
-    bd = board(controller_netlist(parts) if plant is None else loop_netlist(parts, plant), amp, package)
+    if netlist is None:
+        netlist = controller_netlist(parts) if plant is None else loop_netlist(parts, plant)
+    bd = board(netlist, amp, package)
     return {a.ref: u.designator for a, u in zip(bd.netlist.amps, bd.units)}
 
 

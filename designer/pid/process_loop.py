@@ -45,7 +45,7 @@ from ..spice.deck import SquareTest
 from . import blocks, model as M, rules, selection
 from .delayloop import closed_loop_step, pid_tf, step_figures
 from .delaymargins import loop_margins
-from .netlist import controller_netlist, model_loop_deck
+from .netlist import circuit_loop_deck, circuit_loop_netlist, controller_netlist, model_loop_deck
 from .process_notes import opamp_speed_notes, sizing_notes
 from .process_result import LoopFigures, ProcessPidResult, RobustCheck, RuleRow
 from .result import Achieved, Waveforms
@@ -444,7 +444,11 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
     if mg.stable:
         step = closed_loop_step(plant, sim_ctrl, t, spec.step_v)
         y = edged(t, step["y"], spec.edge_s)
-        waves = stage_waves(parts, amp, t, r, y)
+        if spec.circuit is not None and spec.circuit.reversed_action:
+            # r and y exchanged at the difference amplifier: every controller stage is its own for (y, r)
+            waves = {**stage_waves(parts, amp, t, y, r), "y": y}
+        else:
+            waves = stage_waves(parts, amp, t, r, y)
     else:
         waves = {k: np.full(t.size, np.nan) for k in M.SIGNALS if k != "vd" or parts.has_derivative}
     ideal = pid_tf(gains.kp, gains.ti_s, gains.td_s, 10.0 if gains.td_s > 0 else None)
@@ -455,7 +459,7 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
     # the ideal PID has a true integrator: it settles on the step itself
     ideal_figures = loop_metrics(t, y_ideal, spec.step_v) if np.all(np.isfinite(y_ideal)) else None
     rise = figures.rise_time_s if math.isfinite(figures.rise_time_s) and figures.rise_time_s else t[-1] / 20
-    names = _designators(parts, None, amp, spec.package)
+    names = _designators(parts, None, amp, spec.package, loop_netlist_of(spec, parts))
     levels = M.waveform_limits({k: v for k, v in waves.items() if k != "y"}, t, amp,
                                M.SLEW_DELAY_FRACTION * rise) if mg.stable else {}
     levels = _named(levels, names)
@@ -463,13 +467,30 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
         mg.stable, levels, amp, spec.step_v, rise, parts, names.get)
     title = (f"PID closed loop Kp={parts.kp:.4g} Ti={parts.ti_s:.4g}s Td={parts.td_s:.4g}s "
              f"plant {model.text()} op-amp={amp.name}")
-    deck = model_loop_deck(parts, model, amp, test, title, expected)
+    deck = loop_deck(spec, parts, model, amp, test, title, expected)
     lo, hi = min(fc, mg.crossover_hz if math.isfinite(mg.crossover_hz) else fc) / 100, 100 * f_fast
     bode_w = 2 * np.pi * np.logspace(np.log10(lo), np.log10(hi), 2000)
     from .delaymargins import loop_response
     wf = Waveforms(t, r, waves, y_ideal, y_open, bode_w, loop_response(plant, ctrl, bode_w), t_long,
                    model.step(t_long), None)
     return _Loop(ctrl, mg, ideal_mg, ideal_figures, figures, dc, levels, tuple(checks), test, expected, deck, t, wf)
+
+
+def loop_netlist_of(spec: PidSpec, parts):
+    """The loop's part and net table as built: the controller alone around a
+    model plant, or with the plant's own circuit (:func:`~designer.pid.netlist.circuit_loop_netlist`)."""
+    if spec.circuit is not None:
+        return circuit_loop_netlist(parts, spec.circuit)
+    return controller_netlist(parts)
+
+
+def loop_deck(spec: PidSpec, parts, model, amp, test, title: str, expected: float) -> str:
+    """The loop's deck: the model as native elements
+    (:func:`~designer.pid.netlist.model_loop_deck`), or the plant's circuit
+    (:func:`~designer.pid.netlist.circuit_loop_deck`)."""
+    if spec.circuit is not None:
+        return circuit_loop_deck(parts, spec.circuit, amp, test, title, expected)
+    return model_loop_deck(parts, model, amp, test, title, expected)
 
 
 def loop_checks(spec, mg, dc, amp, levels, waves, t, parts) -> list:
@@ -540,7 +561,7 @@ def rules_in_spice(res: ProcessPidResult, simulator: str) -> tuple:
             out.append(row)
             continue
         expected = spec.step_v * loop_dc_gain(res.model, M.controller_tf(parts, res.opamp))
-        deck = model_loop_deck(parts, res.model, res.opamp, res.test, f"rule {r.rule}", expected)
+        deck = loop_deck(spec, parts, res.model, res.opamp, res.test, f"rule {r.rule}", expected)
         got = sim.run(deck).measurements.get("overshoot_pct")
         out.append(replace(row, spice_overshoot_pct=None if got is None else float(got)))
     return tuple(out)
@@ -554,6 +575,7 @@ def run_spice(res: ProcessPidResult, simulator: str) -> None:
     sp = run_and_compare(res.deck, simulator, w.t, res.test.delay_s, w.analytic["y"], res.test.amplitude_v,
                          res.expected_final_v, res.opamp)
     stages = {k: v for k, v in sp.stages.items() if k != "plant"}   # y is the model's, not an op-amp's
-    res.spice = sp = replace(sp, stages=_named(stages, _designators(res.parts, None, res.opamp, res.package)))
+    res.spice = sp = replace(sp, stages=_named(stages, _designators(res.parts, None, res.opamp, res.package,
+                                                                     loop_netlist_of(res.spec, res.parts))))
     res.verdict = explain(sp, res.analytic, res.checks)
     res.notes += spice_notes(sp, res.verdict, res.expected_final_v)
