@@ -30,7 +30,7 @@ from ..report.tolerance import section as tolerance_section
 from ..report.tolerance import title as tolerance_title
 from ..report.wiring import bom_csv, bom_rows, net_text
 from ..spice.deck import board
-from .netlist import NET_LABELS, controller_netlist
+from .netlist import NET_LABELS
 from .report import (METRICS, _achieved_blocks, _blocks_plot, _build_blocks, _closed_loop_plot, _known,
                      _loop_gain_plot, _scope_blocks, _spice_agreement, _v, _wiring_blocks, controller_source,
                      verdict_of)
@@ -62,9 +62,11 @@ def verdict_text(result) -> str:
 
 
 def build_board(result):
-    """The controller as built on the bench (the plant is off the board): its part
-    and net table (:func:`~designer.pid.netlist.controller_netlist`) in the result's package."""
-    return board(controller_netlist(result.parts), result.opamp, result.package)
+    """The loop as built on the bench: the controller's part and net table
+    (the plant off the board), or with a circuit plant's own sections on it
+    (:func:`~designer.pid.process_loop.loop_netlist_of`), in the result's package."""
+    from .process_loop import loop_netlist_of
+    return board(loop_netlist_of(result.spec, result.parts), result.opamp, result.package)
 
 
 def bom(result, b=None) -> list:
@@ -329,7 +331,10 @@ def _model_step_plot(result) -> bytes:
 
 def schematic(result):
     """The loop's schematic: the controller, the plant a block (:func:`~designer.pid.schematic.draw_model_loop`)."""
-    from .schematic import draw_model_loop
+    from .schematic import draw_circuit_loop, draw_model_loop
+    plant = getattr(result.spec, "circuit", None)
+    if plant is not None:   # the plant's own sections, as the deck has them
+        return draw_circuit_loop(build_board(result), result.opamp, plant.circuit.netlist("u", "y"))
     return draw_model_loop(build_board(result), result.opamp, result.model.text())
 
 
