@@ -19,7 +19,7 @@ ALLOWED = {
     # the circuits as plug-ins (Topology, its sections, the cascade): below the wings
     "filters": {"core", "spice"},
     "plant": {"core", "spice", "report"},
-    "pid": {"core", "spice", "report", "plant"},
+    "pid": {"core", "spice", "report", "plant", "filters"},
     "identify": {"core", "spice", "report"},
     "tolerance": {"core", "spice", "report", "plant", "pid"},
     "check": {"core", "spice", "report", "plant", "pid", "identify", "tolerance"},
