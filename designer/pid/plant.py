@@ -364,9 +364,10 @@ def sallen_key_parts(spec):
         return spec.plant_parts, "parts", None
     if spec.json_plant is not None:
         return spec.json_plant, f"json:{spec.plant_json}", None
+    from ..core.errors import ParamError
     from ..plant.design import choose_parts
+    from ..plant.sallenkey import check_parts
     from ..plant.spec import PlantSpec
-    from .spec import check_plant
     ps = PlantSpec(fc_hz=spec.plant_fc_hz, zeta=spec.plant_zeta, opamp=spec.opamp,
                    r_series=spec.r_series, c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
                    c_min=spec.c_min, c_max=spec.c_max, alternatives=1)
@@ -374,7 +375,10 @@ def sallen_key_parts(spec):
     what = f"the plant designed for {{plant_fc_hz}} {spec.plant_fc_hz:g} {{plant_zeta}} {spec.plant_zeta:g}"
     names = {k: f"{what}: {v}" for k, v in (("r1", "R1"), ("r2", "R2"), ("c1", "C1"), ("c2", "C2"),
                                                ("r3", "R3"), ("r4", "R4"), ("gain", "gain K"))}
-    built = check_plant(res.built, names | {"plant": what})
+    try:   # the one plant validation, its parts named after the request (markers: see ParamError)
+        built = check_parts(res.built, name_of=names | {"plant": what})
+    except DesignError as exc:
+        raise ParamError(str(exc), ("plant_fc_hz", "plant_zeta")) from None
     return (built, f"design-plant fc={spec.plant_fc_hz:g} Hz zeta={spec.plant_zeta:g}",
             (spec.r_series, spec.c_series))
 

@@ -31,6 +31,7 @@ from ..report.tolerance import title as tolerance_title
 from ..report.wiring import bom_csv, bom_rows, net_text
 from ..spice.deck import board
 from .netlist import NET_LABELS
+from .plant import PLANT_PREFIX
 from .report import (METRICS, _achieved_blocks, _blocks_plot, _build_blocks, _closed_loop_plot, _known,
                      _loop_gain_plot, _scope_blocks, _spice_agreement, _v, _wiring_blocks, controller_source,
                      verdict_of)
@@ -90,10 +91,15 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     elsewhere = _shown_elsewhere(result)
     out = [("Verdict", [R.text(verdict_text(result))] + [R.text(n) for n in result.notes if n not in elsewhere])]
     out.append(("Build", _build_blocks(result, b, bom(result, b), with_images, schematic_svg)))
-    out.append(("Wiring", _wiring_blocks(
-        result, b, plant_rows(b),
-        " The plant is not on this board: its input takes u, its output y goes to R17 and to CH2, and its "
-        "ground joins the common ground (the first rows).")))
+    circuit = getattr(result.spec, "circuit", None)
+    if circuit is not None:   # the plant's own sections are on the board, wired as the rest
+        out.append(("Wiring", _wiring_blocks(result, b, (), " The plant's sections are on this board (their parts "
+                                                             f"prefixed {PLANT_PREFIX}: RP1, CP1, op-amp UP).")))
+    else:
+        out.append(("Wiring", _wiring_blocks(
+            result, b, plant_rows(b),
+            " The plant is not on this board: its input takes u, its output y goes to R17 and to CH2, and its "
+            "ground joins the common ground (the first rows).")))
     out.append(("The plant", _plant_blocks(result)))
     out.append(("Tuning", _tuning_blocks(result)))
     out.append(("Target and achieved", _achieved_blocks(result, result) + [R.text(
@@ -140,6 +146,17 @@ def _plant_blocks(result) -> list:
     m, spec = result.model, result.spec
     blocks = [R.text(f"{m.text()} ({m.kind}); the controller's output u is its input, its output y is fed back."),
               R.text(f"Where it came from: {m.source}.")]
+    plant = getattr(spec, "circuit", None)
+    if plant is not None:
+        c = plant.circuit
+        stages = "; ".join(f"{st['title']}: " + ", ".join(f"{k} {format_eng(v, 'Ohm' if k[0] == 'R' else 'F')}"
+                                                           for k, v in st["parts"].items())
+                           for st in c.to_dict()["stages"])
+        blocks.append(R.text(f"The plant is a circuit ({c.topology}), built on the board and simulated as built: "
+                             f"{stages}. Its own transfer function is {plant.model.text()}"
+                             + ("; it inverts, so the controller's action is reversed (r and y exchanged at the "
+                                "difference amplifier) and the gains are chosen for -G(s), the model above."
+                                if plant.reversed_action else ".")))
     if m.ci95:
         rows = [[_param_name(k), _param(m.kind, k, v),
                  "not given" if not m.ci95.get(k) else "+/- " + _param(m.kind, k, m.ci95[k]),

@@ -217,3 +217,33 @@ def test_every_registered_lowpass_is_a_plant():
         plant = circuit_plant(topo, values)
         assert plant.reversed_action == topo.inverting
         assert math.isclose(abs(plant.model.gain), topo.figures(values).gain, rel_tol=1e-9)
+
+
+def test_a_sallen_key_result_names_its_topology():
+    res = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2), simulate=False)
+    assert res.to_dict()["plant"]["topology"] == "sallen-key-lowpass"
+
+
+def test_the_pid_package_has_no_import_cycle():
+    """design <-> process_loop <-> process_optimize and spec <-> plant went (function-level imports counted)."""
+    import ast
+    from pathlib import Path
+
+    import designer.pid as pkg
+    root = Path(pkg.__file__).parent
+    graph = {}
+    for f in root.glob("*.py"):
+        graph[f.stem] = {(n.module or "").split(".")[0] or a.name for n in ast.walk(ast.parse(f.read_text()))
+                         if isinstance(n, ast.ImportFrom) and n.level == 1 for a in n.names}
+    done = set()
+
+    def visit(m, path):
+        assert m not in path, " -> ".join(path + [m])
+        if m in done or m not in graph:
+            return
+        for x in graph[m]:
+            visit(x, path + [m])
+        done.add(m)
+
+    for m in graph:
+        visit(m, [])
