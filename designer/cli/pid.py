@@ -24,6 +24,9 @@ EPILOG = """examples:
         gains that keep every LM741 out of saturation and within its slew rate for a 1 V step
   design-pid --plant-r1 820 --plant-r2 1k --plant-c1 10n --plant-c2 220n --tuning amigo --opamp TL072
   design-pid --plant-json reports/plant_fc3500_z0.2/result.json --tuning chr0 --json --no-sim
+  design-pid --plant-topology mfb-lowpass --plant-part R1=10k R2=20k R3=6k8 C1=10n C2=100n
+        a plant that is a filter section (any registered low-pass, or a design-filter result.json as --plant-json):
+        designed on its model, its own circuit in the SPICE deck and on the sheet (an inverting one: action reversed)
   design-pid --plant-tf "K=2 tau=1m theta=200u" --tuning simc
         a plant known only as a model (FOPDT), SIMC's PI/PID, the model in the SPICE deck
   design-pid --plant-model models.json --tuning optimize --robust

@@ -31,7 +31,26 @@ def designators(parts, plant, amp, package, netlist=None) -> dict:
     (``U3B`` in duals), so that checks, notes and JSON name the op-amp the
     sheet wires; a stage the circuit does not have (a PI's differentiator) is
     absent. ``plant`` None: the controller alone (a plant known only as a model);
-    ``netlist``: the loop's table as given (a circuit plant's)."""
+    ``netlist``: the loop's table as given (a circuit plant's).
+
+    Parameters
+    ----------
+    parts : designer.pid.blocks.PidParts
+        The controller.
+    plant : designer.plant.sallenkey.SallenKeyParts or None
+        A Sallen-Key plant, or None.
+    amp : designer.core.opamps.OpAmp
+        The op-amp (its packages).
+    package : str or None
+        ``single``, ``dual``, ``quad`` or the op-amp's default.
+    netlist : designer.spice.deck.Netlist, optional
+        The loop's table, when not the controller's or the Sallen-Key loop's.
+
+    Returns
+    -------
+    dict
+        Deck designator -> bench designator.
+    """
     from ..spice.deck import board
     from .netlist import controller_netlist, loop_netlist
     if netlist is None:
@@ -42,13 +61,43 @@ def designators(parts, plant, amp, package, netlist=None) -> dict:
 
 def named(levels: dict, names: dict) -> dict:
     """Per-stage figures (analytic or SPICE, keyed by role, each with the deck's
-    ``opamp``) with their op-amp named as on the bench; stages not built dropped."""
+    ``opamp``) with their op-amp named as on the bench; stages not built dropped.
+
+    Parameters
+    ----------
+    levels : dict
+        Role -> figures with an ``opamp`` field.
+    names : dict
+        Deck designator -> bench designator (:func:`designators`).
+
+    Returns
+    -------
+    dict
+        The same, renamed.
+    """
     return {role: replace(v, opamp=names[v.opamp]) for role, v in levels.items() if v.opamp in names}
 
 
 def kick_note(parts, amp, step_v, name_of=str) -> str:
     """The controller's answer to the step edge alone (ideal op-amps):
-    u = Kp (1 + Td/(R12 C3)) x step, the high-frequency gain times the step."""
+    u = Kp (1 + Td/(R12 C3)) x step, the high-frequency gain times the step.
+
+    Parameters
+    ----------
+    parts : designer.pid.blocks.PidParts
+        The controller.
+    amp : designer.core.opamps.OpAmp
+        Its op-amps (their swing).
+    step_v : float
+        The reference step, volts.
+    name_of : callable
+        Deck designator -> the name shown.
+
+    Returns
+    -------
+    str
+        A clause for the swing check's message, or "" when the kick fits.
+    """
     hf = parts.kp * (1 + (parts.td_s / (parts.r12 * parts.c3) if parts.has_derivative else 0.0))
     u = hf * step_v
     if amp.ideal or abs(u) <= amp.vout_max:
@@ -58,7 +107,18 @@ def kick_note(parts, amp, step_v, name_of=str) -> str:
 
 
 def steady_state_check(dc_gain: float) -> list:
-    """The leaky integrator's steady-state error 1 - y/r at DC (none when unknown)."""
+    """The leaky integrator's steady-state error 1 - y/r at DC (none when unknown).
+
+    Parameters
+    ----------
+    dc_gain : float
+        y/r at DC of the loop as built.
+
+    Returns
+    -------
+    list of Check
+        One check, or none.
+    """
     if not math.isfinite(dc_gain):
         return []
     e = 1 - dc_gain
@@ -69,7 +129,30 @@ def steady_state_check(dc_gain: float) -> list:
 
 def stage_checks(stable, levels, amp, step_v, rise, parts, name_of=str) -> list:
     """Slew rate and output swing of every op-amp stage of the analytic loop
-    (``levels``: :func:`designer.pid.model.waveform_limits`), for any plant."""
+    (``levels``: :func:`designer.pid.model.waveform_limits`), for any plant.
+
+    Parameters
+    ----------
+    stable : bool
+        Whether the loop is stable.
+    levels : dict
+        Role -> the stage's figures.
+    amp : designer.core.opamps.OpAmp
+        The op-amps.
+    step_v : float
+        The reference step, volts.
+    rise : float
+        The loop's rise time, seconds (the slew budget is 5 % of it).
+    parts : designer.pid.blocks.PidParts
+        The controller.
+    name_of : callable
+        Deck designator -> the name shown.
+
+    Returns
+    -------
+    list of Check
+        ``slew_rate`` and ``output_swing``.
+    """
     out = []
     if not stable:
         out.append(Check("slew_rate", False, "unstable loop: no steady waveforms to check"))
@@ -102,7 +185,22 @@ def stage_checks(stable, levels, amp, step_v, rise, parts, name_of=str) -> list:
 
 def spice_notes(sp, verdict, expected_final_v: float) -> list:
     """What a SPICE run of a loop says beyond its figures: saturated stages,
-    oscillation, latch-up, a disagreement no check explains."""
+    oscillation, latch-up, a disagreement no check explains.
+
+    Parameters
+    ----------
+    sp : designer.pid.verify.SpiceRun
+        The run.
+    verdict : designer.pid.verify.Verdict
+        Its comparison with the analytic loop.
+    expected_final_v : float
+        The settled output expected, volts.
+
+    Returns
+    -------
+    list of str
+        The notes.
+    """
     out = []
     sat = [f"{v.opamp} {role}" for role, v in sp.stages.items() if v.saturated]
     if sat:

@@ -142,7 +142,20 @@ def circuit_loop_netlist(parts: PidParts, plant) -> Netlist:
     :class:`~designer.pid.plant.Plant` with its circuit): the plant's sections
     between ``u`` and ``y`` first (designators prefixed ``P``:
     :meth:`~designer.pid.plant.PlantCircuit.netlist`), then the controller,
-    its action reversed for an inverting plant."""
+    its action reversed for an inverting plant.
+
+    Parameters
+    ----------
+    parts : PidParts
+        The controller.
+    plant : designer.pid.plant.Plant
+        A plant with its circuit.
+
+    Returns
+    -------
+    Netlist
+        The loop's parts and op-amps, the plant's first.
+    """
     pl = plant.circuit.netlist("u", "y")
     ctl = controller_netlist(parts, plant.reversed_action)
     return Netlist(pl.parts + ctl.parts, pl.amps + ctl.amps)
@@ -152,7 +165,30 @@ def circuit_loop_deck(parts: PidParts, plant, opamp: OpAmp, test: SquareTest, ti
                       expected_final: float, points: int = 20000) -> str:
     """The whole loop around a circuit plant as a standalone deck
     (:func:`circuit_loop_netlist`: the plant's own sections and op-amps), with
-    the reference, ``.tran`` and ``.meas`` lines of every loop deck."""
+    the reference, ``.tran`` and ``.meas`` lines of every loop deck.
+
+    Parameters
+    ----------
+    parts : PidParts
+        The controller.
+    plant : designer.pid.plant.Plant
+        A plant with its circuit.
+    opamp : OpAmp
+        Every op-amp's model (the plant's too).
+    test : SquareTest
+        The reference square wave.
+    title : str
+        The deck's title.
+    expected_final : float
+        The settled plant output the ``.meas`` levels refer to, volts.
+    points : int
+        The transient's resolution (samples over the run).
+
+    Returns
+    -------
+    str
+        The deck (runs alone with ``ngspice -b``).
+    """
     c = plant.circuit
     stages = ", ".join(f"{st.topology.title} (U{c.prefix(i)})" for i, st in enumerate(c.stages, 1))
     about = [f"* plant (a circuit, {c.topology}): {stages}; input u, output y",

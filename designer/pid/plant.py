@@ -117,15 +117,9 @@ class PlantCircuit:
         Netlist
             Every stage's parts and op-amp, in stage order.
         """
-        parts, amps, node = [], [], inp
-        for i, st in enumerate(self.stages, 1):
-            nxt = out if i == len(self.stages) else f"ps{i}"
-            pre = self.prefix(i)
-            net = st.topology.netlist(st.values, prefix=pre, amp_ref=f"U{pre}", inp=node, out=nxt)
-            parts += net.parts
-            amps += net.amps
-            node = nxt
-        return Netlist(tuple(parts), tuple(amps))
+        from ..filters.cascade import Cascade
+        return Cascade(self.stages).netlist(inp, out, prefix=self.prefix, amp_ref=lambda i: f"U{self.prefix(i)}",
+                                            link="ps")
 
     def to_dict(self) -> dict:
         """The circuit as JSON-ready data.
@@ -258,9 +252,16 @@ def circuit_from_cascade(stages, *, source: str = "circuit", name: str = "plant_
     from ..filters.registry import get
     if isinstance(stages, Cascade):
         stages = stages.stages
+    if isinstance(stages, (str, bytes, dict)) or not hasattr(stages, "__iter__"):
+        raise DesignError(f"{name}: a plant circuit is a Cascade or a list of (topology, part values) pairs, "
+                          f"got {type(stages).__name__}", param=name)
     out = []
     for st in stages:
-        topo, values = (st.topology, st.values) if isinstance(st, Stage) else st
+        try:
+            topo, values = (st.topology, st.values) if isinstance(st, Stage) else st
+        except (TypeError, ValueError):
+            raise DesignError(f"{name}: each section is a (topology, part values) pair, got {st!r}",
+                              param=name) from None
         topo = get(topo) if isinstance(topo, str) else topo
         out.append(Stage(topo, parse_part_values(topo, values, name)))
     if not out:
@@ -281,7 +282,9 @@ def circuit_from_cascade(stages, *, source: str = "circuit", name: str = "plant_
 
 
 def circuit_plant(topology, values, *, source: str = "parts", name: str = "plant_values") -> Plant:
-    """A :class:`Plant` of one registered section with its part values.
+    """A :class:`Plant` of one registered section with its part values
+    (:func:`circuit_from_cascade` of one stage; an unknown topology is refused
+    in one line listing the registered ones).
 
     Parameters
     ----------
@@ -289,20 +292,13 @@ def circuit_plant(topology, values, *, source: str = "parts", name: str = "plant
         A registered name (``mfb-lowpass``) or the section.
     values : dict or iterable of str
         Its part values (:func:`parse_part_values`).
-    source : str
-        Where it came from.
-    name : str
-        The parameter named in messages about the values.
+    source, name : str
+        As for :func:`circuit_from_cascade` (``name``: the values' parameter).
 
     Returns
     -------
     Plant
-        With its circuit.
-
-    Raises
-    ------
-    DesignError
-        One line (an unknown topology lists the registered ones).
+        The section's plant.
     """
     from ..filters.registry import get
     topo = get(topology) if isinstance(topology, str) else topology
@@ -323,7 +319,7 @@ def circuit_from_json(data: dict, *, name: str = "result") -> Plant:
     Returns
     -------
     Plant
-        With its circuit.
+        The file's sections as a cascade plant (one stage: that section's).
 
     Raises
     ------

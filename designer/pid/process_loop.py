@@ -320,7 +320,20 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _Loop:
 
 def loop_netlist_of(spec: PidSpec, parts):
     """The loop's part and net table as built: the controller alone around a
-    model plant, or with the plant's own circuit (:func:`~designer.pid.netlist.circuit_loop_netlist`)."""
+    model plant, or with the plant's own circuit (:func:`~designer.pid.netlist.circuit_loop_netlist`).
+
+    Parameters
+    ----------
+    spec : PidSpec
+        The request (its ``circuit``, if any).
+    parts : designer.pid.blocks.PidParts
+        The controller.
+
+    Returns
+    -------
+    designer.spice.deck.Netlist
+        The table the board, the BOM and the schematic are written from.
+    """
     if spec.circuit is not None:
         return circuit_loop_netlist(parts, spec.circuit)
     return controller_netlist(parts)
@@ -329,7 +342,30 @@ def loop_netlist_of(spec: PidSpec, parts):
 def loop_deck(spec: PidSpec, parts, model, amp, test, title: str, expected: float) -> str:
     """The loop's deck: the model as native elements
     (:func:`~designer.pid.netlist.model_loop_deck`), or the plant's circuit
-    (:func:`~designer.pid.netlist.circuit_loop_deck`)."""
+    (:func:`~designer.pid.netlist.circuit_loop_deck`).
+
+    Parameters
+    ----------
+    spec : PidSpec
+        The request (its ``circuit``, if any).
+    parts : designer.pid.blocks.PidParts
+        The controller.
+    model : designer.core.process.ProcessModel
+        The plant's model (a model plant's deck is written from it).
+    amp : designer.core.opamps.OpAmp
+        The op-amps.
+    test : designer.spice.deck.SquareTest
+        The reference square wave.
+    title : str
+        The deck's title.
+    expected : float
+        The settled output the ``.meas`` levels refer to, volts.
+
+    Returns
+    -------
+    str
+        The deck.
+    """
     if spec.circuit is not None:
         return circuit_loop_deck(parts, spec.circuit, amp, test, title, expected)
     return model_loop_deck(parts, model, amp, test, title, expected)

@@ -93,7 +93,24 @@ def draw_circuit_loop(board, opamp, plant, probes: dict = PROBES) -> Sheet:
     plant, and below it the plant's own sections (``plant``: the
     :class:`~designer.spice.deck.Netlist` of
     :meth:`~designer.pid.plant.PlantCircuit.netlist`, whose parts and op-amps
-    are on ``board``) drawn by :func:`draw_circuit` from net ``u`` to net ``y``."""
+    are on ``board``) drawn by :func:`draw_circuit` from net ``u`` to net ``y``.
+
+    Parameters
+    ----------
+    board : designer.spice.deck.Board
+        The loop as built.
+    opamp : designer.core.opamps.OpAmp
+        Its part (for the supplies).
+    plant : designer.spice.deck.Netlist
+        The plant's sections.
+    probes : dict
+        Net -> scope tag.
+
+    Returns
+    -------
+    Sheet
+        The drawing with its connectivity.
+    """
     s = Sheet(fontsize=10)
     bottom = _draw_controller(s, board, probes)
     low = draw_circuit(s, board, plant, (0.0, bottom), "u", "y", probes.get("y", "CH2"))
@@ -113,7 +130,28 @@ def draw_circuit(s: Sheet, board, netlist, origin, inp: str, out: str, probe: st
     its second's (to a ground symbol for ground), each op-amp to the right with
     its inputs wired left to their buses and its output over it to its bus.
     Crossings carry no dot and join nothing (:meth:`Sheet.connectivity` joins
-    only end points). Returns the lowest y drawn."""
+    only end points).
+
+    Parameters
+    ----------
+    s : Sheet
+        Where to draw.
+    board : designer.spice.deck.Board
+        Places the op-amps in packages (designators, pins).
+    netlist : designer.spice.deck.Netlist
+        The circuit.
+    origin : tuple of float
+        The top left corner.
+    inp, out : str
+        The input and output nets (labelled ``u`` and ``y``).
+    probe : str
+        The output's scope tag.
+
+    Returns
+    -------
+    float
+        The lowest y drawn.
+    """
     from ..spice.deck import GROUND
     x0, y0 = origin
     order = [inp]

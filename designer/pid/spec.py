@@ -204,8 +204,9 @@ class PidSpec(PartBounds):
                 return circuit_plant(self.plant_topology, self.plant_values, name="plant_values")
             return circuit_from_cascade(self.plant_circuit, name="plant_circuit")
         except DesignError as exc:
-            if exc.param == "topology":
-                raise _refused("{plant_topology}" + str(exc)[len("topology"):]) from None
+            if exc.param == "topology":   # the registry's refusal, named as this spec's parameter
+                where = "{plant_topology}" if self.plant_topology is not None else "{plant_circuit}"
+                raise _refused(where + str(exc)[len("topology"):]) from None
             raise
 
     def _process(self):
@@ -304,7 +305,18 @@ BUILT_KEYS = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "gain"
 def filter_plant_from_json(path):
     """The circuit of a ``design-filter`` result.json as a
     :class:`~designer.pid.plant.Plant`, or None for any other file (read then
-    by :func:`plant_from_json`, whose refusals name what it accepts)."""
+    by :func:`plant_from_json`, whose refusals name what it accepts).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``plant_json`` file.
+
+    Returns
+    -------
+    designer.pid.plant.Plant or None
+        The cascade plant, or None for another kind of file.
+    """
     try:
         data = read_result(path, "{plant_json}")
     except DesignError:

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from helpers import deck_terminals
 
 from designer.cli.common import flag_message
 from designer.core.errors import DesignError
@@ -144,24 +145,6 @@ def test_any_typed_value_is_a_part_or_a_one_line_refusal(text):
 
 # ---- designed, simulated with the plant's circuit in the deck, drawn ----------------------------
 
-def deck_terminals(deck: str) -> dict:
-    """(designator, terminal) -> net of the deck's R, C and X lines (outside subcircuits)."""
-    out, inside = {}, False
-    for line in deck.splitlines():
-        f = line.split()
-        if f and f[0].lower() == ".subckt":
-            inside = True
-        elif f and f[0].lower() == ".ends":
-            inside = False
-        if inside or not f or f[0][0] not in "RCX":
-            continue
-        if f[0][0] in "RC":
-            out[(f[0], "a")], out[(f[0], "b")] = f[1], f[2]
-        else:
-            for term, net in zip(("inp", "inn", "vcc", "vee", "out"), f[1:6]):
-                out[(f[0][1:], term)] = net
-    return out
-
 
 @pytest.fixture(scope="module", params=list(CIRCUITS))
 def designed(request):
@@ -247,3 +230,9 @@ def test_the_pid_package_has_no_import_cycle():
 
     for m in graph:
         visit(m, [])
+
+
+@pytest.mark.parametrize("bad", [[1], 5, "rc-lowpass", [("rc-lowpass",)], [], [("nope", RC)]])
+def test_a_malformed_plant_circuit_is_one_line(bad):
+    text = str(refusal(plant_circuit=bad))
+    assert "\n" not in text and ("plant_circuit" in text or "topology" in text), text
