@@ -169,10 +169,8 @@ def circuit_loop_deck(parts: PidParts, plant, opamp: OpAmp, test: SquareTest, ti
 
     Parameters
     ----------
-    parts : PidParts
-        The controller.
-    plant : designer.pid.plant.Plant
-        A plant with its circuit.
+    parts, plant : PidParts, designer.pid.plant.Plant
+        As for :func:`circuit_loop_netlist`.
     opamp : OpAmp
         Every op-amp's model (the plant's too).
     test : SquareTest

@@ -77,17 +77,17 @@ class PlantCircuit:
         return sum(st.topology.inverting for st in self.stages) % 2 == 1
 
     def prefix(self, i: int) -> str:
-        """The designator prefix of stage ``i`` (1-based): ``P``, or ``Pi`` in a cascade.
+        """The designator prefix of stage ``i`` (1-based).
 
         Parameters
         ----------
         i : int
-            Stage number.
+            The stage, 1 for the plant's input section.
 
         Returns
         -------
         str
-            The prefix.
+            ``P`` for a one-section plant (R1 -> RP1), ``Pi`` in a cascade (RPi1).
         """
         return PLANT_PREFIX if len(self.stages) == 1 else f"{PLANT_PREFIX}{i}"
 

@@ -346,10 +346,8 @@ def loop_deck(spec: PidSpec, parts, model, amp, test, title: str, expected: floa
 
     Parameters
     ----------
-    spec : PidSpec
-        The request (its ``circuit``, if any).
-    parts : designer.pid.blocks.PidParts
-        The controller.
+    spec, parts : PidSpec, designer.pid.blocks.PidParts
+        As for :func:`loop_netlist_of`.
     model : designer.core.process.ProcessModel
         The plant's model (a model plant's deck is written from it).
     amp : designer.core.opamps.OpAmp
