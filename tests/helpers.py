@@ -72,3 +72,27 @@ def wilson_half_width(k: int, n: int, z: float = 1.959963984540054) -> float:
     lo = (p + z * z / (2 * n) - z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))) / (1 + z * z / n)
     hi = (p + z * z / (2 * n) + z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))) / (1 + z * z / n)
     return ((1.0 if k == n else hi) - (0.0 if k == 0 else lo)) / 2
+
+
+#: an X line's op-amp pins, in the order the project's subcircuits take them
+X_PINS = ("inp", "inn", "vcc", "vee", "out")
+
+
+def deck_terminals(deck: str) -> dict:
+    """(designator, terminal) -> net, read from the deck's element lines (R, C, X)."""
+    out = {}
+    inside = False       # the inlined op-amp models' own elements are not the circuit's
+    for line in deck.splitlines():
+        f = line.split()
+        if f and f[0].lower() == ".subckt":
+            inside = True
+        elif f and f[0].lower() == ".ends":
+            inside = False
+        if inside or not f or f[0][0] not in "RCX":
+            continue
+        kind, name = f[0][0], f[0][1:]
+        if kind in "RC":
+            out[(f[0], "a")], out[(f[0], "b")] = f[1], f[2]
+        else:
+            out.update({(name, pin): net for pin, net in zip(X_PINS, f[1:6])})
+    return out

@@ -35,7 +35,8 @@ FLAGS = {
     # design-pid
     "plant_fc_hz": "--plant-fc", "plant_zeta": "--plant-zeta", "plant_gain": "--plant-gain",
     "plant_r1": "--plant-r1", "plant_r2": "--plant-r2", "plant_c1": "--plant-c1", "plant_c2": "--plant-c2",
-    "plant_json": "--plant-json", "tuning": "--tuning", "kp": "--kp", "ti_s": "--ti", "td_s": "--td",
+    "plant_json": "--plant-json", "plant_topology": "--plant-topology", "plant_values": "--plant-part",
+    "tuning": "--tuning", "kp": "--kp", "ti_s": "--ti", "td_s": "--td",
     "step_v": "--step", "edge_s": "--edge", "target_overshoot_pct": "--target-overshoot",
     "target_settling_s": "--target-settling", "f_integrator_hz": "--f-integrator",
     "f_differentiator_hz": "--f-differentiator",

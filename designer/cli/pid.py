@@ -26,6 +26,9 @@ EPILOG = """examples:
         gains that keep every LM741 out of saturation and within its slew rate for a 1 V step
   design-pid --plant-r1 820 --plant-r2 1k --plant-c1 10n --plant-c2 220n --tuning amigo --opamp TL072
   design-pid --plant-json reports/plant_fc3500_z0.2/result.json --tuning chr0 --json --no-sim
+  design-pid --plant-topology mfb-lowpass --plant-part R1=10k R2=20k R3=6k8 C1=10n C2=100n
+        a plant that is a filter section (any registered low-pass, or a design-filter result.json as --plant-json):
+        designed on its model, its own circuit in the SPICE deck and on the sheet (an inverting one: action reversed)
   design-pid --plant-tf "K=2 tau=1m theta=200u" --tuning simc
         a plant known only as a model (FOPDT), SIMC's PI/PID, the model in the SPICE deck
   design-pid --plant-model models.json --tuning optimize --robust
@@ -146,9 +149,17 @@ def _add_plant_options(p):
     g.add_argument("--plant-gain", metavar="K",
                    help=f"plant gain K = 1 + R4/R3 with --plant-r1.. {_r('gain')} (default 1; R3 = 10k, "
                         "R4 = (K - 1) R3)")
+    from ..filters.registry import REGISTRY
+    lows = [n for n, t in REGISTRY.items() if t.kind == "lowpass"]
+    g.add_argument("--plant-topology", metavar="NAME",
+                   help="plant as built from one filter section, its circuit in the deck and on the sheet: "
+                        f"{', '.join(lows)} (with --plant-part)")
+    g.add_argument("--plant-part", nargs="+", action=common.ExtendList, metavar="REF=VALUE",
+                   help=f"with --plant-topology: every part of the section, e.g. R1=10k C1=100n "
+                        f"(resistors {_r('resistor_ohm')}, capacitors {_r('capacitor_f')})")
     g.add_argument("--plant-json", metavar="FILE",
                    help="a result.json written by design-plant or analyze-plant (its 'built' parts, checked "
-                        "against the same ranges)")
+                        "against the same ranges), or by design-filter (its stages as a cascade plant)")
     g.add_argument("--plant-tf", metavar="MODEL",
                    help="a model typed by hand, e.g. \"K=2 tau=1m theta=200u\" (forms below)")
     g.add_argument("--plant-model", metavar="FILE",
@@ -185,7 +196,9 @@ def _add_signal_options(p):
 #: the spec's parameters set from options of the same meaning (their options: FLAGS)
 MODEL_PARAMS = ("plant_tf", "plant_model", "plant_method", "plant_input", "plant_output", "simc_tauc_s",
                 "imc_lambda_s", "min_phase_margin_deg", "min_gain_margin_db", "max_ms", "robust")
-SPEC_PARAMS = ("plant_fc_hz", "plant_zeta", "plant_json", "tuning", "kp", "ti_s", "td_s", "opamp", "step_v", "edge_s",
+#: a plant circuit of any registered topology
+CIRCUIT_PARAMS = ("plant_topology", "plant_values")
+SPEC_PARAMS = CIRCUIT_PARAMS + ("plant_fc_hz", "plant_zeta", "plant_json", "tuning", "kp", "ti_s", "td_s", "opamp", "step_v", "edge_s",
                "r_series", "c_series", "r_min", "r_max", "c_min", "c_max", "target_overshoot_pct",
                "target_settling_s", "f_integrator_hz", "f_differentiator_hz", "square_hz") + MODEL_PARAMS
 
@@ -291,8 +304,9 @@ def _default_name(spec, fn_hz, zeta) -> str:
 
 
 def _model_name(spec, method: str) -> str:
-    """The default design name of a model plant: ``pid_<rule>_<opamp>_<kind>``."""
-    return f"pid_{method}_{spec.opamp.lower()}_{spec.process.kind}"
+    """The default design name of a model plant: ``pid_<rule>_<opamp>_<kind>`` (a circuit plant: its topology)."""
+    kind = spec.circuit.circuit.topology if spec.circuit is not None else spec.process.kind
+    return f"pid_{method}_{spec.opamp.lower()}_{kind}"
 
 
 def _run(args) -> int:
@@ -422,7 +436,7 @@ def _analyzed_name(args, spec, result) -> str:
 
 
 #: the spec's parameters analyze-pid sets from options of the same meaning
-ANALYZE_PARAMS = ("plant_fc_hz", "plant_zeta", "plant_json", "kp", "ti_s", "td_s", "opamp", "step_v", "edge_s",
+ANALYZE_PARAMS = CIRCUIT_PARAMS + ("plant_fc_hz", "plant_zeta", "plant_json", "kp", "ti_s", "td_s", "opamp", "step_v", "edge_s",
                   "square_hz") + MODEL_PARAMS
 
 

@@ -124,7 +124,7 @@ class Cascade:
             h = h * st.topology.response(st.values, s, opamp)
         return h
 
-    def netlist(self, inp: str = "vin", out: str = "vout") -> Netlist:
+    def netlist(self, inp: str = "vin", out: str = "vout", prefix=None, amp_ref=None, link: str = "s") -> Netlist:
         """The whole cascade: stage i's parts prefixed ``i0``, its op-amp ``Ui``,
         its output net ``s{i}`` (the last one's ``out``) the next stage's input.
 
@@ -132,16 +132,24 @@ class Cascade:
         ----------
         inp, out : str
             The cascade's input and output nets.
+        prefix : callable, optional
+            Stage number -> designator prefix (default :meth:`prefix`).
+        amp_ref : callable, optional
+            Stage number -> op-amp designator (default ``Ui``).
+        link : str
+            The stem of the nets between stages (``s1``, ``s2``, ...).
 
         Returns
         -------
         Netlist
             Every stage's parts then op-amps, in stage order.
         """
+        prefix = prefix or self.prefix
+        amp_ref = amp_ref or (lambda i: f"U{i}")
         parts, amps, node = [], [], inp
         for i, st in enumerate(self.stages, 1):
-            nxt = out if i == len(self.stages) else f"s{i}"
-            net = st.topology.netlist(st.values, prefix=self.prefix(i), amp_ref=f"U{i}", inp=node, out=nxt)
+            nxt = out if i == len(self.stages) else f"{link}{i}"
+            net = st.topology.netlist(st.values, prefix=prefix(i), amp_ref=amp_ref(i), inp=node, out=nxt)
             parts += net.parts
             amps += net.amps
             node = nxt

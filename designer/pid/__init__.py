@@ -19,6 +19,11 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "plant": ("PLANT_PREFIX", "Plant", "PlantCircuit", "circuit_from_cascade", "circuit_from_json", "circuit_plant",
+              "parse_part_values", "resolve_plant", "sallen_key_circuit", "sallen_key_parts"),
+    "modelloop": ("FAR_FACTOR", "LEAK_LOOP_GAIN", "TABLE_STEP_FRACTION", "limits", "loop_figures", "size"),
+    "loopchecks": ("MAX_STEADY_STATE_ERROR", "designators", "kick_note", "named", "spice_notes", "stage_checks",
+                   "steady_state_check"),
     "blocks": ("PidParts", "THESIS_BENCH", "continuous_parts", "seed_bench_parts", "seed_parts", "static_checks"),
     "delayloop": ("MAX_STEPS", "STEP_BUDGET", "closed_loop_step", "parse_loop", "pid_tf", "step_figures"),
     "delaymargins": ("loop_margins", "loop_response"),

@@ -33,42 +33,26 @@ from ..spice.deck import SquareTest
 from . import blocks, model, selection, tuning
 from .netlist import closed_loop_deck
 from .result import Achieved, AnalyticLoop, PidResult, Waveforms
-from .spec import PidSpec, check_plant
+from .spec import PidSpec
+from .loopchecks import designators, named, spice_notes, stage_checks, steady_state_check
 from .verify import explain, loop_metrics, run_and_compare
 
 __all__ = ["PidSpec", "SEED_BENCH_PLANT", "analyze_pid", "design_pid", "run_spice"]
 
 #: phase margin below which the loop is called under-damped on the bench
 MIN_PHASE_MARGIN_DEG = 30.0
-#: largest acceptable steady-state error of the leaky-integrator loop
-MAX_STEADY_STATE_ERROR = 0.02
 #: checks that fail when the gains do not suit the op-amps (then the optimiser is suggested)
 LIMITS = ("closed_loop_stable", "phase_margin", "slew_rate", "output_swing")
-
 
 
 # ---- plant ------------------------------------------------------------------
 
 def resolve_plant(spec: PidSpec):
-    """(parts, description, series) of the plant, designed, given or read;
-    every way through :func:`designer.plant.sallenkey.check_parts`. ``series``
-    is the (R, C) pair of a plant designed here, else None."""
-    if spec.plant_parts is not None:
-        return spec.plant_parts, "parts", None
-    if spec.json_plant is not None:
-        return spec.json_plant, f"json:{spec.plant_json}", None
-    from ..plant.design import choose_parts
-    from ..plant.spec import PlantSpec
-    ps = PlantSpec(fc_hz=spec.plant_fc_hz, zeta=spec.plant_zeta, opamp=spec.opamp,
-                   r_series=spec.r_series, c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
-                   c_min=spec.c_min, c_max=spec.c_max, alternatives=1)
-    res = choose_parts(ps)   # the parts only: no analysis, no deck
-    what = f"the plant designed for {{plant_fc_hz}} {spec.plant_fc_hz:g} {{plant_zeta}} {spec.plant_zeta:g}"
-    names = {k: f"{what}: {v}" for k, v in (("r1", "R1"), ("r2", "R2"), ("c1", "C1"), ("c2", "C2"),
-                                               ("r3", "R3"), ("r4", "R4"), ("gain", "gain K"))}
-    built = check_plant(res.built, names | {"plant": what})
-    return (built, f"design-plant fc={spec.plant_fc_hz:g} Hz zeta={spec.plant_zeta:g}",
-            (spec.r_series, spec.c_series))
+    """(parts, description, series) of the Sallen-Key plant
+    (:func:`designer.pid.plant.sallen_key_parts`; every plant source as a
+    :class:`~designer.pid.plant.Plant`: :func:`designer.pid.plant.resolve_plant`)."""
+    from .plant import sallen_key_parts
+    return sallen_key_parts(spec)
 
 
 def plant_model(parts: SallenKeyParts, amp: OpAmp):
@@ -428,9 +412,9 @@ def _analyse(spec, plant, amp, tun, parts, ps, simulate=True) -> _Loop:
     figures = loop_metrics(t, waves["y"], expected)
     ideal = loop_metrics(t, y_ideal, spec.step_v)   # a true integrator: no steady-state error
     rise = figures.rise_time_s if math.isfinite(figures.rise_time_s) and figures.rise_time_s else hp / 20
-    names = _designators(parts, plant, amp, spec.package)
+    names = designators(parts, plant, amp, spec.package)
     levels = model.waveform_limits(waves, t, amp, model.SLEW_DELAY_FRACTION * rise) if stable else {}
-    levels = _named(levels, names)
+    levels = named(levels, names)
     checks = _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, spec.step_v, rise, parts, names.get)
     title = (f"PID closed loop Kp={parts.kp:.4g} Ti={parts.ti_s:.4g}s Td={parts.td_s:.4g}s "
              f"plant fn={plant.fn_hz:.5g}Hz zeta={plant.zeta:.4g} op-amp={amp.name}")
@@ -450,34 +434,6 @@ def _diverging(lm, t, r, limit):
             v[np.argmax(bad):] = np.nan
             w[k] = v
     return w
-
-
-def _designators(parts, plant, amp, package) -> dict:
-    """The deck's op-amp (``U6``) -> its designator on the bench in ``package``
-    (``U3B`` in duals), so that checks, notes and JSON name the op-amp the
-    sheet wires; a stage the circuit does not have (a PI's differentiator) is
-    absent. ``plant`` None: the controller alone (a plant known only as a model)."""
-    from ..spice.deck import board
-    from .netlist import controller_netlist, loop_netlist
-    bd = board(controller_netlist(parts) if plant is None else loop_netlist(parts, plant), amp, package)
-    return {a.ref: u.designator for a, u in zip(bd.netlist.amps, bd.units)}
-
-
-def _named(levels: dict, names: dict) -> dict:
-    """Per-stage figures (analytic or SPICE, keyed by role, each with the deck's
-    ``opamp``) with their op-amp named as on the bench; stages not built dropped."""
-    return {role: replace(v, opamp=names[v.opamp]) for role, v in levels.items() if v.opamp in names}
-
-
-def _kick(parts, amp, step_v, name_of=str) -> str:
-    """The controller's answer to the step edge alone (ideal op-amps):
-    u = Kp (1 + Td/(R12 C3)) x step, the high-frequency gain times the step."""
-    hf = parts.kp * (1 + (parts.td_s / (parts.r12 * parts.c3) if parts.has_derivative else 0.0))
-    u = hf * step_v
-    if amp.ideal or abs(u) <= amp.vout_max:
-        return ""
-    return (f"; even before the loop reacts, the step edge alone asks {name_of('U6')} for Kp (1 + Td/(R12 C3)) x "
-            f"{step_v:g} V = {u:.3g} V (the {amp.name} reaches {amp.vout_max:.3g} V)")
 
 
 def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise, parts, name_of=str) -> list:
@@ -505,75 +461,15 @@ def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise, parts, nam
     return out + steady_state_check(dc_cl) + stage_checks(stable, levels, amp, step_v, rise, parts, name_of)
 
 
-def steady_state_check(dc_gain: float) -> list:
-    """The leaky integrator's steady-state error 1 - y/r at DC (none when unknown)."""
-    if not math.isfinite(dc_gain):
-        return []
-    e = 1 - dc_gain
-    return [Check("steady_state_error", bool(abs(e) <= MAX_STEADY_STATE_ERROR),
-                  f"{100 * e:.3g} % of the step (the integrator leaks through R13; "
-                  f"want <= {100 * MAX_STEADY_STATE_ERROR:g} %)")]
-
-
-def stage_checks(stable, levels, amp, step_v, rise, parts, name_of=str) -> list:
-    """Slew rate and output swing of every op-amp stage of the analytic loop
-    (``levels``: :func:`designer.pid.model.waveform_limits`), for any plant."""
-    out = []
-    if not stable:
-        out.append(Check("slew_rate", False, "unstable loop: no steady waveforms to check"))
-        out.append(Check("output_swing", False,
-                         "unstable loop: the outputs run to the rails" + _kick(parts, amp, step_v, name_of)))
-        return out
-    if amp.ideal:
-        worst_sw = max(levels.values(), key=lambda v: max(abs(v.v_max), abs(v.v_min)))
-        out.append(Check("slew_rate", True, "ideal op-amps (no slew limit)"))
-        out.append(Check("output_swing", True,
-                         f"ideal op-amps; the largest excursion is {worst_sw.opamp} ({worst_sw.signal}) "
-                         f"{worst_sw.v_min:.3g} V to {worst_sw.v_max:.3g} V"))
-        return out
-    budget = model.SLEW_DELAY_FRACTION * rise
-    slow = [f"{v.opamp} {role} needs {v.slope_v_per_s / 1e6:.3g} V/us, slews for ~"
-            f"{format_eng(v.slew_delay_s, 's')}" for role, v in levels.items() if not v.slew_ok]
-    worst_role, worst_v = max(levels.items(), key=lambda kv: kv[1].slew_delay_s)
-    out.append(Check("slew_rate", not slow,
-                     f"{amp.name} slews at {amp.slew_v_per_s / 1e6:.3g} V/us; slewing may delay a stage by "
-                     f"at most {format_eng(budget, 's')} (5 % of the rise time). "
-                     + ("; ".join(slow) if slow else
-                        f"worst: {worst_v.opamp} {worst_role}, {format_eng(worst_v.slew_delay_s, 's')}")))
-    clip = [f"{v.opamp} {role} {v.v_min:.3g}..{v.v_max:.3g} V" for role, v in levels.items() if not v.swing_ok]
-    out.append(Check("output_swing", not clip,
-                     f"{amp.name} outputs reach {amp.vout_min:.3g} V to {amp.vout_max:.3g} V on "
-                     f"{amp.vcc:g}/{amp.vee:g} V supplies for a {step_v:g} V square wave; "
-                     + ("would need " + "; ".join(clip) if clip else "all stages stay inside")))
-    return out
-
-
 def run_spice(res: PidResult, simulator: str) -> None:
     """Simulate the deck, compare, detect saturation and oscillation; fills
     ``spice``, ``verdict`` and the notes of ``res``."""
     w = res.waveforms
     sp = run_and_compare(res.deck, simulator, w.t, res.test.delay_s, w.analytic["y"],
                          res.test.amplitude_v, res.expected_final_v, res.opamp)
-    res.spice = sp = replace(sp, stages=_named(sp.stages, _designators(res.parts, res.plant, res.opamp,
+    res.spice = sp = replace(sp, stages=named(sp.stages, designators(res.parts, res.plant, res.opamp,
                                                                       res.package)))
     res.verdict = explain(sp, res.analytic.figures, res.checks)
     res.notes += spice_notes(sp, res.verdict, res.expected_final_v)
 
 
-def spice_notes(sp, verdict, expected_final_v: float) -> list:
-    """What a SPICE run of a loop says beyond its figures: saturated stages,
-    oscillation, latch-up, a disagreement no check explains."""
-    out = []
-    sat = [f"{v.opamp} {role}" for role, v in sp.stages.items() if v.saturated]
-    if sat:
-        out.append("SPICE: op-amp output pinned at a rail: " + ", ".join(sat))
-    osc = sp.oscillation
-    if osc.oscillating:
-        out.append(f"SPICE: the loop is still oscillating at the end of the half period "
-                   f"({osc.tail_p2p_v:.3g} V peak to peak)")
-    if osc.latched:
-        out.append(f"SPICE: the output is stuck at {osc.tail_mean_v:.3g} V instead of settling near "
-                   f"{expected_final_v:.3g} V (latch-up)")
-    if verdict.unexplained:
-        out.append("SPICE and the analytic loop disagree and no check explains it (please report this)")
-    return out

@@ -125,15 +125,78 @@ def _loop_deck(parts, opamp, test, title, expected_final, about, plant_lines, ne
     lines = deck.measure_lines("y", test, expected_final) + extreme_lines(parts, test)
     return deck.finish_deck(circuit, test, lines, points=points, max_step_s=max_step_s)
 
-def controller_netlist(parts: PidParts) -> Netlist:
+def controller_netlist(parts: PidParts, reversed_action: bool = False) -> Netlist:
     """The controller alone (U2..U7 and their parts), for a plant that is only a
     model: the deck puts the model between ``u`` and ``y``
-    (:func:`designer.spice.behavioural.plant_lines`)."""
+    (:func:`designer.spice.behavioural.plant_lines`). ``reversed_action``: the
+    reference and the plant output exchanged at the difference amplifier (r into
+    R17, y into R15: u = -C(s) (r - y), for an inverting plant)."""
     rows, amps = [], []
-    for amp, passives in controller_stages(parts):
+    nets = {"ref": "y", "y": "ref"} if reversed_action else {}
+    for amp, passives in controller_stages(parts, **nets):
         rows += passives
         amps.append(amp)
     return Netlist(tuple(rows), tuple(amps))
+
+
+def circuit_loop_netlist(parts: PidParts, plant) -> Netlist:
+    """The loop around a circuit plant of any topology (a
+    :class:`~designer.pid.plant.Plant` with its circuit): the plant's sections
+    between ``u`` and ``y`` first (designators prefixed ``P``:
+    :meth:`~designer.pid.plant.PlantCircuit.netlist`), then the controller,
+    its action reversed for an inverting plant.
+
+    Parameters
+    ----------
+    parts : PidParts
+        The controller.
+    plant : designer.pid.plant.Plant
+        A plant with its circuit.
+
+    Returns
+    -------
+    Netlist
+        The loop's parts and op-amps, the plant's first.
+    """
+    pl = plant.circuit.netlist("u", "y")
+    ctl = controller_netlist(parts, plant.reversed_action)
+    return Netlist(pl.parts + ctl.parts, pl.amps + ctl.amps)
+
+
+def circuit_loop_deck(parts: PidParts, plant, opamp: OpAmp, test: SquareTest, title: str,
+                      expected_final: float, points: int = 20000) -> str:
+    """The whole loop around a circuit plant as a standalone deck
+    (:func:`circuit_loop_netlist`: the plant's own sections and op-amps), with
+    the reference, ``.tran`` and ``.meas`` lines of every loop deck.
+
+    Parameters
+    ----------
+    parts, plant : PidParts, designer.pid.plant.Plant
+        As for :func:`circuit_loop_netlist`.
+    opamp : OpAmp
+        Every op-amp's model (the plant's too).
+    test : SquareTest
+        The reference square wave.
+    title : str
+        The deck's title.
+    expected_final : float
+        The settled plant output the ``.meas`` levels refer to, volts.
+    points : int
+        The transient's resolution (samples over the run).
+
+    Returns
+    -------
+    str
+        The deck (runs alone with ``ngspice -b``).
+    """
+    c = plant.circuit
+    stages = ", ".join(f"{st.topology.title} (U{c.prefix(i)})" for i, st in enumerate(c.stages, 1))
+    about = [f"* plant (a circuit, {c.topology}): {stages}; input u, output y",
+             "* controller (seed 001, Fig. 66): U2 difference (ve = y - r"
+             + (", r and y exchanged: the plant inverts" if plant.reversed_action else "") + "), U3 inverter,",
+             "*   U4 differentiator, U5 integrator, U6 summer, U7 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y)"]
+    return _loop_deck(parts, opamp, test, title, expected_final, about, [], circuit_loop_netlist(parts, plant),
+                      points)
 
 
 def model_loop_deck(parts: PidParts, model, opamp: OpAmp, test: SquareTest, title: str,

@@ -105,7 +105,7 @@ class _Problem:
     """Everything one evaluation needs, computed once."""
 
     def __init__(self, spec, model, amp, fc_hz, t, robust, leak_hz=None):
-        from .process_loop import corner_frequencies, limits, plant_of
+        from .modelloop import corner_frequencies, limits, plant_of
         self.spec, self.model, self.amp, self.fc = spec, model, amp, fc_hz
         self.pm_min, self.gm_min, self.ms_max = limits(spec)
         self.f_i, self.f_d = corner_frequencies(spec, fc_hz, leak_hz)
@@ -129,7 +129,7 @@ class _Problem:
     def built(self, kp, ti, td):
         """The controller as built (op-amp poles included): the E-series parts the design
         selects for these gains (the same call), else before rounding."""
-        from .process_loop import size
+        from .modelloop import size
         try:
             parts = size(self.spec, kp, ti, td, self.fc, self.f_i, self.f_d).parts
         except DesignError:
@@ -203,7 +203,7 @@ class _Problem:
         grid 400 steps long, the plant's output (smooth there) interpolated; the grid's
         first step is read as the edge it holds (:func:`slew_delay_stages`). ``corners``:
         (fc, f_i, f_d) of another build than the search's (a rule's own)."""
-        from .process_loop import edged, stage_waves
+        from .modelloop import edged, stage_waves
         amp = self.amp
         if amp.ideal:
             return 0.0
@@ -229,7 +229,7 @@ class _Problem:
         """Whether a rule's loop (:class:`~designer.pid.process_result.LoopFigures` ``f``), built
         as the design builds it (its own crossover's corners, the op-amp poles), keeps every
         op-amp output within its swing and slew (its row holds its margins and u only)."""
-        from .process_loop import (built_controller, corner_frequencies, ideal_crossover_hz, leak_limit_hz,
+        from .modelloop import (built_controller, corner_frequencies, ideal_crossover_hz, leak_limit_hz,
                                    simulation_controller)
         if self.amp.ideal:
             return True
@@ -275,7 +275,7 @@ def optimize_model_loop(spec, model, amp, table) -> ModelOptimizeResult:
 
     from dataclasses import replace
 
-    from .process_loop import (edged, ideal_crossover_hz, leak_limit_hz, limits, loop_dc_gain, response_grid,
+    from .modelloop import (edged, ideal_crossover_hz, leak_limit_hz, limits, loop_dc_gain, response_grid,
                                simulation_controller)
     from .verify import loop_metrics
     pm_min, gm_min, ms_max = limits(spec)
@@ -393,7 +393,7 @@ def optimize_model_loop(spec, model, amp, table) -> ModelOptimizeResult:
     f_i, f_d = prob.f_i, prob.f_d
     if beaten is not None:
         # built as the rule's row was: its own crossover sets the corners
-        from .process_loop import corner_frequencies
+        from .modelloop import corner_frequencies
         f = beaten.figures
         kp, ti, td, iae, os_, met = f.kp, f.ti_s, f.td_s, f.step.iae, f.step.overshoot_pct, True
         fc = ideal_crossover_hz(model, kp, ti, td)

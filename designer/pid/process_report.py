@@ -30,7 +30,8 @@ from ..report.tolerance import section as tolerance_section
 from ..report.tolerance import title as tolerance_title
 from ..report.wiring import bom_csv, bom_rows, net_text
 from ..spice.deck import board
-from .netlist import NET_LABELS, controller_netlist
+from .netlist import NET_LABELS
+from .plant import PLANT_PREFIX
 from .report import (METRICS, _achieved_blocks, _blocks_plot, _build_blocks, _closed_loop_plot, _known,
                      _loop_gain_plot, _scope_blocks, _spice_agreement, _v, _wiring_blocks, controller_source,
                      verdict_of)
@@ -64,9 +65,11 @@ def verdict_text(result) -> str:
 
 
 def build_board(result):
-    """The controller as built on the bench (the plant is off the board): its part
-    and net table (:func:`~designer.pid.netlist.controller_netlist`) in the result's package."""
-    return board(controller_netlist(result.parts), result.opamp, result.package)
+    """The loop as built on the bench: the controller's part and net table
+    (the plant off the board), or with a circuit plant's own sections on it
+    (:func:`~designer.pid.process_loop.loop_netlist_of`), in the result's package."""
+    from .process_loop import loop_netlist_of
+    return board(loop_netlist_of(result.spec, result.parts), result.opamp, result.package)
 
 
 def bom(result, b=None) -> list:
@@ -90,10 +93,15 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     elsewhere = _shown_elsewhere(result)
     out = [("Verdict", [R.text(verdict_text(result))] + [R.text(n) for n in result.notes if n not in elsewhere])]
     out.append(("Build", _build_blocks(result, b, bom(result, b), with_images, schematic_svg)))
-    out.append(("Wiring", _wiring_blocks(
-        result, b, plant_rows(b),
-        " The plant is not on this board: its input takes u, its output y goes to R17 and to CH2, and its "
-        "ground joins the common ground (the first rows).")))
+    circuit = getattr(result.spec, "circuit", None)
+    if circuit is not None:   # the plant's own sections are on the board, wired as the rest
+        out.append(("Wiring", _wiring_blocks(result, b, (), " The plant's sections are on this board (their parts "
+                                                             f"prefixed {PLANT_PREFIX}: RP1, CP1, op-amp UP).")))
+    else:
+        out.append(("Wiring", _wiring_blocks(
+            result, b, plant_rows(b),
+            " The plant is not on this board: its input takes u, its output y goes to R17 and to CH2, and its "
+            "ground joins the common ground (the first rows).")))
     out.append(("The plant", _plant_blocks(result)))
     out.append(("Tuning", _tuning_blocks(result)))
     out.append(("Target and achieved", _achieved_blocks(result, result) + [R.text(
@@ -140,6 +148,17 @@ def _plant_blocks(result) -> list:
     m, spec = result.model, result.spec
     blocks = [R.text(f"{m.text()} ({m.kind}); the controller's output u is its input, its output y is fed back."),
               R.text(f"Where it came from: {m.source}.")]
+    plant = getattr(spec, "circuit", None)
+    if plant is not None:
+        c = plant.circuit
+        stages = "; ".join(f"{st['title']}: " + ", ".join(f"{k} {format_eng(v, 'Ohm' if k[0] == 'R' else 'F')}"
+                                                           for k, v in st["parts"].items())
+                           for st in c.to_dict()["stages"])
+        blocks.append(R.text(f"The plant is a circuit ({c.topology}), built on the board and simulated as built: "
+                             f"{stages}. Its own transfer function is {plant.model.text()}"
+                             + ("; it inverts, so the controller's action is reversed (r and y exchanged at the "
+                                "difference amplifier) and the gains are chosen for -G(s), the model above."
+                                if plant.reversed_action else ".")))
     if m.ci95:
         rows = [[_param_name(k), _param(m.kind, k, v),
                  "not given" if not m.ci95.get(k) else "+/- " + _param(m.kind, k, m.ci95[k]),
@@ -331,7 +350,10 @@ def _model_step_plot(result) -> bytes:
 
 def schematic(result):
     """The loop's schematic: the controller, the plant a block (:func:`~designer.pid.schematic.draw_model_loop`)."""
-    from .schematic import draw_model_loop
+    from .schematic import draw_circuit_loop, draw_model_loop
+    plant = getattr(result.spec, "circuit", None)
+    if plant is not None:   # the plant's own sections, as the deck has them
+        return draw_circuit_loop(build_board(result), result.opamp, plant.circuit.netlist("u", "y"))
     return draw_model_loop(build_board(result), result.opamp, result.model.text())
 
 

@@ -162,6 +162,19 @@ class ProcessPidResult(LoopVerdicts):
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
+    def circuit_dict(self) -> dict:
+        """A circuit plant's keys of ``plant`` (none for a model plant): ``kind``
+        ``circuit``, its ``topology`` (a registry name or ``cascade``), its
+        ``circuit`` (stages and parts as on the board), ``circuit_model`` (its own
+        transfer function) and ``reversed_action`` (an inverting circuit, the
+        model the gains were chosen for being -G)."""
+        plant = getattr(self.spec, "circuit", None)
+        if plant is None:
+            return {}
+        c = plant.circuit
+        return {"kind": "circuit", "topology": c.topology, "circuit": c.to_dict()["stages"],
+                "circuit_model": plant.model.to_dict(), "reversed_action": plant.reversed_action}
+
     def to_dict(self) -> dict:
         pm_min, gm_min, ms_max = self.limits
         out = {
@@ -169,7 +182,7 @@ class ProcessPidResult(LoopVerdicts):
             "tool": tool_info(self.simulator),
             "plant": {"kind": "model", "source": self.model.source, "model": self.model.to_dict(),
                       "rules_model": self.reduced.to_dict(), "input_range_v": self.spec.plant_input,
-                      "output_range_v": self.spec.plant_output},
+                      "output_range_v": self.spec.plant_output, **self.circuit_dict()},
             "opamp": self.opamp.to_dict(), "package": self.opamp.package(self.package).to_dict(),
             "tuning": {"method": self.method, "kp": self.kp, "ti_s": self.ti_s, "td_s": self.td_s,
                        "rule": None if self.rule is None else self.rule.to_dict()},

@@ -26,6 +26,7 @@ from ..spice.simulate import tool_info
 from .blocks import PidParts
 from .model import Margins
 from .optimize import OptimizeResult
+from .plant import sallen_key_circuit
 from .selection import Selection
 from .spec import PidSpec
 from .tuning import Tuning
@@ -183,7 +184,7 @@ class PidResult(LoopVerdicts):
             "schema_version": SCHEMA_VERSION,
             "tool": tool_info(self.simulator),
             "plant": {"source": self.plant_source, **pl.as_dict(), "q": pl.q, "fn_opamp_hz": self.plant_fn_opamp_hz,
-                      "zeta_opamp": self.plant_zeta_opamp},
+                      "zeta_opamp": self.plant_zeta_opamp, "topology": sallen_key_circuit(pl).topology},
             "opamp": self.opamp.to_dict(), "package": self.opamp.package(self.package).to_dict(),
             "tuning": self.tuning.to_dict(),
             "rules": [r.to_dict(brief=True) for r in self.rules],

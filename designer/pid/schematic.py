@@ -88,6 +88,129 @@ def draw_model_loop(board, opamp, model_text: str, probes: dict = PROBES) -> She
     return s
 
 
+def draw_circuit_loop(board, opamp, plant, probes: dict = PROBES) -> Sheet:
+    """The closed loop around a circuit plant of any topology, on a new sheet:
+    the controller of ``board`` (a :class:`~designer.spice.deck.Board` of
+    :func:`~designer.pid.netlist.circuit_loop_netlist`) as for a Sallen-Key
+    plant, and below it the plant's own sections (``plant``: the
+    :class:`~designer.spice.deck.Netlist` of
+    :meth:`~designer.pid.plant.PlantCircuit.netlist`, whose parts and op-amps
+    are on ``board``) drawn by :func:`draw_circuit` from net ``u`` to net ``y``.
+
+    Parameters
+    ----------
+    board : designer.spice.deck.Board
+        The loop as built.
+    opamp : designer.core.opamps.OpAmp
+        Its part (for the supplies).
+    plant : designer.spice.deck.Netlist
+        The plant's sections.
+    probes : dict
+        Net -> scope tag.
+
+    Returns
+    -------
+    Sheet
+        The drawing with its connectivity.
+    """
+    s = Sheet(fontsize=10)
+    bottom = _draw_controller(s, board, probes)
+    low = draw_circuit(s, board, plant, (0.0, bottom), "u", "y", probes.get("y", "CH2"))
+    draw_supplies(s, board, opamp, (1.0, low - 2.5), per_row=16)
+    return s
+
+
+#: a circuit's nets are vertical buses this far apart; a part spans PART_LENGTH of the gap (never a bus)
+BUS_PITCH, PART_LENGTH, ROW_PITCH = 4.0, 2.5, 1.6
+
+
+def draw_circuit(s: Sheet, board, netlist, origin, inp: str, out: str, probe: str = "CH2") -> float:
+    """Any circuit of parts and op-amps (``netlist``, placed on ``board``) on ``s``
+    as a bus diagram: every net but ground a vertical bus (``inp`` first,
+    ``out`` last, labelled with their names at the top, ``out`` with the
+    ``probe`` tag), each part on a row of its own from its first net's bus toward
+    its second's (to a ground symbol for ground), each op-amp to the right with
+    its inputs wired left to their buses and its output over it to its bus.
+    Crossings carry no dot and join nothing (:meth:`Sheet.connectivity` joins
+    only end points).
+
+    Parameters
+    ----------
+    s : Sheet
+        Where to draw.
+    board : designer.spice.deck.Board
+        Places the op-amps in packages (designators, pins).
+    netlist : designer.spice.deck.Netlist
+        The circuit.
+    origin : tuple of float
+        The top left corner.
+    inp, out : str
+        The input and output nets (labelled ``u`` and ``y``).
+    probe : str
+        The output's scope tag.
+
+    Returns
+    -------
+    float
+        The lowest y drawn.
+    """
+    from ..spice.deck import GROUND
+    x0, y0 = origin
+    order = [inp]
+    for p in netlist.parts:
+        order += [p.a, p.b]
+    for a in netlist.amps:
+        order += [a.inp, a.inn, a.out]
+    nets = [n for n in dict.fromkeys(order) if n not in (GROUND, out)] + [out]
+    col = {n: x0 + 2.0 + BUS_PITCH * i for i, n in enumerate(nets)}
+    at = {n: [] for n in nets}
+    for n, text in ((inp, "u"), (out, "y")):
+        s.net_label((col[n], y0), n, text, loc="top")
+        at[n].append(y0)
+    s.probe((col[out], y0), probe, 1.0)
+    y = y0 - ROW_PITCH
+    for p in netlist.parts:
+        ends = [n for n in (p.a, p.b) if n != GROUND]
+        first = ends[0]
+        x = col[first]
+        towards = 1.0 if len(ends) == 1 or col[ends[1]] > x else -1.0
+        end = (x + towards * PART_LENGTH, y)
+        if p.a == first:
+            s.part(p, (x, y), end)
+        else:
+            s.part(p, end, (x, y))
+        at[first].append(y)
+        if len(ends) == 1:
+            s.ground(end)
+        else:
+            s.wire(end, (col[ends[1]], y))
+            at[ends[1]].append(y)
+        y -= ROW_PITCH
+    x_amp = col[out] + 3.0
+    for a in netlist.amps:
+        pts = s.opamp(a, board.unit_of(a.ref), board.package.part, (x_amp, y - 1.0), plus_on_top=True)
+        for term, net in (("inp", a.inp), ("inn", a.inn)):
+            pt = pts[term]
+            if net == GROUND:
+                s.wire(pt, (pt[0] - 0.5, pt[1]), (pt[0] - 0.5, pt[1] - 0.6))
+                s.ground((pt[0] - 0.5, pt[1] - 0.6))
+            else:
+                s.wire(pt, (col[net], pt[1]))
+                at[net].append(pt[1])
+        o = pts["out"]
+        top = max(pts["inp"][1], pts["inn"][1]) + 0.9
+        s.wire(o, (o[0] + 0.6, o[1]), (o[0] + 0.6, top), (col[a.out], top))
+        at[a.out].append(top)
+        y = min(pts["inp"][1], pts["inn"][1]) - 1.4 - ROW_PITCH
+    for n, ys in at.items():
+        if len(set(ys)) > 1:
+            s.wire((col[n], max(ys)), (col[n], min(ys)))
+        for v in ys:
+            if min(ys) < v < max(ys):   # a tee: the bus goes on past it
+                s.dot((col[n], v))
+    return y
+
+
 #: the plant block's designator on the sheet (its terminals: in, out, gnd)
 PLANT_BLOCK = "PLANT"
 
@@ -140,12 +263,13 @@ def _draw_controller(s: Sheet, board, probes) -> float:
     d = amps["difference"]
     unit = board.unit_of(d.ref)
     pts = s.opamp(d, unit, board.package.part, (3.6, 0.0), plus_on_top=False)
-    s.net_label((0, 1.25), P("R15").a, "r", loc="left")
-    tag((0, 1.25), "ref")
+    text = {"ref": "r", "y": "y"}
+    s.net_label((0, 1.25), P("R15").a, text[P("R15").a], loc="left")
+    tag((0, 1.25), P("R15").a)
     s.part(P("R15"), (0, 1.25), (3.0, 1.25))
     s.wire((3.0, 1.25), pts["inn"])
     s.dot((3.0, 1.25))
-    s.net_label((0, 0), P("R17").a, "y", loc="left")
+    s.net_label((0, 0), P("R17").a, text[P("R17").a], loc="left")
     s.part(P("R17"), (0, 0), (2.4, 0), label_loc="bottom")
     s.wire((2.4, 0), pts["inp"])
     s.dot((2.4, 0))

@@ -116,10 +116,19 @@ class PidSpec(PartBounds):
     min_gain_margin_db: float | None = None
     max_ms: float | None = None
     robust: bool = False
+    #: a plant that is one registered filter section (designer.filters.registry), with ``plant_values``
+    plant_topology: str | None = None
+    #: its part values: designator -> value (number or engineering notation), or "R1=10k" items
+    plant_values: object = None
+    #: a plant circuit given as sections: a designer.filters.cascade.Cascade or (topology, values) pairs
+    plant_circuit: object = None
     #: the plant read from ``plant_json`` (read and checked on construction, before any work)
     json_plant: SallenKeyParts | None = field(default=None, init=False, repr=False, compare=False)
     #: the model plant, from plant_tf, plant_model or plant_process (None for a Sallen-Key plant)
     process: ProcessModel | None = field(default=None, init=False, repr=False, compare=False)
+    #: a circuit plant of any topology (designer.pid.plant.Plant), from plant_topology, plant_circuit or a
+    #: design-filter plant_json; its model is ``process``
+    circuit: object = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         def put(name, value):
@@ -135,10 +144,14 @@ class PidSpec(PartBounds):
             from ..core.opamps import get
             get(self.opamp).package(self.package)
         sources = sum(x is not None for x in (self.plant_fc_hz, self.plant_parts, self.plant_json,
-                                              self.plant_tf, self.plant_model, self.plant_process))
+                                              self.plant_tf, self.plant_model, self.plant_process,
+                                              self.plant_topology, self.plant_circuit))
         if sources != 1:
             raise _refused("give the plant one way: {plant_fc_hz}/{plant_zeta}, {plant_r1}..{plant_c2}, "
-                           "{plant_json}, {plant_tf}, {plant_model} or --plant-capture")
+                           "{plant_topology} with {plant_values}, {plant_json}, {plant_tf}, {plant_model} or "
+                           "--plant-capture")
+        if (self.plant_values is not None) != (self.plant_topology is not None):
+            raise _refused("{plant_topology} and {plant_values} go together (the section and its parts)")
         if self.plant_fc_hz is not None and self.plant_zeta is None:
             raise _refused("{plant_fc_hz} needs {plant_zeta}")
         if self.plant_fc_hz is None and self.plant_zeta is not None:
@@ -149,7 +162,13 @@ class PidSpec(PartBounds):
                      for k, key in PLANT_RANGES.items() if isinstance(getattr(self.plant_parts, k), str)}
             put("plant_parts", check_plant(replace(self.plant_parts, **typed), PLANT_NAMES))
         if self.plant_json is not None:
-            put("json_plant", plant_from_json(self.plant_json))
+            circuit = filter_plant_from_json(self.plant_json)
+            if circuit is not None:
+                put("circuit", circuit)
+            else:
+                put("json_plant", plant_from_json(self.plant_json))
+        if self.plant_topology is not None or self.plant_circuit is not None:
+            put("circuit", self._circuit())
         if self.controller_parts is not None:
             put("controller_parts", check_controller(self.controller_parts))
         put("opamp", opamps.get(self.opamp).name)
@@ -179,8 +198,23 @@ class PidSpec(PartBounds):
         elif self.process is None and (self.target_overshoot_pct is not None or self.target_settling_s is not None):
             raise _refused("{target_overshoot_pct}/{target_settling_s} only apply to {tuning} optimize")
 
+    def _circuit(self):
+        """The circuit plant of ``plant_topology``/``plant_values`` or ``plant_circuit``."""
+        from .plant import circuit_from_cascade, circuit_plant
+        try:
+            if self.plant_topology is not None:
+                return circuit_plant(self.plant_topology, self.plant_values, name="plant_values")
+            return circuit_from_cascade(self.plant_circuit, name="plant_circuit")
+        except DesignError as exc:
+            if exc.param == "topology":   # the registry's refusal, named as this spec's parameter
+                where = "{plant_topology}" if self.plant_topology is not None else "{plant_circuit}"
+                raise _refused(where + str(exc)[len("topology"):]) from None
+            raise
+
     def _process(self):
         """The model plant, read and checked (None for a Sallen-Key plant)."""
+        if self.circuit is not None:
+            return self.circuit.design_model   # an inverting circuit: -G, the controller's action reversed
         if self.plant_tf is not None:
             from ..core.process_text import parse_tf
             try:
@@ -268,6 +302,34 @@ def check_plant(parts: SallenKeyParts, names: dict) -> SallenKeyParts:
 #: result.json keys of the plant's parts (the ``built`` object of design-plant and analyze-plant)
 BUILT_KEYS = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "gain": "gain", "r3": "R3_ohm",
               "r4": "R4_ohm"}
+
+
+def filter_plant_from_json(path):
+    """The circuit of a ``design-filter`` result.json as a
+    :class:`~designer.pid.plant.Plant`, or None for any other file (read then
+    by :func:`plant_from_json`, whose refusals name what it accepts).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``plant_json`` file.
+
+    Returns
+    -------
+    designer.pid.plant.Plant or None
+        The cascade plant, or None for another kind of file.
+    """
+    try:
+        data = read_result(path, "{plant_json}")
+    except DesignError:
+        return None
+    if not (isinstance(data, dict) and data.get("tool") == "design-filter"):
+        return None
+    from .plant import circuit_from_json
+    try:
+        return circuit_from_json(data, name=f"{{plant_json}} {shown(path)}")
+    except DesignError as exc:
+        raise _refused(str(exc)) from None
 
 
 def plant_from_json(path) -> SallenKeyParts:

@@ -9,6 +9,7 @@ import re
 from dataclasses import replace
 
 import pytest
+from helpers import deck_terminals as all_terminals
 
 from designer.core import opamps
 from designer.core.errors import DesignError
@@ -141,31 +142,20 @@ def test_an_integrating_plant_renders_without_simulation():
 # ---- the block schematic is the deck ------------------------------------------------
 
 TEST = SquareTest(amplitude_v=1.0, frequency_hz=100.0, delay_s=1e-4)
-X_PINS = ("inp", "inn", "vcc", "vee", "out")
 
 
 def deck_terminals(deck: str) -> dict:
-    """(designator, terminal) -> net of the controller's R, C and X lines, and the
+    """(designator, terminal) -> net of the controller's R, C and X lines
+    (:func:`helpers.deck_terminals`, the model's own elements left out), and the
     plant block's: its input (the node the model senses), output (the node it
     drives) and ground."""
-    out, inside = {}, False
+    out = {k: v for k, v in all_terminals(deck).items() if "plant" not in k[0]}
     for line in deck.splitlines():
         f = line.split()
-        if f and f[0].lower() == ".subckt":
-            inside = True
-        elif f and f[0].lower() == ".ends":
-            inside = False
-        if inside or not f:
-            continue
-        if f[0] == "Gplant_u":           # G n+ n- nc+ nc- gain: the model senses u
+        if f and f[0] == "Gplant_u":           # G n+ n- nc+ nc- gain: the model senses u
             out[(PLANT_BLOCK, "in")], out[(PLANT_BLOCK, "gnd")] = f[3], f[4]
-        elif f[0] == "Eplant_o":         # E n+ n- ...: the model drives y
+        elif f and f[0] == "Eplant_o":         # E n+ n- ...: the model drives y
             out[(PLANT_BLOCK, "out")] = f[1]
-        elif f[0][0] in "RCX" and "plant" not in f[0]:
-            if f[0][0] in "RC":
-                out[(f[0], "a")], out[(f[0], "b")] = f[1], f[2]
-            else:
-                out.update({(f[0][1:], pin): net for pin, net in zip(X_PINS, f[1:6])})
     return out
 
 

@@ -31,7 +31,8 @@ def refusal(**kw):
      "--tuning zn and explicit --kp/--ti/--td exclude each other"),
     (dict(plant_fc_hz=3500), "plant_fc_hz needs plant_zeta", "--plant-fc needs --plant-zeta"),
     (dict(plant_zeta=0.2), "give the plant one way", "give the plant one way: --plant-fc/--plant-zeta, "
-                                                       "--plant-r1..--plant-c2, --plant-json, --plant-tf, "
+                                                       "--plant-r1..--plant-c2, --plant-topology with "
+                                                       "--plant-part, --plant-json, --plant-tf, "
                                                        "--plant-model or --plant-capture"),
     (dict(SEED, tuning="Magic"), "unknown tuning 'magic'", "unknown --tuning 'magic'"),
     (dict(SEED, tuning="optimize"), "tuning optimize needs target_overshoot_pct",

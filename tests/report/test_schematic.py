@@ -5,6 +5,7 @@ with K = 1 and K > 1 and for the whole PID loop in each package option."""
 import re
 
 import pytest
+from helpers import deck_terminals
 
 from designer.core import opamps
 from designer.core.errors import DesignError
@@ -21,27 +22,6 @@ UNITY = SallenKeyParts(1.6e3, 3.9e3, 3.3e-9, 100e-9)
 GAIN2 = SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, 2.0, 10e3, 10e3)
 TEST = SquareTest(amplitude_v=2.0, frequency_hz=330.0, delay_s=1e-5)
 #: the op-amp pins of a deck's X line, in the subcircuit's order
-X_PINS = ("inp", "inn", "vcc", "vee", "out")
-
-
-def deck_terminals(deck: str) -> dict:
-    """(designator, terminal) -> net, read from the deck's element lines (R, C, X)."""
-    out = {}
-    inside = False       # the inlined op-amp models' own elements are not the circuit's
-    for line in deck.splitlines():
-        f = line.split()
-        if f and f[0].lower() == ".subckt":
-            inside = True
-        elif f and f[0].lower() == ".ends":
-            inside = False
-        if inside or not f or f[0][0] not in "RCX":
-            continue
-        kind, name = f[0][0], f[0][1:]
-        if kind in "RC":
-            out[(f[0], "a")], out[(f[0], "b")] = f[1], f[2]
-        else:
-            out.update({(name, pin): net for pin, net in zip(X_PINS, f[1:6])})
-    return out
 
 
 def drawn_terminals(b, deck: str) -> dict:

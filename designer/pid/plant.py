@@ -1,0 +1,430 @@
+"""A PID's plant: an analysis model and, optionally, the circuit that realises it.
+
+A :class:`Plant` is what every controller design works on: its ``model`` (a
+:class:`~designer.core.process.ProcessModel`, what the tuning rules, the
+optimiser and the analytic loop see) and, when the plant is a circuit on the
+bench, ``circuit`` (a :class:`PlantCircuit`: one registered filter section or
+a cascade of them, :mod:`designer.filters`, with its part values), which then
+goes into the closed-loop deck and onto the schematic in place of the model's
+behavioural block.
+
+The model of a circuit is its ideal-op-amp transfer function, the product of
+its sections' (:meth:`designer.filters.topology.Topology.coefficients`,
+:meth:`designer.filters.cascade.Cascade.coefficients`), as a rational
+:class:`~designer.core.process.ProcessModel`
+(:func:`designer.core.process_build.rational`: proper, strictly stable, a
+non-zero static gain, so a high-pass or band-pass section, with N(0) = 0, is
+refused: no PID sets the level of a plant that passes no DC).
+
+An inverting circuit (an MFB or inverting low-pass: K < 0) is controlled with
+the controller's action reversed (the rules are written for K > 0; Astrom and
+Hagglund, *Advanced PID Control*, 2006, section 1.3): the gains are chosen for
+-G(s), and the deck exchanges the reference and the plant output at the
+difference amplifier (r into R17, y into R15), so that u = -C(s) (r - y) and
+the loop y = (-G)(-C)(r - y) is the one designed.
+
+Designators: a plant of one section keeps the section's names with the prefix
+``P`` after the letter (RP1, CP2) and its op-amp is ``UP``; stage i of a
+cascade is prefixed ``Pi`` (RP11, CP22) with op-amp ``UPi``, so that no plant
+part collides with the controller's R3..R18, C3, C4, U2..U7 or the board's
+decoupling C101.. (:func:`designer.spice.deck.board`).
+
+:func:`resolve_plant` is the one place that turns every plant source of a
+:class:`~designer.pid.spec.PidSpec` into a :class:`Plant`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.errors import DesignError
+from ..core.process import ProcessModel
+from ..core.ranges import parse_in_range
+from ..spice.deck import Netlist
+
+__all__ = ["PLANT_PREFIX", "PlantCircuit", "Plant", "parse_part_values", "circuit_plant", "circuit_from_json",
+           "circuit_from_cascade", "sallen_key_parts", "sallen_key_circuit", "resolve_plant"]
+
+#: the designator prefix of a one-section plant (R1 -> RP1; stage i of a cascade: RPi1)
+PLANT_PREFIX = "P"
+#: the ranges a part of a circuit plant is held to (keys of designer.core.ranges.RANGES)
+PART_RANGES = {"R": "resistor_ohm", "C": "capacitor_f"}
+
+
+@dataclass(frozen=True)
+class PlantCircuit:
+    """The circuit of a plant: registered filter sections in series, input first.
+
+    Parameters
+    ----------
+    stages : tuple of designer.filters.cascade.Stage
+        Each section (its topology) and its part values (designator -> ohm, farad).
+    """
+
+    stages: tuple
+
+    @property
+    def topology(self) -> str:
+        """The registry name of a one-section plant, else ``"cascade"``."""
+        return self.stages[0].topology.name if len(self.stages) == 1 else "cascade"
+
+    @property
+    def inverting(self) -> bool:
+        """Whether the circuit's static gain is negative (an odd number of inverting sections)."""
+        return sum(st.topology.inverting for st in self.stages) % 2 == 1
+
+    def prefix(self, i: int) -> str:
+        """The designator prefix of stage ``i`` (1-based).
+
+        Parameters
+        ----------
+        i : int
+            The stage, 1 for the plant's input section.
+
+        Returns
+        -------
+        str
+            ``P`` for a one-section plant (R1 -> RP1), ``Pi`` in a cascade (RPi1).
+        """
+        return PLANT_PREFIX if len(self.stages) == 1 else f"{PLANT_PREFIX}{i}"
+
+    def coefficients(self) -> tuple:
+        """The ideal (num, den) polynomials in s, highest power first (the stages' products).
+
+        Returns
+        -------
+        tuple of ndarray
+            (num, den).
+        """
+        from ..filters.cascade import Cascade
+        return Cascade(self.stages).coefficients()
+
+    def netlist(self, inp: str = "u", out: str = "y") -> Netlist:
+        """The circuit between nets ``inp`` and ``out``: stage i's parts prefixed
+        (:meth:`prefix`), its op-amp ``U`` + prefix, its output net ``ps{i}`` the
+        next stage's input.
+
+        Parameters
+        ----------
+        inp, out : str
+            The plant's input and output nets.
+
+        Returns
+        -------
+        Netlist
+            Every stage's parts and op-amp, in stage order.
+        """
+        from ..filters.cascade import Cascade
+        return Cascade(self.stages).netlist(inp, out, prefix=self.prefix, amp_ref=lambda i: f"U{self.prefix(i)}",
+                                            link="ps")
+
+    def to_dict(self) -> dict:
+        """The circuit as JSON-ready data.
+
+        Returns
+        -------
+        dict
+            ``topology`` and ``stages`` (each its ``topology``, ``title`` and
+            ``parts``: designator as on the board -> value).
+        """
+        out = []
+        for i, st in enumerate(self.stages, 1):
+            t = st.topology
+            out.append({"topology": t.name, "title": t.title,
+                        "parts": {t.prefixed(ref, self.prefix(i)): float(v) for ref, v in st.values.items()}})
+        return {"topology": self.topology, "stages": out}
+
+
+@dataclass(frozen=True)
+class Plant:
+    """A PID's plant: its analysis model and, when it is a circuit, the circuit.
+
+    Parameters
+    ----------
+    model : ProcessModel
+        What the rules, the optimiser and the analytic loop see.
+    circuit : PlantCircuit or None
+        The circuit that realises ``model`` (drawn and simulated as parts), or
+        None for a plant known only as a model (a block on the sheet, native
+        elements in the deck).
+    source : str
+        Where the plant came from, for the sheet.
+    """
+
+    model: ProcessModel
+    circuit: PlantCircuit | None = None
+    source: str = ""
+
+    @property
+    def reversed_action(self) -> bool:
+        """Whether the controller's action is reversed (an inverting circuit)."""
+        return self.circuit is not None and self.circuit.inverting
+
+    @property
+    def design_model(self) -> ProcessModel:
+        """The model the gains are chosen for: ``model``, or -``model`` for a
+        reversed action (the rules are written for K > 0)."""
+        if not self.reversed_action:
+            return self.model
+        from dataclasses import replace
+        m = self.model
+        return replace(m, num=tuple(-c for c in m.num),
+                       source=f"{m.source}, negated (the controller's action reversed)")
+
+
+def parse_part_values(topology, values, name: str = "plant_values") -> dict:
+    """Part values of ``topology`` as typed (numbers, or text in engineering
+    notation: ``{"R1": "10k"}``; or ``"R1=10k"`` items), checked against its
+    declared parts and the resistor and capacitor ranges.
+
+    Parameters
+    ----------
+    topology : designer.filters.topology.Topology
+        The section.
+    values : dict or iterable of str
+        Designator -> value, or ``REF=VALUE`` items.
+    name : str
+        The parameter named in messages.
+
+    Returns
+    -------
+    dict
+        Designator -> float (ohm, farad).
+
+    Raises
+    ------
+    DesignError
+        One line: an item not ``REF=VALUE``, a part the topology does not have
+        (its parts listed), one missing, a value out of range.
+    """
+    if not isinstance(values, dict):
+        items = {}
+        for item in values:
+            ref, eq, value = str(item).partition("=")
+            if not eq or not ref.strip() or not value.strip():
+                raise DesignError(f"{name}: {item!r} is not REF=VALUE (such as R1=10k)", param=name)
+            ref = ref.strip().upper()
+            if ref in items:
+                raise DesignError(f"{name}: {ref} given twice; give each part once", param=name)
+            items[ref] = value.strip()
+        values = items
+    values = {str(k).strip().upper(): v for k, v in values.items()}
+    parts = ", ".join(topology.designators)
+    extra = [r for r in values if r not in topology.designators]
+    if extra:
+        raise DesignError(f"{name}: {topology.name} has no part {extra[0]}; its parts are {parts}", param=name)
+    missing = [r for r in topology.designators if r not in values]
+    if missing:
+        raise DesignError(f"{name}: {topology.name} needs {', '.join(missing)} too; its parts are {parts}",
+                          param=name)
+    return {r: parse_in_range(values[r], f"{name} {r}", PART_RANGES[r[0]]) for r in topology.designators}
+
+
+def circuit_from_cascade(stages, *, source: str = "circuit", name: str = "plant_circuit") -> Plant:
+    """A :class:`Plant` from sections and part values, its model the circuit's
+    ideal transfer function.
+
+    Parameters
+    ----------
+    stages : designer.filters.cascade.Cascade or iterable of Stage or (Topology, dict)
+        The sections, input first.
+    source : str
+        Where it came from (the sheet's words).
+    name : str
+        The parameter named in messages.
+
+    Returns
+    -------
+    Plant
+        With its circuit.
+
+    Raises
+    ------
+    DesignError
+        One line: no section, a topology unknown, part values wrong, or a
+        circuit no PID can control (no DC gain, unstable, out of range).
+    """
+    from ..core.process_build import rational
+    from ..filters.cascade import Cascade, Stage
+    from ..filters.registry import get
+    if isinstance(stages, Cascade):
+        stages = stages.stages
+    if isinstance(stages, (str, bytes, dict)) or not hasattr(stages, "__iter__"):
+        raise DesignError(f"{name}: a plant circuit is a Cascade or a list of (topology, part values) pairs, "
+                          f"got {type(stages).__name__}", param=name)
+    out = []
+    for st in stages:
+        try:
+            topo, values = (st.topology, st.values) if isinstance(st, Stage) else st
+        except (TypeError, ValueError):
+            raise DesignError(f"{name}: each section is a (topology, part values) pair, got {st!r}",
+                              param=name) from None
+        topo = get(topo) if isinstance(topo, str) else topo
+        out.append(Stage(topo, parse_part_values(topo, values, name)))
+    if not out:
+        raise DesignError(f"{name}: a plant circuit needs at least one section", param=name)
+    circuit = PlantCircuit(tuple(out))
+    lows = [st.topology.name for st in out if st.topology.kind != "lowpass"]
+    if lows:
+        raise DesignError(f"{name}: {lows[0]} passes no DC (its gain at 0 Hz is 0), so no PID can set the "
+                          "plant's level; a PID plant is a low-pass section or a cascade of them", param=name)
+    num, den = circuit.coefficients()
+    title = " + ".join(st.topology.title for st in out)
+    try:
+        model = rational(np.asarray(num, float), np.asarray(den, float),
+                         source=f"{title} as built ({source})")
+    except DesignError as exc:
+        raise DesignError(f"{name}: the circuit's transfer function is no PID plant: {exc}", param=name) from None
+    return Plant(model, circuit, source)
+
+
+def circuit_plant(topology, values, *, source: str = "parts", name: str = "plant_values") -> Plant:
+    """A :class:`Plant` of one registered section with its part values
+    (:func:`circuit_from_cascade` of one stage; an unknown topology is refused
+    in one line listing the registered ones).
+
+    Parameters
+    ----------
+    topology : str or designer.filters.topology.Topology
+        A registered name (``mfb-lowpass``) or the section.
+    values : dict or iterable of str
+        Its part values (:func:`parse_part_values`).
+    source, name : str
+        As for :func:`circuit_from_cascade` (``name``: the values' parameter).
+
+    Returns
+    -------
+    Plant
+        The section's plant.
+    """
+    from ..filters.registry import get
+    topo = get(topology) if isinstance(topology, str) else topology
+    return circuit_from_cascade([(topo, values)], source=source, name=name)
+
+
+def circuit_from_json(data: dict, *, name: str = "result") -> Plant:
+    """The circuit of a parsed ``design-filter`` result (its ``stages``: each
+    ``topology`` and ``parts``), as a :class:`Plant`.
+
+    Parameters
+    ----------
+    data : dict
+        The parsed result.json.
+    name : str
+        How messages name the file (``--plant-json f.json``).
+
+    Returns
+    -------
+    Plant
+        The file's sections as a cascade plant (one stage: that section's).
+
+    Raises
+    ------
+    DesignError
+        One line naming the file and the key at fault.
+    """
+    where = name
+    stages = data.get("stages")
+    if not isinstance(stages, list) or not stages:
+        raise DesignError(f"{where}: a design-filter result needs stages (each with topology and parts)")
+    out = []
+    for i, st in enumerate(stages):
+        if not (isinstance(st, dict) and isinstance(st.get("topology"), str) and isinstance(st.get("parts"), dict)):
+            raise DesignError(f"{where}: stages[{i}] needs topology (a name) and parts (designator -> value)")
+        out.append((st["topology"], {k: v for k, v in st["parts"].items()}))
+    try:
+        return circuit_from_cascade(out, source="design-filter result", name=where)
+    except DesignError as exc:
+        raise DesignError(str(exc)) from None
+
+
+def sallen_key_parts(spec):
+    """(parts, description, series) of a Sallen-Key plant, designed, given or
+    read; every way through :func:`designer.plant.sallenkey.check_parts`.
+    ``series`` is the (R, C) pair of a plant designed here, else None.
+
+    Parameters
+    ----------
+    spec : designer.pid.spec.PidSpec
+        With ``plant_parts``, ``plant_json`` or ``plant_fc_hz``/``plant_zeta``.
+
+    Returns
+    -------
+    tuple
+        (:class:`~designer.plant.sallenkey.SallenKeyParts`, str, tuple or None).
+    """
+    if spec.plant_parts is not None:
+        return spec.plant_parts, "parts", None
+    if spec.json_plant is not None:
+        return spec.json_plant, f"json:{spec.plant_json}", None
+    from ..core.errors import ParamError
+    from ..plant.design import choose_parts
+    from ..plant.sallenkey import check_parts
+    from ..plant.spec import PlantSpec
+    ps = PlantSpec(fc_hz=spec.plant_fc_hz, zeta=spec.plant_zeta, opamp=spec.opamp,
+                   r_series=spec.r_series, c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
+                   c_min=spec.c_min, c_max=spec.c_max, alternatives=1)
+    res = choose_parts(ps)   # the parts only: no analysis, no deck
+    what = f"the plant designed for {{plant_fc_hz}} {spec.plant_fc_hz:g} {{plant_zeta}} {spec.plant_zeta:g}"
+    names = {k: f"{what}: {v}" for k, v in (("r1", "R1"), ("r2", "R2"), ("c1", "C1"), ("c2", "C2"),
+                                               ("r3", "R3"), ("r4", "R4"), ("gain", "gain K"))}
+    try:   # the one plant validation, its parts named after the request (markers: see ParamError)
+        built = check_parts(res.built, name_of=names | {"plant": what})
+    except DesignError as exc:
+        raise ParamError(str(exc), ("plant_fc_hz", "plant_zeta")) from None
+    return (built, f"design-plant fc={spec.plant_fc_hz:g} Hz zeta={spec.plant_zeta:g}",
+            (spec.r_series, spec.c_series))
+
+
+def sallen_key_circuit(parts) -> PlantCircuit:
+    """The Sallen-Key plant's circuit as its registered section (unity gain, or
+    gain K = 1 + R4/R3).
+
+    Parameters
+    ----------
+    parts : designer.plant.sallenkey.SallenKeyParts
+        The plant as built.
+
+    Returns
+    -------
+    PlantCircuit
+        One stage.
+    """
+    from ..filters.cascade import Stage
+    from ..filters.registry import get
+    values = {"R1": parts.r1, "R2": parts.r2, "C1": parts.c1, "C2": parts.c2}
+    if math.isclose(parts.gain, 1.0):
+        return PlantCircuit((Stage(get("sallen-key-lowpass"), values),))
+    return PlantCircuit((Stage(get("sallen-key-lowpass-gain"), values | {"R3": parts.r3, "R4": parts.r4}),))
+
+
+def resolve_plant(spec) -> Plant:
+    """Every plant source of ``spec`` as a :class:`Plant`: a circuit of any
+    topology (``plant_topology`` with ``plant_values``, ``plant_circuit``, a
+    design-filter result in ``plant_json``), a model (``plant_tf``,
+    ``plant_model``, ``plant_process``, a capture), or a Sallen-Key plant
+    (``plant_fc_hz``/``plant_zeta``, ``plant_parts``, a design-plant
+    ``plant_json``: its circuit is the Sallen-Key low-pass section
+    (:func:`sallen_key_circuit`), its model
+    :func:`designer.pid.plant_source.sallen_key_model`).
+
+    Parameters
+    ----------
+    spec : designer.pid.spec.PidSpec
+        The request (validated when built).
+
+    Returns
+    -------
+    Plant
+        The plant.
+    """
+    if spec.circuit is not None:
+        return spec.circuit
+    if spec.process is not None:
+        return Plant(spec.process, None, spec.process.source)
+    from .plant_source import sallen_key_model
+    parts, source, _ = sallen_key_parts(spec)
+    return Plant(sallen_key_model(parts, source), sallen_key_circuit(parts), source)

@@ -1,0 +1,238 @@
+"""A PID's plant as a model plus, optionally, its circuit (issue 26): the one
+resolver of plant sources, the model of a circuit from its own sections, the
+controller's action reversed for an inverting circuit, and a PID for a plant
+that is any registered circuit (an MFB low-pass, a first-order section, a
+2-stage cascade) designed, simulated with the plant's own sections in the
+ngspice deck, and drawn (the drawing checked against the deck)."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from helpers import deck_terminals
+
+from designer.cli.common import flag_message
+from designer.core.errors import DesignError
+from designer.filters.registry import REGISTRY, get
+from designer.pid import process_report as P
+from designer.pid.design import design_pid
+from designer.pid.netlist import circuit_loop_netlist, controller_netlist
+from designer.pid.plant import (PLANT_PREFIX, Plant, circuit_from_cascade, circuit_plant, parse_part_values,
+                                resolve_plant)
+from designer.pid.process_result import ProcessPidResult
+from designer.pid.spec import PidSpec
+from designer.report.schematic import check_connectivity
+
+RC = {"R1": "10k", "C1": "100n"}
+MFB = {"R1": "10k", "R2": "20k", "R3": "6k8", "C1": "10n", "C2": "100n"}
+SK = {"R1": "10k", "R2": "10k", "C1": "10n", "C2": "47n"}
+#: the done-when's three circuits: an MFB low-pass, a first-order section, a 2-stage cascade
+CIRCUITS = {"mfb-lowpass": dict(plant_topology="mfb-lowpass", plant_values=MFB),
+            "rc-lowpass": dict(plant_topology="rc-lowpass", plant_values=[f"{k}={v}" for k, v in RC.items()]),
+            "cascade": dict(plant_circuit=[("rc-lowpass", RC), ("sallen-key-lowpass", SK)])}
+
+
+def refusal(**kw):
+    with pytest.raises(DesignError) as exc:
+        PidSpec(**kw)
+    return exc.value
+
+
+# ---- the model of a circuit -------------------------------------------------------------------
+
+def test_a_first_order_plant_is_its_closed_form():
+    plant = circuit_plant("rc-lowpass", RC)
+    tau = 10e3 * 100e-9
+    assert np.allclose(plant.model.num, [1.0]) and np.allclose(plant.model.den, [tau, 1.0])
+    assert not plant.reversed_action and plant.design_model is plant.model
+
+
+def test_a_cascade_is_the_product_of_its_sections():
+    plant = circuit_from_cascade(CIRCUITS["cascade"]["plant_circuit"])
+    vals = {k: parse_part_values(get("sallen-key-lowpass"), SK)[k] for k in SK}
+    a = vals["R1"] * vals["R2"] * vals["C1"] * vals["C2"]
+    b = vals["C1"] * (vals["R1"] + vals["R2"])   # SLOA088's unity-gain s coefficient
+    assert np.allclose(plant.model.den, np.polymul([1e-3, 1.0], [a, b, 1.0]), rtol=1e-12)
+    assert plant.circuit.topology == "cascade" and len(plant.circuit.stages) == 2
+
+
+def test_an_inverting_circuit_reverses_the_controllers_action():
+    plant = circuit_plant("mfb-lowpass", MFB)
+    assert plant.reversed_action and plant.model.gain < 0
+    assert math.isclose(plant.design_model.gain, -plant.model.gain)
+    assert np.allclose(plant.design_model.den, plant.model.den)
+    spec = PidSpec(plant_topology="mfb-lowpass", plant_values=MFB)
+    parts = design_pid(spec, simulate=False).parts
+    normal, rev = controller_netlist(parts), controller_netlist(parts, reversed_action=True)
+    assert (normal.part("R15").a, normal.part("R17").a) == ("ref", "y")
+    assert (rev.part("R15").a, rev.part("R17").a) == ("y", "ref")
+
+
+def test_every_plant_source_resolves_to_one_type():
+    sources = [dict(plant_fc_hz=3500, plant_zeta=0.2), dict(plant_tf="K=2 tau=1m"), *CIRCUITS.values()]
+    for kw in sources:
+        plant = resolve_plant(PidSpec(**kw))
+        assert isinstance(plant, Plant) and plant.model.gain != 0
+    sk = resolve_plant(PidSpec(plant_fc_hz=3500, plant_zeta=0.2))
+    assert sk.circuit.topology == "sallen-key-lowpass"
+    # the Sallen-Key circuit's model is its own closed form (fn of the parts)
+    from designer.pid.design import resolve_plant as sallen_key
+    parts = sallen_key(PidSpec(plant_fc_hz=3500, plant_zeta=0.2))[0]
+    assert math.isclose(sk.model.params["fn_hz"], parts.fn_hz, rel_tol=1e-9)
+
+
+def test_designators_do_not_collide_with_the_controller_or_the_decoupling():
+    spec = PidSpec(**CIRCUITS["cascade"])
+    res = design_pid(spec, simulate=False)
+    net = circuit_loop_netlist(res.parts, spec.circuit)
+    refs = [p.ref for p in net.parts] + [a.ref for a in net.amps]
+    assert len(refs) == len(set(refs))
+    board = P.build_board(res)
+    assert not {p.ref for p in net.parts} & {p.ref for p in board.decoupling}
+    assert all(r[1] == PLANT_PREFIX for r in refs if r not in {p.ref for p in controller_netlist(res.parts).parts}
+               | {a.ref for a in controller_netlist(res.parts).amps})
+
+
+# ---- bad input ---------------------------------------------------------------------------------
+
+def test_an_unknown_topology_lists_the_registered_ones():
+    exc = refusal(plant_topology="mfb-lowpas", plant_values=MFB)
+    text = flag_message(exc)
+    assert text.startswith("--plant-topology: unknown topology") and "mfb-lowpass" in text and "\n" not in text
+
+
+def test_a_part_the_topology_lacks_lists_its_parts():
+    exc = refusal(plant_topology="sallen-key-lowpass", plant_values=dict(SK, R5="1k"))
+    text = flag_message(exc)
+    assert text.startswith("--plant-part: sallen-key-lowpass has no part R5; its parts are R1, R2, C1, C2"), text
+
+
+@pytest.mark.parametrize("values,what", [
+    (["R1=10k"], "needs C1 too"),
+    (["R1=10k", "C1"], "is not REF=VALUE"),
+    (["R1=10k", "R1=1k", "C1=1n"], "R1 given twice"),
+    (["R1=1e300", "C1=1n"], "--plant-part R1 must be"),
+])
+def test_bad_part_values_are_one_line_each(values, what):
+    text = flag_message(refusal(plant_topology="rc-lowpass", plant_values=values))
+    assert what in text and "\n" not in text, text
+
+
+def test_a_plant_that_passes_no_dc_is_refused():
+    values = {r: ("10k" if r[0] == "R" else "10n") for r in get("mfb-highpass").designators}
+    text = flag_message(refusal(plant_topology="mfb-highpass", plant_values=values))
+    assert "passes no DC" in text and "\n" not in text
+
+
+def test_the_plant_is_given_one_way():
+    assert "give the plant one way" in str(refusal(plant_fc_hz=3500, plant_zeta=0.2, plant_topology="rc-lowpass",
+                                                   plant_values=RC))
+    assert "go together" in str(refusal(plant_fc_hz=3500, plant_zeta=0.2, plant_values=RC))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.text(max_size=12))
+def test_any_typed_value_is_a_part_or_a_one_line_refusal(text):
+    try:
+        got = parse_part_values(get("rc-lowpass"), {"R1": text, "C1": "1n"})
+    except DesignError as exc:
+        assert "\n" not in str(exc)
+    else:
+        assert 0.1 <= got["R1"] <= 1e9
+
+
+# ---- designed, simulated with the plant's circuit in the deck, drawn ----------------------------
+
+
+@pytest.fixture(scope="module", params=list(CIRCUITS))
+def designed(request):
+    spec = PidSpec(**CIRCUITS[request.param])
+    return spec, design_pid(spec, simulate=True, simulator="ngspice-cli")
+
+
+@pytest.mark.spice
+def test_a_circuit_plant_is_designed_and_simulated_with_its_own_sections(designed):
+    spec, res = designed
+    assert isinstance(res, ProcessPidResult) and res.stable and res.spice is not None
+    plant_net = spec.circuit.circuit.netlist("u", "y")
+    terms = deck_terminals(res.deck)
+    for p in plant_net.parts:
+        assert (terms[(p.ref, "a")], terms[(p.ref, "b")]) == (p.a, p.b)
+    for a in plant_net.amps:
+        assert (terms[(a.ref, "inp")], terms[(a.ref, "inn")], terms[(a.ref, "out")]) == (a.inp, a.inn, a.out)
+    # the analytic loop (the circuit's model) and ngspice (the circuit) agree by the project's rule
+    assert res.verdict.agree, (res.verdict, res.analytic, res.spice.figures)
+    assert math.isclose(res.spice.figures.final_value, res.expected_final_v, rel_tol=0.02)
+    data = res.to_dict()
+    assert data["plant"]["topology"] == spec.circuit.circuit.topology and data["plant"]["kind"] == "circuit"
+    assert data["plant"]["reversed_action"] == spec.circuit.reversed_action
+
+
+@pytest.mark.spice
+def test_a_circuit_plant_is_drawn_as_its_deck(designed):
+    spec, res = designed
+    board = P.build_board(res)
+    sheet = P.schematic(res)
+    terms = deck_terminals(res.deck)
+    for p in board.decoupling:
+        terms[(p.ref, "a")], terms[(p.ref, "b")] = p.a, p.b
+    assert check_connectivity(sheet, terms) == []
+    nets, _ = sheet.connectivity()
+    plant_net = spec.circuit.circuit.netlist("u", "y")
+    assert {(p.ref, "a") for p in plant_net.parts} <= set(nets)
+    assert {(a.ref, "out") for a in plant_net.amps} <= set(nets)
+    # the plant's output reaches the difference amplifier's y input; a miswired drawing is caught
+    y_in = "R17" if not spec.circuit.reversed_action else "R15"
+    last = plant_net.amps[-1].ref
+    assert nets[(last, "out")] == nets[(y_in, "a")]
+    wrong = dict(terms)
+    wrong[(last, "out")] = "u"
+    assert check_connectivity(sheet, wrong)
+
+
+def test_every_registered_lowpass_is_a_plant():
+    for name, topo in REGISTRY.items():
+        if topo.kind != "lowpass":
+            continue
+        values = topo.synthesize(topo.example)
+        plant = circuit_plant(topo, values)
+        assert plant.reversed_action == topo.inverting
+        assert math.isclose(abs(plant.model.gain), topo.figures(values).gain, rel_tol=1e-9)
+
+
+def test_a_sallen_key_result_names_its_topology():
+    res = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2), simulate=False)
+    assert res.to_dict()["plant"]["topology"] == "sallen-key-lowpass"
+
+
+def test_the_pid_package_has_no_import_cycle():
+    """design <-> process_loop <-> process_optimize and spec <-> plant went (function-level imports counted)."""
+    import ast
+    from pathlib import Path
+
+    import designer.pid as pkg
+    root = Path(pkg.__file__).parent
+    graph = {}
+    for f in root.glob("*.py"):
+        graph[f.stem] = {(n.module or "").split(".")[0] or a.name for n in ast.walk(ast.parse(f.read_text()))
+                         if isinstance(n, ast.ImportFrom) and n.level == 1 for a in n.names}
+    done = set()
+
+    def visit(m, path):
+        assert m not in path, " -> ".join(path + [m])
+        if m in done or m not in graph:
+            return
+        for x in graph[m]:
+            visit(x, path + [m])
+        done.add(m)
+
+    for m in graph:
+        visit(m, [])
+
+
+@pytest.mark.parametrize("bad", [[1], 5, "rc-lowpass", [("rc-lowpass",)], [], [("nope", RC)]])
+def test_a_malformed_plant_circuit_is_one_line(bad):
+    text = str(refusal(plant_circuit=bad))
+    assert "\n" not in text and ("plant_circuit" in text or "topology" in text), text
