@@ -1,7 +1,8 @@
 """The dependency rule of the package, checked on every import statement:
 ``{cli, web} -> {plant, pid, identify} -> {spice, report} -> core`` (``web -> cli``), ``pid -> plant``,
 and ``identify -> plant`` only for the comparison with a design; ``filters``
-(the circuits as plug-ins) stands on ``spice`` and ``core`` only; ``tolerance``
+(the circuits as plug-ins) stands on ``spice`` and ``core`` only and the plant wing (a plant on any
+topology) and what runs it stand on it; ``tolerance``
 (Monte Carlo) runs the wings' models; ``check`` (the CI checker of users'
 designs) runs the wings and tolerance, and only ``cli`` uses it."""
 
@@ -18,11 +19,11 @@ ALLOWED = {
     "report": {"core"},
     # the circuits as plug-ins (Topology, its sections, the cascade): below the wings
     "filters": {"core", "spice"},
-    "plant": {"core", "spice", "report"},
+    "plant": {"core", "spice", "report", "filters"},
     "pid": {"core", "spice", "report", "plant"},
     "identify": {"core", "spice", "report"},
-    "tolerance": {"core", "spice", "report", "plant", "pid"},
-    "check": {"core", "spice", "report", "plant", "pid", "identify", "tolerance"},
+    "tolerance": {"core", "spice", "report", "plant", "pid", "filters"},
+    "check": {"core", "spice", "report", "plant", "pid", "identify", "tolerance", "filters"},
     "cli": {"core", "spice", "report", "plant", "pid", "identify", "check", "tolerance", "filters"},
     # the web page: a front end beside cli, whose parsers and checks it shares
     "web": {"core", "spice", "report", "plant", "pid", "identify", "check", "tolerance", "cli"},

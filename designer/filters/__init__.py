@@ -35,6 +35,7 @@ from .topology import (
     SectionTarget,
     Topology,
     nodal_response,
+    nodal_system,
     open_loop_gain,
     polynomial,
     polyval,
@@ -49,5 +50,5 @@ __all__ = ["Cascade", "Stage", "ac_deck", "simulate_ac", "FilterDesign", "StageD
            "reference_response", "TOPOLOGY_CHOICES", "FilterSpec", "InvertingLowPass", "MfbBandPass", "MfbHighPass",
            "MfbLowPass", "RcHighPass", "RcLowPass", "REGISTRY", "get", "names", "register", "GAIN_PARTS",
            "SallenKeySection", "SallenKeyHighPass", "SallenKeyLowPass", "sallen_key_ratio_min",
-           "DEFAULT_IMPEDANCE_OHM", "KINDS", "Figures", "PartSpec", "SectionTarget", "Topology", "nodal_response",
+           "DEFAULT_IMPEDANCE_OHM", "KINDS", "Figures", "PartSpec", "SectionTarget", "Topology", "nodal_response", "nodal_system",
            "open_loop_gain", "polynomial", "polyval", "quadratic_root"]
