@@ -9,6 +9,8 @@ import sys
 from .. import __version__
 from ..core.errors import DesignError
 from ..core.ranges import help_range
+from ..filters.registry import names as topology_names
+from ..plant.circuit import DEFAULT_TOPOLOGY
 from .common import (
     OneLineParser,
     add_opamp_option,
@@ -34,18 +36,26 @@ def _design_parser():
   design-plant --fc 20k --zeta 0.5 --opamp LM358 --compensate-gbw
   design-plant --fc 3500 --zeta 0.2 --json --no-sim
   design-plant --fc 3500 --zeta 0.2 --stimulus prbs  also the bench's PRBS in ngspice: prbs.csv, waveforms.csv
+  design-plant --fc 1k --zeta 0.5 --gain 2 --topology mfb-lowpass   the same target on an inverting MFB section
+  design-plant --fc 1k --topology rc-lowpass          a first-order section takes no --zeta
 
 Outputs: netlists/<name>.cir (run it alone with `ngspice -b`), reports/<name>/build-sheet.md and .html,
 result.json, step.png, bode.png. Exit status 2 on bad input.""",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     t = p.add_argument_group("target")
-    t.add_argument("--fc", required=True, metavar="HZ",
-                   help=f"natural frequency fn = wn / 2 pi, Hz (e.g. 3500, 3.5k) {help_range('fc_hz')}")
-    t.add_argument("--zeta", required=True, metavar="Z",
-                   help=f"damping ratio (>= 1 is overdamped) {help_range('zeta')}")
+    # --fc and --zeta are required (checked in _design: a first-order --topology takes no --zeta)
+    t.add_argument("--fc", metavar="HZ",
+                   help=f"natural frequency fn = wn / 2 pi, Hz (e.g. 3500, 3.5k) {help_range('fc_hz')} (required)")
+    t.add_argument("--zeta", metavar="Z",
+                   help=f"damping ratio (>= 1 is overdamped) {help_range('zeta')} (required, but for a "
+                        "first-order --topology)")
     t.add_argument("--gain", default="1", metavar="K",
                    help=f"DC gain K = 1 + R4/R3 (default 1: follower) {help_range('gain')}")
+    t.add_argument("--topology", default=DEFAULT_TOPOLOGY, metavar="NAME",
+                   help=f"the section that realises the plant (default {DEFAULT_TOPOLOGY}, the seed's): "
+                        + ", ".join(topology_names()) + "; every one but the default is designed by the "
+                        "generic E-series search and checked by ngspice's .ac of its deck")
     t.add_argument("--compensate-gbw", action="store_true",
                    help="pre-distort the targets so the circuit lands on them with the op-amp's finite GBW")
     sel = p.add_argument_group("parts")
@@ -359,8 +369,23 @@ def _with_stimulus(result, args, stim):
     return with_prbs(result, result.test.amplitude_v, stim[0], stim[1], not args.no_sim, args.simulator)
 
 
+def _required(args, topology: str) -> None:
+    """--fc and --zeta as argparse would require them (--zeta not for a first-order topology)."""
+    from ..filters import registry
+    order = registry.get(topology).order
+    missing = [f for f, v, need in (("--fc", args.fc, True), ("--zeta", args.zeta, order == 2))
+               if need and v is None]
+    if missing:
+        raise DesignError(f"the following arguments are required: {', '.join(missing)} (see design-plant --help)")
+
+
 def _design(args) -> int:
+    from ..filters import registry
     from ..plant.spec import PlantSpec
+    topology = registry.get(args.topology).name   # an unknown one refused first, with the registered ones
+    _required(args, topology)
+    if topology != DEFAULT_TOPOLOGY:
+        return _design_circuit(args, registry.get(topology))
     # the spec parses and checks what was typed (once); its errors name parameters, shown as options
     spec = PlantSpec(fc_hz=args.fc, zeta=args.zeta, gain=args.gain, **part_options(args), r=args.r, c=args.c,
                      opamp=args.opamp, compensate_gbw=args.compensate_gbw, amplitude_v=args.amplitude,
@@ -378,6 +403,51 @@ def _design(args) -> int:
         result = _with_stimulus(design_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, stim)
         result = _with_monte_carlo(result, args, mc, spice)
     return _emit(result, args, name)
+
+
+def _design_circuit(args, topo) -> int:
+    """design-plant --topology NAME (not the default): the plant on a registered section."""
+    from ..plant.spec import PlantSpec
+    spec = PlantSpec(fc_hz=args.fc, zeta=args.zeta, gain=args.gain, **part_options(args), r=args.r, c=args.c,
+                     opamp=args.opamp, compensate_gbw=args.compensate_gbw, amplitude_v=args.amplitude,
+                     square_hz=args.square_freq, alternatives=args.alternatives, package=args.package,
+                     topology=topo.name)
+    unsupported = [f for f, v in (("--stimulus prbs", args.stimulus == "prbs"), ("--prbs-bits", args.prbs_bits),
+                                  ("--prbs-clock", args.prbs_clock), ("--square-freq", args.square_freq),
+                                  ("--engine " + args.engine, args.engine != "analytic"),
+                                  ("--spice-samples", args.spice_samples), ("--replay", args.replay),
+                                  ("--tol GBW/SR", any(str(t).split("=")[0].strip().upper() in ("GBW", "SR")
+                                                       for t in args.tol or ())))
+                   if v]
+    if unsupported:
+        raise DesignError(f"{unsupported[0].split()[0]}: {unsupported[0]} is the {DEFAULT_TOPOLOGY}'s for now; "
+                          f"--topology {topo.name} has the .ac check and the analytic Monte Carlo")
+    name = args.name if args.name is not None else (
+        f"plant_{topo.name}_fc{spec.fc_hz:g}" + ("" if spec.zeta is None else f"_z{spec.zeta:g}")
+        + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
+    mc = monte_carlo_settings(args, topo.designators)
+    check_output(args, name)
+    from ..plant import circuit
+    from ..plant.circuit_design import design_circuit_plant, tolerance_nominal
+    from ..plant.circuit_report import summary_text, write_outputs
+    with cluster_ahead(args):
+        result = design_circuit_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
+        s = result.sourcing
+        series = {"R": s.r_series, "C": s.c_series}
+        nominal = tolerance_nominal(result)
+        context = (topo.name, result.opamp)
+        if args.worst_case:
+            from ..tolerance.parts import resolve
+            from ..tolerance.worstcase import worst_case
+            tol = resolve(args.tol or (), nominal, series)
+            result.worst_case = worst_case(lambda v: circuit.evaluate(context, v), nominal, tol.of)
+        if mc is not None:
+            from ..tolerance.montecarlo import plant_monte_carlo
+            scale, target = scale_settings(args)
+            result.monte_carlo = plant_monte_carlo(None, series, result.opamp, mc[0], mc[1], args.sampler,
+                                                   args.dist, args.tol or (), args.limit or (), scale=scale,
+                                                   target_ci=target, circuit=(nominal, circuit.evaluate, context))
+    return emit(result, args, name, write_outputs, summary_text)
 
 
 def _emit(result, args, name) -> int:

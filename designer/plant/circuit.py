@@ -100,7 +100,7 @@ def plant_target(topology: Topology, fc_hz: float, zeta, gain: float = 1.0) -> S
         A damping for a first-order section, or none for a second-order one.
     """
     if topology.order == 1 and zeta is not None:
-        raise DesignError(f"zeta: {topology.name} is first-order and has no damping; leave zeta out or use a "
+        raise DesignError(f"zeta: {topology.name} is first-order and has no damping; leave the damping out or use a "
                           "second-order topology", param="zeta")
     if topology.order == 2 and zeta is None:
         raise DesignError(f"zeta: {topology.name} is second-order: give its damping", param="zeta")
