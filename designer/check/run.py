@@ -24,6 +24,7 @@ import numpy as np
 from ..core.compare import nrms
 from ..core.errors import DesignError, SimulatorError
 from ..core.fileio import atomic_write
+from ..plant.circuit import DEFAULT_TOPOLOGY
 from . import figures as F
 from . import golden as G
 from .result import ERROR, FAIL, PASS, SIM_ERROR, SKIP, SPEC_ERROR, Case, CornerOutcome
@@ -76,6 +77,10 @@ def _simulate(spec: CheckSpec, index: int, simulator: str):
         vectors = {k: np.real(v) for k, v in r.vectors.items() if k not in ("time", "frequency")}
         waves = (r.vectors["time"], vectors) if "time" in r.vectors else (None, {})
         return dict(r.measurements), None, {"measurements": r.measurements, "simulator": r.backend}, waves
+    if spec.kind == "plant" and hasattr(design, "topology") and design.topology != DEFAULT_TOPOLOGY:
+        from ..plant.circuit_design import design_circuit_plant
+        res = design_circuit_plant(design, simulate=True, simulator=simulator)
+        return F.circuit_plant_figures(res), res, res.to_dict(), (None, {})
     if spec.kind == "plant":
         from ..plant.design import analyze_plant, design_plant
         res = (analyze_plant if spec.analyze else design_plant)(design, simulate=True, simulator=simulator)
@@ -211,7 +216,9 @@ def _golden_cases(spec, corner, waves, tool, update, out_dir):
 
 def _write_design(spec, corner, res, out_dir) -> dict:
     """The corner's build sheet bundle in the spec's folder ``out_dir`` (reports/<corner>/, netlists/<corner>.cir)."""
-    if spec.kind == "plant":
+    if spec.kind == "plant" and hasattr(res, "topology"):
+        from ..plant.circuit_report import write_outputs
+    elif spec.kind == "plant":
         from ..plant.report import write_outputs
     else:
         from ..pid.report import write_outputs

@@ -9,7 +9,7 @@ import sys
 from .. import __version__
 from ..core.errors import DesignError
 from ..core.ranges import help_range
-from ..filters.registry import names as topology_names
+from ..filters import registry
 from ..plant.circuit import DEFAULT_TOPOLOGY
 from .common import (
     OneLineParser,
@@ -40,7 +40,10 @@ def _design_parser():
   design-plant --fc 1k --topology rc-lowpass          a first-order section takes no --zeta
 
 Outputs: netlists/<name>.cir (run it alone with `ngspice -b`), reports/<name>/build-sheet.md and .html,
-result.json, step.png, bode.png. Exit status 2 on bad input.""",
+result.json, step.png, bode.png. Exit status 2 on bad input.
+
+topologies (--topology NAME):
+""" + "".join(f"  {t.name:26s}{t.title}\n" for t in registry.REGISTRY.values()),
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     t = p.add_argument_group("target")
@@ -53,8 +56,8 @@ result.json, step.png, bode.png. Exit status 2 on bad input.""",
     t.add_argument("--gain", default="1", metavar="K",
                    help=f"DC gain K = 1 + R4/R3 (default 1: follower) {help_range('gain')}")
     t.add_argument("--topology", default=DEFAULT_TOPOLOGY, metavar="NAME",
-                   help=f"the section that realises the plant (default {DEFAULT_TOPOLOGY}, the seed's): "
-                        + ", ".join(topology_names()) + "; every one but the default is designed by the "
+                   help=f"the section that realises the plant (default {DEFAULT_TOPOLOGY}, the seed's; the "
+                        "registered ones are listed below); every one but the default is designed by the "
                         "generic E-series search and checked by ngspice's .ac of its deck")
     t.add_argument("--compensate-gbw", action="store_true",
                    help="pre-distort the targets so the circuit lands on them with the op-amp's finite GBW")
@@ -371,7 +374,6 @@ def _with_stimulus(result, args, stim):
 
 def _required(args, topology: str) -> None:
     """--fc and --zeta as argparse would require them (--zeta not for a first-order topology)."""
-    from ..filters import registry
     order = registry.get(topology).order
     missing = [f for f, v, need in (("--fc", args.fc, True), ("--zeta", args.zeta, order == 2))
                if need and v is None]
@@ -380,7 +382,6 @@ def _required(args, topology: str) -> None:
 
 
 def _design(args) -> int:
-    from ..filters import registry
     from ..plant.spec import PlantSpec
     topology = registry.get(args.topology).name   # an unknown one refused first, with the registered ones
     _required(args, topology)
