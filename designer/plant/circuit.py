@@ -112,8 +112,12 @@ def _capacitors(topology: Topology) -> tuple:
     return tuple(p.ref for p in topology.parts if p.kind == "C")
 
 
-def capacitor_combinations(topology: Topology, target: SectionTarget, c_values) -> list:
+def capacitor_combinations(topology: Topology, target: SectionTarget, c_values) -> dict:
     """The capacitor combinations the topology's choices reach, each with its continuous synthesis.
+
+    A synthesis scales with its reference capacitor (every capacitor times c, every resistor
+    over c, but the parts a free choice sets, :attr:`Topology.choice_parts`): the topology
+    synthesises once per capacitor ratio (at the smallest capacitor), scaled to every other.
 
     Parameters
     ----------
@@ -126,8 +130,9 @@ def capacitor_combinations(topology: Topology, target: SectionTarget, c_values) 
 
     Returns
     -------
-    list of dict
-        Designator -> value: the capacitors exact series values, the resistors continuous.
+    dict
+        Designator -> array (one entry per combination): the capacitors exact series
+        values, the resistors continuous.
 
     Raises
     ------
@@ -138,40 +143,57 @@ def capacitor_combinations(topology: Topology, target: SectionTarget, c_values) 
     c_values = np.asarray(c_values, dtype=float)
     topology.check_realisable(target)
     caps = _capacitors(topology)
-    combos = []
-    for c_ref in c_values:
-        ratios = c_values / c_ref if "ratio" in topology.choices else (None,)
-        for m in ratios:
-            choices = {} if m is None else {"ratio": float(m)}
-            try:
-                v = topology.synthesize(SectionTarget(target.kind, target.fn_hz, target.q, target.gain,
-                                                      c_f=float(c_ref)), **choices)
-            except DesignError:
-                continue     # below the topology's ratio bound: no resistors realise it
-            if not all(math.isfinite(x) and x > 0 for x in v.values()):
-                continue
+    c0 = float(c_values[0])
+    bound = topology.limits(target).get("ratio_min", 0.0)
+    if "ratio" in topology.choices:
+        i, j = np.meshgrid(np.arange(len(c_values)), np.arange(len(c_values)), indexing="ij")
+        m = c_values[j.ravel()] / c_values[i.ravel()]
+        keep = m >= bound * (1 - 1e-12)    # below the topology's ratio bound no resistors realise it
+        ref, m = c_values[i.ravel()][keep], m[keep]
+        keys, inverse = np.unique(np.round(np.log(m), 9), return_inverse=True)
+        choices = [{"ratio": float(m[np.argmax(inverse == k)])} for k in range(len(keys))]
+    else:
+        ref, inverse, choices = c_values, np.zeros(len(c_values), int), [{}]
+    bases = []
+    for ch in choices:
+        try:
+            v = topology.synthesize(SectionTarget(target.kind, target.fn_hz, target.q, target.gain, c_f=c0), **ch)
+            bases.append(v if all(math.isfinite(x) and x > 0 for x in v.values()) else None)
+        except DesignError:
+            bases.append(None)
+    ok = np.array([bases[k] is not None for k in inverse], bool)
+    ref, inverse = ref[ok], inverse[ok]
+    scale = ref / c0
+    columns = {}
+    for r in topology.designators:
+        base = np.array([np.nan if b is None else b[r] for b in bases])[inverse]
+        if r in caps:
             # the capacitors are series values up to rounding: snap them
-            combos.append({r: (float(c_values[np.argmin(np.abs(np.log(c_values / x)))]) if r in caps else x)
-                           for r, x in v.items()})
-    if not combos:
-        bound = topology.limits(target).get("ratio_min")
+            x = base * scale
+            idx = np.clip(np.searchsorted(c_values, x), 1, len(c_values) - 1)
+            nearer_low = np.abs(np.log(c_values[idx - 1] / x)) <= np.abs(np.log(c_values[idx] / x))
+            columns[r] = c_values[np.where(nearer_low, idx - 1, idx)] if len(c_values) > 1 else np.full(len(x),
+                                                                                                       c_values[0])
+        else:
+            columns[r] = base if r in topology.choice_parts else base / scale
+    if not len(columns[topology.designators[0]]):
         why = f"its capacitor ratio must be at least {bound:.4g}" if bound else "no capacitor value fits"
         raise DesignError(f"c_max: {topology.name} cannot realise fn {target.fn_hz:g} Hz"
                           + (f", Q {target.q:.4g}" if target.q else "")
                           + f" with capacitors from {c_values[0]:g} to {c_values[-1]:g} F: {why}; widen the "
                           "capacitor bounds, lower Q, or use another topology", param="c_max")
-    return combos
+    return columns
 
 
-def _neighbours(series: np.ndarray, x: float, width: int) -> np.ndarray:
-    """The ``width`` series values on each side of ``x`` (``x`` itself when it is one), inside the series."""
-    lo = int(np.searchsorted(series, x * (1 + 1e-12), side="right")) - 1     # last value <= x
-    hi = int(np.searchsorted(series, x * (1 - 1e-12), side="left"))          # first value >= x (lo when x is one)
-    return series[max(0, lo - width + 1):min(len(series), hi + width)]
+def _lower(series: np.ndarray, x) -> np.ndarray:
+    """The index of the last series value <= x (-1 below the series), rounding forgiven."""
+    return np.searchsorted(series, np.asarray(x) * (1 + 1e-12), side="right") - 1
 
 
 def candidate_set(topology: Topology, target: SectionTarget, r_values, c_values, width: int = 1) -> list:
-    """The search's candidate set: per capacitor combination, each part's candidate values.
+    """The search's candidate set: per capacitor combination, each part's candidate values
+    (a capacitor its one value; a resistor the ``width`` series values at or below its
+    continuous value and the ``width`` above, inside the series).
 
     Parameters
     ----------
@@ -191,20 +213,22 @@ def candidate_set(topology: Topology, target: SectionTarget, r_values, c_values,
     """
     rv = np.asarray(r_values, dtype=float)
     caps = _capacitors(topology)
+    combos = capacitor_combinations(topology, target, c_values)
     out = []
-    for combo in capacitor_combinations(topology, target, c_values):
+    for b in range(len(combos[topology.designators[0]])):
         block = {}
         for ref in topology.designators:
-            x = combo[ref]
-            block[ref] = np.array([x]) if ref in caps else _neighbours(rv, x, width)
-        if all(v.size for v in block.values()):
-            out.append(block)
+            x = combos[ref][b]
+            lo = int(_lower(rv, x))
+            block[ref] = np.array([x]) if ref in caps else rv[max(0, lo - width + 1):max(0, lo + width + 1)]
+        out.append(block)
     return out
 
 
 def _errors(topology: Topology, target: SectionTarget, values: dict) -> tuple:
     """(worse, summed) relative error and the figures of arrays of part values."""
-    f = topology.figures(values)
+    with np.errstate(divide="ignore", invalid="ignore"):    # no damping at all: Q infinite, an error like any
+        f = topology.figures(values)
     errs = [np.abs(np.asarray(f.fn_hz) / target.fn_hz - 1), np.abs(np.asarray(f.gain) / target.gain - 1)]
     zeta = None
     if f.q is not None:
@@ -249,12 +273,26 @@ def search(topology: Topology, target: SectionTarget, r_values, c_values, top: i
     list of Candidate
         Best first (worse error, then summed error, then values).
     """
-    columns = {r: [] for r in topology.designators}
-    for block in candidate_set(topology, target, r_values, c_values, width):
-        grids = np.meshgrid(*(block[r] for r in topology.designators), indexing="ij")
-        for r, g in zip(topology.designators, grids):
-            columns[r].append(g.ravel())
-    values = {r: np.concatenate(v) for r, v in columns.items()}
+    rv = np.asarray(r_values, dtype=float)
+    combos = capacitor_combinations(topology, target, c_values)
+    n_b = len(combos[topology.designators[0]])
+    res = [p.ref for p in topology.parts if p.kind == "R"]
+    offsets = np.arange(-width + 1, width + 1)
+    # every resistor's 2 width candidates, as an axis each: (combination, o_1, ..., o_k)
+    shape = (n_b,) + (len(offsets),) * len(res)
+    valid = np.ones(shape, bool)
+    values = {}
+    for axis, ref in enumerate(res):
+        idx = _lower(rv, combos[ref])[:, None] + offsets[None, :]
+        ok = (idx >= 0) & (idx < len(rv))
+        view = [n_b] + [1] * len(res)
+        view[axis + 1] = len(offsets)
+        values[ref] = np.broadcast_to(rv[np.clip(idx, 0, len(rv) - 1)].reshape(view), shape)
+        valid &= ok.reshape(view)
+    for ref in topology.designators:
+        if ref not in values:
+            values[ref] = np.broadcast_to(combos[ref].reshape((n_b,) + (1,) * len(res)), shape)
+    values = {r: v[valid] for r, v in values.items()}
     return _ranked(topology, target, values, top)
 
 
