@@ -27,7 +27,7 @@ import numpy as np
 from ..core import opamps
 from ..core.checks import SPICE_AGREEMENT, Check
 from ..core.errors import DesignError
-from ..core.jsonio import SCHEMA_VERSION, json_safe
+from ..core.jsonio import json_safe
 from ..core.lti import dense_time, response_span, step_response
 from ..core.metrics import step_metrics
 from ..core.units import format_eng
@@ -38,7 +38,7 @@ from ..filters.topology import SectionTarget
 from ..spice.simulate import tool_info
 from . import circuit
 from .design import MAX_ERROR, candidates, part_series
-from .result import METRICS, Sourcing, Target
+from .result import METRICS, PLANT_SCHEMA_VERSION, Sourcing, Target
 
 __all__ = ["GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "CircuitPlantResult", "design_circuit_plant", "check_opamp_reach",
            "tolerance_nominal"]
@@ -137,7 +137,7 @@ class CircuitPlantResult:
         parts = {p.ref: {"kind": p.kind, "role": p.role, "value": self.values[p.ref],
                          **self.sourcing.parts[p.ref].to_dict()} for p in topo.parts}
         return json_safe({
-            "schema_version": SCHEMA_VERSION,
+            "schema_version": PLANT_SCHEMA_VERSION,
             "tool": tool_info(None if self.spice is None else self.spice["simulator"]),
             "mode": "design",
             "topology": self.topology,
