@@ -185,9 +185,8 @@ def check_opamp_reach(topology, target: SectionTarget, amp) -> None:
     need = GBW_MARGIN * target.fn_hz * (target.q or 1.0) * noise_gain
     if need <= amp.gbw_hz:
         return
-    faster = sorted((opamps.get(n) for n in opamps.names() if n != "ideal"), key=lambda o: o.gbw_hz)
-    ok = [o for o in faster if o.gbw_hz >= need]
-    instead = f"use --opamp {ok[0].name} ({format_eng(ok[0].gbw_hz, 'Hz')})" if ok else \
+    ok = opamps.fast_enough(need)
+    instead = f"use --opamp {ok.name} ({format_eng(ok.gbw_hz, 'Hz')})" if ok else \
         "no catalogue op-amp is fast enough: lower fc, Q or the gain"
     q = f" x Q {target.q:.3g}" if target.q else ""
     raise DesignError(f"opamp: {amp.name} (GBW {format_eng(amp.gbw_hz, 'Hz')}) is too slow for {topology.name} at fn "

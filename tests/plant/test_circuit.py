@@ -78,3 +78,20 @@ def test_a_damping_for_a_first_order_section_is_refused():
     assert exc.value.param == "zeta" and "first-order" in str(exc.value)
     with pytest.raises(DesignError):
         circuit.plant_target(registry.get("mfb-lowpass"), 1e3, None)
+
+
+def test_a_section_beyond_the_op_amp_names_the_catalogue_op_amp_fast_enough():
+    """An MFB low-pass at 50 kHz, Q 2.5, gain 3 needs 10 x 50k x 2.5 x 4 = 5 MHz: the LM741 (1 MHz) is
+    refused and the slowest catalogue op-amp with 5 MHz named (core.opamps.fast_enough)."""
+    from designer.core import opamps
+    from designer.plant.circuit_design import GBW_MARGIN, check_opamp_reach
+    mfb = registry.get("mfb-lowpass")
+    target = circuit.plant_target(mfb, 50e3, 0.2, 3.0)
+    need = GBW_MARGIN * 50e3 * 2.5 * 4
+    with pytest.raises(DesignError) as exc:
+        check_opamp_reach(mfb, target, get_opamp("LM741"))
+    fast = opamps.fast_enough(need)
+    assert exc.value.param == "opamp" and "\n" not in str(exc.value)
+    assert fast is not None and fast.gbw_hz >= need and f"use --opamp {fast.name}" in str(exc.value)
+    assert all(a.gbw_hz < need or a.gbw_hz >= fast.gbw_hz for a in map(opamps.get, opamps.names()) if not a.ideal)
+    check_opamp_reach(mfb, target, fast)     # fast enough: no refusal
