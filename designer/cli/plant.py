@@ -413,42 +413,84 @@ def _design_circuit(args, topo) -> int:
                      opamp=args.opamp, compensate_gbw=args.compensate_gbw, amplitude_v=args.amplitude,
                      square_hz=args.square_freq, alternatives=args.alternatives, package=args.package,
                      topology=topo.name)
-    unsupported = [f for f, v in (("--stimulus prbs", args.stimulus == "prbs"), ("--prbs-bits", args.prbs_bits),
-                                  ("--prbs-clock", args.prbs_clock), ("--square-freq", args.square_freq),
-                                  ("--engine " + args.engine, args.engine != "analytic"),
-                                  ("--spice-samples", args.spice_samples), ("--replay", args.replay),
-                                  ("--tol GBW/SR", any(str(t).split("=")[0].strip().upper() in ("GBW", "SR")
-                                                       for t in args.tol or ())))
-                   if v]
-    if unsupported:
-        raise DesignError(f"{unsupported[0].split()[0]}: {unsupported[0]} is the {DEFAULT_TOPOLOGY}'s for now; "
-                          f"--topology {topo.name} has the .ac check and the analytic Monte Carlo")
+    _circuit_unsupported(args, topo)
     name = args.name if args.name is not None else (
         f"plant_{topo.name}_fc{spec.fc_hz:g}" + ("" if spec.zeta is None else f"_z{spec.zeta:g}")
         + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
     mc = monte_carlo_settings(args, topo.designators)
     check_output(args, name)
-    from ..plant import circuit
-    from ..plant.circuit_design import design_circuit_plant, tolerance_nominal
+    from ..plant.circuit_design import design_circuit_plant
     from ..plant.circuit_report import summary_text, write_outputs
     with cluster_ahead(args):
-        result = design_circuit_plant(spec, simulate=not args.no_sim, simulator=args.simulator)
-        s = result.sourcing
-        series = {"R": s.r_series, "C": s.c_series}
-        nominal = tolerance_nominal(result)
-        context = (topo.name, result.opamp)
-        if args.worst_case:
-            from ..tolerance.parts import resolve
-            from ..tolerance.worstcase import worst_case
-            tol = resolve(args.tol or (), nominal, series)
-            result.worst_case = worst_case(lambda v: circuit.evaluate(context, v), nominal, tol.of)
-        if mc is not None:
-            from ..tolerance.montecarlo import plant_monte_carlo
-            scale, target = scale_settings(args)
-            result.monte_carlo = plant_monte_carlo(None, series, result.opamp, mc[0], mc[1], args.sampler,
-                                                   args.dist, args.tol or (), args.limit or (), scale=scale,
-                                                   target_ci=target, circuit=(nominal, circuit.evaluate, context))
+        result = _circuit_tolerance(design_circuit_plant(spec, simulate=not args.no_sim, simulator=args.simulator),
+                                    args, mc)
     return emit(result, args, name, write_outputs, summary_text)
+
+
+def _circuit_unsupported(args, topo, options=()) -> None:
+    """The options the plant on another topology has not (yet): refused in one line."""
+    unsupported = [f for f, v in (("--stimulus prbs", args.stimulus == "prbs"), ("--prbs-bits", args.prbs_bits),
+                                  ("--prbs-clock", args.prbs_clock), ("--square-freq", args.square_freq),
+                                  ("--engine " + args.engine, args.engine != "analytic"),
+                                  ("--spice-samples", args.spice_samples), ("--replay", args.replay),
+                                  ("--tol GBW/SR", any(str(t).split("=")[0].strip().upper() in ("GBW", "SR")
+                                                       for t in args.tol or ())), *options)
+                   if v]
+    if unsupported:
+        raise DesignError(f"{unsupported[0].split()[0]}: {unsupported[0]} is the {DEFAULT_TOPOLOGY}'s for now; "
+                          f"--topology {topo.name} has the .ac check and the analytic Monte Carlo")
+
+
+def _analyze_circuit(args, topo) -> int:
+    """analyze-plant --topology NAME (not the default) --part REF=VALUE ..: a section's parts as built."""
+    named = [n for n in ("r1", "r2", "c1", "c2", "r3", "r4", "gain") if getattr(args, n) is not None]
+    if named:
+        raise DesignError(f"--{named[0]} is the {DEFAULT_TOPOLOGY}'s; give {topo.name}'s parts as --part REF=VALUE "
+                          f"({', '.join(topo.designators)})")
+    _circuit_unsupported(args, topo)
+    from ..core.units import value_code
+    from ..plant.circuit_design import analyze_circuit_plant
+    from ..plant.circuit_report import summary_text, write_outputs
+    parts = args.part or {}
+    bad = [r for r in parts if r not in topo.designators]
+    missing = [r for r in topo.designators if r not in parts]
+    if bad or missing:
+        what = f"has no part {bad[0]}" if bad else f"needs {', '.join(missing)} too"
+        raise DesignError(f"--part: {topo.name} {what}; its parts are {', '.join(topo.designators)}")
+    mc = monte_carlo_settings(args, topo.designators)
+    from ..core.ranges import parse_in_range
+    values = {r: parse_in_range(v, f"--part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
+              for r, v in parts.items()}
+    name = args.name if args.name is not None else f"built_{topo.name}_" + "_".join(
+        f"{r.lower()}{value_code(values[r])}" for r in topo.designators)
+    check_output(args, name)
+    with cluster_ahead(args):
+        result = _circuit_tolerance(analyze_circuit_plant(
+            topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,
+            simulate=not args.no_sim, simulator=args.simulator), args, mc)
+    return emit(result, args, name, write_outputs, summary_text)
+
+
+def _circuit_tolerance(result, args, mc):
+    """--worst-case and --monte-carlo of a plant on another topology (the analytic engine over its parts)."""
+    from ..plant import circuit
+    from ..plant.circuit_design import tolerance_nominal
+    s = result.sourcing
+    series = {"R": s.r_series, "C": s.c_series}
+    nominal = tolerance_nominal(result)
+    context = (result.topology, result.opamp)
+    if args.worst_case:
+        from ..tolerance.parts import resolve
+        from ..tolerance.worstcase import worst_case
+        tol = resolve(args.tol or (), nominal, series)
+        result.worst_case = worst_case(lambda v: circuit.evaluate(context, v), nominal, tol.of)
+    if mc is not None:
+        from ..tolerance.montecarlo import plant_monte_carlo
+        scale, target = scale_settings(args)
+        result.monte_carlo = plant_monte_carlo(None, series, result.opamp, mc[0], mc[1], args.sampler, args.dist,
+                                               args.tol or (), args.limit or (), scale=scale, target_ci=target,
+                                               circuit=(nominal, circuit.evaluate, context))
+    return result
 
 
 def _emit(result, args, name) -> int:
@@ -465,15 +507,26 @@ def _analyze_parser():
   analyze-plant --r1 820 --r2 1k --c1 10n --c2 220n                 the seed's rounded parts
   analyze-plant --r1 820 --r2 1k --c1 10n --c2 220n --fc 3500 --zeta 0.2   errors against the seed's target
   analyze-plant --r1 10k --r2 10k --c1 10n --c2 10n --gain 2.5      equal-component design with gain
-  analyze-plant --r1 10k --r2 10k --c1 10n --c2 10n --r3 10k --r4 15k  gain from its resistors""",
+  analyze-plant --r1 10k --r2 10k --c1 10n --c2 10n --r3 10k --r4 15k  gain from its resistors
+  analyze-plant --topology mfb-lowpass --part R1=1k1 --part R2=2k2 --part R3=43k --part C1=1n2 --part C2=220n
+
+topologies (--topology NAME):
+""" + "".join(f"  {t.name:26s}{t.title}: {', '.join(t.designators)}\n" for t in registry.REGISTRY.values()),
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     g = p.add_argument_group("parts")
+    # required for the Sallen-Key low-pass unless given as --part (checked in _analyze)
     for n, what, key in (("r1", "input resistor, ohms", "resistor_ohm"),
                          ("r2", "resistor to the non-inverting input, ohms", "resistor_ohm"),
                          ("c1", "non-inverting input to ground, farads", "capacitor_f"),
                          ("c2", "feedback capacitor, farads", "capacitor_f")):
-        g.add_argument(f"--{n}", required=True, help=f"{what} {help_range(key)}")
+        g.add_argument(f"--{n}", help=f"{what} {help_range(key)} (required, or --part {n.upper()}=VALUE)")
+    g.add_argument("--topology", default=DEFAULT_TOPOLOGY, metavar="NAME",
+                   help=f"the section the parts are (default {DEFAULT_TOPOLOGY}, the seed's, whose parts are "
+                        "also --r1 .. --r4; the registered ones are listed below)")
+    g.add_argument("--part", action=PartValue, metavar="REF=VALUE",
+                   help="a part by its designator, repeatable: --part R1=1k6 --part C2=220n (a designator given "
+                        "twice is refused); every part of --topology")
     g.add_argument("--gain", default=None, metavar="K", help=f"gain K = 1 + R4/R3 (default 1) {help_range('gain')}")
     g.add_argument("--r3", help="gain resistor to ground (with --r4, instead of --gain)")
     g.add_argument("--r4", help="gain feedback resistor")
@@ -489,11 +542,50 @@ def _analyze_parser():
     return p
 
 
+class PartValue(argparse.Action):
+    """``--part REF=VALUE``, repeatable, into a dict; a designator given twice is refused in one line."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        ref, eq, value = str(values).partition("=")
+        ref = ref.strip().upper()
+        if not eq or not ref or not value.strip():
+            parser.error(f"--part {values!r}: give REF=VALUE, e.g. --part R1=1k6")
+        parts = dict(getattr(namespace, self.dest, None) or {})
+        if ref in parts:
+            parser.error(f"--part {ref} given twice: {parts[ref]} and {value.strip()}; give it once")
+        parts[ref] = value.strip()
+        setattr(namespace, self.dest, parts)
+
+
+#: the Sallen-Key low-pass's part options (its designators' names on the command line)
+SK_PART_OPTIONS = {"R1": "r1", "R2": "r2", "C1": "c1", "C2": "c2", "R3": "r3", "R4": "r4"}
+
+
+def _sk_parts(args) -> None:
+    """--part on the Sallen-Key low-pass: its designators into --r1 .. --r4 (a part given both ways refused),
+    then --r1, --r2, --c1, --c2 required as argparse would."""
+    for ref, value in (args.part or {}).items():
+        dest = SK_PART_OPTIONS.get(ref)
+        if dest is None:
+            raise DesignError(f"--part {ref}: {DEFAULT_TOPOLOGY} has no part {ref}; its parts are "
+                              f"{', '.join(SK_PART_OPTIONS)}")
+        if getattr(args, dest) is not None:
+            raise DesignError(f"--part {ref} and --{dest} name the same part; give it once")
+        setattr(args, dest, value)
+    missing = [f"--{n}" for n in ("r1", "r2", "c1", "c2") if getattr(args, n) is None]
+    if missing:
+        raise DesignError(f"the following arguments are required: {', '.join(missing)} (see analyze-plant --help)")
+
+
 def _analyze(args) -> int:
     from ..core.units import value_code
     from ..plant.design import analyze_plant
     from ..plant.sallenkey import SallenKeyParts
     from ..plant.spec import AnalysisSpec
+    topo = registry.get(args.topology)
+    if topo.name != DEFAULT_TOPOLOGY:
+        return _analyze_circuit(args, topo)
+    _sk_parts(args)
     if args.r3 is not None and args.gain is not None:
         raise DesignError("give either --gain or --r3/--r4, not both")
     # the spec parses and checks what was typed (once): the parts through the plant check,

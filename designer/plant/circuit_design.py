@@ -30,6 +30,8 @@ from ..core.errors import DesignError
 from ..core.jsonio import json_safe
 from ..core.lti import dense_time, response_span, step_response
 from ..core.metrics import step_metrics
+from ..core.eseries import series_name
+from ..core.ranges import parse_in_range
 from ..core.units import format_eng
 from ..filters import registry
 from ..filters.deck import ac_deck, simulate_ac
@@ -41,7 +43,7 @@ from .design import MAX_ERROR, candidates, part_series
 from .result import METRICS, PLANT_SCHEMA_VERSION, Sourcing, Target
 
 __all__ = ["GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "CircuitPlantResult", "design_circuit_plant", "check_opamp_reach",
-           "tolerance_nominal"]
+           "analyze_circuit_plant", "tolerance_nominal"]
 
 #: the op-amp's gain-bandwidth a section needs, in units of fn x Q x noise gain
 GBW_MARGIN = 10.0
@@ -57,12 +59,14 @@ class CircuitPlantResult:
     ----------
     topology : str
         The registry's name.
+    mode : str
+        ``design`` (searched) or ``analyze`` (parts as built).
     target : Target
         fn, zeta (None: first order) and gain asked for.
     values : dict
         The build: designator -> E-series value.
-    ideal : dict
-        The continuous synthesis at the build's reference capacitor.
+    ideal : dict or None
+        The continuous synthesis at the build's reference capacitor (None: parts as built).
     alternatives : list of designer.plant.circuit.Candidate
         The best combinations, best first (the build first).
     sourcing : Sourcing
@@ -90,6 +94,7 @@ class CircuitPlantResult:
     """
 
     topology: str
+    mode: str
     target: Target
     values: dict
     ideal: dict
@@ -139,7 +144,7 @@ class CircuitPlantResult:
         return json_safe({
             "schema_version": PLANT_SCHEMA_VERSION,
             "tool": tool_info(None if self.spice is None else self.spice["simulator"]),
-            "mode": "design",
+            "mode": self.mode,
             "topology": self.topology,
             "topology_title": topo.title,
             "spec": self.target.to_dict(),
@@ -203,11 +208,11 @@ def _figures(topo, values: dict, amp, target: Target) -> dict:
     opa = {"fn_hz": float(arrays["fn_hz"]), "zeta": float(arrays["zeta"]), "q": float(arrays["q"]),
            "f3db_hz": circuit.corner_frequencies(topo, values, amp)}
     for f in (ideal, opa):
-        f["fn_error_pct"] = 100 * (f["fn_hz"] / target.fc_hz - 1)
+        f["fn_error_pct"] = None if target.fc_hz is None else 100 * (f["fn_hz"] / target.fc_hz - 1)
         f["zeta_error_pct"] = None if target.zeta is None else 100 * (f["zeta"] / target.zeta - 1)
         if topo.order == 1:
             f["zeta"] = f["q"] = None
-    ideal["gain_error_pct"] = 100 * (ideal["gain"] / target.gain - 1)
+    ideal["gain_error_pct"] = None if target.gain is None else 100 * (ideal["gain"] / target.gain - 1)
     return {"ideal": ideal, "opamp": opa}
 
 
@@ -280,24 +285,92 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
                           f"{100 * best.worst:.3g} % off the target (more than {100 * MAX_ERROR:g} %); widen the "
                           "part bounds or use a finer series", param="fc_hz")
     t_search = time.perf_counter() - tick
-    tick = time.perf_counter()
     values = best.values
     ideal = topo.synthesize(dataclasses.replace(aim, c_f=values[topo.reference_capacitor]))
     labels, _, _, _ = part_series(values, spec.r_series, spec.c_series)
-    sourcing = Sourcing(spec.r_series, spec.c_series, labels)
-    figures = _figures(topo, values, amp, target)
-    steps = _steps(topo, values, amp, figures)
-    sensitivity = {"ideal": circuit.sensitivities(topo, values), "opamp": circuit.sensitivities(topo, values, amp)}
-    netlist = topo.netlist(values)
-    fn = figures["ideal"]["fn_hz"]
-    title = f"{topo.title} plant fn={fn:.5g}Hz op-amp={amp.name}"
-    deck = ac_deck(netlist, amp, fn / 30, fn * 30, title=title)
     notes = [f"{topo.title}: parts {', '.join(f'{p.ref} ({p.role})' for p in topo.parts)}"]
     if spec.compensate_gbw:
         notes.append(f"--compensate-gbw: designed for fn {aim.fn_hz:.5g} Hz"
                      + (f", Q {aim.q:.4g}" if aim.q else "")
                      + f" so that with the {amp.name}'s {format_eng(amp.gbw_hz, 'Hz')} GBW it lands on the spec")
-    timings = {"search_s": t_search, "analytic_s": time.perf_counter() - tick}
+    if math.isfinite(best.worst) and best.worst > 0.005:
+        notes.append(f"the best parts land {100 * best.worst:.3g} % off the target; a finer series or wider "
+                     "bounds may come closer")
+    result = _analyse(topo, "design", target, values, ideal, ranked, Sourcing(spec.r_series, spec.c_series, labels),
+                      amp, notes, spec.package, simulate, simulator)
+    result.timings = {"search_s": t_search, **result.timings}
+    return result
+
+
+def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", target_fc_hz=None, target_zeta=None,
+                          r_series=None, c_series=None, package=None, simulate: bool = True,
+                          simulator: str = "ngspice-cli") -> CircuitPlantResult:
+    """Analyse a section's parts as built (``analyze-plant --topology NAME --part R1=1k6 ..``).
+
+    Parameters
+    ----------
+    topology : str
+        A registered section's name.
+    values : dict
+        Designator -> value (a number or engineering notation), every declared part.
+    opamp : str
+        The op-amp's catalogue name.
+    target_fc_hz, target_zeta : float or str, optional
+        What the errors are reported against.
+    r_series, c_series : str, optional
+        Where the parts come from, for their tolerance (None: the smallest series holding each value).
+    package : str, optional
+        The op-amp package of the wiring.
+    simulate : bool
+        Run ngspice's .ac of the deck.
+    simulator : str
+        :func:`designer.spice.simulate.get_simulator`'s name.
+
+    Returns
+    -------
+    CircuitPlantResult
+        The typed result (``mode`` "analyze").
+
+    Raises
+    ------
+    DesignError
+        A part missing, not the section's, or out of range; a bad target or series (one line each).
+    """
+    topo = registry.get(topology)
+    unknown = [r for r in values if r not in topo.designators]
+    missing = [r for r in topo.designators if r not in values]
+    if unknown or missing:
+        what = f"has no part {unknown[0]}" if unknown else f"needs {', '.join(missing)} too"
+        raise DesignError(f"part: {topo.name} {what}; its parts are {', '.join(topo.designators)}", param="part")
+    parsed = {r: parse_in_range(values[r], f"part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
+              for r in topo.designators}
+    fc = None if target_fc_hz is None else parse_in_range(target_fc_hz, "target_fc_hz", "fc_hz")
+    zeta = None if target_zeta is None else parse_in_range(target_zeta, "target_zeta", "zeta")
+    if zeta is not None and topo.order == 1:
+        raise DesignError(f"target_zeta: {topo.name} is first-order and has no damping", param="target_zeta")
+    amp = opamps.get(opamp)
+    amp.package(package)
+    series = [None if s is None else series_name(s) for s in (r_series, c_series)]
+    labels, r_s, c_s, why = part_series(parsed, *series)
+    gain = float(topo.figures(parsed).gain)
+    fig = topo.figures(parsed)
+    notes = [f"these parts give fn = {fig.fn_hz:.5g} Hz" + ("" if fig.q is None else f", Q = {fig.q:.4g}")
+             + f", gain {gain:.4g}", *why]
+    return _analyse(topo, "analyze", Target(fc, zeta, gain), parsed, None, [], Sourcing(r_s, c_s, labels), amp,
+                    notes, package, simulate, simulator)
+
+
+def _analyse(topo, mode: str, target: Target, values: dict, ideal, ranked: list, sourcing: Sourcing, amp, notes: list,
+             package, simulate: bool, simulator: str) -> CircuitPlantResult:
+    """The figures, sensitivities, deck and (when ``simulate``) SPICE check of a build, as one result."""
+    tick = time.perf_counter()
+    figures = _figures(topo, values, amp, target)
+    steps = _steps(topo, values, amp, figures)
+    sensitivity = {"ideal": circuit.sensitivities(topo, values), "opamp": circuit.sensitivities(topo, values, amp)}
+    netlist = topo.netlist(values)
+    fn = figures["ideal"]["fn_hz"]
+    deck = ac_deck(netlist, amp, fn / 30, fn * 30, title=f"{topo.title} plant fn={fn:.5g}Hz op-amp={amp.name}")
+    timings = {"analytic_s": time.perf_counter() - tick}
     checks, run = [], None
     if simulate:
         tick = time.perf_counter()
@@ -306,11 +379,8 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
         timings["simulation_s"] = time.perf_counter() - tick
     else:
         notes.append("SPICE simulation skipped (--no-sim): the figures are analytic only")
-    if math.isfinite(best.worst) and best.worst > 0.005:
-        notes.append(f"the best parts land {100 * best.worst:.3g} % off the target; a finer series or wider "
-                     "bounds may come closer")
-    return CircuitPlantResult(topo.name, target, values, ideal, ranked, sourcing, amp, figures, steps, sensitivity,
-                              netlist, deck, checks, notes, run, spec.package, timings=timings)
+    return CircuitPlantResult(topo.name, mode, target, values, ideal, ranked, sourcing, amp, figures, steps,
+                              sensitivity, netlist, deck, checks, notes, run, package, timings=timings)
 
 
 def tolerance_nominal(result: CircuitPlantResult) -> dict:

@@ -35,6 +35,10 @@ def title_of(result) -> str:
         One line.
     """
     t = result.target
+    if result.mode == "analyze":
+        f = result.figures["ideal"]
+        zeta = "" if f["zeta"] is None else f", zeta {f['zeta']:.4g}"
+        return f"{result.section.title} plant as built: fn {f['fn_hz']:.5g} Hz{zeta}, gain {f['gain']:.4g}"
     zeta = "" if t.zeta is None else f", zeta {t.zeta:g}"
     return f"{result.section.title} plant: fc {t.fc_hz:g} Hz{zeta}, gain {t.gain:g}"
 

@@ -101,3 +101,53 @@ def test_help_lists_the_topologies():
     text = " ".join(out.stdout.split())
     for name in REGISTRY:
         assert name in text
+
+
+def analyze(*args, cwd=None):
+    return subprocess.run([script("analyze-plant"), *args], capture_output=True, text=True, cwd=cwd, timeout=300)
+
+
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_analyze_plant_takes_every_topology_s_parts_by_designator(topology, tmp_path):
+    """The example's exact synthesis given as --part: its figures are the example's (closed forms)."""
+    values = topology.synthesize(topology.example)
+    parts = [a for r, v in values.items() for a in ("--part", f"{r}={v!r}")]
+    out = analyze("--topology", topology.name, *parts, "--no-sim", "--json", "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    assert d["mode"] == "analyze" and d["topology"] == topology.name
+    assert d["built"]["ideal"]["fn_hz"] == pytest.approx(topology.example.fn_hz, rel=1e-9)
+    assert d["built"]["ideal"]["gain"] == pytest.approx(topology.example.gain, rel=1e-9)
+
+
+def test_part_on_the_sallen_key_low_pass_is_its_r1_to_c2(tmp_path):
+    """--part R1=820 is --r1 820: the same result."""
+    a = analyze("--part", "R1=820", "--part", "C2=220n", "--r2", "1k", "--c1", "10n", "--no-sim", "--json",
+                "--no-files")
+    b = analyze("--r1", "820", "--r2", "1k", "--c1", "10n", "--c2", "220n", "--no-sim", "--json", "--no-files")
+    assert a.returncode == 0 and b.returncode == 0, a.stderr + b.stderr
+    da, db = json.loads(a.stdout), json.loads(b.stdout)
+    da.pop("tool"), db.pop("tool")
+    assert da == db
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--part", "R1=820", "--part", "R1=1k", "--r2", "1k", "--c1", "10n", "--c2", "220n"],
+     ["--part R1 given twice: 820 and 1k"]),
+    (["--part", "R5=1k", "--r1", "1k", "--r2", "1k", "--c1", "10n", "--c2", "220n"],
+     ["no part R5", "R1, R2, C1, C2, R3, R4"]),
+    (["--part", "R1=1k", "--r1", "1k", "--r2", "1k", "--c1", "10n", "--c2", "220n"], ["same part"]),
+    (["--r2", "1k", "--c1", "10n"], ["the following arguments are required: --r1, --c2"]),
+    (["--topology", "mfb-lowpass", "--part", "R1=1k"], ["needs R2, R3, C1, C2 too"]),
+    (["--topology", "mfb-lowpass", "--part", "R5=1k"], ["has no part R5", "R1, R2, R3, C1, C2"]),
+    (["--topology", "mfb-lowpass", "--r1", "1k"], ["--r1 is the sallen-key-lowpass's", "--part"]),
+    (["--topology", "rc-lowpass", "--part", "R1=1k", "--part", "C1=1x"], ["--part C1", "not a number"]),
+])
+def test_analyze_plant_part_refusals_are_one_line(args, words, tmp_path):
+    out = analyze(*args, "--no-sim", cwd=tmp_path)
+    assert out.returncode == 2 and out.stdout == ""
+    line = out.stderr.strip()
+    assert "\n" not in line
+    for w in words:
+        assert w in line, (w, line)
+    assert list(tmp_path.iterdir()) == []
