@@ -557,8 +557,8 @@ class PartValue(argparse.Action):
         setattr(namespace, self.dest, parts)
 
 
-#: the Sallen-Key low-pass's part options (its designators' names on the command line)
-SK_PART_OPTIONS = {"R1": "r1", "R2": "r2", "C1": "c1", "C2": "c2", "R3": "r3", "R4": "r4"}
+#: the default section's parts (its gain resistors too: the gain K) as the command line names them (--r1 ..)
+SK_PART_OPTIONS = {r: r.lower() for r in registry.get(DEFAULT_TOPOLOGY + "-gain").designators}
 
 
 def _sk_parts(args) -> None:
