@@ -451,7 +451,7 @@ def _analyze_circuit(args, topo) -> int:
     from ..core.units import value_code
     from ..plant.circuit_design import analyze_circuit_plant
     from ..plant.circuit_report import summary_text, write_outputs
-    parts = args.part or {}
+    parts = part_values(args.part)
     bad = [r for r in parts if r not in topo.designators]
     missing = [r for r in topo.designators if r not in parts]
     if bad or missing:
@@ -524,7 +524,7 @@ topologies (--topology NAME):
     g.add_argument("--topology", default=DEFAULT_TOPOLOGY, metavar="NAME",
                    help=f"the section the parts are (default {DEFAULT_TOPOLOGY}, the seed's, whose parts are "
                         "also --r1 .. --r4; the registered ones are listed below)")
-    g.add_argument("--part", action=PartValue, metavar="REF=VALUE",
+    g.add_argument("--part", action="append", metavar="REF=VALUE",
                    help="a part by its designator, repeatable: --part R1=1k6 --part C2=220n (a designator given "
                         "twice is refused); every part of --topology")
     g.add_argument("--gain", default=None, metavar="K", help=f"gain K = 1 + R4/R3 (default 1) {help_range('gain')}")
@@ -542,19 +542,30 @@ topologies (--topology NAME):
     return p
 
 
-class PartValue(argparse.Action):
-    """``--part REF=VALUE``, repeatable, into a dict; a designator given twice is refused in one line."""
+def part_values(items) -> dict:
+    """``--part REF=VALUE`` items (argparse's append: repeatable) as {designator: value as typed};
+    a malformed item or a designator given twice refused in one line.
 
-    def __call__(self, parser, namespace, values, option_string=None):
-        ref, eq, value = str(values).partition("=")
+    Parameters
+    ----------
+    items : list of str or None
+        The items as typed.
+
+    Returns
+    -------
+    dict
+        Designator (upper case) -> value text.
+    """
+    parts = {}
+    for item in items or ():
+        ref, eq, value = str(item).partition("=")
         ref = ref.strip().upper()
         if not eq or not ref or not value.strip():
-            parser.error(f"--part {values!r}: give REF=VALUE, e.g. --part R1=1k6")
-        parts = dict(getattr(namespace, self.dest, None) or {})
+            raise DesignError(f"--part {item!r}: give REF=VALUE, e.g. --part R1=1k6")
         if ref in parts:
-            parser.error(f"--part {ref} given twice: {parts[ref]} and {value.strip()}; give it once")
+            raise DesignError(f"--part {ref} given twice: {parts[ref]} and {value.strip()}; give it once")
         parts[ref] = value.strip()
-        setattr(namespace, self.dest, parts)
+    return parts
 
 
 #: the default section's parts (its gain resistors too: the gain K) as the command line names them (--r1 ..)
@@ -564,7 +575,7 @@ SK_PART_OPTIONS = {r: r.lower() for r in registry.get(DEFAULT_TOPOLOGY + "-gain"
 def _sk_parts(args) -> None:
     """--part on the Sallen-Key low-pass: its designators into --r1 .. --r4 (a part given both ways refused),
     then --r1, --r2, --c1, --c2 required as argparse would."""
-    for ref, value in (args.part or {}).items():
+    for ref, value in part_values(args.part).items():
         dest = SK_PART_OPTIONS.get(ref)
         if dest is None:
             raise DesignError(f"--part {ref}: {DEFAULT_TOPOLOGY} has no part {ref}; its parts are "
