@@ -1,7 +1,8 @@
 """The dependency rule of the package, checked on every import statement:
 ``{cli, web} -> {plant, pid, identify} -> {spice, report} -> core`` (``web -> cli``), ``pid -> plant``,
 and ``identify -> plant`` only for the comparison with a design; ``filters``
-(the circuits as plug-ins) stands on ``spice``, ``report`` (its build sheet) and ``core``; ``tolerance``
+(the circuits as plug-ins) stands on ``spice``, ``report`` (its build sheet) and ``core``, and the plant wing
+(a plant on any topology) and what runs it stand on it; ``tolerance``
 (Monte Carlo) runs the wings' models; ``check`` (the CI checker of users'
 designs) runs the wings, the filters and tolerance, and only ``cli`` uses it."""
 
@@ -19,7 +20,7 @@ ALLOWED = {
     "report": {"core"},
     # the circuits as plug-ins (Topology, its sections, the cascade): below the wings
     "filters": {"core", "spice", "report"},
-    "plant": {"core", "spice", "report"},
+    "plant": {"core", "spice", "report", "filters"},
     "pid": {"core", "spice", "report", "plant", "filters"},
     "identify": {"core", "spice", "report"},
     "tolerance": {"core", "spice", "report", "plant", "pid", "filters"},

@@ -125,6 +125,34 @@ def plant_figures(res) -> dict:
     return out
 
 
+def circuit_plant_figures(res) -> dict:
+    """The :data:`PLANT` figures of a plant on another topology
+    (:class:`~designer.plant.circuit_design.CircuitPlantResult`): fn, zeta, Q with the corner's
+    op-amp and of the parts alone, the gain, the errors and the models' step figures (None for
+    what it has not: its SPICE run is an .ac sweep, no step).
+
+    Parameters
+    ----------
+    res : CircuitPlantResult
+        The corner's design.
+
+    Returns
+    -------
+    dict
+        Figure -> value or None.
+    """
+    i, o = res.figures["ideal"], res.figures["opamp"]
+    out = {"fn_hz": o["fn_hz"], "zeta": o["zeta"], "q": o["q"], "ideal_fn_hz": i["fn_hz"], "ideal_zeta": i["zeta"],
+           "ideal_q": i["q"], "gain": i["gain"], "fn_error_pct": o["fn_error_pct"],
+           "zeta_error_pct": o["zeta_error_pct"], "nrms": None, "nrms_ideal": None}
+    out.update({alias: out[name] for alias, name in ALIASES.items()})
+    for f in STEP:
+        out[f"model_{f}"] = None if res.steps["opamp"] is None else res.steps["opamp"][f]
+        out[f"ideal_{f}"] = None if res.steps["ideal"] is None else res.steps["ideal"][f]
+        out[f] = None
+    return out
+
+
 def _float(value):
     """A plain float (the model's figures are numpy scalars), None kept."""
     return None if value is None else float(value)

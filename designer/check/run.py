@@ -24,6 +24,7 @@ import numpy as np
 from ..core.compare import nrms
 from ..core.errors import DesignError, SimulatorError
 from ..core.fileio import atomic_write
+from ..plant.circuit import DEFAULT_TOPOLOGY
 from . import figures as F
 from . import golden as G
 from .result import ERROR, FAIL, PASS, SIM_ERROR, SKIP, SPEC_ERROR, Case, CornerOutcome
@@ -122,6 +123,10 @@ def _simulate(spec: CheckSpec, index: int, simulator: str):
         from .filter_kind import run_filter
         res = run_filter(design, simulator)
         return res.figures, res, res.to_dict(), (None, {})
+    if spec.kind == "plant" and hasattr(design, "topology") and design.topology != DEFAULT_TOPOLOGY:
+        from ..plant.circuit_design import design_circuit_plant
+        res = design_circuit_plant(design, simulate=True, simulator=simulator)
+        return F.circuit_plant_figures(res), res, res.to_dict(), (None, {})
     if spec.kind == "plant":
         from ..plant.design import analyze_plant, design_plant
         res = (analyze_plant if spec.analyze else design_plant)(design, simulate=True, simulator=simulator)
@@ -264,7 +269,9 @@ def _write_design(spec, corner, res, out_dir) -> dict:
         from ..filters.report import write_outputs as write_filter
         files = write_filter(sheet_of(res.design), Path(out_dir), corner or spec.name)
         return {"build_sheet": files.get("build_sheet_md"), "design_result": files.get("result_json")}
-    if spec.kind == "plant":
+    if spec.kind == "plant" and hasattr(res, "topology"):
+        from ..plant.circuit_report import write_outputs
+    elif spec.kind == "plant":
         from ..plant.report import write_outputs
     else:
         from ..pid.report import write_outputs

@@ -178,10 +178,26 @@ def _common(doc, kind: str) -> dict:
     return out
 
 
+def read_topology(doc):
+    """``topology:`` (default the seed's Sallen-Key low-pass): the registered section, refused
+    in one line listing the registered ones and the closest."""
+    from ..filters import registry
+    from ..plant.circuit import DEFAULT_TOPOLOGY
+    name = doc.data.get("topology", DEFAULT_TOPOLOGY)
+    if not isinstance(name, str):
+        raise doc.error(("topology",), f"topology must be a name, got {kind_of(name)}; registered: "
+                        f"{', '.join(registry.names())}")
+    return built_in_spec_words(doc, {"topology": "topology"}, lambda: registry.get(name))
+
+
 def read_plant_designs(doc, corners):
+    from ..plant.circuit import DEFAULT_TOPOLOGY
     from ..plant.sallenkey import SallenKeyParts
     from ..plant.spec import AnalysisSpec, PlantSpec
+    topo = read_topology(doc)
     target = doc.mapping(("target",), SUB["target"])
+    if topo.name != DEFAULT_TOPOLOGY:
+        return read_circuit_designs(doc, corners, topo, target)
     parts = doc.mapping(("parts",), SUB["parts"])
     common = _common(doc, "plant")
     if not target and not parts:
@@ -212,6 +228,28 @@ def read_plant_designs(doc, corners):
         fc_hz=target["fc"], zeta=target["zeta"], opamp=amp, alternatives=1, **extra, **common))
         for amp in corners]
     return designs, False
+
+
+def read_circuit_designs(doc, corners, topo, target):
+    """A plant on another registered topology: designed from ``target:`` (``parts:`` keys are the
+    topology's designators; parts as built are the Sallen-Key low-pass's for now)."""
+    from ..plant.spec import PlantSpec
+    parts = doc.mapping(("parts",), topo.designators)
+    if parts:
+        raise doc.error(("parts",), f"parts: as built are the sallen-key-lowpass's for now; give {topo.name} a "
+                        f"target: (its parts are {', '.join(topo.designators)})")
+    need = ("fc", "zeta") if topo.order == 2 else ("fc",)
+    for k in need:
+        if k not in target:
+            raise doc.error(("target",), f"target needs {' and '.join(need)}: the {topo.name} plant to design")
+    extra = {k: target[k] for k in ("gain", "compensate_gbw") if k in target}
+    common = _common(doc, "plant")
+    if "square_hz" in common:
+        raise doc.error(("stimulus", "frequency"), f"stimulus.frequency: {topo.name} is checked by its .ac "
+                        "sweep; the square wave is the sallen-key-lowpass's")
+    return [built_in_spec_words(doc, PLANT_KEYS, lambda amp=amp: PlantSpec(
+        fc_hz=target["fc"], zeta=target.get("zeta"), opamp=amp, alternatives=1, topology=topo.name, **extra,
+        **common)) for amp in corners], False
 
 
 def read_pid_designs(doc, corners):

@@ -49,6 +49,7 @@ from pathlib import Path
 
 from ..core.errors import DesignError
 from ..core.fileio import check_plain_name, shown
+from ..plant.circuit import DEFAULT_TOPOLOGY
 from . import figures as F
 from .sections import (Agreement, Golden, YieldSpec, read_agreement, read_checks, read_corners, read_design_checks, read_golden,
                        read_pid_designs, read_plant_designs, read_tolerance, read_yield)
@@ -59,8 +60,8 @@ __all__ = ["TOP", "load_spec"]
 KINDS = ("plant", "pid", "netlist", "filter")
 #: the top-level keys of each kind
 TOP = {
-    "plant": ("name", "kind", "description", "target", "parts", "series", "bounds", "opamp", "stimulus", "checks",
-              "design_checks", "spice_agreement", "tolerance", "tolerances", "yield", "golden"),
+    "plant": ("name", "kind", "description", "topology", "target", "parts", "series", "bounds", "opamp", "stimulus",
+              "checks", "design_checks", "spice_agreement", "tolerance", "tolerances", "yield", "golden"),
     "pid": ("name", "kind", "description", "plant", "tuning", "controller", "series", "bounds", "opamp", "stimulus",
             "checks", "design_checks", "spice_agreement", "tolerances", "yield", "golden"),
     "netlist": ("name", "kind", "description", "deck", "checks", "golden"),
@@ -147,6 +148,13 @@ def load_spec(path, update_golden: bool = False, root=None, allow_outside: bool 
     tolerance = read_tolerance(doc, checks) if kind == "plant" else ()
     golden = read_golden(doc, kind, corners, update_golden)
     yield_spec = read_yield(doc, kind, checks)
+    if kind == "plant" and getattr(designs[0], "topology", DEFAULT_TOPOLOGY) != DEFAULT_TOPOLOGY:
+        for key, given in (("spice_agreement", agreement), ("golden", golden), ("tolerance", tolerance),
+                           ("yield", yield_spec)):
+            if given:
+                raise doc.error((key,), f"{key}: is the {DEFAULT_TOPOLOGY}'s for now; topology: "
+                                f"{designs[0].topology} checks checks: and design_checks: (its ngspice .ac "
+                                "agreement is the design check spice_agreement)")
     if not (checks or design_checks or agreement or golden):
         raise doc.error((), "nothing to check: give checks:, design_checks:, spice_agreement: or golden:")
     return CheckSpec(doc.path, name, kind, corners, tuple(designs), analyze, checks, design_checks, agreement,

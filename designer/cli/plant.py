@@ -9,6 +9,8 @@ import sys
 from .. import __version__
 from ..core.errors import DesignError
 from ..core.ranges import help_range
+from ..filters import registry
+from ..plant.circuit import DEFAULT_TOPOLOGY
 from .common import (
     OneLineParser,
     add_opamp_option,
@@ -36,18 +38,29 @@ def design_plant_parser():
   design-plant --fc 20k --zeta 0.5 --opamp LM358 --compensate-gbw
   design-plant --fc 3500 --zeta 0.2 --json --no-sim
   design-plant --fc 3500 --zeta 0.2 --stimulus prbs  also the bench's PRBS in ngspice: prbs.csv, waveforms.csv
+  design-plant --fc 1k --zeta 0.5 --gain 2 --topology mfb-lowpass   the same target on an inverting MFB section
+  design-plant --fc 1k --topology rc-lowpass          a first-order section takes no --zeta
 
 Outputs: netlists/<name>.cir (run it alone with `ngspice -b`), reports/<name>/build-sheet.md and .html,
-result.json, step.png, bode.png. Exit status 2 on bad input.""",
+result.json, step.png, bode.png. Exit status 2 on bad input.
+
+topologies (--topology NAME):
+""" + "".join(f"  {t.name:26s}{t.title}\n" for t in registry.REGISTRY.values()),
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     t = p.add_argument_group("target")
-    t.add_argument("--fc", required=True, metavar="HZ",
-                   help=f"natural frequency fn = wn / 2 pi, Hz (e.g. 3500, 3.5k) {help_range('fc_hz')}")
-    t.add_argument("--zeta", required=True, metavar="Z",
-                   help=f"damping ratio (>= 1 is overdamped) {help_range('zeta')}")
+    # --fc and --zeta are required (checked in _design: a first-order --topology takes no --zeta)
+    t.add_argument("--fc", metavar="HZ",
+                   help=f"natural frequency fn = wn / 2 pi, Hz (e.g. 3500, 3.5k) {help_range('fc_hz')} (required)")
+    t.add_argument("--zeta", metavar="Z",
+                   help=f"damping ratio (>= 1 is overdamped) {help_range('zeta')} (required, but for a "
+                        "first-order --topology)")
     t.add_argument("--gain", default="1", metavar="K",
                    help=f"DC gain K = 1 + R4/R3 (default 1: follower) {help_range('gain')}")
+    t.add_argument("--topology", default=DEFAULT_TOPOLOGY, metavar="NAME",
+                   help=f"the section that realises the plant (default {DEFAULT_TOPOLOGY}, the seed's; the "
+                        "registered ones are listed below); every one but the default is designed by the "
+                        "generic E-series search and checked by ngspice's .ac of its deck")
     t.add_argument("--compensate-gbw", action="store_true",
                    help="pre-distort the targets so the circuit lands on them with the op-amp's finite GBW")
     sel = p.add_argument_group("parts")
@@ -361,8 +374,21 @@ def _with_stimulus(result, args, stim):
     return with_prbs(result, result.test.amplitude_v, stim[0], stim[1], not args.no_sim, args.simulator)
 
 
+def _required(args, topology: str) -> None:
+    """--fc and --zeta as argparse would require them (--zeta not for a first-order topology)."""
+    order = registry.get(topology).order
+    missing = [f for f, v, need in (("--fc", args.fc, True), ("--zeta", args.zeta, order == 2))
+               if need and v is None]
+    if missing:
+        raise DesignError(f"the following arguments are required: {', '.join(missing)} (see design-plant --help)")
+
+
 def _design(args) -> int:
     from ..plant.spec import PlantSpec
+    topology = registry.get(args.topology).name   # an unknown one refused first, with the registered ones
+    _required(args, topology)
+    if topology != DEFAULT_TOPOLOGY:
+        return _design_circuit(args, registry.get(topology))
     # the spec parses and checks what was typed (once); its errors name parameters, shown as options
     spec = PlantSpec(fc_hz=args.fc, zeta=args.zeta, gain=args.gain, **part_options(args), r=args.r, c=args.c,
                      opamp=args.opamp, compensate_gbw=args.compensate_gbw, amplitude_v=args.amplitude,
@@ -382,6 +408,93 @@ def _design(args) -> int:
     return _emit(result, args, name)
 
 
+def _design_circuit(args, topo) -> int:
+    """design-plant --topology NAME (not the default): the plant on a registered section."""
+    from ..plant.spec import PlantSpec
+    spec = PlantSpec(fc_hz=args.fc, zeta=args.zeta, gain=args.gain, **part_options(args), r=args.r, c=args.c,
+                     opamp=args.opamp, compensate_gbw=args.compensate_gbw, amplitude_v=args.amplitude,
+                     square_hz=args.square_freq, alternatives=args.alternatives, package=args.package,
+                     topology=topo.name)
+    _circuit_unsupported(args, topo)
+    name = args.name if args.name is not None else (
+        f"plant_{topo.name}_fc{spec.fc_hz:g}" + ("" if spec.zeta is None else f"_z{spec.zeta:g}")
+        + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
+    mc = monte_carlo_settings(args, topo.designators)
+    check_output(args, name)
+    from ..plant.circuit_design import design_circuit_plant
+    from ..plant.circuit_report import summary_text, write_outputs
+    with cluster_ahead(args):
+        result = _circuit_tolerance(design_circuit_plant(spec, simulate=not args.no_sim, simulator=args.simulator),
+                                    args, mc)
+    return emit(result, args, name, write_outputs, summary_text)
+
+
+def _circuit_unsupported(args, topo, options=()) -> None:
+    """The options the plant on another topology has not (yet): refused in one line."""
+    unsupported = [f for f, v in (("--stimulus prbs", args.stimulus == "prbs"), ("--prbs-bits", args.prbs_bits),
+                                  ("--prbs-clock", args.prbs_clock), ("--square-freq", args.square_freq),
+                                  ("--engine " + args.engine, args.engine != "analytic"),
+                                  ("--spice-samples", args.spice_samples), ("--replay", args.replay),
+                                  ("--tol GBW/SR", any(str(t).split("=")[0].strip().upper() in ("GBW", "SR")
+                                                       for t in args.tol or ())), *options)
+                   if v]
+    if unsupported:
+        raise DesignError(f"{unsupported[0].split()[0]}: {unsupported[0]} is the {DEFAULT_TOPOLOGY}'s for now; "
+                          f"--topology {topo.name} has the .ac check and the analytic Monte Carlo")
+
+
+def _analyze_circuit(args, topo) -> int:
+    """analyze-plant --topology NAME (not the default) --part REF=VALUE ..: a section's parts as built."""
+    named = [n for n in ("r1", "r2", "c1", "c2", "r3", "r4", "gain") if getattr(args, n) is not None]
+    if named:
+        raise DesignError(f"--{named[0]} is the {DEFAULT_TOPOLOGY}'s; give {topo.name}'s parts as --part REF=VALUE "
+                          f"({', '.join(topo.designators)})")
+    _circuit_unsupported(args, topo)
+    from ..core.units import value_code
+    from ..plant.circuit_design import analyze_circuit_plant
+    from ..plant.circuit_report import summary_text, write_outputs
+    parts = part_values(args.part)
+    bad = [r for r in parts if r not in topo.designators]
+    missing = [r for r in topo.designators if r not in parts]
+    if bad or missing:
+        what = f"has no part {bad[0]}" if bad else f"needs {', '.join(missing)} too"
+        raise DesignError(f"--part: {topo.name} {what}; its parts are {', '.join(topo.designators)}")
+    mc = monte_carlo_settings(args, topo.designators)
+    from ..core.ranges import parse_in_range
+    values = {r: parse_in_range(v, f"--part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
+              for r, v in parts.items()}
+    name = args.name if args.name is not None else f"built_{topo.name}_" + "_".join(
+        f"{r.lower()}{value_code(values[r])}" for r in topo.designators)
+    check_output(args, name)
+    with cluster_ahead(args):
+        result = _circuit_tolerance(analyze_circuit_plant(
+            topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,
+            simulate=not args.no_sim, simulator=args.simulator), args, mc)
+    return emit(result, args, name, write_outputs, summary_text)
+
+
+def _circuit_tolerance(result, args, mc):
+    """--worst-case and --monte-carlo of a plant on another topology (the analytic engine over its parts)."""
+    from ..plant import circuit
+    from ..plant.circuit_design import tolerance_nominal
+    s = result.sourcing
+    series = {"R": s.r_series, "C": s.c_series}
+    nominal = tolerance_nominal(result)
+    context = (result.topology, result.opamp)
+    if args.worst_case:
+        from ..tolerance.parts import resolve
+        from ..tolerance.worstcase import worst_case
+        tol = resolve(args.tol or (), nominal, series)
+        result.worst_case = worst_case(lambda v: circuit.evaluate(context, v), nominal, tol.of)
+    if mc is not None:
+        from ..tolerance.montecarlo import plant_monte_carlo
+        scale, target = scale_settings(args)
+        result.monte_carlo = plant_monte_carlo(None, series, result.opamp, mc[0], mc[1], args.sampler, args.dist,
+                                               args.tol or (), args.limit or (), scale=scale, target_ci=target,
+                                               circuit=(nominal, circuit.evaluate, context))
+    return result
+
+
 def _emit(result, args, name) -> int:
     from ..plant.report import summary_text, write_outputs
     return emit(result, args, name, write_outputs, summary_text)
@@ -396,15 +509,26 @@ def analyze_plant_parser():
   analyze-plant --r1 820 --r2 1k --c1 10n --c2 220n                 the seed's rounded parts
   analyze-plant --r1 820 --r2 1k --c1 10n --c2 220n --fc 3500 --zeta 0.2   errors against the seed's target
   analyze-plant --r1 10k --r2 10k --c1 10n --c2 10n --gain 2.5      equal-component design with gain
-  analyze-plant --r1 10k --r2 10k --c1 10n --c2 10n --r3 10k --r4 15k  gain from its resistors""",
+  analyze-plant --r1 10k --r2 10k --c1 10n --c2 10n --r3 10k --r4 15k  gain from its resistors
+  analyze-plant --topology mfb-lowpass --part R1=1k1 --part R2=2k2 --part R3=43k --part C1=1n2 --part C2=220n
+
+topologies (--topology NAME):
+""" + "".join(f"  {t.name:26s}{t.title}: {', '.join(t.designators)}\n" for t in registry.REGISTRY.values()),
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     g = p.add_argument_group("parts")
+    # required for the Sallen-Key low-pass unless given as --part (checked in _analyze)
     for n, what, key in (("r1", "input resistor, ohms", "resistor_ohm"),
                          ("r2", "resistor to the non-inverting input, ohms", "resistor_ohm"),
                          ("c1", "non-inverting input to ground, farads", "capacitor_f"),
                          ("c2", "feedback capacitor, farads", "capacitor_f")):
-        g.add_argument(f"--{n}", required=True, help=f"{what} {help_range(key)}")
+        g.add_argument(f"--{n}", help=f"{what} {help_range(key)} (required, or --part {n.upper()}=VALUE)")
+    g.add_argument("--topology", default=DEFAULT_TOPOLOGY, metavar="NAME",
+                   help=f"the section the parts are (default {DEFAULT_TOPOLOGY}, the seed's, whose parts are "
+                        "also --r1 .. --r4; the registered ones are listed below)")
+    g.add_argument("--part", action="append", metavar="REF=VALUE",
+                   help="a part by its designator, repeatable: --part R1=1k6 --part C2=220n (a designator given "
+                        "twice is refused); every part of --topology")
     g.add_argument("--gain", default=None, metavar="K", help=f"gain K = 1 + R4/R3 (default 1) {help_range('gain')}")
     g.add_argument("--r3", help="gain resistor to ground (with --r4, instead of --gain)")
     g.add_argument("--r4", help="gain feedback resistor")
@@ -420,11 +544,61 @@ def analyze_plant_parser():
     return p
 
 
+def part_values(items) -> dict:
+    """``--part REF=VALUE`` items (argparse's append: repeatable) as {designator: value as typed};
+    a malformed item or a designator given twice refused in one line.
+
+    Parameters
+    ----------
+    items : list of str or None
+        The items as typed.
+
+    Returns
+    -------
+    dict
+        Designator (upper case) -> value text.
+    """
+    parts = {}
+    for item in items or ():
+        ref, eq, value = str(item).partition("=")
+        ref = ref.strip().upper()
+        if not eq or not ref or not value.strip():
+            raise DesignError(f"--part {item!r}: give REF=VALUE, e.g. --part R1=1k6")
+        if ref in parts:
+            raise DesignError(f"--part {ref} given twice: {parts[ref]} and {value.strip()}; give it once")
+        parts[ref] = value.strip()
+    return parts
+
+
+#: the default section's parts (its gain resistors too: the gain K) as the command line names them (--r1 ..)
+SK_PART_OPTIONS = {r: r.lower() for r in registry.get(DEFAULT_TOPOLOGY + "-gain").designators}
+
+
+def _sk_parts(args) -> None:
+    """--part on the Sallen-Key low-pass: its designators into --r1 .. --r4 (a part given both ways refused),
+    then --r1, --r2, --c1, --c2 required as argparse would."""
+    for ref, value in part_values(args.part).items():
+        dest = SK_PART_OPTIONS.get(ref)
+        if dest is None:
+            raise DesignError(f"--part {ref}: {DEFAULT_TOPOLOGY} has no part {ref}; its parts are "
+                              f"{', '.join(SK_PART_OPTIONS)}")
+        if getattr(args, dest) is not None:
+            raise DesignError(f"--part {ref} and --{dest} name the same part; give it once")
+        setattr(args, dest, value)
+    missing = [f"--{n}" for n in ("r1", "r2", "c1", "c2") if getattr(args, n) is None]
+    if missing:
+        raise DesignError(f"the following arguments are required: {', '.join(missing)} (see analyze-plant --help)")
+
+
 def _analyze(args) -> int:
     from ..core.units import value_code
     from ..plant.design import analyze_plant
     from ..plant.sallenkey import SallenKeyParts
     from ..plant.spec import AnalysisSpec
+    topo = registry.get(args.topology)
+    if topo.name != DEFAULT_TOPOLOGY:
+        return _analyze_circuit(args, topo)
+    _sk_parts(args)
     if args.r3 is not None and args.gain is not None:
         raise DesignError("give either --gain or --r3/--r4, not both")
     # the spec parses and checks what was typed (once): the parts through the plant check,

@@ -197,6 +197,23 @@ def names() -> list:
     return list(_catalogue())
 
 
+def fast_enough(gbw_hz: float) -> OpAmp | None:
+    """The slowest catalogue op-amp (the ideal one aside) whose gain-bandwidth is at least ``gbw_hz``.
+
+    Parameters
+    ----------
+    gbw_hz : float
+        The gain-bandwidth needed, Hz.
+
+    Returns
+    -------
+    OpAmp or None
+        None when none is that fast.
+    """
+    ok = sorted((a for a in _catalogue().values() if not a.ideal and a.gbw_hz >= gbw_hz), key=lambda a: a.gbw_hz)
+    return ok[0] if ok else None
+
+
 def get(name: str) -> OpAmp:
     """Look up an op-amp by name (case-insensitive).
 

@@ -39,7 +39,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "spec": ("FilterSpec", "TOPOLOGY_CHOICES",),
     "tables": ("TableRow", "coefficient_table", "section_3db_ratio", "table_corner",),
     "topology": ("DEFAULT_IMPEDANCE_OHM", "Figures", "KINDS", "PartSpec", "SectionTarget", "Topology",
-                 "nodal_response", "open_loop_gain", "polynomial", "polyval", "quadratic_root",),
+                 "nodal_response", "nodal_system", "open_loop_gain", "polynomial", "polyval", "quadratic_root"),
     "verify": ("BenchSignal", "NRMS_PASS", "PROOF_POINTS_PER_DECADE", "Proof", "StageDrive", "TRAN_POINTS",
                "analytic_tran", "bench_signal", "mask_edges", "opamp_aware_polys", "proof_deck", "prove",
                "stage_drive", "stage_polys",),

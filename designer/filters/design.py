@@ -525,9 +525,8 @@ def _check_gbw(number: int, plan: SectionPlan, name: str, gain: float, need: flo
     """Refuse a stage whose op-amp is too slow (one line naming the catalogue's op-amp that is fast enough)."""
     if need <= opamp.gbw_hz:
         return
-    faster = sorted((opamps.get(n) for n in opamps.names() if n != "ideal"), key=lambda o: o.gbw_hz)
-    ok = [o for o in faster if o.gbw_hz >= need]
-    instead = f"use {ok[0].name} ({format_eng(ok[0].gbw_hz, 'Hz')})" if ok else \
+    ok = opamps.fast_enough(need)
+    instead = f"use {ok.name} ({format_eng(ok.gbw_hz, 'Hz')})" if ok else \
         "no catalogue op-amp is fast enough: lower fc, Q or the gain"
     q = f", Q {plan.q:.3g}" if plan.q else ""
     raise DesignError(

@@ -40,7 +40,7 @@ from ..core.errors import DesignError
 from ..spice.deck import GROUND, Netlist, Part
 
 __all__ = ["KINDS", "DEFAULT_IMPEDANCE_OHM", "PartSpec", "SectionTarget", "Figures", "Topology",
-           "open_loop_gain", "nodal_response", "polynomial", "polyval", "quadratic_root"]
+           "open_loop_gain", "nodal_system", "nodal_response", "polynomial", "polyval", "quadratic_root"]
 
 #: the section responses a target may ask for
 KINDS = ("lowpass", "highpass", "bandpass")
@@ -200,15 +200,18 @@ def open_loop_gain(opamp, s) -> np.ndarray:
     return opamp.a0 / (1 + s * opamp.a0 / (2 * math.pi * opamp.gbw_hz))
 
 
-def nodal_response(netlist: Netlist, values: dict, s, opamp, inp: str = "vin", out: str = "vout") -> np.ndarray:
-    """V(out)/V(inp) of a circuit by nodal analysis, each op-amp a finite-gain
-    voltage source V_out = A(s) (V+ - V-); vectorised.
+def nodal_system(netlist: Netlist, values: dict, s, opamp, inp: str = "vin") -> tuple:
+    """The nodal equations Y(s) V = b of a circuit driven at ``inp`` (1 V), each op-amp a
+    finite-gain voltage source; vectorised (:func:`nodal_response` solves them).
 
     Unknowns: every net but ground and the input. Rows: Kirchhoff's current law
     at each net that no op-amp drives, sum Y (V_net - V_other) = 0 (Y = 1/R,
     s C; a part to the input puts Y * 1 V on the right-hand side), and
     V_out / A - (V+ - V-) = 0 for each op-amp's output (divided by A so that
-    the system stays well conditioned however large A is).
+    the system stays well conditioned however large A is). With the single-pole
+    A(s), 1/A(s) = (1 + s A0 / (2 pi GBW)) / A0: every entry is a polynomial of
+    degree <= 1 in s, so det Y(s) is a polynomial (Cramer's rule then gives the
+    transfer function as a ratio of polynomials).
 
     Parameters
     ----------
@@ -220,13 +223,13 @@ def nodal_response(netlist: Netlist, values: dict, s, opamp, inp: str = "vin", o
         Laplace variable, rad/s; broadcast against the value arrays.
     opamp : designer.core.opamps.OpAmp
         Its A0 and GBW give A(s) of every op-amp.
-    inp, out : str
-        The input net (driven at 1 V) and the output net.
+    inp : str
+        The input net (driven at 1 V).
 
     Returns
     -------
-    ndarray
-        The transfer function, shape ``broadcast(values..., s)``.
+    tuple
+        (Y of shape ``batch + (n, n)``, b of shape ``batch + (n,)``, {net: row index}).
     """
     s = np.asarray(s, dtype=complex)
     vals = {p.ref: np.asarray(values[p.ref], dtype=float) for p in netlist.parts}
@@ -263,6 +266,32 @@ def nodal_response(netlist: Netlist, values: dict, s, opamp, inp: str = "vin", o
                 y_mat[..., i, idx[net]] += sign
             elif net == inp:
                 rhs[..., i] -= sign
+    return y_mat, rhs, idx
+
+
+def nodal_response(netlist: Netlist, values: dict, s, opamp, inp: str = "vin", out: str = "vout") -> np.ndarray:
+    """V(out)/V(inp) of a circuit by nodal analysis (:func:`nodal_system`), each op-amp a
+    finite-gain voltage source V_out = A(s) (V+ - V-); vectorised.
+
+    Parameters
+    ----------
+    netlist : Netlist
+        The circuit (designators are the keys of ``values``).
+    values : dict
+        Designator -> value (ohm, farad), numbers or arrays.
+    s : complex or ndarray
+        Laplace variable, rad/s; broadcast against the value arrays.
+    opamp : designer.core.opamps.OpAmp
+        Its A0 and GBW give A(s) of every op-amp.
+    inp, out : str
+        The input net (driven at 1 V) and the output net.
+
+    Returns
+    -------
+    ndarray
+        The transfer function, shape ``broadcast(values..., s)``.
+    """
+    y_mat, rhs, idx = nodal_system(netlist, values, s, opamp, inp)
     return np.linalg.solve(y_mat, rhs[..., None])[..., idx[out], 0]
 
 

@@ -23,9 +23,14 @@ from ..core.opamps import OpAmp
 from ..spice.deck import SquareTest
 from ..spice.simulate import tool_info
 from .bench import BenchPeriod, ScopeSetup, SineCheck, ToleranceBand
+from .circuit import DEFAULT_TOPOLOGY
 from .sallenkey import SallenKeyParts
 
 __all__ = ["PlantResult"]
+
+#: the plant JSON's schema: the project's (:data:`designer.core.jsonio.SCHEMA_VERSION`) plus one for the
+#: ``topology`` key (the section that realises the plant; every other key as before)
+PLANT_SCHEMA_VERSION = SCHEMA_VERSION + 1
 
 #: the step metrics a result gives, in the order of its JSON
 METRICS = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s", "settling_time_5pct_s",
@@ -261,9 +266,10 @@ class PlantResult:
                  "fn_opamp_hz": opa.fn_hz, "zeta_opamp": opa.zeta, "fn_opamp_error_pct": opa.fn_error_pct,
                  "zeta_opamp_error_pct": opa.zeta_error_pct, "tolerance_band": self.tolerance.to_dict()}
         return json_safe({
-            "schema_version": SCHEMA_VERSION,
+            "schema_version": PLANT_SCHEMA_VERSION,
             "tool": tool_info(self.spice.simulator if self.spice is not None else None),
             "mode": self.mode,
+            "topology": DEFAULT_TOPOLOGY,
             "spec": target.to_dict(),
             "ratios": self.ratios.to_dict(),
             "ideal": None if self.ideal is None else parts_dict(self.ideal),

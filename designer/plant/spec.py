@@ -27,6 +27,8 @@ from ..core.errors import DesignError, ParamError
 from ..core.eseries import PartBounds, series_name
 from ..core.opamps import OpAmp
 from ..core.ranges import RANGES, parse_in_range
+from ..filters import registry
+from .circuit import DEFAULT_TOPOLOGY, plant_target
 from .sallenkey import SallenKeyParts, check_parts
 
 __all__ = ["AnalysisSpec", "PlantSpec"]
@@ -78,7 +80,10 @@ class PlantSpec(PartBounds):
     its finite gain-bandwidth lands it on the target); ``amplitude_v`` and
     ``square_hz`` set the bench's square wave (default frequency: see
     :func:`designer.plant.bench.recommend_square_wave`); ``alternatives`` is how
-    many best combinations the result lists.
+    many best combinations the result lists. ``topology`` names the registered
+    section that realises the plant (:mod:`designer.filters.registry`; default
+    the seed's Sallen-Key low-pass, the only one the seed's procedure ``r``, ``c``
+    fits); a first-order section takes no ``zeta`` (None).
 
     Raises
     ------
@@ -97,11 +102,20 @@ class PlantSpec(PartBounds):
     square_hz: float | None = None
     alternatives: int = 5
     package: str | None = None    #: single, dual, quad for the sheet's wiring (None: the op-amp's first)
+    topology: str = DEFAULT_TOPOLOGY
 
     def __post_init__(self):
         put = _setter(self)
+        topo = registry.get(self.topology)
+        put("topology", topo.name)
         for name in ("fc_hz", "zeta", "gain"):
+            if name == "zeta" and topo.order == 1 and self.zeta is None:
+                continue
             put(name, parse_in_range(getattr(self, name), name, name))
+        plant_target(topo, self.fc_hz, self.zeta, self.gain)   # a damping for a first-order section refused
+        if topo.name != DEFAULT_TOPOLOGY and self.r is not None:
+            raise ParamError("{r} and {c}: the seed's procedure (fix R and C, solve m and n) is the "
+                             f"{DEFAULT_TOPOLOGY}'s; {topo.name} takes the E-series search")
         self.check_bounds()
         if (self.r is None) != (self.c is None):
             raise ParamError("{r} and {c} go together (the seed's procedure fixes both R and C)")

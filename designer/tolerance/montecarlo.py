@@ -199,7 +199,8 @@ def plant_worst_case(parts, series: dict, opamp, tol_items=()):
 
 def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler: str = "random",
                       dist: str = "uniform", tol_items=(), limit_items=(), tighten: bool = True, scale=None,
-                      target_ci: float | None = None, engine_name: str = "analytic", evaluate=None) -> MonteCarlo:
+                      target_ci: float | None = None, engine_name: str = "analytic", evaluate=None,
+                      circuit=None) -> MonteCarlo:
     """A Monte Carlo of the Sallen-Key ``parts`` (:class:`~designer.plant.sallenkey.SallenKeyParts`).
 
     Parameters
@@ -225,6 +226,10 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     engine_name, evaluate : str, callable
         The engine's name and, for another engine than the analytic one, its
         ``evaluate(values) -> {figure: array}`` (:mod:`designer.tolerance.spice_mc`).
+    circuit : tuple, optional
+        A plant on another topology than the Sallen-Key low-pass: (nominal {designator: value},
+        chunk function, its context) of its analytic engine (:func:`designer.plant.circuit.evaluate`
+        with (topology name, op-amp)); ``parts`` is then unused.
     scale : designer.tolerance.runner.Scale, optional
         Where the samples run (``--jobs``, ``--dask``, a progress bar); default in this process.
         The result is the same wherever they run.
@@ -239,21 +244,22 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     """
     check_draw(n, dist, sampler)
     limits = tuple(t if isinstance(t, Limit) else parse_limit(t, engine.FIGURES) for t in limit_items or ())
-    nominal = {**plant_parts(parts), **opamp_nominal(tol_items, opamp)}
+    analytic = (engine.evaluate, opamp) if circuit is None else circuit[1:]
+    nominal = {**(plant_parts(parts) if circuit is None else circuit[0]), **opamp_nominal(tol_items, opamp)}
     if "SR" in nominal and evaluate is None:
         raise DesignError(NO_SLEW)
     tol = resolve(tol_items, nominal, series)
     until, first = target_plan(target_ci, limits, sampler, n, lambda figs: inside_limits(figs, limits))
     # another engine's evaluate(values) travels to the workers as the context of _apply
-    chunk_fn, context = (engine.evaluate, opamp) if evaluate is None else (apply_engine, evaluate)
+    chunk_fn, context = analytic if evaluate is None else (apply_engine, evaluate)
     with runner.Runner(scale or runner.Scale()) as run:
         values, figs, ends = run.run(chunk_fn, context, runner.Draw(nominal, tol.of, n, seed, sampler, dist),
                                      first, until)
         mc = _analyse(seed, sampler, dist, tol, nominal, values, figs, limits,
-                      evaluate or (lambda v: figures_with_fixed(v, {}, opamp)), engine_name)
+                      evaluate or (lambda v: analytic[0](analytic[1], v)), engine_name)
         mc.record_target(target_ci, n, ends)
         if tighten and limits:
-            mc.tighten = _tighten(run, mc, opamp, n)
+            mc.tighten = _tighten(run, mc, analytic, n)
             if engine_name != "analytic":
                 mc.tighten["engine"] = "analytic"
     return mc
@@ -411,7 +417,7 @@ def _analyse(seed, sampler, dist, tol, nominal, values, figs, limits, figure_of,
 TIGHTEN_HERE = 20000
 
 
-def _tighten(run, mc: MonteCarlo, opamp, n_max: int) -> dict:
+def _tighten(run, mc: MonteCarlo, analytic, n_max: int) -> dict:
     """The part whose tolerance halved raises the yield most (the same samples' deviations, each
     part's halved in turn), and the yield it gives (on ``run``'s workers, or here for a few builds:
     the same figures either way)."""
@@ -420,7 +426,7 @@ def _tighten(run, mc: MonteCarlo, opamp, n_max: int) -> dict:
     best = None
     for ref, t in mc.tolerances.of.items():
         draw = runner.Draw(mc.nominal, dict(mc.tolerances.of, **{ref: t / 2}), n_max, mc.seed, mc.sampler, mc.dist)
-        _, figs, _ = run.run(engine.evaluate, opamp, draw, mc.n, progress=False)
+        _, figs, _ = run.run(*analytic, draw, mc.n, progress=False)
         y = float(np.mean(inside_limits(figs, mc.limits)))
         if best is None or y > best[1]:
             best = (ref, y)

@@ -8,6 +8,8 @@ import pytest
 
 from designer.core import opamps
 from designer.core.errors import DesignError
+from designer.filters import registry
+from designer.plant import circuit
 from designer.plant.sallenkey import SallenKeyParts
 from designer.tolerance.montecarlo import plant_monte_carlo
 from designer.tolerance.plant import plant_figures
@@ -118,3 +120,19 @@ def test_the_tightening_here_or_on_the_workers_gives_the_same_part_and_yield(mon
     there = plant_monte_carlo(PARTS, SERIES, amp, 2000, seed=5, limit_items=LIMITS, scale=scale)
     assert len(calls) == 1 + 1 + 4
     assert there.to_dict() == here.to_dict()
+
+
+def test_a_plant_on_another_topology_runs_the_same_monte_carlo_over_its_declared_parts():
+    """circuit=(nominal, designer.plant.circuit.evaluate, (name, op-amp)): the MFB low-pass's five parts
+    drawn, every figure recomputed from the drawn values, and the tightening over its own parts."""
+    mfb = registry.get("mfb-lowpass")
+    nominal = mfb.synthesize(mfb.example)
+    amp = opamps.get("LM741")
+    fn0 = float(mfb.figures(nominal).fn_hz)
+    mc = plant_monte_carlo(None, {"R": "E24", "C": "E12"}, amp, 200, seed=4, limit_items=[f"fn_hz={0.95 * fn0}:{1.05 * fn0}"],
+             circuit=(nominal, circuit.evaluate, (mfb.name, amp)))
+    assert set(mc.values) == set(mfb.designators)
+    again = circuit.circuit_figures(mfb, mc.values, amp)
+    for k in ("fn_hz", "zeta", "ideal_fn_hz", "gain"):
+        assert np.allclose(mc.figures[k], again[k], rtol=1e-12), k
+    assert mc.tighten["part"] in mfb.designators

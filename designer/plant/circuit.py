@@ -1,0 +1,546 @@
+"""A plant realised by any registered section (:mod:`designer.filters`): the
+target T(s) of the seed (001, IV.3-IV.9; fn, zeta and the passband gain) as a
+:class:`~designer.filters.topology.SectionTarget` (Q = 1 / (2 zeta)), its parts
+chosen jointly from E-series values by one search written against the
+:class:`~designer.filters.topology.Topology`, and its figures: ideal (the
+topology's own coefficients), op-amp-aware (the dominant pair of the topology's
+netlist with the single-pole op-amp), step, -3 dB and sensitivities, all
+vectorised over arrays of part values (the Monte Carlo's analytic engine).
+
+The search (:func:`search`) is exact over its candidate set:
+
+- capacitors: every combination of series values the topology's free choices
+  reach (a reference capacitor C from the series, and for a topology with a
+  capacitor ``ratio`` every other series value C' with C'/C realisable: the
+  topology's own limit, e.g. C2/C1 >= 4 Q^2 (1 + |A0|) of the MFB low-pass);
+- resistors: for each capacitor combination, the continuous synthesis's
+  resistors (:meth:`Topology.synthesize`) and their ``width`` nearest series
+  values on each side inside the bounds.
+
+Every combination of the set is evaluated at once (numpy) and ranked by the
+worse relative error ``max(|fn/fn0 - 1|, |zeta/zeta0 - 1|, |G/G0 - 1|)``, then
+the summed error (the Sallen-Key search's ranking: :mod:`designer.plant.selection`).
+:func:`brute_force` enumerates the same set one combination at a time (the
+tests' reference); with ``width`` as wide as the series the resistors' set is
+every series value, so the search is brute force over the whole grid.
+
+The op-amp-aware transfer function (:func:`opamp_tf`) is Cramer's rule on the
+topology's nodal equations (:func:`designer.filters.topology.nodal_system`),
+H = det Y_out(s) / det Y(s): every entry of Y is a polynomial of degree <= 1 in
+s, so both determinants are polynomials of degree <= n (n nets), recovered
+exactly from n + 1 values on a circle |s| = wn by the inverse DFT (polynomial
+interpolation at roots of unity).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.errors import DesignError
+from ..filters import registry
+from ..filters.topology import SectionTarget, Topology, nodal_system
+
+__all__ = ["DEFAULT_TOPOLOGY", "FIGURES", "Candidate", "plant_target", "capacitor_combinations", "candidate_set",
+           "search", "brute_force", "opamp_tf", "dominant_pairs", "circuit_figures", "evaluate", "sensitivities",
+           "corner_frequencies"]
+
+#: the topology of ``design-plant`` without ``--topology``: the seed's plant (its own search, :mod:`.selection`)
+DEFAULT_TOPOLOGY = "sallen-key-lowpass"
+#: the figures :func:`circuit_figures` gives (the Monte Carlo's, as the Sallen-Key engine's)
+FIGURES = ("fn_hz", "zeta", "q", "ideal_fn_hz", "ideal_zeta", "ideal_q", "overshoot_pct", "peak_time_s", "gain")
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One combination of part values and where it lands.
+
+    Parameters
+    ----------
+    values : dict
+        Designator -> value (ohm, farad).
+    fn_hz, zeta, gain : float
+        Its ideal figures (zeta None for a first-order section).
+    worst : float
+        The worse relative error against the target.
+    """
+
+    values: dict
+    fn_hz: float
+    zeta: float | None
+    gain: float
+    worst: float
+
+
+def plant_target(topology: Topology, fc_hz: float, zeta, gain: float = 1.0) -> SectionTarget:
+    """The section target of a plant: fn, Q = 1 / (2 zeta) (second order) and the gain magnitude.
+
+    Parameters
+    ----------
+    topology : Topology
+        The section (its kind and order).
+    fc_hz : float
+        Natural (corner, centre) frequency, Hz.
+    zeta : float or None
+        Damping ratio; None for a first-order section.
+    gain : float
+        Passband gain magnitude.
+
+    Returns
+    -------
+    SectionTarget
+        The target :meth:`Topology.synthesize` takes.
+
+    Raises
+    ------
+    DesignError
+        A damping for a first-order section, or none for a second-order one.
+    """
+    if topology.order == 1 and zeta is not None:
+        raise DesignError(f"zeta: {topology.name} is first-order and has no damping; leave the damping out or use a "
+                          "second-order topology", param="zeta")
+    if topology.order == 2 and zeta is None:
+        raise DesignError(f"zeta: {topology.name} is second-order: give its damping", param="zeta")
+    q = None if zeta is None else 1.0 / (2.0 * zeta)
+    return SectionTarget(topology.kind, fc_hz, q=q, gain=gain)
+
+
+def _capacitors(topology: Topology) -> tuple:
+    return tuple(p.ref for p in topology.parts if p.kind == "C")
+
+
+def capacitor_combinations(topology: Topology, target: SectionTarget, c_values) -> dict:
+    """The capacitor combinations the topology's choices reach, each with its continuous synthesis.
+
+    A synthesis scales with its reference capacitor (every capacitor times c, every resistor
+    over c, but the parts a free choice sets, :attr:`Topology.choice_parts`): the topology
+    synthesises once per capacitor ratio (at the smallest capacitor), scaled to every other.
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    target : SectionTarget
+        The target.
+    c_values : array_like
+        The capacitor series values inside the bounds, ascending.
+
+    Returns
+    -------
+    dict
+        Designator -> array (one entry per combination): the capacitors exact series
+        values, the resistors continuous.
+
+    Raises
+    ------
+    DesignError
+        The target is beyond the topology (its own limit, one line), or no capacitor
+        combination inside the bounds realises it (the ratio bound against the range).
+    """
+    c_values = np.asarray(c_values, dtype=float)
+    topology.check_realisable(target)
+    caps = _capacitors(topology)
+    c0 = float(c_values[0])
+    bound = topology.limits(target).get("ratio_min", 0.0)
+    if "ratio" in topology.choices:
+        i, j = np.meshgrid(np.arange(len(c_values)), np.arange(len(c_values)), indexing="ij")
+        m = c_values[j.ravel()] / c_values[i.ravel()]
+        keep = m >= bound * (1 - 1e-12)    # below the topology's ratio bound no resistors realise it
+        ref, m = c_values[i.ravel()][keep], m[keep]
+        keys, inverse = np.unique(np.round(np.log(m), 9), return_inverse=True)
+        choices = [{"ratio": float(m[np.argmax(inverse == k)])} for k in range(len(keys))]
+    else:
+        ref, inverse, choices = c_values, np.zeros(len(c_values), int), [{}]
+    bases = []
+    for ch in choices:
+        try:
+            v = topology.synthesize(SectionTarget(target.kind, target.fn_hz, target.q, target.gain, c_f=c0), **ch)
+            bases.append(v if all(math.isfinite(x) and x > 0 for x in v.values()) else None)
+        except DesignError:
+            bases.append(None)
+    ok = np.array([bases[k] is not None for k in inverse], bool)
+    ref, inverse = ref[ok], inverse[ok]
+    scale = ref / c0
+    columns = {}
+    for r in topology.designators:
+        base = np.array([np.nan if b is None else b[r] for b in bases])[inverse]
+        if r in caps:
+            # the capacitors are series values up to rounding: snap them
+            x = base * scale
+            idx = np.clip(np.searchsorted(c_values, x), 1, len(c_values) - 1)
+            nearer_low = np.abs(np.log(c_values[idx - 1] / x)) <= np.abs(np.log(c_values[idx] / x))
+            columns[r] = c_values[np.where(nearer_low, idx - 1, idx)] if len(c_values) > 1 else np.full(len(x),
+                                                                                                       c_values[0])
+        else:
+            columns[r] = base if r in topology.choice_parts else base / scale
+    if not len(columns[topology.designators[0]]):
+        why = f"its capacitor ratio must be at least {bound:.4g}" if bound else "no capacitor value fits"
+        raise DesignError(f"c_max: {topology.name} cannot realise fn {target.fn_hz:g} Hz"
+                          + (f", Q {target.q:.4g}" if target.q else "")
+                          + f" with capacitors from {c_values[0]:g} to {c_values[-1]:g} F: {why}; widen the "
+                          "capacitor bounds, lower Q, or use another topology", param="c_max")
+    return columns
+
+
+def _lower(series: np.ndarray, x) -> np.ndarray:
+    """The index of the last series value <= x (-1 below the series), rounding forgiven."""
+    return np.searchsorted(series, np.asarray(x) * (1 + 1e-12), side="right") - 1
+
+
+def candidate_set(topology: Topology, target: SectionTarget, r_values, c_values, width: int = 1) -> list:
+    """The search's candidate set: per capacitor combination, each part's candidate values
+    (a capacitor its one value; a resistor the ``width`` series values at or below its
+    continuous value and the ``width`` above, inside the series).
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    target : SectionTarget
+        The target.
+    r_values, c_values : array_like
+        The resistor and capacitor series values inside the bounds, ascending.
+    width : int
+        How many series values on each side of a continuous resistor (>= 1).
+
+    Returns
+    -------
+    list of dict
+        Per capacitor combination, designator -> 1-D array of candidate values.
+    """
+    rv = np.asarray(r_values, dtype=float)
+    caps = _capacitors(topology)
+    combos = capacitor_combinations(topology, target, c_values)
+    out = []
+    for b in range(len(combos[topology.designators[0]])):
+        block = {}
+        for ref in topology.designators:
+            x = combos[ref][b]
+            lo = int(_lower(rv, x))
+            block[ref] = np.array([x]) if ref in caps else rv[max(0, lo - width + 1):max(0, lo + width + 1)]
+        out.append(block)
+    return out
+
+
+def _errors(topology: Topology, target: SectionTarget, values: dict) -> tuple:
+    """(worse, summed) relative error and the figures of arrays of part values."""
+    with np.errstate(divide="ignore", invalid="ignore"):    # no damping at all: Q infinite, an error like any
+        f = topology.figures(values)
+    errs = [np.abs(np.asarray(f.fn_hz) / target.fn_hz - 1), np.abs(np.asarray(f.gain) / target.gain - 1)]
+    zeta = None
+    if f.q is not None:
+        zeta = 1.0 / (2.0 * np.asarray(f.q))
+        errs.append(np.abs(zeta * 2.0 * target.q - 1))
+    worst = np.maximum.reduce(errs)
+    return worst, sum(errs), f, zeta
+
+
+def _ranked(topology, target, values: dict, top: int) -> list:
+    worst, total, f, zeta = _errors(topology, target, values)
+    refs = topology.designators
+    # the worse error (rounded: ties), then the summed error, then the values: one order for every run
+    order = np.lexsort(tuple(values[r] for r in reversed(refs)) + (total, np.round(worst, 12)))
+    fn, gain = np.atleast_1d(f.fn_hz), np.atleast_1d(f.gain)
+    out = []
+    for i in order[:top]:
+        out.append(Candidate({r: float(values[r][i]) for r in refs}, float(fn[i]),
+                             None if zeta is None else float(np.atleast_1d(zeta)[i]), float(gain[i]),
+                             float(worst[i])))
+    return out
+
+
+def search(topology: Topology, target: SectionTarget, r_values, c_values, top: int = 5, width: int = 1) -> list:
+    """The ``top`` best combinations of the candidate set (:func:`candidate_set`), best first.
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    target : SectionTarget
+        The target.
+    r_values, c_values : array_like
+        The resistor and capacitor series values inside the bounds, ascending.
+    top : int
+        How many to return.
+    width : int
+        The resistors' neighbours on each side.
+
+    Returns
+    -------
+    list of Candidate
+        Best first (worse error, then summed error, then values).
+    """
+    rv = np.asarray(r_values, dtype=float)
+    combos = capacitor_combinations(topology, target, c_values)
+    n_b = len(combos[topology.designators[0]])
+    res = [p.ref for p in topology.parts if p.kind == "R"]
+    offsets = np.arange(-width + 1, width + 1)
+    # every resistor's 2 width candidates, as an axis each: (combination, o_1, ..., o_k)
+    shape = (n_b,) + (len(offsets),) * len(res)
+    valid = np.ones(shape, bool)
+    values = {}
+    for axis, ref in enumerate(res):
+        idx = _lower(rv, combos[ref])[:, None] + offsets[None, :]
+        ok = (idx >= 0) & (idx < len(rv))
+        view = [n_b] + [1] * len(res)
+        view[axis + 1] = len(offsets)
+        values[ref] = np.broadcast_to(rv[np.clip(idx, 0, len(rv) - 1)].reshape(view), shape)
+        valid &= ok.reshape(view)
+    for ref in topology.designators:
+        if ref not in values:
+            values[ref] = np.broadcast_to(combos[ref].reshape((n_b,) + (1,) * len(res)), shape)
+    values = {r: v[valid] for r, v in values.items()}
+    return _ranked(topology, target, values, top)
+
+
+def brute_force(topology: Topology, target: SectionTarget, blocks: list, top: int = 5) -> list:
+    """Every combination of ``blocks`` (:func:`candidate_set`'s form) evaluated one at a
+    time with scalar values: the reference the tests hold :func:`search` to.
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    target : SectionTarget
+        The target.
+    blocks : list of dict
+        Designator -> candidate values, per block; the set is the union of each block's product.
+    top : int
+        How many to return.
+
+    Returns
+    -------
+    list of Candidate
+        Best first, ranked as :func:`search` ranks.
+    """
+    rows = []
+    for block in blocks:
+        for combo in itertools.product(*(block[r] for r in topology.designators)):
+            v = dict(zip(topology.designators, (float(x) for x in combo)))
+            worst, total, _, _ = _errors(topology, target, v)
+            rows.append((round(float(worst), 12), float(total), tuple(v[r] for r in topology.designators), v))
+    rows.sort(key=lambda row: row[:3])
+    values = {r: np.array([row[3][r] for row in rows[:top]]) for r in topology.designators}
+    return _ranked(topology, target, values, top)
+
+
+def opamp_tf(topology: Topology, values: dict, opamp) -> tuple:
+    """The op-amp-aware transfer function of the section as polynomials (vectorised).
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    values : dict
+        Designator -> value, numbers or arrays (one batch shape).
+    opamp : designer.core.opamps.OpAmp
+        Its A0 and GBW (the single-pole model).
+
+    Returns
+    -------
+    tuple of ndarray
+        (num, den), each of shape ``batch + (n + 1,)``, highest power first, den's
+        constant term 1; numerically zero leading terms (below 1e-10 of the
+        polynomial's size at |s| = wn, judged on the whole batch) dropped.
+    """
+    vals = topology.values_of(values)
+    shape = np.broadcast_shapes(*(v.shape for v in vals.values()))
+    vals = {r: np.broadcast_to(v, shape)[..., None] for r, v in vals.items()}
+    net = topology.netlist({r: 1.0 for r in topology.designators})
+    n_nets = len({n for p in net.parts for n in (p.a, p.b)} | {n for a in net.amps for n in (a.inp, a.inn, a.out)})
+    size = n_nets + 1
+    rho = 2 * math.pi * np.asarray(topology.figures({r: v[..., 0] for r, v in vals.items()}).fn_hz, float)[..., None]
+    s = rho * np.exp(2j * math.pi * np.arange(size) / size)
+    y_mat, rhs, idx = nodal_system(net, vals, s, opamp)
+    out = idx["vout"]
+    y_out = y_mat.copy()
+    y_out[..., :, out] = rhs
+    scale = rho ** np.arange(size)
+    polys = []
+    for d in (np.linalg.det(y_out), np.linalg.det(y_mat)):
+        c = np.real(np.fft.fft(d, axis=-1)) / size / scale      # ascending powers of s
+        polys.append(c[..., ::-1])
+    num, den = polys
+    # the degree: terms that are rounding at |s| = wn across the whole batch go
+    size_at = np.abs(den * (rho ** np.arange(size)[::-1]))
+    keep = np.max(size_at / np.max(size_at, axis=-1, keepdims=True), axis=tuple(range(size_at.ndim - 1))) > 1e-10
+    first = int(np.argmax(keep))
+    num, den = num[..., first:], den[..., first:]
+    num_size = np.abs(num * (rho ** np.arange(num.shape[-1])[::-1]))
+    num = np.where(num_size < 1e-10 * np.max(size_at, axis=-1, keepdims=True), 0.0, num)
+    d0 = den[..., -1:]
+    return num / d0, den / d0
+
+
+def dominant_pairs(den: np.ndarray, first_order: bool = False) -> tuple:
+    """fn (Hz) and zeta of the slowest pole pair of each polynomial (vectorised
+    :func:`designer.core.lti.dominant_pair`: the slowest complex pair, else the two
+    slowest real poles; one real pole: its corner and zeta NaN).
+
+    Parameters
+    ----------
+    den : ndarray
+        Shape ``batch + (m + 1,)``, highest power first.
+    first_order : bool
+        A first-order section's: the slowest real pole alone (zeta NaN).
+
+    Returns
+    -------
+    tuple of ndarray
+        (fn_hz, zeta), shape ``batch``.
+    """
+    den = np.asarray(den, float)
+    m = den.shape[-1] - 1
+    if m == 1:
+        return np.abs(den[..., 1] / den[..., 0]) / (2 * math.pi), np.full(den.shape[:-1], np.nan)
+    comp = np.zeros(den.shape[:-1] + (m, m))
+    comp[..., 0, :] = -den[..., 1:] / den[..., :1]
+    comp[..., np.arange(1, m), np.arange(m - 1)] = 1.0
+    poles = np.linalg.eigvals(comp)
+    mag = np.abs(poles)
+    cplx = np.abs(poles.imag) > 1e-9 * mag
+    slow_c = np.argmin(np.where(cplx, mag, np.inf), axis=-1)
+    pc = np.take_along_axis(poles, slow_c[..., None], -1)[..., 0]
+    real = np.sort(np.where(cplx, np.inf, np.abs(poles.real)), axis=-1)
+    if first_order:
+        return real[..., 0] / (2 * math.pi), np.full(den.shape[:-1], np.nan)
+    with np.errstate(invalid="ignore", over="ignore"):
+        w_r = np.sqrt(real[..., 0] * real[..., 1])
+        z_r = (real[..., 0] + real[..., 1]) / (2 * w_r)
+    has = np.any(cplx, axis=-1)
+    w = np.where(has, np.abs(pc), w_r)
+    z = np.where(has, -pc.real / np.where(has, np.abs(pc), 1.0), z_r)
+    return w / (2 * math.pi), z
+
+
+def circuit_figures(topology: Topology, values: dict, opamp=None) -> dict:
+    """Every figure of :data:`FIGURES` for arrays of part values (the Monte Carlo's analytic engine).
+
+    ``fn_hz``, ``zeta``, ``q``: the dominant pair of the op-amp-aware model (of the ideal
+    one without an op-amp); ``ideal_*``: the topology's coefficients; ``overshoot_pct``
+    and ``peak_time_s``: the dominant pair's, 100 exp(-pi zeta / sqrt(1 - zeta^2)) and
+    pi / (wn sqrt(1 - zeta^2)) (0 and NaN at zeta >= 1); ``gain``: the passband gain magnitude.
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    values : dict
+        Designator -> value, numbers or arrays.
+    opamp : designer.core.opamps.OpAmp, optional
+        The op-amp (None or the ideal one: the ideal figures).
+
+    Returns
+    -------
+    dict
+        Figure -> array (numbers for numbers).
+    """
+    f = topology.figures(values)
+    fn_i = np.asarray(f.fn_hz, float)
+    z_i = np.full(fn_i.shape, np.nan) if f.q is None else 1.0 / (2.0 * np.asarray(f.q, float))
+    if opamp is None or opamp.ideal:
+        fn, z = fn_i, z_i
+    else:
+        fn, z = dominant_pairs(opamp_tf(topology, values, opamp)[1], topology.order == 1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        under = np.where(z < 1, np.sqrt(np.clip(1 - z * z, 0.0, None)), np.nan)
+        over = np.where(z < 1, 100 * np.exp(-math.pi * z / under), 0.0)
+        tpk = np.where(z < 1, 1.0 / (2 * fn * under), np.nan)
+        return {"fn_hz": fn, "zeta": z, "q": 1 / (2 * z), "ideal_fn_hz": fn_i, "ideal_zeta": z_i,
+                "ideal_q": 1 / (2 * z_i), "overshoot_pct": over, "peak_time_s": tpk,
+                "gain": np.asarray(f.gain, float)}
+
+
+def evaluate(context: tuple, values: dict) -> dict:
+    """The Monte Carlo's chunk function (:mod:`designer.tolerance.runner`): :func:`circuit_figures`.
+
+    Parameters
+    ----------
+    context : tuple
+        (topology name, op-amp).
+    values : dict
+        Designator -> array of sampled values.
+
+    Returns
+    -------
+    dict
+        Figure -> array.
+    """
+    name, opamp = context
+    topo = registry.get(name)
+    return circuit_figures(topo, {r: values[r] for r in topo.designators}, opamp)
+
+
+def sensitivities(topology: Topology, values: dict, opamp=None, rel_step: float = 1e-6) -> dict:
+    """Relative sensitivities S = d ln y / d ln x of wn and zeta to every declared part
+    (central differences in log space, all parts at once).
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    values : dict
+        Designator -> value.
+    opamp : designer.core.opamps.OpAmp, optional
+        The op-amp-aware model's (None: the ideal one).
+    rel_step : float
+        The relative step.
+
+    Returns
+    -------
+    dict
+        Designator -> {"wn": S, "zeta": S} (zeta None for a first-order section).
+    """
+    refs = topology.designators
+    batch = {r: np.array([values[r] * (1 + rel_step * sgn * (r == p)) for p in refs for sgn in (1, -1)])
+             for r in refs}
+    f = circuit_figures(topology, batch, opamp)
+    out = {}
+    for i, ref in enumerate(refs):
+        up, down = 2 * i, 2 * i + 1
+        d = math.log1p(rel_step) - math.log1p(-rel_step)
+        s_wn = float(np.log(f["fn_hz"][up] / f["fn_hz"][down]) / d)
+        s_z = None if topology.order == 1 else float(np.log(f["zeta"][up] / f["zeta"][down]) / d)
+        out[ref] = {"wn": s_wn, "zeta": s_z}
+    return out
+
+
+def corner_frequencies(topology: Topology, values: dict, opamp=None) -> list:
+    """The -3 dB frequencies of the response (Hz): where |H| crosses the passband
+    gain / sqrt 2 between fn / 1000 and 1000 fn (one for a low- or high-pass, two
+    for a band-pass), found on a dense grid and refined by bisection in log f.
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    values : dict
+        Designator -> value.
+    opamp : designer.core.opamps.OpAmp, optional
+        None: the ideal response; else the op-amp-aware one.
+
+    Returns
+    -------
+    list of float
+        Ascending.
+    """
+    fn = float(topology.figures(values).fn_hz)
+    level = float(topology.figures(values).gain) / math.sqrt(2)
+    mag = lambda f: np.abs(topology.response(values, 2j * np.pi * np.asarray(f), opamp))  # noqa: E731
+    f = np.logspace(math.log10(fn) - 3, math.log10(fn) + 3, 1201)
+    above = mag(f) >= level
+    out = []
+    for i in np.flatnonzero(above[1:] != above[:-1]):
+        lo, hi = math.log(f[i]), math.log(f[i + 1])
+        a_lo = bool(above[i])
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            if (mag(math.exp(mid)) >= level) == a_lo:
+                lo = mid
+            else:
+                hi = mid
+        out.append(math.exp(0.5 * (lo + hi)))
+    return out

@@ -1,0 +1,400 @@
+"""``design-plant --topology NAME``: the plant's target realised by any registered
+section (:mod:`designer.filters`), through the one :class:`~designer.filters.topology.Topology`
+interface: the E-series search (:func:`designer.plant.circuit.search`), the figures
+(fn, zeta, Q, gain, -3 dB, the op-amp-aware dominant pair, the step), the
+sensitivities over the declared parts, the deck, BOM and wiring from the topology's
+netlist (:func:`designer.spice.deck.board`), and the ngspice ``.ac`` of that deck
+against the op-amp-aware model (the conformance's rule: 0.05 dB and 0.5 degrees over
+fn / 30 .. 30 fn). The seed's Sallen-Key low-pass keeps its own pipeline
+(:mod:`designer.plant.design`), byte for byte.
+
+The op-amp's reach: a section needs GBW >= :data:`GBW_MARGIN` x fn x Q x noise gain
+(the noise gain 1 + |G| of an inverting section, G of a non-inverting one): the rule of
+``design-filter`` (:mod:`designer.filters.design`, whose default margin is 100 for a
+filter's passband accuracy) with a tenth of its margin, since a plant's figures are
+reported with the op-amp's effect (the op-amp-aware model) rather than hidden by it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core import opamps
+from ..core.checks import SPICE_AGREEMENT, Check
+from ..core.errors import DesignError
+from ..core.jsonio import json_safe
+from ..core.lti import dense_time, response_span, step_response
+from ..core.metrics import step_metrics
+from ..core.eseries import series_name
+from ..core.ranges import parse_in_range
+from ..core.units import format_eng
+from ..filters import registry
+from ..filters.deck import ac_deck, simulate_ac
+from ..filters.design import predistort
+from ..filters.topology import SectionTarget
+from ..spice.simulate import tool_info
+from . import circuit
+from .design import MAX_ERROR, candidates, part_series
+from .result import METRICS, PLANT_SCHEMA_VERSION, Sourcing, Target
+
+__all__ = ["GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "CircuitPlantResult", "design_circuit_plant", "check_opamp_reach",
+           "analyze_circuit_plant", "tolerance_nominal"]
+
+#: the op-amp's gain-bandwidth a section needs, in units of fn x Q x noise gain
+GBW_MARGIN = 10.0
+#: SPICE's .ac against the op-amp-aware model: the largest gain (dB) and phase (degrees) difference allowed
+SPICE_DB, SPICE_DEG = 0.05, 0.5
+
+
+@dataclass(eq=False)
+class CircuitPlantResult:
+    """A plant designed on a registered topology; :meth:`to_dict` is its JSON.
+
+    Parameters
+    ----------
+    topology : str
+        The registry's name.
+    mode : str
+        ``design`` (searched) or ``analyze`` (parts as built).
+    target : Target
+        fn, zeta (None: first order) and gain asked for.
+    values : dict
+        The build: designator -> E-series value.
+    ideal : dict or None
+        The continuous synthesis at the build's reference capacitor (None: parts as built).
+    alternatives : list of designer.plant.circuit.Candidate
+        The best combinations, best first (the build first).
+    sourcing : Sourcing
+        Each part's series and tolerance.
+    opamp : designer.core.opamps.OpAmp
+        The op-amp.
+    figures : dict
+        ``ideal`` and ``opamp``: fn_hz, zeta, q, gain, f3db_hz, their errors.
+    steps : dict
+        ``ideal`` and ``opamp`` unit-step metrics (None for a high- or band-pass: the step settles to 0).
+    sensitivity : dict
+        ``ideal`` and ``opamp``: designator -> {"wn", "zeta"}.
+    netlist : designer.spice.deck.Netlist
+        The section as built.
+    deck : str
+        The standalone ngspice ``.ac`` deck.
+    checks : list of Check
+        The verdicts (the SPICE agreement when simulated).
+    notes : list of str
+        What the user should know.
+    spice : dict or None
+        ``max_db``, ``max_deg`` of SPICE against the op-amp-aware model, the simulator.
+    package : str or None
+        The op-amp package of the wiring.
+    """
+
+    topology: str
+    mode: str
+    target: Target
+    values: dict
+    ideal: dict
+    alternatives: list
+    sourcing: Sourcing
+    opamp: object
+    figures: dict
+    steps: dict
+    sensitivity: dict
+    netlist: object
+    deck: str
+    checks: list
+    notes: list
+    spice: dict | None = None
+    package: str | None = None
+    monte_carlo: object = None
+    worst_case: object = None
+    files: dict = field(default_factory=dict)
+    timings: dict = field(default_factory=dict)
+
+    @property
+    def section(self):
+        """The registered :class:`~designer.filters.topology.Topology`."""
+        return registry.get(self.topology)
+
+    def verdicts(self) -> list:
+        """Every pass/fail verdict (``--fail-on-check``).
+
+        Returns
+        -------
+        list of Check
+            The checks.
+        """
+        return list(self.checks)
+
+    def to_dict(self) -> dict:
+        """The JSON form (``result.json``, ``--json``).
+
+        Returns
+        -------
+        dict
+            JSON-safe.
+        """
+        topo = self.section
+        parts = {p.ref: {"kind": p.kind, "role": p.role, "value": self.values[p.ref],
+                         **self.sourcing.parts[p.ref].to_dict()} for p in topo.parts}
+        return json_safe({
+            "schema_version": PLANT_SCHEMA_VERSION,
+            "tool": tool_info(None if self.spice is None else self.spice["simulator"]),
+            "mode": self.mode,
+            "topology": self.topology,
+            "topology_title": topo.title,
+            "spec": self.target.to_dict(),
+            "parts": parts,
+            "ideal": self.ideal,
+            "built": self.figures,
+            "series": self.sourcing.to_dict(),
+            "alternatives": [{**c.values, "fn_hz": c.fn_hz, "zeta": c.zeta, "gain": c.gain,
+                              "worst_error_pct": 100 * c.worst} for c in self.alternatives],
+            "opamp": self.opamp.to_dict(), "package": self.opamp.package(self.package).to_dict(),
+            "analytic": self.steps["ideal"],
+            "analytic_opamp": self.steps["opamp"],
+            "sensitivity": self.sensitivity,
+            "checks": [c.to_dict() for c in self.checks],
+            "notes": self.notes,
+            "spice": self.spice,
+            "monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
+            "worst_case": None if self.worst_case is None else self.worst_case.to_dict(),
+            "files": self.files,
+        })
+
+
+def check_opamp_reach(topology, target: SectionTarget, amp) -> None:
+    """Refuse a section beyond the op-amp's gain-bandwidth (the module docstring's rule).
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    target : SectionTarget
+        Its target.
+    amp : designer.core.opamps.OpAmp
+        The op-amp (the ideal one is never refused).
+
+    Raises
+    ------
+    DesignError
+        One line: the GBW needed, the op-amp's, and a catalogue op-amp fast enough.
+    """
+    if amp.ideal:
+        return
+    noise_gain = 1.0 + target.gain if topology.inverting else target.gain
+    need = GBW_MARGIN * target.fn_hz * (target.q or 1.0) * noise_gain
+    if need <= amp.gbw_hz:
+        return
+    ok = opamps.fast_enough(need)
+    instead = f"use --opamp {ok.name} ({format_eng(ok.gbw_hz, 'Hz')})" if ok else \
+        "no catalogue op-amp is fast enough: lower fc, Q or the gain"
+    q = f" x Q {target.q:.3g}" if target.q else ""
+    raise DesignError(f"opamp: {amp.name} (GBW {format_eng(amp.gbw_hz, 'Hz')}) is too slow for {topology.name} at fn "
+                      f"{format_eng(target.fn_hz, 'Hz')}: it needs GBW >= {GBW_MARGIN:g} x fn{q} x noise gain "
+                      f"{noise_gain:.3g} = {format_eng(need, 'Hz')}; {instead}", param="opamp")
+
+
+def _figures(topo, values: dict, amp, target: Target) -> dict:
+    """The ideal and op-amp-aware figures of the build, with their errors against the target."""
+    arrays = circuit.circuit_figures(topo, values, amp)
+    ideal = {"fn_hz": float(arrays["ideal_fn_hz"]), "zeta": float(arrays["ideal_zeta"]),
+             "q": float(arrays["ideal_q"]), "gain": float(arrays["gain"]),
+             "f3db_hz": circuit.corner_frequencies(topo, values)}
+    opa = {"fn_hz": float(arrays["fn_hz"]), "zeta": float(arrays["zeta"]), "q": float(arrays["q"]),
+           "f3db_hz": circuit.corner_frequencies(topo, values, amp)}
+    for f in (ideal, opa):
+        f["fn_error_pct"] = None if target.fc_hz is None else 100 * (f["fn_hz"] / target.fc_hz - 1)
+        f["zeta_error_pct"] = None if target.zeta is None else 100 * (f["zeta"] / target.zeta - 1)
+        if topo.order == 1:
+            f["zeta"] = f["q"] = None
+    ideal["gain_error_pct"] = None if target.gain is None else 100 * (ideal["gain"] / target.gain - 1)
+    return {"ideal": ideal, "opamp": opa}
+
+
+def _steps(topo, values: dict, amp, figures: dict) -> dict:
+    """Unit-step metrics of both models (a low-pass's; None for a step that settles to 0)."""
+    if topo.kind != "lowpass":
+        return {"ideal": None, "opamp": None}
+    num_i, den_i = (np.asarray(c, float) for c in topo.coefficients(values))
+    num_o, den_o = circuit.opamp_tf(topo, values, amp)
+    fig = figures["opamp"]
+    span = response_span(min(figures["ideal"]["fn_hz"], fig["fn_hz"]), fig["zeta"] or 1.0)
+    t = dense_time(span)
+    out = {}
+    for key, (num, den) in (("ideal", (num_i, den_i)), ("opamp", (num_o, den_o))):
+        num = np.trim_zeros(num, "f") if np.any(num) else num
+        y = step_response(num, den, t)
+        m = step_metrics(t, y, final=float(num[-1] / den[-1])).to_dict()
+        out[key] = {k: m[k] for k in METRICS}
+    return out
+
+
+def _spice(netlist, amp, fn_hz: float, topo, values: dict, simulator: str) -> tuple:
+    """ngspice's .ac of the build against the op-amp-aware model: (summary, Check)."""
+    f, h = simulate_ac(netlist, amp, fn_hz / 30, fn_hz * 30, simulator=simulator)
+    model = topo.response(values, 2j * np.pi * f, amp)
+    ratio = h / model
+    db = float(np.max(np.abs(20 * np.log10(np.abs(ratio)))))
+    deg = float(np.max(np.abs(np.degrees(np.angle(ratio)))))
+    ok = db <= SPICE_DB and deg <= SPICE_DEG
+    detail = (f"SPICE .ac against the op-amp-aware model, fn/30 .. 30 fn: {db:.3g} dB, {deg:.3g} deg "
+              f"(allowed {SPICE_DB:g} dB, {SPICE_DEG:g} deg)")
+    return {"simulator": simulator, "max_db": db, "max_deg": deg, "pass": ok}, Check(SPICE_AGREEMENT, ok, detail)
+
+
+def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-cli") -> CircuitPlantResult:
+    """Design, analyse and (unless ``simulate`` is False) verify a plant on ``spec.topology``.
+
+    Parameters
+    ----------
+    spec : designer.plant.spec.PlantSpec
+        The request (its ``topology`` any registered one; the seed's ``r``, ``c`` refused by the spec).
+    simulate : bool
+        Run ngspice's .ac of the deck.
+    simulator : str
+        :func:`designer.spice.simulate.get_simulator`'s name.
+
+    Returns
+    -------
+    CircuitPlantResult
+        The typed result.
+
+    Raises
+    ------
+    DesignError
+        A target the topology cannot realise, the op-amp too slow, no parts close enough (one line each).
+    """
+    tick = time.perf_counter()
+    topo = registry.get(spec.topology)
+    amp = spec.amp
+    target = Target(spec.fc_hz, spec.zeta, spec.gain)
+    section = circuit.plant_target(topo, spec.fc_hz, spec.zeta, spec.gain)
+    check_opamp_reach(topo, section, amp)
+    aim = predistort(topo, section, amp) if spec.compensate_gbw else section
+    rv = candidates(spec.r_series, spec.r_min, spec.r_max, "resistor")
+    cv = candidates(spec.c_series, spec.c_min, spec.c_max, "capacitor")
+    ranked = circuit.search(topo, aim, rv, cv, top=spec.alternatives)
+    best = ranked[0]
+    if aim is section and best.worst > MAX_ERROR:
+        raise DesignError(f"fc_hz: the best {spec.r_series}/{spec.c_series} parts for {topo.name} land "
+                          f"{100 * best.worst:.3g} % off the target (more than {100 * MAX_ERROR:g} %); widen the "
+                          "part bounds or use a finer series", param="fc_hz")
+    t_search = time.perf_counter() - tick
+    values = best.values
+    ideal = topo.synthesize(dataclasses.replace(aim, c_f=values[topo.reference_capacitor]))
+    labels, _, _, _ = part_series(values, spec.r_series, spec.c_series)
+    notes = [f"{topo.title}: parts {', '.join(f'{p.ref} ({p.role})' for p in topo.parts)}"]
+    if spec.compensate_gbw:
+        notes.append(f"--compensate-gbw: designed for fn {aim.fn_hz:.5g} Hz"
+                     + (f", Q {aim.q:.4g}" if aim.q else "")
+                     + f" so that with the {amp.name}'s {format_eng(amp.gbw_hz, 'Hz')} GBW it lands on the spec")
+    if math.isfinite(best.worst) and best.worst > 0.005:
+        notes.append(f"the best parts land {100 * best.worst:.3g} % off the target; a finer series or wider "
+                     "bounds may come closer")
+    result = _analyse(topo, "design", target, values, ideal, ranked, Sourcing(spec.r_series, spec.c_series, labels),
+                      amp, notes, spec.package, simulate, simulator)
+    result.timings = {"search_s": t_search, **result.timings}
+    return result
+
+
+def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", target_fc_hz=None, target_zeta=None,
+                          r_series=None, c_series=None, package=None, simulate: bool = True,
+                          simulator: str = "ngspice-cli") -> CircuitPlantResult:
+    """Analyse a section's parts as built (``analyze-plant --topology NAME --part R1=1k6 ..``).
+
+    Parameters
+    ----------
+    topology : str
+        A registered section's name.
+    values : dict
+        Designator -> value (a number or engineering notation), every declared part.
+    opamp : str
+        The op-amp's catalogue name.
+    target_fc_hz, target_zeta : float or str, optional
+        What the errors are reported against.
+    r_series, c_series : str, optional
+        Where the parts come from, for their tolerance (None: the smallest series holding each value).
+    package : str, optional
+        The op-amp package of the wiring.
+    simulate : bool
+        Run ngspice's .ac of the deck.
+    simulator : str
+        :func:`designer.spice.simulate.get_simulator`'s name.
+
+    Returns
+    -------
+    CircuitPlantResult
+        The typed result (``mode`` "analyze").
+
+    Raises
+    ------
+    DesignError
+        A part missing, not the section's, or out of range; a bad target or series (one line each).
+    """
+    topo = registry.get(topology)
+    unknown = [r for r in values if r not in topo.designators]
+    missing = [r for r in topo.designators if r not in values]
+    if unknown or missing:
+        what = f"has no part {unknown[0]}" if unknown else f"needs {', '.join(missing)} too"
+        raise DesignError(f"part: {topo.name} {what}; its parts are {', '.join(topo.designators)}", param="part")
+    parsed = {r: parse_in_range(values[r], f"part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
+              for r in topo.designators}
+    fc = None if target_fc_hz is None else parse_in_range(target_fc_hz, "target_fc_hz", "fc_hz")
+    zeta = None if target_zeta is None else parse_in_range(target_zeta, "target_zeta", "zeta")
+    if zeta is not None and topo.order == 1:
+        raise DesignError(f"target_zeta: {topo.name} is first-order and has no damping", param="target_zeta")
+    amp = opamps.get(opamp)
+    amp.package(package)
+    series = [None if s is None else series_name(s) for s in (r_series, c_series)]
+    labels, r_s, c_s, why = part_series(parsed, *series)
+    gain = float(topo.figures(parsed).gain)
+    fig = topo.figures(parsed)
+    notes = [f"these parts give fn = {fig.fn_hz:.5g} Hz" + ("" if fig.q is None else f", Q = {fig.q:.4g}")
+             + f", gain {gain:.4g}", *why]
+    return _analyse(topo, "analyze", Target(fc, zeta, gain), parsed, None, [], Sourcing(r_s, c_s, labels), amp,
+                    notes, package, simulate, simulator)
+
+
+def _analyse(topo, mode: str, target: Target, values: dict, ideal, ranked: list, sourcing: Sourcing, amp, notes: list,
+             package, simulate: bool, simulator: str) -> CircuitPlantResult:
+    """The figures, sensitivities, deck and (when ``simulate``) SPICE check of a build, as one result."""
+    tick = time.perf_counter()
+    figures = _figures(topo, values, amp, target)
+    steps = _steps(topo, values, amp, figures)
+    sensitivity = {"ideal": circuit.sensitivities(topo, values), "opamp": circuit.sensitivities(topo, values, amp)}
+    netlist = topo.netlist(values)
+    fn = figures["ideal"]["fn_hz"]
+    deck = ac_deck(netlist, amp, fn / 30, fn * 30, title=f"{topo.title} plant fn={fn:.5g}Hz op-amp={amp.name}")
+    timings = {"analytic_s": time.perf_counter() - tick}
+    checks, run = [], None
+    if simulate:
+        tick = time.perf_counter()
+        run, check = _spice(netlist, amp, fn, topo, values, simulator)
+        checks.append(check)
+        timings["simulation_s"] = time.perf_counter() - tick
+    else:
+        notes.append("SPICE simulation skipped (--no-sim): the figures are analytic only")
+    return CircuitPlantResult(topo.name, mode, target, values, ideal, ranked, sourcing, amp, figures, steps,
+                              sensitivity, netlist, deck, checks, notes, run, package, timings=timings)
+
+
+def tolerance_nominal(result: CircuitPlantResult) -> dict:
+    """The parts that vary in a tolerance analysis: designator -> value.
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design.
+
+    Returns
+    -------
+    dict
+        Every declared part.
+    """
+    return dict(result.values)
+

@@ -1,0 +1,165 @@
+"""The build sheet and bundle of a plant on a registered topology
+(:class:`~designer.plant.circuit_design.CircuitPlantResult`): the bill of materials
+and the wiring from the topology's netlist on the bench board
+(:func:`designer.spice.deck.board`, :mod:`designer.report.wiring`: topology-free), the
+target and what the build achieves, the SPICE agreement, the sensitivities over the
+declared parts and the alternatives; rendered as the result is (nothing recomputed).
+"""
+
+from __future__ import annotations
+
+from ..core.units import format_eng
+from ..report import document as R
+from ..report.bundle import bundle_paths, write_bundle
+from ..report.tolerance import csv_texts
+from ..report.wiring import bom_csv, bom_rows, wiring_rows
+from ..spice.deck import board
+
+__all__ = ["title_of", "sections", "bom", "summary_text", "write_outputs"]
+
+#: what the section's end nets are called on the sheet
+NET_LABELS = {"vin": "generator (CH1)", "vout": "output (CH2)", "0": "ground"}
+
+
+def title_of(result) -> str:
+    """The sheet's title.
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    t = result.target
+    if result.mode == "analyze":
+        f = result.figures["ideal"]
+        zeta = "" if f["zeta"] is None else f", zeta {f['zeta']:.4g}"
+        return f"{result.section.title} plant as built: fn {f['fn_hz']:.5g} Hz{zeta}, gain {f['gain']:.4g}"
+    zeta = "" if t.zeta is None else f", zeta {t.zeta:g}"
+    return f"{result.section.title} plant: fc {t.fc_hz:g} Hz{zeta}, gain {t.gain:g}"
+
+
+def bom(result) -> list:
+    """The bill of materials rows (:data:`designer.report.wiring.BOM_HEADER`).
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design.
+
+    Returns
+    -------
+    list of list
+        Rows.
+    """
+    lab = result.sourcing.parts
+    b = board(result.netlist, result.opamp, result.package)
+
+    def source(ref):
+        src = lab.get(ref)
+        return None if src is None else (src.series, src.tolerance_pct)
+    return bom_rows(b, source, result.opamp.name)
+
+
+def _f(v, unit: str) -> str:
+    return "-" if v is None else format_eng(v, unit, 4)
+
+
+def _n(v) -> str:
+    return "-" if v is None else f"{v:.4g}"
+
+
+def _targets(result) -> list:
+    t, fi, fo = result.target, result.figures["ideal"], result.figures["opamp"]
+    rows = [["fn", _f(t.fc_hz, "Hz"), _f(fi["fn_hz"], "Hz"), _f(fo["fn_hz"], "Hz")],
+            ["zeta", _n(t.zeta), _n(fi["zeta"]), _n(fo["zeta"])],
+            ["gain", _n(t.gain), _n(fi["gain"]), ""],
+            ["-3 dB", "", ", ".join(_f(f, "Hz") for f in fi["f3db_hz"]),
+             ", ".join(_f(f, "Hz") for f in fo["f3db_hz"])]]
+    out = [R.table(["figure", "target", "ideal op-amp", result.opamp.name], rows)]
+    step = result.steps["opamp"]
+    if step is not None:
+        out.append(R.text(f"step ({result.opamp.name}): overshoot {step['overshoot_pct']:.3g} %, peak time "
+                          f"{_f(step['peak_time_s'], 's')}, 2 % settling {_f(step['settling_time_s'], 's')}"))
+    return out
+
+
+def sections(result) -> list:
+    """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`).
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design.
+
+    Returns
+    -------
+    list of tuple
+        The sections.
+    """
+    b = board(result.netlist, result.opamp, result.package)
+    out = [("Build", [R.table(["Ref", "Value", "Code", "Qty", "Series", "Tol.", "Package", "Role"], bom(result))]),
+           ("Wiring", [R.table(["part", "code", "from", "to"],
+                               wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee)))]),
+           ("Target and achieved", _targets(result)),
+           ("Checks", [R.table(["check", "result", "detail"],
+                               [[c.title, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]),
+           ("Sensitivity", [R.table(["part", "S wn (ideal)", "S zeta (ideal)", "S wn (op-amp)", "S zeta (op-amp)"],
+                                    [[ref, _n(s["wn"]), _n(s["zeta"]), _n(result.sensitivity["opamp"][ref]["wn"]),
+                                      _n(result.sensitivity["opamp"][ref]["zeta"])]
+                                     for ref, s in result.sensitivity["ideal"].items()])])]
+    if len(result.alternatives) > 1:
+        refs = result.section.designators
+        out.append(("Alternatives (best first)",
+                    [R.table([*refs, "fn", "zeta", "gain", "worst error"],
+                             [[*(format_eng(c.values[r], "Ohm" if r[0] == "R" else "F", 3) for r in refs),
+                               _f(c.fn_hz, "Hz"), _n(c.zeta), _n(c.gain), f"{100 * c.worst:.3g} %"]
+                              for c in result.alternatives])]))
+    if result.notes:
+        out.append(("Notes", [R.text(n) for n in result.notes]))
+    return out
+
+
+def summary_text(result) -> str:
+    """The terminal summary: the sheet as text.
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design.
+
+    Returns
+    -------
+    str
+        Text.
+    """
+    return R.to_text(title_of(result), sections(result)) + "\n"
+
+
+def write_outputs(result, out_dir, name: str) -> dict:
+    """Write ``netlists/<name>.cir`` and ``reports/<name>/`` (sheets, result.json, bom.csv,
+    monte-carlo.csv with a Monte Carlo) atomically (:func:`designer.report.bundle.write_bundle`).
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design (its ``files`` set here, before result.json is written).
+    out_dir : str or Path
+        Where ``netlists/`` and ``reports/`` go.
+    name : str
+        The design's name.
+
+    Returns
+    -------
+    dict
+        The files written.
+    """
+    texts = {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))), **csv_texts(result)}
+    result.files = bundle_paths(out_dir, name, [], {k: f for k, (f, _) in texts.items()})
+    extras = {k: text(result) for k, (_, text) in texts.items()}
+    write_bundle(result.files, result.deck, {}, title_of(result), sections(result), result.to_dict(), extras)
+    return result.files

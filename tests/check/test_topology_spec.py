@@ -1,0 +1,59 @@
+"""check-design with ``topology:`` over the registry (every registered section but the default,
+picked up without editing this file): a plant spec designed on it and checked in ngspice (its
+.ac agreement a design check), its figures within the spec's limits; the refusals at the key's line."""
+
+import json
+import subprocess
+
+import pytest
+from helpers import script
+
+from designer.filters import REGISTRY
+from designer.plant.circuit import DEFAULT_TOPOLOGY
+
+TOPOLOGIES = [t for t in REGISTRY.values() if t.name != DEFAULT_TOPOLOGY]
+IDS = [t.name for t in TOPOLOGIES]
+
+
+def check(path, *args):
+    return subprocess.run([script("check-design"), str(path), *args], capture_output=True, text=True, timeout=300,
+                          cwd=path.parent)
+
+
+def spec_text(topology) -> str:
+    ex = topology.example
+    zeta = "" if ex.q is None else f", zeta: {1 / (2 * ex.q):.6g}"
+    return (f"name: plant-{topology.name}\nkind: plant\ntopology: {topology.name}\n"
+            f"target: {{fc: {ex.fn_hz:g}{zeta}, gain: {ex.gain:g}}}\nopamp: TL072\n"
+            f"checks:\n  ideal_fn_hz: {{min: {0.95 * ex.fn_hz:g}, max: {1.05 * ex.fn_hz:g}}}\n"
+            "design_checks: all\n")
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_a_check_design_spec_with_its_topology_passes(topology, tmp_path):
+    path = tmp_path / "spec.yaml"
+    path.write_text(spec_text(topology))
+    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert f"plant-{topology.name}: pass" in out.stdout
+    results = list((tmp_path / "out").rglob("result.json"))
+    designs = [json.loads(p.read_text()) for p in results]
+    assert any(d.get("topology") == topology.name for d in designs)
+
+
+def test_an_unknown_topology_is_refused_at_its_line(tmp_path):
+    path = tmp_path / "spec.yaml"
+    path.write_text(spec_text(REGISTRY["mfb-lowpass"]).replace("topology: mfb-lowpass", "topology: mfb-lowpas"))
+    out = check(path)
+    assert out.returncode == 2
+    line = out.stderr.strip()
+    assert "\n" not in line and "spec.yaml:3: topology: unknown topology" in line and "did you mean mfb-lowpass" in line
+
+
+def test_parts_keys_are_the_topology_s(tmp_path):
+    path = tmp_path / "spec.yaml"
+    path.write_text(spec_text(REGISTRY["mfb-lowpass"]) + "parts: {R1: 1k, R5: 2k}\n")
+    out = check(path)
+    assert out.returncode == 2
+    assert "unknown key 'R5' in parts; allowed: R1, R2, R3, C1, C2" in out.stderr

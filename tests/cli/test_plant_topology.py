@@ -1,0 +1,153 @@
+"""design-plant --topology NAME over the registry (every registered section, picked up without
+editing this file): the design from the CLI with ngspice's .ac check, its JSON (the topology key,
+the parts the topology declares), its Monte Carlo rows recomputed from their part values, and the
+refusals (one line, exit status 2, nothing written)."""
+
+import csv
+import json
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+from helpers import script
+
+from designer.core.opamps import get as get_opamp
+from designer.filters import REGISTRY
+from designer.plant import circuit
+
+TOPOLOGIES = [t for t in REGISTRY.values() if t.name != circuit.DEFAULT_TOPOLOGY]
+IDS = [t.name for t in TOPOLOGIES]
+
+
+def run(*args, cwd=None):
+    return subprocess.run([script("design-plant"), *args], capture_output=True, text=True, cwd=cwd, timeout=300)
+
+
+def target_args(topology) -> list:
+    """The topology's example as design-plant's target options."""
+    ex = topology.example
+    out = ["--fc", f"{ex.fn_hz:g}", "--gain", f"{ex.gain:g}", "--topology", topology.name]
+    return out + ([] if ex.q is None else ["--zeta", f"{1 / (2 * ex.q):.6g}"])
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_design_plant_on_every_topology(topology, tmp_path):
+    out = run(*target_args(topology), "--json", "--out", str(tmp_path), "--simulator", "ngspice-cli",
+              "--monte-carlo", "50", "--seed", "3", "--alternatives", "3")
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    assert d["topology"] == topology.name
+    assert list(d["parts"]) == list(topology.designators)
+    values = {r: p["value"] for r, p in d["parts"].items()}
+    f = topology.figures(values)
+    assert d["built"]["ideal"]["fn_hz"] == pytest.approx(f.fn_hz, rel=1e-12)
+    assert abs(d["built"]["ideal"]["fn_error_pct"]) < 5
+    assert d["spice"]["pass"] and d["spice"]["max_db"] <= 0.05
+    assert json.loads(Path(d["files"]["result_json"]).read_text()) == d
+    # the Monte Carlo's rows: each build's figures recomputed from its part values
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 50
+    batch = {r: np.array([float(row[r]) for row in rows]) for r in topology.designators}
+    figs = circuit.circuit_figures(topology, batch, get_opamp(d["opamp"]["name"]))
+    for k in ("fn_hz", "ideal_fn_hz", "gain"):
+        got = np.array([float(row[k]) for row in rows])
+        assert np.allclose(got, figs[k], rtol=1e-8), k
+
+
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_a_part_the_topology_does_not_have_is_refused_listing_its_parts(topology, tmp_path):
+    out = run(*target_args(topology), "--no-sim", "--tol", "R9=1%", "--worst-case", cwd=tmp_path)
+    assert out.returncode == 2 and out.stdout == ""
+    line = out.stderr.strip()
+    assert "\n" not in line and "R9" in line and ", ".join(topology.designators) in line
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_unknown_topology_is_one_line_with_the_registered_and_the_closest(tmp_path):
+    out = run("--fc", "1k", "--zeta", "0.5", "--topology", "mfb-lowpas", cwd=tmp_path)
+    assert out.returncode == 2 and "\n" not in out.stderr.strip()
+    assert "did you mean mfb-lowpass?" in out.stderr and ", ".join(REGISTRY) in out.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("args, words", [
+    # MFB low-pass, Q 5, gain 2: C2/C1 >= 4 Q^2 (1 + 2) = 300, beyond the capacitor bounds' ratio 10
+    (["--fc", "1k", "--zeta", "0.1", "--gain", "2", "--topology", "mfb-lowpass", "--c-min", "1n", "--c-max", "10n"],
+     ["--c-max", "capacitor ratio must be at least 300", "widen the capacitor bounds"]),
+    # MFB band-pass: the gain at f0 must stay below 2 Q^2
+    (["--fc", "1k", "--zeta", "0.5", "--gain", "4", "--topology", "mfb-bandpass"], ["--gain", "2 Q^2"]),
+    # 40 MHz of GBW needed against the LM741's 1 MHz
+    (["--fc", "200k", "--zeta", "0.1", "--gain", "3", "--topology", "mfb-lowpass"], ["--opamp", "too slow", "GBW"]),
+    (["--fc", "1k", "--zeta", "0.5", "--topology", "rc-lowpass"], ["--zeta", "first-order"]),
+    (["--fc", "1k", "--topology", "mfb-lowpass"], ["required: --zeta"]),
+    (["--fc", "1k", "--zeta", "0.5", "--topology", "mfb-lowpass", "--r", "1k", "--c", "10n"], ["--r", "seed"]),
+])
+def test_targets_a_topology_cannot_realise_are_one_line(args, words, tmp_path):
+    out = run(*args, "--no-sim", cwd=tmp_path)
+    assert out.returncode == 2 and out.stdout == ""
+    line = out.stderr.strip()
+    assert "\n" not in line and "Traceback" not in line
+    for w in words:
+        assert w in line, (w, line)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_help_lists_the_topologies():
+    out = run("--help")
+    assert out.returncode == 0
+    text = " ".join(out.stdout.split())
+    for name in REGISTRY:
+        assert name in text
+
+
+def analyze(*args, cwd=None):
+    return subprocess.run([script("analyze-plant"), *args], capture_output=True, text=True, cwd=cwd, timeout=300)
+
+
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_analyze_plant_takes_every_topology_s_parts_by_designator(topology, tmp_path):
+    """The example's exact synthesis given as --part: its figures are the example's (closed forms)."""
+    values = topology.synthesize(topology.example)
+    parts = [a for r, v in values.items() for a in ("--part", f"{r}={v!r}")]
+    out = analyze("--topology", topology.name, *parts, "--no-sim", "--json", "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    assert d["mode"] == "analyze" and d["topology"] == topology.name
+    assert d["built"]["ideal"]["fn_hz"] == pytest.approx(topology.example.fn_hz, rel=1e-9)
+    assert d["built"]["ideal"]["gain"] == pytest.approx(topology.example.gain, rel=1e-9)
+
+
+def test_part_on_the_sallen_key_low_pass_is_its_r1_to_c2(tmp_path):
+    """--part R1=820 is --r1 820: the same result."""
+    a = analyze("--part", "R1=820", "--part", "C2=220n", "--r2", "1k", "--c1", "10n", "--no-sim", "--json",
+                "--no-files")
+    b = analyze("--r1", "820", "--r2", "1k", "--c1", "10n", "--c2", "220n", "--no-sim", "--json", "--no-files")
+    assert a.returncode == 0 and b.returncode == 0, a.stderr + b.stderr
+    da, db = json.loads(a.stdout), json.loads(b.stdout)
+    da.pop("tool"), db.pop("tool")
+    assert da == db
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--part", "R1=820", "--part", "R1=1k", "--r2", "1k", "--c1", "10n", "--c2", "220n"],
+     ["--part R1 given twice: 820 and 1k"]),
+    (["--part", "R5=1k", "--r1", "1k", "--r2", "1k", "--c1", "10n", "--c2", "220n"],
+     ["no part R5", "R1, R2, C1, C2, R3, R4"]),
+    (["--part", "R1=1k", "--r1", "1k", "--r2", "1k", "--c1", "10n", "--c2", "220n"], ["same part"]),
+    (["--r2", "1k", "--c1", "10n"], ["the following arguments are required: --r1, --c2"]),
+    (["--topology", "mfb-lowpass", "--part", "R1=1k"], ["needs R2, R3, C1, C2 too"]),
+    (["--topology", "mfb-lowpass", "--part", "R5=1k"], ["has no part R5", "R1, R2, R3, C1, C2"]),
+    (["--topology", "mfb-lowpass", "--r1", "1k"], ["--r1 is the sallen-key-lowpass's", "--part"]),
+    (["--topology", "rc-lowpass", "--part", "R1=1k", "--part", "C1=1x"], ["--part C1", "not a number"]),
+])
+def test_analyze_plant_part_refusals_are_one_line(args, words, tmp_path):
+    out = analyze(*args, "--no-sim", cwd=tmp_path)
+    assert out.returncode == 2 and out.stdout == ""
+    line = out.stderr.strip()
+    assert "\n" not in line
+    for w in words:
+        assert w in line, (w, line)
+    assert list(tmp_path.iterdir()) == []

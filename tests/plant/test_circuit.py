@@ -1,0 +1,97 @@
+"""designer.plant.circuit: the plant on any topology. The Sallen-Key low-pass's generic search
+against its own parallelogram search (the fast path), the op-amp-aware polynomials against the
+seed plant's closed form, the vectorised dominant pair against core.lti's, the refusals."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from designer.core import eseries
+from designer.core.errors import DesignError
+from designer.core.lti import dominant_pair
+from designer.core.opamps import get as get_opamp
+from designer.filters import registry
+from designer.plant import circuit, selection
+from designer.plant.model import plant_tf_opamp
+from designer.plant.sallenkey import SallenKeyParts
+
+SK = registry.get(circuit.DEFAULT_TOPOLOGY)
+
+
+@settings(max_examples=6, deadline=None)
+@given(fc=st.floats(50.0, 20e3), zeta=st.floats(0.15, 1.5))
+def test_generic_search_equals_the_sallen_key_fast_path(fc, zeta):
+    """On the default bounds' E24/E12 grid the generic search finds the fast path's best error."""
+    rv, cv = eseries.values("E24", 100, 1e6), eseries.values("E12", 100e-12, 10e-6)
+    generic = circuit.search(SK, circuit.plant_target(SK, fc, zeta), rv, cv, top=1)[0]
+    fast = selection.joint_search(fc, zeta, rv, cv, 1.0, top=1)[0]
+    assert generic.worst == pytest.approx(fast.worst, rel=1e-9, abs=1e-15)
+
+
+def test_generic_search_equals_the_fast_path_on_a_small_grid():
+    """Exhaustive on a grid small enough to enumerate: the fast path's brute force, the generic search
+    with every resistor value a candidate."""
+    rv, cv = eseries.values("E6", 1e3, 10e3), eseries.values("E6", 1e-9, 100e-9)
+    for fc, zeta in ((3500.0, 0.2), (12e3, 0.7), (8e3, 1.1)):
+        generic = circuit.search(SK, circuit.plant_target(SK, fc, zeta), rv, cv, top=1, width=20)[0]
+        exhaustive = selection.brute_force(fc, zeta, rv, cv, 1.0, top=1)[0]
+        assert generic.worst == pytest.approx(exhaustive.worst, rel=1e-9)
+
+
+def test_opamp_aware_polynomials_equal_the_seed_plant_closed_form():
+    """Cramer's rule on the netlist gives plant_tf_opamp's third-order polynomials (seed 001's plant, LM741)."""
+    values = {"R1": 820.0, "R2": 1e3, "C1": 10e-9, "C2": 220e-9}
+    amp = get_opamp("LM741")
+    num, den = circuit.opamp_tf(SK, values, amp)
+    num_ref, den_ref = plant_tf_opamp(SallenKeyParts(820.0, 1e3, 10e-9, 220e-9), amp)
+    assert den.shape == den_ref.shape
+    assert np.allclose(den, den_ref, rtol=1e-8)
+    assert num[-1] == pytest.approx(num_ref[-1], rel=1e-9)
+    assert np.allclose(num[:-1], 0.0)
+
+
+def test_vectorised_dominant_pair_is_core_lti_s():
+    rng = np.random.default_rng(7)
+    dens = np.column_stack([rng.uniform(1e-12, 1e-9, 50), rng.uniform(1e-8, 1e-5, 50), rng.uniform(1e-4, 1e-2, 50),
+                            np.ones(50)])
+    fn, z = circuit.dominant_pairs(dens)
+    for i in range(50):
+        f1, z1 = dominant_pair(dens[i])
+        assert fn[i] == pytest.approx(f1, rel=1e-9)
+        assert z[i] == pytest.approx(z1, rel=1e-9)
+
+
+def test_unrealisable_in_the_capacitor_range_is_one_line_naming_the_limit():
+    """MFB low-pass at Q 5, gain 2: C2/C1 >= 4 Q^2 (1 + 2) = 300, beyond a decade of capacitors."""
+    mfb = registry.get("mfb-lowpass")
+    target = circuit.plant_target(mfb, 1e3, 0.1, 2.0)
+    with pytest.raises(DesignError) as exc:
+        circuit.search(mfb, target, eseries.values("E24", 100, 1e6), eseries.values("E12", 1e-9, 10e-9))
+    msg = str(exc.value)
+    assert "\n" not in msg and "capacitor ratio must be at least 300" in msg and exc.value.param == "c_max"
+
+
+def test_a_damping_for_a_first_order_section_is_refused():
+    with pytest.raises(DesignError) as exc:
+        circuit.plant_target(registry.get("rc-lowpass"), 1e3, 0.5)
+    assert exc.value.param == "zeta" and "first-order" in str(exc.value)
+    with pytest.raises(DesignError):
+        circuit.plant_target(registry.get("mfb-lowpass"), 1e3, None)
+
+
+def test_a_section_beyond_the_op_amp_names_the_catalogue_op_amp_fast_enough():
+    """An MFB low-pass at 50 kHz, Q 2.5, gain 3 needs 10 x 50k x 2.5 x 4 = 5 MHz: the LM741 (1 MHz) is
+    refused and the slowest catalogue op-amp with 5 MHz named (core.opamps.fast_enough)."""
+    from designer.core import opamps
+    from designer.plant.circuit_design import GBW_MARGIN, check_opamp_reach
+    mfb = registry.get("mfb-lowpass")
+    target = circuit.plant_target(mfb, 50e3, 0.2, 3.0)
+    need = GBW_MARGIN * 50e3 * 2.5 * 4
+    with pytest.raises(DesignError) as exc:
+        check_opamp_reach(mfb, target, get_opamp("LM741"))
+    fast = opamps.fast_enough(need)
+    assert exc.value.param == "opamp" and "\n" not in str(exc.value)
+    assert fast is not None and fast.gbw_hz >= need and f"use --opamp {fast.name}" in str(exc.value)
+    assert all(a.gbw_hz < need or a.gbw_hz >= fast.gbw_hz for a in map(opamps.get, opamps.names()) if not a.ideal)
+    check_opamp_reach(mfb, target, fast)     # fast enough: no refusal
