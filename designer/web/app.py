@@ -39,6 +39,7 @@ from ..core.fileio import MAX_CAPTURE_BYTES, check_plain_name
 from . import pool as pool_module
 from . import request as req
 from .guard import Guard, Trust, error_response
+from .jobs import LIBRARY
 
 STATIC = Path(__file__).parent / "static"
 MEDIA = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=utf-8",
@@ -115,12 +116,15 @@ def create_app(pool, trust: Trust):
     async def choices_endpoint(request):
         return JSONResponse(choices)
 
-    async def run(request, prog: str, argv: list, want: str, tmp: str, upload_name: str | None = None):
+    async def run(request, prog: str, argv: list | None, want: str, tmp: str, upload_name: str | None = None,
+                  fields: dict | None = None):
         # the task goes to the pool as its file's name: a message of a hundred bytes, so that the pipe to the
         # pool never fills while the pool is sending a long answer the other way (each would wait on the other)
         task_file = os.path.join(tmp, "task.json")
+        task = {"prog": prog, "want": want, "tmp": tmp}
+        task.update({"fields": fields} if prog in LIBRARY else {"argv": argv})
         with open(task_file, "w", encoding="utf-8") as fh:
-            json.dump({"prog": prog, "argv": argv, "want": want, "tmp": tmp}, fh)
+            json.dump(task, fh)
         try:
             rid, answer = pool.start({"task_file": task_file})
         except pool_module.Busy as exc:
@@ -143,6 +147,8 @@ def create_app(pool, trust: Trust):
             code = 400 if status == 2 else 502 if status == 3 else 503
             if status == 2 and _TOO_LARGE.search(line):
                 code = 413
+            if "field" in value:   # the library's refusal in the page's words: the field it names
+                return error_response(code, line, value["field"], value["label"])
             return _error(code, line)
         if want in ("sheet", "bundle"):
             return Response(value["body"], media_type=value["media"],
@@ -168,6 +174,8 @@ def create_app(pool, trust: Trust):
                                        f"{req.MAX_JSON_BYTES // (1024 * 1024)} MiB")
                 except DesignError as exc:
                     return _error(400, f"{prog}: error: {exc}")
+                if prog in LIBRARY:   # the library called with the request's fields: no command line
+                    return await run(request, prog, None, how, tmp, fields=options)
                 try:
                     argv = req.build_argv(options, tmp, traits[prog])
                 except DesignError as exc:

@@ -77,6 +77,8 @@ def run(task: dict) -> dict:
             task = json.load(fh)
     if task["prog"] == "warm-up":
         return warm_up()
+    if "fields" in task:
+        return LIBRARY[task["prog"]](task["fields"], task.get("want", "json"), task.get("tmp"))
     prog, argv, want, tmp = task["prog"], list(task["argv"]), task.get("want", "json"), task.get("tmp")
     seen = {}
     out, err = io.StringIO(), io.StringIO()
@@ -148,6 +150,67 @@ def _error_line(stderr: str, status: int) -> str | None:
 def _read(path) -> bytes:
     with open(path, "rb") as fh:
         return fh.read()
+
+
+# --------------------------------------------------------------------------- library-first commands
+
+def design_plant_task(fields: dict, want: str = "json", tmp: str | None = None) -> dict:
+    """design-plant for the page, the library called directly: the request's fields as the specs
+    (:func:`designer.web.forms.plant_request`), :func:`designer.plant.design.design_plant`, the PRBS
+    bench test and the tolerance analysis asked for, and the typed result rendered.
+
+    Parameters
+    ----------
+    fields : dict
+        The request's JSON object (the plant page's fields, :data:`designer.web.forms.PLANT`).
+    want : str
+        As :func:`run`'s.
+    tmp : str or None
+        The request's private folder (the files of a sheet or bundle; every temporary file).
+
+    Returns
+    -------
+    dict
+        As :func:`run`'s; a refusal's ``field`` and ``label`` name the page's field at fault.
+    """
+    from ..core.errors import DesignError, SimulatorError
+    from ..plant.design import design_plant
+    from ..plant.report import write_outputs
+    from ..tolerance.mcspec import plant_tolerance
+    from .forms import PLANT, page_message, plant_request
+    prog = "design-plant"
+    try:
+        with temporaries_in(tmp):
+            rq = plant_request(fields)
+            result = design_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
+            if rq.stimulus is not None:
+                from ..plant.prbs import with_prbs
+                result = with_prbs(result, result.test.amplitude_v, rq.stimulus[0], rq.stimulus[1], rq.simulate,
+                                   rq.simulator)
+            result = plant_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
+            if want in ("sheet", "bundle"):
+                write_outputs(result, tmp, rq.name)
+    except SimulatorError as exc:
+        return {"status": 3, "error": f"{prog}: error: simulator error: {exc}", "json": None}
+    except DesignError as exc:
+        text, field = page_message(exc, PLANT)
+        return {"status": 2, "error": f"{prog}: error: {text}", "json": None, "field": field,
+                "label": PLANT[field].label if field else None}
+    data = json.loads(json.dumps(result.to_dict()))
+    data["tool"]["argv"] = rq.argv   # the command line this request stands for: a record, never parsed
+    answer = {"status": 0, "error": None, "json": data}
+    if want == "page":
+        answer["page"] = plant_page(result)
+    elif want == "sheet":
+        answer.update(body=_read(os.path.join(tmp, "reports", rq.name, "build-sheet.html")),
+                      media="text/html; charset=utf-8", filename="build-sheet.html")
+    elif want == "bundle":
+        answer.update(body=bundle_zip(tmp, rq.name), media="application/zip", filename=f"{rq.name}.zip")
+    return answer
+
+
+#: the commands the page runs through the library (no console script, no argv, no printed JSON)
+LIBRARY = {"design-plant": design_plant_task}
 
 
 # --------------------------------------------------------------------------- identify
@@ -394,4 +457,4 @@ def check_files(tmp: str) -> dict:
 def warm_up() -> None:
     """A worker's first task: one plant designed, simulated and drawn for the page, so that the
     first request finds ngspice loaded, every module imported and schemdraw's fonts measured."""
-    run({"prog": "design-plant", "argv": ["--fc", "3500", "--zeta", "0.2", "--json", "--no-files"], "want": "page"})
+    design_plant_task({"fc": 3500, "zeta": 0.2}, "page")

@@ -83,12 +83,34 @@ def test_identify_takes_a_frequency_table_as_identify_does(server):
     assert without_run_details(got) == without_run_details(want)
 
 
+@pytest.mark.parametrize("body, argv", [
+    ({"fc": 3500, "zeta": -1}, ["--fc", "3500", "--zeta", "-1"]),
+    ({"fc": "3.5q", "zeta": 0.2}, ["--fc", "3.5q", "--zeta", "0.2"]),
+    ({"fc": 3500, "zeta": 0.2, "opamp": "LM999"}, ["--fc", "3500", "--zeta", "0.2", "--opamp", "LM999"]),
+    ({"fc": 3500, "zeta": 0.2, "r": "1k"}, ["--fc", "3500", "--zeta", "0.2", "--r", "1k"]),
+    ({"fc": 3500, "zeta": 0.2, "r-min": "10M"}, ["--fc", "3500", "--zeta", "0.2", "--r-min", "10M"]),
+])
+def test_the_plant_page_refuses_with_the_clis_line_in_its_own_words(server, body, argv):
+    """Issue 26 (library-first): the page's request goes to the library's specs, whose refusal names the
+    parameter; the page shows its field's label where the command line shows its option."""
+    import re
+    from designer.web.forms import PLANT
+    status, got = server.post_json("/api/plant", body)
+    assert status == 400
+    want = re.sub(r"--([a-z][a-z0-9-]*)", lambda m: f'"{PLANT[m.group(1)].label}"',
+                  cli_error("design-plant", *argv, "--json", "--no-files"))
+    assert got["error"] == want and "--" not in got["message"]
+    named = re.search(r"--([a-z][a-z0-9-]*)", cli_error("design-plant", *argv, "--json", "--no-files"))
+    assert got["option"] == (named and named.group(0))
+    assert got.get("label") == (named and PLANT[named.group(1)].label)
+
+
+def test_a_missing_plant_field_is_named_by_its_label(server):
+    status, got = server.post_json("/api/plant", {"zeta": 0.2})
+    assert status == 400 and got["error"] == 'design-plant: error: "fc (Hz)" is required' and got["field"] == "fc"
+
+
 @pytest.mark.parametrize("path, body, argv", [
-    ("/api/plant", {"fc": 3500, "zeta": -1}, ["design-plant", "--fc", "3500", "--zeta", "-1"]),
-    ("/api/plant", {"fc": "3.5q", "zeta": 0.2}, ["design-plant", "--fc", "3.5q", "--zeta", "0.2"]),
-    ("/api/plant", {"zeta": 0.2}, ["design-plant", "--zeta", "0.2"]),
-    ("/api/plant", {"fc": 3500, "zeta": 0.2, "opamp": "LM999"}, ["design-plant", "--fc", "3500", "--zeta", "0.2",
-                                                                  "--opamp", "LM999"]),
     ("/api/pid", {"plant-fc": 3500}, ["design-pid", "--plant-fc", "3500"]),
     ("/api/pid", {"plant-fc": 3500, "plant-zeta": 0.2, "tuning": "magic"},
      ["design-pid", "--plant-fc", "3500", "--plant-zeta", "0.2", "--tuning", "magic"]),
@@ -101,18 +123,18 @@ def test_bad_input_is_a_400_with_the_clis_one_line(server, path, body, argv):
 
 
 @pytest.mark.parametrize("body, words", [
-    ({"fc": 3500, "zeta": 0.2, "out": "/etc"}, "--out is set by the web page"),
-    ({"fc": 3500, "zeta": 0.2, "json": True}, "--json is set by the web page"),
-    ({"fc": 3500, "zeta": 0.2, "no-sim": "yes"}, "--no-sim is a switch"),
-    ({"fc": [1, 2], "zeta": 0.2}, "--fc takes one value"),
-    ({"o": "x", "fc": 3500, "zeta": 0.2}, "unrecognized arguments: --o"),
-    ({"fc": {"a": 1}, "zeta": 0.2}, "--fc takes a number"),
+    ({"fc": 3500, "zeta": 0.2, "out": "/etc"}, "out is set by the web page"),
+    ({"fc": 3500, "zeta": 0.2, "json": True}, "json is set by the web page"),
+    ({"fc": 3500, "zeta": 0.2, "no-sim": "yes"}, '"skip SPICE" is a switch'),
+    ({"fc": [1, 2], "zeta": 0.2}, '"fc (Hz)" takes one value'),
+    ({"o": "x", "fc": 3500, "zeta": 0.2}, "'o' is not a field of this page"),
+    ({"fc": {"a": 1}, "zeta": 0.2}, '"fc (Hz)" takes a number'),
     ({"../../x": 1}, "is not an option name"),
     ([1, 2], "must be a JSON object"),
 ])
 def test_what_a_request_may_not_choose_is_refused(server, body, words):
     status, got = server.post_json("/api/plant", body)
-    assert status == 400 and words in got["error"], got
+    assert status == 400 and words in got["error"] and "--" not in got["message"], got
 
 
 @settings(max_examples=25)
@@ -434,21 +456,22 @@ def test_a_request_never_chooses_processes_or_addresses(server):
                            ("/api/check", {"spec": "x", "options": {"jobs": 2}})]:
             status, got = server.post_json(path, body)
             assert status == 400 and "\n" not in got["error"], got
-            assert "the server's own setting" in got["error"] or "unrecognized arguments" in got["error"], got
+            assert any(w in got["error"] for w in ("the server's own setting", "unrecognized arguments",
+                                                   "is not a field of this page")), got
         with pytest.raises(socket.timeout):
             listener.accept()
 
 
 @pytest.mark.parametrize("body, words", [
-    ({"tol": ["R=1%", "--jobs=3"]}, "--tol '--jobs=3': a value of an option that takes several"),
-    ({"tol": ["R=1%", "--help"]}, "--tol '--help'"),
-    ({"tol": ["R=1%", "-h"]}, "--tol '-h'"),
-    ({"limit": ["--help"]}, "--limit"),
-    ({"zeta": "--help"}, "--zeta: '--help' is not a number"),
-    ({"zeta": "--version"}, "--zeta: '--version' is not a number"),
+    ({"tol": ["R=1%", "--jobs=3"]}, "\"tolerances\" '--jobs=3': give CLASS=PCT"),
+    ({"tol": ["R=1%", "--help"]}, "\"tolerances\" '--help'"),
+    ({"tol": ["R=1%", "-h"]}, "\"tolerances\" '-h'"),
+    ({"limit": ["--help"]}, "\"limits\" '--help'"),
+    ({"zeta": "--help"}, "\"zeta\": '--help' is not a number"),
+    ({"zeta": "--version"}, "\"zeta\": '--version' is not a number"),
     ({"opamp": "--help"}, "unknown op-amp '--help'"),
     ({"name": "--help"}, None),   # a plain name, the design's: a value, answered
-    ({"tol": "--help"}, "--tol"),
+    ({"tol": "--help"}, "\"tolerances\" '--help'"),
 ])
 def test_a_value_never_becomes_an_option_and_no_worker_exits(server, body, words):
     """Issue 25, item 3: ["R=1%", "--jobs=3"] ran the refused --jobs (64 forked processes a request) and
@@ -478,7 +501,7 @@ MALFORMED = [
     ("/api/plant", b'{"fc": "1k\\ud800", "zeta": 0.5}', {}, "lone surrogate"),
     ("/api/pid", b'{"plant-model": {"best": "\\udfff"}}', {}, "lone surrogate"),
     ("/api/plant", b'{"fc": "\xff\xfe", "zeta": 0.5}', {}, "not UTF-8"),
-    ("/api/plant", b"", {}, "the following arguments are required"),
+    ("/api/plant", b"", {}, '"fc (Hz)" is required'),
     ("/api/plant", b"[1, 2]", {}, "must be a JSON object"),
     ("/api/plant", b"3", {}, "must be a JSON object"),
     ("/api/plant", b'"fc"', {}, "must be a JSON object"),
