@@ -50,6 +50,9 @@ PAGES = {"/": "plant.html", "/plant": "plant.html", "/pid": "pid.html", "/identi
          "/check": "check.html"}
 #: the commands' refusals of a file over their size limits (designer.core.fileio): answered 413
 _TOO_LARGE = re.compile(r"the most this command reads|; at most [0-9.]+ [KMG]?i?B is read")
+#: how often a waiting request looks whether its client is still there (a page typing on closes it): a
+#: superseded run is stopped within this
+DISCONNECT_POLL_S = 0.03
 #: multipart framing around an upload (boundaries, part headers) allowed over the file's own limit
 FRAMING_BYTES = 64 * 1024
 
@@ -109,7 +112,7 @@ def create_app(pool, trust: Trust):
 
     async def health(request):
         return JSONResponse({"ok": True, "jobs": pool.jobs, "timeout_s": pool.timeout, "dropped": pool.dropped,
-                             "ran": pool.ran})
+                             "ran": pool.ran, "superseded": pool.superseded})
 
     choices = _choices()
 
@@ -131,7 +134,7 @@ def create_app(pool, trust: Trust):
             return _error(503, f"{prog}: error: {exc}")
         # a page typing ahead drops its older requests: one whose client has gone leaves the queue
         while not answer.done():
-            await asyncio.wait({answer}, timeout=0.25)
+            await asyncio.wait({answer}, timeout=DISCONNECT_POLL_S)
             if not answer.done() and await request.is_disconnected():
                 pool.cancel(rid)
                 await answer   # dropped from the queue at once, or its run finished: the folder is free

@@ -24,6 +24,7 @@ import io
 import json
 import math
 import os
+import signal
 import sys
 import tempfile
 from contextlib import contextmanager, redirect_stderr, redirect_stdout
@@ -35,6 +36,7 @@ from ..cli import identify as cli_identify
 from ..cli import pid as cli_pid
 from ..cli import plant as cli_plant
 from ..cli.common import RESULT_HOOK, run_cli
+from ..core import lifetime
 from ..core.jsonio import json_safe
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
@@ -52,7 +54,54 @@ MAINS = {
 }
 
 
+class Superseded(BaseException):
+    """The page typed on: the request under way is of inputs nobody will see (the pool's SIGUSR1, raised
+    between two bytecodes of the run; a BaseException, so that no ``except Exception`` of the library keeps
+    it). Whatever it runs unwinds: ``subprocess.run`` kills an ``ngspice -b`` it waits for, the
+    ``with`` blocks close, and the worker takes the next request."""
+
+
+#: whether a task is running in this process (a cancel that comes after it ended is ignored)
+_RUNNING = False
+
+
+def _cancel(signum, frame) -> None:
+    if not _RUNNING:
+        return
+    if lifetime.in_native():   # inside ngspice's callbacks cffi would swallow it: again in 5 ms
+        signal.signal(signal.SIGALRM, _cancel)
+        signal.setitimer(signal.ITIMER_REAL, 0.005)
+        return
+    raise Superseded()
+
+
 def run(task: dict) -> dict:
+    """Run one task in this (worker) process; a SIGUSR1 while it runs (:class:`Superseded`: the pool's
+    cancel of a request whose client left) ends it at once, answered ``{"status": "superseded"}``.
+
+    Parameters
+    ----------
+    task : dict
+        As :func:`run_task`'s.
+
+    Returns
+    -------
+    dict
+        :func:`run_task`'s answer.
+    """
+    global _RUNNING
+    if signal.getsignal(signal.SIGUSR1) is not _cancel:
+        signal.signal(signal.SIGUSR1, _cancel)
+    _RUNNING = True
+    try:
+        return run_task(task)
+    except Superseded:
+        return {"status": "superseded", "error": None, "json": None}
+    finally:
+        _RUNNING = False
+
+
+def run_task(task: dict) -> dict:
     """Run one task in this (worker) process.
 
     Parameters

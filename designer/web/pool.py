@@ -45,6 +45,8 @@ WARM_UP_TIMEOUT_S = 300.0
 MAX_WAITING = 256
 #: requests a worker serves before a fresh one replaces it (designer-web --recycle)
 RECYCLE_AFTER = 200
+#: seconds a superseded run has to unwind before its worker is killed (and replaced) instead
+SUPERSEDED_GRACE_S = 1.0
 #: what a request still waiting when the server stops is answered
 STOPPED = "the server is stopping: the request was cancelled; send it again once the server is back"
 
@@ -97,6 +99,15 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                     if any(m[0] == -msg[0] for m in queue):
                         queue = deque(m for m in queue if m[0] != -msg[0])
                         conn.send((-msg[0], "cancelled", None))
+                    for w in workers:   # under way: stopped where it is (designer.web.jobs.Superseded)
+                        if w.task == -msg[0] and not getattr(w, "superseded", False):
+                            w.superseded = True
+                            try:
+                                os.kill(w.proc.pid, signal.SIGUSR1)
+                            except ProcessLookupError:
+                                pass
+                            # a run that does not come back (stuck in a long C call) is killed as at its deadline
+                            w.deadline = min(w.deadline, time.monotonic() + SUPERSEDED_GRACE_S)
                 else:
                     queue.append(msg)
             for k, w in enumerate(workers):
@@ -108,6 +119,8 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                     except (EOFError, OSError):
                         kind, value = "dead", "the worker running it died: the simulator crashed"
                     if w.task:
+                        if getattr(w, "superseded", False):
+                            kind, value = "superseded", None
                         conn.send((w.task, kind, value))
                         served[w.proc.pid] = served.get(w.proc.pid, 0) + 1
                     w.task = None
@@ -124,6 +137,7 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
             for w in workers:
                 if w.task is None and queue:
                     rid, task = queue.popleft()
+                    w.superseded = False
                     w.give(rid, task, timeout)
     finally:
         close_all(workers)
@@ -150,6 +164,7 @@ class Pool:
         self._loop = None
         self.dropped = 0   #: requests whose client left while they were queued (never run)
         self.ran = 0       #: requests a worker ran (answered, whatever the answer): what a page's typing cost
+        self.superseded = 0  #: requests stopped while they ran, their client gone (their worker freed at once)
         self.stopping = False
 
     def attach(self) -> None:
@@ -170,6 +185,8 @@ class Pool:
             return
         if kind == "cancelled":
             self.dropped += 1
+        elif kind == "superseded":
+            self.superseded += 1
         else:
             self.ran += 1
         fut = self._waiting.pop(rid, None)
@@ -205,7 +222,8 @@ class Pool:
 
     def cancel(self, rid: int) -> None:
         """Its client has gone: drop the task if it waits in the queue (answered "cancelled"); a run
-        already started finishes (and is answered as usual: its folder is in use until then)."""
+        already started is stopped where it is (answered "superseded" as soon as it has unwound, its
+        ngspice killed; killed with its worker after :data:`SUPERSEDED_GRACE_S`)."""
         try:
             self.conn.send((-rid, None))
         except (OSError, ValueError):
