@@ -162,9 +162,17 @@ D.markCurrent = function () {
 // would send: the inputs last asked for are not asked again when nothing was typed since (leaving the field
 // whose pause already sent them).
 D.UNFINISHED = /(^\s*[-+]?\s*$)|(\d\.|\d[eE][-+]?|[-+])\s*$/;
+// The pause: 250 ms, or 1.3 times the typist's own gap between keys when that is longer (up to 700 ms), so a
+// slow typist is not answered at every key; 600 ms while that gap is not known yet (the page's first key).
+// A superseded request is stopped on the server too (its worker freed at once), so asking early costs the
+// room little (issue 29: last key to drawn under 0.5 s).
+D.DEBOUNCE_MS = 250;
+D.DEBOUNCE_MAX_MS = 700;
+D.DEBOUNCE_FIRST_MS = 600;
 D.liveForm = function (form, run, key, wait) {
-  wait = wait || 600;
-  let timer = null, asked = null;
+  let timer = null, asked = null, lastKey = 0, gap = 0;
+  const pause = () => wait || (gap ? Math.min(D.DEBOUNCE_MAX_MS, Math.max(D.DEBOUNCE_MS, 1.3 * gap))
+                                     : D.DEBOUNCE_FIRST_MS);
   const now = () => {
     clearTimeout(timer); timer = null;
     const k = key();
@@ -174,14 +182,31 @@ D.liveForm = function (form, run, key, wait) {
   };
   form.addEventListener("input", e => {
     if (e.target.type === "file") return;
+    const t = performance.now();
+    // a gap between two keys of a burst of typing (a new burst keeps the last; a field emptied, a paste or a
+    // script's fill, two events within 30 ms, say nothing of the typist)
+    if (e.target.value !== "") {
+      if (t - lastKey < 1500 && t - lastKey > 30) gap = t - lastKey;
+      lastKey = t;
+    }
     clearTimeout(timer);
     D.cancel("form");
     asked = null;
     D.markStale("pending");
     // a number still being typed ("0.", "1e", "-") is not asked about on a pause, only when the field is left
-    if (!(e.target.tagName === "INPUT" && D.UNFINISHED.test(e.target.value))) timer = setTimeout(now, wait);
+    if (!(e.target.tagName === "INPUT" && D.UNFINISHED.test(e.target.value))) timer = setTimeout(now, pause());
   });
   form.addEventListener("change", e => { if (e.target.type !== "file") now(); });
+  // back and forward move between the designs shown: the fields as that address has them, asked at once
+  window.addEventListener("popstate", () => {
+    D.fillFromQuery(form);
+    if (D.onRestore) D.onRestore();
+    D.history.restoring = true;
+    clearTimeout(timer);
+    D.cancel("form");
+    asked = null;
+    now();
+  });
   return {now, forget: () => { asked = null; }};
 };
 
@@ -197,11 +222,32 @@ D.answered = function (state) {
 };
 
 // The inputs of the design shown, in the address bar: a link to share, a reload that keeps them (the pages
-// read their fields from the query string as they open). Replaced, not pushed: one history entry a page.
+// read their fields from the query string as they open, D.fillFromQuery). Each new design is a history entry
+// (back and forward move between them, D.liveForm); the page's first, and one restored by back or forward,
+// replace theirs.
+D.history = {first: true, restoring: false};
 D.remember = function (opts) {
   const q = new URLSearchParams();
   for (const [k, v] of Object.entries(opts)) if (typeof v !== "object") q.set(k, v === true ? "true" : v);
-  history.replaceState(null, "", `${location.pathname}?${q}`);
+  const url = `${location.pathname}?${q}`;
+  if (url !== location.pathname + location.search) {
+    if (D.history.first || D.history.restoring) history.replaceState({designer: true}, "", url);
+    else history.pushState({designer: true}, "", url);
+  }
+  D.history.first = false;
+  D.history.restoring = false;
+};
+// The form's fields as the address has them; a field it does not name back to its default.
+D.fillFromQuery = function (form) {
+  const q = new URLSearchParams(location.search);
+  for (const el of form.querySelectorAll("[name]")) {
+    if (el.type === "file") continue;
+    const v = q.get(el.name);
+    if (el.type === "radio") { if (v !== null) el.checked = el.value === v; else el.checked = el.defaultChecked; }
+    else if (el.type === "checkbox") el.checked = v === null ? el.defaultChecked : v === "true";
+    else if (el.tagName === "SELECT") el.value = v !== null ? v : (el.dataset.default || (el.options[0] || {}).value || "");
+    else el.value = v !== null ? v : el.defaultValue;
+  }
 };
 
 D.busy = function (on, el) {

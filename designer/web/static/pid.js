@@ -117,12 +117,8 @@ async function file(kind) {
     D.fill(s, [...keepFirst, ...c[s.dataset.choices]], s.dataset.default || keepFirst[0]);
     if (keepFirst.length && s.options[0].value === "") s.options[0].textContent = "default";
   }
-  const q = new URLSearchParams(location.search);
-  for (const [k, v] of q) {
-    if (k === "plant") { const r = form.querySelector(`input[name=plant][value="${CSS.escape(v)}"]`); if (r) r.checked = true; continue; }
-    const el = form.querySelector(`[name="${CSS.escape(k)}"]`);
-    if (el) el.value = v;
-  }
+  D.fillFromQuery(form);
+  D.onRestore = () => { showPlantKind(); showTargets(); };
   if (identified) {
     const b = identified.best || {};
     document.getElementById("model-text").textContent =

@@ -65,8 +65,7 @@ async function file(kind) {
 (async function () {
   const c = await D.loadChoices();
   for (const s of form.querySelectorAll("select[data-choices]")) D.fill(s, c[s.dataset.choices], s.dataset.default);
-  const q = new URLSearchParams(location.search);
-  for (const [k, v] of q) { const el = form.querySelector(`[name="${CSS.escape(k)}"]`); if (el) el.value = v; }
+  D.fillFromQuery(form);
   D.liveForm(form, design, () => JSON.stringify(D.options(form)));
   document.getElementById("sheet").onclick = () => file("sheet");
   document.getElementById("bundle").onclick = () => file("bundle");
