@@ -160,6 +160,7 @@ def create_app(pool, trust: Trust):
             answer = {"result": value["json"], "page": value.get("page"), "status": status}
         elif prog == "check-design":
             answer = {"status": status, **value["json"], "junit": value["junit"], "summary": value["summary"],
+                      "golden": value.get("golden", {}),
                       "lines": value["stdout"].splitlines(), "messages": value["stderr"].splitlines()}
         else:
             answer = value["json"]
@@ -213,10 +214,15 @@ def create_app(pool, trust: Trust):
                 return _error(413, f"{prog}: error: the spec and its decks are larger than check-design reads")
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
+            golden = options.pop("update-golden", None) if isinstance(options, dict) else None
             try:
-                argv = [files["spec"]] + req.build_argv(options, None, traits[prog])
+                if golden not in (None, True, False, "true", "false", "on", "off", ""):
+                    raise DesignError(f"--update-golden is a switch: true or false, got {str(golden)[:40]}")
+                argv = list(files["specs"]) + req.build_argv(options, None, traits[prog])
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
+            # the golden files recorded in the request's folder, answered for download (never kept)
+            argv += ["--update-golden"] if golden in (True, "true", "on") else []
             argv += ["--junit", os.path.join(tmp, "junit.xml"), "--summary", os.path.join(tmp, "summary.md"),
                      "--out", os.path.join(tmp, "out"), "--root", os.path.join(tmp, "in")]
             return await run(request, prog, argv, "check", tmp)
@@ -295,6 +301,35 @@ async def _body(request: Request, limit: int) -> bytes:
             raise TooLarge()
         chunks.append(chunk)
     return b"".join(chunks)
+
+
+#: most folders deep a Check upload's relative path may go (specs/decks/sub/x.cir is 3)
+MAX_DEPTH = 8
+
+
+def _relative(name) -> str:
+    """An uploaded file's path relative to the folder chosen (``specs/decks/rc_ladder.cir``, as a browser gives
+    a folder's files), every part a plain name (:func:`~designer.core.fileio.check_plain_name`): no ``..``, no
+    absolute path, nothing outside the request's private folder; else a one-line refusal."""
+    text = str(name or "").replace("\\", "/")
+    parts = text.split("/")
+    try:
+        if text.startswith("/") or len(parts) > MAX_DEPTH + 1:
+            raise DesignError("")
+        for part in parts:
+            check_plain_name(part, "file name")
+    except DesignError:
+        raise DesignError(f"file {text[:80]!r}: a path relative to the folder chosen, each part a plain name "
+                          "(letters, digits and . _ - + = , @; no '..', no absolute path), as the spec names it") \
+            from None
+    return "/".join(parts)
+
+
+def _write_inside(inside: str, rel: str) -> str:
+    """The path of ``rel`` (checked by :func:`_relative`) under ``inside``, its folders made."""
+    path = os.path.join(inside, *rel.split("/"))
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    return path
 
 
 def _plain(name, fallback: str) -> str:
@@ -416,38 +451,53 @@ async def _check_inputs(request: Request, tmp: str, limit: int) -> tuple:
     if ctype.startswith("multipart/form-data"):
         files, fields = await _multipart(request, tmp, limit)
         spec = files.pop("spec", None)
-        if not spec:
-            raise DesignError("the form has no spec: send the spec file as the field 'spec'")
-        written["spec"] = os.path.join(inside, _plain(spec[0].file_name and
-                                                      spec[0].file_name.decode("utf-8", "replace"), "spec.yaml"))
-        _save(spec[0], written["spec"])
+        specs = []
+        if spec:
+            specs.append(_relative(spec[0].file_name.decode("utf-8", "replace") if spec[0].file_name
+                                   else "spec.yaml"))
+            _save(spec[0], _write_inside(inside, specs[0]))
         for parts in files.values():
             for f in parts:
-                name = _plain(f.file_name and f.file_name.decode("utf-8", "replace"), "")
-                if not name:
-                    raise DesignError("an uploaded file's name must be plain (letters, digits and . _ - + = , @), "
-                                      "as the spec names it")
-                _save(f, os.path.join(inside, name))
+                rel = _relative(f.file_name and f.file_name.decode("utf-8", "replace"))
+                _save(f, _write_inside(inside, rel))
+                if not spec and _is_spec(rel):   # a folder's specs, every one of them run
+                    specs.append(rel)
+        if not specs:
+            raise DesignError("the form has no spec: send the spec file as the field 'spec', or a folder holding "
+                              "specs (.yaml)")
         options = {k: v for k, v in fields.items() if k != "spec"}
         spec_text = fields.get("spec")
         if spec_text is not None:
             raise DesignError("send the spec as a file, not a text field")
+        written["specs"] = [os.path.join(inside, *rel.split("/")) for rel in sorted(specs)]
         return written, options
     body = req.parse_json(await _body(request, limit))
-    form = 'the body must be {"spec": "<the spec file\'s text>", "files": {"deck.cir": "..."}, "options": {...}}'
-    if not isinstance(body, dict) or not isinstance(body.get("spec"), str):
+    form = ('the body must be {"spec": "<the spec file\'s text>", "files": {"decks/deck.cir": "..."}, "options": '
+            '{...}}, or {"specs": ["specs/a.yaml"], "files": {"specs/a.yaml": "...", ...}}')
+    if not isinstance(body, dict) or not (isinstance(body.get("spec"), str) or isinstance(body.get("specs"), list)):
         raise DesignError(form)
     files = body.get("files") or {}
     if not isinstance(files, dict) or not isinstance(body.get("options") or {}, dict) \
             or not isinstance(body.get("spec_name", ""), (str, type(None))):
         raise DesignError(form)
-    name = _plain(body.get("spec_name"), "spec.yaml")
-    written["spec"] = os.path.join(inside, name)
-    Path(written["spec"]).write_text(body["spec"], encoding="utf-8")
     for fname, text in files.items():
-        plain = _plain(fname, "")
-        if not plain or not isinstance(text, str):
+        if not isinstance(text, str):
             raise DesignError(f"file {str(fname)[:60]!r}: a plain name and its text")
-        Path(inside, plain).write_text(text, encoding="utf-8")
+        Path(_write_inside(inside, _relative(fname))).write_text(text, encoding="utf-8")
+    if isinstance(body.get("spec"), str):
+        name = _relative(body.get("spec_name") or "spec.yaml")
+        specs = [name]
+        Path(_write_inside(inside, name)).write_text(body["spec"], encoding="utf-8")
+    else:
+        specs = [_relative(p) if isinstance(p, str) else _relative(None) for p in body["specs"]]
+        missing = [p for p in specs if p not in {_relative(f) for f in files}]
+        if not specs or missing:
+            raise DesignError(f"spec {missing[0]!r} is not among the files sent" if missing else form)
+    written["specs"] = [os.path.join(inside, *rel.split("/")) for rel in specs]
     options = body.get("options") or {}
     return written, options
+
+
+def _is_spec(rel: str) -> bool:
+    """Whether a file of a folder sent to Check is a spec to run (a YAML file)."""
+    return rel.lower().endswith((".yaml", ".yml"))

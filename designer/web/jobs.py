@@ -132,6 +132,7 @@ def run_task(task: dict) -> dict:
     seen = {}
     out, err = io.StringIO(), io.StringIO()
     token = RESULT_HOOK.set(lambda result, name: seen.update(result=result, name=name))
+    before = files_in(os.path.join(tmp, "in")) if prog == "check-design" and tmp else {}
     argv0 = sys.argv
     sys.argv = [prog, *argv]   # the JSON's tool.argv: the command line this request stands for
     try:
@@ -154,6 +155,7 @@ def run_task(task: dict) -> dict:
         return answer
     if prog == "check-design":
         answer.update(check_files(tmp))
+        answer["golden"] = written_since(os.path.join(tmp, "in"), before) if "--update-golden" in argv else {}
         answer["stdout"] = out.getvalue()
         return answer
     answer["json"] = json.loads(out.getvalue())
@@ -501,6 +503,24 @@ def check_files(tmp: str) -> dict:
     return {"json": {"specs": results},
             "junit": _read(junit).decode("utf-8") if os.path.isfile(junit) else None,
             "summary": _read(summary).decode("utf-8") if os.path.isfile(summary) else None}
+
+
+def files_in(folder: str) -> dict:
+    """Every file under ``folder``: its path relative to it (``/``-separated) -> (size, modification time)."""
+    out = {}
+    for base, _dirs, names in os.walk(folder):
+        for name in names:
+            path = os.path.join(base, name)
+            st = os.stat(path)
+            out[os.path.relpath(path, folder).replace(os.sep, "/")] = (st.st_size, st.st_mtime_ns)
+    return out
+
+
+def written_since(folder: str, before: dict) -> dict:
+    """The files under ``folder`` made or changed since ``before`` (:func:`files_in`): relative path -> text
+    (what check-design ``--update-golden`` recorded: the golden waveforms, CSV)."""
+    return {rel: _read(os.path.join(folder, *rel.split("/"))).decode("utf-8", "replace")
+            for rel, stamp in sorted(files_in(folder).items()) if before.get(rel) != stamp}
 
 
 def warm_up() -> None:

@@ -686,3 +686,66 @@ def test_a_running_request_whose_client_left_is_stopped_with_its_ngspice():
     finally:
         err = s.stop()
     assert "Traceback" not in err and "Exception ignored" not in err, err
+
+
+def _specs_folder() -> dict:
+    """The repository's own specs/ folder as a browser sends a chosen folder: relative path -> text."""
+    root = ROOT / "specs"
+    return {f"specs/{p.relative_to(root).as_posix()}": p.read_text() for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def test_check_runs_the_repositorys_own_specs_folder_as_it_is(server, tmp_path):
+    """Issue 29: the folder keeps its relative paths (decks/, golden/) inside the request's private folder; every
+    spec in it runs, as check-design specs/*.yaml does. A spec that names a file beside the folder
+    (``../reports/<design>/result.json``) finds it when that file is sent too, under its own relative path."""
+    import yaml
+    files = _specs_folder()
+    specs = sorted(p for p in files if p.endswith(".yaml"))
+    status, got = server.post_json("/api/check", {"specs": specs, "files": files})
+    assert status == 400 and "../reports/" in got["error"] and "does not exist" in got["error"]
+    for p in specs:   # the results.json the PID specs take their controller from
+        controller = (yaml.safe_load(files[p]).get("controller") or {}).get("json")
+        if controller:
+            rel = (ROOT / "specs" / controller).resolve().relative_to(ROOT).as_posix()
+            files[rel] = (ROOT / rel).read_text()
+    status, got = server.post_json("/api/check", {"specs": specs, "files": files}, timeout=600)
+    assert status == 200, got
+    assert sorted(s["spec"]["name"] for s in got["specs"]) == sorted(yaml.safe_load(files[p])["name"] for p in specs)
+    # each spec's verdict as check-design gives it in the repository (the seed's Kp = 45 loop fails on purpose)
+    cli("check-design", *[str(ROOT / p) for p in specs], "--root", str(ROOT), "--out", str(tmp_path))
+    want = {d.name: json.loads((d / "result.json").read_text())["status"] for d in tmp_path.iterdir() if d.is_dir()}
+    assert {s["spec"]["name"]: s["status"] for s in got["specs"]} == want and "pass" in want.values()
+    assert got["golden"] == {}
+    assert "designer-web-" not in json.dumps(got)
+    # the same folder as a form's files, each under its relative path
+    body, headers = multipart({}, {f"f{i}": (p, files[p].encode()) for i, p in enumerate(files)
+                                   if "rc_ladder" in p})
+    status, got = server.post_json("/api/check", body, headers=headers)
+    assert status == 200, got
+    assert [s["spec"]["name"] for s in got["specs"]] == ["rc_ladder"] and got["specs"][0]["status"] == "pass"
+
+
+def test_check_records_golden_files_and_answers_them(server):
+    """A spec with golden: and no golden file yet: "update-golden" records it in the request's folder and the
+    answer carries it (what check-design --update-golden writes), under the path the spec names."""
+    files = {p: t for p, t in _specs_folder().items() if "rc_ladder" in p and "golden/" not in p}
+    status, got = server.post_json("/api/check", {"specs": ["specs/rc_ladder.yaml"], "files": files,
+                                                  "options": {"update-golden": True}})
+    assert status == 200, got
+    assert list(got["golden"]) == ["specs/golden/rc_ladder.csv"]
+    recorded = got["golden"]["specs/golden/rc_ladder.csv"]
+    # taken back by its path, it is the reference the next run compares against
+    status, again = server.post_json("/api/check", {"specs": ["specs/rc_ladder.yaml"],
+                                                    "files": {**files, "specs/golden/rc_ladder.csv": recorded}})
+    assert status == 200 and again["specs"][0]["status"] == "pass" and again["golden"] == {}
+    # without it, the run says the golden file is missing
+    status, none = server.post_json("/api/check", {"specs": ["specs/rc_ladder.yaml"], "files": files})
+    assert (status == 400 and "golden" in none["error"]) or none["specs"][0]["status"] != "pass", none
+
+
+@pytest.mark.parametrize("name", ["../x.cir", "/etc/passwd", "a/../../x.cir", "a//b.cir", ".hidden/x.cir",
+                                  "a/" * 10 + "x.cir", "a\\..\\x.cir"])
+def test_check_refuses_a_path_that_leaves_the_folder(server, name):
+    status, got = server.post_json("/api/check", {"spec": "name: x\nkind: netlist\ndeck: d.cir\n",
+                                                  "files": {name: "* x\n"}})
+    assert status == 400 and "a path relative to the folder chosen" in got["error"] and "\n" not in got["error"]
