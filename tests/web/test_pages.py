@@ -480,3 +480,33 @@ def test_back_and_forward_move_between_designs(page, server):
     assert "fc 1000 Hz" in page.inner_text("#title")
     assert after(page, lambda: page.go_forward()) == "done"
     assert page.input_value("input[name=fc]") == "2000" and "fc 2000 Hz" in page.inner_text("#title")
+
+
+def test_check_page_runs_the_repositorys_specs_folder_and_records_golden_files(page, server, tmp_path):
+    """Issue 29: the repository's own specs/ folder, chosen as a folder, runs as it is (its decks and golden
+    files by their paths; the PID specs' controllers from ../reports, chosen as a second folder); with "record
+    the golden files" ticked the page offers each golden file recorded for download."""
+    import yaml
+    from helpers import ROOT
+    for spec in (ROOT / "specs").glob("*.yaml"):   # the reports/ files the specs name, as a folder of their own
+        controller = (yaml.safe_load(spec.read_text()).get("controller") or {}).get("json")
+        if controller:
+            rel = (spec.parent / controller).resolve().relative_to(ROOT)
+            (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy(ROOT / rel, tmp_path / rel)
+    open_page(page, server, "/check")
+    page.set_input_files("#folder", str(ROOT / "specs"))
+    page.set_input_files("#folder", str(tmp_path / "reports"))
+    page.wait_for_function("() => /reports\\//.test(document.getElementById('decks').textContent)")
+    assert after(page, lambda: page.click("#run"), timeout=300000) == "done"
+    table = page.inner_text("#cases-table")
+    for spec in (ROOT / "specs").glob("*.yaml"):
+        assert yaml.safe_load(spec.read_text())["name"] in table
+    assert page.locator(".golden-file").count() == 0
+    page.check("input[name=update-golden]")
+    assert after(page, lambda: page.click("#run"), timeout=300000) == "done"
+    with page.expect_download() as dl:
+        page.locator(".golden-file", has_text="specs/golden/rc_ladder.csv").click()
+    assert dl.value.suggested_filename == "rc_ladder.csv"
+    assert Path(dl.value.path()).read_text().splitlines()[0] == (ROOT / "specs/golden/rc_ladder.csv").read_text() \
+        .splitlines()[0]
