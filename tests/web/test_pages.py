@@ -510,3 +510,41 @@ def test_check_page_runs_the_repositorys_specs_folder_and_records_golden_files(p
     assert dl.value.suggested_filename == "rc_ladder.csv"
     assert Path(dl.value.path()).read_text().splitlines()[0] == (ROOT / "specs/golden/rc_ladder.csv").read_text() \
         .splitlines()[0]
+
+
+def test_identify_a_synthetic_loop_table_shows_its_margins_marked(page, server, tmp_path):
+    """Issue 29: a loop-gain table (WaveForms' network-analyser export) shows the crossover, the phase and gain
+    margins among its figures and marked on both plots; the numbers are those solved from the loop's expression."""
+    import math
+    import numpy as np
+    from scipy.optimize import brentq
+    k, tau, T = 2 * math.pi * 3000.0 * 1.2, 1 / (2 * math.pi * 8e3), 5e-6
+    f = np.geomspace(100, 50e3, 151)
+    loop = lambda x: k * np.exp(-2j * math.pi * x * T) / (2j * math.pi * x * (tau * 2j * math.pi * x + 1))  # noqa
+    rows = ["#Digilent WaveForms Network Analyzer - Bode", "#Device Name: Discovery2", f"#Steps: {f.size}", "",
+            "Frequency (Hz),Channel 1 Magnitude (dB),Channel 2 Magnitude (dB),Channel 2 Phase (deg)"]
+    rows += [f"{a!r},-36.5,{20 * math.log10(abs(loop(a)))!r},{math.degrees(np.angle(loop(a)))!r}" for a in f.tolist()]
+    path = tmp_path / "loop_bode.csv"
+    path.write_text("\n".join(rows) + "\n")
+    fc = brentq(lambda x: abs(loop(x)) - 1.0, 100, 50e3)
+    pm = 180.0 - 90.0 - math.degrees(math.atan(2 * math.pi * fc * tau)) - 360.0 * fc * T
+    open_page(page, server, "/identify")
+    assert after(page, lambda: page.set_input_files("#file", str(path))) == "done"
+    shown = float(figure(page, "phase margin").split()[0])
+    assert abs(shown - pm) <= 0.3
+    assert page.get_attribute("#plot", "data-marks").startswith("crossover, PM ")
+    assert "GM " in page.get_attribute("#phase", "data-marks")
+    assert "A loop gain" in page.inner_text("#best")
+
+
+def test_identify_the_waveforms_loop_table_shows_pm_42_9_deg(page, server):
+    path = EXT_CAPTURES / "cbabe_Lab10_open_loop_bode.csv"
+    if not path.exists():
+        pytest.skip(f"{path.name} not found: real captures live beside the project (../shared/ext-captures)")
+    open_page(page, server, "/identify")
+    assert after(page, lambda: page.set_input_files("#file", str(path))) == "done"
+    status, _, raw = server.post("/api/identify?filename=open_loop.csv", path.read_bytes())
+    loop = json.loads(raw)["loop"]
+    assert figure(page, "phase margin") == f"{loop['phase_margin_deg']:.1f} deg" == "42.9 deg"
+    assert figure(page, "gain margin") == f"{loop['gain_margin_db']:.1f} dB"
+    assert "crossover, PM 42.9 deg" in page.get_attribute("#plot", "data-marks")
