@@ -128,9 +128,9 @@ def _fields(options, table: dict) -> dict:
             if word not in (True, False, "true", "false", "on", "off", ""):
                 raise DesignError(f"{f.param} is a switch: true or false, got {str(value)[:40]}", param=f.param)
             out[f.param] = word in (True, "true", "on")
-        elif f.kind == "list":
+        elif f.kind == "list":   # a list, or one text of items apart (a form's field: "R=1% C=5%")
             values = value if isinstance(value, list) else [value]
-            out[f.param] = tuple(value_text(v, f.param) for v in values)
+            out[f.param] = tuple(w for v in values for w in value_text(v, f.param).split())
         else:
             if isinstance(value, list):
                 raise DesignError(f"{f.param} takes one value, got {len(value)}", param=f.param)

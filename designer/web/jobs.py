@@ -384,7 +384,7 @@ def plant_page(result) -> dict:
     if result.sine is not None:   # as the sheet's settings table gives it
         bench.append(["sine check", rep._sine_text(result.sine)])
     return {"step": _trace(result.time_s, step, "time from the edge (s)"),
-            "bode": _bode(f, resp),
+            "bode": _bode(f, resp), "histograms": histograms(result.monte_carlo),
             "schematic_svg": _schematic_svg(rep, result, (result.built.as_dict(), result.package)),
             "bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
             "bench": bench,
@@ -434,6 +434,27 @@ def _schematic_svg(rep, result, key) -> str:
             _SCHEMATICS.pop(next(iter(_SCHEMATICS)))
         _SCHEMATICS[key] = svg
     return svg
+
+
+def histograms(mc) -> list:
+    """A Monte Carlo's histograms for the page, as the sheet draws them (:mod:`designer.report.tolerance`: the
+    headline figure's, then each limited figure's; 2 sqrt(n) bins, 10 to 60): each figure's bin edges and counts,
+    its nominal value and its limits; none without a Monte Carlo (or one build replayed)."""
+    if mc is None or mc.headline is None:
+        return []
+    out = []
+    for name in dict.fromkeys([mc.headline, *(lim.figure for lim in mc.limits)]):
+        v = np.asarray(mc.figures[name], float)
+        v = v[np.isfinite(v)]
+        if not v.size:
+            continue
+        k = int(np.clip(2 * math.sqrt(v.size), 10, 60)) if np.ptp(v) > 0 else 1
+        counts, edges = np.histogram(v, bins=k)
+        lim = next((lim for lim in mc.limits if lim.figure == name), None)
+        out.append({"figure": name, "edges": _list(edges), "counts": [int(c) for c in counts],
+                    "nominal": mc.nominal_figures.get(name), "min": None if lim is None else lim.min,
+                    "max": None if lim is None else lim.max, "n": int(v.size)})
+    return json_safe(out)
 
 
 def _complex_on_grid(f_data, h_data, grid) -> np.ndarray:

@@ -548,3 +548,40 @@ def test_identify_the_waveforms_loop_table_shows_pm_42_9_deg(page, server):
     assert figure(page, "phase margin") == f"{loop['phase_margin_deg']:.1f} deg" == "42.9 deg"
     assert figure(page, "gain margin") == f"{loop['gain_margin_db']:.1f} dB"
     assert "crossover, PM 42.9 deg" in page.get_attribute("#plot", "data-marks")
+
+
+def test_the_plant_pages_tolerance_panel_shows_yield_histogram_and_the_part_to_tighten(page, server):
+    """Issue 29: Monte Carlo count, tolerances and limits on the page; the yield with its interval, the histogram
+    with its limits, the part to buy tighter, as the API (the library) computes them."""
+    open_page(page, server, "/plant")
+    assert page.locator("#tolerance-section").is_hidden()
+    page.fill("input[name=tol]", "R=1% C=5%")
+    page.fill("input[name=limit]", "fn_hz=3.3k:3.7k")
+    assert after(page, lambda: page.fill("input[name=monte-carlo]", "200")) == "done"
+    status, want = server.post_json("/api/plant", {"fc": 3500, "zeta": 0.2, "monte-carlo": 200, "tol": "R=1% C=5%",
+                                                   "limit": "fn_hz=3.3k:3.7k"})
+    mc = want["monte_carlo"]
+    assert mc["settings"]["tolerances_pct"]["R1"] == 1.0 and mc["settings"]["tolerances_pct"]["C2"] == 5.0
+    pct = lambda v: f"{float(f'{100 * v:.3g}'):g}"  # noqa: E731 - as toPrecision(3) writes it
+    assert figure(page, "yield").split()[0] == pct(mc["yield"]["fraction"])
+    assert pct(mc["yield"]["ci95"][0]) in figure(page, "95 % interval")
+    t = mc["tighten"]
+    assert (f"Buy {t['part']} tighter" if t["yield"] > t["yield_now"] else "No part bought tighter") \
+        in page.inner_text("#tighten")
+    hist = page.locator(".histogram-figure[data-figure=fn_hz] svg")
+    assert hist.get_attribute("role") == "img" and "limits 3300 to 3700" in hist.get_attribute("aria-label")
+    assert page.locator(".histogram-figure[data-figure=fn_hz] line[data-limit]").count() == 2
+    assert page.evaluate("D.labelOf(document.getElementById('form'), 'monte-carlo')") == "Monte Carlo builds"
+    # a refused count is said beside its field in the page's words
+    assert after(page, lambda: page.fill("input[name=monte-carlo]", "5")) == "error"
+    assert page.inner_text(".field-error").startswith('"Monte Carlo builds" must be a whole number from 10')
+
+
+def test_every_plant_field_has_the_label_of_the_name_table(page, server):
+    """One name table per front end: the page's labels are designer.web.forms.PLANT's."""
+    from designer.web.forms import PLANT
+    open_page(page, server, "/plant")
+    names = page.evaluate("[...document.querySelectorAll('#form [name]')].map(e => e.name)")
+    assert names
+    for name in names:
+        assert page.evaluate(f"D.labelOf(document.getElementById('form'), '{name}')") == PLANT[name].label, name

@@ -432,3 +432,69 @@ D.dropZone = function (zone, input, onFile) {
   });
   input.addEventListener("change", () => { if (input.files.length) onFile(input.files); });
 };
+
+// The tolerance panel (Plant, PID): the yield with its 95 % interval, the part to buy tighter, and each
+// histogram (the server's bins: D.histogram) with its limits; hidden without a Monte Carlo.
+D.pct = v => `${(100 * v).toPrecision(3)} %`;
+D.tolerance = function (mc, hists) {
+  const section = document.getElementById("tolerance-section");
+  if (!section) return;
+  section.hidden = !mc;
+  if (!mc) return;
+  const figs = [D.fig("builds drawn", String(mc.settings.samples))];
+  const y = mc.yield;
+  if (y && mc.limits && mc.limits.length) {
+    figs.push(D.fig("yield", D.pct(y.fraction)),
+              D.fig("95 % interval (Wilson)", `${D.pct(y.ci95[0])} to ${D.pct(y.ci95[1])}`),
+              D.fig("within", mc.limits.map(l => `${l.figure} ${D.num(l.min, 4)} to ${D.num(l.max, 4)}`).join("; ")));
+  } else figs.push(D.fig("yield", "no limits given: the spread alone"));
+  document.getElementById("yield").replaceChildren(...figs);
+  const t = mc.tighten, tight = document.getElementById("tighten");
+  tight.textContent = !t ? "" : t.yield > t.yield_now
+    ? `Buy ${t.part} tighter: at ${t.tolerance_pct} % the yield is ${D.pct(t.yield)} (now ${D.pct(t.yield_now)}).`
+    : "No part bought tighter raises the yield: the design, not the parts, limits it.";
+  const box = document.getElementById("histograms");
+  box.replaceChildren(...(hists || []).map(h => D.histogram(h)));
+};
+
+// A histogram as SVG (bars, the limits as red lines, the nominal dashed), zoomable as any SVG, with its text
+// alternative: the counts per bin in a table below.
+D.histogram = function (h) {
+  const W = 640, H = 200, pad = 30, ns = "http://www.w3.org/2000/svg";
+  const lo = Math.min(h.edges[0], h.min ?? Infinity, h.nominal ?? Infinity);
+  const hi = Math.max(h.edges[h.edges.length - 1], h.max ?? -Infinity, h.nominal ?? -Infinity);
+  const span = hi - lo || Math.abs(hi) || 1, top = Math.max(...h.counts, 1);
+  const x = v => pad + (W - 2 * pad) * (v - lo + 0.03 * span) / (1.06 * span);
+  const yv = c => H - pad - (H - 2 * pad) * c / top;
+  const svg = document.createElementNS(ns, "svg");
+  svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+  svg.setAttribute("role", "img");
+  svg.setAttribute("class", "histogram");
+  svg.setAttribute("aria-label", `histogram of ${h.figure} over ${h.n} builds` +
+                   (h.min !== null ? `, limits ${D.num(h.min, 4)} to ${D.num(h.max, 4)}` : ""));
+  const el = (name, attrs, text) => {
+    const e = document.createElementNS(ns, name);
+    for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+    if (text) e.textContent = text;
+    svg.append(e);
+  };
+  h.counts.forEach((c, i) => el("rect", {x: x(h.edges[i]), y: yv(c), width: Math.max(0.5, x(h.edges[i + 1]) - x(h.edges[i]) - 0.5),
+                                         height: H - pad - yv(c), fill: "#6b8fc7"}));
+  el("line", {x1: pad, x2: W - pad, y1: H - pad, y2: H - pad, stroke: "#555"});
+  for (const [v, what] of [[h.min, "min"], [h.max, "max"]]) if (v !== null && v !== undefined)
+    el("line", {x1: x(v), x2: x(v), y1: pad / 2, y2: H - pad, stroke: "#d62728", "stroke-width": 2, "data-limit": what});
+  if (h.nominal !== null && h.nominal !== undefined)
+    el("line", {x1: x(h.nominal), x2: x(h.nominal), y1: pad / 2, y2: H - pad, stroke: "#333", "stroke-dasharray": "4 3"});
+  el("text", {x: pad, y: H - 8, "font-size": 11}, D.num(lo, 4));
+  el("text", {x: W - pad, y: H - 8, "font-size": 11, "text-anchor": "end"}, D.num(hi, 4));
+  el("text", {x: W / 2, y: 12, "font-size": 12, "text-anchor": "middle"}, `${h.figure} over ${h.n} builds`);
+  const wrap = document.createElement("figure");
+  wrap.className = "histogram-figure";
+  wrap.dataset.figure = h.figure;
+  wrap.append(svg);
+  const details = document.createElement("details");
+  details.append(Object.assign(document.createElement("summary"), {textContent: `${h.figure}: the counts as a table`}),
+                 D.table(["from", "to", "builds"], h.counts.map((c, i) => [D.num(h.edges[i], 4), D.num(h.edges[i + 1], 4), c])));
+  wrap.append(details);
+  return wrap;
+};

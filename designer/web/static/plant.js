@@ -25,6 +25,7 @@ function show(answer) {
   document.getElementById("bench").replaceChildren(D.table(["set", "to"], p.bench));
   document.getElementById("bomtable").replaceChildren(D.table(p.bom.header.slice(0, 7), p.bom.rows.map(x => x.slice(0, 7))));
   document.getElementById("checks").replaceChildren(D.checksTable(r.checks));
+  D.tolerance(r.monte_carlo, p.histograms);
   D.plot(document.getElementById("step"), p.step, {xUnit: "s", yLabel: "output (V)"});
   D.plot(document.getElementById("bode-gain"), p.bode.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 240});
   D.plot(document.getElementById("bode-phase"), p.bode.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 200});
