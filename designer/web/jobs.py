@@ -360,6 +360,7 @@ def plant_page(result) -> dict:
     band) and Bode (both models, SPICE's .ac points), schematic, BOM, bench."""
     from ..core.lti import freq_response
     from ..plant import report as rep
+    from ..report.document import to_html
     from ..report.wiring import BOM_HEADER, bench_rows, bom_csv
     a = result.test.amplitude_v
     amp = result.opamp.name
@@ -388,6 +389,9 @@ def plant_page(result) -> dict:
             "schematic_svg": _schematic_svg(rep, result, (result.built.as_dict(), result.package)),
             "bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
             "bench": bench,
+            # the sheet's content (wiring, expected readings and their band, target and achieved, sensitivity,
+            # alternatives) without its pictures: the page draws those itself
+            "sheet_html": to_html(rep.title_of(result), rep.sections(result, with_images=False), {}),
             "title": rep.title_of(result)}
 
 

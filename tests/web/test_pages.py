@@ -585,3 +585,18 @@ def test_every_plant_field_has_the_label_of_the_name_table(page, server):
     assert names
     for name in names:
         assert page.evaluate(f"D.labelOf(document.getElementById('form'), '{name}')") == PLANT[name].label, name
+
+
+def test_the_plant_page_shows_the_sheets_content(page, server):
+    """Issue 29: wiring, the expected scope readings with their tolerance band, target against achieved,
+    sensitivity and the alternatives, as the build sheet has them, in the page's words."""
+    open_page(page, server, "/plant")
+    text = page.evaluate("document.getElementById('sheet-html').shadowRoot.textContent")
+    for heading in ("Wiring", "Bench test: what the scope shows", "Target and achieved", "Sensitivity",
+                    "Alternatives (best first)"):
+        assert heading in text, heading
+    status, _, raw = server.post("/api/plant/sheet", {"fc": 3500, "zeta": 0.2})
+    sheet = raw.decode()
+    for heading in ("Wiring", "Target and achieved", "Sensitivity"):
+        assert heading in sheet
+    assert "--" not in text

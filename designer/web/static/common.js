@@ -498,3 +498,15 @@ D.histogram = function (h) {
   wrap.append(details);
   return wrap;
 };
+
+// The build sheet's content on the page: our own HTML (the sheet's renderer escapes every text), in a shadow root
+// so its styles stay inside; its advice in the page's words (the printed sheet keeps the command's: it goes with
+// the bundle's files).
+D.sheet = function (host, html, form) {
+  const root = host.shadowRoot || host.attachShadow({mode: "open"});
+  root.innerHTML = html;
+  const walk = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
+  for (let n = walk.nextNode(); n; n = walk.nextNode()) {
+    if (n.textContent.includes("--")) n.textContent = D.inPageWords(form, n.textContent, true);
+  }
+};

@@ -64,16 +64,7 @@ function show(answer) {
   D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 220, marks});
   D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 180, marks});
   document.getElementById("schematic").innerHTML = p.schematic_svg;
-  // the sheet is our own HTML (the build sheet's renderer escapes every text); shown in a shadow root so its
-  // styles stay inside
-  const host = document.getElementById("sheet-html");
-  const root = host.shadowRoot || host.attachShadow({mode: "open"});
-  root.innerHTML = p.sheet_html;
-  // its advice in the page's words (the printed sheet keeps the command's: it goes with the bundle's files)
-  const walk = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
-  for (let n = walk.nextNode(); n; n = walk.nextNode()) {
-    if (n.textContent.includes("--")) n.textContent = D.inPageWords(form, n.textContent, true);
-  }
+  D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
 }
 
 async function design() {

@@ -26,6 +26,7 @@ function show(answer) {
   document.getElementById("bomtable").replaceChildren(D.table(p.bom.header.slice(0, 7), p.bom.rows.map(x => x.slice(0, 7))));
   document.getElementById("checks").replaceChildren(D.checksTable(r.checks));
   D.tolerance(r.monte_carlo, p.histograms);
+  D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
   D.plot(document.getElementById("step"), p.step, {xUnit: "s", yLabel: "output (V)"});
   D.plot(document.getElementById("bode-gain"), p.bode.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 240});
   D.plot(document.getElementById("bode-phase"), p.bode.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 200});
