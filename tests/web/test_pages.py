@@ -600,3 +600,56 @@ def test_the_plant_page_shows_the_sheets_content(page, server):
     for heading in ("Wiring", "Target and achieved", "Sensitivity"):
         assert heading in sheet
     assert "--" not in text
+
+
+def _strokes(page) -> dict:
+    """Each trace label's colour on every plot of the page: label -> set of colours."""
+    return {k: set(v) for k, v in page.evaluate("""() => {
+        const out = {};
+        for (const el of document.querySelectorAll('.plot')) {
+            if (!el._plot) continue;
+            el._plot.series.forEach((s, i) => {
+                if (!i) return;
+                const c = typeof s.stroke === 'function' ? s.stroke(el._plot, i) : s.stroke;
+                (out[s.label] = out[s.label] || []).push(c);
+            });
+        }
+        return out; }""").items()}
+
+
+def test_one_colour_per_trace_kind_and_a_text_alternative_for_every_plot(page, server):
+    """Issue 29 (small things): SPICE is one colour on every plot, the ideal op-amp another; every plot has a
+    text alternative (its description and its key points as a table); the schematic too, and it opens full size."""
+    open_page(page, server, "/plant")
+    strokes = _strokes(page)
+    spice = strokes["SPICE (ngspice)"] | strokes["SPICE .ac"]
+    ideal = {c for label, cs in strokes.items() if "ideal" in label for c in cs}
+    assert len(spice) == 1 and len(ideal) == 1 and spice != ideal
+    for el in page.locator(".plot").all():
+        assert el.get_attribute("role") == "img" and " against " in el.get_attribute("aria-label")
+    tables = page.locator("details.plot-text table")
+    assert tables.count() == page.locator(".plot").count() and tables.first.locator("tbody tr").count() >= 10
+    svg = page.locator("#schematic svg")
+    r1 = page.locator("#bomtable tbody tr").first.locator("td")
+    assert svg.get_attribute("role") == "img"
+    assert f"{r1.nth(0).inner_text()} {r1.nth(1).inner_text()}" in svg.get_attribute("aria-label")
+    with page.context.expect_page() as popup:
+        page.click(".open-full")
+    shown = popup.value
+    shown.wait_for_load_state()
+    assert shown.url.startswith("blob:") and shown.locator("svg").count() >= 1
+    shown.close()
+    # the PID page: SPICE the same red
+    open_page(page, server, "/pid")
+    assert _strokes(page)["SPICE (ngspice)"] == spice
+
+
+@pytest.mark.parametrize("path, field, bad", [("/plant", "zeta", "-1"), ("/pid", "kp", "-3"),
+                                              ("/identify", None, None), ("/check", None, None)])
+def test_no_message_on_any_page_contains_a_flag(page, server, path, field, bad):
+    open_page(page, server, path)
+    if field is not None and page.locator(f"input[name={field}]").is_visible():
+        assert after(page, lambda: page.fill(f"input[name={field}]", bad), timeout=120000) == "error"
+    text = page.evaluate("document.body.innerText + [...document.querySelectorAll('*')].filter(e => e.shadowRoot)"
+                         ".map(e => e.shadowRoot.textContent).join(' ')")
+    assert "--" not in text, [line for line in text.splitlines() if "--" in line]

@@ -340,7 +340,16 @@ D.download = function (blob, name) {
   setTimeout(() => { URL.revokeObjectURL(a.href); a.remove(); }, 1000);
 };
 
-const COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf"];
+const COLOURS = ["#9467bd", "#8c564b", "#17becf", "#bcbd22", "#e377c2", "#7f7f7f"];
+// One colour per kind of trace on every plot (issue 29: red was SPICE on one plot and the ideal op-amp on the
+// next): SPICE red, the op-amp-aware model (and the realised loop) blue, the ideal one green, the measured data
+// black, the plant alone grey, the tolerance band orange; the identified models take the other colours in turn.
+D.TRACE_KINDS = [[/^SPICE/, "#d62728"], [/^data$|integrated impulse/, "#111111"], [/^tolerance band/, "#e0a040"],
+                 [/ideal/, "#2ca02c"], [/plant alone/, "#7f7f7f"], [/model|analytic|realised|loop gain/, "#1f77b4"]];
+D.traceColour = function (label, i) {
+  const kind = D.TRACE_KINDS.find(([re]) => re.test(label));
+  return kind ? kind[1] : COLOURS[i % COLOURS.length];
+};
 
 // One interactive plot (uPlot): drag to zoom, double-click to reset, click a legend entry to hide its trace.
 D.plot = function (el, trace, opts) {
@@ -351,13 +360,18 @@ D.plot = function (el, trace, opts) {
   const data = [trace.x, ...trace.series.map(s => s.y)];
   // as wide as its box (a phone's 390 px too), and redrawn at the box's width when that changes
   const width = Math.max(200, el.clientWidth || 640);
-  const series = [{label: trace.x_label}];
+  // the legend's values as the page writes numbers (uPlot shows "--" for none: blank here)
+  const series = [{label: trace.x_label, value: (u, v) => v === null || v === undefined ? "" : D.eng(v, opts.xUnit || "", 4)}];
+  let others = 0;
   trace.series.forEach((s, i) => {
     const band = /^tolerance band/.test(s.label);
     const points = /^(data|SPICE \.ac)$/.test(s.label);
-    series.push({label: s.label, stroke: band ? "#e0a040" : COLOURS[i % COLOURS.length],
+    const kind = D.TRACE_KINDS.some(([re]) => re.test(s.label));
+    // measured points as small rings, so the model lines under them stay visible
+    series.push({label: s.label, stroke: D.traceColour(s.label, kind ? 0 : others++),
                  width: i === 0 && !band ? 2.5 : 1.5, dash: band ? [4, 4] : undefined,
-                 spanGaps: false, points: points ? {show: true, size: 5} : {show: false},
+                 value: (u, v) => v === null || v === undefined ? "" : D.num(v, 4),
+                 spanGaps: false, points: points ? {show: true, size: 4, width: 1, fill: "transparent"} : {show: false},
                  paths: points ? () => null : undefined});
   });
   const u = new uPlot({
@@ -381,7 +395,58 @@ D.plot = function (el, trace, opts) {
   }
   el.dataset.series = trace.series.map(s => s.label).join("|");
   el.dataset.marks = (opts.marks || []).map(m => m.label).join("|");
+  D.plotText(el, trace, opts);
   return u;
+};
+
+// A plot's text alternative: what it shows in one line (its aria-label) and its key points as a table (a
+// dozen points along x, each trace's value there; the marks), in a <details> under it.
+D.plotText = function (el, trace, opts) {
+  const yLabel = opts.yLabel || "value";
+  el.setAttribute("role", "img");
+  el.setAttribute("aria-label", `${yLabel} against ${trace.x_label}: ${trace.series.map(s => s.label).join(", ")}` +
+                  ((opts.marks || []).length ? `; marked: ${opts.marks.map(m => m.label).join(", ")}` : ""));
+  const n = trace.x.length, rows = [];
+  for (let k = 0; k < 12 && n; k++) {
+    const i = Math.round(k * (n - 1) / 11);
+    if (rows.length && rows[rows.length - 1].i === i) continue;
+    rows.push({i, cells: [D.eng(trace.x[i], opts.xUnit || "", 4),
+                          ...trace.series.map(s => s.y[i] === null || s.y[i] === undefined ? "" : D.num(s.y[i], 4))]});
+  }
+  const table = D.table([trace.x_label, ...trace.series.map(s => s.label)], rows.map(r => r.cells));
+  const marks = (opts.marks || []).map(m => { const p = document.createElement("p"); p.textContent = m.label; return p; });
+  let details = el.nextElementSibling;
+  if (!details || !details.classList.contains("plot-text")) {
+    details = document.createElement("details");
+    details.className = "plot-text";
+    el.after(details);
+  }
+  details.replaceChildren(Object.assign(document.createElement("summary"), {textContent: `${yLabel}: key points as a table`}),
+                          ...marks, Object.assign(document.createElement("div"), {className: "scroll"}));
+  details.lastChild.append(table);
+};
+
+// The schematic (SVG, drawn by the server): a text alternative naming its parts, and a button that opens it
+// full size in a tab of its own, where the browser zooms it as any SVG.
+D.schematic = function (el, svg, what) {
+  el.innerHTML = svg;
+  const img = el.querySelector("svg");
+  if (img) {
+    img.setAttribute("role", "img");
+    img.setAttribute("aria-label", what);
+  }
+  let open = el.parentElement.querySelector(".open-full");
+  if (!open) {
+    open = document.createElement("button");
+    open.type = "button";
+    open.className = "open-full";
+    open.textContent = "open the schematic full size";
+    el.after(open);
+  }
+  open.onclick = () => {
+    const url = URL.createObjectURL(new Blob([svg], {type: "image/svg+xml"}));
+    if (!window.open(url, "_blank")) D.download(new Blob([svg], {type: "image/svg+xml"}), "schematic.svg");
+  };
 };
 
 // Vertical marks on a plot ({x, label}: the crossover, the phase-crossover), drawn over the traces with their

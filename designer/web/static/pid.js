@@ -63,7 +63,7 @@ function show(answer) {
   if (isFinite(m.phase_crossover_hz)) marks.push({x: m.phase_crossover_hz, label: `-180 deg: GM ${D.num(m.gain_margin_db, 3)} dB`});
   D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 220, marks});
   D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 180, marks});
-  document.getElementById("schematic").innerHTML = p.schematic_svg;
+  D.schematic(document.getElementById("schematic"), p.schematic_svg, `schematic of the loop: ${p.title}`);
   D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
 }
 

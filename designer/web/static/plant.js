@@ -21,7 +21,8 @@ function show(answer) {
     D.fig("settling time (2 %)", D.eng((r.spice || r.analytic_opamp).settling_time_s, "s", 4)),
     D.fig("SPICE agrees with the model", r.comparison.pass === undefined ? "n/a" : (r.comparison.pass ? "yes" : "NO")));
   document.getElementById("notes").replaceChildren(...r.notes.map(n => { const e = document.createElement("p"); e.textContent = D.inPageWords(form, n); return e; }));
-  document.getElementById("schematic").innerHTML = p.schematic_svg;
+  D.schematic(document.getElementById("schematic"), p.schematic_svg,
+              `schematic: ${p.bom.rows.map(x => `${x[0]} ${x[1]}`).join(", ")}`);
   document.getElementById("bench").replaceChildren(D.table(["set", "to"], p.bench));
   document.getElementById("bomtable").replaceChildren(D.table(p.bom.header.slice(0, 7), p.bom.rows.map(x => x.slice(0, 7))));
   document.getElementById("checks").replaceChildren(D.checksTable(r.checks));
