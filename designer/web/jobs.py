@@ -418,6 +418,7 @@ def pid_page(result) -> dict:
             "loop_gain": _bode(np.asarray(w.bode_w) / (2 * math.pi), {"loop gain L(jw)": w.loop_gain}),
             "schematic_svg": _schematic_svg(rep, result, None),
             "sheet_html": to_html(rep.title_of(result), rep.sections(result, with_images=False), {}),
+            "histograms": histograms(getattr(result, "monte_carlo", None)),
             "title": rep.title_of(result)}
 
 

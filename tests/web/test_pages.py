@@ -653,3 +653,20 @@ def test_no_message_on_any_page_contains_a_flag(page, server, path, field, bad):
     text = page.evaluate("document.body.innerText + [...document.querySelectorAll('*')].filter(e => e.shadowRoot)"
                          ".map(e => e.shadowRoot.textContent).join(' ')")
     assert "--" not in text, [line for line in text.splitlines() if "--" in line]
+
+
+def test_the_pid_pages_tolerance_panel(page, server):
+    """Issue 29: the PID page's tolerance panel: the loop's Monte Carlo, its yield and interval, its histogram
+    with the limits; the fields kept in the address."""
+    open_page(page, server, "/pid")
+
+    def fill_panel():   # the three fields at once, then left (asked at once): no half-filled panel is sent
+        page.evaluate("""() => { const f = document.getElementById('form');
+            f.elements['tol'].value = 'R=1% C=5%'; f.elements['limit'].value = 'overshoot_pct=0:30';
+            f.elements['monte-carlo'].value = '100';
+            f.elements['monte-carlo'].dispatchEvent(new Event('change', {bubbles: true})); }""")
+    assert after(page, fill_panel, timeout=120000) == "done"
+    assert page.locator("#tolerance-section").is_visible()
+    assert figure(page, "builds drawn") == "100"
+    assert page.locator(".histogram-figure line[data-limit]").count() == 2   # the limited figure's
+    assert "tol=R%3D1%25+C%3D5%25" in page.url and "monte-carlo=100" in page.url

@@ -228,7 +228,10 @@ D.answered = function (state) {
 D.history = {first: true, restoring: false};
 D.remember = function (opts) {
   const q = new URLSearchParams();
-  for (const [k, v] of Object.entries(opts)) if (typeof v !== "object") q.set(k, v === true ? "true" : v);
+  for (const [k, v] of Object.entries(opts)) {
+    if (Array.isArray(v)) q.set(k, v.join(" "));   // a field's items apart, as typed
+    else if (typeof v !== "object") q.set(k, v === true ? "true" : v);
+  }
   const url = `${location.pathname}?${q}`;
   if (url !== location.pathname + location.search) {
     if (D.history.first || D.history.restoring) history.replaceState({designer: true}, "", url);

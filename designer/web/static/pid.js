@@ -23,6 +23,8 @@ function showTargets() {
 function request() {
   const o = D.options(form);
   delete o.plant;
+  // the tolerance panel's fields hold several items apart ("R=1% C=5%"): the API takes them as a list
+  for (const k of ["tol", "limit"]) if (o[k]) o[k] = o[k].split(/\s+/);
   if (plantKind() === "identify") {
     if (!identified) return null;
     o["plant-model"] = identified;   // identify's own --json, as design-pid --plant-model reads it
@@ -64,6 +66,7 @@ function show(answer) {
   D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 220, marks});
   D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 180, marks});
   D.schematic(document.getElementById("schematic"), p.schematic_svg, `schematic of the loop: ${p.title}`);
+  D.tolerance(r.monte_carlo, p.histograms);
   D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
 }
 
