@@ -41,6 +41,8 @@ from . import request as req
 from .guard import Guard, Trust, error_response
 from .jobs import LIBRARY
 
+__all__ = ["DISCONNECT_POLL_S", "MAX_DEPTH", "PAGES", "STATIC", "TooLarge", "create_app"]
+
 STATIC = Path(__file__).parent / "static"
 MEDIA = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=utf-8",
          ".css": "text/css; charset=utf-8", ".txt": "text/plain; charset=utf-8", ".svg": "image/svg+xml",

@@ -39,6 +39,10 @@ from ..cli.common import RESULT_HOOK, run_cli
 from ..core import lifetime
 from ..core.jsonio import json_safe
 
+__all__ = ["BODE_POINTS", "LIBRARY", "MAINS", "TRACE_POINTS", "Superseded", "bundle_zip", "check_files",
+           "design_plant_task", "files_in", "histograms", "identify_page", "pid_page", "plant_page", "run",
+           "run_task", "temporaries_in", "warm_up", "written_since"]
+
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
 #: frequency points of a Bode trace
@@ -91,7 +95,10 @@ def run(task: dict) -> dict:
     """
     global _RUNNING
     if signal.getsignal(signal.SIGUSR1) is not _cancel:
-        signal.signal(signal.SIGUSR1, _cancel)
+        try:
+            signal.signal(signal.SIGUSR1, _cancel)
+        except ValueError:   # not the main thread (a caller's own thread): no cancel, the run goes on
+            pass
     _RUNNING = True
     try:
         return run_task(task)

@@ -40,6 +40,9 @@ from multiprocessing.connection import wait
 from ..core import lifetime
 from ..core.workers import Worker, close_all
 
+__all__ = ["DEFAULT_TIMEOUT_S", "MAX_WAITING", "RECYCLE_AFTER", "SPARE", "STOPPED", "SUPERSEDED_GRACE_S", "Busy",
+           "Pool"]
+
 #: seconds a worker may take over one request before it is killed (design-pid's optimiser takes a few)
 DEFAULT_TIMEOUT_S = 120.0
 #: a new worker's first task (:func:`designer.web.jobs.run` warms up: ngspice loaded, modules imported), its own
