@@ -259,6 +259,18 @@ def native():
         _native -= 1
 
 
+def in_native() -> bool:
+    """Whether a :func:`native` block is running (an exception raised now may land in a callback of
+    ngspice's, where cffi prints and swallows it).
+
+    Returns
+    -------
+    bool
+        True inside :func:`native`.
+    """
+    return _native > 0
+
+
 def emergency(signum: int) -> None:
     """End the process now: the one line, the clean-ups, exit 128 + ``signum``."""
     try:

@@ -39,6 +39,9 @@ from ..core.fileio import MAX_CAPTURE_BYTES, check_plain_name
 from . import pool as pool_module
 from . import request as req
 from .guard import Guard, Trust, error_response
+from .jobs import LIBRARY
+
+__all__ = ["DISCONNECT_POLL_S", "MAX_DEPTH", "PAGES", "STATIC", "TooLarge", "create_app"]
 
 __all__ = []
 
@@ -51,6 +54,9 @@ PAGES = {"/": "plant.html", "/plant": "plant.html", "/pid": "pid.html", "/identi
          "/check": "check.html"}
 #: the commands' refusals of a file over their size limits (designer.core.fileio): answered 413
 _TOO_LARGE = re.compile(r"the most this command reads|; at most [0-9.]+ [KMG]?i?B is read")
+#: how often a waiting request looks whether its client is still there (a page typing on closes it): a
+#: superseded run is stopped within this
+DISCONNECT_POLL_S = 0.03
 #: multipart framing around an upload (boundaries, part headers) allowed over the file's own limit
 FRAMING_BYTES = 64 * 1024
 
@@ -110,26 +116,29 @@ def create_app(pool, trust: Trust):
 
     async def health(request):
         return JSONResponse({"ok": True, "jobs": pool.jobs, "timeout_s": pool.timeout, "dropped": pool.dropped,
-                             "ran": pool.ran})
+                             "ran": pool.ran, "superseded": pool.superseded})
 
     choices = _choices()
 
     async def choices_endpoint(request):
         return JSONResponse(choices)
 
-    async def run(request, prog: str, argv: list, want: str, tmp: str, upload_name: str | None = None):
+    async def run(request, prog: str, argv: list | None, want: str, tmp: str, upload_name: str | None = None,
+                  fields: dict | None = None):
         # the task goes to the pool as its file's name: a message of a hundred bytes, so that the pipe to the
         # pool never fills while the pool is sending a long answer the other way (each would wait on the other)
         task_file = os.path.join(tmp, "task.json")
+        task = {"prog": prog, "want": want, "tmp": tmp}
+        task.update({"fields": fields} if prog in LIBRARY else {"argv": argv})
         with open(task_file, "w", encoding="utf-8") as fh:
-            json.dump({"prog": prog, "argv": argv, "want": want, "tmp": tmp}, fh)
+            json.dump(task, fh)
         try:
             rid, answer = pool.start({"task_file": task_file})
         except pool_module.Busy as exc:
             return _error(503, f"{prog}: error: {exc}")
         # a page typing ahead drops its older requests: one whose client has gone leaves the queue
         while not answer.done():
-            await asyncio.wait({answer}, timeout=0.25)
+            await asyncio.wait({answer}, timeout=DISCONNECT_POLL_S)
             if not answer.done() and await request.is_disconnected():
                 pool.cancel(rid)
                 await answer   # dropped from the queue at once, or its run finished: the folder is free
@@ -145,6 +154,8 @@ def create_app(pool, trust: Trust):
             code = 400 if status == 2 else 502 if status == 3 else 503
             if status == 2 and _TOO_LARGE.search(line):
                 code = 413
+            if "field" in value:   # the library's refusal in the page's words: the field it names
+                return error_response(code, line, value["field"], value["label"])
             return _error(code, line)
         if want in ("sheet", "bundle"):
             return Response(value["body"], media_type=value["media"],
@@ -153,6 +164,7 @@ def create_app(pool, trust: Trust):
             answer = {"result": value["json"], "page": value.get("page"), "status": status}
         elif prog == "check-design":
             answer = {"status": status, **value["json"], "junit": value["junit"], "summary": value["summary"],
+                      "golden": value.get("golden", {}),
                       "lines": value["stdout"].splitlines(), "messages": value["stderr"].splitlines()}
         else:
             answer = value["json"]
@@ -170,6 +182,8 @@ def create_app(pool, trust: Trust):
                                        f"{req.MAX_JSON_BYTES // (1024 * 1024)} MiB")
                 except DesignError as exc:
                     return _error(400, f"{prog}: error: {exc}")
+                if prog in LIBRARY:   # the library called with the request's fields: no command line
+                    return await run(request, prog, None, how, tmp, fields=options)
                 try:
                     argv = req.build_argv(options, tmp, traits[prog])
                 except DesignError as exc:
@@ -204,10 +218,15 @@ def create_app(pool, trust: Trust):
                 return _error(413, f"{prog}: error: the spec and its decks are larger than check-design reads")
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
+            golden = options.pop("update-golden", None) if isinstance(options, dict) else None
             try:
-                argv = [files["spec"]] + req.build_argv(options, None, traits[prog])
+                if golden not in (None, True, False, "true", "false", "on", "off", ""):
+                    raise DesignError(f"--update-golden is a switch: true or false, got {str(golden)[:40]}")
+                argv = list(files["specs"]) + req.build_argv(options, None, traits[prog])
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
+            # the golden files recorded in the request's folder, answered for download (never kept)
+            argv += ["--update-golden"] if golden in (True, "true", "on") else []
             argv += ["--junit", os.path.join(tmp, "junit.xml"), "--summary", os.path.join(tmp, "summary.md"),
                      "--out", os.path.join(tmp, "out"), "--root", os.path.join(tmp, "in")]
             return await run(request, prog, argv, "check", tmp)
@@ -286,6 +305,35 @@ async def _body(request: Request, limit: int) -> bytes:
             raise TooLarge()
         chunks.append(chunk)
     return b"".join(chunks)
+
+
+#: most folders deep a Check upload's relative path may go (specs/decks/sub/x.cir is 3)
+MAX_DEPTH = 8
+
+
+def _relative(name) -> str:
+    """An uploaded file's path relative to the folder chosen (``specs/decks/rc_ladder.cir``, as a browser gives
+    a folder's files), every part a plain name (:func:`~designer.core.fileio.check_plain_name`): no ``..``, no
+    absolute path, nothing outside the request's private folder; else a one-line refusal."""
+    text = str(name or "").replace("\\", "/")
+    parts = text.split("/")
+    try:
+        if text.startswith("/") or len(parts) > MAX_DEPTH + 1:
+            raise DesignError("")
+        for part in parts:
+            check_plain_name(part, "file name")
+    except DesignError:
+        raise DesignError(f"file {text[:80]!r}: a path relative to the folder chosen, each part a plain name "
+                          "(letters, digits and . _ - + = , @; no '..', no absolute path), as the spec names it") \
+            from None
+    return "/".join(parts)
+
+
+def _write_inside(inside: str, rel: str) -> str:
+    """The path of ``rel`` (checked by :func:`_relative`) under ``inside``, its folders made."""
+    path = os.path.join(inside, *rel.split("/"))
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    return path
 
 
 def _plain(name, fallback: str) -> str:
@@ -407,38 +455,53 @@ async def _check_inputs(request: Request, tmp: str, limit: int) -> tuple:
     if ctype.startswith("multipart/form-data"):
         files, fields = await _multipart(request, tmp, limit)
         spec = files.pop("spec", None)
-        if not spec:
-            raise DesignError("the form has no spec: send the spec file as the field 'spec'")
-        written["spec"] = os.path.join(inside, _plain(spec[0].file_name and
-                                                      spec[0].file_name.decode("utf-8", "replace"), "spec.yaml"))
-        _save(spec[0], written["spec"])
+        specs = []
+        if spec:
+            specs.append(_relative(spec[0].file_name.decode("utf-8", "replace") if spec[0].file_name
+                                   else "spec.yaml"))
+            _save(spec[0], _write_inside(inside, specs[0]))
         for parts in files.values():
             for f in parts:
-                name = _plain(f.file_name and f.file_name.decode("utf-8", "replace"), "")
-                if not name:
-                    raise DesignError("an uploaded file's name must be plain (letters, digits and . _ - + = , @), "
-                                      "as the spec names it")
-                _save(f, os.path.join(inside, name))
+                rel = _relative(f.file_name and f.file_name.decode("utf-8", "replace"))
+                _save(f, _write_inside(inside, rel))
+                if not spec and _is_spec(rel):   # a folder's specs, every one of them run
+                    specs.append(rel)
+        if not specs:
+            raise DesignError("the form has no spec: send the spec file as the field 'spec', or a folder holding "
+                              "specs (.yaml)")
         options = {k: v for k, v in fields.items() if k != "spec"}
         spec_text = fields.get("spec")
         if spec_text is not None:
             raise DesignError("send the spec as a file, not a text field")
+        written["specs"] = [os.path.join(inside, *rel.split("/")) for rel in sorted(specs)]
         return written, options
     body = req.parse_json(await _body(request, limit))
-    form = 'the body must be {"spec": "<the spec file\'s text>", "files": {"deck.cir": "..."}, "options": {...}}'
-    if not isinstance(body, dict) or not isinstance(body.get("spec"), str):
+    form = ('the body must be {"spec": "<the spec file\'s text>", "files": {"decks/deck.cir": "..."}, "options": '
+            '{...}}, or {"specs": ["specs/a.yaml"], "files": {"specs/a.yaml": "...", ...}}')
+    if not isinstance(body, dict) or not (isinstance(body.get("spec"), str) or isinstance(body.get("specs"), list)):
         raise DesignError(form)
     files = body.get("files") or {}
     if not isinstance(files, dict) or not isinstance(body.get("options") or {}, dict) \
             or not isinstance(body.get("spec_name", ""), (str, type(None))):
         raise DesignError(form)
-    name = _plain(body.get("spec_name"), "spec.yaml")
-    written["spec"] = os.path.join(inside, name)
-    Path(written["spec"]).write_text(body["spec"], encoding="utf-8")
     for fname, text in files.items():
-        plain = _plain(fname, "")
-        if not plain or not isinstance(text, str):
+        if not isinstance(text, str):
             raise DesignError(f"file {str(fname)[:60]!r}: a plain name and its text")
-        Path(inside, plain).write_text(text, encoding="utf-8")
+        Path(_write_inside(inside, _relative(fname))).write_text(text, encoding="utf-8")
+    if isinstance(body.get("spec"), str):
+        name = _relative(body.get("spec_name") or "spec.yaml")
+        specs = [name]
+        Path(_write_inside(inside, name)).write_text(body["spec"], encoding="utf-8")
+    else:
+        specs = [_relative(p) if isinstance(p, str) else _relative(None) for p in body["specs"]]
+        missing = [p for p in specs if p not in {_relative(f) for f in files}]
+        if not specs or missing:
+            raise DesignError(f"spec {missing[0]!r} is not among the files sent" if missing else form)
+    written["specs"] = [os.path.join(inside, *rel.split("/")) for rel in specs]
     options = body.get("options") or {}
     return written, options
+
+
+def _is_spec(rel: str) -> bool:
+    """Whether a file of a folder sent to Check is a spec to run (a YAML file)."""
+    return rel.lower().endswith((".yaml", ".yml"))

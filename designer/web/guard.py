@@ -165,12 +165,16 @@ class _LocalAddresses:
         return local
 
 
-def error_response(code: int, line: str) -> JSONResponse:
+def error_response(code: int, line: str, field: str | None = None, label: str | None = None) -> JSONResponse:
     """An error answer: the one line, its message (the line without the command's name) and the option it
-    names (for the page), as every refusal of the server is written."""
+    names (for the page), as every refusal of the server is written; a library refusal already in the page's
+    words gives the ``field`` it names (``option`` is then ``--`` and the field) and that field's ``label``."""
     import re
     line = " ".join(str(line).split())
     message = re.sub(r"^[a-z-]+: error: ", "", line)
+    if field is not None or label is not None:
+        return JSONResponse({"error": line, "message": message, "option": None if field is None else "--" + field,
+                             "field": field, "label": label}, status_code=code)
     found = re.search(r"--[a-z][a-z0-9-]*", message)
     return JSONResponse({"error": line, "message": message, "option": found.group(0) if found else None},
                         status_code=code)

@@ -24,6 +24,7 @@ import io
 import json
 import math
 import os
+import signal
 import sys
 import tempfile
 from contextlib import contextmanager, redirect_stderr, redirect_stdout
@@ -35,9 +36,12 @@ from ..cli import identify as cli_identify
 from ..cli import pid as cli_pid
 from ..cli import plant as cli_plant
 from ..cli.common import RESULT_HOOK, run_cli
+from ..core import lifetime
 from ..core.jsonio import json_safe
 
-__all__ = ["TRACE_POINTS", "run", "temporaries_in", "warm_up"]
+__all__ = ["BODE_POINTS", "LIBRARY", "MAINS", "TRACE_POINTS", "Superseded", "bundle_zip", "check_files",
+           "design_plant_task", "files_in", "histograms", "identify_page", "pid_page", "plant_page", "run",
+           "run_task", "temporaries_in", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
@@ -54,7 +58,57 @@ MAINS = {
 }
 
 
+class Superseded(BaseException):
+    """The page typed on: the request under way is of inputs nobody will see (the pool's SIGUSR1, raised
+    between two bytecodes of the run; a BaseException, so that no ``except Exception`` of the library keeps
+    it). Whatever it runs unwinds: ``subprocess.run`` kills an ``ngspice -b`` it waits for, the
+    ``with`` blocks close, and the worker takes the next request."""
+
+
+#: whether a task is running in this process (a cancel that comes after it ended is ignored)
+_RUNNING = False
+
+
+def _cancel(signum, frame) -> None:
+    if not _RUNNING:
+        return
+    if lifetime.in_native():   # inside ngspice's callbacks cffi would swallow it: again in 5 ms
+        signal.signal(signal.SIGALRM, _cancel)
+        signal.setitimer(signal.ITIMER_REAL, 0.005)
+        return
+    raise Superseded()
+
+
 def run(task: dict) -> dict:
+    """Run one task in this (worker) process; a SIGUSR1 while it runs (:class:`Superseded`: the pool's
+    cancel of a request whose client left) ends it at once, answered ``{"status": "superseded"}``.
+
+    Parameters
+    ----------
+    task : dict
+        As :func:`run_task`'s.
+
+    Returns
+    -------
+    dict
+        :func:`run_task`'s answer.
+    """
+    global _RUNNING
+    if signal.getsignal(signal.SIGUSR1) is not _cancel:
+        try:
+            signal.signal(signal.SIGUSR1, _cancel)
+        except ValueError:   # not the main thread (a caller's own thread): no cancel, the run goes on
+            pass
+    _RUNNING = True
+    try:
+        return run_task(task)
+    except Superseded:
+        return {"status": "superseded", "error": None, "json": None}
+    finally:
+        _RUNNING = False
+
+
+def run_task(task: dict) -> dict:
     """Run one task in this (worker) process.
 
     Parameters
@@ -79,10 +133,13 @@ def run(task: dict) -> dict:
             task = json.load(fh)
     if task["prog"] == "warm-up":
         return warm_up()
+    if "fields" in task:
+        return LIBRARY[task["prog"]](task["fields"], task.get("want", "json"), task.get("tmp"))
     prog, argv, want, tmp = task["prog"], list(task["argv"]), task.get("want", "json"), task.get("tmp")
     seen = {}
     out, err = io.StringIO(), io.StringIO()
     token = RESULT_HOOK.set(lambda result, name: seen.update(result=result, name=name))
+    before = files_in(os.path.join(tmp, "in")) if prog == "check-design" and tmp else {}
     argv0 = sys.argv
     sys.argv = [prog, *argv]   # the JSON's tool.argv: the command line this request stands for
     try:
@@ -105,6 +162,7 @@ def run(task: dict) -> dict:
         return answer
     if prog == "check-design":
         answer.update(check_files(tmp))
+        answer["golden"] = written_since(os.path.join(tmp, "in"), before) if "--update-golden" in argv else {}
         answer["stdout"] = out.getvalue()
         return answer
     answer["json"] = json.loads(out.getvalue())
@@ -150,6 +208,67 @@ def _error_line(stderr: str, status: int) -> str | None:
 def _read(path) -> bytes:
     with open(path, "rb") as fh:
         return fh.read()
+
+
+# --------------------------------------------------------------------------- library-first commands
+
+def design_plant_task(fields: dict, want: str = "json", tmp: str | None = None) -> dict:
+    """design-plant for the page, the library called directly: the request's fields as the specs
+    (:func:`designer.web.forms.plant_request`), :func:`designer.plant.design.design_plant`, the PRBS
+    bench test and the tolerance analysis asked for, and the typed result rendered.
+
+    Parameters
+    ----------
+    fields : dict
+        The request's JSON object (the plant page's fields, :data:`designer.web.forms.PLANT`).
+    want : str
+        As :func:`run`'s.
+    tmp : str or None
+        The request's private folder (the files of a sheet or bundle; every temporary file).
+
+    Returns
+    -------
+    dict
+        As :func:`run`'s; a refusal's ``field`` and ``label`` name the page's field at fault.
+    """
+    from ..core.errors import DesignError, SimulatorError
+    from ..plant.design import design_plant
+    from ..plant.report import write_outputs
+    from ..tolerance.mcspec import plant_tolerance
+    from .forms import PLANT, page_message, plant_request
+    prog = "design-plant"
+    try:
+        with temporaries_in(tmp):
+            rq = plant_request(fields)
+            result = design_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
+            if rq.stimulus is not None:
+                from ..plant.prbs import with_prbs
+                result = with_prbs(result, result.test.amplitude_v, rq.stimulus[0], rq.stimulus[1], rq.simulate,
+                                   rq.simulator)
+            result = plant_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
+            if want in ("sheet", "bundle"):
+                write_outputs(result, tmp, rq.name)
+    except SimulatorError as exc:
+        return {"status": 3, "error": f"{prog}: error: simulator error: {exc}", "json": None}
+    except DesignError as exc:
+        text, field = page_message(exc, PLANT)
+        return {"status": 2, "error": f"{prog}: error: {text}", "json": None, "field": field,
+                "label": PLANT[field].label if field else None}
+    data = json.loads(json.dumps(result.to_dict()))
+    data["tool"]["argv"] = rq.argv   # the command line this request stands for: a record, never parsed
+    answer = {"status": 0, "error": None, "json": data}
+    if want == "page":
+        answer["page"] = plant_page(result)
+    elif want == "sheet":
+        answer.update(body=_read(os.path.join(tmp, "reports", rq.name, "build-sheet.html")),
+                      media="text/html; charset=utf-8", filename="build-sheet.html")
+    elif want == "bundle":
+        answer.update(body=bundle_zip(tmp, rq.name), media="application/zip", filename=f"{rq.name}.zip")
+    return answer
+
+
+#: the commands the page runs through the library (no console script, no argv, no printed JSON)
+LIBRARY = {"design-plant": design_plant_task}
 
 
 # --------------------------------------------------------------------------- identify
@@ -248,6 +367,7 @@ def plant_page(result) -> dict:
     band) and Bode (both models, SPICE's .ac points), schematic, BOM, bench."""
     from ..core.lti import freq_response
     from ..plant import report as rep
+    from ..report.document import to_html
     from ..report.wiring import BOM_HEADER, bench_rows, bom_csv
     a = result.test.amplitude_v
     amp = result.opamp.name
@@ -272,10 +392,13 @@ def plant_page(result) -> dict:
     if result.sine is not None:   # as the sheet's settings table gives it
         bench.append(["sine check", rep.sine_text(result.sine)])
     return {"step": _trace(result.time_s, step, "time from the edge (s)"),
-            "bode": _bode(f, resp),
+            "bode": _bode(f, resp), "histograms": histograms(result.monte_carlo),
             "schematic_svg": _schematic_svg(rep, result, (result.built.as_dict(), result.package)),
             "bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
             "bench": bench,
+            # the sheet's content (wiring, expected readings and their band, target and achieved, sensitivity,
+            # alternatives) without its pictures: the page draws those itself
+            "sheet_html": to_html(rep.title_of(result), rep.sections(result, with_images=False), {}),
             "title": rep.title_of(result)}
 
 
@@ -302,6 +425,7 @@ def pid_page(result) -> dict:
             "loop_gain": _bode(np.asarray(w.bode_w) / (2 * math.pi), {"loop gain L(jw)": w.loop_gain}),
             "schematic_svg": _schematic_svg(rep, result, None),
             "sheet_html": to_html(rep.title_of(result), rep.sections(result, with_images=False), {}),
+            "histograms": histograms(getattr(result, "monte_carlo", None)),
             "title": rep.title_of(result)}
 
 
@@ -322,6 +446,27 @@ def _schematic_svg(rep, result, key) -> str:
             _SCHEMATICS.pop(next(iter(_SCHEMATICS)))
         _SCHEMATICS[key] = svg
     return svg
+
+
+def histograms(mc) -> list:
+    """A Monte Carlo's histograms for the page, as the sheet draws them (:mod:`designer.report.tolerance`: the
+    headline figure's, then each limited figure's; 2 sqrt(n) bins, 10 to 60): each figure's bin edges and counts,
+    its nominal value and its limits; none without a Monte Carlo (or one build replayed)."""
+    if mc is None or mc.headline is None:
+        return []
+    out = []
+    for name in dict.fromkeys([mc.headline, *(lim.figure for lim in mc.limits)]):
+        v = np.asarray(mc.figures[name], float)
+        v = v[np.isfinite(v)]
+        if not v.size:
+            continue
+        k = int(np.clip(2 * math.sqrt(v.size), 10, 60)) if np.ptp(v) > 0 else 1
+        counts, edges = np.histogram(v, bins=k)
+        lim = next((lim for lim in mc.limits if lim.figure == name), None)
+        out.append({"figure": name, "edges": _list(edges), "counts": [int(c) for c in counts],
+                    "nominal": mc.nominal_figures.get(name), "min": None if lim is None else lim.min,
+                    "max": None if lim is None else lim.max, "n": int(v.size)})
+    return json_safe(out)
 
 
 def _complex_on_grid(f_data, h_data, grid) -> np.ndarray:
@@ -393,7 +538,25 @@ def check_files(tmp: str) -> dict:
             "summary": _read(summary).decode("utf-8") if os.path.isfile(summary) else None}
 
 
+def files_in(folder: str) -> dict:
+    """Every file under ``folder``: its path relative to it (``/``-separated) -> (size, modification time)."""
+    out = {}
+    for base, _dirs, names in os.walk(folder):
+        for name in names:
+            path = os.path.join(base, name)
+            st = os.stat(path)
+            out[os.path.relpath(path, folder).replace(os.sep, "/")] = (st.st_size, st.st_mtime_ns)
+    return out
+
+
+def written_since(folder: str, before: dict) -> dict:
+    """The files under ``folder`` made or changed since ``before`` (:func:`files_in`): relative path -> text
+    (what check-design ``--update-golden`` recorded: the golden waveforms, CSV)."""
+    return {rel: _read(os.path.join(folder, *rel.split("/"))).decode("utf-8", "replace")
+            for rel, stamp in sorted(files_in(folder).items()) if before.get(rel) != stamp}
+
+
 def warm_up() -> None:
     """A worker's first task: one plant designed, simulated and drawn for the page, so that the
     first request finds ngspice loaded, every module imported and schemdraw's fonts measured."""
-    run({"prog": "design-plant", "argv": ["--fc", "3500", "--zeta", "0.2", "--json", "--no-files"], "want": "page"})
+    design_plant_task({"fc": 3500, "zeta": 0.2}, "page")

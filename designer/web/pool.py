@@ -13,6 +13,11 @@ order: none is lost, and each answer carries its request's number, so none is
 mixed with another's. The pool and the workers die with the server
 (:func:`designer.core.lifetime.die_with_parent`).
 
+A killed worker (past its deadline, or a superseded run that did not unwind within
+:data:`SUPERSEDED_GRACE_S`: one stuck in ngspice's shared library) is replaced at once by a
+spare, a worker warmed up beforehand and kept idle (:data:`SPARE`), so that the next request
+does not wait for a new worker's warm-up.
+
 A worker that has served ``recycle`` requests (:data:`RECYCLE_AFTER`) is replaced by a fresh
 one between two requests, so that what a long-lived process accumulates (each request left
 40-80 kB in a worker: caches of the libraries it runs) stays bounded. When the server stops
@@ -35,7 +40,8 @@ from multiprocessing.connection import wait
 from ..core import lifetime
 from ..core.workers import Worker, close_all
 
-__all__ = ["Busy", "Pool", "STOPPED"]
+__all__ = ["DEFAULT_TIMEOUT_S", "MAX_WAITING", "RECYCLE_AFTER", "SPARE", "STOPPED", "SUPERSEDED_GRACE_S", "Busy",
+           "Pool"]
 
 #: seconds a worker may take over one request before it is killed (design-pid's optimiser takes a few)
 DEFAULT_TIMEOUT_S = 120.0
@@ -47,6 +53,10 @@ WARM_UP_TIMEOUT_S = 300.0
 MAX_WAITING = 256
 #: requests a worker serves before a fresh one replaces it (designer-web --recycle)
 RECYCLE_AFTER = 200
+#: seconds a superseded run has to unwind before its worker is killed (and replaced) instead
+SUPERSEDED_GRACE_S = 0.1
+#: warmed-up workers kept idle to replace a killed one at once (designer-web's workers plus these)
+SPARE = 1
 #: what a request still waiting when the server stops is answered
 STOPPED = "the server is stopping: the request was cancelled; send it again once the server is back"
 
@@ -56,7 +66,7 @@ class Busy(Exception):
 
 
 def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work,
-               recycle: int = RECYCLE_AFTER) -> None:
+               recycle: int = RECYCLE_AFTER, spare: int = SPARE) -> None:
     """The pool process: requests ``(id, task)`` in from the server, ``(id, kind, value)`` out
     (ids from 1: 0 is a worker's warm-up, answered to nobody)."""
     lifetime.die_with_parent(parent_pid)
@@ -73,19 +83,30 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
         return w
 
     workers = [fresh() for _ in range(jobs)]
+    # warmed up and idle: one takes a killed worker's place at once (a superseded run stuck in ngspice's shared
+    # library, a run past its deadline), so that the next request does not wait for a new worker's warm-up
+    spares = [fresh() for _ in range(spare)]
     served = {}   # requests each worker (by pid) has answered
+
+    def replacement():
+        ready = next((w for w in spares if w.task is None), None)
+        if ready is None:
+            return fresh()
+        spares.remove(ready)
+        spares.append(fresh())
+        return ready
 
     def stop(_signum, _frame):
         # the server stops (Pool.stop_now): every run ends now, with its ngspice; the server answers
         # everything it waits for when this process's end of the pipe closes
-        for w in workers:
+        for w in workers + spares:
             w.kill()
         os._exit(0)
     signal.signal(signal.SIGTERM, stop)
     queue = deque()
     try:
         while True:
-            busy = [w for w in workers if w.task is not None]
+            busy = [w for w in workers + spares if w.task is not None]
             left = None if not busy else max(0.0, min(w.deadline for w in busy) - time.monotonic())
             ready = wait([conn] + [w.conn for w in busy], timeout=left)
             if conn in ready:
@@ -99,8 +120,28 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                     if any(m[0] == -msg[0] for m in queue):
                         queue = deque(m for m in queue if m[0] != -msg[0])
                         conn.send((-msg[0], "cancelled", None))
+                    for w in workers:   # under way: stopped where it is (designer.web.jobs.Superseded)
+                        if w.task == -msg[0] and not getattr(w, "superseded", False):
+                            w.superseded = True
+                            try:
+                                os.kill(w.proc.pid, signal.SIGUSR1)
+                            except ProcessLookupError:
+                                pass
+                            # a run that does not come back (stuck in a long C call) is killed as at its deadline
+                            w.deadline = min(w.deadline, time.monotonic() + SUPERSEDED_GRACE_S)
                 else:
                     queue.append(msg)
+            for k, w in enumerate(spares):   # a spare's warm-up done (or past its deadline: another)
+                if w.task is not None and w.conn in ready:
+                    try:
+                        w.conn.recv()
+                        w.task = None
+                    except (EOFError, OSError):
+                        w.kill()
+                        spares[k] = fresh()
+                elif w.task is not None and time.monotonic() >= w.deadline:
+                    w.kill()
+                    spares[k] = fresh()
             for k, w in enumerate(workers):
                 if w.task is None:
                     continue
@@ -110,25 +151,30 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                     except (EOFError, OSError):
                         kind, value = "dead", "the worker running it died: the simulator crashed"
                     if w.task:
-                        conn.send((w.task, kind, value))
+                        # a superseded run's answer, whatever it was (or its death): nobody reads it
+                        conn.send((w.task, "superseded", None) if getattr(w, "superseded", False) else
+                                  (w.task, kind, value))
                         served[w.proc.pid] = served.get(w.proc.pid, 0) + 1
                     w.task = None
                     if kind == "dead" or served.get(w.proc.pid, 0) >= recycle:   # dead, or recycled
                         served.pop(w.proc.pid, None)
                         w.kill()
-                        workers[k] = fresh()
+                        workers[k] = replacement()
                 elif time.monotonic() >= w.deadline:
                     served.pop(w.proc.pid, None)
                     w.kill()
-                    if w.task:
+                    if w.task and getattr(w, "superseded", False):
+                        conn.send((w.task, "superseded", None))
+                    elif w.task:
                         conn.send((w.task, "timeout", f"timed out after {timeout:g} s (killed)"))
-                    workers[k] = fresh()
+                    workers[k] = replacement()
             for w in workers:
                 if w.task is None and queue:
                     rid, task = queue.popleft()
+                    w.superseded = False
                     w.give(rid, task, timeout)
     finally:
-        close_all(workers)
+        close_all(workers + spares)
 
 
 class Pool:
@@ -137,14 +183,15 @@ class Pool:
     "crash" (a bug in the task, its words), "dead", "timeout", "cancelled" or "stopped" (the
     server is stopping: :meth:`stop_now`). A worker is replaced after ``recycle`` requests."""
 
-    def __init__(self, jobs: int, timeout: float = DEFAULT_TIMEOUT_S, work=None, recycle: int = RECYCLE_AFTER):
+    def __init__(self, jobs: int, timeout: float = DEFAULT_TIMEOUT_S, work=None, recycle: int = RECYCLE_AFTER,
+                 spare: int = SPARE):
         from . import jobs as job
         ctx = multiprocessing.get_context("fork")
         self.conn, child = ctx.Pipe()
         self.timeout = timeout
         self.jobs = jobs
         self.proc = ctx.Process(target=_pool_main, args=(child, self.conn, os.getpid(), jobs, timeout,
-                                                         work or job.run, recycle))
+                                                         work or job.run, recycle, spare))
         self.proc.start()
         child.close()
         self._ids = itertools.count(1)
@@ -152,6 +199,7 @@ class Pool:
         self._loop = None
         self.dropped = 0   #: requests whose client left while they were queued (never run)
         self.ran = 0       #: requests a worker ran (answered, whatever the answer): what a page's typing cost
+        self.superseded = 0  #: requests stopped while they ran, their client gone (their worker freed at once)
         self.stopping = False
 
     def attach(self) -> None:
@@ -172,6 +220,8 @@ class Pool:
             return
         if kind == "cancelled":
             self.dropped += 1
+        elif kind == "superseded":
+            self.superseded += 1
         else:
             self.ran += 1
         fut = self._waiting.pop(rid, None)
@@ -207,7 +257,8 @@ class Pool:
 
     def cancel(self, rid: int) -> None:
         """Its client has gone: drop the task if it waits in the queue (answered "cancelled"); a run
-        already started finishes (and is answered as usual: its folder is in use until then)."""
+        already started is stopped where it is (answered "superseded" as soon as it has unwound, its
+        ngspice killed; killed with its worker after :data:`SUPERSEDED_GRACE_S`)."""
         try:
             self.conn.send((-rid, None))
         except (OSError, ValueError):

@@ -35,7 +35,8 @@ from typing import NamedTuple
 from ..core.errors import DesignError
 
 __all__ = ["FILE_OPTIONS", "MAX_DEPTH", "MAX_JSON_BYTES", "REFUSED", "SERVERS_OWN", "Traits", "build_argv",
-           "check_text", "check_value", "option_name", "parse_json", "parser_traits", "write_content"]
+           "check_text", "check_value", "option_name", "parse_json", "parser_traits", "value_text",
+           "write_content"]
 
 #: options the server sets itself (files, output form) or that would reach past a request's folder
 REFUSED = ("out", "json", "no-files", "plot", "help", "version", "junit", "summary", "root", "allow-outside",
@@ -170,7 +171,7 @@ def build_argv(options: dict, tmp: str | None, traits: "Traits | None" = None) -
             raise DesignError(f"{opt} takes one value, got {len(value)}" if len(value) != 1 else
                               f"{opt} takes one value, not a list: {_shown(value)}")
         values = value if isinstance(value, list) else [value]
-        words = [_word(v, opt) for v in values]
+        words = [value_text(v, opt) for v in values]
         count = t.nargs.get(opt)
         if isinstance(count, int) and len(words) != count:
             raise DesignError(f"{opt} takes {count} values, got {len(words)}")
@@ -192,20 +193,35 @@ def _shown(value) -> str:
     return json.dumps(value)[:40]
 
 
-def _word(value, opt: str) -> str:
+def value_text(value, opt: str) -> str:
     """One value as typed: a string as it is, a number as Python writes it (a negative one without an
-    exponent, as the parsers read a number)."""
+    exponent, as the parsers read a number).
+
+    Parameters
+    ----------
+    value : str, int or float
+        A JSON value of a request.
+    opt : str
+        What it is given for: an option (``--fc``) or a library parameter (``fc_hz``, then the error's
+        ``param``).
+
+    Returns
+    -------
+    str
+        The value as a user would type it.
+    """
+    param = None if opt.startswith("-") else opt
     if isinstance(value, bool) or isinstance(value, (dict, list)):
-        raise DesignError(f"{opt} takes a number or a text such as 4k7, got {_shown(value)}")
+        raise DesignError(f"{opt} takes a number or a text such as 4k7, got {_shown(value)}", param=param)
     if isinstance(value, float):
         if not math.isfinite(value):
-            raise DesignError(f"{opt} takes a finite number, got {value!r}")
+            raise DesignError(f"{opt} takes a finite number, got {value!r}", param=param)
         text = repr(value)
         return format(decimal.Decimal(text), "f") if "e" in text else text
     if isinstance(value, int):
         return str(value)
     if not isinstance(value, str):
-        raise DesignError(f"{opt} takes a number or a text such as 4k7, got {type(value).__name__}")
+        raise DesignError(f"{opt} takes a number or a text such as 4k7, got {type(value).__name__}", param=param)
     return check_text(value)
 
 

@@ -83,7 +83,7 @@ def test_a_worker_is_replaced_after_recycle_requests():
 
 
 def test_a_stop_answers_queued_and_running_requests_at_once_and_kills_the_workers():
-    from designer.web.pool import STOPPED, Busy
+    from designer.web.pool import SPARE, STOPPED, Busy
 
     async def body(pool):
         running = asyncio.ensure_future(pool.submit({"do": "hang"}))
@@ -101,7 +101,7 @@ def test_a_stop_answers_queued_and_running_requests_at_once_and_kills_the_worker
         return answers, took, workers, later
     answers, took, workers, later = run_with_pool(1, 30, body)
     assert answers == [("stopped", STOPPED)] * 4 and took < 1.0 and later == STOPPED
-    assert len(workers) == 1 and not any(os.path.exists(f"/proc/{p}") for p in workers)
+    assert len(workers) == 1 + SPARE and not any(os.path.exists(f"/proc/{p}") for p in workers)
 
 
 def children(pid: int) -> set:
@@ -116,3 +116,24 @@ def children(pid: int) -> set:
             if fields[0] != "Z" and int(fields[1]) == pid:
                 found.add(int(d))
     return found
+
+
+def test_a_superseded_run_frees_its_worker_at_once_a_spare_taking_its_place():
+    """Issue 29: a run whose client left is stopped where it is; one that does not unwind (here: a work
+    function without designer.web.jobs's handler) is killed after the grace, and a spare warmed up beforehand
+    takes the next request at once."""
+    from designer.web.pool import SUPERSEDED_GRACE_S
+
+    async def body(pool):
+        await pool.submit({"do": "first"})          # the workers have warmed up
+        await asyncio.sleep(0.5)                     # and so has the spare
+        rid, fut = pool.start({"do": "hang"})
+        await asyncio.sleep(0.3)
+        tick = time.monotonic()
+        pool.cancel(rid)
+        cancelled = await fut
+        nxt = await pool.submit({"do": "next"})
+        return cancelled, nxt, time.monotonic() - tick, pool.superseded
+    cancelled, nxt, took, superseded = run_with_pool(1, 30, body)
+    assert cancelled == ("superseded", None) and nxt[0] == "ok" and superseded == 1
+    assert took < SUPERSEDED_GRACE_S + 0.5, took

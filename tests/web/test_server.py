@@ -259,8 +259,11 @@ def test_a_worker_is_replaced_after_recycle_requests_and_answers_stay_right():
             seen.append(children(pool))
     finally:
         s.stop()
-    # six requests, two a worker: the first worker and three fresh ones, each in turn the pool's only one
-    assert all(len(w) == 1 for w in seen) and len(set.union(*seen)) == 3 and seen[0] != seen[2] != seen[4], seen
+    # six requests, two a worker: the first worker and fresh ones (the warmed-up spare when it is ready), each
+    # in turn the pool's only worker beside its spare
+    from designer.web.pool import SPARE
+    assert all(len(w) == 1 + SPARE for w in seen) and len(set.union(*seen)) >= 3 + SPARE, seen
+    assert seen[0] != seen[2] != seen[4], seen
 
 
 def test_bad_recycle_is_one_line(capsys):

@@ -5,17 +5,32 @@
 D.nav("/check");
 const form = document.getElementById("form");
 const status = document.getElementById("status");
-const decks = {};
+// every file chosen or dropped, by its path in the folder chosen (a folder's files keep their relative paths:
+// specs/decks/rc_ladder.cir), and the specs among them (run all, as check-design specs/*.yaml does)
+let files = {}, specs = [];
 let specName = "spec.yaml", last = null;
 
-async function addFiles(files) {
-  for (const f of files) {
-    const text = await f.text();
-    if (/\.ya?ml$/i.test(f.name)) { document.getElementById("spec").value = text; specName = f.name; }
-    else decks[f.name] = text;
+async function addFiles(list) {
+  const added = [];
+  for (const f of list) {
+    const path = f.webkitRelativePath || f.name;
+    if (/\.(png|jpe?g|gif|pdf|zip|svg)$/i.test(path)) continue;   // pictures and bundles: no spec names them
+    files[path] = await f.text();
+    added.push(path);
   }
-  document.getElementById("decks").textContent = "Decks: " + (Object.keys(decks).join(", ") || "none");
+  const yaml = added.filter(p => /\.ya?ml$/i.test(p));
+  // one spec alone: shown in the box to edit; several (a folder): each run as it is
+  if (yaml.length === 1 && added.length === 1 && !specs.length) {
+    document.getElementById("spec").value = files[yaml[0]]; specName = yaml[0]; delete files[yaml[0]];
+  } else for (const p of yaml) if (!specs.includes(p)) specs.push(p);
+  showFiles();
 }
+function showFiles() {
+  const names = Object.keys(files);
+  document.getElementById("decks").textContent = "Files: " + (names.join(", ") || "none") +
+    (specs.length ? ` (specs run: ${specs.join(", ")})` : "");
+}
+document.getElementById("clear").onclick = () => { files = {}; specs = []; showFiles(); };
 
 function show(answer) {
   const v = document.getElementById("verdict");
@@ -36,20 +51,31 @@ function show(answer) {
   t.id = "cases-table";
   document.getElementById("cases").replaceChildren(t);
   document.getElementById("summary").textContent = answer.summary || "";
+  const golden = document.getElementById("golden");
+  const recorded = Object.entries(answer.golden || {});
+  golden.replaceChildren(...(recorded.length ? recorded.map(([path, text]) => {
+    const b = document.createElement("button");
+    b.type = "button";
+    b.textContent = `${path} (download)`;
+    b.dataset.current = "";
+    b.className = "golden-file";
+    b.onclick = () => { if (!D.isStale()) D.download(new Blob([text], {type: "text/csv"}), path.split("/").pop()); };
+    return b;
+  }) : [Object.assign(document.createElement("p"), {textContent: "none recorded in this run"})]));
 }
 
 // a refused run leaves no result to read: the previous run's table, summary and junit.xml are cleared
 D.onStale = function (why) {
   if (why !== "refused") return;
   last = null;
-  for (const id of ["verdict", "cases", "summary"]) document.getElementById(id).replaceChildren();
+  for (const id of ["verdict", "cases", "summary", "golden"]) document.getElementById(id).replaceChildren();
 };
 
 async function run() {
   D.markStale("pending");
   D.busy(true, status);
-  const body = {spec: document.getElementById("spec").value, spec_name: specName, files: decks,
-                options: D.options(form)};
+  const body = specs.length ? {specs, files, options: D.options(form)} :
+    {spec: document.getElementById("spec").value, spec_name: specName, files, options: D.options(form)};
   const r = await D.api("/api/check", body);
   D.busy(false, status);
   if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
@@ -62,5 +88,6 @@ async function run() {
 }
 
 D.dropZone(document.getElementById("drop"), document.getElementById("files"), addFiles);
+document.getElementById("folder").addEventListener("change", e => { if (e.target.files.length) addFiles(e.target.files); });
 document.getElementById("run").onclick = run;
 document.getElementById("junit").onclick = () => last && D.download(new Blob([last.junit], {type: "application/xml"}), "junit.xml");

@@ -162,9 +162,17 @@ D.markCurrent = function () {
 // would send: the inputs last asked for are not asked again when nothing was typed since (leaving the field
 // whose pause already sent them).
 D.UNFINISHED = /(^\s*[-+]?\s*$)|(\d\.|\d[eE][-+]?|[-+])\s*$/;
+// The pause: 250 ms, or 1.3 times the typist's own gap between keys when that is longer (up to 700 ms), so a
+// slow typist is not answered at every key; 600 ms while that gap is not known yet (the page's first key).
+// A superseded request is stopped on the server too (its worker freed at once), so asking early costs the
+// room little (issue 29: last key to drawn under 0.5 s).
+D.DEBOUNCE_MS = 250;
+D.DEBOUNCE_MAX_MS = 700;
+D.DEBOUNCE_FIRST_MS = 600;
 D.liveForm = function (form, run, key, wait) {
-  wait = wait || 600;
-  let timer = null, asked = null;
+  let timer = null, asked = null, lastKey = 0, gap = 0;
+  const pause = () => wait || (gap ? Math.min(D.DEBOUNCE_MAX_MS, Math.max(D.DEBOUNCE_MS, 1.3 * gap))
+                                     : D.DEBOUNCE_FIRST_MS);
   const now = () => {
     clearTimeout(timer); timer = null;
     const k = key();
@@ -174,14 +182,31 @@ D.liveForm = function (form, run, key, wait) {
   };
   form.addEventListener("input", e => {
     if (e.target.type === "file") return;
+    const t = performance.now();
+    // a gap between two keys of a burst of typing (a new burst keeps the last; a field emptied, a paste or a
+    // script's fill, two events within 30 ms, say nothing of the typist)
+    if (e.target.value !== "") {
+      if (t - lastKey < 1500 && t - lastKey > 30) gap = t - lastKey;
+      lastKey = t;
+    }
     clearTimeout(timer);
     D.cancel("form");
     asked = null;
     D.markStale("pending");
     // a number still being typed ("0.", "1e", "-") is not asked about on a pause, only when the field is left
-    if (!(e.target.tagName === "INPUT" && D.UNFINISHED.test(e.target.value))) timer = setTimeout(now, wait);
+    if (!(e.target.tagName === "INPUT" && D.UNFINISHED.test(e.target.value))) timer = setTimeout(now, pause());
   });
   form.addEventListener("change", e => { if (e.target.type !== "file") now(); });
+  // back and forward move between the designs shown: the fields as that address has them, asked at once
+  window.addEventListener("popstate", () => {
+    D.fillFromQuery(form);
+    if (D.onRestore) D.onRestore();
+    D.history.restoring = true;
+    clearTimeout(timer);
+    D.cancel("form");
+    asked = null;
+    now();
+  });
   return {now, forget: () => { asked = null; }};
 };
 
@@ -197,11 +222,35 @@ D.answered = function (state) {
 };
 
 // The inputs of the design shown, in the address bar: a link to share, a reload that keeps them (the pages
-// read their fields from the query string as they open). Replaced, not pushed: one history entry a page.
+// read their fields from the query string as they open, D.fillFromQuery). Each new design is a history entry
+// (back and forward move between them, D.liveForm); the page's first, and one restored by back or forward,
+// replace theirs.
+D.history = {first: true, restoring: false};
 D.remember = function (opts) {
   const q = new URLSearchParams();
-  for (const [k, v] of Object.entries(opts)) if (typeof v !== "object") q.set(k, v === true ? "true" : v);
-  history.replaceState(null, "", `${location.pathname}?${q}`);
+  for (const [k, v] of Object.entries(opts)) {
+    if (Array.isArray(v)) q.set(k, v.join(" "));   // a field's items apart, as typed
+    else if (typeof v !== "object") q.set(k, v === true ? "true" : v);
+  }
+  const url = `${location.pathname}?${q}`;
+  if (url !== location.pathname + location.search) {
+    if (D.history.first || D.history.restoring) history.replaceState({designer: true}, "", url);
+    else history.pushState({designer: true}, "", url);
+  }
+  D.history.first = false;
+  D.history.restoring = false;
+};
+// The form's fields as the address has them; a field it does not name back to its default.
+D.fillFromQuery = function (form) {
+  const q = new URLSearchParams(location.search);
+  for (const el of form.querySelectorAll("[name]")) {
+    if (el.type === "file") continue;
+    const v = q.get(el.name);
+    if (el.type === "radio") { if (v !== null) el.checked = el.value === v; else el.checked = el.defaultChecked; }
+    else if (el.type === "checkbox") el.checked = v === null ? el.defaultChecked : v === "true";
+    else if (el.tagName === "SELECT") el.value = v !== null ? v : (el.dataset.default || (el.options[0] || {}).value || "");
+    else el.value = v !== null ? v : el.defaultValue;
+  }
 };
 
 D.busy = function (on, el) {
@@ -294,7 +343,16 @@ D.download = function (blob, name) {
   setTimeout(() => { URL.revokeObjectURL(a.href); a.remove(); }, 1000);
 };
 
-const COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf"];
+const COLOURS = ["#9467bd", "#8c564b", "#17becf", "#bcbd22", "#e377c2", "#7f7f7f"];
+// One colour per kind of trace on every plot (issue 29: red was SPICE on one plot and the ideal op-amp on the
+// next): SPICE red, the op-amp-aware model (and the realised loop) blue, the ideal one green, the measured data
+// black, the plant alone grey, the tolerance band orange; the identified models take the other colours in turn.
+D.TRACE_KINDS = [[/^SPICE/, "#d62728"], [/^data$|integrated impulse/, "#111111"], [/^tolerance band/, "#e0a040"],
+                 [/ideal/, "#2ca02c"], [/plant alone/, "#7f7f7f"], [/model|analytic|realised|loop gain/, "#1f77b4"]];
+D.traceColour = function (label, i) {
+  const kind = D.TRACE_KINDS.find(([re]) => re.test(label));
+  return kind ? kind[1] : COLOURS[i % COLOURS.length];
+};
 
 // One interactive plot (uPlot): drag to zoom, double-click to reset, click a legend entry to hide its trace.
 D.plot = function (el, trace, opts) {
@@ -305,13 +363,18 @@ D.plot = function (el, trace, opts) {
   const data = [trace.x, ...trace.series.map(s => s.y)];
   // as wide as its box (a phone's 390 px too), and redrawn at the box's width when that changes
   const width = Math.max(200, el.clientWidth || 640);
-  const series = [{label: trace.x_label}];
+  // the legend's values as the page writes numbers (uPlot shows "--" for none: blank here)
+  const series = [{label: trace.x_label, value: (u, v) => v === null || v === undefined ? "" : D.eng(v, opts.xUnit || "", 4)}];
+  let others = 0;
   trace.series.forEach((s, i) => {
     const band = /^tolerance band/.test(s.label);
     const points = /^(data|SPICE \.ac)$/.test(s.label);
-    series.push({label: s.label, stroke: band ? "#e0a040" : COLOURS[i % COLOURS.length],
+    const kind = D.TRACE_KINDS.some(([re]) => re.test(s.label));
+    // measured points as small rings, so the model lines under them stay visible
+    series.push({label: s.label, stroke: D.traceColour(s.label, kind ? 0 : others++),
                  width: i === 0 && !band ? 2.5 : 1.5, dash: band ? [4, 4] : undefined,
-                 spanGaps: false, points: points ? {show: true, size: 5} : {show: false},
+                 value: (u, v) => v === null || v === undefined ? "" : D.num(v, 4),
+                 spanGaps: false, points: points ? {show: true, size: 4, width: 1, fill: "transparent"} : {show: false},
                  paths: points ? () => null : undefined});
   });
   const u = new uPlot({
@@ -335,7 +398,58 @@ D.plot = function (el, trace, opts) {
   }
   el.dataset.series = trace.series.map(s => s.label).join("|");
   el.dataset.marks = (opts.marks || []).map(m => m.label).join("|");
+  D.plotText(el, trace, opts);
   return u;
+};
+
+// A plot's text alternative: what it shows in one line (its aria-label) and its key points as a table (a
+// dozen points along x, each trace's value there; the marks), in a <details> under it.
+D.plotText = function (el, trace, opts) {
+  const yLabel = opts.yLabel || "value";
+  el.setAttribute("role", "img");
+  el.setAttribute("aria-label", `${yLabel} against ${trace.x_label}: ${trace.series.map(s => s.label).join(", ")}` +
+                  ((opts.marks || []).length ? `; marked: ${opts.marks.map(m => m.label).join(", ")}` : ""));
+  const n = trace.x.length, rows = [];
+  for (let k = 0; k < 12 && n; k++) {
+    const i = Math.round(k * (n - 1) / 11);
+    if (rows.length && rows[rows.length - 1].i === i) continue;
+    rows.push({i, cells: [D.eng(trace.x[i], opts.xUnit || "", 4),
+                          ...trace.series.map(s => s.y[i] === null || s.y[i] === undefined ? "" : D.num(s.y[i], 4))]});
+  }
+  const table = D.table([trace.x_label, ...trace.series.map(s => s.label)], rows.map(r => r.cells));
+  const marks = (opts.marks || []).map(m => { const p = document.createElement("p"); p.textContent = m.label; return p; });
+  let details = el.nextElementSibling;
+  if (!details || !details.classList.contains("plot-text")) {
+    details = document.createElement("details");
+    details.className = "plot-text";
+    el.after(details);
+  }
+  details.replaceChildren(Object.assign(document.createElement("summary"), {textContent: `${yLabel}: key points as a table`}),
+                          ...marks, Object.assign(document.createElement("div"), {className: "scroll"}));
+  details.lastChild.append(table);
+};
+
+// The schematic (SVG, drawn by the server): a text alternative naming its parts, and a button that opens it
+// full size in a tab of its own, where the browser zooms it as any SVG.
+D.schematic = function (el, svg, what) {
+  el.innerHTML = svg;
+  const img = el.querySelector("svg");
+  if (img) {
+    img.setAttribute("role", "img");
+    img.setAttribute("aria-label", what);
+  }
+  let open = el.parentElement.querySelector(".open-full");
+  if (!open) {
+    open = document.createElement("button");
+    open.type = "button";
+    open.className = "open-full";
+    open.textContent = "open the schematic full size";
+    el.after(open);
+  }
+  open.onclick = () => {
+    const url = URL.createObjectURL(new Blob([svg], {type: "image/svg+xml"}));
+    if (!window.open(url, "_blank")) D.download(new Blob([svg], {type: "image/svg+xml"}), "schematic.svg");
+  };
 };
 
 // Vertical marks on a plot ({x, label}: the crossover, the phase-crossover), drawn over the traces with their
@@ -385,4 +499,82 @@ D.dropZone = function (zone, input, onFile) {
     if (e.dataTransfer.files.length) onFile(e.dataTransfer.files);
   });
   input.addEventListener("change", () => { if (input.files.length) onFile(input.files); });
+};
+
+// The tolerance panel (Plant, PID): the yield with its 95 % interval, the part to buy tighter, and each
+// histogram (the server's bins: D.histogram) with its limits; hidden without a Monte Carlo.
+D.pct = v => `${(100 * v).toPrecision(3)} %`;
+D.tolerance = function (mc, hists) {
+  const section = document.getElementById("tolerance-section");
+  if (!section) return;
+  section.hidden = !mc;
+  if (!mc) return;
+  const figs = [D.fig("builds drawn", String(mc.settings.samples))];
+  const y = mc.yield;
+  if (y && mc.limits && mc.limits.length) {
+    figs.push(D.fig("yield", D.pct(y.fraction)),
+              D.fig("95 % interval (Wilson)", `${D.pct(y.ci95[0])} to ${D.pct(y.ci95[1])}`),
+              D.fig("within", mc.limits.map(l => `${l.figure} ${D.num(l.min, 4)} to ${D.num(l.max, 4)}`).join("; ")));
+  } else figs.push(D.fig("yield", "no limits given: the spread alone"));
+  document.getElementById("yield").replaceChildren(...figs);
+  const t = mc.tighten, tight = document.getElementById("tighten");
+  tight.textContent = !t ? "" : t.yield > t.yield_now
+    ? `Buy ${t.part} tighter: at ${t.tolerance_pct} % the yield is ${D.pct(t.yield)} (now ${D.pct(t.yield_now)}).`
+    : "No part bought tighter raises the yield: the design, not the parts, limits it.";
+  const box = document.getElementById("histograms");
+  box.replaceChildren(...(hists || []).map(h => D.histogram(h)));
+};
+
+// A histogram as SVG (bars, the limits as red lines, the nominal dashed), zoomable as any SVG, with its text
+// alternative: the counts per bin in a table below.
+D.histogram = function (h) {
+  const W = 640, H = 200, pad = 30, ns = "http://www.w3.org/2000/svg";
+  const lo = Math.min(h.edges[0], h.min ?? Infinity, h.nominal ?? Infinity);
+  const hi = Math.max(h.edges[h.edges.length - 1], h.max ?? -Infinity, h.nominal ?? -Infinity);
+  const span = hi - lo || Math.abs(hi) || 1, top = Math.max(...h.counts, 1);
+  const x = v => pad + (W - 2 * pad) * (v - lo + 0.03 * span) / (1.06 * span);
+  const yv = c => H - pad - (H - 2 * pad) * c / top;
+  const svg = document.createElementNS(ns, "svg");
+  svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+  svg.setAttribute("role", "img");
+  svg.setAttribute("class", "histogram");
+  svg.setAttribute("aria-label", `histogram of ${h.figure} over ${h.n} builds` +
+                   (h.min !== null ? `, limits ${D.num(h.min, 4)} to ${D.num(h.max, 4)}` : ""));
+  const el = (name, attrs, text) => {
+    const e = document.createElementNS(ns, name);
+    for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+    if (text) e.textContent = text;
+    svg.append(e);
+  };
+  h.counts.forEach((c, i) => el("rect", {x: x(h.edges[i]), y: yv(c), width: Math.max(0.5, x(h.edges[i + 1]) - x(h.edges[i]) - 0.5),
+                                         height: H - pad - yv(c), fill: "#6b8fc7"}));
+  el("line", {x1: pad, x2: W - pad, y1: H - pad, y2: H - pad, stroke: "#555"});
+  for (const [v, what] of [[h.min, "min"], [h.max, "max"]]) if (v !== null && v !== undefined)
+    el("line", {x1: x(v), x2: x(v), y1: pad / 2, y2: H - pad, stroke: "#d62728", "stroke-width": 2, "data-limit": what});
+  if (h.nominal !== null && h.nominal !== undefined)
+    el("line", {x1: x(h.nominal), x2: x(h.nominal), y1: pad / 2, y2: H - pad, stroke: "#333", "stroke-dasharray": "4 3"});
+  el("text", {x: pad, y: H - 8, "font-size": 11}, D.num(lo, 4));
+  el("text", {x: W - pad, y: H - 8, "font-size": 11, "text-anchor": "end"}, D.num(hi, 4));
+  el("text", {x: W / 2, y: 12, "font-size": 12, "text-anchor": "middle"}, `${h.figure} over ${h.n} builds`);
+  const wrap = document.createElement("figure");
+  wrap.className = "histogram-figure";
+  wrap.dataset.figure = h.figure;
+  wrap.append(svg);
+  const details = document.createElement("details");
+  details.append(Object.assign(document.createElement("summary"), {textContent: `${h.figure}: the counts as a table`}),
+                 D.table(["from", "to", "builds"], h.counts.map((c, i) => [D.num(h.edges[i], 4), D.num(h.edges[i + 1], 4), c])));
+  wrap.append(details);
+  return wrap;
+};
+
+// The build sheet's content on the page: our own HTML (the sheet's renderer escapes every text), in a shadow root
+// so its styles stay inside; its advice in the page's words (the printed sheet keeps the command's: it goes with
+// the bundle's files).
+D.sheet = function (host, html, form) {
+  const root = host.shadowRoot || host.attachShadow({mode: "open"});
+  root.innerHTML = html;
+  const walk = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
+  for (let n = walk.nextNode(); n; n = walk.nextNode()) {
+    if (n.textContent.includes("--")) n.textContent = D.inPageWords(form, n.textContent, true);
+  }
 };

@@ -14,7 +14,7 @@ function params(p) {
 D.onStale = function (why) {
   if (why !== "refused") return;
   last = null;
-  for (const id of ["format", "methods"]) document.getElementById(id).replaceChildren();
+  for (const id of ["format", "methods", "loop"]) document.getElementById(id).replaceChildren();
   for (const id of ["plot", "phase"]) {
     const el = document.getElementById(id);
     if (el._plot) { el._plot.destroy(); el._plot = null; }
@@ -39,13 +39,28 @@ function show(answer) {
   b.innerHTML = "<b>Best model:</b> ";
   b.append(best ? `${best.name} (${best.model}): ${params(best.params)}` : "none valid");
   document.getElementById("format").append(b);
+  // a loop gain's table: what it is for, its crossover and margins, among the figures and marked on its plots
+  const loop = r.loop, marks = [];
+  const loopBox = document.getElementById("loop");
+  loopBox.replaceChildren();
+  if (loop) {
+    const deg = v => v === null || v === undefined ? "not reached" : `${(+v).toFixed(1)} deg`;
+    const db = v => v === null || v === undefined ? "not reached" : `${(+v).toFixed(1)} dB`;
+    loopBox.append(D.fig("gain crossover", D.eng(loop.crossover_hz, "Hz", 3)), D.fig("phase margin", deg(loop.phase_margin_deg)),
+                   D.fig("gain margin", db(loop.gain_margin_db)), D.fig("phase crossover", D.eng(loop.phase_crossover_hz, "Hz", 3)));
+    loopBox.setAttribute("aria-label", "loop gain margins");
+    b.replaceChildren(Object.assign(document.createElement("b"), {textContent: "A loop gain (open loop): "}),
+                      `its margins above; best model ${best ? `${best.name} (${best.model}): ${params(best.params)}` : "none valid"}`);
+    marks.push({x: loop.crossover_hz, label: `crossover, PM ${deg(loop.phase_margin_deg)}`});
+    if (loop.phase_crossover_hz) marks.push({x: loop.phase_crossover_hz, label: `GM ${db(loop.gain_margin_db)}`});
+  }
   const ph = document.getElementById("phase");
   if (p.kind === "step") {
     D.plot(document.getElementById("plot"), p.plot, {xUnit: "s", yLabel: cap.output || "output"});
     if (ph._plot) { ph._plot.destroy(); ph._plot = null; } ph.innerHTML = "";
   } else if (p.kind === "frequency") {
-    D.plot(document.getElementById("plot"), p.plot, {xUnit: "Hz", yLabel: "gain (dB)"});
-    if (p.phase) D.plot(ph, p.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 220});
+    D.plot(document.getElementById("plot"), p.plot, {xUnit: "Hz", yLabel: "gain (dB)", marks});
+    if (p.phase) D.plot(ph, p.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 220, marks});
   } else {   // broadband: the integrated impulse response and the spectral estimate's gain
     const unit = t => t.log_x ? ["Hz", "gain (dB)"] : ["s", cap.output || "output"];
     if (p.plot) D.plot(document.getElementById("plot"), p.plot, {xUnit: unit(p.plot)[0], yLabel: unit(p.plot)[1]});

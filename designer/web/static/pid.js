@@ -23,6 +23,8 @@ function showTargets() {
 function request() {
   const o = D.options(form);
   delete o.plant;
+  // the tolerance panel's fields hold several items apart ("R=1% C=5%"): the API takes them as a list
+  for (const k of ["tol", "limit"]) if (o[k]) o[k] = o[k].split(/\s+/);
   if (plantKind() === "identify") {
     if (!identified) return null;
     o["plant-model"] = identified;   // identify's own --json, as design-pid --plant-model reads it
@@ -63,17 +65,9 @@ function show(answer) {
   if (isFinite(m.phase_crossover_hz)) marks.push({x: m.phase_crossover_hz, label: `-180 deg: GM ${D.num(m.gain_margin_db, 3)} dB`});
   D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 220, marks});
   D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 180, marks});
-  document.getElementById("schematic").innerHTML = p.schematic_svg;
-  // the sheet is our own HTML (the build sheet's renderer escapes every text); shown in a shadow root so its
-  // styles stay inside
-  const host = document.getElementById("sheet-html");
-  const root = host.shadowRoot || host.attachShadow({mode: "open"});
-  root.innerHTML = p.sheet_html;
-  // its advice in the page's words (the printed sheet keeps the command's: it goes with the bundle's files)
-  const walk = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
-  for (let n = walk.nextNode(); n; n = walk.nextNode()) {
-    if (n.textContent.includes("--")) n.textContent = D.inPageWords(form, n.textContent, true);
-  }
+  D.schematic(document.getElementById("schematic"), p.schematic_svg, `schematic of the loop: ${p.title}`);
+  D.tolerance(r.monte_carlo, p.histograms);
+  D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
 }
 
 async function design() {
@@ -117,12 +111,8 @@ async function file(kind) {
     D.fill(s, [...keepFirst, ...c[s.dataset.choices]], s.dataset.default || keepFirst[0]);
     if (keepFirst.length && s.options[0].value === "") s.options[0].textContent = "default";
   }
-  const q = new URLSearchParams(location.search);
-  for (const [k, v] of q) {
-    if (k === "plant") { const r = form.querySelector(`input[name=plant][value="${CSS.escape(v)}"]`); if (r) r.checked = true; continue; }
-    const el = form.querySelector(`[name="${CSS.escape(k)}"]`);
-    if (el) el.value = v;
-  }
+  D.fillFromQuery(form);
+  D.onRestore = () => { showPlantKind(); showTargets(); };
   if (identified) {
     const b = identified.best || {};
     document.getElementById("model-text").textContent =

@@ -21,10 +21,13 @@ function show(answer) {
     D.fig("settling time (2 %)", D.eng((r.spice || r.analytic_opamp).settling_time_s, "s", 4)),
     D.fig("SPICE agrees with the model", r.comparison.pass === undefined ? "n/a" : (r.comparison.pass ? "yes" : "NO")));
   document.getElementById("notes").replaceChildren(...r.notes.map(n => { const e = document.createElement("p"); e.textContent = D.inPageWords(form, n); return e; }));
-  document.getElementById("schematic").innerHTML = p.schematic_svg;
+  D.schematic(document.getElementById("schematic"), p.schematic_svg,
+              `schematic: ${p.bom.rows.map(x => `${x[0]} ${x[1]}`).join(", ")}`);
   document.getElementById("bench").replaceChildren(D.table(["set", "to"], p.bench));
   document.getElementById("bomtable").replaceChildren(D.table(p.bom.header.slice(0, 7), p.bom.rows.map(x => x.slice(0, 7))));
   document.getElementById("checks").replaceChildren(D.checksTable(r.checks));
+  D.tolerance(r.monte_carlo, p.histograms);
+  D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
   D.plot(document.getElementById("step"), p.step, {xUnit: "s", yLabel: "output (V)"});
   D.plot(document.getElementById("bode-gain"), p.bode.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 240});
   D.plot(document.getElementById("bode-phase"), p.bode.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 200});
@@ -65,8 +68,7 @@ async function file(kind) {
 (async function () {
   const c = await D.loadChoices();
   for (const s of form.querySelectorAll("select[data-choices]")) D.fill(s, c[s.dataset.choices], s.dataset.default);
-  const q = new URLSearchParams(location.search);
-  for (const [k, v] of q) { const el = form.querySelector(`[name="${CSS.escape(k)}"]`); if (el) el.value = v; }
+  D.fillFromQuery(form);
   D.liveForm(form, design, () => JSON.stringify(D.options(form)));
   document.getElementById("sheet").onclick = () => file("sheet");
   document.getElementById("bundle").onclick = () => file("bundle");

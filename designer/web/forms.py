@@ -1,0 +1,226 @@
+"""The web page's own names for the library's parameters, and a request's
+fields turned into the spec objects the command line builds.
+
+One name table per front end (issue 26): the command line maps its
+``--flags`` to the library's parameters (:data:`designer.cli.common.FLAGS`);
+the page maps its fields to the same parameters here (:data:`PLANT`), each
+with the label the page shows beside the field. A request's JSON
+(``{"fc": 3500, "zeta": "0.2"}``) becomes a :class:`~designer.plant.spec.PlantSpec`
+and, with a Monte Carlo, a :class:`~designer.tolerance.mcspec.MonteCarloSpec`,
+typed values in, no command line built nor parsed. The specs check the
+values once; their errors name a library parameter, which
+:func:`page_message` shows as the field's label (``"fc (Hz)" must be ...``),
+never as a ``--flag``.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import NamedTuple
+
+from ..core.errors import DesignError
+from .request import option_name, value_text
+
+__all__ = ["Field", "PLANT", "PlantRequest", "field_of", "page_message", "plant_request"]
+
+
+class Field(NamedTuple):
+    """One field of a page's form: the library parameter it sets and its label on the page."""
+
+    param: str            #: the library's name (``fc_hz``; a MonteCarloSpec's ``n``)
+    label: str            #: what the page shows beside it (``fc (Hz)``)
+    kind: str = "value"   #: ``value`` (a number or a text), ``switch`` (true/false), ``list`` (several texts)
+
+
+#: the plant page's fields (the API's keys, as design-plant's option names) -> parameter and label
+PLANT = {
+    "fc": Field("fc_hz", "fc (Hz)"), "zeta": Field("zeta", "zeta"), "gain": Field("gain", "gain K"),
+    "compensate-gbw": Field("compensate_gbw", "compensate the op-amp's GBW", "switch"),
+    "r": Field("r", "R fixed (Ohm)"), "c": Field("c", "C fixed (F)"),
+    "r-series": Field("r_series", "R series"), "c-series": Field("c_series", "C series"),
+    "r-min": Field("r_min", "R min"), "r-max": Field("r_max", "R max"),
+    "c-min": Field("c_min", "C min"), "c-max": Field("c_max", "C max"),
+    "alternatives": Field("alternatives", "alternatives listed"),
+    "opamp": Field("opamp", "op-amp"), "amplitude": Field("amplitude_v", "amplitude (V)"),
+    "square-freq": Field("square_hz", "square wave (Hz)"), "package": Field("package", "package"),
+    "no-sim": Field("no_sim", "skip SPICE", "switch"), "simulator": Field("simulator", "simulator"),
+    "name": Field("name", "design name"),
+    # the tolerance panel (a MonteCarloSpec)
+    "monte-carlo": Field("n", "Monte Carlo builds"), "seed": Field("seed", "seed"),
+    "tol": Field("tol", "tolerances", "list"), "limit": Field("limits", "limits", "list"),
+    "dist": Field("dist", "distribution"), "sampler": Field("sampler", "sampler"),
+    "target-ci": Field("target_ci", "target interval"), "engine": Field("engine", "engine"),
+    "spice-samples": Field("spice_samples", "SPICE samples"),
+    "worst-case": Field("worst_case", "worst case", "switch"),
+    "stimulus": Field("stimulus", "stimulus"), "prbs-bits": Field("bits", "PRBS bits"),
+    "prbs-clock": Field("clock_hz", "PRBS clock (Hz)"),
+}
+#: the simulators a request may choose (designer.spice.simulate's backends)
+SIMULATORS = ("pyspice", "ngspice-cli")
+_FLAG = re.compile(r"--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?")
+#: a value a message quotes as given ('3.5q', '--help'): never read as a flag
+_QUOTED = re.compile(r"((?<![A-Za-z])'[^']*')")
+
+
+class PlantRequest(NamedTuple):
+    """A plant page's request as the library takes it."""
+
+    spec: object                #: :class:`~designer.plant.spec.PlantSpec`
+    monte_carlo: object         #: :class:`~designer.tolerance.mcspec.MonteCarloSpec` or None
+    worst_case: bool            #: the extremes over the tolerance box too
+    tol: tuple                  #: the worst case's tolerances (without a Monte Carlo)
+    simulate: bool
+    simulator: str
+    stimulus: tuple | None      #: (bits, clock Hz) of a PRBS bench test, or None
+    name: str                   #: the design's name (its files)
+    argv: list                  #: the command line this request stands for (``tool.argv`` of its JSON)
+
+
+def field_of(table: dict, param: str | None) -> str | None:
+    """The field of ``table`` that sets the library parameter ``param`` (None: no field)."""
+    return next((k for k, f in table.items() if f.param == param), None)
+
+
+def page_message(exc: DesignError, table: dict) -> tuple:
+    """A library refusal in the page's words: (the message, the field it names or None).
+
+    Parameters
+    ----------
+    exc : DesignError
+        The library's error (its parameter, or ``{name}`` markers).
+    table : dict
+        The page's fields (:data:`PLANT`).
+
+    Returns
+    -------
+    tuple
+        The message with each parameter (and each ``--flag`` the library wrote) as its field's label,
+        quoted; and the field of the parameter it names first.
+    """
+    labels = {f.param: f'"{f.label}"' for f in table.values()}
+    text = exc.naming(labels) if callable(getattr(exc, "naming", None)) else str(exc)
+    # a flag the library wrote, outside the values it quotes ('--help' given as a value stays as given)
+    parts = _QUOTED.split(text)
+    text = "".join(p if k % 2 else _FLAG.sub(lambda m: f'"{table[m.group(1)].label}"' if m.group(1) in table
+                                             else m.group(1).replace("-", " "), p) for k, p in enumerate(parts))
+    field = field_of(table, getattr(exc, "param", None))
+    if field is None:   # a message written with the command line's option: the first one it names
+        found = _FLAG.search(str(exc))
+        field = found.group(1) if found and found.group(1) in table else None
+    return text, field
+
+
+def _fields(options, table: dict) -> dict:
+    """``options`` checked against ``table``: parameter -> typed value (a text, a bool, a tuple of texts)."""
+    if not isinstance(options, dict):
+        raise DesignError('the request\'s body must be a JSON object of field names and values, '
+                          'e.g. {"fc": 3500, "zeta": 0.2}')
+    out = {}
+    for key, value in options.items():
+        name = option_name(key)[2:]   # refuses the server's own settings and what a page may not choose
+        f = table.get(name)
+        if f is None:
+            raise DesignError(f"{name!r} is not a field of this page; allowed: {', '.join(sorted(table))}")
+        if value is None:
+            continue
+        if f.kind == "switch":
+            word = value if isinstance(value, bool) else value.strip().lower() if isinstance(value, str) else None
+            if word not in (True, False, "true", "false", "on", "off", ""):
+                raise DesignError(f"{f.param} is a switch: true or false, got {str(value)[:40]}", param=f.param)
+            out[f.param] = word in (True, "true", "on")
+        elif f.kind == "list":   # a list, or one text of items apart (a form's field: "R=1% C=5%")
+            values = value if isinstance(value, list) else [value]
+            out[f.param] = tuple(w for v in values for w in value_text(v, f.param).split())
+        else:
+            if isinstance(value, list):
+                raise DesignError(f"{f.param} takes one value, got {len(value)}", param=f.param)
+            out[f.param] = value_text(value, f.param)
+    return out
+
+
+def plant_request(options) -> PlantRequest:
+    """A plant page's request (its JSON object) as the library's specs, checked.
+
+    Parameters
+    ----------
+    options : dict
+        Field -> value (:data:`PLANT`'s keys; numbers, or texts in engineering notation).
+
+    Returns
+    -------
+    PlantRequest
+        The :class:`~designer.plant.spec.PlantSpec`, the Monte Carlo's spec and the run's settings.
+
+    Raises
+    ------
+    DesignError
+        One line naming the library parameter at fault (shown by :func:`page_message`).
+    """
+    from ..core.errors import ParamError
+    from ..plant.spec import PlantSpec
+    from ..tolerance.mcspec import MonteCarloSpec
+    v = _fields(options, PLANT)
+    for need in ("fc_hz", "zeta"):
+        if need not in v:
+            raise DesignError(f"{need} is required", param=need)
+    spec_keys = ("fc_hz", "zeta", "gain", "r", "c", "opamp", "compensate_gbw", "amplitude_v", "square_hz",
+                 "alternatives", "package", "r_series", "c_series", "r_min", "r_max", "c_min", "c_max")
+    spec = PlantSpec(**{k: v[k] for k in spec_keys if k in v})
+    if v.get("package") not in (None, "single", "dual", "quad"):
+        raise DesignError(f"package {v['package']!r} unknown; allowed: single, dual, quad", param="package")
+    mc_keys = ("n", "seed", "sampler", "dist", "tol", "limits", "target_ci", "engine", "spice_samples")
+    if "n" in v:
+        mc = MonteCarloSpec(**{k: v[k] for k in mc_keys if k in v})
+    else:
+        mc = None
+        alone = [k for k in mc_keys if k in v and not (k == "tol" and v.get("worst_case"))
+                 and not (k == "engine" and v[k] == "analytic")]
+        if alone:
+            raise ParamError("{%s} goes with {n}" % alone[0], mc_keys)
+    simulator = v.get("simulator", "pyspice")
+    if simulator not in SIMULATORS:
+        raise DesignError(f"simulator {simulator!r} unknown; allowed: {', '.join(SIMULATORS)}", param="simulator")
+    stimulus = _stimulus(v)
+    from ..cli.common import check_name
+    name = v.get("name") or f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}")
+    try:
+        check_name(name)
+    except DesignError as exc:
+        raise DesignError(str(exc).replace("--name", "name", 1), param="name") from None
+    argv = ["design-plant"] + [a for key, value in options.items() if value is not None
+                               for a in _flag_words(key, value)]
+    return PlantRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False),
+                        simulator, stimulus, name, argv)
+
+
+def _stimulus(v: dict):
+    """The PRBS bench test asked for: None, or (bits or None, clock Hz or None)."""
+    from ..core.errors import ParamError
+    kind = v.get("stimulus", "step")
+    if kind not in ("step", "prbs"):
+        raise DesignError(f"stimulus {kind!r} unknown; allowed: step, prbs", param="stimulus")
+    given = [k for k in ("bits", "clock_hz") if k in v]
+    if kind != "prbs":
+        if given:
+            raise ParamError("{%s} goes with the prbs {stimulus}" % given[0], ("bits", "clock_hz", "stimulus"))
+        return None
+    from ..core.prbs import check_bits
+    from ..core.ranges import parse_in_range
+    bits = None
+    if "bits" in v:
+        try:
+            bits = check_bits(v["bits"])
+        except DesignError as exc:
+            raise DesignError(str(exc).replace("--bits", "bits", 1), param="bits") from None
+    clock = None if "clock_hz" not in v else parse_in_range(v["clock_hz"], "clock_hz", "prbs_clock_hz")
+    return bits, clock
+
+
+def _flag_words(key, value) -> list:
+    """A field as the command line writes it (for the record only: nothing parses it)."""
+    flag = "--" + str(key).replace("_", "-")
+    if isinstance(value, bool):
+        return [flag] if value else []
+    values = value if isinstance(value, list) else [value]
+    return [f"{flag}={x}" for x in values]
+

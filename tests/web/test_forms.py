@@ -1,0 +1,51 @@
+"""The web page's name table (designer.web.forms): a plant request's fields as the library's specs, and a
+library refusal in the page's words (the field's label, never a --flag, a value as it was typed)."""
+
+import dataclasses
+
+import pytest
+
+from designer.core.errors import DesignError, ParamError
+from designer.plant.spec import PlantSpec
+from designer.tolerance.mcspec import MonteCarloSpec
+from designer.web.forms import PLANT, field_of, page_message, plant_request
+
+
+def test_every_field_sets_a_parameter_of_the_specs_or_of_the_run():
+    specs = {f.name for f in dataclasses.fields(PlantSpec)} | {f.name for f in dataclasses.fields(MonteCarloSpec)}
+    run = {"no_sim", "simulator", "name", "worst_case", "stimulus", "bits", "clock_hz"}
+    assert {f.param for f in PLANT.values()} <= specs | run
+    assert len({f.label for f in PLANT.values()}) == len(PLANT)   # a label names one field
+
+
+def test_a_request_is_the_spec_the_command_line_builds():
+    rq = plant_request({"fc": "3.5k", "zeta": 0.2, "opamp": "TL072", "monte-carlo": "200", "tol": "R=1% C=5%",
+                        "limit": ["fn_hz=3.3k:3.7k"], "no-sim": True})
+    assert rq.spec == PlantSpec(fc_hz="3.5k", zeta=0.2, opamp="TL072")
+    assert rq.monte_carlo == MonteCarloSpec(n=200, tol=("R=1%", "C=5%"), limits=("fn_hz=3.3k:3.7k",))
+    assert rq.simulate is False and rq.name == "plant_fc3500_z0.2"
+    assert rq.argv[:3] == ["design-plant", "--fc=3.5k", "--zeta=0.2"]
+
+
+def test_a_refusal_names_the_fields_label():
+    text, field = page_message(DesignError("zeta must be 0.01 to 10, got '-1'", param="zeta"), PLANT)
+    assert (text, field) == ('"zeta" must be 0.01 to 10, got \'-1\'', "zeta")
+    text, field = page_message(ParamError("{r_min} (1e+07 Ohm) is above {r_max} (1e+06 Ohm)"), PLANT)
+    assert text == '"R min" (1e+07 Ohm) is above "R max" (1e+06 Ohm)' and field == "r-min"
+    # a flag the library wrote becomes the label; a value quoted as typed stays as it was
+    text, field = page_message(DesignError("--tol '--help': give CLASS=PCT, the seed's way"), PLANT)
+    assert text == "\"tolerances\" '--help': give CLASS=PCT, the seed's way" and field == "tol"
+    assert field_of(PLANT, "nothing") is None
+
+
+@pytest.mark.parametrize("fields, param", [
+    ({"zeta": 0.2}, "fc_hz"), ({"fc": 3500, "zeta": 0.2, "limit": "fn_hz=1:2"}, "limits"),
+    ({"fc": 3500, "zeta": 0.2, "prbs-bits": 7}, "bits"), ({"fc": 3500, "zeta": 0.2, "simulator": "x"}, "simulator"),
+    ({"fc": 3500, "zeta": 0.2, "name": "../x"}, "name"), ({"fc": 3500, "zeta": 0.2, "no-sim": "maybe"}, "no_sim"),
+])
+def test_bad_fields_are_refused_naming_their_parameter(fields, param):
+    with pytest.raises(DesignError) as exc:
+        plant_request(fields)
+    assert exc.value.param == param
+    text, _ = page_message(exc.value, PLANT)
+    assert "--" not in text and "\n" not in text
