@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..core.errors import ParamError
+from ..core.i18n import N_
 from ..core.opamps import OpAmp
 from ..core.units import format_eng
 from .library import library_text
@@ -167,8 +168,8 @@ def board(netlist: Netlist, opamp: OpAmp, package: str | None = None) -> Board:
     for ic in ics:
         dec += [Part(f"C{ic}01", "vcc", GROUND, DECOUPLING_F, f"U{ic} V+ (pin {pkg.vcc}) to ground, at the pin"),
                 Part(f"C{ic}02", "vee", GROUND, DECOUPLING_F, f"U{ic} V- (pin {pkg.vee}) to ground, at the pin")]
-    dec += [Part("C901", "vcc", GROUND, BULK_F, "+supply entry to ground (bulk, + to the rail)"),
-            Part("C902", GROUND, "vee", BULK_F, "-supply entry to ground (bulk, + to ground)")]
+    dec += [Part("C901", "vcc", GROUND, BULK_F, N_("+supply entry to ground (bulk, + to the rail)")),
+            Part("C902", GROUND, "vee", BULK_F, N_("-supply entry to ground (bulk, + to ground)"))]
     return Board(netlist, tuple(units), tuple(spare_units(len(units), pkg)), tuple(dec), pkg)
 
 
