@@ -62,10 +62,9 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
                      [r[:7] for r in bom(result, b)], "compact"),
              R.subhead(_("Generator and scope")), *_settings(result)]
     fig = [R.figure("schematic.png", schematic_svg, _("schematic"))] if with_images else []
-    nets = {k: _(v) for k, v in NET_LABELS.items()}
     out = [(_("Build"), [R.columns(fig, first)] if with_images else first),
            (_("Wiring"), [R.table([_("part"), _("code"), _("from"), _("to")],
-                                  wiring_rows(b, nets, (result.opamp.vcc, result.opamp.vee)))]),
+                                  wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee)))]),
            (_("Bench test: what the scope shows"), _bench(result)),
            *([(_("Bench test under a PRBS (--stimulus prbs)"), _prbs(result))] if result.prbs is not None else []),
            (_("Target and achieved"), _targets(result)),

@@ -138,6 +138,7 @@ def net_text(board, net, labels: dict) -> str:
     """
     pins = _pins_on(board, net)
     label = labels.get(net)
+    label = _(label) if label else label
     if pins:
         return (f"{label}: " if label else "") + ", ".join(pins)
     return label or _("node {net}").format(net=net)
