@@ -72,3 +72,41 @@ def wilson_half_width(k: int, n: int, z: float = 1.959963984540054) -> float:
     lo = (p + z * z / (2 * n) - z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))) / (1 + z * z / n)
     hi = (p + z * z / (2 * n) + z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))) / (1 + z * z / n)
     return ((1.0 if k == n else hi) - (0.0 if k == 0 else lo)) / 2
+
+
+def sheet_text_nodes(page: str) -> list:
+    """The text a reader sees in a build sheet's HTML: every text node (stripped; the style sheet and
+    the schematic's SVG left out) and every picture's alternative text."""
+    from html.parser import HTMLParser
+
+    class Nodes(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.out, self.skip = [], 0
+
+        def handle_starttag(self, tag, attrs):
+            if tag in ("style", "svg"):
+                self.skip += 1
+            alt = dict(attrs).get("alt") or dict(attrs).get("aria-label")
+            if alt and not self.skip:
+                self.out.append(alt.strip())
+
+        def handle_endtag(self, tag):
+            if tag in ("style", "svg"):
+                self.skip -= 1
+
+        def handle_data(self, data):
+            if not self.skip and data.strip():
+                self.out.append(data.strip())
+
+    p = Nodes()
+    p.feed(page)
+    return p.out
+
+
+def english_left(page: str, lang: str = "es") -> list:
+    """The text nodes of a sheet in ``lang`` that are an English message of the catalogue whose
+    translation differs (a word the sheet forgot to translate)."""
+    from designer.core.i18n import catalogue
+    english = {m for m, t in catalogue(lang).items() if t != m}
+    return [n for n in sheet_text_nodes(page) if n in english or n.rstrip(":") in english]

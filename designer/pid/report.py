@@ -154,7 +154,7 @@ def controller_source(sel):
     """``source_of`` for :func:`designer.report.wiring.bom_rows` of the controller's
     parts chosen by ``sel`` (a :class:`~designer.pid.selection.Selection`, None for
     given parts): (series, tolerance %) by kind, None for the decoupling."""
-    r_series, c_series = (sel.r_series, sel.c_series) if sel is not None else ("as given", "as given")
+    r_series, c_series = (sel.r_series, sel.c_series) if sel is not None else (_("as given"), _("as given"))
     rt, ct = sel.tolerances_pct if sel is not None else (None, None)
 
     def source(ref):
@@ -175,7 +175,7 @@ def bom(result, b=None) -> list:
 
     def source(ref):
         if ref in plant_refs:
-            return (prs or "as given", prt) if ref[0] == "R" else (pcs or "as given", pct)
+            return (prs or _("as given"), prt) if ref[0] == "R" else (pcs or _("as given"), pct)
         return controller(ref)
     return bom_rows(b, source, result.opamp.name)
 

@@ -1,0 +1,47 @@
+"""The plant's build sheet (designer/plant/report.py) in its two languages: Spanish with no English message
+left and decimal commas, English byte for byte the committed reference (reports/plant_fc3500_z0.2)."""
+
+import re
+import subprocess
+
+import pytest
+from helpers import REPORTS, english_left, script, sheet_text_nodes
+
+#: the Makefile demo's plant (reports/plant_fc3500_z0.2): a Monte Carlo with limits and the worst case
+DEMO = ["--fc", "3500", "--zeta", "0.2", "--monte-carlo", "5000", "--seed", "1", "--limit", "fn_hz=3.3k:3.7k",
+        "--limit", "overshoot_pct=0:55", "--worst-case", "--name", "plant_fc3500_z0.2"]
+#: a number written with a decimal point (not a file name's dot, nor a dotted run)
+DECIMAL_POINT = re.compile(r"(?<![\w.])\d+\.\d+\b(?!\.\d)")
+DECIMAL_COMMA = re.compile(r"(?<![\w,])\d+,\d+\b")
+
+
+def design_plant(out, *args):
+    proc = subprocess.run([script("design-plant"), *DEMO, "--out", str(out), *args], capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    return proc.stdout, out / "reports" / "plant_fc3500_z0.2"
+
+
+@pytest.mark.spice
+def test_the_spanish_sheet_leaves_no_english_message_and_writes_decimal_commas(tmp_path):
+    summary, rep = design_plant(tmp_path, "--lang", "es")
+    page = (rep / "build-sheet.html").read_text()
+    assert english_left(page) == []
+    nodes = sheet_text_nodes(page)
+    assert [n for n in nodes if DECIMAL_POINT.search(n)] == []
+    assert sum(len(DECIMAL_COMMA.findall(n)) for n in nodes) > 50
+    assert "<html lang='es'>" in page and "Planta Sallen-Key: fc 3500 Hz, zeta 0,2, ganancia 1" in page
+    assert "1,6 kΩ" in page   # R1, as the BOM and the alternatives give it
+    # the Markdown and the terminal summary are the same sheet
+    md = (rep / "build-sheet.md").read_text()
+    assert "\n### Lista de materiales\n" in md and "\n## Cableado\n" in md and "Bill of materials" not in md
+    assert "Lista de materiales:" in summary and "Bill of materials" not in summary
+    # the data files keep their columns: a CSV is read by programs, in any language
+    assert (rep / "bom.csv").read_text().startswith("Ref,Value,Code,Qty,Series,Tolerance,Package,Description\n")
+
+
+@pytest.mark.spice
+def test_the_english_sheet_is_byte_identical_to_the_reference(tmp_path):
+    _, rep = design_plant(tmp_path, "--lang", "en")
+    for name in ("build-sheet.md", "build-sheet.html"):
+        assert (rep / name).read_bytes() == (REPORTS / "plant_fc3500_z0.2" / name).read_bytes(), name
