@@ -110,3 +110,22 @@ def english_left(page: str, lang: str = "es") -> list:
     from designer.core.i18n import catalogue
     english = {m for m, t in catalogue(lang).items() if t != m}
     return [n for n in sheet_text_nodes(page) if n in english or n.rstrip(":") in english]
+
+
+def sheet_command(exe: str, args, out, *more):
+    """Run a sheet-writing command (``args`` its design's options, ``--out out``, then ``more``), which must
+    succeed in silence; its standard output and its report folder (``--name``'s, the value after it in ``args``)."""
+    import subprocess
+    args = list(args)
+    proc = subprocess.run([script(exe), *args, "--out", str(out), *more], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    return proc.stdout, Path(out) / "reports" / args[args.index("--name") + 1]
+
+
+def spanish_sheet(exe: str, args, out):
+    """A sheet-writing command run with ``--lang es`` (:func:`sheet_command`), its sheet checked for English
+    messages left (:func:`english_left`); its summary, HTML page and text nodes."""
+    summary, rep = sheet_command(exe, args, out, "--lang", "es")
+    page = (rep / "build-sheet.html").read_text()
+    assert english_left(page) == []
+    return summary, rep, page, sheet_text_nodes(page)

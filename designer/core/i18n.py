@@ -123,10 +123,14 @@ def catalogue(lang: str) -> dict:
     dict
         The messages.
     """
+    return {m.id: m.string for m in _read_po(lang) if m.id and isinstance(m.id, str) and m.string and not m.fuzzy}
+
+
+def _read_po(lang: str):
+    """The ``.po`` file of ``lang`` as Babel's Catalog."""
     from babel.messages.pofile import read_po
     with open(catalogue_path(lang), "rb") as f:
-        cat = read_po(f, locale=lang, domain=DOMAIN)
-    return {m.id: m.string for m in cat if m.id and isinstance(m.id, str) and m.string and not m.fuzzy}
+        return read_po(f, locale=lang, domain=DOMAIN)
 
 
 def gettext(message: str) -> str:
@@ -254,16 +258,14 @@ def update_catalogue(lang: str = "es") -> int:
     int
         How many were added.
     """
-    from babel.messages.pofile import read_po, write_po
-    path = catalogue_path(lang)
-    with open(path, "rb") as f:
-        cat = read_po(f, locale=lang, domain=DOMAIN)
+    from babel.messages.pofile import write_po
+    cat = _read_po(lang)
     added = 0
     for msg, where in extract().items():
         if msg not in cat:
             cat.add(msg, "", locations=[tuple(w.rsplit(":", 1)) for w in where])
             added += 1
-    with open(path, "wb") as f:
+    with open(catalogue_path(lang), "wb") as f:
         write_po(f, cat, width=116, omit_header=False, include_lineno=False, sort_output=True)
     catalogue.cache_clear()
     return added

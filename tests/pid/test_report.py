@@ -1,8 +1,7 @@
 import re
-import subprocess
 
 import pytest
-from helpers import REPORTS, english_left, script, sheet_text_nodes
+from helpers import REPORTS, sheet_command, spanish_sheet
 
 from designer.pid.blocks import seed_parts
 from designer.pid.design import PidSpec, design_pid
@@ -70,19 +69,9 @@ def test_the_json_keeps_its_keys():
 ZN_DEMO = ["--plant-fc", "3500", "--plant-zeta", "0.2", "--opamp", "LM741", "--name", "pid_zn_lm741_fc3500_z0.2"]
 
 
-def _design_pid(out, *args):
-    proc = subprocess.run([script("design-pid"), *ZN_DEMO, "--out", str(out), *args], capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
-    return proc.stdout, out / "reports" / "pid_zn_lm741_fc3500_z0.2"
-
-
 @pytest.mark.spice
 def test_the_spanish_pid_sheet_leaves_no_english_message_and_writes_decimal_commas(tmp_path):
-    summary, rep = _design_pid(tmp_path, "--lang", "es")
-    page = (rep / "build-sheet.html").read_text()
-    assert english_left(page) == []
-    nodes = sheet_text_nodes(page)
+    summary, _rep, page, nodes = spanish_sheet("design-pid", ZN_DEMO, tmp_path)
     # the verdict's and the tables' figures: a decimal comma, never a point (notes from the library aside)
     assert re.search(r"\d+,\d+ % de sobrepaso", page) and "Ti = 43,75 µs" in page
     headings = re.findall(r"<h2>([^<]*)</h2>", page)
@@ -93,6 +82,6 @@ def test_the_spanish_pid_sheet_leaves_no_english_message_and_writes_decimal_comm
 
 @pytest.mark.spice
 def test_the_english_pid_sheet_is_byte_identical_to_the_reference(tmp_path):
-    _, rep = _design_pid(tmp_path)
+    _, rep = sheet_command("design-pid", ZN_DEMO, tmp_path)
     for name in ("build-sheet.md", "build-sheet.html"):
         assert (rep / name).read_bytes() == (REPORTS / "pid_zn_lm741_fc3500_z0.2" / name).read_bytes(), name

@@ -2,10 +2,9 @@
 left and decimal commas, English byte for byte the committed reference (reports/plant_fc3500_z0.2)."""
 
 import re
-import subprocess
 
 import pytest
-from helpers import REPORTS, english_left, script, sheet_text_nodes
+from helpers import REPORTS, sheet_command, spanish_sheet
 
 #: the Makefile demo's plant (reports/plant_fc3500_z0.2): a Monte Carlo with limits and the worst case
 DEMO = ["--fc", "3500", "--zeta", "0.2", "--monte-carlo", "5000", "--seed", "1", "--limit", "fn_hz=3.3k:3.7k",
@@ -16,18 +15,12 @@ DECIMAL_COMMA = re.compile(r"(?<![\w,])\d+,\d+\b")
 
 
 def design_plant(out, *args):
-    proc = subprocess.run([script("design-plant"), *DEMO, "--out", str(out), *args], capture_output=True,
-                          text=True, timeout=300)
-    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
-    return proc.stdout, out / "reports" / "plant_fc3500_z0.2"
+    return sheet_command("design-plant", DEMO, out, *args)
 
 
 @pytest.mark.spice
 def test_the_spanish_sheet_leaves_no_english_message_and_writes_decimal_commas(tmp_path):
-    summary, rep = design_plant(tmp_path, "--lang", "es")
-    page = (rep / "build-sheet.html").read_text()
-    assert english_left(page) == []
-    nodes = sheet_text_nodes(page)
+    summary, rep, page, nodes = spanish_sheet("design-plant", DEMO, tmp_path)
     assert [n for n in nodes if DECIMAL_POINT.search(n)] == []
     assert sum(len(DECIMAL_COMMA.findall(n)) for n in nodes) > 50
     assert "<html lang='es'>" in page and "Planta Sallen-Key: fc 3500 Hz, zeta 0,2, ganancia 1" in page
