@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from ..core import eseries
-from ..core.i18n import N_
+from ..core.i18n import N_, language
 from ..core.i18n import gettext as _
 from ..core.units import format_eng
 from ..report import document as R
@@ -388,8 +388,9 @@ def _fmt(v, unit, signed=False):
     return (f"{v:+.3g}" if signed else f"{v:.3g}") + (f" {unit}" if unit else "")
 
 
-def summary_text(result) -> str:
-    text = R.to_text(title_of(result), sections(result, with_images=False))
+def summary_text(result, lang=None) -> str:
+    with language(lang):   # None: the current language (designer.core.i18n)
+        text = R.to_text(title_of(result), sections(result, with_images=False))
     for extra in (result.monte_carlo, result.worst_case):
         if extra is not None:
             text += "\n" + "\n".join(extra.summary_lines()) + "\n"
@@ -490,9 +491,11 @@ PLOTS = (("closed-loop.png", _closed_loop_plot), ("blocks.png", _blocks_plot),
          ("loop-bode.png", _loop_gain_plot), ("reaction-curve.png", _reaction_plot))
 
 
-def write_outputs(result, out_dir, name: str) -> dict:
+def write_outputs(result, out_dir, name: str, lang=None) -> dict:
     """``netlists/<name>.cir`` and ``reports/<name>/`` (build sheet, result.json,
-    plots, schematic, bom.csv) under ``out_dir``, each written atomically."""
-    return write_design(result, out_dir, name, PLOTS + histogram_plots(result), schematic,
-                        lambda svg: sections(result, schematic_svg=svg), title_of(result),
-                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))), **csv_texts(result)})
+    plots, schematic, bom.csv) under ``out_dir``, each written atomically; the sheet in ``lang``
+    (None: the current language, :mod:`designer.core.i18n`)."""
+    with language(lang):
+        return write_design(result, out_dir, name, PLOTS + histogram_plots(result), schematic,
+                            lambda svg: sections(result, schematic_svg=svg), title_of(result),
+                            {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))), **csv_texts(result)})

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from ..core.i18n import N_
+from ..core.i18n import N_, language
 from ..core.i18n import gettext as _
 from ..core.units import format_eng
 from ..report import document as R
@@ -283,20 +283,24 @@ def _n(v):
     return "" if v is None else f"{v:.4g}"
 
 
-def summary_text(result) -> str:
+def summary_text(result, lang: str | None = None) -> str:
     """The terminal summary: the build sheet without plots (and the Monte Carlo's lines when run).
 
     Parameters
     ----------
     result : PlantResult
         The plant.
+    lang : str or None
+        The language (:data:`designer.core.i18n.LANGUAGES`); None: the current one (English unless a
+        :func:`designer.core.i18n.language` block says otherwise).
 
     Returns
     -------
     str
         The summary.
     """
-    text = R.to_text(title_of(result), sections(result, with_images=False))
+    with language(lang):
+        text = R.to_text(title_of(result), sections(result, with_images=False))
     for extra in (result.monte_carlo, result.worst_case):
         if extra is not None:
             text += "\n" + "\n".join(extra.summary_lines()) + "\n"
@@ -436,7 +440,7 @@ def schematic(result):
 PLOTS = (("step.png", step_png), ("bode.png", bode_png))
 
 
-def write_outputs(result, out_dir, name: str) -> dict:
+def write_outputs(result, out_dir, name: str, lang: str | None = None) -> dict:
     """Write ``netlists/<name>.cir`` and ``reports/<name>/`` under ``out_dir``.
 
     Every file goes through a temporary file and a rename; the paths are
@@ -450,6 +454,8 @@ def write_outputs(result, out_dir, name: str) -> dict:
         The folder.
     name : str
         The design's name.
+    lang : str or None
+        The build sheet's language (None: the current one, see :func:`summary_text`).
 
     Returns
     -------
@@ -465,5 +471,6 @@ def write_outputs(result, out_dir, name: str) -> dict:
                       "prbs_deck": ("prbs-test.cir", lambda r: r.prbs.deck)})
     texts.update(csv_texts(result))   # monte-carlo.csv: one row per sample, every varied part and figure
     prbs_plots = (("prbs.png", prbs_png),) if result.prbs is not None else ()
-    return write_design(result, out_dir, name, PLOTS + prbs_plots + histogram_plots(result), schematic,
-                        lambda svg: sections(result, schematic_svg=svg), title_of(result), texts)
+    with language(lang):
+        return write_design(result, out_dir, name, PLOTS + prbs_plots + histogram_plots(result), schematic,
+                            lambda svg: sections(result, schematic_svg=svg), title_of(result), texts)

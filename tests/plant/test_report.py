@@ -38,3 +38,16 @@ def test_the_english_sheet_is_byte_identical_to_the_reference(tmp_path):
     _, rep = design_plant(tmp_path, "--lang", "en")
     for name in ("build-sheet.md", "build-sheet.html"):
         assert (rep / name).read_bytes() == (REPORTS / "plant_fc3500_z0.2" / name).read_bytes(), name
+
+
+def test_the_library_writes_a_sheet_in_the_language_it_is_given(tmp_path):
+    from designer.core.i18n import current
+    from designer.plant.design import design_plant as design
+    from designer.plant.report import summary_text, write_outputs
+    from designer.plant.spec import PlantSpec
+    result = design(PlantSpec(fc_hz=3500, zeta=0.2), simulate=False)
+    write_outputs(result, tmp_path, "es", lang="es")
+    md = (tmp_path / "reports" / "es" / "build-sheet.md").read_text()
+    assert md.startswith("# Planta Sallen-Key: fc 3500 Hz, zeta 0,2, ganancia 1\n") and "no simulado" in md
+    assert current() == "en" and summary_text(result).startswith("Sallen-Key plant: fc 3500 Hz, zeta 0.2, gain 1\n")
+    assert summary_text(result, lang="es").startswith("Planta Sallen-Key")
