@@ -57,7 +57,8 @@ FLAGS = {
     "bessel_norm": "--bessel-norm", "chebyshev_cutoff": "--chebyshev-cutoff", "gbw_margin": "--gbw-margin",
     "impedance_ohm": "--impedance", "series": "--series",
     "f_low_hz": "--f-low", "f_high_hz": "--f-high", "bandpass_method": "--bandpass-method",
-    "lang": "--lang", "duration_s": "--duration", "points": "--points", "noise_v": "--noise", "lsb_v": "--lsb", "seed": "--seed",
+    "lang": "--lang",
+    "duration_s": "--duration", "points": "--points", "noise_v": "--noise", "lsb_v": "--lsb", "seed": "--seed",
 }
 
 

@@ -48,11 +48,13 @@ def controller_stages(parts: PidParts, ref="ref", y="y", u="u") -> list:
     p = parts
     stages = [
         (Amp("U2", "difference", "p2", "n2", "ve"),
-         [Part("R15", ref, "n2", p.r15, N_("U2 input from the reference r")), Part("R16", "n2", "ve", p.r16, N_("U2 feedback")),
+         [Part("R15", ref, "n2", p.r15, N_("U2 input from the reference r")),
+          Part("R16", "n2", "ve", p.r16, N_("U2 feedback")),
           Part("R17", y, "p2", p.r17, N_("U2 +in from the plant output y")),
           Part("R18", "p2", GROUND, p.r18, N_("U2 +in to ground"))]),
         (Amp("U3", "inverter", GROUND, "n3", "vp"),
-         [Part("R10", "ve", "n3", p.r10, N_("U3 input (unity inverter)")), Part("R9", "n3", "vp", p.r9, N_("U3 feedback"))]),
+         [Part("R10", "ve", "n3", p.r10, N_("U3 input (unity inverter)")),
+          Part("R9", "n3", "vp", p.r9, N_("U3 feedback"))]),
     ]
     if p.has_derivative:
         stages.append((Amp("U4", "differentiator", GROUND, "n4", "vd"),
@@ -67,7 +69,8 @@ def controller_stages(parts: PidParts, ref="ref", y="y", u="u") -> list:
         (Amp("U6", "summer", GROUND, "n6", "vs"),
          [Part("R6", "vp", "n6", p.r6, N_("U6 input from U3 (proportional)"))]
          + ([Part("R7", "vd", "n6", p.r7, N_("U6 input from U4 (derivative)"))] if p.has_derivative else [])
-         + [Part("R8", "vi", "n6", p.r8, N_("U6 input from U5 (integral)")), Part("R5", "n6", "vs", p.r5, N_("U6 feedback"))]),
+         + [Part("R8", "vi", "n6", p.r8, N_("U6 input from U5 (integral)")),
+            Part("R5", "n6", "vs", p.r5, N_("U6 feedback"))]),
         (Amp("U7", "gain", GROUND, "n7", u),
          [Part("R4", "vs", "n7", p.r4, N_("U7 input (final gain)")), Part("R3", "n7", u, p.r3, N_("U7 feedback"))]),
     ]

@@ -185,7 +185,8 @@ def wiring_rows(board, labels: dict, supplies: tuple) -> list:
                      supply.format(pin=pkg.vee, rail="V-", v=f"{vee:+g}", cap=f"C{n}02") + opened])
     for u in board.spares:
         rows.append([_("wire"), "", _pin(u, "inp"), _("ground (spare unit)")])
-        rows.append([_("wire"), "", _pin(u, "out"), _pin(u, "inn") + _(": spare as a follower, so it cannot oscillate")])
+        rows.append([_("wire"), "", _pin(u, "out"),
+                     _pin(u, "inn") + _(": spare as a follower, so it cannot oscillate")])
     rows.append([_("wire"), "", _("supply 0 V, generator ground, scope grounds"), _("ground (one star point)")])
     rows.append(["C901, C902", "10u", _("{vcc} V and {vee} V where the supply enters").format(vcc=f"{vcc:+g}",
                                                                                            vee=f"{vee:+g}"),
