@@ -4,7 +4,7 @@ PY := .venv/bin/python
 VENV_STAMP := .venv/.installed
 export MPLBACKEND := Agg
 
-.PHONY: setup system-deps lock demo test bench web clean
+.PHONY: setup system-deps lock demo test bench web clean i18n i18n-update
 
 # compileall: the environment may set PYTHONDONTWRITEBYTECODE, and every command would recompile the package
 setup: system-deps $(VENV_STAMP)
@@ -103,6 +103,14 @@ web: setup
 test: setup
 	$(PY) -m ruff check --quiet --no-cache designer tests benchmarks
 	$(PY) -m pytest -q -p no:cacheprovider tests
+
+# the build sheets' Spanish catalogue: every message the code marks (Babel's extractor) translated in
+# designer/locale/es/LC_MESSAGES/designer.po; i18n-update adds the missing ones with an empty translation
+i18n: setup
+	$(PY) -m designer.core.i18n
+
+i18n-update: setup
+	$(PY) -m designer.core.i18n --update
 
 bench: setup
 	$(PY) benchmarks/run.py

@@ -96,3 +96,60 @@ def deck_terminals(deck: str) -> dict:
         else:
             out.update({(name, pin): net for pin, net in zip(X_PINS, f[1:6])})
     return out
+
+
+def sheet_text_nodes(page: str) -> list:
+    """The text a reader sees in a build sheet's HTML: every text node (stripped; the style sheet and
+    the schematic's SVG left out) and every picture's alternative text."""
+    from html.parser import HTMLParser
+
+    class Nodes(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.out, self.skip = [], 0
+
+        def handle_starttag(self, tag, attrs):
+            if tag in ("style", "svg"):
+                self.skip += 1
+            alt = dict(attrs).get("alt") or dict(attrs).get("aria-label")
+            if alt and not self.skip:
+                self.out.append(alt.strip())
+
+        def handle_endtag(self, tag):
+            if tag in ("style", "svg"):
+                self.skip -= 1
+
+        def handle_data(self, data):
+            if not self.skip and data.strip():
+                self.out.append(data.strip())
+
+    p = Nodes()
+    p.feed(page)
+    return p.out
+
+
+def english_left(page: str, lang: str = "es") -> list:
+    """The text nodes of a sheet in ``lang`` that are an English message of the catalogue whose
+    translation differs (a word the sheet forgot to translate)."""
+    from designer.core.i18n import catalogue
+    english = {m for m, t in catalogue(lang).items() if t != m}
+    return [n for n in sheet_text_nodes(page) if n in english or n.rstrip(":") in english]
+
+
+def sheet_command(exe: str, args, out, *more):
+    """Run a sheet-writing command (``args`` its design's options, ``--out out``, then ``more``), which must
+    succeed in silence; its standard output and its report folder (``--name``'s, the value after it in ``args``)."""
+    import subprocess
+    args = list(args)
+    proc = subprocess.run([script(exe), *args, "--out", str(out), *more], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    return proc.stdout, Path(out) / "reports" / args[args.index("--name") + 1]
+
+
+def spanish_sheet(exe: str, args, out):
+    """A sheet-writing command run with ``--lang es`` (:func:`sheet_command`), its sheet checked for English
+    messages left (:func:`english_left`); its summary, HTML page and text nodes."""
+    summary, rep = sheet_command(exe, args, out, "--lang", "es")
+    page = (rep / "build-sheet.html").read_text()
+    assert english_left(page) == []
+    return summary, rep, page, sheet_text_nodes(page)

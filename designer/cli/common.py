@@ -60,6 +60,7 @@ FLAGS = {
     "bessel_norm": "--bessel-norm", "chebyshev_cutoff": "--chebyshev-cutoff", "gbw_margin": "--gbw-margin",
     "impedance_ohm": "--impedance", "series": "--series",
     "f_low_hz": "--f-low", "f_high_hz": "--f-high", "bandpass_method": "--bandpass-method",
+    "lang": "--lang",
     "duration_s": "--duration", "points": "--points", "noise_v": "--noise", "lsb_v": "--lsb", "seed": "--seed",
 }
 
@@ -244,6 +245,7 @@ def add_output_options(p, default_name: str):
                                    f"(default from the figures, e.g. {default_name})")
     g.add_argument("--json", action="store_true", help="print one JSON object on stdout instead of the summary")
     g.add_argument("--no-files", action="store_true", help="do not write the netlist and report files")
+    add_lang_option(g)
     g.add_argument("--fail-on-check", action="store_true",
                    help="exit status 1 when a design check or the SPICE agreement fails (for CI; the files and "
                         "the summary are written first, the failed checks listed on stderr)")
@@ -253,6 +255,21 @@ def add_output_options(p, default_name: str):
                    help="pyspice: ngspice shared library via PySpice (default); "
                         "ngspice-cli: `ngspice -b` subprocess")
     return s
+
+
+def add_lang_option(group):
+    """``--lang``: the language of the build sheet and the summary (:mod:`designer.core.i18n`).
+
+    Parameters
+    ----------
+    group : argparse group or parser
+        Where the option goes.
+    """
+    from ..core.i18n import DEFAULT, LANGUAGES
+    group.add_argument("--lang", default=DEFAULT, choices=LANGUAGES,
+                       help=f"language of the build sheet and the summary: {', '.join(LANGUAGES)} (default {DEFAULT}, "
+                            "whatever LANG or LC_ALL say, so a sheet is the same on every machine; es writes decimal "
+                            "commas; values are typed with a dot in every language: a comma separates list items)")
 
 
 def add_opamp_option(group):
@@ -291,15 +308,17 @@ def emit(result, args, name, write_outputs, summary_text) -> int:
     """Write the files (unless --no-files), then print JSON or the summary and the file list.
     Returns the exit status: 1 with ``--fail-on-check`` when a verdict failed
     (:meth:`verdicts` of the result: the checks and the SPICE agreement), else 0."""
-    if not args.no_files:
-        write_outputs(result, args.out, name)
+    from ..core.i18n import language
+    with language(getattr(args, "lang", None)):
+        if not args.no_files:
+            write_outputs(result, args.out, name)
+        text = None if args.json else summary_text(result)
     hook = RESULT_HOOK.get()
     if hook is not None:
         hook(result, name)
     if args.json:
         print_output(json.dumps(result.to_dict(), indent=2))
     else:
-        text = summary_text(result)
         if result.files:
             text += "\nFiles:\n" + "".join(
                 f"  {key}: {', '.join(path) if isinstance(path, list) else path}\n"

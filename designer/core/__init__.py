@@ -21,6 +21,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                "check_output_file", "check_output_folder", "check_plain_name", "clean_stale", "decode", "ensure_dir",
                "link_into", "new_folder_beside", "open_limited", "os_error", "publish_folder", "read_text",
                "remove_tree", "show_cell", "shown", "size_text"),
+    "i18n": ("DEFAULT", "LANGUAGES", "N_", "catalogue", "check_language", "current", "extract", "gettext", "language",
+             "localise", "missing", "update_catalogue"),
     "jsonio": ("SCHEMA_VERSION", "json_safe", "read_result"),
     "lifetime": ("Interrupted", "WORDS", "die_with_parent", "finish", "forget", "install", "interruption", "native",
                  "on_exit", "owned_prefix", "preexec", "quiet", "remove_stale", "reset_in_child", "status_of",

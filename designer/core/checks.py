@@ -6,26 +6,28 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .i18n import N_
+
 __all__ = ["Check", "IDS", "SPICE_AGREEMENT"]
 
 #: what each check id means, for the build sheets (ids not listed print as themselves)
 TITLES = {
-    "slew_rate": "slew rate",
-    "output_swing": "output swing",
-    "prbs_slew_rate": "slew rate under the PRBS",
-    "prbs_output_swing": "output swing under the PRBS",
-    "square_wave_period": "square-wave period",
-    "spice_agreement": "SPICE agreement",
-    "closed_loop_stable": "closed loop stable",
-    "phase_margin": "phase margin",
-    "steady_state_error": "steady-state error",
-    "kp_accuracy": "Kp accuracy",
-    "ti_accuracy": "Ti accuracy",
-    "td_accuracy": "Td accuracy",
-    "integrator_corner": "integrator corner",
-    "differentiator_corner": "differentiator corner",
-    "resistor_bounds": "resistor bounds",
-    "capacitor_bounds": "capacitor bounds",
+    "slew_rate": N_("slew rate"),
+    "output_swing": N_("output swing"),
+    "prbs_slew_rate": N_("slew rate under the PRBS"),
+    "prbs_output_swing": N_("output swing under the PRBS"),
+    "square_wave_period": N_("square-wave period"),
+    "spice_agreement": N_("SPICE agreement"),
+    "closed_loop_stable": N_("closed loop stable"),
+    "phase_margin": N_("phase margin"),
+    "steady_state_error": N_("steady-state error"),
+    "kp_accuracy": N_("Kp accuracy"),
+    "ti_accuracy": N_("Ti accuracy"),
+    "td_accuracy": N_("Td accuracy"),
+    "integrator_corner": N_("integrator corner"),
+    "differentiator_corner": N_("differentiator corner"),
+    "resistor_bounds": N_("resistor bounds"),
+    "capacitor_bounds": N_("capacitor bounds"),
 }
 
 

@@ -22,6 +22,7 @@ inverting inputs, ``p2`` the difference amplifier's non-inverting input,
 
 from __future__ import annotations
 
+from ..core.i18n import N_
 from ..core.opamps import OpAmp
 from ..plant.netlist import plant_netlist
 from ..plant.sallenkey import SallenKeyParts
@@ -34,9 +35,10 @@ __all__ = ["closed_loop_deck", "controller_netlist", "loop_netlist", "model_loop
 #: signals whose extremes the deck measures (one per op-amp output)
 PROBES = ("ve", "vp", "vd", "vi", "vs", "u", "y")
 #: what the nets are called on the sheet (wiring table, schematic labels)
-NET_LABELS = {"ref": "reference r (generator, CH1)", "y": "plant output y (CH2)", "ve": "error ve",
-              "vp": "proportional vp", "vd": "derivative vd", "vi": "integral vi", "vs": "summer vs",
-              "u": "controller output u", "pv1": "plant node A (R1-R2-C2)", "d4": "R12-C3 node", "0": "ground"}
+NET_LABELS = {"ref": N_("reference r (generator, CH1)"), "y": N_("plant output y (CH2)"), "ve": N_("error ve"),
+              "vp": N_("proportional vp"), "vd": N_("derivative vd"), "vi": N_("integral vi"), "vs": N_("summer vs"),
+              "u": N_("controller output u"), "pv1": N_("plant node A (R1-R2-C2)"), "d4": N_("R12-C3 node"),
+              "0": N_("ground")}
 
 
 def controller_stages(parts: PidParts, ref="ref", y="y", u="u") -> list:
@@ -46,28 +48,31 @@ def controller_stages(parts: PidParts, ref="ref", y="y", u="u") -> list:
     p = parts
     stages = [
         (Amp("U2", "difference", "p2", "n2", "ve"),
-         [Part("R15", ref, "n2", p.r15, "U2 input from the reference r"), Part("R16", "n2", "ve", p.r16, "U2 feedback"),
-          Part("R17", y, "p2", p.r17, "U2 +in from the plant output y"),
-          Part("R18", "p2", GROUND, p.r18, "U2 +in to ground")]),
+         [Part("R15", ref, "n2", p.r15, N_("U2 input from the reference r")),
+          Part("R16", "n2", "ve", p.r16, N_("U2 feedback")),
+          Part("R17", y, "p2", p.r17, N_("U2 +in from the plant output y")),
+          Part("R18", "p2", GROUND, p.r18, N_("U2 +in to ground"))]),
         (Amp("U3", "inverter", GROUND, "n3", "vp"),
-         [Part("R10", "ve", "n3", p.r10, "U3 input (unity inverter)"), Part("R9", "n3", "vp", p.r9, "U3 feedback")]),
+         [Part("R10", "ve", "n3", p.r10, N_("U3 input (unity inverter)")),
+          Part("R9", "n3", "vp", p.r9, N_("U3 feedback"))]),
     ]
     if p.has_derivative:
         stages.append((Amp("U4", "differentiator", GROUND, "n4", "vd"),
-                       [Part("R12", "ve", "d4", p.r12, "U4 input, in series with C3"),
-                        Part("C3", "d4", "n4", p.c3, "U4 input, in series with R12 (derivative)"),
-                        Part("R11", "n4", "vd", p.r11, "U4 feedback (differentiator)")]))
+                       [Part("R12", "ve", "d4", p.r12, N_("U4 input, in series with C3")),
+                        Part("C3", "d4", "n4", p.c3, N_("U4 input, in series with R12 (derivative)")),
+                        Part("R11", "n4", "vd", p.r11, N_("U4 feedback (differentiator)"))]))
     stages += [
         (Amp("U5", "integrator", GROUND, "n5", "vi"),
-         [Part("R14", "ve", "n5", p.r14, "U5 input (integrator)"),
-          Part("R13", "n5", "vi", p.r13, "U5 feedback, parallel to C4 (integrator leak)"),
-          Part("C4", "n5", "vi", p.c4, "U5 feedback (integrator)")]),
+         [Part("R14", "ve", "n5", p.r14, N_("U5 input (integrator)")),
+          Part("R13", "n5", "vi", p.r13, N_("U5 feedback, parallel to C4 (integrator leak)")),
+          Part("C4", "n5", "vi", p.c4, N_("U5 feedback (integrator)"))]),
         (Amp("U6", "summer", GROUND, "n6", "vs"),
-         [Part("R6", "vp", "n6", p.r6, "U6 input from U3 (proportional)")]
-         + ([Part("R7", "vd", "n6", p.r7, "U6 input from U4 (derivative)")] if p.has_derivative else [])
-         + [Part("R8", "vi", "n6", p.r8, "U6 input from U5 (integral)"), Part("R5", "n6", "vs", p.r5, "U6 feedback")]),
+         [Part("R6", "vp", "n6", p.r6, N_("U6 input from U3 (proportional)"))]
+         + ([Part("R7", "vd", "n6", p.r7, N_("U6 input from U4 (derivative)"))] if p.has_derivative else [])
+         + [Part("R8", "vi", "n6", p.r8, N_("U6 input from U5 (integral)")),
+            Part("R5", "n6", "vs", p.r5, N_("U6 feedback"))]),
         (Amp("U7", "gain", GROUND, "n7", u),
-         [Part("R4", "vs", "n7", p.r4, "U7 input (final gain)"), Part("R3", "n7", u, p.r3, "U7 feedback")]),
+         [Part("R4", "vs", "n7", p.r4, N_("U7 input (final gain)")), Part("R3", "n7", u, p.r3, N_("U7 feedback"))]),
     ]
     return stages
 

@@ -21,6 +21,7 @@ import math
 
 import numpy as np
 
+from ..core.i18n import gettext as _
 from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import draw_early as bundle_early, write_design
@@ -44,9 +45,9 @@ RULE_HEADER = ("rule", "Kp", "Ti", "Td", "phase margin", "gain margin", "delay m
 
 
 def title_of(result) -> str:
-    return (f"Op-amp PID ({result.method}: Kp {result.kp:.4g}, Ti {format_eng(result.ti_s, 's')}, "
-            f"Td {format_eng(result.td_s, 's')}) for the model plant {result.model.text()}, "
-            f"with {result.opamp.name}")
+    return _("Op-amp PID ({method}: Kp {kp}, Ti {ti}, Td {td}) for the model plant {model}, with {opamp}").format(
+        method=result.method, kp=f"{result.kp:.4g}", ti=format_eng(result.ti_s, 's'), td=format_eng(result.td_s, 's'),
+        model=result.model.text(), opamp=result.opamp.name)
 
 
 def _dash(v, unit: str = "", digits: int = 4) -> str:
@@ -91,30 +92,30 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`)."""
     b = build_board(result)
     elsewhere = _shown_elsewhere(result)
-    out = [("Verdict", [R.text(verdict_text(result))] + [R.text(n) for n in result.notes if n not in elsewhere])]
-    out.append(("Build", _build_blocks(result, b, bom(result, b), with_images, schematic_svg)))
+    out = [(_("Verdict"), [R.text(verdict_text(result))] + [R.text(n) for n in result.notes if n not in elsewhere])]
+    out.append((_("Build"), _build_blocks(result, b, bom(result, b), with_images, schematic_svg)))
     circuit = getattr(result.spec, "circuit", None)
     if circuit is not None:   # the plant's own sections are on the board, wired as the rest
-        out.append(("Wiring", _wiring_blocks(result, b, (), " The plant's sections are on this board (their parts "
-                                                             f"prefixed {PLANT_PREFIX}: RP1, CP1, op-amp UP).")))
+        out.append((_("Wiring"), _wiring_blocks(result, b, (), " The plant's sections are on this board (their parts "
+                                                                f"prefixed {PLANT_PREFIX}: RP1, CP1, op-amp UP).")))
     else:
-        out.append(("Wiring", _wiring_blocks(
+        out.append((_("Wiring"), _wiring_blocks(
             result, b, plant_rows(b),
             " The plant is not on this board: its input takes u, its output y goes to R17 and to CH2, and its "
             "ground joins the common ground (the first rows).")))
-    out.append(("The plant", _plant_blocks(result)))
-    out.append(("Tuning", _tuning_blocks(result)))
-    out.append(("Target and achieved", _achieved_blocks(result, result) + [R.text(
+    out.append((_("The plant"), _plant_blocks(result)))
+    out.append((_("Tuning"), _tuning_blocks(result)))
+    out.append((_("Target and achieved"), _achieved_blocks(result, result) + [R.text(
         f"The integrator leak (R13) and the derivative filter (R12) are placed from fc = "
         f"{_v(result.fc_ref_hz, 'Hz')}, the crossover of the ideal PID around the model (near fc/100 and "
         "10 fc unless set).")]))
-    out.append(("Checks", [R.table(["check", "result", "detail"],
-                                   [[c.id, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]))
-    out.append(("Closed loop", _loop_blocks(result, with_images)))
+    out.append((_("Checks"), [R.table([_("check"), _("result"), _("detail")],
+                                      [[c.id, _("ok") if c.ok else _("FAILED"), c.detail] for c in result.checks])]))
+    out.append((_("Closed loop"), _loop_blocks(result, with_images)))
     heading = tolerance_title(result, worst=True)
     if heading is not None:
         out.append((heading, tolerance_section(result, with_images, worst=True)))
-    out.append(("Expected scope readings", _scope(result, with_images, b)))
+    out.append((_("Expected scope readings"), _scope(result, with_images, b)))
     return out
 
 
@@ -246,12 +247,14 @@ def _loop_blocks(result, with_images) -> list:
     a, s, amp, mg = result.analytic, result.spice, result.opamp, result.margins
     rows = _margin_rows(result.ideal_margins, mg)
     i = result.ideal_pid
-    rows += [[label, f(_known(getattr(i, key))) if i is not None else "-", f(_known(getattr(a, key))),
-              f(_known(getattr(s.figures, key))) if s else "not simulated"] for key, label, f in METRICS]
-    rows.append(["stable", str(result.ideal_margins.stable), str(result.stable), str(s.stable) if s else ""])
-    rows.append(["saturated", "", "", str(s.saturated) if s else ""])
+    rows += [[_(label), f(_known(getattr(i, key))) if i is not None else "-", f(_known(getattr(a, key))),
+              f(_known(getattr(s.figures, key))) if s else _("not simulated")] for key, label, f in METRICS]
+    rows.append([_("stable"), _(str(result.ideal_margins.stable)), _(str(result.stable)),
+                 _(str(s.stable)) if s else ""])
+    rows.append([_("saturated"), "", "", _(str(s.saturated)) if s else ""])
     pm, gm, ms = result.limits
-    blocks = [R.table(["", "ideal PID around the model", f"realised (with {amp.name})", "SPICE"], rows),
+    blocks = [R.table(["", _("ideal PID around the model"), _("realised (with {opamp})").format(opamp=amp.name),
+                       "SPICE"], rows),
               R.text(f"The loop as built (op-amp poles, integrator leak, derivative filter, exact dead time): phase "
                      f"margin {_dash(mg.phase_margin_deg, 'deg')} at {_dash(mg.crossover_hz, 'Hz')}, gain margin "
                      f"{_dash(mg.gain_margin_db, 'dB')} at {_dash(mg.phase_crossover_hz, 'Hz')}, delay margin "
@@ -263,8 +266,8 @@ def _loop_blocks(result, with_images) -> list:
     if result.robust is not None:
         blocks += _robust_blocks(result.robust)
     if with_images:
-        blocks.append(R.columns([R.image("closed-loop.png", "closed-loop step and controller output")],
-                                [R.image("loop-bode.png", "loop gain with its margins")]))
+        blocks.append(R.columns([R.image("closed-loop.png", _("closed-loop step and controller output"))],
+                                [R.image("loop-bode.png", _("loop gain with its margins"))]))
     return blocks
 
 

@@ -14,6 +14,8 @@ import math
 import numpy as np
 
 from ..core import eseries
+from ..core.i18n import N_, language
+from ..core.i18n import gettext as _
 from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import write_design
@@ -31,28 +33,34 @@ __all__ = ["bom", "build_board", "plots", "schematic", "sections", "summary_text
 
 #: what each block's output looks like on the scope for a square-wave reference
 SHAPES = {
-    "difference": "error y - r: a spike of -step at each rising edge that decays as the plant catches up "
-                  "(seed Fig. 79/88)",
-    "inverter": "the error inverted: r - y (seed Fig. 81)",
-    "differentiator": "short spikes at the edges of the error, decaying with R12 C3 (seed Fig. 85)",
-    "integrator": "ramps while the error is large, then flattens at the level that holds the output "
-                  "(seed Fig. 83)",
-    "summer": "the three actions added (and inverted): a kick at each edge, then a level (seed Fig. 86)",
-    "gain": "the controller output u = Kp (...): the summer's waveform times R3/R4 (seed Fig. 87)",
-    "plant": "the controlled output y (seed Fig. 89/90)",
+    "difference": N_("error y - r: a spike of -step at each rising edge that decays as the plant catches up "
+                  "(seed Fig. 79/88)"),
+    "inverter": N_("the error inverted: r - y (seed Fig. 81)"),
+    "differentiator": N_("short spikes at the edges of the error, decaying with R12 C3 (seed Fig. 85)"),
+    "integrator": N_("ramps while the error is large, then flattens at the level that holds the output "
+                  "(seed Fig. 83)"),
+    "summer": N_("the three actions added (and inverted): a kick at each edge, then a level (seed Fig. 86)"),
+    "gain": N_("the controller output u = Kp (...): the summer's waveform times R3/R4 (seed Fig. 87)"),
+    "plant": N_("the controlled output y (seed Fig. 89/90)"),
 }
-METRICS = (("overshoot_pct", "overshoot Mp", lambda v: "n/a" if v is None else f"{v:.4g} %"),
-           ("peak_time_s", "peak time tp", R.fmt_time),
-           ("rise_time_s", "rise time tr (10-90 %)", R.fmt_time),
-           ("settling_time_s", "settling time ts (2 %)", R.fmt_time),
-           ("final_value", "final value", lambda v: "n/a" if v is None else f"{v:.4g} V"))
+METRICS = (("overshoot_pct", N_("overshoot Mp"), lambda v: _("n/a") if v is None else f"{v:.4g} %"),
+           ("peak_time_s", N_("peak time tp"), R.fmt_time),
+           ("rise_time_s", N_("rise time tr (10-90 %)"), R.fmt_time),
+           ("settling_time_s", N_("settling time ts (2 %)"), R.fmt_time),
+           ("final_value", N_("final value"), lambda v: _("n/a") if v is None else f"{v:.4g} V"))
+
+
+#: words the sheet shows from data (the loop table's booleans, the stages' names), for the catalogue
+SHOWN_WORDS = (N_("True"), N_("False"), N_("difference"), N_("inverter"), N_("differentiator"), N_("integrator"),
+               N_("summer"), N_("gain"))
 
 
 def title_of(result) -> str:
     t = result.tuning
-    return (f"Op-amp PID ({t.method}: Kp {t.kp:.4g}, Ti {format_eng(t.ti_s, 's')}, "
-            f"Td {format_eng(t.td_s, 's')}) for the plant fn {result.plant.fn_hz:.5g} Hz, "
-            f"zeta {result.plant.zeta:.3g}, with {result.opamp.name}")
+    return _("Op-amp PID ({method}: Kp {kp}, Ti {ti}, Td {td}) for the plant fn {fn} Hz, zeta {zeta}, "
+             "with {opamp}").format(method=t.method, kp=f"{t.kp:.4g}", ti=format_eng(t.ti_s, 's'),
+                                    td=format_eng(t.td_s, 's'), fn=f"{result.plant.fn_hz:.5g}",
+                                    zeta=f"{result.plant.zeta:.3g}", opamp=result.opamp.name)
 
 
 def _known(x):
@@ -61,7 +69,7 @@ def _known(x):
 
 
 def _v(x, unit="V", digits=4):
-    return "n/a" if _known(x) is None else format_eng(x, unit, digits)
+    return _("n/a") if _known(x) is None else format_eng(x, unit, digits)
 
 
 def verdict_text(result) -> str:
@@ -74,22 +82,22 @@ def verdict_of(stable, figures, s, checks) -> str:
     failed = [c.id for c in checks if not c.ok]
     parts = []
     if stable is False:
-        parts.append("the analytic loop with the op-amp poles is UNSTABLE")
+        parts.append(_("the analytic loop with the op-amp poles is UNSTABLE"))
     elif _known(figures.overshoot_pct) is not None:
-        parts.append(f"analytic: {figures.overshoot_pct:.3g} % overshoot, settles (2 %) in "
-                     f"{_v(figures.settling_time_s, 's')}")
+        parts.append(_("analytic: {os} % overshoot, settles (2 %) in {ts}").format(
+            os=f"{figures.overshoot_pct:.3g}", ts=_v(figures.settling_time_s, 's')))
     if s is not None:
         what = []
         if s.saturated:
-            what.append("op-amps saturate")
+            what.append(_("op-amps saturate"))
         if not s.stable:
-            what.append("the loop oscillates or latches")
+            what.append(_("the loop oscillates or latches"))
         os_pct = _known(s.figures.overshoot_pct)
         if os_pct is not None and not what:
-            what.append(f"{os_pct:.3g} % overshoot, nrms {s.nrms:.3g}" if _known(s.nrms) is not None
-                        else f"{os_pct:.3g} % overshoot")
+            what.append(_("{os} % overshoot, nrms {nrms}").format(os=f"{os_pct:.3g}", nrms=f"{s.nrms:.3g}")
+                        if _known(s.nrms) is not None else _("{os} % overshoot").format(os=f"{os_pct:.3g}"))
         parts.append("SPICE: " + ", ".join(what))
-    parts.append("all checks pass" if not failed else "failed checks: " + ", ".join(failed))
+    parts.append(_("all checks pass") if not failed else _("failed checks: ") + ", ".join(failed))
     return "; ".join(parts) + "."
 
 
@@ -101,32 +109,33 @@ def build_board(result):
 def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`)."""
     b = build_board(result)
-    out = [("Verdict", [R.text(verdict_text(result))] + [R.text(n) for n in result.notes])]
-    out.append(("Build", _build_blocks(result, b, bom(result, b), with_images, schematic_svg)))
-    out.append(("Wiring", _wiring_blocks(result, b)))
+    out = [(_("Verdict"), [R.text(verdict_text(result))] + [R.text(n) for n in result.notes])]
+    out.append((_("Build"), _build_blocks(result, b, bom(result, b), with_images, schematic_svg)))
+    out.append((_("Wiring"), _wiring_blocks(result, b)))
     if result.seed_bench is not None:
         out.append(("The seed's bench: predicted against measured (001, V.13, Figures 88-90)",
                     _seed_bench_blocks(result)))
     elif result.diff_amp is not None:
-        out.append(("Difference amplifier as built", _diff_amp_blocks(result)))
-    out.append(("Tuning", _tuning_blocks(result)))
-    out.append(("Target and achieved", _achieved_blocks(result)))
-    out.append(("Checks", [R.table(["check", "result", "detail"],
-                                   [[c.id, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]))
-    out.append(("Closed loop", _loop_blocks(result, with_images)))
+        out.append((_("Difference amplifier as built"), _diff_amp_blocks(result)))
+    out.append((_("Tuning"), _tuning_blocks(result)))
+    out.append((_("Target and achieved"), _achieved_blocks(result)))
+    out.append((_("Checks"), [R.table([_("check"), _("result"), _("detail")],
+                                      [[c.id, _("ok") if c.ok else _("FAILED"), c.detail] for c in result.checks])]))
+    out.append((_("Closed loop"), _loop_blocks(result, with_images)))
     heading = tolerance_title(result, worst=True)
     if heading is not None:
         out.append((heading, tolerance_section(result, with_images, worst=True)))
-    out.append(("Expected scope readings", _scope_blocks(result, with_images, b)))
+    out.append((_("Expected scope readings"), _scope_blocks(result, with_images, b)))
     return out
 
 
 def _build_blocks(result, b, rows, with_images, schematic_svg) -> list:
     """The schematic, the bill of materials ``rows`` and the bench settings."""
-    first = [R.subhead("Bill of materials"),
-             R.table(["Ref", "Value", "Code", "Qty", "Series", "Tol."], [r[:6] for r in rows], "compact"),
-             R.subhead("Generator and scope"), *_settings(result, b)]
-    fig = [R.figure("schematic.png", schematic_svg, "schematic of the loop")] if with_images else []
+    first = [R.subhead(_("Bill of materials")),
+             R.table([_("Ref"), _("Value"), _("Code"), _("Qty"), _("Series"), _("Tol.")], [r[:6] for r in rows],
+                     "compact"),
+             R.subhead(_("Generator and scope")), *_settings(result, b)]
+    fig = [R.figure("schematic.png", schematic_svg, _("schematic of the loop"))] if with_images else []
     # the loop is wide: the schematic spans the page, the parts and the settings sit under it
     return fig + [R.columns(first[:2], first[2:])] if with_images else first
 
@@ -134,10 +143,10 @@ def _build_blocks(result, b, rows, with_images, schematic_svg) -> list:
 def _wiring_blocks(result, b, first_rows=(), after: str = "") -> list:
     """The packages and the pin-level wiring table of board ``b``; ``first_rows``
     (part, code, from, to) go before the board's rows, ``after`` closes the intro."""
-    return [R.text(f"{b.package.part} in {b.package.pinout} packages: "
-                   + ", ".join(f"{u.designator} {a.role}" for a, u in zip(b.netlist.amps, b.units))
+    return [R.text(_("{part} in {pinout} packages: ").format(part=b.package.part, pinout=b.package.pinout)
+                   + ", ".join(f"{u.designator} {_(a.role)}" for a, u in zip(b.netlist.amps, b.units))
                    + ". Kp = R5 R3/(R6 R4), Ti = R8 R14 C4/R6, Td = R6 R11 C3/R7." + after),
-            R.table(["part", "code", "from", "to"],
+            R.table([_("part"), _("code"), _("from"), _("to")],
                     [*first_rows, *wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee))])]
 
 
@@ -145,7 +154,7 @@ def controller_source(sel):
     """``source_of`` for :func:`designer.report.wiring.bom_rows` of the controller's
     parts chosen by ``sel`` (a :class:`~designer.pid.selection.Selection`, None for
     given parts): (series, tolerance %) by kind, None for the decoupling."""
-    r_series, c_series = (sel.r_series, sel.c_series) if sel is not None else ("as given", "as given")
+    r_series, c_series = (sel.r_series, sel.c_series) if sel is not None else (_("as given"), _("as given"))
     rt, ct = sel.tolerances_pct if sel is not None else (None, None)
 
     def source(ref):
@@ -166,22 +175,22 @@ def bom(result, b=None) -> list:
 
     def source(ref):
         if ref in plant_refs:
-            return (prs or "as given", prt) if ref[0] == "R" else (pcs or "as given", pct)
+            return (prs or _("as given"), prt) if ref[0] == "R" else (pcs or _("as given"), pct)
         return controller(ref)
     return bom_rows(b, source, result.opamp.name)
 
 
 def _settings(result, b) -> list:
     rows = bench_rows(result.test, result.scope, "R15 (r)", channels=2)
-    return [R.table(["set", "to"], rows, "compact"),
-            R.text("Generator output in High-Z mode (in 50-ohm mode it shows half the amplitude it gives into "
-                   "R15); check the level on CH1. Move CH2 to each TP in turn with its settings below.")]
+    return [R.table([_("set"), _("to")], rows, "compact"),
+            R.text(_("Generator output in High-Z mode (in 50-ohm mode it shows half the amplitude it gives into "
+                     "R15); check the level on CH1. Move CH2 to each TP in turn with its settings below."))]
 
 
 def _tuning_blocks(result) -> list:
     tun = result.tuning
-    blocks = [R.text(f"Method: {tun.method}. Kp = {tun.kp:.4g}, Ti = {_v(tun.ti_s, 's')}, "
-                     f"Td = {_v(tun.td_s, 's')}.")]
+    blocks = [R.text(_("Method: {method}. Kp = {kp}, Ti = {ti}, Td = {td}.").format(
+        method=tun.method, kp=f"{tun.kp:.4g}", ti=_v(tun.ti_s, 's'), td=_v(tun.td_s, 's')))]
     rc = tun.curve
     fit = None if rc is None else rc.fit
     if rc is not None:
@@ -204,7 +213,7 @@ def _tuning_blocks(result) -> list:
     if result.rules:
         rows = [[r.method, _model_cell(r.model), f"{r.kp:.4g}", _v(r.ti_s, "s"), _v(r.td_s, "s")]
                 for r in result.rules]
-        blocks.append(R.table(["rule", "model it uses (K, L, T)", "Kp", "Ti", "Td"], rows))
+        blocks.append(R.table([_("rule"), _("model it uses (K, L, T)"), "Kp", "Ti", "Td"], rows))
     opt = result.optimizer
     if opt is not None:
         b = opt.best
@@ -283,41 +292,43 @@ def _achieved_blocks(result, target=None) -> list:
     rows = [["Kp", f"{tun.kp:.4g}", f"{ach.kp:.4g}", R.fmt_pct(err["kp"])],
             ["Ti", _v(tun.ti_s, "s"), _v(ach.ti_s, "s"), R.fmt_pct(err["ti"])],
             ["Td", _v(tun.td_s, "s"), _v(ach.td_s, "s"), R.fmt_pct(err["td"])],
-            ["integrator corner 1/(2 pi R13 C4)", "", _v(ach.f_integrator_hz, "Hz"), ""],
-            ["derivative filter 1/(2 pi R12 C3)", "", _v(ach.f_differentiator_hz, "Hz"), ""]]
+            [_("integrator corner 1/(2 pi R13 C4)"), "", _v(ach.f_integrator_hz, "Hz"), ""],
+            [_("derivative filter 1/(2 pi R12 C3)"), "", _v(ach.f_differentiator_hz, "Hz"), ""]]
     for stage, ng in ach.noise_gains.items():
-        rows.append([f"{stage} stage: noise gain, bandwidth", "", f"{ng:.3g}, "
+        rows.append([_("{stage} stage: noise gain, bandwidth").format(stage=_(stage)), "", f"{ng:.3g}, "
                      f"{_v(ach.stage_bandwidths_hz[stage], 'Hz')}", ""])
-    return [R.table(["", "target", "achieved", "error"], rows)]
+    return [R.table(["", _("target"), _("achieved"), _("error")], rows)]
 
 
 def _loop_blocks(result, with_images) -> list:
     a, i, s, amp = result.analytic, result.ideal_pid, result.spice, result.opamp
-    rows = [[label, f(_known(getattr(i, key))), f(_known(getattr(a.figures, key))),
-             f(_known(getattr(s.figures, key))) if s else "not simulated"] for key, label, f in METRICS]
-    rows.append(["stable", "", str(a.stable), str(s.stable) if s else ""])
-    rows.append(["saturated", "", "", str(s.saturated) if s else ""])
-    blocks = [R.table(["", "ideal PID + ideal plant", f"realised (with {amp.name})", "SPICE"], rows)]
+    rows = [[_(label), f(_known(getattr(i, key))), f(_known(getattr(a.figures, key))),
+             f(_known(getattr(s.figures, key))) if s else _("not simulated")] for key, label, f in METRICS]
+    rows.append([_("stable"), "", _(str(a.stable)), _(str(s.stable)) if s else ""])
+    rows.append([_("saturated"), "", "", _(str(s.saturated)) if s else ""])
+    blocks = [R.table(["", _("ideal PID + ideal plant"), _("realised (with {opamp})").format(opamp=amp.name), "SPICE"],
+                      rows)]
     mg = result.margins
     blocks.append(R.text(
-        f"Loop with the op-amp poles: phase margin {_fmt(mg.phase_margin_deg, 'deg')} at "
-        f"{_v(mg.crossover_hz, 'Hz')}, gain margin {_fmt(mg.gain_margin_db, 'dB')}. "
-        f"Closed-loop DC gain {a.dc_gain:.4g} (steady-state error {_fmt(a.steady_state_error_pct, '%')})."))
+        _("Loop with the op-amp poles: phase margin {pm} at {fc}, gain margin {gm}. Closed-loop DC gain {dc} "
+          "(steady-state error {sse}).").format(pm=_fmt(mg.phase_margin_deg, 'deg'), fc=_v(mg.crossover_hz, 'Hz'),
+                                                 gm=_fmt(mg.gain_margin_db, 'dB'), dc=f"{a.dc_gain:.4g}",
+                                                 sse=_fmt(a.steady_state_error_pct, '%'))))
     if s:
         blocks.append(R.text(_spice_agreement(result)))
     if with_images:
-        blocks.append(R.columns([R.image("closed-loop.png", "closed-loop step and controller output")],
-                                [R.image("loop-bode.png", "loop gain with its margins")]))
+        blocks.append(R.columns([R.image("closed-loop.png", _("closed-loop step and controller output"))],
+                                [R.image("loop-bode.png", _("loop gain with its margins"))]))
     return blocks
 
 
 def _spice_agreement(result) -> str:
     v, s = result.verdict, result.spice
-    return (f"SPICE vs analytic: overshoot {_fmt(v.overshoot_delta_pp, 'pp', signed=True)}, nrms "
-            f"{_fmt(s.nrms, '')} (below 1 is agreement); "
-            + ("they agree." if v.agree else
-               ("the difference is explained by the failed checks: " + ", ".join(v.explained_by) + "."
-                if v.explained_by else "they disagree and no check explains it.")))
+    return (_("SPICE vs analytic: overshoot {os}, nrms {nrms} (below 1 is agreement); ").format(
+        os=_fmt(v.overshoot_delta_pp, 'pp', signed=True), nrms=_fmt(s.nrms, ''))
+            + (_("they agree.") if v.agree else
+               (_("the difference is explained by the failed checks: ") + ", ".join(v.explained_by) + "."
+                if v.explained_by else _("they disagree and no check explains it."))))
 
 
 def _scope_blocks(result, with_images, b=None, levels=None) -> list:
@@ -340,22 +351,23 @@ def _scope_blocks(result, with_images, b=None, levels=None) -> list:
         unit = b.unit_of(amp.ref)
         rail = None if y is None else y.time_high_s + y.time_low_s if y.time_high_s is not None else 0
         ch = vdiv.get(sig)
-        rows.append([f"{unit.designator} pin {unit.pins['out']}", role, sig,
-                     "" if ch is None else f"{format_eng(ch.volts_per_div, 'V')}/div, 0 V {ch.zero_div_below_centre:g}"
-                                           " div down",
-                     "n/a .. n/a" if x is None else f"{_v(x.v_min)} .. {_v(x.v_max)}",
+        rows.append([_("{unit} pin {pin}").format(unit=unit.designator, pin=unit.pins['out']), _(role), sig,
+                     "" if ch is None else _("{v}/div, 0 V {div} div down").format(
+                         v=format_eng(ch.volts_per_div, 'V'), div=f"{ch.zero_div_below_centre:g}"),
+                     _("n/a") + " .. " + _("n/a") if x is None else f"{_v(x.v_min)} .. {_v(x.v_max)}",
                      "" if y is None else f"{_v(y.v_min)} .. {_v(y.v_max)}",
                      "" if x is None else f"{x.slope_v_per_s / 1e6:.3g} V/us",
-                     "" if rail is None else _v(rail, "s"), SHAPES[role]])
-    blocks = [R.text(f"Bench test: square wave 0 -> {test.amplitude_v:g} V at {test.frequency_hz:g} Hz "
-                     f"(edges {_v(test.edge_s, 's')}); the output should settle near "
-                     f"{result.expected_final_v:.4g} V. Probe each op-amp output against ground; levels cover the "
-                     "whole period (the falling half mirrors the rising one)."),
-              R.table(["probe", "block", "node", "CH2 setting", "expected (analytic)", "SPICE", "fastest slope",
-                       "at a rail (SPICE)", "what the scope shows"], rows)]
+                     "" if rail is None else _v(rail, "s"), _(SHAPES[role])])
+    blocks = [R.text(_("Bench test: square wave 0 -> {a} V at {f} Hz (edges {edge}); the output should settle near "
+                       "{final} V. Probe each op-amp output against ground; levels cover the whole period (the "
+                       "falling half mirrors the rising one).").format(
+                           a=f"{test.amplitude_v:g}", f=f"{test.frequency_hz:g}", edge=_v(test.edge_s, 's'),
+                           final=f"{result.expected_final_v:.4g}")),
+              R.table([_("probe"), _("block"), _("node"), _("CH2 setting"), _("expected (analytic)"), "SPICE",
+                       _("fastest slope"), _("at a rail (SPICE)"), _("what the scope shows")], rows)]
     if with_images:
-        blocks.append(R.columns([R.image("blocks.png", "every op-amp output")],
-                                [R.image("reaction-curve.png", "plant reaction curve")]))
+        blocks.append(R.columns([R.image("blocks.png", _("every op-amp output"))],
+                                [R.image("reaction-curve.png", _("plant reaction curve"))]))
     return blocks
 
 
@@ -372,12 +384,13 @@ def _pct(ratio):
 
 def _fmt(v, unit, signed=False):
     if _known(v) is None:
-        return "n/a"
+        return _("n/a")
     return (f"{v:+.3g}" if signed else f"{v:.3g}") + (f" {unit}" if unit else "")
 
 
-def summary_text(result) -> str:
-    text = R.to_text(title_of(result), sections(result, with_images=False))
+def summary_text(result, lang=None) -> str:
+    with language(lang):   # None: the current language (designer.core.i18n)
+        text = R.to_text(title_of(result), sections(result, with_images=False))
     for extra in (result.monte_carlo, result.worst_case):
         if extra is not None:
             text += "\n" + "\n".join(extra.summary_lines()) + "\n"
@@ -478,9 +491,11 @@ PLOTS = (("closed-loop.png", _closed_loop_plot), ("blocks.png", _blocks_plot),
          ("loop-bode.png", _loop_gain_plot), ("reaction-curve.png", _reaction_plot))
 
 
-def write_outputs(result, out_dir, name: str) -> dict:
+def write_outputs(result, out_dir, name: str, lang=None) -> dict:
     """``netlists/<name>.cir`` and ``reports/<name>/`` (build sheet, result.json,
-    plots, schematic, bom.csv) under ``out_dir``, each written atomically."""
-    return write_design(result, out_dir, name, PLOTS + histogram_plots(result), schematic,
-                        lambda svg: sections(result, schematic_svg=svg), title_of(result),
-                        {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))), **csv_texts(result)})
+    plots, schematic, bom.csv) under ``out_dir``, each written atomically; the sheet in ``lang``
+    (None: the current language, :mod:`designer.core.i18n`)."""
+    with language(lang):
+        return write_design(result, out_dir, name, PLOTS + histogram_plots(result), schematic,
+                            lambda svg: sections(result, schematic_svg=svg), title_of(result),
+                            {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))), **csv_texts(result)})

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..core.checks import Check
 from ..core.compare import resample
+from ..core.i18n import N_
 from ..core.lti import dense_time, dominant_pair, step_response
 from ..core.metrics import step_metrics
 from ..core.opamps import OpAmp
@@ -328,8 +329,8 @@ def plant_scope(test: SquareTest, peak_value: float, trough_value: float,
     a = test.amplitude_v
     window = min(1.2 * settling_time_s, test.half_period_s) if math.isfinite(settling_time_s) \
         else test.half_period_s
-    return scope_setup(window, a / 2, (channel("CH1", "generator (R1)", 0.0, a),
-                                       channel("CH2", "U1 output", a * trough_value, a * peak_value)))
+    return scope_setup(window, a / 2, (channel("CH1", N_("generator (R1)"), 0.0, a),
+                                       channel("CH2", N_("U1 output"), a * trough_value, a * peak_value)))
 
 
 @dataclass(frozen=True, eq=False)

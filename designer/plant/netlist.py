@@ -16,6 +16,7 @@ controller's R3 and R4, so they are R19 and R20 here.
 
 from __future__ import annotations
 
+from ..core.i18n import N_
 from ..core.opamps import OpAmp
 from ..spice.deck import (
     GROUND,
@@ -67,15 +68,15 @@ def plant_netlist(parts: SallenKeyParts, inp: str = "input", out: str = "out", p
         The circuit.
     """
     v1, vp, vn = f"{prefix}v1", f"{prefix}vp", f"{prefix}vn"
-    rows = [Part("R1", inp, v1, parts.r1, "input resistor"),
-            Part("R2", v1, vp, parts.r2, "to the non-inverting input"),
-            Part("C1", vp, GROUND, parts.c1, "non-inverting input to ground"),
-            Part("C2", v1, out, parts.c2, "R1-R2 node to the output (feedback)")]
+    rows = [Part("R1", inp, v1, parts.r1, N_("input resistor")),
+            Part("R2", v1, vp, parts.r2, N_("to the non-inverting input")),
+            Part("C1", vp, GROUND, parts.c1, N_("non-inverting input to ground")),
+            Part("C2", v1, out, parts.c2, N_("R1-R2 node to the output (feedback)"))]
     if parts.r3 is None:
-        return Netlist(tuple(rows), (Amp(amp_ref, "plant", vp, out, out),))
-    rows += [Part("R19", vn, GROUND, parts.r3, "gain: inverting input to ground (seed's R3)"),
-             Part("R20", out, vn, parts.r4, "gain: output to inverting input (seed's R4)")]
-    return Netlist(tuple(rows), (Amp(amp_ref, "plant", vp, vn, out),))
+        return Netlist(tuple(rows), (Amp(amp_ref, N_("plant"), vp, out, out),))
+    rows += [Part("R19", vn, GROUND, parts.r3, N_("gain: inverting input to ground (seed's R3)")),
+             Part("R20", out, vn, parts.r4, N_("gain: output to inverting input (seed's R4)"))]
+    return Netlist(tuple(rows), (Amp(amp_ref, N_("plant"), vp, vn, out),))
 
 
 def _circuit(title: str, opamp: OpAmp, header: list):

@@ -15,6 +15,8 @@ import math
 
 import numpy as np
 
+from ..core.i18n import N_, language
+from ..core.i18n import gettext as _
 from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import write_design
@@ -27,17 +29,19 @@ from .netlist import SEED_NAMES, plant_netlist
 
 __all__ = ["bode_png", "schematic", "sine_text", "step_png", "summary_text", "waveforms_csv", "write_outputs"]
 
-METRIC_ROWS = (("overshoot_pct", "overshoot Mp", lambda v: "n/a" if v is None else f"{v:.4g} %"),
-               ("peak_time_s", "peak time tp", R.fmt_time),
-               ("rise_time_s", "rise time tr (10-90 %)", R.fmt_time),
-               ("settling_time_s", "settling time ts (2 %)", R.fmt_time))
+METRIC_ROWS = (("overshoot_pct", N_("overshoot Mp"), lambda v: _("n/a") if v is None else f"{v:.4g} %"),
+               ("peak_time_s", N_("peak time tp"), R.fmt_time),
+               ("rise_time_s", N_("rise time tr (10-90 %)"), R.fmt_time),
+               ("settling_time_s", N_("settling time ts (2 %)"), R.fmt_time))
 
 
 def title_of(result) -> str:
     s = result.target
     if result.mode == "analyze":
-        return f"Sallen-Key plant as built: fn {result.built.fn_hz:.5g} Hz, zeta {result.built.zeta:.4g}"
-    return f"Sallen-Key plant: fc {s.fc_hz:g} Hz, zeta {s.zeta:g}, gain {s.gain:g}"
+        return _("Sallen-Key plant as built: fn {fn} Hz, zeta {zeta}").format(fn=f"{result.built.fn_hz:.5g}",
+                                                                             zeta=f"{result.built.zeta:.4g}")
+    return _("Sallen-Key plant: fc {fc} Hz, zeta {zeta}, gain {gain}").format(fc=f"{s.fc_hz:g}", zeta=f"{s.zeta:g}",
+                                                                           gain=f"{s.gain:g}")
 
 
 def build_board(result):
@@ -46,38 +50,40 @@ def build_board(result):
 
 
 #: what the plant's nets are called on the sheet
-NET_LABELS = {"input": "generator (CH1)", "v1": "node A (R1-R2-C2)", "out": "output (CH2)", "0": "ground"}
+NET_LABELS = {"input": N_("generator (CH1)"), "v1": N_("node A (R1-R2-C2)"), "out": N_("output (CH2)"),
+              "0": N_("ground")}
 
 
 def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     """The build sheet as (heading, blocks) sections (see :mod:`designer.report.document`)."""
     b = build_board(result)
-    first = [R.subhead("Bill of materials"), R.table(["Ref", "Value", "Code", "Qty", "Series", "Tol.", "Package"],
-                                                     [r[:7] for r in bom(result, b)], "compact"),
-             R.subhead("Generator and scope"), *_settings(result)]
-    fig = [R.figure("schematic.png", schematic_svg, "schematic")] if with_images else []
-    out = [("Build", [R.columns(fig, first)] if with_images else first),
-           ("Wiring", [R.table(["part", "code", "from", "to"], wiring_rows(b, NET_LABELS, (result.opamp.vcc,
-                                                                                      result.opamp.vee)))]),
-           ("Bench test: what the scope shows", _bench(result)),
-           *([("Bench test under a PRBS (--stimulus prbs)", _prbs(result))] if result.prbs is not None else []),
-           ("Target and achieved", _targets(result)),
-           ("Checks", [R.table(["check", "result", "detail"],
-                               [[c.title, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])])]
+    first = [R.subhead(_("Bill of materials")),
+             R.table([_("Ref"), _("Value"), _("Code"), _("Qty"), _("Series"), _("Tol."), _("Package")],
+                     [r[:7] for r in bom(result, b)], "compact"),
+             R.subhead(_("Generator and scope")), *_settings(result)]
+    fig = [R.figure("schematic.png", schematic_svg, _("schematic"))] if with_images else []
+    out = [(_("Build"), [R.columns(fig, first)] if with_images else first),
+           (_("Wiring"), [R.table([_("part"), _("code"), _("from"), _("to")],
+                                  wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee)))]),
+           (_("Bench test: what the scope shows"), _bench(result)),
+           *([(_("Bench test under a PRBS (--stimulus prbs)"), _prbs(result))] if result.prbs is not None else []),
+           (_("Target and achieved"), _targets(result)),
+           (_("Checks"), [R.table([_("check"), _("result"), _("detail")],
+                                  [[_(c.title), _("ok") if c.ok else _("FAILED"), c.detail] for c in result.checks])])]
     if result.spice is not None:
-        out.append(("SPICE against the analytic models", _spice(result)))
+        out.append((_("SPICE against the analytic models"), _spice(result)))
     if with_images:
-        out.append(("Plots", [R.columns([R.image("step.png", "step response: analytic and SPICE, residual")],
-                                        [R.image("bode.png", "Bode plot with the sine check's points")])]))
+        out.append((_("Plots"), [R.columns([R.image("step.png", _("step response: analytic and SPICE, residual"))],
+                                           [R.image("bode.png", _("Bode plot with the sine check's points"))])]))
         if result.prbs is not None:
-            out[-1][1].append(R.image("prbs.png", "the last period of the PRBS: generator, SPICE and the model"))
+            out[-1][1].append(R.image("prbs.png", _("the last period of the PRBS: generator, SPICE and the model")))
     if result.monte_carlo is not None:
-        out.append(("Tolerance analysis (Monte Carlo)", tolerance_section(result, with_images)))
-    out.append(("Sensitivity", _sensitivity(result)))
+        out.append((_("Tolerance analysis (Monte Carlo)"), tolerance_section(result, with_images)))
+    out.append((_("Sensitivity"), _sensitivity(result)))
     if result.alternatives:
-        out.append(("Alternatives (best first)", [_alternatives(result.alternatives), R.text(ALTERNATIVES_NOTE)]))
+        out.append((_("Alternatives (best first)"), [_alternatives(result.alternatives), R.text(_(ALTERNATIVES_NOTE))]))
     if result.notes:
-        out.append(("Notes", [R.text(n) for n in result.notes]))
+        out.append((_("Notes"), [R.text(n) for n in result.notes]))
     return out
 
 
@@ -97,10 +103,10 @@ def _settings(result) -> list:
     sine = result.sine
     rows = bench_rows(result.test, result.scope, "R1")
     if sine is not None:
-        rows.append(["sine check", sine_text(sine)])
-    return [R.table(["set", "to"], rows, "compact"),
-            R.text("Set the generator's output to High-Z (not 50 ohm): in 50-ohm mode it shows half the amplitude "
-                   "it really gives into this circuit's high input impedance; check the level on CH1.")]
+        rows.append([_("sine check"), sine_text(sine)])
+    return [R.table([_("set"), _("to")], rows, "compact"),
+            R.text(_("Set the generator's output to High-Z (not 50 ohm): in 50-ohm mode it shows half the amplitude "
+                     "it really gives into this circuit's high input impedance; check the level on CH1."))]
 
 
 def sine_text(sine) -> str:
@@ -118,17 +124,17 @@ def sine_text(sine) -> str:
     str
         The line.
     """
-    head = f"sine {format_eng(sine.amplitude_v, 'V')} pk"
+    head = _("sine {amplitude} pk").format(amplitude=format_eng(sine.amplitude_v, 'V'))
     parts = []
     if sine.f_peak_hz is not None:
         g = sine.spice_peak_gain if sine.spice_peak_gain is not None else sine.peak_gain
         f = sine.spice_f_peak_hz if sine.spice_f_peak_hz is not None else sine.f_peak_hz
-        parts.append(f"peak x{g / sine.dc_gain:.3g} at {format_eng(f, 'Hz', 3)}")
+        parts.append(_("peak x{gain} at {f}").format(gain=f"{g / sine.dc_gain:.3g}", f=format_eng(f, 'Hz', 3)))
     elif sine.no_peak:
         parts.append(sine.no_peak)
     f3 = sine.spice_f_3db_hz if sine.spice_f_3db_hz is not None else sine.f_3db_hz
     if f3 is not None:
-        parts.append(f"-3 dB (x0.707) at {format_eng(f3, 'Hz', 3)}")
+        parts.append(_("-3 dB (x0.707) at {f}").format(f=format_eng(f3, 'Hz', 3)))
     return head + ": " + ", ".join(parts)
 
 
@@ -140,10 +146,11 @@ def _targets(result):
             ["zeta", _n(s.zeta), _n(ideal and ideal.zeta), _n(fig.zeta), R.fmt_pct(fig.zeta_error_pct),
              _n(opa.zeta), R.fmt_pct(opa.zeta_error_pct)],
             ["Q", _n(s.q), _n(ideal and ideal.q), _n(result.built.q), "", _n(opa.q), ""]]
-    blocks = [R.table(["", "target", "exact parts", "built (ideal op-amp)", "error",
-                       f"built with {result.opamp.name}", "error"], rows)]
+    blocks = [R.table(["", _("target"), _("exact parts"), _("built (ideal op-amp)"), _("error"),
+                       _("built with {opamp}").format(opamp=result.opamp.name), _("error")], rows)]
     if result.ratios.m is not None:
-        blocks.append(R.text(f"Ratios: m = R1/R2 = {result.ratios.m:.4g}, n = C2/C1 = {result.ratios.n:.4g}."))
+        blocks.append(R.text(_("Ratios: m = R1/R2 = {m}, n = C2/C1 = {n}.").format(m=f"{result.ratios.m:.4g}",
+                                                                                 n=f"{result.ratios.n:.4g}")))
     return blocks
 
 
@@ -153,23 +160,25 @@ def _bench(result):
     rows = []
     for key, label, f in METRIC_ROWS:
         band = getattr(tol, key)
-        rows.append([label, f(_value(expected, key)), f(_value(spice.step, key)) if spice else "not simulated",
+        rows.append([_(label), f(_value(expected, key)), f(_value(spice.step, key)) if spice else _("not simulated"),
                      f"{f(band.lo)} .. {f(band.hi)}"])
     amp_v = ts.amplitude_v
-    rows.append(["peak output", format_eng(expected.peak_value * amp_v, "V"),
+    rows.append([_("peak output"), format_eng(expected.peak_value * amp_v, "V"),
                  format_eng(spice.step.peak_value * amp_v, "V") if spice else "", ""])
-    blocks = [R.table(["reading (rising edge)", f"expected ({result.opamp.name} model)", "SPICE",
-                       f"band (R {tol.r_tolerance_pct:g} %, C {tol.c_tolerance_pct:g} %)"], rows)]
+    blocks = [R.table([_("reading (rising edge)"), _("expected ({opamp} model)").format(opamp=result.opamp.name),
+                       "SPICE", _("band (R {r} %, C {c} %)").format(r=f"{tol.r_tolerance_pct:g}",
+                                                                    c=f"{tol.c_tolerance_pct:g}")], rows)]
     sine = result.sine
     if sine is not None:
-        srows = [["resonance peak", _fg(sine.f_peak_hz, sine.peak_gain, sine.dc_gain, sine.no_peak),
+        srows = [[_("resonance peak"), _fg(sine.f_peak_hz, sine.peak_gain, sine.dc_gain, sine.no_peak),
                   _fg(sine.spice_f_peak_hz, sine.spice_peak_gain, sine.dc_gain, sine.spice_no_peak)
-                  if spice else "not simulated"],
-                 ["-3 dB point", _f(sine.f_3db_hz, "Hz"), _f(sine.spice_f_3db_hz, "Hz") if spice else ""]]
-        blocks += [R.text(f"Sine check: a {format_eng(sine.amplitude_v, 'V')} peak sine, no offset; sweep the "
-                          "frequency and read the output's amplitude on CH2 against CH1 (gain relative to the "
-                          "DC gain). SPICE's figures come from an .ac run of the same circuit."),
-                   R.table(["sine", f"{result.opamp.name} model", "SPICE (.ac)"], srows)]
+                  if spice else _("not simulated")],
+                 [_("-3 dB point"), _f(sine.f_3db_hz, "Hz"), _f(sine.spice_f_3db_hz, "Hz") if spice else ""]]
+        blocks += [R.text(_("Sine check: a {amplitude} peak sine, no offset; sweep the frequency and read the "
+                            "output's amplitude on CH2 against CH1 (gain relative to the DC gain). SPICE's figures "
+                            "come from an .ac run of the same circuit.").format(
+                                amplitude=format_eng(sine.amplitude_v, 'V'))),
+                   R.table([_("sine"), _("{opamp} model").format(opamp=result.opamp.name), "SPICE (.ac)"], srows)]
     return blocks
 
 
@@ -201,8 +210,9 @@ def _prbs(result):
 
 def _fg(f, g, dc, why=None):
     if f is None or g is None:
-        return why or "none (no peak)"
-    return f"x{g / dc:.4g} ({20 * math.log10(g / dc):+.2f} dB) at {format_eng(f, 'Hz', 4)}"
+        return why or _("none (no peak)")
+    return _("x{gain} ({db} dB) at {f}").format(gain=f"{g / dc:.4g}", db=f"{20 * math.log10(g / dc):+.2f}",
+                                                 f=format_eng(f, 'Hz', 4))
 
 
 def _sensitivity(result):
@@ -212,12 +222,13 @@ def _sensitivity(result):
              f"{sens_o[k].wn:+.3f}" if k in sens_o else "", f"{sens_o[k].zeta:+.3f}" if k in sens_o else ""]
             for k, v in sens.items()]
     rows += [[k, "", "", f"{v.wn:+.4f}", f"{v.zeta:+.4f}"] for k, v in sens_o.items() if k not in sens]
-    return [R.text("Relative sensitivity S = d ln(y) / d ln(x): a 1 % change in the part changes y by S %."),
-            R.table(["part", "S(wn)", "S(zeta)", f"S(wn) with {amp}", f"S(zeta) with {amp}"], rows)]
+    return [R.text(_("Relative sensitivity S = d ln(y) / d ln(x): a 1 % change in the part changes y by S %.")),
+            R.table([_("part"), "S(wn)", "S(zeta)", _("S(wn) with {opamp}").format(opamp=amp),
+                     _("S(zeta) with {opamp}").format(opamp=amp)], rows)]
 
 
 #: how the alternatives are chosen (designer.plant.design's module docstring has the sources)
-ALTERNATIVES_NOTE = ("Each response is listed once (the same parts at ten times the resistance and a tenth of "
+ALTERNATIVES_NOTE = N_("Each response is listed once (the same parts at ten times the resistance and a tenth of "
                      "the capacitance give the same fn and zeta), with resistors from 1 kOhm to 100 kOhm where it "
                      "can: below, they load the op-amp's output and the generator's 50 Ohm adds to R1; above, "
                      "their thermal noise (41 nV/sqrt(Hz) at 100 kOhm) and the op-amp's input bias current "
@@ -231,7 +242,7 @@ def _alternatives(alternatives):
              _f(a.figures.fn_hz, "Hz"), _n(a.figures.zeta), R.fmt_pct(a.figures.fn_error_pct),
              R.fmt_pct(a.figures.zeta_error_pct)]
             for i, a in enumerate(alternatives)]
-    return R.table(["#", "R1 / R2 / C1 / C2", "fn", "zeta", "fn error", "zeta error"], rows)
+    return R.table(["#", "R1 / R2 / C1 / C2", "fn", "zeta", _("fn error"), _("zeta error")], rows)
 
 
 def _spice(result):
@@ -240,19 +251,22 @@ def _spice(result):
 
     def delta(x, key):
         if x["delta"] is None:
-            return "n/a"
+            return _("n/a")
         if key == "overshoot_pct":
             return f"{x['delta']:+.3g} pp"
         return f"{format_eng(x['delta'], 's', 3)} ({R.fmt_pct(x['delta_pct'])})"
 
-    rows = [[label, delta(cmp_.vs_ideal[key], key), delta(cmp_.vs_opamp[key], key)] for key, label, _ in METRIC_ROWS]
-    rows.append(["normalised RMS waveform error", f"{spice.nrms_ideal:.3g}", f"{spice.nrms:.3g}"])
-    return [R.text(f"ngspice ({spice.simulator} backend), {amp} behavioural model. Deltas are SPICE minus "
-                   f"model; NRMS = RMS of (model - SPICE) / (1 % of |model| + {format_eng(cmp_.nrms_abstol_v, 'V')})"
-                   ". SPICE agrees with the op-amp-aware model when NRMS is below 1 and overshoot is within 1 pp, "
-                   "peak and rise time within 2 %, settling time within 5 % (or half a ringing period): "
-                   + ("it does." if cmp_.passed else "it does NOT (" + "; ".join(cmp_.disagreements) + ").")),
-            R.table(["metric", "vs ideal model", f"vs {amp}-aware model"], rows)]
+    rows = [[_(label), delta(cmp_.vs_ideal[key], key), delta(cmp_.vs_opamp[key], key)]
+            for key, label, _fmt in METRIC_ROWS]
+    rows.append([_("normalised RMS waveform error"), f"{spice.nrms_ideal:.3g}", f"{spice.nrms:.3g}"])
+    return [R.text(_("ngspice ({simulator} backend), {opamp} behavioural model. Deltas are SPICE minus "
+                     "model; NRMS = RMS of (model - SPICE) / (1 % of |model| + {abstol}). SPICE agrees with the "
+                     "op-amp-aware model when NRMS is below 1 and overshoot is within 1 pp, peak and rise time "
+                     "within 2 %, settling time within 5 % (or half a ringing period): ").format(
+                         simulator=spice.simulator, opamp=amp, abstol=format_eng(cmp_.nrms_abstol_v, 'V'))
+                   + (_("it does.") if cmp_.passed else _("it does NOT ({reasons}).").format(
+                       reasons="; ".join(cmp_.disagreements)))),
+            R.table([_("metric"), _("vs ideal model"), _("vs {opamp}-aware model").format(opamp=amp)], rows)]
 
 
 def _f(v, unit):
@@ -269,20 +283,24 @@ def _n(v):
     return "" if v is None else f"{v:.4g}"
 
 
-def summary_text(result) -> str:
+def summary_text(result, lang: str | None = None) -> str:
     """The terminal summary: the build sheet without plots (and the Monte Carlo's lines when run).
 
     Parameters
     ----------
     result : PlantResult
         The plant.
+    lang : str or None
+        The language (:data:`designer.core.i18n.LANGUAGES`); None: the current one (English unless a
+        :func:`designer.core.i18n.language` block says otherwise).
 
     Returns
     -------
     str
         The summary.
     """
-    text = R.to_text(title_of(result), sections(result, with_images=False))
+    with language(lang):
+        text = R.to_text(title_of(result), sections(result, with_images=False))
     for extra in (result.monte_carlo, result.worst_case):
         if extra is not None:
             text += "\n" + "\n".join(extra.summary_lines()) + "\n"
@@ -422,7 +440,7 @@ def schematic(result):
 PLOTS = (("step.png", step_png), ("bode.png", bode_png))
 
 
-def write_outputs(result, out_dir, name: str) -> dict:
+def write_outputs(result, out_dir, name: str, lang: str | None = None) -> dict:
     """Write ``netlists/<name>.cir`` and ``reports/<name>/`` under ``out_dir``.
 
     Every file goes through a temporary file and a rename; the paths are
@@ -436,6 +454,8 @@ def write_outputs(result, out_dir, name: str) -> dict:
         The folder.
     name : str
         The design's name.
+    lang : str or None
+        The build sheet's language (None: the current one, see :func:`summary_text`).
 
     Returns
     -------
@@ -451,5 +471,6 @@ def write_outputs(result, out_dir, name: str) -> dict:
                       "prbs_deck": ("prbs-test.cir", lambda r: r.prbs.deck)})
     texts.update(csv_texts(result))   # monte-carlo.csv: one row per sample, every varied part and figure
     prbs_plots = (("prbs.png", prbs_png),) if result.prbs is not None else ()
-    return write_design(result, out_dir, name, PLOTS + prbs_plots + histogram_plots(result), schematic,
-                        lambda svg: sections(result, schematic_svg=svg), title_of(result), texts)
+    with language(lang):
+        return write_design(result, out_dir, name, PLOTS + prbs_plots + histogram_plots(result), schematic,
+                            lambda svg: sections(result, schematic_svg=svg), title_of(result), texts)

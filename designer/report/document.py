@@ -15,6 +15,8 @@ import base64
 import html
 import math
 
+from ..core.i18n import current, localise
+from ..core.i18n import gettext as _
 from ..core.units import format_eng, value_code
 
 __all__ = ["columns", "figure", "fmt_pct", "fmt_time", "image", "subhead", "table", "text", "to_html", "to_text"]
@@ -142,7 +144,7 @@ def fmt_pct(v, digits=3):
     str
         The text.
     """
-    return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:+.{digits}g} %"
+    return _("n/a") if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:+.{digits}g} %"
 
 
 def fmt_time(v):
@@ -158,7 +160,33 @@ def fmt_time(v):
     str
         The text.
     """
-    return "n/a" if v is None else format_eng(v, "s")
+    return _("n/a") if v is None else format_eng(v, "s")
+
+
+def _localised(title, sections):
+    """The title and sections with their numbers and units as the current language writes them
+    (:func:`designer.core.i18n.localise`); as given in English, so an English sheet is unchanged."""
+    if current() == "en":
+        return title, sections
+    return localise(title), [(localise(h), _localised_blocks(blocks)) for h, blocks in sections]
+
+
+def _localised_blocks(blocks):
+    out = []
+    for b in blocks:
+        if b[0] in ("text", "subhead"):
+            out.append((b[0], localise(b[1])))
+        elif b[0] == "table":
+            out.append(("table", [localise(h) for h in b[1]], [[localise(c) for c in r] for r in b[2]], *b[3:]))
+        elif b[0] == "image":
+            out.append(("image", b[1], localise(b[2])))
+        elif b[0] == "figure":
+            out.append(("figure", b[1], b[2], localise(b[3])))
+        elif b[0] == "columns":
+            out.append(("columns", [_localised_blocks(c) for c in b[1]]))
+        else:
+            out.append(b)
+    return out
 
 
 def _flat(blocks):
@@ -173,6 +201,7 @@ def _flat(blocks):
 # ---- renderers --------------------------------------------------------------
 
 def to_markdown(title, sections) -> str:
+    title, sections = _localised(title, sections)
     out = [f"# {title}", ""]
     for heading, blocks in sections:
         out += [f"## {heading}", ""]
@@ -267,7 +296,8 @@ def to_html(title, sections, images: dict) -> str:
         The HTML document.
     """
     e = html.escape
-    out = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{e(title)}</title>",
+    title, sections = _localised(title, sections)
+    out = [f"<!DOCTYPE html><html lang='{current()}'><head><meta charset='utf-8'><title>{e(title)}</title>",
            f"<style>{_CSS}</style></head><body>", f"<h1>{e(title)}</h1>"]
     for heading, blocks in sections:
         if heading:
@@ -292,6 +322,7 @@ def to_text(title, sections) -> str:
     str
         The text.
     """
+    title, sections = _localised(title, sections)
     out = [title, "=" * len(title)]
     for heading, blocks in sections:
         if heading:
@@ -309,9 +340,9 @@ def to_text(title, sections) -> str:
                     if j == 0:
                         out.append("  ".join("-" * w for w in widths))
             elif b[0] == "image":
-                out.append(f"[plot: {b[1]}]")
+                out.append(_("[plot: {name}]").format(name=b[1]))
             elif b[0] == "figure":
-                out.append(f"[schematic: {b[1]}]")
+                out.append(_("[schematic: {name}]").format(name=b[1]))
     return "\n".join(out) + "\n"
 
 

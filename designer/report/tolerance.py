@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import functools
 
+from ..core.i18n import N_
+from ..core.i18n import gettext as _
 from ..core.units import format_figure
 from . import document as R
 from .plots import histogram_plot
@@ -101,8 +103,8 @@ def title(result, worst: bool = False) -> str | None:
         The heading.
     """
     what = [w for w, x in (("Monte Carlo", result.monte_carlo),
-                           ("worst case", getattr(result, "worst_case", None) if worst else None)) if x is not None]
-    return f"Tolerance analysis ({', '.join(what)})" if what else None
+                           (_("worst case"), getattr(result, "worst_case", None) if worst else None)) if x is not None]
+    return _("Tolerance analysis ({what})").format(what=", ".join(what)) if what else None
 
 
 #: a part at its bound: the deviation (in tolerances) at least this far out
@@ -116,7 +118,7 @@ def corner_text(deviations: dict) -> str:
     down = [r for r, d in deviations.items() if d <= -AT_BOUND]
     inside = [f"{r} {d:+.2f}" for r, d in deviations.items() if -AT_BOUND < d < AT_BOUND]
     out = ([f"+tol: {' '.join(up)}"] if up else []) + ([f"-tol: {' '.join(down)}"] if down else [])
-    return "; ".join(out + ([f"inside: {', '.join(inside)}"] if inside else []))
+    return "; ".join(out + ([_("inside: {parts}").format(parts=", ".join(inside))] if inside else []))
 
 
 def worst_case_blocks(wc) -> list:
@@ -124,12 +126,13 @@ def worst_case_blocks(wc) -> list:
     highest value and the corner that gives each (:func:`corner_text`)."""
     rows = []
     for fig, (lo, hi) in wc.extremes.items():
-        for which, e in (("lowest", lo), ("highest", hi)):
-            rows.append([fig if which == "lowest" else "", which, _value(fig, e.value),
-                         ("corner: " if e.at_corner else "inside the box: ") + corner_text(e.deviations)])
-    head = (f"Worst case over the tolerance box: {wc.corners} corners evaluated ({wc.method}); each part at "
-            "+tol or -tol of its nominal, in tolerances where an extreme lies inside.")
-    return [R.text(head), R.table(["figure", "extreme", "value", "where (parts)"], rows)]
+        for which, e in ((N_("lowest"), lo), (N_("highest"), hi)):
+            rows.append([fig if which == "lowest" else "", _(which), _value(fig, e.value),
+                         (_("corner: ") if e.at_corner else _("inside the box: ")) + corner_text(e.deviations)])
+    head = _("Worst case over the tolerance box: {corners} corners evaluated ({method}); each part at "
+             "+tol or -tol of its nominal, in tolerances where an extreme lies inside.").format(corners=wc.corners,
+                                                                                                method=wc.method)
+    return [R.text(head), R.table([_("figure"), _("extreme"), _("value"), _("where (parts)")], rows)]
 
 
 def section(result, with_images: bool = True, worst: bool = False) -> list:
@@ -161,37 +164,41 @@ def _monte_carlo_blocks(result, with_images: bool) -> list:
         return []
     if mc.headline is None:   # one build replayed (--replay I): what it is, no spread
         return [R.text(" ".join(mc.summary_lines()))]
-    head = (f"{mc.n} builds drawn within the parts' tolerances ({mc.dist}, {mc.sampler} sampler, seed {mc.seed}; "
-            "each build's parts are in monte-carlo.csv).")
+    head = _("{n} builds drawn within the parts' tolerances ({dist}, {sampler} sampler, seed {seed}; "
+             "each build's parts are in monte-carlo.csv).").format(n=mc.n, dist=mc.dist, sampler=mc.sampler,
+                                                                   seed=mc.seed)
     lines = [head]
     if mc.limits:
         lo, hi = mc.yield_interval()
-        lines.append(f"Yield {_pct(mc.yield_count / mc.n)} ({mc.yield_count} of {mc.n}; 95 % Wilson interval "
-                     f"{_pct(lo)} to {_pct(hi)}) within " + "; ".join(lim.text() for lim in mc.limits) + ".")
+        lines.append(_("Yield {y} ({count} of {n}; 95 % Wilson interval {lo} to {hi}) within {limits}.").format(
+            y=_pct(mc.yield_count / mc.n), count=mc.yield_count, n=mc.n, lo=_pct(lo), hi=_pct(hi),
+            limits="; ".join(lim.text() for lim in mc.limits)))
         lost = sorted(mc.failing.items(), key=lambda kv: -kv[1]["count"])
         if lost and lost[0][1]["count"]:
-            lines.append("Lost builds: " + ", ".join(f"{k} {v['count']}" for k, v in lost if v["count"])
-                         + f" (the worst: build {lost[0][1]['worst'][0]}).")
+            lines.append(_("Lost builds: {lost} (the worst: build {worst}).").format(
+                lost=", ".join(f"{k} {v['count']}" for k, v in lost if v["count"]), worst=lost[0][1]['worst'][0]))
         if mc.tighten:
             t = mc.tighten
             better = t["yield"] > t["yield_now"]
-            lines.append(f"Buy {t['part']} tighter: at {t['tolerance_pct']:g} % the yield is {_pct(t['yield'])}"
-                         + ("." if better else " (no part tried raises it: the design, not the parts, limits it)."))
+            lines.append(_("Buy {part} tighter: at {tol} % the yield is {y}").format(
+                part=t['part'], tol=f"{t['tolerance_pct']:g}", y=_pct(t['yield']))
+                + ("." if better else _(" (no part tried raises it: the design, not the parts, limits it).")))
     else:
-        lines.append("No limits given (--limit FIGURE=MIN:MAX), so no yield: the spread alone.")
-    for key, what in (("p_unstable", "unstable"), ("p_saturated", "an op-amp beyond its swing"),
-                      ("p_slewing", "failing the slew check")):
+        lines.append(_("No limits given (--limit FIGURE=MIN:MAX), so no yield: the spread alone."))
+    for key, what in (("p_unstable", _("Unstable")), ("p_saturated", _("An op-amp beyond its swing")),
+                      ("p_slewing", _("Failing the slew check"))):
         p = getattr(mc, key, None)
         if p is not None:
-            lines.append(f"{what.capitalize()}: {_pct(p['fraction'])} (95 % Wilson {_pct(p['ci95'][0])} to "
-                         f"{_pct(p['ci95'][1])}).")
+            lines.append(_("{what}: {p} (95 % Wilson {lo} to {hi}).").format(
+                what=what, p=_pct(p['fraction']), lo=_pct(p['ci95'][0]), hi=_pct(p['ci95'][1])))
     s = mc.stats.get(mc.headline)
     if s is not None and s.percentiles:
         p = s.percentiles
         h = mc.headline
-        lines.append(f"{h}: nominal {_value(h, s.nominal)}, 95 % of builds {_value(h, p[2.5])} to "
-                     f"{_value(h, p[97.5])}.")
+        lines.append(_("{figure}: nominal {nominal}, 95 % of builds {lo} to {hi}.").format(
+            figure=h, nominal=_value(h, s.nominal), lo=_value(h, p[2.5]), hi=_value(h, p[97.5])))
     text = [R.text(" ".join(lines))]
     if not with_images:
         return text
-    return [R.columns([R.image(histogram_name(mc.headline), f"histogram of {mc.headline}")], text)]
+    return [R.columns([R.image(histogram_name(mc.headline), _("histogram of {figure}").format(figure=mc.headline))],
+                      text)]

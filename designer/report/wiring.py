@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import io
 
+from ..core.i18n import gettext as _
 from ..core.units import format_eng, value_code
 
 __all__ = ["BOM_HEADER", "bench_rows", "bom_csv", "bom_rows", "net_text", "wiring_rows"]
@@ -23,12 +24,12 @@ BOM_HEADER = ("Ref", "Value", "Code", "Qty", "Series", "Tolerance", "Package", "
 
 def _package_of(part) -> str:
     if part.kind == "R":
-        return "axial, 0.25 W metal film"
+        return _("axial, 0.25 W metal film")
     if part.value >= 1e-6:
-        return "radial electrolytic, 35 V"
+        return _("radial electrolytic, 35 V")
     if part.role.startswith("U") and "pin" in part.role:
-        return "ceramic X7R, 5 mm pitch"
-    return "film or C0G ceramic, 5 mm pitch"
+        return _("ceramic X7R, 5 mm pitch")
+    return _("film or C0G ceramic, 5 mm pitch")
 
 
 def bom_rows(board, source_of, opamp_name: str) -> list:
@@ -66,16 +67,17 @@ def bom_rows(board, source_of, opamp_name: str) -> list:
         ps = groups[key]
         kind, value, series, tol, pkg = key
         roles = [p.role for p in ps]
-        desc = roles[0] if len(ps) == 1 else ("decoupling, at the supply pins" if ps[0].ref[1:2] in "123456789"
-                                             and len(ps[0].ref) == 4 else "; ".join(f"{p.ref}: {p.role}"
-                                                                                   for p in ps))
+        desc = _(roles[0]) if len(ps) == 1 else (_("decoupling, at the supply pins") if ps[0].ref[1:2] in "123456789"
+                                                and len(ps[0].ref) == 4 else "; ".join(f"{p.ref}: {_(p.role)}"
+                                                                                      for p in ps))
         rows.append([", ".join(p.ref for p in ps), format_eng(value, ps[0].unit, 4), value_code(value), len(ps),
                      series, "" if tol is None else f"{tol:g} %", pkg, desc])
     pkg = board.package
-    what = ", ".join(f"{u.designator} {a.role}" for a, u in zip(board.netlist.amps, board.units))
+    what = ", ".join(f"{u.designator} {_(a.role)}" for a, u in zip(board.netlist.amps, board.units))
     spare = [u.designator for u in board.spares]
     rows.append([", ".join(board.ics), pkg.part, "", len(board.ics), "", "", pkg.pinout,
-                 f"{opamp_name} op-amps: {what}" + (f"; spare {', '.join(spare)} tied off" if spare else "")])
+                 _("{opamp} op-amps: {what}").format(opamp=opamp_name, what=what)
+                 + (_("; spare {units} tied off").format(units=", ".join(spare)) if spare else "")])
     return rows
 
 
@@ -108,8 +110,13 @@ def _pins_on(board, net) -> list:
     for a, u in zip(board.netlist.amps, board.units):
         for term, name in PIN_NAMES.items():
             if getattr(a, term) == net:
-                out.append(f"{u.designator} pin {u.pins[term]} ({name})")
+                out.append(_pin(u, term))
     return out
+
+
+def _pin(u, term) -> str:
+    """An op-amp unit's pin: ``U1A pin 1 (out)``."""
+    return _("{unit} pin {pin} ({name})").format(unit=u.designator, pin=u.pins[term], name=PIN_NAMES[term])
 
 
 def net_text(board, net, labels: dict) -> str:
@@ -131,9 +138,10 @@ def net_text(board, net, labels: dict) -> str:
     """
     pins = _pins_on(board, net)
     label = labels.get(net)
+    label = _(label) if label else label
     if pins:
         return (f"{label}: " if label else "") + ", ".join(pins)
-    return label or f"node {net}"
+    return label or _("node {net}").format(net=net)
 
 
 def wiring_rows(board, labels: dict, supplies: tuple) -> list:
@@ -162,26 +170,28 @@ def wiring_rows(board, labels: dict, supplies: tuple) -> list:
             for p in board.netlist.parts]
     for a, u in zip(board.netlist.amps, board.units):
         if a.inn == a.out:
-            rows.append(["wire", "", f"{u.designator} pin {u.pins['out']} (out)",
-                         f"{u.designator} pin {u.pins['inn']} (-in): follower"])
+            rows.append([_("wire"), "", _pin(u, "out"), _pin(u, "inn") + _(": follower")])
         if a.inp == "0":
-            rows.append(["wire", "", f"{u.designator} pin {u.pins['inp']} (+in)", "ground"])
+            rows.append([_("wire"), "", _pin(u, "inp"), _("ground")])
     pkg = board.package
     vcc, vee = supplies
     # the decoupling as the board names it: two per package in package order, then the two bulk ones
     dec = board.decoupling
     for i, ic in enumerate(board.ics):
-        opened = (f"; pins {', '.join(str(k) for k in pkg.unused)} open ({', '.join(sorted(set(pkg.unused.values())))})"
+        opened = (_("; pins {pins} open ({what})").format(pins=", ".join(str(k) for k in pkg.unused),
+                                                          what=", ".join(sorted(set(pkg.unused.values()))))
                   if pkg.unused else "")
-        rows.append([ic, pkg.part, f"pin {pkg.vcc} (V+): {vcc:+g} V, {dec[2 * i].ref} 100n to ground at the pin",
-                     f"pin {pkg.vee} (V-): {vee:+g} V, {dec[2 * i + 1].ref} 100n to ground at the pin" + opened])
+        supply = _("pin {pin} ({rail}): {v} V, {cap} 100n to ground at the pin")
+        rows.append([ic, pkg.part, supply.format(pin=pkg.vcc, rail="V+", v=f"{vcc:+g}", cap=dec[2 * i].ref),
+                     supply.format(pin=pkg.vee, rail="V-", v=f"{vee:+g}", cap=dec[2 * i + 1].ref) + opened])
     for u in board.spares:
-        rows.append(["wire", "", f"{u.designator} pin {u.pins['inp']} (+in)", "ground (spare unit)"])
-        rows.append(["wire", "", f"{u.designator} pin {u.pins['out']} (out)",
-                     f"{u.designator} pin {u.pins['inn']} (-in): spare as a follower, so it cannot oscillate"])
-    rows.append(["wire", "", "supply 0 V, generator ground, scope grounds", "ground (one star point)"])
-    rows.append([f"{dec[-2].ref}, {dec[-1].ref}", "10u", f"{vcc:+g} V and {vee:+g} V where the supply enters",
-                 "ground (mind the polarity)"])
+        rows.append([_("wire"), "", _pin(u, "inp"), _("ground (spare unit)")])
+        rows.append([_("wire"), "", _pin(u, "out"),
+                     _pin(u, "inn") + _(": spare as a follower, so it cannot oscillate")])
+    rows.append([_("wire"), "", _("supply 0 V, generator ground, scope grounds"), _("ground (one star point)")])
+    rows.append([f"{dec[-2].ref}, {dec[-1].ref}", "10u",
+                 _("{vcc} V and {vee} V where the supply enters").format(vcc=f"{vcc:+g}", vee=f"{vee:+g}"),
+                 _("ground (mind the polarity)")])
     return rows
 
 
@@ -208,14 +218,15 @@ def bench_rows(test, scope, into: str, channels=None) -> list:
         (set, to) rows.
     """
     a = test.amplitude_v
-    rows = [["generator", f"square {format_eng(test.frequency_hz, 'Hz')}, {format_eng(a, 'V')} pk-pk, offset "
-                          f"{format_eng(a / 2, 'V')} (0 to {format_eng(a, 'V')}), into {into}"]]
+    rows = [[_("generator"), _("square {f}, {a} pk-pk, offset {offset} (0 to {a}), into {into}").format(
+        f=format_eng(test.frequency_hz, 'Hz'), a=format_eng(a, 'V'), offset=format_eng(a / 2, 'V'), into=_(into))]]
     if scope is None:
         return rows
-    rows += [["time base", f"{format_eng(scope.time_per_div_s, 's')}/div, edge {scope.edge_div:g} div from the left"],
-             ["trigger", f"CH1 rising, {format_eng(scope.trigger_v, 'V')}"]]
+    rows += [[_("time base"), _("{t}/div, edge {div} div from the left").format(
+                 t=format_eng(scope.time_per_div_s, 's'), div=f"{scope.edge_div:g}")],
+             [_("trigger"), _("CH1 rising, {v}").format(v=format_eng(scope.trigger_v, 'V'))]]
     for c in scope.channels[:channels]:
-        rows.append([c.name, f"{format_eng(c.volts_per_div, 'V')}/div DC, 0 V {c.zero_div_below_centre:g} div "
-                             f"below centre: {c.node}"])
+        rows.append([c.name, _("{v}/div DC, 0 V {div} div below centre: {node}").format(
+            v=format_eng(c.volts_per_div, 'V'), div=f"{c.zero_div_below_centre:g}", node=_(c.node))])
     return rows
 

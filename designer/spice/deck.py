@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..core.errors import ParamError
+from ..core.i18n import N_
 from ..core.opamps import OpAmp
 from ..core.units import format_eng
 from .library import library_text
@@ -175,8 +176,8 @@ def board(netlist: Netlist, opamp: OpAmp, package: str | None = None, decoupling
                 Part(f"C{ic}{d}2", "vee", GROUND, DECOUPLING_F, f"U{ic} V- (pin {pkg.vee}) to ground, at the pin")]
     # the bulk pair: C901, C902; with another digit C99d1, C99d2, clear of package 9's pair (C9d1)
     bulk = "C90" if d == "0" else f"C99{d}"
-    dec += [Part(f"{bulk}1", "vcc", GROUND, BULK_F, "+supply entry to ground (bulk, + to the rail)"),
-            Part(f"{bulk}2", GROUND, "vee", BULK_F, "-supply entry to ground (bulk, + to ground)")]
+    dec += [Part(f"{bulk}1", "vcc", GROUND, BULK_F, N_("+supply entry to ground (bulk, + to the rail)")),
+            Part(f"{bulk}2", GROUND, "vee", BULK_F, N_("-supply entry to ground (bulk, + to ground)"))]
     return Board(netlist, tuple(units), tuple(spare_units(len(units), pkg)), tuple(dec), pkg)
 
 

@@ -186,3 +186,22 @@ def test_simc_refusal_names_the_option_not_the_library_parameter():
     from designer.pid.rules import tune_model
     with pytest.raises(DesignError, match="give tauc_s"):
         tune_model(fopdt(2.0, 1e-3), "simc")
+
+
+#: the commands that write a build sheet, and so take --lang
+SHEET_COMMANDS = ("design-plant", "analyze-plant", "design-pid", "analyze-pid")
+
+
+@pytest.mark.parametrize("exe", SHEET_COMMANDS)
+def test_a_bad_language_is_one_line_listing_the_languages(exe, tmp_path):
+    line = one_line(run(exe, "--lang", "fr", "--out", tmp_path))
+    assert "--lang" in line and "'fr'" in line and "'en'" in line and "'es'" in line, line
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("exe", SHEET_COMMANDS)
+def test_every_sheet_command_offers_the_languages_with_english_by_default(exe):
+    from designer.core.i18n import LANGUAGES
+    p = PARSERS[exe]()
+    (action,) = [a for a in p._actions if "--lang" in a.option_strings]
+    assert tuple(action.choices) == LANGUAGES and action.default == "en" and "LANG" in action.help

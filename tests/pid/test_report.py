@@ -1,3 +1,8 @@
+import re
+
+import pytest
+from helpers import REPORTS, sheet_command, spanish_sheet
+
 from designer.pid.blocks import seed_parts
 from designer.pid.design import PidSpec, design_pid
 
@@ -58,3 +63,25 @@ def test_the_json_keeps_its_keys():
     assert [c["name"] for c in result["checks"]] == [c["name"] for c in ref["checks"]]
     assert all(c["id"] == c["name"] for c in result["checks"])
     assert result["closed_loop"]["spice"] is None and result["levels"]["spice"] is None
+
+
+#: the Makefile demo's Ziegler-Nichols loop (reports/pid_zn_lm741_fc3500_z0.2)
+ZN_DEMO = ["--plant-fc", "3500", "--plant-zeta", "0.2", "--opamp", "LM741", "--name", "pid_zn_lm741_fc3500_z0.2"]
+
+
+@pytest.mark.spice
+def test_the_spanish_pid_sheet_leaves_no_english_message_and_writes_decimal_commas(tmp_path):
+    summary, _rep, page, nodes = spanish_sheet("design-pid", ZN_DEMO, tmp_path)
+    # the verdict's and the tables' figures: a decimal comma, never a point (notes from the library aside)
+    assert re.search(r"\d+,\d+ % de sobrepaso", page) and "Ti = 43,75 µs" in page
+    headings = re.findall(r"<h2>([^<]*)</h2>", page)
+    assert headings[:3] == ["Veredicto", "Montaje", "Cableado"] and "Lazo cerrado" in headings
+    assert not any(re.search(r"(?<![\w.])\d+\.\d+\b(?!\.\d)", n) for n in nodes if n in headings)
+    assert "Veredicto" in summary and "Verdict" not in summary
+
+
+@pytest.mark.spice
+def test_the_english_pid_sheet_is_byte_identical_to_the_reference(tmp_path):
+    _, rep = sheet_command("design-pid", ZN_DEMO, tmp_path)
+    for name in ("build-sheet.md", "build-sheet.html"):
+        assert (rep / name).read_bytes() == (REPORTS / "pid_zn_lm741_fc3500_z0.2" / name).read_bytes(), name
