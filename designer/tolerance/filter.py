@@ -48,14 +48,15 @@ import numpy as np
 from ..core.errors import DesignError
 from ..filters.registry import get as get_topology
 from ..filters.verify import mask_edges
-from . import runner, sampling
+from . import runner, sampling, yields
 from .montecarlo import check_draw
 from .parts import resolve
 from .stats import Limit, figure_stats, parse_limit, variance_shares, wilson
 
 __all__ = ["LOWHIGH_FIGURES", "BANDPASS_FIGURES", "FilterContext", "FilterMonteCarlo", "YieldOptimum", "figures_of",
            "context", "nominal_parts", "series_of", "mask_limits", "stage_responses", "evaluate", "spice_context",
-           "spice_evaluate", "filter_monte_carlo", "filter_worst_case", "optimize_yield"]
+           "spice_evaluate", "filter_monte_carlo", "filter_worst_case", "optimize_yield", "SPEC_FIGURES",
+           "FilterYieldVerdict", "filter_spec_yield"]
 
 #: the figures of a low- or high-pass
 LOWHIGH_FIGURES = ("passband_loss_db", "ripple_db", "f3_hz", "stopband_attenuation_db", "group_delay_s")
@@ -143,7 +144,7 @@ def series_of(result) -> dict:
     return {"R": result.spec.r_series, "C": result.spec.c_series}
 
 
-def context(result, stage_values=None) -> FilterContext:
+def context(result, stage_values=None, edges=None) -> FilterContext:
     """The analytic engine's context of ``result`` (its chosen parts, or ``stage_values``: one
     designator -> value dict per stage, for another candidate set).
 
@@ -153,6 +154,9 @@ def context(result, stage_values=None) -> FilterContext:
         The design.
     stage_values : list of dict, optional
         Per stage its part values (default the chosen ones).
+    edges : tuple, optional
+        (passband edge, stopband edge) to judge at, such as a check spec's own ``mask:``
+        (default :func:`designer.filters.verify.mask_edges`).
 
     Returns
     -------
@@ -160,7 +164,7 @@ def context(result, stage_values=None) -> FilterContext:
         Frequencies and each stage's op-amp factor.
     """
     kind = result.spec.filter_type
-    fp, fs = mask_edges(result)
+    fp, fs = edges if edges is not None else mask_edges(result)
     f3 = result.figures["f3_target_hz"]
     groups = {}
     if kind == "bandpass":
@@ -627,7 +631,7 @@ class FilterMonteCarlo:
 
 def filter_monte_carlo(result, n: int, seed: int = 0, sampler: str = "random", dist: str = "uniform",
                        tol_items=(), limit_items=(), tighten: bool = True, scale=None, spice_samples: int = 0,
-                       simulator: str = "ngspice-cli") -> FilterMonteCarlo:
+                       simulator: str = "ngspice-cli", edges=None) -> FilterMonteCarlo:
     """A Monte Carlo of ``result``'s chosen parts against its mask (module docstring).
 
     Parameters
@@ -649,6 +653,8 @@ def filter_monte_carlo(result, n: int, seed: int = 0, sampler: str = "random", d
         yield of both engines on them and their disagreement.
     simulator : str
         ``ngspice-cli`` or ``pyspice``.
+    edges : tuple, optional
+        (passband edge, stopband edge) the figures are taken at (:func:`context`).
 
     Returns
     -------
@@ -659,7 +665,7 @@ def filter_monte_carlo(result, n: int, seed: int = 0, sampler: str = "random", d
     limits = mask_limits(result, limit_items)
     nominal = nominal_parts(result)
     tol = resolve(tol_items, nominal, series_of(result))
-    ctx = context(result)
+    ctx = context(result, edges=edges)
     draw = runner.Draw(nominal, tol.of, n, seed, sampler, dist)
     with runner.Runner(scale or runner.Scale()) as run:
         values, figs, _ = run.run(evaluate, ctx, draw)
@@ -883,3 +889,103 @@ def optimize_yield(result, n: int = 2000, seed: int = 0, sampler: str = "random"
     return YieldOptimum(choice, [st.candidates[c] for st, c in zip(result.stages, choice)], y0, best, n, seed,
                         wilson(k0, n), wilson(k1, n), [i + 1 for i, (a, b) in enumerate(zip(start, choice)) if a != b],
                         tried)
+
+
+# ---- check-design's yield (kind: filter) ---------------------------------------------------------
+@dataclass(frozen=True)
+class FilterYieldVerdict:
+    """A ``kind: filter`` spec's yield on one corner (:func:`filter_spec_yield`).
+
+    Attributes
+    ----------
+    mc : FilterMonteCarlo
+        The Monte Carlo.
+    required : float
+        The fraction the spec requires.
+    skipped : tuple of str
+        The spec's failing checks the analytic engine has no figure of (not counted).
+    """
+
+    mc: FilterMonteCarlo
+    required: float
+    skipped: tuple = ()
+
+    @property
+    def fraction(self) -> float:
+        """The builds inside every counted limit, as a fraction."""
+        return self.mc.yield_count / self.mc.n
+
+    @property
+    def ok(self) -> bool:
+        """The yield reaches the required fraction."""
+        return self.fraction >= self.required
+
+    def message(self) -> str:
+        """One line: the yield, its Wilson interval, the verdict, and when it fails the figure that loses most.
+
+        Returns
+        -------
+        str
+            ``yield: 97.5 % (1950/2000 builds; 95 % Wilson interval ..) at or above min 95 % over ..``.
+        """
+        mc = self.mc
+        lo, hi = mc.yield_interval()
+        over = ", ".join(dict.fromkeys(lim.figure for lim in mc.limits))
+        text = (f"yield: {100 * self.fraction:.4g} % ({mc.yield_count}/{mc.n} builds; 95 % Wilson interval "
+                f"{100 * lo:.4g} % to {100 * hi:.4g} %) {'at or above' if self.ok else 'below'} min "
+                f"{100 * self.required:g} % over {over} (analytic engine, {mc.sampler} sampler, seed {mc.seed}")
+        text += ")" if not self.skipped else f"; not counted, no engine figure: {', '.join(self.skipped)})"
+        if self.ok:
+            return text
+        lost = [(lim, int(np.count_nonzero(~lim.inside(mc.figures[lim.figure])))) for lim in mc.limits]
+        lim, count = max(lost, key=lambda kv: kv[1])
+        return f"{text}; {lim.figure} loses most: {count} builds outside {lim.window()}"
+
+
+#: check-design's filter figures the analytic engine counts (the same names: both the op-amp-aware response's)
+SPEC_FIGURES = tuple(yields.FILTER)
+
+
+def filter_spec_yield(result, mask, checks, required: float, samples: int, seed: int, tol_items=(),
+                      sampler: str = "random", dist: str = "uniform") -> FilterYieldVerdict:
+    """The yield of one corner's designed filter over a check spec's ``checks`` (its ``mask:`` among them).
+
+    The builds are :func:`filter_monte_carlo`'s (the analytic engine, every part of every stage within
+    its tolerance), judged at the spec's mask edges when it has ``mask:``, else the design's own; a
+    failing check on a figure the engine has not (:data:`SPEC_FIGURES`: the ``spice_`` figures, the
+    design's) is not counted and the verdict says so; a report-only check is never counted.
+
+    Parameters
+    ----------
+    result : designer.filters.FilterDesign
+        The corner's design.
+    mask : dict or None
+        The spec's ``{passband, max_loss, stopband, min_attenuation}``.
+    checks : sequence of designer.check.limits.Limit
+        The spec's checks.
+    required : float
+        The yield required (fraction).
+    samples, seed : int
+        The Monte Carlo's builds and seed.
+    tol_items : sequence of str
+        ``--tol`` items (``R=1%``) from the spec's ``tolerances:``.
+    sampler, dist : str
+        How the builds are drawn.
+
+    Returns
+    -------
+    FilterYieldVerdict
+        The Monte Carlo and the verdict.
+    """
+    live = [c for c in checks if c.fail]
+    use = {}
+    for c in live:   # the mask's limit and a check: on the same figure both hold
+        if c.figure in SPEC_FIGURES:
+            lo, hi = use.get(c.figure, (None, None))
+            use[c.figure] = (c.min if lo is None or (c.min is not None and c.min > lo) else lo,
+                             c.max if hi is None or (c.max is not None and c.max < hi) else hi)
+    skipped = tuple(dict.fromkeys(c.figure for c in live if c.figure not in SPEC_FIGURES))
+    limits = tuple(Limit(k, lo, hi) for k, (lo, hi) in use.items())
+    edges = None if mask is None else (mask["passband"], mask["stopband"])
+    mc = filter_monte_carlo(result, samples, seed, sampler, dist, tol_items, limits, tighten=False, edges=edges)
+    return FilterYieldVerdict(mc, required, skipped)
