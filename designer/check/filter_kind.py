@@ -38,7 +38,7 @@ __all__ = ["FILTER_KEYS", "SUB_FILTER", "MASK_KEYS", "MASK_FIGURES", "FilterCase
 
 #: the keys of ``filter:`` (design-filter's options) and ``mask:``
 SUB_FILTER = ("type", "family", "order", "fc", "ripple", "bessel_norm", "chebyshev_cutoff", "f_low", "f_high",
-              "bandpass_method", "topology", "stage_order", "gain", "amplitude", "gbw_margin", "impedance",
+              "bandpass_method", "topology", "stage_order", "gain", "stage_gain", "amplitude", "gbw_margin", "impedance",
               "compensate_gbw")
 MASK_KEYS = ("passband", "max_loss", "stopband", "min_attenuation")
 #: library parameter -> the filter spec's key (messages of FilterSpec)
@@ -47,6 +47,7 @@ FILTER_KEYS = {"filter_type": "filter.type", "family": "filter.family", "order":
                "chebyshev_cutoff": "filter.chebyshev_cutoff", "f_low_hz": "filter.f_low",
                "f_high_hz": "filter.f_high", "bandpass_method": "filter.bandpass_method",
                "topology": "filter.topology", "stage_order": "filter.stage_order", "gain": "filter.gain",
+               "stage_gains": "filter.stage_gain",
                "amplitude_v": "filter.amplitude", "gbw_margin": "filter.gbw_margin",
                "impedance_ohm": "filter.impedance", "compensate_gbw": "filter.compensate_gbw",
                "passband_hz": "mask.passband", "max_loss_db": "mask.max_loss", "stopband_hz": "mask.stopband",

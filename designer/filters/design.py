@@ -216,7 +216,9 @@ class FilterDesign:
                 "bandpass_method": (bandpass_method(s.f_low_hz, s.f_high_hz, s.bandpass_method)
                                     if s.filter_type == "bandpass" else None),
                 "r_series": s.r_series, "c_series": s.c_series, "amplitude_v": s.amplitude_v,
-                "gbw_margin": s.gbw_margin, "compensate_gbw": s.compensate_gbw}
+                "gbw_margin": s.gbw_margin, "compensate_gbw": s.compensate_gbw,
+                # only when given: the reference outputs of a split by the design stay as they are
+                **({"stage_gains": list(s.stage_gains)} if s.stage_gains is not None else {})}
         return json_safe({"tool": "design-filter", "schema_version": SCHEMA_VERSION, "spec": spec,
                           "opamp": self.opamp.to_dict(), "stages": [st.to_dict() for st in self.stages],
                           "figures": dict(self.figures), "spice": self.spice})
@@ -584,16 +586,25 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
                           param="topology")
     families = list(spec.topology) * n if len(spec.topology) == 1 else list(spec.topology)
     swing = min(opamp.vout_max, -opamp.vout_min)
+    if spec.stage_gains is not None:
+        if plans[0].kind == "bandpass":
+            raise DesignError("stage_gains: a narrow band-pass's sections peak at their own fn, their gains are "
+                              "split by the design; give gain only (or bandpass_method wide)", param="stage_gains")
+        if len(spec.stage_gains) != n:
+            raise DesignError(f"stage_gains: give one gain per stage ({n} stages, in build order), got "
+                              f"{len(spec.stage_gains)}", param="stage_gains")
+        strategies = ("given",)
     for strategy in strategies:
-        gains = _split_gains(plans, total_gain, strategy)
+        gains = list(spec.stage_gains) if strategy == "given" else _split_gains(plans, total_gain, strategy)
         peaks, nodes = _node_peaks(plans, gains, spec.amplitude_v, fc)
         if max(nodes) <= swing:
             break
     else:
         worst = int(np.argmax(nodes))
+        change = "--stage-gain" if spec.stage_gains is not None else "--gain"
         raise DesignError(f"amplitude_v: stage {worst + 1}'s output peaks at {nodes[worst]:.3g} V at --amplitude "
                           f"{spec.amplitude_v:g} V, beyond {opamp.name}'s swing of +-{swing:.3g} V; lower "
-                          "--amplitude or --gain", param="amplitude_v")
+                          f"--amplitude or {change}", param="amplitude_v")
     grid = analysis_grid(spec, order, fc)
     limits = None
     if spec.has_mask:

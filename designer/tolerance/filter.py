@@ -48,14 +48,14 @@ import numpy as np
 from ..core.errors import DesignError
 from ..filters.registry import get as get_topology
 from ..filters.verify import mask_edges
-from . import runner, sampling, yields
+from . import runner, sampling
 from .montecarlo import check_draw
 from .parts import resolve
 from .stats import Limit, figure_stats, parse_limit, variance_shares, wilson
 
 __all__ = ["LOWHIGH_FIGURES", "BANDPASS_FIGURES", "FilterContext", "FilterMonteCarlo", "YieldOptimum", "figures_of",
            "context", "nominal_parts", "series_of", "mask_limits", "stage_responses", "evaluate", "spice_context",
-           "spice_evaluate", "filter_monte_carlo", "filter_worst_case", "optimize_yield", "SPEC_FIGURES",
+           "spice_evaluate", "filter_monte_carlo", "filter_worst_case", "optimize_yield",
            "FilterYieldVerdict", "filter_spec_yield"]
 
 #: the figures of a low- or high-pass
@@ -942,18 +942,14 @@ class FilterYieldVerdict:
         return f"{text}; {lim.figure} loses most: {count} builds outside {lim.window()}"
 
 
-#: check-design's filter figures the analytic engine counts (the same names: both the op-amp-aware response's)
-SPEC_FIGURES = tuple(yields.FILTER)
-
-
-def filter_spec_yield(result, mask, checks, required: float, samples: int, seed: int, tol_items=(),
-                      sampler: str = "random", dist: str = "uniform") -> FilterYieldVerdict:
-    """The yield of one corner's designed filter over a check spec's ``checks`` (its ``mask:`` among them).
+def filter_spec_yield(result, mask, limits, required: float, samples: int, seed: int, tol_items=(),
+                      sampler: str = "random", dist: str = "uniform", skipped=()) -> FilterYieldVerdict:
+    """The yield of one corner's designed filter within a check spec's ``limits`` (its checks on the
+    figures this engine has, :data:`designer.tolerance.yields.FILTER`; the ``mask:``'s among them).
 
     The builds are :func:`filter_monte_carlo`'s (the analytic engine, every part of every stage within
-    its tolerance), judged at the spec's mask edges when it has ``mask:``, else the design's own; a
-    failing check on a figure the engine has not (:data:`SPEC_FIGURES`: the ``spice_`` figures, the
-    design's) is not counted and the verdict says so; a report-only check is never counted.
+    its tolerance), judged at the spec's mask edges when it has ``mask:``, else the design's own; two
+    limits on one figure both hold.
 
     Parameters
     ----------
@@ -961,8 +957,8 @@ def filter_spec_yield(result, mask, checks, required: float, samples: int, seed:
         The corner's design.
     mask : dict or None
         The spec's ``{passband, max_loss, stopband, min_attenuation}``.
-    checks : sequence of designer.check.limits.Limit
-        The spec's checks.
+    limits : sequence of designer.tolerance.stats.Limit
+        The windows a build must be inside.
     required : float
         The yield required (fraction).
     samples, seed : int
@@ -971,21 +967,15 @@ def filter_spec_yield(result, mask, checks, required: float, samples: int, seed:
         ``--tol`` items (``R=1%``) from the spec's ``tolerances:``.
     sampler, dist : str
         How the builds are drawn.
+    skipped : tuple of str
+        The spec's failing checks not counted (the verdict names them).
 
     Returns
     -------
     FilterYieldVerdict
         The Monte Carlo and the verdict.
     """
-    live = [c for c in checks if c.fail]
-    use = {}
-    for c in live:   # the mask's limit and a check: on the same figure both hold
-        if c.figure in SPEC_FIGURES:
-            lo, hi = use.get(c.figure, (None, None))
-            use[c.figure] = (c.min if lo is None or (c.min is not None and c.min > lo) else lo,
-                             c.max if hi is None or (c.max is not None and c.max < hi) else hi)
-    skipped = tuple(dict.fromkeys(c.figure for c in live if c.figure not in SPEC_FIGURES))
-    limits = tuple(Limit(k, lo, hi) for k, (lo, hi) in use.items())
     edges = None if mask is None else (mask["passband"], mask["stopband"])
-    mc = filter_monte_carlo(result, samples, seed, sampler, dist, tol_items, limits, tighten=False, edges=edges)
-    return FilterYieldVerdict(mc, required, skipped)
+    mc = filter_monte_carlo(result, samples, seed, sampler, dist, tol_items, tuple(limits), tighten=False,
+                            edges=edges)
+    return FilterYieldVerdict(mc, required, tuple(skipped))

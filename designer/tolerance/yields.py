@@ -14,6 +14,10 @@ figures a check names (``overshoot_pct``, ``peak_time_s``, ``rise_time_s``,
 ``settling_time_s``) from those runs (:data:`PLANT_SPICE`, :data:`LOOP_SPICE`); the
 other figures (``fn_hz``, the gains, the margins, ``model_*``) stay the models',
 as check-design reads them on the nominal build.
+
+A designed filter (``kind: filter``) counts its checks on :data:`FILTER`'s figures
+(the mask's among them) on :func:`designer.tolerance.filter.filter_spec_yield`'s builds:
+the analytic engine only, its SPICE comparison is analyze-filter's ``--spice-samples``.
 """
 
 from __future__ import annotations
@@ -171,14 +175,14 @@ def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int,
     """
     from .loop import loop_monte_carlo, loop_series
     from .montecarlo import plant_monte_carlo
-    if kind == "filter":   # a FilterRun of check-design: its design and the spec's mask
-        from .filter import filter_spec_yield
-        return filter_spec_yield(res.design, res.case.mask, checks, required, samples, seed, tol_items, sampler,
-                                 dist)
     use, skipped = counted(kind, checks, engine)
     table = TABLES[engine][kind]
     limits = tuple(Limit(table[c.figure], c.min, c.max) for c in use)
     names = {table[c.figure]: c.figure for c in use}
+    if kind == "filter":   # a FilterRun of check-design: its design and the spec's mask
+        from .filter import filter_spec_yield
+        return filter_spec_yield(res.design, res.case.mask, limits, required, samples, seed, tol_items, sampler,
+                                 dist, skipped)
     if kind == "plant":
         s = res.sourcing
         evaluate = None

@@ -34,6 +34,17 @@ from designer.cli.filter import analyze_filter_main, design_filter_main
      "the band's edges cross: --f-low (1100 Hz) is not below --f-high (900 Hz)"),
     (["--type", "bandpass", "--order", "2", "--fc", "1k"], "a bandpass takes its edges"),
     (["--order", "2", "--fc", "1k", "--f-low", "900"], "band edges are for a bandpass"),
+    (["--order", "6", "--fc", "1k", "--gain", "4", "--stage-gain", "2,3,1"],
+     "--stage-gain: 2 x 3 x 1 = 6 is not --gain 4"),
+    (["--order", "6", "--fc", "1k", "--gain", "4", "--stage-gain", "2,2"],
+     "--stage-gain: give one gain per stage (3 stages, in build order), got 2"),
+    (["--order", "6", "--fc", "1k", "--gain", "4", "--stage-gain", "4,0.5,2"], "--stage-gain must be 1 to 100"),
+    (["--order", "6", "--fc", "1k", "--gain", "4", "--stage-gain", "2,x,2"], "--stage-gain"),
+    (["--order", "6", "--fc", "1k", "--gain", "100", "--stage-gain", "1,1,100", "--opamp", "TL072"],
+     "stage 3's output peaks at 100 V at --amplitude 1 V, beyond TL072's swing of +-13.5 V; lower --amplitude "
+     "or --stage-gain"),
+    (["--type", "bandpass", "--order", "2", "--f-low", "900", "--f-high", "1.1k", "--gain", "2", "--stage-gain",
+      "2,1"], "--stage-gain: a narrow band-pass's sections peak at their own fn"),
 ])
 def test_bad_input_is_one_line_exit_2(argv, words, capsys):
     assert design_filter_main(argv + ["--no-sim"]) == 2

@@ -8,11 +8,14 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as hst
 
 from designer.core.errors import DesignError
 from designer.core.opamps import get as get_opamp
 from designer.filters import FilterSpec, design
 from designer.filters.prototype import reference_response
+from designer.filters.registry import get
 
 
 def test_butterworth_4th_order_lowpass_figures():
@@ -65,6 +68,40 @@ def test_topology_per_stage():
     d = design(FilterSpec(order=4, fc_hz=1e3, topology=("mfb", "sallen-key")))
     assert [st.topology for st in d.stages] == ["mfb-lowpass", "sallen-key-lowpass"]
     assert d.figures["inverting"]
+
+
+@pytest.mark.parametrize("gains", [(2.0, 2.0, 1.0), (1.0, 1.0, 4.0), (4.0, 1.0, 1.0)])
+def test_stage_gains_given_per_stage(gains):
+    d = design(FilterSpec(order=6, fc_hz=1e3, gain=4.0, stage_gains=",".join(map(str, gains)), opamp="TL072"))
+    assert tuple(stage.gain for stage in d.stages) == gains
+    assert d.to_dict()["spec"]["stage_gains"] == list(gains)
+    # each stage's peak gain is its own response's, from its gain: brute force over a dense grid
+    f = np.geomspace(10.0, 1e5, 20001)
+    for stage in d.stages:
+        h = get(stage.topology).response(stage.continuous, 2j * math.pi * f)   # the ideal section of its target
+        assert stage.peak_gain == pytest.approx(np.max(np.abs(h)), rel=1e-3)
+        assert stage.peak_gain >= stage.gain * (1 - 1e-5)   # the grid starts at fc/1000, not DC
+    # the chosen parts' passband gain is the asked one, and the per-stage split is not the design's own
+    h0 = d.cascade().response(np.array([2j * math.pi * 10.0]))
+    assert abs(h0[0]) == pytest.approx(4.0, rel=0.05)
+    assert "stage_gains" not in design(FilterSpec(order=6, fc_hz=1e3, gain=4.0)).to_dict()["spec"]
+
+
+@given(hst.lists(hst.floats(1.0, 10.0), min_size=1, max_size=5), hst.floats(1.0, 100.0))
+@settings(max_examples=60, deadline=None)
+def test_stage_gains_must_multiply_to_the_gain(gains, gain):
+    product = math.prod(gains)
+    if product > 100:
+        return
+    text = ",".join(repr(g) for g in gains)
+    if math.isclose(product, gain, rel_tol=1e-9):
+        assert FilterSpec(order=4, fc_hz=1e3, gain=gain, stage_gains=text).stage_gains == tuple(gains)
+    else:
+        with pytest.raises(DesignError, match="stage_gains: .* is not gain") as e:
+            FilterSpec(order=4, fc_hz=1e3, gain=gain, stage_gains=text)
+        assert "\n" not in str(e.value)
+    spec = FilterSpec(order=4, fc_hz=1e3, gain=product, stage_gains=text)
+    assert spec.stage_gains == tuple(gains)
 
 
 def test_mask_design_meets_the_mask():
