@@ -234,8 +234,16 @@ def _design(args) -> int:
     spec = _spec(args)
     _check_sheet_args(args)
     settings = tolerance_settings(args)
-    result = design(spec, simulate=not args.no_sim, simulator=args.simulator)
-    return _emit(result, args, run_tolerance(result, args, settings))
+    apply = None
+    if args.apply_optimum:
+        from ..core.errors import DesignError
+        from ..filters.design import with_choice
+        if args.optimize != "yield":
+            raise DesignError("--apply-optimum goes with --optimize yield (the set it builds)")
+        apply = lambda res, choice: with_choice(res, choice, not args.no_sim, args.simulator)  # noqa: E731
+    result = design(spec, simulate=not args.no_sim and apply is None, simulator=args.simulator)
+    extras = run_tolerance(result, args, settings, apply)
+    return _emit(extras.pop("built", result), args, extras)
 
 
 def _emit(result, args, extras: dict) -> int:

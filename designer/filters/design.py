@@ -52,7 +52,7 @@ from .topology import SectionTarget
 from .verify import proof_deck, prove
 
 __all__ = ["StageDesign", "FilterDesign", "design", "as_built", "section_plans", "section_name", "stage_candidates", "verify_spice", "predistort",
-           "analysis_grid"]
+           "analysis_grid", "with_choice"]
 
 #: the capacitor values (C1, nearest first) each stage offers the joint search
 C_CHOICES = 3
@@ -831,6 +831,45 @@ def _figures(result: FilterDesign, grid: dict, errors, choice, j_joint, examined
         figs["mask_passband_margin_db"] = spec.max_loss_db + h(spec.passband_hz)
         figs["mask_stopband_margin_db"] = -h(spec.stopband_hz) - spec.min_attenuation_db
     return figs
+
+
+def with_choice(result: FilterDesign, choice, simulate: bool = False, simulator: str = "ngspice-cli") -> FilterDesign:
+    """``result`` built with another candidate of each stage (``--optimize yield --apply-optimum``: the
+    yield-optimal set): the achieved figures (``f3_hz``, ``passband_deviation_db``, the mask margins) are the
+    new set's, ``error_built_db`` its worst deviation on the joint search's objective; ``error_joint_db``
+    and the other search figures stay the joint choice's, reported beside it.
+
+    Parameters
+    ----------
+    result : FilterDesign
+        The design (its stages' candidates).
+    choice : sequence of int
+        Per stage, the candidate index to build.
+    simulate : bool
+        Also run the SPICE proof of the new set.
+    simulator : str
+        ``ngspice-cli`` or ``pyspice``.
+
+    Returns
+    -------
+    FilterDesign
+        A new design; ``result`` is left as it is.
+    """
+    import dataclasses
+    stages = [dataclasses.replace(st, chosen=int(c)) for st, c in zip(result.stages, choice)]
+    out = FilterDesign(result.spec, result.order, result.fc_hz, stages)
+    grid = analysis_grid(result.spec, result.order, result.fc_hz)
+    errors = [st.errors for st in stages]
+    f = result.figures
+    figs = _figures(out, grid, errors, list(choice), None, f.get("examined", 0), f.get("candidates_s", 0.0),
+                    f.get("search_s", 0.0))
+    out.figures = {**f, **{k: figs[k] for k in ("f3_hz", "passband_deviation_db", "mask_passband_margin_db",
+                                                "mask_stopband_margin_db") if k in figs},
+                   "error_built_db": objective(errors, list(choice)), "built": "yield-optimal"}
+    if simulate:
+        out.proof = prove(out, simulator)
+        out.spice = out.proof.to_dict()
+    return out
 
 
 def verify_spice(result: FilterDesign, simulator: str = "ngspice-cli") -> dict:

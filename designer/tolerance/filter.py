@@ -775,6 +775,8 @@ class YieldOptimum:
         The stages whose parts changed.
     tried : int
         Candidate sets evaluated.
+    joint_values : list of dict or None
+        Per stage the joint choice's parts, when the found set is the one built (``--apply-optimum``).
     """
 
     choice: list
@@ -787,6 +789,7 @@ class YieldOptimum:
     ci_optimum: tuple
     changed: list
     tried: int
+    joint_values: list | None = None
 
     def to_dict(self) -> dict:
         """The optimum as JSON."""
@@ -794,7 +797,11 @@ class YieldOptimum:
                 "samples": self.n, "seed": self.seed, "yield_joint": self.yield_nominal,
                 "ci95_joint": list(self.ci_nominal), "yield_optimized": self.yield_optimum,
                 "ci95_optimized": list(self.ci_optimum), "stages_changed": self.changed, "sets_tried": self.tried,
-                "parts": [{k: float(v) for k, v in vals.items()} for vals in self.values]}
+                "parts": [{k: float(v) for k, v in vals.items()} for vals in self.values],
+                # only when applied: without --apply-optimum the JSON stays as it was
+                **({"applied": True, "joint_parts": [{k: float(v) for k, v in vals.items()}
+                                                     for vals in self.joint_values]}
+                   if self.joint_values is not None else {})}
 
     def lines(self) -> list:
         """The summary's lines."""
@@ -802,10 +809,16 @@ class YieldOptimum:
         out = [f"Yield-optimal parts ({self.n} builds, seed {self.seed}, the same draws for both): joint choice "
                f"{100 * self.yield_nominal:.2f} %, optimized {100 * self.yield_optimum:.2f} % "
                f"(stages changed: {', '.join(map(str, self.changed)) or 'none'}; {self.tried} sets tried)"]
+        def shown(parts, i):
+            return ", ".join(f"{r[0]}{i}0{r[1:]} {format_eng(v, 'Ohm' if r.startswith('R') else 'F')}"
+                             for r, v in parts.items())
         for i in self.changed:
-            parts = self.values[i - 1]
-            out.append(f"  stage {i}: " + ", ".join(
-                f"{r[0]}{i}0{r[1:]} {format_eng(v, 'Ohm' if r.startswith('R') else 'F')}" for r, v in parts.items()))
+            out.append(f"  stage {i}: {shown(self.values[i - 1], i)}")
+        if self.joint_values is not None:
+            out.append("  built: the yield-optimal set (the stages above, the deck, result.json, the sheet); the "
+                       "joint choice had" + "".join(f" stage {i}: {shown(self.joint_values[i - 1], i)};"
+                                                    for i in self.changed).rstrip(";")
+                       + ("" if self.changed else " the same parts"))
         return out
 
 

@@ -237,3 +237,21 @@ def test_bandpass_orders_agree_with_spice(family, order):
     assert d.spice["max_deviation_passband_db"] < 0.1
     assert d.spice["max_deviation_60db_db"] < 0.5
     assert d.spice["nrms"]["ac_opamp"] < 1 and d.spice["nrms"]["tran_opamp"] < 1
+
+
+def test_with_choice_rebuilds_the_achieved_figures():
+    from designer.filters.design import with_choice
+    d = design(FilterSpec(order=4, fc_hz=1e3, opamp="TL072"))
+    same = with_choice(d, [s.chosen for s in d.stages])
+    for k in ("f3_hz", "passband_deviation_db", "error_joint_db"):
+        assert same.figures[k] == pytest.approx(d.figures[k], rel=1e-12), k
+    assert same.figures["error_built_db"] == pytest.approx(d.figures["error_joint_db"], rel=1e-12)
+    other = [(s.chosen + 1) % len(s.candidates) for s in d.stages]
+    moved = with_choice(d, other)
+    assert [s.chosen for s in d.stages] != other   # the original is left as it was
+    assert [s.values for s in moved.stages] == [s.candidates[c] for s, c in zip(d.stages, other)]
+    # the -3 dB point of the new parts, by brute force on a dense grid
+    f = np.geomspace(500, 2e3, 200001)
+    g = 20 * np.log10(np.abs(moved.cascade().response(2j * math.pi * f, get_opamp("TL072"))))
+    assert moved.figures["f3_hz"] == pytest.approx(f[np.flatnonzero(g >= -10 * math.log10(2))[-1]], rel=1e-4)
+    assert moved.figures["error_joint_db"] == d.figures["error_joint_db"]
