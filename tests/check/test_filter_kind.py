@@ -188,3 +188,12 @@ def test_a_yield_below_its_minimum_names_the_figure_that_loses_most(tmp_path):
     case = next(c for c in out.cases if c.id == "yield")
     assert case.status == "fail" and "below min 99 %" in case.message
     assert "f3_hz loses most" in case.message and "outside 995 Hz to 1.005 kHz" in case.message
+
+
+def test_stage_gain_in_a_spec(tmp_path):
+    text = DESIGNED.replace("order: 4, fc: 1k}", "order: 6, fc: 1k, gain: 4, stage_gain: '2,2,1'}").replace(
+        "[TL072, NE5532]", "TL072")
+    spec = load_spec(write(tmp_path, text))
+    assert spec.designs[0].spec.stage_gains == (2.0, 2.0, 1.0)
+    msg = refusal(write(tmp_path, text.replace("'2,2,1'", "'2,3,1'"), "bad.yaml"))
+    assert "filter.stage_gain: 2 x 3 x 1 = 6 is not filter.gain 4" in msg, msg
