@@ -18,7 +18,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "mcspec": ("MonteCarloSpec", "plant_tolerance"),
     "chunks": ("lost_twice", "run_chunk",),
     "cluster": ("CONNECT_TIMEOUT", "ClusterStart", "DaskPool", "WORKERS", "cluster_ahead", "parse_dask", "probe",),
-    "filter": ("BANDPASS_FIGURES", "FilterContext", "FilterMonteCarlo", "FilterYieldVerdict", "LOWHIGH_FIGURES",
+    "filter": ("BANDPASS_FIGURES", "FilterContext", "FilterMonteCarlo", "LOWHIGH_FIGURES",
                "YieldOptimum", "figures_of", "filter_monte_carlo", "filter_spec_yield", "filter_worst_case", "mask_limits", "nominal_parts",
                "optimize_yield", "series_of", "spice_context", "stage_responses",),
     "loop": ("LIMITABLE", "LoopContext", "STEP_POINTS", "kick_grid", "loop_figures", "loop_monte_carlo",

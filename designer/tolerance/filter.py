@@ -51,12 +51,12 @@ from ..filters.verify import mask_edges
 from . import runner, sampling
 from .montecarlo import check_draw
 from .parts import resolve
-from .stats import Limit, figure_stats, parse_limit, variance_shares, wilson
+from .stats import Limit, failing_samples, figure_stats, parse_limit, variance_shares, wilson
 
 __all__ = ["LOWHIGH_FIGURES", "BANDPASS_FIGURES", "FilterContext", "FilterMonteCarlo", "YieldOptimum", "figures_of",
            "context", "nominal_parts", "series_of", "mask_limits", "stage_responses", "evaluate", "spice_context",
            "spice_evaluate", "filter_monte_carlo", "filter_worst_case", "optimize_yield",
-           "FilterYieldVerdict", "filter_spec_yield"]
+           "filter_spec_yield"]
 
 #: the figures of a low- or high-pass
 LOWHIGH_FIGURES = ("passband_loss_db", "ripple_db", "f3_hz", "stopband_attenuation_db", "group_delay_s")
@@ -550,6 +550,10 @@ class FilterMonteCarlo:
         The part and the stage whose tolerance halved raises the yield most.
     spice : dict or None
         The SPICE engine on the first builds: its yield and the disagreement.
+    values : dict
+        Designator -> the builds' values (the draws).
+    engine : str
+        The engine that computed the figures.
     """
 
     n: int
@@ -566,6 +570,13 @@ class FilterMonteCarlo:
     shares: dict = field(default_factory=dict)
     tighten: dict | None = None
     spice: dict | None = None
+    values: dict = field(default_factory=dict, repr=False)
+    engine: str = "analytic"
+
+    @property
+    def failing(self) -> dict:
+        """Limited figure -> {count, worst}: the builds outside its window (:func:`~.stats.failing_samples`)."""
+        return failing_samples(self.figures, self.limits)
 
     @property
     def yield_count(self) -> int:
@@ -675,7 +686,7 @@ def filter_monte_carlo(result, n: int, seed: int = 0, sampler: str = "random", d
     rel = {r: values[r] / nominal[r] - 1 for r in values}
     shares = {k: variance_shares(rel, figs[k]) for k in by_fig}
     mc = FilterMonteCarlo(n, seed, sampler, dist, dict(tol.of), nominal, nom, figs, limits,
-                          _passed(figs, limits) if limits else None, stats, shares)
+                          _passed(figs, limits) if limits else None, stats, shares, values=values)
     if tighten and limits:
         mc.tighten = _tighten(result, ctx, mc)
     if spice_samples:
@@ -905,58 +916,8 @@ def optimize_yield(result, n: int = 2000, seed: int = 0, sampler: str = "random"
 
 
 # ---- check-design's yield (kind: filter) ---------------------------------------------------------
-@dataclass(frozen=True)
-class FilterYieldVerdict:
-    """A ``kind: filter`` spec's yield on one corner (:func:`filter_spec_yield`).
-
-    Attributes
-    ----------
-    mc : FilterMonteCarlo
-        The Monte Carlo.
-    required : float
-        The fraction the spec requires.
-    skipped : tuple of str
-        The spec's failing checks the analytic engine has no figure of (not counted).
-    """
-
-    mc: FilterMonteCarlo
-    required: float
-    skipped: tuple = ()
-
-    @property
-    def fraction(self) -> float:
-        """The builds inside every counted limit, as a fraction."""
-        return self.mc.yield_count / self.mc.n
-
-    @property
-    def ok(self) -> bool:
-        """The yield reaches the required fraction."""
-        return self.fraction >= self.required
-
-    def message(self) -> str:
-        """One line: the yield, its Wilson interval, the verdict, and when it fails the figure that loses most.
-
-        Returns
-        -------
-        str
-            ``yield: 97.5 % (1950/2000 builds; 95 % Wilson interval ..) at or above min 95 % over ..``.
-        """
-        mc = self.mc
-        lo, hi = mc.yield_interval()
-        over = ", ".join(dict.fromkeys(lim.figure for lim in mc.limits))
-        text = (f"yield: {100 * self.fraction:.4g} % ({mc.yield_count}/{mc.n} builds; 95 % Wilson interval "
-                f"{100 * lo:.4g} % to {100 * hi:.4g} %) {'at or above' if self.ok else 'below'} min "
-                f"{100 * self.required:g} % over {over} (analytic engine, {mc.sampler} sampler, seed {mc.seed}")
-        text += ")" if not self.skipped else f"; not counted, no engine figure: {', '.join(self.skipped)})"
-        if self.ok:
-            return text
-        lost = [(lim, int(np.count_nonzero(~lim.inside(mc.figures[lim.figure])))) for lim in mc.limits]
-        lim, count = max(lost, key=lambda kv: kv[1])
-        return f"{text}; {lim.figure} loses most: {count} builds outside {lim.window()}"
-
-
-def filter_spec_yield(result, mask, limits, required: float, samples: int, seed: int, tol_items=(),
-                      sampler: str = "random", dist: str = "uniform", skipped=()) -> FilterYieldVerdict:
+def filter_spec_yield(result, mask, limits, samples: int, seed: int, tol_items=(),
+                      sampler: str = "random", dist: str = "uniform") -> FilterMonteCarlo:
     """The yield of one corner's designed filter within a check spec's ``limits`` (its checks on the
     figures this engine has, :data:`designer.tolerance.yields.FILTER`; the ``mask:``'s among them).
 
@@ -972,23 +933,18 @@ def filter_spec_yield(result, mask, limits, required: float, samples: int, seed:
         The spec's ``{passband, max_loss, stopband, min_attenuation}``.
     limits : sequence of designer.tolerance.stats.Limit
         The windows a build must be inside.
-    required : float
-        The yield required (fraction).
     samples, seed : int
         The Monte Carlo's builds and seed.
     tol_items : sequence of str
         ``--tol`` items (``R=1%``) from the spec's ``tolerances:``.
     sampler, dist : str
         How the builds are drawn.
-    skipped : tuple of str
-        The spec's failing checks not counted (the verdict names them).
 
     Returns
     -------
-    FilterYieldVerdict
-        The Monte Carlo and the verdict.
+    FilterMonteCarlo
+        The Monte Carlo (its draws kept: :class:`designer.tolerance.yields.YieldVerdict` names the worst build).
     """
     edges = None if mask is None else (mask["passband"], mask["stopband"])
-    mc = filter_monte_carlo(result, samples, seed, sampler, dist, tol_items, tuple(limits), tighten=False,
-                            edges=edges)
-    return FilterYieldVerdict(mc, required, tuple(skipped))
+    return filter_monte_carlo(result, samples, seed, sampler, dist, tol_items, tuple(limits), tighten=False,
+                              edges=edges)

@@ -181,8 +181,8 @@ def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int,
     names = {table[c.figure]: c.figure for c in use}
     if kind == "filter":   # a FilterRun of check-design: its design and the spec's mask
         from .filter import filter_spec_yield
-        return filter_spec_yield(res.design, res.case.mask, limits, required, samples, seed, tol_items, sampler,
-                                 dist, skipped)
+        mc = filter_spec_yield(res.design, res.case.mask, limits, samples, seed, tol_items, sampler, dist)
+        return YieldVerdict(mc, required, names, skipped)
     if kind == "plant":
         s = res.sourcing
         evaluate = None
