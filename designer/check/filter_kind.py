@@ -4,7 +4,10 @@ or as built (``stages:``, each ``{topology: <registry name>, parts: {R1: .., C1:
 the parts keys the topology's designators), in every op-amp corner (``opamp:``),
 with ``mask: {passband, max_loss, stopband, min_attenuation}`` as checks on the
 op-amp-aware response and on SPICE's ``.ac`` (:data:`MASK_FIGURES`), besides the
-spec's own ``checks:`` on :data:`designer.check.figures.FILTER`.
+spec's own ``checks:`` on :data:`designer.check.figures.FILTER`; a designed filter's
+``yield: {min, samples, seed, sampler, dist}`` (with ``tolerances: {R: 1%, C: 5%}``)
+counts the builds of :func:`designer.tolerance.filter.filter_spec_yield` inside the
+checks on the model's figures (the mask's among them), with its Wilson interval.
 
 The figures of a corner (:func:`filter_figures`): the -3 dB frequencies (where
 the gain is 3 dB below the passband gain; a low-pass its last crossing, a
@@ -35,7 +38,7 @@ __all__ = ["FILTER_KEYS", "SUB_FILTER", "MASK_KEYS", "MASK_FIGURES", "FilterCase
 
 #: the keys of ``filter:`` (design-filter's options) and ``mask:``
 SUB_FILTER = ("type", "family", "order", "fc", "ripple", "bessel_norm", "chebyshev_cutoff", "f_low", "f_high",
-              "bandpass_method", "topology", "stage_order", "gain", "amplitude", "gbw_margin", "impedance",
+              "bandpass_method", "topology", "stage_order", "gain", "stage_gain", "amplitude", "gbw_margin", "impedance",
               "compensate_gbw")
 MASK_KEYS = ("passband", "max_loss", "stopband", "min_attenuation")
 #: library parameter -> the filter spec's key (messages of FilterSpec)
@@ -44,6 +47,7 @@ FILTER_KEYS = {"filter_type": "filter.type", "family": "filter.family", "order":
                "chebyshev_cutoff": "filter.chebyshev_cutoff", "f_low_hz": "filter.f_low",
                "f_high_hz": "filter.f_high", "bandpass_method": "filter.bandpass_method",
                "topology": "filter.topology", "stage_order": "filter.stage_order", "gain": "filter.gain",
+               "stage_gains": "filter.stage_gain",
                "amplitude_v": "filter.amplitude", "gbw_margin": "filter.gbw_margin",
                "impedance_ohm": "filter.impedance", "compensate_gbw": "filter.compensate_gbw",
                "passband_hz": "mask.passband", "max_loss_db": "mask.max_loss", "stopband_hz": "mask.stopband",
@@ -93,12 +97,15 @@ class FilterRun:
         :data:`designer.check.figures.FILTER` figures.
     stages : list
         (topology name, parts) of the cascade run.
+    monte_carlo : FilterMonteCarlo or None
+        The spec's ``yield:`` Monte Carlo (set by check-design's yield check).
     """
 
     case: FilterCase
     design: object
     figures: dict
     stages: list = field(default_factory=list)
+    monte_carlo: object = None
 
     def to_dict(self) -> dict:
         """The corner as JSON.
@@ -113,7 +120,8 @@ class FilterRun:
                           "stages": [{"topology": t, "parts": {k: float(v) for k, v in p.items()}}
                                      for t, p in self.stages],
                           "figures": self.figures,
-                          "design": None if self.design is None else self.design.to_dict()})
+                          "design": None if self.design is None else self.design.to_dict(),
+                          **({} if self.monte_carlo is None else {"monte_carlo": self.monte_carlo.to_dict()})})
 
 
 def _mask(doc) -> dict | None:

@@ -51,7 +51,7 @@ SUB = {
 }
 #: the parts a ``tolerances:`` may name besides the classes R and C
 TOLERANCE_PARTS = {"plant": ("R1", "R2", "C1", "C2", "R3", "R4", "GBW", "SR"),
-                   "pid": ("R1", "R2", "C1", "C2") + CONTROLLER_PARTS + ("GBW", "SR")}
+                   "pid": ("R1", "R2", "C1", "C2") + CONTROLLER_PARTS + ("GBW", "SR"), "filter": ()}
 #: a yield's builds: at least, at most, and by default
 YIELD_SAMPLES = (10, 10 ** 6, 2000)
 STIMULUS = {"plant": ("amplitude", "frequency"), "pid": ("amplitude", "frequency", "edge")}
@@ -465,6 +465,9 @@ def read_yield(doc, kind: str, checks):
     for key, allowed in (("engine", yields.ENGINES), ("sampler", sampling.SAMPLERS), ("dist", DISTRIBUTIONS)):
         if key in y and y[key] not in allowed:
             raise doc.error(("yield", key), f"yield.{key} {kind_of(y[key])} unknown; allowed: {', '.join(allowed)}")
+    if kind == "filter" and engine != "analytic":
+        raise doc.error(("yield", "engine"), "yield.engine: a filter's yield has the analytic engine only (allowed: "
+                        "analytic); analyze-filter --spice-samples compares it with ngspice on the same builds")
     use, skipped = yields.counted(kind, checks, engine)
     if not use:
         known = ", ".join(yields.TABLES[engine][kind])

@@ -22,7 +22,7 @@ Three kinds::
 and, for every kind: ``checks:`` (figure -> ``{min, typ, max, fail}``), and
 ``golden:``; for plant and pid: ``opamp`` (one name or a list: the corners),
 ``series``, ``bounds``, ``stimulus``, ``design_checks``, ``spice_agreement``;
-a plant also ``tolerance``; for plant and pid ``yield: {min: 95%, samples: 2000, seed: 1, engine:
+a plant also ``tolerance``; for plant, pid and filter (designed) ``yield: {min: 95%, samples: 2000, seed: 1, engine:
 analytic|spice}`` with ``tolerances: {R: 1%, C: 5%, C2: 2%, SR: 20%}`` (default: the series'), the Monte Carlo
 yield over the spec's own checks (:mod:`designer.tolerance.yields`). Paths (``deck``, ``golden.file``, the ``json``
 files) are relative to the spec file and must resolve (links followed) inside
@@ -65,7 +65,8 @@ TOP = {
     "pid": ("name", "kind", "description", "plant", "tuning", "controller", "series", "bounds", "opamp", "stimulus",
             "checks", "design_checks", "spice_agreement", "tolerances", "yield", "golden"),
     "netlist": ("name", "kind", "description", "deck", "checks", "golden"),
-    "filter": ("name", "kind", "description", "filter", "stages", "mask", "series", "bounds", "opamp", "checks"),
+    "filter": ("name", "kind", "description", "filter", "stages", "mask", "series", "bounds", "opamp", "checks",
+               "tolerances", "yield"),
 }
 
 
@@ -198,4 +199,9 @@ def _filter(doc, name: str, corners) -> CheckSpec:
     checks = read_checks(doc, "filter", set(F.FIGURES["filter"])) + mask_limits(designs[0].mask)
     if not checks:
         raise doc.error((), "nothing to check: give checks: (figures) or mask:")
-    return CheckSpec(doc.path, name, "filter", corners, tuple(designs), analyze, checks, None, None, (), None)
+    if analyze and doc.data.get("yield") is not None:
+        raise doc.error(("yield",), "yield: draws a design's parts around their E-series values; give filter: "
+                        "(designed) for a yield, stages: (as built) are checked as they are")
+    yield_spec = read_yield(doc, "filter", checks)
+    return CheckSpec(doc.path, name, "filter", corners, tuple(designs), analyze, checks, None, None, (), None,
+                     yield_spec)

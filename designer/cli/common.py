@@ -57,6 +57,7 @@ FLAGS = {
     "filter_type": "--type", "family": "--family", "order": "--order", "ripple_db": "--ripple",
     "passband_hz": "--passband", "max_loss_db": "--max-loss", "stopband_hz": "--stopband",
     "min_attenuation_db": "--min-attenuation", "topology": "--topology", "stage_order": "--stage-order",
+    "stage_gains": "--stage-gain",
     "bessel_norm": "--bessel-norm", "chebyshev_cutoff": "--chebyshev-cutoff", "gbw_margin": "--gbw-margin",
     "impedance_ohm": "--impedance", "series": "--series",
     "f_low_hz": "--f-low", "f_high_hz": "--f-high", "bandpass_method": "--bandpass-method",

@@ -67,8 +67,12 @@ def _parser():
                    "(Sallen-Key, MFB where it cannot); a comma list gives one per stage (default sallen-key)")
     s.add_argument("--stage-order", help="the stages (numbered 1.. in rising Q) in build order, e.g. 2,1 "
                    "(default: rising Q, so that a high-Q stage does not clip)")
-    s.add_argument("--gain", default="1", help=f"passband gain, V/V {help_range('gain')} (default 1), split "
-                   "evenly in dB over the second-order stages")
+    s.add_argument("--gain", default="1", help=f"passband gain, V/V {help_range('gain')} (default 1), put in the "
+                   "lowest-Q second-order stage, or split evenly in dB, then last, where that stage would clip")
+    s.add_argument("--stage-gain", dest="stage_gains", metavar="G1,G2,..",
+                   help=f"each stage's gain in build order, V/V {help_range('gain')} each, a comma list with one per "
+                   "stage whose product is --gain (e.g. --gain 4 --stage-gain 2,2,1); each stage's peak gain and "
+                   "output are still checked against the op-amp's swing")
     s.add_argument("--opamp", default="LM741", metavar="NAME",
                    help=f"op-amp of every stage: {', '.join(opamp_names())} (default LM741)")
     s.add_argument("--amplitude", dest="amplitude_v", default="1", help="bench input amplitude, peak volts "
@@ -104,7 +108,8 @@ def _parser():
 def _spec(args):
     from ..filters.spec import FilterSpec
     keys = ("filter_type", "family", "order", "fc_hz", "ripple_db", "bessel_norm", "chebyshev_cutoff", "passband_hz",
-            "max_loss_db", "stopband_hz", "min_attenuation_db", "f_low_hz", "f_high_hz", "bandpass_method", "topology", "stage_order", "gain", "opamp",
+            "max_loss_db", "stopband_hz", "min_attenuation_db", "f_low_hz", "f_high_hz", "bandpass_method", "topology", "stage_order", "gain",
+            "stage_gains", "opamp",
             "amplitude_v", "gbw_margin", "impedance_ohm", "r_series", "c_series", "r_min", "r_max", "c_min",
             "c_max")
     kw = {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
@@ -229,8 +234,16 @@ def _design(args) -> int:
     spec = _spec(args)
     _check_sheet_args(args)
     settings = tolerance_settings(args)
-    result = design(spec, simulate=not args.no_sim, simulator=args.simulator)
-    return _emit(result, args, run_tolerance(result, args, settings))
+    apply = None
+    if args.apply_optimum:
+        from ..core.errors import DesignError
+        from ..filters.design import with_choice
+        if args.optimize != "yield":
+            raise DesignError("--apply-optimum goes with --optimize yield (the set it builds)")
+        apply = lambda res, choice: with_choice(res, choice, not args.no_sim, args.simulator)  # noqa: E731
+    result = design(spec, simulate=not args.no_sim and apply is None, simulator=args.simulator)
+    extras = run_tolerance(result, args, settings, apply)
+    return _emit(extras.pop("built", result), args, extras)
 
 
 def _emit(result, args, extras: dict) -> int:

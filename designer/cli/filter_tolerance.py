@@ -59,7 +59,12 @@ def add_filter_tolerance(p, optimize: bool = False):
         g.add_argument("--optimize", choices=("yield",),
                        help="yield: among each stage's E-series candidates, the set with the highest yield against "
                             f"the mask, both sets' yields from the same --monte-carlo N builds (default "
-                            f"{OPTIMIZE_DEFAULT_BUILDS})")
+                            f"{OPTIMIZE_DEFAULT_BUILDS}); reported beside the joint choice, which stays the one "
+                            "built unless --apply-optimum")
+        g.add_argument("--apply-optimum", action="store_true",
+                       help="with --optimize yield: build the yield-optimal set instead (the deck, result.json's "
+                            "stages, the sheet, the SPICE proof and --monte-carlo use it; the joint choice's parts "
+                            "and yield are reported beside it)")
     s = p.add_argument_group("where the builds run (the same result wherever they run)")
     s.add_argument("--jobs", metavar="N", help="local worker processes, 1 to 64 (default 1: this process); with "
                                                "--dask local, the LocalCluster's workers (default 2)")
@@ -131,7 +136,7 @@ def tolerance_settings(args) -> dict | None:
             "scale": Scale(jobs=jobs, dask=dask, work="analytic")}
 
 
-def run_tolerance(result, args, settings: dict | None) -> dict:
+def run_tolerance(result, args, settings: dict | None, apply=None) -> dict:
     """The analyses asked for ``result`` (a FilterDesign).
 
     Parameters
@@ -143,10 +148,15 @@ def run_tolerance(result, args, settings: dict | None) -> dict:
     settings : dict or None
         :func:`tolerance_settings`'s.
 
+    apply : callable, optional
+        ``apply(result, choice)`` -> the design built with the yield-optimal set (``--apply-optimum``):
+        the Monte Carlo and the worst case then run on it.
+
     Returns
     -------
     dict
-        ``monte_carlo``, ``worst_case``, ``optimize``: the results asked (objects).
+        ``monte_carlo``, ``worst_case``, ``optimize``: the results asked (objects); ``built``: the
+        design applied (only with ``apply``).
     """
     from ..tolerance import filter as tf
     out = {}
@@ -156,6 +166,9 @@ def run_tolerance(result, args, settings: dict | None) -> dict:
     if settings["optimize"] == "yield":
         out["optimize"] = tf.optimize_yield(result, settings["n"] or OPTIMIZE_DEFAULT_BUILDS, settings["seed"],
                                             args.sampler, args.dist, tol, limits)
+        if apply is not None:
+            out["optimize"].joint_values = [dict(st.values) for st in result.stages]
+            result = out["built"] = apply(result, out["optimize"].choice)
     if settings["n"] is not None:
         out["monte_carlo"] = tf.filter_monte_carlo(result, settings["n"], settings["seed"], args.sampler, args.dist,
                                                    tol, limits, scale=settings["scale"],
@@ -204,4 +217,4 @@ def tolerance_json(extras: dict) -> dict:
     """
     from ..core.jsonio import json_safe
     names = {"monte_carlo": "monte_carlo", "worst_case": "worst_case", "optimize": "optimize_yield"}
-    return json_safe({names[k]: v.to_dict() for k, v in extras.items()})
+    return json_safe({names[k]: v.to_dict() for k, v in extras.items() if k in names})

@@ -52,7 +52,7 @@ from .topology import SectionTarget
 from .verify import proof_deck, prove
 
 __all__ = ["StageDesign", "FilterDesign", "design", "as_built", "section_plans", "section_name", "stage_candidates", "verify_spice", "predistort",
-           "analysis_grid"]
+           "analysis_grid", "with_choice"]
 
 #: the capacitor values (C1, nearest first) each stage offers the joint search
 C_CHOICES = 3
@@ -216,7 +216,9 @@ class FilterDesign:
                 "bandpass_method": (bandpass_method(s.f_low_hz, s.f_high_hz, s.bandpass_method)
                                     if s.filter_type == "bandpass" else None),
                 "r_series": s.r_series, "c_series": s.c_series, "amplitude_v": s.amplitude_v,
-                "gbw_margin": s.gbw_margin, "compensate_gbw": s.compensate_gbw}
+                "gbw_margin": s.gbw_margin, "compensate_gbw": s.compensate_gbw,
+                # only when given: the reference outputs of a split by the design stay as they are
+                **({"stage_gains": list(s.stage_gains)} if s.stage_gains is not None else {})}
         return json_safe({"tool": "design-filter", "schema_version": SCHEMA_VERSION, "spec": spec,
                           "opamp": self.opamp.to_dict(), "stages": [st.to_dict() for st in self.stages],
                           "figures": dict(self.figures), "spice": self.spice})
@@ -584,16 +586,25 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
                           param="topology")
     families = list(spec.topology) * n if len(spec.topology) == 1 else list(spec.topology)
     swing = min(opamp.vout_max, -opamp.vout_min)
+    if spec.stage_gains is not None:
+        if plans[0].kind == "bandpass":
+            raise DesignError("stage_gains: a narrow band-pass's sections peak at their own fn, their gains are "
+                              "split by the design; give gain only (or bandpass_method wide)", param="stage_gains")
+        if len(spec.stage_gains) != n:
+            raise DesignError(f"stage_gains: give one gain per stage ({n} stages, in build order), got "
+                              f"{len(spec.stage_gains)}", param="stage_gains")
+        strategies = ("given",)
     for strategy in strategies:
-        gains = _split_gains(plans, total_gain, strategy)
+        gains = list(spec.stage_gains) if strategy == "given" else _split_gains(plans, total_gain, strategy)
         peaks, nodes = _node_peaks(plans, gains, spec.amplitude_v, fc)
         if max(nodes) <= swing:
             break
     else:
         worst = int(np.argmax(nodes))
+        change = "--stage-gain" if spec.stage_gains is not None else "--gain"
         raise DesignError(f"amplitude_v: stage {worst + 1}'s output peaks at {nodes[worst]:.3g} V at --amplitude "
                           f"{spec.amplitude_v:g} V, beyond {opamp.name}'s swing of +-{swing:.3g} V; lower "
-                          "--amplitude or --gain", param="amplitude_v")
+                          f"--amplitude or {change}", param="amplitude_v")
     grid = analysis_grid(spec, order, fc)
     limits = None
     if spec.has_mask:
@@ -820,6 +831,45 @@ def _figures(result: FilterDesign, grid: dict, errors, choice, j_joint, examined
         figs["mask_passband_margin_db"] = spec.max_loss_db + h(spec.passband_hz)
         figs["mask_stopband_margin_db"] = -h(spec.stopband_hz) - spec.min_attenuation_db
     return figs
+
+
+def with_choice(result: FilterDesign, choice, simulate: bool = False, simulator: str = "ngspice-cli") -> FilterDesign:
+    """``result`` built with another candidate of each stage (``--optimize yield --apply-optimum``: the
+    yield-optimal set): the achieved figures (``f3_hz``, ``passband_deviation_db``, the mask margins) are the
+    new set's, ``error_built_db`` its worst deviation on the joint search's objective; ``error_joint_db``
+    and the other search figures stay the joint choice's, reported beside it.
+
+    Parameters
+    ----------
+    result : FilterDesign
+        The design (its stages' candidates).
+    choice : sequence of int
+        Per stage, the candidate index to build.
+    simulate : bool
+        Also run the SPICE proof of the new set.
+    simulator : str
+        ``ngspice-cli`` or ``pyspice``.
+
+    Returns
+    -------
+    FilterDesign
+        A new design; ``result`` is left as it is.
+    """
+    import dataclasses
+    stages = [dataclasses.replace(st, chosen=int(c)) for st, c in zip(result.stages, choice)]
+    out = FilterDesign(result.spec, result.order, result.fc_hz, stages)
+    grid = analysis_grid(result.spec, result.order, result.fc_hz)
+    errors = [st.errors for st in stages]
+    f = result.figures
+    figs = _figures(out, grid, errors, list(choice), None, f.get("examined", 0), f.get("candidates_s", 0.0),
+                    f.get("search_s", 0.0))
+    out.figures = {**f, **{k: figs[k] for k in ("f3_hz", "passband_deviation_db", "mask_passband_margin_db",
+                                                "mask_stopband_margin_db") if k in figs},
+                   "error_built_db": objective(errors, list(choice)), "built": "yield-optimal"}
+    if simulate:
+        out.proof = prove(out, simulator)
+        out.spice = out.proof.to_dict()
+    return out
 
 
 def verify_spice(result: FilterDesign, simulator: str = "ngspice-cli") -> dict:

@@ -71,6 +71,8 @@ class FilterSpec(PartBounds):
         The stages (numbered 1.. in rising Q) in the order to build them; None: rising Q.
     gain : float
         Passband gain magnitude, 1..100 V/V.
+    stage_gains : tuple of float or None
+        Each stage's gain in build order, 1..100 V/V each, their product ``gain``; None: split by the design.
     opamp : str
         Catalogue name (:mod:`designer.core.opamps`).
     amplitude_v : float
@@ -102,6 +104,7 @@ class FilterSpec(PartBounds):
     topology: object = "sallen-key"
     stage_order: tuple | None = None
     gain: float = 1.0
+    stage_gains: tuple | None = None
     opamp: str = "LM741"
     amplitude_v: float = 1.0
     gbw_margin: float = 100.0
@@ -156,6 +159,19 @@ class FilterSpec(PartBounds):
             except ValueError:
                 raise DesignError(f"stage_order must be stage numbers such as 2,1,3, got {so!r}",
                                   param="stage_order") from None
+        if self.stage_gains is not None:
+            self._check_stage_gains()
+
+    def _check_stage_gains(self) -> None:
+        sg = self.stage_gains
+        items = str(sg).split(",") if isinstance(sg, str) else list(sg)
+        gains = tuple(parse_in_range(str(x).strip(), "stage_gains", "gain") for x in items)
+        product = math.prod(gains)
+        if not math.isclose(product, self.gain, rel_tol=1e-9):
+            shown = " x ".join(f"{g:g}" for g in gains)
+            raise ParamError(f"{{stage_gains}}: {shown} = {product:.6g} is not {{gain}} {self.gain:g}; give stage "
+                             "gains whose product is the passband gain")
+        object.__setattr__(self, "stage_gains", gains)
 
     def _check_band(self, given: list) -> None:
         put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731

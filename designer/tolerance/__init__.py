@@ -18,8 +18,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "mcspec": ("MonteCarloSpec", "plant_tolerance"),
     "chunks": ("lost_twice", "run_chunk",),
     "cluster": ("CONNECT_TIMEOUT", "ClusterStart", "DaskPool", "WORKERS", "cluster_ahead", "parse_dask", "probe",),
-    "filter": ("BANDPASS_FIGURES", "FilterContext", "FilterMonteCarlo", "LOWHIGH_FIGURES", "YieldOptimum",
-               "figures_of", "filter_monte_carlo", "filter_worst_case", "mask_limits", "nominal_parts",
+    "filter": ("BANDPASS_FIGURES", "FilterContext", "FilterMonteCarlo", "LOWHIGH_FIGURES",
+               "YieldOptimum", "figures_of", "filter_monte_carlo", "filter_spec_yield", "filter_worst_case", "mask_limits", "nominal_parts",
                "optimize_yield", "series_of", "spice_context", "stage_responses",),
     "loop": ("LIMITABLE", "LoopContext", "STEP_POINTS", "kick_grid", "loop_figures", "loop_monte_carlo",
              "loop_parts", "loop_series", "loop_worst_case", "parse_loop_limit",),
@@ -36,5 +36,5 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "spice_mc": ("plant_monte_carlo_engine", "replay_values", "spice_samples",),
     "stats": ("Limit", "Z95", "figure_stats", "variance_shares", "wilson",),
     "worstcase": ("WorstCase", "worst_case",),
-    "yields": ("ENGINES", "LOOP", "PLANT", "TABLES", "counted", "spec_yield",),
+    "yields": ("ENGINES", "FILTER", "LOOP", "PLANT", "TABLES", "counted", "spec_yield",),
 })

@@ -51,11 +51,12 @@ from ..filters.verify import mask_edges
 from . import runner, sampling
 from .montecarlo import check_draw
 from .parts import resolve
-from .stats import Limit, figure_stats, parse_limit, variance_shares, wilson
+from .stats import Limit, failing_samples, figure_stats, parse_limit, variance_shares, wilson
 
 __all__ = ["LOWHIGH_FIGURES", "BANDPASS_FIGURES", "FilterContext", "FilterMonteCarlo", "YieldOptimum", "figures_of",
            "context", "nominal_parts", "series_of", "mask_limits", "stage_responses", "evaluate", "spice_context",
-           "spice_evaluate", "filter_monte_carlo", "filter_worst_case", "optimize_yield"]
+           "spice_evaluate", "filter_monte_carlo", "filter_worst_case", "optimize_yield",
+           "filter_spec_yield"]
 
 #: the figures of a low- or high-pass
 LOWHIGH_FIGURES = ("passband_loss_db", "ripple_db", "f3_hz", "stopband_attenuation_db", "group_delay_s")
@@ -143,7 +144,7 @@ def series_of(result) -> dict:
     return {"R": result.spec.r_series, "C": result.spec.c_series}
 
 
-def context(result, stage_values=None) -> FilterContext:
+def context(result, stage_values=None, edges=None) -> FilterContext:
     """The analytic engine's context of ``result`` (its chosen parts, or ``stage_values``: one
     designator -> value dict per stage, for another candidate set).
 
@@ -153,6 +154,9 @@ def context(result, stage_values=None) -> FilterContext:
         The design.
     stage_values : list of dict, optional
         Per stage its part values (default the chosen ones).
+    edges : tuple, optional
+        (passband edge, stopband edge) to judge at, such as a check spec's own ``mask:``
+        (default :func:`designer.filters.verify.mask_edges`).
 
     Returns
     -------
@@ -160,7 +164,7 @@ def context(result, stage_values=None) -> FilterContext:
         Frequencies and each stage's op-amp factor.
     """
     kind = result.spec.filter_type
-    fp, fs = mask_edges(result)
+    fp, fs = edges if edges is not None else mask_edges(result)
     f3 = result.figures["f3_target_hz"]
     groups = {}
     if kind == "bandpass":
@@ -546,6 +550,10 @@ class FilterMonteCarlo:
         The part and the stage whose tolerance halved raises the yield most.
     spice : dict or None
         The SPICE engine on the first builds: its yield and the disagreement.
+    values : dict
+        Designator -> the builds' values (the draws).
+    engine : str
+        The engine that computed the figures.
     """
 
     n: int
@@ -562,6 +570,13 @@ class FilterMonteCarlo:
     shares: dict = field(default_factory=dict)
     tighten: dict | None = None
     spice: dict | None = None
+    values: dict = field(default_factory=dict, repr=False)
+    engine: str = "analytic"
+
+    @property
+    def failing(self) -> dict:
+        """Limited figure -> {count, worst}: the builds outside its window (:func:`~.stats.failing_samples`)."""
+        return failing_samples(self.figures, self.limits)
 
     @property
     def yield_count(self) -> int:
@@ -627,7 +642,7 @@ class FilterMonteCarlo:
 
 def filter_monte_carlo(result, n: int, seed: int = 0, sampler: str = "random", dist: str = "uniform",
                        tol_items=(), limit_items=(), tighten: bool = True, scale=None, spice_samples: int = 0,
-                       simulator: str = "ngspice-cli") -> FilterMonteCarlo:
+                       simulator: str = "ngspice-cli", edges=None) -> FilterMonteCarlo:
     """A Monte Carlo of ``result``'s chosen parts against its mask (module docstring).
 
     Parameters
@@ -649,6 +664,8 @@ def filter_monte_carlo(result, n: int, seed: int = 0, sampler: str = "random", d
         yield of both engines on them and their disagreement.
     simulator : str
         ``ngspice-cli`` or ``pyspice``.
+    edges : tuple, optional
+        (passband edge, stopband edge) the figures are taken at (:func:`context`).
 
     Returns
     -------
@@ -659,7 +676,7 @@ def filter_monte_carlo(result, n: int, seed: int = 0, sampler: str = "random", d
     limits = mask_limits(result, limit_items)
     nominal = nominal_parts(result)
     tol = resolve(tol_items, nominal, series_of(result))
-    ctx = context(result)
+    ctx = context(result, edges=edges)
     draw = runner.Draw(nominal, tol.of, n, seed, sampler, dist)
     with runner.Runner(scale or runner.Scale()) as run:
         values, figs, _ = run.run(evaluate, ctx, draw)
@@ -669,7 +686,7 @@ def filter_monte_carlo(result, n: int, seed: int = 0, sampler: str = "random", d
     rel = {r: values[r] / nominal[r] - 1 for r in values}
     shares = {k: variance_shares(rel, figs[k]) for k in by_fig}
     mc = FilterMonteCarlo(n, seed, sampler, dist, dict(tol.of), nominal, nom, figs, limits,
-                          _passed(figs, limits) if limits else None, stats, shares)
+                          _passed(figs, limits) if limits else None, stats, shares, values=values)
     if tighten and limits:
         mc.tighten = _tighten(result, ctx, mc)
     if spice_samples:
@@ -769,6 +786,8 @@ class YieldOptimum:
         The stages whose parts changed.
     tried : int
         Candidate sets evaluated.
+    joint_values : list of dict or None
+        Per stage the joint choice's parts, when the found set is the one built (``--apply-optimum``).
     """
 
     choice: list
@@ -781,6 +800,7 @@ class YieldOptimum:
     ci_optimum: tuple
     changed: list
     tried: int
+    joint_values: list | None = None
 
     def to_dict(self) -> dict:
         """The optimum as JSON."""
@@ -788,7 +808,11 @@ class YieldOptimum:
                 "samples": self.n, "seed": self.seed, "yield_joint": self.yield_nominal,
                 "ci95_joint": list(self.ci_nominal), "yield_optimized": self.yield_optimum,
                 "ci95_optimized": list(self.ci_optimum), "stages_changed": self.changed, "sets_tried": self.tried,
-                "parts": [{k: float(v) for k, v in vals.items()} for vals in self.values]}
+                "parts": [{k: float(v) for k, v in vals.items()} for vals in self.values],
+                # only when applied: without --apply-optimum the JSON stays as it was
+                **({"applied": True, "joint_parts": [{k: float(v) for k, v in vals.items()}
+                                                     for vals in self.joint_values]}
+                   if self.joint_values is not None else {})}
 
     def lines(self) -> list:
         """The summary's lines."""
@@ -796,10 +820,16 @@ class YieldOptimum:
         out = [f"Yield-optimal parts ({self.n} builds, seed {self.seed}, the same draws for both): joint choice "
                f"{100 * self.yield_nominal:.2f} %, optimized {100 * self.yield_optimum:.2f} % "
                f"(stages changed: {', '.join(map(str, self.changed)) or 'none'}; {self.tried} sets tried)"]
+        def shown(parts, i):
+            return ", ".join(f"{r[0]}{i}0{r[1:]} {format_eng(v, 'Ohm' if r.startswith('R') else 'F')}"
+                             for r, v in parts.items())
         for i in self.changed:
-            parts = self.values[i - 1]
-            out.append(f"  stage {i}: " + ", ".join(
-                f"{r[0]}{i}0{r[1:]} {format_eng(v, 'Ohm' if r.startswith('R') else 'F')}" for r, v in parts.items()))
+            out.append(f"  stage {i}: {shown(self.values[i - 1], i)}")
+        if self.joint_values is not None:
+            out.append("  built: the yield-optimal set (the stages above, the deck, result.json, the sheet); the "
+                       "joint choice had" + "".join(f" stage {i}: {shown(self.joint_values[i - 1], i)};"
+                                                    for i in self.changed).rstrip(";")
+                       + ("" if self.changed else " the same parts"))
         return out
 
 
@@ -883,3 +913,38 @@ def optimize_yield(result, n: int = 2000, seed: int = 0, sampler: str = "random"
     return YieldOptimum(choice, [st.candidates[c] for st, c in zip(result.stages, choice)], y0, best, n, seed,
                         wilson(k0, n), wilson(k1, n), [i + 1 for i, (a, b) in enumerate(zip(start, choice)) if a != b],
                         tried)
+
+
+# ---- check-design's yield (kind: filter) ---------------------------------------------------------
+def filter_spec_yield(result, mask, limits, samples: int, seed: int, tol_items=(),
+                      sampler: str = "random", dist: str = "uniform") -> FilterMonteCarlo:
+    """The yield of one corner's designed filter within a check spec's ``limits`` (its checks on the
+    figures this engine has, :data:`designer.tolerance.yields.FILTER`; the ``mask:``'s among them).
+
+    The builds are :func:`filter_monte_carlo`'s (the analytic engine, every part of every stage within
+    its tolerance), judged at the spec's mask edges when it has ``mask:``, else the design's own; two
+    limits on one figure both hold.
+
+    Parameters
+    ----------
+    result : designer.filters.FilterDesign
+        The corner's design.
+    mask : dict or None
+        The spec's ``{passband, max_loss, stopband, min_attenuation}``.
+    limits : sequence of designer.tolerance.stats.Limit
+        The windows a build must be inside.
+    samples, seed : int
+        The Monte Carlo's builds and seed.
+    tol_items : sequence of str
+        ``--tol`` items (``R=1%``) from the spec's ``tolerances:``.
+    sampler, dist : str
+        How the builds are drawn.
+
+    Returns
+    -------
+    FilterMonteCarlo
+        The Monte Carlo (its draws kept: :class:`designer.tolerance.yields.YieldVerdict` names the worst build).
+    """
+    edges = None if mask is None else (mask["passband"], mask["stopband"])
+    return filter_monte_carlo(result, samples, seed, sampler, dist, tol_items, tuple(limits), tighten=False,
+                              edges=edges)

@@ -14,6 +14,10 @@ figures a check names (``overshoot_pct``, ``peak_time_s``, ``rise_time_s``,
 ``settling_time_s``) from those runs (:data:`PLANT_SPICE`, :data:`LOOP_SPICE`); the
 other figures (``fn_hz``, the gains, the margins, ``model_*``) stay the models',
 as check-design reads them on the nominal build.
+
+A designed filter (``kind: filter``) counts its checks on :data:`FILTER`'s figures
+(the mask's among them) on :func:`designer.tolerance.filter.filter_spec_yield`'s builds:
+the analytic engine only, its SPICE comparison is analyze-filter's ``--spice-samples``.
 """
 
 from __future__ import annotations
@@ -24,7 +28,7 @@ from ..core.units import format_eng
 from .loop import LIMITABLE, STANDS_IN
 from .stats import Limit
 
-__all__ = ["ENGINES", "LOOP", "PLANT", "TABLES", "counted", "spec_yield"]
+__all__ = ["ENGINES", "FILTER", "LOOP", "PLANT", "TABLES", "counted", "spec_yield"]
 
 #: check-design's plant figure -> the analytic plant engine's (designer.tolerance.plant.FIGURES)
 PLANT = {**{f: f for f in ("fn_hz", "zeta", "q", "ideal_fn_hz", "ideal_zeta", "ideal_q", "gain", "overshoot_pct",
@@ -33,7 +37,9 @@ PLANT = {**{f: f for f in ("fn_hz", "zeta", "q", "ideal_fn_hz", "ideal_zeta", "i
          "model_peak_time_s": "peak_time_s"}
 #: check-design's loop figure -> the analytic loop engine's (designer.tolerance.loop.FIGURES)
 LOOP = {**{f: f for f in LIMITABLE}, **STANDS_IN}
-BY_KIND = {"plant": PLANT, "pid": LOOP}
+#: check-design's filter figure -> the filter engine's (designer.tolerance.filter: the same op-amp-aware figures)
+FILTER = {f: f for f in ("passband_loss_db", "stopband_attenuation_db", "f3_hz", "f3_low_hz", "f3_high_hz")}
+BY_KIND = {"plant": PLANT, "pid": LOOP, "filter": FILTER}
 #: the SPICE step figures a check may name, counted from each build's ngspice run
 SPICE_STEP = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
 #: check-design's plant figure -> the SPICE engine's (the models' besides SPICE's ``spice_*``)
@@ -52,7 +58,7 @@ def counted(kind: str, checks, engine: str = "analytic") -> tuple:
     Parameters
     ----------
     kind : str
-        ``plant`` or ``pid``.
+        ``plant``, ``pid`` or ``filter``.
     checks : sequence of designer.check.limits.Limit
         The spec's checks.
     engine : str
@@ -140,9 +146,9 @@ def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int,
     Parameters
     ----------
     kind : str
-        ``plant`` or ``pid``.
-    res : designer.plant.result.PlantResult or designer.pid.result.PidResult
-        The corner's design.
+        ``plant``, ``pid`` or ``filter``.
+    res : designer.plant.result.PlantResult or designer.pid.result.PidResult or FilterRun
+        The corner's design (a filter: check-design's run, :func:`designer.tolerance.filter.filter_spec_yield`).
     checks : sequence of designer.check.limits.Limit
         The spec's checks.
     required : float
@@ -173,6 +179,10 @@ def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int,
     table = TABLES[engine][kind]
     limits = tuple(Limit(table[c.figure], c.min, c.max) for c in use)
     names = {table[c.figure]: c.figure for c in use}
+    if kind == "filter":   # a FilterRun of check-design: its design and the spec's mask
+        from .filter import filter_spec_yield
+        mc = filter_spec_yield(res.design, res.case.mask, limits, samples, seed, tol_items, sampler, dist)
+        return YieldVerdict(mc, required, names, skipped)
     if kind == "plant":
         s = res.sourcing
         evaluate = None

@@ -64,6 +64,16 @@ def test_designed_spec_loads_a_design_per_corner_and_the_mask_as_checks(tmp_path
     ("kind: filter\nstages:\n  - {topology: rc-lowpass, parts: {R1: 1k, C1: -1n}}\nchecks: {f3_hz: {max: 1k}}\n",
      "must be positive"),
     ("kind: filter\nfilter: {order: 4, fc: 1k}\nstages: []\nchecks: {f3_hz: {max: 1k}}\n", "one of them"),
+    ("kind: filter\nfilter: {order: 4, fc: 1k}\nchecks: {f3_hz: {max: 1k}}\nyield: {min: 95%, engine: spice}\n",
+     "a filter's yield has the analytic engine only"),
+    ("kind: filter\nfilter: {order: 4, fc: 1k}\nchecks: {spice_f3_hz: {max: 1k}}\nyield: {min: 95%}\n",
+     "none of them limits a figure the analytic engine computes"),
+    ("kind: filter\nfilter: {order: 4, fc: 1k}\nchecks: {f3_hz: {max: 1k}}\ntolerances: {R: 1%}\n",
+     "give yield: {min: 95%} too"),
+    ("kind: filter\nfilter: {order: 4, fc: 1k}\nchecks: {f3_hz: {max: 1k}}\nyield: {min: 95%}\n"
+     "tolerances: {R1: 1%}\n", "tolerances"),
+    ("kind: filter\nstages:\n  - {topology: rc-lowpass, parts: {R1: 1k, C1: 1n}}\nchecks: {f3_hz: {max: 1k}}\n"
+     "yield: {min: 95%}\n", "stages: (as built) are checked as they are"),
 ])
 def test_refusals_are_one_line(tmp_path, text, words):
     msg = refusal(write(tmp_path, text))
@@ -121,3 +131,70 @@ def test_a_broken_mask_fails_on_the_model_and_on_spice(tmp_path):
     assert status["stopband_attenuation_db"] == "fail" and status["spice_stopband_attenuation_db"] == "fail"
     assert status["passband_loss_db"] == "pass" and status["f3_hz"] == "pass"
     assert out.design["figures"]["stopband_attenuation_db"] < 60
+
+
+YIELD = DESIGNED.replace("[TL072, NE5532]", "TL072") + """tolerances: {R: 1%, C: 5%}
+    yield: {min: 99%, samples: 300, seed: 7}
+    """
+
+
+def _build(res, values, i) -> list:
+    """Build ``i``'s stages (topology, parts) from the cascade designators' draws (R101 is stage 1's R1)."""
+    out = []
+    for k, st in enumerate(res.stages, 1):
+        topo = get(st.topology)
+        out.append((st.topology, {r: float(values[topo.prefixed(r, f"{k}0")][i]) for r in topo.designators}))
+    return out
+
+
+@pytest.mark.spice
+def test_yield_counts_the_builds_inside_the_checks_and_the_mask(tmp_path):
+    from designer.tolerance import runner
+    from designer.tolerance.filter import nominal_parts, series_of
+    from designer.tolerance.parts import resolve
+    spec = load_spec(write(tmp_path, YIELD))
+    y = spec.yield_spec
+    assert (y.min, y.samples, y.seed, y.tolerances) == (0.99, 300, 7, ("R=1.0%", "C=5.0%"))
+    out = run_corner(spec, 0, "ngspice-cli")
+    case = next(c for c in out.cases if c.id == "yield")
+    mc = out.design["monte_carlo"]
+    assert mc["yield"]["samples"] == 300 and case.value == mc["yield"]["fraction"]
+    lo, hi = mc["yield"]["ci95"]
+    assert lo <= case.value <= hi
+    # brute force: every build's figures from the check's own dense-grid model with the exact op-amp
+    # response, judged against the same limits, agree with the engine's verdict build by build
+    res = run_filter(spec.designs[0], "ngspice-cli").design
+    nominal = nominal_parts(res)
+    tol = resolve(y.tolerances, nominal, series_of(res))
+    values = runner.Draw(nominal, tol.of, y.samples, y.seed, y.sampler, y.dist).values()
+    amp = opamps.get("TL072")
+    mask = spec.designs[0].mask
+    checks = [c for c in spec.checks if not c.figure.startswith("spice_")]
+    passed = 0
+    for i in range(y.samples):
+        figs = filter_figures(_build(res, values, i), amp, 0.0, mask, None)
+        passed += all(c.judge(figs[c.figure])[0] for c in checks)
+    assert passed / y.samples == pytest.approx(case.value, abs=2 / y.samples)
+    assert 0 < case.value < 1   # the f3_hz window cuts some builds: not trivially all or none
+    assert case.status == ("pass" if case.value >= 0.99 else "fail")
+    assert "95 % Wilson interval" in case.message and "not counted, no engine figure: spice_passband_loss_db" \
+        in case.message
+
+
+@pytest.mark.spice
+def test_a_yield_below_its_minimum_names_the_figure_that_loses_most(tmp_path):
+    text = YIELD.replace("f3_hz: {min: 950, max: 1050}", "f3_hz: {min: 995, max: 1005}")
+    out = run_corner(load_spec(write(tmp_path, text)), 0, "ngspice-cli")
+    case = next(c for c in out.cases if c.id == "yield")
+    assert case.status == "fail" and "below min 99 %" in case.message
+    assert "f3_hz loses most" in case.message and "outside 995 Hz to 1.005 kHz" in case.message
+    assert "the corner (build " in case.message and "R101 " in case.message
+
+
+def test_stage_gain_in_a_spec(tmp_path):
+    text = DESIGNED.replace("order: 4, fc: 1k}", "order: 6, fc: 1k, gain: 4, stage_gain: '2,2,1'}").replace(
+        "[TL072, NE5532]", "TL072")
+    spec = load_spec(write(tmp_path, text))
+    assert spec.designs[0].spec.stage_gains == (2.0, 2.0, 1.0)
+    msg = refusal(write(tmp_path, text.replace("'2,2,1'", "'2,3,1'"), "bad.yaml"))
+    assert "filter.stage_gain: 2 x 3 x 1 = 6 is not filter.gain 4" in msg, msg

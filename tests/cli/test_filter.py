@@ -34,6 +34,18 @@ from designer.cli.filter import analyze_filter_main, design_filter_main
      "the band's edges cross: --f-low (1100 Hz) is not below --f-high (900 Hz)"),
     (["--type", "bandpass", "--order", "2", "--fc", "1k"], "a bandpass takes its edges"),
     (["--order", "2", "--fc", "1k", "--f-low", "900"], "band edges are for a bandpass"),
+    (["--order", "4", "--fc", "1k", "--apply-optimum"], "--apply-optimum goes with --optimize yield"),
+    (["--order", "6", "--fc", "1k", "--gain", "4", "--stage-gain", "2,3,1"],
+     "--stage-gain: 2 x 3 x 1 = 6 is not --gain 4"),
+    (["--order", "6", "--fc", "1k", "--gain", "4", "--stage-gain", "2,2"],
+     "--stage-gain: give one gain per stage (3 stages, in build order), got 2"),
+    (["--order", "6", "--fc", "1k", "--gain", "4", "--stage-gain", "4,0.5,2"], "--stage-gain must be 1 to 100"),
+    (["--order", "6", "--fc", "1k", "--gain", "4", "--stage-gain", "2,x,2"], "--stage-gain"),
+    (["--order", "6", "--fc", "1k", "--gain", "100", "--stage-gain", "1,1,100", "--opamp", "TL072"],
+     "stage 3's output peaks at 100 V at --amplitude 1 V, beyond TL072's swing of +-13.5 V; lower --amplitude "
+     "or --stage-gain"),
+    (["--type", "bandpass", "--order", "2", "--f-low", "900", "--f-high", "1.1k", "--gain", "2", "--stage-gain",
+      "2,1"], "--stage-gain: a narrow band-pass's sections peak at their own fn"),
 ])
 def test_bad_input_is_one_line_exit_2(argv, words, capsys):
     assert design_filter_main(argv + ["--no-sim"]) == 2
@@ -226,3 +238,33 @@ def test_analyze_filter_per_stage_bad_input(argv, words, capsys):
 def test_analyze_filter_from_and_target_exclude_each_other(designed, capsys):
     assert analyze_filter_main(["--from", str(designed), "--target", "--order 2 --fc 1k", "--no-sim"]) == 2
     assert "give one or the other" in capsys.readouterr().err
+
+
+def test_design_filter_apply_optimum_builds_the_yield_optimal_set(capsys):
+    argv = ["--family", "chebyshev", "--passband", "1k", "--max-loss", "1", "--stopband", "2k", "--min-attenuation",
+            "40", "--topology", "mfb", "--opamp", "TL072", "--no-sim", "--json", "--monte-carlo", "600", "--seed", "5",
+            "--optimize", "yield"]
+    assert design_filter_main(argv) == 0
+    joint = json.loads(capsys.readouterr().out)
+    assert "applied" not in joint["optimize_yield"]   # without --apply-optimum: as before, the joint set built
+    assert design_filter_main(argv + ["--apply-optimum"]) == 0
+    built = json.loads(capsys.readouterr().out)
+    o = built["optimize_yield"]
+    assert o["applied"] and o["joint_parts"] == [s["parts"] for s in joint["stages"]]
+    assert [s["parts"] for s in built["stages"]] == o["parts"]
+    # the same draws: the built set's Monte Carlo yield is the optimum's, never below the joint one's
+    assert built["monte_carlo"]["yield"]["fraction"] == pytest.approx(o["yield_optimized"])
+    assert joint["monte_carlo"]["yield"]["fraction"] == pytest.approx(o["yield_joint"])
+    assert o["yield_optimized"] >= o["yield_joint"]
+    f = built["figures"]
+    assert f["built"] == "yield-optimal" and f["error_joint_db"] == joint["figures"]["error_joint_db"]
+    assert f["error_built_db"] >= f["error_joint_db"] - 1e-12   # the joint choice is the least error
+    assert f["f3_hz"] != joint["figures"]["f3_hz"] or o["stages_changed"] == []
+
+
+def test_design_filter_apply_optimum_summary_names_what_is_built(capsys):
+    argv = ["--family", "chebyshev", "--passband", "1k", "--max-loss", "1", "--stopband", "2k", "--min-attenuation",
+            "40", "--topology", "mfb", "--opamp", "TL072", "--no-sim", "--optimize", "yield", "--monte-carlo", "300",
+            "--apply-optimum"]
+    assert design_filter_main(argv) == 0
+    assert "built: the yield-optimal set" in capsys.readouterr().out

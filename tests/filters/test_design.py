@@ -8,11 +8,14 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as hst
 
 from designer.core.errors import DesignError
 from designer.core.opamps import get as get_opamp
 from designer.filters import FilterSpec, design
 from designer.filters.prototype import reference_response
+from designer.filters.registry import get
 
 
 def test_butterworth_4th_order_lowpass_figures():
@@ -65,6 +68,40 @@ def test_topology_per_stage():
     d = design(FilterSpec(order=4, fc_hz=1e3, topology=("mfb", "sallen-key")))
     assert [st.topology for st in d.stages] == ["mfb-lowpass", "sallen-key-lowpass"]
     assert d.figures["inverting"]
+
+
+@pytest.mark.parametrize("gains", [(2.0, 2.0, 1.0), (1.0, 1.0, 4.0), (4.0, 1.0, 1.0)])
+def test_stage_gains_given_per_stage(gains):
+    d = design(FilterSpec(order=6, fc_hz=1e3, gain=4.0, stage_gains=",".join(map(str, gains)), opamp="TL072"))
+    assert tuple(stage.gain for stage in d.stages) == gains
+    assert d.to_dict()["spec"]["stage_gains"] == list(gains)
+    # each stage's peak gain is its own response's, from its gain: brute force over a dense grid
+    f = np.geomspace(10.0, 1e5, 20001)
+    for stage in d.stages:
+        h = get(stage.topology).response(stage.continuous, 2j * math.pi * f)   # the ideal section of its target
+        assert stage.peak_gain == pytest.approx(np.max(np.abs(h)), rel=1e-3)
+        assert stage.peak_gain >= stage.gain * (1 - 1e-5)   # the grid starts at fc/1000, not DC
+    # the chosen parts' passband gain is the asked one, and the per-stage split is not the design's own
+    h0 = d.cascade().response(np.array([2j * math.pi * 10.0]))
+    assert abs(h0[0]) == pytest.approx(4.0, rel=0.05)
+    assert "stage_gains" not in design(FilterSpec(order=6, fc_hz=1e3, gain=4.0)).to_dict()["spec"]
+
+
+@given(hst.lists(hst.floats(1.0, 10.0), min_size=1, max_size=5), hst.floats(1.0, 100.0))
+@settings(max_examples=60, deadline=None)
+def test_stage_gains_must_multiply_to_the_gain(gains, gain):
+    product = math.prod(gains)
+    if product > 100:
+        return
+    text = ",".join(repr(g) for g in gains)
+    if math.isclose(product, gain, rel_tol=1e-9):
+        assert FilterSpec(order=4, fc_hz=1e3, gain=gain, stage_gains=text).stage_gains == tuple(gains)
+    else:
+        with pytest.raises(DesignError, match="stage_gains: .* is not gain") as e:
+            FilterSpec(order=4, fc_hz=1e3, gain=gain, stage_gains=text)
+        assert "\n" not in str(e.value)
+    spec = FilterSpec(order=4, fc_hz=1e3, gain=product, stage_gains=text)
+    assert spec.stage_gains == tuple(gains)
 
 
 def test_mask_design_meets_the_mask():
@@ -200,3 +237,21 @@ def test_bandpass_orders_agree_with_spice(family, order):
     assert d.spice["max_deviation_passband_db"] < 0.1
     assert d.spice["max_deviation_60db_db"] < 0.5
     assert d.spice["nrms"]["ac_opamp"] < 1 and d.spice["nrms"]["tran_opamp"] < 1
+
+
+def test_with_choice_rebuilds_the_achieved_figures():
+    from designer.filters.design import with_choice
+    d = design(FilterSpec(order=4, fc_hz=1e3, opamp="TL072"))
+    same = with_choice(d, [s.chosen for s in d.stages])
+    for k in ("f3_hz", "passband_deviation_db", "error_joint_db"):
+        assert same.figures[k] == pytest.approx(d.figures[k], rel=1e-12), k
+    assert same.figures["error_built_db"] == pytest.approx(d.figures["error_joint_db"], rel=1e-12)
+    other = [(s.chosen + 1) % len(s.candidates) for s in d.stages]
+    moved = with_choice(d, other)
+    assert [s.chosen for s in d.stages] != other   # the original is left as it was
+    assert [s.values for s in moved.stages] == [s.candidates[c] for s, c in zip(d.stages, other)]
+    # the -3 dB point of the new parts, by brute force on a dense grid
+    f = np.geomspace(500, 2e3, 200001)
+    g = 20 * np.log10(np.abs(moved.cascade().response(2j * math.pi * f, get_opamp("TL072"))))
+    assert moved.figures["f3_hz"] == pytest.approx(f[np.flatnonzero(g >= -10 * math.log10(2))[-1]], rel=1e-4)
+    assert moved.figures["error_joint_db"] == d.figures["error_joint_db"]
