@@ -127,10 +127,47 @@ def misses(plant: str, best) -> list:
     return out
 
 
+# the library's gaps (reported to the lead with these numbers), not the data's
+CHIRP = ("identify_record raises on a chirp: examine_input does not read it as broadband, and the step methods "
+         "refuse it ('no usable step in the response', or 'the square wave is too fast' for the underdamped "
+         "plant): a chirp has no route to the output-error fit")
+INTEGRATING = ("no integrating structure in assess.OE_KINDS: under a random binary input no model is valid and "
+               "the record is refused as 'too short for the plant's dead time plus settling' (the best-fitting "
+               "model a lead-lag or SOPDT of 7.8 ks); fit_output_error(kind='integrating', initial='estimate') on "
+               "the estimation part gives K 0.24 /s, theta 4.5 s at rb0.5/10 dB (true 0.3 /s, 1.1 s); under a "
+               "step the step methods refuse the ramp ('the record ends before the response settles') or no "
+               "model is valid")
+# what the data cannot give to the tolerance (measured, seed 28)
+# (the best model's validation fit is the true model's to 0.05 point in each: the data cannot tell them apart)
+_SAME = "; its fit {} equals the true model's {}"
+DATA = {
+    ("fopdt", "step", 10): "a step at 10 dB: theta 1.404 s (true 1.3 s, +8.0 %)" + _SAME.format(69.70, 69.69),
+    ("sopdt", "rb0.1", 10): ("random binary p 0.1 at 10 dB: K 1.537 (+2.5 %), the short lag 1.612 s (true 1.5 s, "
+                             "+7.5 %), theta 0.816 s (true 0.9 s, -9.4 %)" + _SAME.format(67.07, 67.06)),
+    ("sopdt", "rb0.5", 10): ("random binary p 0.5 at 10 dB: the short lag 1.402 s (-6.5 %), theta 0.945 s "
+                             "(+5.0 %)" + _SAME.format(36.73, 36.76)),
+    ("sopdt", "step", 20): ("a step at 20 dB: the lags 1.304 s and 4.214 s (true 1.5 s, -13.1 %, and 4 s, +5.3 %)"
+                            + _SAME.format(90.01, 90.01)),
+    ("sopdt", "step", 10): ("a step at 10 dB: the short lag 1.407 s (-6.2 %), theta 1.076 s (true 0.9 s, +19.6 %)"
+                            + _SAME.format(69.68, 69.68)),
+    ("underdamped", "step", 10): ("a step at 10 dB: theta 0.597 s (true 0.5 s, +19.4 %)"
+                                  + _SAME.format(69.71, 69.67)),
+}
+
+
+def _case(plant, inp, snr):
+    why = CHIRP if inp == "chirp" else INTEGRATING if plant == "integrating" else DATA.get((plant, inp, snr))
+    if why is None:
+        return pytest.param(plant, inp, snr, id=f"{plant}-{inp}-{snr}dB")
+    strict = inp == "chirp" or plant == "integrating"
+    return pytest.param(plant, inp, snr, id=f"{plant}-{inp}-{snr}dB",
+                        marks=pytest.mark.xfail(reason=why, strict=strict))
+
+
 CASES = [(plant, inp, snr) for plant in PLANTS for inp in INPUTS for snr in (20, 10)]
 
 
-@pytest.mark.parametrize("plant, inp, snr_db", CASES)
+@pytest.mark.parametrize("plant, inp, snr_db", [_case(*c) for c in CASES])
 def test_best_model_recovers_the_plant(plant, inp, snr_db):
     r = run(plant, inp, snr_db)
     best = r["best"]
