@@ -170,6 +170,7 @@ CASES = [(plant, inp, snr) for plant in PLANTS for inp in INPUTS for snr in (20,
 @pytest.mark.parametrize("plant, inp, snr_db", [_case(*c) for c in CASES])
 def test_best_model_recovers_the_plant(plant, inp, snr_db):
     r = run(plant, inp, snr_db)
+    assert r["a"].hold == "zoh"     # the inputs hold their level between samples
     best = r["best"]
     assert not misses(plant, best), (misses(plant, best), None if best is None else best.params)
     assert best.fit_percent >= r["truth"] - 1.0, (best.label, best.fit_percent, r["truth"])
