@@ -44,7 +44,7 @@ from .frequency import wide_interval
 from .outputerror import fit_output_error, simulate
 from .validation import Split, Validation, validate
 
-__all__ = ["ROUTES", "ESTIMATION_FRACTION", "MAX_SAMPLES", "OE_KINDS", "FOH_MARGIN", "HELD_LEVELS", "Candidate", "Assessment",
+__all__ = ["ROUTES", "ESTIMATION_FRACTION", "MAX_SAMPLES", "OE_KINDS", "Candidate", "Assessment",
            "method_process", "choose_split", "judge_candidate", "assess", "regular_interval",
            "match_validation", "assess_result", "identify_record"]
 
@@ -56,10 +56,6 @@ ESTIMATION_FRACTION = 2.0 / 3.0
 MAX_SAMPLES = 20_000
 #: the output-error route's model structures
 OE_KINDS = ("fopdt", "sopdt", "underdamped", "lead-lag")
-#: the FOPDT's rms residuals under the two holds closer than this fraction: a tie, broken by the input's samples
-FOH_MARGIN = 0.01
-#: an input of at most this many distinct levels holds them between samples (a tie's zero-order hold)
-HELD_LEVELS = 8
 #: evenly sampled: every interval within this fraction of the mean one
 SPACING_TOLERANCE = 0.01
 
@@ -203,10 +199,7 @@ class Assessment:
         The input between samples every model is simulated with (``zoh`` or
         ``foh``): the one under which the output-error FOPDT fits the
         estimation data better (a sequence switching between the scope's
-        samples is a ramp to a first-order hold, centred where it switched);
-        within :data:`FOH_MARGIN` of each other, ``zoh`` for an input that
-        holds its level (at most :data:`HELD_LEVELS` levels, or most samples
-        equal to the one before), else ``foh``.
+        samples is a ramp to a first-order hold, centred where it switched).
     """
 
     scope: str
@@ -509,15 +502,6 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
             res.skipped.setdefault("output-error", str(exc))
     if fits:
         res.hold = min(fits, key=lambda h: fits[h].rms_residual)
-        if len(fits) == 2 and abs(fits["foh"].rms_residual - fits["zoh"].rms_residual) <= \
-                FOH_MARGIN * fits["zoh"].rms_residual:
-            # a tie says nothing of the input between samples (a smooth plant takes either hold with a
-            # dead time half a sample apart): the input's own samples do: a few levels (a binary
-            # sequence switching on samples, even at every one) or most samples equal to the one
-            # before are a zero-order hold
-            ue = uu[est]
-            held = np.unique(ue).size <= HELD_LEVELS or np.count_nonzero(np.diff(ue) == 0) > 0.5 * (ue.size - 1)
-            res.hold = "zoh" if held else "foh"
     for kind in kinds if fits else ():
         try:
             f = fits[res.hold] if kind == "fopdt" else fit_output_error(uu[est], yy[est], T, kind, hold=res.hold,
