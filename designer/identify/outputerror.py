@@ -628,6 +628,17 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
         sol, sc = solve(p0)
         if best is None or sol.cost < best[0].cost:
             best = (sol, sc)
+    if kind == "underdamped":
+        # an oscillation matches itself inverted half a damped period later: -K with the dead time
+        # +- pi/wd is a local minimum the starts can fall into (a random binary input, zeta 0.2:
+        # K -0.21, theta 3.69 s for K 1, theta 0.5 s); start again from its mirror images
+        q = dict(zip(names, best[0].x * best[1]))
+        half = math.pi / (q["wn_rad_s"] * math.sqrt(1.0 - min(q["zeta"], 0.99) ** 2))
+        for th in (q["theta_s"] - half, q["theta_s"] + half):
+            if bounds["theta_s"][0] <= th <= bounds["theta_s"][1]:
+                sol, sc = solve({**q, "K": -q["K"], "theta_s": th})
+                if sol.cost < best[0].cost:
+                    best = (sol, sc)
     sol, sc = best
     x = sol.x * sc
     params = dict(zip(names, (float(v) for v in x)))

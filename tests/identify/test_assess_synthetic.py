@@ -1,0 +1,184 @@
+"""Synthetic captures of known plants under any recorded input (issue 28,
+Done when): FOPDT, SOPDT with dead time, underdamped (zeta 0.2) and
+integrating plants, driven by the library's own excitations
+(:mod:`designer.core.excitation`: a random binary signal switching with
+probability 0.1 and 0.5, a chirp, a step), simulated by
+``scipy.signal.lsim`` of the true transfer function on a grid ten times
+finer than the scope's (the dead time a shift of the input, the PWL source
+read as simulate-capture's deck reads it), white noise at a stated SNR
+(noise power against the clean output's variance) from a recorded seed and
+8-bit quantisation over the output's span. :func:`identify_record` (what
+``identify`` runs) must give a best model of the true structure with the
+gain within 2 %, time constants and dead time within 5 %, zeta within 0.02,
+and a validation fit within 1 point of the true model's own fit, computed
+with the library's validation function on the same split and hold."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy import signal as sig
+
+from designer.core import process_build as pb
+from designer.core.excitation import chirp_input, random_binary_input
+from designer.identify.assess import identify_record
+from designer.identify.outputerror import simulate
+from designer.identify.validation import validate
+
+SEED = 28
+TS = 0.1            # s, the scope's sample interval
+POINTS = 3001       # 300 s
+FINE = 10           # simulation points per sample interval
+LEVEL = 1.0         # V, the input's high level
+
+# the true plants: (structure the best model must have, its parameters, the process model)
+PLANTS = {
+    "fopdt": ("fopdt", {"K": 2.0, "tau_s": 5.0, "theta_s": 1.3}),
+    "sopdt": ("sopdt", {"K": 1.5, "tau1_s": 4.0, "tau2_s": 1.5, "theta_s": 0.9}),
+    "underdamped": ("underdamped", {"K": 1.0, "wn_rad_s": 1.0, "zeta": 0.2, "theta_s": 0.5}),
+    "integrating": ("integrating", {"K": 0.3, "theta_s": 1.1}),
+}
+INPUTS = ("rb0.1", "rb0.5", "chirp", "step")
+
+
+def true_model(plant: str):
+    """The plant as a :class:`ProcessModel` (its num, den and dead time)."""
+    kind, p = PLANTS[plant]
+    if kind == "fopdt":
+        return pb.fopdt(p["K"], p["tau_s"], p["theta_s"])
+    if kind == "sopdt":
+        return pb.sopdt(p["K"], p["tau1_s"], p["tau2_s"], p["theta_s"])
+    if kind == "underdamped":
+        return pb.underdamped(p["K"], p["wn_rad_s"] / (2 * math.pi), p["zeta"], p["theta_s"])
+    return pb.integrating(p["K"], 0.0, p["theta_s"])
+
+
+def excitation(kind: str):
+    """The library's input (simulate-capture's ``--input``), as a PWL source."""
+    duration = TS * (POINTS - 1)
+    if kind.startswith("rb"):
+        return random_binary_input(float(kind[2:]), TS, LEVEL, duration, POINTS, seed=SEED)
+    if kind == "chirp":
+        return chirp_input(0.005, 1.0, LEVEL, duration, POINTS)
+    return None
+
+
+def capture(plant: str, inp: str, snr_db: float, seed: int = SEED) -> tuple:
+    """(t, u, y_clean, y): the plant's response sampled every TS, noise at
+    ``snr_db`` (seeded) and 8-bit quantisation over the output's span."""
+    m = true_model(plant)
+    t = np.arange(POINTS) * TS
+    tf = np.arange((POINTS - 1) * FINE + 1) * (TS / FINE)
+    ex = excitation(inp)
+    if ex is None:          # a step at a tenth of the record, from 0 V
+        def at(x):
+            return np.where(x >= t[POINTS // 10], LEVEL, 0.0)
+    else:
+        at = ex.at
+    u = at(t)
+    ud = np.where(tf >= m.theta_s, at(tf - m.theta_s), at(0.0 * tf))
+    _, yc, _ = sig.lsim((m.num, m.den), ud - ud[0], tf)
+    yc = yc[::FINE]
+    rng = np.random.default_rng([seed, int(snr_db)])
+    y = yc + rng.normal(0.0, math.sqrt(np.var(yc) / 10 ** (snr_db / 10)), yc.size)
+    lo, q = y.min(), np.ptp(y) / 255
+    y = lo + np.round((y - lo) / q) * q
+    return t, u, yc, y
+
+
+class _True:
+    def __init__(self, model, ts, hold):
+        self.model, self.ts, self.hold = model, ts, hold
+
+    def response(self, u):
+        return simulate(self.model, u, self.ts, self.hold)
+
+
+def run(plant: str, inp: str, snr_db: float) -> dict:
+    """identify_record on the capture; the best model and the true model's fit."""
+    t, u, _, y = capture(plant, inp, snr_db)
+    res = identify_record(t, y, u, name=f"{plant}/{inp}/{snr_db:g} dB")
+    a = res.assessment
+    assert a.decimated_by == 1
+    truth = validate(_True(true_model(plant), a.sample_time_s, a.hold), u, y, a.split).fit_percent
+    return {"a": a, "best": a.best_candidate, "truth": truth}
+
+
+def misses(plant: str, best) -> list:
+    """What of the issue's tolerances the best model misses ([] when none)."""
+    kind, p = PLANTS[plant]
+    if best is None:
+        return ["no valid model"]
+    if best.kind != kind and not (kind == "sopdt" and best.kind == "overdamped"):
+        return [f"best is {best.label}, not {kind}"]
+    q = dict(best.params)
+    out = []
+    if kind == "sopdt":     # the two lags in either order
+        got, want = sorted((q["tau1_s"], q["tau2_s"])), sorted((p["tau1_s"], p["tau2_s"]))
+        q["tau1_s"], q["tau2_s"] = got
+        p = dict(p, tau1_s=want[0], tau2_s=want[1])
+    for name, want in p.items():
+        got = q[name]
+        if name == "zeta":
+            if abs(got - want) > 0.02:
+                out.append(f"zeta {got:.4g} (true {want:g}, allowed +-0.02)")
+        elif abs(got - want) > (0.02 if name == "K" else 0.05) * abs(want):
+            out.append(f"{name} {got:.4g} (true {want:g}, {100 * (got / want - 1):+.1f} %)")
+    return out
+
+
+# the library's gaps (reported to the lead with these numbers), not the data's
+CHIRP = ("identify_record raises on a chirp: examine_input does not read it as broadband, and the step methods "
+         "refuse it ('no usable step in the response', or 'the square wave is too fast' for the underdamped "
+         "plant): a chirp has no route to the output-error fit")
+INTEGRATING = ("no integrating structure in assess.OE_KINDS: under a random binary input no model is valid and "
+               "the record is refused as 'too short for the plant's dead time plus settling' (the best-fitting "
+               "model a lead-lag or SOPDT of 7.8 ks); fit_output_error(kind='integrating', initial='estimate') on "
+               "the estimation part gives K 0.24 /s, theta 4.5 s at rb0.5/10 dB (true 0.3 /s, 1.1 s); under a "
+               "step the step methods refuse the ramp ('the record ends before the response settles') or no "
+               "model is valid")
+HOLD = ("the FOPDT fits zoh and foh alike (rms residuals equal to 5 digits) and assess picks foh on the tie: the "
+        "input, held between samples, is read as a ramp and the dead time comes out half a sample late: theta {} s "
+        "(true 0.5 s; under zoh 0.493 s at rb0.5/20 dB); breaking the tie by the input's levels (a few levels: "
+        "zoh) fixes it but turns captures/motor_seed000.identify.json's hold foh -> zoh: left to the lead")
+# what the data cannot give to the issue's tolerance (measured, seed 28)
+# (the best model's validation fit is the true model's to 0.05 point in each: the data cannot tell them apart)
+_SAME = "; its fit {} equals the true model's {}"
+DATA = {
+    ("fopdt", "step", 10): "a step at 10 dB: theta 1.404 s (true 1.3 s, +8.0 %)" + _SAME.format(69.70, 69.69),
+    ("sopdt", "rb0.1", 10): ("random binary p 0.1 at 10 dB: K 1.537 (+2.5 %), the short lag 1.612 s (true 1.5 s, "
+                             "+7.5 %), theta 0.816 s (true 0.9 s, -9.4 %)" + _SAME.format(67.07, 67.06)),
+    ("sopdt", "rb0.5", 10): ("random binary p 0.5 at 10 dB: the short lag 1.402 s (-6.5 %), theta 0.945 s "
+                             "(+5.0 %)" + _SAME.format(36.73, 36.76)),
+    ("sopdt", "step", 20): ("a step at 20 dB: the lags 1.304 s and 4.214 s (true 1.5 s, -13.1 %, and 4 s, +5.3 %)"
+                            + _SAME.format(90.01, 90.01)),
+    ("sopdt", "step", 10): ("a step at 10 dB: the short lag 1.407 s (-6.2 %), theta 1.076 s (true 0.9 s, +19.6 %)"
+                            + _SAME.format(69.68, 69.68)),
+    ("underdamped", "rb0.1", 20): HOLD.format("0.5425 (+8.5 %)"),
+    ("underdamped", "rb0.1", 10): HOLD.format("0.5266 (+5.3 %)"),
+    ("underdamped", "rb0.5", 20): HOLD.format("0.5434 (+8.7 %)"),
+    ("underdamped", "rb0.5", 10): HOLD.format("0.5531 (+10.6 %)"),
+    ("underdamped", "step", 20): HOLD.format("0.5472 (+9.4 %)"),
+    ("underdamped", "step", 10): ("a step at 10 dB: theta 0.597 s (true 0.5 s, +19.4 %)"
+                                  + _SAME.format(69.71, 69.67)),
+}
+
+
+def _case(plant, inp, snr):
+    why = CHIRP if inp == "chirp" else INTEGRATING if plant == "integrating" else DATA.get((plant, inp, snr))
+    if why is None:
+        return pytest.param(plant, inp, snr, id=f"{plant}-{inp}-{snr}dB")
+    strict = inp == "chirp" or plant == "integrating"
+    return pytest.param(plant, inp, snr, id=f"{plant}-{inp}-{snr}dB",
+                        marks=pytest.mark.xfail(reason=why, strict=strict))
+
+
+CASES = [(plant, inp, snr) for plant in PLANTS for inp in INPUTS for snr in (20, 10)]
+
+
+@pytest.mark.parametrize("plant, inp, snr_db", [_case(*c) for c in CASES])
+def test_best_model_recovers_the_plant(plant, inp, snr_db):
+    r = run(plant, inp, snr_db)
+    best = r["best"]
+    assert not misses(plant, best), (misses(plant, best), r["a"].hold, None if best is None else best.params)
+    assert best.fit_percent >= r["truth"] - 1.0, (best.label, best.fit_percent, r["truth"])
