@@ -241,8 +241,11 @@ def sample_model(num, den, theta_s: float, sample_time_s: float, hold: str = "zo
     num = np.trim_zeros(np.asarray(num, float), "f")
     if num.size >= den.size:
         raise DesignError("an output-error model needs a strictly proper rational part")
-    A, B, C, _ = tf2ss(num, den)
-    B, C = B[:, 0], C[0]
+    # the numerator's scale out of tf2ss: a capture in nV or in kV gives a gain of 1e-9 or 1e3, and scipy's
+    # normalize reads a numerator of all-tiny coefficients as badly conditioned (found by the scale fuzz)
+    g = float(np.max(np.abs(num))) if num.size else 1.0
+    A, B, C, _ = tf2ss(num / g, den)
+    B, C = B[:, 0], C[0] * g
     n = A.shape[0]
     d = int(math.floor(theta_s / T + 1e-12))
     f = max(theta_s / T - d, 0.0)
