@@ -241,9 +241,11 @@ def sample_model(num, den, theta_s: float, sample_time_s: float, hold: str = "zo
     num = np.trim_zeros(np.asarray(num, float), "f")
     if num.size >= den.size:
         raise DesignError("an output-error model needs a strictly proper rational part")
-    # the numerator's scale out of tf2ss: a capture in nV or in kV gives a gain of 1e-9 or 1e3, and scipy's
-    # normalize reads a numerator of all-tiny coefficients as badly conditioned (found by the scale fuzz)
-    g = float(np.max(np.abs(num))) if num.size else 1.0
+    # the numerator's scale out of tf2ss when it is tiny: a capture in nV gives a gain of 1e-9, and scipy's
+    # normalize reads a numerator of all-tiny coefficients as badly conditioned and strips them (found by the
+    # scale fuzz); a power of two, and only below 1e-6, so ordinary gains keep their exact arithmetic
+    big = float(np.max(np.abs(num))) if num.size else 1.0
+    g = 2.0 ** math.floor(math.log2(big)) if 0.0 < big < 1e-6 else 1.0
     A, B, C, _ = tf2ss(num / g, den)
     B, C = B[:, 0], C[0] * g
     n = A.shape[0]
@@ -485,7 +487,8 @@ def _arx_start(kind: str, ud, y, T: float) -> dict:
     duration = ud.size * T
     p = {"theta_s": max((nk - 1 + frac) * Ts, 0.0)}
     poles = np.roots(best.a) if na else np.array([])
-    s = np.log(poles.astype(complex)) / Ts if poles.size else poles
+    with np.errstate(divide="ignore", invalid="ignore"):   # a pole at 0: infinitely fast (tau_of's slow)
+        s = np.log(poles.astype(complex)) / Ts if poles.size else poles
     gain = float(np.sum(best.b) / np.sum(best.a))
     slow = duration / 10
 
