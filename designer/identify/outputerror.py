@@ -243,8 +243,8 @@ def sample_model(num, den, theta_s: float, sample_time_s: float, hold: str = "zo
         raise DesignError("an output-error model needs a strictly proper rational part")
     # the numerator's scale out of tf2ss when it is tiny: a capture in nV gives a gain of 1e-9, and scipy's
     # normalize reads a numerator of all-tiny coefficients as badly conditioned and strips them (found by the
-    # scale fuzz); a power of two, and only below 1e-6, so ordinary gains keep their exact arithmetic
-    big = float(np.max(np.abs(num))) if num.size else 1.0
+    # scale fuzz: also a gain of 0.015 over time constants of 5e5 s); a power of two, and only below 1e-6, so ordinary gains keep their exact arithmetic
+    big = float(np.max(np.abs(num))) / abs(den[0]) if num.size else 1.0   # as normalize sees it (monic den)
     g = 2.0 ** math.floor(math.log2(big)) if 0.0 < big < 1e-6 else 1.0
     A, B, C, _ = tf2ss(num / g, den)
     B, C = B[:, 0], C[0] * g
