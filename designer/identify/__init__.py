@@ -50,7 +50,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
            "looks_like_step_input", "parse_capture_text", "parse_freq_table", "plain_columns", "read_capture",
            "read_freq_table", "text_lines", "unit_hint"),
     "outputerror": ("FIT_KINDS", "HOLDS", "INITIALS", "OEFit", "OEResult", "Sampled", "fit_output_error",
-                    "identify_output_error", "sample_model", "simulate"),
+                    "identify_output_error", "power_of_two", "sample_model", "simulate"),
     "overdamped": ("alfaro_123c_overdamped", "harriott", "jahanmiri_fallahi", "peeling", "stark_mollenkamp",
                    "two_pole"),
     "preprocess": ("check_window", "prepare_step"),

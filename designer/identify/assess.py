@@ -497,15 +497,16 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
     fits = {}
     for hold in ("zoh", "foh"):
         try:
-            fits[hold] = _oe_fit(uu[est], yy[est], T, "fopdt", hold)
-        except (DesignError, ArithmeticError, IndexError, ValueError, np.linalg.LinAlgError) as exc:
+            fits[hold] = fit_output_error(uu[est], yy[est], T, "fopdt", hold=hold, initial="estimate")
+        except DesignError as exc:
             res.skipped.setdefault("output-error", str(exc))
     if fits:
         res.hold = min(fits, key=lambda h: fits[h].rms_residual)
     for kind in kinds if fits else ():
         try:
-            f = fits[res.hold] if kind == "fopdt" else _oe_fit(uu[est], yy[est], T, kind, res.hold)
-        except (DesignError, ArithmeticError, IndexError, ValueError, np.linalg.LinAlgError) as exc:
+            f = fits[res.hold] if kind == "fopdt" else fit_output_error(uu[est], yy[est], T, kind, hold=res.hold,
+                                                                         initial="estimate")
+        except DesignError as exc:
             res.skipped.setdefault("output-error", str(exc))
             continue
         res.output_error.append(f)
@@ -691,19 +692,6 @@ def identify_record(t, y, u=None, *, step_time=None, step_amplitude=None, window
         if not explained and not step_answer:
             _check_room(result.assessment, t, name)
     return result
-
-
-def _oe_fit(u, y, T: float, kind: str, hold: str):
-    """One output-error fit for the assessment. At the far ends of the scales the project accepts (an input of
-    1e-12 V, a gain of 1e14: the scale fuzz) its regressions are singular; the route is then skipped with its
-    reason, and scipy's conditioning warnings of those trials are not the user's business (the fit is judged
-    on validation data either way)."""
-    import warnings
-
-    from scipy.signal import BadCoefficients
-    with warnings.catch_warnings(), np.errstate(all="ignore"):
-        warnings.simplefilter("ignore", BadCoefficients)
-        return fit_output_error(u, y, T, kind, hold=hold, initial="estimate")
 
 
 def _check_room(a: Assessment, t, name: str) -> None:

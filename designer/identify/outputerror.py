@@ -85,7 +85,7 @@ from ..core.errors import DesignError
 from ..core.process import ProcessModel
 from .validation import DEFAULT_FRACTION, Split, arx_fit, split_record, validate
 
-__all__ = ["FIT_KINDS", "HOLDS", "INITIALS", "Sampled", "sample_model", "simulate", "OEFit", "OEResult",
+__all__ = ["FIT_KINDS", "HOLDS", "INITIALS", "Sampled", "sample_model", "simulate", "OEFit", "OEResult", "power_of_two",
            "fit_output_error", "identify_output_error"]
 
 #: the model structures fitted, with their parameters (in the solver's order)
@@ -214,6 +214,22 @@ class Sampled:
         return out
 
 
+def power_of_two(x: float) -> float:
+    """The power of two nearest ``x`` (1 for 0 or a non-finite ``x``): a scale that divides exactly.
+
+    Parameters
+    ----------
+    x : float
+        A positive size.
+
+    Returns
+    -------
+    float
+        2 ** round(log2 x).
+    """
+    return 2.0 ** round(math.log2(x)) if x > 0 and math.isfinite(x) else 1.0
+
+
 def sample_model(num, den, theta_s: float, sample_time_s: float, hold: str = "zoh") -> Sampled:
     """Sample N(s)/D(s) e^(-theta s) exactly under a zero- or first-order hold
     (the equations of the module's notes, dead time not a whole number of samples).
@@ -241,11 +257,10 @@ def sample_model(num, den, theta_s: float, sample_time_s: float, hold: str = "zo
     num = np.trim_zeros(np.asarray(num, float), "f")
     if num.size >= den.size:
         raise DesignError("an output-error model needs a strictly proper rational part")
-    # the numerator's scale out of tf2ss when it is tiny: a capture in nV gives a gain of 1e-9, and scipy's
-    # normalize reads a numerator of all-tiny coefficients as badly conditioned and strips them (found by the
-    # scale fuzz: also a gain of 0.015 over time constants of 5e5 s); a power of two, and only below 1e-6, so ordinary gains keep their exact arithmetic
-    big = float(np.max(np.abs(num))) / abs(den[0]) if num.size else 1.0   # as normalize sees it (monic den)
-    g = 2.0 ** math.floor(math.log2(big)) if 0.0 < big < 1e-6 else 1.0
+    # the numerator's scale out of tf2ss: scipy's normalize reads a numerator of all-tiny coefficients
+    # (against a monic denominator: a gain of 1e-9, or 0.015 over time constants of 5e5 s, in the scale
+    # fuzz) as badly conditioned and strips them. A power of two: the scaling is exact.
+    g = power_of_two(float(np.max(np.abs(num))) / abs(den[0])) if num.size else 1.0
     A, B, C, _ = tf2ss(num / g, den)
     B, C = B[:, 0], C[0] * g
     n = A.shape[0]
@@ -487,8 +502,7 @@ def _arx_start(kind: str, ud, y, T: float) -> dict:
     duration = ud.size * T
     p = {"theta_s": max((nk - 1 + frac) * Ts, 0.0)}
     poles = np.roots(best.a) if na else np.array([])
-    with np.errstate(divide="ignore", invalid="ignore"):   # a pole at 0: infinitely fast (tau_of's slow)
-        s = np.log(poles.astype(complex)) / Ts if poles.size else poles
+    s = np.log(poles.astype(complex)) / Ts if poles.size else poles
     gain = float(np.sum(best.b) / np.sum(best.a))
     slow = duration / 10
 
@@ -591,7 +605,15 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
         raise DesignError(f"{u.size} samples are too few for an output-error fit (50 or more)")
     if np.ptp(u) == 0:
         raise DesignError("the input never moves: there is nothing to identify")
+    # amplitudes and the sample interval of order one, by powers of two (exact): a record of 1e-12 V in and
+    # 100 V out, or sampled every 1e-13 s (the scale fuzz), leaves the regressions singular and scipy's
+    # conversions badly conditioned otherwise; the parameters are scaled back below (_scale_back)
+    su, sy, st = power_of_two(float(np.ptp(u))), power_of_two(float(np.ptp(y))), power_of_two(T)
+    u0, T_record = float(u[0]), T
+    u, y, T = u / su, y / sy, T / st
     names = FIT_KINDS[kind]
+    if start is not None:
+        start = {k: float(v) / _scale_of(kind, k, su, sy, st) for k, v in start.items() if k in names}
     ud = u - u[0]
     n = u.size
     bounds = _bounds(kind, T, n * T)
@@ -663,6 +685,12 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
         half = float(stdtrit(dof, 0.975)) * np.sqrt(np.clip(np.diag(cov), 0.0, None))
         for k, h in zip(np.array(names)[free], half):
             ci[str(k)] = float(h)
+    # back to the record's units
+    for k in names:
+        f = _scale_of(kind, k, su, sy, st)
+        params[k] *= f
+        if ci[k] is not None:
+            ci[k] *= f
     notes = []
     converged = sol.status > 0
     if not converged:
@@ -679,8 +707,29 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     model, why = _process_model(kind, params, ci)
     if why:
         notes.append(why)
-    return OEFit(kind, params, ci, model, not notes, "; ".join(notes), T, hold, initial, float(u[0]),
-                 tuple(float(v) for v in beta), float(math.sqrt(r @ r / n)), n, evals, converged)
+    return OEFit(kind, params, ci, model, not notes, "; ".join(notes), T_record, hold, initial, u0,
+                 _linear_back(beta, sy, su, kind, initial), float(math.sqrt(r @ r / n)) * sy, n, evals, converged)
+
+
+def _scale_of(kind: str, name: str, su: float, sy: float, st: float) -> float:
+    """What a parameter fitted on amplitudes divided by ``su`` (input) and ``sy`` (output) and on times
+    divided by ``st`` is multiplied by in the record's units: a gain sy/su (an integrating model's, per
+    second, sy/(su st)), a time st, a natural frequency 1/st, a damping ratio 1."""
+    if name == "K":
+        return sy / su / (st if kind.startswith("integrating") else 1.0)
+    if name == "wn_rad_s":
+        return 1.0 / st
+    return st if name.endswith("_s") else 1.0
+
+
+def _linear_back(beta, sy: float, su: float, kind: str, initial: str) -> tuple:
+    """The linear coefficients of a fit on scaled amplitudes in the record's units: the output level and
+    the free responses are output quantities (times ``sy``); an integrating model's balance input, the
+    last column of :func:`_columns`, is an input quantity (times ``su``)."""
+    out = [float(v) * sy for v in beta]
+    if initial == "estimate" and kind.startswith("integrating"):
+        out[-1] = float(beta[-1]) * su
+    return tuple(out)
 
 
 def _process_model(kind: str, p: dict, ci: dict) -> tuple:
