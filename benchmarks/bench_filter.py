@@ -92,7 +92,8 @@ def _best(times: int, fn) -> float:
 
 
 def end_to_end_section():
-    from designer.filters import FilterSpec, design
+    from designer.filters import FilterSpec
+    from designer.filters.design import design
     spec = FilterSpec(order=8, fc_hz=1e3, r_series="E24", c_series="E12")
     exe = Path(sys.executable).parent / "design-filter"
     with tempfile.TemporaryDirectory(prefix="bench-filter-") as tmp:
@@ -147,7 +148,8 @@ def monte_carlo_section(d):
 
 
 def main():
-    from designer.filters import FilterSpec, design
+    from designer.filters import FilterSpec
+    from designer.filters.design import design
     d = design(FilterSpec(order=8, fc_hz=1e3, r_series="E24", c_series="E12"))
     joint_section(d)
     end_to_end_section()

@@ -45,8 +45,3 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                "stage_drive", "stage_polys",),
 })
 
-# design() shares its module's name: importing the module binds the package's ``design`` to the module, so
-# the function is bound here, after it, for ``from designer.filters import design`` (as before the lazy table)
-from .design import design  # noqa: E402, F401
-
-__all__ = sorted({*__all__, "design"})

@@ -13,7 +13,8 @@ from hypothesis import strategies as hst
 
 from designer.core.errors import DesignError
 from designer.core.opamps import get as get_opamp
-from designer.filters import FilterSpec, design
+from designer.filters import FilterSpec
+from designer.filters.design import design
 from designer.filters.prototype import reference_response
 from designer.filters.registry import get
 

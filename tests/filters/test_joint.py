@@ -7,7 +7,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from designer.filters import FilterSpec, design
+from designer.filters import FilterSpec
+from designer.filters.design import design
 from designer.filters.joint import brute_force, descend, joint_search, objective, per_stage
 
 

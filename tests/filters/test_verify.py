@@ -13,7 +13,8 @@ import pytest
 from scipy import signal
 
 from designer.core.opamps import get as get_opamp
-from designer.filters import REGISTRY, FilterSpec, design
+from designer.filters import REGISTRY, FilterSpec
+from designer.filters.design import design
 from designer.filters.verify import (NRMS_PASS, analytic_tran, bench_signal, opamp_aware_polys, proof_deck, prove,
                                      stage_drive, stage_polys)
 

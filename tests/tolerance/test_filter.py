@@ -14,7 +14,8 @@ from hypothesis import strategies as st
 from scipy.optimize import brentq
 
 from designer.core.errors import DesignError
-from designer.filters import FilterSpec, as_built, design
+from designer.filters import FilterSpec, as_built
+from designer.filters.design import design
 from designer.tolerance import runner, sampling
 from designer.tolerance.filter import (context, evaluate, filter_monte_carlo, filter_worst_case, mask_limits,
                                        nominal_parts, optimize_yield)
