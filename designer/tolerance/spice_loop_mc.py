@@ -122,8 +122,8 @@ def loop_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler
 
     Returns
     -------
-    designer.tolerance.montecarlo.MonteCarlo
-        The Monte Carlo.
+    designer.tolerance.loop.LoopMonteCarlo
+        The loop's Monte Carlo.
     """
     from .loop import stable_and_inside, engine_of, loop_monte_carlo, loop_parts
     from .spice_mc import ENGINES, disagreement, run_picked, spice_checked, spice_samples

@@ -203,3 +203,29 @@ def test_the_long_runs_killed_leave_nothing_running_and_nothing_half_written(tmp
     elif left:   # a whole bundle or none
         result = json.loads(next(p for p in left if p.name == "result.json").read_text())
         assert all(Path(f).is_file() for f in [result["files"]["netlist"], *result["files"]["plots"]])
+
+
+#: the filter commands' long runs (issue 27): the SPICE proof, a Monte Carlo over worker processes and SPICE
+#: builds of an 8th-order cascade
+FILTER_RUNS = {
+    "design-filter": ["--family", "butterworth", "--order", "8", "--fc", "1k", "--monte-carlo", "100000",
+                      "--spice-samples", "60", "--jobs", "2"],
+    "analyze-filter": ["--target", "--order 2 --fc 1k", "--stage", "sallen-key-lowpass", "--part", "R101=10k",
+                       "--part", "R102=10k", "--part", "C101=10n", "--part", "C102=22n", "--monte-carlo", "100000",
+                       "--spice-samples", "60", "--jobs", "2"],
+}
+
+
+@pytest.mark.parametrize("command", sorted(FILTER_RUNS))
+@pytest.mark.parametrize("sig", (signal.SIGKILL, signal.SIGTERM), ids=lambda s: signal.Signals(s).name)
+def test_the_filter_runs_killed_leave_nothing_running_and_nothing_half_written(tmp_path, command, sig):
+    out = tmp_path / "out"
+    tag = uuid.uuid4().hex
+    # 3 s: past the imports, into the proof, the workers and ngspice
+    code, err = stop([script(command), *FILTER_RUNS[command], "--out", str(out)], sig, 3.0, tag)
+    assert_ended_by(code, err, sig, command)
+    assert wait_gone(tag) == [], f"a worker or ngspice outlived {command}"
+    left = [p for p in out.rglob("*") if p.is_file()] if out.exists() else []
+    if left:   # a whole folder or none
+        result = json.loads((out / "result.json").read_text())
+        assert all(Path(f).is_file() for f in result["files"].values() if isinstance(f, str))
