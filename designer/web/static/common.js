@@ -4,6 +4,15 @@
 
 const D = {};
 
+// The page's words in the reader's language: every string the page shows goes through D.t (the English text is
+// the key; {name} placeholders filled from params). English is the identity until a catalogue is loaded.
+D.catalogue = {};
+D.t = function (text, params) {
+  let s = D.catalogue[text] || text;
+  if (params) for (const k of Object.keys(params)) s = s.split("{" + k + "}").join(String(params[k]));
+  return s;
+};
+
 D.choices = null;
 D.loadChoices = async function () {
   if (!D.choices) D.choices = await (await fetch("/api/choices")).json();
