@@ -36,6 +36,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "sallen_key": ("GAIN_PARTS", "SallenKeySection",),
     "sallen_key_highpass": ("SallenKeyHighPass",),
     "sallen_key_lowpass": ("SallenKeyLowPass", "sallen_key_ratio_min",),
+    "sallen_key_lowpass_parts": ("FIELD_OF", "REF_OF", "field_values", "fields", "gain_refs", "part_values", "refs",
+                                 "section_of",),
     "spec": ("FilterSpec", "TOPOLOGY_CHOICES",),
     "tables": ("TableRow", "coefficient_table", "section_3db_ratio", "table_corner",),
     "topology": ("DEFAULT_IMPEDANCE_OHM", "Figures", "KINDS", "PartSpec", "SectionTarget", "Topology",

@@ -12,14 +12,15 @@ The low-pass and high-pass networks are in their own modules.
 from __future__ import annotations
 
 from ..core.errors import DesignError
+from ..core.i18n import N_
 from ..spice.deck import GROUND, Amp, Netlist
 from .topology import DEFAULT_IMPEDANCE_OHM, PartSpec, SectionTarget, Topology
 
 __all__ = ["SallenKeySection", "GAIN_PARTS"]
 
 #: the gain network of a Sallen-Key section with gain
-GAIN_PARTS = (PartSpec("R3", "R", "gain: inverting input to ground"),
-              PartSpec("R4", "R", "gain: output to inverting input"))
+GAIN_PARTS = (PartSpec("R3", "R", N_("gain: inverting input to ground")),
+              PartSpec("R4", "R", N_("gain: output to inverting input")))
 
 
 class SallenKeySection(Topology):

@@ -39,6 +39,7 @@ gain when the bound allows it.
 from __future__ import annotations
 
 from ..core.errors import DesignError
+from ..core.i18n import N_
 from ..spice.deck import GROUND, Netlist
 from .sallen_key import SallenKeySection
 from .topology import PartSpec, SectionTarget, polynomial, quadratic_root
@@ -74,10 +75,10 @@ class SallenKeyLowPass(SallenKeySection):
     """
 
     kind, base_name = "lowpass", "sallen-key-lowpass"
-    network = (PartSpec("R1", "R", "input resistor"),
-               PartSpec("R2", "R", "to the non-inverting input"),
-               PartSpec("C1", "C", "non-inverting input to ground"),
-               PartSpec("C2", "C", "R1-R2 node to the output (feedback)"))
+    network = (PartSpec("R1", "R", N_("input resistor")),
+               PartSpec("R2", "R", N_("to the non-inverting input")),
+               PartSpec("C1", "C", N_("non-inverting input to ground")),
+               PartSpec("C2", "C", N_("R1-R2 node to the output (feedback)")))
 
     def coefficients(self, values: dict) -> tuple:
         v = self.values_of(values)
@@ -114,6 +115,30 @@ class SallenKeyLowPass(SallenKeySection):
 
     def netlist(self, values: dict, prefix: str = "", amp_ref: str = "U1", inp: str = "vin",
                 out: str = "vout") -> Netlist:
-        x, p, n = self.internal(amp_ref, "x", "p", "n")
+        return self.wired(values, prefix, amp_ref, inp, out, self.internal(amp_ref, "x", "p", "n"))
+
+    def wired(self, values: dict, prefix: str, amp_ref: str, inp: str, out: str, nets: tuple) -> Netlist:
+        """The section with its internal nets named by the caller (the plant's sheet
+        keeps the seed's ``v1``, ``vp``, ``vn``); :meth:`netlist` names them after the op-amp.
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value (ohm, farad).
+        prefix : str
+            Put after each designator's letter, for chaining (:meth:`prefixed`).
+        amp_ref : str
+            The op-amp's designator.
+        inp, out : str
+            The nets the section sits between.
+        nets : tuple of str
+            The internal nets: the R1-R2 node, the non-inverting and the inverting input.
+
+        Returns
+        -------
+        Netlist
+            Its parts (roles from :attr:`parts`) and op-amp.
+        """
+        x, p, n = nets
         ends = {"R1": (inp, x), "R2": (x, p), "C1": (p, GROUND), "C2": (x, out)}
         return self.amplified(values, prefix, ends, amp_ref, p, n, out)

@@ -30,7 +30,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "design": ("SEED_BENCH_PLANT", "analyze_pid", "design_pid", "run_spice"),
     "model": ("SLEW_DELAY_FRACTION", "assemble", "controller_tf", "dc_gain", "ideal_loop", "inverting_stage",
               "loop_gain", "margins", "reference", "slew_delay", "waveform_limits"),
-    "netlist": ("closed_loop_deck", "controller_netlist", "loop_netlist", "model_loop_deck"),
+    "netlist": ("closed_loop_deck", "controller_netlist", "loop_netlist", "model_loop_deck", "plant_ref_prefix"),
     "optimize": ("Context", "evaluate"),
     "plant_source": ("model_from_json", "model_from_result", "result_kind", "sallen_key_model"),
     "process_loop": ("analyse", "built_controller", "corner_frequencies", "design_model_pid", "edged",

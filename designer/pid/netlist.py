@@ -7,8 +7,11 @@ circuit, the project's behavioural op-amp models (inlined from
 The table (:func:`loop_netlist`) is the one description of the circuit: the
 deck, the schematic (:mod:`designer.pid.schematic`), the wiring table and the
 bill of materials are all written from it. Designators are one scheme with the
-plant's sheet (:mod:`designer.plant.netlist`): the plant keeps R1, R2, C1, C2
-and its op-amp U1; the controller has the seed's R3..R18, C3, C4 and the
+plant's sheet (:mod:`designer.plant.netlist`): the plant keeps its section's
+designators (R1, R2, C1, C2) and its op-amp U1, unless it has the gain pair,
+whose R3 and R4 the controller owns: then all its designators carry the
+section's chaining prefix ``P`` (:data:`designer.pid.plant.PLANT_PREFIX`,
+:func:`plant_ref_prefix`: RP1 .. RP4, as a circuit plant's); the controller has the seed's R3..R18, C3, C4 and the
 op-amps U2 (difference), U3 (inverter), U4 (differentiator), U5 (integrator),
 U6 (summer) and U7 (final gain), one per package as the seed built it;
 :func:`designer.spice.deck.board` puts them in dual or quad packages.
@@ -30,7 +33,7 @@ from ..spice import deck
 from ..spice.deck import GROUND, Amp, Netlist, Part, SquareTest
 from .blocks import PidParts
 
-__all__ = ["closed_loop_deck", "controller_netlist", "loop_netlist", "model_loop_deck"]
+__all__ = ["closed_loop_deck", "controller_netlist", "loop_netlist", "model_loop_deck", "plant_ref_prefix"]
 
 #: signals whose extremes the deck measures (one per op-amp output)
 PROBES = ("ve", "vp", "vd", "vi", "vs", "u", "y")
@@ -88,10 +91,19 @@ def extreme_lines(parts: PidParts, test: SquareTest) -> list:
     return out
 
 
+def plant_ref_prefix(plant: SallenKeyParts) -> str:
+    """The designator prefix of the Sallen-Key plant in the loop: none for the
+    follower, :data:`~designer.pid.plant.PLANT_PREFIX` when its gain pair would take
+    the controller's R3 and R4."""
+    from .plant import PLANT_PREFIX
+    return "" if plant.r3 is None else PLANT_PREFIX
+
+
 def loop_netlist(parts: PidParts, plant: SallenKeyParts) -> Netlist:
     """The whole loop as one table: the plant (U1 and its parts) first, then the
     controller's stages in signal order."""
-    pl, ctl = plant_netlist(plant, "u", "y", prefix="p", amp_ref="U1"), controller_netlist(parts)
+    pl = plant_netlist(plant, "u", "y", prefix="p", amp_ref="U1", ref_prefix=plant_ref_prefix(plant))
+    ctl = controller_netlist(parts)
     return Netlist(pl.parts + ctl.parts, pl.amps + ctl.amps)
 
 

@@ -17,6 +17,7 @@ from ..core import eseries
 from ..core.i18n import N_, language
 from ..core.i18n import gettext as _
 from ..core.units import format_eng
+from ..filters.sallen_key_lowpass_parts import section_of
 from ..report import document as R
 from ..report.bundle import write_design
 from ..report.plots import decimate, figure, loop_gain_plot, png_bytes, step_plot, time_unit
@@ -26,7 +27,7 @@ from ..report.tolerance import title as tolerance_title
 from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
 from .model import OPAMP_OUTPUTS
-from .netlist import NET_LABELS, loop_netlist
+from .netlist import NET_LABELS, loop_netlist, plant_ref_prefix
 from .tuning import MODEL_NAMES
 
 __all__ = ["bom", "build_board", "plots", "schematic", "sections", "summary_text", "title_of", "write_outputs"]
@@ -171,7 +172,8 @@ def bom(result, b=None) -> list:
     controller = controller_source(result.selection)
     prs, pcs = result.plant_series or (None, None)
     prt, pct = ((100 * eseries.TOLERANCE[prs], 100 * eseries.TOLERANCE[pcs]) if prs else (None, None))
-    plant_refs = {"R1", "R2", "C1", "C2", "R19", "R20"}
+    section, prefix = section_of(result.plant), plant_ref_prefix(result.plant)
+    plant_refs = {section.prefixed(ref, prefix) for ref in section.designators}
 
     def source(ref):
         if ref in plant_refs:
@@ -483,7 +485,7 @@ def _reaction_plot(result) -> bytes:
 def schematic(result):
     """The loop's schematic (:mod:`designer.pid.schematic`) as a drawing."""
     from .schematic import draw_loop
-    return draw_loop(build_board(result), result.opamp)
+    return draw_loop(build_board(result), result.opamp, plant_prefix=plant_ref_prefix(result.plant))
 
 
 #: the sheet's plots: (file name, drawing function of the result)

@@ -62,14 +62,15 @@ def _inverting(s, board, amp, inputs, feedback, x_in, row, x_out_min=None):
     return (xo, out[1])
 
 
-def draw_loop(board, opamp, probes: dict = PROBES) -> Sheet:
+def draw_loop(board, opamp, probes: dict = PROBES, plant_prefix: str = "") -> Sheet:
     """The closed loop of ``board`` (a :class:`~designer.spice.deck.Board` of
-    :func:`~designer.pid.netlist.loop_netlist`) on a new sheet."""
+    :func:`~designer.pid.netlist.loop_netlist`, its plant's designators prefixed
+    with ``plant_prefix``) on a new sheet."""
     s = Sheet(fontsize=10)
     bottom = _draw_controller(s, board, probes)
     # the plant, below, fed from u by its net label
     draw_plant(board, opamp, s, origin=(0.0, bottom), inp_label="u", probes={"y": probes.get("y", "CH2")},
-               supplies=False)
+               supplies=False, ref_prefix=plant_prefix)
     draw_supplies(s, board, opamp, (17.5, bottom - 1.0), per_row=12)
     return s
 

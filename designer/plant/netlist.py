@@ -7,22 +7,23 @@ The table (:class:`~designer.spice.deck.Netlist`) is the one description of the
 circuit: the decks, the schematic (:mod:`designer.plant.schematic`), the wiring
 table and the bill of materials are all written from it.
 
-Designators follow one scheme on every sheet, the seed's: the plant is R1, R2,
-C1, C2 and its op-amp U1; the controller (seed Figure 66) numbers its parts from
-R3 and C3 on. The seed's gain resistors of the general Sallen-Key (its R3 to
-ground and R4 in the feedback, K = (R3 + R4)/R3) would clash with the
-controller's R3 and R4, so they are R19 and R20 here.
+Designators are the Sallen-Key low-pass section's own
+(:mod:`designer.filters.sallen_key_lowpass_parts`, the seed's names): R1, R2,
+C1, C2, and with gain K = (R3 + R4)/R3 the gain pair R3 (to ground) and R4
+(feedback), as on the command line and in check-design; its op-amp is U1. Where
+the plant shares a sheet with a controller that owns R3 and R4 (the PID's
+closed loop), the caller gives a designator prefix (``ref_prefix``, the
+section's chaining mechanism: R3 -> RP3).
 """
 
 from __future__ import annotations
 
 from ..core.i18n import N_
 from ..core.opamps import OpAmp
+from ..filters.sallen_key_lowpass_parts import part_values, section_of
 from ..spice.deck import (
-    GROUND,
     Amp,
     Netlist,
-    Part,
     SquareTest,
     ac_lines,
     add_supplies,
@@ -35,21 +36,15 @@ from .sallenkey import SallenKeyParts
 
 __all__ = ["plant_ac_deck", "plant_deck", "plant_netlist", "plant_prbs_deck"]
 
-#: the seed's name of each plant part (its R3, R4 of the gain are R19, R20 here), by designator
-SEED_NAMES = {"R1": "R1", "R2": "R2", "C1": "C1", "C2": "C2", "R19": "R3", "R20": "R4"}
-#: designators of the gain resistors (to ground, feedback): the seed's R3 and R4
-GAIN_REFS = ("R19", "R20")
-#: the designator of each SallenKeyParts field
-FIELD_OF = {"R1": "r1", "R2": "r2", "C1": "c1", "C2": "c2", "R19": "r3", "R20": "r4"}
-
 
 def plant_netlist(parts: SallenKeyParts, inp: str = "input", out: str = "out", prefix: str = "",
-                  amp_ref: str = "U1") -> Netlist:
+                  amp_ref: str = "U1", ref_prefix: str = "") -> Netlist:
     """The Sallen-Key low-pass between nets ``inp`` and ``out`` (internal nets
     ``v1``, ``vp``, ``vn`` with ``prefix``): R1 from the input to v1, R2 from v1
     to the non-inverting input, C1 from there to ground, C2 from v1 to the output
-    (the positive feedback); a follower at K = 1, else R19 (inverting input to
-    ground) and R20 (output to inverting input).
+    (the positive feedback); a follower at K = 1, else the gain pair (inverting
+    input to ground, output to inverting input). Designators and roles are the
+    section's (:func:`designer.filters.sallen_key_lowpass_parts.section_of`).
 
     Parameters
     ----------
@@ -58,25 +53,23 @@ def plant_netlist(parts: SallenKeyParts, inp: str = "input", out: str = "out", p
     inp, out : str
         The input and output nets.
     prefix : str
-        Prepended to the internal nets and designators (for chaining).
+        Prepended to the internal nets.
     amp_ref : str
         The op-amp's reference.
+    ref_prefix : str
+        Put after each designator's letter (R1 -> RP1 with ``"P"``), for a sheet
+        the plant shares.
 
     Returns
     -------
     Netlist
         The circuit.
     """
-    v1, vp, vn = f"{prefix}v1", f"{prefix}vp", f"{prefix}vn"
-    rows = [Part("R1", inp, v1, parts.r1, N_("input resistor")),
-            Part("R2", v1, vp, parts.r2, N_("to the non-inverting input")),
-            Part("C1", vp, GROUND, parts.c1, N_("non-inverting input to ground")),
-            Part("C2", v1, out, parts.c2, N_("R1-R2 node to the output (feedback)"))]
-    if parts.r3 is None:
-        return Netlist(tuple(rows), (Amp(amp_ref, N_("plant"), vp, out, out),))
-    rows += [Part("R19", vn, GROUND, parts.r3, N_("gain: inverting input to ground (seed's R3)")),
-             Part("R20", out, vn, parts.r4, N_("gain: output to inverting input (seed's R4)"))]
-    return Netlist(tuple(rows), (Amp(amp_ref, N_("plant"), vp, vn, out),))
+    section = section_of(parts)
+    vp, vn = f"{prefix}vp", f"{prefix}vn"
+    net = section.wired(part_values(parts), ref_prefix, amp_ref, inp, out, (f"{prefix}v1", vp, vn))
+    follower = parts.r3 is None
+    return Netlist(net.parts, (Amp(amp_ref, N_("plant"), vp, out if follower else vn, out),))
 
 
 def _circuit(title: str, opamp: OpAmp, header: list):

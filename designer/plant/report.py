@@ -25,7 +25,7 @@ from ..report.tolerance import csv_texts, histogram_plots
 from ..report.tolerance import section as tolerance_section
 from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
-from .netlist import SEED_NAMES, plant_netlist
+from .netlist import plant_netlist
 
 __all__ = ["bode_png", "schematic", "sine_text", "step_png", "summary_text", "waveforms_csv", "write_outputs"]
 
@@ -93,7 +93,7 @@ def bom(result, b=None) -> list:
     lab = result.sourcing.parts
 
     def source(ref):
-        src = lab.get(SEED_NAMES.get(ref, ref))
+        src = lab.get(ref)
         return None if src is None else (src.series, src.tolerance_pct)
     return bom_rows(b, source, result.opamp.name)
 

@@ -8,6 +8,7 @@ comes from that table, the layout alone is written here.
 
 from __future__ import annotations
 
+from ..filters.sallen_key_lowpass_parts import section_of
 from ..report.schematic import Sheet
 
 __all__ = ["draw_plant", "draw_supplies"]
@@ -17,7 +18,7 @@ PROBES = {"input": "CH1", "out": "CH2"}
 
 
 def draw_plant(board, opamp, sheet: Sheet | None = None, origin=(0.0, 0.0), inp_label: str = "generator",
-               probes: dict = PROBES, supplies: bool = True) -> Sheet:
+               probes: dict = PROBES, supplies: bool = True, ref_prefix: str = "") -> Sheet:
     """The Sallen-Key plant of ``board`` (a :class:`~designer.spice.deck.Board`
     whose netlist is :func:`~designer.plant.netlist.plant_netlist`'s) on
     ``sheet`` (a new one by default) at ``origin``; its input net is labelled
@@ -40,6 +41,8 @@ def draw_plant(board, opamp, sheet: Sheet | None = None, origin=(0.0, 0.0), inp_
         Net -> the scope channel on it.
     supplies : bool
         Draw the supplies.
+    ref_prefix : str
+        The plant's designator prefix on a shared sheet (:func:`~designer.plant.netlist.plant_netlist`).
 
     Returns
     -------
@@ -51,7 +54,10 @@ def draw_plant(board, opamp, sheet: Sheet | None = None, origin=(0.0, 0.0), inp_
     amp = n.amps[0]
     unit = board.unit_of(amp.ref)
     x0, y0 = origin
-    r1, r2, c1, c2 = (n.part(r) for r in ("R1", "R2", "C1", "C2"))
+    section = section_of(with_gain=amp.inn != amp.out)
+    # the section's parts in its declared order: the network (input R, R to +in, C to ground, feedback C),
+    # then the gain pair (to ground, feedback)
+    r1, r2, c1, c2, *gain = (n.part(section.prefixed(r, ref_prefix)) for r in section.designators)
     pin = (x0, y0)
     a = (x0 + 3.0, y0)
     b = (x0 + 6.0, y0)
@@ -84,14 +90,14 @@ def draw_plant(board, opamp, sheet: Sheet | None = None, origin=(0.0, 0.0), inp_
     if amp.inn == amp.out:      # follower: output back to the inverting input
         s.wire(inn, (inn[0] - 0.5, inn[1]), (inn[0] - 0.5, low), (o[0], low), o)
     else:
-        r19, r20 = n.part("R19"), n.part("R20")
+        to_ground, feedback = gain
         k = (inn[0] - 0.5, low)
         s.wire(inn, (inn[0] - 0.5, inn[1]), k)
-        s.part(r20, (o[0], low), k, label_loc="bottom")
+        s.part(feedback, (o[0], low), k, label_loc="bottom")
         s.wire(o, (o[0], low))
         s.dot(k)
         g = (k[0], k[1] - 2.5)
-        s.part(r19, k, g, label_loc="bottom")
+        s.part(to_ground, k, g, label_loc="bottom")
         s.ground(g)
     if supplies:
         draw_supplies(s, board, opamp, (x0 + 1.0, y0 - 8.2 if amp.inn != amp.out else y0 - 5.6))

@@ -3,8 +3,8 @@ in ngspice, many samples per ngspice process.
 
 The plant deck design-plant writes (:func:`designer.plant.netlist.plant_deck`)
 is loaded once, without its ``.tran`` and ``.meas`` lines; a loop of control
-commands then, per sample, ``alter``\\ s R1 R2 C1 C2 (and the gain resistors, the
-deck's R19/R20 for the seed's R3/R4; the op-amp's integrating capacitor for
+commands then, per sample, ``alter``\\ s each part of the deck's Sallen-Key section
+(by its designator; the op-amp's integrating capacitor for
 ``--tol GBW``; for ``--tol SR`` the op-amp subcircuit's own ``SR`` parameter,
 made a global ``.param`` of the loaded copy, is changed by ``alterparam`` and the
 circuit ``reset`` before the other alters, :func:`opamp_commands`), runs ``tran`` over the rising half of the bench period only, and
@@ -78,7 +78,7 @@ class SpiceContext:
     """What every sample of one design shares (picklable: strings and numbers).
 
     ``circuit`` is the plant deck without its analyses; ``elements`` maps each
-    designator that may vary to its element in the deck (``R3`` -> ``r19``);
+    designator that may vary to its element in the deck (``R3`` -> ``r3``);
     ``cint`` names the op-amp's integrating capacitor and ``rint`` its resistor
     (``GBW`` varies through C = A0/(2 pi GBW RINT); the model's slew current is fixed
     at the nominal one, so the slew rate follows the gain-bandwidth, as a real
@@ -132,10 +132,8 @@ def context(deck: str, parts, opamp, test, simulator: str = "ngspice-cli") -> Sp
     keep = [ln for ln in deck.splitlines()
             if not re.match(r"\s*\.(meas\w*|tran|end)\b", ln, re.I)]
     net = plant_netlist(parts)
-    elements = tuple((d, p.ref.lower()) for d, p in zip(("R1", "R2", "C1", "C2", "R3", "R4"), net.parts))
-    nominal = (("R1", parts.r1), ("R2", parts.r2), ("C1", parts.c1), ("C2", parts.c2))
-    if parts.r3 is not None:
-        nominal += (("R3", parts.r3), ("R4", parts.r4))
+    elements = tuple((p.ref, p.ref.lower()) for p in net.parts)
+    nominal = tuple((p.ref, p.value) for p in net.parts)
     step = MAX_STEP_FACTOR * test.max_step_s()
     if test.time_scale_s is not None:
         step = min(step, test.time_scale_s / MIN_STEPS_PER_TIME_SCALE)

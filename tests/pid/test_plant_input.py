@@ -105,9 +105,9 @@ def test_gain_without_resistors_from_parts_builds_them_too(capsys):
     res = design_pid(PidSpec(plant_parts=SallenKeyParts(R, R, C, C, 1.5), opamp="ideal", tuning="simc"),
                      simulate=False)
     assert (res.plant.r3, res.plant.r4) == (DEFAULT_R3_OHM, 0.5 * DEFAULT_R3_OHM)
-    # the plant's gain resistors (the seed's R3, R4) are R19 and R20 in the one designator scheme
-    assert "R19 pvn 0" in res.deck and "R20 y pvn" in res.deck
-    assert "R19" not in design_pid(PidSpec(plant_parts=SallenKeyParts(820, 1e3, 10e-9, 220e-9), opamp="ideal",
+    # the controller owns R3, R4: the plant's section carries the chaining prefix P (RP1 .. RP4), no renaming
+    assert "RP3 pvn 0" in res.deck and "RP4 y pvn" in res.deck and "RP1 u pv1" in res.deck
+    assert "RP" not in design_pid(PidSpec(plant_parts=SallenKeyParts(820, 1e3, 10e-9, 220e-9), opamp="ideal",
                                            tuning="simc"), simulate=False).deck
 
 

@@ -28,6 +28,19 @@ def test_a_designed_plant_keeps_its_series_when_the_controller_uses_the_seed_par
     assert rows["R5"][4] == "as given"
 
 
+def test_a_gain_plants_parts_keep_the_plants_series_under_their_prefix():
+    # regression: the BOM knew the plant's parts by a fixed list (R1 R2 C1 C2 R19 R20); the plant with gain is
+    # its section prefixed (RP1 .. RP4) beside the controller's own R3, R4
+    from designer.pid.report import bom
+    from designer.plant.sallenkey import SallenKeyParts
+    result = design_pid(PidSpec(plant_parts=SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, 1.5, 10e3, 5e3),
+                                opamp="ideal", tuning="simc"), simulate=False)
+    rows = {ref: row for row in bom(result) for ref in row[0].split(", ")}
+    assert {"RP1", "RP2", "CP1", "CP2", "RP3", "RP4", "R3", "R4"} <= set(rows)
+    assert rows["RP3"][4] == rows["RP1"][4] and rows["CP1"][4] == rows["CP2"][4]
+    assert "R1" not in rows and "R19" not in rows
+
+
 def test_renderers_read_the_typed_result_and_compute_nothing(monkeypatch):
     # the build sheet and the plots take the result as it is: no JSON round trip, no design code
     from designer.pid import design, model, report

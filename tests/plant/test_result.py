@@ -59,7 +59,7 @@ def test_renderers_read_the_typed_result_and_never_its_json(monkeypatch):
 
     monkeypatch.setattr(PlantResult, "to_dict", no_json)
     text = report.summary_text(r)
-    assert "Bill of materials" in text and "R19" in text and "R20" in text and "not simulated" in text
+    assert "Bill of materials" in text and "R3" in text and "R4" in text and "not simulated" in text
     lines = report.waveforms_csv(r).splitlines()
     assert lines[0] == "time_s,input_v,output_v,analytic_v,analytic_opamp_v" and len(lines) == 4002
     data = np.loadtxt(lines[1:], delimiter=",")

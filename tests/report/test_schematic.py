@@ -58,7 +58,7 @@ def test_the_plant_drawing_is_its_deck(parts, name, kind):
     nets, _ = sheet.connectivity()
     assert {k for k in terms if k[0][0] in "RC"} <= set(nets)
     if parts.r3 is not None:
-        assert ("R19", "a") in nets and ("R20", "b") in nets
+        assert ("R3", "a") in nets and ("R4", "b") in nets   # the gain pair as on the command line
 
 
 @pytest.mark.parametrize("derivative", [True, False], ids=["PID", "PI"])
@@ -79,6 +79,21 @@ def test_the_loop_drawing_is_its_deck(derivative, name, kind):
     amps = {k[0] for k in deck_terminals(deck) if k[0].startswith("U")}
     assert amps == {a.ref for a in b.netlist.amps}
     assert all((a, "out") in nets for a in amps)
+
+
+def test_a_gain_plant_in_the_loop_is_drawn_with_its_prefixed_designators():
+    # the controller owns R3, R4: the plant's section comes in with the chaining prefix (RP1 .. RP4), and the
+    # drawing finds its parts by the same prefix
+    from designer.pid.netlist import plant_ref_prefix
+    amp = opamps.get("LM741")
+    plant = SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, 1.5, 10e3, 5e3)
+    deck = closed_loop_deck(seed_parts(), plant, amp, TEST, "t", 2.0)
+    b = board(loop_netlist(seed_parts(), plant), amp)
+    sheet = draw_loop(b, amp, plant_prefix=plant_ref_prefix(plant))
+    terms = drawn_terminals(b, deck)
+    assert check_connectivity(sheet, terms) == []
+    nets, _ = sheet.connectivity()
+    assert {("RP3", "a"), ("RP4", "b"), ("RP1", "a"), ("R3", "a"), ("R4", "a")} <= set(nets)
 
 
 def test_a_miswired_drawing_is_caught():

@@ -1,0 +1,124 @@
+"""The Sallen-Key low-pass's part names, in one place: the designators the
+section declares (:class:`~designer.filters.sallen_key_lowpass.SallenKeyLowPass`:
+R1, R2, C1, C2 and, with gain K = 1 + R4/R3, R3 and R4; the seed's names, seed
+001 sections IV.3-IV.9, which are TI's in "Op Amps for Everyone", ch. 16,
+SLOA088) and the lower-case field of each on the plant's parts record
+(:class:`designer.plant.sallenkey.SallenKeyParts`: ``r1`` .. ``r4``), the
+names the JSON keys, the command line's ``--r1`` .. and check-design's YAML
+spell.
+
+Every module outside the Sallen-Key family reads the plant's parts from here
+(the section's declaration, :attr:`~designer.filters.topology.Topology.parts`)
+instead of spelling them: the designator of a field, the field of a
+designator, the section of a parts record and its values by designator.
+"""
+
+from __future__ import annotations
+
+from .registry import get
+from .topology import Topology
+
+__all__ = ["FIELD_OF", "REF_OF", "section_of", "part_values", "field_values", "refs", "fields", "gain_refs"]
+
+#: the plant record's field of each designator of the section (with gain)
+FIELD_OF = {"R1": "r1", "R2": "r2", "C1": "c1", "C2": "c2", "R3": "r3", "R4": "r4"}
+#: the designator of each field
+REF_OF = {f: r for r, f in FIELD_OF.items()}
+#: the registry names of the follower and of the section with gain
+_NAMES = ("sallen-key-lowpass", "sallen-key-lowpass-gain")
+
+
+def section_of(parts=None, with_gain: bool | None = None) -> Topology:
+    """The registered Sallen-Key low-pass a parts record realises: the follower
+    when it has no gain pair (``r3`` None), else the section with gain.
+
+    Parameters
+    ----------
+    parts : object, optional
+        Has ``r3`` (a :class:`~designer.plant.sallenkey.SallenKeyParts`).
+    with_gain : bool, optional
+        Instead of ``parts``: which section.
+
+    Returns
+    -------
+    Topology
+        The registry's instance.
+    """
+    if with_gain is None:
+        with_gain = parts is not None and getattr(parts, "r3", None) is not None
+    return get(_NAMES[bool(with_gain)])
+
+
+def refs(with_gain: bool = True) -> tuple:
+    """The section's designators, in its declared order.
+
+    Parameters
+    ----------
+    with_gain : bool
+        Include the gain pair.
+
+    Returns
+    -------
+    tuple of str
+        ``R1 R2 C1 C2`` (then ``R3 R4``).
+    """
+    return section_of(with_gain=with_gain).designators
+
+
+def fields(with_gain: bool = True) -> tuple:
+    """The plant record's fields, in the section's declared order.
+
+    Parameters
+    ----------
+    with_gain : bool
+        Include the gain pair.
+
+    Returns
+    -------
+    tuple of str
+        ``r1 r2 c1 c2`` (then ``r3 r4``).
+    """
+    return tuple(FIELD_OF[r] for r in refs(with_gain))
+
+
+def gain_refs() -> tuple:
+    """The designators the gain section adds to the follower's (to ground, feedback).
+
+    Returns
+    -------
+    tuple of str
+        The gain pair.
+    """
+    return section_of(with_gain=True).choice_parts
+
+
+def part_values(parts) -> dict:
+    """A parts record's values by designator, the parts of :func:`section_of` it.
+
+    Parameters
+    ----------
+    parts : object
+        Has the fields of :data:`FIELD_OF` (a :class:`~designer.plant.sallenkey.SallenKeyParts`).
+
+    Returns
+    -------
+    dict
+        Designator -> value (ohm, farad).
+    """
+    return {r: getattr(parts, FIELD_OF[r]) for r in section_of(parts).designators}
+
+
+def field_values(values: dict) -> dict:
+    """Values by designator as the plant record's keyword arguments.
+
+    Parameters
+    ----------
+    values : dict
+        Designator -> value.
+
+    Returns
+    -------
+    dict
+        Field -> value (``{"r1": ..}``).
+    """
+    return {FIELD_OF[r]: v for r, v in values.items()}
