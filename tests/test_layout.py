@@ -405,3 +405,85 @@ def test_the_numpydoc_check_fails_on_planted_gaps(tmp_path, monkeypatch):
             del sys.modules[name]
     assert codes == ["plantednpd.a.Thing GL08", "plantednpd.a.bare GL08", "plantednpd.a.no_returns PR01",
                      "plantednpd.a.no_returns RT01"]
+
+
+# --------------------------------------------------------------------------- part names (issue 26)
+#: the Sallen-Key low-pass's designators (with its gain pair; R19/R20 the plant deck's old names for it), its
+#: parts record's fields and its result.json keys: spelled as a string in code, a module names its parts
+SK_PART_NAME = r"(R1|R2|C1|C2|R3|R4|R19|R20|r1|r2|c1|c2|r3|r4)(_ohm|_f)?"
+#: the modules that may spell them: the Sallen-Key low-pass's own family (the section, its parts table, its
+#: synthesis and its fast-path search) and every other topology's own module (each declares its own R1, C1 ..)
+PART_NAME_OWNERS = ("designer/filters/sallen_key", "designer/filters/mfb_", "designer/filters/rc_",
+                    "designer/filters/inverting_lowpass.py")
+#: (module, top-level definition) -> why it may still spell them
+PART_NAME_EXEMPT = {
+    ("designer/cli/common.py", "FLAGS"): "the command line's name table: library parameter -> --flag (--r1 ..)",
+    ("designer/cli/plant.py", "analyze_plant_parser"): "the command line's name table: the --r1 .. --c2 options",
+    ("designer/cli/pid.py", "_add_plant_options"): "the command line's name table: --plant-r1 .. --plant-c2",
+    ("designer/report/plots.py", "step_plot"): "matplotlib's colour 'C2' (its colour cycle), not a part",
+    ("designer/filters/design.py", "stage_candidates"): "the free choice named r3 of Topology.choices (the gain "
+                                                        "section's), by its name; filters/design is another "
+                                                        "helper's (the generic search)",
+    ("designer/pid/netlist.py", "controller_stages"): "the controller's own R3, R4 (seed Figure 66)",
+    ("designer/pid/schematic.py", "_draw_controller"): "the controller's own R3, R4 (seed Figure 66)",
+    # the PID pipelines are being merged by another helper (issue 26): their plant names are left for that merge
+    ("designer/pid/plant.py", "sallen_key_parts"): "pid, left for the PID merge: the plant's fields in messages",
+    ("designer/pid/plant_source.py", "BUILT_KEYS"): "pid, left for the PID merge: a design-plant JSON's keys",
+    ("designer/pid/spec.py", "PLANT_NAMES"): "pid, left for the PID merge: the plant's fields in messages",
+    ("designer/pid/spec.py", "PLANT_RANGES"): "pid, left for the PID merge: the plant's fields' ranges",
+    ("designer/pid/spec.py", "BUILT_KEYS"): "pid, left for the PID merge: a design-plant JSON's keys",
+    ("designer/pid/spec.py", "plant_from_json"): "pid, left for the PID merge: a design-plant JSON's keys",
+    ("designer/pid/spec.py", "controller_from_json"): "the controller's own R3 in a design-pid JSON",
+    ("designer/web/jobs.py", "plant_page"): "web, another helper's: the input resistor the generator drives",
+}
+
+
+def part_names_spelled(root: Path, owners=PART_NAME_OWNERS) -> list:
+    """(module, top-level definition, line, string) of every string constant in code (docstrings and
+    comments are prose, and f-string pieces are messages) that is exactly one of :data:`SK_PART_NAME`, in
+    the modules under ``root/designer`` outside ``owners``."""
+    import re
+    pattern = re.compile(SK_PART_NAME)
+    out = []
+    for path in sorted((root / "designer").rglob("*.py")):
+        rel = path.relative_to(root).as_posix()
+        if rel.startswith(owners):
+            continue
+        tree = ast.parse(path.read_text())
+        docs = {id(n.body[0].value) for n in ast.walk(tree)
+                if isinstance(n, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and n.body
+                and isinstance(n.body[0], ast.Expr) and isinstance(n.body[0].value, ast.Constant)}
+        for top in tree.body:
+            if isinstance(top, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                where = top.name
+            elif isinstance(top, ast.Assign) and isinstance(top.targets[0], ast.Name):
+                where = top.targets[0].id
+            elif isinstance(top, ast.AnnAssign) and isinstance(top.target, ast.Name):
+                where = top.target.id
+            else:
+                where = "<module>"
+            out += [(rel, where, n.lineno, n.value) for n in ast.walk(top)
+                    if isinstance(n, ast.Constant) and isinstance(n.value, str) and id(n) not in docs
+                    and pattern.fullmatch(n.value)]
+    return out
+
+
+def test_nothing_outside_the_sallen_key_family_names_its_parts():
+    found = [f"{rel}:{line} ({where}) spells {value!r}" for rel, where, line, value in part_names_spelled(ROOT)
+             if (rel, where) not in PART_NAME_EXEMPT]
+    assert not found, ("read the parts from the topology's declaration (designer.filters.sallen_key_lowpass_parts)"
+                       " instead:\n" + "\n".join(found))
+
+
+def test_every_part_name_exemption_is_still_needed():
+    used = {(rel, where) for rel, where, _, _ in part_names_spelled(ROOT)}
+    assert not set(PART_NAME_EXEMPT) - used
+
+
+def test_the_part_name_check_fails_on_a_planted_spelling(tmp_path):
+    plant(tmp_path, {"designer/plant/a.py": '"""R1 in a docstring is prose."""\n\n'
+                                            'REFS = ("R1", "C2")\n\n\ndef f(v):\n    """R3."""\n'
+                                            '    return v["R19"], f"{v} R1", "r1x"\n',
+                     "designer/filters/sallen_key_lowpass_parts.py": 'FIELD_OF = {"R1": "r1"}\n'})
+    assert [(w, line, v) for _, w, line, v in part_names_spelled(tmp_path)] == [
+        ("REFS", 3, "R1"), ("REFS", 3, "C2"), ("f", 8, "R19")]

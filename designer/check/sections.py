@@ -29,6 +29,7 @@ from ..core.checks import IDS, SPICE_AGREEMENT
 from ..core.errors import DesignError
 from ..core.fileio import shown
 from ..core.units import parse_value
+from ..filters.sallen_key_lowpass_parts import FIELD_OF, parts_of, refs
 from . import figures as F
 from .limits import LIMIT_KEYS, limit_from
 from .yamldoc import kind_of, closest
@@ -39,10 +40,10 @@ CONTROLLER_PARTS = tuple(f"R{i}" for i in range(3, 19)) + ("C3", "C4")
 #: the keys of each mapping below the top level
 SUB = {
     "target": ("fc", "zeta", "gain", "compensate_gbw"),
-    "parts": ("R1", "R2", "C1", "C2", "R3", "R4", "gain"),
+    "parts": (*refs(), "gain"),          # the Sallen-Key low-pass's designators (with its gain pair)
     "series": ("r", "c"),
     "bounds": ("r_min", "r_max", "c_min", "c_max"),
-    "plant": ("fc", "zeta", "R1", "R2", "C1", "C2", "gain", "json"),
+    "plant": ("fc", "zeta", *refs(with_gain=False), "gain", "json"),
     "tuning": ("rule", "kp", "ti", "td", "target_overshoot", "target_settling"),
     "controller": CONTROLLER_PARTS + ("json",),
     "spice_agreement": ("nrms_max", "against"),
@@ -50,8 +51,8 @@ SUB = {
     "yield": ("min", "samples", "seed", "engine", "sampler", "dist"),
 }
 #: the parts a ``tolerances:`` may name besides the classes R and C
-TOLERANCE_PARTS = {"plant": ("R1", "R2", "C1", "C2", "R3", "R4", "GBW", "SR"),
-                   "pid": ("R1", "R2", "C1", "C2") + CONTROLLER_PARTS + ("GBW", "SR"), "filter": ()}
+TOLERANCE_PARTS = {"plant": (*refs(), "GBW", "SR"),
+                   "pid": refs(with_gain=False) + CONTROLLER_PARTS + ("GBW", "SR"), "filter": ()}
 #: a yield's builds: at least, at most, and by default
 YIELD_SAMPLES = (10, 10 ** 6, 2000)
 STIMULUS = {"plant": ("amplitude", "frequency"), "pid": ("amplitude", "frequency", "edge")}
@@ -66,13 +67,13 @@ RELTOL, ABSTOL = 0.01, 1e-3
 #: library parameter -> the plant spec's key (messages of PlantSpec/AnalysisSpec)
 PLANT_KEYS = {"fc_hz": "target.fc", "target_fc_hz": "target.fc", "zeta": "target.zeta",
               "target_zeta": "target.zeta", "gain": "target.gain", "compensate_gbw": "target.compensate_gbw",
-              **{k: f"parts.{k.upper()}" for k in ("r1", "r2", "c1", "c2", "r3", "r4")},
+              **{f: f"parts.{r}" for r, f in FIELD_OF.items()},
               "plant": "parts", "r_series": "series.r", "c_series": "series.c",
               **{k: f"bounds.{k}" for k in ("r_min", "r_max", "c_min", "c_max")}, "opamp": "opamp",
               "amplitude_v": "stimulus.amplitude", "square_hz": "stimulus.frequency"}
 #: library parameter -> the pid spec's key (messages of PidSpec)
 PID_KEYS = {"plant_fc_hz": "plant.fc", "plant_zeta": "plant.zeta",
-            **{f"plant_{k}": f"plant.{k.upper()}" for k in ("r1", "r2", "c1", "c2")}, "plant_gain": "plant.gain",
+            **{f"plant_{FIELD_OF[r]}": f"plant.{r}" for r in refs(with_gain=False)}, "plant_gain": "plant.gain",
             "plant_json": "plant.json", "tuning": "tuning.rule", "kp": "tuning.kp", "ti_s": "tuning.ti",
             "td_s": "tuning.td", "target_overshoot_pct": "tuning.target_overshoot",
             "target_settling_s": "tuning.target_settling", "opamp": "opamp", "step_v": "stimulus.amplitude",
@@ -192,7 +193,6 @@ def read_topology(doc):
 
 def read_plant_designs(doc, corners):
     from ..plant.circuit import DEFAULT_TOPOLOGY
-    from ..plant.sallenkey import SallenKeyParts
     from ..plant.spec import AnalysisSpec, PlantSpec
     topo = read_topology(doc)
     target = doc.mapping(("target",), SUB["target"])
@@ -210,7 +210,7 @@ def read_plant_designs(doc, corners):
         for k in ("bounds",):
             if doc.data.get(k) is not None:
                 raise doc.error((k,), "bounds: limit a design's part search; parts: are already chosen")
-        sk = SallenKeyParts(*(parts.get(k) for k in ("R1", "R2", "C1", "C2", "gain", "R3", "R4")))
+        sk = parts_of({r: parts.get(r) for r in refs()}, gain=parts.get("gain"))
         kw = {k: v for k, v in common.items() if k in ("r_series", "c_series", "amplitude_v", "square_hz")}
         designs = [built_in_spec_words(doc, PLANT_KEYS, lambda amp=amp: AnalysisSpec(
             sk, opamp=amp, target_fc_hz=target.get("fc"), target_zeta=target.get("zeta"), **kw))
@@ -255,7 +255,6 @@ def read_circuit_designs(doc, corners, topo, target):
 def read_pid_designs(doc, corners):
     from ..pid.blocks import PidParts
     from ..pid.spec import PidSpec, controller_from_json
-    from ..plant.sallenkey import SallenKeyParts
     plant = doc.mapping(("plant",), SUB["plant"])
     if not plant:
         raise doc.error(("plant",) if "plant" in doc.data else (),
@@ -264,9 +263,9 @@ def read_pid_designs(doc, corners):
     kw.update({"plant_fc_hz": plant.get("fc"), "plant_zeta": plant.get("zeta")})
     if "json" in plant:
         kw["plant_json"] = str(doc.resolve(("plant", "json")))
-    given = [k for k in ("R1", "R2", "C1", "C2") if k in plant]
+    given = [r for r in refs(with_gain=False) if r in plant]
     if given:
-        kw["plant_parts"] = SallenKeyParts(*(plant.get(k) for k in ("R1", "R2", "C1", "C2", "gain")))
+        kw["plant_parts"] = parts_of({r: plant.get(r) for r in refs(with_gain=False)}, gain=plant.get("gain"))
     elif "gain" in plant:
         raise doc.error(("plant", "gain"), "plant.gain goes with plant.R1 .. plant.C2")
     tuning = doc.data.get("tuning")

@@ -6,13 +6,14 @@
 from __future__ import annotations
 
 from ..core.errors import DesignError
+from ..filters.sallen_key_lowpass_parts import refs
 
 __all__ = []
 
 #: the controller's parts a --tol may name
 CONTROLLER_PARTS = (*(f"R{i}" for i in range(3, 19)), "C3", "C4")
 #: the loop's parts a --tol may name: the plant's and the controller's
-LOOP_PARTS = ("R1", "R2", "C1", "C2", *CONTROLLER_PARTS)
+LOOP_PARTS = (*refs(with_gain=False), *CONTROLLER_PARTS)
 
 
 def add_monte_carlo(p):

@@ -10,6 +10,7 @@ from .. import __version__
 from ..core.errors import DesignError
 from ..core.ranges import help_range
 from ..filters import registry
+from ..filters.sallen_key_lowpass_parts import FIELD_OF, fields, refs
 from ..plant.circuit import DEFAULT_TOPOLOGY
 from .common import (
     OneLineParser,
@@ -186,7 +187,7 @@ def _add_spice_options(g):
 
 
 #: the designators a plant's --tol may name
-PLANT_PARTS = ("R1", "R2", "C1", "C2", "R3", "R4")
+PLANT_PARTS = refs()      # the Sallen-Key low-pass section's, with its gain pair
 
 
 def monte_carlo_settings(args, designators=PLANT_PARTS, parse_limit_item=None):
@@ -445,7 +446,7 @@ def _circuit_unsupported(args, topo, options=()) -> None:
 
 def _analyze_circuit(args, topo) -> int:
     """analyze-plant --topology NAME (not the default) --part REF=VALUE ..: a section's parts as built."""
-    named = [n for n in ("r1", "r2", "c1", "c2", "r3", "r4", "gain") if getattr(args, n) is not None]
+    named = [n for n in (*fields(), "gain") if getattr(args, n) is not None]
     if named:
         raise DesignError(f"--{named[0]} is the {DEFAULT_TOPOLOGY}'s; give {topo.name}'s parts as --part REF=VALUE "
                           f"({', '.join(topo.designators)})")
@@ -571,7 +572,7 @@ def part_values(items) -> dict:
 
 
 #: the default section's parts (its gain resistors too: the gain K) as the command line names them (--r1 ..)
-SK_PART_OPTIONS = {r: r.lower() for r in registry.get(DEFAULT_TOPOLOGY + "-gain").designators}
+SK_PART_OPTIONS = {r: FIELD_OF[r] for r in refs()}
 
 
 def _sk_parts(args) -> None:
@@ -585,7 +586,7 @@ def _sk_parts(args) -> None:
         if getattr(args, dest) is not None:
             raise DesignError(f"--part {ref} and --{dest} name the same part; give it once")
         setattr(args, dest, value)
-    missing = [f"--{n}" for n in ("r1", "r2", "c1", "c2") if getattr(args, n) is None]
+    missing = [f"--{n}" for n in fields(with_gain=False) if getattr(args, n) is None]
     if missing:
         raise DesignError(f"the following arguments are required: {', '.join(missing)} (see analyze-plant --help)")
 
@@ -609,7 +610,7 @@ def _analyze(args) -> int:
                         package=args.package)
     p = spec.parts
     name = args.name if args.name is not None else "built_" + "_".join(
-        f"{k}{value_code(v)}" for k, v in (("r1", p.r1), ("r2", p.r2), ("c1", p.c1), ("c2", p.c2)))
+        f"{k}{value_code(getattr(p, k))}" for k in fields(with_gain=False))
     mc = monte_carlo_settings(args)
     spice = spice_settings(args, mc)
     stim = stimulus_settings(args)

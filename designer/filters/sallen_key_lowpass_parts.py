@@ -15,10 +15,14 @@ designator, the section of a parts record and its values by designator.
 
 from __future__ import annotations
 
+import numpy as np
+
 from .registry import get
+from .sallen_key_lowpass_synthesis import SallenKeyParts
 from .topology import Topology
 
-__all__ = ["FIELD_OF", "REF_OF", "section_of", "part_values", "field_values", "refs", "fields", "gain_refs"]
+__all__ = ["FIELD_OF", "REF_OF", "section_of", "part_values", "field_values", "refs", "fields", "gain_refs",
+           "parts_of", "gain_of", "network"]
 
 #: the plant record's field of each designator of the section (with gain)
 FIELD_OF = {"R1": "r1", "R2": "r2", "C1": "c1", "C2": "c2", "R3": "r3", "R4": "r4"}
@@ -122,3 +126,65 @@ def field_values(values: dict) -> dict:
         Field -> value (``{"r1": ..}``).
     """
     return {FIELD_OF[r]: v for r, v in values.items()}
+
+
+def network(values: dict) -> tuple:
+    """The RC network's values of ``values`` in the section's declared order
+    (the input resistor, the resistor to the non-inverting input, the capacitor
+    to ground, the feedback capacitor: the seed's r1, r2, c1, c2 of the closed forms).
+
+    Parameters
+    ----------
+    values : dict
+        Designator -> value (numbers or arrays).
+
+    Returns
+    -------
+    tuple
+        Four values.
+    """
+    return tuple(values[r] for r in refs(with_gain=False))
+
+
+def gain_of(values: dict):
+    """K = 1 + (feedback)/(to ground) of the gain pair in ``values``, 1 (shaped as
+    the network's values) without it.
+
+    Parameters
+    ----------
+    values : dict
+        Designator -> value (numbers or arrays).
+
+    Returns
+    -------
+    float or ndarray
+        The gain.
+    """
+    to_ground, feedback = gain_refs()
+    if to_ground in values and feedback in values:
+        return 1.0 + np.asarray(values[feedback]) / np.asarray(values[to_ground])
+    return np.ones_like(np.asarray(network(values)[0], dtype=float))
+
+
+def parts_of(values: dict, base=None, **other) -> SallenKeyParts:
+    """A parts record from values by designator.
+
+    Parameters
+    ----------
+    values : dict
+        Designator -> value: the network's, and optionally the gain pair's.
+    base : SallenKeyParts, optional
+        Where a gain pair missing from ``values`` comes from.
+    **other
+        The record's other fields (``gain``; None leaves it to
+        :func:`~designer.filters.sallen_key_lowpass_synthesis.check_parts`).
+
+    Returns
+    -------
+    SallenKeyParts
+        The record.
+    """
+    kw = field_values({r: values[r] for r in refs() if r in values})
+    if base is not None:
+        kw = {FIELD_OF[r]: getattr(base, FIELD_OF[r]) for r in gain_refs()} | kw
+    return SallenKeyParts(**kw, **other)

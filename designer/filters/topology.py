@@ -332,7 +332,6 @@ class Topology(ABC):
     parts: tuple = ()
     choices: tuple = ()
     example: SectionTarget | None = None
-    reference_capacitor: str = "C1"
     choice_parts: tuple = ()
 
     # ---- what every section implements ------------------------------------------------------
@@ -407,6 +406,12 @@ class Topology(ABC):
         return {}
 
     # ---- inherited ---------------------------------------------------------------------------
+    @property
+    def reference_capacitor(self) -> str:
+        """The part :attr:`SectionTarget.c_f` sets: the first capacitor :attr:`parts` declares
+        (a section whose synthesis scales from another overrides this)."""
+        return next(p.ref for p in self.parts if p.kind == "C")
+
     @property
     def designators(self) -> tuple:
         """The designators of :attr:`parts`, in order."""

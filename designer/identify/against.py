@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from ..core.errors import DesignError
 from ..core.fileio import shown
 from ..core.jsonio import json_safe, read_result
-from ..plant.sallenkey import SallenKeyParts, fn_zeta
+from ..plant.sallenkey import NETWORK_KEYS, SallenKeyParts, fn_zeta
 
 __all__ = ["agreement_band", "compare_with_design", "load_design", "model_fn_zeta", "overshoot_from_zeta"]
 
@@ -32,7 +32,7 @@ DEFAULT_C_TOL = 0.10
 GAIN_MEASUREMENT_TOL = 0.02
 #: The identified models a design is compared with, best first.
 SECOND_ORDER = ("underdamped", "overdamped", "double-pole")
-PART_KEYS = ("R1_ohm", "R2_ohm", "C1_f", "C2_f")
+PART_KEYS = NETWORK_KEYS
 
 
 def model_fn_zeta(m) -> tuple:

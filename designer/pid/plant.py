@@ -394,11 +394,11 @@ def sallen_key_circuit(parts) -> PlantCircuit:
         One stage.
     """
     from ..filters.cascade import Stage
-    from ..filters.registry import get
-    values = {"R1": parts.r1, "R2": parts.r2, "C1": parts.c1, "C2": parts.c2}
-    if math.isclose(parts.gain, 1.0):
-        return PlantCircuit((Stage(get("sallen-key-lowpass"), values),))
-    return PlantCircuit((Stage(get("sallen-key-lowpass-gain"), values | {"R3": parts.r3, "R4": parts.r4}),))
+    from ..filters.sallen_key_lowpass_parts import part_values, section_of
+    follower = math.isclose(parts.gain, 1.0)
+    values = part_values(parts)
+    section = section_of(with_gain=not follower)
+    return PlantCircuit((Stage(section, {r: values[r] for r in section.designators}),))
 
 
 def resolve_plant(spec) -> Plant:

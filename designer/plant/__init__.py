@@ -25,7 +25,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
              "prbs_run", "with_prbs"),
     "report": ("bode_png", "sine_text", "step_png", "summary_text", "waveforms_csv", "write_outputs"),
     "result": ("PlantResult",),
-    "sallenkey": ("DEFAULT_R3_OHM", "GAIN_TOLERANCE", "SallenKeyParts", "check_parts", "coefficients", "fn_zeta",
+    "sallenkey": ("DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts", "coefficients", "fn_zeta",
                   "ratios_from_rc", "realizability_notes", "resistors_for_caps"),
     "schematic": ("draw_plant", "draw_supplies"),
     "selection": ("Candidate", "brute_force", "joint_search"),

@@ -71,14 +71,15 @@ from .result import (
     SpiceRun,
     Target,
 )
-from .sallenkey import (
+from ..filters.sallen_key_lowpass_synthesis import (
     SallenKeyParts,
     ratios_from_rc,
     realizability_notes,
     resistors_for_caps,
     unity_gain_c2_min,
 )
-from .selection import around, brute_force, joint_search
+from ..filters.sallen_key_lowpass_parts import part_values, section_of
+from ..filters.sallen_key_lowpass_search import around, brute_force, joint_search
 from .spec import AnalysisSpec, PlantSpec
 
 __all__ = ["PlantSpec", "AnalysisSpec", "PlantResult", "choose_parts", "design_plant", "analyze_plant", "listed",
@@ -223,7 +224,7 @@ def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspi
     t_search = time.perf_counter() - tick
     target = Target(spec.fc_hz, spec.zeta, spec.gain)
     built = choice.built
-    refs = ("R1", "R2", "C1", "C2") + (("R3", "R4") if built.r3 is not None else ())
+    refs = section_of(built).designators
 
     def source(ref):
         series = spec.r_series if ref[0] == "R" else spec.c_series
@@ -270,9 +271,7 @@ def analyze_plant(spec: AnalysisSpec, simulate: bool = True, simulator: str = "p
     parts = spec.parts
     target = Target(spec.target_fc_hz, spec.target_zeta, parts.gain)
     notes = [f"these parts give fn = {parts.fn_hz:.5g} Hz and zeta = {parts.zeta:.4g} (Q = {parts.q:.4g})"]
-    values = {"R1": parts.r1, "R2": parts.r2, "C1": parts.c1, "C2": parts.c2}
-    if parts.r3 is not None:
-        values.update(R3=parts.r3, R4=parts.r4)
+    values = part_values(parts)
     labels, r_s, c_s, why = part_series(values, spec.r_series, spec.c_series)
     choice = Choice(parts, None, Ratios(parts.r1 / parts.r2, parts.c2 / parts.c1), [], notes + why)
     return _analyse("analyze", target, choice, Sourcing(r_s, c_s, labels), [], spec.amp, spec.amplitude_v,

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..core.lti import dominant_pair
 from ..core.opamps import OpAmp
+from ..filters.sallen_key_lowpass_parts import FIELD_OF, refs
 from .sallenkey import SallenKeyParts
 
 __all__ = ["plant_tf", "plant_tf_opamp", "sensitivities"]
@@ -113,7 +114,7 @@ def sensitivities(parts: SallenKeyParts, opamp: OpAmp | None = None, rel_step: f
             (wu, zu), (wd, zd) = figures(parts, up), figures(parts, dn)
         return Sensitivity(math.log(wu / wd) / dl, math.log(zu / zd) / dl)
 
-    names = {"R1": "r1", "R2": "r2", "C1": "c1", "C2": "c2"}
+    names = {r: FIELD_OF[r] for r in refs(with_gain=False)}
     if parts.gain != 1.0:
         names["K"] = "gain"
     table = {label: moved(parts, attr) for label, attr in names.items()}

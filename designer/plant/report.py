@@ -17,6 +17,7 @@ import numpy as np
 
 from ..core.i18n import N_, language
 from ..core.i18n import gettext as _
+from ..filters.sallen_key_lowpass_parts import refs, section_of
 from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import write_design
@@ -101,7 +102,7 @@ def bom(result, b=None) -> list:
 def _settings(result) -> list:
     """The generator and the scope as set (1-2-5 steps), and the sine check."""
     sine = result.sine
-    rows = bench_rows(result.test, result.scope, "R1")
+    rows = bench_rows(result.test, result.scope, section_of(result.built).designators[0])   # the input resistor
     if sine is not None:
         rows.append([_("sine check"), sine_text(sine)])
     return [R.table([_("set"), _("to")], rows, "compact"),
@@ -242,7 +243,7 @@ def _alternatives(alternatives):
              _f(a.figures.fn_hz, "Hz"), _n(a.figures.zeta), R.fmt_pct(a.figures.fn_error_pct),
              R.fmt_pct(a.figures.zeta_error_pct)]
             for i, a in enumerate(alternatives)]
-    return R.table(["#", "R1 / R2 / C1 / C2", "fn", "zeta", _("fn error"), _("zeta error")], rows)
+    return R.table(["#", " / ".join(refs(with_gain=False)), "fn", "zeta", _("fn error"), _("zeta error")], rows)
 
 
 def _spice(result):

@@ -24,7 +24,7 @@ from ..spice.deck import SquareTest
 from ..spice.simulate import tool_info
 from .bench import BenchPeriod, ScopeSetup, SineCheck, ToleranceBand
 from .circuit import DEFAULT_TOPOLOGY
-from .sallenkey import SallenKeyParts
+from .sallenkey import JSON_KEYS, SallenKeyParts
 
 __all__ = ["PlantResult"]
 
@@ -102,8 +102,8 @@ class Alternative:
 
     def to_dict(self) -> dict:
         f = self.figures
-        return {"R1_ohm": self.r1, "R2_ohm": self.r2, "C1_f": self.c1, "C2_f": self.c2, "fn_hz": f.fn_hz,
-                "zeta": f.zeta, "fn_error_pct": f.fn_error_pct, "zeta_error_pct": f.zeta_error_pct}
+        return {**{key: getattr(self, attr) for attr, key in JSON_KEYS.items() if hasattr(self, attr)},
+                "fn_hz": f.fn_hz, "zeta": f.zeta, "fn_error_pct": f.fn_error_pct, "zeta_error_pct": f.zeta_error_pct}
 
 
 @dataclass(frozen=True)

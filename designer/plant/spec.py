@@ -28,6 +28,7 @@ from ..core.eseries import PartBounds, series_name
 from ..core.opamps import OpAmp
 from ..core.ranges import RANGES, parse_in_range
 from ..filters import registry
+from ..filters.sallen_key_lowpass_parts import FIELD_OF
 from .circuit import DEFAULT_TOPOLOGY, plant_target
 from .sallenkey import SallenKeyParts, check_parts
 
@@ -132,7 +133,7 @@ class PlantSpec(PartBounds):
 
 
 #: the parts' fields as the plant check names them: markers of a ParamError
-_PART_NAMES = {k: f"{{{k}}}" for k in ("r1", "r2", "c1", "c2", "r3", "r4", "gain")}
+_PART_NAMES = {k: f"{{{k}}}" for k in (*FIELD_OF.values(), "gain")}
 
 
 @dataclass(frozen=True)

@@ -99,10 +99,12 @@ def loop_parts(result, tol_items=()) -> dict:
     dict
         Designator -> nominal value.
     """
+    from ..filters.sallen_key_lowpass_parts import part_values, refs
     from .parts import opamp_nominal
     c = result.parts
     p = None if is_model_loop(result) else result.plant
-    out = {} if p is None else {"R1": p.r1, "R2": p.r2, "C1": p.c1, "C2": p.c2}
+    # the plant's network only: its gain pair's designators are the controller's R3, R4 here
+    out = {} if p is None else {r: v for r, v in part_values(p).items() if r in refs(with_gain=False)}
     for f in fields(c):
         v = getattr(c, f.name)
         if v is not None:
@@ -305,7 +307,7 @@ def evaluate(context: LoopContext, values: dict) -> dict:
     from ..pid import model
     from ..pid.blocks import PidParts
     from ..plant.model import plant_tf, plant_tf_opamp
-    from ..plant.sallenkey import SallenKeyParts
+    from ..filters.sallen_key_lowpass_parts import parts_of, refs
     from .parts import sample_opamp
     n = next(iter(values.values())).size
     out = {k: np.full(n, np.nan) for k in FIGURES}
@@ -314,7 +316,7 @@ def evaluate(context: LoopContext, values: dict) -> dict:
     t = np.linspace(0.0, context.t_end, STEP_POINTS)
     r = model.reference(t, step, 0.0, context.edge_s)
     for i in range(n):
-        plant = SallenKeyParts(values["R1"][i], values["R2"][i], values["C1"][i], values["C2"][i])
+        plant = parts_of({r: values[r][i] for r in refs(with_gain=False)})
         parts = PidParts(**{k: (values[k.upper()][i] if k.upper() in values else None) for k in names})
         amp = sample_opamp(context.opamp, values, i)
         out["kp"][i], out["ti_s"][i], out["td_s"][i] = parts.kp, parts.ti_s, parts.td_s

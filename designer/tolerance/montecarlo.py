@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.errors import DesignError
+from ..filters.sallen_key_lowpass_parts import part_values, refs
 from . import plant as engine
 from . import runner, sampling
 from .parts import DISTRIBUTIONS, opamp_nominal, resolve
@@ -166,9 +167,9 @@ def plant_parts(parts) -> dict:
     dict
         Designator -> nominal value.
     """
-    nominal = {"R1": parts.r1, "R2": parts.r2, "C1": parts.c1, "C2": parts.c2}
-    if parts.r3 is not None and parts.r4 is not None and parts.gain > 1:
-        nominal.update(R3=parts.r3, R4=parts.r4)
+    nominal = part_values(parts)
+    if not (parts.r3 is not None and parts.r4 is not None and parts.gain > 1):
+        nominal = {r: v for r, v in nominal.items() if r in refs(with_gain=False)}
     return nominal
 
 

@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 
+from ..filters.sallen_key_lowpass_parts import gain_of, network
 from ..plant.sallenkey import fn_zeta
 
 __all__ = ["FIGURES", "evaluate", "plant_figures"]
@@ -32,14 +33,12 @@ NEWTON_STEPS = 8
 
 
 def _gain(v: dict):
-    if "R3" in v and "R4" in v:
-        return 1.0 + v["R4"] / v["R3"]
-    return np.ones_like(v["R1"])
+    return gain_of(v)
 
 
 def _cubic(v: dict, opamp):
     """(d3, d2, d1, d0) of D(s) with the op-amp (ideal: d3 = 0, the quadratic)."""
-    r1, r2, c1, c2 = v["R1"], v["R2"], v["C1"], v["C2"]
+    r1, r2, c1, c2 = network(v)
     k = _gain(v)
     i2 = r2 * c1 * r1 * c2
     i1 = r2 * c1 * (1 + r1 / r2) + r1 * c2
@@ -122,7 +121,7 @@ def plant_figures(v: dict, opamp=None) -> dict:
         Figure -> array over the samples.
     """
     k = _gain(v)
-    fn_i, z_i = fn_zeta(v["R1"], v["R2"], v["C1"], v["C2"], k)
+    fn_i, z_i = fn_zeta(*network(v), k)
     d3, d2, d1, d0 = _cubic(v, opamp)
     ideal = opamp is None or opamp.ideal
     dcoef = (d2, d1, d0) if ideal else (d3, d2, d1, d0)

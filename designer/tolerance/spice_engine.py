@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.errors import SimulatorError
+from ..filters.sallen_key_lowpass_parts import gain_refs
 
 __all__ = ["FIGURES", "commands", "context", "evaluate", "measures", "parse"]
 
@@ -100,8 +101,9 @@ class SpiceContext:
     def final_v(self, values: dict, n: int) -> np.ndarray:
         """Each sample's settled output: amplitude x K A0/(K + A0)."""
         nom = dict(self.nominal)
-        r3 = np.asarray(values.get("R3", nom.get("R3", np.nan)), float)
-        r4 = np.asarray(values.get("R4", nom.get("R4", np.nan)), float)
+        to_ground, feedback = gain_refs()
+        r3 = np.asarray(values.get(to_ground, nom.get(to_ground, np.nan)), float)
+        r4 = np.asarray(values.get(feedback, nom.get(feedback, np.nan)), float)
         k = np.where(np.isfinite(r3) & np.isfinite(r4), 1.0 + r4 / r3, 1.0) * np.ones(n)
         return self.amplitude_v * k * self.a0 / (k + self.a0)
 

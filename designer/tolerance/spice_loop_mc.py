@@ -263,7 +263,7 @@ def replay_spec(spec, result, values: dict):
     plant's too for a Sallen-Key plant; a model plant stays as given), no gains to meet (as built), and
     the run's square wave."""
     from ..pid.blocks import PidParts
-    from ..plant.sallenkey import SallenKeyParts
+    from ..filters.sallen_key_lowpass_parts import parts_of
     parts = PidParts(**{f.name: (values[f.name.upper()] if f.name.upper() in values else getattr(result.parts, f.name))
                         for f in dataclasses.fields(PidParts)})
     change = dict(controller_parts=parts, tuning=None, kp=None, ti_s=None, td_s=None, target_overshoot_pct=None,
@@ -271,8 +271,7 @@ def replay_spec(spec, result, values: dict):
     if spec.process is None:
         p = result.plant
         change.update(plant_fc_hz=None, plant_zeta=None, plant_json=None,
-                      plant_parts=SallenKeyParts(values["R1"], values["R2"], values["C1"], values["C2"], None,
-                                                 p.r3, p.r4))
+                      plant_parts=parts_of(values, base=p, gain=None))
     return dataclasses.replace(spec, **change)
 
 

@@ -393,12 +393,11 @@ def replay_result(result, rep: Replay, simulator: str, r_series=None, c_series=N
         The analysis of the sample.
     """
     from ..plant.design import analyze_plant
-    from ..plant.sallenkey import SallenKeyParts
+    from ..filters.sallen_key_lowpass_parts import parts_of
     from ..plant.spec import AnalysisSpec
     from .parts import sample_opamp
     v = rep.values
-    parts = SallenKeyParts(v["R1"], v["R2"], v["C1"], v["C2"], None, v.get("R3", result.built.r3),
-                           v.get("R4", result.built.r4))
+    parts = parts_of(v, base=result.built, gain=None)
     amp = sample_opamp(result.opamp, {k: np.array([x]) for k, x in v.items()}, 0)
 
     class _SampleSpec(AnalysisSpec):

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designer.core.errors import DesignError
-from designer.plant.sallenkey import SallenKeyParts, fn_zeta, ratios_from_rc, realizability_notes, resistors_for_caps
+from designer.filters.sallen_key_lowpass_synthesis import SallenKeyParts, fn_zeta, ratios_from_rc, realizability_notes, resistors_for_caps
 
 
 def test_seed_procedure_m_n_and_transfer_function():

@@ -7,9 +7,9 @@ from hypothesis import strategies as st
 
 from designer.core.eseries import nearest, values
 from designer.core.ranges import RANGES
-from designer.plant import selection
-from designer.plant.sallenkey import SallenKeyParts, ratios_from_rc
-from designer.plant.selection import brute_force, joint_search
+from designer.filters import sallen_key_lowpass_search as selection
+from designer.filters.sallen_key_lowpass_synthesis import SallenKeyParts, ratios_from_rc
+from designer.filters.sallen_key_lowpass_search import brute_force, joint_search
 
 #: Peak numpy memory the search may use, whatever the series and bounds (the
 #: benchmark's goal is 300 MB for the whole design-plant process).

@@ -1,0 +1,354 @@
+"""Sallen-Key low-pass synthesis (seed 001, sections IV.3-IV.9).
+
+Topology and names follow the seed: R1 from the input to node V1, R2 from V1
+to the non-inverting input, C1 from the non-inverting input to ground, C2 from
+V1 to the output; gain K = 1 + R4/R3 (R3 to ground, R4 feedback), K = 1 is a
+voltage follower.
+
+    Vs/Ve = K / (a s^2 + b s + 1),  a = R1 R2 C1 C2,
+    b = C1 (R1 + R2) + R1 C2 (1 - K)
+    wn = 1/sqrt(a),  zeta = b / (2 sqrt(a)),  Q = 1 / (2 zeta)
+
+These formulas live in :func:`coefficients` and :func:`fn_zeta` only (the
+parts' properties and the vectorised search use them). At unity gain zeta can
+only be reached with C2/C1 >= 1/zeta^2 (:func:`unity_gain_c2_min`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.errors import DesignError
+from ..core.ranges import RANGES, parse_in_range
+
+__all__ = ["DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts", "coefficients", "fn_zeta",
+           "ratios_from_rc", "realizability_notes", "resistors_for_caps"]
+
+#: the result.json key of each field of the record (:meth:`SallenKeyParts.as_dict`), the network first
+JSON_KEYS = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "r3": "R3_ohm", "r4": "R4_ohm"}
+#: the keys of the RC network (a follower's every part), in the record's order
+NETWORK_KEYS = tuple(JSON_KEYS.values())[:4]
+
+
+@dataclass(frozen=True)
+class SallenKeyParts:
+    """Component values of a Sallen-Key low-pass (ohms and farads).
+
+    Parameters
+    ----------
+    r1, r2 : float
+        The input resistor and the resistor to the non-inverting input.
+    c1, c2 : float
+        The capacitor to ground and the feedback capacitor.
+    gain : float
+        K = 1 + R4/R3 (1: a follower).
+    r3, r4 : float or None
+        The gain pair: to ground and feedback (None for a follower).
+    """
+
+    r1: float
+    r2: float
+    c1: float
+    c2: float
+    gain: float = 1.0
+    r3: float | None = None  #: gain-setting resistor to ground (None for a follower)
+    r4: float | None = None  #: gain-setting feedback resistor
+
+    @property
+    def a(self) -> float:
+        return coefficients(self.r1, self.r2, self.c1, self.c2, self.gain)[0]
+
+    @property
+    def b(self) -> float:
+        return coefficients(self.r1, self.r2, self.c1, self.c2, self.gain)[1]
+
+    @property
+    def wn(self) -> float:
+        return 1.0 / math.sqrt(self.a)
+
+    @property
+    def fn_hz(self) -> float:
+        return float(fn_zeta(self.r1, self.r2, self.c1, self.c2, self.gain)[0])
+
+    @property
+    def zeta(self) -> float:
+        return float(fn_zeta(self.r1, self.r2, self.c1, self.c2, self.gain)[1])
+
+    @property
+    def q(self) -> float:
+        return 1.0 / (2 * self.zeta) if self.zeta > 0 else math.inf
+
+    def as_dict(self) -> dict:
+        """The parts and their figures as result.json writes them.
+
+        Returns
+        -------
+        dict
+            :data:`JSON_KEYS` of the parts present, ``gain``, ``fn_hz`` and ``zeta``.
+        """
+        d = {key: getattr(self, f) for f, key in JSON_KEYS.items() if getattr(self, f) is not None}
+        d.update(gain=self.gain, fn_hz=self.fn_hz, zeta=self.zeta)
+        return d
+
+
+def coefficients(r1, r2, c1, c2, gain=1.0):
+    """a and b of K / (a s^2 + b s + 1), for numbers or arrays of them.
+
+    Parameters
+    ----------
+    r1, r2, c1, c2 : float or array_like
+        The parts (Ohm, F).
+    gain : float or array_like
+        The gain K.
+
+    Returns
+    -------
+    tuple
+        (a, b).
+    """
+    return r1 * r2 * c1 * c2, c1 * (r1 + r2) + r1 * c2 * (1.0 - gain)
+
+
+def fn_zeta(r1, r2, c1, c2, gain=1.0):
+    """Natural frequency (Hz) and damping of the Sallen-Key low-pass, for numbers
+    or arrays of them (the joint search evaluates millions at once).
+
+    Parameters
+    ----------
+    r1, r2, c1, c2 : float or array_like
+        The parts (Ohm, F).
+    gain : float or array_like
+        The gain K.
+
+    Returns
+    -------
+    tuple
+        (fn in Hz, zeta).
+    """
+    a, b = coefficients(r1, r2, c1, c2, gain)
+    sa = np.sqrt(a)
+    # wn = 1/sqrt(a) first, then fn: the rounding the designs' figures have always had
+    return (1.0 / sa) / (2 * np.pi), b / (2 * sa)
+
+
+def unity_gain_c2_min(c1, zeta: float):
+    """The smallest C2 with which a unity-gain Sallen-Key reaches ``zeta`` with C1:
+    C2/C1 >= 1/zeta^2 (seed 001's realizability condition, n >= 1/zeta^2)."""
+    return c1 / zeta ** 2
+
+
+def ratios_from_rc(fc_hz: float, zeta: float, r: float, c: float, gain: float = 1.0):
+    """The seed's procedure (simplification 2): fix R and C, solve m and n.
+
+    With R1 = m R, R2 = R, C1 = C, C2 = n C:  m n = 1/(wn R C)^2 and
+    m = 2 zeta sqrt(mn) - 1 + mn (K - 1),  n = mn / m.
+
+    Parameters
+    ----------
+    fc_hz : float
+        The natural frequency.
+    zeta : float
+        The damping.
+    r : float
+        R (Ohm).
+    c : float
+        C (F).
+    gain : float
+        The gain K.
+
+    Returns
+    -------
+    (m, n) : tuple of float
+
+    Raises
+    ------
+    DesignError
+        When m <= 0, i.e. R C is too large for this fc and zeta; the message
+        says how small R C must be.
+    """
+    wn = 2 * math.pi * fc_hz
+    p = 1.0 / (wn * r * c) ** 2
+    m = 2 * zeta * math.sqrt(p) - 1.0 + p * (gain - 1.0)
+    if m <= 0:
+        if gain == 1.0:
+            limit = 2 * zeta / wn
+            raise DesignError(
+                f"no positive m, n for R = {r:g} Ohm, C = {c:g} F: unity gain needs "
+                f"R*C < 2*zeta/wn = {limit:.4g} s (R*C is {r * c:.4g} s); choose a smaller R or C")
+        raise DesignError(f"no positive m, n for R = {r:g} Ohm, C = {c:g} F at gain {gain:g}: "
+                          "choose a smaller R or C, or a larger gain")
+    return m, p / m
+
+
+def resistors_for_caps(fc_hz: float, zeta: float, c1, c2, gain: float = 1.0):
+    """Exact R1, R2 (ohms) that give fc and zeta with capacitors C1, C2.
+
+    From R1 R2 = 1/(wn^2 C1 C2) and b = 2 zeta / wn:
+    (C1 + C2 (1 - K)) R1^2 - (2 zeta/wn) R1 + C1/(wn^2 C1 C2) = 0.
+    Vectorised over c1, c2. Returns two arrays (R1 roots, smaller first); a
+    root is nan where it is not a positive real number (for unity gain that is
+    C2/C1 < 1/zeta^2).
+
+    Parameters
+    ----------
+    fc_hz : float
+        The natural frequency.
+    zeta : float
+        The damping.
+    c1, c2 : float or array_like
+        The capacitors (F).
+    gain : float
+        The gain K.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        The R1 roots, smaller first (nan where not a positive real number).
+    """
+    c1 = np.asarray(c1, float)
+    c2 = np.asarray(c2, float)
+    wn = 2 * np.pi * fc_hz
+    alpha = c1 + c2 * (1.0 - gain)
+    beta = 2 * zeta / wn
+    gamma = 1.0 / (wn * wn * c2)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        disc = beta * beta - 4 * alpha * gamma
+        sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
+        # The cancellation-free form of the quadratic's roots: q = (beta + sq)/2
+        # gives gamma/q and q/alpha, so an alpha near zero (K C2 close to
+        # C1 + C2) leaves the finite root exact and sends the other to infinity.
+        q = 0.5 * (beta + sq)
+        ra = gamma / q
+        rb = np.where(alpha != 0, q / alpha, np.nan)
+        rb = np.where(np.isfinite(rb), rb, np.nan)
+    lo = np.fmin(ra, rb)
+    hi = np.fmax(ra, rb)
+    lo = np.where(lo > 0, lo, np.nan)
+    hi = np.where(hi > 0, hi, np.nan)
+    lo2 = np.where(np.isnan(lo), hi, lo)
+    hi2 = np.where(np.isnan(lo), np.nan, hi)
+    return lo2, hi2
+
+
+def realizability_notes(fc_hz: float, zeta: float, gain: float, c_lo: float, c_hi: float) -> list:
+    """Plain-language warnings about a spec, with a suggested fix.
+
+    Parameters
+    ----------
+    fc_hz : float
+        The natural frequency.
+    zeta : float
+        The damping.
+    gain : float
+        The gain K.
+    c_lo, c_hi : float
+        The capacitors' range (F).
+
+    Returns
+    -------
+    list of str
+        The warnings.
+    """
+    notes = []
+    if gain == 1.0:
+        need = unity_gain_c2_min(1.0, zeta)
+        if need > c_hi / c_lo:
+            k = 1.0 + 1.0 / (2 * zeta) if zeta < 0.5 else 2.0
+            notes.append(
+                f"unity gain needs C2/C1 >= 1/zeta^2 = {need:.4g}, more than the capacitor bounds allow "
+                f"({c_hi / c_lo:.4g}); use --gain K > 1 (e.g. --gain {k:.2g}) or widen --c-min/--c-max")
+        elif need > 100:
+            notes.append(
+                f"unity gain needs C2/C1 >= 1/zeta^2 = {need:.4g}, an impractical capacitor ratio; "
+                "a gain K > 1 (--gain) lowers it")
+    elif gain >= 3.0:
+        notes.append(f"gain K = {gain:g} >= 3 makes the equal-component Sallen-Key unstable; "
+                     "it relies on R1 C2 (K-1) staying below C1 (R1 + R2), so damping is very sensitive to parts")
+    return notes
+
+
+#: relative mismatch allowed between a stated gain K and its resistors' 1 + R4/R3
+GAIN_TOLERANCE = 1e-3
+#: R3 when only K is given (R4 = (K - 1) R3), as the command-line tools derive it
+DEFAULT_R3_OHM = 10e3
+_PART_NAMES = {"r1": "R1", "r2": "R2", "c1": "C1", "c2": "C2", "r3": "R3", "r4": "R4", "gain": "gain K",
+               "plant": "the plant"}
+
+
+def check_parts(parts: SallenKeyParts, name_of=None, text: bool = False) -> SallenKeyParts:
+    """The one validation of a Sallen-Key plant as built, however it arrives
+    (designed, typed as parts, or read from a JSON file).
+
+    Checks, in this order: every part value is a real number inside its
+    physical range (``designer.core.ranges``: ``resistor_ohm``, ``capacitor_f``,
+    ``gain``); R3 and R4 come together; a stated gain agrees with its
+    resistors, K = 1 + R4/R3 (seed 001, Fig. 43), within
+    :data:`GAIN_TOLERANCE`; and the circuit is a stable plant whose fn and
+    zeta (the module's formulas) lie in the ranges ``fc_hz`` and ``zeta``
+    that ``--fc``/``--zeta`` accept. A zeta <= 0 (K too large for the parts)
+    means the circuit oscillates on its own.
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        Values as received, possibly of the wrong type. ``gain`` may be None
+        (then it is 1 + R4/R3, or 1 without R3/R4).
+    name_of : mapping or callable, optional
+        What to call each field in messages: keys ``r1, r2, c1, c2, r3, r4,
+        gain`` and ``plant`` (the whole circuit), e.g. ``{"r1": "--plant-r1"}``;
+        missing keys default to ``R1``... ``gain K``, ``the plant``. Names
+        may be ``{name}`` markers of a
+        :class:`~designer.core.errors.ParamError` (the caller raises it).
+    text : bool
+        Also accept values as text in engineering notation (``"4k7"``), as a
+        user typed them; a file's values must be numbers.
+
+    Returns
+    -------
+    SallenKeyParts
+        Floats only; the gain is the resistors' 1 + R4/R3 when they are given,
+        and a gain K > 1 without them gets R3 = :data:`DEFAULT_R3_OHM` and
+        R4 = (K - 1) R3, so that the netlist builds the gain the model assumes.
+
+    Raises
+    ------
+    DesignError
+        One line naming the offending field and what is allowed.
+    """
+    def name(key):
+        if callable(name_of):
+            return name_of(key)
+        return (name_of or {}).get(key, _PART_NAMES[key])
+
+    def number(key, value, range_key):
+        if text:
+            return parse_in_range(value, name(key), range_key)
+        return RANGES[range_key].check(value, name(key))
+
+    r1, r2 = (number(k, getattr(parts, k), "resistor_ohm") for k in ("r1", "r2"))
+    c1, c2 = (number(k, getattr(parts, k), "capacitor_f") for k in ("c1", "c2"))
+    if (parts.r3 is None) != (parts.r4 is None):
+        raise DesignError(f"{name('r3')} and {name('r4')} go together (K = 1 + R4/R3)")
+    gain = None if parts.gain is None else number("gain", parts.gain, "gain")
+    if parts.r3 is not None:
+        r3, r4 = number("r3", parts.r3, "resistor_ohm"), number("r4", parts.r4, "resistor_ohm")
+        k = RANGES["gain"].check(1.0 + r4 / r3, f"1 + {name('r4')}/{name('r3')}")
+        if gain is not None and abs(gain - k) > GAIN_TOLERANCE * k:
+            raise DesignError(f"{name('gain')} = {gain:g} does not match its resistors: K = 1 + R4/R3 = "
+                              f"{k:.6g} (they must agree within {100 * GAIN_TOLERANCE:g} %)")
+        gain = k
+    elif gain is None or gain <= 1.0 + GAIN_TOLERANCE:
+        gain, r3, r4 = 1.0, None, None   # a voltage follower
+    else:
+        r3, r4 = DEFAULT_R3_OHM, (gain - 1.0) * DEFAULT_R3_OHM
+    out = SallenKeyParts(r1, r2, c1, c2, gain, r3, r4)
+    if not out.b > 0:
+        raise DesignError(
+            f"{name('plant')}: these parts give zeta = {out.zeta:.4g} <= 0 (R1 C2 (K - 1) is not below "
+            "C1 (R1 + R2)): the circuit oscillates on its own; lower the gain or change the parts")
+    RANGES["fc_hz"].check(out.fn_hz, f"{name('plant')}: the natural frequency fn of these parts")
+    RANGES["zeta"].check(out.zeta, f"{name('plant')}: the damping ratio zeta of these parts")
+    return out
