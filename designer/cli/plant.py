@@ -10,7 +10,7 @@ from .. import __version__
 from ..core.errors import DesignError
 from ..core.ranges import help_range
 from ..filters import registry
-from ..filters.sallen_key_lowpass_parts import FIELD_OF, fields, refs
+from ..filters.sallen_key_lowpass_parts import FIELD_OF, refs
 from ..plant.circuit import DEFAULT_TOPOLOGY
 from .common import (
     OneLineParser,
@@ -446,7 +446,7 @@ def _circuit_unsupported(args, topo, options=()) -> None:
 
 def _analyze_circuit(args, topo) -> int:
     """analyze-plant --topology NAME (not the default) --part REF=VALUE ..: a section's parts as built."""
-    named = [n for n in (*fields(), "gain") if getattr(args, n) is not None]
+    named = [n for n in (*FIELD_OF.values(), "gain") if getattr(args, n) is not None]
     if named:
         raise DesignError(f"--{named[0]} is the {DEFAULT_TOPOLOGY}'s; give {topo.name}'s parts as --part REF=VALUE "
                           f"({', '.join(topo.designators)})")
@@ -586,7 +586,7 @@ def _sk_parts(args) -> None:
         if getattr(args, dest) is not None:
             raise DesignError(f"--part {ref} and --{dest} name the same part; give it once")
         setattr(args, dest, value)
-    missing = [f"--{n}" for n in fields(with_gain=False) if getattr(args, n) is None]
+    missing = [f"--{FIELD_OF[r]}" for r in refs(with_gain=False) if getattr(args, FIELD_OF[r]) is None]
     if missing:
         raise DesignError(f"the following arguments are required: {', '.join(missing)} (see analyze-plant --help)")
 
@@ -610,7 +610,7 @@ def _analyze(args) -> int:
                         package=args.package)
     p = spec.parts
     name = args.name if args.name is not None else "built_" + "_".join(
-        f"{k}{value_code(getattr(p, k))}" for k in fields(with_gain=False))
+        f"{k}{value_code(getattr(p, k))}" for k in (FIELD_OF[r] for r in refs(with_gain=False)))
     mc = monte_carlo_settings(args)
     spice = spice_settings(args, mc)
     stim = stimulus_settings(args)

@@ -36,7 +36,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "sallen_key": ("GAIN_PARTS", "SallenKeySection",),
     "sallen_key_highpass": ("SallenKeyHighPass",),
     "sallen_key_lowpass": ("SallenKeyLowPass", "sallen_key_ratio_min",),
-    "sallen_key_lowpass_parts": ("FIELD_OF", "REF_OF", "field_values", "fields", "gain_of", "gain_refs", "network",
+    "sallen_key_lowpass_parts": ("FIELD_OF", "REF_OF", "gain_of", "gain_refs", "network",
                                  "part_values", "parts_of", "refs", "section_of",),
     "sallen_key_lowpass_search": ("Candidate",),
     "sallen_key_lowpass_synthesis": ("DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts",

@@ -21,7 +21,7 @@ from .registry import get
 from .sallen_key_lowpass_synthesis import SallenKeyParts
 from .topology import Topology
 
-__all__ = ["FIELD_OF", "REF_OF", "section_of", "part_values", "field_values", "refs", "fields", "gain_refs",
+__all__ = ["FIELD_OF", "REF_OF", "section_of", "part_values", "refs", "gain_refs",
            "parts_of", "gain_of", "network"]
 
 #: the plant record's field of each designator of the section (with gain)
@@ -69,22 +69,6 @@ def refs(with_gain: bool = True) -> tuple:
     return section_of(with_gain=with_gain).designators
 
 
-def fields(with_gain: bool = True) -> tuple:
-    """The plant record's fields, in the section's declared order.
-
-    Parameters
-    ----------
-    with_gain : bool
-        Include the gain pair.
-
-    Returns
-    -------
-    tuple of str
-        ``r1 r2 c1 c2`` (then ``r3 r4``).
-    """
-    return tuple(FIELD_OF[r] for r in refs(with_gain))
-
-
 def gain_refs() -> tuple:
     """The designators the gain section adds to the follower's (to ground, feedback).
 
@@ -110,22 +94,6 @@ def part_values(parts) -> dict:
         Designator -> value (ohm, farad).
     """
     return {r: getattr(parts, FIELD_OF[r]) for r in section_of(parts).designators}
-
-
-def field_values(values: dict) -> dict:
-    """Values by designator as the plant record's keyword arguments.
-
-    Parameters
-    ----------
-    values : dict
-        Designator -> value.
-
-    Returns
-    -------
-    dict
-        Field -> value (``{"r1": ..}``).
-    """
-    return {FIELD_OF[r]: v for r, v in values.items()}
 
 
 def network(values: dict) -> tuple:
@@ -184,7 +152,7 @@ def parts_of(values: dict, base=None, **other) -> SallenKeyParts:
     SallenKeyParts
         The record.
     """
-    kw = field_values({r: values[r] for r in refs() if r in values})
+    kw = {FIELD_OF[r]: values[r] for r in refs() if r in values}
     if base is not None:
         kw = {FIELD_OF[r]: getattr(base, FIELD_OF[r]) for r in gain_refs()} | kw
     return SallenKeyParts(**kw, **other)
