@@ -56,10 +56,12 @@ def _parser():
     r.add_argument("--chebyshev-cutoff", default="ripple", help="Chebyshev cut-off: ripple (the ripple edge at "
                    "--fc, default) or 3db")
     m = p.add_argument_group("mask (instead of --order and --fc: picks the least order that meets it)")
-    m.add_argument("--passband", dest="passband_hz", help=f"passband edge frequency {help_range('fc_hz')}")
+    m.add_argument("--passband", dest="passband_hz", help=f"passband edge frequency {help_range('fc_hz')}; a "
+                   "band-pass takes two, F1,F2 (the order, edges and wide or narrow split then come from the mask)")
     m.add_argument("--max-loss", dest="max_loss_db", help=f"largest loss in the passband, dB "
                    f"{help_range('max_loss_db')}")
-    m.add_argument("--stopband", dest="stopband_hz", help=f"stopband edge frequency {help_range('fc_hz')}")
+    m.add_argument("--stopband", dest="stopband_hz", help=f"stopband edge frequency {help_range('fc_hz')}; a "
+                   "band-pass takes two, F1,F2, outside the passband's")
     m.add_argument("--min-attenuation", dest="min_attenuation_db", help="least attenuation in the stopband, dB "
                    f"{help_range('min_attenuation_db')}")
     s = p.add_argument_group("stages")
@@ -155,8 +157,9 @@ def summary_text(result) -> str:
              f"({conv}), gain {s.gain:g}" + (" (inverting)" if f["inverting"] else "")
              + f"; op-amp {op.name} (GBW {format_eng(op.gbw_hz, 'Hz')})"]
     if s.has_mask:
-        lines.append(f"  from the mask: at most {s.max_loss_db:g} dB loss to {format_eng(s.passband_hz, 'Hz')}, at "
-                     f"least {s.min_attenuation_db:g} dB from {format_eng(s.stopband_hz, 'Hz')}")
+        where_pass, where_stop = s.mask_phrases()
+        lines.append(f"  from the mask: at most {s.max_loss_db:g} dB loss {where_pass}, at least "
+                     f"{s.min_attenuation_db:g} dB {where_stop}")
     lines.append(f"Stages, in build order ({s.r_series} resistors, {s.c_series} capacitors; in brackets the "
                  "continuous design at the nearest capacitor):")
     for st in result.stages:
@@ -345,7 +348,9 @@ def _as_built_inputs(data: dict, parts, opamp) -> tuple:
                               "c_series", "amplitude_v", "gbw_margin") if sp.get(k) is not None}
     if sp.get("ripple_db") is not None and sp["family"] == "chebyshev" and not mask:
         kw["ripple_db"] = sp["ripple_db"]
-    if sp["filter_type"] == "bandpass":
+    if sp["filter_type"] == "bandpass" and mask:
+        kw.update(mask, bandpass_method=sp["bandpass_method"])   # the mask picks the same order and edges
+    elif sp["filter_type"] == "bandpass":
         kw.update(order=sp["order"], f_low_hz=sp["f_low_hz"], f_high_hz=sp["f_high_hz"],
                   bandpass_method=sp["bandpass_method"])
     elif mask:

@@ -340,8 +340,8 @@ def _sweep_frequencies(result, h_db_of) -> list:
         if v:
             keys[float(v)] = "-3 dB"
     if s.has_mask:
-        keys[float(s.passband_hz)] = "passband edge"
-        keys[float(s.stopband_hz)] = "stopband edge"
+        keys.update({float(e): "passband edge" for e in s.passband_edges})
+        keys.update({float(e): "stopband edge" for e in s.stopband_edges})
     e_lo, e_hi = math.floor(math.log10(lo)), math.ceil(math.log10(hi))
     grid = [m * 10.0 ** e for e in range(e_lo, e_hi + 1) for m in (1, 2, 5) if lo <= m * 10.0 ** e <= hi]
     ref = 20 * math.log10(passband_gain(result))

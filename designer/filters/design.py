@@ -389,8 +389,11 @@ def analysis_grid(spec: FilterSpec, order: int, fc_hz: float) -> dict:
     level3 = -10 * math.log10(2)
     if kind == "bandpass":
         f3 = [_crossing(wide, db, level3, False), _crossing(wide, db, level3, True)]
-        fp = [spec.f_low_hz, spec.f_high_hz]
-        ft = [_crossing(wide, db, -TRANSITION_DB, False), _crossing(wide, db, -TRANSITION_DB, True)]
+        if spec.has_mask:
+            fp, ft = list(spec.passband_edges), list(spec.stopband_edges)
+        else:
+            fp = [spec.f_low_hz, spec.f_high_hz]
+            ft = [_crossing(wide, db, -TRANSITION_DB, False), _crossing(wide, db, -TRANSITION_DB, True)]
         pb_range, obj_range = (fp[0], fp[1]), (ft[0], ft[1])
     else:
         low = kind == "lowpass"
@@ -406,6 +409,14 @@ def analysis_grid(spec: FilterSpec, order: int, fc_hz: float) -> dict:
             "passband_range_hz": tuple(map(float, pb_range)), "objective_range_hz": tuple(map(float, obj_range)),
             "objective": np.geomspace(*obj_range, GRID_POINTS), "passband": np.geomspace(*pb_range, GRID_POINTS // 2),
             "sweep_hz": (float(min(obj_range[0], pb_range[0]) / 30), float(max(obj_range[1], pb_range[1]) * 30))}
+
+
+def _in_passband(spec: FilterSpec, f) -> np.ndarray:
+    """Which of ``f`` lie in the mask's passband (its edges included)."""
+    if spec.filter_type == "bandpass":
+        lo, hi = spec.passband_edges
+        return (f >= lo) & (f <= hi)
+    return f <= spec.passband_hz if spec.filter_type == "lowpass" else f >= spec.passband_hz
 
 
 def _reference(spec: FilterSpec, order: int, fc_hz: float, f) -> np.ndarray:
@@ -611,17 +622,18 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         # the mask's edges as two more columns of the objective, with one-sided limits (joint.py): the sum S of
         # the stages' dB errors may lower the passband edge's gain, or raise the stopband edge's, by the ideal
         # response's own margin there and no more
-        ideal = 20 * np.log10(np.abs(_reference(spec, order, fc, np.array([spec.passband_hz, spec.stopband_hz]))
-                                     / spec.gain))
-        margin_pass = spec.max_loss_db + ideal[0]
-        margin_stop = -ideal[1] - spec.min_attenuation_db
-        grid["objective"] = np.append(grid["objective"], [spec.passband_hz, spec.stopband_hz])
-        n = grid["objective"].size
-        limits = [(n - 2, -1.0, -margin_pass), (n - 1, 1.0, -margin_stop)]
+        # (a band-pass: both passband edges and both stopband edges)
+        edges = np.array([*spec.passband_edges, *spec.stopband_edges])
+        n_pass = len(spec.passband_edges)
+        ideal = 20 * np.log10(np.abs(_reference(spec, order, fc, edges) / spec.gain))
+        n0 = grid["objective"].size
+        grid["objective"] = np.append(grid["objective"], edges)
+        limits = [(n0 + i, -1.0, -(spec.max_loss_db + ideal[i])) if i < n_pass else
+                  (n0 + i, 1.0, -(-ideal[i] - spec.min_attenuation_db)) for i in range(edges.size)]
         # the loss is limited over the whole passband, not at its edge only (a Chebyshev's ripple troughs
         # inside it sit at the ideal's full ripple: the parts may not deepen them past --max-loss)
-        f_obj = grid["objective"][:n - 2]
-        inside = f_obj <= spec.passband_hz if spec.filter_type == "lowpass" else f_obj >= spec.passband_hz
+        f_obj = grid["objective"][:n0]
+        inside = _in_passband(spec, f_obj)
         ideal_in = 20 * np.log10(np.abs(_reference(spec, order, fc, f_obj[inside]) / spec.gain))
         limits += [(int(c), -1.0, -(spec.max_loss_db + d)) for c, d in zip(np.flatnonzero(inside), ideal_in)]
     f_obj = grid["objective"]
@@ -691,9 +703,10 @@ def section_plans(spec: FilterSpec) -> tuple:
     DesignError
         A mask that needs more than order 10 (one line).
     """
-    if spec.has_mask:
+    if spec.has_mask and spec.filter_type != "bandpass":   # a band-pass's mask gave its order and edges
         order, fc = order_from_mask(spec.filter_type, spec.family, spec.passband_hz, spec.max_loss_db,
-                                    spec.stopband_hz, spec.min_attenuation_db, spec.bessel_norm)
+                                    spec.stopband_hz, spec.min_attenuation_db, spec.bessel_norm,
+                                    spec.max_delay_error_pct, spec.delay_to_hz)
     else:
         order, fc = spec.order, spec.fc_hz
     conv = (spec.ripple_db or 1.0, spec.bessel_norm, spec.chebyshev_cutoff)
@@ -828,8 +841,8 @@ def _figures(result: FilterDesign, grid: dict, errors, choice, j_joint, examined
     }
     if spec.has_mask:
         h = lambda f: 20 * math.log10(abs(complex(chosen.response(2j * math.pi * f, opamp)))) - g_db  # noqa: E731
-        figs["mask_passband_margin_db"] = spec.max_loss_db + h(spec.passband_hz)
-        figs["mask_stopband_margin_db"] = -h(spec.stopband_hz) - spec.min_attenuation_db
+        figs["mask_passband_margin_db"] = spec.max_loss_db + min(h(f) for f in spec.passband_edges)
+        figs["mask_stopband_margin_db"] = -max(h(f) for f in spec.stopband_edges) - spec.min_attenuation_db
     return figs
 
 

@@ -407,10 +407,11 @@ def _achieved(r) -> list:
     rows = [["-3 dB frequency", show(f3t), show(f3)],
             ["max passband deviation from the ideal", "0 dB", f"{f['passband_deviation_db']:.3g} dB"]]
     if s.has_mask:
-        rows += [["mask: passband margin", f">= 0 (loss <= {s.max_loss_db:g} dB to {format_eng(s.passband_hz, 'Hz')})",
+        where_pass, where_stop = s.mask_phrases()
+        rows += [["mask: passband margin", f">= 0 (loss <= {s.max_loss_db:g} dB {where_pass})",
                   f"{f['mask_passband_margin_db']:.3g} dB"],
-                 ["mask: stopband margin", f">= 0 (>= {s.min_attenuation_db:g} dB from "
-                                          f"{format_eng(s.stopband_hz, 'Hz')})", f"{f['mask_stopband_margin_db']:.3g} dB"]]
+                 ["mask: stopband margin", f">= 0 (>= {s.min_attenuation_db:g} dB {where_stop})",
+                  f"{f['mask_stopband_margin_db']:.3g} dB"]]
     out = [R.table(["figure", "target", f"chosen parts, {r.opamp.name} model"], rows)]
     if r.spice:
         sp = r.spice
@@ -494,12 +495,17 @@ def bode_png(data: FilterSheet) -> bytes:
     lo_db = max(float(np.min(20 * np.log10(np.abs(h)))), ref - (s.min_attenuation_db + 30 if s.has_mask else 80))
     if s.has_mask:
         # the forbidden regions: more loss than allowed in the passband, less attenuation in the stopband
-        if s.filter_type == "lowpass":
-            pb, sb = (f[0], s.passband_hz), (s.stopband_hz, f[-1])
+        if s.filter_type == "bandpass":
+            pbs, sbs = [s.passband_edges], [(f[0], s.stopband_edges[0]), (s.stopband_edges[1], f[-1])]
+        elif s.filter_type == "lowpass":
+            pbs, sbs = [(f[0], s.passband_hz)], [(s.stopband_hz, f[-1])]
         else:
-            pb, sb = (s.passband_hz, f[-1]), (f[0], s.stopband_hz)
-        a1.fill_between(pb, [lo_db] * 2, [ref - s.max_loss_db] * 2, color="#d33", alpha=0.15, lw=0, label="mask")
-        a1.fill_between(sb, [ref - s.min_attenuation_db] * 2, [ref + 10] * 2, color="#d33", alpha=0.15, lw=0)
+            pbs, sbs = [(s.passband_hz, f[-1])], [(f[0], s.stopband_hz)]
+        for i, pb in enumerate(pbs):
+            a1.fill_between(pb, [lo_db] * 2, [ref - s.max_loss_db] * 2, color="#d33", alpha=0.15, lw=0,
+                            label=None if i else "mask")
+        for sb in sbs:
+            a1.fill_between(sb, [ref - s.min_attenuation_db] * 2, [ref + 10] * 2, color="#d33", alpha=0.15, lw=0)
     a1.axhline(ref - 10 * math.log10(2), color="0.5", lw=0.6, ls=":")
     a1.set_ylim(lo_db, ref + 6)
     a2.plot(f, np.degrees(np.unwrap(np.angle(h))), "-", lw=1.4)
