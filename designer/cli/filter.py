@@ -64,6 +64,11 @@ def _parser():
                    "band-pass takes two, F1,F2, outside the passband's")
     m.add_argument("--min-attenuation", dest="min_attenuation_db", help="least attenuation in the stopband, dB "
                    f"{help_range('min_attenuation_db')}")
+    m.add_argument("--max-delay-error", dest="max_delay_error_pct", metavar="PCT", help="a Bessel low-pass's "
+                   "group-delay target with the mask: the delay within PCT %% of its DC value up to --delay-to "
+                   f"{help_range('max_delay_error_pct')}; the least order meeting both")
+    m.add_argument("--delay-to", dest="delay_to_hz", metavar="F", help="the frequency the group-delay target holds "
+                   f"to {help_range('fc_hz')}")
     s = p.add_argument_group("stages")
     s.add_argument("--topology", default="sallen-key", help="sallen-key, mfb (inverting multiple feedback) or auto "
                    "(Sallen-Key, MFB where it cannot); a comma list gives one per stage (default sallen-key)")
@@ -110,7 +115,7 @@ def _parser():
 def _spec(args):
     from ..filters.spec import FilterSpec
     keys = ("filter_type", "family", "order", "fc_hz", "ripple_db", "bessel_norm", "chebyshev_cutoff", "passband_hz",
-            "max_loss_db", "stopband_hz", "min_attenuation_db", "f_low_hz", "f_high_hz", "bandpass_method", "topology", "stage_order", "gain",
+            "max_loss_db", "stopband_hz", "min_attenuation_db", "max_delay_error_pct", "delay_to_hz", "f_low_hz", "f_high_hz", "bandpass_method", "topology", "stage_order", "gain",
             "stage_gains", "opamp",
             "amplitude_v", "gbw_margin", "impedance_ohm", "r_series", "c_series", "r_min", "r_max", "c_min",
             "c_max")
@@ -159,7 +164,9 @@ def summary_text(result) -> str:
     if s.has_mask:
         where_pass, where_stop = s.mask_phrases()
         lines.append(f"  from the mask: at most {s.max_loss_db:g} dB loss {where_pass}, at least "
-                     f"{s.min_attenuation_db:g} dB {where_stop}")
+                     f"{s.min_attenuation_db:g} dB {where_stop}"
+                     + (f", the group delay within {s.max_delay_error_pct:g} % of its DC value up to "
+                        f"{format_eng(s.delay_to_hz, 'Hz')}" if s.has_delay_target else ""))
     lines.append(f"Stages, in build order ({s.r_series} resistors, {s.c_series} capacitors; in brackets the "
                  "continuous design at the nearest capacitor):")
     for st in result.stages:
@@ -183,6 +190,11 @@ def summary_text(result) -> str:
     if s.has_mask:
         lines += [f"  mask margins: passband {f['mask_passband_margin_db']:.3g} dB, stopband "
                   f"{f['mask_stopband_margin_db']:.3g} dB"]
+    if s.has_delay_target:
+        lines += [f"  group delay                            within {f['delay_error_pct']:.3g} % of its DC value "
+                  f"{format_eng(f['delay_dc_s'], 's')} up to {format_eng(s.delay_to_hz, 'Hz')} (at most "
+                  f"{s.max_delay_error_pct:g} %; the ideal Bessel {f['delay_error_ideal_pct']:.3g} %): "
+                  + ("met" if f["delay_target_met"] else "NOT met")]
     lines += [f"E-series choice: worst deviation from the ideal over {format_eng(lo, 'Hz')} to "
               f"{format_eng(hi, 'Hz')} (passband and transition band):",
               f"  joint across the stages   {f['error_joint_db']:.3g} dB  (exact over {f['combinations']} "
@@ -354,7 +366,7 @@ def _as_built_inputs(data: dict, parts, opamp) -> tuple:
         kw.update(order=sp["order"], f_low_hz=sp["f_low_hz"], f_high_hz=sp["f_high_hz"],
                   bandpass_method=sp["bandpass_method"])
     elif mask:
-        kw.update(mask)
+        kw.update(mask, **sp.get("delay_target", {}))
     else:
         kw.update(order=sp["order"], fc_hz=sp["fc_hz"])
     kw["opamp"] = opamp or data["opamp"]["name"]

@@ -17,7 +17,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
               "TimeTest", "bench_of", "nice_down", "nice_up", "passband_gain",),
     "cascade": ("Cascade", "Stage",),
     "deck": ("ac_deck", "simulate_ac",),
-    "design": ("FilterDesign", "StageDesign", "analysis_grid", "as_built", "predistort", "section_name", "with_choice",
+    "design": ("FilterDesign", "StageDesign", "analysis_grid", "as_built", "delay_figures", "predistort", "section_name", "with_choice",
                "section_plans", "stage_candidates", "verify_spice",),
     "inverting_lowpass": ("InvertingLowPass",),
     "joint": ("brute_force", "descend", "joint_search", "objective", "per_stage",),

@@ -44,7 +44,8 @@ from ..core.units import format_eng
 from .cascade import Cascade
 from .deck import simulate_ac
 from .joint import joint_search, objective, per_stage
-from .prototype import (SectionPlan, bandpass_method, order_from_mask, plan_bandpass, plan_sections,
+from .prototype import (DELAY_POINTS, SectionPlan, bandpass_method, delay_error_pct, group_delay, order_from_mask,
+                        plan_bandpass, plan_sections, prototype_zpk,
                         reference_bandpass, reference_response)
 from .registry import get as get_topology
 from .spec import FilterSpec
@@ -52,7 +53,7 @@ from .topology import SectionTarget
 from .verify import proof_deck, prove
 
 __all__ = ["StageDesign", "FilterDesign", "design", "as_built", "section_plans", "section_name", "stage_candidates", "verify_spice", "predistort",
-           "analysis_grid", "with_choice"]
+           "analysis_grid", "with_choice", "delay_figures"]
 
 #: the capacitor values (C1, nearest first) each stage offers the joint search
 C_CHOICES = 3
@@ -218,7 +219,9 @@ class FilterDesign:
                 "r_series": s.r_series, "c_series": s.c_series, "amplitude_v": s.amplitude_v,
                 "gbw_margin": s.gbw_margin, "compensate_gbw": s.compensate_gbw,
                 # only when given: the reference outputs of a split by the design stay as they are
-                **({"stage_gains": list(s.stage_gains)} if s.stage_gains is not None else {})}
+                **({"stage_gains": list(s.stage_gains)} if s.stage_gains is not None else {}),
+                **({"delay_target": {"max_delay_error_pct": s.max_delay_error_pct, "delay_to_hz": s.delay_to_hz}}
+                   if s.has_delay_target else {})}
         return json_safe({"tool": "design-filter", "schema_version": SCHEMA_VERSION, "spec": spec,
                           "opamp": self.opamp.to_dict(), "stages": [st.to_dict() for st in self.stages],
                           "figures": dict(self.figures), "spice": self.spice})
@@ -839,11 +842,43 @@ def _figures(result: FilterDesign, grid: dict, errors, choice, j_joint, examined
         "inverting": sum(get_topology(st.topology).inverting for st in stages) % 2 == 1,
         "sweep_hz": grid["sweep_hz"],
     }
+    if spec.has_delay_target:
+        figs.update(delay_figures(spec, result.order, result.fc_hz, lambda s: chosen.response(s, opamp)))
     if spec.has_mask:
         h = lambda f: 20 * math.log10(abs(complex(chosen.response(2j * math.pi * f, opamp)))) - g_db  # noqa: E731
         figs["mask_passband_margin_db"] = spec.max_loss_db + min(h(f) for f in spec.passband_edges)
         figs["mask_stopband_margin_db"] = -max(h(f) for f in spec.stopband_edges) - spec.min_attenuation_db
     return figs
+
+
+def delay_figures(spec: FilterSpec, order: int, fc_hz: float, response) -> dict:
+    """A group-delay target's figures: the largest departure of the delay from its DC value, % of it, from
+    DC to ``spec.delay_to_hz``, of ``response`` (the chosen parts' cascade; by a central difference of its
+    phase, tau = -arg(H(j(w + dw)) / H(j(w - dw))) / (2 dw), which holds at DC too, H(-jw) being H(jw)'s
+    conjugate) and of the ideal prototype (exact from its poles, :func:`~designer.filters.prototype.group_delay`).
+
+    Parameters
+    ----------
+    spec : FilterSpec
+        With a delay target.
+    order, fc_hz : int, float
+        The design's order and cut-off.
+    response : callable
+        s (rad/s, complex array) -> H.
+
+    Returns
+    -------
+    dict
+        ``delay_error_pct`` (the parts'), ``delay_error_ideal_pct``, ``delay_dc_s``, ``delay_target_met``.
+    """
+    f = np.linspace(0.0, spec.delay_to_hz, DELAY_POINTS)
+    dw = 2 * math.pi * fc_hz * 1e-4
+    w = 2 * math.pi * f
+    tau = -np.angle(response(1j * (w + dw)) / response(1j * (w - dw))) / (2 * dw)
+    ideal = group_delay(prototype_zpk(spec.family, order, 1.0, spec.bessel_norm), f, fc_hz)
+    err = delay_error_pct(tau, tau[0])
+    return {"delay_error_pct": err, "delay_error_ideal_pct": delay_error_pct(ideal, ideal[0]),
+            "delay_dc_s": float(tau[0]), "delay_target_met": bool(err <= spec.max_delay_error_pct)}
 
 
 def with_choice(result: FilterDesign, choice, simulate: bool = False, simulator: str = "ngspice-cli") -> FilterDesign:
@@ -877,7 +912,8 @@ def with_choice(result: FilterDesign, choice, simulate: bool = False, simulator:
     figs = _figures(out, grid, errors, list(choice), None, f.get("examined", 0), f.get("candidates_s", 0.0),
                     f.get("search_s", 0.0))
     out.figures = {**f, **{k: figs[k] for k in ("f3_hz", "passband_deviation_db", "mask_passband_margin_db",
-                                                "mask_stopband_margin_db") if k in figs},
+                                                "mask_stopband_margin_db", "delay_error_pct", "delay_dc_s",
+                                                "delay_target_met") if k in figs},
                    "error_built_db": objective(errors, list(choice)), "built": "yield-optimal"}
     if simulate:
         out.proof = prove(out, simulator)

@@ -412,6 +412,7 @@ def _achieved(r) -> list:
                   f"{f['mask_passband_margin_db']:.3g} dB"],
                  ["mask: stopband margin", f">= 0 (>= {s.min_attenuation_db:g} dB {where_stop})",
                   f"{f['mask_stopband_margin_db']:.3g} dB"]]
+    rows += _delay_rows(r)
     out = [R.table(["figure", "target", f"chosen parts, {r.opamp.name} model"], rows)]
     if r.spice:
         sp = r.spice
@@ -464,6 +465,7 @@ def sections(data: FilterSheet, with_images: bool = True, schematic_svg: str = "
                 R.image("time-test.png", "the step or burst test")]
         if data.bench.group_delay is not None:
             imgs.append(R.image("group-delay.png", "group delay"))
+            imgs += [R.text(f"Group-delay target: {row[0]}, {row[1]}; achieved {row[2]}.") for row in _delay_rows(r)]
         out.append(("Plots", [R.columns(imgs[:2]), *imgs[2:]]))
     return out
 
@@ -539,6 +541,17 @@ def time_png(data: FilterSheet) -> bytes:
                      ylabel="voltage (V)", xlabel="time from the " + ("step" if tt.kind == "step" else "burst's start"))
 
 
+def _delay_rows(r) -> list:
+    """The group-delay target's row (none without one): the parts' largest departure from the DC delay."""
+    s, f = r.spec, r.figures
+    if not s.has_delay_target:
+        return []
+    return [["group delay from DC to " + format_eng(s.delay_to_hz, "Hz"),
+             f"within {s.max_delay_error_pct:g} % of DC's (ideal Bessel {f['delay_error_ideal_pct']:.3g} %)",
+             f"{f['delay_error_pct']:.3g} % of {format_eng(f['delay_dc_s'], 's')}"
+             + ("" if f["delay_target_met"] else " (NOT met)")]]
+
+
 def group_delay_png(data: FilterSheet) -> bytes:
     """The group delay of the chosen parts with the op-amp's model.
 
@@ -554,7 +567,16 @@ def group_delay_png(data: FilterSheet) -> bytes:
     """
     f, tau = data.bench.group_delay
     fig, ax = figure(7.5, 3.2)
-    ax.plot(f, np.asarray(tau) * 1e6, "-", lw=1.6)
+    ax.plot(f, np.asarray(tau) * 1e6, "-", lw=1.6, label="chosen parts")
+    s, figs = data.design.spec, data.design.figures
+    if s.has_delay_target:
+        # the target: the DC delay +- the allowed error, up to its frequency
+        d0, e = figs["delay_dc_s"] * 1e6, s.max_delay_error_pct / 100
+        ax.fill_between([f[0], s.delay_to_hz], [d0 * (1 - e)] * 2, [d0 * (1 + e)] * 2, color="C2", alpha=0.2, lw=0,
+                        label=f"target: within {s.max_delay_error_pct:g} % to {format_eng(s.delay_to_hz, 'Hz')} "
+                              f"(parts: {figs['delay_error_pct']:.3g} %)")
+        ax.axvline(s.delay_to_hz, color="C2", lw=0.8, ls=":")
+        ax.legend(fontsize=8, loc="lower left")
     log_frequency_axis(ax)
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("group delay (us)")

@@ -56,6 +56,12 @@ from designer.cli.filter import analyze_filter_main, design_filter_main
       "--min-attenuation", "30", "--order", "3"], "--order: give either a band-pass's order and edges or its mask"),
     (["--passband", "900,1.1k", "--max-loss", "1", "--stopband", "3k", "--min-attenuation", "30"],
      "--passband: two edges F1,F2 are for a bandpass"),
+    (["--family", "chebyshev", "--passband", "1k", "--max-loss", "1", "--stopband", "10k", "--min-attenuation", "30",
+      "--max-delay-error", "1", "--delay-to", "1k"], "--max-delay-error: a group-delay target is for a bessel filter"),
+    (["--family", "bessel", "--order", "4", "--fc", "1k", "--max-delay-error", "1", "--delay-to", "1k"],
+     "--max-delay-error: a group-delay target joins a mask"),
+    (["--family", "bessel", "--passband", "1k", "--max-loss", "3", "--stopband", "10k", "--min-attenuation", "30",
+      "--max-delay-error", "1"], "--delay-to: a group-delay target needs both --max-delay-error and --delay-to"),
 ])
 def test_bad_input_is_one_line_exit_2(argv, words, capsys):
     assert design_filter_main(argv + ["--no-sim"]) == 2
@@ -319,3 +325,23 @@ def test_bandpass_mask_yield_counts_against_the_mask(capsys):
     assert mc["nominal_figures"]["stopband_attenuation_db"] == pytest.approx(
         30.0 + d["figures"]["mask_stopband_margin_db"], abs=0.05)
     assert 0 <= mc["yield"]["passed"] <= 300
+
+
+@pytest.mark.spice
+def test_bessel_delay_target_picks_the_order_and_is_checked_on_spice(tmp_path, capsys):
+    argv = ["--family", "bessel", "--passband", "1k", "--max-loss", "3", "--stopband", "10k", "--min-attenuation",
+            "30", "--opamp", "TL072"]
+    assert design_filter_main(argv + ["--no-sim", "--json"]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert design_filter_main(argv + ["--max-delay-error", "1", "--delay-to", "1k", "--json", "--out",
+                                      str(tmp_path)]) == 0
+    d = json.loads(capsys.readouterr().out)
+    f, m = d["figures"], d["spice"]["mask"]
+    # the target raises the order above the mask's own, and the parts meet it
+    assert d["spec"]["order"] > plain["spec"]["order"] and f["delay_target_met"]
+    # SPICE's .ac phase gives the model's delay error (its sweep's lowest point standing for DC)
+    assert m["delay_error_pct"] == pytest.approx(f["delay_error_pct"], abs=0.01) and m["met"]
+    assert "group delay from DC to 1 kHz" in (tmp_path / "build-sheet.md").read_text()
+    assert design_filter_main(argv + ["--max-delay-error", "1", "--delay-to", "1k", "--no-sim"]) == 0
+    out = capsys.readouterr().out
+    assert "the group delay within 1 % of its DC value up to 1 kHz" in out and ": met" in out

@@ -14,8 +14,8 @@ from scipy import signal
 from designer.core.errors import DesignError
 from designer.filters import Cascade, SectionTarget, get
 from designer.filters.design import section_name
-from designer.filters.prototype import (bandpass_from_mask, chebyshev_3db_factor, order_from_mask, plan_bandpass,
-                                        plan_sections, prototype_zpk, reference_ba, reference_bandpass,
+from designer.filters.prototype import (DELAY_POINTS, bandpass_from_mask, chebyshev_3db_factor, delay_error_pct,
+                                        group_delay, order_from_mask, plan_bandpass, plan_sections, prototype_zpk, reference_ba, reference_bandpass,
                                         reference_response)
 
 
@@ -258,3 +258,49 @@ def test_bandpass_mask_chebyshev_3db_edges_are_minus_3db():
     h = reference_bandpass(np.array([fl, fh]), "chebyshev", n, fl, fh, 1.0, "mag", "3db", "narrow")
     # relative to the passband's peak (an odd order's centre is the peak)
     assert 20 * np.log10(np.abs(h)) == pytest.approx([-10 * math.log10(2)] * 2, abs=1e-6)
+
+
+@pytest.mark.parametrize("norm", ["mag", "delay"])
+@pytest.mark.parametrize("order", [1, 2, 3, 5, 8, 10])
+def test_group_delay_equals_scipys_of_the_prototype(order, norm):
+    # scipy's group_delay of the prototype through the bilinear transform: the digital frequency f is the analog
+    # F = (fs / pi) tan(pi f / fs), and the delays are tau_d(f) = tau_a(F) dF/df = tau_a(F) / cos^2(pi f / fs)
+    fc, fs = 1e3, 20e3
+    zpk = prototype_zpk("bessel", order, bessel_norm=norm)
+    b, a = signal.zpk2tf(*signal.lp2lp_zpk(*zpk, 2 * math.pi * fc))
+    bd, ad = signal.bilinear(b, a, fs)
+    f = np.linspace(0.0, 2 * fc, 41)
+    _, gd_samples = signal.group_delay((bd, ad), w=f, fs=fs)
+    analog_f = fs / math.pi * np.tan(math.pi * f / fs)
+    np.testing.assert_allclose(group_delay(zpk, analog_f, fc), gd_samples / fs * np.cos(math.pi * f / fs) ** 2,
+                               rtol=1e-7)
+    if norm == "delay":   # the delay normalisation: 1 / (2 pi fc) at DC
+        assert group_delay(zpk, [0.0], fc)[0] == pytest.approx(1 / (2 * math.pi * fc), rel=1e-12)
+
+
+@pytest.mark.parametrize("pct, to", [(1.0, 1e3), (0.1, 1e3), (5.0, 2e3), (0.5, 500.0)])
+def test_delay_target_order_is_the_least_meeting_mask_and_target(pct, to):
+    mask = ("lowpass", "bessel", 1e3, 3.0, 10e3, 30.0)
+    order, fc = order_from_mask(*mask, "mag", pct, to)
+    plain, _ = order_from_mask(*mask)
+    f = np.linspace(0.0, to, DELAY_POINTS)
+
+    def err(n, c):
+        tau = group_delay(prototype_zpk("bessel", n), f, c)
+        return delay_error_pct(tau, tau[0])
+
+    assert order >= plain and err(order, fc) <= pct
+    if order > plain:   # one order less meets the mask (order >= plain) but not the target
+        n1, fc1 = order - 1, None
+        lo, hi = math.log(1e3) - 12, math.log(1e3) + 12
+        for _ in range(100):   # its cut-off: the loss at the passband edge at the limit
+            mid = 0.5 * (lo + hi)
+            loss = -20 * math.log10(abs(reference_response([1e3], "lowpass", "bessel", n1, math.exp(mid))[0]))
+            lo, hi = (mid, hi) if loss > 3.0 else (lo, mid)
+        fc1 = math.exp(hi)
+        assert err(n1, fc1) > pct
+
+
+def test_delay_target_beyond_order_10_says_both():
+    with pytest.raises(DesignError, match=r"above order 10 .*the delay within .* % up to 5000 Hz, 0.01 % asked"):
+        order_from_mask("lowpass", "bessel", 1e3, 3.0, 2e3, 30.0, "mag", 0.01, 5e3)

@@ -73,3 +73,35 @@ def test_band_mask_parsing_accepts_or_refuses_in_one_line(p1, p2, s1, s2, family
     assert s.passband_edges == (p1, p2) and 1 <= s.order <= 10 and s.f_low_hz < s.f_high_hz
     assert s.bandpass_method == ("wide" if p2 / p1 >= 2 else "narrow")
     assert math.isfinite(s.f_low_hz) and math.isfinite(s.f_high_hz)
+
+
+BESSEL_MASK = dict(family="bessel", passband_hz=1e3, max_loss_db=3, stopband_hz=10e3, min_attenuation_db=30)
+
+
+@pytest.mark.parametrize("kw, words", [
+    (dict(BESSEL_MASK, family="butterworth", max_delay_error_pct=1, delay_to_hz=1e3),
+     "max_delay_error_pct: a group-delay target is for a bessel filter"),
+    (dict(family="bessel", order=4, fc_hz=1e3, max_delay_error_pct=1, delay_to_hz=1e3),
+     "a group-delay target joins a mask in picking the order"),
+    (dict(BESSEL_MASK, max_delay_error_pct=1), "delay_to_hz: a group-delay target needs both"),
+    (dict(BESSEL_MASK, delay_to_hz=1e3), "max_delay_error_pct: a group-delay target needs both"),
+    (dict(BESSEL_MASK, max_delay_error_pct=60, delay_to_hz=1e3), "max_delay_error_pct must be 0.01 % to 50 %"),
+    (dict(family="bessel", filter_type="highpass", passband_hz=10e3, max_loss_db=3, stopband_hz=1e3,
+          min_attenuation_db=30, max_delay_error_pct=1, delay_to_hz=1e3), "is for a lowpass (its delay at DC)"),
+])
+def test_delay_target_refusals_are_one_line(kw, words):
+    with pytest.raises(DesignError) as exc:
+        FilterSpec(**kw)
+    assert words in str(exc.value) and "\n" not in str(exc.value)
+
+
+@settings(max_examples=30, deadline=None)
+@given(pct=hst.one_of(hst.floats(0.0, 100.0), hst.sampled_from(["1", "0.5%", "abc", "1e-3"])),
+       to=hst.one_of(hst.floats(1e-3, 1e8), hst.sampled_from(["1k", "500", "x"])))
+def test_delay_target_parsing_accepts_or_refuses_in_one_line(pct, to):
+    try:
+        s = FilterSpec(**BESSEL_MASK, max_delay_error_pct=pct, delay_to_hz=to)
+    except DesignError as exc:
+        assert "\n" not in str(exc)
+        return
+    assert 0.01 <= s.max_delay_error_pct <= 50 and 0.01 <= s.delay_to_hz <= 10e6 and s.has_delay_target
