@@ -66,7 +66,7 @@ def _parser():
                    f"{help_range('min_attenuation_db')}")
     m.add_argument("--max-delay-error", dest="max_delay_error_pct", metavar="PCT", help="a Bessel low-pass's "
                    "group-delay target with the mask: the delay within PCT %% of its DC value up to --delay-to "
-                   f"{help_range('max_delay_error_pct')}; the least order meeting both")
+                   + help_range("max_delay_error_pct").replace("%", "%%") + "; the least order meeting both")
     m.add_argument("--delay-to", dest="delay_to_hz", metavar="F", help="the frequency the group-delay target holds "
                    f"to {help_range('fc_hz')}")
     s = p.add_argument_group("stages")
@@ -101,6 +101,7 @@ def _parser():
     add_filter_tolerance(p, optimize=True)
     o = p.add_argument_group("output")
     o.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    _add_lang(o)
     o.add_argument("--out", metavar="DIR", help="write DIR/filter.cir (the ngspice .ac deck of the cascade), "
                    "DIR/result.json and the build sheet (build-sheet.html and .md, schematic, plots, bom.csv); with "
                    "--name, the bundle DIR/reports/NAME/ and DIR/netlists/NAME.cir instead")
@@ -110,6 +111,14 @@ def _parser():
     o.add_argument("--simulator", default="ngspice-cli", choices=("ngspice-cli", "pyspice"),
                    help="ngspice-cli: `ngspice -b` (default); pyspice: the shared library")
     return p
+
+
+def _add_lang(group) -> None:
+    """``--lang``: the build sheet's language (the summary and the JSON stay English)."""
+    from ..core.i18n import DEFAULT, LANGUAGES
+    group.add_argument("--lang", default=DEFAULT, choices=LANGUAGES,
+                       help=f"language of the build sheet written with --out: {', '.join(LANGUAGES)} (default "
+                            f"{DEFAULT}, whatever LANG says; es writes decimal commas); the summary and JSON stay English")
 
 
 def _spec(args):
@@ -228,7 +237,7 @@ def _proof_lines(result) -> list:
     return result.proof.lines() if getattr(result, "proof", None) is not None else []
 
 
-def _write_sheet(result, folder, name, extra=None):
+def _write_sheet(result, folder, name, extra=None, lang=None):
     """The build sheet: into ``folder`` (filter.cir, result.json and the sheet's files), or with ``name``
     the bundle under ``folder`` (default .): reports/NAME/ and netlists/NAME.cir; ``extra`` (the tolerance
     analyses' JSON) joins result.json. Returns the :class:`~designer.filters.report.FilterSheet` written (its
@@ -237,10 +246,10 @@ def _write_sheet(result, folder, name, extra=None):
     data = sheet_of(result)
     data.extra = dict(extra or {})
     if name is None:
-        write_folder(data, folder)
+        write_folder(data, folder, lang)
     else:
         from .common import check_name
-        write_outputs(data, folder or ".", check_name(name))
+        write_outputs(data, folder or ".", check_name(name), lang)
     return data
 
 
@@ -265,7 +274,7 @@ def _emit(result, args, extras: dict) -> int:
     """The result (and its tolerance analyses) printed, and written with --out (or --name)."""
     extra = tolerance_json(extras)
     name = getattr(args, "name", None)
-    sheet = _write_sheet(result, args.out, name, extra) if args.out or name else None
+    sheet = _write_sheet(result, args.out, name, extra, getattr(args, "lang", None)) if args.out or name else None
     files = sheet.files if sheet is not None else {}
     if args.json:
         # what result.json holds when written (the bench test too)
@@ -329,6 +338,7 @@ def _analyze_parser():
     add_filter_tolerance(p)
     o = p.add_argument_group("output")
     o.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    _add_lang(o)
     o.add_argument("--out", metavar="DIR", help="write DIR/filter.cir (the proof deck) and DIR/result.json")
     o.add_argument("--no-sim", action="store_true", help="skip the ngspice proof")
     o.add_argument("--simulator", default="ngspice-cli", choices=("ngspice-cli", "pyspice"),

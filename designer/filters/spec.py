@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 from ..core import opamps
 from ..core.errors import DesignError, ParamError
+from ..core.i18n import gettext as _
 from ..core.eseries import PartBounds
 from ..core.ranges import parse_in_range
 from ..core.units import format_eng
@@ -305,7 +306,7 @@ class FilterSpec(PartBounds):
         return _as_tuple(self.stopband_hz)
 
     def mask_phrases(self) -> tuple:
-        """Where the mask's loss and attenuation hold, in words.
+        """Where the mask's loss and attenuation hold, in words (the current language's, :mod:`designer.core.i18n`).
 
         Returns
         -------
@@ -316,8 +317,9 @@ class FilterSpec(PartBounds):
         hz = lambda v: format_eng(v, "Hz")  # noqa: E731
         if self.filter_type == "bandpass":
             (p1, p2), (s1, s2) = self.passband_edges, self.stopband_edges
-            return f"from {hz(p1)} to {hz(p2)}", f"below {hz(s1)} and above {hz(s2)}"
-        return f"to {hz(self.passband_hz)}", f"from {hz(self.stopband_hz)}"
+            return (_("from {low} to {high}").format(low=hz(p1), high=hz(p2)),
+                    _("below {low} and above {high}").format(low=hz(s1), high=hz(s2)))
+        return _("to {f}").format(f=hz(self.passband_hz)), _("from {f}").format(f=hz(self.stopband_hz))
 
 
 def _as_tuple(v) -> tuple:
