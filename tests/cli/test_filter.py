@@ -345,3 +345,15 @@ def test_bessel_delay_target_picks_the_order_and_is_checked_on_spice(tmp_path, c
     assert design_filter_main(argv + ["--max-delay-error", "1", "--delay-to", "1k", "--no-sim"]) == 0
     out = capsys.readouterr().out
     assert "the group delay within 1 % of its DC value up to 1 kHz" in out and ": met" in out
+
+
+def test_analyze_filter_writes_its_sheet_in_the_language_asked(designed, tmp_path, capsys):
+    from helpers import english_left
+    assert analyze_filter_main(["--from", str(designed), "--no-sim", "--out", str(tmp_path / "es"), "--lang",
+                                "es"]) == 0
+    assert analyze_filter_main(["--from", str(designed), "--no-sim", "--out", str(tmp_path / "en")]) == 0
+    capsys.readouterr()
+    es, en = ((tmp_path / d / "build-sheet.md").read_text() for d in ("es", "en"))
+    assert "Lista de materiales" in es and "máscara: margen en la banda de paso" in es and "hasta 3 kHz" in es
+    assert "Bill of materials" in en and "mask: passband margin" in en
+    assert english_left((tmp_path / "es" / "build-sheet.html").read_text()) == []
