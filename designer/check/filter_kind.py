@@ -59,6 +59,8 @@ MASK_FIGURES = {"passband_loss_db": ("max", "max_loss"), "stopband_attenuation_d
                 "spice_stopband_attenuation_db": ("min", "min_attenuation")}
 #: points of the model's frequency grid, per decade
 POINTS_PER_DECADE = 100
+#: points per decade of SPICE's .ac against a band-pass's mask
+_BAND_POINTS_PER_DECADE = 400
 
 
 @dataclass(frozen=True)
@@ -132,7 +134,32 @@ def _mask(doc) -> dict | None:
     missing = [k for k in MASK_KEYS if k not in m]
     if missing:
         raise doc.error(("mask",), f"mask needs {', '.join(MASK_KEYS)}; missing {', '.join(missing)}")
-    return {k: read_positive(doc, ("mask", k)) for k in MASK_KEYS}
+    out = {}
+    for k in MASK_KEYS:
+        v = m[k]
+        if k in ("passband", "stopband") and isinstance(v, list):
+            # a band-pass's two edges, [low, high]
+            if len(v) != 2:
+                raise doc.error(("mask", k), f"mask.{k} takes one edge, or a band-pass's two [low, high]; got "
+                                f"{len(v)} values")
+            out[k] = tuple(_positive_item(doc, k, x) for x in v)
+        else:
+            out[k] = read_positive(doc, ("mask", k))
+    if isinstance(out["passband"], tuple) != isinstance(out["stopband"], tuple):
+        raise doc.error(("mask",), "mask: a band-pass's mask gives passband and stopband both as [low, high]; a "
+                        "low- or high-pass's both as one edge")
+    return out
+
+
+def _positive_item(doc, key: str, value) -> float:
+    """One of a band-pass mask's two edges (``mask.<key>: [low, high]``), a positive number."""
+    try:
+        out = parse_value(value, f"mask.{key}") if not isinstance(value, bool) else None
+    except DesignError:
+        out = None
+    if out is None or not out > 0:
+        raise doc.error(("mask", key), f"mask.{key} must be positive numbers [low, high], got {value!r}")
+    return out
 
 
 def _stages(doc) -> tuple:
@@ -199,14 +226,16 @@ def filter_designs(doc, corners) -> tuple:
         if doc.data.get("bounds") is not None:
             raise doc.error(("bounds",), "bounds: limit a design's part search; stages: are already chosen")
         stages = _stages(doc)
+        _check_mask_kind(doc, mask, _kind(stages))
         return [FilterCase(amp, None, stages, mask) for amp in corners], True
     f = doc.mapping(("filter",), SUB_FILTER)
     kw = {FILTER_TO_PARAM[k]: v for k, v in f.items()}
     series = doc.mapping(("series",), SUB["series"])
     kw.update({f"{k}_series": series[k] for k in ("r", "c") if k in series})
     kw.update(doc.mapping(("bounds",), SUB["bounds"]))
-    if mask is not None and "order" not in f and "fc" not in f and f.get("type", "lowpass") != "bandpass":
-        # no order: the mask picks it, as design-filter's --passband .. --min-attenuation
+    _check_mask_kind(doc, mask, str(f.get("type", "lowpass")).strip().lower())
+    if mask is not None and not {"order", "fc", "f_low", "f_high"} & set(f):
+        # no order: the mask picks it (a band-pass's also its edges), as design-filter's --passband .. --min-attenuation
         kw.update({"passband_hz": mask["passband"], "max_loss_db": mask["max_loss"],
                    "stopband_hz": mask["stopband"], "min_attenuation_db": mask["min_attenuation"]})
     if "compensate_gbw" in kw and not isinstance(kw["compensate_gbw"], bool):
@@ -214,6 +243,14 @@ def filter_designs(doc, corners) -> tuple:
     cases = [FilterCase(amp, built_in_spec_words(doc, FILTER_KEYS, lambda amp=amp: FilterSpec(opamp=amp, **kw)), (), mask)
              for amp in corners]
     return cases, False
+
+
+def _check_mask_kind(doc, mask, kind: str) -> None:
+    """A mask of two edges a side for a band-pass, of one for a low- or high-pass."""
+    if mask is not None and isinstance(mask["passband"], tuple) != (kind == "bandpass"):
+        need = "two edges each, passband: [low, high] and stopband: [low, high]" if kind == "bandpass" else \
+            "one edge each, passband: F and stopband: F"
+        raise doc.error(("mask",), f"mask: a {kind}'s mask takes {need}")
 
 
 #: filter: key -> FilterSpec parameter
@@ -269,6 +306,7 @@ def _crossings(f, g_db, level) -> list:
 
 
 def _response_figures(f, h, kind, ref_db, mask, prefix="") -> dict:
+    from ..filters.verify import band_edge_db
     g = 20 * np.log10(np.abs(h))
     cross = _crossings(f, g, ref_db - 10 * math.log10(2))
     out = {}
@@ -280,10 +318,15 @@ def _response_figures(f, h, kind, ref_db, mask, prefix="") -> dict:
     if mask is not None:
         pb, sb = mask["passband"], mask["stopband"]
         # the edges themselves by interpolation in log f, the points between them as they are
-        g_pb = float(np.interp(math.log(pb), np.log(f), g))
-        g_sb = float(np.interp(math.log(sb), np.log(f), g))
-        inside = f <= pb if kind == "lowpass" else f >= pb
-        stop = f >= sb if kind == "lowpass" else f <= sb
+        at = lambda edges: np.interp(np.log(np.atleast_1d(edges)), np.log(f), g) if not isinstance(pb, tuple) \
+            else band_edge_db(f, g, edges)  # noqa: E731  (a band-pass's narrow edges: a cubic, not a chord)
+        g_pb, g_sb = float(np.min(at(pb))), float(np.max(at(sb)))
+        if isinstance(pb, tuple):   # a band-pass's [low, high] (_mask: both or neither)
+            inside = (f >= pb[0]) & (f <= pb[1])
+            stop = (f <= sb[0]) | (f >= sb[1])
+        else:
+            inside = f <= pb if kind == "lowpass" else f >= pb
+            stop = f >= sb if kind == "lowpass" else f <= sb
         out[f"{prefix}passband_loss_db"] = float(ref_db - min(g_pb, *g[inside])) if inside.any() else \
             float(ref_db - g_pb)
         out[f"{prefix}stopband_attenuation_db"] = float(ref_db - max(g_sb, *g[stop])) if stop.any() else \
@@ -317,7 +360,7 @@ def filter_figures(stages, opamp, ref_db: float, mask, simulator: str | None) ->
     from ..filters.registry import get
     cascade = Cascade([(get(t), v) for t, v in stages])
     kind = _kind(stages)
-    edges = () if mask is None else (mask["passband"], mask["stopband"])
+    edges = () if mask is None else tuple(np.hstack([mask["passband"], mask["stopband"]]))
     f = _grid(stages, edges)
     h = cascade.response(2j * math.pi * f, opamp)
     if ref_db is None:
@@ -332,7 +375,10 @@ def filter_figures(stages, opamp, ref_db: float, mask, simulator: str | None) ->
     out = {"passband_gain_db": float(ref_db), "stages": len(stages),
            **_response_figures(f, h, kind, ref_db, mask)}
     if simulator is not None:
-        fs, hs = simulate_ac(cascade.netlist(), opamp, float(f[0]), float(f[-1]), simulator=simulator)
+        # a band-pass mask's narrow band: a denser sweep (the edges within a few points otherwise)
+        dense = {"points_per_decade": _BAND_POINTS_PER_DECADE} if mask is not None and \
+            isinstance(mask["passband"], tuple) else {}
+        fs, hs = simulate_ac(cascade.netlist(), opamp, float(f[0]), float(f[-1]), simulator=simulator, **dense)
         out.update(_response_figures(fs, hs, kind, ref_db, mask, "spice_"))
         an = cascade.response(2j * math.pi * fs, opamp)
         dev = np.abs(20 * np.log10(np.abs(hs)) - 20 * np.log10(np.abs(an)))

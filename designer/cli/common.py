@@ -56,7 +56,8 @@ FLAGS = {
     # design-filter
     "filter_type": "--type", "family": "--family", "order": "--order", "ripple_db": "--ripple",
     "passband_hz": "--passband", "max_loss_db": "--max-loss", "stopband_hz": "--stopband",
-    "min_attenuation_db": "--min-attenuation", "topology": "--topology", "stage_order": "--stage-order",
+    "min_attenuation_db": "--min-attenuation", "max_delay_error_pct": "--max-delay-error", "delay_to_hz": "--delay-to",
+    "topology": "--topology", "stage_order": "--stage-order",
     "stage_gains": "--stage-gain",
     "bessel_norm": "--bessel-norm", "chebyshev_cutoff": "--chebyshev-cutoff", "gbw_margin": "--gbw-margin",
     "impedance_ohm": "--impedance", "series": "--series",

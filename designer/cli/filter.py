@@ -56,12 +56,19 @@ def _parser():
     r.add_argument("--chebyshev-cutoff", default="ripple", help="Chebyshev cut-off: ripple (the ripple edge at "
                    "--fc, default) or 3db")
     m = p.add_argument_group("mask (instead of --order and --fc: picks the least order that meets it)")
-    m.add_argument("--passband", dest="passband_hz", help=f"passband edge frequency {help_range('fc_hz')}")
+    m.add_argument("--passband", dest="passband_hz", help=f"passband edge frequency {help_range('fc_hz')}; a "
+                   "band-pass takes two, F1,F2 (the order, edges and wide or narrow split then come from the mask)")
     m.add_argument("--max-loss", dest="max_loss_db", help=f"largest loss in the passband, dB "
                    f"{help_range('max_loss_db')}")
-    m.add_argument("--stopband", dest="stopband_hz", help=f"stopband edge frequency {help_range('fc_hz')}")
+    m.add_argument("--stopband", dest="stopband_hz", help=f"stopband edge frequency {help_range('fc_hz')}; a "
+                   "band-pass takes two, F1,F2, outside the passband's")
     m.add_argument("--min-attenuation", dest="min_attenuation_db", help="least attenuation in the stopband, dB "
                    f"{help_range('min_attenuation_db')}")
+    m.add_argument("--max-delay-error", dest="max_delay_error_pct", metavar="PCT", help="a Bessel low-pass's "
+                   "group-delay target with the mask: the delay within PCT %% of its DC value up to --delay-to "
+                   + help_range("max_delay_error_pct").replace("%", "%%") + "; the least order meeting both")
+    m.add_argument("--delay-to", dest="delay_to_hz", metavar="F", help="the frequency the group-delay target holds "
+                   f"to {help_range('fc_hz')}")
     s = p.add_argument_group("stages")
     s.add_argument("--topology", default="sallen-key", help="sallen-key, mfb (inverting multiple feedback) or auto "
                    "(Sallen-Key, MFB where it cannot); a comma list gives one per stage (default sallen-key)")
@@ -94,6 +101,7 @@ def _parser():
     add_filter_tolerance(p, optimize=True)
     o = p.add_argument_group("output")
     o.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    _add_lang(o)
     o.add_argument("--out", metavar="DIR", help="write DIR/filter.cir (the ngspice .ac deck of the cascade), "
                    "DIR/result.json and the build sheet (build-sheet.html and .md, schematic, plots, bom.csv); with "
                    "--name, the bundle DIR/reports/NAME/ and DIR/netlists/NAME.cir instead")
@@ -105,10 +113,18 @@ def _parser():
     return p
 
 
+def _add_lang(group) -> None:
+    """``--lang``: the build sheet's language (the summary and the JSON stay English)."""
+    from ..core.i18n import DEFAULT, LANGUAGES
+    group.add_argument("--lang", default=DEFAULT, choices=LANGUAGES,
+                       help=f"language of the build sheet written with --out: {', '.join(LANGUAGES)} (default "
+                            f"{DEFAULT}, whatever LANG says; es writes decimal commas); the summary and JSON stay English")
+
+
 def _spec(args):
     from ..filters.spec import FilterSpec
     keys = ("filter_type", "family", "order", "fc_hz", "ripple_db", "bessel_norm", "chebyshev_cutoff", "passband_hz",
-            "max_loss_db", "stopband_hz", "min_attenuation_db", "f_low_hz", "f_high_hz", "bandpass_method", "topology", "stage_order", "gain",
+            "max_loss_db", "stopband_hz", "min_attenuation_db", "max_delay_error_pct", "delay_to_hz", "f_low_hz", "f_high_hz", "bandpass_method", "topology", "stage_order", "gain",
             "stage_gains", "opamp",
             "amplitude_v", "gbw_margin", "impedance_ohm", "r_series", "c_series", "r_min", "r_max", "c_min",
             "c_max")
@@ -155,8 +171,11 @@ def summary_text(result) -> str:
              f"({conv}), gain {s.gain:g}" + (" (inverting)" if f["inverting"] else "")
              + f"; op-amp {op.name} (GBW {format_eng(op.gbw_hz, 'Hz')})"]
     if s.has_mask:
-        lines.append(f"  from the mask: at most {s.max_loss_db:g} dB loss to {format_eng(s.passband_hz, 'Hz')}, at "
-                     f"least {s.min_attenuation_db:g} dB from {format_eng(s.stopband_hz, 'Hz')}")
+        where_pass, where_stop = s.mask_phrases()
+        lines.append(f"  from the mask: at most {s.max_loss_db:g} dB loss {where_pass}, at least "
+                     f"{s.min_attenuation_db:g} dB {where_stop}"
+                     + (f", the group delay within {s.max_delay_error_pct:g} % of its DC value up to "
+                        f"{format_eng(s.delay_to_hz, 'Hz')}" if s.has_delay_target else ""))
     lines.append(f"Stages, in build order ({s.r_series} resistors, {s.c_series} capacitors; in brackets the "
                  "continuous design at the nearest capacitor):")
     for st in result.stages:
@@ -180,6 +199,11 @@ def summary_text(result) -> str:
     if s.has_mask:
         lines += [f"  mask margins: passband {f['mask_passband_margin_db']:.3g} dB, stopband "
                   f"{f['mask_stopband_margin_db']:.3g} dB"]
+    if s.has_delay_target:
+        lines += [f"  group delay                            within {f['delay_error_pct']:.3g} % of its DC value "
+                  f"{format_eng(f['delay_dc_s'], 's')} up to {format_eng(s.delay_to_hz, 'Hz')} (at most "
+                  f"{s.max_delay_error_pct:g} %; the ideal Bessel {f['delay_error_ideal_pct']:.3g} %): "
+                  + ("met" if f["delay_target_met"] else "NOT met")]
     lines += [f"E-series choice: worst deviation from the ideal over {format_eng(lo, 'Hz')} to "
               f"{format_eng(hi, 'Hz')} (passband and transition band):",
               f"  joint across the stages   {f['error_joint_db']:.3g} dB  (exact over {f['combinations']} "
@@ -213,7 +237,7 @@ def _proof_lines(result) -> list:
     return result.proof.lines() if getattr(result, "proof", None) is not None else []
 
 
-def _write_sheet(result, folder, name, extra=None):
+def _write_sheet(result, folder, name, extra=None, lang=None):
     """The build sheet: into ``folder`` (filter.cir, result.json and the sheet's files), or with ``name``
     the bundle under ``folder`` (default .): reports/NAME/ and netlists/NAME.cir; ``extra`` (the tolerance
     analyses' JSON) joins result.json. Returns the :class:`~designer.filters.report.FilterSheet` written (its
@@ -222,10 +246,10 @@ def _write_sheet(result, folder, name, extra=None):
     data = sheet_of(result)
     data.extra = dict(extra or {})
     if name is None:
-        write_folder(data, folder)
+        write_folder(data, folder, lang)
     else:
         from .common import check_name
-        write_outputs(data, folder or ".", check_name(name))
+        write_outputs(data, folder or ".", check_name(name), lang)
     return data
 
 
@@ -250,7 +274,7 @@ def _emit(result, args, extras: dict) -> int:
     """The result (and its tolerance analyses) printed, and written with --out (or --name)."""
     extra = tolerance_json(extras)
     name = getattr(args, "name", None)
-    sheet = _write_sheet(result, args.out, name, extra) if args.out or name else None
+    sheet = _write_sheet(result, args.out, name, extra, getattr(args, "lang", None)) if args.out or name else None
     files = sheet.files if sheet is not None else {}
     if args.json:
         # what result.json holds when written (the bench test too)
@@ -314,6 +338,7 @@ def _analyze_parser():
     add_filter_tolerance(p)
     o = p.add_argument_group("output")
     o.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    _add_lang(o)
     o.add_argument("--out", metavar="DIR", help="write DIR/filter.cir (the proof deck) and DIR/result.json")
     o.add_argument("--no-sim", action="store_true", help="skip the ngspice proof")
     o.add_argument("--simulator", default="ngspice-cli", choices=("ngspice-cli", "pyspice"),
@@ -345,11 +370,13 @@ def _as_built_inputs(data: dict, parts, opamp) -> tuple:
                               "c_series", "amplitude_v", "gbw_margin") if sp.get(k) is not None}
     if sp.get("ripple_db") is not None and sp["family"] == "chebyshev" and not mask:
         kw["ripple_db"] = sp["ripple_db"]
-    if sp["filter_type"] == "bandpass":
+    if sp["filter_type"] == "bandpass" and mask:
+        kw.update(mask, bandpass_method=sp["bandpass_method"])   # the mask picks the same order and edges
+    elif sp["filter_type"] == "bandpass":
         kw.update(order=sp["order"], f_low_hz=sp["f_low_hz"], f_high_hz=sp["f_high_hz"],
                   bandpass_method=sp["bandpass_method"])
     elif mask:
-        kw.update(mask)
+        kw.update(mask, **sp.get("delay_target", {}))
     else:
         kw.update(order=sp["order"], fc_hz=sp["fc_hz"])
     kw["opamp"] = opamp or data["opamp"]["name"]

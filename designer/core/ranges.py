@@ -147,6 +147,7 @@ RANGES = {
     "ripple_db": Range(0.01, 3.0, "dB"),
     "max_loss_db": Range(0.01, 20.0, "dB"),
     "min_attenuation_db": Range(1.0, 200.0, "dB"),
+    "max_delay_error_pct": Range(0.01, 50.0, "%"),
     "gbw_margin": Range(1.0, 1000.0),
     "impedance_ohm": Range(10.0, 1e8, "Ohm"),
 }

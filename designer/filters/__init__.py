@@ -17,7 +17,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
               "TimeTest", "bench_of", "nice_down", "nice_up", "passband_gain",),
     "cascade": ("Cascade", "Stage",),
     "deck": ("ac_deck", "simulate_ac",),
-    "design": ("FilterDesign", "StageDesign", "analysis_grid", "as_built", "predistort", "section_name", "with_choice",
+    "design": ("FilterDesign", "StageDesign", "analysis_grid", "as_built", "delay_figures", "predistort", "section_name", "with_choice",
                "section_plans", "stage_candidates", "verify_spice",),
     "inverting_lowpass": ("InvertingLowPass",),
     "joint": ("brute_force", "descend", "joint_search", "objective", "per_stage",),
@@ -25,7 +25,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "mfb_highpass": ("MfbHighPass",),
     "mfb_lowpass": ("MfbLowPass",),
     "prototype": ("BANDPASS_METHODS", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER",
-                  "RESPONSE_TYPES", "SectionPlan", "WIDE_RATIO", "bandpass_method", "chebyshev_3db_factor",
+                  "RESPONSE_TYPES", "SectionPlan", "WIDE_RATIO", "DELAY_POINTS", "bandpass_from_mask", "bandpass_method", "chebyshev_3db_factor", "delay_error_pct", "group_delay",
                   "order_from_mask", "plan_bandpass", "plan_sections", "prototype_zpk", "reference_ba",
                   "reference_bandpass", "reference_response",),
     "rc_highpass": ("RcHighPass",),
@@ -47,7 +47,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "topology": ("DEFAULT_IMPEDANCE_OHM", "Figures", "KINDS", "PartSpec", "SectionTarget", "Topology",
                  "nodal_response", "nodal_system", "open_loop_gain", "polynomial", "polyval", "quadratic_root"),
     "verify": ("BenchSignal", "NRMS_PASS", "PROOF_POINTS_PER_DECADE", "Proof", "StageDrive", "TRAN_POINTS",
-               "analytic_tran", "bench_signal", "mask_edges", "opamp_aware_polys", "proof_deck", "prove",
+               "analytic_tran", "band_edge_db", "bench_signal", "mask_edges", "opamp_aware_polys", "proof_deck", "prove",
                "stage_drive", "stage_polys",),
 })
 

@@ -28,6 +28,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from ..core.i18n import N_
 from ..core.jsonio import json_safe
 from ..core.lti import filter_foh
 from ..core.metrics import step_metrics
@@ -338,10 +339,10 @@ def _sweep_frequencies(result, h_db_of) -> list:
     f3 = result.figures.get("f3_hz")
     for v in (f3 if isinstance(f3, (list, tuple)) else [f3]):
         if v:
-            keys[float(v)] = "-3 dB"
+            keys[float(v)] = "-3 dB"   # the same in every language
     if s.has_mask:
-        keys[float(s.passband_hz)] = "passband edge"
-        keys[float(s.stopband_hz)] = "stopband edge"
+        keys.update({float(e): N_("passband edge") for e in s.passband_edges})
+        keys.update({float(e): N_("stopband edge") for e in s.stopband_edges})
     e_lo, e_hi = math.floor(math.log10(lo)), math.ceil(math.log10(hi))
     grid = [m * 10.0 ** e for e in range(e_lo, e_hi + 1) for m in (1, 2, 5) if lo <= m * 10.0 ** e <= hi]
     ref = 20 * math.log10(passband_gain(result))

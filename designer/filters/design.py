@@ -44,7 +44,8 @@ from ..core.units import format_eng
 from .cascade import Cascade
 from .deck import simulate_ac
 from .joint import joint_search, objective, per_stage
-from .prototype import (SectionPlan, bandpass_method, order_from_mask, plan_bandpass, plan_sections,
+from .prototype import (DELAY_POINTS, SectionPlan, bandpass_method, delay_error_pct, group_delay, order_from_mask,
+                        plan_bandpass, plan_sections, prototype_zpk,
                         reference_bandpass, reference_response)
 from .registry import get as get_topology
 from .spec import FilterSpec
@@ -52,7 +53,7 @@ from .topology import SectionTarget
 from .verify import proof_deck, prove
 
 __all__ = ["StageDesign", "FilterDesign", "design", "as_built", "section_plans", "section_name", "stage_candidates", "verify_spice", "predistort",
-           "analysis_grid", "with_choice"]
+           "analysis_grid", "with_choice", "delay_figures"]
 
 #: the capacitor values (C1, nearest first) each stage offers the joint search
 C_CHOICES = 3
@@ -218,7 +219,9 @@ class FilterDesign:
                 "r_series": s.r_series, "c_series": s.c_series, "amplitude_v": s.amplitude_v,
                 "gbw_margin": s.gbw_margin, "compensate_gbw": s.compensate_gbw,
                 # only when given: the reference outputs of a split by the design stay as they are
-                **({"stage_gains": list(s.stage_gains)} if s.stage_gains is not None else {})}
+                **({"stage_gains": list(s.stage_gains)} if s.stage_gains is not None else {}),
+                **({"delay_target": {"max_delay_error_pct": s.max_delay_error_pct, "delay_to_hz": s.delay_to_hz}}
+                   if s.has_delay_target else {})}
         return json_safe({"tool": "design-filter", "schema_version": SCHEMA_VERSION, "spec": spec,
                           "opamp": self.opamp.to_dict(), "stages": [st.to_dict() for st in self.stages],
                           "figures": dict(self.figures), "spice": self.spice})
@@ -389,8 +392,11 @@ def analysis_grid(spec: FilterSpec, order: int, fc_hz: float) -> dict:
     level3 = -10 * math.log10(2)
     if kind == "bandpass":
         f3 = [_crossing(wide, db, level3, False), _crossing(wide, db, level3, True)]
-        fp = [spec.f_low_hz, spec.f_high_hz]
-        ft = [_crossing(wide, db, -TRANSITION_DB, False), _crossing(wide, db, -TRANSITION_DB, True)]
+        if spec.has_mask:
+            fp, ft = list(spec.passband_edges), list(spec.stopband_edges)
+        else:
+            fp = [spec.f_low_hz, spec.f_high_hz]
+            ft = [_crossing(wide, db, -TRANSITION_DB, False), _crossing(wide, db, -TRANSITION_DB, True)]
         pb_range, obj_range = (fp[0], fp[1]), (ft[0], ft[1])
     else:
         low = kind == "lowpass"
@@ -406,6 +412,14 @@ def analysis_grid(spec: FilterSpec, order: int, fc_hz: float) -> dict:
             "passband_range_hz": tuple(map(float, pb_range)), "objective_range_hz": tuple(map(float, obj_range)),
             "objective": np.geomspace(*obj_range, GRID_POINTS), "passband": np.geomspace(*pb_range, GRID_POINTS // 2),
             "sweep_hz": (float(min(obj_range[0], pb_range[0]) / 30), float(max(obj_range[1], pb_range[1]) * 30))}
+
+
+def _in_passband(spec: FilterSpec, f) -> np.ndarray:
+    """Which of ``f`` lie in the mask's passband (its edges included)."""
+    if spec.filter_type == "bandpass":
+        lo, hi = spec.passband_edges
+        return (f >= lo) & (f <= hi)
+    return f <= spec.passband_hz if spec.filter_type == "lowpass" else f >= spec.passband_hz
 
 
 def _reference(spec: FilterSpec, order: int, fc_hz: float, f) -> np.ndarray:
@@ -611,17 +625,18 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         # the mask's edges as two more columns of the objective, with one-sided limits (joint.py): the sum S of
         # the stages' dB errors may lower the passband edge's gain, or raise the stopband edge's, by the ideal
         # response's own margin there and no more
-        ideal = 20 * np.log10(np.abs(_reference(spec, order, fc, np.array([spec.passband_hz, spec.stopband_hz]))
-                                     / spec.gain))
-        margin_pass = spec.max_loss_db + ideal[0]
-        margin_stop = -ideal[1] - spec.min_attenuation_db
-        grid["objective"] = np.append(grid["objective"], [spec.passband_hz, spec.stopband_hz])
-        n = grid["objective"].size
-        limits = [(n - 2, -1.0, -margin_pass), (n - 1, 1.0, -margin_stop)]
+        # (a band-pass: both passband edges and both stopband edges)
+        edges = np.array([*spec.passband_edges, *spec.stopband_edges])
+        n_pass = len(spec.passband_edges)
+        ideal = 20 * np.log10(np.abs(_reference(spec, order, fc, edges) / spec.gain))
+        n0 = grid["objective"].size
+        grid["objective"] = np.append(grid["objective"], edges)
+        limits = [(n0 + i, -1.0, -(spec.max_loss_db + ideal[i])) if i < n_pass else
+                  (n0 + i, 1.0, -(-ideal[i] - spec.min_attenuation_db)) for i in range(edges.size)]
         # the loss is limited over the whole passband, not at its edge only (a Chebyshev's ripple troughs
         # inside it sit at the ideal's full ripple: the parts may not deepen them past --max-loss)
-        f_obj = grid["objective"][:n - 2]
-        inside = f_obj <= spec.passband_hz if spec.filter_type == "lowpass" else f_obj >= spec.passband_hz
+        f_obj = grid["objective"][:n0]
+        inside = _in_passband(spec, f_obj)
         ideal_in = 20 * np.log10(np.abs(_reference(spec, order, fc, f_obj[inside]) / spec.gain))
         limits += [(int(c), -1.0, -(spec.max_loss_db + d)) for c, d in zip(np.flatnonzero(inside), ideal_in)]
     f_obj = grid["objective"]
@@ -691,9 +706,10 @@ def section_plans(spec: FilterSpec) -> tuple:
     DesignError
         A mask that needs more than order 10 (one line).
     """
-    if spec.has_mask:
+    if spec.has_mask and spec.filter_type != "bandpass":   # a band-pass's mask gave its order and edges
         order, fc = order_from_mask(spec.filter_type, spec.family, spec.passband_hz, spec.max_loss_db,
-                                    spec.stopband_hz, spec.min_attenuation_db, spec.bessel_norm)
+                                    spec.stopband_hz, spec.min_attenuation_db, spec.bessel_norm,
+                                    spec.max_delay_error_pct, spec.delay_to_hz)
     else:
         order, fc = spec.order, spec.fc_hz
     conv = (spec.ripple_db or 1.0, spec.bessel_norm, spec.chebyshev_cutoff)
@@ -826,11 +842,43 @@ def _figures(result: FilterDesign, grid: dict, errors, choice, j_joint, examined
         "inverting": sum(get_topology(st.topology).inverting for st in stages) % 2 == 1,
         "sweep_hz": grid["sweep_hz"],
     }
+    if spec.has_delay_target:
+        figs.update(delay_figures(spec, result.order, result.fc_hz, lambda s: chosen.response(s, opamp)))
     if spec.has_mask:
         h = lambda f: 20 * math.log10(abs(complex(chosen.response(2j * math.pi * f, opamp)))) - g_db  # noqa: E731
-        figs["mask_passband_margin_db"] = spec.max_loss_db + h(spec.passband_hz)
-        figs["mask_stopband_margin_db"] = -h(spec.stopband_hz) - spec.min_attenuation_db
+        figs["mask_passband_margin_db"] = spec.max_loss_db + min(h(f) for f in spec.passband_edges)
+        figs["mask_stopband_margin_db"] = -max(h(f) for f in spec.stopband_edges) - spec.min_attenuation_db
     return figs
+
+
+def delay_figures(spec: FilterSpec, order: int, fc_hz: float, response) -> dict:
+    """A group-delay target's figures: the largest departure of the delay from its DC value, % of it, from
+    DC to ``spec.delay_to_hz``, of ``response`` (the chosen parts' cascade; by a central difference of its
+    phase, tau = -arg(H(j(w + dw)) / H(j(w - dw))) / (2 dw), which holds at DC too, H(-jw) being H(jw)'s
+    conjugate) and of the ideal prototype (exact from its poles, :func:`~designer.filters.prototype.group_delay`).
+
+    Parameters
+    ----------
+    spec : FilterSpec
+        With a delay target.
+    order, fc_hz : int, float
+        The design's order and cut-off.
+    response : callable
+        s (rad/s, complex array) -> H.
+
+    Returns
+    -------
+    dict
+        ``delay_error_pct`` (the parts'), ``delay_error_ideal_pct``, ``delay_dc_s``, ``delay_target_met``.
+    """
+    f = np.linspace(0.0, spec.delay_to_hz, DELAY_POINTS)
+    dw = 2 * math.pi * fc_hz * 1e-4
+    w = 2 * math.pi * f
+    tau = -np.angle(response(1j * (w + dw)) / response(1j * (w - dw))) / (2 * dw)
+    ideal = group_delay(prototype_zpk(spec.family, order, 1.0, spec.bessel_norm), f, fc_hz)
+    err = delay_error_pct(tau, tau[0])
+    return {"delay_error_pct": err, "delay_error_ideal_pct": delay_error_pct(ideal, ideal[0]),
+            "delay_dc_s": float(tau[0]), "delay_target_met": bool(err <= spec.max_delay_error_pct)}
 
 
 def with_choice(result: FilterDesign, choice, simulate: bool = False, simulator: str = "ngspice-cli") -> FilterDesign:
@@ -864,7 +912,8 @@ def with_choice(result: FilterDesign, choice, simulate: bool = False, simulator:
     figs = _figures(out, grid, errors, list(choice), None, f.get("examined", 0), f.get("candidates_s", 0.0),
                     f.get("search_s", 0.0))
     out.figures = {**f, **{k: figs[k] for k in ("f3_hz", "passband_deviation_db", "mask_passband_margin_db",
-                                                "mask_stopband_margin_db") if k in figs},
+                                                "mask_stopband_margin_db", "delay_error_pct", "delay_dc_s",
+                                                "delay_target_met") if k in figs},
                    "error_built_db": objective(errors, list(choice)), "built": "yield-optimal"}
     if simulate:
         out.proof = prove(out, simulator)

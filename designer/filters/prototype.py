@@ -34,7 +34,7 @@ from ..core.errors import DesignError
 
 __all__ = ["FAMILIES", "RESPONSE_TYPES", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "BANDPASS_METHODS", "MAX_ORDER",
            "WIDE_RATIO", "SectionPlan", "prototype_zpk", "plan_sections", "reference_ba", "reference_response",
-           "order_from_mask", "chebyshev_3db_factor", "bandpass_method", "plan_bandpass", "reference_bandpass"]
+           "order_from_mask", "bandpass_from_mask", "group_delay", "delay_error_pct", "DELAY_POINTS", "chebyshev_3db_factor", "bandpass_method", "plan_bandpass", "reference_bandpass"]
 
 FAMILIES = ("butterworth", "bessel", "chebyshev")
 RESPONSE_TYPES = ("lowpass", "highpass", "bandpass")
@@ -214,8 +214,55 @@ def _loss_db(kind, family, order, fc_hz, f_hz, ripple_db, bessel_norm):
     return -20 * np.log10(np.abs(h))
 
 
+def group_delay(zpk: tuple, f_hz, fc_hz: float = 1 / (2 * math.pi)) -> np.ndarray:
+    """The group delay of a prototype scaled to ``fc_hz``, exact from its poles: for H = k / prod(s - p),
+    tau(w) = -d arg H(jw) / dw = sum over the poles of -Re p / ((Re p)^2 + (w - Im p)^2) (zeros at the
+    origin, a high-pass's, add none; a low-pass prototype has none).
+
+    Parameters
+    ----------
+    zpk : tuple
+        (zeros, poles, gain) of the normalised prototype (:func:`prototype_zpk`; cut-off 1 rad/s).
+    f_hz : array_like
+        Frequencies, Hz.
+    fc_hz : float
+        The cut-off the prototype is scaled to (its poles times 2 pi fc).
+
+    Returns
+    -------
+    ndarray
+        Group delay, s.
+    """
+    p = np.asarray(zpk[1], complex) * 2 * math.pi * fc_hz
+    w = 2 * math.pi * np.asarray(f_hz, float)[..., None]
+    return np.sum(-p.real / (p.real ** 2 + (w - p.imag) ** 2), axis=-1)
+
+
+def delay_error_pct(tau: np.ndarray, tau_dc: float) -> float:
+    """The largest departure of a group delay from its DC value, % of it.
+
+    Parameters
+    ----------
+    tau : ndarray
+        Group delay over the band the target covers, s.
+    tau_dc : float
+        The delay at DC, s.
+
+    Returns
+    -------
+    float
+        max |tau / tau_dc - 1| x 100.
+    """
+    return float(100 * np.max(np.abs(np.asarray(tau) / tau_dc - 1)))
+
+
+#: points of the grid a group-delay target is judged on, from DC to its frequency
+DELAY_POINTS = 201
+
+
 def order_from_mask(kind: str, family: str, passband_hz: float, max_loss_db: float, stopband_hz: float,
-                    min_attenuation_db: float, bessel_norm: str = "mag") -> tuple:
+                    min_attenuation_db: float, bessel_norm: str = "mag", max_delay_error_pct: float | None = None,
+                    delay_to_hz: float | None = None) -> tuple:
     """The least order meeting the mask, and the cut-off it gives.
 
     Butterworth and Chebyshev by scipy's ``buttord`` and ``cheb1ord`` (``analog=True``;
@@ -235,6 +282,10 @@ def order_from_mask(kind: str, family: str, passband_hz: float, max_loss_db: flo
         The mask.
     bessel_norm : str
         The Bessel normalisation the cut-off is given in.
+    max_delay_error_pct, delay_to_hz : float or None
+        A Bessel low-pass's group-delay target: the delay within this % of its DC value from DC to
+        ``delay_to_hz`` (:func:`group_delay`, on :data:`DELAY_POINTS` points); the least order meeting the
+        mask and the target.
 
     Returns
     -------
@@ -266,9 +317,20 @@ def order_from_mask(kind: str, family: str, passband_hz: float, max_loss_db: flo
                     hi = mid
             fc_try = math.exp(hi if kind == "lowpass" else lo)
             att = _loss_db(kind, family, order, fc_try, stopband_hz, 1.0, bessel_norm)[0]
-            if att >= min_attenuation_db:
+            err = None
+            if max_delay_error_pct is not None:
+                zpk = prototype_zpk(family, order, 1.0, bessel_norm)
+                tau = group_delay(zpk, np.linspace(0.0, delay_to_hz, DELAY_POINTS), fc_try)
+                err = delay_error_pct(tau, tau[0])
+            if att >= min_attenuation_db and (err is None or err <= max_delay_error_pct):
                 n, fc = order, fc_try
                 break
+        if n is None and max_delay_error_pct is not None:
+            raise DesignError(f"order: the mask and the group-delay target need a Bessel filter above order "
+                              f"{MAX_ORDER} (order {MAX_ORDER}: {att:.3g} dB at the stopband edge, "
+                              f"{min_attenuation_db:.3g} dB asked; the delay within {err:.3g} % up to "
+                              f"{delay_to_hz:g} Hz, {max_delay_error_pct:g} % asked); lower --delay-to, allow more "
+                              "delay error or widen the transition band", param="order")
         if n is None:
             # a Bessel's attenuation grows slowly (near-Gaussian), so there is no closed form to name the order
             raise DesignError(f"order: the mask needs a Bessel filter above order {MAX_ORDER} (order {MAX_ORDER} "
@@ -376,3 +438,163 @@ def reference_bandpass(f_hz, family: str, order: int, f_low_hz: float, f_high_hz
     z, p, k = signal.lp2bp_zpk(z, p, k, w0, 2 * math.pi * (f_high_hz - f_low_hz))
     h = signal.freqs_zpk(z, p, k, 2 * math.pi * np.append(f, math.sqrt(f_low_hz * f_high_hz)))[1]
     return h[:-1] / abs(h[-1])
+
+
+def _band_loss_db(f_hz, family, order, f_low_hz, f_high_hz, conv, method) -> np.ndarray:
+    return -20 * np.log10(np.abs(reference_bandpass(np.atleast_1d(f_hz), family, order, f_low_hz, f_high_hz,
+                                                    *conv, method)))
+
+
+def _first_feasible(lo: float, hi: float, ok) -> float:
+    """The first x from ``lo`` towards ``hi`` (either way round; log scale) where ``ok(x)``: a scan of 40 points a
+    decade, then 50 halvings between the last refused point and the first accepted one. A scan, not a bisection
+    over the whole span, because a Chebyshev's loss at an edge is not monotonic in its cut-off (the ripple):
+    the set of accepted cut-offs has gaps, and the nearest one is the one that attenuates most."""
+    grid = np.geomspace(lo, hi, max(2, int(abs(math.log10(hi / lo)) * 40) + 1))
+    prev = None
+    for x in grid:
+        if ok(x):
+            break
+        prev = x
+    else:
+        return float(hi)
+    if prev is None:
+        return float(x)
+    a, b = math.log(prev), math.log(x)
+    for _ in range(50):
+        mid = 0.5 * (a + b)
+        if ok(math.exp(mid)):
+            b = mid
+        else:
+            a = mid
+    return math.exp(b)
+
+
+def _band_edges_search(family, order, passband, max_loss_db, conv, method) -> tuple:
+    """(f_low, f_high) of an order-``order`` band-pass whose loss over the passband is at most ``max_loss_db``,
+    its edges as close to the passband as that allows (the most stopband attenuation).
+
+    Wide: the low-pass edge upwards from p2 / 2, the loss over the passband's upper half held to the limit,
+    and the high-pass edge downwards from 2 p1, over its lower half, each with the other held, alternated until
+    they settle (each side's loss at the far edge is small but not nil: a first-order high-pass still takes
+    0.97 dB an octave above its corner). Narrow: the centre the passband's geometric centre, the bandwidth
+    the least that holds the loss over the passband (the transformation is geometrically symmetric).
+    """
+    p1, p2 = passband
+    grid = np.geomspace(p1, p2, 41)
+    limit = max_loss_db * (1 + 1e-9)
+    if method == "wide":
+        upper, lower = grid[grid >= math.sqrt(p1 * p2)], grid[grid <= math.sqrt(p1 * p2)]
+        # each side's normalised design once (cut-off 1 rad/s): at cut-off fc its loss at f is the normalised one at f / fc
+        norm = {k: reference_ba(k, family, order, 1 / (2 * math.pi), *conv) for k in ("lowpass", "highpass")}
+        side = lambda kind, f, fc: -20 * np.log10(np.abs(signal.freqs(*norm[kind], f / fc)[1]))  # noqa: E731
+        fl, fh = p1 / 2, p2 * 2
+        for _ in range(8):
+            before = (fl, fh)
+            held = side("highpass", upper, fl)   # the product's loss in dB: the sides' losses add
+            fh = _first_feasible(p2 / 2, p2 * 100, lambda x: np.max(held + side("lowpass", upper, x)) <= limit)
+            held = side("lowpass", lower, fh)
+            fl = _first_feasible(p1 * 2, p1 / 100, lambda x: np.max(held + side("highpass", lower, x)) <= limit)
+            if math.isclose(fl, before[0], rel_tol=1e-12) and math.isclose(fh, before[1], rel_tol=1e-12):
+                break
+        return fl, fh
+    f0 = math.sqrt(p1 * p2)
+    z, p, k = prototype_zpk(family, order, *conv)   # once: reference_bandpass's transformation, per bandwidth
+
+    def loss(bw):
+        zb, pb, kb = signal.lp2bp_zpk(z, p, k, 2 * math.pi * f0, 2 * math.pi * bw)
+        h = np.abs(signal.freqs_zpk(zb, pb, kb, 2 * math.pi * np.append(grid, f0))[1])
+        return -20 * np.log10(h[:-1] / h[-1])
+
+    bw = _first_feasible((p2 - p1) / 4, (p2 - p1) * 100, lambda b: np.max(loss(b)) <= limit)
+    return _centred(f0, bw)
+
+
+def _centred(f0: float, bw: float) -> tuple:
+    """The edges (f_low, f_high) of geometric centre ``f0`` and width ``bw``: f_low f_high = f0^2, f_high - f_low = bw."""
+    fl = (-bw + math.sqrt(bw * bw + 4 * f0 * f0)) / 2
+    return fl, fl + bw
+
+
+def bandpass_from_mask(family: str, passband_hz: tuple, max_loss_db: float, stopband_hz: tuple,
+                       min_attenuation_db: float, bessel_norm: str = "mag", chebyshev_cutoff: str = "ripple",
+                       method: str = "auto") -> tuple:
+    """The least prototype order, band edges and method of a band-pass meeting a mask.
+
+    The method (``wide`` or ``narrow``) is :func:`bandpass_method` of the passband edges.
+    Narrow Butterworth and Chebyshev: scipy's ``buttord`` / ``cheb1ord`` with the band-pass edges
+    (``analog=True``; their ``wn`` are the edges of ``lp2bp``'s transformation, the one
+    :func:`plan_bandpass` uses; a Chebyshev at ``3db`` takes the edges where the prototype's
+    w3 (:func:`chebyshev_3db_factor`) lands: f = (w3 B + sqrt(w3^2 B^2 + 4 f0^2)) / 2).
+    Bessel, and every wide band-pass (a high-pass and a low-pass of the same order, whose response
+    is not ``lp2bp``'s): for n = 1, 2, ... the edges that put the loss at the passband edges at
+    ``max_loss_db`` (bisection), then the attenuation at both stopband edges checked. Every answer
+    is checked on :func:`reference_bandpass` at the four edges.
+
+    Parameters
+    ----------
+    family : str
+        One of :data:`FAMILIES` (a Chebyshev's ripple is ``max_loss_db``).
+    passband_hz, stopband_hz : tuple of float
+        (low, high) edges, Hz; the stopband's outside the passband's.
+    max_loss_db, min_attenuation_db : float
+        The mask's largest passband loss and least stopband attenuation, dB.
+    bessel_norm, chebyshev_cutoff : str
+        The cut-off conventions the edges are given in (:func:`prototype_zpk`).
+    method : str
+        One of :data:`BANDPASS_METHODS`.
+
+    Returns
+    -------
+    tuple
+        (order of the prototype, f_low_hz, f_high_hz, method): the band-pass's order is 2 x order.
+
+    Raises
+    ------
+    DesignError
+        The mask needs a prototype above :data:`MAX_ORDER` (naming the order it needs, or what order 10 gives).
+    """
+    method = bandpass_method(passband_hz[0], passband_hz[1], method)
+    conv = (max_loss_db, bessel_norm, chebyshev_cutoff)
+
+    inside = np.geomspace(*passband_hz, 41)
+
+    def meets(n, fl, fh) -> tuple:
+        # the loss over the passband (its edges among the points; a Chebyshev's troughs inside), the
+        # attenuation at the stopband edges (the skirts fall monotonically beyond them)
+        loss = _band_loss_db(np.array([*inside, *stopband_hz]), family, n, fl, fh, conv, method)
+        att = float(min(loss[-2:]))
+        return max(loss[:-2]) <= max_loss_db * (1 + 1e-6) + 1e-9 and att >= min_attenuation_db * (1 - 1e-6), att
+
+    start = 1
+    if family != "bessel" and method == "narrow":
+        fn = signal.buttord if family == "butterworth" else signal.cheb1ord
+        n, wn = fn(2 * math.pi * np.asarray(passband_hz, float), 2 * math.pi * np.asarray(stopband_hz, float),
+                   max_loss_db, min_attenuation_db, analog=True)
+        n = int(n)
+        if n > MAX_ORDER:
+            raise DesignError(f"order: the band-pass mask needs a {family} prototype of order {n} (a band-pass of "
+                              f"order {2 * n}), above the limit {MAX_ORDER}; widen the transition bands, allow more "
+                              "passband loss or less stopband attenuation", param="order")
+        fl, fh = (float(w) / (2 * math.pi) for w in wn)
+        if family == "chebyshev" and chebyshev_cutoff == "3db":
+            w3 = chebyshev_3db_factor(n, max_loss_db)
+            fl, fh = _centred(math.sqrt(fl * fh), w3 * (fh - fl))
+        if meets(n, fl, fh)[0]:
+            return n, fl, fh, method
+        start = n + 1
+    elif family != "bessel":
+        # a wide band-pass needs at least what each side needs alone (scipy's buttord / cheb1ord per side)
+        fn = signal.buttord if family == "butterworth" else signal.cheb1ord
+        start = max(int(fn(2 * math.pi * p, 2 * math.pi * st, max_loss_db, min_attenuation_db, analog=True)[0])
+                    for p, st in zip(passband_hz, stopband_hz))
+    att = 0.0
+    for n in range(start, MAX_ORDER + 1):
+        fl, fh = _band_edges_search(family, n, passband_hz, max_loss_db, conv, method)
+        ok, att = meets(n, fl, fh)
+        if ok:
+            return n, fl, fh, method
+    raise DesignError(f"order: the band-pass mask needs a {family} prototype above order {MAX_ORDER} ({method} "
+                      f"band-pass: order {MAX_ORDER} gives {att:.3g} dB at the stopband edges, "
+                      f"{min_attenuation_db:.3g} dB asked); widen the transition bands, or allow more passband loss",
+                      param="order")

@@ -24,6 +24,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.i18n import N_
+from ..core.i18n import gettext as _
 from ..core.units import format_eng
 from ..report import document as R
 from ..report.plots import figure, log_frequency_axis, png_bytes, step_plot
@@ -262,11 +264,16 @@ def title_of(result) -> str:
         ``4th-order Butterworth low-pass, fc 1 kHz ...``.
     """
     s = result.spec
-    kind = {"lowpass": "low-pass", "highpass": "high-pass", "bandpass": "band-pass"}[s.filter_type]
-    where = (f"band {format_eng(s.f_low_hz, 'Hz')} to {format_eng(s.f_high_hz, 'Hz')}"
+    kind = _(_KIND_WORDS[s.filter_type])
+    where = (_("band {low} to {high}").format(low=format_eng(s.f_low_hz, "Hz"), high=format_eng(s.f_high_hz, "Hz"))
              if s.filter_type == "bandpass" else f"fc {format_eng(result.fc_hz, 'Hz')}")
     fam = s.family.capitalize() + (f" {s.ripple_db:g} dB" if s.family == "chebyshev" else "")
-    return f"Order-{result.order} {fam} {kind}, {where}, gain {s.gain:g}, {result.opamp.name}"
+    return _("Order-{order} {family} {kind}, {where}, gain {gain}, {opamp}").format(
+        order=result.order, family=fam, kind=kind, where=where, gain=f"{s.gain:g}", opamp=result.opamp.name)
+
+
+#: the response types in the sheet's words (translated where shown)
+_KIND_WORDS = {"lowpass": N_("low-pass"), "highpass": N_("high-pass"), "bandpass": N_("band-pass")}
 
 
 def bom(result, b=None) -> list:
@@ -305,60 +312,70 @@ def _sweep(data: FilterSheet) -> list:
     rows = [[format_eng(p.f_hz, "Hz", 4), f"{p.gain_db:+.2f}", f"{p.gain_lo_db:+.2f} .. {p.gain_hi_db:+.2f}",
              _deg(p.phase_deg), f"{_deg(p.phase_lo_deg)} .. {_deg(p.phase_hi_deg)}",
              format_eng(p.out_pk_v, "V", 3), format_eng(p.time_per_div_s, "s") + "/div",
-             format_eng(p.ch1_v_per_div, "V") + "/div", format_eng(p.ch2_v_per_div, "V") + "/div", p.note]
+             format_eng(p.ch1_v_per_div, "V") + "/div", format_eng(p.ch2_v_per_div, "V") + "/div",
+             _(p.note) if p.note else ""]
             for p in bench.sweep]
-    return [R.text(f"Generator: sine, {format_eng(amp, 'V')} peak ({format_eng(2 * amp, 'V')} pk-pk), no offset, "
-                   "output High-Z, into IN; scope CH1 on IN, CH2 on OUT, DC coupled, trigger CH1 rising at 0 V. "
-                   "At each frequency read the gain 20 log10(CH2 pk-pk / CH1 pk-pk) and the phase -360 x f x (the "
-                   "delay from CH1's rising zero crossing to CH2's); the phase is shown within -180..+180 deg, as "
-                   "the scope shows it."),
-            R.text(f"Band: {bench.builds} builds of the parts drawn within R {bench.r_tol_pct:g} %, C "
-                   f"{bench.c_tol_pct:g} % (seed {bench.seed}), 0.5th to 99.5th percentile, with the "
-                   f"{data.design.opamp.name} model."),
-            R.table(["f", "gain (dB)", "band (dB)", "phase (deg)", "band (deg)", "CH2 peak", "time base", "CH1",
-                     "CH2", ""], rows, "compact")]
+    return [R.text(_("Generator: sine, {peak} peak ({pp} pk-pk), no offset, output High-Z, into IN; scope CH1 on IN, "
+                     "CH2 on OUT, DC coupled, trigger CH1 rising at 0 V. At each frequency read the gain 20 log10(CH2 "
+                     "pk-pk / CH1 pk-pk) and the phase -360 x f x (the delay from CH1's rising zero crossing to "
+                     "CH2's); the phase is shown within -180..+180 deg, as the scope shows it.").format(
+                         peak=format_eng(amp, "V"), pp=format_eng(2 * amp, "V"))),
+            R.text(_("Band: {builds} builds of the parts drawn within R {r} %, C {c} % (seed {seed}), 0.5th to 99.5th "
+                     "percentile, with the {opamp} model.").format(
+                         builds=bench.builds, r=f"{bench.r_tol_pct:g}", c=f"{bench.c_tol_pct:g}", seed=bench.seed,
+                         opamp=data.design.opamp.name)),
+            R.table(["f", _("gain (dB)"), _("band (dB)"), _("phase (deg)"), _("band (deg)"), _("CH2 peak"),
+                     _("time base"), "CH1", "CH2", ""], rows, "compact")]
 
 
 def _time_test(data: FilterSheet) -> list:
     tt = data.bench.time_test
     m = tt.metrics
     if tt.kind == "step":
-        gen = (f"square {format_eng(tt.frequency_hz, 'Hz')}, 0 to {format_eng(tt.amplitude_v, 'V')} (offset "
-               f"{format_eng(tt.amplitude_v / 2, 'V')}), into IN")
-        rows = [["overshoot", f"{m['overshoot_pct']:.3g} %"], ["rise time (10-90 %)", format_eng(m["rise_time_s"], "s")],
-                ["settling time (2 %)", format_eng(m["settling_time_s"], "s")],
-                ["output peak", format_eng(m["peak_v"], "V")], ["final value", format_eng(m["final_v"], "V")]]
-        what = "the step: the rising edge of a square wave whose half period is five settling times"
+        gen = _("square {f}, 0 to {a} (offset {offset}), into IN").format(
+            f=format_eng(tt.frequency_hz, "Hz"), a=format_eng(tt.amplitude_v, "V"),
+            offset=format_eng(tt.amplitude_v / 2, "V"))
+        rows = [[_("overshoot"), f"{m['overshoot_pct']:.3g} %"],
+                [_("rise time (10-90 %)"), format_eng(m["rise_time_s"], "s")],
+                [_("settling time (2 %)"), format_eng(m["settling_time_s"], "s")],
+                [_("output peak"), format_eng(m["peak_v"], "V")], [_("final value"), format_eng(m["final_v"], "V")]]
+        what = _("the step: the rising edge of a square wave whose half period is five settling times")
     else:
-        gen = (f"burst of {tt.cycles} cycles of a {format_eng(tt.frequency_hz, 'Hz')} sine, "
-               f"{format_eng(tt.amplitude_v, 'V')} peak, repeated at {format_eng(tt.repeat_hz, 'Hz')}, into IN")
-        rows = [["steady output peak", format_eng(m["steady_pk_v"], "V")], ["largest output peak",
-                                                                           format_eng(m["peak_v"], "V")],
-                ["within 2 % of the steady peak after", format_eng(m["settle_s"], "s")]]
-        what = "the tone burst at the passband's centre: the output builds up and rings out"
-    settings = [["generator", gen], ["time base", f"{format_eng(tt.time_per_div_s, 's')}/div, trigger CH1 rising"],
-                ["CH2", f"{format_eng(tt.ch2_v_per_div, 'V')}/div DC on OUT"]]
-    return [R.text(f"Test: {what} (the chosen parts, ideal op-amps)."), R.table(["set", "to"], settings, "compact"),
-            R.table(["reading", "expected"], rows, "compact")]
+        gen = _("burst of {cycles} cycles of a {f} sine, {a} peak, repeated at {repeat}, into IN").format(
+            cycles=tt.cycles, f=format_eng(tt.frequency_hz, "Hz"), a=format_eng(tt.amplitude_v, "V"),
+            repeat=format_eng(tt.repeat_hz, "Hz"))
+        rows = [[_("steady output peak"), format_eng(m["steady_pk_v"], "V")],
+                [_("largest output peak"), format_eng(m["peak_v"], "V")],
+                [_("within 2 % of the steady peak after"), format_eng(m["settle_s"], "s")]]
+        what = _("the tone burst at the passband's centre: the output builds up and rings out")
+    settings = [[_("generator"), gen],
+                [_("time base"), _("{t}/div, trigger CH1 rising").format(t=format_eng(tt.time_per_div_s, "s"))],
+                ["CH2", _("{v}/div DC on OUT").format(v=format_eng(tt.ch2_v_per_div, "V"))]]
+    return [R.text(_("Test: {what} (the chosen parts, ideal op-amps).").format(what=what)),
+            R.table([_("set"), _("to")], settings, "compact"),
+            R.table([_("reading"), _("expected")], rows, "compact")]
 
 
 def _stages(data: FilterSheet) -> list:
     r = data.design
     op = r.opamp
     rows = []
+    of = _("{needed} of {available}")
     for st, c in zip(r.stages, data.bench.checks):
         rows.append([st.number, st.topology, format_eng(st.plan.fn_hz, "Hz", 4),
                      "" if st.plan.q is None else f"{st.plan.q:.4g}", f"{st.gain:.4g}",
                      f"{20 * math.log10(st.peak_gain):+.2f} dB", format_eng(c.out_peak_v, "V", 3),
-                     f"{format_eng(c.gbw_needed_hz, 'Hz', 3)} of {format_eng(c.gbw_hz, 'Hz', 3)}",
-                     f"{format_eng(c.slew_needed_v_per_s, 'V/s', 3)} of {format_eng(c.slew_v_per_s, 'V/s', 3)}",
-                     "ok" if c.ok else "FAILED"])
-    return [R.text(f"Each stage against the {op.name} at {format_eng(data.bench.amplitude_v, 'V')} peak in: GBW "
-                   f"needed = {r.spec.gbw_margin:g} x fn x Q x noise gain; the output's peak (the cascade up to it, "
-                   f"at its worst frequency) within the swing {format_eng(data.bench.checks[0].swing_v, 'V')}; the "
-                   "slew a sine of that peak needs at fn, 2 pi fn Vpk."),
-            R.table(["stage", "section", "fn", "Q", "gain", "peak gain", "output peak", "GBW needed", "slew needed",
-                     "check"], rows)]
+                     of.format(needed=format_eng(c.gbw_needed_hz, "Hz", 3), available=format_eng(c.gbw_hz, "Hz", 3)),
+                     of.format(needed=format_eng(c.slew_needed_v_per_s, "V/s", 3),
+                               available=format_eng(c.slew_v_per_s, "V/s", 3)),
+                     _("ok") if c.ok else _("FAILED")])
+    return [R.text(_("Each stage against the {opamp} at {amp} peak in: GBW needed = {margin} x fn x Q x noise gain; "
+                     "the output's peak (the cascade up to it, at its worst frequency) within the swing {swing}; the "
+                     "slew a sine of that peak needs at fn, 2 pi fn Vpk.").format(
+                         opamp=op.name, amp=format_eng(data.bench.amplitude_v, "V"), margin=f"{r.spec.gbw_margin:g}",
+                         swing=format_eng(data.bench.checks[0].swing_v, "V"))),
+            R.table([_("stage"), _("section"), "fn", "Q", _("gain"), _("peak gain"), _("output peak"),
+                     _("GBW needed"), _("slew needed"), _("check")], rows)]
 
 
 def _tables(data: FilterSheet) -> list:
@@ -374,54 +391,61 @@ def _tables(data: FilterSheet) -> list:
                      format_eng(t.fn_built_hz, "Hz", 5), "" if t.q_built is None else f"{t.q_built:.4f}"])
     text = []
     if s.filter_type == "bandpass":
-        text.append("A band-pass has no row in the low-pass tables: its sections come from the prototype "
-                    "transformed (or a high-pass and a low-pass cascade).")
+        text.append(_("A band-pass has no row in the low-pass tables: its sections come from the prototype "
+                      "transformed (or a high-pass and a low-pass cascade)."))
     elif abs(bench.table_corner - 1) > 1e-9:
-        text.append(f"The tables (TI SLOA088, section 16.9) put the corner fC 3 dB below the DC gain; this design's "
-                    f"fc is the {'ripple edge' if s.chebyshev_cutoff == 'ripple' else '-3 dB point below the ripple top'}"
-                    f": fC = {bench.table_corner:.4f} x the ripple edge, so the table's fn/fC differ from this "
-                    "design's fn/fc by that factor; Q is the same.")
+        edge = _("ripple edge") if s.chebyshev_cutoff == "ripple" else _("-3 dB point below the ripple top")
+        text.append(_("The tables (TI SLOA088, section 16.9) put the corner fC 3 dB below the DC gain; this design's "
+                      "fc is the {edge}: fC = {ratio} x the ripple edge, so the table's fn/fC differ from this "
+                      "design's fn/fc by that factor; Q is the same.").format(edge=edge,
+                                                                              ratio=f"{bench.table_corner:.4f}"))
     else:
-        text.append("The tables (TI SLOA088, section 16.9) and this design share the corner: fn/fc and Q agree with "
-                    "the table's; k = fCi/fC is each section's own -3 dB point, not its fn.")
+        text.append(_("The tables (TI SLOA088, section 16.9) and this design share the corner: fn/fc and Q agree "
+                      "with the table's; k = fCi/fC is each section's own -3 dB point, not its fn."))
     if s.filter_type == "highpass":
-        text.append("A high-pass uses the low-pass table with each fn mirrored about fc: fn = fc / (table fn/fC).")
+        text.append(_("A high-pass uses the low-pass table with each fn mirrored about fc: fn = fc / (table fn/fC)."))
     if s.compensate_gbw:
-        text.append("--compensate-gbw: each stage's parts are synthesised for a pre-distorted fn and Q (the "
-                    "'synthesised for' columns) so that with the op-amp's finite GBW it gives the table's.")
-    text.append(f"The parts are E-series values chosen jointly across the stages against the whole response: the "
-                f"worst deviation from the ideal is {f['error_joint_db']:.3g} dB, against {f['error_per_stage_db']:.3g}"
-                f" dB when each stage is rounded on its own and {f['error_nearest_db']:.3g} dB with every part at its "
-                "nearest value; so a stage's built fn and Q may sit further from its target than rounding would "
-                "put them, when that makes the whole response closer.")
-    return [R.table(["stage", "table fn/fC", "table Q", "table k", "design fn/fc", "fn", "Q", "synthesised for fn",
-                     "and Q", "built fn", "built Q"], rows, "compact"), *[R.text(t) for t in text]]
+        text.append(_("--compensate-gbw: each stage's parts are synthesised for a pre-distorted fn and Q (the "
+                      "'synthesised for' columns) so that with the op-amp's finite GBW it gives the table's."))
+    text.append(_("The parts are E-series values chosen jointly across the stages against the whole response: the "
+                  "worst deviation from the ideal is {joint} dB, against {per_stage} dB when each stage is rounded on "
+                  "its own and {nearest} dB with every part at its nearest value; so a stage's built fn and Q may sit "
+                  "further from its target than rounding would put them, when that makes the whole response "
+                  "closer.").format(joint=f"{f['error_joint_db']:.3g}", per_stage=f"{f['error_per_stage_db']:.3g}",
+                                    nearest=f"{f['error_nearest_db']:.3g}"))
+    return [R.table([_("stage"), _("table fn/fC"), _("table Q"), _("table k"), _("design fn/fc"), "fn", "Q",
+                     _("synthesised for fn"), _("and Q"), _("built fn"), _("built Q")], rows, "compact"),
+            *[R.text(t) for t in text]]
 
 
 def _achieved(r) -> list:
     f, s = r.figures, r.spec
     f3 = f["f3_hz"]
     f3t = f["f3_target_hz"]
-    show = lambda v: " and ".join(format_eng(x, "Hz", 5) for x in v) if isinstance(v, (list, tuple)) \
-        else format_eng(v, "Hz", 5)  # noqa: E731
-    rows = [["-3 dB frequency", show(f3t), show(f3)],
-            ["max passband deviation from the ideal", "0 dB", f"{f['passband_deviation_db']:.3g} dB"]]
+    show = lambda v: _("{a} and {b}").format(a=format_eng(v[0], "Hz", 5), b=format_eng(v[1], "Hz", 5)) \
+        if isinstance(v, (list, tuple)) else format_eng(v, "Hz", 5)  # noqa: E731
+    rows = [[_("-3 dB frequency"), show(f3t), show(f3)],
+            [_("max passband deviation from the ideal"), "0 dB", f"{f['passband_deviation_db']:.3g} dB"]]
     if s.has_mask:
-        rows += [["mask: passband margin", f">= 0 (loss <= {s.max_loss_db:g} dB to {format_eng(s.passband_hz, 'Hz')})",
-                  f"{f['mask_passband_margin_db']:.3g} dB"],
-                 ["mask: stopband margin", f">= 0 (>= {s.min_attenuation_db:g} dB from "
-                                          f"{format_eng(s.stopband_hz, 'Hz')})", f"{f['mask_stopband_margin_db']:.3g} dB"]]
-    out = [R.table(["figure", "target", f"chosen parts, {r.opamp.name} model"], rows)]
+        where_pass, where_stop = s.mask_phrases()
+        rows += [[_("mask: passband margin"), _(">= 0 (loss <= {loss} dB {where})").format(
+                     loss=f"{s.max_loss_db:g}", where=where_pass), f"{f['mask_passband_margin_db']:.3g} dB"],
+                 [_("mask: stopband margin"), _(">= 0 (>= {att} dB {where})").format(
+                     att=f"{s.min_attenuation_db:g}", where=where_stop), f"{f['mask_stopband_margin_db']:.3g} dB"]]
+    rows += _delay_rows(r)
+    out = [R.table([_("figure"), _("target"), _("chosen parts, {opamp} model").format(opamp=r.opamp.name)], rows)]
     if r.spice:
         sp = r.spice
-        out.append(R.text(f"SPICE (.ac, {sp['simulator']}) against the analytic response of these parts: max "
-                          f"deviation {sp['max_deviation_passband_db']:.2g} dB in the passband, "
-                          f"{sp['max_deviation_60db_db']:.2g} dB down to -60 dB."))
+        out.append(R.text(_("SPICE (.ac, {simulator}) against the analytic response of these parts: max deviation "
+                            "{passband} dB in the passband, {down60} dB down to -60 dB.").format(
+                                simulator=sp["simulator"], passband=f"{sp['max_deviation_passband_db']:.2g}",
+                                down60=f"{sp['max_deviation_60db_db']:.2g}")))
     return out
 
 
 def sections(data: FilterSheet, with_images: bool = True, schematic_svg: str = "") -> list:
-    """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`).
+    """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`), in the current
+    language (:mod:`designer.core.i18n`).
 
     Parameters
     ----------
@@ -442,28 +466,33 @@ def sections(data: FilterSheet, with_images: bool = True, schematic_svg: str = "
     op = r.opamp
     labels = {net: net_label(net) for net in {p.a for p in b.netlist.parts} | {p.b for p in b.netlist.parts}
               | {a.out for a in b.netlist.amps}}
-    first = [R.subhead("Bill of materials"),
-             R.table(["Ref", "Value", "Code", "Qty", "Series", "Tol.", "Package"], [x[:7] for x in bom(r, b)],
-                     "compact"),
-             R.text(f"Supplies {op.vcc:+g} V and {op.vee:+g} V. Set the generator's output to High-Z.")]
+    first = [R.subhead(_("Bill of materials")),
+             R.table([_("Ref"), _("Value"), _("Code"), _("Qty"), _("Series"), _("Tol."), _("Package")],
+                     [x[:7] for x in bom(r, b)], "compact"),
+             R.text(_("Supplies {vcc} V and {vee} V. Set the generator's output to High-Z.").format(
+                 vcc=f"{op.vcc:+g}", vee=f"{op.vee:+g}"))]
     # the cascade is wider than the plant: its schematic takes the page's width, the parts list follows
-    fig = [("Schematic", [R.figure("schematic.png", schematic_svg, "the cascade's schematic, stage by stage")])] \
+    fig = [(_("Schematic"), [R.figure("schematic.png", schematic_svg, _("the cascade's schematic, stage by stage"))])] \
         if with_images else []
-    out = [*fig, ("Build", first),
-           ("Stages and their op-amp checks", _stages(data)),
-           ("Wiring", [R.text("Nets by name: a label on the schematic is that net; S1, S2 .. are the stages' "
-                              "outputs, each the next stage's input."),
-                       R.table(["part", "code", "from", "to"], wiring_rows(b, labels, (op.vcc, op.vee)))]),
-           ("Bench test: sine sweep", _sweep(data)),
-           ("Bench test: " + ("step" if data.bench.time_test.kind == "step" else "tone burst"), _time_test(data)),
-           ("Target and achieved", _achieved(r)),
-           ("Why the values differ from a table's", _tables(data))]
+    out = [*fig, (_("Build"), first),
+           (_("Stages and their op-amp checks"), _stages(data)),
+           (_("Wiring"), [R.text(_("Nets by name: a label on the schematic is that net; S1, S2 .. are the stages' "
+                                   "outputs, each the next stage's input.")),
+                          R.table([_("part"), _("code"), _("from"), _("to")],
+                                  wiring_rows(b, labels, (op.vcc, op.vee)))]),
+           (_("Bench test: sine sweep"), _sweep(data)),
+           (_("Bench test: step") if data.bench.time_test.kind == "step" else _("Bench test: tone burst"),
+            _time_test(data)),
+           (_("Target and achieved"), _achieved(r)),
+           (_("Why the values differ from a table's"), _tables(data))]
     if with_images:
-        imgs = [R.image("bode.png", "Bode plot with the mask and the sweep's points"),
-                R.image("time-test.png", "the step or burst test")]
+        imgs = [R.image("bode.png", _("Bode plot with the mask and the sweep's points")),
+                R.image("time-test.png", _("the step or burst test"))]
         if data.bench.group_delay is not None:
-            imgs.append(R.image("group-delay.png", "group delay"))
-        out.append(("Plots", [R.columns(imgs[:2]), *imgs[2:]]))
+            imgs.append(R.image("group-delay.png", _("group delay")))
+            imgs += [R.text(_("Group-delay target: {what}, {target}; achieved {got}.").format(
+                what=row[0], target=row[1], got=row[2])) for row in _delay_rows(r)]
+        out.append((_("Plots"), [R.columns(imgs[:2]), *imgs[2:]]))
     return out
 
 
@@ -494,12 +523,17 @@ def bode_png(data: FilterSheet) -> bytes:
     lo_db = max(float(np.min(20 * np.log10(np.abs(h)))), ref - (s.min_attenuation_db + 30 if s.has_mask else 80))
     if s.has_mask:
         # the forbidden regions: more loss than allowed in the passband, less attenuation in the stopband
-        if s.filter_type == "lowpass":
-            pb, sb = (f[0], s.passband_hz), (s.stopband_hz, f[-1])
+        if s.filter_type == "bandpass":
+            pbs, sbs = [s.passband_edges], [(f[0], s.stopband_edges[0]), (s.stopband_edges[1], f[-1])]
+        elif s.filter_type == "lowpass":
+            pbs, sbs = [(f[0], s.passband_hz)], [(s.stopband_hz, f[-1])]
         else:
-            pb, sb = (s.passband_hz, f[-1]), (f[0], s.stopband_hz)
-        a1.fill_between(pb, [lo_db] * 2, [ref - s.max_loss_db] * 2, color="#d33", alpha=0.15, lw=0, label="mask")
-        a1.fill_between(sb, [ref - s.min_attenuation_db] * 2, [ref + 10] * 2, color="#d33", alpha=0.15, lw=0)
+            pbs, sbs = [(s.passband_hz, f[-1])], [(f[0], s.stopband_hz)]
+        for i, pb in enumerate(pbs):
+            a1.fill_between(pb, [lo_db] * 2, [ref - s.max_loss_db] * 2, color="#d33", alpha=0.15, lw=0,
+                            label=None if i else "mask")
+        for sb in sbs:
+            a1.fill_between(sb, [ref - s.min_attenuation_db] * 2, [ref + 10] * 2, color="#d33", alpha=0.15, lw=0)
     a1.axhline(ref - 10 * math.log10(2), color="0.5", lw=0.6, ls=":")
     a1.set_ylim(lo_db, ref + 6)
     a2.plot(f, np.degrees(np.unwrap(np.angle(h))), "-", lw=1.4)
@@ -533,6 +567,18 @@ def time_png(data: FilterSheet) -> bytes:
                      ylabel="voltage (V)", xlabel="time from the " + ("step" if tt.kind == "step" else "burst's start"))
 
 
+def _delay_rows(r) -> list:
+    """The group-delay target's row (none without one): the parts' largest departure from the DC delay."""
+    s, f = r.spec, r.figures
+    if not s.has_delay_target:
+        return []
+    return [[_("group delay from DC to {f}").format(f=format_eng(s.delay_to_hz, "Hz")),
+             _("within {pct} % of DC's (ideal Bessel {ideal} %)").format(
+                 pct=f"{s.max_delay_error_pct:g}", ideal=f"{f['delay_error_ideal_pct']:.3g}"),
+             _("{pct} % of {delay}").format(pct=f"{f['delay_error_pct']:.3g}", delay=format_eng(f["delay_dc_s"], "s"))
+             + ("" if f["delay_target_met"] else _(" (NOT met)"))]]
+
+
 def group_delay_png(data: FilterSheet) -> bytes:
     """The group delay of the chosen parts with the op-amp's model.
 
@@ -548,7 +594,16 @@ def group_delay_png(data: FilterSheet) -> bytes:
     """
     f, tau = data.bench.group_delay
     fig, ax = figure(7.5, 3.2)
-    ax.plot(f, np.asarray(tau) * 1e6, "-", lw=1.6)
+    ax.plot(f, np.asarray(tau) * 1e6, "-", lw=1.6, label="chosen parts")
+    s, figs = data.design.spec, data.design.figures
+    if s.has_delay_target:
+        # the target: the DC delay +- the allowed error, up to its frequency
+        d0, e = figs["delay_dc_s"] * 1e6, s.max_delay_error_pct / 100
+        ax.fill_between([f[0], s.delay_to_hz], [d0 * (1 - e)] * 2, [d0 * (1 + e)] * 2, color="C2", alpha=0.2, lw=0,
+                        label=f"target: within {s.max_delay_error_pct:g} % to {format_eng(s.delay_to_hz, 'Hz')} "
+                              f"(parts: {figs['delay_error_pct']:.3g} %)")
+        ax.axvline(s.delay_to_hz, color="C2", lw=0.8, ls=":")
+        ax.legend(fontsize=8, loc="lower left")
     log_frequency_axis(ax)
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("group delay (us)")
@@ -578,7 +633,7 @@ def _texts() -> dict:
     return {"bom_csv": ("bom.csv", lambda d: bom_csv(bom(d.design)))}
 
 
-def write_outputs(data: FilterSheet, out_dir, name: str) -> dict:
+def write_outputs(data: FilterSheet, out_dir, name: str, lang: str | None = None) -> dict:
     """The bundle: ``reports/<name>/`` (build sheets, result.json, plots, bom.csv, the deck) and
     ``netlists/<name>.cir`` under ``out_dir`` (:func:`designer.report.bundle.write_design`).
 
@@ -590,19 +645,23 @@ def write_outputs(data: FilterSheet, out_dir, name: str) -> dict:
         Where ``reports/`` and ``netlists/`` go.
     name : str
         The design's name.
+    lang : str or None
+        The sheet's language (:mod:`designer.core.i18n`; None: the current one).
 
     Returns
     -------
     dict
         The files written.
     """
+    from ..core.i18n import language
     from ..report.bundle import write_design
     data.wall_clock = False
-    return write_design(data, out_dir, name, plots(data), schematic,
-                        lambda svg: sections(data, schematic_svg=svg), title_of(data.design), _texts())
+    with language(lang):
+        return write_design(data, out_dir, name, plots(data), schematic,
+                            lambda svg: sections(data, schematic_svg=svg), title_of(data.design), _texts())
 
 
-def write_folder(data: FilterSheet, folder) -> dict:
+def write_folder(data: FilterSheet, folder, lang: str | None = None) -> dict:
     """A ``--out`` folder: ``filter.cir`` (the deck), ``result.json`` and the sheet's files
     (:data:`SHEET_FILES`, ``group-delay.png`` for a Bessel), all made in a staging folder beside it and then
     moved in (each by an atomic rename), so that a failure leaves the folder as it was.
@@ -613,6 +672,8 @@ def write_folder(data: FilterSheet, folder) -> dict:
         The sheet.
     folder : str or Path
         The folder (created if missing; other files in it are left alone).
+    lang : str or None
+        The sheet's language (:mod:`designer.core.i18n`; None: the current one).
 
     Returns
     -------
@@ -632,13 +693,15 @@ def write_folder(data: FilterSheet, folder) -> dict:
     pics = dict((n, draw(data)) for n, draw in plots(data))
     names.update({n.replace(".png", "").replace("-", "_"): n for n in pics})
     data.files = {k: str(folder / v) for k, v in names.items()}
+    from ..core.i18n import language
     svg, png = schematic_pictures(schematic, data)
-    secs = sections(data, schematic_svg=svg)
-    title = title_of(data.design)
-    images = {**pics, "schematic.png": png}
-    contents = {"filter.cir": data.deck, "result.json": json.dumps(data.to_dict(), indent=2) + "\n",
-                "build-sheet.md": to_markdown(title, secs), "build-sheet.html": to_html(title, secs, images),
-                "bom.csv": bom_csv(bom(data.design)), **images}
+    with language(lang):
+        secs = sections(data, schematic_svg=svg)
+        title = title_of(data.design)
+        images = {**pics, "schematic.png": png}
+        contents = {"filter.cir": data.deck, "result.json": json.dumps(data.to_dict(), indent=2) + "\n",
+                    "build-sheet.md": to_markdown(title, secs), "build-sheet.html": to_html(title, secs, images),
+                    "bom.csv": bom_csv(bom(data.design)), **images}
     fileio.clean_stale(folder.parent)
     stage = fileio.new_folder_beside(folder)
     try:

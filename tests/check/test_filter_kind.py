@@ -198,3 +198,47 @@ def test_stage_gain_in_a_spec(tmp_path):
     assert spec.designs[0].spec.stage_gains == (2.0, 2.0, 1.0)
     msg = refusal(write(tmp_path, text.replace("'2,2,1'", "'2,3,1'"), "bad.yaml"))
     assert "filter.stage_gain: 2 x 3 x 1 = 6 is not filter.gain 4" in msg, msg
+
+
+BAND = """\
+    name: bp
+    kind: filter
+    filter: {type: bandpass, family: butterworth}
+    opamp: TL072
+    mask: {passband: [900, 1.1k], max_loss: 1, stopband: [600, 1.7k], min_attenuation: 30}
+    """
+
+
+@pytest.mark.spice
+def test_bandpass_mask_picks_the_design_and_is_checked_on_model_and_spice(tmp_path):
+    from designer.filters.spec import FilterSpec
+    spec = load_spec(write(tmp_path, BAND))
+    want = FilterSpec(filter_type="bandpass", passband_hz=(900, 1100), stopband_hz=(600, 1700), max_loss_db=1,
+                      min_attenuation_db=30, opamp="TL072")
+    got = spec.designs[0].spec
+    assert (got.order, got.f_low_hz, got.f_high_hz) == (want.order, want.f_low_hz, want.f_high_hz)
+    out = run_corner(spec, 0, "ngspice-cli")
+    status = {c.id: c.status for c in out.cases}
+    assert set(status.values()) == {"pass"} and len(status) == 4
+    f = out.design["figures"]
+    # the model's figures against the design's own margins; SPICE's (a denser sweep) against the model's
+    assert f["passband_loss_db"] == pytest.approx(1 - out.design["design"]["figures"]["mask_passband_margin_db"],
+                                                  abs=0.01)
+    assert f["spice_passband_loss_db"] == pytest.approx(f["passband_loss_db"], abs=0.01)
+    assert f["spice_stopband_attenuation_db"] == pytest.approx(f["stopband_attenuation_db"], abs=0.01)
+
+
+@pytest.mark.parametrize("mask, words", [
+    ("{passband: [900, 1.1k], max_loss: 1, stopband: 600, min_attenuation: 30}", "gives passband and stopband both"),
+    ("{passband: [900, 1.1k, 2k], max_loss: 1, stopband: [600, 3k], min_attenuation: 30}", "got 3 values"),
+    ("{passband: [900, abc], max_loss: 1, stopband: [600, 3k], min_attenuation: 30}", "positive numbers"),
+    ("{passband: [1.1k, 900], max_loss: 1, stopband: [600, 3k], min_attenuation: 30}", "edges cross"),
+])
+def test_bandpass_mask_refusals(tmp_path, mask, words):
+    msg = refusal(write(tmp_path, BAND.replace(BAND.splitlines()[4].strip(), f"mask: {mask}")))
+    assert words in msg and "\n" not in msg, msg
+
+
+def test_a_lowpass_refuses_a_two_edge_mask(tmp_path):
+    text = DESIGNED.replace("passband: 500", "passband: [500, 600]").replace("stopband: 4k", "stopband: [100, 4k]")
+    assert "a lowpass's mask takes one edge each" in refusal(write(tmp_path, text))

@@ -46,6 +46,22 @@ from designer.cli.filter import analyze_filter_main, design_filter_main
      "or --stage-gain"),
     (["--type", "bandpass", "--order", "2", "--f-low", "900", "--f-high", "1.1k", "--gain", "2", "--stage-gain",
       "2,1"], "--stage-gain: a narrow band-pass's sections peak at their own fn"),
+    (["--type", "bandpass", "--passband", "1.1k,900", "--max-loss", "1", "--stopband", "600,1.7k",
+      "--min-attenuation", "30"], "--passband's edges cross: 1100 Hz is not below 900 Hz"),
+    (["--type", "bandpass", "--passband", "900,1.1k", "--max-loss", "1", "--stopband", "950,1.7k",
+      "--min-attenuation", "30"], "the stopband is not outside the passband: --stopband (950, 1700 Hz)"),
+    (["--type", "bandpass", "--passband", "900,1.1k", "--max-loss", "1", "--stopband", "600",
+      "--min-attenuation", "30"], "--stopband: a band-pass mask takes two edges F1,F2"),
+    (["--type", "bandpass", "--passband", "900,1.1k", "--max-loss", "1", "--stopband", "600,1.7k",
+      "--min-attenuation", "30", "--order", "3"], "--order: give either a band-pass's order and edges or its mask"),
+    (["--passband", "900,1.1k", "--max-loss", "1", "--stopband", "3k", "--min-attenuation", "30"],
+     "--passband: two edges F1,F2 are for a bandpass"),
+    (["--family", "chebyshev", "--passband", "1k", "--max-loss", "1", "--stopband", "10k", "--min-attenuation", "30",
+      "--max-delay-error", "1", "--delay-to", "1k"], "--max-delay-error: a group-delay target is for a bessel filter"),
+    (["--family", "bessel", "--order", "4", "--fc", "1k", "--max-delay-error", "1", "--delay-to", "1k"],
+     "--max-delay-error: a group-delay target joins a mask"),
+    (["--family", "bessel", "--passband", "1k", "--max-loss", "3", "--stopband", "10k", "--min-attenuation", "30",
+      "--max-delay-error", "1"], "--delay-to: a group-delay target needs both --max-delay-error and --delay-to"),
 ])
 def test_bad_input_is_one_line_exit_2(argv, words, capsys):
     assert design_filter_main(argv + ["--no-sim"]) == 2
@@ -268,3 +284,76 @@ def test_design_filter_apply_optimum_summary_names_what_is_built(capsys):
             "--apply-optimum"]
     assert design_filter_main(argv) == 0
     assert "built: the yield-optimal set" in capsys.readouterr().out
+
+
+BAND_MASK = ["--type", "bandpass", "--passband", "900,1.1k", "--max-loss", "1", "--stopband", "600,1.7k",
+             "--min-attenuation", "30", "--opamp", "TL072"]
+
+
+@pytest.mark.spice
+def test_bandpass_mask_met_on_the_model_and_on_spice(tmp_path, capsys):
+    assert design_filter_main(BAND_MASK + ["--json", "--out", str(tmp_path)]) == 0
+    d = json.loads(capsys.readouterr().out)
+    f, sp = d["figures"], d["spice"]
+    assert d["spec"]["mask"]["passband_hz"] == [900.0, 1100.0] and d["spec"]["bandpass_method"] == "narrow"
+    assert f["mask_passband_margin_db"] >= 0 and f["mask_stopband_margin_db"] >= 0
+    assert f["mask_violation_joint_db"] == 0 <= f["mask_violation_per_stage_db"]
+    # SPICE's .ac meets the mask too, and agrees with the model's margins at the edges
+    assert sp["mask"]["met"]
+    assert sp["mask"]["passband_margin_db"] == pytest.approx(f["mask_passband_margin_db"], abs=0.01)
+    assert sp["mask"]["stopband_margin_db"] == pytest.approx(f["mask_stopband_margin_db"], abs=0.01)
+    sheet = (tmp_path / "build-sheet.md").read_text()
+    assert "loss <= 1 dB from 900 Hz to 1.1 kHz" in sheet and "below 600 Hz and above 1.7 kHz" in sheet
+    # analyze-filter of the result keeps the mask (the same order and edges picked from it)
+    assert analyze_filter_main(["--from", str(tmp_path / "result.json"), "--no-sim", "--json"]) == 0
+    a = json.loads(capsys.readouterr().out)
+    assert a["spec"]["mask"] == d["spec"]["mask"] and a["spec"]["order"] == d["spec"]["order"]
+    assert a["figures"]["mask_passband_margin_db"] == pytest.approx(f["mask_passband_margin_db"])
+
+
+def test_bandpass_mask_yield_counts_against_the_mask(capsys):
+    argv = ["--type", "bandpass", "--family", "chebyshev", "--passband", "300,3k", "--max-loss", "1", "--stopband",
+            "100,9k", "--min-attenuation", "30", "--opamp", "TL072", "--no-sim", "--json", "--monte-carlo", "300",
+            "--seed", "2"]
+    assert design_filter_main(argv) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["spec"]["bandpass_method"] == "wide"
+    mc = d["monte_carlo"]
+    # the yield's window is the mask's, and the nominal build's figures are the design's at the mask's edges
+    assert {(lim["figure"], lim.get("min"), lim.get("max")) for lim in mc["limits"]} == \
+        {("passband_loss_db", None, 1.0), ("stopband_attenuation_db", 30.0, None)}
+    assert mc["nominal_figures"]["stopband_attenuation_db"] == pytest.approx(
+        30.0 + d["figures"]["mask_stopband_margin_db"], abs=0.05)
+    assert 0 <= mc["yield"]["passed"] <= 300
+
+
+@pytest.mark.spice
+def test_bessel_delay_target_picks_the_order_and_is_checked_on_spice(tmp_path, capsys):
+    argv = ["--family", "bessel", "--passband", "1k", "--max-loss", "3", "--stopband", "10k", "--min-attenuation",
+            "30", "--opamp", "TL072"]
+    assert design_filter_main(argv + ["--no-sim", "--json"]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert design_filter_main(argv + ["--max-delay-error", "1", "--delay-to", "1k", "--json", "--out",
+                                      str(tmp_path)]) == 0
+    d = json.loads(capsys.readouterr().out)
+    f, m = d["figures"], d["spice"]["mask"]
+    # the target raises the order above the mask's own, and the parts meet it
+    assert d["spec"]["order"] > plain["spec"]["order"] and f["delay_target_met"]
+    # SPICE's .ac phase gives the model's delay error (its sweep's lowest point standing for DC)
+    assert m["delay_error_pct"] == pytest.approx(f["delay_error_pct"], abs=0.01) and m["met"]
+    assert "group delay from DC to 1 kHz" in (tmp_path / "build-sheet.md").read_text()
+    assert design_filter_main(argv + ["--max-delay-error", "1", "--delay-to", "1k", "--no-sim"]) == 0
+    out = capsys.readouterr().out
+    assert "the group delay within 1 % of its DC value up to 1 kHz" in out and ": met" in out
+
+
+def test_analyze_filter_writes_its_sheet_in_the_language_asked(designed, tmp_path, capsys):
+    from helpers import english_left
+    assert analyze_filter_main(["--from", str(designed), "--no-sim", "--out", str(tmp_path / "es"), "--lang",
+                                "es"]) == 0
+    assert analyze_filter_main(["--from", str(designed), "--no-sim", "--out", str(tmp_path / "en")]) == 0
+    capsys.readouterr()
+    es, en = ((tmp_path / d / "build-sheet.md").read_text() for d in ("es", "en"))
+    assert "Lista de materiales" in es and "máscara: margen en la banda de paso" in es and "hasta 3 kHz" in es
+    assert "Bill of materials" in en and "mask: passband margin" in en
+    assert english_left((tmp_path / "es" / "build-sheet.html").read_text()) == []

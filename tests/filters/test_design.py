@@ -256,3 +256,31 @@ def test_with_choice_rebuilds_the_achieved_figures():
     g = 20 * np.log10(np.abs(moved.cascade().response(2j * math.pi * f, get_opamp("TL072"))))
     assert moved.figures["f3_hz"] == pytest.approx(f[np.flatnonzero(g >= -10 * math.log10(2))[-1]], rel=1e-4)
     assert moved.figures["error_joint_db"] == d.figures["error_joint_db"]
+
+
+def test_delay_figures_central_difference_equals_the_poles_exact_delay():
+    from designer.filters.design import delay_figures
+    from designer.filters.prototype import DELAY_POINTS, delay_error_pct, group_delay, prototype_zpk
+    s = FilterSpec(family="bessel", passband_hz=1e3, max_loss_db=3, stopband_hz=10e3, min_attenuation_db=30,
+                   max_delay_error_pct=1, delay_to_hz=1e3)
+    order, fc = 5, 1.2e3
+    # the ideal response through the central difference against the exact delay from the poles
+    figs = delay_figures(s, order, fc, lambda sv: np.asarray(
+        reference_response(np.imag(sv) / (2 * math.pi), "lowpass", "bessel", order, fc)))
+    tau = group_delay(prototype_zpk("bessel", order), np.linspace(0, 1e3, DELAY_POINTS), fc)
+    assert figs["delay_dc_s"] == pytest.approx(tau[0], rel=1e-7)
+    assert figs["delay_error_pct"] == pytest.approx(delay_error_pct(tau, tau[0]), abs=1e-6)
+    assert figs["delay_error_ideal_pct"] == pytest.approx(delay_error_pct(tau, tau[0]), rel=1e-12)
+    assert figs["delay_target_met"] == (figs["delay_error_pct"] <= 1)
+
+
+def test_delay_target_design_reports_the_parts_delay():
+    s = FilterSpec(family="bessel", passband_hz=1e3, max_loss_db=3, stopband_hz=10e3, min_attenuation_db=30,
+                   max_delay_error_pct=1, delay_to_hz=1e3, opamp="TL072")
+    d = design(s, simulate=False)
+    f = d.figures
+    assert d.order == 5 and f["delay_error_ideal_pct"] <= 1
+    assert f["delay_target_met"] == (f["delay_error_pct"] <= 1)
+    assert d.to_dict()["spec"]["delay_target"] == {"max_delay_error_pct": 1.0, "delay_to_hz": 1e3}
+    # without a target the JSON has no such key (the reference outputs stay as they are)
+    assert "delay_target" not in design(FilterSpec(order=2, fc_hz=1e3), simulate=False).to_dict()["spec"]

@@ -14,8 +14,9 @@ from scipy import signal
 from designer.core.errors import DesignError
 from designer.filters import Cascade, SectionTarget, get
 from designer.filters.design import section_name
-from designer.filters.prototype import (chebyshev_3db_factor, order_from_mask, plan_bandpass, plan_sections,
-                                        reference_bandpass, reference_response)
+from designer.filters.prototype import (DELAY_POINTS, bandpass_from_mask, chebyshev_3db_factor, delay_error_pct,
+                                        group_delay, order_from_mask, plan_bandpass, plan_sections, prototype_zpk, reference_ba, reference_bandpass,
+                                        reference_response)
 
 
 def scipy_design(kind, family, order, fc, ripple=1.0, norm="mag"):
@@ -183,3 +184,123 @@ def test_wide_bandpass_is_the_highpass_then_lowpass():
     want = reference_response(f, "highpass", "butterworth", 4, 300.0) * reference_response(f, "lowpass", "butterworth",
                                                                                           4, 3e3)
     np.testing.assert_allclose(reference_bandpass(f, "butterworth", 4, 300.0, 3e3), want, rtol=1e-12)
+
+
+BAND_MASKS = [((900.0, 1100.0), 1.0, (600.0, 1700.0), 30.0), ((9e3, 11e3), 0.5, (7e3, 14e3), 40.0),
+              ((300.0, 3000.0), 1.0, (100.0, 9000.0), 30.0), ((300.0, 3000.0), 1.0, (30.0, 30e3), 30.0)]
+
+
+def _band_loss(f, family, n, fl, fh, method, loss_db):
+    return -20 * np.log10(np.abs(reference_bandpass(np.asarray(f, float), family, n, fl, fh, loss_db, "mag",
+                                                    "ripple", method)))
+
+
+@pytest.mark.parametrize("mask", BAND_MASKS)
+@pytest.mark.parametrize("family", ["butterworth", "chebyshev", "bessel"])
+def test_bandpass_mask_is_met_by_the_least_order(mask, family):
+    pb, ap, sb, as_ = mask
+    try:
+        n, fl, fh, method = bandpass_from_mask(family, pb, ap, sb, as_)
+    except DesignError as exc:   # a Bessel's slow skirt: say so, naming what order 10 reaches
+        assert family == "bessel" and "above order 10" in str(exc)
+        return
+    assert method == ("wide" if pb[1] / pb[0] >= 2 else "narrow")
+    inside = np.geomspace(*pb, 41)   # the loss is held over the whole passband, its edges among the points
+    loss = _band_loss([*pb, *sb], family, n, fl, fh, method, ap)
+    assert max(_band_loss(inside, family, n, fl, fh, method, ap)) <= ap + 1e-6
+    assert min(loss[2:]) >= as_ * (1 - 1e-6)
+    if method == "narrow" and family != "bessel":
+        # scipy's own order functions with the band-pass edges, and their edges the scipy design's
+        fn, design = (signal.buttord, signal.butter) if family == "butterworth" else (signal.cheb1ord, None)
+        n_scipy, wn = fn(2 * math.pi * np.array(pb), 2 * math.pi * np.array(sb), ap, as_, analog=True)
+        assert n == n_scipy and (fl, fh) == pytest.approx(wn / (2 * math.pi))
+        if design is not None:
+            b, a = design(n, wn, "bandpass", analog=True)
+            h = signal.freqs(b, a, 2 * math.pi * np.array([*pb, *sb]))[1]
+            assert loss == pytest.approx(-20 * np.log10(np.abs(h)), abs=1e-9)
+    if n > 1:
+        # one order less: no edges that hold the passband loss (brute force over a grid of edges for a wide
+        # band, of bandwidths about the passband's centre for a narrow one) reach the stopband attenuation
+        assert _best_attenuation(family, n - 1, pb, ap, sb, method) < as_
+
+
+def _best_attenuation(family, n, pb, ap, sb, method):
+    """The most stopband attenuation of an order-n band-pass over a grid of its edges that hold the loss over
+    the passband (scipy's normalised designs, each side's or the prototype's computed once)."""
+    f = np.array([*np.geomspace(*pb, 41), *sb])
+    if method == "wide":
+        fls, fhs = np.geomspace(pb[0] / 4, pb[0] * 1.1, 150), np.geomspace(pb[1] / 1.1, pb[1] * 4, 150)
+        side = {k: reference_ba(k, family, n, 1 / (2 * math.pi), ap) for k in ("lowpass", "highpass")}
+        hp = np.array([-20 * np.log10(np.abs(signal.freqs(*side["highpass"], f / c)[1])) for c in fls])
+        lp = np.array([-20 * np.log10(np.abs(signal.freqs(*side["lowpass"], f / c)[1])) for c in fhs])
+        loss = (hp[:, None, :] + lp[None, :, :]).reshape(-1, f.size)
+    else:
+        f0 = math.sqrt(pb[0] * pb[1])
+        z, p, k = prototype_zpk(family, n, ap)
+        rows = []
+        for bw in np.geomspace((pb[1] - pb[0]) / 2, (pb[1] - pb[0]) * 8, 3000):
+            h = np.abs(signal.freqs_zpk(*signal.lp2bp_zpk(z, p, k, 2 * math.pi * f0, 2 * math.pi * bw),
+                                        2 * math.pi * np.append(f, f0))[1])
+            rows.append(-20 * np.log10(h[:-1] / h[-1]))
+        loss = np.array(rows)
+    ok = loss[:, :-2].max(axis=1) <= ap
+    return float(loss[ok, -2:].min(axis=1).max()) if ok.any() else -np.inf
+
+
+def test_bandpass_mask_beyond_order_10_names_the_order():
+    with pytest.raises(DesignError, match=r"order 21 \(a band-pass of order 42\), above the limit 10"):
+        bandpass_from_mask("butterworth", (900.0, 1100.0), 1.0, (880.0, 1150.0), 30.0)
+
+
+def test_bandpass_mask_chebyshev_3db_edges_are_minus_3db():
+    n, fl, fh, _ = bandpass_from_mask("chebyshev", (900.0, 1100.0), 1.0, (600.0, 1700.0), 30.0,
+                                      chebyshev_cutoff="3db")
+    h = reference_bandpass(np.array([fl, fh]), "chebyshev", n, fl, fh, 1.0, "mag", "3db", "narrow")
+    # relative to the passband's peak (an odd order's centre is the peak)
+    assert 20 * np.log10(np.abs(h)) == pytest.approx([-10 * math.log10(2)] * 2, abs=1e-6)
+
+
+@pytest.mark.parametrize("norm", ["mag", "delay"])
+@pytest.mark.parametrize("order", [1, 2, 3, 5, 8, 10])
+def test_group_delay_equals_scipys_of_the_prototype(order, norm):
+    # scipy's group_delay of the prototype through the bilinear transform: the digital frequency f is the analog
+    # F = (fs / pi) tan(pi f / fs), and the delays are tau_d(f) = tau_a(F) dF/df = tau_a(F) / cos^2(pi f / fs)
+    fc, fs = 1e3, 20e3
+    zpk = prototype_zpk("bessel", order, bessel_norm=norm)
+    b, a = signal.zpk2tf(*signal.lp2lp_zpk(*zpk, 2 * math.pi * fc))
+    bd, ad = signal.bilinear(b, a, fs)
+    f = np.linspace(0.0, 2 * fc, 41)
+    _, gd_samples = signal.group_delay((bd, ad), w=f, fs=fs)
+    analog_f = fs / math.pi * np.tan(math.pi * f / fs)
+    np.testing.assert_allclose(group_delay(zpk, analog_f, fc), gd_samples / fs * np.cos(math.pi * f / fs) ** 2,
+                               rtol=1e-7)
+    if norm == "delay":   # the delay normalisation: 1 / (2 pi fc) at DC
+        assert group_delay(zpk, [0.0], fc)[0] == pytest.approx(1 / (2 * math.pi * fc), rel=1e-12)
+
+
+@pytest.mark.parametrize("pct, to", [(1.0, 1e3), (0.1, 1e3), (5.0, 2e3), (0.5, 500.0)])
+def test_delay_target_order_is_the_least_meeting_mask_and_target(pct, to):
+    mask = ("lowpass", "bessel", 1e3, 3.0, 10e3, 30.0)
+    order, fc = order_from_mask(*mask, "mag", pct, to)
+    plain, _ = order_from_mask(*mask)
+    f = np.linspace(0.0, to, DELAY_POINTS)
+
+    def err(n, c):
+        tau = group_delay(prototype_zpk("bessel", n), f, c)
+        return delay_error_pct(tau, tau[0])
+
+    assert order >= plain and err(order, fc) <= pct
+    if order > plain:   # one order less meets the mask (order >= plain) but not the target
+        n1, fc1 = order - 1, None
+        lo, hi = math.log(1e3) - 12, math.log(1e3) + 12
+        for _ in range(100):   # its cut-off: the loss at the passband edge at the limit
+            mid = 0.5 * (lo + hi)
+            loss = -20 * math.log10(abs(reference_response([1e3], "lowpass", "bessel", n1, math.exp(mid))[0]))
+            lo, hi = (mid, hi) if loss > 3.0 else (lo, mid)
+        fc1 = math.exp(hi)
+        assert err(n1, fc1) > pct
+
+
+def test_delay_target_beyond_order_10_says_both():
+    with pytest.raises(DesignError, match=r"above order 10 .*the delay within .* % up to 5000 Hz, 0.01 % asked"):
+        order_from_mask("lowpass", "bessel", 1e3, 3.0, 2e3, 30.0, "mag", 0.01, 5e3)

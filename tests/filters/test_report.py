@@ -147,3 +147,32 @@ def test_reference_sheet_prints_on_three_pages(name, paper, tmp_path):
     out = h.chromium(tmp_path, f"--print-to-pdf={pdf}", "--no-pdf-header-footer", page.as_uri())
     assert pdf.exists() and pdf.stat().st_size > 0, out.stderr[-2000:]
     assert 1 <= h.pages(pdf) <= 3
+
+
+SPANISH = {
+    "bessel-delay": ["--family", "bessel", "--passband", "1k", "--max-loss", "3", "--stopband", "10k",
+                     "--min-attenuation", "30", "--max-delay-error", "1", "--delay-to", "1k", "--opamp", "TL072",
+                     "--name", "bessel_delay"],
+    "bandpass-mask": ["--type", "bandpass", "--passband", "900,1.1k", "--max-loss", "1", "--stopband", "600,1.7k",
+                      "--min-attenuation", "30", "--opamp", "TL072", "--name", "bp_mask", "--no-sim"],
+}
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("key", sorted(SPANISH))
+def test_the_spanish_sheet_leaves_no_english_message(key, tmp_path):
+    from helpers import sheet_command, spanish_sheet
+    summary, rep, page, nodes = spanish_sheet("design-filter", SPANISH[key], tmp_path / "es")
+    assert "<html lang='es'>" in page and "Lista de materiales" in page and "Bill of materials" not in page
+    md = (rep / "build-sheet.md").read_text()
+    assert "Prueba en banco: barrido senoidal" in md and "Target and achieved" not in md
+    if key == "bessel-delay":
+        assert "retardo de grupo de DC a 1 kHz" in md and "Prueba en banco: escalón" in md
+    else:
+        assert "pérdida <= 1 dB de 900 Hz a 1,1 kHz" in md and "por debajo de 600 Hz y por encima de 1,7 kHz" in md
+    # English is the code's own text: the same sheet without --lang; the data files keep their columns
+    _, rep_en = sheet_command("design-filter", SPANISH[key], tmp_path / "en")
+    en = (rep_en / "build-sheet.md").read_text()
+    assert "Target and achieved" in en and "Prueba" not in en
+    bom_en, bom_es = ((r / "bom.csv").read_text().splitlines() for r in (rep_en, rep))
+    assert bom_en[0] == bom_es[0] and len(bom_en) == len(bom_es)
