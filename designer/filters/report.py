@@ -599,10 +599,10 @@ def group_delay_png(data: FilterSheet) -> bytes:
     if s.has_delay_target:
         # the target: the DC delay +- the allowed error, up to its frequency
         d0, e = figs["delay_dc_s"] * 1e6, s.max_delay_error_pct / 100
-        ax.fill_between([f[0], s.delay_to_hz], [d0 * (1 - e)] * 2, [d0 * (1 + e)] * 2, color="C2", alpha=0.2, lw=0,
+        ax.fill_between([f[0], s.delay_to_hz], [d0 * (1 - e)] * 2, [d0 * (1 + e)] * 2, color="tab:green", alpha=0.2, lw=0,
                         label=f"target: within {s.max_delay_error_pct:g} % to {format_eng(s.delay_to_hz, 'Hz')} "
                               f"(parts: {figs['delay_error_pct']:.3g} %)")
-        ax.axvline(s.delay_to_hz, color="C2", lw=0.8, ls=":")
+        ax.axvline(s.delay_to_hz, color="tab:green", lw=0.8, ls=":")
         ax.legend(fontsize=8, loc="lower left")
     log_frequency_axis(ax)
     ax.set_xlabel("frequency (Hz)")
