@@ -38,10 +38,11 @@ from ..cli import plant as cli_plant
 from ..cli.common import RESULT_HOOK, run_cli
 from ..core import lifetime
 from ..core.jsonio import json_safe
+from ..core.units import format_eng
 
 __all__ = ["BODE_POINTS", "LIBRARY", "MAINS", "TRACE_POINTS", "Superseded", "bundle_zip", "check_files",
-           "design_plant_task", "files_in", "histograms", "identify_page", "pid_page", "plant_page", "run",
-           "run_task", "temporaries_in", "warm_up", "written_since"]
+           "design_filter_task", "design_plant_task", "files_in", "filter_page", "histograms", "identify_page",
+           "pid_page", "plant_page", "run", "run_task", "temporaries_in", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
@@ -231,44 +232,103 @@ def design_plant_task(fields: dict, want: str = "json", tmp: str | None = None) 
     dict
         As :func:`run`'s; a refusal's ``field`` and ``label`` name the page's field at fault.
     """
+    from .forms import PLANT
+
+    def work():
+        from ..plant.design import design_plant
+        from ..plant.report import write_outputs
+        from ..tolerance.mcspec import plant_tolerance
+        from .forms import plant_request
+        rq = plant_request(fields)
+        result = design_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
+        if rq.stimulus is not None:
+            from ..plant.prbs import with_prbs
+            result = with_prbs(result, result.test.amplitude_v, rq.stimulus[0], rq.stimulus[1], rq.simulate,
+                               rq.simulator)
+        result = plant_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
+        if want in ("sheet", "bundle"):
+            write_outputs(result, tmp, rq.name)
+        data = json.loads(json.dumps(result.to_dict()))
+        data["tool"]["argv"] = rq.argv   # the command line this request stands for: a record, never parsed
+        return data, lambda: plant_page(result), rq.name
+    return _library_task("design-plant", PLANT, work, want, tmp)
+
+
+def design_filter_task(fields: dict, want: str = "json", tmp: str | None = None) -> dict:
+    """design-filter for the page, the library called directly: the request's fields as the specs
+    (:func:`designer.web.forms.filter_request`), :func:`designer.filters.design.design` (with its SPICE
+    proof), the Monte Carlo against the mask and the worst case asked for
+    (:mod:`designer.tolerance.filter`), and the typed result rendered (the sheet design-filter writes).
+
+    Parameters
+    ----------
+    fields : dict
+        The request's JSON object (the filter page's fields, :data:`designer.web.forms.FILTER`).
+    want : str
+        As :func:`run`'s.
+    tmp : str or None
+        The request's private folder (the files of a sheet or bundle; every temporary file).
+
+    Returns
+    -------
+    dict
+        As :func:`run`'s (the JSON as ``design-filter --json`` prints it); a refusal's ``field`` and
+        ``label`` name the page's field at fault.
+    """
+    from .forms import FILTER
+
+    def work():
+        from ..filters.design import design
+        from ..filters.report import sheet_of, write_outputs
+        from ..tolerance import filter as tf
+        from .forms import filter_request
+        rq = filter_request(fields)
+        result = design(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
+        mc = rq.monte_carlo
+        extras = {}
+        if mc is not None:
+            extras["monte_carlo"] = tf.filter_monte_carlo(result, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol,
+                                                          mc.limits)
+        if rq.worst_case:
+            extras["worst_case"] = tf.filter_worst_case(result, mc.tol if mc is not None else rq.tol)
+        extra = json_safe({k: v.to_dict() for k, v in extras.items()})
+        sheet = sheet_of(result)
+        sheet.extra = extra
+        if want in ("sheet", "bundle"):
+            write_outputs(sheet, tmp, rq.name)
+        data = json_safe({**result.to_dict(), **extra, "files": {}})   # as design-filter --json prints it
+        return data, lambda: filter_page(sheet, extras.get("monte_carlo")), rq.name
+    return _library_task("design-filter", FILTER, work, want, tmp)
+
+
+def _library_task(prog: str, table: dict, work, want: str, tmp: str | None) -> dict:
+    """One library-first task: ``work()`` (in ``tmp``, every temporary file there) gives (the JSON, a function
+    drawing the page, the design's name: its files, written there for a sheet or bundle); a refusal in the
+    page's words (the field of ``table`` at fault), the simulator's failure exit status 3."""
     from ..core.errors import DesignError, SimulatorError
-    from ..plant.design import design_plant
-    from ..plant.report import write_outputs
-    from ..tolerance.mcspec import plant_tolerance
-    from .forms import PLANT, page_message, plant_request
-    prog = "design-plant"
+    from .forms import page_message
     try:
         with temporaries_in(tmp):
-            rq = plant_request(fields)
-            result = design_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
-            if rq.stimulus is not None:
-                from ..plant.prbs import with_prbs
-                result = with_prbs(result, result.test.amplitude_v, rq.stimulus[0], rq.stimulus[1], rq.simulate,
-                                   rq.simulator)
-            result = plant_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
-            if want in ("sheet", "bundle"):
-                write_outputs(result, tmp, rq.name)
+            data, page, name = work()
     except SimulatorError as exc:
         return {"status": 3, "error": f"{prog}: error: simulator error: {exc}", "json": None}
     except DesignError as exc:
-        text, field = page_message(exc, PLANT)
+        text, field = page_message(exc, table)
         return {"status": 2, "error": f"{prog}: error: {text}", "json": None, "field": field,
-                "label": PLANT[field].label if field else None}
-    data = json.loads(json.dumps(result.to_dict()))
-    data["tool"]["argv"] = rq.argv   # the command line this request stands for: a record, never parsed
+                "label": table[field].label if field else None}
     answer = {"status": 0, "error": None, "json": data}
     if want == "page":
-        answer["page"] = plant_page(result)
+        answer["page"] = page()
     elif want == "sheet":
-        answer.update(body=_read(os.path.join(tmp, "reports", rq.name, "build-sheet.html")),
+        answer.update(body=_read(os.path.join(tmp, "reports", name, "build-sheet.html")),
                       media="text/html; charset=utf-8", filename="build-sheet.html")
     elif want == "bundle":
-        answer.update(body=bundle_zip(tmp, rq.name), media="application/zip", filename=f"{rq.name}.zip")
+        answer.update(body=bundle_zip(tmp, name), media="application/zip", filename=f"{name}.zip")
     return answer
 
 
 #: the commands the page runs through the library (no console script, no argv, no printed JSON)
-LIBRARY = {"design-plant": design_plant_task}
+LIBRARY = {"design-plant": design_plant_task, "design-filter": design_filter_task}
 
 
 # --------------------------------------------------------------------------- identify
@@ -429,6 +489,52 @@ def pid_page(result) -> dict:
             "title": rep.title_of(result)}
 
 
+def filter_page(sheet, mc=None) -> dict:
+    """A filter design's page, from its sheet (:class:`designer.filters.report.FilterSheet`) as the build sheet
+    has it: the Bode plot of the chosen parts with the op-amp's model, the bench band of the builds and the mask
+    (its forbidden edges: the largest loss over the passband, the least attenuation over the stopband), the
+    stages with their op-amp checks, the schematic, the BOM and the sheet's content; ``mc`` a Monte Carlo
+    against the mask (:class:`designer.tolerance.filter.FilterMonteCarlo`) for the histograms."""
+    from ..filters import report as rep
+    from ..filters.registry import get as get_topology
+    from ..report.document import to_html
+    from ..report.wiring import BOM_HEADER, bom_csv
+    r, bench = sheet.design, sheet.bench
+    s = r.spec
+    f = np.asarray(bench.f_hz, float)
+    h = np.asarray(bench.h)
+    gain = {f"chosen parts, {r.opamp.name} model": 20 * np.log10(np.abs(h)),
+            "tolerance band low": bench.h_lo_db, "tolerance band high": bench.h_hi_db}
+    if s.has_mask and s.filter_type != "bandpass":
+        ref = 20 * math.log10(s.gain)
+        low = s.filter_type == "lowpass"
+        passing = f <= s.passband_hz if low else f >= s.passband_hz
+        stopping = f >= s.stopband_hz if low else f <= s.stopband_hz
+        gain["mask: largest passband loss"] = np.where(passing, ref - s.max_loss_db, np.nan)
+        gain["mask: least stopband attenuation"] = np.where(stopping, ref - s.min_attenuation_db, np.nan)
+    phase = {f"chosen parts, {r.opamp.name} model": np.degrees(np.unwrap(np.angle(h)))}
+    stages = []
+    for st, c in zip(r.stages, bench.checks):
+        topo = get_topology(st.topology)
+        parts = ", ".join(f"{topo.prefixed(ref, f'{st.number}0')} "
+                          f"{format_eng(st.values[ref], 'Ohm' if ref.startswith('R') else 'F', 3)}"
+                          for ref in topo.designators)
+        stages.append({"stage": st.number, "topology": st.topology, "fn_hz": st.plan.fn_hz, "q": st.plan.q,
+                       "gain": st.gain, "peak_gain_db": 20 * math.log10(st.peak_gain), "parts": parts,
+                       "out_peak_v": c.out_peak_v, "swing_v": c.swing_v, "gbw_needed_hz": c.gbw_needed_hz,
+                       "gbw_hz": c.gbw_hz, "slew_needed_v_per_s": c.slew_needed_v_per_s,
+                       "slew_v_per_s": c.slew_v_per_s, "ok": c.ok})
+    b = rep.build_board(r)
+    bom = rep.bom(r, b)
+    return json_safe({"bode": {"gain": _trace(f, gain, "frequency (Hz)", log_x=True),
+                               "phase": _trace(f, phase, "frequency (Hz)", log_x=True)},
+                      "stages": stages, "histograms": histograms(mc),
+                      "schematic_svg": rep.schematic(sheet).svg(),
+                      "bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
+                      "sheet_html": to_html(rep.title_of(r), rep.sections(sheet, with_images=False), {}),
+                      "title": rep.title_of(r)})
+
+
 #: the last schematics drawn, by what they show: typing a new fc often lands on the same parts
 _SCHEMATICS: dict = {}
 
@@ -452,10 +558,11 @@ def histograms(mc) -> list:
     """A Monte Carlo's histograms for the page, as the sheet draws them (:mod:`designer.report.tolerance`: the
     headline figure's, then each limited figure's; 2 sqrt(n) bins, 10 to 60): each figure's bin edges and counts,
     its nominal value and its limits; none without a Monte Carlo (or one build replayed)."""
-    if mc is None or mc.headline is None:
+    if mc is None or (hasattr(mc, "headline") and mc.headline is None):
         return []
+    headline = getattr(mc, "headline", None)   # a filter's Monte Carlo has none: its limited figures alone
     out = []
-    for name in dict.fromkeys([mc.headline, *(lim.figure for lim in mc.limits)]):
+    for name in dict.fromkeys([x for x in (headline, *(lim.figure for lim in mc.limits)) if x is not None]):
         v = np.asarray(mc.figures[name], float)
         v = v[np.isfinite(v)]
         if not v.size:

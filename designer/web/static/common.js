@@ -356,7 +356,7 @@ const COLOURS = ["#9467bd", "#8c564b", "#17becf", "#bcbd22", "#e377c2", "#7f7f7f
 // One colour per kind of trace on every plot (issue 29: red was SPICE on one plot and the ideal op-amp on the
 // next): SPICE red, the op-amp-aware model (and the realised loop) blue, the ideal one green, the measured data
 // black, the plant alone grey, the tolerance band orange; the identified models take the other colours in turn.
-D.TRACE_KINDS = [[/^SPICE/, "#d62728"], [/^data$|integrated impulse/, "#111111"], [/^tolerance band/, "#e0a040"],
+D.TRACE_KINDS = [[/^mask/, "#6a3d9a"], [/^SPICE/, "#d62728"], [/^data$|integrated impulse/, "#111111"], [/^tolerance band/, "#e0a040"],
                  [/ideal/, "#2ca02c"], [/plant alone/, "#7f7f7f"], [/model|analytic|realised|loop gain/, "#1f77b4"]];
 D.traceColour = function (label, i) {
   const kind = D.TRACE_KINDS.find(([re]) => re.test(label));
@@ -376,7 +376,7 @@ D.plot = function (el, trace, opts) {
   const series = [{label: trace.x_label, value: (u, v) => v === null || v === undefined ? "" : D.eng(v, opts.xUnit || "", 4)}];
   let others = 0;
   trace.series.forEach((s, i) => {
-    const band = /^tolerance band/.test(s.label);
+    const band = /^(tolerance band|mask)/.test(s.label);   // dashed: limits, not responses
     const points = /^(data|SPICE \.ac)$/.test(s.label);
     const kind = D.TRACE_KINDS.some(([re]) => re.test(s.label));
     // measured points as small rings, so the model lines under them stay visible
@@ -483,7 +483,8 @@ D.drawMarks = function (u, marks) {
 
 D.nav = function (current) {
   const nav = document.querySelector("nav");
-  for (const [href, text] of [["/plant", "Plant"], ["/pid", "PID"], ["/identify", "Identify"], ["/check", "Check"]]) {
+  for (const [href, text] of [["/plant", "Plant"], ["/pid", "PID"], ["/filter", "Filter"], ["/identify", "Identify"],
+                              ["/check", "Check"]]) {
     const a = document.createElement("a");
     a.href = href; a.textContent = text;
     if (href === current) a.className = "here";
