@@ -18,7 +18,7 @@ from __future__ import annotations
 import re
 from typing import NamedTuple
 
-from ..core.errors import DesignError
+from ..core.errors import DesignError, ParamError
 from .request import option_name, value_text
 
 __all__ = ["FILTER", "Field", "FilterRequest", "PLANT", "PlantRequest", "field_of", "filter_request", "page_message",
@@ -45,7 +45,7 @@ PLANT = {
     "opamp": Field("opamp", "op-amp"), "amplitude": Field("amplitude_v", "amplitude (V)"),
     "square-freq": Field("square_hz", "square wave (Hz)"), "package": Field("package", "package"),
     "no-sim": Field("no_sim", "skip SPICE", "switch"), "simulator": Field("simulator", "simulator"),
-    "name": Field("name", "design name"),
+    "name": Field("name", "design name"), "topology": Field("topology", "topology"),
     # the tolerance panel (a MonteCarloSpec)
     "monte-carlo": Field("n", "Monte Carlo builds"), "seed": Field("seed", "seed"),
     "tol": Field("tol", "tolerances", "list"), "limit": Field("limits", "limits", "list"),
@@ -205,19 +205,30 @@ def plant_request(options) -> PlantRequest:
         One line naming the library parameter at fault (shown by :func:`page_message`).
     """
     from ..plant.spec import PlantSpec
+    from ..filters import registry
+    from ..plant.circuit import DEFAULT_TOPOLOGY
     v = _fields(options, PLANT)
-    for need in ("fc_hz", "zeta"):
+    topology = v.get("topology", DEFAULT_TOPOLOGY)
+    # a first-order section takes no zeta (an unknown name is the spec's to refuse, listing the registered)
+    first_order = topology in registry.names() and registry.get(topology).order == 1
+    for need in ("fc_hz",) if first_order else ("fc_hz", "zeta"):
         if need not in v:
             raise DesignError(f"{need} is required", param=need)
     spec_keys = ("fc_hz", "zeta", "gain", "r", "c", "opamp", "compensate_gbw", "amplitude_v", "square_hz",
-                 "alternatives", "package", "r_series", "c_series", "r_min", "r_max", "c_min", "c_max")
-    spec = PlantSpec(**{k: v[k] for k in spec_keys if k in v})
+                 "alternatives", "package", "r_series", "c_series", "r_min", "r_max", "c_min", "c_max", "topology")
+    spec = PlantSpec(**{"zeta": None, **{k: v[k] for k in spec_keys if k in v}})
     if v.get("package") not in (None, "single", "dual", "quad"):
         raise DesignError(f"package {v['package']!r} unknown; allowed: single, dual, quad", param="package")
     mc = _monte_carlo(v, ("n", "seed", "sampler", "dist", "tol", "limits", "target_ci", "engine", "spice_samples"))
     simulator = _simulator(v, "pyspice")
     stimulus = _stimulus(v)
-    name = _name(v, f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
+    if spec.topology != DEFAULT_TOPOLOGY and (stimulus is not None or (mc is not None and mc.engine != "analytic")):
+        raise ParamError("{%s}: the %s's for now; another topology has the .ac check and the analytic Monte Carlo"
+                         % ("stimulus" if stimulus is not None else "engine", DEFAULT_TOPOLOGY),
+                         ("stimulus", "engine"))
+    where = "" if spec.topology == DEFAULT_TOPOLOGY else f"_{spec.topology}"
+    name = _name(v, f"plant{where}_fc{spec.fc_hz:g}" + ("" if spec.zeta is None else f"_z{spec.zeta:g}")
+                 + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
     return PlantRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False),
                         simulator, stimulus, name, _argv("design-plant", options))
 
@@ -260,7 +271,6 @@ def filter_request(options) -> FilterRequest:
 def _monte_carlo(v: dict, keys: tuple):
     """The Monte Carlo asked for (a :class:`~designer.tolerance.mcspec.MonteCarloSpec` of ``keys``), or None;
     one of its settings without its builds (``n``) refused (the worst case's tolerances apart)."""
-    from ..core.errors import ParamError
     from ..tolerance.mcspec import MonteCarloSpec
     if "n" in v:
         return MonteCarloSpec(**{k: v[k] for k in keys if k in v})
@@ -297,7 +307,6 @@ def _argv(prog: str, options: dict) -> list:
 
 def _stimulus(v: dict):
     """The PRBS bench test asked for: None, or (bits or None, clock Hz or None)."""
-    from ..core.errors import ParamError
     kind = v.get("stimulus", "step")
     if kind not in ("step", "prbs"):
         raise DesignError(f"stimulus {kind!r} unknown; allowed: step, prbs", param="stimulus")

@@ -41,7 +41,7 @@ from ..core.jsonio import json_safe
 from ..core.units import format_eng
 
 __all__ = ["BODE_POINTS", "LIBRARY", "MAINS", "TRACE_POINTS", "Superseded", "bundle_zip", "check_files",
-           "design_filter_task", "design_plant_task", "files_in", "filter_page", "histograms", "identify_page",
+           "circuit_plant_page", "design_filter_task", "design_plant_task", "files_in", "filter_page", "histograms", "identify_page",
            "pid_page", "plant_page", "run", "run_task", "temporaries_in", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
@@ -235,11 +235,14 @@ def design_plant_task(fields: dict, want: str = "json", tmp: str | None = None) 
     from .forms import PLANT
 
     def work():
+        from ..plant.circuit import DEFAULT_TOPOLOGY
         from ..plant.design import design_plant
         from ..plant.report import write_outputs
         from ..tolerance.mcspec import plant_tolerance
         from .forms import plant_request
         rq = plant_request(fields)
+        if rq.spec.topology != DEFAULT_TOPOLOGY:   # another registered section: the generic plant pipeline
+            return _circuit_plant(rq, want, tmp)
         result = design_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
         if rq.stimulus is not None:
             from ..plant.prbs import with_prbs
@@ -252,6 +255,54 @@ def design_plant_task(fields: dict, want: str = "json", tmp: str | None = None) 
         data["tool"]["argv"] = rq.argv   # the command line this request stands for: a record, never parsed
         return data, lambda: plant_page(result), rq.name
     return _library_task("design-plant", PLANT, work, want, tmp)
+
+
+def _circuit_plant(rq, want: str, tmp: str | None) -> tuple:
+    """A plant on a registered topology other than the seed's (:func:`designer.plant.circuit_design.
+    design_circuit_plant`), with the analytic Monte Carlo and worst case over its declared parts; as
+    :func:`_library_task`'s ``work`` answers."""
+    from ..plant import circuit
+    from ..plant.circuit_design import design_circuit_plant
+    from ..plant.circuit_report import write_outputs
+    from ..tolerance.montecarlo import plant_monte_carlo
+    from ..tolerance.parts import resolve
+    from ..tolerance.worstcase import worst_case
+    result = design_circuit_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
+    series = {"R": result.sourcing.r_series, "C": result.sourcing.c_series}
+    nominal, context, mc = dict(result.values), (result.topology, result.opamp), rq.monte_carlo
+    if rq.worst_case:
+        tol = resolve(mc.tol if mc is not None else rq.tol, nominal, series)
+        result.worst_case = worst_case(lambda v: circuit.evaluate(context, v), nominal, tol.of)
+    if mc is not None:
+        result.monte_carlo = plant_monte_carlo(None, series, result.opamp, mc.n, mc.seed, mc.sampler, mc.dist,
+                                               mc.tol, mc.limits, target_ci=mc.target_ci,
+                                               circuit=(nominal, circuit.evaluate, context))
+    if want in ("sheet", "bundle"):
+        write_outputs(result, tmp, rq.name)
+    data = json.loads(json.dumps(result.to_dict()))
+    data["tool"]["argv"] = rq.argv
+    return data, lambda: circuit_plant_page(result), rq.name
+
+
+def circuit_plant_page(result) -> dict:
+    """A plant on a registered topology, for the page: its declared parts (designator, role, value), the Bode
+    plot of both models (the section's transfer function with the parts as built, ideal and with the op-amp's
+    model, evaluated on a grid as the sheet's plots are), the BOM and the sheet's content (the wiring, target
+    and achieved, sensitivities, alternatives); no schematic (the sheet has none yet)."""
+    from ..plant import circuit_report as rep
+    from ..report.document import to_html
+    from ..report.wiring import BOM_HEADER, bom_csv
+    topo, amp = result.section, result.opamp
+    fn = result.figures["opamp"]["fn_hz"]
+    f = np.geomspace(fn / 100, fn * 100, BODE_POINTS)
+    s = 2j * np.pi * f
+    resp = {"ideal op-amp": topo.response(result.values, s), f"{amp.name} model": topo.response(result.values, s, amp)}
+    bom = rep.bom(result)
+    return {"parts": [{"ref": p.ref, "role": p.role, "value": result.values[p.ref], "kind": p.kind}
+                      for p in topo.parts],
+            "bode": _bode(f, resp), "histograms": histograms(result.monte_carlo),
+            "bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
+            "sheet_html": to_html(rep.title_of(result), rep.sections(result), {}), "title": rep.title_of(result)}
 
 
 def design_filter_task(fields: dict, want: str = "json", tmp: str | None = None) -> dict:

@@ -809,3 +809,36 @@ def test_every_filter_field_has_the_label_of_the_name_table(page, server):
     assert len(names) > 20
     for name in names:
         assert page.evaluate(f"D.labelOf(document.getElementById('form'), '{name}')") == FILTER[name].label, name
+
+
+# --------------------------------------------------------------------------- the Plant page's topology menu (26)
+def test_the_plant_pages_topology_menu_designs_an_mfb_lowpass(page, server):
+    """Issue 26: the menu lists the registered sections; the part list is the chosen one's declared parts; an MFB
+    low-pass is designed by the generic plant pipeline, its parts, figures and Bode plot shown; a first-order
+    section takes no zeta; the seed's circuit stays as it was."""
+    from designer.filters import registry
+    open_page(page, server, "/plant")
+    menu = page.locator("select[name=topology]")
+    assert [o.get_attribute("value") for o in menu.locator("option").all()] == registry.names()
+    assert menu.input_value() == "sallen-key-lowpass" and page.locator("#step-section").is_visible()
+    assert after(page, lambda: menu.select_option("mfb-lowpass"), timeout=120000) == "done", \
+        page.inner_text(".form-foot")
+    topo = registry.get("mfb-lowpass")
+    listed = page.locator("#topology-parts tbody tr")
+    assert [listed.nth(i).locator("td").first.inner_text() for i in range(listed.count())] == list(topo.designators)
+    status, want = server.post_json("/api/plant", {"fc": 3500, "zeta": 0.2, "topology": "mfb-lowpass"})
+    assert status == 200 and want["topology"] == "mfb-lowpass"
+    for p in topo.parts:
+        shown = page.locator(".figure", has_text=f"{p.ref} ({p.role})").locator("b").inner_text()
+        assert shown == page.evaluate("([v, u]) => D.eng(v, u, 3)", [want["parts"][p.ref]["value"],
+                                                                      "Ohm" if p.kind == "R" else "F"])
+    assert "MFB low-pass" in page.inner_text("#title") and "topology=mfb-lowpass" in page.url
+    assert page.locator("#bode-gain canvas").count() == 1 and not page.locator("#step-section").is_visible()
+    assert figure(page, "SPICE agrees with the model") == "yes" and not page.locator("#topid").is_visible()
+    assert not page.locator("#bom").is_disabled()
+    # a first-order section: no zeta asked
+    assert after(page, lambda: menu.select_option("rc-lowpass"), timeout=120000) == "done"
+    assert not page.locator("input[name=zeta]").is_visible() and "zeta=" not in page.url
+    # back to the seed's circuit: its own panels
+    assert after(page, lambda: menu.select_option("sallen-key-lowpass"), timeout=120000) == "done"
+    assert page.locator("#step-section").is_visible() and page.locator("#topid").is_visible()

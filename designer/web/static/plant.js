@@ -6,7 +6,57 @@ const form = document.getElementById("form");
 const status = document.getElementById("status");
 let seq = 0, last = null;
 
+const SEED_TOPOLOGY = "sallen-key-lowpass";   // the seed's circuit: its own pipeline (step, bench, schematic)
+let topologies = [];
+
+// The chosen topology's declared parts (designator, R or C, role), as the registry lists them; a first-order
+// section takes no zeta (its field hidden: not sent).
+function showTopology() {
+  const name = form.elements["topology"].value;
+  const topo = topologies.find(t => t.name === name);
+  if (!topo) return;
+  const zeta = form.elements["zeta"].closest("label");
+  zeta.hidden = topo.order === 1;
+  document.getElementById("topology-parts").replaceChildren(
+    D.table([D.t("part"), D.t("kind"), D.t("role")], topo.parts.map(x => [x.ref, x.kind === "R" ? D.t("resistor")
+                                                                                    : D.t("capacitor"), x.role])));
+}
+D.onRestore = showTopology;
+
+// A plant on another registered section (the generic pipeline): its declared parts, both models' figures and
+// Bode plot, the BOM, checks and sheet; the seed circuit's step, bench and schematic panels are not its.
+function showCircuit(answer) {
+  const r = answer.result, p = answer.page, o = r.built.opamp, i = r.built.ideal;
+  document.getElementById("title").textContent = p.title;
+  const spice = r.checks.find(c => c.id === "spice_agreement");
+  document.getElementById("figures").replaceChildren(
+    ...p.parts.map(x => D.fig(`${x.ref} (${x.role})`, D.eng(x.value, x.kind === "R" ? "Ohm" : "F", 3))),
+    D.fig(D.t("fn as built ({amp})", {amp: r.opamp.name}), D.eng(o.fn_hz, "Hz", 4)),
+    ...(o.zeta === null ? [] : [D.fig(D.t("zeta as built ({amp})", {amp: r.opamp.name}), D.num(o.zeta, 4))]),
+    D.fig(D.t("gain"), D.num(i.gain, 4)),
+    D.fig(D.t("-3 dB frequency ({amp})", {amp: r.opamp.name}), o.f3db_hz.map(v => D.eng(v, "Hz", 4)).join(", ")),
+    D.fig(D.t("SPICE agrees with the model"), !spice ? D.t("not simulated") : (spice.ok ? D.t("yes") : D.t("NO"))));
+  document.getElementById("notes").replaceChildren(...r.notes.map(n => { const e = document.createElement("p"); e.textContent = D.inPageWords(form, n); return e; }));
+  const sch = document.getElementById("schematic");
+  sch.replaceChildren(Object.assign(document.createElement("p"), {textContent:
+    D.t("{title}: the parts and their wiring are in the build sheet below.", {title: r.topology_title})}));
+  const open = sch.parentElement.querySelector(".open-full");
+  if (open) open.remove();
+  document.getElementById("bomtable").replaceChildren(D.table(p.bom.header.slice(0, 7), p.bom.rows.map(x => x.slice(0, 7))));
+  document.getElementById("checks").replaceChildren(D.checksTable(r.checks));
+  D.tolerance(r.monte_carlo, p.histograms);
+  D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
+  D.plot(document.getElementById("bode-gain"), p.bode.gain, {xUnit: "Hz", yLabel: D.t("gain (dB)"), height: 240});
+  D.plot(document.getElementById("bode-phase"), p.bode.phase, {xUnit: "Hz", yLabel: D.t("phase (deg)"), height: 200});
+}
+
 function show(answer) {
+  const seed = (answer.result.topology || SEED_TOPOLOGY) === SEED_TOPOLOGY;
+  document.getElementById("step-section").hidden = !seed;
+  document.getElementById("bench-section").hidden = !seed;
+  // "a PID for this plant" takes the seed circuit's four parts
+  document.getElementById("topid").hidden = !seed;
+  if (!seed) { showCircuit(answer); return; }
   const r = answer.result, p = answer.page, b = r.built;
   document.getElementById("title").textContent = p.title;
   const figs = document.getElementById("figures");
@@ -68,7 +118,13 @@ async function file(kind) {
 (async function () {
   const c = await D.loadChoices();
   for (const s of form.querySelectorAll("select[data-choices]")) D.fill(s, c[s.dataset.choices], s.dataset.default);
+  topologies = c.topologies;
+  const menu = form.elements["topology"];
+  D.fill(menu, topologies.map(t => t.name), SEED_TOPOLOGY);
+  for (const o of menu.options) o.textContent = topologies.find(t => t.name === o.value).title;
   D.fillFromQuery(form);
+  showTopology();
+  form.addEventListener("change", e => { if (e.target === menu) showTopology(); }, true);   // before it asks
   D.liveForm(form, design, () => JSON.stringify(D.options(form)));
   document.getElementById("sheet").onclick = () => file("sheet");
   document.getElementById("bundle").onclick = () => file("bundle");
