@@ -12,7 +12,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                     "StoppingServer"),
     "guard": ("CSP", "Guard", "JSON_PATHS", "PAGE_HEADER", "SECURITY_HEADERS", "Trust", "UPLOAD_PATHS",
               "error_response", "origin_of", "trust_for"),
-    "jobs": ("BODE_POINTS", "LIBRARY", "MAINS", "Superseded", "TRACE_POINTS", "bundle_zip", "check_files",
+    "jobs": ("BODE_POINTS", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "Superseded", "TRACE_POINTS", "bundle_zip", "check_files",
              "circuit_plant_page", "design_filter_task", "design_plant_task", "files_in", "filter_page", "histograms",
              "identify_page", "pid_page", "plant_page", "run", "run_task", "temporaries_in", "warm_up",
              "written_since"),

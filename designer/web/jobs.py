@@ -39,8 +39,13 @@ from ..cli.common import RESULT_HOOK, run_cli
 from ..core import lifetime
 from ..core.jsonio import json_safe
 from ..core.units import format_eng
+# the filter stack (scipy.signal's prototypes, the sheet) imported here, in the server process before it forks the
+# pool: every worker has it, and a worker's first filter request does not pay ~2 s of imports
+from ..filters import report as filter_report
+from ..filters.design import design as design_filter
+from ..tolerance import filter as filter_tolerance
 
-__all__ = ["BODE_POINTS", "LIBRARY", "MAINS", "TRACE_POINTS", "Superseded", "bundle_zip", "check_files",
+__all__ = ["BODE_POINTS", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACE_POINTS", "Superseded", "bundle_zip", "check_files",
            "circuit_plant_page", "design_filter_task", "design_plant_task", "files_in", "filter_page", "histograms", "identify_page",
            "pid_page", "plant_page", "run", "run_task", "temporaries_in", "warm_up", "written_since"]
 
@@ -70,10 +75,17 @@ class Superseded(BaseException):
 _RUNNING = False
 
 
+#: modules whose functions the interpreter calls where an exception is printed and swallowed, not raised: the
+#: at-fork hooks (logging takes and releases its lock around every fork, each ``subprocess.run`` of
+#: ``ngspice -b`` among them): a cancel landing there would be a traceback on the server's stderr, the run going on
+SWALLOWING_MODULES = ("logging",)
+
+
 def _cancel(signum, frame) -> None:
     if not _RUNNING:
         return
-    if lifetime.in_native():   # inside ngspice's callbacks cffi would swallow it: again in 5 ms
+    # inside ngspice's callbacks cffi would swallow it, inside an at-fork hook the interpreter: again in 5 ms
+    if lifetime.in_native() or (frame is not None and frame.f_globals.get("__name__") in SWALLOWING_MODULES):
         signal.signal(signal.SIGALRM, _cancel)
         signal.setitimer(signal.ITIMER_REAL, 0.005)
         return
@@ -329,12 +341,10 @@ def design_filter_task(fields: dict, want: str = "json", tmp: str | None = None)
     from .forms import FILTER
 
     def work():
-        from ..filters.design import design
-        from ..filters.report import sheet_of, write_outputs
-        from ..tolerance import filter as tf
         from .forms import filter_request
+        tf = filter_tolerance
         rq = filter_request(fields)
-        result = design(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
+        result = design_filter(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
         mc = rq.monte_carlo
         extras = {}
         if mc is not None:
@@ -343,10 +353,10 @@ def design_filter_task(fields: dict, want: str = "json", tmp: str | None = None)
         if rq.worst_case:
             extras["worst_case"] = tf.filter_worst_case(result, mc.tol if mc is not None else rq.tol)
         extra = json_safe({k: v.to_dict() for k, v in extras.items()})
-        sheet = sheet_of(result)
+        sheet = filter_report.sheet_of(result)
         sheet.extra = extra
         if want in ("sheet", "bundle"):
-            write_outputs(sheet, tmp, rq.name)
+            filter_report.write_outputs(sheet, tmp, rq.name)
         data = json_safe({**result.to_dict(), **extra, "files": {}})   # as design-filter --json prints it
         return data, lambda: filter_page(sheet, extras.get("monte_carlo")), rq.name
     return _library_task("design-filter", FILTER, work, want, tmp)
@@ -546,10 +556,10 @@ def filter_page(sheet, mc=None) -> dict:
     (its forbidden edges: the largest loss over the passband, the least attenuation over the stopband), the
     stages with their op-amp checks, the schematic, the BOM and the sheet's content; ``mc`` a Monte Carlo
     against the mask (:class:`designer.tolerance.filter.FilterMonteCarlo`) for the histograms."""
-    from ..filters import report as rep
     from ..filters.registry import get as get_topology
     from ..report.document import to_html
     from ..report.wiring import BOM_HEADER, bom_csv
+    rep = filter_report
     r, bench = sheet.design, sheet.bench
     s = r.spec
     f = np.asarray(bench.f_hz, float)

@@ -219,6 +219,45 @@ D.liveForm = function (form, run, key, wait) {
   return {now, forget: () => { asked = null; }};
 };
 
+// A design page's two actions (Plant, Filter): `design()` posts the form to `endpoint?view=page` (a newer one
+// supersedes it), shows the answer with `show` and `said(answer)` on the status line, or the refusal beside its
+// field; `file(kind)` downloads "bom" (from the answer), "sheet" (opened in a tab to print) or "bundle" of the
+// design shown, never of inputs it is not of. `shown()` is that design: {opts, answer}, or null.
+D.designPage = function (form, status, endpoint, show, said) {
+  let seq = 0, last = null;
+  async function design() {
+    const mine = ++seq;
+    const opts = D.options(form);
+    D.markStale("pending");
+    D.busy(true, status);
+    const r = await D.api(`${endpoint}?view=page`, opts, false, "form");
+    if (r.aborted || mine !== seq) return;          // a newer request is on its way: this answer is stale
+    D.busy(false, status);
+    if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
+    D.clearError(form);
+    last = {opts, answer: r.data};   // the downloads are of these inputs (D.answered turns them on)
+    D.remember(opts);
+    show(r.data);
+    status.textContent = said(r.data);
+    D.answered("done");
+  }
+  async function file(kind) {
+    if (!last || D.isStale()) return;
+    if (kind === "bom") {
+      D.download(new Blob([last.answer.page.bom_csv], {type: "text/csv"}), "bom.csv");
+      return;
+    }
+    D.busy(true, status);
+    const r = await D.api(`${endpoint}/${kind}`, last.opts, true);
+    D.busy(false, status);
+    if (!r.ok) { D.showError(form, r.data); return; }
+    // the sheet in a new tab to print; a browser that blocks the tab gets it as a file
+    if (kind === "sheet") { if (!window.open(URL.createObjectURL(r.blob), "_blank")) D.download(r.blob, "build-sheet.html"); }
+    else D.download(r.blob, r.filename || "design.zip");   // the design's name, as its command names it
+  }
+  return {design, file, shown: () => last};
+};
+
 // Each answer shown: the page's state ("done" or "error") and how many answers it has shown (for its tests).
 D.answered = function (state) {
   document.body.dataset.state = state;

@@ -6,7 +6,6 @@ D.nav("/filter");
 const form = document.getElementById("form");
 const status = document.getElementById("status");
 const entry = document.getElementById("entry");
-let seq = 0, last = null;
 
 // Only the fields of the entry, type and family chosen are sent (a hidden field is left out by D.options).
 function showFields() {
@@ -68,37 +67,7 @@ function show(answer) {
   D.plot(document.getElementById("bode-phase"), p.bode.phase, {xUnit: "Hz", yLabel: D.t("phase (deg)"), height: 200});
 }
 
-async function design() {
-  const mine = ++seq;
-  const opts = D.options(form);
-  D.markStale("pending");
-  D.busy(true, status);
-  const r = await D.api("/api/filter?view=page", opts, false, "form");
-  if (r.aborted || mine !== seq) return;          // a newer request is on its way: this answer is stale
-  D.busy(false, status);
-  if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
-  D.clearError(form);
-  last = {opts, answer: r.data};   // the downloads are of these inputs (D.answered turns them on)
-  D.remember(opts);
-  show(r.data);
-  status.textContent = r.data.result.spice ? D.t("designed and proven in SPICE") : D.t("designed (not simulated)");
-  D.answered("done");
-}
-
-async function file(kind) {
-  if (!last || D.isStale()) return;
-  if (kind === "bom") {
-    D.download(new Blob([last.answer.page.bom_csv], {type: "text/csv"}), "bom.csv");
-    return;
-  }
-  D.busy(true, status);
-  const r = await D.api(`/api/filter/${kind}`, last.opts, true);
-  D.busy(false, status);
-  if (!r.ok) { D.showError(form, r.data); return; }
-  // the sheet in a new tab to print; a browser that blocks the tab gets it as a file
-  if (kind === "sheet") { if (!window.open(URL.createObjectURL(r.blob), "_blank")) D.download(r.blob, "build-sheet.html"); }
-  else D.download(r.blob, r.filename || "filter.zip");   // the design's name, as the bundle names it
-}
+const page = D.designPage(form, status, "/api/filter", show, r => r.result.spice ? D.t("designed and proven in SPICE") : D.t("designed (not simulated)"));
 
 (async function () {
   const c = await D.loadChoices();
@@ -108,9 +77,9 @@ async function file(kind) {
   // the entry, type or family chosen shows its fields (the change then asks, as any menu does)
   form.addEventListener("change", e => { if (e.target === entry || ["type", "family"].includes(e.target.name)) showFields(); },
                         true);
-  D.liveForm(form, design, () => JSON.stringify(D.options(form)));
-  document.getElementById("sheet").onclick = () => file("sheet");
-  document.getElementById("bundle").onclick = () => file("bundle");
-  document.getElementById("bom").onclick = () => file("bom");
-  design();
+  D.liveForm(form, page.design, () => JSON.stringify(D.options(form)));
+  document.getElementById("sheet").onclick = () => page.file("sheet");
+  document.getElementById("bundle").onclick = () => page.file("bundle");
+  document.getElementById("bom").onclick = () => page.file("bom");
+  page.design();
 })();

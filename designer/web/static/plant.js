@@ -4,7 +4,6 @@
 D.nav("/plant");
 const form = document.getElementById("form");
 const status = document.getElementById("status");
-let seq = 0, last = null;
 
 const SEED_TOPOLOGY = "sallen-key-lowpass";   // the seed's circuit: its own pipeline (step, bench, schematic)
 let topologies = [];
@@ -83,37 +82,7 @@ function show(answer) {
   D.plot(document.getElementById("bode-phase"), p.bode.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 200});
 }
 
-async function design() {
-  const mine = ++seq;
-  const opts = D.options(form);
-  D.markStale("pending");
-  D.busy(true, status);
-  const r = await D.api("/api/plant?view=page", opts, false, "form");
-  if (r.aborted || mine !== seq) return;          // a newer request is on its way: this answer is stale
-  D.busy(false, status);
-  if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
-  D.clearError(form);
-  last = {opts, answer: r.data};   // the downloads are of these inputs (D.answered turns them on)
-  D.remember(opts);
-  show(r.data);
-  status.textContent = `designed and simulated (${r.data.result.simulator || "no simulator"})`;
-  D.answered("done");
-}
-
-async function file(kind) {
-  if (!last || D.isStale()) return;
-  if (kind === "bom") {
-    D.download(new Blob([last.answer.page.bom_csv], {type: "text/csv"}), "bom.csv");
-    return;
-  }
-  D.busy(true, status);
-  const r = await D.api(`/api/plant/${kind}`, last.opts, true);
-  D.busy(false, status);
-  if (!r.ok) { D.showError(form, r.data); return; }
-  // the sheet in a new tab to print; a browser that blocks the tab gets it as a file
-  if (kind === "sheet") { if (!window.open(URL.createObjectURL(r.blob), "_blank")) D.download(r.blob, "build-sheet.html"); }
-  else D.download(r.blob, r.filename || "plant.zip");   // the design's name, as design-plant names it
-}
+const page = D.designPage(form, status, "/api/plant", show, r => `designed and simulated (${r.result.simulator || "no simulator"})`);
 
 (async function () {
   const c = await D.loadChoices();
@@ -125,11 +94,12 @@ async function file(kind) {
   D.fillFromQuery(form);
   showTopology();
   form.addEventListener("change", e => { if (e.target === menu) showTopology(); }, true);   // before it asks
-  D.liveForm(form, design, () => JSON.stringify(D.options(form)));
-  document.getElementById("sheet").onclick = () => file("sheet");
-  document.getElementById("bundle").onclick = () => file("bundle");
-  document.getElementById("bom").onclick = () => file("bom");
+  D.liveForm(form, page.design, () => JSON.stringify(D.options(form)));
+  document.getElementById("sheet").onclick = () => page.file("sheet");
+  document.getElementById("bundle").onclick = () => page.file("bundle");
+  document.getElementById("bom").onclick = () => page.file("bom");
   document.getElementById("topid").onclick = () => {
+    const last = page.shown();
     if (!last || D.isStale()) return;
     const o = last.opts, b = last.answer.result.built;
     // the plant as built, by its parts: the PID is designed for the circuit on the bench
@@ -139,5 +109,5 @@ async function file(kind) {
     if (b.gain !== 1) q.set("plant-gain", b.gain);
     location.href = "/pid?" + q.toString();
   };
-  design();
+  page.design();
 })();
