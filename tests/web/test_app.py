@@ -456,7 +456,8 @@ def test_a_capture_as_the_body_with_its_own_type_needs_no_header(server):
         assert status == 200, raw
 
 
-@pytest.mark.parametrize("path", ["/", "/plant", "/check", "/static/common.js", "/static/style.css",
+@pytest.mark.parametrize("path", ["/", "/plant", "/check", "/filter", "/static/filter.js", "/static/common.js",
+                                  "/static/style.css",
                                   "/static/vendor/uplot/uPlot.iife.min.js", "/static/nothere.js", "/api/health",
                                   "/api/choices", "/favicon.ico", "/api/plant"])
 def test_every_answer_has_the_security_headers(server, path):
