@@ -789,18 +789,6 @@ def test_filter_tolerance_panel_gives_the_yield_against_the_mask(page, server):
     assert t["part"] in page.inner_text("#tighten") or str(t["stage"]) in page.inner_text("#tighten-stage")
 
 
-def test_the_filter_page_is_no_wider_than_a_phone(browser, server):
-    context = browser.new_context(viewport={"width": 390, "height": 844})
-    pg = context.new_page()
-    try:
-        assert open_filter(pg, server) == "done"
-        assert pg.evaluate("document.scrollingElement.scrollWidth") <= 390
-        for canvas in pg.locator(".plot canvas").all():
-            assert canvas.bounding_box()["width"] <= 390
-    finally:
-        context.close()
-
-
 def test_every_filter_field_has_the_label_of_the_name_table(page, server):
     """One name table per front end: the page's labels are designer.web.forms.FILTER's."""
     from designer.web.forms import FILTER
