@@ -26,8 +26,9 @@ ALLOWED = {
     "tolerance": {"core", "spice", "report", "plant", "pid", "filters"},
     "check": {"core", "spice", "report", "plant", "pid", "identify", "tolerance", "filters"},
     "cli": {"core", "spice", "report", "plant", "pid", "identify", "check", "tolerance", "filters"},
-    # the web page: a front end beside cli, whose parsers and checks it shares
-    "web": {"core", "spice", "report", "plant", "pid", "identify", "check", "tolerance", "cli"},
+    # the web page: a front end beside cli, whose parsers and checks it shares (and, library-first, the filters'
+    # design, its sheet and the registry's sections)
+    "web": {"core", "spice", "report", "plant", "pid", "identify", "check", "tolerance", "cli", "filters"},
 }
 #: the one module of identify that may use plant (the comparison with a design)
 IDENTIFY_TO_PLANT = {"designer/identify/against.py"}

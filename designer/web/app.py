@@ -51,7 +51,7 @@ MEDIA = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=u
          ".png": "image/png", "": "text/plain; charset=utf-8"}
 #: the pages, by path
 PAGES = {"/": "plant.html", "/plant": "plant.html", "/pid": "pid.html", "/identify": "identify.html",
-         "/check": "check.html"}
+         "/check": "check.html", "/filter": "filter.html"}
 #: the commands' refusals of a file over their size limits (designer.core.fileio): answered 413
 _TOO_LARGE = re.compile(r"the most this command reads|; at most [0-9.]+ [KMG]?i?B is read")
 #: how often a waiting request looks whether its client is still there (a page typing on closes it): a
@@ -242,6 +242,9 @@ def create_app(pool, trust: Trust):
                Route("/api/plant/sheet", designing("design-plant", "sheet"), methods=["POST"]),
                Route("/api/plant/bundle", designing("design-plant", "bundle"), methods=["POST"]),
                Route("/api/analyze-plant", designing("analyze-plant"), methods=["POST"]),
+               Route("/api/filter", designing("design-filter"), methods=["POST"]),
+               Route("/api/filter/sheet", designing("design-filter", "sheet"), methods=["POST"]),
+               Route("/api/filter/bundle", designing("design-filter", "bundle"), methods=["POST"]),
                Route("/api/pid", designing("design-pid"), methods=["POST"]),
                Route("/api/pid/sheet", designing("design-pid", "sheet"), methods=["POST"]),
                Route("/api/pid/bundle", designing("design-pid", "bundle"), methods=["POST"]),
@@ -258,13 +261,21 @@ def create_app(pool, trust: Trust):
 
 
 def _choices() -> dict:
-    """What the forms offer in their lists: the op-amp catalogue, the E-series, the tuning rules."""
+    """What the forms offer in their lists: the op-amp catalogue, the E-series, the tuning rules, the filters'
+    responses, families and stage topologies, and the registered sections (each with its declared parts)."""
     from ..cli.identify import FORMATS
     from ..core import opamps
     from ..core.eseries import SERIES
+    from ..filters import registry
+    from ..filters.prototype import FAMILIES, RESPONSE_TYPES
+    from ..filters.spec import TOPOLOGY_CHOICES
     return {"opamps": opamps.names(), "series": list(SERIES), "formats": list(FORMATS),
             "tunings": ["zn", "cohen-coon", "chr0", "chr20", "amigo", "simc", "imc", "optimize"],
-            "packages": ["single", "dual", "quad"]}
+            "packages": ["single", "dual", "quad"], "filter_types": list(RESPONSE_TYPES),
+            "families": list(FAMILIES), "filter_topologies": list(TOPOLOGY_CHOICES),
+            "topologies": [{"name": n, "title": registry.get(n).title, "kind": registry.get(n).kind, "order": registry.get(n).order,
+                            "parts": [{"ref": p.ref, "kind": p.kind, "role": p.role}
+                                      for p in registry.get(n).parts]} for n in registry.names()]}
 
 
 def _view(request) -> str:

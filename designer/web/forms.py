@@ -18,10 +18,11 @@ from __future__ import annotations
 import re
 from typing import NamedTuple
 
-from ..core.errors import DesignError
+from ..core.errors import DesignError, ParamError
 from .request import option_name, value_text
 
-__all__ = ["Field", "PLANT", "PlantRequest", "field_of", "page_message", "plant_request"]
+__all__ = ["FILTER", "Field", "FilterRequest", "PLANT", "PlantRequest", "field_of", "filter_request", "page_message",
+           "plant_request"]
 
 
 class Field(NamedTuple):
@@ -44,7 +45,7 @@ PLANT = {
     "opamp": Field("opamp", "op-amp"), "amplitude": Field("amplitude_v", "amplitude (V)"),
     "square-freq": Field("square_hz", "square wave (Hz)"), "package": Field("package", "package"),
     "no-sim": Field("no_sim", "skip SPICE", "switch"), "simulator": Field("simulator", "simulator"),
-    "name": Field("name", "design name"),
+    "name": Field("name", "design name"), "topology": Field("topology", "topology"),
     # the tolerance panel (a MonteCarloSpec)
     "monte-carlo": Field("n", "Monte Carlo builds"), "seed": Field("seed", "seed"),
     "tol": Field("tol", "tolerances", "list"), "limit": Field("limits", "limits", "list"),
@@ -55,11 +56,51 @@ PLANT = {
     "stimulus": Field("stimulus", "stimulus"), "prbs-bits": Field("bits", "PRBS bits"),
     "prbs-clock": Field("clock_hz", "PRBS clock (Hz)"),
 }
+#: the filter page's fields (the API's keys, as design-filter's option names) -> parameter and label
+FILTER = {
+    "type": Field("filter_type", "type"), "family": Field("family", "family"),
+    "order": Field("order", "order"), "fc": Field("fc_hz", "fc (Hz)"), "ripple": Field("ripple_db", "ripple (dB)"),
+    "bessel-norm": Field("bessel_norm", "Bessel cut-off"), "chebyshev-cutoff": Field("chebyshev_cutoff",
+                                                                                      "Chebyshev cut-off"),
+    "passband": Field("passband_hz", "passband edge (Hz)"), "max-loss": Field("max_loss_db", "max loss (dB)"),
+    "stopband": Field("stopband_hz", "stopband edge (Hz)"),
+    "min-attenuation": Field("min_attenuation_db", "min attenuation (dB)"),
+    "f-low": Field("f_low_hz", "low edge (Hz)"), "f-high": Field("f_high_hz", "high edge (Hz)"),
+    "bandpass-method": Field("bandpass_method", "band-pass method"),
+    "topology": Field("topology", "topology"), "stage-order": Field("stage_order", "stage order"),
+    "gain": Field("gain", "gain (V/V)"), "stage-gain": Field("stage_gains", "stage gains"),
+    "opamp": Field("opamp", "op-amp"), "amplitude": Field("amplitude_v", "amplitude (V)"),
+    "gbw-margin": Field("gbw_margin", "GBW margin"), "impedance": Field("impedance_ohm", "impedance (Ohm)"),
+    "compensate-gbw": Field("compensate_gbw", "compensate the op-amp's GBW", "switch"),
+    "series": Field("r_series", "R series"), "c-series": Field("c_series", "C series"),
+    "r-min": Field("r_min", "R min"), "r-max": Field("r_max", "R max"),
+    "c-min": Field("c_min", "C min"), "c-max": Field("c_max", "C max"),
+    "no-sim": Field("no_sim", "skip SPICE", "switch"), "simulator": Field("simulator", "simulator"),
+    "name": Field("name", "design name"),
+    # the tolerance panel (a MonteCarloSpec, run against the mask)
+    "monte-carlo": Field("n", "Monte Carlo builds"), "seed": Field("seed", "seed"),
+    "tol": Field("tol", "tolerances", "list"), "limit": Field("limits", "limits", "list"),
+    "dist": Field("dist", "distribution"), "sampler": Field("sampler", "sampler"),
+    "worst-case": Field("worst_case", "worst case", "switch"),
+}
 #: the simulators a request may choose (designer.spice.simulate's backends)
 SIMULATORS = ("pyspice", "ngspice-cli")
 _FLAG = re.compile(r"--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?")
 #: a value a message quotes as given ('3.5q', '--help'): never read as a flag
 _QUOTED = re.compile(r"((?<![A-Za-z])'[^']*')")
+
+
+class FilterRequest(NamedTuple):
+    """A filter page's request as the library takes it."""
+
+    spec: object                #: :class:`~designer.filters.spec.FilterSpec`
+    monte_carlo: object         #: :class:`~designer.tolerance.mcspec.MonteCarloSpec` or None
+    worst_case: bool            #: the extremes over the tolerance box too
+    tol: tuple                  #: the worst case's tolerances (without a Monte Carlo)
+    simulate: bool
+    simulator: str
+    name: str                   #: the design's name (its files)
+    argv: list                  #: the command line this request stands for (``tool.argv`` of its JSON)
 
 
 class PlantRequest(NamedTuple):
@@ -101,8 +142,15 @@ def page_message(exc: DesignError, table: dict) -> tuple:
     text = exc.naming(labels) if callable(getattr(exc, "naming", None)) else str(exc)
     # a flag the library wrote, outside the values it quotes ('--help' given as a value stays as given)
     parts = _QUOTED.split(text)
-    text = "".join(p if k % 2 else _FLAG.sub(lambda m: f'"{table[m.group(1)].label}"' if m.group(1) in table
-                                             else m.group(1).replace("-", " "), p) for k, p in enumerate(parts))
+    # a library name the message writes in its text ("unknown filter_type 'foo'"): the field's label
+    names = re.compile(r"(?<![\w.{-])(" + "|".join(sorted((re.escape(f.param) for f in table.values() if "_" in f.param),
+                                                          key=len, reverse=True)) + r")(?![\w=])")
+
+    def words(p):
+        p = _FLAG.sub(lambda m: f'"{table[m.group(1)].label}"' if m.group(1) in table
+                      else m.group(1).replace("-", " "), p)
+        return names.sub(lambda m: labels[m.group(1)], p)
+    text = "".join(p if k % 2 else words(p) for k, p in enumerate(parts))
     field = field_of(table, getattr(exc, "param", None))
     if field is None:   # a message written with the command line's option: the first one it names
         found = _FLAG.search(str(exc))
@@ -156,46 +204,109 @@ def plant_request(options) -> PlantRequest:
     DesignError
         One line naming the library parameter at fault (shown by :func:`page_message`).
     """
-    from ..core.errors import ParamError
     from ..plant.spec import PlantSpec
-    from ..tolerance.mcspec import MonteCarloSpec
+    from ..filters import registry
+    from ..plant.circuit import DEFAULT_TOPOLOGY
     v = _fields(options, PLANT)
-    for need in ("fc_hz", "zeta"):
+    topology = v.get("topology", DEFAULT_TOPOLOGY)
+    # a first-order section takes no zeta (an unknown name is the spec's to refuse, listing the registered)
+    first_order = topology in registry.names() and registry.get(topology).order == 1
+    for need in ("fc_hz",) if first_order else ("fc_hz", "zeta"):
         if need not in v:
             raise DesignError(f"{need} is required", param=need)
     spec_keys = ("fc_hz", "zeta", "gain", "r", "c", "opamp", "compensate_gbw", "amplitude_v", "square_hz",
-                 "alternatives", "package", "r_series", "c_series", "r_min", "r_max", "c_min", "c_max")
-    spec = PlantSpec(**{k: v[k] for k in spec_keys if k in v})
+                 "alternatives", "package", "r_series", "c_series", "r_min", "r_max", "c_min", "c_max", "topology")
+    spec = PlantSpec(**{"zeta": None, **{k: v[k] for k in spec_keys if k in v}})
     if v.get("package") not in (None, "single", "dual", "quad"):
         raise DesignError(f"package {v['package']!r} unknown; allowed: single, dual, quad", param="package")
-    mc_keys = ("n", "seed", "sampler", "dist", "tol", "limits", "target_ci", "engine", "spice_samples")
+    mc = _monte_carlo(v, ("n", "seed", "sampler", "dist", "tol", "limits", "target_ci", "engine", "spice_samples"))
+    simulator = _simulator(v, "pyspice")
+    stimulus = _stimulus(v)
+    if spec.topology != DEFAULT_TOPOLOGY and (stimulus is not None or (mc is not None and mc.engine != "analytic")):
+        raise ParamError("{%s}: the %s's for now; another topology has the .ac check and the analytic Monte Carlo"
+                         % ("stimulus" if stimulus is not None else "engine", DEFAULT_TOPOLOGY),
+                         ("stimulus", "engine"))
+    where = "" if spec.topology == DEFAULT_TOPOLOGY else f"_{spec.topology}"
+    name = _name(v, f"plant{where}_fc{spec.fc_hz:g}" + ("" if spec.zeta is None else f"_z{spec.zeta:g}")
+                 + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
+    return PlantRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False),
+                        simulator, stimulus, name, _argv("design-plant", options))
+
+
+def filter_request(options) -> FilterRequest:
+    """A filter page's request (its JSON object) as the library's specs, checked.
+
+    Parameters
+    ----------
+    options : dict
+        Field -> value (:data:`FILTER`'s keys; numbers, or texts in engineering notation).
+
+    Returns
+    -------
+    FilterRequest
+        The :class:`~designer.filters.spec.FilterSpec`, the Monte Carlo's spec and the run's settings.
+
+    Raises
+    ------
+    DesignError
+        One line naming the library parameter at fault (shown by :func:`page_message`).
+    """
+    from ..filters.spec import FilterSpec
+    v = _fields(options, FILTER)
+    spec_keys = ("filter_type", "family", "order", "fc_hz", "ripple_db", "bessel_norm", "chebyshev_cutoff",
+                 "passband_hz", "max_loss_db", "stopband_hz", "min_attenuation_db", "f_low_hz", "f_high_hz",
+                 "bandpass_method", "topology", "stage_order", "gain", "stage_gains", "opamp", "amplitude_v",
+                 "gbw_margin", "impedance_ohm", "compensate_gbw", "r_series", "c_series", "r_min", "r_max", "c_min",
+                 "c_max")
+    spec = FilterSpec(**{k: v[k] for k in spec_keys if k in v})
+    mc = _monte_carlo(v, ("n", "seed", "sampler", "dist", "tol", "limits"))
+    simulator = _simulator(v, "ngspice-cli")
+    where = f"_o{spec.order}" if spec.order is not None else ""
+    where += f"_fc{spec.fc_hz:g}" if spec.fc_hz is not None else "_mask" if spec.has_mask else ""
+    name = _name(v, f"filter_{spec.filter_type}_{spec.family}{where}")
+    return FilterRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False),
+                         simulator, name, _argv("design-filter", options))
+
+
+def _monte_carlo(v: dict, keys: tuple):
+    """The Monte Carlo asked for (a :class:`~designer.tolerance.mcspec.MonteCarloSpec` of ``keys``), or None;
+    one of its settings without its builds (``n``) refused (the worst case's tolerances apart)."""
+    from ..tolerance.mcspec import MonteCarloSpec
     if "n" in v:
-        mc = MonteCarloSpec(**{k: v[k] for k in mc_keys if k in v})
-    else:
-        mc = None
-        alone = [k for k in mc_keys if k in v and not (k == "tol" and v.get("worst_case"))
-                 and not (k == "engine" and v[k] == "analytic")]
-        if alone:
-            raise ParamError("{%s} goes with {n}" % alone[0], mc_keys)
-    simulator = v.get("simulator", "pyspice")
+        return MonteCarloSpec(**{k: v[k] for k in keys if k in v})
+    alone = [k for k in keys if k in v and not (k == "tol" and v.get("worst_case"))
+             and not (k == "engine" and v[k] == "analytic")]
+    if alone:
+        raise ParamError("{%s} goes with {n}" % alone[0], keys)
+    return None
+
+
+def _simulator(v: dict, default: str) -> str:
+    """The simulator asked for (:data:`SIMULATORS`)."""
+    simulator = v.get("simulator", default)
     if simulator not in SIMULATORS:
         raise DesignError(f"simulator {simulator!r} unknown; allowed: {', '.join(SIMULATORS)}", param="simulator")
-    stimulus = _stimulus(v)
+    return simulator
+
+
+def _name(v: dict, default: str) -> str:
+    """The design's name (its files), the one given or ``default``, checked as ``--name`` is."""
     from ..cli.common import check_name
-    name = v.get("name") or f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}")
+    name = v.get("name") or default
     try:
         check_name(name)
     except DesignError as exc:
         raise DesignError(str(exc).replace("--name", "name", 1), param="name") from None
-    argv = ["design-plant"] + [a for key, value in options.items() if value is not None
-                               for a in _flag_words(key, value)]
-    return PlantRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False),
-                        simulator, stimulus, name, argv)
+    return name
+
+
+def _argv(prog: str, options: dict) -> list:
+    """The command line a request stands for (a record: nothing parses it)."""
+    return [prog] + [a for key, value in options.items() if value is not None for a in _flag_words(key, value)]
 
 
 def _stimulus(v: dict):
     """The PRBS bench test asked for: None, or (bits or None, clock Hz or None)."""
-    from ..core.errors import ParamError
     kind = v.get("stimulus", "step")
     if kind not in ("step", "prbs"):
         raise DesignError(f"stimulus {kind!r} unknown; allowed: step, prbs", param="stimulus")

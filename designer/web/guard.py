@@ -60,7 +60,8 @@ SECURITY_HEADERS = ((b"content-security-policy", CSP.encode()), (b"x-frame-optio
                     (b"cross-origin-resource-policy", b"same-origin"))
 #: endpoints whose body is JSON, and only JSON
 JSON_PATHS = frozenset({"/api/plant", "/api/plant/sheet", "/api/plant/bundle", "/api/analyze-plant", "/api/pid",
-                        "/api/pid/sheet", "/api/pid/bundle", "/api/analyze-pid"})
+                        "/api/pid/sheet", "/api/pid/bundle", "/api/analyze-pid", "/api/filter", "/api/filter/sheet",
+                        "/api/filter/bundle"})
 #: endpoints that take an upload (a file as the body, a multipart form) or JSON
 UPLOAD_PATHS = {"/api/identify": ("identify", "the file with its own type (text/csv, application/octet-stream)"),
                 "/api/check": ("check-design", "JSON (Content-Type: application/json)")}

@@ -38,10 +38,16 @@ from ..cli import plant as cli_plant
 from ..cli.common import RESULT_HOOK, run_cli
 from ..core import lifetime
 from ..core.jsonio import json_safe
+from ..core.units import format_eng
+# the filter stack (scipy.signal's prototypes, the sheet) imported here, in the server process before it forks the
+# pool: every worker has it, and a worker's first filter request does not pay ~2 s of imports
+from ..filters import report as filter_report
+from ..filters.design import design as design_filter
+from ..tolerance import filter as filter_tolerance
 
-__all__ = ["BODE_POINTS", "LIBRARY", "MAINS", "TRACE_POINTS", "Superseded", "bundle_zip", "check_files",
-           "design_plant_task", "files_in", "histograms", "identify_page", "pid_page", "plant_page", "run",
-           "run_task", "temporaries_in", "warm_up", "written_since"]
+__all__ = ["BODE_POINTS", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACE_POINTS", "Superseded", "bundle_zip", "check_files",
+           "circuit_plant_page", "design_filter_task", "design_plant_task", "files_in", "filter_page", "histograms", "identify_page",
+           "pid_page", "plant_page", "run", "run_task", "temporaries_in", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
@@ -69,10 +75,17 @@ class Superseded(BaseException):
 _RUNNING = False
 
 
+#: modules whose functions the interpreter calls where an exception is printed and swallowed, not raised: the
+#: at-fork hooks (logging takes and releases its lock around every fork, each ``subprocess.run`` of
+#: ``ngspice -b`` among them): a cancel landing there would be a traceback on the server's stderr, the run going on
+SWALLOWING_MODULES = ("logging",)
+
+
 def _cancel(signum, frame) -> None:
     if not _RUNNING:
         return
-    if lifetime.in_native():   # inside ngspice's callbacks cffi would swallow it: again in 5 ms
+    # inside ngspice's callbacks cffi would swallow it, inside an at-fork hook the interpreter: again in 5 ms
+    if lifetime.in_native() or (frame is not None and frame.f_globals.get("__name__") in SWALLOWING_MODULES):
         signal.signal(signal.SIGALRM, _cancel)
         signal.setitimer(signal.ITIMER_REAL, 0.005)
         return
@@ -231,44 +244,152 @@ def design_plant_task(fields: dict, want: str = "json", tmp: str | None = None) 
     dict
         As :func:`run`'s; a refusal's ``field`` and ``label`` name the page's field at fault.
     """
+    from .forms import PLANT
+
+    def work():
+        from ..plant.circuit import DEFAULT_TOPOLOGY
+        from ..plant.design import design_plant
+        from ..plant.report import write_outputs
+        from ..tolerance.mcspec import plant_tolerance
+        from .forms import plant_request
+        rq = plant_request(fields)
+        if rq.spec.topology != DEFAULT_TOPOLOGY:   # another registered section: the generic plant pipeline
+            return _circuit_plant(rq, want, tmp)
+        result = design_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
+        if rq.stimulus is not None:
+            from ..plant.prbs import with_prbs
+            result = with_prbs(result, result.test.amplitude_v, rq.stimulus[0], rq.stimulus[1], rq.simulate,
+                               rq.simulator)
+        result = plant_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
+        if want in ("sheet", "bundle"):
+            write_outputs(result, tmp, rq.name)
+        data = json.loads(json.dumps(result.to_dict()))
+        data["tool"]["argv"] = rq.argv   # the command line this request stands for: a record, never parsed
+        return data, lambda: plant_page(result), rq.name
+    return _library_task("design-plant", PLANT, work, want, tmp)
+
+
+def _circuit_plant(rq, want: str, tmp: str | None) -> tuple:
+    """A plant on a registered topology other than the seed's (:func:`designer.plant.circuit_design.
+    design_circuit_plant`), with the analytic Monte Carlo and worst case over its declared parts; as
+    :func:`_library_task`'s ``work`` answers."""
+    from ..plant import circuit
+    from ..plant.circuit_design import design_circuit_plant
+    from ..plant.circuit_report import write_outputs
+    from ..tolerance.montecarlo import plant_monte_carlo
+    from ..tolerance.parts import resolve
+    from ..tolerance.worstcase import worst_case
+    result = design_circuit_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
+    series = {"R": result.sourcing.r_series, "C": result.sourcing.c_series}
+    nominal, context, mc = dict(result.values), (result.topology, result.opamp), rq.monte_carlo
+    if rq.worst_case:
+        tol = resolve(mc.tol if mc is not None else rq.tol, nominal, series)
+        result.worst_case = worst_case(lambda v: circuit.evaluate(context, v), nominal, tol.of)
+    if mc is not None:
+        result.monte_carlo = plant_monte_carlo(None, series, result.opamp, mc.n, mc.seed, mc.sampler, mc.dist,
+                                               mc.tol, mc.limits, target_ci=mc.target_ci,
+                                               circuit=(nominal, circuit.evaluate, context))
+    if want in ("sheet", "bundle"):
+        write_outputs(result, tmp, rq.name)
+    data = json.loads(json.dumps(result.to_dict()))
+    data["tool"]["argv"] = rq.argv
+    return data, lambda: circuit_plant_page(result), rq.name
+
+
+def circuit_plant_page(result) -> dict:
+    """A plant on a registered topology, for the page: its declared parts (designator, role, value), the Bode
+    plot of both models (the section's transfer function with the parts as built, ideal and with the op-amp's
+    model, evaluated on a grid as the sheet's plots are), the BOM and the sheet's content (the wiring, target
+    and achieved, sensitivities, alternatives); no schematic (the sheet has none yet)."""
+    from ..plant import circuit_report as rep
+    from ..report.document import to_html
+    from ..report.wiring import BOM_HEADER, bom_csv
+    topo, amp = result.section, result.opamp
+    fn = result.figures["opamp"]["fn_hz"]
+    f = np.geomspace(fn / 100, fn * 100, BODE_POINTS)
+    s = 2j * np.pi * f
+    resp = {"ideal op-amp": topo.response(result.values, s), f"{amp.name} model": topo.response(result.values, s, amp)}
+    bom = rep.bom(result)
+    return {"parts": [{"ref": p.ref, "role": p.role, "value": result.values[p.ref], "kind": p.kind}
+                      for p in topo.parts],
+            "bode": _bode(f, resp), "histograms": histograms(result.monte_carlo),
+            "bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
+            "sheet_html": to_html(rep.title_of(result), rep.sections(result), {}), "title": rep.title_of(result)}
+
+
+def design_filter_task(fields: dict, want: str = "json", tmp: str | None = None) -> dict:
+    """design-filter for the page, the library called directly: the request's fields as the specs
+    (:func:`designer.web.forms.filter_request`), :func:`designer.filters.design.design` (with its SPICE
+    proof), the Monte Carlo against the mask and the worst case asked for
+    (:mod:`designer.tolerance.filter`), and the typed result rendered (the sheet design-filter writes).
+
+    Parameters
+    ----------
+    fields : dict
+        The request's JSON object (the filter page's fields, :data:`designer.web.forms.FILTER`).
+    want : str
+        As :func:`run`'s.
+    tmp : str or None
+        The request's private folder (the files of a sheet or bundle; every temporary file).
+
+    Returns
+    -------
+    dict
+        As :func:`run`'s (the JSON as ``design-filter --json`` prints it); a refusal's ``field`` and
+        ``label`` name the page's field at fault.
+    """
+    from .forms import FILTER
+
+    def work():
+        from .forms import filter_request
+        tf = filter_tolerance
+        rq = filter_request(fields)
+        result = design_filter(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
+        mc = rq.monte_carlo
+        extras = {}
+        if mc is not None:
+            extras["monte_carlo"] = tf.filter_monte_carlo(result, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol,
+                                                          mc.limits)
+        if rq.worst_case:
+            extras["worst_case"] = tf.filter_worst_case(result, mc.tol if mc is not None else rq.tol)
+        extra = json_safe({k: v.to_dict() for k, v in extras.items()})
+        sheet = filter_report.sheet_of(result)
+        sheet.extra = extra
+        if want in ("sheet", "bundle"):
+            filter_report.write_outputs(sheet, tmp, rq.name)
+        data = json_safe({**result.to_dict(), **extra, "files": {}})   # as design-filter --json prints it
+        return data, lambda: filter_page(sheet, extras.get("monte_carlo")), rq.name
+    return _library_task("design-filter", FILTER, work, want, tmp)
+
+
+def _library_task(prog: str, table: dict, work, want: str, tmp: str | None) -> dict:
+    """One library-first task: ``work()`` (in ``tmp``, every temporary file there) gives (the JSON, a function
+    drawing the page, the design's name: its files, written there for a sheet or bundle); a refusal in the
+    page's words (the field of ``table`` at fault), the simulator's failure exit status 3."""
     from ..core.errors import DesignError, SimulatorError
-    from ..plant.design import design_plant
-    from ..plant.report import write_outputs
-    from ..tolerance.mcspec import plant_tolerance
-    from .forms import PLANT, page_message, plant_request
-    prog = "design-plant"
+    from .forms import page_message
     try:
         with temporaries_in(tmp):
-            rq = plant_request(fields)
-            result = design_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
-            if rq.stimulus is not None:
-                from ..plant.prbs import with_prbs
-                result = with_prbs(result, result.test.amplitude_v, rq.stimulus[0], rq.stimulus[1], rq.simulate,
-                                   rq.simulator)
-            result = plant_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
-            if want in ("sheet", "bundle"):
-                write_outputs(result, tmp, rq.name)
+            data, page, name = work()
     except SimulatorError as exc:
         return {"status": 3, "error": f"{prog}: error: simulator error: {exc}", "json": None}
     except DesignError as exc:
-        text, field = page_message(exc, PLANT)
+        text, field = page_message(exc, table)
         return {"status": 2, "error": f"{prog}: error: {text}", "json": None, "field": field,
-                "label": PLANT[field].label if field else None}
-    data = json.loads(json.dumps(result.to_dict()))
-    data["tool"]["argv"] = rq.argv   # the command line this request stands for: a record, never parsed
+                "label": table[field].label if field else None}
     answer = {"status": 0, "error": None, "json": data}
     if want == "page":
-        answer["page"] = plant_page(result)
+        answer["page"] = page()
     elif want == "sheet":
-        answer.update(body=_read(os.path.join(tmp, "reports", rq.name, "build-sheet.html")),
+        answer.update(body=_read(os.path.join(tmp, "reports", name, "build-sheet.html")),
                       media="text/html; charset=utf-8", filename="build-sheet.html")
     elif want == "bundle":
-        answer.update(body=bundle_zip(tmp, rq.name), media="application/zip", filename=f"{rq.name}.zip")
+        answer.update(body=bundle_zip(tmp, name), media="application/zip", filename=f"{name}.zip")
     return answer
 
 
 #: the commands the page runs through the library (no console script, no argv, no printed JSON)
-LIBRARY = {"design-plant": design_plant_task}
+LIBRARY = {"design-plant": design_plant_task, "design-filter": design_filter_task}
 
 
 # --------------------------------------------------------------------------- identify
@@ -429,6 +550,52 @@ def pid_page(result) -> dict:
             "title": rep.title_of(result)}
 
 
+def filter_page(sheet, mc=None) -> dict:
+    """A filter design's page, from its sheet (:class:`designer.filters.report.FilterSheet`) as the build sheet
+    has it: the Bode plot of the chosen parts with the op-amp's model, the bench band of the builds and the mask
+    (its forbidden edges: the largest loss over the passband, the least attenuation over the stopband), the
+    stages with their op-amp checks, the schematic, the BOM and the sheet's content; ``mc`` a Monte Carlo
+    against the mask (:class:`designer.tolerance.filter.FilterMonteCarlo`) for the histograms."""
+    from ..filters.registry import get as get_topology
+    from ..report.document import to_html
+    from ..report.wiring import BOM_HEADER, bom_csv
+    rep = filter_report
+    r, bench = sheet.design, sheet.bench
+    s = r.spec
+    f = np.asarray(bench.f_hz, float)
+    h = np.asarray(bench.h)
+    gain = {f"chosen parts, {r.opamp.name} model": 20 * np.log10(np.abs(h)),
+            "tolerance band low": bench.h_lo_db, "tolerance band high": bench.h_hi_db}
+    if s.has_mask and s.filter_type != "bandpass":
+        ref = 20 * math.log10(s.gain)
+        low = s.filter_type == "lowpass"
+        passing = f <= s.passband_hz if low else f >= s.passband_hz
+        stopping = f >= s.stopband_hz if low else f <= s.stopband_hz
+        gain["mask: largest passband loss"] = np.where(passing, ref - s.max_loss_db, np.nan)
+        gain["mask: least stopband attenuation"] = np.where(stopping, ref - s.min_attenuation_db, np.nan)
+    phase = {f"chosen parts, {r.opamp.name} model": np.degrees(np.unwrap(np.angle(h)))}
+    stages = []
+    for st, c in zip(r.stages, bench.checks):
+        topo = get_topology(st.topology)
+        parts = ", ".join(f"{topo.prefixed(ref, f'{st.number}0')} "
+                          f"{format_eng(st.values[ref], 'Ohm' if ref.startswith('R') else 'F', 3)}"
+                          for ref in topo.designators)
+        stages.append({"stage": st.number, "topology": st.topology, "fn_hz": st.plan.fn_hz, "q": st.plan.q,
+                       "gain": st.gain, "peak_gain_db": 20 * math.log10(st.peak_gain), "parts": parts,
+                       "out_peak_v": c.out_peak_v, "swing_v": c.swing_v, "gbw_needed_hz": c.gbw_needed_hz,
+                       "gbw_hz": c.gbw_hz, "slew_needed_v_per_s": c.slew_needed_v_per_s,
+                       "slew_v_per_s": c.slew_v_per_s, "ok": c.ok})
+    b = rep.build_board(r)
+    bom = rep.bom(r, b)
+    return json_safe({"bode": {"gain": _trace(f, gain, "frequency (Hz)", log_x=True),
+                               "phase": _trace(f, phase, "frequency (Hz)", log_x=True)},
+                      "stages": stages, "histograms": histograms(mc),
+                      "schematic_svg": rep.schematic(sheet).svg(),
+                      "bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
+                      "sheet_html": to_html(rep.title_of(r), rep.sections(sheet, with_images=False), {}),
+                      "title": rep.title_of(r)})
+
+
 #: the last schematics drawn, by what they show: typing a new fc often lands on the same parts
 _SCHEMATICS: dict = {}
 
@@ -452,10 +619,11 @@ def histograms(mc) -> list:
     """A Monte Carlo's histograms for the page, as the sheet draws them (:mod:`designer.report.tolerance`: the
     headline figure's, then each limited figure's; 2 sqrt(n) bins, 10 to 60): each figure's bin edges and counts,
     its nominal value and its limits; none without a Monte Carlo (or one build replayed)."""
-    if mc is None or mc.headline is None:
+    if mc is None or (hasattr(mc, "headline") and mc.headline is None):
         return []
+    headline = getattr(mc, "headline", None)   # a filter's Monte Carlo has none: its limited figures alone
     out = []
-    for name in dict.fromkeys([mc.headline, *(lim.figure for lim in mc.limits)]):
+    for name in dict.fromkeys([x for x in (headline, *(lim.figure for lim in mc.limits)) if x is not None]):
         v = np.asarray(mc.figures[name], float)
         v = v[np.isfinite(v)]
         if not v.size:

@@ -52,6 +52,36 @@ def test_plant_answers_design_plants_json(server):
         (1600.0, 3900.0, 3.3e-9, 1e-7)
 
 
+def test_filter_answers_design_filters_json(server):
+    """Issue 27: /api/filter is design-filter, the library called with the page's fields: the same JSON as
+    ``design-filter --json`` (the search's wall-clock seconds apart), the mask's order picked as it picks it."""
+    for body, argv in [({"order": 4, "fc": "1k"}, ["--order", "4", "--fc", "1k"]),
+                       ({"family": "chebyshev", "passband": "3k", "max-loss": 1, "stopband": "12k",
+                         "min-attenuation": 40, "topology": "mfb", "opamp": "TL072"},
+                        ["--family", "chebyshev", "--passband", "3k", "--max-loss", "1", "--stopband", "12k",
+                         "--min-attenuation", "40", "--topology", "mfb", "--opamp", "TL072"])]:
+        status, got = server.post_json("/api/filter", body)
+        assert status == 200, got
+        want = cli_json("design-filter", *argv, "--json")
+        for d in (got, want):
+            for k in ("search_s", "candidates_s"):
+                d["figures"].pop(k)
+        assert got == want
+
+
+@pytest.mark.parametrize("body, field, words", [
+    ({"order": 4}, "order", '"order": give "order" and "fc (Hz)", or the mask ("passband edge (Hz)"'),
+    ({"order": 4, "fc": "1k", "family": "chebyshev", "ripple": 9}, "ripple", '"ripple (dB)" must be'),
+    ({"order": 4, "fc": "1k", "type": "notch"}, "type", 'unknown "type" \'notch\''),
+    ({"passband": "3k", "max-loss": 1, "stopband": "3.1k", "min-attenuation": 80}, "order", "above the limit 10"),
+    ({"order": 4, "fc": "1k", "out": "x"}, None, "set by the web page itself"),
+])
+def test_a_refused_filter_names_the_pages_field_never_a_flag(server, body, field, words):
+    status, got = server.post_json("/api/filter", body)
+    assert status == 400 and words in got["message"] and "--" not in got["message"], got
+    assert (got.get("option") or "").lstrip("-") == (field or "")
+
+
 def test_identify_answers_identifys_json_body_or_multipart(server):
     want = cli_json("identify", str(CAPTURE), "--json")
     status, _, raw = server.post("/api/identify?filename=tektronix_mso.csv", CAPTURE.read_bytes())
@@ -342,6 +372,9 @@ RUNNING = [("/api/plant", {"fc": 1000, "zeta": 0.5, "no-sim": True}),
            ("/api/pid/bundle", {"plant-fc": 3500, "plant-zeta": 0.2, "no-sim": True}),
            ("/api/analyze-pid", {"plant-fc": 3500, "plant-zeta": 0.2, "kp": 2, "ti": "1m", "td": "10u",
                                  "no-sim": True}),
+           ("/api/filter", {"order": 4, "fc": 1000, "no-sim": True}),
+           ("/api/filter/sheet", {"order": 4, "fc": 1000, "no-sim": True}),
+           ("/api/filter/bundle", {"order": 4, "fc": 1000, "no-sim": True}),
            ("/api/identify", CAPTURE.read_bytes()),
            ("/api/check", {"spec": "name: x\nkind: plant\ntarget: {fc: 1k, zeta: 0.5}\nchecks:\n  fn_hz: {max: 2k}\n"})]
 
@@ -423,7 +456,8 @@ def test_a_capture_as_the_body_with_its_own_type_needs_no_header(server):
         assert status == 200, raw
 
 
-@pytest.mark.parametrize("path", ["/", "/plant", "/check", "/static/common.js", "/static/style.css",
+@pytest.mark.parametrize("path", ["/", "/plant", "/check", "/filter", "/static/filter.js", "/static/common.js",
+                                  "/static/style.css",
                                   "/static/vendor/uplot/uPlot.iife.min.js", "/static/nothere.js", "/api/health",
                                   "/api/choices", "/favicon.ico", "/api/plant"])
 def test_every_answer_has_the_security_headers(server, path):

@@ -49,3 +49,38 @@ def test_bad_fields_are_refused_naming_their_parameter(fields, param):
     assert exc.value.param == param
     text, _ = page_message(exc.value, PLANT)
     assert "--" not in text and "\n" not in text
+
+
+def test_every_filter_field_sets_a_parameter_of_the_specs_or_of_the_run():
+    from designer.filters.spec import FilterSpec
+    from designer.web.forms import FILTER
+    specs = {f.name for f in dataclasses.fields(FilterSpec)} | {f.name for f in dataclasses.fields(MonteCarloSpec)}
+    assert {f.param for f in FILTER.values()} <= specs | {"no_sim", "simulator", "name", "worst_case"}
+    assert len({f.label for f in FILTER.values()}) == len(FILTER)
+
+
+def test_a_filter_request_is_the_spec_design_filter_builds():
+    from designer.filters.spec import FilterSpec
+    from designer.web.forms import filter_request
+    rq = filter_request({"family": "chebyshev", "passband": "3k", "max-loss": 1, "stopband": "12k",
+                         "min-attenuation": 40, "topology": "mfb", "series": "E96", "monte-carlo": 500,
+                         "tol": "R=1% C=5%"})
+    assert rq.spec == FilterSpec(family="chebyshev", passband_hz="3k", max_loss_db="1", stopband_hz="12k",
+                                 min_attenuation_db="40", topology="mfb", r_series="E96")
+    assert rq.monte_carlo == MonteCarloSpec(n=500, tol=("R=1%", "C=5%"))
+    assert rq.simulate and rq.simulator == "ngspice-cli" and rq.name == "filter_lowpass_chebyshev_mask"
+    assert filter_request({"order": 4, "fc": "1k"}).name == "filter_lowpass_butterworth_o4_fc1000"
+
+
+@pytest.mark.parametrize("fields, param", [
+    ({"fc": "1k"}, "order"), ({"order": 4, "fc": "1k", "family": "chebyshev", "ripple": 5}, "ripple_db"),
+    ({"order": 4, "fc": "1k", "type": "notch"}, "filter_type"), ({"order": 4, "fc": "1k", "seed": 3}, "seed"),
+    ({"order": 4, "fc": "1k", "name": "a/b"}, "name"),
+])
+def test_bad_filter_fields_are_refused_in_the_pages_words(fields, param):
+    from designer.web.forms import FILTER, filter_request
+    with pytest.raises(DesignError) as exc:
+        filter_request(fields)
+    assert exc.value.param == param
+    text, field = page_message(exc.value, FILTER)
+    assert "--" not in text and "_" not in text.split("'")[0] and FILTER[field].param == param

@@ -63,7 +63,7 @@ def after(pg, action, timeout=60000):
 
 def open_page(pg, server, path):
     pg.goto(server.url + path)
-    if path.split("?")[0] in ("/plant", "/pid"):
+    if path.split("?")[0] in ("/plant", "/pid", "/filter"):
         pg.wait_for_function("() => +(document.body.dataset.answers || 0) > 0", timeout=60000)
 
 
@@ -383,7 +383,7 @@ def test_the_pid_page_opens_on_a_design_that_passes_with_its_margins(page, serve
     assert "--tuning" not in sheet and "--target" not in sheet
 
 
-@pytest.mark.parametrize("path", ["/plant", "/pid", "/identify", "/check"])
+@pytest.mark.parametrize("path", ["/plant", "/pid", "/filter", "/identify", "/check"])
 def test_no_page_is_wider_than_a_phone(browser, server, path):
     context = browser.new_context(viewport={"width": 390, "height": 844})
     pg = context.new_page()
@@ -649,7 +649,8 @@ def test_one_colour_per_trace_kind_and_a_text_alternative_for_every_plot(page, s
 
 
 @pytest.mark.parametrize("path, field, bad", [("/plant", "zeta", "-1"), ("/pid", "kp", "-3"),
-                                              ("/identify", None, None), ("/check", None, None)])
+                                              ("/filter", "fc", "1e9"), ("/identify", None, None),
+                                              ("/check", None, None)])
 def test_no_message_on_any_page_contains_a_flag(page, server, path, field, bad):
     open_page(page, server, path)
     if field is not None and page.locator(f"input[name={field}]").is_visible():
@@ -674,3 +675,158 @@ def test_the_pid_pages_tolerance_panel(page, server):
     assert figure(page, "builds drawn") == "100"
     assert page.locator(".histogram-figure line[data-limit]").count() == 2   # the limited figure's
     assert "tol=R%3D1%25+C%3D5%25" in page.url and "monte-carlo=100" in page.url
+
+
+# --------------------------------------------------------------------------- the Filter page (issues 27, 29)
+FILTER_DOWNLOADS = ("#sheet", "#bom", "#bundle")
+
+
+def open_filter(pg, server, query=""):
+    pg.goto(server.url + "/filter" + query)
+    pg.wait_for_function("() => +(document.body.dataset.answers || 0) > 0", timeout=120000)
+    return pg.evaluate("document.body.dataset.state")
+
+
+def test_filter_a_4th_order_butterworth_lowpass_at_1k_shows_its_stages_bode_and_schematic(page, server):
+    assert open_filter(page, server) == "done", page.inner_text(".form-foot")
+    status, want = server.post_json("/api/filter", {"order": 4, "fc": 1000})
+    assert status == 200 and want["spec"]["order"] == 4 and len(want["stages"]) == 2
+    assert "Order-4 Butterworth low-pass, fc 1 kHz" in page.inner_text("#title")
+    rows = page.locator("#stages tbody tr")
+    assert rows.count() == 2
+    svg = page.inner_html("#schematic")
+    for st in want["stages"]:   # the stage's fn, Q and its parts, as the library chose them, in its row
+        row = rows.nth(st["stage"] - 1).inner_text()
+        assert page.evaluate("([v, d]) => D.num(v, d)", [st["q"], 4]) in row
+        assert page.evaluate("v => D.eng(v, 'Hz', 4)", st["fn_hz"]) in row
+        for ref in st["parts"]:
+            assert f"{ref[0]}{st['stage']}0{ref[1:]}" in row and f"{ref[0]}{st['stage']}0{ref[1:]}" in svg
+    assert page.locator("#bode-gain canvas").count() == 1 and page.locator("#bode-phase canvas").count() == 1
+    assert "chosen parts, LM741 model" in page.get_attribute("#bode-gain", "data-series")
+    assert figure(page, "SPICE agrees with the model").startswith("yes")
+    assert disabled(page, FILTER_DOWNLOADS) == [False] * 3
+
+
+def test_filter_a_mask_picks_the_order_and_is_drawn_on_the_bode_plot(page, server):
+    open_filter(page, server)
+
+    def mask():
+        page.select_option("select[name=family]", "chebyshev")
+        page.select_option("#entry", "mask")
+    assert after(page, mask, timeout=120000) == "done", page.inner_text(".form-foot")
+    status, want = server.post_json("/api/filter", {"family": "chebyshev", "passband": "3k", "max-loss": 1,
+                                                     "stopband": "12k", "min-attenuation": 40})
+    assert status == 200
+    assert figure(page, "order") == str(want["spec"]["order"])
+    assert figure(page, "mask: stopband margin") == page.evaluate(
+        "v => D.num(v, 3) + ' dB'", want["figures"]["mask_stopband_margin_db"])
+    series = page.get_attribute("#bode-gain", "data-series")
+    assert "mask: largest passband loss" in series and "mask: least stopband attenuation" in series
+    assert "passband=3k" in page.url and "order=" not in page.url and "fc=" not in page.url
+
+
+def test_filter_a_refused_input_disables_every_download_and_no_message_has_a_flag(page, server):
+    open_filter(page, server)
+    assert after(page, lambda: page.fill("input[name=fc]", "1e9")) == "error"
+    assert disabled(page, FILTER_DOWNLOADS) == [True] * 3 and "not of the current inputs" in stale_note(page)
+    error = page.inner_text(".field-error")
+    assert error.startswith('"fc (Hz)" must be') and "--" not in error
+    downloads = []
+    page.on("download", lambda d: downloads.append(d))
+    page.locator("#bom").dispatch_event("click")
+    page.wait_for_timeout(300)
+    assert not downloads
+    # a message the library writes with flags (the order missing) reads in the page's words
+    # (an emptied field is asked about when it is left)
+    assert after(page, lambda: (page.fill("input[name=fc]", "1k"), page.fill("input[name=order]", ""),
+                                page.press("input[name=order]", "Tab"))) == "error"
+    text = page.evaluate("document.body.innerText + [...document.querySelectorAll('*')].filter(e => e.shadowRoot)"
+                         ".map(e => e.shadowRoot.textContent).join(' ')")
+    assert "--" not in text, [line for line in text.splitlines() if "--" in line]
+    assert '"order"' in page.inner_text(".field-error")
+    assert after(page, lambda: page.fill("input[name=order]", "4")) == "done"
+    assert disabled(page, FILTER_DOWNLOADS) == [False] * 3 and stale_note(page) == ""
+
+
+def test_filter_a_shared_link_reproduces_the_design(page, server):
+    open_filter(page, server)
+    assert after(page, lambda: (page.select_option("select[name=type]", "highpass"),
+                                page.select_option("select[name=family]", "bessel"),
+                                page.fill("input[name=order]", "3")), timeout=120000) == "done"
+    assert "type=highpass" in page.url and "family=bessel" in page.url and "order=3" in page.url
+    title, shared = page.inner_text("#title"), page.url
+    page.goto(server.url + "/plant")
+    open_filter(page, server, shared.replace(server.url + "/filter", ""))
+    assert page.inner_text("#title") == title and page.input_value("select[name=family]") == "bessel"
+    # a mask's link opens on the mask's entry
+    open_filter(page, server, "?passband=3k&max-loss=1&stopband=12k&min-attenuation=40")
+    assert page.input_value("#entry") == "mask" and page.locator("input[name=passband]").is_visible()
+
+
+def test_the_bundle_and_the_sheet_are_the_design_filters(page, server):
+    open_filter(page, server)
+    with page.expect_download() as dl:
+        page.click("#bundle")
+    z = zipfile.ZipFile(io.BytesIO(Path(dl.value.path()).read_bytes()))
+    names = z.namelist()
+    name = dl.value.suggested_filename[:-len(".zip")]
+    assert f"netlists/{name}.cir" in names and f"reports/{name}/build-sheet.html" in names
+    status, _, raw = server.post("/api/filter/sheet", {"order": 4, "fc": 1000})
+    assert status == 200 and b"Stages and their op-amp checks" in raw
+
+
+def test_filter_tolerance_panel_gives_the_yield_against_the_mask(page, server):
+    open_filter(page, server, "?family=chebyshev&passband=3k&max-loss=1&stopband=12k&min-attenuation=40")
+    assert after(page, lambda: page.fill("input[name=monte-carlo]", "200"), timeout=120000) == "done"
+    status, want = server.post_json("/api/filter", {"family": "chebyshev", "passband": "3k", "max-loss": 1,
+                                                     "stopband": "12k", "min-attenuation": 40, "monte-carlo": 200})
+    y = want["monte_carlo"]["yield"]
+    assert figure(page, "builds drawn") == "200"
+    assert figure(page, "yield") == page.evaluate("v => D.pct(v)", y["fraction"])
+    assert figure(page, "95 % interval (Wilson)") == page.evaluate("([a, b]) => D.pct(a) + ' to ' + D.pct(b)", y["ci95"])
+    assert page.locator(".histogram-figure").count() == len(want["monte_carlo"]["limits"])
+    t = want["monte_carlo"]["tighten"]
+    assert t["part"] in page.inner_text("#tighten") or str(t["stage"]) in page.inner_text("#tighten-stage")
+
+
+def test_every_filter_field_has_the_label_of_the_name_table(page, server):
+    """One name table per front end: the page's labels are designer.web.forms.FILTER's."""
+    from designer.web.forms import FILTER
+    open_filter(page, server)
+    names = page.evaluate("[...document.querySelectorAll('#form [name]')].map(e => e.name)")
+    assert len(names) > 20
+    for name in names:
+        assert page.evaluate(f"D.labelOf(document.getElementById('form'), '{name}')") == FILTER[name].label, name
+
+
+# --------------------------------------------------------------------------- the Plant page's topology menu (26)
+def test_the_plant_pages_topology_menu_designs_an_mfb_lowpass(page, server):
+    """Issue 26: the menu lists the registered sections; the part list is the chosen one's declared parts; an MFB
+    low-pass is designed by the generic plant pipeline, its parts, figures and Bode plot shown; a first-order
+    section takes no zeta; the seed's circuit stays as it was."""
+    from designer.filters import registry
+    open_page(page, server, "/plant")
+    menu = page.locator("select[name=topology]")
+    assert [o.get_attribute("value") for o in menu.locator("option").all()] == registry.names()
+    assert menu.input_value() == "sallen-key-lowpass" and page.locator("#step-section").is_visible()
+    assert after(page, lambda: menu.select_option("mfb-lowpass"), timeout=120000) == "done", \
+        page.inner_text(".form-foot")
+    topo = registry.get("mfb-lowpass")
+    listed = page.locator("#topology-parts tbody tr")
+    assert [listed.nth(i).locator("td").first.inner_text() for i in range(listed.count())] == list(topo.designators)
+    status, want = server.post_json("/api/plant", {"fc": 3500, "zeta": 0.2, "topology": "mfb-lowpass"})
+    assert status == 200 and want["topology"] == "mfb-lowpass"
+    for p in topo.parts:
+        shown = page.locator(".figure", has_text=f"{p.ref} ({p.role})").locator("b").inner_text()
+        assert shown == page.evaluate("([v, u]) => D.eng(v, u, 3)", [want["parts"][p.ref]["value"],
+                                                                      "Ohm" if p.kind == "R" else "F"])
+    assert "MFB low-pass" in page.inner_text("#title") and "topology=mfb-lowpass" in page.url
+    assert page.locator("#bode-gain canvas").count() == 1 and not page.locator("#step-section").is_visible()
+    assert figure(page, "SPICE agrees with the model") == "yes" and not page.locator("#topid").is_visible()
+    assert not page.locator("#bom").is_disabled()
+    # a first-order section: no zeta asked
+    assert after(page, lambda: menu.select_option("rc-lowpass"), timeout=120000) == "done"
+    assert not page.locator("input[name=zeta]").is_visible() and "zeta=" not in page.url
+    # back to the seed's circuit: its own panels
+    assert after(page, lambda: menu.select_option("sallen-key-lowpass"), timeout=120000) == "done"
+    assert page.locator("#step-section").is_visible() and page.locator("#topid").is_visible()

@@ -219,6 +219,45 @@ D.liveForm = function (form, run, key, wait) {
   return {now, forget: () => { asked = null; }};
 };
 
+// A design page's two actions (Plant, Filter): `design()` posts the form to `endpoint?view=page` (a newer one
+// supersedes it), shows the answer with `show` and `said(answer)` on the status line, or the refusal beside its
+// field; `file(kind)` downloads "bom" (from the answer), "sheet" (opened in a tab to print) or "bundle" of the
+// design shown, never of inputs it is not of. `shown()` is that design: {opts, answer}, or null.
+D.designPage = function (form, status, endpoint, show, said) {
+  let seq = 0, last = null;
+  async function design() {
+    const mine = ++seq;
+    const opts = D.options(form);
+    D.markStale("pending");
+    D.busy(true, status);
+    const r = await D.api(`${endpoint}?view=page`, opts, false, "form");
+    if (r.aborted || mine !== seq) return;          // a newer request is on its way: this answer is stale
+    D.busy(false, status);
+    if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
+    D.clearError(form);
+    last = {opts, answer: r.data};   // the downloads are of these inputs (D.answered turns them on)
+    D.remember(opts);
+    show(r.data);
+    status.textContent = said(r.data);
+    D.answered("done");
+  }
+  async function file(kind) {
+    if (!last || D.isStale()) return;
+    if (kind === "bom") {
+      D.download(new Blob([last.answer.page.bom_csv], {type: "text/csv"}), "bom.csv");
+      return;
+    }
+    D.busy(true, status);
+    const r = await D.api(`${endpoint}/${kind}`, last.opts, true);
+    D.busy(false, status);
+    if (!r.ok) { D.showError(form, r.data); return; }
+    // the sheet in a new tab to print; a browser that blocks the tab gets it as a file
+    if (kind === "sheet") { if (!window.open(URL.createObjectURL(r.blob), "_blank")) D.download(r.blob, "build-sheet.html"); }
+    else D.download(r.blob, r.filename || "design.zip");   // the design's name, as its command names it
+  }
+  return {design, file, shown: () => last};
+};
+
 // Each answer shown: the page's state ("done" or "error") and how many answers it has shown (for its tests).
 D.answered = function (state) {
   document.body.dataset.state = state;
@@ -356,7 +395,7 @@ const COLOURS = ["#9467bd", "#8c564b", "#17becf", "#bcbd22", "#e377c2", "#7f7f7f
 // One colour per kind of trace on every plot (issue 29: red was SPICE on one plot and the ideal op-amp on the
 // next): SPICE red, the op-amp-aware model (and the realised loop) blue, the ideal one green, the measured data
 // black, the plant alone grey, the tolerance band orange; the identified models take the other colours in turn.
-D.TRACE_KINDS = [[/^SPICE/, "#d62728"], [/^data$|integrated impulse/, "#111111"], [/^tolerance band/, "#e0a040"],
+D.TRACE_KINDS = [[/^mask/, "#6a3d9a"], [/^SPICE/, "#d62728"], [/^data$|integrated impulse/, "#111111"], [/^tolerance band/, "#e0a040"],
                  [/ideal/, "#2ca02c"], [/plant alone/, "#7f7f7f"], [/model|analytic|realised|loop gain/, "#1f77b4"]];
 D.traceColour = function (label, i) {
   const kind = D.TRACE_KINDS.find(([re]) => re.test(label));
@@ -376,7 +415,7 @@ D.plot = function (el, trace, opts) {
   const series = [{label: trace.x_label, value: (u, v) => v === null || v === undefined ? "" : D.eng(v, opts.xUnit || "", 4)}];
   let others = 0;
   trace.series.forEach((s, i) => {
-    const band = /^tolerance band/.test(s.label);
+    const band = /^(tolerance band|mask)/.test(s.label);   // dashed: limits, not responses
     const points = /^(data|SPICE \.ac)$/.test(s.label);
     const kind = D.TRACE_KINDS.some(([re]) => re.test(s.label));
     // measured points as small rings, so the model lines under them stay visible
@@ -483,7 +522,8 @@ D.drawMarks = function (u, marks) {
 
 D.nav = function (current) {
   const nav = document.querySelector("nav");
-  for (const [href, text] of [["/plant", "Plant"], ["/pid", "PID"], ["/identify", "Identify"], ["/check", "Check"]]) {
+  for (const [href, text] of [["/plant", "Plant"], ["/pid", "PID"], ["/filter", "Filter"], ["/identify", "Identify"],
+                              ["/check", "Check"]]) {
     const a = document.createElement("a");
     a.href = href; a.textContent = text;
     if (href === current) a.className = "here";

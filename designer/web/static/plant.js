@@ -4,9 +4,58 @@
 D.nav("/plant");
 const form = document.getElementById("form");
 const status = document.getElementById("status");
-let seq = 0, last = null;
+
+const SEED_TOPOLOGY = "sallen-key-lowpass";   // the seed's circuit: its own pipeline (step, bench, schematic)
+let topologies = [];
+
+// The chosen topology's declared parts (designator, R or C, role), as the registry lists them; a first-order
+// section takes no zeta (its field hidden: not sent).
+function showTopology() {
+  const name = form.elements["topology"].value;
+  const topo = topologies.find(t => t.name === name);
+  if (!topo) return;
+  const zeta = form.elements["zeta"].closest("label");
+  zeta.hidden = topo.order === 1;
+  document.getElementById("topology-parts").replaceChildren(
+    D.table([D.t("part"), D.t("kind"), D.t("role")], topo.parts.map(x => [x.ref, x.kind === "R" ? D.t("resistor")
+                                                                                    : D.t("capacitor"), x.role])));
+}
+D.onRestore = showTopology;
+
+// A plant on another registered section (the generic pipeline): its declared parts, both models' figures and
+// Bode plot, the BOM, checks and sheet; the seed circuit's step, bench and schematic panels are not its.
+function showCircuit(answer) {
+  const r = answer.result, p = answer.page, o = r.built.opamp, i = r.built.ideal;
+  document.getElementById("title").textContent = p.title;
+  const spice = r.checks.find(c => c.id === "spice_agreement");
+  document.getElementById("figures").replaceChildren(
+    ...p.parts.map(x => D.fig(`${x.ref} (${x.role})`, D.eng(x.value, x.kind === "R" ? "Ohm" : "F", 3))),
+    D.fig(D.t("fn as built ({amp})", {amp: r.opamp.name}), D.eng(o.fn_hz, "Hz", 4)),
+    ...(o.zeta === null ? [] : [D.fig(D.t("zeta as built ({amp})", {amp: r.opamp.name}), D.num(o.zeta, 4))]),
+    D.fig(D.t("gain"), D.num(i.gain, 4)),
+    D.fig(D.t("-3 dB frequency ({amp})", {amp: r.opamp.name}), o.f3db_hz.map(v => D.eng(v, "Hz", 4)).join(", ")),
+    D.fig(D.t("SPICE agrees with the model"), !spice ? D.t("not simulated") : (spice.ok ? D.t("yes") : D.t("NO"))));
+  document.getElementById("notes").replaceChildren(...r.notes.map(n => { const e = document.createElement("p"); e.textContent = D.inPageWords(form, n); return e; }));
+  const sch = document.getElementById("schematic");
+  sch.replaceChildren(Object.assign(document.createElement("p"), {textContent:
+    D.t("{title}: the parts and their wiring are in the build sheet below.", {title: r.topology_title})}));
+  const open = sch.parentElement.querySelector(".open-full");
+  if (open) open.remove();
+  document.getElementById("bomtable").replaceChildren(D.table(p.bom.header.slice(0, 7), p.bom.rows.map(x => x.slice(0, 7))));
+  document.getElementById("checks").replaceChildren(D.checksTable(r.checks));
+  D.tolerance(r.monte_carlo, p.histograms);
+  D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
+  D.plot(document.getElementById("bode-gain"), p.bode.gain, {xUnit: "Hz", yLabel: D.t("gain (dB)"), height: 240});
+  D.plot(document.getElementById("bode-phase"), p.bode.phase, {xUnit: "Hz", yLabel: D.t("phase (deg)"), height: 200});
+}
 
 function show(answer) {
+  const seed = (answer.result.topology || SEED_TOPOLOGY) === SEED_TOPOLOGY;
+  document.getElementById("step-section").hidden = !seed;
+  document.getElementById("bench-section").hidden = !seed;
+  // "a PID for this plant" takes the seed circuit's four parts
+  document.getElementById("topid").hidden = !seed;
+  if (!seed) { showCircuit(answer); return; }
   const r = answer.result, p = answer.page, b = r.built;
   document.getElementById("title").textContent = p.title;
   const figs = document.getElementById("figures");
@@ -33,47 +82,24 @@ function show(answer) {
   D.plot(document.getElementById("bode-phase"), p.bode.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 200});
 }
 
-async function design() {
-  const mine = ++seq;
-  const opts = D.options(form);
-  D.markStale("pending");
-  D.busy(true, status);
-  const r = await D.api("/api/plant?view=page", opts, false, "form");
-  if (r.aborted || mine !== seq) return;          // a newer request is on its way: this answer is stale
-  D.busy(false, status);
-  if (!r.ok) { D.showError(form, r.data); D.answered("error"); return; }
-  D.clearError(form);
-  last = {opts, answer: r.data};   // the downloads are of these inputs (D.answered turns them on)
-  D.remember(opts);
-  show(r.data);
-  status.textContent = `designed and simulated (${r.data.result.simulator || "no simulator"})`;
-  D.answered("done");
-}
-
-async function file(kind) {
-  if (!last || D.isStale()) return;
-  if (kind === "bom") {
-    D.download(new Blob([last.answer.page.bom_csv], {type: "text/csv"}), "bom.csv");
-    return;
-  }
-  D.busy(true, status);
-  const r = await D.api(`/api/plant/${kind}`, last.opts, true);
-  D.busy(false, status);
-  if (!r.ok) { D.showError(form, r.data); return; }
-  // the sheet in a new tab to print; a browser that blocks the tab gets it as a file
-  if (kind === "sheet") { if (!window.open(URL.createObjectURL(r.blob), "_blank")) D.download(r.blob, "build-sheet.html"); }
-  else D.download(r.blob, r.filename || "plant.zip");   // the design's name, as design-plant names it
-}
+const page = D.designPage(form, status, "/api/plant", show, r => `designed and simulated (${r.result.simulator || "no simulator"})`);
 
 (async function () {
   const c = await D.loadChoices();
   for (const s of form.querySelectorAll("select[data-choices]")) D.fill(s, c[s.dataset.choices], s.dataset.default);
+  topologies = c.topologies;
+  const menu = form.elements["topology"];
+  D.fill(menu, topologies.map(t => t.name), SEED_TOPOLOGY);
+  for (const o of menu.options) o.textContent = topologies.find(t => t.name === o.value).title;
   D.fillFromQuery(form);
-  D.liveForm(form, design, () => JSON.stringify(D.options(form)));
-  document.getElementById("sheet").onclick = () => file("sheet");
-  document.getElementById("bundle").onclick = () => file("bundle");
-  document.getElementById("bom").onclick = () => file("bom");
+  showTopology();
+  form.addEventListener("change", e => { if (e.target === menu) showTopology(); }, true);   // before it asks
+  D.liveForm(form, page.design, () => JSON.stringify(D.options(form)));
+  document.getElementById("sheet").onclick = () => page.file("sheet");
+  document.getElementById("bundle").onclick = () => page.file("bundle");
+  document.getElementById("bom").onclick = () => page.file("bom");
   document.getElementById("topid").onclick = () => {
+    const last = page.shown();
     if (!last || D.isStale()) return;
     const o = last.opts, b = last.answer.result.built;
     // the plant as built, by its parts: the PID is designed for the circuit on the bench
@@ -83,5 +109,5 @@ async function file(kind) {
     if (b.gain !== 1) q.set("plant-gain", b.gain);
     location.href = "/pid?" + q.toString();
   };
-  design();
+  page.design();
 })();
