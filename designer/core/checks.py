@@ -4,9 +4,10 @@ snake_case id that is the same in every command and in ``result.json``."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from .i18n import N_
+from .i18n import gettext as _
 
 __all__ = ["Check", "IDS", "SPICE_AGREEMENT"]
 
@@ -33,11 +34,51 @@ TITLES = {
 
 @dataclass(frozen=True)
 class Check:
-    """One verdict: ``id`` (snake_case, stable), whether it passed, and why."""
+    """One verdict: ``id`` (snake_case, stable), whether it passed, and why.
+
+    ``detail`` is the why in English (``result.json``'s); a check made with :meth:`of` also keeps its message and
+    values, so that each sheet shows it in its own language (:meth:`shown`).
+    """
 
     id: str
     ok: bool
     detail: str
+    message: str | None = field(default=None, compare=False, repr=False)   #: the detail's message (English)
+    values: tuple = field(default=(), compare=False, repr=False)           #: its {name} values, (name, text) pairs
+
+    @classmethod
+    def of(cls, id: str, ok, message: str, **values) -> "Check":
+        """A check whose detail is ``message`` (marked with ``N_`` where it is written) filled with ``values``.
+
+        Parameters
+        ----------
+        id : str
+            The check's id.
+        ok : bool
+            Whether it passed.
+        message : str
+            The detail's English text with ``{name}`` fields.
+        **values
+            The fields' values (already written as text: ``f"{x:.3g}"``).
+
+        Returns
+        -------
+        Check
+            The check, its ``detail`` the English text.
+        """
+        return cls(id, bool(ok), message.format(**values), message, tuple(sorted(values.items())))
+
+    def shown(self) -> str:
+        """The detail in the current language (:func:`designer.core.i18n.gettext`; as written without a message).
+
+        Returns
+        -------
+        str
+            The text.
+        """
+        if self.message is None:
+            return self.detail
+        return _(self.message).format(**dict(self.values))
 
     @property
     def title(self) -> str:
@@ -45,7 +86,7 @@ class Check:
         return TITLES.get(self.id, self.id.replace("_", " "))
 
     def to_dict(self) -> dict:
-        # "name" is the id too: the key result.json has always had
+        # "name" is the id too: the key result.json has always had (the detail in English: the file's language)
         return {"id": self.id, "name": self.id, "ok": bool(self.ok), "detail": self.detail}
 
 

@@ -143,7 +143,7 @@ def _build_blocks(result, b, rows, with_images, schematic_svg) -> list:
 def _wiring_blocks(result, b, first_rows=(), after: str = "") -> list:
     """The packages and the pin-level wiring table of board ``b``; ``first_rows``
     (part, code, from, to) go before the board's rows, ``after`` closes the intro."""
-    return [R.text(_("{part} in {pinout} packages: ").format(part=b.package.part, pinout=b.package.pinout)
+    return [R.text(_("{part} in {pinout} packages: ").format(part=b.package.part, pinout=_(b.package.pinout))
                    + ", ".join(f"{u.designator} {_(a.role)}" for a, u in zip(b.netlist.amps, b.units))
                    + ". Kp = R5 R3/(R6 R4), Ti = R8 R14 C4/R6, Td = R6 R11 C3/R7." + after),
             R.table([_("part"), _("code"), _("from"), _("to")],
