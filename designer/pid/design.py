@@ -21,6 +21,7 @@ import numpy as np
 
 from ..core import opamps
 from ..core.checks import Check
+from ..core.i18n import N_
 from ..core.errors import ParamError
 from ..core.lti import dominant_pair, response_span, step_response
 from ..core.metrics import StepMetrics
@@ -441,9 +442,9 @@ def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise, parts, nam
     out = []
     poles = lm.poles()
     worst = float(np.max(poles.real)) if poles.size else -math.inf
-    out.append(Check("closed_loop_stable", bool(stable),
-                     "all closed-loop poles in the left half plane" if stable else
-                     f"a closed-loop pole has real part {worst:+.4g} 1/s: the loop oscillates or latches at a rail"))
+    out.append(Check.of("closed_loop_stable", True, N_("all closed-loop poles in the left half plane")) if stable
+               else Check.of("closed_loop_stable", False, N_("a closed-loop pole has real part {re} 1/s: the loop "
+                                                             "oscillates or latches at a rail"), re=f"{worst:+.4g}"))
     pm = mg.phase_margin_deg
     near = ""
     if math.isfinite(pm) and not amp.ideal:

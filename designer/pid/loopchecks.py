@@ -16,6 +16,7 @@ import math
 from dataclasses import replace
 
 from ..core.checks import Check
+from ..core.i18n import N_
 from ..core.units import format_eng
 from . import model
 
@@ -122,9 +123,9 @@ def steady_state_check(dc_gain: float) -> list:
     if not math.isfinite(dc_gain):
         return []
     e = 1 - dc_gain
-    return [Check("steady_state_error", bool(abs(e) <= MAX_STEADY_STATE_ERROR),
-                  f"{100 * e:.3g} % of the step (the integrator leaks through R13; "
-                  f"want <= {100 * MAX_STEADY_STATE_ERROR:g} %)")]
+    return [Check.of("steady_state_error", abs(e) <= MAX_STEADY_STATE_ERROR,
+                     N_("{error} % of the step (the integrator leaks through R13; want <= {max} %)"),
+                     error=f"{100 * e:.3g}", max=f"{100 * MAX_STEADY_STATE_ERROR:g}")]
 
 
 def stage_checks(stable, levels, amp, step_v, rise, parts, name_of=str) -> list:

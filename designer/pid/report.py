@@ -120,7 +120,7 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     out.append((_("Tuning"), _tuning_blocks(result)))
     out.append((_("Target and achieved"), _achieved_blocks(result)))
     out.append((_("Checks"), [R.table([_("check"), _("result"), _("detail")],
-                                      [[c.id, _("ok") if c.ok else _("FAILED"), c.detail] for c in result.checks])]))
+                                      [[c.id, _("ok") if c.ok else _("FAILED"), c.shown()] for c in result.checks])]))
     out.append((_("Closed loop"), _loop_blocks(result, with_images)))
     heading = tolerance_title(result, worst=True)
     if heading is not None:

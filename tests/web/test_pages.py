@@ -699,10 +699,10 @@ PAGE_WORDS = """(left) => {
   }
   return out;
 }"""
-#: what the library writes in its own words that the walk leaves out for now, with where it comes from: the check
-#: details (designer.plant/pid), the design notes, identify's method notes and the build sheet's (its details and
-#: the op-amp's pin notes); the page's own words, the check titles, the figures and plots are all walked
-LIBRARY_TEXT = ["#checks td:nth-child(3)", "#notes", "#sheet-html", "#methods td:nth-child(7)"]
+#: what the library still writes in English that the walk leaves out, by page: the PID's build sheet (its slew and
+#: phase-margin details, the tuning rules' notes) and identify's method notes; everything else is walked (the
+#: page's own words, figures, plots' text, check titles and details, the plant's whole sheet)
+LIBRARY_TEXT = {"/plant": [], "/pid": ["#sheet-html"], "/identify": ["#methods td:nth-child(7)"], "/check": []}
 
 
 def _words_on(pg, left=()) -> list:
@@ -724,7 +724,7 @@ def test_every_page_in_each_language_shows_none_of_the_other(browser, server, pa
             pg.wait_for_selector("select[name=format] option:nth-child(2)", state="attached")
             assert after(pg, lambda: pg.set_input_files("#file", str(SYNTHETIC_TEK))) == "done"
         pg.wait_for_function("() => document.documentElement.lang !== ''")
-        texts = _words_on(pg, LIBRARY_TEXT)
+        texts = _words_on(pg, LIBRARY_TEXT[path])
         assert pg.evaluate("document.documentElement.lang") == lang
         left = foreign(texts, english if lang == "es" else spanish)
         assert not left, "\n".join(f"{words}: {text!r}" for text, words in left)
