@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from .i18n import N_
 from .i18n import gettext as _
 
-__all__ = ["Check", "IDS", "SPICE_AGREEMENT"]
+__all__ = ["Check", "IDS", "SPICE_AGREEMENT", "listing"]
 
 #: what each check id means, for the build sheets (ids not listed print as themselves)
 TITLES = {
@@ -59,17 +59,19 @@ class Check:
         message : str
             The detail's English text with ``{name}`` fields.
         **values
-            The fields' values (already written as text: ``f"{x:.3g}"``).
+            The fields' values (already written as text: ``f"{x:.3g}"``), or a list written by :func:`listing`.
 
         Returns
         -------
         Check
             The check, its ``detail`` the English text.
         """
-        return cls(id, bool(ok), message.format(**values), message, tuple(sorted(values.items())))
+        values = tuple(sorted(values.items()))
+        return cls(id, bool(ok), _fill(message, values, False), message, values)
 
     def shown(self) -> str:
-        """The detail in the current language (:func:`designer.core.i18n.gettext`; as written without a message).
+        """The detail in the current language (:func:`designer.core.i18n.gettext`, the message and each value that is
+        a message of the catalogue; as written without a message).
 
         Returns
         -------
@@ -78,7 +80,7 @@ class Check:
         """
         if self.message is None:
             return self.detail
-        return _(self.message).format(**dict(self.values))
+        return _fill(self.message, self.values, True)
 
     @property
     def title(self) -> str:
@@ -88,6 +90,37 @@ class Check:
     def to_dict(self) -> dict:
         # "name" is the id too: the key result.json has always had (the detail in English: the file's language)
         return {"id": self.id, "name": self.id, "ok": bool(self.ok), "detail": self.detail}
+
+
+def listing(sep: str, items) -> tuple:
+    """A list inside a check's detail (the stages that slew too long, the poles near the crossover), each item a
+    message of its own, joined by ``sep``: a value of :meth:`Check.of`.
+
+    Parameters
+    ----------
+    sep : str
+        What goes between two items (``"; "``).
+    items : iterable of (str, dict)
+        Each item's message (marked ``N_``) and its values.
+
+    Returns
+    -------
+    tuple
+        The list as :meth:`Check.of` keeps it.
+    """
+    return ("parts", sep, tuple((m, tuple(sorted(v.items()))) for m, v in items))
+
+
+def _fill(message: str, values: tuple, translate: bool) -> str:
+    """``message`` with its ``values`` (a list of :func:`listing` written out), in the current language when
+    ``translate``; a value that is itself a word of the catalogue (a stage's role, "gain") translated too."""
+    word = _ if translate else str
+
+    def text(v):
+        if isinstance(v, tuple) and v[:1] == ("parts",):
+            return v[1].join(_fill(m, vals, translate) for m, vals in v[2])
+        return word(v)
+    return word(message).format(**{k: text(v) for k, v in values})
 
 
 def failed(checks) -> list:
