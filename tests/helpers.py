@@ -157,10 +157,14 @@ def vocabulary(lang: str = "es") -> tuple:
     return en - other - SHARED_WORDS, other - en - SHARED_WORDS
 
 
+#: a snake_case identifier (a check's id, ``phase_margin``; a figure's, ``overshoot_pct``): a name, not words
+IDENTIFIER = re.compile(r"\b\w+_\w+\b")
+
+
 def foreign(texts, words) -> list:
-    """The texts holding a word of ``words`` (:func:`vocabulary`), each with those words."""
-    return [(t, sorted({w.lower() for w in WORD.findall(t)} & words)) for t in texts
-            if {w.lower() for w in WORD.findall(t)} & words]
+    """The texts holding a word of ``words`` (:func:`vocabulary`; identifiers left out), each with those words."""
+    found = [(t, {w.lower() for w in WORD.findall(IDENTIFIER.sub(" ", t))} & words) for t in texts]
+    return [(t, sorted(ws)) for t, ws in found if ws]
 
 
 def sheet_command(exe: str, args, out, *more):

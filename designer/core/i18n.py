@@ -39,7 +39,8 @@ from pathlib import Path
 from .errors import DesignError
 
 __all__ = ["DEFAULT", "LANGUAGES", "N_", "catalogue", "check_language", "current", "extract", "gettext", "language",
-           "localise", "missing", "negotiate", "page_catalogue", "page_messages", "update_catalogue"]
+           "html_words", "localise", "missing", "negotiate", "page_catalogue", "page_messages",
+           "update_catalogue"]
 
 #: the languages a sheet can be written in (English first: the default and the source text)
 LANGUAGES = ("en", "es")

@@ -41,9 +41,10 @@ from ..core.i18n import N_, language, localise
 from ..core.i18n import gettext as _
 from ..core.jsonio import json_safe
 
-__all__ = ["BODE_POINTS", "LIBRARY", "MAINS", "TRACE_POINTS", "Superseded", "bundle_zip", "check_files",
-           "design_plant_task", "files_in", "histograms", "identify_page", "pid_page", "plant_page", "run",
-           "run_task", "temporaries_in", "warm_up", "written_since"]
+__all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "LIBRARY", "MAINS", "TRACES", "TRACE_POINTS", "Superseded",
+           "bundle_zip", "check_files", "checks_shown", "design_plant_task", "files_in", "histograms",
+           "identify_page", "pid_page", "plant_page", "run", "run_task", "series_text", "temporaries_in", "warm_up",
+           "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
