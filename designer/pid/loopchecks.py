@@ -172,27 +172,24 @@ def stage_checks(stable, levels, amp, step_v, rise, parts, name_of=str) -> list:
              {"unit": v.opamp, "role": role, "need": f"{v.slope_v_per_s / 1e6:.3g}",
               "delay": format_eng(v.slew_delay_s, 's')}) for role, v in levels.items() if not v.slew_ok]
     worst_role, worst_v = max(levels.items(), key=lambda kv: kv[1].slew_delay_s)
-    slew = dict(opamp=amp.name, rate=f"{amp.slew_v_per_s / 1e6:.3g}", budget=format_eng(budget, 's'))
-    if slow:
-        out.append(Check.of("slew_rate", False, N_("{opamp} slews at {rate} V/us; slewing may delay a stage by at most "
-                                                   "{budget} (5 % of the rise time). {slow}"),
-                            slow=listing("; ", slow), **slew))
-    else:
-        out.append(Check.of("slew_rate", True, N_("{opamp} slews at {rate} V/us; slewing may delay a stage by at most "
-                                                  "{budget} (5 % of the rise time). worst: {unit} {role}, {delay}"),
-                            unit=worst_v.opamp, role=worst_role, delay=format_eng(worst_v.slew_delay_s, 's'), **slew))
+    # one message for a pass, one for a failure, the values of both given (a message takes the ones it names)
+    out.append(Check.of("slew_rate", not slow,
+                        N_("{opamp} slews at {rate} V/us; slewing may delay a stage by at most {budget} (5 % of the "
+                           "rise time). {slow}") if slow else
+                        N_("{opamp} slews at {rate} V/us; slewing may delay a stage by at most {budget} (5 % of the "
+                           "rise time). worst: {unit} {role}, {delay}"),
+                        opamp=amp.name, rate=f"{amp.slew_v_per_s / 1e6:.3g}", budget=format_eng(budget, 's'),
+                        slow=listing("; ", slow), unit=worst_v.opamp, role=worst_role,
+                        delay=format_eng(worst_v.slew_delay_s, 's')))
     clip = [(N_("{unit} {role} {lo}..{hi} V"), {"unit": v.opamp, "role": role, "lo": f"{v.v_min:.3g}",
                                                   "hi": f"{v.v_max:.3g}"}) for role, v in levels.items() if not v.swing_ok]
-    swing = dict(opamp=amp.name, lo=f"{amp.vout_min:.3g}", hi=f"{amp.vout_max:.3g}", vcc=f"{amp.vcc:g}",
-                 vee=f"{amp.vee:g}", step=f"{step_v:g}")
-    if clip:
-        out.append(Check.of("output_swing", False, N_("{opamp} outputs reach {lo} V to {hi} V on {vcc}/{vee} V "
-                                                      "supplies for a {step} V square wave; would need {clip}"),
-                            clip=listing("; ", clip), **swing))
-    else:
-        out.append(Check.of("output_swing", True, N_("{opamp} outputs reach {lo} V to {hi} V on {vcc}/{vee} V "
-                                                     "supplies for a {step} V square wave; all stages stay inside"),
-                            **swing))
+    out.append(Check.of("output_swing", not clip,
+                        N_("{opamp} outputs reach {lo} V to {hi} V on {vcc}/{vee} V supplies for a {step} V square "
+                           "wave; would need {clip}") if clip else
+                        N_("{opamp} outputs reach {lo} V to {hi} V on {vcc}/{vee} V supplies for a {step} V square "
+                           "wave; all stages stay inside"),
+                        opamp=amp.name, lo=f"{amp.vout_min:.3g}", hi=f"{amp.vout_max:.3g}", vcc=f"{amp.vcc:g}",
+                        vee=f"{amp.vee:g}", step=f"{step_v:g}", clip=listing("; ", clip)))
     return out
 
 
