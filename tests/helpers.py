@@ -157,8 +157,9 @@ def vocabulary(lang: str = "es") -> tuple:
     return en - other - SHARED_WORDS, other - en - SHARED_WORDS
 
 
-#: a snake_case identifier (a check's id, ``phase_margin``; a figure's, ``overshoot_pct``): a name, not words
-IDENTIFIER = re.compile(r"\b\w+_\w+\b")
+#: a snake_case or lower-case hyphenated identifier (a check's id, ``phase_margin``; identify's methods and models,
+#: ``viteckova-double-pole``, typed as they are): a name, not words
+IDENTIFIER = re.compile(r"\b\w+_\w+\b|\b[a-z0-9]+(?:-[a-z0-9]+)+\b")
 
 
 def foreign(texts, words) -> list:

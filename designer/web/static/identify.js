@@ -96,11 +96,12 @@ async function identify() {
 }
 
 (async function () {
+  // a file chosen at once is taken at once (the format's menu, "auto" until it is filled, is auto)
+  D.dropZone(document.getElementById("drop"), document.getElementById("file"), files => { file = files[0]; identify(); });
+  D.liveForm(form, identify, () => file ? JSON.stringify([file.name, file.size, file.lastModified, D.options(form)]) : null);
   const c = await D.loadChoices();
   D.fill(form.querySelector("select[name=format]"), ["", ...c.formats], "");
   form.querySelector("select[name=format]").options[0].textContent = D.t("auto");
-  D.dropZone(document.getElementById("drop"), document.getElementById("file"), files => { file = files[0]; identify(); });
-  D.liveForm(form, identify, () => file ? JSON.stringify([file.name, file.size, file.lastModified, D.options(form)]) : null);
   document.getElementById("topid").onclick = () => {
     if (!last) return;
     sessionStorage.setItem("identify-result", JSON.stringify(last.result));
