@@ -1,6 +1,7 @@
 """What tests share: where things are, and the one way to find a console script
 (the running interpreter's bin folder, so a clone anywhere, any venv, works)."""
 
+import re
 import sys
 import tracemalloc
 from pathlib import Path
@@ -134,6 +135,37 @@ def english_left(page: str, lang: str = "es") -> list:
     from designer.core.i18n import catalogue
     english = {m for m, t in catalogue(lang).items() if t != m}
     return [n for n in sheet_text_nodes(page) if n in english or n.rstrip(":") in english]
+
+
+WORD = re.compile(r"[A-Za-zÀ-ÿ]{3,}")
+#: words the two languages share that the catalogue does not show as shared: units, symbols, proper names, file
+#: names and formats (each a name, the same in Spanish)
+SHARED_WORDS = {"ohm", "spice", "ngspice", "pyspice", "sallen", "key", "csv", "yaml", "zip", "json", "xml", "junit",
+                "markdown", "fopdt", "sopdt", "arx", "iae", "prbs", "gbw", "wilson", "tektronix", "rigol", "siglent",
+                "keysight", "picoscope", "digilent", "waveforms", "lab", "mso", "tds", "motor", "deg",
+                # identify's methods and models, and the tuning rules, by the names they are chosen by
+                "least", "squares", "overdamped", "underdamped", "optimize"}
+
+
+def vocabulary(lang: str = "es") -> tuple:
+    """(English-only words, ``lang``-only words) of the catalogue: the words of its English messages that no
+    translation uses, and the other way round (:data:`SHARED_WORDS` out of both)."""
+    from designer.core.i18n import catalogue
+    cat = catalogue(lang)
+    en = {w.lower() for m in cat for w in WORD.findall(m)}
+    other = {w.lower() for t in cat.values() for w in WORD.findall(t)}
+    return en - other - SHARED_WORDS, other - en - SHARED_WORDS
+
+
+#: a snake_case or lower-case hyphenated identifier (a check's id, ``phase_margin``; identify's methods and models,
+#: ``viteckova-double-pole``, typed as they are): a name, not words
+IDENTIFIER = re.compile(r"\b\w+_\w+\b|\b[a-z0-9]+(?:-[a-z0-9]+)+\b")
+
+
+def foreign(texts, words) -> list:
+    """The texts holding a word of ``words`` (:func:`vocabulary`; identifiers left out), each with those words."""
+    found = [(t, {w.lower() for w in WORD.findall(IDENTIFIER.sub(" ", t))} & words) for t in texts]
+    return [(t, sorted(ws)) for t, ws in found if ws]
 
 
 def sheet_command(exe: str, args, out, *more):

@@ -9,7 +9,7 @@ from .exports import lazy_exports
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "excitation": ("EDGE_FRACTION", "Excitation", "INPUT_KINDS", "MAX_CORNERS", "chirp_input", "file_input", "held", "prbs_input", "random_binary_input"),
-    "checks": ("Check", "IDS", "SPICE_AGREEMENT"),
+    "checks": ("Check", "IDS", "SPICE_AGREEMENT", "listing"),
     "compare": ("AGREEMENT", "disagreements", "metric_deltas", "nrms", "resample", "trapezoid_weights"),
     "errors": ("DeckError", "DesignError", "EXIT_BAD_INPUT", "EXIT_CHECK_FAILED", "EXIT_OK", "EXIT_SIMULATOR",
                "ParamError", "SimulatorError"),
@@ -22,7 +22,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                "link_into", "new_folder_beside", "open_limited", "os_error", "publish_folder", "read_text",
                "remove_tree", "show_cell", "shown", "size_text"),
     "i18n": ("DEFAULT", "LANGUAGES", "N_", "catalogue", "check_language", "current", "extract", "gettext", "language",
-             "localise", "missing", "update_catalogue"),
+             "html_words", "localise", "missing", "negotiate", "page_catalogue", "page_messages", "update_catalogue"),
     "jsonio": ("SCHEMA_VERSION", "json_safe", "read_result"),
     "lifetime": ("Interrupted", "WORDS", "die_with_parent", "finish", "forget", "install", "interruption", "native",
                  "on_exit", "owned_prefix", "preexec", "quiet", "remove_stale", "reset_in_child", "status_of",

@@ -20,6 +20,11 @@ Numbers: CLDR (through Babel's ``get_decimal_symbol``) gives the decimal symbol,
 a comma in Spanish (``1,6 kΩ``); Spanish sheets also write the ohm as ``Ω``
 (the SI symbol, as the seed documents do), where the English sheets keep ``Ohm``
 as they always have.
+
+The web page's words are messages of the same catalogue: its scripts' ``D.t("...")`` calls (Babel's
+JavaScript extractor) and its HTML's text, titles, placeholders and labels (:func:`page_messages`); the
+server answers them as JSON (:func:`page_catalogue`, ``GET /api/catalogue?lang=es``), a language
+negotiated from the browser's ``Accept-Language`` (:func:`negotiate`, Babel's ``negotiate_locale``).
 """
 
 from __future__ import annotations
@@ -34,7 +39,8 @@ from pathlib import Path
 from .errors import DesignError
 
 __all__ = ["DEFAULT", "LANGUAGES", "N_", "catalogue", "check_language", "current", "extract", "gettext", "language",
-           "localise", "missing", "update_catalogue"]
+           "html_words", "localise", "missing", "negotiate", "page_catalogue", "page_messages",
+           "update_catalogue"]
 
 #: the languages a sheet can be written in (English first: the default and the source text)
 LANGUAGES = ("en", "es")
@@ -45,6 +51,18 @@ LOCALE_DIR = Path(__file__).resolve().parent.parent / "locale"
 DOMAIN = "designer"
 #: the functions whose string arguments are messages (Babel's extractor looks for their calls)
 KEYWORDS = {"_": None, "gettext": None, "N_": None}
+#: the web page's files (its scripts and HTML; not the vendored plotting library)
+STATIC_DIR = LOCALE_DIR.parent / "web" / "static"
+#: the page's scripts mark their words as ``D.t("...")`` (translated there) or ``D.N_("...")`` (shown later),
+#: the first argument a string literal or literals joined by ``+``. (Babel's JavaScript extractor loses a call
+#: nested in another's arguments, ``D.t("{a}", {a: D.t("b")})``, which the page writes often: a regular
+#: expression over the call's literal is exact for this one form.)
+_JS_STRING = re.compile(r'"(?:[^"\\\n]|\\.)*"|\'(?:[^\'\\\n]|\\.)*\'')
+_PAGE_CALL = re.compile(r"\bD\.(?:t|N_)\(\s*((?:%s)(?:\s*\+\s*(?:%s))*)" % (_JS_STRING.pattern, _JS_STRING.pattern))
+#: the attributes of the page's HTML that a reader sees or hears
+PAGE_ATTRIBUTES = ("placeholder", "title", "aria-label", "alt")
+#: HTML's elements without an end tag
+VOID = ("area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source", "track", "wbr")
 
 _CURRENT = contextvars.ContextVar("designer_language", default=DEFAULT)
 
@@ -206,7 +224,7 @@ def localise(text: str) -> str:
 
 
 def extract(root: Path | None = None) -> dict:
-    """Every message the package marks (Babel's extractor over its Python files).
+    """Every message the package marks (Babel's extractor over its Python files; the web page's too).
 
     Parameters
     ----------
@@ -224,7 +242,136 @@ def extract(root: Path | None = None) -> dict:
     for path, line, msg, _comments, _context in extract_from_dir(str(root), [("**.py", "python")], keywords=KEYWORDS):
         if isinstance(msg, str) and msg:
             out.setdefault(msg, []).append(f"{path}:{line}")
+    if root == LOCALE_DIR.parent:   # the package's: its web page's words too
+        for msg, where in page_messages().items():
+            out.setdefault(msg, []).extend(where)
     return out
+
+
+def page_messages(root: Path | None = None) -> dict:
+    """Every message of the web page: its scripts' ``D.t("...")`` and ``D.N_("...")`` calls and its HTML's words.
+
+    Parameters
+    ----------
+    root : Path or None
+        The page's folder (default: this package's ``web/static``).
+
+    Returns
+    -------
+    dict
+        msgid -> the places it is marked ("path:line").
+    """
+    import ast
+    root = root or STATIC_DIR
+    out: dict = {}
+    for path in sorted(root.glob("*.js")):
+        text = path.read_text(encoding="utf-8")
+        for m in _PAGE_CALL.finditer(text):
+            msg = "".join(ast.literal_eval(lit) for lit in _JS_STRING.findall(m.group(1)))
+            if msg:
+                out.setdefault(msg, []).append(f"web/static/{path.name}:{text.count(chr(10), 0, m.start()) + 1}")
+    for path in sorted(root.glob("*.html")):
+        for line, msg in html_words(path.read_text(encoding="utf-8")):
+            out.setdefault(msg, []).append(f"web/static/{path.name}:{line}")
+    return out
+
+
+def html_words(html: str) -> list:
+    """The words of an HTML page as a reader meets them: each text between tags (spaces collapsed, as the
+    page's ``D.translatePage`` keys them) and each attribute of :data:`PAGE_ATTRIBUTES`; scripts, styles and
+    texts without a letter left out.
+
+    Parameters
+    ----------
+    html : str
+        The page.
+
+    Returns
+    -------
+    list
+        (line, text) pairs.
+    """
+    from html.parser import HTMLParser
+    found = []
+
+    def keep(text, line):
+        text = " ".join(text.split())
+        if re.search(r"[A-Za-z]", text):
+            found.append((line, text))
+
+    class Words(HTMLParser):
+        skip = 0
+        closes: list = []   # the tags whose end ends a skip (a script, a style, an element marked translate="no")
+
+        def handle_starttag(self, tag, attrs):
+            quiet = tag in ("script", "style") or ("translate", "no") in attrs
+            if quiet and tag not in VOID:
+                self.skip += 1
+                self.closes = self.closes + [tag]
+            for k, v in attrs:
+                if k in PAGE_ATTRIBUTES and v and not quiet and not self.skip:
+                    keep(v, self.getpos()[0])
+
+        def handle_endtag(self, tag):
+            if self.closes and self.closes[-1] == tag:
+                self.skip -= 1
+                self.closes = self.closes[:-1]
+
+        def handle_data(self, data):
+            if not self.skip:
+                keep(data, self.getpos()[0])
+
+    Words(convert_charrefs=True).feed(html)
+    return found
+
+
+def page_catalogue(lang) -> dict:
+    """What the web page needs to speak ``lang``: the catalogue's translations (the page's own words and the
+    library's it shows, check titles among them) and how the language writes a number.
+
+    Parameters
+    ----------
+    lang : str or None
+        A code of :data:`LANGUAGES` (checked: :func:`check_language`).
+
+    Returns
+    -------
+    dict
+        ``lang``, ``decimal`` (the decimal symbol, CLDR's) and ``messages`` (English -> translation; empty
+        for English).
+    """
+    lang = check_language(lang)
+    return {"lang": lang, "decimal": _decimal_symbol(lang),
+            "messages": {} if lang == "en" else dict(catalogue(lang))}
+
+
+def negotiate(accept_language: str | None) -> str:
+    """The language of :data:`LANGUAGES` a browser prefers (its ``Accept-Language`` header), else :data:`DEFAULT`.
+
+    Parameters
+    ----------
+    accept_language : str or None
+        The header (``es-ES,es;q=0.9,en;q=0.8``).
+
+    Returns
+    -------
+    str
+        A code of :data:`LANGUAGES`.
+    """
+    from babel import negotiate_locale
+    wanted = []
+    for item in str(accept_language or "").split(","):
+        tag, _, q = item.strip().partition(";q=")
+        try:
+            weight = float(q) if q else 1.0
+        except ValueError:
+            continue
+        if tag and weight > 0:
+            wanted.append((weight, tag.strip().replace("_", "-")))
+    ordered = [t for _w, t in sorted(wanted, key=lambda x: -x[0])]
+    # a region's code ("es-AR") reads as its language's
+    ordered = [p for t in ordered for p in (t, t.split("-")[0])]
+    return negotiate_locale(ordered, list(LANGUAGES), sep="-") or DEFAULT
 
 
 def missing(lang: str = "es") -> dict:

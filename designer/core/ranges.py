@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import DesignError
+from .i18n import gettext as _
 from .units import format_eng, parse_value
 
 __all__ = ["RANGES", "Range", "help_range", "parse_in_range"]
@@ -42,8 +43,9 @@ class Range:
     def text(self) -> str:
         """``"1 mHz to 10 MHz"``, for messages and --help."""
         lo, hi = _fmt(self.lo, self.unit), _fmt(self.hi, self.unit)
-        core = f"above {lo} up to {hi}" if self.lo_open else f"{lo} to {hi}"
-        return f"0 or {core}" if self.zero_ok else core
+        # (in the language of the request that is refused: the web page's; the command line's is English)
+        core = (_("above {lo} up to {hi}") if self.lo_open else _("{lo} to {hi}")).format(lo=lo, hi=hi)
+        return _("0 or {range}").format(range=core) if self.zero_ok else core
 
     def contains(self, value: float) -> bool:
         if self.zero_ok and value == 0:
@@ -55,10 +57,11 @@ class Range:
         """``value`` as a float if it is a real number inside the range, else a
         :class:`DesignError` starting with ``name`` (its ``param``)."""
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
-            raise DesignError(f"{name} must be a number, got {_short(value)}", param=name)
+            raise DesignError(_("{name} must be a number, got {got}").format(name=name, got=_short(value)), param=name)
         if not self.contains(value):
             got = shown if shown is not None else _show(value)
-            raise DesignError(f"{name} must be {self.text()}, got {got}", param=name)
+            raise DesignError(_("{name} must be {range}, got {got}").format(name=name, range=self.text(), got=got),
+                              param=name)
         return float(value)
 
 

@@ -36,6 +36,7 @@ import numpy as np
 
 from ..core import eseries
 from ..core.checks import Check
+from ..core.i18n import N_
 from ..core.errors import DesignError
 from ..core.units import format_eng
 
@@ -184,39 +185,49 @@ def static_checks(parts: PidParts, fn_hz: float, gbw_hz: float, targets: dict, *
             continue
         got = getattr(parts, key)
         e = got / want - 1
-        checks.append(Check(f"{label.lower()}_accuracy", abs(e) <= tol * (1 + 1e-9),
-                            f"{label} = {format_eng(got, unit)} for {format_eng(want, unit)} "
-                            f"({e * 100:+.2f} %, allowed +/-{tol * 100:g} %)"))
+        checks.append(Check.of(f"{label.lower()}_accuracy", abs(e) <= tol * (1 + 1e-9),
+                               N_("{name} = {got} for {want} ({error} %, allowed +/-{tol} %)"), name=label,
+                               got=format_eng(got, unit), want=format_eng(want, unit), error=f"{e * 100:+.2f}",
+                               tol=f"{tol * 100:g}"))
     fi = parts.f_integrator_hz
-    checks.append(Check("integrator_corner", fi <= fn_hz / CORNER_MARGIN,
-                        f"1/(2 pi R13 C4) = {format_eng(fi, 'Hz')}, must be below {fn_name}/{CORNER_MARGIN:g} = "
-                        f"{format_eng(fn_hz / CORNER_MARGIN, 'Hz')} ({fn_name} = {format_eng(fn_hz, 'Hz')})"))
+    checks.append(Check.of("integrator_corner", fi <= fn_hz / CORNER_MARGIN,
+                           N_("1/(2 pi R13 C4) = {corner}, must be below {fn}/{margin} = {limit} ({fn} = {f})"),
+                           corner=format_eng(fi, 'Hz'), fn=fn_name, margin=f"{CORNER_MARGIN:g}",
+                           limit=format_eng(fn_hz / CORNER_MARGIN, 'Hz'), f=format_eng(fn_hz, 'Hz')))
     if parts.has_derivative:
         fd = parts.f_differentiator_hz
-        checks.append(Check("differentiator_corner", fd >= fn_hz * CORNER_MARGIN,
-                            f"1/(2 pi R12 C3) = {format_eng(fd, 'Hz')}, must be above "
-                            f"{CORNER_MARGIN:g} {fn_name} = {format_eng(fn_hz * CORNER_MARGIN, 'Hz')}"))
-        f_need, why = fd, "the differentiator corner"
+        checks.append(Check.of("differentiator_corner", fd >= fn_hz * CORNER_MARGIN,
+                               N_("1/(2 pi R12 C3) = {corner}, must be above {margin} {fn} = {limit}"),
+                               corner=format_eng(fd, 'Hz'), margin=f"{CORNER_MARGIN:g}", fn=fn_name,
+                               limit=format_eng(fn_hz * CORNER_MARGIN, 'Hz')))
+        f_need = fd
     else:
-        f_need, why = CORNER_MARGIN * fn_hz, f"{CORNER_MARGIN:g} {fn_name}"
+        f_need = CORNER_MARGIN * fn_hz
     ng = parts.noise_gains()
     for stage, bw in parts.stage_bandwidths(gbw_hz).items():
-        checks.append(Check(f"bandwidth_{stage}", bw >= f_need,
-                            f"GBW/noise gain = {format_eng(gbw_hz, 'Hz')}/{ng[stage]:.3g} = "
-                            f"{format_eng(bw, 'Hz')}, must be above {why} ({format_eng(f_need, 'Hz')})"))
+        values = dict(gbw=format_eng(gbw_hz, 'Hz'), gain=f"{ng[stage]:.3g}", bw=format_eng(bw, 'Hz'),
+                      need=format_eng(f_need, 'Hz'))
+        if parts.has_derivative:
+            checks.append(Check.of(f"bandwidth_{stage}", bw >= f_need,
+                                   N_("GBW/noise gain = {gbw}/{gain} = {bw}, must be above the differentiator "
+                                      "corner ({need})"), **values))
+        else:
+            checks.append(Check.of(f"bandwidth_{stage}", bw >= f_need,
+                                   N_("GBW/noise gain = {gbw}/{gain} = {bw}, must be above {margin} {fn} ({need})"),
+                                   margin=f"{CORNER_MARGIN:g}", fn=fn_name, **values))
     rs, cs = parts.resistors(), parts.capacitors()
     bad_r = [f"{k} = {format_eng(v, 'Ohm')}" for k, v in rs.items()
              if not r_min * (1 - 1e-9) <= v <= r_max * (1 + 1e-9)]
     bad_c = [f"{k} = {format_eng(v, 'F')}" for k, v in cs.items()
              if not c_min * (1 - 1e-9) <= v <= c_max * (1 + 1e-9)]
-    checks.append(Check("resistor_bounds", not bad_r,
-                        (f"all resistors within {format_eng(r_min, 'Ohm')}..{format_eng(r_max, 'Ohm')} "
-                         f"(smallest {format_eng(min(rs.values()), 'Ohm')}, largest "
-                         f"{format_eng(max(rs.values()), 'Ohm')})") if not bad_r
-                        else "outside the bounds: " + ", ".join(bad_r)))
-    checks.append(Check("capacitor_bounds", not bad_c,
-                        f"all capacitors within {format_eng(c_min, 'F')}..{format_eng(c_max, 'F')}"
-                        if not bad_c else "outside the bounds: " + ", ".join(bad_c)))
+    checks.append(Check.of("resistor_bounds", True, N_("all resistors within {lo}..{hi} (smallest {small}, largest "
+                                                       "{large})"), lo=format_eng(r_min, 'Ohm'),
+                           hi=format_eng(r_max, 'Ohm'), small=format_eng(min(rs.values()), 'Ohm'),
+                           large=format_eng(max(rs.values()), 'Ohm')) if not bad_r else
+                  Check.of("resistor_bounds", False, N_("outside the bounds: {parts}"), parts=", ".join(bad_r)))
+    checks.append(Check.of("capacitor_bounds", True, N_("all capacitors within {lo}..{hi}"),
+                           lo=format_eng(c_min, 'F'), hi=format_eng(c_max, 'F')) if not bad_c else
+                  Check.of("capacitor_bounds", False, N_("outside the bounds: {parts}"), parts=", ".join(bad_c)))
     return checks
 
 

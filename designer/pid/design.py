@@ -21,6 +21,8 @@ import numpy as np
 
 from ..core import opamps
 from ..core.checks import Check
+from ..core.checks import listing
+from ..core.i18n import N_
 from ..core.errors import ParamError
 from ..core.lti import dominant_pair, response_span, step_response
 from ..core.metrics import StepMetrics
@@ -441,23 +443,28 @@ def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise, parts, nam
     out = []
     poles = lm.poles()
     worst = float(np.max(poles.real)) if poles.size else -math.inf
-    out.append(Check("closed_loop_stable", bool(stable),
-                     "all closed-loop poles in the left half plane" if stable else
-                     f"a closed-loop pole has real part {worst:+.4g} 1/s: the loop oscillates or latches at a rail"))
+    out.append(Check.of("closed_loop_stable", True, N_("all closed-loop poles in the left half plane")) if stable
+               else Check.of("closed_loop_stable", False, N_("a closed-loop pole has real part {re} 1/s: the loop "
+                                                             "oscillates or latches at a rail"), re=f"{worst:+.4g}"))
     pm = mg.phase_margin_deg
-    near = ""
+    close = []
     if math.isfinite(pm) and not amp.ideal:
         fc = mg.crossover_hz
-        close = [f"{k} {format_eng(v, 'Hz')}" for k, v in sorted(parts.stage_bandwidths(amp.gbw_hz).items(),
-                                                                  key=lambda kv: kv[1]) if v < 10 * fc]
+        close = [(N_("{stage} {f}"), {"stage": k, "f": format_eng(v, 'Hz')})
+                 for k, v in sorted(parts.stage_bandwidths(amp.gbw_hz).items(), key=lambda kv: kv[1]) if v < 10 * fc]
         if parts.has_derivative and parts.f_differentiator_hz < 10 * fc:
-            close.append(f"derivative filter {format_eng(parts.f_differentiator_hz, 'Hz')}")
-        if close:
-            near = "; poles within 10x of the crossover, each costing phase there: " + ", ".join(close)
-    out.append(Check("phase_margin", bool(math.isfinite(pm) and pm >= MIN_PHASE_MARGIN_DEG),
-                     (f"{pm:.3g} deg at {format_eng(mg.crossover_hz, 'Hz')} with the op-amp poles "
-                      f"(want >= {MIN_PHASE_MARGIN_DEG:g} deg){near}") if math.isfinite(pm)
-                     else "the loop gain never crosses 1"))
+            close.append((N_("derivative filter {f}"), {"f": format_eng(parts.f_differentiator_hz, 'Hz')}))
+    ok = bool(math.isfinite(pm) and pm >= MIN_PHASE_MARGIN_DEG)
+    margin = dict(pm=f"{pm:.3g}", fc=format_eng(mg.crossover_hz, 'Hz'), min=f"{MIN_PHASE_MARGIN_DEG:g}")
+    if not math.isfinite(pm):
+        out.append(Check.of("phase_margin", ok, N_("the loop gain never crosses 1")))
+    elif close:
+        out.append(Check.of("phase_margin", ok, N_("{pm} deg at {fc} with the op-amp poles (want >= {min} deg); poles "
+                                                   "within 10x of the crossover, each costing phase there: {poles}"),
+                            poles=listing(", ", close), **margin))
+    else:
+        out.append(Check.of("phase_margin", ok, N_("{pm} deg at {fc} with the op-amp poles (want >= {min} deg)"),
+                            **margin))
     return out + steady_state_check(dc_cl) + stage_checks(stable, levels, amp, step_v, rise, parts, name_of)
 
 

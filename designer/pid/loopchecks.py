@@ -15,7 +15,8 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from ..core.checks import Check
+from ..core.checks import Check, listing
+from ..core.i18n import N_
 from ..core.units import format_eng
 from . import model
 
@@ -122,9 +123,9 @@ def steady_state_check(dc_gain: float) -> list:
     if not math.isfinite(dc_gain):
         return []
     e = 1 - dc_gain
-    return [Check("steady_state_error", bool(abs(e) <= MAX_STEADY_STATE_ERROR),
-                  f"{100 * e:.3g} % of the step (the integrator leaks through R13; "
-                  f"want <= {100 * MAX_STEADY_STATE_ERROR:g} %)")]
+    return [Check.of("steady_state_error", abs(e) <= MAX_STEADY_STATE_ERROR,
+                     N_("{error} % of the step (the integrator leaks through R13; want <= {max} %)"),
+                     error=f"{100 * e:.3g}", max=f"{100 * MAX_STEADY_STATE_ERROR:g}")]
 
 
 def stage_checks(stable, levels, amp, step_v, rise, parts, name_of=str) -> list:
@@ -167,19 +168,28 @@ def stage_checks(stable, levels, amp, step_v, rise, parts, name_of=str) -> list:
                          f"{worst_sw.v_min:.3g} V to {worst_sw.v_max:.3g} V"))
         return out
     budget = model.SLEW_DELAY_FRACTION * rise
-    slow = [f"{v.opamp} {role} needs {v.slope_v_per_s / 1e6:.3g} V/us, slews for ~"
-            f"{format_eng(v.slew_delay_s, 's')}" for role, v in levels.items() if not v.slew_ok]
+    slow = [(N_("{unit} {role} needs {need} V/us, slews for ~{delay}"),
+             {"unit": v.opamp, "role": role, "need": f"{v.slope_v_per_s / 1e6:.3g}",
+              "delay": format_eng(v.slew_delay_s, 's')}) for role, v in levels.items() if not v.slew_ok]
     worst_role, worst_v = max(levels.items(), key=lambda kv: kv[1].slew_delay_s)
-    out.append(Check("slew_rate", not slow,
-                     f"{amp.name} slews at {amp.slew_v_per_s / 1e6:.3g} V/us; slewing may delay a stage by "
-                     f"at most {format_eng(budget, 's')} (5 % of the rise time). "
-                     + ("; ".join(slow) if slow else
-                        f"worst: {worst_v.opamp} {worst_role}, {format_eng(worst_v.slew_delay_s, 's')}")))
-    clip = [f"{v.opamp} {role} {v.v_min:.3g}..{v.v_max:.3g} V" for role, v in levels.items() if not v.swing_ok]
-    out.append(Check("output_swing", not clip,
-                     f"{amp.name} outputs reach {amp.vout_min:.3g} V to {amp.vout_max:.3g} V on "
-                     f"{amp.vcc:g}/{amp.vee:g} V supplies for a {step_v:g} V square wave; "
-                     + ("would need " + "; ".join(clip) if clip else "all stages stay inside")))
+    # one message for a pass, one for a failure, the values of both given (a message takes the ones it names)
+    out.append(Check.of("slew_rate", not slow,
+                        N_("{opamp} slews at {rate} V/us; slewing may delay a stage by at most {budget} (5 % of the "
+                           "rise time). {slow}") if slow else
+                        N_("{opamp} slews at {rate} V/us; slewing may delay a stage by at most {budget} (5 % of the "
+                           "rise time). worst: {unit} {role}, {delay}"),
+                        opamp=amp.name, rate=f"{amp.slew_v_per_s / 1e6:.3g}", budget=format_eng(budget, 's'),
+                        slow=listing("; ", slow), unit=worst_v.opamp, role=worst_role,
+                        delay=format_eng(worst_v.slew_delay_s, 's')))
+    clip = [(N_("{unit} {role} {lo}..{hi} V"), {"unit": v.opamp, "role": role, "lo": f"{v.v_min:.3g}",
+                                                  "hi": f"{v.v_max:.3g}"}) for role, v in levels.items() if not v.swing_ok]
+    out.append(Check.of("output_swing", not clip,
+                        N_("{opamp} outputs reach {lo} V to {hi} V on {vcc}/{vee} V supplies for a {step} V square "
+                           "wave; would need {clip}") if clip else
+                        N_("{opamp} outputs reach {lo} V to {hi} V on {vcc}/{vee} V supplies for a {step} V square "
+                           "wave; all stages stay inside"),
+                        opamp=amp.name, lo=f"{amp.vout_min:.3g}", hi=f"{amp.vout_max:.3g}", vcc=f"{amp.vcc:g}",
+                        vee=f"{amp.vee:g}", step=f"{step_v:g}", clip=listing("; ", clip)))
     return out
 
 

@@ -110,7 +110,7 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
         f"{_v(result.fc_ref_hz, 'Hz')}, the crossover of the ideal PID around the model (near fc/100 and "
         "10 fc unless set).")]))
     out.append((_("Checks"), [R.table([_("check"), _("result"), _("detail")],
-                                      [[c.id, _("ok") if c.ok else _("FAILED"), c.detail] for c in result.checks])]))
+                                      [[c.id, _("ok") if c.ok else _("FAILED"), c.shown()] for c in result.checks])]))
     out.append((_("Closed loop"), _loop_blocks(result, with_images)))
     heading = tolerance_title(result, worst=True)
     if heading is not None:

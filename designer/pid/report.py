@@ -121,7 +121,7 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     out.append((_("Tuning"), _tuning_blocks(result)))
     out.append((_("Target and achieved"), _achieved_blocks(result)))
     out.append((_("Checks"), [R.table([_("check"), _("result"), _("detail")],
-                                      [[c.id, _("ok") if c.ok else _("FAILED"), c.detail] for c in result.checks])]))
+                                      [[c.id, _("ok") if c.ok else _("FAILED"), c.shown()] for c in result.checks])]))
     out.append((_("Closed loop"), _loop_blocks(result, with_images)))
     heading = tolerance_title(result, worst=True)
     if heading is not None:
@@ -144,7 +144,7 @@ def _build_blocks(result, b, rows, with_images, schematic_svg) -> list:
 def _wiring_blocks(result, b, first_rows=(), after: str = "") -> list:
     """The packages and the pin-level wiring table of board ``b``; ``first_rows``
     (part, code, from, to) go before the board's rows, ``after`` closes the intro."""
-    return [R.text(_("{part} in {pinout} packages: ").format(part=b.package.part, pinout=b.package.pinout)
+    return [R.text(_("{part} in {pinout} packages: ").format(part=b.package.part, pinout=_(b.package.pinout))
                    + ", ".join(f"{u.designator} {_(a.role)}" for a, u in zip(b.netlist.amps, b.units))
                    + ". Kp = R5 R3/(R6 R4), Ti = R8 R14 C4/R6, Td = R6 R11 C3/R7." + after),
             R.table([_("part"), _("code"), _("from"), _("to")],

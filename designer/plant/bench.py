@@ -76,16 +76,19 @@ def signal_checks(t, y_unit, amplitude_v: float, opamp: OpAmp) -> list:
     # the falling edge undershoots below 0 by as much as the rising edge overshoots
     trough = -(float(np.max(y_unit)) - float(y_unit[-1])) * amplitude_v
     if opamp.ideal:
-        return [Check("slew_rate", True, f"ideal op-amp; output needs {slope / 1e6:.3g} V/us"),
-                Check("output_swing", True, f"ideal op-amp; output spans {trough:.3g} V to {peak:.3g} V")]
+        return [Check.of("slew_rate", True, N_("ideal op-amp; output needs {need} V/us"), need=f"{slope / 1e6:.3g}"),
+                Check.of("output_swing", True, N_("ideal op-amp; output spans {lo} V to {hi} V"),
+                         lo=f"{trough:.3g}", hi=f"{peak:.3g}")]
     sr = opamp.slew_v_per_s
     slew_ok = slope <= 0.5 * sr
-    return [Check("slew_rate", slew_ok,
-                  f"output needs {slope / 1e6:.3g} V/us, {opamp.name} gives {sr / 1e6:.3g} V/us"
-                  + ("" if slew_ok else " (keep below half of it: lower the amplitude)")),
-            Check("output_swing", peak <= opamp.vout_max and trough >= opamp.vout_min,
-                  f"output spans {trough:.3g} V to {peak:.3g} V; {opamp.name} on {opamp.vcc:g}/{opamp.vee:g} V "
-                  f"reaches {opamp.vout_min:.3g} V to {opamp.vout_max:.3g} V")]
+    return [Check.of("slew_rate", slew_ok,
+                     N_("output needs {need} V/us, {opamp} gives {have} V/us") if slew_ok else
+                     N_("output needs {need} V/us, {opamp} gives {have} V/us (keep below half of it: lower the "
+                        "amplitude)"), need=f"{slope / 1e6:.3g}", opamp=opamp.name, have=f"{sr / 1e6:.3g}"),
+            Check.of("output_swing", peak <= opamp.vout_max and trough >= opamp.vout_min,
+                     N_("output spans {lo} V to {hi} V; {opamp} on {vcc}/{vee} V reaches {min} V to {max} V"),
+                     lo=f"{trough:.3g}", hi=f"{peak:.3g}", opamp=opamp.name, vcc=f"{opamp.vcc:g}",
+                     vee=f"{opamp.vee:g}", min=f"{opamp.vout_min:.3g}", max=f"{opamp.vout_max:.3g}")]
 
 
 def period_check(test: SquareTest, settling_time_s: float) -> Check | None:
@@ -93,9 +96,10 @@ def period_check(test: SquareTest, settling_time_s: float) -> Check | None:
     settling time (the scope would never show a settled step); None when it is not."""
     if test.half_period_s >= settling_time_s:
         return None
-    return Check("square_wave_period", False,
-                 f"half period {test.half_period_s * 1e6:.4g} us is shorter than the 2 % settling "
-                 f"time {settling_time_s * 1e6:.4g} us: the scope will not show a settled step")
+    return Check.of("square_wave_period", False,
+                    N_("half period {half} us is shorter than the 2 % settling time {settling} us: the scope will "
+                       "not show a settled step"), half=f"{test.half_period_s * 1e6:.4g}",
+                    settling=f"{settling_time_s * 1e6:.4g}")
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from ..core.checks import Check
+from ..core.i18n import N_
 from ..core.prbs import PrbsPlan, plan_for_plant
 
 __all__ = ["MAX_INTERVALS", "PERIODS", "SAMPLES_PER_INTERVAL", "model_response", "op_amp_checks", "plan_for_result",
@@ -171,17 +172,20 @@ def op_amp_checks(t, y, opamp) -> tuple:
     """
     lo, hi = float(np.min(y)), float(np.max(y))
     slope = float(np.max(np.abs(np.diff(y)))) / float(t[1] - t[0])
-    span = f"output spans {lo:.3g} V to {hi:.3g} V"
+    span = {"lo": f"{lo:.3g}", "hi": f"{hi:.3g}"}
+    need = f"{slope / 1e6:.3g}"
     if opamp.ideal:
-        return (Check("prbs_output_swing", True, f"ideal op-amp; {span}"),
-                Check("prbs_slew_rate", True, f"ideal op-amp; output needs {slope / 1e6:.3g} V/us"))
+        return (Check.of("prbs_output_swing", True, N_("ideal op-amp; output spans {lo} V to {hi} V"), **span),
+                Check.of("prbs_slew_rate", True, N_("ideal op-amp; output needs {need} V/us"), need=need))
     sr = opamp.slew_v_per_s
-    return (Check("prbs_output_swing", lo >= opamp.vout_min and hi <= opamp.vout_max,
-                  f"under the PRBS the {span}; {opamp.name} reaches {opamp.vout_min:.3g} V to "
-                  f"{opamp.vout_max:.3g} V"),
-            Check("prbs_slew_rate", slope <= 0.5 * sr,
-                  f"under the PRBS the output needs {slope / 1e6:.3g} V/us, {opamp.name} gives {sr / 1e6:.3g} V/us"
-                  + ("" if slope <= 0.5 * sr else " (keep below half of it: lower the amplitude)")))
+    return (Check.of("prbs_output_swing", lo >= opamp.vout_min and hi <= opamp.vout_max,
+                     N_("under the PRBS the output spans {lo} V to {hi} V; {opamp} reaches {min} V to {max} V"),
+                     **span, opamp=opamp.name, min=f"{opamp.vout_min:.3g}", max=f"{opamp.vout_max:.3g}"),
+            Check.of("prbs_slew_rate", slope <= 0.5 * sr,
+                     N_("under the PRBS the output needs {need} V/us, {opamp} gives {have} V/us")
+                     if slope <= 0.5 * sr else
+                     N_("under the PRBS the output needs {need} V/us, {opamp} gives {have} V/us (keep below half "
+                        "of it: lower the amplitude)"), need=need, opamp=opamp.name, have=f"{sr / 1e6:.3g}"))
 
 
 def prbs_run(result, plan: PrbsPlan, simulate: bool = True, simulator: str = "pyspice") -> PrbsRun:

@@ -60,7 +60,8 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     b = build_board(result)
     first = [R.subhead(_("Bill of materials")),
              R.table([_("Ref"), _("Value"), _("Code"), _("Qty"), _("Series"), _("Tol."), _("Package")],
-                     [r[:7] for r in bom(result, b)], "compact"),
+                     # the package by its name in the sheet's language (designer.report.wiring.CATALOGUE_WORDS)
+                     [[*r[:6], _(r[6])] for r in bom(result, b)], "compact"),
              R.subhead(_("Generator and scope")), *_settings(result)]
     fig = [R.figure("schematic.png", schematic_svg, _("schematic"))] if with_images else []
     out = [(_("Build"), [R.columns(fig, first)] if with_images else first),
@@ -70,7 +71,7 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
            *([(_("Bench test under a PRBS (--stimulus prbs)"), _prbs(result))] if result.prbs is not None else []),
            (_("Target and achieved"), _targets(result)),
            (_("Checks"), [R.table([_("check"), _("result"), _("detail")],
-                                  [[_(c.title), _("ok") if c.ok else _("FAILED"), c.detail] for c in result.checks])])]
+                                  [[_(c.title), _("ok") if c.ok else _("FAILED"), c.shown()] for c in result.checks])])]
     if result.spice is not None:
         out.append((_("SPICE against the analytic models"), _spice(result)))
     if with_images:

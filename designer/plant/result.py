@@ -17,6 +17,7 @@ import numpy as np
 
 from ..core import eseries
 from ..core.checks import SPICE_AGREEMENT, Check
+from ..core.i18n import N_
 from ..core.jsonio import SCHEMA_VERSION, json_safe
 from ..core.metrics import StepMetrics
 from ..core.opamps import OpAmp
@@ -249,9 +250,11 @@ class PlantResult:
         if self.spice is None:
             return list(self.checks)
         cmp_ = self.spice.comparison
-        detail = ("; ".join(cmp_.disagreements) if cmp_.disagreements else
-                  f"waveform NRMS {self.spice.nrms:.3g} (below 1) and every step figure within its allowance")
-        return list(self.checks) + [Check(SPICE_AGREEMENT, cmp_.passed, detail)]
+        if cmp_.disagreements:
+            return list(self.checks) + [Check(SPICE_AGREEMENT, cmp_.passed, "; ".join(cmp_.disagreements))]
+        return list(self.checks) + [Check.of(SPICE_AGREEMENT, cmp_.passed, N_("waveform NRMS {nrms} (below 1) and "
+                                                                              "every step figure within its allowance"),
+                                             nrms=f"{self.spice.nrms:.3g}")]
 
     def to_dict(self) -> dict:
         d = self._to_dict()

@@ -13,13 +13,18 @@ from __future__ import annotations
 import csv
 import io
 
+from ..core.i18n import N_
 from ..core.i18n import gettext as _
 from ..core.units import format_eng, value_code
 
-__all__ = ["BOM_HEADER", "bench_rows", "bom_csv", "bom_rows", "net_text", "wiring_rows"]
+__all__ = ["BOM_HEADER", "CATALOGUE_WORDS", "bench_rows", "bom_csv", "bom_rows", "net_text", "wiring_rows"]
 
 #: bill of materials columns (bom.csv and the sheet)
 BOM_HEADER = ("Ref", "Value", "Code", "Qty", "Series", "Tolerance", "Package", "Description")
+#: the words of the op-amp catalogue (designer/core/data/opamps.json) a sheet shows: the packages' names and the
+#: notes of the pins left open; translated where they are shown (bom.csv keeps them as the catalogue has them)
+CATALOGUE_WORDS = (N_("DIP-8 single"), N_("DIP-8 dual"), N_("DIP-14 quad"), N_("offset null (leave open)"),
+                   N_("not connected"))
 
 
 def _package_of(part) -> str:
@@ -179,7 +184,7 @@ def wiring_rows(board, labels: dict, supplies: tuple) -> list:
     dec = board.decoupling
     for i, ic in enumerate(board.ics):
         opened = (_("; pins {pins} open ({what})").format(pins=", ".join(str(k) for k in pkg.unused),
-                                                          what=", ".join(sorted(set(pkg.unused.values()))))
+                                                          what=", ".join(sorted({_(v) for v in pkg.unused.values()})))
                   if pkg.unused else "")
         supply = _("pin {pin} ({rail}): {v} V, {cap} 100n to ground at the pin")
         rows.append([ic, pkg.part, supply.format(pin=pkg.vcc, rail="V+", v=f"{vcc:+g}", cap=dec[2 * i].ref),

@@ -123,13 +123,25 @@ def create_app(pool, trust: Trust):
     async def choices_endpoint(request):
         return JSONResponse(choices)
 
+    async def catalogue_endpoint(request):
+        # the page's words in a language of the list (never a path: the code picks the catalogue's file);
+        # none asked: the browser's Accept-Language
+        from ..core import i18n
+        lang = request.query_params.get("lang") or i18n.negotiate(request.headers.get("accept-language"))
+        try:
+            return JSONResponse(i18n.page_catalogue(lang), headers={"Cache-Control": "no-cache"})
+        except DesignError as exc:
+            return _error(400, f"designer-web: error: {exc}")
+
     async def run(request, prog: str, argv: list | None, want: str, tmp: str, upload_name: str | None = None,
-                  fields: dict | None = None):
+                  fields: dict | None = None, lang: str | None = None):
         # the task goes to the pool as its file's name: a message of a hundred bytes, so that the pipe to the
         # pool never fills while the pool is sending a long answer the other way (each would wait on the other)
         task_file = os.path.join(tmp, "task.json")
         task = {"prog": prog, "want": want, "tmp": tmp}
         task.update({"fields": fields} if prog in LIBRARY else {"argv": argv})
+        if lang is not None:
+            task["lang"] = lang
         with open(task_file, "w", encoding="utf-8") as fh:
             json.dump(task, fh)
         try:
@@ -204,10 +216,11 @@ def create_app(pool, trust: Trust):
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
             try:
+                options, lang = req.split_language(options)   # identify has no --lang: its page's words
                 argv = [path] + req.build_argv(options, tmp, traits[prog]) + ["--json"]
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
-            return await run(request, prog, argv, _view(request), tmp, name)
+            return await run(request, prog, argv, _view(request), tmp, name, lang=lang)
 
     async def check(request: Request):
         prog = "check-design"
@@ -238,6 +251,7 @@ def create_app(pool, trust: Trust):
     routes += [Route("/static/{path:path}", static_file), Route("/api/health", health),
                Route("/favicon.ico", no_icon),
                Route("/api/choices", choices_endpoint),
+               Route("/api/catalogue", catalogue_endpoint),
                Route("/api/plant", designing("design-plant"), methods=["POST"]),
                Route("/api/plant/sheet", designing("design-plant", "sheet"), methods=["POST"]),
                Route("/api/plant/bundle", designing("design-plant", "bundle"), methods=["POST"]),

@@ -19,6 +19,8 @@ import re
 from typing import NamedTuple
 
 from ..core.errors import DesignError, ParamError
+from ..core.i18n import N_, localise
+from ..core.i18n import gettext as _
 from .request import option_name, value_text
 
 __all__ = ["FILTER", "Field", "FilterRequest", "PLANT", "PlantRequest", "field_of", "filter_request", "page_message",
@@ -35,53 +37,53 @@ class Field(NamedTuple):
 
 #: the plant page's fields (the API's keys, as design-plant's option names) -> parameter and label
 PLANT = {
-    "fc": Field("fc_hz", "fc (Hz)"), "zeta": Field("zeta", "zeta"), "gain": Field("gain", "gain K"),
-    "compensate-gbw": Field("compensate_gbw", "compensate the op-amp's GBW", "switch"),
-    "r": Field("r", "R fixed (Ohm)"), "c": Field("c", "C fixed (F)"),
-    "r-series": Field("r_series", "R series"), "c-series": Field("c_series", "C series"),
-    "r-min": Field("r_min", "R min"), "r-max": Field("r_max", "R max"),
-    "c-min": Field("c_min", "C min"), "c-max": Field("c_max", "C max"),
-    "alternatives": Field("alternatives", "alternatives listed"),
-    "opamp": Field("opamp", "op-amp"), "amplitude": Field("amplitude_v", "amplitude (V)"),
-    "square-freq": Field("square_hz", "square wave (Hz)"), "package": Field("package", "package"),
-    "no-sim": Field("no_sim", "skip SPICE", "switch"), "simulator": Field("simulator", "simulator"),
-    "name": Field("name", "design name"), "topology": Field("topology", "topology"),
+    "fc": Field("fc_hz", N_("fc (Hz)")), "zeta": Field("zeta", N_("zeta")), "gain": Field("gain", N_("gain K")),
+    "compensate-gbw": Field("compensate_gbw", N_("compensate the op-amp's GBW"), "switch"),
+    "r": Field("r", N_("R fixed (Ohm)")), "c": Field("c", N_("C fixed (F)")),
+    "r-series": Field("r_series", N_("R series")), "c-series": Field("c_series", N_("C series")),
+    "r-min": Field("r_min", N_("R min")), "r-max": Field("r_max", N_("R max")),
+    "c-min": Field("c_min", N_("C min")), "c-max": Field("c_max", N_("C max")),
+    "alternatives": Field("alternatives", N_("alternatives listed")),
+    "opamp": Field("opamp", N_("op-amp")), "amplitude": Field("amplitude_v", N_("amplitude (V)")),
+    "square-freq": Field("square_hz", N_("square wave (Hz)")), "package": Field("package", N_("package")),
+    "no-sim": Field("no_sim", N_("skip SPICE"), "switch"), "simulator": Field("simulator", N_("simulator")),
+    "name": Field("name", N_("design name")), "topology": Field("topology", N_("topology")),
     # the tolerance panel (a MonteCarloSpec)
-    "monte-carlo": Field("n", "Monte Carlo builds"), "seed": Field("seed", "seed"),
-    "tol": Field("tol", "tolerances", "list"), "limit": Field("limits", "limits", "list"),
-    "dist": Field("dist", "distribution"), "sampler": Field("sampler", "sampler"),
-    "target-ci": Field("target_ci", "target interval"), "engine": Field("engine", "engine"),
-    "spice-samples": Field("spice_samples", "SPICE samples"),
-    "worst-case": Field("worst_case", "worst case", "switch"),
-    "stimulus": Field("stimulus", "stimulus"), "prbs-bits": Field("bits", "PRBS bits"),
-    "prbs-clock": Field("clock_hz", "PRBS clock (Hz)"),
+    "monte-carlo": Field("n", N_("Monte Carlo builds")), "seed": Field("seed", N_("seed")),
+    "tol": Field("tol", N_("tolerances"), "list"), "limit": Field("limits", N_("limits"), "list"),
+    "dist": Field("dist", N_("distribution")), "sampler": Field("sampler", N_("sampler")),
+    "target-ci": Field("target_ci", N_("target interval")), "engine": Field("engine", N_("engine")),
+    "spice-samples": Field("spice_samples", N_("SPICE samples")),
+    "worst-case": Field("worst_case", N_("worst case"), "switch"),
+    "stimulus": Field("stimulus", N_("stimulus")), "prbs-bits": Field("bits", N_("PRBS bits")),
+    "prbs-clock": Field("clock_hz", N_("PRBS clock (Hz)")),
 }
 #: the filter page's fields (the API's keys, as design-filter's option names) -> parameter and label
 FILTER = {
-    "type": Field("filter_type", "type"), "family": Field("family", "family"),
-    "order": Field("order", "order"), "fc": Field("fc_hz", "fc (Hz)"), "ripple": Field("ripple_db", "ripple (dB)"),
-    "bessel-norm": Field("bessel_norm", "Bessel cut-off"), "chebyshev-cutoff": Field("chebyshev_cutoff",
-                                                                                      "Chebyshev cut-off"),
-    "passband": Field("passband_hz", "passband edge (Hz)"), "max-loss": Field("max_loss_db", "max loss (dB)"),
-    "stopband": Field("stopband_hz", "stopband edge (Hz)"),
-    "min-attenuation": Field("min_attenuation_db", "min attenuation (dB)"),
-    "f-low": Field("f_low_hz", "low edge (Hz)"), "f-high": Field("f_high_hz", "high edge (Hz)"),
-    "bandpass-method": Field("bandpass_method", "band-pass method"),
-    "topology": Field("topology", "topology"), "stage-order": Field("stage_order", "stage order"),
-    "gain": Field("gain", "gain (V/V)"), "stage-gain": Field("stage_gains", "stage gains"),
-    "opamp": Field("opamp", "op-amp"), "amplitude": Field("amplitude_v", "amplitude (V)"),
-    "gbw-margin": Field("gbw_margin", "GBW margin"), "impedance": Field("impedance_ohm", "impedance (Ohm)"),
-    "compensate-gbw": Field("compensate_gbw", "compensate the op-amp's GBW", "switch"),
-    "series": Field("r_series", "R series"), "c-series": Field("c_series", "C series"),
-    "r-min": Field("r_min", "R min"), "r-max": Field("r_max", "R max"),
-    "c-min": Field("c_min", "C min"), "c-max": Field("c_max", "C max"),
-    "no-sim": Field("no_sim", "skip SPICE", "switch"), "simulator": Field("simulator", "simulator"),
-    "name": Field("name", "design name"),
+    "type": Field("filter_type", N_("type")), "family": Field("family", N_("family")),
+    "order": Field("order", N_("order")), "fc": Field("fc_hz", N_("fc (Hz)")), "ripple": Field("ripple_db", N_("ripple (dB)")),
+    "bessel-norm": Field("bessel_norm", N_("Bessel cut-off")), "chebyshev-cutoff": Field("chebyshev_cutoff",
+                                                                                      N_("Chebyshev cut-off")),
+    "passband": Field("passband_hz", N_("passband edge (Hz)")), "max-loss": Field("max_loss_db", N_("max loss (dB)")),
+    "stopband": Field("stopband_hz", N_("stopband edge (Hz)")),
+    "min-attenuation": Field("min_attenuation_db", N_("min attenuation (dB)")),
+    "f-low": Field("f_low_hz", N_("low edge (Hz)")), "f-high": Field("f_high_hz", N_("high edge (Hz)")),
+    "bandpass-method": Field("bandpass_method", N_("band-pass method")),
+    "topology": Field("topology", N_("topology")), "stage-order": Field("stage_order", N_("stage order")),
+    "gain": Field("gain", N_("gain (V/V)")), "stage-gain": Field("stage_gains", N_("stage gains")),
+    "opamp": Field("opamp", N_("op-amp")), "amplitude": Field("amplitude_v", N_("amplitude (V)")),
+    "gbw-margin": Field("gbw_margin", N_("GBW margin")), "impedance": Field("impedance_ohm", N_("impedance (Ohm)")),
+    "compensate-gbw": Field("compensate_gbw", N_("compensate the op-amp's GBW"), "switch"),
+    "series": Field("r_series", N_("R series")), "c-series": Field("c_series", N_("C series")),
+    "r-min": Field("r_min", N_("R min")), "r-max": Field("r_max", N_("R max")),
+    "c-min": Field("c_min", N_("C min")), "c-max": Field("c_max", N_("C max")),
+    "no-sim": Field("no_sim", N_("skip SPICE"), "switch"), "simulator": Field("simulator", N_("simulator")),
+    "name": Field("name", N_("design name")),
     # the tolerance panel (a MonteCarloSpec, run against the mask)
-    "monte-carlo": Field("n", "Monte Carlo builds"), "seed": Field("seed", "seed"),
-    "tol": Field("tol", "tolerances", "list"), "limit": Field("limits", "limits", "list"),
-    "dist": Field("dist", "distribution"), "sampler": Field("sampler", "sampler"),
-    "worst-case": Field("worst_case", "worst case", "switch"),
+    "monte-carlo": Field("n", N_("Monte Carlo builds")), "seed": Field("seed", N_("seed")),
+    "tol": Field("tol", N_("tolerances"), "list"), "limit": Field("limits", N_("limits"), "list"),
+    "dist": Field("dist", N_("distribution")), "sampler": Field("sampler", N_("sampler")),
+    "worst-case": Field("worst_case", N_("worst case"), "switch"),
 }
 #: the simulators a request may choose (designer.spice.simulate's backends)
 SIMULATORS = ("pyspice", "ngspice-cli")
@@ -138,16 +140,17 @@ def page_message(exc: DesignError, table: dict) -> tuple:
         The message with each parameter (and each ``--flag`` the library wrote) as its field's label,
         quoted; and the field of the parameter it names first.
     """
-    labels = {f.param: f'"{f.label}"' for f in table.values()}
+    labels = {f.param: f'"{_(f.label)}"' for f in table.values()}
     text = exc.naming(labels) if callable(getattr(exc, "naming", None)) else str(exc)
     # a flag the library wrote, outside the values it quotes ('--help' given as a value stays as given)
-    parts = _QUOTED.split(text)
+    # the numbers as the page's language writes them (a value quoted as given stays as given)
+    parts = [p if k % 2 else localise(p) for k, p in enumerate(_QUOTED.split(text))]
     # a library name the message writes in its text ("unknown filter_type 'foo'"): the field's label
     names = re.compile(r"(?<![\w.{-])(" + "|".join(sorted((re.escape(f.param) for f in table.values() if "_" in f.param),
                                                           key=len, reverse=True)) + r")(?![\w=])")
 
     def words(p):
-        p = _FLAG.sub(lambda m: f'"{table[m.group(1)].label}"' if m.group(1) in table
+        p = _FLAG.sub(lambda m: f'"{_(table[m.group(1)].label)}"' if m.group(1) in table
                       else m.group(1).replace("-", " "), p)
         return names.sub(lambda m: labels[m.group(1)], p)
     text = "".join(p if k % 2 else words(p) for k, p in enumerate(parts))

@@ -37,6 +37,8 @@ from ..cli import pid as cli_pid
 from ..cli import plant as cli_plant
 from ..cli.common import RESULT_HOOK, run_cli
 from ..core import lifetime
+from ..core.i18n import N_, language, localise
+from ..core.i18n import gettext as _
 from ..core.jsonio import json_safe
 from ..core.units import format_eng
 # the filter stack (scipy.signal's prototypes, the sheet) imported here, in the server process before it forks the
@@ -45,9 +47,10 @@ from ..filters import report as filter_report
 from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
 
-__all__ = ["BODE_POINTS", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACE_POINTS", "Superseded", "bundle_zip", "check_files",
-           "circuit_plant_page", "design_filter_task", "design_plant_task", "files_in", "filter_page", "histograms", "identify_page",
-           "pid_page", "plant_page", "run", "run_task", "temporaries_in", "warm_up", "written_since"]
+__all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACES", "TRACE_POINTS",
+           "Superseded", "bundle_zip", "check_files", "checks_shown", "circuit_plant_page", "design_filter_task",
+           "design_plant_task", "files_in", "filter_page", "histograms", "identify_page", "pid_page", "plant_page",
+           "run", "run_task", "series_text", "temporaries_in", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
@@ -132,7 +135,8 @@ def run_task(task: dict) -> dict:
         for the designing commands), ``want``: "page" (the JSON and the page's
         extras), "json", "sheet" (the printable build sheet), "bundle" (the
         design's files as a zip) or "check" (check-design's files); ``tmp``:
-        the request's private folder (files written there), or None.
+        the request's private folder (files written there), or None; ``lang``: the language of the page's
+        words (a command with ``--lang`` takes it from there).
 
     Returns
     -------
@@ -149,6 +153,8 @@ def run_task(task: dict) -> dict:
     if "fields" in task:
         return LIBRARY[task["prog"]](task["fields"], task.get("want", "json"), task.get("tmp"))
     prog, argv, want, tmp = task["prog"], list(task["argv"]), task.get("want", "json"), task.get("tmp")
+    # the page's language: a sheet command's --lang, or the server's (a command without --lang: identify)
+    lang = task.get("lang") or _lang_of(argv)
     seen = {}
     out, err = io.StringIO(), io.StringIO()
     token = RESULT_HOOK.set(lambda result, name: seen.update(result=result, name=name))
@@ -156,7 +162,7 @@ def run_task(task: dict) -> dict:
     argv0 = sys.argv
     sys.argv = [prog, *argv]   # the JSON's tool.argv: the command line this request stands for
     try:
-        with redirect_stdout(out), redirect_stderr(err), temporaries_in(tmp):
+        with redirect_stdout(out), redirect_stderr(err), temporaries_in(tmp), language(lang):
             if prog in ("identify", "identify-freq"):
                 status = _identify(prog, argv, seen)
             else:
@@ -171,7 +177,8 @@ def run_task(task: dict) -> dict:
     if prog in ("identify", "identify-freq"):
         answer["json"] = seen["json"]
         if want == "page":
-            answer["page"] = identify_page(seen["result"])
+            with language(lang):
+                answer["page"] = identify_page(seen["result"])
         return answer
     if prog == "check-design":
         answer.update(check_files(tmp))
@@ -181,13 +188,25 @@ def run_task(task: dict) -> dict:
     answer["json"] = json.loads(out.getvalue())
     result, name = seen["result"], seen["name"]
     if want == "page":
-        answer["page"] = plant_page(result) if prog.endswith("plant") else pid_page(result)
+        with language(lang):   # the page's words in the request's language, as its sheet
+            answer["page"] = plant_page(result) if prog.endswith("plant") else pid_page(result)
     elif want == "sheet":
         answer.update(body=_read(os.path.join(tmp, "reports", name, "build-sheet.html")),
                       media="text/html; charset=utf-8", filename="build-sheet.html")
     elif want == "bundle":
         answer.update(body=bundle_zip(tmp, name), media="application/zip", filename=f"{name}.zip")
     return answer
+
+
+def _lang_of(argv: list) -> str | None:
+    """The language a command line asks for (``--lang=es``, as :func:`designer.web.request.build_argv` writes
+    it; the command's parser checked it), or None."""
+    for i, word in enumerate(argv):
+        if word.startswith("--lang="):
+            return word.split("=", 1)[1]
+        if word == "--lang" and i + 1 < len(argv):
+            return argv[i + 1]
+    return None
 
 
 @contextmanager
@@ -246,7 +265,7 @@ def design_plant_task(fields: dict, want: str = "json", tmp: str | None = None) 
     """
     from .forms import PLANT
 
-    def work():
+    def work(fields, lang):
         from ..plant.circuit import DEFAULT_TOPOLOGY
         from ..plant.design import design_plant
         from ..plant.report import write_outputs
@@ -254,7 +273,7 @@ def design_plant_task(fields: dict, want: str = "json", tmp: str | None = None) 
         from .forms import plant_request
         rq = plant_request(fields)
         if rq.spec.topology != DEFAULT_TOPOLOGY:   # another registered section: the generic plant pipeline
-            return _circuit_plant(rq, want, tmp)
+            return _circuit_plant(rq, want, tmp, lang)
         result = design_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
         if rq.stimulus is not None:
             from ..plant.prbs import with_prbs
@@ -264,12 +283,13 @@ def design_plant_task(fields: dict, want: str = "json", tmp: str | None = None) 
         if want in ("sheet", "bundle"):
             write_outputs(result, tmp, rq.name)
         data = json.loads(json.dumps(result.to_dict()))
-        data["tool"]["argv"] = rq.argv   # the command line this request stands for: a record, never parsed
+        # the command line this request stands for: a record, never parsed
+        data["tool"]["argv"] = rq.argv + ([f"--lang={lang}"] if lang else [])
         return data, lambda: plant_page(result), rq.name
-    return _library_task("design-plant", PLANT, work, want, tmp)
+    return _library_task("design-plant", PLANT, fields, work, want, tmp)
 
 
-def _circuit_plant(rq, want: str, tmp: str | None) -> tuple:
+def _circuit_plant(rq, want: str, tmp: str | None, lang: str | None) -> tuple:
     """A plant on a registered topology other than the seed's (:func:`designer.plant.circuit_design.
     design_circuit_plant`), with the analytic Monte Carlo and worst case over its declared parts; as
     :func:`_library_task`'s ``work`` answers."""
@@ -292,7 +312,7 @@ def _circuit_plant(rq, want: str, tmp: str | None) -> tuple:
     if want in ("sheet", "bundle"):
         write_outputs(result, tmp, rq.name)
     data = json.loads(json.dumps(result.to_dict()))
-    data["tool"]["argv"] = rq.argv
+    data["tool"]["argv"] = rq.argv + ([f"--lang={lang}"] if lang else [])
     return data, lambda: circuit_plant_page(result), rq.name
 
 
@@ -340,7 +360,7 @@ def design_filter_task(fields: dict, want: str = "json", tmp: str | None = None)
     """
     from .forms import FILTER
 
-    def work():
+    def work(fields, lang):
         from .forms import filter_request
         tf = filter_tolerance
         rq = filter_request(fields)
@@ -356,27 +376,40 @@ def design_filter_task(fields: dict, want: str = "json", tmp: str | None = None)
         sheet = filter_report.sheet_of(result)
         sheet.extra = extra
         if want in ("sheet", "bundle"):
-            filter_report.write_outputs(sheet, tmp, rq.name)
+            filter_report.write_outputs(sheet, tmp, rq.name, lang)
         data = json_safe({**result.to_dict(), **extra, "files": {}})   # as design-filter --json prints it
         return data, lambda: filter_page(sheet, extras.get("monte_carlo")), rq.name
-    return _library_task("design-filter", FILTER, work, want, tmp)
+    return _library_task("design-filter", FILTER, fields, work, want, tmp)
 
 
-def _library_task(prog: str, table: dict, work, want: str, tmp: str | None) -> dict:
-    """One library-first task: ``work()`` (in ``tmp``, every temporary file there) gives (the JSON, a function
-    drawing the page, the design's name: its files, written there for a sheet or bundle); a refusal in the
-    page's words (the field of ``table`` at fault), the simulator's failure exit status 3."""
+def _library_task(prog: str, table: dict, fields: dict, work, want: str, tmp: str | None) -> dict:
+    """One library-first task: the request's language taken from ``fields``, then ``work(fields, lang)`` (in
+    ``tmp``, every temporary file there) gives (the JSON, a function drawing the page, the design's name: its
+    files, written there for a sheet or bundle); a refusal in the page's words and language (the field of
+    ``table`` at fault), the simulator's failure exit status 3."""
+    from ..core.errors import DesignError
+    from .request import split_language
+    try:
+        fields, lang = split_language(fields)
+    except DesignError as exc:
+        return {"status": 2, "error": f"{prog}: error: {exc}", "json": None, "field": None, "label": None}
+    with language(lang):   # the refusals, the page's words and the sheet in the request's language
+        return _library_work(prog, table, fields, lang, work, want, tmp)
+
+
+def _library_work(prog: str, table: dict, fields: dict, lang: str | None, work, want: str, tmp: str | None) -> dict:
+    """:func:`_library_task`'s work, in the request's language."""
     from ..core.errors import DesignError, SimulatorError
     from .forms import page_message
     try:
         with temporaries_in(tmp):
-            data, page, name = work()
+            data, page, name = work(fields, lang)
     except SimulatorError as exc:
         return {"status": 3, "error": f"{prog}: error: simulator error: {exc}", "json": None}
     except DesignError as exc:
         text, field = page_message(exc, table)
         return {"status": 2, "error": f"{prog}: error: {text}", "json": None, "field": field,
-                "label": table[field].label if field else None}
+                "label": _(table[field].label) if field else None}
     answer = {"status": 0, "error": None, "json": data}
     if want == "page":
         answer["page"] = page()
@@ -511,16 +544,36 @@ def plant_page(result) -> dict:
     bom = rep.bom(result)
     bench = bench_rows(result.test, result.scope, "R1")
     if result.sine is not None:   # as the sheet's settings table gives it
-        bench.append(["sine check", rep.sine_text(result.sine)])
+        bench.append([_("sine check"), rep.sine_text(result.sine)])
     return {"step": _trace(result.time_s, step, "time from the edge (s)"),
             "bode": _bode(f, resp), "histograms": histograms(result.monte_carlo),
             "schematic_svg": _schematic_svg(rep, result, (result.built.as_dict(), result.package)),
             "bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
-            "bench": bench,
+            # the table as the page's language writes it: its columns, the packages' names, the numbers
+            "bom_header": [_(h) for h in BOM_HEADER],
+            "bom_text": [[localise(_(c)) if isinstance(c, str) and c else c for c in row] for row in bom],
+            "bench": [[localise(c) for c in row] for row in bench],
+            "checks": checks_shown(result.checks),
             # the sheet's content (wiring, expected readings and their band, target and achieved, sensitivity,
             # alternatives) without its pictures: the page draws those itself
             "sheet_html": to_html(rep.title_of(result), rep.sections(result, with_images=False), {}),
             "title": rep.title_of(result)}
+
+
+def checks_shown(checks) -> list:
+    """The checks as the page shows them: id, title and detail in the current language, pass or fail.
+
+    Parameters
+    ----------
+    checks : list of designer.core.checks.Check
+        The result's checks.
+
+    Returns
+    -------
+    list
+        ``{"id", "title", "ok", "detail"}`` per check.
+    """
+    return [{"id": c.id, "title": _(c.title), "ok": bool(c.ok), "detail": localise(c.shown())} for c in checks]
 
 
 def pid_page(result) -> dict:
@@ -662,12 +715,48 @@ def _bode(f, responses: dict) -> dict:
 
 def _trace(x, series: dict, x_label: str, log_x: bool = False) -> dict:
     """One plot's data for the browser: ``x`` and each named series on it,
-    decimated to :data:`TRACE_POINTS`, NaN as null."""
+    decimated to :data:`TRACE_POINTS`, NaN as null; each series' ``label`` (English: the page tells the kinds
+    of trace apart by it) and ``text`` (in the current language: what the page shows)."""
     from ..report.plots import decimate
     names = list(series)
     x, *ys = decimate(np.asarray(x, float), *[np.asarray(series[k], float) for k in names], n=TRACE_POINTS)
-    return {"x": _list(x), "x_label": x_label, "log_x": log_x,
-            "series": [{"label": k, "y": _list(y)} for k, y in zip(names, ys)]}
+    return {"x": _list(x), "x_label": _(x_label), "log_x": log_x,
+            "series": [{"label": k, "text": series_text(k), "y": _list(y)} for k, y in zip(names, ys)]}
+
+
+#: the plots' axes and traces, as the catalogue has them (the traces' English names are written where they are
+#: drawn; those naming an op-amp or a model are read back through these patterns)
+#: the bill of materials' columns as the page shows them (bom.csv keeps its English columns: programs read it)
+BOM_COLUMNS = (N_("Ref"), N_("Value"), N_("Code"), N_("Qty"), N_("Series"), N_("Tolerance"), N_("Package"),
+               N_("Description"))
+AXES = (N_("time from the edge (s)"), N_("frequency (Hz)"), N_("time since the step (s)"), N_("time (s)"))
+TRACES = (N_("SPICE (ngspice)"), N_("analytic (ideal op-amp)"), N_("tolerance band low"), N_("tolerance band high"),
+          N_("ideal op-amp"), N_("SPICE .ac"), N_("ideal PID, ideal plant"), N_("plant alone (open loop)"),
+          N_("loop gain L(jw)"), N_("data"), N_("integrated impulse response"))
+_TRACE_PATTERNS = ((r"analytic \((?P<name>.+) model\)", N_("analytic ({name} model)")),
+                   (r"realised loop, analytic \((?P<name>.+)\)", N_("realised loop, analytic ({name})")),
+                   (r"(?P<name>\S+) model", N_("{name} model")))
+
+
+def series_text(label: str) -> str:
+    """A trace's name in the current language (a model's own name, ``ARX (FOPDT)``, as it is).
+
+    Parameters
+    ----------
+    label : str
+        The English name it is drawn under.
+
+    Returns
+    -------
+    str
+        The name to show.
+    """
+    import re
+    for pattern, message in _TRACE_PATTERNS:
+        m = re.fullmatch(pattern, label)
+        if m:
+            return _(message).format(**m.groupdict())
+    return _(label)
 
 
 def _list(a) -> list:

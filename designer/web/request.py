@@ -35,8 +35,8 @@ from typing import NamedTuple
 from ..core.errors import DesignError
 
 __all__ = ["FILE_OPTIONS", "MAX_DEPTH", "MAX_JSON_BYTES", "REFUSED", "SERVERS_OWN", "Traits", "build_argv",
-           "check_text", "check_value", "option_name", "parse_json", "parser_traits", "value_text",
-           "write_content"]
+           "check_text", "check_value", "option_name", "parse_json", "parser_traits", "split_language",
+           "value_text", "write_content"]
 
 #: options the server sets itself (files, output form) or that would reach past a request's folder
 REFUSED = ("out", "json", "no-files", "plot", "help", "version", "junit", "summary", "root", "allow-outside",
@@ -88,6 +88,27 @@ def parse_json(raw: bytes):
         raise DesignError(f"the request's body is not JSON: {exc}") from None
     check_value(value)
     return value
+
+
+def split_language(options):
+    """A request's ``lang`` (the page's language) apart from its other options.
+
+    Parameters
+    ----------
+    options : dict or object
+        The request's options (anything else is returned as it is, for its own refusal).
+
+    Returns
+    -------
+    tuple
+        (the other options, the language checked by :func:`designer.core.i18n.check_language`, or None).
+    """
+    from ..core.i18n import check_language
+    if not isinstance(options, dict) or "lang" not in options:
+        return options, None
+    rest = dict(options)
+    lang = rest.pop("lang")
+    return rest, check_language(lang if isinstance(lang, str) else repr(lang))
 
 
 def check_value(value) -> None:

@@ -55,3 +55,54 @@ def test_a_language_outside_the_list_is_refused_naming_the_list(bad):
     with pytest.raises(DesignError) as info:
         i18n.check_language(bad)
     assert info.value.param == "lang" and "en, es" in str(info.value)
+
+
+def test_the_pages_messages_are_its_scripts_calls_and_its_htmls_words():
+    """Issue 29: the page's words are the catalogue's: D.t and D.N_ calls (one nested in another's arguments too),
+    the HTML's text and the attributes a reader sees or hears; an element marked translate="no" is left out."""
+    from pathlib import Path
+    static = Path(i18n.__file__).resolve().parent.parent / "web" / "static"
+    found = i18n.page_messages()
+    words = dict((t, line) for line, t in i18n.html_words((static / "plant.html").read_text()))
+    h1 = re.search(r"<h1>([^<]+)</h1>", (static / "plant.html").read_text()).group(1)
+    assert h1 in found and h1 in words
+    placeholder = re.search(r'name="r-min" placeholder="([^"]+)"', (static / "plant.html").read_text()).group(1)
+    assert placeholder in found   # "1k": a letter in it
+    spec = re.search(r'<textarea translate="no"[^>]*placeholder="([^"]+)"', (static / "check.html").read_text())
+    assert spec and " ".join(spec.group(1).replace("&#10;", " ").split()) not in found
+    script = (static / "identify.js").read_text()
+    nested = re.search(r'D\.t\("its margins above; best model \{model\}",[^;]*D\.t\("([^"]+)"\)', script)
+    assert nested and nested.group(1) in found and "its margins above; best model {model}" in found
+    # every message found is in the catalogue (make i18n's check covers the page)
+    assert set(found) <= set(i18n.extract())
+
+
+@pytest.mark.parametrize("header, lang", [("es-ES,es;q=0.9,en;q=0.8", "es"), ("en-US,en;q=0.9,es;q=0.8", "en"),
+                                          ("fr-FR,fr;q=0.9", "en"), ("fr;q=1, es;q=0.5", "es"), ("es;q=0", "en"),
+                                          ("", "en"), (None, "en"), ("es;q=bad, es-MX", "es")])
+def test_the_browsers_preference_chooses_a_language_of_the_list(header, lang):
+    assert i18n.negotiate(header) == lang
+
+
+def test_the_pages_catalogue_has_the_languages_decimal_symbol():
+    assert i18n.page_catalogue("es") == {"lang": "es", "decimal": get_decimal_symbol("es"),
+                                         "messages": i18n.catalogue("es")}
+    assert i18n.page_catalogue(None) == {"lang": "en", "decimal": get_decimal_symbol("en"), "messages": {}}
+    with pytest.raises(DesignError, match="lang must be one of en, es"):
+        i18n.page_catalogue("../es")
+
+
+def test_a_range_refusal_reads_in_the_language_in_force():
+    """The library's range refusal goes through the catalogue (the web page's request in Spanish); English is the
+    code's own text, the message starts with the parameter in both (so each front end names it its own way)."""
+    from designer.core.ranges import RANGES
+    r = RANGES["zeta"]
+    with pytest.raises(DesignError) as en:
+        r.check(-1.0, "zeta")
+    assert str(en.value) == f"zeta must be {r.text()}, got -1" and en.value.param == "zeta"
+    with i18n.language("es"):
+        with pytest.raises(DesignError) as es:
+            r.check(-1.0, "zeta")
+        spanish = r.text()
+    assert str(es.value).startswith("zeta ") and str(es.value) != str(en.value) and spanish in str(es.value)
+    assert es.value.naming({"zeta": '"zeta"'}).startswith('"zeta" ')

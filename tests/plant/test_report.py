@@ -4,7 +4,7 @@ left and decimal commas, English byte for byte the committed reference (reports/
 import re
 
 import pytest
-from helpers import REPORTS, sheet_command, spanish_sheet
+from helpers import REPORTS, foreign, sheet_command, spanish_sheet, vocabulary
 
 #: the Makefile demo's plant (reports/plant_fc3500_z0.2): a Monte Carlo with limits and the worst case
 DEMO = ["--fc", "3500", "--zeta", "0.2", "--monte-carlo", "5000", "--seed", "1", "--limit", "fn_hz=3.3k:3.7k",
@@ -25,6 +25,9 @@ def test_the_spanish_sheet_leaves_no_english_message_and_writes_decimal_commas(t
     assert sum(len(DECIMAL_COMMA.findall(n)) for n in nodes) > 50
     assert "<html lang='es'>" in page and "Planta Sallen-Key: fc 3500 Hz, zeta 0,2, ganancia 1" in page
     assert "1,6 kΩ" in page   # R1, as the BOM and the alternatives give it
+    # no English word anywhere on it: the check details, the packages and the pins' notes included (issue 29)
+    english, _spanish = vocabulary()
+    assert foreign(nodes, english) == []
     # the Markdown and the terminal summary are the same sheet
     md = (rep / "build-sheet.md").read_text()
     assert "\n### Lista de materiales\n" in md and "\n## Cableado\n" in md and "Bill of materials" not in md

@@ -6,6 +6,7 @@ killed at its deadline."""
 import io
 import json
 import os
+import re
 import zipfile
 from concurrent.futures import ThreadPoolExecutor
 
@@ -782,3 +783,65 @@ def test_check_refuses_a_path_that_leaves_the_folder(server, name):
     status, got = server.post_json("/api/check", {"spec": "name: x\nkind: netlist\ndeck: d.cir\n",
                                                   "files": {name: "* x\n"}})
     assert status == 400 and "a path relative to the folder chosen" in got["error"] and "\n" not in got["error"]
+
+
+def _get(server, path, headers=None):
+    import urllib.error
+    import urllib.request
+    req = urllib.request.Request(server.url + path, headers=headers or {})
+    try:
+        with urllib.request.urlopen(req, timeout=60) as r:
+            return r.status, json.loads(r.read())
+    except urllib.error.HTTPError as e:
+        with e:
+            return e.code, json.loads(e.read())
+
+
+def test_the_pages_catalogue_is_the_po_files_in_the_language_asked_or_the_browsers(server):
+    """Issue 29: GET /api/catalogue answers the same Babel catalogue as the sheets, with CLDR's decimal symbol;
+    without ?lang the browser's Accept-Language chooses; a language outside the list is one line (the request
+    names a language, never a file)."""
+    from babel.numbers import get_decimal_symbol
+    from designer.core.i18n import catalogue
+    status, es = _get(server, "/api/catalogue?lang=es")
+    assert status == 200 and es["lang"] == "es" and es["messages"] == catalogue("es")
+    assert es["decimal"] == get_decimal_symbol("es") != get_decimal_symbol("en")
+    status, en = _get(server, "/api/catalogue?lang=en")
+    assert status == 200 and en == {"lang": "en", "decimal": get_decimal_symbol("en"), "messages": {}}
+    assert _get(server, "/api/catalogue", {"Accept-Language": "es-AR,es;q=0.9,en;q=0.5"})[1]["lang"] == "es"
+    assert _get(server, "/api/catalogue", {"Accept-Language": "fr-FR,fr;q=0.9"})[1]["lang"] == "en"
+    for bad in ("fr", "../../etc/passwd", "es/LC_MESSAGES/designer"):
+        status, got = _get(server, "/api/catalogue?lang=" + urllib_quote(bad))
+        assert status == 400 and "\n" not in got["error"] and "en, es" in got["error"], got
+
+
+def urllib_quote(text):
+    from urllib.parse import quote
+    return quote(text, safe="")
+
+
+def test_a_spanish_request_is_refused_in_spanish_naming_its_field(server):
+    """Issue 29: the request carries lang; the library's refusal goes through the same catalogue, the field's
+    label in the page's language, the numbers with a decimal comma; English is unchanged."""
+    from designer.core.errors import DesignError
+    from designer.core.i18n import language
+    from designer.web.forms import PLANT, page_message, plant_request
+    body = {"fc": 3500, "zeta": -1}
+    with language("es"):
+        with pytest.raises(DesignError) as caught:
+            plant_request(body)
+        text, field = page_message(caught.value, PLANT)
+    status, got = server.post_json("/api/plant", {**body, "lang": "es"})
+    assert status == 400 and got["error"] == f"design-plant: error: {text}" and got["field"] == field == "zeta"
+    assert "must" not in text and re.search(r"\d,\d", text), text
+    status, en = server.post_json("/api/plant", body)
+    assert status == 400 and en["error"] != got["error"] and "must be" in en["error"]
+    status, bad = server.post_json("/api/plant", {**body, "lang": "fr"})
+    assert status == 400 and "lang must be one of en, es, got 'fr'" in bad["error"]
+    # the PID (through its command line) and identify take the language too
+    status, pid = server.post_json("/api/pid?view=page", {"plant-fc": 3500, "plant-zeta": 0.2, "lang": "es"})
+    from designer.core.i18n import gettext
+    with language("es"):
+        assert status == 200 and pid["page"]["closed_loop"]["x_label"] == gettext("time from the edge (s)")
+    assert pid["page"]["closed_loop"]["x_label"] != "time from the edge (s)"
+    assert "--lang=es" in pid["result"]["tool"]["argv"]

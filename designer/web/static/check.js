@@ -27,10 +27,13 @@ async function addFiles(list) {
 }
 function showFiles() {
   const names = Object.keys(files);
-  document.getElementById("decks").textContent = "Files: " + (names.join(", ") || "none") +
-    (specs.length ? ` (specs run: ${specs.join(", ")})` : "");
+  document.getElementById("decks").textContent = D.t("Files: {names}", {names: names.join(", ") || D.t("none")}) +
+    (specs.length ? D.t(" (specs run: {specs})", {specs: specs.join(", ")}) : "");
 }
 document.getElementById("clear").onclick = () => { files = {}; specs = []; showFiles(); };
+
+// a case's status as the page's language says it
+const STATUS = {pass: D.N_("pass"), fail: D.N_("fail"), skipped: D.N_("skipped"), error: D.N_("error")};
 
 function show(answer) {
   const v = document.getElementById("verdict");
@@ -42,12 +45,12 @@ function show(answer) {
       for (const c of corner.cases || []) {
         const st = document.createElement("span");
         st.className = c.status === "pass" ? "ok" : c.status === "skipped" ? "" : "fail";
-        st.textContent = c.status;
+        st.textContent = D.t(STATUS[c.status] || c.status);
         rows.push([s.spec.name, c.corner || corner.corner || "-", c.id, st, c.message || ""]);
       }
     }
   }
-  const t = D.table(["spec", "corner", "check", "status", "detail"], rows);
+  const t = D.table([D.t("spec"), D.t("corner"), D.t("check"), D.t("status"), D.t("detail")], rows);
   t.id = "cases-table";
   document.getElementById("cases").replaceChildren(t);
   document.getElementById("summary").textContent = answer.summary || "";
@@ -56,12 +59,12 @@ function show(answer) {
   golden.replaceChildren(...(recorded.length ? recorded.map(([path, text]) => {
     const b = document.createElement("button");
     b.type = "button";
-    b.textContent = `${path} (download)`;
+    b.textContent = D.t("{path} (download)", {path});
     b.dataset.current = "";
     b.className = "golden-file";
     b.onclick = () => { if (!D.isStale()) D.download(new Blob([text], {type: "text/csv"}), path.split("/").pop()); };
     return b;
-  }) : [Object.assign(document.createElement("p"), {textContent: "none recorded in this run"})]));
+  }) : [Object.assign(document.createElement("p"), {textContent: D.t("none recorded in this run")})]));
 }
 
 // a refused run leaves no result to read: the previous run's table, summary and junit.xml are cleared
@@ -82,7 +85,7 @@ async function run() {
   D.clearError(form);
   last = r.data;
   show(r.data);
-  status.textContent = r.data.status === 0 ? "every check passed" : "a check failed";
+  status.textContent = r.data.status === 0 ? D.t("every check passed") : D.t("a check failed");
   D.answered("done");
   document.getElementById("junit").disabled = !r.data.junit;
 }

@@ -7,14 +7,76 @@ const D = {};
 // The page's words in the reader's language: every string the page shows goes through D.t (the English text is
 // the key; {name} placeholders filled from params). English is the identity until a catalogue is loaded.
 D.catalogue = {};
+// a word marked for the catalogue where it is written, translated (D.t) where it is shown
+D.N_ = text => text;
 D.t = function (text, params) {
   let s = D.catalogue[text] || text;
   if (params) for (const k of Object.keys(params)) s = s.split("{" + k + "}").join(String(params[k]));
   return s;
 };
 
+// The page's language: the address's ?lang= (the menu's choice, kept in every link the page makes), else the
+// browser's preference (navigator.languages: what it sends as Accept-Language), else English. The catalogue
+// (GET /api/catalogue: the same Babel catalogue as the build sheets) is loaded before a page draws anything.
+D.LANGUAGES = {en: "English", es: "Español"};
+D.lang = (function () {
+  const asked = new URLSearchParams(location.search).get("lang");
+  if (asked && D.LANGUAGES[asked]) return asked;
+  for (const tag of navigator.languages || [navigator.language || ""]) {
+    const code = String(tag).toLowerCase().split("-")[0];
+    if (D.LANGUAGES[code]) return code;
+  }
+  return "en";
+})();
+D.decimal = ".";
+D.ready = (async function () {
+  document.documentElement.lang = D.lang;
+  if (D.lang === "en") return;
+  try {
+    const c = await (await fetch(`/api/catalogue?lang=${encodeURIComponent(D.lang)}`)).json();
+    D.catalogue = c.messages || {};
+    D.decimal = c.decimal || ".";
+  } catch (e) { /* no catalogue: the page stays in English */ }
+  const go = () => D.translatePage(document.body);
+  if (document.readyState === "loading") document.addEventListener("DOMContentLoaded", go); else go();
+  document.title = D.t(document.title);
+})();
+// The page's HTML in the page's language: each text between tags (spaces collapsed: the catalogue's key) and
+// the attributes a reader sees or hears; an element marked translate="no" (names, a file's example) is left.
+D.ATTRIBUTES = ["placeholder", "title", "aria-label", "alt"];
+D.translatePage = function (root) {
+  const walk = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
+  for (let n = walk.nextNode(); n; n = walk.nextNode()) {
+    if (n.parentElement && n.parentElement.closest("script, style, [translate=no]")) continue;
+    const key = n.textContent.replace(/\s+/g, " ").trim();
+    if (key && D.catalogue[key]) {
+      const lead = /^\s*/.exec(n.textContent)[0], tail = /\s*$/.exec(n.textContent)[0];
+      n.textContent = lead + D.catalogue[key] + tail;
+    }
+  }
+  for (const el of root.querySelectorAll(D.ATTRIBUTES.map(a => `[${a}]`).join(","))) {
+    if (el.closest("[translate=no]")) continue;
+    for (const a of D.ATTRIBUTES) {
+      const v = el.getAttribute(a);
+      if (v && D.catalogue[v.replace(/\s+/g, " ").trim()]) el.setAttribute(a, D.catalogue[v.replace(/\s+/g, " ").trim()]);
+    }
+  }
+};
+// A number as the page's language writes it: a decimal comma in Spanish, and there the SI signs (µ, Ω) as the
+// Spanish sheets write them (designer.core.i18n.localise does the same on the server).
+D.localNum = function (text) {
+  if (D.lang === "en") return text;
+  return String(text).replace(/(^|[^A-Za-z_.\d])(\d+)\.(\d+)(?!\.?\d)/g, (all, pre, a, b) => `${pre}${a}${D.decimal}${b}`)
+    .replace(/(\d )([fpnumkMG]?)Ohm\b/g, "$1$2Ω").replace(/(\d )u(?=(?:s|F|V|A|H|Hz)\b)/g, "$1µ");
+};
+// A number typed as the page's language writes it ("0,5" in Spanish) as the API reads it ("0.5"): both are taken.
+D.typed = function (v) {
+  return D.lang === "en" ? v : v.replace(/(\d),(\d)/g, "$1.$2");
+};
+
 D.choices = null;
 D.loadChoices = async function () {
+  await D.ready;
   if (!D.choices) D.choices = await (await fetch("/api/choices")).json();
   return D.choices;
 };
@@ -30,7 +92,10 @@ const channels = {};
 D.cancel = function (channel) {
   if (channels[channel]) { channels[channel].abort(); delete channels[channel]; }
 };
+// the commands that write a sheet answer in the page's language (their --lang)
+D.SPEAKS = /^\/api\/(plant|pid)(\/|\?|$)/;
 D.api = async function (path, body, asBlob, channel) {
+  if (D.lang !== "en" && D.SPEAKS.test(path) && body && body.constructor === Object) body = {...body, lang: D.lang};
   const init = {method: "POST", headers: {"X-Designer": "1"}};
   if (body instanceof FormData || body instanceof Blob) init.body = body;
   else { init.body = JSON.stringify(body || {}); init.headers["Content-Type"] = "application/json"; }
@@ -43,7 +108,8 @@ D.api = async function (path, body, asBlob, channel) {
   try { r = await fetch(path, init); } catch (e) {
     if (e.name === "AbortError") return {aborted: true};
     if (channel) delete channels[channel];
-    return {ok: false, status: 0, data: {error: `the server does not answer: ${e.message}`, message: "the server does not answer"}};
+    return {ok: false, status: 0, data: {error: `the server does not answer: ${e.message}`,
+                                         message: D.t("the server does not answer")}};
   }
   if (r.ok && asBlob) {
     const named = /filename="([^"]+)"/.exec(r.headers.get("Content-Disposition") || "");
@@ -65,7 +131,7 @@ D.options = function (form) {
     if (el.disabled || el.closest("[hidden]")) continue;
     if (el.type === "checkbox") { if (el.checked) out[el.name] = true; continue; }
     if (el.type === "radio") { if (el.checked) out[el.name] = el.value; continue; }
-    const v = el.value.trim();
+    const v = el.tagName === "INPUT" ? D.typed(el.value.trim()) : el.value.trim();
     if (v !== "") out[el.name] = v;
   }
   return out;
@@ -91,13 +157,13 @@ D.labelOf = function (form, name) {
 // the fields), one with no field on this page its plain name; references to the seed documents are left out
 // (they mean nothing beside a form).
 D.inPageWords = function (form, text, keepRefs) {
-  const label = name => (form && D.labelOf(form, name)) || name.replace(/-/g, " ");
+  const label = name => (form && D.labelOf(form, name)) || D.t(name.replace(/-/g, " "));
   // the optimiser's two sentences say what to do: in the page, with its menu and field
   text = String(text || "")
     .replace(/--tuning (\S+) needs --target-overshoot P \(percent\)/g,
-             (all, rule) => `the rule "${rule}" needs a target: fill in "${label("target-overshoot")}"`)
+             (all, rule) => D.t('the rule "{rule}" needs a target: fill in "{field}"', {rule, field: label("target-overshoot")}))
     .replace(/--tuning (\S+) --target-overshoot P\b/g,
-             (all, rule) => `choose the rule "${rule}" and fill in "${label("target-overshoot")}"`);
+             (all, rule) => D.t('choose the rule "{rule}" and fill in "{field}"', {rule, field: label("target-overshoot")}));
   text = text.replace(/--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?(?: \((?:percent|s|Hz|V)\))?/g, (all, name) => {
     return `"${label(name)}"`;
   });
@@ -129,9 +195,9 @@ D.showError = function (form, data) {
 // off and one note above the results says why. A page clears what must not be read at all (a check table)
 // in its own onStale.
 D.STALE = {
-  refused: "The inputs are refused (see the form): what is shown below is the last design that worked, not of " +
-           "the current inputs. Its downloads are off until the form is right again.",
-  pending: "Working on the new inputs: what is shown below is of the previous ones.",
+  refused: D.N_("The inputs are refused (see the form): what is shown below is the last design that worked, not of " +
+                "the current inputs. Its downloads are off until the form is right again."),
+  pending: D.N_("Working on the new inputs: what is shown below is of the previous ones."),
 };
 D.onStale = null;
 D.markStale = function (why) {
@@ -147,7 +213,7 @@ D.markStale = function (why) {
     note.setAttribute("role", "status");
     results.prepend(note);
   }
-  note.textContent = D.STALE[why] || why;
+  note.textContent = D.t(D.STALE[why] || why);
   note.dataset.why = why;
   note.hidden = false;
   results.classList.add("stale");
@@ -170,7 +236,7 @@ D.markCurrent = function () {
 // "0.05", no design per key); leaving a field or choosing from a menu asks at once. `key()` is what the request
 // would send: the inputs last asked for are not asked again when nothing was typed since (leaving the field
 // whose pause already sent them).
-D.UNFINISHED = /(^\s*[-+]?\s*$)|(\d\.|\d[eE][-+]?|[-+])\s*$/;
+D.UNFINISHED = /(^\s*[-+]?\s*$)|(\d[.,]|\d[eE][-+]?|[-+])\s*$/;
 // The pause: 250 ms, or 1.3 times the typist's own gap between keys when that is longer (up to 700 ms), so a
 // slow typist is not answered at every key; 600 ms while that gap is not known yet (the page's first key).
 // A superseded request is stopped on the server too (its worker freed at once), so asking early costs the
@@ -280,6 +346,8 @@ D.remember = function (opts) {
     if (Array.isArray(v)) q.set(k, v.join(" "));   // a field's items apart, as typed
     else if (typeof v !== "object") q.set(k, v === true ? "true" : v);
   }
+  // the language chosen goes with the link (English too when chosen: the reader's browser may prefer another)
+  if (D.lang !== "en" || new URLSearchParams(location.search).has("lang")) q.set("lang", D.lang);
   const url = `${location.pathname}?${q}`;
   if (url !== location.pathname + location.search) {
     if (D.history.first || D.history.restoring) history.replaceState({designer: true}, "", url);
@@ -303,12 +371,16 @@ D.fillFromQuery = function (form) {
 
 D.busy = function (on, el) {
   document.body.classList.toggle("busy", on);
-  if (el) el.textContent = on ? "working..." : "";
+  if (el) el.textContent = on ? D.t("working...") : "";
 };
 
 // Engineering notation with the unit: 1.6 kOhm, 3.3 nF, 97.9 us.
 D.eng = function (v, unit, digits) {
-  if (v === null || v === undefined || !isFinite(v)) return "n/a";
+  return D.localNum(D.engTyped(v, unit, digits));
+};
+// the same as typed into a field or a link (decimal point, "u" for micro): 1.6k
+D.engTyped = function (v, unit, digits) {
+  if (v === null || v === undefined || !isFinite(v)) return D.t("n/a");
   digits = digits || 4;
   if (v === 0) return `0 ${unit || ""}`.trim();
   const pre = [[1e12, "T"], [1e9, "G"], [1e6, "M"], [1e3, "k"], [1, ""], [1e-3, "m"], [1e-6, "u"], [1e-9, "n"],
@@ -320,9 +392,9 @@ D.eng = function (v, unit, digits) {
 
 // A number without a unit (a gain, a damping ratio): plain digits, never an SI prefix ("0.9887", not "988.7 m").
 D.num = function (v, digits) {
-  if (v === null || v === undefined || !isFinite(v)) return "n/a";
+  if (v === null || v === undefined || !isFinite(v)) return D.t("n/a");
   const a = Math.abs(v);
-  return a !== 0 && (a < 1e-3 || a >= 1e6) ? (+v).toExponential((digits || 4) - 1) : String(+(+v).toPrecision(digits || 4));
+  return D.localNum(a !== 0 && (a < 1e-3 || a >= 1e6) ? (+v).toExponential((digits || 4) - 1) : String(+(+v).toPrecision(digits || 4)));
 };
 
 // A model's parameter as "name = value unit": the unit the name carries (tau_s, wn_rad_s) goes on the value.
@@ -334,17 +406,17 @@ D.param = function (name, v, digits) {
 
 // A check by its title: the plant's checks carry one; the PID's (design-pid --json) only an id.
 D.CHECK_TITLES = {
-  kp_accuracy: "Kp as built", ti_accuracy: "Ti as built", td_accuracy: "Td as built",
-  integrator_corner: "integrator corner", differentiator_corner: "differentiator corner",
-  bandwidth_difference: "difference amplifier bandwidth", bandwidth_inverter: "inverter bandwidth",
-  bandwidth_integrator: "integrator bandwidth", bandwidth_summer: "summer bandwidth", bandwidth_gain: "gain stage bandwidth",
-  bandwidth_differentiator: "differentiator bandwidth", resistor_bounds: "resistors within their range",
-  capacitor_bounds: "capacitors within their range", closed_loop_stable: "closed loop stable",
-  phase_margin: "phase margin", steady_state_error: "steady-state error", slew_rate: "op-amp slew rate",
-  output_swing: "op-amp output swing",
+  kp_accuracy: D.N_("Kp as built"), ti_accuracy: D.N_("Ti as built"), td_accuracy: D.N_("Td as built"),
+  integrator_corner: D.N_("integrator corner"), differentiator_corner: D.N_("differentiator corner"),
+  bandwidth_difference: D.N_("difference amplifier bandwidth"), bandwidth_inverter: D.N_("inverter bandwidth"),
+  bandwidth_integrator: D.N_("integrator bandwidth"), bandwidth_summer: D.N_("summer bandwidth"), bandwidth_gain: D.N_("gain stage bandwidth"),
+  bandwidth_differentiator: D.N_("differentiator bandwidth"), resistor_bounds: D.N_("resistors within their range"),
+  capacitor_bounds: D.N_("capacitors within their range"), closed_loop_stable: D.N_("closed loop stable"),
+  phase_margin: D.N_("phase margin"), steady_state_error: D.N_("steady-state error"), slew_rate: D.N_("op-amp slew rate"),
+  output_swing: D.N_("op-amp output swing"),
 };
 D.checkTitle = function (c) {
-  return c.title || D.CHECK_TITLES[c.id] || String(c.id || c.name || "").replace(/_/g, " ");
+  return D.t(c.title || D.CHECK_TITLES[c.id] || String(c.id || c.name || "").replace(/_/g, " "));
 };
 
 D.table = function (header, rows, cls) {
@@ -374,10 +446,10 @@ D.fig = function (label, value) {
 };
 
 D.checksTable = function (checks) {
-  return D.table(["check", "result", "detail"], checks.map(c => {
+  return D.table([D.t("check"), D.t("result"), D.t("detail")], checks.map(c => {
     const s = document.createElement("span");
     s.className = c.ok ? "ok" : "fail";
-    s.textContent = c.ok ? "ok" : "FAILED";
+    s.textContent = c.ok ? D.t("ok") : D.t("FAILED");
     return [D.checkTitle(c), s, c.detail];
   }));
 };
@@ -419,7 +491,7 @@ D.plot = function (el, trace, opts) {
     const points = /^(data|SPICE \.ac)$/.test(s.label);
     const kind = D.TRACE_KINDS.some(([re]) => re.test(s.label));
     // measured points as small rings, so the model lines under them stay visible
-    series.push({label: s.label, stroke: D.traceColour(s.label, kind ? 0 : others++),
+    series.push({label: s.text || s.label, stroke: D.traceColour(s.label, kind ? 0 : others++),
                  width: i === 0 && !band ? 2.5 : 1.5, dash: band ? [4, 4] : undefined,
                  value: (u, v) => v === null || v === undefined ? "" : D.num(v, 4),
                  spanGaps: false, points: points ? {show: true, size: 4, width: 1, fill: "transparent"} : {show: false},
@@ -453,10 +525,11 @@ D.plot = function (el, trace, opts) {
 // A plot's text alternative: what it shows in one line (its aria-label) and its key points as a table (a
 // dozen points along x, each trace's value there; the marks), in a <details> under it.
 D.plotText = function (el, trace, opts) {
-  const yLabel = opts.yLabel || "value";
+  const yLabel = D.t(opts.yLabel || "value");
   el.setAttribute("role", "img");
-  el.setAttribute("aria-label", `${yLabel} against ${trace.x_label}: ${trace.series.map(s => s.label).join(", ")}` +
-                  ((opts.marks || []).length ? `; marked: ${opts.marks.map(m => m.label).join(", ")}` : ""));
+  el.setAttribute("aria-label", D.t("{y} against {x}: {traces}", {y: yLabel, x: trace.x_label,
+                                                                  traces: trace.series.map(s => s.text || s.label).join(", ")}) +
+                  ((opts.marks || []).length ? D.t("; marked: {marks}", {marks: opts.marks.map(m => m.label).join(", ")}) : ""));
   const n = trace.x.length, rows = [];
   for (let k = 0; k < 12 && n; k++) {
     const i = Math.round(k * (n - 1) / 11);
@@ -464,7 +537,7 @@ D.plotText = function (el, trace, opts) {
     rows.push({i, cells: [D.eng(trace.x[i], opts.xUnit || "", 4),
                           ...trace.series.map(s => s.y[i] === null || s.y[i] === undefined ? "" : D.num(s.y[i], 4))]});
   }
-  const table = D.table([trace.x_label, ...trace.series.map(s => s.label)], rows.map(r => r.cells));
+  const table = D.table([trace.x_label, ...trace.series.map(s => s.text || s.label)], rows.map(r => r.cells));
   const marks = (opts.marks || []).map(m => { const p = document.createElement("p"); p.textContent = m.label; return p; });
   let details = el.nextElementSibling;
   if (!details || !details.classList.contains("plot-text")) {
@@ -472,7 +545,7 @@ D.plotText = function (el, trace, opts) {
     details.className = "plot-text";
     el.after(details);
   }
-  details.replaceChildren(Object.assign(document.createElement("summary"), {textContent: `${yLabel}: key points as a table`}),
+  details.replaceChildren(Object.assign(document.createElement("summary"), {textContent: D.t("{y}: key points as a table", {y: yLabel})}),
                           ...marks, Object.assign(document.createElement("div"), {className: "scroll"}));
   details.lastChild.append(table);
 };
@@ -481,6 +554,7 @@ D.plotText = function (el, trace, opts) {
 // full size in a tab of its own, where the browser zooms it as any SVG.
 D.schematic = function (el, svg, what) {
   el.innerHTML = svg;
+  D.translatePage(el);   // its labels ("generator") in the page's language
   const img = el.querySelector("svg");
   if (img) {
     img.setAttribute("role", "img");
@@ -491,7 +565,7 @@ D.schematic = function (el, svg, what) {
     open = document.createElement("button");
     open.type = "button";
     open.className = "open-full";
-    open.textContent = "open the schematic full size";
+    open.textContent = D.t("open the schematic full size");
     el.after(open);
   }
   open.onclick = () => {
@@ -522,13 +596,26 @@ D.drawMarks = function (u, marks) {
 
 D.nav = function (current) {
   const nav = document.querySelector("nav");
-  for (const [href, text] of [["/plant", "Plant"], ["/pid", "PID"], ["/filter", "Filter"], ["/identify", "Identify"],
-                              ["/check", "Check"]]) {
+  const keep = D.lang !== "en" ? `?lang=${D.lang}` : "";
+  for (const [href, text] of [["/plant", D.t("Plant")], ["/pid", D.t("PID")], ["/filter", D.t("Filter")],
+                              ["/identify", D.t("Identify")], ["/check", D.t("Check")]]) {
     const a = document.createElement("a");
-    a.href = href; a.textContent = text;
+    a.href = href + keep; a.textContent = text;
     if (href === current) a.className = "here";
     nav.append(a);
   }
+  // the language menu: the page again in the language chosen, its inputs kept (the address has them)
+  const menu = document.createElement("select");
+  menu.id = "lang";
+  menu.setAttribute("aria-label", "language / idioma");
+  menu.setAttribute("translate", "no");
+  for (const [code, name] of Object.entries(D.LANGUAGES)) menu.append(new Option(name, code, false, code === D.lang));
+  menu.addEventListener("change", () => {
+    const q = new URLSearchParams(location.search);
+    q.set("lang", menu.value);
+    location.search = q.toString();
+  });
+  nav.append(menu);
 };
 
 // Fill a <select> with names (keeping the value chosen, else the default).
@@ -552,24 +639,25 @@ D.dropZone = function (zone, input, onFile) {
 
 // The tolerance panel (Plant, PID): the yield with its 95 % interval, the part to buy tighter, and each
 // histogram (the server's bins: D.histogram) with its limits; hidden without a Monte Carlo.
-D.pct = v => `${(100 * v).toPrecision(3)} %`;
+D.pct = v => D.localNum(`${(100 * v).toPrecision(3)} %`);
 D.tolerance = function (mc, hists) {
   const section = document.getElementById("tolerance-section");
   if (!section) return;
   section.hidden = !mc;
   if (!mc) return;
-  const figs = [D.fig("builds drawn", String(mc.settings.samples))];
+  const figs = [D.fig(D.t("builds drawn"), String(mc.settings.samples))];
   const y = mc.yield;
   if (y && mc.limits && mc.limits.length) {
-    figs.push(D.fig("yield", D.pct(y.fraction)),
-              D.fig("95 % interval (Wilson)", `${D.pct(y.ci95[0])} to ${D.pct(y.ci95[1])}`),
-              D.fig("within", mc.limits.map(l => `${l.figure} ${D.num(l.min, 4)} to ${D.num(l.max, 4)}`).join("; ")));
-  } else figs.push(D.fig("yield", "no limits given: the spread alone"));
+    figs.push(D.fig(D.t("yield"), D.pct(y.fraction)),
+              D.fig(D.t("95 % interval (Wilson)"), D.t("{lo} to {hi}", {lo: D.pct(y.ci95[0]), hi: D.pct(y.ci95[1])})),
+              D.fig(D.t("within"), mc.limits.map(l => `${l.figure} ${D.t("{lo} to {hi}", {lo: D.num(l.min, 4), hi: D.num(l.max, 4)})}`).join("; ")));
+  } else figs.push(D.fig(D.t("yield"), D.t("no limits given: the spread alone")));
   document.getElementById("yield").replaceChildren(...figs);
   const t = mc.tighten, tight = document.getElementById("tighten");
   tight.textContent = !t ? "" : t.yield > t.yield_now
-    ? `Buy ${t.part} tighter: at ${t.tolerance_pct} % the yield is ${D.pct(t.yield)} (now ${D.pct(t.yield_now)}).`
-    : "No part bought tighter raises the yield: the design, not the parts, limits it.";
+    ? D.t("Buy {part} tighter: at {tol} % the yield is {yield} (now {now}).",
+          {part: t.part, tol: D.localNum(String(t.tolerance_pct)), yield: D.pct(t.yield), now: D.pct(t.yield_now)})
+    : D.t("No part bought tighter raises the yield: the design, not the parts, limits it.");
   const box = document.getElementById("histograms");
   box.replaceChildren(...(hists || []).map(h => D.histogram(h)));
 };
@@ -587,8 +675,8 @@ D.histogram = function (h) {
   svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
   svg.setAttribute("role", "img");
   svg.setAttribute("class", "histogram");
-  svg.setAttribute("aria-label", `histogram of ${h.figure} over ${h.n} builds` +
-                   (h.min !== null ? `, limits ${D.num(h.min, 4)} to ${D.num(h.max, 4)}` : ""));
+  svg.setAttribute("aria-label", D.t("histogram of {figure} over {n} builds", {figure: h.figure, n: h.n}) +
+                   (h.min !== null ? D.t(", limits {lo} to {hi}", {lo: D.num(h.min, 4), hi: D.num(h.max, 4)}) : ""));
   const el = (name, attrs, text) => {
     const e = document.createElementNS(ns, name);
     for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
@@ -604,14 +692,14 @@ D.histogram = function (h) {
     el("line", {x1: x(h.nominal), x2: x(h.nominal), y1: pad / 2, y2: H - pad, stroke: "#333", "stroke-dasharray": "4 3"});
   el("text", {x: pad, y: H - 8, "font-size": 11}, D.num(lo, 4));
   el("text", {x: W - pad, y: H - 8, "font-size": 11, "text-anchor": "end"}, D.num(hi, 4));
-  el("text", {x: W / 2, y: 12, "font-size": 12, "text-anchor": "middle"}, `${h.figure} over ${h.n} builds`);
+  el("text", {x: W / 2, y: 12, "font-size": 12, "text-anchor": "middle"}, D.t("{figure} over {n} builds", {figure: h.figure, n: h.n}));
   const wrap = document.createElement("figure");
   wrap.className = "histogram-figure";
   wrap.dataset.figure = h.figure;
   wrap.append(svg);
   const details = document.createElement("details");
-  details.append(Object.assign(document.createElement("summary"), {textContent: `${h.figure}: the counts as a table`}),
-                 D.table(["from", "to", "builds"], h.counts.map((c, i) => [D.num(h.edges[i], 4), D.num(h.edges[i + 1], 4), c])));
+  details.append(Object.assign(document.createElement("summary"), {textContent: D.t("{figure}: the counts as a table", {figure: h.figure})}),
+                 D.table([D.t("from"), D.t("to"), D.t("builds")], h.counts.map((c, i) => [D.num(h.edges[i], 4), D.num(h.edges[i + 1], 4), c])));
   wrap.append(details);
   return wrap;
 };

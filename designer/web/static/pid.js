@@ -41,31 +41,31 @@ function show(answer) {
   const m = cl.margins || {};
   const failed = (r.checks || []).filter(c => !c.ok);
   document.getElementById("figures").replaceChildren(
-    D.fig("method", r.method || t.method || ""),
+    D.fig(D.t("method"), r.method || t.method || ""),
     D.fig("Kp", t.kp !== undefined ? D.num(t.kp, 4) : ""),
     D.fig("Ti", D.eng(t.ti_s, "s")), D.fig("Td", D.eng(t.td_s, "s")),
-    D.fig(cl.spice ? "overshoot (SPICE)" : "overshoot (analytic)", a.overshoot_pct !== undefined && a.overshoot_pct !== null ? `${(+a.overshoot_pct).toPrecision(3)} %` : "n/a"),
-    D.fig("phase margin", m.phase_margin_deg === undefined || m.phase_margin_deg === null ? "n/a" : `${D.num(m.phase_margin_deg, 3)} deg`),
-    D.fig("gain margin", m.gain_margin_db === undefined || m.gain_margin_db === null ? "n/a" : `${D.num(m.gain_margin_db, 3)} dB`),
-    D.fig("crossover", D.eng(m.crossover_hz, "Hz", 4)),
-    D.fig("checks failed", String(failed.length)));
+    D.fig(cl.spice ? D.t("overshoot (SPICE)") : D.t("overshoot (analytic)"), a.overshoot_pct !== undefined && a.overshoot_pct !== null ? D.localNum(`${(+a.overshoot_pct).toPrecision(3)} %`) : D.t("n/a")),
+    D.fig(D.t("phase margin"), m.phase_margin_deg === undefined || m.phase_margin_deg === null ? D.t("n/a") : `${D.num(m.phase_margin_deg, 3)} deg`),
+    D.fig(D.t("gain margin"), m.gain_margin_db === undefined || m.gain_margin_db === null ? D.t("n/a") : `${D.num(m.gain_margin_db, 3)} dB`),
+    D.fig(D.t("crossover"), D.eng(m.crossover_hz, "Hz", 4)),
+    D.fig(D.t("checks failed"), String(failed.length)));
   // the failing checks by their titles, first thing under the heading (the sheet below has their details)
   const f = document.getElementById("failed");
   f.replaceChildren();
   if (failed.length) {
     const line = document.createElement("p");
     line.className = "fail";
-    line.textContent = `Checks failed: ${failed.map(D.checkTitle).join(", ")}`;
+    line.textContent = D.t("Checks failed: {titles}", {titles: failed.map(D.checkTitle).join(", ")});
     f.append(line);
   }
-  D.plot(document.getElementById("closed"), p.closed_loop, {xUnit: "s", yLabel: "output (V)"});
+  D.plot(document.getElementById("closed"), p.closed_loop, {xUnit: "s", yLabel: D.t("output (V)")});
   // the margins where they are read: the gain crossover (phase margin) and the phase crossover (gain margin)
   const marks = [];
-  if (isFinite(m.crossover_hz)) marks.push({x: m.crossover_hz, label: `crossover: PM ${D.num(m.phase_margin_deg, 3)} deg`});
-  if (isFinite(m.phase_crossover_hz)) marks.push({x: m.phase_crossover_hz, label: `-180 deg: GM ${D.num(m.gain_margin_db, 3)} dB`});
-  D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 220, marks});
-  D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 180, marks});
-  D.schematic(document.getElementById("schematic"), p.schematic_svg, `schematic of the loop: ${p.title}`);
+  if (isFinite(m.crossover_hz)) marks.push({x: m.crossover_hz, label: D.t("crossover: PM {pm} deg", {pm: D.num(m.phase_margin_deg, 3)})});
+  if (isFinite(m.phase_crossover_hz)) marks.push({x: m.phase_crossover_hz, label: D.t("-180 deg: GM {gm} dB", {gm: D.num(m.gain_margin_db, 3)})});
+  D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: D.t("gain (dB)"), height: 220, marks});
+  D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: D.t("phase (deg)"), height: 180, marks});
+  D.schematic(document.getElementById("schematic"), p.schematic_svg, D.t("schematic of the loop: {title}", {title: p.title}));
   D.tolerance(r.monte_carlo, p.histograms);
   D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
 }
@@ -73,8 +73,8 @@ function show(answer) {
 async function design() {
   const opts = request();
   if (opts === null) {   // "identified" chosen with no model: what is shown is another plant's
-    D.markStale("No identified model yet (drop a capture on the Identify page): what is shown below is of the " +
-                "plant chosen before, not of the current inputs.");
+    D.markStale(D.t("No identified model yet (drop a capture on the Identify page): what is shown below is of " +
+                    "the plant chosen before, not of the current inputs."));
     return;
   }
   const mine = ++seq;
@@ -89,7 +89,7 @@ async function design() {
   // an identified model lives in this browser's session only: no link for it
   if (plantKind() !== "identify") D.remember({plant: plantKind(), ...opts});
   show(r.data);
-  status.textContent = "designed and simulated";
+  status.textContent = D.t("designed and simulated");
   D.answered("done");
 }
 
@@ -109,15 +109,15 @@ async function file(kind) {
   for (const s of form.querySelectorAll("select[data-choices]")) {
     const keepFirst = s.options.length ? [s.options[0].value] : [];
     D.fill(s, [...keepFirst, ...c[s.dataset.choices]], s.dataset.default || keepFirst[0]);
-    if (keepFirst.length && s.options[0].value === "") s.options[0].textContent = "default";
+    if (keepFirst.length && s.options[0].value === "") s.options[0].textContent = D.t("default");
   }
   D.fillFromQuery(form);
   D.onRestore = () => { showPlantKind(); showTargets(); };
   if (identified) {
     const b = identified.best || {};
     document.getElementById("model-text").textContent =
-      `From ${identified.capture ? identified.capture.source : "the identify page"}: ${b.name} (${b.model}) ` +
-      Object.entries(b.params || {}).map(([k, v]) => D.param(k, v)).join(", ");
+      D.t("From {source}: {name} ({model}) {params}", {source: identified.capture ? identified.capture.source : D.t("the identify page"),
+          name: b.name, model: b.model, params: Object.entries(b.params || {}).map(([k, v]) => D.param(k, v)).join(", ")});
   }
   showPlantKind();
   showTargets();

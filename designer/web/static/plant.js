@@ -62,27 +62,28 @@ function show(answer) {
   figs.replaceChildren(
     D.fig("R1", D.eng(b.R1_ohm, "Ohm", 3)), D.fig("R2", D.eng(b.R2_ohm, "Ohm", 3)),
     D.fig("C1", D.eng(b.C1_f, "F", 3)), D.fig("C2", D.eng(b.C2_f, "F", 3)),
-    D.fig(`fn as built (${r.opamp.name})`, D.eng(b.fn_opamp_hz, "Hz", 4)),
-    D.fig(`zeta as built (${r.opamp.name})`, D.num(b.zeta_opamp, 4)),
-    D.fig("overshoot (model)", `${r.analytic_opamp.overshoot_pct.toPrecision(4)} %`),
-    D.fig("overshoot (SPICE)", r.spice ? `${r.spice.overshoot_pct.toPrecision(4)} %` : "not simulated"),
-    D.fig("peak time", D.eng((r.spice || r.analytic_opamp).peak_time_s, "s", 4)),
-    D.fig("settling time (2 %)", D.eng((r.spice || r.analytic_opamp).settling_time_s, "s", 4)),
-    D.fig("SPICE agrees with the model", r.comparison.pass === undefined ? "n/a" : (r.comparison.pass ? "yes" : "NO")));
-  document.getElementById("notes").replaceChildren(...r.notes.map(n => { const e = document.createElement("p"); e.textContent = D.inPageWords(form, n); return e; }));
+    D.fig(D.t("fn as built ({opamp})", {opamp: r.opamp.name}), D.eng(b.fn_opamp_hz, "Hz", 4)),
+    D.fig(D.t("zeta as built ({opamp})", {opamp: r.opamp.name}), D.num(b.zeta_opamp, 4)),
+    D.fig(D.t("overshoot (model)"), D.localNum(`${r.analytic_opamp.overshoot_pct.toPrecision(4)} %`)),
+    D.fig(D.t("overshoot (SPICE)"), r.spice ? D.localNum(`${r.spice.overshoot_pct.toPrecision(4)} %`) : D.t("not simulated")),
+    D.fig(D.t("peak time"), D.eng((r.spice || r.analytic_opamp).peak_time_s, "s", 4)),
+    D.fig(D.t("settling time (2 %)"), D.eng((r.spice || r.analytic_opamp).settling_time_s, "s", 4)),
+    D.fig(D.t("SPICE agrees with the model"), r.comparison.pass === undefined ? D.t("n/a") : (r.comparison.pass ? D.t("yes") : D.t("NO"))));
+  document.getElementById("notes").replaceChildren(...r.notes.map(n => { const e = document.createElement("p"); e.textContent = D.inPageWords(form, D.localNum(n)); return e; }));
   D.schematic(document.getElementById("schematic"), p.schematic_svg,
-              `schematic: ${p.bom.rows.map(x => `${x[0]} ${x[1]}`).join(", ")}`);
-  document.getElementById("bench").replaceChildren(D.table(["set", "to"], p.bench));
-  document.getElementById("bomtable").replaceChildren(D.table(p.bom.header.slice(0, 7), p.bom.rows.map(x => x.slice(0, 7))));
-  document.getElementById("checks").replaceChildren(D.checksTable(r.checks));
+              D.t("schematic: {parts}", {parts: p.bom.rows.map(x => `${x[0]} ${D.localNum(x[1])}`).join(", ")}));
+  document.getElementById("bench").replaceChildren(D.table([D.t("set"), D.t("to")], p.bench));
+  document.getElementById("bomtable").replaceChildren(D.table((p.bom_header || p.bom.header).slice(0, 7), (p.bom_text || p.bom.rows).map(x => x.slice(0, 7))));
+  document.getElementById("checks").replaceChildren(D.checksTable(p.checks || r.checks));
   D.tolerance(r.monte_carlo, p.histograms);
   D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
-  D.plot(document.getElementById("step"), p.step, {xUnit: "s", yLabel: "output (V)"});
-  D.plot(document.getElementById("bode-gain"), p.bode.gain, {xUnit: "Hz", yLabel: "gain (dB)", height: 240});
-  D.plot(document.getElementById("bode-phase"), p.bode.phase, {xUnit: "Hz", yLabel: "phase (deg)", height: 200});
+  D.plot(document.getElementById("step"), p.step, {xUnit: "s", yLabel: D.t("output (V)")});
+  D.plot(document.getElementById("bode-gain"), p.bode.gain, {xUnit: "Hz", yLabel: D.t("gain (dB)"), height: 240});
+  D.plot(document.getElementById("bode-phase"), p.bode.phase, {xUnit: "Hz", yLabel: D.t("phase (deg)"), height: 200});
 }
 
-const page = D.designPage(form, status, "/api/plant", show, r => `designed and simulated (${r.result.simulator || "no simulator"})`);
+const page = D.designPage(form, status, "/api/plant", show,
+                          r => D.t("designed and simulated ({simulator})", {simulator: r.result.simulator || D.t("no simulator")}));
 
 (async function () {
   const c = await D.loadChoices();
@@ -103,9 +104,10 @@ const page = D.designPage(form, status, "/api/plant", show, r => `designed and s
     if (!last || D.isStale()) return;
     const o = last.opts, b = last.answer.result.built;
     // the plant as built, by its parts: the PID is designed for the circuit on the bench
-    const code = v => D.eng(v, "", 6).replace(" ", "");   // 1.6k, 3.3n: engineering notation as typed
+    const code = v => D.engTyped(v, "", 6).replace(" ", "");   // 1.6k, 3.3n: engineering notation as typed
     const q = new URLSearchParams({"plant": "parts", "plant-r1": code(b.R1_ohm), "plant-r2": code(b.R2_ohm),
                                    "plant-c1": code(b.C1_f), "plant-c2": code(b.C2_f), "opamp": o.opamp || "LM741"});
+    if (D.lang !== "en") q.set("lang", D.lang);
     if (b.gain !== 1) q.set("plant-gain", b.gain);
     location.href = "/pid?" + q.toString();
   };
