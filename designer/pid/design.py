@@ -108,9 +108,8 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice",
     Returns
     -------
     PidResult
-        Or, for a plant given as a model (``spec.process``), the
-        :class:`~designer.pid.process_result.ProcessPidResult` of
-        :func:`designer.pid.process_loop.design_model_pid`.
+        One type for every plant; for a plant given as a model (``spec.process``)
+        its model fields are set (:func:`designer.pid.process_loop.design_model_pid`).
     """
     if spec.process is not None:
         from .process_loop import design_model_pid

@@ -23,7 +23,7 @@ from ..core.lti import filter_foh
 from . import blocks, model as M, selection
 from .delayloop import closed_loop_step, pid_tf, step_figures
 from .delaymargins import loop_margins
-from .process_result import LoopFigures
+from .result import LoopFigures
 from .spec import DEFAULT_MAX_MS, DEFAULT_MIN_GAIN_MARGIN_DB, DEFAULT_MIN_PHASE_MARGIN_DEG, PidSpec
 
 __all__ = ["LEAK_LOOP_GAIN", "TABLE_STEP_FRACTION", "FAR_FACTOR", "limits", "plant_of", "ideal_crossover_hz",

@@ -51,8 +51,7 @@ from .modelloop import (FAR_FACTOR, LEAK_LOOP_GAIN, TABLE_STEP_FRACTION, built_c
 from .loopchecks import designators, named, spice_notes, stage_checks, steady_state_check
 from .netlist import circuit_loop_deck, circuit_loop_netlist, controller_netlist, model_loop_deck
 from .process_notes import opamp_speed_notes, sizing_notes
-from .process_result import ProcessPidResult, RobustCheck, RuleRow
-from .result import Achieved, Waveforms
+from .result import Achieved, AnalyticLoop, PidResult, RobustCheck, RuleRow, Waveforms
 from .spec import PidSpec
 from .verify import explain, loop_metrics, run_and_compare
 
@@ -138,7 +137,7 @@ def rule_table(spec, model, reduced, amp) -> tuple:
 
 
 def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice",
-                     rules_spice: bool = False, before_spice=None, opamp=None) -> ProcessPidResult:
+                     rules_spice: bool = False, before_spice=None, opamp=None) -> PidResult:
     """Tune, size, check and (unless ``simulate`` is False) verify in SPICE a PID
     for ``spec.process``, a plant known only as a model.
 
@@ -159,7 +158,7 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
 
     Returns
     -------
-    ProcessPidResult
+    PidResult
     """
     from .reduction import from_process
     tick = time.perf_counter()
@@ -198,12 +197,13 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
     notes += opamp_speed_notes(amp, loop.margins, loop.ideal_margins, limits(spec)[0], gains.method == "optimize")
     robust = robust_check(spec, model, loop.controller, loop.t, gains) if model.ci95 else None
     checks = tuple(static) + loop.checks + (robust.checks() if robust is not None else ())
-    res = ProcessPidResult(
+    res = PidResult(
         spec=spec, model=model, reduced=reduced, opamp=amp, method=gains.method, kp=gains.kp, ti_s=gains.ti_s,
         td_s=gains.td_s, rule=gains.rule, rules=table, optimizer=opt, parts=parts, selection=sel,
         achieved=Achieved.of(parts, amp, gains), fc_ref_hz=fc, checks=checks, margins=loop.margins,
-        ideal_margins=loop.ideal_margins, ideal_pid=loop.ideal_figures, analytic=loop.figures, stable=loop.margins.stable, dc_gain=loop.dc,
-        levels=loop.levels, robust=robust, test=loop.test, expected_final_v=loop.expected, deck=loop.deck,
+        ideal_margins=loop.ideal_margins, ideal_pid=loop.ideal_figures,
+        analytic=AnalyticLoop(loop.figures, loop.margins.stable, loop.dc, loop.levels), robust=robust,
+        test=loop.test, expected_final_v=loop.expected, deck=loop.deck,
         waveforms=loop.waves, notes=list(notes), package=spec.package, limits=limits(spec))
     lap("analytic_s")
     if before_spice is not None:
@@ -220,7 +220,7 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
     return res
 
 
-def model_loop_scope(res: ProcessPidResult):
+def model_loop_scope(res: PidResult):
     """The bench scope for the loop (as :func:`designer.pid.design.loop_scope`): CH1
     the reference, CH2 the plant output y and then each op-amp output in turn,
     volts/div fitting what SPICE (else the analytic loop) shows there, 1.2 settling
@@ -239,7 +239,7 @@ def model_loop_scope(res: ProcessPidResult):
             chans.append(channel("CH2", sig, got.v_min, got.v_max))
         elif role != "plant" and (sig != "vd" or res.parts.has_derivative):
             chans.append(channel("CH2", sig, *rails))
-    ts = res.spice.figures.settling_time_s if res.spice is not None else res.analytic.settling_time_s
+    ts = res.spice.figures.settling_time_s if res.spice is not None else res.analytic.figures.settling_time_s
     window = min(1.2 * ts, test.half_period_s) if ts is not None and math.isfinite(ts) else test.half_period_s
     return scope_setup(window, test.amplitude_v / 2, chans)
 
@@ -420,7 +420,7 @@ def robust_check(spec, model, controller, t, gains) -> RobustCheck:
     return RobustCheck(tuple(rows), pm_min, gm_min, ms_max)
 
 
-def rules_in_spice(res: ProcessPidResult, simulator: str) -> tuple:
+def rules_in_spice(res: PidResult, simulator: str) -> tuple:
     """The rule table with each applicable, stable rule's SPICE overshoot: its
     gains sized as the design's were (same series, bounds and corner rules), its
     deck on the same bench test, the deck's own ``overshoot_pct`` measurement."""
@@ -445,7 +445,7 @@ def rules_in_spice(res: ProcessPidResult, simulator: str) -> tuple:
     return tuple(out)
 
 
-def run_spice(res: ProcessPidResult, simulator: str) -> None:
+def run_spice(res: PidResult, simulator: str) -> None:
     """Simulate the deck, compare with the analytic loop; fills ``spice``,
     ``verdict`` and the notes."""
     w = res.waveforms
@@ -454,5 +454,5 @@ def run_spice(res: ProcessPidResult, simulator: str) -> None:
     stages = {k: v for k, v in sp.stages.items() if k != "plant"}   # y is the model's, not an op-amp's
     res.spice = sp = replace(sp, stages=named(stages, designators(res.parts, None, res.opamp, res.package,
                                                                      loop_netlist_of(res.spec, res.parts))))
-    res.verdict = explain(sp, res.analytic, res.checks)
+    res.verdict = explain(sp, res.analytic.figures, res.checks)
     res.notes += spice_notes(sp, res.verdict, res.expected_final_v)

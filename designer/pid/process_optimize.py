@@ -226,7 +226,7 @@ class _Problem:
         return max(0.0, swing - SWING_LIMIT) + max(0.0, slew - SLEW_LIMIT)
 
     def rule_within_stages(self, f) -> bool:
-        """Whether a rule's loop (:class:`~designer.pid.process_result.LoopFigures` ``f``), built
+        """Whether a rule's loop (:class:`~designer.pid.result.LoopFigures` ``f``), built
         as the design builds it (its own crossover's corners, the op-amp poles), keeps every
         op-amp output within its swing and slew (its row holds its margins and u only)."""
         from .modelloop import (built_controller, corner_frequencies, ideal_crossover_hz, leak_limit_hz,

@@ -12,7 +12,7 @@ used), every rule side by side on it (gains, margins, Ms, IAE, overshoot),
 target against achieved, the checks, the loop as built against the ideal PID
 and SPICE, the worst case over the model's 95 % corners, and the scope
 readings. Everything is read from the typed
-:class:`~designer.pid.process_result.ProcessPidResult`: nothing is computed here.
+:class:`~designer.pid.result.PidResult`: nothing is computed here.
 """
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ def _dash(v, unit: str = "", digits: int = 4) -> str:
 
 
 def verdict_text(result) -> str:
-    return verdict_of(result.stable, result.analytic, result.spice, result.checks)
+    return verdict_of(result.stable, result.analytic.figures, result.spice, result.checks)
 
 
 def build_board(result):
@@ -244,7 +244,7 @@ def _margin_rows(ideal, built) -> list:
 
 
 def _loop_blocks(result, with_images) -> list:
-    a, s, amp, mg = result.analytic, result.spice, result.opamp, result.margins
+    a, s, amp, mg = result.analytic.figures, result.spice, result.opamp, result.margins
     rows = _margin_rows(result.ideal_margins, mg)
     i = result.ideal_pid
     rows += [[_(label), f(_known(getattr(i, key))) if i is not None else "-", f(_known(getattr(a, key))),

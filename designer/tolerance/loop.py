@@ -78,7 +78,7 @@ WORST_FIGURES = ("phase_margin_deg", "gain_margin_db", "model_overshoot_pct")
 
 
 def is_model_loop(result) -> bool:
-    """Whether ``result`` is a model plant's loop (:class:`~designer.pid.process_result.ProcessPidResult`)."""
+    """Whether ``result`` is a model plant's loop (:class:`~designer.pid.result.PidResult`)."""
     return getattr(result, "model", None) is not None
 
 

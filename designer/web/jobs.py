@@ -407,7 +407,7 @@ def pid_page(result) -> dict:
     PID, the plant alone), the loop gain, the schematic and the build sheet
     without its pictures (verdict, BOM, settings, wiring, block checks)."""
     from ..report.document import to_html
-    if hasattr(result, "model"):
+    if result.model is not None:
         from ..pid import process_report as rep
         open_loop = not result.model.integrating
     else:

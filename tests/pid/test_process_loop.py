@@ -125,7 +125,7 @@ def test_spice_agrees_with_the_analytic_loop_with_exact_dead_time(tf, tuning, si
     assert not res.failed_checks(), [c.to_dict() for c in res.failed_checks()]   # nothing to explain away
     v = res.verdict
     assert v.agree and not v.unexplained, (res.spice.nrms, v)
-    assert v.overshoot_delta_pp == pytest.approx(res.spice.figures.overshoot_pct - res.analytic.overshoot_pct)
+    assert v.overshoot_delta_pp == pytest.approx(res.spice.figures.overshoot_pct - res.analytic.figures.overshoot_pct)
     assert res.verdicts()[-1].ok
 
 
@@ -261,7 +261,7 @@ def test_a_loop_far_slower_than_its_controller_is_simulated():
     and zeros far above the crossover, and the time simulations' reduced controller was a 0-d array."""
     from designer.pid.process_loop import simulation_controller
     res = design(plant_tf=ISSUE_TF, tuning="imc", imc_lambda_s=1.0)
-    assert res.analytic.final_value > 0
+    assert res.analytic.figures.final_value > 0
     num, den = simulation_controller(([1.0, 1e9], [1.0, 1e8]), 1.0)   # both far above 1 Hz: a gain
     assert num.shape == den.shape == (1,) and num[0] / den[0] == pytest.approx(10.0, rel=1e-6)
 
@@ -315,4 +315,4 @@ def test_a_sweep_of_dead_times_and_time_constants_designs(tf):
     suite turns one into a failure), and its loop as built is stable with a finite step response."""
     res = design(plant_tf=tf)
     assert res.stable
-    assert math.isfinite(res.analytic.overshoot_pct) and math.isfinite(res.analytic.final_value)
+    assert math.isfinite(res.analytic.figures.overshoot_pct) and math.isfinite(res.analytic.figures.final_value)

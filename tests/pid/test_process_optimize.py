@@ -172,10 +172,10 @@ def test_a_target_overshoot_is_met_by_the_analytic_loop(tf):
     on the integrating plant; the target is now checked on the loop as built, Kp lowered until it holds."""
     free = optimized(plant_tf=tf)
     # 5 %, or below the free optimum where the op-amp's slew already holds it lower: the target binds
-    target = min(5.0, round(0.6 * free.analytic.overshoot_pct, 1))
-    assert free.analytic.overshoot_pct > target
+    target = min(5.0, round(0.6 * free.analytic.figures.overshoot_pct, 1))
+    assert free.analytic.figures.overshoot_pct > target
     res = optimized(plant_tf=tf, target_overshoot_pct=target)
-    assert res.analytic.overshoot_pct <= target, res.analytic.overshoot_pct
+    assert res.analytic.figures.overshoot_pct <= target, res.analytic.figures.overshoot_pct
     assert meets(built_margins(res), res.limits)
 
 

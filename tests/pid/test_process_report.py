@@ -97,13 +97,13 @@ def test_the_robust_worst_case_is_on_the_sheet(robust):
 
 def test_renderers_read_the_typed_result_and_compute_nothing(robust, monkeypatch):
     from designer.pid import delayloop, delaymargins, model, process_loop
-    from designer.pid.process_result import ProcessPidResult
+    from designer.pid.result import PidResult
     expected = P.summary_text(robust)
 
     def forbidden(*args, **kwargs):
         raise AssertionError("a renderer called back into the design or its JSON")
 
-    monkeypatch.setattr(ProcessPidResult, "to_dict", forbidden)
+    monkeypatch.setattr(PidResult, "to_dict", forbidden)
     for mod, names in ((process_loop, ("design_model_pid", "analyse", "loop_figures", "robust_check",
                                        "rule_table", "model_loop_scope")),
                        (delaymargins, ("loop_margins", "loop_response")), (delayloop, ("closed_loop_step",)),
