@@ -274,9 +274,8 @@ def test_the_cycle_check_fails_on_a_planted_cycle_through_a_function_level_impor
 
 #: (importer, module) pairs other helpers of issue 26 are merging, exempted exactly (the lead deletes them
 #: at the merge): helper "pidone" merges the two PID pipelines (orchestration and build sheet)
-#: private names taken across modules, exempted exactly: the PID's two sheets (report, process_report) are one
-#: concept split in two, to be merged with the two PID pipelines (issue 26)
-KNOWN_PRIVATE: set = {("designer/pid/process_report.py", "designer.pid.report")}
+#: private names taken across modules, exempted exactly (none: the PID's two sheets are one module, issue 26)
+KNOWN_PRIVATE: set = set()
 
 
 def test_no_module_takes_another_modules_private_name():

@@ -11,9 +11,8 @@ margins, the levels at every op-amp output, the worst case over a model's
 95 % corners (:class:`RobustCheck`), the bench test, the SPICE run and its
 verdict, and the waveforms the plots draw. Its one :meth:`PidResult.to_dict`
 is the JSON of ``design-pid --json`` and ``result.json`` (each plant kind's
-keys as before the two results were one); the build sheets
-(:mod:`designer.pid.report`, :mod:`designer.pid.process_report`) read the
-typed result and compute nothing.
+keys as before the two results were one); the build sheet
+(:mod:`designer.pid.report`) reads the typed result and computes nothing.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ from helpers import deck_terminals
 from designer.cli.common import flag_message
 from designer.core.errors import DesignError
 from designer.filters.registry import REGISTRY, get
-from designer.pid import process_report as P
+from designer.pid import report as P
 from designer.pid.design import design_pid
 from designer.pid.netlist import circuit_loop_netlist, controller_netlist
 from designer.pid.plant import (PLANT_PREFIX, Plant, circuit_from_cascade, circuit_plant, parse_part_values,
