@@ -1,6 +1,6 @@
 """The figures of a PID loop around a plant model, G(s) = N(s)/D(s) e^(-theta s),
 that the model plant's design (:mod:`designer.pid.process_loop`) and its
-optimiser (:mod:`designer.pid.process_optimize`) both use: the spec's limits,
+optimiser (:mod:`designer.pid.optimize`) both use: the spec's limits,
 the ideal loop's crossover, the integrator leak and derivative filter corners
 (fc/100 and 10 fc, as for a Sallen-Key plant's fn), the step response of the
 loop with the exact dead time (:func:`designer.pid.delayloop.closed_loop_step`)
@@ -10,7 +10,7 @@ and the E-series sizing (:func:`designer.pid.selection.select_parts`).
 
 Moved out of :mod:`designer.pid.process_loop` (which re-exports every name) so
 that the optimiser needs not import the design that calls it: the cycle
-process_loop <-> process_optimize went with it.
+process_loop <-> optimize went with it.
 """
 
 from __future__ import annotations

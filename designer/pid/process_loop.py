@@ -8,7 +8,7 @@ plant is a circuit:
 
 1. the rules of :mod:`designer.pid.rules` on the model each intends (every one,
    side by side, with the reason where one does not apply), or the optimiser
-   (:mod:`designer.pid.process_optimize`), or explicit gains;
+   (:mod:`designer.pid.optimize`), or explicit gains;
 2. the parts (:func:`designer.pid.selection.select_parts`), the integrator leak at
    fc/100 and the derivative filter at 10 fc, fc the crossover of the rule's
    ideal loop (as fn/100 and 10 fn for a Sallen-Key plant);
@@ -86,7 +86,7 @@ def choose_gains(spec: PidSpec, model, reduced, amp, table) -> tuple:
     if spec.kp is not None:
         return Gains("explicit", spec.kp, spec.ti_s, spec.td_s), None, []
     if spec.tuning == "optimize":
-        from .process_optimize import optimize_model_loop
+        from .optimize import optimize_model_loop
         opt = optimize_model_loop(spec, model, amp, table)
         return (Gains("optimize", opt.kp, opt.ti_s, opt.td_s), opt, [opt.message])
     if spec.tuning is not None:

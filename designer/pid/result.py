@@ -249,7 +249,7 @@ class PidResult(LoopVerdicts):
     spec: PidSpec
     opamp: OpAmp
     rules: tuple                        #: Tuning per reaction-curve rule (Sallen-Key plant), else RuleRow per rule
-    optimizer: object                   #: OptimizeResult or designer.pid.process_optimize's result, else None
+    optimizer: object                   #: designer.pid.optimize's OptimizeResult or ModelOptimizeResult, else None
     parts: PidParts
     selection: Selection | None         #: None for given parts
     achieved: Achieved

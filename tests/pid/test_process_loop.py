@@ -15,7 +15,7 @@ Each result is checked against a computation done another way here:
   microsecond plants.
 
 :func:`designer.pid.process_loop.design_model_pid` with ``tuning="optimize"`` is
-tested in test_process_optimize.py.
+tested in test_optimize.py.
 """
 
 import math

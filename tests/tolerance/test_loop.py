@@ -230,7 +230,7 @@ def _row_loop(designed, row, amp):
     plant = SallenKeyParts(row["R1"], row["R2"], row["C1"], row["C2"])
     parts = PidParts(**{f: row[f.upper()] for f in PidParts.__dataclass_fields__ if f.upper() in row.dtype.names})
     pn, pd = plant_tf_opamp(plant, amp)
-    from designer.pid.process_optimize import slew_delay_stages
+    from designer.pid.optimize import slew_delay_stages
     from designer.tolerance.loop import kick_grid
     step, edge = designed.test.amplitude_v, designed.test.edge_s
     t = np.linspace(0.0, designed.waveforms.t[-1], STEP_POINTS)

@@ -1,4 +1,4 @@
-"""``tuning="optimize"`` for a model plant (designer.pid.process_optimize through
+"""``tuning="optimize"`` for a model plant (designer.pid.optimize through
 design_model_pid): the limits hold on the loop as built (the E-series parts'
 controller with its op-amp poles, exact margins with the dead time), its IAE is
 no worse than the best rule's that meets the same limits, and the options
@@ -79,7 +79,7 @@ def test_the_searchs_slew_delay_equals_a_fine_grids():
     from designer.core import opamps
     from designer.pid import blocks, model as M
     from designer.pid.process_loop import edged, stage_waves
-    from designer.pid.process_optimize import KICK_POINTS, SEARCH_POINTS, SEARCH_STEP_FRACTION, _Problem
+    from designer.pid.optimize import KICK_POINTS, SEARCH_POINTS, SEARCH_STEP_FRACTION, _Problem
     spec = PidSpec(plant_tf=FAST_TF, tuning="optimize")
     model, amp = spec.process, opamps.get(spec.opamp)
     kp, ti, td, fc = 1.6, 200e-6, 10e-6, 8e3
