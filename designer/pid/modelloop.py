@@ -1,5 +1,5 @@
 """The figures of a PID loop around a plant model, G(s) = N(s)/D(s) e^(-theta s),
-that the model plant's design (:mod:`designer.pid.process_loop`) and its
+that the model plant's design (:mod:`designer.pid.design`) and its
 optimiser (:mod:`designer.pid.optimize`) both use: the spec's limits,
 the ideal loop's crossover, the integrator leak and derivative filter corners
 (fc/100 and 10 fc, as for a Sallen-Key plant's fn), the step response of the
@@ -8,9 +8,9 @@ and every op-amp stage's output from it (:func:`designer.pid.model.stage_tfs`),
 the controller as it will be built (:func:`designer.pid.model.controller_tf`),
 and the E-series sizing (:func:`designer.pid.selection.select_parts`).
 
-Moved out of :mod:`designer.pid.process_loop` (which re-exports every name) so
-that the optimiser needs not import the design that calls it: the cycle
-process_loop <-> optimize went with it.
+Kept apart from :mod:`designer.pid.design` (which re-exports every name) so
+that the optimiser needs not import the design that calls it: no cycle
+design <-> optimize.
 """
 
 from __future__ import annotations

@@ -462,7 +462,7 @@ class _Problem:
 def optimize_model_loop(spec, model, amp, table) -> ModelOptimizeResult:
     """Optimise the gains for ``spec.process`` (see the module's notes).
 
-    ``table`` is the rule table (:func:`designer.pid.process_loop.rule_table`):
+    ``table`` is the rule table (:func:`designer.pid.design.rule_table`):
     its applicable, stable rows are the candidate starts; the one with the
     smallest IAE among those that meet the limits (else the smallest Ms) wins.
     """

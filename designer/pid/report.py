@@ -566,8 +566,8 @@ def _model_verdict_text(result) -> str:
 def _model_board(result):
     """The loop as built on the bench: the controller's part and net table
     (the plant off the board), or with a circuit plant's own sections on it
-    (:func:`~designer.pid.process_loop.loop_netlist_of`), in the result's package."""
-    from .process_loop import loop_netlist_of
+    (:func:`~designer.pid.design.loop_netlist_of`), in the result's package."""
+    from .design import loop_netlist_of
     return board(loop_netlist_of(result.spec, result.parts), result.opamp, result.package)
 
 
@@ -856,5 +856,5 @@ BEFORE_SPICE = ("loop-bode.png", "reaction-curve.png")
 
 def draw_early(result):
     """Start drawing the schematic and :data:`BEFORE_SPICE` (``before_spice`` of
-    :func:`~designer.pid.process_loop.design_model_pid`); give it to :func:`write_outputs`."""
+    :func:`~designer.pid.design.design_model_pid`); give it to :func:`write_outputs`."""
     return bundle_early(result, MODEL_PLOTS, schematic, BEFORE_SPICE)

@@ -216,12 +216,12 @@ def _step_and_swing(out: dict, i: int, t, waves: dict, expected: float, amp, kic
 def model_loop_figures(values: dict, result) -> dict:
     """:data:`FIGURES` of the controller's sampled parts around a plant given as a model (its
     parameters as identified), each loop analysed as design-pid analyses it
-    (:func:`designer.pid.process_loop.analyse`: exact dead time, its margins by the argument
+    (:func:`designer.pid.design.analyse`: exact dead time, its margins by the argument
     principle, the step on the result's grid; about 0.2 s a build)."""
     from ..pid import model as M
     from ..pid.blocks import PidParts
     from ..pid.delaymargins import loop_margins
-    from ..pid.process_loop import closed_loop_step, edged, loop_dc_gain, plant_of, simulation_controller, stage_waves
+    from ..pid.design import closed_loop_step, edged, loop_dc_gain, plant_of, simulation_controller, stage_waves
     from .parts import sample_opamp
     model = result.model
     plant = plant_of(model)

@@ -11,7 +11,7 @@ from designer.core import process_build
 from designer.pid.delayloop import closed_loop_step, step_figures
 from designer.pid.delaymargins import loop_margins
 from designer.pid.model import controller_tf
-from designer.pid.process_loop import (built_controller, corner_frequencies, design_model_pid, ideal_crossover_hz,
+from designer.pid.design import (built_controller, corner_frequencies, design_model_pid, ideal_crossover_hz,
                                        leak_limit_hz, plant_of,
                                        response_grid)
 from designer.pid.selection import select_parts
@@ -78,7 +78,7 @@ def test_the_searchs_slew_delay_equals_a_fine_grids():
     on a grid 250 times finer: within 5 %."""
     from designer.core import opamps
     from designer.pid import blocks, model as M
-    from designer.pid.process_loop import edged, stage_waves
+    from designer.pid.design import edged, stage_waves
     from designer.pid.optimize import KICK_POINTS, SEARCH_POINTS, SEARCH_STEP_FRACTION, _Problem
     spec = PidSpec(plant_tf=FAST_TF, tuning="optimize")
     model, amp = spec.process, opamps.get(spec.opamp)

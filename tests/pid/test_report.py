@@ -19,7 +19,7 @@ from designer.pid import report as P
 from designer.pid.blocks import seed_parts
 from designer.pid.design import PidSpec, design_pid
 from designer.pid.netlist import controller_netlist, model_loop_deck
-from designer.pid.process_loop import design_model_pid
+from designer.pid.design import design_model_pid
 from designer.pid.rules import RULES
 from designer.pid.schematic import PLANT_BLOCK, draw_model_loop
 from designer.report.schematic import check_connectivity
@@ -177,7 +177,7 @@ def test_the_robust_worst_case_is_on_the_sheet(robust):
 
 
 def test_a_model_plants_sheet_reads_the_typed_result_and_computes_nothing(robust, monkeypatch):
-    from designer.pid import delayloop, delaymargins, model, process_loop
+    from designer.pid import delayloop, delaymargins, design, model
     from designer.pid.result import PidResult
     expected = P.summary_text(robust)
 
@@ -185,7 +185,7 @@ def test_a_model_plants_sheet_reads_the_typed_result_and_computes_nothing(robust
         raise AssertionError("a renderer called back into the design or its JSON")
 
     monkeypatch.setattr(PidResult, "to_dict", forbidden)
-    for mod, names in ((process_loop, ("design_model_pid", "analyse", "loop_figures", "robust_check",
+    for mod, names in ((design, ("design_model_pid", "analyse", "loop_figures", "robust_check",
                                        "rule_table", "model_loop_scope")),
                        (delaymargins, ("loop_margins", "loop_response")), (delayloop, ("closed_loop_step",)),
                        (model, ("controller_tf", "waveform_limits", "stage_tfs"))):
