@@ -165,6 +165,21 @@ def analyze_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice"
     :class:`~designer.core.opamps.OpAmp` in place of ``spec.opamp``'s catalogue entry (a
     Monte Carlo build's, its gain-bandwidth and slew rate drawn: ``--replay``).
 
+    Parameters
+    ----------
+    spec : PidSpec
+        With ``controller_parts``.
+    simulate : bool
+        Run the closed-loop deck in ngspice.
+    simulator : str
+        ``"pyspice"`` or ``"ngspice-cli"``.
+    opamp : designer.core.opamps.OpAmp, optional
+        In place of ``spec.opamp``'s catalogue entry.
+
+    Returns
+    -------
+    PidResult
+
     Raises
     ------
     ParamError
@@ -497,7 +512,19 @@ def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise, parts, nam
 
 def run_spice(res: PidResult, simulator: str) -> None:
     """Simulate the deck, compare, detect saturation and oscillation; fills
-    ``spice``, ``verdict`` and the notes of ``res``."""
+    ``spice``, ``verdict`` and the notes of ``res`` (a model plant's by its own rule).
+
+    Parameters
+    ----------
+    res : PidResult
+        The design, analysed.
+    simulator : str
+        ``"pyspice"`` or ``"ngspice-cli"``.
+
+    Returns
+    -------
+    None
+    """
     if res.model is not None:
         return run_model_spice(res, simulator)
     w = res.waveforms
@@ -608,6 +635,8 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
     before_spice : callable, optional
         Called with the result, analysed but not yet simulated, just before the
         SPICE run (a command starts drawing the pictures that need no SPICE then).
+    opamp : designer.core.opamps.OpAmp, optional
+        In place of ``spec.opamp``'s catalogue entry (a Monte Carlo build's).
 
     Returns
     -------
@@ -715,7 +744,29 @@ class _ModelLoop:
 
 
 def analyse(spec, model, amp, parts, gains, fc, simulate) -> _ModelLoop:
-    """The loop as built around the model: margins, time response, every stage, checks, deck."""
+    """The loop as built around the model: margins, time response, every stage, checks, deck.
+
+    Parameters
+    ----------
+    spec : PidSpec
+        The request (a model plant).
+    model : designer.core.process.ProcessModel
+        The plant.
+    amp : designer.core.opamps.OpAmp
+        The op-amp of every stage.
+    parts : designer.pid.blocks.PidParts
+        The controller as built.
+    gains : Gains
+        The gains the parts are for.
+    fc : float
+        The ideal loop's crossover (Hz): the scale of the time grids and the bench test.
+    simulate : bool
+        Whether the deck will be simulated (its notes say so).
+
+    Returns
+    -------
+    _ModelLoop
+    """
     ctrl = M.controller_tf(parts, amp)
     plant = plant_of(model)
     mg = loop_margins(plant, ctrl)

@@ -145,7 +145,23 @@ class OptimizeResult:
 
 def evaluate(kp: float, ti: float, td: float, ctx: Context) -> Evaluation:
     """Cost and figures of one (Kp, Ti, Td) on the realised closed loop
-    (unrounded parts, :func:`designer.pid.blocks.continuous_parts`)."""
+    (unrounded parts, :func:`designer.pid.blocks.continuous_parts`).
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain.
+    ti : float
+        Integral time (s).
+    td : float
+        Derivative time (s).
+    ctx : Context
+        The plant, the op-amp, the step and the targets.
+
+    Returns
+    -------
+    Evaluation
+    """
     parts = blocks.continuous_parts(kp, ti, td, ctx.fn_hz, f_integrator_hz=ctx.f_integrator_hz,
                                     f_differentiator_hz=ctx.f_differentiator_hz)
     return evaluate_parts(parts, ctx, (kp, ti, td))
@@ -197,7 +213,21 @@ def meets(ev: Evaluation, ctx: Context) -> bool:
 
 def optimize(ctx: Context, starts, maxiter: int = 120) -> OptimizeResult:
     """Minimise the cost from each (Kp, Ti, Td) in ``starts``; the best point wins.
-    The targets in ``ctx`` are taken as valid (:class:`designer.pid.spec.PidSpec` checks them)."""
+    The targets in ``ctx`` are taken as valid (:class:`designer.pid.spec.PidSpec` checks them).
+
+    Parameters
+    ----------
+    ctx : Context
+        The plant, the op-amp, the step and the targets.
+    starts : iterable of tuple
+        (Kp, Ti, Td) starting points (the rules' gains).
+    maxiter : int
+        Nelder-Mead iterations per start.
+
+    Returns
+    -------
+    OptimizeResult
+    """
     count = 0
     cache = {}
 
@@ -261,7 +291,24 @@ KICK_POINTS = 401
 def slew_delay_stages(t_fine, v_fine, t, v, slew_v_per_s: float, edge_s: float) -> float:
     """The slew delay (:func:`designer.pid.model.slew_delay`) of a stage output known on
     a fine grid ``t_fine`` over the kick and on the coarse ``t`` after it; the fine grid's
-    first step, which holds the reference's edge, counts as the edge's length."""
+    first step, which holds the reference's edge, counts as the edge's length.
+
+    Parameters
+    ----------
+    t_fine, v_fine : numpy.ndarray
+        The fine grid over the kick (s) and the output on it (V).
+    t, v : numpy.ndarray
+        The coarse grid (s) and the output on it (V).
+    slew_v_per_s : float
+        The op-amp's slew rate.
+    edge_s : float
+        The reference's edge (s).
+
+    Returns
+    -------
+    float
+        The delay (s).
+    """
     dv = np.abs(np.diff(v_fine))
     dt = np.diff(t_fine)
     if edge_s > 0:
@@ -465,6 +512,21 @@ def optimize_model_loop(spec, model, amp, table) -> ModelOptimizeResult:
     ``table`` is the rule table (:func:`designer.pid.design.rule_table`):
     its applicable, stable rows are the candidate starts; the one with the
     smallest IAE among those that meet the limits (else the smallest Ms) wins.
+
+    Parameters
+    ----------
+    spec : designer.pid.spec.PidSpec
+        The request (its limits, targets and ``robust``).
+    model : designer.core.process.ProcessModel
+        The plant.
+    amp : designer.core.opamps.OpAmp
+        The op-amp of every stage.
+    table : tuple of designer.pid.result.RuleRow
+        Every rule on the plant.
+
+    Returns
+    -------
+    ModelOptimizeResult
     """
     from scipy.optimize import minimize
 

@@ -71,6 +71,17 @@ SHOWN_WORDS = (N_("True"), N_("False"), N_("difference"), N_("inverter"), N_("di
 
 
 def title_of(result) -> str:
+    """The sheet's title: the tuning, the gains, the plant and the op-amp.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design, either kind of plant.
+
+    Returns
+    -------
+    str
+    """
     if result.model is not None:
         return _model_title_of(result)
     t = result.tuning
@@ -121,14 +132,40 @@ def verdict_of(stable, figures, s, checks) -> str:
 
 
 def build_board(result):
-    """The loop as built on the bench: its part and net table (the deck's) in the result's package."""
+    """The loop as built on the bench: its part and net table (the deck's) in the result's package
+    (a model plant's: the controller, and a circuit plant's own sections when a circuit realises it).
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design, either kind of plant.
+
+    Returns
+    -------
+    designer.spice.deck.Board
+    """
     if result.model is not None:
         return _model_board(result)
     return board(loop_netlist(result.parts, result.plant), result.opamp, result.package)
 
 
 def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
-    """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`)."""
+    """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`).
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design, either kind of plant.
+    with_images : bool
+        Place the schematic and the plots (False: the terminal's text).
+    schematic_svg : str
+        The schematic drawn as SVG, inlined in the HTML sheet.
+
+    Returns
+    -------
+    list
+        (heading, blocks) pairs.
+    """
     if result.model is not None:
         return _model_sections(result, with_images, schematic_svg)
     b = build_board(result)
@@ -189,7 +226,20 @@ def controller_source(sel):
 
 def bom(result, b=None) -> list:
     """The bill of materials rows (:data:`designer.report.wiring.BOM_HEADER`): the
-    controller's parts from its series, the plant's from the plant's."""
+    controller's parts from its series, the plant's from the plant's.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design, either kind of plant.
+    b : designer.spice.deck.Board, optional
+        The board (default :func:`build_board` of ``result``).
+
+    Returns
+    -------
+    list
+        One row per value and kind.
+    """
     if result.model is not None:
         return _model_bom(result, b)
     b = b or build_board(result)
@@ -414,6 +464,19 @@ def _fmt(v, unit, signed=False):
 
 
 def summary_text(result, lang=None) -> str:
+    """The sheet as terminal text, with the Monte Carlo's and the worst case's summary lines.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design, either kind of plant.
+    lang : str, optional
+        The sheet's language (None: the current one, :mod:`designer.core.i18n`).
+
+    Returns
+    -------
+    str
+    """
     with language(lang):   # None: the current language (designer.core.i18n)
         text = R.to_text(title_of(result), sections(result, with_images=False))
     for extra in (result.monte_carlo, result.worst_case):
@@ -427,7 +490,18 @@ def summary_text(result, lang=None) -> str:
 def plots(result) -> dict:
     """The sheet's plots, by file name (:func:`plots_of`): the closed-loop step (SPICE minus
     the analytic loop below it), every op-amp output, the loop gain with its margins,
-    the reaction curve."""
+    the reaction curve.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design, either kind of plant.
+
+    Returns
+    -------
+    dict
+        File name -> PNG bytes.
+    """
     return {name: draw(result) for name, draw in plots_of(result)}
 
 
@@ -506,7 +580,18 @@ def _reaction_plot(result) -> bytes:
 
 
 def schematic(result):
-    """The loop's schematic (:mod:`designer.pid.schematic`) as a drawing."""
+    """The loop's schematic (:mod:`designer.pid.schematic`) as a drawing: a model plant a
+    block labelled with its G(s), a circuit plant its own sections.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design, either kind of plant.
+
+    Returns
+    -------
+    designer.report.schematic.Sheet
+    """
     if result.model is not None:
         return _model_schematic(result)
     from .schematic import draw_loop
@@ -520,7 +605,17 @@ PLOTS = (("closed-loop.png", _closed_loop_plot), ("blocks.png", _blocks_plot),
 
 def plots_of(result) -> tuple:
     """The (file name, drawing function) pairs of ``result``'s sheet: :data:`PLOTS`, or
-    :data:`MODEL_PLOTS` for a model plant."""
+    :data:`MODEL_PLOTS` for a model plant.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design, either kind of plant.
+
+    Returns
+    -------
+    tuple
+    """
     return MODEL_PLOTS if result.model is not None else PLOTS
 
 
@@ -528,7 +623,26 @@ def write_outputs(result, out_dir, name: str, lang=None, early=None) -> dict:
     """``netlists/<name>.cir`` and ``reports/<name>/`` (build sheet, result.json,
     plots, schematic, bom.csv, and the Monte Carlo's files) under ``out_dir``, each written
     atomically; the sheet in ``lang`` (None: the current language, :mod:`designer.core.i18n`);
-    the pictures ``early`` (:func:`draw_early`) started are not drawn again."""
+    the pictures ``early`` (:func:`draw_early`) started are not drawn again.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design, either kind of plant.
+    out_dir : str or Path
+        Where ``netlists/`` and ``reports/`` go.
+    name : str
+        The bundle's name.
+    lang : str, optional
+        The sheet's language.
+    early : object, optional
+        What :func:`draw_early` returned.
+
+    Returns
+    -------
+    dict
+        What was written, by kind (the result's ``files``).
+    """
     with language(lang):
         return write_design(result, out_dir, name, plots_of(result) + histogram_plots(result), schematic,
                             lambda svg: sections(result, schematic_svg=svg), title_of(result),
@@ -856,5 +970,16 @@ BEFORE_SPICE = ("loop-bode.png", "reaction-curve.png")
 
 def draw_early(result):
     """Start drawing the schematic and :data:`BEFORE_SPICE` (``before_spice`` of
-    :func:`~designer.pid.design.design_model_pid`); give it to :func:`write_outputs`."""
+    :func:`~designer.pid.design.design_model_pid`); give it to :func:`write_outputs`.
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        A model plant's design, analysed but not yet simulated.
+
+    Returns
+    -------
+    object
+        The drawings under way (:func:`designer.report.bundle.draw_early`).
+    """
     return bundle_early(result, MODEL_PLOTS, schematic, BEFORE_SPICE)
