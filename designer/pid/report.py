@@ -179,13 +179,20 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
         out.append((_("Difference amplifier as built"), _diff_amp_blocks(result)))
     out.append((_("Tuning"), _tuning_blocks(result)))
     out.append((_("Target and achieved"), _achieved_blocks(result)))
-    out.append((_("Checks"), [R.table([_("check"), _("result"), _("detail")],
-                                      [[c.id, _("ok") if c.ok else _("FAILED"), c.detail] for c in result.checks])]))
-    out.append((_("Closed loop"), _loop_blocks(result, with_images)))
+    return out + _closing_sections(result, _loop_blocks(result, with_images), with_images,
+                                   _scope_blocks(result, with_images, b))
+
+
+def _closing_sections(result, loop_blocks, with_images, scope_blocks) -> list:
+    """The sheet's last sections, the same for every plant: the checks, the closed loop
+    (``loop_blocks``), the tolerance analysis when there is one, the scope readings (``scope_blocks``)."""
+    out = [(_("Checks"), [R.table([_("check"), _("result"), _("detail")],
+                                  [[c.id, _("ok") if c.ok else _("FAILED"), c.detail] for c in result.checks])]),
+           (_("Closed loop"), loop_blocks)]
     heading = tolerance_title(result, worst=True)
     if heading is not None:
         out.append((heading, tolerance_section(result, with_images, worst=True)))
-    out.append((_("Expected scope readings"), _scope_blocks(result, with_images, b)))
+    out.append((_("Expected scope readings"), scope_blocks))
     return out
 
 
@@ -391,10 +398,13 @@ def _loop_blocks(result, with_images) -> list:
                                                  sse=_fmt(a.steady_state_error_pct, '%'))))
     if s:
         blocks.append(R.text(_spice_agreement(result)))
-    if with_images:
-        blocks.append(R.columns([R.image("closed-loop.png", _("closed-loop step and controller output"))],
-                                [R.image("loop-bode.png", _("loop gain with its margins"))]))
-    return blocks
+    return blocks + _loop_images(with_images)
+
+
+def _loop_images(with_images: bool) -> list:
+    """The closed-loop step beside the loop gain (none without images)."""
+    return [R.columns([R.image("closed-loop.png", _("closed-loop step and controller output"))],
+                      [R.image("loop-bode.png", _("loop gain with its margins"))])] if with_images else []
 
 
 def _spice_agreement(result) -> str:
@@ -721,14 +731,8 @@ def _model_sections(result, with_images: bool = True, schematic_svg: str = "") -
         f"The integrator leak (R13) and the derivative filter (R12) are placed from fc = "
         f"{_v(result.fc_ref_hz, 'Hz')}, the crossover of the ideal PID around the model (near fc/100 and "
         "10 fc unless set).")]))
-    out.append((_("Checks"), [R.table([_("check"), _("result"), _("detail")],
-                                      [[c.id, _("ok") if c.ok else _("FAILED"), c.detail] for c in result.checks])]))
-    out.append((_("Closed loop"), _model_loop_blocks(result, with_images)))
-    heading = tolerance_title(result, worst=True)
-    if heading is not None:
-        out.append((heading, tolerance_section(result, with_images, worst=True)))
-    out.append((_("Expected scope readings"), _scope(result, with_images, b)))
-    return out
+    return out + _closing_sections(result, _model_loop_blocks(result, with_images), with_images,
+                                   _scope(result, with_images, b))
 
 
 def plant_rows(b) -> list:
@@ -877,10 +881,7 @@ def _model_loop_blocks(result, with_images) -> list:
         blocks.append(R.text(_spice_agreement(result)))
     if result.robust is not None:
         blocks += _robust_blocks(result.robust)
-    if with_images:
-        blocks.append(R.columns([R.image("closed-loop.png", _("closed-loop step and controller output"))],
-                                [R.image("loop-bode.png", _("loop gain with its margins"))]))
-    return blocks
+    return blocks + _loop_images(with_images)
 
 
 def _robust_blocks(rb) -> list:
