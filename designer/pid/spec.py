@@ -390,7 +390,17 @@ def check_controller(parts: PidParts, names: dict | None = None) -> PidParts:
 def controller_from_json(path) -> PidParts:
     """The controller parts of a ``design-pid``/``analyze-pid`` result.json (its
     ``components`` object: ``R3_ohm`` .. ``C4_f``), read by the one reader and
-    checked by :func:`check_controller`; a refusal names the file and the key."""
+    checked by :func:`check_controller`; a refusal names the file and the key.
+
+    Parameters
+    ----------
+    path : str or Path
+        The result.json.
+
+    Returns
+    -------
+    PidParts
+    """
     try:
         comp = read_result(path, "{controller_json}", needs={"components": ("R3_ohm",)},
                            what="a design-pid result.json")["components"]
