@@ -275,9 +275,8 @@ def test_the_cycle_check_fails_on_a_planted_cycle_through_a_function_level_impor
 
 #: (importer, module) pairs other helpers of issue 26 are merging, exempted exactly (the lead deletes them
 #: at the merge): helper "pidone" merges the two PID pipelines (orchestration and build sheet)
-#: private names taken across modules, exempted exactly: the PID's two sheets (report, process_report) are one
-#: concept split in two, to be merged with the two PID pipelines (issue 26)
-KNOWN_PRIVATE: set = {("designer/pid/process_report.py", "designer.pid.report")}
+#: private names taken across modules, exempted exactly (none: the PID's two sheets are one module, issue 26)
+KNOWN_PRIVATE: set = set()
 
 
 def test_no_module_takes_another_modules_private_name():
@@ -344,10 +343,10 @@ def test_the_api_check_fails_on_planted_gaps(tmp_path):
 
 # --------------------------------------------------------------------------- docstrings (numpydoc)
 #: the packages (or single modules) whose public API (every function and class in a module's __all__) the
-#: numpydoc check covers: a growing list; identify, pid, cli and web are being rewritten by other
+#: numpydoc check covers: a growing list; identify, cli and web are being rewritten by other
 #: helpers of issue 26
 NUMPYDOC_PACKAGES = ["designer.core", "designer.spice", "designer.report", "designer.tolerance", "designer.check",
-                     "designer.plant", "designer.filters"]
+                     "designer.plant", "designer.filters", "designer.pid"]
 #: numpydoc's checks of substance, not of style: a docstring (GL08) with a summary (SS01); for a function,
 #: every parameter documented (PR01), none that it does not have (PR02), a Returns section when it returns
 #: a value (RT01), the sections in numpydoc's order (GL07). A class needs a docstring with a summary (its

@@ -19,7 +19,7 @@ __all__ = ["analyze_pid", "analyze_plant", "check_design", "design_filter", "des
            "identify", "identify_freq", "make_prbs", "simulate_capture"]
 
 #: the report module whose pictures each command's renderer draws
-_REPORTS = {"plant": ("designer.plant.report",), "pid": ("designer.pid.report", "designer.pid.process_report")}
+_REPORTS = {"plant": ("designer.plant.report",), "pid": ("designer.pid.report",)}
 
 
 def draws(argv) -> bool:

@@ -315,14 +315,13 @@ def _run(args) -> int:
     spec = _build_spec(args)
     mc, spice = monte_carlo_settings(args, spec)
     if spec.process is not None:
-        from ..pid.process_report import summary_text as model_text, write_outputs as model_write
         common.check_output(args, replay_name(args.name if args.name is not None else "pid_model", spice))
         if spice[2] is not None:    # the design is the draw's nominal; the build's own run is the simulation
             result = design_pid(spec, simulate=False, simulator=args.simulator)
             name = args.name or _model_name(spec, result.method)
-            return emit(replay(spec, result, args, mc, spice), args, replay_name(name, spice), model_write,
-                        model_text)
-        from ..pid.process_report import draw_early
+            return emit(replay(spec, result, args, mc, spice), args, replay_name(name, spice), write_outputs,
+                        summary_text)
+        from ..pid.report import draw_early
         early = []   # the pictures that need no SPICE, drawn in the renderer while ngspice runs
         with cluster_ahead(args):
             result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator,
@@ -330,7 +329,7 @@ def _run(args) -> int:
                                 before_spice=None if args.no_files else lambda r: early.append(draw_early(r)))
             result = loop_monte_carlo(result, args, mc, spice)
         return emit(result, args, args.name or _model_name(spec, result.method),
-                    lambda *a: model_write(*a, early=early[0] if early else None), model_text)
+                    lambda *a: write_outputs(*a, early=early[0] if early else None), summary_text)
     # the default name needs the plant as built; its fixed start stands in for it in the check
     common.check_output(args, replay_name(args.name if args.name is not None else f"pid_{spec.method}", spice))
     if spice[2] is not None:
@@ -413,8 +412,6 @@ def _analyze(args) -> int:
     spec = PidSpec(plant_parts=_plant_parts(args), controller_parts=parts, package=args.package,
                    plant_process=_captured_model(args, typed), **typed)
     mc, spice = monte_carlo_settings(args, spec)
-    if spec.process is not None:
-        from ..pid.process_report import summary_text, write_outputs
     common.check_output(args, replay_name(args.name if args.name is not None else "pid_as-built", spice))
     if spice[2] is not None:    # the parts as given are the draw's nominal; the build's own run is the simulation
         result = analyze_pid(spec, simulate=False, simulator=args.simulator)

@@ -174,6 +174,25 @@ def static_checks(parts: PidParts, fn_hz: float, gbw_hz: float, targets: dict, *
     ``fn_name`` is what the messages call ``fn_hz`` (``fc``, the crossover, for
     a plant known only as a model).
 
+    Parameters
+    ----------
+    parts : PidParts
+        The controller.
+    fn_hz : float
+        The plant's natural frequency (a model plant: the loop's crossover).
+    gbw_hz : float
+        The op-amp's gain-bandwidth.
+    targets : dict
+        ``kp``, ``ti_s``, ``td_s`` the parts should give.
+    r_min, r_max : float
+        The resistors' bounds (Ohm).
+    c_min, c_max : float
+        The capacitors' bounds (F).
+    tol : float
+        The accuracy the gains are held to (fraction).
+    fn_name : str
+        How the messages name ``fn_hz``.
+
     Returns
     -------
     list of designer.core.checks.Check
@@ -233,7 +252,12 @@ def static_checks(parts: PidParts, fn_hz: float, gbw_hz: float, targets: dict, *
 
 def seed_parts() -> PidParts:
     """The seed's own controller (lines ~3263-3330), with the difference
-    amplifier as designed (all 10 kOhm) rather than the bench-trimmed values."""
+    amplifier as designed (all 10 kOhm) rather than the bench-trimmed values.
+
+    Returns
+    -------
+    PidParts
+    """
     return PidParts(r3=12e3, r4=1.777e3, r5=22e3, r6=3.3e3, r7=14.356e3, r8=1.2e3, r9=10e3,
                     r10=10e3, r11=10e3, r12=1.026e3, r13=26.048e3, r14=2.528e3, r15=10e3,
                     r16=10e3, r17=10e3, r18=10e3, c3=4.7e-9, c4=47e-9)
@@ -246,7 +270,29 @@ def continuous_parts(kp: float, ti_s: float, td_s: float, fn_hz: float, *,
     gains before any part is chosen: R6 = R7 = R8 = R9 = R10 = R14 = R15..R18 = r,
     R11 C3 = Td, R14 C4 = Ti, corners as in :func:`designer.pid.selection.select_parts`, and Kp split
     between the summer and the final gain so that their noise gains match
-    (1 + 3 g = 1 + Kp/g, g = sqrt(Kp/3); 1 + 2 g and g = sqrt(Kp/2) for a PI)."""
+    (1 + 3 g = 1 + Kp/g, g = sqrt(Kp/3); 1 + 2 g and g = sqrt(Kp/2) for a PI).
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain.
+    ti_s : float
+        Integral time (s).
+    td_s : float
+        Derivative time (s; 0 for a PI).
+    fn_hz : float
+        The plant's natural frequency (a model plant: the loop's crossover) the corners are set from.
+    f_integrator_hz : float, optional
+        The integrator leak's corner (default fn/100).
+    f_differentiator_hz : float, optional
+        The derivative filter's corner (default 10 fn).
+    r : float
+        The balanced resistors' value (Ohm).
+
+    Returns
+    -------
+    PidParts
+    """
     check_targets(kp, ti_s, td_s)
     f_i = fn_hz * F_INTEGRATOR_RATIO if f_integrator_hz is None else f_integrator_hz
     f_d = fn_hz * F_DIFFERENTIATOR_RATIO if f_differentiator_hz is None else f_differentiator_hz
@@ -266,7 +312,12 @@ def seed_bench_parts() -> PidParts:
     :func:`seed_parts` with the difference amplifier trimmed by hand on the bench
     to R15 = 10k, R16 = 3.279k, R17 = 1.716k, R18 = 9.98k, in the order the
     thesis lists them and with this project's names for the four positions (R15
-    from r, R16 feedback, R17 from y, R18 to ground)."""
+    from r, R16 feedback, R17 from y, R18 to ground).
+
+    Returns
+    -------
+    PidParts
+    """
     from dataclasses import replace
     return replace(seed_parts(), r15=10e3, r16=3.279e3, r17=1.716e3, r18=9.98e3)
 

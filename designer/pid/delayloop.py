@@ -401,7 +401,21 @@ def step_figures(t, y, r_step: float = 1.0) -> StepFigures:
     """Overshoot, peak time, rise time (10-90 %) and 2 % settling time from
     :func:`designer.core.metrics.step_metrics` (from rest, the final value the last
     sample), IAE = integral |r - y| dt (trapezoids) and the steady-state error
-    r - y(end). A record that has not settled reads a settling time near its end."""
+    r - y(end). A record that has not settled reads a settling time near its end.
+
+    Parameters
+    ----------
+    t : array_like
+        Times from the step (s).
+    y : array_like
+        The output.
+    r_step : float
+        The reference step.
+
+    Returns
+    -------
+    StepFigures
+    """
     t = np.asarray(t, float)
     y = np.asarray(y, float)
     m = step_metrics(t, y, initial=0.0)

@@ -114,7 +114,22 @@ def parse_loop(plant, controller) -> LoopParts:
 
 
 def loop_response(plant, controller, w) -> np.ndarray:
-    """L(jw) = C(jw) Np(jw)/Dp(jw) e^(-j w theta) at ``w`` (rad/s), the delay exact."""
+    """L(jw) = C(jw) Np(jw)/Dp(jw) e^(-j w theta) at ``w`` (rad/s), the delay exact.
+
+    Parameters
+    ----------
+    plant : tuple
+        (num, den, theta_s) of the plant (:func:`designer.pid.modelloop.plant_of`).
+    controller : tuple
+        The controller's (num, den).
+    w : array_like
+        Angular frequencies (rad/s).
+
+    Returns
+    -------
+    numpy.ndarray
+        Complex L(jw).
+    """
     return _response(parse_loop(plant, controller), np.asarray(w, float))
 
 

@@ -9,6 +9,33 @@ gains (a rule, explicit, or optimised on the loop as built), the parts
 (:mod:`.blocks`, chosen by :mod:`.selection`), the analytic closed loop with
 the op-amp poles (:mod:`.model`), the checks, the deck (:mod:`.netlist`) and
 its simulation (:mod:`.verify`).
+
+A plant known only as a model, G(s) = N(s)/D(s) e^(-theta s) (an identified
+process from ``identify`` or ``identify-freq``, a typed transfer function, a
+design-plant result read as its model, or a registered circuit's own model),
+goes through :func:`design_model_pid`, behind ``design-pid
+--plant-tf/--plant-model/--plant-capture/--plant-topology``. The steps, as for
+the Sallen-Key plant above:
+
+1. the rules of :mod:`designer.pid.rules` on the model each intends (every one,
+   side by side, with the reason where one does not apply), or the optimiser
+   (:mod:`designer.pid.optimize`), or explicit gains;
+2. the parts (:func:`designer.pid.selection.select_parts`), the integrator leak at
+   fc/100 and the derivative filter at 10 fc, fc the crossover of the rule's
+   ideal loop (as fn/100 and 10 fn for a Sallen-Key plant);
+3. the loop as built: the realised controller (op-amp poles, leak, filter:
+   :func:`designer.pid.model.controller_tf`) around the model with its exact
+   dead time, in the frequency domain (:func:`designer.pid.delaymargins.loop_margins`:
+   phase, gain and delay margins, Ms, stability by the argument principle) and
+   in time (:func:`designer.pid.delayloop.closed_loop_step`, the reference's
+   edge applied exactly as a moving average of the step response); every
+   op-amp output from the error by each stage's own transfer function;
+4. the checks (parts, margins, Ms, slew and swing, the ranges the plant accepts
+   and delivers), and at the corners of the model's 95 % intervals the worst
+   phase margin and overshoot;
+5. the deck with the model as native elements and a matched line for the dead
+   time (:func:`designer.pid.netlist.model_loop_deck`) and its simulation, judged
+   as for a Sallen-Key plant (:func:`designer.pid.verify.run_and_compare`).
 """
 
 from __future__ import annotations
@@ -22,8 +49,8 @@ import numpy as np
 from ..core import opamps
 from ..core.checks import Check
 from ..core.checks import listing
+from ..core.errors import DesignError, ParamError
 from ..core.i18n import N_
-from ..core.errors import ParamError
 from ..core.lti import dominant_pair, response_span, step_response
 from ..core.metrics import StepMetrics
 from ..core.opamps import OpAmp
@@ -32,14 +59,24 @@ from ..plant.bench import recommend_square_wave
 from ..plant.model import plant_tf, plant_tf_opamp
 from ..plant.sallenkey import SallenKeyParts
 from ..spice.deck import SquareTest
-from . import blocks, model, selection, tuning
-from .netlist import closed_loop_deck
-from .result import Achieved, AnalyticLoop, PidResult, Waveforms
-from .spec import PidSpec
+from . import blocks, rules, selection, tuning
+from . import model as M
+from .delayloop import closed_loop_step, pid_tf
+from .delaymargins import loop_margins
 from .loopchecks import designators, named, spice_notes, stage_checks, steady_state_check
+# the model loop's figures live in modelloop (the optimiser's too); re-exported here, where they were
+from .modelloop import (FAR_FACTOR, LEAK_LOOP_GAIN, TABLE_STEP_FRACTION, built_controller,  # noqa: F401
+                        corner_frequencies, edged, ideal_crossover_hz, leak_limit_hz, limits, loop_dc_gain,
+                        loop_figures, plant_of, response_grid, simulation_controller, size, stage_waves)
+from .netlist import circuit_loop_deck, circuit_loop_netlist, closed_loop_deck, controller_netlist, model_loop_deck
+from .process_notes import opamp_speed_notes, sizing_notes
+from .result import Achieved, AnalyticLoop, PidResult, RobustCheck, RuleRow, Waveforms
+from .spec import PidSpec
 from .verify import explain, loop_metrics, run_and_compare
 
-__all__ = ["PidSpec", "SEED_BENCH_PLANT", "analyze_pid", "design_pid", "run_spice"]
+__all__ = ["PidSpec", "SEED_BENCH_PLANT", "analyse", "analyze_pid", "built_controller", "closed_loop_step",
+           "corner_frequencies", "design_model_pid", "design_pid", "edged", "ideal_crossover_hz", "leak_limit_hz",
+           "loop_dc_gain", "plant_of", "response_grid", "run_spice", "simulation_controller", "stage_waves"]
 
 #: phase margin below which the loop is called under-damped on the bench
 MIN_PHASE_MARGIN_DEG = 30.0
@@ -105,17 +142,15 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice",
         A model plant: simulate every rule's loop too (the rule table's SPICE overshoot).
     before_spice : callable, optional
         A model plant: called with the result just before its SPICE run
-        (:func:`designer.pid.process_loop.design_model_pid`).
+        (:func:`designer.pid.design.design_model_pid`).
 
     Returns
     -------
     PidResult
-        Or, for a plant given as a model (``spec.process``), the
-        :class:`~designer.pid.process_result.ProcessPidResult` of
-        :func:`designer.pid.process_loop.design_model_pid`.
+        One type for every plant; for a plant given as a model (``spec.process``)
+        its model fields are set (:func:`designer.pid.design.design_model_pid`).
     """
     if spec.process is not None:
-        from .process_loop import design_model_pid
         return design_model_pid(spec, simulate, simulator, rules_spice, before_spice)
     return _run(spec, simulate, simulator, as_built=False)
 
@@ -132,6 +167,21 @@ def analyze_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice"
     :class:`~designer.core.opamps.OpAmp` in place of ``spec.opamp``'s catalogue entry (a
     Monte Carlo build's, its gain-bandwidth and slew rate drawn: ``--replay``).
 
+    Parameters
+    ----------
+    spec : PidSpec
+        With ``controller_parts``.
+    simulate : bool
+        Run the closed-loop deck in ngspice.
+    simulator : str
+        ``"pyspice"`` or ``"ngspice-cli"``.
+    opamp : designer.core.opamps.OpAmp, optional
+        In place of ``spec.opamp``'s catalogue entry.
+
+    Returns
+    -------
+    PidResult
+
     Raises
     ------
     ParamError
@@ -140,7 +190,6 @@ def analyze_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice"
     if spec.controller_parts is None:
         raise ParamError("analyze_pid needs the controller's parts ({controller_parts})", ("controller_parts",))
     if spec.process is not None:
-        from .process_loop import design_model_pid
         return design_model_pid(spec, simulate, simulator, opamp=opamp)
     return _run(spec, simulate, simulator, as_built=spec.kp is None and spec.tuning is None, opamp=opamp)
 
@@ -207,7 +256,7 @@ def _run(spec: PidSpec, simulate: bool, simulator: str, as_built: bool, opamp=No
     else:
         res.notes.append("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only")
     res.scope = loop_scope(res)
-    res.diff_amp = model.diff_amp_balance(parts, amp, ps.num, ps.den, loop.bode_w, loop.analytic.dc_gain)
+    res.diff_amp = M.diff_amp_balance(parts, amp, ps.num, ps.den, loop.bode_w, loop.analytic.dc_gain)
     if simulate and _same(parts, blocks.seed_bench_parts()) and _same(plant, SEED_BENCH_PLANT):
         res.seed_bench = seed_bench_finding(res, spec, simulator)
     res.timings = clock.laps
@@ -276,7 +325,7 @@ def loop_scope(res: PidResult):
     test, amp = res.test, res.opamp
     rails = (amp.vout_min, amp.vout_max) if not amp.ideal else (amp.vee, amp.vcc)
     levels = {}
-    for ref, role, sig in model.OPAMP_OUTPUTS:
+    for ref, role, sig in M.OPAMP_OUTPUTS:
         got = (res.spice.stages.get(role) if res.spice is not None else None) or res.analytic.levels.get(role)
         if got is not None:
             levels[sig] = (ref, got.v_min, got.v_max)
@@ -354,7 +403,7 @@ class _Loop:
 
     analytic: AnalyticLoop
     ideal: StepMetrics
-    margins: model.Margins
+    margins: M.Margins
     checks: tuple
     test: SquareTest
     expected: float
@@ -370,10 +419,10 @@ class _Loop:
 
 def _analyse(spec, plant, amp, tun, parts, ps, simulate=True) -> _Loop:
     pn, pd, span = ps.num, ps.den, ps.span_s
-    lm = model.assemble(parts, amp, pn, pd)
+    lm = M.assemble(parts, amp, pn, pd)
     stable = lm.stable()
     # closed-loop DC gain y/r from the state-space model (the integrator leaks)
-    iy = model.SIGNALS.index("y")
+    iy = M.SIGNALS.index("y")
     try:
         dc_cl = float(-(lm.c[iy] @ np.linalg.solve(lm.a, lm.b)).item() + lm.d[iy, 0])
     except np.linalg.LinAlgError:
@@ -384,15 +433,15 @@ def _analyse(spec, plant, amp, tun, parts, ps, simulate=True) -> _Loop:
     t_long = np.linspace(0.0, span, 8001)
     ts = None
     if stable:
-        w_long = lm.simulate(t_long, model.reference(t_long, 1.0, 0.0, spec.edge_s))
+        w_long = lm.simulate(t_long, M.reference(t_long, 1.0, 0.0, spec.edge_s))
         ts = loop_metrics(t_long, w_long["y"], expected / spec.step_v).settling_time_s
     if ts is None or math.isnan(ts):
         ts = span / 2
     f_lo = min(parts.f_integrator_hz, plant.fn_hz) / 20
     f_hi = max(amp.gbw_hz if not amp.ideal else 0.0, 100 * plant.fn_hz)
     w = 2 * np.pi * np.logspace(np.log10(f_lo), np.log10(f_hi), 4000)
-    gain = model.loop_gain(parts, amp, pn, pd, w)
-    mg = model.margins(w, gain)
+    gain = M.loop_gain(parts, amp, pn, pd, w)
+    mg = M.margins(w, gain)
     # the loop's fastest time scale (plant or crossover) bounds the simulation step, so that a
     # slow --square-freq cannot hide the response between time steps (as for the plant)
     f_fast = max(plant.fn_hz, mg.crossover_hz if math.isfinite(mg.crossover_hz) else 0.0)
@@ -404,18 +453,18 @@ def _analyse(spec, plant, amp, tun, parts, ps, simulate=True) -> _Loop:
         test.check_simulable()
     # the rising half period, or its start when the square wave is much slower than the loop
     t = np.linspace(0.0, min(hp, 10 * max(span, ts)), 20001)
-    r = model.reference(t, spec.step_v, 0.0, spec.edge_s)
+    r = M.reference(t, spec.step_v, 0.0, spec.edge_s)
     rails = 2 * max(abs(amp.vcc), abs(amp.vee))
     waves = lm.simulate(t, r) if stable else _diverging(lm, t, r, rails)
-    il = model.ideal_loop(tun.kp, tun.ti_s, tun.td_s, *plant_tf(plant))
+    il = M.ideal_loop(tun.kp, tun.ti_s, tun.td_s, *plant_tf(plant))
     y_ideal = (il.simulate(t, r) if il.stable() else _diverging(il, t, r, rails))["y"]
     # the plant alone, for the plot: the edged reference needs the state-space simulation
-    y_open = model.state_space(pn, pd).simulate(t, r)["y"]
+    y_open = M.state_space(pn, pd).simulate(t, r)["y"]
     figures = loop_metrics(t, waves["y"], expected)
     ideal = loop_metrics(t, y_ideal, spec.step_v)   # a true integrator: no steady-state error
     rise = figures.rise_time_s if math.isfinite(figures.rise_time_s) and figures.rise_time_s else hp / 20
     names = designators(parts, plant, amp, spec.package)
-    levels = model.waveform_limits(waves, t, amp, model.SLEW_DELAY_FRACTION * rise) if stable else {}
+    levels = M.waveform_limits(waves, t, amp, M.SLEW_DELAY_FRACTION * rise) if stable else {}
     levels = named(levels, names)
     checks = _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, spec.step_v, rise, parts, names.get)
     title = (f"PID closed loop Kp={parts.kp:.4g} Ti={parts.ti_s:.4g}s Td={parts.td_s:.4g}s "
@@ -470,7 +519,21 @@ def _dynamic_checks(stable, lm, levels, mg, dc_cl, amp, step_v, rise, parts, nam
 
 def run_spice(res: PidResult, simulator: str) -> None:
     """Simulate the deck, compare, detect saturation and oscillation; fills
-    ``spice``, ``verdict`` and the notes of ``res``."""
+    ``spice``, ``verdict`` and the notes of ``res`` (a model plant's by its own rule).
+
+    Parameters
+    ----------
+    res : PidResult
+        The design, analysed.
+    simulator : str
+        ``"pyspice"`` or ``"ngspice-cli"``.
+
+    Returns
+    -------
+    None
+    """
+    if res.model is not None:
+        return run_model_spice(res, simulator)
     w = res.waveforms
     sp = run_and_compare(res.deck, simulator, w.t, res.test.delay_s, w.analytic["y"],
                          res.test.amplitude_v, res.expected_final_v, res.opamp)
@@ -480,3 +543,427 @@ def run_spice(res: PidResult, simulator: str) -> None:
     res.notes += spice_notes(sp, res.verdict, res.expected_final_v)
 
 
+# ==== a plant known as a model =====================================================
+
+
+#: the rules tried, in order, when none is named: the first that applies is the default
+DEFAULT_RULES = ("amigo", "simc", "imc")
+#: analytic samples over the rising half period (as for a Sallen-Key plant)
+POINTS = 20001
+
+
+@dataclass(frozen=True)
+class Gains:
+    """The gains being built, how they were chosen, and the rule's record (or None)."""
+
+    method: str
+    kp: float
+    ti_s: float
+    td_s: float
+    rule: rules.RuleTuning | None = None
+
+
+# ---- the flow -------------------------------------------------------------------
+
+def choose_gains(spec: PidSpec, model, reduced, amp, table) -> tuple:
+    """(Gains, optimizer result or None, notes) for the spec."""
+    if spec.controller_parts is not None and spec.kp is None and spec.tuning is None:
+        p = spec.controller_parts
+        return Gains("as-built", p.kp, p.ti_s, p.td_s), None, []
+    if spec.kp is not None:
+        return Gains("explicit", spec.kp, spec.ti_s, spec.td_s), None, []
+    if spec.tuning == "optimize":
+        from .optimize import optimize_model_loop
+        opt = optimize_model_loop(spec, model, amp, table)
+        return (Gains("optimize", opt.kp, opt.ti_s, opt.td_s), opt, [opt.message])
+    if spec.tuning is not None:
+        rt = check_gains(rules.tune_model(reduced, spec.tuning, tauc_s=spec.simc_tauc_s, lambda_s=spec.imc_lambda_s))
+        return Gains(rt.rule, rt.kp, rt.ti_s, rt.td_s, rt), None, []
+    for row in table:
+        if row.tuning is not None and row.reason is None and row.rule in DEFAULT_RULES:
+            rt = row.tuning
+            return (Gains(rt.rule, rt.kp, rt.ti_s, rt.td_s, rt), None,
+                    [f"rule {rt.rule} (the first of {', '.join(DEFAULT_RULES)} that applies to this model; "
+                     "--tuning names another, --tuning optimize meets margins and Ms)"])
+    # the tangent rules share one reason: each said once
+    reasons = list(dict.fromkeys(r.reason for r in table if r.reason))
+    raise DesignError("no tuning rule applies to this model (" + "; ".join(reasons)
+                      + "); give --kp, --ti and --td", param="tuning")
+
+
+def check_gains(rt):
+    """A rule's gains inside what the circuit takes (:data:`designer.core.ranges.RANGES` of kp, ti_s,
+    td_s), else a one-line refusal naming the rule (a dead time of 1e-144 s makes SIMC's Kp 1e143)."""
+    from ..core.ranges import RANGES
+    for key, value, label in (("kp", rt.kp, "Kp"), ("ti_s", rt.ti_s, "Ti"), ("td_s", rt.td_s, "Td")):
+        try:
+            RANGES[key].check(value, label)
+        except DesignError as exc:
+            raise DesignError(f"{rt.rule}: its {exc} (the circuit's range): this model is outside what the "
+                              "rule is for") from None
+    return rt
+
+
+def rule_table(spec, model, reduced, amp) -> tuple:
+    """Every rule of :data:`designer.pid.rules.RULES` on the model: its gains and
+    the figures of its loop as it would be built (or why it does not apply)."""
+    rows = []
+    for r in rules.all_rules(reduced, tauc_s=spec.simc_tauc_s, lambda_s=spec.imc_lambda_s):
+        if isinstance(r, tuple):
+            rows.append(RuleRow(r[0], None, r[1], None))
+            continue
+        try:
+            check_gains(r)
+            fc = ideal_crossover_hz(model, r.kp, r.ti_s, r.td_s)
+            ctrl = built_controller(r.kp, r.ti_s, r.td_s, fc, spec, amp)
+            rows.append(RuleRow(r.rule, r, None, loop_figures(model, ctrl, r.kp, r.ti_s, r.td_s,
+                                                                response_grid(model, fc), spec.step_v)))
+        except DesignError as exc:   # gains outside what the circuit can be sized for
+            rows.append(RuleRow(r.rule, r, str(exc), None))
+    return tuple(rows)
+
+
+def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice",
+                     rules_spice: bool = False, before_spice=None, opamp=None) -> PidResult:
+    """Tune, size, check and (unless ``simulate`` is False) verify in SPICE a PID
+    for ``spec.process``, a plant known only as a model.
+
+    Parameters
+    ----------
+    spec : PidSpec
+        With a model plant (``spec.process`` not None).
+    simulate : bool
+        Run the closed-loop deck in ngspice.
+    simulator : str
+        ``"pyspice"`` or ``"ngspice-cli"``.
+    rules_spice : bool
+        Also simulate every applicable rule's loop, sized as this one is, for the
+        rule table's SPICE overshoot (one more ngspice run per rule).
+    before_spice : callable, optional
+        Called with the result, analysed but not yet simulated, just before the
+        SPICE run (a command starts drawing the pictures that need no SPICE then).
+    opamp : designer.core.opamps.OpAmp, optional
+        In place of ``spec.opamp``'s catalogue entry (a Monte Carlo build's).
+
+    Returns
+    -------
+    PidResult
+    """
+    from .reduction import from_process
+    tick = time.perf_counter()
+    laps = {}
+
+    def lap(name):
+        nonlocal tick
+        now = time.perf_counter()
+        laps[name], tick = now - tick, now
+
+    model = spec.process
+    amp = opamp or opamps.get(spec.opamp)   # a Monte Carlo build's own (--replay), or the catalogue's
+    reduced = from_process(model)
+    table = rule_table(spec, model, reduced, amp)
+    gains, opt, notes = choose_gains(spec, model, reduced, amp, table)
+    if gains.rule is not None:
+        notes = notes + list(gains.rule.notes)
+    lap("tuning_s")
+    # the optimiser sized its loop with the corners of its start's crossover: build those
+    fc = opt.fc_hz if opt is not None else ideal_crossover_hz(model, gains.kp, gains.ti_s, gains.td_s)
+    f_i, f_d = ((opt.f_integrator_hz, opt.f_differentiator_hz) if opt is not None
+                else corner_frequencies(spec, fc, leak_limit_hz(model, gains.kp, gains.ti_s)))
+    if spec.controller_parts is not None:
+        parts, sel = spec.controller_parts, None
+        targets = {"kp": gains.kp, "ti_s": gains.ti_s, "td_s": gains.td_s}
+    else:
+        sel = size(spec, gains.kp, gains.ti_s, gains.td_s, fc, f_i, f_d)
+        parts, targets = sel.parts, sel.targets
+        notes += sel.notes + sizing_notes(sel, spec)
+    static = blocks.static_checks(parts, fc, amp.gbw_hz, targets, r_min=spec.r_min, r_max=spec.r_max,
+                                  c_min=spec.c_min, c_max=spec.c_max, tol=spec.tol, fn_name="fc")
+    if gains.method == "as-built":
+        static = [c for c in static if not c.id.endswith("_accuracy") and not c.id.endswith("_bounds")]
+    lap("sizing_s")
+    loop = analyse(spec, model, amp, parts, gains, fc, simulate)
+    notes += opamp_speed_notes(amp, loop.margins, loop.ideal_margins, limits(spec)[0], gains.method == "optimize")
+    robust = robust_check(spec, model, loop.controller, loop.t, gains) if model.ci95 else None
+    checks = tuple(static) + loop.checks + (robust.checks() if robust is not None else ())
+    res = PidResult(
+        spec=spec, model=model, reduced=reduced, opamp=amp, method=gains.method, kp=gains.kp, ti_s=gains.ti_s,
+        td_s=gains.td_s, rule=gains.rule, rules=table, optimizer=opt, parts=parts, selection=sel,
+        achieved=Achieved.of(parts, amp, gains), fc_ref_hz=fc, checks=checks, margins=loop.margins,
+        ideal_margins=loop.ideal_margins, ideal_pid=loop.ideal_figures,
+        analytic=AnalyticLoop(loop.figures, loop.margins.stable, loop.dc, loop.levels), robust=robust,
+        test=loop.test, expected_final_v=loop.expected, deck=loop.deck,
+        waveforms=loop.waves, notes=list(notes), package=spec.package, limits=limits(spec))
+    lap("analytic_s")
+    if before_spice is not None:
+        before_spice(res)
+    if simulate:
+        run_model_spice(res, simulator)
+        if rules_spice:
+            res.rules = rules_in_spice(res, simulator)
+        lap("simulation_s")
+    else:
+        res.notes.append("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only")
+    res.scope = model_loop_scope(res)
+    res.timings = laps
+    return res
+
+
+def model_loop_scope(res: PidResult):
+    """The bench scope for the loop (as :func:`designer.pid.design.loop_scope`): CH1
+    the reference, CH2 the plant output y and then each op-amp output in turn,
+    volts/div fitting what SPICE (else the analytic loop) shows there, 1.2 settling
+    times on screen (at most the half period)."""
+    from ..plant.bench import channel, scope_setup
+    test, amp = res.test, res.opamp
+    rails = (amp.vout_min, amp.vout_max) if not amp.ideal else (amp.vee, amp.vcc)
+    y = res.waveforms.analytic["y"]
+    if res.spice is not None and "y" in res.spice.waves:
+        y = res.spice.waves["y"]
+    y_lo, y_hi = (float(np.nanmin(y)), float(np.nanmax(y))) if np.any(np.isfinite(y)) else rails
+    chans = [channel("CH1", "reference r", 0.0, test.amplitude_v), channel("CH2", "y", y_lo, y_hi)]
+    for ref, role, sig in M.OPAMP_OUTPUTS:
+        got = (res.spice.stages.get(role) if res.spice is not None else None) or res.levels.get(role)
+        if got is not None:
+            chans.append(channel("CH2", sig, got.v_min, got.v_max))
+        elif role != "plant" and (sig != "vd" or res.parts.has_derivative):
+            chans.append(channel("CH2", sig, *rails))
+    ts = res.spice.figures.settling_time_s if res.spice is not None else res.analytic.figures.settling_time_s
+    window = min(1.2 * ts, test.half_period_s) if ts is not None and math.isfinite(ts) else test.half_period_s
+    return scope_setup(window, test.amplitude_v / 2, chans)
+
+
+@dataclass(frozen=True)
+class _ModelLoop:
+    controller: tuple
+    margins: object
+    ideal_margins: object
+    ideal_figures: object
+    figures: object
+    dc: float
+    levels: dict
+    checks: tuple
+    test: SquareTest
+    expected: float
+    deck: str
+    t: np.ndarray
+    waves: Waveforms
+
+
+def analyse(spec, model, amp, parts, gains, fc, simulate) -> _ModelLoop:
+    """The loop as built around the model: margins, time response, every stage, checks, deck.
+
+    Parameters
+    ----------
+    spec : PidSpec
+        The request (a model plant).
+    model : designer.core.process.ProcessModel
+        The plant.
+    amp : designer.core.opamps.OpAmp
+        The op-amp of every stage.
+    parts : designer.pid.blocks.PidParts
+        The controller as built.
+    gains : Gains
+        The gains the parts are for.
+    fc : float
+        The ideal loop's crossover (Hz): the scale of the time grids and the bench test.
+    simulate : bool
+        Whether the deck will be simulated (its notes say so).
+
+    Returns
+    -------
+    _ModelLoop
+    """
+    ctrl = M.controller_tf(parts, amp)
+    plant = plant_of(model)
+    mg = loop_margins(plant, ctrl)
+    ideal_mg = loop_margins(plant, pid_tf(gains.kp, gains.ti_s, gains.td_s))
+    dc = loop_dc_gain(model, ctrl)
+    expected = spec.step_v * dc
+    sim_ctrl = simulation_controller(ctrl, max(fc, mg.crossover_hz if math.isfinite(mg.crossover_hz) else fc))
+    # a first look on a long grid, for the settling time that sizes the square wave
+    t_long = response_grid(model, mg.crossover_hz if math.isfinite(mg.crossover_hz) else fc, 4001)
+    ts = None
+    if mg.stable:
+        y_long = closed_loop_step(plant, sim_ctrl, t_long, 1.0, step_fraction=TABLE_STEP_FRACTION)["y"]
+        ts = loop_metrics(t_long, y_long, dc).settling_time_s
+    if ts is None or not math.isfinite(ts):
+        ts = t_long[-1] / 2
+    f_fast = max(fc, mg.crossover_hz if math.isfinite(mg.crossover_hz) else 0.0)
+    time_scale = 1.0 / (2 * math.pi * f_fast)
+    sq = recommend_square_wave(ts, spec.step_v, spec.square_hz, time_scale_s=time_scale)
+    test = SquareTest(spec.step_v, sq.frequency_hz, sq.delay_s, spec.edge_s, time_scale_s=time_scale)
+    if simulate:
+        test.check_simulable()
+    t = np.linspace(0.0, min(test.half_period_s, 10 * max(t_long[-1], ts)), POINTS)
+    r = M.reference(t, spec.step_v, 0.0, spec.edge_s)
+    if mg.stable:
+        step = closed_loop_step(plant, sim_ctrl, t, spec.step_v)
+        y = edged(t, step["y"], spec.edge_s)
+        if spec.circuit is not None and spec.circuit.reversed_action:
+            # r and y exchanged at the difference amplifier: every controller stage is its own for (y, r)
+            waves = {**stage_waves(parts, amp, t, y, r), "y": y}
+        else:
+            waves = stage_waves(parts, amp, t, r, y)
+    else:
+        waves = {k: np.full(t.size, np.nan) for k in M.SIGNALS if k != "vd" or parts.has_derivative}
+    ideal = pid_tf(gains.kp, gains.ti_s, gains.td_s, 10.0 if gains.td_s > 0 else None)
+    y_ideal = (edged(t, closed_loop_step(plant, ideal, t, spec.step_v)["y"], spec.edge_s)
+               if loop_margins(plant, ideal).stable else np.full(t.size, np.nan))
+    y_open = edged(t, spec.step_v * model.step(t), spec.edge_s)
+    figures = loop_metrics(t, waves["y"], expected)
+    # the ideal PID has a true integrator: it settles on the step itself
+    ideal_figures = loop_metrics(t, y_ideal, spec.step_v) if np.all(np.isfinite(y_ideal)) else None
+    rise = figures.rise_time_s if math.isfinite(figures.rise_time_s) and figures.rise_time_s else t[-1] / 20
+    names = designators(parts, None, amp, spec.package, loop_netlist_of(spec, parts))
+    levels = M.waveform_limits({k: v for k, v in waves.items() if k != "y"}, t, amp,
+                               M.SLEW_DELAY_FRACTION * rise) if mg.stable else {}
+    levels = named(levels, names)
+    checks = loop_checks(spec, mg, dc, amp, levels, waves, t, parts) + stage_checks(
+        mg.stable, levels, amp, spec.step_v, rise, parts, names.get)
+    title = (f"PID closed loop Kp={parts.kp:.4g} Ti={parts.ti_s:.4g}s Td={parts.td_s:.4g}s "
+             f"plant {model.text()} op-amp={amp.name}")
+    deck = loop_deck(spec, parts, model, amp, test, title, expected)
+    lo, hi = min(fc, mg.crossover_hz if math.isfinite(mg.crossover_hz) else fc) / 100, 100 * f_fast
+    bode_w = 2 * np.pi * np.logspace(np.log10(lo), np.log10(hi), 2000)
+    from .delaymargins import loop_response
+    wf = Waveforms(t, r, waves, y_ideal, y_open, bode_w, loop_response(plant, ctrl, bode_w), t_long,
+                   model.step(t_long), None)
+    return _ModelLoop(ctrl, mg, ideal_mg, ideal_figures, figures, dc, levels, tuple(checks), test, expected, deck, t, wf)
+
+
+def loop_netlist_of(spec: PidSpec, parts):
+    """The loop's part and net table as built: the controller alone around a
+    model plant, or with the plant's own circuit (:func:`~designer.pid.netlist.circuit_loop_netlist`).
+
+    Parameters
+    ----------
+    spec : PidSpec
+        The request (its ``circuit``, if any).
+    parts : designer.pid.blocks.PidParts
+        The controller.
+
+    Returns
+    -------
+    designer.spice.deck.Netlist
+        The table the board, the BOM and the schematic are written from.
+    """
+    if spec.circuit is not None:
+        return circuit_loop_netlist(parts, spec.circuit)
+    return controller_netlist(parts)
+
+
+def loop_deck(spec: PidSpec, parts, model, amp, test, title: str, expected: float) -> str:
+    """The loop's deck: the model as native elements
+    (:func:`~designer.pid.netlist.model_loop_deck`), or the plant's circuit
+    (:func:`~designer.pid.netlist.circuit_loop_deck`).
+
+    Parameters
+    ----------
+    spec, parts : PidSpec, designer.pid.blocks.PidParts
+        As for :func:`loop_netlist_of`.
+    model : designer.core.process.ProcessModel
+        The plant's model (a model plant's deck is written from it).
+    amp : designer.core.opamps.OpAmp
+        The op-amps.
+    test : designer.spice.deck.SquareTest
+        The reference square wave.
+    title : str
+        The deck's title.
+    expected : float
+        The settled output the ``.meas`` levels refer to, volts.
+
+    Returns
+    -------
+    str
+        The deck.
+    """
+    if spec.circuit is not None:
+        return circuit_loop_deck(parts, spec.circuit, amp, test, title, expected)
+    return model_loop_deck(parts, model, amp, test, title, expected)
+
+
+def loop_checks(spec, mg, dc, amp, levels, waves, t, parts) -> list:
+    """Stability, phase and gain margins, Ms, steady-state error and the plant's ranges."""
+    pm_min, gm_min, ms_max = limits(spec)
+    out = [Check("closed_loop_stable", bool(mg.stable),
+                 "no closed-loop root in the right half plane (argument principle, exact dead time)"
+                 if mg.stable else f"{mg.rhp_roots:g} closed-loop roots in the right half plane: the loop "
+                 "oscillates or runs to a rail")]
+    pm = mg.phase_margin_deg
+    out.append(Check("phase_margin", bool(math.isfinite(pm) and pm >= pm_min),
+                     f"{pm:.3g} deg at {format_eng(mg.crossover_hz, 'Hz')} with the op-amp poles and the dead "
+                     f"time (want >= {pm_min:g} deg; delay margin {format_eng(mg.delay_margin_s, 's')})"
+                     if math.isfinite(pm) else "the loop gain never crosses 1"))
+    gm = mg.gain_margin_db
+    out.append(Check("gain_margin", bool(gm >= gm_min),
+                     f"{gm:.3g} dB at {format_eng(mg.phase_crossover_hz, 'Hz')} (want >= {gm_min:g} dB)"
+                     if math.isfinite(gm) else f"the phase never reaches -180 deg (want >= {gm_min:g} dB)"))
+    out.append(Check("max_sensitivity", bool(mg.ms <= ms_max),
+                     f"Ms = {mg.ms:.3g} at {format_eng(mg.ms_hz, 'Hz')} (want <= {ms_max:g}; 1/Ms = "
+                     f"{1 / mg.ms:.3g} is the distance of the Nyquist curve from -1)"))
+    out += steady_state_check(dc)
+    for key, sig, what in (("plant_input", "u", "input (the controller's output u)"),
+                           ("plant_output", "y", "output y")):
+        rng = getattr(spec, key)
+        if rng is None or not mg.stable:
+            continue
+        v = np.asarray(waves[sig], float)
+        vf = float(v[-1])
+        vmax, vmin = max(float(v.max()), vf - float(v.min())), min(float(v.min()), vf - float(v.max()))
+        ok = vmin >= rng[0] - 1e-9 and vmax <= rng[1] + 1e-9
+        out.append(Check(f"{key}_range", bool(ok),
+                         f"the plant's {what} spans {vmin:.3g} V to {vmax:.3g} V over the square wave "
+                         f"(rising and falling edge); it accepts {rng[0]:g} V to {rng[1]:g} V"
+                         + ("" if ok else ": lower --step or the gains (a softer rule, --tuning optimize)")))
+    return out
+
+
+def robust_check(spec, model, controller, t, gains) -> RobustCheck:
+    """The loop as built at every corner of the model's 95 % box: the worst phase
+    margin, gain margin, Ms and overshoot, and the corner where each is reached."""
+    pm_min, gm_min, ms_max = limits(spec)
+    rows = []
+    for corner in model.corners():
+        fig = loop_figures(corner, controller, gains.kp, gains.ti_s, gains.td_s, t[:: max(1, t.size // 4000)],
+                           spec.step_v)
+        rows.append((corner.source.rsplit("corner ", 1)[-1], fig))
+    return RobustCheck(tuple(rows), pm_min, gm_min, ms_max)
+
+
+def rules_in_spice(res: PidResult, simulator: str) -> tuple:
+    """The rule table with each applicable, stable rule's SPICE overshoot: its
+    gains sized as the design's were (same series, bounds and corner rules), its
+    deck on the same bench test, the deck's own ``overshoot_pct`` measurement."""
+    from ..spice.simulate import get_simulator
+    spec, sim, out = res.spec, get_simulator(simulator), []
+    for row in res.rules:
+        if row.figures is None or not row.figures.margins.stable:
+            out.append(row)
+            continue
+        r = row.tuning
+        fc = ideal_crossover_hz(res.model, r.kp, r.ti_s, r.td_s)
+        f_i, f_d = corner_frequencies(spec, fc, leak_limit_hz(res.model, r.kp, r.ti_s))
+        try:
+            parts = size(spec, r.kp, r.ti_s, r.td_s, fc, f_i, f_d).parts
+        except DesignError:
+            out.append(row)
+            continue
+        expected = spec.step_v * loop_dc_gain(res.model, M.controller_tf(parts, res.opamp))
+        deck = loop_deck(spec, parts, res.model, res.opamp, res.test, f"rule {r.rule}", expected)
+        got = sim.run(deck).measurements.get("overshoot_pct")
+        out.append(replace(row, spice_overshoot_pct=None if got is None else float(got)))
+    return tuple(out)
+
+
+def run_model_spice(res: PidResult, simulator: str) -> None:
+    """Simulate the deck, compare with the analytic loop; fills ``spice``,
+    ``verdict`` and the notes."""
+    w = res.waveforms
+    sp = run_and_compare(res.deck, simulator, w.t, res.test.delay_s, w.analytic["y"], res.test.amplitude_v,
+                         res.expected_final_v, res.opamp)
+    stages = {k: v for k, v in sp.stages.items() if k != "plant"}   # y is the model's, not an op-amp's
+    res.spice = sp = replace(sp, stages=named(stages, designators(res.parts, None, res.opamp, res.package,
+                                                                     loop_netlist_of(res.spec, res.parts))))
+    res.verdict = explain(sp, res.analytic.figures, res.checks)
+    res.notes += spice_notes(sp, res.verdict, res.expected_final_v)

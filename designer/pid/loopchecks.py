@@ -1,13 +1,12 @@
 """The checks and names every PID loop shares, whatever its plant (a
-Sallen-Key circuit, :mod:`designer.pid.design`; a model or any circuit,
-:mod:`designer.pid.process_loop`): the op-amps' bench designators, the
+Sallen-Key circuit or a model that any circuit may realise, :mod:`designer.pid.design`): the op-amps' bench designators, the
 leaky integrator's steady-state error, the slew rate and output swing of every
 op-amp stage (the slew budget: 5 % of the rise time, Jung, *Op Amp
 Applications Handbook*, 2005, section 1.5), and what a SPICE run says beyond
 its figures.
 
-Moved out of :mod:`designer.pid.design` so that the model plant's design needs
-not import the Sallen-Key plant's (the cycle design <-> process_loop went with it).
+Kept apart from :mod:`designer.pid.design` so that the optimiser and the model
+loop's figures (:mod:`designer.pid.modelloop`) need not import the design.
 """
 
 from __future__ import annotations

@@ -49,7 +49,20 @@ def _opamp_inv(opamp: OpAmp | None):
 
 def inverting_stage(p, q, g, opamp):
     """Transfer function -(p/q) / (1 + (g/q)/A) of an inverting stage whose
-    ideal gain is -p/q and whose noise gain is g/q (same denominator)."""
+    ideal gain is -p/q and whose noise gain is g/q (same denominator).
+
+    Parameters
+    ----------
+    p, q, g : array_like
+        Numerator, common denominator and noise-gain numerator (descending powers of s).
+    opamp : OpAmp or None
+        The stage's op-amp (None: ideal).
+
+    Returns
+    -------
+    tuple
+        (num, den), descending powers of s.
+    """
     p, q, g = (np.atleast_1d(np.asarray(x, float)) for x in (p, q, g))
     inv = _opamp_inv(opamp)
     if inv is None:
@@ -105,7 +118,20 @@ def controller_tf(parts: PidParts, opamp: OpAmp | None):
     """The realised controller u/(r - y) as (num, den): difference amplifier,
     the three paths (leaky integrator, filtered derivative), summer and final
     gain, each with its op-amp's finite gain-bandwidth. (The difference
-    amplifier's two weights are taken equal, as with R15 = R16 = R17 = R18.)"""
+    amplifier's two weights are taken equal, as with R15 = R16 = R17 = R18.)
+
+    Parameters
+    ----------
+    parts : PidParts
+        The controller's parts.
+    opamp : OpAmp or None
+        The op-amp of every stage (None: ideal op-amps).
+
+    Returns
+    -------
+    tuple
+        (num, den), descending powers of s.
+    """
     tfs = stage_tfs(parts, opamp)
     sw = summer_weights(parts)
     num, den = np.array([0.0]), np.array([1.0])
@@ -266,6 +292,19 @@ def assemble(parts: PidParts, opamp: OpAmp | None, plant_num, plant_den) -> Loop
 
     Each block is y_k = H_k(s) (sum of weighted signals); the signal vector
     z = (ve, vp, vd, vi, vs, u, y) satisfies z = C x + Dz z + Dr r, solved once.
+
+    Parameters
+    ----------
+    parts : PidParts
+        The controller's parts.
+    opamp : OpAmp or None
+        The op-amp of every stage (None: ideal op-amps).
+    plant_num, plant_den : array_like
+        The plant's transfer function (descending powers of s).
+
+    Returns
+    -------
+    LoopModel
     """
     tfs = stage_tfs(parts, opamp)
     g_y, g_r = difference_weights(parts)
@@ -323,7 +362,24 @@ def assemble(parts: PidParts, opamp: OpAmp | None, plant_num, plant_den) -> Loop
 
 def loop_gain(parts: PidParts, opamp: OpAmp | None, plant_num, plant_den, w) -> np.ndarray:
     """Loop gain L(jw), signed so that the loop is the usual 1 + L(s) = 0
-    negative-feedback loop (the three inversions are accounted for)."""
+    negative-feedback loop (the three inversions are accounted for).
+
+    Parameters
+    ----------
+    parts : PidParts
+        The controller's parts.
+    opamp : OpAmp or None
+        The op-amp of every stage (None: ideal op-amps).
+    plant_num, plant_den : array_like
+        The plant's transfer function (descending powers of s).
+    w : array_like
+        Angular frequencies (rad/s).
+
+    Returns
+    -------
+    numpy.ndarray
+        Complex L(jw).
+    """
     s = 1j * np.asarray(w, float)
     tfs = stage_tfs(parts, opamp)
     ev = lambda tf: np.polyval(tf[0], s) / np.polyval(tf[1], s)  # noqa: E731
@@ -352,7 +408,19 @@ class Margins:
 
 def margins(w, L) -> Margins:
     """Phase margin (deg) at every gain crossover (the smallest is reported),
-    gain margin (dB) at the first -180 deg crossing, from samples of L(jw)."""
+    gain margin (dB) at the first -180 deg crossing, from samples of L(jw).
+
+    Parameters
+    ----------
+    w : array_like
+        Angular frequencies (rad/s), ascending.
+    L : array_like
+        The loop gain at ``w``.
+
+    Returns
+    -------
+    Margins
+    """
     w = np.asarray(w, float)
     mag = np.abs(L)
     ph = np.unwrap(np.angle(L))
@@ -399,7 +467,23 @@ def trim_leading(p):
 
 
 def reference(t, step: float, t0: float, edge: float) -> np.ndarray:
-    """A step of ``step`` volts starting at ``t0`` with a linear edge of ``edge`` seconds."""
+    """A step of ``step`` volts starting at ``t0`` with a linear edge of ``edge`` seconds.
+
+    Parameters
+    ----------
+    t : array_like
+        Times (s).
+    step : float
+        Height (V).
+    t0 : float
+        Start (s).
+    edge : float
+        Rise time of the edge (s; 0: a jump).
+
+    Returns
+    -------
+    numpy.ndarray
+    """
     t = np.asarray(t, float)
     if edge <= 0:
         return np.where(t >= t0, step, 0.0)
@@ -407,7 +491,23 @@ def reference(t, step: float, t0: float, edge: float) -> np.ndarray:
 
 
 def ideal_loop(kp, ti, td, plant_num, plant_den) -> LoopModel:
-    """The ideal-PID loop y/r as a :class:`LoopModel` (output ``y``)."""
+    """The ideal-PID loop y/r as a :class:`LoopModel` (output ``y``).
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain.
+    ti : float
+        Integral time (s).
+    td : float
+        Derivative time (s; 0 for a PI).
+    plant_num, plant_den : array_like
+        The plant's transfer function (descending powers of s).
+
+    Returns
+    -------
+    LoopModel
+    """
     n, d = ideal_closed_loop(kp, ti, td, plant_num, plant_den)
     if len(n) >= len(d):
         raise DesignError("ideal closed loop is improper (plant of order < 2 with Td > 0)")
@@ -421,7 +521,22 @@ SLEW_DELAY_FRACTION = 0.05
 def slew_delay(t, v, slew_v_per_s: float) -> float:
     """Extra time a slew-limited op-amp needs to follow the linear waveform
     ``v``: the part of its excursions faster than the slew rate, divided by
-    the slew rate, sum(max(0, |dv| - SR dt)) / SR (0 when it never slews)."""
+    the slew rate, sum(max(0, |dv| - SR dt)) / SR (0 when it never slews).
+
+    Parameters
+    ----------
+    t : array_like
+        Times (s).
+    v : array_like
+        The linear waveform (V).
+    slew_v_per_s : float
+        The op-amp's slew rate.
+
+    Returns
+    -------
+    float
+        The delay (s).
+    """
     dv = np.abs(np.diff(np.asarray(v, float)))
     dt = np.diff(np.asarray(t, float))
     return float(np.sum(np.maximum(0.0, dv - slew_v_per_s * dt)) / slew_v_per_s)
@@ -451,7 +566,24 @@ def waveform_limits(wave: dict, t, opamp: OpAmp, delay_budget_s: float) -> dict:
     waveforms, and whether they stay within the op-amp's swing and slew
     rate (slewing is accepted while it delays the stage by less than
     ``delay_budget_s``). ``wave`` is the rising half of the square wave, from
-    rest; the extremes cover the falling half too."""
+    rest; the extremes cover the falling half too.
+
+    Parameters
+    ----------
+    wave : dict
+        Signal name -> waveform (V) on ``t``.
+    t : array_like
+        Times (s).
+    opamp : OpAmp
+        The op-amp of every stage.
+    delay_budget_s : float
+        The slew delay a stage may have.
+
+    Returns
+    -------
+    dict
+        Role -> :class:`StageLevels`.
+    """
     t = np.asarray(t, float)
     out = {}
     for ref, role, sig in OPAMP_OUTPUTS:
@@ -499,7 +631,19 @@ class DiffAmpBalance:
 
 
 def dc_gain(lm: LoopModel, output: str = "y") -> float:
-    """The closed loop's DC gain from r to ``output`` (nan when singular)."""
+    """The closed loop's DC gain from r to ``output`` (nan when singular).
+
+    Parameters
+    ----------
+    lm : LoopModel
+        The closed loop.
+    output : str
+        One of its signals (:data:`SIGNALS`).
+
+    Returns
+    -------
+    float
+    """
     i = lm.outputs.index(output)
     try:
         return float(-(lm.c[i] @ np.linalg.solve(lm.a, lm.b)).item() + lm.d[i, 0])

@@ -1,6 +1,6 @@
 """The figures of a PID loop around a plant model, G(s) = N(s)/D(s) e^(-theta s),
-that the model plant's design (:mod:`designer.pid.process_loop`) and its
-optimiser (:mod:`designer.pid.process_optimize`) both use: the spec's limits,
+that the model plant's design (:mod:`designer.pid.design`) and its
+optimiser (:mod:`designer.pid.optimize`) both use: the spec's limits,
 the ideal loop's crossover, the integrator leak and derivative filter corners
 (fc/100 and 10 fc, as for a Sallen-Key plant's fn), the step response of the
 loop with the exact dead time (:func:`designer.pid.delayloop.closed_loop_step`)
@@ -8,9 +8,9 @@ and every op-amp stage's output from it (:func:`designer.pid.model.stage_tfs`),
 the controller as it will be built (:func:`designer.pid.model.controller_tf`),
 and the E-series sizing (:func:`designer.pid.selection.select_parts`).
 
-Moved out of :mod:`designer.pid.process_loop` (which re-exports every name) so
-that the optimiser needs not import the design that calls it: the cycle
-process_loop <-> process_optimize went with it.
+Kept apart from :mod:`designer.pid.design` (which re-exports every name) so
+that the optimiser needs not import the design that calls it: no cycle
+design <-> optimize.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from ..core.lti import filter_foh
 from . import blocks, model as M, selection
 from .delayloop import closed_loop_step, pid_tf, step_figures
 from .delaymargins import loop_margins
-from .process_result import LoopFigures
+from .result import LoopFigures
 from .spec import DEFAULT_MAX_MS, DEFAULT_MIN_GAIN_MARGIN_DB, DEFAULT_MIN_PHASE_MARGIN_DEG, PidSpec
 
 __all__ = ["LEAK_LOOP_GAIN", "TABLE_STEP_FRACTION", "FAR_FACTOR", "limits", "plant_of", "ideal_crossover_hz",
@@ -35,14 +35,34 @@ LEAK_LOOP_GAIN = 100.0
 
 
 def limits(spec: PidSpec) -> tuple:
-    """(min phase margin deg, min gain margin dB, max Ms) of the spec, defaults filled in."""
+    """(min phase margin deg, min gain margin dB, max Ms) of the spec, defaults filled in.
+
+    Parameters
+    ----------
+    spec : PidSpec
+        The request.
+
+    Returns
+    -------
+    tuple
+    """
     return (DEFAULT_MIN_PHASE_MARGIN_DEG if spec.min_phase_margin_deg is None else spec.min_phase_margin_deg,
             DEFAULT_MIN_GAIN_MARGIN_DB if spec.min_gain_margin_db is None else spec.min_gain_margin_db,
             DEFAULT_MAX_MS if spec.max_ms is None else spec.max_ms)
 
 
 def plant_of(model):
-    """The (num, den, theta_s) triple the loop functions take."""
+    """The (num, den, theta_s) triple the loop functions take.
+
+    Parameters
+    ----------
+    model : designer.core.process.ProcessModel
+        The plant.
+
+    Returns
+    -------
+    tuple
+    """
     return (np.asarray(model.num, float), np.asarray(model.den, float), float(model.theta_s))
 
 
@@ -52,7 +72,24 @@ def ideal_crossover_hz(model, kp: float, ti_s: float, td_s: float) -> float:
     """The (first) gain crossover of the ideal PID (filter N = 10) around the
     model, or the model's own corner 1/(2 pi time scale) when the loop never
     crosses. |C P| needs no phase: a log grid over eight decades about the
-    model's corner, refined between the two samples that straddle 1."""
+    model's corner, refined between the two samples that straddle 1.
+
+    Parameters
+    ----------
+    model : designer.core.process.ProcessModel
+        The plant.
+    kp : float
+        Proportional gain.
+    ti_s : float
+        Integral time (s).
+    td_s : float
+        Derivative time (s; 0 for a PI).
+
+    Returns
+    -------
+    float
+        Hz.
+    """
     from scipy.optimize import brentq
     num, den = pid_tf(kp, ti_s, td_s, 10.0)
     w0 = 1.0 / model.time_scale_s
@@ -76,7 +113,21 @@ def corner_frequencies(spec: PidSpec, fc_hz: float, loop_gain_hz: float | None =
     """(leak corner, derivative filter corner) in Hz: the spec's, else fc/100 and
     10 fc; the leak also at most ``loop_gain_hz`` / :data:`LEAK_LOOP_GAIN` (with
     ``loop_gain_hz`` = |K| Kp/(2 pi Ti), the leaky integrator's DC loop gain is
-    then at least that: a steady-state error under 1/(1 + 100))."""
+    then at least that: a steady-state error under 1/(1 + 100)).
+
+    Parameters
+    ----------
+    spec : PidSpec
+        Its ``f_integrator_hz`` and ``f_differentiator_hz``, when given.
+    fc_hz : float
+        The ideal loop's crossover.
+    loop_gain_hz : float, optional
+        |K| Kp/(2 pi Ti) (:func:`leak_limit_hz`); None: no limit.
+
+    Returns
+    -------
+    tuple
+    """
     f_i = spec.f_integrator_hz
     if f_i is None:
         f_i = fc_hz * blocks.F_INTEGRATOR_RATIO
@@ -88,14 +139,42 @@ def corner_frequencies(spec: PidSpec, fc_hz: float, loop_gain_hz: float | None =
 
 def leak_limit_hz(model, kp: float, ti_s: float) -> float | None:
     """|K| Kp/(2 pi Ti) of a non-integrating model (None for an integrating one, whose
-    own pole at 0 makes the steady-state error zero whatever the leak)."""
+    own pole at 0 makes the steady-state error zero whatever the leak).
+
+    Parameters
+    ----------
+    model : designer.core.process.ProcessModel
+        The plant.
+    kp : float
+        Proportional gain.
+    ti_s : float
+        Integral time (s).
+
+    Returns
+    -------
+    float or None
+    """
     return None if model.integrating else abs(model.gain) * kp / (2 * math.pi * ti_s)
 
 
 def edged(t, x, edge_s: float) -> np.ndarray:
     """The response to a reference ramping over ``edge_s`` from the response ``x``
     to a step at 0 (an LTI loop: the moving average of the step response over the
-    edge, exactly, from its running integral)."""
+    edge, exactly, from its running integral).
+
+    Parameters
+    ----------
+    t : array_like
+        Times from the step (s).
+    x : array_like
+        The step response on ``t``.
+    edge_s : float
+        The reference's edge (s; 0: ``x`` itself).
+
+    Returns
+    -------
+    numpy.ndarray
+    """
     if edge_s <= 0 or t.size < 2:
         return x
     h = t[1] - t[0]
@@ -108,7 +187,24 @@ def edged(t, x, edge_s: float) -> np.ndarray:
 def stage_waves(parts, amp, t, r, y) -> dict:
     """Every op-amp output of the controller for the reference ``r`` and the plant
     output ``y`` (the controller is linear from them: each stage's transfer
-    function, :func:`designer.pid.model.stage_tfs`, on its inputs)."""
+    function, :func:`designer.pid.model.stage_tfs`, on its inputs).
+
+    Parameters
+    ----------
+    parts : designer.pid.blocks.PidParts
+        The controller as built.
+    amp : designer.core.opamps.OpAmp
+        The op-amp of every stage.
+    t : array_like
+        Times (s).
+    r, y : array_like
+        The reference and the plant's output on ``t`` (V).
+
+    Returns
+    -------
+    dict
+        Signal -> waveform (V).
+    """
     tfs = M.stage_tfs(parts, amp)
     g_y, g_r = M.difference_weights(parts)
     w = {"ve": filter_foh(*tfs["ve"], t, g_y * y - g_r * r)}
@@ -123,7 +219,19 @@ def stage_waves(parts, amp, t, r, y) -> dict:
 
 
 def loop_dc_gain(model, controller) -> float:
-    """y/r at DC of the loop as built (an integrating plant: 1)."""
+    """y/r at DC of the loop as built (an integrating plant: 1).
+
+    Parameters
+    ----------
+    model : designer.core.process.ProcessModel
+        The plant.
+    controller : tuple
+        The controller's (num, den), descending powers of s.
+
+    Returns
+    -------
+    float
+    """
     if model.integrating:
         return 1.0
     c0 = controller[0][-1] / controller[1][-1]
@@ -142,7 +250,20 @@ FAR_FACTOR = 1e3
 def simulation_controller(controller, fc_hz: float):
     """``controller`` without its poles and zeros above :data:`FAR_FACTOR` x the
     crossover ``fc_hz``, its gain matched at the crossover (for the time
-    simulations; the margins use the whole controller)."""
+    simulations; the margins use the whole controller).
+
+    Parameters
+    ----------
+    controller : tuple
+        The controller's (num, den), descending powers of s.
+    fc_hz : float
+        The loop's crossover.
+
+    Returns
+    -------
+    tuple
+        (num, den).
+    """
     num, den = (np.atleast_1d(np.asarray(c, float)) for c in controller)
     w_keep = FAR_FACTOR * 2 * math.pi * fc_hz
     z, p = np.roots(num), np.roots(den)
@@ -157,7 +278,29 @@ def simulation_controller(controller, fc_hz: float):
 
 def loop_figures(model, controller, kp, ti_s, td_s, t, step_v=1.0) -> LoopFigures:
     """Margins, Ms and the closed-loop step figures (IAE included) of ``controller``
-    around ``model`` on the grid ``t`` (from the step)."""
+    around ``model`` on the grid ``t`` (from the step).
+
+    Parameters
+    ----------
+    model : designer.core.process.ProcessModel
+        The plant.
+    controller : tuple
+        The controller's (num, den), descending powers of s.
+    kp : float
+        Proportional gain.
+    ti_s : float
+        Integral time (s).
+    td_s : float
+        Derivative time (s; 0 for a PI).
+    t : array_like
+        Times from the step (s).
+    step_v : float
+        The reference step (V).
+
+    Returns
+    -------
+    LoopFigures
+    """
     mg = loop_margins(plant_of(model), controller)
     if not mg.stable:
         return LoopFigures(kp, ti_s, td_s, mg, None, math.nan, math.nan)
@@ -170,7 +313,27 @@ def loop_figures(model, controller, kp, ti_s, td_s, t, step_v=1.0) -> LoopFigure
 
 def built_controller(kp, ti_s, td_s, fc_hz, spec, amp):
     """The controller as it will be built, before any part is rounded
-    (:func:`designer.pid.blocks.continuous_parts` with the spec's corners), as (num, den)."""
+    (:func:`designer.pid.blocks.continuous_parts` with the spec's corners), as (num, den).
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain.
+    ti_s : float
+        Integral time (s).
+    td_s : float
+        Derivative time (s; 0 for a PI).
+    fc_hz : float
+        The ideal loop's crossover the corners are set from.
+    spec : PidSpec
+        The request (its corners, when given).
+    amp : designer.core.opamps.OpAmp
+        The op-amp of every stage.
+
+    Returns
+    -------
+    tuple
+    """
     f_i, f_d = corner_frequencies(spec, fc_hz, leak_limit_hz(spec.process, kp, ti_s))
     parts = blocks.continuous_parts(kp, ti_s, td_s, fc_hz, f_integrator_hz=f_i, f_differentiator_hz=f_d)
     return M.controller_tf(parts, amp)
@@ -178,7 +341,24 @@ def built_controller(kp, ti_s, td_s, fc_hz, spec, amp):
 
 def response_grid(model, fc_hz: float, points: int = 2001, per_crossover: float = 40.0) -> np.ndarray:
     """A grid long enough to see the loop settle: ``per_crossover`` times 1/wc,
-    or three open-loop settling times, whichever is longer."""
+    or three open-loop settling times, whichever is longer.
+
+    Parameters
+    ----------
+    model : designer.core.process.ProcessModel
+        The plant.
+    fc_hz : float
+        The loop's crossover.
+    points : int
+        Samples.
+    per_crossover : float
+        How many 1/wc the grid spans at least.
+
+    Returns
+    -------
+    numpy.ndarray
+        Times from 0 (s).
+    """
     span = max(per_crossover / (2 * math.pi * fc_hz), 3.0 * (model.settling_time_s if not model.integrating
                                                              else model.time_scale_s + model.theta_s))
     return np.linspace(0.0, span, points)
@@ -187,7 +367,27 @@ def response_grid(model, fc_hz: float, points: int = 2001, per_crossover: float 
 def size(spec: PidSpec, kp: float, ti_s: float, td_s: float, fc_hz: float, f_i: float, f_d: float):
     """The E-series parts for these gains with the spec's series, bounds and tolerance, the leak and
     filter at ``f_i`` and ``f_d`` (:func:`designer.pid.selection.select_parts`): the design's, the rule
-    table's SPICE runs' and the optimiser's final check's one call."""
+    table's SPICE runs' and the optimiser's final check's one call.
+
+    Parameters
+    ----------
+    spec : PidSpec
+        The request (series, bounds, tolerance).
+    kp : float
+        Proportional gain.
+    ti_s : float
+        Integral time (s).
+    td_s : float
+        Derivative time (s; 0 for a PI).
+    fc_hz : float
+        The ideal loop's crossover.
+    f_i, f_d : float
+        The leak's and the derivative filter's corners (Hz).
+
+    Returns
+    -------
+    designer.pid.selection.Selection
+    """
     return selection.select_parts(kp, ti_s, td_s, fc_hz, r_series=spec.r_series, c_series=spec.c_series,
                                r_min=spec.r_min, r_max=spec.r_max, c_min=spec.c_min, c_max=spec.c_max,
                                f_integrator_hz=f_i, f_differentiator_hz=f_d, tol=spec.tol)

@@ -101,7 +101,19 @@ def plant_ref_prefix(plant: SallenKeyParts) -> str:
 
 def loop_netlist(parts: PidParts, plant: SallenKeyParts) -> Netlist:
     """The whole loop as one table: the plant (U1 and its parts) first, then the
-    controller's stages in signal order."""
+    controller's stages in signal order.
+
+    Parameters
+    ----------
+    parts : PidParts
+        The controller.
+    plant : SallenKeyParts
+        The plant.
+
+    Returns
+    -------
+    Netlist
+    """
     pl = plant_netlist(plant, "u", "y", prefix="p", amp_ref="U1", ref_prefix=plant_ref_prefix(plant))
     ctl = controller_netlist(parts)
     return Netlist(pl.parts + ctl.parts, pl.amps + ctl.amps)
@@ -110,7 +122,29 @@ def loop_netlist(parts: PidParts, plant: SallenKeyParts) -> Netlist:
 def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test: SquareTest,
                      title: str, expected_final: float, points: int = 20000) -> str:
     """The whole loop as a standalone deck; ``expected_final`` (V) is the settled
-    plant output the ``.meas`` levels refer to (the analytic closed loop's)."""
+    plant output the ``.meas`` levels refer to (the analytic closed loop's).
+
+    Parameters
+    ----------
+    parts : PidParts
+        The controller.
+    plant : SallenKeyParts
+        The plant.
+    opamp : OpAmp
+        The op-amp of every stage.
+    test : SquareTest
+        The reference square wave.
+    title : str
+        The deck's title line.
+    expected_final : float
+        The settled plant output (V) the ``.meas`` levels refer to.
+    points : int
+        ``.tran`` points.
+
+    Returns
+    -------
+    str
+    """
     about = ["* plant (seed 001, Fig. 43-45): XU1 Sallen-Key; controller (Fig. 66): U2 difference (ve = y - r),",
              "*   U3 inverter, U4 differentiator, U5 integrator, U6 summer, U7 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y)"]
     return _loop_deck(parts, opamp, test, title, expected_final, about, [], loop_netlist(parts, plant), points)
@@ -147,7 +181,19 @@ def controller_netlist(parts: PidParts, reversed_action: bool = False) -> Netlis
     model: the deck puts the model between ``u`` and ``y``
     (:func:`designer.spice.behavioural.plant_lines`). ``reversed_action``: the
     reference and the plant output exchanged at the difference amplifier (r into
-    R17, y into R15: u = -C(s) (r - y), for an inverting plant)."""
+    R17, y into R15: u = -C(s) (r - y), for an inverting plant).
+
+    Parameters
+    ----------
+    parts : PidParts
+        The controller.
+    reversed_action : bool
+        Exchange r and y at the difference amplifier.
+
+    Returns
+    -------
+    Netlist
+    """
     rows, amps = [], []
     nets = {"ref": "y", "y": "ref"} if reversed_action else {}
     for amp, passives in controller_stages(parts, **nets):
@@ -224,7 +270,29 @@ def model_loop_deck(parts: PidParts, model, opamp: OpAmp, test: SquareTest, titl
     time (:mod:`designer.spice.behavioural`), the six op-amp stages as for a
     Sallen-Key plant, the same reference, ``.tran`` and ``.meas`` lines. The
     step is at most the plant's own accuracy hint
-    (:func:`~designer.spice.behavioural.max_step_hint_s`)."""
+    (:func:`~designer.spice.behavioural.max_step_hint_s`).
+
+    Parameters
+    ----------
+    parts : PidParts
+        The controller.
+    model : designer.core.process.ProcessModel
+        The plant.
+    opamp : OpAmp
+        The op-amp of every stage.
+    test : SquareTest
+        The reference square wave.
+    title : str
+        The deck's title line.
+    expected_final : float
+        The settled plant output (V) the ``.meas`` levels refer to.
+    points : int
+        ``.tran`` points.
+
+    Returns
+    -------
+    str
+    """
     from ..spice.behavioural import max_step_hint_s, plant_lines
     about = [f"* plant (a model, not a circuit): {model.text()}",
              f"*   from {model.source}; input u (the controller's output), output y",

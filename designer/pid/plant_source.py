@@ -62,7 +62,17 @@ BUILT_KEYS = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "gain"
 def result_kind(data) -> str | None:
     """What wrote a parsed result JSON: ``"identify"``, ``"identify-freq"``,
     ``"plant"`` (design-plant/analyze-plant), ``"check-design"``,
-    ``"design-pid"``, or None (none of these)."""
+    ``"design-pid"``, or None (none of these).
+
+    Parameters
+    ----------
+    data : object
+        The parsed JSON.
+
+    Returns
+    -------
+    str or None
+    """
     if not isinstance(data, dict):
         return None
     if data.get("format") in IDENTIFY_FORMATS and "best" in data:
@@ -114,7 +124,21 @@ def model_from_json(path, method: str | None = None) -> ProcessModel:
 
 
 def model_from_result(data, method: str | None = None, *, name: str = "result") -> ProcessModel:
-    """:func:`model_from_json` of JSON already parsed (``name`` names it in messages)."""
+    """:func:`model_from_json` of JSON already parsed (``name`` names it in messages).
+
+    Parameters
+    ----------
+    data : dict
+        The parsed result.
+    method : str, optional
+        As :func:`model_from_json`'s.
+    name : str
+        How messages name the result.
+
+    Returns
+    -------
+    ProcessModel
+    """
     kind = result_kind(data)
     where = f"plant model {name}"
     if kind in ("identify", "identify-freq"):
@@ -276,7 +300,19 @@ def model_from_plant(data: dict, *, name: str = "result") -> ProcessModel:
 def sallen_key_model(parts: SallenKeyParts, source: str = "Sallen-Key") -> ProcessModel:
     """K/(a s^2 + b s + 1) (:func:`designer.plant.model.plant_tf`) as a
     :class:`ProcessModel`: underdamped with the parts' fn and zeta, or for
-    zeta >= 1 the SOPDT whose (tau1 s + 1)(tau2 s + 1) = a s^2 + b s + 1."""
+    zeta >= 1 the SOPDT whose (tau1 s + 1)(tau2 s + 1) = a s^2 + b s + 1.
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        The plant's parts.
+    source : str
+        Where the model came from (its ``source``).
+
+    Returns
+    -------
+    ProcessModel
+    """
     num, den = plant_tf(parts)
     k, (a, b, _) = float(num[0]), (float(c) for c in den)
     zeta = b / (2.0 * math.sqrt(a))

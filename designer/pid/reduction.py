@@ -217,7 +217,19 @@ MODEL_TYPES = (ModelFopdt, ModelSopdt, ModelIntegrating, ModelTf)
 
 
 def model_step(model, t) -> np.ndarray:
-    """The model's exact response to a unit step at t = 0."""
+    """The model's exact response to a unit step at t = 0.
+
+    Parameters
+    ----------
+    model : designer.core.process.ProcessModel
+        The plant.
+    t : array_like
+        Times (s).
+
+    Returns
+    -------
+    numpy.ndarray
+    """
     num, den, theta = model.tf()
     return step_response(num, den, np.asarray(t, float) - theta)
 
@@ -370,6 +382,15 @@ def model_tangent(model) -> ModelTangent:
     integrating plant, the ramp asymptote (L = theta + tau). Otherwise the
     steepest point of the exact step is found on a dense grid and refined by
     maximising the impulse response (the step's slope) between its neighbours.
+
+    Parameters
+    ----------
+    model : designer.core.process.ProcessModel
+        The plant.
+
+    Returns
+    -------
+    ModelTangent
 
     Raises
     ------

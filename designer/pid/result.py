@@ -1,17 +1,23 @@
-"""What a controller design knows, typed until the JSON edge.
+"""What a controller design knows, typed until the JSON edge: one result for
+every plant (the Sallen-Key circuit of the seed, or a model that a registered
+circuit may realise).
 
 :class:`PidResult` nests the tuning (:class:`designer.pid.tuning.Tuning`, the
-rules and the optimiser's run), the parts and their selection, what the parts
-achieve, the checks (:class:`designer.core.checks.Check`), the analytic closed
-loop and its margins, the levels at every op-amp output, the bench test, the
-SPICE run and its verdict, and the waveforms the plots draw. Its one
-:meth:`PidResult.to_dict` is the JSON of ``design-pid --json`` and
-``result.json``; the build sheet (:mod:`designer.pid.report`) reads the typed
-result and computes nothing.
+rules and the optimiser's run; for a model plant the chosen gains and every
+rule's :class:`RuleRow`: gains, margins, Ms, IAE and, when simulated, SPICE's
+overshoot), the parts and their selection, what the parts achieve, the checks
+(:class:`designer.core.checks.Check`), the analytic closed loop and its
+margins, the levels at every op-amp output, the worst case over a model's
+95 % corners (:class:`RobustCheck`), the bench test, the SPICE run and its
+verdict, and the waveforms the plots draw. Its one :meth:`PidResult.to_dict`
+is the JSON of ``design-pid --json`` and ``result.json`` (each plant kind's
+keys as before the two results were one); the build sheet
+(:mod:`designer.pid.report`) reads the typed result and computes nothing.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -24,15 +30,13 @@ from ..plant.sallenkey import SallenKeyParts
 from ..spice.deck import SquareTest
 from ..spice.simulate import tool_info
 from .blocks import PidParts
-from .model import Margins
-from .optimize import OptimizeResult
 from .plant import sallen_key_circuit
 from .selection import Selection
 from .spec import PidSpec
 from .tuning import Tuning
 from .verify import SpiceRun, Verdict
 
-__all__ = ["PidResult"]
+__all__ = ["Achieved", "AnalyticLoop", "LoopFigures", "PidResult", "RobustCheck", "RuleRow", "Waveforms"]
 
 
 def loop_verdicts(checks, verdict, spice) -> list:
@@ -135,41 +139,155 @@ class LoopVerdicts:
         return loop_verdicts(self.checks, self.verdict, self.spice)
 
 
-@dataclass
-class PidResult(LoopVerdicts):
-    """Everything known about one controller design; :meth:`to_dict` is the JSON.
+@dataclass(frozen=True)
+class LoopFigures:
+    """One loop's figures: gains, margins (:class:`~designer.pid.delaymargins.DelayLoopMargins`),
+    step figures (:class:`~designer.pid.delayloop.StepFigures`, None when unstable)
+    and the controller output's extremes over the step."""
 
-    ``files`` and ``timings`` are filled in as the bundle is written.
+    kp: float
+    ti_s: float
+    td_s: float
+    margins: object
+    step: object
+    u_min_v: float
+    u_max_v: float
+
+    def to_dict(self) -> dict:
+        m = self.margins
+        return {"kp": self.kp, "ti_s": self.ti_s, "td_s": self.td_s, "stable": m.stable,
+                "phase_margin_deg": m.phase_margin_deg, "crossover_hz": m.crossover_hz,
+                "gain_margin_db": m.gain_margin_db, "delay_margin_s": m.delay_margin_s, "ms": m.ms,
+                "step": None if self.step is None else self.step.to_dict(),
+                "u_min_v": self.u_min_v, "u_max_v": self.u_max_v}
+
+
+@dataclass(frozen=True)
+class RuleRow:
+    """One rule on the one plant: its tuning (:class:`~designer.pid.rules.RuleTuning`),
+    or the reason it does not apply, and its loop as it would be built."""
+
+    rule: str
+    tuning: object
+    reason: str | None
+    figures: LoopFigures | None
+    spice_overshoot_pct: float | None = None
+
+    def to_dict(self) -> dict:
+        return {"rule": self.rule, "applies": self.tuning is not None, "reason": self.reason,
+                "tuning": None if self.tuning is None else self.tuning.to_dict(),
+                "loop": None if self.figures is None else self.figures.to_dict(),
+                "spice_overshoot_pct": self.spice_overshoot_pct}
+
+
+@dataclass(frozen=True)
+class RobustCheck:
+    """The loop as built at each corner of the model's 95 % box (label, LoopFigures)."""
+
+    corners: tuple
+    min_phase_margin_deg: float
+    min_gain_margin_db: float
+    max_ms: float
+
+    def worst(self, key: str, sign: float = 1.0):
+        """(label, value) of the corner with the smallest ``sign`` x figure ``key``
+        of :meth:`LoopFigures.to_dict` (sign -1: the largest); an unstable corner first."""
+        def value(fig):
+            d = fig.to_dict()
+            v = d[key] if key in d else (d["step"] or {}).get(key)
+            return math.inf if v is None or (isinstance(v, float) and math.isnan(v)) else sign * v
+        unstable = [(lab, f) for lab, f in self.corners if not f.margins.stable]
+        if unstable:
+            return unstable[0][0], math.nan
+        lab, fig = min(self.corners, key=lambda c: value(c[1]))
+        return lab, sign * value(fig)
+
+    @property
+    def all_stable(self) -> bool:
+        return all(f.margins.stable for _, f in self.corners)
+
+    def checks(self) -> tuple:
+        pm_at, pm = self.worst("phase_margin_deg")
+        os_at, os_ = self.worst("overshoot_pct", -1.0)
+        ms_at, ms = self.worst("ms", -1.0)
+        n = len(self.corners)
+        if not self.all_stable:
+            return (Check("robust_stability", False, f"the loop is unstable at the 95 % corner {pm_at} "
+                                                     f"(of {n} corners)"),)
+        return (Check("robust_stability", True, f"stable at all {n} corners of the model's 95 % intervals"),
+                Check("robust_phase_margin", bool(pm >= self.min_phase_margin_deg),
+                      f"worst {pm:.3g} deg at the corner {pm_at} (want >= {self.min_phase_margin_deg:g} deg); "
+                      f"worst overshoot {os_:.3g} % at {os_at}"),
+                Check("robust_max_sensitivity", bool(ms <= self.max_ms),
+                      f"worst Ms {ms:.3g} at the corner {ms_at} (want <= {self.max_ms:g})"))
+
+    def to_dict(self) -> dict:
+        pm_at, pm = self.worst("phase_margin_deg")
+        os_at, os_ = self.worst("overshoot_pct", -1.0)
+        gm_at, gm = self.worst("gain_margin_db")
+        ms_at, ms = self.worst("ms", -1.0)
+        return {"corners": [{"corner": lab, **f.to_dict()} for lab, f in self.corners],
+                "all_stable": self.all_stable,
+                "worst_phase_margin_deg": pm, "worst_phase_margin_at": pm_at,
+                "worst_gain_margin_db": gm, "worst_gain_margin_at": gm_at,
+                "worst_ms": ms, "worst_ms_at": ms_at,
+                "worst_overshoot_pct": os_, "worst_overshoot_at": os_at}
+
+
+@dataclass(kw_only=True)
+class PidResult(LoopVerdicts):
+    """Everything known about one controller design, for either kind of plant; :meth:`to_dict` is the JSON.
+
+    The plant is either the Sallen-Key circuit of the seed (``plant`` set, the
+    reaction-curve ``tuning`` and its ``rules``) or a model (``model`` set: a
+    :class:`~designer.core.process.ProcessModel`, typed or identified, that a
+    registered circuit may realise; the chosen ``method`` and gains, every rule's
+    :class:`RuleRow`, the ``robust`` corners). The fields of the other kind stay
+    None. ``files`` and ``timings`` are filled in as the bundle is written.
     """
 
     spec: PidSpec
-    plant: SallenKeyParts
-    plant_source: str
-    plant_series: tuple | None          #: (R, C) series of a plant designed here, else None
-    plant_fn_opamp_hz: float            #: the plant's dominant pair with its op-amp
-    plant_zeta_opamp: float
     opamp: OpAmp
-    tuning: Tuning
-    rules: tuple                        #: every rule on the same reaction curve
-    optimizer: OptimizeResult | None
+    rules: tuple                        #: Tuning per reaction-curve rule (Sallen-Key plant), else RuleRow per rule
+    optimizer: object                   #: designer.pid.optimize's OptimizeResult or ModelOptimizeResult, else None
     parts: PidParts
     selection: Selection | None         #: None for given parts
     achieved: Achieved
     checks: tuple                       #: Check, static then dynamic
     analytic: AnalyticLoop
-    ideal_pid: StepMetrics
-    margins: Margins
+    ideal_pid: StepMetrics | None       #: the ideal PID around the plant (None: a model's ideal loop is unstable)
+    margins: object                     #: Margins (Sallen-Key plant) or DelayLoopMargins (model) of the loop as built
     test: SquareTest
     expected_final_v: float
     deck: str
     waveforms: Waveforms = field(repr=False)
     notes: list = field(default_factory=list)
+    # the Sallen-Key plant's (None for a model plant)
+    plant: SallenKeyParts | None = None
+    plant_source: str | None = None
+    plant_series: tuple | None = None   #: (R, C) series of a plant designed here, else None
+    plant_fn_opamp_hz: float | None = None  #: the plant's dominant pair with its op-amp
+    plant_zeta_opamp: float | None = None
+    tuning: Tuning | None = None
+    diff_amp: object = None             #: designer.pid.model.DiffAmpBalance when R15..R18 are unbalanced
+    seed_bench: object = None           #: designer.pid.design.SeedBenchFinding for the seed's as-built parts
+    # the model plant's (None for the Sallen-Key plant)
+    model: object = None                #: designer.core.process.ProcessModel
+    reduced: object = None              #: the model the rules see (designer.pid.reduction)
+    method: str | None = None           #: a rule, optimize, explicit or as-built
+    kp: float | None = None
+    ti_s: float | None = None
+    td_s: float | None = None
+    rule: object = None                 #: RuleTuning of the chosen rule, else None
+    fc_ref_hz: float | None = None      #: the ideal loop's crossover the corners are set from
+    ideal_margins: object = None        #: DelayLoopMargins of the ideal PID around the model
+    robust: RobustCheck | None = None
+    limits: tuple = (45.0, 6.0, 1.7)    #: (min PM deg, min GM dB, max Ms) of a model's loop
+    # both
+    package: str | None = None          #: op-amp package kind the sheet wires (None: the op-amp's default)
     spice: SpiceRun | None = None
     verdict: Verdict | None = None
     scope: object = None                #: designer.plant.bench.ScopeSetup of the bench test (CH2 per node)
-    diff_amp: object = None             #: designer.pid.model.DiffAmpBalance when R15..R18 are unbalanced
-    seed_bench: object = None           #: designer.pid.design.SeedBenchFinding for the seed's as-built parts
-    package: str | None = None          #: op-amp package kind the sheet wires (None: the op-amp's default)
     #: a tolerance analysis of the loop (designer.tolerance.loop.LoopMonteCarlo), when asked for
     monte_carlo: object = None
     #: the loop's worst case over the tolerance box (designer.tolerance.worstcase.WorstCase), when asked for
@@ -177,38 +295,100 @@ class PidResult(LoopVerdicts):
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
+    @property
+    def stable(self) -> bool:
+        """Whether the loop as built is stable (the analytic loop's verdict)."""
+        return self.analytic.stable
+
+    @property
+    def dc_gain(self) -> float:
+        """The loop as built's y/r at DC."""
+        return self.analytic.dc_gain
+
+    @property
+    def levels(self) -> dict:
+        """Role -> analytic levels at every op-amp output."""
+        return self.analytic.levels
+
+    def circuit_dict(self) -> dict:
+        """A circuit plant's keys of a model's ``plant`` (none for a model alone): ``kind``
+        ``circuit``, its ``topology`` (a registry name or ``cascade``), its
+        ``circuit`` (stages and parts as on the board), ``circuit_model`` (its own
+        transfer function) and ``reversed_action`` (an inverting circuit, the
+        model the gains were chosen for being -G)."""
+        plant = getattr(self.spec, "circuit", None)
+        if plant is None:
+            return {}
+        c = plant.circuit
+        return {"kind": "circuit", "topology": c.topology, "circuit": c.to_dict()["stages"],
+                "circuit_model": plant.model.to_dict(), "reversed_action": plant.reversed_action}
 
     def to_dict(self) -> dict:
-        pl = self.plant
-        out = {
-            "schema_version": SCHEMA_VERSION,
-            "tool": tool_info(self.simulator),
-            "plant": {"source": self.plant_source, **pl.as_dict(), "q": pl.q, "fn_opamp_hz": self.plant_fn_opamp_hz,
-                      "zeta_opamp": self.plant_zeta_opamp, "topology": sallen_key_circuit(pl).topology},
-            "opamp": self.opamp.to_dict(), "package": self.opamp.package(self.package).to_dict(),
-            "tuning": self.tuning.to_dict(),
-            "rules": [r.to_dict(brief=True) for r in self.rules],
-            "optimizer": None if self.optimizer is None else self.optimizer.to_dict(),
-            "components": self.parts.to_dict(),
-            "series": None if self.selection is None else self.selection.to_dict(),
-            "achieved": self.achieved.to_dict(),
-            "checks": [c.to_dict() for c in self.checks],
-            "closed_loop": {"analytic": self.analytic.to_dict(), "ideal_pid": self.ideal_pid.to_dict(),
-                            "spice": None if self.spice is None else self.spice.to_dict(),
-                            "margins": self.margins.to_dict(),
-                            "verdict": None if self.verdict is None else self.verdict.to_dict()},
-            "levels": {"analytic": {k: v.to_dict() for k, v in self.analytic.levels.items()},
+        """The JSON of ``design-pid --json`` and ``result.json`` (a model plant's keys when ``model`` is set)."""
+        tail = {
+            "levels": {"analytic": {k: v.to_dict() for k, v in self.levels.items()},
                        "spice": None if self.spice is None else {k: v.to_dict() for k, v in self.spice.stages.items()}},
             "test_signal": {**self.test.to_dict(), "edge_s": self.test.edge_s,
                             "expected_final_v": self.expected_final_v},
             "notes": self.notes,
             "simulator": self.simulator,
             "scope": None if self.scope is None else self.scope.to_dict(),
-            "difference_amplifier": None if self.diff_amp is None else self.diff_amp.to_dict(),
-            "seed_bench": None if self.seed_bench is None else self.seed_bench.to_dict(),
-            "monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
-            "worst_case": None if self.worst_case is None else self.worst_case.to_dict(),
-            "files": self.files,
         }
-        return json_safe(out)
+        if self.model is None:
+            tail.update({"difference_amplifier": None if self.diff_amp is None else self.diff_amp.to_dict(),
+                         "seed_bench": None if self.seed_bench is None else self.seed_bench.to_dict()})
+        tail.update({"monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
+                     "worst_case": None if self.worst_case is None else self.worst_case.to_dict(),
+                     "files": self.files})
+        head = {"schema_version": SCHEMA_VERSION, "tool": tool_info(self.simulator)}
+        return json_safe({**head, **(self._circuit_keys() if self.model is None else self._model_keys()), **tail})
 
+    def _circuit_keys(self) -> dict:
+        """The Sallen-Key plant's keys from ``plant`` to ``closed_loop``."""
+        pl = self.plant
+        return {
+            "plant": {"source": self.plant_source, **pl.as_dict(), "q": pl.q, "fn_opamp_hz": self.plant_fn_opamp_hz,
+                      "zeta_opamp": self.plant_zeta_opamp, "topology": sallen_key_circuit(pl).topology},
+            **self._amp_keys(),
+            "tuning": self.tuning.to_dict(),
+            "rules": [r.to_dict(brief=True) for r in self.rules],
+            "optimizer": None if self.optimizer is None else self.optimizer.to_dict(),
+            **self._parts_keys(),
+            "checks": [c.to_dict() for c in self.checks],
+            "closed_loop": {"analytic": self.analytic.to_dict(), "ideal_pid": self.ideal_pid.to_dict(),
+                            "spice": None if self.spice is None else self.spice.to_dict(),
+                            "margins": self.margins.to_dict(),
+                            "verdict": None if self.verdict is None else self.verdict.to_dict()},
+        }
+
+    def _model_keys(self) -> dict:
+        """A model plant's keys from ``plant`` to ``robust``."""
+        pm_min, gm_min, ms_max = self.limits
+        return {
+            "plant": {"kind": "model", "source": self.model.source, "model": self.model.to_dict(),
+                      "rules_model": self.reduced.to_dict(), "input_range_v": self.spec.plant_input,
+                      "output_range_v": self.spec.plant_output, **self.circuit_dict()},
+            **self._amp_keys(),
+            "tuning": {"method": self.method, "kp": self.kp, "ti_s": self.ti_s, "td_s": self.td_s,
+                       "rule": None if self.rule is None else self.rule.to_dict()},
+            "rules": [r.to_dict() for r in self.rules],
+            "optimizer": None if self.optimizer is None else self.optimizer.to_dict(),
+            "limits": {"min_phase_margin_deg": pm_min, "min_gain_margin_db": gm_min, "max_ms": ms_max},
+            **self._parts_keys(),
+            "fc_ref_hz": self.fc_ref_hz,
+            "checks": [c.to_dict() for c in self.checks],
+            "closed_loop": {"analytic": self.analytic.to_dict(),
+                            "ideal_pid": None if self.ideal_pid is None else self.ideal_pid.to_dict(),
+                            "margins": self.margins.to_dict(), "ideal_pid_margins": self.ideal_margins.to_dict(),
+                            "spice": None if self.spice is None else self.spice.to_dict(),
+                            "verdict": None if self.verdict is None else self.verdict.to_dict()},
+            "robust": None if self.robust is None else self.robust.to_dict(),
+        }
+
+    def _amp_keys(self) -> dict:
+        return {"opamp": self.opamp.to_dict(), "package": self.opamp.package(self.package).to_dict()}
+
+    def _parts_keys(self) -> dict:
+        return {"components": self.parts.to_dict(),
+                "series": None if self.selection is None else self.selection.to_dict(),
+                "achieved": self.achieved.to_dict()}

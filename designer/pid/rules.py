@@ -144,14 +144,44 @@ class RuleTuning:
 
 def series_to_parallel(kc: float, tau_i: float, tau_d: float) -> tuple:
     """Kc (1 + 1/(tauI s))(1 + tauD s) as Kp (1 + 1/(Ti s) + Td s):
-    Kp = Kc (1 + tauD/tauI), Ti = tauI + tauD, Td = tauI tauD/(tauI + tauD)."""
+    Kp = Kc (1 + tauD/tauI), Ti = tauI + tauD, Td = tauI tauD/(tauI + tauD).
+
+    Parameters
+    ----------
+    kc : float
+        Series gain.
+    tau_i : float
+        Series integral time (s).
+    tau_d : float
+        Series derivative time (s).
+
+    Returns
+    -------
+    tuple
+        (Kp, Ti, Td).
+    """
     ti = tau_i + tau_d
     return kc * (1.0 + tau_d / tau_i), ti, tau_i * tau_d / ti
 
 
 def parallel_to_series(kp: float, ti: float, td: float) -> tuple:
     """The inverse of :func:`series_to_parallel`, tauI >= tauD; it exists only for
-    Ti >= 4 Td (real controller zeros)."""
+    Ti >= 4 Td (real controller zeros).
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain.
+    ti : float
+        Integral time (s).
+    td : float
+        Derivative time (s).
+
+    Returns
+    -------
+    tuple
+        (Kc, tauI, tauD).
+    """
     if td == 0:
         return kp, ti, 0.0
     disc = 1.0 - 4.0 * td / ti
@@ -440,7 +470,21 @@ def tune_model(model, rule: str, *, tauc_s: float | None = None,
 def applicable(model, *, tauc_s: float | None = None, lambda_s: float | None = None) -> dict:
     """``{rule: None}`` for each rule that applies to ``model`` (any model
     :func:`tune_model` takes, a ProcessModel included), ``{rule: reason}`` (the
-    one-line refusal of :func:`tune_model`) for each that does not."""
+    one-line refusal of :func:`tune_model`) for each that does not.
+
+    Parameters
+    ----------
+    model : object
+        Any model :func:`tune_model` takes.
+    tauc_s : float, optional
+        SIMC's closed-loop time constant (s).
+    lambda_s : float, optional
+        IMC's lambda (s).
+
+    Returns
+    -------
+    dict
+    """
     out = {}
     for r in RULES:
         try:
@@ -454,7 +498,21 @@ def applicable(model, *, tauc_s: float | None = None, lambda_s: float | None = N
 def all_rules(model, *, tauc_s: float | None = None, lambda_s: float | None = None) -> list:
     """Every rule of :data:`RULES` on ``model`` (any model :func:`tune_model`
     takes, a ProcessModel included), for the side-by-side table: a
-    :class:`RuleTuning`, or ``(rule, reason)`` where the rule does not apply."""
+    :class:`RuleTuning`, or ``(rule, reason)`` where the rule does not apply.
+
+    Parameters
+    ----------
+    model : object
+        Any model :func:`tune_model` takes.
+    tauc_s : float, optional
+        SIMC's closed-loop time constant (s).
+    lambda_s : float, optional
+        IMC's lambda (s).
+
+    Returns
+    -------
+    list
+    """
     out = []
     for r in RULES:
         try:

@@ -65,7 +65,23 @@ def _inverting(s, board, amp, inputs, feedback, x_in, row, x_out_min=None):
 def draw_loop(board, opamp, probes: dict = PROBES, plant_prefix: str = "") -> Sheet:
     """The closed loop of ``board`` (a :class:`~designer.spice.deck.Board` of
     :func:`~designer.pid.netlist.loop_netlist`, its plant's designators prefixed
-    with ``plant_prefix``) on a new sheet."""
+    with ``plant_prefix``) on a new sheet.
+
+    Parameters
+    ----------
+    board : designer.spice.deck.Board
+        The loop as built.
+    opamp : designer.core.opamps.OpAmp
+        Its op-amp.
+    probes : dict
+        Node -> probe tag (:data:`PROBES`).
+    plant_prefix : str
+        The designator prefix the plant's parts carry in the loop (:func:`~designer.pid.netlist.plant_ref_prefix`).
+
+    Returns
+    -------
+    Sheet
+    """
     s = Sheet(fontsize=10)
     bottom = _draw_controller(s, board, probes)
     # the plant, below, fed from u by its net label
@@ -81,7 +97,23 @@ def draw_model_loop(board, opamp, model_text: str, probes: dict = PROBES) -> She
     :func:`~designer.pid.netlist.controller_netlist`) as for a Sallen-Key plant,
     and the plant a block labelled ``model_text`` (``G(s) = ...``) from net ``u``
     to net ``y``, its ground on the common ground. The block's terminals are
-    ``PLANT`` ``in``, ``out`` and ``gnd`` in :meth:`Sheet.connectivity`."""
+    ``PLANT`` ``in``, ``out`` and ``gnd`` in :meth:`Sheet.connectivity`.
+
+    Parameters
+    ----------
+    board : designer.spice.deck.Board
+        The controller as built.
+    opamp : designer.core.opamps.OpAmp
+        Its op-amp.
+    model_text : str
+        The block's label.
+    probes : dict
+        Node -> probe tag (:data:`PROBES`).
+
+    Returns
+    -------
+    Sheet
+    """
     s = Sheet(fontsize=10)
     bottom = _draw_controller(s, board, probes)
     low = draw_plant_block(s, model_text, (0.0, bottom), probes.get("y", "CH2"))

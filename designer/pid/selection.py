@@ -75,7 +75,23 @@ def objective(parts: PidParts, targets: dict, best: float, tol: float) -> tuple:
     """The quantity the selection minimises, lexicographically: the worst
     relative error of Kp, Ti, Td (errors at or below max(best, tol) count as
     equal), then the largest high-frequency noise gain of the summer, final
-    gain and differentiator stages (smaller = more bandwidth)."""
+    gain and differentiator stages (smaller = more bandwidth).
+
+    Parameters
+    ----------
+    parts : PidParts
+        A candidate controller.
+    targets : dict
+        ``kp``, ``ti_s``, ``td_s``.
+    best : float
+        The smallest worst error found.
+    tol : float
+        Errors at or below max(best, tol) count as equal.
+
+    Returns
+    -------
+    tuple
+    """
     err = worst_error(parts, targets)
     level = max(best, tol) * (1 + 1e-9)
     ng = parts.noise_gains()
@@ -158,6 +174,29 @@ def select_parts(kp: float, ti_s: float, td_s: float, fn_hz: float, *,
     10 kOhm; R11 nearest 10 kOhm; the smallest R6, R5, R7. The search works on
     tables of n^2 entries (n resistor values), never on the n^3 Kp triples, in
     fixed-size chunks: E192/E192 takes under a second and tens of MB.
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain.
+    ti_s : float
+        Integral time (s).
+    td_s : float
+        Derivative time (s; 0 for a PI).
+    fn_hz : float
+        The plant's natural frequency (a model plant: the loop's crossover) the corners are set from.
+    r_series, c_series : str
+        The E-series of the resistors and of the capacitors.
+    r_min, r_max : float
+        The resistors' bounds (Ohm).
+    c_min, c_max : float
+        The capacitors' bounds (F).
+    tol : float
+        Errors of Kp, Ti and Td at or below this count as equal.
+    f_integrator_hz : float, optional
+        The integrator leak's corner (default fn/100).
+    f_differentiator_hz : float, optional
+        The derivative filter's corner (default 10 fn).
 
     Returns
     -------
@@ -419,7 +458,36 @@ def brute_force(kp: float, ti_s: float, td_s: float, fn_hz: float, *, r_series: 
                 f_integrator_hz=None, f_differentiator_hz=None):
     """Exhaustive reference for :func:`select_parts` on small candidate sets:
     every combination of R3, R4, R5, R6, R7, R8, R11, R14, C3, C4 (R12, R13 follow
-    from the capacitors as in the search). Returns (best worst-error, best objective)."""
+    from the capacitors as in the search). Returns (best worst-error, best objective).
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain.
+    ti_s : float
+        Integral time (s).
+    td_s : float
+        Derivative time (s).
+    fn_hz : float
+        The plant's natural frequency (a model plant: the loop's crossover) the corners are set from.
+    r_series, c_series : str
+        The E-series of the resistors and of the capacitors.
+    r_min, r_max : float
+        The resistors' bounds (Ohm).
+    c_min, c_max : float
+        The capacitors' bounds (F).
+    tol : float
+        Errors of Kp, Ti and Td at or below this count as equal.
+    f_integrator_hz : float, optional
+        The integrator leak's corner (default fn/100).
+    f_differentiator_hz : float, optional
+        The derivative filter's corner (default 10 fn).
+
+    Returns
+    -------
+    tuple
+        (best worst-error, best objective).
+    """
     rv = eseries.values(r_series, r_min, r_max)
     cv = eseries.values(c_series, c_min, c_max)
     f_i = fn_hz * F_INTEGRATOR_RATIO if f_integrator_hz is None else f_integrator_hz

@@ -65,7 +65,7 @@ class PidSpec(PartBounds):
     ``plant_model`` (an ``identify``/``identify-freq`` JSON, its best valid
     model or ``plant_method``) or ``plant_process`` (a
     :class:`~designer.core.process.ProcessModel`). A model plant is designed
-    by :mod:`designer.pid.process_loop`: its rules are :data:`designer.pid.rules.RULES`,
+    by :mod:`designer.pid.design`: its rules are :data:`designer.pid.rules.RULES`,
     ``optimize`` holds the loop to ``min_phase_margin_deg``,
     ``min_gain_margin_db`` and ``max_ms`` (defaults 45 deg, 6 dB, 1.7; with
     ``robust`` over the model's 95 % corners too), and ``plant_input`` /
@@ -390,7 +390,17 @@ def check_controller(parts: PidParts, names: dict | None = None) -> PidParts:
 def controller_from_json(path) -> PidParts:
     """The controller parts of a ``design-pid``/``analyze-pid`` result.json (its
     ``components`` object: ``R3_ohm`` .. ``C4_f``), read by the one reader and
-    checked by :func:`check_controller`; a refusal names the file and the key."""
+    checked by :func:`check_controller`; a refusal names the file and the key.
+
+    Parameters
+    ----------
+    path : str or Path
+        The result.json.
+
+    Returns
+    -------
+    PidParts
+    """
     try:
         comp = read_result(path, "{controller_json}", needs={"components": ("R3_ohm",)},
                            what="a design-pid result.json")["components"]

@@ -278,6 +278,17 @@ def tune(rule: str, source) -> Tuning:
 
     ``source`` is a :class:`ReactionCurve` (the rule takes its model, tangent
     or fit, per :data:`RULE_MODEL`) or a :class:`Fopdt` (applied as given).
+
+    Parameters
+    ----------
+    rule : str
+        A name of :data:`RULES`.
+    source : ReactionCurve or Fopdt
+        What the rule is applied to.
+
+    Returns
+    -------
+    Tuning
     """
     rule = str(rule).strip().lower()
     if rule not in RULES:
@@ -294,5 +305,15 @@ def tune(rule: str, source) -> Tuning:
 
 
 def all_rules(curve: ReactionCurve) -> list:
-    """Every rule of :data:`RULES` applied to one reaction curve (each to its model)."""
+    """Every rule of :data:`RULES` applied to one reaction curve (each to its model).
+
+    Parameters
+    ----------
+    curve : ReactionCurve
+        The plant's reaction curve.
+
+    Returns
+    -------
+    list of Tuning
+    """
     return [tune(r, curve) for r in RULES]

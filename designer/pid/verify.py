@@ -105,7 +105,22 @@ class SpiceStage:
 
 def stages(t, waves: dict, opamp: OpAmp) -> dict:
     """Per op-amp role (:data:`designer.pid.model.OPAMP_OUTPUTS`) present in
-    ``waves``: a :class:`SpiceStage` over the whole record."""
+    ``waves``: a :class:`SpiceStage` over the whole record.
+
+    Parameters
+    ----------
+    t : array_like
+        Times (s).
+    waves : dict
+        Signal -> SPICE waveform (V).
+    opamp : OpAmp
+        The op-amp of every stage.
+
+    Returns
+    -------
+    dict
+        Role -> :class:`SpiceStage`.
+    """
     t = np.asarray(t, float)
     dt_next = np.diff(t, append=t[-1])
     dt = np.diff(t)
@@ -145,7 +160,25 @@ class Oscillation:
 
 
 def oscillation(t, y, step_v: float, expected_final: float, tail: float = 0.3) -> Oscillation:
-    """:class:`Oscillation` of ``y``, judged on the last ``tail`` fraction of the record."""
+    """:class:`Oscillation` of ``y``, judged on the last ``tail`` fraction of the record.
+
+    Parameters
+    ----------
+    t : array_like
+        Times (s).
+    y : array_like
+        The output (V).
+    step_v : float
+        The reference step (V).
+    expected_final : float
+        Where the output should settle (V).
+    tail : float
+        The fraction of the record judged.
+
+    Returns
+    -------
+    Oscillation
+    """
     y = np.asarray(y, float)
     k = int(len(y) * (1 - tail))
     seg = y[k:]

@@ -27,7 +27,7 @@ budget, or the loop is unstable, as the check fails then); over the builds the
 probability of failing the slew check with its Wilson interval (``p_slewing``).
 The step is sampled at :data:`STEP_POINTS` points, and the reference's kick
 again on a fine grid (:func:`kick_grid`, the optimiser's reading,
-:func:`designer.pid.process_optimize.slew_delay_stages`): on the coarse grid alone
+:func:`designer.pid.optimize.slew_delay_stages`): on the coarse grid alone
 the edge's kick read about 9 % short (the optimised LM741 loop's 2.81 us against
 design-pid's own 3.08 us); with it the nominal build reads the design's check.
 
@@ -78,7 +78,7 @@ WORST_FIGURES = ("phase_margin_deg", "gain_margin_db", "model_overshoot_pct")
 
 
 def is_model_loop(result) -> bool:
-    """Whether ``result`` is a model plant's loop (:class:`~designer.pid.process_result.ProcessPidResult`)."""
+    """Whether ``result`` is a model plant's loop (:class:`~designer.pid.result.PidResult`)."""
     return getattr(result, "model", None) is not None
 
 
@@ -159,8 +159,8 @@ def _unstable(out: dict, i: int) -> None:
 
 def kick_grid(parts, t, edge_s: float) -> np.ndarray:
     """The fine grid the reference's kick is redone on, as the optimiser does
-    (:func:`designer.pid.process_optimize.slew_delay_stages`): ten derivative-filter time constants
-    (twenty edges, three coarse steps at least) in about :data:`designer.pid.process_optimize.KICK_POINTS`
+    (:func:`designer.pid.optimize.slew_delay_stages`): ten derivative-filter time constants
+    (twenty edges, three coarse steps at least) in about :data:`designer.pid.optimize.KICK_POINTS`
     points, its step the coarse grid's over a power of two (one matrix exponential for both grids,
     :meth:`designer.pid.model.LoopModel.simulate_with_kick`).
 
@@ -178,7 +178,7 @@ def kick_grid(parts, t, edge_s: float) -> np.ndarray:
     numpy.ndarray
         The fine grid (s).
     """
-    from ..pid.process_optimize import KICK_POINTS
+    from ..pid.optimize import KICK_POINTS
     f_d = parts.f_differentiator_hz if parts.td_s else math.inf
     dt = t[1] - t[0]
     tw = max(10.0 / (2 * math.pi * f_d) if math.isfinite(f_d) and f_d > 0 else 0.0, 20.0 * edge_s, 3.0 * dt)
@@ -192,7 +192,7 @@ def _step_and_swing(out: dict, i: int, t, waves: dict, expected: float, amp, kic
     from a stable loop's waves; ``kick``: (fine grid, its waves, the edge's length), the first
     moments again on the fine grid (:func:`kick_grid`), where the slew delay is read."""
     from ..pid.model import SLEW_DELAY_FRACTION, slew_delay
-    from ..pid.process_optimize import slew_delay_stages
+    from ..pid.optimize import slew_delay_stages
     from ..pid.verify import loop_metrics
     fig = loop_metrics(t, waves["y"], expected)
     for f in STEP:
@@ -218,12 +218,12 @@ def _step_and_swing(out: dict, i: int, t, waves: dict, expected: float, amp, kic
 def model_loop_figures(values: dict, result) -> dict:
     """:data:`FIGURES` of the controller's sampled parts around a plant given as a model (its
     parameters as identified), each loop analysed as design-pid analyses it
-    (:func:`designer.pid.process_loop.analyse`: exact dead time, its margins by the argument
+    (:func:`designer.pid.design.analyse`: exact dead time, its margins by the argument
     principle, the step on the result's grid; about 0.2 s a build)."""
     from ..pid import model as M
     from ..pid.blocks import PidParts
     from ..pid.delaymargins import loop_margins
-    from ..pid.process_loop import closed_loop_step, edged, loop_dc_gain, plant_of, simulation_controller, stage_waves
+    from ..pid.design import closed_loop_step, edged, loop_dc_gain, plant_of, simulation_controller, stage_waves
     from .parts import sample_opamp
     model = result.model
     plant = plant_of(model)

@@ -581,12 +581,8 @@ def pid_page(result) -> dict:
     PID, the plant alone), the loop gain, the schematic and the build sheet
     without its pictures (verdict, BOM, settings, wiring, block checks)."""
     from ..report.document import to_html
-    if hasattr(result, "model"):
-        from ..pid import process_report as rep
-        open_loop = not result.model.integrating
-    else:
-        from ..pid import report as rep
-        open_loop = True
+    from ..pid import report as rep
+    open_loop = result.model is None or not result.model.integrating
     w = result.waveforms
     curves = {}
     if result.spice is not None:

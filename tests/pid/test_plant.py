@@ -16,12 +16,12 @@ from helpers import deck_terminals
 from designer.cli.common import flag_message
 from designer.core.errors import DesignError
 from designer.filters.registry import REGISTRY, get
-from designer.pid import process_report as P
+from designer.pid import report as P
 from designer.pid.design import design_pid
 from designer.pid.netlist import circuit_loop_netlist, controller_netlist
 from designer.pid.plant import (PLANT_PREFIX, Plant, circuit_from_cascade, circuit_plant, parse_part_values,
                                 resolve_plant)
-from designer.pid.process_result import ProcessPidResult
+from designer.pid.result import PidResult
 from designer.pid.spec import PidSpec
 from designer.report.schematic import check_connectivity
 
@@ -155,7 +155,7 @@ def designed(request):
 @pytest.mark.spice
 def test_a_circuit_plant_is_designed_and_simulated_with_its_own_sections(designed):
     spec, res = designed
-    assert isinstance(res, ProcessPidResult) and res.stable and res.spice is not None
+    assert isinstance(res, PidResult) and res.stable and res.spice is not None
     plant_net = spec.circuit.circuit.netlist("u", "y")
     terms = deck_terminals(res.deck)
     for p in plant_net.parts:

@@ -185,7 +185,7 @@ def test_a_model_plants_loop_varies_the_controller_alone_as_analyze_pid_sees_it(
     mc = loop_monte_carlo(res, {"R": "E24", "C": "E12"}, 12, seed=2, limit_items=["phase_margin_deg=55:90"])
     assert set(mc.values) == {p.upper() for p in PidParts.__dataclass_fields__ if getattr(res.parts, p) is not None}
     assert mc.nominal_figures["phase_margin_deg"] == pytest.approx(res.margins.phase_margin_deg, rel=1e-9)
-    assert mc.nominal_figures["model_overshoot_pct"] == pytest.approx(res.analytic.overshoot_pct, rel=1e-9)
+    assert mc.nominal_figures["model_overshoot_pct"] == pytest.approx(res.analytic.figures.overshoot_pct, rel=1e-9)
     rows = np.genfromtxt(io.StringIO(mc.csv_text()), delimiter=",", names=True)
     for row in rows[:2]:
         parts = PidParts(**{f: (row[f.upper()] if f.upper() in rows.dtype.names else None)   # a PI: no R7..C3
@@ -230,7 +230,7 @@ def _row_loop(designed, row, amp):
     plant = SallenKeyParts(row["R1"], row["R2"], row["C1"], row["C2"])
     parts = PidParts(**{f: row[f.upper()] for f in PidParts.__dataclass_fields__ if f.upper() in row.dtype.names})
     pn, pd = plant_tf_opamp(plant, amp)
-    from designer.pid.process_optimize import slew_delay_stages
+    from designer.pid.optimize import slew_delay_stages
     from designer.tolerance.loop import kick_grid
     step, edge = designed.test.amplitude_v, designed.test.edge_s
     t = np.linspace(0.0, designed.waveforms.t[-1], STEP_POINTS)

@@ -1,4 +1,4 @@
-"""``tuning="optimize"`` for a model plant (designer.pid.process_optimize through
+"""``tuning="optimize"`` for a model plant (designer.pid.optimize through
 design_model_pid): the limits hold on the loop as built (the E-series parts'
 controller with its op-amp poles, exact margins with the dead time), its IAE is
 no worse than the best rule's that meets the same limits, and the options
@@ -11,7 +11,7 @@ from designer.core import process_build
 from designer.pid.delayloop import closed_loop_step, step_figures
 from designer.pid.delaymargins import loop_margins
 from designer.pid.model import controller_tf
-from designer.pid.process_loop import (built_controller, corner_frequencies, design_model_pid, ideal_crossover_hz,
+from designer.pid.design import (built_controller, corner_frequencies, design_model_pid, ideal_crossover_hz,
                                        leak_limit_hz, plant_of,
                                        response_grid)
 from designer.pid.selection import select_parts
@@ -78,8 +78,8 @@ def test_the_searchs_slew_delay_equals_a_fine_grids():
     on a grid 250 times finer: within 5 %."""
     from designer.core import opamps
     from designer.pid import blocks, model as M
-    from designer.pid.process_loop import edged, stage_waves
-    from designer.pid.process_optimize import KICK_POINTS, SEARCH_POINTS, SEARCH_STEP_FRACTION, _Problem
+    from designer.pid.design import edged, stage_waves
+    from designer.pid.optimize import KICK_POINTS, SEARCH_POINTS, SEARCH_STEP_FRACTION, _Problem
     spec = PidSpec(plant_tf=FAST_TF, tuning="optimize")
     model, amp = spec.process, opamps.get(spec.opamp)
     kp, ti, td, fc = 1.6, 200e-6, 10e-6, 8e3
@@ -172,10 +172,10 @@ def test_a_target_overshoot_is_met_by_the_analytic_loop(tf):
     on the integrating plant; the target is now checked on the loop as built, Kp lowered until it holds."""
     free = optimized(plant_tf=tf)
     # 5 %, or below the free optimum where the op-amp's slew already holds it lower: the target binds
-    target = min(5.0, round(0.6 * free.analytic.overshoot_pct, 1))
-    assert free.analytic.overshoot_pct > target
+    target = min(5.0, round(0.6 * free.analytic.figures.overshoot_pct, 1))
+    assert free.analytic.figures.overshoot_pct > target
     res = optimized(plant_tf=tf, target_overshoot_pct=target)
-    assert res.analytic.overshoot_pct <= target, res.analytic.overshoot_pct
+    assert res.analytic.figures.overshoot_pct <= target, res.analytic.figures.overshoot_pct
     assert meets(built_margins(res), res.limits)
 
 
