@@ -94,7 +94,18 @@ def extreme_lines(parts: PidParts, test: SquareTest) -> list:
 def plant_ref_prefix(plant: SallenKeyParts) -> str:
     """The designator prefix of the Sallen-Key plant in the loop: none for the
     follower, :data:`~designer.pid.plant.PLANT_PREFIX` when its gain pair would take
-    the controller's R3 and R4."""
+    the controller's R3 and R4.
+
+    Parameters
+    ----------
+    plant : SallenKeyParts
+        The plant's parts.
+
+    Returns
+    -------
+    str
+        The prefix its designators carry in the loop ("" for the follower).
+    """
     from .plant import PLANT_PREFIX
     return "" if plant.r3 is None else PLANT_PREFIX
 
