@@ -295,9 +295,10 @@ def broadband_text(result) -> str:
                       f"{sp.coh.min():.2f} .. {sp.coh.max():.2f} ==",
                   freq_text(result.freq_result)]
     best = result.best
-    lines += ["", f"Best ({result.method}): " + (f"{best.name} ({best.model}): "
-                                                 f"{format_params(best.params, True)}"
-                                                 if best else "none valid")]
+    if ex.kind != "other":      # an input only the output-error route reads: its best is the validation's
+        lines += ["", f"Best ({result.method}): " + (f"{best.name} ({best.model}): "
+                                                     f"{format_params(best.params, True)}"
+                                                     if best else "none valid")]
     if result.segment_length:
         lines.append(f"Welch segment: {result.segment_note}")
     if result.assessment is not None:
