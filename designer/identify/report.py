@@ -275,7 +275,7 @@ def broadband_text(result) -> str:
     lines = []
     if cap is not None:
         lines.append(_capture_line(cap))
-    lines.append(f"Broadband input: {ex.text()}")
+    lines.append(f"{'Input' if ex.kind == 'other' else 'Broadband input'}: {ex.text()}")
     for n in (list(cap.notes) if cap is not None else []) + list(result.notes):
         lines.append(f"  note: {n}")
     est = result.impulse
