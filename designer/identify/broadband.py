@@ -205,7 +205,19 @@ def positional_input(cap):
 
 def looks_broadband(u) -> bool:
     """True for a PRBS or noise: at least MIN_TRANSITIONS transitions at
-    irregular intervals and no spectral line holding MAX_LINE_SHARE of the power."""
+    irregular intervals and no spectral line holding MAX_LINE_SHARE of the power.
+
+    Parameters
+    ----------
+    u : array_like
+        The input channel.
+
+    Returns
+    -------
+    bool
+        False also for a square wave, a PWM (of steady or changing duty) and a
+        quiet channel's noise.
+    """
     u = np.asarray(u, float)
     if u.size < MIN_SAMPLES:
         return False
@@ -243,7 +255,18 @@ def multilevel_levels(u) -> list | None:
     holding :data:`LEVEL_SHARE`, and the level changes at least
     :data:`MIN_TRANSITIONS` times, spread through the record, held for at least two
     samples at a time in most runs (a clocked sequence, not a quiet channel's
-    noise a few quantisation steps wide, which moves nearly every sample)."""
+    noise a few quantisation steps wide, which moves nearly every sample).
+
+    Parameters
+    ----------
+    u : array_like
+        The input channel.
+
+    Returns
+    -------
+    list of float or None
+        The levels, lowest first.
+    """
     u = np.asarray(u, float)
     if u.size < MIN_SAMPLES or not np.all(np.isfinite(u)):
         return None
@@ -419,7 +442,25 @@ def _period(bits: np.ndarray) -> int | None:
 
 def examine_input(t, u, *, name: str = "capture") -> Excitation | None:
     """The excitation of a capture, or None when ``u`` is not broadband (a step,
-    a square wave, a sine: the step methods' input)."""
+    a square wave, a sine: the step methods' input).
+
+    Parameters
+    ----------
+    t, u : array_like
+        The record's time (s) and input.
+    name : str
+        The capture's name in messages.
+
+    Returns
+    -------
+    Excitation or None
+
+    Raises
+    ------
+    DesignError
+        A multi-level input, unevenly spaced samples, a clock that is not a
+        whole number of samples, fewer than two periods of an m-sequence.
+    """
     u = np.asarray(u, float)
     _refuse_multilevel(u, name)       # before the noise test, which its middle levels would pass
     if not looks_broadband(u):
@@ -575,6 +616,18 @@ def _wrap_advice(est: corr.ImpulseEstimate, ex: Excitation) -> tuple:
 
 
 def check_method(method) -> str | None:
+    """A broadband capture's route as the user named it, checked.
+
+    Parameters
+    ----------
+    method : str or None
+        ``correlation`` or ``spectral`` (any case), or None.
+
+    Returns
+    -------
+    str or None
+        The lower-case name, or None.
+    """
     if method is None:
         return None
     m = str(method).strip().lower()
@@ -595,6 +648,29 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
     (:func:`~.correlation.wiener_impulse`), never read as white. Its Welch
     segments are sized from the data (:func:`welch_segment`) unless
     ``segment_length`` (samples) is given.
+
+    Parameters
+    ----------
+    t, y, u : array_like
+        The record: time (s), output and input.
+    excitation : Excitation, optional
+        :func:`examine_input`'s reading (read here when None).
+    method : str, optional
+        ``correlation`` or ``spectral``: the route ``best`` comes from.
+    refine : bool
+        Refine the step methods' estimates by least squares.
+    methods : sequence of str, optional
+        The step methods run on the correlation's step response.
+    capture : CaptureInfo, optional
+        What was read, kept with the result.
+    name : str
+        The capture's name in messages.
+    segment_length : int, optional
+        A noise input's Welch segment (samples).
+
+    Returns
+    -------
+    BroadbandResult
 
     Raises
     ------
@@ -770,7 +846,20 @@ def period_drift(y, ex: Excitation) -> tuple:
     standard error) over the periods used: the least-squares slope of the
     period means (0, inf for fewer than two periods or a noise input). The
     standard error is from the output's sample-to-sample noise (the second
-    difference's spread / sqrt 6, as :func:`.correlation.tail_drift` takes it)."""
+    difference's spread / sqrt 6, as :func:`.correlation.tail_drift` takes it).
+
+    Parameters
+    ----------
+    y : array_like
+        The output.
+    ex : Excitation
+        The input's excitation (its periods).
+
+    Returns
+    -------
+    tuple of (float, float)
+        The slope per period and its standard error.
+    """
     if ex.kind == "noise" or ex.count < 2:
         return 0.0, math.inf
     seg = np.asarray(y, float)[ex.start:ex.start + ex.period * ex.count]
