@@ -210,7 +210,7 @@ def looks_broadband(u) -> bool:
     Parameters
     ----------
     u : array_like
-        The input channel.
+        The input's samples.
 
     Returns
     -------
@@ -260,7 +260,7 @@ def multilevel_levels(u) -> list | None:
     Parameters
     ----------
     u : array_like
-        The input channel.
+        The recorded sequence.
 
     Returns
     -------
