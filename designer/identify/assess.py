@@ -527,6 +527,11 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
     drive = (vu, vy, None) if validation is not None else (uu, yy, split)
     for c in res.candidates:
         _score(c, T, res.hold, *drive)
+        if c.kind == "integrating" and c.valid and c.fit_percent < 0:
+            # its dead time at 0 has no interval to fail: a settling plant's integrator, worse than the mean
+            c.valid = False
+            c.note = "; ".join(n for n in (c.note, f"its validation fit ({c.fit_percent:.1f} %) is below 0: the "
+                                           "output does not follow the input's integral") if n)
     ok = [i for i, c in enumerate(res.candidates) if c.valid and math.isfinite(c.fit_percent)]
     res.best = max(ok, key=lambda i: res.candidates[i].fit_percent) if ok else None
     return res

@@ -346,7 +346,8 @@ def broadband_plot(result, n_models: int = 3) -> bytes:
     ax_h.set_xlabel("time (s)")
     ax_s.set_title("Step response: its running integral, and step models")
     ax_s.set_xlabel("time (s)")
-    ax_s.legend(fontsize=7)
+    if ax_s.get_legend_handles_labels()[0]:     # an input only output error reads has no estimate to draw
+        ax_s.legend(fontsize=7)
     sp = result.spectrum
     if sp is not None and sp.f.size:
         ax_g.semilogx(sp.f, 20 * np.log10(np.abs(sp.h)), "o", ms=3, color="k", label="S_yu/S_uu")
@@ -357,7 +358,8 @@ def broadband_plot(result, n_models: int = 3) -> bytes:
                 ax_g.semilogx(sp.f, 20 * np.log10(np.abs(g)), lw=1.1, label=f"{m.name} ({m.model})")
     ax_g.set_title("Spectral estimate: gain (dB)")
     ax_g.set_xlabel("frequency (Hz)")
-    ax_g.legend(fontsize=7)
+    if ax_g.get_legend_handles_labels()[0]:
+        ax_g.legend(fontsize=7)
     ax_c.set_title("Coherence")
     ax_c.set_ylim(0, 1.05)
     ax_c.set_xlabel("frequency (Hz)")

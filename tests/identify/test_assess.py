@@ -193,3 +193,17 @@ def test_a_hold_tie_is_broken_by_the_inputs_levels():
     assert choose_hold(fits, u) == "zoh"
     assert choose_hold(fits, np.sin(t)) == "foh"
     assert fits["zoh"].params["theta_s"] == pytest.approx(1.3, rel=0.05)
+
+
+def test_an_integrator_worse_than_the_mean_is_not_valid():
+    """K 2, tau 0.5 s, no dead time, under a sine sweep (0.05 to 2 Hz over 30 s,
+    every 20 ms, seeded noise): the integrating fit's dead time sits at 0 (no
+    interval to fail), its validation fit is below 0: not valid, never the best."""
+    def sweep(x):
+        return 1.0 - np.cos(2 * np.pi * 0.05 * 30.0 * np.expm1(np.asarray(x) * np.log(40.0) / 30.0) / np.log(40.0))
+
+    t, u, y = _fopdt_capture(sweep, K=2.0, tau=0.5, theta=0.0, ts=0.02, n=1500)
+    a = identify_record(t, y, u, name="sweep").assessment
+    (c,) = [c for c in a.candidates if c.kind == "integrating"]
+    assert c.fit_percent < 0 and not c.valid and "below 0" in c.note
+    assert a.best_candidate is None or a.best_candidate.kind != "integrating"
