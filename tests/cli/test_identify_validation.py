@@ -188,5 +188,6 @@ def test_a_chirp_capture_is_identified_by_output_error(tmp_path):
     assert best["params"]["K"] == pytest.approx(2.0, rel=0.02)
     assert best["params"]["tau_s"] == pytest.approx(0.5, rel=0.05)
     assert best["params"]["theta_s"] == pytest.approx(0.15, rel=0.05)
-    text = run(IDENTIFY, path)
+    text = run(IDENTIFY, path, "--plot", tmp_path / "fit.png")
     assert text.returncode == 0 and "output-error fit alone" in text.stdout, text.stderr
+    assert text.stderr == "" and (tmp_path / "fit.png").stat().st_size > 0    # no warning lines
