@@ -29,14 +29,14 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    "assess": ("Assessment", "Candidate", "ESTIMATION_FRACTION", "MAX_SAMPLES", "OE_KINDS", "ROUTES",
-               "assess_result", "choose_split", "identify_record", "judge_candidate", "match_validation",
-               "method_process", "regular_interval"),
+    "assess": ("Assessment", "Candidate", "ESTIMATION_FRACTION", "MAX_SAMPLES", "OE_INITIAL", "OE_KINDS", "ROUTES",
+               "assess_result", "choose_hold", "choose_split", "identify_record", "judge_candidate",
+               "match_validation", "method_process", "regular_interval"),
     "against": ("agreement_band", "compare_with_design", "load_design", "model_fn_zeta", "overshoot_from_zeta"),
     "bode_readings": ("asymptotes", "low_frequency_slope", "model_phase", "model_response", "peak_gain_db",
                       "resonant_peak", "zeta_from_peak"),
-    "broadband": ("BroadbandResult", "check_method", "examine_input", "identify_broadband", "looks_broadband",
-                  "multilevel_levels", "period_drift"),
+    "broadband": ("BroadbandResult", "between_levels", "check_method", "examine_input", "identify_broadband",
+                  "looks_broadband", "multilevel_levels", "other_excitation", "other_input", "period_drift"),
     "correlation": ("DECAY", "circular_xcorr", "mls_impulse", "rms_error", "settling_check", "settling_time"),
     "dc_motor": ("dc_motor_position", "dc_motor_velocity"),
     "edges": ("check_samples", "find_edges", "number_text"),

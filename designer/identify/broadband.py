@@ -45,7 +45,7 @@ from . import spectral as spec
 from ..core.prbs import MAX_BITS, MIN_BITS, SETTLE_MARGIN, bits_for, is_mls_length, mls_bit_errors
 
 __all__ = ["BroadbandResult", "check_method", "examine_input", "identify_broadband", "looks_broadband",
-           "multilevel_levels", "period_drift"]
+           "multilevel_levels", "period_drift", "between_levels", "other_input", "other_excitation"]
 
 #: at least this many transitions make an input broadband
 MIN_TRANSITIONS = 20
@@ -77,8 +77,10 @@ MAX_PERIOD_DRIFT = 0.01
 @dataclass
 class Excitation:
     """What the input is: ``kind`` ``"mls"`` (a maximum-length sequence),
-    ``"periodic"`` (a periodic binary sequence of another length) or
-    ``"noise"``; sample interval ``ts``; for a sequence its clock interval
+    ``"periodic"`` (a periodic binary sequence of another length),
+    ``"noise"`` or ``"other"`` (neither a step, a square wave nor a sequence:
+    a chirp, a knob turned by hand, a PWM of changing duty; the output-error
+    route alone, :func:`other_input`, ``why`` saying so); sample interval ``ts``; for a sequence its clock interval
     (``samples_per_bit`` samples), levels ``offset +- amplitude``, period
     (``n`` intervals, ``period`` samples), ``bits`` for an m-sequence; the
     whole periods used (``count`` from sample ``start``)."""
@@ -95,6 +97,8 @@ class Excitation:
     count: int = 0
     #: of a period of an m-sequence's length: its values that differ from the nearest m-sequence
     bit_errors: int = 0
+    #: of an ``"other"`` input: what it is, in words
+    why: str = ""
 
     @property
     def dt_s(self) -> float:
@@ -106,6 +110,8 @@ class Excitation:
 
     def text(self) -> str:
         from ..core.units import format_eng as fe
+        if self.kind == "other":
+            return f"{self.why}, sampled every {fe(self.ts, 's')}"
         if self.kind == "noise":
             return (f"noise input ({self.transitions} transitions), sampled every "
                     f"{fe(self.ts, 's')}")
@@ -121,7 +127,9 @@ class Excitation:
 
     def to_dict(self) -> dict:
         d = {"kind": self.kind, "sample_interval_s": self.ts, "transitions": self.transitions}
-        if self.kind != "noise":
+        if self.kind == "other":
+            d["input"] = self.why
+        elif self.kind != "noise":
             d.update({"clock_hz": 1 / self.dt_s, "dt_s": self.dt_s,
                       "samples_per_interval": self.samples_per_bit, "N": self.n,
                       "bits": self.bits, "offset": self.offset, "amplitude": self.amplitude,
@@ -197,7 +205,19 @@ def positional_input(cap):
 
 def looks_broadband(u) -> bool:
     """True for a PRBS or noise: at least MIN_TRANSITIONS transitions at
-    irregular intervals and no spectral line holding MAX_LINE_SHARE of the power."""
+    irregular intervals and no spectral line holding MAX_LINE_SHARE of the power.
+
+    Parameters
+    ----------
+    u : array_like
+        The input's samples.
+
+    Returns
+    -------
+    bool
+        False also for a square wave, a PWM (of steady or changing duty) and a
+        quiet channel's noise.
+    """
     u = np.asarray(u, float)
     if u.size < MIN_SAMPLES:
         return False
@@ -215,6 +235,8 @@ def looks_broadband(u) -> bool:
     # a square wave or a PWM: its high runs alike and its low runs alike
     if all(r.std() < REGULAR_CV * r.mean() for r in (runs[0::2], runs[1::2])):
         return False
+    if _pwm_period(runs):
+        return False            # a PWM of changing duty (output error reads it, other_input)
     return _line_share(u) < MAX_LINE_SHARE
 
 
@@ -233,7 +255,18 @@ def multilevel_levels(u) -> list | None:
     holding :data:`LEVEL_SHARE`, and the level changes at least
     :data:`MIN_TRANSITIONS` times, spread through the record, held for at least two
     samples at a time in most runs (a clocked sequence, not a quiet channel's
-    noise a few quantisation steps wide, which moves nearly every sample)."""
+    noise a few quantisation steps wide, which moves nearly every sample).
+
+    Parameters
+    ----------
+    u : array_like
+        The recorded sequence.
+
+    Returns
+    -------
+    list of float or None
+        The levels, lowest first.
+    """
     u = np.asarray(u, float)
     if u.size < MIN_SAMPLES or not np.all(np.isfinite(u)):
         return None
@@ -279,6 +312,94 @@ def _refuse_multilevel(u, name) -> None:
                       "correlation and spectral methods); capture the plant under one of those")
 
 
+def _pwm_period(runs) -> bool:
+    """True when each high run and the low run after it add up to the same
+    period (a PWM whose duty changes: its carrier's period stays)."""
+    m = (runs.size // 2) * 2
+    if m < 2:
+        return False
+    pairs = runs[0:m:2] + runs[1:m:2]
+    return bool(pairs.std() < REGULAR_CV * pairs.mean() / 4)
+
+
+def between_levels(u) -> float:
+    """The share of an input's samples between its two levels (more than 10 %
+    of the span from both the 1st and the 99th percentile): below
+    :data:`TWO_LEVEL_FRACTION` a two-level input, held between samples.
+
+    Parameters
+    ----------
+    u : array_like
+        The input channel.
+
+    Returns
+    -------
+    float
+        0 to 1 (0 for an input that never moves).
+    """
+    u = np.asarray(u, float)
+    lo, hi = np.percentile(u, [1, 99])
+    span = hi - lo
+    if not span > 0:
+        return 0.0
+    return float(np.count_nonzero((u > lo + 0.1 * span) & (u < lo + 0.9 * span)) / u.size)
+
+
+def other_input(u) -> str:
+    """Whether an input that is not broadband is something else than a step or
+    a square wave (the step methods' input): one that spends more than
+    :data:`TWO_LEVEL_FRACTION` of its samples between its levels (a chirp, a
+    sine, a knob turned by hand), or a two-level one switching at irregular
+    intervals (a PWM of changing duty), which only an output-error fit reads.
+
+    Parameters
+    ----------
+    u : array_like
+        The recorded input, one value per sample.
+
+    Returns
+    -------
+    str
+        The input in words ("" for a step, a square wave, or a two-level
+        input of fewer than ``MIN_TRANSITIONS // 2`` transitions: steps, for
+        the step methods).
+    """
+    u = np.asarray(u, float)
+    edges, lo, hi = _transitions(u)
+    if not hi - lo > 0:
+        return ""
+    between = between_levels(u)
+    if between > TWO_LEVEL_FRACTION:
+        return (f"an input that is neither a step, a square wave nor a binary sequence or noise "
+                f"({100 * between:.0f} % of its samples between its levels, a chirp or a hand-turned knob)")
+    runs = np.diff(edges)
+    if edges.size >= MIN_TRANSITIONS // 2 and not all(r.std() < REGULAR_CV * r.mean()
+                                                       for r in (runs[0::2], runs[1::2])):
+        return (f"a two-level input switching at irregular intervals ({edges.size} transitions"
+                + (", its period steady: a PWM of changing duty)" if _pwm_period(runs) else ")"))
+    return ""
+
+
+def other_excitation(t, u, why: str) -> Excitation:
+    """The :class:`Excitation` of an input :func:`other_input` described.
+
+    Parameters
+    ----------
+    t, u : array_like
+        The record's time and input.
+    why : str
+        :func:`other_input`'s words.
+
+    Returns
+    -------
+    Excitation
+        Of kind ``"other"``.
+    """
+    t = np.asarray(t, float)
+    ts = float((t[-1] - t[0]) / (t.size - 1)) if t.size > 1 else 0.0
+    return Excitation("other", ts, int(_transitions(np.asarray(u, float))[0].size), why=why)
+
+
 def _clock(edges, ts, name) -> int:
     """Samples per interval of a binary sequence from its transition indices."""
     runs = np.diff(edges).astype(float)
@@ -321,7 +442,25 @@ def _period(bits: np.ndarray) -> int | None:
 
 def examine_input(t, u, *, name: str = "capture") -> Excitation | None:
     """The excitation of a capture, or None when ``u`` is not broadband (a step,
-    a square wave, a sine: the step methods' input)."""
+    a square wave, a sine: the step methods' input).
+
+    Parameters
+    ----------
+    t, u : array_like
+        The record's time (s) and input.
+    name : str
+        The capture's name in messages.
+
+    Returns
+    -------
+    Excitation or None
+
+    Raises
+    ------
+    DesignError
+        A multi-level input, unevenly spaced samples, a clock that is not a
+        whole number of samples, fewer than two periods of an m-sequence.
+    """
     u = np.asarray(u, float)
     _refuse_multilevel(u, name)       # before the noise test, which its middle levels would pass
     if not looks_broadband(u):
@@ -335,8 +474,7 @@ def examine_input(t, u, *, name: str = "capture") -> Excitation | None:
                           "uniformly sampled record")
     edges, lo, hi = _transitions(u)
     span = hi - lo
-    between = np.count_nonzero((u > lo + 0.1 * span) & (u < lo + 0.9 * span)) / u.size
-    if between > TWO_LEVEL_FRACTION:
+    if between_levels(u) > TWO_LEVEL_FRACTION:
         return Excitation("noise", ts, int(edges.size))
     m = _clock(edges, ts, name)
     state = _schmitt(u, lo + 0.35 * span, lo + 0.65 * span)
@@ -478,6 +616,18 @@ def _wrap_advice(est: corr.ImpulseEstimate, ex: Excitation) -> tuple:
 
 
 def check_method(method) -> str | None:
+    """A broadband capture's route as the user named it, checked.
+
+    Parameters
+    ----------
+    method : str or None
+        ``correlation`` or ``spectral`` (any case), or None.
+
+    Returns
+    -------
+    str or None
+        The lower-case name, or None.
+    """
     if method is None:
         return None
     m = str(method).strip().lower()
@@ -498,6 +648,29 @@ def identify_broadband(t, y, u, *, excitation: Excitation | None = None, method=
     (:func:`~.correlation.wiener_impulse`), never read as white. Its Welch
     segments are sized from the data (:func:`welch_segment`) unless
     ``segment_length`` (samples) is given.
+
+    Parameters
+    ----------
+    t, y, u : array_like
+        The record: time (s), output and input.
+    excitation : Excitation, optional
+        :func:`examine_input`'s reading (read here when None).
+    method : str, optional
+        ``correlation`` or ``spectral``: the route ``best`` comes from.
+    refine : bool
+        Refine the step methods' estimates by least squares.
+    methods : sequence of str, optional
+        The step methods run on the correlation's step response.
+    capture : CaptureInfo, optional
+        What was read, kept with the result.
+    name : str
+        The capture's name in messages.
+    segment_length : int, optional
+        A noise input's Welch segment (samples).
+
+    Returns
+    -------
+    BroadbandResult
 
     Raises
     ------
@@ -673,7 +846,20 @@ def period_drift(y, ex: Excitation) -> tuple:
     standard error) over the periods used: the least-squares slope of the
     period means (0, inf for fewer than two periods or a noise input). The
     standard error is from the output's sample-to-sample noise (the second
-    difference's spread / sqrt 6, as :func:`.correlation.tail_drift` takes it)."""
+    difference's spread / sqrt 6, as :func:`.correlation.tail_drift` takes it).
+
+    Parameters
+    ----------
+    y : array_like
+        The output.
+    ex : Excitation
+        The input's excitation (its periods).
+
+    Returns
+    -------
+    tuple of (float, float)
+        The slope per period and its standard error.
+    """
     if ex.kind == "noise" or ex.count < 2:
         return 0.0, math.inf
     seg = np.asarray(y, float)[ex.start:ex.start + ex.period * ex.count]

@@ -529,6 +529,29 @@ def _arx_start(kind: str, ud, y, T: float) -> dict:
     return p
 
 
+#: dead times tried by :func:`_theta_grid_start`, at most
+GRID_THETAS = 200
+
+
+def _theta_grid_start(kind: str, p0: dict, ud, y, T: float, hold: str, initial: str, top: float) -> dict:
+    """A start with the dead time from a grid and the gain, given it, by linear
+    least squares (the response is linear in K, as are the output level and
+    the initial state's columns): an integrator's cost in the dead time is
+    flat and holds local minima the ARX start falls into (a random binary
+    input switching with probability 0.5: theta 5.5 s for 1.1 s)."""
+    best = None
+    for th in np.arange(0.0, top, max(T, top / GRID_THETAS)):
+        num, den = _rational(kind, {**p0, "K": 1.0})
+        s = sample_model(num, den, th, T, hold)
+        X = np.column_stack((s.run(ud), _columns(s, y.size, True, initial)))
+        coef, *_ = np.linalg.lstsq(X, y, rcond=None)
+        sse = float(np.sum((y - X @ coef) ** 2))
+        if best is None or sse < best[0]:
+            best = (sse, th, float(coef[0]))
+    _, th, k = best
+    return {**p0, "theta_s": float(th), "K": k if k != 0 else p0["K"]}
+
+
 def _zero_start(p: dict, ud, y, T: float) -> tuple:
     """(K, tz) of K (tz s + 1)/D(s) for the start's poles and dead time: the
     output is linear in K and K tz (the responses of 1/D and s/D), so one
@@ -647,6 +670,8 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
         return sol, sc
 
     starts = [_arx_start(kind, ud, y, T)]
+    if kind.startswith("integrating"):
+        starts.append(_theta_grid_start(kind, starts[0], ud, y, T, hold, initial, bounds["theta_s"][1]))
     if start is not None:
         starts.append({k: float(start[k]) for k in names})
     # the cost is kinked and can hold a local minimum in the dead time: a second start at half of it

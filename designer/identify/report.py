@@ -275,7 +275,7 @@ def broadband_text(result) -> str:
     lines = []
     if cap is not None:
         lines.append(_capture_line(cap))
-    lines.append(f"Broadband input: {ex.text()}")
+    lines.append(f"{'Input' if ex.kind == 'other' else 'Broadband input'}: {ex.text()}")
     for n in (list(cap.notes) if cap is not None else []) + list(result.notes):
         lines.append(f"  note: {n}")
     est = result.impulse
@@ -295,9 +295,10 @@ def broadband_text(result) -> str:
                       f"{sp.coh.min():.2f} .. {sp.coh.max():.2f} ==",
                   freq_text(result.freq_result)]
     best = result.best
-    lines += ["", f"Best ({result.method}): " + (f"{best.name} ({best.model}): "
-                                                 f"{format_params(best.params, True)}"
-                                                 if best else "none valid")]
+    if ex.kind != "other":      # an input only the output-error route reads: its best is the validation's
+        lines += ["", f"Best ({result.method}): " + (f"{best.name} ({best.model}): "
+                                                     f"{format_params(best.params, True)}"
+                                                     if best else "none valid")]
     if result.segment_length:
         lines.append(f"Welch segment: {result.segment_note}")
     if result.assessment is not None:
@@ -345,7 +346,8 @@ def broadband_plot(result, n_models: int = 3) -> bytes:
     ax_h.set_xlabel("time (s)")
     ax_s.set_title("Step response: its running integral, and step models")
     ax_s.set_xlabel("time (s)")
-    ax_s.legend(fontsize=7)
+    if ax_s.get_legend_handles_labels()[0]:     # an input only output error reads has no estimate to draw
+        ax_s.legend(fontsize=7)
     sp = result.spectrum
     if sp is not None and sp.f.size:
         ax_g.semilogx(sp.f, 20 * np.log10(np.abs(sp.h)), "o", ms=3, color="k", label="S_yu/S_uu")
@@ -356,7 +358,8 @@ def broadband_plot(result, n_models: int = 3) -> bytes:
                 ax_g.semilogx(sp.f, 20 * np.log10(np.abs(g)), lw=1.1, label=f"{m.name} ({m.model})")
     ax_g.set_title("Spectral estimate: gain (dB)")
     ax_g.set_xlabel("frequency (Hz)")
-    ax_g.legend(fontsize=7)
+    if ax_g.get_legend_handles_labels()[0]:
+        ax_g.legend(fontsize=7)
     ax_c.set_title("Coherence")
     ax_c.set_ylim(0, 1.05)
     ax_c.set_xlabel("frequency (Hz)")

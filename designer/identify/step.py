@@ -250,7 +250,17 @@ def judge(m: MethodResult, step: PreparedStep, overshoot: Overshoot | None = Non
     a monotonic model on an overshooting record, an underdamped one that rings
     far more or less than the data), a time constant (or 1/wn) below the
     sample interval, or a least-squares parameter whose 95 % confidence
-    interval is wider than the value."""
+    interval is wider than the value.
+
+    Parameters
+    ----------
+    m : MethodResult
+        Changed in place (``valid``, ``note``).
+    step : PreparedStep
+        The record it was fitted to.
+    overshoot : Overshoot, optional
+        The overshoot measured on the record, with its uncertainty.
+    """
     if not m.valid:
         return
     why = ""

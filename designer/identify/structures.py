@@ -16,7 +16,20 @@ __all__ = ["MODELS", "MethodResult", "iae_ise", "model_step"]
 
 
 def iae_ise(t, y, y_model):
-    """Integral of |error| and of error^2 over the record (trapezoid rule)."""
+    """Integral of |error| and of error^2 over the record (trapezoid rule).
+
+    Parameters
+    ----------
+    t, y : array_like
+        The record's time (s) and output.
+    y_model : array_like
+        The model's output at the same times.
+
+    Returns
+    -------
+    tuple of (float, float)
+        IAE and ISE.
+    """
     e = np.asarray(y, float) - np.asarray(y_model, float)
     t = np.asarray(t, float)
     return float(np.trapezoid(np.abs(e), t)), float(np.trapezoid(e * e, t))

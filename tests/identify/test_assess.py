@@ -113,3 +113,97 @@ def test_a_record_too_short_for_the_plants_settling_is_refused():
     t = np.arange(n) * ts
     with pytest.raises(DesignError, match="too short for the plant's dead time plus settling"):
         identify_record(t[:1000], y[:1000], u[:1000])
+
+
+def _fopdt_capture(at, K=2.0, tau=5.0, theta=1.3, ts=0.1, n=3001, snr_db=30.0, seed=28):
+    """(t, u, y): K e^(-theta s)/(tau s + 1) under the input ``at(t)``, simulated
+    by ``scipy.signal.lsim`` on a grid ten times finer than the samples, white
+    noise at ``snr_db`` from a recorded seed."""
+    t = np.arange(n) * ts
+    tf = np.arange((n - 1) * 10 + 1) * (ts / 10)
+    ud = np.where(tf >= theta, at(tf - theta), at(0.0 * tf))
+    _, yc, _ = sig.lsim(([K], [tau, 1.0]), ud - ud[0], tf)
+    yc = yc[::10]
+    rng = np.random.default_rng(seed)
+    return t, at(t), yc + rng.normal(0.0, math.sqrt(np.var(yc) / 10 ** (snr_db / 10)), n)
+
+
+def _recovers_fopdt(res, K=2.0, tau=5.0, theta=1.3):
+    assert res.excitation.kind == "other"
+    a = res.assessment
+    assert set(a.skipped) >= {"step", "correlation", "spectral"}
+    best = a.best_candidate
+    assert best is not None and best.route == "output-error" and best.kind == "fopdt", best
+    assert best.params["K"] == pytest.approx(K, rel=0.02)
+    assert best.params["tau_s"] == pytest.approx(tau, rel=0.05)
+    assert best.params["theta_s"] == pytest.approx(theta, rel=0.05)
+
+
+def test_a_hand_turned_knob_routes_to_the_output_error_fit():
+    """A slow, smooth input of no two levels (a few sines of seeded phases, 0 to 1 V):
+    neither a step nor a sequence, so only the output-error fit reads it."""
+    rng = np.random.default_rng(5)
+    f = np.array([0.01, 0.023, 0.051, 0.09])
+    ph = rng.uniform(0, 2 * np.pi, f.size)
+
+    def knob(x):
+        x = np.asarray(x, float)
+        return 0.5 + 0.12 * np.sum(np.sin(2 * np.pi * f[:, None] * x[None, :] + ph[:, None]), axis=0)
+
+    t, u, y = _fopdt_capture(knob)
+    res = identify_record(t, y, u, name="knob")
+    _recovers_fopdt(res)
+    assert "between its levels" in res.excitation.text()
+
+
+def test_a_pwm_of_changing_duty_routes_to_the_output_error_fit():
+    """A 0/1 V PWM of 4 s period whose duty sweeps 0.2 to 0.8 over the record,
+    held between samples: two levels at irregular intervals, too few
+    transitions for noise."""
+    ts, n = 0.1, 3001
+    k = np.arange(n)
+    duty = 0.2 + 0.6 * k / (n - 1)
+    levels = ((k % 40) < duty * 40).astype(float)
+
+    def pwm(x):
+        return levels[np.clip(np.floor(np.asarray(x) / ts + 1e-9).astype(int), 0, n - 1)]
+
+    t, u, y = _fopdt_capture(pwm, ts=ts, n=n)
+    res = identify_record(t, y, u, name="pwm")
+    _recovers_fopdt(res)
+
+
+def test_a_hold_tie_is_broken_by_the_inputs_levels():
+    """The FOPDT plant under a random binary signal held between samples (p 0.2,
+    seeded), 10 dB of noise: its zoh and foh fits tie (rms within 1 %), and a two-level input is
+    then held (zoh: under foh the dead time came out half a sample late); the same
+    tie on an input that moves between its levels goes to foh."""
+    from designer.identify.assess import HOLD_TIE, choose_hold
+    from designer.identify.outputerror import fit_output_error
+    ts, n = 0.1, 2001
+    levels = (np.cumsum(np.random.default_rng(7).random(n) < 0.2) % 2).astype(float)
+
+    def held(x):
+        return levels[np.clip(np.floor(np.asarray(x) / ts + 1e-9).astype(int), 0, n - 1)]
+
+    t, u, y = _fopdt_capture(held, ts=ts, n=n, snr_db=10.0)
+    fits = {h: fit_output_error(u, y, ts, "fopdt", hold=h, initial="estimate") for h in ("zoh", "foh")}
+    z, f = fits["zoh"].rms_residual, fits["foh"].rms_residual
+    assert abs(z - f) <= HOLD_TIE * min(z, f)
+    assert choose_hold(fits, u) == "zoh"
+    assert choose_hold(fits, np.sin(t)) == "foh"
+    assert fits["zoh"].params["theta_s"] == pytest.approx(1.3, rel=0.05)
+
+
+def test_an_integrator_worse_than_the_mean_is_not_valid():
+    """K 2, tau 0.5 s, no dead time, under a sine sweep (0.05 to 2 Hz over 30 s,
+    every 20 ms, seeded noise): the integrating fit's dead time sits at 0 (no
+    interval to fail), its validation fit is below 0: not valid, never the best."""
+    def sweep(x):
+        return 1.0 - np.cos(2 * np.pi * 0.05 * 30.0 * np.expm1(np.asarray(x) * np.log(40.0) / 30.0) / np.log(40.0))
+
+    t, u, y = _fopdt_capture(sweep, K=2.0, tau=0.5, theta=0.0, ts=0.02, n=1500)
+    a = identify_record(t, y, u, name="sweep").assessment
+    (c,) = [c for c in a.candidates if c.kind == "integrating"]
+    assert c.fit_percent < 0 and not c.valid and "below 0" in c.note
+    assert a.best_candidate is None or a.best_candidate.kind != "integrating"
