@@ -36,7 +36,18 @@ PART_KEYS = NETWORK_KEYS
 
 
 def model_fn_zeta(m) -> tuple:
-    """(fn_hz, zeta) of a second-order :class:`~.structures.MethodResult`; (nan, nan) for FOPDT."""
+    """(fn_hz, zeta) of a second-order :class:`~.structures.MethodResult`; (nan, nan) for FOPDT.
+
+    Parameters
+    ----------
+    m : MethodResult
+        A step-identification model.
+
+    Returns
+    -------
+    tuple of float
+        ``(fn_hz, zeta)``.
+    """
     p = m.params
     if m.model == "underdamped":
         return p["wn_rad_s"] / (2 * math.pi), p["zeta"]
@@ -50,7 +61,18 @@ def model_fn_zeta(m) -> tuple:
 
 
 def overshoot_from_zeta(zeta: float) -> float:
-    """Percent overshoot of a standard second-order step response."""
+    """Percent overshoot of a standard second-order step response.
+
+    Parameters
+    ----------
+    zeta : float
+        Damping ratio.
+
+    Returns
+    -------
+    float
+        Overshoot in percent of the final value; 0 for zeta >= 1 or not finite.
+    """
     if not math.isfinite(zeta) or zeta >= 1:
         return 0.0
     return 100.0 * math.exp(-math.pi * zeta / math.sqrt(1 - zeta * zeta))
@@ -84,6 +106,22 @@ def agreement_band(built: dict, gain: float = 1.0, r_tol: float = DEFAULT_R_TOL,
     factors of fn ~ 1/sqrt(R1 R2 C1 C2) and zeta ~ sqrt(C1/C2) (unity gain).
     The gain, read as the ratio of two measured signals, gets the
     measurement's own error (:data:`GAIN_MEASUREMENT_TOL`) on top.
+
+    Parameters
+    ----------
+    built : dict
+        The design's ``built`` record: the part values ``R1_ohm``, ``R2_ohm``,
+        ``C1_f``, ``C2_f`` when known, else its ``fn_hz`` and ``zeta``.
+    gain : float, optional
+        The design's DC gain K (1: unity-gain follower).
+    r_tol, c_tol : float, optional
+        Relative tolerances of the resistors and capacitors.
+
+    Returns
+    -------
+    AgreementBand
+        The (low, high) bands of fn_hz, zeta, overshoot_pct and gain, the
+        tolerances used and how the band was found (``basis``).
     """
     g_lo = g_hi = gain
     if gain != 1.0:
@@ -138,7 +176,18 @@ def design_band(built: dict, gain: float) -> tuple:
 def load_design(path) -> dict:
     """Read a design-plant result.json (:func:`designer.core.jsonio.read_result`);
     a clear one-line error if it is not one, or if a value the comparison uses
-    is not a finite number where one is needed."""
+    is not a finite number where one is needed.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The design-plant result.json given to ``--against``.
+
+    Returns
+    -------
+    dict
+        The result's JSON object.
+    """
     d = read_result(path, "--against", needs={"built": ("fn_hz", "zeta")})
     _check_design(d, shown(path))
     return d
@@ -249,6 +298,19 @@ def compare_with_design(result, design: dict) -> Comparison:
     For each of fn, zeta, gain and overshoot: the design (built) value, the
     identified one (the best second-order model's; the overshoot measured on
     the data), the difference and the band (see :func:`design_band`).
+
+    Parameters
+    ----------
+    result : IdentifyResult
+        The step identification of the built plant.
+    design : dict
+        A design-plant result.json as read by :func:`load_design`.
+
+    Returns
+    -------
+    Comparison
+        The best second-order model's name, the tolerance basis, one
+        :class:`Quantity` per compared value and the design's spec.
     """
     built = design["built"]
     spec = design.get("spec", {}) or {}

@@ -66,7 +66,23 @@ PARAMS = {
 # --------------------------------------------------------------------------
 
 def model_response(model: str, params: dict, w) -> np.ndarray:
-    """Complex G(j w) of ``model`` (same parameters as core.model_step)."""
+    """Complex G(j w) of ``model`` (same parameters as core.model_step).
+
+    Parameters
+    ----------
+    model : str
+        ``fopdt``, ``double-pole``, ``underdamped`` or ``overdamped``.
+    params : dict
+        The model's parameters: ``K`` and its time constants or ``wn_rad_s`` and
+        ``zeta``, optional ``theta_s``.
+    w : array_like
+        Angular frequencies in rad/s.
+
+    Returns
+    -------
+    numpy.ndarray
+        Complex G(j w) at each ``w``.
+    """
     w = np.asarray(w, float)
     s = 1j * w
     K = params["K"]
@@ -86,7 +102,25 @@ def model_response(model: str, params: dict, w) -> np.ndarray:
 
 
 def model_phase(model: str, params: dict, w, with_delay: bool = True) -> np.ndarray:
-    """Continuous (unwrapped) phase in radians of ``model`` for K > 0."""
+    """Continuous (unwrapped) phase in radians of ``model`` for K > 0.
+
+    Parameters
+    ----------
+    model : str
+        ``fopdt``, ``double-pole``, ``underdamped`` or ``overdamped``.
+    params : dict
+        The model's parameters (``tau_s``, ``wn_rad_s``/``zeta``, ``tau1_s``/``tau2_s``,
+        optional ``theta_s``).
+    w : array_like
+        Angular frequencies in rad/s.
+    with_delay : bool, optional
+        Include the dead time's phase -w theta.
+
+    Returns
+    -------
+    numpy.ndarray
+        Phase in radians at each ``w``.
+    """
     w = np.asarray(w, float)
     if model == "fopdt":
         ph = -np.arctan(w * params["tau_s"])
@@ -162,7 +196,18 @@ def low_frequency_slope(data: FreqData) -> float:
     """Slope in dB/decade of the lowest decade of the table: the least-squares
     line through every point up to ten times the lowest frequency (at least the
     three lowest), so one noisy point does not decide it (two points did: a
-    0.25 dB error in the second of 151 read a flat first-order table as falling)."""
+    0.25 dB error in the second of 151 read a flat first-order table as falling).
+
+    Parameters
+    ----------
+    data : FreqData
+        The frequency-response table.
+
+    Returns
+    -------
+    float
+        Slope of the gain in dB/decade (0 when the points span no frequency).
+    """
     lw = np.log10(data.w)
     n = max(3, int(np.searchsorted(lw, lw[0] + 1.0, "right")))
     x, y = lw[:n], data.gain_db[:n]
@@ -211,6 +256,17 @@ def asymptotes(data: FreqData) -> MethodResult:
     tau = 1/wc; n = 2: double pole tau = 1/wc
     (zeta = 1). The intersection of the fitted high-frequency line with K
     is reported in ``points`` as ``w_intersection_rad_s``.
+
+    Parameters
+    ----------
+    data : FreqData
+        The frequency-response table.
+
+    Returns
+    -------
+    MethodResult
+        The ``fopdt`` or ``double-pole`` model read (invalid, with the reason,
+        when the table allows no reading).
     """
     name = "asymptotes"
     lf = low_frequency_slope(data)
@@ -254,7 +310,18 @@ def asymptotes(data: FreqData) -> MethodResult:
 
 def zeta_from_peak(mr_db: float) -> float:
     """Damping ratio from the resonant peak height above K in dB (seed 000 eq 79),
-    the root below 1/sqrt(2); nan if ``mr_db`` <= 0."""
+    the root below 1/sqrt(2); nan if ``mr_db`` <= 0.
+
+    Parameters
+    ----------
+    mr_db : float
+        Peak height above the DC gain in dB.
+
+    Returns
+    -------
+    float
+        Damping ratio, or nan.
+    """
     if not mr_db > 0.0:
         return math.nan
     q = 10.0 ** (-mr_db / 10.0)            # = 4 zeta^2 (1 - zeta^2)
@@ -264,7 +331,18 @@ def zeta_from_peak(mr_db: float) -> float:
 
 
 def peak_gain_db(zeta: float) -> float:
-    """Seed 000 eq 79: -10 log(4 zeta^2 (1 - zeta^2)), for zeta < 1/sqrt(2)."""
+    """Seed 000 eq 79: -10 log(4 zeta^2 (1 - zeta^2)), for zeta < 1/sqrt(2).
+
+    Parameters
+    ----------
+    zeta : float
+        Damping ratio, below 1/sqrt(2).
+
+    Returns
+    -------
+    float
+        Height of the resonant peak above the DC gain in dB.
+    """
     return -10.0 * math.log10(4.0 * zeta * zeta * (1.0 - zeta * zeta))
 
 
@@ -277,6 +355,19 @@ def resonant_peak(data: FreqData, min_db: float = 0.1) -> MethodResult:
     -10 log(4 zeta^2 (1 - zeta^2)) = Mr and wn = w_peak / sqrt(1 - 2 zeta^2).
     Valid when the table shows a peak at least ``min_db`` above K between its
     first and last points (zeta < 0.707).
+
+    Parameters
+    ----------
+    data : FreqData
+        The frequency-response table.
+    min_db : float, optional
+        Smallest peak height above K (dB) that counts as a peak.
+
+    Returns
+    -------
+    MethodResult
+        The ``underdamped`` model read (invalid, with the reason, when the
+        table shows no peak).
     """
     name, model = "resonant-peak", "underdamped"
     lf = low_frequency_slope(data)

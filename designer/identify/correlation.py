@@ -74,7 +74,18 @@ def period_mean(x, start: int, period: int, count: int) -> np.ndarray:
 
 
 def circular_xcorr(x, y) -> np.ndarray:
-    """phi[k] = (1/P) sum_i x[i] y[(i + k) mod P] over one period (eq. 2.4.18), by FFT."""
+    """phi[k] = (1/P) sum_i x[i] y[(i + k) mod P] over one period (eq. 2.4.18), by FFT.
+
+    Parameters
+    ----------
+    x, y : array_like
+        One period of the input and of the output, of the same length P.
+
+    Returns
+    -------
+    numpy.ndarray
+        phi[k] for k = 0 .. P - 1.
+    """
     x = np.asarray(x, float)
     y = np.asarray(y, float)
     p = x.size
@@ -111,6 +122,27 @@ def mls_impulse(x, y, *, n: int, dt_s: float, ts: float, amplitude: float) -> Im
     ``ts`` with ``dt_s`` = m ts per interval and ``n`` intervals per period.
 
     Eq. 2.4.19 with the DC term from the tail (see the module docstring).
+
+    Parameters
+    ----------
+    x : array_like
+        One period of the input, offset removed.
+    y : array_like
+        The output over the same samples.
+    n : int
+        Intervals (bits) per MLS period.
+    dt_s : float
+        Length of one interval in s.
+    ts : float
+        Sample period in s.
+    amplitude : float
+        The input's half swing.
+
+    Returns
+    -------
+    ImpulseEstimate
+        The impulse and step responses on lags from -dt_s, the DC term, the
+        period, and the settling check's fields.
     """
     x = np.asarray(x, float)
     y = np.asarray(y, float)
@@ -263,7 +295,22 @@ def input_whiteness(x, mls: bool = False) -> InputWhiteness:
 
 
 def settling_time(t, step, band: float = SETTLE_BAND) -> float:
-    """The last time ``step`` is outside +-band of its final value (the mean of its last tenth)."""
+    """The last time ``step`` is outside +-band of its final value (the mean of its last tenth).
+
+    Parameters
+    ----------
+    t : array_like
+        Times in s.
+    step : array_like
+        Step response at ``t``.
+    band : float, optional
+        Relative band around the final value.
+
+    Returns
+    -------
+    float
+        Settling time in s (``t[0]`` if the response never leaves the band).
+    """
     k = max(int(0.1 * step.size), 1)
     final = float(np.mean(step[-k:]))
     out = np.nonzero(np.abs(step - final) > band * abs(final))[0]
@@ -308,7 +355,15 @@ def settling_check(est: ImpulseEstimate, per_bit: int = 1) -> None:
     last :data:`TAIL_CHECK` (by more than :data:`FLAT_FRACTION` of its peak and
     three times its noise). (The step response's own settling time is no test:
     its noise is the running sum of h's, a random walk that leaves a 2 % band
-    on a noisy record however long the period.)"""
+    on a noisy record however long the period.)
+
+    Parameters
+    ----------
+    est : ImpulseEstimate
+        The estimate to fill in place.
+    per_bit : int, optional
+        Samples per MLS interval.
+    """
     est.settling_s = settling_time(est.t, est.step)
     start = int((1.0 - TAIL_CHECK) * est.h.size)
     drift, se = tail_drift(est.h, start, per_bit)
@@ -344,7 +399,22 @@ def needed_period(est: ImpulseEstimate) -> tuple:
 
 
 def rms_error(t, h_est, h_true, t0: float, t1: float) -> float:
-    """RMS of ``h_est - h_true`` over t0 <= t <= t1, relative to the peak of |h_true|."""
+    """RMS of ``h_est - h_true`` over t0 <= t <= t1, relative to the peak of |h_true|.
+
+    Parameters
+    ----------
+    t : array_like
+        Times of the samples in s.
+    h_est, h_true : array_like
+        The estimated and the true impulse response at ``t``.
+    t0, t1 : float
+        The time window compared, in s.
+
+    Returns
+    -------
+    float
+        Relative RMS error.
+    """
     sel = (t >= t0) & (t <= t1)
     err = np.asarray(h_est)[sel] - np.asarray(h_true)[sel]
     return float(np.sqrt(np.mean(err * err)) / np.max(np.abs(np.asarray(h_true)[sel])))

@@ -33,7 +33,24 @@ __all__ = ["dc_motor", "dc_motor_position", "dc_motor_velocity"]
 
 def dc_motor_velocity(a, w_inf, t0, w_t0):
     """Seed 000 eqs 52 and 55: ``(Km, tau_m)`` from the step size ``a``, the final
-    velocity ``w_inf`` and one transient sample ``w_t0`` at ``t0``."""
+    velocity ``w_inf`` and one transient sample ``w_t0`` at ``t0``.
+
+    Parameters
+    ----------
+    a : float
+        The voltage step's size.
+    w_inf : float
+        Final velocity.
+    t0 : float
+        Time of the transient sample in s.
+    w_t0 : float
+        Velocity at ``t0``.
+
+    Returns
+    -------
+    tuple of float
+        ``(Km, tau_m)``, tau_m in s.
+    """
     km = w_inf / a
     tau = -t0 / math.log(1.0 - w_t0 / w_inf)
     return km, tau
@@ -50,6 +67,23 @@ def dc_motor(t, y, yf, sigma=None) -> MethodResult:
     clean first-order response every sample gives the same value). Valid for
     a delay-free first-order lag: the spread of those estimates says whether
     the data are one.
+
+    Parameters
+    ----------
+    t : array_like
+        Times after the step in s.
+    y : array_like
+        The measured velocity at ``t``.
+    yf : float
+        Its final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+
+    Returns
+    -------
+    MethodResult
+        The ``fopdt`` model K/(tau s + 1) without dead time, or an invalid
+        result with the reason.
     """
     name, model = "dc-motor", "fopdt"
     t, z, sigma, err = prepare(t, y, yf, sigma)
@@ -86,6 +120,23 @@ def dc_motor_position(t, theta, a: float = 1.0, tail: float = 0.3) -> MethodResu
     record gives Km = slope/a and tau_m = -intercept/slope. The result is
     reported as the velocity model W/U = Km/(tau_m s + 1) (``fopdt`` with no
     dead time); the position model is Km/(s (tau_m s + 1)).
+
+    Parameters
+    ----------
+    t : array_like
+        Times after the step in s.
+    theta : array_like
+        The shaft position at ``t``.
+    a : float, optional
+        The voltage step's size.
+    tail : float, optional
+        Fraction of the record (its end) the straight line is fitted to.
+
+    Returns
+    -------
+    MethodResult
+        The velocity model as ``fopdt`` (K = Km, tau_s = tau_m, no dead time),
+        or an invalid result with the reason.
     """
     name, model = "dc-motor-position", "fopdt"
     t = np.asarray(t, float)

@@ -29,7 +29,18 @@ MIN_SAMPLES = 10
 
 
 def number_text(v) -> str:
-    """A number for a message: plain digits, never a numpy repr."""
+    """A number for a message: plain digits, never a numpy repr.
+
+    Parameters
+    ----------
+    v : float
+        The number.
+
+    Returns
+    -------
+    str
+        Up to 10 significant digits.
+    """
     return f"{float(v):.10g}"
 
 
@@ -131,6 +142,21 @@ def find_edges(t, u, *, plateaus: bool = False) -> list:
     never makes a false edge. Each edge's time is the interpolated 50 %
     crossing; its levels are the means of the settled parts of the
     neighbouring plateaus.
+
+    Parameters
+    ----------
+    t : array_like
+        Times in s.
+    u : array_like
+        The signal at ``t``.
+    plateaus : bool, optional
+        The signal is an output (levels from its plateaus, see above).
+
+    Returns
+    -------
+    list of Edge
+        The edges found, in time order (empty when the signal does not move
+        between two levels).
     """
     t = np.asarray(t, float)
     u = np.asarray(u, float)

@@ -102,6 +102,18 @@ def exact_coefficients(p1: float, p2: float, model: str = "fopdt") -> tuple:
     double pole x solves 1 - (1 + x) e^-x = p. Then tau = (t2 - t1)/(x2 - x1)
     and theta = t1 - x1 tau. Used by the tests to bound each published
     coefficient's rounding.
+
+    Parameters
+    ----------
+    p1, p2 : float
+        The two fractions of the final value the method reads (0 < p < 1).
+    model : str, optional
+        ``fopdt`` or ``double-pole``.
+
+    Returns
+    -------
+    tuple of float
+        ``(a, b, c, d)`` of tau = a t1 + b t2, theta = c t1 + d t2.
     """
     x1, x2 = unit_time(p1, model), unit_time(p2, model)
     b = 1.0 / (x2 - x1)
@@ -110,7 +122,20 @@ def exact_coefficients(p1: float, p2: float, model: str = "fopdt") -> tuple:
 
 
 def unit_time(p: float, model: str = "fopdt") -> float:
-    """Time (in units of tau, after the dead time) at which the model reaches fraction p."""
+    """Time (in units of tau, after the dead time) at which the model reaches fraction p.
+
+    Parameters
+    ----------
+    p : float
+        Fraction of the final value (0 < p < 1).
+    model : str, optional
+        ``fopdt`` or ``double-pole``.
+
+    Returns
+    -------
+    float
+        The time in units of tau.
+    """
     if model == "fopdt":
         return -math.log(1.0 - p)
     from scipy.optimize import brentq
@@ -160,6 +185,22 @@ def ziegler_nichols(t, y, yf, sigma=None, overshoot=None) -> MethodResult:
     """Ziegler-Nichols reaction curve (seed 000 eq. 7, fig. 3).
 
     Validity: monotonic S-shaped response with an identifiable inflection.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+    overshoot : Overshoot, optional
+        The record's overshoot when the caller measured it, else measured here.
+
+    Returns
+    -------
+    MethodResult
+        The ``fopdt`` model, flagged invalid with the reason when it does not apply.
     """
     sigma = noise_sigma(y) if sigma is None else sigma
     tg = inflection_tangent(t, y, yf, sigma=sigma)
@@ -172,7 +213,24 @@ def ziegler_nichols(t, y, yf, sigma=None, overshoot=None) -> MethodResult:
 
 
 def hagglund(t, y, yf, sigma=None, overshoot=None) -> MethodResult:
-    """Hägglund: ZN dead time, tau to the 63.2 % point (seed 000 fig. 3)."""
+    """Hägglund: ZN dead time, tau to the 63.2 % point (seed 000 fig. 3).
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+    overshoot : Overshoot, optional
+        The record's overshoot when the caller measured it, else measured here.
+
+    Returns
+    -------
+    MethodResult
+        The ``fopdt`` model, flagged invalid with the reason when it does not apply.
+    """
     sigma = noise_sigma(y) if sigma is None else sigma
     tg = inflection_tangent(t, y, yf, sigma=sigma)
     theta = tg.t_base
@@ -192,7 +250,26 @@ def _cross(t, y, yf, p, sigma):
 
 
 def two_point(row: TwoPoint, t, y, yf, sigma=None, overshoot=None) -> MethodResult:
-    """General two-point method: tau = a t1 + b t2, theta = c t1 + d t2 (seed 000 eq. 16)."""
+    """General two-point method: tau = a t1 + b t2, theta = c t1 + d t2 (seed 000 eq. 16).
+
+    Parameters
+    ----------
+    row : TwoPoint
+        The method: its name, model, the two fractions read and a, b, c, d.
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+    overshoot : Overshoot, optional
+        The record's overshoot when the caller measured it, else measured here.
+
+    Returns
+    -------
+    MethodResult
+        The row's model, flagged invalid with the reason when it does not apply.
+    """
     sigma = noise_sigma(y) if sigma is None else sigma
     t1 = _cross(t, y, yf, row.p1, sigma)
     t2 = _cross(t, y, yf, row.p2, sigma)
@@ -217,6 +294,22 @@ def nishikawa(t, y, yf, sigma=None, overshoot=None) -> MethodResult:
     monotonic responses the method is meant for they coincide, and only the
     signed area equals the sum of time constants plus dead time). The record
     must cover the settling: the area is truncated at its end.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+    overshoot : Overshoot, optional
+        The record's overshoot when the caller measured it, else measured here.
+
+    Returns
+    -------
+    MethodResult
+        The ``fopdt`` model, flagged invalid with the reason when it does not apply.
     """
     t = np.asarray(t, float)
     y = np.asarray(y, float)

@@ -96,7 +96,23 @@ def _fit_bounds(model, data, fit_delay) -> tuple:
 
 def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     """Fit ``model`` to the complex response from each of ``starts`` (parameter
-    dicts) and keep the lowest cost; 95 % half-widths from the Jacobian."""
+    dicts) and keep the lowest cost; 95 % half-widths from the Jacobian.
+
+    Parameters
+    ----------
+    data : FreqData
+        The frequency-response table.
+    model : str
+        ``fopdt``, ``underdamped`` or ``overdamped``.
+    starts : iterable of dict
+        Starting parameter sets.
+
+    Returns
+    -------
+    MethodResult
+        The best fit named ``least-squares`` with its error and half-widths in
+        ``points``, or an invalid result when no start converged.
+    """
     from scipy.optimize import least_squares
 
     # Student t quantile from scipy.special: scipy.stats costs 0.4 s to import

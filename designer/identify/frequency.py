@@ -78,7 +78,20 @@ class FreqIdentifyResult:
 
 
 def corner_frequencies(model: str, params: dict) -> dict:
-    """The model's corner frequencies (rad/s): 1/tau of each time constant, wn."""
+    """The model's corner frequencies (rad/s): 1/tau of each time constant, wn.
+
+    Parameters
+    ----------
+    model : str
+        The model's name.
+    params : dict
+        Its parameters.
+
+    Returns
+    -------
+    dict
+        Parameter name -> corner frequency in rad/s.
+    """
     out = {}
     for k, v in params.items():
         if k.startswith("tau") and isinstance(v, float) and v > 0:
@@ -147,7 +160,19 @@ def wide_interval(m: MethodResult) -> str | None:
 
 
 def identify_freq(data: FreqData) -> FreqIdentifyResult:
-    """Run the classical readings and the least-squares fits; rank by fit error."""
+    """Run the classical readings and the least-squares fits; rank by fit error.
+
+    Parameters
+    ----------
+    data : FreqData
+        The frequency-response table.
+
+    Returns
+    -------
+    FreqIdentifyResult
+        Every method's result in rank order, the best valid one (or None), the
+        data and the loop margins.
+    """
     classical = [asymptotes(data), resonant_peak(data)]
     K, _ = low_frequency_gain(data)
     wc = interp_logf(data.w, data.gain_db, 20.0 * math.log10(K) - 3.0)

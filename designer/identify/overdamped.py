@@ -52,6 +52,22 @@ def two_pole(t, y, yf, sigma=None, levels=(0.6, 0.9)) -> MethodResult:
     which is the seed's two-point line on clean data and far less sensitive
     to noise. The seed writes e^{p2 t} with p2 signed; only the magnitude
     makes eqs 17/18 consistent.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+    levels : tuple of float, optional
+        The two fractions of the final value bounding the fitted samples.
+
+    Returns
+    -------
+    MethodResult
+        The ``overdamped`` model, or an invalid result with the reason.
     """
     name, model = "two-pole", "overdamped"
     t, z, sigma, err = prepare(t, y, yf, sigma)
@@ -108,6 +124,21 @@ def stark_mollenkamp(t, y, yf, sigma=None) -> MethodResult:
     wn = f2(zeta)/(t75 - t15) with f2 = 0.708 (2.811)^zeta (zeta < 1) or
     2.6 zeta - 0.6; theta = t45 - f3(zeta)/wn with f3 = 0.922 (1.66)^zeta.
     An empirical correlation: within 3 % for 0.45 <= zeta <= 1.3.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+
+    Returns
+    -------
+    MethodResult
+        The ``underdamped`` or ``overdamped`` model with dead time, or an invalid
+        result with the reason.
     """
     name = "stark-mollenkamp"
     t, z, sigma, err = prepare(t, y, yf, sigma)
@@ -165,6 +196,20 @@ def jahanmiri_fallahi(t, y, yf, sigma=None) -> MethodResult:
     tau = (t90 - theta)/(0.424301 + 4.62533 zeta - 2.65412 e^{-zeta}).
     The correlation yields zeta >= 0.696 only: for more oscillatory responses
     it is flagged invalid.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+
+    Returns
+    -------
+    MethodResult
+        The second-order model with dead time, or an invalid result with the reason.
     """
     name = "jahanmiri-fallahi"
     t, z, sigma, err = prepare(t, y, yf, sigma)
@@ -222,6 +267,22 @@ def peeling(t, y, yf, sigma=None, iterations: int = 500) -> MethodResult:
     Valid when the fast term has the sign of two cascaded poles (K1 > 0);
     a response with a zero, like seed 003's furnace (both exponentials
     falling), is reported with valid=False and its amplitudes in ``points``.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+    iterations : int, optional
+        Most alternations of the two fits.
+
+    Returns
+    -------
+    MethodResult
+        The ``overdamped`` model, or an invalid result with the reason.
     """
     name, model = "peeling", "overdamped"
     t, z, sigma, err = prepare(t, y, yf, sigma)
@@ -340,6 +401,20 @@ def alfaro_123c_overdamped(t, y, yf, sigma=None) -> MethodResult:
     response to about 1 % of the step (checked in the tests), its parameters
     less closely (T within about 13 %); towards a = 0 it drifts (7-12 % of the
     step), so a result whose model misses the data by over 2 % rms is invalid.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+
+    Returns
+    -------
+    MethodResult
+        The ``overdamped`` model with dead time, or an invalid result with the reason.
     """
     name, model = "alfaro-123c-overdamped", "overdamped"
     t, z, sigma, err = prepare(t, y, yf, sigma)
@@ -407,6 +482,20 @@ def harriott(t, y, yf, sigma=None) -> MethodResult:
     Harriott's chart, computed here from the exact two-pole response (0.393 for
     one pole down to 0.264 for a double pole). Valid for responses inside the
     chart and without dead time.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+
+    Returns
+    -------
+    MethodResult
+        The ``overdamped`` model, or an invalid result with the reason.
     """
     name, model = "harriott", "overdamped"
     t, z, sigma, err = prepare(t, y, yf, sigma)

@@ -43,7 +43,25 @@ __all__ = ["check_window", "prepare_step"]
 def check_window(window, t=None) -> tuple:
     """``(t0, t1)`` of ``--window``: both inside ``RANGES["capture_time_s"]``,
     t0 < t1, and (given the record's times ``t``) holding at least
-    :data:`MIN_SAMPLES` samples."""
+    :data:`MIN_SAMPLES` samples.
+
+    Parameters
+    ----------
+    window : tuple of float
+        ``(t0, t1)`` in s.
+    t : array_like, optional
+        The record's times in s.
+
+    Returns
+    -------
+    tuple of float
+        ``(t0, t1)``.
+
+    Raises
+    ------
+    DesignError
+        When a bound is out of range, t0 >= t1, or too few samples lie inside.
+    """
     t0, t1 = (float(v) for v in window)
     for v, what in ((t0, "start"), (t1, "end")):
         RANGES["capture_time_s"].check(v, f"the window's {what} (s)", shown=number_text(v))
@@ -77,6 +95,11 @@ def prepare_step(t, y, u=None, *, step_time: float | None = None,
         scope's trigger); the amplitude defaults to 1.
     window : (float, float), optional
         Use only the samples from ``window[0]`` to ``window[1]`` seconds.
+
+    Returns
+    -------
+    PreparedStep
+        The normalised step response and how it was obtained.
     """
     t = np.asarray(t, float)
     y = np.asarray(y, float)

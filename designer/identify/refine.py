@@ -21,7 +21,28 @@ __all__ = ["fit", "refine_all"]
 
 def fit(model: str, t, y, yf, start: dict | None = None, sigma=None,
         overshoot=None) -> MethodResult:
-    """:func:`~designer.core.stepfit.fit_step` as a :class:`MethodResult` named ``least-squares``."""
+    """:func:`~designer.core.stepfit.fit_step` as a :class:`MethodResult` named ``least-squares``.
+
+    Parameters
+    ----------
+    model : str
+        ``fopdt``, ``underdamped`` or ``overdamped``.
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    start : dict, optional
+        Starting parameters.
+    sigma : float, optional
+        Noise standard deviation of ``y``.
+    overshoot : Overshoot, optional
+        The record's overshoot when the caller measured it.
+
+    Returns
+    -------
+    MethodResult
+        The fit, with its validity and note.
+    """
     f = fit_step(model, t, y, yf, start, sigma, overshoot)
     points = {f"{k}_ci95": v for k, v in f.ci95.items()}
     points["samples_fitted"] = f.samples
@@ -34,7 +55,26 @@ def fit(model: str, t, y, yf, start: dict | None = None, sigma=None,
 def refine_all(t, y, yf, starts: dict | None = None, sigma=None, overshoot=None) -> list:
     """The three least-squares fits, each from ``starts[model]`` (a MethodResult) if given;
     ``sigma`` is the noise of ``y`` and ``overshoot`` the
-    :class:`~designer.core.metrics.Overshoot` of the record when the caller measured them."""
+    :class:`~designer.core.metrics.Overshoot` of the record when the caller measured them.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    starts : dict, optional
+        Model name -> MethodResult to start from.
+    sigma : float, optional
+        Noise standard deviation of ``y``.
+    overshoot : Overshoot, optional
+        The record's overshoot.
+
+    Returns
+    -------
+    list of MethodResult
+        One fit per model.
+    """
     starts = starts or {}
     out = []
     for model in PARAMS:

@@ -71,7 +71,18 @@ def _capture_line(cap) -> str:
 
 
 def step_text(result) -> str:
-    """The ``identify`` table of an :class:`~.step.IdentifyResult`."""
+    """The ``identify`` table of an :class:`~.step.IdentifyResult`.
+
+    Parameters
+    ----------
+    result : IdentifyResult
+        The step identification.
+
+    Returns
+    -------
+    str
+        The table's text.
+    """
     s, cap = result.step, result.capture
     lines = []
     if cap is not None:
@@ -171,7 +182,18 @@ def comparison_text(c) -> list:
 
 
 def freq_text(result) -> str:
-    """The ``identify-freq`` table of a :class:`~.frequency.FreqIdentifyResult`."""
+    """The ``identify-freq`` table of a :class:`~.frequency.FreqIdentifyResult`.
+
+    Parameters
+    ----------
+    result : FreqIdentifyResult
+        The frequency identification.
+
+    Returns
+    -------
+    str
+        The table's text.
+    """
     d = result.data
     lines = [f"Table: {d.source or 'data'}: {d.w.size} points, "
              f"{format_eng(d.f_hz[0], 'Hz')} to {format_eng(d.f_hz[-1], 'Hz')}, "
@@ -205,7 +227,20 @@ def _pyplot():
 
 
 def fit_plot(result, n_models: int = 3) -> bytes:
-    """PNG of the step data against the best ``n_models`` valid models, with the residuals."""
+    """PNG of the step data against the best ``n_models`` valid models, with the residuals.
+
+    Parameters
+    ----------
+    result : IdentifyResult
+        The step identification.
+    n_models : int, optional
+        How many valid models to draw.
+
+    Returns
+    -------
+    bytes
+        The PNG file's content.
+    """
     from .settle import block_mean
     from .structures import model_step
     plt = _pyplot()
@@ -233,7 +268,20 @@ def fit_plot(result, n_models: int = 3) -> bytes:
 
 
 def bode_fit_plot(result, n_models: int = 3) -> bytes:
-    """PNG Bode plot of a frequency table and the best ``n_models`` valid models."""
+    """PNG Bode plot of a frequency table and the best ``n_models`` valid models.
+
+    Parameters
+    ----------
+    result : FreqIdentifyResult
+        The frequency identification.
+    n_models : int, optional
+        How many valid models to draw.
+
+    Returns
+    -------
+    bytes
+        The PNG file's content.
+    """
     from .bode_readings import model_phase, model_response
     plt = _pyplot()
     d = result.data
@@ -270,7 +318,18 @@ def broadband_text(result) -> str:
     """The ``identify`` text of a :class:`~.broadband.BroadbandResult`: the
     excitation, the impulse estimate, then the correlation's step methods and
     the spectral estimate's frequency methods, each table as it is for a step
-    or a frequency table."""
+    or a frequency table.
+
+    Parameters
+    ----------
+    result : BroadbandResult
+        The broadband identification.
+
+    Returns
+    -------
+    str
+        The text, one line per row.
+    """
     ex, cap = result.excitation, result.capture
     lines = []
     if cap is not None:
@@ -324,7 +383,20 @@ def broadband_plot(result, n_models: int = 3) -> bytes:
     """PNG of a broadband identification: the impulse response, the step it
     integrates to with the best step models, the spectral estimate (gain and
     phase) with the best frequency models, and its coherence; when validated,
-    the residual tests of the best model by validation fit."""
+    the residual tests of the best model by validation fit.
+
+    Parameters
+    ----------
+    result : BroadbandResult
+        The broadband identification.
+    n_models : int, optional
+        How many valid models to draw.
+
+    Returns
+    -------
+    bytes
+        The PNG file's content.
+    """
     from .bode_readings import model_response
     from .structures import model_step
     plt = _pyplot()

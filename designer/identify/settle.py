@@ -99,6 +99,20 @@ def final_value(t, y, y0: float, *, sigma: float | None = None) -> float:
     a straight line through it changes, by more than ``SETTLE_TOL`` of the
     step (beyond what the noise explains). ``t`` and ``y`` are the post-step
     samples.
+
+    Parameters
+    ----------
+    t, y : array_like
+        The post-step times (s) and samples.
+    y0 : float
+        The value before the step.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+
+    Returns
+    -------
+    float
+        The settled value.
     """
     t = np.asarray(t, float)
     y = np.asarray(y, float)
@@ -129,6 +143,18 @@ def block_mean(t, y, max_samples: int = MAX_WORK_SAMPLES) -> tuple:
     """Reduce a long record by averaging blocks of samples (anti-aliased decimation).
 
     Block means of time keep the samples centred, so no delay is introduced.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times (s) and samples.
+    max_samples : int, optional
+        Most samples kept.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(t, y)`` reduced, or unchanged when short enough.
     """
     t = np.asarray(t, float)
     y = np.asarray(y, float)

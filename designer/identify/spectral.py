@@ -72,7 +72,28 @@ def _keep(f, h, coh, suu, f_max, how, var) -> Spectrum:
 def periodic_response(u, y, *, start: int, period: int, count: int, ts: float,
                       f_max: float) -> Spectrum:
     """H at the harmonics of 1/(period ts) from ``count`` whole periods of
-    ``period`` samples from ``start``; the coherence across periods (1 for one)."""
+    ``period`` samples from ``start``; the coherence across periods (1 for one).
+
+    Parameters
+    ----------
+    u, y : array_like
+        Input and output samples.
+    start : int
+        Index of the first sample used.
+    period : int
+        Samples per period.
+    count : int
+        Whole periods used.
+    ts : float
+        Sample period in s.
+    f_max : float
+        Highest frequency kept, in Hz.
+
+    Returns
+    -------
+    Spectrum
+        The estimate at the harmonics the input excites.
+    """
     seg_u = np.asarray(u, float)[start:start + period * count].reshape(count, period)
     seg_y = np.asarray(y, float)[start:start + period * count].reshape(count, period)
     U = np.fft.rfft(seg_u, axis=1)
@@ -93,7 +114,24 @@ def periodic_response(u, y, *, start: int, period: int, count: int, ts: float,
 
 
 def welch_response(u, y, *, ts: float, nperseg: int, f_max: float) -> Spectrum:
-    """H = S_yu / S_uu and the coherence by Welch's method (Hann, half overlap)."""
+    """H = S_yu / S_uu and the coherence by Welch's method (Hann, half overlap).
+
+    Parameters
+    ----------
+    u, y : array_like
+        Input and output samples.
+    ts : float
+        Sample period in s.
+    nperseg : int
+        Samples per segment.
+    f_max : float
+        Highest frequency kept, in Hz.
+
+    Returns
+    -------
+    Spectrum
+        The estimate.
+    """
     from scipy.signal import csd, welch
     fs = 1.0 / ts
     u = np.asarray(u, float)
@@ -115,7 +153,20 @@ def log_bands(sp: Spectrum, per_decade: int = BANDS_PER_DECADE) -> Spectrum:
     """The spectrum averaged in bands equally spaced in log f: per band
     H = sum S_uu H / sum S_uu (the band's S_yu over its S_uu: unbiased by the
     output's noise, as a mean of log|H| is not), f its power-weighted geometric
-    mean, the coherence its power-weighted mean. Bands with one point keep it."""
+    mean, the coherence its power-weighted mean. Bands with one point keep it.
+
+    Parameters
+    ----------
+    sp : Spectrum
+        The estimate.
+    per_decade : int, optional
+        Bands per decade.
+
+    Returns
+    -------
+    Spectrum
+        The band-averaged estimate.
+    """
     if sp.f.size == 0:
         return sp
     lf = np.log10(sp.f)
@@ -142,7 +193,20 @@ def unwrapped_phase_deg(sp: Spectrum) -> np.ndarray:
 
 def to_freq_data(sp: Spectrum, source: str = ""):
     """The spectrum as identify-freq's :class:`~designer.identify.io.FreqData`
-    (gain as a ratio, phase in degrees)."""
+    (gain as a ratio, phase in degrees).
+
+    Parameters
+    ----------
+    sp : Spectrum
+        The estimate.
+    source : str, optional
+        Name for messages.
+
+    Returns
+    -------
+    FreqData
+        The validated table.
+    """
     from .io import freq_data
     return freq_data(sp.f, np.abs(sp.h), unwrapped_phase_deg(sp), gain_units="ratio",
                      phase_units="deg", freq_units="hz", source=source)
@@ -150,7 +214,18 @@ def to_freq_data(sp: Spectrum, source: str = ""):
 
 def table_text(sp: Spectrum) -> str:
     """The spectrum as a table identify-freq reads: ``f_hz,gain_db,phase_deg``
-    after a ``#`` line saying how it was estimated (the coherence is in the JSON)."""
+    after a ``#`` line saying how it was estimated (the coherence is in the JSON).
+
+    Parameters
+    ----------
+    sp : Spectrum
+        The estimate.
+
+    Returns
+    -------
+    str
+        The CSV text.
+    """
     ph = unwrapped_phase_deg(sp)
     rows = ["# spectral estimate H = S_yu/S_uu (" + sp.how + ")", "f_hz,gain_db,phase_deg"]
     rows += [f"{f:.9g},{20 * math.log10(abs(h)):.6f},{p:.4f}" for f, h, p in zip(sp.f, sp.h, ph)]

@@ -53,20 +53,57 @@ Y4_LEVEL = 1.0 - 4.0 / math.e ** 3
 # --------------------------------------------------------------------------
 
 def zeta_from_overshoot(mp):
-    """Damping ratio from the fractional overshoot ``mp`` (0 < mp < 1), seed 000 eq 23 / 26."""
+    """Damping ratio from the fractional overshoot ``mp`` (0 < mp < 1), seed 000 eq 23 / 26.
+
+    Parameters
+    ----------
+    mp : float or array_like
+        Overshoot as a fraction of the final value.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Damping ratio.
+    """
     lm = np.log(np.asarray(mp, float))
     return -lm / np.sqrt(math.pi ** 2 + lm * lm)
 
 
 def wn_from_peak_time(tp, zeta):
-    """Natural frequency from the peak time, wn = pi / (tp sqrt(1 - zeta^2)) (seed 000 eq 20)."""
+    """Natural frequency from the peak time, wn = pi / (tp sqrt(1 - zeta^2)) (seed 000 eq 20).
+
+    Parameters
+    ----------
+    tp : float or array_like
+        Peak time in s.
+    zeta : float or array_like
+        Damping ratio (< 1).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Natural frequency in rad/s.
+    """
     return math.pi / (np.asarray(tp, float) * np.sqrt(1.0 - np.asarray(zeta, float) ** 2))
 
 
 
 def normalized_step(zeta: float, t) -> np.ndarray:
     """Exact unit step response of wn^2/(s^2 + 2 zeta wn s + wn^2) with wn = 1,
-    for any zeta > 0 (under-, critically or over-damped)."""
+    for any zeta > 0 (under-, critically or over-damped).
+
+    Parameters
+    ----------
+    zeta : float
+        Damping ratio (> 0).
+    t : array_like
+        Times in units of 1/wn.
+
+    Returns
+    -------
+    numpy.ndarray
+        The response at ``t``.
+    """
     t = np.asarray(t, float)
     if math.isclose(zeta, 1.0, rel_tol=1e-9):
         return 1.0 - (1.0 + t) * np.exp(-t)
@@ -96,7 +133,18 @@ def _t3_t4(zeta: float) -> tuple[float, float]:
 
 
 def t4_t3_ratio(zeta: float) -> float:
-    """t4/t3 of the exact response (seed 002 eq 9: 3 at zeta = 1); increasing in zeta."""
+    """t4/t3 of the exact response (seed 002 eq 9: 3 at zeta = 1); increasing in zeta.
+
+    Parameters
+    ----------
+    zeta : float
+        Damping ratio.
+
+    Returns
+    -------
+    float
+        t4/t3.
+    """
     t3, t4 = _t3_t4(float(zeta))
     return t4 / t3
 
@@ -104,6 +152,12 @@ def t4_t3_ratio(zeta: float) -> float:
 def t4_t3_table(zetas=(0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2, 1.3, 1.4,
                        1.5, 1.6, 1.7, 1.8, 1.9, 2.0)):
     """Seed 002 Table 2, computed from the exact response rather than typed.
+
+    Parameters
+    ----------
+    zetas : sequence of float, optional
+        The damping ratios of the table's rows.
+
 
     Returns
     -------
@@ -123,7 +177,18 @@ _ZETA_SEARCH = (0.02, 20.0)
 
 
 def zeta_from_t4_t3(ratio: float) -> float:
-    """Invert :func:`t4_t3_ratio` (nan outside what any second-order system gives)."""
+    """Invert :func:`t4_t3_ratio` (nan outside what any second-order system gives).
+
+    Parameters
+    ----------
+    ratio : float
+        t4/t3.
+
+    Returns
+    -------
+    float
+        Damping ratio, or nan.
+    """
     lo, hi = _ZETA_SEARCH
     f = lambda z: t4_t3_ratio(z) - ratio  # noqa: E731
     flo, fhi = f(lo), f(hi)
@@ -175,6 +240,22 @@ def extrema(t, z, sigma: float = 0.0, count: int = 3):
     moving average (n/2000 samples wide, threshold 5 sigma of the average),
     so that a noise spike in a settled tail is not taken for an overshoot;
     each extremum is then refined on the raw samples.
+
+    Parameters
+    ----------
+    t : array_like
+        Times in s.
+    z : array_like
+        The response divided by its final value.
+    sigma : float, optional
+        Noise standard deviation of ``z`` (0: no smoothing).
+    count : int, optional
+        Most extrema returned.
+
+    Returns
+    -------
+    list of tuple
+        ``(kind, time, value)`` per extremum.
     """
     t = np.asarray(t, float)
     z = np.asarray(z, float)
@@ -222,6 +303,20 @@ def overshoot(t, y, yf, sigma=None) -> MethodResult:
     Mp the first overshoot as a fraction of the final value, tp measured from
     the step. Valid for 0 < zeta < 1 with an overshoot above the noise and
     no dead time (a dead time adds to tp and lowers wn).
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+
+    Returns
+    -------
+    MethodResult
+        The ``underdamped`` model, or an invalid result with the reason.
     """
     name, model = "overshoot", "underdamped"
     t, z, sigma, err = prepare(t, y, yf, sigma)
@@ -254,6 +349,20 @@ def log_decrement(t, y, yf, sigma=None) -> MethodResult:
     |ln Y2|/sqrt(4 pi^2 + ln^2 Y2) (eq 6; the seed's signs need the magnitude)
     and wn = 2 pi / (T sqrt(1 - zeta^2)) (eq 7), T the time between the first
     two peaks (twice the peak-to-trough time if the record shows one peak only).
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+
+    Returns
+    -------
+    MethodResult
+        The ``underdamped`` model, or an invalid result with the reason.
     """
     name, model = "log-decrement", "underdamped"
     t, z, sigma, err = prepare(t, y, yf, sigma)
@@ -294,6 +403,20 @@ def t4_t3(t, y, yf, sigma=None) -> MethodResult:
     t3 and t4 are the times to 1 - 2/e = 26.4 % and 1 - 4/e^3 = 80.1 % of the
     final value; zeta solves t4/t3 = ratio(zeta) on the exact response (the
     seed's Table 2, recomputed), and wn = (wn t4)(zeta) / t4.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+
+    Returns
+    -------
+    MethodResult
+        The ``underdamped`` model, or an invalid result with the reason.
     """
     name = "t4-t3"
     t, z, sigma, err = prepare(t, y, yf, sigma)
@@ -333,6 +456,20 @@ def chen(t, y, yf, sigma=None) -> MethodResult:
     (eq 30), zeta from eq 26, tau = 1/wn = (t_m1 - t_p1) sqrt(1 - zeta^2)/pi
     (eq 27), theta = 2 t_p1 - t_m1 (eq 28). K is the measured final value;
     eq 29's estimate of it is reported in ``points``.
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times after the step (s) and the response.
+    yf : float
+        The response's final value.
+    sigma : float, optional
+        Noise standard deviation of ``y``; estimated from ``y`` when None.
+
+    Returns
+    -------
+    MethodResult
+        The ``underdamped`` model with dead time, or an invalid result with the reason.
     """
     name, model = "chen", "underdamped"
     t, z, sigma, err = prepare(t, y, yf, sigma)

@@ -419,7 +419,18 @@ def _load(head, layout, keep, blocks, name, size_hint, ahead=None) -> _Columns:
 
 
 def text_lines(text: str) -> int:
-    """Lines in a block of text, as ``str.splitlines`` counts them for a CSV."""
+    """Lines in a block of text, as ``str.splitlines`` counts them for a CSV.
+
+    Parameters
+    ----------
+    text : str
+        The text.
+
+    Returns
+    -------
+    int
+        The number of lines.
+    """
     return text.count("\n") + (0 if not text or text.endswith("\n") else 1)
 
 
@@ -635,7 +646,18 @@ def _transition_fraction(x) -> float:
 def looks_like_step_input(u, y) -> bool:
     """True when ``u`` is a two-level signal whose transitions are much faster
     than ``y``'s: it spends under 2 % of the record between its 10 % and 90 %
-    levels, and under a fifth of the time ``y`` spends between its own."""
+    levels, and under a fifth of the time ``y`` spends between its own.
+
+    Parameters
+    ----------
+    u, y : array_like
+        The input and output columns.
+
+    Returns
+    -------
+    bool
+        Whether ``u`` looks like a step (or square-wave) input.
+    """
     u = np.asarray(u, float)
     fu = _transition_fraction(u)
     if np.ptp(u) == 0:

@@ -35,7 +35,23 @@ _DETECT = (
 
 
 def check_format(fmt) -> str:
-    """``fmt`` lowercased if it is ``auto`` or one of :data:`FORMATS`."""
+    """``fmt`` lowercased if it is ``auto`` or one of :data:`FORMATS`.
+
+    Parameters
+    ----------
+    fmt : str
+        The format named by the user.
+
+    Returns
+    -------
+    str
+        The lowercased format.
+
+    Raises
+    ------
+    DesignError
+        When it is neither ``auto`` nor a known format.
+    """
     f = str(fmt).strip().lower()
     if f != "auto" and f not in FORMATS:
         raise DesignError(f"unknown capture format {show_cell(str(fmt))}; allowed: auto, "

@@ -85,6 +85,25 @@ def freq_data(freq, gain, phase=None, *, gain_units="db", phase_units="deg",
 
     ``lines`` (optional) are the file lines of the rows, for messages.
 
+    Parameters
+    ----------
+    freq, gain : array_like
+        Frequency and gain columns.
+    phase : array_like, optional
+        Phase column.
+    gain_units, phase_units, freq_units : str, optional
+        Units of the columns (``db``/``ratio``, ``deg``/``rad``/``s``, ``hz``/``rad/s``).
+    source : str, optional
+        The table's name, for messages.
+    lines : sequence of int, optional
+        The file lines of the rows, for messages.
+
+    Returns
+    -------
+    FreqData
+        The table in rad/s, amplitude ratio and radians.
+
+
     Raises
     ------
     DesignError
@@ -209,7 +228,20 @@ def _tokens(name: str) -> set:
 
 
 def unit_hint(name: str, kind: str):
-    """Units named in a header cell, or None."""
+    """Units named in a header cell, or None.
+
+    Parameters
+    ----------
+    name : str
+        A header cell.
+    kind : str
+        The column: ``frequency``, ``gain`` or ``phase``.
+
+    Returns
+    -------
+    tuple or None
+        ``(units, scale)``, e.g. ``("hz", 1e3)`` for kHz, or None.
+    """
     tk = _tokens(name)
     low = name.lower()
     if kind == "frequency":
@@ -250,6 +282,20 @@ def parse_freq_table(text: str, *, gain_units=None, phase_units=None, freq_units
     ``gain_ratio``, ``phase_deg``, ``phase_rad``, ``shift_us``...). Units given
     as arguments (any case: ``dB``, ``Hz``) win over the header; the defaults
     are Hz, dB and degrees.
+
+    Parameters
+    ----------
+    text : str
+        The CSV text.
+    gain_units, phase_units, freq_units : str, optional
+        Units of the columns; None: from the header, else the defaults.
+    source : str, optional
+        The table's name, for messages.
+
+    Returns
+    -------
+    FreqData
+        The validated table (see :func:`freq_data`).
     """
     pre = f"{source}: " if source else ""
     lines = [(i + 1, ln.strip()) for i, ln in enumerate(text.lstrip("\ufeff").splitlines())]
@@ -378,6 +424,19 @@ def _analyser_columns(header):
 
 def read_freq_table(path, **units) -> FreqData:
     """Read a frequency-response CSV file (see :func:`parse_freq_table`): at most
-    :data:`~designer.core.fileio.MAX_TABLE_BYTES`, UTF-8 or ASCII."""
+    :data:`~designer.core.fileio.MAX_TABLE_BYTES`, UTF-8 or ASCII.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The CSV file.
+    **units
+        ``gain_units``, ``phase_units``, ``freq_units`` of :func:`parse_freq_table`.
+
+    Returns
+    -------
+    FreqData
+        The validated table.
+    """
     text = read_text(path, "table", MAX_TABLE_BYTES)
     return parse_freq_table(text, source=shown(path), **units)

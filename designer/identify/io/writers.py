@@ -9,7 +9,26 @@ __all__ = ["format_generic"]
 
 
 def format_generic(t, y, u=None, *, delimiter=",", header=True, decimal_comma=False) -> str:
-    """Text of a generic ``t,[u,]y`` CSV (used by fixtures and round-trip tests)."""
+    """Text of a generic ``t,[u,]y`` CSV (used by fixtures and round-trip tests).
+
+    Parameters
+    ----------
+    t, y : array_like
+        Times (s) and output.
+    u : array_like, optional
+        Input column.
+    delimiter : str, optional
+        Cell separator.
+    header : bool, optional
+        Write a ``t,u,y`` header row.
+    decimal_comma : bool, optional
+        Write decimal commas.
+
+    Returns
+    -------
+    str
+        The CSV text, one row per sample.
+    """
     cols = [np.asarray(t, float)] + ([np.asarray(u, float)] if u is not None else []) \
         + [np.asarray(y, float)]
     names = ["t", "u", "y"] if u is not None else ["t", "y"]
