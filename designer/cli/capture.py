@@ -93,7 +93,13 @@ def epilog() -> str:
 
 
 def build_parser():
-    """The ``simulate-capture`` command line."""
+    """The ``simulate-capture`` command line.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser of ``simulate-capture``'s options.
+    """
     p = command_parser("simulate-capture", "Simulate a plant model's step response in ngspice and write it as a "
                        "capture (CSV t,u,y) that identify reads.", epilog())
     p.add_argument("--plant-tf", metavar="MODEL", required=True,

@@ -53,6 +53,13 @@ allowed); 3 a simulator error or timeout; --no-fail makes it 0 whatever happened
 
 
 def check_parser():
+    """The ``check-design`` command line.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser of ``check-design``'s options.
+    """
     p = command_parser(
         "check-design",
         "SPICE regression checks of your own analog designs, for CI: each spec file names a design (a Sallen-Key "
@@ -276,6 +283,18 @@ def _relocate(outcome, stage: Path, final: Path) -> None:
 
 
 def check_design_main(argv=None) -> int:
+    """Console entry point ``check-design``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit status (see :func:`~designer.cli.common.run_cli`).
+    """
     return run_cli("check-design", check_parser, _run, argv)
 
 

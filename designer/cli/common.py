@@ -79,7 +79,18 @@ def flag_message(exc: DesignError) -> str:
     names (:meth:`DesignError.naming`: every ``{name}`` marker of a
     :class:`~designer.core.errors.ParamError`, else the parameter it starts with),
     and for a library name anywhere in its text (``simc: ... give tauc_s``, said
-    by the tuning rules, reads ``give --simc-tauc``)."""
+    by the tuning rules, reads ``give --simc-tauc``).
+
+    Parameters
+    ----------
+    exc : DesignError
+        The library's error.
+
+    Returns
+    -------
+    str
+        The message in the command line's words.
+    """
     text = exc.naming(FLAGS) if callable(getattr(exc, "naming", None)) else str(exc)
     return _NAME_IN_TEXT.sub(lambda m: FLAGS[m.group(1)], text)
 
@@ -176,7 +187,24 @@ def _silence_stdout() -> None:
 def run_cli(prog: str, build_parser, action, argv=None) -> int:
     """Run ``action(args)`` with the one-line error convention; returns the exit status:
     0 done, 1 a check failed (when asked), 2 bad input or usage, 3 simulator error,
-    130, 143, 129 interrupted by SIGINT, SIGTERM, SIGHUP. Every failure is one line on stderr, never a traceback."""
+    130, 143, 129 interrupted by SIGINT, SIGTERM, SIGHUP. Every failure is one line on stderr, never a traceback.
+
+    Parameters
+    ----------
+    prog : str
+        The command's name, for its messages.
+    build_parser : callable
+        Returns the command's :class:`argparse.ArgumentParser`.
+    action : callable
+        Runs the parsed arguments; returns an exit status or None (0).
+    argv : list of str, optional
+        The arguments; None reads ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from ..core.errors import EXIT_BAD_INPUT, EXIT_SIMULATOR, SimulatorError
     from ..core import lifetime
     try:

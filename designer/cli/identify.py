@@ -280,7 +280,13 @@ def step_amplitude(text) -> float:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The ``identify`` command line."""
+    """The ``identify`` command line.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser of ``identify``'s options.
+    """
     p = _parser("identify", "Identify plant models (FOPDT, double pole, second order with dead\n"
                 "time) from a measured or simulated step response, ranked by IAE.",
                 identify_epilog(), "CSV file with the step response", "capture")
@@ -508,7 +514,18 @@ def _header_text(header) -> str:
 def identify_run(args) -> int:
     """``identify``'s action: a frequency-response table (:func:`frequency_table_header`)
     analysed and printed as ``identify-freq`` does, saying so (a first line, and
-    ``"format": "frequency-table"`` in the JSON); anything else through the step methods."""
+    ``"format": "frequency-table"`` in the JSON); anything else through the step methods.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``identify`` options.
+
+    Returns
+    -------
+    int
+        The exit status: 0 when done.
+    """
     from ..identify.report import bode_fit_plot, broadband_plot, broadband_text, fit_plot, freq_text, step_text
     header = frequency_table_header(args.capture)
     if header is None:
@@ -531,7 +548,18 @@ def identify_run(args) -> int:
 
 
 def identify_main(argv=None) -> int:
-    """Console entry point ``identify``."""
+    """Console entry point ``identify``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit status (see :func:`~designer.cli.common.run_cli`).
+    """
     return run_cli("identify", build_parser, identify_run, argv)
 
 
@@ -552,7 +580,13 @@ def _lower(text: str) -> str:
 
 
 def build_freq_parser() -> argparse.ArgumentParser:
-    """The ``identify-freq`` command line."""
+    """The ``identify-freq`` command line.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser of ``identify-freq``'s options.
+    """
     p = _parser("identify-freq", "identify-freq: plant models from a measured frequency response "
                 "(Bode table).",
                 freq_epilog(), "CSV table: frequency, gain[, phase]", "table")
@@ -582,7 +616,18 @@ def identify_table(args):
 
 
 def identify_freq_main(argv=None) -> int:
-    """Console entry point ``identify-freq``."""
+    """Console entry point ``identify-freq``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit status (see :func:`~designer.cli.common.run_cli`).
+    """
     from ..identify.report import bode_fit_plot, freq_text
     return run_cli("identify-freq", build_freq_parser,
                    lambda args: _run(args, identify_table, freq_text, bode_fit_plot), argv)

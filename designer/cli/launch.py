@@ -24,7 +24,18 @@ _REPORTS = {"plant": ("designer.plant.report",), "pid": ("designer.pid.report",)
 
 def draws(argv) -> bool:
     """Whether a command line will draw a sheet: not with ``--no-files`` (or an
-    abbreviation argparse accepts), ``--help`` or ``--version``."""
+    abbreviation argparse accepts), ``--help`` or ``--version``.
+
+    Parameters
+    ----------
+    argv : sequence of str
+        The command's arguments, without the program name.
+
+    Returns
+    -------
+    bool
+        True when the command will draw.
+    """
     for a in argv:
         if a in ("-h", "--help", "--version") or (len(a) > len("--no-") and "--no-files".startswith(a)):
             return False
@@ -55,38 +66,110 @@ def _run(prog: str, module: str, main: str, wing: str | None = None) -> int:
 
 
 def design_plant() -> int:
+    """Console script ``design-plant``: its main on ``sys.argv``, the sheet renderer forked first.
+
+    Returns
+    -------
+    int
+        The exit status when the command is stopped before its own handling
+        (an interruption); otherwise the process exits with the command's status.
+    """
     return _run("design-plant", "designer.cli.plant", "design_plant_main", "plant")
 
 
 def analyze_plant() -> int:
+    """Console script ``analyze-plant``: its main on ``sys.argv``, the sheet renderer forked first.
+
+    Returns
+    -------
+    int
+        The exit status when the command is stopped before its own handling
+        (an interruption); otherwise the process exits with the command's status.
+    """
     return _run("analyze-plant", "designer.cli.plant", "analyze_plant_main", "plant")
 
 
 def design_pid() -> int:
+    """Console script ``design-pid``: its main on ``sys.argv``, the sheet renderer forked first.
+
+    Returns
+    -------
+    int
+        The exit status when the command is stopped before its own handling
+        (an interruption); otherwise the process exits with the command's status.
+    """
     return _run("design-pid", "designer.cli.pid", "design_pid_main", "pid")
 
 
 def analyze_pid() -> int:
+    """Console script ``analyze-pid``: its main on ``sys.argv``, the sheet renderer forked first.
+
+    Returns
+    -------
+    int
+        The exit status when the command is stopped before its own handling
+        (an interruption); otherwise the process exits with the command's status.
+    """
     return _run("analyze-pid", "designer.cli.pid", "analyze_pid_main", "pid")
 
 
 def check_design() -> int:
+    """Console script ``check-design``: its main on ``sys.argv``.
+
+    Returns
+    -------
+    int
+        The exit status when the command is stopped before its own handling
+        (an interruption); otherwise the process exits with the command's status.
+    """
     return _run("check-design", "designer.cli.check", "check_design_main")
 
 
 def identify() -> int:
+    """Console script ``identify``: its main on ``sys.argv``.
+
+    Returns
+    -------
+    int
+        The exit status when the command is stopped before its own handling
+        (an interruption); otherwise the process exits with the command's status.
+    """
     return _run("identify", "designer.cli.identify", "identify_main")
 
 
 def identify_freq() -> int:
+    """Console script ``identify-freq``: its main on ``sys.argv``.
+
+    Returns
+    -------
+    int
+        The exit status when the command is stopped before its own handling
+        (an interruption); otherwise the process exits with the command's status.
+    """
     return _run("identify-freq", "designer.cli.identify", "identify_freq_main")
 
 
 def simulate_capture() -> int:
+    """Console script ``simulate-capture``: its main on ``sys.argv``.
+
+    Returns
+    -------
+    int
+        The exit status when the command is stopped before its own handling
+        (an interruption); otherwise the process exits with the command's status.
+    """
     return _run("simulate-capture", "designer.cli.capture", "simulate_capture_main")
 
 
 def design_filter() -> int:
+    """Console script ``design-filter``: its main on ``sys.argv``.
+
+    Returns
+    -------
+    int
+        The exit status when the command is stopped before its own handling
+        (an interruption); otherwise the process exits with the command's status.
+    """
     return _run("design-filter", "designer.cli.filter", "design_filter_main")
 
 
@@ -95,4 +178,12 @@ def analyze_filter() -> int:
 
 
 def make_prbs() -> int:
+    """Console script ``make-prbs``: its main on ``sys.argv``.
+
+    Returns
+    -------
+    int
+        The exit status when the command is stopped before its own handling
+        (an interruption); otherwise the process exits with the command's status.
+    """
     return _run("make-prbs", "designer.cli.prbs", "make_prbs_main")

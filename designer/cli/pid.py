@@ -65,6 +65,13 @@ def _r(key: str) -> str:
 
 
 def pid_parser():
+    """The ``design-pid`` command line.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser of ``design-pid``'s options.
+    """
     from ..core.process_text import FORMS_TEXT
     p = common.command_parser(
         "design-pid",
@@ -345,6 +352,18 @@ def _run(args) -> int:
 
 
 def design_pid_main(argv=None) -> int:
+    """Console entry point ``design-pid``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit status (see :func:`~designer.cli.common.run_cli`).
+    """
     return common.run_cli("design-pid", pid_parser, _run, argv)
 
 
@@ -366,6 +385,13 @@ failed (with --fail-on-check), 2 bad input (one line on stderr, nothing written)
 
 
 def analyze_pid_parser():
+    """The ``analyze-pid`` command line.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser of ``analyze-pid``'s options.
+    """
     p = common.command_parser(
         "analyze-pid",
         "Analyse the seed's six-op-amp PID controller as built from its parts, on its plant: the gains the parts "
@@ -438,6 +464,18 @@ ANALYZE_PARAMS = CIRCUIT_PARAMS + ("plant_fc_hz", "plant_zeta", "plant_json", "k
 
 
 def analyze_pid_main(argv=None) -> int:
+    """Console entry point ``analyze-pid``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit status (see :func:`~designer.cli.common.run_cli`).
+    """
     return common.run_cli("analyze-pid", analyze_pid_parser, _analyze, argv)
 
 

@@ -27,6 +27,13 @@ __all__ = ["analyze_plant_main", "analyze_plant_parser", "design_plant_main", "d
 
 
 def design_plant_parser():
+    """The ``design-plant`` command line.
+
+    Returns
+    -------
+    OneLineParser
+        The parser of ``design-plant``'s options.
+    """
     p = OneLineParser(
         prog="design-plant",
         description="Design a unity-gain (or gain K) Sallen-Key low-pass that realises the second-order plant "
@@ -502,6 +509,13 @@ def _emit(result, args, name) -> int:
 
 
 def analyze_plant_parser():
+    """The ``analyze-plant`` command line.
+
+    Returns
+    -------
+    OneLineParser
+        The parser of ``analyze-plant``'s options.
+    """
     p = OneLineParser(
         prog="analyze-plant",
         description="Analyse a Sallen-Key low-pass as built from its parts: fn, zeta and Q it really gives, step "
@@ -624,10 +638,34 @@ def _analyze(args) -> int:
 
 
 def design_plant_main(argv=None) -> int:
+    """Console entry point ``design-plant``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit status (see :func:`~designer.cli.common.run_cli`).
+    """
     return run_cli("design-plant", design_plant_parser, _design, argv)
 
 
 def analyze_plant_main(argv=None) -> int:
+    """Console entry point ``analyze-plant``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit status (see :func:`~designer.cli.common.run_cli`).
+    """
     return run_cli("analyze-plant", analyze_plant_parser, _analyze, argv)
 
 

@@ -67,6 +67,13 @@ exit status: 0 success, 2 bad input (one line on stderr saying what and why).
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``make-prbs`` command line.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser of ``make-prbs``'s options.
+    """
     p = OneLineParser(prog="make-prbs",
                       description="Write a pseudo-random binary sequence (maximum-length sequence) for a "
                                   "function generator and ngspice, to identify a plant by correlation.",
@@ -239,7 +246,18 @@ def run(args) -> int:
 
 
 def make_prbs_main(argv=None) -> int:
-    """Console entry point ``make-prbs``."""
+    """Console entry point ``make-prbs``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit status (see :func:`~designer.cli.common.run_cli`).
+    """
     return run_cli("make-prbs", build_parser, run, argv)
 
 
