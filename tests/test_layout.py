@@ -346,7 +346,8 @@ def test_the_api_check_fails_on_planted_gaps(tmp_path):
 #: numpydoc check covers: a growing list; identify, cli and web are being rewritten by other
 #: helpers of issue 26
 NUMPYDOC_PACKAGES = ["designer.core", "designer.spice", "designer.report", "designer.tolerance", "designer.check",
-                     "designer.plant", "designer.filters", "designer.pid", "designer.identify", "designer.cli"]
+                     "designer.plant", "designer.filters", "designer.pid", "designer.identify", "designer.cli",
+                     "designer.web"]
 #: numpydoc's checks of substance, not of style: a docstring (GL08) with a summary (SS01); for a function,
 #: every parameter documented (PR01), none that it does not have (PR02), a Returns section when it returns
 #: a value (RT01), the sections in numpydoc's order (GL07). A class needs a docstring with a summary (its

@@ -120,7 +120,20 @@ class PlantRequest(NamedTuple):
 
 
 def field_of(table: dict, param: str | None) -> str | None:
-    """The field of ``table`` that sets the library parameter ``param`` (None: no field)."""
+    """The field of ``table`` that sets the library parameter ``param`` (None: no field).
+
+    Parameters
+    ----------
+    table : dict
+        Field name -> field of a command's form.
+    param : str or None
+        A library parameter's name.
+
+    Returns
+    -------
+    str or None
+        The field's name.
+    """
     return next((k for k, f in table.items() if f.param == param), None)
 
 

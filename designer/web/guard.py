@@ -87,6 +87,17 @@ def origin_of(url: str) -> str:
     """``--allow-origin``'s URL as a browser writes an ``Origin``: ``scheme://host[:port]``, lowercase,
     the scheme's default port left out.
 
+    Parameters
+    ----------
+    url : str
+        A ``--allow-origin`` value.
+
+    Returns
+    -------
+    str
+        The origin.
+
+
     Raises
     ------
     DesignError
@@ -116,7 +127,23 @@ def _with_port(host: str, port: int) -> set:
 
 
 def trust_for(bind: str, port: int, allow_origins=()) -> Trust:
-    """The :class:`Trust` of a server bound to ``bind``:``port``, with ``--allow-origin`` URLs."""
+    """The :class:`Trust` of a server bound to ``bind``:``port``, with ``--allow-origin`` URLs.
+
+    Parameters
+    ----------
+    bind : str
+        The address the server listens on.
+    port : int
+        Its port.
+    allow_origins : iterable of str, optional
+        The ``--allow-origin`` URLs.
+
+    Returns
+    -------
+    Trust
+        Its port, its own Host names, the allowed origins and their Host names, and
+        whether the bind is a wildcard.
+    """
     origins = frozenset(origin_of(u) for u in allow_origins)
     hosts = set()
     try:
@@ -169,7 +196,24 @@ class _LocalAddresses:
 def error_response(code: int, line: str, field: str | None = None, label: str | None = None) -> JSONResponse:
     """An error answer: the one line, its message (the line without the command's name) and the option it
     names (for the page), as every refusal of the server is written; a library refusal already in the page's
-    words gives the ``field`` it names (``option`` is then ``--`` and the field) and that field's ``label``."""
+    words gives the ``field`` it names (``option`` is then ``--`` and the field) and that field's ``label``.
+
+    Parameters
+    ----------
+    code : int
+        The HTTP status.
+    line : str
+        The one-line error, as the command line writes it.
+    field : str, optional
+        The page's field the refusal names.
+    label : str, optional
+        That field's label.
+
+    Returns
+    -------
+    JSONResponse
+        ``error``, ``message`` and ``option`` (with ``field`` and ``label`` when given).
+    """
     import re
     line = " ".join(str(line).split())
     message = re.sub(r"^[a-z-]+: error: ", "", line)

@@ -213,7 +213,13 @@ def _lang_of(argv: list) -> str | None:
 def temporaries_in(folder: str | None):
     """Every temporary file of the block (the simulator's ``designer-sim-*``, ``ngspice -b``'s own,
     through ``TMPDIR``) made in ``folder`` (the request's private folder; None: where they were), so
-    that removing the folder removes them, a run killed at its deadline included."""
+    that removing the folder removes them, a run killed at its deadline included.
+
+    Parameters
+    ----------
+    folder : str or None
+        The request's private folder.
+    """
     if folder is None:
         yield
         return
@@ -320,7 +326,19 @@ def circuit_plant_page(result) -> dict:
     """A plant on a registered topology, for the page: its declared parts (designator, role, value), the Bode
     plot of both models (the section's transfer function with the parts as built, ideal and with the op-amp's
     model, evaluated on a grid as the sheet's plots are), the BOM and the sheet's content (the wiring, target
-    and achieved, sensitivities, alternatives); no schematic (the sheet has none yet)."""
+    and achieved, sensitivities, alternatives); no schematic (the sheet has none yet).
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design on a registered topology
+        (:func:`designer.plant.circuit_design.design_circuit_plant`).
+
+    Returns
+    -------
+    dict
+        The page's JSON-ready content.
+    """
     from ..plant import circuit_report as rep
     from ..report.document import to_html
     from ..report.wiring import BOM_HEADER, bom_csv
@@ -456,7 +474,18 @@ def identify_page(result) -> dict:
     """The data with the best three valid models over them (a step capture: time
     since the step; a frequency table: gain and phase against frequency; a
     broadband capture, PRBS or noise: the step its impulse estimate integrates
-    to, and its spectral estimate's gain, each with its own ranking's models)."""
+    to, and its spectral estimate's gain, each with its own ranking's models).
+
+    Parameters
+    ----------
+    result : IdentifyResult, FreqIdentifyResult or BroadbandResult
+        The identification.
+
+    Returns
+    -------
+    dict
+        The page's JSON-ready content (``kind`` and its plots).
+    """
     if hasattr(result, "excitation"):
         return _broadband_page(result)
     shown = [m for m in result.methods if m.valid][:3]
@@ -518,7 +547,18 @@ def _on_grid(x_data, y_data, grid) -> np.ndarray:
 
 def plant_page(result) -> dict:
     """A plant design's page: step (SPICE, both analytic models, the tolerance
-    band) and Bode (both models, SPICE's .ac points), schematic, BOM, bench."""
+    band) and Bode (both models, SPICE's .ac points), schematic, BOM, bench.
+
+    Parameters
+    ----------
+    result : PlantResult
+        The Sallen-Key plant's design or analysis.
+
+    Returns
+    -------
+    dict
+        The page's JSON-ready content.
+    """
     from ..core.lti import freq_response
     from ..plant import report as rep
     from ..report.document import to_html
@@ -579,7 +619,18 @@ def checks_shown(checks) -> list:
 def pid_page(result) -> dict:
     """A loop's page: the closed-loop step (SPICE, the analytic loop, the ideal
     PID, the plant alone), the loop gain, the schematic and the build sheet
-    without its pictures (verdict, BOM, settings, wiring, block checks)."""
+    without its pictures (verdict, BOM, settings, wiring, block checks).
+
+    Parameters
+    ----------
+    result : PidResult
+        The loop's design or analysis.
+
+    Returns
+    -------
+    dict
+        The page's JSON-ready content.
+    """
     from ..report.document import to_html
     from ..pid import report as rep
     open_loop = result.model is None or not result.model.integrating
@@ -604,7 +655,20 @@ def filter_page(sheet, mc=None) -> dict:
     has it: the Bode plot of the chosen parts with the op-amp's model, the bench band of the builds and the mask
     (its forbidden edges: the largest loss over the passband, the least attenuation over the stopband), the
     stages with their op-amp checks, the schematic, the BOM and the sheet's content; ``mc`` a Monte Carlo
-    against the mask (:class:`designer.tolerance.filter.FilterMonteCarlo`) for the histograms."""
+    against the mask (:class:`designer.tolerance.filter.FilterMonteCarlo`) for the histograms.
+
+    Parameters
+    ----------
+    sheet : FilterSheet
+        The filter design's sheet.
+    mc : FilterMonteCarlo, optional
+        The Monte Carlo against the mask.
+
+    Returns
+    -------
+    dict
+        The page's JSON-ready content.
+    """
     from ..filters.registry import get as get_topology
     from ..report.document import to_html
     from ..report.wiring import BOM_HEADER, bom_csv
@@ -667,7 +731,18 @@ def _schematic_svg(rep, result, key) -> str:
 def histograms(mc) -> list:
     """A Monte Carlo's histograms for the page, as the sheet draws them (:mod:`designer.report.tolerance`: the
     headline figure's, then each limited figure's; 2 sqrt(n) bins, 10 to 60): each figure's bin edges and counts,
-    its nominal value and its limits; none without a Monte Carlo (or one build replayed)."""
+    its nominal value and its limits; none without a Monte Carlo (or one build replayed).
+
+    Parameters
+    ----------
+    mc : object or None
+        The Monte Carlo result.
+
+    Returns
+    -------
+    list of dict
+        Per figure: ``figure``, ``edges``, ``counts``, ``nominal``, ``min``, ``max``, ``n``.
+    """
     if mc is None or (hasattr(mc, "headline") and mc.headline is None):
         return []
     headline = getattr(mc, "headline", None)   # a filter's Monte Carlo has none: its limited figures alone
@@ -763,7 +838,20 @@ def _list(a) -> list:
 
 def bundle_zip(tmp: str, name: str) -> bytes:
     """The files design-plant (or design-pid) wrote under ``tmp``, as a zip in
-    memory: ``reports/<name>/...`` and ``netlists/<name>.cir``."""
+    memory: ``reports/<name>/...`` and ``netlists/<name>.cir``.
+
+    Parameters
+    ----------
+    tmp : str
+        The run's folder.
+    name : str
+        The design's name.
+
+    Returns
+    -------
+    bytes
+        The zip file's content.
+    """
     import zipfile
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
@@ -776,7 +864,18 @@ def bundle_zip(tmp: str, name: str) -> bytes:
 
 def check_files(tmp: str) -> dict:
     """check-design's files of one run in ``tmp``: the JUnit XML, the Markdown
-    summary and each spec's result.json (as check-design writes them)."""
+    summary and each spec's result.json (as check-design writes them).
+
+    Parameters
+    ----------
+    tmp : str
+        The run's folder.
+
+    Returns
+    -------
+    dict
+        ``json`` (``{"specs": [...]}``), ``junit`` and ``summary`` (None when not written).
+    """
     out = os.path.join(tmp, "out")
     results = []
     if os.path.isdir(out):
@@ -792,7 +891,18 @@ def check_files(tmp: str) -> dict:
 
 
 def files_in(folder: str) -> dict:
-    """Every file under ``folder``: its path relative to it (``/``-separated) -> (size, modification time)."""
+    """Every file under ``folder``: its path relative to it (``/``-separated) -> (size, modification time).
+
+    Parameters
+    ----------
+    folder : str
+        The folder.
+
+    Returns
+    -------
+    dict
+        Relative path -> (size in bytes, modification time in ns).
+    """
     out = {}
     for base, _dirs, names in os.walk(folder):
         for name in names:
@@ -804,7 +914,20 @@ def files_in(folder: str) -> dict:
 
 def written_since(folder: str, before: dict) -> dict:
     """The files under ``folder`` made or changed since ``before`` (:func:`files_in`): relative path -> text
-    (what check-design ``--update-golden`` recorded: the golden waveforms, CSV)."""
+    (what check-design ``--update-golden`` recorded: the golden waveforms, CSV).
+
+    Parameters
+    ----------
+    folder : str
+        The folder.
+    before : dict
+        :func:`files_in` of the folder before the run.
+
+    Returns
+    -------
+    dict
+        Relative path -> text.
+    """
     return {rel: _read(os.path.join(folder, *rel.split("/"))).decode("utf-8", "replace")
             for rel, stamp in sorted(files_in(folder).items()) if before.get(rel) != stamp}
 

@@ -113,7 +113,13 @@ def split_language(options):
 
 def check_value(value) -> None:
     """Refuse (one line) JSON nested deeper than :data:`MAX_DEPTH` or holding a text
-    that is no Unicode (a lone surrogate): every later step may then write and print it."""
+    that is no Unicode (a lone surrogate): every later step may then write and print it.
+
+    Parameters
+    ----------
+    value : object
+        The request's decoded JSON.
+    """
     todo = [(value, 1)]
     while todo:
         v, depth = todo.pop()
@@ -130,7 +136,18 @@ def check_value(value) -> None:
 
 
 def check_text(text: str) -> str:
-    """``text`` when it encodes as UTF-8, else a one-line refusal naming where it breaks."""
+    """``text`` when it encodes as UTF-8, else a one-line refusal naming where it breaks.
+
+    Parameters
+    ----------
+    text : str
+        A text of the request.
+
+    Returns
+    -------
+    str
+        ``text`` unchanged.
+    """
     try:
         text.encode("utf-8")
     except UnicodeEncodeError as exc:
@@ -140,7 +157,18 @@ def check_text(text: str) -> str:
 
 
 def option_name(key) -> str:
-    """``"r_series"`` -> ``"--r-series"``, after checking it is an option's name at all."""
+    """``"r_series"`` -> ``"--r-series"``, after checking it is an option's name at all.
+
+    Parameters
+    ----------
+    key : str
+        A field or option name of the request.
+
+    Returns
+    -------
+    str
+        The option, ``--`` and the name.
+    """
     name = str(key).strip().lstrip("-").replace("_", "-").lower()
     if not _KEY.match(name):
         raise DesignError(f"{str(key)[:60]!r} is not an option name (letters, digits and dashes, as --help lists "
@@ -165,6 +193,11 @@ def build_argv(options: dict, tmp: str | None, traits: "Traits | None" = None) -
     traits : Traits, optional
         The command's options (:func:`parser_traits`): only those, spelt out in full (argparse
         would take ``--o`` for ``--out``), each with the values it takes. None: any name.
+
+    Returns
+    -------
+    list of str
+        The command's arguments.
     """
     if not isinstance(options, dict):
         raise DesignError("the request's body must be a JSON object of option names and values, " + _FORM_EXAMPLE)
@@ -248,7 +281,24 @@ def value_text(value, opt: str) -> str:
 
 def write_content(tmp: str | None, name: str, value, opt: str) -> str:
     """A file option's content (text, or a JSON object or list written as JSON) in the
-    request's folder; returns its path."""
+    request's folder; returns its path.
+
+    Parameters
+    ----------
+    tmp : str or None
+        The request's folder (None: the request takes no files).
+    name : str
+        The file's name.
+    value : str, dict or list
+        The content.
+    opt : str
+        The option, for messages.
+
+    Returns
+    -------
+    str
+        The file's path.
+    """
     if tmp is None:
         raise DesignError(f"{opt} is not taken by this request")
     if isinstance(value, (dict, list)):
@@ -273,7 +323,19 @@ class Traits(NamedTuple):
 
 
 def parser_traits(parser) -> Traits:
-    """The :class:`Traits` of an argparse parser."""
+    """The :class:`Traits` of an argparse parser.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        A command's parser.
+
+    Returns
+    -------
+    Traits
+        Its switches, appended, multi-valued and known options, and the number of
+        values of each option that takes a fixed number above 1.
+    """
     import argparse
     switches, appended, multi, known, nargs = set(), set(), set(), set(), {}
     for action in parser._actions:   # argparse has no public list of its actions

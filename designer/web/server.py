@@ -73,7 +73,18 @@ def _whole(text, option: str, lo: int, hi: int) -> int:
 
 
 def is_local(host: str) -> bool:
-    """Whether ``host`` is a loopback address (only this machine can connect)."""
+    """Whether ``host`` is a loopback address (only this machine can connect).
+
+    Parameters
+    ----------
+    host : str
+        A host name or address.
+
+    Returns
+    -------
+    bool
+        True for ``localhost`` or a loopback address.
+    """
     if host == "localhost":
         return True
     try:
@@ -83,7 +94,20 @@ def is_local(host: str) -> bool:
 
 
 def exposure_warning(host: str, port: int) -> str | None:
-    """The line said at start-up when ``host`` lets other machines in (None for a loopback address)."""
+    """The line said at start-up when ``host`` lets other machines in (None for a loopback address).
+
+    Parameters
+    ----------
+    host : str
+        The address the server listens on.
+    port : int
+        Its port.
+
+    Returns
+    -------
+    str or None
+        The warning line.
+    """
     if is_local(host):
         return None
     return (f"designer-web: warning: {host} is not this machine's loopback address: anyone who can reach port {port} "
@@ -159,7 +183,18 @@ def _serve_in(args, port: int, jobs: int, timeout: int, recycle: int, allowed: l
 
 
 def main(argv=None) -> int:
-    """Console entry point ``designer-web``."""
+    """Console entry point ``designer-web``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit status (see :func:`~designer.cli.common.run_cli`).
+    """
     return run_cli("designer-web", _parser, _serve, argv)
 
 
