@@ -468,7 +468,7 @@ def sections(data: FilterSheet, with_images: bool = True, schematic_svg: str = "
               | {a.out for a in b.netlist.amps}}
     first = [R.subhead(_("Bill of materials")),
              R.table([_("Ref"), _("Value"), _("Code"), _("Qty"), _("Series"), _("Tol."), _("Package")],
-                     [x[:7] for x in bom(r, b)], "compact"),
+                     [[*x[:6], _(x[6])] for x in bom(r, b)], "compact"),   # the package in the sheet's words
              R.text(_("Supplies {vcc} V and {vee} V. Set the generator's output to High-Z.").format(
                  vcc=f"{op.vcc:+g}", vee=f"{op.vee:+g}"))]
     # the cascade is wider than the plant: its schematic takes the page's width, the parts list follows
