@@ -861,7 +861,8 @@ PAGE_WORDS = """(left) => {
 LIBRARY_TEXT = {"/plant": [], "/pid": ["#sheet-html"], "/identify": ["#methods td:nth-child(7)"], "/check": [],
                 "/filter": [],
                 # a registered section's plant: its sheet (designer.plant.circuit_report), title and SPICE check's
-                # detail are the library's English; its parts' roles and its title are taken out of the texts below
+                # detail are the library's English; its parts' roles and its title (the registry's, on every
+                # Plant page) are taken out of the texts by _library_names
                 "/plant?topology=mfb-lowpass": ["#sheet-html", "#title", "#checks td:nth-child(3)"]}
 
 
@@ -870,11 +871,13 @@ FILTER_MASK_MC = "/filter?family=chebyshev&passband=3k&max-loss=1&stopband=12k&m
 
 
 def _library_names(path) -> list:
-    """The registered section's own names a page shows as the library has them (its title, its parts' roles)."""
+    """The registered section's own names a page shows as the library has them (its title, its parts' roles):
+    the Plant page's section (the seed's when none is asked) lists its parts' roles."""
     from designer.filters import registry
-    topology = dict(re.findall(r"(\w+)=([\w-]+)", path)).get("topology")
-    if topology is None:
+    from designer.plant.circuit import DEFAULT_TOPOLOGY
+    if not path.startswith("/plant"):
         return []
+    topology = dict(re.findall(r"(\w+)=([\w-]+)", path)).get("topology", DEFAULT_TOPOLOGY)
     topo = registry.get(topology)
     return sorted([topo.title, *(p.role for p in topo.parts)], key=len, reverse=True)
 
