@@ -26,6 +26,7 @@ import numpy as np
 
 from ..core.i18n import N_
 from ..core.i18n import gettext as _
+from ..core.i18n import localise
 from ..core.units import format_eng
 from ..report import document as R
 from ..report.plots import figure, log_frequency_axis, png_bytes, step_plot
@@ -190,10 +191,12 @@ def draw_cascade(b, result, sheet: Sheet | None = None) -> Sheet:
             y = y - row_h
             row_h = max(heights[i:i + 2])
         x0 = col * width
-        q = f"Q {st.plan.q:.3g}" if st.plan.q else "first order"
-        s.text((x0, y + 3.9), f"Stage {st.number}: {st.topology}", size=1.05, halign="left")
-        s.text((x0, y + 2.9), f"fn {format_eng(st.plan.fn_hz, 'Hz', 4)}, {q}, gain {st.gain:.3g}", size=0.95,
-               halign="left")
+        # the labels in the sheet's language (the page draws this schematic too), numbers as it writes them
+        q = f"Q {st.plan.q:.3g}" if st.plan.q else _("first order")
+        s.text((x0, y + 3.9), _("Stage {number}: {topology}").format(number=st.number, topology=st.topology),
+               size=1.05, halign="left")
+        s.text((x0, y + 2.9), localise(_("fn {fn}, {q}, gain {gain}").format(
+            fn=format_eng(st.plan.fn_hz, 'Hz', 4), q=q, gain=f"{st.gain:.3g}")), size=0.95, halign="left")
         # the drawing's extent: matplotlib crops the picture to its elements, not to the labels' text
         s.d.add(elm.Line().at((x0 - 0.6, y + 4.5)).to((x0 + width - 0.6, y + 4.5)).color("white"))
         mine = [p for p in parts if p.ref[1:-1] == f"{st.number}0"]

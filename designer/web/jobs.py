@@ -48,8 +48,8 @@ from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
 
 __all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACES", "TRACE_POINTS",
-           "Superseded", "bundle_zip", "check_files", "checks_shown", "circuit_plant_page", "design_filter_task",
-           "design_plant_task", "files_in", "filter_page", "histograms", "identify_page", "pid_page", "plant_page",
+           "Superseded", "bom_shown", "bundle_zip", "check_files", "checks_shown", "circuit_plant_page",
+           "design_filter_task", "design_plant_task", "files_in", "filter_page", "histograms", "identify_page", "pid_page", "plant_page",
            "run", "run_task", "series_text", "temporaries_in", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
@@ -341,7 +341,6 @@ def circuit_plant_page(result) -> dict:
     """
     from ..plant import circuit_report as rep
     from ..report.document import to_html
-    from ..report.wiring import BOM_HEADER, bom_csv
     topo, amp = result.section, result.opamp
     fn = result.figures["opamp"]["fn_hz"]
     f = np.geomspace(fn / 100, fn * 100, BODE_POINTS)
@@ -350,8 +349,8 @@ def circuit_plant_page(result) -> dict:
     bom = rep.bom(result)
     return {"parts": [{"ref": p.ref, "role": p.role, "value": result.values[p.ref], "kind": p.kind}
                       for p in topo.parts],
-            "bode": _bode(f, resp), "histograms": histograms(result.monte_carlo),
-            "bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
+            "bode": _bode(f, resp), "histograms": histograms(result.monte_carlo), **bom_shown(bom),
+            "checks": checks_shown(result.checks),
             "sheet_html": to_html(rep.title_of(result), rep.sections(result), {}), "title": rep.title_of(result)}
 
 
@@ -562,7 +561,7 @@ def plant_page(result) -> dict:
     from ..core.lti import freq_response
     from ..plant import report as rep
     from ..report.document import to_html
-    from ..report.wiring import BOM_HEADER, bench_rows, bom_csv
+    from ..report.wiring import bench_rows
     a = result.test.amplitude_v
     amp = result.opamp.name
     step = {}
@@ -588,11 +587,7 @@ def plant_page(result) -> dict:
     return {"step": _trace(result.time_s, step, "time from the edge (s)"),
             "bode": _bode(f, resp), "histograms": histograms(result.monte_carlo),
             "schematic_svg": _schematic_svg(rep, result, (result.built.as_dict(), result.package)),
-            "bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
-            # the table as the page's language writes it: its columns, the packages' names, the numbers
-            "bom_header": [_(h) for h in BOM_HEADER],
-            "bom_text": [[localise(_(c)) if isinstance(c, str) and c else c for c in row] for row in bom],
-            "bench": [[localise(c) for c in row] for row in bench],
+            **bom_shown(bom), "bench": [[localise(c) for c in row] for row in bench],
             "checks": checks_shown(result.checks),
             # the sheet's content (wiring, expected readings and their band, target and achieved, sensitivity,
             # alternatives) without its pictures: the page draws those itself
@@ -614,6 +609,26 @@ def checks_shown(checks) -> list:
         ``{"id", "title", "ok", "detail"}`` per check.
     """
     return [{"id": c.id, "title": _(c.title), "ok": bool(c.ok), "detail": localise(c.shown())} for c in checks]
+
+
+def bom_shown(bom) -> dict:
+    """A bill of materials for the page: its rows as bom.csv has them (English columns: programs read it) and as
+    the page's language writes them (its columns, the packages' names, the numbers).
+
+    Parameters
+    ----------
+    bom : list of list
+        The rows (:data:`designer.report.wiring.BOM_HEADER`'s columns).
+
+    Returns
+    -------
+    dict
+        ``bom`` (``header``, ``rows``), ``bom_csv``, ``bom_header`` and ``bom_text`` (in the current language).
+    """
+    from ..report.wiring import BOM_HEADER, bom_csv
+    return {"bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
+            "bom_header": [_(h) for h in BOM_HEADER],
+            "bom_text": [[localise(_(c)) if isinstance(c, str) and c else c for c in row] for row in bom]}
 
 
 def pid_page(result) -> dict:
@@ -671,7 +686,6 @@ def filter_page(sheet, mc=None) -> dict:
     """
     from ..filters.registry import get as get_topology
     from ..report.document import to_html
-    from ..report.wiring import BOM_HEADER, bom_csv
     rep = filter_report
     r, bench = sheet.design, sheet.bench
     s = r.spec
@@ -704,7 +718,7 @@ def filter_page(sheet, mc=None) -> dict:
                                "phase": _trace(f, phase, "frequency (Hz)", log_x=True)},
                       "stages": stages, "histograms": histograms(mc),
                       "schematic_svg": rep.schematic(sheet).svg(),
-                      "bom": {"header": list(BOM_HEADER), "rows": bom}, "bom_csv": bom_csv(bom),
+                      **bom_shown(bom),
                       "sheet_html": to_html(rep.title_of(r), rep.sections(sheet, with_images=False), {}),
                       "title": rep.title_of(r)})
 
@@ -803,8 +817,10 @@ BOM_COLUMNS = (N_("Ref"), N_("Value"), N_("Code"), N_("Qty"), N_("Series"), N_("
 AXES = (N_("time from the edge (s)"), N_("frequency (Hz)"), N_("time since the step (s)"), N_("time (s)"))
 TRACES = (N_("SPICE (ngspice)"), N_("analytic (ideal op-amp)"), N_("tolerance band low"), N_("tolerance band high"),
           N_("ideal op-amp"), N_("SPICE .ac"), N_("ideal PID, ideal plant"), N_("plant alone (open loop)"),
-          N_("loop gain L(jw)"), N_("data"), N_("integrated impulse response"))
+          N_("loop gain L(jw)"), N_("data"), N_("integrated impulse response"), N_("mask: largest passband loss"),
+          N_("mask: least stopband attenuation"))
 _TRACE_PATTERNS = ((r"analytic \((?P<name>.+) model\)", N_("analytic ({name} model)")),
+                   (r"chosen parts, (?P<name>.+) model", N_("chosen parts, {name} model")),
                    (r"realised loop, analytic \((?P<name>.+)\)", N_("realised loop, analytic ({name})")),
                    (r"(?P<name>\S+) model", N_("{name} model")))
 

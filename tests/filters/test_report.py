@@ -176,3 +176,24 @@ def test_the_spanish_sheet_leaves_no_english_message(key, tmp_path):
     assert "Target and achieved" in en and "Prueba" not in en
     bom_en, bom_es = ((r / "bom.csv").read_text().splitlines() for r in (rep_en, rep))
     assert bom_en[0] == bom_es[0] and len(bom_en) == len(bom_es)
+
+
+def test_the_spanish_sheet_names_the_package_and_the_schematics_stages_in_spanish():
+    """Issue 29 (the Filter page in Spanish): the sheet's BOM gives the op-amp's package in the sheet's language,
+    and the schematic's stage labels (the page draws it too) are the catalogue's, numbers with a decimal comma;
+    in English both stay the code's own text."""
+    import re
+
+    from designer.core.i18n import catalogue, language
+    from designer.filters.report import schematic, title_of
+    es = catalogue("es")
+    r = design(FilterSpec(**SPECS["sk-hp3-single"]), simulate=False)   # order 3: a first-order stage; DIP-8 single
+    sheet = sheet_of(r)
+    for lang, words, point in (("es", es, ","), ("en", {}, ".")):
+        with language(lang):
+            text = to_text(title_of(r), sections(sheet, with_images=False))
+            svg = schematic(sheet).svg()
+        t = {m: words.get(m, m) for m in ("DIP-8 single", "first order", "Stage {number}: {topology}")}
+        assert t["DIP-8 single"] in text
+        assert t["first order"] in svg and t["Stage {number}: {topology}"].format(number=1, topology="") in svg
+        assert re.search(rf"fn \d+[{point}]\d+ Hz, Q 0[{point}]\d+", svg), svg

@@ -105,3 +105,29 @@ def test_a_cancel_landing_in_an_at_fork_hook_waits_until_it_returns(monkeypatch)
         signal.signal(signal.SIGALRM, before)
     with pytest.raises(jobs.Superseded):
         jobs._cancel(signal.SIGUSR1, sys._getframe())
+
+
+@pytest.mark.spice
+def test_the_filter_and_circuit_plant_pages_speak_the_requests_language():
+    """Issue 29: /api/filter and a plant on a menu's section answer in the request's language: the BOM's columns
+    and packages (bom.csv keeps its English), the Bode traces (their English label kept), the checks' titles;
+    English without a language."""
+    from designer.core.i18n import catalogue, language, localise
+    from designer.report.wiring import BOM_HEADER
+    es = catalogue("es")
+    for lang, words in (("es", es), (None, {})):
+        ask = {"lang": lang} if lang else {}
+        f = jobs.design_filter_task({"order": 3, "fc": 1000, "no-sim": True, **ask}, "page")
+        c = jobs.design_plant_task({"fc": 3500, "zeta": 0.2, "topology": "mfb-lowpass", **ask}, "page")   # SPICE checks
+        assert f["status"] == 0 and c["status"] == 0, (f["error"], c["error"])
+        for page in (f["page"], c["page"]):
+            assert page["bom"]["header"] == list(BOM_HEADER) and page["bom_csv"].startswith(",".join(BOM_HEADER[:3]))
+            assert page["bom_header"] == [words.get(h, h) for h in BOM_HEADER]
+            packages = {row[6] for row in page["bom"]["rows"]}
+            with language(lang or "en"):   # the numbers as the language writes them: 0,25 W
+                assert {localise(words.get(p, p)) for p in packages} == {row[6] for row in page["bom_text"]}
+        trace = f["page"]["bode"]["gain"]["series"][0]
+        assert trace["label"] == "chosen parts, LM741 model"
+        assert trace["text"] == words.get("chosen parts, {name} model", "chosen parts, {name} model").format(name="LM741")
+        shown = {ch["id"]: ch["title"] for ch in c["page"]["checks"]}
+        assert shown == {"spice_agreement": words.get("SPICE agreement", "SPICE agreement")}

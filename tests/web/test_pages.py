@@ -858,7 +858,28 @@ PAGE_WORDS = """(left) => {
 #: what the library still writes in English that the walk leaves out, by page: the PID's build sheet (its slew and
 #: phase-margin details, the tuning rules' notes) and identify's method notes; everything else is walked (the
 #: page's own words, figures, plots' text, check titles and details, the plant's whole sheet)
-LIBRARY_TEXT = {"/plant": [], "/pid": ["#sheet-html"], "/identify": ["#methods td:nth-child(7)"], "/check": []}
+LIBRARY_TEXT = {"/plant": [], "/pid": ["#sheet-html"], "/identify": ["#methods td:nth-child(7)"], "/check": [],
+                "/filter": [],
+                # a registered section's plant: its sheet (designer.plant.circuit_report), title and SPICE check's
+                # detail are the library's English; its parts' roles and its title (the registry's, on every
+                # Plant page) are taken out of the texts by _library_names
+                "/plant?topology=mfb-lowpass": ["#sheet-html", "#title", "#checks td:nth-child(3)"]}
+
+
+#: the Filter page on a mask (its edges drawn on the Bode plot) with the tolerance panel's Monte Carlo against it
+FILTER_MASK_MC = "/filter?family=chebyshev&passband=3k&max-loss=1&stopband=12k&min-attenuation=40&monte-carlo=200"
+
+
+def _library_names(path) -> list:
+    """The registered section's own names a page shows as the library has them (its title, its parts' roles):
+    the Plant page's section (the seed's when none is asked) lists its parts' roles."""
+    from designer.filters import registry
+    from designer.plant.circuit import DEFAULT_TOPOLOGY
+    if not path.startswith("/plant"):
+        return []
+    topology = dict(re.findall(r"(\w+)=([\w-]+)", path)).get("topology", DEFAULT_TOPOLOGY)
+    topo = registry.get(topology)
+    return sorted([topo.title, *(p.role for p in topo.parts)], key=len, reverse=True)
 
 
 def _words_on(pg, left=()) -> list:
@@ -866,25 +887,36 @@ def _words_on(pg, left=()) -> list:
 
 
 @pytest.mark.parametrize("lang", ["es", "en"])
-@pytest.mark.parametrize("path", ["/plant", "/pid", "/identify", "/check"])
+@pytest.mark.parametrize("path", ["/plant", "/plant?topology=mfb-lowpass", "/pid", "/filter", FILTER_MASK_MC,
+                                  "/identify", "/check"])
 def test_every_page_in_each_language_shows_none_of_the_other(browser, server, path, lang):
     """Issue 29: the Spanish page shows no English string (the catalogue's English words that no translation
     uses), numbers with a decimal comma; the English page none of the Spanish ones. The plant and PID pages with
-    their first design drawn (figures, plots' text, checks, the build sheet), Identify with a capture identified."""
+    their first design drawn (figures, plots' text, checks, the build sheet), the Plant page on a section of its
+    topology menu (its part list, the generic pipeline's figures), the Filter page with its stages table and
+    build sheet, on a mask with its tolerance panel too, Identify with a capture identified."""
+    from designer.core.i18n import catalogue
     english, spanish = vocabulary()
     context = browser.new_context(viewport={"width": 1400, "height": 1400}, locale="en-US")
     pg = context.new_page()
     try:
-        open_page(pg, server, f"{path}?lang={lang}")
+        open_page(pg, server, f"{path}{'&' if '?' in path else '?'}lang={lang}")
         if path == "/identify":   # once the page is wired (its catalogue and menus loaded)
             pg.wait_for_selector("select[name=format] option:nth-child(2)", state="attached")
             assert after(pg, lambda: pg.set_input_files("#file", str(SYNTHETIC_TEK))) == "done"
         pg.wait_for_function("() => document.documentElement.lang !== ''")
-        texts = _words_on(pg, LIBRARY_TEXT[path])
+        texts = _words_on(pg, LIBRARY_TEXT.get(path, LIBRARY_TEXT[path.split("?")[0]]))
+        for name in _library_names(path):
+            texts = [t.replace(name, " ") for t in texts]
         assert pg.evaluate("document.documentElement.lang") == lang
+        if path == FILTER_MASK_MC:   # the tolerance panel and the mask's edges are on the page walked
+            assert pg.locator("#tolerance-section").is_visible() and pg.locator(".histogram-figure").count() > 0
+            mask = "mask: largest passband loss"
+            assert mask in pg.get_attribute("#bode-gain", "data-series").split("|")
+            assert any((catalogue("es")[mask] if lang == "es" else mask) in t for t in texts)
         left = foreign(texts, english if lang == "es" else spanish)
         assert not left, "\n".join(f"{words}: {text!r}" for text, words in left)
-        if lang == "es" and path in ("/plant", "/pid"):
+        if lang == "es" and path.split("?")[0] in ("/plant", "/pid", "/filter"):
             figures = pg.locator("#figures .figure b").all_inner_texts()
             assert any(re.search(r"\d,\d", f) for f in figures) and not any(re.search(r"\d\.\d", f) for f in figures), figures
     finally:

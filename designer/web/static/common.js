@@ -93,7 +93,7 @@ D.cancel = function (channel) {
   if (channels[channel]) { channels[channel].abort(); delete channels[channel]; }
 };
 // the commands that write a sheet answer in the page's language (their --lang)
-D.SPEAKS = /^\/api\/(plant|pid)(\/|\?|$)/;
+D.SPEAKS = /^\/api\/(plant|pid|filter)(\/|\?|$)/;
 D.api = async function (path, body, asBlob, channel) {
   if (D.lang !== "en" && D.SPEAKS.test(path) && body && body.constructor === Object) body = {...body, lang: D.lang};
   const init = {method: "POST", headers: {"X-Designer": "1"}};
@@ -443,6 +443,11 @@ D.fig = function (label, value) {
   d.querySelector("b").textContent = value;
   d.querySelector("span").textContent = label;
   return d;
+};
+
+// A design's bill of materials as the page's language writes it (the answer's bom_text), its first 7 columns.
+D.bomTable = function (p) {
+  return D.table((p.bom_header || p.bom.header).slice(0, 7), (p.bom_text || p.bom.rows).map(x => x.slice(0, 7)));
 };
 
 D.checksTable = function (checks) {

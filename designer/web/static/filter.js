@@ -56,7 +56,7 @@ function show(answer) {
     })));
   D.schematic(document.getElementById("schematic"), p.schematic_svg,
               D.t("schematic: {parts}", {parts: p.bom.rows.map(x => `${x[0]} ${x[1]}`).join(", ")}));
-  document.getElementById("bomtable").replaceChildren(D.table(p.bom.header.slice(0, 7), p.bom.rows.map(x => x.slice(0, 7))));
+  document.getElementById("bomtable").replaceChildren(D.bomTable(p));
   D.tolerance(r.monte_carlo, p.histograms);
   const t = r.monte_carlo && r.monte_carlo.tighten;
   document.getElementById("tighten-stage").textContent = t && t.stage_yield > t.yield_now

@@ -41,8 +41,8 @@ function showCircuit(answer) {
     D.t("{title}: the parts and their wiring are in the build sheet below.", {title: r.topology_title})}));
   const open = sch.parentElement.querySelector(".open-full");
   if (open) open.remove();
-  document.getElementById("bomtable").replaceChildren(D.table(p.bom.header.slice(0, 7), p.bom.rows.map(x => x.slice(0, 7))));
-  document.getElementById("checks").replaceChildren(D.checksTable(r.checks));
+  document.getElementById("bomtable").replaceChildren(D.bomTable(p));
+  document.getElementById("checks").replaceChildren(D.checksTable(p.checks || r.checks));
   D.tolerance(r.monte_carlo, p.histograms);
   D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
   D.plot(document.getElementById("bode-gain"), p.bode.gain, {xUnit: "Hz", yLabel: D.t("gain (dB)"), height: 240});
@@ -73,7 +73,7 @@ function show(answer) {
   D.schematic(document.getElementById("schematic"), p.schematic_svg,
               D.t("schematic: {parts}", {parts: p.bom.rows.map(x => `${x[0]} ${D.localNum(x[1])}`).join(", ")}));
   document.getElementById("bench").replaceChildren(D.table([D.t("set"), D.t("to")], p.bench));
-  document.getElementById("bomtable").replaceChildren(D.table((p.bom_header || p.bom.header).slice(0, 7), (p.bom_text || p.bom.rows).map(x => x.slice(0, 7))));
+  document.getElementById("bomtable").replaceChildren(D.bomTable(p));
   document.getElementById("checks").replaceChildren(D.checksTable(p.checks || r.checks));
   D.tolerance(r.monte_carlo, p.histograms);
   D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
