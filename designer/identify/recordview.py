@@ -49,8 +49,8 @@ class ModelTrace:
 
     @property
     def label(self) -> str:
-        """``route method (model), fit F %``: what the plots' legends say."""
-        return f"{self.route} {self.name} ({self.kind}), fit {self.fit_percent:.1f} %"
+        """``route method (model), validation fit F %``: what the plots' legends say."""
+        return f"{self.route} {self.name} ({self.kind}), validation fit {self.fit_percent:.1f} %"
 
 
 @dataclass(frozen=True)

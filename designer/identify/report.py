@@ -13,7 +13,8 @@ import numpy as np
 from ..core.units import format_eng
 from ..report.plots import png_bytes
 
-__all__ = ["bode_fit_plot", "broadband_plot", "broadband_text", "fit_plot", "freq_text", "record_axes", "step_text"]
+__all__ = ["bode_fit_plot", "broadband_plot", "broadband_text", "fit_plot", "freq_text", "ranked_candidates", "record_axes",
+           "step_text"]
 
 
 def format_params(p: dict, corners: bool = False) -> str:
@@ -120,6 +121,22 @@ def _verdict(c) -> str:
     return f"{'white' if w.inside else f'{w.worst:.1f}x'}/{'ok' if x.inside else f'{x.worst:.1f}x'}"
 
 
+def ranked_candidates(a) -> list:
+    """The candidates of an :class:`~.assess.Assessment` as its tables list them:
+    the valid ones first, each group by validation fit, the best first.
+
+    Parameters
+    ----------
+    a : Assessment
+
+    Returns
+    -------
+    list of Candidate
+    """
+    return sorted(a.candidates, key=lambda c: (not c.valid, -c.fit_percent if math.isfinite(c.fit_percent)
+                                               else math.inf))
+
+
 def validation_text(a) -> list:
     """The validation table of an :class:`~.assess.Assessment`: the split, each
     route's models by validation fit, the residual tests' verdicts, the skipped
@@ -134,12 +151,7 @@ def validation_text(a) -> list:
                  "('white'/'ok', else the worst lag over the band)")
     lines.append(f"{'route':13s} {'method':24s} {'model':12s} {'fit %':>8s} {'residuals':>11s} {'ok':3s} "
                  "parameters")
-    order = sorted(range(len(a.candidates)),
-                   key=lambda i: (not a.candidates[i].valid,
-                                  -a.candidates[i].fit_percent if math.isfinite(a.candidates[i].fit_percent)
-                                  else math.inf))
-    for i in order:
-        c = a.candidates[i]
+    for c in ranked_candidates(a):
         fit = f"{c.fit_percent:8.2f}" if math.isfinite(c.fit_percent) else f"{'-':>8s}"
         lines.append(f"{c.route:13s} {c.name[:24]:24s} {c.kind[:12]:12s} {fit} {_verdict(c):>11s} "
                      f"{'yes' if c.valid else 'no ':3s} {format_params(c.params, False)}"
