@@ -46,7 +46,10 @@ function show(answer) {
   const b = document.createElement("p");
   b.id = "best";
   b.replaceChildren(Object.assign(document.createElement("b"), {textContent: D.t("Best model:")}), " ");
-  b.append(best ? `${best.name} (${best.model}): ${params(best.params)}` : D.t("none valid"));
+  // an input only the output-error fit reads has no route ranking of its own: its best is the validation's
+  const vbest = r.validation && r.validation.best;
+  b.append(best ? `${best.name} (${best.model}): ${params(best.params)}` :
+           vbest ? `${vbest.route} ${vbest.name} (${vbest.model}): ${params(vbest.params)}` : D.t("none valid"));
   document.getElementById("format").append(b);
   // a loop gain's table: what it is for, its crossover and margins, among the figures and marked on its plots
   const loop = r.loop, marks = [];
@@ -89,7 +92,7 @@ function show(answer) {
                     c.valid ? D.t("yes") : D.t("no"), D.inPageWords(form, c.note || "")]))] : []));
   document.getElementById("methods").replaceChildren(D.table(
     ["#", D.t("method"), D.t("model"), D.t("parameters"), "IAE", D.t("valid"), D.t("note")],
-    r.methods.map((m, i) => [i + 1, m.name, m.model, params(m.params), m.iae === null ? "" : D.localNum((+m.iae).toPrecision(3)),
+    (r.methods || []).map((m, i) => [i + 1, m.name, m.model, params(m.params), m.iae === null ? "" : D.localNum((+m.iae).toPrecision(3)),
                              m.valid ? D.t("yes") : D.t("no"), D.inPageWords(form, m.note || "")])));
 }
 
