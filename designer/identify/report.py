@@ -336,7 +336,19 @@ def record_axes(ax, view) -> None:
     """The record with its models (:class:`~.recordview.RecordView`) on one
     axis: the recorded output, the validation part shaded from its start, each
     model as simulated under the recorded input, labelled with its route,
-    method, model and validation fit."""
+    method, model and validation fit.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Where to draw.
+    view : RecordView
+        :attr:`~.assess.Assessment.view`.
+
+    Returns
+    -------
+    None
+    """
     ax.plot(view.t, view.y, color="k", lw=2.2, alpha=0.35, label="recorded output")
     for m, style in zip(view.models, ("-", "--", ":")):
         ax.plot(view.t, m.y, lw=1.1, ls=style, label=m.label)
