@@ -16,7 +16,8 @@ noise: seed 003, 2.4 and 3.2) and ``broadband`` recognises such an input and
 runs both, with the step and frequency methods on their results;
 ``outputerror`` fits continuous-time models with dead time to any recorded
 input by output error, and ``validation`` judges a model on data it was not
-fitted to (fit percentage, residual tests, an ARX reference);
+fitted to (fit percentage, residual tests, an ARX reference), and
+``recordview`` simulates the best models over the record they were scored on;
 ``against`` compares an identified plant with its design (the one use of the
 plant wing) and ``report`` prints and plots the results. The waveform
 readings they share (noise, crossings, derivative, tangent) are
@@ -55,7 +56,9 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                    "two_pole"),
     "preprocess": ("check_window", "prepare_step"),
     "refine": ("fit", "refine_all"),
-    "report": ("bode_fit_plot", "broadband_plot", "broadband_text", "fit_plot", "freq_text", "step_text"),
+    "recordview": ("ModelTrace", "RecordView", "record_view"),
+    "report": ("bode_fit_plot", "broadband_plot", "broadband_text", "fit_plot", "freq_text", "ranked_candidates",
+               "record_axes", "step_text"),
     "second_order": ("STEP_METHODS",),
     "settle": ("block_mean", "final_value"),
     "spectral": ("BANDS_PER_DECADE", "MAX_REL_ERROR", "MIN_COHERENCE", "log_bands", "periodic_response", "table_text",

@@ -219,6 +219,7 @@ class Assessment:
     skipped: dict = field(default_factory=dict)
     output_error: list = field(default_factory=list)
     hold: str = "zoh"
+    view: object | None = None
 
     @property
     def best_candidate(self) -> Candidate | None:
@@ -737,6 +738,7 @@ def identify_record(t, y, u=None, *, step_time=None, step_amplitude=None, window
             # a step capture the step methods could read (unevenly sampled, say): identified as before
             result.step.notes.append(f"not validated: {exc}")
             return result
+        _attach_view(result.assessment, t, u, y, validation)
         explained = getattr(result, "refused", "") or getattr(getattr(result, "step", None), "nonlinear", "")
         # a step capture whose own methods found a valid model from its edge is not "too short" (the step
         # methods check their edge; a gain outside the process model's range, 1.5e-10 V/V in the scale fuzz,
@@ -745,6 +747,17 @@ def identify_record(t, y, u=None, *, step_time=None, step_amplitude=None, window
         if not explained and not step_answer:
             _check_room(result.assessment, t, name)
     return result
+
+
+def _attach_view(a: Assessment, t, u, y, validation: tuple | None) -> None:
+    """The record ``a`` scored, with its best models on it (a step capture without an input channel: none)."""
+    from .recordview import record_view
+    if validation is not None:
+        ts = regular_interval(t)
+        vu, vy, _ = match_validation(ts, *validation)
+        a.view = record_view(a, np.arange(vu.size) * ts, vu, vy)
+    elif u is not None:
+        a.view = record_view(a, t, u, y)
 
 
 def _output_error_only(t, u, why: str, capture):

@@ -13,7 +13,8 @@ import numpy as np
 from ..core.units import format_eng
 from ..report.plots import png_bytes
 
-__all__ = ["bode_fit_plot", "broadband_plot", "broadband_text", "fit_plot", "freq_text", "step_text"]
+__all__ = ["bode_fit_plot", "broadband_plot", "broadband_text", "fit_plot", "freq_text", "ranked_candidates", "record_axes",
+           "step_text"]
 
 
 def format_params(p: dict, corners: bool = False) -> str:
@@ -131,6 +132,22 @@ def _verdict(c) -> str:
     return f"{'white' if w.inside else f'{w.worst:.1f}x'}/{'ok' if x.inside else f'{x.worst:.1f}x'}"
 
 
+def ranked_candidates(a) -> list:
+    """The candidates of an :class:`~.assess.Assessment` as its tables list them:
+    the valid ones first, each group by validation fit, the best first.
+
+    Parameters
+    ----------
+    a : Assessment
+
+    Returns
+    -------
+    list of Candidate
+    """
+    return sorted(a.candidates, key=lambda c: (not c.valid, -c.fit_percent if math.isfinite(c.fit_percent)
+                                               else math.inf))
+
+
 def validation_text(a) -> list:
     """The validation table of an :class:`~.assess.Assessment`: the split, each
     route's models by validation fit, the residual tests' verdicts, the skipped
@@ -145,12 +162,7 @@ def validation_text(a) -> list:
                  "('white'/'ok', else the worst lag over the band)")
     lines.append(f"{'route':13s} {'method':24s} {'model':12s} {'fit %':>8s} {'residuals':>11s} {'ok':3s} "
                  "parameters")
-    order = sorted(range(len(a.candidates)),
-                   key=lambda i: (not a.candidates[i].valid,
-                                  -a.candidates[i].fit_percent if math.isfinite(a.candidates[i].fit_percent)
-                                  else math.inf))
-    for i in order:
-        c = a.candidates[i]
+    for c in ranked_candidates(a):
         fit = f"{c.fit_percent:8.2f}" if math.isfinite(c.fit_percent) else f"{'-':>8s}"
         lines.append(f"{c.route:13s} {c.name[:24]:24s} {c.kind[:12]:12s} {fit} {_verdict(c):>11s} "
                      f"{'yes' if c.valid else 'no ':3s} {format_params(c.params, False)}"
@@ -379,11 +391,45 @@ def residual_axes(pair, c) -> None:
         ax.legend(fontsize=7)
 
 
+def record_axes(ax, view) -> None:
+    """The record with its models (:class:`~.recordview.RecordView`) on one
+    axis: the recorded output, the validation part shaded from its start, each
+    model as simulated under the recorded input, labelled with its route,
+    method, model and validation fit.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Where to draw.
+    view : RecordView
+        :attr:`~.assess.Assessment.view`.
+
+    Returns
+    -------
+    None
+    """
+    ax.plot(view.t, view.y, color="k", lw=2.2, alpha=0.35, label="recorded output")
+    for m, style in zip(view.models, ("-", "--", ":")):
+        ax.plot(view.t, m.y, lw=1.1, ls=style, label=m.label)
+    if view.validation_start_s is not None:
+        ax.axvspan(view.validation_start_s, view.t[-1], color="tab:orange", alpha=0.08,
+                   label="validation part" + (" (separate record)" if view.scope == "separate" else ""))
+        ax.axvline(view.validation_start_s, color="tab:orange", lw=1, ls="--")
+    ax.set_title("Record and models simulated under the recorded input"
+                 + ("" if view.models else ": no valid model")
+                 + ("" if view.validation_start_s is not None else " (scored on the data fitted)"), fontsize=9)
+    ax.set_xlabel("time (s)")
+    ax.legend(fontsize=7, loc="best")
+
+
 def broadband_plot(result, n_models: int = 3) -> bytes:
     """PNG of a broadband identification: the impulse response, the step it
     integrates to with the best step models, the spectral estimate (gain and
     phase) with the best frequency models, and its coherence; when validated,
-    the residual tests of the best model by validation fit.
+    the residual tests of the best model by validation fit and the record with
+    its best models (:func:`record_axes`). An input only the output-error route
+    reads (``excitation.kind == "other"``) has no estimates: the record with its
+    models and the residual tests alone.
 
     Parameters
     ----------
@@ -397,15 +443,40 @@ def broadband_plot(result, n_models: int = 3) -> bytes:
     bytes
         The PNG file's content.
     """
+    plt = _pyplot()
+    a = result.assessment
+    best = getattr(a, "best_candidate", None)
+    view = getattr(a, "view", None)
+    other = result.excitation.kind == "other"
+    rows = (0 if other else 2) + (best is not None and best.validation is not None) + (view is not None)
+    fig = plt.figure(figsize=(11, 3.5 * max(rows, 1)), dpi=100)
+    grid = fig.add_gridspec(max(rows, 1), 2)
+    axes = []
+    row = 0
+    if not other:
+        axes += [fig.add_subplot(grid[r, c]) for r in (0, 1) for c in (0, 1)]
+        _estimate_axes(result, axes, n_models)
+        row = 2
+    if view is not None:
+        axes.append(fig.add_subplot(grid[row, :]))
+        record_axes(axes[-1], view)
+        row += 1
+    if best is not None and best.validation is not None:
+        pair = [fig.add_subplot(grid[row, c]) for c in (0, 1)]
+        residual_axes(pair, best)
+        axes += pair
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    return png_bytes(fig)
+
+
+def _estimate_axes(result, axes, n_models: int) -> None:
+    """The impulse response, its integral with the step models, the spectral gain
+    with the frequency models and the coherence, on four axes."""
     from .bode_readings import model_response
     from .structures import model_step
-    plt = _pyplot()
-    best = getattr(result.assessment, "best_candidate", None)
-    rows = 3 if best is not None and best.validation is not None else 2
-    fig, axes = plt.subplots(rows, 2, figsize=(11, 3.5 * rows), dpi=100)
-    (ax_h, ax_s), (ax_g, ax_c) = axes[:2]
-    if rows == 3:
-        residual_axes(axes[2], best)
+    ax_h, ax_s, ax_g, ax_c = axes
     est = result.impulse
     if est is not None:
         ax_h.plot(est.t, est.h, color="k", lw=1)
@@ -418,7 +489,7 @@ def broadband_plot(result, n_models: int = 3) -> bytes:
     ax_h.set_xlabel("time (s)")
     ax_s.set_title("Step response: its running integral, and step models")
     ax_s.set_xlabel("time (s)")
-    if ax_s.get_legend_handles_labels()[0]:     # an input only output error reads has no estimate to draw
+    if ax_s.get_legend_handles_labels()[0]:     # a spectral-only analysis has no impulse estimate to draw
         ax_s.legend(fontsize=7)
     sp = result.spectrum
     if sp is not None and sp.f.size:
@@ -435,7 +506,3 @@ def broadband_plot(result, n_models: int = 3) -> bytes:
     ax_c.set_title("Coherence")
     ax_c.set_ylim(0, 1.05)
     ax_c.set_xlabel("frequency (Hz)")
-    for a in axes.flat:
-        a.grid(True, alpha=0.3)
-    fig.tight_layout()
-    return png_bytes(fig)

@@ -513,7 +513,10 @@ def identify_page(result) -> dict:
 
 
 def _broadband_page(result) -> dict:
-    """A broadband identification's two views (as ``identify --plot`` draws them)."""
+    """A broadband identification's views (as ``identify --plot`` draws them): the integrated impulse
+    response, the spectral estimate's gain, the record with its best models (``record``; the ``plot`` of an
+    input only the output-error route reads), and every route's candidate with its validation fit and why
+    it is not valid (``candidates``)."""
     from ..core.stepfit import model_step
     from ..identify.bode_readings import model_response
     page = {"kind": "broadband"}
@@ -530,6 +533,17 @@ def _broadband_page(result) -> dict:
             gain[f"{m.name} ({m.model})"] = 20 * np.log10(np.abs(model_response(m.model, m.params,
                                                                                 2 * math.pi * sp.f)))
         page["plot" if "plot" not in page else "second"] = _trace(sp.f, gain, "frequency (Hz)", log_x=True)
+    a = result.assessment
+    view = getattr(a, "view", None)
+    if view is not None:    # the record with its best models (an input only output error reads: the plot)
+        series = {"recorded output": view.y, **{m.label: m.y for m in view.models}}
+        record = {**_trace(view.t, series, "time (s)"), "validation_start_s": view.validation_start_s}
+        page["plot" if "plot" not in page else "record"] = record
+    if a is not None:
+        from ..identify.report import ranked_candidates
+        page["candidates"] = [{"route": c.route, "method": c.name, "model": c.kind, "valid": c.valid,
+                               "fit_percent": c.fit_percent if math.isfinite(c.fit_percent) else None,
+                               "note": c.note} for c in ranked_candidates(a)]
     return page
 
 
@@ -818,8 +832,9 @@ AXES = (N_("time from the edge (s)"), N_("frequency (Hz)"), N_("time since the s
 TRACES = (N_("SPICE (ngspice)"), N_("analytic (ideal op-amp)"), N_("tolerance band low"), N_("tolerance band high"),
           N_("ideal op-amp"), N_("SPICE .ac"), N_("ideal PID, ideal plant"), N_("plant alone (open loop)"),
           N_("loop gain L(jw)"), N_("data"), N_("integrated impulse response"), N_("mask: largest passband loss"),
-          N_("mask: least stopband attenuation"))
-_TRACE_PATTERNS = ((r"analytic \((?P<name>.+) model\)", N_("analytic ({name} model)")),
+          N_("mask: least stopband attenuation"), N_("recorded output"))
+_TRACE_PATTERNS = ((r"(?P<name>.+), validation fit (?P<fit>\S+) %", N_("{name}, validation fit {fit} %")),
+                   (r"analytic \((?P<name>.+) model\)", N_("analytic ({name} model)")),
                    (r"chosen parts, (?P<name>.+) model", N_("chosen parts, {name} model")),
                    (r"realised loop, analytic \((?P<name>.+)\)", N_("realised loop, analytic ({name})")),
                    (r"(?P<name>\S+) model", N_("{name} model")))

@@ -191,3 +191,57 @@ def test_a_chirp_capture_is_identified_by_output_error(tmp_path):
     text = run(IDENTIFY, path, "--plot", tmp_path / "fit.png")
     assert text.returncode == 0 and "output-error fit alone" in text.stdout, text.stderr
     assert text.stderr == "" and (tmp_path / "fit.png").stat().st_size > 0    # no warning lines
+
+
+#: a plant under a logarithmic sweep (simulate-capture --input chirp, seeded): an input only output error reads
+CHIRP_ARGS = ("--plant-tf", "K=2 tau=1.3 theta=0.437", "--input", "chirp", "--step", "2", "--noise", "10m",
+              "--seed", "5", "--points", "1200")
+
+
+def chirp_capture(folder):
+    """simulate-capture's chirp capture (ngspice) in ``folder``; its path."""
+    path = folder / "chirp.csv"
+    r = run(script("simulate-capture"), *CHIRP_ARGS, "--out", path)
+    assert r.returncode == 0, r.stderr
+    return path
+
+
+def record_expected(a, u, y):
+    """The assessment's own simulation of each valid model, best first (assess's public API: the models
+    simulated from the record's start at the assessment's interval and hold, raised to the validation
+    part's mean), and each one's fit on the validation part, as compare scores it."""
+    from designer.identify.outputerror import simulate
+    from designer.identify.validation import compare_fit
+    val = a.split.validation
+    out = []
+    for c in sorted((c for c in a.candidates if c.valid), key=lambda c: -c.fit_percent)[:3]:
+        ym = simulate(c.model, u - u[0], a.sample_time_s, a.hold)
+        ym = ym + y[val].mean() - ym[val].mean()
+        out.append((c, ym, compare_fit(y[val] - y[val].mean(), ym[val] - ym[val].mean())))
+    return out
+
+
+@pytest.mark.spice
+def test_a_chirp_capture_is_drawn_with_its_best_models(tmp_path):
+    """Issues 28/29: an input only the output-error route reads is drawn as the record with its best valid
+    models simulated under the recorded input (not empty estimate axes): identify --plot writes the PNG
+    without a warning line, and the view's series are the assessment's own simulation, scored as it was."""
+    from designer.identify.assess import identify_record
+    from designer.identify.io import read_capture
+    path = chirp_capture(tmp_path)
+    r = run(IDENTIFY, path, "--plot", tmp_path / "fit.png")
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+    assert (tmp_path / "fit.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    cap = read_capture(path)
+    result = identify_record(cap.t, cap.y, cap.u)
+    a, view = result.assessment, result.assessment.view
+    assert result.excitation.kind == "other" and a.scope == "split" and a.decimated_by == 1
+    assert view.validation_start_s == cap.t[a.split.n_est]
+    np.testing.assert_array_equal(view.y, cap.y)
+    expected = record_expected(a, cap.u, cap.y)
+    assert [m.label for m in view.models] == [f"{c.route} {c.name} ({c.kind}), validation fit {c.fit_percent:.1f} %"
+                                             for c, _, _ in expected]
+    assert view.models and view.models[0].fit_percent == a.best_candidate.fit_percent
+    for m, (c, ym, fit) in zip(view.models, expected):
+        np.testing.assert_allclose(m.y, ym, rtol=1e-12, atol=1e-12)
+        assert fit == pytest.approx(c.fit_percent, rel=1e-9)    # the line drawn is the one scored

@@ -131,3 +131,38 @@ def test_the_filter_and_circuit_plant_pages_speak_the_requests_language():
         assert trace["text"] == words.get("chosen parts, {name} model", "chosen parts, {name} model").format(name="LM741")
         shown = {ch["id"]: ch["title"] for ch in c["page"]["checks"]}
         assert shown == {"spice_agreement": words.get("SPICE agreement", "SPICE agreement")}
+
+
+def test_a_chirp_capture_page_draws_the_record_with_its_models_and_every_candidate(tmp_path):
+    """Issues 28/29: the Identify answer for an input only output error reads (a chirp) has the plot: the
+    recorded output, the validation part's start, the best valid models as the assessment simulated them
+    (recomputed here through its public API), and every candidate with its validation fit and why not valid."""
+    from cli.test_identify_validation import chirp_capture, record_expected
+    from designer.identify.assess import identify_record
+    from designer.identify.io import read_capture
+    path = chirp_capture(tmp_path)
+    out = jobs.run({"prog": "identify", "argv": [str(path), "--json"], "want": "page"})
+    assert out["status"] == 0, out["error"]
+    page = out["page"]
+    json.dumps(page, allow_nan=False)
+    cap = read_capture(path)
+    a = identify_record(cap.t, cap.y, cap.u).assessment
+    plot = page["plot"]
+    assert page["kind"] == "broadband" and "record" not in page and "second" not in page
+    assert plot["validation_start_s"] == pytest.approx(cap.t[a.split.n_est], rel=1e-12)
+    six = {"rtol": 5e-6, "atol": 1e-12}      # the page's numbers have six significant digits
+    np.testing.assert_allclose(plot["x"], cap.t, **six)
+    assert plot["series"][0]["label"] == "recorded output"
+    np.testing.assert_allclose(plot["series"][0]["y"], cap.y, **six)
+    expected = record_expected(a, cap.u, cap.y)
+    assert [s["label"] for s in plot["series"][1:]] == [
+        f"{c.route} {c.name} ({c.kind}), validation fit {c.fit_percent:.1f} %" for c, _, _ in expected]
+    for s, (_, ym, _) in zip(plot["series"][1:], expected):
+        np.testing.assert_allclose(s["y"], ym, **six)
+    rows = page["candidates"]
+    assert len(rows) == len(out["json"]["validation"]["models"]) == len(a.candidates)
+    assert [r["valid"] for r in rows] == sorted((r["valid"] for r in rows), reverse=True)   # valid ones first
+    assert all(r["note"] for r in rows if not r["valid"]) and not any(r["note"] for r in rows if r["valid"])
+    best = out["json"]["validation"]["best"]
+    assert (rows[0]["route"], rows[0]["model"]) == (best["route"], best["model"])
+    assert rows[0]["fit_percent"] == pytest.approx(best["validation"]["fit_percent"])

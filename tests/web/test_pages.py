@@ -957,3 +957,26 @@ def test_the_browsers_preferred_language_chooses_the_pages(browser, server):
         assert pg.input_value("#lang") == "es"
     finally:
         context.close()
+
+
+def test_identify_a_chirp_shows_the_record_with_its_models_and_every_candidate(page, server, tmp_path):
+    """Issues 28/29: a capture under a chirp (simulate-capture --input chirp) shows the record with its best
+    models, the validation part's start marked, and the table of every route's candidate, valid or why not;
+    a step capture after it leaves no stale table."""
+    from cli.test_identify_validation import chirp_capture
+    path = chirp_capture(tmp_path)
+    open_page(page, server, "/identify")
+    assert drop(page, path) == "done"
+    assert page.locator("#plot canvas").count() == 1
+    legend = page.inner_text("#plot .u-legend")
+    assert "recorded output" in legend and "output-error oe (fopdt), validation fit" in legend
+    assert "validation from here" in page.get_attribute("#plot", "data-marks")
+    assert page.locator("#candidates-box").is_visible()
+    assert "output-error oe (fopdt): K = 2" in page.inner_text("#best")
+    rows = page.locator("#candidates tbody tr").all_inner_texts()
+    assert len(rows) == 5 and all(r.startswith("output-error\toe\t") for r in rows), rows
+    assert rows[0].split("\t")[2] == "fopdt" and rows[0].split("\t")[4] == "yes", rows
+    integrating = [r for r in rows if "\tintegrating\t" in r]
+    assert integrating and "\tno\t" in integrating[0] and "below 0" in integrating[0], integrating
+    assert drop(page, SYNTHETIC_TEK) == "done"
+    assert not page.locator("#candidates-box").is_visible() and page.locator("#candidates tbody tr").count() == 0

@@ -14,13 +14,20 @@ function params(p) {
 D.onStale = function (why) {
   if (why !== "refused") return;
   last = null;
-  for (const id of ["format", "methods", "loop"]) document.getElementById(id).replaceChildren();
-  for (const id of ["plot", "phase"]) {
+  for (const id of ["format", "methods", "loop", "candidates"]) document.getElementById(id).replaceChildren();
+  document.getElementById("candidates-box").hidden = true;
+  for (const id of ["plot", "phase", "record"]) {
     const el = document.getElementById(id);
     if (el._plot) { el._plot.destroy(); el._plot = null; }
     el.replaceChildren();
   }
 };
+
+// where the validation part of a record starts, marked on its plot
+function split(trace) {
+  const x = trace.validation_start_s;
+  return x === null || x === undefined ? [] : [{x, label: D.t("validation from here")}];
+}
 
 function show(answer) {
   const r = answer.result, p = answer.page;
@@ -39,7 +46,10 @@ function show(answer) {
   const b = document.createElement("p");
   b.id = "best";
   b.replaceChildren(Object.assign(document.createElement("b"), {textContent: D.t("Best model:")}), " ");
-  b.append(best ? `${best.name} (${best.model}): ${params(best.params)}` : D.t("none valid"));
+  // an input only the output-error fit reads has no route ranking of its own: its best is the validation's
+  const vbest = r.validation && r.validation.best;
+  b.append(best ? `${best.name} (${best.model}): ${params(best.params)}` :
+           vbest ? `${vbest.route} ${vbest.name} (${vbest.model}): ${params(vbest.params)}` : D.t("none valid"));
   document.getElementById("format").append(b);
   // a loop gain's table: what it is for, its crossover and margins, among the figures and marked on its plots
   const loop = r.loop, marks = [];
@@ -66,12 +76,23 @@ function show(answer) {
     if (p.phase) D.plot(ph, p.phase, {xUnit: "Hz", yLabel: D.t("phase (deg)"), height: 220, marks});
   } else {   // broadband: the integrated impulse response and the spectral estimate's gain
     const unit = t => t.log_x ? ["Hz", D.t("gain (dB)")] : ["s", cap.output || D.t("output")];
-    if (p.plot) D.plot(document.getElementById("plot"), p.plot, {xUnit: unit(p.plot)[0], yLabel: unit(p.plot)[1]});
+    if (p.plot) D.plot(document.getElementById("plot"), p.plot, {xUnit: unit(p.plot)[0], yLabel: unit(p.plot)[1], marks: split(p.plot)});
     if (p.second) D.plot(ph, p.second, {xUnit: "Hz", yLabel: D.t("gain (dB)"), height: 240});
   }
+  // the record with its best models simulated under the recorded input (the plot itself for an input only
+  // the output-error fit reads), and every route's models with their validation fit and why not valid
+  const rec = document.getElementById("record");
+  if (rec._plot) { rec._plot.destroy(); rec._plot = null; } rec.replaceChildren();
+  if (p.record) D.plot(rec, p.record, {xUnit: "s", yLabel: cap.output || D.t("output"), height: 260, marks: split(p.record)});
+  const cands = p.candidates || [];
+  document.getElementById("candidates-box").hidden = !cands.length;
+  document.getElementById("candidates").replaceChildren(...(cands.length ? [D.table(
+    [D.t("route"), D.t("method"), D.t("model"), D.t("validation fit"), D.t("valid"), D.t("why not")],
+    cands.map(c => [c.route, c.method, c.model, c.fit_percent === null ? "" : D.localNum(`${(+c.fit_percent).toFixed(1)} %`),
+                    c.valid ? D.t("yes") : D.t("no"), D.inPageWords(form, c.note || "")]))] : []));
   document.getElementById("methods").replaceChildren(D.table(
     ["#", D.t("method"), D.t("model"), D.t("parameters"), "IAE", D.t("valid"), D.t("note")],
-    r.methods.map((m, i) => [i + 1, m.name, m.model, params(m.params), m.iae === null ? "" : D.localNum((+m.iae).toPrecision(3)),
+    (r.methods || []).map((m, i) => [i + 1, m.name, m.model, params(m.params), m.iae === null ? "" : D.localNum((+m.iae).toPrecision(3)),
                              m.valid ? D.t("yes") : D.t("no"), D.inPageWords(form, m.note || "")])));
 }
 
