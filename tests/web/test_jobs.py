@@ -133,6 +133,7 @@ def test_the_filter_and_circuit_plant_pages_speak_the_requests_language():
         assert shown == {"spice_agreement": words.get("SPICE agreement", "SPICE agreement")}
 
 
+@pytest.mark.spice
 def test_a_chirp_capture_page_draws_the_record_with_its_models_and_every_candidate(tmp_path):
     """Issues 28/29: the Identify answer for an input only output error reads (a chirp) has the plot: the
     recorded output, the validation part's start, the best valid models as the assessment simulated them
