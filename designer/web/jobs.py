@@ -49,8 +49,8 @@ from ..tolerance import filter as filter_tolerance
 
 __all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACES", "TRACE_POINTS",
            "Superseded", "bundle_zip", "check_files", "checks_shown", "circuit_plant_page", "design_filter_task",
-           "design_plant_task", "files_in", "filter_page", "histograms", "identify_page", "pid_page", "plant_page",
-           "run", "run_task", "series_text", "temporaries_in", "warm_up", "written_since"]
+           "design_pid_task", "design_plant_task", "files_in", "filter_page", "histograms", "identify_page",
+           "pid_page", "plant_page", "run", "run_task", "series_text", "temporaries_in", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
@@ -382,6 +382,50 @@ def design_filter_task(fields: dict, want: str = "json", tmp: str | None = None)
     return _library_task("design-filter", FILTER, fields, work, want, tmp)
 
 
+def design_pid_task(fields: dict, want: str = "json", tmp: str | None = None) -> dict:
+    """design-pid for the page, the library called directly: the request's fields as the specs
+    (:func:`designer.web.forms.pid_request`, through :func:`designer.pid.spec.pid_spec`, the command line's
+    mapping), :func:`designer.pid.design.design_pid`, the loop's tolerance analysis asked for
+    (:func:`designer.tolerance.mcspec.loop_tolerance`), and the typed result rendered (the sheet and bundle
+    :func:`designer.pid.report.write_outputs` writes).
+
+    Parameters
+    ----------
+    fields : dict
+        The request's JSON object (the PID page's fields, :data:`designer.web.forms.PID`).
+    want : str
+        As :func:`run`'s.
+    tmp : str or None
+        The request's private folder (a file field's content, the files of a sheet or bundle; every
+        temporary file).
+
+    Returns
+    -------
+    dict
+        As :func:`run`'s (the JSON as ``design-pid --json`` prints it); a refusal's ``field`` and ``label``
+        name the page's field at fault.
+    """
+    from .forms import PID
+
+    def work(fields, lang):
+        from ..pid.design import design_pid
+        from ..pid.report import write_outputs
+        from ..pid.spec import default_name
+        from ..tolerance.mcspec import loop_tolerance
+        from .forms import pid_request
+        rq = pid_request(fields, tmp)
+        result = design_pid(rq.spec, simulate=rq.simulate, simulator=rq.simulator, rules_spice=rq.rules_spice)
+        result = loop_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
+        name = rq.name or default_name(rq.spec, result)
+        if want in ("sheet", "bundle"):
+            write_outputs(result, tmp, name)
+        data = json.loads(json.dumps(result.to_dict()))
+        # the command line this request stands for: a record, never parsed
+        data["tool"]["argv"] = rq.argv + ([f"--lang={lang}"] if lang else [])
+        return data, lambda: pid_page(result), name
+    return _library_task("design-pid", PID, fields, work, want, tmp)
+
+
 def _library_task(prog: str, table: dict, fields: dict, work, want: str, tmp: str | None) -> dict:
     """One library-first task: the request's language taken from ``fields``, then ``work(fields, lang)`` (in
     ``tmp``, every temporary file there) gives (the JSON, a function drawing the page, the design's name: its
@@ -422,7 +466,7 @@ def _library_work(prog: str, table: dict, fields: dict, lang: str | None, work, 
 
 
 #: the commands the page runs through the library (no console script, no argv, no printed JSON)
-LIBRARY = {"design-plant": design_plant_task, "design-filter": design_filter_task}
+LIBRARY = {"design-plant": design_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task}
 
 
 # --------------------------------------------------------------------------- identify
