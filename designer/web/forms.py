@@ -21,6 +21,7 @@ from typing import NamedTuple
 from ..core.errors import DesignError, ParamError
 from ..core.i18n import N_, localise
 from ..core.i18n import gettext as _
+from ..filters.sallen_key_lowpass_parts import refs as sallen_key_refs
 from .request import option_name, value_text
 
 __all__ = ["FILTER", "Field", "FilterRequest", "PID", "PLANT", "PidRequest", "PlantRequest", "field_of",
@@ -91,8 +92,8 @@ FILTER = {
 PID = {
     # the plant, one way
     "plant-fc": Field("plant_fc_hz", N_("plant fc (Hz)")), "plant-zeta": Field("plant_zeta", N_("plant zeta")),
-    "plant-r1": Field("plant_r1", N_("R1")), "plant-r2": Field("plant_r2", N_("R2")),
-    "plant-c1": Field("plant_c1", N_("C1")), "plant-c2": Field("plant_c2", N_("C2")),
+    # the Sallen-Key plant as built: its parts by their designators (the topology's declaration), their labels
+    **{f"plant-{ref.lower()}": Field(f"plant_{ref.lower()}", ref) for ref in sallen_key_refs(with_gain=False)},
     "plant-gain": Field("plant_gain", N_("gain K")), "plant-topology": Field("plant_topology", N_("plant topology")),
     "plant-part": Field("plant_values", N_("plant parts"), "list"),
     "plant-json": Field("plant_json", N_("plant result.json"), "file"), "plant-tf": Field("plant_tf", N_("model")),

@@ -47,10 +47,11 @@ from ..filters import report as filter_report
 from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
 
-__all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACES", "TRACE_POINTS",
-           "Superseded", "bundle_zip", "check_files", "checks_shown", "circuit_plant_page", "design_filter_task",
-           "design_pid_task", "design_plant_task", "files_in", "filter_page", "histograms", "identify_page",
-           "pid_page", "plant_page", "run", "run_task", "series_text", "temporaries_in", "warm_up", "written_since"]
+__all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "CLI_ONLY", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACES",
+           "TRACE_POINTS", "Superseded", "bundle_zip", "check_files", "checks_shown", "circuit_plant_page",
+           "design_filter_task", "design_pid_task", "design_plant_task", "files_in", "filter_page", "histograms",
+           "identify_page", "pid_page", "plant_page", "run", "run_task", "series_text", "temporaries_in",
+           "through_library", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
@@ -467,6 +468,35 @@ def _library_work(prog: str, table: dict, fields: dict, lang: str | None, work, 
 
 #: the commands the page runs through the library (no console script, no argv, no printed JSON)
 LIBRARY = {"design-plant": design_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task}
+#: a command's options its page's name table does not map (design-pid's capture identified first, with identify's
+#: options; a replayed build; --fail-on-check): a request with one runs the command's entry point, as before
+CLI_ONLY = {"design-pid": frozenset({"plant-capture", "step-time", "step-amplitude", "window", "format", "input-column",
+                                     "output-column", "sample-time", "columns", "methods", "no-refine", "replay",
+                                     "fail-on-check"})}
+
+
+def through_library(prog: str, options) -> bool:
+    """Whether a request of ``prog`` is run by the library with its fields (:data:`LIBRARY`), not by the
+    command's entry point with an argument list.
+
+    Parameters
+    ----------
+    prog : str
+        The command.
+    options : object
+        The request's JSON (an object of fields; anything else is the library task's to refuse).
+
+    Returns
+    -------
+    bool
+        False for a command without a library task, or a request naming one of its :data:`CLI_ONLY` options.
+    """
+    if prog not in LIBRARY:
+        return False
+    if not isinstance(options, dict):
+        return True
+    only = CLI_ONLY.get(prog, frozenset())
+    return not any(str(k).strip().lstrip("-").replace("_", "-").lower() in only for k in options)
 
 
 # --------------------------------------------------------------------------- identify

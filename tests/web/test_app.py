@@ -879,3 +879,18 @@ def test_a_spanish_request_is_refused_in_spanish_naming_its_field(server):
         assert status == 200 and pid["page"]["closed_loop"]["x_label"] == gettext("time from the edge (s)")
     assert pid["page"]["closed_loop"]["x_label"] != "time from the edge (s)"
     assert "--lang=es" in pid["result"]["tool"]["argv"]
+
+
+def test_pid_with_a_capture_runs_design_pid_as_before(server):
+    """Issue 26: the options the PID page's name table does not map (a capture identified first, with
+    identify's options; --replay; --fail-on-check) still work: such a request runs design-pid's entry point,
+    the JSON its --json."""
+    from designer.web.jobs import CLI_ONLY, through_library
+    assert not through_library("design-pid", {"plant_capture": "x"}) and through_library("design-pid", {"kp": 1})
+    assert CLI_ONLY["design-pid"] >= {"plant-capture", "replay"}
+    status, got = server.post_json("/api/pid", {"plant-capture": CAPTURE.read_text(), "tuning": "amigo",
+                                                "no-sim": True})
+    assert status == 200, got
+    want = cli_json("design-pid", "--plant-capture", str(CAPTURE), "--tuning", "amigo", "--no-sim", "--json",
+                    "--no-files")
+    assert got["tuning"] == want["tuning"] and got["tuning"]["method"] == "amigo"
