@@ -116,7 +116,7 @@ PID = {
     "r-min": Field("r_min", N_("R min")), "r-max": Field("r_max", N_("R max")),
     "c-min": Field("c_min", N_("C min")), "c-max": Field("c_max", N_("C max")),
     "f-integrator": Field("f_integrator_hz", N_("integrator corner (Hz)")),
-    "f-differentiator": Field("f_differentiator_hz", N_("derivative filter corner (Hz)")),
+    "f-differentiator": Field("f_differentiator_hz", N_("derivative corner (Hz)")),
     # the op-amps and the test signal
     "opamp": Field("opamp", N_("op-amp")), "step": Field("step_v", N_("step (V)")),
     "edge": Field("edge_s", N_("edge (s)")), "square-freq": Field("square_hz", N_("square wave (Hz)")),
