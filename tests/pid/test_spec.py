@@ -94,7 +94,8 @@ def test_pid_spec_is_the_one_mapping_from_plain_parameters():
 @pytest.mark.parametrize("params, library, cli", [
     ({"plant_r1": "820", "plant_r2": "1k"}, "plant_r1, plant_r2, plant_c1 and plant_c2 go together",
      "--plant-r1, --plant-r2, --plant-c1 and --plant-c2 go together"),
-    ({**SEED, "plant_gain": 2}, "plant_gain goes with plant_r1..plant_c2", "--plant-gain goes with --plant-r1..--plant-c2"),
+    ({**SEED, "plant_gain": 2}, "plant_gain goes with plant_r1..plant_c2",
+     "--plant-gain goes with --plant-r1..--plant-c2"),
 ])
 def test_pid_spec_refuses_naming_its_parameters(params, library, cli):
     from designer.pid.spec import pid_spec

@@ -148,7 +148,8 @@ def test_a_missing_plant_field_is_named_by_its_label(server):
      ["--plant-fc", "3500", "--plant-zeta", "0.2", "--tuning", "magic"]),
     ({"plant-r1": "820", "plant-r2": "1k"}, ["--plant-r1", "820", "--plant-r2", "1k"]),
     ({"plant-fc": 3500, "plant-zeta": 0.2, "kp": 2}, ["--plant-fc", "3500", "--plant-zeta", "0.2", "--kp", "2"]),
-    ({"plant-fc": 3500, "plant-zeta": 0.2, "step": "9q"}, ["--plant-fc", "3500", "--plant-zeta", "0.2", "--step", "9q"]),
+    ({"plant-fc": 3500, "plant-zeta": 0.2, "step": "9q"},
+     ["--plant-fc", "3500", "--plant-zeta", "0.2", "--step", "9q"]),
 ])
 def test_the_pid_page_refuses_with_the_clis_line_in_its_own_words(server, body, argv):
     """Issue 26 (library-first): /api/pid calls the library with the page's fields; its refusal is design-pid's
