@@ -139,7 +139,7 @@ def create_app(pool, trust: Trust):
         # pool never fills while the pool is sending a long answer the other way (each would wait on the other)
         task_file = os.path.join(tmp, "task.json")
         task = {"prog": prog, "want": want, "tmp": tmp}
-        task.update({"fields": fields} if fields is not None else {"argv": argv})
+        task.update({"argv": argv} if argv is not None else {"fields": fields})   # no argv: the library's fields
         if lang is not None:
             task["lang"] = lang
         with open(task_file, "w", encoding="utf-8") as fh:

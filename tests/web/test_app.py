@@ -577,6 +577,8 @@ MALFORMED = [
     ("/api/plant", b"3", {}, "must be a JSON object"),
     ("/api/plant", b'"fc"', {}, "must be a JSON object"),
     ("/api/plant", b"null", {}, "must be a JSON object"),
+    ("/api/pid", b"null", {}, "must be a JSON object"),
+    ("/api/pid", b"[1, 2]", {}, "must be a JSON object"),
     ("/api/plant", b"{not json", {}, "not JSON"),
     ("/api/plant", b'{"fc": 1e999, "zeta": 0.5}', {}, "finite number"),
     ("/api/plant", b'{"fc": NaN, "zeta": 0.5}', {}, "finite number"),
