@@ -208,6 +208,8 @@ CIRCUIT_PARAMS = ("plant_topology", "plant_values")
 SPEC_PARAMS = CIRCUIT_PARAMS + ("plant_fc_hz", "plant_zeta", "plant_json", "tuning", "kp", "ti_s", "td_s", "opamp", "step_v", "edge_s",
                "r_series", "c_series", "r_min", "r_max", "c_min", "c_max", "target_overshoot_pct",
                "target_settling_s", "f_integrator_hz", "f_differentiator_hz", "square_hz") + MODEL_PARAMS
+#: the Sallen-Key plant as built, part by part (designer.pid.spec.pid_spec makes its parts)
+PLANT_PARTS = ("plant_r1", "plant_r2", "plant_c1", "plant_c2", "plant_gain")
 
 
 def _typed(args, params) -> dict:
@@ -215,13 +217,12 @@ def _typed(args, params) -> dict:
 
 
 def _build_spec(args):
-    """The spec from the options as typed: the spec parses and checks them (the one validation)."""
-    from ..pid.blocks import seed_parts
-    from ..pid.spec import PidSpec
-    typed = _typed(args, SPEC_PARAMS)
+    """The spec from the options as typed: :func:`designer.pid.spec.pid_spec` parses and checks them (the one
+    mapping and validation, the web page's too)."""
+    from ..pid.spec import pid_spec
+    typed = _typed(args, SPEC_PARAMS + PLANT_PARTS)
     process = _captured_model(args, typed)
-    return PidSpec(plant_parts=_plant_parts(args), controller_parts=seed_parts() if args.seed_parts else None,
-                   package=args.package, plant_process=process, **typed)
+    return pid_spec({**typed, "seed_parts": args.seed_parts, "package": args.package, "plant_process": process})
 
 
 #: identify's options that --plant-capture passes on: (argparse dest, flag, value when not given)
@@ -292,40 +293,17 @@ def _identified(args, fmt: str, given: list, ident):
                            step_only_given=edge_only)
 
 
-def _plant_parts(args):
-    """The plant's parts as typed (--plant-r1 ..), or None; the spec checks them."""
-    from ..plant.sallenkey import SallenKeyParts
-    given = [args.plant_r1, args.plant_r2, args.plant_c1, args.plant_c2]
-    if any(v is not None for v in given):
-        if not all(v is not None for v in given):
-            raise DesignError("--plant-r1, --plant-r2, --plant-c1 and --plant-c2 go together")
-        return SallenKeyParts(*given, args.plant_gain)
-    if args.plant_gain is not None:
-        raise DesignError("--plant-gain goes with --plant-r1..--plant-c2")
-    return None
-
-
-def _default_name(spec, fn_hz, zeta) -> str:
-    extra = "_seedparts" if spec.controller_parts is not None else ""
-    return f"pid_{spec.method}_{spec.opamp.lower()}_fn{fn_hz:.5g}_z{zeta:.3g}{extra}"
-
-
-def _model_name(spec, method: str) -> str:
-    """The default design name of a model plant: ``pid_<rule>_<opamp>_<kind>`` (a circuit plant: its topology)."""
-    kind = spec.circuit.circuit.topology if spec.circuit is not None else spec.process.kind
-    return f"pid_{method}_{spec.opamp.lower()}_{kind}"
-
-
 def _run(args) -> int:
     from ..pid.design import design_pid
     from ..pid.report import summary_text, write_outputs
+    from ..pid.spec import default_name
     spec = _build_spec(args)
     mc, spice = monte_carlo_settings(args, spec)
     if spec.process is not None:
         common.check_output(args, replay_name(args.name if args.name is not None else "pid_model", spice))
         if spice[2] is not None:    # the design is the draw's nominal; the build's own run is the simulation
             result = design_pid(spec, simulate=False, simulator=args.simulator)
-            name = args.name or _model_name(spec, result.method)
+            name = args.name or default_name(spec, result)
             return emit(replay(spec, result, args, mc, spice), args, replay_name(name, spice), write_outputs,
                         summary_text)
         from ..pid.report import draw_early
@@ -335,19 +313,19 @@ def _run(args) -> int:
                                 rules_spice=args.rules_spice,
                                 before_spice=None if args.no_files else lambda r: early.append(draw_early(r)))
             result = loop_monte_carlo(result, args, mc, spice)
-        return emit(result, args, args.name or _model_name(spec, result.method),
+        return emit(result, args, args.name or default_name(spec, result),
                     lambda *a: write_outputs(*a, early=early[0] if early else None), summary_text)
     # the default name needs the plant as built; its fixed start stands in for it in the check
     common.check_output(args, replay_name(args.name if args.name is not None else f"pid_{spec.method}", spice))
     if spice[2] is not None:
         result = design_pid(spec, simulate=False, simulator=args.simulator)
-        name = args.name or _default_name(spec, result.plant.fn_hz, result.plant.zeta)
+        name = args.name or default_name(spec, result)
         return emit(replay(spec, result, args, mc, spice), args, replay_name(name, spice), write_outputs,
                     summary_text)
     with cluster_ahead(args):
         result = loop_monte_carlo(design_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc,
                                   spice)
-    name = args.name or _default_name(spec, result.plant.fn_hz, result.plant.zeta)
+    name = args.name or default_name(spec, result)
     return emit(result, args, name, write_outputs, summary_text)
 
 
@@ -424,7 +402,7 @@ def _analyze(args) -> int:
     from ..pid.blocks import PidParts
     from ..pid.design import analyze_pid
     from ..pid.report import summary_text, write_outputs
-    from ..pid.spec import PidSpec, controller_from_json
+    from ..pid.spec import controller_from_json, pid_spec
     typed = {k: getattr(args, k) for k in CONTROLLER_FIELDS}
     if args.parts_json is not None:
         if any(v is not None for v in typed.values()):
@@ -434,9 +412,9 @@ def _analyze(args) -> int:
         raise DesignError("the controller's parts are needed: --r3 .. --r18, --c3, --c4 (or --parts-json FILE)")
     else:
         parts = PidParts(**typed)
-    typed = _typed(args, ANALYZE_PARAMS)
-    spec = PidSpec(plant_parts=_plant_parts(args), controller_parts=parts, package=args.package,
-                   plant_process=_captured_model(args, typed), **typed)
+    typed = _typed(args, ANALYZE_PARAMS + PLANT_PARTS)
+    process = _captured_model(args, typed)
+    spec = pid_spec({**typed, "controller_parts": parts, "package": args.package, "plant_process": process})
     mc, spice = monte_carlo_settings(args, spec)
     common.check_output(args, replay_name(args.name if args.name is not None else "pid_as-built", spice))
     if spice[2] is not None:    # the parts as given are the draw's nominal; the build's own run is the simulation
@@ -451,10 +429,11 @@ def _analyze(args) -> int:
 
 def _analyzed_name(args, spec, result) -> str:
     """analyze-pid's bundle name: --name, else from the tuning, the op-amp and the plant."""
+    from ..pid.spec import default_name
     if args.name:
         return args.name
     if spec.process is not None:
-        return _model_name(spec, result.method)
+        return default_name(spec, result)
     return f"pid_{result.tuning.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}_z{result.plant.zeta:.3g}"
 
 

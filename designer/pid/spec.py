@@ -30,7 +30,7 @@ from ..plant.sallenkey import SallenKeyParts, check_parts
 from . import tuning as rules
 from .blocks import PidParts
 
-__all__ = ["PidSpec", "controller_from_json"]
+__all__ = ["PLAIN_PARAMS", "PidSpec", "controller_from_json", "default_name", "pid_spec"]
 
 #: what the plant validation calls the fields of ``plant_parts`` (markers: see ParamError)
 PLANT_NAMES = {"r1": "{plant_r1}", "r2": "{plant_r2}", "c1": "{plant_c1}", "c2": "{plant_c2}",
@@ -282,6 +282,71 @@ def voltage_range(value, name: str) -> tuple:
 
 #: the names a message of the spec marks as parameters (``{kp}``): its fields and the plant's parts
 PARAMS = frozenset({f.name for f in fields(PidSpec)} | {f"plant_{k}" for k in PLANT_RANGES})
+
+
+#: the plain parameters :func:`pid_spec` takes beside the spec's own fields: the Sallen-Key plant as built,
+#: part by part, and the seed's controller parts (V.13) instead of sizing
+PLAIN_PARAMS = ("plant_r1", "plant_r2", "plant_c1", "plant_c2", "plant_gain", "seed_parts")
+
+
+def pid_spec(params: dict) -> PidSpec:
+    """A :class:`PidSpec` from plain parameters, as every front end has them (the command line's options, the
+    web page's fields): the one mapping from what a user types to the spec.
+
+    Parameters
+    ----------
+    params : dict
+        The spec's own fields (:class:`PidSpec`; a value None is not given), and :data:`PLAIN_PARAMS`:
+        ``plant_r1``, ``plant_r2``, ``plant_c1``, ``plant_c2`` (all four together) with ``plant_gain``
+        (default 1) as the plant's :class:`~designer.plant.sallenkey.SallenKeyParts`, and ``seed_parts``
+        (true: the seed's controller parts, :func:`designer.pid.blocks.seed_parts`).
+
+    Returns
+    -------
+    PidSpec
+        Checked on construction.
+
+    Raises
+    ------
+    DesignError
+        One line naming the parameters at fault (``{name}`` markers of a :class:`ParamError`).
+    """
+    p = {k: v for k, v in params.items() if v is not None}
+    parts = [p.pop(k, None) for k in PLAIN_PARAMS[:4]]
+    gain = p.pop("plant_gain", None)
+    if any(v is not None for v in parts):
+        if not all(v is not None for v in parts):
+            raise _refused("{plant_r1}, {plant_r2}, {plant_c1} and {plant_c2} go together")
+        p["plant_parts"] = SallenKeyParts(*parts, gain)
+    elif gain is not None:
+        raise _refused("{plant_gain} goes with {plant_r1}..{plant_c2}")
+    if p.pop("seed_parts", False):
+        from .blocks import seed_parts
+        p["controller_parts"] = seed_parts()
+    return PidSpec(**p)
+
+
+def default_name(spec: PidSpec, result) -> str:
+    """design-pid's name of a design (its files) when none is given.
+
+    Parameters
+    ----------
+    spec : PidSpec
+        What was asked.
+    result : designer.pid.result.PidResult
+        The design (its rule; a Sallen-Key plant's fn and zeta as built).
+
+    Returns
+    -------
+    str
+        ``pid_<rule>_<opamp>_fn<fn>_z<zeta>`` (``_seedparts`` with the seed's controller parts) for a
+        Sallen-Key plant; ``pid_<rule>_<opamp>_<kind>`` for a model plant (a circuit plant: its topology).
+    """
+    if spec.process is not None:
+        kind = spec.circuit.circuit.topology if spec.circuit is not None else spec.process.kind
+        return f"pid_{result.method}_{spec.opamp.lower()}_{kind}"
+    extra = "_seedparts" if spec.controller_parts is not None else ""
+    return f"pid_{spec.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}_z{result.plant.zeta:.3g}{extra}"
 
 
 def _refused(marked: str) -> ParamError:

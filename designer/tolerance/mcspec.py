@@ -21,7 +21,7 @@ from .montecarlo import MAX_SAMPLES, MIN_SAMPLES
 from .parts import DISTRIBUTIONS
 from .sampling import SAMPLERS
 
-__all__ = ["ENGINES", "MonteCarloSpec", "plant_tolerance"]
+__all__ = ["ENGINES", "MonteCarloSpec", "loop_tolerance", "plant_tolerance"]
 
 #: where each build's figures come from (the plant's; a loop's Monte Carlo is analytic)
 ENGINES = ("analytic", "spice", "both")
@@ -164,4 +164,44 @@ def plant_tolerance(result, mc: MonteCarloSpec | None, worst_case: bool = False,
     from .montecarlo import plant_monte_carlo
     result.monte_carlo = plant_monte_carlo(result.built, series, result.opamp, mc.n, mc.seed, mc.sampler, mc.dist,
                                            mc.tol, mc.limits, scale=scale, target_ci=mc.target_ci)
+    return result
+
+
+def loop_tolerance(result, mc: MonteCarloSpec | None, worst_case: bool = False, tol=(), simulator: str = "pyspice",
+                   scale=None):
+    """The tolerance analysis of a PID loop as built (the plant's parts and the controller's), attached to it,
+    as design-pid runs it (:func:`designer.tolerance.loop.loop_worst_case`,
+    :func:`designer.tolerance.spice_loop_mc.loop_monte_carlo_engine`).
+
+    Parameters
+    ----------
+    result : designer.pid.result.PidResult
+        The design.
+    mc : MonteCarloSpec or None
+        The Monte Carlo to run (None: none); its engine analytic, spice or both.
+    worst_case : bool
+        Also the extremes of the margins and the overshoot (and every limited figure) over the tolerance box.
+    tol : tuple of str
+        The tolerances of the worst case when there is no Monte Carlo (else ``mc.tol``).
+    simulator : str
+        The SPICE engine's backend.
+    scale : designer.tolerance.runner.Scale, optional
+        Where the builds run (default: this process).
+
+    Returns
+    -------
+    PidResult
+        ``result``, with ``worst_case`` and ``monte_carlo`` set as asked.
+    """
+    from .loop import loop_series, loop_worst_case
+    series = loop_series(result)
+    if worst_case:
+        result.worst_case = loop_worst_case(result, series, mc.tol if mc is not None else tuple(tol or ()),
+                                            mc.limits if mc is not None else ())
+    if mc is None:
+        return result
+    from .spice_loop_mc import loop_monte_carlo_engine
+    result.monte_carlo = loop_monte_carlo_engine(result, series, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol,
+                                                 mc.limits, mc.engine, mc.spice_samples, simulator, scale=scale,
+                                                 target_ci=mc.target_ci)
     return result

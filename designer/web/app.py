@@ -39,7 +39,7 @@ from ..core.fileio import MAX_CAPTURE_BYTES, check_plain_name
 from . import pool as pool_module
 from . import request as req
 from .guard import Guard, Trust, error_response
-from .jobs import LIBRARY
+from .jobs import through_library
 
 __all__ = ["DISCONNECT_POLL_S", "MAX_DEPTH", "PAGES", "STATIC", "TooLarge", "create_app"]
 
@@ -139,7 +139,7 @@ def create_app(pool, trust: Trust):
         # pool never fills while the pool is sending a long answer the other way (each would wait on the other)
         task_file = os.path.join(tmp, "task.json")
         task = {"prog": prog, "want": want, "tmp": tmp}
-        task.update({"fields": fields} if prog in LIBRARY else {"argv": argv})
+        task.update({"argv": argv} if argv is not None else {"fields": fields})   # no argv: the library's fields
         if lang is not None:
             task["lang"] = lang
         with open(task_file, "w", encoding="utf-8") as fh:
@@ -194,7 +194,7 @@ def create_app(pool, trust: Trust):
                                        f"{req.MAX_JSON_BYTES // (1024 * 1024)} MiB")
                 except DesignError as exc:
                     return _error(400, f"{prog}: error: {exc}")
-                if prog in LIBRARY:   # the library called with the request's fields: no command line
+                if through_library(prog, options):   # the library called with the request's fields: no command line
                     return await run(request, prog, None, how, tmp, fields=options)
                 try:
                     argv = req.build_argv(options, tmp, traits[prog])

@@ -21,10 +21,11 @@ from typing import NamedTuple
 from ..core.errors import DesignError, ParamError
 from ..core.i18n import N_, localise
 from ..core.i18n import gettext as _
+from ..filters.sallen_key_lowpass_parts import refs as sallen_key_refs
 from .request import option_name, value_text
 
-__all__ = ["FILTER", "Field", "FilterRequest", "PLANT", "PlantRequest", "field_of", "filter_request", "page_message",
-           "plant_request"]
+__all__ = ["FILTER", "Field", "FilterRequest", "PID", "PLANT", "PidRequest", "PlantRequest", "field_of",
+           "filter_request", "page_message", "pid_request", "plant_request"]
 
 
 class Field(NamedTuple):
@@ -32,7 +33,8 @@ class Field(NamedTuple):
 
     param: str            #: the library's name (``fc_hz``; a MonteCarloSpec's ``n``)
     label: str            #: what the page shows beside it (``fc (Hz)``)
-    kind: str = "value"   #: ``value`` (a number or a text), ``switch`` (true/false), ``list`` (several texts)
+    kind: str = "value"   #: ``value`` (a number or a text), ``switch`` (true/false), ``list`` (several texts),
+    #: ``file`` (a file's content: a JSON object or a text, written in the request's folder)
 
 
 #: the plant page's fields (the API's keys, as design-plant's option names) -> parameter and label
@@ -85,6 +87,56 @@ FILTER = {
     "dist": Field("dist", N_("distribution")), "sampler": Field("sampler", N_("sampler")),
     "worst-case": Field("worst_case", N_("worst case"), "switch"),
 }
+#: the PID page's fields (the API's keys, as design-pid's option names) -> parameter of
+#: :func:`designer.pid.spec.pid_spec` (or of the Monte Carlo) and label
+PID = {
+    # the plant, one way
+    "plant-fc": Field("plant_fc_hz", N_("plant fc (Hz)")), "plant-zeta": Field("plant_zeta", N_("plant zeta")),
+    # the Sallen-Key plant as built: its parts by their designators (the topology's declaration), their labels
+    **{f"plant-{ref.lower()}": Field(f"plant_{ref.lower()}", ref) for ref in sallen_key_refs(with_gain=False)},
+    "plant-gain": Field("plant_gain", N_("gain K")), "plant-topology": Field("plant_topology", N_("plant topology")),
+    "plant-part": Field("plant_values", N_("plant parts"), "list"),
+    "plant-json": Field("plant_json", N_("plant result.json"), "file"), "plant-tf": Field("plant_tf", N_("model")),
+    "plant-model": Field("plant_model", N_("identified model"), "file"),
+    "plant-method": Field("plant_method", N_("method")),
+    "plant-input": Field("plant_input", N_("plant input range (V)")),
+    "plant-output": Field("plant_output", N_("plant output range (V)")),
+    # the tuning
+    "tuning": Field("tuning", N_("rule")), "kp": Field("kp", N_("Kp")), "ti": Field("ti_s", N_("Ti (s)")),
+    "td": Field("td_s", N_("Td (s)")), "target-overshoot": Field("target_overshoot_pct", N_("target overshoot (%)")),
+    "target-settling": Field("target_settling_s", N_("target settling (s)")),
+    "simc-tauc": Field("simc_tauc_s", N_("SIMC tau_c (s)")), "imc-lambda": Field("imc_lambda_s", N_("IMC lambda (s)")),
+    "min-pm": Field("min_phase_margin_deg", N_("min phase margin (deg)")),
+    "min-gm": Field("min_gain_margin_db", N_("min gain margin (dB)")), "max-ms": Field("max_ms", N_("max Ms")),
+    "robust": Field("robust", N_("robust"), "switch"),
+    "rules-spice": Field("rules_spice", N_("every rule in SPICE"), "switch"),
+    "seed-parts": Field("seed_parts", N_("the seed's parts"), "switch"),
+    # the parts
+    "r-series": Field("r_series", N_("R series")), "c-series": Field("c_series", N_("C series")),
+    "r-min": Field("r_min", N_("R min")), "r-max": Field("r_max", N_("R max")),
+    "c-min": Field("c_min", N_("C min")), "c-max": Field("c_max", N_("C max")),
+    "f-integrator": Field("f_integrator_hz", N_("integrator corner (Hz)")),
+    "f-differentiator": Field("f_differentiator_hz", N_("derivative corner (Hz)")),
+    # the op-amps and the test signal
+    "opamp": Field("opamp", N_("op-amp")), "step": Field("step_v", N_("step (V)")),
+    "edge": Field("edge_s", N_("edge (s)")), "square-freq": Field("square_hz", N_("square wave (Hz)")),
+    "package": Field("package", N_("package")),
+    "no-sim": Field("no_sim", N_("skip SPICE"), "switch"), "simulator": Field("simulator", N_("simulator")),
+    "name": Field("name", N_("design name")),
+    # the tolerance panel (a MonteCarloSpec of the loop as built)
+    "monte-carlo": Field("n", N_("Monte Carlo builds")), "seed": Field("seed", N_("seed")),
+    "tol": Field("tol", N_("tolerances"), "list"), "limit": Field("limits", N_("limits"), "list"),
+    "dist": Field("dist", N_("distribution")), "sampler": Field("sampler", N_("sampler")),
+    "target-ci": Field("target_ci", N_("target interval")), "engine": Field("engine", N_("engine")),
+    "spice-samples": Field("spice_samples", N_("SPICE samples")),
+    "worst-case": Field("worst_case", N_("worst case"), "switch"),
+}
+#: design-pid's defaults as its options type them (the spec parses them as it parses the command line's: the
+#: same numbers to the last bit, so the page's JSON is design-pid's)
+PID_DEFAULTS = {"step_v": "1", "edge_s": "100n", "r_series": "E24", "c_series": "E12", "r_min": "1k", "r_max": "1M",
+                "c_min": "1n", "c_max": "10u"}
+#: the file a file field's content is written to, in the request's folder (never a path the request gives)
+PID_FILES = {"plant_json": "plant-result.json", "plant_model": "plant-model.json"}
 #: the simulators a request may choose (designer.spice.simulate's backends)
 SIMULATORS = ("pyspice", "ngspice-cli")
 _FLAG = re.compile(r"--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?")
@@ -102,6 +154,20 @@ class FilterRequest(NamedTuple):
     simulate: bool
     simulator: str
     name: str                   #: the design's name (its files)
+    argv: list                  #: the command line this request stands for (``tool.argv`` of its JSON)
+
+
+class PidRequest(NamedTuple):
+    """A PID page's request as the library takes it."""
+
+    spec: object                #: :class:`~designer.pid.spec.PidSpec`
+    monte_carlo: object         #: :class:`~designer.tolerance.mcspec.MonteCarloSpec` or None
+    worst_case: bool            #: the extremes over the tolerance box too
+    tol: tuple                  #: the worst case's tolerances (without a Monte Carlo)
+    simulate: bool
+    simulator: str
+    rules_spice: bool           #: a model plant: every applicable rule's loop in SPICE too
+    name: str | None            #: the design's name (its files); None: design-pid's default, from the result
     argv: list                  #: the command line this request stands for (``tool.argv`` of its JSON)
 
 
@@ -187,7 +253,9 @@ def _fields(options, table: dict) -> dict:
             raise DesignError(f"{name!r} is not a field of this page; allowed: {', '.join(sorted(table))}")
         if value is None:
             continue
-        if f.kind == "switch":
+        if f.kind == "file":   # the file's content, as design-pid reads it from a file
+            out[f.param] = value
+        elif f.kind == "switch":
             word = value if isinstance(value, bool) else value.strip().lower() if isinstance(value, str) else None
             if word not in (True, False, "true", "false", "on", "off", ""):
                 raise DesignError(f"{f.param} is a switch: true or false, got {str(value)[:40]}", param=f.param)
@@ -282,6 +350,72 @@ def filter_request(options) -> FilterRequest:
     name = _name(v, f"filter_{spec.filter_type}_{spec.family}{where}")
     return FilterRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False),
                          simulator, name, _argv("design-filter", options))
+
+
+def pid_request(options, tmp: str | None) -> PidRequest:
+    """A PID page's request (its JSON object) as the library's specs, checked as design-pid checks its options.
+
+    Parameters
+    ----------
+    options : dict
+        Field -> value (:data:`PID`'s keys; numbers, or texts in engineering notation; a file field's
+        content as a JSON object or a text).
+    tmp : str or None
+        The request's private folder: a file field's content is written there (:data:`PID_FILES`).
+
+    Returns
+    -------
+    PidRequest
+        The :class:`~designer.pid.spec.PidSpec` (made by :func:`designer.pid.spec.pid_spec`, the mapping the
+        command line uses too), the Monte Carlo's spec and the run's settings.
+
+    Raises
+    ------
+    DesignError
+        One line naming the library parameter at fault (shown by :func:`page_message`).
+    """
+    from ..pid.spec import PLAIN_PARAMS, pid_spec
+    from .request import write_content
+    v = {**PID_DEFAULTS, **_fields(options, PID)}
+    for param, filename in PID_FILES.items():
+        if param in v:
+            try:
+                v[param] = write_content(tmp, filename, v[param], param)
+            except DesignError as exc:
+                raise DesignError(str(exc), param=param) from None
+    spec_keys = ("plant_fc_hz", "plant_zeta", "plant_topology", "plant_values", "plant_json", "plant_tf",
+                 "plant_model", "plant_method", "plant_input", "plant_output", "tuning", "kp", "ti_s", "td_s",
+                 "target_overshoot_pct", "target_settling_s", "simc_tauc_s", "imc_lambda_s", "min_phase_margin_deg",
+                 "min_gain_margin_db", "max_ms", "robust", "r_series", "c_series", "r_min", "r_max", "c_min",
+                 "c_max", "f_integrator_hz", "f_differentiator_hz", "opamp", "step_v", "edge_s", "square_hz",
+                 "package") + PLAIN_PARAMS
+    if v.get("package") not in (None, "single", "dual", "quad"):
+        raise DesignError(f"package {v['package']!r} unknown; allowed: single, dual, quad", param="package")
+    spec = pid_spec({k: v[k] for k in spec_keys if k in v})
+    mc = _monte_carlo(v, ("n", "seed", "sampler", "dist", "tol", "limits", "target_ci", "engine", "spice_samples"))
+    _check_loop_tolerance(spec, mc, v.get("tol", ()))
+    simulator = _simulator(v, "pyspice")
+    name = _name(v, "pid") if "name" in v else None
+    return PidRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False), simulator,
+                      bool(v.get("rules_spice")), name, _argv("design-pid", options))
+
+
+def _check_loop_tolerance(spec, mc, tol) -> None:
+    """The loop's tolerances and limits checked before any work, as design-pid checks them: the parts a
+    tolerance may name (a model plant's parameters stay as given: the controller's alone), the op-amp's
+    spread, each limit a figure of the engine."""
+    from ..cli.pid_tolerance import CONTROLLER_PARTS, LOOP_PARTS
+    from ..core import opamps
+    from ..tolerance.parts import check_items, opamp_nominal
+    items = mc.tol if mc is not None else tuple(tol)
+    if items:
+        check_items(items, LOOP_PARTS if spec.process is None else CONTROLLER_PARTS)
+        opamp_nominal(items, opamps.get(spec.opamp))
+    if mc is not None:
+        from ..tolerance.loop import parse_loop_limit
+        from ..tolerance.spice_loop_mc import parse_limit
+        for item in mc.limits:
+            (parse_loop_limit if mc.engine == "analytic" else parse_limit)(item)
 
 
 def _monte_carlo(v: dict, keys: tuple):

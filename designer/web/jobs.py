@@ -47,10 +47,11 @@ from ..filters import report as filter_report
 from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
 
-__all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACES", "TRACE_POINTS",
-           "Superseded", "bom_shown", "bundle_zip", "check_files", "checks_shown", "circuit_plant_page",
-           "design_filter_task", "design_plant_task", "files_in", "filter_page", "histograms", "identify_page", "pid_page", "plant_page",
-           "run", "run_task", "series_text", "temporaries_in", "warm_up", "written_since"]
+__all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "CLI_ONLY", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACES",
+           "TRACE_POINTS", "Superseded", "bom_shown", "bundle_zip", "check_files", "checks_shown", "circuit_plant_page",
+           "design_filter_task", "design_pid_task", "design_plant_task", "files_in", "filter_page", "histograms",
+           "identify_page", "pid_page", "plant_page", "run", "run_task", "series_text", "temporaries_in",
+           "through_library", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
@@ -399,6 +400,50 @@ def design_filter_task(fields: dict, want: str = "json", tmp: str | None = None)
     return _library_task("design-filter", FILTER, fields, work, want, tmp)
 
 
+def design_pid_task(fields: dict, want: str = "json", tmp: str | None = None) -> dict:
+    """design-pid for the page, the library called directly: the request's fields as the specs
+    (:func:`designer.web.forms.pid_request`, through :func:`designer.pid.spec.pid_spec`, the command line's
+    mapping), :func:`designer.pid.design.design_pid`, the loop's tolerance analysis asked for
+    (:func:`designer.tolerance.mcspec.loop_tolerance`), and the typed result rendered (the sheet and bundle
+    :func:`designer.pid.report.write_outputs` writes).
+
+    Parameters
+    ----------
+    fields : dict
+        The request's JSON object (the PID page's fields, :data:`designer.web.forms.PID`).
+    want : str
+        As :func:`run`'s.
+    tmp : str or None
+        The request's private folder (a file field's content, the files of a sheet or bundle; every
+        temporary file).
+
+    Returns
+    -------
+    dict
+        As :func:`run`'s (the JSON as ``design-pid --json`` prints it); a refusal's ``field`` and ``label``
+        name the page's field at fault.
+    """
+    from .forms import PID
+
+    def work(fields, lang):
+        from ..pid.design import design_pid
+        from ..pid.report import write_outputs
+        from ..pid.spec import default_name
+        from ..tolerance.mcspec import loop_tolerance
+        from .forms import pid_request
+        rq = pid_request(fields, tmp)
+        result = design_pid(rq.spec, simulate=rq.simulate, simulator=rq.simulator, rules_spice=rq.rules_spice)
+        result = loop_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
+        name = rq.name or default_name(rq.spec, result)
+        if want in ("sheet", "bundle"):
+            write_outputs(result, tmp, name)
+        data = json.loads(json.dumps(result.to_dict()))
+        # the command line this request stands for: a record, never parsed
+        data["tool"]["argv"] = rq.argv + ([f"--lang={lang}"] if lang else [])
+        return data, lambda: pid_page(result), name
+    return _library_task("design-pid", PID, fields, work, want, tmp)
+
+
 def _library_task(prog: str, table: dict, fields: dict, work, want: str, tmp: str | None) -> dict:
     """One library-first task: the request's language taken from ``fields``, then ``work(fields, lang)`` (in
     ``tmp``, every temporary file there) gives (the JSON, a function drawing the page, the design's name: its
@@ -439,7 +484,36 @@ def _library_work(prog: str, table: dict, fields: dict, lang: str | None, work, 
 
 
 #: the commands the page runs through the library (no console script, no argv, no printed JSON)
-LIBRARY = {"design-plant": design_plant_task, "design-filter": design_filter_task}
+LIBRARY = {"design-plant": design_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task}
+#: a command's options its page's name table does not map (design-pid's capture identified first, with identify's
+#: options; a replayed build; --fail-on-check): a request with one runs the command's entry point, as before
+CLI_ONLY = {"design-pid": frozenset({"plant-capture", "step-time", "step-amplitude", "window", "format", "input-column",
+                                     "output-column", "sample-time", "columns", "methods", "no-refine", "replay",
+                                     "fail-on-check"})}
+
+
+def through_library(prog: str, options) -> bool:
+    """Whether a request of ``prog`` is run by the library with its fields (:data:`LIBRARY`), not by the
+    command's entry point with an argument list.
+
+    Parameters
+    ----------
+    prog : str
+        The command.
+    options : object
+        The request's JSON (an object of fields; anything else is the library task's to refuse).
+
+    Returns
+    -------
+    bool
+        False for a command without a library task, or a request naming one of its :data:`CLI_ONLY` options.
+    """
+    if prog not in LIBRARY:
+        return False
+    if not isinstance(options, dict):
+        return True
+    only = CLI_ONLY.get(prog, frozenset())
+    return not any(str(k).strip().lstrip("-").replace("_", "-").lower() in only for k in options)
 
 
 # --------------------------------------------------------------------------- identify

@@ -76,3 +76,29 @@ def test_a_plant_json_is_read_and_checked_when_the_spec_is_built(tmp_path):
     assert flag_message(exc).startswith("--plant-json ")
     path.write_text("[1]")
     assert "not a design-plant result.json" in flag_message(refusal(plant_json=str(path)))
+
+
+def test_pid_spec_is_the_one_mapping_from_plain_parameters():
+    """Issue 26: designer.pid.spec.pid_spec turns what a front end has (design-pid's options, the PID page's
+    fields) into the spec: the plant's four parts with its gain as SallenKeyParts, the seed's controller parts;
+    a value None is not given."""
+    from designer.pid.blocks import seed_parts
+    from designer.pid.spec import pid_spec
+    spec = pid_spec({"plant_r1": "820", "plant_r2": "1k", "plant_c1": "10n", "plant_c2": "220n", "plant_gain": None,
+                     "tuning": "amigo", "seed_parts": True, "kp": None})
+    assert spec == PidSpec(plant_parts=SallenKeyParts("820", "1k", "10n", "220n"), tuning="amigo",
+                           controller_parts=seed_parts())
+    assert pid_spec({**SEED, "seed_parts": False}) == PidSpec(**SEED)
+
+
+@pytest.mark.parametrize("params, library, cli", [
+    ({"plant_r1": "820", "plant_r2": "1k"}, "plant_r1, plant_r2, plant_c1 and plant_c2 go together",
+     "--plant-r1, --plant-r2, --plant-c1 and --plant-c2 go together"),
+    ({**SEED, "plant_gain": 2}, "plant_gain goes with plant_r1..plant_c2",
+     "--plant-gain goes with --plant-r1..--plant-c2"),
+])
+def test_pid_spec_refuses_naming_its_parameters(params, library, cli):
+    from designer.pid.spec import pid_spec
+    with pytest.raises(DesignError) as exc:
+        pid_spec(params)
+    assert str(exc.value) == library and flag_message(exc.value) == cli

@@ -142,16 +142,51 @@ def test_a_missing_plant_field_is_named_by_its_label(server):
     assert status == 400 and got["error"] == 'design-plant: error: "fc (Hz)" is required' and got["field"] == "fc"
 
 
-@pytest.mark.parametrize("path, body, argv", [
-    ("/api/pid", {"plant-fc": 3500}, ["design-pid", "--plant-fc", "3500"]),
-    ("/api/pid", {"plant-fc": 3500, "plant-zeta": 0.2, "tuning": "magic"},
-     ["design-pid", "--plant-fc", "3500", "--plant-zeta", "0.2", "--tuning", "magic"]),
+@pytest.mark.parametrize("body, argv", [
+    ({"plant-fc": 3500}, ["--plant-fc", "3500"]),
+    ({"plant-fc": 3500, "plant-zeta": 0.2, "tuning": "magic"},
+     ["--plant-fc", "3500", "--plant-zeta", "0.2", "--tuning", "magic"]),
+    ({"plant-r1": "820", "plant-r2": "1k"}, ["--plant-r1", "820", "--plant-r2", "1k"]),
+    ({"plant-fc": 3500, "plant-zeta": 0.2, "kp": 2}, ["--plant-fc", "3500", "--plant-zeta", "0.2", "--kp", "2"]),
+    ({"plant-fc": 3500, "plant-zeta": 0.2, "step": "9q"},
+     ["--plant-fc", "3500", "--plant-zeta", "0.2", "--step", "9q"]),
 ])
-def test_bad_input_is_a_400_with_the_clis_one_line(server, path, body, argv):
-    status, got = server.post_json(path, body)
+def test_the_pid_page_refuses_with_the_clis_line_in_its_own_words(server, body, argv):
+    """Issue 26 (library-first): /api/pid calls the library with the page's fields; its refusal is design-pid's
+    one line with each option as the page's label (no "--"), and names the field at fault."""
+    from designer.web.forms import PID
+    status, got = server.post_json("/api/pid", body)
     assert status == 400
-    assert got["error"] == cli_error(*argv, "--json", "--no-files")
-    assert "\n" not in got["error"] and "Traceback" not in got["error"]
+    line = cli_error("design-pid", *argv, "--json", "--no-files")
+    want = re.sub(r"--([a-z][a-z0-9-]*)", lambda m: f'"{PID[m.group(1)].label}"', line)
+    assert got["error"] == want and "--" not in got["message"] and "Traceback" not in got["error"], (got, line)
+    named = re.search(r"--([a-z][a-z0-9-]*)", line)
+    assert got.get("label") == (named and PID[named.group(1)].label)
+
+
+def test_pid_answers_design_pids_json(server, tmp_path):
+    """Issue 26: /api/pid is design-pid, the library called with the page's fields (no argv, no console
+    script): the same JSON as ``design-pid --json`` (wall-clock seconds and the argv record apart), for a
+    plant by fn and zeta with the optimiser and a Monte Carlo, by its parts, and as an identified model."""
+    ident = cli_json("identify", str(CAPTURE), "--json")
+    model = tmp_path / "plant-model.json"   # the name the page's content is written under
+    model.write_text(json.dumps(ident))
+    for body, argv in [({"plant-fc": 3500, "plant-zeta": 0.2, "tuning": "optimize", "target-overshoot": 10,
+                         "monte-carlo": 100, "tol": ["R=1%", "C=5%"], "limit": "phase_margin_deg=40:90",
+                         "worst-case": True},
+                        ["--plant-fc", "3500", "--plant-zeta", "0.2", "--tuning", "optimize", "--target-overshoot",
+                         "10", "--monte-carlo", "100", "--tol", "R=1%", "C=5%", "--limit", "phase_margin_deg=40:90",
+                         "--worst-case"]),
+                       ({"plant-r1": 820, "plant-r2": "1k", "plant-c1": "10n", "plant-c2": "220n", "tuning": "amigo",
+                         "opamp": "TL072", "no-sim": True},
+                        ["--plant-r1", "820", "--plant-r2", "1k", "--plant-c1", "10n", "--plant-c2", "220n",
+                         "--tuning", "amigo", "--opamp", "TL072", "--no-sim"]),
+                       ({"plant-model": ident, "no-sim": True}, ["--plant-model", str(model), "--no-sim"])]:
+        status, got = server.post_json("/api/pid", body)
+        assert status == 200, got
+        want = cli_json("design-pid", *argv, "--json", "--no-files")
+        assert got["tool"]["argv"][0] == "design-pid"
+        assert without_run_details(got) == without_run_details(want)
 
 
 @pytest.mark.parametrize("body, words", [
@@ -542,6 +577,8 @@ MALFORMED = [
     ("/api/plant", b"3", {}, "must be a JSON object"),
     ("/api/plant", b'"fc"', {}, "must be a JSON object"),
     ("/api/plant", b"null", {}, "must be a JSON object"),
+    ("/api/pid", b"null", {}, "must be a JSON object"),
+    ("/api/pid", b"[1, 2]", {}, "must be a JSON object"),
     ("/api/plant", b"{not json", {}, "not JSON"),
     ("/api/plant", b'{"fc": 1e999, "zeta": 0.5}', {}, "finite number"),
     ("/api/plant", b'{"fc": NaN, "zeta": 0.5}', {}, "finite number"),
@@ -845,3 +882,18 @@ def test_a_spanish_request_is_refused_in_spanish_naming_its_field(server):
         assert status == 200 and pid["page"]["closed_loop"]["x_label"] == gettext("time from the edge (s)")
     assert pid["page"]["closed_loop"]["x_label"] != "time from the edge (s)"
     assert "--lang=es" in pid["result"]["tool"]["argv"]
+
+
+def test_pid_with_a_capture_runs_design_pid_as_before(server):
+    """Issue 26: the options the PID page's name table does not map (a capture identified first, with
+    identify's options; --replay; --fail-on-check) still work: such a request runs design-pid's entry point,
+    the JSON its --json."""
+    from designer.web.jobs import CLI_ONLY, through_library
+    assert not through_library("design-pid", {"plant_capture": "x"}) and through_library("design-pid", {"kp": 1})
+    assert CLI_ONLY["design-pid"] >= {"plant-capture", "replay"}
+    status, got = server.post_json("/api/pid", {"plant-capture": CAPTURE.read_text(), "tuning": "amigo",
+                                                "no-sim": True})
+    assert status == 200, got
+    want = cli_json("design-pid", "--plant-capture", str(CAPTURE), "--tuning", "amigo", "--no-sim", "--json",
+                    "--no-files")
+    assert got["tuning"] == want["tuning"] and got["tuning"]["method"] == "amigo"

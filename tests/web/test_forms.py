@@ -84,3 +84,50 @@ def test_bad_filter_fields_are_refused_in_the_pages_words(fields, param):
     assert exc.value.param == param
     text, field = page_message(exc.value, FILTER)
     assert "--" not in text and "_" not in text.split("'")[0] and FILTER[field].param == param
+
+
+def test_every_pid_field_is_a_design_pid_option_setting_a_parameter_of_the_specs_or_of_the_run():
+    """Issue 26: the PID page's fields are design-pid's option names, each setting a parameter of
+    designer.pid.spec.pid_spec (the spec's fields and its plain parameters), of the Monte Carlo or of the run."""
+    from designer.cli.pid import pid_parser
+    from designer.pid.spec import PLAIN_PARAMS, PidSpec
+    from designer.web.forms import PID
+    specs = ({f.name for f in dataclasses.fields(PidSpec)} | set(PLAIN_PARAMS)
+             | {f.name for f in dataclasses.fields(MonteCarloSpec)})
+    assert {f.param for f in PID.values()} <= specs | {"no_sim", "simulator", "name", "worst_case", "rules_spice"}
+    assert len({f.label for f in PID.values()}) == len(PID)
+    options = {o for a in pid_parser()._actions for o in a.option_strings}
+    assert {f"--{k}" for k in PID} <= options
+
+
+def test_a_pid_request_is_the_spec_design_pid_builds(tmp_path):
+    """One mapping (designer.pid.spec.pid_spec): the page's fields and design-pid's options give equal specs,
+    the Sallen-Key plant's parts and the seed's controller parts included."""
+    from designer.cli.pid import _build_spec, pid_parser
+    from designer.web.forms import pid_request
+    argv = ["--plant-r1", "820", "--plant-r2", "1k", "--plant-c1", "10n", "--plant-c2", "220n", "--plant-gain", "1",
+            "--tuning", "amigo", "--opamp", "TL072", "--seed-parts", "--step", "0.5"]
+    rq = pid_request({"plant-r1": 820, "plant-r2": "1k", "plant-c1": "10n", "plant-c2": "220n", "plant-gain": 1,
+                      "tuning": "amigo", "opamp": "TL072", "seed-parts": True, "step": 0.5, "monte-carlo": 100,
+                      "tol": "R=1% C=5%"}, str(tmp_path))
+    assert rq.spec == _build_spec(pid_parser().parse_args(argv))
+    assert rq.monte_carlo == MonteCarloSpec(n=100, tol=("R=1%", "C=5%")) and rq.name is None and rq.simulate
+
+
+@pytest.mark.parametrize("fields, param, words", [
+    ({"plant-fc": 3500}, "plant_fc_hz", '"plant fc (Hz)" needs "plant zeta"'),
+    ({"plant-fc": 3500, "plant-zeta": 0.2, "plant-r1": "1k"}, "plant_r1", '"R1", "R2", "C1" and "C2" go together'),
+    ({"plant-r1": "820", "plant-r2": "1k", "plant-c1": "10n", "plant-c2": "220n", "plant-gain": "x"}, "plant_gain",
+     '"gain K"'),
+    ({"plant-fc": 3500, "plant-zeta": 0.2, "plant-gain": 2}, "plant_gain", '"gain K" goes with "R1".."C2"'),
+    ({"plant-fc": 3500, "plant-zeta": 0.2, "tol": "Q9=1%", "worst-case": True}, "tol", '"tolerances"'),
+    ({"plant-fc": 3500, "plant-zeta": 0.2, "monte-carlo": 100, "limit": "nope=1:2"}, "limits", '"limits"'),
+    ({"plant-fc": 3500, "plant-zeta": 0.2, "package": "octal"}, "package", '"package"'),
+])
+def test_bad_pid_fields_are_refused_in_the_pages_words(tmp_path, fields, param, words):
+    from designer.web.forms import PID, pid_request
+    with pytest.raises(DesignError) as exc:
+        pid_request(fields, str(tmp_path))
+    text, field = page_message(exc.value, PID)
+    assert words in text and "--" not in text and "\n" not in text, text
+    assert PID[field].param == param, (field, text)

@@ -162,6 +162,9 @@ D.inPageWords = function (form, text, keepRefs) {
   text = String(text || "")
     .replace(/--tuning (\S+) needs --target-overshoot P \(percent\)/g,
              (all, rule) => D.t('the rule "{rule}" needs a target: fill in "{field}"', {rule, field: label("target-overshoot")}))
+    // ... as the library-first API words it, its fields by their labels already
+    .replace(/^"[^"]+" (\S+) needs "([^"]+)" P \(percent\)/,
+             (all, rule, field) => D.t('the rule "{rule}" needs a target: fill in "{field}"', {rule, field}))
     .replace(/--tuning (\S+) --target-overshoot P\b/g,
              (all, rule) => D.t('choose the rule "{rule}" and fill in "{field}"', {rule, field: label("target-overshoot")}));
   text = text.replace(/--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?(?: \((?:percent|s|Hz|V)\))?/g, (all, name) => {
