@@ -12,7 +12,7 @@ parameter):
 - time constants (tau, tau1, tau2, 1/|p| of every pole): :data:`TAU_RANGE`
 - |K| (either sign: a negative K is an inverting plant): :data:`GAIN_RANGE`
 - fn: :data:`FN_RANGE` (the time-constant range as 1/(2 pi tau))
-- zeta: strictly between 0 and 1 (zeta >= 1 is the SOPDT form)
+- zeta: :data:`ZETA_MIN` up to (not including) 1 (zeta >= 1 is the SOPDT form)
 - theta: 0 to :data:`MAX_DEAD_TIME_RATIO` times the slowest time constant
   (a pure integrator, with none: up to :data:`MAX_DEAD_TIME_S`)
 - a rational plant's order: at most :data:`MAX_ORDER`
@@ -28,7 +28,7 @@ from .errors import DesignError
 from .process import KINDS, PARAMS, ProcessModel, format_g, integ_den, pair_den, sopdt_den
 from .ranges import Range
 
-__all__ = ["MAX_DEAD_TIME_RATIO", "fopdt", "integrating", "model_from_dict", "rational", "sopdt", "underdamped"]
+__all__ = ["MAX_DEAD_TIME_RATIO", "ZETA_MIN", "fopdt", "integrating", "model_from_dict", "rational", "sopdt", "underdamped"]
 
 #: every time constant (tau, tau1, tau2; 1/|p| of a rational plant's poles): 1 ps
 #: (a 160 GHz pole) to 1e6 s (eleven days): beyond either, the numbers are a typo
@@ -37,6 +37,10 @@ TAU_RANGE = Range(1e-12, 1e6, "s")
 GAIN_RANGE = Range(1e-9, 1e9)
 #: natural frequency of an underdamped pair: the time-constant range as 1/(2 pi tau)
 FN_RANGE = Range(1e-7, 1e11, "Hz")
+#: the least damping ratio of an underdamped pair: below it the pair rings for thousands of cycles (Q above
+#: 5000), a typo or an oscillator rather than a plant, and the tangent rules' step reaches 63 % after ~1e236 s
+#: (scipy's bounded search overflows: zeta 1.3e-262 at 251.82 MHz, found by the typed-model fuzz)
+ZETA_MIN = 1e-4
 #: a dead time at most this many times the slowest time constant: beyond it the
 #: plant is a pure delay for any controller, and a typo (ms for us) is likelier
 MAX_DEAD_TIME_RATIO = 100.0
@@ -110,7 +114,7 @@ def _check_fn(fn, name: str) -> float:
 def _check_zeta(zeta, fn: float, names: dict) -> float:
     name = names["zeta"]
     zeta = _real(zeta, name)
-    if not 0.0 < zeta < 1.0:
+    if not ZETA_MIN <= zeta < 1.0:
         hint = ""
         if 1.0 <= zeta <= 1e6:
             # the same pair as two real poles (tau1 s + 1)(tau2 s + 1), tau = 1/(wn (zeta -+ sqrt(zeta^2 - 1))):
@@ -119,7 +123,7 @@ def _check_zeta(zeta, fn: float, names: dict) -> float:
             t1, t2 = (zeta + r) / wn, 1.0 / (wn * (zeta + r))
             hint = (f"; for zeta >= 1 use the SOPDT form, here {names['tau1_s']} = {format_g(t1, 's')} and "
                     f"{names['tau2_s']} = {format_g(t2, 's')}")
-        raise DesignError(f"{name} must be above 0 and below 1 (an underdamped pair), got {zeta:.4g}{hint}")
+        raise DesignError(f"{name} must be {ZETA_MIN:g} or more and below 1 (an underdamped pair), got {zeta:.4g}{hint}")
     return zeta
 
 
