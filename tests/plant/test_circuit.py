@@ -95,3 +95,15 @@ def test_a_section_beyond_the_op_amp_names_the_catalogue_op_amp_fast_enough():
     assert fast is not None and fast.gbw_hz >= need and f"use --opamp {fast.name}" in str(exc.value)
     assert all(a.gbw_hz < need or a.gbw_hz >= fast.gbw_hz for a in map(opamps.get, opamps.names()) if not a.ideal)
     check_opamp_reach(mfb, target, fast)     # fast enough: no refusal
+
+
+@pytest.mark.xfail(strict=True, reason="the generic search leaves out capacitor ratios below the topology's continuous "
+                   "bound (4 Q^2 for the unity-gain Sallen-Key), where rounded resistors can still come nearer: at "
+                   "fc 212 Hz, zeta 0.998 the fast path's C1 = C2 (zeta 1.0) has worst error 0.196 %, the generic "
+                   "search's best 0.314 % (found by the hypothesis test above, which CI runs derandomized)")
+def test_generic_search_reaches_a_ratio_just_below_the_bound():
+    rv, cv = eseries.values("E24", 100, 1e6), eseries.values("E12", 100e-12, 10e-6)
+    fc, zeta = 212.0, 0.998046875
+    generic = circuit.search(SK, circuit.plant_target(SK, fc, zeta), rv, cv, top=1)[0]
+    fast = selection.joint_search(fc, zeta, rv, cv, 1.0, top=1)[0]
+    assert generic.worst == pytest.approx(fast.worst, rel=1e-9, abs=1e-15)
