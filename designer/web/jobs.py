@@ -85,11 +85,24 @@ _RUNNING = False
 SWALLOWING_MODULES = ("logging",)
 
 
+def _starting_a_child(frame) -> bool:
+    """Whether ``frame`` runs inside :class:`subprocess.Popen`'s constructor (its ``_execute_child``): an
+    exception raised there leaves the process it forked (an ``ngspice -b``) running, its Popen never returned,
+    so nothing kills or reaps it (Python warns "subprocess N is still running" when the object goes)."""
+    while frame is not None:
+        if frame.f_globals.get("__name__") == "subprocess" and frame.f_code.co_name in ("__init__", "_execute_child"):
+            return True
+        frame = frame.f_back
+    return False
+
+
 def _cancel(signum, frame) -> None:
     if not _RUNNING:
         return
-    # inside ngspice's callbacks cffi would swallow it, inside an at-fork hook the interpreter: again in 5 ms
-    if lifetime.in_native() or (frame is not None and frame.f_globals.get("__name__") in SWALLOWING_MODULES):
+    # inside ngspice's callbacks cffi would swallow it, inside an at-fork hook the interpreter, inside Popen's
+    # start the child it forked would be left running with no one to kill and reap it: again in 5 ms
+    if lifetime.in_native() or (frame is not None and frame.f_globals.get("__name__") in SWALLOWING_MODULES) \
+            or _starting_a_child(frame):
         signal.signal(signal.SIGALRM, _cancel)
         signal.setitimer(signal.ITIMER_REAL, 0.005)
         return
