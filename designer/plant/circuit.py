@@ -44,13 +44,16 @@ from ..core.errors import DesignError
 from ..filters import registry
 from ..filters.topology import SectionTarget, Topology, nodal_system
 
-__all__ = ["DEFAULT_TOPOLOGY", "FIGURES", "Candidate", "plant_target", "capacitor_combinations", "candidate_set",
+__all__ = ["BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "Candidate", "plant_target", "capacitor_combinations", "candidate_set",
            "search", "brute_force", "opamp_tf", "dominant_pairs", "circuit_figures", "evaluate", "sensitivities",
            "corner_frequencies"]
 
 #: the topology of ``design-plant`` without ``--topology``: the seed's plant (its own search, :mod:`.selection`)
 DEFAULT_TOPOLOGY = "sallen-key-lowpass"
 #: the figures :func:`circuit_figures` gives (the Monte Carlo's, as the Sallen-Key engine's)
+#: how far under a topology's capacitor-ratio bound the search still takes a pair (the bound's resistors,
+#: rounded): a pair further under it is off by more than the series' rounding (zeta ~5 % high at 1/1.1)
+BELOW_BOUND = 1.1
 FIGURES = ("fn_hz", "zeta", "q", "ideal_fn_hz", "ideal_zeta", "ideal_q", "overshoot_pct", "peak_time_s", "gain")
 
 
@@ -148,16 +151,24 @@ def capacitor_combinations(topology: Topology, target: SectionTarget, c_values) 
     if "ratio" in topology.choices:
         i, j = np.meshgrid(np.arange(len(c_values)), np.arange(len(c_values)), indexing="ij")
         m = c_values[j.ravel()] / c_values[i.ravel()]
-        keep = m >= bound * (1 - 1e-12)    # below the topology's ratio bound no resistors realise it
+        # below the topology's ratio bound no exact resistors realise the target, but rounded ones can still
+        # come nearer than any pair above it (unity-gain Sallen-Key at fc 212 Hz, zeta 0.998: C1 = C2 gives
+        # zeta 1.0, 0.196 % off, the best above the bound 0.314 %): a pair up to BELOW_BOUND under the bound
+        # takes the bound's resistors (the nearest realisable synthesis) with its own capacitors
+        keep = m >= bound / BELOW_BOUND * (1 - 1e-12)
         ref, m = c_values[i.ravel()][keep], m[keep]
         keys, inverse = np.unique(np.round(np.log(m), 9), return_inverse=True)
-        choices = [{"ratio": float(m[np.argmax(inverse == k)])} for k in range(len(keys))]
+        actual = [float(m[np.argmax(inverse == k)]) for k in range(len(keys))]
+        choices = [{"ratio": max(r, bound * (1 + 1e-9))} for r in actual]
     else:
-        ref, inverse, choices = c_values, np.zeros(len(c_values), int), [{}]
+        ref, inverse, choices, actual = c_values, np.zeros(len(c_values), int), [{}], [None]
     bases = []
-    for ch in choices:
+    for ch, r in zip(choices, actual):
         try:
             v = topology.synthesize(SectionTarget(target.kind, target.fn_hz, target.q, target.gain, c_f=c0), **ch)
+            if r is not None and r < ch["ratio"]:   # C2 = ratio C1: the pair's own capacitors
+                v = {k: x * r / ch["ratio"] if k in caps and k != topology.reference_capacitor else x
+                     for k, x in v.items()}
             bases.append(v if all(math.isfinite(x) and x > 0 for x in v.values()) else None)
         except DesignError:
             bases.append(None)

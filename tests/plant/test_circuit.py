@@ -97,11 +97,10 @@ def test_a_section_beyond_the_op_amp_names_the_catalogue_op_amp_fast_enough():
     check_opamp_reach(mfb, target, fast)     # fast enough: no refusal
 
 
-@pytest.mark.xfail(strict=True, reason="the generic search leaves out capacitor ratios below the topology's continuous "
-                   "bound (4 Q^2 for the unity-gain Sallen-Key), where rounded resistors can still come nearer: at "
-                   "fc 212 Hz, zeta 0.998 the fast path's C1 = C2 (zeta 1.0) has worst error 0.196 %, the generic "
-                   "search's best 0.314 % (found by the hypothesis test above, which CI runs derandomized)")
 def test_generic_search_reaches_a_ratio_just_below_the_bound():
+    """Bug fixed (hypothesis, the test above): the generic search left out capacitor ratios under the topology's
+    continuous bound (4 Q^2 at unity gain), where rounded resistors still come nearer: at fc 212 Hz, zeta 0.998
+    the fast path's C1 = C2 (zeta 1.0) against the generic search's best above the bound (0.314 % off)."""
     rv, cv = eseries.values("E24", 100, 1e6), eseries.values("E12", 100e-12, 10e-6)
     fc, zeta = 212.0, 0.998046875
     generic = circuit.search(SK, circuit.plant_target(SK, fc, zeta), rv, cv, top=1)[0]
