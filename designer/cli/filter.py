@@ -216,6 +216,10 @@ def summary_text(result) -> str:
     if s.has_mask:
         broken = [f[f"mask_violation_{k}_db"] for k in ("joint", "per_stage", "nearest")]
         lines.append("  mask broken by (0: met): joint {:.3g} dB, per-stage {:.3g} dB, nearest {:.3g} dB".format(*broken))
+    if "delay_error_per_stage_pct" in f:
+        lines.append(f"  group delay error (at most {s.max_delay_error_pct:g} %, weighed by the joint choice): joint "
+                     f"{f['delay_error_pct']:.3g} %, per-stage {f['delay_error_per_stage_pct']:.3g} %, nearest "
+                     f"{f['delay_error_nearest_pct']:.3g} %")
     if result.spice:
         sp = result.spice
         lines.append(f"SPICE (.ac, {sp['simulator']}) against the analytic response of these parts: max deviation "

@@ -43,7 +43,7 @@ from ..core.eseries import values as series_values
 from ..core.units import format_eng
 from .cascade import Cascade
 from .deck import simulate_ac
-from .joint import joint_search, objective, per_stage
+from .joint import delay_columns, joint_search, objective, per_stage
 from .prototype import (DELAY_POINTS, SectionPlan, bandpass_method, delay_error_pct, group_delay, order_from_mask,
                         plan_bandpass, plan_sections, prototype_zpk,
                         reference_bandpass, reference_response)
@@ -113,6 +113,7 @@ class StageDesign:
     gbw_needed_hz: float = 0.0
     fn_design_hz: float | None = None
     q_design: float | None = None
+    delays: np.ndarray | None = None
 
     @property
     def values(self) -> dict:
@@ -155,6 +156,9 @@ class FilterDesign:
         The SPICE proof's figures when run (:meth:`designer.filters.verify.Proof.to_dict`).
     proof : designer.filters.verify.Proof or None
         The SPICE proof itself (:func:`designer.filters.verify.prove`).
+    problem : tuple or None
+        The joint search's problem as :func:`~designer.filters.joint.joint_search` took it (errors per stage,
+        with a delay target's columns; limits; n_dev), so that a check can enumerate the same candidates.
     """
 
     spec: FilterSpec
@@ -164,6 +168,7 @@ class FilterDesign:
     figures: dict = field(default_factory=dict)
     spice: dict | None = None
     proof: object = None
+    problem: tuple | None = None
 
     @property
     def opamp(self):
@@ -572,7 +577,10 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         deviation from the ideal over the objective grid, op-amp included, of each
         choice), ``passband_deviation_db``, ``f3_hz`` against ``f3_target_hz``, the
         search's size and time; with a mask, its margins (``mask_passband_margin_db``,
-        ``mask_stopband_margin_db``) and how far each choice breaks it (``mask_violation_*_db``).
+        ``mask_stopband_margin_db``) and how far each choice breaks it (``mask_violation_*_db``); with a
+        group-delay target, the joint choice's delay figures (:func:`delay_figures`) and the per-stage
+        rounding's and the all-nearest's beside them (``delay_error_per_stage_pct``,
+        ``delay_target_met_per_stage``, ``delay_error_nearest_pct``, ``delay_target_met_nearest``).
 
     Raises
     ------
@@ -667,13 +675,26 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
                                   gbw_needed_hz=need, fn_design_hz=built.fn_hz, q_design=built.q))
     pruned = _prune(stages)
     errors = [st.errors for st in stages]
+    search, all_limits, n_dev = errors, limits, None
+    if spec.has_delay_target:
+        # the delay target as more limit columns, read by the limits only (joint.py's rule)
+        f_d, dw = _delay_grid(spec, fc)
+        for st in stages:
+            topo = get_topology(st.topology)
+            st.delays = _central_delay(lambda sv, t=topo, c=st.candidates: t.response(
+                {r: np.array([v[r] for v in c])[:, None] for r in t.designators}, sv[None, :], opamp), f_d, dw)
+        tau_ref = float(group_delay(prototype_zpk(spec.family, order, 1.0, spec.bessel_norm), [0.0], fc)[0])
+        n_dev = errors[0].shape[1]
+        cols, d_limits = delay_columns([st.delays for st in stages], spec.max_delay_error_pct, tau_ref, n_dev)
+        search = [np.hstack([e, c]) for e, c in zip(errors, cols)]
+        all_limits = (limits or []) + d_limits
     t_cand = time.perf_counter() - t0
     t1 = time.perf_counter()
-    choice, j_joint, examined = joint_search(errors, limits=limits)
+    choice, j_joint, examined = joint_search(search, limits=all_limits, n_dev=n_dev)
     t_search = time.perf_counter() - t1
     for st, c in zip(stages, choice):
         st.chosen = c
-    result = FilterDesign(spec, order, fc, stages)
+    result = FilterDesign(spec, order, fc, stages, problem=(search, all_limits, n_dev))
     result.figures = _figures(result, grid, errors, choice, j_joint, examined, t_cand, t_search)
     result.figures["candidates_dropped"] = pruned
     if limits:
@@ -681,6 +702,13 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         for key, ch in (("joint", choice), ("per_stage", per_stage(errors)), ("nearest", [st.nearest for st in stages])):
             total = sum(e[c] for e, c in zip(errors, ch))
             result.figures[f"mask_violation_{key}_db"] = max(0.0, *(o + sg * total[col] for col, sg, o in limits))
+    if spec.has_delay_target:
+        # what the per-stage rounding (and every part's nearest value) would give for the delay, beside the joint's
+        for key, ch in (("per_stage", per_stage(errors)), ("nearest", [st.nearest for st in stages])):
+            tau = sum(st.delays[c] for st, c in zip(stages, ch))
+            result.figures[f"delay_error_{key}_pct"] = delay_error_pct(tau, tau[0])
+            result.figures[f"delay_target_met_{key}"] = bool(result.figures[f"delay_error_{key}_pct"]
+                                                             <= spec.max_delay_error_pct)
     if simulate:
         result.proof = prove(result, simulator)
         result.spice = result.proof.to_dict()
@@ -871,14 +899,23 @@ def delay_figures(spec: FilterSpec, order: int, fc_hz: float, response) -> dict:
     dict
         ``delay_error_pct`` (the parts'), ``delay_error_ideal_pct``, ``delay_dc_s``, ``delay_target_met``.
     """
-    f = np.linspace(0.0, spec.delay_to_hz, DELAY_POINTS)
-    dw = 2 * math.pi * fc_hz * 1e-4
-    w = 2 * math.pi * f
-    tau = -np.angle(response(1j * (w + dw)) / response(1j * (w - dw))) / (2 * dw)
+    f, dw = _delay_grid(spec, fc_hz)
+    tau = _central_delay(response, f, dw)
     ideal = group_delay(prototype_zpk(spec.family, order, 1.0, spec.bessel_norm), f, fc_hz)
     err = delay_error_pct(tau, tau[0])
     return {"delay_error_pct": err, "delay_error_ideal_pct": delay_error_pct(ideal, ideal[0]),
             "delay_dc_s": float(tau[0]), "delay_target_met": bool(err <= spec.max_delay_error_pct)}
+
+
+def _delay_grid(spec: FilterSpec, fc_hz: float) -> tuple:
+    """The frequencies a delay target is judged on (DC to its frequency, DELAY_POINTS) and the half-step dw."""
+    return np.linspace(0.0, spec.delay_to_hz, DELAY_POINTS), 2 * math.pi * fc_hz * 1e-4
+
+
+def _central_delay(response, f, dw: float) -> np.ndarray:
+    """-arg(H(j(w + dw)) / H(j(w - dw))) / (2 dw) at ``f`` (Hz), along the last axis of ``response``'s result."""
+    w = 2 * math.pi * np.asarray(f, float)
+    return -np.angle(response(1j * (w + dw)) / response(1j * (w - dw))) / (2 * dw)
 
 
 def with_choice(result: FilterDesign, choice, simulate: bool = False, simulator: str = "ngspice-cli") -> FilterDesign:

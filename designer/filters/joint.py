@@ -22,7 +22,17 @@ passband edge, the attenuation at the stopband edge): ``limits`` of
 (column k, sign, offset) whose violation offset + sign * S(f_k) > 0 costs
 :data:`PENALTY` dB per dB in J, so a choice that meets the mask wins over any
 that does not; its bound is the violation at the best end of the reachable
-interval. Per-stage rounding (:func:`per_stage`, each stage minimising its own
+interval. A Bessel's group-delay target (the delay within T % of its DC value
+from DC to a frequency) is more one-sided limits of the same kind, on columns
+that only limits read (``n_dev``: J's deviation is max_f |S| over the first
+``n_dev`` columns, the dB ones): the cascade's delay is the sum of its stages',
+tau = sum_i tau_i, so |tau(f) - tau(0)| <= T/100 tau(0) is, at each f, the two
+sums sum_i (+-100 (tau_i(f) - tau_i(0)) - T tau_i(0)) / tau_ref <= 0 (tau_ref
+the ideal's DC delay), linear in the stages like the dB errors; their
+violation is the delay error's excess over T in % points (times tau(0) /
+tau_ref, about 1), weighted by the same :data:`PENALTY`: a choice that meets
+the mask and the delay target wins over any that does not, and the search stays
+exact (the same interval bound holds for every limit column). Per-stage rounding (:func:`per_stage`, each stage minimising its own
 error alone: what the filter design tools do) is a point of the same product,
 so the joint choice is never worse.
 """
@@ -33,7 +43,7 @@ import itertools
 
 import numpy as np
 
-__all__ = ["objective", "per_stage", "descend", "joint_search", "brute_force"]
+__all__ = ["objective", "per_stage", "descend", "joint_search", "brute_force", "delay_columns"]
 
 #: dB of objective per dB of mask violation: a mask met is worth more than any deviation
 PENALTY = 1000.0
@@ -41,15 +51,45 @@ PENALTY = 1000.0
 _BLOCK = 4_000_000
 
 
-def _score(total: np.ndarray, limits) -> np.ndarray:
-    """J of sums ``total`` (rows): max_f |S|, and PENALTY x the worst mask violation."""
-    j = np.max(np.abs(total), axis=-1)
+def _score(total: np.ndarray, limits, n_dev=None) -> np.ndarray:
+    """J of sums ``total`` (rows): max_f |S| over the first ``n_dev`` columns, and PENALTY x the worst
+    limit's violation."""
+    j = np.max(np.abs(total[..., :n_dev]), axis=-1)
     for col, sign, offset in limits or ():
         j = np.maximum(j, PENALTY * (offset + sign * total[..., col]))
     return j
 
 
-def objective(errors: list, choice, limits=None) -> float:
+def delay_columns(taus: list, max_error_pct: float, tau_ref: float, first: int) -> tuple:
+    """A group-delay target as limit columns (the module's rule): per stage, the columns
+    +-100 (tau_i(f) - tau_i(0)) / tau_ref - T tau_i(0) / tau_ref at every f but DC, and their limits.
+
+    Parameters
+    ----------
+    taus : list of ndarray
+        Per stage, shape (n_candidates_i, n_f): each candidate's group delay (s), DC first.
+    max_error_pct : float
+        T: the delay error allowed, % of the DC delay.
+    tau_ref : float
+        The scale of the columns (s): the ideal's DC delay, so that a violation reads in % points.
+    first : int
+        The index the first column will have (the number of columns before them).
+
+    Returns
+    -------
+    tuple
+        (list of ndarray per stage, shape (n_candidates_i, 2 (n_f - 1)); list of limits (column, 1, 0)).
+    """
+    cols = []
+    for tau in taus:
+        dev = 100 * (tau[:, 1:] - tau[:, :1]) / tau_ref
+        allowed = max_error_pct * tau[:, :1] / tau_ref
+        cols.append(np.hstack([dev - allowed, -dev - allowed]))
+    n = cols[0].shape[1] if cols else 0
+    return cols, [(first + k, 1.0, 0.0) for k in range(n)]
+
+
+def objective(errors: list, choice, limits=None, n_dev=None) -> float:
     """J of one choice: the cascade's worst deviation in dB (and its mask violation, weighted).
 
     Parameters
@@ -60,6 +100,8 @@ def objective(errors: list, choice, limits=None) -> float:
         One candidate index per stage.
     limits : list of tuple, optional
         (column, sign, offset): the violation offset + sign * S[column] must stay <= 0.
+    n_dev : int, optional
+        The columns of the deviation (the first ``n_dev``; default all); the others serve ``limits`` only.
 
     Returns
     -------
@@ -67,26 +109,28 @@ def objective(errors: list, choice, limits=None) -> float:
         max(max_f |sum_i errors[i][choice[i]]|, PENALTY x the worst violation).
     """
     total = sum(e[c] for e, c in zip(errors, choice))
-    return float(_score(total, limits))
+    return float(_score(total, limits, n_dev))
 
 
-def per_stage(errors: list) -> list:
+def per_stage(errors: list, n_dev=None) -> list:
     """Each stage's own best candidate (least max_f |e_i|), independently of the others.
 
     Parameters
     ----------
     errors : list of ndarray
         As :func:`objective`.
+    n_dev : int, optional
+        As :func:`objective`: each stage's own deviation is over these columns.
 
     Returns
     -------
     list of int
         One index per stage.
     """
-    return [int(np.argmin(np.max(np.abs(e), axis=1))) for e in errors]
+    return [int(np.argmin(np.max(np.abs(e[:, :n_dev]), axis=1))) for e in errors]
 
 
-def brute_force(errors: list, limits=None) -> tuple:
+def brute_force(errors: list, limits=None, n_dev=None) -> tuple:
     """Exhaustive enumeration of every combination (for tests and small cases).
 
     Parameters
@@ -94,6 +138,8 @@ def brute_force(errors: list, limits=None) -> tuple:
     errors : list of ndarray
         As :func:`objective`.
     limits : list of tuple, optional
+        As :func:`objective`.
+    n_dev : int, optional
         As :func:`objective`.
 
     Returns
@@ -103,13 +149,13 @@ def brute_force(errors: list, limits=None) -> tuple:
     """
     best, best_j = None, np.inf
     for choice in itertools.product(*(range(len(e)) for e in errors)):
-        j = objective(errors, choice, limits)
+        j = objective(errors, choice, limits, n_dev)
         if j < best_j:
             best, best_j = list(choice), j
     return best, best_j
 
 
-def descend(errors: list, choice, limits=None) -> list:
+def descend(errors: list, choice, limits=None, n_dev=None) -> list:
     """Coordinate descent from ``choice``: each stage in turn moved to its best
     candidate with the others held, until no move helps. A local optimum whose J
     bounds :func:`joint_search` tightly from the start.
@@ -122,6 +168,8 @@ def descend(errors: list, choice, limits=None) -> list:
         The starting choice.
     limits : list of tuple, optional
         As :func:`objective`.
+    n_dev : int, optional
+        As :func:`objective`.
 
     Returns
     -------
@@ -130,20 +178,20 @@ def descend(errors: list, choice, limits=None) -> list:
     """
     choice = list(choice)
     total = sum(e[c] for e, c in zip(errors, choice))
-    best = float(_score(total, limits))
+    best = float(_score(total, limits, n_dev))
     improved = True
     while improved:
         improved = False
         for i, e in enumerate(errors):
             others = total - e[choice[i]]
-            j = _score(others[None, :] + e, limits)
+            j = _score(others[None, :] + e, limits, n_dev)
             c = int(np.argmin(j))
             if j[c] < best - 1e-15:
                 best, choice[i], total, improved = float(j[c]), c, others + e[c], True
     return choice
 
 
-def joint_search(errors: list, start=None, limits=None) -> tuple:
+def joint_search(errors: list, start=None, limits=None, n_dev=None) -> tuple:
     """The exact minimiser of :func:`objective` over the product of the candidate sets.
 
     Parameters
@@ -154,6 +202,8 @@ def joint_search(errors: list, start=None, limits=None) -> tuple:
         A known choice whose J bounds the search (default: :func:`per_stage`).
     limits : list of tuple, optional
         As :func:`objective`.
+    n_dev : int, optional
+        As :func:`objective`.
 
     Returns
     -------
@@ -161,8 +211,8 @@ def joint_search(errors: list, start=None, limits=None) -> tuple:
         (choice as a list of int, J, number of partial choices examined).
     """
     n = len(errors)
-    start = descend(errors, per_stage(errors) if start is None else start, limits)
-    best_j = objective(errors, start, limits)
+    start = descend(errors, per_stage(errors, n_dev) if start is None else start, limits, n_dev)
+    best_j = objective(errors, start, limits, n_dev)
     # the stages whose candidates differ most first: their choice decides most, and the
     # narrow remainder [L, U] then bounds tightly
     order = sorted(range(n), key=lambda i: -float(np.max(np.ptp(errors[i], axis=0))))
@@ -188,7 +238,7 @@ def joint_search(errors: list, start=None, limits=None) -> tuple:
             examined += len(block)
             # distance from 0 of the interval every completion can still reach, at each f
             low, high = block + rest_lo[k + 1], block + rest_hi[k + 1]
-            bound = np.max(np.maximum(np.maximum(low, -high), 0.0), axis=1)
+            bound = np.max(np.maximum(np.maximum(low[:, :n_dev], -high[:, :n_dev]), 0.0), axis=1)
             for col, sign, offset in limits or ():
                 best_end = low[:, col] if sign > 0 else high[:, col]
                 bound = np.maximum(bound, PENALTY * (offset + sign * best_end))
@@ -200,7 +250,7 @@ def joint_search(errors: list, start=None, limits=None) -> tuple:
                 kept_picks.append(np.hstack([base, cand])[keep])
         partial = np.vstack(kept_sums)
         picks = np.vstack(kept_picks)
-    j = _score(partial, limits)
+    j = _score(partial, limits, n_dev)
     w = int(np.argmin(j))
     choice = [0] * n
     for k, i in enumerate(order):

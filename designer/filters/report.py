@@ -416,6 +416,13 @@ def _tables(data: FilterSheet) -> list:
                   "further from its target than rounding would put them, when that makes the whole response "
                   "closer.").format(joint=f"{f['error_joint_db']:.3g}", per_stage=f"{f['error_per_stage_db']:.3g}",
                                     nearest=f"{f['error_nearest_db']:.3g}"))
+    if "delay_error_per_stage_pct" in f:
+        text.append(_("The group-delay target is part of the joint choice: the delay departs {joint} % from its DC "
+                      "value (at most {target} % asked), against {per_stage} % when each stage is rounded on its own "
+                      "and {nearest} % with every part at its nearest value (a set that meets the target wins over one that "
+                      "does not, whatever their deviations).").format(
+            joint=f"{f['delay_error_pct']:.3g}", target=f"{s.max_delay_error_pct:g}",
+            per_stage=f"{f['delay_error_per_stage_pct']:.3g}", nearest=f"{f['delay_error_nearest_pct']:.3g}"))
     return [R.table([_("stage"), _("table fn/fC"), _("table Q"), _("table k"), _("design fn/fc"), "fn", "Q",
                      _("synthesised for fn"), _("and Q"), _("built fn"), _("built Q")], rows, "compact"),
             *[R.text(t) for t in text]]

@@ -347,6 +347,20 @@ def test_bessel_delay_target_picks_the_order_and_is_checked_on_spice(tmp_path, c
     assert "the group delay within 1 % of its DC value up to 1 kHz" in out and ": met" in out
 
 
+def test_delay_target_summary_shows_the_per_stage_roundings_delay(capsys):
+    # the summary puts the joint choice's delay error beside the per-stage rounding's and the nearest values'
+    argv = ["--family", "bessel", "--passband", "1k", "--max-loss", "3", "--stopband", "5k", "--min-attenuation",
+            "40", "--max-delay-error", "0.15", "--delay-to", "500", "--series", "E12", "--c-series", "E12",
+            "--opamp", "TL072", "--no-sim"]
+    assert design_filter_main(argv + ["--json"]) == 0
+    f = json.loads(capsys.readouterr().out)["figures"]
+    assert design_filter_main(argv) == 0
+    out = capsys.readouterr().out
+    assert (f"group delay error (at most 0.15 %, weighed by the joint choice): joint {f['delay_error_pct']:.3g} %, "
+            f"per-stage {f['delay_error_per_stage_pct']:.3g} %, nearest {f['delay_error_nearest_pct']:.3g} %") in out
+    assert f["delay_target_met"] and not f["delay_target_met_per_stage"]
+
+
 def test_analyze_filter_writes_its_sheet_in_the_language_asked(designed, tmp_path, capsys):
     from helpers import english_left
     assert analyze_filter_main(["--from", str(designed), "--no-sim", "--out", str(tmp_path / "es"), "--lang",

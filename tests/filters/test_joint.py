@@ -1,6 +1,9 @@
 """The joint E-series choice (designer.filters.joint): exact over its
 candidate set (equal to exhaustive enumeration), never worse than per-stage
-rounding, on random error tables and on a real cascade's candidates."""
+rounding, on random error tables and on a real cascade's candidates; with a
+group-delay target, meeting it where per-stage rounding misses."""
+
+import itertools
 
 import numpy as np
 import pytest
@@ -9,7 +12,8 @@ from hypothesis import strategies as st
 
 from designer.filters import FilterSpec
 from designer.filters.design import design
-from designer.filters.joint import brute_force, descend, joint_search, objective, per_stage
+from designer.filters.joint import brute_force, delay_columns, descend, joint_search, objective, per_stage
+from designer.filters.prototype import delay_error_pct
 
 
 @given(seed=st.integers(0, 2 ** 32 - 1), stages=st.integers(1, 4), smooth=st.booleans())
@@ -65,3 +69,53 @@ def test_mask_design_joint_choice_meets_the_mask():
     assert f["mask_passband_margin_db"] >= -1e-9 and f["mask_stopband_margin_db"] >= -1e-9
     # per-stage rounding breaks this mask (the reason the joint objective carries it)
     assert f["mask_violation_per_stage_db"] > 0.1
+
+
+@given(seed=st.integers(0, 2 ** 32 - 1), stages=st.integers(1, 4))
+def test_joint_with_limit_only_columns_equals_brute_force(seed, stages):
+    # columns past n_dev (a delay target's) enter through their limits only, never the deviation
+    rng = np.random.default_rng(seed)
+    n_dev = 10
+    taus = [np.abs(rng.normal(1.0, 0.05, (int(rng.integers(1, 6)), 8))) for _ in range(stages)]
+    cols, limits = delay_columns(taus, 2.0, float(sum(t[0, 0] for t in taus)), n_dev)
+    errors = [np.hstack([rng.normal(0, 0.2, (len(t), n_dev)), c]) for t, c in zip(taus, cols)]
+    choice, j, _ = joint_search(errors, limits=limits, n_dev=n_dev)
+    _, j_brute = brute_force(errors, limits, n_dev)
+    assert j == pytest.approx(j_brute, abs=1e-9)
+    assert objective(errors, choice, limits, n_dev) == pytest.approx(j, abs=1e-9)
+    # the limits read the delay error: met exactly when the delay error is within 2 %
+    total = sum(t[c] for t, c in zip(taus, choice))
+    met = max(0.0, *(sg * np.sum([e[c][col] for e, c in zip(errors, choice)]) + o for col, sg, o in limits)) == 0.0
+    assert met == (delay_error_pct(total, total[0]) <= 2.0 + 1e-9)
+
+
+#: a Bessel mask whose E12 parts the delay target decides (found by a scan of Bessel masks, series and delay_to)
+DELAY_CASE = dict(family="bessel", passband_hz=1e3, max_loss_db=3, stopband_hz=5e3, min_attenuation_db=40,
+                  delay_to_hz=500.0, r_series="E12", c_series="E12", opamp="TL072")
+
+
+def test_delay_target_joint_meets_it_where_rounding_misses():
+    # a target no choice can miss (50 %): the joint choice is the deviation's alone, as before the delay counted
+    loose = design(FilterSpec(max_delay_error_pct=50.0, **DELAY_CASE))
+    lf = loose.figures
+    # the least delay error any candidate set gives, by enumeration
+    least = min(delay_error_pct(t, t[0]) for t in
+                (sum(x) for x in itertools.product(*(s.delays for s in loose.stages))))
+    # a target between what the candidates can do (and the ideal, so the order stays) and what the deviation's
+    # joint choice and the per-stage rounding give
+    target = (max(least, lf["delay_error_ideal_pct"]) + min(lf["delay_error_pct"], lf["delay_error_per_stage_pct"])) / 2
+    d = design(FilterSpec(max_delay_error_pct=target, **DELAY_CASE))
+    f = d.figures
+    assert d.order == loose.order
+    assert not f["delay_target_met_per_stage"] and f["delay_error_per_stage_pct"] > target
+    assert lf["delay_error_pct"] > target        # the joint choice without the delay in its objective misses
+    assert f["delay_target_met"] and f["delay_error_pct"] <= target
+    assert f["mask_violation_joint_db"] == 0.0
+    # exact over its candidates: brute force over the same problem agrees
+    search, limits, n_dev = d.problem
+    choice = [s.chosen for s in d.stages]
+    _, j_brute = brute_force(search, limits, n_dev)
+    assert objective(search, choice, limits, n_dev) == pytest.approx(j_brute, abs=1e-9)
+    # the delay from the stages' candidate delays is the cascade's (delay_figures, by the cascade's response)
+    tau = sum(s.delays[c] for s, c in zip(d.stages, choice))
+    assert delay_error_pct(tau, tau[0]) == pytest.approx(f["delay_error_pct"], abs=1e-6)

@@ -197,3 +197,18 @@ def test_the_spanish_sheet_names_the_package_and_the_schematics_stages_in_spanis
         assert t["DIP-8 single"] in text
         assert t["first order"] in svg and t["Stage {number}: {topology}"].format(number=1, topology="") in svg
         assert re.search(rf"fn \d+[{point}]\d+ Hz, Q 0[{point}]\d+", svg), svg
+
+
+def test_the_sheet_shows_the_delay_per_stage_rounding_would_give():
+    # a delay target's design: the sheet names the joint choice's delay error beside the per-stage rounding's and
+    # the all-nearest's, as it does for the dB deviation (the figures design() computed)
+    r = design(FilterSpec(family="bessel", passband_hz=1e3, max_loss_db=3, stopband_hz=10e3, min_attenuation_db=30,
+                          max_delay_error_pct=1, delay_to_hz=1e3, opamp="TL072"), simulate=False)
+    f = r.figures
+    text = to_text("sheet", sections(sheet_of(r), with_images=False))
+    assert (f"the delay departs {f['delay_error_pct']:.3g} % from its DC value (at most 1 % asked), against "
+            f"{f['delay_error_per_stage_pct']:.3g} % when each stage is rounded on its own and "
+            f"{f['delay_error_nearest_pct']:.3g} % with every part") in " ".join(text.split())
+    # without a target the sheet says nothing of it
+    plain = design(FilterSpec(**SPECS["sk-lp4-dual"]), simulate=False)
+    assert "group-delay target" not in to_text("sheet", sections(sheet_of(plain), with_images=False))
