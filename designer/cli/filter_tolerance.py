@@ -32,7 +32,7 @@ def add_filter_tolerance(p, optimize: bool = False):
     from ..tolerance.cluster import CONNECT_TIMEOUT
     from ..tolerance.filter import BANDPASS_FIGURES, LOWHIGH_FIGURES
     from ..tolerance.montecarlo import MAX_SAMPLES, MIN_SAMPLES
-    figs = ", ".join(dict.fromkeys(LOWHIGH_FIGURES + BANDPASS_FIGURES))
+    figs = ", ".join(dict.fromkeys(LOWHIGH_FIGURES + BANDPASS_FIGURES)) + ", delay_error_pct (with --max-delay-error)"
     g = p.add_argument_group("tolerance against the mask (every part of every stage; analytic, vectorised)")
     g.add_argument("--monte-carlo", metavar="N",
                    help=f"draw N builds within the parts' tolerances ({MIN_SAMPLES} to {MAX_SAMPLES:.0e}): each "
@@ -122,7 +122,7 @@ def tolerance_settings(args) -> dict | None:
     for key, value in split_items(args.tol):
         parse_tolerance(value, f"--tol {key}")
     for item in args.limit or ():
-        parse_limit(item, tuple(dict.fromkeys(LOWHIGH_FIGURES + BANDPASS_FIGURES)))
+        parse_limit(item, tuple(dict.fromkeys(LOWHIGH_FIGURES + BANDPASS_FIGURES + ("delay_error_pct",))))
     spice = None
     if args.spice_samples is not None:
         if n is None:

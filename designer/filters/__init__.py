@@ -20,7 +20,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "design": ("FilterDesign", "StageDesign", "analysis_grid", "as_built", "delay_figures", "predistort", "section_name", "with_choice",
                "section_plans", "stage_candidates", "verify_spice",),
     "inverting_lowpass": ("InvertingLowPass",),
-    "joint": ("brute_force", "descend", "joint_search", "objective", "per_stage",),
+    "joint": ("brute_force", "delay_columns", "descend", "joint_search", "objective", "per_stage",),
     "mfb_bandpass": ("MfbBandPass",),
     "mfb_highpass": ("MfbHighPass",),
     "mfb_lowpass": ("MfbLowPass",),

@@ -25,7 +25,13 @@ over the passband (a decade inside its edge: the mask's and the design's grid),
 ``ripple_db`` the gain's spread over it, ``f3_hz`` (``f3_low_hz``/``f3_high_hz``
 for a band-pass) the -3 dB crossing, ``stopband_attenuation_db`` the least
 attenuation over the stopband (a decade beyond its edge), ``group_delay_s``
--d(phase)/d(omega) at the passband's low end (a band-pass: its centre).
+-d(phase)/d(omega) at the passband's low end (a band-pass: its centre); with a
+Bessel's group-delay target, ``delay_error_pct``, the build's own delay error as
+:func:`designer.filters.design.delay_figures` takes it (the central difference of
+the phase, half-step 2 pi fc 1e-4, at the DELAY_POINTS points from DC to the
+target's frequency; at DC the pair is H(j dw) and its conjugate), which joins the
+mask's limits: a build passes only if it meets the mask and the delay target, and
+the part to tighten is judged on both.
 
 The yield's interval is Wilson's (:func:`designer.tolerance.stats.wilson`); the part
 to tighten is the one whose tolerance halved, on the same draws, raises the yield
@@ -46,6 +52,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.errors import DesignError
+from ..filters.prototype import DELAY_POINTS
 from ..filters.registry import get as get_topology
 from ..filters.verify import mask_edges
 from . import runner, sampling
@@ -95,6 +102,9 @@ class FilterContext:
         Per stage, d ln(H_opamp/H_ideal) / d ln(part), shape (its parts, ``f``).
     nominal : tuple of ndarray
         Per stage, its nominal part values (designator order).
+    delay_dw : float
+        With a group-delay target, the central difference's half-step (rad/s; ``f`` then ends with the
+        groups ``dlp`` and ``dlm``, the DELAY_POINTS points plus and, but DC, minus it); 0 without one.
     """
 
     kind: str
@@ -105,11 +115,13 @@ class FilterContext:
     correction: tuple
     sensitivity: tuple
     nominal: tuple
+    delay_dw: float = 0.0
 
     @property
     def figures(self) -> tuple:
         """The figures this filter's builds have."""
-        return BANDPASS_FIGURES if self.kind == "bandpass" else LOWHIGH_FIGURES
+        return (BANDPASS_FIGURES if self.kind == "bandpass" else LOWHIGH_FIGURES) + \
+            (("delay_error_pct",) if self.delay_dw else ())
 
 
 def nominal_parts(result) -> dict:
@@ -181,6 +193,11 @@ def context(result, stage_values=None, edges=None) -> FilterContext:
         groups["f3"] = np.geomspace(f3 / F3_SPAN, f3 * F3_SPAN, F3_POINTS)
         at = fp / 10 if low else fp * 10
     groups["gd"] = np.array([at * (1 - GD_STEP), at * (1 + GD_STEP)])
+    dw = 0.0
+    if result.spec.has_delay_target:
+        # design.delay_figures' grid and step, so the nominal build's figure is the design's
+        f_d, dw = np.linspace(0.0, result.spec.delay_to_hz, DELAY_POINTS), 2 * math.pi * result.fc_hz * 1e-4
+        groups["dlp"], groups["dlm"] = f_d + dw / (2 * math.pi), f_d[1:] - dw / (2 * math.pi)
     sl, start = {}, 0
     for k, v in groups.items():
         sl[k] = (start, start + v.size)
@@ -198,7 +215,7 @@ def context(result, stage_values=None, edges=None) -> FilterContext:
         sens.append(d)
         nom.append(np.array([vals[r] for r in topo.designators], float))
     return FilterContext(kind, tuple(stages), 20 * math.log10(result.spec.gain), f, sl, tuple(corr), tuple(sens),
-                         tuple(nom))
+                         tuple(nom), dw)
 
 
 #: the relative step of the op-amp factor's sensitivities (central differences)
@@ -263,11 +280,11 @@ def stage_responses(ctx: FilterContext, values: dict) -> list:
     -------
     list of tuple
         Per stage (ideal |H|^2 and the op-amp factor's ln |.|, each of shape (builds, frequencies),
-        H at the group-delay pair (builds, 2)).
+        H at the group-delay pair and at the delay target's points (builds, 2 + their number)).
     """
     n = len(next(iter(values.values())))
     out = []
-    a, b = ctx.sl["gd"]
+    a, b = ctx.sl["gd"][0], ctx.f.size
     x = (2 * math.pi * ctx.f) ** 2
     s_gd = 2j * math.pi * ctx.f[a:b]
     for (name, prefix, refs), corr, sens, nom in zip(ctx.stages, ctx.correction, ctx.sensitivity, ctx.nominal):
@@ -332,7 +349,8 @@ def figures_of(ctx: FilterContext, db: np.ndarray, h_gd: np.ndarray) -> dict:
     db : ndarray
         20 log10 |H|, shape (builds, ``ctx.f``).
     h_gd : ndarray
-        H at the group delay's two frequencies, shape (builds, 2).
+        H at the group delay's two frequencies, then (with a delay target) at ``dlp`` and ``dlm``'s,
+        shape (builds, 2 + their number).
 
     Returns
     -------
@@ -353,6 +371,12 @@ def figures_of(ctx: FilterContext, db: np.ndarray, h_gd: np.ndarray) -> dict:
     a, b = ctx.sl["gd"]
     w = 2 * math.pi * ctx.f[a:b]
     out["group_delay_s"] = -np.angle(h_gd[:, 1] / h_gd[:, 0]) / (w[1] - w[0])
+    if ctx.delay_dw:
+        plus = h_gd[:, 2:2 + DELAY_POINTS]
+        # at DC the lower point is -dw: H(-j dw) is H(j dw)'s conjugate
+        minus = np.column_stack([np.conj(plus[:, 0]), h_gd[:, 2 + DELAY_POINTS:]])
+        tau = -np.angle(plus / minus) / (2 * ctx.delay_dw)
+        out["delay_error_pct"] = 100 * np.max(np.abs(tau / tau[:, :1] - 1), axis=1)
     return {k: out[k] for k in ctx.figures}
 
 
@@ -377,7 +401,7 @@ def evaluate(ctx: FilterContext, values: dict) -> dict:
 def mask_limits(result, limit_items=()) -> tuple:
     """The limits a build must meet: ``limit_items`` (``FIGURE=MIN:MAX``) when given, else the mask's
     (``passband_loss_db`` at most ``--max-loss``, ``stopband_attenuation_db`` at least
-    ``--min-attenuation``).
+    ``--min-attenuation``) and a group-delay target's (``delay_error_pct`` at most ``--max-delay-error``).
 
     Parameters
     ----------
@@ -391,14 +415,16 @@ def mask_limits(result, limit_items=()) -> tuple:
     tuple of Limit
         Possibly empty (no mask and no limit: no yield).
     """
-    figs = BANDPASS_FIGURES if result.spec.filter_type == "bandpass" else LOWHIGH_FIGURES
+    s = result.spec
+    figs = (BANDPASS_FIGURES if s.filter_type == "bandpass" else LOWHIGH_FIGURES) + \
+        (("delay_error_pct",) if s.has_delay_target else ())
     if limit_items:
         return tuple(t if isinstance(t, Limit) else parse_limit(t, figs) for t in limit_items)
-    s = result.spec
     if not s.has_mask:
         return ()
     return (Limit("passband_loss_db", None, s.max_loss_db), Limit("stopband_attenuation_db", s.min_attenuation_db,
-                                                                   None))
+                                                                   None)) + \
+        ((Limit("delay_error_pct", None, s.max_delay_error_pct),) if s.has_delay_target else ())
 
 
 def _passed(figs: dict, limits) -> np.ndarray:
@@ -437,8 +463,9 @@ def spice_context(result, simulator: str = "ngspice-cli") -> SpiceFilterContext:
     """
     from ..filters.deck import ac_deck
     ctx = context(result)
-    lo = float(min(ctx.f.min() / 3, result.figures["sweep_hz"][0]))
-    hi = float(max(ctx.f.max() * 3, result.figures["sweep_hz"][1]))
+    f = ctx.f[:ctx.sl["gd"][1]]   # the delay target's points have sweeps of their own
+    lo = float(min(f.min() / 3, result.figures["sweep_hz"][0]))
+    hi = float(max(f.max() * 3, result.figures["sweep_hz"][1]))
     text = ac_deck(result.cascade().netlist(), result.opamp, lo, hi, title="filter Monte Carlo")
     keep = [ln for ln in text.splitlines() if not re.match(r"\s*\.(ac|end)\b", ln, re.I)]
     return SpiceFilterContext("\n".join(keep) + "\n.end\n", (lo, hi), ctx, simulator)
@@ -455,13 +482,21 @@ def _spice_commands(sctx: SpiceFilterContext, values: dict, start: int) -> list:
     for i in range(n):
         out += [f"alter {ref.lower()} = {float(v[i]):.12g}" for ref, v in values.items()]
         out += [f"ac dec 100 {lo:.6g} {hi:.6g}", f"echo MCROW {start + i}"]
-        out += [f"meas ac mg{k} find vdb(vout) at={f:.10g}" for k, f in enumerate(sctx.ctx.f)]
         a, b = sctx.ctx.sl["gd"]
+        out += [f"meas ac mg{k} find vdb(vout) at={f:.10g}" for k, f in enumerate(sctx.ctx.f[:b])]
         # the group delay's pair on a sweep of its own, points 0.1 % apart (interpolating between a decade
         # sweep's would swamp a 0.2 % phase step), from the real and imaginary parts (vp() wraps)
         lo_gd, hi_gd = sctx.ctx.f[a] * (1 - GD_STEP), sctx.ctx.f[b - 1] * (1 + GD_STEP)
         out.append(f"ac lin 9 {lo_gd:.12g} {hi_gd:.12g}")
         out += [f"meas ac m{p}{k} find v{p[-1]}(vout) at={sctx.ctx.f[k]:.12g}" for k in range(a, b) for p in ("pr", "pi")]
+        for group in ("dlp", "dlm") if sctx.ctx.delay_dw else ():
+            # the delay target's points: a linear sweep through exactly them (evenly spaced)
+            c, d = sctx.ctx.sl[group]
+            # a hair wider than the points: a measurement at a sweep's very end can fall outside it by rounding
+            pad = 1e-6 * (sctx.ctx.f[d - 1] - sctx.ctx.f[c]) / (d - c - 1)
+            out.append(f"ac lin {d - c} {sctx.ctx.f[c] - pad:.15g} {sctx.ctx.f[d - 1] + pad:.15g}")
+            out += [f"meas ac m{p}{k} find v{p[-1]}(vout) at={sctx.ctx.f[k]:.12g}" for k in range(c, d)
+                    for p in ("pr", "pi")]
         out.append("destroy all")
     return out
 
@@ -508,13 +543,13 @@ def spice_evaluate(sctx: SpiceFilterContext, values: dict, start: int = 0) -> di
             seg = text[m.end():marks[j + 1].start() if j + 1 < len(marks) else len(text)]
             got = {k: float(v) for k, v in _MEAS.findall(seg)}
             h[lo + i] = [10 ** (got.get(f"mg{k}", np.nan) / 20) for k in range(nf)]
-            for k in range(a, b):
+            for k in range(a, nf):
                 h[lo + i, k] = got.get(f"mpr{k}", np.nan) + 1j * got.get(f"mpi{k}", np.nan)
             seen.add(i)
         if len(seen) < hi - lo:
             missing = min(set(range(hi - lo)) - seen) + start + lo
             raise SimulatorError(f"ngspice stopped before filter Monte Carlo build {missing}")
-    return figures_of(sctx.ctx, 20 * np.log10(np.abs(h)), h[:, a:b])
+    return figures_of(sctx.ctx, 20 * np.log10(np.abs(h)), h[:, a:])
 
 
 def _spice_chunk(sctx, values: dict) -> dict:
@@ -881,7 +916,7 @@ def optimize_yield(result, n: int = 2000, seed: int = 0, sampler: str = "random"
             cand = result.stages[i].candidates[c]
             corr, sens = _correction(topo, cand, s, op)
             one = FilterContext(ctx.kind, (ctx.stages[i],), ctx.gain_db, ctx.f, ctx.sl, (corr,), (sens,),
-                                (np.array([cand[r] for r in refs], float),))
+                                (np.array([cand[r] for r in refs], float),), ctx.delay_dw)
             vals = {topo.prefixed(r, prefix): cand[r] * rel[topo.prefixed(r, prefix)] for r in refs}
             cache[(i, c)] = stage_responses(one, vals)[0]
         return cache[(i, c)]

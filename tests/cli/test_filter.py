@@ -371,3 +371,26 @@ def test_analyze_filter_writes_its_sheet_in_the_language_asked(designed, tmp_pat
     assert "Lista de materiales" in es and "máscara: margen en la banda de paso" in es and "hasta 3 kHz" in es
     assert "Bill of materials" in en and "mask: passband margin" in en
     assert english_left((tmp_path / "es" / "build-sheet.html").read_text()) == []
+
+
+def test_delay_target_joins_the_mask_in_the_yield(capsys, tmp_path):
+    argv = ["--family", "bessel", "--passband", "1k", "--max-loss", "3", "--stopband", "10k", "--min-attenuation",
+            "30", "--max-delay-error", "1", "--delay-to", "1k", "--opamp", "TL072", "--no-sim", "--json",
+            "--monte-carlo", "300", "--seed", "3"]
+    assert design_filter_main(argv) == 0
+    d = json.loads(capsys.readouterr().out)
+    mc = d["monte_carlo"]
+    assert {(lim["figure"], lim.get("min"), lim.get("max")) for lim in mc["limits"]} == \
+        {("passband_loss_db", None, 3.0), ("stopband_attenuation_db", 30.0, None), ("delay_error_pct", None, 1.0)}
+    assert mc["nominal_figures"]["delay_error_pct"] == pytest.approx(d["figures"]["delay_error_pct"], abs=1e-6)
+    # the mask alone as --limit: the same draws, a yield at least as high
+    assert design_filter_main(argv + ["--limit", "passband_loss_db=0:3", "--limit", "stopband_attenuation_db=30:1000"]) == 0
+    plain = json.loads(capsys.readouterr().out)["monte_carlo"]
+    assert plain["yield"]["passed"] >= mc["yield"]["passed"]
+    # a delay limit on a filter without a delay target: one line, exit 2, nothing written
+    out = tmp_path / "sheet"
+    assert design_filter_main(["--family", "butterworth", "--order", "2", "--fc", "1k", "--no-sim", "--monte-carlo",
+                               "100", "--limit", "delay_error_pct=0:1", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--limit 'delay_error_pct': unknown figure" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
