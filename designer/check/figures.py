@@ -67,10 +67,12 @@ FILTER = {
     "passband_gain_db": ("", "the passband gain, dB (the design's, or as built the cascade's own)"),
     "passband_loss_db": ("", "the largest loss below the passband gain over the mask's passband, dB"),
     "stopband_attenuation_db": ("", "the least attenuation over the mask's stopband, dB"),
+    "delay_error_pct": ("", "the group delay's largest departure from its DC value up to delay.to, percent"),
     **{f"spice_{k}": (u, f"SPICE .ac: {w}") for k, (u, w) in (
         ("f3_hz", ("Hz", "-3 dB frequency")), ("f3_low_hz", ("Hz", "lower -3 dB frequency")),
         ("f3_high_hz", ("Hz", "upper -3 dB frequency")), ("passband_loss_db", ("", "passband loss, dB")),
-        ("stopband_attenuation_db", ("", "stopband attenuation, dB")))},
+        ("stopband_attenuation_db", ("", "stopband attenuation, dB")),
+        ("delay_error_pct", ("", "group delay error up to delay.to, percent")))},
     "spice_max_deviation_db": ("", "SPICE .ac against the op-amp-aware model, largest |difference| down to -60 dB"),
     "stages": ("", "number of stages"),
     "order": ("", "filter order (designed)"),

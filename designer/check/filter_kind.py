@@ -9,6 +9,16 @@ spec's own ``checks:`` on :data:`designer.check.figures.FILTER`; a designed filt
 counts the builds of :func:`designer.tolerance.filter.filter_spec_yield` inside the
 checks on the model's figures (the mask's among them), with its Wilson interval.
 
+A Bessel low-pass's group-delay target is ``delay: {max_error_pct: 1, to: 1k}``
+beside ``mask:`` (the delay within max_error_pct % of its DC value from DC to
+``to``, as design-filter's ``--max-delay-error`` and ``--delay-to``): checks on
+the model's ``delay_error_pct`` (the central difference of the op-amp-aware
+cascade's phase on DELAY_POINTS points from DC, :func:`designer.filters.design.central_delay`)
+and on SPICE's ``spice_delay_error_pct`` (:func:`designer.filters.verify.phase_delay_error_pct`)
+(:data:`DELAY_FIGURES`), and in the yield. Designed, it joins ``mask:`` in picking the
+order and the joint part choice (no ``filter.order`` then), on a ``family: bessel``;
+as built, any low-pass cascade.
+
 The figures of a corner (:func:`filter_figures`): the -3 dB frequencies (where
 the gain is 3 dB below the passband gain; a low-pass its last crossing, a
 high-pass its first, a band-pass both), the largest loss below the passband
@@ -33,14 +43,16 @@ from ..core.errors import DesignError
 from ..core.jsonio import json_safe
 from ..core.units import parse_value
 
-__all__ = ["FILTER_KEYS", "SUB_FILTER", "MASK_KEYS", "MASK_FIGURES", "FilterCase", "filter_designs",
-           "mask_limits", "run_filter", "filter_figures"]
+__all__ = ["FILTER_KEYS", "SUB_FILTER", "MASK_KEYS", "MASK_FIGURES", "DELAY_KEYS", "DELAY_FIGURES", "FilterCase",
+           "filter_designs", "mask_limits", "delay_limits", "run_filter", "filter_figures"]
 
 #: the keys of ``filter:`` (design-filter's options) and ``mask:``
 SUB_FILTER = ("type", "family", "order", "fc", "ripple", "bessel_norm", "chebyshev_cutoff", "f_low", "f_high",
               "bandpass_method", "topology", "stage_order", "gain", "stage_gain", "amplitude", "gbw_margin", "impedance",
               "compensate_gbw")
 MASK_KEYS = ("passband", "max_loss", "stopband", "min_attenuation")
+#: the keys of ``delay:``
+DELAY_KEYS = ("max_error_pct", "to")
 #: library parameter -> the filter spec's key (messages of FilterSpec)
 FILTER_KEYS = {"filter_type": "filter.type", "family": "filter.family", "order": "filter.order",
                "fc_hz": "filter.fc", "ripple_db": "filter.ripple", "bessel_norm": "filter.bessel_norm",
@@ -52,11 +64,14 @@ FILTER_KEYS = {"filter_type": "filter.type", "family": "filter.family", "order":
                "impedance_ohm": "filter.impedance", "compensate_gbw": "filter.compensate_gbw",
                "passband_hz": "mask.passband", "max_loss_db": "mask.max_loss", "stopband_hz": "mask.stopband",
                "min_attenuation_db": "mask.min_attenuation", "opamp": "opamp", "r_series": "series.r",
-               "c_series": "series.c", **{k: f"bounds.{k}" for k in ("r_min", "r_max", "c_min", "c_max")}}
+               "c_series": "series.c", **{k: f"bounds.{k}" for k in ("r_min", "r_max", "c_min", "c_max")},
+               "max_delay_error_pct": "delay.max_error_pct", "delay_to_hz": "delay.to"}
 #: the mask's checks: figure -> (limit key, mask key); each on the model and on SPICE's .ac
 MASK_FIGURES = {"passband_loss_db": ("max", "max_loss"), "stopband_attenuation_db": ("min", "min_attenuation"),
                 "spice_passband_loss_db": ("max", "max_loss"),
                 "spice_stopband_attenuation_db": ("min", "min_attenuation")}
+#: the delay target's checks: figure -> (limit key, delay key); on the model and on SPICE's .ac
+DELAY_FIGURES = {"delay_error_pct": ("max", "max_error_pct"), "spice_delay_error_pct": ("max", "max_error_pct")}
 #: points of the model's frequency grid, per decade
 POINTS_PER_DECADE = 100
 #: points per decade of SPICE's .ac against a band-pass's mask
@@ -77,12 +92,15 @@ class FilterCase:
         As built: (topology name, parts dict) pairs; () when designed.
     mask : dict or None
         ``{passband, max_loss, stopband, min_attenuation}`` in Hz and dB, or None.
+    delay : dict or None
+        ``{max_error_pct, to}`` (%, Hz): a group-delay target, or None.
     """
 
     opamp: str
     spec: object = None
     stages: tuple = ()
     mask: dict | None = None
+    delay: dict | None = None
 
 
 @dataclass
@@ -118,7 +136,7 @@ class FilterRun:
             ``kind``, ``opamp``, ``as_built``, ``stages``, ``figures`` and the design's JSON when designed.
         """
         return json_safe({"kind": "filter", "opamp": self.case.opamp, "as_built": self.design is None,
-                          "mask": self.case.mask,
+                          "mask": self.case.mask, **({"delay": self.case.delay} if self.case.delay else {}),
                           "stages": [{"topology": t, "parts": {k: float(v) for k, v in p.items()}}
                                      for t, p in self.stages],
                           "figures": self.figures,
@@ -149,6 +167,30 @@ def _mask(doc) -> dict | None:
         raise doc.error(("mask",), "mask: a band-pass's mask gives passband and stopband both as [low, high]; a "
                         "low- or high-pass's both as one edge")
     return out
+
+
+def _delay(doc) -> dict | None:
+    from .sections import read_positive
+    if doc.data.get("delay") is None:
+        return None
+    m = doc.mapping(("delay",), DELAY_KEYS)
+    missing = [k for k in DELAY_KEYS if k not in m]
+    if missing:
+        raise doc.error(("delay",), f"delay needs {' and '.join(DELAY_KEYS)} (the delay within max_error_pct % of "
+                        f"its DC value from DC to the frequency to); missing {', '.join(missing)}")
+    return {k: read_positive(doc, ("delay", k)) for k in DELAY_KEYS}
+
+
+def _check_delay(doc, delay, kind: str, family: str | None = None) -> None:
+    """A group-delay target on a low-pass (designed: a Bessel's)."""
+    if delay is None:
+        return
+    if kind != "lowpass":
+        raise doc.error(("delay",), f"delay: a group-delay target is for a lowpass (its delay at DC); this filter "
+                        f"is a {kind}")
+    if family is not None and family != "bessel":
+        raise doc.error(("delay",), f"delay: a group-delay target is for a bessel filter (the flat-delay family); "
+                        f"filter.family is {family}")
 
 
 def _positive_item(doc, key: str, value) -> float:
@@ -217,7 +259,7 @@ def filter_designs(doc, corners) -> tuple:
     """
     from ..filters.spec import FilterSpec
     from .sections import SUB, built_in_spec_words
-    mask = _mask(doc)
+    mask, delay = _mask(doc), _delay(doc)
     has_filter, has_stages = doc.data.get("filter") is not None, doc.data.get("stages") is not None
     if has_filter == has_stages:
         raise doc.error((), "a filter spec needs filter: {type, family, order, fc, ..} (designed) or stages: "
@@ -227,21 +269,30 @@ def filter_designs(doc, corners) -> tuple:
             raise doc.error(("bounds",), "bounds: limit a design's part search; stages: are already chosen")
         stages = _stages(doc)
         _check_mask_kind(doc, mask, _kind(stages))
-        return [FilterCase(amp, None, stages, mask) for amp in corners], True
+        _check_delay(doc, delay, _kind(stages))
+        return [FilterCase(amp, None, stages, mask, delay) for amp in corners], True
     f = doc.mapping(("filter",), SUB_FILTER)
     kw = {FILTER_TO_PARAM[k]: v for k, v in f.items()}
     series = doc.mapping(("series",), SUB["series"])
     kw.update({f"{k}_series": series[k] for k in ("r", "c") if k in series})
     kw.update(doc.mapping(("bounds",), SUB["bounds"]))
     _check_mask_kind(doc, mask, str(f.get("type", "lowpass")).strip().lower())
-    if mask is not None and not {"order", "fc", "f_low", "f_high"} & set(f):
+    _check_delay(doc, delay, str(f.get("type", "lowpass")).strip().lower(),
+                 str(f.get("family", "butterworth")).strip().lower())
+    picks = mask is not None and not {"order", "fc", "f_low", "f_high"} & set(f)
+    if delay is not None and not picks:
+        raise doc.error(("delay",), "delay: a designed filter's group-delay target joins mask: in picking the order "
+                        "(as design-filter's --max-delay-error); give mask: and no filter.order or filter.fc")
+    if delay is not None:
+        kw.update({"max_delay_error_pct": delay["max_error_pct"], "delay_to_hz": delay["to"]})
+    if picks:
         # no order: the mask picks it (a band-pass's also its edges), as design-filter's --passband .. --min-attenuation
         kw.update({"passband_hz": mask["passband"], "max_loss_db": mask["max_loss"],
                    "stopband_hz": mask["stopband"], "min_attenuation_db": mask["min_attenuation"]})
     if "compensate_gbw" in kw and not isinstance(kw["compensate_gbw"], bool):
         raise doc.error(("filter", "compensate_gbw"), "filter.compensate_gbw must be true or false")
-    cases = [FilterCase(amp, built_in_spec_words(doc, FILTER_KEYS, lambda amp=amp: FilterSpec(opamp=amp, **kw)), (), mask)
-             for amp in corners]
+    cases = [FilterCase(amp, built_in_spec_words(doc, FILTER_KEYS, lambda amp=amp: FilterSpec(opamp=amp, **kw)), (), mask,
+                        delay) for amp in corners]
     return cases, False
 
 
@@ -276,6 +327,27 @@ def mask_limits(mask: dict | None) -> tuple:
         return ()
     return tuple(limit_from(fig, {side: mask[key]}, f"mask.{key}", F.unit_of("filter", fig))
                  for fig, (side, key) in MASK_FIGURES.items())
+
+
+def delay_limits(delay: dict | None) -> tuple:
+    """The group-delay target as :class:`~designer.check.limits.Limit` checks (:data:`DELAY_FIGURES`).
+
+    Parameters
+    ----------
+    delay : dict or None
+        The spec's ``delay:``.
+
+    Returns
+    -------
+    tuple of Limit
+        None for no target: ().
+    """
+    from . import figures as F
+    from .limits import limit_from
+    if delay is None:
+        return ()
+    return tuple(limit_from(fig, {side: delay[key]}, f"delay.{key}", F.unit_of("filter", fig))
+                 for fig, (side, key) in DELAY_FIGURES.items())
 
 
 def _grid(stages, extra=()) -> np.ndarray:
@@ -334,7 +406,7 @@ def _response_figures(f, h, kind, ref_db, mask, prefix="") -> dict:
     return out
 
 
-def filter_figures(stages, opamp, ref_db: float, mask, simulator: str | None) -> dict:
+def filter_figures(stages, opamp, ref_db: float, mask, simulator: str | None, delay=None) -> dict:
     """The :data:`designer.check.figures.FILTER` figures of a cascade with ``opamp``.
 
     Parameters
@@ -349,6 +421,8 @@ def filter_figures(stages, opamp, ref_db: float, mask, simulator: str | None) ->
         The mask.
     simulator : str or None
         ngspice backend for the ``spice_`` figures (None: not simulated).
+    delay : dict or None
+        A group-delay target ``{max_error_pct, to}``: the ``delay_error_pct`` figures too.
 
     Returns
     -------
@@ -374,12 +448,22 @@ def filter_figures(stages, opamp, ref_db: float, mask, simulator: str | None) ->
         ref_db = 20 * math.log10(ref)
     out = {"passband_gain_db": float(ref_db), "stages": len(stages),
            **_response_figures(f, h, kind, ref_db, mask)}
+    if delay is not None:
+        from ..filters.design import central_delay
+        from ..filters.prototype import DELAY_POINTS, delay_error_pct
+        # design-filter's grid (DC to the target, DELAY_POINTS); the half-step a 1e-4 of the target's frequency
+        tau = central_delay(lambda s: cascade.response(s, opamp), np.linspace(0.0, delay["to"], DELAY_POINTS),
+                            2 * math.pi * delay["to"] * 1e-4)
+        out["delay_error_pct"] = delay_error_pct(tau, tau[0])
     if simulator is not None:
         # a band-pass mask's narrow band: a denser sweep (the edges within a few points otherwise)
         dense = {"points_per_decade": _BAND_POINTS_PER_DECADE} if mask is not None and \
             isinstance(mask["passband"], tuple) else {}
         fs, hs = simulate_ac(cascade.netlist(), opamp, float(f[0]), float(f[-1]), simulator=simulator, **dense)
         out.update(_response_figures(fs, hs, kind, ref_db, mask, "spice_"))
+        if delay is not None:
+            from ..filters.verify import phase_delay_error_pct
+            out["spice_delay_error_pct"] = phase_delay_error_pct(fs, hs, delay["to"])
         an = cascade.response(2j * math.pi * fs, opamp)
         dev = np.abs(20 * np.log10(np.abs(hs)) - 20 * np.log10(np.abs(an)))
         within = 20 * np.log10(np.abs(an)) >= ref_db - 60
@@ -411,7 +495,7 @@ def run_filter(case: FilterCase, simulator: str) -> FilterRun:
         res = design(case.spec, simulate=False)
         stages = [(st.topology, dict(st.values)) for st in res.stages]
         ref_db = 20 * math.log10(case.spec.gain)
-    figs = filter_figures(stages, opamp, ref_db, case.mask, simulator)
+    figs = filter_figures(stages, opamp, ref_db, case.mask, simulator, case.delay)
     if res is not None:
         f = res.figures
         figs.update({"passband_deviation_db": f["passband_deviation_db"], "error_joint_db": f["error_joint_db"],

@@ -65,8 +65,8 @@ TOP = {
     "pid": ("name", "kind", "description", "plant", "tuning", "controller", "series", "bounds", "opamp", "stimulus",
             "checks", "design_checks", "spice_agreement", "tolerances", "yield", "golden"),
     "netlist": ("name", "kind", "description", "deck", "checks", "golden"),
-    "filter": ("name", "kind", "description", "filter", "stages", "mask", "series", "bounds", "opamp", "checks",
-               "tolerances", "yield"),
+    "filter": ("name", "kind", "description", "filter", "stages", "mask", "delay", "series", "bounds", "opamp",
+               "checks", "tolerances", "yield"),
 }
 
 
@@ -194,11 +194,12 @@ def _netlist(doc, name: str, update: bool) -> CheckSpec:
 # ---- kind: filter -----------------------------------------------------------------
 
 def _filter(doc, name: str, corners) -> CheckSpec:
-    from .filter_kind import filter_designs, mask_limits
+    from .filter_kind import delay_limits, filter_designs, mask_limits
     designs, analyze = filter_designs(doc, corners)
-    checks = read_checks(doc, "filter", set(F.FIGURES["filter"])) + mask_limits(designs[0].mask)
+    checks = read_checks(doc, "filter", set(F.FIGURES["filter"])) + mask_limits(designs[0].mask) + \
+        delay_limits(designs[0].delay)
     if not checks:
-        raise doc.error((), "nothing to check: give checks: (figures) or mask:")
+        raise doc.error((), "nothing to check: give checks: (figures), mask: or delay:")
     if analyze and doc.data.get("yield") is not None:
         raise doc.error(("yield",), "yield: draws a design's parts around their E-series values; give filter: "
                         "(designed) for a yield, stages: (as built) are checked as they are")

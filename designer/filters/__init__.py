@@ -17,7 +17,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
               "TimeTest", "bench_of", "nice_down", "nice_up", "passband_gain",),
     "cascade": ("Cascade", "Stage",),
     "deck": ("ac_deck", "simulate_ac",),
-    "design": ("FilterDesign", "StageDesign", "analysis_grid", "as_built", "delay_figures", "predistort", "section_name", "with_choice",
+    "design": ("FilterDesign", "StageDesign", "analysis_grid", "as_built", "central_delay", "delay_figures", "predistort", "section_name", "with_choice",
                "section_plans", "stage_candidates", "verify_spice",),
     "inverting_lowpass": ("InvertingLowPass",),
     "joint": ("brute_force", "delay_columns", "descend", "joint_search", "objective", "per_stage",),
@@ -47,7 +47,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "topology": ("DEFAULT_IMPEDANCE_OHM", "Figures", "KINDS", "PartSpec", "SectionTarget", "Topology",
                  "nodal_response", "nodal_system", "open_loop_gain", "polynomial", "polyval", "quadratic_root"),
     "verify": ("BenchSignal", "NRMS_PASS", "PROOF_POINTS_PER_DECADE", "Proof", "StageDrive", "TRAN_POINTS",
-               "analytic_tran", "band_edge_db", "bench_signal", "mask_edges", "opamp_aware_polys", "proof_deck", "prove",
+               "analytic_tran", "band_edge_db", "bench_signal", "mask_edges", "opamp_aware_polys", "phase_delay_error_pct",
+               "proof_deck", "prove",
                "stage_drive", "stage_polys",),
 })
 

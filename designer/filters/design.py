@@ -53,7 +53,7 @@ from .topology import SectionTarget
 from .verify import proof_deck, prove
 
 __all__ = ["StageDesign", "FilterDesign", "design", "as_built", "section_plans", "section_name", "stage_candidates", "verify_spice", "predistort",
-           "analysis_grid", "with_choice", "delay_figures"]
+           "analysis_grid", "with_choice", "delay_figures", "central_delay"]
 
 #: the capacitor values (C1, nearest first) each stage offers the joint search
 C_CHOICES = 3
@@ -681,7 +681,7 @@ def design(spec: FilterSpec, simulate: bool = False, simulator: str = "ngspice-c
         f_d, dw = _delay_grid(spec, fc)
         for st in stages:
             topo = get_topology(st.topology)
-            st.delays = _central_delay(lambda sv, t=topo, c=st.candidates: t.response(
+            st.delays = central_delay(lambda sv, t=topo, c=st.candidates: t.response(
                 {r: np.array([v[r] for v in c])[:, None] for r in t.designators}, sv[None, :], opamp), f_d, dw)
         tau_ref = float(group_delay(prototype_zpk(spec.family, order, 1.0, spec.bessel_norm), [0.0], fc)[0])
         n_dev = errors[0].shape[1]
@@ -900,7 +900,7 @@ def delay_figures(spec: FilterSpec, order: int, fc_hz: float, response) -> dict:
         ``delay_error_pct`` (the parts'), ``delay_error_ideal_pct``, ``delay_dc_s``, ``delay_target_met``.
     """
     f, dw = _delay_grid(spec, fc_hz)
-    tau = _central_delay(response, f, dw)
+    tau = central_delay(response, f, dw)
     ideal = group_delay(prototype_zpk(spec.family, order, 1.0, spec.bessel_norm), f, fc_hz)
     err = delay_error_pct(tau, tau[0])
     return {"delay_error_pct": err, "delay_error_ideal_pct": delay_error_pct(ideal, ideal[0]),
@@ -912,8 +912,24 @@ def _delay_grid(spec: FilterSpec, fc_hz: float) -> tuple:
     return np.linspace(0.0, spec.delay_to_hz, DELAY_POINTS), 2 * math.pi * fc_hz * 1e-4
 
 
-def _central_delay(response, f, dw: float) -> np.ndarray:
-    """-arg(H(j(w + dw)) / H(j(w - dw))) / (2 dw) at ``f`` (Hz), along the last axis of ``response``'s result."""
+def central_delay(response, f, dw: float) -> np.ndarray:
+    """The group delay by a central difference of the phase, -arg(H(j(w + dw)) / H(j(w - dw))) / (2 dw)
+    (:func:`delay_figures`; at DC too, H(-jw) being H(jw)'s conjugate).
+
+    Parameters
+    ----------
+    response : callable
+        s (rad/s, complex array) -> H, along the last axis (rows of candidates or builds allowed).
+    f : array_like
+        Frequencies, Hz.
+    dw : float
+        The half-step, rad/s.
+
+    Returns
+    -------
+    ndarray
+        Group delay, s.
+    """
     w = 2 * math.pi * np.asarray(f, float)
     return -np.angle(response(1j * (w + dw)) / response(1j * (w - dw))) / (2 * dw)
 

@@ -42,7 +42,7 @@ from .registry import get as get_topology
 
 __all__ = ["PROOF_POINTS_PER_DECADE", "TRAN_POINTS", "NRMS_PASS", "BenchSignal", "StageDrive", "Proof",
            "mask_edges", "band_edge_db", "bench_signal", "proof_deck", "opamp_aware_polys", "stage_polys", "analytic_tran", "stage_drive",
-           "prove"]
+           "prove", "phase_delay_error_pct"]
 
 #: the proof's ``.ac`` density (points per decade)
 PROOF_POINTS_PER_DECADE = 200
@@ -606,12 +606,34 @@ def _spice_mask(result, f, db, h=None) -> dict | None:
            "stopband_margin_db": att - s.min_attenuation_db,
            "met": loss <= s.max_loss_db and att >= s.min_attenuation_db}
     if s.has_delay_target and h is not None:
-        w, ph = 2 * math.pi * f, np.unwrap(np.angle(h))
-        tau, mid = -np.diff(ph) / np.diff(w), np.sqrt(f[1:] * f[:-1])
-        err = delay_error_pct(tau[mid <= s.delay_to_hz], tau[0])
+        err = phase_delay_error_pct(f, h, s.delay_to_hz)
         out.update({"delay_error_pct": err, "max_delay_error_pct": s.max_delay_error_pct,
                     "met": out["met"] and err <= s.max_delay_error_pct})
     return out
+
+
+def phase_delay_error_pct(f, h, to_hz: float) -> float:
+    """The group delay's largest departure from its value at a sweep's start, % of it, up to ``to_hz``: tau =
+    -d phi / d w between neighbouring points (at their midpoints), the start two decades or more below the
+    cut-off standing for DC (a Bessel's delay there is DC's within 1e-4 relative).
+
+    Parameters
+    ----------
+    f : ndarray
+        The sweep's frequencies (Hz, rising), such as SPICE's ``.ac``.
+    h : ndarray
+        The complex response at ``f``.
+    to_hz : float
+        The target's frequency.
+
+    Returns
+    -------
+    float
+        The delay error, %.
+    """
+    w, ph = 2 * math.pi * np.asarray(f, float), np.unwrap(np.angle(h))
+    tau, mid = -np.diff(ph) / np.diff(w), np.sqrt(f[1:] * f[:-1])
+    return delay_error_pct(tau[mid <= to_hz], tau[0])
 
 
 def prove(result, simulator: str = "ngspice-cli") -> Proof:

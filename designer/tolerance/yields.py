@@ -38,7 +38,8 @@ PLANT = {**{f: f for f in ("fn_hz", "zeta", "q", "ideal_fn_hz", "ideal_zeta", "i
 #: check-design's loop figure -> the analytic loop engine's (designer.tolerance.loop.FIGURES)
 LOOP = {**{f: f for f in LIMITABLE}, **STANDS_IN}
 #: check-design's filter figure -> the filter engine's (designer.tolerance.filter: the same op-amp-aware figures)
-FILTER = {f: f for f in ("passband_loss_db", "stopband_attenuation_db", "f3_hz", "f3_low_hz", "f3_high_hz")}
+FILTER = {f: f for f in ("passband_loss_db", "stopband_attenuation_db", "f3_hz", "f3_low_hz", "f3_high_hz",
+                          "delay_error_pct")}
 BY_KIND = {"plant": PLANT, "pid": LOOP, "filter": FILTER}
 #: the SPICE step figures a check may name, counted from each build's ngspice run
 SPICE_STEP = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")

@@ -1,7 +1,8 @@
 """check-design ``kind: filter`` (designer.check.filter_kind): a filter designed from
 ``filter:`` or as built from ``stages:``, in every op-amp corner, its mask as checks
 on the op-amp model and on SPICE's .ac; the figures against brute force on the
-response and against the design's own; the refusals one line at the key's line."""
+response and against the design's own; a Bessel's group-delay target (delay:) on
+the model, on SPICE and in the yield; the refusals one line at the key's line."""
 
 import json
 import math
@@ -74,6 +75,23 @@ def test_designed_spec_loads_a_design_per_corner_and_the_mask_as_checks(tmp_path
      "tolerances: {R1: 1%}\n", "tolerances"),
     ("kind: filter\nstages:\n  - {topology: rc-lowpass, parts: {R1: 1k, C1: 1n}}\nchecks: {f3_hz: {max: 1k}}\n"
      "yield: {min: 95%}\n", "stages: (as built) are checked as they are"),
+    # a group-delay target: a Bessel low-pass's, both keys, joining the mask in picking the order when designed
+    ("kind: filter\nfilter: {family: butterworth}\nmask: {passband: 1k, max_loss: 3, stopband: 10k, "
+     "min_attenuation: 30}\ndelay: {max_error_pct: 1, to: 1k}\n", "delay: a group-delay target is for a bessel filter"),
+    ("kind: filter\nfilter: {type: highpass, family: bessel, order: 3, fc: 1k}\ndelay: {max_error_pct: 1, to: 1k}\n",
+     "delay: a group-delay target is for a lowpass (its delay at DC); this filter is a highpass"),
+    ("kind: filter\nfilter: {family: bessel}\nmask: {passband: 1k, max_loss: 3, stopband: 10k, "
+     "min_attenuation: 30}\ndelay: {max_error_pct: 1}\n", "delay needs max_error_pct and to"),
+    ("kind: filter\nfilter: {family: bessel, order: 4, fc: 1k}\ndelay: {max_error_pct: 1, to: 1k}\n",
+     "delay: a designed filter's group-delay target joins mask: in picking the order"),
+    ("kind: filter\nfilter: {family: bessel}\nmask: {passband: 1k, max_loss: 3, stopband: 10k, "
+     "min_attenuation: 30}\ndelay: {max_error_pct: 1, to: 1k, upto: 2k}\n", "upto"),
+    ("kind: filter\nfilter: {family: bessel}\nmask: {passband: 1k, max_loss: 3, stopband: 10k, "
+     "min_attenuation: 30}\ndelay: {max_error_pct: 99, to: 1k}\n", "delay.max_error_pct"),
+    ("kind: filter\nfilter: {family: bessel}\nmask: {passband: 1k, max_loss: 3, stopband: 10k, "
+     "min_attenuation: 30}\ndelay: {max_error_pct: 1, to: -1k}\n", "delay.to"),
+    ("kind: filter\nstages:\n  - {topology: rc-highpass, parts: {R1: 1k, C1: 1n}}\ndelay: {max_error_pct: 1, to: 1k}\n",
+     "this filter is a highpass"),
 ])
 def test_refusals_are_one_line(tmp_path, text, words):
     msg = refusal(write(tmp_path, text))
@@ -242,3 +260,61 @@ def test_bandpass_mask_refusals(tmp_path, mask, words):
 def test_a_lowpass_refuses_a_two_edge_mask(tmp_path):
     text = DESIGNED.replace("passband: 500", "passband: [500, 600]").replace("stopband: 4k", "stopband: [100, 4k]")
     assert "a lowpass's mask takes one edge each" in refusal(write(tmp_path, text))
+
+
+DELAY = """\
+    name: bessel-delay
+    kind: filter
+    filter: {type: lowpass, family: bessel}
+    opamp: TL072
+    mask: {passband: 1k, max_loss: 3, stopband: 10k, min_attenuation: 30}
+    delay: {max_error_pct: 1, to: 1k}
+    tolerances: {R: 1%, C: 5%}
+    yield: {min: 10%, samples: 300, seed: 7}
+    """
+
+
+@pytest.mark.spice
+def test_a_delay_target_is_checked_on_the_model_on_spice_and_in_the_yield(tmp_path):
+    from designer.filters import FilterSpec
+    from designer.filters.design import design
+    from designer.tolerance.filter import filter_monte_carlo, mask_limits
+    spec = load_spec(write(tmp_path, DELAY))
+    limits = {c.figure: c for c in spec.checks}
+    assert limits["delay_error_pct"].max == 1 and limits["spice_delay_error_pct"].max == 1
+    # the target joins the mask in picking the order and the parts: design-filter's with --max-delay-error
+    res = design(FilterSpec(family="bessel", passband_hz=1e3, max_loss_db=3, stopband_hz=10e3, min_attenuation_db=30,
+                            max_delay_error_pct=1, delay_to_hz=1e3, opamp="TL072"))
+    assert spec.designs[0].spec.max_delay_error_pct == 1 and spec.designs[0].spec.delay_to_hz == 1e3
+    out = run_corner(spec, 0, "ngspice-cli")
+    cases = {c.id: c for c in out.cases}
+    assert cases["delay_error_pct"].value == pytest.approx(res.figures["delay_error_pct"], abs=1e-6)
+    # SPICE's .ac phase (differences between its points) against the model's central difference
+    assert cases["spice_delay_error_pct"].value == pytest.approx(res.figures["delay_error_pct"], abs=0.02)
+    assert all(cases[k].status == "pass" for k in ("delay_error_pct", "spice_delay_error_pct"))
+    # the yield counts the mask and the delay target: the tolerance engine's on the same draws; the mask alone more
+    mc = filter_monte_carlo(res, 300, 7, tol_items=("R=1%", "C=5%"), tighten=False)
+    assert cases["yield"].value == mc.yield_count / 300
+    plain = filter_monte_carlo(res, 300, 7, tol_items=("R=1%", "C=5%"), limit_items=mask_limits(res)[:2],
+                               tighten=False)
+    assert plain.yield_count > mc.yield_count
+    assert "delay_error_pct" in cases["yield"].message and out.design["delay"] == {"max_error_pct": 1.0, "to": 1e3}
+
+
+def test_an_as_built_lowpass_takes_a_delay_target(tmp_path):
+    # as built (no family known): any low-pass cascade; the model's figure is the central difference's
+    from designer.filters import Cascade
+    from designer.filters.prototype import DELAY_POINTS, delay_error_pct
+    text = as_built_text().replace("\nmask:", "\ndelay: {max_error_pct: 5, to: 300}\nmask:")
+    spec = load_spec(write(tmp_path, text))
+    case = spec.designs[0]
+    assert case.delay == {"max_error_pct": 5.0, "to": 300.0}
+    figs = run_filter(case, None).figures
+    cascade = Cascade([(get(t), v) for t, v in case.stages])
+    amp = opamps.get("TL072")
+    f = np.linspace(0.0, 300.0, DELAY_POINTS)
+    w = 2 * math.pi * f
+    dw = 2 * math.pi * 300.0 * 1e-3   # a step 10 x the figure's: the difference is second order
+    tau = -np.angle(cascade.response(1j * (w + dw), amp) / cascade.response(1j * (w - dw), amp)) / (2 * dw)
+    assert figs["delay_error_pct"] == pytest.approx(delay_error_pct(tau, tau[0]), rel=1e-3)
+    assert "spice_delay_error_pct" not in figs   # not simulated here
