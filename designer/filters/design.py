@@ -21,6 +21,9 @@ Choices made here, and why:
 - the objective of the joint choice is the whole cascade's response with the
   op-amp's finite gain and GBW, against the ideal response, over the passband and
   the transition band, so that the choice also absorbs part of the op-amp's error;
+  a Bessel's group-delay target joins it as limits (:mod:`designer.filters.joint`),
+  each stage's candidates' op-amp-aware delay on the target's grid, so that
+  rounding does not break a target another candidate set meets;
 - the gain goes to the lowest-Q second-order stage (a Sallen-Key's Q is the more
   sensitive to its gain resistors the higher Q is; a first-order section here is a
   unity-gain buffer); if that clips a stage's output at the bench amplitude, it is
