@@ -144,14 +144,22 @@ class FilterRun:
                           **({} if self.monte_carlo is None else {"monte_carlo": self.monte_carlo.to_dict()})})
 
 
+def _section(doc, name: str, keys: tuple, needs: str) -> dict | None:
+    """The spec's ``name:`` mapping with every one of ``keys`` (None when absent); one line naming the missing."""
+    if doc.data.get(name) is None:
+        return None
+    m = doc.mapping((name,), keys)
+    missing = [k for k in keys if k not in m]
+    if missing:
+        raise doc.error((name,), f"{name} needs {needs}; missing {', '.join(missing)}")
+    return m
+
+
 def _mask(doc) -> dict | None:
     from .sections import read_positive
-    if doc.data.get("mask") is None:
+    m = _section(doc, "mask", MASK_KEYS, ", ".join(MASK_KEYS))
+    if m is None:
         return None
-    m = doc.mapping(("mask",), MASK_KEYS)
-    missing = [k for k in MASK_KEYS if k not in m]
-    if missing:
-        raise doc.error(("mask",), f"mask needs {', '.join(MASK_KEYS)}; missing {', '.join(missing)}")
     out = {}
     for k in MASK_KEYS:
         v = m[k]
@@ -171,13 +179,9 @@ def _mask(doc) -> dict | None:
 
 def _delay(doc) -> dict | None:
     from .sections import read_positive
-    if doc.data.get("delay") is None:
+    if _section(doc, "delay", DELAY_KEYS, f"{' and '.join(DELAY_KEYS)} (the delay within max_error_pct % of its DC "
+                "value from DC to the frequency to)") is None:
         return None
-    m = doc.mapping(("delay",), DELAY_KEYS)
-    missing = [k for k in DELAY_KEYS if k not in m]
-    if missing:
-        raise doc.error(("delay",), f"delay needs {' and '.join(DELAY_KEYS)} (the delay within max_error_pct % of "
-                        f"its DC value from DC to the frequency to); missing {', '.join(missing)}")
     return {k: read_positive(doc, ("delay", k)) for k in DELAY_KEYS}
 
 
@@ -321,12 +325,7 @@ def mask_limits(mask: dict | None) -> tuple:
     tuple of Limit
         None for no mask: ().
     """
-    from . import figures as F
-    from .limits import limit_from
-    if mask is None:
-        return ()
-    return tuple(limit_from(fig, {side: mask[key]}, f"mask.{key}", F.unit_of("filter", fig))
-                 for fig, (side, key) in MASK_FIGURES.items())
+    return _limits(mask, MASK_FIGURES, "mask")
 
 
 def delay_limits(delay: dict | None) -> tuple:
@@ -342,12 +341,17 @@ def delay_limits(delay: dict | None) -> tuple:
     tuple of Limit
         None for no target: ().
     """
+    return _limits(delay, DELAY_FIGURES, "delay")
+
+
+def _limits(values: dict | None, table: dict, section: str) -> tuple:
+    """The checks of a spec section's ``values`` by ``table`` (figure -> (limit side, key)); () without it."""
     from . import figures as F
     from .limits import limit_from
-    if delay is None:
+    if values is None:
         return ()
-    return tuple(limit_from(fig, {side: delay[key]}, f"delay.{key}", F.unit_of("filter", fig))
-                 for fig, (side, key) in DELAY_FIGURES.items())
+    return tuple(limit_from(fig, {side: values[key]}, f"{section}.{key}", F.unit_of("filter", fig))
+                 for fig, (side, key) in table.items())
 
 
 def _grid(stages, extra=()) -> np.ndarray:
