@@ -267,8 +267,8 @@ def default_name(spec: PidSpec, result) -> str:
         ``pid_<rule>_<opamp>_fn<fn>_z<zeta>`` (``_seedparts`` with the seed's controller parts) for a
         Sallen-Key plant; ``pid_<rule>_<opamp>_<kind>`` for a model plant (a circuit plant: its topology).
     """
-    if spec.process is not None:
-        kind = spec.circuit.circuit.topology if spec.circuit is not None else spec.process.kind
+    if spec.plant.process is not None:
+        kind = spec.plant.circuit.circuit.topology if spec.plant.circuit is not None else spec.plant.process.kind
         return f"pid_{result.method}_{spec.opamp.lower()}_{kind}"
     extra = "_seedparts" if spec.controller_parts is not None else ""
     return f"pid_{spec.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}_z{result.plant.zeta:.3g}{extra}"

@@ -154,3 +154,15 @@ def test_pid_spec_of_plain_parameters_equals_the_nested_form(fc, zeta, step, rul
     assert made[0] == made[1] == made[2]
     if parts is None:
         assert isinstance(made[0], PidSpec) and made[0].plant.plant_fc_hz == pytest.approx(fc)
+
+
+def test_the_readme_s_pid_library_use():
+    from designer import design_pid
+    from designer.pid import resolve_plant as exported
+    spec = PidSpec(plant=PlantSource(plant_fc_hz=3500, plant_zeta=0.2), tuning="amigo", opamp="TL072")
+    res = design_pid(spec, simulate=False)
+    flat = PidSpec(plant_fc_hz=3500, plant_zeta=0.2, tuning="amigo", opamp="TL072")
+    assert res.to_dict() == design_pid(flat, simulate=False).to_dict()
+    assert abs(res.plant.fn_hz / 3500 - 1) < 0.005 and res.tuning.kp > 0
+    plant = exported(spec.plant, opamp="TL072")
+    assert plant == resolve_plant(spec) and plant.circuit is not None
