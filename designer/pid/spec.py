@@ -33,6 +33,7 @@ from ..core.ranges import parse_in_range
 from ..plant.sallenkey import SallenKeyParts
 from . import tuning as rules
 from .blocks import PidParts
+from .plant_spec import NUMBERS as PLANT_NUMBERS
 from .plant_spec import PLANT_FIELDS, PLANT_RANGES, PlantSource
 
 __all__ = ["PLAIN_PARAMS", "PidSpec", "controller_from_json", "default_name", "pid_spec"]
@@ -128,6 +129,9 @@ class PidSpec(PartBounds):
         def put(name, value):
             object.__setattr__(self, name, value)   # frozen: the spec is normalised once, here
 
+        for name, key in PLANT_NUMBERS:    # the plant's numbers first, as they always were
+            if flat.get(name) is not None:
+                flat[name] = parse_in_range(flat[name], name, key)
         for name, key in NUMBERS:
             value = getattr(self, name)
             if value is not None:
@@ -229,7 +233,12 @@ def pid_spec(params: dict) -> PidSpec:
     Returns
     -------
     PidSpec
-        Checked on construction.
+        Checked on construction: its ``plant`` (a :class:`~designer.pid.plant_spec.PlantSource`) made of the
+        plant's parameters (:data:`~designer.pid.plant_spec.PLANT_FIELDS`), the rest its controller's fields.
+        The plant's parameters go to the spec flat, so that it makes the plant source where it checked the
+        plant before (after the plant's and the controller's numbers, the bounds and the package): the first
+        refusal of a request with several faults stays the one it was, but for a plant read or parsed (a
+        model, a file) that now comes before the controller's parts and op-amp.
 
     Raises
     ------
