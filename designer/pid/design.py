@@ -905,7 +905,7 @@ def loop_checks(spec, mg, dc, amp, levels, waves, t, parts) -> list:
     out += steady_state_check(dc)
     for key, sig, what in (("plant_input", "u", "input (the controller's output u)"),
                            ("plant_output", "y", "output y")):
-        rng = getattr(spec, key)
+        rng = getattr(spec.plant, key)
         if rng is None or not mg.stable:
             continue
         v = np.asarray(waves[sig], float)
