@@ -54,7 +54,7 @@ ACCEPTED = ("an identify or identify-freq --json output, or a design-plant/analy
 IDENTIFY_FORMATS = ("broadband",)
 #: identification's models this module maps (stepfit's and identify-freq's names)
 IDENTIFIED_MODELS = ("fopdt", "double-pole", "overdamped", "underdamped")
-#: ``built`` keys of a plant result -> :class:`SallenKeyParts` fields
+#: ``built`` keys of a plant result (design-plant, analyze-plant) by :class:`SallenKeyParts` field
 BUILT_KEYS = {**JSON_KEYS, "gain": "gain"}
 
 

@@ -33,7 +33,8 @@ from ..core.jsonio import read_result
 from ..core.process import ProcessModel
 from ..core.ranges import parse_in_range
 from ..filters.sallen_key_lowpass_parts import FIELD_OF, gain_refs, refs, section_of
-from ..plant.sallenkey import JSON_KEYS, SallenKeyParts, check_parts
+from ..plant.sallenkey import SallenKeyParts, check_parts
+from .plant_source import BUILT_KEYS
 
 __all__ = ["PLANT_FIELDS", "PlantSource", "filter_plant_from_json", "plant_from_json", "voltage_range"]
 
@@ -51,8 +52,6 @@ PLANT_RANGES = {**{FIELD_OF[p.ref]: KIND_RANGES[p.kind] for p in section_of(with
 PLANT_NAMES = {**{f: f"{{plant_{f}}}" for f in (*NETWORK_FIELDS, "gain")},
                **{FIELD_OF[r]: r for r in gain_refs()},
                "plant": f"{{plant_{NETWORK_FIELDS[0]}}}..{{plant_{NETWORK_FIELDS[-1]}}}"}
-#: result.json keys of the plant's parts (the ``built`` object of design-plant and analyze-plant), by field
-BUILT_KEYS = {**JSON_KEYS, "gain": "gain"}
 
 
 @dataclass(frozen=True)
