@@ -166,3 +166,13 @@ def test_the_readme_s_pid_library_use():
     assert abs(res.plant.fn_hz / 3500 - 1) < 0.005 and res.tuning.kp > 0
     plant = exported(spec.plant, opamp="TL072")
     assert plant == resolve_plant(spec) and plant.circuit is not None
+
+
+@pytest.mark.parametrize("case", SOURCES)
+def test_a_spec_reaches_a_worker_process_unchanged(case):
+    """--jobs and dask send the spec to other processes: it pickles with its plant and what the plant resolved."""
+    import pickle
+    spec = PidSpec(**SOURCES[case])
+    back = pickle.loads(pickle.dumps(spec))
+    assert back == spec and back.plant == spec.plant
+    assert (back.process, back.circuit, back.json_plant) == (spec.process, spec.circuit, spec.json_plant)
