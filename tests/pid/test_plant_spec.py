@@ -175,4 +175,7 @@ def test_a_spec_reaches_a_worker_process_unchanged(case):
     spec = PidSpec(**SOURCES[case])
     back = pickle.loads(pickle.dumps(spec))
     assert back == spec and back.plant == spec.plant
-    assert (back.process, back.circuit, back.json_plant) == (spec.process, spec.circuit, spec.json_plant)
+    assert (back.process, back.json_plant) == (spec.process, spec.json_plant)
+    if spec.circuit is not None:   # a registered topology compares by identity: the circuit by what it holds
+        assert back.circuit.circuit.to_dict() == spec.circuit.circuit.to_dict()
+        assert back.circuit.model == spec.circuit.model
