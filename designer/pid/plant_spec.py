@@ -274,7 +274,7 @@ def plant_from_json(path) -> SallenKeyParts:
     Parameters
     ----------
     path : str or Path
-        The ``plant_json`` file.
+        ``plant_json``: a result.json whose ``built`` object holds the parts.
 
     Returns
     -------

@@ -113,14 +113,11 @@ class PidSpec(PartBounds):
         # the plant's fields given flat (the spec's keywords before PlantSource) are taken apart here and
         # made into ``plant`` in the checks' order (after the controller's numbers, bounds and package)
         flat = {k: kw.pop(k) for k in PLANT_FIELDS if k in kw}
-        own = {f.name: f for f in fields(self) if f.init}
-        unknown = [k for k in kw if k not in own or k == "plant"]
+        unknown = [k for k in kw if k not in _DEFAULTS]
         if unknown:
             raise TypeError(f"PidSpec.__init__() got an unexpected keyword argument {unknown[0]!r}")
-        for name, f in own.items():
-            if name != "plant":
-                value = kw[name] if name in kw else (f.default if f.default is not MISSING else f.default_factory())
-                object.__setattr__(self, name, value)
+        for name, default in _DEFAULTS.items():
+            object.__setattr__(self, name, kw[name] if name in kw else default)
         object.__setattr__(self, "plant", plant)
         self._validate(flat)
 
@@ -203,6 +200,10 @@ def _plant_attribute(name: str) -> property:
     get.__doc__ = f"``plant.{name}`` (:class:`~designer.pid.plant_spec.PlantSource`)."
     return property(get)
 
+
+#: the spec's own fields but its plant, and their defaults (every one a plain value: no default_factory)
+_DEFAULTS = {f.name: f.default for f in fields(PidSpec) if f.init and f.name != "plant"}
+assert MISSING not in _DEFAULTS.values()
 
 for _name in (*PLANT_FIELDS, *RESOLVED):
     setattr(PidSpec, _name, _plant_attribute(_name))
