@@ -427,13 +427,6 @@ PART_NAME_EXEMPT = {
                                                         "helper's (the generic search)",
     ("designer/pid/netlist.py", "controller_stages"): "the controller's own R3, R4 (seed Figure 66)",
     ("designer/pid/schematic.py", "_draw_controller"): "the controller's own R3, R4 (seed Figure 66)",
-    # the PID pipelines are being merged by another helper (issue 26): their plant names are left for that merge
-    ("designer/pid/plant.py", "sallen_key_parts"): "pid, left for the PID merge: the plant's fields in messages",
-    ("designer/pid/plant_source.py", "BUILT_KEYS"): "pid, left for the PID merge: a design-plant JSON's keys",
-    ("designer/pid/spec.py", "PLANT_NAMES"): "pid, left for the PID merge: the plant's fields in messages",
-    ("designer/pid/spec.py", "PLANT_RANGES"): "pid, left for the PID merge: the plant's fields' ranges",
-    ("designer/pid/spec.py", "BUILT_KEYS"): "pid, left for the PID merge: a design-plant JSON's keys",
-    ("designer/pid/spec.py", "plant_from_json"): "pid, left for the PID merge: a design-plant JSON's keys",
     ("designer/pid/spec.py", "controller_from_json"): "the controller's own R3 in a design-pid JSON",
     ("designer/web/jobs.py", "plant_page"): "web, another helper's: the input resistor the generator drives",
 }

@@ -3,7 +3,8 @@ tuning rules, sizing of the six op-amp blocks from E-series parts, the
 realised controller's transfer function, a closed-loop ngspice deck and its
 verification, and the ``design-pid`` build sheet.
 
-Modules: :mod:`.spec` (the request, validated once), :mod:`.tuning`
+Modules: :mod:`.spec` (the request, validated once), :mod:`.plant_spec` (where the
+plant comes from, validated once), :mod:`.plant` (the plant resolved), :mod:`.tuning`
 (reaction-curve and FOPDT rules), :mod:`.blocks` (topology, formulas, static
 checks), :mod:`.selection` (joint E-series part selection), :mod:`.model`
 (realised controller and closed loop), :mod:`.optimize`
@@ -35,6 +36,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "netlist": ("closed_loop_deck", "controller_netlist", "loop_netlist", "model_loop_deck", "plant_ref_prefix"),
     "optimize": ("Context", "KICK_POINTS", "ModelOptimizeResult", "SEARCH_POINTS", "SEARCH_STEP_FRACTION", "evaluate",
                  "optimize_model_loop", "slew_delay_stages"),
+    "plant_spec": ("PLANT_FIELDS", "PlantSource", "filter_plant_from_json", "plant_from_json", "voltage_range"),
     "plant_source": ("model_from_json", "model_from_result", "result_kind", "sallen_key_model"),
     "reduction": ("ModelFopdt", "ModelIntegrating", "ModelSopdt", "ModelTf", "from_process", "half_rule",
                   "model_step", "model_tangent"),

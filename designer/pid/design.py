@@ -147,10 +147,10 @@ def design_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice",
     Returns
     -------
     PidResult
-        One type for every plant; for a plant given as a model (``spec.process``)
+        One type for every plant; for a plant given as a model (``spec.plant.process``)
         its model fields are set (:func:`designer.pid.design.design_model_pid`).
     """
-    if spec.process is not None:
+    if spec.plant.process is not None:
         return design_model_pid(spec, simulate, simulator, rules_spice, before_spice)
     return _run(spec, simulate, simulator, as_built=False)
 
@@ -189,7 +189,7 @@ def analyze_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice"
     """
     if spec.controller_parts is None:
         raise ParamError("analyze_pid needs the controller's parts ({controller_parts})", ("controller_parts",))
-    if spec.process is not None:
+    if spec.plant.process is not None:
         return design_model_pid(spec, simulate, simulator, opamp=opamp)
     return _run(spec, simulate, simulator, as_built=spec.kp is None and spec.tuning is None, opamp=opamp)
 
@@ -626,12 +626,12 @@ def rule_table(spec, model, reduced, amp) -> tuple:
 def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pyspice",
                      rules_spice: bool = False, before_spice=None, opamp=None) -> PidResult:
     """Tune, size, check and (unless ``simulate`` is False) verify in SPICE a PID
-    for ``spec.process``, a plant known only as a model.
+    for ``spec.plant.process``, a plant known only as a model.
 
     Parameters
     ----------
     spec : PidSpec
-        With a model plant (``spec.process`` not None).
+        With a model plant (``spec.plant.process`` not None).
     simulate : bool
         Run the closed-loop deck in ngspice.
     simulator : str
@@ -658,7 +658,7 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
         now = time.perf_counter()
         laps[name], tick = now - tick, now
 
-    model = spec.process
+    model = spec.plant.process
     amp = opamp or opamps.get(spec.opamp)   # a Monte Carlo build's own (--replay), or the catalogue's
     reduced = from_process(model)
     table = rule_table(spec, model, reduced, amp)
@@ -800,7 +800,7 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _ModelLoop:
     if mg.stable:
         step = closed_loop_step(plant, sim_ctrl, t, spec.step_v)
         y = edged(t, step["y"], spec.edge_s)
-        if spec.circuit is not None and spec.circuit.reversed_action:
+        if spec.plant.circuit is not None and spec.plant.circuit.reversed_action:
             # r and y exchanged at the difference amplifier: every controller stage is its own for (y, r)
             waves = {**stage_waves(parts, amp, t, y, r), "y": y}
         else:
@@ -848,8 +848,8 @@ def loop_netlist_of(spec: PidSpec, parts):
     designer.spice.deck.Netlist
         The table the board, the BOM and the schematic are written from.
     """
-    if spec.circuit is not None:
-        return circuit_loop_netlist(parts, spec.circuit)
+    if spec.plant.circuit is not None:
+        return circuit_loop_netlist(parts, spec.plant.circuit)
     return controller_netlist(parts)
 
 
@@ -878,8 +878,8 @@ def loop_deck(spec: PidSpec, parts, model, amp, test, title: str, expected: floa
     str
         The deck.
     """
-    if spec.circuit is not None:
-        return circuit_loop_deck(parts, spec.circuit, amp, test, title, expected)
+    if spec.plant.circuit is not None:
+        return circuit_loop_deck(parts, spec.plant.circuit, amp, test, title, expected)
     return model_loop_deck(parts, model, amp, test, title, expected)
 
 
@@ -905,7 +905,7 @@ def loop_checks(spec, mg, dc, amp, levels, waves, t, parts) -> list:
     out += steady_state_check(dc)
     for key, sig, what in (("plant_input", "u", "input (the controller's output u)"),
                            ("plant_output", "y", "output y")):
-        rng = getattr(spec, key)
+        rng = getattr(spec.plant, key)
         if rng is None or not mg.stable:
             continue
         v = np.asarray(waves[sig], float)

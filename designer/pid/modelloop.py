@@ -334,7 +334,7 @@ def built_controller(kp, ti_s, td_s, fc_hz, spec, amp):
     -------
     tuple
     """
-    f_i, f_d = corner_frequencies(spec, fc_hz, leak_limit_hz(spec.process, kp, ti_s))
+    f_i, f_d = corner_frequencies(spec, fc_hz, leak_limit_hz(spec.plant.process, kp, ti_s))
     parts = blocks.continuous_parts(kp, ti_s, td_s, fc_hz, f_integrator_hz=f_i, f_differentiator_hz=f_d)
     return M.controller_tf(parts, amp)
 

@@ -359,8 +359,8 @@ class _Problem:
         self.t = t
         self.step_v = spec.step_v
         lo, hi = (amp.vout_min, amp.vout_max) if not amp.ideal else (-math.inf, math.inf)
-        if spec.plant_input is not None:
-            lo, hi = max(lo, spec.plant_input[0]), min(hi, spec.plant_input[1])
+        if spec.plant.plant_input is not None:
+            lo, hi = max(lo, spec.plant.plant_input[0]), min(hi, spec.plant.plant_input[1])
         self.u_range = (lo, hi)
         self.evaluations = 0
         self.reference = M.reference(t, spec.step_v, 0.0, spec.edge_s)
@@ -507,7 +507,7 @@ class _Problem:
 
 
 def optimize_model_loop(spec, model, amp, table) -> ModelOptimizeResult:
-    """Optimise the gains for ``spec.process`` (see the module's notes).
+    """Optimise the gains for ``spec.plant.process`` (see the module's notes).
 
     ``table`` is the rule table (:func:`designer.pid.design.rule_table`):
     its applicable, stable rows are the candidate starts; the one with the

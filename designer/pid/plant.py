@@ -29,8 +29,9 @@ cascade is prefixed ``Pi`` (RP11, CP22) with op-amp ``UPi``, so that no plant
 part collides with the controller's R3..R18, C3, C4, U2..U7 or the board's
 decoupling C101.. (:func:`designer.spice.deck.board`).
 
-:func:`resolve_plant` is the one place that turns every plant source of a
-:class:`~designer.pid.spec.PidSpec` into a :class:`Plant`.
+:func:`resolve_plant` is the one place that turns every plant source (a
+:class:`~designer.pid.plant_spec.PlantSource`, a
+:class:`~designer.pid.spec.PidSpec`'s ``plant``) into a :class:`Plant`.
 """
 
 from __future__ import annotations
@@ -341,42 +342,60 @@ def circuit_from_json(data: dict, *, name: str = "result") -> Plant:
         raise DesignError(str(exc)) from None
 
 
-def sallen_key_parts(spec):
+def sallen_key_parts(source, *, opamp: str | None = None, bounds=None):
     """(parts, description, series) of a Sallen-Key plant, designed, given or
     read; every way through :func:`designer.plant.sallenkey.check_parts`.
     ``series`` is the (R, C) pair of a plant designed here, else None.
 
     Parameters
     ----------
-    spec : designer.pid.spec.PidSpec
-        With ``plant_parts``, ``plant_json`` or ``plant_fc_hz``/``plant_zeta``.
+    source : designer.pid.plant_spec.PlantSource or designer.pid.spec.PidSpec
+        With ``plant_parts``, ``plant_json`` or ``plant_fc_hz``/``plant_zeta``
+        (a spec: its ``plant``, its op-amp and its part bounds).
+    opamp : str, optional
+        The op-amp a plant designed from fn and zeta is built with (default a
+        spec's, else LM741).
+    bounds : designer.core.eseries.PartBounds, optional
+        The series and bounds of its parts (default a spec's, else the defaults).
 
     Returns
     -------
     tuple
         (:class:`~designer.plant.sallenkey.SallenKeyParts`, str, tuple or None).
     """
-    if spec.plant_parts is not None:
-        return spec.plant_parts, "parts", None
-    if spec.json_plant is not None:
-        return spec.json_plant, f"json:{spec.plant_json}", None
+    source, opamp, bounds = _with_design_choices(source, opamp, bounds)
+    if source.plant_parts is not None:
+        return source.plant_parts, "parts", None
+    if source.json_plant is not None:
+        return source.json_plant, f"json:{source.plant_json}", None
     from ..core.errors import ParamError
+    from ..filters.sallen_key_lowpass_parts import FIELD_OF
     from ..plant.design import choose_parts
     from ..plant.sallenkey import check_parts
     from ..plant.spec import PlantSpec
-    ps = PlantSpec(fc_hz=spec.plant_fc_hz, zeta=spec.plant_zeta, opamp=spec.opamp,
-                   r_series=spec.r_series, c_series=spec.c_series, r_min=spec.r_min, r_max=spec.r_max,
-                   c_min=spec.c_min, c_max=spec.c_max, alternatives=1)
+    fc, zeta = source.plant_fc_hz, source.plant_zeta
+    ps = PlantSpec(fc_hz=fc, zeta=zeta, opamp=opamp,
+                   r_series=bounds.r_series, c_series=bounds.c_series, r_min=bounds.r_min, r_max=bounds.r_max,
+                   c_min=bounds.c_min, c_max=bounds.c_max, alternatives=1)
     res = choose_parts(ps)   # the parts only: no analysis, no deck
-    what = f"the plant designed for {{plant_fc_hz}} {spec.plant_fc_hz:g} {{plant_zeta}} {spec.plant_zeta:g}"
-    names = {k: f"{what}: {v}" for k, v in (("r1", "R1"), ("r2", "R2"), ("c1", "C1"), ("c2", "C2"),
-                                               ("r3", "R3"), ("r4", "R4"), ("gain", "gain K"))}
+    what = f"the plant designed for {{plant_fc_hz}} {fc:g} {{plant_zeta}} {zeta:g}"
+    names = {f: f"{what}: {r}" for r, f in FIELD_OF.items()} | {"gain": f"{what}: gain K"}
     try:   # the one plant validation, its parts named after the request (markers: see ParamError)
         built = check_parts(res.built, name_of=names | {"plant": what})
     except DesignError as exc:
         raise ParamError(str(exc), ("plant_fc_hz", "plant_zeta")) from None
-    return (built, f"design-plant fc={spec.plant_fc_hz:g} Hz zeta={spec.plant_zeta:g}",
-            (spec.r_series, spec.c_series))
+    return (built, f"design-plant fc={fc:g} Hz zeta={zeta:g}", (bounds.r_series, bounds.c_series))
+
+
+def _with_design_choices(source, opamp, bounds) -> tuple:
+    """(plant source, op-amp, part bounds): a spec's plant and its own choices, else the defaults."""
+    from ..core.eseries import PartBounds
+    spec = source if hasattr(source, "plant") else None
+    if spec is not None:
+        source = spec.plant
+    opamp = opamp if opamp is not None else (spec.opamp if spec is not None else "LM741")
+    bounds = bounds if bounds is not None else (spec if spec is not None else PartBounds())
+    return source, opamp, bounds
 
 
 def sallen_key_circuit(parts) -> PlantCircuit:
@@ -401,8 +420,8 @@ def sallen_key_circuit(parts) -> PlantCircuit:
     return PlantCircuit((Stage(section, {r: values[r] for r in section.designators}),))
 
 
-def resolve_plant(spec) -> Plant:
-    """Every plant source of ``spec`` as a :class:`Plant`: a circuit of any
+def resolve_plant(source, *, opamp: str | None = None, bounds=None) -> Plant:
+    """Every plant source as a :class:`Plant`: a circuit of any
     topology (``plant_topology`` with ``plant_values``, ``plant_circuit``, a
     design-filter result in ``plant_json``), a model (``plant_tf``,
     ``plant_model``, ``plant_process``, a capture), or a Sallen-Key plant
@@ -413,18 +432,24 @@ def resolve_plant(spec) -> Plant:
 
     Parameters
     ----------
-    spec : designer.pid.spec.PidSpec
-        The request (validated when built).
+    source : designer.pid.plant_spec.PlantSource or designer.pid.spec.PidSpec
+        The plant as given (validated when built); a spec: its ``plant``.
+    opamp : str, optional
+        The op-amp of a Sallen-Key plant designed from fn and zeta (default a
+        spec's, else LM741).
+    bounds : designer.core.eseries.PartBounds, optional
+        Its parts' series and bounds (default a spec's, else the defaults).
 
     Returns
     -------
     Plant
         The plant.
     """
-    if spec.circuit is not None:
-        return spec.circuit
-    if spec.process is not None:
-        return Plant(spec.process, None, spec.process.source)
+    source, opamp, bounds = _with_design_choices(source, opamp, bounds)
+    if source.circuit is not None:
+        return source.circuit
+    if source.process is not None:
+        return Plant(source.process, None, source.process.source)
     from .plant_source import sallen_key_model
-    parts, source, _ = sallen_key_parts(spec)
-    return Plant(sallen_key_model(parts, source), sallen_key_circuit(parts), source)
+    parts, description, _ = sallen_key_parts(source, opamp=opamp, bounds=bounds)
+    return Plant(sallen_key_model(parts, description), sallen_key_circuit(parts), description)

@@ -43,7 +43,7 @@ from ..core.fileio import shown
 from ..core.process import ProcessModel
 from ..core.process_build import fopdt, sopdt, underdamped
 from ..plant.model import plant_tf
-from ..plant.sallenkey import SallenKeyParts, check_parts
+from ..plant.sallenkey import JSON_KEYS, SallenKeyParts, check_parts
 
 __all__ = ["model_from_json", "model_from_result", "result_kind", "sallen_key_model"]
 
@@ -54,9 +54,8 @@ ACCEPTED = ("an identify or identify-freq --json output, or a design-plant/analy
 IDENTIFY_FORMATS = ("broadband",)
 #: identification's models this module maps (stepfit's and identify-freq's names)
 IDENTIFIED_MODELS = ("fopdt", "double-pole", "overdamped", "underdamped")
-#: ``built`` keys of a plant result -> :class:`SallenKeyParts` fields
-BUILT_KEYS = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "gain": "gain", "r3": "R3_ohm",
-              "r4": "R4_ohm"}
+#: ``built`` keys of a plant result (design-plant, analyze-plant) by :class:`SallenKeyParts` field
+BUILT_KEYS = {**JSON_KEYS, "gain": "gain"}
 
 
 def result_kind(data) -> str | None:
@@ -286,7 +285,7 @@ def model_from_plant(data: dict, *, name: str = "result") -> ProcessModel:
     :func:`designer.plant.sallenkey.check_parts`)."""
     where = f"plant model {name}"
     built = data["built"]
-    raw = SallenKeyParts(*(built.get(v) for v in BUILT_KEYS.values()))
+    raw = SallenKeyParts(**{k: built.get(v) for k, v in BUILT_KEYS.items()})
 
     def name_of(key):
         return where if key == "plant" else f"{where}: built.{BUILT_KEYS[key]}"

@@ -789,7 +789,7 @@ def _plant_blocks(result) -> list:
     else:
         blocks.append(R.text("No 95 % intervals were given: the loop is checked on the nominal model only."))
     ranges = []
-    for rng, what in ((spec.plant_input, "accepts u from"), (spec.plant_output, "delivers y from")):
+    for rng, what in ((spec.plant.plant_input, "accepts u from"), (spec.plant.plant_output, "delivers y from")):
         if rng is not None:
             ranges.append(f"{what} {format_eng(rng[0], 'V')} to {format_eng(rng[1], 'V')}")
     blocks.append(R.text("The plant " + " and ".join(ranges) + " (checked over the square wave)." if ranges else

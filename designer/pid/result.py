@@ -366,8 +366,8 @@ class PidResult(LoopVerdicts):
         pm_min, gm_min, ms_max = self.limits
         return {
             "plant": {"kind": "model", "source": self.model.source, "model": self.model.to_dict(),
-                      "rules_model": self.reduced.to_dict(), "input_range_v": self.spec.plant_input,
-                      "output_range_v": self.spec.plant_output, **self.circuit_dict()},
+                      "rules_model": self.reduced.to_dict(), "input_range_v": self.spec.plant.plant_input,
+                      "output_range_v": self.spec.plant.plant_output, **self.circuit_dict()},
             **self._amp_keys(),
             "tuning": {"method": self.method, "kp": self.kp, "ti_s": self.ti_s, "td_s": self.td_s,
                        "rule": None if self.rule is None else self.rule.to_dict()},

@@ -1,12 +1,17 @@
 """What a ``design-pid`` user asks for, validated once, when it is built.
 
-A :class:`PidSpec` that exists is a valid one: every number inside its
-physical range (:data:`designer.core.ranges.RANGES`), the options consistent,
-the plant's parts (given, or read from a ``design-plant`` result.json) through
-the one plant validation, :func:`designer.plant.sallenkey.check_parts`.
-Numbers may be given as numbers or in engineering notation (``"43.215u"``),
-so that the command line hands over what the user typed and the message for
-a bad value quotes it.
+A :class:`PidSpec` is a plant source (:class:`~designer.pid.plant_spec.PlantSource`,
+which validates the plant: exactly one source, its ranges, the Sallen-Key
+plant's parts through the one plant validation,
+:func:`designer.plant.sallenkey.check_parts`) and the controller's fields. A
+spec that exists is a valid one: every number inside its physical range
+(:data:`designer.core.ranges.RANGES`), the options consistent with each other
+and with the plant. Numbers may be given as numbers or in engineering
+notation (``"43.215u"``), so that the command line hands over what the user
+typed and the message for a bad value quotes it. The plant's parameters may
+also be given flat, as before (``PidSpec(plant_fc_hz=3500, plant_zeta=0.2,
+kp=2, ...)``): they make the spec's ``plant``, and read back as its
+attributes (``spec.plant_fc_hz`` is ``spec.plant.plant_fc_hz``).
 
 Errors name the library's parameters (``kp``, ``ti_s``, ``plant_fc_hz``);
 the command line shows its options instead, from one table
@@ -17,28 +22,25 @@ them as ``{name}`` markers (:class:`ParamError`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import MISSING, dataclass, fields, replace
 
 from ..core import opamps
 from ..core.errors import DesignError, ParamError
 from ..core.eseries import PartBounds
 from ..core.fileio import show_cell, shown
 from ..core.jsonio import read_result
-from ..core.process import ProcessModel
 from ..core.ranges import parse_in_range
-from ..plant.sallenkey import SallenKeyParts, check_parts
+from ..plant.sallenkey import SallenKeyParts
 from . import tuning as rules
 from .blocks import PidParts
+from .plant_spec import NUMBERS as PLANT_NUMBERS
+from .plant_spec import PLANT_FIELDS, PLANT_RANGES, PlantSource
 
 __all__ = ["PLAIN_PARAMS", "PidSpec", "controller_from_json", "default_name", "pid_spec"]
 
-#: what the plant validation calls the fields of ``plant_parts`` (markers: see ParamError)
-PLANT_NAMES = {"r1": "{plant_r1}", "r2": "{plant_r2}", "c1": "{plant_c1}", "c2": "{plant_c2}",
-               "gain": "{plant_gain}", "r3": "R3", "r4": "R4", "plant": "{plant_r1}..{plant_c2}"}
-#: the ranges of the plant's parts the command line gives (keys of RANGES)
-PLANT_RANGES = {"r1": "resistor_ohm", "r2": "resistor_ohm", "c1": "capacitor_f", "c2": "capacitor_f", "gain": "gain"}
-#: the spec's own numbers and their ranges (keys of RANGES), in the order they are checked
-NUMBERS = (("plant_fc_hz", "fc_hz"), ("plant_zeta", "zeta"), ("kp", "kp"), ("ti_s", "ti_s"), ("td_s", "td_s"),
+#: the spec's own numbers and their ranges (keys of RANGES), in the order they are checked (the plant's:
+#: designer.pid.plant_spec)
+NUMBERS = (("kp", "kp"), ("ti_s", "ti_s"), ("td_s", "td_s"),
            ("step_v", "step_v"), ("edge_s", "edge_s"), ("target_overshoot_pct", "target_overshoot_pct"),
            ("target_settling_s", "target_settling_s"), ("f_integrator_hz", "f_integrator_hz"),
            ("f_differentiator_hz", "f_differentiator_hz"), ("square_hz", "square_hz"),
@@ -49,28 +51,27 @@ NUMBERS = (("plant_fc_hz", "fc_hz"), ("plant_zeta", "zeta"), ("kp", "kp"), ("ti_
 DEFAULT_MIN_PHASE_MARGIN_DEG = 45.0
 DEFAULT_MIN_GAIN_MARGIN_DB = 6.0
 DEFAULT_MAX_MS = 1.7
-#: the options that only a model plant (--plant-tf, --plant-model, --plant-capture) takes
-MODEL_ONLY = ("plant_input", "plant_output", "simc_tauc_s", "imc_lambda_s", "min_phase_margin_deg",
-              "min_gain_margin_db", "max_ms", "plant_method")
+#: the controller's options that only a model plant (--plant-tf, --plant-model, --plant-capture) takes (the
+#: plant's own, plant_input, plant_output and plant_method, are checked by PlantSource)
+MODEL_ONLY = ("simc_tauc_s", "imc_lambda_s", "min_phase_margin_deg", "min_gain_margin_db", "max_ms")
+#: what the plant source resolves on construction, read through the spec too
+RESOLVED = ("json_plant", "process", "circuit")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class PidSpec(PartBounds):
     """A controller design request (SI units), validated on construction.
 
-    Give the plant one way: ``plant_fc_hz`` with ``plant_zeta`` (designed as
-    ``design-plant`` would), ``plant_parts`` (as built), ``plant_json`` (a
-    ``design-plant``/``analyze-plant`` result.json), or as a model only:
-    ``plant_tf`` (typed, :func:`~designer.core.process_text.parse_tf`),
-    ``plant_model`` (an ``identify``/``identify-freq`` JSON, its best valid
-    model or ``plant_method``) or ``plant_process`` (a
-    :class:`~designer.core.process.ProcessModel`). A model plant is designed
+    ``plant`` is where the plant comes from (a
+    :class:`~designer.pid.plant_spec.PlantSource`: fn and zeta, Sallen-Key
+    parts, a result.json, a filter section or cascade, a typed or identified
+    model); its fields may instead be given flat (``plant_fc_hz=3500,
+    plant_zeta=0.2``; with ``plant`` too, they replace its fields) and read
+    back as the spec's attributes. A model plant is designed
     by :mod:`designer.pid.design`: its rules are :data:`designer.pid.rules.RULES`,
     ``optimize`` holds the loop to ``min_phase_margin_deg``,
     ``min_gain_margin_db`` and ``max_ms`` (defaults 45 deg, 6 dB, 1.7; with
-    ``robust`` over the model's 95 % corners too), and ``plant_input`` /
-    ``plant_output`` (``"0:10"`` or a pair, volts) are the ranges the plant
-    accepts and delivers. Gains come from a rule
+    ``robust`` over the model's 95 % corners too). Gains come from a rule
     (``tuning``: one of :data:`designer.pid.tuning.RULES`, default ``zn``),
     from ``tuning="optimize"`` with ``target_overshoot_pct``, or explicitly
     from ``kp``, ``ti_s`` and ``td_s`` together (``td_s = 0`` for a PI).
@@ -84,10 +85,7 @@ class PidSpec(PartBounds):
         One line naming the parameter at fault and what is allowed.
     """
 
-    plant_fc_hz: float | None = None
-    plant_zeta: float | None = None
-    plant_parts: SallenKeyParts | None = None
-    plant_json: str | None = None
+    plant: PlantSource | None = None
     tuning: str | None = None          #: rule name, "optimize", or None (zn, or explicit if gains are given)
     kp: float | None = None
     ti_s: float | None = None
@@ -104,36 +102,33 @@ class PidSpec(PartBounds):
     tol: float = 0.01
     #: how the bench puts the op-amps in packages: single, dual, quad (None: the op-amp's own first)
     package: str | None = None
-    plant_tf: str | None = None
-    plant_model: str | None = None
-    plant_method: str | None = None
-    plant_process: ProcessModel | None = None
-    plant_input: object = None          #: "lo:hi" (volts) or a (lo, hi) pair: what the plant accepts
-    plant_output: object = None         #: the same for what it delivers
     simc_tauc_s: float | None = None
     imc_lambda_s: float | None = None
     min_phase_margin_deg: float | None = None
     min_gain_margin_db: float | None = None
     max_ms: float | None = None
     robust: bool = False
-    #: a plant that is one registered filter section (designer.filters.registry), with ``plant_values``
-    plant_topology: str | None = None
-    #: its part values: designator -> value (number or engineering notation), or "R1=10k" items
-    plant_values: object = None
-    #: a plant circuit given as sections: a designer.filters.cascade.Cascade or (topology, values) pairs
-    plant_circuit: object = None
-    #: the plant read from ``plant_json`` (read and checked on construction, before any work)
-    json_plant: SallenKeyParts | None = field(default=None, init=False, repr=False, compare=False)
-    #: the model plant, from plant_tf, plant_model or plant_process (None for a Sallen-Key plant)
-    process: ProcessModel | None = field(default=None, init=False, repr=False, compare=False)
-    #: a circuit plant of any topology (designer.pid.plant.Plant), from plant_topology, plant_circuit or a
-    #: design-filter plant_json; its model is ``process``
-    circuit: object = field(default=None, init=False, repr=False, compare=False)
 
-    def __post_init__(self):
+    def __init__(self, plant: PlantSource | None = None, **kw):
+        # the plant's fields given flat (the spec's keywords before PlantSource) are taken apart here and
+        # made into ``plant`` in the checks' order (after the controller's numbers, bounds and package)
+        flat = {k: kw.pop(k) for k in PLANT_FIELDS if k in kw}
+        unknown = [k for k in kw if k not in _DEFAULTS]
+        if unknown:
+            raise TypeError(f"PidSpec.__init__() got an unexpected keyword argument {unknown[0]!r}")
+        for name, default in _DEFAULTS.items():
+            object.__setattr__(self, name, kw[name] if name in kw else default)
+        object.__setattr__(self, "plant", plant)
+        self._validate(flat)
+
+    def _validate(self, flat: dict):
+        """Parse, check and normalise every field (frozen: once, here); ``flat`` the plant's fields given flat."""
         def put(name, value):
             object.__setattr__(self, name, value)   # frozen: the spec is normalised once, here
 
+        for name, key in PLANT_NUMBERS:    # the plant's numbers first, as they always were
+            if flat.get(name) is not None:
+                flat[name] = parse_in_range(flat[name], name, key)
         for name, key in NUMBERS:
             value = getattr(self, name)
             if value is not None:
@@ -143,40 +138,19 @@ class PidSpec(PartBounds):
             # refused before any work when the op-amp does not come in it (an NE5532 has no quad)
             from ..core.opamps import get
             get(self.opamp).package(self.package)
-        sources = sum(x is not None for x in (self.plant_fc_hz, self.plant_parts, self.plant_json,
-                                              self.plant_tf, self.plant_model, self.plant_process,
-                                              self.plant_topology, self.plant_circuit))
-        if sources != 1:
-            raise _refused("give the plant one way: {plant_fc_hz}/{plant_zeta}, {plant_r1}..{plant_c2}, "
-                           "{plant_topology} with {plant_values}, {plant_json}, {plant_tf}, {plant_model} or "
-                           "--plant-capture")
-        if (self.plant_values is not None) != (self.plant_topology is not None):
-            raise _refused("{plant_topology} and {plant_values} go together (the section and its parts)")
-        if self.plant_fc_hz is not None and self.plant_zeta is None:
-            raise _refused("{plant_fc_hz} needs {plant_zeta}")
-        if self.plant_fc_hz is None and self.plant_zeta is not None:
-            raise _refused("{plant_zeta} needs {plant_fc_hz}")
-        if self.plant_parts is not None:
-            # parts typed as text (the command line's) are read here, the rest by the plant validation
-            typed = {k: parse_in_range(getattr(self.plant_parts, k), f"plant_{k}", key)
-                     for k, key in PLANT_RANGES.items() if isinstance(getattr(self.plant_parts, k), str)}
-            put("plant_parts", check_plant(replace(self.plant_parts, **typed), PLANT_NAMES))
-        if self.plant_json is not None:
-            circuit = filter_plant_from_json(self.plant_json)
-            if circuit is not None:
-                put("circuit", circuit)
-            else:
-                put("json_plant", plant_from_json(self.plant_json))
-        if self.plant_topology is not None or self.plant_circuit is not None:
-            put("circuit", self._circuit())
+        if self.plant is None:
+            put("plant", PlantSource(**flat))
+        elif not isinstance(self.plant, PlantSource):
+            raise _refused("{plant} must be a designer.pid.plant_spec.PlantSource")
+        elif flat:
+            put("plant", replace(self.plant, **flat))
         if self.controller_parts is not None:
             put("controller_parts", check_controller(self.controller_parts))
         put("opamp", opamps.get(self.opamp).name)
         if self.tuning is not None:
             put("tuning", str(self.tuning).strip().lower())
-        put("process", self._process())
         if self.process is not None:
-            self._check_model_plant(put)
+            self._check_model_plant()
             return
         given = [k for k in MODEL_ONLY if getattr(self, k) is not None] + (["robust"] if self.robust else [])
         if given:
@@ -188,60 +162,18 @@ class PidSpec(PartBounds):
         if all(explicit) and self.tuning not in (None, "explicit"):
             raise _refused(f"{{tuning}} {self.tuning} and explicit {{kp}}/{{ti_s}}/{{td_s}} "
                            "exclude each other")
-        if (self.process is None and not all(explicit) and self.tuning not in (None, "optimize")
-                and self.tuning not in rules.RULES):
+        if not all(explicit) and self.tuning not in (None, "optimize") and self.tuning not in rules.RULES:
             raise _refused(f"unknown {{tuning}} {show_cell(self.tuning)}; allowed: {', '.join(rules.RULES)}, "
                            "optimize")
-        if self.tuning == "optimize" and self.process is None:
+        if self.tuning == "optimize":
             if self.target_overshoot_pct is None:
                 raise _refused("{tuning} optimize needs {target_overshoot_pct} P (percent)")
-        elif self.process is None and (self.target_overshoot_pct is not None or self.target_settling_s is not None):
+        elif self.target_overshoot_pct is not None or self.target_settling_s is not None:
             raise _refused("{target_overshoot_pct}/{target_settling_s} only apply to {tuning} optimize")
 
-    def _circuit(self):
-        """The circuit plant of ``plant_topology``/``plant_values`` or ``plant_circuit``."""
-        from .plant import circuit_from_cascade, circuit_plant
-        try:
-            if self.plant_topology is not None:
-                return circuit_plant(self.plant_topology, self.plant_values, name="plant_values")
-            return circuit_from_cascade(self.plant_circuit, name="plant_circuit")
-        except DesignError as exc:
-            if exc.param == "topology":   # the registry's refusal, named as this spec's parameter
-                where = "{plant_topology}" if self.plant_topology is not None else "{plant_circuit}"
-                raise _refused(where + str(exc)[len("topology"):]) from None
-            raise
-
-    def _process(self):
-        """The model plant, read and checked (None for a Sallen-Key plant)."""
-        if self.circuit is not None:
-            return self.circuit.design_model   # an inverting circuit: -G, the controller's action reversed
-        if self.plant_tf is not None:
-            from ..core.process_text import parse_tf
-            try:
-                return parse_tf(self.plant_tf)
-            except DesignError as exc:
-                raise _refused("{plant_tf} " + str(exc)) from None
-        if self.plant_model is not None:
-            from .plant_source import model_from_json
-            try:
-                return model_from_json(self.plant_model, self.plant_method)
-            except DesignError as exc:
-                raise _refused(str(exc).replace("--plant-model", "{plant_model}")) from None
-        if self.plant_process is not None:
-            if not isinstance(self.plant_process, ProcessModel):
-                raise _refused("{plant_process} must be a designer.core.process.ProcessModel")
-            return self.plant_process
-        if self.plant_method is not None:
-            raise _refused("{plant_method} chooses among the methods of a {plant_model} file")
-        return None
-
-    def _check_model_plant(self, put):
-        """The options of a model plant: rule names, ranges, robust with intervals."""
+    def _check_model_plant(self):
+        """The controller's options for a model plant: rule names, targets, robust with intervals."""
         from . import rules as model_rules
-        for name in ("plant_input", "plant_output"):
-            value = getattr(self, name)
-            if value is not None:
-                put(name, voltage_range(value, name))
         explicit = self.kp is not None
         if not explicit and self.tuning not in (None, "optimize") and self.tuning not in model_rules.RULES:
             raise _refused(f"unknown {{tuning}} {show_cell(self.tuning)}; allowed for a model plant: "
@@ -260,28 +192,26 @@ class PidSpec(PartBounds):
         return "explicit" if self.kp is not None else (self.tuning or "zn")
 
 
-def voltage_range(value, name: str) -> tuple:
-    """``"0:10"`` (engineering notation either side, ``"-5:5"``, ``"0 : 3.3"``)
-    or a (lo, hi) pair as a (lo, hi) tuple of volts, lo < hi, both inside
-    ``RANGES["plant_voltage_v"]``."""
-    if isinstance(value, str):
-        cells = value.split(":")
-        if len(cells) != 2:
-            raise DesignError(f"{name} is a range LO:HI in volts, such as 0:10 or -5:5; got {show_cell(value)}",
-                              param=name)
-        lo, hi = (parse_in_range(c.strip(), name, "plant_voltage_v") for c in cells)
-    else:
-        try:
-            lo, hi = (parse_in_range(v, name, "plant_voltage_v") for v in value)
-        except (TypeError, ValueError):
-            raise DesignError(f"{name} is a range (lo, hi) in volts", param=name) from None
-    if not lo < hi:
-        raise DesignError(f"{name} needs LO < HI, got {lo:g}:{hi:g} V", param=name)
-    return float(lo), float(hi)
+def _plant_attribute(name: str) -> property:
+    """The plant source's ``name`` read through the spec (the spec's attribute before PlantSource)."""
+    def get(self):
+        return getattr(self.plant, name)
+    get.__name__ = name
+    get.__doc__ = f"``plant.{name}`` (:class:`~designer.pid.plant_spec.PlantSource`)."
+    return property(get)
 
 
-#: the names a message of the spec marks as parameters (``{kp}``): its fields and the plant's parts
-PARAMS = frozenset({f.name for f in fields(PidSpec)} | {f"plant_{k}" for k in PLANT_RANGES})
+#: the spec's own fields but its plant, and their defaults (every one a plain value: no default_factory)
+_DEFAULTS = {f.name: f.default for f in fields(PidSpec) if f.init and f.name != "plant"}
+assert MISSING not in _DEFAULTS.values()
+
+for _name in (*PLANT_FIELDS, *RESOLVED):
+    setattr(PidSpec, _name, _plant_attribute(_name))
+
+
+#: the names a message of the spec marks as parameters (``{kp}``): its fields, the plant's and its parts
+PARAMS = frozenset({f.name for f in fields(PidSpec)} | set(PLANT_FIELDS) | set(RESOLVED)
+                   | {f"plant_{k}" for k in PLANT_RANGES})
 
 
 #: the plain parameters :func:`pid_spec` takes beside the spec's own fields: the Sallen-Key plant as built,
@@ -304,7 +234,12 @@ def pid_spec(params: dict) -> PidSpec:
     Returns
     -------
     PidSpec
-        Checked on construction.
+        Checked on construction: its ``plant`` (a :class:`~designer.pid.plant_spec.PlantSource`) made of the
+        plant's parameters (:data:`~designer.pid.plant_spec.PLANT_FIELDS`), the rest its controller's fields.
+        The plant's parameters go to the spec flat, so that it makes the plant source where it checked the
+        plant before (after the plant's and the controller's numbers, the bounds and the package): the first
+        refusal of a request with several faults stays the one it was, but for a plant read or parsed (a
+        model, a file) that now comes before the controller's parts and op-amp.
 
     Raises
     ------
@@ -342,8 +277,8 @@ def default_name(spec: PidSpec, result) -> str:
         ``pid_<rule>_<opamp>_fn<fn>_z<zeta>`` (``_seedparts`` with the seed's controller parts) for a
         Sallen-Key plant; ``pid_<rule>_<opamp>_<kind>`` for a model plant (a circuit plant: its topology).
     """
-    if spec.process is not None:
-        kind = spec.circuit.circuit.topology if spec.circuit is not None else spec.process.kind
+    if spec.plant.process is not None:
+        kind = spec.plant.circuit.circuit.topology if spec.plant.circuit is not None else spec.plant.process.kind
         return f"pid_{result.method}_{spec.opamp.lower()}_{kind}"
     extra = "_seedparts" if spec.controller_parts is not None else ""
     return f"pid_{spec.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}_z{result.plant.zeta:.3g}{extra}"
@@ -353,64 +288,6 @@ def _refused(marked: str) -> ParamError:
     """A refusal naming parameters as ``{name}`` markers (only :data:`PARAMS`: a
     file name's braces stay as they are)."""
     return ParamError(marked, PARAMS)
-
-
-def check_plant(parts: SallenKeyParts, names: dict) -> SallenKeyParts:
-    """:func:`~designer.plant.sallenkey.check_parts` with its fields named by
-    ``names`` (markers allowed); a refusal as a :class:`ParamError`."""
-    try:
-        return check_parts(parts, name_of=names)
-    except DesignError as exc:
-        raise _refused(str(exc)) from None
-
-
-#: result.json keys of the plant's parts (the ``built`` object of design-plant and analyze-plant)
-BUILT_KEYS = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "gain": "gain", "r3": "R3_ohm",
-              "r4": "R4_ohm"}
-
-
-def filter_plant_from_json(path):
-    """The circuit of a ``design-filter`` result.json as a
-    :class:`~designer.pid.plant.Plant`, or None for any other file (read then
-    by :func:`plant_from_json`, whose refusals name what it accepts).
-
-    Parameters
-    ----------
-    path : str or Path
-        The ``plant_json`` file.
-
-    Returns
-    -------
-    designer.pid.plant.Plant or None
-        The cascade plant, or None for another kind of file.
-    """
-    try:
-        data = read_result(path, "{plant_json}")
-    except DesignError:
-        return None
-    if not (isinstance(data, dict) and data.get("tool") == "design-filter"):
-        return None
-    from .plant import circuit_from_json
-    try:
-        return circuit_from_json(data, name=f"{{plant_json}} {shown(path)}")
-    except DesignError as exc:
-        raise _refused(str(exc)) from None
-
-
-def plant_from_json(path) -> SallenKeyParts:
-    """The built plant of a ``design-plant``/``analyze-plant`` result.json, read
-    by the one reader (:func:`designer.core.jsonio.read_result`) and checked by
-    the one plant validation (:func:`designer.plant.sallenkey.check_parts`):
-    values of the wrong type, out of range, a gain that disagrees with R3/R4 or
-    an unstable circuit are refused in one line naming the file and the key."""
-    needed = tuple(BUILT_KEYS[k] for k in ("r1", "r2", "c1", "c2"))
-    try:
-        built = read_result(path, "{plant_json}", needs={"built": needed})["built"]
-    except DesignError as exc:
-        raise _refused(str(exc)) from None
-    raw = SallenKeyParts(*(built.get(v) for v in BUILT_KEYS.values()))
-    names = {k: f"{{plant_json}} {shown(path)}: built.{v}" for k, v in BUILT_KEYS.items()}
-    return check_plant(raw, names | {"plant": f"{{plant_json}} {shown(path)}"})
 
 
 #: the controller's parts (:class:`~designer.pid.blocks.PidParts` fields) and their ranges (keys of RANGES)

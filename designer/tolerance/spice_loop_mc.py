@@ -268,12 +268,13 @@ def replay_spec(spec, result, values: dict):
                         for f in dataclasses.fields(PidParts)})
     change = dict(controller_parts=parts, tuning=None, kp=None, ti_s=None, td_s=None, target_overshoot_pct=None,
                   target_settling_s=None, square_hz=result.test.frequency_hz)
-    if spec.process is None:
+    if spec.plant.process is None:
+        from ..pid.plant_spec import PlantSource
         p = result.plant
-        change.update(plant_fc_hz=None, plant_zeta=None, plant_json=None,
-                      # the network's parts from the build; the gain pair the design's (the build's R3 and R4 are
-                      # the controller's: the loop's values share its designators)
-                      plant_parts=parts_of({r: values[r] for r in refs(with_gain=False)}, base=p, gain=None))
+        # the network's parts from the build; the gain pair the design's (the build's R3 and R4 are the
+        # controller's: the loop's values share its designators)
+        change.update(plant=PlantSource(plant_parts=parts_of({r: values[r] for r in refs(with_gain=False)},
+                                                             base=p, gain=None)))
     return dataclasses.replace(spec, **change)
 
 

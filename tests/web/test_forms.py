@@ -90,9 +90,10 @@ def test_every_pid_field_is_a_design_pid_option_setting_a_parameter_of_the_specs
     """Issue 26: the PID page's fields are design-pid's option names, each setting a parameter of
     designer.pid.spec.pid_spec (the spec's fields and its plain parameters), of the Monte Carlo or of the run."""
     from designer.cli.pid import pid_parser
+    from designer.pid.plant_spec import PLANT_FIELDS
     from designer.pid.spec import PLAIN_PARAMS, PidSpec
     from designer.web.forms import PID
-    specs = ({f.name for f in dataclasses.fields(PidSpec)} | set(PLAIN_PARAMS)
+    specs = ({f.name for f in dataclasses.fields(PidSpec)} | set(PLANT_FIELDS) | set(PLAIN_PARAMS)
              | {f.name for f in dataclasses.fields(MonteCarloSpec)})
     assert {f.param for f in PID.values()} <= specs | {"no_sim", "simulator", "name", "worst_case", "rules_spice"}
     assert len({f.label for f in PID.values()}) == len(PID)
