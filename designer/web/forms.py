@@ -18,14 +18,15 @@ from __future__ import annotations
 import re
 from typing import NamedTuple
 
+from ..check.yamldoc import WIDER
 from ..core.errors import DesignError, ParamError
 from ..core.i18n import N_, localise
 from ..core.i18n import gettext as _
 from ..filters.sallen_key_lowpass_parts import refs as sallen_key_refs
 from .request import option_name, value_text
 
-__all__ = ["FILTER", "Field", "FilterRequest", "PID", "PLANT", "PidRequest", "PlantRequest", "field_of",
-           "filter_request", "page_message", "pid_request", "plant_request"]
+__all__ = ["CHECK", "CheckRequest", "FILTER", "Field", "FilterRequest", "PID", "PLANT", "PidRequest", "PlantRequest", "field_of",
+           "check_message", "check_request", "filter_request", "page_message", "pid_request", "plant_request"]
 
 
 class Field(NamedTuple):
@@ -131,6 +132,18 @@ PID = {
     "spice-samples": Field("spice_samples", N_("SPICE samples")),
     "worst-case": Field("worst_case", N_("worst case"), "switch"),
 }
+#: the Check page's fields (the API's ``options`` keys, as check-design's option names) -> parameter of
+#: :func:`designer.check.batch.check_specs` and label; the files and the folder they stay inside are the request's
+CHECK = {
+    "simulator": Field("simulator", N_("simulator")),
+    "update-golden": Field("update_golden", N_("record the golden files"), "switch"),
+}
+#: the command line's advice in check-design's refusals (its options the page has not), as the page gives it;
+#: ``--update-golden`` then reads as its field's label (:func:`page_message`)
+CHECK_WORDS = (
+    (WIDER, N_("the folder chosen is the limit: choose a folder holding every file the spec names")),
+    ("check-design --update-golden", "--update-golden"),
+)
 #: design-pid's defaults as its options type them (the spec parses them as it parses the command line's: the
 #: same numbers to the last bit, so the page's JSON is design-pid's)
 PID_DEFAULTS = {"step_v": "1", "edge_s": "100n", "r_series": "E24", "c_series": "E12", "r_min": "1k", "r_max": "1M",
@@ -142,6 +155,14 @@ SIMULATORS = ("pyspice", "ngspice-cli")
 _FLAG = re.compile(r"--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?")
 #: a value a message quotes as given ('3.5q', '--help'): never read as a flag
 _QUOTED = re.compile(r"((?<![A-Za-z])'[^']*')")
+
+
+class CheckRequest(NamedTuple):
+    """A Check page's request as the library takes it (the spec files apart: the server writes them)."""
+
+    simulator: str
+    update_golden: bool         #: record the golden files (answered for download, never kept)
+    argv: list                  #: the command line this request stands for (``tool.argv`` of its JSON)
 
 
 class FilterRequest(NamedTuple):
@@ -315,6 +336,50 @@ def plant_request(options) -> PlantRequest:
                  + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
     return PlantRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False),
                         simulator, stimulus, name, _argv("design-plant", options))
+
+
+def check_request(options) -> CheckRequest:
+    """A Check page's options (the ``options`` of its JSON, or a form's other fields) as the library takes them.
+
+    Parameters
+    ----------
+    options : dict
+        Field -> value (:data:`CHECK`'s keys).
+
+    Returns
+    -------
+    CheckRequest
+        The simulator, whether to record the golden files, and the command line the request stands for.
+
+    Raises
+    ------
+    DesignError
+        One line naming the library parameter at fault (shown by :func:`check_message`).
+    """
+    v = _fields(options, CHECK)
+    return CheckRequest(_simulator(v, "pyspice"), bool(v.get("update_golden")), _argv("check-design", options))
+
+
+def check_message(exc: DesignError) -> tuple:
+    """A check-design refusal in the Check page's words: :func:`page_message` over :data:`CHECK`, the command
+    line's advice (:data:`CHECK_WORDS`) as the page gives it.
+
+    Parameters
+    ----------
+    exc : DesignError
+        The library's error.
+
+    Returns
+    -------
+    tuple
+        (the message, the field it names or None).
+    """
+    if not isinstance(exc, ParamError) and getattr(exc, "param", None) is None:
+        text = str(exc)
+        for cli, page in CHECK_WORDS:
+            text = text.replace(cli, page if page.startswith("--") else _(page))
+        exc = DesignError(text)
+    return page_message(exc, CHECK)
 
 
 def filter_request(options) -> FilterRequest:

@@ -48,7 +48,7 @@ from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
 
 __all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "CLI_ONLY", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACES",
-           "TRACE_POINTS", "Superseded", "bom_shown", "bundle_zip", "check_files", "checks_shown", "circuit_plant_page",
+           "TRACE_POINTS", "Superseded", "bom_shown", "bundle_zip", "check_files", "check_task", "checks_shown", "circuit_plant_page",
            "design_filter_task", "design_pid_task", "design_plant_task", "files_in", "filter_page", "histograms",
            "identify_page", "pid_page", "plant_page", "run", "run_task", "series_text", "temporaries_in",
            "through_library", "warm_up", "written_since"]
@@ -496,8 +496,71 @@ def _library_work(prog: str, table: dict, fields: dict, lang: str | None, work, 
     return answer
 
 
+def check_task(fields: dict, want: str = "check", tmp: str | None = None) -> dict:
+    """check-design for the Check page, the library called directly: the spec files the server wrote in the
+    request's folder (``tmp/in``, each under its relative path), the page's options as
+    :func:`designer.web.forms.check_request` takes them, and :func:`designer.check.batch.check_specs` run
+    with that folder as the root every path of a spec must stay inside (check-design's trust boundary, as
+    ``--root``), its output folder ``tmp/out``.
+
+    Parameters
+    ----------
+    fields : dict
+        ``specs`` (the specs' paths relative to ``tmp/in``, ``/``-separated, as the server checked them) and
+        ``options`` (the page's fields, :data:`designer.web.forms.CHECK`; ``lang`` among them).
+    want : str
+        ``check`` (the only answer Check gives).
+    tmp : str
+        The request's private folder.
+
+    Returns
+    -------
+    dict
+        ``status`` (the run's exit status), ``error`` (a refusal in the page's words, with its ``field`` and
+        ``label``; or the run's last error line when a spec proved bad or the simulator failed), ``json``
+        (``{"specs": [each spec's result.json]}``), ``junit``, ``summary``, ``golden`` (the golden files
+        recorded: their paths relative to the folder chosen -> text), ``lines`` and ``messages`` (what
+        check-design prints on stdout and stderr).
+    """
+    from ..check.batch import check_specs
+    from ..core.errors import DesignError
+    from .forms import CHECK, check_message, check_request
+    from .request import split_language
+    inside = os.path.join(tmp, "in")
+    specs = [os.path.join(inside, *rel.split("/")) for rel in fields["specs"]]
+    try:
+        options, lang = split_language(fields.get("options") or {})
+    except DesignError as exc:
+        return {"status": 2, "error": f"check-design: error: {exc}", "json": None, "field": None, "label": None}
+    argv0 = sys.argv
+    with language(lang), temporaries_in(tmp):
+        try:
+            rq = check_request(options)
+            # each result's tool.argv: the command line this request stands for (a record, never parsed)
+            sys.argv = [rq.argv[0], *specs, *rq.argv[1:], "--junit", os.path.join(tmp, "junit.xml"), "--summary",
+                        os.path.join(tmp, "summary.md"), "--out", os.path.join(tmp, "out"), "--root", inside]
+            before = files_in(inside)
+            run = check_specs(specs, rq.simulator, update_golden=rq.update_golden, root=inside,
+                              out=os.path.join(tmp, "out"))
+        except DesignError as exc:
+            text, field = check_message(exc)
+            return {"status": 2, "error": f"check-design: error: {text}", "json": None, "field": field,
+                    "label": _(CHECK[field].label) if field else None}
+        finally:
+            sys.argv = argv0
+        messages = run.messages()
+        status = run.status
+        error = None
+        if status not in (0, 1):   # a spec that proved bad while running, or the simulator: its last line
+            error = check_message(DesignError(messages[-1]))[0] if messages else f"failed with exit status {status}"
+    return {"status": status, "error": error, "json": {"specs": run.results()}, "junit": run.junit(),
+            "summary": run.summary(), "golden": written_since(inside, before) if rq.update_golden else {},
+            "lines": run.lines(), "messages": messages}
+
+
 #: the commands the page runs through the library (no console script, no argv, no printed JSON)
-LIBRARY = {"design-plant": design_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task}
+LIBRARY = {"design-plant": design_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task,
+           "check-design": check_task}
 #: a command's options its page's name table does not map (design-pid's capture identified first, with identify's
 #: options; a replayed build; --fail-on-check): a request with one runs the command's entry point, as before
 CLI_ONLY = {"design-pid": frozenset({"plant-capture", "step-time", "step-amplitude", "window", "format", "input-column",

@@ -131,3 +131,53 @@ def test_bad_pid_fields_are_refused_in_the_pages_words(tmp_path, fields, param, 
     text, field = page_message(exc.value, PID)
     assert words in text and "--" not in text and "\n" not in text, text
     assert PID[field].param == param, (field, text)
+
+
+def test_a_check_request_is_what_check_design_takes():
+    """Issue 26: the Check page's options through its name table (CHECK), as check_specs takes them."""
+    from designer.web.forms import CHECK, check_request
+    rq = check_request({"simulator": "ngspice-cli", "update-golden": "on"})
+    assert (rq.simulator, rq.update_golden) == ("ngspice-cli", True)
+    assert rq.argv == ["check-design", "--simulator=ngspice-cli", "--update-golden=on"]
+    assert check_request({}).simulator == "pyspice" and check_request({}).update_golden is False
+    import inspect
+    from designer.check.batch import check_specs
+    assert {f.param for f in CHECK.values()} <= set(inspect.signature(check_specs).parameters)
+
+
+@pytest.mark.parametrize("options, field, words", [
+    ({"update-golden": "maybe"}, "update-golden", '"record the golden files" is a switch'),
+    ({"simulator": "spectre"}, "simulator", "'spectre' unknown; allowed: pyspice, ngspice-cli"),
+    ({"jobs": 4}, None, "the server's own setting"),
+    ({"root": "/"}, None, "set by the web page itself"),
+    ({"allow-outside": True}, None, "set by the web page itself"),
+    ({"spec": "x"}, None, "is not a field of this page; allowed: simulator, update-golden"),
+])
+def test_bad_check_options_are_refused_in_the_pages_words(options, field, words):
+    from designer.web.forms import check_message, check_request
+    with pytest.raises(DesignError) as caught:
+        check_request(options)
+    text, got = check_message(caught.value)
+    assert words in text and got == field, text
+
+
+def test_check_designs_advice_reads_as_the_page_offers_it(tmp_path):
+    """A spec's path outside its folder, and a golden file to record: check-design's refusals name its
+    --root, --allow-outside and --update-golden; the page says what it offers (no option)."""
+    from designer.check.spec import load_spec
+    from designer.web.forms import check_message
+    spec = tmp_path / "in" / "x.yaml"
+    spec.parent.mkdir()
+    spec.write_text("name: x\nkind: netlist\ndeck: ../d.cir\nchecks:\n  v: {max: 1}\n")
+    with pytest.raises(DesignError) as caught:
+        load_spec(spec)
+    assert "--root" in str(caught.value)
+    text, _ = check_message(caught.value)
+    assert "--" not in text and "x.yaml:3: deck" in text and "the folder chosen is the limit" in text
+    (tmp_path / "in" / "d.cir").write_text("* d\nV1 1 0 1\nR1 1 0 1k\n.tran 1u 10u\n.meas tran v max v(1)\n.end\n")
+    spec.write_text("name: x\nkind: netlist\ndeck: d.cir\ngolden: {file: g.csv, signals: {v(1): {reltol: 0.01}}}\n")
+    with pytest.raises(DesignError) as caught:
+        load_spec(spec)
+    assert "check-design --update-golden" in str(caught.value)
+    text, _ = check_message(caught.value)
+    assert "--" not in text and 'record it with "record the golden files"' in text, text
