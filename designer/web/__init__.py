@@ -14,7 +14,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "guard": ("CSP", "Guard", "JSON_PATHS", "PAGE_HEADER", "SECURITY_HEADERS", "Trust", "UPLOAD_PATHS",
               "error_response", "origin_of", "trust_for"),
     "jobs": ("AXES", "BODE_POINTS", "BOM_COLUMNS", "CLI_ONLY", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "Superseded",
-             "TRACES", "TRACE_POINTS", "bom_shown", "bundle_zip", "check_files", "check_task", "checks_shown", "circuit_plant_page",
+             "TRACES", "TRACE_POINTS", "bom_shown", "bundle_zip", "check_task", "checks_shown", "circuit_plant_page",
              "design_filter_task", "design_pid_task", "design_plant_task", "files_in", "filter_page", "histograms",
              "identify_page", "pid_page", "plant_page", "run", "run_task", "series_text", "temporaries_in",
              "through_library", "warm_up", "written_since"),

@@ -73,11 +73,12 @@ class TooLarge(Exception):
 
 
 def _parsers() -> dict:
-    """Each command's parser traits (switches, appended options), from the CLI's own parsers."""
-    from ..cli import check, identify, pid, plant
-    builders = {"design-plant": plant.design_plant_parser, "analyze-plant": plant.analyze_plant_parser,
-                "design-pid": pid.pid_parser, "analyze-pid": pid.analyze_pid_parser, "identify": identify.build_parser,
-                "identify-freq": identify.build_freq_parser, "check-design": check.check_parser}
+    """The parser traits (switches, appended options) of each command still run by its argument list (the
+    others are the library's, :data:`designer.web.jobs.LIBRARY`), from the CLI's own parsers."""
+    from ..cli import identify, pid, plant
+    builders = {"analyze-plant": plant.analyze_plant_parser, "design-pid": pid.pid_parser,
+                "analyze-pid": pid.analyze_pid_parser, "identify": identify.build_parser,
+                "identify-freq": identify.build_freq_parser}
     return {prog: req.parser_traits(build()) for prog, build in builders.items()}
 
 

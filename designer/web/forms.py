@@ -131,6 +131,7 @@ PID = {
     "target-ci": Field("target_ci", N_("target interval")), "engine": Field("engine", N_("engine")),
     "spice-samples": Field("spice_samples", N_("SPICE samples")),
     "worst-case": Field("worst_case", N_("worst case"), "switch"),
+    "replay": Field("replay", N_("build replayed")),
 }
 #: the Check page's fields (the API's ``options`` keys, as check-design's option names) -> parameter of
 #: :func:`designer.check.batch.check_specs` and label; the files and the folder they stay inside are the request's
@@ -190,6 +191,7 @@ class PidRequest(NamedTuple):
     rules_spice: bool           #: a model plant: every applicable rule's loop in SPICE too
     name: str | None            #: the design's name (its files); None: design-pid's default, from the result
     argv: list                  #: the command line this request stands for (``tool.argv`` of its JSON)
+    replay: int | None = None   #: the Monte Carlo's build analysed as built in SPICE (design-pid --replay I)
 
 
 class PlantRequest(NamedTuple):
@@ -462,7 +464,29 @@ def pid_request(options, tmp: str | None) -> PidRequest:
     simulator = _simulator(v, "pyspice")
     name = _name(v, "pid") if "name" in v else None
     return PidRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False), simulator,
-                      bool(v.get("rules_spice")), name, _argv("design-pid", options))
+                      bool(v.get("rules_spice")), name, _argv("design-pid", options), _replay(v, mc))
+
+
+def _replay(v: dict, mc) -> int | None:
+    """The build of the Monte Carlo ``mc`` to replay (design-pid's ``--replay I``, checked as it checks it), or
+    None."""
+    if "replay" not in v:
+        return None
+    if mc is None:
+        raise ParamError("{replay} goes with {n} (and the run's {seed}, {sampler}, {dist}, {tol})",
+                         ("replay", "n", "seed", "sampler", "dist", "tol"))
+    if v.get("no_sim"):
+        raise ParamError("{replay} simulates the build in SPICE: leave out {no_sim}", ("replay", "no_sim"))
+    if v.get("rules_spice"):
+        raise ParamError("{rules_spice} does not go with {replay} (a replayed build is analysed as built)",
+                         ("rules_spice", "replay"))
+    try:
+        i = int(v["replay"].strip())
+    except ValueError:
+        i = None
+    if i is None or not 0 <= i <= mc.n - 1:
+        raise DesignError(f"replay {v['replay']!r}: give a whole number from 0 to {mc.n - 1}", param="replay")
+    return i
 
 
 def _check_loop_tolerance(spec, mc, tol) -> None:

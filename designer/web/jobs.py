@@ -1,8 +1,9 @@
 """What a worker process does for one request of the web page: run the
 command as its console script does, and hand back what the page shows.
 
-A task names the command (``design-plant``, ``design-pid``, ``identify``,
-``check-design`` ...) and its argument list, built by :mod:`.request` from the
+Most tasks call the library directly with the request's fields (:data:`LIBRARY`: design-plant, design-filter,
+design-pid, check-design). The others name the command (``analyze-plant``, ``analyze-pid``, ``identify``,
+``design-pid`` with a capture) and its argument list, built by :mod:`.request` from the
 request's option names. The command's own entry point runs it
 (``design_plant_main(argv)``...: the same parser, the same checks, the same
 one-line refusal and exit status), with stdout and stderr taken into strings;
@@ -31,7 +32,6 @@ from contextlib import contextmanager, redirect_stderr, redirect_stdout
 
 import numpy as np
 
-from ..cli import check as cli_check
 from ..cli import identify as cli_identify
 from ..cli import pid as cli_pid
 from ..cli import plant as cli_plant
@@ -48,7 +48,7 @@ from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
 
 __all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "CLI_ONLY", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACES",
-           "TRACE_POINTS", "Superseded", "bom_shown", "bundle_zip", "check_files", "check_task", "checks_shown", "circuit_plant_page",
+           "TRACE_POINTS", "Superseded", "bom_shown", "bundle_zip", "check_task", "checks_shown", "circuit_plant_page",
            "design_filter_task", "design_pid_task", "design_plant_task", "files_in", "filter_page", "histograms",
            "identify_page", "pid_page", "plant_page", "run", "run_task", "series_text", "temporaries_in",
            "through_library", "warm_up", "written_since"]
@@ -58,13 +58,12 @@ TRACE_POINTS = 1500
 #: frequency points of a Bode trace
 BODE_POINTS = 300
 
-#: the commands a task may name, and their console entry points (called as functions: argv in, status out)
+#: the commands a task may name by an argument list, and their console entry points (called as functions: argv
+#: in, status out); the others are :data:`LIBRARY`'s
 MAINS = {
-    "design-plant": cli_plant.design_plant_main,
     "analyze-plant": cli_plant.analyze_plant_main,
     "design-pid": cli_pid.design_pid_main,
     "analyze-pid": cli_pid.analyze_pid_main,
-    "check-design": cli_check.check_design_main,
 }
 
 
@@ -148,7 +147,7 @@ def run_task(task: dict) -> dict:
         task itself: ``prog`` (a command), ``argv`` (its arguments, ``--json`` among them
         for the designing commands), ``want``: "page" (the JSON and the page's
         extras), "json", "sheet" (the printable build sheet), "bundle" (the
-        design's files as a zip) or "check" (check-design's files); ``tmp``:
+        design's files as a zip) or "check" (a library task: check-design's answer); ``tmp``:
         the request's private folder (files written there), or None; ``lang``: the language of the page's
         words (a command with ``--lang`` takes it from there).
 
@@ -172,7 +171,6 @@ def run_task(task: dict) -> dict:
     seen = {}
     out, err = io.StringIO(), io.StringIO()
     token = RESULT_HOOK.set(lambda result, name: seen.update(result=result, name=name))
-    before = files_in(os.path.join(tmp, "in")) if prog == "check-design" and tmp else {}
     argv0 = sys.argv
     sys.argv = [prog, *argv]   # the JSON's tool.argv: the command line this request stands for
     try:
@@ -193,11 +191,6 @@ def run_task(task: dict) -> dict:
         if want == "page":
             with language(lang):
                 answer["page"] = identify_page(seen["result"])
-        return answer
-    if prog == "check-design":
-        answer.update(check_files(tmp))
-        answer["golden"] = written_since(os.path.join(tmp, "in"), before) if "--update-golden" in argv else {}
-        answer["stdout"] = out.getvalue()
         return answer
     answer["json"] = json.loads(out.getvalue())
     result, name = seen["result"], seen["name"]
@@ -445,9 +438,13 @@ def design_pid_task(fields: dict, want: str = "json", tmp: str | None = None) ->
         from ..tolerance.mcspec import loop_tolerance
         from .forms import pid_request
         rq = pid_request(fields, tmp)
-        result = design_pid(rq.spec, simulate=rq.simulate, simulator=rq.simulator, rules_spice=rq.rules_spice)
-        result = loop_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
-        name = rq.name or default_name(rq.spec, result)
+        if rq.replay is not None:   # the design is the draw's nominal; the build's own run is the simulation
+            design, result = _replayed(rq)
+            name = f"{rq.name or default_name(rq.spec, design)}_sample{rq.replay}"
+        else:
+            result = design_pid(rq.spec, simulate=rq.simulate, simulator=rq.simulator, rules_spice=rq.rules_spice)
+            result = loop_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
+            name = rq.name or default_name(rq.spec, result)
         if want in ("sheet", "bundle"):
             write_outputs(result, tmp, name)
         data = json.loads(json.dumps(result.to_dict()))
@@ -455,6 +452,19 @@ def design_pid_task(fields: dict, want: str = "json", tmp: str | None = None) ->
         data["tool"]["argv"] = rq.argv + ([f"--lang={lang}"] if lang else [])
         return data, lambda: pid_page(result), name
     return _library_task("design-pid", PID, fields, work, want, tmp)
+
+
+def _replayed(rq):
+    """Build ``rq.replay`` of the request's Monte Carlo, analysed as built in SPICE (design-pid ``--replay I``:
+    :func:`designer.tolerance.spice_loop_mc.replay`): (the design, the build's result, its ``monte_carlo`` the
+    replayed row)."""
+    from ..pid.design import design_pid
+    from ..tolerance.loop import loop_series
+    from ..tolerance.spice_loop_mc import replay, replay_result
+    design = design_pid(rq.spec, simulate=False, simulator=rq.simulator)
+    mc = rq.monte_carlo
+    build = replay(design, loop_series(design), rq.replay, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol, rq.simulator)
+    return design, replay_result(rq.spec, design, build, rq.simulator)
 
 
 def _library_task(prog: str, table: dict, fields: dict, work, want: str, tmp: str | None) -> dict:
@@ -562,10 +572,9 @@ def check_task(fields: dict, want: str = "check", tmp: str | None = None) -> dic
 LIBRARY = {"design-plant": design_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task,
            "check-design": check_task}
 #: a command's options its page's name table does not map (design-pid's capture identified first, with identify's
-#: options; a replayed build; --fail-on-check): a request with one runs the command's entry point, as before
+#: options): a request with one runs the command's entry point, as before
 CLI_ONLY = {"design-pid": frozenset({"plant-capture", "step-time", "step-amplitude", "window", "format", "input-column",
-                                     "output-column", "sample-time", "columns", "methods", "no-refine", "replay",
-                                     "fail-on-check"})}
+                                     "output-column", "sample-time", "columns", "methods", "no-refine"})}
 
 
 def through_library(prog: str, options) -> bool:
@@ -1041,34 +1050,6 @@ def bundle_zip(tmp: str, name: str) -> bytes:
             z.writestr(f"reports/{name}/{fname}", _read(os.path.join(rep, fname)))
         z.writestr(f"netlists/{name}.cir", _read(os.path.join(tmp, "netlists", f"{name}.cir")))
     return buf.getvalue()
-
-
-def check_files(tmp: str) -> dict:
-    """check-design's files of one run in ``tmp``: the JUnit XML, the Markdown
-    summary and each spec's result.json (as check-design writes them).
-
-    Parameters
-    ----------
-    tmp : str
-        The run's folder.
-
-    Returns
-    -------
-    dict
-        ``json`` (``{"specs": [...]}``), ``junit`` and ``summary`` (None when not written).
-    """
-    out = os.path.join(tmp, "out")
-    results = []
-    if os.path.isdir(out):
-        for name in sorted(os.listdir(out)):
-            path = os.path.join(out, name, "result.json")
-            if os.path.isfile(path):
-                results.append(json.loads(_read(path)))
-    junit = os.path.join(tmp, "junit.xml")
-    summary = os.path.join(tmp, "summary.md")
-    return {"json": {"specs": results},
-            "junit": _read(junit).decode("utf-8") if os.path.isfile(junit) else None,
-            "summary": _read(summary).decode("utf-8") if os.path.isfile(summary) else None}
 
 
 def files_in(folder: str) -> dict:

@@ -930,14 +930,30 @@ def test_a_spanish_request_is_refused_in_spanish_naming_its_field(server):
 
 def test_pid_with_a_capture_runs_design_pid_as_before(server):
     """Issue 26: the options the PID page's name table does not map (a capture identified first, with
-    identify's options; --replay; --fail-on-check) still work: such a request runs design-pid's entry point,
-    the JSON its --json."""
+    identify's options) still work: such a request runs design-pid's entry point, the JSON its --json."""
     from designer.web.jobs import CLI_ONLY, through_library
     assert not through_library("design-pid", {"plant_capture": "x"}) and through_library("design-pid", {"kp": 1})
-    assert CLI_ONLY["design-pid"] >= {"plant-capture", "replay"}
+    assert "plant-capture" in CLI_ONLY["design-pid"]
+    assert through_library("design-pid", {"replay": 1}) and through_library("design-pid", {"fail-on-check": True})
     status, got = server.post_json("/api/pid", {"plant-capture": CAPTURE.read_text(), "tuning": "amigo",
                                                 "no-sim": True})
     assert status == 200, got
     want = cli_json("design-pid", "--plant-capture", str(CAPTURE), "--tuning", "amigo", "--no-sim", "--json",
                     "--no-files")
     assert got["tuning"] == want["tuning"] and got["tuning"]["method"] == "amigo"
+
+
+def test_pid_replays_a_build_through_the_library_as_design_pid_does(server):
+    """Issue 26: design-pid's --replay I (a Monte Carlo build analysed as built in SPICE) through the page's name
+    table, no argument list: the JSON design-pid --replay prints; --fail-on-check stays the server's."""
+    body = {"plant-fc": 3500, "plant-zeta": 0.2, "monte-carlo": 20, "seed": 3, "replay": 4}
+    status, got = server.post_json("/api/pid", body)
+    assert status == 200, got
+    want = cli_json("design-pid", "--plant-fc", "3500", "--plant-zeta", "0.2", "--monte-carlo", "20", "--seed", "3",
+                    "--replay", "4", "--json", "--no-files")
+    assert without_run_details(got) == without_run_details(want)
+    assert got["monte_carlo"] == want["monte_carlo"]
+    status, got = server.post_json("/api/pid", {**body, "replay": 20})
+    assert status == 400 and got["field"] == "replay" and "from 0 to 19" in got["error"] and "--" not in got["error"]
+    status, got = server.post_json("/api/pid", {**body, "fail-on-check": True})
+    assert status == 400 and "set by the web page itself" in got["error"], got

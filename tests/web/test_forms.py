@@ -94,7 +94,7 @@ def test_every_pid_field_is_a_design_pid_option_setting_a_parameter_of_the_specs
     from designer.web.forms import PID
     specs = ({f.name for f in dataclasses.fields(PidSpec)} | set(PLAIN_PARAMS)
              | {f.name for f in dataclasses.fields(MonteCarloSpec)})
-    assert {f.param for f in PID.values()} <= specs | {"no_sim", "simulator", "name", "worst_case", "rules_spice"}
+    assert {f.param for f in PID.values()} <= specs | {"no_sim", "simulator", "name", "worst_case", "rules_spice", "replay"}
     assert len({f.label for f in PID.values()}) == len(PID)
     options = {o for a in pid_parser()._actions for o in a.option_strings}
     assert {f"--{k}" for k in PID} <= options
@@ -181,3 +181,21 @@ def test_check_designs_advice_reads_as_the_page_offers_it(tmp_path):
     assert "check-design --update-golden" in str(caught.value)
     text, _ = check_message(caught.value)
     assert "--" not in text and 'record it with "record the golden files"' in text, text
+
+
+@pytest.mark.parametrize("fields, param, words", [
+    ({"replay": 3}, "replay", '"build replayed" goes with "Monte Carlo builds"'),
+    ({"replay": 3, "monte-carlo": 10, "no-sim": True}, "replay", 'leave out "skip SPICE"'),
+    ({"replay": 3, "monte-carlo": 10, "rules-spice": True}, "rules_spice", '"build replayed" (a replayed build'),
+    ({"replay": 10, "monte-carlo": 10}, "replay", "'10': give a whole number from 0 to 9"),
+    ({"replay": "x", "monte-carlo": 10}, "replay", "'x': give a whole number from 0 to 9"),
+])
+def test_a_replay_is_checked_as_design_pid_checks_it(tmp_path, fields, param, words):
+    """Issue 26: design-pid's --replay I through the PID page's name table, refused in the page's words."""
+    from designer.web.forms import PID, pid_request
+    with pytest.raises(DesignError) as caught:
+        pid_request({"plant-fc": 3500, "plant-zeta": 0.2, **fields}, str(tmp_path))
+    text, field = page_message(caught.value, PID)
+    assert caught.value.param == param and words in text and "--" not in text, text
+    assert pid_request({"plant-fc": 3500, "plant-zeta": 0.2, "replay": "9", "monte-carlo": 10},
+                       str(tmp_path)).replay == 9
