@@ -30,10 +30,11 @@ def test_a_trace_is_json_with_nan_as_null_and_at_most_its_points():
 
 @pytest.mark.spice
 def test_a_plant_page_is_the_commands_json_and_its_own_arrays():
-    out = jobs.run({"prog": "design-plant", "argv": ["--fc", "3500", "--zeta", "0.2", "--json", "--no-files"],
-                    "want": "page"})
+    """design-plant through the library (the page's fields, issue 26): its JSON records the command line it
+    stands for."""
+    out = jobs.run({"prog": "design-plant", "fields": {"fc": 3500, "zeta": 0.2}, "want": "page"})
     assert out["status"] == 0 and out["error"] is None
-    assert out["json"]["tool"]["argv"] == ["design-plant", "--fc", "3500", "--zeta", "0.2", "--json", "--no-files"]
+    assert out["json"]["tool"]["argv"] == ["design-plant", "--fc=3500", "--zeta=0.2"]
     step = out["page"]["step"]
     labels = [s["label"] for s in step["series"]]
     assert labels[:3] == ["SPICE (ngspice)", "analytic (LM741 model)", "analytic (ideal op-amp)"]
@@ -45,9 +46,13 @@ def test_a_plant_page_is_the_commands_json_and_its_own_arrays():
 
 
 def test_a_refusal_is_the_commands_one_line():
-    out = jobs.run({"prog": "design-plant", "argv": ["--fc", "3500", "--zeta", "-1", "--json", "--no-files"],
-                    "want": "page"})
-    assert out["status"] == 2 and out["error"] == "design-plant: error: --zeta must be 0.01 to 10, got '-1'"
+    """A command still run by its argument list refuses in its one line; a library task in the page's words."""
+    out = jobs.run({"prog": "analyze-plant", "argv": ["--r1", "1k6", "--r2", "3k9", "--c1", "3n3", "--c2", "-1",
+                                                      "--json", "--no-files"], "want": "page"})
+    assert out["status"] == 2 and out["error"] == "analyze-plant: error: --c2 must be 100 fF to 1 F, got '-1'"
+    out = jobs.run({"prog": "design-plant", "fields": {"fc": 3500, "zeta": -1}, "want": "page"})
+    assert out["status"] == 2 and out["error"] == "design-plant: error: \"zeta\" must be 0.01 to 10, got '-1'"
+    assert out["field"] == "zeta"
 
 
 def test_a_broadband_capture_gives_its_step_and_spectrum_traces(tmp_path):
