@@ -435,7 +435,6 @@ PART_NAME_EXEMPT = {
     ("designer/pid/spec.py", "BUILT_KEYS"): "pid, left for the PID merge: a design-plant JSON's keys",
     ("designer/pid/spec.py", "plant_from_json"): "pid, left for the PID merge: a design-plant JSON's keys",
     ("designer/pid/spec.py", "controller_from_json"): "the controller's own R3 in a design-pid JSON",
-    ("designer/web/jobs.py", "plant_page"): "web, another helper's: the input resistor the generator drives",
 }
 
 

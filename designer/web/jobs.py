@@ -732,6 +732,7 @@ def plant_page(result) -> dict:
         The page's JSON-ready content.
     """
     from ..core.lti import freq_response
+    from ..filters.sallen_key_lowpass_parts import section_of
     from ..plant import report as rep
     from ..report.document import to_html
     from ..report.wiring import bench_rows
@@ -754,7 +755,8 @@ def plant_page(result) -> dict:
     if sine is not None and sine.h_spice is not None:
         resp["SPICE .ac"] = _complex_on_grid(sine.spice_f_hz, sine.h_spice, f)
     bom = rep.bom(result)
-    bench = bench_rows(result.test, result.scope, "R1")
+    # the generator drives the section's input resistor, as its declaration names it (the sheet's settings table)
+    bench = bench_rows(result.test, result.scope, section_of(result.built).designators[0])
     if result.sine is not None:   # as the sheet's settings table gives it
         bench.append([_("sine check"), rep.sine_text(result.sine)])
     return {"step": _trace(result.time_s, step, "time from the edge (s)"),

@@ -195,3 +195,18 @@ def test_a_chirp_capture_page_draws_the_record_with_its_models_and_every_candida
     best = out["json"]["validation"]["best"]
     assert (rows[0]["route"], rows[0]["model"]) == (best["route"], best["model"])
     assert rows[0]["fit_percent"] == pytest.approx(best["validation"]["fit_percent"])
+
+
+@pytest.mark.parametrize("gain", [1, 2])
+def test_the_plant_pages_bench_names_the_input_resistor_the_section_declares(gain):
+    """Issue 26: the generator's row names the section's input resistor as its declaration gives it (the sheet's
+    settings table), not a designator spelt in the web layer."""
+    from designer.filters.sallen_key_lowpass_parts import section_of
+    from designer.plant.design import design_plant
+    from designer.plant.spec import PlantSpec
+    from designer.report.wiring import bench_rows
+    result = design_plant(PlantSpec(fc_hz=3500, zeta=0.2, gain=gain), simulate=False)
+    ref = section_of(result.built).designators[0]
+    rows = bench_rows(result.test, result.scope, ref)
+    assert jobs.plant_page(result)["bench"][:len(rows)] == rows
+    assert any(ref in str(cell) for row in rows for cell in row)
