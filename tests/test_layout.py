@@ -428,7 +428,6 @@ PART_NAME_EXEMPT = {
     ("designer/pid/netlist.py", "controller_stages"): "the controller's own R3, R4 (seed Figure 66)",
     ("designer/pid/schematic.py", "_draw_controller"): "the controller's own R3, R4 (seed Figure 66)",
     ("designer/pid/spec.py", "controller_from_json"): "the controller's own R3 in a design-pid JSON",
-    ("designer/web/jobs.py", "plant_page"): "web, another helper's: the input resistor the generator drives",
 }
 
 

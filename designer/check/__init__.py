@@ -8,7 +8,8 @@ checks, SPICE's agreement with the model, the tolerance band, golden
 waveforms (:mod:`.golden`). :mod:`.run` runs and judges one corner,
 :mod:`designer.core.workers` runs corners in worker processes with deadlines, and the results
 (:mod:`.result`) are rendered as JUnit XML (:mod:`.junit`) and a Markdown
-summary (:mod:`.summary`). The command is :mod:`designer.cli.check`.
+summary (:mod:`.summary`). :mod:`.batch` is a whole run, as the command
+(:mod:`designer.cli.check`) and the web page's Check both call it.
 """
 
 from ..core.exports import lazy_exports
@@ -17,6 +18,7 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "batch": ("CheckRun", "check_specs", "load_specs", "run_specs",),
     "figures": ("ALIASES", "BAND", "PID", "PLANT", "band_of", "plant_figures",),
     "filter_kind": ("DELAY_FIGURES", "DELAY_KEYS", "FILTER_KEYS", "FilterCase", "MASK_FIGURES", "MASK_KEYS",
                     "SUB_FILTER", "delay_limits", "filter_designs", "filter_figures", "mask_limits", "run_filter",),
@@ -29,6 +31,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "sections": ("SUB",),
     "spec": ("TOP", "load_spec",),
     "summary": ("summary_markdown",),
-    "yamldoc": ("MAX_SPEC_BYTES", "parse_yaml",),
+    "yamldoc": ("MAX_SPEC_BYTES", "WIDER", "parse_yaml",),
     "yamlread": ("MAX_NODES",),
 })

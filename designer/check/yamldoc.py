@@ -24,7 +24,7 @@ from ..core.errors import DesignError
 from ..core.fileio import MIB, read_text, shown
 from .yamlread import compose
 
-__all__ = ["MAX_SPEC_BYTES", "parse_yaml"]
+__all__ = ["MAX_SPEC_BYTES", "WIDER", "parse_yaml"]
 
 #: a spec file is small: at most this many bytes are read
 MAX_SPEC_BYTES = 1 * MIB
@@ -36,7 +36,8 @@ def closest(key, allowed) -> str:
     return best[0] if best else allowed[0]
 
 
-_WIDER = "check-design --root DIR widens the folder, --allow-outside lifts it for trusted specs"
+#: the command line's advice when a spec's path leaves its folder (a front end without these options says its own)
+WIDER = "check-design --root DIR widens the folder, --allow-outside lifts it for trusted specs"
 
 
 class _Doc:
@@ -88,7 +89,7 @@ class _Doc:
             raise self.error(keys, f"{label} must be a file name, got {kind_of(value)}")
         if self.root is not None and (Path(value).is_absolute() or value.startswith("~")):
             raise self.error(keys, f"{label} {shown(value)} is an absolute path: paths in a spec are relative "
-                             f"to its folder and stay inside {shown(self.root)} ({_WIDER})")
+                             f"to its folder and stay inside {shown(self.root)} ({WIDER})")
         return self.inside(keys, self.path.parent / value)
 
     def inside(self, keys, path: Path) -> Path:
@@ -102,7 +103,7 @@ class _Doc:
             raise self.error(keys, f"{label} {shown(path)} cannot be resolved ({exc})") from None
         if not real.is_relative_to(self.root):
             raise self.error(keys, f"{label} {shown(path)} resolves to {shown(real)}, outside "
-                             f"{shown(self.root)}: paths in a spec stay inside it ({_WIDER})")
+                             f"{shown(self.root)}: paths in a spec stay inside it ({WIDER})")
         return path
 
 

@@ -1,12 +1,12 @@
-"""Command-line layer of ``check-design``: load every spec (all refusals before
-any run), run each spec's corners in worker processes, print a line per
-failure, write the JUnit file, the Markdown summary and the ``--out`` folder,
-and exit with the run's status."""
+"""Command-line layer of ``check-design``: its options checked, the run
+(:func:`designer.check.batch.check_specs`: every spec loaded, all refusals before any run, each
+spec's corners in worker processes, the ``--out`` folder) called as the web page's Check calls it,
+then a line per spec and per failure printed, the JUnit file and the Markdown summary written, and
+the run's exit status."""
 
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
 
 from .common import command_parser, print_output, run_cli
@@ -111,175 +111,28 @@ def _whole(text, name: str, lo: int, hi: int) -> int:
 
 
 def _run(args) -> int:
-    from ..check.spec import load_spec
+    from ..check.batch import check_specs
     from ..core.errors import EXIT_OK, DesignError
     jobs = _whole(args.jobs, "--jobs", 1, 64)
     timeout = _whole(args.timeout, "--timeout", 1, 86400)
     from ..tolerance.cluster import parse_dask
     dask = None if args.dask is None else parse_dask(args.dask)
-    from ..core.fileio import check_output_file
+    from ..core.fileio import atomic_write, check_output_file
     for value, what in ((args.junit, "--junit"), (args.summary, "--summary")):
         if value is not None:   # before any work: never a link, FIFO or device, never after the run
             check_output_file(value, what)
     if args.root is not None and not Path(args.root).is_dir():
         raise DesignError(f"--root {args.root!r} is not a folder")
-    specs = [load_spec(p, update_golden=args.update_golden, root=args.root, allow_outside=args.allow_outside)
-             for p in args.specs]
-    names = {}
-    for s in specs:
-        if s.name in names:
-            raise DesignError(f"{s.path}: name {s.name!r} is also the name of {names[s.name]}; names must differ "
-                              "(they name the JUnit suites and the --out folders)")
-        names[s.name] = s.path
-    from ..core import fileio
-    out_dir = None if args.out is None else fileio.check_can_create(args.out)
-    stages = {}
-    try:
-        if out_dir is not None:
-            # each spec's folder is written aside and swapped in whole once its run is done: a killed
-            # run leaves the old folder, a rerun with fewer corners leaves none of the old corners
-            fileio.ensure_dir(out_dir)
-            fileio.clean_stale(out_dir)
-            stages = {s.name: fileio.new_folder_beside(out_dir / s.name) for s in specs}
-        tick = time.perf_counter()
-        outcomes = run_specs(specs, args.simulator, jobs=jobs, timeout=timeout, update_golden=args.update_golden,
-                             out_dirs=stages, dask=dask)
-        seconds = time.perf_counter() - tick
-        _report(outcomes, args, seconds, out_dir, stages)
-    finally:
-        for stage in stages.values():   # published ones are gone already
-            fileio.remove_tree(stage)
-    from ..check.result import exit_status
-    return EXIT_OK if args.no_fail else exit_status(outcomes)
-
-
-def run_specs(specs, simulator: str, *, jobs: int = 1, timeout: float = 600, update_golden: bool = False,
-              out_dirs=None, dask: str | None = None) -> list:
-    """Every corner of every spec in worker processes (or as tasks of a Dask cluster: ``dask``, an
-    address or ``"local"``); a :class:`~designer.check.result.SpecOutcome` per spec, in the order given.
-    ``out_dirs``: spec name -> the folder its files are written in (none without)."""
-    from ..core.workers import run_tasks
-    from ..check.result import ERROR, SIM_ERROR, Case, CornerOutcome, SpecOutcome
-    from ..check.run import run_corner
-    from ..spice import simulate
-    from ..spice.simulate import tool_info
-    kinds = {s.kind for s in specs}
-    # imported here, once: the forked workers share them instead of importing each
-    if "plant" in kinds:
-        import designer.plant.design  # noqa: F401
-        import designer.plant.report  # noqa: F401
-    if "pid" in kinds:
-        import designer.pid.design  # noqa: F401
-        import designer.pid.report  # noqa: F401
-    if "filter" in kinds:
-        import designer.filters.design  # noqa: F401
-        import designer.filters.report  # noqa: F401
-    tasks = [(i, k) for i, s in enumerate(specs) for k in range(len(s.corners))]
-
-    def work(task):
-        i, k = task
-        return run_corner(specs[i], k, simulator, update_golden=update_golden,
-                          out_dir=(out_dirs or {}).get(specs[i].name))
-
-    def lost(task, reason):
-        i, k = task
-        corner = specs[i].corners[k]
-        return CornerOutcome(corner, (Case("simulation", corner, ERROR, f"simulation: simulator error: {reason}",
-                                           error_kind=SIM_ERROR),), None, tool_info(simulator), (), {}, timeout)
-
-    def setup():
-        simulate.DEFAULT_TIMEOUT_S = float(timeout)   # each `ngspice -b` run gets the same deadline
-
-    def cost(task):
-        # a closed loop (seven op-amps and the plant) simulates several times
-        # longer than a plant; a user's deck is unknown, taken as a plant
-        return 4.0 if specs[task[0]].kind == "pid" else 1.0
-
-    if dask is None:
-        results = run_tasks(tasks, work, jobs, timeout, lost, setup, cost)
-    else:
-        results = _on_dask(dask, jobs, tasks, specs, simulator, update_golden, out_dirs, timeout, lost, cost)
-    outcomes, at = [], 0
-    for s in specs:
-        corners = results[at: at + len(s.corners)]
-        at += len(s.corners)
-        tool = next((c.tool for c in corners if c.tool.get("ngspice")), corners[0].tool)
-        outcomes.append(SpecOutcome(s.name, str(s.path), s.kind, list(corners), tool))
-    return outcomes
-
-
-def _on_dask(address, jobs, tasks, specs, simulator, update_golden, out_dirs, timeout, lost, cost) -> list:
-    """The corners as tasks of a Dask cluster, longest first (:class:`designer.tolerance.cluster.DaskPool`:
-    a corner whose worker dies runs once more, then is ``lost``); results in task order."""
-    from ..check.run import corner_task
-    from ..tolerance.cluster import DaskPool
-    order = sorted(range(len(tasks)), key=lambda j: -cost(tasks[j]))
-    calls = [(specs[tasks[j][0]], tasks[j][1], simulator, update_golden, (out_dirs or {}).get(specs[tasks[j][0]].name),
-              timeout) for j in order]
-    with DaskPool(address, jobs if jobs > 1 else 2) as pool:
-        got = pool.calls(corner_task, calls, lambda i, why: lost(tasks[order[i]], why))
-    results = [None] * len(tasks)
-    for pos, j in enumerate(order):
-        results[j] = got[pos]
-    return results
-
-
-def _report(outcomes, args, seconds: float, out_dir, stages: dict) -> None:
-    from ..check.junit import junit_xml
-    from ..check.result import ERROR, FAIL, headline
-    from ..check.summary import summary_markdown
-    from ..core import fileio
-    from ..core.fileio import atomic_write
-    if out_dir is not None:
-        import json
-        for o in outcomes:
-            final, stage = Path(out_dir) / o.name, stages[o.name]
-            _relocate(o, stage, final)
-            o.files["result_json"] = str(final / "result.json")
-            atomic_write(stage / "result.json", json.dumps(o.to_dict(), indent=2) + "\n")
-            fileio.publish_folder(stage, final)
+    run = check_specs(args.specs, args.simulator, jobs=jobs, timeout=timeout, update_golden=args.update_golden,
+                      root=args.root, allow_outside=args.allow_outside, out=args.out, dask=dask)
     if args.junit:
-        atomic_write(args.junit, junit_xml(outcomes, seconds))
+        atomic_write(args.junit, run.junit())
     if args.summary:
-        atomic_write(args.summary, summary_markdown(outcomes, seconds))
-    lines = []
-    for o in outcomes:
-        n = o.counts()
-        lines.append(f"{o.name}: {o.status.upper() if o.status != 'pass' else 'pass'} ({n['pass']} passed, "
-                     f"{n[FAIL]} failed, {n[ERROR]} errors, {n['skipped']} report-only)")
-    print_output("\n".join(lines))
-    for o in outcomes:
-        for c in o.cases:
-            if c.status in (FAIL, ERROR):
-                print(f"check-design: {'error' if c.status == ERROR else 'failed'}: {headline(o, c)}",
-                      file=sys.stderr)
-        for w in o.warnings:
-            print(f"check-design: warning: {o.name}: {w}", file=sys.stderr)
-
-
-def _relocate(outcome, stage: Path, final: Path) -> None:
-    """The paths a spec's run recorded under its staging folder, as they will be once it
-    is swapped in: in the outcome, and in the design bundles' own result.json files."""
-    import json
-    old, new = str(stage), str(final)
-
-    def moved(value):
-        if isinstance(value, str):
-            return new + value[len(old):] if value.startswith(old) else value
-        if isinstance(value, list):
-            return [moved(v) for v in value]
-        if isinstance(value, dict):
-            return {k: moved(v) for k, v in value.items()}
-        return value
-
-    from ..core.fileio import atomic_write
-    for corner in outcome.corners:
-        corner.files = moved(corner.files)
-    for path in stage.glob("reports/*/result.json"):
-        data = json.loads(path.read_text(encoding="utf-8"))
-        if "files" in data:
-            data["files"] = moved(data["files"])
-            atomic_write(path, json.dumps(data, indent=2) + "\n")
+        atomic_write(args.summary, run.summary())
+    print_output("\n".join(run.lines()))
+    for line in run.messages():
+        print(line, file=sys.stderr)
+    return EXIT_OK if args.no_fail else run.status
 
 
 def check_design_main(argv=None) -> int:

@@ -73,11 +73,12 @@ class TooLarge(Exception):
 
 
 def _parsers() -> dict:
-    """Each command's parser traits (switches, appended options), from the CLI's own parsers."""
-    from ..cli import check, identify, pid, plant
-    builders = {"design-plant": plant.design_plant_parser, "analyze-plant": plant.analyze_plant_parser,
-                "design-pid": pid.pid_parser, "analyze-pid": pid.analyze_pid_parser, "identify": identify.build_parser,
-                "identify-freq": identify.build_freq_parser, "check-design": check.check_parser}
+    """The parser traits (switches, appended options) of each command still run by its argument list (the
+    others are the library's, :data:`designer.web.jobs.LIBRARY`), from the CLI's own parsers."""
+    from ..cli import identify, pid, plant
+    builders = {"analyze-plant": plant.analyze_plant_parser, "design-pid": pid.pid_parser,
+                "analyze-pid": pid.analyze_pid_parser, "identify": identify.build_parser,
+                "identify-freq": identify.build_freq_parser}
     return {prog: req.parser_traits(build()) for prog, build in builders.items()}
 
 
@@ -176,8 +177,7 @@ def create_app(pool, trust: Trust):
             answer = {"result": value["json"], "page": value.get("page"), "status": status}
         elif prog == "check-design":
             answer = {"status": status, **value["json"], "junit": value["junit"], "summary": value["summary"],
-                      "golden": value.get("golden", {}),
-                      "lines": value["stdout"].splitlines(), "messages": value["stderr"].splitlines()}
+                      "golden": value["golden"], "lines": value["lines"], "messages": value["messages"]}
         else:
             answer = value["json"]
         # the request's private folder is nobody's business: the upload by its own name
@@ -226,23 +226,14 @@ def create_app(pool, trust: Trust):
         prog = "check-design"
         with _private_folder() as tmp:
             try:
-                files, options = await _check_inputs(request, tmp, _check_limit())
+                specs, options = await _check_inputs(request, tmp, _check_limit())
             except TooLarge:
                 return _error(413, f"{prog}: error: the spec and its decks are larger than check-design reads")
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
-            golden = options.pop("update-golden", None) if isinstance(options, dict) else None
-            try:
-                if golden not in (None, True, False, "true", "false", "on", "off", ""):
-                    raise DesignError(f"--update-golden is a switch: true or false, got {str(golden)[:40]}")
-                argv = list(files["specs"]) + req.build_argv(options, None, traits[prog])
-            except DesignError as exc:
-                return _error(400, f"{prog}: error: {exc}")
-            # the golden files recorded in the request's folder, answered for download (never kept)
-            argv += ["--update-golden"] if golden in (True, "true", "on") else []
-            argv += ["--junit", os.path.join(tmp, "junit.xml"), "--summary", os.path.join(tmp, "summary.md"),
-                     "--out", os.path.join(tmp, "out"), "--root", os.path.join(tmp, "in")]
-            return await run(request, prog, argv, "check", tmp)
+            # the library with the specs' paths inside the request's folder (its root: nothing outside it) and
+            # the page's options; golden files recorded there are answered for download, never kept
+            return await run(request, prog, None, "check", tmp, fields={"specs": specs, "options": options})
 
     routes = [Route(path, page(name)) for path, name in PAGES.items()]
     async def no_icon(request):
@@ -303,7 +294,8 @@ def _error(code: int, line: str) -> JSONResponse:
 
 def _hide(text: str, tmp: str, upload_name: str | None) -> str:
     """A message without the request's private folder: the upload by its own name."""
-    text = text.replace(os.path.join(tmp, "in") + os.sep, "").replace(tmp + os.sep, "")
+    inside = os.path.join(tmp, "in")   # the folder a Check request's files are in: the folder the page chose
+    text = text.replace(inside + os.sep, "").replace(inside, "the folder chosen").replace(tmp + os.sep, "")
     return text if upload_name is None else text.replace("upload-" + upload_name, upload_name)
 
 
@@ -472,11 +464,11 @@ async def _upload(request: Request, tmp: str, limit: int, field: str) -> tuple:
 async def _check_inputs(request: Request, tmp: str, limit: int) -> tuple:
     """check-design's spec and the files it names, in ``tmp/in``: a multipart form
     (a ``spec`` file, any other files by their own plain names, options as fields)
-    or JSON ``{"spec": text, "files": {name: text}, "options": {...}}``."""
+    or JSON ``{"spec": text, "files": {name: text}, "options": {...}}``: (the specs' paths relative to
+    ``tmp/in``, the options)."""
     inside = os.path.join(tmp, "in")
     os.mkdir(inside)
     ctype = request.headers.get("content-type", "")
-    written = {}
     if ctype.startswith("multipart/form-data"):
         files, fields = await _multipart(request, tmp, limit)
         spec = files.pop("spec", None)
@@ -498,8 +490,7 @@ async def _check_inputs(request: Request, tmp: str, limit: int) -> tuple:
         spec_text = fields.get("spec")
         if spec_text is not None:
             raise DesignError("send the spec as a file, not a text field")
-        written["specs"] = [os.path.join(inside, *rel.split("/")) for rel in sorted(specs)]
-        return written, options
+        return sorted(specs), options
     body = req.parse_json(await _body(request, limit))
     form = ('the body must be {"spec": "<the spec file\'s text>", "files": {"decks/deck.cir": "..."}, "options": '
             '{...}}, or {"specs": ["specs/a.yaml"], "files": {"specs/a.yaml": "...", ...}}')
@@ -522,9 +513,7 @@ async def _check_inputs(request: Request, tmp: str, limit: int) -> tuple:
         missing = [p for p in specs if p not in {_relative(f) for f in files}]
         if not specs or missing:
             raise DesignError(f"spec {missing[0]!r} is not among the files sent" if missing else form)
-    written["specs"] = [os.path.join(inside, *rel.split("/")) for rel in specs]
-    options = body.get("options") or {}
-    return written, options
+    return specs, body.get("options") or {}
 
 
 def _is_spec(rel: str) -> bool:

@@ -18,14 +18,15 @@ from __future__ import annotations
 import re
 from typing import NamedTuple
 
+from ..check.yamldoc import WIDER
 from ..core.errors import DesignError, ParamError
 from ..core.i18n import N_, localise
 from ..core.i18n import gettext as _
 from ..filters.sallen_key_lowpass_parts import refs as sallen_key_refs
 from .request import option_name, value_text
 
-__all__ = ["FILTER", "Field", "FilterRequest", "PID", "PLANT", "PidRequest", "PlantRequest", "field_of",
-           "filter_request", "page_message", "pid_request", "plant_request"]
+__all__ = ["CHECK", "CheckRequest", "FILTER", "Field", "FilterRequest", "PID", "PLANT", "PidRequest", "PlantRequest", "field_of",
+           "check_message", "check_request", "filter_request", "page_message", "pid_request", "plant_request"]
 
 
 class Field(NamedTuple):
@@ -130,7 +131,20 @@ PID = {
     "target-ci": Field("target_ci", N_("target interval")), "engine": Field("engine", N_("engine")),
     "spice-samples": Field("spice_samples", N_("SPICE samples")),
     "worst-case": Field("worst_case", N_("worst case"), "switch"),
+    "replay": Field("replay", N_("build replayed")),
 }
+#: the Check page's fields (the API's ``options`` keys, as check-design's option names) -> parameter of
+#: :func:`designer.check.batch.check_specs` and label; the files and the folder they stay inside are the request's
+CHECK = {
+    "simulator": Field("simulator", N_("simulator")),
+    "update-golden": Field("update_golden", N_("record the golden files"), "switch"),
+}
+#: the command line's advice in check-design's refusals (its options the page has not), as the page gives it;
+#: ``--update-golden`` then reads as its field's label (:func:`page_message`)
+CHECK_WORDS = (
+    (WIDER, N_("the folder chosen is the limit: choose a folder holding every file the spec names")),
+    ("check-design --update-golden", "--update-golden"),
+)
 #: design-pid's defaults as its options type them (the spec parses them as it parses the command line's: the
 #: same numbers to the last bit, so the page's JSON is design-pid's)
 PID_DEFAULTS = {"step_v": "1", "edge_s": "100n", "r_series": "E24", "c_series": "E12", "r_min": "1k", "r_max": "1M",
@@ -142,6 +156,14 @@ SIMULATORS = ("pyspice", "ngspice-cli")
 _FLAG = re.compile(r"--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?")
 #: a value a message quotes as given ('3.5q', '--help'): never read as a flag
 _QUOTED = re.compile(r"((?<![A-Za-z])'[^']*')")
+
+
+class CheckRequest(NamedTuple):
+    """A Check page's request as the library takes it (the spec files apart: the server writes them)."""
+
+    simulator: str
+    update_golden: bool         #: record the golden files (answered for download, never kept)
+    argv: list                  #: the command line this request stands for (``tool.argv`` of its JSON)
 
 
 class FilterRequest(NamedTuple):
@@ -169,6 +191,7 @@ class PidRequest(NamedTuple):
     rules_spice: bool           #: a model plant: every applicable rule's loop in SPICE too
     name: str | None            #: the design's name (its files); None: design-pid's default, from the result
     argv: list                  #: the command line this request stands for (``tool.argv`` of its JSON)
+    replay: int | None = None   #: the Monte Carlo's build analysed as built in SPICE (design-pid --replay I)
 
 
 class PlantRequest(NamedTuple):
@@ -317,6 +340,50 @@ def plant_request(options) -> PlantRequest:
                         simulator, stimulus, name, _argv("design-plant", options))
 
 
+def check_request(options) -> CheckRequest:
+    """A Check page's options (the ``options`` of its JSON, or a form's other fields) as the library takes them.
+
+    Parameters
+    ----------
+    options : dict
+        Field -> value (:data:`CHECK`'s keys).
+
+    Returns
+    -------
+    CheckRequest
+        The simulator, whether to record the golden files, and the command line the request stands for.
+
+    Raises
+    ------
+    DesignError
+        One line naming the library parameter at fault (shown by :func:`check_message`).
+    """
+    v = _fields(options, CHECK)
+    return CheckRequest(_simulator(v, "pyspice"), bool(v.get("update_golden")), _argv("check-design", options))
+
+
+def check_message(exc: DesignError) -> tuple:
+    """A check-design refusal in the Check page's words: :func:`page_message` over :data:`CHECK`, the command
+    line's advice (:data:`CHECK_WORDS`) as the page gives it.
+
+    Parameters
+    ----------
+    exc : DesignError
+        The library's error.
+
+    Returns
+    -------
+    tuple
+        (the message, the field it names or None).
+    """
+    if not isinstance(exc, ParamError) and getattr(exc, "param", None) is None:
+        text = str(exc)
+        for cli, page in CHECK_WORDS:
+            text = text.replace(cli, page if page.startswith("--") else _(page))
+        exc = DesignError(text)
+    return page_message(exc, CHECK)
+
+
 def filter_request(options) -> FilterRequest:
     """A filter page's request (its JSON object) as the library's specs, checked.
 
@@ -397,7 +464,29 @@ def pid_request(options, tmp: str | None) -> PidRequest:
     simulator = _simulator(v, "pyspice")
     name = _name(v, "pid") if "name" in v else None
     return PidRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False), simulator,
-                      bool(v.get("rules_spice")), name, _argv("design-pid", options))
+                      bool(v.get("rules_spice")), name, _argv("design-pid", options), _replay(v, mc))
+
+
+def _replay(v: dict, mc) -> int | None:
+    """The build of the Monte Carlo ``mc`` to replay (design-pid's ``--replay I``, checked as it checks it), or
+    None."""
+    if "replay" not in v:
+        return None
+    if mc is None:
+        raise ParamError("{replay} goes with {n} (and the run's {seed}, {sampler}, {dist}, {tol})",
+                         ("replay", "n", "seed", "sampler", "dist", "tol"))
+    if v.get("no_sim"):
+        raise ParamError("{replay} simulates the build in SPICE: leave out {no_sim}", ("replay", "no_sim"))
+    if v.get("rules_spice"):
+        raise ParamError("{rules_spice} does not go with {replay} (a replayed build is analysed as built)",
+                         ("rules_spice", "replay"))
+    try:
+        i = int(v["replay"].strip())
+    except ValueError:
+        i = None
+    if i is None or not 0 <= i <= mc.n - 1:
+        raise DesignError(f"replay {v['replay']!r}: give a whole number from 0 to {mc.n - 1}", param="replay")
+    return i
 
 
 def _check_loop_tolerance(spec, mc, tol) -> None:

@@ -1,8 +1,9 @@
 """What a worker process does for one request of the web page: run the
 command as its console script does, and hand back what the page shows.
 
-A task names the command (``design-plant``, ``design-pid``, ``identify``,
-``check-design`` ...) and its argument list, built by :mod:`.request` from the
+Most tasks call the library directly with the request's fields (:data:`LIBRARY`: design-plant, design-filter,
+design-pid, check-design). The others name the command (``analyze-plant``, ``analyze-pid``, ``identify``,
+``design-pid`` with a capture) and its argument list, built by :mod:`.request` from the
 request's option names. The command's own entry point runs it
 (``design_plant_main(argv)``...: the same parser, the same checks, the same
 one-line refusal and exit status), with stdout and stderr taken into strings;
@@ -31,7 +32,6 @@ from contextlib import contextmanager, redirect_stderr, redirect_stdout
 
 import numpy as np
 
-from ..cli import check as cli_check
 from ..cli import identify as cli_identify
 from ..cli import pid as cli_pid
 from ..cli import plant as cli_plant
@@ -48,7 +48,7 @@ from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
 
 __all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "CLI_ONLY", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACES",
-           "TRACE_POINTS", "Superseded", "bom_shown", "bundle_zip", "check_files", "checks_shown", "circuit_plant_page",
+           "TRACE_POINTS", "Superseded", "bom_shown", "bundle_zip", "check_task", "checks_shown", "circuit_plant_page",
            "design_filter_task", "design_pid_task", "design_plant_task", "files_in", "filter_page", "histograms",
            "identify_page", "pid_page", "plant_page", "run", "run_task", "series_text", "temporaries_in",
            "through_library", "warm_up", "written_since"]
@@ -58,13 +58,12 @@ TRACE_POINTS = 1500
 #: frequency points of a Bode trace
 BODE_POINTS = 300
 
-#: the commands a task may name, and their console entry points (called as functions: argv in, status out)
+#: the commands a task may name by an argument list, and their console entry points (called as functions: argv
+#: in, status out); the others are :data:`LIBRARY`'s
 MAINS = {
-    "design-plant": cli_plant.design_plant_main,
     "analyze-plant": cli_plant.analyze_plant_main,
     "design-pid": cli_pid.design_pid_main,
     "analyze-pid": cli_pid.analyze_pid_main,
-    "check-design": cli_check.check_design_main,
 }
 
 
@@ -148,7 +147,7 @@ def run_task(task: dict) -> dict:
         task itself: ``prog`` (a command), ``argv`` (its arguments, ``--json`` among them
         for the designing commands), ``want``: "page" (the JSON and the page's
         extras), "json", "sheet" (the printable build sheet), "bundle" (the
-        design's files as a zip) or "check" (check-design's files); ``tmp``:
+        design's files as a zip) or "check" (a library task: check-design's answer); ``tmp``:
         the request's private folder (files written there), or None; ``lang``: the language of the page's
         words (a command with ``--lang`` takes it from there).
 
@@ -172,7 +171,6 @@ def run_task(task: dict) -> dict:
     seen = {}
     out, err = io.StringIO(), io.StringIO()
     token = RESULT_HOOK.set(lambda result, name: seen.update(result=result, name=name))
-    before = files_in(os.path.join(tmp, "in")) if prog == "check-design" and tmp else {}
     argv0 = sys.argv
     sys.argv = [prog, *argv]   # the JSON's tool.argv: the command line this request stands for
     try:
@@ -193,11 +191,6 @@ def run_task(task: dict) -> dict:
         if want == "page":
             with language(lang):
                 answer["page"] = identify_page(seen["result"])
-        return answer
-    if prog == "check-design":
-        answer.update(check_files(tmp))
-        answer["golden"] = written_since(os.path.join(tmp, "in"), before) if "--update-golden" in argv else {}
-        answer["stdout"] = out.getvalue()
         return answer
     answer["json"] = json.loads(out.getvalue())
     result, name = seen["result"], seen["name"]
@@ -445,9 +438,13 @@ def design_pid_task(fields: dict, want: str = "json", tmp: str | None = None) ->
         from ..tolerance.mcspec import loop_tolerance
         from .forms import pid_request
         rq = pid_request(fields, tmp)
-        result = design_pid(rq.spec, simulate=rq.simulate, simulator=rq.simulator, rules_spice=rq.rules_spice)
-        result = loop_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
-        name = rq.name or default_name(rq.spec, result)
+        if rq.replay is not None:   # the design is the draw's nominal; the build's own run is the simulation
+            design, result = _replayed(rq)
+            name = f"{rq.name or default_name(rq.spec, design)}_sample{rq.replay}"
+        else:
+            result = design_pid(rq.spec, simulate=rq.simulate, simulator=rq.simulator, rules_spice=rq.rules_spice)
+            result = loop_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
+            name = rq.name or default_name(rq.spec, result)
         if want in ("sheet", "bundle"):
             write_outputs(result, tmp, name)
         data = json.loads(json.dumps(result.to_dict()))
@@ -455,6 +452,19 @@ def design_pid_task(fields: dict, want: str = "json", tmp: str | None = None) ->
         data["tool"]["argv"] = rq.argv + ([f"--lang={lang}"] if lang else [])
         return data, lambda: pid_page(result), name
     return _library_task("design-pid", PID, fields, work, want, tmp)
+
+
+def _replayed(rq):
+    """Build ``rq.replay`` of the request's Monte Carlo, analysed as built in SPICE (design-pid ``--replay I``:
+    :func:`designer.tolerance.spice_loop_mc.replay`): (the design, the build's result, its ``monte_carlo`` the
+    replayed row)."""
+    from ..pid.design import design_pid
+    from ..tolerance.loop import loop_series
+    from ..tolerance.spice_loop_mc import replay, replay_result
+    design = design_pid(rq.spec, simulate=False, simulator=rq.simulator)
+    mc = rq.monte_carlo
+    build = replay(design, loop_series(design), rq.replay, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol, rq.simulator)
+    return design, replay_result(rq.spec, design, build, rq.simulator)
 
 
 def _library_task(prog: str, table: dict, fields: dict, work, want: str, tmp: str | None) -> dict:
@@ -496,13 +506,75 @@ def _library_work(prog: str, table: dict, fields: dict, lang: str | None, work, 
     return answer
 
 
+def check_task(fields: dict, want: str = "check", tmp: str | None = None) -> dict:
+    """check-design for the Check page, the library called directly: the spec files the server wrote in the
+    request's folder (``tmp/in``, each under its relative path), the page's options as
+    :func:`designer.web.forms.check_request` takes them, and :func:`designer.check.batch.check_specs` run
+    with that folder as the root every path of a spec must stay inside (check-design's trust boundary, as
+    ``--root``), its output folder ``tmp/out``.
+
+    Parameters
+    ----------
+    fields : dict
+        ``specs`` (the specs' paths relative to ``tmp/in``, ``/``-separated, as the server checked them) and
+        ``options`` (the page's fields, :data:`designer.web.forms.CHECK`; ``lang`` among them).
+    want : str
+        ``check`` (the only answer Check gives).
+    tmp : str
+        The request's private folder.
+
+    Returns
+    -------
+    dict
+        ``status`` (the run's exit status), ``error`` (a refusal in the page's words, with its ``field`` and
+        ``label``; or the run's last error line when a spec proved bad or the simulator failed), ``json``
+        (``{"specs": [each spec's result.json]}``), ``junit``, ``summary``, ``golden`` (the golden files
+        recorded: their paths relative to the folder chosen -> text), ``lines`` and ``messages`` (what
+        check-design prints on stdout and stderr).
+    """
+    from ..check.batch import check_specs
+    from ..core.errors import DesignError
+    from .forms import CHECK, check_message, check_request
+    from .request import split_language
+    inside = os.path.join(tmp, "in")
+    specs = [os.path.join(inside, *rel.split("/")) for rel in fields["specs"]]
+    try:
+        options, lang = split_language(fields.get("options") or {})
+    except DesignError as exc:
+        return {"status": 2, "error": f"check-design: error: {exc}", "json": None, "field": None, "label": None}
+    argv0 = sys.argv
+    with language(lang), temporaries_in(tmp):
+        try:
+            rq = check_request(options)
+            # each result's tool.argv: the command line this request stands for (a record, never parsed)
+            sys.argv = [rq.argv[0], *specs, *rq.argv[1:], "--junit", os.path.join(tmp, "junit.xml"), "--summary",
+                        os.path.join(tmp, "summary.md"), "--out", os.path.join(tmp, "out"), "--root", inside]
+            before = files_in(inside)
+            run = check_specs(specs, rq.simulator, update_golden=rq.update_golden, root=inside,
+                              out=os.path.join(tmp, "out"))
+        except DesignError as exc:
+            text, field = check_message(exc)
+            return {"status": 2, "error": f"check-design: error: {text}", "json": None, "field": field,
+                    "label": _(CHECK[field].label) if field else None}
+        finally:
+            sys.argv = argv0
+        messages = run.messages()
+        status = run.status
+        error = None
+        if status not in (0, 1):   # a spec that proved bad while running, or the simulator: its last line
+            error = check_message(DesignError(messages[-1]))[0] if messages else f"failed with exit status {status}"
+    return {"status": status, "error": error, "json": {"specs": run.results()}, "junit": run.junit(),
+            "summary": run.summary(), "golden": written_since(inside, before) if rq.update_golden else {},
+            "lines": run.lines(), "messages": messages}
+
+
 #: the commands the page runs through the library (no console script, no argv, no printed JSON)
-LIBRARY = {"design-plant": design_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task}
+LIBRARY = {"design-plant": design_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task,
+           "check-design": check_task}
 #: a command's options its page's name table does not map (design-pid's capture identified first, with identify's
-#: options; a replayed build; --fail-on-check): a request with one runs the command's entry point, as before
+#: options): a request with one runs the command's entry point, as before
 CLI_ONLY = {"design-pid": frozenset({"plant-capture", "step-time", "step-amplitude", "window", "format", "input-column",
-                                     "output-column", "sample-time", "columns", "methods", "no-refine", "replay",
-                                     "fail-on-check"})}
+                                     "output-column", "sample-time", "columns", "methods", "no-refine"})}
 
 
 def through_library(prog: str, options) -> bool:
@@ -660,6 +732,7 @@ def plant_page(result) -> dict:
         The page's JSON-ready content.
     """
     from ..core.lti import freq_response
+    from ..filters.sallen_key_lowpass_parts import section_of
     from ..plant import report as rep
     from ..report.document import to_html
     from ..report.wiring import bench_rows
@@ -682,7 +755,8 @@ def plant_page(result) -> dict:
     if sine is not None and sine.h_spice is not None:
         resp["SPICE .ac"] = _complex_on_grid(sine.spice_f_hz, sine.h_spice, f)
     bom = rep.bom(result)
-    bench = bench_rows(result.test, result.scope, "R1")
+    # the generator drives the section's input resistor, as its declaration names it (the sheet's settings table)
+    bench = bench_rows(result.test, result.scope, section_of(result.built).designators[0])
     if result.sine is not None:   # as the sheet's settings table gives it
         bench.append([_("sine check"), rep.sine_text(result.sine)])
     return {"step": _trace(result.time_s, step, "time from the edge (s)"),
@@ -978,34 +1052,6 @@ def bundle_zip(tmp: str, name: str) -> bytes:
             z.writestr(f"reports/{name}/{fname}", _read(os.path.join(rep, fname)))
         z.writestr(f"netlists/{name}.cir", _read(os.path.join(tmp, "netlists", f"{name}.cir")))
     return buf.getvalue()
-
-
-def check_files(tmp: str) -> dict:
-    """check-design's files of one run in ``tmp``: the JUnit XML, the Markdown
-    summary and each spec's result.json (as check-design writes them).
-
-    Parameters
-    ----------
-    tmp : str
-        The run's folder.
-
-    Returns
-    -------
-    dict
-        ``json`` (``{"specs": [...]}``), ``junit`` and ``summary`` (None when not written).
-    """
-    out = os.path.join(tmp, "out")
-    results = []
-    if os.path.isdir(out):
-        for name in sorted(os.listdir(out)):
-            path = os.path.join(out, name, "result.json")
-            if os.path.isfile(path):
-                results.append(json.loads(_read(path)))
-    junit = os.path.join(tmp, "junit.xml")
-    summary = os.path.join(tmp, "summary.md")
-    return {"json": {"specs": results},
-            "junit": _read(junit).decode("utf-8") if os.path.isfile(junit) else None,
-            "summary": _read(summary).decode("utf-8") if os.path.isfile(summary) else None}
 
 
 def files_in(folder: str) -> dict:

@@ -40,7 +40,7 @@ __all__ = ["FILE_OPTIONS", "MAX_DEPTH", "MAX_JSON_BYTES", "REFUSED", "SERVERS_OW
 
 #: options the server sets itself (files, output form) or that would reach past a request's folder
 REFUSED = ("out", "json", "no-files", "plot", "help", "version", "junit", "summary", "root", "allow-outside",
-           "jobs", "dask", "spice-jobs", "update-golden", "timeout", "fail-on-check", "no-fail")
+           "jobs", "dask", "spice-jobs", "timeout", "fail-on-check", "no-fail")
 #: of those, the processes, addresses and deadlines of a run: the server's (designer-web --jobs, --timeout)
 SERVERS_OWN = ("jobs", "dask", "spice-jobs", "timeout")
 #: options whose value is a file's content -> the name it is written under in the request's folder

@@ -782,10 +782,17 @@ def test_check_runs_the_repositorys_own_specs_folder_as_it_is(server, tmp_path):
     status, got = server.post_json("/api/check", {"specs": specs, "files": files}, timeout=600)
     assert status == 200, got
     assert sorted(s["spec"]["name"] for s in got["specs"]) == sorted(yaml.safe_load(files[p])["name"] for p in specs)
-    # each spec's verdict as check-design gives it in the repository (the seed's Kp = 45 loop fails on purpose)
-    cli("check-design", *[str(ROOT / p) for p in specs], "--root", str(ROOT), "--out", str(tmp_path))
-    want = {d.name: json.loads((d / "result.json").read_text())["status"] for d in tmp_path.iterdir() if d.is_dir()}
+    # each spec's verdict as check-design gives it in the repository (the seed's Kp = 45 loop fails on purpose),
+    # and every case, the JUnit XML and the lines it prints: the page calls the same library run (issue 26)
+    ran = cli("check-design", *specs, "--root", ".", "--out", str(tmp_path), "--junit", str(tmp_path / "j.xml"))
+    results = {d.name: json.loads((d / "result.json").read_text()) for d in tmp_path.iterdir() if d.is_dir()}
+    want = {name: r["status"] for name, r in results.items()}
     assert {s["spec"]["name"]: s["status"] for s in got["specs"]} == want and "pass" in want.values()
+    assert got["status"] == ran.returncode == 1
+    for s in got["specs"]:
+        assert cases_of(s) == cases_of(results[s["spec"]["name"]]) and s["counts"] == results[s["spec"]["name"]]["counts"]
+    assert junit_shape(got["junit"]) == junit_shape((tmp_path / "j.xml").read_text())
+    assert got["lines"] == ran.stdout.splitlines() and got["messages"] == ran.stderr.splitlines()
     assert got["golden"] == {}
     assert "designer-web-" not in json.dumps(got)
     # the same folder as a form's files, each under its relative path
@@ -796,7 +803,18 @@ def test_check_runs_the_repositorys_own_specs_folder_as_it_is(server, tmp_path):
     assert [s["spec"]["name"] for s in got["specs"]] == ["rc_ladder"] and got["specs"][0]["status"] == "pass"
 
 
-def test_check_records_golden_files_and_answers_them(server):
+def cases_of(result: dict) -> list:
+    """A spec's result.json as what it judged: every corner's cases (the seconds and files apart)."""
+    return [(c["corner"], [case for case in c["cases"]], c["warnings"], c["tool"]["simulator"])
+            for c in result["corners"]]
+
+
+def junit_shape(xml: str) -> str:
+    """A JUnit document without what differs between two runs of the same specs (times, the run's stamp)."""
+    return re.sub(r' (time|timestamp)="[^"]*"', "", xml)
+
+
+def test_check_records_golden_files_and_answers_them(server, tmp_path):
     """A spec with golden: and no golden file yet: "update-golden" records it in the request's folder and the
     answer carries it (what check-design --update-golden writes), under the path the spec names."""
     files = {p: t for p, t in _specs_folder().items() if "rc_ladder" in p and "golden/" not in p}
@@ -805,6 +823,13 @@ def test_check_records_golden_files_and_answers_them(server):
     assert status == 200, got
     assert list(got["golden"]) == ["specs/golden/rc_ladder.csv"]
     recorded = got["golden"]["specs/golden/rc_ladder.csv"]
+    # the file check-design --update-golden writes from the same folder, byte for byte
+    for rel, text in files.items():
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_text(text)
+    ran = cli("check-design", str(tmp_path / "specs" / "rc_ladder.yaml"), "--update-golden")
+    assert ran.returncode == 0, ran.stderr
+    assert (tmp_path / "specs" / "golden" / "rc_ladder.csv").read_text() == recorded
     # taken back by its path, it is the reference the next run compares against
     status, again = server.post_json("/api/check", {"specs": ["specs/rc_ladder.yaml"],
                                                     "files": {**files, "specs/golden/rc_ladder.csv": recorded}})
@@ -820,6 +845,25 @@ def test_check_refuses_a_path_that_leaves_the_folder(server, name):
     status, got = server.post_json("/api/check", {"spec": "name: x\nkind: netlist\ndeck: d.cir\n",
                                                   "files": {name: "* x\n"}})
     assert status == 400 and "a path relative to the folder chosen" in got["error"] and "\n" not in got["error"]
+
+
+@pytest.mark.parametrize("key, value", [("deck", "../../task.json"), ("deck", "/etc/passwd"),
+                                        ("golden", "{file: ../../gold.csv, signals: {v_out: {reltol: 0.01}}}"),
+                                        ("golden", "{file: /tmp/gold.csv, signals: {v_out: {reltol: 0.01}}}")])
+def test_check_refuses_a_spec_whose_path_leaves_the_folder_naming_its_key(server, key, value):
+    """Issue 26: the library-first Check keeps check-design's trust boundary (the request's folder is the
+    root; ``../../task.json`` is the request's own task file, beside it): a spec's deck or golden file outside
+    it is a 400 naming the spec's key, in the page's words (no command-line option)."""
+    deck = (ROOT / "specs" / "decks" / "rc_ladder.cir").read_text()
+    spec = {"deck": "deck: decks/rc_ladder.cir\n", "golden": ""}
+    spec[key] = f"{key}: {value}\n"
+    text = f"name: x\nkind: netlist\n{spec['deck']}{spec['golden']}checks:\n  v_final: {{min: 0.99}}\n"
+    status, got = server.post_json("/api/check", {"specs": ["specs/x.yaml"], "files": {
+        "specs/x.yaml": text, "specs/decks/rc_ladder.cir": deck}})
+    label = "golden.file" if key == "golden" else "deck"
+    assert status == 400 and "specs/x.yaml:" in got["error"] and f": {label} " in got["error"], got
+    assert "--" not in got["error"] and "\n" not in got["error"] and "designer-web-" not in got["error"], got
+    assert "the folder chosen" in got["error"], got
 
 
 def _get(server, path, headers=None):
@@ -886,14 +930,30 @@ def test_a_spanish_request_is_refused_in_spanish_naming_its_field(server):
 
 def test_pid_with_a_capture_runs_design_pid_as_before(server):
     """Issue 26: the options the PID page's name table does not map (a capture identified first, with
-    identify's options; --replay; --fail-on-check) still work: such a request runs design-pid's entry point,
-    the JSON its --json."""
+    identify's options) still work: such a request runs design-pid's entry point, the JSON its --json."""
     from designer.web.jobs import CLI_ONLY, through_library
     assert not through_library("design-pid", {"plant_capture": "x"}) and through_library("design-pid", {"kp": 1})
-    assert CLI_ONLY["design-pid"] >= {"plant-capture", "replay"}
+    assert "plant-capture" in CLI_ONLY["design-pid"]
+    assert through_library("design-pid", {"replay": 1}) and through_library("design-pid", {"fail-on-check": True})
     status, got = server.post_json("/api/pid", {"plant-capture": CAPTURE.read_text(), "tuning": "amigo",
                                                 "no-sim": True})
     assert status == 200, got
     want = cli_json("design-pid", "--plant-capture", str(CAPTURE), "--tuning", "amigo", "--no-sim", "--json",
                     "--no-files")
     assert got["tuning"] == want["tuning"] and got["tuning"]["method"] == "amigo"
+
+
+def test_pid_replays_a_build_through_the_library_as_design_pid_does(server):
+    """Issue 26: design-pid's --replay I (a Monte Carlo build analysed as built in SPICE) through the page's name
+    table, no argument list: the JSON design-pid --replay prints; --fail-on-check stays the server's."""
+    body = {"plant-fc": 3500, "plant-zeta": 0.2, "monte-carlo": 20, "seed": 3, "replay": 4}
+    status, got = server.post_json("/api/pid", body)
+    assert status == 200, got
+    want = cli_json("design-pid", "--plant-fc", "3500", "--plant-zeta", "0.2", "--monte-carlo", "20", "--seed", "3",
+                    "--replay", "4", "--json", "--no-files")
+    assert without_run_details(got) == without_run_details(want)
+    assert got["monte_carlo"] == want["monte_carlo"]
+    status, got = server.post_json("/api/pid", {**body, "replay": 20})
+    assert status == 400 and got["field"] == "replay" and "from 0 to 19" in got["error"] and "--" not in got["error"]
+    status, got = server.post_json("/api/pid", {**body, "fail-on-check": True})
+    assert status == 400 and "set by the web page itself" in got["error"], got

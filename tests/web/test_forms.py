@@ -95,7 +95,7 @@ def test_every_pid_field_is_a_design_pid_option_setting_a_parameter_of_the_specs
     from designer.web.forms import PID
     specs = ({f.name for f in dataclasses.fields(PidSpec)} | set(PLANT_FIELDS) | set(PLAIN_PARAMS)
              | {f.name for f in dataclasses.fields(MonteCarloSpec)})
-    assert {f.param for f in PID.values()} <= specs | {"no_sim", "simulator", "name", "worst_case", "rules_spice"}
+    assert {f.param for f in PID.values()} <= specs | {"no_sim", "simulator", "name", "worst_case", "rules_spice", "replay"}
     assert len({f.label for f in PID.values()}) == len(PID)
     options = {o for a in pid_parser()._actions for o in a.option_strings}
     assert {f"--{k}" for k in PID} <= options
@@ -132,3 +132,71 @@ def test_bad_pid_fields_are_refused_in_the_pages_words(tmp_path, fields, param, 
     text, field = page_message(exc.value, PID)
     assert words in text and "--" not in text and "\n" not in text, text
     assert PID[field].param == param, (field, text)
+
+
+def test_a_check_request_is_what_check_design_takes():
+    """Issue 26: the Check page's options through its name table (CHECK), as check_specs takes them."""
+    from designer.web.forms import CHECK, check_request
+    rq = check_request({"simulator": "ngspice-cli", "update-golden": "on"})
+    assert (rq.simulator, rq.update_golden) == ("ngspice-cli", True)
+    assert rq.argv == ["check-design", "--simulator=ngspice-cli", "--update-golden=on"]
+    assert check_request({}).simulator == "pyspice" and check_request({}).update_golden is False
+    import inspect
+    from designer.check.batch import check_specs
+    assert {f.param for f in CHECK.values()} <= set(inspect.signature(check_specs).parameters)
+
+
+@pytest.mark.parametrize("options, field, words", [
+    ({"update-golden": "maybe"}, "update-golden", '"record the golden files" is a switch'),
+    ({"simulator": "spectre"}, "simulator", "'spectre' unknown; allowed: pyspice, ngspice-cli"),
+    ({"jobs": 4}, None, "the server's own setting"),
+    ({"root": "/"}, None, "set by the web page itself"),
+    ({"allow-outside": True}, None, "set by the web page itself"),
+    ({"spec": "x"}, None, "is not a field of this page; allowed: simulator, update-golden"),
+])
+def test_bad_check_options_are_refused_in_the_pages_words(options, field, words):
+    from designer.web.forms import check_message, check_request
+    with pytest.raises(DesignError) as caught:
+        check_request(options)
+    text, got = check_message(caught.value)
+    assert words in text and got == field, text
+
+
+def test_check_designs_advice_reads_as_the_page_offers_it(tmp_path):
+    """A spec's path outside its folder, and a golden file to record: check-design's refusals name its
+    --root, --allow-outside and --update-golden; the page says what it offers (no option)."""
+    from designer.check.spec import load_spec
+    from designer.web.forms import check_message
+    spec = tmp_path / "in" / "x.yaml"
+    spec.parent.mkdir()
+    spec.write_text("name: x\nkind: netlist\ndeck: ../d.cir\nchecks:\n  v: {max: 1}\n")
+    with pytest.raises(DesignError) as caught:
+        load_spec(spec)
+    assert "--root" in str(caught.value)
+    text, _ = check_message(caught.value)
+    assert "--" not in text and "x.yaml:3: deck" in text and "the folder chosen is the limit" in text
+    (tmp_path / "in" / "d.cir").write_text("* d\nV1 1 0 1\nR1 1 0 1k\n.tran 1u 10u\n.meas tran v max v(1)\n.end\n")
+    spec.write_text("name: x\nkind: netlist\ndeck: d.cir\ngolden: {file: g.csv, signals: {v(1): {reltol: 0.01}}}\n")
+    with pytest.raises(DesignError) as caught:
+        load_spec(spec)
+    assert "check-design --update-golden" in str(caught.value)
+    text, _ = check_message(caught.value)
+    assert "--" not in text and 'record it with "record the golden files"' in text, text
+
+
+@pytest.mark.parametrize("fields, param, words", [
+    ({"replay": 3}, "replay", '"build replayed" goes with "Monte Carlo builds"'),
+    ({"replay": 3, "monte-carlo": 10, "no-sim": True}, "replay", 'leave out "skip SPICE"'),
+    ({"replay": 3, "monte-carlo": 10, "rules-spice": True}, "rules_spice", '"build replayed" (a replayed build'),
+    ({"replay": 10, "monte-carlo": 10}, "replay", "'10': give a whole number from 0 to 9"),
+    ({"replay": "x", "monte-carlo": 10}, "replay", "'x': give a whole number from 0 to 9"),
+])
+def test_a_replay_is_checked_as_design_pid_checks_it(tmp_path, fields, param, words):
+    """Issue 26: design-pid's --replay I through the PID page's name table, refused in the page's words."""
+    from designer.web.forms import PID, pid_request
+    with pytest.raises(DesignError) as caught:
+        pid_request({"plant-fc": 3500, "plant-zeta": 0.2, **fields}, str(tmp_path))
+    text, field = page_message(caught.value, PID)
+    assert caught.value.param == param and words in text and "--" not in text, text
+    assert pid_request({"plant-fc": 3500, "plant-zeta": 0.2, "replay": "9", "monte-carlo": 10},
+                       str(tmp_path)).replay == 9

@@ -30,10 +30,11 @@ def test_a_trace_is_json_with_nan_as_null_and_at_most_its_points():
 
 @pytest.mark.spice
 def test_a_plant_page_is_the_commands_json_and_its_own_arrays():
-    out = jobs.run({"prog": "design-plant", "argv": ["--fc", "3500", "--zeta", "0.2", "--json", "--no-files"],
-                    "want": "page"})
+    """design-plant through the library (the page's fields, issue 26): its JSON records the command line it
+    stands for."""
+    out = jobs.run({"prog": "design-plant", "fields": {"fc": 3500, "zeta": 0.2}, "want": "page"})
     assert out["status"] == 0 and out["error"] is None
-    assert out["json"]["tool"]["argv"] == ["design-plant", "--fc", "3500", "--zeta", "0.2", "--json", "--no-files"]
+    assert out["json"]["tool"]["argv"] == ["design-plant", "--fc=3500", "--zeta=0.2"]
     step = out["page"]["step"]
     labels = [s["label"] for s in step["series"]]
     assert labels[:3] == ["SPICE (ngspice)", "analytic (LM741 model)", "analytic (ideal op-amp)"]
@@ -45,9 +46,13 @@ def test_a_plant_page_is_the_commands_json_and_its_own_arrays():
 
 
 def test_a_refusal_is_the_commands_one_line():
-    out = jobs.run({"prog": "design-plant", "argv": ["--fc", "3500", "--zeta", "-1", "--json", "--no-files"],
-                    "want": "page"})
-    assert out["status"] == 2 and out["error"] == "design-plant: error: --zeta must be 0.01 to 10, got '-1'"
+    """A command still run by its argument list refuses in its one line; a library task in the page's words."""
+    out = jobs.run({"prog": "analyze-plant", "argv": ["--r1", "1k6", "--r2", "3k9", "--c1", "3n3", "--c2", "-1",
+                                                      "--json", "--no-files"], "want": "page"})
+    assert out["status"] == 2 and out["error"] == "analyze-plant: error: --c2 must be 100 fF to 1 F, got '-1'"
+    out = jobs.run({"prog": "design-plant", "fields": {"fc": 3500, "zeta": -1}, "want": "page"})
+    assert out["status"] == 2 and out["error"] == "design-plant: error: \"zeta\" must be 0.01 to 10, got '-1'"
+    assert out["field"] == "zeta"
 
 
 def test_a_broadband_capture_gives_its_step_and_spectrum_traces(tmp_path):
@@ -190,3 +195,18 @@ def test_a_chirp_capture_page_draws_the_record_with_its_models_and_every_candida
     best = out["json"]["validation"]["best"]
     assert (rows[0]["route"], rows[0]["model"]) == (best["route"], best["model"])
     assert rows[0]["fit_percent"] == pytest.approx(best["validation"]["fit_percent"])
+
+
+@pytest.mark.parametrize("gain", [1, 2])
+def test_the_plant_pages_bench_names_the_input_resistor_the_section_declares(gain):
+    """Issue 26: the generator's row names the section's input resistor as its declaration gives it (the sheet's
+    settings table), not a designator spelt in the web layer."""
+    from designer.filters.sallen_key_lowpass_parts import section_of
+    from designer.plant.design import design_plant
+    from designer.plant.spec import PlantSpec
+    from designer.report.wiring import bench_rows
+    result = design_plant(PlantSpec(fc_hz=3500, zeta=0.2, gain=gain), simulate=False)
+    ref = section_of(result.built).designators[0]
+    rows = bench_rows(result.test, result.scope, ref)
+    assert jobs.plant_page(result)["bench"][:len(rows)] == rows
+    assert any(ref in str(cell) for row in rows for cell in row)

@@ -906,6 +906,8 @@ def test_every_page_in_each_language_shows_none_of_the_other(browser, server, pa
             pg.wait_for_selector("select[name=format] option:nth-child(2)", state="attached")
             assert after(pg, lambda: pg.set_input_files("#file", str(SYNTHETIC_TEK))) == "done"
         pg.wait_for_function("() => document.documentElement.lang !== ''")
+        # the catalogue loaded and the page's words translated (a page that sends nothing by itself: /check)
+        pg.wait_for_function("() => D.lang === 'en' || Object.keys(D.catalogue).length > 0")
         texts = _words_on(pg, LIBRARY_TEXT.get(path, LIBRARY_TEXT[path.split("?")[0]]))
         for name in _library_names(path):
             texts = [t.replace(name, " ") for t in texts]
