@@ -91,3 +91,11 @@ def test_an_input_with_two_edges_is_not_a_step_capture():
     t = np.arange(3001) * TS
     u = np.where((np.arange(t.size) >= 300) & (np.arange(t.size) < 1500), 1.0, 0.0)
     assert step_capture_ramp(t, u, np.zeros(t.size)) is None
+
+
+def test_a_ramp_that_started_before_the_step_is_refused():
+    """The output already rising at the step (its line meets the initial level
+    5 s before it): not an integrator answering the step."""
+    t = np.arange(3000) * TS
+    m = asymptote(t, 0.3 * (t + 5.0))
+    assert not m.valid and "before the step" in m.note
