@@ -798,7 +798,12 @@ def _ramp_result(t, u, y, capture, why: str):
     route is the asymptote method, scored with the output-error fits on the
     record's last third; None when the response does not ramp."""
     from .broadband import BroadbandResult, other_excitation
+    from .edges import check_samples
     from .integrating import step_capture_ramp
+    try:
+        check_samples(t, y, u)      # a record no method can use keeps the step methods' refusal
+    except DesignError:
+        return None
     m = step_capture_ramp(t, u, y)
     if m is None or not m.valid:
         return None
