@@ -6,7 +6,8 @@ found), ``settle`` (baseline, final value), ``normalise`` (one step) and
 ``averaging`` (a square wave's steps); ``first_order``, the second-order
 families ``underdamped``, ``overdamped`` and ``dc_motor`` (listed in
 ``second_order``) and ``refine`` (least squares) are the step methods on the
-shared ``structures``;
+shared ``structures``, ``integrating`` the one for a response that ramps (an
+integrating process's asymptote);
 ``step`` runs and ranks them, ``frequency`` does the same for a Bode table
 (the model responses and classical readings of ``bode_readings``, the
 least-squares fit of ``freqfit``, the loop margins of ``bode_margins``);
@@ -45,6 +46,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                     "exact_coefficients", "hagglund", "nishikawa", "two_point", "unit_time", "ziegler_nichols"),
     "freqfit": ("least_squares_fit",),
     "frequency": ("BAND_FACTOR", "FreqIdentifyResult", "MAX_FIT_ERROR", "corner_frequencies", "identify_freq"),
+    "integrating": ("METHOD_NAME", "RAMP_TOLERANCE", "TAIL_FRACTION", "asymptote", "step_capture_ramp"),
     "io": ("BLOCK_LINES", "Capture", "CaptureInfo", "FORMATS", "FORMAT_NAMES", "FREQ_UNITS", "FileBlocks",
            "FreqData", "GAIN_UNITS", "HEAD_LINES", "INPUT_NAMES", "MAX_POINTS", "MIN_POINTS", "NUMBER",
            "OUTPUT_NAMES", "PARSED", "PHASE_UNITS", "TIME_NAMES", "check_format", "format_generic", "freq_data",

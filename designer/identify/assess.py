@@ -76,7 +76,8 @@ def method_process(model: str, params: dict, ci95: dict | None = None, source: s
     ----------
     model : str
         ``fopdt``, ``double-pole``, ``overdamped``, ``underdamped`` (as the
-        step and frequency methods name them) or ``sopdt``.
+        step and frequency methods name them), ``sopdt`` or ``integrating``
+        (K e^(-theta s)/s, :mod:`.integrating`).
     params : dict
         Its parameters (K, tau_s / tau1_s, tau2_s / wn_rad_s, zeta, theta_s).
     ci95 : dict, optional
@@ -107,6 +108,8 @@ def method_process(model: str, params: dict, ci95: dict | None = None, source: s
             ci["fn_hz"] = ci.pop("wn_rad_s") / (2 * math.pi)
         return pb.underdamped(p["K"], p["wn_rad_s"] / (2 * math.pi), p["zeta"], theta, source=source,
                               ci95=ci or None)
+    if model == "integrating":
+        return pb.integrating(p["K"], 0.0, theta, source=source, ci95=ci or None)
     raise DesignError(f"model {model!r} is not a process model this route maps")
 
 
@@ -577,6 +580,9 @@ def _route_methods(result) -> tuple:
     """(route -> its methods, route -> why it gave none) of an identification result."""
     if not hasattr(result, "excitation"):
         return {"step": list(result.methods)}, {}
+    if getattr(result, "ramp", None) is not None:
+        # a step capture whose response ramps: the integrating asymptote is the step route's model
+        return {"step": [result.ramp]}, {"correlation": "the input is a step", "spectral": "the input is a step"}
     if result.excitation.kind == "other":
         return {}, {"step": result.notes[0] if result.notes else "not a step or square wave",
                     "correlation": "the input is not a binary sequence or noise",
@@ -648,6 +654,11 @@ def assess_result(result, t, u, y, *, validation: tuple | None = None, segment_l
             split_at, note = None, f"no split ({exc}); scored on the whole record"
         else:
             routes, skipped = _route_methods(est)
+    if split_at is not None and getattr(result, "ramp", None) is not None:
+        # the asymptote again on the estimation part alone: the validation part is fresh data to it too
+        from .integrating import step_capture_ramp
+        m = step_capture_ramp(t[:split_at], u[:split_at], y[:split_at])
+        routes = {"step": [m]} if m is not None else {}
     return assess(u, y, ts, routes, split_at=split_at, note=note, validation=vrec, skipped=skipped, source=name)
 
 
@@ -723,8 +734,17 @@ def identify_record(t, y, u=None, *, step_time=None, step_amplitude=None, window
     if result is None:
         if step_time is not None and step_amplitude is not None:
             u = u_all = None
-        result = identify_step(t_all, y_all, u_all, step_time=step_time, step_amplitude=step_amplitude, methods=methods,
-                               refine=refine, capture=capture, window=window)
+        ramps = u is not None and step_time is None and assess_routes
+        try:
+            result = identify_step(t_all, y_all, u_all, step_time=step_time, step_amplitude=step_amplitude,
+                                   methods=methods, refine=refine, capture=capture, window=window)
+        except DesignError as exc:
+            result = _ramp_result(t, u, y, capture, str(exc)) if ramps else None
+            if result is None:
+                raise
+        else:
+            if ramps and result.best is None:
+                result = _ramp_result(t, u, y, capture, "no valid model") or result
     if method and not hasattr(result, "excitation"):
         result.step.notes.append(f"--method {method} ignored: the input is not broadband "
                                  "(a step or square wave), identified by the step methods")
@@ -739,7 +759,8 @@ def identify_record(t, y, u=None, *, step_time=None, step_amplitude=None, window
             result.step.notes.append(f"not validated: {exc}")
             return result
         _attach_view(result.assessment, t, u, y, validation)
-        explained = getattr(result, "refused", "") or getattr(getattr(result, "step", None), "nonlinear", "")
+        explained = (getattr(result, "refused", "") or getattr(getattr(result, "step", None), "nonlinear", "")
+                     or getattr(result, "ramp", None) is not None)   # a ramp never settles: no settling to wait for
         # a step capture whose own methods found a valid model from its edge is not "too short" (the step
         # methods check their edge; a gain outside the process model's range, 1.5e-10 V/V in the scale fuzz,
         # leaves no candidate valid for other reasons than the record)
@@ -768,6 +789,29 @@ def _output_error_only(t, u, why: str, capture):
     return BroadbandResult(other_excitation(t, u, why), method="output-error", capture=capture,
                            notes=["the step methods need a step or a square wave, the correlation and spectral "
                                   "routes a binary sequence or noise: the output-error fit alone"])
+
+
+def _ramp_result(t, u, y, capture, why: str):
+    """A step capture whose response ramps (:func:`~.integrating.step_capture_ramp`
+    valid: an integrating plant), which the step methods refused or found no
+    valid model in (``why``): a broadband result of kind ``"other"`` whose step
+    route is the asymptote method, scored with the output-error fits on the
+    record's last third; None when the response does not ramp."""
+    from .broadband import BroadbandResult, other_excitation
+    from .edges import check_samples
+    from .integrating import step_capture_ramp
+    try:
+        check_samples(t, y, u)      # a record no method can use keeps the step methods' refusal
+    except DesignError:
+        return None
+    m = step_capture_ramp(t, u, y)
+    if m is None or not m.valid:
+        return None
+    return BroadbandResult(other_excitation(t, u, "a step whose response ramps without settling (an integrating "
+                                                  "plant)"),
+                           method="output-error", capture=capture, ramp=m,
+                           notes=[f"the step methods: {why}", "the response ramps: the integrating process's "
+                                  "asymptote (step route) and the output-error fits, scored on fresh data"])
 
 
 def _check_room(a: Assessment, t, name: str) -> None:

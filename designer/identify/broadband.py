@@ -552,6 +552,9 @@ class BroadbandResult:
     segment_note: str = ""
     #: every route's models scored on validation data (:class:`~.assess.Assessment`), when assessed
     assessment: object | None = None
+    #: of a step capture whose response ramps (an integrating plant, :mod:`.integrating`): the asymptote
+    #: method's :class:`~.structures.MethodResult` on the whole record, the step route's model
+    ramp: object | None = None
 
     @property
     def best(self):

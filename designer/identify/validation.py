@@ -248,8 +248,12 @@ def cross_correlation(u, e, lags: int = RESID_LAGS) -> Correlation:
     u = np.asarray(u, float) - np.mean(u)
     e = np.asarray(e, float) - np.mean(e)
     n = e.size
-    norm = math.sqrt((u @ u / n) * (e @ e / n))
     ks = np.arange(-lags, lags + 1)
+    if not u @ u > 0:
+        # an input that does not move here (the validation part of a step capture, after its edge): its
+        # deviations are all 0, so is every product with the residuals; nothing to normalise
+        return Correlation(ks, np.zeros(ks.size), Z99 / math.sqrt(n))
+    norm = math.sqrt((u @ u / n) * (e @ e / n))
     r = _xcorr(u, e, ks) / norm
     ruu = _xcorr(u, u, ks) / (u @ u / n)
     ree = _xcorr(e, e, ks) / (e @ e / n)

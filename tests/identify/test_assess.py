@@ -115,14 +115,14 @@ def test_a_record_too_short_for_the_plants_settling_is_refused():
         identify_record(t[:1000], y[:1000], u[:1000])
 
 
-def _fopdt_capture(at, K=2.0, tau=5.0, theta=1.3, ts=0.1, n=3001, snr_db=30.0, seed=28):
-    """(t, u, y): K e^(-theta s)/(tau s + 1) under the input ``at(t)``, simulated
-    by ``scipy.signal.lsim`` on a grid ten times finer than the samples, white
-    noise at ``snr_db`` from a recorded seed."""
+def _fopdt_capture(at, K=2.0, tau=5.0, theta=1.3, ts=0.1, n=3001, snr_db=30.0, seed=28, tf_plant=None):
+    """(t, u, y): K e^(-theta s)/(tau s + 1) (or ``tf_plant``'s (num, den) e^(-theta s))
+    under the input ``at(t)``, simulated by ``scipy.signal.lsim`` on a grid ten
+    times finer than the samples, white noise at ``snr_db`` from a recorded seed."""
     t = np.arange(n) * ts
     tf = np.arange((n - 1) * 10 + 1) * (ts / 10)
     ud = np.where(tf >= theta, at(tf - theta), at(0.0 * tf))
-    _, yc, _ = sig.lsim(([K], [tau, 1.0]), ud - ud[0], tf)
+    _, yc, _ = sig.lsim(tf_plant or ([K], [tau, 1.0]), ud - ud[0], tf)
     yc = yc[::10]
     rng = np.random.default_rng(seed)
     return t, at(t), yc + rng.normal(0.0, math.sqrt(np.var(yc) / 10 ** (snr_db / 10)), n)
@@ -207,3 +207,36 @@ def test_an_integrator_worse_than_the_mean_is_not_valid():
     (c,) = [c for c in a.candidates if c.kind == "integrating"]
     assert c.fit_percent < 0 and not c.valid and "below 0" in c.note
     assert a.best_candidate is None or a.best_candidate.kind != "integrating"
+
+
+def _step_at(t0):
+    def at(x):
+        return np.where(np.asarray(x) >= t0 - 1e-9, 1.0, 0.0)
+    return at
+
+
+def test_a_step_capture_whose_response_ramps_is_an_integrator():
+    """0.3 e^(-1.1 s)/s under a 1 V step at 30 s, 300 s every 0.1 s, 30 dB
+    (seeded): the step methods refuse the never-settling ramp; the asymptote
+    method is the step route, the output-error fits beside it, all scored on the
+    record's last third; the best is an integrator of the plant's gain."""
+    t, u, y = _fopdt_capture(_step_at(30.0), theta=1.1, tf_plant=([0.3], [1.0, 0.0]))
+    res = identify_record(t, y, u, name="ramp")
+    assert res.ramp is not None and res.excitation.kind == "other"
+    assert res.notes[0].startswith("the step methods: the record ends before the response settles")
+    a = res.assessment
+    assert a.scope == "split"
+    (step,) = [c for c in a.candidates if c.route == "step"]
+    assert step.name == "integrating-asymptote" and step.kind == "integrating" and step.valid
+    assert step.params["K"] == pytest.approx(0.3, rel=0.02)
+    best = a.best_candidate
+    assert best.kind == "integrating" and best.params["K"] == pytest.approx(0.3, rel=0.02)
+    assert best.fit_percent == max(c.fit_percent for c in a.candidates if c.valid)
+
+
+def test_a_settling_step_capture_keeps_the_step_methods():
+    """The FOPDT plant under the same step: the step methods' result, never the ramp's route."""
+    t, u, y = _fopdt_capture(_step_at(30.0))
+    res = identify_record(t, y, u, name="settles")
+    assert not hasattr(res, "ramp") and res.best is not None
+    assert res.assessment.best_candidate.kind != "integrating"

@@ -127,9 +127,6 @@ def misses(plant: str, best) -> list:
     return out
 
 
-# the library's gap (reported to the lead with these numbers), not the data's
-STEP_RAMP = ("under a step the step methods refuse the integrator's ramp ('the record ends before the response "
-             "settles', 20 dB) or give no valid model (10 dB): a step capture has no output-error-only route")
 # what the data cannot give to the issue's tolerance (measured, seed 28)
 # (the best model's validation fit is the true model's to 0.05 point in each: the data cannot tell them apart)
 _SAME = "; its fit {} equals the true model's {}"
@@ -149,13 +146,24 @@ DATA = {
     ("underdamped", "step", 10): ("a step at 10 dB: theta 0.597 s (true 0.5 s, +19.4 %)"
                                   + _SAME.format(69.71, 69.67)),
     # the integrator: its gain within 0.2 %, its dead time's 95 % interval about +-0.4 s at 20 dB (the noise
-    # against the clean output's variance, a ramp's: 1.3 V rms)
-    ("integrating", "rb0.1", 20): ("random binary p 0.1 at 20 dB: K 0.2993 /s, theta 0.592 s (true 1.1 s, -46 %)"
+    # against the clean output's variance, a ramp's: 1.3 V rms). Data-limited, not the optimiser's: the fitted
+    # model's in-sample rms is below the true model's (test_an_integrators_dead_time_is_data_limited), and the
+    # fit is the lowest of a 0.01 s grid of dead times (tests/identify/test_outputerror.py)
+    ("integrating", "rb0.1", 20): ("random binary p 0.1 at 20 dB: K 0.2993 /s, theta 0.592 s (true 1.1 s, -46 %, "
+                                   "+-0.41 s); in-sample rms 1.38523 V, the true model's 1.38595 V"
                                    + _SAME.format(70.49, 70.56)),
-    ("integrating", "rb0.5", 20): ("random binary p 0.5 at 20 dB: K 0.2994 /s, theta 0.495 s (true 1.1 s, -55 %)"
-                                   + _SAME.format(70.82, 70.84)),
-    ("integrating", "chirp", 20): ("a chirp at 20 dB: K 0.2994 /s, theta 1.253 s (true 1.1 s, +14 %)"
-                                   + _SAME.format(71.15, 71.16)),
+    ("integrating", "rb0.5", 20): ("random binary p 0.5 at 20 dB: K 0.2994 /s, theta 0.900 s (true 1.1 s, -18 %, "
+                                   "+-0.39 s); in-sample rms 1.34041 V, the true model's 1.34125 V"
+                                   + _SAME.format(70.83, 70.84)),
+    ("integrating", "chirp", 20): ("a chirp at 20 dB: K 0.2994 /s, theta 1.253 s (true 1.1 s, +14 %, +-0.55 s); "
+                                   "in-sample rms 1.33092 V, the true model's 1.33114 V" + _SAME.format(71.15, 71.16)),
+    # under a step the asymptote (integrating-asymptote, the step route) and the output-error integrator tie;
+    # one edge holds all the dead time's information, the ramp's noise (2.5 V rms at 20 dB) hides it
+    ("integrating", "step", 20): ("a step at 20 dB: the asymptote's K 0.3003 /s, theta 1.819 s (true 1.1 s, +65 %, "
+                                  "+-1.37 s; the output-error fit's 1.854 s +-1.23 s); in-sample rms 2.5410 V, the "
+                                  "true model's 2.5423 V" + _SAME.format(72.32, 72.31)),
+    ("integrating", "step", 10): ("a step at 10 dB: the asymptote's K 0.2972 /s (-0.9 %), theta 0.004 s (+-4.6 s; the "
+                                  "output-error fit's 1.40 s +-3.9 s, not valid)" + _SAME.format(31.03, 31.01)),
 }
 # at 10 dB no model is valid: the integrator's dead time interval is wider than the dead time (+-1.25 s at p 0.5),
 # and the record is refused as too short for the best-fitting lag (an SOPDT or FOPDT of 7.6-7.8 ks settling)
@@ -165,12 +173,10 @@ for _inp in ("rb0.1", "rb0.5", "chirp"):
 
 
 def _case(plant, inp, snr):
-    why = STEP_RAMP if (plant, inp) == ("integrating", "step") else DATA.get((plant, inp, snr))
+    why = DATA.get((plant, inp, snr))
     if why is None:
         return pytest.param(plant, inp, snr, id=f"{plant}-{inp}-{snr}dB")
-    strict = (plant, inp) == ("integrating", "step")
-    return pytest.param(plant, inp, snr, id=f"{plant}-{inp}-{snr}dB",
-                        marks=pytest.mark.xfail(reason=why, strict=strict))
+    return pytest.param(plant, inp, snr, id=f"{plant}-{inp}-{snr}dB", marks=pytest.mark.xfail(reason=why))
 
 
 CASES = [(plant, inp, snr) for plant in PLANTS for inp in INPUTS for snr in (20, 10)]
@@ -182,3 +188,31 @@ def test_best_model_recovers_the_plant(plant, inp, snr_db):
     best = r["best"]
     assert not misses(plant, best), (misses(plant, best), r["a"].hold, None if best is None else best.params)
     assert best.fit_percent >= r["truth"] - 1.0, (best.label, best.fit_percent, r["truth"])
+
+
+def _rms(model, u, y, ts: float, hold: str) -> float:
+    """In-sample rms of a model from rest, its output level by least squares
+    (the output-error fit's ``initial="rest"``)."""
+    e = y - simulate(model, u - u[0], ts, hold)
+    e = e - e.mean()
+    return math.sqrt(float(e @ e) / e.size)
+
+
+@pytest.mark.parametrize("inp", INPUTS)
+def test_an_integrators_dead_time_is_data_limited(inp):
+    """The integrating plant at 20 dB (its xfails above): the output-error
+    integrator's in-sample rms is at most the true model's on the same
+    estimation data, so no optimiser can bring the dead time closer: the data
+    prefer the wrong one. Under a step the capture is read as a ramp: the
+    asymptote method is the step route's model."""
+    t, u, _, y = capture("integrating", inp, 20)
+    res = identify_record(t, y, u, name=f"integrating/{inp}")
+    a = res.assessment
+    est = a.split.estimation if a.split is not None else slice(None)
+    fit = next(c for c in a.candidates if c.route == "output-error" and c.kind == "integrating")
+    assert fit.params["K"] == pytest.approx(PLANTS["integrating"][1]["K"], rel=0.02)
+    ue, ye = u[est], y[est]
+    assert (_rms(fit.model, ue, ye, a.sample_time_s, a.hold)
+            <= _rms(true_model("integrating"), ue, ye, a.sample_time_s, a.hold))
+    if inp == "step":
+        assert [c.name for c in a.candidates if c.route == "step"] == ["integrating-asymptote"]

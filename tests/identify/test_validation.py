@@ -61,6 +61,13 @@ def test_cross_correlation_finds_a_residual_that_follows_the_input():
     assert c.lags[np.argmax(np.abs(c.r))] == 3
 
 
+def test_cross_correlation_with_an_input_that_does_not_move_is_zero():
+    """The validation part of a step capture, after its edge: no deviation of the
+    input, nothing correlates with it (and no 0/0 warning)."""
+    c = va.cross_correlation(np.full(500, 2.0), np.random.default_rng(5).standard_normal(500))
+    assert c.inside and not np.any(c.r)
+
+
 def test_arx_recovers_a_discrete_system():
     rng = np.random.default_rng(6)
     a, b = [1.0, -1.2, 0.5], [0.0, 0.0, 0.0, 0.4, 0.25]   # ARX[2 2 3]
