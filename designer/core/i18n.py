@@ -198,7 +198,7 @@ class Message(str):
         The fields' values: text (numbers already written, ``f"{x:.3g}"``), or a :class:`Message` of their own.
     """
 
-    def __new__(cls, message: str, **values):
+    def __new__(cls, message: str, /, **values):
         self = super().__new__(cls, message.format(**values))
         self.message, self.values = message, values
         return self
