@@ -392,9 +392,10 @@ def _optimize(spec, plant, amp, ps):
         ctx.swing_limit *= 0.9
         starts = [(b.kp, b.ti_s, b.td_s)]
     res.evaluations, res.sized, res.rounds = evaluations, sized, attempt + 1
-    note = (f"optimize: target overshoot <= {spec.target_overshoot_pct:g} %"
-            + ("" if spec.target_settling_s is None else f", settling <= {format_eng(spec.target_settling_s, 's')}")
-            + f" for a {spec.step_v:g} V step with {amp.name} limits")
+    note = Message(N_("optimize: target overshoot <= {os} %{ts} for a {step} V step with {opamp} limits"),
+                   os=f"{spec.target_overshoot_pct:g}", step=f"{spec.step_v:g}", opamp=amp.name,
+                   ts="" if spec.target_settling_s is None else Message(N_(", settling <= {ts}"),
+                                                                         ts=format_eng(spec.target_settling_s, 's')))
     return tuning.Tuning("optimize", b.kp, b.ti_s, b.td_s, ps.curve, (note,)), res, sel
 
 

@@ -325,3 +325,16 @@ def test_a_miswired_block_is_caught():
     floating = dict(terms)
     floating[(PLANT_BLOCK, "gnd")] = "vee"
     assert check_connectivity(sheet, floating)
+
+
+@pytest.mark.spice
+def test_the_spanish_optimised_sheet_leaves_no_english_word(tmp_path):
+    """Issue 29: the optimiser's notes (its target, its verdict) in Spanish on the seed plant's sheet."""
+    from designer.core.i18n import catalogue
+    args = ["--plant-fc", "3500", "--plant-zeta", "0.2", "--tuning", "optimize", "--target-overshoot", "10",
+            "--name", "optimize_es"]
+    _summary, _rep, page, nodes = spanish_sheet("design-pid", args, tmp_path)
+    english, _spanish = vocabulary()
+    assert foreign(nodes, english) == []
+    assert catalogue("es")["optimize: target overshoot <= {os} %{ts} for a {step} V step with {opamp} limits"].split(
+        "{")[0] in page
