@@ -319,15 +319,18 @@ def _tuning_blocks(result) -> list:
 def _diff_amp_blocks(result) -> list:
     d = result.diff_amp
     sw = d.swapped
-    other = "feedback" if d.attenuated == "reference" else "reference"
-    return [R.text(
-        f"U2 weighs the plant output y by g_y = (1 + R16/R15) R18/(R17 + R18) = {d.g_y:.4g} and the reference r by "
-        f"g_r = R16/R15 = {d.g_r:.4g}: it attenuates the {d.attenuated} input against the {other}. The loop gain "
-        f"is scaled by g_y ({d.loop_gain_db:+.3g} dB against a balanced amplifier) and the integrator settles the "
-        f"loop where g_y y = g_r r: y = {d.final_ratio:.4g} r (the analytic DC gain). With R17 and R18 the other way "
-        f"round (the divider on the other side), g_y = {sw['g_y']:.4g} ({sw['loop_gain_db']:+.3g} dB), phase "
-        f"margin {_fmt(sw['phase_margin_deg'], 'deg')} at {_v(sw['crossover_hz'], 'Hz')}, "
-        f"{'stable' if sw['stable'] else 'unstable'}, y = {sw['final_ratio']:.4g} r.")]
+    other = N_("feedback") if d.attenuated == "reference" else N_("reference")
+    return [R.text(_(
+        "U2 weighs the plant output y by g_y = (1 + R16/R15) R18/(R17 + R18) = {g_y} and the reference r by "
+        "g_r = R16/R15 = {g_r}: it attenuates the {attenuated} input against the {other}. The loop gain is scaled by "
+        "g_y ({db} dB against a balanced amplifier) and the integrator settles the loop where g_y y = g_r r: y = "
+        "{ratio} r (the analytic DC gain). With R17 and R18 the other way round (the divider on the other side), "
+        "g_y = {sw_g_y} ({sw_db} dB), phase margin {sw_pm} at {sw_fc}, {sw_stable}, y = {sw_ratio} r.").format(
+            g_y=f"{d.g_y:.4g}", g_r=f"{d.g_r:.4g}", attenuated=_(d.attenuated), other=_(other),
+            db=f"{d.loop_gain_db:+.3g}", ratio=f"{d.final_ratio:.4g}", sw_g_y=f"{sw['g_y']:.4g}",
+            sw_db=f"{sw['loop_gain_db']:+.3g}", sw_pm=_fmt(sw['phase_margin_deg'], 'deg'),
+            sw_fc=_v(sw['crossover_hz'], 'Hz'), sw_stable=_("stable") if sw['stable'] else _("unstable"),
+            sw_ratio=f"{sw['final_ratio']:.4g}"))]
 
 
 def _seed_bench_blocks(result) -> list:

@@ -338,3 +338,20 @@ def test_the_spanish_optimised_sheet_leaves_no_english_word(tmp_path):
     assert foreign(nodes, english) == []
     assert catalogue("es")["optimize: target overshoot <= {os} %{ts} for a {step} V step with {opamp} limits"].split(
         "{")[0] in " ".join(nodes) and "<title>PID con" in page
+
+
+def test_the_spanish_sheet_of_a_trimmed_difference_amplifier_leaves_no_english_word():
+    """Issue 29: the section on a difference amplifier that is not balanced (the seed's trimmed bench, not
+    simulated) reads in Spanish: which input it attenuates, the loop gain and the other way round."""
+    from designer.core.i18n import catalogue, language
+    from designer.pid.blocks import seed_bench_parts
+    from designer.pid.design import SEED_BENCH_PLANT, analyze_pid
+    from designer.report.document import to_text
+    result = analyze_pid(PidSpec(plant_parts=SEED_BENCH_PLANT, controller_parts=seed_bench_parts(), opamp="LM741",
+                                 step_v=2.0, kp=45, ti_s=43.215e-6, td_s=10.8037e-6), simulate=False)
+    with language("es"):
+        sections = dict(P.sections(result, with_images=False))
+        heading = catalogue("es")["Difference amplifier as built"]
+        text = to_text("t", [(heading, sections[heading])])
+    english, _spanish = vocabulary()
+    assert foreign(text.splitlines(), english) == [] and "U2 pondera la salida y" in text
