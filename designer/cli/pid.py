@@ -293,6 +293,15 @@ def _identified(args, fmt: str, given: list, ident):
                            step_only_given=edge_only)
 
 
+def _early(result, args):
+    """The pictures that need no SPICE, started in the sheet's language (``--lang``: the run enters it only to
+    write the files)."""
+    from ..core.i18n import language
+    from ..pid.report import draw_early
+    with language(getattr(args, "lang", None)):
+        return draw_early(result)
+
+
 def _run(args) -> int:
     from ..pid.design import design_pid
     from ..pid.report import summary_text, write_outputs
@@ -306,12 +315,11 @@ def _run(args) -> int:
             name = args.name or default_name(spec, result)
             return emit(replay(spec, result, args, mc, spice), args, replay_name(name, spice), write_outputs,
                         summary_text)
-        from ..pid.report import draw_early
         early = []   # the pictures that need no SPICE, drawn in the renderer while ngspice runs
         with cluster_ahead(args):
             result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator,
                                 rules_spice=args.rules_spice,
-                                before_spice=None if args.no_files else lambda r: early.append(draw_early(r)))
+                                before_spice=None if args.no_files else lambda r: early.append(_early(r, args)))
             result = loop_monte_carlo(result, args, mc, spice)
         return emit(result, args, args.name or default_name(spec, result),
                     lambda *a: write_outputs(*a, early=early[0] if early else None), summary_text)

@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .i18n import N_
-from .i18n import gettext as _
+from .i18n import translated
 
 __all__ = ["Check", "IDS", "SPICE_AGREEMENT", "listing"]
 
@@ -114,7 +114,7 @@ def listing(sep: str, items) -> tuple:
 def _fill(message: str, values: tuple, translate: bool) -> str:
     """``message`` with its ``values`` (a list of :func:`listing` written out), in the current language when
     ``translate``; a value that is itself a word of the catalogue (a stage's role, "gain") translated too."""
-    word = _ if translate else str
+    word = translated if translate else str   # a value that is a Message reads in the sheet's language too
 
     def text(v):
         if isinstance(v, tuple) and v[:1] == ("parts",):

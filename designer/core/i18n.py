@@ -38,8 +38,8 @@ from pathlib import Path
 
 from .errors import DesignError
 
-__all__ = ["DEFAULT", "LANGUAGES", "N_", "catalogue", "check_language", "current", "extract", "gettext", "language",
-           "html_words", "localise", "missing", "negotiate", "page_catalogue", "page_messages",
+__all__ = ["DEFAULT", "LANGUAGES", "Message", "N_", "catalogue", "check_language", "current", "extract", "gettext", "language",
+           "html_words", "localise", "missing", "negotiate", "page_catalogue", "page_messages", "translated",
            "update_catalogue"]
 
 #: the languages a sheet can be written in (English first: the default and the source text)
@@ -184,6 +184,71 @@ def N_(message: str) -> str:  # noqa: N802  (gettext's conventional name)
         The same text.
     """
     return message
+
+
+class Message(str):
+    """A note written in English that keeps its message and values, so that a sheet shows it in its own
+    language (:func:`translated`): the text itself (``result.json``'s, a ``str`` everywhere) is the English.
+
+    Parameters
+    ----------
+    message : str
+        The English text with ``{name}`` fields, marked ``N_`` where it is written (for the catalogue).
+    **values
+        The fields' values: text (numbers already written, ``f"{x:.3g}"``), or a :class:`Message` of their own.
+    """
+
+    def __new__(cls, message: str, /, **values):
+        self = super().__new__(cls, message.format(**values))
+        self.message, self.values = message, values
+        return self
+
+    @classmethod
+    def joined(cls, sep: str, items) -> "Message":
+        """``items`` (messages or text) joined by ``sep``, each shown in the sheet's language.
+
+        Parameters
+        ----------
+        sep : str
+            What goes between two items.
+        items : iterable of str
+            The items.
+
+        Returns
+        -------
+        Message
+            The list.
+        """
+        items = list(items)
+        return cls(sep.replace("{", "{{").replace("}", "}}").join(f"{{i{k}}}" for k in range(len(items))),
+                   **{f"i{k}": v for k, v in enumerate(items)})
+
+    def __reduce__(self):
+        # copies and pickles (dataclasses.asdict, worker processes) keep the message and its values
+        return (_message, (self.message, self.values))
+
+
+def _message(message, values):
+    return Message(message, **values)
+
+
+def translated(text):
+    """``text`` in the current language: a :class:`Message` filled with its values, each shown the same way (a
+    value that is a word of the catalogue translated too); another string as :func:`gettext` has it.
+
+    Parameters
+    ----------
+    text : str
+        A :class:`Message` or plain text.
+
+    Returns
+    -------
+    str
+        The text to show.
+    """
+    if isinstance(text, Message):
+        return gettext(text.message).format(**{k: translated(v) for k, v in text.values.items()})
+    return gettext(text) if isinstance(text, str) else text
 
 
 # a decimal point: between digits, and not part of a dotted run (1.2.3) or a name (v1.5, file2.3.csv); a

@@ -19,6 +19,7 @@ reachable.
 
 from __future__ import annotations
 
+from ..core.i18n import N_
 from ..spice.deck import GROUND, Amp, Netlist
 from .topology import PartSpec, SectionTarget, Topology, polynomial
 
@@ -28,11 +29,11 @@ __all__ = ["InvertingLowPass"]
 class InvertingLowPass(Topology):
     """The inverting first-order low-pass (parts R1 R2 C1)."""
 
-    name, title = "inverting-lowpass", "First-order low-pass (inverting)"
+    name, title = "inverting-lowpass", N_("First-order low-pass (inverting)")
     kind, order, inverting = "lowpass", 1, True
-    parts = (PartSpec("R1", "R", "input resistor"),
-             PartSpec("R2", "R", "gain: inverting input to the output"),
-             PartSpec("C1", "C", "across R2 (the pole)"))
+    parts = (PartSpec("R1", "R", N_("input resistor")),
+             PartSpec("R2", "R", N_("gain: inverting input to the output")),
+             PartSpec("C1", "C", N_("across R2 (the pole)")))
     example = SectionTarget("lowpass", 1e3, gain=3.0)
 
     def coefficients(self, values: dict) -> tuple:

@@ -29,6 +29,7 @@ Realisability: R2 > 0 needs R1 > Rp, i.e. Am < 2 Q^2.
 from __future__ import annotations
 
 from ..core.errors import DesignError
+from ..core.i18n import N_
 from ..spice.deck import GROUND, Amp, Netlist
 from .topology import PartSpec, SectionTarget, Topology, polynomial
 
@@ -38,13 +39,13 @@ __all__ = ["MfbBandPass"]
 class MfbBandPass(Topology):
     """The inverting MFB band-pass section (parts R1 R2 R3 C1 C2)."""
 
-    name, title = "mfb-bandpass", "MFB band-pass (inverting)"
+    name, title = "mfb-bandpass", N_("MFB band-pass (inverting)")
     kind, order, inverting = "bandpass", 2, True
-    parts = (PartSpec("R1", "R", "input resistor"),
-             PartSpec("R2", "R", "node x to ground"),
-             PartSpec("R3", "R", "inverting input to the output (feedback)"),
-             PartSpec("C1", "C", "node x to the inverting input"),
-             PartSpec("C2", "C", "node x to the output (feedback)"))
+    parts = (PartSpec("R1", "R", N_("input resistor")),
+             PartSpec("R2", "R", N_("node x to ground")),
+             PartSpec("R3", "R", N_("inverting input to the output (feedback)")),
+             PartSpec("C1", "C", N_("node x to the inverting input")),
+             PartSpec("C2", "C", N_("node x to the output (feedback)")))
     example = SectionTarget("bandpass", 1e3, q=5.0, gain=4.0)
 
     def coefficients(self, values: dict) -> tuple:

@@ -25,6 +25,7 @@ and R2 = G/(wn^2 C^2 R1). Every Q > 0 and G > 0 is reachable.
 
 from __future__ import annotations
 
+from ..core.i18n import N_
 from ..spice.deck import GROUND, Amp, Netlist
 from .topology import PartSpec, SectionTarget, Topology, polynomial
 
@@ -34,13 +35,13 @@ __all__ = ["MfbHighPass"]
 class MfbHighPass(Topology):
     """The inverting MFB high-pass section (parts R1 R2 C1 C2 C3)."""
 
-    name, title = "mfb-highpass", "MFB high-pass (inverting)"
+    name, title = "mfb-highpass", N_("MFB high-pass (inverting)")
     kind, order, inverting = "highpass", 2, True
-    parts = (PartSpec("R1", "R", "node x to ground"),
-             PartSpec("R2", "R", "inverting input to the output (feedback)"),
-             PartSpec("C1", "C", "input capacitor"),
-             PartSpec("C2", "C", "gain: node x to the output"),
-             PartSpec("C3", "C", "node x to the inverting input"))
+    parts = (PartSpec("R1", "R", N_("node x to ground")),
+             PartSpec("R2", "R", N_("inverting input to the output (feedback)")),
+             PartSpec("C1", "C", N_("input capacitor")),
+             PartSpec("C2", "C", N_("gain: node x to the output")),
+             PartSpec("C3", "C", N_("node x to the inverting input")))
     example = SectionTarget("highpass", 1e3, q=0.8, gain=2.0)
 
     def coefficients(self, values: dict) -> tuple:

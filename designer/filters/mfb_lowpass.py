@@ -32,6 +32,7 @@ R2 = 1/(2 wn Q C1)).
 from __future__ import annotations
 
 from ..core.errors import DesignError
+from ..core.i18n import N_
 from ..spice.deck import GROUND, Amp, Netlist
 from .topology import PartSpec, SectionTarget, Topology, polynomial, quadratic_root
 
@@ -41,13 +42,13 @@ __all__ = ["MfbLowPass"]
 class MfbLowPass(Topology):
     """The inverting MFB low-pass section (parts R1 R2 R3 C1 C2)."""
 
-    name, title = "mfb-lowpass", "MFB low-pass (inverting)"
+    name, title = "mfb-lowpass", N_("MFB low-pass (inverting)")
     kind, order, inverting = "lowpass", 2, True
-    parts = (PartSpec("R1", "R", "input resistor"),
-             PartSpec("R2", "R", "gain: node x to the output"),
-             PartSpec("R3", "R", "node x to the inverting input"),
-             PartSpec("C1", "C", "inverting input to the output (feedback)"),
-             PartSpec("C2", "C", "node x to ground"))
+    parts = (PartSpec("R1", "R", N_("input resistor")),
+             PartSpec("R2", "R", N_("gain: node x to the output")),
+             PartSpec("R3", "R", N_("node x to the inverting input")),
+             PartSpec("C1", "C", N_("inverting input to the output (feedback)")),
+             PartSpec("C2", "C", N_("node x to ground")))
     choices = ("ratio",)
     example = SectionTarget("lowpass", 1e3, q=0.7071, gain=2.0)
 

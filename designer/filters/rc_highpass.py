@@ -16,6 +16,7 @@ reachable; the gain is 1.
 
 from __future__ import annotations
 
+from ..core.i18n import N_
 from ..spice.deck import GROUND, Amp, Netlist
 from .rc_lowpass import RcLowPass
 from .topology import PartSpec, SectionTarget, polynomial
@@ -27,10 +28,10 @@ class RcHighPass(RcLowPass):
     """The first-order CR high-pass with a follower (parts R1 C1); its design is the
     low-pass's (:class:`~designer.filters.rc_lowpass.RcLowPass`)."""
 
-    name, title = "rc-highpass", "First-order high-pass (CR and follower)"
+    name, title = "rc-highpass", N_("First-order high-pass (CR and follower)")
     kind = "highpass"
-    parts = (PartSpec("R1", "R", "non-inverting input to ground"),
-             PartSpec("C1", "C", "input capacitor"))
+    parts = (PartSpec("R1", "R", N_("non-inverting input to ground")),
+             PartSpec("C1", "C", N_("input capacitor")))
     example = SectionTarget("highpass", 1e3)
 
     def coefficients(self, values: dict) -> tuple:

@@ -16,6 +16,7 @@ R1 C1 = 1/wc. Every fc is reachable; the gain is 1.
 
 from __future__ import annotations
 
+from ..core.i18n import N_
 from ..spice.deck import GROUND, Amp, Netlist
 from .topology import PartSpec, SectionTarget, Topology, polynomial
 
@@ -25,10 +26,10 @@ __all__ = ["RcLowPass"]
 class RcLowPass(Topology):
     """The first-order RC low-pass with a follower (parts R1 C1)."""
 
-    name, title = "rc-lowpass", "First-order low-pass (RC and follower)"
+    name, title = "rc-lowpass", N_("First-order low-pass (RC and follower)")
     kind, order, inverting = "lowpass", 1, False
-    parts = (PartSpec("R1", "R", "input resistor"),
-             PartSpec("C1", "C", "non-inverting input to ground"))
+    parts = (PartSpec("R1", "R", N_("input resistor")),
+             PartSpec("C1", "C", N_("non-inverting input to ground")))
     example = SectionTarget("lowpass", 1e3)
 
     def coefficients(self, values: dict) -> tuple:

@@ -525,10 +525,11 @@ def bode_png(data: FilterSheet) -> bytes:
     f, h = bench.f_hz, bench.h
     fig, (a1, a2) = figure(7.5, 4.8, 2, 1, sharex=True)
     a1.fill_between(f, bench.h_lo_db, bench.h_hi_db, color="#f4c27a", alpha=0.5, lw=0,
-                    label=f"{bench.builds} builds (R {bench.r_tol_pct:g} %, C {bench.c_tol_pct:g} %)")
-    a1.plot(f, 20 * np.log10(np.abs(h)), "-", lw=1.6, label=f"chosen parts, {r.opamp.name} model")
+                    label=_("{n} builds (R {r} %, C {c} %)").format(n=bench.builds, r=f"{bench.r_tol_pct:g}",
+                                                                     c=f"{bench.c_tol_pct:g}"))
+    a1.plot(f, 20 * np.log10(np.abs(h)), "-", lw=1.6, label=_("chosen parts, {opamp} model").format(opamp=r.opamp.name))
     a1.plot([p.f_hz for p in bench.sweep], [p.gain_db for p in bench.sweep], "o", ms=3.5, mfc="none",
-            color="C3", label="sweep points")
+            color="C3", label=_("sweep points"))
     ref = 20 * math.log10(s.gain)
     # down to 30 dB below the mask's stopband (80 dB without a mask), or the response's floor if higher
     lo_db = max(float(np.min(20 * np.log10(np.abs(h)))), ref - (s.min_attenuation_db + 30 if s.has_mask else 80))
@@ -542,16 +543,16 @@ def bode_png(data: FilterSheet) -> bytes:
             pbs, sbs = [(s.passband_hz, f[-1])], [(f[0], s.stopband_hz)]
         for i, pb in enumerate(pbs):
             a1.fill_between(pb, [lo_db] * 2, [ref - s.max_loss_db] * 2, color="#d33", alpha=0.15, lw=0,
-                            label=None if i else "mask")
+                            label=None if i else _("mask"))
         for sb in sbs:
             a1.fill_between(sb, [ref - s.min_attenuation_db] * 2, [ref + 10] * 2, color="#d33", alpha=0.15, lw=0)
     a1.axhline(ref - 10 * math.log10(2), color="0.5", lw=0.6, ls=":")
     a1.set_ylim(lo_db, ref + 6)
     a2.plot(f, np.degrees(np.unwrap(np.angle(h))), "-", lw=1.4)
     log_frequency_axis(a2)
-    a1.set_ylabel("gain (dB)")
-    a2.set_ylabel("phase (deg)")
-    a2.set_xlabel("frequency (Hz)")
+    a1.set_ylabel(_("gain (dB)"))
+    a2.set_ylabel(_("phase (deg)"))
+    a2.set_xlabel(_("frequency (Hz)"))
     a1.set_title(title_of(r), fontsize=10)
     for a in (a1, a2):
         a.grid(True, which="both", alpha=0.3)
@@ -573,9 +574,11 @@ def time_png(data: FilterSheet) -> bytes:
         PNG.
     """
     tt = data.bench.time_test
-    title = "Step response" if tt.kind == "step" else f"Tone burst at {format_eng(tt.frequency_hz, 'Hz')}"
-    return step_plot(tt.t_s, {"output (chosen parts)": tt.output_v, "generator (CH1)": tt.input_v}, title,
-                     ylabel="voltage (V)", xlabel="time from the " + ("step" if tt.kind == "step" else "burst's start"))
+    title = (N_("Step response") if tt.kind == "step"
+             else _("Tone burst at {f}").format(f=format_eng(tt.frequency_hz, 'Hz')))
+    return step_plot(tt.t_s, {N_("output (chosen parts)"): tt.output_v, N_("generator (CH1)"): tt.input_v}, title,
+                     ylabel=N_("voltage (V)"),
+                     xlabel=N_("time from the step") if tt.kind == "step" else N_("time from the burst's start"))
 
 
 def _delay_rows(r) -> list:
@@ -605,20 +608,21 @@ def group_delay_png(data: FilterSheet) -> bytes:
     """
     f, tau = data.bench.group_delay
     fig, ax = figure(7.5, 3.2)
-    ax.plot(f, np.asarray(tau) * 1e6, "-", lw=1.6, label="chosen parts")
+    ax.plot(f, np.asarray(tau) * 1e6, "-", lw=1.6, label=_("chosen parts"))
     s, figs = data.design.spec, data.design.figures
     if s.has_delay_target:
         # the target: the DC delay +- the allowed error, up to its frequency
         d0, e = figs["delay_dc_s"] * 1e6, s.max_delay_error_pct / 100
         ax.fill_between([f[0], s.delay_to_hz], [d0 * (1 - e)] * 2, [d0 * (1 + e)] * 2, color="tab:green", alpha=0.2, lw=0,
-                        label=f"target: within {s.max_delay_error_pct:g} % to {format_eng(s.delay_to_hz, 'Hz')} "
-                              f"(parts: {figs['delay_error_pct']:.3g} %)")
+                        label=_("target: within {pct} % to {f} (parts: {got} %)").format(
+                            pct=f"{s.max_delay_error_pct:g}", f=format_eng(s.delay_to_hz, 'Hz'),
+                            got=f"{figs['delay_error_pct']:.3g}"))
         ax.axvline(s.delay_to_hz, color="tab:green", lw=0.8, ls=":")
         ax.legend(fontsize=8, loc="lower left")
     log_frequency_axis(ax)
-    ax.set_xlabel("frequency (Hz)")
-    ax.set_ylabel("group delay (us)")
-    ax.set_title("Group delay (flat in the passband: a Bessel's purpose)", fontsize=10)
+    ax.set_xlabel(_("frequency (Hz)"))
+    ax.set_ylabel(_("group delay (us)"))
+    ax.set_title(_("Group delay (flat in the passband: a Bessel's purpose)"), fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     return png_bytes(fig, dpi=100, tight=False)
 

@@ -19,6 +19,10 @@ from .topology import DEFAULT_IMPEDANCE_OHM, PartSpec, SectionTarget, Topology
 __all__ = ["SallenKeySection", "GAIN_PARTS"]
 
 #: the gain network of a Sallen-Key section with gain
+#: the sections' titles by kind and gain (whole phrases, so that the catalogue translates each)
+_TITLES = {("lowpass", False): N_("Sallen-Key low-pass, unity gain"), ("lowpass", True): N_("Sallen-Key low-pass, gain K"),
+          ("highpass", False): N_("Sallen-Key high-pass, unity gain"),
+          ("highpass", True): N_("Sallen-Key high-pass, gain K")}
 GAIN_PARTS = (PartSpec("R3", "R", N_("gain: inverting input to ground")),
               PartSpec("R4", "R", N_("gain: output to inverting input")))
 
@@ -48,8 +52,7 @@ class SallenKeySection(Topology):
     def __init__(self, with_gain: bool = False):
         self.with_gain = with_gain
         self.name = self.base_name + ("-gain" if with_gain else "")
-        kind = "low-pass" if self.kind == "lowpass" else "high-pass"
-        self.title = f"Sallen-Key {kind}, " + ("gain K" if with_gain else "unity gain")
+        self.title = _TITLES[self.kind, with_gain]
         self.parts = self.network + (GAIN_PARTS if with_gain else ())
         self.choices = ("ratio", "r3") if with_gain else ("ratio",)
         self.choice_parts = tuple(p.ref for p in GAIN_PARTS) if with_gain else ()

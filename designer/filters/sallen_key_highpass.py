@@ -32,6 +32,7 @@ positive); the cost is the resistor spread, R2/R1 >= 4 Q^2 at unity gain.
 
 from __future__ import annotations
 
+from ..core.i18n import N_
 from ..spice.deck import GROUND, Netlist
 from .sallen_key import SallenKeySection
 from .topology import PartSpec, SectionTarget, polynomial, quadratic_root
@@ -48,10 +49,10 @@ class SallenKeyHighPass(SallenKeySection):
     """
 
     kind, base_name = "highpass", "sallen-key-highpass"
-    network = (PartSpec("R1", "R", "C1-C2 node to the output (feedback)"),
-               PartSpec("R2", "R", "non-inverting input to ground"),
-               PartSpec("C1", "C", "input capacitor"),
-               PartSpec("C2", "C", "to the non-inverting input"))
+    network = (PartSpec("R1", "R", N_("C1-C2 node to the output (feedback)")),
+               PartSpec("R2", "R", N_("non-inverting input to ground")),
+               PartSpec("C1", "C", N_("input capacitor")),
+               PartSpec("C2", "C", N_("to the non-inverting input")))
 
     def coefficients(self, values: dict) -> tuple:
         v = self.values_of(values)

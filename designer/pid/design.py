@@ -50,7 +50,7 @@ from ..core import opamps
 from ..core.checks import Check
 from ..core.checks import listing
 from ..core.errors import DesignError, ParamError
-from ..core.i18n import N_
+from ..core.i18n import N_, Message
 from ..core.lti import dominant_pair, response_span, step_response
 from ..core.metrics import StepMetrics
 from ..core.opamps import OpAmp
@@ -211,15 +211,16 @@ def _run(spec: PidSpec, simulate: bool, simulator: str, as_built: bool, opamp=No
         tun = tuning.Tuning("explicit", spec.kp, spec.ti_s, spec.td_s, curve, ())
     elif spec.tuning == "optimize":
         tun, opt, presized = _optimize(spec, plant, amp, ps)
-        notes.append(f"optimize: {opt.message} after {opt.evaluations} closed-loop evaluations")
+        notes.append(Message(N_("optimize: {message} after {n} closed-loop evaluations"), message=opt.message,
+                             n=str(opt.evaluations)))
     else:
         tun = tuning.tune(spec.tuning or "zn", curve)
     notes += list(tun.notes)
     if tun.method == "zn":
-        notes.append(f"ZN reaction curve: inflection at {format_eng(curve.t_inflection_s, 's')}, "
-                     f"L = {format_eng(curve.L_s, 's')}, T = {format_eng(curve.T_s, 's')} (from L to where the "
-                     f"tangent reaches the final value, {format_eng(curve.t_tangent_final_s, 's')}; the seed "
-                     "used that absolute time as T)")
+        notes.append(Message(N_("ZN reaction curve: inflection at {t}, L = {l}, T = {tt} (from L to where the tangent "
+                                "reaches the final value, {t_final}; the seed used that absolute time as T)"),
+                             t=format_eng(curve.t_inflection_s, 's'), l=format_eng(curve.L_s, 's'),
+                             tt=format_eng(curve.T_s, 's'), t_final=format_eng(curve.t_tangent_final_s, 's')))
     clock.lap("tuning_s")
     if spec.controller_parts is not None:
         parts, sel = spec.controller_parts, None
@@ -238,9 +239,9 @@ def _run(spec: PidSpec, simulate: bool, simulator: str, as_built: bool, opamp=No
     loop = _analyse(spec, plant, amp, tun, parts, ps, simulate)
     checks = tuple(static) + loop.checks
     if not amp.ideal and any(not c.ok for c in checks if c.id in LIMITS):
-        notes.append(f"to have gains chosen for the loop as built with {amp.name}s (stable with the op-amp poles, "
-                     "every op-amp inside its swing and slew rate for this step): --tuning optimize "
-                     "--target-overshoot P")
+        notes.append(Message(N_("to have gains chosen for the loop as built with {opamp}s (stable with the op-amp "
+                                "poles, every op-amp inside its swing and slew rate for this step): --tuning optimize "
+                                "--target-overshoot P"), opamp=amp.name))
     waves = Waveforms(loop.t, loop.r, loop.waves, loop.y_ideal, loop.y_open, loop.bode_w, loop.loop_gain, ps.t, ps.y,
                       None if curve.fit is None else curve.fit.step(ps.t))
     res = PidResult(spec=spec, plant=plant, plant_source=source, plant_series=plant_series,
@@ -254,7 +255,7 @@ def _run(spec: PidSpec, simulate: bool, simulator: str, as_built: bool, opamp=No
         run_spice(res, simulator)
         clock.lap("simulation_s")
     else:
-        res.notes.append("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only")
+        res.notes.append(N_("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only"))
     res.scope = loop_scope(res)
     res.diff_amp = M.diff_amp_balance(parts, amp, ps.num, ps.den, loop.bode_w, loop.analytic.dc_gain)
     if simulate and _same(parts, blocks.seed_bench_parts()) and _same(plant, SEED_BENCH_PLANT):
@@ -333,7 +334,7 @@ def loop_scope(res: PidResult):
             levels[sig] = (ref, *rails)
     ts = res.spice.figures.settling_time_s if res.spice is not None else res.analytic.figures.settling_time_s
     window = min(1.2 * ts, test.half_period_s) if ts is not None and math.isfinite(ts) else test.half_period_s
-    chans = [channel("CH1", "reference r", 0.0, test.amplitude_v)]
+    chans = [channel("CH1", N_("reference r"), 0.0, test.amplitude_v)]
     chans.append(channel("CH2", "y", *levels["y"][1:]))
     chans += [channel("CH2", sig, lo, hi) for sig, (_, lo, hi) in levels.items() if sig != "y"]
     return scope_setup(window, test.amplitude_v / 2, chans)
@@ -391,9 +392,10 @@ def _optimize(spec, plant, amp, ps):
         ctx.swing_limit *= 0.9
         starts = [(b.kp, b.ti_s, b.td_s)]
     res.evaluations, res.sized, res.rounds = evaluations, sized, attempt + 1
-    note = (f"optimize: target overshoot <= {spec.target_overshoot_pct:g} %"
-            + ("" if spec.target_settling_s is None else f", settling <= {format_eng(spec.target_settling_s, 's')}")
-            + f" for a {spec.step_v:g} V step with {amp.name} limits")
+    note = Message(N_("optimize: target overshoot <= {os} %{ts} for a {step} V step with {opamp} limits"),
+                   os=f"{spec.target_overshoot_pct:g}", step=f"{spec.step_v:g}", opamp=amp.name,
+                   ts="" if spec.target_settling_s is None else Message(N_(", settling <= {ts}"),
+                                                                         ts=format_eng(spec.target_settling_s, 's')))
     return tuning.Tuning("optimize", b.kp, b.ti_s, b.td_s, ps.curve, (note,)), res, sel
 
 
@@ -583,8 +585,9 @@ def choose_gains(spec: PidSpec, model, reduced, amp, table) -> tuple:
         if row.tuning is not None and row.reason is None and row.rule in DEFAULT_RULES:
             rt = row.tuning
             return (Gains(rt.rule, rt.kp, rt.ti_s, rt.td_s, rt), None,
-                    [f"rule {rt.rule} (the first of {', '.join(DEFAULT_RULES)} that applies to this model; "
-                     "--tuning names another, --tuning optimize meets margins and Ms)"])
+                    [Message(N_("rule {rule} (the first of {rules} that applies to this model; --tuning names "
+                                "another, --tuning optimize meets margins and Ms)"), rule=rt.rule,
+                             rules=", ".join(DEFAULT_RULES))])
     # the tangent rules share one reason: each said once
     reasons = list(dict.fromkeys(r.reason for r in table if r.reason))
     raise DesignError("no tuning rule applies to this model (" + "; ".join(reasons)
@@ -703,7 +706,7 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
             res.rules = rules_in_spice(res, simulator)
         lap("simulation_s")
     else:
-        res.notes.append("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only")
+        res.notes.append(N_("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only"))
     res.scope = model_loop_scope(res)
     res.timings = laps
     return res
@@ -721,7 +724,7 @@ def model_loop_scope(res: PidResult):
     if res.spice is not None and "y" in res.spice.waves:
         y = res.spice.waves["y"]
     y_lo, y_hi = (float(np.nanmin(y)), float(np.nanmax(y))) if np.any(np.isfinite(y)) else rails
-    chans = [channel("CH1", "reference r", 0.0, test.amplitude_v), channel("CH2", "y", y_lo, y_hi)]
+    chans = [channel("CH1", N_("reference r"), 0.0, test.amplitude_v), channel("CH2", "y", y_lo, y_hi)]
     for ref, role, sig in M.OPAMP_OUTPUTS:
         got = (res.spice.stages.get(role) if res.spice is not None else None) or res.levels.get(role)
         if got is not None:
@@ -886,25 +889,30 @@ def loop_deck(spec: PidSpec, parts, model, amp, test, title: str, expected: floa
 def loop_checks(spec, mg, dc, amp, levels, waves, t, parts) -> list:
     """Stability, phase and gain margins, Ms, steady-state error and the plant's ranges."""
     pm_min, gm_min, ms_max = limits(spec)
-    out = [Check("closed_loop_stable", bool(mg.stable),
-                 "no closed-loop root in the right half plane (argument principle, exact dead time)"
-                 if mg.stable else f"{mg.rhp_roots:g} closed-loop roots in the right half plane: the loop "
-                 "oscillates or runs to a rail")]
+    out = [Check.of("closed_loop_stable", mg.stable,
+                    N_("no closed-loop root in the right half plane (argument principle, exact dead time)"))
+           if mg.stable else
+           Check.of("closed_loop_stable", False, N_("{n} closed-loop roots in the right half plane: the loop "
+                                                    "oscillates or runs to a rail"), n=f"{mg.rhp_roots:g}")]
     pm = mg.phase_margin_deg
-    out.append(Check("phase_margin", bool(math.isfinite(pm) and pm >= pm_min),
-                     f"{pm:.3g} deg at {format_eng(mg.crossover_hz, 'Hz')} with the op-amp poles and the dead "
-                     f"time (want >= {pm_min:g} deg; delay margin {format_eng(mg.delay_margin_s, 's')})"
-                     if math.isfinite(pm) else "the loop gain never crosses 1"))
+    out.append(Check.of("phase_margin", math.isfinite(pm) and pm >= pm_min,
+                        N_("{pm} deg at {fc} with the op-amp poles and the dead time (want >= {pm_min} deg; delay "
+                           "margin {dm})"), pm=f"{pm:.3g}", fc=format_eng(mg.crossover_hz, 'Hz'), pm_min=f"{pm_min:g}",
+                        dm=format_eng(mg.delay_margin_s, 's'))
+               if math.isfinite(pm) else Check.of("phase_margin", False, N_("the loop gain never crosses 1")))
     gm = mg.gain_margin_db
-    out.append(Check("gain_margin", bool(gm >= gm_min),
-                     f"{gm:.3g} dB at {format_eng(mg.phase_crossover_hz, 'Hz')} (want >= {gm_min:g} dB)"
-                     if math.isfinite(gm) else f"the phase never reaches -180 deg (want >= {gm_min:g} dB)"))
-    out.append(Check("max_sensitivity", bool(mg.ms <= ms_max),
-                     f"Ms = {mg.ms:.3g} at {format_eng(mg.ms_hz, 'Hz')} (want <= {ms_max:g}; 1/Ms = "
-                     f"{1 / mg.ms:.3g} is the distance of the Nyquist curve from -1)"))
+    out.append(Check.of("gain_margin", gm >= gm_min, N_("{gm} dB at {f180} (want >= {gm_min} dB)"), gm=f"{gm:.3g}",
+                        f180=format_eng(mg.phase_crossover_hz, 'Hz'), gm_min=f"{gm_min:g}")
+               if math.isfinite(gm) else
+               Check.of("gain_margin", gm >= gm_min, N_("the phase never reaches -180 deg (want >= {gm_min} dB)"),
+                        gm_min=f"{gm_min:g}"))
+    out.append(Check.of("max_sensitivity", mg.ms <= ms_max,
+                        N_("Ms = {ms} at {f} (want <= {ms_max}; 1/Ms = {inv} is the distance of the Nyquist curve "
+                           "from -1)"), ms=f"{mg.ms:.3g}", f=format_eng(mg.ms_hz, 'Hz'), ms_max=f"{ms_max:g}",
+                        inv=f"{1 / mg.ms:.3g}"))
     out += steady_state_check(dc)
-    for key, sig, what in (("plant_input", "u", "input (the controller's output u)"),
-                           ("plant_output", "y", "output y")):
+    for key, sig, what in (("plant_input", "u", N_("input (the controller's output u)")),
+                           ("plant_output", "y", N_("output y"))):
         rng = getattr(spec.plant, key)
         if rng is None or not mg.stable:
             continue
@@ -912,10 +920,10 @@ def loop_checks(spec, mg, dc, amp, levels, waves, t, parts) -> list:
         vf = float(v[-1])
         vmax, vmin = max(float(v.max()), vf - float(v.min())), min(float(v.min()), vf - float(v.max()))
         ok = vmin >= rng[0] - 1e-9 and vmax <= rng[1] + 1e-9
-        out.append(Check(f"{key}_range", bool(ok),
-                         f"the plant's {what} spans {vmin:.3g} V to {vmax:.3g} V over the square wave "
-                         f"(rising and falling edge); it accepts {rng[0]:g} V to {rng[1]:g} V"
-                         + ("" if ok else ": lower --step or the gains (a softer rule, --tuning optimize)")))
+        out.append(Check.of(f"{key}_range", ok, N_("the plant's {what} spans {lo} V to {hi} V over the square wave "
+                                                   "(rising and falling edge); it accepts {lo_ok} V to {hi_ok} V{fix}"),
+                            what=what, lo=f"{vmin:.3g}", hi=f"{vmax:.3g}", lo_ok=f"{rng[0]:g}", hi_ok=f"{rng[1]:g}",
+                            fix="" if ok else N_(": lower --step or the gains (a softer rule, --tuning optimize)")))
     return out
 
 

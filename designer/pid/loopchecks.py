@@ -15,7 +15,7 @@ import math
 from dataclasses import replace
 
 from ..core.checks import Check, listing
-from ..core.i18n import N_
+from ..core.i18n import N_, Message
 from ..core.units import format_eng
 from . import model
 
@@ -102,8 +102,9 @@ def kick_note(parts, amp, step_v, name_of=str) -> str:
     u = hf * step_v
     if amp.ideal or abs(u) <= amp.vout_max:
         return ""
-    return (f"; even before the loop reacts, the step edge alone asks {name_of('U6')} for Kp (1 + Td/(R12 C3)) x "
-            f"{step_v:g} V = {u:.3g} V (the {amp.name} reaches {amp.vout_max:.3g} V)")
+    return Message(N_("; even before the loop reacts, the step edge alone asks {unit} for Kp (1 + Td/(R12 C3)) x {step} V "
+                      "= {u} V (the {opamp} reaches {vmax} V)"), unit=name_of('U6'), step=f"{step_v:g}", u=f"{u:.3g}",
+                   opamp=amp.name, vmax=f"{amp.vout_max:.3g}")
 
 
 def steady_state_check(dc_gain: float) -> list:
@@ -155,16 +156,16 @@ def stage_checks(stable, levels, amp, step_v, rise, parts, name_of=str) -> list:
     """
     out = []
     if not stable:
-        out.append(Check("slew_rate", False, "unstable loop: no steady waveforms to check"))
-        out.append(Check("output_swing", False,
-                         "unstable loop: the outputs run to the rails" + kick_note(parts, amp, step_v, name_of)))
+        out.append(Check.of("slew_rate", False, N_("unstable loop: no steady waveforms to check")))
+        out.append(Check.of("output_swing", False, N_("unstable loop: the outputs run to the rails{kick}"),
+                            kick=kick_note(parts, amp, step_v, name_of)))
         return out
     if amp.ideal:
         worst_sw = max(levels.values(), key=lambda v: max(abs(v.v_max), abs(v.v_min)))
-        out.append(Check("slew_rate", True, "ideal op-amps (no slew limit)"))
-        out.append(Check("output_swing", True,
-                         f"ideal op-amps; the largest excursion is {worst_sw.opamp} ({worst_sw.signal}) "
-                         f"{worst_sw.v_min:.3g} V to {worst_sw.v_max:.3g} V"))
+        out.append(Check.of("slew_rate", True, N_("ideal op-amps (no slew limit)")))
+        out.append(Check.of("output_swing", True, N_("ideal op-amps; the largest excursion is {unit} ({signal}) {lo} V "
+                                                     "to {hi} V"), unit=worst_sw.opamp, signal=worst_sw.signal,
+                            lo=f"{worst_sw.v_min:.3g}", hi=f"{worst_sw.v_max:.3g}"))
         return out
     budget = model.SLEW_DELAY_FRACTION * rise
     slow = [(N_("{unit} {role} needs {need} V/us, slews for ~{delay}"),
@@ -213,14 +214,14 @@ def spice_notes(sp, verdict, expected_final_v: float) -> list:
     out = []
     sat = [f"{v.opamp} {role}" for role, v in sp.stages.items() if v.saturated]
     if sat:
-        out.append("SPICE: op-amp output pinned at a rail: " + ", ".join(sat))
+        out.append(Message(N_("SPICE: op-amp output pinned at a rail: {units}"), units=", ".join(sat)))
     osc = sp.oscillation
     if osc.oscillating:
-        out.append(f"SPICE: the loop is still oscillating at the end of the half period "
-                   f"({osc.tail_p2p_v:.3g} V peak to peak)")
+        out.append(Message(N_("SPICE: the loop is still oscillating at the end of the half period ({v} V peak to "
+                              "peak)"), v=f"{osc.tail_p2p_v:.3g}"))
     if osc.latched:
-        out.append(f"SPICE: the output is stuck at {osc.tail_mean_v:.3g} V instead of settling near "
-                   f"{expected_final_v:.3g} V (latch-up)")
+        out.append(Message(N_("SPICE: the output is stuck at {v} V instead of settling near {final} V (latch-up)"),
+                           v=f"{osc.tail_mean_v:.3g}", final=f"{expected_final_v:.3g}"))
     if verdict.unexplained:
-        out.append("SPICE and the analytic loop disagree and no check explains it (please report this)")
+        out.append(N_("SPICE and the analytic loop disagree and no check explains it (please report this)"))
     return out

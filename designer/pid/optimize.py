@@ -58,6 +58,7 @@ import numpy as np
 from scipy import optimize as sopt
 
 from ..core.errors import DesignError
+from ..core.i18n import N_, Message
 from ..core.metrics import step_metrics
 from ..core.opamps import OpAmp
 from ..core.ranges import RANGES
@@ -259,9 +260,9 @@ def optimize(ctx: Context, starts, maxiter: int = 120) -> OptimizeResult:
             or [e for e in cache.values() if e.stable] or results)
     best = min(pool, key=lambda e: e.cost)
     met = meets(best, ctx)
-    msg = ("targets met" if met else
-           "targets not met: the best compromise is reported (see the checks); relax the overshoot or "
-           "settling target, lower --step, or choose a faster op-amp")
+    msg = (N_("targets met") if met else
+           N_("targets not met: the best compromise is reported (see the checks); relax the overshoot or "
+              "settling target, lower --step, or choose a faster op-amp"))
     return OptimizeResult(best, met, count, results, msg)
 
 
@@ -655,15 +656,23 @@ def optimize_model_loop(spec, model, amp, table) -> ModelOptimizeResult:
         kp, ti, td, iae, os_, met = f.kp, f.ti_s, f.td_s, f.step.iae, f.step.overshoot_pct, True
         fc = ideal_crossover_hz(model, kp, ti, td)
         f_i, f_d = corner_frequencies(spec, fc, leak_limit_hz(model, kp, ti))
-    what = (f"optimize: IAE {format_eng(iae, 'V s')} (start {start.rule}: {format_eng(g.step.iae, 'V s')}) with "
-            f"phase margin >= {pm_min:g} deg, gain margin >= {gm_min:g} dB, Ms <= {ms_max:g}"
-            + (f", overshoot <= {target:g} %" if target is not None else "")
-            + ("" if amp.ideal else f", every {amp.name} output within its swing and slew")
-            + (f" at all {len(prob.plants) - 1} corners of the 95 % box too" if spec.robust else "")
-            + f", after {prob.evaluations} evaluations"
-            + (f": rule {beaten.rule}'s gains, which meet every limit as built with the smallest IAE, beat the "
-               "search" if beaten is not None else "")
-            + ("" if met else "; NOT all met: the closest found")
-            + (f" (Kp lowered {backed} x 5 % where the search grid was optimistic)" if backed and not beaten else ""))
+    parts = [Message(N_("optimize: IAE {iae} (start {rule}: {iae0}) with phase margin >= {pm} deg, gain margin >= "
+                        "{gm} dB, Ms <= {ms}"), iae=format_eng(iae, 'V s'), rule=start.rule,
+                     iae0=format_eng(g.step.iae, 'V s'), pm=f"{pm_min:g}", gm=f"{gm_min:g}", ms=f"{ms_max:g}")]
+    if target is not None:
+        parts.append(Message(N_(", overshoot <= {target} %"), target=f"{target:g}"))
+    if not amp.ideal:
+        parts.append(Message(N_(", every {opamp} output within its swing and slew"), opamp=amp.name))
+    if spec.robust:
+        parts.append(Message(N_(" at all {n} corners of the 95 % box too"), n=str(len(prob.plants) - 1)))
+    parts.append(Message(N_(", after {n} evaluations"), n=str(prob.evaluations)))
+    if beaten is not None:
+        parts.append(Message(N_(": rule {rule}'s gains, which meet every limit as built with the smallest IAE, beat "
+                                "the search"), rule=beaten.rule))
+    if not met:
+        parts.append(N_("; NOT all met: the closest found"))
+    if backed and not beaten:
+        parts.append(Message(N_(" (Kp lowered {n} x 5 % where the search grid was optimistic)"), n=str(backed)))
+    what = Message.joined("", parts)
     return ModelOptimizeResult(kp, ti, td, start.rule, fc, iae, os_, bool(met), prob.evaluations, what,
                                bool(spec.robust), f_i, f_d)

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.errors import DesignError
+from ..core.i18n import N_, Message
 from ..core.process import ProcessModel
 from ..core.ranges import parse_in_range
 from ..spice.deck import Netlist
@@ -173,7 +174,7 @@ class Plant:
         from dataclasses import replace
         m = self.model
         return replace(m, num=tuple(-c for c in m.num),
-                       source=f"{m.source}, negated (the controller's action reversed)")
+                       source=Message(N_("{source}, negated (the controller's action reversed)"), source=m.source))
 
 
 def parse_part_values(topology, values, name: str = "plant_values") -> dict:
@@ -273,10 +274,10 @@ def circuit_from_cascade(stages, *, source: str = "circuit", name: str = "plant_
         raise DesignError(f"{name}: {lows[0]} passes no DC (its gain at 0 Hz is 0), so no PID can set the "
                           "plant's level; a PID plant is a low-pass section or a cascade of them", param=name)
     num, den = circuit.coefficients()
-    title = " + ".join(st.topology.title for st in out)
     try:
         model = rational(np.asarray(num, float), np.asarray(den, float),
-                         source=f"{title} as built ({source})")
+                         source=Message(N_("{title} as built ({source})"), source=source, title=Message.joined(
+                             " + ", (Message(st.topology.title) for st in out))))
     except DesignError as exc:
         raise DesignError(f"{name}: the circuit's transfer function is no PID plant: {exc}", param=name) from None
     return Plant(model, circuit, source)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 
 from ..core import opamps
+from ..core.i18n import N_, Message
 from ..core.units import format_eng
 from . import selection
 
@@ -27,21 +28,23 @@ def sizing_notes(sel, spec) -> list:
         r_top = min(spec.r_max, selection.R_CORNER_MAX)
         c_need = 1 / (2 * math.pi * f_i * r_top)
         if c_need > PRACTICAL_C_MAX_F:
-            fix = (f"no practical C4 reaches it (it would take {format_eng(c_need, 'F')}): this loop is too slow for "
-                   f"an analog leak at fc/100; accept a higher corner with --f-integrator (the steady-state error "
-                   "grows) or keep the integral action digital")
+            fix = Message(N_("no practical C4 reaches it (it would take {c}): this loop is too slow for an analog leak "
+                             "at fc/100; accept a higher corner with --f-integrator (the steady-state error grows) or "
+                             "keep the integral action digital"), c=format_eng(c_need, 'F'))
         else:
-            fix = (f"give C4 room with --c-max {_cli_value(c_need)} (now "
-                   f"{format_eng(spec.c_max, 'F')}), or accept a higher leak corner with --f-integrator")
-        out.append(f"the integrator leak R13 would need {format_eng(need, 'Ohm')} for a {format_eng(f_i, 'Hz')} "
-                   f"corner with C4 = {format_eng(p.c4, 'F')}, above its {format_eng(r_top, 'Ohm')} limit, so the "
-                   f"corner is {format_eng(p.f_integrator_hz, 'Hz')}: {fix}")
+            fix = Message(N_("give C4 room with --c-max {c} (now {c_max}), or accept a higher leak corner with "
+                             "--f-integrator"), c=_cli_value(c_need), c_max=format_eng(spec.c_max, 'F'))
+        out.append(Message(N_("the integrator leak R13 would need {r} for a {f} corner with C4 = {c4}, above its {r_top} "
+                              "limit, so the corner is {f_built}: {fix}"), r=format_eng(need, 'Ohm'),
+                           f=format_eng(f_i, 'Hz'), c4=format_eng(p.c4, 'F'), r_top=format_eng(r_top, 'Ohm'),
+                           f_built=format_eng(p.f_integrator_hz, 'Hz'), fix=fix))
     for key, label, part in (("ti", "Ti = R8 R14 C4/R6", "C4"), ("td", "Td = R6 R11 C3/R7", "C3")):
         err = sel.errors_pct.get(key)
         if err is not None and abs(err) > 100 * spec.tol:
-            out.append(f"{label} is {err:+.3g} % off its target: its RC is beyond the part bounds; "
-                       f"{part} and its resistors are limited by --c-max {format_eng(spec.c_max, 'F')} and "
-                       f"--r-max {format_eng(spec.r_max, 'Ohm')}: widen them (e.g. --c-max 100u)")
+            out.append(Message(N_("{label} is {err} % off its target: its RC is beyond the part bounds; {part} and its "
+                                  "resistors are limited by --c-max {c_max} and --r-max {r_max}: widen them (e.g. "
+                                  "--c-max 100u)"), label=label, err=f"{err:+.3g}", part=part,
+                               c_max=format_eng(spec.c_max, 'F'), r_max=format_eng(spec.r_max, 'Ohm')))
     return out
 
 
@@ -70,17 +73,22 @@ def opamp_speed_notes(amp, built, ideal, pm_min: float, optimized: bool = False)
     need = GBW_PER_CROSSOVER * fc
     real = [opamps.get(n) for n in opamps.names() if not opamps.get(n).ideal]
     fast = sorted((a for a in real if a.gbw_hz >= need), key=lambda a: a.gbw_hz)
-    slower = ("the optimiser found no slower loop that meets the limits with it" if optimized
-              else "--tuning optimize counts the op-amps' poles")
-    lost = ("is unstable" if not built.stable else f"has {built.phase_margin_deg:.3g} deg of phase margin")
-    head = (f"the {amp.name} (GBW {format_eng(amp.gbw_hz, 'Hz')}) is too slow for this loop: with ideal op-amps "
-            f"these gains give {ideal.phase_margin_deg:.3g} deg of phase margin at {format_eng(fc, 'Hz')}, with "
-            f"its poles the loop {lost}; ")
+    slower = (N_("the optimiser found no slower loop that meets the limits with it") if optimized
+              else N_("--tuning optimize counts the op-amps' poles"))
+    lost = (N_("is unstable") if not built.stable
+            else Message(N_("has {pm} deg of phase margin"), pm=f"{built.phase_margin_deg:.3g}"))
+    head = Message(N_("the {opamp} (GBW {gbw}) is too slow for this loop: with ideal op-amps these gains give {pm} deg "
+                      "of phase margin at {fc}, with its poles the loop {lost}; "), opamp=amp.name,
+                   gbw=format_eng(amp.gbw_hz, 'Hz'), pm=f"{ideal.phase_margin_deg:.3g}", fc=format_eng(fc, 'Hz'),
+                   lost=lost)
     if fast:
-        return [head + f"an op-amp of about {format_eng(need, 'Hz')} GBW keeps it (--opamp {fast[0].name}, "
-                       f"{format_eng(fast[0].gbw_hz, 'Hz')})" + ("" if optimized else f", or slow the loop ({slower})")]
+        return [Message("{head}{fix}{or_slower}", head=head, fix=Message(
+            N_("an op-amp of about {need} GBW keeps it (--opamp {opamp}, {gbw})"), need=format_eng(need, 'Hz'),
+            opamp=fast[0].name, gbw=format_eng(fast[0].gbw_hz, 'Hz')),
+            or_slower="" if optimized else Message(N_(", or slow the loop ({slower})"), slower=slower))]
     top = max(real, key=lambda a: a.gbw_hz)
-    return [head + f"it needs about {format_eng(need, 'Hz')} of GBW and the library's fastest, the {top.name}, "
-                   f"has {format_eng(top.gbw_hz, 'Hz')}: "
-                   + (f"{slower}; lower --min-pm or --max-ms, or slow the plant" if optimized
-                      else f"slow the loop down ({slower}, or a larger --simc-tauc or --imc-lambda)")]
+    return [Message("{head}{need}{fix}", head=head, need=Message(
+        N_("it needs about {need} of GBW and the library's fastest, the {opamp}, has {gbw}: "),
+        need=format_eng(need, 'Hz'), opamp=top.name, gbw=format_eng(top.gbw_hz, 'Hz')),
+        fix=(Message(N_("{slower}; lower --min-pm or --max-ms, or slow the plant"), slower=slower) if optimized
+             else Message(N_("slow the loop down ({slower}, or a larger --simc-tauc or --imc-lambda)"), slower=slower)))]

@@ -47,6 +47,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..core.errors import DesignError
+from ..core.i18n import N_, Message
 from ..core.lti import coefficients, pole_clusters, step_response
 from ..core.process import ProcessModel
 from ..core.units import format_eng
@@ -159,8 +160,8 @@ class ModelIntegrating:
         return (self.K,), tuple(den.tolist()), self.theta_s
 
     def describe(self) -> str:
-        return (f"integrating K {format_eng(self.K, '/s')}, tau {format_seconds(self.tau_s)}, "
-                f"theta {format_seconds(self.theta_s)}")
+        return Message(N_("integrating K {k}, tau {tau}, theta {theta}"), k=format_eng(self.K, '/s'),
+                       tau=format_seconds(self.tau_s), theta=format_seconds(self.theta_s))
 
     def to_dict(self) -> dict:
         return {"kind": self.kind, **asdict(self)}
@@ -207,7 +208,8 @@ class ModelTf:
         return self.num, self.den, self.theta_s
 
     def describe(self) -> str:
-        return f"model num {list(self.num)}, den {list(self.den)}, theta {format_seconds(self.theta_s)}"
+        return Message(N_("model num {num}, den {den}, theta {theta}"), num=str(list(self.num)), den=str(list(self.den)),
+                       theta=format_seconds(self.theta_s))
 
     def to_dict(self) -> dict:
         return {"kind": self.kind, "num": list(self.num), "den": list(self.den), "theta_s": self.theta_s}
@@ -362,13 +364,17 @@ class ModelTangent:
     def steps(self) -> list:
         """How L and T were read, with numbers."""
         if self.integrating:
-            return [f"the steepest slope of an integrating step is its final one, Kv = {format_eng(self.K, '/s')}: "
-                    f"the tangent is the ramp asymptote Kv (t - L), L = {format_seconds(self.L_s)}"]
-        out = [f"steepest point of the step at t = {format_seconds(self.t_steepest_s)}, y = {format_number(self.y_steepest)}, "
-               f"slope {format_eng(self.slope_per_s, '/s')}",
-               f"L = t - y/slope = {format_seconds(self.t_steepest_s)} - {format_number(self.y_steepest)} / "
-               f"{format_eng(self.slope_per_s, '/s')} = {format_seconds(self.L_s)}",
-               f"T = K/slope = {format_number(self.K)} / {format_eng(self.slope_per_s, '/s')} = {format_seconds(self.T_s)}"]
+            return [Message(N_("the steepest slope of an integrating step is its final one, Kv = {kv}: the tangent is "
+                               "the ramp asymptote Kv (t - L), L = {l}"), kv=format_eng(self.K, '/s'),
+                            l=format_seconds(self.L_s))]
+        out = [Message(N_("steepest point of the step at t = {t}, y = {y}, slope {slope}"),
+                       t=format_seconds(self.t_steepest_s), y=format_number(self.y_steepest),
+                       slope=format_eng(self.slope_per_s, '/s')),
+               Message(N_("L = t - y/slope = {t} - {y} / {slope} = {l}"), t=format_seconds(self.t_steepest_s),
+                       y=format_number(self.y_steepest), slope=format_eng(self.slope_per_s, '/s'),
+                       l=format_seconds(self.L_s)),
+               Message(N_("T = K/slope = {k} / {slope} = {t}"), k=format_number(self.K),
+                       slope=format_eng(self.slope_per_s, '/s'), t=format_seconds(self.T_s))]
         return out
 
     def to_dict(self) -> dict:
@@ -528,11 +534,12 @@ def half_rule_of(model, order: int, what: str) -> HalfRule:
     f = check_plant(model, what)
     if f.complex_poles:
         wn, z = f.complex_poles[0]
-        raise DesignError(f"{what}: the model has complex poles (zeta {z:.3g}, fn "
-                          f"{format_eng(wn / (2 * math.pi), 'Hz')}) and the half rule takes real time "
-                          "constants only; the tangent rules (zn, amigo) still apply")
+        raise DesignError(Message(N_("{what}: the model has complex poles (zeta {z}, fn {fn}) and the half rule takes "
+                                     "real time constants only; the tangent rules (zn, amigo) still apply"),
+                                  what=what, z=f"{z:.3g}", fn=format_eng(wn / (2 * math.pi), 'Hz')))
     if f.complex_zeros:
-        raise DesignError(f"{what}: the model has complex zeros and the half rule takes real time constants only")
+        raise DesignError(Message(N_("{what}: the model has complex zeros and the half rule takes real time constants "
+                                     "only"), what=what))
     num, den, theta0 = model.tf()
     return _half(f, float(theta0), order, what)
 
@@ -565,9 +572,11 @@ def _half(f: Factors, theta0: float, order: int, what: str) -> HalfRule:
                 g *= k
                 if new is not None:
                     cur.append(new)
-                log.append(f"zero T0 = {format_seconds(T0)} against the lag tau0 = {format_seconds(tau0)}, rule {name}: "
-                           + (f"lag {format_seconds(new)}" if new is not None else "cancelled")
-                           + (f", gain x {format_number(k)}" if k != 1.0 else ""))
+                log.append(Message(N_("zero T0 = {t0} against the lag tau0 = {tau0}, rule {name}: {what}{gain}"),
+                                   t0=format_seconds(T0), tau0=format_seconds(tau0), name=name,
+                                   what=(Message(N_("lag {lag}"), lag=format_seconds(new)) if new is not None
+                                         else N_("cancelled")),
+                                   gain=Message(N_(", gain x {k}"), k=format_number(k)) if k != 1.0 else ""))
             cur.sort(reverse=True)
             new_theta = _theta_of(cur, order, integ, theta_x)
             if math.isclose(new_theta, theta, rel_tol=1e-12, abs_tol=1e-15):
@@ -577,8 +586,8 @@ def _half(f: Factors, theta0: float, order: int, what: str) -> HalfRule:
             converged = False
         lags, gain = cur, gain * g
         steps.extend(log)
-        steps.append(f"with the effective delay {format_seconds(theta)} the zero rules use"
-                     + ("" if converged else " (did not settle: the rules switch regime)"))
+        steps.append(Message(N_("with the effective delay {theta} the zero rules use{why}"), theta=format_seconds(theta),
+                             why="" if converged else N_(" (did not settle: the rules switch regime)")))
     if not lags and not integ:
         raise DesignError(f"{what}: after the half rule cancels the zeros no time constant is left: "
                           "a gain and a delay, no FOPDT")
@@ -608,9 +617,9 @@ def _half(f: Factors, theta0: float, order: int, what: str) -> HalfRule:
         if len(lags) > 2:
             steps.append(f"tau2 = {format_seconds(lags[1])} + {format_seconds(lags[2])}/2 = {format_seconds(t2)}")
         if t2 > t1:
-            steps.append("tau2 came out larger than tau1: swapped")
+            steps.append(N_("tau2 came out larger than tau1: swapped"))
             t1, t2 = t2, t1
         m = ModelSopdt(gain, t1, t2, theta)
-    steps.append(f"-> {m.describe()}")
+    steps.append(Message("-> {model}", model=m.describe()))
     return HalfRule(m, order, tuple(steps), converged)
 

@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from ..core import eseries
-from ..core.i18n import N_, language
+from ..core.i18n import N_, language, translated
 from ..core.i18n import gettext as _
 from ..core.units import format_eng
 from ..filters.sallen_key_lowpass_parts import section_of
@@ -68,7 +68,11 @@ METRICS = (("overshoot_pct", N_("overshoot Mp"), lambda v: _("n/a") if v is None
 
 #: words the sheet shows from data (the loop table's booleans, the stages' names), for the catalogue
 SHOWN_WORDS = (N_("True"), N_("False"), N_("difference"), N_("inverter"), N_("differentiator"), N_("integrator"),
-               N_("summer"), N_("gain"))
+               N_("summer"), N_("gain"),
+               # where a model plant came from, as the library writes it (designer.core.process, pid.plant)
+               N_("typed"), N_("parts"), N_("circuit"), N_("design-filter result"),
+               # a model plant's kinds (designer.core.process)
+               N_("rational"), N_("integrating"))
 
 
 def title_of(result) -> str:
@@ -170,7 +174,7 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     if result.model is not None:
         return _model_sections(result, with_images, schematic_svg)
     b = build_board(result)
-    out = [(_("Verdict"), [R.text(verdict_text(result))] + [R.text(n) for n in result.notes])]
+    out = [(_("Verdict"), [R.text(verdict_text(result))] + [R.text(translated(n)) for n in result.notes])]
     out.append((_("Build"), _build_blocks(result, b, bom(result, b), with_images, schematic_svg)))
     out.append((_("Wiring"), _wiring_blocks(result, b)))
     if result.seed_bench is not None:
@@ -278,22 +282,24 @@ def _tuning_blocks(result) -> list:
     rc = tun.curve
     fit = None if rc is None else rc.fit
     if rc is not None:
-        blocks.append(R.text(
-            f"Reaction curve of the plant as built: inflection at {_v(rc.t_inflection_s, 's')} "
-            f"(y = {rc.y_inflection:.4g}), tangent slope {rc.slope_per_s:.5g} /s, K = {rc.K:.4g}, "
-            f"L = {_v(rc.L_s, 's')}, T = {_v(rc.T_s, 's')} (the tangent reaches the final value at "
-            f"{_v(rc.t_tangent_final_s, 's')}; T is measured from L). ZN's rule uses this tangent."))
+        blocks.append(R.text(_(
+            "Reaction curve of the plant as built: inflection at {t} (y = {y}), tangent slope {slope} /s, K = {k}, "
+            "L = {l}, T = {tt} (the tangent reaches the final value at {t_final}; T is measured from L). ZN's rule "
+            "uses this tangent.").format(t=_v(rc.t_inflection_s, 's'), y=f"{rc.y_inflection:.4g}",
+                                         slope=f"{rc.slope_per_s:.5g}", k=f"{rc.K:.4g}", l=_v(rc.L_s, 's'),
+                                         tt=_v(rc.T_s, 's'), t_final=_v(rc.t_tangent_final_s, 's'))))
     if fit is not None:
         how = ""
         if not fit.valid:
-            how = (f" The step overshoots {rc.overshoot_pct:.3g} %, which no FOPDT model can follow: treat "
-                   "the rules below as starting points." if rc.overshoot_pct > 2.0
-                   else f" The fit is poor: {fit.note}.")
+            how = " " + (_("The step overshoots {os} %, which no FOPDT model can follow: treat the rules below as "
+                           "starting points.").format(os=f"{rc.overshoot_pct:.3g}") if rc.overshoot_pct > 2.0
+                         else _("The fit is poor: {note}.").format(note=translated(fit.note)))
         blocks.append(R.text(
-            f"Least-squares FOPDT K e^(-L s)/(T s + 1) of the same step (the model Cohen-Coon, CHR, AMIGO and "
-            f"SIMC were derived for): K = {fit.K:.4g}, L = {_v(fit.L_s, 's')}, T = {_v(fit.T_s, 's')}"
-            + ("" if fit.rms_residual is None else f", rms residual {fit.rms_residual:.3g}") + "."
-            + how))
+            _("Least-squares FOPDT K e^(-L s)/(T s + 1) of the same step (the model Cohen-Coon, CHR, AMIGO and "
+              "SIMC were derived for): K = {k}, L = {l}, T = {t}").format(k=f"{fit.K:.4g}", l=_v(fit.L_s, 's'),
+                                                                          t=_v(fit.T_s, 's'))
+            + ("" if fit.rms_residual is None else _(", rms residual {rms}").format(rms=f"{fit.rms_residual:.3g}"))
+            + "." + how))
     if result.rules:
         rows = [[r.method, _model_cell(r.model), f"{r.kp:.4g}", _v(r.ti_s, "s"), _v(r.td_s, "s")]
                 for r in result.rules]
@@ -302,25 +308,29 @@ def _tuning_blocks(result) -> list:
     if opt is not None:
         b = opt.best
         blocks.append(R.text(
-            f"Optimiser: {opt.message} ({opt.evaluations} evaluations); predicted "
-            f"overshoot {_fmt(b.overshoot_pct, '%')}, settling {_v(b.settling_time_s, 's')}, worst swing "
-            f"{_fmt(_pct(b.swing_ratio), '%')} of the rails, worst slew delay {_fmt(_pct(b.slew_ratio), '%')} "
-            "of its budget" + ("" if b.stable else " (the best point found is an unstable loop)") + "."))
+            _("Optimiser: {message} ({n} evaluations); predicted overshoot {os}, settling {ts}, worst swing {swing} of "
+              "the rails, worst slew delay {slew} of its budget").format(
+                message=translated(opt.message), n=opt.evaluations, os=_fmt(b.overshoot_pct, '%'),
+                ts=_v(b.settling_time_s, 's'), swing=_fmt(_pct(b.swing_ratio), '%'), slew=_fmt(_pct(b.slew_ratio), '%'))
+            + ("" if b.stable else _(" (the best point found is an unstable loop)")) + "."))
     return blocks
 
 
 def _diff_amp_blocks(result) -> list:
     d = result.diff_amp
     sw = d.swapped
-    other = "feedback" if d.attenuated == "reference" else "reference"
-    return [R.text(
-        f"U2 weighs the plant output y by g_y = (1 + R16/R15) R18/(R17 + R18) = {d.g_y:.4g} and the reference r by "
-        f"g_r = R16/R15 = {d.g_r:.4g}: it attenuates the {d.attenuated} input against the {other}. The loop gain "
-        f"is scaled by g_y ({d.loop_gain_db:+.3g} dB against a balanced amplifier) and the integrator settles the "
-        f"loop where g_y y = g_r r: y = {d.final_ratio:.4g} r (the analytic DC gain). With R17 and R18 the other way "
-        f"round (the divider on the other side), g_y = {sw['g_y']:.4g} ({sw['loop_gain_db']:+.3g} dB), phase "
-        f"margin {_fmt(sw['phase_margin_deg'], 'deg')} at {_v(sw['crossover_hz'], 'Hz')}, "
-        f"{'stable' if sw['stable'] else 'unstable'}, y = {sw['final_ratio']:.4g} r.")]
+    other = N_("feedback") if d.attenuated == "reference" else N_("reference")
+    return [R.text(_(
+        "U2 weighs the plant output y by g_y = (1 + R16/R15) R18/(R17 + R18) = {g_y} and the reference r by "
+        "g_r = R16/R15 = {g_r}: it attenuates the {attenuated} input against the {other}. The loop gain is scaled by "
+        "g_y ({db} dB against a balanced amplifier) and the integrator settles the loop where g_y y = g_r r: y = "
+        "{ratio} r (the analytic DC gain). With R17 and R18 the other way round (the divider on the other side), "
+        "g_y = {sw_g_y} ({sw_db} dB), phase margin {sw_pm} at {sw_fc}, {sw_stable}, y = {sw_ratio} r.").format(
+            g_y=f"{d.g_y:.4g}", g_r=f"{d.g_r:.4g}", attenuated=_(d.attenuated), other=_(other),
+            db=f"{d.loop_gain_db:+.3g}", ratio=f"{d.final_ratio:.4g}", sw_g_y=f"{sw['g_y']:.4g}",
+            sw_db=f"{sw['loop_gain_db']:+.3g}", sw_pm=_fmt(sw['phase_margin_deg'], 'deg'),
+            sw_fc=_v(sw['crossover_hz'], 'Hz'), sw_stable=_("stable") if sw['stable'] else _("unstable"),
+            sw_ratio=f"{sw['final_ratio']:.4g}"))]
 
 
 def _seed_bench_blocks(result) -> list:
@@ -461,7 +471,7 @@ def _scope_blocks(result, with_images, b=None, levels=None) -> list:
 def _model_cell(m) -> str:
     if m is None:
         return ""
-    return (f"{MODEL_NAMES.get(m.source, m.source)}: {m.K:.4g}, {_v(m.L_s, 's')}, "
+    return (f"{_(MODEL_NAMES.get(m.source, m.source))}: {m.K:.4g}, {_v(m.L_s, 's')}, "
             f"{_v(m.T_s, 's')}")
 
 
@@ -526,17 +536,19 @@ def _closed_loop_plot(result, open_loop: bool = True) -> bytes:
     curves = {}
     if sp is not None:
         curves["SPICE (ngspice)"] = sp["y"]
-    curves[f"realised loop, analytic ({amp})"] = a["y"]
-    curves["ideal PID, ideal plant"] = w.ideal_pid
+    curves[_("realised loop, analytic ({opamp})").format(opamp=amp)] = a["y"]
+    curves[N_("ideal PID, ideal plant")] = w.ideal_pid
     if open_loop:
-        curves["plant alone (open loop)"] = w.open_loop
-    resid = None if sp is None else ("residual: SPICE minus the analytic loop", sp["y"], a["y"])
-    return step_plot(w.t, curves, f"Closed-loop step, 0 -> {result.test.amplitude_v:g} V", residual=resid)
+        curves[N_("plant alone (open loop)")] = w.open_loop
+    resid = None if sp is None else (N_("residual: SPICE minus the analytic loop"), sp["y"], a["y"])
+    return step_plot(w.t, curves, _("Closed-loop step, 0 -> {v} V").format(v=f"{result.test.amplitude_v:g}"),
+                     residual=resid)
 
 
 def _loop_gain_plot(result) -> bytes:
     w, mg = result.waveforms, result.margins
-    return loop_gain_plot(w.bode_w / (2 * np.pi), w.loop_gain, f"Loop gain with {result.opamp.name} poles",
+    return loop_gain_plot(w.bode_w / (2 * np.pi), w.loop_gain, _("Loop gain with {opamp} poles").format(
+                              opamp=result.opamp.name),
                           mg.crossover_hz, mg.phase_margin_deg, mg.phase_crossover_hz, mg.gain_margin_db)
 
 
@@ -549,7 +561,7 @@ def _blocks_plot(result) -> bytes:
     sigs = [(ref, role, s) for ref, role, s in OPAMP_OUTPUTS if s in w.analytic]
     fig, axes = figure(7.5, 0.85 * len(sigs) + 0.6, len(sigs), 1, sharex=True)
     for ax, (ref, role, s) in zip(axes, sigs):
-        ax.plot(*decimate(t, w.analytic[s]), "-", lw=1.2, label="analytic")
+        ax.plot(*decimate(t, w.analytic[s]), "-", lw=1.2, label=_("analytic"))
         if sp is not None and s in sp:
             ax.plot(*decimate(t, sp[s]), "--", lw=1.2, label="SPICE")
         peak = max(np.nanmax(np.abs(w.analytic[s])),
@@ -564,8 +576,8 @@ def _blocks_plot(result) -> bytes:
         ax.set_ylabel(f"{ref} {s}", fontsize=8)
         ax.grid(True, alpha=0.3)
     axes[0].legend(fontsize=7, loc="upper right")
-    axes[0].set_title("Every op-amp output (red: output limits, drawn when reached)")
-    axes[-1].set_xlabel(f"time after the step ({unit})")
+    axes[0].set_title(_("Every op-amp output (red: output limits, drawn when reached)"))
+    axes[-1].set_xlabel(f"{_('time after the step')} ({unit})")
     return png_bytes(fig, dpi=90, tight=False)
 
 
@@ -574,18 +586,18 @@ def _reaction_plot(result) -> bytes:
     tp, yp = w.reaction_t, w.reaction_y
     c = result.tuning.curve
     fig, ax = figure(7.5, 3.6)
-    ax.plot(*decimate(tp * 1e6, yp), label="plant step response")
+    ax.plot(*decimate(tp * 1e6, yp), label=_("plant step response"))
     if c is not None:
         tt = np.linspace(c.L_s, c.t_tangent_final_s, 50)
-        ax.plot(tt * 1e6, c.slope_per_s * (tt - c.t_inflection_s) + c.y_inflection, "--", label="tangent")
-        ax.plot([c.t_inflection_s * 1e6], [c.y_inflection], "o", label="inflection")
+        ax.plot(tt * 1e6, c.slope_per_s * (tt - c.t_inflection_s) + c.y_inflection, "--", label=_("tangent"))
+        ax.plot([c.t_inflection_s * 1e6], [c.y_inflection], "o", label=_("inflection"))
         ax.axhline(c.K, color="k", lw=0.6)
         if w.fopdt_y is not None:
-            ax.plot(*decimate(tp * 1e6, w.fopdt_y), ":", label="least-squares FOPDT")
+            ax.plot(*decimate(tp * 1e6, w.fopdt_y), ":", label=_("least-squares FOPDT"))
         ax.set_xlim(0, min(tp[-1], 6 * c.t_tangent_final_s) * 1e6)
-        ax.set_title(f"Reaction curve: L = {format_eng(c.L_s, 's')}, T = {format_eng(c.T_s, 's')}")
-    ax.set_xlabel("time (us)")
-    ax.set_ylabel("output per volt of step")
+        ax.set_title(_("Reaction curve: L = {l}, T = {t}").format(l=format_eng(c.L_s, 's'), t=format_eng(c.T_s, 's')))
+    ax.set_xlabel(_("time (us)"))
+    ax.set_ylabel(_("output per volt of step"))
     ax.grid(True, alpha=0.3)
     ax.legend()
     return png_bytes(fig, dpi=90, tight=False)
@@ -664,8 +676,8 @@ def write_outputs(result, out_dir, name: str, lang=None, early=None) -> dict:
 # ==== a model plant's sheet =========================================================
 
 #: the rule table's columns
-RULE_HEADER = ("rule", "Kp", "Ti", "Td", "phase margin", "gain margin", "delay margin", "Ms", "crossover", "IAE",
-               "overshoot", "SPICE overshoot", "note")
+RULE_HEADER = (N_("rule"), "Kp", "Ti", "Td", N_("phase margin"), N_("gain margin"), N_("delay margin"), "Ms",
+               N_("crossover"), "IAE", N_("overshoot"), N_("SPICE overshoot"), N_("note"))
 
 
 def _model_title_of(result) -> str:
@@ -716,23 +728,24 @@ def _model_sections(result, with_images: bool = True, schematic_svg: str = "") -
     """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`)."""
     b = _model_board(result)
     elsewhere = _shown_elsewhere(result)
-    out = [(_("Verdict"), [R.text(_model_verdict_text(result))] + [R.text(n) for n in result.notes if n not in elsewhere])]
+    out = [(_("Verdict"), [R.text(_model_verdict_text(result))]
+            + [R.text(translated(n)) for n in result.notes if n not in elsewhere])]
     out.append((_("Build"), _build_blocks(result, b, _model_bom(result, b), with_images, schematic_svg)))
     circuit = getattr(result.spec, "circuit", None)
     if circuit is not None:   # the plant's own sections are on the board, wired as the rest
-        out.append((_("Wiring"), _wiring_blocks(result, b, (), " The plant's sections are on this board (their parts "
-                                                                f"prefixed {PLANT_PREFIX}: RP1, CP1, op-amp UP).")))
+        out.append((_("Wiring"), _wiring_blocks(result, b, (), " " + _(
+            "The plant's sections are on this board (their parts prefixed {prefix}: RP1, CP1, op-amp UP).").format(
+                prefix=PLANT_PREFIX))))
     else:
         out.append((_("Wiring"), _wiring_blocks(
             result, b, plant_rows(b),
-            " The plant is not on this board: its input takes u, its output y goes to R17 and to CH2, and its "
-            "ground joins the common ground (the first rows).")))
+            " " + _("The plant is not on this board: its input takes u, its output y goes to R17 and to CH2, and its "
+                    "ground joins the common ground (the first rows)."))))
     out.append((_("The plant"), _plant_blocks(result)))
     out.append((_("Tuning"), _model_tuning_blocks(result)))
-    out.append((_("Target and achieved"), _achieved_blocks(result, result) + [R.text(
-        f"The integrator leak (R13) and the derivative filter (R12) are placed from fc = "
-        f"{_v(result.fc_ref_hz, 'Hz')}, the crossover of the ideal PID around the model (near fc/100 and "
-        "10 fc unless set).")]))
+    out.append((_("Target and achieved"), _achieved_blocks(result, result) + [R.text(_(
+        "The integrator leak (R13) and the derivative filter (R12) are placed from fc = {fc}, the crossover of the "
+        "ideal PID around the model (near fc/100 and 10 fc unless set).").format(fc=_v(result.fc_ref_hz, 'Hz')))]))
     return out + _closing_sections(result, _model_loop_blocks(result, with_images), with_images,
                                    _scope(result, with_images, b))
 
@@ -740,10 +753,11 @@ def _model_sections(result, with_images: bool = True, schematic_svg: str = "") -
 def plant_rows(b) -> list:
     """Wiring rows (part, code, from, to) of the plant, which is off the board."""
     r17 = b.netlist.part("R17")
-    return [["plant in", "", net_text(b, "u", NET_LABELS), "the plant's input"],
-            ["plant out", "", "the plant's output y", f"R17 (to {net_text(b, r17.b, NET_LABELS)}) and scope CH2"],
-            ["plant ground", "", "the plant's ground (its input's and output's reference)",
-             "ground (the star point)"]]
+    return [[_("plant in"), "", net_text(b, "u", NET_LABELS), _("the plant's input")],
+            [_("plant out"), "", _("the plant's output y"),
+             _("R17 (to {net}) and scope CH2").format(net=net_text(b, r17.b, NET_LABELS))],
+            [_("plant ground"), "", _("the plant's ground (its input's and output's reference)"),
+             _("ground (the star point)")]]
 
 
 # ---- the plant ------------------------------------------------------------------
@@ -765,36 +779,41 @@ def _param_name(key: str) -> str:
 
 def _plant_blocks(result) -> list:
     m, spec = result.model, result.spec
-    blocks = [R.text(f"{m.text()} ({m.kind}); the controller's output u is its input, its output y is fed back."),
-              R.text(f"Where it came from: {m.source}.")]
+    blocks = [R.text(_("{model} ({kind}); the controller's output u is its input, its output y is fed back.").format(
+                  model=m.text(), kind=_(m.kind))),
+              R.text(_("Where it came from: {source}.").format(source=translated(m.source)))]
     plant = getattr(spec, "circuit", None)
     if plant is not None:
         c = plant.circuit
-        stages = "; ".join(f"{st['title']}: " + ", ".join(f"{k} {format_eng(v, 'Ohm' if k[0] == 'R' else 'F')}"
+        stages = "; ".join(f"{_(st['title'])}: " + ", ".join(f"{k} {format_eng(v, 'Ohm' if k[0] == 'R' else 'F')}"
                                                            for k, v in st["parts"].items())
                            for st in c.to_dict()["stages"])
-        blocks.append(R.text(f"The plant is a circuit ({c.topology}), built on the board and simulated as built: "
-                             f"{stages}. Its own transfer function is {plant.model.text()}"
-                             + ("; it inverts, so the controller's action is reversed (r and y exchanged at the "
-                                "difference amplifier) and the gains are chosen for -G(s), the model above."
+        blocks.append(R.text(_("The plant is a circuit ({topology}), built on the board and simulated as built: "
+                               "{stages}. Its own transfer function is {model}").format(
+                                   topology=c.topology, stages=stages, model=plant.model.text())
+                             + (_("; it inverts, so the controller's action is reversed (r and y exchanged at the "
+                                  "difference amplifier) and the gains are chosen for -G(s), the model above.")
                                 if plant.reversed_action else ".")))
     if m.ci95:
         rows = [[_param_name(k), _param(m.kind, k, v),
-                 "not given" if not m.ci95.get(k) else "+/- " + _param(m.kind, k, m.ci95[k]),
+                 _("not given") if not m.ci95.get(k) else "+/- " + _param(m.kind, k, m.ci95[k]),
                  "" if not m.ci95.get(k) else f"{_param(m.kind, k, v - m.ci95[k])} .. "
                                               f"{_param(m.kind, k, v + m.ci95[k])}"]
                 for k, v in m.params.items()]
-        blocks += [R.text("Its 95 % intervals (the loop is checked at every corner of this box: Closed loop):"),
-                   R.table(["parameter", "value", "95 % half-width", "interval"], rows, "compact")]
+        blocks += [R.text(_("Its 95 % intervals (the loop is checked at every corner of this box: Closed loop):")),
+                   R.table([_("parameter"), _("value"), _("95 % half-width"), _("interval")], rows, "compact")]
     else:
-        blocks.append(R.text("No 95 % intervals were given: the loop is checked on the nominal model only."))
+        blocks.append(R.text(_("No 95 % intervals were given: the loop is checked on the nominal model only.")))
     ranges = []
-    for rng, what in ((spec.plant.plant_input, "accepts u from"), (spec.plant.plant_output, "delivers y from")):
+    for rng, what in ((spec.plant.plant_input, N_("accepts u from {lo} to {hi}")),
+                      (spec.plant.plant_output, N_("delivers y from {lo} to {hi}"))):
         if rng is not None:
-            ranges.append(f"{what} {format_eng(rng[0], 'V')} to {format_eng(rng[1], 'V')}")
-    blocks.append(R.text("The plant " + " and ".join(ranges) + " (checked over the square wave)." if ranges else
-                         "Its input and output ranges were not given: only the op-amps' swing is checked."))
-    blocks.append(R.text(f"The rules see it as {result.reduced.describe()} (each rule's own model: Tuning)."))
+            ranges.append(_(what).format(lo=format_eng(rng[0], 'V'), hi=format_eng(rng[1], 'V')))
+    blocks.append(R.text(_("The plant {ranges} (checked over the square wave).").format(ranges=_(" and ").join(ranges))
+                         if ranges else
+                         _("Its input and output ranges were not given: only the op-amps' swing is checked.")))
+    blocks.append(R.text(_("The rules see it as {model} (each rule's own model: Tuning).").format(
+        model=translated(result.reduced.describe()))))
     return blocks
 
 
@@ -802,48 +821,51 @@ def _plant_blocks(result) -> list:
 
 def _model_tuning_blocks(result) -> list:
     pi = not result.parts.has_derivative
-    blocks = [R.text(f"Method: {result.method}. Kp = {result.kp:.4g}, Ti = {_v(result.ti_s, 's')}, "
-                     f"Td = {_v(result.td_s, 's')}, in the ideal parallel form Kp (1 + 1/(Ti s) + Td s)"
-                     + (": a PI (the differentiator, its R7, R11, R12 and C3 are left out)." if pi else "."))]
+    blocks = [R.text(_("Method: {method}. Kp = {kp}, Ti = {ti}, Td = {td}, in the ideal parallel form "
+                       "Kp (1 + 1/(Ti s) + Td s)").format(method=result.method, kp=f"{result.kp:.4g}",
+                                                          ti=_v(result.ti_s, 's'), td=_v(result.td_s, 's'))
+                     + (_(": a PI (the differentiator, its R7, R11, R12 and C3 are left out).") if pi else "."))]
     rt = result.rule
     if rt is not None:
         used = rt.model_used
-        blocks.append(R.text(f"{rt.rule} on {used.describe()}" + (": " + "; ".join(used.steps) if used.steps else "")
-                             + "."))
-        blocks += [R.text(f) for f in rt.formulas]
+        blocks.append(R.text(_("{rule} on {model}").format(rule=rt.rule, model=translated(used.describe()))
+                             + (": " + "; ".join(translated(st) for st in used.steps) if used.steps else "") + "."))
+        blocks += [R.text(translated(f)) for f in rt.formulas]
         if rt.series is not None and rt.series[2] > 0:
             kc, ti, td = rt.series
-            blocks.append(R.text(f"Series form Kc (1 + 1/(tauI s))(1 + tauD s): Kc = {kc:.4g}, tauI = {_v(ti, 's')}, "
-                                 f"tauD = {_v(td, 's')}; {rt.conversion}."))
-        blocks += [R.text(n) for n in rt.notes]
+            blocks.append(R.text(_("Series form Kc (1 + 1/(tauI s))(1 + tauD s): Kc = {kc}, tauI = {ti}, "
+                                   "tauD = {td}; {conversion}.").format(kc=f"{kc:.4g}", ti=_v(ti, 's'), td=_v(td, 's'),
+                                                                        conversion=translated(rt.conversion))))
+        blocks += [R.text(translated(n)) for n in rt.notes]
     opt = result.optimizer
     if opt is not None:
         blocks.append(R.text(
-            f"Optimiser (started from {opt.start_rule}): {opt.message}; predicted overshoot "
-            f"{_dash(opt.overshoot_pct, '%')}" + ("" if opt.met else "; the limits are NOT all met")
-            + (", limits held at every 95 % corner" if opt.robust else "") + "."))
+            _("Optimiser (started from {rule}): {message}; predicted overshoot {os}").format(
+                rule=opt.start_rule, message=translated(opt.message), os=_dash(opt.overshoot_pct, '%'))
+            + ("" if opt.met else _("; the limits are NOT all met"))
+            + (_(", limits held at every 95 % corner") if opt.robust else "") + "."))
     pm, gm, ms = result.limits
-    blocks.append(R.text(
-        f"Every rule on this model, each loop as it would be built (its gains, the op-amp poles, leak and filter, "
-        f"the exact dead time), for a {format_eng(result.spec.step_v, 'V')} step; the limits are phase margin >= "
-        f"{pm:g} deg, gain margin >= {gm:g} dB, Ms <= {ms:g}."))
-    blocks.append(R.table(RULE_HEADER, [_rule_row(result, r) for r in result.rules]))
+    blocks.append(R.text(_(
+        "Every rule on this model, each loop as it would be built (its gains, the op-amp poles, leak and filter, "
+        "the exact dead time), for a {step} step; the limits are phase margin >= {pm} deg, gain margin >= {gm} dB, "
+        "Ms <= {ms}.").format(step=format_eng(result.spec.step_v, 'V'), pm=f"{pm:g}", gm=f"{gm:g}", ms=f"{ms:g}")))
+    blocks.append(R.table([_(h) for h in RULE_HEADER], [_rule_row(result, r) for r in result.rules]))
     return blocks
 
 
 def _rule_row(result, r) -> list:
     t, f = r.tuning, r.figures
     if t is None:
-        return [r.rule] + ["-"] * 11 + [f"does not apply: {r.reason}"]
+        return [r.rule] + ["-"] * 11 + [_("does not apply: {reason}").format(reason=translated(r.reason))]
     gains = [f"{t.kp:.4g}", _v(t.ti_s, "s"), _v(t.td_s, "s")]
-    note = r.reason or ""
+    note = translated(r.reason) if r.reason else ""
     if r.rule == result.method:
-        note = "built" + (f"; {note}" if note else "")
+        note = _("built") + (f"; {note}" if note else "")
     if f is None:
         return [r.rule, *gains] + ["-"] * 8 + [note]
     m, st = f.margins, f.step
     if not m.stable:
-        note = "unstable loop" + (f"; {note}" if note else "")
+        note = _("unstable loop") + (f"; {note}" if note else "")
     return [r.rule, *gains, _dash(m.phase_margin_deg, "deg"), _dash(m.gain_margin_db, "dB"),
             _dash(m.delay_margin_s, "s"), _dash(m.ms), _dash(m.crossover_hz, "Hz"),
             "-" if st is None else _dash(st.iae, "V s"), "-" if st is None else _dash(st.overshoot_pct, "%"),
@@ -854,10 +876,10 @@ def _rule_row(result, r) -> list:
 
 def _margin_rows(ideal, built) -> list:
     rows = []
-    for key, label, unit in (("phase_margin_deg", "phase margin", "deg"), ("crossover_hz", "gain crossover", "Hz"),
-                             ("gain_margin_db", "gain margin", "dB"), ("delay_margin_s", "delay margin", "s"),
-                             ("ms", "Ms (max sensitivity)", "")):
-        rows.append([label, _dash(getattr(ideal, key), unit), _dash(getattr(built, key), unit), "-"])
+    for key, label, unit in (("phase_margin_deg", N_("phase margin"), "deg"),
+                             ("crossover_hz", N_("gain crossover"), "Hz"), ("gain_margin_db", N_("gain margin"), "dB"),
+                             ("delay_margin_s", N_("delay margin"), "s"), ("ms", N_("Ms (max sensitivity)"), "")):
+        rows.append([_(label), _dash(getattr(ideal, key), unit), _dash(getattr(built, key), unit), "-"])
     return rows
 
 
@@ -873,12 +895,14 @@ def _model_loop_blocks(result, with_images) -> list:
     pm, gm, ms = result.limits
     blocks = [R.table(["", _("ideal PID around the model"), _("realised (with {opamp})").format(opamp=amp.name),
                        "SPICE"], rows),
-              R.text(f"The loop as built (op-amp poles, integrator leak, derivative filter, exact dead time): phase "
-                     f"margin {_dash(mg.phase_margin_deg, 'deg')} at {_dash(mg.crossover_hz, 'Hz')}, gain margin "
-                     f"{_dash(mg.gain_margin_db, 'dB')} at {_dash(mg.phase_crossover_hz, 'Hz')}, delay margin "
-                     f"{_dash(mg.delay_margin_s, 's')}, Ms {_dash(mg.ms)} at {_dash(mg.ms_hz, 'Hz')} (limits: "
-                     f"{pm:g} deg, {gm:g} dB, Ms {ms:g}). Closed-loop DC gain {result.dc_gain:.4g}; the step "
-                     "figures are for the rising edge of the bench test.")]
+              R.text(_("The loop as built (op-amp poles, integrator leak, derivative filter, exact dead time): phase "
+                       "margin {pm} at {fc}, gain margin {gm} at {f180}, delay margin {dm}, Ms {ms} at {ms_hz} (limits: "
+                       "{pm_min} deg, {gm_min} dB, Ms {ms_max}). Closed-loop DC gain {dc}; the step figures are for "
+                       "the rising edge of the bench test.").format(
+                  pm=_dash(mg.phase_margin_deg, 'deg'), fc=_dash(mg.crossover_hz, 'Hz'), gm=_dash(mg.gain_margin_db, 'dB'),
+                  f180=_dash(mg.phase_crossover_hz, 'Hz'), dm=_dash(mg.delay_margin_s, 's'), ms=_dash(mg.ms),
+                  ms_hz=_dash(mg.ms_hz, 'Hz'), pm_min=f"{pm:g}", gm_min=f"{gm:g}", ms_max=f"{ms:g}",
+                  dc=f"{result.dc_gain:.4g}"))]
     if s:
         blocks.append(R.text(_spice_agreement(result)))
     if result.robust is not None:
@@ -892,30 +916,33 @@ def _robust_blocks(rb) -> list:
     ms_at, ms = rb.worst("ms", -1.0)
     os_at, os_ = rb.worst("overshoot_pct", -1.0)
     n = len(rb.corners)
-    head = (f"Worst case over the {n} corners of the model's 95 % intervals (the loop as built at each): "
-            + (f"stable at every corner; phase margin {_dash(pm, 'deg')} at {pm_at}, gain margin {_dash(gm, 'dB')} "
-               f"at {gm_at}, Ms {_dash(ms)} at {ms_at}, overshoot {_dash(os_, '%')} at {os_at} (limits: "
-               f"{rb.min_phase_margin_deg:g} deg, {rb.min_gain_margin_db:g} dB, Ms {rb.max_ms:g})."
-               if rb.all_stable else f"UNSTABLE at the corner {pm_at}."))
+    head = (_("Worst case over the {n} corners of the model's 95 % intervals (the loop as built at each): ").format(n=n)
+            + (_("stable at every corner; phase margin {pm} at {pm_at}, gain margin {gm} at {gm_at}, Ms {ms} at "
+                 "{ms_at}, overshoot {os} at {os_at} (limits: {pm_min} deg, {gm_min} dB, Ms {ms_max}).").format(
+                   pm=_dash(pm, 'deg'), pm_at=pm_at, gm=_dash(gm, 'dB'), gm_at=gm_at, ms=_dash(ms), ms_at=ms_at,
+                   os=_dash(os_, '%'), os_at=os_at, pm_min=f"{rb.min_phase_margin_deg:g}",
+                   gm_min=f"{rb.min_gain_margin_db:g}", ms_max=f"{rb.max_ms:g}")
+               if rb.all_stable else _("UNSTABLE at the corner {corner}.").format(corner=pm_at)))
     rows = []
     for label, f in rb.corners:
         m, st = f.margins, f.step
-        rows.append([label, "yes" if m.stable else "NO", _dash(m.phase_margin_deg, "deg"),
+        rows.append([label, _("yes") if m.stable else _("NO"), _dash(m.phase_margin_deg, "deg"),
                      _dash(m.gain_margin_db, "dB"), _dash(m.delay_margin_s, "s"), _dash(m.ms),
                      "-" if st is None else _dash(st.overshoot_pct, "%"),
                      "-" if st is None else _dash(st.settling_time_s, "s")])
-    return [R.text(head), R.table(["corner", "stable", "phase margin", "gain margin", "delay margin", "Ms",
-                                   "overshoot", "settling (2 %)"], rows, "compact")]
+    return [R.text(head), R.table([_("corner"), _("stable"), _("phase margin"), _("gain margin"), _("delay margin"),
+                                   "Ms", _("overshoot"), _("settling (2 %)")], rows, "compact")]
 
 
 def _scope(result, with_images, b) -> list:
     blocks = _scope_blocks(result, with_images, b, result.levels)
     ch = next((c for c in (result.scope.channels if result.scope is not None else ()) if c.node == "y"), None)
     if ch is not None:
-        blocks.insert(1, R.text(
-            f"CH2 on the plant's output y first: {format_eng(ch.volts_per_div, 'V')}/div, 0 V "
-            f"{ch.zero_div_below_centre:g} div below centre; it spans {_v(ch.lo_v)} .. {_v(ch.hi_v)} "
-            f"({'SPICE' if result.spice is not None else 'analytic'}). Then each op-amp output:"))
+        blocks.insert(1, R.text(_(
+            "CH2 on the plant's output y first: {v}/div, 0 V {div} div below centre; it spans {lo} .. {hi} ({by}). "
+            "Then each op-amp output:").format(v=format_eng(ch.volts_per_div, 'V'), div=f"{ch.zero_div_below_centre:g}",
+                                               lo=_v(ch.lo_v), hi=_v(ch.hi_v),
+                                               by="SPICE" if result.spice is not None else _("analytic"))))
     return blocks
 
 
@@ -940,14 +967,14 @@ def _model_step_plot(result) -> bytes:
     k, unit = _time_scale(float(w.reaction_t[-1]))
     fig, ax = figure(7.5, 3.6)
     fig.subplots_adjust(bottom=0.14)
-    ax.plot(*decimate(w.reaction_t * k, w.reaction_y), label="the model's step")
+    ax.plot(*decimate(w.reaction_t * k, w.reaction_y), label=_("the model's step"))
     if m.theta_s > 0:
-        ax.axvline(m.theta_s * k, color="r", lw=0.8, ls="--", label=f"dead time {format_eng(m.theta_s, 's')}")
+        ax.axvline(m.theta_s * k, color="r", lw=0.8, ls="--", label=_("dead time {theta}").format(theta=format_eng(m.theta_s, 's')))
     if not m.integrating and np.isfinite(m.gain):
-        ax.axhline(m.gain, color="k", lw=0.6, label=f"final value K = {m.gain:.4g}")
-    ax.set_title(f"The plant alone: {m.text()}", fontsize=10)
-    ax.set_xlabel(f"time ({unit})")
-    ax.set_ylabel("output per volt of input")
+        ax.axhline(m.gain, color="k", lw=0.6, label=_("final value K = {k}").format(k=f"{m.gain:.4g}"))
+    ax.set_title(_("The plant alone: {model}").format(model=m.text()), fontsize=10)
+    ax.set_xlabel(_("time ({unit})").format(unit=unit))
+    ax.set_ylabel(_("output per volt of input"))
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     return png_bytes(fig, dpi=90, tight=False)

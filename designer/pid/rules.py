@@ -77,6 +77,7 @@ import math
 from dataclasses import dataclass, field
 
 from ..core.errors import DesignError
+from ..core.i18n import N_, Message
 from ..core.process import ProcessModel
 from ..core.units import format_eng
 from .reduction import (MODEL_TYPES, ModelFopdt, ModelIntegrating, ModelSopdt, ModelTangent, check_plant,
@@ -89,10 +90,10 @@ RULES = ("zn", "cohen-coon", "chr0", "chr20", "amigo", "simc", "imc")
 #: the rules read off the reaction curve (K, L and T of the tangent)
 REACTION_CURVE_RULES = ("zn", "cohen-coon", "chr0", "chr20")
 
-GIVEN = "given"
-TANGENT = "tangent of the model's step"
-TANGENT_T63 = "tangent and 63 % point of the model's step"
-HALF_RULE = "Skogestad half rule"
+GIVEN = N_("given")
+TANGENT = N_("tangent of the model's step")
+TANGENT_T63 = N_("tangent and 63 % point of the model's step")
+HALF_RULE = N_("Skogestad half rule")
 
 
 # ----------------------------------------------------------------------------- results
@@ -107,7 +108,7 @@ class ModelUsed:
     steps: tuple = ()         #: how, with numbers
 
     def describe(self) -> str:
-        return f"{self.model.describe()} ({self.source})"
+        return Message("{model} ({source})", model=self.model.describe(), source=self.source)
 
     def to_dict(self) -> dict:
         return {"model": self.model.to_dict(), "source": self.source, "steps": list(self.steps)}
@@ -196,9 +197,10 @@ def parallel_to_series(kp: float, ti: float, td: float) -> tuple:
 
 def _conversion(kc, tau_i, tau_d):
     kp, ti, td = series_to_parallel(kc, tau_i, tau_d)
-    return (f"series -> parallel: Kp = Kc (1 + tauD/tauI) = {format_number(kc)} x (1 + {format_seconds(tau_d)} / {format_seconds(tau_i)}) = {format_number(kp)}; "
-            f"Ti = tauI + tauD = {format_seconds(tau_i)} + {format_seconds(tau_d)} = {format_seconds(ti)}; "
-            f"Td = tauI tauD/(tauI + tauD) = {format_seconds(tau_i)} x {format_seconds(tau_d)} / {format_seconds(ti)} = {format_seconds(td)}")
+    return Message(N_("series -> parallel: Kp = Kc (1 + tauD/tauI) = {kc} x (1 + {tau_d} / {tau_i}) = {kp}; Ti = tauI + "
+                      "tauD = {tau_i} + {tau_d} = {ti}; Td = tauI tauD/(tauI + tauD) = {tau_i} x {tau_d} / {ti} = {td}"),
+                   kc=format_number(kc), tau_d=format_seconds(tau_d), tau_i=format_seconds(tau_i), kp=format_number(kp),
+                   ti=format_seconds(ti), td=format_seconds(td))
 
 
 # ----------------------------------------------------------------------------- rules
@@ -212,19 +214,21 @@ def _no_L(rule, formula):
 def _oscillation_notes(rule, tg: ModelTangent | None, f: Factors | None):
     out = []
     if tg is not None and tg.overshoot_pct > 2.0:
-        what = "slope" if tg.integrating else "step"
-        out.append(f"{rule}: the model's own {what} overshoots {tg.overshoot_pct:.1f} %; the rule assumes an "
-                   "S-shaped, non-oscillatory response, so the loop will be more oscillatory than it intends")
+        what = N_("slope") if tg.integrating else N_("step")
+        out.append(Message(N_("{rule}: the model's own {what} overshoots {os} %; the rule assumes an S-shaped, "
+                              "non-oscillatory response, so the loop will be more oscillatory than it intends"),
+                           rule=rule, what=what, os=f"{tg.overshoot_pct:.1f}"))
     elif f is not None and f.complex_poles:
         z = min(z for _, z in f.complex_poles)
-        out.append(f"{rule}: the model has complex poles (zeta {z:.3g}); the rule assumes a non-oscillatory plant")
+        out.append(Message(N_("{rule}: the model has complex poles (zeta {z}); the rule assumes a non-oscillatory "
+                              "plant"), rule=rule, z=f"{z:.3g}"))
     return out
 
 
 def _reaction_model(model, rule, f):
     """(K, L, T or None, ModelUsed, tangent or None) for the reaction-curve rules."""
     if isinstance(model, ModelFopdt):
-        used = ModelUsed(model, GIVEN, ("the tangent of an FOPDT's step is the model itself: L = theta, T = tau",))
+        used = ModelUsed(model, GIVEN, (N_("the tangent of an FOPDT's step is the model itself: L = theta, T = tau"),))
         return model.K, model.theta_s, model.tau_s, used, None
     tg = model_tangent(model)
     if tg.integrating:
@@ -238,8 +242,9 @@ def _reaction_model(model, rule, f):
 def _range_note(rule, L, T):
     r = L / T
     if not 0.1 <= r <= 1.0:
-        where = "is reliable" if rule == "cohen-coon" else "was derived"
-        return [f"{rule}: L/T = {r:.3g} is outside 0.1..1 where the rule {where}"]
+        if rule == "cohen-coon":
+            return [Message(N_("{rule}: L/T = {r} is outside 0.1..1 where the rule is reliable"), rule=rule, r=f"{r:.3g}")]
+        return [Message(N_("{rule}: L/T = {r} is outside 0.1..1 where the rule was derived"), rule=rule, r=f"{r:.3g}")]
     return []
 
 
@@ -259,8 +264,8 @@ def _tune_reaction(model, rule, f):
         formulas = [f"a = Kv L = {format_eng(K, '/s')} x {format_seconds(L)} = {format_number(a)}",
                     f"Kp = 1.2/a = 1.2 / {format_number(a)} = {format_number(kp)}",
                     f"Ti = 2 L = 2 x {format_seconds(L)} = {format_seconds(ti)}", f"Td = 0.5 L = 0.5 x {format_seconds(L)} = {format_seconds(td)}"]
-        notes.append("zn: Ziegler-Nichols' reaction curve needs only the steepest slope and L (a = slope x L), "
-                     "so it applies to an integrating plant")
+        notes.append(N_("zn: Ziegler-Nichols' reaction curve needs only the steepest slope and L (a = slope x L), "
+                        "so it applies to an integrating plant"))
         return RuleTuning(rule, kp, ti, td, used, formulas, notes)
     r = L / T
     kl = f"({format_number(K)} x {format_seconds(L)})"
@@ -305,7 +310,8 @@ def _tune_amigo(model, f):
                 raise DesignError(f"amigo: the step reaches 63 % (t = {format_seconds(tg.t63_s)}) before the tangent's L "
                                   f"= {format_seconds(L)}: no FOTD model for the rule")
             steps = tuple(tg.steps()[:2]) + (
-                f"t63 = {format_seconds(tg.t63_s)} (63.2 % of K), T = t63 - L = {format_seconds(tg.t63_s)} - {format_seconds(L)} = {format_seconds(T)}",)
+                Message(N_("t63 = {t63} (63.2 % of K), T = t63 - L = {t63} - {l} = {t}"), t63=format_seconds(tg.t63_s),
+                        l=format_seconds(L), t=format_seconds(T)),)
             used = ModelUsed(ModelFopdt(K, T, L), TANGENT_T63, steps)
     if L <= 0:
         raise _no_L("amigo", "Kp = 0.45/(Kv L)" if T is None else "Kp = (0.2 + 0.45 T/L)/K")
@@ -314,7 +320,7 @@ def _tune_amigo(model, f):
         kp, ti, td = 0.45 / (K * L), 8.0 * L, 0.5 * L
         formulas = [f"Kp = 0.45/(Kv L) = 0.45 / ({format_eng(K, '/s')} x {format_seconds(L)}) = {format_number(kp)}",
                     f"Ti = 8 L = 8 x {format_seconds(L)} = {format_seconds(ti)}", f"Td = 0.5 L = 0.5 x {format_seconds(L)} = {format_seconds(td)}"]
-        notes.append("amigo: the integrating-process form (the T -> infinity limit of the FOTD rule)")
+        notes.append(N_("amigo: the integrating-process form (the T -> infinity limit of the FOTD rule)"))
     else:
         kp = (0.2 + 0.45 * T / L) / K
         ti = L * (0.4 * L + 0.8 * T) / (L + 0.1 * T)
@@ -334,12 +340,13 @@ def _simc_model(model):
     m2 = hr2.model
     tau2 = m2.tau2_s if isinstance(m2, ModelSopdt) else m2.tau_s
     if tau2 > m2.theta_s:
-        why = (f"simc: the half rule's second-order model has tau2 = {format_seconds(tau2)} > theta = {format_seconds(m2.theta_s)}, "
-               "so derivative action pays (Skogestad 2003): PID on it")
+        why = Message(N_("simc: the half rule's second-order model has tau2 = {tau2} > theta = {theta}, so derivative "
+                         "action pays (Skogestad 2003): PID on it"), tau2=format_seconds(tau2),
+                      theta=format_seconds(m2.theta_s))
         return ModelUsed(m2, HALF_RULE, hr2.steps), [why]
     hr1 = half_rule_of(model, 1, "simc")
-    why = (f"simc: the half rule's second-order model has tau2 = {format_seconds(tau2)} <= theta = {format_seconds(m2.theta_s)}: "
-           "PI on the first-order model (Skogestad 2003)")
+    why = Message(N_("simc: the half rule's second-order model has tau2 = {tau2} <= theta = {theta}: PI on the "
+                     "first-order model (Skogestad 2003)"), tau2=format_seconds(tau2), theta=format_seconds(m2.theta_s))
     return ModelUsed(hr1.model, HALF_RULE, hr1.steps), [why]
 
 
@@ -353,10 +360,11 @@ def _tune_simc(model, f, tauc_s):
                               "theta)) divides by zero; give tauc_s (the closed-loop time constant wanted), "
                               "or use imc", param="tauc_s")
         tc = theta
-        tc_line = f"tauc = theta = {format_seconds(tc)} (Skogestad's default: tight control, good robustness)"
+        tc_line = Message(N_("tauc = theta = {tc} (Skogestad's default: tight control, good robustness)"),
+                          tc=format_seconds(tc))
     else:
         tc = check_number("simc", "tauc_s", tauc_s, positive=True)
-        tc_line = f"tauc = {format_seconds(tc)} (given)"
+        tc_line = Message(N_("tauc = {tc} (given)"), tc=format_seconds(tc))
     s = tc + theta
     formulas = [tc_line]
     if isinstance(m, ModelIntegrating):
@@ -365,7 +373,7 @@ def _tune_simc(model, f, tauc_s):
         formulas += [f"Kc = 1/(K' (tauc + theta)) = 1 / ({format_eng(m.K, '/s')} x ({format_seconds(tc)} + {format_seconds(theta)})) "
                      f"= {format_number(kc)}",
                      f"tauI = 4 (tauc + theta) = 4 x ({format_seconds(tc)} + {format_seconds(theta)}) = {format_seconds(tau_i)}"]
-        formulas.append(f"tauD = tau = {format_seconds(tau_d)}" if tau_d > 0 else "tauD = 0 (a PI)")
+        formulas.append(f"tauD = tau = {format_seconds(tau_d)}" if tau_d > 0 else N_("tauD = 0 (a PI)"))
     else:
         tau1 = m.tau1_s if isinstance(m, ModelSopdt) else m.tau_s
         tau_d = m.tau2_s if isinstance(m, ModelSopdt) else 0.0
@@ -374,7 +382,7 @@ def _tune_simc(model, f, tauc_s):
         formulas += [f"Kc = {t1}/(K (tauc + theta)) = {format_seconds(tau1)} / ({format_number(m.K)} x ({format_seconds(tc)} + {format_seconds(theta)})) "
                      f"= {format_number(kc)}",
                      f"tauI = min({t1}, 4 (tauc + theta)) = min({format_seconds(tau1)}, {format_seconds(4.0 * s)}) = {format_seconds(tau_i)}"]
-        formulas.append(f"tauD = tau2 = {format_seconds(tau_d)}" if isinstance(m, ModelSopdt) else "tauD = 0 (a PI)")
+        formulas.append(f"tauD = tau2 = {format_seconds(tau_d)}" if isinstance(m, ModelSopdt) else N_("tauD = 0 (a PI)"))
     kp, ti, td = series_to_parallel(kc, tau_i, tau_d)
     notes += _oscillation_notes("simc", None, f)
     return RuleTuning("simc", kp, ti, td, used, formulas, notes, (kc, tau_i, tau_d),
@@ -394,11 +402,11 @@ def _tune_imc(model, f, lambda_s):
     K, tau, theta = m.K, m.tau_s, m.theta_s
     if lambda_s is None:
         lam = max(0.25 * theta, 0.2 * tau)
-        lam_line = (f"lambda = max(0.25 theta, 0.2 tau) = max({format_seconds(0.25 * theta)}, {format_seconds(0.2 * tau)}) = {format_seconds(lam)} "
-                    "(default)")
+        lam_line = Message(N_("lambda = max(0.25 theta, 0.2 tau) = max({a}, {b}) = {lam} (default)"),
+                           a=format_seconds(0.25 * theta), b=format_seconds(0.2 * tau), lam=format_seconds(lam))
     else:
         lam = check_number("imc", "lambda_s", lambda_s, positive=True)
-        lam_line = f"lambda = {format_seconds(lam)} (given)"
+        lam_line = Message(N_("lambda = {lam} (given)"), lam=format_seconds(lam))
     kp = (2.0 * tau + theta) / (2.0 * K * (lam + theta))
     ti = tau + theta / 2.0
     td = tau * theta / (2.0 * tau + theta)
@@ -411,13 +419,14 @@ def _tune_imc(model, f, lambda_s):
     notes = _oscillation_notes("imc", None, f)
     if theta > 0:
         tf_ = lam * theta / (2.0 * (lam + theta))
-        notes.append(f"imc: the rule's PID comes with a filter 1/(tauF s + 1), tauF = lambda theta/(2 (lambda + "
-                     f"theta)) = {format_seconds(tf_)}, not part of Kp, Ti, Td")
+        notes.append(Message(N_("imc: the rule's PID comes with a filter 1/(tauF s + 1), tauF = lambda theta/(2 "
+                                "(lambda + theta)) = {tf}, not part of Kp, Ti, Td"), tf=format_seconds(tf_)))
         if lam < 0.25 * theta:
-            notes.append(f"imc: lambda = {format_seconds(lam)} is below 0.25 theta = {format_seconds(0.25 * theta)}, the table's bound "
-                         "for this PID: expect a poorly damped loop")
+            notes.append(Message(N_("imc: lambda = {lam} is below 0.25 theta = {bound}, the table's bound for this PID: "
+                                    "expect a poorly damped loop"), lam=format_seconds(lam),
+                                 bound=format_seconds(0.25 * theta)))
     else:
-        notes.append("imc: theta = 0, so the PID is a PI (Td = 0) with Kp = tau/(K lambda), Ti = tau")
+        notes.append(N_("imc: theta = 0, so the PID is a PI (Td = 0) with Kp = tau/(K lambda), Ti = tau"))
     return RuleTuning("imc", kp, ti, td, used, formulas, notes, setting={"lambda_s": lam})
 
 
@@ -517,6 +526,6 @@ def all_rules(model, *, tauc_s: float | None = None, lambda_s: float | None = No
     for r in RULES:
         try:
             out.append(tune_model(model, r, tauc_s=tauc_s, lambda_s=lambda_s))
-        except DesignError as e:
-            out.append((r, str(e)))
+        except DesignError as e:   # its message as raised: a Message reads in the sheet's language
+            out.append((r, e.args[0] if e.args and isinstance(e.args[0], str) else str(e)))
     return out

@@ -30,6 +30,7 @@ import numpy as np
 
 from ..core import eseries
 from ..core.errors import DesignError
+from ..core.i18n import N_, Message
 from .blocks import F_DIFFERENTIATOR_RATIO, F_INTEGRATOR_RATIO, PidParts, check_targets, unity_resistor
 
 __all__ = ["R_CORNER_MAX", "brute_force", "objective", "select_parts"]
@@ -224,8 +225,9 @@ def select_parts(kp: float, ti_s: float, td_s: float, fn_hz: float, *,
         errs["td"] = (parts.td_s / td_s - 1) * 100
     sel = Selection(parts, targets, errs, best * 100, r_series, c_series, ncand, tol=tol)
     if best > tol:
-        sel.notes.append(f"{r_series}/{c_series} within the bounds cannot hit all of Kp, Ti, Td within "
-                         f"{tol * 100:g} %; the best possible worst error is {best * 100:.3g} %")
+        sel.notes.append(Message(N_("{r_series}/{c_series} within the bounds cannot hit all of Kp, Ti, Td within "
+                                    "{tol} %; the best possible worst error is {best} %"), r_series=r_series,
+                                 c_series=c_series, tol=f"{tol * 100:g}", best=f"{best * 100:.3g}"))
     return sel
 
 

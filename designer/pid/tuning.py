@@ -39,6 +39,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..core.errors import DesignError
+from ..core.i18n import N_, Message
 from ..core.stepfit import fit_step, model_step
 from ..core.waveform import inflection_tangent, normalised_step
 
@@ -49,7 +50,7 @@ RULES = ("zn", "cohen-coon", "chr0", "chr20", "amigo", "simc")
 RULE_MODEL = {"zn": "tangent", "cohen-coon": "least-squares", "chr0": "least-squares",
               "chr20": "least-squares", "amigo": "least-squares", "simc": "least-squares"}
 #: how the build sheet names each model source
-MODEL_NAMES = {"tangent": "ZN tangent", "least-squares": "least-squares FOPDT"}
+MODEL_NAMES = {"tangent": N_("ZN tangent"), "least-squares": N_("least-squares FOPDT")}
 
 
 @dataclass(frozen=True)
@@ -72,8 +73,8 @@ class Fopdt:
     def describe(self) -> str:
         """``"least-squares FOPDT: K 1.02, L 34.8 us, T 17.5 us"``."""
         from ..core.units import format_eng
-        return (f"{MODEL_NAMES.get(self.source, self.source)}: K {self.K:.4g}, L {format_eng(self.L_s, 's')}, "
-                f"T {format_eng(self.T_s, 's')}")
+        return Message("{name}: K {k}, L {l}, T {t}", name=Message(MODEL_NAMES.get(self.source, self.source)),
+                       k=f"{self.K:.4g}", l=format_eng(self.L_s, 's'), t=format_eng(self.T_s, 's'))
 
     def step(self, t) -> np.ndarray:
         """The model's response to a unit step at t = 0: K (1 - e^(-(t - L)/T)) from t = L."""
@@ -248,19 +249,20 @@ def _rule_notes(rule: str, curve: ReactionCurve | None, model: Fopdt) -> list:
     notes = []
     r = model.L_s / model.T_s
     if curve is not None and curve.overshoot_pct > 2.0:
-        notes.append(
-            f"{rule}: the plant's own step response overshoots {curve.overshoot_pct:.1f} %; "
-            "reaction-curve rules assume an S-shaped, non-oscillatory plant, so the loop will be "
-            "more oscillatory than the rule intends (check the closed-loop figures)")
+        notes.append(Message(N_("{rule}: the plant's own step response overshoots {os} %; reaction-curve rules "
+                                "assume an S-shaped, non-oscillatory plant, so the loop will be more oscillatory "
+                                "than the rule intends (check the closed-loop figures)"),
+                             rule=rule, os=f"{curve.overshoot_pct:.1f}"))
     if rule in ("zn", "chr0", "chr20") and not 0.1 <= r <= 1.0:
-        notes.append(f"{rule}: L/T = {r:.3g} is outside 0.1..1 where the rule was derived")
+        notes.append(Message(N_("{rule}: L/T = {r} is outside 0.1..1 where the rule was derived"), rule=rule,
+                             r=f"{r:.3g}"))
     if rule == "cohen-coon" and not 0.1 <= r <= 1.0:
-        notes.append(f"cohen-coon: L/T = {r:.3g} is outside 0.1..1 where the rule is reliable")
+        notes.append(Message(N_("cohen-coon: L/T = {r} is outside 0.1..1 where the rule is reliable"), r=f"{r:.3g}"))
     if model.source == "least-squares":
-        notes.append(f"{rule}: applied to the {model.describe()} of the plant's step (the rule's model), "
-                     "not to the ZN tangent")
+        notes.append(Message(N_("{rule}: applied to the {model} of the plant's step (the rule's model), not to the ZN "
+                                "tangent"), rule=rule, model=model.describe()))
     if rule == "simc":
-        notes.append("simc: for an FOPDT model SIMC is a PI controller (Td = 0), tuned with tau_c = L")
+        notes.append(N_("simc: for an FOPDT model SIMC is a PI controller (Td = 0), tuned with tau_c = L"))
     return notes
 
 

@@ -27,6 +27,7 @@ import numpy as np
 from ..core import opamps
 from ..core.checks import SPICE_AGREEMENT, Check
 from ..core.errors import DesignError
+from ..core.i18n import N_, Message
 from ..core.jsonio import json_safe
 from ..core.lti import dense_time, response_span, step_response
 from ..core.metrics import step_metrics
@@ -242,9 +243,10 @@ def _spice(netlist, amp, fn_hz: float, topo, values: dict, simulator: str) -> tu
     db = float(np.max(np.abs(20 * np.log10(np.abs(ratio)))))
     deg = float(np.max(np.abs(np.degrees(np.angle(ratio)))))
     ok = db <= SPICE_DB and deg <= SPICE_DEG
-    detail = (f"SPICE .ac against the op-amp-aware model, fn/30 .. 30 fn: {db:.3g} dB, {deg:.3g} deg "
-              f"(allowed {SPICE_DB:g} dB, {SPICE_DEG:g} deg)")
-    return {"simulator": simulator, "max_db": db, "max_deg": deg, "pass": ok}, Check(SPICE_AGREEMENT, ok, detail)
+    check = Check.of(SPICE_AGREEMENT, ok, N_("SPICE .ac against the op-amp-aware model, fn/30 .. 30 fn: {db} dB, "
+                                            "{deg} deg (allowed {db_max} dB, {deg_max} deg)"),
+                     db=f"{db:.3g}", deg=f"{deg:.3g}", db_max=f"{SPICE_DB:g}", deg_max=f"{SPICE_DEG:g}")
+    return {"simulator": simulator, "max_db": db, "max_deg": deg, "pass": ok}, check
 
 
 def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-cli") -> CircuitPlantResult:
@@ -288,14 +290,16 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
     values = best.values
     ideal = topo.synthesize(dataclasses.replace(aim, c_f=values[topo.reference_capacitor]))
     labels, _, _, _ = part_series(values, spec.r_series, spec.c_series)
-    notes = [f"{topo.title}: parts {', '.join(f'{p.ref} ({p.role})' for p in topo.parts)}"]
+    notes = [Message(N_("{section}: parts {parts}"), section=Message(topo.title),
+                     parts=Message.joined(", ", (Message(N_("{ref} ({role})"), ref=p.ref, role=Message(p.role))
+                                                        for p in topo.parts)))]
     if spec.compensate_gbw:
-        notes.append(f"--compensate-gbw: designed for fn {aim.fn_hz:.5g} Hz"
-                     + (f", Q {aim.q:.4g}" if aim.q else "")
-                     + f" so that with the {amp.name}'s {format_eng(amp.gbw_hz, 'Hz')} GBW it lands on the spec")
+        notes.append(Message(N_("--compensate-gbw: designed for fn {fn} Hz{q} so that with the {opamp}'s {gbw} GBW it "
+                                "lands on the spec"), fn=f"{aim.fn_hz:.5g}", q=f", Q {aim.q:.4g}" if aim.q else "",
+                             opamp=amp.name, gbw=format_eng(amp.gbw_hz, 'Hz')))
     if math.isfinite(best.worst) and best.worst > 0.005:
-        notes.append(f"the best parts land {100 * best.worst:.3g} % off the target; a finer series or wider "
-                     "bounds may come closer")
+        notes.append(Message(N_("the best parts land {pct} % off the target; a finer series or wider bounds may come "
+                                "closer"), pct=f"{100 * best.worst:.3g}"))
     result = _analyse(topo, "design", target, values, ideal, ranked, Sourcing(spec.r_series, spec.c_series, labels),
                       amp, notes, spec.package, simulate, simulator)
     result.timings = {"search_s": t_search, **result.timings}
@@ -354,8 +358,8 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
     labels, r_s, c_s, why = part_series(parsed, *series)
     gain = float(topo.figures(parsed).gain)
     fig = topo.figures(parsed)
-    notes = [f"these parts give fn = {fig.fn_hz:.5g} Hz" + ("" if fig.q is None else f", Q = {fig.q:.4g}")
-             + f", gain {gain:.4g}", *why]
+    notes = [Message(N_("these parts give fn = {fn} Hz{q}, gain {gain}"), fn=f"{fig.fn_hz:.5g}",
+                     q="" if fig.q is None else f", Q = {fig.q:.4g}", gain=f"{gain:.4g}"), *why]
     return _analyse(topo, "analyze", Target(fc, zeta, gain), parsed, None, [], Sourcing(r_s, c_s, labels), amp,
                     notes, package, simulate, simulator)
 
@@ -378,7 +382,7 @@ def _analyse(topo, mode: str, target: Target, values: dict, ideal, ranked: list,
         checks.append(check)
         timings["simulation_s"] = time.perf_counter() - tick
     else:
-        notes.append("SPICE simulation skipped (--no-sim): the figures are analytic only")
+        notes.append(N_("SPICE simulation skipped (--no-sim): the figures are analytic only"))
     return CircuitPlantResult(topo.name, mode, target, values, ideal, ranked, sourcing, amp, figures, steps,
                               sensitivity, netlist, deck, checks, notes, run, package, timings=timings)
 

@@ -8,6 +8,8 @@ declared parts and the alternatives; rendered as the result is (nothing recomput
 
 from __future__ import annotations
 
+from ..core.i18n import N_, translated
+from ..core.i18n import gettext as _
 from ..core.units import format_eng
 from ..report import document as R
 from ..report.bundle import bundle_paths, write_bundle
@@ -18,7 +20,9 @@ from ..spice.deck import board
 __all__ = ["title_of", "sections", "bom", "summary_text", "write_outputs"]
 
 #: what the section's end nets are called on the sheet
-NET_LABELS = {"vin": "generator (CH1)", "vout": "output (CH2)", "0": "ground"}
+#: the bill of materials' columns as the sheet heads them
+BOM_SHOWN = (N_("Ref"), N_("Value"), N_("Code"), N_("Qty"), N_("Series"), N_("Tol."), N_("Package"), N_("Role"))
+NET_LABELS = {"vin": N_("generator (CH1)"), "vout": N_("output (CH2)"), "0": N_("ground")}
 
 
 def title_of(result) -> str:
@@ -38,9 +42,11 @@ def title_of(result) -> str:
     if result.mode == "analyze":
         f = result.figures["ideal"]
         zeta = "" if f["zeta"] is None else f", zeta {f['zeta']:.4g}"
-        return f"{result.section.title} plant as built: fn {f['fn_hz']:.5g} Hz{zeta}, gain {f['gain']:.4g}"
+        return _("{section} plant as built: fn {fn} Hz{zeta}, gain {gain}").format(
+            section=_(result.section.title), fn=f"{f['fn_hz']:.5g}", zeta=zeta, gain=f"{f['gain']:.4g}")
     zeta = "" if t.zeta is None else f", zeta {t.zeta:g}"
-    return f"{result.section.title} plant: fc {t.fc_hz:g} Hz{zeta}, gain {t.gain:g}"
+    return _("{section} plant: fc {fc} Hz{zeta}, gain {gain}").format(
+        section=_(result.section.title), fc=f"{t.fc_hz:g}", zeta=zeta, gain=f"{t.gain:g}")
 
 
 def bom(result) -> list:
@@ -77,14 +83,15 @@ def _targets(result) -> list:
     t, fi, fo = result.target, result.figures["ideal"], result.figures["opamp"]
     rows = [["fn", _f(t.fc_hz, "Hz"), _f(fi["fn_hz"], "Hz"), _f(fo["fn_hz"], "Hz")],
             ["zeta", _n(t.zeta), _n(fi["zeta"]), _n(fo["zeta"])],
-            ["gain", _n(t.gain), _n(fi["gain"]), ""],
+            [_("gain"), _n(t.gain), _n(fi["gain"]), ""],
             ["-3 dB", "", ", ".join(_f(f, "Hz") for f in fi["f3db_hz"]),
              ", ".join(_f(f, "Hz") for f in fo["f3db_hz"])]]
-    out = [R.table(["figure", "target", "ideal op-amp", result.opamp.name], rows)]
+    out = [R.table([_("figure"), _("target"), _("ideal op-amp"), result.opamp.name], rows)]
     step = result.steps["opamp"]
     if step is not None:
-        out.append(R.text(f"step ({result.opamp.name}): overshoot {step['overshoot_pct']:.3g} %, peak time "
-                          f"{_f(step['peak_time_s'], 's')}, 2 % settling {_f(step['settling_time_s'], 's')}"))
+        out.append(R.text(_("step ({opamp}): overshoot {os} %, peak time {tp}, 2 % settling {ts}").format(
+            opamp=result.opamp.name, os=f"{step['overshoot_pct']:.3g}", tp=_f(step['peak_time_s'], 's'),
+            ts=_f(step['settling_time_s'], 's'))))
     return out
 
 
@@ -102,25 +109,26 @@ def sections(result) -> list:
         The sections.
     """
     b = board(result.netlist, result.opamp, result.package)
-    out = [("Build", [R.table(["Ref", "Value", "Code", "Qty", "Series", "Tol.", "Package", "Role"], bom(result))]),
-           ("Wiring", [R.table(["part", "code", "from", "to"],
-                               wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee)))]),
-           ("Target and achieved", _targets(result)),
-           ("Checks", [R.table(["check", "result", "detail"],
-                               [[c.title, "ok" if c.ok else "FAILED", c.detail] for c in result.checks])]),
-           ("Sensitivity", [R.table(["part", "S wn (ideal)", "S zeta (ideal)", "S wn (op-amp)", "S zeta (op-amp)"],
+    out = [(_("Build"), [R.table([_(h) for h in BOM_SHOWN], [[*r[:6], _(r[6]), r[7]] for r in bom(result)])]),
+           (_("Wiring"), [R.table([_("part"), _("code"), _("from"), _("to")],
+                                  wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee)))]),
+           (_("Target and achieved"), _targets(result)),
+           (_("Checks"), [R.table([_("check"), _("result"), _("detail")],
+                                  [[_(c.title), _("ok") if c.ok else _("FAILED"), c.shown()] for c in result.checks])]),
+           (_("Sensitivity"), [R.table([_("part"), _("S wn (ideal)"), _("S zeta (ideal)"), _("S wn (op-amp)"),
+                                        _("S zeta (op-amp)")],
                                     [[ref, _n(s["wn"]), _n(s["zeta"]), _n(result.sensitivity["opamp"][ref]["wn"]),
                                       _n(result.sensitivity["opamp"][ref]["zeta"])]
                                      for ref, s in result.sensitivity["ideal"].items()])])]
     if len(result.alternatives) > 1:
         refs = result.section.designators
-        out.append(("Alternatives (best first)",
-                    [R.table([*refs, "fn", "zeta", "gain", "worst error"],
+        out.append((_("Alternatives (best first)"),
+                    [R.table([*refs, "fn", "zeta", _("gain"), _("worst error")],
                              [[*(format_eng(c.values[r], "Ohm" if r[0] == "R" else "F", 3) for r in refs),
                                _f(c.fn_hz, "Hz"), _n(c.zeta), _n(c.gain), f"{100 * c.worst:.3g} %"]
                               for c in result.alternatives])]))
     if result.notes:
-        out.append(("Notes", [R.text(n) for n in result.notes]))
+        out.append((_("Notes"), [R.text(translated(n)) for n in result.notes]))
     return out
 
 

@@ -333,14 +333,16 @@ def step_png(result) -> bytes:
     curves = {}
     if result.spice is not None:
         curves["SPICE (ngspice)"] = result.spice.response
-    curves[f"analytic ({amp} model)"] = real.response
-    curves["analytic (ideal op-amp)"] = ideal.response
+    curves[_("analytic ({opamp} model)").format(opamp=amp)] = real.response
+    curves[N_("analytic (ideal op-amp)")] = ideal.response
     tol = result.tolerance
     band = None if tol.t_s is None else (tol.t_s, tol.lo * a, tol.hi * a,
-                                         f"tolerance band (R {tol.r_tolerance_pct:g} %, C {tol.c_tolerance_pct:g} %)")
-    resid = None if result.spice is None else (f"residual: SPICE minus the {amp} model",
+                                         _("tolerance band (R {r} %, C {c} %)").format(
+                                             r=f"{tol.r_tolerance_pct:g}", c=f"{tol.c_tolerance_pct:g}"))
+    resid = None if result.spice is None else (_("residual: SPICE minus the {opamp} model").format(opamp=amp),
                                                result.spice.response, real.response)
-    return step_plot(result.time_s, curves, f"Step response, 0 -> {a:g} V", residual=resid, band=band)
+    return step_plot(result.time_s, curves, _("Step response, 0 -> {v} V").format(v=f"{a:g}"), residual=resid,
+                     band=band)
 
 
 def prbs_png(result) -> bytes:
@@ -350,14 +352,16 @@ def prbs_png(result) -> bytes:
     c, p = run.capture, run.plan
     last = c.time_s >= (p.periods - 1) * p.period_s
     t = c.time_s[last]
-    out = "SPICE (ngspice)" if run.simulator is not None else f"analytic ({result.opamp.name} model)"
-    curves = {out: c.output_v[last], "generator (CH1)": c.input_v[last]}
+    model = _("analytic ({opamp} model)").format(opamp=result.opamp.name)
+    out = "SPICE (ngspice)" if run.simulator is not None else model
+    curves = {out: c.output_v[last], N_("generator (CH1)"): c.input_v[last]}
     if run.simulator is not None:
-        curves[f"analytic ({result.opamp.name} model)"] = c.analytic_opamp_v[last]
-    resid = None if run.simulator is None else (f"residual: SPICE minus the {result.opamp.name} model",
-                                                c.output_v[last], c.analytic_opamp_v[last])
-    return step_plot(t, curves, f"PRBS of {p.bits} bits at {format_eng(p.clock_hz, 'Hz')}: its last period",
-                     ylabel="voltage (V)", residual=resid, xlabel="time from the start of the sequence")
+        curves[model] = c.analytic_opamp_v[last]
+    resid = None if run.simulator is None else (_("residual: SPICE minus the {opamp} model").format(
+        opamp=result.opamp.name), c.output_v[last], c.analytic_opamp_v[last])
+    return step_plot(t, curves, _("PRBS of {bits} bits at {clock}: its last period").format(
+                         bits=p.bits, clock=format_eng(p.clock_hz, 'Hz')),
+                     ylabel=N_("voltage (V)"), residual=resid, xlabel=N_("time from the start of the sequence"))
 
 
 def bode_png(result) -> bytes:
@@ -381,14 +385,15 @@ def bode_png(result) -> bytes:
     if sine is not None:
         if sine.h_spice is not None:
             measured["SPICE .ac"] = (sine.spice_f_hz, sine.h_spice)
-        marks += [(sine.f_peak_hz, sine.peak_gain, "peak", "kv"), (sine.f_3db_hz,
+        marks += [(sine.f_peak_hz, sine.peak_gain, N_("peak"), "kv"), (sine.f_3db_hz,
                   None if sine.f_3db_hz is None else sine.dc_gain / math.sqrt(2), "-3 dB", "ks")]
         if sine.spice_f_peak_hz is not None:
             marks.append((sine.spice_f_peak_hz, sine.spice_peak_gain, "", "rv"))
         if sine.spice_f_3db_hz is not None:
             marks.append((sine.spice_f_3db_hz, sine.dc_gain / math.sqrt(2), "", "rs"))
-    return bode_plot({"ideal op-amp": (ideal.num, ideal.den), f"{amp} model": (real.num, real.den)},
-                     fn / 100, fn * 100, "Plant frequency response", measured, marks)
+    return bode_plot({N_("ideal op-amp"): (ideal.num, ideal.den),
+                      _("{opamp} model").format(opamp=amp): (real.num, real.den)},
+                     fn / 100, fn * 100, N_("Plant frequency response"), measured, marks)
 
 
 def waveforms_csv(result) -> str:

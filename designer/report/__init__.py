@@ -8,7 +8,8 @@ from ..core.exports import lazy_exports
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "bundle": ("draw_early", "schematic_pictures", "write_design"),
     "document": ("columns", "fmt_pct", "fmt_time", "image", "subhead", "table", "text", "to_html", "to_text"),
-    "plots": ("bode_plot", "decimate", "histogram_plot", "loop_gain_plot", "png_bytes", "step_plot", "time_unit"),
+    "plots": ("bode_plot", "decimate", "histogram_plot", "localise_figure", "loop_gain_plot", "png_bytes", "step_plot",
+              "time_unit"),
     "render": ("ahead", "running", "start", "stop", "submit", "submit_many"),
     "schematic": ("Sheet", "check_connectivity"),
     "tolerance": ("csv_texts", "histogram_plots", "section", "title"),

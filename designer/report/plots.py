@@ -9,6 +9,11 @@ panel under it (SPICE minus model: the two overlap to the pixel otherwise)
 and the parts' tolerance band shaded; the Bode plot marks the resonance peak
 and the -3 dB point, measured in SPICE's ``.ac`` run beside the model's; the
 loop-gain plot marks the gain and phase margins.
+
+Every plot speaks the sheet's language (:mod:`designer.core.i18n`): its axis labels, legends, titles and marks
+through the catalogue (a caller's label too, when it is one of its messages), and, outside English, its numbers
+with the language's decimal symbol: the tick labels through :class:`_LocalisedFormatter` (an explicit formatter,
+never the machine's locale) and every text through :func:`designer.core.i18n.localise` (:func:`png_bytes`).
 """
 
 from __future__ import annotations
@@ -18,8 +23,11 @@ import math
 
 import numpy as np
 
-__all__ = ["bode_plot", "decimate", "figure", "histogram_plot", "loop_gain_plot", "png_bytes", "step_plot",
-           "time_unit"]
+from ..core.i18n import N_, current, localise
+from ..core.i18n import gettext as _
+
+__all__ = ["bode_plot", "decimate", "figure", "histogram_plot", "localise_figure", "loop_gain_plot", "png_bytes",
+           "step_plot", "time_unit"]
 
 #: the most points a curve is drawn with
 MAX_POINTS = 1500
@@ -108,12 +116,77 @@ def png_bytes(fig, dpi: int = 110, tight: bool = True) -> bytes:
     bytes
         The PNG.
     """
+    localise_figure(fig)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight" if tight else None)
     import sys
     if "matplotlib.pyplot" in sys.modules:
         sys.modules["matplotlib.pyplot"].close(fig)
     return buf.getvalue()
+
+
+def localise_figure(fig) -> None:
+    """Outside English, the numbers of ``fig`` as the current language writes them: each axis' tick labels
+    (its formatters wrapped in :class:`_LocalisedFormatter`) and every other text (titles, labels, legends,
+    marks) through :func:`~designer.core.i18n.localise`; an English figure is left as it is.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure, drawn but not yet saved.
+
+    Returns
+    -------
+    None
+    """
+    if current() == "en":
+        return
+    from matplotlib.text import Text
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            for get, put in ((axis.get_major_formatter, axis.set_major_formatter),
+                             (axis.get_minor_formatter, axis.set_minor_formatter)):
+                inner = get()
+                if not isinstance(inner, _formatter_class()):
+                    put(_formatter_class()(inner))
+    for t in fig.findobj(Text):
+        t.set_text(localise(t.get_text()))
+
+
+def _formatter_class():
+    """:class:`_LocalisedFormatter`, made when first needed (matplotlib is imported only when a plot is drawn)."""
+    global _LocalisedFormatter
+    if _LocalisedFormatter is None:
+        from matplotlib.ticker import Formatter
+
+        class _LocalisedFormatter(Formatter):   # noqa: F811
+            """A tick formatter that writes ``inner``'s labels in the current language (the decimal symbol)."""
+
+            def __init__(self, inner):
+                self.inner = inner
+
+            def set_axis(self, axis):
+                super().set_axis(axis)
+                self.inner.set_axis(axis)
+
+            def set_locs(self, locs):
+                self.locs = locs
+                self.inner.set_locs(locs)
+
+            def __call__(self, x, pos=None):
+                return localise(self.inner(x, pos))
+
+            def format_ticks(self, values):
+                return [localise(v) for v in self.inner.format_ticks(values)]
+
+            def get_offset(self):
+                return localise(self.inner.get_offset())
+
+    return _LocalisedFormatter
+
+
+#: the tick formatter of a non-English figure (a matplotlib ``Formatter``; made by :func:`_formatter_class`)
+_LocalisedFormatter = None
 
 
 def time_unit(span_s: float) -> tuple:
@@ -135,8 +208,8 @@ def time_unit(span_s: float) -> tuple:
     return (1e3, "ms") if span_s < 100 else (1.0, "s")
 
 
-def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)", residual: tuple | None = None,
-              band: tuple | None = None, xlabel: str = "time after the step") -> bytes:
+def step_plot(t, curves: dict, title: str, ylabel: str = N_("output (V)"), residual: tuple | None = None,
+              band: tuple | None = None, xlabel: str = N_("time after the step")) -> bytes:
     """Overlaid step responses; ``curves`` maps a label to an array on ``t``.
 
     ``residual``: (label, measured, model) drawn as measured - model in a panel
@@ -174,15 +247,15 @@ def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)", residual:
     if band is not None:
         bt, lo, hi, label = band
         bt, lo, hi = decimate(bt, lo, hi)
-        ax.fill_between(np.asarray(bt) * scale, lo, hi, color="#f4c27a", alpha=0.45, lw=0, label=label)
+        ax.fill_between(np.asarray(bt) * scale, lo, hi, color="#f4c27a", alpha=0.45, lw=0, label=_(label))
     styles = ["-", "--", ":", "-."]
     widths = [2.6, 1.4, 1.4, 1.2]
     for i, (label, y) in enumerate(curves.items()):
         if y is not None:
             x, yy = decimate(tus, y)
-            ax.plot(x, yy, styles[i % 4], label=label, lw=widths[i % 4])
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=10)
+            ax.plot(x, yy, styles[i % 4], label=_(label), lw=widths[i % 4])
+    ax.set_ylabel(_(ylabel))
+    ax.set_title(_(title), fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     last = ax
@@ -192,10 +265,10 @@ def step_plot(t, curves: dict, title: str, ylabel: str = "output (V)", residual:
         ar.plot(x, r * 1e3, color="C2", lw=1.1)
         ar.axhline(0, color="k", lw=0.6)
         ar.set_ylabel("mV", fontsize=8)
-        ar.set_title(label, fontsize=8, loc="left")
+        ar.set_title(_(label), fontsize=8, loc="left")
         ar.grid(True, alpha=0.3)
         last = ar
-    last.set_xlabel(f"{xlabel} ({unit})")
+    last.set_xlabel(f"{_(xlabel)} ({unit})")
     return png_bytes(fig, dpi=100, tight=False)
 
 
@@ -228,23 +301,23 @@ def bode_plot(systems: dict, f_lo: float, f_hi: float, title: str, measured: dic
     fig, (a1, a2) = figure(7.5, 4.6, 2, 1, sharex=True)
     for i, (label, (num, den)) in enumerate(systems.items()):
         h = freq_response(num, den, f)
-        a1.plot(f, 20 * np.log10(np.abs(h)), ["-", "--", ":"][i % 3], label=label)
-        a2.plot(f, np.degrees(np.unwrap(np.angle(h))), ["-", "--", ":"][i % 3], label=label)
+        a1.plot(f, 20 * np.log10(np.abs(h)), ["-", "--", ":"][i % 3], label=_(label))
+        a2.plot(f, np.degrees(np.unwrap(np.angle(h))), ["-", "--", ":"][i % 3], label=_(label))
     for label, (fm, hm) in (measured or {}).items():
         fm, hm = decimate(fm, hm, n=120)
-        a1.plot(fm, 20 * np.log10(np.abs(hm)), "o", ms=2.5, mfc="none", color="C3", label=label)
-        a2.plot(fm, np.degrees(np.unwrap(np.angle(hm))), "o", ms=2.5, mfc="none", color="C3", label=label)
+        a1.plot(fm, 20 * np.log10(np.abs(hm)), "o", ms=2.5, mfc="none", color="C3", label=_(label))
+        a2.plot(fm, np.degrees(np.unwrap(np.angle(hm))), "o", ms=2.5, mfc="none", color="C3", label=_(label))
     for fx, g, txt, style in markers or []:
         if fx is None or g is None:
             continue
         a1.plot([fx], [20 * math.log10(g)], style, ms=7, mfc="none", mew=1.5)
-        a1.annotate(txt, (fx, 20 * math.log10(g)), textcoords="offset points", xytext=(6, 4), fontsize=7.5)
+        a1.annotate(_(txt), (fx, 20 * math.log10(g)), textcoords="offset points", xytext=(6, 4), fontsize=7.5)
         a2.axvline(fx, color="0.5", lw=0.6, ls=":")
     log_frequency_axis(a2)   # sharex: one axis for both
-    a1.set_ylabel("gain (dB)")
-    a2.set_ylabel("phase (deg)")
-    a2.set_xlabel("frequency (Hz)")
-    a1.set_title(title, fontsize=10)
+    a1.set_ylabel(_("gain (dB)"))
+    a2.set_ylabel(_("phase (deg)"))
+    a2.set_xlabel(_("frequency (Hz)"))
+    a1.set_title(_(title), fontsize=10)
     for a in (a1, a2):
         a.grid(True, which="both", alpha=0.3)
     a1.legend(fontsize=7.5, loc="lower left")
@@ -296,7 +369,8 @@ def loop_gain_plot(f, L, title: str, crossover_hz: float, phase_margin_deg: floa
             ax.axvline(crossover_hz, color="r", lw=0.8, ls="--")
         a2.annotate("", xy=(crossover_hz, pc), xytext=(crossover_hz, ref),
                     arrowprops={"arrowstyle": "<->", "color": "r", "lw": 1.2})
-        a2.text(crossover_hz * 1.1, (pc + ref) / 2, f"PM {phase_margin_deg:.3g} deg", color="r", fontsize=8)
+        a2.text(crossover_hz * 1.1, (pc + ref) / 2, _("PM {pm} deg").format(pm=f"{phase_margin_deg:.3g}"), color="r",
+                fontsize=8)
     a2.axhline(ref, color="k", lw=0.6)
     if math.isfinite(phase_crossover_hz) and math.isfinite(gain_margin_db):
         g = float(np.interp(math.log(phase_crossover_hz), np.log(f), mag))
@@ -304,11 +378,12 @@ def loop_gain_plot(f, L, title: str, crossover_hz: float, phase_margin_deg: floa
             ax.axvline(phase_crossover_hz, color="m", lw=0.8, ls=":")
         a1.annotate("", xy=(phase_crossover_hz, g), xytext=(phase_crossover_hz, 0),
                     arrowprops={"arrowstyle": "<->", "color": "m", "lw": 1.2})
-        a1.text(phase_crossover_hz * 1.1, g / 2, f"GM {gain_margin_db:.3g} dB", color="m", fontsize=8)
-    a1.set_title(title, fontsize=10)
-    a1.set_ylabel("gain (dB)")
-    a2.set_ylabel("phase (deg)")
-    a2.set_xlabel("frequency (Hz)")
+        a1.text(phase_crossover_hz * 1.1, g / 2, _("GM {gm} dB").format(gm=f"{gain_margin_db:.3g}"), color="m",
+                fontsize=8)
+    a1.set_title(_(title), fontsize=10)
+    a1.set_ylabel(_("gain (dB)"))
+    a2.set_ylabel(_("phase (deg)"))
+    a2.set_xlabel(_("frequency (Hz)"))
     for ax in (a1, a2):
         ax.grid(True, which="both", alpha=0.3)
     return png_bytes(fig, dpi=100, tight=False)
@@ -359,16 +434,16 @@ def histogram_plot(values, name: str, nominal: float | None = None, lo: float | 
     fmt = (lambda x: format_eng(x, unit, 4)) if unit in ("Hz", "s") else (lambda x: f"{x:.4g}{' ' + unit if unit else ''}")
     for x, side in ((lo, "min"), (hi, "max")):
         if x is not None and math.isfinite(x):
-            ax.axvline(x, color="C3", lw=1.6, label=f"{side} {fmt(x)}")
+            ax.axvline(x, color="C3", lw=1.6, label=f"{_(side)} {fmt(x)}")
             ax.axvspan(*((left, x) if side == "min" else (x, right)), color="C3", alpha=0.08, lw=0)
     if nominal is not None and math.isfinite(nominal):
-        ax.axvline(nominal, color="k", lw=1.2, ls="--", label=f"nominal {fmt(nominal)}")
+        ax.axvline(nominal, color="k", lw=1.2, ls="--", label=_("nominal {value}").format(value=fmt(nominal)))
     ax.set_xlim(left, right)
     if unit in ("Hz", "s"):
         ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _pos: value_code(x) if x else "0"))
-    ax.set_xlabel(f"{name} ({unit})" if unit else name)
-    ax.set_ylabel("builds")
-    ax.set_title(title or f"{name} over {v.size} builds", fontsize=10)
+    ax.set_xlabel(f"{_(name)} ({unit})" if unit else _(name))
+    ax.set_ylabel(_("builds"))
+    ax.set_title(_(title) if title else _("{name} over {n} builds").format(name=_(name), n=v.size), fontsize=10)
     ax.grid(True, alpha=0.3)
     if ax.get_legend_handles_labels()[0]:   # nothing to name without a limit or a nominal
         ax.legend(fontsize=7.5)

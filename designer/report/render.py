@@ -26,6 +26,7 @@ import time
 from contextlib import contextmanager
 
 from ..core import lifetime
+from ..core.i18n import current, language
 from ..core.workers import Worker
 
 __all__ = ["ahead", "running", "start", "stop", "submit", "submit_many"]
@@ -135,7 +136,9 @@ class Pending:
     """A picture being drawn; :meth:`result` gives it."""
 
     def __init__(self, fn, args):
-        self.fn, self.args = fn, args
+        # drawn in the language of the sheet asking (the renderer is another process: no context of ours)
+        self.fn, self.args = _in_language, (current(), fn, args)
+        fn, args = self.fn, self.args
         self.id = None
         if _worker is not None:
             try:
@@ -151,6 +154,12 @@ class Pending:
         if reply is not None and reply[0] == "ok":
             return reply[1]
         return self.fn(*self.args)
+
+
+def _in_language(lang, fn, args):
+    """``fn(*args)`` with the sheets' language ``lang`` in force (:func:`designer.core.i18n.language`)."""
+    with language(lang):
+        return fn(*args)
 
 
 def submit(fn, *args) -> Pending:

@@ -37,7 +37,7 @@ from ..cli import pid as cli_pid
 from ..cli import plant as cli_plant
 from ..cli.common import RESULT_HOOK, run_cli
 from ..core import lifetime
-from ..core.i18n import N_, language, localise
+from ..core.i18n import N_, language, localise, translated
 from ..core.i18n import gettext as _
 from ..core.jsonio import json_safe
 from ..core.units import format_eng
@@ -357,8 +357,9 @@ def circuit_plant_page(result) -> dict:
     return {"parts": [{"ref": p.ref, "role": p.role, "value": result.values[p.ref], "kind": p.kind}
                       for p in topo.parts],
             "bode": _bode(f, resp), "histograms": histograms(result.monte_carlo), **bom_shown(bom),
-            "checks": checks_shown(result.checks),
-            "sheet_html": to_html(rep.title_of(result), rep.sections(result), {}), "title": rep.title_of(result)}
+            "checks": checks_shown(result.checks), "notes": [localise(translated(n)) for n in result.notes],
+            "sheet_html": to_html(rep.title_of(result), rep.sections(result), {}),
+            "title": localise(rep.title_of(result))}
 
 
 def design_filter_task(fields: dict, want: str = "json", tmp: str | None = None) -> dict:

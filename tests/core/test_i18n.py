@@ -106,3 +106,17 @@ def test_a_range_refusal_reads_in_the_language_in_force():
         spanish = r.text()
     assert str(es.value).startswith("zeta ") and str(es.value) != str(en.value) and spanish in str(es.value)
     assert es.value.naming({"zeta": '"zeta"'}).startswith('"zeta" ')
+
+
+def test_a_message_s_values_may_take_any_name_and_read_in_the_language_in_force():
+    """A note's value named ``message`` (the optimiser's, inside design-pid's note) is a value like any other."""
+    import pickle
+
+    from designer.core.i18n import Message, catalogue, language, translated
+    es = catalogue("es")
+    note = Message("optimize: {message} after {n} closed-loop evaluations", message=Message("targets met"), n="12")
+    assert note == "optimize: targets met after 12 closed-loop evaluations"
+    assert pickle.loads(pickle.dumps(note)) == note
+    with language("es"):
+        assert translated(note) == es["optimize: {message} after {n} closed-loop evaluations"].format(
+            message=es["targets met"], n="12")

@@ -9,7 +9,7 @@ import re
 from dataclasses import replace
 
 import pytest
-from helpers import REPORTS, sheet_command, spanish_sheet
+from helpers import REPORTS, foreign, sheet_command, spanish_sheet, vocabulary
 from helpers import deck_terminals as all_terminals
 
 from designer.core import opamps
@@ -114,6 +114,33 @@ def test_the_spanish_pid_sheet_leaves_no_english_message_and_writes_decimal_comm
     assert headings[:3] == ["Veredicto", "Montaje", "Cableado"] and "Lazo cerrado" in headings
     assert not any(re.search(r"(?<![\w.])\d+\.\d+\b(?!\.\d)", n) for n in nodes if n in headings)
     assert "Veredicto" in summary and "Verdict" not in summary
+    # no English word left: the rules' reasoning (the reaction curve, the fit, the rules' notes) and the verdict's
+    # advice included (issue 29)
+    english, _spanish = vocabulary()
+    assert foreign(nodes, english) == []
+    assert "Curva de reacción de ZN: inflexión en" in page and "ZN reaction curve" not in page
+
+
+#: a model plant (typed) and a plant that is a registered section's circuit (inverting: the action reversed)
+MODEL_DEMO = ["--plant-tf", FOPDT, "--name", "model_es"]
+MFB_DEMO = ["--plant-topology", "mfb-lowpass", "--plant-part", "R1=10k", "R2=20k", "R3=6k8", "C1=10n", "C2=100n",
+            "--name", "mfb_es"]
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("args", [MODEL_DEMO, MFB_DEMO], ids=["plant-tf", "plant-topology"])
+def test_the_spanish_model_plant_sheet_leaves_no_english_word(args, tmp_path):
+    """Issue 29: a model plant's sheet (the plant, the rules' models, steps, formulas and notes, the rule table,
+    the margins, the scope) in Spanish, and a circuit plant's (its sections' titles, where it came from)."""
+    from designer.core.i18n import catalogue
+    _summary, _rep, page, nodes = spanish_sheet("design-pid", args, tmp_path)
+    english, _spanish = vocabulary()
+    assert foreign(nodes, english) == []
+    es = catalogue("es")
+    assert es["Where it came from: {source}."].split("{")[0] in page
+    if "mfb-lowpass" in args:   # the half rule's reason (complex poles) for simc and imc, and the section's title
+        assert es["does not apply: {reason}"].split("{")[0] + "simc: " in page and "polos complejos" in page
+        assert es["MFB low-pass (inverting)"] in page and "MFB low-pass (inverting)" not in page
 
 
 @pytest.mark.spice
@@ -298,3 +325,33 @@ def test_a_miswired_block_is_caught():
     floating = dict(terms)
     floating[(PLANT_BLOCK, "gnd")] = "vee"
     assert check_connectivity(sheet, floating)
+
+
+@pytest.mark.spice
+def test_the_spanish_optimised_sheet_leaves_no_english_word(tmp_path):
+    """Issue 29: the optimiser's notes (its target, its verdict) in Spanish on the seed plant's sheet."""
+    from designer.core.i18n import catalogue
+    args = ["--plant-fc", "3500", "--plant-zeta", "0.2", "--tuning", "optimize", "--target-overshoot", "10",
+            "--name", "optimize_es"]
+    _summary, _rep, page, nodes = spanish_sheet("design-pid", args, tmp_path)
+    english, _spanish = vocabulary()
+    assert foreign(nodes, english) == []
+    assert catalogue("es")["optimize: target overshoot <= {os} %{ts} for a {step} V step with {opamp} limits"].split(
+        "{")[0] in " ".join(nodes) and "<title>PID con" in page
+
+
+def test_the_spanish_sheet_of_a_trimmed_difference_amplifier_leaves_no_english_word():
+    """Issue 29: the section on a difference amplifier that is not balanced (the seed's trimmed bench, not
+    simulated) reads in Spanish: which input it attenuates, the loop gain and the other way round."""
+    from designer.core.i18n import catalogue, language
+    from designer.pid.blocks import seed_bench_parts
+    from designer.pid.design import SEED_BENCH_PLANT, analyze_pid
+    from designer.report.document import to_text
+    result = analyze_pid(PidSpec(plant_parts=SEED_BENCH_PLANT, controller_parts=seed_bench_parts(), opamp="LM741",
+                                 step_v=2.0, kp=45, ti_s=43.215e-6, td_s=10.8037e-6), simulate=False)
+    with language("es"):
+        sections = dict(P.sections(result, with_images=False))
+        heading = catalogue("es")["Difference amplifier as built"]
+        text = to_text("t", [(heading, sections[heading])])
+    english, _spanish = vocabulary()
+    assert foreign(text.splitlines(), english) == [] and "U2 pondera la salida y" in text

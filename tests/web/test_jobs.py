@@ -159,6 +159,10 @@ def test_the_filter_and_circuit_plant_pages_speak_the_requests_language():
         assert trace["text"] == words.get("chosen parts, {name} model", "chosen parts, {name} model").format(name="LM741")
         shown = {ch["id"]: ch["title"] for ch in c["page"]["checks"]}
         assert shown == {"spice_agreement": words.get("SPICE agreement", "SPICE agreement")}
+        # the section's title and notes (its parts' roles) in the request's language, result.json's in English
+        section = words.get("MFB low-pass (inverting)", "MFB low-pass (inverting)")
+        assert section in c["page"]["title"] and c["page"]["notes"][0].startswith(section + ": ")
+        assert words.get("input resistor", "input resistor") in c["page"]["notes"][0]
 
 
 @pytest.mark.spice

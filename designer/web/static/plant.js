@@ -18,7 +18,7 @@ function showTopology() {
   zeta.hidden = topo.order === 1;
   document.getElementById("topology-parts").replaceChildren(
     D.table([D.t("part"), D.t("kind"), D.t("role")], topo.parts.map(x => [x.ref, x.kind === "R" ? D.t("resistor")
-                                                                                    : D.t("capacitor"), x.role])));
+                                                                                    : D.t("capacitor"), D.t(x.role)])));
 }
 D.onRestore = showTopology;
 
@@ -29,16 +29,16 @@ function showCircuit(answer) {
   document.getElementById("title").textContent = p.title;
   const spice = r.checks.find(c => c.id === "spice_agreement");
   document.getElementById("figures").replaceChildren(
-    ...p.parts.map(x => D.fig(`${x.ref} (${x.role})`, D.eng(x.value, x.kind === "R" ? "Ohm" : "F", 3))),
+    ...p.parts.map(x => D.fig(`${x.ref} (${D.t(x.role)})`, D.eng(x.value, x.kind === "R" ? "Ohm" : "F", 3))),
     D.fig(D.t("fn as built ({amp})", {amp: r.opamp.name}), D.eng(o.fn_hz, "Hz", 4)),
     ...(o.zeta === null ? [] : [D.fig(D.t("zeta as built ({amp})", {amp: r.opamp.name}), D.num(o.zeta, 4))]),
     D.fig(D.t("gain"), D.num(i.gain, 4)),
     D.fig(D.t("-3 dB frequency ({amp})", {amp: r.opamp.name}), o.f3db_hz.map(v => D.eng(v, "Hz", 4)).join(", ")),
     D.fig(D.t("SPICE agrees with the model"), !spice ? D.t("not simulated") : (spice.ok ? D.t("yes") : D.t("NO"))));
-  document.getElementById("notes").replaceChildren(...r.notes.map(n => { const e = document.createElement("p"); e.textContent = D.inPageWords(form, n); return e; }));
+  document.getElementById("notes").replaceChildren(...(p.notes || r.notes).map(n => { const e = document.createElement("p"); e.textContent = D.inPageWords(form, n); return e; }));
   const sch = document.getElementById("schematic");
   sch.replaceChildren(Object.assign(document.createElement("p"), {textContent:
-    D.t("{title}: the parts and their wiring are in the build sheet below.", {title: r.topology_title})}));
+    D.t("{title}: the parts and their wiring are in the build sheet below.", {title: D.t(r.topology_title)})}));
   const open = sch.parentElement.querySelector(".open-full");
   if (open) open.remove();
   document.getElementById("bomtable").replaceChildren(D.bomTable(p));
@@ -91,7 +91,7 @@ const page = D.designPage(form, status, "/api/plant", show,
   topologies = c.topologies;
   const menu = form.elements["topology"];
   D.fill(menu, topologies.map(t => t.name), SEED_TOPOLOGY);
-  for (const o of menu.options) o.textContent = topologies.find(t => t.name === o.value).title;
+  for (const o of menu.options) o.textContent = D.t(topologies.find(t => t.name === o.value).title);
   D.fillFromQuery(form);
   showTopology();
   form.addEventListener("change", e => { if (e.target === menu) showTopology(); }, true);   // before it asks

@@ -1,0 +1,72 @@
+"""The build sheet of a plant on a registered section (designer/plant/circuit_report.py) in its two languages
+(issue 29): in Spanish no English word is left (the section's title, its parts' roles, the SPICE check's detail,
+the notes), in English it is the code's own text."""
+
+import pickle
+from copy import deepcopy
+
+import pytest
+from helpers import english_left, foreign, sheet_text_nodes, vocabulary
+
+from designer.core.i18n import Message, catalogue, language, translated
+from designer.filters import registry
+from designer.plant import circuit_report as rep
+from designer.plant.circuit_design import design_circuit_plant
+from designer.plant.spec import PlantSpec
+from designer.report.document import to_html
+
+
+def _sheet(result, lang):
+    with language(lang):
+        return rep.title_of(result), to_html(rep.title_of(result), rep.sections(result), {})
+
+
+def _plant(topology, simulate=False):
+    topo = registry.get(topology)
+    zeta = 0.7 if topo.order == 2 else None
+    return design_circuit_plant(PlantSpec(fc_hz=1000, zeta=zeta, gain=topo.example.gain, topology=topology),
+                                simulate=simulate)
+
+
+@pytest.mark.parametrize("topology", [n for n in registry.names() if registry.get(n).kind == "lowpass"])
+def test_the_spanish_sheet_of_every_low_pass_section_leaves_no_english_word(topology):
+    result = _plant(topology)
+    title, page = _sheet(result, "es")
+    english, _spanish = vocabulary()
+    nodes = sheet_text_nodes(page)
+    assert english_left(page) == [] and foreign(nodes, english) == []
+    assert title.startswith("Planta: " + catalogue("es")[registry.get(topology).title])
+    # every declared part's role in the catalogue's Spanish (the BOM's role column, the notes)
+    for part in registry.get(topology).parts:
+        assert catalogue("es")[part.role] in page
+    en_title, en_page = _sheet(result, "en")
+    assert en_title.startswith(registry.get(topology).title + " plant: fc 1000 Hz")
+    assert all(p.role in en_page for p in registry.get(topology).parts)
+
+
+@pytest.mark.spice
+def test_the_spice_check_s_detail_reads_in_the_sheet_s_language():
+    result = _plant("mfb-lowpass", simulate=True)
+    check = result.checks[-1]
+    assert check.detail.startswith("SPICE .ac against the op-amp-aware model")
+    with language("es"):
+        assert check.shown().startswith("SPICE .ac frente al modelo")
+    _title, page = _sheet(result, "es")
+    english, _spanish = vocabulary()
+    assert foreign(sheet_text_nodes(page), english) == []
+
+
+def test_a_message_is_its_english_text_and_keeps_its_values_through_copies():
+    """A note is a ``str`` (result.json's English) that a sheet shows in its language, its values too."""
+    topo = registry.get("mfb-lowpass")
+    part = topo.parts[0]
+    note = Message("{section}: parts {parts}", section=Message(topo.title),
+                   parts=Message.joined(", ", [Message("{ref} ({role})", ref=part.ref, role=Message(part.role))] * 2))
+    assert note == f"{topo.title}: parts {part.ref} ({part.role}), {part.ref} ({part.role})"
+    for copy in (deepcopy(note), pickle.loads(pickle.dumps(note))):
+        assert isinstance(copy, Message) and copy == note and copy.values.keys() == note.values.keys()
+    es = catalogue("es")
+    with language("es"):
+        assert translated(note) == es["{section}: parts {parts}"].format(
+            section=es[topo.title], parts=", ".join([es["{ref} ({role})"].format(ref=part.ref, role=es[part.role])] * 2))
+    assert translated(note) == note
