@@ -235,22 +235,21 @@ CAPTURE_OPTIONS = (("step_time", "--step-time", None), ("step_amplitude", "--ste
 
 def _captured_model(args, typed):
     """--plant-capture: the capture identified as ``identify`` does (a frequency
-    table as ``identify-freq``), its best valid model (or --plant-method's); None
-    without it. identify's options without --plant-capture are refused."""
+    table as ``identify-freq``: :func:`designer.identify.spec.identify_file` of its
+    :class:`~designer.identify.spec.IdentifySpec`), its best valid model (or
+    --plant-method's); None without it. identify's options without --plant-capture are refused."""
     given = [flag for dest, flag, unset in CAPTURE_OPTIONS if getattr(args, dest) != unset]
     if args.plant_capture is None:
         if given:
             raise DesignError(f"{given[0]} is an option of --plant-capture (identify's), and no capture is given")
         return None
     from ..core.fileio import shown
+    from ..identify.spec import identify_file
     from ..pid.plant_source import model_from_result
-    from . import identify as ident
-    fmt = str(args.format).strip().lower()
-    if fmt not in ("auto",) + ident.FORMATS:
-        raise DesignError(f"--format {fmt!r} unknown; allowed: auto, {', '.join(ident.FORMATS)}")
+    from .identify import capture_spec
     method = typed.pop("plant_method")
     where = f"--plant-capture {shown(args.plant_capture)}"
-    result = _identified(args, fmt, given, ident)
+    result = identify_file(capture_spec(args, args.plant_capture))
     best = getattr(getattr(result, "assessment", None), "best_candidate", None)
     if method is None and best is not None and not getattr(result, "refused", ""):
         # the best validation fit across every route (identify's "validation"), named with its capture
@@ -261,36 +260,6 @@ def _captured_model(args, typed):
         return model_from_result(result.to_dict(), method, name=where)
     except DesignError as exc:
         raise DesignError(str(exc).replace("plant model --plant-capture", "--plant-capture")) from None
-
-
-def _identified(args, fmt: str, given: list, ident):
-    """The capture (or frequency table) of --plant-capture identified by the
-    library calls ``identify`` makes, with identify's option names in its messages."""
-    from ..core.fileio import shown
-    path = args.plant_capture
-    header = ident.frequency_table_header(path)
-    if header is not None:
-        if given:
-            raise DesignError(f"{', '.join(given)} {'is' if len(given) == 1 else 'are'} for a step capture; "
-                              f"{shown(path)} is a frequency-response table, analysed as identify-freq does: drop "
-                              f"{'it' if len(given) == 1 else 'them'}")
-        from ..identify.frequency import identify_freq
-        from ..identify.io import read_freq_table
-        return identify_freq(read_freq_table(path))
-    from ..core.ranges import parse_in_range
-    from ..identify.assess import identify_record
-    from ..identify.io import read_capture
-    from ..identify.preprocess import check_window
-    t_step = None if args.step_time is None else ident.step_time(args.step_time)
-    amp = None if args.step_amplitude is None else ident.step_amplitude(args.step_amplitude)
-    window = None if args.window is None else check_window(
-        [parse_in_range(v, f"--window {which}", "capture_time_s") for v, which in zip(args.window, ("T0", "T1"))])
-    from ..identify.broadband import positional_input
-    cap = positional_input(read_capture(path, **{**ident.capture_read_options(args), "fmt": fmt}))
-    edge_only = [flag for dest, flag in ident.STEP_EDGE_ONLY if dest != "against" and getattr(args, dest) is not None]
-    return identify_record(cap.t, cap.y, cap.u, step_time=t_step, step_amplitude=amp, window=window,
-                           methods=args.methods, refine=not args.no_refine, capture=cap.info(), name=shown(path),
-                           step_only_given=edge_only)
 
 
 def _run(args) -> int:

@@ -24,8 +24,9 @@ from ..core.i18n import gettext as _
 from ..filters.sallen_key_lowpass_parts import refs as sallen_key_refs
 from .request import option_name, value_text
 
-__all__ = ["FILTER", "Field", "FilterRequest", "PID", "PLANT", "PidRequest", "PlantRequest", "field_of",
-           "filter_request", "page_message", "pid_request", "plant_request"]
+__all__ = ["FILTER", "Field", "FilterRequest", "IDENTIFY", "IDENTIFY_FILES", "PID", "PLANT", "PidRequest",
+           "PlantRequest", "field_of", "filter_request", "identify_request", "page_message", "pid_request",
+           "plant_request"]
 
 
 class Field(NamedTuple):
@@ -131,6 +132,21 @@ PID = {
     "spice-samples": Field("spice_samples", N_("SPICE samples")),
     "worst-case": Field("worst_case", N_("worst case"), "switch"),
 }
+#: the identify page's fields (the API's keys, as identify's option names) -> parameter of
+#: :func:`designer.identify.spec.identify_spec` and label (``no-refine`` sets ``refine``, inverted)
+IDENTIFY = {
+    "step-time": Field("step_time_s", N_("step time (s)")), "step-amplitude": Field("step_amplitude", N_("step amplitude")),
+    "window": Field("window", N_("window (s)"), "list"), "format": Field("fmt", N_("format")),
+    "input-column": Field("input_column", N_("input column")),
+    "output-column": Field("output_column", N_("output column")),
+    "sample-time": Field("sample_time_s", N_("sample time (s)")), "columns": Field("column_names", N_("columns")),
+    "methods": Field("methods", N_("methods"), "list"), "no-refine": Field("refine", N_("skip least squares"), "switch"),
+    "method": Field("method", N_("broadband route")), "segment-length": Field("segment_length", N_("Welch segment")),
+    "validate": Field("validate", N_("validation capture"), "file"),
+    "against": Field("against", N_("design result.json"), "file"),
+}
+#: the file an identify file field's content is written to, in the request's folder
+IDENTIFY_FILES = {"validate": "validation-capture.csv", "against": "design-result.json"}
 #: design-pid's defaults as its options type them (the spec parses them as it parses the command line's: the
 #: same numbers to the last bit, so the page's JSON is design-pid's)
 PID_DEFAULTS = {"step_v": "1", "edge_s": "100n", "r_series": "E24", "c_series": "E12", "r_min": "1k", "r_max": "1M",
@@ -375,14 +391,8 @@ def pid_request(options, tmp: str | None) -> PidRequest:
         One line naming the library parameter at fault (shown by :func:`page_message`).
     """
     from ..pid.spec import PLAIN_PARAMS, pid_spec
-    from .request import write_content
     v = {**PID_DEFAULTS, **_fields(options, PID)}
-    for param, filename in PID_FILES.items():
-        if param in v:
-            try:
-                v[param] = write_content(tmp, filename, v[param], param)
-            except DesignError as exc:
-                raise DesignError(str(exc), param=param) from None
+    _write_files(v, PID_FILES, tmp)
     spec_keys = ("plant_fc_hz", "plant_zeta", "plant_topology", "plant_values", "plant_json", "plant_tf",
                  "plant_model", "plant_method", "plant_input", "plant_output", "tuning", "kp", "ti_s", "td_s",
                  "target_overshoot_pct", "target_settling_s", "simc_tauc_s", "imc_lambda_s", "min_phase_margin_deg",
@@ -398,6 +408,50 @@ def pid_request(options, tmp: str | None) -> PidRequest:
     name = _name(v, "pid") if "name" in v else None
     return PidRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False), simulator,
                       bool(v.get("rules_spice")), name, _argv("design-pid", options))
+
+
+def identify_request(options, capture: str, tmp: str | None):
+    """An identify page's request (its fields; the capture already written) as the library's request.
+
+    Parameters
+    ----------
+    options : dict
+        Field -> value (:data:`IDENTIFY`'s keys; numbers or texts; a list for ``window`` and ``methods``, or
+        one text of items apart; a file field's content as a text or a JSON object).
+    capture : str
+        The uploaded capture's path (in the request's folder).
+    tmp : str or None
+        The request's private folder: a file field's content is written there (:data:`IDENTIFY_FILES`).
+
+    Returns
+    -------
+    IdentifySpec
+        Made by :func:`designer.identify.spec.identify_spec`, the mapping the command line uses too.
+
+    Raises
+    ------
+    DesignError
+        One line naming the library parameter at fault (shown by :func:`page_message`).
+    """
+    from ..identify.spec import identify_spec
+    v = _fields(options, IDENTIFY)
+    _write_files(v, IDENTIFY_FILES, tmp)
+    if v.get("fmt") == "":   # the format menu's first entry: recognised
+        v.pop("fmt")
+    v["refine"] = not v.get("refine", False)   # the field is "skip least squares"
+    return identify_spec({"capture": capture, **v})
+
+
+def _write_files(v: dict, files: dict, tmp: str | None) -> None:
+    """Each file field's content of ``v`` written in the request's folder under its fixed name (``files``),
+    its path in its place."""
+    from .request import write_content
+    for param, filename in files.items():
+        if param in v:
+            try:
+                v[param] = write_content(tmp, filename, v[param], param)
+            except DesignError as exc:
+                raise DesignError(str(exc), param=param) from None
 
 
 def _check_loop_tolerance(spec, mc, tol) -> None:

@@ -115,6 +115,55 @@ def test_identify_takes_a_frequency_table_as_identify_does(server):
     assert without_run_details(got) == without_run_details(want)
 
 
+def test_identify_is_the_library_called_with_the_pages_fields(server):
+    """Issue 26: /api/identify calls designer.identify.spec.identify_file in the worker with the request's fields
+    (forms.IDENTIFY: no argv, no console script): the same JSON as ``identify --json`` with the same options."""
+    from designer.web.jobs import LIBRARY, identify_task
+    assert LIBRARY["identify"] is identify_task
+    want = cli_json("identify", str(CAPTURE), "--window", "-0.1m", "1.5m", "--no-refine", "--methods", "smith",
+                    "alfaro", "--json")
+    status, _, raw = server.post("/api/identify?window=-0.1m&window=1.5m&no-refine=true&methods=smith%20alfaro",
+                                 CAPTURE.read_bytes())
+    assert status == 200, raw
+    got = json.loads(raw)
+    for d in (got, want):
+        d["capture"].pop("source")
+    assert without_run_details(got) == without_run_details(want)
+    assert [m["name"] for m in got["methods"]][:2] != [] and {m["name"] for m in got["methods"]} <= {"smith", "alfaro"}
+
+
+@pytest.mark.parametrize("query, field, words", [
+    ("step-amplitude=0", "step-amplitude", '"step amplitude" must be non-zero'),
+    ("segment-length=3", "segment-length", '"Welch segment" must be 16 to'),
+    ("format=bogus", "format", "\"format\" 'bogus' unknown; allowed: auto, "),
+    ("window=2m&window=1m", "window", "the window must start before it ends"),
+    ("sample-time=0", "sample-time", '"sample time (s)" must be'),
+    ("methods=nosuch", None, "nosuch"),
+])
+def test_a_refused_identify_names_the_pages_field_never_a_flag(server, query, field, words):
+    from designer.web.forms import IDENTIFY
+    status, got = server.post_json(f"/api/identify?{query}", CAPTURE.read_bytes())
+    assert status == 400 and words in got["message"] and "--" not in got["message"], got
+    assert got["error"].startswith("identify: error: ") and "\n" not in got["error"]
+    if field is not None:
+        assert got["option"] == "--" + field and got["label"] == IDENTIFY[field].label
+
+
+def test_identify_of_a_table_refuses_step_fields_by_their_labels_in_the_requests_language(server):
+    table = FIXTURES / "identify_freq" / "seed003_table31.csv"
+    status, got = server.post_json("/api/identify?filename=t.csv&step-time=0&no-refine=true", table.read_bytes())
+    assert status == 400, got
+    assert got["message"].startswith('"step time (s)", "skip least squares" are for a step capture; ')
+    assert got["option"] == "--step-time" and "frequency-response table" in got["message"]
+    from designer.core.i18n import gettext, language
+    from designer.web.forms import IDENTIFY
+    status, es = server.post_json("/api/identify?filename=t.csv&segment-length=3&lang=es", CAPTURE.read_bytes())
+    with language("es"):
+        label = gettext(IDENTIFY["segment-length"].label)
+    assert status == 400 and es["label"] == label and f'"{label}"' in es["message"], es
+    assert "must be" not in es["message"]
+
+
 @pytest.mark.parametrize("body, argv", [
     ({"fc": 3500, "zeta": -1}, ["--fc", "3500", "--zeta", "-1"]),
     ({"fc": "3.5q", "zeta": 0.2}, ["--fc", "3.5q", "--zeta", "0.2"]),
@@ -583,10 +632,10 @@ MALFORMED = [
     ("/api/plant", b'{"fc": 1e999, "zeta": 0.5}', {}, "finite number"),
     ("/api/plant", b'{"fc": NaN, "zeta": 0.5}', {}, "finite number"),
     ("/api/identify?window=%ff%fe&x=%00", CAPTURE.read_bytes(), {}, "error"),
-    ("/api/identify?window=1", CAPTURE.read_bytes(), {}, "--window takes 2 values, got 1"),
-    ("/api/identify?window=1&window=2&window=3", CAPTURE.read_bytes(), {}, "--window takes 2 values, got 3"),
-    ("/api/identify?step-time=1&step-time=2", CAPTURE.read_bytes(), {}, "--step-time takes one value, got 2"),
-    ("/api/identify?help=1", CAPTURE.read_bytes(), {}, "--help is set by the web page"),
+    ("/api/identify?window=1", CAPTURE.read_bytes(), {}, '"window (s)" takes 2 values, got 1'),
+    ("/api/identify?window=1&window=2&window=3", CAPTURE.read_bytes(), {}, '"window (s)" takes 2 values, got 3'),
+    ("/api/identify?step-time=1&step-time=2", CAPTURE.read_bytes(), {}, '"step time (s)" takes one value, got 2'),
+    ("/api/identify?help=1", CAPTURE.read_bytes(), {}, "help is set by the web page"),
     ("/api/identify?methods=-h", CAPTURE.read_bytes(), {}, "error"),
     ("/api/identify?%80=1", CAPTURE.read_bytes(), {}, "is not an option name"),
     ("/api/check", b"junk", {"Content-Type": "multipart/form-data"}, "boundary"),
