@@ -33,8 +33,8 @@ from ..core.ranges import RANGES, help_range
 from ..identify.io import FORMAT_NAMES, FORMATS, FREQ_UNITS, GAIN_UNITS, MAX_POINTS, PHASE_UNITS
 from .common import OneLineParser, print_output, run_cli
 
-__all__ = ["CAPTURE_DESTS", "FORMATS", "build_freq_parser", "build_parser", "capture_spec", "identify_freq_main",
-           "identify_main", "identify_run", "identify_spec_of"]
+__all__ = ["CAPTURE_DESTS", "FORMATS", "build_freq_parser", "build_parser", "capture_params", "capture_spec",
+           "identify_freq_main", "identify_main", "identify_run", "identify_spec_of"]
 
 IDENTIFY_EPILOG = """\
 examples:
@@ -335,12 +335,30 @@ def add_plain_columns_options(group) -> None:
                             "the second the output)")
 
 
+def capture_params(args) -> dict:
+    """A command's capture options (``--step-time``, ``--step-amplitude``, ``--window``, ``--format``,
+    ``--input-column``, ``--output-column``, ``--sample-time``, ``--columns``, ``--methods``,
+    ``--no-refine``; any not registered reads as not given) as the plain parameters of
+    :func:`~designer.identify.spec.identify_spec`: the one mapping of every command that identifies a
+    capture (identify, design-pid and analyze-pid ``--plant-capture``).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options.
+
+    Returns
+    -------
+    dict
+        Parameter -> value as typed (None: not given), in the options' order; ``refine`` last.
+    """
+    return {**{param: getattr(args, dest, None) for param, dest in CAPTURE_DESTS},
+            "refine": not getattr(args, "no_refine", False)}
+
+
 def capture_spec(args, capture, **more):
     """The :class:`~designer.identify.spec.IdentifySpec` of ``capture`` from a command's capture options
-    (``--step-time``, ``--step-amplitude``, ``--window``, ``--format``, ``--input-column``,
-    ``--output-column``, ``--sample-time``, ``--columns``, ``--methods``, ``--no-refine``; any not
-    registered reads as not given) and ``more`` (the spec's other fields): the one mapping of every
-    command that identifies a capture (identify, design-pid and analyze-pid ``--plant-capture``).
+    (:func:`capture_params`) and ``more`` (the spec's other fields).
 
     Parameters
     ----------
@@ -357,8 +375,7 @@ def capture_spec(args, capture, **more):
         Checked on construction (its errors name the spec's parameters: :data:`.common.FLAGS`).
     """
     from ..identify.spec import identify_spec
-    return identify_spec({"capture": capture, **{param: getattr(args, dest, None) for param, dest in CAPTURE_DESTS},
-                          "refine": not getattr(args, "no_refine", False), **more})
+    return identify_spec({"capture": capture, **capture_params(args), **more})
 
 
 #: the spec's parameters -> the capture options' argparse dests (their flags: :data:`.common.FLAGS`)

@@ -13,7 +13,7 @@ from .common import add_opamp_option, add_output_options, add_part_options, emit
 from .pid_tolerance import add_monte_carlo, loop_monte_carlo, monte_carlo_settings, replay, replay_name
 from .plant import cluster_ahead
 
-__all__ = ["analyze_pid_main", "analyze_pid_parser", "design_pid_main", "pid_parser"]
+__all__ = ["analyze_pid_main", "analyze_pid_parser", "design_pid_main", "pid_parser", "plant_capture_model"]
 
 EPILOG = """examples:
   design-pid --plant-fc 3500 --plant-zeta 0.2
@@ -225,41 +225,62 @@ def _build_spec(args):
     return pid_spec({**typed, "seed_parts": args.seed_parts, "package": args.package, "plant_process": process})
 
 
-#: identify's options that --plant-capture passes on: (argparse dest, flag, value when not given)
-CAPTURE_OPTIONS = (("step_time", "--step-time", None), ("step_amplitude", "--step-amplitude", None),
-                   ("window", "--window", None), ("format", "--format", "auto"),
-                   ("input_column", "--input-column", None), ("output_column", "--output-column", None),
-                   ("sample_time", "--sample-time", None), ("columns", "--columns", None),
-                   ("methods", "--methods", None), ("no_refine", "--no-refine", False))
-
-
 def _captured_model(args, typed):
-    """--plant-capture: the capture identified as ``identify`` does (a frequency
-    table as ``identify-freq``: :func:`designer.identify.spec.identify_file` of its
-    :class:`~designer.identify.spec.IdentifySpec`), its best valid model (or
-    --plant-method's); None without it. identify's options without --plant-capture are refused."""
-    given = [flag for dest, flag, unset in CAPTURE_OPTIONS if getattr(args, dest) != unset]
-    if args.plant_capture is None:
-        if given:
-            raise DesignError(f"{given[0]} is an option of --plant-capture (identify's), and no capture is given")
-        return None
+    """--plant-capture: :func:`plant_capture_model` of the capture and identify's options (refused without
+    it); None without either."""
+    from .identify import capture_params
+    params = {"capture": args.plant_capture, **capture_params(args)}
+    return plant_capture_model(params, typed.pop("plant_method") if args.plant_capture is not None else None)
+
+
+def plant_capture_model(params: dict, method: str | None = None):
+    """A PID plant from a capture: the capture identified as ``identify`` does (a frequency table as
+    ``identify-freq``: :func:`designer.identify.spec.identify_file` of
+    :func:`~designer.identify.spec.identify_spec`), its best valid model across every route (or
+    ``method``'s); what design-pid ``--plant-capture`` and the PID page's capture tune for.
+
+    Parameters
+    ----------
+    params : dict
+        :func:`~designer.identify.spec.identify_spec`'s plain parameters; ``capture`` None: no capture
+        (then any other given is refused).
+    method : str, optional
+        The identification method whose model to take instead of the best (``plant_method``).
+
+    Returns
+    -------
+    ProcessModel or None
+        The model (its source names the capture's file), or None without a capture.
+
+    Raises
+    ------
+    DesignError
+        One line naming the parameter at fault (``{name}`` markers of a ParamError).
+    """
+    import os
+
+    from ..core.errors import ParamError
     from ..core.fileio import shown
-    from ..identify.spec import identify_file
+    from ..identify.spec import identify_file, identify_spec
     from ..pid.plant_source import model_from_result
-    from .identify import capture_spec
-    method = typed.pop("plant_method")
-    where = f"--plant-capture {shown(args.plant_capture)}"
-    result = identify_file(capture_spec(args, args.plant_capture))
+    unset = {"fmt": "auto", "refine": True}
+    if params.get("capture") is None:
+        given = [k for k, v in params.items() if k != "capture" and v is not None and v != unset.get(k)]
+        if given:
+            raise ParamError("{%s} is an option of {plant_capture} (identify's), and no capture is given" % given[0],
+                             (given[0], "plant_capture"))
+        return None
+    result = identify_file(identify_spec(params))
     best = getattr(getattr(result, "assessment", None), "best_candidate", None)
     if method is None and best is not None and not getattr(result, "refused", ""):
         # the best validation fit across every route (identify's "validation"), named with its capture
         import dataclasses
-        import os
-        return dataclasses.replace(best.model, source=f"{best.model.source} ({os.path.basename(args.plant_capture)})")
+        return dataclasses.replace(best.model, source=f"{best.model.source} ({os.path.basename(params['capture'])})")
+    where = f"plant_capture {shown(params['capture'])}"
     try:
         return model_from_result(result.to_dict(), method, name=where)
     except DesignError as exc:
-        raise DesignError(str(exc).replace("plant model --plant-capture", "--plant-capture")) from None
+        raise DesignError(str(exc).replace(f"plant model {where}", where), param="plant_capture") from None
 
 
 def _run(args) -> int:

@@ -523,11 +523,9 @@ def identify_task(fields: dict, want: str = "json", tmp: str | None = None, capt
 #: the commands the page runs through the library (no console script, no argv, no printed JSON)
 LIBRARY = {"design-plant": design_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task,
            "identify": identify_task}
-#: a command's options its page's name table does not map (design-pid's capture identified first, with identify's
-#: options; a replayed build; --fail-on-check): a request with one runs the command's entry point, as before
-CLI_ONLY = {"design-pid": frozenset({"plant-capture", "step-time", "step-amplitude", "window", "format", "input-column",
-                                     "output-column", "sample-time", "columns", "methods", "no-refine", "replay",
-                                     "fail-on-check"})}
+#: a command's options its page's name table does not map (a replayed build; --fail-on-check): a request with one
+#: runs the command's entry point, as before
+CLI_ONLY = {"design-pid": frozenset({"replay", "fail-on-check"})}
 
 
 def through_library(prog: str, options) -> bool:

@@ -933,16 +933,24 @@ def test_a_spanish_request_is_refused_in_spanish_naming_its_field(server):
     assert "--lang=es" in pid["result"]["tool"]["argv"]
 
 
-def test_pid_with_a_capture_runs_design_pid_as_before(server):
-    """Issue 26: the options the PID page's name table does not map (a capture identified first, with
-    identify's options; --replay; --fail-on-check) still work: such a request runs design-pid's entry point,
-    the JSON its --json."""
+def test_pid_with_a_capture_is_the_library_called_with_the_pages_fields(server, tmp_path):
+    """Issue 26: a PID request with a plant capture (and identify's options) goes through the library too
+    (forms.PID maps them; designer.cli.pid.plant_capture_model identifies it, its model the plant_process of
+    pid_spec): the JSON is design-pid --plant-capture's; only --replay and --fail-on-check run design-pid's entry
+    point. A capture option without the capture is refused naming both fields by their labels."""
     from designer.web.jobs import CLI_ONLY, through_library
-    assert not through_library("design-pid", {"plant_capture": "x"}) and through_library("design-pid", {"kp": 1})
-    assert CLI_ONLY["design-pid"] >= {"plant-capture", "replay"}
+    assert through_library("design-pid", {"plant_capture": "x"}) and through_library("design-pid", {"kp": 1})
+    assert CLI_ONLY["design-pid"] == {"replay", "fail-on-check"}
+    assert not through_library("design-pid", {"replay": "x"})
     status, got = server.post_json("/api/pid", {"plant-capture": CAPTURE.read_text(), "tuning": "amigo",
-                                                "no-sim": True})
+                                                "window": ["-0.1m", "1.5m"], "no-refine": True, "no-sim": True})
     assert status == 200, got
-    want = cli_json("design-pid", "--plant-capture", str(CAPTURE), "--tuning", "amigo", "--no-sim", "--json",
-                    "--no-files")
-    assert got["tuning"] == want["tuning"] and got["tuning"]["method"] == "amigo"
+    same = tmp_path / "plant-capture.csv"   # the name the page's content is written under: the model's source
+    same.write_bytes(CAPTURE.read_bytes())
+    want = cli_json("design-pid", "--plant-capture", str(same), "--tuning", "amigo", "--window", "-0.1m", "1.5m",
+                    "--no-refine", "--no-sim", "--json", "--no-files")
+    assert without_run_details(got) == without_run_details(want)
+    assert got["tuning"]["method"] == "amigo"
+    status, bad = server.post_json("/api/pid", {"plant-tf": "K=1 tau=1m", "step-time": "1m"})
+    assert status == 400 and bad["message"].startswith('"step time (s)" is an option of "plant capture"'), bad
+    assert bad["option"] == "--step-time" and "--" not in bad["message"]

@@ -88,12 +88,15 @@ def test_bad_filter_fields_are_refused_in_the_pages_words(fields, param):
 
 def test_every_pid_field_is_a_design_pid_option_setting_a_parameter_of_the_specs_or_of_the_run():
     """Issue 26: the PID page's fields are design-pid's option names, each setting a parameter of
-    designer.pid.spec.pid_spec (the spec's fields and its plain parameters), of the Monte Carlo or of the run."""
+    designer.pid.spec.pid_spec (the spec's fields and its plain parameters), of the Monte Carlo, of the run, or of
+    the plant capture's identification (plant_capture and designer.identify.spec.IdentifySpec's fields)."""
     from designer.cli.pid import pid_parser
+    from designer.identify.spec import IdentifySpec
     from designer.pid.spec import PLAIN_PARAMS, PidSpec
     from designer.web.forms import PID
     specs = ({f.name for f in dataclasses.fields(PidSpec)} | set(PLAIN_PARAMS)
-             | {f.name for f in dataclasses.fields(MonteCarloSpec)})
+             | {f.name for f in dataclasses.fields(MonteCarloSpec)}
+             | {f.name for f in dataclasses.fields(IdentifySpec)} | {"plant_capture"})
     assert {f.param for f in PID.values()} <= specs | {"no_sim", "simulator", "name", "worst_case", "rules_spice"}
     assert len({f.label for f in PID.values()}) == len(PID)
     options = {o for a in pid_parser()._actions for o in a.option_strings}
@@ -131,3 +134,22 @@ def test_bad_pid_fields_are_refused_in_the_pages_words(tmp_path, fields, param, 
     text, field = page_message(exc.value, PID)
     assert words in text and "--" not in text and "\n" not in text, text
     assert PID[field].param == param, (field, text)
+
+
+def test_every_identify_field_is_an_identify_option_setting_a_parameter_of_the_spec():
+    """Issue 26: the identify page's fields are identify's option names, each setting a parameter of
+    designer.identify.spec.identify_spec; an identify request is the spec identify builds from its options."""
+    from designer.cli.identify import build_parser, identify_spec_of
+    from designer.identify.spec import IdentifySpec
+    from designer.web.forms import IDENTIFY, identify_request
+    assert {f.param for f in IDENTIFY.values()} <= {f.name for f in dataclasses.fields(IdentifySpec)}
+    assert len({f.label for f in IDENTIFY.values()}) == len(IDENTIFY)
+    options = {o for a in build_parser()._actions for o in a.option_strings}
+    assert {f"--{k}" for k in IDENTIFY} <= options
+    argv = ["c.csv", "--step-time", "1m", "--step-amplitude", "-2", "--window", "0", "5m", "--format", "rigol",
+            "--input-column", "2", "--methods", "smith", "alfaro", "--no-refine", "--segment-length", "64"]
+    rq = identify_request({"step-time": "1m", "step-amplitude": -2, "window": "0 5m", "format": "RIGOL",
+                           "input-column": 2, "methods": ["smith", "alfaro"], "no-refine": "on",
+                           "segment-length": 64}, "c.csv", None)
+    assert rq == identify_spec_of(build_parser().parse_args(argv))
+    assert identify_request({"format": ""}, "c.csv", None) == IdentifySpec("c.csv")

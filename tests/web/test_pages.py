@@ -592,6 +592,16 @@ def test_every_plant_field_has_the_label_of_the_name_table(page, server):
         assert page.evaluate(f"D.labelOf(document.getElementById('form'), '{name}')") == PLANT[name].label, name
 
 
+def test_every_identify_field_has_the_label_of_the_name_table(page, server):
+    """Issue 26: the identify page's fields are designer.web.forms.IDENTIFY's, each with its label."""
+    from designer.web.forms import IDENTIFY
+    open_page(page, server, "/identify")
+    names = page.evaluate("[...document.querySelectorAll('#form [name]')].map(e => e.name)")
+    assert names
+    for name in names:
+        assert page.evaluate(f"D.labelOf(document.getElementById('form'), '{name}')") == IDENTIFY[name].label, name
+
+
 def test_the_plant_page_shows_the_sheets_content(page, server):
     """Issue 29: wiring, the expected scope readings with their tolerance band, target against achieved,
     sensitivity and the alternatives, as the build sheet has them, in the page's words."""
