@@ -118,8 +118,8 @@ class IdentifySpec:
 
         for key in ("capture", "validate", "against"):
             value = getattr(self, key)
-            if value is not None:
-                if not isinstance(value, (str, os.PathLike)) or str(value) == "":
+            if value is not None:   # a name the reader cannot open (an empty one too) is the reader's to refuse
+                if not isinstance(value, (str, os.PathLike)):
                     raise DesignError(f"{key} needs a file name, got {str(value)[:40]!r}", param=key)
                 put(key, os.fspath(value))
         if self.step_time_s is not None:

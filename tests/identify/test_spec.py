@@ -77,7 +77,7 @@ BAD = st.one_of(
     st.tuples(st.just("method"), st.sampled_from(["fourier", "", "step"])),
     st.tuples(st.just("refine"), st.sampled_from(["yes", 1, "true"])),
     st.tuples(st.just("methods"), st.sampled_from([[1, 2], [None]])),
-    st.tuples(st.sampled_from(["capture", "validate", "against"]), st.sampled_from(["", 3, 2.5])),
+    st.tuples(st.sampled_from(["capture", "validate", "against"]), st.sampled_from([3, 2.5, ["a.csv"]])),
 )
 
 
