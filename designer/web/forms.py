@@ -419,7 +419,7 @@ def pid_request(options, tmp: str | None) -> PidRequest:
     simulator = _simulator(v, "pyspice")
     name = _name(v, "pid") if "name" in v else None
     return PidRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False), simulator,
-                      bool(v.get("rules_spice")), name, _argv("design-pid", options))
+                      bool(v.get("rules_spice")), name, _argv("design-pid", options, PID, PID_FILES))
 
 
 def identify_request(options, capture: str, tmp: str | None):
@@ -521,9 +521,14 @@ def _name(v: dict, default: str) -> str:
     return name
 
 
-def _argv(prog: str, options: dict) -> list:
-    """The command line a request stands for (a record: nothing parses it)."""
-    return [prog] + [a for key, value in options.items() if value is not None for a in _flag_words(key, value)]
+def _argv(prog: str, options: dict, table: dict | None = None, files: dict | None = None) -> list:
+    """The command line a request stands for (a record: nothing parses it); a file field of ``table`` (its
+    parameter a key of ``files``) as the name its content was written under, never the content."""
+    def shown(key, value):
+        field = (table or {}).get(option_name(key)[2:])
+        return files[field.param] if field is not None and field.param in (files or {}) else value
+    return [prog] + [a for key, value in options.items() if value is not None
+                     for a in _flag_words(key, shown(key, value))]
 
 
 def _stimulus(v: dict):

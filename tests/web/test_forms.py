@@ -2,6 +2,7 @@
 library refusal in the page's words (the field's label, never a --flag, a value as it was typed)."""
 
 import dataclasses
+from pathlib import Path
 
 import pytest
 
@@ -153,3 +154,13 @@ def test_every_identify_field_is_an_identify_option_setting_a_parameter_of_the_s
                            "segment-length": 64}, "c.csv", None)
     assert rq == identify_spec_of(build_parser().parse_args(argv))
     assert identify_request({"format": ""}, "c.csv", None) == IdentifySpec("c.csv")
+
+
+def test_a_pid_request_records_a_file_fields_name_never_its_content(tmp_path):
+    """tool.argv of a PID request with a capture (or a model) names the file its content was written under, as the
+    command line it stands for would; the content (a capture of up to 4 MiB) stays out of the result's JSON."""
+    from designer.web.forms import PID_FILES, pid_request
+    capture = (Path(__file__).resolve().parents[1] / "fixtures" / "identify" / "tektronix_mso.csv").read_text()
+    rq = pid_request({"plant-capture": capture, "tuning": "amigo"}, str(tmp_path))
+    assert rq.argv == ["design-pid", f"--plant-capture={PID_FILES['plant_capture']}", "--tuning=amigo"]
+    assert rq.spec.process is not None and rq.spec.process.source.endswith("(plant-capture.csv)")
