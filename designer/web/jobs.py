@@ -149,7 +149,8 @@ def run_task(task: dict) -> dict:
         extras), "json", "sheet" (the printable build sheet), "bundle" (the
         design's files as a zip) or "check" (check-design's files); ``tmp``:
         the request's private folder (files written there), or None; ``lang``: the language of the page's
-        words (a command with ``--lang`` takes it from there).
+        words (a command with ``--lang`` takes it from there). A command of :data:`LIBRARY` gets ``fields``
+        (the request's fields) instead of ``argv``, and identify ``capture`` (the uploaded file's path) too.
 
     Returns
     -------
