@@ -19,10 +19,11 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "filter": ("analyze_filter_main", "design_filter_main", "summary_text",),
     "filter_tolerance": ("OPTIMIZE_DEFAULT_BUILDS", "add_filter_tolerance", "run_tolerance", "tolerance_json",
                          "tolerance_lines", "tolerance_settings",),
-    "identify": ("FORMATS", "build_freq_parser", "identify_freq_main", "identify_main", "identify_run",),
+    "identify": ("CAPTURE_DESTS", "FORMATS", "build_freq_parser", "capture_params", "capture_spec",
+                 "identify_freq_main", "identify_main", "identify_run", "identify_spec_of",),
     "launch": ("analyze_pid", "analyze_plant", "check_design", "design_filter", "design_pid", "design_plant",
                "draws", "identify_freq", "make_prbs", "simulate_capture",),
-    "pid": ("analyze_pid_main", "analyze_pid_parser", "design_pid_main", "pid_parser",),
+    "pid": ("analyze_pid_main", "analyze_pid_parser", "design_pid_main", "pid_parser", "plant_capture_model",),
     "plant": ("analyze_plant_main", "analyze_plant_parser", "design_plant_main", "design_plant_parser",),
     "prbs": ("make_prbs_main",),
 })

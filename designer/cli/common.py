@@ -51,7 +51,9 @@ FLAGS = {
     # identify / identify-freq
     "step_time_s": "--step-time", "step_amplitude": "--step-amplitude",
     "input_column": "--input-column", "output_column": "--output-column", "sample_time_s": "--sample-time",
-    "column_names": "--columns",
+    "column_names": "--columns", "window": "--window", "fmt": "--format", "methods": "--methods",
+    "refine": "--no-refine", "method": "--method", "validate": "--validate", "segment_length": "--segment-length",
+    "against": "--against", "out_folder": "--out",
     # simulate-capture (its step_v, step_time_s as above)
     # design-filter
     "filter_type": "--type", "family": "--family", "order": "--order", "ripple_db": "--ripple",

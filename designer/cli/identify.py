@@ -24,20 +24,17 @@ from ..core.fileio import (
     MAX_CAPTURE_BYTES,
     MAX_CAPTURE_ROWS,
     MAX_TABLE_BYTES,
-    SNIFF_BYTES,
     atomic_write,
-    decode,
-    open_limited,
     shown,
     size_text,
 )
 from ..core.jsonio import json_safe
-from ..core.ranges import RANGES, help_range, parse_in_range
-from ..core.units import parse_value
+from ..core.ranges import RANGES, help_range
 from ..identify.io import FORMAT_NAMES, FORMATS, FREQ_UNITS, GAIN_UNITS, MAX_POINTS, PHASE_UNITS
 from .common import OneLineParser, print_output, run_cli
 
-__all__ = ["FORMATS", "build_freq_parser", "build_parser", "identify_freq_main", "identify_main", "identify_run"]
+__all__ = ["CAPTURE_DESTS", "FORMATS", "build_freq_parser", "build_parser", "capture_params", "capture_spec",
+           "identify_freq_main", "identify_main", "identify_run", "identify_spec_of"]
 
 IDENTIFY_EPILOG = """\
 examples:
@@ -262,23 +259,6 @@ def identify_epilog() -> str:
                                   step_rng=RANGES["output_step"].text())
 
 
-def step_time(text) -> float:
-    """``--step-time``: engineering notation, inside ``RANGES["capture_time_s"]``."""
-    return parse_in_range(text, "--step-time", "capture_time_s")
-
-
-def step_amplitude(text) -> float:
-    """``--step-amplitude``: non-zero, its size inside ``RANGES["step_amplitude"]``
-    (a negative value is a falling step)."""
-    value = parse_value(text, "--step-amplitude")
-    if value == 0:
-        raise DesignError("--step-amplitude must be non-zero (its size "
-                          f"{RANGES['step_amplitude'].text()}, either sign)")
-    RANGES["step_amplitude"].check(abs(value), "the size of --step-amplitude (either sign)",
-                                   shown=repr(text))
-    return value
-
-
 def build_parser() -> argparse.ArgumentParser:
     """The ``identify`` command line.
 
@@ -355,10 +335,12 @@ def add_plain_columns_options(group) -> None:
                             "the second the output)")
 
 
-def capture_read_options(args) -> dict:
-    """:func:`~designer.identify.io.read_capture`'s keyword arguments from a command's reading
-    options (``--format``, ``--input-column``, ``--output-column``, ``--sample-time``,
-    ``--columns``; any not registered reads as not given), ``--sample-time`` checked.
+def capture_params(args) -> dict:
+    """A command's capture options (``--step-time``, ``--step-amplitude``, ``--window``, ``--format``,
+    ``--input-column``, ``--output-column``, ``--sample-time``, ``--columns``, ``--methods``,
+    ``--no-refine``; any not registered reads as not given) as the plain parameters of
+    :func:`~designer.identify.spec.identify_spec`: the one mapping of every command that identifies a
+    capture (identify, design-pid and analyze-pid ``--plant-capture``).
 
     Parameters
     ----------
@@ -368,153 +350,63 @@ def capture_read_options(args) -> dict:
     Returns
     -------
     dict
-        ``input_column``, ``output_column``, ``fmt``, ``sample_time_s``, ``column_names``.
+        Parameter -> value as typed (None: not given), in the options' order; ``refine`` last.
     """
-    sample = getattr(args, "sample_time", None)
-    return {"input_column": getattr(args, "input_column", None),
-            "output_column": getattr(args, "output_column", None),
-            "fmt": getattr(args, "format", None),
-            "sample_time_s": None if sample is None else parse_in_range(sample, "--sample-time", "sample_time_s"),
-            "column_names": getattr(args, "columns", None)}
+    return {**{param: getattr(args, dest, None) for param, dest in CAPTURE_DESTS},
+            "refine": not getattr(args, "no_refine", False)}
 
 
-def identify_capture(args):
-    """Identify from parsed ``identify`` arguments; returns the
-    :class:`~designer.identify.step.IdentifyResult` (with its comparison)."""
-    from ..identify.io import read_capture
-
-    t_step = None if args.step_time is None else step_time(args.step_time)
-    amp = None if args.step_amplitude is None else step_amplitude(args.step_amplitude)
-    window = None
-    if args.window is not None:
-        from ..identify.preprocess import check_window
-        window = check_window([parse_in_range(v, f"--window {which}", "capture_time_s")
-                               for v, which in zip(args.window, ("T0", "T1"))])
-    if args.plot:
-        check_output_path(args.plot, "--plot")
-    # The file is read before scipy is imported, so bad input fails fast.
-    seg = getattr(args, "segment_length", None)
-    seg = None if seg is None else int(parse_in_range(seg, "--segment-length", "segment_length"))
-    from ..identify.broadband import positional_input
-    cap = positional_input(read_capture(args.capture, **capture_read_options(args)))
-    validation = read_validation(args, cap)
-    from ..identify.assess import identify_record
-    from ..identify.broadband import check_method
-    method = check_method(getattr(args, "method", None))
-    given = [flag for dest, flag in STEP_EDGE_ONLY if getattr(args, dest, None) is not None]
-    design = None
-    if args.against:
-        from ..identify.against import load_design
-        design = load_design(args.against)
-    result = identify_record(cap.t, cap.y, cap.u, step_time=t_step, step_amplitude=amp, window=window,
-                             methods=args.methods, refine=not args.no_refine, method=method, capture=cap.info(),
-                             name=shown(args.capture), validation=validation, segment_length=seg,
-                             step_only_given=given)
-    if design is not None and not hasattr(result, "excitation"):
-        from ..identify.against import compare_with_design
-        result.comparison = compare_with_design(result, design)
-    return result
-
-
-def read_validation(args, cap):
-    """``--validate OTHER.csv``: the second capture (t, u, y), read as the first
-    (its format and columns), or None. It needs an input channel."""
-    path = getattr(args, "validate", None)
-    if path is None:
-        return None
-    from ..identify.io import read_capture
-    from ..identify.broadband import positional_input
-    other = positional_input(read_capture(path, **capture_read_options(args)))
-    if other.u is None or cap.u is None:
-        which = shown(path) if other.u is None else shown(args.capture)
-        raise DesignError(f"--validate: {which} has no input column; validation simulates each model under the "
-                          "recorded input, so both captures need one (t,u,y)")
-    return other.t, other.u, other.y
-
-
-#: identify's options a broadband capture does not take: (argparse dest, its flag)
-STEP_EDGE_ONLY = (("step_time", "--step-time"), ("step_amplitude", "--step-amplitude"),
-                  ("against", "--against"))
-
-
-#: what ``identify`` says (``format`` in its JSON) of a frequency-response table it was given
-FREQUENCY_TABLE = "frequency-table"
-#: identify's options that only a step capture has: (argparse dest, its flag)
-STEP_ONLY = (("step_time", "--step-time"), ("step_amplitude", "--step-amplitude"), ("window", "--window"),
-             ("format", "--format"), ("input_column", "--input-column"), ("output_column", "--output-column"),
-             ("sample_time", "--sample-time"), ("columns", "--columns"),
-             ("methods", "--methods"), ("no_refine", "--no-refine"), ("against", "--against"),
-             ("method", "--method"), ("out", "--out"), ("validate", "--validate"),
-             ("segment_length", "--segment-length"))
-
-
-def frequency_table_header(path) -> list | None:
-    """The header cells of ``path`` when it is a frequency-response table as
-    ``identify-freq`` reads it, else None.
-
-    Its first row that is not blank or a ``#`` comment must be a header whose
-    first cell names a frequency (``f_hz``, ``f_khz``, ``w_rad_s``,
-    ``Frequency (Hz)``...) and whose second names a gain (``gain_db``,
-    ``gain_ratio``, ``Channel 1 Magnitude (dB)``...), split as identify-freq
-    splits it. Only the head of the file is read; a file that cannot be read
-    gives None, so the capture reader reports it in its own words.
+def capture_spec(args, capture, **more):
+    """The :class:`~designer.identify.spec.IdentifySpec` of ``capture`` from a command's capture options
+    (:func:`capture_params`) and ``more`` (the spec's other fields).
 
     Parameters
     ----------
-    path : str or Path
-        The file given to ``identify``.
+    args : argparse.Namespace
+        The parsed options.
+    capture : str
+        The file.
+    **more
+        Further fields of the spec.
 
     Returns
     -------
-    list of str or None
-        The header's cells, or None for anything else (a step capture, a table
-        without a header: those are read as captures).
+    IdentifySpec
+        Checked on construction (its errors name the spec's parameters: :data:`.common.FLAGS`).
     """
-    from ..identify.io.freqtable import NUMBER, unit_hint   # identify-freq's own reading of a header
-    try:
-        with open_limited(path, "capture file", MAX_CAPTURE_BYTES) as fh:
-            head = fh.read(SNIFF_BYTES) or b""
-    except DesignError:
-        return None
-    line = next((ln.strip() for ln in decode(head).lstrip("\ufeff").splitlines()
-                 if ln.strip() and not ln.strip().startswith("#")), "")
-    sep = next((c for c in (";", ",", "\t") if c in line), None)
-    cells = [c.strip().strip('"').strip("'") for c in (line.split(sep) if sep else line.split())]
-    while cells and cells[-1] == "":
-        cells.pop()
-    if len(cells) < 2 or all(NUMBER.match(c) for c in cells):
-        return None
-    first, second = cells[0], cells[1].lower()
-    is_freq = first.lower().startswith("freq") or unit_hint(first, "frequency") is not None
-    is_gain = unit_hint(cells[1], "gain") is not None or "gain" in second or "magnitude" in second
-    return cells if is_freq and is_gain else None
+    from ..identify.spec import identify_spec
+    return identify_spec({"capture": capture, **capture_params(args), **more})
 
 
-def identify_frequency_table(args, header):
-    """``identify`` on a frequency-response table: the step-only options refused
-    in one line, then identify-freq's own analysis of the file (its units from
-    the header). Returns the :class:`~designer.identify.frequency.FreqIdentifyResult`."""
-    defaults = {"format": "auto", "no_refine": False}
-    given = [flag for dest, flag in STEP_ONLY if getattr(args, dest, None) not in (None, defaults.get(dest))]
-    if given:
-        raise DesignError(f"{', '.join(given)} {'is' if len(given) == 1 else 'are'} for a step capture; "
-                          f"{shown(args.capture)} is a frequency-response table (header "
-                          f"{_header_text(header)}), analysed as identify-freq does: drop "
-                          f"{'it' if len(given) == 1 else 'them'}")
-    table_args = argparse.Namespace(table=args.capture, gain_units=None, phase_units=None, freq_units=None,
-                                    plot=args.plot, json=args.json)
-    return identify_table(table_args)
+#: the spec's parameters -> the capture options' argparse dests (their flags: :data:`.common.FLAGS`)
+CAPTURE_DESTS = (("step_time_s", "step_time"), ("step_amplitude", "step_amplitude"), ("window", "window"),
+                 ("fmt", "format"), ("input_column", "input_column"), ("output_column", "output_column"),
+                 ("sample_time_s", "sample_time"), ("column_names", "columns"), ("methods", "methods"))
 
 
-def _header_text(header) -> str:
-    text = ",".join(header)
-    return text if len(text) <= 100 else text[:97] + "..."
+def identify_spec_of(args):
+    """``identify``'s options as the library's request (its capture, ``--method``, ``--validate``,
+    ``--segment-length`` and ``--against`` with the capture options of :func:`capture_spec`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``identify`` options.
+
+    Returns
+    -------
+    IdentifySpec
+        The request.
+    """
+    return capture_spec(args, args.capture, method=args.method, validate=args.validate,
+                        segment_length=args.segment_length, against=args.against)
 
 
 def identify_run(args) -> int:
-    """``identify``'s action: a frequency-response table (:func:`frequency_table_header`)
-    analysed and printed as ``identify-freq`` does, saying so (a first line, and
-    ``"format": "frequency-table"`` in the JSON); anything else through the step methods.
+    """``identify``'s action: the options as the library's request
+    (:class:`~designer.identify.spec.IdentifySpec`), identified by
+    :func:`~designer.identify.spec.identify_file`; a frequency-response table analysed and printed as
+    ``identify-freq`` does, saying so (a first line, and ``"format": "frequency-table"`` in the JSON).
 
     Parameters
     ----------
@@ -527,6 +419,8 @@ def identify_run(args) -> int:
         The exit status: 0 when done.
     """
     from ..identify.report import bode_fit_plot, broadband_plot, broadband_text, fit_plot, freq_text, step_text
+    from ..identify.spec import frequency_table_header, header_text, identify_dict, identify_file
+    spec = identify_spec_of(args)
     header = frequency_table_header(args.capture)
     if header is None:
         def text(r):
@@ -534,15 +428,21 @@ def identify_run(args) -> int:
 
         def plot(r):
             return broadband_plot(r) if hasattr(r, "excitation") else fit_plot(r)
-        return _run(args, identify_capture, text, plot)
-    result = identify_frequency_table(args, header)
+
+        def identify(args):
+            if args.plot:
+                check_output_path(args.plot, "--plot")
+            return identify_file(spec)
+        return _run(args, identify, text, plot)
+    if args.plot and not spec.given() and args.out is None:
+        check_output_path(args.plot, "--plot")
+    result = identify_file(spec, ("out_folder",) if args.out is not None else ())
     if args.plot:
         write_png(args.plot, bode_fit_plot(result))
     if args.json:
-        print_output(json.dumps(json_safe({"format": FREQUENCY_TABLE, **result.to_dict()}), indent=2,
-                                allow_nan=False))
+        print_output(json.dumps(json_safe(identify_dict(result)), indent=2, allow_nan=False))
     else:
-        print_output(f"Format: frequency table (header {_header_text(header)}), analysed as identify-freq does\n"
+        print_output(f"Format: frequency table (header {header_text(header)}), analysed as identify-freq does\n"
                      + freq_text(result) + (f"\n\nPlot written to {args.plot}" if args.plot else ""))
     return 0
 

@@ -13,7 +13,7 @@ from .common import add_opamp_option, add_output_options, add_part_options, emit
 from .pid_tolerance import add_monte_carlo, loop_monte_carlo, monte_carlo_settings, replay, replay_name
 from .plant import cluster_ahead
 
-__all__ = ["analyze_pid_main", "analyze_pid_parser", "design_pid_main", "pid_parser"]
+__all__ = ["analyze_pid_main", "analyze_pid_parser", "design_pid_main", "pid_parser", "plant_capture_model"]
 
 EPILOG = """examples:
   design-pid --plant-fc 3500 --plant-zeta 0.2
@@ -225,72 +225,62 @@ def _build_spec(args):
     return pid_spec({**typed, "seed_parts": args.seed_parts, "package": args.package, "plant_process": process})
 
 
-#: identify's options that --plant-capture passes on: (argparse dest, flag, value when not given)
-CAPTURE_OPTIONS = (("step_time", "--step-time", None), ("step_amplitude", "--step-amplitude", None),
-                   ("window", "--window", None), ("format", "--format", "auto"),
-                   ("input_column", "--input-column", None), ("output_column", "--output-column", None),
-                   ("sample_time", "--sample-time", None), ("columns", "--columns", None),
-                   ("methods", "--methods", None), ("no_refine", "--no-refine", False))
-
-
 def _captured_model(args, typed):
-    """--plant-capture: the capture identified as ``identify`` does (a frequency
-    table as ``identify-freq``), its best valid model (or --plant-method's); None
-    without it. identify's options without --plant-capture are refused."""
-    given = [flag for dest, flag, unset in CAPTURE_OPTIONS if getattr(args, dest) != unset]
-    if args.plant_capture is None:
-        if given:
-            raise DesignError(f"{given[0]} is an option of --plant-capture (identify's), and no capture is given")
-        return None
+    """--plant-capture: :func:`plant_capture_model` of the capture and identify's options (refused without
+    it); None without either."""
+    from .identify import capture_params
+    params = {"capture": args.plant_capture, **capture_params(args)}
+    return plant_capture_model(params, typed.pop("plant_method") if args.plant_capture is not None else None)
+
+
+def plant_capture_model(params: dict, method: str | None = None):
+    """A PID plant from a capture: the capture identified as ``identify`` does (a frequency table as
+    ``identify-freq``: :func:`designer.identify.spec.identify_file` of
+    :func:`~designer.identify.spec.identify_spec`), its best valid model across every route (or
+    ``method``'s); what design-pid ``--plant-capture`` and the PID page's capture tune for.
+
+    Parameters
+    ----------
+    params : dict
+        :func:`~designer.identify.spec.identify_spec`'s plain parameters; ``capture`` None: no capture
+        (then any other given is refused).
+    method : str, optional
+        The identification method whose model to take instead of the best (``plant_method``).
+
+    Returns
+    -------
+    ProcessModel or None
+        The model (its source names the capture's file), or None without a capture.
+
+    Raises
+    ------
+    DesignError
+        One line naming the parameter at fault (``{name}`` markers of a ParamError).
+    """
+    import os
+
+    from ..core.errors import ParamError
     from ..core.fileio import shown
+    from ..identify.spec import identify_file, identify_spec
     from ..pid.plant_source import model_from_result
-    from . import identify as ident
-    fmt = str(args.format).strip().lower()
-    if fmt not in ("auto",) + ident.FORMATS:
-        raise DesignError(f"--format {fmt!r} unknown; allowed: auto, {', '.join(ident.FORMATS)}")
-    method = typed.pop("plant_method")
-    where = f"--plant-capture {shown(args.plant_capture)}"
-    result = _identified(args, fmt, given, ident)
+    unset = {"fmt": "auto", "refine": True}
+    if params.get("capture") is None:
+        given = [k for k, v in params.items() if k != "capture" and v is not None and v != unset.get(k)]
+        if given:
+            raise ParamError("{%s} is an option of {plant_capture} (identify's), and no capture is given" % given[0],
+                             (given[0], "plant_capture"))
+        return None
+    result = identify_file(identify_spec(params))
     best = getattr(getattr(result, "assessment", None), "best_candidate", None)
     if method is None and best is not None and not getattr(result, "refused", ""):
         # the best validation fit across every route (identify's "validation"), named with its capture
         import dataclasses
-        import os
-        return dataclasses.replace(best.model, source=f"{best.model.source} ({os.path.basename(args.plant_capture)})")
+        return dataclasses.replace(best.model, source=f"{best.model.source} ({os.path.basename(params['capture'])})")
+    where = f"plant_capture {shown(params['capture'])}"
     try:
         return model_from_result(result.to_dict(), method, name=where)
     except DesignError as exc:
-        raise DesignError(str(exc).replace("plant model --plant-capture", "--plant-capture")) from None
-
-
-def _identified(args, fmt: str, given: list, ident):
-    """The capture (or frequency table) of --plant-capture identified by the
-    library calls ``identify`` makes, with identify's option names in its messages."""
-    from ..core.fileio import shown
-    path = args.plant_capture
-    header = ident.frequency_table_header(path)
-    if header is not None:
-        if given:
-            raise DesignError(f"{', '.join(given)} {'is' if len(given) == 1 else 'are'} for a step capture; "
-                              f"{shown(path)} is a frequency-response table, analysed as identify-freq does: drop "
-                              f"{'it' if len(given) == 1 else 'them'}")
-        from ..identify.frequency import identify_freq
-        from ..identify.io import read_freq_table
-        return identify_freq(read_freq_table(path))
-    from ..core.ranges import parse_in_range
-    from ..identify.assess import identify_record
-    from ..identify.io import read_capture
-    from ..identify.preprocess import check_window
-    t_step = None if args.step_time is None else ident.step_time(args.step_time)
-    amp = None if args.step_amplitude is None else ident.step_amplitude(args.step_amplitude)
-    window = None if args.window is None else check_window(
-        [parse_in_range(v, f"--window {which}", "capture_time_s") for v, which in zip(args.window, ("T0", "T1"))])
-    from ..identify.broadband import positional_input
-    cap = positional_input(read_capture(path, **{**ident.capture_read_options(args), "fmt": fmt}))
-    edge_only = [flag for dest, flag in ident.STEP_EDGE_ONLY if dest != "against" and getattr(args, dest) is not None]
-    return identify_record(cap.t, cap.y, cap.u, step_time=t_step, step_amplitude=amp, window=window,
-                           methods=args.methods, refine=not args.no_refine, capture=cap.info(), name=shown(path),
-                           step_only_given=edge_only)
+        raise DesignError(str(exc).replace(f"plant model {where}", where), param="plant_capture") from None
 
 
 def _early(result, args):

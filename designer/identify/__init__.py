@@ -20,7 +20,9 @@ input by output error, and ``validation`` judges a model on data it was not
 fitted to (fit percentage, residual tests, an ARX reference), and
 ``recordview`` simulates the best models over the record they were scored on;
 ``against`` compares an identified plant with its design (the one use of the
-plant wing) and ``report`` prints and plots the results. The waveform
+plant wing) and ``report`` prints and plots the results; ``spec`` is a
+request about one file (``IdentifySpec``) and ``identify_file``, what the
+``identify`` command and every front end call. The waveform
 readings they share (noise, crossings, derivative, tangent) are
 :mod:`designer.core.waveform`.
 """
@@ -63,6 +65,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                "record_axes", "step_text"),
     "second_order": ("STEP_METHODS",),
     "settle": ("block_mean", "final_value"),
+    "spec": ("FREQUENCY_TABLE", "IdentifySpec", "STEP_EDGE_ONLY", "STEP_ONLY", "frequency_table_header", "header_text",
+             "identify_dict", "identify_file", "identify_spec"),
     "spectral": ("BANDS_PER_DECADE", "MAX_REL_ERROR", "MIN_COHERENCE", "log_bands", "periodic_response", "table_text",
                  "to_freq_data", "welch_response"),
     "step": ("IdentifyResult", "identify_step", "judge"),

@@ -38,7 +38,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..core import process_build as pb
-from ..core.errors import DesignError
+from ..core.errors import DesignError, ParamError
 from ..core.process import ProcessModel
 from .frequency import wide_interval
 from .outputerror import fit_output_error, simulate
@@ -686,8 +686,9 @@ def identify_record(t, y, u=None, *, step_time=None, step_amplitude=None, window
     segment_length : int, optional
         A noise input's Welch segment (samples).
     step_only_given : sequence of str
-        The caller's names of step-only settings it was given (refused, named
-        so, for a broadband capture).
+        The parameters of a step's edge it was given (:data:`designer.identify.spec.STEP_EDGE_ONLY`:
+        refused for a broadband capture, named as ``{name}`` markers of a
+        :class:`~designer.core.errors.ParamError`).
     assess_routes : bool
         Score the routes (False: the routes alone, as before validation existed).
 
@@ -716,9 +717,9 @@ def identify_record(t, y, u=None, *, step_time=None, step_amplitude=None, window
         if ex is not None:
             if step_only_given:
                 g = list(step_only_given)
-                raise DesignError(f"{', '.join(g)} {'is' if len(g) == 1 else 'are'} for a step capture; "
-                                  f"the input of {name} is broadband ({ex.kind}): drop "
-                                  f"{'it' if len(g) == 1 else 'them'}")
+                raise ParamError(f"{', '.join('{%s}' % n for n in g)} {'is' if len(g) == 1 else 'are'} for a "
+                                 f"step capture; the input of {name} is broadband ({ex.kind}): drop "
+                                 f"{'it' if len(g) == 1 else 'them'}", g)
             result = identify_broadband(t, y, u, excitation=ex, method=method, refine=refine, methods=methods,
                                         capture=capture, name=name, segment_length=segment_length)
         elif segment_length is not None:

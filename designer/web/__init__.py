@@ -6,9 +6,9 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    "forms": ("CHECK", "CheckRequest", "FILTER", "Field", "FilterRequest", "PID", "PLANT", "PidRequest",
-              "PlantRequest", "check_message", "check_request", "field_of", "filter_request", "page_message",
-              "pid_request", "plant_request"),
+    "forms": ("CAPTURE_FIELDS", "CHECK", "CheckRequest", "FILTER", "Field", "FilterRequest", "IDENTIFY", "IDENTIFY_FILES",
+              "PID", "PLANT", "PidRequest", "PlantRequest", "check_message", "check_request", "field_of", "filter_request",
+              "identify_request", "page_message", "pid_request", "plant_request"),
     "connections": ("BODY_GRACE_S", "GuardedH11", "HEADER_TIMEOUT_S", "MIN_BODY_RATE", "STOP_GRACE_S",
                     "StoppingServer"),
     "guard": ("CSP", "Guard", "JSON_PATHS", "PAGE_HEADER", "SECURITY_HEADERS", "Trust", "UPLOAD_PATHS",
@@ -16,7 +16,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "jobs": ("AXES", "BODE_POINTS", "BOM_COLUMNS", "CLI_ONLY", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "Superseded",
              "TRACES", "TRACE_POINTS", "bom_shown", "bundle_zip", "check_task", "checks_shown", "circuit_plant_page",
              "design_filter_task", "design_pid_task", "design_plant_task", "files_in", "filter_page", "histograms",
-             "identify_page", "pid_page", "plant_page", "run", "run_task", "series_text", "temporaries_in",
+             "identify_page", "identify_task", "pid_page", "plant_page", "run", "run_task", "series_text", "temporaries_in",
              "through_library", "warm_up", "written_since"),
     "pool": ("Busy", "DEFAULT_TIMEOUT_S", "MAX_WAITING", "Pool", "RECYCLE_AFTER", "SPARE", "STOPPED",
              "SUPERSEDED_GRACE_S"),

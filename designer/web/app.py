@@ -75,10 +75,9 @@ class TooLarge(Exception):
 def _parsers() -> dict:
     """The parser traits (switches, appended options) of each command still run by its argument list (the
     others are the library's, :data:`designer.web.jobs.LIBRARY`), from the CLI's own parsers."""
-    from ..cli import identify, pid, plant
+    from ..cli import pid, plant
     builders = {"analyze-plant": plant.analyze_plant_parser, "design-pid": pid.pid_parser,
-                "analyze-pid": pid.analyze_pid_parser, "identify": identify.build_parser,
-                "identify-freq": identify.build_freq_parser}
+                "analyze-pid": pid.analyze_pid_parser}
     return {prog: req.parser_traits(build()) for prog, build in builders.items()}
 
 
@@ -135,7 +134,7 @@ def create_app(pool, trust: Trust):
             return _error(400, f"designer-web: error: {exc}")
 
     async def run(request, prog: str, argv: list | None, want: str, tmp: str, upload_name: str | None = None,
-                  fields: dict | None = None, lang: str | None = None):
+                  fields: dict | None = None, lang: str | None = None, capture: str | None = None):
         # the task goes to the pool as its file's name: a message of a hundred bytes, so that the pipe to the
         # pool never fills while the pool is sending a long answer the other way (each would wait on the other)
         task_file = os.path.join(tmp, "task.json")
@@ -143,6 +142,8 @@ def create_app(pool, trust: Trust):
         task.update({"argv": argv} if argv is not None else {"fields": fields})   # no argv: the library's fields
         if lang is not None:
             task["lang"] = lang
+        if capture is not None:   # an identify request's upload
+            task["capture"] = capture
         with open(task_file, "w", encoding="utf-8") as fh:
             json.dump(task, fh)
         try:
@@ -215,12 +216,8 @@ def create_app(pool, trust: Trust):
                                    "cut or decimate it")
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
-            try:
-                options, lang = req.split_language(options)   # identify has no --lang: its page's words
-                argv = [path] + req.build_argv(options, tmp, traits[prog]) + ["--json"]
-            except DesignError as exc:
-                return _error(400, f"{prog}: error: {exc}")
-            return await run(request, prog, argv, _view(request), tmp, name, lang=lang)
+            # the library called with the request's fields and the capture: no command line
+            return await run(request, prog, None, _view(request), tmp, name, fields=options, capture=path)
 
     async def check(request: Request):
         prog = "check-design"

@@ -25,8 +25,9 @@ from ..core.i18n import gettext as _
 from ..filters.sallen_key_lowpass_parts import refs as sallen_key_refs
 from .request import option_name, value_text
 
-__all__ = ["CHECK", "CheckRequest", "FILTER", "Field", "FilterRequest", "PID", "PLANT", "PidRequest", "PlantRequest", "field_of",
-           "check_message", "check_request", "filter_request", "page_message", "pid_request", "plant_request"]
+__all__ = ["CAPTURE_FIELDS", "CHECK", "CheckRequest", "FILTER", "Field", "FilterRequest", "IDENTIFY", "IDENTIFY_FILES",
+           "PID", "PLANT", "PidRequest", "PlantRequest", "check_message", "check_request", "field_of", "filter_request",
+           "identify_request", "page_message", "pid_request", "plant_request"]
 
 
 class Field(NamedTuple):
@@ -88,6 +89,24 @@ FILTER = {
     "dist": Field("dist", N_("distribution")), "sampler": Field("sampler", N_("sampler")),
     "worst-case": Field("worst_case", N_("worst case"), "switch"),
 }
+#: the identify page's fields (the API's keys, as identify's option names) -> parameter of
+#: :func:`designer.identify.spec.identify_spec` and label (``no-refine`` sets ``refine``, inverted)
+IDENTIFY = {
+    "step-time": Field("step_time_s", N_("step time (s)")), "step-amplitude": Field("step_amplitude", N_("step amplitude")),
+    "window": Field("window", N_("window (s)"), "list"), "format": Field("fmt", N_("format")),
+    "input-column": Field("input_column", N_("input column")),
+    "output-column": Field("output_column", N_("output column")),
+    "sample-time": Field("sample_time_s", N_("sample time (s)")), "columns": Field("column_names", N_("columns")),
+    "methods": Field("methods", N_("methods"), "list"), "no-refine": Field("refine", N_("skip least squares"), "switch"),
+    "method": Field("method", N_("broadband route")), "segment-length": Field("segment_length", N_("Welch segment")),
+    "validate": Field("validate", N_("validation capture"), "file"),
+    "against": Field("against", N_("design result.json"), "file"),
+}
+#: the file an identify file field's content is written to, in the request's folder
+IDENTIFY_FILES = {"validate": "validation-capture.csv", "against": "design-result.json"}
+#: identify's fields a PID request with a plant capture takes too (design-pid's capture options)
+CAPTURE_FIELDS = ("step-time", "step-amplitude", "window", "format", "input-column", "output-column", "sample-time",
+                  "columns", "methods", "no-refine")
 #: the PID page's fields (the API's keys, as design-pid's option names) -> parameter of
 #: :func:`designer.pid.spec.pid_spec` (or of the Monte Carlo) and label
 PID = {
@@ -99,6 +118,9 @@ PID = {
     "plant-part": Field("plant_values", N_("plant parts"), "list"),
     "plant-json": Field("plant_json", N_("plant result.json"), "file"), "plant-tf": Field("plant_tf", N_("model")),
     "plant-model": Field("plant_model", N_("identified model"), "file"),
+    "plant-capture": Field("plant_capture", N_("plant capture"), "file"),
+    # the capture read and identified as identify does, with its options
+    **{k: IDENTIFY[k] for k in CAPTURE_FIELDS},
     "plant-method": Field("plant_method", N_("method")),
     "plant-input": Field("plant_input", N_("plant input range (V)")),
     "plant-output": Field("plant_output", N_("plant output range (V)")),
@@ -150,7 +172,8 @@ CHECK_WORDS = (
 PID_DEFAULTS = {"step_v": "1", "edge_s": "100n", "r_series": "E24", "c_series": "E12", "r_min": "1k", "r_max": "1M",
                 "c_min": "1n", "c_max": "10u"}
 #: the file a file field's content is written to, in the request's folder (never a path the request gives)
-PID_FILES = {"plant_json": "plant-result.json", "plant_model": "plant-model.json"}
+PID_FILES = {"plant_json": "plant-result.json", "plant_model": "plant-model.json",
+             "plant_capture": "plant-capture.csv"}
 #: the simulators a request may choose (designer.spice.simulate's backends)
 SIMULATORS = ("pyspice", "ngspice-cli")
 _FLAG = re.compile(r"--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?")
@@ -441,15 +464,14 @@ def pid_request(options, tmp: str | None) -> PidRequest:
     DesignError
         One line naming the library parameter at fault (shown by :func:`page_message`).
     """
+    from ..cli.pid import plant_capture_model
     from ..pid.spec import PLAIN_PARAMS, pid_spec
-    from .request import write_content
     v = {**PID_DEFAULTS, **_fields(options, PID)}
-    for param, filename in PID_FILES.items():
-        if param in v:
-            try:
-                v[param] = write_content(tmp, filename, v[param], param)
-            except DesignError as exc:
-                raise DesignError(str(exc), param=param) from None
+    _write_files(v, PID_FILES, tmp)
+    # a plant capture: identified first (as design-pid --plant-capture), its model the plant
+    capture = _identify_params({"capture": v.pop("plant_capture", None),
+                                **{IDENTIFY[k].param: v.pop(IDENTIFY[k].param, None) for k in CAPTURE_FIELDS}})
+    process = plant_capture_model(capture, v.pop("plant_method", None) if capture["capture"] is not None else None)
     spec_keys = ("plant_fc_hz", "plant_zeta", "plant_topology", "plant_values", "plant_json", "plant_tf",
                  "plant_model", "plant_method", "plant_input", "plant_output", "tuning", "kp", "ti_s", "td_s",
                  "target_overshoot_pct", "target_settling_s", "simc_tauc_s", "imc_lambda_s", "min_phase_margin_deg",
@@ -458,13 +480,13 @@ def pid_request(options, tmp: str | None) -> PidRequest:
                  "package") + PLAIN_PARAMS
     if v.get("package") not in (None, "single", "dual", "quad"):
         raise DesignError(f"package {v['package']!r} unknown; allowed: single, dual, quad", param="package")
-    spec = pid_spec({k: v[k] for k in spec_keys if k in v})
+    spec = pid_spec({**{k: v[k] for k in spec_keys if k in v}, "plant_process": process})
     mc = _monte_carlo(v, ("n", "seed", "sampler", "dist", "tol", "limits", "target_ci", "engine", "spice_samples"))
     _check_loop_tolerance(spec, mc, v.get("tol", ()))
     simulator = _simulator(v, "pyspice")
     name = _name(v, "pid") if "name" in v else None
     return PidRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False), simulator,
-                      bool(v.get("rules_spice")), name, _argv("design-pid", options), _replay(v, mc))
+                      bool(v.get("rules_spice")), name, _argv("design-pid", options, PID, PID_FILES), _replay(v, mc))
 
 
 def _replay(v: dict, mc) -> int | None:
@@ -487,6 +509,55 @@ def _replay(v: dict, mc) -> int | None:
     if i is None or not 0 <= i <= mc.n - 1:
         raise DesignError(f"replay {v['replay']!r}: give a whole number from 0 to {mc.n - 1}", param="replay")
     return i
+
+
+def identify_request(options, capture: str, tmp: str | None):
+    """An identify page's request (its fields; the capture already written) as the library's request.
+
+    Parameters
+    ----------
+    options : dict
+        Field -> value (:data:`IDENTIFY`'s keys; numbers or texts; a list for ``window`` and ``methods``, or
+        one text of items apart; a file field's content as a text or a JSON object).
+    capture : str
+        The uploaded capture's path (in the request's folder).
+    tmp : str or None
+        The request's private folder: a file field's content is written there (:data:`IDENTIFY_FILES`).
+
+    Returns
+    -------
+    IdentifySpec
+        Made by :func:`designer.identify.spec.identify_spec`, the mapping the command line uses too.
+
+    Raises
+    ------
+    DesignError
+        One line naming the library parameter at fault (shown by :func:`page_message`).
+    """
+    from ..identify.spec import identify_spec
+    v = _fields(options, IDENTIFY)
+    _write_files(v, IDENTIFY_FILES, tmp)
+    return identify_spec(_identify_params({"capture": capture, **v}))
+
+
+def _identify_params(v: dict) -> dict:
+    """The identify fields' values as :func:`designer.identify.spec.identify_spec`'s parameters: the format
+    menu's first entry ("") is recognised, and the field of ``refine`` is "skip least squares"."""
+    if v.get("fmt") == "":
+        v.pop("fmt")
+    return {**v, "refine": not v.get("refine")}
+
+
+def _write_files(v: dict, files: dict, tmp: str | None) -> None:
+    """Each file field's content of ``v`` written in the request's folder under its fixed name (``files``),
+    its path in its place."""
+    from .request import write_content
+    for param, filename in files.items():
+        if param in v:
+            try:
+                v[param] = write_content(tmp, filename, v[param], param)
+            except DesignError as exc:
+                raise DesignError(str(exc), param=param) from None
 
 
 def _check_loop_tolerance(spec, mc, tol) -> None:
@@ -539,9 +610,14 @@ def _name(v: dict, default: str) -> str:
     return name
 
 
-def _argv(prog: str, options: dict) -> list:
-    """The command line a request stands for (a record: nothing parses it)."""
-    return [prog] + [a for key, value in options.items() if value is not None for a in _flag_words(key, value)]
+def _argv(prog: str, options: dict, table: dict | None = None, files: dict | None = None) -> list:
+    """The command line a request stands for (a record: nothing parses it); a file field of ``table`` (its
+    parameter a key of ``files``) as the name its content was written under, never the content."""
+    def shown(key, value):
+        field = (table or {}).get(option_name(key)[2:])
+        return files[field.param] if field is not None and field.param in (files or {}) else value
+    return [prog] + [a for key, value in options.items() if value is not None
+                     for a in _flag_words(key, shown(key, value))]
 
 
 def _stimulus(v: dict):

@@ -2,8 +2,8 @@
 command as its console script does, and hand back what the page shows.
 
 Most tasks call the library directly with the request's fields (:data:`LIBRARY`: design-plant, design-filter,
-design-pid, check-design). The others name the command (``analyze-plant``, ``analyze-pid``, ``identify``,
-``design-pid`` with a capture) and its argument list, built by :mod:`.request` from the
+design-pid, check-design, identify). The others name the command (``analyze-plant``, ``analyze-pid``)
+and its argument list, built by :mod:`.request` from the
 request's option names. The command's own entry point runs it
 (``design_plant_main(argv)``...: the same parser, the same checks, the same
 one-line refusal and exit status), with stdout and stderr taken into strings;
@@ -32,10 +32,9 @@ from contextlib import contextmanager, redirect_stderr, redirect_stdout
 
 import numpy as np
 
-from ..cli import identify as cli_identify
 from ..cli import pid as cli_pid
 from ..cli import plant as cli_plant
-from ..cli.common import RESULT_HOOK, run_cli
+from ..cli.common import RESULT_HOOK
 from ..core import lifetime
 from ..core.i18n import N_, language, localise, translated
 from ..core.i18n import gettext as _
@@ -50,8 +49,8 @@ from ..tolerance import filter as filter_tolerance
 __all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "CLI_ONLY", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACES",
            "TRACE_POINTS", "Superseded", "bom_shown", "bundle_zip", "check_task", "checks_shown", "circuit_plant_page",
            "design_filter_task", "design_pid_task", "design_plant_task", "files_in", "filter_page", "histograms",
-           "identify_page", "pid_page", "plant_page", "run", "run_task", "series_text", "temporaries_in",
-           "through_library", "warm_up", "written_since"]
+           "identify_page", "identify_task", "pid_page", "plant_page", "run", "run_task", "series_text",
+           "temporaries_in", "through_library", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
@@ -149,7 +148,8 @@ def run_task(task: dict) -> dict:
         extras), "json", "sheet" (the printable build sheet), "bundle" (the
         design's files as a zip) or "check" (a library task: check-design's answer); ``tmp``:
         the request's private folder (files written there), or None; ``lang``: the language of the page's
-        words (a command with ``--lang`` takes it from there).
+        words (a command with ``--lang`` takes it from there). A command of :data:`LIBRARY` gets ``fields``
+        (the request's fields) instead of ``argv``, and identify ``capture`` (the uploaded file's path) too.
 
     Returns
     -------
@@ -163,10 +163,11 @@ def run_task(task: dict) -> dict:
             task = json.load(fh)
     if task["prog"] == "warm-up":
         return warm_up()
-    if "fields" in task:
-        return LIBRARY[task["prog"]](task["fields"], task.get("want", "json"), task.get("tmp"))
+    if "fields" in task:   # a library task: the request's fields (and an identify request's uploaded capture)
+        return LIBRARY[task["prog"]](task["fields"], task.get("want", "json"), task.get("tmp"),
+                                     **({"capture": task["capture"]} if "capture" in task else {}))
     prog, argv, want, tmp = task["prog"], list(task["argv"]), task.get("want", "json"), task.get("tmp")
-    # the page's language: a sheet command's --lang, or the server's (a command without --lang: identify)
+    # the page's language: a sheet command's --lang, or the server's
     lang = task.get("lang") or _lang_of(argv)
     seen = {}
     out, err = io.StringIO(), io.StringIO()
@@ -175,22 +176,13 @@ def run_task(task: dict) -> dict:
     sys.argv = [prog, *argv]   # the JSON's tool.argv: the command line this request stands for
     try:
         with redirect_stdout(out), redirect_stderr(err), temporaries_in(tmp), language(lang):
-            if prog in ("identify", "identify-freq"):
-                status = _identify(prog, argv, seen)
-            else:
-                status = MAINS[prog](argv)
+            status = MAINS[prog](argv)
     finally:
         RESULT_HOOK.reset(token)
         sys.argv = argv0
     answer = {"status": status, "error": _error_line(err.getvalue(), status), "json": None,
               "stderr": err.getvalue()}
     if status not in (0, 1):
-        return answer
-    if prog in ("identify", "identify-freq"):
-        answer["json"] = seen["json"]
-        if want == "page":
-            with language(lang):
-                answer["page"] = identify_page(seen["result"])
         return answer
     answer["json"] = json.loads(out.getvalue())
     result, name = seen["result"], seen["name"]
@@ -569,13 +561,45 @@ def check_task(fields: dict, want: str = "check", tmp: str | None = None) -> dic
             "lines": run.lines(), "messages": messages}
 
 
+def identify_task(fields: dict, want: str = "json", tmp: str | None = None, capture: str | None = None) -> dict:
+    """identify for the page, the library called directly: the request's fields as the library's request
+    (:func:`designer.web.forms.identify_request`, through :func:`designer.identify.spec.identify_spec`, the
+    command line's mapping), :func:`designer.identify.spec.identify_file`, and the typed result rendered
+    (:func:`identify_page`).
+
+    Parameters
+    ----------
+    fields : dict
+        The request's fields (the identify page's, :data:`designer.web.forms.IDENTIFY`).
+    want : str
+        As :func:`run`'s (``json`` or ``page``).
+    tmp : str or None
+        The request's private folder (a file field's content; every temporary file).
+    capture : str or None
+        The uploaded capture's path (in ``tmp``).
+
+    Returns
+    -------
+    dict
+        As :func:`run`'s (the JSON as ``identify --json`` prints it); a refusal's ``field`` and ``label``
+        name the page's field at fault.
+    """
+    from .forms import IDENTIFY
+
+    def work(fields, lang):
+        from ..identify.spec import identify_dict, identify_file
+        from .forms import identify_request
+        result = identify_file(identify_request(fields, capture, tmp))
+        return json_safe(identify_dict(result)), lambda: identify_page(result), None
+    return _library_task("identify", IDENTIFY, fields, work, want, tmp)
+
+
 #: the commands the page runs through the library (no console script, no argv, no printed JSON)
 LIBRARY = {"design-plant": design_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task,
-           "check-design": check_task}
-#: a command's options its page's name table does not map (design-pid's capture identified first, with identify's
-#: options): a request with one runs the command's entry point, as before
-CLI_ONLY = {"design-pid": frozenset({"plant-capture", "step-time", "step-amplitude", "window", "format", "input-column",
-                                     "output-column", "sample-time", "columns", "methods", "no-refine"})}
+           "check-design": check_task, "identify": identify_task}
+#: a command's options its page's name table does not map: a request with one would run the command's entry point
+#: (none left: design-pid's capture, replay and fail-on-check are the library's too)
+CLI_ONLY = {"design-pid": frozenset()}
 
 
 def through_library(prog: str, options) -> bool:
@@ -603,31 +627,6 @@ def through_library(prog: str, options) -> bool:
 
 
 # --------------------------------------------------------------------------- identify
-
-def _identify(prog: str, argv: list, seen: dict) -> int:
-    """``identify`` (or ``identify-freq``) as its console script runs it, the result kept:
-    the CLI's parser and its own functions (a frequency table recognised and
-    analysed as identify-freq does, as :func:`designer.cli.identify.identify_run`)."""
-    ident = cli_identify
-
-    def step_or_table(args):
-        header = ident.frequency_table_header(args.capture)
-        if header is None:
-            result = ident.identify_capture(args)
-            data = result.to_dict()
-        else:
-            result = ident.identify_frequency_table(args, header)
-            data = {"format": ident.FREQUENCY_TABLE, **result.to_dict()}
-        seen.update(result=result, json=json_safe(data))
-
-    def table(args):
-        result = ident.identify_table(args)
-        seen.update(result=result, json=json_safe(result.to_dict()))
-
-    if prog == "identify":
-        return run_cli(prog, ident.build_parser, step_or_table, argv)
-    return run_cli(prog, ident.build_freq_parser, table, argv)
-
 
 def identify_page(result) -> dict:
     """The data with the best three valid models over them (a step capture: time

@@ -115,6 +115,55 @@ def test_identify_takes_a_frequency_table_as_identify_does(server):
     assert without_run_details(got) == without_run_details(want)
 
 
+def test_identify_is_the_library_called_with_the_pages_fields(server):
+    """Issue 26: /api/identify calls designer.identify.spec.identify_file in the worker with the request's fields
+    (forms.IDENTIFY: no argv, no console script): the same JSON as ``identify --json`` with the same options."""
+    from designer.web.jobs import LIBRARY, identify_task
+    assert LIBRARY["identify"] is identify_task
+    want = cli_json("identify", str(CAPTURE), "--window", "-0.1m", "1.5m", "--no-refine", "--methods", "smith",
+                    "alfaro", "--json")
+    status, _, raw = server.post("/api/identify?window=-0.1m&window=1.5m&no-refine=true&methods=smith%20alfaro",
+                                 CAPTURE.read_bytes())
+    assert status == 200, raw
+    got = json.loads(raw)
+    for d in (got, want):
+        d["capture"].pop("source")
+    assert without_run_details(got) == without_run_details(want)
+    assert [m["name"] for m in got["methods"]][:2] != [] and {m["name"] for m in got["methods"]} <= {"smith", "alfaro"}
+
+
+@pytest.mark.parametrize("query, field, words", [
+    ("step-amplitude=0", "step-amplitude", '"step amplitude" must be non-zero'),
+    ("segment-length=3", "segment-length", '"Welch segment" must be 16 to'),
+    ("format=bogus", "format", "\"format\" 'bogus' unknown; allowed: auto, "),
+    ("window=2m&window=1m", "window", "the window must start before it ends"),
+    ("sample-time=0", "sample-time", '"sample time (s)" must be'),
+    ("methods=nosuch", None, "nosuch"),
+])
+def test_a_refused_identify_names_the_pages_field_never_a_flag(server, query, field, words):
+    from designer.web.forms import IDENTIFY
+    status, got = server.post_json(f"/api/identify?{query}", CAPTURE.read_bytes())
+    assert status == 400 and words in got["message"] and "--" not in got["message"], got
+    assert got["error"].startswith("identify: error: ") and "\n" not in got["error"]
+    if field is not None:
+        assert got["option"] == "--" + field and got["label"] == IDENTIFY[field].label
+
+
+def test_identify_of_a_table_refuses_step_fields_by_their_labels_in_the_requests_language(server):
+    table = FIXTURES / "identify_freq" / "seed003_table31.csv"
+    status, got = server.post_json("/api/identify?filename=t.csv&step-time=0&no-refine=true", table.read_bytes())
+    assert status == 400, got
+    assert got["message"].startswith('"step time (s)", "skip least squares" are for a step capture; ')
+    assert got["option"] == "--step-time" and "frequency-response table" in got["message"]
+    from designer.core.i18n import gettext, language
+    from designer.web.forms import IDENTIFY
+    status, es = server.post_json("/api/identify?filename=t.csv&segment-length=3&lang=es", CAPTURE.read_bytes())
+    with language("es"):
+        label = gettext(IDENTIFY["segment-length"].label)
+    assert status == 400 and es["label"] == label and f'"{label}"' in es["message"], es
+    assert "must be" not in es["message"]
+
+
 @pytest.mark.parametrize("body, argv", [
     ({"fc": 3500, "zeta": -1}, ["--fc", "3500", "--zeta", "-1"]),
     ({"fc": "3.5q", "zeta": 0.2}, ["--fc", "3.5q", "--zeta", "0.2"]),
@@ -583,10 +632,10 @@ MALFORMED = [
     ("/api/plant", b'{"fc": 1e999, "zeta": 0.5}', {}, "finite number"),
     ("/api/plant", b'{"fc": NaN, "zeta": 0.5}', {}, "finite number"),
     ("/api/identify?window=%ff%fe&x=%00", CAPTURE.read_bytes(), {}, "error"),
-    ("/api/identify?window=1", CAPTURE.read_bytes(), {}, "--window takes 2 values, got 1"),
-    ("/api/identify?window=1&window=2&window=3", CAPTURE.read_bytes(), {}, "--window takes 2 values, got 3"),
-    ("/api/identify?step-time=1&step-time=2", CAPTURE.read_bytes(), {}, "--step-time takes one value, got 2"),
-    ("/api/identify?help=1", CAPTURE.read_bytes(), {}, "--help is set by the web page"),
+    ("/api/identify?window=1", CAPTURE.read_bytes(), {}, '"window (s)" takes 2 values, got 1'),
+    ("/api/identify?window=1&window=2&window=3", CAPTURE.read_bytes(), {}, '"window (s)" takes 2 values, got 3'),
+    ("/api/identify?step-time=1&step-time=2", CAPTURE.read_bytes(), {}, '"step time (s)" takes one value, got 2'),
+    ("/api/identify?help=1", CAPTURE.read_bytes(), {}, "help is set by the web page"),
     ("/api/identify?methods=-h", CAPTURE.read_bytes(), {}, "error"),
     ("/api/identify?%80=1", CAPTURE.read_bytes(), {}, "is not an option name"),
     ("/api/check", b"junk", {"Content-Type": "multipart/form-data"}, "boundary"),
@@ -928,19 +977,27 @@ def test_a_spanish_request_is_refused_in_spanish_naming_its_field(server):
     assert "--lang=es" in pid["result"]["tool"]["argv"]
 
 
-def test_pid_with_a_capture_runs_design_pid_as_before(server):
-    """Issue 26: the options the PID page's name table does not map (a capture identified first, with
-    identify's options) still work: such a request runs design-pid's entry point, the JSON its --json."""
+def test_pid_with_a_capture_is_the_library_called_with_the_pages_fields(server, tmp_path):
+    """Issue 26: a PID request with a plant capture (and identify's options) goes through the library too
+    (forms.PID maps them; designer.cli.pid.plant_capture_model identifies it, its model the plant_process of
+    pid_spec): the JSON is design-pid --plant-capture's; no option runs design-pid's entry point any more (replay
+    and fail-on-check are the library's too). A capture option without the capture is refused naming both fields by their labels."""
     from designer.web.jobs import CLI_ONLY, through_library
-    assert not through_library("design-pid", {"plant_capture": "x"}) and through_library("design-pid", {"kp": 1})
-    assert "plant-capture" in CLI_ONLY["design-pid"]
+    assert through_library("design-pid", {"plant_capture": "x"}) and through_library("design-pid", {"kp": 1})
+    assert not CLI_ONLY["design-pid"]
     assert through_library("design-pid", {"replay": 1}) and through_library("design-pid", {"fail-on-check": True})
     status, got = server.post_json("/api/pid", {"plant-capture": CAPTURE.read_text(), "tuning": "amigo",
-                                                "no-sim": True})
+                                                "window": ["-0.1m", "1.5m"], "no-refine": True, "no-sim": True})
     assert status == 200, got
-    want = cli_json("design-pid", "--plant-capture", str(CAPTURE), "--tuning", "amigo", "--no-sim", "--json",
-                    "--no-files")
-    assert got["tuning"] == want["tuning"] and got["tuning"]["method"] == "amigo"
+    same = tmp_path / "plant-capture.csv"   # the name the page's content is written under: the model's source
+    same.write_bytes(CAPTURE.read_bytes())
+    want = cli_json("design-pid", "--plant-capture", str(same), "--tuning", "amigo", "--window", "-0.1m", "1.5m",
+                    "--no-refine", "--no-sim", "--json", "--no-files")
+    assert without_run_details(got) == without_run_details(want)
+    assert got["tuning"]["method"] == "amigo"
+    status, bad = server.post_json("/api/pid", {"plant-tf": "K=1 tau=1m", "step-time": "1m"})
+    assert status == 400 and bad["message"].startswith('"step time (s)" is an option of "plant capture"'), bad
+    assert bad["option"] == "--step-time" and "--" not in bad["message"]
 
 
 def test_pid_replays_a_build_through_the_library_as_design_pid_does(server):

@@ -2,6 +2,7 @@
 library refusal in the page's words (the field's label, never a --flag, a value as it was typed)."""
 
 import dataclasses
+from pathlib import Path
 
 import pytest
 
@@ -88,13 +89,16 @@ def test_bad_filter_fields_are_refused_in_the_pages_words(fields, param):
 
 def test_every_pid_field_is_a_design_pid_option_setting_a_parameter_of_the_specs_or_of_the_run():
     """Issue 26: the PID page's fields are design-pid's option names, each setting a parameter of
-    designer.pid.spec.pid_spec (the spec's fields and its plain parameters), of the Monte Carlo or of the run."""
+    designer.pid.spec.pid_spec (the spec's fields and its plain parameters), of the Monte Carlo, of the run, or of
+    the plant capture's identification (plant_capture and designer.identify.spec.IdentifySpec's fields)."""
     from designer.cli.pid import pid_parser
+    from designer.identify.spec import IdentifySpec
     from designer.pid.plant_spec import PLANT_FIELDS
     from designer.pid.spec import PLAIN_PARAMS, PidSpec
     from designer.web.forms import PID
     specs = ({f.name for f in dataclasses.fields(PidSpec)} | set(PLANT_FIELDS) | set(PLAIN_PARAMS)
-             | {f.name for f in dataclasses.fields(MonteCarloSpec)})
+             | {f.name for f in dataclasses.fields(MonteCarloSpec)}
+             | {f.name for f in dataclasses.fields(IdentifySpec)} | {"plant_capture"})
     assert {f.param for f in PID.values()} <= specs | {"no_sim", "simulator", "name", "worst_case", "rules_spice", "replay"}
     assert len({f.label for f in PID.values()}) == len(PID)
     options = {o for a in pid_parser()._actions for o in a.option_strings}
@@ -200,3 +204,32 @@ def test_a_replay_is_checked_as_design_pid_checks_it(tmp_path, fields, param, wo
     assert caught.value.param == param and words in text and "--" not in text, text
     assert pid_request({"plant-fc": 3500, "plant-zeta": 0.2, "replay": "9", "monte-carlo": 10},
                        str(tmp_path)).replay == 9
+
+
+def test_every_identify_field_is_an_identify_option_setting_a_parameter_of_the_spec():
+    """Issue 26: the identify page's fields are identify's option names, each setting a parameter of
+    designer.identify.spec.identify_spec; an identify request is the spec identify builds from its options."""
+    from designer.cli.identify import build_parser, identify_spec_of
+    from designer.identify.spec import IdentifySpec
+    from designer.web.forms import IDENTIFY, identify_request
+    assert {f.param for f in IDENTIFY.values()} <= {f.name for f in dataclasses.fields(IdentifySpec)}
+    assert len({f.label for f in IDENTIFY.values()}) == len(IDENTIFY)
+    options = {o for a in build_parser()._actions for o in a.option_strings}
+    assert {f"--{k}" for k in IDENTIFY} <= options
+    argv = ["c.csv", "--step-time", "1m", "--step-amplitude", "-2", "--window", "0", "5m", "--format", "rigol",
+            "--input-column", "2", "--methods", "smith", "alfaro", "--no-refine", "--segment-length", "64"]
+    rq = identify_request({"step-time": "1m", "step-amplitude": -2, "window": "0 5m", "format": "RIGOL",
+                           "input-column": 2, "methods": ["smith", "alfaro"], "no-refine": "on",
+                           "segment-length": 64}, "c.csv", None)
+    assert rq == identify_spec_of(build_parser().parse_args(argv))
+    assert identify_request({"format": ""}, "c.csv", None) == IdentifySpec("c.csv")
+
+
+def test_a_pid_request_records_a_file_fields_name_never_its_content(tmp_path):
+    """tool.argv of a PID request with a capture (or a model) names the file its content was written under, as the
+    command line it stands for would; the content (a capture of up to 4 MiB) stays out of the result's JSON."""
+    from designer.web.forms import PID_FILES, pid_request
+    capture = (Path(__file__).resolve().parents[1] / "fixtures" / "identify" / "tektronix_mso.csv").read_text()
+    rq = pid_request({"plant-capture": capture, "tuning": "amigo"}, str(tmp_path))
+    assert rq.argv == ["design-pid", f"--plant-capture={PID_FILES['plant_capture']}", "--tuning=amigo"]
+    assert rq.spec.process is not None and rq.spec.process.source.endswith("(plant-capture.csv)")

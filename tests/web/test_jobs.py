@@ -66,7 +66,7 @@ def test_a_broadband_capture_gives_its_step_and_spectrum_traces(tmp_path):
     y = lfilter([1 - a], [1, -a], u)
     path = tmp_path / "prbs.csv"
     np.savetxt(path, np.column_stack([np.arange(u.size) * ts, u, y]), delimiter=",", header="t,u,y", comments="")
-    out = jobs.run({"prog": "identify", "argv": [str(path), "--json"], "want": "page"})
+    out = jobs.run({"prog": "identify", "fields": {}, "capture": str(path), "want": "page"})
     assert out["status"] == 0, out["error"]
     assert out["json"]["format"] == "broadband" and out["json"]["best"]["model"] in ("fopdt", "overdamped")
     page = out["page"]
@@ -174,7 +174,7 @@ def test_a_chirp_capture_page_draws_the_record_with_its_models_and_every_candida
     from designer.identify.assess import identify_record
     from designer.identify.io import read_capture
     path = chirp_capture(tmp_path)
-    out = jobs.run({"prog": "identify", "argv": [str(path), "--json"], "want": "page"})
+    out = jobs.run({"prog": "identify", "fields": {}, "capture": str(path), "want": "page"})
     assert out["status"] == 0, out["error"]
     page = out["page"]
     json.dumps(page, allow_nan=False)

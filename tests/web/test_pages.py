@@ -582,14 +582,17 @@ def test_the_plant_pages_tolerance_panel_shows_yield_histogram_and_the_part_to_t
     assert page.inner_text(".field-error").startswith('"Monte Carlo builds" must be a whole number from 10')
 
 
-def test_every_plant_field_has_the_label_of_the_name_table(page, server):
-    """One name table per front end: the page's labels are designer.web.forms.PLANT's."""
-    from designer.web.forms import PLANT
-    open_page(page, server, "/plant")
+@pytest.mark.parametrize("path, table", [("/plant", "PLANT"), ("/identify", "IDENTIFY")])
+def test_every_plant_field_has_the_label_of_the_name_table(page, server, path, table):
+    """One name table per front end: the page's labels are designer.web.forms.PLANT's (the identify page's
+    IDENTIFY's, issue 26)."""
+    from designer.web import forms
+    fields = getattr(forms, table)
+    open_page(page, server, path)
     names = page.evaluate("[...document.querySelectorAll('#form [name]')].map(e => e.name)")
     assert names
     for name in names:
-        assert page.evaluate(f"D.labelOf(document.getElementById('form'), '{name}')") == PLANT[name].label, name
+        assert page.evaluate(f"D.labelOf(document.getElementById('form'), '{name}')") == fields[name].label, name
 
 
 def test_the_plant_page_shows_the_sheets_content(page, server):
