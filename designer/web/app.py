@@ -76,8 +76,7 @@ def _parsers() -> dict:
     """The parser traits (switches, appended options) of each command still run by its argument list (the
     others are the library's, :data:`designer.web.jobs.LIBRARY`), from the CLI's own parsers."""
     from ..cli import pid, plant
-    builders = {"analyze-plant": plant.analyze_plant_parser, "design-pid": pid.pid_parser,
-                "analyze-pid": pid.analyze_pid_parser}
+    builders = {"analyze-plant": plant.analyze_plant_parser, "analyze-pid": pid.analyze_pid_parser}
     return {prog: req.parser_traits(build()) for prog, build in builders.items()}
 
 

@@ -61,7 +61,6 @@ BODE_POINTS = 300
 #: in, status out); the others are :data:`LIBRARY`'s
 MAINS = {
     "analyze-plant": cli_plant.analyze_plant_main,
-    "design-pid": cli_pid.design_pid_main,
     "analyze-pid": cli_pid.analyze_pid_main,
 }
 

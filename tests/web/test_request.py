@@ -66,12 +66,12 @@ def all_traits() -> dict:
 
 
 def test_the_server_builds_argument_lists_only_for_the_commands_not_yet_the_librarys():
-    """Issue 26: the commands the page runs through the library (design-plant, design-filter, check-design, and
-    design-pid but with a capture) have no entry point nor parser traits left in the server."""
+    """Issue 26: the commands the page runs through the library (design-plant, design-filter, design-pid,
+    check-design, identify) have no entry point nor parser traits left in the server."""
     from designer.web.app import _parsers
     from designer.web.jobs import LIBRARY, MAINS
-    assert set(_parsers()) == set(MAINS) | {"identify", "identify-freq"}
-    assert not set(LIBRARY) & set(MAINS) - {"design-pid"}
+    assert set(_parsers()) == set(MAINS)
+    assert not set(LIBRARY) & set(MAINS)
     for prog, traits in _parsers().items():
         assert traits == all_traits()[prog]
 
