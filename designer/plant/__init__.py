@@ -16,7 +16,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                        "check_opamp_reach", "design_circuit_plant", "tolerance_nominal"),
     "circuit": ("BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "candidate_set", "capacitor_combinations",
                 "circuit_figures", "corner_frequencies", "dominant_pairs", "evaluate", "opamp_tf", "plant_target",
-                "search"),
+                "search", "step_of_pair"),
     "bench": ("PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",
               "tolerance_band"),
     "design": ("R_BAND", "analyze_plant", "choose_parts", "design_plant", "listed"),

@@ -151,3 +151,41 @@ def test_analyze_plant_part_refusals_are_one_line(args, words, tmp_path):
     for w in words:
         assert w in line, (w, line)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.spice
+def test_engine_both_on_a_section_runs_each_build_s_ac_in_ngspice(tmp_path):
+    """--engine both: the CSV's SPICE rows are the analytic engine's next to them (its dominant pair: fn within
+    1 %), the model's rows recomputed from the parts exactly; --spice-samples checks the tails."""
+    topology = REGISTRY["mfb-lowpass"]
+    args = [*target_args(topology), "--monte-carlo", "30", "--seed", "2", "--limit", "fn_hz=950:1050",
+            "--simulator", "ngspice-cli", "--json"]
+    out = run(*args, "--engine", "both", "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    assert d["monte_carlo"]["spice"]["engine"] == "both"
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    col = lambda k: np.array([float(r[k]) for r in rows])  # noqa: E731
+    figs = circuit.circuit_figures(topology, {r: col(r) for r in topology.designators},
+                                   get_opamp(d["opamp"]["name"]))
+    assert np.allclose(col("model_fn_hz"), figs["fn_hz"], rtol=1e-8)
+    assert np.allclose(col("fn_hz"), figs["fn_hz"], rtol=0.01)
+    picked = run(*args, "--engine", "both", "--spice-samples", "2", "--no-files")
+    assert picked.returncode == 0, picked.stderr
+    assert json.loads(picked.stdout)["monte_carlo"]["spice"]["samples_checked"] >= 2
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--monte-carlo", "20", "--replay", "3"], ["--replay", "sallen-key-lowpass's for now", "--engine analytic, spice"]),
+    (["--engine", "spice"], ["--engine spice goes with --monte-carlo N"]),
+    (["--monte-carlo", "20", "--spice-samples", "2"], ["--spice-samples K goes with --engine both"]),
+])
+def test_what_a_section_plant_has_not_is_one_line(args, words, tmp_path):
+    out = run(*target_args(REGISTRY["mfb-lowpass"]), *args, "--no-sim", cwd=tmp_path)
+    assert out.returncode == 2 and out.stdout == ""
+    line = out.stderr.strip()
+    assert "\n" not in line
+    for w in words:
+        assert w in line, (w, line)
+    assert list(tmp_path.iterdir()) == []
