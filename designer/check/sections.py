@@ -231,22 +231,36 @@ def read_plant_designs(doc, corners):
 
 
 def read_circuit_designs(doc, corners, topo, target):
-    """A plant on another registered topology: designed from ``target:`` (``parts:`` keys are the
-    topology's designators; parts as built are the Sallen-Key low-pass's for now)."""
+    """A plant on another registered topology: designed from ``target:`` or its ``parts:`` as built
+    (keys: the topology's designators, every one)."""
+    from ..plant.circuit_design import CircuitAnalysisSpec
     from ..plant.spec import PlantSpec
     parts = doc.mapping(("parts",), topo.designators)
+    common = _common(doc, "plant")
+    if "square_hz" in common:
+        raise doc.error(("stimulus", "frequency"), f"stimulus.frequency: {topo.name} is checked by its .ac "
+                        "sweep; the square wave is the sallen-key-lowpass's")
     if parts:
-        raise doc.error(("parts",), f"parts: as built are the sallen-key-lowpass's for now; give {topo.name} a "
-                        f"target: (its parts are {', '.join(topo.designators)})")
+        for k in ("gain", "compensate_gbw"):
+            if k in target:
+                raise doc.error(("target", k), f"target.{k} applies to a design; with parts: the gain is the "
+                                "parts'")
+        if doc.data.get("bounds") is not None:
+            raise doc.error(("bounds",), "bounds: limit a design's part search; parts: are already chosen")
+        missing = [r for r in topo.designators if r not in parts]
+        if missing:
+            raise doc.error(("parts",), f"parts: {topo.name} needs {', '.join(missing)} too; its parts are "
+                            f"{', '.join(topo.designators)}")
+        kw = {k: v for k, v in common.items() if k in ("r_series", "c_series")}
+        table = {**PLANT_KEYS, "part": "parts", **{f"part {r}": f"parts.{r}" for r in topo.designators}}
+        return [built_in_spec_words(doc, table, lambda amp=amp: CircuitAnalysisSpec(
+            topo.name, dict(parts), opamp=amp, target_fc_hz=target.get("fc"), target_zeta=target.get("zeta"), **kw))
+            for amp in corners], True
     need = ("fc", "zeta") if topo.order == 2 else ("fc",)
     for k in need:
         if k not in target:
             raise doc.error(("target",), f"target needs {' and '.join(need)}: the {topo.name} plant to design")
     extra = {k: target[k] for k in ("gain", "compensate_gbw") if k in target}
-    common = _common(doc, "plant")
-    if "square_hz" in common:
-        raise doc.error(("stimulus", "frequency"), f"stimulus.frequency: {topo.name} is checked by its .ac "
-                        "sweep; the square wave is the sallen-key-lowpass's")
     return [built_in_spec_words(doc, PLANT_KEYS, lambda amp=amp: PlantSpec(
         fc_hz=target["fc"], zeta=target.get("zeta"), opamp=amp, alternatives=1, topology=topo.name, **extra,
         **common)) for amp in corners], False

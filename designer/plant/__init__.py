@@ -12,8 +12,9 @@ from ..core.exports import lazy_exports
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "circuit_report": ("bom", "sections", "title_of"),
-    "circuit_design": ("CircuitPlantResult", "GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "analyze_circuit_plant",
-                       "check_opamp_reach", "design_circuit_plant", "tolerance_nominal"),
+    "circuit_design": ("CircuitAnalysisSpec", "CircuitPlantResult", "GBW_MARGIN", "SPICE_DB", "SPICE_DEG",
+                       "analyze_circuit_plant", "analyze_circuit_spec", "check_circuit_parts", "check_opamp_reach",
+                       "design_circuit_plant", "tolerance_nominal"),
     "circuit": ("BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "candidate_set", "capacitor_combinations",
                 "circuit_figures", "corner_frequencies", "dominant_pairs", "evaluate", "opamp_tf", "plant_target",
                 "search", "step_of_pair"),

@@ -42,8 +42,9 @@ from . import circuit
 from .design import MAX_ERROR, candidates, part_series
 from .result import METRICS, PLANT_SCHEMA_VERSION, Sourcing, Target
 
-__all__ = ["GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "CircuitPlantResult", "design_circuit_plant", "check_opamp_reach",
-           "analyze_circuit_plant", "tolerance_nominal"]
+__all__ = ["GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "CircuitAnalysisSpec", "CircuitPlantResult", "design_circuit_plant",
+           "check_opamp_reach", "analyze_circuit_plant", "analyze_circuit_spec", "check_circuit_parts",
+           "tolerance_nominal"]
 
 #: the op-amp's gain-bandwidth a section needs, in units of fn x Q x noise gain
 GBW_MARGIN = 10.0
@@ -337,17 +338,8 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
         A part missing, not the section's, or out of range; a bad target or series (one line each).
     """
     topo = registry.get(topology)
-    unknown = [r for r in values if r not in topo.designators]
-    missing = [r for r in topo.designators if r not in values]
-    if unknown or missing:
-        what = f"has no part {unknown[0]}" if unknown else f"needs {', '.join(missing)} too"
-        raise DesignError(f"part: {topo.name} {what}; its parts are {', '.join(topo.designators)}", param="part")
-    parsed = {r: parse_in_range(values[r], f"part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
-              for r in topo.designators}
-    fc = None if target_fc_hz is None else parse_in_range(target_fc_hz, "target_fc_hz", "fc_hz")
-    zeta = None if target_zeta is None else parse_in_range(target_zeta, "target_zeta", "zeta")
-    if zeta is not None and topo.order == 1:
-        raise DesignError(f"target_zeta: {topo.name} is first-order and has no damping", param="target_zeta")
+    parsed = check_circuit_parts(topo, values)
+    fc, zeta = _analysis_target(topo, target_fc_hz, target_zeta)
     amp = opamps.get(opamp)
     amp.package(package)
     series = [None if s is None else series_name(s) for s in (r_series, c_series)]
@@ -358,6 +350,104 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
              + f", gain {gain:.4g}", *why]
     return _analyse(topo, "analyze", Target(fc, zeta, gain), parsed, None, [], Sourcing(r_s, c_s, labels), amp,
                     notes, package, simulate, simulator)
+
+
+def _analysis_target(topo, target_fc_hz, target_zeta) -> tuple:
+    """(fc, zeta) an analysis reports its errors against, checked (None: not given)."""
+    fc = None if target_fc_hz is None else parse_in_range(target_fc_hz, "target_fc_hz", "fc_hz")
+    zeta = None if target_zeta is None else parse_in_range(target_zeta, "target_zeta", "zeta")
+    if zeta is not None and topo.order == 1:
+        raise DesignError(f"target_zeta: {topo.name} is first-order and has no damping", param="target_zeta")
+    return fc, zeta
+
+
+def check_circuit_parts(topology, values: dict) -> dict:
+    """A section's parts as built, checked: every declared part once, each a value in range.
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    values : dict
+        Designator -> value (a number or engineering notation).
+
+    Returns
+    -------
+    dict
+        Designator -> value (ohm, farad), in the section's order.
+
+    Raises
+    ------
+    DesignError
+        A part missing, not the section's, or out of range (one line, ``param`` "part").
+    """
+    unknown = [r for r in values if r not in topology.designators]
+    missing = [r for r in topology.designators if r not in values]
+    if unknown or missing:
+        what = f"has no part {unknown[0]}" if unknown else f"needs {', '.join(missing)} too"
+        raise DesignError(f"part: {topology.name} {what}; its parts are {', '.join(topology.designators)}",
+                          param="part")
+    return {r: parse_in_range(values[r], f"part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
+            for r in topology.designators}
+
+
+@dataclass(frozen=True)
+class CircuitAnalysisSpec:
+    """A section's parts as built, to analyse (check-design's ``topology:`` with ``parts:``); the
+    parts are checked when the spec is made (:func:`check_circuit_parts`).
+
+    Parameters
+    ----------
+    topology : str
+        A registered section's name.
+    values : dict
+        Designator -> value, every declared part.
+    opamp : str
+        The op-amp's catalogue name.
+    target_fc_hz, target_zeta : float or str, optional
+        What the errors are reported against.
+    r_series, c_series : str, optional
+        Where the parts come from (None: the smallest series holding each value).
+    package : str, optional
+        The op-amp package of the wiring.
+    """
+
+    topology: str
+    values: dict
+    opamp: str = "LM741"
+    target_fc_hz: object = None
+    target_zeta: object = None
+    r_series: str | None = None
+    c_series: str | None = None
+    package: str | None = None
+
+    def __post_init__(self):
+        topo = registry.get(self.topology)
+        check_circuit_parts(topo, self.values)
+        _analysis_target(topo, self.target_fc_hz, self.target_zeta)
+        opamps.get(self.opamp)
+
+
+def analyze_circuit_spec(spec: CircuitAnalysisSpec, simulate: bool = True,
+                         simulator: str = "ngspice-cli") -> CircuitPlantResult:
+    """:func:`analyze_circuit_plant` of a :class:`CircuitAnalysisSpec`.
+
+    Parameters
+    ----------
+    spec : CircuitAnalysisSpec
+        The parts as built.
+    simulate : bool
+        Run ngspice's .ac of the deck.
+    simulator : str
+        :func:`designer.spice.simulate.get_simulator`'s name.
+
+    Returns
+    -------
+    CircuitPlantResult
+        The typed result (``mode`` "analyze").
+    """
+    return analyze_circuit_plant(spec.topology, spec.values, spec.opamp, spec.target_fc_hz, spec.target_zeta,
+                                 spec.r_series, spec.c_series, spec.package, simulate=simulate, simulator=simulator)
 
 
 def _analyse(topo, mode: str, target: Target, values: dict, ideal, ranked: list, sourcing: Sourcing, amp, notes: list,
