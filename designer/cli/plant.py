@@ -441,15 +441,14 @@ def _design_circuit(args, topo) -> int:
 def _circuit_unsupported(args, topo, options=()) -> None:
     """The options the plant on another topology has not (yet): refused in one line."""
     unsupported = [f for f, v in (("--stimulus prbs", args.stimulus == "prbs"), ("--prbs-bits", args.prbs_bits),
-                                  ("--prbs-clock", args.prbs_clock), ("--square-freq", args.square_freq),
-                                  ("--replay", args.replay),
+                                  ("--prbs-clock", args.prbs_clock), ("--replay", args.replay),
                                   ("--tol GBW/SR", any(str(t).split("=")[0].strip().upper() in ("GBW", "SR")
                                                        for t in args.tol or ())), *options)
                    if v]
     if unsupported:
         raise DesignError(f"{unsupported[0].split()[0]}: {unsupported[0]} is the {DEFAULT_TOPOLOGY}'s for now; "
-                          f"--topology {topo.name} has the .ac check and the Monte Carlo (--engine analytic, spice "
-                          "or both, its SPICE engine an .ac per build)")
+                          f"--topology {topo.name} has the .ac check, design-plant's --square-freq test and the Monte "
+                          "Carlo (--engine analytic, spice or both, its SPICE engine an .ac per build)")
 
 
 def _analyze_circuit(args, topo) -> int:
@@ -458,7 +457,7 @@ def _analyze_circuit(args, topo) -> int:
     if named:
         raise DesignError(f"--{named[0]} is the {DEFAULT_TOPOLOGY}'s; give {topo.name}'s parts as --part REF=VALUE "
                           f"({', '.join(topo.designators)})")
-    _circuit_unsupported(args, topo)
+    _circuit_unsupported(args, topo, (("--square-freq", args.square_freq),))
     from ..core.units import value_code
     from ..plant.circuit_design import analyze_circuit_plant
     from ..plant.circuit_report import summary_text, write_outputs

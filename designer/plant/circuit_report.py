@@ -220,6 +220,9 @@ def write_outputs(result, out_dir, name: str, lang: str | None = None) -> dict:
         The files written.
     """
     texts = {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))), **csv_texts(result)}
+    if result.square is not None:     # --square-freq: the bench test's deck and its waveforms
+        texts.update({"square_deck": ("square-test.cir", lambda r: r.square.deck),
+                      "waveforms_csv": ("waveforms.csv", lambda r: r.square.csv_text())})
     with language(lang):
         return write_design(result, out_dir, name, [], schematic, lambda svg: sections(result, True, svg),
                             title_of(result), texts)

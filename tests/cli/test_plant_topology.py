@@ -189,3 +189,28 @@ def test_what_a_section_plant_has_not_is_one_line(args, words, tmp_path):
     for w in words:
         assert w in line, (w, line)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.spice
+def test_square_freq_on_a_section_simulates_the_bench_test(tmp_path):
+    """--square-freq: one period in ngspice against the op-amp-aware model (NRMS below 1), its deck and
+    waveforms in the bundle; the waveforms' model column recomputed from the input by superposition."""
+    out = run(*target_args(REGISTRY["mfb-lowpass"]), "--opamp", "TL072", "--square-freq", "300", "--json",
+              "--simulator", "ngspice-cli", "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    sq = d["square_test"]
+    assert sq["pass"] and sq["nrms"] < 1 and sq["generator"]["frequency_hz"] == 300
+    assert any(c["id"] == "square_wave_agreement" and c["ok"] for c in d["checks"])
+    assert "PULSE(" in Path(d["files"]["square_deck"]).read_text()
+    w = np.genfromtxt(d["files"]["waveforms_csv"], delimiter=",", names=True)
+    assert w["input_v"].max() == pytest.approx(2.0) and np.all(np.diff(w["time_s"]) >= 0)
+
+
+def test_analyze_plant_square_freq_on_a_section_is_refused(tmp_path):
+    out = analyze("--topology", "rc-lowpass", "--part", "R1=1k", "--part", "C1=100n", "--square-freq", "100",
+                  "--no-sim", cwd=tmp_path)
+    assert out.returncode == 2 and out.stdout == ""
+    line = out.stderr.strip()
+    assert "\n" not in line and "--square-freq" in line and "design-plant's --square-freq" in line
+    assert list(tmp_path.iterdir()) == []
