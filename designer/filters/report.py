@@ -169,7 +169,8 @@ def draw_cascade(b, result, sheet: Sheet | None = None) -> Sheet:
     b : designer.spice.deck.Board
         The board.
     result : FilterDesign
-        The design (the stages' titles).
+        The design (the stages' titles); with one stage every part of the board is its own, unprefixed
+        (a section plant's sheet, :func:`designer.plant.circuit_report.schematic`).
     sheet : Sheet, optional
         Draw on this sheet (a new one by default).
 

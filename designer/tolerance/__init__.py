@@ -32,7 +32,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                "Scale", "parse_jobs",),
     "sampling": ("CHUNK", "SAMPLERS", "deviations", "unit_samples", "values",),
     "spice_ac": ("AcContext", "POINTS_PER_DECADE", "SPAN", "fit", "section_chunk", "section_evaluate",),
-    "spice_engine": ("commands", "measures", "parse",),
+    "spice_engine": ("batched", "commands", "measures", "parse",),
     "spice_loop_mc": ("loop_monte_carlo_engine",),
     "spice_mc": ("plant_monte_carlo_engine", "replay_values", "run_engine", "section_monte_carlo_engine",
                  "spice_samples",),

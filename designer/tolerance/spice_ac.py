@@ -45,10 +45,6 @@ FIGURES = ("fn_hz", "zeta", "q", "gain")
 #: the sweep: fn / SPAN .. fn x SPAN, POINTS_PER_DECADE a decade (10 points at the default)
 SPAN = 3.0
 POINTS_PER_DECADE = 10
-#: builds per ngspice run (bounds one run's output and time; a chunk larger than this takes several)
-BATCH = 1000
-#: seconds allowed per build of a batch, on top of the simulator's fixed timeout
-SECONDS_PER_SAMPLE = 1.0
 _ROW = re.compile(r"^\s*MCROW (\d+)\s*$", re.M)
 _VALUES = re.compile(r"^\s*(MCF|MCRE|MCIM)\s+(.*)$", re.M)
 
@@ -220,7 +216,7 @@ def fit(f_hz, h, order: int, zeros: int) -> dict:
 
 def evaluate(ctx: AcContext, values: dict, start: int = 0) -> dict:
     """Every figure of :data:`FIGURES` for a chunk of builds (designator -> array), each
-    simulated in ngspice: one loaded circuit per :data:`BATCH` builds.
+    simulated in ngspice: one loaded circuit per :data:`designer.tolerance.spice_engine.BATCH` builds.
 
     Parameters
     ----------
@@ -236,19 +232,13 @@ def evaluate(ctx: AcContext, values: dict, start: int = 0) -> dict:
     dict
         Figure -> array over the builds.
     """
-    from ..spice.simulate import DEFAULT_TIMEOUT_S, get_simulator
-    values = {k: np.atleast_1d(np.asarray(v, float)) for k, v in values.items()}
-    n = len(next(iter(values.values())))
-    out = {k: np.full(n, np.nan) for k in FIGURES}
-    for lo in range(0, n, BATCH):
-        hi = min(n, lo + BATCH)
-        chunk = {k: v[lo:hi] for k, v in values.items()}
-        sim = get_simulator(ctx.simulator, timeout=DEFAULT_TIMEOUT_S + SECONDS_PER_SAMPLE * (hi - lo))
-        f, h = parse(sim.run_script(ctx.circuit, commands(ctx, chunk, start + lo)), start + lo, hi - lo)
-        figs = fit(f, h, ctx.order, ctx.zeros)
-        for k in FIGURES:
-            out[k][lo:hi] = figs[k]
-    return out
+    from .spice_engine import batched
+
+    def run(sim, chunk, lo):
+        n = len(next(iter(chunk.values())))
+        f, h = parse(sim.run_script(ctx.circuit, commands(ctx, chunk, start + lo)), start + lo, n)
+        return fit(f, h, ctx.order, ctx.zeros)
+    return batched(values, FIGURES, ctx.simulator, run)
 
 
 def section_chunk(ctx: AcContext, model: tuple, values: dict, start: int = 0) -> dict:

@@ -24,6 +24,16 @@ def run(*args, cwd=None):
     return subprocess.run([script("design-plant"), *args], capture_output=True, text=True, cwd=cwd, timeout=300)
 
 
+def refused(out, words, folder) -> None:
+    """A refusal: exit status 2, one line holding ``words``, nothing on stdout, nothing written in ``folder``."""
+    assert out.returncode == 2 and out.stdout == ""
+    line = out.stderr.strip()
+    assert "\n" not in line and "Traceback" not in line
+    for w in words:
+        assert w in line, (w, line)
+    assert list(folder.iterdir()) == []
+
+
 def target_args(topology) -> list:
     """The topology's example as design-plant's target options."""
     ex = topology.example
@@ -86,13 +96,7 @@ def test_an_unknown_topology_is_one_line_with_the_registered_and_the_closest(tmp
     (["--fc", "1k", "--zeta", "0.5", "--topology", "mfb-lowpass", "--r", "1k", "--c", "10n"], ["--r", "seed"]),
 ])
 def test_targets_a_topology_cannot_realise_are_one_line(args, words, tmp_path):
-    out = run(*args, "--no-sim", cwd=tmp_path)
-    assert out.returncode == 2 and out.stdout == ""
-    line = out.stderr.strip()
-    assert "\n" not in line and "Traceback" not in line
-    for w in words:
-        assert w in line, (w, line)
-    assert list(tmp_path.iterdir()) == []
+    refused(run(*args, "--no-sim", cwd=tmp_path), words, tmp_path)
 
 
 def test_help_lists_the_topologies():
@@ -144,13 +148,7 @@ def test_part_on_the_sallen_key_low_pass_is_its_r1_to_c2(tmp_path):
     (["--topology", "rc-lowpass", "--part", "R1=1k", "--part", "C1=1x"], ["--part C1", "not a number"]),
 ])
 def test_analyze_plant_part_refusals_are_one_line(args, words, tmp_path):
-    out = analyze(*args, "--no-sim", cwd=tmp_path)
-    assert out.returncode == 2 and out.stdout == ""
-    line = out.stderr.strip()
-    assert "\n" not in line
-    for w in words:
-        assert w in line, (w, line)
-    assert list(tmp_path.iterdir()) == []
+    refused(analyze(*args, "--no-sim", cwd=tmp_path), words, tmp_path)
 
 
 @pytest.mark.spice
@@ -182,13 +180,7 @@ def test_engine_both_on_a_section_runs_each_build_s_ac_in_ngspice(tmp_path):
     (["--monte-carlo", "20", "--spice-samples", "2"], ["--spice-samples K goes with --engine both"]),
 ])
 def test_what_a_section_plant_has_not_is_one_line(args, words, tmp_path):
-    out = run(*target_args(REGISTRY["mfb-lowpass"]), *args, "--no-sim", cwd=tmp_path)
-    assert out.returncode == 2 and out.stdout == ""
-    line = out.stderr.strip()
-    assert "\n" not in line
-    for w in words:
-        assert w in line, (w, line)
-    assert list(tmp_path.iterdir()) == []
+    refused(run(*target_args(REGISTRY["mfb-lowpass"]), *args, "--no-sim", cwd=tmp_path), words, tmp_path)
 
 
 @pytest.mark.spice
@@ -210,7 +202,4 @@ def test_square_freq_on_a_section_simulates_the_bench_test(tmp_path):
 def test_analyze_plant_square_freq_on_a_section_is_refused(tmp_path):
     out = analyze("--topology", "rc-lowpass", "--part", "R1=1k", "--part", "C1=100n", "--square-freq", "100",
                   "--no-sim", cwd=tmp_path)
-    assert out.returncode == 2 and out.stdout == ""
-    line = out.stderr.strip()
-    assert "\n" not in line and "--square-freq" in line and "design-plant's --square-freq" in line
-    assert list(tmp_path.iterdir()) == []
+    refused(out, ["--square-freq: --square-freq is the", "design-plant's --square-freq"], tmp_path)
