@@ -447,8 +447,8 @@ def _circuit_unsupported(args, topo, options=()) -> None:
                    if v]
     if unsupported:
         raise DesignError(f"{unsupported[0].split()[0]}: {unsupported[0]} is the {DEFAULT_TOPOLOGY}'s for now; "
-                          f"--topology {topo.name} has the .ac check, design-plant's --square-freq test and the Monte "
-                          "Carlo (--engine analytic, spice or both, its SPICE engine an .ac per build)")
+                          f"--topology {topo.name} has the .ac check, the --square-freq test and the Monte Carlo "
+                          "(--engine analytic, spice or both, its SPICE engine an .ac per build)")
 
 
 def _analyze_circuit(args, topo) -> int:
@@ -457,7 +457,7 @@ def _analyze_circuit(args, topo) -> int:
     if named:
         raise DesignError(f"--{named[0]} is the {DEFAULT_TOPOLOGY}'s; give {topo.name}'s parts as --part REF=VALUE "
                           f"({', '.join(topo.designators)})")
-    _circuit_unsupported(args, topo, (("--square-freq", args.square_freq),))
+    _circuit_unsupported(args, topo)
     from ..core.units import value_code
     from ..plant.circuit_design import analyze_circuit_plant
     from ..plant.circuit_report import summary_text, write_outputs
@@ -478,7 +478,8 @@ def _analyze_circuit(args, topo) -> int:
     with cluster_ahead(args):
         result = _circuit_tolerance(analyze_circuit_plant(
             topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,
-            simulate=not args.no_sim, simulator=args.simulator), args, mc, spice)
+            simulate=not args.no_sim, simulator=args.simulator, amplitude_v=args.amplitude,
+            square_hz=args.square_freq), args, mc, spice)
     return emit(result, args, name, write_outputs, summary_text)
 
 

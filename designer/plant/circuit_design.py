@@ -304,16 +304,21 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
     result = _analyse(topo, "design", target, values, ideal, ranked, Sourcing(spec.r_series, spec.c_series, labels),
                       amp, notes, spec.package, simulate, simulator)
     result.timings = {"search_s": t_search, **result.timings}
-    if spec.square_hz is not None and simulate:
-        with_square_test(result, spec.amplitude_v, spec.square_hz, simulator)
-    elif spec.square_hz is not None:
+    return _square(result, spec.amplitude_v, spec.square_hz, simulate, simulator)
+
+
+def _square(result, amplitude_v: float, square_hz, simulate: bool, simulator: str):
+    """``result`` with its square-wave test when ``square_hz`` is given (and ``simulate``)."""
+    if square_hz is not None and simulate:
+        with_square_test(result, amplitude_v, square_hz, simulator)
+    elif square_hz is not None:
         result.notes.append("--square-freq: the square-wave test is simulated; skipped with --no-sim")
     return result
 
 
 def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", target_fc_hz=None, target_zeta=None,
                           r_series=None, c_series=None, package=None, simulate: bool = True,
-                          simulator: str = "ngspice-cli") -> CircuitPlantResult:
+                          simulator: str = "ngspice-cli", amplitude_v=2.0, square_hz=None) -> CircuitPlantResult:
     """Analyse a section's parts as built (``analyze-plant --topology NAME --part R1=1k6 ..``).
 
     Parameters
@@ -334,6 +339,10 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
         Run ngspice's .ac of the deck.
     simulator : str
         :func:`designer.spice.simulate.get_simulator`'s name.
+    amplitude_v : float or str
+        The square wave's high level (V).
+    square_hz : float or str, optional
+        The square-wave bench test's frequency (None: no square-wave test).
 
     Returns
     -------
@@ -343,11 +352,13 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
     Raises
     ------
     DesignError
-        A part missing, not the section's, or out of range; a bad target or series (one line each).
+        A part missing, not the section's, or out of range; a bad target, series or square wave (one line each).
     """
     topo = registry.get(topology)
     parsed = check_circuit_parts(topo, values)
     fc, zeta = _analysis_target(topo, target_fc_hz, target_zeta)
+    amplitude_v = parse_in_range(amplitude_v, "amplitude_v", "amplitude_v")
+    square_hz = None if square_hz is None else parse_in_range(square_hz, "square_hz", "square_hz")
     amp = opamps.get(opamp)
     amp.package(package)
     series = [None if s is None else series_name(s) for s in (r_series, c_series)]
@@ -356,8 +367,8 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
     fig = topo.figures(parsed)
     notes = [f"these parts give fn = {fig.fn_hz:.5g} Hz" + ("" if fig.q is None else f", Q = {fig.q:.4g}")
              + f", gain {gain:.4g}", *why]
-    return _analyse(topo, "analyze", Target(fc, zeta, gain), parsed, None, [], Sourcing(r_s, c_s, labels), amp,
-                    notes, package, simulate, simulator)
+    return _square(_analyse(topo, "analyze", Target(fc, zeta, gain), parsed, None, [], Sourcing(r_s, c_s, labels),
+                            amp, notes, package, simulate, simulator), amplitude_v, square_hz, simulate, simulator)
 
 
 def _analysis_target(topo, target_fc_hz, target_zeta) -> tuple:

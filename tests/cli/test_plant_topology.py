@@ -199,7 +199,15 @@ def test_square_freq_on_a_section_simulates_the_bench_test(tmp_path):
     assert w["input_v"].max() == pytest.approx(2.0) and np.all(np.diff(w["time_s"]) >= 0)
 
 
-def test_analyze_plant_square_freq_on_a_section_is_refused(tmp_path):
-    out = analyze("--topology", "rc-lowpass", "--part", "R1=1k", "--part", "C1=100n", "--square-freq", "100",
-                  "--no-sim", cwd=tmp_path)
-    refused(out, ["--square-freq: --square-freq is the", "design-plant's --square-freq"], tmp_path)
+@pytest.mark.spice
+def test_analyze_plant_square_freq_on_a_section(tmp_path):
+    """analyze-plant --topology rc-lowpass --square-freq: the parts as built under the square wave (the
+    model's response the closed form, tests/plant/test_circuit_design.py), and a bad frequency refused."""
+    parts = ["--topology", "rc-lowpass", "--part", "R1=1k", "--part", "C1=100n"]
+    out = analyze(*parts, "--square-freq", "100", "--amplitude", "1", "--simulator", "ngspice-cli", "--json",
+                  "--no-files")
+    assert out.returncode == 0, out.stderr
+    sq = json.loads(out.stdout)["square_test"]
+    assert sq["pass"] and sq["nrms"] < 1e-2 and sq["generator"]["high_v"] == 1
+    refused(analyze(*parts, "--square-freq", "1x", "--no-sim", cwd=tmp_path), ["--square-freq", "not a number"],
+            tmp_path)
