@@ -108,3 +108,46 @@ def test_parts_as_built_refusals_are_one_line_at_their_key(edit, words, tmp_path
     assert "\n" not in line and "Traceback" not in line and "spec.yaml:" in line
     for w in words:
         assert w in line, (w, line)
+
+
+@pytest.mark.spice
+def test_a_yield_on_a_section_counts_its_builds(tmp_path):
+    """yield: on topology: mfb-lowpass: the analytic engine over its declared parts, the yield the share of
+    monte-carlo.csv's rows inside the check, each row's fn recomputed from its parts."""
+    import csv
+
+    import numpy as np
+
+    from designer.core.opamps import get as get_opamp
+    from designer.plant.circuit import circuit_figures
+    topology = REGISTRY["mfb-lowpass"]
+    path = tmp_path / "spec.yaml"
+    path.write_text("name: ymfb\nkind: plant\ntopology: mfb-lowpass\ntarget: {fc: 1k, zeta: 0.5, gain: 2}\n"
+                    "opamp: TL072\nchecks:\n  fn_hz: {min: 950, max: 1050}\n"
+                    "tolerances: {R: 2%}\nyield: {min: 50%, samples: 400, seed: 3}\n")
+    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
+    assert out.returncode == 0, out.stdout + out.stderr
+    d = json.loads(next((tmp_path / "out").rglob("reports/*/result.json")).read_text())
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 400
+    parts = {r: np.array([float(row[r]) for row in rows]) for r in topology.designators}
+    fn = circuit_figures(topology, parts, get_opamp("TL072"))["fn_hz"]
+    assert np.allclose([float(row["fn_hz"]) for row in rows], fn, rtol=1e-8)
+    assert d["monte_carlo"]["yield"]["fraction"] == pytest.approx(np.mean((fn >= 950) & (fn <= 1050)))
+
+
+@pytest.mark.parametrize("extra, words", [
+    ("yield: {min: 50%, engine: spice}\n", ["yield.engine", "analytic engine only"]),
+    ("tolerances: {GBW: 20%}\nyield: {min: 50%}\n", ["tolerances.GBW", "the op-amp's spread"]),
+    ("tolerance: [ideal_fn_hz]\n", ["tolerance: is the sallen-key-lowpass's for now", "and yield:"]),
+])
+def test_what_a_section_s_yield_has_not_is_one_line_at_its_key(extra, words, tmp_path):
+    path = tmp_path / "spec.yaml"
+    path.write_text(spec_text(REGISTRY["mfb-lowpass"]) + extra)
+    out = check(path)
+    assert out.returncode == 2, out.stdout + out.stderr
+    line = out.stderr.strip()
+    assert "\n" not in line and "spec.yaml:" in line
+    for w in words:
+        assert w in line, (w, line)
