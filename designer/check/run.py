@@ -124,8 +124,9 @@ def _simulate(spec: CheckSpec, index: int, simulator: str):
         res = run_filter(design, simulator)
         return res.figures, res, res.to_dict(), (None, {})
     if spec.kind == "plant" and hasattr(design, "topology") and design.topology != DEFAULT_TOPOLOGY:
-        from ..plant.circuit_design import design_circuit_plant
-        res = design_circuit_plant(design, simulate=True, simulator=simulator)
+        from ..plant.circuit_design import analyze_circuit_spec, design_circuit_plant
+        res = (analyze_circuit_spec if spec.analyze else design_circuit_plant)(design, simulate=True,
+                                                                                simulator=simulator)
         return F.circuit_plant_figures(res), res, res.to_dict(), (None, {})
     if spec.kind == "plant":
         from ..plant.design import analyze_plant, design_plant

@@ -231,22 +231,36 @@ def read_plant_designs(doc, corners):
 
 
 def read_circuit_designs(doc, corners, topo, target):
-    """A plant on another registered topology: designed from ``target:`` (``parts:`` keys are the
-    topology's designators; parts as built are the Sallen-Key low-pass's for now)."""
+    """A plant on another registered topology: designed from ``target:`` or its ``parts:`` as built
+    (keys: the topology's designators, every one)."""
+    from ..plant.circuit_design import CircuitAnalysisSpec
     from ..plant.spec import PlantSpec
     parts = doc.mapping(("parts",), topo.designators)
+    common = _common(doc, "plant")
+    if "square_hz" in common:
+        raise doc.error(("stimulus", "frequency"), f"stimulus.frequency: {topo.name} is checked by its .ac "
+                        "sweep; the square wave is the sallen-key-lowpass's")
     if parts:
-        raise doc.error(("parts",), f"parts: as built are the sallen-key-lowpass's for now; give {topo.name} a "
-                        f"target: (its parts are {', '.join(topo.designators)})")
+        for k in ("gain", "compensate_gbw"):
+            if k in target:
+                raise doc.error(("target", k), f"target.{k} applies to a design; with parts: the gain is the "
+                                "parts'")
+        if doc.data.get("bounds") is not None:
+            raise doc.error(("bounds",), "bounds: limit a design's part search; parts: are already chosen")
+        missing = [r for r in topo.designators if r not in parts]
+        if missing:
+            raise doc.error(("parts",), f"parts: {topo.name} needs {', '.join(missing)} too; its parts are "
+                            f"{', '.join(topo.designators)}")
+        kw = {k: v for k, v in common.items() if k in ("r_series", "c_series")}
+        table = {**PLANT_KEYS, "part": "parts", **{f"part {r}": f"parts.{r}" for r in topo.designators}}
+        return [built_in_spec_words(doc, table, lambda amp=amp: CircuitAnalysisSpec(
+            topo.name, dict(parts), opamp=amp, target_fc_hz=target.get("fc"), target_zeta=target.get("zeta"), **kw))
+            for amp in corners], True
     need = ("fc", "zeta") if topo.order == 2 else ("fc",)
     for k in need:
         if k not in target:
             raise doc.error(("target",), f"target needs {' and '.join(need)}: the {topo.name} plant to design")
     extra = {k: target[k] for k in ("gain", "compensate_gbw") if k in target}
-    common = _common(doc, "plant")
-    if "square_hz" in common:
-        raise doc.error(("stimulus", "frequency"), f"stimulus.frequency: {topo.name} is checked by its .ac "
-                        "sweep; the square wave is the sallen-key-lowpass's")
     return [built_in_spec_words(doc, PLANT_KEYS, lambda amp=amp: PlantSpec(
         fc_hz=target["fc"], zeta=target.get("zeta"), opamp=amp, alternatives=1, topology=topo.name, **extra,
         **common)) for amp in corners], False
@@ -467,12 +481,24 @@ def read_yield(doc, kind: str, checks):
     if kind == "filter" and engine != "analytic":
         raise doc.error(("yield", "engine"), "yield.engine: a filter's yield has the analytic engine only (allowed: "
                         "analytic); analyze-filter --spice-samples compares it with ngspice on the same builds")
+    from ..filters import registry
+    from ..plant.circuit import DEFAULT_TOPOLOGY
+    # the topology: read (and checked) with the designs, before the yield
+    topology = registry.get(doc.data["topology"]).name if kind == "plant" and "topology" in doc.data else None
+    section = topology is not None and topology != DEFAULT_TOPOLOGY
+    if section and engine != "analytic":
+        raise doc.error(("yield", "engine"), f"yield.engine: topology {topology}'s yield has the analytic engine only "
+                        "(allowed: analytic); design-plant --topology --engine both compares it with ngspice")
     use, skipped = yields.counted(kind, checks, engine)
     if not use:
         known = ", ".join(yields.TABLES[engine][kind])
         raise doc.error(("yield",), "yield counts the builds inside checks:, and none of them limits a figure the "
                         f"{engine} engine computes ({known})" + (f"; not: {', '.join(skipped)}" if skipped else ""))
     tolerances = _tolerances(doc, kind)
+    spread = [t.split("=")[0] for t in tolerances if t.startswith(("GBW=", "SR="))]
+    if section and spread:
+        raise doc.error(("tolerances", spread[0]), f"tolerances.{spread[0]}: the op-amp's spread is the "
+                        f"{DEFAULT_TOPOLOGY}'s for now; topology {topology}'s yield varies its parts")
     if kind == "plant" and engine == "analytic" and any(t.startswith("SR=") for t in tolerances):
         raise doc.error(("tolerances", "SR"), "tolerances.SR: the plant's analytic model is linear, no figure of it "
                         "depends on the slew rate; give yield.engine: spice (ngspice's op-amp slews)")

@@ -428,27 +428,27 @@ def _design_circuit(args, topo) -> int:
         f"plant_{topo.name}_fc{spec.fc_hz:g}" + ("" if spec.zeta is None else f"_z{spec.zeta:g}")
         + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
     mc = monte_carlo_settings(args, topo.designators)
+    spice = spice_settings(args, mc, plant=False)
     check_output(args, name)
     from ..plant.circuit_design import design_circuit_plant
     from ..plant.circuit_report import summary_text, write_outputs
     with cluster_ahead(args):
         result = _circuit_tolerance(design_circuit_plant(spec, simulate=not args.no_sim, simulator=args.simulator),
-                                    args, mc)
+                                    args, mc, spice)
     return emit(result, args, name, write_outputs, summary_text)
 
 
 def _circuit_unsupported(args, topo, options=()) -> None:
     """The options the plant on another topology has not (yet): refused in one line."""
     unsupported = [f for f, v in (("--stimulus prbs", args.stimulus == "prbs"), ("--prbs-bits", args.prbs_bits),
-                                  ("--prbs-clock", args.prbs_clock), ("--square-freq", args.square_freq),
-                                  ("--engine " + args.engine, args.engine != "analytic"),
-                                  ("--spice-samples", args.spice_samples), ("--replay", args.replay),
+                                  ("--prbs-clock", args.prbs_clock), ("--replay", args.replay),
                                   ("--tol GBW/SR", any(str(t).split("=")[0].strip().upper() in ("GBW", "SR")
                                                        for t in args.tol or ())), *options)
                    if v]
     if unsupported:
         raise DesignError(f"{unsupported[0].split()[0]}: {unsupported[0]} is the {DEFAULT_TOPOLOGY}'s for now; "
-                          f"--topology {topo.name} has the .ac check and the analytic Monte Carlo")
+                          f"--topology {topo.name} has the .ac check, the --square-freq test and the Monte Carlo "
+                          "(--engine analytic, spice or both, its SPICE engine an .ac per build)")
 
 
 def _analyze_circuit(args, topo) -> int:
@@ -468,6 +468,7 @@ def _analyze_circuit(args, topo) -> int:
         what = f"has no part {bad[0]}" if bad else f"needs {', '.join(missing)} too"
         raise DesignError(f"--part: {topo.name} {what}; its parts are {', '.join(topo.designators)}")
     mc = monte_carlo_settings(args, topo.designators)
+    spice = spice_settings(args, mc, plant=False)
     from ..core.ranges import parse_in_range
     values = {r: parse_in_range(v, f"--part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
               for r, v in parts.items()}
@@ -477,12 +478,14 @@ def _analyze_circuit(args, topo) -> int:
     with cluster_ahead(args):
         result = _circuit_tolerance(analyze_circuit_plant(
             topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,
-            simulate=not args.no_sim, simulator=args.simulator), args, mc)
+            simulate=not args.no_sim, simulator=args.simulator, amplitude_v=args.amplitude,
+            square_hz=args.square_freq), args, mc, spice)
     return emit(result, args, name, write_outputs, summary_text)
 
 
-def _circuit_tolerance(result, args, mc):
-    """--worst-case and --monte-carlo of a plant on another topology (the analytic engine over its parts)."""
+def _circuit_tolerance(result, args, mc, spice=("analytic", None, None)):
+    """--worst-case and --monte-carlo of a plant on another topology (the analytic engine over its parts;
+    --engine spice|both, --spice-samples: every build's .ac in ngspice)."""
     from ..plant import circuit
     from ..plant.circuit_design import tolerance_nominal
     s = result.sourcing
@@ -495,11 +498,11 @@ def _circuit_tolerance(result, args, mc):
         tol = resolve(args.tol or (), nominal, series)
         result.worst_case = worst_case(lambda v: circuit.evaluate(context, v), nominal, tol.of)
     if mc is not None:
-        from ..tolerance.montecarlo import plant_monte_carlo
+        from ..tolerance.spice_mc import section_monte_carlo_engine
         scale, target = scale_settings(args)
-        result.monte_carlo = plant_monte_carlo(None, series, result.opamp, mc[0], mc[1], args.sampler, args.dist,
-                                               args.tol or (), args.limit or (), scale=scale, target_ci=target,
-                                               circuit=(nominal, circuit.evaluate, context))
+        result.monte_carlo = section_monte_carlo_engine(result, series, mc[0], mc[1], args.sampler, args.dist,
+                                                        args.tol or (), args.limit or (), spice[0], spice[1],
+                                                        args.simulator, scale=scale, target_ci=target)
     return result
 
 

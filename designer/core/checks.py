@@ -18,6 +18,7 @@ TITLES = {
     "prbs_slew_rate": N_("slew rate under the PRBS"),
     "prbs_output_swing": N_("output swing under the PRBS"),
     "square_wave_period": N_("square-wave period"),
+    "square_wave_agreement": N_("SPICE agreement under the square wave"),
     "spice_agreement": N_("SPICE agreement"),
     "closed_loop_stable": N_("closed loop stable"),
     "phase_margin": N_("phase margin"),

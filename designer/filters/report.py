@@ -169,7 +169,8 @@ def draw_cascade(b, result, sheet: Sheet | None = None) -> Sheet:
     b : designer.spice.deck.Board
         The board.
     result : FilterDesign
-        The design (the stages' titles).
+        The design (the stages' titles); with one stage every part of the board is its own, unprefixed
+        (a section plant's sheet, :func:`designer.plant.circuit_report.schematic`).
     sheet : Sheet, optional
         Draw on this sheet (a new one by default).
 
@@ -183,7 +184,10 @@ def draw_cascade(b, result, sheet: Sheet | None = None) -> Sheet:
     s = sheet or CascadeSheet(fontsize=18, unit=2.0)
     parts = b.netlist.parts
     width, pitch = 27.0, 3.8
-    heights = [max(sum(1 for p in parts if p.ref[1:-1] == f"{st.number}0"), 2) * pitch + 4.6 for st in result.stages]
+    # a stage's parts carry its prefix (R101 ..); a single section (a plant's) is every part, unprefixed (R1 ..)
+    mine_of = (lambda st: list(parts)) if len(result.stages) == 1 else \
+        (lambda st: [p for p in parts if p.ref[1:-1] == f"{st.number}0"])
+    heights = [max(len(mine_of(st)), 2) * pitch + 4.6 for st in result.stages]
     y, row_h = 0.0, 0.0
     for i, (st, amp) in enumerate(zip(result.stages, b.netlist.amps)):
         col = i % 2
@@ -199,7 +203,7 @@ def draw_cascade(b, result, sheet: Sheet | None = None) -> Sheet:
             fn=format_eng(st.plan.fn_hz, 'Hz', 4), q=q, gain=f"{st.gain:.3g}")), size=0.95, halign="left")
         # the drawing's extent: matplotlib crops the picture to its elements, not to the labels' text
         s.d.add(elm.Line().at((x0 - 0.6, y + 4.5)).to((x0 + width - 0.6, y + 4.5)).color("white"))
-        mine = [p for p in parts if p.ref[1:-1] == f"{st.number}0"]
+        mine = mine_of(st)
         for k, p in enumerate(mine):
             yy = y - k * pitch
             a, c = (x0 + 4.2, yy), (x0 + 8.2, yy)

@@ -12,11 +12,13 @@ from ..core.exports import lazy_exports
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "circuit_report": ("bom", "sections", "title_of"),
-    "circuit_design": ("CircuitPlantResult", "GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "analyze_circuit_plant",
-                       "check_opamp_reach", "design_circuit_plant", "tolerance_nominal"),
+    "circuit_design": ("CircuitAnalysisSpec", "CircuitPlantResult", "GBW_MARGIN", "SPICE_DB", "SPICE_DEG",
+                       "analyze_circuit_plant", "analyze_circuit_spec", "check_circuit_parts", "check_opamp_reach",
+                       "design_circuit_plant", "tolerance_nominal", "SQUARE_NRMS_PASS", "SquareRun", "square_deck",
+                       "with_square_test"),
     "circuit": ("BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "candidate_set", "capacitor_combinations",
                 "circuit_figures", "corner_frequencies", "dominant_pairs", "evaluate", "opamp_tf", "plant_target",
-                "search"),
+                "search", "step_of_pair"),
     "bench": ("PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",
               "tolerance_band"),
     "design": ("R_BAND", "analyze_plant", "choose_parts", "design_plant", "listed"),

@@ -46,7 +46,7 @@ from ..filters.topology import SectionTarget, Topology, nodal_system
 
 __all__ = ["BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "Candidate", "plant_target", "capacitor_combinations", "candidate_set",
            "search", "brute_force", "opamp_tf", "dominant_pairs", "circuit_figures", "evaluate", "sensitivities",
-           "corner_frequencies"]
+           "corner_frequencies", "step_of_pair"]
 
 #: the topology of ``design-plant`` without ``--topology``: the seed's plant (its own search, :mod:`.selection`)
 DEFAULT_TOPOLOGY = "sallen-key-lowpass"
@@ -433,7 +433,8 @@ def circuit_figures(topology: Topology, values: dict, opamp=None) -> dict:
     ``fn_hz``, ``zeta``, ``q``: the dominant pair of the op-amp-aware model (of the ideal
     one without an op-amp); ``ideal_*``: the topology's coefficients; ``overshoot_pct``
     and ``peak_time_s``: the dominant pair's, 100 exp(-pi zeta / sqrt(1 - zeta^2)) and
-    pi / (wn sqrt(1 - zeta^2)) (0 and NaN at zeta >= 1); ``gain``: the passband gain magnitude.
+    pi / (wn sqrt(1 - zeta^2)) (0 and NaN at zeta >= 1, :func:`step_of_pair`); ``gain``: the passband
+    gain magnitude.
 
     Parameters
     ----------
@@ -457,12 +458,30 @@ def circuit_figures(topology: Topology, values: dict, opamp=None) -> dict:
     else:
         fn, z = dominant_pairs(opamp_tf(topology, values, opamp)[1], topology.order == 1)
     with np.errstate(divide="ignore", invalid="ignore"):
+        return {"fn_hz": fn, "zeta": z, "q": 1 / (2 * z), "ideal_fn_hz": fn_i, "ideal_zeta": z_i,
+                "ideal_q": 1 / (2 * z_i), **step_of_pair(fn, z), "gain": np.asarray(f.gain, float)}
+
+
+def step_of_pair(fn_hz, zeta) -> dict:
+    """The step figures of a second-order pair: 100 exp(-pi zeta / sqrt(1 - zeta^2)) and
+    pi / (wn sqrt(1 - zeta^2)) (0 and NaN at zeta >= 1 or NaN, a first-order section's).
+
+    Parameters
+    ----------
+    fn_hz, zeta : array_like
+        The pair.
+
+    Returns
+    -------
+    dict
+        ``overshoot_pct``, ``peak_time_s``.
+    """
+    fn, z = np.asarray(fn_hz, float), np.asarray(zeta, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
         under = np.where(z < 1, np.sqrt(np.clip(1 - z * z, 0.0, None)), np.nan)
         over = np.where(z < 1, 100 * np.exp(-math.pi * z / under), 0.0)
         tpk = np.where(z < 1, 1.0 / (2 * fn * under), np.nan)
-        return {"fn_hz": fn, "zeta": z, "q": 1 / (2 * z), "ideal_fn_hz": fn_i, "ideal_zeta": z_i,
-                "ideal_q": 1 / (2 * z_i), "overshoot_pct": over, "peak_time_s": tpk,
-                "gain": np.asarray(f.gain, float)}
+    return {"overshoot_pct": over, "peak_time_s": tpk}
 
 
 def evaluate(context: tuple, values: dict) -> dict:

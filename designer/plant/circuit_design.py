@@ -43,8 +43,9 @@ from . import circuit
 from .design import MAX_ERROR, candidates, part_series
 from .result import METRICS, PLANT_SCHEMA_VERSION, Sourcing, Target
 
-__all__ = ["GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "CircuitPlantResult", "design_circuit_plant", "check_opamp_reach",
-           "analyze_circuit_plant", "tolerance_nominal"]
+__all__ = ["GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "CircuitAnalysisSpec", "CircuitPlantResult", "design_circuit_plant",
+           "check_opamp_reach", "analyze_circuit_plant", "analyze_circuit_spec", "check_circuit_parts",
+           "tolerance_nominal", "SQUARE_NRMS_PASS", "SquareRun", "square_deck", "with_square_test"]
 
 #: the op-amp's gain-bandwidth a section needs, in units of fn x Q x noise gain
 GBW_MARGIN = 10.0
@@ -92,6 +93,8 @@ class CircuitPlantResult:
         ``max_db``, ``max_deg`` of SPICE against the op-amp-aware model, the simulator.
     package : str or None
         The op-amp package of the wiring.
+    square : SquareRun or None
+        The square-wave bench test in ngspice against the op-amp-aware model (``--square-freq``).
     """
 
     topology: str
@@ -111,6 +114,7 @@ class CircuitPlantResult:
     notes: list
     spice: dict | None = None
     package: str | None = None
+    square: object = None
     monte_carlo: object = None
     worst_case: object = None
     files: dict = field(default_factory=dict)
@@ -162,6 +166,7 @@ class CircuitPlantResult:
             "checks": [c.to_dict() for c in self.checks],
             "notes": self.notes,
             "spice": self.spice,
+            **({} if self.square is None else {"square_test": self.square.to_dict()}),
             "monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
             "worst_case": None if self.worst_case is None else self.worst_case.to_dict(),
             "files": self.files,
@@ -303,12 +308,21 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
     result = _analyse(topo, "design", target, values, ideal, ranked, Sourcing(spec.r_series, spec.c_series, labels),
                       amp, notes, spec.package, simulate, simulator)
     result.timings = {"search_s": t_search, **result.timings}
+    return _square(result, spec.amplitude_v, spec.square_hz, simulate, simulator)
+
+
+def _square(result, amplitude_v: float, square_hz, simulate: bool, simulator: str):
+    """``result`` with its square-wave test when ``square_hz`` is given (and ``simulate``)."""
+    if square_hz is not None and simulate:
+        with_square_test(result, amplitude_v, square_hz, simulator)
+    elif square_hz is not None:
+        result.notes.append("--square-freq: the square-wave test is simulated; skipped with --no-sim")
     return result
 
 
 def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", target_fc_hz=None, target_zeta=None,
                           r_series=None, c_series=None, package=None, simulate: bool = True,
-                          simulator: str = "ngspice-cli") -> CircuitPlantResult:
+                          simulator: str = "ngspice-cli", amplitude_v=2.0, square_hz=None) -> CircuitPlantResult:
     """Analyse a section's parts as built (``analyze-plant --topology NAME --part R1=1k6 ..``).
 
     Parameters
@@ -329,6 +343,10 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
         Run ngspice's .ac of the deck.
     simulator : str
         :func:`designer.spice.simulate.get_simulator`'s name.
+    amplitude_v : float or str
+        The square wave's high level (V).
+    square_hz : float or str, optional
+        The square-wave bench test's frequency (None: no square-wave test).
 
     Returns
     -------
@@ -338,20 +356,13 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
     Raises
     ------
     DesignError
-        A part missing, not the section's, or out of range; a bad target or series (one line each).
+        A part missing, not the section's, or out of range; a bad target, series or square wave (one line each).
     """
     topo = registry.get(topology)
-    unknown = [r for r in values if r not in topo.designators]
-    missing = [r for r in topo.designators if r not in values]
-    if unknown or missing:
-        what = f"has no part {unknown[0]}" if unknown else f"needs {', '.join(missing)} too"
-        raise DesignError(f"part: {topo.name} {what}; its parts are {', '.join(topo.designators)}", param="part")
-    parsed = {r: parse_in_range(values[r], f"part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
-              for r in topo.designators}
-    fc = None if target_fc_hz is None else parse_in_range(target_fc_hz, "target_fc_hz", "fc_hz")
-    zeta = None if target_zeta is None else parse_in_range(target_zeta, "target_zeta", "zeta")
-    if zeta is not None and topo.order == 1:
-        raise DesignError(f"target_zeta: {topo.name} is first-order and has no damping", param="target_zeta")
+    parsed = check_circuit_parts(topo, values)
+    fc, zeta = _analysis_target(topo, target_fc_hz, target_zeta)
+    amplitude_v = parse_in_range(amplitude_v, "amplitude_v", "amplitude_v")
+    square_hz = None if square_hz is None else parse_in_range(square_hz, "square_hz", "square_hz")
     amp = opamps.get(opamp)
     amp.package(package)
     series = [None if s is None else series_name(s) for s in (r_series, c_series)]
@@ -360,8 +371,106 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
     fig = topo.figures(parsed)
     notes = [Message(N_("these parts give fn = {fn} Hz{q}, gain {gain}"), fn=f"{fig.fn_hz:.5g}",
                      q="" if fig.q is None else f", Q = {fig.q:.4g}", gain=f"{gain:.4g}"), *why]
-    return _analyse(topo, "analyze", Target(fc, zeta, gain), parsed, None, [], Sourcing(r_s, c_s, labels), amp,
-                    notes, package, simulate, simulator)
+    return _square(_analyse(topo, "analyze", Target(fc, zeta, gain), parsed, None, [], Sourcing(r_s, c_s, labels),
+                            amp, notes, package, simulate, simulator), amplitude_v, square_hz, simulate, simulator)
+
+
+def _analysis_target(topo, target_fc_hz, target_zeta) -> tuple:
+    """(fc, zeta) an analysis reports its errors against, checked (None: not given)."""
+    fc = None if target_fc_hz is None else parse_in_range(target_fc_hz, "target_fc_hz", "fc_hz")
+    zeta = None if target_zeta is None else parse_in_range(target_zeta, "target_zeta", "zeta")
+    if zeta is not None and topo.order == 1:
+        raise DesignError(f"target_zeta: {topo.name} is first-order and has no damping", param="target_zeta")
+    return fc, zeta
+
+
+def check_circuit_parts(topology, values: dict) -> dict:
+    """A section's parts as built, checked: every declared part once, each a value in range.
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    values : dict
+        Designator -> value (a number or engineering notation).
+
+    Returns
+    -------
+    dict
+        Designator -> value (ohm, farad), in the section's order.
+
+    Raises
+    ------
+    DesignError
+        A part missing, not the section's, or out of range (one line, ``param`` "part").
+    """
+    unknown = [r for r in values if r not in topology.designators]
+    missing = [r for r in topology.designators if r not in values]
+    if unknown or missing:
+        what = f"has no part {unknown[0]}" if unknown else f"needs {', '.join(missing)} too"
+        raise DesignError(f"part: {topology.name} {what}; its parts are {', '.join(topology.designators)}",
+                          param="part")
+    return {r: parse_in_range(values[r], f"part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
+            for r in topology.designators}
+
+
+@dataclass(frozen=True)
+class CircuitAnalysisSpec:
+    """A section's parts as built, to analyse (check-design's ``topology:`` with ``parts:``); the
+    parts are checked when the spec is made (:func:`check_circuit_parts`).
+
+    Parameters
+    ----------
+    topology : str
+        A registered section's name.
+    values : dict
+        Designator -> value, every declared part.
+    opamp : str
+        The op-amp's catalogue name.
+    target_fc_hz, target_zeta : float or str, optional
+        What the errors are reported against.
+    r_series, c_series : str, optional
+        Where the parts come from (None: the smallest series holding each value).
+    package : str, optional
+        The op-amp package of the wiring.
+    """
+
+    topology: str
+    values: dict
+    opamp: str = "LM741"
+    target_fc_hz: object = None
+    target_zeta: object = None
+    r_series: str | None = None
+    c_series: str | None = None
+    package: str | None = None
+
+    def __post_init__(self):
+        topo = registry.get(self.topology)
+        check_circuit_parts(topo, self.values)
+        _analysis_target(topo, self.target_fc_hz, self.target_zeta)
+        opamps.get(self.opamp)
+
+
+def analyze_circuit_spec(spec: CircuitAnalysisSpec, simulate: bool = True,
+                         simulator: str = "ngspice-cli") -> CircuitPlantResult:
+    """:func:`analyze_circuit_plant` of a :class:`CircuitAnalysisSpec`.
+
+    Parameters
+    ----------
+    spec : CircuitAnalysisSpec
+        The parts as built.
+    simulate : bool
+        Run ngspice's .ac of the deck.
+    simulator : str
+        :func:`designer.spice.simulate.get_simulator`'s name.
+
+    Returns
+    -------
+    CircuitPlantResult
+        The typed result (``mode`` "analyze").
+    """
+    return analyze_circuit_plant(spec.topology, spec.values, spec.opamp, spec.target_fc_hz, spec.target_zeta,
+                                 spec.r_series, spec.c_series, spec.package, simulate=simulate, simulator=simulator)
 
 
 def _analyse(topo, mode: str, target: Target, values: dict, ideal, ranked: list, sourcing: Sourcing, amp, notes: list,
@@ -385,6 +494,175 @@ def _analyse(topo, mode: str, target: Target, values: dict, ideal, ranked: list,
         notes.append(N_("SPICE simulation skipped (--no-sim): the figures are analytic only"))
     return CircuitPlantResult(topo.name, mode, target, values, ideal, ranked, sourcing, amp, figures, steps,
                               sensitivity, netlist, deck, checks, notes, run, package, timings=timings)
+
+
+#: SPICE's square-wave output against the op-amp-aware model's: NRMS (Xyce's rule, :func:`designer.core.compare.nrms`,
+#: reltol 1 %, abstol 1 % of the passband gain x amplitude, as the Sallen-Key plant's bench test) below this passes
+SQUARE_NRMS_PASS = 1.0
+#: the model's response is computed on this many points of the period
+SQUARE_POINTS = 20001
+
+
+@dataclass
+class SquareRun:
+    """The square-wave bench test of a section plant: one period in ngspice against the op-amp-aware model.
+
+    Parameters
+    ----------
+    test : designer.spice.deck.SquareTest
+        The square wave.
+    deck : str
+        The ``.tran`` deck (``square-test.cir``).
+    t : numpy.ndarray
+        The comparison's times (s, from 0).
+    u, y_spice, y_model : numpy.ndarray
+        The input, SPICE's output and the model's, on ``t``.
+    nrms : float
+        The NRMS of SPICE against the model.
+    abstol_v : float
+        Its absolute tolerance.
+    simulator : str
+        The backend.
+    """
+
+    test: object
+    deck: str
+    t: np.ndarray
+    u: np.ndarray
+    y_spice: np.ndarray
+    y_model: np.ndarray
+    nrms: float
+    abstol_v: float
+    simulator: str
+
+    @property
+    def check(self) -> Check:
+        """The verdict (NRMS below :data:`SQUARE_NRMS_PASS`)."""
+        ok = self.nrms < SQUARE_NRMS_PASS
+        return Check("square_wave_agreement", ok, f"SPICE's output under the {format_eng(self.test.frequency_hz, 'Hz')} "
+                     f"square wave against the op-amp-aware model: NRMS {self.nrms:.3g} (reltol 1 %, abstol "
+                     f"{format_eng(self.abstol_v, 'V')}; below {SQUARE_NRMS_PASS:g} agrees)")
+
+    def to_dict(self) -> dict:
+        """The JSON form (``square_test``).
+
+        Returns
+        -------
+        dict
+            The generator's settings, the NRMS and the verdict.
+        """
+        return {"generator": self.test.to_dict(), "delay_s": self.test.delay_s, "simulator": self.simulator,
+                "nrms": self.nrms, "nrms_pass_below": SQUARE_NRMS_PASS, "abstol_v": self.abstol_v,
+                "reltol": 0.01, "pass": self.check.ok}
+
+    def csv_text(self) -> str:
+        """``waveforms.csv``: time, input, SPICE's output, the model's.
+
+        Returns
+        -------
+        str
+            CSV text.
+        """
+        rows = "".join(f"{a:.12g},{b:.9g},{c:.9g},{d:.9g}\n" for a, b, c, d in
+                       zip(self.t, self.u, self.y_spice, self.y_model))
+        return "time_s,input_v,spice_v,model_v\n" + rows
+
+
+def square_deck(netlist, amp, test, title: str) -> str:
+    """The section under the square wave ``test``: one period of ``.tran``.
+
+    Parameters
+    ----------
+    netlist : designer.spice.deck.Netlist
+        The section.
+    amp : designer.core.opamps.OpAmp
+        The op-amp.
+    test : designer.spice.deck.SquareTest
+        The square wave on net ``vin``.
+    title : str
+        The deck's title line.
+
+    Returns
+    -------
+    str
+        The deck.
+    """
+    import logging
+
+    from PySpice.Spice.Netlist import Circuit
+
+    from ..spice.deck import add_supplies, finish_deck, opamp_library_text
+    logging.getLogger("PySpice").setLevel(logging.ERROR)
+    circuit = Circuit(title)
+    circuit.raw_spice = "\n".join([f"* {title}: 0 -> {test.amplitude_v:g} V square wave at "
+                                   f"{test.frequency_hz:g} Hz on vin; op-amp {amp.name}",
+                                   opamp_library_text().rstrip()])
+    add_supplies(circuit, amp)
+    circuit.V("in", "vin", circuit.gnd, test.source())
+    netlist.add_to(circuit, amp)
+    return finish_deck(circuit, test)
+
+
+def with_square_test(result: CircuitPlantResult, amplitude_v: float, frequency_hz: float,
+                     simulator: str = "ngspice-cli") -> CircuitPlantResult:
+    """``result`` with its square-wave bench test (:class:`SquareRun`) and its check added; returned.
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design.
+    amplitude_v : float
+        The square wave's high level (V; low 0 V).
+    frequency_hz : float
+        Its frequency.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    CircuitPlantResult
+        ``result``.
+    """
+    import scipy.signal as sig
+
+    from ..core.compare import nrms, resample
+    from ..spice.deck import SquareTest
+    from ..spice.simulate import get_simulator
+    topo, amp = result.section, result.opamp
+    fn = result.figures["opamp"]["fn_hz"]
+    half = 0.5 / frequency_hz
+    test = SquareTest(amplitude_v, frequency_hz, min(0.05 * half, 20 / (2 * math.pi * fn)),
+                      time_scale_s=1 / (2 * math.pi * fn))
+    test.check_simulable()
+    deck = square_deck(result.netlist, amp, test, f"{topo.title} plant square-wave test op-amp={amp.name}")
+    res = get_simulator(simulator).run(deck)
+    e, d = test.edge_s, test.delay_s
+    corners = [0.0, d, d + e, d + half, d + half + e, test.stop_s]
+    # the edges' corners on the grid, where SPICE's PULSE turns
+    t = np.union1d(np.linspace(0.0, test.stop_s, SQUARE_POINTS), corners)
+    u = np.interp(t, corners, [0.0, 0.0, amplitude_v, amplitude_v, 0.0, 0.0])
+    num, den = circuit.opamp_tf(topo, result.values, amp)
+    # leading numerator terms that are rounding (|c_k wn^k| at 1e-12 of the largest term) go: a high-pass's
+    # numerator is of lower degree than its denominator, and scipy would warn of them
+    w = 2 * math.pi * fn
+    size = np.abs(num) * w ** np.arange(num.size - 1, -1, -1.0)
+    num = num[int(np.argmax(size > 1e-12 * size.max())):]
+    # the model's response: the two edges as steps at their middles (an edge is 1/100 of the time scale or
+    # less), by superposition of the step response s: y = A (s(t - d - e/2) - s(t - d - e/2 - half))
+    tau = np.linspace(0.0, test.stop_s, SQUARE_POINTS)
+    step = sig.step((num, den), T=tau)[1]
+    s_at = lambda x: np.where(x > 0, np.interp(x, tau, step), 0.0)  # noqa: E731
+    y_model = amplitude_v * (s_at(t - d - e / 2) - s_at(t - d - e / 2 - half))
+    y_spice = resample(res["time"], np.real(res["v(vout)"]), t)
+    abstol = 0.01 * abs(result.figures["ideal"]["gain"] * amplitude_v)
+    fit = nrms(y_model, y_spice, abstol, t=t)
+    result.square = SquareRun(test, deck, t, u, y_spice, y_model, fit, abstol, get_simulator(simulator).name)
+    result.checks = [*result.checks, result.square.check]
+    if not result.square.check.ok:
+        result.notes.append(f"under the square wave SPICE differs from the linear model (NRMS {fit:.3g}): an "
+                            f"output that jumps at the edges (a high-pass's) is slew-limited by the {amp.name}'s "
+                            f"{amp.slew_v_per_s / 1e6:.3g} V/us; a lower --amplitude or a faster op-amp follows it")
+    return result
 
 
 def tolerance_nominal(result: CircuitPlantResult) -> dict:

@@ -4,21 +4,29 @@ and the wiring from the topology's netlist on the bench board
 (:func:`designer.spice.deck.board`, :mod:`designer.report.wiring`: topology-free), the
 target and what the build achieves, the SPICE agreement, the sensitivities over the
 declared parts and the alternatives; rendered as the result is (nothing recomputed).
+The schematic is the filter cascade's drawing of one stage
+(:func:`designer.filters.report.draw_cascade`: any registered section), titled with
+the build's ideal fn, Q and gain.
 """
 
 from __future__ import annotations
 
-from ..core.i18n import N_, translated
+from dataclasses import dataclass
+
+from ..core.i18n import N_, language, translated
 from ..core.i18n import gettext as _
 from ..core.units import format_eng
+from ..filters.prototype import SectionPlan
 from ..report import document as R
-from ..report.bundle import bundle_paths, write_bundle
+from ..report.bundle import write_design
 from ..report.tolerance import csv_texts
 from ..report.wiring import bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
 
-__all__ = ["title_of", "sections", "bom", "summary_text", "write_outputs"]
+__all__ = ["title_of", "sections", "bom", "schematic", "summary_text", "write_outputs"]
 
+#: the schematic's width (drawing units) that holds the op-amp's output label
+OUTPUT_LABEL_ROOM = 31.0
 #: what the section's end nets are called on the sheet
 #: the bill of materials' columns as the sheet heads them
 BOM_SHOWN = (N_("Ref"), N_("Value"), N_("Code"), N_("Qty"), N_("Series"), N_("Tol."), N_("Package"), N_("Role"))
@@ -95,13 +103,17 @@ def _targets(result) -> list:
     return out
 
 
-def sections(result) -> list:
+def sections(result, with_images: bool = False, schematic_svg: str = "") -> list:
     """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`).
 
     Parameters
     ----------
     result : CircuitPlantResult
         The design.
+    with_images : bool
+        Include the schematic (the bundle's sheet; False: the terminal text and the web page's sheet).
+    schematic_svg : str
+        The schematic inlined in the HTML.
 
     Returns
     -------
@@ -109,7 +121,8 @@ def sections(result) -> list:
         The sections.
     """
     b = board(result.netlist, result.opamp, result.package)
-    out = [(_("Build"), [R.table([_(h) for h in BOM_SHOWN], [[*r[:6], _(r[6]), r[7]] for r in bom(result)])]),
+    fig = [R.figure("schematic.png", schematic_svg, _("schematic"))] if with_images else []
+    out = [(_("Build"), [*fig, R.table([_(h) for h in BOM_SHOWN], [[*r[:6], _(r[6]), r[7]] for r in bom(result)])]),
            (_("Wiring"), [R.table([_("part"), _("code"), _("from"), _("to")],
                                   wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee)))]),
            (_("Target and achieved"), _targets(result)),
@@ -148,9 +161,52 @@ def summary_text(result) -> str:
     return R.to_text(title_of(result), sections(result)) + "\n"
 
 
-def write_outputs(result, out_dir, name: str) -> dict:
-    """Write ``netlists/<name>.cir`` and ``reports/<name>/`` (sheets, result.json, bom.csv,
-    monte-carlo.csv with a Monte Carlo) atomically (:func:`designer.report.bundle.write_bundle`).
+@dataclass(frozen=True)
+class _Stage:
+    """The build as the cascade drawing's one stage (what its title reads)."""
+
+    number: int
+    topology: str
+    plan: SectionPlan
+    gain: float
+
+
+@dataclass(frozen=True)
+class _OneStage:
+    """The build as a one-stage cascade (:func:`designer.filters.report.draw_cascade`'s ``result``)."""
+
+    stages: tuple
+
+
+def schematic(result):
+    """The section's schematic: the filter cascade's drawing of one stage, its parts
+    and op-amp on the deck's nets (checked by :func:`designer.report.schematic.check_connectivity`).
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design.
+
+    Returns
+    -------
+    designer.report.schematic.Sheet
+        The drawing.
+    """
+    import schemdraw.elements as elm
+
+    from ..filters.report import draw_cascade
+    topo, f = result.section, result.figures["ideal"]
+    stage = _Stage(1, topo.name, SectionPlan(topo.kind, topo.order, f["fn_hz"], f["q"]), abs(f["gain"]))
+    sheet = draw_cascade(board(result.netlist, result.opamp, result.package), _OneStage((stage,)))
+    # the picture is cropped to its elements, not to the labels' text: an unseen line past the output's label
+    # (a cascade's second column gives it that room)
+    sheet.d.add(elm.Line().at((0, 4.5)).to((OUTPUT_LABEL_ROOM, 4.5)).color("white"))
+    return sheet
+
+
+def write_outputs(result, out_dir, name: str, lang: str | None = None) -> dict:
+    """Write ``netlists/<name>.cir`` and ``reports/<name>/`` (sheets, schematic.png, result.json,
+    bom.csv, monte-carlo.csv with a Monte Carlo) atomically (:func:`designer.report.bundle.write_design`).
 
     Parameters
     ----------
@@ -160,6 +216,8 @@ def write_outputs(result, out_dir, name: str) -> dict:
         Where ``netlists/`` and ``reports/`` go.
     name : str
         The design's name.
+    lang : str or None
+        The build sheet's language (None: the current one).
 
     Returns
     -------
@@ -167,7 +225,9 @@ def write_outputs(result, out_dir, name: str) -> dict:
         The files written.
     """
     texts = {"bom_csv": ("bom.csv", lambda r: bom_csv(bom(r))), **csv_texts(result)}
-    result.files = bundle_paths(out_dir, name, [], {k: f for k, (f, _) in texts.items()})
-    extras = {k: text(result) for k, (_, text) in texts.items()}
-    write_bundle(result.files, result.deck, {}, title_of(result), sections(result), result.to_dict(), extras)
-    return result.files
+    if result.square is not None:     # --square-freq: the bench test's deck and its waveforms
+        texts.update({"square_deck": ("square-test.cir", lambda r: r.square.deck),
+                      "waveforms_csv": ("waveforms.csv", lambda r: r.square.csv_text())})
+    with language(lang):
+        return write_design(result, out_dir, name, [], schematic, lambda svg: sections(result, True, svg),
+                            title_of(result), texts)

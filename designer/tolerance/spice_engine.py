@@ -48,7 +48,7 @@ import numpy as np
 from ..core.errors import SimulatorError
 from ..filters.sallen_key_lowpass_parts import gain_refs
 
-__all__ = ["FIGURES", "commands", "context", "evaluate", "measures", "parse"]
+__all__ = ["FIGURES", "batched", "commands", "context", "evaluate", "measures", "parse"]
 
 #: the figures the SPICE engine gives
 FIGURES = ("fn_hz", "zeta", "q", "overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
@@ -346,16 +346,41 @@ def evaluate(ctx: SpiceContext, values: dict, start: int = 0) -> dict:
     dict
         Figure -> array over the samples.
     """
+    def run(sim, chunk, lo):
+        n = len(next(iter(chunk.values())))
+        return figures(ctx, chunk, parse(sim.run_script(ctx.circuit, commands(ctx, chunk, start + lo)), start + lo, n))
+    return batched(values, FIGURES, ctx.simulator, run)
+
+
+def batched(values: dict, names, simulator: str, run) -> dict:
+    """A SPICE engine's figures over a chunk of builds, :data:`BATCH` builds per ngspice run:
+    ``run(sim, batch, lo)`` gives the figures of the builds ``batch`` (their values, the first at
+    index ``lo`` of the chunk) on the backend ``sim``, allowed :data:`SECONDS_PER_SAMPLE` a build.
+
+    Parameters
+    ----------
+    values : dict
+        Designator -> array over the chunk's builds.
+    names : tuple of str
+        The figures.
+    simulator : str
+        The backend's name.
+    run : callable
+        ``run(sim, batch, lo) -> {figure: array}``.
+
+    Returns
+    -------
+    dict
+        Figure -> array over the chunk's builds (NaN where none).
+    """
     from ..spice.simulate import DEFAULT_TIMEOUT_S, get_simulator
     values = {k: np.atleast_1d(np.asarray(v, float)) for k, v in values.items()}
     n = len(next(iter(values.values())))
-    out = {k: np.full(n, np.nan) for k in FIGURES}
+    out = {k: np.full(n, np.nan) for k in names}
     for lo in range(0, n, BATCH):
         hi = min(n, lo + BATCH)
         chunk = {k: v[lo:hi] for k, v in values.items()}
-        sim = get_simulator(ctx.simulator, timeout=DEFAULT_TIMEOUT_S + SECONDS_PER_SAMPLE * (hi - lo))
-        text = sim.run_script(ctx.circuit, commands(ctx, chunk, start + lo))
-        figs = figures(ctx, chunk, parse(text, start + lo, hi - lo))
-        for k in FIGURES:
+        figs = run(get_simulator(simulator, timeout=DEFAULT_TIMEOUT_S + SECONDS_PER_SAMPLE * (hi - lo)), chunk, lo)
+        for k in names:
             out[k][lo:hi] = figs[k]
     return out

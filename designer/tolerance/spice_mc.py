@@ -25,7 +25,8 @@ import numpy as np
 from ..core.errors import DesignError
 from . import spice_engine
 
-__all__ = ["plant_monte_carlo_engine", "replay", "replay_result", "replay_values", "spice_evaluate", "spice_samples"]
+__all__ = ["plant_monte_carlo_engine", "replay", "replay_result", "replay_values", "run_engine",
+           "section_monte_carlo_engine", "spice_evaluate", "spice_samples"]
 
 ENGINES = ("analytic", "spice", "both")
 #: the seed of the random part of --spice-samples: SeedSequence(seed, spawn_key=(RANDOM_KEY,)) (chunks use (c,))
@@ -208,7 +209,7 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
         The Monte Carlo.
     """
     where = {"scale": scale, "target_ci": target_ci}
-    from .montecarlo import apply_engine, figures_with_fixed, plant_monte_carlo
+    from .montecarlo import figures_with_fixed, plant_monte_carlo
     if engine not in ENGINES:
         raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
     amp = result.opamp
@@ -220,9 +221,46 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
                 "fn_zeta": "second-order equivalents of the simulated step (zeta from the overshoot, fn from "
                            "the peak time); the model's are its dominant pole pair",
                 "measured": list(spice_engine.FIGURES)}
+    draw = lambda **kw: plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist,  # noqa: E731
+                                          tol_items, limit_items, **where, **kw)
+    return run_engine(draw, spice_evaluate(ctx, amp), lambda v: figures_with_fixed(v, {}, amp), settings, engine,
+                      spice_k, seed, scale, spice_engine.FIGURES, spice_engine.SHARED)
+
+
+def run_engine(draw, evaluate, model, settings: dict, engine: str, spice_k, seed: int, scale, measured, shared):
+    """A Monte Carlo with a SPICE engine (``spice`` or ``both``; ``spice_k``: SPICE on the tails and
+    ``spice_k`` random builds only), whatever the circuit: the Sallen-Key plant's step engine
+    (:mod:`.spice_engine`) or a section's ``.ac`` engine (:mod:`.spice_ac`).
+
+    Parameters
+    ----------
+    draw : callable
+        ``draw(engine_name=.., evaluate=..) -> MonteCarlo``: the circuit's Monte Carlo.
+    evaluate : callable
+        The SPICE engine's ``evaluate(values) -> figures`` (picklable).
+    model : callable
+        The analytic engine's ``model(values) -> figures``.
+    settings : dict
+        The engine's settings, recorded under ``monte_carlo.spice``.
+    engine : str
+        ``spice`` or ``both``.
+    spice_k : int or None
+        ``--spice-samples``.
+    seed : int
+        The draw's seed (the random builds SPICE checks).
+    scale : designer.tolerance.runner.Scale or None
+        Where the chunks run.
+    measured, shared : tuple of str
+        The figures SPICE gives; those both engines give (their disagreement).
+
+    Returns
+    -------
+    designer.tolerance.montecarlo.MonteCarlo
+        The Monte Carlo.
+    """
+    from .montecarlo import apply_engine
     if spice_k is not None:
-        mc = plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist, tol_items, limit_items,
-                               engine_name="both", **where)
+        mc = draw(engine_name="both")
         n = mc.n       # the builds drawn (--target-ci may stop before --monte-carlo N)
         if not mc.limits:
             raise DesignError("--spice-samples needs --limit: its samples are the tails of each limited figure")
@@ -230,32 +268,94 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
         idx = np.array(worst + rand, int)
         order = np.argsort(idx)
         idx = idx[order]
-        sp = run_picked(mc, idx, apply_engine, spice_evaluate(ctx, amp), scale)
+        sp = run_picked(mc, idx, apply_engine, evaluate, scale)
         model_pass = mc.passed[idx]
         spice_pass = _passes(sp, mc.limits)
         mc.spice = {**settings, **spice_checked(idx, worst, rand, model_pass, spice_pass, mc.yield_count, n,
-                                                disagreement(sp, {k: v[idx] for k, v in mc.figures.items()}, idx))}
-        for k in spice_engine.FIGURES:          # the CSV: SPICE's figures where simulated
+                                                disagreement(sp, {k: v[idx] for k, v in mc.figures.items()}, idx,
+                                                             shared))}
+        for k in measured:          # the CSV: SPICE's figures where simulated
             col = np.full(n, np.nan)
             col[idx] = sp[k]
             mc.figures[f"spice_{k}"] = col
         return mc
-    mc = plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist, tol_items, limit_items,
-                           engine_name=engine, evaluate=spice_evaluate(ctx, amp), **where)
+    mc = draw(engine_name=engine, evaluate=evaluate)
     n = mc.n
     mc.spice = settings
-    model = figures_with_fixed(mc.values, {}, amp)
+    figs = model(mc.values)
     if mc.tighten:       # the tightening search runs the model: its yield now is the model's
-        mc.tighten["yield_now"] = float(np.mean(_passes(model, mc.limits)))
+        mc.tighten["yield_now"] = float(np.mean(_passes(figs, mc.limits)))
     if engine == "both":
-        mc.spice["disagreement"] = disagreement(mc.figures, model, np.arange(n))
+        mc.spice["disagreement"] = disagreement(mc.figures, figs, np.arange(n), shared)
         if mc.limits:
-            y_model = int(np.count_nonzero(_passes(model, mc.limits)))
+            y_model = int(np.count_nonzero(_passes(figs, mc.limits)))
             mc.spice.update(yield_model=y_model / n, yield_with_spice=mc.yield_count / n,
                             yield_shift_pp=100 * (mc.yield_count - y_model) / n)
-        for k in spice_engine.SHARED:
-            mc.figures[f"model_{k}"] = model[k]
+        for k in shared:
+            mc.figures[f"model_{k}"] = figs[k]
     return mc
+
+
+def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler: str = "random",
+                               dist: str = "uniform", tol_items=(), limit_items=(), engine: str = "analytic",
+                               spice_k: int | None = None, simulator: str = "ngspice-cli", scale=None,
+                               target_ci: float | None = None):
+    """:func:`plant_monte_carlo_engine` of a plant on a registered section (a
+    :class:`~designer.plant.circuit_design.CircuitPlantResult`): the analytic engine over its
+    declared parts (:func:`designer.plant.circuit.evaluate`) or, with a SPICE engine, every
+    build's ``.ac`` in ngspice (:mod:`.spice_ac`).
+
+    Parameters
+    ----------
+    result : designer.plant.circuit_design.CircuitPlantResult
+        The design.
+    series : dict
+        ``{"R": series, "C": series}``.
+    n : int
+        The builds.
+    seed : int
+        The seed.
+    sampler, dist : str
+        How the builds are drawn.
+    tol_items, limit_items : sequence of str
+        The ``--tol`` and ``--limit`` items.
+    engine : str
+        :data:`ENGINES`.
+    spice_k : int, optional
+        The builds SPICE checks from each tail and at random (``both``).
+    simulator : str
+        The backend.
+    scale : designer.tolerance.runner.Scale, optional
+        Where the chunks run.
+    target_ci : float, optional
+        ``--target-ci``.
+
+    Returns
+    -------
+    designer.tolerance.montecarlo.MonteCarlo
+        The Monte Carlo.
+    """
+    from ..plant import circuit
+    from . import spice_ac
+    from .montecarlo import plant_monte_carlo
+    if engine not in ENGINES:
+        raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
+    model = (result.topology, result.opamp)
+    nominal = dict(result.values)
+    draw = lambda **kw: plant_monte_carlo(None, series, result.opamp, n, seed, sampler, dist,  # noqa: E731
+                                          tol_items, limit_items, scale=scale, target_ci=target_ci,
+                                          circuit=(nominal, circuit.evaluate, model), **kw)
+    if engine == "analytic":
+        return draw()
+    ctx = spice_ac.context(result.deck, result.netlist, result.section, nominal, result.figures["ideal"]["fn_hz"],
+                           simulator)
+    settings = {"engine": engine, "simulator": ctx.simulator, "sweep_hz": [ctx.f_lo_hz, ctx.f_hi_hz],
+                "points_per_decade": spice_ac.POINTS_PER_DECADE,
+                "fn_zeta": "the section's form fitted to the simulated .ac response over the sweep (Levy's least "
+                           "squares); the model's are its dominant pole pair",
+                "measured": list(spice_ac.FIGURES)}
+    return run_engine(draw, spice_ac.section_evaluate(ctx, model), lambda v: circuit.evaluate(model, v), settings,
+                      engine, spice_k, seed, scale, spice_ac.FIGURES, spice_ac.FIGURES)
 
 
 class Replay:

@@ -149,7 +149,9 @@ def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int,
     kind : str
         ``plant``, ``pid`` or ``filter``.
     res : designer.plant.result.PlantResult or designer.pid.result.PidResult or FilterRun
-        The corner's design (a filter: check-design's run, :func:`designer.tolerance.filter.filter_spec_yield`).
+        The corner's design (a filter: check-design's run, :func:`designer.tolerance.filter.filter_spec_yield`;
+        a plant on a registered section: a :class:`~designer.plant.circuit_design.CircuitPlantResult`, its
+        analytic engine, :func:`designer.plant.circuit.evaluate`).
     checks : sequence of designer.check.limits.Limit
         The spec's checks.
     required : float
@@ -184,7 +186,14 @@ def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int,
         from .filter import filter_spec_yield
         mc = filter_spec_yield(res.design, res.case.mask, limits, samples, seed, tol_items, sampler, dist)
         return YieldVerdict(mc, required, names, skipped)
-    if kind == "plant":
+    if kind == "plant" and hasattr(res, "section"):
+        # a plant on a registered section: its analytic engine over the declared parts
+        from ..plant import circuit
+        s = res.sourcing
+        mc = plant_monte_carlo(None, {"R": s.r_series, "C": s.c_series}, res.opamp, samples, seed, sampler, dist,
+                               tol_items, limits, tighten=False,
+                               circuit=(dict(res.values), circuit.evaluate, (res.topology, res.opamp)))
+    elif kind == "plant":
         s = res.sourcing
         evaluate = None
         if engine == "spice":

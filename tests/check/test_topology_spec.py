@@ -3,6 +3,7 @@ picked up without editing this file): a plant spec designed on it and checked in
 .ac agreement a design check), its figures within the spec's limits; the refusals at the key's line."""
 
 import json
+import re
 import subprocess
 
 import pytest
@@ -57,3 +58,96 @@ def test_parts_keys_are_the_topology_s(tmp_path):
     out = check(path)
     assert out.returncode == 2
     assert "unknown key 'R5' in parts; allowed: R1, R2, R3, C1, C2" in out.stderr
+
+
+def parts_text(topology, values=None) -> str:
+    """A spec of the topology's example synthesised exactly, given as its parts as built."""
+    ex = topology.example
+    values = topology.synthesize(ex) if values is None else values
+    parts = ", ".join(f"{r}: {v!r}" for r, v in values.items())
+    return (f"name: built-{topology.name}\nkind: plant\ntopology: {topology.name}\nparts: {{{parts}}}\n"
+            f"target: {{fc: {ex.fn_hz:g}}}\nopamp: TL072\n"
+            f"checks:\n  ideal_fn_hz: {{min: {0.99 * ex.fn_hz:g}, max: {1.01 * ex.fn_hz:g}}}\n"
+            "design_checks: all\n")
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_its_parts_as_built_are_checked(topology, tmp_path):
+    """parts: keys the topology's designators: analysed as built (the example's exact synthesis: its fn)."""
+    path = tmp_path / "spec.yaml"
+    path.write_text(parts_text(topology))
+    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert f"built-{topology.name}: pass" in out.stdout
+    designs = [json.loads(p.read_text()) for p in (tmp_path / "out").rglob("result.json")]
+    d = next(d for d in designs if d.get("topology") == topology.name)
+    assert d["mode"] == "analyze" and d["spice"]["pass"]
+    assert d["built"]["ideal"]["fn_hz"] == pytest.approx(topology.example.fn_hz, rel=1e-9)
+
+
+def _without_r3(text):
+    return re.sub(r"R3: [^,]+, ", "", text)
+
+
+@pytest.mark.parametrize("edit, words", [
+    (lambda t: t.replace(", C2: ", ", C9: "), ["unknown key 'C9' in parts"]),
+    (_without_r3, ["parts: mfb-lowpass needs R3 too; its parts are R1, R2, R3, C1, C2"]),
+    (lambda t: t.replace("target: {fc: ", "target: {gain: 2, fc: "), ["target.gain applies to a design"]),
+    (lambda t: t + "bounds: {r_min: 1k}\n", ["bounds: limit a design's part search"]),
+    (lambda t: t.replace("R1: ", "R1: 1x", 1), ["spec.yaml:4: parts.R1: ", "not a number"]),
+])
+def test_parts_as_built_refusals_are_one_line_at_their_key(edit, words, tmp_path):
+    topology = REGISTRY["mfb-lowpass"]
+    values = {r: f"{v:.4g}" for r, v in topology.synthesize(topology.example).items()}
+    path = tmp_path / "spec.yaml"
+    path.write_text(edit(parts_text(topology, values).replace("'", "")))
+    out = check(path)
+    assert out.returncode == 2, out.stdout + out.stderr
+    line = out.stderr.strip()
+    assert "\n" not in line and "Traceback" not in line and "spec.yaml:" in line
+    for w in words:
+        assert w in line, (w, line)
+
+
+@pytest.mark.spice
+def test_a_yield_on_a_section_counts_its_builds(tmp_path):
+    """yield: on topology: mfb-lowpass: the analytic engine over its declared parts, the yield the share of
+    monte-carlo.csv's rows inside the check, each row's fn recomputed from its parts."""
+    import csv
+
+    import numpy as np
+
+    from designer.core.opamps import get as get_opamp
+    from designer.plant.circuit import circuit_figures
+    topology = REGISTRY["mfb-lowpass"]
+    path = tmp_path / "spec.yaml"
+    path.write_text("name: ymfb\nkind: plant\ntopology: mfb-lowpass\ntarget: {fc: 1k, zeta: 0.5, gain: 2}\n"
+                    "opamp: TL072\nchecks:\n  fn_hz: {min: 950, max: 1050}\n"
+                    "tolerances: {R: 2%}\nyield: {min: 50%, samples: 400, seed: 3}\n")
+    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
+    assert out.returncode == 0, out.stdout + out.stderr
+    d = json.loads(next((tmp_path / "out").rglob("reports/*/result.json")).read_text())
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 400
+    parts = {r: np.array([float(row[r]) for row in rows]) for r in topology.designators}
+    fn = circuit_figures(topology, parts, get_opamp("TL072"))["fn_hz"]
+    assert np.allclose([float(row["fn_hz"]) for row in rows], fn, rtol=1e-8)
+    assert d["monte_carlo"]["yield"]["fraction"] == pytest.approx(np.mean((fn >= 950) & (fn <= 1050)))
+
+
+@pytest.mark.parametrize("extra, words", [
+    ("yield: {min: 50%, engine: spice}\n", ["yield.engine", "analytic engine only"]),
+    ("tolerances: {GBW: 20%}\nyield: {min: 50%}\n", ["tolerances.GBW", "the op-amp's spread"]),
+    ("tolerance: [ideal_fn_hz]\n", ["tolerance: is the sallen-key-lowpass's for now", "and yield:"]),
+])
+def test_what_a_section_s_yield_has_not_is_one_line_at_its_key(extra, words, tmp_path):
+    path = tmp_path / "spec.yaml"
+    path.write_text(spec_text(REGISTRY["mfb-lowpass"]) + extra)
+    out = check(path)
+    assert out.returncode == 2, out.stdout + out.stderr
+    line = out.stderr.strip()
+    assert "\n" not in line and "spec.yaml:" in line
+    for w in words:
+        assert w in line, (w, line)

@@ -24,6 +24,16 @@ def run(*args, cwd=None):
     return subprocess.run([script("design-plant"), *args], capture_output=True, text=True, cwd=cwd, timeout=300)
 
 
+def refused(out, words, folder) -> None:
+    """A refusal: exit status 2, one line holding ``words``, nothing on stdout, nothing written in ``folder``."""
+    assert out.returncode == 2 and out.stdout == ""
+    line = out.stderr.strip()
+    assert "\n" not in line and "Traceback" not in line
+    for w in words:
+        assert w in line, (w, line)
+    assert list(folder.iterdir()) == []
+
+
 def target_args(topology) -> list:
     """The topology's example as design-plant's target options."""
     ex = topology.example
@@ -86,13 +96,7 @@ def test_an_unknown_topology_is_one_line_with_the_registered_and_the_closest(tmp
     (["--fc", "1k", "--zeta", "0.5", "--topology", "mfb-lowpass", "--r", "1k", "--c", "10n"], ["--r", "seed"]),
 ])
 def test_targets_a_topology_cannot_realise_are_one_line(args, words, tmp_path):
-    out = run(*args, "--no-sim", cwd=tmp_path)
-    assert out.returncode == 2 and out.stdout == ""
-    line = out.stderr.strip()
-    assert "\n" not in line and "Traceback" not in line
-    for w in words:
-        assert w in line, (w, line)
-    assert list(tmp_path.iterdir()) == []
+    refused(run(*args, "--no-sim", cwd=tmp_path), words, tmp_path)
 
 
 def test_help_lists_the_topologies():
@@ -144,10 +148,66 @@ def test_part_on_the_sallen_key_low_pass_is_its_r1_to_c2(tmp_path):
     (["--topology", "rc-lowpass", "--part", "R1=1k", "--part", "C1=1x"], ["--part C1", "not a number"]),
 ])
 def test_analyze_plant_part_refusals_are_one_line(args, words, tmp_path):
-    out = analyze(*args, "--no-sim", cwd=tmp_path)
-    assert out.returncode == 2 and out.stdout == ""
-    line = out.stderr.strip()
-    assert "\n" not in line
-    for w in words:
-        assert w in line, (w, line)
-    assert list(tmp_path.iterdir()) == []
+    refused(analyze(*args, "--no-sim", cwd=tmp_path), words, tmp_path)
+
+
+@pytest.mark.spice
+def test_engine_both_on_a_section_runs_each_build_s_ac_in_ngspice(tmp_path):
+    """--engine both: the CSV's SPICE rows are the analytic engine's next to them (its dominant pair: fn within
+    1 %), the model's rows recomputed from the parts exactly; --spice-samples checks the tails."""
+    topology = REGISTRY["mfb-lowpass"]
+    args = [*target_args(topology), "--monte-carlo", "30", "--seed", "2", "--limit", "fn_hz=950:1050",
+            "--simulator", "ngspice-cli", "--json"]
+    out = run(*args, "--engine", "both", "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    assert d["monte_carlo"]["spice"]["engine"] == "both"
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    col = lambda k: np.array([float(r[k]) for r in rows])  # noqa: E731
+    figs = circuit.circuit_figures(topology, {r: col(r) for r in topology.designators},
+                                   get_opamp(d["opamp"]["name"]))
+    assert np.allclose(col("model_fn_hz"), figs["fn_hz"], rtol=1e-8)
+    assert np.allclose(col("fn_hz"), figs["fn_hz"], rtol=0.01)
+    picked = run(*args, "--engine", "both", "--spice-samples", "2", "--no-files")
+    assert picked.returncode == 0, picked.stderr
+    assert json.loads(picked.stdout)["monte_carlo"]["spice"]["samples_checked"] >= 2
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--monte-carlo", "20", "--replay", "3"], ["--replay", "sallen-key-lowpass's for now", "--engine analytic, spice"]),
+    (["--engine", "spice"], ["--engine spice goes with --monte-carlo N"]),
+    (["--monte-carlo", "20", "--spice-samples", "2"], ["--spice-samples K goes with --engine both"]),
+])
+def test_what_a_section_plant_has_not_is_one_line(args, words, tmp_path):
+    refused(run(*target_args(REGISTRY["mfb-lowpass"]), *args, "--no-sim", cwd=tmp_path), words, tmp_path)
+
+
+@pytest.mark.spice
+def test_square_freq_on_a_section_simulates_the_bench_test(tmp_path):
+    """--square-freq: one period in ngspice against the op-amp-aware model (NRMS below 1), its deck and
+    waveforms in the bundle; the waveforms' model column recomputed from the input by superposition."""
+    out = run(*target_args(REGISTRY["mfb-lowpass"]), "--opamp", "TL072", "--square-freq", "300", "--json",
+              "--simulator", "ngspice-cli", "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    sq = d["square_test"]
+    assert sq["pass"] and sq["nrms"] < 1 and sq["generator"]["frequency_hz"] == 300
+    assert any(c["id"] == "square_wave_agreement" and c["ok"] for c in d["checks"])
+    assert "PULSE(" in Path(d["files"]["square_deck"]).read_text()
+    w = np.genfromtxt(d["files"]["waveforms_csv"], delimiter=",", names=True)
+    assert w["input_v"].max() == pytest.approx(2.0) and np.all(np.diff(w["time_s"]) >= 0)
+
+
+@pytest.mark.spice
+def test_analyze_plant_square_freq_on_a_section(tmp_path):
+    """analyze-plant --topology rc-lowpass --square-freq: the parts as built under the square wave (the
+    model's response the closed form, tests/plant/test_circuit_design.py), and a bad frequency refused."""
+    parts = ["--topology", "rc-lowpass", "--part", "R1=1k", "--part", "C1=100n"]
+    out = analyze(*parts, "--square-freq", "100", "--amplitude", "1", "--simulator", "ngspice-cli", "--json",
+                  "--no-files")
+    assert out.returncode == 0, out.stderr
+    sq = json.loads(out.stdout)["square_test"]
+    assert sq["pass"] and sq["nrms"] < 1e-2 and sq["generator"]["high_v"] == 1
+    refused(analyze(*parts, "--square-freq", "1x", "--no-sim", cwd=tmp_path), ["--square-freq", "not a number"],
+            tmp_path)
