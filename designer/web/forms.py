@@ -352,10 +352,9 @@ def plant_request(options) -> PlantRequest:
     mc = _monte_carlo(v, ("n", "seed", "sampler", "dist", "tol", "limits", "target_ci", "engine", "spice_samples"))
     simulator = _simulator(v, "pyspice")
     stimulus = _stimulus(v)
-    if spec.topology != DEFAULT_TOPOLOGY and (stimulus is not None or (mc is not None and mc.engine != "analytic")):
-        raise ParamError("{%s}: the %s's for now; another topology has the .ac check and the analytic Monte Carlo"
-                         % ("stimulus" if stimulus is not None else "engine", DEFAULT_TOPOLOGY),
-                         ("stimulus", "engine"))
+    if spec.topology != DEFAULT_TOPOLOGY and stimulus is not None:
+        raise ParamError("{stimulus}: the PRBS test is the %s's for now; another topology has the .ac check, the "
+                         "square-wave test and the Monte Carlo" % DEFAULT_TOPOLOGY, ("stimulus",))
     where = "" if spec.topology == DEFAULT_TOPOLOGY else f"_{spec.topology}"
     name = _name(v, f"plant{where}_fc{spec.fc_hz:g}" + ("" if spec.zeta is None else f"_z{spec.zeta:g}")
                  + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))

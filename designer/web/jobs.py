@@ -36,7 +36,7 @@ from ..cli import pid as cli_pid
 from ..cli import plant as cli_plant
 from ..cli.common import RESULT_HOOK
 from ..core import lifetime
-from ..core.i18n import N_, language, localise, translated
+from ..core.i18n import N_, current, language, localise, translated
 from ..core.i18n import gettext as _
 from ..core.jsonio import json_safe
 from ..core.units import format_eng
@@ -295,24 +295,25 @@ def design_plant_task(fields: dict, want: str = "json", tmp: str | None = None) 
 
 def _circuit_plant(rq, want: str, tmp: str | None, lang: str | None) -> tuple:
     """A plant on a registered topology other than the seed's (:func:`designer.plant.circuit_design.
-    design_circuit_plant`), with the analytic Monte Carlo and worst case over its declared parts; as
-    :func:`_library_task`'s ``work`` answers."""
+    design_circuit_plant`), with the Monte Carlo (the analytic engine, or every build's .ac in ngspice) and
+    worst case over its declared parts, as design-plant --topology runs them; as :func:`_library_task`'s
+    ``work`` answers."""
     from ..plant import circuit
-    from ..plant.circuit_design import design_circuit_plant
+    from ..plant.circuit_design import design_circuit_plant, tolerance_nominal
     from ..plant.circuit_report import write_outputs
-    from ..tolerance.montecarlo import plant_monte_carlo
     from ..tolerance.parts import resolve
+    from ..tolerance.spice_mc import section_monte_carlo_engine
     from ..tolerance.worstcase import worst_case
     result = design_circuit_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
     series = {"R": result.sourcing.r_series, "C": result.sourcing.c_series}
-    nominal, context, mc = dict(result.values), (result.topology, result.opamp), rq.monte_carlo
+    nominal, context, mc = tolerance_nominal(result), (result.topology, result.opamp), rq.monte_carlo
     if rq.worst_case:
         tol = resolve(mc.tol if mc is not None else rq.tol, nominal, series)
         result.worst_case = worst_case(lambda v: circuit.evaluate(context, v), nominal, tol.of)
     if mc is not None:
-        result.monte_carlo = plant_monte_carlo(None, series, result.opamp, mc.n, mc.seed, mc.sampler, mc.dist,
-                                               mc.tol, mc.limits, target_ci=mc.target_ci,
-                                               circuit=(nominal, circuit.evaluate, context))
+        result.monte_carlo = section_monte_carlo_engine(result, series, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol,
+                                                        mc.limits, mc.engine, mc.spice_samples, rq.simulator,
+                                                        target_ci=mc.target_ci)
     if want in ("sheet", "bundle"):
         write_outputs(result, tmp, rq.name)
     data = json.loads(json.dumps(result.to_dict()))
@@ -324,7 +325,7 @@ def circuit_plant_page(result) -> dict:
     """A plant on a registered topology, for the page: its declared parts (designator, role, value), the Bode
     plot of both models (the section's transfer function with the parts as built, ideal and with the op-amp's
     model, evaluated on a grid as the sheet's plots are), the BOM and the sheet's content (the wiring, target
-    and achieved, sensitivities, alternatives); no schematic (the sheet has none yet).
+    and achieved, sensitivities, alternatives) and its schematic (the one-stage drawing of the sheet).
 
     Parameters
     ----------
@@ -349,6 +350,7 @@ def circuit_plant_page(result) -> dict:
                       for p in topo.parts],
             "bode": _bode(f, resp), "histograms": histograms(result.monte_carlo), **bom_shown(bom),
             "checks": checks_shown(result.checks), "notes": [localise(translated(n)) for n in result.notes],
+            "schematic_svg": _schematic_svg(rep, result, [topo.name, dict(result.values), result.package]),
             "sheet_html": to_html(rep.title_of(result), rep.sections(result), {}),
             "title": localise(rep.title_of(result))}
 
@@ -902,11 +904,11 @@ _SCHEMATICS: dict = {}
 
 
 def _schematic_svg(rep, result, key) -> str:
-    """The wing's schematic of ``result`` as SVG; ``key`` (the parts and the package, with the op-amp
-    added here; None: not cached) names what it shows."""
+    """The wing's schematic of ``result`` as SVG; ``key`` (the parts and the package, with the op-amp and
+    the language of its labels added here; None: not cached) names what it shows."""
     if key is None:
         return rep.schematic(result).svg()
-    key = json.dumps([key, result.opamp.name], sort_keys=True, default=str)
+    key = json.dumps([key, result.opamp.name, current()], sort_keys=True, default=str)
     svg = _SCHEMATICS.get(key)
     if svg is None:
         svg = rep.schematic(result).svg()

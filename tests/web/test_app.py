@@ -44,6 +44,25 @@ def without_run_details(d: dict) -> dict:
     return d
 
 
+@pytest.mark.spice
+def test_a_section_plant_runs_its_spice_monte_carlo_as_design_plant_does(server):
+    """Issue 26: a plant on another section takes the SPICE engine on the page too (every build's .ac in
+    ngspice), its JSON design-plant --topology's; its page has the schematic; the PRBS test is refused by
+    its field."""
+    body = {"fc": 3500, "zeta": 0.2, "topology": "mfb-lowpass", "opamp": "TL072", "monte-carlo": 10, "seed": 2,
+            "engine": "both", "simulator": "ngspice-cli"}
+    status, got = server.post_json("/api/plant?view=page", body)
+    assert status == 200, got
+    want = cli_json("design-plant", "--fc", "3500", "--zeta", "0.2", "--topology", "mfb-lowpass", "--opamp", "TL072",
+                    "--monte-carlo", "10", "--seed", "2", "--engine", "both", "--simulator", "ngspice-cli", "--json",
+                    "--no-files")
+    assert without_run_details(got["result"]) == without_run_details(want)
+    assert got["result"]["monte_carlo"]["settings"]["engine"] == "both" and got["result"]["monte_carlo"]["spice"]
+    assert got["page"]["schematic_svg"].lstrip().startswith("<")
+    status, bad = server.post_json("/api/plant", {**body, "stimulus": "prbs"})
+    assert status == 400 and bad["field"] == "stimulus" and "--" not in bad["error"], bad
+
+
 def test_plant_answers_design_plants_json(server):
     status, got = server.post_json("/api/plant", {"fc": 3500, "zeta": "0.2", "opamp": "TL072"})
     assert status == 200

@@ -214,3 +214,17 @@ def test_the_plant_pages_bench_names_the_input_resistor_the_section_declares(gai
     rows = bench_rows(result.test, result.scope, ref)
     assert jobs.plant_page(result)["bench"][:len(rows)] == rows
     assert any(ref in str(cell) for row in rows for cell in row)
+
+
+def test_a_cached_schematic_is_drawn_in_the_requests_language():
+    """A bug fixed: the worker's schematic cache was keyed by the parts only, so a section plant drawn for a
+    Spanish request came back with Spanish labels ("Etapa 1") for the next English one."""
+    from designer.core.i18n import catalogue
+    stage = catalogue("es").get("Stage {number}: {topology}", "")
+    assert stage.startswith("Etapa")
+    ask = {"fc": 3500, "zeta": 0.2, "topology": "mfb-lowpass", "no-sim": True}
+    es = jobs.design_plant_task({**ask, "lang": "es"}, "page")
+    en = jobs.design_plant_task(ask, "page")
+    assert es["status"] == 0 and en["status"] == 0, (es["error"], en["error"])
+    assert "Etapa" in es["page"]["schematic_svg"] and "Etapa" not in en["page"]["schematic_svg"]
+    assert "Stage" in en["page"]["schematic_svg"]

@@ -828,6 +828,10 @@ def test_the_plant_pages_topology_menu_designs_an_mfb_lowpass(page, server):
     assert page.locator("#bode-gain canvas").count() == 1 and not page.locator("#step-section").is_visible()
     assert figure(page, "SPICE agrees with the model") == "yes" and not page.locator("#topid").is_visible()
     assert not page.locator("#bom").is_disabled()
+    # its schematic (the sheet's one-stage drawing), labelled with its parts as the seed circuit's
+    svg = page.locator("#schematic svg")
+    assert svg.count() == 1 and svg.get_attribute("role") == "img"
+    assert all(p.ref in svg.get_attribute("aria-label") for p in topo.parts)
     # a first-order section: no zeta asked
     assert after(page, lambda: menu.select_option("rc-lowpass"), timeout=120000) == "done"
     assert not page.locator("input[name=zeta]").is_visible() and "zeta=" not in page.url

@@ -23,7 +23,7 @@ function showTopology() {
 D.onRestore = showTopology;
 
 // A plant on another registered section (the generic pipeline): its declared parts, both models' figures and
-// Bode plot, the BOM, checks and sheet; the seed circuit's step, bench and schematic panels are not its.
+// Bode plot, its schematic, the BOM, checks and sheet; the seed circuit's step and bench panels are not its.
 function showCircuit(answer) {
   const r = answer.result, p = answer.page, o = r.built.opamp, i = r.built.ideal;
   document.getElementById("title").textContent = p.title;
@@ -36,11 +36,8 @@ function showCircuit(answer) {
     D.fig(D.t("-3 dB frequency ({amp})", {amp: r.opamp.name}), o.f3db_hz.map(v => D.eng(v, "Hz", 4)).join(", ")),
     D.fig(D.t("SPICE agrees with the model"), !spice ? D.t("not simulated") : (spice.ok ? D.t("yes") : D.t("NO"))));
   document.getElementById("notes").replaceChildren(...(p.notes || r.notes).map(n => { const e = document.createElement("p"); e.textContent = D.inPageWords(form, n); return e; }));
-  const sch = document.getElementById("schematic");
-  sch.replaceChildren(Object.assign(document.createElement("p"), {textContent:
-    D.t("{title}: the parts and their wiring are in the build sheet below.", {title: D.t(r.topology_title)})}));
-  const open = sch.parentElement.querySelector(".open-full");
-  if (open) open.remove();
+  D.schematic(document.getElementById("schematic"), p.schematic_svg,
+              D.t("schematic: {parts}", {parts: p.bom.rows.map(x => `${x[0]} ${D.localNum(x[1])}`).join(", ")}));
   document.getElementById("bomtable").replaceChildren(D.bomTable(p));
   document.getElementById("checks").replaceChildren(D.checksTable(p.checks || r.checks));
   D.tolerance(r.monte_carlo, p.histograms);
