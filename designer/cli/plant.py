@@ -458,8 +458,7 @@ def _analyze_circuit(args, topo) -> int:
         raise DesignError(f"--{named[0]} is the {DEFAULT_TOPOLOGY}'s; give {topo.name}'s parts as --part REF=VALUE "
                           f"({', '.join(topo.designators)})")
     _circuit_unsupported(args, topo)
-    from ..core.units import value_code
-    from ..plant.circuit_design import analyze_circuit_plant
+    from ..plant.circuit_design import analyze_circuit_plant, built_name
     from ..plant.circuit_report import summary_text, write_outputs
     parts = part_values(args.part)
     bad = [r for r in parts if r not in topo.designators]
@@ -472,8 +471,7 @@ def _analyze_circuit(args, topo) -> int:
     from ..core.ranges import parse_in_range
     values = {r: parse_in_range(v, f"--part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
               for r, v in parts.items()}
-    name = args.name if args.name is not None else f"built_{topo.name}_" + "_".join(
-        f"{r.lower()}{value_code(values[r])}" for r in topo.designators)
+    name = args.name if args.name is not None else built_name(topo.name, values)
     check_output(args, name)
     with cluster_ahead(args):
         result = _circuit_tolerance(analyze_circuit_plant(
@@ -609,7 +607,7 @@ def _sk_parts(args) -> None:
 
 
 def _analyze(args) -> int:
-    from ..core.units import value_code
+    from ..plant.circuit_design import built_name
     from ..plant.design import analyze_plant
     from ..plant.sallenkey import SallenKeyParts
     from ..plant.spec import AnalysisSpec
@@ -626,8 +624,8 @@ def _analyze(args) -> int:
                         c_series=args.c_series, amplitude_v=args.amplitude, square_hz=args.square_freq,
                         package=args.package)
     p = spec.parts
-    name = args.name if args.name is not None else "built_" + "_".join(
-        f"{k}{value_code(getattr(p, k))}" for k in (FIELD_OF[r] for r in refs(with_gain=False)))
+    name = args.name if args.name is not None else built_name(DEFAULT_TOPOLOGY, {
+        r: getattr(p, FIELD_OF[r]) for r in refs(with_gain=False)})
     mc = monte_carlo_settings(args)
     spice = spice_settings(args, mc)
     stim = stimulus_settings(args)

@@ -21,7 +21,7 @@ from ..core.exports import lazy_exports
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "plant": ("PLANT_PREFIX", "Plant", "PlantCircuit", "circuit_from_cascade", "circuit_from_json", "circuit_plant",
-              "parse_part_values", "resolve_plant", "sallen_key_circuit", "sallen_key_parts"),
+              "parse_part_values", "part_items", "resolve_plant", "sallen_key_circuit", "sallen_key_parts"),
     "modelloop": ("FAR_FACTOR", "LEAK_LOOP_GAIN", "TABLE_STEP_FRACTION", "limits", "loop_figures", "size"),
     "loopchecks": ("MAX_STEADY_STATE_ERROR", "designators", "kick_note", "named", "spice_notes", "stage_checks",
                    "steady_state_check"),

@@ -47,7 +47,7 @@ from ..core.process import ProcessModel
 from ..core.ranges import parse_in_range
 from ..spice.deck import Netlist
 
-__all__ = ["PLANT_PREFIX", "PlantCircuit", "Plant", "parse_part_values", "circuit_plant", "circuit_from_json",
+__all__ = ["PLANT_PREFIX", "PlantCircuit", "Plant", "parse_part_values", "part_items", "circuit_plant", "circuit_from_json",
            "circuit_from_cascade", "sallen_key_parts", "sallen_key_circuit", "resolve_plant"]
 
 #: the designator prefix of a one-section plant (R1 -> RP1; stage i of a cascade: RPi1)
@@ -177,6 +177,40 @@ class Plant:
                        source=Message(N_("{source}, negated (the controller's action reversed)"), source=m.source))
 
 
+def part_items(values, name: str = "plant_values") -> dict:
+    """Part values as typed, by designator (upper case), not yet checked against a topology.
+
+    Parameters
+    ----------
+    values : dict or iterable of str
+        Designator -> value, or ``REF=VALUE`` items.
+    name : str
+        The parameter named in messages.
+
+    Returns
+    -------
+    dict
+        Designator -> value as typed.
+
+    Raises
+    ------
+    DesignError
+        One line: an item not ``REF=VALUE``, or a designator given twice.
+    """
+    if not isinstance(values, dict):
+        items = {}
+        for item in values:
+            ref, eq, value = str(item).partition("=")
+            if not eq or not ref.strip() or not value.strip():
+                raise DesignError(f"{name}: {item!r} is not REF=VALUE (such as R1=10k)", param=name)
+            ref = ref.strip().upper()
+            if ref in items:
+                raise DesignError(f"{name}: {ref} given twice; give each part once", param=name)
+            items[ref] = value.strip()
+        values = items
+    return {str(k).strip().upper(): v for k, v in values.items()}
+
+
 def parse_part_values(topology, values, name: str = "plant_values") -> dict:
     """Part values of ``topology`` as typed (numbers, or text in engineering
     notation: ``{"R1": "10k"}``; or ``"R1=10k"`` items), checked against its
@@ -202,18 +236,7 @@ def parse_part_values(topology, values, name: str = "plant_values") -> dict:
         One line: an item not ``REF=VALUE``, a part the topology does not have
         (its parts listed), one missing, a value out of range.
     """
-    if not isinstance(values, dict):
-        items = {}
-        for item in values:
-            ref, eq, value = str(item).partition("=")
-            if not eq or not ref.strip() or not value.strip():
-                raise DesignError(f"{name}: {item!r} is not REF=VALUE (such as R1=10k)", param=name)
-            ref = ref.strip().upper()
-            if ref in items:
-                raise DesignError(f"{name}: {ref} given twice; give each part once", param=name)
-            items[ref] = value.strip()
-        values = items
-    values = {str(k).strip().upper(): v for k, v in values.items()}
+    values = part_items(values, name)
     parts = ", ".join(topology.designators)
     extra = [r for r in values if r not in topology.designators]
     if extra:

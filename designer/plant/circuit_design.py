@@ -45,7 +45,7 @@ from .result import METRICS, PLANT_SCHEMA_VERSION, Sourcing, Target
 
 __all__ = ["GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "CircuitAnalysisSpec", "CircuitPlantResult", "design_circuit_plant",
            "check_opamp_reach", "analyze_circuit_plant", "analyze_circuit_spec", "check_circuit_parts",
-           "tolerance_nominal", "SQUARE_NRMS_PASS", "SquareRun", "square_deck", "with_square_test"]
+           "tolerance_nominal", "built_name", "SQUARE_NRMS_PASS", "SquareRun", "square_deck", "with_square_test"]
 
 #: the op-amp's gain-bandwidth a section needs, in units of fn x Q x noise gain
 GBW_MARGIN = 10.0
@@ -412,6 +412,28 @@ def check_circuit_parts(topology, values: dict) -> dict:
                           param="part")
     return {r: parse_in_range(values[r], f"part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
             for r in topology.designators}
+
+
+def built_name(topology: str, values: dict) -> str:
+    """The default name of an analysis of parts as built (its files): ``built_`` with each part's designator
+    and value code (``built_r1820_r21k_c110n_c2220n``), the section's name after ``built_`` but for the
+    default one's.
+
+    Parameters
+    ----------
+    topology : str
+        The section's registered name.
+    values : dict
+        Designator -> value (ohm, farad), in the order the name lists them.
+
+    Returns
+    -------
+    str
+        The name.
+    """
+    from ..core.units import value_code
+    where = "" if topology == circuit.DEFAULT_TOPOLOGY else f"{topology}_"
+    return f"built_{where}" + "_".join(f"{r.lower()}{value_code(v)}" for r, v in values.items())
 
 
 @dataclass(frozen=True)

@@ -6,8 +6,9 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    "forms": ("CAPTURE_FIELDS", "CHECK", "CheckRequest", "FILTER", "Field", "FilterRequest", "IDENTIFY", "IDENTIFY_FILES",
-              "PID", "PLANT", "PidRequest", "PlantRequest", "check_message", "check_request", "field_of", "filter_request",
+    "forms": ("ANALYZE_PLANT", "AnalyzePlantRequest", "CAPTURE_FIELDS", "CHECK", "CheckRequest", "FILTER", "Field",
+              "FilterRequest", "IDENTIFY", "IDENTIFY_FILES", "PID", "PLANT", "PidRequest", "PlantRequest",
+              "analyze_plant_request", "check_message", "check_request", "field_of", "filter_request",
               "identify_request", "page_message", "pid_request", "plant_request"),
     "connections": ("BODY_GRACE_S", "GuardedH11", "HEADER_TIMEOUT_S", "MIN_BODY_RATE", "STOP_GRACE_S",
                     "StoppingServer"),

@@ -22,12 +22,14 @@ from ..check.yamldoc import WIDER
 from ..core.errors import DesignError, ParamError
 from ..core.i18n import N_, localise
 from ..core.i18n import gettext as _
+from ..filters.sallen_key_lowpass_parts import FIELD_OF
 from ..filters.sallen_key_lowpass_parts import refs as sallen_key_refs
 from .request import option_name, value_text
 
-__all__ = ["CAPTURE_FIELDS", "CHECK", "CheckRequest", "FILTER", "Field", "FilterRequest", "IDENTIFY", "IDENTIFY_FILES",
-           "PID", "PLANT", "PidRequest", "PlantRequest", "check_message", "check_request", "field_of", "filter_request",
-           "identify_request", "page_message", "pid_request", "plant_request"]
+__all__ = ["ANALYZE_PLANT", "AnalyzePlantRequest", "CAPTURE_FIELDS", "CHECK", "CheckRequest", "FILTER", "Field",
+           "FilterRequest", "IDENTIFY", "IDENTIFY_FILES", "PID", "PLANT", "PidRequest", "PlantRequest",
+           "analyze_plant_request", "check_message", "check_request", "field_of", "filter_request", "identify_request",
+           "page_message", "pid_request", "plant_request"]
 
 
 class Field(NamedTuple):
@@ -61,6 +63,17 @@ PLANT = {
     "worst-case": Field("worst_case", N_("worst case"), "switch"),
     "stimulus": Field("stimulus", N_("stimulus")), "prbs-bits": Field("bits", N_("PRBS bits")),
     "prbs-clock": Field("clock_hz", N_("PRBS clock (Hz)")),
+}
+#: the analyze-plant page's fields (the API's keys, as analyze-plant's option names) -> parameter and label: the
+#: parts as built (the Sallen-Key low-pass's by their names, any section's by designator), the target the errors
+#: are reported against; the op-amp, bench, run and tolerance fields as the plant page's
+ANALYZE_PLANT = {
+    **{FIELD_OF[ref]: Field(FIELD_OF[ref], ref) for ref in sallen_key_refs()},
+    "part": Field("part", N_("parts"), "list"), "gain": Field("gain", N_("gain K")),
+    "fc": Field("target_fc_hz", N_("target fc (Hz)")), "zeta": Field("target_zeta", N_("target zeta")),
+    **{k: PLANT[k] for k in PLANT if k not in ("fc", "zeta", "gain", "compensate-gbw", "r", "c", "r-min", "r-max",
+                                               "c-min", "c-max", "alternatives")},
+    "replay": Field("replay", N_("build replayed")),
 }
 #: the filter page's fields (the API's keys, as design-filter's option names) -> parameter and label
 FILTER = {
@@ -179,6 +192,23 @@ SIMULATORS = ("pyspice", "ngspice-cli")
 _FLAG = re.compile(r"--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?")
 #: a value a message quotes as given ('3.5q', '--help'): never read as a flag
 _QUOTED = re.compile(r"((?<![A-Za-z])'[^']*')")
+
+
+class AnalyzePlantRequest(NamedTuple):
+    """An analyze-plant page's request (parts as built) as the library takes it."""
+
+    spec: object                #: :class:`~designer.plant.spec.AnalysisSpec` (the Sallen-Key low-pass), or None
+    circuit: dict | None        #: another section's :func:`~designer.plant.circuit_design.analyze_circuit_plant`
+    #: arguments (its parts checked), or None
+    monte_carlo: object         #: :class:`~designer.tolerance.mcspec.MonteCarloSpec` or None
+    worst_case: bool            #: the extremes over the tolerance box too
+    tol: tuple                  #: the worst case's tolerances (without a Monte Carlo)
+    simulate: bool
+    simulator: str
+    stimulus: tuple | None      #: (bits, clock Hz) of a PRBS bench test, or None
+    name: str                   #: the analysis's name (its files)
+    argv: list                  #: the command line this request stands for (``tool.argv`` of its JSON)
+    replay: int | None = None   #: the Monte Carlo's build analysed alone in SPICE (analyze-plant --replay I)
 
 
 class CheckRequest(NamedTuple):
@@ -347,8 +377,7 @@ def plant_request(options) -> PlantRequest:
     spec_keys = ("fc_hz", "zeta", "gain", "r", "c", "opamp", "compensate_gbw", "amplitude_v", "square_hz",
                  "alternatives", "package", "r_series", "c_series", "r_min", "r_max", "c_min", "c_max", "topology")
     spec = PlantSpec(**{"zeta": None, **{k: v[k] for k in spec_keys if k in v}})
-    if v.get("package") not in (None, "single", "dual", "quad"):
-        raise DesignError(f"package {v['package']!r} unknown; allowed: single, dual, quad", param="package")
+    _check_package(v)
     mc = _monte_carlo(v, ("n", "seed", "sampler", "dist", "tol", "limits", "target_ci", "engine", "spice_samples"))
     simulator = _simulator(v, "pyspice")
     stimulus = _stimulus(v)
@@ -360,6 +389,91 @@ def plant_request(options) -> PlantRequest:
                  + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
     return PlantRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False),
                         simulator, stimulus, name, _argv("design-plant", options))
+
+
+def analyze_plant_request(options) -> AnalyzePlantRequest:
+    """An analyze-plant page's request (its JSON object) as the library's specs, checked as analyze-plant checks
+    its options: the Sallen-Key low-pass's parts by their names (``r1`` ..) or designators (``part``:
+    ``R1=820``), another section's (``topology``) by designator.
+
+    Parameters
+    ----------
+    options : dict
+        Field -> value (:data:`ANALYZE_PLANT`'s keys; numbers, or texts in engineering notation).
+
+    Returns
+    -------
+    AnalyzePlantRequest
+        The :class:`~designer.plant.spec.AnalysisSpec` (or another section's analysis), the Monte Carlo's spec
+        and the run's settings.
+
+    Raises
+    ------
+    DesignError
+        One line naming the library parameter at fault (shown by :func:`page_message`).
+    """
+    from ..filters import registry
+    from ..pid.plant import part_items
+    from ..plant.circuit import DEFAULT_TOPOLOGY
+    from ..plant.circuit_design import built_name, check_circuit_parts
+    v = _fields(options, ANALYZE_PLANT)
+    try:
+        topo = registry.get(v.get("topology", DEFAULT_TOPOLOGY))
+    except DesignError as exc:
+        raise DesignError(str(exc), param=getattr(exc, "param", None) or "topology") from None
+    parts = part_items(v.get("part", ()), "part")
+    bench = {k: v[k] for k in ("opamp", "target_fc_hz", "target_zeta", "r_series", "c_series", "amplitude_v",
+                               "square_hz", "package") if k in v}
+    _check_package(v)
+    mc = _monte_carlo(v, ("n", "seed", "sampler", "dist", "tol", "limits", "target_ci", "engine", "spice_samples"))
+    simulator = _simulator(v, "pyspice")
+    stimulus = _stimulus(v)
+    replay = _replay(v, mc)
+    if stimulus is not None and replay is not None:
+        raise ParamError("the prbs {stimulus} does not go with {replay} (a replayed build plays the square wave)",
+                         ("stimulus", "replay"))
+    spec = circuit = None
+    if topo.name != DEFAULT_TOPOLOGY:
+        named = [k for k in (*FIELD_OF.values(), "gain") if k in v]
+        if named:
+            raise ParamError("{%s} is the %s's; give %s's parts as {part} (%s)" % (
+                named[0], DEFAULT_TOPOLOGY, topo.name, ", ".join(topo.designators)), (named[0], "part"))
+        unsupported = [k for k, given in (("stimulus", stimulus), ("replay", replay)) if given is not None]
+        if unsupported:
+            raise ParamError("{%s} is the %s's for now; another topology has the .ac check, the square-wave test "
+                             "and the Monte Carlo" % (unsupported[0], DEFAULT_TOPOLOGY), tuple(unsupported))
+        values = check_circuit_parts(topo, parts)
+        circuit = {"topology": topo.name, "values": values, **bench}
+    else:
+        for ref, value in parts.items():
+            field = FIELD_OF.get(ref)
+            if field is None:
+                raise DesignError(f"part {ref}: {DEFAULT_TOPOLOGY} has no part {ref}; its parts are "
+                                  f"{', '.join(FIELD_OF)}", param="part")
+            if field in v:
+                raise ParamError("{part} %s and {%s} name the same part; give it once" % (ref, field),
+                                 ("part", field))
+            v[field] = value
+        missing = [FIELD_OF[r] for r in sallen_key_refs(with_gain=False) if FIELD_OF[r] not in v]
+        if missing:
+            raise ParamError("{%s} is required (or its {part})" % missing[0], (missing[0], "part"))
+        if "r3" in v and "gain" in v:
+            raise ParamError("give either {gain} or {r3}/{r4}, not both", ("gain", "r3", "r4"))
+        from ..plant.sallenkey import SallenKeyParts
+        from ..plant.spec import AnalysisSpec
+        spec = AnalysisSpec(SallenKeyParts(v["r1"], v["r2"], v["c1"], v["c2"], v.get("gain"), v.get("r3"),
+                                           v.get("r4")), **bench)
+        values = {r: getattr(spec.parts, FIELD_OF[r]) for r in sallen_key_refs(with_gain=False)}
+    name = _name(v, built_name(topo.name, values))
+    return AnalyzePlantRequest(spec, circuit, mc, bool(v.get("worst_case")), v.get("tol", ()),
+                               not v.get("no_sim", False), simulator, stimulus, name,
+                               _argv("analyze-plant", options), replay)
+
+
+def _check_package(v: dict) -> None:
+    """The op-amp package asked for: single, dual or quad."""
+    if v.get("package") not in (None, "single", "dual", "quad"):
+        raise DesignError(f"package {v['package']!r} unknown; allowed: single, dual, quad", param="package")
 
 
 def check_request(options) -> CheckRequest:
@@ -477,8 +591,7 @@ def pid_request(options, tmp: str | None) -> PidRequest:
                  "min_gain_margin_db", "max_ms", "robust", "r_series", "c_series", "r_min", "r_max", "c_min",
                  "c_max", "f_integrator_hz", "f_differentiator_hz", "opamp", "step_v", "edge_s", "square_hz",
                  "package") + PLAIN_PARAMS
-    if v.get("package") not in (None, "single", "dual", "quad"):
-        raise DesignError(f"package {v['package']!r} unknown; allowed: single, dual, quad", param="package")
+    _check_package(v)
     spec = pid_spec({**{k: v[k] for k in spec_keys if k in v}, "plant_process": process})
     mc = _monte_carlo(v, ("n", "seed", "sampler", "dist", "tol", "limits", "target_ci", "engine", "spice_samples"))
     _check_loop_tolerance(spec, mc, v.get("tol", ()))

@@ -46,11 +46,11 @@ from ..filters import report as filter_report
 from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
 
-__all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "CLI_ONLY", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "TRACES",
-           "TRACE_POINTS", "Superseded", "bom_shown", "bundle_zip", "check_task", "checks_shown", "circuit_plant_page",
-           "design_filter_task", "design_pid_task", "design_plant_task", "files_in", "filter_page", "histograms",
-           "identify_page", "identify_task", "pid_page", "plant_page", "run", "run_task", "series_text",
-           "temporaries_in", "through_library", "warm_up", "written_since"]
+__all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "CLI_ONLY", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "Superseded",
+           "TRACES", "TRACE_POINTS", "analyze_plant_task", "bom_shown", "bundle_zip", "check_task", "checks_shown",
+           "circuit_plant_page", "design_filter_task", "design_pid_task", "design_plant_task", "files_in",
+           "filter_page", "histograms", "identify_page", "identify_task", "pid_page", "plant_page", "run", "run_task",
+           "series_text", "temporaries_in", "through_library", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
@@ -60,7 +60,6 @@ BODE_POINTS = 300
 #: the commands a task may name by an argument list, and their console entry points (called as functions: argv
 #: in, status out); the others are :data:`LIBRARY`'s
 MAINS = {
-    "analyze-plant": cli_plant.analyze_plant_main,
     "analyze-pid": cli_pid.analyze_pid_main,
 }
 
@@ -271,40 +270,97 @@ def design_plant_task(fields: dict, want: str = "json", tmp: str | None = None) 
 
     def work(fields, lang):
         from ..plant.circuit import DEFAULT_TOPOLOGY
+        from ..plant.circuit_design import design_circuit_plant
         from ..plant.design import design_plant
-        from ..plant.report import write_outputs
-        from ..tolerance.mcspec import plant_tolerance
         from .forms import plant_request
         rq = plant_request(fields)
         if rq.spec.topology != DEFAULT_TOPOLOGY:   # another registered section: the generic plant pipeline
-            return _circuit_plant(rq, want, tmp, lang)
-        result = design_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
-        if rq.stimulus is not None:
-            from ..plant.prbs import with_prbs
-            result = with_prbs(result, result.test.amplitude_v, rq.stimulus[0], rq.stimulus[1], rq.simulate,
-                               rq.simulator)
-        result = plant_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
-        if want in ("sheet", "bundle"):
-            write_outputs(result, tmp, rq.name)
-        data = json.loads(json.dumps(result.to_dict()))
-        # the command line this request stands for: a record, never parsed
-        data["tool"]["argv"] = rq.argv + ([f"--lang={lang}"] if lang else [])
-        return data, lambda: plant_page(result), rq.name
+            return _circuit_plant(design_circuit_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator), rq,
+                                  want, tmp, lang)
+        return _sallen_key_plant(design_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator), rq, want,
+                                 tmp, lang)
     return _library_task("design-plant", PLANT, fields, work, want, tmp)
 
 
-def _circuit_plant(rq, want: str, tmp: str | None, lang: str | None) -> tuple:
-    """A plant on a registered topology other than the seed's (:func:`designer.plant.circuit_design.
-    design_circuit_plant`), with the Monte Carlo (the analytic engine, or every build's .ac in ngspice) and
-    worst case over its declared parts, as design-plant --topology runs them; as :func:`_library_task`'s
-    ``work`` answers."""
+def analyze_plant_task(fields: dict, want: str = "json", tmp: str | None = None) -> dict:
+    """analyze-plant for the page, the library called directly: the request's fields as the specs
+    (:func:`designer.web.forms.analyze_plant_request`), :func:`designer.plant.design.analyze_plant` (another
+    section's parts: :func:`designer.plant.circuit_design.analyze_circuit_plant`), the PRBS bench test, the
+    tolerance analysis or the replayed build asked for, and the typed result rendered as design-plant's.
+
+    Parameters
+    ----------
+    fields : dict
+        The request's JSON object (the analysis's fields, :data:`designer.web.forms.ANALYZE_PLANT`).
+    want : str
+        As :func:`run`'s.
+    tmp : str or None
+        The request's private folder (the files of a sheet or bundle; every temporary file).
+
+    Returns
+    -------
+    dict
+        As :func:`run`'s (the JSON as ``analyze-plant --json`` prints it); a refusal's ``field`` and ``label``
+        name the page's field at fault.
+    """
+    from .forms import ANALYZE_PLANT
+
+    def work(fields, lang):
+        from ..plant.circuit_design import analyze_circuit_plant
+        from ..plant.design import analyze_plant
+        from .forms import analyze_plant_request
+        rq = analyze_plant_request(fields)
+        if rq.circuit is not None:   # another registered section's parts
+            return _circuit_plant(analyze_circuit_plant(**rq.circuit, simulate=rq.simulate, simulator=rq.simulator),
+                                  rq, want, tmp, lang)
+        if rq.replay is not None:   # the build's own bundle: analyze-plant of its exact values, in SPICE
+            from ..tolerance.spice_mc import replay, replay_result
+            result, mc = analyze_plant(rq.spec, simulate=False), rq.monte_carlo
+            s = result.sourcing
+            build = replay(result, {"R": s.r_series, "C": s.c_series}, rq.replay, mc.n, mc.seed, mc.sampler, mc.dist,
+                           mc.tol, rq.simulator)
+            result = replay_result(result, build, rq.simulator, s.r_series, s.c_series, rq.spec.package)
+            return _plant_answer(result, rq, want, tmp, lang, f"{rq.name}_sample{rq.replay}")
+        return _sallen_key_plant(analyze_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator), rq, want, tmp,
+                                 lang)
+    return _library_task("analyze-plant", ANALYZE_PLANT, fields, work, want, tmp)
+
+
+def _sallen_key_plant(result, rq, want: str, tmp: str | None, lang: str | None) -> tuple:
+    """A Sallen-Key low-pass plant (designed or as built) with the PRBS bench test and the tolerance analysis
+    ``rq`` asks for; as :func:`_library_task`'s ``work`` answers."""
+    from ..tolerance.mcspec import plant_tolerance
+    if rq.stimulus is not None:
+        from ..plant.prbs import with_prbs
+        result = with_prbs(result, result.test.amplitude_v, rq.stimulus[0], rq.stimulus[1], rq.simulate,
+                           rq.simulator)
+    result = plant_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
+    return _plant_answer(result, rq, want, tmp, lang, rq.name)
+
+
+def _plant_answer(result, rq, want: str, tmp: str | None, lang: str | None, name: str) -> tuple:
+    """A Sallen-Key low-pass plant's result as the page takes it: its files written under ``name`` for a sheet
+    or bundle, its JSON with the command line ``rq`` stands for, its page."""
+    from ..plant.report import write_outputs
+    if want in ("sheet", "bundle"):
+        write_outputs(result, tmp, name)
+    data = json.loads(json.dumps(result.to_dict()))
+    # the command line this request stands for: a record, never parsed
+    data["tool"]["argv"] = rq.argv + ([f"--lang={lang}"] if lang else [])
+    return data, lambda: plant_page(result), name
+
+
+def _circuit_plant(result, rq, want: str, tmp: str | None, lang: str | None) -> tuple:
+    """A plant on a registered topology other than the seed's (designed, :func:`designer.plant.circuit_design.
+    design_circuit_plant`, or as built), with the Monte Carlo (the analytic engine, or every build's .ac in
+    ngspice) and worst case over its declared parts, as design-plant --topology runs them; as
+    :func:`_library_task`'s ``work`` answers."""
     from ..plant import circuit
-    from ..plant.circuit_design import design_circuit_plant, tolerance_nominal
+    from ..plant.circuit_design import tolerance_nominal
     from ..plant.circuit_report import write_outputs
     from ..tolerance.parts import resolve
     from ..tolerance.spice_mc import section_monte_carlo_engine
     from ..tolerance.worstcase import worst_case
-    result = design_circuit_plant(rq.spec, simulate=rq.simulate, simulator=rq.simulator)
     series = {"R": result.sourcing.r_series, "C": result.sourcing.c_series}
     nominal, context, mc = tolerance_nominal(result), (result.topology, result.opamp), rq.monte_carlo
     if rq.worst_case:
@@ -596,7 +652,7 @@ def identify_task(fields: dict, want: str = "json", tmp: str | None = None, capt
 
 
 #: the commands the page runs through the library (no console script, no argv, no printed JSON)
-LIBRARY = {"design-plant": design_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task,
+LIBRARY = {"design-plant": design_plant_task, "analyze-plant": analyze_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task,
            "check-design": check_task, "identify": identify_task}
 #: a command's options its page's name table does not map: a request with one would run the command's entry point
 #: (none left: design-pid's capture, replay and fail-on-check are the library's too)

@@ -382,6 +382,36 @@ def test_analyze_plant_and_the_pid_sheet(server):
     assert raw.startswith(b"<!DOCTYPE html>") and b"Op-amp PID" in raw
 
 
+@pytest.mark.spice
+@pytest.mark.parametrize("body, argv", [
+    ({"r1": 820, "r2": "1k", "c1": "10n", "c2": "220n", "monte-carlo": 200, "seed": 3, "worst-case": True,
+      "limit": "fn_hz=3k:4k"},
+     ["--r1", "820", "--r2", "1k", "--c1", "10n", "--c2", "220n", "--monte-carlo", "200", "--seed", "3",
+      "--worst-case", "--limit", "fn_hz=3k:4k"]),
+    ({"topology": "mfb-lowpass", "part": ["R1=1k1", "R2=2k2", "R3=43k", "C1=1n2", "C2=220n"], "monte-carlo": 100,
+      "worst-case": True, "simulator": "ngspice-cli"},
+     ["--topology", "mfb-lowpass", "--part", "R1=1k1", "--part", "R2=2k2", "--part", "R3=43k", "--part", "C1=1n2",
+      "--part", "C2=220n", "--monte-carlo", "100", "--worst-case", "--simulator", "ngspice-cli"]),
+])
+def test_analyze_plant_is_the_library_and_its_json_the_commands(server, body, argv):
+    """Issue 26: analyze-plant through the library (the page's fields, no command line run): its JSON is
+    analyze-plant --json's for the same inputs, a Sallen-Key low-pass's with its Monte Carlo as another
+    section's by designator; its page as design-plant's."""
+    status, got = server.post_json("/api/analyze-plant?view=page", {**body, "lang": "en"})
+    assert status == 200, got
+    want = cli_json("analyze-plant", *argv, "--json", "--no-files")
+    assert without_run_details(got["result"]) == without_run_details(want)
+    assert got["result"]["tool"]["argv"][0] == "analyze-plant" and "<svg" in got["page"]["schematic_svg"]
+    assert got["page"]["histograms"]
+
+
+def test_an_analyze_plant_refusal_names_the_fields_label(server):
+    status, got = server.post_json("/api/analyze-plant", {"r1": 820, "r2": "1k", "c1": "10n", "c2": "-1"})
+    assert status == 400 and got["error"] == "analyze-plant: error: \"C2\" must be 100 fF to 1 F, got '-1'", got
+    status, got = server.post_json("/api/analyze-plant", {"topology": "mfb-lowpass", "part": "R1=1k R5=2k"})
+    assert status == 400 and "--" not in got["error"] and "R1, R2, R3, C1, C2" in got["error"], got
+
+
 def test_check_runs_a_spec_and_its_deck(server):
     deck = (ROOT / "specs" / "decks" / "rc_ladder.cir").read_text()
     spec = "name: ladder\nkind: netlist\ndeck: rc_ladder.cir\nchecks:\n  v_final: {min: 0.99, max: 1.01}\n"

@@ -9,7 +9,7 @@ import pytest
 from designer.core.errors import DesignError, ParamError
 from designer.plant.spec import PlantSpec
 from designer.tolerance.mcspec import MonteCarloSpec
-from designer.web.forms import PLANT, field_of, page_message, plant_request
+from designer.web.forms import ANALYZE_PLANT, PLANT, analyze_plant_request, field_of, page_message, plant_request
 
 
 def test_every_field_sets_a_parameter_of_the_specs_or_of_the_run():
@@ -233,3 +233,59 @@ def test_a_pid_request_records_a_file_fields_name_never_its_content(tmp_path):
     rq = pid_request({"plant-capture": capture, "tuning": "amigo"}, str(tmp_path))
     assert rq.argv == ["design-pid", f"--plant-capture={PID_FILES['plant_capture']}", "--tuning=amigo"]
     assert rq.spec.process is not None and rq.spec.process.source.endswith("(plant-capture.csv)")
+
+
+def test_every_analyze_plant_field_is_an_analyze_plant_option_setting_a_parameter():
+    """Issue 26: the analysis page's name table: each field is analyze-plant's option of its name, and sets a
+    parameter of the analysis's specs (:class:`AnalysisSpec`, :func:`analyze_circuit_plant`), of the Monte
+    Carlo or of the run; a label names one field."""
+    import inspect
+
+    from designer.cli.plant import analyze_plant_parser
+    from designer.plant.circuit_design import analyze_circuit_plant
+    from designer.plant.spec import AnalysisSpec
+    options = {a.dest.replace("_", "-") for a in analyze_plant_parser()._actions}
+    assert set(ANALYZE_PLANT) <= options
+    params = ({f.name for f in dataclasses.fields(AnalysisSpec)} | set(inspect.signature(analyze_circuit_plant).parameters)
+              | {f.name for f in dataclasses.fields(MonteCarloSpec)}
+              | {"r1", "r2", "c1", "c2", "r3", "r4", "gain", "part", "no_sim", "name", "worst_case", "stimulus",
+                 "bits", "clock_hz", "replay"})
+    assert {f.param for f in ANALYZE_PLANT.values()} <= params
+    assert len({f.label for f in ANALYZE_PLANT.values()}) == len(ANALYZE_PLANT)
+
+
+def test_an_analyze_plant_request_is_the_spec_analyze_plant_builds():
+    from designer.filters import registry
+    from designer.plant.circuit_design import check_circuit_parts
+    from designer.plant.sallenkey import SallenKeyParts
+    from designer.plant.spec import AnalysisSpec
+    rq = analyze_plant_request({"r1": 820, "part": ["R2=1k", "C1=10n"], "c2": "220n", "fc": 3500, "zeta": "0.2",
+                                "opamp": "TL072", "monte-carlo": 50, "no-sim": True})
+    assert rq.spec == AnalysisSpec(SallenKeyParts(820, "1k", "10n", "220n"), opamp="TL072", target_fc_hz=3500,
+                                   target_zeta="0.2")
+    assert rq.circuit is None and rq.monte_carlo == MonteCarloSpec(n=50) and rq.simulate is False
+    assert rq.name == analyze_plant_request({"r1": 820, "r2": "1k", "c1": "10n", "c2": "220n"}).name
+    assert rq.argv[:2] == ["analyze-plant", "--r1=820"]
+    parts = {"R1": "1k1", "R2": "2k2", "R3": "43k", "C1": "1n2", "C2": "220n"}
+    rq = analyze_plant_request({"topology": "mfb-lowpass", "part": [f"{r}={v}" for r, v in parts.items()]})
+    assert rq.spec is None and rq.circuit == {"topology": "mfb-lowpass",
+                                              "values": check_circuit_parts(registry.get("mfb-lowpass"), parts)}
+    assert rq.name.startswith("built_mfb-lowpass_r1")
+
+
+@pytest.mark.parametrize("fields, param, words", [
+    ({"r1": 820, "r2": "1k", "c1": "10n"}, "c2", '"C2" is required'),
+    ({"r1": 820, "r2": "1k", "c1": "10n", "c2": "-1"}, "c2", '"C2" must be'),
+    ({"part": "R1=1k R9=2", "r2": "1k", "c1": "10n", "c2": "1n"}, "part", "its parts are R1, R2, C1, C2, R3, R4"),
+    ({"part": "R1=1k", "r1": 3, "r2": 1, "c1": "1n", "c2": "1n"}, "part", '"R1" name the same part'),
+    ({"r1": 820, "r2": "1k", "c1": "10n", "c2": "220n", "gain": 2, "r3": "1k"}, "gain", '"gain K" or "R3"/"R4"'),
+    ({"topology": "mfb-lowpass", "r1": 5}, "r1", "give mfb-lowpass's parts as \"parts\""),
+    ({"topology": "mfb-lowpass", "part": "R1=1k"}, "part", "needs R2, R3, C1, C2 too"),
+    ({"topology": "nope"}, "topology", "registered: sallen-key-lowpass"),
+    ({"r1": 820, "r2": "1k", "c1": "10n", "c2": "220n", "replay": 3}, "replay", '"build replayed" goes with'),
+])
+def test_bad_analyze_plant_fields_are_refused_in_the_pages_words(fields, param, words):
+    with pytest.raises(DesignError) as exc:
+        analyze_plant_request(fields)
+    text, field = page_message(exc.value, ANALYZE_PLANT)
+    assert ANALYZE_PLANT[field].param == param and words in text and "--" not in text, text

@@ -46,10 +46,11 @@ def test_a_plant_page_is_the_commands_json_and_its_own_arrays():
 
 
 def test_a_refusal_is_the_commands_one_line():
-    """A command still run by its argument list refuses in its one line; a library task in the page's words."""
-    out = jobs.run({"prog": "analyze-plant", "argv": ["--r1", "1k6", "--r2", "3k9", "--c1", "3n3", "--c2", "-1",
-                                                      "--json", "--no-files"], "want": "page"})
-    assert out["status"] == 2 and out["error"] == "analyze-plant: error: --c2 must be 100 fF to 1 F, got '-1'"
+    """A library task refuses in the page's words: the field's label, in the request's language."""
+    out = jobs.run({"prog": "analyze-plant", "fields": {"r1": "1k6", "r2": "3k9", "c1": "3n3", "c2": "-1"},
+                    "want": "page"})
+    assert out["status"] == 2 and out["error"] == "analyze-plant: error: \"C2\" must be 100 fF to 1 F, got '-1'"
+    assert (out["field"], out["label"]) == ("c2", "C2")
     out = jobs.run({"prog": "design-plant", "fields": {"fc": 3500, "zeta": -1}, "want": "page"})
     assert out["status"] == 2 and out["error"] == "design-plant: error: \"zeta\" must be 0.01 to 10, got '-1'"
     assert out["field"] == "zeta"
