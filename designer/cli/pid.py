@@ -392,24 +392,12 @@ def analyze_pid_parser():
     return p
 
 
-#: the controller parts' options, as PidParts fields
-CONTROLLER_FIELDS = tuple(f"r{i}" for i in range(3, 19)) + ("c3", "c4")
-
-
 def _analyze(args) -> int:
-    from ..pid.blocks import PidParts
     from ..pid.design import analyze_pid
     from ..pid.report import summary_text, write_outputs
-    from ..pid.spec import controller_from_json, pid_spec
-    typed = {k: getattr(args, k) for k in CONTROLLER_FIELDS}
-    if args.parts_json is not None:
-        if any(v is not None for v in typed.values()):
-            raise DesignError("give the controller either part by part (--r3 .. --c4) or --parts-json, not both")
-        parts = controller_from_json(args.parts_json)
-    elif all(v is None for v in typed.values()):
-        raise DesignError("the controller's parts are needed: --r3 .. --r18, --c3, --c4 (or --parts-json FILE)")
-    else:
-        parts = PidParts(**typed)
+    from ..pid.spec import CONTROLLER_FIELDS, analyzed_name, controller_as_built, pid_spec
+    parts = controller_as_built({**{k: getattr(args, k) for k in CONTROLLER_FIELDS},
+                                 "controller_json": args.parts_json})
     typed = _typed(args, ANALYZE_PARAMS + PLANT_PARTS)
     process = _captured_model(args, typed)
     spec = pid_spec({**typed, "controller_parts": parts, "package": args.package, "plant_process": process})
@@ -417,22 +405,12 @@ def _analyze(args) -> int:
     common.check_output(args, replay_name(args.name if args.name is not None else "pid_as-built", spice))
     if spice[2] is not None:    # the parts as given are the draw's nominal; the build's own run is the simulation
         result = analyze_pid(spec, simulate=False, simulator=args.simulator)
-        return emit(replay(spec, result, args, mc, spice), args, replay_name(_analyzed_name(args, spec, result),
-                                                                             spice), write_outputs, summary_text)
+        return emit(replay(spec, result, args, mc, spice), args,
+                    replay_name(args.name or analyzed_name(spec, result), spice), write_outputs, summary_text)
     with cluster_ahead(args):
         result = loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc,
                                   spice)
-    return emit(result, args, _analyzed_name(args, spec, result), write_outputs, summary_text)
-
-
-def _analyzed_name(args, spec, result) -> str:
-    """analyze-pid's bundle name: --name, else from the tuning, the op-amp and the plant."""
-    from ..pid.spec import default_name
-    if args.name:
-        return args.name
-    if spec.process is not None:
-        return default_name(spec, result)
-    return f"pid_{result.tuning.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}_z{result.plant.zeta:.3g}"
+    return emit(result, args, args.name or analyzed_name(spec, result), write_outputs, summary_text)
 
 
 #: the spec's parameters analyze-pid sets from options of the same meaning

@@ -47,7 +47,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
               "parallel_to_series", "series_to_parallel", "tune_model"),
     "schematic": ("PLANT_BLOCK", "draw_loop", "draw_model_loop"),
     "selection": ("R_CORNER_MAX", "brute_force", "objective", "select_parts"),
-    "spec": ("PLAIN_PARAMS", "PidSpec", "controller_from_json", "default_name", "pid_spec"),
+    "spec": ("CONTROLLER_FIELDS", "PLAIN_PARAMS", "PidSpec", "analyzed_name", "controller_as_built",
+             "controller_from_json", "default_name", "pid_spec"),
     "tuning": ("Fopdt", "RULE_MODEL", "reaction_curve", "tune"),
     "verify": ("loop_metrics", "oscillation", "stages"),
 })

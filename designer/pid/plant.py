@@ -47,7 +47,8 @@ from ..core.process import ProcessModel
 from ..core.ranges import parse_in_range
 from ..spice.deck import Netlist
 
-__all__ = ["PLANT_PREFIX", "PlantCircuit", "Plant", "parse_part_values", "part_items", "circuit_plant", "circuit_from_json",
+__all__ = ["PLANT_PREFIX", "PlantCircuit", "Plant", "parse_part_values", "part_items", "circuit_plant",
+           "circuit_from_json",
            "circuit_from_cascade", "sallen_key_parts", "sallen_key_circuit", "resolve_plant"]
 
 #: the designator prefix of a one-section plant (R1 -> RP1; stage i of a cascade: RPi1)

@@ -36,7 +36,8 @@ from .blocks import PidParts
 from .plant_spec import NUMBERS as PLANT_NUMBERS
 from .plant_spec import PLANT_FIELDS, PLANT_RANGES, PlantSource
 
-__all__ = ["PLAIN_PARAMS", "PidSpec", "controller_from_json", "default_name", "pid_spec"]
+__all__ = ["CONTROLLER_FIELDS", "PLAIN_PARAMS", "PidSpec", "analyzed_name", "controller_as_built",
+           "controller_from_json", "default_name", "pid_spec"]
 
 #: the spec's own numbers and their ranges (keys of RANGES), in the order they are checked (the plant's:
 #: designer.pid.plant_spec)
@@ -259,6 +260,65 @@ def pid_spec(params: dict) -> PidSpec:
         from .blocks import seed_parts
         p["controller_parts"] = seed_parts()
     return PidSpec(**p)
+
+
+#: the controller as built, part by part (:func:`controller_as_built`), as :class:`~designer.pid.blocks.PidParts`
+#: fields
+CONTROLLER_FIELDS = tuple(f"r{i}" for i in range(3, 19)) + ("c3", "c4")
+
+
+def controller_as_built(params: dict) -> PidParts:
+    """The controller's parts as built, from plain parameters (analyze-pid's options, the web page's fields):
+    every part (:data:`CONTROLLER_FIELDS`: ``r3`` .. ``c4``, as typed) or a result.json's (``controller_json``,
+    its path); the one mapping every front end uses.
+
+    Parameters
+    ----------
+    params : dict
+        :data:`CONTROLLER_FIELDS` and ``controller_json`` (a value None is not given).
+
+    Returns
+    -------
+    PidParts
+        The parts (checked by :class:`PidSpec` when they go into one, or by :func:`controller_from_json`).
+
+    Raises
+    ------
+    DesignError
+        Both ways given, or neither (one line naming the parameters).
+    """
+    typed = {k: params.get(k) for k in CONTROLLER_FIELDS}
+    names = (*CONTROLLER_FIELDS, "controller_json")
+    if params.get("controller_json") is not None:
+        if any(v is not None for v in typed.values()):
+            raise ParamError("give the controller either part by part ({r3} .. {c4}) or {controller_json}, not both",
+                             names)
+        return controller_from_json(params["controller_json"])
+    if all(v is None for v in typed.values()):
+        raise ParamError("the controller's parts are needed: {r3} .. {r18}, {c3}, {c4} (or {controller_json} FILE)",
+                         names)
+    return PidParts(**typed)
+
+
+def analyzed_name(spec: PidSpec, result) -> str:
+    """analyze-pid's name of an analysis (its files) when none is given: from the tuning, the op-amp and the
+    plant (a model plant's: :func:`default_name`).
+
+    Parameters
+    ----------
+    spec : PidSpec
+        What was asked.
+    result : designer.pid.result.PidResult
+        The analysis.
+
+    Returns
+    -------
+    str
+        The name.
+    """
+    if spec.process is not None:
+        return default_name(spec, result)
+    return f"pid_{result.tuning.method}_{spec.opamp.lower()}_fn{result.plant.fn_hz:.5g}_z{result.plant.zeta:.3g}"
 
 
 def default_name(spec: PidSpec, result) -> str:

@@ -13,7 +13,8 @@ from ..core.exports import lazy_exports
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "circuit_report": ("bom", "sections", "title_of"),
     "circuit_design": ("CircuitAnalysisSpec", "CircuitPlantResult", "GBW_MARGIN", "SPICE_DB", "SPICE_DEG",
-                       "analyze_circuit_plant", "analyze_circuit_spec", "built_name", "check_circuit_parts", "check_opamp_reach",
+                       "analyze_circuit_plant", "analyze_circuit_spec", "built_name", "check_circuit_parts",
+                       "check_opamp_reach",
                        "design_circuit_plant", "tolerance_nominal", "SQUARE_NRMS_PASS", "SquareRun", "square_deck",
                        "with_square_test"),
     "circuit": ("BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "candidate_set", "capacitor_combinations",

@@ -22,14 +22,15 @@ from ..check.yamldoc import WIDER
 from ..core.errors import DesignError, ParamError
 from ..core.i18n import N_, localise
 from ..core.i18n import gettext as _
-from ..filters.sallen_key_lowpass_parts import FIELD_OF
+from ..filters.sallen_key_lowpass_parts import FIELD_OF, gain_refs, parts_of
 from ..filters.sallen_key_lowpass_parts import refs as sallen_key_refs
 from .request import option_name, value_text
 
-__all__ = ["ANALYZE_PLANT", "AnalyzePlantRequest", "CAPTURE_FIELDS", "CHECK", "CheckRequest", "FILTER", "Field",
-           "FilterRequest", "IDENTIFY", "IDENTIFY_FILES", "PID", "PLANT", "PidRequest", "PlantRequest",
-           "analyze_plant_request", "check_message", "check_request", "field_of", "filter_request", "identify_request",
-           "page_message", "pid_request", "plant_request"]
+__all__ = ["ANALYZE_PID", "ANALYZE_PLANT", "AnalyzePlantRequest", "CAPTURE_FIELDS", "CHECK", "CheckRequest",
+           "DESIGN_ONLY", "FILTER", "Field", "FilterRequest", "IDENTIFY", "IDENTIFY_FILES", "PID", "PLANT",
+           "PidRequest", "PlantRequest", "analyze_pid_request", "analyze_plant_request", "check_message",
+           "check_request", "field_of", "filter_request", "identify_request", "page_message", "pid_request",
+           "plant_request"]
 
 
 class Field(NamedTuple):
@@ -168,6 +169,17 @@ PID = {
     "worst-case": Field("worst_case", N_("worst case"), "switch"),
     "replay": Field("replay", N_("build replayed")),
 }
+#: design-pid's fields analyze-pid has not (the tuning and the sizing: its controller is built)
+DESIGN_ONLY = ("tuning", "target-overshoot", "target-settling", "rules-spice", "seed-parts", "r-series", "c-series",
+               "r-min", "r-max", "c-min", "c-max", "f-integrator", "f-differentiator")
+#: the analyze-pid page's fields (the API's keys, as analyze-pid's option names) -> parameter of
+#: :func:`designer.pid.spec.pid_spec` (the controller's parts: of :func:`designer.pid.spec.controller_as_built`)
+#: and label: the PID page's but the tuning and sizing, and the controller as built
+ANALYZE_PID = {
+    **{k: f for k, f in PID.items() if k not in DESIGN_ONLY},
+    **{name: Field(name, name.upper()) for name in (*(f"r{i}" for i in range(3, 19)), "c3", "c4")},
+    "parts-json": Field("controller_json", N_("controller result.json"), "file"),
+}
 #: the Check page's fields (the API's ``options`` keys, as check-design's option names) -> parameter of
 #: :func:`designer.check.batch.check_specs` and label; the files and the folder they stay inside are the request's
 CHECK = {
@@ -186,7 +198,7 @@ PID_DEFAULTS = {"step_v": "1", "edge_s": "100n", "r_series": "E24", "c_series": 
                 "c_min": "1n", "c_max": "10u"}
 #: the file a file field's content is written to, in the request's folder (never a path the request gives)
 PID_FILES = {"plant_json": "plant-result.json", "plant_model": "plant-model.json",
-             "plant_capture": "plant-capture.csv"}
+             "plant_capture": "plant-capture.csv", "controller_json": "parts-result.json"}
 #: the simulators a request may choose (designer.spice.simulate's backends)
 SIMULATORS = ("pyspice", "ngspice-cli")
 _FLAG = re.compile(r"--([a-z][a-z0-9-]*)(?: [A-Z][A-Z_]*\b)?")
@@ -457,12 +469,12 @@ def analyze_plant_request(options) -> AnalyzePlantRequest:
         missing = [FIELD_OF[r] for r in sallen_key_refs(with_gain=False) if FIELD_OF[r] not in v]
         if missing:
             raise ParamError("{%s} is required (or its {part})" % missing[0], (missing[0], "part"))
-        if "r3" in v and "gain" in v:
-            raise ParamError("give either {gain} or {r3}/{r4}, not both", ("gain", "r3", "r4"))
-        from ..plant.sallenkey import SallenKeyParts
+        pair = tuple(FIELD_OF[r] for r in gain_refs())   # to ground, feedback
+        if pair[0] in v and "gain" in v:
+            raise ParamError("give either {gain} or {%s}/{%s}, not both" % pair, ("gain", *pair))
         from ..plant.spec import AnalysisSpec
-        spec = AnalysisSpec(SallenKeyParts(v["r1"], v["r2"], v["c1"], v["c2"], v.get("gain"), v.get("r3"),
-                                           v.get("r4")), **bench)
+        spec = AnalysisSpec(parts_of({r: v[FIELD_OF[r]] for r in sallen_key_refs() if FIELD_OF[r] in v},
+                                     gain=v.get("gain")), **bench)
         values = {r: getattr(spec.parts, FIELD_OF[r]) for r in sallen_key_refs(with_gain=False)}
     name = _name(v, built_name(topo.name, values))
     return AnalyzePlantRequest(spec, circuit, mc, bool(v.get("worst_case")), v.get("tol", ()),
@@ -577,10 +589,48 @@ def pid_request(options, tmp: str | None) -> PidRequest:
     DesignError
         One line naming the library parameter at fault (shown by :func:`page_message`).
     """
+    return _loop_request(options, tmp, PID, "design-pid")
+
+
+def analyze_pid_request(options, tmp: str | None) -> PidRequest:
+    """An analyze-pid page's request (its JSON object) as the library's specs, checked as analyze-pid checks
+    its options: the controller's parts as built (:func:`designer.pid.spec.controller_as_built`, every part
+    or a result.json's) on the plant, as :func:`pid_request` takes it.
+
+    Parameters
+    ----------
+    options : dict
+        Field -> value (:data:`ANALYZE_PID`'s keys; numbers, or texts in engineering notation; a file field's
+        content as a JSON object or a text).
+    tmp : str or None
+        The request's private folder: a file field's content is written there (:data:`PID_FILES`).
+
+    Returns
+    -------
+    PidRequest
+        The :class:`~designer.pid.spec.PidSpec` with its ``controller_parts``, the Monte Carlo's spec and the
+        run's settings.
+
+    Raises
+    ------
+    DesignError
+        One line naming the library parameter at fault (shown by :func:`page_message`).
+    """
+    return _loop_request(options, tmp, ANALYZE_PID, "analyze-pid")
+
+
+def _loop_request(options, tmp: str | None, table: dict, prog: str) -> PidRequest:
+    """A PID page's request (design-pid's, or analyze-pid's: ``table`` :data:`ANALYZE_PID`) as the library's
+    specs, checked in the order the command checks its options."""
     from ..cli.pid import plant_capture_model
-    from ..pid.spec import PLAIN_PARAMS, pid_spec
-    v = {**PID_DEFAULTS, **_fields(options, PID)}
+    from ..pid.spec import CONTROLLER_FIELDS, PLAIN_PARAMS, controller_as_built, pid_spec
+    params = {f.param for f in table.values()}
+    v = {**{k: d for k, d in PID_DEFAULTS.items() if k in params}, **_fields(options, table)}
     _write_files(v, PID_FILES, tmp)
+    built = {}
+    if table is ANALYZE_PID:   # the controller as built, checked first as analyze-pid does
+        built["controller_parts"] = controller_as_built({k: v.pop(k, None)
+                                                         for k in (*CONTROLLER_FIELDS, "controller_json")})
     # a plant capture: identified first (as design-pid --plant-capture), its model the plant
     capture = _identify_params({"capture": v.pop("plant_capture", None),
                                 **{IDENTIFY[k].param: v.pop(IDENTIFY[k].param, None) for k in CAPTURE_FIELDS}})
@@ -592,13 +642,13 @@ def pid_request(options, tmp: str | None) -> PidRequest:
                  "c_max", "f_integrator_hz", "f_differentiator_hz", "opamp", "step_v", "edge_s", "square_hz",
                  "package") + PLAIN_PARAMS
     _check_package(v)
-    spec = pid_spec({**{k: v[k] for k in spec_keys if k in v}, "plant_process": process})
+    spec = pid_spec({**{k: v[k] for k in spec_keys if k in v}, **built, "plant_process": process})
     mc = _monte_carlo(v, ("n", "seed", "sampler", "dist", "tol", "limits", "target_ci", "engine", "spice_samples"))
     _check_loop_tolerance(spec, mc, v.get("tol", ()))
     simulator = _simulator(v, "pyspice")
     name = _name(v, "pid") if "name" in v else None
     return PidRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False), simulator,
-                      bool(v.get("rules_spice")), name, _argv("design-pid", options, PID, PID_FILES), _replay(v, mc))
+                      bool(v.get("rules_spice")), name, _argv(prog, options, table, PID_FILES), _replay(v, mc))
 
 
 def _replay(v: dict, mc) -> int | None:

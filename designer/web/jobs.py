@@ -32,8 +32,6 @@ from contextlib import contextmanager, redirect_stderr, redirect_stdout
 
 import numpy as np
 
-from ..cli import pid as cli_pid
-from ..cli import plant as cli_plant
 from ..cli.common import RESULT_HOOK
 from ..core import lifetime
 from ..core.i18n import N_, current, language, localise, translated
@@ -47,10 +45,10 @@ from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
 
 __all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "CLI_ONLY", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "Superseded",
-           "TRACES", "TRACE_POINTS", "analyze_plant_task", "bom_shown", "bundle_zip", "check_task", "checks_shown",
-           "circuit_plant_page", "design_filter_task", "design_pid_task", "design_plant_task", "files_in",
-           "filter_page", "histograms", "identify_page", "identify_task", "pid_page", "plant_page", "run", "run_task",
-           "series_text", "temporaries_in", "through_library", "warm_up", "written_since"]
+           "TRACES", "TRACE_POINTS", "analyze_pid_task", "analyze_plant_task", "bom_shown", "bundle_zip", "check_task",
+           "checks_shown", "circuit_plant_page", "design_filter_task", "design_pid_task", "design_plant_task",
+           "files_in", "filter_page", "histograms", "identify_page", "identify_task", "pid_page", "plant_page", "run",
+           "run_task", "series_text", "temporaries_in", "through_library", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
@@ -60,7 +58,6 @@ BODE_POINTS = 300
 #: the commands a task may name by an argument list, and their console entry points (called as functions: argv
 #: in, status out); the others are :data:`LIBRARY`'s
 MAINS = {
-    "analyze-pid": cli_pid.analyze_pid_main,
 }
 
 
@@ -483,38 +480,77 @@ def design_pid_task(fields: dict, want: str = "json", tmp: str | None = None) ->
 
     def work(fields, lang):
         from ..pid.design import design_pid
-        from ..pid.report import write_outputs
         from ..pid.spec import default_name
-        from ..tolerance.mcspec import loop_tolerance
         from .forms import pid_request
+
+        def run(spec, simulate, simulator):
+            return design_pid(spec, simulate=simulate, simulator=simulator, rules_spice=rq.rules_spice)
         rq = pid_request(fields, tmp)
-        if rq.replay is not None:   # the design is the draw's nominal; the build's own run is the simulation
-            design, result = _replayed(rq)
-            name = f"{rq.name or default_name(rq.spec, design)}_sample{rq.replay}"
-        else:
-            result = design_pid(rq.spec, simulate=rq.simulate, simulator=rq.simulator, rules_spice=rq.rules_spice)
-            result = loop_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
-            name = rq.name or default_name(rq.spec, result)
-        if want in ("sheet", "bundle"):
-            write_outputs(result, tmp, name)
-        data = json.loads(json.dumps(result.to_dict()))
-        # the command line this request stands for: a record, never parsed
-        data["tool"]["argv"] = rq.argv + ([f"--lang={lang}"] if lang else [])
-        return data, lambda: pid_page(result), name
+        return _loop_answer(rq, run, default_name, want, tmp, lang)
     return _library_task("design-pid", PID, fields, work, want, tmp)
 
 
-def _replayed(rq):
-    """Build ``rq.replay`` of the request's Monte Carlo, analysed as built in SPICE (design-pid ``--replay I``:
-    :func:`designer.tolerance.spice_loop_mc.replay`): (the design, the build's result, its ``monte_carlo`` the
-    replayed row)."""
-    from ..pid.design import design_pid
-    from ..tolerance.loop import loop_series
-    from ..tolerance.spice_loop_mc import replay, replay_result
-    design = design_pid(rq.spec, simulate=False, simulator=rq.simulator)
-    mc = rq.monte_carlo
-    build = replay(design, loop_series(design), rq.replay, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol, rq.simulator)
-    return design, replay_result(rq.spec, design, build, rq.simulator)
+def analyze_pid_task(fields: dict, want: str = "json", tmp: str | None = None) -> dict:
+    """analyze-pid for the page, the library called directly: the request's fields as the specs
+    (:func:`designer.web.forms.analyze_pid_request`: the controller's parts as built through
+    :func:`designer.pid.spec.controller_as_built`, the rest through :func:`designer.pid.spec.pid_spec`, the command
+    line's mappings), :func:`designer.pid.design.analyze_pid`, the loop's tolerance analysis or the replayed build
+    asked for, and the typed result rendered as design-pid's.
+
+    Parameters
+    ----------
+    fields : dict
+        The request's JSON object (the analysis's fields, :data:`designer.web.forms.ANALYZE_PID`).
+    want : str
+        As :func:`run`'s.
+    tmp : str or None
+        The request's private folder (a file field's content, the files of a sheet or bundle; every
+        temporary file).
+
+    Returns
+    -------
+    dict
+        As :func:`run`'s (the JSON as ``analyze-pid --json`` prints it); a refusal's ``field`` and ``label``
+        name the page's field at fault.
+    """
+    from .forms import ANALYZE_PID
+
+    def work(fields, lang):
+        from ..pid.design import analyze_pid
+        from ..pid.spec import analyzed_name
+        from .forms import analyze_pid_request
+        rq = analyze_pid_request(fields, tmp)
+        return _loop_answer(rq, lambda spec, simulate, simulator: analyze_pid(spec, simulate=simulate,
+                                                                             simulator=simulator),
+                            analyzed_name, want, tmp, lang)
+    return _library_task("analyze-pid", ANALYZE_PID, fields, work, want, tmp)
+
+
+def _loop_answer(rq, run, default_name, want: str, tmp: str | None, lang: str | None) -> tuple:
+    """A PID loop (``run(spec, simulate, simulator)``: designed or as built) with the tolerance analysis ``rq``
+    asks for, or its replayed build (``--replay I``: the run without SPICE is the draw's nominal, the build's
+    own run the simulation, :func:`designer.tolerance.spice_loop_mc.replay`); its files named by ``rq`` or
+    ``default_name(spec, result)``; as :func:`_library_task`'s ``work`` answers."""
+    from ..pid.report import write_outputs
+    from ..tolerance.mcspec import loop_tolerance
+    if rq.replay is not None:
+        from ..tolerance.loop import loop_series
+        from ..tolerance.spice_loop_mc import replay, replay_result
+        nominal, mc = run(rq.spec, False, rq.simulator), rq.monte_carlo
+        build = replay(nominal, loop_series(nominal), rq.replay, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol,
+                       rq.simulator)
+        result = replay_result(rq.spec, nominal, build, rq.simulator)
+        name = f"{rq.name or default_name(rq.spec, nominal)}_sample{rq.replay}"
+    else:
+        result = loop_tolerance(run(rq.spec, rq.simulate, rq.simulator), rq.monte_carlo, rq.worst_case, rq.tol,
+                                rq.simulator)
+        name = rq.name or default_name(rq.spec, result)
+    if want in ("sheet", "bundle"):
+        write_outputs(result, tmp, name)
+    data = json.loads(json.dumps(result.to_dict()))
+    # the command line this request stands for: a record, never parsed
+    data["tool"]["argv"] = rq.argv + ([f"--lang={lang}"] if lang else [])
+    return data, lambda: pid_page(result), name
 
 
 def _library_task(prog: str, table: dict, fields: dict, work, want: str, tmp: str | None) -> dict:
@@ -652,7 +688,8 @@ def identify_task(fields: dict, want: str = "json", tmp: str | None = None, capt
 
 
 #: the commands the page runs through the library (no console script, no argv, no printed JSON)
-LIBRARY = {"design-plant": design_plant_task, "analyze-plant": analyze_plant_task, "design-pid": design_pid_task, "design-filter": design_filter_task,
+LIBRARY = {"design-plant": design_plant_task, "analyze-plant": analyze_plant_task, "design-pid": design_pid_task,
+           "analyze-pid": analyze_pid_task, "design-filter": design_filter_task,
            "check-design": check_task, "identify": identify_task}
 #: a command's options its page's name table does not map: a request with one would run the command's entry point
 #: (none left: design-pid's capture, replay and fail-on-check are the library's too)

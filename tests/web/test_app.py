@@ -405,6 +405,30 @@ def test_analyze_plant_is_the_library_and_its_json_the_commands(server, body, ar
     assert got["page"]["histograms"]
 
 
+#: the seed's controller as built (analyze-pid --help's example), by its parts' options
+AS_BUILT = {"r3": "12k", "r4": "1k8", "r5": "22k", "r6": "3k3", "r7": "15k", "r8": "1k2", "r9": "10k", "r10": "10k",
+            "r11": "10k", "r12": "1k", "r13": "27k", "r14": "2k7", "r15": "10k", "r16": "10k", "r17": "10k",
+            "r18": "10k", "c3": "4n7", "c4": "47n"}
+
+
+def test_analyze_pid_is_the_library_and_its_json_the_commands(server):
+    """Issue 26: analyze-pid through the library (the controller's parts as built, a Monte Carlo of the loop):
+    its JSON is analyze-pid --json's for the same inputs; its page as design-pid's; a refusal names the field's
+    label."""
+    body = {"plant-fc": 3500, "plant-zeta": 0.2, **AS_BUILT, "kp": 45, "ti": "43.215u", "td": "10.8037u",
+            "no-sim": True, "monte-carlo": 50, "seed": 1}
+    status, got = server.post_json("/api/analyze-pid?view=page", body)
+    assert status == 200, got
+    argv = [w for k, v in body.items() if k != "no-sim" for w in (f"--{k}", str(v))]
+    want = cli_json("analyze-pid", *argv, "--no-sim", "--json", "--no-files")
+    assert without_run_details(got["result"]) == without_run_details(want)
+    assert got["result"]["tool"]["argv"][0] == "analyze-pid" and got["page"]["histograms"]
+    status, got = server.post_json("/api/analyze-pid", {"plant-fc": 3500, "plant-zeta": 0.2, **AS_BUILT, "r5": -1})
+    assert status == 400 and got["error"] == "analyze-pid: error: \"R5\" must be 100 mOhm to 1 GOhm, got '-1'", got
+    status, got = server.post_json("/api/analyze-pid", {"plant-fc": 3500, "plant-zeta": 0.2})
+    assert status == 400 and "--" not in got["error"] and "\"R3\" .. \"R18\"" in got["error"], got
+
+
 def test_an_analyze_plant_refusal_names_the_fields_label(server):
     status, got = server.post_json("/api/analyze-plant", {"r1": 820, "r2": "1k", "c1": "10n", "c2": "-1"})
     assert status == 400 and got["error"] == "analyze-plant: error: \"C2\" must be 100 fF to 1 F, got '-1'", got

@@ -246,7 +246,8 @@ def test_every_analyze_plant_field_is_an_analyze_plant_option_setting_a_paramete
     from designer.plant.spec import AnalysisSpec
     options = {a.dest.replace("_", "-") for a in analyze_plant_parser()._actions}
     assert set(ANALYZE_PLANT) <= options
-    params = ({f.name for f in dataclasses.fields(AnalysisSpec)} | set(inspect.signature(analyze_circuit_plant).parameters)
+    params = ({f.name for f in dataclasses.fields(AnalysisSpec)}
+              | set(inspect.signature(analyze_circuit_plant).parameters)
               | {f.name for f in dataclasses.fields(MonteCarloSpec)}
               | {"r1", "r2", "c1", "c2", "r3", "r4", "gain", "part", "no_sim", "name", "worst_case", "stimulus",
                  "bits", "clock_hz", "replay"})
@@ -289,3 +290,47 @@ def test_bad_analyze_plant_fields_are_refused_in_the_pages_words(fields, param, 
         analyze_plant_request(fields)
     text, field = page_message(exc.value, ANALYZE_PLANT)
     assert ANALYZE_PLANT[field].param == param and words in text and "--" not in text, text
+
+
+def test_every_analyze_pid_field_is_an_analyze_pid_option_setting_a_parameter():
+    """Issue 26: the analyze-pid name table: design-pid's fields but the tuning and sizing, and the controller
+    as built (:func:`designer.pid.spec.controller_as_built`'s parameters); each an analyze-pid option."""
+    from designer.cli.pid import analyze_pid_parser
+    from designer.pid.spec import CONTROLLER_FIELDS
+    from designer.web.forms import ANALYZE_PID, DESIGN_ONLY, PID
+    options = {a.dest.replace("_", "-") for a in analyze_pid_parser()._actions}
+    assert set(ANALYZE_PID) <= options and not set(DESIGN_ONLY) & options
+    own = {f.param for k, f in ANALYZE_PID.items() if k not in PID}
+    assert own == {*CONTROLLER_FIELDS, "controller_json"}
+    assert len({f.label for f in ANALYZE_PID.values()}) == len(ANALYZE_PID)
+
+
+def test_an_analyze_pid_request_is_the_spec_analyze_pid_builds(tmp_path):
+    from designer.pid.blocks import seed_parts
+    from designer.pid.spec import pid_spec
+    from designer.web.forms import analyze_pid_request
+    parts = seed_parts()
+    fields = {k: getattr(parts, k) for k in dataclasses.asdict(parts) if getattr(parts, k) is not None}
+    rq = analyze_pid_request({"plant-fc": 3500, "plant-zeta": 0.2, **fields}, str(tmp_path))
+    assert rq.spec == pid_spec({"plant_fc_hz": 3500, "plant_zeta": 0.2, "controller_parts": parts, "step_v": "1",
+                                "edge_s": "100n"})
+    assert rq.argv[:3] == ["analyze-pid", "--plant-fc=3500", "--plant-zeta=0.2"]
+    # the parts of a result.json, its content written in the request's folder
+    components = {(f"{k.upper()}_ohm" if k[0] == "r" else f"{k.upper()}_f"): v for k, v in fields.items()}
+    rq = analyze_pid_request({"plant-fc": 3500, "plant-zeta": 0.2, "parts-json": {"components": components}},
+                             str(tmp_path))
+    assert rq.spec.controller_parts == parts and "--parts-json=parts-result.json" in rq.argv
+
+
+@pytest.mark.parametrize("fields, param, words", [
+    ({"plant-fc": 3500, "plant-zeta": 0.2}, "r3", "the controller's parts are needed"),
+    ({"plant-fc": 3500, "plant-zeta": 0.2, "r3": "1k", "parts-json": {"components": {}}}, "r3",
+     "either part by part"),
+    ({"plant-fc": 3500, "plant-zeta": 0.2, "tuning": "zn"}, None, "'tuning' is not a field of this page"),
+])
+def test_bad_analyze_pid_fields_are_refused_in_the_pages_words(tmp_path, fields, param, words):
+    from designer.web.forms import ANALYZE_PID, analyze_pid_request
+    with pytest.raises(DesignError) as exc:
+        analyze_pid_request(fields, str(tmp_path))
+    text, field = page_message(exc.value, ANALYZE_PID)
+    assert (ANALYZE_PID[field].param if field else None) == param and words in text and "--" not in text, text
