@@ -2,9 +2,10 @@
 step, every file served from this package: the lab may be offline) and the
 JSON API under them.
 
-``POST /api/plant``, ``/api/pid``, ``/api/identify``, ``/api/check`` take the
-commands' options by name (:mod:`.request`) and answer what the command's
-``--json`` prints; ``?view=page`` adds what the page draws
+``POST /api/plant``, ``/api/analyze-plant``, ``/api/filter``, ``/api/pid``, ``/api/analyze-pid``,
+``/api/identify``, ``/api/check`` take the page's fields by the commands' option names (:mod:`.forms`), call
+the library with them in a worker (:data:`.jobs.LIBRARY`: no command line built, no console script run) and
+answer what the command's ``--json`` prints; ``?view=page`` adds what the page draws
 (``{"result": ..., "page": ...}``). ``/api/plant/sheet`` and ``/bundle`` (and
 the PID's) answer the printable build sheet and the design's files as a zip.
 Bad input is a 400 whose ``error`` is the command's one line (a body that is
@@ -39,7 +40,6 @@ from ..core.fileio import MAX_CAPTURE_BYTES, check_plain_name
 from . import pool as pool_module
 from . import request as req
 from .guard import Guard, Trust, error_response
-from .jobs import through_library
 
 __all__ = ["DISCONNECT_POLL_S", "MAX_DEPTH", "PAGES", "STATIC", "TooLarge", "create_app"]
 
@@ -72,18 +72,9 @@ class TooLarge(Exception):
     """A request body over its limit: answered 413."""
 
 
-def _parsers() -> dict:
-    """The parser traits (switches, appended options) of each command still run by its argument list (the
-    others are the library's, :data:`designer.web.jobs.LIBRARY`), from the CLI's own parsers."""
-    from ..cli import pid, plant
-    builders = {"analyze-plant": plant.analyze_plant_parser, "analyze-pid": pid.analyze_pid_parser}
-    return {prog: req.parser_traits(build()) for prog, build in builders.items()}
-
-
 def create_app(pool, trust: Trust):
     """The application, its commands run by ``pool`` (a :class:`.pool.Pool`), answering the requests
     ``trust`` (:func:`.guard.trust_for`) lets in: an ASGI application."""
-    traits = _parsers()
     # python-multipart logs a malformed form before it raises: the raise is the client's 400, the log line
     # would be noise on the server's stderr for every broken upload
     quiet = logging.getLogger("python_multipart")
@@ -132,15 +123,13 @@ def create_app(pool, trust: Trust):
         except DesignError as exc:
             return _error(400, f"designer-web: error: {exc}")
 
-    async def run(request, prog: str, argv: list | None, want: str, tmp: str, upload_name: str | None = None,
-                  fields: dict | None = None, lang: str | None = None, capture: str | None = None):
+    async def run(request, prog: str, want: str, tmp: str, upload_name: str | None = None, fields: dict | None = None,
+                  capture: str | None = None):
         # the task goes to the pool as its file's name: a message of a hundred bytes, so that the pipe to the
         # pool never fills while the pool is sending a long answer the other way (each would wait on the other)
         task_file = os.path.join(tmp, "task.json")
-        task = {"prog": prog, "want": want, "tmp": tmp}
-        task.update({"argv": argv} if argv is not None else {"fields": fields})   # no argv: the library's fields
-        if lang is not None:
-            task["lang"] = lang
+        # the library's task: the request's fields (their lang among them), never a command line
+        task = {"prog": prog, "want": want, "tmp": tmp, "fields": fields}
         if capture is not None:   # an identify request's upload
             task["capture"] = capture
         with open(task_file, "w", encoding="utf-8") as fh:
@@ -194,14 +183,8 @@ def create_app(pool, trust: Trust):
                                        f"{req.MAX_JSON_BYTES // (1024 * 1024)} MiB")
                 except DesignError as exc:
                     return _error(400, f"{prog}: error: {exc}")
-                if through_library(prog, options):   # the library called with the request's fields: no command line
-                    return await run(request, prog, None, how, tmp, fields=options)
-                try:
-                    argv = req.build_argv(options, tmp, traits[prog])
-                except DesignError as exc:
-                    return _error(400, f"{prog}: error: {exc}")
-                argv += ["--json"] + (["--out", tmp] if how in ("sheet", "bundle") else ["--no-files"])
-                return await run(request, prog, argv, how, tmp)
+                # the library called with the request's fields: no command line
+                return await run(request, prog, how, tmp, fields=options)
         return endpoint
 
     async def identify(request: Request):
@@ -216,7 +199,7 @@ def create_app(pool, trust: Trust):
             except DesignError as exc:
                 return _error(400, f"{prog}: error: {exc}")
             # the library called with the request's fields and the capture: no command line
-            return await run(request, prog, None, _view(request), tmp, name, fields=options, capture=path)
+            return await run(request, prog, _view(request), tmp, name, fields=options, capture=path)
 
     async def check(request: Request):
         prog = "check-design"
@@ -229,7 +212,7 @@ def create_app(pool, trust: Trust):
                 return _error(400, f"{prog}: error: {exc}")
             # the library with the specs' paths inside the request's folder (its root: nothing outside it) and
             # the page's options; golden files recorded there are answered for download, never kept
-            return await run(request, prog, None, "check", tmp, fields={"specs": specs, "options": options})
+            return await run(request, prog, "check", tmp, fields={"specs": specs, "options": options})
 
     routes = [Route(path, page(name)) for path, name in PAGES.items()]
     async def no_icon(request):

@@ -1,17 +1,12 @@
-"""What a worker process does for one request of the web page: run the
-command as its console script does, and hand back what the page shows.
+"""What a worker process does for one request of the web page: call the
+library with the request's fields, and hand back what the page shows.
 
-Most tasks call the library directly with the request's fields (:data:`LIBRARY`: design-plant, design-filter,
-design-pid, check-design, identify). The others name the command (``analyze-plant``, ``analyze-pid``)
-and its argument list, built by :mod:`.request` from the
-request's option names. The command's own entry point runs it
-(``design_plant_main(argv)``...: the same parser, the same checks, the same
-one-line refusal and exit status), with stdout and stderr taken into strings;
-this process runs one task at a time, so that is safe. Its ``--json`` output
-is the answer's JSON, word for word. The typed result the command printed
-(:data:`designer.cli.common.RESULT_HOOK`) gives the page what a terminal
-cannot show: plot traces, the schematic as SVG, the bill of materials, the
-build sheet.
+Every task is the library's (:data:`LIBRARY`: design-plant, analyze-plant, design-filter, design-pid,
+analyze-pid, check-design, identify; issue 26): the request's fields become the library's specs through
+the page's name tables (:mod:`.forms`), the library runs in this process, and the typed result is
+rendered: its JSON (what the command's ``--json`` prints), and what a terminal cannot show: plot
+traces, the schematic as SVG, the bill of materials, the build sheet. No command line is built, no
+console script run, no printed JSON parsed back.
 
 Nothing here computes a figure of a design: the traces are the result's own
 arrays (decimated for the browser), and the frequency responses the models'
@@ -28,11 +23,10 @@ import os
 import signal
 import sys
 import tempfile
-from contextlib import contextmanager, redirect_stderr, redirect_stdout
+from contextlib import contextmanager
 
 import numpy as np
 
-from ..cli.common import RESULT_HOOK
 from ..core import lifetime
 from ..core.i18n import N_, current, language, localise, translated
 from ..core.i18n import gettext as _
@@ -44,21 +38,16 @@ from ..filters import report as filter_report
 from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
 
-__all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "CLI_ONLY", "LIBRARY", "MAINS", "SWALLOWING_MODULES", "Superseded",
-           "TRACES", "TRACE_POINTS", "analyze_pid_task", "analyze_plant_task", "bom_shown", "bundle_zip", "check_task",
+__all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "LIBRARY", "SWALLOWING_MODULES", "Superseded", "TRACES",
+           "TRACE_POINTS", "analyze_pid_task", "analyze_plant_task", "bom_shown", "bundle_zip", "check_task",
            "checks_shown", "circuit_plant_page", "design_filter_task", "design_pid_task", "design_plant_task",
            "files_in", "filter_page", "histograms", "identify_page", "identify_task", "pid_page", "plant_page", "run",
-           "run_task", "series_text", "temporaries_in", "through_library", "warm_up", "written_since"]
+           "run_task", "series_text", "temporaries_in", "warm_up", "written_since"]
 
 #: points of a trace sent to the browser (uPlot draws thousands in a frame; the sheet's PNGs use fewer)
 TRACE_POINTS = 1500
 #: frequency points of a Bode trace
 BODE_POINTS = 300
-
-#: the commands a task may name by an argument list, and their console entry points (called as functions: argv
-#: in, status out); the others are :data:`LIBRARY`'s
-MAINS = {
-}
 
 
 class Superseded(BaseException):
@@ -138,19 +127,18 @@ def run_task(task: dict) -> dict:
     ----------
     task : dict
         ``task_file`` (the name of a JSON file holding the task, as the server sends it), or the
-        task itself: ``prog`` (a command), ``argv`` (its arguments, ``--json`` among them
-        for the designing commands), ``want``: "page" (the JSON and the page's
+        task itself: ``prog`` (a command of :data:`LIBRARY`), ``fields`` (the request's fields, the
+        page's language ``lang`` among them), ``want``: "page" (the JSON and the page's
         extras), "json", "sheet" (the printable build sheet), "bundle" (the
-        design's files as a zip) or "check" (a library task: check-design's answer); ``tmp``:
-        the request's private folder (files written there), or None; ``lang``: the language of the page's
-        words (a command with ``--lang`` takes it from there). A command of :data:`LIBRARY` gets ``fields``
-        (the request's fields) instead of ``argv``, and identify ``capture`` (the uploaded file's path) too.
+        design's files as a zip) or "check" (check-design's answer); ``tmp``:
+        the request's private folder (files written there), or None; identify's ``capture`` (the uploaded
+        file's path).
 
     Returns
     -------
     dict
-        ``status`` (the command's exit status), ``error`` (its one line on
-        stderr, or None), ``json`` (what ``--json`` printed), and per ``want``:
+        ``status`` (the command's exit status), ``error`` (its one-line refusal in the page's words, or
+        None), ``json`` (what the command's ``--json`` prints), and per ``want``:
         ``page``, ``body`` (bytes) with ``media`` and ``filename``.
     """
     if "task_file" in task:   # the server's requests come as a file in their private folder (see .app)
@@ -158,49 +146,9 @@ def run_task(task: dict) -> dict:
             task = json.load(fh)
     if task["prog"] == "warm-up":
         return warm_up()
-    if "fields" in task:   # a library task: the request's fields (and an identify request's uploaded capture)
-        return LIBRARY[task["prog"]](task["fields"], task.get("want", "json"), task.get("tmp"),
-                                     **({"capture": task["capture"]} if "capture" in task else {}))
-    prog, argv, want, tmp = task["prog"], list(task["argv"]), task.get("want", "json"), task.get("tmp")
-    # the page's language: a sheet command's --lang, or the server's
-    lang = task.get("lang") or _lang_of(argv)
-    seen = {}
-    out, err = io.StringIO(), io.StringIO()
-    token = RESULT_HOOK.set(lambda result, name: seen.update(result=result, name=name))
-    argv0 = sys.argv
-    sys.argv = [prog, *argv]   # the JSON's tool.argv: the command line this request stands for
-    try:
-        with redirect_stdout(out), redirect_stderr(err), temporaries_in(tmp), language(lang):
-            status = MAINS[prog](argv)
-    finally:
-        RESULT_HOOK.reset(token)
-        sys.argv = argv0
-    answer = {"status": status, "error": _error_line(err.getvalue(), status), "json": None,
-              "stderr": err.getvalue()}
-    if status not in (0, 1):
-        return answer
-    answer["json"] = json.loads(out.getvalue())
-    result, name = seen["result"], seen["name"]
-    if want == "page":
-        with language(lang):   # the page's words in the request's language, as its sheet
-            answer["page"] = plant_page(result) if prog.endswith("plant") else pid_page(result)
-    elif want == "sheet":
-        answer.update(body=_read(os.path.join(tmp, "reports", name, "build-sheet.html")),
-                      media="text/html; charset=utf-8", filename="build-sheet.html")
-    elif want == "bundle":
-        answer.update(body=bundle_zip(tmp, name), media="application/zip", filename=f"{name}.zip")
-    return answer
-
-
-def _lang_of(argv: list) -> str | None:
-    """The language a command line asks for (``--lang=es``, as :func:`designer.web.request.build_argv` writes
-    it; the command's parser checked it), or None."""
-    for i, word in enumerate(argv):
-        if word.startswith("--lang="):
-            return word.split("=", 1)[1]
-        if word == "--lang" and i + 1 < len(argv):
-            return argv[i + 1]
-    return None
+    # the request's fields (and an identify request's uploaded capture)
+    return LIBRARY[task["prog"]](task["fields"], task.get("want", "json"), task.get("tmp"),
+                                 **({"capture": task["capture"]} if "capture" in task else {}))
 
 
 @contextmanager
@@ -227,14 +175,6 @@ def temporaries_in(folder: str | None):
             os.environ.pop("TMPDIR", None)
         else:
             os.environ["TMPDIR"] = env
-
-
-def _error_line(stderr: str, status: int) -> str | None:
-    """The command's one-line refusal (its last line on stderr), or None when it did its work."""
-    if status in (0, 1):
-        return None
-    lines = [ln for ln in stderr.splitlines() if ln.strip()]
-    return lines[-1] if lines else f"failed with exit status {status}"
 
 
 def _read(path) -> bytes:
@@ -689,35 +629,8 @@ def identify_task(fields: dict, want: str = "json", tmp: str | None = None, capt
 
 #: the commands the page runs through the library (no console script, no argv, no printed JSON)
 LIBRARY = {"design-plant": design_plant_task, "analyze-plant": analyze_plant_task, "design-pid": design_pid_task,
-           "analyze-pid": analyze_pid_task, "design-filter": design_filter_task,
-           "check-design": check_task, "identify": identify_task}
-#: a command's options its page's name table does not map: a request with one would run the command's entry point
-#: (none left: design-pid's capture, replay and fail-on-check are the library's too)
-CLI_ONLY = {"design-pid": frozenset()}
-
-
-def through_library(prog: str, options) -> bool:
-    """Whether a request of ``prog`` is run by the library with its fields (:data:`LIBRARY`), not by the
-    command's entry point with an argument list.
-
-    Parameters
-    ----------
-    prog : str
-        The command.
-    options : object
-        The request's JSON (an object of fields; anything else is the library task's to refuse).
-
-    Returns
-    -------
-    bool
-        False for a command without a library task, or a request naming one of its :data:`CLI_ONLY` options.
-    """
-    if prog not in LIBRARY:
-        return False
-    if not isinstance(options, dict):
-        return True
-    only = CLI_ONLY.get(prog, frozenset())
-    return not any(str(k).strip().lstrip("-").replace("_", "-").lower() in only for k in options)
+           "analyze-pid": analyze_pid_task, "design-filter": design_filter_task, "check-design": check_task,
+           "identify": identify_task}
 
 
 # --------------------------------------------------------------------------- identify

@@ -1,26 +1,21 @@
-"""A request's inputs as the command line its command parses.
+"""A request's inputs checked before any of them is used: its JSON body, its
+field names, its values.
 
-``{"fc": 3500, "zeta": "0.2", "r-series": "E24"}`` becomes ``--fc=3500
---zeta=0.2 --r-series=E24``: every key is an option's name (dashes or
-underscores), every value what a user types after it (numbers, engineering
-notation in strings; ``true`` for a switch, a list for an option that takes
-several values). The command's own parser then checks them, so a refusal is its
-one line. What a page must not choose is refused here in one line: where files
-go and how output is printed (the server sets those), the processes and
-addresses a run uses (``jobs``, ``dask``, ``timeout``), the trust settings of
-check-design. An option that names a file on the command line (``plant-model``,
-``plant-json``...) takes the file's *content* here, written into the request's
-private folder under a fixed name: no path a user gives is ever opened.
-
-Values are values: each JSON type is checked against what the option takes (a
-number or a text for a valued option, a boolean for a switch, a list only where
-the option repeats or takes several values, an object only as a file's content),
-a single value is joined to its option (``--zeta=--help`` is the value
-``--help``, which the command refuses), and a word of a several-value option
-that begins with ``-`` is refused unless it is a number, so nothing a request
-sends can become an option, ``--help`` and ``--version`` included (a worker
-must never exit). :func:`parse_json` bounds the JSON's nesting and refuses text
-that is not Unicode (a lone surrogate), before any of it is used.
+``{"fc": 3500, "zeta": "0.2", "r-series": "E24"}``: every key is a field's name,
+the command's option name (dashes or underscores), every value what a user types
+after it (numbers, engineering notation in strings; ``true`` for a switch, a
+list for a field that takes several values). The page's name tables
+(:mod:`.forms`) map the fields to the library's parameters; nothing builds a
+command line. What a page must not choose is refused here in one line
+(:func:`option_name`): where files go and how output is printed (the server
+sets those), the processes and addresses a run uses (``jobs``, ``dask``,
+``timeout``), the trust settings of check-design. A field that names a file on
+the command line (``plant-model``, ``plant-json``...) takes the file's
+*content*, written into the request's private folder under a fixed name
+(:func:`write_content`): no path a user gives is ever opened. :func:`parse_json`
+bounds the JSON's nesting and refuses text that is not Unicode (a lone
+surrogate), before any of it is used; :func:`value_text` checks each value's
+JSON type.
 """
 
 from __future__ import annotations
@@ -30,31 +25,22 @@ import json
 import math
 import os
 import re
-from typing import NamedTuple
 
 from ..core.errors import DesignError
 
-__all__ = ["FILE_OPTIONS", "MAX_DEPTH", "MAX_JSON_BYTES", "REFUSED", "SERVERS_OWN", "Traits", "build_argv",
-           "check_text", "check_value", "option_name", "parse_json", "parser_traits", "split_language",
-           "value_text", "write_content"]
+__all__ = ["MAX_DEPTH", "MAX_JSON_BYTES", "REFUSED", "SERVERS_OWN", "check_text", "check_value", "option_name",
+           "parse_json", "split_language", "value_text", "write_content"]
 
 #: options the server sets itself (files, output form) or that would reach past a request's folder
 REFUSED = ("out", "json", "no-files", "plot", "help", "version", "junit", "summary", "root", "allow-outside",
            "jobs", "dask", "spice-jobs", "timeout", "fail-on-check", "no-fail")
 #: of those, the processes, addresses and deadlines of a run: the server's (designer-web --jobs, --timeout)
 SERVERS_OWN = ("jobs", "dask", "spice-jobs", "timeout")
-#: options whose value is a file's content -> the name it is written under in the request's folder
-FILE_OPTIONS = {"plant-json": "plant-result.json", "plant-model": "plant-model.json",
-                "parts-json": "parts-result.json", "plant-capture": "plant-capture.csv",
-                "against": "design-result.json", "validate": "validation-capture.csv"}
 #: most bytes of a request's JSON body (its options; a model or result.json given inline included)
 MAX_JSON_BYTES = 4 * 1024 * 1024
 #: deepest nesting of a request's JSON (a model's JSON is 4 deep; Python's own parser fails near 1000)
 MAX_DEPTH = 64
 _KEY = re.compile(r"^[a-z][a-z0-9-]{0,40}$")
-#: a word beginning with "-" that the commands' parsers read as a number (designer.cli.common.OneLineParser)
-_NEGATIVE = re.compile(r"^-\.?\d")
-_FORM_EXAMPLE = 'e.g. {"fc": 3500, "zeta": 0.2}'
 
 
 def parse_json(raw: bytes):
@@ -181,68 +167,6 @@ def option_name(key) -> str:
     return "--" + name
 
 
-def build_argv(options: dict, tmp: str | None, traits: "Traits | None" = None) -> list:
-    """The argument list of ``options`` (see the module docstring).
-
-    Parameters
-    ----------
-    options : dict
-        Option name -> value, as the request gave them.
-    tmp : str or None
-        The request's private folder, for the options of :data:`FILE_OPTIONS`.
-    traits : Traits, optional
-        The command's options (:func:`parser_traits`): only those, spelt out in full (argparse
-        would take ``--o`` for ``--out``), each with the values it takes. None: any name.
-
-    Returns
-    -------
-    list of str
-        The command's arguments.
-    """
-    if not isinstance(options, dict):
-        raise DesignError("the request's body must be a JSON object of option names and values, " + _FORM_EXAMPLE)
-    t = traits or Traits(set(), set(), set(), None)
-    argv = []
-    for key, value in options.items():
-        opt = option_name(key)
-        if t.known is not None and opt not in t.known:
-            raise DesignError(f"unrecognized arguments: {opt} (options by their full names, as --help lists them)")
-        if value is None:
-            continue
-        if opt in t.switches:
-            # a form's field or a query string says it in words
-            word = value if isinstance(value, bool) else str(value).strip().lower() if isinstance(value, str) else None
-            if word not in (True, False, "true", "false", "on", "off", ""):
-                raise DesignError(f"{opt} is a switch: true or false, got {_shown(value)}")
-            if word in (True, "true", "on"):
-                argv.append(opt)
-            continue
-        if opt[2:] in FILE_OPTIONS:
-            argv.append(f"{opt}={write_content(tmp, FILE_OPTIONS[opt[2:]], value, opt)}")
-            continue
-        several = opt in t.appended or opt in t.multi
-        if isinstance(value, list) and not several and t.known is not None:
-            raise DesignError(f"{opt} takes one value, got {len(value)}" if len(value) != 1 else
-                              f"{opt} takes one value, not a list: {_shown(value)}")
-        values = value if isinstance(value, list) else [value]
-        words = [value_text(v, opt) for v in values]
-        count = t.nargs.get(opt)
-        if isinstance(count, int) and len(words) != count:
-            raise DesignError(f"{opt} takes {count} values, got {len(words)}")
-        if not words:
-            raise DesignError(f"{opt} takes at least one value, got an empty list")
-        if opt in t.appended or len(words) == 1:
-            # joined to its option: a value that begins with "-" (--help, -x) is a value, never an option
-            argv += [f"{opt}={w}" for w in words]
-        else:
-            for w in words:
-                if w.startswith("-") and not _NEGATIVE.match(w):
-                    raise DesignError(f"{opt} {w[:40]!r}: a value of an option that takes several must not begin "
-                                      "with '-' unless it is a number")
-            argv += [opt, *words]
-    return argv
-
-
 def _shown(value) -> str:
     return json.dumps(value)[:40]
 
@@ -310,43 +234,3 @@ def write_content(tmp: str | None, name: str, value, opt: str) -> str:
     with open(path, "w", encoding="utf-8") as fh:
         fh.write(value)
     return path
-
-
-class Traits(NamedTuple):
-    """A command's options as its parser defines them."""
-
-    switches: set    #: taking no value (``--no-sim``)
-    appended: set    #: given once per value (``--limit``)
-    multi: set       #: taking several values after one flag (``--window T0 T1``, ``--methods``)
-    known: set | None  #: every option string (None: not checked)
-    nargs: dict = {}   #: option -> how many values it takes, where that is a fixed number above 1
-
-
-def parser_traits(parser) -> Traits:
-    """The :class:`Traits` of an argparse parser.
-
-    Parameters
-    ----------
-    parser : argparse.ArgumentParser
-        A command's parser.
-
-    Returns
-    -------
-    Traits
-        Its switches, appended, multi-valued and known options, and the number of
-        values of each option that takes a fixed number above 1.
-    """
-    import argparse
-    switches, appended, multi, known, nargs = set(), set(), set(), set(), {}
-    for action in parser._actions:   # argparse has no public list of its actions
-        for opt in action.option_strings:
-            known.add(opt)
-            if action.nargs == 0:
-                switches.add(opt)
-            elif isinstance(action, argparse._AppendAction):
-                appended.add(opt)
-            elif action.nargs not in (None, "?"):
-                multi.add(opt)
-                if isinstance(action.nargs, int):
-                    nargs[opt] = action.nargs
-    return Traits(switches, appended, multi, known, nargs)
