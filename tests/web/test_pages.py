@@ -121,7 +121,11 @@ def test_every_answer_carries_the_security_headers(page, server):
     """What the browser gets: the pages, their scripts and styles, and the API (issue 25, item 1)."""
     seen = {}
     page.on("response", lambda r: seen.setdefault(r.url.split("?")[0].replace(server.url, ""), r.all_headers()))
-    open_page(page, server, "/plant")
+    # the design's answer waited for as such: the page counting an answer drawn does not order Playwright's
+    # response events before it (a full run under load once saw the page done and no /api/plant event yet)
+    with page.expect_response(lambda r: r.url.split("?")[0] == server.url + "/api/plant", timeout=60000) as answer:
+        open_page(page, server, "/plant")
+    seen.setdefault("/api/plant", answer.value.all_headers())
     for path in ("/plant", "/static/common.js", "/static/style.css", "/api/choices", "/api/plant"):
         h = seen[path]
         assert "default-src 'self'" in h["content-security-policy"], path
