@@ -15,7 +15,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "check": ("check_design_main", "check_parser",),
-    "common": ("ExtendList", "FLAGS", "OneLineParser", "RESULT_HOOK", "StoreOnce", "flag_message", "run_cli",),
+    "common": ("ExtendList", "FLAGS", "OneLineParser", "StoreOnce", "flag_message", "run_cli",),
     "filter": ("analyze_filter_main", "design_filter_main", "summary_text",),
     "filter_tolerance": ("OPTIMIZE_DEFAULT_BUILDS", "add_filter_tolerance", "run_tolerance", "tolerance_json",
                          "tolerance_lines", "tolerance_settings",),

@@ -11,7 +11,6 @@ typed: the specs check them, once.
 from __future__ import annotations
 
 import argparse
-import contextvars
 import json
 import re
 import sys
@@ -21,7 +20,7 @@ from ..core.errors import DesignError
 from ..core.eseries import SERIES
 from ..core.ranges import help_range
 
-__all__ = ["ExtendList", "FLAGS", "OneLineParser", "RESULT_HOOK", "StoreOnce", "flag_message", "run_cli"]
+__all__ = ["ExtendList", "FLAGS", "OneLineParser", "StoreOnce", "flag_message", "run_cli"]
 
 #: library parameter -> the option a user types; errors naming a parameter
 #: (:attr:`DesignError.param`) are shown with the option instead
@@ -331,11 +330,6 @@ def check_output(args, name: str) -> None:
         check_output_folder(os.path.join(args.out, "reports", name), "report folder")
 
 
-#: a front end's hook (the web page, :mod:`designer.web.jobs`): called with each result :func:`emit` is given,
-#: after its files are written, so that the page draws its plots from the typed result the command printed
-RESULT_HOOK = contextvars.ContextVar("designer_result_hook", default=None)
-
-
 def emit(result, args, name, write_outputs, summary_text) -> int:
     """Write the files (unless --no-files), then print JSON or the summary and the file list.
     Returns the exit status: 1 with ``--fail-on-check`` when a verdict failed
@@ -345,9 +339,6 @@ def emit(result, args, name, write_outputs, summary_text) -> int:
         if not args.no_files:
             write_outputs(result, args.out, name)
         text = None if args.json else summary_text(result)
-    hook = RESULT_HOOK.get()
-    if hook is not None:
-        hook(result, name)
     if args.json:
         print_output(json.dumps(result.to_dict(), indent=2))
     else:
