@@ -117,10 +117,11 @@ def plant_step(plant: SallenKeyParts, amp: OpAmp) -> PlantStep:
     pn, pd = plant_model(plant, amp)
     fn_o, z_o = dominant_pair(pd)
     span = response_span(min(plant.fn_hz, fn_o), min(plant.zeta, z_o))
-    # the reaction curve of the plant as built (an LTI step: the closed form), on a dense grid
+    # the plant as built's step (an LTI step: the closed form) on a dense grid, for the fit and the plot;
+    # the tangent from its exact step, as the rules take it on every model (designer.pid.rules)
     t = np.linspace(0.0, span, 20001)
     y = step_response(pn, pd, t)
-    curve = tuning.reaction_curve(t, y, final=float(pn[-1] / pd[-1]))
+    curve = tuning.model_reaction_curve(pn, pd, t, y)
     return PlantStep(pn, pd, fn_o, z_o, span, t, y, curve)
 
 
