@@ -4,8 +4,11 @@ op-amp PID controller: the orchestration behind ``design-pid``.
 :func:`design_pid` takes a :class:`~designer.pid.spec.PidSpec` (valid by
 construction) and returns a :class:`~designer.pid.result.PidResult`; its
 ``to_dict`` is the JSON of ``design-pid --json`` and ``result.json``. The
-steps: the plant as built (designed, given or read), its reaction curve, the
-gains (a rule, explicit, or optimised on the loop as built), the parts
+steps: the plant as built (designed, given or read), its reaction curve (the
+tangent of its exact step, :func:`designer.pid.tuning.model_reaction_curve`),
+the gains (a rule of :mod:`designer.pid.rules` on the FOPDT the rule takes,
+through :func:`designer.pid.tuning.tune`; explicit; or optimised on the loop
+as built), the parts
 (:mod:`.blocks`, chosen by :mod:`.selection`), the analytic closed loop with
 the op-amp poles (:mod:`.model`), the checks, the deck (:mod:`.netlist`) and
 its simulation (:mod:`.verify`).
