@@ -5,7 +5,8 @@ verification, and the ``design-pid`` build sheet.
 
 Modules: :mod:`.spec` (the request, validated once), :mod:`.plant_spec` (where the
 plant comes from, validated once), :mod:`.plant` (the plant resolved), :mod:`.tuning`
-(reaction-curve and FOPDT rules), :mod:`.blocks` (topology, formulas, static
+(the reaction curve and the FOPDT each of its rules takes), :mod:`.rules` (every
+rule, on any model), :mod:`.blocks` (topology, formulas, static
 checks), :mod:`.selection` (joint E-series part selection), :mod:`.model`
 (realised controller and closed loop), :mod:`.optimize`
 (gains within the op-amps' limits), :mod:`.netlist` (closed-loop deck),
@@ -49,6 +50,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "selection": ("R_CORNER_MAX", "brute_force", "objective", "select_parts"),
     "spec": ("CONTROLLER_FIELDS", "PLAIN_PARAMS", "PidSpec", "analyzed_name", "controller_as_built",
              "controller_from_json", "default_name", "pid_spec"),
-    "tuning": ("Fopdt", "RULE_MODEL", "reaction_curve", "tune"),
+    "tuning": ("Fopdt", "RULE_MODEL", "model_reaction_curve", "reaction_curve", "tune"),
     "verify": ("loop_metrics", "oscillation", "stages"),
 })

@@ -4,8 +4,11 @@ op-amp PID controller: the orchestration behind ``design-pid``.
 :func:`design_pid` takes a :class:`~designer.pid.spec.PidSpec` (valid by
 construction) and returns a :class:`~designer.pid.result.PidResult`; its
 ``to_dict`` is the JSON of ``design-pid --json`` and ``result.json``. The
-steps: the plant as built (designed, given or read), its reaction curve, the
-gains (a rule, explicit, or optimised on the loop as built), the parts
+steps: the plant as built (designed, given or read), its reaction curve (the
+tangent of its exact step, :func:`designer.pid.tuning.model_reaction_curve`),
+the gains (a rule of :mod:`designer.pid.rules` on the FOPDT the rule takes,
+through :func:`designer.pid.tuning.tune`; explicit; or optimised on the loop
+as built), the parts
 (:mod:`.blocks`, chosen by :mod:`.selection`), the analytic closed loop with
 the op-amp poles (:mod:`.model`), the checks, the deck (:mod:`.netlist`) and
 its simulation (:mod:`.verify`).
@@ -117,10 +120,11 @@ def plant_step(plant: SallenKeyParts, amp: OpAmp) -> PlantStep:
     pn, pd = plant_model(plant, amp)
     fn_o, z_o = dominant_pair(pd)
     span = response_span(min(plant.fn_hz, fn_o), min(plant.zeta, z_o))
-    # the reaction curve of the plant as built (an LTI step: the closed form), on a dense grid
+    # the plant as built's step (an LTI step: the closed form) on a dense grid, for the fit and the plot;
+    # the tangent from its exact step, as the rules take it on every model (designer.pid.rules)
     t = np.linspace(0.0, span, 20001)
     y = step_response(pn, pd, t)
-    curve = tuning.reaction_curve(t, y, final=float(pn[-1] / pd[-1]))
+    curve = tuning.model_reaction_curve(pn, pd, t, y)
     return PlantStep(pn, pd, fn_o, z_o, span, t, y, curve)
 
 

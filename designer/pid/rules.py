@@ -1,7 +1,8 @@
 """PID tuning rules applied to a plant MODEL, each to the model its author
 derived it on.
 
-:mod:`.tuning` reads a measured step (an array); this module takes a model of
+The one implementation of the rules for every plant (:func:`designer.pid.tuning.tune`
+hands it the FOPDT of a reaction curve, a Sallen-Key plant's included). It takes a model of
 :mod:`.reduction` (:class:`~.reduction.ModelFopdt`,
 :class:`~.reduction.ModelSopdt`, :class:`~.reduction.ModelIntegrating`,
 :class:`~.reduction.ModelTf`) or the project's

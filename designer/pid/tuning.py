@@ -1,13 +1,18 @@
-"""PID tuning rules from a plant's step response.
+"""The reaction curve of a plant's step and the FOPDT each reaction-curve
+rule is applied to; the rules themselves are :mod:`designer.pid.rules`'.
 
 The reaction curve (Ziegler-Nichols' first method, seed 001 section V.8) is
-read from a step-response ARRAY: the inflection point is where a smoothed
-derivative peaks (:func:`designer.core.waveform.inflection_tangent`, the same
-tangent identification's ``ziegler-nichols`` reads), the tangent there gives L
-(where it crosses the initial value) and T (from L to where it reaches the
-final value). The seed reads T as
-the absolute time at which the tangent reaches the final value (81.75 us for
-its plant); the time constant is that time minus L (60.14 us).
+the tangent at the inflection point of the step: it gives L (where it crosses
+the initial value) and T (from L to where it reaches the final value). The seed
+reads T as the absolute time at which the tangent reaches the final value
+(81.75 us for its plant); the time constant is that time minus L (60.14 us).
+A plant known as a transfer function (the Sallen-Key plant as built, its
+op-amp included) gets it from its exact step by
+:func:`designer.pid.reduction.model_tangent`, the construction the rules of
+:mod:`designer.pid.rules` use on every model (:func:`model_reaction_curve`);
+a measured step ARRAY gets it where a smoothed derivative peaks
+(:func:`reaction_curve`, :func:`designer.core.waveform.inflection_tangent`,
+the same tangent identification's ``ziegler-nichols`` reads).
 
 The tangent's K, L, T are the model ZN's rule was derived on. The other rules
 were derived for a *fitted* first-order-plus-dead-time (FOPDT) model
@@ -17,18 +22,13 @@ example E1 the tangent's T is 67 % long and would make SIMC's Kc 91 % high.
 Each :class:`Tuning` records the model it used (:class:`Fopdt`, ``source``
 ``"tangent"`` or ``"least-squares"``); :data:`RULE_MODEL` says which.
 
-* zn:         Kp = 1.2 T/(K L),                 Ti = 2 L,                        Td = 0.5 L
-* cohen-coon: Kp = (T/(K L)) (4/3 + L/(4 T)),   Ti = L (32 + 6 L/T)/(13 + 8 L/T), Td = 4 L/(11 + 2 L/T)
-* chr0:       Kp = 0.6 T/(K L),                 Ti = T,                          Td = 0.5 L
-* chr20:      Kp = 0.95 T/(K L),                Ti = 1.4 T,                      Td = 0.47 L
-* amigo:      Kp = (0.2 + 0.45 T/L)/K,          Ti = L (0.4 L + 0.8 T)/(L + 0.1 T), Td = 0.5 L T/(0.3 L + T)
-* simc:       Kp = T/(K (tc + L)), tc = L,      Ti = min(T, 4 (tc + L)),         Td = 0 (a PI)
-
-(Ziegler & Nichols 1942; Cohen & Coon 1953; Chien, Hrones & Reswick 1952,
-set-point response; Astrom & Hagglund 2004, AMIGO; Skogestad 2003, SIMC, which
-for an FOPDT model is a PI controller.) All rules assume an S-shaped,
+:func:`tune` applies :func:`designer.pid.rules.tune_model` to that FOPDT (as
+a given model: the tangent of an FOPDT's step is the model itself), so one
+implementation of zn, cohen-coon, chr0, chr20, amigo and simc (their formulas
+and sources: :mod:`designer.pid.rules`) serves every plant; simc on an FOPDT
+is a PI controller with tau_c = L. All rules assume an S-shaped,
 non-oscillatory response; for an underdamped plant they still give numbers,
-with a warning, rather than refuse.
+with a note, rather than refuse.
 """
 
 from __future__ import annotations
@@ -42,13 +42,16 @@ from ..core.errors import DesignError
 from ..core.i18n import N_, Message
 from ..core.stepfit import fit_step, model_step
 from ..core.waveform import inflection_tangent, normalised_step
+from . import rules
+from .reduction import ModelFopdt, ModelTf, model_tangent
 
-__all__ = ["Fopdt", "RULES", "RULE_MODEL", "all_rules", "reaction_curve", "tune"]
+__all__ = ["Fopdt", "RULES", "RULE_MODEL", "all_rules", "model_reaction_curve", "reaction_curve", "tune"]
 
-RULES = ("zn", "cohen-coon", "chr0", "chr20", "amigo", "simc")
 #: the model each rule was derived on: the ZN tangent, or a fitted FOPDT
 RULE_MODEL = {"zn": "tangent", "cohen-coon": "least-squares", "chr0": "least-squares",
               "chr20": "least-squares", "amigo": "least-squares", "simc": "least-squares"}
+#: the rules read off a reaction curve (those of :data:`designer.pid.rules.RULES` with an FOPDT of the step)
+RULES = tuple(r for r in rules.RULES if r in RULE_MODEL)
 #: how the build sheet names each model source
 MODEL_NAMES = {"tangent": N_("ZN tangent"), "least-squares": N_("least-squares FOPDT")}
 
@@ -194,6 +197,36 @@ def reaction_curve(t, y, *, u_step: float = 1.0, t_step: float | None = None,
                          t_tangent_final_s=t_end, overshoot_pct=os_pct, fit=model)
 
 
+def model_reaction_curve(num, den, t, y) -> ReactionCurve:
+    """The reaction curve of a transfer function's exact step
+    (:func:`designer.pid.reduction.model_tangent`, the tangent construction of
+    :mod:`designer.pid.rules`), and the least-squares FOPDT of its step ``y``.
+
+    Parameters
+    ----------
+    num, den : array_like
+        The plant's transfer function (highest power of s first), proper,
+        stable, with a positive static gain and an inflection point.
+    t : array_like
+        A uniform time grid from the step (t[0] = 0), long enough to see the
+        step settle: the grid of the fit.
+    y : array_like
+        The plant's unit step on ``t`` (the fit's data, and the plot's).
+
+    Returns
+    -------
+    ReactionCurve
+        K, L, T, the steepest point and the overshoot of the exact step; ``fit``
+        the least-squares FOPDT of ``y``, started from the tangent's K, L, T.
+    """
+    tg = model_tangent(ModelTf(tuple(num), tuple(den)))
+    t, z, _y0, _yf = normalised_step(t, y, final=tg.K, what="reaction curve")
+    fit = fit_fopdt(t, z * tg.K, tg.K, start=Fopdt(tg.K, tg.L_s, tg.T_s, "tangent"))
+    return ReactionCurve(K=tg.K, L_s=tg.L_s, T_s=tg.T_s, t_inflection_s=tg.t_steepest_s,
+                         y_inflection=tg.y_steepest, slope_per_s=tg.slope_per_s,
+                         t_tangent_final_s=tg.L_s + tg.T_s, overshoot_pct=tg.overshoot_pct, fit=fit)
+
+
 def fit_fopdt(t, y, K: float, start: Fopdt | None = None) -> Fopdt:
     """Least-squares FOPDT of a step response (:func:`designer.core.stepfit.fit_step`,
     seed 000's FOPDT model, the fit identification uses too).
@@ -223,41 +256,16 @@ def fit_fopdt(t, y, K: float, start: Fopdt | None = None) -> Fopdt:
                  rms if math.isfinite(rms) else None, dict(f.ci95))
 
 
-def _gains(rule: str, K: float, L: float, T: float):
-    r = L / T
-    if rule == "zn":
-        return 1.2 * T / (K * L), 2.0 * L, 0.5 * L
-    if rule == "cohen-coon":
-        return ((T / (K * L)) * (4.0 / 3.0 + L / (4.0 * T)),
-                L * (32.0 + 6.0 * r) / (13.0 + 8.0 * r),
-                4.0 * L / (11.0 + 2.0 * r))
-    if rule == "chr0":
-        return 0.6 * T / (K * L), T, 0.5 * L
-    if rule == "chr20":
-        return 0.95 * T / (K * L), 1.4 * T, 0.47 * L
-    if rule == "amigo":
-        return ((0.2 + 0.45 * T / L) / K,
-                L * (0.4 * L + 0.8 * T) / (L + 0.1 * T),
-                0.5 * L * T / (0.3 * L + T))
-    if rule == "simc":
-        tc = L
-        return T / (K * (tc + L)), min(T, 4.0 * (tc + L)), 0.0
-    raise DesignError(f"unknown tuning rule {rule!r}; allowed: {', '.join(RULES)}")
-
-
-def _rule_notes(rule: str, curve: ReactionCurve | None, model: Fopdt) -> list:
+def _curve_notes(rule: str, curve: ReactionCurve | None, model: Fopdt, ruled: list) -> list:
+    """The rule's own notes (``ruled``, from :mod:`.rules`: the L/T range) between what the
+    reaction curve adds: the plant's overshoot first, the model used and SIMC's PI form after."""
     notes = []
-    r = model.L_s / model.T_s
     if curve is not None and curve.overshoot_pct > 2.0:
         notes.append(Message(N_("{rule}: the plant's own step response overshoots {os} %; reaction-curve rules "
                                 "assume an S-shaped, non-oscillatory plant, so the loop will be more oscillatory "
                                 "than the rule intends (check the closed-loop figures)"),
                              rule=rule, os=f"{curve.overshoot_pct:.1f}"))
-    if rule in ("zn", "chr0", "chr20") and not 0.1 <= r <= 1.0:
-        notes.append(Message(N_("{rule}: L/T = {r} is outside 0.1..1 where the rule was derived"), rule=rule,
-                             r=f"{r:.3g}"))
-    if rule == "cohen-coon" and not 0.1 <= r <= 1.0:
-        notes.append(Message(N_("cohen-coon: L/T = {r} is outside 0.1..1 where the rule is reliable"), r=f"{r:.3g}"))
+    notes += ruled
     if model.source == "least-squares":
         notes.append(Message(N_("{rule}: applied to the {model} of the plant's step (the rule's model), not to the ZN "
                                 "tangent"), rule=rule, model=model.describe()))
@@ -302,8 +310,10 @@ def tune(rule: str, source) -> Tuning:
             f"{rule}: the {MODEL_NAMES.get(model.source, model.source)} model has K = {model.K:.4g}, "
             f"L = {model.L_s:.4g} s, T = {model.T_s:.4g} s; the rule needs all three positive "
             "(a rising response with a visible delay)")
-    kp, ti, td = _gains(rule, model.K, model.L_s, model.T_s)
-    return Tuning(rule, kp, ti, td, curve, tuple(_rule_notes(rule, curve, model)), model)
+    # the one implementation of the rule (designer.pid.rules), on the FOPDT as a given model
+    rt = rules.tune_model(ModelFopdt(model.K, model.T_s, model.L_s), rule)
+    return Tuning(rule, rt.kp, rt.ti_s, rt.td_s, curve, tuple(_curve_notes(rule, curve, model, list(rt.notes))),
+                  model)
 
 
 def all_rules(curve: ReactionCurve) -> list:

@@ -230,6 +230,26 @@ def test_the_rule_table_has_every_rule_and_refuses_reaction_curves_on_an_integra
         assert one_line(exc) == refused[r]
 
 
+
+def test_the_sallen_key_plants_rules_are_the_rules_on_its_model():
+    # issue 26: one rule table and one implementation; the Sallen-Key plant's reaction curve is the tangent
+    # of its op-amp-aware transfer function's exact step, as on every model
+    from designer.pid.design import plant_step
+    from designer.pid.reduction import ModelFopdt, ModelTf, model_tangent
+    res = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2, opamp="LM741"), simulate=False)
+    ps = plant_step(res.plant, res.opamp)
+    model = ModelTf(tuple(ps.num), tuple(ps.den))
+    tg = model_tangent(model)
+    assert (res.tuning.curve.L_s, res.tuning.curve.T_s) == (tg.L_s, tg.T_s)
+    assert [r.method for r in res.rules] == [r for r in rules.RULES if r != "imc"]
+    for row in res.rules:
+        rt = (rules.tune_model(model, "zn") if row.method == "zn"
+              else rules.tune_model(ModelFopdt(row.model.K, row.model.T_s, row.model.L_s), row.method))
+        assert (row.kp, row.ti_s, row.td_s) == (rt.kp, rt.ti_s, rt.td_s), row.method
+    assert (res.tuning.kp, res.tuning.ti_s, res.tuning.td_s) == (res.rules[0].kp, res.rules[0].ti_s,
+                                                                 res.rules[0].td_s)
+
+
 @pytest.mark.parametrize("tf, rule", [("K=1 fn=200 zeta=0.4 theta=100u", "simc"),
                                       ("K=1 fn=200 zeta=0.4 theta=100u", "imc"),
                                       ("K=500 tau=100u integrator theta=100u", "imc")])

@@ -25,9 +25,7 @@ def seed_curve(n=20001, t_end=2e-3, noise=0.0, seed=0):
     return t, y
 
 
-def test_seed_reaction_curve_numbers():
-    t, y = seed_curve()
-    c = tuning.reaction_curve(t, y, final=1.0)
+def assert_the_seeds_numbers(c):
     # the seed's published figures (lines ~2990-3060)
     assert c.t_inflection_s == pytest.approx(63.5574e-6, rel=2e-4)
     assert c.y_inflection == pytest.approx(0.6975, abs=2e-4)
@@ -37,6 +35,11 @@ def test_seed_reaction_curve_numbers():
     # T is measured from L (SEEDS.md): 81.7506 - 21.6075 = 60.143 us
     assert c.T_s == pytest.approx(60.143e-6, rel=2e-4)
     assert c.K == pytest.approx(1.0)
+
+
+def test_seed_reaction_curve_numbers():
+    t, y = seed_curve()
+    assert_the_seeds_numbers(tuning.reaction_curve(t, y, final=1.0))
 
 
 def test_seed_zn_gains_and_the_seeds_mistake():
@@ -216,3 +219,46 @@ def test_explicit_gains_outside_their_ranges_are_refused_in_one_line():
         assert "\n" not in str(exc.value) and "np." not in str(exc.value)
     spec = PidSpec(plant_fc_hz=3500, plant_zeta=0.2, kp=RANGES["kp"].hi, ti_s=RANGES["ti_s"].lo, td_s="0")
     assert spec.td_s == 0.0 and spec.method == "explicit"
+
+
+# ---- one implementation: the rules of designer.pid.rules, the tangent of the model's exact step (issue 26)
+
+
+def test_a_transfer_functions_curve_is_the_rules_tangent_with_the_seeds_numbers():
+    from designer.pid.reduction import ModelTf, model_tangent
+    t, y = seed_curve()
+    c = tuning.model_reaction_curve([1.0], [A, B, 1.0], t, y)
+    tg = model_tangent(ModelTf((1.0,), (A, B, 1.0)))
+    # the very construction rules.py uses on every model
+    assert (c.K, c.L_s, c.T_s, c.t_inflection_s, c.y_inflection, c.slope_per_s, c.overshoot_pct) == (
+        tg.K, tg.L_s, tg.T_s, tg.t_steepest_s, tg.y_steepest, tg.slope_per_s, tg.overshoot_pct)
+    assert c.t_tangent_final_s == tg.L_s + tg.T_s
+    # the seed's published figures, as the array reader gives them
+    assert_the_seeds_numbers(c)
+    zn = tuning.tune("zn", c)
+    assert zn.kp == pytest.approx(3.340, abs=2e-3)
+    # the array reader of a measured step finds the same tangent on this 0.1 us grid
+    a = tuning.reaction_curve(t, y, final=1.0)
+    for x, z in ((c.L_s, a.L_s), (c.T_s, a.T_s), (c.t_inflection_s, a.t_inflection_s), (c.K, a.K)):
+        assert x == pytest.approx(z, rel=1e-6)
+    # and the least-squares FOPDT of the same step (the other rules' model) to the fit's tolerance
+    assert (c.fit.K, c.fit.L_s, c.fit.T_s) == pytest.approx((a.fit.K, a.fit.L_s, a.fit.T_s), rel=1e-6)
+
+
+def test_every_rule_is_the_one_of_designer_pid_rules_on_its_fopdt():
+    from designer.pid import rules
+    from designer.pid.reduction import ModelFopdt
+    t, y = seed_curve()
+    c = tuning.model_reaction_curve([1.0], [A, B, 1.0], t, y)
+    assert tuning.RULES == tuple(r for r in rules.RULES if r in tuning.RULE_MODEL)
+    for r in tuning.all_rules(c):
+        m = r.model
+        rt = rules.tune_model(ModelFopdt(m.K, m.T_s, m.L_s), r.method)
+        assert (r.kp, r.ti_s, r.td_s) == (rt.kp, rt.ti_s, rt.td_s)
+        # the rule's own notes (the L/T range), between the curve's
+        assert [str(n) for n in rt.notes] == [str(n) for n in r.notes[1:1 + len(rt.notes)]]
+    # ZN on the curve is rules.py's zn on the transfer function itself (the tangent of the model's step)
+    from designer.pid.reduction import ModelTf
+    zn, on_curve = rules.tune_model(ModelTf((1.0,), (A, B, 1.0)), "zn"), tuning.tune("zn", c)
+    assert (zn.kp, zn.ti_s, zn.td_s) == (on_curve.kp, on_curve.ti_s, on_curve.td_s)
+    assert zn.model_used.source == rules.TANGENT
