@@ -19,6 +19,8 @@ from designer.cli.filter import analyze_filter_main, design_filter_main
     (["--order", "4", "--fc", "1k", "--type", "notch"], "allowed: lowpass, highpass, bandpass"),
     (["--order", "4", "--fc", "1k", "--family", "chebyshev", "--ripple", "5"], "--ripple must be 0.01 dB to 3 dB"),
     (["--order", "4", "--fc", "1k", "--ripple", "1"], "only a chebyshev filter has a ripple"),
+    (["--family", "chebyshev", "--passband", "1k", "--max-loss", "4", "--stopband", "2k", "--min-attenuation", "60"],
+     "--max-loss: a chebyshev mask's passband loss is its ripple, which must be 0.01 dB to 3 dB, got 4 dB"),
     (["--order", "4"], "give --order and --fc"),
     (["--passband", "3k", "--max-loss", "1", "--stopband", "2k", "--min-attenuation", "40"],
      "must be below its stopband edge"),
