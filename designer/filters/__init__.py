@@ -24,7 +24,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "mfb_bandpass": ("MfbBandPass",),
     "mfb_highpass": ("MfbHighPass",),
     "mfb_lowpass": ("MfbLowPass",),
-    "prototype": ("BANDPASS_METHODS", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER",
+    "prototype": ("BANDPASS_METHODS", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER", "BESSEL_SEARCH_ORDER",
                   "RESPONSE_TYPES", "SectionPlan", "WIDE_RATIO", "DELAY_POINTS", "bandpass_from_mask", "bandpass_method", "chebyshev_3db_factor", "delay_error_pct", "group_delay",
                   "order_from_mask", "plan_bandpass", "plan_sections", "prototype_zpk", "reference_ba",
                   "reference_bandpass", "reference_response",),
