@@ -396,3 +396,18 @@ def test_delay_target_joins_the_mask_in_the_yield(capsys, tmp_path):
     err = capsys.readouterr().err
     assert "--limit 'delay_error_pct': unknown figure" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_design_filter_monte_carlo_the_same_whatever_the_workers():
+    """--jobs 1, --jobs 2 and --dask local (a LocalCluster the command starts and stops) draw the same
+    builds: the JSON's monte_carlo section is the same, byte for byte, and nothing is printed on stderr."""
+    argv = [script("design-filter"), "--family", "chebyshev", "--passband", "1k", "--max-loss", "1", "--stopband",
+            "3k", "--min-attenuation", "30", "--opamp", "TL072", "--monte-carlo", "2000", "--seed", "3", "--no-sim",
+            "--json"]
+    got = {}
+    for where in (["--jobs", "1"], ["--jobs", "2"], ["--dask", "local"]):
+        p = subprocess.run(argv + where, capture_output=True, text=True, timeout=300)
+        assert p.returncode == 0 and p.stderr == "", (where, p.stderr)
+        got[where[-1]] = json.dumps(json.loads(p.stdout)["monte_carlo"], sort_keys=True)
+    assert got["1"] == got["2"] == got["local"]
+    assert json.loads(got["1"])["yield"]["samples"] == 2000
