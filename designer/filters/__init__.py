@@ -13,6 +13,7 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "alternatives": ("Alternative", "design_alternatives",),
     "bench": ("BUILDS", "C_TOL_PCT", "FilterBench", "R_TOL_PCT", "SEED", "StageCheck", "SweepPoint", "TableCompare",
               "TimeTest", "bench_of", "nice_down", "nice_up", "passband_gain",),
     "cascade": ("Cascade", "Stage",),
@@ -20,7 +21,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "design": ("FilterDesign", "StageDesign", "analysis_grid", "as_built", "central_delay", "delay_figures", "predistort", "section_name", "with_choice",
                "section_plans", "stage_candidates", "verify_spice",),
     "inverting_lowpass": ("InvertingLowPass",),
-    "joint": ("brute_force", "delay_columns", "descend", "joint_search", "objective", "per_stage",),
+    "joint": ("brute_force", "delay_columns", "descend", "joint_alternatives", "joint_search", "objective", "per_stage",),
     "mfb_bandpass": ("MfbBandPass",),
     "mfb_highpass": ("MfbHighPass",),
     "mfb_lowpass": ("MfbLowPass",),
