@@ -13,10 +13,37 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..core.errors import DesignError
+from ..core.ranges import RANGES, parse_in_range
 from .joint import joint_alternatives, objective
 from .registry import get as get_topology
 
-__all__ = ["Alternative", "design_alternatives"]
+__all__ = ["Alternative", "alternatives_count", "design_alternatives"]
+
+
+def alternatives_count(value) -> int:
+    """How many part sets to list, as asked (a number or text): a whole number in ``RANGES["alternatives"]``.
+
+    Parameters
+    ----------
+    value : int, float or str
+        The count as given.
+
+    Returns
+    -------
+    int
+        The count.
+
+    Raises
+    ------
+    DesignError
+        Not a whole number in the range (naming ``alternatives``).
+    """
+    n = parse_in_range(value, "alternatives", "alternatives")
+    if n != int(n):
+        raise DesignError(f"alternatives must be a whole number from {RANGES['alternatives'].text()}, got {value!r}",
+                          param="alternatives")
+    return int(n)
 
 
 @dataclass(frozen=True)
@@ -59,7 +86,7 @@ class Alternative:
                 "violation": self.violation, "parts": dict(self.parts)}
 
 
-def design_alternatives(result, count: int) -> list:
+def design_alternatives(result, alternatives: int) -> list:
     """The ``count`` best part sets of ``result``'s candidates, the joint choice first (exact: equal to the
     enumeration of every combination).
 
@@ -67,14 +94,20 @@ def design_alternatives(result, count: int) -> list:
     ----------
     result : designer.filters.FilterDesign
         A design by :func:`designer.filters.design.design` (its ``problem`` set).
-    count : int
-        How many, 1 or more (fewer when the candidates make fewer).
+    alternatives : int or str
+        How many (:func:`alternatives_count`); fewer are listed when the candidates make fewer.
 
     Returns
     -------
     list of Alternative
         Best first.
+
+    Raises
+    ------
+    DesignError
+        ``alternatives`` not a whole number from 1 to 50.
     """
+    count = alternatives_count(alternatives)
     search, limits, n_dev = result.problem
     errors = [st.errors for st in result.stages]
     out = []

@@ -411,3 +411,39 @@ def test_design_filter_monte_carlo_the_same_whatever_the_workers():
         got[where[-1]] = json.dumps(json.loads(p.stdout)["monte_carlo"], sort_keys=True)
     assert got["1"] == got["2"] == got["local"]
     assert json.loads(got["1"])["yield"]["samples"] == 2000
+
+
+def test_design_filter_alternatives_list_the_joint_searchs_best_sets(capsys):
+    """--alternatives N: the JSON's alternatives are design_alternatives' (the joint choice first, its parts
+    the stages'), the summary lists them with the mask met; without it the JSON has no such key."""
+    from designer.filters import FilterSpec
+    from designer.filters.alternatives import design_alternatives
+    from designer.filters.design import design
+    argv = ["--family", "chebyshev", "--passband", "1k", "--max-loss", "1", "--stopband", "3k", "--min-attenuation",
+            "30", "--opamp", "TL072", "--no-sim"]
+    assert design_filter_main(argv + ["--alternatives", "4", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    want = design_alternatives(design(FilterSpec(family="chebyshev", passband_hz=1e3, max_loss_db=1,
+                                                 stopband_hz=3e3, min_attenuation_db=30, opamp="TL072")), 4)
+    assert d["alternatives"] == [a.to_dict() for a in want]
+    first = {}
+    for st in d["stages"]:
+        first.update({f"{r[0]}{st['stage']}0{r[1:]}": v for r, v in st["parts"].items()})
+    assert d["alternatives"][0]["parts"] == first
+    assert d["alternatives"][0]["error_db"] == pytest.approx(d["figures"]["error_joint_db"], abs=1e-12)
+    assert design_filter_main(argv + ["--alternatives", "3"]) == 0
+    out = capsys.readouterr().out
+    assert "Alternatives (best first; the joint choice is 1; worst deviation from the ideal; limits: the mask):" in out
+    assert out.count("meets the limits") + out.count("breaks the limits by") == 3
+    assert design_filter_main(argv + ["--json"]) == 0
+    assert "alternatives" not in json.loads(capsys.readouterr().out)
+
+
+@pytest.mark.parametrize("value, words", [("2.5", "--alternatives must be a whole number from 1 to 50, got '2.5'"),
+                                          ("51", "--alternatives must be 1 to 50, got '51'")])
+def test_design_filter_alternatives_bad_count_is_one_line_nothing_written(tmp_path, capsys, value, words):
+    assert design_filter_main(["--order", "4", "--fc", "1k", "--no-sim", "--alternatives", value,
+                               "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err
+    assert list(tmp_path.iterdir()) == []
