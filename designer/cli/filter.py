@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 from ..core.eseries import SERIES
+from ..core.jsonio import json_safe
 from ..core.opamps import names as opamp_names
 from ..core.ranges import help_range
 from ..core.units import format_eng
@@ -98,6 +99,9 @@ def _parser():
     k.add_argument("--r-max", default="1M", help=f"largest resistor (default 1M) {help_range('resistor_ohm')}")
     k.add_argument("--c-min", default="1n", help=f"smallest capacitor (default 1n) {help_range('capacitor_f')}")
     k.add_argument("--c-max", default="10u", help=f"largest capacitor (default 10u) {help_range('capacitor_f')}")
+    k.add_argument("--alternatives", metavar="N", help="also list the N best part sets of the joint choice's "
+                   "candidates, the joint choice first, each with its deviation and whether it meets the mask "
+                   f"{help_range('alternatives')}")
     add_filter_tolerance(p, optimize=True)
     o = p.add_argument_group("output")
     o.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
@@ -261,6 +265,10 @@ def _design(args) -> int:
     from ..filters.design import design
     spec = _spec(args)
     _check_sheet_args(args)
+    count = None
+    if args.alternatives is not None:
+        from ..filters.alternatives import alternatives_count
+        count = alternatives_count(args.alternatives)
     settings = tolerance_settings(args)
     apply = None
     if args.apply_optimum:
@@ -271,12 +279,34 @@ def _design(args) -> int:
         apply = lambda res, choice: with_choice(res, choice, not args.no_sim, args.simulator)  # noqa: E731
     result = design(spec, simulate=not args.no_sim and apply is None, simulator=args.simulator)
     extras = run_tolerance(result, args, settings, apply)
-    return _emit(extras.pop("built", result), args, extras)
+    alts = None
+    if count is not None:
+        from ..filters.alternatives import design_alternatives
+        alts = design_alternatives(result, count)
+    return _emit(extras.pop("built", result), args, extras, alts)
 
 
-def _emit(result, args, extras: dict) -> int:
-    """The result (and its tolerance analyses) printed, and written with --out (or --name)."""
+def _alternatives_lines(spec, alts: list) -> list:
+    """--alternatives' lines: each set's deviation, the mask (and delay target) met or broken, its parts."""
+    limited = alts[0].violation is not None
+    out = ["Alternatives (best first; the joint choice is 1; worst deviation from the ideal"
+           + ("; limits: the mask" + (" and the delay target" if spec.has_delay_target else "") if limited else "")
+           + "):"]
+    for a in alts:
+        met = ("" if not limited else "  meets the limits" if a.violation <= 0 else
+               f"  breaks the limits by {a.violation:.3g}")
+        out.append(f"  {a.rank:>2}  {a.error_db:.3g} dB{met}")
+        out.append("      " + ", ".join(f"{ref} {format_eng(v, 'Ohm' if ref.startswith('R') else 'F')}"
+                                        for ref, v in a.parts.items()))
+    return out
+
+
+def _emit(result, args, extras: dict, alts=None) -> int:
+    """The result (and its tolerance analyses, and --alternatives' sets) printed, and written with --out (or
+    --name)."""
     extra = tolerance_json(extras)
+    if alts is not None:
+        extra["alternatives"] = json_safe([a.to_dict() for a in alts])
     name = getattr(args, "name", None)
     sheet = _write_sheet(result, args.out, name, extra, getattr(args, "lang", None)) if args.out or name else None
     files = sheet.files if sheet is not None else {}
@@ -285,7 +315,8 @@ def _emit(result, args, extras: dict) -> int:
         print_output(json.dumps(sheet.to_dict() if sheet is not None else {**result.to_dict(), **extra, "files": {}},
                                 indent=2))
     else:
-        text = summary_text(result) + "".join(line + "\n" for line in tolerance_lines(extras))
+        text = summary_text(result) + "".join(line + "\n" for line in tolerance_lines(extras)
+                                             + (_alternatives_lines(result.spec, alts) if alts is not None else []))
         if files:
             text += "Files:\n" + "".join(f"  {k}: {', '.join(v) if isinstance(v, list) else v}\n"
                                           for k, v in files.items())

@@ -13,6 +13,7 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "alternatives": ("Alternative", "alternatives_count", "design_alternatives",),
     "bench": ("BUILDS", "C_TOL_PCT", "FilterBench", "R_TOL_PCT", "SEED", "StageCheck", "SweepPoint", "TableCompare",
               "TimeTest", "bench_of", "nice_down", "nice_up", "passband_gain",),
     "cascade": ("Cascade", "Stage",),
@@ -20,11 +21,11 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "design": ("FilterDesign", "StageDesign", "analysis_grid", "as_built", "central_delay", "delay_figures", "predistort", "section_name", "with_choice",
                "section_plans", "stage_candidates", "verify_spice",),
     "inverting_lowpass": ("InvertingLowPass",),
-    "joint": ("brute_force", "delay_columns", "descend", "joint_search", "objective", "per_stage",),
+    "joint": ("brute_force", "delay_columns", "descend", "joint_alternatives", "joint_search", "objective", "per_stage",),
     "mfb_bandpass": ("MfbBandPass",),
     "mfb_highpass": ("MfbHighPass",),
     "mfb_lowpass": ("MfbLowPass",),
-    "prototype": ("BANDPASS_METHODS", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER",
+    "prototype": ("BANDPASS_METHODS", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "FAMILIES", "MAX_ORDER", "BESSEL_SEARCH_ORDER",
                   "RESPONSE_TYPES", "SectionPlan", "WIDE_RATIO", "DELAY_POINTS", "bandpass_from_mask", "bandpass_method", "chebyshev_3db_factor", "delay_error_pct", "group_delay",
                   "order_from_mask", "plan_bandpass", "plan_sections", "prototype_zpk", "reference_ba",
                   "reference_bandpass", "reference_response",),

@@ -43,7 +43,7 @@ import itertools
 
 import numpy as np
 
-__all__ = ["objective", "per_stage", "descend", "joint_search", "brute_force", "delay_columns"]
+__all__ = ["objective", "per_stage", "descend", "joint_search", "brute_force", "delay_columns", "joint_alternatives"]
 
 #: dB of objective per dB of mask violation: a mask met is worth more than any deviation
 PENALTY = 1000.0
@@ -210,9 +210,18 @@ def joint_search(errors: list, start=None, limits=None, n_dev=None) -> tuple:
     tuple
         (choice as a list of int, J, number of partial choices examined).
     """
-    n = len(errors)
     start = descend(errors, per_stage(errors, n_dev) if start is None else start, limits, n_dev)
     best_j = objective(errors, start, limits, n_dev)
+    sums, picks, examined = _survivors(errors, best_j, limits, n_dev)
+    j = _score(sums, limits, n_dev)
+    w = int(np.argmin(j))
+    return [int(c) for c in picks[w]], float(j[w]), examined
+
+
+def _survivors(errors: list, best_j: float, limits, n_dev) -> tuple:
+    """The branch and bound of :func:`joint_search`: every complete choice whose bound is within ``best_j``
+    (so every one with J <= best_j), as (their sums, their picks in stage order, partials examined)."""
+    n = len(errors)
     # the stages whose candidates differ most first: their choice decides most, and the
     # narrow remainder [L, U] then bounds tightly
     order = sorted(range(n), key=lambda i: -float(np.max(np.ptp(errors[i], axis=0))))
@@ -250,9 +259,43 @@ def joint_search(errors: list, start=None, limits=None, n_dev=None) -> tuple:
                 kept_picks.append(np.hstack([base, cand])[keep])
         partial = np.vstack(kept_sums)
         picks = np.vstack(kept_picks)
-    j = _score(partial, limits, n_dev)
-    w = int(np.argmin(j))
-    choice = [0] * n
-    for k, i in enumerate(order):
-        choice[i] = int(picks[w, k])
-    return choice, float(j[w]), examined
+    in_stage_order = np.empty_like(picks)
+    in_stage_order[:, order] = picks
+    return partial, in_stage_order, examined
+
+
+def joint_alternatives(errors: list, best, count: int, limits=None, n_dev=None) -> list:
+    """The ``count`` least-J choices, best first (the joint choice first): exact, as :func:`joint_search`.
+    The choices one stage away from ``best`` are ``count`` distinct choices or more (else every choice is
+    enumerated), so the ``count``-th least J among them bounds the ``count``-th least J of all; the
+    branch and bound keeps every choice within that bound, and the ``count`` least are taken from those.
+
+    Parameters
+    ----------
+    errors : list of ndarray
+        As :func:`objective`.
+    best : sequence of int
+        The joint choice (:func:`joint_search`'s).
+    count : int
+        How many choices, 1 or more.
+    limits : list of tuple, optional
+        As :func:`objective`.
+    n_dev : int, optional
+        As :func:`objective`.
+
+    Returns
+    -------
+    list of tuple
+        (choice as a list of int, J), J rising (ties in the enumeration's order); fewer when the product
+        has fewer choices.
+    """
+    best = [int(c) for c in best]
+    near = {tuple(best)}
+    for i, e in enumerate(errors):
+        near.update(tuple(best[:i] + [c] + best[i + 1:]) for c in range(len(e)))
+    js = sorted(objective(errors, ch, limits, n_dev) for ch in near)
+    bound = js[count - 1] if len(js) >= count else np.inf
+    sums, picks, _ = _survivors(errors, bound, limits, n_dev)
+    j = _score(sums, limits, n_dev)
+    top = np.argsort(j, kind="stable")[:count]
+    return [([int(c) for c in picks[w]], float(j[w])) for w in top]

@@ -33,7 +33,7 @@ from scipy import signal
 from ..core.errors import DesignError
 
 __all__ = ["FAMILIES", "RESPONSE_TYPES", "BESSEL_NORMS", "CHEBYSHEV_CUTOFFS", "BANDPASS_METHODS", "MAX_ORDER",
-           "WIDE_RATIO", "SectionPlan", "prototype_zpk", "plan_sections", "reference_ba", "reference_response",
+           "BESSEL_SEARCH_ORDER", "WIDE_RATIO", "SectionPlan", "prototype_zpk", "plan_sections", "reference_ba", "reference_response",
            "order_from_mask", "bandpass_from_mask", "group_delay", "delay_error_pct", "DELAY_POINTS", "chebyshev_3db_factor", "bandpass_method", "plan_bandpass", "reference_bandpass"]
 
 FAMILIES = ("butterworth", "bessel", "chebyshev")
@@ -46,6 +46,10 @@ WIDE_RATIO = 2.0
 BESSEL_NORMS = ("mag", "delay")
 CHEBYSHEV_CUTOFFS = ("ripple", "3db")
 MAX_ORDER = 10
+#: how far a Bessel mask beyond :data:`MAX_ORDER` is searched to name the order it needs (a Bessel's skirt
+#: tends to a Gaussian's as its order grows, so its attenuation at a given edge peaks at some order and then
+#: falls: a mask may need no order at all)
+BESSEL_SEARCH_ORDER = 25
 
 
 @dataclass(frozen=True)
@@ -260,6 +264,34 @@ def delay_error_pct(tau: np.ndarray, tau_dc: float) -> float:
 DELAY_POINTS = 201
 
 
+def _bessel_order_beyond(kind, passband_hz, max_loss_db, stopband_hz, min_attenuation_db, bessel_norm,
+                         max_delay_error_pct, delay_to_hz):
+    """The least Bessel order from MAX_ORDER + 1 to BESSEL_SEARCH_ORDER meeting the mask (and the delay
+    target), or None: :func:`order_from_mask`'s search on the normalised prototype alone. A low-pass's loss
+    at f is L(f / fc) and a high-pass's L(fc / f), L the prototype's (monotonic: a Bessel does not peak), so
+    the passband edge sits at the w_p where L(w_p) is the loss allowed, fc = f_p / w_p (high-pass f_p w_p),
+    and the stopband edge at w_p times the edges' ratio."""
+    ratio = stopband_hz / passband_hz if kind == "lowpass" else passband_hz / stopband_hz
+    for order in range(MAX_ORDER + 1, BESSEL_SEARCH_ORDER + 1):
+        _, p, _ = prototype_zpk("bessel", order, 1.0, bessel_norm)
+
+        def loss(w, p=p):
+            return float(20 * np.sum(np.log10(np.abs(1j * w - p) / np.abs(p))))
+        lo, hi = -12.0, 12.0
+        for _ in range(100):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (lo, mid) if loss(math.exp(mid)) > max_loss_db else (mid, hi)
+        w_p = math.exp(lo)
+        if loss(w_p * ratio) < min_attenuation_db:
+            continue
+        if max_delay_error_pct is not None:
+            tau = group_delay((None, p, None), np.linspace(0.0, delay_to_hz, DELAY_POINTS), passband_hz / w_p)
+            if delay_error_pct(tau, tau[0]) > max_delay_error_pct:
+                continue
+        return order
+    return None
+
+
 def order_from_mask(kind: str, family: str, passband_hz: float, max_loss_db: float, stopband_hz: float,
                     min_attenuation_db: float, bessel_norm: str = "mag", max_delay_error_pct: float | None = None,
                     delay_to_hz: float | None = None) -> tuple:
@@ -325,15 +357,22 @@ def order_from_mask(kind: str, family: str, passband_hz: float, max_loss_db: flo
             if att >= min_attenuation_db and (err is None or err <= max_delay_error_pct):
                 n, fc = order, fc_try
                 break
+        if n is None:
+            # no closed form names a Bessel's order: the search goes on (on the prototype alone) to say it
+            need = _bessel_order_beyond(kind, passband_hz, max_loss_db, stopband_hz, min_attenuation_db,
+                                        bessel_norm, max_delay_error_pct, delay_to_hz)
+            which = (f"of order {need}, above the limit {MAX_ORDER}" if need is not None else
+                     f"above order {MAX_ORDER}, and no order up to {BESSEL_SEARCH_ORDER} meets "
+                     f"{'them' if max_delay_error_pct is not None else 'it'}: a Bessel's skirt tends to a "
+                     "Gaussian's as its order grows")
         if n is None and max_delay_error_pct is not None:
-            raise DesignError(f"order: the mask and the group-delay target need a Bessel filter above order "
-                              f"{MAX_ORDER} (order {MAX_ORDER}: {att:.3g} dB at the stopband edge, "
+            raise DesignError(f"order: the mask and the group-delay target need a Bessel filter {which} (order "
+                              f"{MAX_ORDER}: {att:.3g} dB at the stopband edge, "
                               f"{min_attenuation_db:.3g} dB asked; the delay within {err:.3g} % up to "
                               f"{delay_to_hz:g} Hz, {max_delay_error_pct:g} % asked); lower --delay-to, allow more "
                               "delay error or widen the transition band", param="order")
         if n is None:
-            # a Bessel's attenuation grows slowly (near-Gaussian), so there is no closed form to name the order
-            raise DesignError(f"order: the mask needs a Bessel filter above order {MAX_ORDER} (order {MAX_ORDER} "
+            raise DesignError(f"order: the mask needs a Bessel filter {which} (order {MAX_ORDER} "
                               f"gives {att:.3g} dB at the stopband edge, {min_attenuation_db:.3g} dB asked); widen "
                               "the transition band, or use butterworth or chebyshev", param="order")
     if n > MAX_ORDER:

@@ -24,7 +24,7 @@ from ..core import opamps
 from ..core.errors import DesignError, ParamError
 from ..core.i18n import gettext as _
 from ..core.eseries import PartBounds
-from ..core.ranges import parse_in_range
+from ..core.ranges import RANGES, parse_in_range
 from ..core.units import format_eng
 from .prototype import BANDPASS_METHODS, BESSEL_NORMS, CHEBYSHEV_CUTOFFS, FAMILIES, RESPONSE_TYPES
 
@@ -154,6 +154,11 @@ class FilterSpec(PartBounds):
             put("order", int(order))
         if self.family == "chebyshev":
             rip = self.ripple_db if self.ripple_db is not None else (self.max_loss_db if given else 1.0)
+            if self.ripple_db is None and given and not RANGES["ripple_db"].contains(rip):
+                # the ripple was not given: the mask's loss is, so the refusal names the loss
+                raise DesignError(f"max_loss_db: a chebyshev mask's passband loss is its ripple, which must be "
+                                  f"{RANGES['ripple_db'].text()}, got {rip:g} dB; allow less loss, or use "
+                                  "butterworth or bessel", param="max_loss_db")
             put("ripple_db", parse_in_range(rip, "ripple_db", "ripple_db"))
         elif self.ripple_db is not None:
             raise DesignError(f"ripple_db: only a chebyshev filter has a ripple ({self.family} asked)",

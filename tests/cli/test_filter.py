@@ -19,6 +19,8 @@ from designer.cli.filter import analyze_filter_main, design_filter_main
     (["--order", "4", "--fc", "1k", "--type", "notch"], "allowed: lowpass, highpass, bandpass"),
     (["--order", "4", "--fc", "1k", "--family", "chebyshev", "--ripple", "5"], "--ripple must be 0.01 dB to 3 dB"),
     (["--order", "4", "--fc", "1k", "--ripple", "1"], "only a chebyshev filter has a ripple"),
+    (["--family", "chebyshev", "--passband", "1k", "--max-loss", "4", "--stopband", "2k", "--min-attenuation", "60"],
+     "--max-loss: a chebyshev mask's passband loss is its ripple, which must be 0.01 dB to 3 dB, got 4 dB"),
     (["--order", "4"], "give --order and --fc"),
     (["--passband", "3k", "--max-loss", "1", "--stopband", "2k", "--min-attenuation", "40"],
      "must be below its stopband edge"),
@@ -394,3 +396,54 @@ def test_delay_target_joins_the_mask_in_the_yield(capsys, tmp_path):
     err = capsys.readouterr().err
     assert "--limit 'delay_error_pct': unknown figure" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_design_filter_monte_carlo_the_same_whatever_the_workers():
+    """--jobs 1, --jobs 2 and --dask local (a LocalCluster the command starts and stops) draw the same
+    builds: the JSON's monte_carlo section is the same, byte for byte, and nothing is printed on stderr."""
+    argv = [script("design-filter"), "--family", "chebyshev", "--passband", "1k", "--max-loss", "1", "--stopband",
+            "3k", "--min-attenuation", "30", "--opamp", "TL072", "--monte-carlo", "2000", "--seed", "3", "--no-sim",
+            "--json"]
+    got = {}
+    for where in (["--jobs", "1"], ["--jobs", "2"], ["--dask", "local"]):
+        p = subprocess.run(argv + where, capture_output=True, text=True, timeout=300)
+        assert p.returncode == 0 and p.stderr == "", (where, p.stderr)
+        got[where[-1]] = json.dumps(json.loads(p.stdout)["monte_carlo"], sort_keys=True)
+    assert got["1"] == got["2"] == got["local"]
+    assert json.loads(got["1"])["yield"]["samples"] == 2000
+
+
+def test_design_filter_alternatives_list_the_joint_searchs_best_sets(capsys):
+    """--alternatives N: the JSON's alternatives are design_alternatives' (the joint choice first, its parts
+    the stages'), the summary lists them with the mask met; without it the JSON has no such key."""
+    from designer.filters import FilterSpec
+    from designer.filters.alternatives import design_alternatives
+    from designer.filters.design import design
+    argv = ["--family", "chebyshev", "--passband", "1k", "--max-loss", "1", "--stopband", "3k", "--min-attenuation",
+            "30", "--opamp", "TL072", "--no-sim"]
+    assert design_filter_main(argv + ["--alternatives", "4", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    want = design_alternatives(design(FilterSpec(family="chebyshev", passband_hz=1e3, max_loss_db=1,
+                                                 stopband_hz=3e3, min_attenuation_db=30, opamp="TL072")), 4)
+    assert d["alternatives"] == [a.to_dict() for a in want]
+    first = {}
+    for st in d["stages"]:
+        first.update({f"{r[0]}{st['stage']}0{r[1:]}": v for r, v in st["parts"].items()})
+    assert d["alternatives"][0]["parts"] == first
+    assert d["alternatives"][0]["error_db"] == pytest.approx(d["figures"]["error_joint_db"], abs=1e-12)
+    assert design_filter_main(argv + ["--alternatives", "3"]) == 0
+    out = capsys.readouterr().out
+    assert "Alternatives (best first; the joint choice is 1; worst deviation from the ideal; limits: the mask):" in out
+    assert out.count("meets the limits") + out.count("breaks the limits by") == 3
+    assert design_filter_main(argv + ["--json"]) == 0
+    assert "alternatives" not in json.loads(capsys.readouterr().out)
+
+
+@pytest.mark.parametrize("value, words", [("2.5", "--alternatives must be a whole number from 1 to 50, got '2.5'"),
+                                          ("51", "--alternatives must be 1 to 50, got '51'")])
+def test_design_filter_alternatives_bad_count_is_one_line_nothing_written(tmp_path, capsys, value, words):
+    assert design_filter_main(["--order", "4", "--fc", "1k", "--no-sim", "--alternatives", value,
+                               "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err
+    assert list(tmp_path.iterdir()) == []

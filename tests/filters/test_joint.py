@@ -12,7 +12,8 @@ from hypothesis import strategies as st
 
 from designer.filters import FilterSpec
 from designer.filters.design import design
-from designer.filters.joint import brute_force, delay_columns, descend, joint_search, objective, per_stage
+from designer.filters.joint import (brute_force, delay_columns, descend, joint_search, objective,
+                                    joint_alternatives, per_stage)
 from designer.filters.prototype import delay_error_pct
 
 
@@ -119,3 +120,21 @@ def test_delay_target_joint_meets_it_where_rounding_misses():
     # the delay from the stages' candidate delays is the cascade's (delay_figures, by the cascade's response)
     tau = sum(s.delays[c] for s, c in zip(d.stages, choice))
     assert delay_error_pct(tau, tau[0]) == pytest.approx(f["delay_error_pct"], abs=1e-6)
+
+
+@given(seed=st.integers(0, 2 ** 32 - 1), stages=st.integers(1, 4), count=st.integers(1, 12),
+       masked=st.booleans())
+def test_alternatives_are_the_least_j_choices_of_the_enumeration(seed, stages, count, masked):
+    """The alternatives are the ``count`` least J of every combination (enumerated here), best first, the
+    joint choice first; with mask limits too."""
+    rng = np.random.default_rng(seed)
+    errors = [rng.normal(0, 0.2, (int(rng.integers(1, 6)), 12)) for _ in range(stages)]
+    limits = [(10, -1.0, -0.05), (11, 1.0, -0.1)] if masked else None
+    best, j_best, _ = joint_search(errors, limits=limits)
+    got = joint_alternatives(errors, best, count, limits)
+    every = sorted(objective(errors, ch, limits) for ch in itertools.product(*(range(len(e)) for e in errors)))
+    assert [j for _, j in got] == pytest.approx(every[:count], abs=1e-12)
+    assert got[0][1] == pytest.approx(j_best, abs=1e-12)
+    assert len({tuple(ch) for ch, _ in got}) == len(got)
+    for ch, j in got:
+        assert objective(errors, ch, limits) == pytest.approx(j, abs=1e-12)

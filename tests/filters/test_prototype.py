@@ -4,6 +4,7 @@ cheby1 with freqs) for every order 1..10; the conventions; the section tables
 of TI SLOA088 reproduced; the mask's order equals buttord/cheb1ord."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -14,7 +15,7 @@ from scipy import signal
 from designer.core.errors import DesignError
 from designer.filters import Cascade, SectionTarget, get
 from designer.filters.design import section_name
-from designer.filters.prototype import (DELAY_POINTS, bandpass_from_mask, chebyshev_3db_factor, delay_error_pct,
+from designer.filters.prototype import (BESSEL_SEARCH_ORDER, DELAY_POINTS, bandpass_from_mask, chebyshev_3db_factor, delay_error_pct,
                                         group_delay, order_from_mask, plan_bandpass, plan_sections, prototype_zpk, reference_ba, reference_bandpass,
                                         reference_response)
 
@@ -130,25 +131,50 @@ def test_mask_order_equals_buttord_and_cheb1ord(mask):
 def test_bessel_mask_order_is_the_least_that_meets_it(mask):
     kind, fp, ap, fs, as_ = mask
     order, fc = order_from_mask(kind, "bessel", fp, ap, fs, as_)
-    loss = lambda n, f, c: -20 * math.log10(abs(reference_response([f], kind, "bessel", n, c)[0]))  # noqa: E731
-    assert loss(order, fp, fc) == pytest.approx(ap, abs=1e-6)
-    assert loss(order, fs, fc) >= as_
+    assert _bessel_loss(kind, order, fp, fc) == pytest.approx(ap, abs=1e-6)
+    assert _bessel_loss(kind, order, fs, fc) >= as_
     if order > 1:   # one order less cannot: with its loss at fp set to the limit, fs is not attenuated enough
-        n1, fc1 = order - 1, fc
-        lo, hi = math.log(fp) - 12, math.log(fp) + 12
-        for _ in range(100):
-            mid = 0.5 * (lo + hi)
-            if (loss(n1, fp, math.exp(mid)) > ap) == (kind == "lowpass"):
-                lo = mid
-            else:
-                hi = mid
-        fc1 = math.exp(hi if kind == "lowpass" else lo)
-        assert loss(n1, fs, fc1) < as_
+        assert _bessel_attenuation(kind, order - 1, fp, ap, fs) < as_
 
 
-def test_bessel_mask_beyond_order_10_says_so():
-    with pytest.raises(DesignError, match=r"above order 10 \(order 10 gives .* dB"):
-        order_from_mask("lowpass", "bessel", 3e3, 1.0, 12e3, 40.0)
+def _bessel_loss(kind, n, f, fc):
+    return -20 * math.log10(abs(reference_response([f], kind, "bessel", n, fc)[0]))
+
+
+def _bessel_attenuation(kind, n, fp, ap, fs):
+    """The attenuation at fs of the order-n Bessel whose loss at fp is ap (its cut-off by bisection on
+    scipy's response)."""
+    lo, hi = math.log(fp) - 12, math.log(fp) + 12
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        if (_bessel_loss(kind, n, fp, math.exp(mid)) > ap) == (kind == "lowpass"):
+            lo = mid
+        else:
+            hi = mid
+    return _bessel_loss(kind, n, fs, math.exp(hi if kind == "lowpass" else lo))
+
+
+@pytest.mark.parametrize("mask", [("lowpass", 1e3, 3.0, 4e3, 60.0), ("highpass", 4e3, 3.0, 1e3, 60.0)])
+def test_bessel_mask_beyond_order_10_names_the_order_it_needs(mask):
+    """As Butterworth's and Chebyshev's, a Bessel mask above order 10 is refused naming the order it needs:
+    that order meets it on scipy's response, one less does not."""
+    kind, fp, ap, fs, as_ = mask
+    with pytest.raises(DesignError, match=r"needs a Bessel filter of order (\d+), above the limit 10 \(order 10 "
+                                          r"gives .* dB") as exc:
+        order_from_mask(kind, "bessel", fp, ap, fs, as_)
+    n = int(re.search(r"of order (\d+)", str(exc.value)).group(1))
+    assert 10 < n <= BESSEL_SEARCH_ORDER
+    assert _bessel_attenuation(kind, n, fp, ap, fs) >= as_ > _bessel_attenuation(kind, n - 1, fp, ap, fs)
+
+
+def test_bessel_mask_no_order_meets_says_so():
+    """A Bessel's attenuation at an edge peaks at some order and falls towards the Gaussian's: a mask no
+    order up to the search's end meets is refused saying so (brute force over those orders agrees)."""
+    kind, fp, ap, fs, as_ = "lowpass", 3e3, 1.0, 12e3, 40.0
+    with pytest.raises(DesignError, match=r"above order 10, and no order up to 25 meets it: .*\(order 10 gives "
+                                          r".* dB at the stopband edge, 40 dB asked\)"):
+        order_from_mask(kind, "bessel", fp, ap, fs, as_)
+    assert max(_bessel_attenuation(kind, n, fp, ap, fs) for n in range(1, BESSEL_SEARCH_ORDER + 1)) < as_
 
 
 @given(order=st.integers(1, 5), f_low=st.floats(50.0, 5e4), ratio=st.floats(1.05, 1.9),
@@ -302,5 +328,6 @@ def test_delay_target_order_is_the_least_meeting_mask_and_target(pct, to):
 
 
 def test_delay_target_beyond_order_10_says_both():
-    with pytest.raises(DesignError, match=r"above order 10 .*the delay within .* % up to 5000 Hz, 0.01 % asked"):
+    with pytest.raises(DesignError, match=r"above order 10, and no order up to 25 meets them.*the delay within .* % "
+                                          r"up to 5000 Hz, 0.01 % asked"):
         order_from_mask("lowpass", "bessel", 1e3, 3.0, 2e3, 30.0, "mag", 0.01, 5e3)

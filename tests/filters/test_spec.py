@@ -42,6 +42,20 @@ def test_band_mask_refusals_are_one_line(kw, words):
     assert words in str(exc.value) and "\n" not in str(exc.value)
 
 
+@pytest.mark.parametrize("kw", [dict(passband_hz=1e3, stopband_hz=2e3),
+                                dict(filter_type="bandpass", passband_hz="900,1.1k", stopband_hz="600,1.7k")])
+def test_a_chebyshev_masks_loss_beyond_the_ripple_range_names_the_loss(kw):
+    """The ripple of a Chebyshev from a mask is the mask's loss: a loss outside the ripple's range is refused
+    naming max_loss_db (what was given), never ripple_db (which was not)."""
+    with pytest.raises(DesignError) as exc:
+        FilterSpec(family="chebyshev", max_loss_db=3.5, min_attenuation_db=60, **kw)
+    assert exc.value.param == "max_loss_db" and "\n" not in str(exc.value)
+    assert str(exc.value).startswith("max_loss_db: a chebyshev mask's passband loss is its ripple, which must be "
+                                     "0.01 dB to 3 dB, got 3.5 dB")
+    # at the range's end it is a design (the ripple is the loss)
+    assert FilterSpec(family="chebyshev", max_loss_db=3, min_attenuation_db=60, **kw).ripple_db == 3.0
+
+
 def test_a_low_pass_takes_one_edge():
     with pytest.raises(DesignError, match="two edges F1,F2 are for a bandpass"):
         FilterSpec(passband_hz="900,1.1k", stopband_hz="3k", max_loss_db=1, min_attenuation_db=30)

@@ -172,7 +172,10 @@ def test_spice_engine_on_the_same_builds(lowpass):
     assert sp["max_abs_difference"]["passband_loss_db"] < 0.1
     assert sp["max_abs_difference"]["stopband_attenuation_db"] < 0.1
     assert sp["max_abs_difference"]["f3_hz"] < 0.01 * 3.3e3
-    assert sp["disagree"] == round(abs(sp["yield_spice"] - sp["yield_analytic"]) * 12) or sp["disagree"] >= 0
+    # builds judged differently: at least the difference of the passing counts, and of its parity (a build
+    # passing on one engine only moves that difference by one)
+    diff = round(sp["yield_spice"] * 12) - round(sp["yield_analytic"] * 12)
+    assert abs(diff) <= sp["disagree"] <= 12 and (sp["disagree"] - diff) % 2 == 0
     assert sp["ci95_spice"] == list(wilson(round(sp["yield_spice"] * 12), 12))
 
 
