@@ -130,8 +130,9 @@ def plant_figures(res) -> dict:
 def circuit_plant_figures(res) -> dict:
     """The :data:`PLANT` figures of a plant on another topology
     (:class:`~designer.plant.circuit_design.CircuitPlantResult`): fn, zeta, Q with the corner's
-    op-amp and of the parts alone, the gain, the errors and the models' step figures (None for
-    what it has not: its SPICE run is an .ac sweep, no step).
+    op-amp and of the parts alone, the gain, the errors and the models' step figures; ``nrms`` and
+    ``nrms_ideal`` are its square-wave test's (SPICE's ``.tran`` against the op-amp-aware and the ideal
+    model, when it ran); None for what it has not (SPICE's step figures: its .ac sweep has no step).
 
     Parameters
     ----------
@@ -146,7 +147,8 @@ def circuit_plant_figures(res) -> dict:
     i, o = res.figures["ideal"], res.figures["opamp"]
     out = {"fn_hz": o["fn_hz"], "zeta": o["zeta"], "q": o["q"], "ideal_fn_hz": i["fn_hz"], "ideal_zeta": i["zeta"],
            "ideal_q": i["q"], "gain": i["gain"], "fn_error_pct": o["fn_error_pct"],
-           "zeta_error_pct": o["zeta_error_pct"], "nrms": None, "nrms_ideal": None}
+           "zeta_error_pct": o["zeta_error_pct"], "nrms": None if res.square is None else res.square.nrms,
+           "nrms_ideal": None if res.square is None else res.square.nrms_ideal}
     out.update({alias: out[name] for alias, name in ALIASES.items()})
     for f in STEP:
         out[f"model_{f}"] = None if res.steps["opamp"] is None else res.steps["opamp"][f]

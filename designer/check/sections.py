@@ -237,9 +237,6 @@ def read_circuit_designs(doc, corners, topo, target):
     from ..plant.spec import PlantSpec
     parts = doc.mapping(("parts",), topo.designators)
     common = _common(doc, "plant")
-    if "square_hz" in common:
-        raise doc.error(("stimulus", "frequency"), f"stimulus.frequency: {topo.name} is checked by its .ac "
-                        "sweep; the square wave is the sallen-key-lowpass's")
     if parts:
         for k in ("gain", "compensate_gbw"):
             if k in target:
@@ -251,7 +248,7 @@ def read_circuit_designs(doc, corners, topo, target):
         if missing:
             raise doc.error(("parts",), f"parts: {topo.name} needs {', '.join(missing)} too; its parts are "
                             f"{', '.join(topo.designators)}")
-        kw = {k: v for k, v in common.items() if k in ("r_series", "c_series")}
+        kw = {k: v for k, v in common.items() if k in ("r_series", "c_series", "amplitude_v", "square_hz")}
         table = {**PLANT_KEYS, "part": "parts", **{f"part {r}": f"parts.{r}" for r in topo.designators}}
         return [built_in_spec_words(doc, table, lambda amp=amp: CircuitAnalysisSpec(
             topo.name, dict(parts), opamp=amp, target_fc_hz=target.get("fc"), target_zeta=target.get("zeta"), **kw))

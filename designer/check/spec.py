@@ -150,7 +150,7 @@ def load_spec(path, update_golden: bool = False, root=None, allow_outside: bool 
     golden = read_golden(doc, kind, corners, update_golden)
     yield_spec = read_yield(doc, kind, checks)
     if kind == "plant" and getattr(designs[0], "topology", DEFAULT_TOPOLOGY) != DEFAULT_TOPOLOGY:
-        for key, given in (("spice_agreement", agreement), ("golden", golden), ("tolerance", tolerance)):
+        for key, given in (("tolerance", tolerance),):
             if given:
                 raise doc.error((key,), f"{key}: is the {DEFAULT_TOPOLOGY}'s for now; topology: "
                                 f"{designs[0].topology} checks checks:, design_checks: (its ngspice .ac "

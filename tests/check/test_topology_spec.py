@@ -151,3 +151,59 @@ def test_what_a_section_s_yield_has_not_is_one_line_at_its_key(extra, words, tmp
     assert "\n" not in line and "spec.yaml:" in line
     for w in words:
         assert w in line, (w, line)
+
+
+def _cases(out_dir) -> dict:
+    """case id -> case, of the one spec under ``out_dir``."""
+    d = json.loads(next(out_dir.glob("*/result.json")).read_text())
+    return {c["id"]: c for corner in d["corners"] for c in corner["cases"]}
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_spice_agreement_on_a_section_is_its_square_wave_test(topology, tmp_path):
+    """spice_agreement: on every registered section: SPICE's .tran under the square wave against the
+    op-amp-aware model, as the Sallen-Key plant's; the case's nrms recomputed from the run's waveforms.csv."""
+    import numpy as np
+
+    from designer.core.compare import nrms
+    path = tmp_path / "spec.yaml"
+    path.write_text(spec_text(topology) + "stimulus: {amplitude: 0.5}\nspice_agreement: {nrms_max: 1}\n")
+    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
+    assert out.returncode == 0, out.stdout + out.stderr
+    case = _cases(tmp_path / "out")["spice_agreement"]
+    assert case["status"] == "pass" and "against the op-amp-aware model" in case["message"]
+    d = json.loads(next((tmp_path / "out").rglob("reports/*/result.json")).read_text())
+    wave = np.genfromtxt(next((tmp_path / "out").rglob("reports/*/waveforms.csv")), delimiter=",", names=True)
+    sq = d["square_test"]
+    assert sq["abstol_v"] == pytest.approx(0.01 * 0.5 * abs(d["built"]["ideal"]["gain"]))
+    again = nrms(wave["model_v"], wave["spice_v"], sq["abstol_v"], t=wave["time_s"])
+    assert case["value"] == pytest.approx(sq["nrms"], rel=1e-12)
+    assert case["value"] == pytest.approx(again, rel=1e-3, abs=1e-6)
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("name", ["mfb-lowpass", "sallen-key-highpass"])
+def test_a_section_s_golden_records_then_compares_and_a_changed_part_fails(name, tmp_path):
+    """golden: on a section as built: --update-golden records the square-wave run's signals (the
+    Sallen-Key plant's names); the same parts compare (exit 0); one part 10 % off fails (exit 1)."""
+    topology = REGISTRY[name]
+    values = topology.synthesize(topology.example)
+    signals = "[output_v, input_v, analytic_v, analytic_opamp_v]"
+    golden = f"golden: {{file: 'gold-{{corner}}.csv', signals: {signals}}}\n"
+    path = tmp_path / "spec.yaml"
+    path.write_text(parts_text(topology, values) + golden)
+    rec = check(path, "--simulator", "ngspice-cli", "--update-golden")
+    assert rec.returncode == 0, rec.stdout + rec.stderr
+    header = (tmp_path / "gold-TL072.csv").read_text().splitlines()
+    assert "time_s,output_v,input_v,analytic_v,analytic_opamp_v" in header
+    same = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "same"))
+    assert same.returncode == 0, same.stdout + same.stderr
+    assert all(_cases(tmp_path / "same")[f"golden_{s}"]["status"] == "pass" for s in ("output_v", "analytic_v"))
+    first = topology.designators[0]
+    path.write_text(parts_text(topology, {**values, first: 1.1 * values[first]}) + golden)
+    changed = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "changed"))
+    assert changed.returncode == 1, changed.stdout + changed.stderr
+    cases = _cases(tmp_path / "changed")
+    assert cases["golden_output_v"]["status"] == "fail" and cases["golden_input_v"]["status"] == "pass"
+    assert list((tmp_path / "changed").rglob("golden-TL072-output_v.png"))
