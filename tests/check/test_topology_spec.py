@@ -140,11 +140,13 @@ def test_a_yield_on_a_section_counts_its_builds(tmp_path):
 @pytest.mark.parametrize("extra, words", [
     ("yield: {min: 50%, engine: spice}\n", ["yield.engine", "analytic engine only"]),
     ("tolerances: {GBW: 20%}\nyield: {min: 50%}\n", ["tolerances.GBW", "the op-amp's spread"]),
-    ("tolerance: [ideal_fn_hz]\n", ["tolerance: is the sallen-key-lowpass's for now", "and yield:"]),
+    (lambda t: t.replace("checks:\n", "checks:\n  overshoot_pct: {max: 30}\n") + "tolerance: [overshoot_pct]\n",
+     ["spec.yaml:10: tolerance: overshoot_pct has no tolerance band on topology mfb-lowpass", "allowed: fn_hz"]),
 ])
 def test_what_a_section_s_yield_has_not_is_one_line_at_its_key(extra, words, tmp_path):
     path = tmp_path / "spec.yaml"
-    path.write_text(spec_text(REGISTRY["mfb-lowpass"]) + extra)
+    text = spec_text(REGISTRY["mfb-lowpass"])
+    path.write_text(extra(text) if callable(extra) else text + extra)
     out = check(path)
     assert out.returncode == 2, out.stdout + out.stderr
     line = out.stderr.strip()
@@ -207,3 +209,58 @@ def test_a_section_s_golden_records_then_compares_and_a_changed_part_fails(name,
     cases = _cases(tmp_path / "changed")
     assert cases["golden_output_v"]["status"] == "fail" and cases["golden_input_v"]["status"] == "pass"
     assert list((tmp_path / "changed").rglob("golden-TL072-output_v.png"))
+
+
+@pytest.mark.parametrize("name", ["mfb-lowpass", "sallen-key-highpass"])
+def test_a_section_s_tolerance_band_is_the_worst_over_its_declared_parts(name):
+    """circuit_band_of: the band over every declared part at +/- its series tolerance; brute force on a
+    3-level grid of each part (-tol, 0, +tol: 3^n builds, the corners among them) lands inside it and
+    reaches both ends."""
+    import itertools
+
+    import numpy as np
+
+    from designer.check.figures import SECTION_BAND, circuit_band_of
+    from designer.core.eseries import TOLERANCE
+    from designer.plant.circuit import circuit_figures
+    from designer.plant.circuit_design import design_circuit_plant
+    from designer.plant.spec import PlantSpec
+    topology = REGISTRY[name]
+    ex = topology.example
+    res = design_circuit_plant(PlantSpec(fc_hz=ex.fn_hz, zeta=1 / (2 * ex.q), gain=ex.gain, opamp="TL072",
+                                         topology=name), simulate=False)
+    band = circuit_band_of(res)
+    assert set(band) == set(SECTION_BAND)
+    series = {"R": res.sourcing.r_series, "C": res.sourcing.c_series}
+    refs = topology.designators
+    grid = np.array(list(itertools.product((-1.0, 0.0, 1.0), repeat=len(refs))))
+    values = {r: res.values[r] * (1 + TOLERANCE[series[r[0]]] * grid[:, k]) for k, r in enumerate(refs)}
+    brute = {**circuit_figures(topology, values, res.opamp),
+             **{f"ideal_{f}": circuit_figures(topology, values)[f] for f in ("fn_hz", "zeta")}}
+    for fig in ("fn_hz", "zeta", "ideal_fn_hz", "ideal_zeta"):
+        lo, hi = band[fig]
+        assert lo == pytest.approx(brute[fig].min(), rel=1e-9) and hi == pytest.approx(brute[fig].max(), rel=1e-9)
+        assert lo < getattr(res, "figures")["opamp" if fig in ("fn_hz", "zeta") else "ideal"][
+            fig.replace("ideal_", "")] < hi
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("name", ["mfb-lowpass", "sallen-key-highpass"])
+def test_tolerance_on_a_section_passes_inside_and_fails_outside_its_limits(name, tmp_path):
+    """tolerance: [fn_hz] on a section: limits around the band pass (exit 0), limits inside it fail (exit 1)."""
+    from designer.check.figures import circuit_band_of
+    from designer.plant.circuit_design import design_circuit_plant
+    from designer.plant.spec import PlantSpec
+    topology = REGISTRY[name]
+    ex = topology.example
+    lo, hi = circuit_band_of(design_circuit_plant(PlantSpec(
+        fc_hz=ex.fn_hz, zeta=1 / (2 * ex.q), gain=ex.gain, opamp="TL072", topology=name), simulate=False))["fn_hz"]
+    base = spec_text(topology).replace("design_checks: all\n", "")
+    for (a, b), code in (((0.999 * lo, 1.001 * hi), 0), ((1.001 * lo, 0.999 * hi), 1)):
+        path = tmp_path / "spec.yaml"
+        path.write_text(base.replace("checks:\n", f"checks:\n  fn_hz: {{min: {a!r}, max: {b!r}}}\n")
+                        + "tolerance: [fn_hz]\n")
+        out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / f"out{code}"))
+        assert out.returncode == code, out.stdout + out.stderr
+        case = _cases(tmp_path / f"out{code}")["tolerance_fn_hz"]
+        assert case["status"] == ("pass" if code == 0 else "fail")
