@@ -138,8 +138,10 @@ def test_a_yield_on_a_section_counts_its_builds(tmp_path):
 
 
 @pytest.mark.parametrize("extra, words", [
-    ("yield: {min: 50%, engine: spice}\n", ["yield.engine", "analytic engine only"]),
-    ("tolerances: {GBW: 20%}\nyield: {min: 50%}\n", ["tolerances.GBW", "the op-amp's spread"]),
+    (lambda t: re.sub(r"  ideal_fn_hz: .*\n", "  rise_time_s: {max: 1m}\n", t) + "yield: {min: 50%, engine: spice}\n",
+     ["yield counts the builds inside checks:", "the spice engine computes", "not: rise_time_s"]),
+    ("tolerances: {SR: 20%}\nyield: {min: 50%, engine: spice}\n",
+     ["spec.yaml:9: tolerances.SR: topology mfb-lowpass's yield engines are linear", "GBW: spreads the op-amp"]),
     (lambda t: t.replace("checks:\n", "checks:\n  overshoot_pct: {max: 30}\n") + "tolerance: [overshoot_pct]\n",
      ["spec.yaml:10: tolerance: overshoot_pct has no tolerance band on topology mfb-lowpass", "allowed: fn_hz"]),
 ])
@@ -264,3 +266,40 @@ def test_tolerance_on_a_section_passes_inside_and_fails_outside_its_limits(name,
         assert out.returncode == code, out.stdout + out.stderr
         case = _cases(tmp_path / f"out{code}")["tolerance_fn_hz"]
         assert case["status"] == ("pass" if code == 0 else "fail")
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("name", ["mfb-lowpass", "sallen-key-highpass"])
+def test_a_section_s_yield_with_the_spice_engine_and_the_op_amp_s_spread(name, tmp_path):
+    """yield: {engine: spice} with tolerances: {GBW: 30%} on a section: each build's .ac in ngspice (its fitted
+    fn next to the op-amp-aware model with that build's parts and GBW: within 1 %, the engine's tested bound);
+    the yield the share of monte-carlo.csv's rows inside the check."""
+    import csv
+    import dataclasses
+
+    import numpy as np
+
+    from designer.core.opamps import get as get_opamp
+    from designer.plant.circuit import circuit_figures
+    topology = REGISTRY[name]
+    ex = topology.example
+    path = tmp_path / "spec.yaml"
+    path.write_text(spec_text(topology).replace("opamp: TL072", "opamp: LM741").replace(
+        "checks:\n", f"checks:\n  fn_hz: {{min: {0.98 * ex.fn_hz:g}, max: {1.02 * ex.fn_hz:g}}}\n")
+        + "tolerances: {R: 1%, C: 2%, GBW: 30%}\nyield: {min: 10%, samples: 30, seed: 7, engine: spice}\n")
+    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
+    assert out.returncode in (0, 1), out.stdout + out.stderr
+    d = json.loads(next((tmp_path / "out").rglob("reports/*/result.json")).read_text())
+    mc = d["monte_carlo"]
+    assert mc["settings"]["engine"] == "spice" and mc["settings"]["tolerances_pct"]["GBW"] == 30
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 30
+    amp = get_opamp("LM741")
+    fn = np.array([float(r["fn_hz"]) for r in rows])
+    model = np.array([float(circuit_figures(topology, {p: float(r[p]) for p in topology.designators},
+                                            dataclasses.replace(amp, gbw_hz=float(r["GBW"])))["fn_hz"]) for r in rows])
+    np.testing.assert_allclose(fn, model, rtol=0.01)
+    inside = (fn >= 0.98 * ex.fn_hz) & (fn <= 1.02 * ex.fn_hz)
+    assert mc["yield"]["fraction"] == pytest.approx(inside.mean())
+    assert _cases(tmp_path / "out")["yield"]["status"] == ("pass" if inside.mean() >= 0.1 else "fail")
