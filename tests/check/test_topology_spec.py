@@ -303,3 +303,24 @@ def test_a_section_s_yield_with_the_spice_engine_and_the_op_amp_s_spread(name, t
     inside = (fn >= 0.98 * ex.fn_hz) & (fn <= 1.02 * ex.fn_hz)
     assert mc["yield"]["fraction"] == pytest.approx(inside.mean())
     assert _cases(tmp_path / "out")["yield"]["status"] == ("pass" if inside.mean() >= 0.1 else "fail")
+
+
+@pytest.mark.spice
+def test_spice_agreement_against_the_ideal_model_on_a_section(tmp_path):
+    """against: ideal: the same square-wave run against the ideal-op-amp model (the library's nrms_ideal of the
+    same design), farther from SPICE than the op-amp-aware model."""
+    from designer.plant.circuit_design import default_square_hz, design_circuit_plant, with_square_test
+    from designer.plant.spec import PlantSpec
+    topology = REGISTRY["mfb-lowpass"]
+    ex = topology.example
+    path = tmp_path / "spec.yaml"
+    path.write_text(spec_text(topology) + "spice_agreement: {nrms_max: 1, against: ideal}\n")
+    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
+    assert out.returncode == 0, out.stdout + out.stderr
+    case = _cases(tmp_path / "out")["spice_agreement"]
+    assert "against the ideal model" in case["message"]
+    res = design_circuit_plant(PlantSpec(fc_hz=ex.fn_hz, zeta=1 / (2 * ex.q), gain=ex.gain, opamp="TL072",
+                                         alternatives=1, topology=topology.name), simulator="ngspice-cli")
+    with_square_test(res, 2.0, default_square_hz(res), "ngspice-cli")
+    assert case["value"] == pytest.approx(res.square.nrms_ideal, rel=1e-6)
+    assert res.square.nrms < res.square.nrms_ideal
