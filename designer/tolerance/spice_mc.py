@@ -334,6 +334,12 @@ def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, samp
     -------
     designer.tolerance.montecarlo.MonteCarlo
         The Monte Carlo.
+
+    Raises
+    ------
+    DesignError
+        An unknown engine; ``SR`` in ``tol_items`` (both engines are linear:
+        :func:`designer.tolerance.montecarlo.check_section_spread`).
     """
     from ..plant import circuit
     from . import spice_ac
