@@ -20,7 +20,7 @@ from __future__ import annotations
 import itertools
 from dataclasses import replace
 
-__all__ = ["ALIASES", "BAND", "PID", "PLANT", "band_of", "plant_figures"]
+__all__ = ["ALIASES", "BAND", "PID", "PLANT", "SECTION_BAND", "band_of", "circuit_band_of", "plant_figures"]
 
 STEP = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
 
@@ -91,6 +91,9 @@ ALIASES = {"fn_opamp_hz": "fn_hz", "zeta_opamp": "zeta"}
 #: op-amp and of the parts alone, and the step figures (see :func:`band_of`)
 BAND = ("fn_hz", "zeta", "ideal_fn_hz", "ideal_zeta", *ALIASES, "overshoot_pct", "peak_time_s", "rise_time_s",
         "settling_time_s")
+#: the band's figures on a plant of another topology (:func:`circuit_band_of`): fn and zeta, with the
+#: corner's op-amp and of the parts alone (its step figures are the models', SPICE's .ac has no step)
+SECTION_BAND = ("fn_hz", "zeta", "ideal_fn_hz", "ideal_zeta", *ALIASES)
 
 
 def unit_of(kind: str, figure: str) -> str:
@@ -130,8 +133,9 @@ def plant_figures(res) -> dict:
 def circuit_plant_figures(res) -> dict:
     """The :data:`PLANT` figures of a plant on another topology
     (:class:`~designer.plant.circuit_design.CircuitPlantResult`): fn, zeta, Q with the corner's
-    op-amp and of the parts alone, the gain, the errors and the models' step figures (None for
-    what it has not: its SPICE run is an .ac sweep, no step).
+    op-amp and of the parts alone, the gain, the errors and the models' step figures; ``nrms`` and
+    ``nrms_ideal`` are its square-wave test's (SPICE's ``.tran`` against the op-amp-aware and the ideal
+    model, when it ran); None for what it has not (SPICE's step figures: its .ac sweep has no step).
 
     Parameters
     ----------
@@ -146,7 +150,8 @@ def circuit_plant_figures(res) -> dict:
     i, o = res.figures["ideal"], res.figures["opamp"]
     out = {"fn_hz": o["fn_hz"], "zeta": o["zeta"], "q": o["q"], "ideal_fn_hz": i["fn_hz"], "ideal_zeta": i["zeta"],
            "ideal_q": i["q"], "gain": i["gain"], "fn_error_pct": o["fn_error_pct"],
-           "zeta_error_pct": o["zeta_error_pct"], "nrms": None, "nrms_ideal": None}
+           "zeta_error_pct": o["zeta_error_pct"], "nrms": None if res.square is None else res.square.nrms,
+           "nrms_ideal": None if res.square is None else res.square.nrms_ideal}
     out.update({alias: out[name] for alias, name in ALIASES.items()})
     for f in STEP:
         out[f"model_{f}"] = None if res.steps["opamp"] is None else res.steps["opamp"][f]
@@ -196,11 +201,48 @@ def band_of(res) -> dict:
     dict
         figure -> (lo, hi); (None, None) where no tolerance corner has the figure.
     """
+    if hasattr(res, "section"):
+        return circuit_band_of(res)
     t = res.tolerance
     out = {f: (getattr(t, f).lo, getattr(t, f).hi) for f in BAND if hasattr(t, f)}
     out["ideal_fn_hz"], out["ideal_zeta"] = out["fn_hz"], out["zeta"]
     out["fn_hz"], out["zeta"] = _opamp_band(res.built, res.opamp, t.r_tolerance_pct / 100, t.c_tolerance_pct / 100)
     out.update({alias: out[name] for alias, name in ALIASES.items()})
+    return out
+
+
+def circuit_band_of(res) -> dict:
+    """figure -> (lo, hi) of :data:`SECTION_BAND` for a plant on a registered section
+    (:class:`~designer.plant.circuit_design.CircuitPlantResult`): the worst case over the 2^n corners of
+    its n declared parts at +/- their tolerance (the series' own, :func:`designer.tolerance.parts.resolve`,
+    as ``--worst-case`` and the Monte Carlo take them), as the Sallen-Key plant's band is over its 16;
+    ``fn_hz``, ``zeta`` the op-amp-aware model's dominant pair with the corner's op-amp, ``ideal_*`` the
+    parts alone (:func:`designer.plant.circuit.circuit_figures`, vectorised over the corners).
+
+    Parameters
+    ----------
+    res : CircuitPlantResult
+        One corner's plant result.
+
+    Returns
+    -------
+    dict
+        figure -> (lo, hi); (None, None) where no corner has the figure (a first-order section's zeta).
+    """
+    import numpy as np
+
+    from ..plant import circuit
+    from ..tolerance.parts import resolve
+    s = res.sourcing
+    tol = resolve((), res.values, {"R": s.r_series, "C": s.c_series}).of
+    signs = np.array(list(itertools.product((-1.0, 1.0), repeat=len(tol))))
+    values = {r: res.values[r] * (1 + tol[r] * signs[:, k]) for k, r in enumerate(tol)}
+    figs = circuit.circuit_figures(res.section, values, res.opamp)
+    out = {}
+    for f in SECTION_BAND:
+        v = np.asarray(figs[ALIASES.get(f, f)], float)
+        v = v[np.isfinite(v)]
+        out[f] = (float(v.min()), float(v.max())) if v.size else (None, None)
     return out
 
 

@@ -124,10 +124,15 @@ def _simulate(spec: CheckSpec, index: int, simulator: str):
         res = run_filter(design, simulator)
         return res.figures, res, res.to_dict(), (None, {})
     if spec.kind == "plant" and hasattr(design, "topology") and design.topology != DEFAULT_TOPOLOGY:
-        from ..plant.circuit_design import analyze_circuit_spec, design_circuit_plant
+        from ..plant.circuit_design import (analyze_circuit_spec, default_square_hz, design_circuit_plant,
+                                            with_square_test)
         res = (analyze_circuit_spec if spec.analyze else design_circuit_plant)(design, simulate=True,
                                                                                 simulator=simulator)
-        return F.circuit_plant_figures(res), res, res.to_dict(), (None, {})
+        if res.square is None and (spec.agreement is not None or spec.golden is not None):
+            # the SPICE agreement and the golden waveforms are the square-wave test's, as the Sallen-Key plant's
+            with_square_test(res, design.amplitude_v, default_square_hz(res), simulator)
+        return F.circuit_plant_figures(res), res, res.to_dict(), (None, {}) if res.square is None else \
+            res.square.waves()
     if spec.kind == "plant":
         from ..plant.design import analyze_plant, design_plant
         res = (analyze_plant if spec.analyze else design_plant)(design, simulate=True, simulator=simulator)

@@ -150,11 +150,12 @@ def load_spec(path, update_golden: bool = False, root=None, allow_outside: bool 
     golden = read_golden(doc, kind, corners, update_golden)
     yield_spec = read_yield(doc, kind, checks)
     if kind == "plant" and getattr(designs[0], "topology", DEFAULT_TOPOLOGY) != DEFAULT_TOPOLOGY:
-        for key, given in (("spice_agreement", agreement), ("golden", golden), ("tolerance", tolerance)):
-            if given:
-                raise doc.error((key,), f"{key}: is the {DEFAULT_TOPOLOGY}'s for now; topology: "
-                                f"{designs[0].topology} checks checks:, design_checks: (its ngspice .ac "
-                                "agreement is the design check spice_agreement) and yield:")
+        other = [f for f in tolerance if f not in F.SECTION_BAND]
+        if other:
+            listed = doc.data["tolerance"]
+            keys = ("tolerance", listed.index(other[0])) if isinstance(listed, list) else ("tolerance",)
+            raise doc.error(keys, f"tolerance: {other[0]} has no tolerance band on topology {designs[0].topology} "
+                            f"(its SPICE run is an .ac sweep, no step); allowed: {', '.join(F.SECTION_BAND)}")
     if not (checks or design_checks or agreement or golden):
         raise doc.error((), "nothing to check: give checks:, design_checks:, spice_agreement: or golden:")
     return CheckSpec(doc.path, name, kind, corners, tuple(designs), analyze, checks, design_checks, agreement,

@@ -424,6 +424,8 @@ def _design_circuit(args, topo) -> int:
                      square_hz=args.square_freq, alternatives=args.alternatives, package=args.package,
                      topology=topo.name)
     _circuit_unsupported(args, topo)
+    from ..tolerance.montecarlo import check_section_spread
+    check_section_spread(args.tol)
     name = args.name if args.name is not None else (
         f"plant_{topo.name}_fc{spec.fc_hz:g}" + ("" if spec.zeta is None else f"_z{spec.zeta:g}")
         + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
@@ -441,9 +443,7 @@ def _design_circuit(args, topo) -> int:
 def _circuit_unsupported(args, topo, options=()) -> None:
     """The options the plant on another topology has not (yet): refused in one line."""
     unsupported = [f for f, v in (("--stimulus prbs", args.stimulus == "prbs"), ("--prbs-bits", args.prbs_bits),
-                                  ("--prbs-clock", args.prbs_clock), ("--replay", args.replay),
-                                  ("--tol GBW/SR", any(str(t).split("=")[0].strip().upper() in ("GBW", "SR")
-                                                       for t in args.tol or ())), *options)
+                                  ("--prbs-clock", args.prbs_clock), ("--replay", args.replay), *options)
                    if v]
     if unsupported:
         raise DesignError(f"{unsupported[0].split()[0]}: {unsupported[0]} is the {DEFAULT_TOPOLOGY}'s for now; "
@@ -458,6 +458,8 @@ def _analyze_circuit(args, topo) -> int:
         raise DesignError(f"--{named[0]} is the {DEFAULT_TOPOLOGY}'s; give {topo.name}'s parts as --part REF=VALUE "
                           f"({', '.join(topo.designators)})")
     _circuit_unsupported(args, topo)
+    from ..tolerance.montecarlo import check_section_spread
+    check_section_spread(args.tol)
     from ..plant.circuit_design import analyze_circuit_plant, built_name
     from ..plant.circuit_report import summary_text, write_outputs
     parts = part_values(args.part)
@@ -486,9 +488,10 @@ def _circuit_tolerance(result, args, mc, spice=("analytic", None, None)):
     --engine spice|both, --spice-samples: every build's .ac in ngspice)."""
     from ..plant import circuit
     from ..plant.circuit_design import tolerance_nominal
+    from ..tolerance.parts import opamp_nominal
     s = result.sourcing
     series = {"R": s.r_series, "C": s.c_series}
-    nominal = tolerance_nominal(result)
+    nominal = {**tolerance_nominal(result), **opamp_nominal(args.tol, result.opamp)}   # --tol GBW: the op-amp's
     context = (result.topology, result.opamp)
     if args.worst_case:
         from ..tolerance.parts import resolve

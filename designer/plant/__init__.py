@@ -16,7 +16,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                        "analyze_circuit_plant", "analyze_circuit_spec", "built_name", "check_circuit_parts",
                        "check_opamp_reach",
                        "design_circuit_plant", "tolerance_nominal", "SQUARE_NRMS_PASS", "SquareRun", "square_deck",
-                       "with_square_test"),
+                       "with_square_test", "default_square_hz"),
     "circuit": ("BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "candidate_set", "capacitor_combinations",
                 "circuit_figures", "corner_frequencies", "dominant_pairs", "evaluate", "opamp_tf", "plant_target",
                 "search", "step_of_pair"),

@@ -34,6 +34,8 @@ interpolation at roots of unity).
 
 from __future__ import annotations
 
+import dataclasses
+
 import itertools
 import math
 from dataclasses import dataclass
@@ -492,7 +494,8 @@ def evaluate(context: tuple, values: dict) -> dict:
     context : tuple
         (topology name, op-amp).
     values : dict
-        Designator -> array of sampled values.
+        Designator -> array of sampled values; ``GBW`` (Hz), when there, the op-amp's gain-bandwidth of
+        each build.
 
     Returns
     -------
@@ -501,6 +504,9 @@ def evaluate(context: tuple, values: dict) -> dict:
     """
     name, opamp = context
     topo = registry.get(name)
+    if "GBW" in values and opamp is not None and not opamp.ideal:
+        # the op-amp's spread (--tol GBW): one gain-bandwidth per build, on the batch axis of the nodal system
+        opamp = dataclasses.replace(opamp, gbw_hz=np.asarray(values["GBW"], float)[..., None])
     return circuit_figures(topo, {r: values[r] for r in topo.designators}, opamp)
 
 

@@ -45,7 +45,8 @@ from .result import METRICS, PLANT_SCHEMA_VERSION, Sourcing, Target
 
 __all__ = ["GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "CircuitAnalysisSpec", "CircuitPlantResult", "design_circuit_plant",
            "check_opamp_reach", "analyze_circuit_plant", "analyze_circuit_spec", "check_circuit_parts",
-           "tolerance_nominal", "built_name", "SQUARE_NRMS_PASS", "SquareRun", "square_deck", "with_square_test"]
+           "tolerance_nominal", "built_name", "SQUARE_NRMS_PASS", "SquareRun", "square_deck", "with_square_test",
+           "default_square_hz"]
 
 #: the op-amp's gain-bandwidth a section needs, in units of fn x Q x noise gain
 GBW_MARGIN = 10.0
@@ -455,6 +456,10 @@ class CircuitAnalysisSpec:
         Where the parts come from (None: the smallest series holding each value).
     package : str, optional
         The op-amp package of the wiring.
+    amplitude_v : float or str
+        The square wave's high level (V).
+    square_hz : float or str, optional
+        The square-wave bench test's frequency (None: no square-wave test).
     """
 
     topology: str
@@ -465,12 +470,17 @@ class CircuitAnalysisSpec:
     r_series: str | None = None
     c_series: str | None = None
     package: str | None = None
+    amplitude_v: object = 2.0
+    square_hz: object = None
 
     def __post_init__(self):
         topo = registry.get(self.topology)
         check_circuit_parts(topo, self.values)
         _analysis_target(topo, self.target_fc_hz, self.target_zeta)
         opamps.get(self.opamp)
+        parse_in_range(self.amplitude_v, "amplitude_v", "amplitude_v")
+        if self.square_hz is not None:
+            parse_in_range(self.square_hz, "square_hz", "square_hz")
 
 
 def analyze_circuit_spec(spec: CircuitAnalysisSpec, simulate: bool = True,
@@ -492,7 +502,8 @@ def analyze_circuit_spec(spec: CircuitAnalysisSpec, simulate: bool = True,
         The typed result (``mode`` "analyze").
     """
     return analyze_circuit_plant(spec.topology, spec.values, spec.opamp, spec.target_fc_hz, spec.target_zeta,
-                                 spec.r_series, spec.c_series, spec.package, simulate=simulate, simulator=simulator)
+                                 spec.r_series, spec.c_series, spec.package, simulate=simulate, simulator=simulator,
+                                 amplitude_v=spec.amplitude_v, square_hz=spec.square_hz)
 
 
 def _analyse(topo, mode: str, target: Target, values: dict, ideal, ranked: list, sourcing: Sourcing, amp, notes: list,
@@ -545,6 +556,10 @@ class SquareRun:
         Its absolute tolerance.
     simulator : str
         The backend.
+    y_ideal : numpy.ndarray, optional
+        The ideal-op-amp model's output on ``t`` (check-design's ``analytic_v``).
+    nrms_ideal : float, optional
+        The NRMS of SPICE against the ideal model (check-design's ``nrms_ideal``).
     """
 
     test: object
@@ -556,6 +571,20 @@ class SquareRun:
     nrms: float
     abstol_v: float
     simulator: str
+    y_ideal: np.ndarray | None = None
+    nrms_ideal: float | None = None
+
+    def waves(self) -> tuple:
+        """(t, {signal: samples}): the run under the Sallen-Key plant's signal names (check-design's
+        golden waveforms): ``input_v``, ``output_v`` (SPICE), ``analytic_opamp_v``, ``analytic_v``.
+
+        Returns
+        -------
+        tuple
+            (times in s, signal name -> samples on them).
+        """
+        return self.t, {"input_v": self.u, "output_v": self.y_spice, "analytic_v": self.y_ideal,
+                        "analytic_opamp_v": self.y_model}
 
     @property
     def check(self) -> Check:
@@ -645,8 +674,6 @@ def with_square_test(result: CircuitPlantResult, amplitude_v: float, frequency_h
     CircuitPlantResult
         ``result``.
     """
-    import scipy.signal as sig
-
     from ..core.compare import nrms, resample
     from ..spice.deck import SquareTest
     from ..spice.simulate import get_simulator
@@ -663,28 +690,60 @@ def with_square_test(result: CircuitPlantResult, amplitude_v: float, frequency_h
     # the edges' corners on the grid, where SPICE's PULSE turns
     t = np.union1d(np.linspace(0.0, test.stop_s, SQUARE_POINTS), corners)
     u = np.interp(t, corners, [0.0, 0.0, amplitude_v, amplitude_v, 0.0, 0.0])
-    num, den = circuit.opamp_tf(topo, result.values, amp)
-    # leading numerator terms that are rounding (|c_k wn^k| at 1e-12 of the largest term) go: a high-pass's
-    # numerator is of lower degree than its denominator, and scipy would warn of them
-    w = 2 * math.pi * fn
-    size = np.abs(num) * w ** np.arange(num.size - 1, -1, -1.0)
-    num = num[int(np.argmax(size > 1e-12 * size.max())):]
-    # the model's response: the two edges as steps at their middles (an edge is 1/100 of the time scale or
-    # less), by superposition of the step response s: y = A (s(t - d - e/2) - s(t - d - e/2 - half))
     tau = np.linspace(0.0, test.stop_s, SQUARE_POINTS)
-    step = sig.step((num, den), T=tau)[1]
-    s_at = lambda x: np.where(x > 0, np.interp(x, tau, step), 0.0)  # noqa: E731
-    y_model = amplitude_v * (s_at(t - d - e / 2) - s_at(t - d - e / 2 - half))
+    y_model, y_ideal = (_square_response(num, den, fn, amplitude_v, test, t, tau) for num, den in
+                        (circuit.opamp_tf(topo, result.values, amp), topo.coefficients(result.values)))
     y_spice = resample(res["time"], np.real(res["v(vout)"]), t)
     abstol = 0.01 * abs(result.figures["ideal"]["gain"] * amplitude_v)
     fit = nrms(y_model, y_spice, abstol, t=t)
-    result.square = SquareRun(test, deck, t, u, y_spice, y_model, fit, abstol, get_simulator(simulator).name)
+    result.square = SquareRun(test, deck, t, u, y_spice, y_model, fit, abstol, get_simulator(simulator).name,
+                              y_ideal, nrms(y_ideal, y_spice, abstol, t=t))
     result.checks = [*result.checks, result.square.check]
     if not result.square.check.ok:
         result.notes.append(f"under the square wave SPICE differs from the linear model (NRMS {fit:.3g}): an "
                             f"output that jumps at the edges (a high-pass's) is slew-limited by the {amp.name}'s "
                             f"{amp.slew_v_per_s / 1e6:.3g} V/us; a lower --amplitude or a faster op-amp follows it")
     return result
+
+
+def _square_response(num, den, fn: float, amplitude_v: float, test, t, tau):
+    """A model's output under the square wave ``test`` on ``t`` (its step response computed on ``tau``)."""
+    import scipy.signal as sig
+    num, den = np.asarray(num, float), np.asarray(den, float)
+    # leading numerator terms that are rounding (|c_k wn^k| at 1e-12 of the largest term) go: a high-pass's
+    # numerator is of lower degree than its denominator, and scipy would warn of them
+    w = 2 * math.pi * fn
+    size = np.abs(num) * w ** np.arange(num.size - 1, -1, -1.0)
+    num = num[int(np.argmax(size > 1e-12 * size.max())):]
+    # the two edges as steps at their middles (an edge is 1/100 of the time scale or less), by superposition
+    # of the step response s: y = A (s(t - d - e/2) - s(t - d - e/2 - half))
+    e, d, half = test.edge_s, test.delay_s, test.half_period_s
+    step = sig.step((num, den), T=tau)[1]
+    s_at = lambda x: np.where(x > 0, np.interp(x, tau, step), 0.0)  # noqa: E731
+    return amplitude_v * (s_at(t - d - e / 2) - s_at(t - d - e / 2 - half))
+
+
+def default_square_hz(result: CircuitPlantResult) -> float:
+    """The square-wave test's frequency when none is given (check-design's ``spice_agreement`` and
+    ``golden`` on a section): the Sallen-Key plant's rule (:func:`designer.plant.bench.recommend_square_wave`:
+    a half period of 1.5 settling times) with the 2 % settling time of the op-amp-aware model's slowest
+    pole, ln(50) / sigma (sigma its decay rate: the envelope exp(-sigma t) falls to 2 %; 4 / (zeta wn) for a
+    dominant pair, Ogata, *Modern Control Engineering*, 5th ed., section 5-3).
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design.
+
+    Returns
+    -------
+    float
+        The frequency (Hz).
+    """
+    from .bench import recommend_square_wave
+    den = np.asarray(circuit.opamp_tf(result.section, result.values, result.opamp)[1], float)
+    sigma = float(np.min(np.abs(np.roots(den).real)))
+    return recommend_square_wave(math.log(50) / sigma, 1.0).frequency_hz
 
 
 def tolerance_nominal(result: CircuitPlantResult) -> dict:

@@ -23,8 +23,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                "optimize_yield", "series_of", "spice_context", "stage_responses",),
     "loop": ("LIMITABLE", "LoopContext", "STEP_POINTS", "kick_grid", "loop_figures", "loop_monte_carlo",
              "loop_parts", "loop_series", "loop_worst_case", "parse_loop_limit",),
-    "montecarlo": ("MAX_SAMPLES", "MAX_TARGET_CI", "MIN_SAMPLES", "MonteCarlo", "NO_SLEW", "TARGET_ROUND",
-                   "apply_engine", "check_target_ci", "parse_target_ci", "plant_monte_carlo", "plant_parts",
+    "montecarlo": ("MAX_SAMPLES", "MAX_TARGET_CI", "MIN_SAMPLES", "MonteCarlo", "NO_SLEW", "NO_SLEW_SECTION", "TARGET_ROUND",
+                   "apply_engine", "check_section_spread", "check_target_ci", "parse_target_ci", "plant_monte_carlo", "plant_parts",
                    "plant_worst_case",),
     "parts": ("DISTRIBUTIONS", "MAX_TOL", "check_items", "opamp_nominal", "parse_tolerance", "resolve",),
     "plant": ("plant_figures",),
@@ -38,5 +38,5 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                  "spice_samples",),
     "stats": ("Limit", "Z95", "figure_stats", "variance_shares", "wilson",),
     "worstcase": ("WorstCase", "worst_case",),
-    "yields": ("ENGINES", "FILTER", "LOOP", "PLANT", "TABLES", "counted", "spec_yield",),
+    "yields": ("ENGINES", "FILTER", "LOOP", "PLANT", "SECTION", "TABLES", "counted", "spec_yield",),
 })

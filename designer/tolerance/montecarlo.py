@@ -18,7 +18,8 @@ from . import runner, sampling
 from .parts import DISTRIBUTIONS, opamp_nominal, resolve
 from .stats import Limit, failing_samples, figure_stats, parse_limit, samples_csv, variance_shares, wilson
 
-__all__ = ["MAX_SAMPLES", "MAX_TARGET_CI", "MIN_SAMPLES", "MonteCarlo", "NO_SLEW", "TARGET_ROUND", "apply_engine",
+__all__ = ["MAX_SAMPLES", "MAX_TARGET_CI", "MIN_SAMPLES", "MonteCarlo", "NO_SLEW", "NO_SLEW_SECTION",
+           "check_section_spread", "TARGET_ROUND", "apply_engine",
            "check_target_ci", "parse_target_ci", "plant_monte_carlo", "plant_parts", "plant_worst_case"]
 
 #: the number of samples allowed
@@ -32,6 +33,27 @@ MAX_TARGET_CI = 0.5
 #: --tol SR on the analytic plant engine (a linear model: nothing in it slews)
 NO_SLEW = ("--tol SR: the plant's analytic model is linear, no figure of it depends on the slew rate; spread SR "
            "with --engine spice or both (ngspice's op-amp slews)")
+#: --tol SR on a plant of another topology: both its engines are linear
+NO_SLEW_SECTION = ("--tol SR: a section plant's engines are linear (its analytic model, and ngspice's .ac sweep: "
+                   "small signal), no figure of them depends on the slew rate; drop SR from --tol (GBW=.. spreads "
+                   "the op-amp)")
+
+
+def check_section_spread(tol_items) -> None:
+    """Refuse ``--tol SR`` on a plant of another topology (:data:`NO_SLEW_SECTION`), before any work.
+
+    Parameters
+    ----------
+    tol_items : sequence of str
+        The ``--tol`` items.
+
+    Raises
+    ------
+    DesignError
+        One line, ``param`` "SR".
+    """
+    if any(str(t).split("=")[0].strip().upper() == "SR" for t in tol_items or ()):
+        raise DesignError(NO_SLEW_SECTION, param="SR")
 
 
 @dataclass

@@ -5,7 +5,9 @@ per ngspice process, as the Sallen-Key plant's engine does (:mod:`.spice_engine`
 The section's ``.ac`` deck (:func:`designer.filters.deck.ac_deck`, the one the
 plant's SPICE check runs) is loaded once without its analysis; a loop of control
 commands then, per build, ``alter``\\ s each part of the section by its designator
-(``R3`` -> element ``r3``: the deck's parts are the topology's netlist), runs
+(``R3`` -> element ``r3``: the deck's parts are the topology's netlist; a drawn ``GBW``, the
+op-amp's gain-bandwidth, alters every op-amp's integrating capacitor to A0/(2 pi GBW RINT), as the
+Sallen-Key plant's engine does, :func:`designer.tolerance.spice_engine.opamp_commands`), runs
 ``ac dec`` :data:`POINTS_PER_DECADE` over fn / :data:`SPAN` .. fn x :data:`SPAN`
 (fn the nominal build's), and ``echo``\\ es the sweep's frequencies (ngspice spreads
 its points evenly in log f between the two ends) and the real and imaginary parts of v(vout).
@@ -67,6 +69,10 @@ class AcContext:
         The power of s of its numerator (m in the module docstring).
     simulator : str
         The backend's name.
+    cints : tuple
+        The op-amps' integrating capacitors (``c.xu1.cint``; empty with the ideal op-amp).
+    a0, rint, gbw_hz : float
+        The op-amp model's DC gain, integrating resistor (ohm) and nominal gain-bandwidth (Hz).
     """
 
     circuit: str
@@ -76,9 +82,14 @@ class AcContext:
     order: int
     zeros: int
     simulator: str = "ngspice-cli"
+    cints: tuple = ()
+    a0: float = 0.0
+    rint: float = 0.0
+    gbw_hz: float = 0.0
 
 
-def context(deck: str, netlist, topology, values: dict, fn_hz: float, simulator: str = "ngspice-cli") -> AcContext:
+def context(deck: str, netlist, topology, values: dict, fn_hz: float, simulator: str = "ngspice-cli",
+            opamp=None) -> AcContext:
     """The :class:`AcContext` of a section plant's deck.
 
     Parameters
@@ -95,6 +106,8 @@ def context(deck: str, netlist, topology, values: dict, fn_hz: float, simulator:
         The sweep's centre.
     simulator : str
         The backend.
+    opamp : designer.core.opamps.OpAmp, optional
+        The deck's op-amp, whose gain-bandwidth a build may vary (None or the ideal one: not).
 
     Returns
     -------
@@ -102,14 +115,17 @@ def context(deck: str, netlist, topology, values: dict, fn_hz: float, simulator:
         The context.
     """
     from ..spice.simulate import get_simulator
+    from .spice_engine import deck_rint
     keep = [ln for ln in deck.splitlines() if not re.match(r"\s*\.(ac|end)\b", ln, re.I)]
     num = np.atleast_1d(np.asarray(topology.coefficients(values)[0], float))
     scale = np.max(np.abs(num))
     zeros = 0
     while zeros < num.size - 1 and abs(num[num.size - 1 - zeros]) <= 1e-12 * scale:
         zeros += 1
+    amp = () if opamp is None or opamp.ideal else (tuple(f"c.x{a.ref.lower()}.cint" for a in netlist.amps),
+                                                   opamp.a0, deck_rint(deck), opamp.gbw_hz)
     return AcContext("\n".join(keep) + "\n.end\n", tuple((p.ref, p.ref.lower()) for p in netlist.parts),
-                     fn_hz / SPAN, fn_hz * SPAN, topology.order, zeros, get_simulator(simulator).name)
+                     fn_hz / SPAN, fn_hz * SPAN, topology.order, zeros, get_simulator(simulator).name, *amp)
 
 
 def commands(ctx: AcContext, values: dict, start: int = 0) -> list:
@@ -130,15 +146,18 @@ def commands(ctx: AcContext, values: dict, start: int = 0) -> list:
     list of str
         The commands.
     """
+    from .spice_engine import opamp_commands
     n = len(next(iter(values.values())))
     elem = dict(ctx.elements)
-    unknown = [d for d in values if d not in elem]
+    unknown = [d for d in values if d not in elem and not (d == "GBW" and ctx.cints)]
     if unknown:
         raise ValueError(f"the section's deck has no part {unknown[0]}")
     sweep = f"ac dec {POINTS_PER_DECADE} {ctx.f_lo_hz:.12g} {ctx.f_hi_hz:.12g}"
     out = []
     for i in range(n):
-        out += [f"alter {elem[d]} = {float(v[i]):.12g}" for d, v in values.items()]
+        if "GBW" in values:   # the slew rate is no .ac's business: only the integrating capacitors move
+            out += opamp_commands({"GBW": values["GBW"]}, i, ctx.cints, ctx.a0, ctx.rint, ctx.gbw_hz, 0.0)
+        out += [f"alter {elem[d]} = {float(v[i]):.12g}" for d, v in values.items() if d != "GBW"]
         out += [sweep, f"echo MCROW {start + i}", "let mcf = real(frequency)", "let mcre = real(v(vout))",
                 "let mcim = imag(v(vout))", "echo MCF $&mcf", "echo MCRE $&mcre", "echo MCIM $&mcim", "destroy all"]
     return out
@@ -264,7 +283,7 @@ def section_chunk(ctx: AcContext, model: tuple, values: dict, start: int = 0) ->
         Figure -> array over the builds.
     """
     from ..plant.circuit import evaluate as analytic, step_of_pair
-    parts = {r: v for r, v in values.items() if r in dict(ctx.elements)}
+    parts = {r: v for r, v in values.items() if r in dict(ctx.elements) or (r == "GBW" and ctx.cints)}
     sp = evaluate(ctx, parts, start)
     return {**analytic(model, values), **sp, **step_of_pair(sp["fn_hz"], sp["zeta"])}
 

@@ -334,12 +334,19 @@ def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, samp
     -------
     designer.tolerance.montecarlo.MonteCarlo
         The Monte Carlo.
+
+    Raises
+    ------
+    DesignError
+        An unknown engine; ``SR`` in ``tol_items`` (both engines are linear:
+        :func:`designer.tolerance.montecarlo.check_section_spread`).
     """
     from ..plant import circuit
     from . import spice_ac
-    from .montecarlo import plant_monte_carlo
+    from .montecarlo import check_section_spread, plant_monte_carlo
     if engine not in ENGINES:
         raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
+    check_section_spread(tol_items)
     model = (result.topology, result.opamp)
     nominal = dict(result.values)
     draw = lambda **kw: plant_monte_carlo(None, series, result.opamp, n, seed, sampler, dist,  # noqa: E731
@@ -348,7 +355,7 @@ def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, samp
     if engine == "analytic":
         return draw()
     ctx = spice_ac.context(result.deck, result.netlist, result.section, nominal, result.figures["ideal"]["fn_hz"],
-                           simulator)
+                           simulator, result.opamp)
     settings = {"engine": engine, "simulator": ctx.simulator, "sweep_hz": [ctx.f_lo_hz, ctx.f_hi_hz],
                 "points_per_decade": spice_ac.POINTS_PER_DECADE,
                 "fn_zeta": "the section's form fitted to the simulated .ac response over the sweep (Levy's least "

@@ -28,7 +28,7 @@ from ..core.units import format_eng
 from .loop import LIMITABLE, STANDS_IN
 from .stats import Limit
 
-__all__ = ["ENGINES", "FILTER", "LOOP", "PLANT", "TABLES", "counted", "spec_yield"]
+__all__ = ["ENGINES", "FILTER", "LOOP", "PLANT", "SECTION", "TABLES", "counted", "spec_yield"]
 
 #: check-design's plant figure -> the analytic plant engine's (designer.tolerance.plant.FIGURES)
 PLANT = {**{f: f for f in ("fn_hz", "zeta", "q", "ideal_fn_hz", "ideal_zeta", "ideal_q", "gain", "overshoot_pct",
@@ -47,7 +47,12 @@ SPICE_STEP = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
 PLANT_SPICE = {**PLANT, **{f: f"spice_{f}" for f in SPICE_STEP}}
 #: check-design's loop figure -> the SPICE engine's (the analytic loop's besides SPICE's ``spice_*``)
 LOOP_SPICE = {**{f: f for f in LIMITABLE}, **{f: f"spice_{f}" for f in SPICE_STEP}}
-TABLES = {"analytic": BY_KIND, "spice": {"plant": PLANT_SPICE, "pid": LOOP_SPICE}}
+#: the table key of a plant on another topology than the Sallen-Key low-pass: the analytic engine's figures
+#: (:func:`designer.plant.circuit.evaluate`) under both engines; with the SPICE engine fn_hz, zeta, q and gain
+#: are fitted to each build's ngspice .ac and the step figures follow from the fitted pair
+#: (:func:`designer.tolerance.spice_ac.section_chunk`): its SPICE run has no step to measure
+SECTION = "section"
+TABLES = {"analytic": {**BY_KIND, SECTION: PLANT}, "spice": {"plant": PLANT_SPICE, "pid": LOOP_SPICE, SECTION: PLANT}}
 #: the engines a spec's yield may use
 ENGINES = ("analytic", "spice")
 
@@ -59,7 +64,7 @@ def counted(kind: str, checks, engine: str = "analytic") -> tuple:
     Parameters
     ----------
     kind : str
-        ``plant``, ``pid`` or ``filter``.
+        ``plant``, ``pid``, ``filter`` or :data:`SECTION` (a plant on another topology).
     checks : sequence of designer.check.limits.Limit
         The spec's checks.
     engine : str
@@ -178,21 +183,32 @@ def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int,
     """
     from .loop import loop_monte_carlo, loop_series
     from .montecarlo import plant_monte_carlo
-    use, skipped = counted(kind, checks, engine)
-    table = TABLES[engine][kind]
+    section = kind == "plant" and hasattr(res, "section")
+    use, skipped = counted(SECTION if section else kind, checks, engine)
+    table = TABLES[engine][SECTION if section else kind]
     limits = tuple(Limit(table[c.figure], c.min, c.max) for c in use)
     names = {table[c.figure]: c.figure for c in use}
     if kind == "filter":   # a FilterRun of check-design: its design and the spec's mask
         from .filter import filter_spec_yield
         mc = filter_spec_yield(res.design, res.case.mask, limits, samples, seed, tol_items, sampler, dist)
         return YieldVerdict(mc, required, names, skipped)
-    if kind == "plant" and hasattr(res, "section"):
-        # a plant on a registered section: its analytic engine over the declared parts
+    if section:
+        # a plant on a registered section: its analytic engine over the declared parts (and GBW), or every
+        # build's .ac in ngspice (designer.tolerance.spice_ac)
         from ..plant import circuit
+        from .montecarlo import check_section_spread
+        check_section_spread(tol_items)
         s = res.sourcing
+        model = (res.topology, res.opamp)
+        evaluate = None
+        if engine == "spice":
+            from . import spice_ac
+            evaluate = spice_ac.section_evaluate(spice_ac.context(
+                res.deck, res.netlist, res.section, dict(res.values), res.figures["ideal"]["fn_hz"], simulator,
+                res.opamp), model)
         mc = plant_monte_carlo(None, {"R": s.r_series, "C": s.c_series}, res.opamp, samples, seed, sampler, dist,
-                               tol_items, limits, tighten=False,
-                               circuit=(dict(res.values), circuit.evaluate, (res.topology, res.opamp)))
+                               tol_items, limits, tighten=False, engine_name=engine, evaluate=evaluate,
+                               circuit=(dict(res.values), circuit.evaluate, model))
     elif kind == "plant":
         s = res.sourcing
         evaluate = None

@@ -138,16 +138,189 @@ def test_a_yield_on_a_section_counts_its_builds(tmp_path):
 
 
 @pytest.mark.parametrize("extra, words", [
-    ("yield: {min: 50%, engine: spice}\n", ["yield.engine", "analytic engine only"]),
-    ("tolerances: {GBW: 20%}\nyield: {min: 50%}\n", ["tolerances.GBW", "the op-amp's spread"]),
-    ("tolerance: [ideal_fn_hz]\n", ["tolerance: is the sallen-key-lowpass's for now", "and yield:"]),
+    (lambda t: re.sub(r"  ideal_fn_hz: .*\n", "  rise_time_s: {max: 1m}\n", t) + "yield: {min: 50%, engine: spice}\n",
+     ["yield counts the builds inside checks:", "the spice engine computes", "not: rise_time_s"]),
+    ("tolerances: {SR: 20%}\nyield: {min: 50%, engine: spice}\n",
+     ["spec.yaml:9: tolerances.SR: topology mfb-lowpass's yield engines are linear", "GBW: spreads the op-amp"]),
+    (lambda t: t.replace("checks:\n", "checks:\n  overshoot_pct: {max: 30}\n") + "tolerance: [overshoot_pct]\n",
+     ["spec.yaml:10: tolerance: overshoot_pct has no tolerance band on topology mfb-lowpass", "allowed: fn_hz"]),
 ])
 def test_what_a_section_s_yield_has_not_is_one_line_at_its_key(extra, words, tmp_path):
     path = tmp_path / "spec.yaml"
-    path.write_text(spec_text(REGISTRY["mfb-lowpass"]) + extra)
+    text = spec_text(REGISTRY["mfb-lowpass"])
+    path.write_text(extra(text) if callable(extra) else text + extra)
     out = check(path)
     assert out.returncode == 2, out.stdout + out.stderr
     line = out.stderr.strip()
     assert "\n" not in line and "spec.yaml:" in line
     for w in words:
         assert w in line, (w, line)
+
+
+def _cases(out_dir) -> dict:
+    """case id -> case, of the one spec under ``out_dir``."""
+    d = json.loads(next(out_dir.glob("*/result.json")).read_text())
+    return {c["id"]: c for corner in d["corners"] for c in corner["cases"]}
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_spice_agreement_on_a_section_is_its_square_wave_test(topology, tmp_path):
+    """spice_agreement: on every registered section: SPICE's .tran under the square wave against the
+    op-amp-aware model, as the Sallen-Key plant's; the case's nrms recomputed from the run's waveforms.csv."""
+    import numpy as np
+
+    from designer.core.compare import nrms
+    path = tmp_path / "spec.yaml"
+    path.write_text(spec_text(topology) + "stimulus: {amplitude: 0.5}\nspice_agreement: {nrms_max: 1}\n")
+    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
+    assert out.returncode == 0, out.stdout + out.stderr
+    case = _cases(tmp_path / "out")["spice_agreement"]
+    assert case["status"] == "pass" and "against the op-amp-aware model" in case["message"]
+    d = json.loads(next((tmp_path / "out").rglob("reports/*/result.json")).read_text())
+    wave = np.genfromtxt(next((tmp_path / "out").rglob("reports/*/waveforms.csv")), delimiter=",", names=True)
+    sq = d["square_test"]
+    assert sq["abstol_v"] == pytest.approx(0.01 * 0.5 * abs(d["built"]["ideal"]["gain"]))
+    again = nrms(wave["model_v"], wave["spice_v"], sq["abstol_v"], t=wave["time_s"])
+    assert case["value"] == pytest.approx(sq["nrms"], rel=1e-12)
+    assert case["value"] == pytest.approx(again, rel=1e-3, abs=1e-6)
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("name", ["mfb-lowpass", "sallen-key-highpass"])
+def test_a_section_s_golden_records_then_compares_and_a_changed_part_fails(name, tmp_path):
+    """golden: on a section as built: --update-golden records the square-wave run's signals (the
+    Sallen-Key plant's names); the same parts compare (exit 0); one part 10 % off fails (exit 1)."""
+    topology = REGISTRY[name]
+    values = topology.synthesize(topology.example)
+    signals = "[output_v, input_v, analytic_v, analytic_opamp_v]"
+    golden = f"golden: {{file: 'gold-{{corner}}.csv', signals: {signals}}}\n"
+    path = tmp_path / "spec.yaml"
+    path.write_text(parts_text(topology, values) + golden)
+    rec = check(path, "--simulator", "ngspice-cli", "--update-golden")
+    assert rec.returncode == 0, rec.stdout + rec.stderr
+    header = (tmp_path / "gold-TL072.csv").read_text().splitlines()
+    assert "time_s,output_v,input_v,analytic_v,analytic_opamp_v" in header
+    same = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "same"))
+    assert same.returncode == 0, same.stdout + same.stderr
+    assert all(_cases(tmp_path / "same")[f"golden_{s}"]["status"] == "pass" for s in ("output_v", "analytic_v"))
+    first = topology.designators[0]
+    path.write_text(parts_text(topology, {**values, first: 1.1 * values[first]}) + golden)
+    changed = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "changed"))
+    assert changed.returncode == 1, changed.stdout + changed.stderr
+    cases = _cases(tmp_path / "changed")
+    assert cases["golden_output_v"]["status"] == "fail" and cases["golden_input_v"]["status"] == "pass"
+    assert list((tmp_path / "changed").rglob("golden-TL072-output_v.png"))
+
+
+@pytest.mark.parametrize("name", ["mfb-lowpass", "sallen-key-highpass"])
+def test_a_section_s_tolerance_band_is_the_worst_over_its_declared_parts(name):
+    """circuit_band_of: the band over every declared part at +/- its series tolerance; brute force on a
+    3-level grid of each part (-tol, 0, +tol: 3^n builds, the corners among them) lands inside it and
+    reaches both ends."""
+    import itertools
+
+    import numpy as np
+
+    from designer.check.figures import SECTION_BAND, circuit_band_of
+    from designer.core.eseries import TOLERANCE
+    from designer.plant.circuit import circuit_figures
+    from designer.plant.circuit_design import design_circuit_plant
+    from designer.plant.spec import PlantSpec
+    topology = REGISTRY[name]
+    ex = topology.example
+    res = design_circuit_plant(PlantSpec(fc_hz=ex.fn_hz, zeta=1 / (2 * ex.q), gain=ex.gain, opamp="TL072",
+                                         topology=name), simulate=False)
+    band = circuit_band_of(res)
+    assert set(band) == set(SECTION_BAND)
+    series = {"R": res.sourcing.r_series, "C": res.sourcing.c_series}
+    refs = topology.designators
+    grid = np.array(list(itertools.product((-1.0, 0.0, 1.0), repeat=len(refs))))
+    values = {r: res.values[r] * (1 + TOLERANCE[series[r[0]]] * grid[:, k]) for k, r in enumerate(refs)}
+    brute = {**circuit_figures(topology, values, res.opamp),
+             **{f"ideal_{f}": circuit_figures(topology, values)[f] for f in ("fn_hz", "zeta")}}
+    for fig in ("fn_hz", "zeta", "ideal_fn_hz", "ideal_zeta"):
+        lo, hi = band[fig]
+        assert lo == pytest.approx(brute[fig].min(), rel=1e-9) and hi == pytest.approx(brute[fig].max(), rel=1e-9)
+        assert lo < getattr(res, "figures")["opamp" if fig in ("fn_hz", "zeta") else "ideal"][
+            fig.replace("ideal_", "")] < hi
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("name", ["mfb-lowpass", "sallen-key-highpass"])
+def test_tolerance_on_a_section_passes_inside_and_fails_outside_its_limits(name, tmp_path):
+    """tolerance: [fn_hz] on a section: limits around the band pass (exit 0), limits inside it fail (exit 1)."""
+    from designer.check.figures import circuit_band_of
+    from designer.plant.circuit_design import design_circuit_plant
+    from designer.plant.spec import PlantSpec
+    topology = REGISTRY[name]
+    ex = topology.example
+    lo, hi = circuit_band_of(design_circuit_plant(PlantSpec(
+        fc_hz=ex.fn_hz, zeta=1 / (2 * ex.q), gain=ex.gain, opamp="TL072", topology=name), simulate=False))["fn_hz"]
+    base = spec_text(topology).replace("design_checks: all\n", "")
+    for (a, b), code in (((0.999 * lo, 1.001 * hi), 0), ((1.001 * lo, 0.999 * hi), 1)):
+        path = tmp_path / "spec.yaml"
+        path.write_text(base.replace("checks:\n", f"checks:\n  fn_hz: {{min: {a!r}, max: {b!r}}}\n")
+                        + "tolerance: [fn_hz]\n")
+        out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / f"out{code}"))
+        assert out.returncode == code, out.stdout + out.stderr
+        case = _cases(tmp_path / f"out{code}")["tolerance_fn_hz"]
+        assert case["status"] == ("pass" if code == 0 else "fail")
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("name", ["mfb-lowpass", "sallen-key-highpass"])
+def test_a_section_s_yield_with_the_spice_engine_and_the_op_amp_s_spread(name, tmp_path):
+    """yield: {engine: spice} with tolerances: {GBW: 30%} on a section: each build's .ac in ngspice (its fitted
+    fn next to the op-amp-aware model with that build's parts and GBW: within 1 %, the engine's tested bound);
+    the yield the share of monte-carlo.csv's rows inside the check."""
+    import csv
+    import dataclasses
+
+    import numpy as np
+
+    from designer.core.opamps import get as get_opamp
+    from designer.plant.circuit import circuit_figures
+    topology = REGISTRY[name]
+    ex = topology.example
+    path = tmp_path / "spec.yaml"
+    path.write_text(spec_text(topology).replace("opamp: TL072", "opamp: LM741").replace(
+        "checks:\n", f"checks:\n  fn_hz: {{min: {0.98 * ex.fn_hz:g}, max: {1.02 * ex.fn_hz:g}}}\n")
+        + "tolerances: {R: 1%, C: 2%, GBW: 30%}\nyield: {min: 10%, samples: 30, seed: 7, engine: spice}\n")
+    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
+    assert out.returncode in (0, 1), out.stdout + out.stderr
+    d = json.loads(next((tmp_path / "out").rglob("reports/*/result.json")).read_text())
+    mc = d["monte_carlo"]
+    assert mc["settings"]["engine"] == "spice" and mc["settings"]["tolerances_pct"]["GBW"] == 30
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 30
+    amp = get_opamp("LM741")
+    fn = np.array([float(r["fn_hz"]) for r in rows])
+    model = np.array([float(circuit_figures(topology, {p: float(r[p]) for p in topology.designators},
+                                            dataclasses.replace(amp, gbw_hz=float(r["GBW"])))["fn_hz"]) for r in rows])
+    np.testing.assert_allclose(fn, model, rtol=0.01)
+    inside = (fn >= 0.98 * ex.fn_hz) & (fn <= 1.02 * ex.fn_hz)
+    assert mc["yield"]["fraction"] == pytest.approx(inside.mean())
+    assert _cases(tmp_path / "out")["yield"]["status"] == ("pass" if inside.mean() >= 0.1 else "fail")
+
+
+@pytest.mark.spice
+def test_spice_agreement_against_the_ideal_model_on_a_section(tmp_path):
+    """against: ideal: the same square-wave run against the ideal-op-amp model (the library's nrms_ideal of the
+    same design), farther from SPICE than the op-amp-aware model."""
+    from designer.plant.circuit_design import default_square_hz, design_circuit_plant, with_square_test
+    from designer.plant.spec import PlantSpec
+    topology = REGISTRY["mfb-lowpass"]
+    ex = topology.example
+    path = tmp_path / "spec.yaml"
+    path.write_text(spec_text(topology) + "spice_agreement: {nrms_max: 1, against: ideal}\n")
+    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
+    assert out.returncode == 0, out.stdout + out.stderr
+    case = _cases(tmp_path / "out")["spice_agreement"]
+    assert "against the ideal model" in case["message"]
+    res = design_circuit_plant(PlantSpec(fc_hz=ex.fn_hz, zeta=1 / (2 * ex.q), gain=ex.gain, opamp="TL072",
+                                         alternatives=1, topology=topology.name), simulator="ngspice-cli")
+    with_square_test(res, 2.0, default_square_hz(res), "ngspice-cli")
+    assert case["value"] == pytest.approx(res.square.nrms_ideal, rel=1e-6)
+    assert res.square.nrms < res.square.nrms_ideal

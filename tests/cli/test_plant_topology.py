@@ -178,6 +178,8 @@ def test_engine_both_on_a_section_runs_each_build_s_ac_in_ngspice(tmp_path):
     (["--monte-carlo", "20", "--replay", "3"], ["--replay", "sallen-key-lowpass's for now", "--engine analytic, spice"]),
     (["--engine", "spice"], ["--engine spice goes with --monte-carlo N"]),
     (["--monte-carlo", "20", "--spice-samples", "2"], ["--spice-samples K goes with --engine both"]),
+    (["--monte-carlo", "20", "--engine", "spice", "--tol", "SR=20%"], ["--tol SR", "linear", "drop SR from --tol"]),
+    (["--worst-case", "--tol", "SR=20%"], ["--tol SR", "linear"]),
 ])
 def test_what_a_section_plant_has_not_is_one_line(args, words, tmp_path):
     refused(run(*target_args(REGISTRY["mfb-lowpass"]), *args, "--no-sim", cwd=tmp_path), words, tmp_path)
@@ -211,3 +213,32 @@ def test_analyze_plant_square_freq_on_a_section(tmp_path):
     assert sq["pass"] and sq["nrms"] < 1e-2 and sq["generator"]["high_v"] == 1
     refused(analyze(*parts, "--square-freq", "1x", "--no-sim", cwd=tmp_path), ["--square-freq", "not a number"],
             tmp_path)
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("engine", ["analytic", "both"])
+def test_tol_gbw_on_a_section_spreads_the_op_amp_in_both_engines(engine, tmp_path):
+    """--tol GBW=30% on --topology mfb-lowpass: a gain-bandwidth per build in the CSV; the model's rows are the
+    op-amp-aware model with that build's GBW (recomputed exactly), SPICE's (--engine both: each build's .ac with
+    the op-amp's integrating capacitor altered) next to them; --worst-case reaches GBW too."""
+    import dataclasses
+    topology = REGISTRY["mfb-lowpass"]
+    out = run(*target_args(topology), "--monte-carlo", "20", "--seed", "5", "--tol", "GBW=30%", "--engine", engine,
+              "--worst-case", "--simulator", "ngspice-cli", "--json", "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    assert d["monte_carlo"]["settings"]["tolerances_pct"]["GBW"] == 30
+    assert "GBW" in d["worst_case"]["fn_hz"]["min"]["deviations"]
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    col = lambda k: np.array([float(r[k]) for r in rows])  # noqa: E731
+    amp = get_opamp(d["opamp"]["name"])
+    gbw = col("GBW")
+    assert np.all(np.abs(gbw / amp.gbw_hz - 1) <= 0.3) and np.ptp(gbw) > 0
+    model = "fn_hz" if engine == "analytic" else "model_fn_hz"
+    for i, row in enumerate(rows):
+        want = circuit.circuit_figures(topology, {r: float(row[r]) for r in topology.designators},
+                                       dataclasses.replace(amp, gbw_hz=gbw[i]))["fn_hz"]
+        assert float(row[model]) == pytest.approx(float(want), rel=1e-9)
+    if engine == "both":
+        assert np.allclose(col("fn_hz"), col("model_fn_hz"), rtol=0.01)

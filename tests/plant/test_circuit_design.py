@@ -62,3 +62,35 @@ def test_a_slew_limited_edge_fails_the_check_with_a_note():
     r = design_of(REGISTRY["mfb-highpass"], "LM741", 10)
     assert not r.square.check.ok and r.square.nrms >= SQUARE_NRMS_PASS
     assert any("slew-limited" in n and "LM741" in n for n in r.notes)
+
+
+def test_the_ideal_model_under_the_square_wave_is_the_closed_form_too():
+    """rc-lowpass with an LM741: ``y_ideal`` is A (1 - exp(-t'/tau)) of the parts alone (tau = R1 C1, the
+    op-amp's pole absent), and ``nrms_ideal`` the project's rule of SPICE against it."""
+    from designer.core.compare import nrms
+    r = design_of(REGISTRY["rc-lowpass"], "LM741", 10)
+    sq, test = r.square, r.square.test
+    tau = r.values["R1"] * r.values["C1"]
+    rise = test.delay_s + test.edge_s / 2
+    step = lambda x: np.where(x > 0, 1 - np.exp(-np.clip(x, 0, None) / tau), 0.0)  # noqa: E731
+    want = test.amplitude_v * (step(sq.t - rise) - step(sq.t - rise - test.half_period_s))
+    np.testing.assert_allclose(sq.y_ideal, want, atol=1e-5 * test.amplitude_v)
+    assert sq.nrms_ideal == nrms(sq.y_ideal, sq.y_spice, sq.abstol_v, t=sq.t)
+    t, waves = sq.waves()
+    assert t is sq.t and waves["output_v"] is sq.y_spice and waves["analytic_v"] is sq.y_ideal
+
+
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_the_default_square_wave_leaves_the_slowest_pole_1_5_settling_times(topology):
+    """default_square_hz: the Sallen-Key plant's rule (recommend_square_wave) on the 2 % settling time
+    ln(50)/sigma of the op-amp-aware model's slowest pole: the half period at least 1.5 of it."""
+    from designer.plant.bench import recommend_square_wave
+    from designer.plant.circuit_design import default_square_hz
+    ex = topology.example
+    r = design_circuit_plant(PlantSpec(fc_hz=ex.fn_hz, zeta=None if ex.q is None else 1 / (2 * ex.q), gain=ex.gain,
+                                       opamp="TL072", topology=topology.name), simulate=False)
+    den = circuit.opamp_tf(topology, r.values, r.opamp)[1]
+    settle = math.log(50) / np.min(np.abs(np.roots(den).real))
+    f = default_square_hz(r)
+    assert f == recommend_square_wave(settle, 1.0).frequency_hz
+    assert 0.5 / f >= 1.5 * settle

@@ -103,3 +103,30 @@ def test_engine_both_records_both_engines_and_the_tails():
     assert s["samples_checked"] == idx.size and np.isfinite(picked.figures["spice_fn_hz"][idx]).all()
     # the builds SPICE checked are those of the full run, with its figures
     np.testing.assert_allclose(picked.figures["spice_fn_hz"][idx], rows["fn_hz"][idx], rtol=1e-9)
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_a_drawn_gbw_alters_the_op_amp_of_each_build(topology):
+    """GBW drawn per build (the op-amp's spread): ngspice's .ac of each build is the op-amp-aware model's
+    response with that build's gain-bandwidth (the same fit within 1e-4), and the analytic engine
+    (circuit.evaluate) takes the same GBW."""
+    import dataclasses
+    result = design_of(topology)
+    ctx = spice_ac.context(result.deck, result.netlist, topology, result.values, result.figures["ideal"]["fn_hz"],
+                           opamp=result.opamp)
+    assert ctx.cints and ctx.gbw_hz == result.opamp.gbw_hz
+    vals = {**builds(result, n=4), "GBW": result.opamp.gbw_hz * np.array([0.5, 0.8, 1.2, 1.5])}
+    f, h = spice_ac.parse(get_simulator("ngspice-cli").run_script(ctx.circuit, spice_ac.commands(ctx, vals)), 0, 4)
+    ev = spice_ac.fit(f, h, topology.order, ctx.zeros)
+    np.testing.assert_allclose(spice_ac.evaluate(ctx, vals)["fn_hz"], ev["fn_hz"], rtol=1e-12)
+    parts = {r: v for r, v in vals.items() if r != "GBW"}
+    again = spice_ac.fit(f, np.stack([topology.response(
+        {r: v[i] for r, v in parts.items()}, 2j * np.pi * f, dataclasses.replace(result.opamp, gbw_hz=vals["GBW"][i]))
+        for i in range(4)]), topology.order, ctx.zeros)
+    np.testing.assert_allclose(ev["fn_hz"], again["fn_hz"], rtol=1e-4)
+    model = circuit.evaluate((topology.name, result.opamp), vals)
+    for i in range(4):
+        one = circuit.circuit_figures(topology, {r: v[i] for r, v in parts.items()},
+                                      dataclasses.replace(result.opamp, gbw_hz=vals["GBW"][i]))
+        assert model["fn_hz"][i] == pytest.approx(float(one["fn_hz"]), rel=1e-12)
