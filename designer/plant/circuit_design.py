@@ -95,6 +95,12 @@ class CircuitPlantResult:
         The op-amp package of the wiring.
     square : SquareRun or None
         The square-wave bench test in ngspice against the op-amp-aware model (``--square-freq``).
+    monte_carlo, worst_case : object or None
+        The tolerance analyses, when asked for.
+    amplitude_v : float
+        The bench's high level (V): the square wave's and the PRBS's.
+    prbs : designer.plant.prbs.PrbsRun or None
+        The PRBS bench test (``--stimulus prbs``, :func:`designer.plant.circuit_prbs.with_section_prbs`).
     """
 
     topology: str
@@ -117,6 +123,8 @@ class CircuitPlantResult:
     square: object = None
     monte_carlo: object = None
     worst_case: object = None
+    amplitude_v: float = 2.0
+    prbs: object = None
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
@@ -169,6 +177,8 @@ class CircuitPlantResult:
             **({} if self.square is None else {"square_test": self.square.to_dict()}),
             "monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
             "worst_case": None if self.worst_case is None else self.worst_case.to_dict(),
+            # only with --stimulus prbs, before files (the Sallen-Key plant's JSON's place)
+            **({} if self.prbs is None else {"prbs": self.prbs.to_dict()}),
             "files": self.files,
         })
 
@@ -312,7 +322,9 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
 
 
 def _square(result, amplitude_v: float, square_hz, simulate: bool, simulator: str):
-    """``result`` with its square-wave test when ``square_hz`` is given (and ``simulate``)."""
+    """``result`` with its square-wave test when ``square_hz`` is given (and ``simulate``), its bench amplitude
+    recorded."""
+    result.amplitude_v = amplitude_v
     if square_hz is not None and simulate:
         with_square_test(result, amplitude_v, square_hz, simulator)
     elif square_hz is not None:
