@@ -430,14 +430,29 @@ def _design_circuit(args, topo) -> int:
     mc = monte_carlo_settings(args, topo.designators)
     spice = spice_settings(args, mc, plant=False)
     stim = stimulus_settings(args)
-    check_output(args, name)
+    check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
     from ..plant.circuit_design import design_circuit_plant
     from ..plant.circuit_report import summary_text, write_outputs
+    if spice[2] is not None:     # the design is the draw's nominal; the build's own run the simulation
+        return _circuit_replay(design_circuit_plant(spec, simulate=False), args, mc, spice, name)
     with cluster_ahead(args):
         result = _circuit_stimulus(design_circuit_plant(spec, simulate=not args.no_sim, simulator=args.simulator),
                                    args, stim)
         result = _circuit_tolerance(result, args, mc, spice)
     return emit(result, args, name, write_outputs, summary_text)
+
+
+def _circuit_replay(result, args, settings, spice, name) -> int:
+    """--replay I on a section plant: the build's values drawn again, its .ac in ngspice (the SPICE engine's row
+    I), and its bundle (analyze-plant --topology of its exact values) written under ``name``_sample<I>."""
+    from ..plant.circuit_report import summary_text, write_outputs
+    from ..tolerance.spice_mc import section_replay, section_replay_result
+    s = result.sourcing
+    n, seed = settings
+    rep = section_replay(result, {"R": s.r_series, "C": s.c_series}, spice[2], n, seed, args.sampler, args.dist,
+                         args.tol or (), args.simulator)
+    out = section_replay_result(result, rep, args.simulator, args.square_freq)
+    return emit(out, args, f"{name}_sample{spice[2]}", write_outputs, summary_text)
 
 
 def _circuit_stimulus(result, args, stim):
@@ -450,8 +465,7 @@ def _circuit_stimulus(result, args, stim):
 
 def _circuit_unsupported(args, topo, options=()) -> None:
     """The options the plant on another topology has not (yet): refused in one line."""
-    unsupported = [f for f, v in (("--replay", args.replay),
-                                  ("--tol GBW/SR", any(str(t).split("=")[0].strip().upper() in ("GBW", "SR")
+    unsupported = [f for f, v in (("--tol GBW/SR", any(str(t).split("=")[0].strip().upper() in ("GBW", "SR")
                                                        for t in args.tol or ())), *options)
                    if v]
     if unsupported:
@@ -482,7 +496,11 @@ def _analyze_circuit(args, topo) -> int:
               for r, v in parts.items()}
     stim = stimulus_settings(args)
     name = args.name if args.name is not None else built_name(topo.name, values)
-    check_output(args, name)
+    check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
+    if spice[2] is not None:
+        return _circuit_replay(analyze_circuit_plant(
+            topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,
+            simulate=False, amplitude_v=args.amplitude), args, mc, spice, name)
     with cluster_ahead(args):
         result = _circuit_stimulus(analyze_circuit_plant(
             topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,

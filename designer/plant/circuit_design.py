@@ -343,8 +343,8 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
         A registered section's name.
     values : dict
         Designator -> value (a number or engineering notation), every declared part.
-    opamp : str
-        The op-amp's catalogue name.
+    opamp : str or designer.core.opamps.OpAmp
+        The op-amp's catalogue name, or the op-amp itself (a Monte Carlo build's, its GBW and slew rate drawn).
     target_fc_hz, target_zeta : float or str, optional
         What the errors are reported against.
     r_series, c_series : str, optional
@@ -375,7 +375,7 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
     fc, zeta = _analysis_target(topo, target_fc_hz, target_zeta)
     amplitude_v = parse_in_range(amplitude_v, "amplitude_v", "amplitude_v")
     square_hz = None if square_hz is None else parse_in_range(square_hz, "square_hz", "square_hz")
-    amp = opamps.get(opamp)
+    amp = opamp if isinstance(opamp, opamps.OpAmp) else opamps.get(opamp)   # an OpAmp: a replayed build's own
     amp.package(package)
     series = [None if s is None else series_name(s) for s in (r_series, c_series)]
     labels, r_s, c_s, why = part_series(parsed, *series)

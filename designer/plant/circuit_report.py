@@ -20,6 +20,7 @@ from ..filters.prototype import SectionPlan
 from ..report import document as R
 from ..report.bundle import write_design
 from ..report.tolerance import csv_texts
+from ..report.tolerance import section as tolerance_section
 from ..report.wiring import bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
 from .report import prbs_blocks, prbs_png, prbs_texts
@@ -145,6 +146,8 @@ def sections(result, with_images: bool = False, schematic_svg: str = "") -> list
                              [[*(format_eng(c.values[r], "Ohm" if r[0] == "R" else "F", 3) for r in refs),
                                _f(c.fn_hz, "Hz"), _n(c.zeta), _n(c.gain), f"{100 * c.worst:.3g} %"]
                               for c in result.alternatives])]))
+    if result.monte_carlo is not None and result.monte_carlo.headline is None:   # --replay I: the build replayed
+        out.append((_("Tolerance analysis (Monte Carlo)"), tolerance_section(result, False)))
     if result.notes:
         out.append((_("Notes"), [R.text(translated(n)) for n in result.notes]))
     return out
