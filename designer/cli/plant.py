@@ -431,19 +431,43 @@ def _design_circuit(args, topo) -> int:
         + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
     mc = monte_carlo_settings(args, topo.designators)
     spice = spice_settings(args, mc, plant=False)
-    check_output(args, name)
+    stim = stimulus_settings(args)
+    check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
     from ..plant.circuit_design import design_circuit_plant
     from ..plant.circuit_report import summary_text, write_outputs
+    if spice[2] is not None:     # the design is the draw's nominal; the build's own run the simulation
+        return _circuit_replay(design_circuit_plant(spec, simulate=False), args, mc, spice, name)
     with cluster_ahead(args):
-        result = _circuit_tolerance(design_circuit_plant(spec, simulate=not args.no_sim, simulator=args.simulator),
-                                    args, mc, spice)
+        result = _circuit_stimulus(design_circuit_plant(spec, simulate=not args.no_sim, simulator=args.simulator),
+                                   args, stim)
+        result = _circuit_tolerance(result, args, mc, spice)
     return emit(result, args, name, write_outputs, summary_text)
+
+
+def _circuit_replay(result, args, settings, spice, name) -> int:
+    """--replay I on a section plant: the build's values drawn again, its .ac in ngspice (the SPICE engine's row
+    I), and its bundle (analyze-plant --topology of its exact values) written under ``name``_sample<I>."""
+    from ..plant.circuit_report import summary_text, write_outputs
+    from ..tolerance.spice_mc import section_replay, section_replay_result
+    s = result.sourcing
+    n, seed = settings
+    rep = section_replay(result, {"R": s.r_series, "C": s.c_series}, spice[2], n, seed, args.sampler, args.dist,
+                         args.tol or (), args.simulator)
+    out = section_replay_result(result, rep, args.simulator, args.square_freq)
+    return emit(out, args, f"{name}_sample{spice[2]}", write_outputs, summary_text)
+
+
+def _circuit_stimulus(result, args, stim):
+    """A section plant with its PRBS bench test when --stimulus prbs (``stim``)."""
+    if stim is None:
+        return result
+    from ..plant.circuit_prbs import with_section_prbs
+    return with_section_prbs(result, result.amplitude_v, stim[0], stim[1], not args.no_sim, args.simulator)
 
 
 def _circuit_unsupported(args, topo, options=()) -> None:
     """The options the plant on another topology has not (yet): refused in one line."""
-    unsupported = [f for f, v in (("--stimulus prbs", args.stimulus == "prbs"), ("--prbs-bits", args.prbs_bits),
-                                  ("--prbs-clock", args.prbs_clock), ("--replay", args.replay), *options)
+    unsupported = [f for f, v in options
                    if v]
     if unsupported:
         raise DesignError(f"{unsupported[0].split()[0]}: {unsupported[0]} is the {DEFAULT_TOPOLOGY}'s for now; "
@@ -473,13 +497,19 @@ def _analyze_circuit(args, topo) -> int:
     from ..core.ranges import parse_in_range
     values = {r: parse_in_range(v, f"--part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
               for r, v in parts.items()}
+    stim = stimulus_settings(args)
     name = args.name if args.name is not None else built_name(topo.name, values)
-    check_output(args, name)
+    check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
+    if spice[2] is not None:
+        return _circuit_replay(analyze_circuit_plant(
+            topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,
+            simulate=False, amplitude_v=args.amplitude), args, mc, spice, name)
     with cluster_ahead(args):
-        result = _circuit_tolerance(analyze_circuit_plant(
+        result = _circuit_stimulus(analyze_circuit_plant(
             topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,
             simulate=not args.no_sim, simulator=args.simulator, amplitude_v=args.amplitude,
-            square_hz=args.square_freq), args, mc, spice)
+            square_hz=args.square_freq), args, stim)
+        result = _circuit_tolerance(result, args, mc, spice)
     return emit(result, args, name, write_outputs, summary_text)
 
 

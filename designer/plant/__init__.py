@@ -12,6 +12,7 @@ from ..core.exports import lazy_exports
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "circuit_report": ("bom", "sections", "title_of"),
+    "circuit_prbs": ("band_edge_hz", "section_plan", "slowest_settling_s", "with_section_prbs"),
     "circuit_design": ("CircuitAnalysisSpec", "CircuitPlantResult", "GBW_MARGIN", "SPICE_DB", "SPICE_DEG",
                        "analyze_circuit_plant", "analyze_circuit_spec", "built_name", "check_circuit_parts",
                        "check_opamp_reach",
@@ -24,10 +25,10 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
               "tolerance_band"),
     "design": ("R_BAND", "analyze_plant", "choose_parts", "design_plant", "listed"),
     "model": ("plant_tf", "plant_tf_opamp", "sensitivities"),
-    "netlist": ("plant_ac_deck", "plant_deck", "plant_netlist", "plant_prbs_deck"),
-    "prbs": ("MAX_INTERVALS", "PERIODS", "SAMPLES_PER_INTERVAL", "model_response", "op_amp_checks", "plan_for_result",
-             "prbs_run", "with_prbs"),
-    "report": ("bode_png", "sine_text", "step_png", "summary_text", "waveforms_csv", "write_outputs"),
+    "netlist": ("plant_ac_deck", "plant_deck", "plant_netlist", "plant_prbs_deck", "prbs_deck"),
+    "prbs": ("MAX_INTERVALS", "PERIODS", "SAMPLES_PER_INTERVAL", "attach", "check_size", "model_response",
+             "op_amp_checks", "plan_for_result", "plan_of", "prbs_run", "run_deck", "with_prbs"),
+    "report": ("bode_png", "prbs_blocks", "prbs_png", "prbs_texts", "prbs_waveforms_csv", "sine_text", "step_png", "summary_text", "waveforms_csv", "write_outputs"),
     "result": ("PlantResult",),
     "sallenkey": ("DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts", "coefficients", "fn_zeta",
                   "ratios_from_rc", "realizability_notes", "resistors_for_caps"),

@@ -96,6 +96,12 @@ class CircuitPlantResult:
         The op-amp package of the wiring.
     square : SquareRun or None
         The square-wave bench test in ngspice against the op-amp-aware model (``--square-freq``).
+    monte_carlo, worst_case : object or None
+        The tolerance analyses, when asked for.
+    amplitude_v : float
+        The bench's high level (V): the square wave's and the PRBS's.
+    prbs : designer.plant.prbs.PrbsRun or None
+        The PRBS bench test (``--stimulus prbs``, :func:`designer.plant.circuit_prbs.with_section_prbs`).
     """
 
     topology: str
@@ -118,6 +124,8 @@ class CircuitPlantResult:
     square: object = None
     monte_carlo: object = None
     worst_case: object = None
+    amplitude_v: float = 2.0
+    prbs: object = None
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
@@ -170,6 +178,8 @@ class CircuitPlantResult:
             **({} if self.square is None else {"square_test": self.square.to_dict()}),
             "monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
             "worst_case": None if self.worst_case is None else self.worst_case.to_dict(),
+            # only with --stimulus prbs, before files (the Sallen-Key plant's JSON's place)
+            **({} if self.prbs is None else {"prbs": self.prbs.to_dict()}),
             "files": self.files,
         })
 
@@ -313,7 +323,9 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
 
 
 def _square(result, amplitude_v: float, square_hz, simulate: bool, simulator: str):
-    """``result`` with its square-wave test when ``square_hz`` is given (and ``simulate``)."""
+    """``result`` with its square-wave test when ``square_hz`` is given (and ``simulate``), its bench amplitude
+    recorded."""
+    result.amplitude_v = amplitude_v
     if square_hz is not None and simulate:
         with_square_test(result, amplitude_v, square_hz, simulator)
     elif square_hz is not None:
@@ -332,8 +344,8 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
         A registered section's name.
     values : dict
         Designator -> value (a number or engineering notation), every declared part.
-    opamp : str
-        The op-amp's catalogue name.
+    opamp : str or designer.core.opamps.OpAmp
+        The op-amp's catalogue name, or the op-amp itself (a Monte Carlo build's, its GBW and slew rate drawn).
     target_fc_hz, target_zeta : float or str, optional
         What the errors are reported against.
     r_series, c_series : str, optional
@@ -364,7 +376,7 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
     fc, zeta = _analysis_target(topo, target_fc_hz, target_zeta)
     amplitude_v = parse_in_range(amplitude_v, "amplitude_v", "amplitude_v")
     square_hz = None if square_hz is None else parse_in_range(square_hz, "square_hz", "square_hz")
-    amp = opamps.get(opamp)
+    amp = opamp if isinstance(opamp, opamps.OpAmp) else opamps.get(opamp)   # an OpAmp: a replayed build's own
     amp.package(package)
     series = [None if s is None else series_name(s) for s in (r_series, c_series)]
     labels, r_s, c_s, why = part_series(parsed, *series)

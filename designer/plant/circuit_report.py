@@ -20,8 +20,10 @@ from ..filters.prototype import SectionPlan
 from ..report import document as R
 from ..report.bundle import write_design
 from ..report.tolerance import csv_texts
+from ..report.tolerance import section as tolerance_section
 from ..report.wiring import bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
+from .report import prbs_blocks, prbs_png, prbs_texts
 
 __all__ = ["title_of", "sections", "bom", "schematic", "summary_text", "write_outputs"]
 
@@ -122,9 +124,13 @@ def sections(result, with_images: bool = False, schematic_svg: str = "") -> list
     """
     b = board(result.netlist, result.opamp, result.package)
     fig = [R.figure("schematic.png", schematic_svg, _("schematic"))] if with_images else []
+    prbs = [] if result.prbs is None else [(_("Bench test under a PRBS (--stimulus prbs)"), [
+        *prbs_blocks(result), *([R.image("prbs.png", _("the last period of the PRBS: generator, SPICE and the model"))]
+                                if with_images else [])])]
     out = [(_("Build"), [*fig, R.table([_(h) for h in BOM_SHOWN], [[*r[:6], _(r[6]), r[7]] for r in bom(result)])]),
            (_("Wiring"), [R.table([_("part"), _("code"), _("from"), _("to")],
                                   wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee)))]),
+           *prbs,
            (_("Target and achieved"), _targets(result)),
            (_("Checks"), [R.table([_("check"), _("result"), _("detail")],
                                   [[_(c.title), _("ok") if c.ok else _("FAILED"), c.shown()] for c in result.checks])]),
@@ -140,6 +146,8 @@ def sections(result, with_images: bool = False, schematic_svg: str = "") -> list
                              [[*(format_eng(c.values[r], "Ohm" if r[0] == "R" else "F", 3) for r in refs),
                                _f(c.fn_hz, "Hz"), _n(c.zeta), _n(c.gain), f"{100 * c.worst:.3g} %"]
                               for c in result.alternatives])]))
+    if result.monte_carlo is not None and result.monte_carlo.headline is None:   # --replay I: the build replayed
+        out.append((_("Tolerance analysis (Monte Carlo)"), tolerance_section(result, False)))
     if result.notes:
         out.append((_("Notes"), [R.text(translated(n)) for n in result.notes]))
     return out
@@ -228,6 +236,9 @@ def write_outputs(result, out_dir, name: str, lang: str | None = None) -> dict:
     if result.square is not None:     # --square-freq: the bench test's deck and its waveforms
         texts.update({"square_deck": ("square-test.cir", lambda r: r.square.deck),
                       "waveforms_csv": ("waveforms.csv", lambda r: r.square.csv_text())})
+    # --stimulus prbs: the generator's files, its deck, and waveforms.csv becomes its run (as the Sallen-Key plant's)
+    texts.update(prbs_texts(result))
+    plots = [("prbs.png", prbs_png)] if result.prbs is not None else []
     with language(lang):
-        return write_design(result, out_dir, name, [], schematic, lambda svg: sections(result, True, svg),
+        return write_design(result, out_dir, name, plots, schematic, lambda svg: sections(result, True, svg),
                             title_of(result), texts)

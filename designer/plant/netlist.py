@@ -34,7 +34,7 @@ from ..spice.deck import (
 )
 from .sallenkey import SallenKeyParts
 
-__all__ = ["plant_ac_deck", "plant_deck", "plant_netlist", "plant_prbs_deck"]
+__all__ = ["plant_ac_deck", "plant_deck", "plant_netlist", "plant_prbs_deck", "prbs_deck"]
 
 
 def plant_netlist(parts: SallenKeyParts, inp: str = "input", out: str = "out", prefix: str = "",
@@ -142,10 +142,9 @@ def plant_ac_deck(parts: SallenKeyParts, opamp: OpAmp, f_lo: float, f_hi: float,
 def plant_prbs_deck(parts: SallenKeyParts, opamp: OpAmp, plan, title: str, samples_per_interval: int = 10) -> str:
     """The Sallen-Key plant driven by the pseudo-random binary sequence of
     ``plan`` (a :class:`~designer.core.prbs.PrbsPlan`, as ``make-prbs``
-    writes it: its ngspice PWL subcircuit on the input), every period of it,
-    the maximum time step a ``samples_per_interval``-th of the clock interval
-    (and at most 1/100 of 1/wn): the prediction a bench capture of the plant
-    under that sequence is compared with, and what ``identify`` reads.
+    writes it: its ngspice PWL subcircuit on the input), every period of it
+    (:func:`prbs_deck` of :func:`plant_netlist`): the prediction a bench capture
+    of the plant under that sequence is compared with, and what ``identify`` reads.
 
     Parameters
     ----------
@@ -165,17 +164,49 @@ def plant_prbs_deck(parts: SallenKeyParts, opamp: OpAmp, plan, title: str, sampl
     str
         The deck.
     """
+    from .sallenkey import fn_zeta
+    fn, _ = fn_zeta(parts.r1, parts.r2, parts.c1, parts.c2, parts.gain)
+    return prbs_deck(plant_netlist(parts), opamp, plan, title, fn, "input", samples_per_interval)
+
+
+def prbs_deck(netlist, opamp: OpAmp, plan, title: str, fn_hz: float, inp: str = "input",
+              samples_per_interval: int = 10) -> str:
+    """Any circuit (its :class:`~designer.spice.deck.Netlist`, input net ``inp``) driven by the
+    pseudo-random binary sequence of ``plan`` (its ngspice PWL subcircuit, as ``make-prbs``
+    writes it), every period of it, the maximum time step a ``samples_per_interval``-th of the
+    clock interval and at most 1/100 of 1/wn (``fn_hz`` its natural frequency).
+
+    Parameters
+    ----------
+    netlist : designer.spice.deck.Netlist
+        The circuit.
+    opamp : OpAmp
+        The op-amp.
+    plan : designer.core.prbs.PrbsPlan
+        The sequence.
+    title : str
+        The deck's title line.
+    fn_hz : float
+        The circuit's natural frequency (its time step).
+    inp : str
+        The net the sequence drives.
+    samples_per_interval : int
+        Output samples per clock interval.
+
+    Returns
+    -------
+    str
+        The deck.
+    """
     import math
 
     from ..core.prbs import pwl_subcircuit
-    from .sallenkey import fn_zeta
-    fn, _ = fn_zeta(parts.r1, parts.r2, parts.c1, parts.c2, parts.gain)
-    step = min(plan.dt_s / samples_per_interval, 1.0 / (2 * math.pi * fn) / 100)
+    step = min(plan.dt_s / samples_per_interval, 1.0 / (2 * math.pi * fn_hz) / 100)
     circuit = _circuit(title, opamp, [
         f"* op-amp: {opamp.name} ({opamp.description}); supplies {opamp.vcc:g} V / {opamp.vee:g} V",
         f"* stimulus: PRBS of {plan.bits} bits (N = {plan.n}), clock {plan.clock_hz:.6g} Hz, "
         f"{plan.periods} period(s), levels {plan.offset - plan.amplitude:.6g} V and {plan.offset + plan.amplitude:.6g} V",
-        pwl_subcircuit(plan).rstrip(), "Xgen input prbs_source"])
-    plant_netlist(parts).add_to(circuit, opamp)
+        pwl_subcircuit(plan).rstrip(), f"Xgen {inp} prbs_source"])
+    netlist.add_to(circuit, opamp)
     stop = plan.periods * plan.period_s
     return "\n".join([str(circuit).rstrip(), f".tran {step:.6g} {stop:.6g} 0 {step:.6g}", ".end"]) + "\n"

@@ -26,8 +26,8 @@ from ..core.checks import Check
 from ..core.i18n import N_
 from ..core.prbs import PrbsPlan, plan_for_plant
 
-__all__ = ["MAX_INTERVALS", "PERIODS", "SAMPLES_PER_INTERVAL", "model_response", "op_amp_checks", "plan_for_result",
-           "prbs_run", "with_prbs"]
+__all__ = ["MAX_INTERVALS", "PERIODS", "SAMPLES_PER_INTERVAL", "attach", "check_size", "model_response",
+           "op_amp_checks", "plan_for_result", "plan_of", "prbs_run", "run_deck", "with_prbs"]
 
 #: periods played: the first settles the plant, the other three are identified
 PERIODS = 4
@@ -63,17 +63,59 @@ def plan_for_result(result, amplitude_v: float, bits=None, clock_hz=None) -> Prb
     settling = result.analytic_opamp.step.settling_time_s
     sine = result.sine
     band = sine.f_3db_hz if sine is not None and sine.f_3db_hz is not None else result.built.fn_hz
+    return plan_of(settling, band, result.built.fn_hz, amplitude_v, bits, clock_hz)
+
+
+def plan_of(settling_s: float, band_hz: float, fn_hz: float, amplitude_v: float, bits=None, clock_hz=None) -> PrbsPlan:
+    """The sequence for a plant of 2 % settling time ``settling_s``, band edge ``band_hz`` and natural
+    frequency ``fn_hz`` (its time step): levels 0 V and ``amplitude_v``, :data:`PERIODS` periods,
+    ``bits`` and ``clock_hz`` chosen unless given (:func:`designer.core.prbs.plan_for_plant`), its
+    size checked (:func:`check_size`).
+
+    Parameters
+    ----------
+    settling_s : float
+        The settling time (s).
+    band_hz : float
+        The band edge the clock covers (Hz).
+    fn_hz : float
+        The natural frequency (Hz).
+    amplitude_v : float
+        The sequence's high level (V).
+    bits : int, optional
+        The register's length; None: chosen.
+    clock_hz : float, optional
+        The clock; None: chosen.
+
+    Returns
+    -------
+    PrbsPlan
+        The sequence.
+    """
     half = 0.5 * float(amplitude_v)
-    plan = plan_for_plant(settling, band, amplitude=half, offset=half, periods=PERIODS,
+    plan = plan_for_plant(settling_s, band_hz, amplitude=half, offset=half, periods=PERIODS,
                           dt_s=None if clock_hz is None else 1.0 / float(clock_hz), bits=bits)
-    check_size(plan, result.built.fn_hz)
+    check_size(plan, fn_hz)
     return plan
 
 
 def check_size(plan: PrbsPlan, fn_hz: float) -> None:
     """One line when the run would be too long: more than :data:`MAX_INTERVALS`
     intervals, or more than :data:`MAX_SPICE_STEPS` time steps of a plant of
-    natural frequency ``fn_hz`` (its step is at most 1/100 of 1/wn)."""
+    natural frequency ``fn_hz`` (its step is at most 1/100 of 1/wn).
+
+    Parameters
+    ----------
+    plan : PrbsPlan
+        The sequence.
+    fn_hz : float
+        The plant's natural frequency (Hz).
+
+    Raises
+    ------
+    DesignError
+        The run too long (one line).
+    """
     import math
 
     from ..core.errors import DesignError
@@ -208,22 +250,53 @@ def prbs_run(result, plan: PrbsPlan, simulate: bool = True, simulator: str = "py
     PrbsRun
         The responses, the deck and the checks.
     """
-    from ..core.compare import resample
-    from ..spice.simulate import get_simulator
     from .netlist import plant_prbs_deck
-    num, den = result.analytic_opamp.num, result.analytic_opamp.den
-    t, u, y_model = model_response(num, den, plan)
     deck = plant_prbs_deck(result.built, result.opamp, plan,
                            f"Sallen-Key plant fn={result.built.fn_hz:.5g}Hz zeta={result.built.zeta:.4g} under a "
                            f"PRBS of {plan.bits} bits, op-amp={result.opamp.name}")
-    checks = op_amp_checks(t, y_model, result.opamp)
+    return run_deck(result.analytic_opamp.num, result.analytic_opamp.den, plan, deck, result.opamp, simulate,
+                    simulator, "out", "input")
+
+
+def run_deck(num, den, plan: PrbsPlan, deck: str, opamp, simulate: bool = True, simulator: str = "pyspice",
+             out: str = "out", inp: str = "input") -> PrbsRun:
+    """A circuit's PRBS deck (:func:`designer.plant.netlist.prbs_deck`) against its model N(s)/D(s):
+    the model's response to the held sequence (:func:`model_response`), the op-amp's checks under
+    it and, when ``simulate``, ngspice's output on the same samples.
+
+    Parameters
+    ----------
+    num, den : array_like
+        The op-amp-aware model, highest power first.
+    plan : PrbsPlan
+        The sequence.
+    deck : str
+        The circuit under the sequence.
+    opamp : designer.core.opamps.OpAmp
+        The op-amp.
+    simulate : bool
+        Run the deck in ngspice too.
+    simulator : str
+        The backend.
+    out, inp : str
+        The deck's output and input nets.
+
+    Returns
+    -------
+    PrbsRun
+        The responses, the deck and the checks.
+    """
+    from ..core.compare import resample
+    from ..spice.simulate import get_simulator
+    t, u, y_model = model_response(num, den, plan)
+    checks = op_amp_checks(t, y_model, opamp)
     if not simulate:
         return PrbsRun(plan, PrbsCapture(t, u, y_model, y_model), deck, None, checks)
     sim = get_simulator(simulator)
     res = sim.run(deck)
     ts = res["time"]
-    y = resample(ts, np.real(res["v(out)"]), t)
-    u_s = resample(ts, np.real(res["input"]), t)
+    y = resample(ts, np.real(res[out]), t)
+    u_s = resample(ts, np.real(res[inp]), t)
     span = float(np.ptp(y_model)) or 1.0
     fit = float(np.sqrt(np.mean((y - y_model) ** 2)) / span)
     return PrbsRun(plan, PrbsCapture(t, u_s, y, y_model), deck, sim.name, checks, fit)
@@ -259,7 +332,25 @@ def with_prbs(result, amplitude_v: float, bits=None, clock_hz=None, simulate: bo
         ``result``.
     """
     plan = plan_for_result(result, amplitude_v, bits, clock_hz)
-    run = prbs_run(result, plan, simulate, simulator)
+    return attach(result, prbs_run(result, plan, simulate, simulator))
+
+
+def attach(result, run: PrbsRun):
+    """``result`` (a plant's, any topology) with the PRBS run ``run`` as its ``prbs``, the op-amp's
+    checks under it added to its checks, and a note when SPICE departs from the model; returned.
+
+    Parameters
+    ----------
+    result : PlantResult or designer.plant.circuit_design.CircuitPlantResult
+        The plant.
+    run : PrbsRun
+        Its PRBS bench test.
+
+    Returns
+    -------
+    object
+        ``result``.
+    """
     result.prbs = run
     result.checks = list(result.checks) + list(run.checks)
     if run.nrms is not None and run.nrms >= NRMS_LIMIT:

@@ -28,7 +28,7 @@ from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
 from .netlist import plant_netlist
 
-__all__ = ["bode_png", "schematic", "sine_text", "step_png", "summary_text", "waveforms_csv", "write_outputs"]
+__all__ = ["bode_png", "prbs_blocks", "prbs_png", "prbs_texts", "prbs_waveforms_csv", "schematic", "sine_text", "step_png", "summary_text", "waveforms_csv", "write_outputs"]
 
 METRIC_ROWS = (("overshoot_pct", N_("overshoot Mp"), lambda v: _("n/a") if v is None else f"{v:.4g} %"),
                ("peak_time_s", N_("peak time tp"), R.fmt_time),
@@ -68,7 +68,7 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
            (_("Wiring"), [R.table([_("part"), _("code"), _("from"), _("to")],
                                   wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee)))]),
            (_("Bench test: what the scope shows"), _bench(result)),
-           *([(_("Bench test under a PRBS (--stimulus prbs)"), _prbs(result))] if result.prbs is not None else []),
+           *([(_("Bench test under a PRBS (--stimulus prbs)"), prbs_blocks(result))] if result.prbs is not None else []),
            (_("Target and achieved"), _targets(result)),
            (_("Checks"), [R.table([_("check"), _("result"), _("detail")],
                                   [[_(c.title), _("ok") if c.ok else _("FAILED"), c.shown()] for c in result.checks])])]
@@ -184,8 +184,20 @@ def _bench(result):
     return blocks
 
 
-def _prbs(result):
-    """The generator's settings for the sequence, why they were chosen, and what to compare."""
+def prbs_blocks(result):
+    """The generator's settings for the sequence, why they were chosen, and what to compare (any plant's
+    ``prbs``: the Sallen-Key plant's and a section plant's sheet).
+
+    Parameters
+    ----------
+    result : PlantResult or designer.plant.circuit_design.CircuitPlantResult
+        The plant, with its PRBS run.
+
+    Returns
+    -------
+    list
+        The sheet's blocks.
+    """
     run = result.prbs
     p = run.plan
     lo, hi = p.offset - p.amplitude, p.offset + p.amplitude
@@ -347,7 +359,18 @@ def step_png(result) -> bytes:
 
 def prbs_png(result) -> bytes:
     """The last period of the PRBS run: the generator, the output (SPICE when
-    simulated) and the op-amp-aware model, their difference below."""
+    simulated) and the op-amp-aware model, their difference below.
+
+    Parameters
+    ----------
+    result : PlantResult or designer.plant.circuit_design.CircuitPlantResult
+        The plant, with its PRBS run.
+
+    Returns
+    -------
+    bytes
+        The PNG.
+    """
     run = result.prbs
     c, p = run.capture, run.plan
     last = c.time_s >= (p.periods - 1) * p.period_s
@@ -415,7 +438,18 @@ def waveforms_csv(result) -> str:
 
 def prbs_waveforms_csv(result) -> str:
     """The plant under the PRBS as CSV (``time_s,input_v,output_v,analytic_opamp_v``;
-    output is SPICE when simulated): what ``identify`` reads and a capture is compared with."""
+    output is SPICE when simulated): what ``identify`` reads and a capture is compared with.
+
+    Parameters
+    ----------
+    result : PlantResult or designer.plant.circuit_design.CircuitPlantResult
+        The plant, with its PRBS run.
+
+    Returns
+    -------
+    str
+        The CSV text.
+    """
     return _columns_csv(result.prbs.capture.columns())
 
 
@@ -441,6 +475,29 @@ def schematic(result):
     """
     from .schematic import draw_plant
     return draw_plant(build_board(result), result.opamp)
+
+
+def prbs_texts(result) -> dict:
+    """The bundle's files of a PRBS run (none without one): the generator's (prbs.csv, prbs_awg.csv, as
+    make-prbs writes them), its deck (prbs-test.cir) and the run as waveforms.csv (what identify reads).
+
+    Parameters
+    ----------
+    result : PlantResult or designer.plant.circuit_design.CircuitPlantResult
+        The plant.
+
+    Returns
+    -------
+    dict
+        Key -> (file name, text of the result), :func:`designer.report.bundle.write_design`'s form.
+    """
+    if result.prbs is None:
+        return {}
+    from ..core.prbs import awg_csv, time_value_csv
+    return {"waveforms_csv": ("waveforms.csv", prbs_waveforms_csv),
+            "prbs_csv": ("prbs.csv", lambda r: time_value_csv(r.prbs.plan)),
+            "prbs_awg_csv": ("prbs_awg.csv", lambda r: awg_csv(r.prbs.plan)),
+            "prbs_deck": ("prbs-test.cir", lambda r: r.prbs.deck)}
 
 
 #: the sheet's plots: (file name, drawing function of the result)
@@ -470,12 +527,7 @@ def write_outputs(result, out_dir, name: str, lang: str | None = None) -> dict:
         The files written.
     """
     texts = {"waveforms_csv": ("waveforms.csv", waveforms_csv), "bom_csv": ("bom.csv", lambda r: bom_csv(bom(r)))}
-    if result.prbs is not None:
-        from ..core.prbs import awg_csv, time_value_csv
-        texts.update({"waveforms_csv": ("waveforms.csv", prbs_waveforms_csv),
-                      "prbs_csv": ("prbs.csv", lambda r: time_value_csv(r.prbs.plan)),
-                      "prbs_awg_csv": ("prbs_awg.csv", lambda r: awg_csv(r.prbs.plan)),
-                      "prbs_deck": ("prbs-test.cir", lambda r: r.prbs.deck)})
+    texts.update(prbs_texts(result))
     texts.update(csv_texts(result))   # monte-carlo.csv: one row per sample, every varied part and figure
     prbs_plots = (("prbs.png", prbs_png),) if result.prbs is not None else ()
     with language(lang):

@@ -25,8 +25,9 @@ import numpy as np
 from ..core.errors import DesignError
 from . import spice_engine
 
-__all__ = ["plant_monte_carlo_engine", "replay", "replay_result", "replay_values", "run_engine",
-           "section_monte_carlo_engine", "spice_evaluate", "spice_samples"]
+__all__ = ["drawn_values", "plant_monte_carlo_engine", "replay", "replay_result", "replay_values", "run_engine",
+           "section_context", "section_monte_carlo_engine", "section_replay", "section_replay_result",
+           "spice_evaluate", "spice_samples"]
 
 ENGINES = ("analytic", "spice", "both")
 #: the seed of the random part of --spice-samples: SeedSequence(seed, spawn_key=(RANDOM_KEY,)) (chunks use (c,))
@@ -354,8 +355,7 @@ def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, samp
                                           circuit=(nominal, circuit.evaluate, model), **kw)
     if engine == "analytic":
         return draw()
-    ctx = spice_ac.context(result.deck, result.netlist, result.section, nominal, result.figures["ideal"]["fn_hz"],
-                           simulator, result.opamp)
+    ctx = section_context(result, simulator)
     settings = {"engine": engine, "simulator": ctx.simulator, "sweep_hz": [ctx.f_lo_hz, ctx.f_hi_hz],
                 "points_per_decade": spice_ac.POINTS_PER_DECADE,
                 "fn_zeta": "the section's form fitted to the simulated .ac response over the sweep (Levy's least "
@@ -365,6 +365,27 @@ def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, samp
                       engine, spice_k, seed, scale, spice_ac.FIGURES, spice_ac.FIGURES)
 
 
+def section_context(result, simulator: str = "ngspice-cli"):
+    """The SPICE engine's context of a section plant (:func:`designer.tolerance.spice_ac.context`): its
+    ``.ac`` deck, its parts as built, the sweep about its ideal fn.
+
+    Parameters
+    ----------
+    result : designer.plant.circuit_design.CircuitPlantResult
+        The design.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    designer.tolerance.spice_ac.AcContext
+        The context.
+    """
+    from . import spice_ac
+    return spice_ac.context(result.deck, result.netlist, result.section, dict(result.values),
+                            result.figures["ideal"]["fn_hz"], simulator, result.opamp)
+
+
 class Replay:
     """One Monte Carlo sample replayed (``--replay I``): its index, the draw's settings, its parts'
     values and its figures from the SPICE engine and the model (the result's ``monte_carlo``)."""
@@ -372,8 +393,11 @@ class Replay:
     #: no spread to draw: the sheet shows the build itself (designer.report.tolerance)
     headline = None
 
-    def __init__(self, index: int, settings: dict, values: dict, spice: dict, model: dict):
+    def __init__(self, index: int, settings: dict, values: dict, spice: dict, model: dict,
+                 measured=spice_engine.FIGURES, shared=spice_engine.SHARED):
         self.index, self.settings, self.values, self.spice, self.model = index, settings, values, spice, model
+        # the figures the engine measures (printed) and those the model gives too (model_<figure> in the CSV)
+        self.measured, self.shared = tuple(measured), tuple(shared)
 
     def to_dict(self) -> dict:
         f = lambda d: {k: (None if not np.isfinite(v) else float(v)) for k, v in d.items()}  # noqa: E731
@@ -384,7 +408,7 @@ class Replay:
         from .stats import samples_csv
         text = samples_csv({k: np.array([v]) for k, v in self.values.items()},
                            {**{k: np.array([v]) for k, v in self.spice.items()},
-                            **{f"model_{k}": np.array([self.model[k]]) for k in spice_engine.SHARED}})
+                            **{f"model_{k}": np.array([self.model[k]]) for k in self.shared}})
         head, row = text.split("\n", 1)
         return head + "\n" + str(self.index) + row[row.index(","):]
 
@@ -392,8 +416,8 @@ class Replay:
         st = self.settings
         return [f"Replay of Monte Carlo sample {self.index} (of {st['samples']}, {st['sampler']}, {st['dist']}, "
                 f"seed {st['seed']}): " + ", ".join(f"{k} {v:.6g}" for k, v in self.values.items()),
-                "  SPICE engine: " + ", ".join(f"{k} {self.spice[k]:.5g}" for k in spice_engine.FIGURES),
-                "  model: " + ", ".join(f"{k} {self.model[k]:.5g}" for k in spice_engine.SHARED)]
+                "  SPICE engine: " + ", ".join(f"{k} {self.spice[k]:.5g}" for k in self.measured),
+                "  model: " + ", ".join(f"{k} {self.model[k]:.5g}" for k in self.shared)]
 
 
 def replay_values(parts, series: dict, opamp, index: int, n: int, seed: int, sampler: str, dist: str,
@@ -425,12 +449,45 @@ def replay_values(parts, series: dict, opamp, index: int, n: int, seed: int, sam
     tuple
         (nominal, tolerances, values).
     """
-    from . import sampling
     from .montecarlo import plant_parts
+    return drawn_values(plant_parts(parts), series, opamp, index, n, seed, sampler, dist, tol_items)
+
+
+def drawn_values(parts: dict, series: dict, opamp, index: int, n: int, seed: int, sampler: str, dist: str,
+                 tol_items=()) -> tuple:
+    """(nominal, tolerances, values) of build ``index`` of an ``n``-build draw over the parts ``parts``
+    (designator -> nominal value, any circuit's) and the op-amp's spread figures: exactly the values
+    :func:`designer.tolerance.montecarlo.plant_monte_carlo` drew for it.
+
+    Parameters
+    ----------
+    parts : dict
+        Designator -> nominal value, in the Monte Carlo's order.
+    series : dict
+        ``{"R": series, "C": series}``.
+    opamp : designer.core.opamps.OpAmp
+        The op-amp.
+    index : int
+        The build.
+    n : int
+        The draw's builds.
+    seed : int
+        The seed.
+    sampler, dist : str
+        How the builds are drawn.
+    tol_items : sequence of str
+        The ``--tol`` items.
+
+    Returns
+    -------
+    tuple
+        (nominal, tolerances, values).
+    """
+    from . import sampling
     from .parts import opamp_nominal, resolve
     if not 0 <= index < n:
         raise DesignError(f"--replay {index}: the Monte Carlo has samples 0 to {n - 1}")
-    nominal = {**plant_parts(parts), **opamp_nominal(tol_items, opamp)}
+    nominal = {**parts, **opamp_nominal(tol_items, opamp)}
     tol = resolve(tol_items, nominal, series)
     v = sampling.values(nominal, tol.of, n, seed, sampler, dist, start=index, stop=index + 1)
     return nominal, tol, {k: float(a[0]) for k, a in v.items()}
@@ -514,6 +571,86 @@ def replay_result(result, rep: Replay, simulator: str, r_series=None, c_series=N
     spec = _SampleSpec(parts, opamp=result.opamp.name, r_series=r_series, c_series=c_series,
                        amplitude_v=result.test.amplitude_v, square_hz=result.test.frequency_hz, package=package)
     out = analyze_plant(spec, simulate=True, simulator=simulator)
+    out.notes.append(f"Monte Carlo sample {rep.index} replayed (seed {rep.settings['seed']}, "
+                     f"{rep.settings['sampler']}, {rep.settings['dist']}): these are its exact drawn values")
+    out.monte_carlo = rep
+    return out
+
+
+def section_replay(result, series: dict, index: int, n: int, seed: int, sampler: str, dist: str, tol_items=(),
+                   simulator: str = "ngspice-cli") -> Replay:
+    """Build ``index`` of the Monte Carlo on a section plant's parts (:func:`section_monte_carlo_engine`'s
+    draw), through its SPICE engine (the build's ``.ac`` in ngspice, :func:`designer.tolerance.spice_ac.section_chunk`:
+    the row ``--engine spice`` gives it) and the analytic engine.
+
+    Parameters
+    ----------
+    result : designer.plant.circuit_design.CircuitPlantResult
+        The design.
+    series : dict
+        ``{"R": series, "C": series}``.
+    index : int
+        The build replayed.
+    n : int
+        The draw's builds.
+    seed : int
+        The seed.
+    sampler, dist : str
+        How the builds are drawn.
+    tol_items : sequence of str
+        The ``--tol`` items.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    Replay
+        The build's values and figures.
+    """
+    from ..plant import circuit
+    from . import spice_ac
+    _, tol, v = drawn_values(dict(result.values), series, result.opamp, index, n, seed, sampler, dist, tol_items)
+    arr = {k: np.array([x]) for k, x in v.items()}
+    ctx = section_context(result, simulator)
+    model = (result.topology, result.opamp)
+    sp = spice_ac.section_chunk(ctx, model, arr, start=index)
+    figs = circuit.evaluate(model, arr)
+    settings = {"samples": n, "seed": seed, "sampler": sampler, "dist": dist, "engine": "spice",
+                "simulator": ctx.simulator, "tolerances_pct": tol.to_dict()}
+    return Replay(index, settings, v, {k: float(a[0]) for k, a in sp.items()},
+                  {k: float(figs[k][0]) for k in spice_ac.FIGURES}, spice_ac.FIGURES, spice_ac.FIGURES)
+
+
+def section_replay_result(result, rep: Replay, simulator: str, square_hz=None):
+    """The analysis (sheet, deck, SPICE's ``.ac`` check) of the replayed build's parts as drawn (no E-series
+    rounding) on the design's section and op-amp (with the build's gain-bandwidth and slew rate when they
+    vary); its ``monte_carlo`` is the :class:`Replay`.
+
+    Parameters
+    ----------
+    result : designer.plant.circuit_design.CircuitPlantResult
+        The design.
+    rep : Replay
+        The build replayed.
+    simulator : str
+        The backend.
+    square_hz : float or str, optional
+        The square-wave bench test's frequency (None: none).
+
+    Returns
+    -------
+    designer.plant.circuit_design.CircuitPlantResult
+        The analysis of the build (``mode`` "analyze").
+    """
+    from ..plant.circuit_design import analyze_circuit_plant
+    from .parts import sample_opamp
+    topo = result.section
+    values = {r: rep.values[r] for r in topo.designators}
+    amp = sample_opamp(result.opamp, {k: np.array([x]) for k, x in rep.values.items()}, 0)
+    s = result.sourcing
+    out = analyze_circuit_plant(topo.name, values, amp, result.target.fc_hz, result.target.zeta, s.r_series,
+                                s.c_series, result.package, simulate=True, simulator=simulator,
+                                amplitude_v=result.amplitude_v, square_hz=square_hz)
     out.notes.append(f"Monte Carlo sample {rep.index} replayed (seed {rep.settings['seed']}, "
                      f"{rep.settings['sampler']}, {rep.settings['dist']}): these are its exact drawn values")
     out.monte_carlo = rep

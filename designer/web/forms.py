@@ -393,9 +393,6 @@ def plant_request(options) -> PlantRequest:
     mc = _monte_carlo(v, ("n", "seed", "sampler", "dist", "tol", "limits", "target_ci", "engine", "spice_samples"))
     simulator = _simulator(v, "pyspice")
     stimulus = _stimulus(v)
-    if spec.topology != DEFAULT_TOPOLOGY and stimulus is not None:
-        raise ParamError("{stimulus}: the PRBS test is the %s's for now; another topology has the .ac check, the "
-                         "square-wave test and the Monte Carlo" % DEFAULT_TOPOLOGY, ("stimulus",))
     where = "" if spec.topology == DEFAULT_TOPOLOGY else f"_{spec.topology}"
     name = _name(v, f"plant{where}_fc{spec.fc_hz:g}" + ("" if spec.zeta is None else f"_z{spec.zeta:g}")
                  + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
@@ -450,10 +447,6 @@ def analyze_plant_request(options) -> AnalyzePlantRequest:
         if named:
             raise ParamError("{%s} is the %s's; give %s's parts as {part} (%s)" % (
                 named[0], DEFAULT_TOPOLOGY, topo.name, ", ".join(topo.designators)), (named[0], "part"))
-        unsupported = [k for k, given in (("stimulus", stimulus), ("replay", replay)) if given is not None]
-        if unsupported:
-            raise ParamError("{%s} is the %s's for now; another topology has the .ac check, the square-wave test "
-                             "and the Monte Carlo" % (unsupported[0], DEFAULT_TOPOLOGY), tuple(unsupported))
         values = check_circuit_parts(topo, parts)
         circuit = {"topology": topo.name, "values": values, **bench}
     else:

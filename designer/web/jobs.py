@@ -247,6 +247,14 @@ def analyze_plant_task(fields: dict, want: str = "json", tmp: str | None = None)
         from ..plant.design import analyze_plant
         from .forms import analyze_plant_request
         rq = analyze_plant_request(fields)
+        if rq.circuit is not None and rq.replay is not None:   # a section's build replayed, as the Sallen-Key's
+            from ..tolerance.spice_mc import section_replay, section_replay_result
+            result, mc = analyze_circuit_plant(**rq.circuit, simulate=False), rq.monte_carlo
+            s = result.sourcing
+            build = section_replay(result, {"R": s.r_series, "C": s.c_series}, rq.replay, mc.n, mc.seed, mc.sampler,
+                                   mc.dist, mc.tol, rq.simulator)
+            result = section_replay_result(result, build, rq.simulator, rq.circuit.get("square_hz"))
+            return _circuit_answer(result, rq, want, tmp, lang, f"{rq.name}_sample{rq.replay}")
         if rq.circuit is not None:   # another registered section's parts
             return _circuit_plant(analyze_circuit_plant(**rq.circuit, simulate=rq.simulate, simulator=rq.simulator),
                                   rq, want, tmp, lang)
@@ -290,14 +298,17 @@ def _plant_answer(result, rq, want: str, tmp: str | None, lang: str | None, name
 def _circuit_plant(result, rq, want: str, tmp: str | None, lang: str | None) -> tuple:
     """A plant on a registered topology other than the seed's (designed, :func:`designer.plant.circuit_design.
     design_circuit_plant`, or as built), with the Monte Carlo (the analytic engine, or every build's .ac in
-    ngspice) and worst case over its declared parts, as design-plant --topology runs them; as
-    :func:`_library_task`'s ``work`` answers."""
+    ngspice) and worst case over its declared parts and the PRBS bench test, as design-plant --topology runs
+    them; as :func:`_library_task`'s ``work`` answers."""
     from ..plant import circuit
     from ..plant.circuit_design import tolerance_nominal
-    from ..plant.circuit_report import write_outputs
     from ..tolerance.parts import resolve
     from ..tolerance.spice_mc import section_monte_carlo_engine
     from ..tolerance.worstcase import worst_case
+    if rq.stimulus is not None:
+        from ..plant.circuit_prbs import with_section_prbs
+        result = with_section_prbs(result, result.amplitude_v, rq.stimulus[0], rq.stimulus[1], rq.simulate,
+                                   rq.simulator)
     series = {"R": result.sourcing.r_series, "C": result.sourcing.c_series}
     nominal, context, mc = tolerance_nominal(result), (result.topology, result.opamp), rq.monte_carlo
     if rq.worst_case:
@@ -307,11 +318,18 @@ def _circuit_plant(result, rq, want: str, tmp: str | None, lang: str | None) -> 
         result.monte_carlo = section_monte_carlo_engine(result, series, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol,
                                                         mc.limits, mc.engine, mc.spice_samples, rq.simulator,
                                                         target_ci=mc.target_ci)
+    return _circuit_answer(result, rq, want, tmp, lang, rq.name)
+
+
+def _circuit_answer(result, rq, want: str, tmp: str | None, lang: str | None, name: str) -> tuple:
+    """A section plant's result as the page takes it: its files written under ``name`` for a sheet or bundle,
+    its JSON with the command line ``rq`` stands for, its page."""
+    from ..plant.circuit_report import write_outputs
     if want in ("sheet", "bundle"):
-        write_outputs(result, tmp, rq.name)
+        write_outputs(result, tmp, name)
     data = json.loads(json.dumps(result.to_dict()))
     data["tool"]["argv"] = rq.argv + ([f"--lang={lang}"] if lang else [])
-    return data, lambda: circuit_plant_page(result), rq.name
+    return data, lambda: circuit_plant_page(result), name
 
 
 def circuit_plant_page(result) -> dict:

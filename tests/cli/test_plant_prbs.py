@@ -91,3 +91,39 @@ def test_help_states_the_stimulus():
     out = run("design-plant", "--help")
     assert "--stimulus" in out.stdout and "--prbs-bits" in out.stdout and "3 to 20" in out.stdout
     assert "--stimulus" in run("analyze-plant", "--help").stdout
+
+
+@pytest.mark.spice
+def test_identify_recovers_a_section_plants_fn_from_its_prbs_run(tmp_path):
+    """Issue 26: --stimulus prbs on a section plant (an inverting MFB low-pass): the generator's files, the
+    run, and identify on the written run recovers the op-amp-aware model's fn (within 2 %) and gain."""
+    out = run("design-plant", "--fc", "1k", "--zeta", "0.5", "--topology", "mfb-lowpass", "--stimulus", "prbs",
+              "--json", "--out", str(tmp_path), "--simulator", "ngspice-cli")
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    files, p = d["files"], d["prbs"]
+    plan = PrbsPlan(p["bits"], p["dt_s"], p["amplitude"], p["offset"], p["periods"])
+    assert Path(files["prbs_csv"]).read_text() == time_value_csv(plan)
+    assert Path(files["prbs_awg_csv"]).read_text() == awg_csv(plan)
+    assert "Xgen vin prbs_source" in Path(files["prbs_deck"]).read_text()
+    assert p["simulator"] == "ngspice-cli" and p["spice_vs_model_nrms"] < 1e-3
+    md = Path(files["build_sheet_md"]).read_text()
+    assert "under a PRBS" in md and f"{p['bits']} bits" in md and "(prbs.png)" in md
+    ident = run("identify", files["waveforms_csv"], "--json")
+    assert ident.returncode == 0, ident.stderr
+    best = json.loads(ident.stdout)["best"]
+    fn = d["built"]["opamp"]["fn_hz"]
+    assert best["params"]["wn_rad_s"] / (2 * math.pi) == pytest.approx(fn, rel=0.02)
+    assert best["params"]["K"] == pytest.approx(-d["built"]["ideal"]["gain"], rel=0.02)   # inverting
+
+
+def test_analyze_plant_on_a_section_takes_the_stimulus_and_its_options():
+    out = run("analyze-plant", "--topology", "rc-highpass", "--part", "R1=16k", "--part", "C1=10n",
+              "--stimulus", "prbs", "--prbs-bits", "8", "--prbs-clock", "20k", "--amplitude", "1", "--no-sim",
+              "--no-files", "--json")
+    assert out.returncode == 0, out.stderr
+    p = json.loads(out.stdout)["prbs"]
+    assert (p["bits"], p["clock_hz"], p["simulator"]) == (8, pytest.approx(20e3), None)
+    assert (p["low_v"], p["high_v"]) == (0.0, 1.0)
+    # a high-pass blocks the offset: its output swings about 0 V
+    assert p["output_min_v"] < 0 < p["output_max_v"]

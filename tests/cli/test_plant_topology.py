@@ -175,7 +175,8 @@ def test_engine_both_on_a_section_runs_each_build_s_ac_in_ngspice(tmp_path):
 
 
 @pytest.mark.parametrize("args, words", [
-    (["--monte-carlo", "20", "--replay", "3"], ["--replay", "sallen-key-lowpass's for now", "--engine analytic, spice"]),
+    (["--monte-carlo", "20", "--replay", "3"], ["--replay simulates the build in SPICE: drop --no-sim"]),
+    (["--replay", "3"], ["--replay I goes with --monte-carlo N"]),
     (["--engine", "spice"], ["--engine spice goes with --monte-carlo N"]),
     (["--monte-carlo", "20", "--spice-samples", "2"], ["--spice-samples K goes with --engine both"]),
     (["--monte-carlo", "20", "--engine", "spice", "--tol", "SR=20%"], ["--tol SR", "linear", "drop SR from --tol"]),
@@ -242,3 +243,26 @@ def test_tol_gbw_on_a_section_spreads_the_op_amp_in_both_engines(engine, tmp_pat
         assert float(row[model]) == pytest.approx(float(want), rel=1e-9)
     if engine == "both":
         assert np.allclose(col("fn_hz"), col("model_fn_hz"), rtol=0.01)
+
+
+def test_replay_on_a_section_is_the_monte_carlos_build(tmp_path):
+    """Issue 26: --replay I on a section plant: build I of the Monte Carlo with the same options (seed, sampler,
+    dist, --tol), its exact values analysed and simulated alone, its bundle under <name>_sample<I>; printed as the
+    Sallen-Key replay is."""
+    args = [*target_args(REGISTRY["sallen-key-highpass"]), "--monte-carlo", "20", "--seed", "4", "--sampler", "sobol",
+            "--dist", "normal", "--tol", "C=2%", "--simulator", "ngspice-cli"]
+    mc = run(*args, "--json", "--out", str(tmp_path / "mc"))
+    assert mc.returncode == 0, mc.stderr
+    with open(json.loads(mc.stdout)["files"]["monte_carlo_csv"], newline="") as fh:
+        row = list(csv.DictReader(fh))[5]
+    out = run(*args, "--replay", "5", "--json", "--out", str(tmp_path / "r"))
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    rep = d["monte_carlo"]["replay"]
+    assert rep["sample"] == 5 and d["mode"] == "analyze" and d["spice"]["pass"]
+    for ref in REGISTRY["sallen-key-highpass"].designators:
+        assert rep["values"][ref] == pytest.approx(float(row[ref]), rel=1e-9)
+        assert d["parts"][ref]["value"] == rep["values"][ref]
+    assert Path(d["files"]["result_json"]).parent.name.endswith("_sample5")
+    text = run(*args, "--replay", "5", "--no-files")
+    assert text.returncode == 0 and "Replay of Monte Carlo sample 5 (of 20, sobol, normal, seed 4)" in text.stdout

@@ -143,3 +143,38 @@ def test_spice_samples_run_on_the_runners_workers(seed_plant, monkeypatch):
     picked = [tasks for kind, tasks in seen if kind == "Picked"]
     assert len(picked) == 1 and len(picked[0]) >= 2     # the checked builds, in chunks on two workers
     assert one.to_dict() == two.to_dict() and one.csv_text() == two.csv_text()
+
+
+@pytest.fixture(scope="module")
+def mfb_plant():
+    from designer.plant.circuit_design import design_circuit_plant
+    return design_circuit_plant(PlantSpec(fc_hz=1000, zeta=0.5, gain=2, topology="mfb-lowpass"), simulate=False)
+
+
+@pytest.mark.parametrize("sampler", ["random", "lhs", "sobol"])
+def test_a_section_replay_draws_the_builds_values_again(mfb_plant, sampler):
+    """Issue 26: --replay I on a section plant draws build I of the analytic Monte Carlo over its parts."""
+    from designer.tolerance.spice_mc import drawn_values, section_monte_carlo_engine
+    full = section_monte_carlo_engine(mfb_plant, SERIES, 200, seed=7, sampler=sampler, dist="normal",
+                                      tol_items=["R3=1%"])
+    for i in (0, 77, 199):
+        _, _, v = drawn_values(dict(mfb_plant.values), SERIES, mfb_plant.opamp, i, 200, 7, sampler, "normal",
+                               ["R3=1%"])
+        assert v == {k: a[i] for k, a in full.values.items()}
+
+
+def test_a_section_replay_gives_the_spice_engines_row(mfb_plant):
+    """The replayed build's figures are the SPICE engine's row I (its .ac fitted, the model's beside); its
+    bundle is the analysis of its exact values."""
+    from designer.tolerance.spice_mc import section_monte_carlo_engine, section_replay, section_replay_result
+    mc = section_monte_carlo_engine(mfb_plant, SERIES, 12, seed=3, engine="spice", simulator="ngspice-cli")
+    rep = section_replay(mfb_plant, SERIES, 9, 12, 3, "random", "uniform", simulator="ngspice-cli")
+    assert rep.values == {k: mc.values[k][9] for k in mfb_plant.section.designators}
+    assert set(rep.spice) == set(mc.figures)
+    for k, v in rep.spice.items():
+        assert v == pytest.approx(mc.figures[k][9], rel=1e-9)
+    row = np.genfromtxt(io.StringIO(rep.csv_text()), delimiter=",", names=True)
+    assert int(row["sample"]) == 9 and float(row["model_fn_hz"]) == pytest.approx(rep.model["fn_hz"], rel=1e-9)
+    out = section_replay_result(mfb_plant, rep, "ngspice-cli")
+    assert out.values == rep.values and out.mode == "analyze" and out.spice["pass"]
+    assert out.to_dict()["monte_carlo"]["replay"]["sample"] == 9

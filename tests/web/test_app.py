@@ -47,8 +47,7 @@ def without_run_details(d: dict) -> dict:
 @pytest.mark.spice
 def test_a_section_plant_runs_its_spice_monte_carlo_as_design_plant_does(server):
     """Issue 26: a plant on another section takes the SPICE engine on the page too (every build's .ac in
-    ngspice), its JSON design-plant --topology's; its page has the schematic; the PRBS test is refused by
-    its field."""
+    ngspice), its JSON design-plant --topology's; its page has the schematic."""
     body = {"fc": 3500, "zeta": 0.2, "topology": "mfb-lowpass", "opamp": "TL072", "monte-carlo": 10, "seed": 2,
             "engine": "both", "simulator": "ngspice-cli"}
     status, got = server.post_json("/api/plant?view=page", body)
@@ -59,8 +58,38 @@ def test_a_section_plant_runs_its_spice_monte_carlo_as_design_plant_does(server)
     assert without_run_details(got["result"]) == without_run_details(want)
     assert got["result"]["monte_carlo"]["settings"]["engine"] == "both" and got["result"]["monte_carlo"]["spice"]
     assert got["page"]["schematic_svg"].lstrip().startswith("<")
-    status, bad = server.post_json("/api/plant", {**body, "stimulus": "prbs"})
-    assert status == 400 and bad["field"] == "stimulus" and "--" not in bad["error"], bad
+
+
+@pytest.mark.spice
+def test_a_section_plant_plays_the_prbs_as_design_plant_does(server):
+    """Issue 26: the PRBS bench test of a section plant through the page's fields: the JSON design-plant
+    --topology --stimulus prbs prints (the run simulated in ngspice), its sheet with the run."""
+    body = {"fc": 1000, "zeta": 0.5, "topology": "sallen-key-highpass", "opamp": "TL072", "stimulus": "prbs",
+            "prbs-bits": 8, "simulator": "ngspice-cli"}
+    status, got = server.post_json("/api/plant?view=page", body)
+    assert status == 200, got
+    want = cli_json("design-plant", "--fc", "1000", "--zeta", "0.5", "--topology", "sallen-key-highpass", "--opamp",
+                    "TL072", "--stimulus", "prbs", "--prbs-bits", "8", "--simulator", "ngspice-cli", "--json",
+                    "--no-files")
+    assert without_run_details(got["result"]) == without_run_details(want)
+    assert got["result"]["prbs"]["bits"] == 8 and got["result"]["prbs"]["simulator"] == "ngspice-cli"
+    assert "PRBS" in got["page"]["sheet_html"]
+
+
+@pytest.mark.spice
+def test_a_section_build_replays_as_analyze_plant_does(server):
+    """Issue 26: analyze-plant --topology --replay I through the page's fields: the build's exact values, its
+    .ac in ngspice, the JSON analyze-plant prints."""
+    parts = ["R1=16k", "C1=10n"]
+    body = {"topology": "rc-highpass", "part": parts, "monte-carlo": 15, "seed": 2, "replay": 6,
+            "simulator": "ngspice-cli"}
+    status, got = server.post_json("/api/analyze-plant?view=page", body)
+    assert status == 200, got
+    want = cli_json("analyze-plant", "--topology", "rc-highpass", "--part", parts[0], "--part", parts[1],
+                    "--monte-carlo", "15", "--seed", "2", "--replay", "6", "--simulator", "ngspice-cli", "--json",
+                    "--no-files")
+    assert without_run_details(got["result"]) == without_run_details(want)
+    assert got["result"]["monte_carlo"]["replay"]["sample"] == 6 and got["page"]["histograms"] == []
 
 
 def test_plant_answers_design_plants_json(server):
