@@ -195,6 +195,57 @@ def test_a_hold_tie_is_broken_by_the_inputs_levels():
     assert fits["zoh"].params["theta_s"] == pytest.approx(1.3, rel=0.05)
 
 
+def test_a_noise_capture_too_short_for_the_spectrum_has_the_output_error_route():
+    """400 samples of a random binary signal (p 0.3 every 50 ms, seeded) into K 2,
+    tau 1 s, theta 0.3 s: too few for the spectral estimate (512), which refused
+    the whole capture; the output-error fit needs 50. The routes are skipped
+    with that reason and the record is scored on itself (too short to split);
+    a route asked for by name keeps the refusal."""
+    ts, n = 0.05, 400
+    levels = (np.cumsum(np.random.default_rng(5).random(n) < 0.3) % 2).astype(float)
+
+    def held(x):
+        return levels[np.clip(np.floor(np.asarray(x) / ts + 1e-9).astype(int), 0, n - 1)]
+
+    t, u, y = _fopdt_capture(held, K=2.0, tau=1.0, theta=0.3, ts=ts, n=n)
+    res = identify_record(t, y, u, name="short")
+    a = res.assessment
+    assert res.excitation.kind == "other" and "noise input" in res.excitation.why
+    for route in ("correlation", "spectral"):
+        assert "needs at least 512" in a.skipped[route], a.skipped
+    assert a.scope == "whole"
+    best = a.best_candidate
+    assert best is not None and best.route == "output-error" and best.kind == "fopdt", best
+    assert best.params["K"] == pytest.approx(2.0, rel=0.02)
+    assert best.params["tau_s"] == pytest.approx(1.0, rel=0.05)
+    assert best.params["theta_s"] == pytest.approx(0.3, rel=0.05)
+    with pytest.raises(DesignError, match="needs at least 512"):
+        identify_record(t, y, u, name="short", method="spectral")
+
+
+def test_the_hold_is_chosen_on_each_holds_best_fopdt():
+    """An SOPDT under a random binary signal switching with probability 0.5 (the
+    synthetic grid's capture, 20 and 10 dB, seeded): the zero-order hold's FOPDT
+    stopped in a local minimum of the dead time (theta 4.3 s, rms 2.4 times foh's
+    at 20 dB), so the hold went to foh on the optimiser's luck and the SOPDT's
+    dead time came out half a sample late at 10 dB (0.945 s for 0.9 s). Refitted
+    from foh's optimum the two holds tie and the two-level input is held."""
+    from designer.identify.assess import HOLD_TIE
+    from designer.identify.outputerror import fit_output_error
+    from identify.test_assess_synthetic import PLANTS, capture
+    for snr_db in (20, 10):
+        t, u, _, y = capture("sopdt", "rb0.5", snr_db)
+        a = identify_record(t, y, u, name="sopdt/rb0.5").assessment
+        assert a.hold == "zoh", snr_db
+        est = a.split.estimation
+        foh = fit_output_error(u[est], y[est], a.sample_time_s, "fopdt", hold="foh", initial="estimate")
+        zoh = next(f for f in a.output_error if f.kind == "fopdt")
+        assert zoh.hold == "zoh" and zoh.rms_residual <= (1 + HOLD_TIE) * foh.rms_residual, snr_db
+        best = a.best_candidate
+        assert best.kind == "sopdt"
+        assert best.params["theta_s"] == pytest.approx(PLANTS["sopdt"][1]["theta_s"], rel=0.05), snr_db
+
+
 def test_an_integrator_worse_than_the_mean_is_not_valid():
     """K 2, tau 0.5 s, no dead time, under a sine sweep (0.05 to 2 Hz over 30 s,
     every 20 ms, seeded noise): the integrating fit's dead time sits at 0 (no
