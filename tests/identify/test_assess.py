@@ -102,6 +102,22 @@ def test_bad_input_one_line_each():
     assert uv.size == 150 and uv[1] == 2.0 and "every 2" in how
 
 
+def test_uneven_sample_times_are_refused_in_one_line():
+    """Issue 28's bad input: samples at different intervals (every other one 10 ms
+    late, a random binary input that only the broadband and output-error routes
+    read), and a validation record sampled so: one line each, naming the
+    intervals."""
+    from designer.identify.assess import regular_interval
+    n, ts = 600, 0.02
+    t = np.arange(n) * ts + np.where(np.arange(n) % 2 == 1, 0.01, 0.0)
+    u = np.where(np.cumsum(np.random.default_rng(4).random(n) < 0.2) % 2 == 0, 1.0, -1.0)
+    for call in (lambda: identify_record(t, np.cumsum(u), u, name="uneven"),
+                 lambda: regular_interval(t, "validation record")):
+        with pytest.raises(DesignError, match="not evenly spaced") as err:
+            call()
+        assert "\n" not in str(err.value) and "0.01 s to 0.03 s" in str(err.value)
+
+
 def test_a_record_too_short_for_the_plants_settling_is_refused():
     """K 1, tau 100 s under a random binary signal for 10 s (seeded): no model can be
     valid, and the best-fitting one's dead time plus settling outlasts the record."""
