@@ -2,7 +2,9 @@
 
 ``identify`` reads a CSV step-response capture (generic, Tektronix, Rigol or
 this project's waveforms), runs every classical method of seeds 000-003 plus
-least squares, and prints them ranked by IAE; a frequency-response table given
+least squares, and prints them ranked by IAE; a capture under any other
+recorded input goes to the correlation, spectral and output-error routes, and
+every route's models are scored on held-out data (issue 28); a frequency-response table given
 to it (a header naming a frequency and a gain column, as identify-freq reads
 it) is analysed as ``identify-freq`` does, never fitted as a step.
 ``identify-freq`` reads a table of frequency, gain and (optionally) phase,
@@ -267,9 +269,11 @@ def build_parser() -> argparse.ArgumentParser:
     argparse.ArgumentParser
         The parser of ``identify``'s options.
     """
-    p = _parser("identify", "Identify plant models (FOPDT, double pole, second order with dead\n"
-                "time) from a measured or simulated step response, ranked by IAE.",
-                identify_epilog(), "CSV file with the step response", "capture")
+    p = _parser("identify", "Identify plant models (FOPDT, two lags, second order, integrating, with dead\n"
+                "time) from a capture under any recorded input: a step (its methods ranked by IAE),\n"
+                "a square wave, a sequence, noise, a chirp or anything else (output-error fits);\n"
+                "every route's models scored on data they were not fitted to, the best by validation fit.",
+                identify_epilog(), "CSV file with the step response, or the record under any input", "capture")
     p.add_argument("--step-time", metavar="T",
                    help="when the input stepped, in seconds " + help_range("capture_time_s")
                         + " (default: from the input column, else from the output's own edge: "

@@ -69,7 +69,9 @@ white output noise: with coloured noise or a wrong structure they are
 optimistic). A parameter held at its bound has no interval (a dead time at
 0 is a plant without one); any other at a bound makes the model invalid. A
 model is valid when the solver converged, no parameter but the dead time
-sits at a bound, every interval is narrower than its parameter, and the
+sits at a bound, every interval is narrower than its parameter (the dead
+time's exempt but an integrator's, as in the other routes: one reaching 0
+says the data show no dead time), and the
 process model's own ranges (:mod:`designer.core.process_build`) accept it.
 """
 
@@ -738,7 +740,13 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
         if act != 0 and k != "theta_s":
             notes.append(f"{k} at its bound ({params[k]:.4g})")
     for k, h in ci.items():
-        if h is not None and not h < abs(params[k]):
+        # the dead time is exempt, as in the other routes (frequency.wide_interval): an interval reaching 0
+        # says the data show no dead time (a delay-free plant fits theta 66 us +-0.62 ms), not that the
+        # other parameters are undetermined. Not an integrator's: its dead time is its only time, and one
+        # that the data cannot place is a record an integrator cannot be told from a slow lag by (10 s of
+        # a 100 s lag: K 0.0093 /s, theta 0.05 s +-0.17 s), which is refused as too short
+        exempt = k == "theta_s" and not kind.startswith("integrating")
+        if h is not None and not exempt and not h < abs(params[k]):
             notes.append(f"{k}'s 95 % interval +-{h:.3g} is not narrower than {k} = {params[k]:.4g}")
     if kind in ("sopdt", "lead-lag") and params["tau1_s"] < params["tau2_s"]:   # the slow time constant first
         params["tau1_s"], params["tau2_s"] = params["tau2_s"], params["tau1_s"]

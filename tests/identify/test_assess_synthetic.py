@@ -134,8 +134,8 @@ DATA = {
     ("fopdt", "step", 10): "a step at 10 dB: theta 1.404 s (true 1.3 s, +8.0 %)" + _SAME.format(69.70, 69.69),
     ("sopdt", "rb0.1", 10): ("random binary p 0.1 at 10 dB: K 1.537 (+2.5 %), the short lag 1.612 s (true 1.5 s, "
                              "+7.5 %), theta 0.816 s (true 0.9 s, -9.4 %)" + _SAME.format(67.07, 67.06)),
-    ("sopdt", "rb0.5", 10): ("random binary p 0.5 at 10 dB: the short lag 1.402 s (-6.5 %), theta 0.945 s "
-                             "(+5.0 %)" + _SAME.format(36.73, 36.76)),
+    ("sopdt", "rb0.5", 10): ("random binary p 0.5 at 10 dB: the short lag 1.407 s (-6.2 %)"
+                             + _SAME.format(36.73, 36.76)),
     ("sopdt", "step", 20): ("a step at 20 dB: the lags 1.304 s and 4.214 s (true 1.5 s, -13.1 %, and 4 s, +5.3 %)"
                             + _SAME.format(90.01, 90.01)),
     ("sopdt", "step", 10): ("a step at 10 dB: the short lag 1.407 s (-6.2 %), theta 1.076 s (true 0.9 s, +19.6 %)"
@@ -216,3 +216,42 @@ def test_an_integrators_dead_time_is_data_limited(inp):
             <= _rms(true_model("integrating"), ue, ye, a.sample_time_s, a.hold))
     if inp == "step":
         assert [c.name for c in a.candidates if c.route == "step"] == ["integrating-asymptote"]
+
+
+def _tolerance(name: str, want: float) -> float:
+    """The issue's tolerance on one parameter, in its units."""
+    return 0.02 if name == "zeta" else (0.02 if name == "K" else 0.05) * abs(want)
+
+
+@pytest.mark.parametrize("plant, inp, snr_db", [c for c in CASES if c in DATA and c[0] != "integrating"])
+def test_the_settling_plants_misses_are_the_datas(plant, inp, snr_db):
+    """The non-integrating xfails above (10 dB, and an SOPDT under a step at 20
+    dB): the misses are the record's, not the estimator's. The output-error fit
+    of the true structure started from the true parameters ends where the fit
+    from its own starts ends (the same rms: no start, and no ranking among the
+    routes' candidates, can do better by least squares), its in-sample rms from
+    rest is at most the true model's on the same estimation data, and every
+    parameter the best model misses has a 95 % interval wider than the issue's
+    tolerance on it: the record cannot place it that close."""
+    from designer.identify.outputerror import fit_output_error
+    t, u, _, y = capture(plant, inp, snr_db)
+    a = identify_record(t, y, u, name=f"{plant}/{inp}/{snr_db:g} dB").assessment
+    kind, p = PLANTS[plant]
+    est = a.split.estimation if a.split is not None else slice(None)
+    ue, ye, ts = u[est], y[est], a.sample_time_s
+    for initial in ("rest", "estimate"):
+        own = fit_output_error(ue, ye, ts, kind, hold=a.hold, initial=initial)
+        from_truth = fit_output_error(ue, ye, ts, kind, hold=a.hold, initial=initial, start=p)
+        assert from_truth.rms_residual == pytest.approx(own.rms_residual, rel=1e-6), initial
+    rest = fit_output_error(ue, ye, ts, kind, hold=a.hold, initial="rest", start=p)
+    assert _rms(rest.model, ue, ye, ts, a.hold) <= _rms(true_model(plant), ue, ye, ts, a.hold)
+    best = a.best_candidate
+    assert best is not None and best.kind in (kind, "overdamped"), best
+    got, ci, want = dict(best.params), dict(best.ci95), dict(p)
+    if kind == "sopdt":     # the two lags in either order, each with its interval
+        lags = sorted(((got["tau1_s"], ci["tau1_s"]), (got["tau2_s"], ci["tau2_s"])))
+        (got["tau1_s"], ci["tau1_s"]), (got["tau2_s"], ci["tau2_s"]) = lags
+        want["tau1_s"], want["tau2_s"] = sorted((p["tau1_s"], p["tau2_s"]))
+    for name, w in want.items():
+        if abs(got[name] - w) > _tolerance(name, w):
+            assert ci[name] > _tolerance(name, w), (name, got[name], w, ci[name])

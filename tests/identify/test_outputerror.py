@@ -241,6 +241,27 @@ def test_the_fit_is_a_process_model_with_its_intervals():
     assert np.sqrt(np.mean((fit.simulate(u) - y) ** 2)) == pytest.approx(fit.rms_residual, rel=1e-9)
 
 
+def test_a_dead_time_the_data_do_not_show_leaves_the_model_valid():
+    """K 2, tau 0.5 s and no dead time under a random binary signal (p 0.2, 300
+    samples at 20 ms, seeded noise): the dead time comes out a few tens of
+    microseconds, off its bound, with an interval reaching 0. As in the other
+    routes (frequency.wide_interval) that says the plant has no dead time the
+    data show: the model stays valid (it was invalid, and the capture's best
+    model was an integrator of 1 % validation fit)."""
+    from scipy import signal as sig
+    rng = np.random.default_rng(1)
+    n, ts = 2000, 0.02
+    u = np.where(np.cumsum(rng.random(n) < 0.2) % 2 == 0, 1.0, -1.0)
+    b, a, _ = sig.cont2discrete(([2.0], [0.5, 1.0]), ts, method="zoh")
+    y = sig.lfilter(np.squeeze(b), a, u - u[0]) + rng.normal(0, 0.02, n)
+    fit = oe.fit_output_error(u[:300], y[:300], ts, "fopdt", initial="estimate")
+    p, ci = fit.params, fit.ci95
+    assert 0 < p["theta_s"] < ci["theta_s"] < ts, (p, ci)
+    assert fit.valid and "theta_s" not in fit.note
+    assert p["K"] == pytest.approx(2.0, rel=0.02) and p["tau_s"] == pytest.approx(0.5, rel=0.05)
+    assert all(ci[k] < abs(p[k]) for k in ("K", "tau_s"))
+
+
 def test_bad_input_is_refused_in_one_line():
     u = step(n=400)
     with pytest.raises(DesignError, match="same length"):
