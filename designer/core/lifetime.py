@@ -44,8 +44,8 @@ import signal
 import sys
 from contextlib import contextmanager
 
-__all__ = ["Interrupted", "WORDS", "die_with_parent", "finish", "forget", "install", "interruption", "native",
-           "on_exit", "owned_prefix", "preexec", "quiet", "remove_stale", "reset_in_child", "status_of", "to_devnull",
+__all__ = ["Interrupted", "WORDS", "after_native", "die_with_parent", "finish", "forget", "install", "interruption",
+           "native", "on_exit", "owned_prefix", "preexec", "quiet", "remove_stale", "reset_in_child", "status_of", "to_devnull",
            "words_of"]
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
@@ -122,6 +122,7 @@ _prog = None
 _received = None
 _native = 0
 _cleanups: list = []
+_after_native: list = []
 
 
 def install(prog: str) -> None:
@@ -257,6 +258,26 @@ def native():
         yield
     finally:
         _native -= 1
+        if not _native and _after_native:   # what a signal that landed inside it left to do (after_native)
+            todo = list(_after_native)
+            _after_native.clear()
+            for fn in todo:
+                fn()
+
+
+def after_native(fn) -> None:
+    """Call ``fn()`` as the :func:`native` block running now ends, before its caller goes on: a signal
+    handler that runs inside ngspice's callbacks (where cffi would print and swallow what it raises) leaves
+    its exception to be raised there (ngspice's shared library returns between the commands of a Monte
+    Carlo's loop, a signal's handler may never run outside it).
+
+    Parameters
+    ----------
+    fn : callable
+        Called without arguments (it may raise).
+    """
+    if fn not in _after_native:
+        _after_native.append(fn)
 
 
 def in_native() -> bool:
@@ -292,6 +313,7 @@ def reset_in_child() -> None:
     global _native, _received
     _native, _received = 0, None
     _cleanups.clear()
+    _after_native.clear()
     for s in (*SIGNALS, signal.SIGALRM):
         signal.signal(s, signal.SIG_DFL)
     try:

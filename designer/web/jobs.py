@@ -81,14 +81,23 @@ def _starting_a_child(frame) -> bool:
 def _cancel(signum, frame) -> None:
     if not _RUNNING:
         return
-    # inside ngspice's callbacks cffi would swallow it, inside an at-fork hook the interpreter, inside Popen's
-    # start the child it forked would be left running with no one to kill and reap it: again in 5 ms
-    if lifetime.in_native() or (frame is not None and frame.f_globals.get("__name__") in SWALLOWING_MODULES) \
-            or _starting_a_child(frame):
+    # inside ngspice's callbacks cffi would swallow it: raised as the library's command returns (a signal
+    # handled only in those callbacks, as in a SPICE Monte Carlo's loop, would otherwise wait for the whole
+    # loop); inside an at-fork hook the interpreter would swallow it, inside Popen's start the child it forked
+    # would be left running with no one to kill and reap it: again in 5 ms
+    if lifetime.in_native():
+        lifetime.after_native(_superseded)
+        return
+    if (frame is not None and frame.f_globals.get("__name__") in SWALLOWING_MODULES) or _starting_a_child(frame):
         signal.signal(signal.SIGALRM, _cancel)
         signal.setitimer(signal.ITIMER_REAL, 0.005)
         return
     raise Superseded()
+
+
+def _superseded() -> None:
+    if _RUNNING:
+        raise Superseded()
 
 
 def run(task: dict) -> dict:

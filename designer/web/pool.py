@@ -20,11 +20,11 @@ shared with the pool's). A killed worker (past its deadline, or a superseded run
 at once by a spare, a worker forked beforehand and kept idle (:data:`SPARE`), and the spare by a new fork, so
 that the next request waits neither for a warm-up nor for a fork.
 
-A superseded run (:meth:`Pool.cancel`: the page typed on while it ran) is killed at once with its worker's
-process group, whatever it runs: a library call in the worker, ngspice's shared library inside it (which no
-signal interrupts until it returns), an ``ngspice -b`` child. Its worker's place is taken by the spare within
-milliseconds; its request's private folder, where its temporaries are, is removed by the server once the
-pool has answered "superseded".
+A superseded run (:meth:`Pool.cancel`: the page typed on while it ran) is stopped where it is: the pool
+signals its worker (SIGUSR1, :class:`designer.web.jobs.Superseded`), which unwinds, an ``ngspice -b`` it
+waits for killed, and keeps its warm caches; a run inside ngspice's shared library unwinds as soon as the
+library's current command returns. One that has not answered within :data:`SUPERSEDED_GRACE_S` is killed
+with its worker's process group, and the spare takes its place.
 
 A worker that has served ``recycle`` requests (:data:`RECYCLE_AFTER`) is replaced by a fresh
 one between two requests, so that what a long-lived process accumulates (each request left
@@ -48,7 +48,8 @@ from multiprocessing.connection import wait
 from ..core import lifetime
 from ..core.workers import Worker, close_all
 
-__all__ = ["DEFAULT_TIMEOUT_S", "MAX_WAITING", "RECYCLE_AFTER", "SPARE", "STOPPED", "WARM_UP", "Busy", "Pool"]
+__all__ = ["DEFAULT_TIMEOUT_S", "MAX_WAITING", "RECYCLE_AFTER", "SPARE", "STOPPED", "SUPERSEDED_GRACE_S", "WARM_UP",
+           "Busy", "Pool"]
 
 #: seconds a worker may take over one request before it is killed (design-pid's optimiser takes a few)
 DEFAULT_TIMEOUT_S = 120.0
@@ -59,6 +60,8 @@ WARM_UP = {"prog": "warm-up"}
 MAX_WAITING = 256
 #: requests a worker serves before a fresh one replaces it (designer-web --recycle)
 RECYCLE_AFTER = 200
+#: seconds a superseded run has to unwind (keeping its warm worker) before its worker is killed and replaced
+SUPERSEDED_GRACE_S = 0.1
 #: workers forked ahead and kept idle to replace a killed one at once (designer-web's workers plus these)
 SPARE = 1
 #: what a request still waiting when the server stops is answered
@@ -89,7 +92,9 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
     ctx = multiprocessing.get_context("fork")
 
     def fresh():
-        return Worker(ctx, work, None, daemon=False)
+        w = Worker(ctx, work, None, daemon=False)
+        w.superseded = False   # its run's client gone (its answer, whatever it is, is "superseded")
+        return w
 
     workers = [fresh() for _ in range(jobs)]
     # forked ahead and idle: one takes a killed worker's place at once (a superseded run, a run past its
@@ -131,12 +136,15 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                     if any(m[0] == -msg[0] for m in queue):
                         queue = deque(m for m in queue if m[0] != -msg[0])
                         conn.send((-msg[0], "cancelled", None))
-                    for k, w in enumerate(workers):   # under way: killed now with its process group, replaced
-                        if w.task == -msg[0]:
-                            served.pop(w.proc.pid, None)
-                            w.kill()
-                            conn.send((-msg[0], "superseded", None))
-                            replace(k)
+                    for w in workers:   # under way: stopped where it is (designer.web.jobs.Superseded)
+                        if w.task == -msg[0] and not w.superseded:
+                            w.superseded = True
+                            try:
+                                os.kill(w.proc.pid, signal.SIGUSR1)
+                            except ProcessLookupError:
+                                pass
+                            # a run that does not come back (a long call into C) is killed as at its deadline
+                            w.deadline = min(w.deadline, time.monotonic() + SUPERSEDED_GRACE_S)
                 else:
                     queue.append(msg)
             for k, w in enumerate(workers):
@@ -147,7 +155,8 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                         kind, value = w.conn.recv()
                     except (EOFError, OSError):
                         kind, value = "dead", "the worker running it died: the simulator crashed"
-                    conn.send((w.task, kind, value))
+                    # a superseded run's answer, whatever it was (or its death): nobody reads it
+                    conn.send((w.task, "superseded", None) if w.superseded else (w.task, kind, value))
                     served[w.proc.pid] = served.get(w.proc.pid, 0) + 1
                     w.task = None
                     if kind == "dead" or served[w.proc.pid] >= recycle:   # dead, or recycled
@@ -157,11 +166,13 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                 elif time.monotonic() >= w.deadline:
                     served.pop(w.proc.pid, None)
                     w.kill()
-                    conn.send((w.task, "timeout", f"timed out after {timeout:g} s (killed)"))
+                    conn.send((w.task, "superseded", None) if w.superseded else
+                              (w.task, "timeout", f"timed out after {timeout:g} s (killed)"))
                     replace(k)
             for w in workers:
                 if w.task is None and queue:
                     rid, task = queue.popleft()
+                    w.superseded = False
                     w.give(rid, task, timeout)
             while len(spares) < spare:   # after the queue is served: the next request waits for no fork
                 spares.append(fresh())
@@ -249,8 +260,9 @@ class Pool:
 
     def cancel(self, rid: int) -> None:
         """Its client has gone: drop the task if it waits in the queue (answered "cancelled"); a run
-        already started is killed with its worker's process group (its ngspice) and answered
-        "superseded", a spare taking the worker's place."""
+        already started is stopped where it is (answered "superseded" as soon as it has unwound, its
+        ngspice killed; killed with its worker's process group after :data:`SUPERSEDED_GRACE_S`, a spare
+        taking its place)."""
         try:
             self.conn.send((-rid, None))
         except (OSError, ValueError):
