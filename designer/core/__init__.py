@@ -47,5 +47,5 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "waveform": ("crossing_time", "inflection_tangent", "moving_average", "noise_sigma", "normalised_step",
                  "parabola_vertex", "peak_region", "quantum", "refine_peak", "savgol", "smooth_derivative",
                  "tangent_window"),
-    "workers": ("Worker", "close_all", "run_tasks"),
+    "workers": ("Worker", "close_all", "death_of", "run_tasks"),
 })

@@ -46,7 +46,7 @@ from collections import deque
 from multiprocessing.connection import wait
 
 from ..core import lifetime
-from ..core.workers import Worker, close_all
+from ..core.workers import Worker, close_all, death_of
 
 __all__ = ["DEFAULT_TIMEOUT_S", "MAX_WAITING", "RECYCLE_AFTER", "SPARE", "STOPPED", "SUPERSEDED_GRACE_S", "WARM_UP",
            "Busy", "Pool"]
@@ -154,7 +154,7 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                     try:
                         kind, value = w.conn.recv()
                     except (EOFError, OSError):
-                        kind, value = "dead", "the worker running it died: the simulator crashed"
+                        kind, value = "dead", death_of(w)
                     # a superseded run's answer, whatever it was (or its death): nobody reads it
                     conn.send((w.task, "superseded", None) if w.superseded else (w.task, kind, value))
                     served[w.proc.pid] = served.get(w.proc.pid, 0) + 1
