@@ -45,8 +45,8 @@ import sys
 from contextlib import contextmanager
 
 __all__ = ["Interrupted", "WORDS", "after_native", "die_with_parent", "finish", "forget", "install", "interruption",
-           "native", "on_exit", "owned_prefix", "preexec", "quiet", "remove_stale", "reset_in_child", "status_of", "to_devnull",
-           "words_of"]
+           "native", "on_exit", "owned_prefix", "preexec", "quiet", "remove_stale", "reset_in_child", "status_of",
+           "to_devnull", "words_of"]
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 #: what the one line says for each signal
