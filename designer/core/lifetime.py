@@ -16,7 +16,9 @@ however it is stopped.
   signal that arrives there ends the process at once instead
   (:func:`emergency`): the one line, the registered clean-ups (:func:`on_exit`:
   the renderer, worker processes), then ``os._exit``. Nothing is half-written
-  then: no file is being written while ngspice runs.
+  then: no file is being written while ngspice runs. A handler that must raise
+  something else there (the web worker's cancel) leaves it for the block's end
+  (:func:`after_native`): raised as the library's current command returns.
 - **Children die with their parent** (:func:`die_with_parent`, :func:`preexec`
   for a subprocess): every worker, renderer, drawing helper and
   ``ngspice -b`` asks Linux for SIGKILL when its parent dies

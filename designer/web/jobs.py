@@ -52,9 +52,9 @@ BODE_POINTS = 300
 
 class Superseded(BaseException):
     """The page typed on: the request under way is of inputs nobody will see (the pool's SIGUSR1, raised
-    between two bytecodes of the run; a BaseException, so that no ``except Exception`` of the library keeps
-    it). Whatever it runs unwinds: ``subprocess.run`` kills an ``ngspice -b`` it waits for, the
-    ``with`` blocks close, and the worker takes the next request."""
+    between two bytecodes of the run, or as ngspice's shared library returns; a BaseException, so that no
+    ``except Exception`` of the library keeps it). Whatever it runs unwinds: ``subprocess.run`` kills an
+    ``ngspice -b`` it waits for, the ``with`` blocks close, and the worker takes the next request."""
 
 
 #: whether a task is running in this process (a cancel that comes after it ended is ignored)
