@@ -16,7 +16,9 @@ however it is stopped.
   signal that arrives there ends the process at once instead
   (:func:`emergency`): the one line, the registered clean-ups (:func:`on_exit`:
   the renderer, worker processes), then ``os._exit``. Nothing is half-written
-  then: no file is being written while ngspice runs.
+  then: no file is being written while ngspice runs. A handler that must raise
+  something else there (the web worker's cancel) leaves it for the block's end
+  (:func:`after_native`): raised as the library's current command returns.
 - **Children die with their parent** (:func:`die_with_parent`, :func:`preexec`
   for a subprocess): every worker, renderer, drawing helper and
   ``ngspice -b`` asks Linux for SIGKILL when its parent dies
@@ -44,9 +46,9 @@ import signal
 import sys
 from contextlib import contextmanager
 
-__all__ = ["Interrupted", "WORDS", "die_with_parent", "finish", "forget", "install", "interruption", "native",
-           "on_exit", "owned_prefix", "preexec", "quiet", "remove_stale", "reset_in_child", "status_of", "to_devnull",
-           "words_of"]
+__all__ = ["Interrupted", "WORDS", "after_native", "die_with_parent", "finish", "forget", "install", "interruption",
+           "native", "on_exit", "owned_prefix", "preexec", "quiet", "remove_stale", "reset_in_child", "status_of",
+           "to_devnull", "words_of"]
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 #: what the one line says for each signal
@@ -122,6 +124,7 @@ _prog = None
 _received = None
 _native = 0
 _cleanups: list = []
+_after_native: list = []
 
 
 def install(prog: str) -> None:
@@ -257,6 +260,26 @@ def native():
         yield
     finally:
         _native -= 1
+        if not _native and _after_native:   # what a signal that landed inside it left to do (after_native)
+            todo = list(_after_native)
+            _after_native.clear()
+            for fn in todo:
+                fn()
+
+
+def after_native(fn) -> None:
+    """Call ``fn()`` as the :func:`native` block running now ends, before its caller goes on: a signal
+    handler that runs inside ngspice's callbacks (where cffi would print and swallow what it raises) leaves
+    its exception to be raised there (ngspice's shared library returns between the commands of a Monte
+    Carlo's loop, a signal's handler may never run outside it).
+
+    Parameters
+    ----------
+    fn : callable
+        Called without arguments (it may raise).
+    """
+    if fn not in _after_native:
+        _after_native.append(fn)
 
 
 def in_native() -> bool:
@@ -292,6 +315,7 @@ def reset_in_child() -> None:
     global _native, _received
     _native, _received = 0, None
     _cleanups.clear()
+    _after_native.clear()
     for s in (*SIGNALS, signal.SIGALRM):
         signal.signal(s, signal.SIG_DFL)
     try:

@@ -28,7 +28,7 @@ from multiprocessing.connection import wait
 
 from . import lifetime
 
-__all__ = ["Worker", "close_all", "run_tasks"]
+__all__ = ["Worker", "close_all", "death_of", "run_tasks"]
 
 
 def _serve(conn, other_end, parent_pid, work, setup) -> None:
@@ -136,10 +136,7 @@ def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, co
                     try:
                         kind, value = w.conn.recv()
                     except (EOFError, OSError):
-                        w.proc.join(5)
-                        code = w.proc.exitcode
-                        why = f"signal {-code}" if code is not None and code < 0 else f"exit status {code}"
-                        kind, value = "dead", f"the worker running it died ({why}): the simulator crashed"
+                        kind, value = "dead", death_of(w)
                     results[i] = value if kind == "ok" else lost(tasks[i], value)
                     w.task = None
                     if done is not None:
@@ -163,6 +160,25 @@ def run_tasks(tasks: list, work, jobs: int, timeout: float, lost, setup=None, co
     finally:
         close_all(workers)
     return results
+
+
+def death_of(worker: Worker) -> str:
+    """What a task is answered when its worker died under it (its pipe closed): how it died.
+
+    Parameters
+    ----------
+    worker : Worker
+        The worker, its pipe found closed.
+
+    Returns
+    -------
+    str
+        The words, with the signal or exit status.
+    """
+    worker.proc.join(5)
+    code = worker.proc.exitcode
+    why = f"signal {-code}" if code is not None and code < 0 else f"exit status {code}"
+    return f"the worker running it died ({why}): the simulator crashed"
 
 
 def close_all(workers) -> None:

@@ -21,7 +21,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
              "files_in", "filter_page", "histograms", "identify_page", "identify_task", "pid_page", "plant_page", "run",
              "run_task", "series_text", "temporaries_in", "warm_up", "written_since"),
     "pool": ("Busy", "DEFAULT_TIMEOUT_S", "MAX_WAITING", "Pool", "RECYCLE_AFTER", "SPARE", "STOPPED",
-             "SUPERSEDED_GRACE_S"),
+             "SUPERSEDED_GRACE_S", "WARM_UP"),
     "request": ("MAX_DEPTH", "MAX_JSON_BYTES", "REFUSED", "SERVERS_OWN", "check_text", "check_value", "option_name",
                 "parse_json", "split_language", "value_text", "write_content"),
     "server": ("exposure_warning", "is_local", "main"),

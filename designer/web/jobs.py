@@ -52,9 +52,9 @@ BODE_POINTS = 300
 
 class Superseded(BaseException):
     """The page typed on: the request under way is of inputs nobody will see (the pool's SIGUSR1, raised
-    between two bytecodes of the run; a BaseException, so that no ``except Exception`` of the library keeps
-    it). Whatever it runs unwinds: ``subprocess.run`` kills an ``ngspice -b`` it waits for, the
-    ``with`` blocks close, and the worker takes the next request."""
+    between two bytecodes of the run, or as ngspice's shared library returns; a BaseException, so that no
+    ``except Exception`` of the library keeps it). Whatever it runs unwinds: ``subprocess.run`` kills an
+    ``ngspice -b`` it waits for, the ``with`` blocks close, and the worker takes the next request."""
 
 
 #: whether a task is running in this process (a cancel that comes after it ended is ignored)
@@ -81,14 +81,23 @@ def _starting_a_child(frame) -> bool:
 def _cancel(signum, frame) -> None:
     if not _RUNNING:
         return
-    # inside ngspice's callbacks cffi would swallow it, inside an at-fork hook the interpreter, inside Popen's
-    # start the child it forked would be left running with no one to kill and reap it: again in 5 ms
-    if lifetime.in_native() or (frame is not None and frame.f_globals.get("__name__") in SWALLOWING_MODULES) \
-            or _starting_a_child(frame):
+    # inside ngspice's callbacks cffi would swallow it: raised as the library's command returns (a signal
+    # handled only in those callbacks, as in a SPICE Monte Carlo's loop, would otherwise wait for the whole
+    # loop); inside an at-fork hook the interpreter would swallow it, inside Popen's start the child it forked
+    # would be left running with no one to kill and reap it: again in 5 ms
+    if lifetime.in_native():
+        lifetime.after_native(_superseded)
+        return
+    if (frame is not None and frame.f_globals.get("__name__") in SWALLOWING_MODULES) or _starting_a_child(frame):
         signal.signal(signal.SIGALRM, _cancel)
         signal.setitimer(signal.ITIMER_REAL, 0.005)
         return
     raise Superseded()
+
+
+def _superseded() -> None:
+    if _RUNNING:
+        raise Superseded()
 
 
 def run(task: dict) -> dict:

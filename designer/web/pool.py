@@ -13,10 +13,18 @@ order: none is lost, and each answer carries its request's number, so none is
 mixed with another's. The pool and the workers die with the server
 (:func:`designer.core.lifetime.die_with_parent`).
 
-A killed worker (past its deadline, or a superseded run that did not unwind within
-:data:`SUPERSEDED_GRACE_S`: one stuck in ngspice's shared library) is replaced at once by a
-spare, a worker warmed up beforehand and kept idle (:data:`SPARE`), so that the next request
-does not wait for a new worker's warm-up.
+The pool warms up itself (ngspice loaded, every module imported, schemdraw's fonts measured: ``work``'s
+:data:`WARM_UP` task, run once in the pool) before it forks its first worker, so that every worker, the
+first ones and every replacement, is a fork of a warm process, ready in milliseconds (copy-on-write: its pages
+shared with the pool's). A killed worker (past its deadline, or a superseded run: its client gone) is replaced
+at once by a spare, a worker forked beforehand and kept idle (:data:`SPARE`), and the spare by a new fork, so
+that the next request waits neither for a warm-up nor for a fork.
+
+A superseded run (:meth:`Pool.cancel`: the page typed on while it ran) is stopped where it is: the pool
+signals its worker (SIGUSR1, :class:`designer.web.jobs.Superseded`), which unwinds, an ``ngspice -b`` it
+waits for killed, and keeps its warm caches; a run inside ngspice's shared library unwinds as soon as the
+library's current command returns. One that has not answered within :data:`SUPERSEDED_GRACE_S` is killed
+with its worker's process group, and the spare takes its place.
 
 A worker that has served ``recycle`` requests (:data:`RECYCLE_AFTER`) is replaced by a fresh
 one between two requests, so that what a long-lived process accumulates (each request left
@@ -38,24 +46,23 @@ from collections import deque
 from multiprocessing.connection import wait
 
 from ..core import lifetime
-from ..core.workers import Worker, close_all
+from ..core.workers import Worker, close_all, death_of
 
-__all__ = ["DEFAULT_TIMEOUT_S", "MAX_WAITING", "RECYCLE_AFTER", "SPARE", "STOPPED", "SUPERSEDED_GRACE_S", "Busy",
-           "Pool"]
+__all__ = ["DEFAULT_TIMEOUT_S", "MAX_WAITING", "RECYCLE_AFTER", "SPARE", "STOPPED", "SUPERSEDED_GRACE_S", "WARM_UP",
+           "Busy", "Pool"]
 
 #: seconds a worker may take over one request before it is killed (design-pid's optimiser takes a few)
 DEFAULT_TIMEOUT_S = 120.0
-#: a new worker's first task (:func:`designer.web.jobs.run` warms up: ngspice loaded, modules imported), its own
-#: deadline: a request's deadline counts its own run only
+#: the task the pool runs once in its own process before it forks its workers (:func:`designer.web.jobs.run`
+#: warms up: ngspice loaded, modules imported), so that each worker is a fork of a warm process
 WARM_UP = {"prog": "warm-up"}
-WARM_UP_TIMEOUT_S = 300.0
 #: most requests queued or running at once (each a message of ~100 bytes to the pool: 64 KiB of pipe holds them)
 MAX_WAITING = 256
 #: requests a worker serves before a fresh one replaces it (designer-web --recycle)
 RECYCLE_AFTER = 200
-#: seconds a superseded run has to unwind before its worker is killed (and replaced) instead
+#: seconds a superseded run has to unwind (keeping its warm worker) before its worker is killed and replaced
 SUPERSEDED_GRACE_S = 0.1
-#: warmed-up workers kept idle to replace a killed one at once (designer-web's workers plus these)
+#: workers forked ahead and kept idle to replace a killed one at once (designer-web's workers plus these)
 SPARE = 1
 #: what a request still waiting when the server stops is answered
 STOPPED = "the server is stopping: the request was cancelled; send it again once the server is back"
@@ -67,34 +74,43 @@ class Busy(Exception):
 
 def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work,
                recycle: int = RECYCLE_AFTER, spare: int = SPARE) -> None:
-    """The pool process: requests ``(id, task)`` in from the server, ``(id, kind, value)`` out
-    (ids from 1: 0 is a worker's warm-up, answered to nobody)."""
+    """The pool process: requests ``(id, task)`` in from the server, ``(id, kind, value)`` out; ``(-id, None)``
+    in: request ``id``'s client has gone."""
     lifetime.die_with_parent(parent_pid)
     lifetime.reset_in_child()
     # a Ctrl-C in the terminal reaches the whole process group: the server stops this pool itself, once the
     # requests under way are answered (or this pool dies with it)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     other_end.close()
+    # warm up here, once, before the first fork: every worker (and every replacement) is then ready at once.
+    # Before the SIGTERM handler: a stop during the warm-up (seconds, partly inside ngspice's library, where a
+    # Python handler would wait for it to return) ends this process at once, no worker forked yet
+    try:
+        work(WARM_UP)
+    except Exception:   # noqa: BLE001 - a warm-up that fails costs speed only: each worker loads on its first task
+        pass
     ctx = multiprocessing.get_context("fork")
 
     def fresh():
         w = Worker(ctx, work, None, daemon=False)
-        w.give(0, WARM_UP, WARM_UP_TIMEOUT_S)
+        w.superseded = False   # its run's client gone (its answer, whatever it is, is "superseded")
         return w
 
     workers = [fresh() for _ in range(jobs)]
-    # warmed up and idle: one takes a killed worker's place at once (a superseded run stuck in ngspice's shared
-    # library, a run past its deadline), so that the next request does not wait for a new worker's warm-up
+    # forked ahead and idle: one takes a killed worker's place at once (a superseded run, a run past its
+    # deadline), so that the next request waits for no fork
     spares = [fresh() for _ in range(spare)]
     served = {}   # requests each worker (by pid) has answered
 
-    def replacement():
-        ready = next((w for w in spares if w.task is None), None)
-        if ready is None:
-            return fresh()
-        spares.remove(ready)
-        spares.append(fresh())
-        return ready
+    def replace(k):
+        # a spare that died while idle (killed from outside) is no replacement: its pipe is closed
+        while spares:
+            ready = spares.pop(0)
+            if ready.proc.is_alive():
+                workers[k] = ready
+                return
+            ready.kill()
+        workers[k] = fresh()
 
     def stop(_signum, _frame):
         # the server stops (Pool.stop_now): every run ends now, with its ngspice; the server answers
@@ -106,7 +122,7 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
     queue = deque()
     try:
         while True:
-            busy = [w for w in workers + spares if w.task is not None]
+            busy = [w for w in workers if w.task is not None]
             left = None if not busy else max(0.0, min(w.deadline for w in busy) - time.monotonic())
             ready = wait([conn] + [w.conn for w in busy], timeout=left)
             if conn in ready:
@@ -121,27 +137,16 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                         queue = deque(m for m in queue if m[0] != -msg[0])
                         conn.send((-msg[0], "cancelled", None))
                     for w in workers:   # under way: stopped where it is (designer.web.jobs.Superseded)
-                        if w.task == -msg[0] and not getattr(w, "superseded", False):
+                        if w.task == -msg[0] and not w.superseded:
                             w.superseded = True
                             try:
                                 os.kill(w.proc.pid, signal.SIGUSR1)
                             except ProcessLookupError:
                                 pass
-                            # a run that does not come back (stuck in a long C call) is killed as at its deadline
+                            # a run that does not come back (a long call into C) is killed as at its deadline
                             w.deadline = min(w.deadline, time.monotonic() + SUPERSEDED_GRACE_S)
                 else:
                     queue.append(msg)
-            for k, w in enumerate(spares):   # a spare's warm-up done (or past its deadline: another)
-                if w.task is not None and w.conn in ready:
-                    try:
-                        w.conn.recv()
-                        w.task = None
-                    except (EOFError, OSError):
-                        w.kill()
-                        spares[k] = fresh()
-                elif w.task is not None and time.monotonic() >= w.deadline:
-                    w.kill()
-                    spares[k] = fresh()
             for k, w in enumerate(workers):
                 if w.task is None:
                     continue
@@ -149,30 +154,28 @@ def _pool_main(conn, other_end, parent_pid: int, jobs: int, timeout: float, work
                     try:
                         kind, value = w.conn.recv()
                     except (EOFError, OSError):
-                        kind, value = "dead", "the worker running it died: the simulator crashed"
-                    if w.task:
-                        # a superseded run's answer, whatever it was (or its death): nobody reads it
-                        conn.send((w.task, "superseded", None) if getattr(w, "superseded", False) else
-                                  (w.task, kind, value))
-                        served[w.proc.pid] = served.get(w.proc.pid, 0) + 1
+                        kind, value = "dead", death_of(w)
+                    # a superseded run's answer, whatever it was (or its death): nobody reads it
+                    conn.send((w.task, "superseded", None) if w.superseded else (w.task, kind, value))
+                    served[w.proc.pid] = served.get(w.proc.pid, 0) + 1
                     w.task = None
-                    if kind == "dead" or served.get(w.proc.pid, 0) >= recycle:   # dead, or recycled
+                    if kind == "dead" or served[w.proc.pid] >= recycle:   # dead, or recycled
                         served.pop(w.proc.pid, None)
                         w.kill()
-                        workers[k] = replacement()
+                        replace(k)
                 elif time.monotonic() >= w.deadline:
                     served.pop(w.proc.pid, None)
                     w.kill()
-                    if w.task and getattr(w, "superseded", False):
-                        conn.send((w.task, "superseded", None))
-                    elif w.task:
-                        conn.send((w.task, "timeout", f"timed out after {timeout:g} s (killed)"))
-                    workers[k] = replacement()
+                    conn.send((w.task, "superseded", None) if w.superseded else
+                              (w.task, "timeout", f"timed out after {timeout:g} s (killed)"))
+                    replace(k)
             for w in workers:
                 if w.task is None and queue:
                     rid, task = queue.popleft()
                     w.superseded = False
                     w.give(rid, task, timeout)
+            while len(spares) < spare:   # after the queue is served: the next request waits for no fork
+                spares.append(fresh())
     finally:
         close_all(workers + spares)
 
@@ -258,7 +261,8 @@ class Pool:
     def cancel(self, rid: int) -> None:
         """Its client has gone: drop the task if it waits in the queue (answered "cancelled"); a run
         already started is stopped where it is (answered "superseded" as soon as it has unwound, its
-        ngspice killed; killed with its worker after :data:`SUPERSEDED_GRACE_S`)."""
+        ngspice killed; killed with its worker's process group after :data:`SUPERSEDED_GRACE_S`, a spare
+        taking its place)."""
         try:
             self.conn.send((-rid, None))
         except (OSError, ValueError):

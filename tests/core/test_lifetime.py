@@ -193,3 +193,24 @@ def test_stale_folders_are_those_of_gone_owners_only(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(alive)
     assert lifetime.owned_prefix("sim") == f"designer-sim-{os.getpid()}-"
     assert lifetime.remove_stale(str(tmp_path / "nowhere")) == []
+
+
+def test_what_a_handler_leaves_for_the_end_of_a_native_block_runs_there_once():
+    """Issue 29: a signal handled inside ngspice's callbacks (where cffi swallows what is raised) leaves its
+    exception for the end of the native block: raised there, before the block's caller goes on, once."""
+    ran = []
+
+    def stop():
+        ran.append(lifetime.in_native())
+        raise lifetime.Interrupted()
+
+    lifetime.after_native(stop)   # outside a block: waits for the next one's end
+    with pytest.raises(lifetime.Interrupted):
+        with lifetime.native():
+            with lifetime.native():   # an inner block's end is not the end
+                lifetime.after_native(stop)
+            assert ran == []
+    assert ran == [False]
+    with lifetime.native():        # done with: not again
+        pass
+    assert ran == [False]

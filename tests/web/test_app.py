@@ -880,17 +880,12 @@ def _descendants(pid: int) -> list:
 def test_a_running_request_whose_client_left_is_stopped_with_its_ngspice():
     """Issue 29 (typing): a superseded request is cancelled on the server too: the run under way stops (its
     ``ngspice -b`` killed), its worker takes the next request at once, not when the run would have ended."""
-    import socket
     import time
-    import urllib.parse
+    import urllib.request
     s = Server("--jobs", "1")
     try:
-        body = json.dumps({"fc": 3500, "zeta": 0.2, "monte-carlo": 5000, "engine": "spice",
-                           "simulator": "ngspice-cli"}).encode()
-        u = urllib.parse.urlsplit(s.url)
-        sock = socket.create_connection((u.hostname, u.port))
-        sock.sendall(f"POST /api/plant HTTP/1.1\r\nHost: {u.netloc}\r\nContent-Length: {len(body)}\r\n"
-                     "Content-Type: application/json\r\n\r\n".encode() + body)
+        sock = _raw_post(s, "/api/plant", {"fc": 3500, "zeta": 0.2, "monte-carlo": 5000, "engine": "spice",
+                                           "simulator": "ngspice-cli"})
         deadline = time.monotonic() + 60
         while not any(name == "ngspice" for _, name in _descendants(s.proc.pid)):
             assert time.monotonic() < deadline, "no ngspice started"
@@ -908,6 +903,102 @@ def test_a_running_request_whose_client_left_is_stopped_with_its_ngspice():
     finally:
         err = s.stop()
     assert "Traceback" not in err and "Exception ignored" not in err, err
+
+
+def _cpu_ticks(pid: int) -> int:
+    """The CPU time (user + system, in clock ticks) process ``pid`` has used; 0 once it is gone."""
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            fields = fh.read().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0
+    return int(fields[11]) + int(fields[12])
+
+
+def _busy_worker(server) -> int:
+    """The pid of the worker running the one request under way: the one whose CPU time grows (the pool's other
+    worker, its spare, is idle)."""
+    import time
+    pool = next(pid for pid, _ in _descendants(server.proc.pid) if _descendants(pid))
+    workers = [pid for pid, _ in _descendants(pool)]   # no ngspice -b: the requests here run the library
+    deadline = time.monotonic() + 60
+    while True:
+        before = {pid: _cpu_ticks(pid) for pid in workers}
+        time.sleep(0.3)
+        busy = [pid for pid in workers if _cpu_ticks(pid) - before[pid] > 5]
+        if len(busy) == 1:
+            return busy[0]
+        assert time.monotonic() < deadline, "no worker busy with the request"
+
+
+def _raw_post(server, path: str, body: dict):
+    """A request sent on a socket of its own, its answer never read: close the socket to leave (a page typing on)."""
+    import socket
+    import urllib.parse
+    data = json.dumps(body).encode()
+    u = urllib.parse.urlsplit(server.url)
+    sock = socket.create_connection((u.hostname, u.port))
+    sock.sendall(f"POST {path} HTTP/1.1\r\nHost: {u.netloc}\r\nContent-Length: {len(data)}\r\n"
+                 "Content-Type: application/json\r\n\r\n".encode() + data)
+    return sock
+
+
+#: a SPICE Monte Carlo on ngspice's shared library: minutes of a library call inside the worker, no child process
+LIBRARY_MONTE_CARLO = {"fc": 3500, "zeta": 0.2, "monte-carlo": 5000, "engine": "spice", "simulator": "pyspice",
+                       "no-sim": True}
+
+
+def test_a_library_call_whose_client_left_frees_its_worker_at_once():
+    """Issue 29: a request whose run is a library call in the worker (a SPICE Monte Carlo inside ngspice's shared
+    library, not an ``ngspice -b`` it could kill) and whose client leaves: the run stops (its worker's CPU time
+    stops growing, or the worker is gone, replaced), the next request is answered at once, no process is left
+    over (the pool's workers and spare, as before), nothing on the server's stderr but its stop."""
+    import time
+    import urllib.request
+    s = Server("--jobs", "1")
+    try:
+        before = sorted(name for _, name in _descendants(s.proc.pid))
+        sock = _raw_post(s, "/api/plant", LIBRARY_MONTE_CARLO)
+        busy = _busy_worker(s)
+        sock.close()   # the page typed on
+        tick = time.monotonic()
+        status, got = s.post_json("/api/plant", {"fc": 1000, "zeta": 0.5, "no-sim": True})
+        waited = time.monotonic() - tick
+        assert status == 200 and got["spec"]["fc_hz"] == 1000
+        assert waited < 5.0, waited   # the 5000 builds take minutes; the speed goal (0.1 s) is bench_web's
+        ticks = _cpu_ticks(busy)
+        time.sleep(0.5)
+        assert _cpu_ticks(busy) - ticks <= 5   # stopped (or gone)
+        assert sorted(name for _, name in _descendants(s.proc.pid)) == before   # no ngspice, no extra worker
+        with urllib.request.urlopen(s.url + "/api/health", timeout=60) as r:
+            health = json.loads(r.read())
+        assert health["superseded"] == 1 and health["dropped"] == 0
+    finally:
+        err = s.stop()
+    assert logged(err) == [], err
+
+
+def test_a_worker_killed_in_a_library_call_answers_its_request_in_one_line_and_is_replaced():
+    """A worker SIGKILLed in the middle of a library call (the OOM killer, an administrator): its request is
+    answered a 502 naming what happened in one line, never a 500 nor a traceback; the pool forks its replacement
+    and the next request is answered; no process is left over."""
+    s = Server("--jobs", "1")
+    try:
+        before = sorted(name for _, name in _descendants(s.proc.pid))
+        with ThreadPoolExecutor(1) as ex:
+            waiting = ex.submit(s.post_json, "/api/plant", LIBRARY_MONTE_CARLO)
+            busy = _busy_worker(s)
+            os.kill(busy, 9)
+            status, got = waiting.result(60)
+        assert status == 502 and got["error"] == ("design-plant: error: the worker running it died (signal 9): "
+                                                  "the simulator crashed"), got
+        status, got = s.post_json("/api/plant", {"fc": 1000, "zeta": 0.5, "no-sim": True})
+        assert status == 200 and got["spec"]["fc_hz"] == 1000
+        assert not os.path.exists(f"/proc/{busy}")
+        assert sorted(name for _, name in _descendants(s.proc.pid)) == before
+    finally:
+        err = s.stop()
+    assert logged(err) == [], err
 
 
 def _specs_folder() -> dict:

@@ -137,6 +137,32 @@ def test_a_cancel_landing_in_popens_start_waits_until_the_child_is_its(monkeypat
 
 
 @pytest.mark.spice
+def test_a_cancel_inside_ngspices_shared_library_stops_a_spice_monte_carlo_as_its_command_returns():
+    """Issue 29: a SPICE Monte Carlo on ngspice's shared library spends its time inside the library, the cancel's
+    handler running only in ngspice's callbacks (where cffi swallows what it raises): it was put off 5 ms at a
+    time, unwinding only when the whole loop ended (7.5 s here), its worker killed meanwhile. It is now raised as
+    the library's current command returns; the library serves the next run."""
+    import os
+    import signal
+    import threading
+    import time
+    jobs.run({"prog": "warm-up"})
+    sent = []
+
+    def cancel():
+        time.sleep(1.0)
+        sent.append(time.monotonic())
+        os.kill(os.getpid(), signal.SIGUSR1)
+    threading.Thread(target=cancel, daemon=True).start()
+    mc = {"fc": 3500, "zeta": 0.2, "monte-carlo": 2000, "engine": "spice", "simulator": "pyspice", "no-sim": True}
+    out = jobs.run({"prog": "design-plant", "fields": mc, "want": "json"})
+    took = time.monotonic() - sent[0]
+    assert out["status"] == "superseded" and took < 1.0, took
+    out = jobs.run({"prog": "design-plant", "fields": {**mc, "monte-carlo": 20}, "want": "json"})
+    assert out["status"] == 0 and out["json"]["monte_carlo"]["spice"]
+
+
+@pytest.mark.spice
 def test_the_filter_and_circuit_plant_pages_speak_the_requests_language():
     """Issue 29: /api/filter and a plant on a menu's section answer in the request's language: the BOM's columns
     and packages (bom.csv keeps its English), the Bode traces (their English label kept), the checks' titles;
