@@ -245,6 +245,7 @@ def test_tol_gbw_on_a_section_spreads_the_op_amp_in_both_engines(engine, tmp_pat
         assert np.allclose(col("fn_hz"), col("model_fn_hz"), rtol=0.01)
 
 
+@pytest.mark.spice
 def test_replay_on_a_section_is_the_monte_carlos_build(tmp_path):
     """Issue 26: --replay I on a section plant: build I of the Monte Carlo with the same options (seed, sampler,
     dist, --tol), its exact values analysed and simulated alone, its bundle under <name>_sample<I>; printed as the
