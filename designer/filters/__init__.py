@@ -14,8 +14,8 @@ from ..core.exports import lazy_exports
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "alternatives": ("Alternative", "alternatives_count", "design_alternatives",),
-    "bench": ("BUILDS", "C_TOL_PCT", "FilterBench", "R_TOL_PCT", "SEED", "StageCheck", "SweepPoint", "TableCompare",
-              "TimeTest", "bench_of", "nice_down", "nice_up", "passband_gain",),
+    "bench": ("BURST_CYCLES", "BUILDS", "C_TOL_PCT", "FilterBench", "R_TOL_PCT", "SEED", "StageCheck", "SweepPoint", "TableCompare",
+              "TimeTest", "bench_of", "burst_tone", "nice_down", "nice_up", "passband_gain",),
     "cascade": ("Cascade", "Stage",),
     "deck": ("ac_deck", "simulate_ac",),
     "design": ("FilterDesign", "StageDesign", "analysis_grid", "as_built", "central_delay", "delay_figures", "predistort", "section_name", "with_choice",

@@ -10,7 +10,9 @@ which formats and recomputes nothing):
   two periods across ten divisions, the trace over six of eight divisions);
 - the step test (a low-pass: a 0 -> A square wave whose half period is five
   settling times) or the tone burst (high- and band-pass: ten cycles at the
-  passband's centre), its output from the chosen parts' ideal transfer function
+  passband's centre or, a high-pass, the 1-2-5 value at or above three times the
+  cut-off, :func:`burst_tone`; the SPICE proof's transient is the same burst), its
+  output from the chosen parts' ideal transfer function
   (:func:`designer.core.lti.filter_foh`, exact for a piecewise-linear input);
 - each stage's op-amp checks at the bench amplitude: its GBW against
   margin x fn x Q x noise gain (SLOA088's rule of thumb, the design's figure), the
@@ -36,12 +38,14 @@ from .registry import get as get_topology
 from .tables import coefficient_table
 
 __all__ = ["BUILDS", "SEED", "R_TOL_PCT", "C_TOL_PCT", "SweepPoint", "TimeTest", "StageCheck", "TableCompare",
-           "FilterBench", "nice_up", "nice_down", "bench_of", "passband_gain"]
+           "FilterBench", "BURST_CYCLES", "nice_up", "nice_down", "burst_tone", "bench_of", "passband_gain"]
 
 #: Monte Carlo builds behind each sweep point's band, and their recorded seed
 BUILDS, SEED = 500, 0
 #: the parts' tolerances the band assumes (and the bill of materials lists): 1 % metal film, 5 % film or C0G
 R_TOL_PCT, C_TOL_PCT = 1.0, 5.0
+#: the tone burst's cycles (the bench sheet's time test of a high- or band-pass, and the SPICE proof's transient)
+BURST_CYCLES = 10
 #: sweep points more than this far below the passband gain are not on the table (the scope's floor)
 FLOOR_DB = 60.0
 
@@ -306,6 +310,36 @@ def passband_gain(result) -> float:
     return float(result.spec.gain)
 
 
+def burst_tone(result) -> tuple:
+    """The tone burst of a high- or band-pass: its tone, the 1-2-5 value at or above three times the
+    cut-off (a high-pass, well inside the passband) or the passband's geometric centre (a band-pass), and
+    its cycles, and the window that shows it: the burst and eight of the chosen cascade's slowest time
+    constants after it; the bench sheet's time test and the SPICE proof's transient
+    (:func:`designer.filters.verify.bench_signal`) are this one burst.
+
+    Parameters
+    ----------
+    result : designer.filters.FilterDesign
+        A high- or band-pass design.
+
+    Returns
+    -------
+    tuple
+        (tone frequency in Hz, cycles, window in s).
+    """
+    if result.spec.filter_type == "highpass":
+        f0 = nice_up(3 * result.fc_hz)
+    else:
+        f0 = math.sqrt(result.spec.f_low_hz * result.spec.f_high_hz)
+    return f0, BURST_CYCLES, BURST_CYCLES / f0 + 8 * _slowest_time_constant(result)
+
+
+def _slowest_time_constant(result) -> float:
+    """The chosen cascade's slowest mode's time constant, 1 / min |Re p| (s)."""
+    _, den = result.cascade().coefficients()
+    return 1 / float(np.min(np.abs(np.roots(den).real)))
+
+
 def _drawn_values(result, rng) -> list:
     """Every stage's parts, :data:`BUILDS` builds each, uniform within the tolerances."""
     out = []
@@ -378,8 +412,7 @@ def _sweep(result, rng):
 def _time_test(result) -> TimeTest:
     amp = float(result.spec.amplitude_v)
     num, den = result.cascade().coefficients()
-    poles = np.roots(den)
-    slow = 1 / float(np.min(np.abs(poles.real)))       # the slowest mode's time constant
+    slow = _slowest_time_constant(result)
     kind = result.spec.filter_type
     if kind == "lowpass":
         t_end = 12 * slow
@@ -395,13 +428,8 @@ def _time_test(result) -> TimeTest:
         return TimeTest("step", nice_down(0.5 / half), amp, 0, 0.0, t, x, y, metrics,
                         nice_up(max(m.settling_time_s, m.rise_time_s) * 1.5 / 10),
                         nice_up(max(np.max(np.abs(y)), 1e-3) * 2 / 6))
-    if kind == "highpass":
-        f0 = nice_up(3 * result.fc_hz)
-    else:
-        f0 = math.sqrt(result.spec.f_low_hz * result.spec.f_high_hz)
-    cycles = 10
+    f0, cycles, t_end = burst_tone(result)
     t_tone = cycles / f0
-    t_end = t_tone + 8 * slow
     t = np.linspace(0, t_end, 8001)
     x = np.where(t <= t_tone, amp * np.sin(2 * math.pi * f0 * t), 0.0)
     y = filter_foh(num, den, t, x)

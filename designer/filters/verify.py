@@ -1,7 +1,7 @@
 """The proof of a designed cascade in SPICE: one standalone deck (``ngspice -b``
 prints its measurements) with an ``.ac`` sweep (gain and phase at the mask's
 frequencies, the -3 dB point, the stopband attenuation) and a ``.tran`` of the
-bench test (a step for a low-pass, a sine at a passband frequency otherwise),
+bench test (a step for a low-pass, the bench sheet's tone burst otherwise),
 compared with the analytic cascade, ideal and op-amp-aware, by the project's
 NRMS rule (:func:`designer.core.compare.nrms`, Xyce's ``xyce_verify``: below 1
 passes); the mask checked on SPICE's own ``.ac``; each stage's slew and swing at
@@ -21,6 +21,11 @@ Sources and rules:
 - NRMS of the ``.ac`` magnitude over log f with an absolute tolerance of -60 dB of
   the passband gain (the conformance's floor), of the transient with 1 % of the
   output's step (the plant's rule, :func:`designer.plant.design.run_spice`);
+- the burst: ngspice's ``SIN`` source has no cycle count, so the deck gates the
+  sine with a behavioural source of time alone in series with the ``.ac`` source
+  (``V = time <= T ? A sin(w time) : 0``; its small-signal part is nil, so the
+  ``.ac`` is unchanged); the gate closes at a zero crossing (whole cycles), so
+  the input stays continuous;
 - slew: a sine of amplitude V at f slews at 2 pi f V (its steepest point); the step's
   slope is the analytic transient's derivative; swing: the node's largest excursion.
 """
@@ -36,6 +41,7 @@ import numpy as np
 from ..core import opamps
 from ..core.compare import nrms
 from ..core.units import format_eng
+from .bench import burst_tone
 from .deck import ac_deck
 from .prototype import delay_error_pct
 from .registry import get as get_topology
@@ -60,20 +66,23 @@ SK_ITERATIONS = 4
 
 @dataclass(frozen=True)
 class BenchSignal:
-    """The transient test: a ``step`` (a low-pass) or a ``sine`` at ``f_hz``, ``amplitude_v`` peak.
+    """The transient test: a ``step`` (a low-pass), a ``burst`` of ``cycles`` cycles or a ``sine`` at ``f_hz``,
+    ``amplitude_v`` peak.
 
     Parameters
     ----------
     kind : str
-        ``step`` or ``sine``.
+        ``step``, ``burst`` or ``sine``.
     amplitude_v : float
         Step height or sine peak (V).
     f_hz : float or None
-        The sine's frequency (None for a step).
+        The tone's frequency (None for a step).
     t_stop_s : float
         The transient's length.
     rise_s : float
         The step's edge (a ramp, the same in the deck and the analytic input).
+    cycles : int
+        The burst's cycles (0 otherwise).
     """
 
     kind: str
@@ -81,6 +90,12 @@ class BenchSignal:
     f_hz: float | None
     t_stop_s: float
     rise_s: float
+    cycles: int = 0
+
+    @property
+    def burst_s(self) -> float:
+        """The burst's length, ``cycles / f_hz`` (s)."""
+        return self.cycles / self.f_hz
 
     def source(self) -> str:
         """The input source's transient part in SPICE syntax.
@@ -88,10 +103,14 @@ class BenchSignal:
         Returns
         -------
         str
-            ``PULSE(...)`` or ``SIN(...)``.
+            ``PULSE(...)`` or ``SIN(...)``; a burst: the gating behavioural source's ``V = ...`` expression
+            (module docstring).
         """
         if self.kind == "step":
             return f"PULSE(0 {self.amplitude_v:.6g} 0 {self.rise_s:.6g} {self.rise_s:.6g} 1e3 2e3)"
+        if self.kind == "burst":
+            return (f"V = time <= {self.burst_s:.10g} ? {self.amplitude_v:.6g} * "
+                    f"sin({2 * math.pi * self.f_hz:.10g} * time) : 0")
         return f"SIN(0 {self.amplitude_v:.6g} {self.f_hz:.6g} 0)"
 
     def waveform(self, t) -> np.ndarray:
@@ -110,6 +129,8 @@ class BenchSignal:
         t = np.asarray(t, float)
         if self.kind == "step":
             return self.amplitude_v * np.clip(t / self.rise_s, 0.0, 1.0)
+        if self.kind == "burst":
+            return np.where(t <= self.burst_s, self.amplitude_v * np.sin(2 * math.pi * self.f_hz * t), 0.0)
         return self.amplitude_v * np.sin(2 * math.pi * self.f_hz * t)
 
     def to_dict(self) -> dict:
@@ -118,10 +139,13 @@ class BenchSignal:
         Returns
         -------
         dict
-            Its fields.
+            Its fields (``cycles`` only for a burst).
         """
-        return {"kind": self.kind, "amplitude_v": self.amplitude_v, "f_hz": self.f_hz, "t_stop_s": self.t_stop_s,
-                "rise_s": self.rise_s}
+        out = {"kind": self.kind, "amplitude_v": self.amplitude_v, "f_hz": self.f_hz, "t_stop_s": self.t_stop_s,
+               "rise_s": self.rise_s}
+        if self.kind == "burst":
+            out["cycles"] = self.cycles
+        return out
 
 
 @dataclass
@@ -285,8 +309,8 @@ def _edges(result) -> tuple:
 
 
 def bench_signal(result) -> BenchSignal:
-    """The transient test of ``result``: a step for a low-pass; a sine at twice the passband edge
-    (a high-pass) or at the centre (a band-pass); the bench amplitude; long enough to settle.
+    """The transient test of ``result``: a step for a low-pass; otherwise the bench sheet's tone burst
+    in the sheet's window (:func:`designer.filters.bench.burst_tone`); the bench amplitude.
 
     Parameters
     ----------
@@ -299,13 +323,12 @@ def bench_signal(result) -> BenchSignal:
         The test.
     """
     s, fc = result.spec, result.fc_hz
-    # the slowest section sets the settling: its time constant Q / (pi fn)
-    slow = max((st.plan.q or 0.5) / (math.pi * st.plan.fn_hz) for st in result.stages)
     if s.filter_type == "lowpass":
+        # the slowest section sets the settling: its time constant Q / (pi fn)
+        slow = max((st.plan.q or 0.5) / (math.pi * st.plan.fn_hz) for st in result.stages)
         return BenchSignal("step", s.amplitude_v, None, max(12 * slow, 6 / fc), 1e-3 / fc)
-    fp, _, _ = _edges(result)
-    f = 2 * fp[0] if s.filter_type == "highpass" else fc
-    return BenchSignal("sine", s.amplitude_v, float(f), max(12 * slow, 10 / f), 1e-3 / f)
+    f, cycles, t_stop = burst_tone(result)
+    return BenchSignal("burst", s.amplitude_v, float(f), t_stop, 1e-3 / f, cycles)
 
 
 def _level_db(result) -> float:
@@ -354,8 +377,16 @@ def _circuit(result, signal: BenchSignal) -> str:
                    title=f"{result.spec.family} {result.spec.filter_type} order {result.order}",
                    points_per_decade=PROOF_POINTS_PER_DECADE)
     lines = [ln for ln in text.rstrip().splitlines() if not ln.startswith(".ac ") and ln.strip().lower() != ".end"]
-    src = re.compile(r"^(Vin\s+\S+\s+\S+\s+DC 0 AC 1)\s*$", re.I)
-    lines = [src.sub(lambda m: f"{m.group(1)} {signal.source()}", ln) for ln in lines]
+    src = re.compile(r"^(Vin\s+(\S+)\s+(\S+)\s+DC 0 AC 1)\s*$", re.I)
+
+    def sub(m):
+        if signal.kind != "burst":
+            return f"{m.group(1)} {signal.source()}"
+        # the .ac source below the gated burst (module docstring): a B-source of time alone adds nothing to .ac
+        node, ref = m.group(2), m.group(3)
+        return f"Vin {node}_ac {ref} DC 0 AC 1\nBburst {node} {node}_ac {signal.source()}"
+
+    lines = [src.sub(sub, ln) for ln in lines]
     return "\n".join(lines) + "\n"
 
 

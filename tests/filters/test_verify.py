@@ -14,6 +14,7 @@ from scipy import signal
 
 from designer.core.opamps import get as get_opamp
 from designer.filters import REGISTRY, FilterSpec
+from designer.filters.bench import bench_of
 from designer.filters.design import design
 from designer.filters.verify import (NRMS_PASS, analytic_tran, bench_signal, opamp_aware_polys, proof_deck, prove,
                                      stage_drive, stage_polys)
@@ -84,7 +85,7 @@ def test_proof_agrees_with_the_op_amp_aware_cascade(kw):
     # the op-amp-aware model is at least as close to SPICE as the ideal one
     assert p.nrms["ac_opamp"] <= p.nrms["ac_ideal"] and p.nrms["tran_opamp"] <= p.nrms["tran_ideal"] + 1e-9
     assert p.fit_error < 1e-6
-    assert p.signal.kind == ("step" if d.spec.filter_type == "lowpass" else "sine")
+    assert p.signal.kind == ("step" if d.spec.filter_type == "lowpass" else "burst")
     # every measurement at the edges against the analytic op-amp-aware response
     fp = d.spec.passband_hz if d.spec.has_mask else d.figures["passband_edge_hz"]
     fp = fp if isinstance(fp, list) else [fp]
@@ -95,6 +96,38 @@ def test_proof_agrees_with_the_op_amp_aware_cascade(kw):
         assert abs(dphi) < 0.5
     assert p.passed == (p.mask is None or p.mask["met"])
     assert p.to_dict()["nrms_pass_below"] == NRMS_PASS
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("kw", [HP, BP], ids=["highpass", "bandpass"])
+def test_spice_runs_the_bench_sheets_burst(kw):
+    """The proof's transient of a high- or band-pass is the sheet's tone burst (its tone, cycles, window and
+    input samples; the proof's analytic ideal burst is the sheet's output), gated in the deck by a B-source
+    beside the .ac source, and ngspice's burst agrees with the analytic op-amp-aware cascade's (NRMS)."""
+    d = design(FilterSpec(**kw))
+    sheet = bench_of(d).time_test
+    sig = bench_signal(d)
+    assert (sig.kind, sig.f_hz, sig.cycles) == ("burst", sheet.frequency_hz, sheet.cycles)
+    assert sig.t_stop_s == pytest.approx(sheet.t_s[-1], rel=1e-12)
+    assert np.array_equal(sig.waveform(sheet.t_s), sheet.input_v)
+    assert sig.to_dict()["cycles"] == sheet.cycles
+    # the proof's analytic burst (bilinear, stage by stage) is the sheet's (exact for a piecewise-linear input)
+    y = analytic_tran(stage_polys(d)[0], sheet.t_s, sheet.input_v)[-1]
+    assert np.max(np.abs(y - sheet.output_v)) < 1e-3 * sheet.amplitude_v
+    deck = proof_deck(d)
+    assert "\nVin vin_ac 0 DC 0 AC 1\nBburst vin vin_ac V = time <= " in deck and " SIN(" not in deck
+    p = prove(d)
+    assert p.signal == sig and p.nrms["tran_opamp"] < 0.1 and p.nrms["ac_opamp"] < 1e-3
+
+
+def test_only_a_burst_has_cycles_in_its_json():
+    """The low-pass's step keeps the earlier JSON keys (the committed references'); a burst adds ``cycles``."""
+    lp, hp = (bench_signal(design(FilterSpec(**kw))) for kw in (LP, HP))
+    assert set(lp.to_dict()) == {"kind", "amplitude_v", "f_hz", "t_stop_s", "rise_s"}
+    assert set(hp.to_dict()) == set(lp.to_dict()) | {"cycles"}
+    # the burst ends after whole cycles: the input is back at 0 V, continuous, when the gate closes
+    t = np.array([hp.burst_s * (1 - 1e-9), hp.burst_s * (1 + 1e-9)])
+    assert np.max(np.abs(hp.waveform(t))) < 1e-6 * hp.amplitude_v
 
 
 @pytest.mark.spice
