@@ -24,6 +24,7 @@ import numpy as np
 from ..core.compare import nrms
 from ..core.errors import DesignError, SimulatorError
 from ..core.fileio import atomic_write
+from ..core.i18n import N_, Message
 from ..plant.circuit import DEFAULT_TOPOLOGY
 from . import figures as F
 from . import golden as G
@@ -105,8 +106,12 @@ def corner_task(spec: CheckSpec, index: int, simulator: str, update_golden: bool
 
 
 def _failed(corner, kind, exc, tool, tick) -> CornerOutcome:
-    what = "simulator error" if kind == SIM_ERROR else "bad spec"
-    case = Case("simulation", corner, ERROR, f"simulation: {what}: {' '.join(str(exc).split())}", error_kind=kind)
+    what = N_("simulator error") if kind == SIM_ERROR else N_("bad spec")
+    said = exc.args[0] if exc.args and isinstance(exc.args[0], Message) else " ".join(str(exc).split())
+    # a typed message (one carrying a parameter) stays typed: each front end names the parameter its own way
+    message = Message(N_("simulation: {what}: {error}"), what=what, error=said) if isinstance(said, Message) else \
+        f"simulation: {what}: {said}"
+    case = Case("simulation", corner, ERROR, message, error_kind=kind)
     return CornerOutcome(corner, (case,), None, tool, (), {}, time.perf_counter() - tick)
 
 
@@ -238,12 +243,13 @@ def _golden_cases(spec, corner, waves, tool, update, out_dir):
     header = G.header_of(tool, spec.name, corner)
     if update:
         G.write_golden(path, t, {s: test[s] for s in wanted}, header)
-        return ([Case(f"golden_{s}", corner, PASS, f"golden_{s}: recorded in {path.name} (--update-golden)")
+        return ([Case(f"golden_{s}", corner, PASS, Message(N_("golden_{signal}: recorded in {file} ({update_golden})"),
+                                                            signal=s, file=path.name, update_golden="--update-golden"))
                  for s in wanted], [], {"golden": str(path)})
     recorded, t_gold, gold = G.read_golden(path)
     absent = [s for s in wanted if s not in gold]
     if absent:
-        raise DesignError(f"golden file {path}: no column {absent[0]!r}; record it with --update-golden")
+        raise DesignError(G.record_advice(f"golden file {path}: no column {absent[0]!r}", switch="--update-golden"))
     warnings = G.version_warnings(recorded, header, path)
     errors = G.compare(t, test, t_gold, gold, wanted, path=path)
     cases, files = [], {"golden": str(path)}
