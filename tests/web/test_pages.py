@@ -976,3 +976,39 @@ def test_identify_a_chirp_shows_the_record_with_its_models_and_every_candidate(p
     assert integrating and "\tno\t" in integrating[0] and "below 0" in integrating[0], integrating
     assert drop(page, SYNTHETIC_TEK) == "done"
     assert not page.locator("#candidates-box").is_visible() and page.locator("#candidates tbody tr").count() == 0
+
+
+def test_the_spanish_check_page_sends_its_language_and_its_golden_lines_name_no_option(page, server, tmp_path):
+    """Issue 29: the Check page sends its language (options.lang, as /api/check reads it); a spec with golden:
+    recorded, then compared, shows no "--" in any line, the switch named by its field's label in the page's
+    language."""
+    from helpers import ROOT
+    from designer.core.i18n import catalogue
+    es = catalogue("es")
+    for rel in ("specs/rc_ladder.yaml", "specs/decks/rc_ladder.cir"):
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(ROOT / rel, tmp_path / rel)
+    open_page(page, server, "/check?lang=es")
+    page.wait_for_function("() => Object.keys(D.catalogue).length > 0")
+    page.set_input_files("#folder", str(tmp_path / "specs"))
+    page.wait_for_function("() => /rc_ladder\\.cir/.test(document.getElementById('decks').textContent)")
+    page.check("input[name=update-golden]")
+    with page.expect_request(lambda r: r.url.endswith("/api/check")) as sent:
+        assert after(page, lambda: page.click("#run"), timeout=300000) == "done"
+    options = json.loads(sent.value.post_data)["options"]
+    assert options["lang"] == "es" and options["update-golden"] is True
+    shown = lambda: " ".join(page.inner_text(s) for s in ("#verdict", "#cases-table", "#summary"))  # noqa: E731
+    recorded = es["golden_{signal}: recorded in {file} ({update_golden})"].format(
+        signal="out", file="rc_ladder.csv", update_golden=f'"{es["record the golden files"]}"')
+    assert recorded in page.inner_text("#cases-table")
+    assert "--update-golden" not in shown()
+    # compared against the repository's own golden file, chosen as a second folder under the same root
+    (tmp_path / "more" / "specs" / "golden").mkdir(parents=True)
+    shutil.copy(ROOT / "specs/golden/rc_ladder.csv", tmp_path / "more" / "specs" / "golden" / "rc_ladder.csv")
+    page.set_input_files("#folder", str(tmp_path / "more" / "specs"))
+    page.wait_for_function("() => /golden\\/rc_ladder\\.csv/.test(document.getElementById('decks').textContent)")
+    page.uncheck("input[name=update-golden]")
+    assert after(page, lambda: page.click("#run"), timeout=300000) == "done"
+    table = page.inner_text("#cases-table")
+    assert "golden_out" in table and "rc_ladder.csv" in table and "--" not in table
+    assert "--" not in page.inner_text("#verdict")
