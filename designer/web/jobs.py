@@ -598,7 +598,7 @@ def check_task(fields: dict, want: str = "check", tmp: str | None = None) -> dic
             error = check_message(DesignError(messages[-1]))[0] if messages else f"failed with exit status {status}"
     return {"status": status, "error": error, "json": {"specs": results}, "junit": run.junit(),
             "summary": summary, "golden": written_since(inside, before) if rq.update_golden else {},
-            "lines": run.lines(), "messages": messages}
+            "lines": [page_text(line, CHECK) for line in run.lines()], "messages": messages}
 
 
 def _said(lines: list, said: dict) -> list:

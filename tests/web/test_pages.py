@@ -1012,3 +1012,30 @@ def test_the_spanish_check_page_sends_its_language_and_its_golden_lines_name_no_
     table = page.inner_text("#cases-table")
     assert "golden_out" in table and "rc_ladder.csv" in table and "--" not in table
     assert "--" not in page.inner_text("#verdict")
+
+
+def test_the_spanish_check_page_runs_the_repositorys_specs_with_no_english_in_its_table(page, server, tmp_path):
+    """Issue 29: the repository's specs/ folder (and the reports/ file its PID spec names) run on the Spanish
+    Check page: the result table (each check's detail: the value against its limits, the design's own checks,
+    SPICE's agreement, the tolerance band, the golden comparison) and each spec's line hold no English word of
+    the catalogue."""
+    import yaml
+    from helpers import ROOT
+    for spec in (ROOT / "specs").glob("*.yaml"):
+        controller = (yaml.safe_load(spec.read_text()).get("controller") or {}).get("json")
+        if controller:
+            rel = (spec.parent / controller).resolve().relative_to(ROOT)
+            (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy(ROOT / rel, tmp_path / rel)
+    open_page(page, server, "/check?lang=es")
+    page.wait_for_function("() => Object.keys(D.catalogue).length > 0")
+    page.set_input_files("#folder", str(ROOT / "specs"))
+    page.set_input_files("#folder", str(tmp_path / "reports"))
+    page.wait_for_function("() => /reports\\//.test(document.getElementById('decks').textContent)")
+    assert after(page, lambda: page.click("#run"), timeout=300000) == "done"
+    cells = page.locator("#cases-table td").all_inner_texts()
+    lines = page.locator("#verdict p").all_inner_texts()   # each spec's verdict and counts
+    assert len(cells) > 50 and len(lines) == len(list((ROOT / "specs").glob("*.yaml")))
+    english, _spanish = vocabulary()
+    left = foreign(cells + lines, english)
+    assert not left, "\n".join(f"{words}: {text!r}" for text, words in left)
