@@ -592,13 +592,14 @@ def check_task(fields: dict, want: str = "check", tmp: str | None = None) -> dic
                     if isinstance(c.message, Message):
                         case["message"] = said[str(c.message)] = page_text(c.message, CHECK)
         messages, summary = _said(run.messages(), said), _said([run.summary()], said)[0]
+        lines = [page_text(line, CHECK) for line in run.lines()]   # in the request's language, as the cases
         status = run.status
         error = None
         if status not in (0, 1):   # a spec that proved bad while running, or the simulator: its last line
             error = check_message(DesignError(messages[-1]))[0] if messages else f"failed with exit status {status}"
     return {"status": status, "error": error, "json": {"specs": results}, "junit": run.junit(),
             "summary": summary, "golden": written_since(inside, before) if rq.update_golden else {},
-            "lines": [page_text(line, CHECK) for line in run.lines()], "messages": messages}
+            "lines": lines, "messages": messages}
 
 
 def _said(lines: list, said: dict) -> list:

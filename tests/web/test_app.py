@@ -1110,6 +1110,11 @@ def test_check_golden_lines_name_the_pages_switch_not_the_command_lines(server, 
     assert golden == [words("golden_{signal}: recorded in {file} ({update_golden})").format(
         signal="out", file="rc_ladder.csv", update_golden=f'"{label}"')]
     assert not [t for t in _check_texts(recorded) if "--" in t]
+    n = recorded["specs"][0]["counts"]   # the spec's line in the page's language too
+    assert recorded["lines"] == [words("{spec}: {status} ({passed} passed, {failed} failed, {errors} errors, "
+                                       "{skipped} report-only)").format(
+        spec="rc_ladder", status=words("pass"), passed=n["pass"], failed=n["fail"], errors=n["error"],
+        skipped=n["skipped"])]
     # compared against the file just recorded
     gold = {"specs/golden/rc_ladder.csv": recorded["golden"]["specs/golden/rc_ladder.csv"]}
     status, compared = server.post_json("/api/check", {**ask, "files": {**files, **gold},
