@@ -487,10 +487,9 @@ def test_back_and_forward_move_between_designs(page, server):
     assert page.input_value("input[name=fc]") == "2000" and "fc 2000 Hz" in page.inner_text("#title")
 
 
-def test_check_page_runs_the_repositorys_specs_folder_and_records_golden_files(page, server, tmp_path):
-    """Issue 29: the repository's own specs/ folder, chosen as a folder, runs as it is (its decks and golden
-    files by their paths; the PID specs' controllers from ../reports, chosen as a second folder); with "record
-    the golden files" ticked the page offers each golden file recorded for download."""
+def run_the_repositorys_specs(page, server, tmp_path, path="/check"):
+    """The Check page at ``path`` given the repository's specs/ folder, then the reports/ files its specs name (as
+    a folder of their own, copied to ``tmp_path``), and run; the page's state after its answer."""
     import yaml
     from helpers import ROOT
     for spec in (ROOT / "specs").glob("*.yaml"):   # the reports/ files the specs name, as a folder of their own
@@ -499,11 +498,21 @@ def test_check_page_runs_the_repositorys_specs_folder_and_records_golden_files(p
             rel = (spec.parent / controller).resolve().relative_to(ROOT)
             (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy(ROOT / rel, tmp_path / rel)
-    open_page(page, server, "/check")
+    open_page(page, server, path)
+    page.wait_for_function("() => D.lang === 'en' || Object.keys(D.catalogue).length > 0")
     page.set_input_files("#folder", str(ROOT / "specs"))
     page.set_input_files("#folder", str(tmp_path / "reports"))
     page.wait_for_function("() => /reports\\//.test(document.getElementById('decks').textContent)")
-    assert after(page, lambda: page.click("#run"), timeout=300000) == "done"
+    return after(page, lambda: page.click("#run"), timeout=300000)
+
+
+def test_check_page_runs_the_repositorys_specs_folder_and_records_golden_files(page, server, tmp_path):
+    """Issue 29: the repository's own specs/ folder, chosen as a folder, runs as it is (its decks and golden
+    files by their paths; the PID specs' controllers from ../reports, chosen as a second folder); with "record
+    the golden files" ticked the page offers each golden file recorded for download."""
+    import yaml
+    from helpers import ROOT
+    assert run_the_repositorys_specs(page, server, tmp_path) == "done"
     table = page.inner_text("#cases-table")
     for spec in (ROOT / "specs").glob("*.yaml"):
         assert yaml.safe_load(spec.read_text())["name"] in table
@@ -1019,20 +1028,8 @@ def test_the_spanish_check_page_runs_the_repositorys_specs_with_no_english_in_it
     Check page: the result table (each check's detail: the value against its limits, the design's own checks,
     SPICE's agreement, the tolerance band, the golden comparison) and each spec's line hold no English word of
     the catalogue."""
-    import yaml
     from helpers import ROOT
-    for spec in (ROOT / "specs").glob("*.yaml"):
-        controller = (yaml.safe_load(spec.read_text()).get("controller") or {}).get("json")
-        if controller:
-            rel = (spec.parent / controller).resolve().relative_to(ROOT)
-            (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy(ROOT / rel, tmp_path / rel)
-    open_page(page, server, "/check?lang=es")
-    page.wait_for_function("() => Object.keys(D.catalogue).length > 0")
-    page.set_input_files("#folder", str(ROOT / "specs"))
-    page.set_input_files("#folder", str(tmp_path / "reports"))
-    page.wait_for_function("() => /reports\\//.test(document.getElementById('decks').textContent)")
-    assert after(page, lambda: page.click("#run"), timeout=300000) == "done"
+    assert run_the_repositorys_specs(page, server, tmp_path, "/check?lang=es") == "done"
     cells = page.locator("#cases-table td").all_inner_texts()
     lines = page.locator("#verdict p").all_inner_texts()   # each spec's verdict and counts
     assert len(cells) > 50 and len(lines) == len(list((ROOT / "specs").glob("*.yaml")))
