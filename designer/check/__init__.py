@@ -22,7 +22,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "figures": ("ALIASES", "BAND", "PID", "PLANT", "SECTION_BAND", "band_of", "circuit_band_of", "plant_figures",),
     "filter_kind": ("DELAY_FIGURES", "DELAY_KEYS", "FILTER_KEYS", "FilterCase", "MASK_FIGURES", "MASK_KEYS",
                     "SUB_FILTER", "delay_limits", "filter_designs", "filter_figures", "mask_limits", "run_filter",),
-    "golden": ("compare", "read_golden", "write_golden",),
+    "golden": ("RECORD_GOLDEN", "compare", "read_golden", "record_advice", "write_golden",),
     "junit": ("junit_xml", "visible",),
     "limits": ("Limit", "limit_from",),
     "result": ("Case", "CornerOutcome", "ERROR", "FAIL", "PASS", "SIM_ERROR", "SKIP", "SPEC_ERROR", "SpecOutcome",

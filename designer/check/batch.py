@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..core.errors import DesignError
+from ..core.i18n import N_, Message
 from .result import ERROR, FAIL, SpecOutcome, exit_status, headline
 
 __all__ = ["CheckRun", "check_specs", "load_specs", "run_specs"]
@@ -67,10 +68,13 @@ class CheckRun:
             The lines.
         """
         out = []
+        shout = {"pass": N_("pass"), FAIL: N_("FAIL"), ERROR: N_("ERROR")}
         for o in self.outcomes:
             n = o.counts()
-            out.append(f"{o.name}: {o.status.upper() if o.status != 'pass' else 'pass'} ({n['pass']} passed, "
-                       f"{n[FAIL]} failed, {n[ERROR]} errors, {n['skipped']} report-only)")
+            # a typed message: the text is the English, a page shows it in its language
+            out.append(Message(N_("{spec}: {status} ({passed} passed, {failed} failed, {errors} errors, {skipped} "
+                                  "report-only)"), spec=o.name, status=shout[o.status], passed=str(n["pass"]),
+                               failed=str(n[FAIL]), errors=str(n[ERROR]), skipped=str(n["skipped"])))
         return out
 
     def messages(self, prog: str = "check-design") -> list:

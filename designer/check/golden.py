@@ -8,6 +8,11 @@ signal, CSV, ``identify`` reads it) under a header of ``# key: value``
 comment lines recording what produced it: the tool's version, ngspice's, the
 simulator backend, the spec and the corner. A file recorded by other versions
 still compares; the difference is a warning (a JUnit property), not a failure.
+
+A refusal that a recording would cure advises it as a :class:`~designer.core.i18n.Message` whose
+``{update_golden}`` value (:func:`record_advice`) names :func:`designer.check.batch.check_specs`'s parameter: its
+text is the command line's (``check-design --update-golden``), and a front end with its own words for the switch
+reads the value by that key (the Check page: its field's label, :func:`designer.web.forms.page_text`).
 """
 
 from __future__ import annotations
@@ -20,13 +25,40 @@ import numpy as np
 from ..core.compare import nrms
 from ..core.errors import DesignError
 from ..core.fileio import MAX_TABLE_BYTES, atomic_write, read_text, shown
+from ..core.i18n import N_, Message
 from ..core.units import format_eng
 
-__all__ = ["compare", "read_golden", "write_golden"]
+__all__ = ["RECORD_GOLDEN", "compare", "read_golden", "record_advice", "write_golden"]
 
 TITLE = "designer golden waveform"
 #: the header's keys whose change since recording is worth a warning
 VERSIONED = ("tool", "ngspice", "simulator")
+#: check_specs' ``update_golden`` as the command line gives it (the ``{update_golden}`` value of the advice)
+RECORD_GOLDEN = "check-design --update-golden"
+
+
+def record_advice(problem: str, aside: bool = False, switch: str = RECORD_GOLDEN) -> Message:
+    """``problem`` and the advice to record the golden file, the switch carried as the ``update_golden`` value
+    (each front end names it its own way; the text is the command line's).
+
+    Parameters
+    ----------
+    problem : str
+        What is wrong with the golden file (one clause, naming it).
+    aside : bool
+        The advice in parentheses after ``problem`` (else after a semicolon).
+    switch : str
+        How the text names the switch (:data:`RECORD_GOLDEN`; ``--update-golden`` where the command is
+        understood).
+
+    Returns
+    -------
+    Message
+        ``<problem>; record it with check-design --update-golden`` (or ``<problem> (record it with ...)``).
+    """
+    form = N_("{problem} (record it with {update_golden})") if aside else \
+        N_("{problem}; record it with {update_golden}")
+    return Message(form, problem=problem, update_golden=switch)
 
 
 def header_of(tool: dict, spec: str, corner: str) -> dict:
@@ -89,13 +121,13 @@ def read_golden(path) -> tuple:
             body.append(ln)
             lines.append(n)
     if not body or not body[0].startswith("time_s,"):
-        raise DesignError(f"golden file {name} is not a golden waveform (a time_s,... header line, then "
-                          "samples); record it with check-design --update-golden")
+        raise DesignError(record_advice(f"golden file {name} is not a golden waveform (a time_s,... header line, "
+                                        "then samples)"))
     names = [c.strip() for c in body[0].split(",")]
     if len(body) < 3:   # loadtxt warns on no rows; one row is no waveform
         rows = f"{len(body) - 1} row{'' if len(body) == 2 else 's'}"
-        raise DesignError(f"golden file {name}: {rows} of samples; a golden waveform has at least 2 (record it "
-                          "with check-design --update-golden)")
+        raise DesignError(record_advice(f"golden file {name}: {rows} of samples; a golden waveform has at least 2",
+                                        aside=True))
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error")   # whatever numpy would print is a refusal here
@@ -108,9 +140,9 @@ def read_golden(path) -> tuple:
     bad = ~np.isfinite(data)
     if bad.any():
         row, col = (int(i) for i in np.argwhere(bad)[0])
-        raise DesignError(f"golden file {name}:{lines[row + 1]}: {names[col]} is {float(data[row, col])} in "
-                          f"sample row {row + 1}; a golden waveform holds finite numbers only (record it with "
-                          "check-design --update-golden)")
+        raise DesignError(record_advice(f"golden file {name}:{lines[row + 1]}: {names[col]} is "
+                                        f"{float(data[row, col])} in sample row {row + 1}; a golden waveform holds "
+                                        "finite numbers only", aside=True))
     t = data[:, 0]
     if not np.all(np.diff(t) > 0):
         raise DesignError(f"golden file {name}: time_s must increase")
@@ -162,9 +194,9 @@ def compare(t, test: dict, t_gold, gold: dict, tolerances: dict, path=None) -> d
     if np.count_nonzero(inside) < 2:
         span = f"{format_eng(t_gold[0], 's')} to {format_eng(t_gold[-1], 's')}" if t_gold.size else "no time"
         run = f"{format_eng(t[0], 's')} to {format_eng(t[-1], 's')}" if t.size else "no time"
-        raise DesignError(f"golden file{name} covers {span}; the run covers {run}: fewer than 2 of the run's time "
-                          "points lie in the golden span, nothing to compare (record it with check-design "
-                          "--update-golden)")
+        raise DesignError(record_advice(f"golden file{name} covers {span}; the run covers {run}: fewer than 2 of "
+                                        "the run's time points lie in the golden span, nothing to compare",
+                                        aside=True))
     out = {}
     for sig, (reltol, abstol) in tolerances.items():
         y = np.asarray(test[sig], float)

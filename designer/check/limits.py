@@ -13,6 +13,7 @@ import re
 from dataclasses import dataclass
 
 from ..core.errors import DesignError
+from ..core.i18n import N_, Message
 from ..core.units import format_eng, parse_value
 
 __all__ = ["Limit", "limit_from"]
@@ -74,15 +75,19 @@ class Limit:
         """(passed, text): whether ``value`` is within the limits, and the value
         against them in words (``overshoot_pct = 55.2 above max 55``).
         A missing value (None or NaN: not measured) never passes."""
+        # typed messages (designer.core.i18n.Message): the text is the English, the page shows its language
         name = self.figure
         if value is None or (isinstance(value, float) and math.isnan(value)):
-            return False, f"{name} not measured (limits {self.text()})"
+            return False, Message(N_("{figure} not measured (limits {limits})"), figure=name, limits=self.text())
         v = float(value)
         if self.min is not None and v < self.min:
-            return False, f"{name} = {self.fmt(v)} below min {self.fmt(self.min)}"
+            return False, Message(N_("{figure} = {value} below min {limit}"), figure=name, value=self.fmt(v),
+                                  limit=self.fmt(self.min))
         if self.max is not None and v > self.max:
-            return False, f"{name} = {self.fmt(v)} above max {self.fmt(self.max)}"
-        return True, f"{name} = {self.fmt(v)} within {self.text()}"
+            return False, Message(N_("{figure} = {value} above max {limit}"), figure=name, value=self.fmt(v),
+                                  limit=self.fmt(self.max))
+        return True, Message(N_("{figure} = {value} within {limits}"), figure=name, value=self.fmt(v),
+                             limits=self.text())
 
     def text(self) -> str:
         """``3.4 kHz .. 3.6 kHz``, ``<= 55``, ``>= 30``."""

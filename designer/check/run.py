@@ -24,6 +24,7 @@ import numpy as np
 from ..core.compare import nrms
 from ..core.errors import DesignError, SimulatorError
 from ..core.fileio import atomic_write
+from ..core.i18n import N_, Message
 from ..plant.circuit import DEFAULT_TOPOLOGY
 from . import figures as F
 from . import golden as G
@@ -105,8 +106,12 @@ def corner_task(spec: CheckSpec, index: int, simulator: str, update_golden: bool
 
 
 def _failed(corner, kind, exc, tool, tick) -> CornerOutcome:
-    what = "simulator error" if kind == SIM_ERROR else "bad spec"
-    case = Case("simulation", corner, ERROR, f"simulation: {what}: {' '.join(str(exc).split())}", error_kind=kind)
+    what = N_("simulator error") if kind == SIM_ERROR else N_("bad spec")
+    said = exc.args[0] if exc.args and isinstance(exc.args[0], Message) else " ".join(str(exc).split())
+    # a typed message (one carrying a parameter) stays typed: each front end names the parameter its own way
+    message = Message(N_("simulation: {what}: {error}"), what=what, error=said) if isinstance(said, Message) else \
+        f"simulation: {what}: {said}"
+    case = Case("simulation", corner, ERROR, message, error_kind=kind)
     return CornerOutcome(corner, (case,), None, tool, (), {}, time.perf_counter() - tick)
 
 
@@ -151,7 +156,7 @@ def _judge(spec, corner, figures, res, waves, tool, update_golden, out_dir):
         value = figures.get(lim.figure)
         ok, text = lim.judge(value)
         status = (PASS if ok else FAIL) if lim.fail else SKIP
-        cases.append(Case(lim.figure, corner, status, text if lim.fail else f"report only: {text}",
+        cases.append(Case(lim.figure, corner, status, text if lim.fail else Message(N_("report only: {text}"), text=text),
                           _num(value), lim.text(), would_pass=None if lim.fail else ok))
     if spec.design_checks is not None:
         cases += _design_cases(spec, corner, res)
@@ -164,11 +169,11 @@ def _judge(spec, corner, figures, res, waves, tool, update_golden, out_dir):
             lo, hi = band[fig]
             lim = limits[fig]
             ok = lim.inside(lo, hi)
-            span = "none" if lo is None else f"{lim.fmt(lo)} .. {lim.fmt(hi)}"
+            span = N_("none") if lo is None else f"{lim.fmt(lo)} .. {lim.fmt(hi)}"
+            said = N_("{id}: the part-tolerance band {span} is inside {limits}") if ok else \
+                N_("{id}: the part-tolerance band {span} is outside {limits}")
             cases.append(Case(f"tolerance_{fig}", corner, PASS if ok else FAIL,
-                              f"tolerance_{fig}: the part-tolerance band {span} is "
-                              f"{'inside' if ok else 'outside'} {lim.text()}",
-                              None, lim.text()))
+                              Message(said, id=f"tolerance_{fig}", span=span, limits=lim.text()), None, lim.text()))
     if spec.yield_spec is not None:
         cases.append(_yield_case(spec, corner, res, tool["simulator"]))
     warnings, files = [], {}
@@ -204,10 +209,25 @@ def _design_cases(spec, corner, res) -> list:
     for cid in wanted:
         c = checks.get(cid)
         if c is None:   # e.g. square_wave_period, reported only when the period is too short
-            out.append(Case(cid, corner, PASS, f"{cid}: not reported by this design (nothing to flag)"))
+            out.append(Case(cid, corner, PASS, Message(N_("{id}: not reported by this design (nothing to flag)"),
+                                                       id=cid)))
         else:
-            out.append(Case(cid, corner, PASS if c.ok else FAIL, f"{cid}: {c.detail}"))
+            out.append(Case(cid, corner, PASS if c.ok else FAIL, Message(N_("{id}: {detail}"), id=cid,
+                                                                         detail=_detail(c))))
     return out
+
+
+def _detail(check):
+    """A design check's detail as a typed message (its message and values, a list among them as its items),
+    the text its English ``detail``; the detail itself when it has no message."""
+    def value(v):
+        if isinstance(v, tuple) and v[:1] == ("parts",):
+            return Message.joined(v[1], [Message(m, **{k: value(x) for k, x in vals}) for m, vals in v[2]])
+        return v
+    if check.message is None:
+        return check.detail
+    typed = Message(check.message, **{k: value(v) for k, v in check.values})
+    return typed if str(typed) == check.detail else check.detail
 
 
 def _agreement_case(spec, corner, res, figures) -> Case:
@@ -219,14 +239,16 @@ def _agreement_case(spec, corner, res, figures) -> Case:
     else:   # the loop with the ideal PID and plant, against SPICE's plant output, on the same grid
         s = res.spice
         value = nrms(res.waveforms.ideal_pid, s.waves["y"], s.nrms_abstol_v, t=res.waveforms.t)
-    model = "op-amp-aware model" if a.against == "opamp_model" else "ideal model"
+    model = N_("op-amp-aware model") if a.against == "opamp_model" else N_("ideal model")
     if value is None or not np.isfinite(value):
-        return Case("spice_agreement", corner, FAIL, f"spice_agreement: no nrms against the {model}",
-                    None, f"< {a.nrms_max:g}")
+        return Case("spice_agreement", corner, FAIL, Message(N_("spice_agreement: no nrms against the {model}"),
+                                                             model=model), None, f"< {a.nrms_max:g}")
     ok = value < a.nrms_max
+    said = N_("spice_agreement: nrms = {nrms} against the {model} below nrms_max {max}") if ok else \
+        N_("spice_agreement: nrms = {nrms} against the {model} not below nrms_max {max}")
     return Case("spice_agreement", corner, PASS if ok else FAIL,
-                f"spice_agreement: nrms = {value:.4g} against the {model} "
-                f"{'below' if ok else 'not below'} nrms_max {a.nrms_max:g}", float(value), f"< {a.nrms_max:g}")
+                Message(said, nrms=f"{value:.4g}", model=model, max=f"{a.nrms_max:g}"), float(value),
+                f"< {a.nrms_max:g}")
 
 
 def _golden_cases(spec, corner, waves, tool, update, out_dir):
@@ -243,21 +265,24 @@ def _golden_cases(spec, corner, waves, tool, update, out_dir):
     header = G.header_of(tool, spec.name, corner)
     if update:
         G.write_golden(path, t, {s: test[s] for s in wanted}, header)
-        return ([Case(f"golden_{s}", corner, PASS, f"golden_{s}: recorded in {path.name} (--update-golden)")
+        return ([Case(f"golden_{s}", corner, PASS, Message(N_("golden_{signal}: recorded in {file} ({update_golden})"),
+                                                            signal=s, file=path.name, update_golden="--update-golden"))
                  for s in wanted], [], {"golden": str(path)})
     recorded, t_gold, gold = G.read_golden(path)
     absent = [s for s in wanted if s not in gold]
     if absent:
-        raise DesignError(f"golden file {path}: no column {absent[0]!r}; record it with --update-golden")
+        raise DesignError(G.record_advice(f"golden file {path}: no column {absent[0]!r}", switch="--update-golden"))
     warnings = G.version_warnings(recorded, header, path)
     errors = G.compare(t, test, t_gold, gold, wanted, path=path)
     cases, files = [], {"golden": str(path)}
     for sig, value in errors.items():
         reltol, abstol = wanted[sig]
         ok = bool(np.isfinite(value) and value < 1.0)
+        said = N_("golden_{signal}: nrms = {nrms} below 1 (reltol {reltol}, abstol {abstol}, against {file})") if ok \
+            else N_("golden_{signal}: nrms = {nrms} not below 1 (reltol {reltol}, abstol {abstol}, against {file})")
         cases.append(Case(f"golden_{sig}", corner, PASS if ok else FAIL,
-                          f"golden_{sig}: nrms = {value:.4g} {'below' if ok else 'not below'} 1 (reltol {reltol:g}, "
-                          f"abstol {abstol:g}, against {path.name})", float(value), "< 1"))
+                          Message(said, signal=sig, nrms=f"{value:.4g}", reltol=f"{reltol:g}", abstol=f"{abstol:g}",
+                                  file=path.name), float(value), "< 1"))
         if not ok and out_dir is not None:
             png = G.error_plot(t, test[sig], t_gold, gold[sig], reltol, abstol,
                                f"{spec.classname(corner)} {sig}: nrms {value:.3g}")

@@ -31,6 +31,7 @@ from ..core.fileio import shown
 from ..core.units import parse_value
 from ..filters.sallen_key_lowpass_parts import FIELD_OF, parts_of, refs
 from . import figures as F
+from .golden import record_advice
 from .limits import LIMIT_KEYS, limit_from
 from .yamldoc import kind_of, closest
 
@@ -536,6 +537,6 @@ def read_golden(doc, kind: str, corners, update: bool):
     if not update:
         for c in corners:
             if not golden.path(c).is_file():
-                raise doc.error(("golden", "file"), f"golden file {shown(golden.path(c))} does not exist; "
-                                "record it with check-design --update-golden")
+                raise doc.error(("golden", "file"), record_advice(f"golden file {shown(golden.path(c))} does not "
+                                                                  "exist"))
     return golden

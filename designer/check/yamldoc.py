@@ -22,6 +22,7 @@ from pathlib import Path
 
 from ..core.errors import DesignError
 from ..core.fileio import MIB, read_text, shown
+from ..core.i18n import N_, Message
 from .yamlread import compose
 
 __all__ = ["MAX_SPEC_BYTES", "WIDER", "parse_yaml"]
@@ -53,6 +54,9 @@ class _Doc:
         return f"{shown(self.path)}:{self.lines.get(keys, 1)}"
 
     def error(self, keys, message: str) -> DesignError:
+        # a typed message (one carrying a parameter, designer.core.i18n.Message) stays typed behind its place
+        if isinstance(message, Message):
+            return DesignError(Message(N_("{where}: {message}"), where=self.where(keys), message=message))
         return DesignError(f"{self.where(keys)}: {message}")
 
     def mapping(self, keys, allowed, value=None) -> dict:

@@ -325,10 +325,10 @@ def seed_bench_parts() -> PidParts:
 #: what the thesis reports of its bench (001, V.13, Figures 88-90), for the comparison on the sheet
 THESIS_BENCH = {
     "stable": True,
-    "output_vs_reference": "larger (Fig. 89: 'la magnitud de la salida es mas grande que la senal de entrada')",
-    "overshoot": "suppressed ('se redujo significativamente el valor del sobrepaso maximo', Fig. 89-90)",
-    "scope": "Fig. 88: CH1 1.00 V/div, CH2 5.00 V/div, 500 us/div, trigger CH1, 434 Hz",
-    "amplitude": "not stated for the loop (the plant's own test, IV.9: a 2 V, 330 Hz square wave)",
-    "opamp": "LM741 (V.10 uses 1.5 MHz and 0.7 V/us; TI's typicals are 1 MHz and 0.5 V/us)",
-    "plant": "R1 = 805 Ohm, R2 = 1k, C1 = 10n, C2 = 220n (its list swaps the C1/C2 names)",
+    "output_vs_reference": N_("larger (Fig. 89: 'la magnitud de la salida es mas grande que la senal de entrada')"),
+    "overshoot": N_("suppressed ('se redujo significativamente el valor del sobrepaso maximo', Fig. 89-90)"),
+    "scope": N_("Fig. 88: CH1 1.00 V/div, CH2 5.00 V/div, 500 us/div, trigger CH1, 434 Hz"),
+    "amplitude": N_("not stated for the loop (the plant's own test, IV.9: a 2 V, 330 Hz square wave)"),
+    "opamp": N_("LM741 (V.10 uses 1.5 MHz and 0.7 V/us; TI's typicals are 1 MHz and 0.5 V/us)"),
+    "plant": N_("R1 = 805 Ohm, R2 = 1k, C1 = 10n, C2 = 220n (its list swaps the C1/C2 names)"),
 }

@@ -212,9 +212,10 @@ def spice_notes(sp, verdict, expected_final_v: float) -> list:
         The notes.
     """
     out = []
-    sat = [f"{v.opamp} {role}" for role, v in sp.stages.items() if v.saturated]
+    # each unit with its stage's name (a word of the catalogue: shown in the sheet's language)
+    sat = [Message(N_("{opamp} {stage}"), opamp=v.opamp, stage=role) for role, v in sp.stages.items() if v.saturated]
     if sat:
-        out.append(Message(N_("SPICE: op-amp output pinned at a rail: {units}"), units=", ".join(sat)))
+        out.append(Message(N_("SPICE: op-amp output pinned at a rail: {units}"), units=Message.joined(", ", sat)))
     osc = sp.oscillation
     if osc.oscillating:
         out.append(Message(N_("SPICE: the loop is still oscillating at the end of the half period ({v} V peak to "

@@ -178,7 +178,7 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
     out.append((_("Build"), _build_blocks(result, b, bom(result, b), with_images, schematic_svg)))
     out.append((_("Wiring"), _wiring_blocks(result, b)))
     if result.seed_bench is not None:
-        out.append(("The seed's bench: predicted against measured (001, V.13, Figures 88-90)",
+        out.append((_("The seed's bench: predicted against measured (001, V.13, Figures 88-90)"),
                     _seed_bench_blocks(result)))
     elif result.diff_amp is not None:
         out.append((_("Difference amplifier as built"), _diff_amp_blocks(result)))
@@ -335,47 +335,64 @@ def _diff_amp_blocks(result) -> list:
 
 def _seed_bench_blocks(result) -> list:
     sb, d = result.seed_bench, result.diff_amp
-    th = sb.thesis
+    # the thesis's words are data (result.json keeps them in English): translated where they are shown
+    th = {k: _(v) if isinstance(v, str) else v for k, v in sb.thesis.items()}
     sw = d.swapped
     a, s = result.analytic, result.spice
     amp = result.opamp.name
-    spice_txt = "not simulated" if s is None else ("oscillates" + (", saturated" if s.saturated else "")
-                                                   if not s.stable else "settles")
-    rows = [["loop", "stable" if th["stable"] else "unstable",
-             ("stable" if a.stable else "UNSTABLE") + f" (phase margin {_fmt(result.margins.phase_margin_deg, 'deg')}"
-             f"); SPICE {spice_txt}",
-             ("stable" if sw["stable"] else "unstable") + f" (phase margin {_fmt(sw['phase_margin_deg'], 'deg')})"],
-            ["output against the reference", th["output_vs_reference"], f"y = {d.final_ratio:.3g} r ({'larger' if d.final_ratio > 1 else 'smaller'})",
-             f"y = {sw['final_ratio']:.3g} r ({'larger' if sw['final_ratio'] > 1 else 'smaller'})"],
-            ["loop gain against a balanced U2", "", f"{d.loop_gain_db:+.3g} dB", f"{sw['loop_gain_db']:+.3g} dB"],
-            ["overshoot", th["overshoot"], "", ""]]
-    runs = [[f"{k[0]}, {k[1]:g} V step", "stable" if v[0] else "unstable", _fmt(v[1], "deg"),
-             ("settles" if v[2] else "oscillates") + (", saturated" if v[3] else ""),
-             f"{_v(v[4])} (expected {_v(v[5])})"] for k, v in sb.runs.items()]
+
+    def stable(ok):
+        return _("stable") if ok else _("unstable")
+
+    def ratio(r):
+        return _("y = {ratio} r ({side})").format(ratio=f"{r:.3g}", side=_("larger") if r > 1 else _("smaller"))
+
+    def spice(settles, saturated):
+        return (_("settles") if settles else _("oscillates")) + (_(", saturated") if saturated else "")
+    spice_txt = _("not simulated") if s is None else spice(False, s.saturated) if not s.stable else _("settles")
+    rows = [[_("loop"), stable(th["stable"]),
+             _("{verdict} (phase margin {pm}); SPICE {spice}").format(
+                 verdict=_("stable") if a.stable else _("UNSTABLE"), pm=_fmt(result.margins.phase_margin_deg, "deg"),
+                 spice=spice_txt),
+             _("{verdict} (phase margin {pm})").format(verdict=stable(sw["stable"]),
+                                                      pm=_fmt(sw["phase_margin_deg"], "deg"))],
+            [_("output against the reference"), th["output_vs_reference"], ratio(d.final_ratio),
+             ratio(sw["final_ratio"])],
+            [_("loop gain against a balanced U2"), "", f"{d.loop_gain_db:+.3g} dB", f"{sw['loop_gain_db']:+.3g} dB"],
+            [_("overshoot"), th["overshoot"], "", ""]]
+    runs = [[_("{opamp}, {step} V step").format(opamp=k[0], step=f"{k[1]:g}"), stable(v[0]), _fmt(v[1], "deg"),
+             spice(v[2], v[3]), _("{final} (expected {expected})").format(final=_v(v[4]), expected=_v(v[5]))]
+            for k, v in sb.runs.items()]
     ok_small = [k for k, v in sb.runs.items() if v[2]]
+    settled = (" (" + _("{runs} settles in SPICE").format(
+        runs=", ".join(_("{step} V with {opamp}").format(step=f"{k[1]:g}", opamp=k[0]) for k in ok_small)) + ")"
+               if ok_small else "")
     return [
-        R.text(f"The thesis built this controller with {th['opamp']} and trimmed U2 on the bench; it reports "
-               f"a stable loop with the overshoot suppressed and the output larger than the reference. Its plant: "
-               f"{th['plant']}. Its scope: {th['scope']}. Test amplitude: {th['amplitude']}."),
-        R.table(["", "thesis measured", f"predicted, parts as named here ({amp})",
-                 "predicted, divider on y (R17, R18 exchanged)"], rows),
-        R.text(f"Why they disagree. (1) Which input is attenuated: read with this project's names (R17 from y, R18 "
-               f"to ground) the trimmed values attenuate the REFERENCE (g_r = {d.g_r:.3g}, g_y = {d.g_y:.3g}): "
-               f"the loop gain does not fall ({d.loop_gain_db:+.2g} dB), the loop stays unstable, and it would settle "
-               f"at {d.final_ratio:.2g} r, below the reference, against both of the thesis's observations. With the "
-               f"9.98k/1.716k divider on the FEEDBACK input instead (y through 9.98k, 1.716k to ground), y is "
-               f"attenuated to g_y = {sw['g_y']:.3g}: the loop gain falls by {-sw['loop_gain_db']:.3g} dB (Kp = "
-               f"{result.achieved.kp:.3g} acts as {result.achieved.kp * sw['g_y']:.3g}), the crossover drops to {_v(sw['crossover_hz'], 'Hz')}, and the loop "
-               f"settles at y = {sw['final_ratio']:.3g} r, larger than the reference as the thesis saw: the thesis's "
-               "figures fit this wiring, which its text does not name. (2) The op-amp model and (3) the test "
-               "amplitude decide the rest, as the runs below show: with that wiring the loop sits at the edge of "
-               "stability, stable only with the seed's faster LM741 figures, and then only for a step small enough "
-               "that no stage saturates or slews."),
-        R.table(["divider on y, run", "analytic loop", "phase margin", "SPICE", "SPICE final value"], runs),
-        R.text("So the bench result is reproduced only by the divider on the feedback input, an LM741 near the "
-               "seed's 1.5 MHz, and a small test amplitude"
-               + (f" ({', '.join(f'{k[1]:g} V with {k[0]}' for k in ok_small)} settles in SPICE)" if ok_small
-                  else "") + "; at the seed's 2 V the stages saturate and the loop oscillates in SPICE.")]
+        R.text(_("The thesis built this controller with {opamp} and trimmed U2 on the bench; it reports a stable loop "
+                 "with the overshoot suppressed and the output larger than the reference. Its plant: {plant}. Its "
+                 "scope: {scope}. Test amplitude: {amplitude}.").format(
+                     opamp=th["opamp"], plant=th["plant"], scope=th["scope"], amplitude=th["amplitude"])),
+        R.table(["", _("thesis measured"), _("predicted, parts as named here ({opamp})").format(opamp=amp),
+                 _("predicted, divider on y (R17, R18 exchanged)")], rows),
+        R.text(_("Why they disagree. (1) Which input is attenuated: read with this project's names (R17 from y, R18 "
+                 "to ground) the trimmed values attenuate the REFERENCE (g_r = {g_r}, g_y = {g_y}): the loop gain "
+                 "does not fall ({db} dB), the loop stays unstable, and it would settle at {ratio} r, below the "
+                 "reference, against both of the thesis's observations. With the 9.98k/1.716k divider on the FEEDBACK "
+                 "input instead (y through 9.98k, 1.716k to ground), y is attenuated to g_y = {sw_g_y}: the loop gain "
+                 "falls by {sw_db} dB (Kp = {kp} acts as {kp_eff}), the crossover drops to {sw_fc}, and the loop "
+                 "settles at y = {sw_ratio} r, larger than the reference as the thesis saw: the thesis's figures fit "
+                 "this wiring, which its text does not name. (2) The op-amp model and (3) the test amplitude decide "
+                 "the rest, as the runs below show: with that wiring the loop sits at the edge of stability, stable "
+                 "only with the seed's faster LM741 figures, and then only for a step small enough that no stage "
+                 "saturates or slews.").format(
+                     g_r=f"{d.g_r:.3g}", g_y=f"{d.g_y:.3g}", db=f"{d.loop_gain_db:+.2g}", ratio=f"{d.final_ratio:.2g}",
+                     sw_g_y=f"{sw['g_y']:.3g}", sw_db=f"{-sw['loop_gain_db']:.3g}", kp=f"{result.achieved.kp:.3g}",
+                     kp_eff=f"{result.achieved.kp * sw['g_y']:.3g}", sw_fc=_v(sw["crossover_hz"], "Hz"),
+                     sw_ratio=f"{sw['final_ratio']:.3g}")),
+        R.table([_("divider on y, run"), _("analytic loop"), _("phase margin"), "SPICE", _("SPICE final value")], runs),
+        R.text(_("So the bench result is reproduced only by the divider on the feedback input, an LM741 near the "
+                 "seed's 1.5 MHz, and a small test amplitude{settled}; at the seed's 2 V the stages saturate and the "
+                 "loop oscillates in SPICE.").format(settled=settled))]
 
 
 def _achieved_blocks(result, target=None) -> list:

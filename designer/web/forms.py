@@ -20,7 +20,7 @@ from typing import NamedTuple
 
 from ..check.yamldoc import WIDER
 from ..core.errors import DesignError, ParamError
-from ..core.i18n import N_, localise
+from ..core.i18n import N_, Message, localise, translated
 from ..core.i18n import gettext as _
 from ..filters.sallen_key_lowpass_parts import FIELD_OF, gain_refs, parts_of
 from ..filters.sallen_key_lowpass_parts import refs as sallen_key_refs
@@ -29,8 +29,8 @@ from .request import option_name, value_text
 __all__ = ["ANALYZE_PID", "ANALYZE_PLANT", "AnalyzePlantRequest", "CAPTURE_FIELDS", "CHECK", "CheckRequest",
            "DESIGN_ONLY", "FILTER", "Field", "FilterRequest", "IDENTIFY", "IDENTIFY_FILES", "PID", "PLANT",
            "PidRequest", "PlantRequest", "analyze_pid_request", "analyze_plant_request", "check_message",
-           "check_request", "field_of", "filter_request", "identify_request", "page_message", "pid_request",
-           "plant_request"]
+           "check_request", "field_of", "filter_request", "identify_request", "page_message", "page_text",
+           "pid_request", "plant_request"]
 
 
 class Field(NamedTuple):
@@ -503,6 +503,31 @@ def check_request(options) -> CheckRequest:
     return CheckRequest(_simulator(v, "pyspice"), bool(v.get("update_golden")), _argv("check-design", options))
 
 
+def page_text(text, table: dict) -> str:
+    """A library text in the page's words and language: a typed message (:class:`designer.core.i18n.Message`)
+    with each value it carries under a library parameter of ``table`` (check-design's ``{update_golden}``,
+    written ``--update-golden`` for the command line) read as that field's label, quoted; its other values, and
+    its text, translated (:func:`designer.core.i18n.translated`).
+
+    Parameters
+    ----------
+    text : str
+        A :class:`~designer.core.i18n.Message` or plain text.
+    table : dict
+        The page's fields (:data:`CHECK`).
+
+    Returns
+    -------
+    str
+        The text to show.
+    """
+    if not isinstance(text, Message):
+        return translated(text)
+    labels = {f.param: f'"{_(f.label)}"' for f in table.values()}
+    return _(text.message).format(**{k: labels[k] if k in labels else page_text(v, table)
+                                     for k, v in text.values.items()})
+
+
 def check_message(exc: DesignError) -> tuple:
     """A check-design refusal in the Check page's words: :func:`page_message` over :data:`CHECK`, the command
     line's advice (:data:`CHECK_WORDS`) as the page gives it.
@@ -517,6 +542,8 @@ def check_message(exc: DesignError) -> tuple:
     tuple
         (the message, the field it names or None).
     """
+    if exc.args and isinstance(exc.args[0], Message):   # a typed message: its parameters by their labels
+        return page_text(exc.args[0], CHECK), None
     if not isinstance(exc, ParamError) and getattr(exc, "param", None) is None:
         text = str(exc)
         for cli, page in CHECK_WORDS:

@@ -28,7 +28,7 @@ from contextlib import contextmanager
 import numpy as np
 
 from ..core import lifetime
-from ..core.i18n import N_, current, language, localise, translated
+from ..core.i18n import N_, Message, current, language, localise, translated
 from ..core.i18n import gettext as _
 from ..core.jsonio import json_safe
 from ..core.units import format_eng
@@ -587,7 +587,7 @@ def check_task(fields: dict, want: str = "check", tmp: str | None = None) -> dic
     """
     from ..check.batch import check_specs
     from ..core.errors import DesignError
-    from .forms import CHECK, check_message, check_request
+    from .forms import CHECK, check_message, check_request, page_text
     from .request import split_language
     inside = os.path.join(tmp, "in")
     specs = [os.path.join(inside, *rel.split("/")) for rel in fields["specs"]]
@@ -611,14 +611,29 @@ def check_task(fields: dict, want: str = "check", tmp: str | None = None) -> dic
                     "label": _(CHECK[field].label) if field else None}
         finally:
             sys.argv = argv0
-        messages = run.messages()
+        # the cases' typed messages (a parameter they carry) in the page's words; the junit.xml as check-design's
+        results, said = run.results(), {}
+        for spec, outcome in zip(results, run.outcomes):
+            for corner, outcome_corner in zip(spec["corners"], outcome.corners):
+                for case, c in zip(corner["cases"], outcome_corner.cases):
+                    if isinstance(c.message, Message):
+                        case["message"] = said[str(c.message)] = page_text(c.message, CHECK)
+        messages, summary = _said(run.messages(), said), _said([run.summary()], said)[0]
+        lines = [page_text(line, CHECK) for line in run.lines()]   # in the request's language, as the cases
         status = run.status
         error = None
         if status not in (0, 1):   # a spec that proved bad while running, or the simulator: its last line
             error = check_message(DesignError(messages[-1]))[0] if messages else f"failed with exit status {status}"
-    return {"status": status, "error": error, "json": {"specs": run.results()}, "junit": run.junit(),
-            "summary": run.summary(), "golden": written_since(inside, before) if rq.update_golden else {},
-            "lines": run.lines(), "messages": messages}
+    return {"status": status, "error": error, "json": {"specs": results}, "junit": run.junit(),
+            "summary": summary, "golden": written_since(inside, before) if rq.update_golden else {},
+            "lines": lines, "messages": messages}
+
+
+def _said(lines: list, said: dict) -> list:
+    """``lines`` with each English text of ``said`` as the page words it (text -> page text)."""
+    for english, page in said.items():
+        lines = [line.replace(english, page) for line in lines]
+    return lines
 
 
 def identify_task(fields: dict, want: str = "json", tmp: str | None = None, capture: str | None = None) -> dict:

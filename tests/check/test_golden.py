@@ -119,3 +119,17 @@ def test_check_design_refuses_a_golden_file_of_another_time_span_in_one_line(tmp
     lines = out.stderr.splitlines()
     assert len(lines) == 1 and "Warning" not in out.stderr and "Traceback" not in out.stderr
     assert f"golden file {tmp_path / 'g.csv'} covers 1 s to 2 s; the run covers 0 s to 20 us" in lines[0], lines[0]
+
+
+@pytest.mark.parametrize("aside", [False, True])
+def test_the_record_advice_carries_its_parameter_and_reads_as_the_command_line(aside):
+    """Issue 29: the advice is a typed message whose update_golden value a front end names its own way; its
+    text is check-design's words, as before (the CLI, its JUnit file and result.json unchanged)."""
+    from designer.check.golden import RECORD_GOLDEN, record_advice
+    from designer.core.errors import DesignError
+    from designer.cli.common import flag_message
+    advice = record_advice("golden file g.csv: 1 row of samples", aside=aside)
+    assert advice.values["update_golden"] == RECORD_GOLDEN == "check-design --update-golden"
+    want = "golden file g.csv: 1 row of samples" + (" (record it with check-design --update-golden)" if aside
+                                                    else "; record it with check-design --update-golden")
+    assert str(advice) == want and flag_message(DesignError(advice)) == want

@@ -127,20 +127,39 @@ MFB_DEMO = ["--plant-topology", "mfb-lowpass", "--plant-part", "R1=10k", "R2=20k
             "--name", "mfb_es"]
 
 
+#: the Makefile demo's seed bench (reports/pid_seed_bench_lm741): the seed's plant with the seed's parts as built,
+#: which adds the section on the seed's bench (its thesis's measurements against the predictions)
+SEED_BENCH_DEMO = ["--plant-r1", "805", "--plant-r2", "1k", "--plant-c1", "10n", "--plant-c2", "220n", "--opamp",
+                   "LM741", "--step", "2", "--r3", "12k", "--r4", "1.777k", "--r5", "22k", "--r6", "3.3k", "--r7",
+                   "14.356k", "--r8", "1.2k", "--r9", "10k", "--r10", "10k", "--r11", "10k", "--r12", "1.026k",
+                   "--r13", "26.048k", "--r14", "2.528k", "--r15", "10k", "--r16", "3.279k", "--r17", "1.716k",
+                   "--r18", "9.98k", "--c3", "4.7n", "--c4", "47n", "--kp", "45", "--ti", "43.215u", "--td",
+                   "10.8037u", "--name", "seed_bench_es"]
+
+
 @pytest.mark.spice
-@pytest.mark.parametrize("args", [MODEL_DEMO, MFB_DEMO], ids=["plant-tf", "plant-topology"])
-def test_the_spanish_model_plant_sheet_leaves_no_english_word(args, tmp_path):
+@pytest.mark.parametrize("exe, args", [("design-pid", MODEL_DEMO), ("design-pid", MFB_DEMO),
+                                       ("analyze-pid", SEED_BENCH_DEMO)],
+                         ids=["plant-tf", "plant-topology", "seed-bench"])
+def test_the_spanish_model_plant_sheet_leaves_no_english_word(exe, args, tmp_path):
     """Issue 29: a model plant's sheet (the plant, the rules' models, steps, formulas and notes, the rule table,
-    the margins, the scope) in Spanish, and a circuit plant's (its sections' titles, where it came from)."""
+    the margins, the scope) in Spanish, a circuit plant's (its sections' titles, where it came from), and the
+    seed's bench (the thesis's measurements, the predictions, why they disagree, the runs)."""
     from designer.core.i18n import catalogue
-    _summary, _rep, page, nodes = spanish_sheet("design-pid", args, tmp_path)
+    _summary, rep, page, nodes = spanish_sheet(exe, args, tmp_path)
     english, _spanish = vocabulary()
     assert foreign(nodes, english) == []
     es = catalogue("es")
-    assert es["Where it came from: {source}."].split("{")[0] in page
+    if exe == "design-pid":   # a plant given as a model or a section: where it came from
+        assert es["Where it came from: {source}."].split("{")[0] in page
     if "mfb-lowpass" in args:   # the half rule's reason (complex poles) for simc and imc, and the section's title
         assert es["does not apply: {reason}"].split("{")[0] + "simc: " in page and "polos complejos" in page
         assert es["MFB low-pass (inverting)"] in page and "MFB low-pass (inverting)" not in page
+    if exe == "analyze-pid":   # the seed bench's section, in Spanish; result.json keeps its English
+        assert es["The seed's bench: predicted against measured (001, V.13, Figures 88-90)"] in page
+        assert es["divider on y, run"] in page and "Why they disagree" not in page
+        result = json.loads((rep / "result.json").read_text())
+        assert result["seed_bench"]["thesis"]["overshoot"].startswith("suppressed")
 
 
 @pytest.mark.spice

@@ -1203,3 +1203,57 @@ def test_pid_replays_a_build_through_the_library_as_design_pid_does(server):
     assert status == 400 and got["field"] == "replay" and "from 0 to 19" in got["error"] and "--" not in got["error"]
     status, got = server.post_json("/api/pid", {**body, "fail-on-check": True})
     assert status == 400 and "set by the web page itself" in got["error"], got
+
+
+def _check_texts(answer: dict) -> list:
+    """Every line a Check answer gives the page: the cases' details, the run's lines and messages, the
+    summary's lines (its Markdown table's rule, |---|, is no message), the refusal."""
+    cases = [c["message"] for s in answer.get("specs", []) for corner in s["corners"] for c in corner["cases"]]
+    summary = [line for line in (answer.get("summary") or "").splitlines() if not re.fullmatch(r"[-:|]+", line)]
+    return cases + answer.get("lines", []) + answer.get("messages", []) + summary + [answer.get("error") or ""]
+
+
+@pytest.mark.parametrize("lang", ["en", "es"])
+def test_check_golden_lines_name_the_pages_switch_not_the_command_lines(server, tmp_path, lang):
+    """Issue 29 ("no message on any page contains --"): a golden case recorded, compared, and its file missing
+    reads the switch as the page's field ("record the golden files", in the page's language, sent as the
+    options' lang); check-design's own lines keep --update-golden."""
+    from designer.core.i18n import catalogue
+    from designer.web.forms import CHECK
+    words = (lambda m: m) if lang == "en" else (lambda m: catalogue("es")[m])
+    label = words(CHECK["update-golden"].label)
+    files = {p: t for p, t in _specs_folder().items() if "rc_ladder" in p and "golden/" not in p}
+    ask = {"specs": ["specs/rc_ladder.yaml"], "files": files, "options": {"update-golden": True, "lang": lang}}
+    status, recorded = server.post_json("/api/check", ask)
+    assert status == 200, recorded
+    golden = [c["message"] for c in recorded["specs"][0]["corners"][0]["cases"] if c["id"] == "golden_out"]
+    assert golden == [words("golden_{signal}: recorded in {file} ({update_golden})").format(
+        signal="out", file="rc_ladder.csv", update_golden=f'"{label}"')]
+    assert not [t for t in _check_texts(recorded) if "--" in t]
+    n = recorded["specs"][0]["counts"]   # the spec's line in the page's language too
+    assert recorded["lines"] == [words("{spec}: {status} ({passed} passed, {failed} failed, {errors} errors, "
+                                       "{skipped} report-only)").format(
+        spec="rc_ladder", status=words("pass"), passed=n["pass"], failed=n["fail"], errors=n["error"],
+        skipped=n["skipped"])]
+    # compared against the file just recorded
+    gold = {"specs/golden/rc_ladder.csv": recorded["golden"]["specs/golden/rc_ladder.csv"]}
+    status, compared = server.post_json("/api/check", {**ask, "files": {**files, **gold},
+                                                       "options": {"lang": lang}})
+    assert status == 200 and compared["specs"][0]["status"] == "pass", compared
+    assert not [t for t in _check_texts(compared) if "--" in t]
+    # the file missing: the refusal advises the page's switch
+    status, missing = server.post_json("/api/check", {**ask, "options": {"lang": lang}})
+    assert status == 400 and f"{label}" in missing["error"], missing
+    assert "--" not in missing["error"].split("error: ", 1)[1]
+    # check-design itself: the command line's words, in its output folder's result.json and its refusal
+    for rel, text in files.items():
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_text(text)
+    spec = str(tmp_path / "specs" / "rc_ladder.yaml")
+    ran = cli("check-design", spec)
+    assert ran.returncode == 2 and ran.stderr.strip().endswith("record it with check-design --update-golden")
+    ran = cli("check-design", spec, "--update-golden", "--out", str(tmp_path / "out"))
+    assert ran.returncode == 0, ran.stderr
+    result = json.loads((tmp_path / "out" / "rc_ladder" / "result.json").read_text())
+    assert [c["message"] for c in result["corners"][0]["cases"] if c["id"] == "golden_out"] == \
+        ["golden_out: recorded in rc_ladder.csv (--update-golden)"]

@@ -334,3 +334,20 @@ def test_bad_analyze_pid_fields_are_refused_in_the_pages_words(tmp_path, fields,
         analyze_pid_request(fields, str(tmp_path))
     text, field = page_message(exc.value, ANALYZE_PID)
     assert (ANALYZE_PID[field].param if field else None) == param and words in text and "--" not in text, text
+
+
+@pytest.mark.parametrize("lang", ["en", "es"])
+def test_page_text_names_a_parameter_a_message_carries_by_its_fields_label(lang):
+    """Issue 29: a typed message carrying check_specs' update_golden (its text the command line's words) reads
+    on the page with the field's label, in the page's language; its other values as they are."""
+    from designer.check.golden import RECORD_GOLDEN, record_advice
+    from designer.core.i18n import catalogue, language
+    from designer.web.forms import CHECK, page_text
+    advice = record_advice("golden file g.csv does not exist")
+    assert str(advice) == f"golden file g.csv does not exist; record it with {RECORD_GOLDEN}"
+    with language(lang):
+        shown = page_text(advice, CHECK)
+    words = (lambda m: m) if lang == "en" else (lambda m: catalogue("es")[m])
+    assert shown == words("{problem}; record it with {update_golden}").format(
+        problem="golden file g.csv does not exist", update_golden=f'"{words(CHECK["update-golden"].label)}"')
+    assert "--" not in shown and page_text("plain text", CHECK) == "plain text"

@@ -487,10 +487,9 @@ def test_back_and_forward_move_between_designs(page, server):
     assert page.input_value("input[name=fc]") == "2000" and "fc 2000 Hz" in page.inner_text("#title")
 
 
-def test_check_page_runs_the_repositorys_specs_folder_and_records_golden_files(page, server, tmp_path):
-    """Issue 29: the repository's own specs/ folder, chosen as a folder, runs as it is (its decks and golden
-    files by their paths; the PID specs' controllers from ../reports, chosen as a second folder); with "record
-    the golden files" ticked the page offers each golden file recorded for download."""
+def run_the_repositorys_specs(page, server, tmp_path, path="/check"):
+    """The Check page at ``path`` given the repository's specs/ folder, then the reports/ files its specs name (as
+    a folder of their own, copied to ``tmp_path``), and run; the page's state after its answer."""
     import yaml
     from helpers import ROOT
     for spec in (ROOT / "specs").glob("*.yaml"):   # the reports/ files the specs name, as a folder of their own
@@ -499,11 +498,21 @@ def test_check_page_runs_the_repositorys_specs_folder_and_records_golden_files(p
             rel = (spec.parent / controller).resolve().relative_to(ROOT)
             (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy(ROOT / rel, tmp_path / rel)
-    open_page(page, server, "/check")
+    open_page(page, server, path)
+    page.wait_for_function("() => D.lang === 'en' || Object.keys(D.catalogue).length > 0")
     page.set_input_files("#folder", str(ROOT / "specs"))
     page.set_input_files("#folder", str(tmp_path / "reports"))
     page.wait_for_function("() => /reports\\//.test(document.getElementById('decks').textContent)")
-    assert after(page, lambda: page.click("#run"), timeout=300000) == "done"
+    return after(page, lambda: page.click("#run"), timeout=300000)
+
+
+def test_check_page_runs_the_repositorys_specs_folder_and_records_golden_files(page, server, tmp_path):
+    """Issue 29: the repository's own specs/ folder, chosen as a folder, runs as it is (its decks and golden
+    files by their paths; the PID specs' controllers from ../reports, chosen as a second folder); with "record
+    the golden files" ticked the page offers each golden file recorded for download."""
+    import yaml
+    from helpers import ROOT
+    assert run_the_repositorys_specs(page, server, tmp_path) == "done"
     table = page.inner_text("#cases-table")
     for spec in (ROOT / "specs").glob("*.yaml"):
         assert yaml.safe_load(spec.read_text())["name"] in table
@@ -976,3 +985,54 @@ def test_identify_a_chirp_shows_the_record_with_its_models_and_every_candidate(p
     assert integrating and "\tno\t" in integrating[0] and "below 0" in integrating[0], integrating
     assert drop(page, SYNTHETIC_TEK) == "done"
     assert not page.locator("#candidates-box").is_visible() and page.locator("#candidates tbody tr").count() == 0
+
+
+def test_the_spanish_check_page_sends_its_language_and_its_golden_lines_name_no_option(page, server, tmp_path):
+    """Issue 29: the Check page sends its language (options.lang, as /api/check reads it); a spec with golden:
+    recorded, then compared, shows no "--" in any line, the switch named by its field's label in the page's
+    language."""
+    from helpers import ROOT
+    from designer.core.i18n import catalogue
+    es = catalogue("es")
+    for rel in ("specs/rc_ladder.yaml", "specs/decks/rc_ladder.cir"):
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(ROOT / rel, tmp_path / rel)
+    open_page(page, server, "/check?lang=es")
+    page.wait_for_function("() => Object.keys(D.catalogue).length > 0")
+    page.set_input_files("#folder", str(tmp_path / "specs"))
+    page.wait_for_function("() => /rc_ladder\\.cir/.test(document.getElementById('decks').textContent)")
+    page.check("input[name=update-golden]")
+    with page.expect_request(lambda r: r.url.endswith("/api/check")) as sent:
+        assert after(page, lambda: page.click("#run"), timeout=300000) == "done"
+    options = json.loads(sent.value.post_data)["options"]
+    assert options["lang"] == "es" and options["update-golden"] is True
+    shown = lambda: " ".join(page.inner_text(s) for s in ("#verdict", "#cases-table", "#summary"))  # noqa: E731
+    recorded = es["golden_{signal}: recorded in {file} ({update_golden})"].format(
+        signal="out", file="rc_ladder.csv", update_golden=f'"{es["record the golden files"]}"')
+    assert recorded in page.inner_text("#cases-table")
+    assert "--update-golden" not in shown()
+    # compared against the repository's own golden file, chosen as a second folder under the same root
+    (tmp_path / "more" / "specs" / "golden").mkdir(parents=True)
+    shutil.copy(ROOT / "specs/golden/rc_ladder.csv", tmp_path / "more" / "specs" / "golden" / "rc_ladder.csv")
+    page.set_input_files("#folder", str(tmp_path / "more" / "specs"))
+    page.wait_for_function("() => /golden\\/rc_ladder\\.csv/.test(document.getElementById('decks').textContent)")
+    page.uncheck("input[name=update-golden]")
+    assert after(page, lambda: page.click("#run"), timeout=300000) == "done"
+    table = page.inner_text("#cases-table")
+    assert "golden_out" in table and "rc_ladder.csv" in table and "--" not in table
+    assert "--" not in page.inner_text("#verdict")
+
+
+def test_the_spanish_check_page_runs_the_repositorys_specs_with_no_english_in_its_table(page, server, tmp_path):
+    """Issue 29: the repository's specs/ folder (and the reports/ file its PID spec names) run on the Spanish
+    Check page: the result table (each check's detail: the value against its limits, the design's own checks,
+    SPICE's agreement, the tolerance band, the golden comparison) and each spec's line hold no English word of
+    the catalogue."""
+    from helpers import ROOT
+    assert run_the_repositorys_specs(page, server, tmp_path, "/check?lang=es") == "done"
+    cells = page.locator("#cases-table td").all_inner_texts()
+    lines = page.locator("#verdict p").all_inner_texts()   # each spec's verdict and counts
+    assert len(cells) > 50 and len(lines) == len(list((ROOT / "specs").glob("*.yaml")))
+    english, _spanish = vocabulary()
+    left = foreign(cells + lines, english)
+    assert not left, "\n".join(f"{words}: {text!r}" for text, words in left)

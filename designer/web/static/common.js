@@ -92,10 +92,15 @@ const channels = {};
 D.cancel = function (channel) {
   if (channels[channel]) { channels[channel].abort(); delete channels[channel]; }
 };
-// the commands that write a sheet answer in the page's language (their --lang)
-D.SPEAKS = /^\/api\/(plant|pid|filter)(\/|\?|$)/;
+// the commands answer in the page's language (their --lang): the design and analysis commands take it among
+// their fields, check-design among its options (the JSON's "options"); identify in its query (identify.js)
+D.SPEAKS = /^\/api\/(analyze-)?(plant|pid|filter)(\/|\?|$)/;
+D.SPEAKS_IN_OPTIONS = /^\/api\/check(\?|$)/;
 D.api = async function (path, body, asBlob, channel) {
-  if (D.lang !== "en" && D.SPEAKS.test(path) && body && body.constructor === Object) body = {...body, lang: D.lang};
+  if (D.lang !== "en" && body && body.constructor === Object) {
+    if (D.SPEAKS.test(path)) body = {...body, lang: D.lang};
+    else if (D.SPEAKS_IN_OPTIONS.test(path)) body = {...body, options: {...(body.options || {}), lang: D.lang}};
+  }
   const init = {method: "POST", headers: {"X-Designer": "1"}};
   if (body instanceof FormData || body instanceof Blob) init.body = body;
   else { init.body = JSON.stringify(body || {}); init.headers["Content-Type"] = "application/json"; }
