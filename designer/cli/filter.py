@@ -288,15 +288,15 @@ def _design(args) -> int:
 
 def _alternatives_lines(spec, alts: list) -> list:
     """--alternatives' lines: each set's deviation, the mask (and delay target) met or broken, its parts."""
-    from ..filters.report import alternative_limits, alternative_parts
+    from ..filters.report import alternative_words
     limited = alts[0].violation is not None
     out = ["Alternatives (best first; the joint choice is 1; worst deviation from the ideal"
            + ("; limits: the mask" + (" and the delay target" if spec.has_delay_target else "") if limited else "")
            + "):"]
     for a in alts:
-        met = "  " + alternative_limits(a) if limited else ""
-        out.append(f"  {a.rank:>2}  {a.error_db:.3g} dB{met}")
-        out.append("      " + alternative_parts(a))
+        met, parts = alternative_words(a)
+        out.append(f"  {a.rank:>2}  {a.error_db:.3g} dB{'  ' + met if limited else ''}")
+        out.append("      " + parts)
     return out
 
 

@@ -37,7 +37,7 @@ from ..report.wiring import bom_csv, bom_rows, wiring_rows
 from ..spice.deck import GROUND, board
 from .bench import FilterBench, bench_of
 
-__all__ = ["FilterSheet", "sheet_of", "alternatives_json", "alternative_parts", "alternative_limits", "build_board", "draw_cascade", "net_label", "sections", "title_of",
+__all__ = ["FilterSheet", "sheet_of", "alternatives_json", "alternative_words", "build_board", "draw_cascade", "net_label", "sections", "title_of",
            "bom", "plots", "schematic", "write_outputs", "write_folder", "SHEET_FILES"]
 
 #: the decoupling's middle digit (C191, C192, ..): the stages' own capacitors are C101, C201, ..
@@ -133,8 +133,10 @@ def alternatives_json(alternatives: list) -> dict:
     return {"alternatives": json_safe([a.to_dict() for a in alternatives])} if alternatives else {}
 
 
-def alternative_parts(alt) -> str:
-    """One part set's parts as a line: designator and value, every stage's (``R101 10 kOhm, C101 10 nF, ..``).
+def alternative_words(alt) -> tuple:
+    """One part set as the sheet, the summary and the page show it: whether it meets the mask (and the delay
+    target), in the current language (``meets the limits``, ``breaks the limits by X``, or empty without
+    limits), and its parts as a line, every stage's in build order (``R101 10 kOhm, C101 10 nF, ..``).
 
     Parameters
     ----------
@@ -143,38 +145,21 @@ def alternative_parts(alt) -> str:
 
     Returns
     -------
-    str
-        The parts in build order.
+    tuple of str
+        (limits, parts).
     """
-    return ", ".join(f"{ref} {format_eng(v, 'Ohm' if ref.startswith('R') else 'F')}" for ref, v in alt.parts.items())
-
-
-def alternative_limits(alt) -> str:
-    """Whether a part set meets the mask (and the delay target): ``meets the limits``, ``breaks the limits by
-    X``, or empty without limits, in the current language.
-
-    Parameters
-    ----------
-    alt : Alternative
-        The part set.
-
-    Returns
-    -------
-    str
-        The words.
-    """
+    parts = ", ".join(f"{ref} {format_eng(v, 'Ohm' if ref.startswith('R') else 'F')}" for ref, v in alt.parts.items())
     if alt.violation is None:
-        return ""
-    return _("meets the limits") if alt.violation <= 0 else \
-        _("breaks the limits by {amount}").format(amount=f"{alt.violation:.3g}")
+        return "", parts
+    return (_("meets the limits") if alt.violation <= 0 else
+            _("breaks the limits by {amount}").format(amount=f"{alt.violation:.3g}")), parts
 
 
 def _alternatives(data: FilterSheet) -> list:
     alts, s = data.alternatives, data.design.spec
     limited = alts[0].violation is not None
     head = [_("rank"), _("worst deviation from the ideal")] + ([_("limits")] if limited else []) + [_("parts")]
-    rows = [[a.rank, f"{a.error_db:.3g} dB"] + ([alternative_limits(a)] if limited else []) + [alternative_parts(a)]
-            for a in alts]
+    rows = [[a.rank, f"{a.error_db:.3g} dB", *alternative_words(a)[0 if limited else 1:]] for a in alts]
     what = (_("the mask and the group-delay target") if s.has_delay_target else _("the mask")) if limited else None
     text = _("The joint search's best part sets over the same E-series candidates, best first (1 is the one "
              "built): its worst deviation from the ideal with the {opamp} model{limits}. A builder short of one "

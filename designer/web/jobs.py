@@ -932,8 +932,9 @@ def filter_page(sheet, mc=None) -> dict:
     return json_safe({"bode": {"gain": _trace(f, gain, "frequency (Hz)", log_x=True),
                                "phase": _trace(f, phase, "frequency (Hz)", log_x=True)},
                       "stages": stages, "histograms": histograms(mc),
-                      "alternatives": [{"rank": a.rank, "error_db": a.error_db, "limits": rep.alternative_limits(a),
-                                        "parts": rep.alternative_parts(a)} for a in sheet.alternatives],
+                      "alternatives": [dict(zip(("rank", "error_db", "limits", "parts"),
+                                                (a.rank, a.error_db, *rep.alternative_words(a))))
+                                        for a in sheet.alternatives],
                       "schematic_svg": rep.schematic(sheet).svg(),
                       **bom_shown(bom),
                       "sheet_html": to_html(rep.title_of(r), rep.sections(sheet, with_images=False), {}),
