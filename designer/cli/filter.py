@@ -13,7 +13,6 @@ import sys
 from pathlib import Path
 
 from ..core.eseries import SERIES
-from ..core.jsonio import json_safe
 from ..core.opamps import names as opamp_names
 from ..core.ranges import help_range
 from ..core.units import format_eng
@@ -245,14 +244,15 @@ def _proof_lines(result) -> list:
     return result.proof.lines() if getattr(result, "proof", None) is not None else []
 
 
-def _write_sheet(result, folder, name, extra=None, lang=None):
+def _write_sheet(result, folder, name, extra=None, lang=None, alts=None):
     """The build sheet: into ``folder`` (filter.cir, result.json and the sheet's files), or with ``name``
     the bundle under ``folder`` (default .): reports/NAME/ and netlists/NAME.cir; ``extra`` (the tolerance
-    analyses' JSON) joins result.json. Returns the :class:`~designer.filters.report.FilterSheet` written (its
-    ``files`` set)."""
+    analyses' JSON) joins result.json, and ``alts`` (--alternatives' part sets) the sheet and result.json.
+    Returns the :class:`~designer.filters.report.FilterSheet` written (its ``files`` set)."""
     from ..filters.report import sheet_of, write_folder, write_outputs
     data = sheet_of(result)
     data.extra = dict(extra or {})
+    data.alternatives = list(alts or [])
     if name is None:
         write_folder(data, folder, lang)
     else:
@@ -288,32 +288,31 @@ def _design(args) -> int:
 
 def _alternatives_lines(spec, alts: list) -> list:
     """--alternatives' lines: each set's deviation, the mask (and delay target) met or broken, its parts."""
+    from ..filters.report import alternative_words
     limited = alts[0].violation is not None
     out = ["Alternatives (best first; the joint choice is 1; worst deviation from the ideal"
            + ("; limits: the mask" + (" and the delay target" if spec.has_delay_target else "") if limited else "")
            + "):"]
     for a in alts:
-        met = ("" if not limited else "  meets the limits" if a.violation <= 0 else
-               f"  breaks the limits by {a.violation:.3g}")
-        out.append(f"  {a.rank:>2}  {a.error_db:.3g} dB{met}")
-        out.append("      " + ", ".join(f"{ref} {format_eng(v, 'Ohm' if ref.startswith('R') else 'F')}"
-                                        for ref, v in a.parts.items()))
+        met, parts = alternative_words(a)
+        out.append(f"  {a.rank:>2}  {a.error_db:.3g} dB{'  ' + met if limited else ''}")
+        out.append("      " + parts)
     return out
 
 
 def _emit(result, args, extras: dict, alts=None) -> int:
     """The result (and its tolerance analyses, and --alternatives' sets) printed, and written with --out (or
     --name)."""
+    from ..filters.report import alternatives_json
     extra = tolerance_json(extras)
-    if alts is not None:
-        extra["alternatives"] = json_safe([a.to_dict() for a in alts])
     name = getattr(args, "name", None)
-    sheet = _write_sheet(result, args.out, name, extra, getattr(args, "lang", None)) if args.out or name else None
+    sheet = _write_sheet(result, args.out, name, extra, getattr(args, "lang", None), alts) \
+        if args.out or name else None
     files = sheet.files if sheet is not None else {}
     if args.json:
         # what result.json holds when written (the bench test too)
-        print_output(json.dumps(sheet.to_dict() if sheet is not None else {**result.to_dict(), **extra, "files": {}},
-                                indent=2))
+        print_output(json.dumps(sheet.to_dict() if sheet is not None else
+                                {**result.to_dict(), **extra, **alternatives_json(alts or []), "files": {}}, indent=2))
     else:
         text = summary_text(result) + "".join(line + "\n" for line in tolerance_lines(extras)
                                              + (_alternatives_lines(result.spec, alts) if alts is not None else []))

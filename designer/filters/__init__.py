@@ -32,7 +32,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "rc_highpass": ("RcHighPass",),
     "rc_lowpass": ("RcLowPass",),
     "registry": ("REGISTRY", "get", "names", "register",),
-    "report": ("FilterSheet", "SHEET_FILES", "bom", "build_board", "draw_cascade", "net_label", "plots",
+    "report": ("FilterSheet", "SHEET_FILES", "alternative_words", "alternatives_json", "bom", "build_board", "draw_cascade", "net_label", "plots",
                "schematic", "sections", "sheet_of", "title_of", "write_folder", "write_outputs",),
     "sallen_key": ("GAIN_PARTS", "SallenKeySection",),
     "sallen_key_highpass": ("SallenKeyHighPass",),

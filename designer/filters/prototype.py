@@ -591,7 +591,8 @@ def bandpass_from_mask(family: str, passband_hz: tuple, max_loss_db: float, stop
     Raises
     ------
     DesignError
-        The mask needs a prototype above :data:`MAX_ORDER` (naming the order it needs, or what order 10 gives).
+        The mask needs a prototype above :data:`MAX_ORDER`: naming the order it needs (searched up to
+        :data:`BESSEL_SEARCH_ORDER` where no closed form gives it) and what order 10 gives.
     """
     method = bandpass_method(passband_hz[0], passband_hz[1], method)
     conv = (max_loss_db, bessel_norm, chebyshev_cutoff)
@@ -627,13 +628,20 @@ def bandpass_from_mask(family: str, passband_hz: tuple, max_loss_db: float, stop
         fn = signal.buttord if family == "butterworth" else signal.cheb1ord
         start = max(int(fn(2 * math.pi * p, 2 * math.pi * st, max_loss_db, min_attenuation_db, analog=True)[0])
                     for p, st in zip(passband_hz, stopband_hz))
-    att = 0.0
     for n in range(start, MAX_ORDER + 1):
         fl, fh = _band_edges_search(family, n, passband_hz, max_loss_db, conv, method)
         ok, att = meets(n, fl, fh)
         if ok:
             return n, fl, fh, method
-    raise DesignError(f"order: the band-pass mask needs a {family} prototype above order {MAX_ORDER} ({method} "
-                      f"band-pass: order {MAX_ORDER} gives {att:.3g} dB at the stopband edges, "
-                      f"{min_attenuation_db:.3g} dB asked); widen the transition bands, or allow more passband loss",
-                      param="order")
+    # no closed form names the order of a Bessel (or of a wide band-pass): the search goes on to say it, as
+    # order_from_mask's does, and order 10's attenuation is what the refusal shows beside it
+    att = meets(MAX_ORDER, *_band_edges_search(family, MAX_ORDER, passband_hz, max_loss_db, conv, method))[1] \
+        if start > MAX_ORDER else att
+    need = next((n for n in range(max(start, MAX_ORDER + 1), BESSEL_SEARCH_ORDER + 1)
+                 if meets(n, *_band_edges_search(family, n, passband_hz, max_loss_db, conv, method))[0]), None)
+    which = (f"of order {need} (a band-pass of order {2 * need}), above the limit {MAX_ORDER}" if need is not None
+             else f"above order {MAX_ORDER}, and no order up to {BESSEL_SEARCH_ORDER} meets it"
+             + (": a Bessel's skirt tends to a Gaussian's as its order grows" if family == "bessel" else ""))
+    raise DesignError(f"order: the band-pass mask needs a {family} prototype {which} ({method} band-pass: order "
+                      f"{MAX_ORDER} gives {att:.3g} dB at the stopband edges, {min_attenuation_db:.3g} dB asked); "
+                      "widen the transition bands, or allow more passband loss", param="order")

@@ -14,7 +14,8 @@ each stage's figures and op-amp checks, the sine sweep with its tolerance band
 and the generator and scope settings, the step or tone-burst test, the Bode plot
 with the mask drawn, the Bessel's group delay, and why the values differ from a
 table's (the tables' corner convention, the op-amp pre-distortion, the joint
-E-series choice).
+E-series choice), and with ``--alternatives`` the joint search's next best part sets
+(:mod:`designer.filters.alternatives`).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import numpy as np
 from ..core.i18n import N_
 from ..core.i18n import gettext as _
 from ..core.i18n import localise
+from ..core.jsonio import json_safe
 from ..core.units import format_eng
 from ..report import document as R
 from ..report.plots import figure, log_frequency_axis, png_bytes, step_plot
@@ -35,7 +37,7 @@ from ..report.wiring import bom_csv, bom_rows, wiring_rows
 from ..spice.deck import GROUND, board
 from .bench import FilterBench, bench_of
 
-__all__ = ["FilterSheet", "sheet_of", "build_board", "draw_cascade", "net_label", "sections", "title_of",
+__all__ = ["FilterSheet", "sheet_of", "alternatives_json", "alternative_words", "build_board", "draw_cascade", "net_label", "sections", "title_of",
            "bom", "plots", "schematic", "write_outputs", "write_folder", "SHEET_FILES"]
 
 #: the decoupling's middle digit (C191, C192, ..): the stages' own capacitors are C101, C201, ..
@@ -65,6 +67,9 @@ class FilterSheet:
         leaves them out, so that it regenerates byte for byte.
     extra : dict
         More of the JSON (the tolerance analyses'), beside the design's.
+    alternatives : list
+        The joint search's best part sets asked for (:class:`~designer.filters.alternatives.Alternative`, best
+        first): a table on the sheet, ``alternatives`` in the JSON; empty (none asked): neither.
     """
 
     design: object
@@ -73,6 +78,7 @@ class FilterSheet:
     timings: dict = field(default_factory=dict)
     wall_clock: bool = True
     extra: dict = field(default_factory=dict)
+    alternatives: list = field(default_factory=list)
 
     @property
     def deck(self) -> str:
@@ -87,7 +93,8 @@ class FilterSheet:
         dict
             JSON-ready.
         """
-        data = {**self.design.to_dict(), **self.extra, "bench": self.bench.to_dict(), "files": dict(self.files)}
+        data = {**self.design.to_dict(), **self.extra, **alternatives_json(self.alternatives),
+                "bench": self.bench.to_dict(), "files": dict(self.files)}
         if not self.wall_clock:
             data["figures"] = {k: v for k, v in data["figures"].items() if k not in WALL_CLOCK}
         return data
@@ -107,6 +114,60 @@ def sheet_of(result) -> FilterSheet:
         With :func:`designer.filters.bench.bench_of`'s bench.
     """
     return FilterSheet(result, bench_of(result))
+
+
+def alternatives_json(alternatives: list) -> dict:
+    """The part sets' JSON as design-filter --json prints it: ``{"alternatives": [...]}``, or ``{}`` when none
+    were asked for.
+
+    Parameters
+    ----------
+    alternatives : list of Alternative
+        Best first.
+
+    Returns
+    -------
+    dict
+        JSON-ready.
+    """
+    return {"alternatives": json_safe([a.to_dict() for a in alternatives])} if alternatives else {}
+
+
+def alternative_words(alt) -> tuple:
+    """One part set as the sheet, the summary and the page show it: whether it meets the mask (and the delay
+    target), in the current language (``meets the limits``, ``breaks the limits by X``, or empty without
+    limits), and its parts as a line, every stage's in build order (``R101 10 kOhm, C101 10 nF, ..``).
+
+    Parameters
+    ----------
+    alt : Alternative
+        The part set.
+
+    Returns
+    -------
+    tuple of str
+        (limits, parts).
+    """
+    parts = ", ".join(f"{ref} {format_eng(v, 'Ohm' if ref.startswith('R') else 'F')}" for ref, v in alt.parts.items())
+    if alt.violation is None:
+        return "", parts
+    return (_("meets the limits") if alt.violation <= 0 else
+            _("breaks the limits by {amount}").format(amount=f"{alt.violation:.3g}")), parts
+
+
+def _alternatives(data: FilterSheet) -> list:
+    alts, s = data.alternatives, data.design.spec
+    limited = alts[0].violation is not None
+    head = [_("rank"), _("worst deviation from the ideal")] + ([_("limits")] if limited else []) + [_("parts")]
+    rows = [[a.rank, f"{a.error_db:.3g} dB", *alternative_words(a)[0 if limited else 1:]] for a in alts]
+    what = (_("the mask and the group-delay target") if s.has_delay_target else _("the mask")) if limited else None
+    text = _("The joint search's best part sets over the same E-series candidates, best first (1 is the one "
+             "built): its worst deviation from the ideal with the {opamp} model{limits}. A builder short of one "
+             "value takes the next set whole, not that part alone.").format(
+                 opamp=data.design.opamp.name,
+                 limits=_("; the limits are {what} (the search weighs how far a set breaks them, in dB or % "
+                          "points, 1000 times its deviation)").format(what=what) if limited else "")
+    return [R.text(text), R.table(head, rows, "compact")]
 
 
 def build_board(result):
@@ -500,6 +561,8 @@ def sections(data: FilterSheet, with_images: bool = True, schematic_svg: str = "
             _time_test(data)),
            (_("Target and achieved"), _achieved(r)),
            (_("Why the values differ from a table's"), _tables(data))]
+    if data.alternatives:
+        out.append((_("Alternatives (best first)"), _alternatives(data)))
     if with_images:
         imgs = [R.image("bode.png", _("Bode plot with the mask and the sweep's points")),
                 R.image("time-test.png", _("the step or burst test"))]

@@ -95,6 +95,7 @@ FILTER = {
     "series": Field("r_series", N_("R series")), "c-series": Field("c_series", N_("C series")),
     "r-min": Field("r_min", N_("R min")), "r-max": Field("r_max", N_("R max")),
     "c-min": Field("c_min", N_("C min")), "c-max": Field("c_max", N_("C max")),
+    "alternatives": Field("alternatives", N_("alternatives listed")),
     "no-sim": Field("no_sim", N_("skip SPICE"), "switch"), "simulator": Field("simulator", N_("simulator")),
     "name": Field("name", N_("design name")),
     # the tolerance panel (a MonteCarloSpec, run against the mask)
@@ -242,6 +243,7 @@ class FilterRequest(NamedTuple):
     simulator: str
     name: str                   #: the design's name (its files)
     argv: list                  #: the command line this request stands for (``tool.argv`` of its JSON)
+    alternatives: int | None = None   #: how many of the joint search's best part sets to list (None: none)
 
 
 class PidRequest(NamedTuple):
@@ -570,6 +572,7 @@ def filter_request(options) -> FilterRequest:
     DesignError
         One line naming the library parameter at fault (shown by :func:`page_message`).
     """
+    from ..filters.alternatives import alternatives_count
     from ..filters.spec import FilterSpec
     v = _fields(options, FILTER)
     spec_keys = ("filter_type", "family", "order", "fc_hz", "ripple_db", "bessel_norm", "chebyshev_cutoff",
@@ -583,8 +586,9 @@ def filter_request(options) -> FilterRequest:
     where = f"_o{spec.order}" if spec.order is not None else ""
     where += f"_fc{spec.fc_hz:g}" if spec.fc_hz is not None else "_mask" if spec.has_mask else ""
     name = _name(v, f"filter_{spec.filter_type}_{spec.family}{where}")
+    alternatives = alternatives_count(v["alternatives"]) if "alternatives" in v else None
     return FilterRequest(spec, mc, bool(v.get("worst_case")), v.get("tol", ()), not v.get("no_sim", False),
-                         simulator, name, _argv("design-filter", options))
+                         simulator, name, _argv("design-filter", options), alternatives)
 
 
 def pid_request(options, tmp: str | None) -> PidRequest:

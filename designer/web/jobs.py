@@ -35,6 +35,7 @@ from ..core.units import format_eng
 # the filter stack (scipy.signal's prototypes, the sheet) imported here, in the server process before it forks the
 # pool: every worker has it, and a worker's first filter request does not pay ~2 s of imports
 from ..filters import report as filter_report
+from ..filters.alternatives import design_alternatives
 from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
 
@@ -413,9 +414,13 @@ def design_filter_task(fields: dict, want: str = "json", tmp: str | None = None)
         extra = json_safe({k: v.to_dict() for k, v in extras.items()})
         sheet = filter_report.sheet_of(result)
         sheet.extra = extra
+        # design-filter --alternatives N: the joint search's best part sets, on the sheet and in the JSON
+        sheet.alternatives = design_alternatives(result, rq.alternatives) if rq.alternatives is not None else []
         if want in ("sheet", "bundle"):
             filter_report.write_outputs(sheet, tmp, rq.name, lang)
-        data = json_safe({**result.to_dict(), **extra, "files": {}})   # as design-filter --json prints it
+        # as design-filter --json prints it
+        data = json_safe({**result.to_dict(), **extra, **filter_report.alternatives_json(sheet.alternatives),
+                          "files": {}})
         return data, lambda: filter_page(sheet, extras.get("monte_carlo")), rq.name
     return _library_task("design-filter", FILTER, fields, work, want, tmp)
 
@@ -893,7 +898,8 @@ def filter_page(sheet, mc=None) -> dict:
     """A filter design's page, from its sheet (:class:`designer.filters.report.FilterSheet`) as the build sheet
     has it: the Bode plot of the chosen parts with the op-amp's model, the bench band of the builds and the mask
     (its forbidden edges: the largest loss over the passband, the least attenuation over the stopband), the
-    stages with their op-amp checks, the schematic, the BOM and the sheet's content; ``mc`` a Monte Carlo
+    stages with their op-amp checks, the schematic, the BOM, the part sets of ``--alternatives`` (the sheet's
+    :attr:`~designer.filters.report.FilterSheet.alternatives`) and the sheet's content; ``mc`` a Monte Carlo
     against the mask (:class:`designer.tolerance.filter.FilterMonteCarlo`) for the histograms.
 
     Parameters
@@ -941,6 +947,9 @@ def filter_page(sheet, mc=None) -> dict:
     return json_safe({"bode": {"gain": _trace(f, gain, "frequency (Hz)", log_x=True),
                                "phase": _trace(f, phase, "frequency (Hz)", log_x=True)},
                       "stages": stages, "histograms": histograms(mc),
+                      "alternatives": [dict(zip(("rank", "error_db", "limits", "parts"),
+                                                (a.rank, a.error_db, *rep.alternative_words(a))))
+                                        for a in sheet.alternatives],
                       "schematic_svg": rep.schematic(sheet).svg(),
                       **bom_shown(bom),
                       "sheet_html": to_html(rep.title_of(r), rep.sections(sheet, with_images=False), {}),

@@ -27,6 +27,9 @@ from designer.cli.filter import analyze_filter_main, design_filter_main
     (["--passband", "3k", "--max-loss", "1", "--stopband", "3.3k", "--min-attenuation", "80"],
      "order 104, above the limit 10"),
     (["--passband", "3k", "--max-loss", "1"], "a mask needs all of"),
+    (["--type", "bandpass", "--family", "bessel", "--passband", "300,3k", "--max-loss", "3", "--stopband",
+      "60,15k", "--min-attenuation", "80"], "needs a bessel prototype of order 12 (a band-pass of order 24), above "
+                                            "the limit 10 (wide band-pass: order 10 gives 74.9 dB"),
     (["--order", "10", "--fc", "1k", "--family", "chebyshev", "--ripple", "3"], "too slow for stage 5"),
     (["--order", "4", "--fc", "1M", "--opamp", "ideal"], "not realisable within the part bounds"),
     (["--order", "4", "--fc", "1k", "--opamp", "uA709"], "uA709"),

@@ -278,6 +278,31 @@ def test_bandpass_mask_beyond_order_10_names_the_order():
         bandpass_from_mask("butterworth", (900.0, 1100.0), 1.0, (880.0, 1150.0), 30.0)
 
 
+@pytest.mark.parametrize("mask, method", [(((300.0, 3000.0), 3.0, (60.0, 15e3), 80.0), "wide"),
+                                          (((900.0, 1100.0), 3.0, (400.0, 2500.0), 150.0), "narrow")])
+def test_bessel_bandpass_mask_beyond_order_10_names_the_order_it_needs(mask, method):
+    """As the Bessel low- and high-pass's, a Bessel band-pass mask above order 10 is refused naming the prototype
+    order it needs: that order's edges reach the attenuation, one less's do not (brute force over the edges)."""
+    pb, ap, sb, as_ = mask
+    with pytest.raises(DesignError, match=r"needs a bessel prototype of order (\d+) \(a band-pass of order \d+\), "
+                                          rf"above the limit 10 \({method} band-pass: order 10 gives .* dB") as exc:
+        bandpass_from_mask("bessel", pb, ap, sb, as_)
+    n = int(re.search(r"of order (\d+)", str(exc.value)).group(1))
+    assert f"a band-pass of order {2 * n})" in str(exc.value) and 10 < n <= BESSEL_SEARCH_ORDER
+    assert _best_attenuation("bessel", n, pb, ap, sb, method) >= as_ > _best_attenuation("bessel", n - 1, pb, ap, sb,
+                                                                                          method)
+
+
+def test_bessel_bandpass_mask_no_order_meets_says_so():
+    """A band-pass Bessel's attenuation at the edges falls with the order here: refused saying no order up to the
+    search's end meets it (brute force over those orders' edges agrees)."""
+    pb, ap, sb, as_ = (900.0, 1100.0), 3.0, (800.0, 1250.0), 20.0
+    with pytest.raises(DesignError, match=r"above order 10, and no order up to 25 meets it: .*\(narrow band-pass: "
+                                          r"order 10 gives .* dB at the stopband edges, 20 dB asked\)"):
+        bandpass_from_mask("bessel", pb, ap, sb, as_)
+    assert max(_best_attenuation("bessel", n, pb, ap, sb, "narrow") for n in range(11, BESSEL_SEARCH_ORDER + 1)) < as_
+
+
 def test_bandpass_mask_chebyshev_3db_edges_are_minus_3db():
     n, fl, fh, _ = bandpass_from_mask("chebyshev", (900.0, 1100.0), 1.0, (600.0, 1700.0), 30.0,
                                       chebyshev_cutoff="3db")

@@ -212,3 +212,42 @@ def test_the_sheet_shows_the_delay_per_stage_rounding_would_give():
     # without a target the sheet says nothing of it
     plain = design(FilterSpec(**SPECS["sk-lp4-dual"]), simulate=False)
     assert "group-delay target" not in to_text("sheet", sections(sheet_of(plain), with_images=False))
+
+
+def test_the_sheet_lists_the_alternatives_only_when_asked(tmp_path, capsys):
+    """Issue 27: design-filter --alternatives N puts the joint search's best part sets on the build sheet (a table:
+    rank, deviation, the mask met or broken, every part), the same sets as the JSON's (design_alternatives'); in
+    Spanish its words are the catalogue's; without --alternatives the sheet has no such section (the reference
+    sheets under reports/ keep theirs)."""
+    from designer.core.i18n import catalogue
+    from designer.filters.alternatives import design_alternatives
+    from designer.report.document import to_text as text_of
+    argv = ["--family", "chebyshev", "--passband", "1k", "--max-loss", "1", "--stopband", "3k", "--min-attenuation",
+            "30", "--opamp", "TL072", "--no-sim"]
+    assert design_filter_main(argv + ["--alternatives", "3", "--json", "--out", str(tmp_path / "en")]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    saved = json.loads((tmp_path / "en" / "result.json").read_text())
+    r = design(FilterSpec(family="chebyshev", passband_hz=1e3, max_loss_db=1, stopband_hz=3e3, min_attenuation_db=30,
+                          opamp="TL072"), simulate=False)
+    want = design_alternatives(r, 3)
+    assert printed["alternatives"] == saved["alternatives"] == [a.to_dict() for a in want]
+    md = (tmp_path / "en" / "build-sheet.md").read_text()
+    table = md.split("## Alternatives (best first)")[1].split("\n## ")[0]
+    rows = [line for line in table.splitlines() if line.startswith("| ") and line[2].isdigit()]
+    assert len(rows) == 3 and "| rank | worst deviation from the ideal | limits | parts |" in table
+    for row, a in zip(rows, want):
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        assert cells[:2] == [str(a.rank), f"{a.error_db:.3g} dB"]
+        assert cells[2] == ("meets the limits" if a.violation <= 0 else f"breaks the limits by {a.violation:.3g}")
+        for ref in a.parts:
+            assert f"{ref} " in cells[3]
+    assert "Alternatives (best first)" in (tmp_path / "en" / "build-sheet.html").read_text()
+    # in Spanish: the section's words from the catalogue
+    es = catalogue("es")
+    assert design_filter_main(argv + ["--alternatives", "2", "--lang", "es", "--out", str(tmp_path / "es")]) == 0
+    md_es = (tmp_path / "es" / "build-sheet.md").read_text()
+    for m in ("Alternatives (best first)", "worst deviation from the ideal", "meets the limits", "rank"):
+        assert es[m] in md_es and m not in md_es, m
+    # not asked: no section, no key (the sheet of sheet_of alone)
+    assert "Alternatives" not in text_of("sheet", sections(sheet_of(r), with_images=False))
+    assert "alternatives" not in sheet_of(r).to_dict()

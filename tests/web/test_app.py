@@ -108,7 +108,10 @@ def test_filter_answers_design_filters_json(server):
                        ({"family": "chebyshev", "passband": "3k", "max-loss": 1, "stopband": "12k",
                          "min-attenuation": 40, "topology": "mfb", "opamp": "TL072"},
                         ["--family", "chebyshev", "--passband", "3k", "--max-loss", "1", "--stopband", "12k",
-                         "--min-attenuation", "40", "--topology", "mfb", "--opamp", "TL072"])]:
+                         "--min-attenuation", "40", "--topology", "mfb", "--opamp", "TL072"]),
+                       # the alternatives field: design-filter --alternatives' part sets (ranked, the JSON's key)
+                       ({"order": 4, "fc": "1k", "alternatives": 3, "no-sim": True},
+                        ["--order", "4", "--fc", "1k", "--alternatives", "3", "--no-sim"])]:
         status, got = server.post_json("/api/filter", body)
         assert status == 200, got
         want = cli_json("design-filter", *argv, "--json")
@@ -124,6 +127,7 @@ def test_filter_answers_design_filters_json(server):
     ({"order": 4, "fc": "1k", "type": "notch"}, "type", 'unknown "type" \'notch\''),
     ({"passband": "3k", "max-loss": 1, "stopband": "3.1k", "min-attenuation": 80}, "order", "above the limit 10"),
     ({"order": 4, "fc": "1k", "out": "x"}, None, "set by the web page itself"),
+    ({"order": 4, "fc": "1k", "alternatives": 51}, "alternatives", '"alternatives listed" must be 1 to 50'),
 ])
 def test_a_refused_filter_names_the_pages_field_never_a_flag(server, body, field, words):
     status, got = server.post_json("/api/filter", body)

@@ -56,7 +56,7 @@ def test_every_filter_field_sets_a_parameter_of_the_specs_or_of_the_run():
     from designer.filters.spec import FilterSpec
     from designer.web.forms import FILTER
     specs = {f.name for f in dataclasses.fields(FilterSpec)} | {f.name for f in dataclasses.fields(MonteCarloSpec)}
-    assert {f.param for f in FILTER.values()} <= specs | {"no_sim", "simulator", "name", "worst_case"}
+    assert {f.param for f in FILTER.values()} <= specs | {"no_sim", "simulator", "name", "worst_case", "alternatives"}
     assert len({f.label for f in FILTER.values()}) == len(FILTER)
 
 

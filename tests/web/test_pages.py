@@ -806,6 +806,27 @@ def test_filter_tolerance_panel_gives_the_yield_against_the_mask(page, server):
     assert t["part"] in page.inner_text("#tighten") or str(t["stage"]) in page.inner_text("#tighten-stage")
 
 
+def test_filter_alternatives_field_lists_the_joint_searchs_part_sets(page, server):
+    """Issue 27: the alternatives field lists the joint search's best part sets in a table, the API answer's (the
+    same as design-filter --alternatives' JSON); left blank, no section."""
+    query = "?family=chebyshev&passband=3k&max-loss=1&stopband=12k&min-attenuation=40"
+    assert open_filter(page, server, query) == "done", page.inner_text(".form-foot")
+    assert page.locator("#alternatives-section").is_hidden()
+    assert after(page, lambda: page.fill("input[name=alternatives]", "3"), timeout=120000) == "done"
+    status, want = server.post_json("/api/filter", {"family": "chebyshev", "passband": "3k", "max-loss": 1,
+                                                     "stopband": "12k", "min-attenuation": 40, "no-sim": True,
+                                                     "alternatives": 3})
+    assert status == 200 and [a["rank"] for a in want["alternatives"]] == [1, 2, 3]
+    assert page.locator("#alternatives-section").is_visible() and "alternatives=3" in page.url
+    rows = page.locator("#alternatives tbody tr")
+    assert rows.count() == 3
+    for i, a in enumerate(want["alternatives"]):
+        row = rows.nth(i).inner_text()
+        assert page.evaluate("v => D.num(v, 3) + ' dB'", a["error_db"]) in row
+        assert ("meets the limits" if a["violation"] <= 0 else "breaks the limits by") in row
+        assert all(f"{ref} " in row for ref in a["parts"]), row
+
+
 def test_every_filter_field_has_the_label_of_the_name_table(page, server):
     """One name table per front end: the page's labels are designer.web.forms.FILTER's."""
     from designer.web.forms import FILTER
@@ -883,8 +904,10 @@ LIBRARY_TEXT = {"/plant": [], "/pid": [], "/identify": ["#methods td:nth-child(7
                 "/plant?topology=mfb-lowpass": []}
 
 
-#: the Filter page on a mask (its edges drawn on the Bode plot) with the tolerance panel's Monte Carlo against it
-FILTER_MASK_MC = "/filter?family=chebyshev&passband=3k&max-loss=1&stopband=12k&min-attenuation=40&monte-carlo=200"
+#: the Filter page on a mask (its edges drawn on the Bode plot) with the tolerance panel's Monte Carlo against it,
+#: and the joint search's alternatives listed
+FILTER_MASK_MC = ("/filter?family=chebyshev&passband=3k&max-loss=1&stopband=12k&min-attenuation=40&monte-carlo=200"
+                  "&alternatives=3")
 
 
 def _words_on(pg, left=()) -> list:
@@ -919,6 +942,7 @@ def test_every_page_in_each_language_shows_none_of_the_other(browser, server, pa
             mask = "mask: largest passband loss"
             assert mask in pg.get_attribute("#bode-gain", "data-series").split("|")
             assert any((catalogue("es")[mask] if lang == "es" else mask) in t for t in texts)
+            assert pg.locator("#alternatives tbody tr").count() == 3
         left = foreign(texts, english if lang == "es" else spanish)
         assert not left, "\n".join(f"{words}: {text!r}" for text, words in left)
         if lang == "es" and path.split("?")[0] in ("/plant", "/pid", "/filter"):

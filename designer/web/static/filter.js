@@ -54,6 +54,12 @@ function show(answer) {
               `${D.eng(st.gbw_needed_hz, "Hz", 3)} (${D.eng(st.gbw_hz, "Hz", 3)})`,
               `${D.eng(st.slew_needed_v_per_s, "V/s", 3)} (${D.eng(st.slew_v_per_s, "V/s", 3)})`, ok];
     })));
+  // --alternatives N: the joint search's best part sets, as the sheet lists them (none asked: no section)
+  document.getElementById("alternatives-section").hidden = !p.alternatives.length;
+  const limited = p.alternatives.some(a => a.limits);   // a mask or a delay target: met or broken
+  document.getElementById("alternatives").replaceChildren(D.table(
+    [D.t("rank"), D.t("worst deviation from the ideal"), ...(limited ? [D.t("limits")] : []), D.t("parts")],
+    p.alternatives.map(a => [a.rank, db(a.error_db), ...(limited ? [a.limits] : []), a.parts])));
   D.schematic(document.getElementById("schematic"), p.schematic_svg,
               D.t("schematic: {parts}", {parts: p.bom.rows.map(x => `${x[0]} ${x[1]}`).join(", ")}));
   document.getElementById("bomtable").replaceChildren(D.bomTable(p));
