@@ -118,6 +118,36 @@ def test_furnace_under_the_seeds_own_sequence(tmp_path):
     assert furnace_step_nrmse(lambda tt: sig.step((pm["num"], pm["den"]), T=tt)[1]) < 0.02
 
 
+def test_a_short_sequence_record_scored_whole_fits_its_rest_level():
+    """The seed's sequence (5 bits, Dt = 3 min, a = 0.1) for four periods only
+    (372 min, too few to split): every model is scored on the record it was
+    fitted to. The furnace rested at the operating point (input 0) and the
+    record starts at the first bit, 0.1 away: scored from rest at that level,
+    every model missed a 90 degC transient (fits 2-31 %) and the spectral FOPDT
+    (gain 8 % low, step NRMSE 7 %) was called best. With the rest level fitted
+    (validation, how="rest"), the fitted level is the operating point, the best
+    is the output-error fit, within 1.5 % of 904.5 and 2 % NRMSE of the true
+    step, and the record view draws each model as it was scored."""
+    from designer.identify.validation import compare_fit
+    t, u, y = prbs_capture(*FURNACE, bits=5, per_bit=3, periods=4, ts=1.0, amplitude=0.1, offset=0.0)
+    res = identify_record(t, y, u, name="furnace")
+    a = res.assessment
+    assert a.scope == "whole" and a.split is None
+    best = a.best_candidate
+    assert best is not None and best.route == "output-error", best.label
+    assert best.model.gain == pytest.approx(904.5, rel=0.015), best.label
+    assert furnace_step_nrmse(best.model.step) < 0.02, best.label
+    for c in a.candidates:
+        if c.valid:
+            assert c.validation.how == "rest"
+        if c.valid and c.fit_percent > 90.0:      # the models of the furnace (not the 2 % integrator)
+            assert c.validation.rest_shift == pytest.approx(u[0] - 0.0, rel=0.05), c.label
+    for trace in a.view.models:
+        c = next(c for c in a.candidates if (c.route, c.name, c.kind) == (trace.route, trace.name, trace.kind))
+        assert compare_fit(a.view.y - a.view.y.mean(), trace.y - trace.y.mean()) == pytest.approx(c.fit_percent,
+                                                                                                  abs=1e-6)
+
+
 def test_split_keeps_whole_periods_and_says_when_there_is_no_room():
     t, u, y = prbs_capture(*FURNACE, bits=5, per_bit=2, periods=6, ts=1.0)
     res = identify_record(t, y, u, assess_routes=False)
