@@ -548,6 +548,8 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
         _check_settles(c, span)
     drive = (vu, vy, None) if validation is not None else (uu, yy, split)
     how = "rest" if scope == "whole" and rest == "fitted" else "detrend"
+    if how == "rest":
+        res.note += "; each model from rest at the input level that fits the output best"
     for c in res.candidates:
         _score(c, T, res.hold, *drive, how=how)
         if c.kind == "integrating" and c.valid and c.fit_percent < 0:

@@ -132,7 +132,7 @@ def test_a_short_sequence_record_scored_whole_fits_its_rest_level():
     t, u, y = prbs_capture(*FURNACE, bits=5, per_bit=3, periods=4, ts=1.0, amplitude=0.1, offset=0.0)
     res = identify_record(t, y, u, name="furnace")
     a = res.assessment
-    assert a.scope == "whole" and a.split is None
+    assert a.scope == "whole" and a.split is None and "from rest at the input level that fits" in a.note
     best = a.best_candidate
     assert best is not None and best.route == "output-error", best.label
     assert best.model.gain == pytest.approx(904.5, rel=0.015), best.label
