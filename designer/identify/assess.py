@@ -422,11 +422,11 @@ def _check_settles(c: Candidate, span: float) -> None:
                                        f"estimation record ({fe(span, 's')})") if n)
 
 
-def _score(c: Candidate, ts: float, hold: str, u, y, split: Split | None) -> None:
+def _score(c: Candidate, ts: float, hold: str, u, y, split: Split | None, how: str = "detrend") -> None:
     if c.model is None:
         return
     try:
-        v = validate(_Simulated(c.model, ts, hold), u, y, split)
+        v = validate(_Simulated(c.model, ts, hold), u, y, split, how=how)
     except (DesignError, ValueError, np.linalg.LinAlgError) as exc:
         c.valid = False
         c.note = "; ".join(n for n in (c.note, f"not simulated: {exc}") if n)
@@ -439,7 +439,7 @@ def _score(c: Candidate, ts: float, hold: str, u, y, split: Split | None) -> Non
 
 def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: str,
            validation: tuple | None = None, skipped: dict | None = None, source: str = "capture",
-           kinds=OE_KINDS) -> Assessment:
+           kinds=OE_KINDS, rest: str = "first") -> Assessment:
     """Fit the output-error models, score every route's models on validation
     data, choose the best.
 
@@ -464,6 +464,12 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
         The data's name.
     kinds : sequence of str
         The output-error structures.
+    rest : {"first", "fitted"}
+        A record scored whole (no split, no separate record): the models start
+        at rest at the first input level (a step capture, at rest before its
+        edge) or at a rest level fitted to the output (``"fitted"``: a
+        sequence or any input that jumped from the operating point to its
+        first sample; :func:`~.validation.validate`, ``how="rest"``).
 
     Returns
     -------
@@ -541,8 +547,11 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
     for c in res.candidates:
         _check_settles(c, span)
     drive = (vu, vy, None) if validation is not None else (uu, yy, split)
+    how = "rest" if scope == "whole" and rest == "fitted" else "detrend"
+    if how == "rest":
+        res.note += "; each model from rest at the input level that fits the output best"
     for c in res.candidates:
-        _score(c, T, res.hold, *drive)
+        _score(c, T, res.hold, *drive, how=how)
         if c.kind == "integrating" and c.valid and c.fit_percent < 0:
             # its dead time at 0 has no interval to fail: a settling plant's integrator, worse than the mean
             c.valid = False
@@ -672,7 +681,11 @@ def assess_result(result, t, u, y, *, validation: tuple | None = None, segment_l
         from .integrating import step_capture_ramp
         m = step_capture_ramp(t[:split_at], u[:split_at], y[:split_at])
         routes = {"step": [m]} if m is not None else {}
-    return assess(u, y, ts, routes, split_at=split_at, note=note, validation=vrec, skipped=skipped, source=name)
+    # a step capture (a ramping one too) rests at its first level before the edge; any other input may have
+    # jumped there from the operating point
+    step = ex is None or getattr(result, "ramp", None) is not None
+    return assess(u, y, ts, routes, split_at=split_at, note=note, validation=vrec, skipped=skipped, source=name,
+                  rest="first" if step else "fitted")
 
 
 def identify_record(t, y, u=None, *, step_time=None, step_amplitude=None, window=None, methods=None,

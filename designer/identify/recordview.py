@@ -4,7 +4,8 @@ the recorded input, as MATLAB's ``compare`` draws them.
 
 Each model is simulated as the assessment scored it
 (:func:`~.outputerror.simulate` at the assessment's sample interval and hold,
-driven from the record's start at rest at its first input level; a separate
+driven from the record's start at rest at its first input level, or at the
+rest level the score fitted (``Validation.rest_shift``); a separate
 validation record from its own start), then raised by the difference of the
 validation part's means: the fit percentage compares the two with their means
 removed (:func:`~.validation.validate`, ``how="detrend"``), so this is the
@@ -118,7 +119,7 @@ def record_view(assessment, t, u, y, n_models: int = 3) -> RecordView:
                    key=lambda c: -c.fit_percent)[:n_models]
     traces = []
     for c in order:
-        ym = simulate(c.model, ub - ub[0], a.sample_time_s, a.hold)
+        ym = simulate(c.model, ub - ub[0] + c.validation.rest_shift, a.sample_time_s, a.hold)
         traces.append(ModelTrace(c.route, c.name, c.kind, c.fit_percent,
                                  ym + (yb[val].mean() - ym[val].mean())))
     return RecordView(tb, ub, yb, start, a.scope, a.note, tuple(traces))

@@ -377,16 +377,39 @@ def broadband_text(result) -> str:
     return "\n".join(lines)
 
 
-def residual_axes(pair, c) -> None:
-    """The residual tests of a validated model on two axes (as ``resid`` draws
+def residual_axes(pair, models) -> None:
+    """The residual tests of validated models on two axes (as ``resid`` draws
     them): the residuals' autocorrelation and their cross-correlation with the
-    input, each lag against its 99 % band."""
-    v = c.validation
-    for ax, corr_, title in ((pair[0], v.whiteness, "Residuals: autocorrelation"),
-                             (pair[1], v.cross, "Residuals: cross-correlation with the input")):
-        ax.vlines(corr_.lags, 0, corr_.r, color="k", lw=1)
-        ax.axhspan(-corr_.band, corr_.band, color="tab:blue", alpha=0.15, label="99 % band")
-        ax.set_title(f"{title} ({c.route} {c.name} {c.kind}, validation fit {v.fit_percent:.1f} %)", fontsize=8)
+    input, each lag against its 99 % band; each model's stems beside the
+    others' (a third of a lag apart), in its own colour, its band as dashed
+    lines (the first model's also shaded).
+
+    Parameters
+    ----------
+    pair : sequence of two matplotlib.axes.Axes
+        Autocorrelation, cross-correlation.
+    models : sequence of Candidate
+        Validated candidates (``validation`` set), the best first.
+
+    Returns
+    -------
+    None
+    """
+    models = list(models)
+    n = len(models)
+    for ax, what, title in ((pair[0], "whiteness", "Residuals: autocorrelation"),
+                            (pair[1], "cross", "Residuals: cross-correlation with the input")):
+        for i, c in enumerate(models):
+            corr_, colour = getattr(c.validation, what), f"C{i}"
+            # side by side: every model's lag k stays within a lag's width of k
+            shift = (i - (n - 1) / 2) / 3 if n > 1 else 0.0
+            ax.vlines(np.asarray(corr_.lags) + shift, 0, corr_.r, color=colour if n > 1 else "k", lw=1,
+                      label=f"{c.route} {c.name} {c.kind}, fit {c.validation.fit_percent:.1f} %")
+            if i == 0:
+                ax.axhspan(-corr_.band, corr_.band, color="tab:blue", alpha=0.15, label="99 % band")
+            if n > 1:
+                ax.hlines([-corr_.band, corr_.band], corr_.lags[0], corr_.lags[-1], colors=colour, lw=0.8, ls="--")
+        ax.set_title(f"{title} ({'the best' if n == 1 else f'the {n} best'} by validation fit)", fontsize=8)
         ax.set_xlabel("lag (samples)")
         ax.legend(fontsize=7)
 
@@ -426,8 +449,8 @@ def broadband_plot(result, n_models: int = 3) -> bytes:
     """PNG of a broadband identification: the impulse response, the step it
     integrates to with the best step models, the spectral estimate (gain and
     phase) with the best frequency models, and its coherence; when validated,
-    the residual tests of the best model by validation fit and the record with
-    its best models (:func:`record_axes`). An input only the output-error route
+    the residual tests of the best ``n_models`` valid models by validation fit
+    and the record with them (:func:`record_axes`). An input only the output-error route
     reads (``excitation.kind == "other"``) has no estimates: the record with its
     models and the residual tests alone.
 
@@ -463,7 +486,8 @@ def broadband_plot(result, n_models: int = 3) -> bytes:
         row += 1
     if best is not None and best.validation is not None:
         pair = [fig.add_subplot(grid[row, c]) for c in (0, 1)]
-        residual_axes(pair, best)
+        residual_axes(pair, [c for c in ranked_candidates(a) if c.valid and c.validation is not None
+                             and math.isfinite(c.fit_percent)][:n_models])
         axes += pair
     for ax in axes:
         ax.grid(True, alpha=0.3)

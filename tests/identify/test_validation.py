@@ -117,3 +117,28 @@ def test_a_separate_validation_record_is_simulated_from_rest():
     assert v.samples == u2.size
     ceiling = va.compare_fit(y2 - y2.mean(), clean2 - clean2.mean())
     assert abs(v.fit_percent - ceiling) <= 1.0
+
+
+def test_a_record_scored_whole_fits_the_level_it_rested_at():
+    """``how="rest"``: a plant at rest at input 0 whose record starts at the
+    sequence's first level (+1): scored from rest at that level the true model
+    misses the whole transient; with the rest level fitted it is exact, and
+    the fitted shift is the jump, u[0] - 0."""
+    b, a = [0.0, 0.02], [1.0, -0.98]           # a lag of 50 samples, gain 1
+
+    class Model:
+        def response(self, x):
+            return lfilter(b, a, np.asarray(x, float))
+
+    flips = np.random.default_rng(21).random(400) < 0.1
+    flips[0] = False
+    u = np.where(np.cumsum(flips) % 2 == 0, 1.0, -1.0)   # +-1, from +1 at the first sample
+    y = lfilter(b, a, u) + 3.0                   # from rest at input 0, output level 3
+    first = va.validate(Model(), u, y)
+    fitted = va.validate(Model(), u, y, how="rest")
+    assert first.fit_percent < 90.0 and first.rest_shift == 0.0
+    assert fitted.fit_percent == pytest.approx(100.0, abs=1e-6)
+    assert fitted.rest_shift == pytest.approx(u[0] - 0.0, rel=1e-6)
+    assert fitted.how == "rest" and not np.any(np.abs(fitted.whiteness.r) > 1.0)
+    with pytest.raises(DesignError, match="scored whole"):
+        va.validate(Model(), u, y, va.split_record(u.size), how="rest")
