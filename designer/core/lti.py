@@ -184,13 +184,33 @@ class StepTerms:
             terms.append((p, m, _series_ratio(_taylor(num, p, m), list(gx[::-1][:m]) + [0j] * max(0, m - gx.size))))
         return cls(tuple(terms))
 
-    def __call__(self, t) -> np.ndarray:
+    def exponentials(self, t) -> list:
+        """The terms' exponentials e^(p t) on ``t`` (clipped at 0), one array per pole.
+
+        Parameters
+        ----------
+        t : array_like
+            The times (s).
+
+        Returns
+        -------
+        list of numpy.ndarray
+            For :meth:`__call__`'s ``exps``: two steps over one denominator (a
+            step and its slope) share their poles, so they can share these.
+        """
+        tp = np.clip(np.asarray(t, float), 0.0, None)
+        return [np.exp(p * tp) for p, _, _ in self.terms]
+
+    def __call__(self, t, exps=None) -> np.ndarray:
         """The step at ``t`` (0 before the step).
 
         Parameters
         ----------
         t : array_like
             The times (s).
+        exps : list of numpy.ndarray, optional
+            :meth:`exponentials` on ``t`` of terms with these same poles, in order
+            (computed here when not given).
 
         Returns
         -------
@@ -202,10 +222,10 @@ class StepTerms:
             return np.zeros_like(t)
         y = np.zeros(t.shape, complex)
         tp = np.clip(t, 0.0, None)
-        for p, m, c in self.terms:
+        for k, (p, m, c) in enumerate(self.terms):
             # c[j] multiplies 1/(s - p)^(m - j): t^(m-j-1)/(m-j-1)! e^(p t)
             poly_t = sum(c[j] * tp ** (m - j - 1) / math.factorial(m - j - 1) for j in range(m))
-            y = y + poly_t * np.exp(p * tp)
+            y = y + poly_t * (np.exp(p * tp) if exps is None else exps[k])
         return np.where(t >= 0, y.real, 0.0)
 
 

@@ -442,8 +442,9 @@ def _tangent(num: tuple, den: tuple, theta: float, integrators: int) -> ModelTan
     def slope(x):
         return float(slope_of([x])[0]) / K
 
-    h = slope_of(t) / K
-    y = step_of(t) / K
+    exps = step_of.exponentials(t)        # one denominator: the two steps share their poles
+    h = slope_of(t, exps) / K
+    y = step_of(t, exps) / K
     i = int(np.argmax(h))
     ts = float(t[i])
     if 0 < i < t.size - 1:

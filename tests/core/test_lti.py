@@ -121,8 +121,9 @@ def test_step_response_with_repeated_poles_matches_scipy(rates, mult, zero):
        st.lists(st.floats(0.0, 10.0), min_size=1, max_size=5))
 def test_step_terms_evaluated_point_by_point_equal_step_response(rates, mult, zeta, points):
     """The terms found once and evaluated at separate points (the reaction curve's
-    root finders do this) give step_response's numbers bit for bit, on real,
-    repeated and complex poles, before and after the step."""
+    root finders do this), or with exponentials shared with another step over the
+    same denominator, give step_response's numbers bit for bit, on real, repeated
+    and complex poles, before and after the step."""
     poles = [-r for r, m in zip(rates, mult) for _ in range(m)]
     den = np.polymul(np.poly(poles), [1.0, 2 * zeta * min(rates), min(rates) ** 2])
     num = [float(np.polyval(den, 0.0))]
@@ -131,6 +132,11 @@ def test_step_terms_evaluated_point_by_point_equal_step_response(rates, mult, ze
         assert terms([x])[0] == step_response(num, den, [x])[0]
     grid = np.linspace(-1.0, 10.0 / min(rates), 501)
     assert np.array_equal(terms(grid), step_response(num, den, grid))
+    # a step and its slope (s num over the same den) share their exponentials
+    slope = StepTerms.of(np.polymul(num, [1.0, 0.0]), den)
+    exps = terms.exponentials(grid)
+    assert np.array_equal(terms(grid, exps), step_response(num, den, grid))
+    assert np.array_equal(slope(grid, exps), step_response(np.polymul(num, [1.0, 0.0]), den, grid))
     assert np.array_equal(StepTerms.of([0.0], den)(grid), np.zeros_like(grid))
 
 
