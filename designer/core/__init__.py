@@ -28,7 +28,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "lifetime": ("Interrupted", "WORDS", "after_native", "die_with_parent", "finish", "forget", "install",
                  "interruption", "native", "on_exit", "owned_prefix", "preexec", "quiet", "remove_stale",
                  "reset_in_child", "status_of", "to_devnull", "words_of"),
-    "lti": ("MAX_CLUSTER", "coefficients", "dense_time", "dominant_pair", "filter_foh", "freq_response",
+    "lti": ("MAX_CLUSTER", "StepTerms", "coefficients", "dense_time", "dominant_pair", "filter_foh", "freq_response",
             "pole_clusters", "response_span", "step_response"),
     "metrics": ("Overshoot", "StepMetrics", "measure_step", "step_metrics"),
     "opamps": ("OpAmp", "PACKAGE_KINDS", "Unit", "assign", "get", "names", "spare_units"),

@@ -14,7 +14,7 @@ import numpy as np
 
 from .errors import DesignError
 
-__all__ = ["MAX_CLUSTER", "coefficients", "dense_time", "dominant_pair", "filter_foh", "freq_response",
+__all__ = ["MAX_CLUSTER", "StepTerms", "coefficients", "dense_time", "dominant_pair", "filter_foh", "freq_response",
            "pole_clusters", "response_span", "step_response"]
 
 
@@ -126,27 +126,107 @@ def step_response(num, den, t):
     numpy.ndarray
         The response on ``t``.
     """
-    t = np.asarray(t, float)
-    num = np.trim_zeros(np.atleast_1d(np.asarray(num, float)), "f")
-    den = np.trim_zeros(np.atleast_1d(np.asarray(den, float)), "f")
-    if num.size == 0:
-        return np.zeros_like(t)
-    if den.size == 0 or len(num) > len(den):
-        raise ValueError("step_response needs a proper transfer function (deg num <= deg den)")
-    clusters = pole_clusters(np.concatenate([np.roots(den), [0.0]]))
-    y = np.zeros(t.shape, complex)
-    tp = np.clip(t, 0.0, None)
-    for i, (p, m) in enumerate(clusters):
-        others = [q for j, (q, mq) in enumerate(clusters) if j != i for _ in range(mq)]
-        # (s - p)^m Y(s) = num(s) / g(s), analytic at p, with g(p + x) = den[0] prod (x - (q - p)):
-        # expanded in x from the differences q - p, never evaluated from expanded
-        # coefficients (that cancels catastrophically for close poles)
-        gx = den[0] * np.poly(np.array(others, complex) - p) if others else np.array([den[0]], complex)
-        c = _series_ratio(_taylor(num, p, m), list(gx[::-1][:m]) + [0j] * max(0, m - gx.size))
-        # c[j] multiplies 1/(s - p)^(m - j): t^(m-j-1)/(m-j-1)! e^(p t)
-        poly_t = sum(c[j] * tp ** (m - j - 1) / math.factorial(m - j - 1) for j in range(m))
-        y = y + poly_t * np.exp(p * tp)
-    return np.where(t >= 0, y.real, 0.0)
+    return StepTerms.of(num, den)(t)
+
+
+class StepTerms:
+    """The partial-fraction terms of a step response, computed once and then
+    evaluated at any times: :func:`step_response` is ``StepTerms.of(num, den)(t)``.
+
+    A caller that evaluates one step at many separate points (a root finder, a
+    bounded maximiser) pays the poles and residues once; the arithmetic of each
+    evaluation is :func:`step_response`'s, so the numbers are the same bit for bit.
+
+    Parameters
+    ----------
+    terms : tuple of tuple
+        (pole, multiplicity, Laurent coefficients) per pole cluster, the step's
+        pole at 0 included; empty for a zero numerator.
+    """
+
+    __slots__ = ("terms",)
+
+    def __init__(self, terms: tuple):
+        self.terms = terms
+
+    @classmethod
+    def of(cls, num, den) -> StepTerms:
+        """The terms of the unit step of ``num/den``.
+
+        Parameters
+        ----------
+        num, den : array_like
+            The transfer function, highest power first, proper.
+
+        Returns
+        -------
+        StepTerms
+
+        Raises
+        ------
+        ValueError
+            An improper transfer function.
+        """
+        num = np.trim_zeros(np.atleast_1d(np.asarray(num, float)), "f")
+        den = np.trim_zeros(np.atleast_1d(np.asarray(den, float)), "f")
+        if num.size == 0:
+            return cls(())
+        if den.size == 0 or len(num) > len(den):
+            raise ValueError("step_response needs a proper transfer function (deg num <= deg den)")
+        clusters = pole_clusters(np.concatenate([np.roots(den), [0.0]]))
+        terms = []
+        for i, (p, m) in enumerate(clusters):
+            others = [q for j, (q, mq) in enumerate(clusters) if j != i for _ in range(mq)]
+            # (s - p)^m Y(s) = num(s) / g(s), analytic at p, with g(p + x) = den[0] prod (x - (q - p)):
+            # expanded in x from the differences q - p, never evaluated from expanded
+            # coefficients (that cancels catastrophically for close poles)
+            gx = den[0] * np.poly(np.array(others, complex) - p) if others else np.array([den[0]], complex)
+            terms.append((p, m, _series_ratio(_taylor(num, p, m), list(gx[::-1][:m]) + [0j] * max(0, m - gx.size))))
+        return cls(tuple(terms))
+
+    def exponentials(self, t) -> list:
+        """The terms' exponentials e^(p t) on ``t`` (clipped at 0), one array per pole.
+
+        Parameters
+        ----------
+        t : array_like
+            The times (s).
+
+        Returns
+        -------
+        list of numpy.ndarray
+            For :meth:`__call__`'s ``exps``: two steps over one denominator (a
+            step and its slope) share their poles, so they can share these.
+        """
+        tp = np.clip(np.asarray(t, float), 0.0, None)
+        return [np.exp(p * tp) for p, _, _ in self.terms]
+
+    def __call__(self, t, exps=None) -> np.ndarray:
+        """The step at ``t`` (0 before the step).
+
+        Parameters
+        ----------
+        t : array_like
+            The times (s).
+        exps : list of numpy.ndarray, optional
+            :meth:`exponentials` on ``t`` of terms with these same poles, in order
+            (computed here when not given).
+
+        Returns
+        -------
+        numpy.ndarray
+            The response on ``t``.
+        """
+        t = np.asarray(t, float)
+        if not self.terms:
+            return np.zeros_like(t)
+        y = np.zeros(t.shape, complex)
+        tp = np.clip(t, 0.0, None)
+        for k, (p, m, c) in enumerate(self.terms):
+            # c[j] multiplies 1/(s - p)^(m - j): t^(m-j-1)/(m-j-1)! e^(p t)
+            poly_t = sum(c[j] * tp ** (m - j - 1) / math.factorial(m - j - 1) for j in range(m))
+            y = y + poly_t * (np.exp(p * tp) if exps is None else exps[k])
+        return np.where(t >= 0, y.real, 0.0)
 
 
 #: widest relative diameter of a group of poles taken as one repeated pole

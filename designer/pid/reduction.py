@@ -48,7 +48,7 @@ import numpy as np
 
 from ..core.errors import DesignError
 from ..core.i18n import N_, Message
-from ..core.lti import coefficients, pole_clusters, step_response
+from ..core.lti import StepTerms, coefficients, pole_clusters, step_response
 from ..core.process import ProcessModel
 from ..core.units import format_eng
 
@@ -434,13 +434,17 @@ def _tangent(num: tuple, den: tuple, theta: float, integrators: int) -> ModelTan
                           "it has no reaction curve")
     K = float(num_a[-1] / den_a[-1])
     t = _grid(den_a)
-    dnum = np.polymul(num_a, [1.0, 0.0])   # the step's slope is the step response of s G(s)
+    # the step's slope is the step response of s G(s); both steps' poles and residues
+    # found once, for the grid and the refining searches' single points alike
+    slope_of = StepTerms.of(np.polymul(num_a, [1.0, 0.0]), den_a)
+    step_of = StepTerms.of(num_a, den_a)
 
     def slope(x):
-        return float(step_response(dnum, den_a, [x])[0]) / K
+        return float(slope_of([x])[0]) / K
 
-    h = step_response(dnum, den_a, t) / K
-    y = step_response(num_a, den_a, t) / K
+    exps = step_of.exponentials(t)        # one denominator: the two steps share their poles
+    h = slope_of(t, exps) / K
+    y = step_of(t, exps) / K
     i = int(np.argmax(h))
     ts = float(t[i])
     if 0 < i < t.size - 1:
@@ -450,12 +454,12 @@ def _tangent(num: tuple, den: tuple, theta: float, integrators: int) -> ModelTan
         if -r.fun >= h[i]:
             ts = float(r.x)
     hs = slope(ts)
-    ys = float(step_response(num_a, den_a, [ts])[0]) / K
+    ys = float(step_of([ts])[0]) / K
     L = theta + ts - ys / hs
     T = 1.0 / hs
     j = int(np.argmax(y >= F63))
     from scipy.optimize import brentq
-    t63 = brentq(lambda x: float(step_response(num_a, den_a, [x])[0]) / K - F63,
+    t63 = brentq(lambda x: float(step_of([x])[0]) / K - F63,
                  float(t[j - 1]), float(t[j]), xtol=1e-15 * float(t[-1])) if j > 0 else float(t[0])
     os_pct = max(0.0, (float(np.max(y)) - 1.0) * 100.0)
     return ModelTangent(K, float(L), float(T), K * hs, theta + ts, K * ys, theta + t63, os_pct)

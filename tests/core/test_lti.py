@@ -7,7 +7,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from designer.core import opamps
-from designer.core.lti import dominant_pair, step_response
+from designer.core.lti import StepTerms, dominant_pair, step_response
 from designer.plant.model import plant_tf, plant_tf_opamp, sensitivities
 from designer.plant.sallenkey import SallenKeyParts
 
@@ -113,6 +113,31 @@ def test_step_response_with_repeated_poles_matches_scipy(rates, mult, zero):
     ref = signal.step((num, den), T=t)[1]
     got = step_response(num, den, t)
     assert np.max(np.abs(got - ref)) <= 1e-7 * max(1.0, np.max(np.abs(ref)))
+
+
+@settings(max_examples=40)
+@given(st.lists(st.sampled_from([10.0, 30.0, 100.0, 300.0, 1e3]), min_size=1, max_size=3, unique=True),
+       st.lists(st.integers(1, 2), min_size=3, max_size=3), st.floats(0.05, 2.0),
+       st.lists(st.floats(0.0, 10.0), min_size=1, max_size=5))
+def test_step_terms_evaluated_point_by_point_equal_step_response(rates, mult, zeta, points):
+    """The terms found once and evaluated at separate points (the reaction curve's
+    root finders do this), or with exponentials shared with another step over the
+    same denominator, give step_response's numbers bit for bit, on real, repeated
+    and complex poles, before and after the step."""
+    poles = [-r for r, m in zip(rates, mult) for _ in range(m)]
+    den = np.polymul(np.poly(poles), [1.0, 2 * zeta * min(rates), min(rates) ** 2])
+    num = [float(np.polyval(den, 0.0))]
+    terms = StepTerms.of(num, den)
+    for x in [-1.0, 0.0] + [p / min(rates) for p in points]:
+        assert terms([x])[0] == step_response(num, den, [x])[0]
+    grid = np.linspace(-1.0, 10.0 / min(rates), 501)
+    assert np.array_equal(terms(grid), step_response(num, den, grid))
+    # a step and its slope (s num over the same den) share their exponentials
+    slope = StepTerms.of(np.polymul(num, [1.0, 0.0]), den)
+    exps = terms.exponentials(grid)
+    assert np.array_equal(terms(grid, exps), step_response(num, den, grid))
+    assert np.array_equal(slope(grid, exps), step_response(np.polymul(num, [1.0, 0.0]), den, grid))
+    assert np.array_equal(StepTerms.of([0.0], den)(grid), np.zeros_like(grid))
 
 
 def test_pole_clusters_never_merge_poles_a_percent_apart():

@@ -79,6 +79,31 @@ def test_seed_plant_tangent():
     assert tg.overshoot_pct == pytest.approx(100 * math.exp(-math.pi * z / math.sqrt(1 - z * z)), rel=1e-4)
 
 
+def test_tangent_numbers_are_the_pointwise_step_responses():
+    """Regression (bda0897 made a first design_pid ~15 % slower): the tangent's
+    searches evaluate prepared partial-fraction terms instead of refactoring the
+    polynomial at every point; the numbers are the construction's on
+    step_response itself, bit for bit (so every reference output stays)."""
+    from scipy.optimize import brentq, minimize_scalar
+
+    from designer.core.lti import step_response
+    num, den = (1.0,), (2.0677e-9 * 1e-5, 2.0677e-9 + 1.8189e-5 * 1e-5, 1.8189e-5 + 1e-5, 1.0)
+    tg = M.model_tangent(M.ModelTf(num, den))
+    dnum = np.polymul(num, [1.0, 0.0])
+    t = M._grid(np.array(den))
+    h = step_response(dnum, den, t)
+    i = int(np.argmax(h))
+    r = minimize_scalar(lambda x: -float(step_response(dnum, den, [x])[0]), bounds=(t[i - 1], t[i + 1]),
+                        method="bounded", options={"xatol": 1e-13 * float(t[-1])})
+    ts = float(r.x) if -r.fun >= h[i] else float(t[i])
+    hs, ys = float(step_response(dnum, den, [ts])[0]), float(step_response(num, den, [ts])[0])
+    assert (tg.t_steepest_s, tg.slope_per_s, tg.y_steepest) == (ts, hs, ys)
+    assert (tg.L_s, tg.T_s) == (ts - ys / hs, 1.0 / hs)
+    j = int(np.argmax(step_response(num, den, t) >= M.F63))
+    t63 = brentq(lambda x: float(step_response(num, den, [x])[0]) - M.F63, t[j - 1], t[j], xtol=1e-15 * t[-1])
+    assert tg.t63_s == t63
+
+
 def test_integrating_tangent_is_the_ramp_asymptote():
     tg = M.model_tangent(M.ModelIntegrating(20.0, 1e-3, 0.5e-3))
     assert tg.integrating and (tg.K, tg.L_s, tg.T_s) == (20.0, 1.5e-3, None)   # L = theta + tau

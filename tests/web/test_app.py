@@ -14,6 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from designer.filters.registry import REGISTRY
 from webserver import Server, cli
 from helpers import EXT_CAPTURES, FIXTURES, ROOT
 
@@ -58,6 +59,23 @@ def test_a_section_plant_runs_its_spice_monte_carlo_as_design_plant_does(server)
     assert without_run_details(got["result"]) == without_run_details(want)
     assert got["result"]["monte_carlo"]["settings"]["engine"] == "both" and got["result"]["monte_carlo"]["spice"]
     assert got["page"]["schematic_svg"].lstrip().startswith("<")
+
+
+@pytest.mark.parametrize("topology", list(REGISTRY.values()), ids=list(REGISTRY))
+def test_every_registered_section_designs_on_the_page_as_design_plant_does(server, topology):
+    """Issue 26's conformance: every section of the registry (a new one picked up without editing this test)
+    is designed from the page's plant fields, its JSON design-plant --topology's (its example target)."""
+    ex = topology.example
+    body = {"fc": ex.fn_hz, "gain": ex.gain, "topology": topology.name, "opamp": "TL072", "no-sim": True}
+    args = ["--fc", repr(ex.fn_hz), "--gain", repr(ex.gain), "--topology", topology.name]
+    if ex.q is not None:
+        body["zeta"] = 1 / (2 * ex.q)
+        args += ["--zeta", repr(body["zeta"])]
+    status, got = server.post_json("/api/plant", body)
+    assert status == 200, got
+    want = cli_json("design-plant", *args, "--opamp", "TL072", "--no-sim", "--json", "--no-files")
+    assert without_run_details(got) == without_run_details(want)
+    assert got["topology"] == topology.name
 
 
 @pytest.mark.spice
