@@ -8,9 +8,10 @@ from designer.filters.rc_lowpass import RcLowPass
 
 
 def test_every_section_of_the_first_slice_is_registered_under_its_own_name():
-    assert names() == ["sallen-key-lowpass", "sallen-key-lowpass-gain", "sallen-key-highpass",
-                       "sallen-key-highpass-gain", "mfb-lowpass", "mfb-highpass", "mfb-bandpass", "rc-lowpass",
-                       "rc-highpass", "inverting-lowpass"]
+    # the first slice, in registration order; a section added later goes after it (and needs no edit here)
+    assert names()[:10] == ["sallen-key-lowpass", "sallen-key-lowpass-gain", "sallen-key-highpass",
+                            "sallen-key-highpass-gain", "mfb-lowpass", "mfb-highpass", "mfb-bandpass", "rc-lowpass",
+                            "rc-highpass", "inverting-lowpass"]
     for name, topology in REGISTRY.items():
         assert isinstance(topology, Topology) and topology.name == name and get(name) is topology
         assert len(set(topology.designators)) == len(topology.designators)
