@@ -9,6 +9,7 @@ from __future__ import annotations
 import difflib
 
 from ..core.errors import DesignError
+from .inverting_highpass import InvertingHighPass
 from .inverting_lowpass import InvertingLowPass
 from .mfb_bandpass import MfbBandPass
 from .mfb_highpass import MfbHighPass
@@ -56,7 +57,8 @@ for _t in (SallenKeyLowPass(), SallenKeyLowPass(with_gain=True),
            MfbBandPass(),
            RcLowPass(),
            RcHighPass(),
-           InvertingLowPass()):
+           InvertingLowPass(),
+           InvertingHighPass()):
     register(_t)
 
 
