@@ -364,6 +364,42 @@ def test_typing_slowly_runs_no_design_per_key_and_flashes_no_refusal(page, serve
     assert answers(page) - before <= 2
 
 
+def test_typing_back_to_the_design_shown_asks_nothing(page, server):
+    """Issue 29 (speed): a digit typed and erased before its pause, or erased while its request is on its way,
+    brings the inputs back to those of the design drawn: it is current again at once (downloads on, no note),
+    nothing is asked (the request in flight cancelled); a value whose answer is no longer the one drawn is
+    asked again."""
+    open_page(page, server, "/plant")
+    fc = page.locator("input[name=fc]")
+    title = page.inner_text("#title")
+    n, ran = answers(page), health(server)["ran"]
+
+    def current():
+        return (not page.locator("#bom").is_disabled() and not page.locator("#stale-note").is_visible()
+                and page.evaluate("document.body.dataset.state") == "done"
+                and not page.evaluate("document.body.classList.contains('busy')"))
+
+    fc.press("End")
+    fc.press("0")                                   # 35000: stale, its pause running
+    assert page.locator("#bom").is_disabled()
+    fc.press("Backspace")                           # 3500 again before the pause ended
+    assert current()
+    page.wait_for_timeout(1500)                     # past any pause: nothing was asked
+    assert answers(page) == n and health(server)["ran"] == ran and page.inner_text("#title") == title
+    # erased while its request is on its way: cancelled, the design drawn current again
+    fc.press("0")
+    page.wait_for_function("() => document.body.classList.contains('busy')", timeout=10000)
+    fc.press("Backspace")
+    assert current() and page.inner_text("#status") != ""
+    page.wait_for_timeout(1500)
+    assert answers(page) == n and page.inner_text("#title") == title and current()
+    assert "fc=3500" in page.url or "fc=" not in page.url
+    # 35000 answered (refused: above the range): what is shown is no longer 3500's answer, so 3500 is asked again
+    assert after(page, lambda: fc.press("0")) == "error" and answers(page) == n + 1
+    assert after(page, lambda: fc.press("Backspace")) == "done" and answers(page) == n + 2
+    assert page.inner_text("#title") == title
+
+
 def test_the_pid_page_opens_on_a_design_that_passes_with_its_margins(page, server):
     open_page(page, server, "/pid")
     assert page.evaluate("document.body.dataset.state") == "done", page.inner_text(".form-foot")

@@ -126,8 +126,8 @@ async function file(kind) {
     if (e.target.name === "plant") showPlantKind();
     if (e.target.name === "tuning") showTargets();
   });
-  D.liveForm(form, design, () => JSON.stringify(request()));
+  const live = D.liveForm(form, design, () => JSON.stringify(request()));
   document.getElementById("sheet").onclick = () => file("sheet");
   document.getElementById("bundle").onclick = () => file("bundle");
-  design();
+  live.now();   // (through the form: typing back to these inputs asks nothing)
 })();
