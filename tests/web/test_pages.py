@@ -445,6 +445,27 @@ def test_no_page_is_wider_than_a_phone(browser, server, path):
         context.close()
 
 
+@pytest.mark.parametrize("path", ["/plant", "/pid", "/filter", "/identify", "/check"])
+def test_every_page_announces_its_status_resizes_its_plots_and_prints_its_results(page, server, path):
+    """Issue 29 (layout, small things): the status line is announced (aria-live); the plots follow their box when
+    the window is resized (a phone turned, a window narrowed: drawn again at the new width, no sideways scroll);
+    the page's own print stylesheet prints the results without the form."""
+    open_page(page, server, path)
+    assert page.get_attribute("#status", "aria-live") == "polite" and page.get_attribute("#status", "role") == "status"
+    canvases = page.locator(".plot canvas")
+    wide = [c.bounding_box()["width"] for c in canvases.all()]
+    assert (len(wide) > 0) == (path in ("/plant", "/pid", "/filter"))
+    page.set_viewport_size({"width": 390, "height": 844})
+    page.wait_for_function("() => document.scrollingElement.scrollWidth <= 390 && [...document.querySelectorAll("
+                           "'.plot canvas')].every(c => c.getBoundingClientRect().width <= 390)", timeout=10000)
+    page.set_viewport_size({"width": 1400, "height": 1400})
+    page.wait_for_function("w => [...document.querySelectorAll('.plot canvas')].every((c, i) => "
+                           "Math.abs(c.getBoundingClientRect().width - w[i]) < 2)", arg=wide, timeout=10000)
+    page.emulate_media(media="print")
+    assert page.locator("form").first.is_hidden() and page.locator("header").first.is_hidden()
+    assert page.locator(".results").first.is_visible()
+
+
 def test_dimensionless_numbers_have_no_si_prefix(page, server):
     open_page(page, server, "/identify")
     assert drop(page, SYNTHETIC_TEK) == "done"
