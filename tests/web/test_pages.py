@@ -364,6 +364,46 @@ def test_typing_slowly_runs_no_design_per_key_and_flashes_no_refusal(page, serve
     assert answers(page) - before <= 2
 
 
+def test_typing_back_to_the_design_shown_asks_nothing(page, server):
+    """Issue 29 (speed): a digit typed and erased before its pause, or erased while its request is on its way,
+    brings the inputs back to those of the design drawn: it is current again at once (downloads on, no note),
+    nothing is asked (the request in flight cancelled); a value whose answer is no longer the one drawn is
+    asked again."""
+    open_page(page, server, "/plant")
+    fc = page.locator("input[name=fc]")
+    title = page.inner_text("#title")
+    n, ran = answers(page), health(server)["ran"]
+
+    def current():
+        return (not page.locator("#bom").is_disabled() and not page.locator("#stale-note").is_visible()
+                and page.evaluate("document.body.dataset.state") == "done"
+                and not page.evaluate("document.body.classList.contains('busy')"))
+
+    fc.press("End")
+    fc.press("0")                                   # 35000: stale, its pause running
+    assert page.locator("#bom").is_disabled()
+    fc.press("Backspace")                           # 3500 again before the pause ended
+    assert current()
+    page.wait_for_timeout(1500)                     # past any pause: nothing was asked
+    assert answers(page) == n and health(server)["ran"] == ran and page.inner_text("#title") == title
+    # erased while its request is on its way (zeta 0.25: a design with SPICE, answered in no less than 0.2 s;
+    # fc 35000 would be refused at once): cancelled, the design drawn current again
+    zeta = page.locator("input[name=zeta]")
+    zeta.press("End")
+    zeta.press("5")
+    page.wait_for_function("() => document.body.classList.contains('busy')", timeout=10000)
+    zeta.press("Backspace")
+    assert current() and page.inner_text("#status") != ""
+    page.wait_for_timeout(1500)
+    assert answers(page) == n and page.inner_text("#title") == title and current()
+    assert "fc=3500" in page.url or "fc=" not in page.url
+    # 35000 answered (refused: above the range): what is shown is no longer 3500's answer, so 3500 is asked again
+    fc.press("End")
+    assert after(page, lambda: fc.press("0")) == "error" and answers(page) == n + 1
+    assert after(page, lambda: fc.press("Backspace")) == "done" and answers(page) == n + 2
+    assert page.inner_text("#title") == title
+
+
 def test_the_pid_page_opens_on_a_design_that_passes_with_its_margins(page, server):
     open_page(page, server, "/pid")
     assert page.evaluate("document.body.dataset.state") == "done", page.inner_text(".form-foot")
@@ -388,6 +428,27 @@ def test_the_pid_page_opens_on_a_design_that_passes_with_its_margins(page, serve
     assert "--tuning" not in sheet and "--target" not in sheet
 
 
+def test_a_model_plants_pid_shows_its_ms_and_its_hint_names_no_command(page, server):
+    """Issue 29: for a plant typed as a model the PID page shows Ms (the library's peak sensitivity) among its
+    margins; the model field's hint gives the forms to type, not a command's --help."""
+    open_page(page, server, "/pid")
+    model = "K=1 tau=100u theta=20u"
+    after(page, lambda: page.check("input[name=plant][value=tf]"), timeout=120000)   # (no model yet: refused)
+    # the model typed, then the rule chosen (a menu asks at once)
+    assert after(page, lambda: (page.fill("input[name=plant-tf]", model), page.select_option("select[name=tuning]",
+                                                                                            "imc")),
+                 timeout=120000) == "done", page.inner_text("form")
+    status, want = server.post_json("/api/pid", {"plant-tf": model, "tuning": "imc"})
+    ms = want["closed_loop"]["margins"]["ms"]
+    assert status == 200 and figure(page, "Ms (max sensitivity)") == page.evaluate("v => D.num(v, 3)", ms)
+    hint = page.locator("input[name=plant-tf]").locator("xpath=..").inner_text()
+    assert "--" not in hint and "K=2 tau=1m theta=200u" in hint
+    # the seed's Sallen-Key plant: its margins have no Ms, and no empty figure stands for it
+    assert after(page, lambda: page.select_option("select[name=tuning]", "optimize"), timeout=120000) == "done"
+    assert after(page, lambda: page.check("input[name=plant][value=design]"), timeout=120000) == "done"
+    assert page.locator(".figure", has_text="Ms (max sensitivity)").count() == 0
+
+
 @pytest.mark.parametrize("path", ["/plant", "/pid", "/filter", "/identify", "/check"])
 def test_no_page_is_wider_than_a_phone(browser, server, path):
     context = browser.new_context(viewport={"width": 390, "height": 844})
@@ -407,6 +468,27 @@ def test_no_page_is_wider_than_a_phone(browser, server, path):
             assert canvas.bounding_box()["width"] <= 390
     finally:
         context.close()
+
+
+@pytest.mark.parametrize("path", ["/plant", "/pid", "/filter", "/identify", "/check"])
+def test_every_page_announces_its_status_resizes_its_plots_and_prints_its_results(page, server, path):
+    """Issue 29 (layout, small things): the status line is announced (aria-live); the plots follow their box when
+    the window is resized (a phone turned, a window narrowed: drawn again at the new width, no sideways scroll);
+    the page's own print stylesheet prints the results without the form."""
+    open_page(page, server, path)
+    assert page.get_attribute("#status", "aria-live") == "polite" and page.get_attribute("#status", "role") == "status"
+    canvases = page.locator(".plot canvas")
+    wide = [c.bounding_box()["width"] for c in canvases.all()]
+    assert (len(wide) > 0) == (path in ("/plant", "/pid", "/filter"))
+    page.set_viewport_size({"width": 390, "height": 844})
+    page.wait_for_function("() => document.scrollingElement.scrollWidth <= 390 && [...document.querySelectorAll("
+                           "'.plot canvas')].every(c => c.getBoundingClientRect().width <= 390)", timeout=10000)
+    page.set_viewport_size({"width": 1400, "height": 1400})
+    page.wait_for_function("w => [...document.querySelectorAll('.plot canvas')].every((c, i) => "
+                           "Math.abs(c.getBoundingClientRect().width - w[i]) < 2)", arg=wide, timeout=10000)
+    page.emulate_media(media="print")
+    assert page.locator("form").first.is_hidden() and page.locator("header").first.is_hidden()
+    assert page.locator(".results").first.is_visible()
 
 
 def test_dimensionless_numbers_have_no_si_prefix(page, server):

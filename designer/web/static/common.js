@@ -243,7 +243,8 @@ D.markCurrent = function () {
 // would be of the inputs before it) and waits for a pause (`wait` ms: no refusal of the "0." on the way to
 // "0.05", no design per key); leaving a field or choosing from a menu asks at once. `key()` is what the request
 // would send: the inputs last asked for are not asked again when nothing was typed since (leaving the field
-// whose pause already sent them).
+// whose pause already sent them). Typing back to the inputs whose answer is drawn (a digit typed and erased, a value
+// retyped as it was) asks nothing: that answer is current again, and a request sent meanwhile is cancelled.
 D.UNFINISHED = /(^\s*[-+]?\s*$)|(\d[.,]|\d[eE][-+]?|[-+])\s*$/;
 // The pause: 250 ms, or 1.3 times the typist's own gap between keys when that is longer (up to 700 ms), so a
 // slow typist is not answered at every key; 600 ms while that gap is not known yet (the page's first key).
@@ -254,6 +255,9 @@ D.DEBOUNCE_MAX_MS = 700;
 D.DEBOUNCE_FIRST_MS = 600;
 D.liveForm = function (form, run, key, wait) {
   let timer = null, asked = null, lastKey = 0, gap = 0;
+  // the inputs whose answer is drawn: their key, the page's answer count then, its status line
+  let shown = null;
+  const answersNow = () => +(document.body.dataset.answers || 0);
   const pause = () => wait || (gap ? Math.min(D.DEBOUNCE_MAX_MS, Math.max(D.DEBOUNCE_MS, 1.3 * gap))
                                      : D.DEBOUNCE_FIRST_MS);
   const now = () => {
@@ -261,7 +265,29 @@ D.liveForm = function (form, run, key, wait) {
     const k = key();
     if (k !== null && k === asked) return;   // nothing typed since: its answer is shown or on its way
     asked = k;
-    run();
+    const n = answersNow();
+    Promise.resolve(run()).then(() => {
+      // drawn for these inputs: answered since, nothing asked since, and not a refusal
+      if (k !== null && asked === k && answersNow() > n && document.body.dataset.state === "done") {
+        const status = document.getElementById("status");
+        // (and which of its controls the page left off: "a PID for this model" without a valid model)
+        const off = [...document.querySelectorAll("[data-current]")].filter(el => el.disabled);
+        shown = {k, n: answersNow(), said: status ? status.textContent : "", off};
+      }
+    });
+  };
+  // the inputs are back to those of the answer drawn, nothing answered since: current again, nothing asked
+  const restored = () => {
+    const k = key();
+    if (!shown || k === null || k !== shown.k || answersNow() !== shown.n) return false;
+    D.cancel("form");
+    asked = k;
+    const status = document.getElementById("status");
+    D.busy(false, status);
+    if (status) status.textContent = shown.said;
+    D.markCurrent();
+    for (const el of shown.off) el.disabled = true;
+    return true;
   };
   form.addEventListener("input", e => {
     if (e.target.type === "file") return;
@@ -273,6 +299,7 @@ D.liveForm = function (form, run, key, wait) {
       lastKey = t;
     }
     clearTimeout(timer);
+    if (restored()) return;
     D.cancel("form");
     asked = null;
     D.markStale("pending");

@@ -83,9 +83,9 @@ const page = D.designPage(form, status, "/api/filter", show, r => r.result.spice
   // the entry, type or family chosen shows its fields (the change then asks, as any menu does)
   form.addEventListener("change", e => { if (e.target === entry || ["type", "family"].includes(e.target.name)) showFields(); },
                         true);
-  D.liveForm(form, page.design, () => JSON.stringify(D.options(form)));
+  const live = D.liveForm(form, page.design, () => JSON.stringify(D.options(form)));
   document.getElementById("sheet").onclick = () => page.file("sheet");
   document.getElementById("bundle").onclick = () => page.file("bundle");
   document.getElementById("bom").onclick = () => page.file("bom");
-  page.design();
+  live.now();   // (through the form: typing back to these inputs asks nothing)
 })();

@@ -48,6 +48,8 @@ function show(answer) {
     D.fig(D.t("phase margin"), m.phase_margin_deg === undefined || m.phase_margin_deg === null ? D.t("n/a") : `${D.num(m.phase_margin_deg, 3)} deg`),
     D.fig(D.t("gain margin"), m.gain_margin_db === undefined || m.gain_margin_db === null ? D.t("n/a") : `${D.num(m.gain_margin_db, 3)} dB`),
     D.fig(D.t("crossover"), D.eng(m.crossover_hz, "Hz", 4)),
+    // the peak sensitivity: the library gives it for a model plant (the Sallen-Key plant's margins have none)
+    ...(m.ms === undefined || m.ms === null ? [] : [D.fig(D.t("Ms (max sensitivity)"), D.num(m.ms, 3))]),
     D.fig(D.t("checks failed"), String(failed.length)));
   // the failing checks by their titles, first thing under the heading (the sheet below has their details)
   const f = document.getElementById("failed");
@@ -126,8 +128,8 @@ async function file(kind) {
     if (e.target.name === "plant") showPlantKind();
     if (e.target.name === "tuning") showTargets();
   });
-  D.liveForm(form, design, () => JSON.stringify(request()));
+  const live = D.liveForm(form, design, () => JSON.stringify(request()));
   document.getElementById("sheet").onclick = () => file("sheet");
   document.getElementById("bundle").onclick = () => file("bundle");
-  design();
+  live.now();   // (through the form: typing back to these inputs asks nothing)
 })();

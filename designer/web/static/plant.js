@@ -92,7 +92,7 @@ const page = D.designPage(form, status, "/api/plant", show,
   D.fillFromQuery(form);
   showTopology();
   form.addEventListener("change", e => { if (e.target === menu) showTopology(); }, true);   // before it asks
-  D.liveForm(form, page.design, () => JSON.stringify(D.options(form)));
+  const live = D.liveForm(form, page.design, () => JSON.stringify(D.options(form)));
   document.getElementById("sheet").onclick = () => page.file("sheet");
   document.getElementById("bundle").onclick = () => page.file("bundle");
   document.getElementById("bom").onclick = () => page.file("bom");
@@ -108,5 +108,5 @@ const page = D.designPage(form, status, "/api/plant", show,
     if (b.gain !== 1) q.set("plant-gain", b.gain);
     location.href = "/pid?" + q.toString();
   };
-  page.design();
+  live.now();   // (through the form: typing back to these inputs asks nothing)
 })();
