@@ -13,6 +13,7 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    "inverting_highpass": ("InvertingHighPass",),
     "alternatives": ("Alternative", "alternatives_count", "design_alternatives",),
     "bench": ("BURST_CYCLES", "BUILDS", "C_TOL_PCT", "FilterBench", "R_TOL_PCT", "SEED", "StageCheck", "SweepPoint", "TableCompare",
               "TimeTest", "bench_of", "burst_tone", "nice_down", "nice_up", "passband_gain",),

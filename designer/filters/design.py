@@ -253,20 +253,14 @@ def section_name(kind: str, order: int, family: str, gain: float) -> str:
     -------
     str
         A registered name.
-
-    Raises
-    ------
-    DesignError
-        A first-order stage with gain that no section realises (one line).
     """
     if kind == "bandpass":
         return "mfb-bandpass"   # the registry's one band-pass section, whatever the topology asked
     if order == 1:
         if kind == "lowpass" and (family == "mfb" or gain > 1 + 1e-12):
             return "inverting-lowpass"
-        if gain > 1 + 1e-12:
-            raise DesignError("gain: a first-order high-pass section (rc-highpass) has unity gain; use gain 1 or "
-                              "an order of 2 or more", param="gain")
+        if gain > 1 + 1e-12:     # the follower's RC has unity gain; the inverting section has R2/R1
+            return "inverting-highpass"
         return "rc-lowpass" if kind == "lowpass" else "rc-highpass"
     if family == "mfb":
         return f"mfb-{kind}"
