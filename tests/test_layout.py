@@ -414,8 +414,15 @@ def test_the_numpydoc_check_fails_on_planted_gaps(tmp_path, monkeypatch):
 SK_PART_NAME = r"(R1|R2|C1|C2|R3|R4|R19|R20|r1|r2|c1|c2|r3|r4)(_ohm|_f)?"
 #: the modules that may spell them: the Sallen-Key low-pass's own family (the section, its parts table, its
 #: synthesis and its fast-path search) and every other topology's own module (each declares its own R1, C1 ..)
-PART_NAME_OWNERS = ("designer/filters/sallen_key", "designer/filters/mfb_", "designer/filters/rc_",
-                    "designer/filters/inverting_lowpass.py")
+def _section_modules() -> tuple:
+    """Every registered section's own module (a section added to the registry owns its part names with no
+    edit here), and the Sallen-Key low-pass's family (its parts, synthesis and search modules)."""
+    from designer.filters.registry import REGISTRY
+    mods = {type(t).__module__.replace(".", "/") + ".py" for t in REGISTRY.values()}
+    return ("designer/filters/sallen_key", *sorted(mods))
+
+
+PART_NAME_OWNERS = _section_modules()
 #: (module, top-level definition) -> why it may still spell them
 PART_NAME_EXEMPT = {
     ("designer/cli/common.py", "FLAGS"): "the command line's name table: library parameter -> --flag (--r1 ..)",
