@@ -35,7 +35,7 @@ class InvertingHighPass(Topology):
     parts = (PartSpec("R1", "R", N_("input resistor (sets fc with C1)")),
              PartSpec("R2", "R", N_("gain: inverting input to the output")),
              PartSpec("C1", "C", N_("input capacitor (the zero at DC)")))
-    example = SectionTarget("highpass", 1e3, gain=3.0)
+    example = SectionTarget("highpass", 1e3, gain=2.0)
 
     def coefficients(self, values: dict) -> tuple:
         v = self.values_of(values)
