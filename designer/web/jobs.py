@@ -38,6 +38,7 @@ from ..filters import report as filter_report
 from ..filters.alternatives import design_alternatives
 from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
+from ..tolerance.titles import figure_shown
 
 __all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "LIBRARY", "SWALLOWING_MODULES", "Superseded", "TRACES",
            "TRACE_POINTS", "analyze_pid_task", "analyze_plant_task", "bom_shown", "bundle_zip", "check_task",
@@ -988,7 +989,8 @@ def histograms(mc) -> list:
     Returns
     -------
     list of dict
-        Per figure: ``figure``, ``edges``, ``counts``, ``nominal``, ``min``, ``max``, ``n``.
+        Per figure: ``figure`` (its id), ``title`` (in the current language), ``unit`` (its values'),
+        ``edges``, ``counts``, ``nominal``, ``min``, ``max``, ``n``.
     """
     if mc is None or (hasattr(mc, "headline") and mc.headline is None):
         return []
@@ -1002,7 +1004,8 @@ def histograms(mc) -> list:
         k = int(np.clip(2 * math.sqrt(v.size), 10, 60)) if np.ptp(v) > 0 else 1
         counts, edges = np.histogram(v, bins=k)
         lim = next((lim for lim in mc.limits if lim.figure == name), None)
-        out.append({"figure": name, "edges": _list(edges), "counts": [int(c) for c in counts],
+        title, unit = figure_shown(name)   # the page shows the title, the unit on the values (issue 29)
+        out.append({"figure": name, "title": title, "unit": unit, "edges": _list(edges), "counts": [int(c) for c in counts],
                     "nominal": mc.nominal_figures.get(name), "min": None if lim is None else lim.min,
                     "max": None if lim is None else lim.max, "n": int(v.size)})
     return json_safe(out)

@@ -669,12 +669,38 @@ def test_the_plant_pages_tolerance_panel_shows_yield_histogram_and_the_part_to_t
     assert (f"Buy {t['part']} tighter" if t["yield"] > t["yield_now"] else "No part bought tighter") \
         in page.inner_text("#tighten")
     hist = page.locator(".histogram-figure[data-figure=fn_hz] svg")
-    assert hist.get_attribute("role") == "img" and "limits 3300 to 3700" in hist.get_attribute("aria-label")
+    assert hist.get_attribute("role") == "img" and "limits 3.3 kHz to 3.7 kHz" in hist.get_attribute("aria-label")
     assert page.locator(".histogram-figure[data-figure=fn_hz] line[data-limit]").count() == 2
     assert page.evaluate("D.labelOf(document.getElementById('form'), 'monte-carlo')") == "Monte Carlo builds"
     # a refused count is said beside its field in the page's words
     assert after(page, lambda: page.fill("input[name=monte-carlo]", "5")) == "error"
     assert page.inner_text(".field-error").startswith('"Monte Carlo builds" must be a whole number from 10')
+
+
+@pytest.mark.parametrize("lang", ["en", "es"])
+def test_the_plant_pages_tolerance_panel_names_its_figures_by_title_with_units_on_the_values(browser, server, lang):
+    """Issue 29: the tolerance panel (limits, histogram, its table) shows each Monte Carlo figure by its title from
+    the library's table (designer.tolerance.titles), in the page's language, the unit on the values: no figure id
+    (a word ending in _hz, _pct...) anywhere in it."""
+    from designer.core.i18n import catalogue
+    from designer.tolerance.titles import FIGURE_TITLES
+    context = browser.new_context(viewport={"width": 1400, "height": 1400}, locale="en-US")
+    pg = context.new_page()
+    try:
+        open_page(pg, server, f"/plant?tol=R%3D1%25+C%3D5%25&limit=fn_hz%3D3.3k%3A3.7k&monte-carlo=100&lang={lang}")
+        pg.wait_for_function("() => D.lang === 'en' || Object.keys(D.catalogue).length > 0")
+        assert pg.locator("#tolerance-section").is_visible() and pg.locator(".histogram-figure").count() > 0
+        pg.evaluate("document.querySelectorAll('#tolerance-section details').forEach(d => d.open = true)")
+        text = pg.inner_text("#tolerance-section") + " ".join(
+            pg.locator("#tolerance-section svg").evaluate_all("s => s.map(e => e.getAttribute('aria-label'))"))
+        assert not re.search(r"\b[a-z0-9]+_[a-z0-9_]*\b", text), text
+        title = FIGURE_TITLES["fn_hz"][0]
+        title = catalogue("es")[title] if lang == "es" else title
+        assert f"{title} (Hz)" in text                                # the histogram: its title, its unit
+        within = figure(pg, catalogue("es")["within"] if lang == "es" else "within")
+        assert within.startswith(title) and "kHz" in within            # the limits: the unit on the values
+    finally:
+        context.close()
 
 
 @pytest.mark.parametrize("path, table", [("/plant", "PLANT"), ("/identify", "IDENTIFY")])

@@ -680,7 +680,16 @@ D.dropZone = function (zone, input, onFile) {
 // The tolerance panel (Plant, PID): the yield with its 95 % interval, the part to buy tighter, and each
 // histogram (the server's bins: D.histogram) with its limits; hidden without a Monte Carlo.
 D.pct = v => D.localNum(`${(100 * v).toPrecision(3)} %`);
+// A Monte Carlo figure's value with its unit (the histogram's, from the library's title table): engineering
+// notation for Hz and s, else the number and the unit; the title carries no unit (issue 29).
+D.figureValue = function (v, unit) {
+  if (unit === "Hz" || unit === "s") return D.eng(v, unit, 4);
+  return unit && v !== null && v !== undefined && isFinite(v) ? `${D.num(v, 4)} ${unit}` : D.num(v, 4);
+};
 D.tolerance = function (mc, hists) {
+  const shown = Object.fromEntries((hists || []).map(h => [h.figure, h]));
+  const title = name => (shown[name] && shown[name].title) || name;
+  const value = (name, v) => D.figureValue(v, shown[name] && shown[name].unit);
   const section = document.getElementById("tolerance-section");
   if (!section) return;
   section.hidden = !mc;
@@ -690,7 +699,7 @@ D.tolerance = function (mc, hists) {
   if (y && mc.limits && mc.limits.length) {
     figs.push(D.fig(D.t("yield"), D.pct(y.fraction)),
               D.fig(D.t("95 % interval (Wilson)"), D.t("{lo} to {hi}", {lo: D.pct(y.ci95[0]), hi: D.pct(y.ci95[1])})),
-              D.fig(D.t("within"), mc.limits.map(l => `${l.figure} ${D.t("{lo} to {hi}", {lo: D.num(l.min, 4), hi: D.num(l.max, 4)})}`).join("; ")));
+              D.fig(D.t("within"), mc.limits.map(l => `${title(l.figure)} ${D.t("{lo} to {hi}", {lo: value(l.figure, l.min), hi: value(l.figure, l.max)})}`).join("; ")));
   } else figs.push(D.fig(D.t("yield"), D.t("no limits given: the spread alone")));
   document.getElementById("yield").replaceChildren(...figs);
   const t = mc.tighten, tight = document.getElementById("tighten");
@@ -705,6 +714,8 @@ D.tolerance = function (mc, hists) {
 // A histogram as SVG (bars, the limits as red lines, the nominal dashed), zoomable as any SVG, with its text
 // alternative: the counts per bin in a table below.
 D.histogram = function (h) {
+  const name = h.title ? (h.unit ? `${h.title} (${h.unit})` : h.title) : h.figure;   // "fn (Hz)": the unit on the axis
+  const value = v => D.figureValue(v, h.unit);
   const W = 640, H = 200, pad = 30, ns = "http://www.w3.org/2000/svg";
   const lo = Math.min(h.edges[0], h.min ?? Infinity, h.nominal ?? Infinity);
   const hi = Math.max(h.edges[h.edges.length - 1], h.max ?? -Infinity, h.nominal ?? -Infinity);
@@ -715,8 +726,8 @@ D.histogram = function (h) {
   svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
   svg.setAttribute("role", "img");
   svg.setAttribute("class", "histogram");
-  svg.setAttribute("aria-label", D.t("histogram of {figure} over {n} builds", {figure: h.figure, n: h.n}) +
-                   (h.min !== null ? D.t(", limits {lo} to {hi}", {lo: D.num(h.min, 4), hi: D.num(h.max, 4)}) : ""));
+  svg.setAttribute("aria-label", D.t("histogram of {figure} over {n} builds", {figure: name, n: h.n}) +
+                   (h.min !== null ? D.t(", limits {lo} to {hi}", {lo: value(h.min), hi: value(h.max)}) : ""));
   const el = (name, attrs, text) => {
     const e = document.createElementNS(ns, name);
     for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
@@ -730,16 +741,16 @@ D.histogram = function (h) {
     el("line", {x1: x(v), x2: x(v), y1: pad / 2, y2: H - pad, stroke: "#d62728", "stroke-width": 2, "data-limit": what});
   if (h.nominal !== null && h.nominal !== undefined)
     el("line", {x1: x(h.nominal), x2: x(h.nominal), y1: pad / 2, y2: H - pad, stroke: "#333", "stroke-dasharray": "4 3"});
-  el("text", {x: pad, y: H - 8, "font-size": 11}, D.num(lo, 4));
-  el("text", {x: W - pad, y: H - 8, "font-size": 11, "text-anchor": "end"}, D.num(hi, 4));
-  el("text", {x: W / 2, y: 12, "font-size": 12, "text-anchor": "middle"}, D.t("{figure} over {n} builds", {figure: h.figure, n: h.n}));
+  el("text", {x: pad, y: H - 8, "font-size": 11}, value(lo));
+  el("text", {x: W - pad, y: H - 8, "font-size": 11, "text-anchor": "end"}, value(hi));
+  el("text", {x: W / 2, y: 12, "font-size": 12, "text-anchor": "middle"}, D.t("{figure} over {n} builds", {figure: name, n: h.n}));
   const wrap = document.createElement("figure");
   wrap.className = "histogram-figure";
   wrap.dataset.figure = h.figure;
   wrap.append(svg);
   const details = document.createElement("details");
-  details.append(Object.assign(document.createElement("summary"), {textContent: D.t("{figure}: the counts as a table", {figure: h.figure})}),
-                 D.table([D.t("from"), D.t("to"), D.t("builds")], h.counts.map((c, i) => [D.num(h.edges[i], 4), D.num(h.edges[i + 1], 4), c])));
+  details.append(Object.assign(document.createElement("summary"), {textContent: D.t("{figure}: the counts as a table", {figure: name})}),
+                 D.table([D.t("from"), D.t("to"), D.t("builds")], h.counts.map((c, i) => [value(h.edges[i]), value(h.edges[i + 1]), c])));
   wrap.append(details);
   return wrap;
 };

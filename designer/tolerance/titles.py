@@ -1,0 +1,71 @@
+"""What each Monte Carlo figure is called where people read it (issue 29: "units on values, not on names";
+figures shown by title, not by id): the one table of every engine's figure ids (:data:`.plant.FIGURES`,
+:data:`.spice_engine.FIGURES`, :data:`.loop.FIGURES`, :data:`.spice_loop.FIGURES`, :data:`.filter.LOWHIGH_FIGURES`,
+:data:`.filter.BANDPASS_FIGURES`) -> a title and the unit its values carry, marked for translation. The ids stay
+what ``--limit`` takes and what the JSON keys say; only the pages show these titles. The units are those the
+ids' suffixes name (:func:`designer.core.units.figure_unit`)."""
+
+from __future__ import annotations
+
+from ..core.i18n import N_
+from ..core.i18n import gettext as _
+
+__all__ = ["FIGURE_TITLES", "PREFIX_TITLES", "figure_shown"]
+
+#: figure id (without an engine's prefix) -> (title, unit of its values)
+FIGURE_TITLES = {
+    "fn_hz": (N_("natural frequency fn"), "Hz"),
+    "zeta": (N_("damping ratio zeta"), ""),
+    "q": (N_("quality factor Q"), ""),
+    "gain": (N_("DC gain"), ""),
+    "overshoot_pct": (N_("step overshoot"), "%"),
+    "peak_time_s": (N_("time to the first peak"), "s"),
+    "rise_time_s": (N_("step rise time"), "s"),
+    "settling_time_s": (N_("step settling time"), "s"),
+    "stable": (N_("loop stable (1) or not (0)"), ""),
+    "saturated": (N_("output saturated (1) or not (0)"), ""),
+    "slewing": (N_("slewing (1) or not (0)"), ""),
+    "kp": (N_("Kp as built"), ""),
+    "ti_s": (N_("Ti as built"), "s"),
+    "td_s": (N_("Td as built"), "s"),
+    "phase_margin_deg": (N_("phase margin"), "deg"),
+    "crossover_hz": (N_("crossover frequency"), "Hz"),
+    "gain_margin_db": (N_("gain margin"), "dB"),
+    "steady_state_error_pct": (N_("steady-state error"), "%"),
+    "slew_delay_s": (N_("slew delay of the worst stage"), "s"),
+    "passband_loss_db": (N_("largest passband loss"), "dB"),
+    "ripple_db": (N_("passband ripple"), "dB"),
+    "f3_hz": (N_("-3 dB frequency"), "Hz"),
+    "f3_low_hz": (N_("lower -3 dB frequency"), "Hz"),
+    "f3_high_hz": (N_("upper -3 dB frequency"), "Hz"),
+    "stopband_attenuation_db": (N_("least stopband attenuation"), "dB"),
+    "group_delay_s": (N_("group delay at DC"), "s"),
+    "delay_error_pct": (N_("group delay error"), "%"),
+}
+
+#: an engine's prefix on a figure id -> how the title says whose figure it is
+PREFIX_TITLES = {
+    "ideal_": N_("{figure}, ideal op-amp"),
+    "model_": N_("{figure}, analytic model"),
+    "spice_": N_("{figure}, SPICE"),
+}
+
+
+def figure_shown(name: str) -> tuple:
+    """A Monte Carlo figure's title in the current language and the unit of its values.
+
+    Parameters
+    ----------
+    name : str
+        The figure's id (``fn_hz``, ``model_overshoot_pct``, ``spice_rise_time_s``).
+
+    Returns
+    -------
+    tuple of str
+        (title, unit); an id the table lacks shows as itself with no unit.
+    """
+    prefix = next((p for p in PREFIX_TITLES if name.startswith(p) and name[len(p):] in FIGURE_TITLES), "")
+    title, unit = FIGURE_TITLES.get(name[len(prefix):], (None, ""))
+    if title is None:
+        return name, ""
+    return (_(PREFIX_TITLES[prefix]).format(figure=_(title)) if prefix else _(title)), unit
