@@ -29,7 +29,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                  "interruption", "native", "on_exit", "owned_prefix", "preexec", "quiet", "remove_stale",
                  "reset_in_child", "status_of", "to_devnull", "words_of"),
     "lti": ("MAX_CLUSTER", "StepTerms", "coefficients", "dense_time", "dominant_pair", "filter_foh", "freq_response",
-            "pole_clusters", "response_span", "step_response"),
+            "pole_clusters", "response_span", "slowest_settling_s", "step_response"),
     "metrics": ("Overshoot", "StepMetrics", "measure_step", "step_metrics"),
     "opamps": ("OpAmp", "PACKAGE_KINDS", "Unit", "assign", "get", "names", "spare_units"),
     "prbs": ("BAND_FACTOR", "HALF_POWER", "LINES_IN_BAND", "MAX_BITS", "MIN_BITS", "PrbsPlan", "SETTLE_MARGIN",

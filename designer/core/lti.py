@@ -15,7 +15,7 @@ import numpy as np
 from .errors import DesignError
 
 __all__ = ["MAX_CLUSTER", "StepTerms", "coefficients", "dense_time", "dominant_pair", "filter_foh", "freq_response",
-           "pole_clusters", "response_span", "step_response"]
+           "pole_clusters", "response_span", "slowest_settling_s", "step_response"]
 
 
 def coefficients(p, name: str, what: str = "") -> np.ndarray:
@@ -424,3 +424,21 @@ def filter_foh(num, den, t, x) -> np.ndarray:
         f = (i0 - i1) * x[:-1] + i1 * x[1:]
         y = y + r * _first_order_scan(a, f.astype(complex))
     return y.real
+
+
+def slowest_settling_s(den) -> float:
+    """ln(50) / min |Re p| over the poles p of ``den``: when the slowest mode's envelope exp(-sigma t) is at
+    2 % (4 / (zeta wn) for a dominant pair; Ogata, *Modern Control Engineering*, 5th ed., section 5-3).
+
+    Parameters
+    ----------
+    den : array_like
+        The denominator, highest power first.
+
+    Returns
+    -------
+    float
+        Seconds.
+    """
+    sigma = np.abs(np.real(np.roots(np.asarray(den, float))))
+    return math.log(50.0) / float(np.min(sigma))

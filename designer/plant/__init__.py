@@ -12,7 +12,7 @@ from ..core.exports import lazy_exports
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "circuit_report": ("bom", "sections", "title_of"),
-    "circuit_prbs": ("band_edge_hz", "section_plan", "slowest_settling_s", "with_section_prbs"),
+    "circuit_prbs": ("band_edge_hz", "section_plan", "with_section_prbs"),
     "circuit_design": ("CircuitAnalysisSpec", "CircuitPlantResult", "GBW_MARGIN", "SPICE_DB", "SPICE_DEG",
                        "analyze_circuit_plant", "analyze_circuit_spec", "built_name", "check_circuit_parts",
                        "check_opamp_reach",

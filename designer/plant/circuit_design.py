@@ -29,7 +29,7 @@ from ..core.checks import SPICE_AGREEMENT, Check
 from ..core.errors import DesignError
 from ..core.i18n import N_, Message
 from ..core.jsonio import json_safe
-from ..core.lti import dense_time, response_span, step_response
+from ..core.lti import dense_time, response_span, slowest_settling_s, step_response
 from ..core.metrics import step_metrics
 from ..core.eseries import series_name
 from ..core.ranges import parse_in_range
@@ -753,9 +753,8 @@ def default_square_hz(result: CircuitPlantResult) -> float:
         The frequency (Hz).
     """
     from .bench import recommend_square_wave
-    den = np.asarray(circuit.opamp_tf(result.section, result.values, result.opamp)[1], float)
-    sigma = float(np.min(np.abs(np.roots(den).real)))
-    return recommend_square_wave(math.log(50) / sigma, 1.0).frequency_hz
+    den = circuit.opamp_tf(result.section, result.values, result.opamp)[1]
+    return recommend_square_wave(slowest_settling_s(den), 1.0).frequency_hz
 
 
 def tolerance_nominal(result: CircuitPlantResult) -> dict:

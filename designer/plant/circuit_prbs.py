@@ -27,15 +27,15 @@ slew checks under it.
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
+from ..core.lti import slowest_settling_s
 from ..core.prbs import PrbsPlan
 from . import circuit
 from .prbs import attach, plan_of, run_deck
 
-__all__ = ["slowest_settling_s", "band_edge_hz", "section_plan", "with_section_prbs"]
+__all__ = ["band_edge_hz", "section_plan", "with_section_prbs"]
 
 
 def _model(result) -> tuple:
@@ -43,23 +43,6 @@ def _model(result) -> tuple:
     num, den = circuit.opamp_tf(result.section, result.values, result.opamp)
     num = np.trim_zeros(np.asarray(num, float), "f")
     return (num if num.size else np.zeros(1)), np.asarray(den, float)
-
-
-def slowest_settling_s(den) -> float:
-    """ln(50) / min |Re p| over the poles p of ``den``: when the slowest mode's envelope is at 2 %.
-
-    Parameters
-    ----------
-    den : array_like
-        The denominator, highest power first.
-
-    Returns
-    -------
-    float
-        Seconds.
-    """
-    sigma = np.abs(np.real(np.roots(np.asarray(den, float))))
-    return math.log(50.0) / float(np.min(sigma))
 
 
 def band_edge_hz(result) -> float:
@@ -84,7 +67,7 @@ def band_edge_hz(result) -> float:
 
 def section_plan(result, amplitude_v: float, bits=None, clock_hz=None) -> PrbsPlan:
     """The sequence for a section plant: levels 0 V and ``amplitude_v``; ``bits`` and ``clock_hz``
-    chosen from :func:`slowest_settling_s` and :func:`band_edge_hz` unless given.
+    chosen from :func:`designer.core.lti.slowest_settling_s` and :func:`band_edge_hz` unless given.
 
     Parameters
     ----------

@@ -14,7 +14,8 @@ from designer.core.prbs import BAND_FACTOR, HALF_POWER, SETTLE_MARGIN
 from designer.filters import REGISTRY
 from designer.plant import circuit
 from designer.plant.circuit_design import design_circuit_plant
-from designer.plant.circuit_prbs import band_edge_hz, section_plan, slowest_settling_s, with_section_prbs
+from designer.core.lti import slowest_settling_s
+from designer.plant.circuit_prbs import band_edge_hz, section_plan, with_section_prbs
 from designer.plant.spec import PlantSpec
 
 TOPOLOGIES = [t for t in REGISTRY.values() if t.name != circuit.DEFAULT_TOPOLOGY]
