@@ -47,6 +47,19 @@ def decks(specs) -> dict:
             if s.kind == "netlist":
                 out[(s.name, corner)] = ([s.designs[k]], None)
                 continue
+            if s.kind == "filter":    # its cascade's .ac over the check's own sweep
+                from designer.check.filter_kind import corner_stages, model_grid, spice_sweep
+                from designer.core import opamps
+                from designer.filters.cascade import Cascade
+                from designer.filters.deck import ac_deck
+                from designer.filters.registry import get
+                case = s.designs[k]
+                _, stages, _ = corner_stages(case)
+                netlist, f_lo, f_hi, ppd = spice_sweep(Cascade([(get(t), v) for t, v in stages]),
+                                                       model_grid(stages, case.mask), case.mask)
+                out[(s.name, corner)] = ([ac_deck(netlist, opamps.get(case.opamp), f_lo, f_hi,
+                                                  points_per_decade=ppd)], None)
+                continue
             if s.kind == "plant":
                 from designer.plant.design import analyze_plant as analyze, design_plant as design
             else:

@@ -53,7 +53,7 @@ _COLD = """
 import json, tempfile, time
 tick = time.perf_counter()
 from designer.pid.design import design_pid
-from designer.pid.process_report import write_outputs
+from designer.pid.report import write_outputs
 from designer.pid.spec import PidSpec
 imports = time.perf_counter() - tick
 res = design_pid(PidSpec(plant_tf=%r, tuning="optimize"))
@@ -74,7 +74,7 @@ def cold(repeat: int = 3) -> dict:
 def warm(repeat: int = 3):
     """Median seconds per phase of the same design in this process, run after run (imports paid before)."""
     from designer.pid.design import design_pid
-    from designer.pid.process_report import write_outputs
+    from designer.pid.report import write_outputs
     from designer.pid.spec import PidSpec
     runs, res = [], None
     for _ in range(repeat):

@@ -44,7 +44,8 @@ from ..core.jsonio import json_safe
 from ..core.units import parse_value
 
 __all__ = ["FILTER_KEYS", "SUB_FILTER", "MASK_KEYS", "MASK_FIGURES", "DELAY_KEYS", "DELAY_FIGURES", "FilterCase",
-           "filter_designs", "mask_limits", "delay_limits", "run_filter", "filter_figures"]
+           "filter_designs", "mask_limits", "delay_limits", "run_filter", "filter_figures", "spice_sweep",
+           "corner_stages", "model_grid"]
 
 #: the keys of ``filter:`` (design-filter's options) and ``mask:``
 SUB_FILTER = ("type", "family", "order", "fc", "ripple", "bessel_norm", "chebyshev_cutoff", "f_low", "f_high",
@@ -438,8 +439,7 @@ def filter_figures(stages, opamp, ref_db: float, mask, simulator: str | None, de
     from ..filters.registry import get
     cascade = Cascade([(get(t), v) for t, v in stages])
     kind = _kind(stages)
-    edges = () if mask is None else tuple(np.hstack([mask["passband"], mask["stopband"]]))
-    f = _grid(stages, edges)
+    f = model_grid(stages, mask)
     h = cascade.response(2j * math.pi * f, opamp)
     if ref_db is None:
         num, den = cascade.coefficients()
@@ -460,10 +460,8 @@ def filter_figures(stages, opamp, ref_db: float, mask, simulator: str | None, de
                             2 * math.pi * delay["to"] * 1e-4)
         out["delay_error_pct"] = delay_error_pct(tau, tau[0])
     if simulator is not None:
-        # a band-pass mask's narrow band: a denser sweep (the edges within a few points otherwise)
-        dense = {"points_per_decade": _BAND_POINTS_PER_DECADE} if mask is not None and \
-            isinstance(mask["passband"], tuple) else {}
-        fs, hs = simulate_ac(cascade.netlist(), opamp, float(f[0]), float(f[-1]), simulator=simulator, **dense)
+        netlist, f_lo, f_hi, ppd = spice_sweep(cascade, f, mask)
+        fs, hs = simulate_ac(netlist, opamp, f_lo, f_hi, simulator=simulator, points_per_decade=ppd)
         out.update(_response_figures(fs, hs, kind, ref_db, mask, "spice_"))
         if delay is not None:
             from ..filters.verify import phase_delay_error_pct
@@ -473,6 +471,72 @@ def filter_figures(stages, opamp, ref_db: float, mask, simulator: str | None, de
         within = 20 * np.log10(np.abs(an)) >= ref_db - 60
         out["spice_max_deviation_db"] = float(np.max(dev[within]))
     return out
+
+
+def model_grid(stages, mask) -> np.ndarray:
+    """The frequency grid the figures are read on: the stages' own and the mask's edges.
+
+    Parameters
+    ----------
+    stages : list
+        (topology name, parts) pairs.
+    mask : dict or None
+        The mask.
+
+    Returns
+    -------
+    numpy.ndarray
+        Frequencies, Hz, ascending.
+    """
+    edges = () if mask is None else tuple(np.hstack([mask["passband"], mask["stopband"]]))
+    return _grid(stages, edges)
+
+
+def spice_sweep(cascade, f, mask) -> tuple:
+    """The SPICE ``.ac`` sweep :func:`filter_figures` runs: over the model's grid
+    ``f``, denser for a band-pass mask (its narrow band's edges within a few
+    points otherwise).
+
+    Parameters
+    ----------
+    cascade : designer.filters.cascade.Cascade
+        The corner's circuit.
+    f : numpy.ndarray
+        The model's frequency grid, Hz.
+    mask : dict or None
+        The mask.
+
+    Returns
+    -------
+    tuple
+        (netlist, lowest Hz, highest Hz, points per decade): what
+        :func:`designer.filters.deck.ac_deck` takes.
+    """
+    from ..filters.deck import AC_POINTS_PER_DECADE
+    dense = mask is not None and isinstance(mask["passband"], tuple)
+    return (cascade.netlist(), float(f[0]), float(f[-1]),
+            _BAND_POINTS_PER_DECADE if dense else AC_POINTS_PER_DECADE)
+
+
+def corner_stages(case: FilterCase) -> tuple:
+    """A corner's stages: designed from its spec (not simulated) or as built.
+
+    Parameters
+    ----------
+    case : FilterCase
+        The corner.
+
+    Returns
+    -------
+    tuple
+        (the design or None as built, [(topology name, parts)], the passband
+        gain in dB or None for the cascade's own).
+    """
+    from ..filters.design import design
+    if case.spec is None:
+        return None, list(case.stages), None
+    res = design(case.spec, simulate=False)
+    return res, [(st.topology, dict(st.values)) for st in res.stages], 20 * math.log10(case.spec.gain)
 
 
 def run_filter(case: FilterCase, simulator: str) -> FilterRun:
@@ -490,15 +554,8 @@ def run_filter(case: FilterCase, simulator: str) -> FilterRun:
     FilterRun
         The run.
     """
-    from ..filters.design import design
     opamp = opamps.get(case.opamp)
-    if case.spec is None:
-        stages = list(case.stages)
-        res, ref_db = None, None
-    else:
-        res = design(case.spec, simulate=False)
-        stages = [(st.topology, dict(st.values)) for st in res.stages]
-        ref_db = 20 * math.log10(case.spec.gain)
+    res, stages, ref_db = corner_stages(case)
     figs = filter_figures(stages, opamp, ref_db, case.mask, simulator, case.delay)
     if res is not None:
         f = res.figures

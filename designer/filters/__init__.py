@@ -18,7 +18,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "bench": ("BURST_CYCLES", "BUILDS", "C_TOL_PCT", "FilterBench", "R_TOL_PCT", "SEED", "StageCheck", "SweepPoint", "TableCompare",
               "TimeTest", "bench_of", "burst_tone", "nice_down", "nice_up", "passband_gain",),
     "cascade": ("Cascade", "Stage",),
-    "deck": ("ac_deck", "simulate_ac",),
+    "deck": ("AC_POINTS_PER_DECADE", "ac_deck", "simulate_ac",),
     "design": ("FilterDesign", "StageDesign", "analysis_grid", "as_built", "central_delay", "delay_figures", "predistort", "section_name", "with_choice",
                "section_plans", "stage_candidates", "verify_spice",),
     "inverting_lowpass": ("InvertingLowPass",),

@@ -18,11 +18,14 @@ from ..core.opamps import OpAmp
 from ..spice.deck import Netlist, ac_lines, add_supplies, opamp_library_text
 from ..spice.simulate import get_simulator
 
-__all__ = ["ac_deck", "simulate_ac"]
+__all__ = ["AC_POINTS_PER_DECADE", "ac_deck", "simulate_ac"]
+
+#: points per decade of an ``.ac`` sweep unless a caller asks for more
+AC_POINTS_PER_DECADE = 50
 
 
 def ac_deck(netlist: Netlist, opamp: OpAmp, f_lo: float, f_hi: float, inp: str = "vin",
-            title: str = "filter", points_per_decade: int = 50) -> str:
+            title: str = "filter", points_per_decade: int = AC_POINTS_PER_DECADE) -> str:
     """The ``.ac`` deck of ``netlist`` driven at net ``inp``.
 
     Parameters
@@ -59,7 +62,7 @@ def ac_deck(netlist: Netlist, opamp: OpAmp, f_lo: float, f_hi: float, inp: str =
 
 
 def simulate_ac(netlist: Netlist, opamp: OpAmp, f_lo: float, f_hi: float, inp: str = "vin", out: str = "vout",
-                simulator: str = "ngspice-cli", points_per_decade: int = 50) -> tuple:
+                simulator: str = "ngspice-cli", points_per_decade: int = AC_POINTS_PER_DECADE) -> tuple:
     """Simulate :func:`ac_deck` and read V(out).
 
     Parameters
