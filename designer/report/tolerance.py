@@ -25,7 +25,7 @@ from ..core.units import format_figure
 from . import document as R
 from .plots import histogram_plot
 
-__all__ = ["csv_texts", "histogram_plots", "limit_text", "section", "title"]
+__all__ = ["csv_texts", "histogram_plots", "histogram_words", "limit_text", "section", "title"]
 
 
 def histogram_name(figure: str) -> str:
@@ -36,11 +36,30 @@ def histogram_png(result, figure: str) -> bytes:
     """The histogram of ``figure`` over ``result.monte_carlo``'s samples, its limit and nominal marked."""
     mc = result.monte_carlo
     lim = next((lim for lim in mc.limits if lim.figure == figure), None)
-    inside = "" if lim is None else _(", {count} outside the limits").format(count=mc.failing[figure]['count'])
+    title, label = histogram_words(mc, figure)
     return histogram_plot(mc.figures[figure], figure, mc.nominal_figures.get(figure),
-                          None if lim is None else lim.min, None if lim is None else lim.max,
-                          _("{figure} over {n} builds").format(figure=figure_shown(figure)[0], n=mc.n) + inside,
-                          label=figure_label(figure))
+                          None if lim is None else lim.min, None if lim is None else lim.max, title, label=label)
+
+
+def histogram_words(mc, figure: str) -> tuple:
+    """A histogram's title and x-axis label in the current language: the figure by its title, never its id
+    (``natural frequency fn over 5000 builds, 1112 outside the limits``; ``natural frequency fn (Hz)``).
+
+    Parameters
+    ----------
+    mc : designer.tolerance.montecarlo.MonteCarlo
+        The Monte Carlo (its count of builds, limits and builds outside each).
+    figure : str
+        The figure's id.
+
+    Returns
+    -------
+    tuple of str
+        (title, label).
+    """
+    lim = next((lim for lim in mc.limits if lim.figure == figure), None)
+    inside = "" if lim is None else _(", {count} outside the limits").format(count=mc.failing[figure]['count'])
+    return _("{figure} over {n} builds").format(figure=_name(figure), n=mc.n) + inside, figure_label(figure)
 
 
 def histogram_plots(result) -> tuple:
