@@ -680,10 +680,10 @@ def test_the_plant_pages_tolerance_panel_shows_yield_histogram_and_the_part_to_t
 @pytest.mark.parametrize("lang", ["en", "es"])
 def test_the_plant_pages_tolerance_panel_names_its_figures_by_title_with_units_on_the_values(browser, server, lang):
     """Issue 29: the tolerance panel (limits, histogram, its table) shows each Monte Carlo figure by its title from
-    the library's table (designer.tolerance.titles), in the page's language, the unit on the values: no figure id
+    the library's table (designer.core.figure_titles), in the page's language, the unit on the values: no figure id
     (a word ending in _hz, _pct...) anywhere in it."""
     from designer.core.i18n import catalogue
-    from designer.tolerance.titles import FIGURE_TITLES
+    from designer.core.figure_titles import FIGURE_TITLES
     context = browser.new_context(viewport={"width": 1400, "height": 1400}, locale="en-US")
     pg = context.new_page()
     try:
