@@ -21,6 +21,7 @@ import functools
 from ..core.i18n import N_
 from ..core.figure_titles import figure_label, figure_shown
 from ..core.i18n import gettext as _
+from ..core.i18n import translated
 from ..core.units import format_figure
 from . import document as R
 from .plots import histogram_plot
@@ -194,7 +195,7 @@ def worst_case_blocks(wc) -> list:
                          (_("corner: ") if e.at_corner else _("inside the box: ")) + corner_text(e.deviations)])
     head = _("Worst case over the tolerance box: {corners} corners evaluated ({method}); each part at "
              "+tol or -tol of its nominal, in tolerances where an extreme lies inside.").format(corners=wc.corners,
-                                                                                                method=wc.method)
+                                                                                                method=translated(wc.method))
     return [R.text(head), R.table([_("figure"), _("extreme"), _("value"), _("where (parts)")], rows)]
 
 
