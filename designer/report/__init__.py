@@ -12,6 +12,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
               "time_unit"),
     "render": ("ahead", "running", "start", "stop", "submit", "submit_many"),
     "schematic": ("Sheet", "check_connectivity"),
-    "tolerance": ("csv_texts", "histogram_plots", "section", "title"),
+    "tolerance": ("csv_texts", "histogram_plots", "histogram_words", "limit_text", "section", "title"),
     "wiring": ("BOM_HEADER", "CATALOGUE_WORDS", "bench_rows", "bom_csv", "bom_rows", "net_text", "wiring_rows"),
 })

@@ -390,7 +390,7 @@ def loop_gain_plot(f, L, title: str, crossover_hz: float, phase_margin_deg: floa
 
 
 def histogram_plot(values, name: str, nominal: float | None = None, lo: float | None = None,
-                   hi: float | None = None, title: str = "", bins: int = 60) -> bytes:
+                   hi: float | None = None, title: str = "", bins: int = 60, label: str | None = None) -> bytes:
     """A histogram of a figure over Monte Carlo samples (NaN left out), the limits ``lo``/``hi``
     drawn as red lines with the region outside shaded, the nominal design as a dashed line.
 
@@ -399,7 +399,7 @@ def histogram_plot(values, name: str, nominal: float | None = None, lo: float | 
     values : array_like
         The figure's value in each sample.
     name : str
-        The figure's name (the axis label).
+        The figure's id (its unit; the axis label without ``label``).
     nominal : float, optional
         The nominal design's value.
     lo, hi : float, optional
@@ -408,6 +408,9 @@ def histogram_plot(values, name: str, nominal: float | None = None, lo: float | 
         The plot's title.
     bins : int
         The histogram's bins.
+    label : str, optional
+        The x axis's label (the figure's title with its unit, as the caller words it); default the
+        id with its unit.
 
     Returns
     -------
@@ -441,7 +444,7 @@ def histogram_plot(values, name: str, nominal: float | None = None, lo: float | 
     ax.set_xlim(left, right)
     if unit in ("Hz", "s"):
         ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _pos: value_code(x) if x else "0"))
-    ax.set_xlabel(f"{_(name)} ({unit})" if unit else _(name))
+    ax.set_xlabel(label if label is not None else f"{_(name)} ({unit})" if unit else _(name))
     ax.set_ylabel(_("builds"))
     ax.set_title(_(title) if title else _("{name} over {n} builds").format(name=_(name), n=v.size), fontsize=10)
     ax.grid(True, alpha=0.3)

@@ -7,19 +7,26 @@ part to buy tighter and, for a loop, the probabilities of instability,
 saturation and of failing the slew check; and, where asked (the PID sheet), the
 worst case (``--worst-case``, :class:`designer.tolerance.worstcase.WorstCase`): each
 figure's extremes over the tolerance box and the corner (or the point inside the
-box) that gives each, as one compact table."""
+box) that gives each, as one compact table.
+
+Every figure is named by its title, with the unit on its values (issue 29;
+:mod:`designer.core.figure_titles`, the table the web page reads): ``natural
+frequency fn`` and ``3.3 kHz to 3.7 kHz``, never ``fn_hz``; the file names and the
+JSON keep the ids."""
 
 from __future__ import annotations
 
 import functools
 
 from ..core.i18n import N_
+from ..core.figure_titles import figure_label, figure_shown
 from ..core.i18n import gettext as _
+from ..core.i18n import translated
 from ..core.units import format_figure
 from . import document as R
 from .plots import histogram_plot
 
-__all__ = ["csv_texts", "histogram_plots", "section", "title"]
+__all__ = ["csv_texts", "histogram_plots", "histogram_words", "limit_text", "section", "title"]
 
 
 def histogram_name(figure: str) -> str:
@@ -30,10 +37,30 @@ def histogram_png(result, figure: str) -> bytes:
     """The histogram of ``figure`` over ``result.monte_carlo``'s samples, its limit and nominal marked."""
     mc = result.monte_carlo
     lim = next((lim for lim in mc.limits if lim.figure == figure), None)
-    inside = "" if lim is None else f", {mc.failing[figure]['count']} outside the limits"
+    title, label = histogram_words(mc, figure)
     return histogram_plot(mc.figures[figure], figure, mc.nominal_figures.get(figure),
-                          None if lim is None else lim.min, None if lim is None else lim.max,
-                          f"{figure} over {mc.n} builds{inside}")
+                          None if lim is None else lim.min, None if lim is None else lim.max, title, label=label)
+
+
+def histogram_words(mc, figure: str) -> tuple:
+    """A histogram's title and x-axis label in the current language: the figure by its title, never its id
+    (``natural frequency fn over 5000 builds, 1112 outside the limits``; ``natural frequency fn (Hz)``).
+
+    Parameters
+    ----------
+    mc : designer.tolerance.montecarlo.MonteCarlo
+        The Monte Carlo (its count of builds, limits and builds outside each).
+    figure : str
+        The figure's id.
+
+    Returns
+    -------
+    tuple of str
+        (title, label).
+    """
+    lim = next((lim for lim in mc.limits if lim.figure == figure), None)
+    inside = "" if lim is None else _(", {count} outside the limits").format(count=mc.failing[figure]['count'])
+    return _("{figure} over {n} builds").format(figure=_name(figure), n=mc.n) + inside, figure_label(figure)
 
 
 def histogram_plots(result) -> tuple:
@@ -82,6 +109,43 @@ def _value(figure: str, v) -> str:
     return format_figure(figure, v)
 
 
+def _name(figure: str) -> str:
+    return figure_shown(figure)[0]
+
+
+def _sentence(text: str) -> str:
+    return text[:1].upper() + text[1:]
+
+
+#: the draw's distribution and sampler as the sheet words them (the JSON and --dist/--sampler keep the ids)
+DRAW_WORDS = {"uniform": N_("uniform"), "normal": N_("normal"), "random": N_("random"), "lhs": N_("lhs"),
+              "sobol": N_("sobol")}
+
+
+def limit_text(lim) -> str:
+    """A limit as the sheet words it: the figure's title and its window, units on the values
+    (``natural frequency fn 3.3 kHz to 3.7 kHz``, ``phase margin at least 45 deg``).
+
+    Parameters
+    ----------
+    lim : designer.tolerance.stats.Limit
+        The limit (its figure id, ``min`` and ``max``; either may be None).
+
+    Returns
+    -------
+    str
+        The text in the current language.
+    """
+    f = lim.figure
+    if lim.min is not None and lim.max is not None:
+        window = _("{lo} to {hi}").format(lo=_value(f, lim.min), hi=_value(f, lim.max))
+    elif lim.min is not None:
+        window = _("at least {value}").format(value=_value(f, lim.min))
+    else:
+        window = _("at most {value}").format(value=_value(f, lim.max))
+    return f"{_name(f)} {window}"
+
+
 def _pct(x: float) -> str:
     return f"{100 * x:.3g} %" if x < 0.9995 or x == 1 else f"{100 * x:.4g} %"
 
@@ -127,11 +191,11 @@ def worst_case_blocks(wc) -> list:
     rows = []
     for fig, (lo, hi) in wc.extremes.items():
         for which, e in ((N_("lowest"), lo), (N_("highest"), hi)):
-            rows.append([fig if which == "lowest" else "", _(which), _value(fig, e.value),
+            rows.append([_name(fig) if which == "lowest" else "", _(which), _value(fig, e.value),
                          (_("corner: ") if e.at_corner else _("inside the box: ")) + corner_text(e.deviations)])
     head = _("Worst case over the tolerance box: {corners} corners evaluated ({method}); each part at "
              "+tol or -tol of its nominal, in tolerances where an extreme lies inside.").format(corners=wc.corners,
-                                                                                                method=wc.method)
+                                                                                                method=translated(wc.method))
     return [R.text(head), R.table([_("figure"), _("extreme"), _("value"), _("where (parts)")], rows)]
 
 
@@ -165,18 +229,20 @@ def _monte_carlo_blocks(result, with_images: bool) -> list:
     if mc.headline is None:   # one build replayed (--replay I): what it is, no spread
         return [R.text(" ".join(mc.summary_lines()))]
     head = _("{n} builds drawn within the parts' tolerances ({dist}, {sampler} sampler, seed {seed}; "
-             "each build's parts are in monte-carlo.csv).").format(n=mc.n, dist=mc.dist, sampler=mc.sampler,
+             "each build's parts are in monte-carlo.csv).").format(n=mc.n, dist=_(DRAW_WORDS.get(mc.dist, mc.dist)),
+                                                                   sampler=_(DRAW_WORDS.get(mc.sampler, mc.sampler)),
                                                                    seed=mc.seed)
     lines = [head]
     if mc.limits:
         lo, hi = mc.yield_interval()
         lines.append(_("Yield {y} ({count} of {n}; 95 % Wilson interval {lo} to {hi}) within {limits}.").format(
             y=_pct(mc.yield_count / mc.n), count=mc.yield_count, n=mc.n, lo=_pct(lo), hi=_pct(hi),
-            limits="; ".join(lim.text() for lim in mc.limits)))
+            limits="; ".join(limit_text(lim) for lim in mc.limits)))
         lost = sorted(mc.failing.items(), key=lambda kv: -kv[1]["count"])
         if lost and lost[0][1]["count"]:
             lines.append(_("Lost builds: {lost} (the worst: build {worst}).").format(
-                lost=", ".join(f"{k} {v['count']}" for k, v in lost if v["count"]), worst=lost[0][1]['worst'][0]))
+                lost="; ".join(_("{count} on {figure}").format(count=v["count"], figure=_name(k))
+                               for k, v in lost if v["count"]), worst=lost[0][1]['worst'][0]))
         if mc.tighten:
             t = mc.tighten
             better = t["yield"] > t["yield_now"]
@@ -195,10 +261,11 @@ def _monte_carlo_blocks(result, with_images: bool) -> list:
     if s is not None and s.percentiles:
         p = s.percentiles
         h = mc.headline
-        lines.append(_("{figure}: nominal {nominal}, 95 % of builds {lo} to {hi}.").format(
-            figure=h, nominal=_value(h, s.nominal), lo=_value(h, p[2.5]), hi=_value(h, p[97.5])))
+        lines.append(_sentence(_("{figure}: nominal {nominal}, 95 % of builds {lo} to {hi}.").format(
+            figure=_name(h), nominal=_value(h, s.nominal), lo=_value(h, p[2.5]), hi=_value(h, p[97.5]))))
     text = [R.text(" ".join(lines))]
     if not with_images:
         return text
-    return [R.columns([R.image(histogram_name(mc.headline), _("histogram of {figure}").format(figure=mc.headline))],
+    return [R.columns([R.image(histogram_name(mc.headline), _("histogram of {figure}").format(
+        figure=_name(mc.headline)))],
                       text)]

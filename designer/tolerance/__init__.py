@@ -37,7 +37,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "spice_mc": ("drawn_values", "plant_monte_carlo_engine", "replay_values", "run_engine", "section_context",
                  "section_monte_carlo_engine", "section_replay", "section_replay_result", "spice_samples",),
     "stats": ("Limit", "Z95", "figure_stats", "variance_shares", "wilson",),
-    "titles": ("FIGURE_TITLES", "PREFIX_TITLES", "figure_shown",),
     "worstcase": ("WorstCase", "worst_case",),
     "yields": ("ENGINES", "FILTER", "LOOP", "PLANT", "SECTION", "TABLES", "counted", "spec_yield",),
 })

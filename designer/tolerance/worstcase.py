@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.i18n import N_, Message
+
 __all__ = ["WorstCase", "worst_case"]
 
 #: figures whose extremes are reported
@@ -40,7 +42,8 @@ class WorstCase:
 
     extremes: dict
     corners: int
-    method: str = "every corner, then L-BFGS-B from the worst corner"
+    #: how the box was searched, in English (result.json's); a Message (a sheet shows it in its language)
+    method: str = Message(N_("every corner, then L-BFGS-B from the worst corner"))
 
     def to_dict(self) -> dict:
         return {"corners": self.corners, "method": self.method,
@@ -107,8 +110,8 @@ def worst_case(evaluate, nominal: dict, tol: dict, figures=FIGURES, max_corners:
         method = WorstCase.method
     else:
         signs = sensitivity_corners(evaluate, values, d, figures)
-        method = ("each part alone at -tol and +tol, the corners their slopes point to, then L-BFGS-B from the "
-                  f"worst ({2 ** d} corners are too many to enumerate)")
+        method = Message(N_("each part alone at -tol and +tol, the corners their slopes point to, then L-BFGS-B "
+                            "from the worst ({corners} corners are too many to enumerate)"), corners=str(2 ** d))
     at_corners = evaluate(values(signs))
     out = {}
     for fig in figures:

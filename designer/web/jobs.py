@@ -38,7 +38,7 @@ from ..filters import report as filter_report
 from ..filters.alternatives import design_alternatives
 from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
-from ..tolerance.titles import figure_shown
+from ..core.figure_titles import figure_shown
 
 __all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "LIBRARY", "SWALLOWING_MODULES", "Superseded", "TRACES",
            "TRACE_POINTS", "analyze_pid_task", "analyze_plant_task", "bom_shown", "bundle_zip", "check_task",

@@ -48,3 +48,23 @@ def test_the_sensitivity_corners_find_a_monotone_plants_extremes():
     for fig in ("fn_hz", "zeta"):
         for a, b in zip(full.extremes[fig], fast.extremes[fig]):
             assert b.value == pytest.approx(a.value, rel=1e-9)
+
+
+def test_the_search_is_english_in_the_json_and_in_the_sheets_language_on_the_sheet():
+    """Issue 29: how the box was searched is result.json's English (a str), and the Spanish sheet's worst-case
+    paragraph says it in Spanish, the number of corners kept."""
+    import json
+
+    from designer.core.i18n import catalogue, language
+    from designer.report.tolerance import worst_case_blocks
+    amp = opamps.get("LM741")
+    es = catalogue("es")
+    for max_corners in (8, 2 ** 20):
+        wc = worst_case(lambda v: plant_figures(v, amp), NOMINAL, TOL, ("fn_hz",), max_corners=max_corners)
+        data = json.loads(json.dumps(wc.to_dict()))
+        assert data["method"] == str(wc.method) and ("slopes" in data["method"]) == (max_corners == 8)
+        with language("es"):
+            head = worst_case_blocks(wc)[0][1]
+        spanish = es[wc.method.message].format(**wc.method.values)
+        assert spanish in head and data["method"] not in head
+        assert ("(16 esquinas son demasiadas" in head) == (max_corners == 8)   # 2^4 corners, over max_corners 8

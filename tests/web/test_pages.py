@@ -680,10 +680,10 @@ def test_the_plant_pages_tolerance_panel_shows_yield_histogram_and_the_part_to_t
 @pytest.mark.parametrize("lang", ["en", "es"])
 def test_the_plant_pages_tolerance_panel_names_its_figures_by_title_with_units_on_the_values(browser, server, lang):
     """Issue 29: the tolerance panel (limits, histogram, its table) shows each Monte Carlo figure by its title from
-    the library's table (designer.tolerance.titles), in the page's language, the unit on the values: no figure id
+    the library's table (designer.core.figure_titles), in the page's language, the unit on the values: no figure id
     (a word ending in _hz, _pct...) anywhere in it."""
     from designer.core.i18n import catalogue
-    from designer.tolerance.titles import FIGURE_TITLES
+    from designer.core.figure_titles import FIGURE_TITLES
     context = browser.new_context(viewport={"width": 1400, "height": 1400}, locale="en-US")
     pg = context.new_page()
     try:
@@ -1158,8 +1158,8 @@ def test_the_spanish_check_page_sends_its_language_and_its_golden_lines_name_no_
 def test_the_spanish_check_page_runs_the_repositorys_specs_with_no_english_in_its_table(page, server, tmp_path):
     """Issue 29: the repository's specs/ folder (and the reports/ file its PID spec names) run on the Spanish
     Check page: the result table (each check's detail: the value against its limits, the design's own checks,
-    SPICE's agreement, the tolerance band, the golden comparison) and each spec's line hold no English word of
-    the catalogue."""
+    SPICE's agreement, the tolerance band, the golden comparison), each spec's line and the Markdown summary's
+    own words (its headings, totals and table header) hold no English word of the catalogue."""
     from helpers import ROOT
     assert run_the_repositorys_specs(page, server, tmp_path, "/check?lang=es") == "done"
     cells = page.locator("#cases-table td").all_inner_texts()
@@ -1167,4 +1167,10 @@ def test_the_spanish_check_page_runs_the_repositorys_specs_with_no_english_in_it
     assert len(cells) > 50 and len(lines) == len(list((ROOT / "specs").glob("*.yaml")))
     english, _spanish = vocabulary()
     left = foreign(cells + lines, english)
+    assert not left, "\n".join(f"{words}: {text!r}" for text, words in left)
+    # the Markdown summary the page offers: its headings, totals line and table header in Spanish too
+    summary = page.inner_text("#summary").splitlines()
+    own = [line for line in summary if line.startswith("#")] + [summary[2], summary[4]]
+    assert summary[0].startswith("## check-design: ") and summary[4].startswith("| ")
+    left = foreign([line.replace("check-design", "") for line in own], english)
     assert not left, "\n".join(f"{words}: {text!r}" for text, words in left)

@@ -3,14 +3,18 @@ figures shown by title, not by id): the one table of every engine's figure ids (
 :data:`.spice_engine.FIGURES`, :data:`.loop.FIGURES`, :data:`.spice_loop.FIGURES`, :data:`.filter.LOWHIGH_FIGURES`,
 :data:`.filter.BANDPASS_FIGURES`) -> a title and the unit its values carry, marked for translation. The ids stay
 what ``--limit`` takes and what the JSON keys say; only the pages show these titles. The units are those the
-ids' suffixes name (:func:`designer.core.units.figure_unit`)."""
+ids' suffixes name (:func:`designer.core.units.figure_unit`).
+
+The table lives in ``core`` (not beside the engines in ``tolerance``) because every layer that shows a figure
+reads it: the web page's panels, and the build sheets' tolerance sections and histograms
+(:mod:`designer.report.tolerance`), which may import nothing above ``core``."""
 
 from __future__ import annotations
 
-from ..core.i18n import N_
-from ..core.i18n import gettext as _
+from .i18n import N_
+from .i18n import gettext as _
 
-__all__ = ["FIGURE_TITLES", "PREFIX_TITLES", "figure_shown"]
+__all__ = ["FIGURE_TITLES", "PREFIX_TITLES", "figure_label", "figure_shown"]
 
 #: figure id (without an engine's prefix) -> (title, unit of its values)
 FIGURE_TITLES = {
@@ -69,3 +73,21 @@ def figure_shown(name: str) -> tuple:
     if title is None:
         return name, ""
     return (_(PREFIX_TITLES[prefix]).format(figure=_(title)) if prefix else _(title)), unit
+
+
+def figure_label(name: str) -> str:
+    """A Monte Carlo figure's title with its unit in brackets, as an axis or a table names it
+    (``natural frequency fn (Hz)``; ``damping ratio zeta`` without a unit), in the current language.
+
+    Parameters
+    ----------
+    name : str
+        The figure's id.
+
+    Returns
+    -------
+    str
+        The label.
+    """
+    title, unit = figure_shown(name)
+    return f"{title} ({unit})" if unit else title

@@ -6,7 +6,8 @@ import pytest
 from designer.core.i18n import catalogue, language
 from designer.core.units import figure_unit
 from designer.tolerance import filter as filter_tolerance
-from designer.tolerance import loop, plant, spice_ac, spice_engine, spice_loop, titles
+from designer.core import figure_titles as titles
+from designer.tolerance import loop, plant, spice_ac, spice_engine, spice_loop
 
 
 def every_figure() -> set:
