@@ -8,7 +8,7 @@ plant comes from, validated once), :mod:`.plant` (the plant resolved), :mod:`.tu
 (the reaction curve and the FOPDT each of its rules takes), :mod:`.rules` (every
 rule, on any model), :mod:`.blocks` (topology, formulas, static
 checks), :mod:`.selection` (joint E-series part selection), :mod:`.model`
-(realised controller and closed loop), :mod:`.optimize`
+(realised controller and closed loop), :mod:`.sensitivity` (the loop's sensitivity peak Ms), :mod:`.optimize`
 (gains within the op-amps' limits), :mod:`.netlist` (closed-loop deck),
 :mod:`.verify` (SPICE run and failure detection), :mod:`.design`
 (orchestration), :mod:`.result` (the typed result and its JSON),
@@ -47,6 +47,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "rules": ("GIVEN", "HALF_RULE", "REACTION_CURVE_RULES", "RuleTuning", "TANGENT", "TANGENT_T63", "applicable",
               "parallel_to_series", "series_to_parallel", "tune_model"),
     "schematic": ("PLANT_BLOCK", "draw_loop", "draw_model_loop"),
+    "sensitivity": ("sensitivity_peak",),
     "selection": ("R_CORNER_MAX", "brute_force", "objective", "select_parts"),
     "spec": ("CONTROLLER_FIELDS", "PLAIN_PARAMS", "PidSpec", "analyzed_name", "controller_as_built",
              "controller_from_json", "default_name", "pid_spec"),

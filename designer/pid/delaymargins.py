@@ -18,7 +18,8 @@ the controller is ``(num, den)``: C(s) = Nc(s)/Dc(s), with any extra factors
   the loop's corners, widened until every gain crossover is inside.
 * :func:`loop_margins`: gain crossovers |L| = 1 (PM = 180 + arg L, the smallest
   reported), phase crossovers arg L = -180 - 360 k (GM = -20 log10 |L|), the delay
-  margin PM/wc (the extra dead time the loop tolerates), Ms = max |1/(1 + L)|;
+  margin PM/wc (the extra dead time the loop tolerates), Ms = max |1/(1 + L)|
+  (:func:`designer.pid.sensitivity.sensitivity_peak`);
   crossings found on a dense grid, refined with brentq (:class:`DelayLoopMargins`).
 * :func:`closed_loop_rhp_roots`: closed-loop roots with Re s > 0 by the argument
   principle on the characteristic quasi-polynomial
@@ -40,6 +41,7 @@ import numpy as np
 from ..core.errors import DesignError
 from ..core.jsonio import json_safe
 from .model import trim_leading
+from .sensitivity import sensitivity_peak
 
 __all__ = ["loop_margins", "loop_response"]
 
@@ -389,21 +391,6 @@ class DelayLoopMargins:
         return json_safe(asdict(self))
 
 
-def _sensitivity_peak(lp: LoopParts, w):
-    """(Ms, w at the peak): the grid's largest |1/(1 + L)|, refined between its
-    neighbours by a bounded scalar search."""
-    from scipy.optimize import minimize_scalar
-    with np.errstate(divide="ignore"):
-        s = 1 / np.abs(1 + _response(lp, w))
-    i = int(np.argmax(s))
-    if not math.isfinite(s[i]) or i == 0 or i == w.size - 1:
-        return float(s[i]), float(w[i])
-    neg = lambda x: -1 / abs(1 + _response(lp, np.array([x]))[0])  # noqa: E731
-    res = minimize_scalar(neg, bounds=(w[i - 1], w[i + 1]), method="bounded",
-                          options={"xatol": 1e-12 * w[i + 1]})
-    return (-float(res.fun), float(res.x)) if -res.fun >= s[i] else (float(s[i]), float(w[i]))
-
-
 def loop_margins(plant, controller, w_min: float | None = None, w_max: float | None = None) -> DelayLoopMargins:
     """Margins, sensitivity peak and closed-loop stability of C(s) P(s) e^(-theta s).
 
@@ -455,7 +442,7 @@ def loop_margins(plant, controller, w_min: float | None = None, w_max: float | N
         pm, dm, crossover_hz, phase_margin = np.array([]), math.inf, math.nan, math.inf
     wp = _phase_crossovers(lp, w[w <= lin_top] if lp.theta > 0 else w)
     gms = -20 * np.log10(np.abs(_response(lp, wp))) if wp.size else np.array([])
-    ms, w_ms = _sensitivity_peak(lp, w)
+    ms, w_ms = sensitivity_peak(w, _response(lp, w), lambda x: _response(lp, x))
     return DelayLoopMargins(
         crossover_hz=crossover_hz, phase_margin_deg=phase_margin,
         crossovers_hz=tuple(float(x) for x in wc / (2 * math.pi)), phase_margins_deg=tuple(float(x) for x in pm),

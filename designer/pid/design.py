@@ -447,7 +447,8 @@ def _analyse(spec, plant, amp, tun, parts, ps, simulate=True) -> _Loop:
     f_hi = max(amp.gbw_hz if not amp.ideal else 0.0, 100 * plant.fn_hz)
     w = 2 * np.pi * np.logspace(np.log10(f_lo), np.log10(f_hi), 4000)
     gain = M.loop_gain(parts, amp, pn, pd, w)
-    mg = M.margins(w, gain)
+    # Ms refined on the loop's own transfer function (op-amp poles included, as the margins)
+    mg = M.margins(w, gain, lambda x: M.loop_gain(parts, amp, pn, pd, x))
     # the loop's fastest time scale (plant or crossover) bounds the simulation step, so that a
     # slow --square-freq cannot hide the response between time steps (as for the plant)
     f_fast = max(plant.fn_hz, mg.crossover_hz if math.isfinite(mg.crossover_hz) else 0.0)

@@ -27,6 +27,7 @@ import numpy as np
 from ..core.errors import DesignError
 from ..core.opamps import OpAmp
 from .blocks import PidParts
+from .sensitivity import sensitivity_peak
 
 __all__ = ["SLEW_DELAY_FRACTION", "assemble", "controller_tf", "dc_gain", "ideal_loop", "inverting_stage",
            "loop_gain", "margins", "reference", "slew_delay", "waveform_limits"]
@@ -400,15 +401,20 @@ class Margins:
     crossover_hz: float
     gain_margin_db: float
     phase_crossover_hz: float
+    ms: float = math.nan          #: the sensitivity peak max |1/(1 + L(jw))| (:mod:`designer.pid.sensitivity`)
+    ms_hz: float = math.nan       #: where it peaks
 
     def to_dict(self) -> dict:
+        # Ms stays out of the result's JSON: design-pid's reports/ references keep their bytes (the web page
+        # takes Ms from its own part of the answer, designer.web.jobs.pid_page)
         return {"phase_margin_deg": self.phase_margin_deg, "crossover_hz": self.crossover_hz,
                 "gain_margin_db": self.gain_margin_db, "phase_crossover_hz": self.phase_crossover_hz}
 
 
-def margins(w, L) -> Margins:
+def margins(w, L, loop=None) -> Margins:
     """Phase margin (deg) at every gain crossover (the smallest is reported),
-    gain margin (dB) at the first -180 deg crossing, from samples of L(jw).
+    gain margin (dB) at the first -180 deg crossing, from samples of L(jw); the
+    sensitivity peak Ms (:func:`designer.pid.sensitivity.sensitivity_peak`).
 
     Parameters
     ----------
@@ -416,6 +422,9 @@ def margins(w, L) -> Margins:
         Angular frequencies (rad/s), ascending.
     L : array_like
         The loop gain at ``w``.
+    loop : callable, optional
+        ``loop(w)`` -> L(jw): the loop's transfer function, which refines Ms
+        between the grid's points (without it, the grid's largest 1/|1 + L|).
 
     Returns
     -------
@@ -443,8 +452,9 @@ def margins(w, L) -> Margins:
         if mg > 0:
             gm, w180 = -20 * math.log10(mg), w[i] + f * (w[i + 1] - w[i])
             break
+    ms, w_ms = sensitivity_peak(w, L, loop)
     return Margins(pm, wc / (2 * math.pi) if math.isfinite(wc) else math.nan,
-                   gm, w180 / (2 * math.pi) if math.isfinite(w180) else math.nan)
+                   gm, w180 / (2 * math.pi) if math.isfinite(w180) else math.nan, ms, w_ms / (2 * math.pi))
 
 
 def ideal_pid_tf(kp: float, ti: float, td: float):

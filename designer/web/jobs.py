@@ -863,8 +863,10 @@ def bom_shown(bom) -> dict:
 
 def pid_page(result) -> dict:
     """A loop's page: the closed-loop step (SPICE, the analytic loop, the ideal
-    PID, the plant alone), the loop gain, the schematic and the build sheet
-    without its pictures (verdict, BOM, settings, wiring, block checks).
+    PID, the plant alone), the loop gain, the sensitivity peak Ms and its
+    frequency (for either plant kind: the Sallen-Key plant's result JSON leaves
+    them out, :class:`designer.pid.model.Margins`), the schematic and the build
+    sheet without its pictures (verdict, BOM, settings, wiring, block checks).
 
     Parameters
     ----------
@@ -889,6 +891,7 @@ def pid_page(result) -> dict:
         curves["plant alone (open loop)"] = w.open_loop
     return {"closed_loop": _trace(w.t, curves, "time from the edge (s)"),
             "loop_gain": _bode(np.asarray(w.bode_w) / (2 * math.pi), {"loop gain L(jw)": w.loop_gain}),
+            "sensitivity": json_safe({"ms": result.margins.ms, "ms_hz": result.margins.ms_hz}),
             "schematic_svg": _schematic_svg(rep, result, None),
             "sheet_html": to_html(rep.title_of(result), rep.sections(result, with_images=False), {}),
             "histograms": histograms(getattr(result, "monte_carlo", None)),

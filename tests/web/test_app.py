@@ -1279,3 +1279,23 @@ def test_check_golden_lines_name_the_pages_switch_not_the_command_lines(server, 
     result = json.loads((tmp_path / "out" / "rc_ladder" / "result.json").read_text())
     assert [c["message"] for c in result["corners"][0]["cases"] if c["id"] == "golden_out"] == \
         ["golden_out: recorded in rc_ladder.csv (--update-golden)"]
+
+
+def test_the_pid_pages_answer_carries_ms_for_both_plant_kinds(server):
+    """Issue 29: the PID page's answer carries the loop's sensitivity peak for the Sallen-Key plant too: the
+    library's (designer.pid.sensitivity, on the loop as built), in the page's part of the answer; the result's
+    JSON keeps design-pid --json's keys (no ms for that plant); a model plant's is the one its margins report."""
+    from designer.pid.design import design_pid
+    from designer.pid.spec import PidSpec
+    body = {"plant-fc": 3500, "plant-zeta": 0.2, "opamp": "LM741", "tuning": "optimize", "target-overshoot": 10,
+            "no-sim": True}
+    status, got = server.post_json("/api/pid?view=page", body)
+    assert status == 200, got
+    mg = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2, opamp="LM741", tuning="optimize",
+                            target_overshoot_pct=10), simulate=False).margins
+    assert got["page"]["sensitivity"] == {"ms": mg.ms, "ms_hz": mg.ms_hz}
+    assert "ms" not in got["result"]["closed_loop"]["margins"]
+    status, got = server.post_json("/api/pid?view=page", {"plant-tf": "K=1 tau=100u theta=20u", "tuning": "imc",
+                                                          "no-sim": True})
+    m = got["result"]["closed_loop"]["margins"]
+    assert status == 200 and got["page"]["sensitivity"] == {"ms": m["ms"], "ms_hz": m["ms_hz"]}

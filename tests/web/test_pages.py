@@ -443,10 +443,41 @@ def test_a_model_plants_pid_shows_its_ms_and_its_hint_names_no_command(page, ser
     assert status == 200 and figure(page, "Ms (max sensitivity)") == page.evaluate("v => D.num(v, 3)", ms)
     hint = page.locator("input[name=plant-tf]").locator("xpath=..").inner_text()
     assert "--" not in hint and "K=2 tau=1m theta=200u" in hint
-    # the seed's Sallen-Key plant: its margins have no Ms, and no empty figure stands for it
+    # the sensitivity peak marked on both loop-gain plots, as the Sallen-Key plant's (below)
+    for plot in ("#lg-gain", "#lg-phase"):
+        assert f"max sensitivity: Ms {page.evaluate('v => D.num(v, 3)', ms)}" in page.get_attribute(plot, "data-marks")
+    # the seed's Sallen-Key plant shows its Ms too (test_the_pid_pages_opening_design_shows_ms_and_marks_it)
     assert after(page, lambda: page.select_option("select[name=tuning]", "optimize"), timeout=120000) == "done"
     assert after(page, lambda: page.check("input[name=plant][value=design]"), timeout=120000) == "done"
-    assert page.locator(".figure", has_text="Ms (max sensitivity)").count() == 0
+    assert page.locator(".figure", has_text="Ms (max sensitivity)").count() == 1
+
+
+@pytest.mark.parametrize("lang", ["en", "es"])
+def test_the_pid_pages_opening_design_shows_ms_and_marks_it(browser, server, lang):
+    """Issue 29: the Sallen-Key plant's PID (the page's opening design) shows Ms among its figures, the library's
+    (the API's answer for the same design), and marks the crossover with its phase margin, the -180 deg crossing
+    with its gain margin and the sensitivity peak on both loop-gain plots, in English and in Spanish."""
+    from designer.core.i18n import catalogue
+    es = catalogue("es")
+    word = (lambda text: es[text]) if lang == "es" else (lambda text: text)
+    context = browser.new_context(viewport={"width": 1400, "height": 1400}, locale="en-US")
+    pg = context.new_page()
+    try:
+        open_page(pg, server, f"/pid?lang={lang}")
+        assert pg.evaluate("document.body.dataset.state") == "done", pg.inner_text(".form-foot")
+        status, want = server.post_json("/api/pid?view=page", {"plant-fc": 3500, "plant-zeta": 0.2,
+                                                               "tuning": "optimize", "target-overshoot": 10})
+        assert status == 200
+        sens, m = want["page"]["sensitivity"], want["result"]["closed_loop"]["margins"]
+        num = lambda v: pg.evaluate("v => D.num(v, 3)", v)  # noqa: E731
+        assert figure(pg, word("Ms (max sensitivity)")) == num(sens["ms"])
+        for plot in ("#lg-gain", "#lg-phase"):
+            marks = pg.get_attribute(plot, "data-marks").split("|")
+            assert marks == [word("crossover: PM {pm} deg").replace("{pm}", num(m["phase_margin_deg"])),
+                             word("-180 deg: GM {gm} dB").replace("{gm}", num(m["gain_margin_db"])),
+                             word("max sensitivity: Ms {ms}").replace("{ms}", num(sens["ms"]))], marks
+    finally:
+        context.close()
 
 
 @pytest.mark.parametrize("path", ["/plant", "/pid", "/filter", "/identify", "/check"])

@@ -614,8 +614,10 @@ D.schematic = function (el, svg, what) {
   };
 };
 
-// Vertical marks on a plot ({x, label}: the crossover, the phase-crossover), drawn over the traces with their
-// label at the top; one off the axis's range is left out (zoomed away).
+// Vertical marks on a plot ({x, label}: the crossover, the phase-crossover, the sensitivity peak), drawn over the
+// traces with their label at the top, each label a line lower than the one before (marks a few percent apart in
+// frequency, as a loop's crossover and its sensitivity peak often are, would print over each other); one off the
+// axis's range is left out (zoomed away).
 D.drawMarks = function (u, marks) {
   const ctx = u.ctx, top = u.bbox.top, bottom = u.bbox.top + u.bbox.height;
   ctx.save();
@@ -625,11 +627,12 @@ D.drawMarks = function (u, marks) {
   ctx.textBaseline = "top";
   ctx.setLineDash([5 * devicePixelRatio, 4 * devicePixelRatio]);
   ctx.lineWidth = devicePixelRatio;
+  let row = 0;
   for (const m of marks) {
     if (!isFinite(m.x) || m.x < u.scales.x.min || m.x > u.scales.x.max) continue;
     const x = Math.round(u.valToPos(m.x, "x", true));
     ctx.beginPath(); ctx.moveTo(x, top); ctx.lineTo(x, bottom); ctx.stroke();
-    ctx.fillText(m.label, x + 4 * devicePixelRatio, top + 2 * devicePixelRatio);
+    ctx.fillText(m.label, x + 4 * devicePixelRatio, top + (2 + 14 * row++) * devicePixelRatio);
   }
   ctx.restore();
 };

@@ -39,6 +39,9 @@ function show(answer) {
   const cl = r.closed_loop || {};
   const a = cl.spice || cl.analytic || {};
   const m = cl.margins || {};
+  // the peak sensitivity, for either plant kind: the page's part of the answer has it (the Sallen-Key plant's
+  // result JSON leaves it out, so that design-pid's reference outputs keep their bytes)
+  const sens = p.sensitivity || {};
   const failed = (r.checks || []).filter(c => !c.ok);
   document.getElementById("figures").replaceChildren(
     D.fig(D.t("method"), r.method || t.method || ""),
@@ -48,8 +51,7 @@ function show(answer) {
     D.fig(D.t("phase margin"), m.phase_margin_deg === undefined || m.phase_margin_deg === null ? D.t("n/a") : `${D.num(m.phase_margin_deg, 3)} deg`),
     D.fig(D.t("gain margin"), m.gain_margin_db === undefined || m.gain_margin_db === null ? D.t("n/a") : `${D.num(m.gain_margin_db, 3)} dB`),
     D.fig(D.t("crossover"), D.eng(m.crossover_hz, "Hz", 4)),
-    // the peak sensitivity: the library gives it for a model plant (the Sallen-Key plant's margins have none)
-    ...(m.ms === undefined || m.ms === null ? [] : [D.fig(D.t("Ms (max sensitivity)"), D.num(m.ms, 3))]),
+    D.fig(D.t("Ms (max sensitivity)"), D.num(sens.ms, 3)),
     D.fig(D.t("checks failed"), String(failed.length)));
   // the failing checks by their titles, first thing under the heading (the sheet below has their details)
   const f = document.getElementById("failed");
@@ -61,10 +63,12 @@ function show(answer) {
     f.append(line);
   }
   D.plot(document.getElementById("closed"), p.closed_loop, {xUnit: "s", yLabel: D.t("output (V)")});
-  // the margins where they are read: the gain crossover (phase margin) and the phase crossover (gain margin)
+  // the margins where they are read: the gain crossover (phase margin), the phase crossover (gain margin) and
+  // the sensitivity peak (Ms), the same three for either plant kind
   const marks = [];
   if (isFinite(m.crossover_hz)) marks.push({x: m.crossover_hz, label: D.t("crossover: PM {pm} deg", {pm: D.num(m.phase_margin_deg, 3)})});
   if (isFinite(m.phase_crossover_hz)) marks.push({x: m.phase_crossover_hz, label: D.t("-180 deg: GM {gm} dB", {gm: D.num(m.gain_margin_db, 3)})});
+  if (sens.ms_hz !== undefined && sens.ms_hz !== null && isFinite(sens.ms_hz)) marks.push({x: sens.ms_hz, label: D.t("max sensitivity: Ms {ms}", {ms: D.num(sens.ms, 3)})});
   D.plot(document.getElementById("lg-gain"), p.loop_gain.gain, {xUnit: "Hz", yLabel: D.t("gain (dB)"), height: 220, marks});
   D.plot(document.getElementById("lg-phase"), p.loop_gain.phase, {xUnit: "Hz", yLabel: D.t("phase (deg)"), height: 180, marks});
   D.schematic(document.getElementById("schematic"), p.schematic_svg, D.t("schematic of the loop: {title}", {title: p.title}));
