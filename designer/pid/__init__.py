@@ -21,8 +21,9 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    "plant": ("PLANT_PREFIX", "Plant", "PlantCircuit", "circuit_from_cascade", "circuit_from_json", "circuit_plant",
-              "parse_part_values", "part_items", "resolve_plant", "sallen_key_circuit", "sallen_key_parts"),
+    "plant": ("LoopNames", "PLANT_PREFIX", "Plant", "PlantCircuit", "circuit_from_cascade", "circuit_from_json", "circuit_plant",
+              "parse_part_values", "part_items", "resolve_plant", "SEED_LOOP_NAMES",
+              "sallen_key_circuit", "sallen_key_parts"),
     "modelloop": ("FAR_FACTOR", "LEAK_LOOP_GAIN", "TABLE_STEP_FRACTION", "limits", "loop_figures", "size"),
     "loopchecks": ("MAX_STEADY_STATE_ERROR", "designators", "kick_note", "named", "spice_notes", "stage_checks",
                    "steady_state_check"),
@@ -34,7 +35,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                "plant_of", "response_grid", "run_spice", "simulation_controller", "stage_waves"),
     "model": ("SLEW_DELAY_FRACTION", "assemble", "controller_tf", "dc_gain", "ideal_loop", "inverting_stage",
               "loop_gain", "margins", "reference", "slew_delay", "waveform_limits"),
-    "netlist": ("closed_loop_deck", "controller_netlist", "loop_netlist", "model_loop_deck", "plant_ref_prefix"),
+    "netlist": ("closed_loop_deck", "controller_netlist", "loop_netlist", "model_loop_deck", "plant_circuit",
+                "plant_ref_prefix"),
     "optimize": ("Context", "KICK_POINTS", "ModelOptimizeResult", "SEARCH_POINTS", "SEARCH_STEP_FRACTION", "evaluate",
                  "optimize_model_loop", "slew_delay_stages"),
     "plant_spec": ("PLANT_FIELDS", "PlantSource", "filter_plant_from_json", "plant_from_json", "voltage_range"),

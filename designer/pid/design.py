@@ -71,7 +71,7 @@ from .loopchecks import designators, named, spice_notes, stage_checks, steady_st
 from .modelloop import (FAR_FACTOR, LEAK_LOOP_GAIN, TABLE_STEP_FRACTION, built_controller,  # noqa: F401
                         corner_frequencies, edged, ideal_crossover_hz, leak_limit_hz, limits, loop_dc_gain,
                         loop_figures, plant_of, response_grid, simulation_controller, size, stage_waves)
-from .netlist import circuit_loop_deck, circuit_loop_netlist, closed_loop_deck, controller_netlist, model_loop_deck
+from .netlist import closed_loop_deck, controller_netlist, loop_netlist, model_loop_deck
 from .process_notes import opamp_speed_notes, sizing_notes
 from .result import Achieved, AnalyticLoop, PidResult, RobustCheck, RuleRow, Waveforms
 from .spec import PidSpec
@@ -841,7 +841,7 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _ModelLoop:
 
 def loop_netlist_of(spec: PidSpec, parts):
     """The loop's part and net table as built: the controller alone around a
-    model plant, or with the plant's own circuit (:func:`~designer.pid.netlist.circuit_loop_netlist`).
+    model plant, or with the plant's own circuit (:func:`~designer.pid.netlist.loop_netlist`).
 
     Parameters
     ----------
@@ -856,14 +856,14 @@ def loop_netlist_of(spec: PidSpec, parts):
         The table the board, the BOM and the schematic are written from.
     """
     if spec.plant.circuit is not None:
-        return circuit_loop_netlist(parts, spec.plant.circuit)
+        return loop_netlist(parts, spec.plant.circuit)
     return controller_netlist(parts)
 
 
 def loop_deck(spec: PidSpec, parts, model, amp, test, title: str, expected: float) -> str:
     """The loop's deck: the model as native elements
     (:func:`~designer.pid.netlist.model_loop_deck`), or the plant's circuit
-    (:func:`~designer.pid.netlist.circuit_loop_deck`).
+    (:func:`~designer.pid.netlist.closed_loop_deck`).
 
     Parameters
     ----------
@@ -886,7 +886,7 @@ def loop_deck(spec: PidSpec, parts, model, amp, test, title: str, expected: floa
         The deck.
     """
     if spec.plant.circuit is not None:
-        return circuit_loop_deck(parts, spec.plant.circuit, amp, test, title, expected)
+        return closed_loop_deck(parts, spec.plant.circuit, amp, test, title, expected)
     return model_loop_deck(parts, model, amp, test, title, expected)
 
 

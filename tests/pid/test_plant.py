@@ -18,7 +18,7 @@ from designer.core.errors import DesignError
 from designer.filters.registry import REGISTRY, get
 from designer.pid import report as P
 from designer.pid.design import design_pid
-from designer.pid.netlist import circuit_loop_netlist, controller_netlist
+from designer.pid.netlist import controller_netlist, loop_netlist
 from designer.pid.plant import (PLANT_PREFIX, Plant, circuit_from_cascade, circuit_plant, parse_part_values,
                                 resolve_plant)
 from designer.pid.result import PidResult
@@ -86,7 +86,7 @@ def test_every_plant_source_resolves_to_one_type():
 def test_designators_do_not_collide_with_the_controller_or_the_decoupling():
     spec = PidSpec(**CIRCUITS["cascade"])
     res = design_pid(spec, simulate=False)
-    net = circuit_loop_netlist(res.parts, spec.circuit)
+    net = loop_netlist(res.parts, spec.circuit)
     refs = [p.ref for p in net.parts] + [a.ref for a in net.amps]
     assert len(refs) == len(set(refs))
     board = P.build_board(res)
