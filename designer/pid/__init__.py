@@ -30,7 +30,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "blocks": ("PidParts", "THESIS_BENCH", "continuous_parts", "seed_bench_parts", "seed_parts", "static_checks"),
     "delayloop": ("MAX_STEPS", "STEP_BUDGET", "closed_loop_step", "parse_loop", "pid_tf", "step_figures"),
     "delaymargins": ("loop_margins", "loop_response"),
-    "design": ("SEED_BENCH_PLANT", "analyse", "analyze_pid", "built_controller", "corner_frequencies",
+    "design": ("SEED_BENCH_PLANT", "analyse", "analyze_pid", "built_controller", "corner_frequencies", "ideal_pair",
                "design_model_pid", "design_pid", "edged", "ideal_crossover_hz", "leak_limit_hz", "loop_dc_gain",
                "plant_of", "response_grid", "run_spice", "simulation_controller", "stage_waves"),
     "model": ("SLEW_DELAY_FRACTION", "assemble", "controller_tf", "dc_gain", "ideal_loop", "inverting_stage",
