@@ -22,7 +22,7 @@ from .sallen_key_lowpass_synthesis import SallenKeyParts
 from .topology import Topology
 
 __all__ = ["FIELD_OF", "REF_OF", "section_of", "part_values", "refs", "gain_refs",
-           "parts_of", "gain_of", "network"]
+           "parts_of", "gain_of", "network", "record_of"]
 
 #: the plant record's field of each designator of the section (with gain)
 FIELD_OF = {"R1": "r1", "R2": "r2", "C1": "c1", "C2": "c2", "R3": "r3", "R4": "r4"}
@@ -156,3 +156,28 @@ def parts_of(values: dict, base=None, **other) -> SallenKeyParts:
     if base is not None:
         kw = {FIELD_OF[r]: getattr(base, FIELD_OF[r]) for r in gain_refs()} | kw
     return SallenKeyParts(**kw, **other)
+
+
+def record_of(topology, values: dict):
+    """The parts record of a Sallen-Key low-pass section with its values (its
+    gain K = 1 + R4/R3 from the gain pair, 1 for the follower), or None for any
+    other section: where the record's closed forms (seed 001, IV.3-IV.9) can
+    stand in for a section's nodal model.
+
+    Parameters
+    ----------
+    topology : Topology
+        A registered section.
+    values : dict
+        Its values by designator.
+
+    Returns
+    -------
+    SallenKeyParts or None
+        The record, or None when ``topology`` is not the Sallen-Key low-pass.
+    """
+    if topology.name not in _NAMES:
+        return None
+    with_gain = "R3" in topology.designators
+    gain = 1.0 + values["R4"] / values["R3"] if with_gain else 1.0
+    return parts_of(values, gain=gain)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from ..core.errors import DesignError
 from ..core.fileio import shown
 from ..core.jsonio import json_safe, read_result
-from ..plant.sallenkey import NETWORK_KEYS, SallenKeyParts, fn_zeta
+from ..plant.sallenkey import NETWORK_KEYS, fn_zeta
 
 __all__ = ["agreement_band", "compare_with_design", "load_design", "model_fn_zeta", "overshoot_from_zeta"]
 
@@ -130,12 +130,12 @@ def agreement_band(built: dict, gain: float = 1.0, r_tol: float = DEFAULT_R_TOL,
         g_lo = 1 + ratio * (1 - r_tol) / (1 + r_tol)
         g_hi = 1 + ratio * (1 + r_tol) / (1 - r_tol)
     if all(isinstance(built.get(k), (int, float)) for k in PART_KEYS):
-        nominal = SallenKeyParts(*(float(built[k]) for k in PART_KEYS))
+        r1, r2, c1, c2 = (float(built[k]) for k in PART_KEYS)   # the network in fn_zeta's order
         fns, zetas = [], []
         for s in itertools.product((-1, 1), repeat=4):
             for k in ((g_lo, g_hi) if gain != 1.0 else (gain,)):
-                fn, z = fn_zeta(nominal.r1 * (1 + s[0] * r_tol), nominal.r2 * (1 + s[1] * r_tol),
-                                nominal.c1 * (1 + s[2] * c_tol), nominal.c2 * (1 + s[3] * c_tol), k)
+                fn, z = fn_zeta(r1 * (1 + s[0] * r_tol), r2 * (1 + s[1] * r_tol),
+                                c1 * (1 + s[2] * c_tol), c2 * (1 + s[3] * c_tol), k)
                 fns.append(float(fn))
                 zetas.append(float(z))
         basis = "corners of the built parts"

@@ -71,13 +71,13 @@ from .loopchecks import designators, named, spice_notes, stage_checks, steady_st
 from .modelloop import (FAR_FACTOR, LEAK_LOOP_GAIN, TABLE_STEP_FRACTION, built_controller,  # noqa: F401
                         corner_frequencies, edged, ideal_crossover_hz, leak_limit_hz, limits, loop_dc_gain,
                         loop_figures, plant_of, response_grid, simulation_controller, size, stage_waves)
-from .netlist import circuit_loop_deck, circuit_loop_netlist, closed_loop_deck, controller_netlist, model_loop_deck
+from .netlist import closed_loop_deck, controller_netlist, loop_netlist, model_loop_deck
 from .process_notes import opamp_speed_notes, sizing_notes
 from .result import Achieved, AnalyticLoop, PidResult, RobustCheck, RuleRow, Waveforms
 from .spec import PidSpec
 from .verify import explain, loop_metrics, run_and_compare
 
-__all__ = ["PidSpec", "SEED_BENCH_PLANT", "analyse", "analyze_pid", "built_controller", "closed_loop_step",
+__all__ = ["PidSpec", "SEED_BENCH_PLANT", "analyse", "analyze_pid", "built_controller", "closed_loop_step", "ideal_pair",
            "corner_frequencies", "design_model_pid", "design_pid", "edged", "ideal_crossover_hz", "leak_limit_hz",
            "loop_dc_gain", "plant_of", "response_grid", "run_spice", "simulation_controller", "stage_waves"]
 
@@ -97,9 +97,72 @@ def resolve_plant(spec: PidSpec):
     return sallen_key_parts(spec)
 
 
-def plant_model(parts: SallenKeyParts, amp: OpAmp):
-    """The plant's (num, den) as built, with its op-amp's finite gain-bandwidth unless ideal."""
-    return plant_tf(parts) if amp.ideal else plant_tf_opamp(parts, amp)
+def _sallen_key_record(circuit):
+    """The Sallen-Key parts record of a one-section circuit on that section, else None."""
+    from ..filters.sallen_key_lowpass_parts import record_of
+    if len(circuit.stages) != 1:
+        return None
+    st = circuit.stages[0]
+    return record_of(st.topology, st.values)
+
+
+def plant_model(plant, amp: OpAmp | None = None):
+    """The plant's (num, den) as built, with its op-amp's finite gain and
+    gain-bandwidth unless ideal, for any circuit plant: each section's nodal
+    model (:func:`designer.plant.circuit.opamp_tf`; ideal: its coefficients),
+    multiplied; on the Sallen-Key low-pass section its closed forms
+    (:func:`designer.plant.model.plant_tf_opamp`, seed 001 IV.3-IV.9), which
+    equal the nodal model to rounding and take a fraction of its time.
+
+    Parameters
+    ----------
+    plant : designer.pid.plant.Plant, designer.pid.plant.PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+        The plant (:func:`designer.pid.netlist.plant_circuit`).
+    amp : OpAmp, optional
+        The op-amp of its sections (None: ideal).
+
+    Returns
+    -------
+    tuple of ndarray
+        (num, den), highest power first.
+    """
+    from .netlist import plant_circuit
+    circuit = plant_circuit(plant)[0]
+    rec = _sallen_key_record(circuit)
+    ideal = amp is None or amp.ideal
+    if rec is not None:   # the closed forms: the fast path
+        return plant_tf(rec) if ideal else plant_tf_opamp(rec, amp)
+    if ideal:
+        return tuple(np.asarray(c, float) for c in circuit.coefficients())
+    from ..plant.circuit import opamp_tf
+    num, den = np.array([1.0]), np.array([1.0])
+    for st in circuit.stages:
+        n, d = opamp_tf(st.topology, st.values, amp)
+        num, den = np.polymul(num, np.trim_zeros(n, "f")), np.polymul(den, d)
+    return num, den
+
+
+def ideal_pair(plant) -> tuple:
+    """(fn in Hz, zeta) of the plant's ideal model: the Sallen-Key section's
+    closed forms (:func:`designer.plant.sallenkey.fn_zeta`), else the slowest
+    pole pair of its ideal denominator.
+
+    Parameters
+    ----------
+    plant : designer.pid.plant.Plant, designer.pid.plant.PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+        The plant.
+
+    Returns
+    -------
+    tuple of float
+        (fn_hz, zeta).
+    """
+    from .netlist import plant_circuit
+    circuit = plant_circuit(plant)[0]
+    rec = _sallen_key_record(circuit)
+    if rec is not None:
+        return rec.fn_hz, rec.zeta
+    return dominant_pair(np.asarray(circuit.coefficients()[1], float))
 
 
 @dataclass(frozen=True)
@@ -116,10 +179,26 @@ class PlantStep:
     curve: tuning.ReactionCurve
 
 
-def plant_step(plant: SallenKeyParts, amp: OpAmp) -> PlantStep:
+def plant_step(plant, amp: OpAmp) -> PlantStep:
+    """The plant as built with its op-amp (:func:`plant_model`), its dominant
+    pair and its step on a grid long enough to settle, with the reaction curve
+    the rules take (:func:`designer.pid.tuning.model_reaction_curve`).
+
+    Parameters
+    ----------
+    plant : designer.pid.plant.Plant, designer.pid.plant.PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+        Any circuit plant.
+    amp : OpAmp
+        The op-amp of its sections.
+
+    Returns
+    -------
+    PlantStep
+    """
     pn, pd = plant_model(plant, amp)
     fn_o, z_o = dominant_pair(pd)
-    span = response_span(min(plant.fn_hz, fn_o), min(plant.zeta, z_o))
+    fn, zeta = ideal_pair(plant)
+    span = response_span(min(fn, fn_o), min(zeta, z_o))
     # the plant as built's step (an LTI step: the closed form) on a dense grid, for the fit and the plot;
     # the tangent from its exact step, as the rules take it on every model (designer.pid.rules)
     t = np.linspace(0.0, span, 20001)
@@ -463,7 +542,7 @@ def _analyse(spec, plant, amp, tun, parts, ps, simulate=True) -> _Loop:
     r = M.reference(t, spec.step_v, 0.0, spec.edge_s)
     rails = 2 * max(abs(amp.vcc), abs(amp.vee))
     waves = lm.simulate(t, r) if stable else _diverging(lm, t, r, rails)
-    il = M.ideal_loop(tun.kp, tun.ti_s, tun.td_s, *plant_tf(plant))
+    il = M.ideal_loop(tun.kp, tun.ti_s, tun.td_s, *plant_model(plant))
     y_ideal = (il.simulate(t, r) if il.stable() else _diverging(il, t, r, rails))["y"]
     # the plant alone, for the plot: the edged reference needs the state-space simulation
     y_open = M.state_space(pn, pd).simulate(t, r)["y"]
@@ -842,7 +921,7 @@ def analyse(spec, model, amp, parts, gains, fc, simulate) -> _ModelLoop:
 
 def loop_netlist_of(spec: PidSpec, parts):
     """The loop's part and net table as built: the controller alone around a
-    model plant, or with the plant's own circuit (:func:`~designer.pid.netlist.circuit_loop_netlist`).
+    model plant, or with the plant's own circuit (:func:`~designer.pid.netlist.loop_netlist`).
 
     Parameters
     ----------
@@ -857,14 +936,14 @@ def loop_netlist_of(spec: PidSpec, parts):
         The table the board, the BOM and the schematic are written from.
     """
     if spec.plant.circuit is not None:
-        return circuit_loop_netlist(parts, spec.plant.circuit)
+        return loop_netlist(parts, spec.plant.circuit)
     return controller_netlist(parts)
 
 
 def loop_deck(spec: PidSpec, parts, model, amp, test, title: str, expected: float) -> str:
     """The loop's deck: the model as native elements
     (:func:`~designer.pid.netlist.model_loop_deck`), or the plant's circuit
-    (:func:`~designer.pid.netlist.circuit_loop_deck`).
+    (:func:`~designer.pid.netlist.closed_loop_deck`).
 
     Parameters
     ----------
@@ -887,7 +966,7 @@ def loop_deck(spec: PidSpec, parts, model, amp, test, title: str, expected: floa
         The deck.
     """
     if spec.plant.circuit is not None:
-        return circuit_loop_deck(parts, spec.plant.circuit, amp, test, title, expected)
+        return closed_loop_deck(parts, spec.plant.circuit, amp, test, title, expected)
     return model_loop_deck(parts, model, amp, test, title, expected)
 
 

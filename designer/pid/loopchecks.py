@@ -37,8 +37,8 @@ def designators(parts, plant, amp, package, netlist=None) -> dict:
     ----------
     parts : designer.pid.blocks.PidParts
         The controller.
-    plant : designer.plant.sallenkey.SallenKeyParts or None
-        A Sallen-Key plant, or None.
+    plant : designer.pid.plant.Plant, designer.pid.plant.PlantCircuit, designer.plant.sallenkey.SallenKeyParts or None
+        A circuit plant (:func:`designer.pid.netlist.plant_circuit`), or None.
     amp : designer.core.opamps.OpAmp
         The op-amp (its packages).
     package : str or None

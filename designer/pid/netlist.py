@@ -6,12 +6,15 @@ circuit, the project's behavioural op-amp models (inlined from
 
 The table (:func:`loop_netlist`) is the one description of the circuit: the
 deck, the schematic (:mod:`designer.pid.schematic`), the wiring table and the
-bill of materials are all written from it. Designators are one scheme with the
-plant's sheet (:mod:`designer.plant.netlist`): the plant keeps its section's
-designators (R1, R2, C1, C2) and its op-amp U1, unless it has the gain pair,
-whose R3 and R4 the controller owns: then all its designators carry the
-section's chaining prefix ``P`` (:data:`designer.pid.plant.PLANT_PREFIX`,
-:func:`plant_ref_prefix`: RP1 .. RP4, as a circuit plant's); the controller has the seed's R3..R18, C3, C4 and the
+bill of materials are all written from it, by the same code for every circuit
+plant (:class:`designer.pid.plant.PlantCircuit`: its registered sections'
+netlists). A plant's designators are its sections' with the prefix ``P``
+(:data:`designer.pid.plant.PLANT_PREFIX`: RP1, UP; RPi1, UPi in a cascade);
+the seed's Sallen-Key plant keeps the names of its own sheet
+(:data:`designer.pid.plant.SEED_LOOP_NAMES`): its section's designators and
+the op-amp U1, unless it has the gain pair, whose R3 and R4 the controller
+owns: then its designators carry the prefix ``P`` (:func:`plant_ref_prefix`);
+the controller has the seed's R3..R18, C3, C4 and the
 op-amps U2 (difference), U3 (inverter), U4 (differentiator), U5 (integrator),
 U6 (summer) and U7 (final gain), one per package as the seed built it;
 :func:`designer.spice.deck.board` puts them in dual or quad packages.
@@ -27,13 +30,12 @@ from __future__ import annotations
 
 from ..core.i18n import N_
 from ..core.opamps import OpAmp
-from ..plant.netlist import plant_netlist
-from ..plant.sallenkey import SallenKeyParts
 from ..spice import deck
 from ..spice.deck import GROUND, Amp, Netlist, Part, SquareTest
 from .blocks import PidParts
 
-__all__ = ["closed_loop_deck", "controller_netlist", "loop_netlist", "model_loop_deck", "plant_ref_prefix"]
+__all__ = ["closed_loop_deck", "controller_netlist", "loop_netlist", "model_loop_deck", "plant_circuit",
+           "plant_ref_prefix"]
 
 #: signals whose extremes the deck measures (one per op-amp output)
 PROBES = ("ve", "vp", "vd", "vi", "vs", "u", "y")
@@ -91,58 +93,89 @@ def extreme_lines(parts: PidParts, test: SquareTest) -> list:
     return out
 
 
-def plant_ref_prefix(plant: SallenKeyParts) -> str:
-    """The designator prefix of the Sallen-Key plant in the loop: none for the
-    follower, :data:`~designer.pid.plant.PLANT_PREFIX` when its gain pair would take
-    the controller's R3 and R4.
+def plant_circuit(plant):
+    """The circuit a loop's plant is built as, and whether the controller's
+    action is reversed: a :class:`~designer.pid.plant.Plant` with its circuit,
+    a :class:`~designer.pid.plant.PlantCircuit`, or the Sallen-Key plant's
+    parts record (its registered section, named as the seed's sheets:
+    :func:`~designer.pid.plant.sallen_key_circuit`).
 
     Parameters
     ----------
-    plant : SallenKeyParts
-        The plant's parts.
+    plant : Plant, PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+        The plant.
+
+    Returns
+    -------
+    tuple
+        (:class:`~designer.pid.plant.PlantCircuit`, bool: the action reversed).
+    """
+    from .plant import Plant, PlantCircuit, sallen_key_circuit
+    if isinstance(plant, Plant):
+        return plant.circuit, plant.reversed_action
+    if isinstance(plant, PlantCircuit):
+        return plant, plant.inverting
+    return sallen_key_circuit(plant), False
+
+
+def plant_ref_prefix(plant) -> str:
+    """The designator prefix of a one-section plant in the loop: none for the
+    seed's Sallen-Key follower, :data:`~designer.pid.plant.PLANT_PREFIX` otherwise
+    (a Sallen-Key plant's gain pair would take the controller's R3 and R4).
+
+    Parameters
+    ----------
+    plant : Plant, PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+        The plant (:func:`plant_circuit`).
 
     Returns
     -------
     str
         The prefix its designators carry in the loop ("" for the follower).
     """
-    from .plant import PLANT_PREFIX
-    return "" if plant.r3 is None else PLANT_PREFIX
+    return plant_circuit(plant)[0].prefix(1)
 
 
-def loop_netlist(parts: PidParts, plant: SallenKeyParts) -> Netlist:
-    """The whole loop as one table: the plant (U1 and its parts) first, then the
-    controller's stages in signal order.
+def loop_netlist(parts: PidParts, plant) -> Netlist:
+    """The whole loop around a circuit plant as one table: the plant's sections
+    between ``u`` and ``y`` first (:meth:`~designer.pid.plant.PlantCircuit.netlist`:
+    its designators prefixed, or named as the seed's plant), then the
+    controller's stages in signal order, its action reversed for an inverting plant.
 
     Parameters
     ----------
     parts : PidParts
         The controller.
-    plant : SallenKeyParts
-        The plant.
+    plant : Plant, PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+        The plant (:func:`plant_circuit`).
 
     Returns
     -------
     Netlist
+        The loop's parts and op-amps, the plant's first.
     """
-    pl = plant_netlist(plant, "u", "y", prefix="p", amp_ref="U1", ref_prefix=plant_ref_prefix(plant))
-    ctl = controller_netlist(parts)
+    circuit, reversed_action = plant_circuit(plant)
+    pl = circuit.netlist("u", "y")
+    ctl = controller_netlist(parts, reversed_action)
     return Netlist(pl.parts + ctl.parts, pl.amps + ctl.amps)
 
 
-def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test: SquareTest,
+def closed_loop_deck(parts: PidParts, plant, opamp: OpAmp, test: SquareTest,
                      title: str, expected_final: float, points: int = 20000) -> str:
-    """The whole loop as a standalone deck; ``expected_final`` (V) is the settled
-    plant output the ``.meas`` levels refer to (the analytic closed loop's).
+    """The whole loop around a circuit plant as a standalone deck
+    (:func:`loop_netlist`: the plant's own sections and op-amps), with the
+    reference, ``.tran`` and ``.meas`` lines of every loop deck; ``expected_final``
+    (V) is the settled plant output the ``.meas`` levels refer to (the analytic
+    closed loop's).
 
     Parameters
     ----------
     parts : PidParts
         The controller.
-    plant : SallenKeyParts
-        The plant.
+    plant : Plant, PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+        The plant (:func:`plant_circuit`).
     opamp : OpAmp
-        The op-amp of every stage.
+        The op-amp of every stage (the plant's too).
     test : SquareTest
         The reference square wave.
     title : str
@@ -155,9 +188,20 @@ def closed_loop_deck(parts: PidParts, plant: SallenKeyParts, opamp: OpAmp, test:
     Returns
     -------
     str
+        The deck (runs alone with ``ngspice -b``).
     """
-    about = ["* plant (seed 001, Fig. 43-45): XU1 Sallen-Key; controller (Fig. 66): U2 difference (ve = y - r),",
-             "*   U3 inverter, U4 differentiator, U5 integrator, U6 summer, U7 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y)"]
+    c, reversed_action = plant_circuit(plant)
+    if c.names is not None:   # the seed's plant: the header its reference decks have always had
+        about = [f"* plant (seed 001, Fig. 43-45): X{c.names.amp_ref} Sallen-Key; controller (Fig. 66): "
+                 "U2 difference (ve = y - r),",
+                 "*   U3 inverter, U4 differentiator, U5 integrator, U6 summer, U7 gain -> "
+                 "u = Kp (1 + 1/(Ti s) + Td s) (r - y)"]
+    else:
+        stages = ", ".join(f"{st.topology.title} (U{c.prefix(i)})" for i, st in enumerate(c.stages, 1))
+        about = [f"* plant (a circuit, {c.topology}): {stages}; input u, output y",
+                 "* controller (seed 001, Fig. 66): U2 difference (ve = y - r"
+                 + (", r and y exchanged: the plant inverts" if reversed_action else "") + "), U3 inverter,",
+                 "*   U4 differentiator, U5 integrator, U6 summer, U7 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y)"]
     return _loop_deck(parts, opamp, test, title, expected_final, about, [], loop_netlist(parts, plant), points)
 
 
@@ -211,66 +255,6 @@ def controller_netlist(parts: PidParts, reversed_action: bool = False) -> Netlis
         rows += passives
         amps.append(amp)
     return Netlist(tuple(rows), tuple(amps))
-
-
-def circuit_loop_netlist(parts: PidParts, plant) -> Netlist:
-    """The loop around a circuit plant of any topology (a
-    :class:`~designer.pid.plant.Plant` with its circuit): the plant's sections
-    between ``u`` and ``y`` first (designators prefixed ``P``:
-    :meth:`~designer.pid.plant.PlantCircuit.netlist`), then the controller,
-    its action reversed for an inverting plant.
-
-    Parameters
-    ----------
-    parts : PidParts
-        The controller.
-    plant : designer.pid.plant.Plant
-        A plant with its circuit.
-
-    Returns
-    -------
-    Netlist
-        The loop's parts and op-amps, the plant's first.
-    """
-    pl = plant.circuit.netlist("u", "y")
-    ctl = controller_netlist(parts, plant.reversed_action)
-    return Netlist(pl.parts + ctl.parts, pl.amps + ctl.amps)
-
-
-def circuit_loop_deck(parts: PidParts, plant, opamp: OpAmp, test: SquareTest, title: str,
-                      expected_final: float, points: int = 20000) -> str:
-    """The whole loop around a circuit plant as a standalone deck
-    (:func:`circuit_loop_netlist`: the plant's own sections and op-amps), with
-    the reference, ``.tran`` and ``.meas`` lines of every loop deck.
-
-    Parameters
-    ----------
-    parts, plant : PidParts, designer.pid.plant.Plant
-        As for :func:`circuit_loop_netlist`.
-    opamp : OpAmp
-        Every op-amp's model (the plant's too).
-    test : SquareTest
-        The reference square wave.
-    title : str
-        The deck's title.
-    expected_final : float
-        The settled plant output the ``.meas`` levels refer to, volts.
-    points : int
-        The transient's resolution (samples over the run).
-
-    Returns
-    -------
-    str
-        The deck (runs alone with ``ngspice -b``).
-    """
-    c = plant.circuit
-    stages = ", ".join(f"{st.topology.title} (U{c.prefix(i)})" for i, st in enumerate(c.stages, 1))
-    about = [f"* plant (a circuit, {c.topology}): {stages}; input u, output y",
-             "* controller (seed 001, Fig. 66): U2 difference (ve = y - r"
-             + (", r and y exchanged: the plant inverts" if plant.reversed_action else "") + "), U3 inverter,",
-             "*   U4 differentiator, U5 integrator, U6 summer, U7 gain -> u = Kp (1 + 1/(Ti s) + Td s) (r - y)"]
-    return _loop_deck(parts, opamp, test, title, expected_final, about, [], circuit_loop_netlist(parts, plant),
-                      points)
 
 
 def model_loop_deck(parts: PidParts, model, opamp: OpAmp, test: SquareTest, title: str,

@@ -47,7 +47,7 @@ from ..core.process import ProcessModel
 from ..core.ranges import parse_in_range
 from ..spice.deck import Netlist
 
-__all__ = ["PLANT_PREFIX", "PlantCircuit", "Plant", "parse_part_values", "part_items", "circuit_plant",
+__all__ = ["PLANT_PREFIX", "LoopNames", "SEED_LOOP_NAMES", "PlantCircuit", "Plant", "parse_part_values", "part_items", "circuit_plant",
            "circuit_from_json",
            "circuit_from_cascade", "sallen_key_parts", "sallen_key_circuit", "resolve_plant"]
 
@@ -58,6 +58,65 @@ PART_RANGES = {"R": "resistor_ohm", "C": "capacitor_f"}
 
 
 @dataclass(frozen=True)
+class LoopNames:
+    """How a one-section plant is named in the loop when not by the generic
+    scheme (RP1 .., op-amp ``UP``, internal nets after the op-amp): the seed's
+    Sallen-Key plant keeps the names its sheets and reference decks have always
+    had (:data:`SEED_LOOP_NAMES`).
+
+    Parameters
+    ----------
+    prefix : str
+        Put after each designator's letter ("" keeps the section's own names).
+    amp_ref : str
+        The plant's op-amp in the deck.
+    amp_role : str
+        The op-amp's role on the sheet and in the bill of materials.
+    nets : tuple of str
+        The section's internal nets, in the order they first appear in its
+        netlist (parts in declared order, then the op-amp).
+    """
+
+    prefix: str
+    amp_ref: str
+    amp_role: str
+    nets: tuple
+
+    def renamed(self, net: Netlist, keep) -> Netlist:
+        """``net`` (one section, its op-amp :attr:`amp_ref`) with its internal
+        nets renamed to :attr:`nets` and its op-amp's role :attr:`amp_role`.
+
+        Parameters
+        ----------
+        net : Netlist
+            The section as its topology wrote it.
+        keep : collection of str
+            The nets it sits between (and ground): not renamed.
+
+        Returns
+        -------
+        Netlist
+            The same circuit, renamed.
+        """
+        from dataclasses import replace
+
+        from ..spice.deck import GROUND
+        order = [n for p in net.parts for n in (p.a, p.b)] + [n for a in net.amps for n in (a.inp, a.inn, a.out)]
+        inner = [n for n in dict.fromkeys(order) if n not in keep and n != GROUND]
+        to = dict(zip(inner, self.nets))
+        r = lambda n: to.get(n, n)  # noqa: E731
+        return Netlist(tuple(replace(p, a=r(p.a), b=r(p.b)) for p in net.parts),
+                       tuple(replace(a, role=self.amp_role, inp=r(a.inp), inn=r(a.inn), out=r(a.out))
+                             for a in net.amps))
+
+
+#: the seed's Sallen-Key plant in its loop (seed 001, Fig. 43-45 beside Fig. 66): op-amp U1 "plant",
+#: nets pv1 (node A), pvp, pvn; its designators unprefixed for the follower, prefixed P with the gain pair
+#: (whose R3, R4 the controller owns): the names of the reference decks and sheets
+SEED_LOOP_NAMES = LoopNames("", "U1", N_("plant"), ("pv1", "pvp", "pvn"))
+
+
+@dataclass(frozen=True)
 class PlantCircuit:
     """The circuit of a plant: registered filter sections in series, input first.
 
@@ -65,9 +124,13 @@ class PlantCircuit:
     ----------
     stages : tuple of designer.filters.cascade.Stage
         Each section (its topology) and its part values (designator -> ohm, farad).
+    names : LoopNames, optional
+        A one-section plant's names in the loop when not the generic scheme
+        (:data:`SEED_LOOP_NAMES` for the seed's Sallen-Key plant).
     """
 
     stages: tuple
+    names: LoopNames | None = None
 
     @property
     def topology(self) -> str:
@@ -90,8 +153,11 @@ class PlantCircuit:
         Returns
         -------
         str
-            ``P`` for a one-section plant (R1 -> RP1), ``Pi`` in a cascade (RPi1).
+            ``P`` for a one-section plant (R1 -> RP1), ``Pi`` in a cascade (RPi1);
+            :attr:`names`' prefix when given.
         """
+        if self.names is not None:
+            return self.names.prefix
         return PLANT_PREFIX if len(self.stages) == 1 else f"{PLANT_PREFIX}{i}"
 
     def coefficients(self) -> tuple:
@@ -121,6 +187,11 @@ class PlantCircuit:
             Every stage's parts and op-amp, in stage order.
         """
         from ..filters.cascade import Cascade
+        if self.names is not None:   # one section, named as given (the seed's plant)
+            st = self.stages[0]
+            net = st.topology.netlist(st.values, prefix=self.names.prefix, amp_ref=self.names.amp_ref, inp=inp,
+                                      out=out)
+            return self.names.renamed(net, (inp, out))
         return Cascade(self.stages).netlist(inp, out, prefix=self.prefix, amp_ref=lambda i: f"U{self.prefix(i)}",
                                             link="ps")
 
@@ -425,7 +496,9 @@ def _with_design_choices(source, opamp, bounds) -> tuple:
 
 def sallen_key_circuit(parts) -> PlantCircuit:
     """The Sallen-Key plant's circuit as its registered section (unity gain, or
-    gain K = 1 + R4/R3).
+    gain K = 1 + R4/R3), named in the loop as the seed's sheets name it
+    (:data:`SEED_LOOP_NAMES`; with the gain pair its designators prefixed
+    :data:`PLANT_PREFIX`, clear of the controller's R3 and R4).
 
     Parameters
     ----------
@@ -437,12 +510,15 @@ def sallen_key_circuit(parts) -> PlantCircuit:
     PlantCircuit
         One stage.
     """
+    from dataclasses import replace
+
     from ..filters.cascade import Stage
     from ..filters.sallen_key_lowpass_parts import part_values, section_of
     follower = math.isclose(parts.gain, 1.0)
     values = part_values(parts)
     section = section_of(with_gain=not follower)
-    return PlantCircuit((Stage(section, {r: values[r] for r in section.designators}),))
+    names = replace(SEED_LOOP_NAMES, prefix="" if follower else PLANT_PREFIX)
+    return PlantCircuit((Stage(section, {r: values[r] for r in section.designators}),), names)
 
 
 def resolve_plant(source, *, opamp: str | None = None, bounds=None) -> Plant:

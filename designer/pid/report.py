@@ -30,7 +30,6 @@ from ..core import eseries
 from ..core.i18n import N_, language, translated
 from ..core.i18n import gettext as _
 from ..core.units import format_eng
-from ..filters.sallen_key_lowpass_parts import section_of
 from ..report import document as R
 from ..report.bundle import draw_early as bundle_early, write_design
 from ..report.plots import decimate, figure, loop_gain_plot, png_bytes, step_plot, time_unit
@@ -40,7 +39,7 @@ from ..report.tolerance import title as tolerance_title
 from ..report.wiring import bench_rows, bom_csv, bom_rows, net_text, wiring_rows
 from ..spice.deck import board
 from .model import OPAMP_OUTPUTS
-from .netlist import NET_LABELS, loop_netlist, plant_ref_prefix
+from .netlist import NET_LABELS, loop_netlist, plant_circuit, plant_ref_prefix
 from .plant import PLANT_PREFIX
 from .tuning import MODEL_NAMES
 
@@ -258,8 +257,7 @@ def bom(result, b=None) -> list:
     controller = controller_source(result.selection)
     prs, pcs = result.plant_series or (None, None)
     prt, pct = ((100 * eseries.TOLERANCE[prs], 100 * eseries.TOLERANCE[pcs]) if prs else (None, None))
-    section, prefix = section_of(result.plant), plant_ref_prefix(result.plant)
-    plant_refs = {section.prefixed(ref, prefix) for ref in section.designators}
+    plant_refs = {p.ref for p in plant_circuit(result.plant)[0].netlist("u", "y").parts}
 
     def source(ref):
         if ref in plant_refs:

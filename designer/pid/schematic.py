@@ -124,7 +124,7 @@ def draw_model_loop(board, opamp, model_text: str, probes: dict = PROBES) -> She
 def draw_circuit_loop(board, opamp, plant, probes: dict = PROBES) -> Sheet:
     """The closed loop around a circuit plant of any topology, on a new sheet:
     the controller of ``board`` (a :class:`~designer.spice.deck.Board` of
-    :func:`~designer.pid.netlist.circuit_loop_netlist`) as for a Sallen-Key
+    :func:`~designer.pid.netlist.loop_netlist`) as for a Sallen-Key
     plant, and below it the plant's own sections (``plant``: the
     :class:`~designer.spice.deck.Netlist` of
     :meth:`~designer.pid.plant.PlantCircuit.netlist`, whose parts and op-amps

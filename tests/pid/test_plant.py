@@ -18,7 +18,7 @@ from designer.core.errors import DesignError
 from designer.filters.registry import REGISTRY, get
 from designer.pid import report as P
 from designer.pid.design import design_pid
-from designer.pid.netlist import circuit_loop_netlist, controller_netlist
+from designer.pid.netlist import controller_netlist, loop_netlist
 from designer.pid.plant import (PLANT_PREFIX, Plant, circuit_from_cascade, circuit_plant, parse_part_values,
                                 resolve_plant)
 from designer.pid.result import PidResult
@@ -86,13 +86,83 @@ def test_every_plant_source_resolves_to_one_type():
 def test_designators_do_not_collide_with_the_controller_or_the_decoupling():
     spec = PidSpec(**CIRCUITS["cascade"])
     res = design_pid(spec, simulate=False)
-    net = circuit_loop_netlist(res.parts, spec.circuit)
+    net = loop_netlist(res.parts, spec.circuit)
     refs = [p.ref for p in net.parts] + [a.ref for a in net.amps]
     assert len(refs) == len(set(refs))
     board = P.build_board(res)
     assert not {p.ref for p in net.parts} & {p.ref for p in board.decoupling}
     assert all(r[1] == PLANT_PREFIX for r in refs if r not in {p.ref for p in controller_netlist(res.parts).parts}
                | {a.ref for a in controller_netlist(res.parts).amps})
+
+
+SK_RECORDS = {"follower": dict(r1=1600.0, r2=3900.0, c1=3.3e-9, c2=100e-9),
+              "gain": dict(r1=1600.0, r2=3900.0, c1=100e-9, c2=3.3e-9, gain=1.5, r3=10e3, r4=5e3)}
+
+
+@pytest.mark.parametrize("kind", sorted(SK_RECORDS))
+def test_the_sallen_key_plants_loop_is_the_generic_circuit_loop_named_as_its_own_sheet(kind):
+    # issue 26: one loop netlist for every circuit plant; the seed's plant (a parts record) goes through its
+    # registered section's netlist and comes out as the plant's own sheet draws it (designer.plant.netlist,
+    # an independent writer): the same parts, nets, values and roles, op-amp U1 "plant", the controller after it
+    from designer.pid.blocks import seed_parts
+    from designer.pid.netlist import plant_ref_prefix
+    from designer.pid.plant import sallen_key_circuit
+    from designer.plant.netlist import plant_netlist
+    from designer.plant.sallenkey import SallenKeyParts, check_parts
+    rec = check_parts(SallenKeyParts(**SK_RECORDS[kind]))
+    circuit = sallen_key_circuit(rec)
+    prefix = plant_ref_prefix(rec)
+    assert prefix == ("" if kind == "follower" else PLANT_PREFIX) == plant_ref_prefix(circuit)
+    own = plant_netlist(rec, "u", "y", prefix="p", amp_ref="U1", ref_prefix=prefix)
+    net = loop_netlist(seed_parts(), rec)
+    assert net == loop_netlist(seed_parts(), circuit) == loop_netlist(seed_parts(), Plant(None, circuit))
+    assert net.parts[:len(own.parts)] == own.parts and net.amps[:1] == own.amps
+    assert net.parts[len(own.parts):] == controller_netlist(seed_parts()).parts
+    # the same section given by topology keeps the generic scheme (RP1 .., UP)
+    generic = circuit_plant(circuit.stages[0].topology, circuit.stages[0].values)
+    assert {a.ref for a in loop_netlist(seed_parts(), generic).amps} >= {"UP"}
+
+
+@pytest.mark.parametrize("kind", sorted(SK_RECORDS))
+def test_the_sallen_key_closed_forms_equal_the_sections_nodal_model(kind):
+    # the fast path of plant_model (seed 001's closed forms) stands in for the generic nodal model of its
+    # section (designer.plant.circuit.opamp_tf): equal to rounding, with the op-amp and ideal
+    from designer.core import opamps
+    from designer.pid.design import ideal_pair, plant_model
+    from designer.pid.plant import sallen_key_circuit
+    from designer.plant.circuit import opamp_tf
+    from designer.plant.sallenkey import SallenKeyParts, check_parts
+    rec = check_parts(SallenKeyParts(**SK_RECORDS[kind]))
+    st0 = sallen_key_circuit(rec).stages[0]
+    for name in ("LM741", "TL072"):
+        amp = opamps.get(name)
+        num, den = plant_model(rec, amp)
+        n, d = opamp_tf(st0.topology, st0.values, amp)
+        assert np.allclose(den, d / d[-1], rtol=1e-9, atol=0) and math.isclose(num[-1], n[-1] / d[-1], rel_tol=1e-9)
+    num, den = plant_model(rec)
+    n, d = st0.topology.coefficients(st0.values)
+    assert np.allclose(den, np.asarray(d) / d[-1], rtol=1e-9) and math.isclose(num[-1], n[-1] / d[-1], rel_tol=1e-9)
+    assert np.allclose(ideal_pair(rec), dominant(den), rtol=1e-9)
+
+
+def dominant(den):
+    from designer.core.lti import dominant_pair
+    return dominant_pair(den)
+
+
+def test_a_non_sallen_key_circuit_plants_model_is_its_sections_nodal_model():
+    # the generic path of plant_model: a cascade's op-amp-aware model is the product of its sections'
+    from designer.core import opamps
+    from designer.pid.design import plant_model, plant_step
+    from designer.plant.circuit import opamp_tf
+    amp = opamps.get("LM741")
+    plant = resolve_plant(PidSpec(**CIRCUITS["cascade"]))
+    num, den = plant_model(plant, amp)
+    n1, d1 = opamp_tf(plant.circuit.stages[0].topology, plant.circuit.stages[0].values, amp)
+    n2, d2 = opamp_tf(plant.circuit.stages[1].topology, plant.circuit.stages[1].values, amp)
+    assert np.allclose(den, np.polymul(d1, d2)) and math.isclose(num[-1], n1[-1] * n2[-1])
+    ps = plant_step(plant, amp)
+    assert np.array_equal(ps.num, num) and np.array_equal(ps.den, den)
 
 
 # ---- bad input ---------------------------------------------------------------------------------
