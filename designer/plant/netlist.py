@@ -23,7 +23,7 @@ from ..core.opamps import OpAmp
 from ..filters.deck import ac_deck
 from ..filters.sallen_key_lowpass_parts import part_values, section_of
 from ..spice.deck import (
-    AC_POINTS_PER_DECADE,
+    SINE_POINTS_PER_DECADE,
     Amp,
     Netlist,
     SquareTest,
@@ -125,7 +125,7 @@ def plant_ac_deck(parts: SallenKeyParts, opamp: OpAmp, f_lo: float, f_hi: float,
         The deck.
     """
     return ac_deck(plant_netlist(parts), opamp, f_lo, f_hi, inp="input", title=title,
-                   points_per_decade=AC_POINTS_PER_DECADE)
+                   points_per_decade=SINE_POINTS_PER_DECADE)
 
 
 def plant_prbs_deck(parts: SallenKeyParts, opamp: OpAmp, plan, title: str, samples_per_interval: int = 10) -> str:

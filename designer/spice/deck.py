@@ -22,7 +22,7 @@ from ..core.opamps import OpAmp
 from ..core.units import format_eng
 from .library import library_text
 
-__all__ = ["AC_POINTS_PER_DECADE", "Amp", "Board", "GROUND", "MAX_SIM_POINTS", "Netlist", "Part", "STEPS_PER_TIME_SCALE", "SquareTest",
+__all__ = ["SINE_POINTS_PER_DECADE", "Amp", "Board", "GROUND", "MAX_SIM_POINTS", "Netlist", "Part", "STEPS_PER_TIME_SCALE", "SquareTest",
            "ac_lines", "add_supplies", "board", "bench_circuit", "finish_deck", "measure_lines", "opamp_library_text",
            "settle_error_source"]
 
@@ -375,10 +375,10 @@ def settle_error_source(circuit, node: str, final: float, initial: float = 0.0):
 
 
 #: the sine check's ``.ac`` density (points a decade): the resonance peak and the -3 dB point read off it
-AC_POINTS_PER_DECADE = 200
+SINE_POINTS_PER_DECADE = 200
 
 
-def ac_lines(f_lo: float, f_hi: float, points_per_decade: int = AC_POINTS_PER_DECADE) -> list:
+def ac_lines(f_lo: float, f_hi: float, points_per_decade: int = SINE_POINTS_PER_DECADE) -> list:
     """The ``.ac`` analysis of the sine check: a decade sweep from ``f_lo`` to ``f_hi``.
 
     Parameters

@@ -7,7 +7,7 @@ from designer.core import opamps
 from designer.filters.sallen_key_lowpass_parts import part_values, section_of
 from designer.plant.netlist import plant_ac_deck, plant_deck, plant_netlist
 from designer.plant.sallenkey import SallenKeyParts
-from designer.spice.deck import AC_POINTS_PER_DECADE, SquareTest, ac_lines
+from designer.spice.deck import SINE_POINTS_PER_DECADE, SquareTest, ac_lines
 
 UNITY = SallenKeyParts(1.6e3, 3.9e3, 3.3e-9, 100e-9)
 GAIN2 = SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, 2.0, 10e3, 10e3)
@@ -46,7 +46,7 @@ def test_the_sine_checks_deck_is_the_sections_ac_deck_of_the_plant():
         deck = plant_ac_deck(parts, amp, 10.0, 1e5, "t").splitlines()
         lines = [str(line) for line in ac_lines(10.0, 1e5)]
         assert deck[-1 - len(lines):-1] == lines and lines[0].split()[:2] == [".ac", "dec"]
-        assert lines[0].split()[2] == str(AC_POINTS_PER_DECADE)
+        assert lines[0].split()[2] == str(SINE_POINTS_PER_DECADE)
         assert "Vin input 0 DC 0 AC 1" in deck
         net = plant_netlist(parts)
         for p in net.parts:
