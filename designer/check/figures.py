@@ -249,13 +249,12 @@ def circuit_band_of(res) -> dict:
 def _opamp_band(parts, opamp, r_tol: float, c_tol: float) -> tuple:
     """((lo, hi) of fn, (lo, hi) of zeta) with ``opamp`` over the tolerance corners of ``parts``."""
     # imported here: loading a spec (which reads this module) needs no plant model
-    from ..core.lti import dominant_pair
-    from ..plant.model import plant_tf_opamp
+    from ..plant.model import opamp_pair
     fns, zetas = [], []
     for s in itertools.product((-1, 1), repeat=4):   # the same 16 corners as the passive band
         p = replace(parts, r1=parts.r1 * (1 + s[0] * r_tol), r2=parts.r2 * (1 + s[1] * r_tol),
                     c1=parts.c1 * (1 + s[2] * c_tol), c2=parts.c2 * (1 + s[3] * c_tol))
-        fn, z = dominant_pair(plant_tf_opamp(p, opamp)[1])
+        fn, z = opamp_pair(p, opamp)
         fns.append(float(fn))
         zetas.append(float(z))
     return (min(fns), max(fns)), (min(zetas), max(zetas))

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..core.errors import SimulatorError
 from ..core.opamps import OpAmp
-from ..spice.deck import Netlist, ac_lines, add_supplies, opamp_library_text
+from ..spice.deck import Netlist, ac_lines, bench_circuit
 from ..spice.simulate import get_simulator
 
 __all__ = ["AC_POINTS_PER_DECADE", "ac_deck", "simulate_ac"]
@@ -48,14 +48,7 @@ def ac_deck(netlist: Netlist, opamp: OpAmp, f_lo: float, f_hi: float, inp: str =
     str
         Standalone deck text (``ngspice -b`` runs it).
     """
-    import logging
-
-    from PySpice.Spice.Netlist import Circuit
-    logging.getLogger("PySpice").setLevel(logging.ERROR)
-    circuit = Circuit(title)
-    circuit.raw_spice = "\n".join([f"* {title}: 1 V AC at {inp}; op-amp {opamp.name}",
-                                   opamp_library_text().rstrip()])
-    add_supplies(circuit, opamp)
+    circuit = bench_circuit(title, opamp, [f"* {title}: 1 V AC at {inp}; op-amp {opamp.name}"])
     circuit.V("in", inp, circuit.gnd, "DC 0 AC 1")
     netlist.add_to(circuit, opamp)
     return "\n".join([str(circuit).rstrip(), *ac_lines(f_lo, f_hi, points_per_decade), ".end"]) + "\n"

@@ -42,6 +42,7 @@ from ..core.errors import DesignError
 from ..core.i18n import N_
 from ..spice.deck import GROUND, Netlist
 from .sallen_key import SallenKeySection
+from .sallen_key_lowpass_synthesis import coefficients
 from .topology import PartSpec, SectionTarget, polynomial, quadratic_root
 
 __all__ = ["SallenKeyLowPass", "sallen_key_ratio_min"]
@@ -83,8 +84,8 @@ class SallenKeyLowPass(SallenKeySection):
     def coefficients(self, values: dict) -> tuple:
         v = self.values_of(values)
         k = self.gain_of(v)
-        den = polynomial(v["R1"] * v["R2"] * v["C1"] * v["C2"],
-                         v["C1"] * (v["R1"] + v["R2"]) + v["R1"] * v["C2"] * (1 - k), 1.0)
+        # the seed's a and b, written once (the plant's parts record and the joint search use the same function)
+        den = polynomial(*coefficients(v["R1"], v["R2"], v["C1"], v["C2"], k), 1.0)
         num = polynomial(0.0, 0.0, k * den[2])
         return num, den
 

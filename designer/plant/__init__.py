@@ -24,7 +24,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "bench": ("PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",
               "tolerance_band"),
     "design": ("R_BAND", "analyze_plant", "choose_parts", "design_plant", "listed"),
-    "model": ("plant_tf", "plant_tf_opamp", "sensitivities"),
+    "model": ("opamp_pair", "plant_model", "plant_tf", "plant_tf_opamp", "sensitivities"),
     "netlist": ("plant_ac_deck", "plant_deck", "plant_netlist", "plant_prbs_deck", "prbs_deck"),
     "prbs": ("MAX_INTERVALS", "PERIODS", "SAMPLES_PER_INTERVAL", "attach", "check_size", "model_response",
              "op_amp_checks", "plan_for_result", "plan_of", "prbs_run", "run_deck", "with_prbs"),

@@ -650,17 +650,9 @@ def square_deck(netlist, amp, test, title: str) -> str:
     str
         The deck.
     """
-    import logging
-
-    from PySpice.Spice.Netlist import Circuit
-
-    from ..spice.deck import add_supplies, finish_deck, opamp_library_text
-    logging.getLogger("PySpice").setLevel(logging.ERROR)
-    circuit = Circuit(title)
-    circuit.raw_spice = "\n".join([f"* {title}: 0 -> {test.amplitude_v:g} V square wave at "
-                                   f"{test.frequency_hz:g} Hz on vin; op-amp {amp.name}",
-                                   opamp_library_text().rstrip()])
-    add_supplies(circuit, amp)
+    from ..spice.deck import bench_circuit, finish_deck
+    circuit = bench_circuit(title, amp, [f"* {title}: 0 -> {test.amplitude_v:g} V square wave at "
+                                         f"{test.frequency_hz:g} Hz on vin; op-amp {amp.name}"])
     circuit.V("in", "vin", circuit.gnd, test.source())
     netlist.add_to(circuit, amp)
     return finish_deck(circuit, test)

@@ -72,13 +72,7 @@ def bom(result) -> list:
     list of list
         Rows.
     """
-    lab = result.sourcing.parts
-    b = board(result.netlist, result.opamp, result.package)
-
-    def source(ref):
-        src = lab.get(ref)
-        return None if src is None else (src.series, src.tolerance_pct)
-    return bom_rows(b, source, result.opamp.name)
+    return bom_rows(board(result.netlist, result.opamp, result.package), result.sourcing.source, result.opamp.name)
 
 
 def _f(v, unit: str) -> str:

@@ -57,7 +57,7 @@ from .bench import (
     sine_check,
     tolerance_band,
 )
-from .model import plant_tf, plant_tf_opamp, sensitivities
+from .model import opamp_pair, plant_tf, plant_tf_opamp, sensitivities
 from .netlist import plant_ac_deck, plant_deck
 from .result import (
     Alternative,
@@ -104,7 +104,7 @@ def gain_resistors(gain: float, spec: PlantSpec):
 def gbw_shift(parts: SallenKeyParts, opamp: OpAmp):
     """How far the op-amp's finite GBW moves these parts: (fn_ideal / fn_opamp,
     zeta_ideal / zeta_opamp). ``compensate_gbw`` multiplies the targets by it."""
-    fo, zo = dominant_pair(plant_tf_opamp(parts, opamp)[1])
+    fo, zo = opamp_pair(parts, opamp)
     return parts.fn_hz / fo, parts.zeta / zo
 
 

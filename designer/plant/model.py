@@ -16,7 +16,7 @@ from ..core.opamps import OpAmp
 from ..filters.sallen_key_lowpass_parts import FIELD_OF, refs
 from .sallenkey import SallenKeyParts
 
-__all__ = ["plant_tf", "plant_tf_opamp", "sensitivities"]
+__all__ = ["plant_tf", "plant_tf_opamp", "plant_model", "opamp_pair", "sensitivities"]
 
 
 def plant_tf(parts: SallenKeyParts):
@@ -63,6 +63,44 @@ def plant_tf_opamp(parts: SallenKeyParts, opamp: OpAmp):
     return np.array([1.0 / d[-1]]), d / d[-1]
 
 
+def plant_model(parts: SallenKeyParts, opamp: OpAmp):
+    """The model a loop or a check takes of the plant: :func:`plant_tf` with an ideal
+    op-amp, else :func:`plant_tf_opamp`.
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        The parts.
+    opamp : OpAmp
+        The op-amp.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (num, den), highest power first.
+    """
+    return plant_tf(parts) if opamp.ideal else plant_tf_opamp(parts, opamp)
+
+
+def opamp_pair(parts: SallenKeyParts, opamp: OpAmp) -> tuple:
+    """fn (Hz) and zeta of the op-amp-aware model's dominant pair
+    (:func:`designer.core.lti.dominant_pair` of :func:`plant_tf_opamp`).
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        The parts.
+    opamp : OpAmp
+        The op-amp.
+
+    Returns
+    -------
+    tuple of float
+        (fn_hz, zeta).
+    """
+    return dominant_pair(plant_tf_opamp(parts, opamp)[1])
+
+
 @dataclass(frozen=True)
 class Sensitivity:
     """How much wn and zeta move, relatively, for a relative change of one part:
@@ -99,7 +137,7 @@ def sensitivities(parts: SallenKeyParts, opamp: OpAmp | None = None, rel_step: f
     def figures(p, amp):
         if amp is None:
             return p.wn, p.zeta
-        fn, z = dominant_pair(plant_tf_opamp(p, amp)[1])
+        fn, z = opamp_pair(p, amp)
         return 2 * math.pi * fn, z
 
     h = rel_step

@@ -20,16 +20,16 @@ from __future__ import annotations
 
 from ..core.i18n import N_
 from ..core.opamps import OpAmp
+from ..filters.deck import ac_deck
 from ..filters.sallen_key_lowpass_parts import part_values, section_of
 from ..spice.deck import (
+    SINE_POINTS_PER_DECADE,
     Amp,
     Netlist,
     SquareTest,
-    ac_lines,
-    add_supplies,
+    bench_circuit,
     finish_deck,
     measure_lines,
-    opamp_library_text,
     settle_error_source,
 )
 from .sallenkey import SallenKeyParts
@@ -72,17 +72,6 @@ def plant_netlist(parts: SallenKeyParts, inp: str = "input", out: str = "out", p
     return Netlist(net.parts, (Amp(amp_ref, N_("plant"), vp, out if follower else vn, out),))
 
 
-def _circuit(title: str, opamp: OpAmp, header: list):
-    import logging
-
-    from PySpice.Spice.Netlist import Circuit
-    logging.getLogger("PySpice").setLevel(logging.ERROR)
-    circuit = Circuit(title)
-    circuit.raw_spice = "\n".join([f"* {title}", *header, opamp_library_text().rstrip()])
-    add_supplies(circuit, opamp)
-    return circuit
-
-
 def plant_deck(parts: SallenKeyParts, opamp: OpAmp, test: SquareTest, title: str) -> str:
     """Standalone deck of the Sallen-Key plant under the square-wave test.
 
@@ -102,7 +91,8 @@ def plant_deck(parts: SallenKeyParts, opamp: OpAmp, test: SquareTest, title: str
     str
         The deck.
     """
-    circuit = _circuit(title, opamp, [
+    circuit = bench_circuit(title, opamp, [
+        f"* {title}",
         f"* op-amp: {opamp.name} ({opamp.description}); supplies {opamp.vcc:g} V / {opamp.vee:g} V",
         f"* test: 0 -> {test.amplitude_v:g} V square wave at {test.frequency_hz:g} Hz, step at {test.delay_s:.4g} s",
         "* Run: ngspice -b <this file>   (prints overshoot_pct, peak_time_s, rise_time_s, settling_time_s)"])
@@ -114,8 +104,9 @@ def plant_deck(parts: SallenKeyParts, opamp: OpAmp, test: SquareTest, title: str
 
 
 def plant_ac_deck(parts: SallenKeyParts, opamp: OpAmp, f_lo: float, f_hi: float, title: str) -> str:
-    """The sine check as an ngspice deck: the same circuit driven by a 1 V AC
-    source, an ``.ac`` sweep from ``f_lo`` to ``f_hi`` (v(out) is the gain).
+    """The sine check as an ngspice deck: the generic section's ``.ac`` deck
+    (:func:`designer.filters.deck.ac_deck`) of :func:`plant_netlist`, driven at
+    the plant's ``input`` net by 1 V AC, at the sine check's density (v(out) is the gain).
 
     Parameters
     ----------
@@ -133,10 +124,8 @@ def plant_ac_deck(parts: SallenKeyParts, opamp: OpAmp, f_lo: float, f_hi: float,
     str
         The deck.
     """
-    circuit = _circuit(title, opamp, ["* sine check: 1 V AC at the input, v(out) = gain and phase"])
-    circuit.V("in", "input", circuit.gnd, "DC 0 AC 1")
-    plant_netlist(parts).add_to(circuit, opamp)
-    return "\n".join([str(circuit).rstrip(), *ac_lines(f_lo, f_hi), ".end"]) + "\n"
+    return ac_deck(plant_netlist(parts), opamp, f_lo, f_hi, inp="input", title=title,
+                   points_per_decade=SINE_POINTS_PER_DECADE)
 
 
 def plant_prbs_deck(parts: SallenKeyParts, opamp: OpAmp, plan, title: str, samples_per_interval: int = 10) -> str:
@@ -202,7 +191,8 @@ def prbs_deck(netlist, opamp: OpAmp, plan, title: str, fn_hz: float, inp: str = 
 
     from ..core.prbs import pwl_subcircuit
     step = min(plan.dt_s / samples_per_interval, 1.0 / (2 * math.pi * fn_hz) / 100)
-    circuit = _circuit(title, opamp, [
+    circuit = bench_circuit(title, opamp, [
+        f"* {title}",
         f"* op-amp: {opamp.name} ({opamp.description}); supplies {opamp.vcc:g} V / {opamp.vee:g} V",
         f"* stimulus: PRBS of {plan.bits} bits (N = {plan.n}), clock {plan.clock_hz:.6g} Hz, "
         f"{plan.periods} period(s), levels {plan.offset - plan.amplitude:.6g} V and {plan.offset + plan.amplitude:.6g} V",

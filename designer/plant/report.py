@@ -91,13 +91,7 @@ def sections(result, with_images: bool = True, schematic_svg: str = "") -> list:
 
 def bom(result, b=None) -> list:
     """The bill of materials rows (:data:`designer.report.wiring.BOM_HEADER`)."""
-    b = b or build_board(result)
-    lab = result.sourcing.parts
-
-    def source(ref):
-        src = lab.get(ref)
-        return None if src is None else (src.series, src.tolerance_pct)
-    return bom_rows(b, source, result.opamp.name)
+    return bom_rows(b or build_board(result), result.sourcing.source, result.opamp.name)
 
 
 def _settings(result) -> list:

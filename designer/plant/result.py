@@ -131,6 +131,23 @@ class Sourcing:
     def r_tolerance_pct(self) -> float:
         return 100 * eseries.TOLERANCE[self.r_series]
 
+    def source(self, ref: str):
+        """A part's (series label, tolerance %) as the bill of materials lists it
+        (:func:`designer.report.wiring.bom_rows`' ``source``), None for a part without one (the op-amp).
+
+        Parameters
+        ----------
+        ref : str
+            The designator.
+
+        Returns
+        -------
+        tuple or None
+            (series, tolerance_pct).
+        """
+        src = self.parts.get(ref)
+        return None if src is None else (src.series, src.tolerance_pct)
+
     @property
     def c_tolerance_pct(self) -> float:
         return 100 * eseries.TOLERANCE[self.c_series]

@@ -7,7 +7,8 @@ from ..core.exports import lazy_exports
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "behavioural": ("FORMS", "HINT_WH", "max_step_hint_s", "normalise", "plant_lines", "poles"),
-    "deck": ("Amp", "Board", "GROUND", "MAX_SIM_POINTS", "Netlist", "Part", "STEPS_PER_TIME_SCALE", "SquareTest",
+    "deck": ("SINE_POINTS_PER_DECADE", "Amp", "Board", "GROUND", "MAX_SIM_POINTS", "Netlist", "Part", "STEPS_PER_TIME_SCALE",
+             "SquareTest", "bench_circuit",
              "ac_lines", "add_supplies", "board", "finish_deck", "measure_lines", "opamp_library_text",
              "settle_error_source"),
     "model_step": ("DURATION_SETTLING_TIMES", "MAX_POINTS", "MIN_CODES", "default_duration_s", "default_step_time_s",

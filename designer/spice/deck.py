@@ -22,8 +22,8 @@ from ..core.opamps import OpAmp
 from ..core.units import format_eng
 from .library import library_text
 
-__all__ = ["Amp", "Board", "GROUND", "MAX_SIM_POINTS", "Netlist", "Part", "STEPS_PER_TIME_SCALE", "SquareTest",
-           "ac_lines", "add_supplies", "board", "finish_deck", "measure_lines", "opamp_library_text",
+__all__ = ["SINE_POINTS_PER_DECADE", "Amp", "Board", "GROUND", "MAX_SIM_POINTS", "Netlist", "Part", "STEPS_PER_TIME_SCALE", "SquareTest",
+           "ac_lines", "add_supplies", "board", "bench_circuit", "finish_deck", "measure_lines", "opamp_library_text",
            "settle_error_source"]
 
 #: the simulation's maximum step is at most this fraction of the response's time scale
@@ -274,6 +274,35 @@ def add_opamp(circuit, name: str, inp, inn, out, opamp: OpAmp, vcc="vcc", vee="v
     circuit.X(name, subckt_name(opamp), inp, inn, vcc, vee, out, **opamp_params(opamp))
 
 
+def bench_circuit(title: str, opamp: OpAmp, comments: list):
+    """A standalone deck's start: a PySpice circuit titled ``title`` whose raw text is the
+    ``comments`` lines and the op-amp library, with the op-amps' supplies (:func:`add_supplies`).
+    The Sallen-Key plant's decks, a section's ``.ac`` and square-wave decks start here.
+
+    Parameters
+    ----------
+    title : str
+        The deck's ``.title``.
+    comments : list of str
+        The comment lines above the library, each with its ``*``.
+    opamp : designer.core.opamps.OpAmp
+        Whose supplies and model the deck uses.
+
+    Returns
+    -------
+    PySpice.Spice.Netlist.Circuit
+        The circuit, for the caller's sources, netlist and analyses.
+    """
+    import logging
+
+    from PySpice.Spice.Netlist import Circuit
+    logging.getLogger("PySpice").setLevel(logging.ERROR)
+    circuit = Circuit(title)
+    circuit.raw_spice = "\n".join([*comments, opamp_library_text().rstrip()])
+    add_supplies(circuit, opamp)
+    return circuit
+
+
 def add_supplies(circuit, opamp: OpAmp):
     """The op-amps' supplies: sources ``Vcc`` and ``Vee`` from ground to the ``vcc`` and ``vee`` rails.
 
@@ -345,7 +374,11 @@ def settle_error_source(circuit, node: str, final: float, initial: float = 0.0):
               voltage_expression=f"abs(V({node})-{final:.6g})/{span:.6g}")
 
 
-def ac_lines(f_lo: float, f_hi: float, points_per_decade: int = 200) -> list:
+#: the sine check's ``.ac`` density (points a decade): the resonance peak and the -3 dB point read off it
+SINE_POINTS_PER_DECADE = 200
+
+
+def ac_lines(f_lo: float, f_hi: float, points_per_decade: int = SINE_POINTS_PER_DECADE) -> list:
     """The ``.ac`` analysis of the sine check: a decade sweep from ``f_lo`` to ``f_hi``.
 
     Parameters

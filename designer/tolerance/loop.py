@@ -306,7 +306,7 @@ def evaluate(context: LoopContext, values: dict) -> dict:
     """
     from ..pid import model
     from ..pid.blocks import PidParts
-    from ..plant.model import plant_tf, plant_tf_opamp
+    from ..plant.model import plant_model
     from ..filters.sallen_key_lowpass_parts import parts_of, refs
     from .parts import sample_opamp
     n = next(iter(values.values())).size
@@ -320,7 +320,7 @@ def evaluate(context: LoopContext, values: dict) -> dict:
         parts = PidParts(**{k: (values[k.upper()][i] if k.upper() in values else None) for k in names})
         amp = sample_opamp(context.opamp, values, i)
         out["kp"][i], out["ti_s"][i], out["td_s"][i] = parts.kp, parts.ti_s, parts.td_s
-        pn, pd = plant_tf(plant) if amp.ideal else plant_tf_opamp(plant, amp)
+        pn, pd = plant_model(plant, amp)
         lm = model.assemble(parts, amp, pn, pd)
         stable = lm.stable()
         out["stable"][i] = float(stable)

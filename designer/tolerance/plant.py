@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from ..filters.sallen_key_lowpass_parts import gain_of, network
-from ..plant.sallenkey import fn_zeta
+from ..plant.sallenkey import coefficients, fn_zeta
 
 __all__ = ["FIGURES", "evaluate", "plant_figures"]
 
@@ -44,7 +44,7 @@ def _cubic(v: dict, opamp):
     i1 = r2 * c1 * (1 + r1 / r2) + r1 * c2
     if opamp is None or opamp.ideal:
         # K/(a s^2 + b s + 1): D = (a s^2 + b s + 1)/K
-        b = c1 * (r1 + r2) + r1 * c2 * (1 - k)
+        b = coefficients(r1, r2, c1, c2, k)[1]
         return np.zeros_like(r1), i2 / k, b / k, 1 / k
     a0 = opamp.a0
     # the op-amp's own spread (--tol GBW=30%): a gain-bandwidth per sample

@@ -7,7 +7,7 @@ from designer.core import opamps
 from designer.filters.sallen_key_lowpass_parts import part_values, section_of
 from designer.plant.netlist import plant_ac_deck, plant_deck, plant_netlist
 from designer.plant.sallenkey import SallenKeyParts
-from designer.spice.deck import SquareTest
+from designer.spice.deck import SINE_POINTS_PER_DECADE, SquareTest, ac_lines
 
 UNITY = SallenKeyParts(1.6e3, 3.9e3, 3.3e-9, 100e-9)
 GAIN2 = SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, 2.0, 10e3, 10e3)
@@ -36,3 +36,18 @@ def test_a_designator_prefix_for_a_shared_sheet_moves_every_part_and_no_net():
                                                                             ref_prefix="P")
     assert [p.ref for p in shared.parts] == ["RP1", "RP2", "CP1", "CP2", "RP3", "RP4"]
     assert [(p.a, p.b, p.value) for p in shared.parts] == [(p.a, p.b, p.value) for p in plain.parts]
+
+
+def test_the_sine_checks_deck_is_the_sections_ac_deck_of_the_plant():
+    # the plant's .ac deck is the generic one (designer.filters.deck.ac_deck) of its netlist, driven at the plant's
+    # own input net at the sine check's density: every element and the sweep as the plant's deck had them
+    amp = opamps.get("LM741")
+    for parts in (UNITY, GAIN2):
+        deck = plant_ac_deck(parts, amp, 10.0, 1e5, "t").splitlines()
+        lines = [str(line) for line in ac_lines(10.0, 1e5)]
+        assert deck[-1 - len(lines):-1] == lines and lines[0].split()[:2] == [".ac", "dec"]
+        assert lines[0].split()[2] == str(SINE_POINTS_PER_DECADE)
+        assert "Vin input 0 DC 0 AC 1" in deck
+        net = plant_netlist(parts)
+        for p in net.parts:
+            assert any(line.split()[:3] == [p.ref, p.a, p.b] for line in deck), p.ref

@@ -77,3 +77,21 @@ def test_the_result_is_typed_to_the_leaves():
     d = r.to_dict()
     assert d["spice"] is None and d["comparison"] == {} and d["simulator"] is None
     assert d["opamp"] == r.opamp.to_dict() and d["test_signal"] == r.test.to_dict()
+
+
+def test_both_plants_bills_of_materials_read_a_parts_source_from_the_sourcing():
+    # one lookup (Sourcing.source) for the Sallen-Key sheet's and a section plant's bill of materials
+    from designer.plant import circuit_report
+    from designer.plant.circuit_design import design_circuit_plant
+
+    res = design_plant(PlantSpec(fc_hz=3500, zeta=0.2), simulate=False)
+    for ref, src in res.sourcing.parts.items():
+        assert res.sourcing.source(ref) == (src.series, src.tolerance_pct)
+    assert res.sourcing.source("U1") is None
+    section = design_circuit_plant(PlantSpec(fc_hz=1000, zeta=0.5, topology="mfb-lowpass"), simulate=False)
+    for result, rows in ((res, report.bom(res)), (section, circuit_report.bom(section))):
+        # a row lists equal parts together ("R1, R2")
+        row_of = {ref: r for r in rows for ref in r[0].split(", ")}
+        for ref in result.sourcing.parts:
+            series, tol = result.sourcing.source(ref)
+            assert series in row_of[ref] and f"{tol:g} %" in row_of[ref]
