@@ -208,28 +208,22 @@ def closed_loop_deck(parts: PidParts, plant, opamp: OpAmp, test: SquareTest,
 def _loop_deck(parts, opamp, test, title, expected_final, about, plant_lines, netlist, points, max_step_s=None):
     """The loop deck either plant gives: header comments (``about``: the plant and controller), the op-amp
     library, raw ``plant_lines``, supplies, the reference, ``netlist``, the .meas lines, .tran, .end."""
-    import logging
-
-    from PySpice.Spice.Netlist import Circuit
-    logging.getLogger("PySpice").setLevel(logging.ERROR)
-    circuit = Circuit(title)
-    circuit.raw_spice = "\n".join([
+    circuit = deck.bench_circuit(title, opamp, [
         f"* {title}",
         f"* op-amps: {opamp.name} ({opamp.description}); supplies {opamp.vcc:g} V / {opamp.vee:g} V",
         f"* reference: 0 -> {test.amplitude_v:g} V square wave at {test.frequency_hz:g} Hz, edges "
         f"{test.edge_s:.3g} s, rising step at {test.delay_s:.4g} s",
         *about,
         "* Run: ngspice -b <this file>   (prints overshoot_pct, peak_time_s, rise_time_s, settling_time_s,",
-        "*   and the extremes of every op-amp output)",
-        deck.opamp_library_text().rstrip(),
-        *plant_lines,
-    ])
-    deck.add_supplies(circuit, opamp)
+        "*   and the extremes of every op-amp output)"])
+    if plant_lines:     # a model plant's behavioural lines, after the library as before
+        circuit.raw_spice = "\n".join([circuit.raw_spice, *plant_lines])
     circuit.V("ref", "ref", circuit.gnd, test.source())
     netlist.add_to(circuit, opamp)
     deck.settle_error_source(circuit, "y", expected_final)
     lines = deck.measure_lines("y", test, expected_final) + extreme_lines(parts, test)
     return deck.finish_deck(circuit, test, lines, points=points, max_step_s=max_step_s)
+
 
 def controller_netlist(parts: PidParts, reversed_action: bool = False) -> Netlist:
     """The controller alone (U2..U7 and their parts), for a plant that is only a
