@@ -25,7 +25,7 @@ Rp = 1/(2 Q w0 C), R2 = 1/(1/Rp - 1/R1).
 
 Realisability: R2 > 0 needs R1 > Rp, i.e. Am < 2 Q^2.
 
-R and C given (:meth:`MfbBandPass.synthesize_rc`): the input resistor R1 = R and
+R and C given (:meth:`~designer.filters.topology.Topology.synthesize_rc`): the input resistor R1 = R and
 C1 = C, C2 free: the gain gives R3 = Am R (C1 + C2)/C1, the s coefficient
 Rp (C1 + C2) = 1/(w0 Q) and the s^2 one C1 C2 R3 Rp = 1/w0^2 then give
 
@@ -83,23 +83,8 @@ class MfbBandPass(Topology):
         rp = 1.0 / (2 * q * w * c)
         return {"R1": r1, "R2": 1.0 / (1.0 / rp - 1.0 / r1), "R3": r3, "C1": c, "C2": c}
 
-    def synthesize_rc(self, target: SectionTarget, r: float, c: float) -> dict:
-        """R1 = R, C1 = C, C2, R2 and R3 solved (the module's equations).
-
-        Parameters
-        ----------
-        target : SectionTarget
-            The section target.
-        r, c : float
-            R (ohm) and C (farad).
-
-        Returns
-        -------
-        dict
-            Designator -> value.
-        """
-        self.check_rc(r, c)
-        self.check_realisable(target)
+    def _rc_design(self, target: SectionTarget, r: float, c: float) -> dict:
+        """R1 = R, C1 = C; C2, R2 and R3 solved (the module's equations)."""
         q, g, w = target.q, target.gain, target.wn
         c2 = q / (w * g * r)
         rp = 1.0 / (w * q * (c + c2))

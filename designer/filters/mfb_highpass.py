@@ -22,7 +22,7 @@ With a finite-gain op-amp, Vo = -A(s) Vn and the n row is (Vx - Vn) s C3 = (Vn -
 Design (TI's): C1 = C3 = C (the target's), C2 = C/G; then R1 = 1/(wn Q C (2 + 1/G))
 and R2 = G/(wn^2 C^2 R1). Every Q > 0 and G > 0 is reachable.
 
-R and C given (:meth:`MfbHighPass.synthesize_rc`): R1 = R, the input capacitor
+R and C given (:meth:`~designer.filters.topology.Topology.synthesize_rc`): R1 = R, the input capacitor
 C1 = C, C2 = C/G (the gain); the s coefficient R (C1 + C2 + C3) = 1/(wn Q) and
 R2 C3 = 1/(wn^2 C2 R) give
 
@@ -66,23 +66,8 @@ class MfbHighPass(Topology):
         r1 = 1.0 / (w * q * c * (2 + 1 / g))
         return {"R1": r1, "R2": g / (w * w * c * c * r1), "C1": c, "C2": c / g, "C3": c}
 
-    def synthesize_rc(self, target: SectionTarget, r: float, c: float) -> dict:
-        """R1 = R, C1 = C, C2 = C/G, C3 and R2 solved (the module's equations).
-
-        Parameters
-        ----------
-        target : SectionTarget
-            The section target.
-        r, c : float
-            R (ohm) and C (farad).
-
-        Returns
-        -------
-        dict
-            Designator -> value.
-        """
-        self.check_rc(r, c)
-        self.check_realisable(target)
+    def _rc_design(self, target: SectionTarget, r: float, c: float) -> dict:
+        """R1 = R, C1 = C, C2 = C/G; C3 and R2 solved (the module's equations)."""
         q, g, w = target.q, target.gain, target.wn
         c3 = 1.0 / (w * q * r) - c * (1 + 1 / g)
         if c3 <= 0:

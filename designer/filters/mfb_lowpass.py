@@ -28,7 +28,7 @@ Realisability: a real root needs C2/C1 >= 4 Q^2 (1 + G) (TI's
 "C2 >= 4 b1 (1 - A0) C1 / a1^2", A0 = -G). The default ratio is that bound (then
 R2 = 1/(2 wn Q C1)).
 
-R and C given (:meth:`MfbLowPass.synthesize_rc`): the gain resistor R2 = R,
+R and C given (:meth:`~designer.filters.topology.Topology.synthesize_rc`): the gain resistor R2 = R,
 R1 = R/G, the capacitor to ground C2 = C; then R3 C1 = T = 1/(wn^2 R C) and the
 s coefficient C1 R + T (1 + G) = 1/(wn Q) give
 
@@ -88,23 +88,8 @@ class MfbLowPass(Topology):
         r2 = quadratic_root(c1, 1.0 / (w * q), c1 * (1 + g) * p)
         return {"R1": r2 / g, "R2": r2, "R3": p / r2, "C1": c1, "C2": c2}
 
-    def synthesize_rc(self, target: SectionTarget, r: float, c: float) -> dict:
-        """R2 = R, R1 = R/G, C2 = C, C1 and R3 solved (the module's equations).
-
-        Parameters
-        ----------
-        target : SectionTarget
-            The section target.
-        r, c : float
-            R (ohm) and C (farad).
-
-        Returns
-        -------
-        dict
-            Designator -> value.
-        """
-        self.check_rc(r, c)
-        self.check_realisable(target)
+    def _rc_design(self, target: SectionTarget, r: float, c: float) -> dict:
+        """R2 = R, R1 = R/G, C2 = C; C1 and R3 solved (the module's equations)."""
         q, g, w = target.q, target.gain, target.wn
         t = 1.0 / (w * w * r * c)
         c1 = (1.0 / (w * q) - t * (1 + g)) / r

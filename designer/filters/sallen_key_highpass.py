@@ -29,7 +29,7 @@ impedance and R4 = (K - 1) R3.
 Realisability: every Q > 0 and K >= 1 is reachable (the constant term is never
 positive); the cost is the resistor spread, R2/R1 >= 4 Q^2 at unity gain.
 
-R and C given (:meth:`SallenKeyHighPass.synthesize_rc`): the seed's procedure
+R and C given (:meth:`~designer.filters.topology.Topology.synthesize_rc`): the seed's procedure
 with the roles of R and C swapped: R1 = R, C1 = C, C2 = n C, R2 = m R. With
 u = wn R C, R2 C2 = 1/(wn^2 R C) and the s coefficient R (C + C2) + R2 C2 (1 - K)
 = 1/(wn Q) give
@@ -82,23 +82,8 @@ class SallenKeyHighPass(SallenKeySection):
         r1 = quadratic_root(c1 + c2, 1.0 / (w * q), p * c2 * (1 - k))
         return {"R1": r1, "R2": p / r1, "C1": c1, "C2": c2, **self.gain_values(target, choices)}
 
-    def synthesize_rc(self, target: SectionTarget, r: float, c: float) -> dict:
-        """R1 = R, C1 = C, C2 = n C, R2 = m R (the module's equations).
-
-        Parameters
-        ----------
-        target : SectionTarget
-            The section target.
-        r, c : float
-            R (ohm) and C (farad).
-
-        Returns
-        -------
-        dict
-            Designator -> value.
-        """
-        self.check_rc(r, c)
-        self.check_realisable(target)
+    def _rc_design(self, target: SectionTarget, r: float, c: float) -> dict:
+        """R1 = R, C1 = C, C2 = n C, R2 = m R (the module's equations)."""
         q, k, u = target.q, target.gain, target.wn * r * c
         n = 1.0 / (q * u) - 1.0 + (k - 1.0) / (u * u)
         if n <= 0:

@@ -35,7 +35,7 @@ m (1/(4 Q^2) + K - 1) >= 1, i.e. at unity gain C2/C1 >= 4 Q^2 (SLOA088's
 ratio is the bound at unity gain (then R1 = R2) and 1 (equal capacitors) with
 gain when the bound allows it.
 
-R and C given (:meth:`SallenKeyLowPass.synthesize_rc`): the seed's procedure
+R and C given (:meth:`~designer.filters.topology.Topology.synthesize_rc`): the seed's procedure
 (001, simplification 2; :func:`~designer.filters.sallen_key_lowpass_synthesis.ratios_from_rc`):
 R2 = R, R1 = m R, C1 = C, C2 = n C with
 
@@ -122,23 +122,8 @@ class SallenKeyLowPass(SallenKeySection):
         r1 = quadratic_root(c1 * (1 + m * (1 - k)), 1.0 / (w * q), c1 * p)
         return {"R1": r1, "R2": p / r1, "C1": c1, "C2": c2, **self.gain_values(target, choices)}
 
-    def synthesize_rc(self, target: SectionTarget, r: float, c: float) -> dict:
-        """The seed's procedure: R2 = R, R1 = m R, C1 = C, C2 = n C (the module's equations).
-
-        Parameters
-        ----------
-        target : SectionTarget
-            The section target.
-        r, c : float
-            R (ohm) and C (farad).
-
-        Returns
-        -------
-        dict
-            Designator -> value.
-        """
-        self.check_rc(r, c)
-        self.check_realisable(target)
+    def _rc_design(self, target: SectionTarget, r: float, c: float) -> dict:
+        """The seed's procedure: R2 = R, R1 = m R, C1 = C, C2 = n C (the module's equations)."""
         try:
             m, n = ratios_from_rc(target.fn_hz, 1.0 / (2 * target.q), r, c, target.gain)
         except DesignError as exc:

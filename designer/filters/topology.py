@@ -409,8 +409,9 @@ class Topology(ABC):
         time constant R C = 1/wc): :meth:`synthesize` with C as the reference capacitor,
         accepted when one of its resistors is R (to :data:`RC_MATCH`, relative: the
         values returned are C's, exact), refused otherwise, since R and C then
-        over-determine the section. A section with a second free scale overrides it
-        with its closed form (the equations in its module).
+        over-determine the section. A section with a second free scale overrides
+        ``_rc_design`` (R, C and the target checked) with its closed form (the equations
+        in its module).
 
         Parameters
         ----------
@@ -434,6 +435,11 @@ class Topology(ABC):
             that the section cannot take together (one line naming ``r`` or ``c``).
         """
         self.check_rc(r, c)
+        self.check_realisable(target)
+        return self._rc_design(target, r, c)
+
+    def _rc_design(self, target: SectionTarget, r: float, c: float) -> dict:
+        """:meth:`synthesize_rc` on checked inputs: the one-free-scale default; sections override it."""
         values = self.synthesize(dataclasses.replace(target, impedance_ohm=r, c_f=c))
         resistors = [p.ref for p in self.parts if p.kind == "R"]
         if any(abs(values[ref] / r - 1) <= RC_MATCH for ref in resistors):
