@@ -48,6 +48,7 @@ def design_plant_parser():
   design-plant --fc 3500 --zeta 0.2 --stimulus prbs  also the bench's PRBS in ngspice: prbs.csv, waveforms.csv
   design-plant --fc 1k --zeta 0.5 --gain 2 --topology mfb-lowpass   the same target on an inverting MFB section
   design-plant --fc 1k --topology rc-lowpass          a first-order section takes no --zeta
+  design-plant --fc 1k --zeta 0.5 --topology sallen-key-highpass --r 10k --c 10n   fix R and C on a section
 
 Outputs: netlists/<name>.cir (run it alone with `ngspice -b`), reports/<name>/build-sheet.md and .html,
 result.json, step.png, bode.png. Exit status 2 on bad input.
@@ -74,7 +75,10 @@ topologies (--topology NAME):
     sel = p.add_argument_group("parts")
     sel.add_argument("--r", metavar="OHM", help="the seed's procedure: fix R (R2 = R, R1 = m R) ... "
                                                 "(resistors: " + help_range("resistor_ohm")[1:])
-    sel.add_argument("--c", metavar="F", help="... and C (C1 = C, C2 = n C), solve m and n "
+    sel.add_argument("--c", metavar="F", help="... and C (C1 = C, C2 = n C), solve m and n, round the parts "
+                                              "jointly to the series; with --topology the section's own "
+                                              "procedure (its module's equations; a first-order section has one "
+                                              "time constant, so R C must be 1/(2 pi fc)) "
                                               "(capacitors: " + help_range("capacitor_f")[1:])
     add_part_options(sel)
     sel.add_argument("--alternatives", default="5",

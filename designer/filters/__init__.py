@@ -46,7 +46,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                                      "resistors_for_caps",),
     "spec": ("FilterSpec", "TOPOLOGY_CHOICES",),
     "tables": ("TableRow", "coefficient_table", "section_3db_ratio", "table_corner",),
-    "topology": ("DEFAULT_IMPEDANCE_OHM", "Figures", "KINDS", "PartSpec", "SectionTarget", "Topology",
+    "topology": ("DEFAULT_IMPEDANCE_OHM", "Figures", "KINDS", "PartSpec", "RC_MATCH", "SectionTarget", "Topology",
                  "nodal_response", "nodal_system", "open_loop_gain", "polynomial", "polyval", "quadratic_root"),
     "verify": ("BenchSignal", "NRMS_PASS", "PROOF_POINTS_PER_DECADE", "Proof", "StageDrive", "TRAN_POINTS",
                "analytic_tran", "band_edge_db", "bench_signal", "mask_edges", "opamp_aware_polys", "phase_delay_error_pct",

@@ -24,11 +24,20 @@ Design (TI's, equal capacitors C1 = C2 = C): R3 = 2 Q/(w0 C), R1 = R3/(2 Am),
 Rp = 1/(2 Q w0 C), R2 = 1/(1/Rp - 1/R1).
 
 Realisability: R2 > 0 needs R1 > Rp, i.e. Am < 2 Q^2.
+
+R and C given (:meth:`~designer.filters.topology.Topology.synthesize_rc`): the input resistor R1 = R and
+C1 = C, C2 free: the gain gives R3 = Am R (C1 + C2)/C1, the s coefficient
+Rp (C1 + C2) = 1/(w0 Q) and the s^2 one C1 C2 R3 Rp = 1/w0^2 then give
+
+    C2 = Q/(w0 Am R),   Rp = 1/(w0 Q (C + C2)),   R2 = 1/(1/Rp - 1/R),
+
+R2 positive only when Rp < R, i.e. w0 Q R C + Q^2/Am > 1 (the section's limit
+Am < 2 Q^2, its equal-capacitor design's, still applies).
 """
 
 from __future__ import annotations
 
-from ..core.errors import DesignError
+from ..core.errors import DesignError, ParamError
 from ..core.i18n import N_
 from ..spice.deck import GROUND, Amp, Netlist
 from .topology import PartSpec, SectionTarget, Topology, polynomial
@@ -73,6 +82,17 @@ class MfbBandPass(Topology):
         r1 = r3 / (2 * g)
         rp = 1.0 / (2 * q * w * c)
         return {"R1": r1, "R2": 1.0 / (1.0 / rp - 1.0 / r1), "R3": r3, "C1": c, "C2": c}
+
+    def _rc_design(self, target: SectionTarget, r: float, c: float) -> dict:
+        """R1 = R, C1 = C; C2, R2 and R3 solved (the module's equations)."""
+        q, g, w = target.q, target.gain, target.wn
+        c2 = q / (w * g * r)
+        rp = 1.0 / (w * q * (c + c2))
+        if rp >= r:
+            raise ParamError(f"{{r}} and {{c}}: no positive R2 for R = {r:g} Ohm, C = {c:g} F: {self.name} needs "
+                             f"R*C > (1 - Q^2/gain)/(w0 Q) = {(1 - q * q / g) / (w * q):.4g} s (R*C is "
+                             f"{r * c:.4g} s); choose a larger R or C", params=("r", "c"))
+        return {"R1": r, "R2": 1.0 / (1.0 / rp - 1.0 / r), "R3": g * r * (c + c2) / c, "C1": c, "C2": c2}
 
     def netlist(self, values: dict, prefix: str = "", amp_ref: str = "U1", inp: str = "vin",
                 out: str = "vout") -> Netlist:

@@ -21,10 +21,19 @@ With a finite-gain op-amp, Vo = -A(s) Vn and the n row is (Vx - Vn) s C3 = (Vn -
 
 Design (TI's): C1 = C3 = C (the target's), C2 = C/G; then R1 = 1/(wn Q C (2 + 1/G))
 and R2 = G/(wn^2 C^2 R1). Every Q > 0 and G > 0 is reachable.
+
+R and C given (:meth:`~designer.filters.topology.Topology.synthesize_rc`): R1 = R, the input capacitor
+C1 = C, C2 = C/G (the gain); the s coefficient R (C1 + C2 + C3) = 1/(wn Q) and
+R2 C3 = 1/(wn^2 C2 R) give
+
+    C3 = 1/(wn Q R) - C (1 + 1/G),   R2 = 1/(wn^2 C2 C3 R),
+
+positive only when R C (1 + 1/G) < 1/(wn Q).
 """
 
 from __future__ import annotations
 
+from ..core.errors import ParamError
 from ..core.i18n import N_
 from ..spice.deck import GROUND, Amp, Netlist
 from .topology import PartSpec, SectionTarget, Topology, polynomial
@@ -56,6 +65,17 @@ class MfbHighPass(Topology):
         c = self.scale(target)
         r1 = 1.0 / (w * q * c * (2 + 1 / g))
         return {"R1": r1, "R2": g / (w * w * c * c * r1), "C1": c, "C2": c / g, "C3": c}
+
+    def _rc_design(self, target: SectionTarget, r: float, c: float) -> dict:
+        """R1 = R, C1 = C, C2 = C/G; C3 and R2 solved (the module's equations)."""
+        q, g, w = target.q, target.gain, target.wn
+        c3 = 1.0 / (w * q * r) - c * (1 + 1 / g)
+        if c3 <= 0:
+            raise ParamError(f"{{r}} and {{c}}: no positive C3 for R = {r:g} Ohm, C = {c:g} F: {self.name} needs "
+                             f"R*C < 1/(wn Q (1 + 1/|gain|)) = {1.0 / (w * q * (1 + 1 / g)):.4g} s (R*C is "
+                             f"{r * c:.4g} s); choose a smaller R or C", params=("r", "c"))
+        c2 = c / g
+        return {"R1": r, "R2": 1.0 / (w * w * c2 * c3 * r), "C1": c, "C2": c2, "C3": c3}
 
     def netlist(self, values: dict, prefix: str = "", amp_ref: str = "U1", inp: str = "vin",
                 out: str = "vout") -> Netlist:

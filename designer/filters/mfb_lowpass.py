@@ -27,11 +27,20 @@ smaller root (TI's choice), R3 = P/R2.
 Realisability: a real root needs C2/C1 >= 4 Q^2 (1 + G) (TI's
 "C2 >= 4 b1 (1 - A0) C1 / a1^2", A0 = -G). The default ratio is that bound (then
 R2 = 1/(2 wn Q C1)).
+
+R and C given (:meth:`~designer.filters.topology.Topology.synthesize_rc`): the gain resistor R2 = R,
+R1 = R/G, the capacitor to ground C2 = C; then R3 C1 = T = 1/(wn^2 R C) and the
+s coefficient C1 R + T (1 + G) = 1/(wn Q) give
+
+    C1 = (1/(wn Q) - T (1 + G)) / R,   R3 = T / C1,
+
+positive only when R C > Q (1 + G)/wn (the MFB's own bound, C2/C1 >= 4 Q^2 (1 + G),
+then holds: this is the root the default ratio takes, met from the other side).
 """
 
 from __future__ import annotations
 
-from ..core.errors import DesignError
+from ..core.errors import DesignError, ParamError
 from ..core.i18n import N_
 from ..spice.deck import GROUND, Amp, Netlist
 from .topology import PartSpec, SectionTarget, Topology, polynomial, quadratic_root
@@ -78,6 +87,17 @@ class MfbLowPass(Topology):
         p = 1.0 / (w * w * c1 * c2)
         r2 = quadratic_root(c1, 1.0 / (w * q), c1 * (1 + g) * p)
         return {"R1": r2 / g, "R2": r2, "R3": p / r2, "C1": c1, "C2": c2}
+
+    def _rc_design(self, target: SectionTarget, r: float, c: float) -> dict:
+        """R2 = R, R1 = R/G, C2 = C; C1 and R3 solved (the module's equations)."""
+        q, g, w = target.q, target.gain, target.wn
+        t = 1.0 / (w * w * r * c)
+        c1 = (1.0 / (w * q) - t * (1 + g)) / r
+        if c1 <= 0:
+            raise ParamError(f"{{r}} and {{c}}: no positive C1 for R = {r:g} Ohm, C = {c:g} F: {self.name} needs "
+                             f"R*C > Q (1 + |gain|)/wn = {q * (1 + g) / w:.4g} s (R*C is {r * c:.4g} s); choose a "
+                             "larger R or C", params=("r", "c"))
+        return {"R1": r / g, "R2": r, "R3": t / c1, "C1": c1, "C2": c}
 
     def netlist(self, values: dict, prefix: str = "", amp_ref: str = "U1", inp: str = "vin",
                 out: str = "vout") -> Netlist:

@@ -28,10 +28,21 @@ impedance and R4 = (K - 1) R3.
 
 Realisability: every Q > 0 and K >= 1 is reachable (the constant term is never
 positive); the cost is the resistor spread, R2/R1 >= 4 Q^2 at unity gain.
+
+R and C given (:meth:`~designer.filters.topology.Topology.synthesize_rc`): the seed's procedure
+with the roles of R and C swapped: R1 = R, C1 = C, C2 = n C, R2 = m R. With
+u = wn R C, R2 C2 = 1/(wn^2 R C) and the s coefficient R (C + C2) + R2 C2 (1 - K)
+= 1/(wn Q) give
+
+    n = 1/(Q u) - 1 + (K - 1)/u^2,   m = 1/(u^2 n)
+
+(the low-pass's m, with zeta = 1/(2 Q)), positive only when R C < 1/(wn Q) at
+unity gain; with gain R3 = R, R4 = (K - 1) R.
 """
 
 from __future__ import annotations
 
+from ..core.errors import ParamError
 from ..core.i18n import N_
 from ..spice.deck import GROUND, Netlist
 from .sallen_key import SallenKeySection
@@ -70,6 +81,18 @@ class SallenKeyHighPass(SallenKeySection):
         p = 1.0 / (w * w * c1 * c2)
         r1 = quadratic_root(c1 + c2, 1.0 / (w * q), p * c2 * (1 - k))
         return {"R1": r1, "R2": p / r1, "C1": c1, "C2": c2, **self.gain_values(target, choices)}
+
+    def _rc_design(self, target: SectionTarget, r: float, c: float) -> dict:
+        """R1 = R, C1 = C, C2 = n C, R2 = m R (the module's equations)."""
+        q, k, u = target.q, target.gain, target.wn * r * c
+        n = 1.0 / (q * u) - 1.0 + (k - 1.0) / (u * u)
+        if n <= 0:
+            raise ParamError(f"{{r}} and {{c}}: no positive C2 for R = {r:g} Ohm, C = {c:g} F: {self.name} needs "
+                             f"R*C < (1/Q + (K - 1)/(wn R C))/wn; at unity gain R*C < 1/(wn Q) = "
+                             f"{1.0 / (target.wn * q):.4g} s (R*C is {r * c:.4g} s); choose a smaller R or C"
+                             + (", or a larger gain" if self.with_gain else ""), params=("r", "c"))
+        gain = {"R3": r, "R4": (k - 1) * r} if self.with_gain else {}
+        return {"R1": r, "R2": r / (u * u * n), "C1": c, "C2": n * c, **gain}
 
     def netlist(self, values: dict, prefix: str = "", amp_ref: str = "U1", inp: str = "vin",
                 out: str = "vout") -> Netlist:

@@ -34,15 +34,23 @@ m (1/(4 Q^2) + K - 1) >= 1, i.e. at unity gain C2/C1 >= 4 Q^2 (SLOA088's
 "C2 >= C1 4 b1 / a1^2"), with gain C2/C1 >= 1 / (1/(4 Q^2) + K - 1). The default
 ratio is the bound at unity gain (then R1 = R2) and 1 (equal capacitors) with
 gain when the bound allows it.
+
+R and C given (:meth:`~designer.filters.topology.Topology.synthesize_rc`): the seed's procedure
+(001, simplification 2; :func:`~designer.filters.sallen_key_lowpass_synthesis.ratios_from_rc`):
+R2 = R, R1 = m R, C1 = C, C2 = n C with
+
+    m n = 1/(wn R C)^2,   m = 2 zeta sqrt(m n) - 1 + m n (K - 1),   zeta = 1/(2 Q),
+
+positive only when R C < 2 zeta / wn at unity gain; with gain R3 = R, R4 = (K - 1) R.
 """
 
 from __future__ import annotations
 
-from ..core.errors import DesignError
+from ..core.errors import DesignError, ParamError
 from ..core.i18n import N_
 from ..spice.deck import GROUND, Netlist
 from .sallen_key import SallenKeySection
-from .sallen_key_lowpass_synthesis import coefficients
+from .sallen_key_lowpass_synthesis import coefficients, ratios_from_rc
 from .topology import PartSpec, SectionTarget, polynomial, quadratic_root
 
 __all__ = ["SallenKeyLowPass", "sallen_key_ratio_min"]
@@ -113,6 +121,15 @@ class SallenKeyLowPass(SallenKeySection):
         p = 1.0 / (w * w * c1 * c2)
         r1 = quadratic_root(c1 * (1 + m * (1 - k)), 1.0 / (w * q), c1 * p)
         return {"R1": r1, "R2": p / r1, "C1": c1, "C2": c2, **self.gain_values(target, choices)}
+
+    def _rc_design(self, target: SectionTarget, r: float, c: float) -> dict:
+        """The seed's procedure: R2 = R, R1 = m R, C1 = C, C2 = n C (the module's equations)."""
+        try:
+            m, n = ratios_from_rc(target.fn_hz, 1.0 / (2 * target.q), r, c, target.gain)
+        except DesignError as exc:
+            raise ParamError("{r} and {c}: " + str(exc), params=("r", "c")) from None
+        gain = {"R3": r, "R4": (target.gain - 1) * r} if self.with_gain else {}
+        return {"R1": m * r, "R2": r, "C1": c, "C2": n * c, **gain}
 
     def netlist(self, values: dict, prefix: str = "", amp_ref: str = "U1", inp: str = "vin",
                 out: str = "vout") -> Netlist:

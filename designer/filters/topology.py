@@ -9,6 +9,12 @@ role shown on a sheet) and implements four things:
   s (closed forms, vectorised over arrays of part values);
 - :meth:`Topology.synthesize`: continuous part values from a
   :class:`SectionTarget` and the free choices the topology offers;
+- :meth:`Topology.synthesize_rc`: the seed's hand procedure (001: "fix R and C,
+  solve the rest") on the section: a resistor R and a capacitor C given, the other
+  parts solved so that both appear among the parts, or a one-line refusal naming
+  which of R or C the section cannot take (the default, from :meth:`synthesize`,
+  fits a section with one time constant; the second-order sections write their
+  closed forms in their own modules);
 - :meth:`Topology.check_realisable`: its realisability limits, refused in one
   line naming the limit and what to change;
 - :meth:`Topology.netlist`: its :class:`~designer.spice.deck.Netlist` with a
@@ -30,6 +36,7 @@ well conditioned at any gain). The section modules write their node equations ou
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
@@ -37,15 +44,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.errors import DesignError
+from ..core.units import format_eng
 from ..spice.deck import GROUND, Netlist, Part
 
 __all__ = ["KINDS", "DEFAULT_IMPEDANCE_OHM", "PartSpec", "SectionTarget", "Figures", "Topology",
-           "open_loop_gain", "nodal_system", "nodal_response", "polynomial", "polyval", "quadratic_root"]
+           "RC_MATCH", "open_loop_gain", "nodal_system", "nodal_response", "polynomial", "polyval", "quadratic_root"]
 
 #: the section responses a target may ask for
 KINDS = ("lowpass", "highpass", "bandpass")
 #: the resistor scale of a synthesis given neither an impedance nor a capacitor (ohm)
 DEFAULT_IMPEDANCE_OHM = 10e3
+#: how close (relative) a given R must be to the resistor a given C sets, for a section with one free scale
+#: (:meth:`Topology.synthesize_rc`'s default): seven significant digits typed agree
+RC_MATCH = 1e-6
 
 
 @dataclass(frozen=True)
@@ -389,6 +400,73 @@ class Topology(ABC):
         Netlist
             Its parts (roles from :attr:`parts`) and op-amp.
         """
+
+    def synthesize_rc(self, target: SectionTarget, r: float, c: float) -> dict:
+        """Continuous part values realising ``target`` exactly with a resistor R and a
+        capacitor C given (the seed's "fix R and C, solve the rest").
+
+        The default fits a section with a single free scale (the first-order ones: one
+        time constant R C = 1/wc): :meth:`synthesize` with C as the reference capacitor,
+        accepted when one of its resistors is R (to :data:`RC_MATCH`, relative: the
+        values returned are C's, exact), refused otherwise, since R and C then
+        over-determine the section. A section with a second free scale overrides
+        ``_rc_design`` (R, C and the target checked) with its closed form (the equations
+        in its module).
+
+        Parameters
+        ----------
+        target : SectionTarget
+            The section's kind, fn, Q and gain (its ``impedance_ohm`` and ``c_f`` are
+            replaced by ``r`` and ``c``).
+        r : float
+            The resistor R, ohm.
+        c : float
+            The capacitor C, farad.
+
+        Returns
+        -------
+        dict
+            Designator -> value (ohm, farad).
+
+        Raises
+        ------
+        DesignError
+            R or C not positive, the target out of the section's limits, or R and C
+            that the section cannot take together (one line naming ``r`` or ``c``).
+        """
+        self.check_rc(r, c)
+        self.check_realisable(target)
+        return self._rc_design(target, r, c)
+
+    def _rc_design(self, target: SectionTarget, r: float, c: float) -> dict:
+        """:meth:`synthesize_rc` on checked inputs: the one-free-scale default; sections override it."""
+        values = self.synthesize(dataclasses.replace(target, impedance_ohm=r, c_f=c))
+        resistors = [p.ref for p in self.parts if p.kind == "R"]
+        if any(abs(values[ref] / r - 1) <= RC_MATCH for ref in resistors):
+            return values
+        first = resistors[0]
+        ohm = lambda v: format_eng(v, "Ohm")  # noqa: E731
+        set_by_c = ", ".join(f"{ref} = {ohm(values[ref])}" for ref in resistors)
+        raise DesignError(f"r: {self.name} has one free scale, so C = {format_eng(c, 'F')} sets its resistors "
+                          f"({set_by_c}) and R = {ohm(r)} is none of them; give R = {ohm(values[first])}, or "
+                          f"C = {format_eng(c * values[first] / r, 'F')} (then {first} = R)", param="r")
+
+    def check_rc(self, r: float, c: float) -> None:
+        """Refuse an R or C of :meth:`synthesize_rc` that is not a positive number.
+
+        Parameters
+        ----------
+        r, c : float
+            The resistor (ohm) and capacitor (farad).
+
+        Raises
+        ------
+        DesignError
+            One line naming ``r`` or ``c``.
+        """
+        for name, v in (("r", r), ("c", c)):
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise DesignError(f"{name} must be a positive number, got {v!r}", param=name)
 
     def limits(self, target: SectionTarget) -> dict:
         """The bounds ``target`` puts on the free choices (none by default).

@@ -20,7 +20,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                        "with_square_test", "default_square_hz"),
     "circuit": ("BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "candidate_set", "capacitor_combinations",
                 "circuit_figures", "corner_frequencies", "dominant_pairs", "evaluate", "opamp_tf", "plant_target",
-                "search", "step_of_pair"),
+                "rounded", "search", "step_of_pair"),
     "bench": ("PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",
               "tolerance_band"),
     "design": ("R_BAND", "analyze_plant", "choose_parts", "design_plant", "listed"),

@@ -47,7 +47,7 @@ from ..filters import registry
 from ..filters.topology import SectionTarget, Topology, nodal_system
 
 __all__ = ["BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "Candidate", "plant_target", "capacitor_combinations", "candidate_set",
-           "search", "brute_force", "opamp_tf", "dominant_pairs", "circuit_figures", "evaluate", "sensitivities",
+           "search", "rounded", "brute_force", "opamp_tf", "dominant_pairs", "circuit_figures", "evaluate", "sensitivities",
            "corner_frequencies", "step_of_pair"]
 
 #: the topology of ``design-plant`` without ``--topology``: the seed's plant (its own search, :mod:`.selection`)
@@ -307,6 +307,42 @@ def search(topology: Topology, target: SectionTarget, r_values, c_values, top: i
             values[ref] = np.broadcast_to(combos[ref].reshape((n_b,) + (1,) * len(res)), shape)
     values = {r: v[valid] for r, v in values.items()}
     return _ranked(topology, target, values, top)
+
+
+def rounded(topology: Topology, target: SectionTarget, ideal: dict, r_values, c_values, top: int = 5,
+            width: int = 2) -> list:
+    """The ``top`` best combinations of each part's ``width`` series values on each side of its
+    value in ``ideal`` (an exact design: :meth:`Topology.synthesize_rc`'s, the seed's "fix R
+    and C"): that design rounded jointly, as the seed's plant rounds its own
+    (:func:`designer.plant.design.choose_parts`), every combination evaluated at once.
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    target : SectionTarget
+        The target the combinations are ranked against.
+    ideal : dict
+        Designator -> continuous value.
+    r_values, c_values : array_like
+        The resistor and capacitor series values inside the bounds, ascending.
+    top : int
+        How many to return.
+    width : int
+        Series values on each side of each part's value (a part beyond the bounds takes the nearest).
+
+    Returns
+    -------
+    list of Candidate
+        Best first, ranked as :func:`search` ranks.
+    """
+    axes = []
+    for p in topology.parts:
+        series = np.unique(np.asarray(r_values if p.kind == "R" else c_values, dtype=float))
+        i = int(np.searchsorted(series, ideal[p.ref]))
+        axes.append(series[max(0, i - width):i + width])
+    grid = np.meshgrid(*axes, indexing="ij")
+    return _ranked(topology, target, {p.ref: g.ravel() for p, g in zip(topology.parts, grid)}, top)
 
 
 def brute_force(topology: Topology, target: SectionTarget, blocks: list, top: int = 5) -> list:

@@ -1,6 +1,8 @@
 """``design-plant --topology NAME``: the plant's target realised by any registered
 section (:mod:`designer.filters`), through the one :class:`~designer.filters.topology.Topology`
-interface: the E-series search (:func:`designer.plant.circuit.search`), the figures
+interface: the E-series search (:func:`designer.plant.circuit.search`; with R and C
+given, the seed's procedure: the section's exact design from them rounded jointly,
+:func:`designer.plant.circuit.rounded`), the figures
 (fn, zeta, Q, gain, -3 dB, the op-amp-aware dominant pair, the step), the
 sensitivities over the declared parts, the deck, BOM and wiring from the topology's
 netlist (:func:`designer.spice.deck.board`), and the ngspice ``.ac`` of that deck
@@ -271,7 +273,9 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
     Parameters
     ----------
     spec : designer.plant.spec.PlantSpec
-        The request (its ``topology`` any registered one; the seed's ``r``, ``c`` refused by the spec).
+        The request (its ``topology`` any registered one; with ``r`` and ``c`` the seed's procedure:
+        the section's :meth:`~designer.filters.topology.Topology.synthesize_rc` design, rounded jointly
+        to the series by :func:`designer.plant.circuit.rounded`, as the seed's plant rounds its own).
     simulate : bool
         Run ngspice's .ac of the deck.
     simulator : str
@@ -296,7 +300,12 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
     aim = predistort(topo, section, amp) if spec.compensate_gbw else section
     rv = candidates(spec.r_series, spec.r_min, spec.r_max, "resistor")
     cv = candidates(spec.c_series, spec.c_min, spec.c_max, "capacitor")
-    ranked = circuit.search(topo, aim, rv, cv, top=spec.alternatives)
+    if spec.r is None:
+        ranked = circuit.search(topo, aim, rv, cv, top=spec.alternatives)
+    else:
+        # the seed's procedure on the section: R and C fixed, the rest solved, then rounded jointly
+        exact = topo.synthesize_rc(aim, spec.r, spec.c)
+        ranked = circuit.rounded(topo, aim, exact, rv, cv, top=spec.alternatives)
     best = ranked[0]
     if aim is section and best.worst > MAX_ERROR:
         raise DesignError(f"fc_hz: the best {spec.r_series}/{spec.c_series} parts for {topo.name} land "
@@ -304,11 +313,17 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
                           "part bounds or use a finer series", param="fc_hz")
     t_search = time.perf_counter() - tick
     values = best.values
-    ideal = topo.synthesize(dataclasses.replace(aim, c_f=values[topo.reference_capacitor]))
+    ideal = exact if spec.r is not None else topo.synthesize(dataclasses.replace(aim, c_f=values[topo.reference_capacitor]))
     labels, _, _, _ = part_series(values, spec.r_series, spec.c_series)
     notes = [Message(N_("{section}: parts {parts}"), section=Message(topo.title),
                      parts=Message.joined(", ", (Message(N_("{ref} ({role})"), ref=p.ref, role=Message(p.role))
                                                         for p in topo.parts)))]
+    if spec.r is not None:
+        notes.append(Message(N_("R = {r} and C = {c} fixed (the seed's procedure): the exact design {parts}, "
+                                "rounded jointly to the series"), r=format_eng(spec.r, "Ohm"),
+                             c=format_eng(spec.c, "F"),
+                             parts=", ".join(f"{ref} = {format_eng(v, 'Ohm' if ref[0] == 'R' else 'F')}"
+                                             for ref, v in exact.items())))
     if spec.compensate_gbw:
         notes.append(Message(N_("--compensate-gbw: designed for fn {fn} Hz{q} so that with the {opamp}'s {gbw} GBW it "
                                 "lands on the spec"), fn=f"{aim.fn_hz:.5g}", q=f", Q {aim.q:.4g}" if aim.q else "",

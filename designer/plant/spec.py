@@ -83,8 +83,11 @@ class PlantSpec(PartBounds):
     :func:`designer.plant.bench.recommend_square_wave`); ``alternatives`` is how
     many best combinations the result lists. ``topology`` names the registered
     section that realises the plant (:mod:`designer.filters.registry`; default
-    the seed's Sallen-Key low-pass, the only one the seed's procedure ``r``, ``c``
-    fits); a first-order section takes no ``zeta`` (None).
+    the seed's Sallen-Key low-pass); with ``r`` and ``c`` another section takes the
+    seed's procedure through its
+    :meth:`~designer.filters.topology.Topology.synthesize_rc` (which refuses, at
+    design time, an R and C the section cannot take); a first-order section takes
+    no ``zeta`` (None).
 
     Raises
     ------
@@ -114,9 +117,6 @@ class PlantSpec(PartBounds):
                 continue
             put(name, parse_in_range(getattr(self, name), name, name))
         plant_target(topo, self.fc_hz, self.zeta, self.gain)   # a damping for a first-order section refused
-        if topo.name != DEFAULT_TOPOLOGY and self.r is not None:
-            raise ParamError("{r} and {c}: the seed's procedure (fix R and C, solve m and n) is the "
-                             f"{DEFAULT_TOPOLOGY}'s; {topo.name} takes the E-series search")
         self.check_bounds()
         if (self.r is None) != (self.c is None):
             raise ParamError("{r} and {c} go together (the seed's procedure fixes both R and C)")

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from helpers import script
 
+from designer.core import eseries
 from designer.core.opamps import get as get_opamp
 from designer.filters import REGISTRY
 from designer.plant import circuit
@@ -93,7 +94,9 @@ def test_an_unknown_topology_is_one_line_with_the_registered_and_the_closest(tmp
     (["--fc", "200k", "--zeta", "0.1", "--gain", "3", "--topology", "mfb-lowpass"], ["--opamp", "too slow", "GBW"]),
     (["--fc", "1k", "--zeta", "0.5", "--topology", "rc-lowpass"], ["--zeta", "first-order"]),
     (["--fc", "1k", "--topology", "mfb-lowpass"], ["required: --zeta"]),
-    (["--fc", "1k", "--zeta", "0.5", "--topology", "mfb-lowpass", "--r", "1k", "--c", "10n"], ["--r", "seed"]),
+    # the seed's procedure on the MFB low-pass: R C = 10 us is below its Q (1 + |gain|)/wn = 318 us
+    (["--fc", "1k", "--zeta", "0.5", "--topology", "mfb-lowpass", "--r", "1k", "--c", "10n"],
+     ["--r and --c", "no positive C1", "choose a larger R or C"]),
 ])
 def test_targets_a_topology_cannot_realise_are_one_line(args, words, tmp_path):
     refused(run(*args, "--no-sim", cwd=tmp_path), words, tmp_path)
@@ -267,3 +270,37 @@ def test_replay_on_a_section_is_the_monte_carlos_build(tmp_path):
     assert Path(d["files"]["result_json"]).parent.name.endswith("_sample5")
     text = run(*args, "--replay", "5", "--no-files")
     assert text.returncode == 0 and "Replay of Monte Carlo sample 5 (of 20, sobol, normal, seed 4)" in text.stdout
+
+
+@pytest.mark.parametrize("name,args", [
+    ("sallen-key-highpass", ["--fc", "1k", "--zeta", "0.5", "--r", "10k", "--c", "10n"]),
+    ("mfb-lowpass", ["--fc", "1k", "--zeta", "0.5", "--gain", "2", "--r", "10k", "--c", "100n"]),
+])
+def test_r_and_c_on_a_section_is_its_exact_design_rounded_jointly(name, args, tmp_path):
+    """design-plant --topology NAME --r R --c C: the JSON's ideal is the section's synthesize_rc design (R and C
+    among its parts), the build each part within two series values of it, a note says so."""
+    topo = REGISTRY[name]
+    out = run(*args, "--topology", name, "--no-sim", "--json", "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    fc, zeta, gain = d["spec"]["fc_hz"], d["spec"]["zeta"], d["spec"]["gain"]
+    c = float(args[args.index("--c") + 1][:-1]) * 1e-9
+    exact = topo.synthesize_rc(circuit.plant_target(topo, fc, zeta, gain), 10e3, c)
+    assert d["ideal"] == pytest.approx(exact, rel=1e-12)
+    for ref, part in d["parts"].items():
+        v = part["value"]
+        series = eseries.values("E24", 1, 1e9) if ref[0] == "R" else eseries.values("E12", 1e-13, 1)
+        i = int(np.searchsorted(series, exact[ref]))
+        assert v in series[max(0, i - 2):i + 2], (ref, v, exact[ref])
+    assert any("fixed (the seed's procedure)" in n for n in d["notes"])
+
+
+@pytest.mark.parametrize("args,words", [
+    (["--fc", "1k", "--topology", "rc-lowpass", "--r", "1k", "--c", "10n"],
+     ["--r: rc-lowpass has one free scale", "give R = 15.92 kOhm, or C = 159.2 nF"]),
+    (["--fc", "1k", "--zeta", "0.5", "--gain", "2", "--topology", "mfb-lowpass", "--r", "1k", "--c", "10n"],
+     ["--r and --c: no positive C1", "R*C > Q (1 + |gain|)/wn"]),
+    (["--fc", "1k", "--zeta", "0.5", "--topology", "mfb-highpass", "--r", "1k"], ["--r and --c go together"]),
+])
+def test_r_and_c_a_section_cannot_take_are_one_line(args, words, tmp_path):
+    refused(run(*args, "--no-sim", cwd=tmp_path), words, tmp_path)

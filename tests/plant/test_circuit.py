@@ -108,3 +108,21 @@ def test_generic_search_reaches_a_ratio_just_below_the_bound():
     generic = circuit.search(SK, circuit.plant_target(SK, fc, zeta), rv, cv, top=1)[0]
     fast = selection.joint_search(fc, zeta, rv, cv, 1.0, top=1)[0]
     assert generic.worst == pytest.approx(fast.worst, rel=1e-9, abs=1e-15)
+
+
+@pytest.mark.parametrize("topology", list(registry.REGISTRY.values()), ids=registry.names())
+def test_rounded_is_the_brute_force_over_each_part_s_series_neighbours(topology):
+    """circuit.rounded (the seed's procedure's rounding on a section) ranks every combination of each part's
+    two E-series values a side of the exact design as the scalar brute force does."""
+    rv, cv = eseries.values("E24", 100, 1e6), eseries.values("E12", 100e-12, 10e-6)
+    target = topology.example
+    exact = topology.synthesize(target)
+    got = circuit.rounded(topology, target, exact, rv, cv, top=3)
+    block = {}
+    for p in topology.parts:
+        series = rv if p.kind == "R" else cv
+        lo, hi = series[series < exact[p.ref]][-2:], series[series >= exact[p.ref]][:2]
+        block[p.ref] = np.concatenate([lo, hi])
+    want = circuit.brute_force(topology, target, [block], top=3)
+    assert [c.values for c in got] == [c.values for c in want]
+    assert [c.worst for c in got] == pytest.approx([c.worst for c in want], rel=1e-12)

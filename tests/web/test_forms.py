@@ -351,3 +351,15 @@ def test_page_text_names_a_parameter_a_message_carries_by_its_fields_label(lang)
     assert shown == words("{problem}; record it with {update_golden}").format(
         problem="golden file g.csv does not exist", update_golden=f'"{words(CHECK["update-golden"].label)}"')
     assert "--" not in shown and page_text("plain text", CHECK) == "plain text"
+
+
+def test_r_and_c_on_a_section_reach_its_synthesize_rc():
+    """The plant API's r and c (the seed's procedure) are taken with any topology, as design-plant --r/--c."""
+    from designer.filters import REGISTRY
+    from designer.plant.circuit import plant_target
+    from designer.plant.circuit_design import design_circuit_plant
+    rq = plant_request({"fc": 1000, "zeta": 0.5, "topology": "sallen-key-highpass", "r": "10k", "c": "10n"})
+    assert (rq.spec.topology, rq.spec.r, rq.spec.c) == ("sallen-key-highpass", 10e3, 10e-9)
+    topo = REGISTRY["sallen-key-highpass"]
+    assert design_circuit_plant(rq.spec, simulate=False).ideal == topo.synthesize_rc(
+        plant_target(topo, 1000.0, 0.5), 10e3, 10e-9)
