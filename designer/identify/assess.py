@@ -52,7 +52,9 @@ __all__ = ["ROUTES", "ESTIMATION_FRACTION", "MAX_SAMPLES", "OE_KINDS", "OE_INITI
 ROUTES = ("step", "correlation", "spectral", "output-error")
 #: the estimation part's share of one record
 ESTIMATION_FRACTION = 2.0 / 3.0
-#: records longer than this are block-averaged to it for the output-error fit and the scoring
+#: records longer than this are block-averaged to it: the output-error fits compare block means (the model
+#: simulated at the record's own rate, :func:`~.outputerror.fit_output_error`'s ``block``), the scoring
+#: runs on the block means as a record
 MAX_SAMPLES = 20_000
 #: the output-error route's model structures
 OE_KINDS = ("fopdt", "sopdt", "underdamped", "lead-lag", "integrating")
@@ -197,7 +199,10 @@ class Assessment:
     sample_time_s : float
         Of the record scored.
     decimated_by : int
-        Block means of this many samples (1: none).
+        Block means of this many samples (1: none): the output-error fits
+        compare them with the block means of the model simulated at the
+        record's own rate (unbiased), the scoring simulates every candidate
+        on the block means.
     candidates : list of Candidate
     best : int or None
         Index of the valid candidate with the best validation fit.
