@@ -63,7 +63,13 @@ with the dead time from a grid over the ARX input delay, then converted to
 continuous time), from a second start at half its dead time, and from the
 caller's ``start`` when given (a classical method's estimate); the lower cost
 wins. The start is fitted on at most :data:`START_SAMPLES` block means of a
-long record; the output-error fit itself always uses every sample. 95 % half-widths from the Jacobian at the optimum,
+long record; the output-error fit itself simulates every sample, and with
+``block`` = m > 1 compares means of m consecutive samples of the simulation
+with the same means of the output: exact under the record's own hold (the
+means' half-block delay and low-pass act on both sides alike; fitting the
+block means as a record of their own does not, it turns a held input into
+ramps and moved an SOPDT's dead time by half a sample), with m times fewer
+residuals. 95 % half-widths from the Jacobian at the optimum,
 t(0.975, N - p) sqrt(diag((J^T J)^-1) s^2), s^2 = SSE/(N - p) (they assume
 white output noise: with coloured noise or a wrong structure they are
 optimistic). A parameter held at its bound has no interval (a dead time at
