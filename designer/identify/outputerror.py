@@ -63,7 +63,13 @@ with the dead time from a grid over the ARX input delay, then converted to
 continuous time), from a second start at half its dead time, and from the
 caller's ``start`` when given (a classical method's estimate); the lower cost
 wins. The start is fitted on at most :data:`START_SAMPLES` block means of a
-long record; the output-error fit itself always uses every sample. 95 % half-widths from the Jacobian at the optimum,
+long record; the output-error fit itself simulates every sample, and with
+``block`` = m > 1 compares means of m consecutive samples of the simulation
+with the same means of the output: exact under the record's own hold (the
+means' half-block delay and low-pass act on both sides alike; fitting the
+block means as a record of their own does not, it turns a held input into
+ramps and moved an SOPDT's dead time by half a sample), with m times fewer
+residuals. 95 % half-widths from the Jacobian at the optimum,
 t(0.975, N - p) sqrt(diag((J^T J)^-1) s^2), s^2 = SSE/(N - p) (they assume
 white output noise: with coloured noise or a wrong structure they are
 optimistic). A parameter held at its bound has no interval (a dead time at
@@ -338,16 +344,33 @@ def _columns(s: Sampled, n: int, integrating: bool, initial: str) -> np.ndarray:
     return np.column_stack(cols)
 
 
-def _evaluate(kind: str, p: dict, ud, y, T: float, hold: str, initial: str) -> tuple:
-    """(residual, simulated deviation, linear coefficients) of one parameter set."""
+def _regressors(s: Sampled, ud, integrating: bool, initial: str, block: int) -> tuple:
+    """(response, linear part's regressors) of the sampled model over the whole
+    record at its own rate, as block means of ``block`` samples when ``block`` > 1:
+    the model sees the input the plant saw (its hold, its levels), and the
+    output's block means are compared with the same means of the simulation,
+    the block's half-sample delay and low-pass on both sides alike."""
+    sim = s.run(ud)
+    X = _columns(s, ud.size, integrating, initial)
+    if block > 1:
+        return _block_means(sim, block), _block_means(X, block)
+    return sim, X
+
+
+def _evaluate(kind: str, p: dict, ud, y, T: float, hold: str, initial: str, block: int = 1) -> tuple:
+    """(residual, simulated deviation, linear coefficients) of one parameter set;
+    ``y`` holds the output's block means of ``block`` samples of ``ud``'s."""
     num, den = _rational(kind, p)
     s = sample_model(num, den, p["theta_s"], T, hold)
-    sim = s.run(ud)
-    rest = y - sim
     if initial == "rest":
+        sim = s.run(ud)
+        if block > 1:
+            sim = _block_means(sim, block)
+        rest = y - sim
         beta = np.array([rest.mean()])
         return rest - beta[0], sim, beta
-    X = _columns(s, y.size, kind.startswith("integrating"), initial)
+    sim, X = _regressors(s, ud, kind.startswith("integrating"), initial, block)
+    rest = y - sim
     beta, *_ = np.linalg.lstsq(X, rest, rcond=None)
     return rest - X @ beta, sim, beta
 
@@ -381,13 +404,16 @@ class OEFit:
         The linearly estimated coefficients: output level first, then (``initial="estimate"``)
         the free responses' and the balance drift's.
     rms_residual : float
-        RMS of the output error over the fitted samples.
+        RMS of the output error over the fitted samples (block means when ``block`` > 1).
     samples : int
-        Samples fitted.
+        Samples fitted (block means when ``block`` > 1).
     evaluations : int
         Simulations of the record the solver used (the Jacobian's included).
     converged : bool
         The solver's own verdict (status > 0).
+    block : int
+        The output's block means compared (1: every sample), the model
+        simulated at ``sample_time_s`` under ``hold`` all the same.
     """
 
     kind: str
@@ -405,6 +431,7 @@ class OEFit:
     samples: int
     evaluations: int
     converged: bool
+    block: int = 1
 
     @property
     def gain(self) -> float:
@@ -468,14 +495,15 @@ class OEFit:
                 "note": self.note, "sample_time_s": self.sample_time_s, "hold": self.hold,
                 "initial": self.initial, "u_ref": self.u_ref, "linear": [float(v) for v in self.linear],
                 "rms_residual": self.rms_residual, "samples": self.samples, "evaluations": self.evaluations,
-                "converged": self.converged}
+                "converged": self.converged, "block": self.block}
 
 
 # --------------------------------------------------------------------------- start
 
 def _block_means(x, m: int) -> np.ndarray:
-    k = x.size // m
-    return x[:k * m].reshape(k, m).mean(axis=1)
+    """Means of ``m`` consecutive rows (a trailing partial block dropped)."""
+    k = x.shape[0] // m
+    return x[:k * m].reshape(k, m, *x.shape[1:]).mean(axis=1)
 
 
 def _arx_start(kind: str, ud, y, T: float) -> dict:
@@ -537,7 +565,8 @@ GRID_THETAS = 200
 GRID_REFINED = 3
 
 
-def _theta_grid_start(kind: str, p0: dict, ud, y, T: float, hold: str, initial: str, top: float) -> dict:
+def _theta_grid_start(kind: str, p0: dict, ud, y, T: float, hold: str, initial: str, top: float,
+                      block: int = 1) -> dict:
     """A start with the dead time from a grid and the gain, given it, by linear
     least squares (the response is linear in K, as are the output level and
     the initial state's columns): an integrator's cost in the dead time is
@@ -553,7 +582,7 @@ def _theta_grid_start(kind: str, p0: dict, ud, y, T: float, hold: str, initial: 
 
     def cost(th):
         s = sample_model(num, den, th, T, hold)
-        X = np.column_stack((s.run(ud), _columns(s, y.size, True, initial)))
+        X = np.column_stack(_regressors(s, ud, True, initial, block))
         coef, *_ = np.linalg.lstsq(X, y, rcond=None)
         return float(np.sum((y - X @ coef) ** 2)), float(th), float(coef[0])
 
@@ -592,7 +621,7 @@ def _bounds(kind: str, T: float, duration: float) -> dict:
 # --------------------------------------------------------------------------- the fit
 
 def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: str = "zoh",
-                     initial: str = "rest", start: dict | None = None) -> OEFit:
+                     initial: str = "rest", start: dict | None = None, block: int = 1) -> OEFit:
     """Fit one continuous-time model to a record by output error.
 
     Parameters
@@ -611,6 +640,12 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     start : dict, optional
         A start (parameters named as :data:`FIT_KINDS`), e.g. a classical
         method's estimate, tried beside the ARX start.
+    block : int
+        Compare means of this many consecutive samples (1: every sample; a
+        trailing partial block is dropped). The model is still simulated at
+        the record's own rate under ``hold``, and its block means compared
+        with the output's: exact (no bias from the averaging), and a long
+        record's residual and Jacobian hold ``block`` times fewer rows.
 
     Returns
     -------
@@ -620,7 +655,8 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     ------
     DesignError
         Input and output of different lengths, a non-finite sample, an input
-        that never moves, a record too short, an unknown kind, hold or initial.
+        that never moves, a record too short, an unknown kind, hold or initial,
+        a block that is not a whole number of samples from 1 up.
     """
     from scipy.optimize import least_squares
     from scipy.special import stdtrit
@@ -640,8 +676,13 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
         raise DesignError(f"sample_time_s must be a positive number, got {sample_time_s}")
     if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
         raise DesignError("the record holds a sample that is not a finite number")
-    if u.size < 50:
-        raise DesignError(f"{u.size} samples are too few for an output-error fit (50 or more)")
+    if isinstance(block, bool) or not isinstance(block, (int, np.integer)) or block < 1:
+        raise DesignError(f"block must be a whole number of samples, 1 or more, got {block!r}")
+    block = int(block)
+    u, y = u[:u.size // block * block], y[:y.size // block * block]
+    if u.size // block < 50:
+        raise DesignError(f"{u.size // block} samples (block means) are too few for an output-error fit "
+                          "(50 or more)")
     if np.ptp(u) == 0:
         raise DesignError("the input never moves: there is nothing to identify")
     # amplitudes and the sample interval of order one, by powers of two (exact): a record of 1e-12 V in and
@@ -654,8 +695,9 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     if start is not None:
         start = {k: float(v) / _scale_of(kind, k, su, sy, st) for k, v in start.items() if k in names}
     ud = u - u[0]
-    n = u.size
-    bounds = _bounds(kind, T, n * T)
+    yb = _block_means(y, block) if block > 1 else y
+    n = yb.size
+    bounds = _bounds(kind, T, u.size * T)
     lo = np.array([bounds[k][0] for k in names])
     hi = np.array([bounds[k][1] for k in names])
     yscale = max(float(np.std(y)), 1e-300)
@@ -678,7 +720,7 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
         def fun(z):
             nonlocal evals
             evals += 1
-            r, *_ = _evaluate(kind, dict(zip(names, z * sc)), ud, y, T, hold, initial)
+            r, *_ = _evaluate(kind, dict(zip(names, z * sc)), ud, yb, T, hold, initial, block)
             return r / yscale
 
         sol = least_squares(fun, x0 / sc, bounds=(lo / sc, hi / sc), method="trf", x_scale="jac",
@@ -687,7 +729,8 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
 
     starts = [_arx_start(kind, ud, y, T)]
     if kind.startswith("integrating"):
-        starts.append(_theta_grid_start(kind, starts[0], ud, y, T, hold, initial, bounds["theta_s"][1]))
+        starts.append(_theta_grid_start(kind, starts[0], ud, yb, T, hold, initial, bounds["theta_s"][1],
+                                        block))
     if start is not None:
         starts.append({k: float(start[k]) for k in names})
     # the cost is kinked and can hold a local minimum in the dead time: a second start at half of it
@@ -713,7 +756,7 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     params = dict(zip(names, (float(v) for v in x)))
     if params["theta_s"] < 1e-9 * T:    # the solver's round-off at the bound: no dead time
         params["theta_s"] = 0.0
-    r, sim, beta = _evaluate(kind, params, ud, y, T, hold, initial)
+    r, sim, beta = _evaluate(kind, params, ud, yb, T, hold, initial, block)
     n_lin = beta.size
     # intervals from the Jacobian over the parameters not held at a bound
     free = sol.active_mask == 0
@@ -755,7 +798,8 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     if why:
         notes.append(why)
     return OEFit(kind, params, ci, model, not notes, "; ".join(notes), T_record, hold, initial, u0,
-                 _linear_back(beta, sy, su, kind, initial), float(math.sqrt(r @ r / n)) * sy, n, evals, converged)
+                 _linear_back(beta, sy, su, kind, initial), float(math.sqrt(r @ r / n)) * sy, n, evals, converged,
+                 block)
 
 
 def _scale_of(kind: str, name: str, su: float, sy: float, st: float) -> float:

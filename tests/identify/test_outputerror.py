@@ -192,6 +192,22 @@ def test_noiseless_records_give_the_parameters_back(kind, tau, ratio, theta, see
         assert fit.params[k] == pytest.approx(v, rel=1e-3, abs=1e-5), (k, fit.params, want)
 
 
+@settings(max_examples=6, deadline=None)
+@given(kind=st.sampled_from(["fopdt", "sopdt"]), theta=st.floats(0.02, 1.5), block=st.integers(2, 7),
+       seed=st.integers(0, 2 ** 16))
+def test_block_means_of_a_noiseless_record_give_the_parameters_back(kind, theta, block, seed):
+    # the model simulated at the record's rate and averaged as the output is: exact, whatever the block
+    # (as a record of its own the block means put a held input's dead time off by up to half a block)
+    model = pb.fopdt(1.7, 2.0, theta) if kind == "fopdt" else pb.sopdt(1.7, 2.0, 0.7, theta)
+    u = random_binary(np.random.default_rng(seed), n=3000, p_switch=0.2)
+    u[:10] = U_LOW
+    y = 0.3 + exact_response(model, u)
+    fit = oe.fit_output_error(u, y, T, kind, block=block)
+    assert fit.block == block and fit.samples == u.size // block
+    for k, v in true_params(model, kind).items():
+        assert fit.params[k] == pytest.approx(v, rel=1e-3, abs=1e-5), (k, fit.params)
+
+
 def test_a_first_order_hold_record_is_fitted_under_that_hold():
     # a smooth input the plant saw interpolated between samples (a generator
     # whose samples the scope took): lsim on a grid of T/16, the dead time a
@@ -274,6 +290,11 @@ def test_bad_input_is_refused_in_one_line():
         oe.fit_output_error(u[:20], u[:20], T)
     with pytest.raises(DesignError, match="hold"):
         oe.fit_output_error(u, u, T, hold="cubic")
+    for block in (0, 2.5, True):
+        with pytest.raises(DesignError, match="block must be a whole number"):
+            oe.fit_output_error(u, u, T, block=block)
+    with pytest.raises(DesignError, match="too few"):
+        oe.fit_output_error(u, u, T, block=10)     # 40 block means
 
 
 # --------------------------------------------------------------------------- the dryer
