@@ -488,14 +488,19 @@ class OEFit:
         Returns
         -------
         dict
-            Every attribute, the process model as its own ``to_dict``.
+            Every attribute, the process model as its own ``to_dict``; ``block``
+            only when the fit compared block means (a record's JSON keys stay
+            as they were for every other fit).
         """
-        return {"kind": self.kind, "params": dict(self.params), "ci95": dict(self.ci95),
-                "model": None if self.model is None else self.model.to_dict(), "valid": self.valid,
-                "note": self.note, "sample_time_s": self.sample_time_s, "hold": self.hold,
-                "initial": self.initial, "u_ref": self.u_ref, "linear": [float(v) for v in self.linear],
-                "rms_residual": self.rms_residual, "samples": self.samples, "evaluations": self.evaluations,
-                "converged": self.converged, "block": self.block}
+        out = {"kind": self.kind, "params": dict(self.params), "ci95": dict(self.ci95),
+               "model": None if self.model is None else self.model.to_dict(), "valid": self.valid,
+               "note": self.note, "sample_time_s": self.sample_time_s, "hold": self.hold,
+               "initial": self.initial, "u_ref": self.u_ref, "linear": [float(v) for v in self.linear],
+               "rms_residual": self.rms_residual, "samples": self.samples, "evaluations": self.evaluations,
+               "converged": self.converged}
+        if self.block > 1:
+            out["block"] = self.block
+        return out
 
 
 # --------------------------------------------------------------------------- start

@@ -407,3 +407,17 @@ def test_an_integrators_dead_time_is_the_lowest_of_a_fine_grid(seed, p_switch):
         c, *_ = np.linalg.lstsq(X, y, rcond=None)
         grid.append(math.sqrt(float(np.sum((y - X @ c) ** 2)) / n))
     assert f.rms_residual <= min(grid) * (1 + 1e-6), (f.params, 0.01 * int(np.argmin(grid)))
+
+
+
+def test_a_fit_on_every_sample_keeps_the_json_keys_it_had():
+    """``block`` is in a fit's JSON only when it compared block means: identify's JSON
+    (the reference captures/motor_seed000.identify.json) keeps its keys (a merge that
+    wrote ``"block": 1`` into every fit changed that reference)."""
+    m = pb.fopdt(2.0, 0.5, 0.1)
+    u = random_binary(np.random.default_rng(3), n=3000, p_switch=0.3)
+    y = exact_response(m, u)
+    every = oe.fit_output_error(u, y, T, "fopdt").to_dict()
+    means = oe.fit_output_error(u, y, T, "fopdt", block=3).to_dict()
+    assert "block" not in every and means["block"] == 3
+    assert set(means) - set(every) == {"block"}
