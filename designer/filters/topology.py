@@ -32,6 +32,11 @@ the op-amp is a voltage source at its output,
 sum over parts of Y_part (V_node - V_other) = 0 with Y = 1/R or s C, the input
 node driven at 1 V (the op-amp's row is solved as V_out / A(s) - (V+ - V-) = 0,
 well conditioned at any gain). The section modules write their node equations out.
+
+The op-amp-aware model as polynomials, :meth:`Topology.opamp_model`, is a hook: by
+default :meth:`Topology.nodal_model` (Cramer's rule on those equations), overridden by a
+section with closed forms (the Sallen-Key low-pass: seed 001, IV.3-IV.9), which must
+equal the nodal solution to rounding (the conformance suite checks every section).
 """
 
 from __future__ import annotations
