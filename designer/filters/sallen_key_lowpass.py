@@ -102,9 +102,8 @@ class SallenKeyLowPass(SallenKeySection):
         return num, den
 
     def opamp_model(self, values: dict, opamp) -> tuple:
-        """The op-amp-aware model's closed form, Vo/Vin = 1/D(s) (the module's equations),
-        in the shape of :meth:`~designer.filters.topology.Topology.nodal_model`: num padded
-        to den's length, den's constant term 1."""
+        # the closed form Vo/Vin = 1/D(s) (the module's equations) in nodal_model's shape:
+        # num padded to den's length, den's constant term 1
         v = self.values_of(values)
         d = opamp_denominator(v["R1"], v["R2"], v["C1"], v["C2"], self.gain_of(v), opamp.a0, opamp.gbw_hz)
         d0 = d[..., -1:]
