@@ -635,7 +635,7 @@ class Topology(ABC):
         values : dict
             Designator -> value, numbers or arrays (one batch shape).
         opamp : designer.core.opamps.OpAmp
-            Its A0 and GBW (the single-pole model).
+            Its A0 and GBW (the single-pole model; numbers, or arrays shaped as the batch).
 
         Returns
         -------
@@ -657,7 +657,7 @@ class Topology(ABC):
         values : dict
             Designator -> value, numbers or arrays (one batch shape).
         opamp : designer.core.opamps.OpAmp
-            Its A0 and GBW (the single-pole model).
+            Its A0 and GBW (the single-pole model; numbers, or arrays shaped as the batch).
 
         Returns
         -------
@@ -674,6 +674,10 @@ class Topology(ABC):
         size = n_nets + 1
         rho = 2 * math.pi * np.asarray(self.figures({r: v[..., 0] for r, v in vals.items()}).fn_hz, float)[..., None]
         s = rho * np.exp(2j * math.pi * np.arange(size) / size)
+        if np.ndim(opamp.a0) or np.ndim(opamp.gbw_hz):
+            # per-build op-amp figures (the Monte Carlo's GBW spread) beside the batch, against s's last axis
+            opamp = dataclasses.replace(opamp, a0=np.asarray(opamp.a0, float)[..., None],
+                                        gbw_hz=np.asarray(opamp.gbw_hz, float)[..., None])
         y_mat, rhs, idx = nodal_system(net, vals, s, opamp)
         out = idx["vout"]
         y_out = y_mat.copy()

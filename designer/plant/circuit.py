@@ -514,8 +514,8 @@ def evaluate(context: tuple, values: dict) -> dict:
     name, opamp = context
     topo = registry.get(name)
     if "GBW" in values and opamp is not None and not opamp.ideal:
-        # the op-amp's spread (--tol GBW): one gain-bandwidth per build, on the batch axis of the nodal system
-        opamp = dataclasses.replace(opamp, gbw_hz=np.asarray(values["GBW"], float)[..., None])
+        # the op-amp's spread (--tol GBW): one gain-bandwidth per build, shaped as the parts' batch
+        opamp = dataclasses.replace(opamp, gbw_hz=np.asarray(values["GBW"], float))
     return circuit_figures(topo, {r: values[r] for r in topo.designators}, opamp)
 
 

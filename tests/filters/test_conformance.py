@@ -131,7 +131,8 @@ def test_opamp_model_is_the_nodal_solution(topology):
     """The section's op-amp-aware model (:meth:`Topology.opamp_model`, a closed form where the
     section overrides it) equals the nodal solution, as polynomials (:meth:`Topology.nodal_model`)
     and as the response solved directly (:meth:`Topology.response`), to 1e-9 relative, on the
-    example's parts and on targets a decade away, for two op-amps; batched as one by one."""
+    example's parts and on targets a decade away, for two op-amps; batched as one by one, with
+    one gain-bandwidth per build too."""
     for target in targets(topology):
         values = topology.synthesize(target)
         s = 2j * np.pi * np.geomspace(target.fn_hz / SPAN, target.fn_hz * SPAN, 13)
@@ -151,10 +152,18 @@ def test_opamp_model_is_the_nodal_solution(topology):
     arrays = {r: v * rng.uniform(0.9, 1.1, size=5) for r, v in topology.synthesize(topology.example).items()}
     amp = get_opamp("TL072")
     num, den = topology.opamp_model(arrays, amp)
+    # one gain-bandwidth per build (the Monte Carlo's op-amp spread), shaped as the batch
+    gbw = amp.gbw_hz * np.array([0.5, 0.8, 1.0, 1.2, 1.5])
+    num_g, den_g = topology.opamp_model(arrays, dataclasses.replace(amp, gbw_hz=gbw))
+    assert den_g.shape == den.shape
     for i in range(5):
-        n1, d1 = topology.opamp_model({r: float(a[i]) for r, a in arrays.items()}, amp)
+        one = {r: float(a[i]) for r, a in arrays.items()}
+        n1, d1 = topology.opamp_model(one, amp)
         np.testing.assert_allclose(den[i], d1, rtol=1e-12)
         np.testing.assert_allclose(num[i], n1, rtol=1e-12, atol=1e-300)
+        n1, d1 = topology.opamp_model(one, dataclasses.replace(amp, gbw_hz=float(gbw[i])))
+        np.testing.assert_allclose(den_g[i], d1, rtol=1e-12)
+        np.testing.assert_allclose(num_g[i], n1, rtol=1e-12, atol=1e-300)
 
 
 @pytest.mark.spice
