@@ -42,7 +42,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                                  "part_values", "parts_of", "record_of", "refs", "section_of",),
     "sallen_key_lowpass_search": ("Candidate",),
     "sallen_key_lowpass_synthesis": ("DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts",
-                                     "coefficients", "fn_zeta", "ratios_from_rc", "realizability_notes",
+                                     "coefficients", "fn_zeta", "opamp_denominator", "ratios_from_rc", "realizability_notes",
                                      "resistors_for_caps",),
     "spec": ("FilterSpec", "TOPOLOGY_CHOICES",),
     "tables": ("TableRow", "coefficient_table", "section_3db_ratio", "table_corner",),

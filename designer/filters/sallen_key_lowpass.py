@@ -18,7 +18,9 @@ Node equations (p: the non-inverting input, Vo = K Vp):
 x: (Vi - Vx)/R1 = (Vx - Vp)/R2 + (Vx - Vo) s C2;  p: (Vx - Vp)/R2 = Vp s C1.
 With a finite-gain op-amp the amplifier is Vo = K' Vp, K' = A/(1 + A/K): the same
 H(s) with K replaced by K'(s) (what :func:`~designer.filters.topology.nodal_response`
-computes from the netlist).
+computes from the netlist). :meth:`SallenKeyLowPass.opamp_model` is that model's closed
+form (seed 001, IV.3-IV.9: :func:`~designer.filters.sallen_key_lowpass_synthesis.opamp_denominator`),
+equal to the nodal solution to rounding and about three times faster.
 
 Design (continuous): C1 from the target (its capacitor, or the one that puts
 R1 = R2 near its impedance), C2 = ratio C1, then R1 R2 = 1/(wn^2 C1 C2) and
@@ -46,11 +48,13 @@ positive only when R C < 2 zeta / wn at unity gain; with gain R3 = R, R4 = (K - 
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..core.errors import DesignError, ParamError
 from ..core.i18n import N_
 from ..spice.deck import GROUND, Netlist
 from .sallen_key import SallenKeySection
-from .sallen_key_lowpass_synthesis import coefficients, ratios_from_rc
+from .sallen_key_lowpass_synthesis import coefficients, opamp_denominator, ratios_from_rc
 from .topology import PartSpec, SectionTarget, polynomial, quadratic_root
 
 __all__ = ["SallenKeyLowPass", "sallen_key_ratio_min"]
@@ -96,6 +100,16 @@ class SallenKeyLowPass(SallenKeySection):
         den = polynomial(*coefficients(v["R1"], v["R2"], v["C1"], v["C2"], k), 1.0)
         num = polynomial(0.0, 0.0, k * den[2])
         return num, den
+
+    def opamp_model(self, values: dict, opamp) -> tuple:
+        # the closed form Vo/Vin = 1/D(s) (the module's equations) in nodal_model's shape:
+        # num padded to den's length, den's constant term 1
+        v = self.values_of(values)
+        d = opamp_denominator(v["R1"], v["R2"], v["C1"], v["C2"], self.gain_of(v), opamp.a0, opamp.gbw_hz)
+        d0 = d[..., -1:]
+        num = np.zeros_like(d)
+        num[..., -1:] = 1.0 / d0
+        return num, d / d0
 
     def limits(self, target: SectionTarget) -> dict:
         return {"ratio_min": sallen_key_ratio_min(target.q, target.gain)}

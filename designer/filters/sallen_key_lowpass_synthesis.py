@@ -25,7 +25,7 @@ from ..core.errors import DesignError
 from ..core.ranges import RANGES, parse_in_range
 
 __all__ = ["DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts", "coefficients", "fn_zeta",
-           "ratios_from_rc", "realizability_notes", "resistors_for_caps"]
+           "opamp_denominator", "ratios_from_rc", "realizability_notes", "resistors_for_caps"]
 
 #: the result.json key of each field of the record (:meth:`SallenKeyParts.as_dict`), the network first
 JSON_KEYS = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "r3": "R3_ohm", "r4": "R4_ohm"}
@@ -110,6 +110,42 @@ def coefficients(r1, r2, c1, c2, gain=1.0):
         (a, b).
     """
     return r1 * r2 * c1 * c2, c1 * (r1 + r2) + r1 * c2 * (1.0 - gain)
+
+
+def opamp_denominator(r1, r2, c1, c2, gain, a0, gbw_hz):
+    """D(s) of the Sallen-Key low-pass with a single-pole op-amp, Vo/Vin = 1/D(s)
+    (third order; numbers or arrays of them, the coefficients on the last axis).
+
+    Node equations with Vp = Vo (1/A + 1/K) and V1 = Vp (1 + s R2 C1) give
+    D = (N/A0) [(1 + s R2 C1)(1 + R1/R2 + s R1 C2) - R1/R2] - s R1 C2,
+    N = 1 + A0/K + s/wp, wp = 2 pi GBW / A0; as A0, wp -> inf, Vo/Vin -> K/(a s^2 + b s + 1).
+    The products are written out in the order :func:`numpy.polymul` takes them, so that a
+    scalar's coefficients are the ones the plant's model has always had.
+
+    Parameters
+    ----------
+    r1, r2, c1, c2 : float or array_like
+        The parts (Ohm, F).
+    gain : float or array_like
+        The gain K.
+    a0 : float
+        The op-amp's DC gain (V/V).
+    gbw_hz : float
+        Its gain-bandwidth, Hz.
+
+    Returns
+    -------
+    ndarray
+        D's coefficients, highest power first, shape ``batch + (4,)`` (D(0) is not 1).
+    """
+    wp = 2 * math.pi * gbw_hz / a0
+    n1, n0 = (1.0 / wp) / a0, (1.0 + a0 / gain) / a0
+    # (R2 C1 s + 1)(R1 C2 s + 1 + R1/R2) - R1/R2
+    i2 = (r2 * c1) * (r1 * c2)
+    i1 = (r2 * c1) * (1.0 + r1 / r2) + (r1 * c2)
+    i0 = (1.0 + r1 / r2) - r1 / r2
+    d = (n1 * i2, n1 * i1 + n0 * i2, n1 * i0 + n0 * i1 - r1 * c2, n0 * i0)
+    return np.stack(np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in d)), axis=-1)
 
 
 def fn_zeta(r1, r2, c1, c2, gain=1.0):

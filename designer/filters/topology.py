@@ -32,6 +32,11 @@ the op-amp is a voltage source at its output,
 sum over parts of Y_part (V_node - V_other) = 0 with Y = 1/R or s C, the input
 node driven at 1 V (the op-amp's row is solved as V_out / A(s) - (V+ - V-) = 0,
 well conditioned at any gain). The section modules write their node equations out.
+
+The op-amp-aware model as polynomials, :meth:`Topology.opamp_model`, is a hook: by
+default :meth:`Topology.nodal_model` (Cramer's rule on those equations), overridden by a
+section with closed forms (the Sallen-Key low-pass: seed 001, IV.3-IV.9), which must
+equal the nodal solution to rounding (the conformance suite checks every section).
 """
 
 from __future__ import annotations
@@ -619,6 +624,79 @@ class Topology(ABC):
         vals = self.values_of(values)
         net = self.netlist({r: 1.0 for r in self.designators})
         return nodal_response(net, vals, s, opamp)
+
+    def opamp_model(self, values: dict, opamp) -> tuple:
+        """The op-amp-aware transfer function as polynomials (vectorised): by default
+        :meth:`nodal_model`; a section with closed forms overrides this (they must equal
+        the nodal solution to rounding: the conformance suite checks it on every section).
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value, numbers or arrays (one batch shape).
+        opamp : designer.core.opamps.OpAmp
+            Its A0 and GBW (the single-pole model; numbers, or arrays shaped as the batch).
+
+        Returns
+        -------
+        tuple of ndarray
+            (num, den), each of shape ``batch + (n + 1,)``, highest power first, den's
+            constant term 1.
+        """
+        return self.nodal_model(values, opamp)
+
+    def nodal_model(self, values: dict, opamp) -> tuple:
+        """The op-amp-aware transfer function by Cramer's rule on the section's nodal
+        equations (:func:`nodal_system` of :meth:`netlist`), H = det Y_out(s) / det Y(s):
+        every entry of Y is a polynomial of degree <= 1 in s, so both determinants are
+        polynomials of degree <= n (n nets), recovered exactly from n + 1 values on a
+        circle |s| = wn by the inverse DFT (polynomial interpolation at roots of unity).
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value, numbers or arrays (one batch shape).
+        opamp : designer.core.opamps.OpAmp
+            Its A0 and GBW (the single-pole model; numbers, or arrays shaped as the batch).
+
+        Returns
+        -------
+        tuple of ndarray
+            (num, den), each of shape ``batch + (n + 1,)``, highest power first, den's
+            constant term 1; numerically zero leading terms (below 1e-10 of the
+            polynomial's size at |s| = wn, judged on the whole batch) dropped.
+        """
+        vals = self.values_of(values)
+        shape = np.broadcast_shapes(*(v.shape for v in vals.values()))
+        vals = {r: np.broadcast_to(v, shape)[..., None] for r, v in vals.items()}
+        net = self.netlist({r: 1.0 for r in self.designators})
+        n_nets = len({n for p in net.parts for n in (p.a, p.b)} | {n for a in net.amps for n in (a.inp, a.inn, a.out)})
+        size = n_nets + 1
+        rho = 2 * math.pi * np.asarray(self.figures({r: v[..., 0] for r, v in vals.items()}).fn_hz, float)[..., None]
+        s = rho * np.exp(2j * math.pi * np.arange(size) / size)
+        if np.ndim(opamp.a0) or np.ndim(opamp.gbw_hz):
+            # per-build op-amp figures (the Monte Carlo's GBW spread) beside the batch, against s's last axis
+            opamp = dataclasses.replace(opamp, a0=np.asarray(opamp.a0, float)[..., None],
+                                        gbw_hz=np.asarray(opamp.gbw_hz, float)[..., None])
+        y_mat, rhs, idx = nodal_system(net, vals, s, opamp)
+        out = idx["vout"]
+        y_out = y_mat.copy()
+        y_out[..., :, out] = rhs
+        scale = rho ** np.arange(size)
+        polys = []
+        for d in (np.linalg.det(y_out), np.linalg.det(y_mat)):
+            c = np.real(np.fft.fft(d, axis=-1)) / size / scale      # ascending powers of s
+            polys.append(c[..., ::-1])
+        num, den = polys
+        # the degree: terms that are rounding at |s| = wn across the whole batch go
+        size_at = np.abs(den * (rho ** np.arange(size)[::-1]))
+        keep = np.max(size_at / np.max(size_at, axis=-1, keepdims=True), axis=tuple(range(size_at.ndim - 1))) > 1e-10
+        first = int(np.argmax(keep))
+        num, den = num[..., first:], den[..., first:]
+        num_size = np.abs(num * (rho ** np.arange(num.shape[-1])[::-1]))
+        num = np.where(num_size < 1e-10 * np.max(size_at, axis=-1, keepdims=True), 0.0, num)
+        d0 = den[..., -1:]
+        return num / d0, den / d0
 
     def figures(self, values: dict) -> Figures:
         """fn, Q and the passband gain magnitude from the ideal coefficients.

@@ -59,7 +59,6 @@ from ..core.metrics import StepMetrics
 from ..core.opamps import OpAmp
 from ..core.units import format_eng
 from ..plant.bench import recommend_square_wave
-from ..plant.model import plant_tf, plant_tf_opamp
 from ..plant.sallenkey import SallenKeyParts
 from ..spice.deck import SquareTest
 from . import blocks, rules, selection, tuning
@@ -108,11 +107,10 @@ def _sallen_key_record(circuit):
 
 def plant_model(plant, amp: OpAmp | None = None):
     """The plant's (num, den) as built, with its op-amp's finite gain and
-    gain-bandwidth unless ideal, for any circuit plant: each section's nodal
-    model (:func:`designer.plant.circuit.opamp_tf`; ideal: its coefficients),
-    multiplied; on the Sallen-Key low-pass section its closed forms
-    (:func:`designer.plant.model.plant_tf_opamp`, seed 001 IV.3-IV.9), which
-    equal the nodal model to rounding and take a fraction of its time.
+    gain-bandwidth unless ideal, for any circuit plant: each section's own
+    op-amp-aware model (:meth:`designer.filters.topology.Topology.opamp_model`:
+    the nodal solution, or a section's closed forms, the Sallen-Key low-pass's
+    seed 001 IV.3-IV.9; ideal: its coefficients), multiplied.
 
     Parameters
     ----------
@@ -124,21 +122,17 @@ def plant_model(plant, amp: OpAmp | None = None):
     Returns
     -------
     tuple of ndarray
-        (num, den), highest power first.
+        (num, den), highest power first (num without leading zeros).
     """
     from .netlist import plant_circuit
     circuit = plant_circuit(plant)[0]
-    rec = _sallen_key_record(circuit)
-    ideal = amp is None or amp.ideal
-    if rec is not None:   # the closed forms: the fast path
-        return plant_tf(rec) if ideal else plant_tf_opamp(rec, amp)
-    if ideal:
-        return tuple(np.asarray(c, float) for c in circuit.coefficients())
-    from ..plant.circuit import opamp_tf
     num, den = np.array([1.0]), np.array([1.0])
     for st in circuit.stages:
-        n, d = opamp_tf(st.topology, st.values, amp)
-        num, den = np.polymul(num, np.trim_zeros(n, "f")), np.polymul(den, d)
+        if amp is None or amp.ideal:
+            n, d = st.topology.coefficients(st.values)
+        else:
+            n, d = st.topology.opamp_model(st.values, amp)
+        num, den = np.polymul(num, np.trim_zeros(np.asarray(n, float), "f")), np.polymul(den, np.asarray(d, float))
     return num, den
 
 

@@ -24,12 +24,10 @@ the summed error (the Sallen-Key search's ranking: :mod:`designer.plant.selectio
 tests' reference); with ``width`` as wide as the series the resistors' set is
 every series value, so the search is brute force over the whole grid.
 
-The op-amp-aware transfer function (:func:`opamp_tf`) is Cramer's rule on the
-topology's nodal equations (:func:`designer.filters.topology.nodal_system`),
-H = det Y_out(s) / det Y(s): every entry of Y is a polynomial of degree <= 1 in
-s, so both determinants are polynomials of degree <= n (n nets), recovered
-exactly from n + 1 values on a circle |s| = wn by the inverse DFT (polynomial
-interpolation at roots of unity).
+The op-amp-aware transfer function (:func:`opamp_tf`) is the section's own
+:meth:`~designer.filters.topology.Topology.opamp_model`: Cramer's rule on its nodal
+equations by default (:meth:`~designer.filters.topology.Topology.nodal_model`), the
+closed forms where a section has them (the Sallen-Key low-pass: seed 001, IV.3-IV.9).
 """
 
 from __future__ import annotations
@@ -44,7 +42,7 @@ import numpy as np
 
 from ..core.errors import DesignError
 from ..filters import registry
-from ..filters.topology import SectionTarget, Topology, nodal_system
+from ..filters.topology import SectionTarget, Topology
 
 __all__ = ["BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "Candidate", "plant_target", "capacitor_combinations", "candidate_set",
            "search", "rounded", "brute_force", "opamp_tf", "dominant_pairs", "circuit_figures", "evaluate", "sensitivities",
@@ -377,7 +375,9 @@ def brute_force(topology: Topology, target: SectionTarget, blocks: list, top: in
 
 
 def opamp_tf(topology: Topology, values: dict, opamp) -> tuple:
-    """The op-amp-aware transfer function of the section as polynomials (vectorised).
+    """The op-amp-aware transfer function of the section as polynomials (vectorised):
+    the section's own model, :meth:`~designer.filters.topology.Topology.opamp_model`
+    (the nodal solution by default, a section's closed form where it has one).
 
     Parameters
     ----------
@@ -392,36 +392,9 @@ def opamp_tf(topology: Topology, values: dict, opamp) -> tuple:
     -------
     tuple of ndarray
         (num, den), each of shape ``batch + (n + 1,)``, highest power first, den's
-        constant term 1; numerically zero leading terms (below 1e-10 of the
-        polynomial's size at |s| = wn, judged on the whole batch) dropped.
+        constant term 1.
     """
-    vals = topology.values_of(values)
-    shape = np.broadcast_shapes(*(v.shape for v in vals.values()))
-    vals = {r: np.broadcast_to(v, shape)[..., None] for r, v in vals.items()}
-    net = topology.netlist({r: 1.0 for r in topology.designators})
-    n_nets = len({n for p in net.parts for n in (p.a, p.b)} | {n for a in net.amps for n in (a.inp, a.inn, a.out)})
-    size = n_nets + 1
-    rho = 2 * math.pi * np.asarray(topology.figures({r: v[..., 0] for r, v in vals.items()}).fn_hz, float)[..., None]
-    s = rho * np.exp(2j * math.pi * np.arange(size) / size)
-    y_mat, rhs, idx = nodal_system(net, vals, s, opamp)
-    out = idx["vout"]
-    y_out = y_mat.copy()
-    y_out[..., :, out] = rhs
-    scale = rho ** np.arange(size)
-    polys = []
-    for d in (np.linalg.det(y_out), np.linalg.det(y_mat)):
-        c = np.real(np.fft.fft(d, axis=-1)) / size / scale      # ascending powers of s
-        polys.append(c[..., ::-1])
-    num, den = polys
-    # the degree: terms that are rounding at |s| = wn across the whole batch go
-    size_at = np.abs(den * (rho ** np.arange(size)[::-1]))
-    keep = np.max(size_at / np.max(size_at, axis=-1, keepdims=True), axis=tuple(range(size_at.ndim - 1))) > 1e-10
-    first = int(np.argmax(keep))
-    num, den = num[..., first:], den[..., first:]
-    num_size = np.abs(num * (rho ** np.arange(num.shape[-1])[::-1]))
-    num = np.where(num_size < 1e-10 * np.max(size_at, axis=-1, keepdims=True), 0.0, num)
-    d0 = den[..., -1:]
-    return num / d0, den / d0
+    return topology.opamp_model(values, opamp)
 
 
 def dominant_pairs(den: np.ndarray, first_order: bool = False) -> tuple:
@@ -541,8 +514,8 @@ def evaluate(context: tuple, values: dict) -> dict:
     name, opamp = context
     topo = registry.get(name)
     if "GBW" in values and opamp is not None and not opamp.ideal:
-        # the op-amp's spread (--tol GBW): one gain-bandwidth per build, on the batch axis of the nodal system
-        opamp = dataclasses.replace(opamp, gbw_hz=np.asarray(values["GBW"], float)[..., None])
+        # the op-amp's spread (--tol GBW): one gain-bandwidth per build, shaped as the parts' batch
+        opamp = dataclasses.replace(opamp, gbw_hz=np.asarray(values["GBW"], float))
     return circuit_figures(topo, {r: values[r] for r in topo.designators}, opamp)
 
 

@@ -14,6 +14,7 @@ import numpy as np
 from ..core.lti import dominant_pair
 from ..core.opamps import OpAmp
 from ..filters.sallen_key_lowpass_parts import FIELD_OF, refs
+from ..filters.sallen_key_lowpass_synthesis import opamp_denominator
 from .sallenkey import SallenKeyParts
 
 __all__ = ["plant_tf", "plant_tf_opamp", "plant_model", "opamp_pair", "sensitivities"]
@@ -38,9 +39,8 @@ def plant_tf(parts: SallenKeyParts):
 def plant_tf_opamp(parts: SallenKeyParts, opamp: OpAmp):
     """Sallen-Key low-pass with a single-pole op-amp (third order).
 
-    Node equations with Vp = Vo (1/A + 1/K) and V1 = Vp (1 + s R2 C1) give
-    Vo/Vin = 1/D(s),  D = (N/A0) [(1 + s R2 C1)(1 + R1/R2 + s R1 C2) - R1/R2] - s R1 C2,
-    N = 1 + A0/K + s/wp. As A0, wp -> inf this is the ideal K/(a s^2 + b s + 1).
+    Vo/Vin = 1/D(s), D from the section's closed form
+    (:func:`designer.filters.sallen_key_lowpass_synthesis.opamp_denominator`), normalised to D(0) = 1.
 
     Parameters
     ----------
@@ -54,12 +54,7 @@ def plant_tf_opamp(parts: SallenKeyParts, opamp: OpAmp):
     tuple of numpy.ndarray
         (num, den), highest power first.
     """
-    r1, r2, c1, c2, k = parts.r1, parts.r2, parts.c1, parts.c2, parts.gain
-    a0 = opamp.a0
-    wp = 2 * math.pi * opamp.gbw_hz / a0
-    n = np.array([1.0 / wp, 1.0 + a0 / k]) / a0
-    inner = np.polysub(np.polymul([r2 * c1, 1.0], [r1 * c2, 1.0 + r1 / r2]), [r1 / r2])
-    d = np.polysub(np.polymul(n, inner), [r1 * c2, 0.0])
+    d = opamp_denominator(parts.r1, parts.r2, parts.c1, parts.c2, parts.gain, opamp.a0, opamp.gbw_hz)
     return np.array([1.0 / d[-1]]), d / d[-1]
 
 

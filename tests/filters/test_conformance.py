@@ -9,7 +9,9 @@ one new registration picked up without editing this file, run through
     A0 = 1e7), the op-amp-aware one with the LM741's behavioural model (A0, GBW
     from the catalogue), within 0.05 dB and 0.5 degrees over three decades
     around fn;
-(d) the vectorised response and figures equal the scalar ones element by element;
+(d) the vectorised response and figures equal the scalar ones element by element, and the
+    op-amp-aware model (:meth:`Topology.opamp_model`, a section's closed form where it has one)
+    equals the nodal solution;
 (f) refusals (wrong kind, bad numbers, unknown choices, each realisability limit
     the topology declares) are one line naming the parameter.
 
@@ -122,6 +124,46 @@ def test_opamp_aware_response_tends_to_the_ideal_one(topology):
     huge = dataclasses.replace(get_opamp("LM741"), a0=1e12, gbw_hz=1e15)
     s = 2j * np.pi * np.geomspace(topology.example.fn_hz / SPAN, topology.example.fn_hz * SPAN, 31)
     np.testing.assert_allclose(topology.response(values, s, huge), topology.response(values, s), rtol=1e-8)
+
+
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_opamp_model_is_the_nodal_solution(topology):
+    """The section's op-amp-aware model (:meth:`Topology.opamp_model`, a closed form where the
+    section overrides it) equals the nodal solution, as polynomials (:meth:`Topology.nodal_model`)
+    and as the response solved directly (:meth:`Topology.response`), to 1e-9 relative, on the
+    example's parts and on targets a decade away, for two op-amps; batched as one by one, with
+    one gain-bandwidth per build too."""
+    for target in targets(topology):
+        values = topology.synthesize(target)
+        s = 2j * np.pi * np.geomspace(target.fn_hz / SPAN, target.fn_hz * SPAN, 13)
+        for name in ("LM741", "NE5532"):
+            amp = get_opamp(name)
+            num, den = topology.opamp_model(values, amp)
+            n_ref, d_ref = topology.nodal_model(values, amp)
+            assert den.shape == d_ref.shape and num.shape == n_ref.shape and den[-1] == 1.0
+            # each coefficient against the polynomial's size at |s| = wn (the terms are of very different scales)
+            at = (2 * np.pi * target.fn_hz) ** np.arange(den.size)[::-1]
+            size = np.max(np.abs(d_ref * at))
+            assert np.max(np.abs((den - d_ref) * at)) < 1e-9 * size
+            assert np.max(np.abs((num - n_ref) * at)) < 1e-9 * size
+            h = np.polyval(num, s) / np.polyval(den, s)
+            np.testing.assert_allclose(h, topology.response(values, s, amp), rtol=1e-9)
+    rng = np.random.default_rng(20261204)
+    arrays = {r: v * rng.uniform(0.9, 1.1, size=5) for r, v in topology.synthesize(topology.example).items()}
+    amp = get_opamp("TL072")
+    num, den = topology.opamp_model(arrays, amp)
+    # one gain-bandwidth per build (the Monte Carlo's op-amp spread), shaped as the batch
+    gbw = amp.gbw_hz * np.array([0.5, 0.8, 1.0, 1.2, 1.5])
+    num_g, den_g = topology.opamp_model(arrays, dataclasses.replace(amp, gbw_hz=gbw))
+    assert den_g.shape == den.shape
+    for i in range(5):
+        one = {r: float(a[i]) for r, a in arrays.items()}
+        n1, d1 = topology.opamp_model(one, amp)
+        np.testing.assert_allclose(den[i], d1, rtol=1e-12)
+        np.testing.assert_allclose(num[i], n1, rtol=1e-12, atol=1e-300)
+        n1, d1 = topology.opamp_model(one, dataclasses.replace(amp, gbw_hz=float(gbw[i])))
+        np.testing.assert_allclose(den_g[i], d1, rtol=1e-12)
+        np.testing.assert_allclose(num_g[i], n1, rtol=1e-12, atol=1e-300)
 
 
 @pytest.mark.spice
@@ -263,6 +305,7 @@ def test_a_new_section_is_one_class_and_passes_the_suite(monkeypatch):
     test_synthesis_meets_the_target(topology)
     test_ideal_response_is_scipy_freqs_of_the_coefficients(topology)
     test_opamp_aware_response_tends_to_the_ideal_one(topology)
+    test_opamp_model_is_the_nodal_solution(topology)
     for opamp in ("ideal", "LM741"):
         test_analytic_response_matches_ngspice_ac(topology, opamp)
     test_vectorised_response_and_figures_equal_the_scalar_ones(topology)

@@ -45,3 +45,21 @@ def test_the_follower_refuses_a_gain_and_the_gain_section_unity():
         get("sallen-key-lowpass").synthesize(SectionTarget("lowpass", 1e3, q=0.7, gain=2.0))
     with pytest.raises(DesignError, match="^gain: sallen-key-lowpass-gain needs a gain above 1"):
         get("sallen-key-lowpass-gain").synthesize(SectionTarget("lowpass", 1e3, q=0.7, gain=1.0))
+
+
+@pytest.mark.parametrize("name, gain", [("sallen-key-lowpass", 1.0), ("sallen-key-lowpass-gain", 2.2)])
+def test_opamp_model_is_the_seed_plants_closed_form(name, gain):
+    """The section's op-amp-aware model is the plant's closed form (seed 001, IV.3-IV.9;
+    :func:`designer.plant.model.plant_tf_opamp`), bit for bit, not the inherited nodal solution."""
+    from designer.core.opamps import get as get_opamp
+    from designer.filters import Topology
+    from designer.filters.sallen_key_lowpass_parts import parts_of
+    from designer.plant.model import plant_tf_opamp
+    topology = get(name)
+    assert type(topology).opamp_model is not Topology.opamp_model
+    values = topology.synthesize(SectionTarget("lowpass", 3.5e3, q=0.9, gain=gain))
+    for amp in (get_opamp("LM741"), get_opamp("NE5532")):
+        num, den = topology.opamp_model(values, amp)
+        n_ref, d_ref = plant_tf_opamp(parts_of(values, gain=1.0 + values["R4"] / values["R3"]
+                                               if "R3" in values else 1.0), amp)
+        assert np.array_equal(den, d_ref) and np.array_equal(np.trim_zeros(num, "f"), n_ref)
