@@ -300,12 +300,15 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
     aim = predistort(topo, section, amp) if spec.compensate_gbw else section
     rv = candidates(spec.r_series, spec.r_min, spec.r_max, "resistor")
     cv = candidates(spec.c_series, spec.c_min, spec.c_max, "capacitor")
+    # a pool four times the list: impedance-scaled copies and swapped builds fold into one (circuit.listed)
     if spec.r is None:
-        ranked = circuit.search(topo, aim, rv, cv, top=spec.alternatives)
+        ranked = circuit.listed(topo, circuit.search(topo, aim, rv, cv, top=4 * spec.alternatives), spec.alternatives)
     else:
-        # the seed's procedure on the section: R and C fixed, the rest solved, then rounded jointly
+        # the seed's procedure on the section: R and C fixed, the rest solved, then rounded jointly; the level
+        # is the user's: each response once, best error first
         exact = topo.synthesize_rc(aim, spec.r, spec.c)
-        ranked = circuit.rounded(topo, aim, exact, rv, cv, top=spec.alternatives)
+        ranked = circuit.listed(topo, circuit.rounded(topo, aim, exact, rv, cv, top=4 * spec.alternatives),
+                                spec.alternatives, band=False)
     best = ranked[0]
     if aim is section and best.worst > MAX_ERROR:
         raise DesignError(f"fc_hz: the best {spec.r_series}/{spec.c_series} parts for {topo.name} land "
