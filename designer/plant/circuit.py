@@ -446,12 +446,13 @@ def _level(topology: Topology, c: Candidate) -> float:
 
 
 def _same_response(topology: Topology, a: Candidate, b: Candidate) -> bool:
-    """One build scaled in impedance (R times s, C over s; a gain pair the same): every ratio
-    of the scaled resistors, of the capacitors, and one time constant equal."""
-    res, caps = _scaled(topology, "R"), _scaled(topology, "C")
-    pairs = [(a.values[r] / a.values[res[0]], b.values[r] / b.values[res[0]]) for r in res[1:]]
-    pairs += [(a.values[c] / a.values[caps[0]], b.values[c] / b.values[caps[0]]) for c in caps[1:]]
-    pairs += [(a.values[r], b.values[r]) for r in topology.choice_parts]
+    """One build scaled in impedance (R times s, C over s; a gain pair, whose ratio alone counts, at
+    any level): every ratio of the scaled resistors, of the capacitors and of the gain pair, and one
+    time constant equal."""
+    res, caps, pair = _scaled(topology, "R"), _scaled(topology, "C"), list(topology.choice_parts)
+    pairs = []
+    for group in (res, caps, pair):
+        pairs += [(a.values[r] / a.values[group[0]], b.values[r] / b.values[group[0]]) for r in group[1:]]
     if res and caps:
         pairs.append((a.values[res[0]] * a.values[caps[0]], b.values[res[0]] * b.values[caps[0]]))
     return all(math.isclose(x, y, rel_tol=1e-9) for x, y in pairs)

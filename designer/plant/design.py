@@ -65,7 +65,7 @@ from ..filters.sallen_key_lowpass_synthesis import (
     resistors_for_caps,
     unity_gain_c2_min,
 )
-from ..filters.sallen_key_lowpass_parts import part_values, section_of
+from ..filters.sallen_key_lowpass_parts import gain_of, network, part_values, section_of
 from ..filters.sallen_key_lowpass_search import scored
 from ..filters.topology import SectionTarget
 from .spec import AnalysisSpec, PlantSpec
@@ -148,7 +148,7 @@ def choose_parts(spec: PlantSpec) -> Choice:
     def pick(ranked, n, fc_t, z_t):
         """The builds listed (circuit.listed), as the plant's candidates against the target aimed at."""
         chosen = circuit.listed(topo, ranked, n, band)
-        return scored(*(np.array([c.values[r] for c in chosen]) for r in ("R1", "R2", "C1", "C2")), fc_t, z_t, k)
+        return scored(*network({r: np.array([c.values[r] for c in chosen]) for r in topo.designators}), fc_t, z_t, k)
 
     fc_t, z_t = spec.fc_hz, spec.zeta
     ranked, ideal, ratios = rank(fc_t, z_t)
@@ -338,9 +338,9 @@ def _bound_notes(spec: PlantSpec, fc: float, zeta: float, worst: float) -> list:
         if not (rv.size and cv.size):
             return math.inf
         # the generic entry (the section's fast path), the gain pair chosen again within the bounds tried
-        found = circuit.search(section_of(with_gain=spec.gain != 1.0), aim, rv, cv, top=1)[0].values
-        return scored(*([found[r]] for r in ("R1", "R2", "C1", "C2")), fc, zeta,
-                      1.0 + found["R4"] / found["R3"] if "R3" in found else 1.0)[0].worst
+        found = {r: np.array([v]) for r, v in circuit.search(section_of(with_gain=spec.gain != 1.0), aim, rv, cv,
+                                                                 top=1)[0].values.items()}
+        return scored(*network(found), fc, zeta, float(gain_of(found)[0]))[0].worst
 
     aim = SectionTarget("lowpass", fc, q=1.0 / (2.0 * zeta), gain=spec.gain)
 
