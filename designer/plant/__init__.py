@@ -19,7 +19,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                        "design_circuit_plant", "tolerance_nominal", "SQUARE_NRMS_PASS", "SquareRun", "square_deck",
                        "with_square_test", "default_square_hz"),
     "circuit": ("BAND_ERROR", "BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "R_BAND", "candidate_set", "capacitor_combinations",
-                "circuit_figures", "corner_frequencies", "dominant_pairs", "evaluate", "listed", "opamp_tf",
+                "circuit_figures", "corner_frequencies", "dominant_pairs", "evaluate", "listed", "opamp_tf", "GBW_ROUNDS", "gbw_shift", "compensate_gbw",
                 "plant_target", "rounded", "search", "step_of_pair"),
     "bench": ("PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",
               "tolerance_band"),

@@ -44,7 +44,7 @@ from .bench import (
     tolerance_band,
 )
 from . import circuit
-from .model import opamp_pair, plant_tf, plant_tf_opamp, sensitivities
+from .model import plant_tf, plant_tf_opamp, sensitivities
 from .netlist import plant_ac_deck, plant_deck
 from .result import (
     Alternative,
@@ -88,13 +88,6 @@ def gain_resistors(gain: float, spec: PlantSpec):
     return r3, r4, 1.0 + r4 / r3
 
 
-def gbw_shift(parts: SallenKeyParts, opamp: OpAmp):
-    """How far the op-amp's finite GBW moves these parts: (fn_ideal / fn_opamp,
-    zeta_ideal / zeta_opamp). ``compensate_gbw`` multiplies the targets by it."""
-    fo, zo = opamp_pair(parts, opamp)
-    return parts.fn_hz / fo, parts.zeta / zo
-
-
 @dataclass(frozen=True)
 class Choice:
     """The parts a spec gets: the build, the exact design it rounds and its
@@ -133,39 +126,33 @@ def choose_parts(spec: PlantSpec) -> Choice:
     top = spec.alternatives
     topo = section_of(with_gain=r3 is not None)
 
-    def rank(fc_t, z_t):
-        """Ranked E-series candidates for a target (the generic entry, circuit.search: the section's fast
-        path); with R and C fixed (the seed's procedure) the exact design they round (circuit.rounded), and
-        its m and n."""
-        aim = SectionTarget("lowpass", fc_t, q=1.0 / (2.0 * z_t), gain=spec.gain)
-        if spec.r is None:
-            return circuit.search(topo, aim, rv, cv, top=4 * top), None, None
-        m, n = ratios_from_rc(fc_t, z_t, spec.r, spec.c, k)
-        ideal = SallenKeyParts(m * spec.r, spec.r, spec.c, n * spec.c, k, r3, r4)
-        # each part rounded jointly around the exact design
-        return circuit.rounded(topo, aim, part_values(ideal), rv, cv, top=4 * top), ideal, Ratios(m, n)
-
-    def pick(ranked, n, fc_t, z_t):
-        """The builds listed (circuit.listed), as the plant's candidates against the target aimed at."""
-        chosen = circuit.listed(topo, ranked, n, band)
-        return scored(*network({r: np.array([c.values[r] for c in chosen]) for r in topo.designators}), fc_t, z_t, k)
-
-    fc_t, z_t = spec.fc_hz, spec.zeta
-    ranked, ideal, ratios = rank(fc_t, z_t)
     # with R and C fixed (the seed's procedure) the level is the user's: each response once, best error first
     band = spec.r is None
-    if spec.compensate_gbw:
-        # aim off by the shift the op-amp causes on the parts chosen, and choose again;
-        # the shift hardly depends on the parts, so two or three rounds settle it
-        for _ in range(4):
-            b = pick(ranked, 1, fc_t, z_t)[0]
-            sf, sz = gbw_shift(SallenKeyParts(b.r1, b.r2, b.c1, b.c2, k, r3, r4), spec.amp)
-            new = (spec.fc_hz * sf, spec.zeta * sz)
-            if abs(new[0] / fc_t - 1) < 1e-9 and abs(new[1] / z_t - 1) < 1e-9:
-                break
-            fc_t, z_t = new
-            ranked, ideal, ratios = rank(fc_t, z_t)
-    ranked = pick(ranked, top, fc_t, z_t)
+    target = SectionTarget("lowpass", spec.fc_hz, q=1.0 / (2.0 * spec.zeta), gain=spec.gain)
+    exact = {"ideal": None, "ratios": None}
+
+    def zeta_of(aim):
+        return spec.zeta if aim is target else 1.0 / (2.0 * aim.q)
+
+    def rank(aim):
+        """The builds listed for a target (circuit.listed) from the generic entry, circuit.search (the section's
+        fast path); with R and C fixed (the seed's procedure) circuit.rounded of the exact design they give."""
+        if spec.r is None:
+            return circuit.listed(topo, circuit.search(topo, aim, rv, cv, top=4 * top), top, band)
+        m, n = ratios_from_rc(aim.fn_hz, zeta_of(aim), spec.r, spec.c, k)
+        ideal = SallenKeyParts(m * spec.r, spec.r, spec.c, n * spec.c, k, r3, r4)
+        # each part rounded jointly around the exact design
+        found = circuit.rounded(topo, aim, part_values(ideal), rv, cv, top=4 * top)
+        exact.update(ideal=ideal, ratios=Ratios(m, n))
+        return circuit.listed(topo, found, top, band)
+
+    # --compensate-gbw: aim off by the shift the op-amp causes on the parts chosen, and choose again (every
+    # section's rule, circuit.compensate_gbw)
+    aim, chosen = circuit.compensate_gbw(topo, target, spec.amp, rank) if spec.compensate_gbw else (target,
+                                                                                                     rank(target))
+    fc_t, z_t = aim.fn_hz, zeta_of(aim)
+    ideal, ratios = exact["ideal"], exact["ratios"]
+    ranked = scored(*network({r: np.array([c.values[r] for c in chosen]) for r in topo.designators}), fc_t, z_t, k)
     best = ranked[0]
     if spec.r is None:
         # solved once, for the target finally aimed at
