@@ -244,3 +244,37 @@ def test_every_section_lists_each_response_once_in_the_band_when_it_can(topology
         return all(circuit.R_BAND[0] <= c.values[r] <= circuit.R_BAND[1] for r in scaled if r[0] == "R")
     if any(in_band(c) and c.worst <= circuit.BAND_ERROR for c in ranked):
         assert in_band(shown[0]) and shown[0].worst <= circuit.BAND_ERROR
+
+
+# --------------------------------------------------------------------------- --compensate-gbw (every section)
+
+def _landing(topology, target, values, amp):
+    """The worse of the op-amp-aware dominant pair's fn and zeta errors against the spec."""
+    f = circuit.circuit_figures(topology, values, amp)
+    errs = [abs(float(f["fn_hz"]) / target.fn_hz - 1)]
+    if target.q is not None:
+        errs.append(abs(float(f["zeta"]) * 2 * target.q - 1))
+    return max(errs)
+
+
+@pytest.mark.parametrize("topology", list(registry.REGISTRY.values()), ids=registry.names())
+def test_compensate_gbw_never_lands_further_than_the_spec_s_own_build(topology):
+    """circuit.compensate_gbw (both plant pipelines' --compensate-gbw) on every section, an LM741 near its reach
+    (GBW = 20 x fn x Q x noise gain): the build kept lands at least as near the spec as the spec's own build, and
+    nearer where the op-amp moves it by more than the series' rounding."""
+    amp = get_opamp("LM741")
+    ex = topology.example
+    noise_gain = 1 + ex.gain if topology.inverting else ex.gain
+    fc = min(20e3, amp.gbw_hz / (20 * (ex.q or 1.0) * noise_gain))
+    target = circuit.plant_target(topology, fc, None if ex.q is None else 1 / (2 * ex.q), ex.gain)
+    rv, cv = eseries.values("E24", 100, 1e6), eseries.values("E12", 100e-12, 10e-6)
+
+    def rank(aim):
+        return circuit.listed(topology, circuit.search(topology, aim, rv, cv, top=20), 5)
+    plain = _landing(topology, target, rank(target)[0].values, amp)
+    aim, ranked = circuit.compensate_gbw(topology, target, amp, rank)
+    kept = _landing(topology, target, ranked[0].values, amp)
+    assert kept <= plain + 1e-12
+    # the shift is the op-amp's: an ideal op-amp leaves the aim where it is
+    aim_ideal, _ = circuit.compensate_gbw(topology, target, get_opamp("ideal"), rank)
+    assert aim_ideal is target

@@ -361,19 +361,20 @@ def test_alternatives_differ_and_sit_in_the_resistor_band(fc, zeta):
         assert worst <= in_band.worst
 
 
-def _pipelines(fc, zeta, gain):
+def _pipelines(fc, zeta, gain, compensate=False):
     """The parts of the seed plant's pipeline (choose_parts) and of the generic one on the same section
     (design-plant --topology sallen-key-lowpass[-gain]): (built, alternatives) each, or the refusal's type."""
     from designer.filters.sallen_key_lowpass_parts import part_values
     from designer.plant.circuit_design import design_circuit_plant
     name = "sallen-key-lowpass" if gain == 1.0 else "sallen-key-lowpass-gain"
     try:
-        choice = choose_parts(PlantSpec(fc, zeta, gain=gain))
+        choice = choose_parts(PlantSpec(fc, zeta, gain=gain, compensate_gbw=compensate))
         sk = (part_values(choice.built), [(c.r1, c.r2, c.c1, c.c2) for c in choice.ranked])
     except DesignError as exc:
         sk = type(exc)
     try:
-        r = design_circuit_plant(PlantSpec(fc, zeta, gain=gain, topology=name), simulate=False)
+        r = design_circuit_plant(PlantSpec(fc, zeta, gain=gain, topology=name, compensate_gbw=compensate),
+                                 simulate=False)
         generic = (dict(r.values), [tuple(c.values[k] for k in ("R1", "R2", "C1", "C2")) for c in r.alternatives])
     except DesignError:
         generic = DesignError
@@ -385,16 +386,19 @@ def test_both_pipelines_build_the_seed_plant_alike():
     section's fast path through circuit.search), one listing (circuit.listed): the same build and alternatives."""
     sk, generic = _pipelines(3500.0, 0.2, 1.0)
     assert sk == generic
-    assert sk[0] == {"R1": 1.6e3, "R2": 3.9e3, "C1": 3.3e-9, "C2": 100e-9}
+    built = json.loads(REFERENCE.read_text())["built"]     # the committed reference's build
+    assert sk[0] == {ref: built[f"{ref}_{'ohm' if ref[0] == 'R' else 'f'}"] for ref in sk[0]}
+    assert _pipelines(3500.0, 0.2, 1.0, compensate=True)[0] == _pipelines(3500.0, 0.2, 1.0, compensate=True)[1]
 
 
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(fc=st.floats(100.0, 20e3), zeta=st.floats(0.1, 1.5),
-       gain=st.one_of(st.just(1.0), st.floats(1.0, 3.0).filter(lambda g: g > 1.0)))
-def test_both_pipelines_build_the_same_parts(fc, zeta, gain):
+       gain=st.one_of(st.just(1.0), st.floats(1.0, 3.0).filter(lambda g: g > 1.0)), compensate=st.booleans())
+def test_both_pipelines_build_the_same_parts(fc, zeta, gain, compensate):
     """The seed plant's pipeline and the generic one on the Sallen-Key low-pass (unity or gain K) build the
-    same parts and list the same alternatives, or both refuse."""
-    sk, generic = _pipelines(fc, zeta, gain)
+    same parts and list the same alternatives, or both refuse; with --compensate-gbw (LM741) too, one rule
+    (circuit.compensate_gbw)."""
+    sk, generic = _pipelines(fc, zeta, gain, compensate)
     refused = [isinstance(x, type) for x in (sk, generic)]
     assert refused[0] == refused[1], (sk, generic)
     if not refused[0]:
