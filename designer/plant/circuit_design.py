@@ -8,7 +8,10 @@ sensitivities over the declared parts, the deck, BOM and wiring from the topolog
 netlist (:func:`designer.spice.deck.board`), and the ngspice ``.ac`` of that deck
 against the op-amp-aware model (the conformance's rule: 0.05 dB and 0.5 degrees over
 fn / 30 .. 30 fn). The seed's Sallen-Key low-pass keeps its own pipeline
-(:mod:`designer.plant.design`), byte for byte.
+(:mod:`designer.plant.design`), byte for byte, its parts chosen through the same search entry (the
+section's fast path, :meth:`~designer.filters.topology.Topology.fast_search`), listing
+(:func:`designer.plant.circuit.listed`) and ``--compensate-gbw`` (:func:`designer.plant.circuit.compensate_gbw`):
+``--topology sallen-key-lowpass`` builds the same parts.
 
 The op-amp's reach: a section needs GBW >= :data:`GBW_MARGIN` x fn x Q x noise gain
 (the noise gain 1 + |G| of an inverting section, G of a non-inverting one): the rule of
