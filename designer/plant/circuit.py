@@ -459,14 +459,16 @@ def _same_response(topology: Topology, a: Candidate, b: Candidate) -> bool:
     return all(math.isclose(x, y, rel_tol=1e-9) for x, y in pairs)
 
 
+def _parts_key(topology: Topology, c: Candidate) -> tuple:
+    """A build's values as a sorted set per kind (which part holds which value left out)."""
+    return tuple(tuple(sorted(c.values[p.ref] for p in topology.parts if p.kind == kind)) for kind in "RC")
+
+
 def _same_build(topology: Topology, a: Candidate, b: Candidate) -> bool:
-    """The same parts (as a set per kind) with the same figures: equal parts swapped where the
-    section is symmetric (R1 and R2 of the unity-gain Sallen-Key low-pass), one build."""
-    def parts(c, kind):
-        return sorted(c.values[p.ref] for p in topology.parts if p.kind == kind)
+    """Of two builds with the same parts as a set per kind (:func:`_parts_key`), the same figures: equal
+    parts swapped where the section is symmetric (R1 and R2 of the unity-gain Sallen-Key low-pass), one build."""
     close = [(a.fn_hz, b.fn_hz), (a.gain, b.gain)] + ([] if a.zeta is None else [(a.zeta, b.zeta)])
-    return (parts(a, "R") == parts(b, "R") and parts(a, "C") == parts(b, "C")
-            and all(math.isclose(x, y, rel_tol=1e-9) for x, y in close))
+    return all(math.isclose(x, y, rel_tol=1e-9) for x, y in close)
 
 
 def listed(topology: Topology, ranked: list, top: int, band: bool = True) -> list:
@@ -493,9 +495,11 @@ def listed(topology: Topology, ranked: list, top: int, band: bool = True) -> lis
     list of Candidate
         Members of ``ranked``.
     """
-    builds = []
+    builds, seen = [], {}
     for c in ranked:
-        if not any(_same_build(topology, b, c) for b in builds):
+        same_parts = seen.setdefault(_parts_key(topology, c), [])
+        if not any(_same_build(topology, b, c) for b in same_parts):
+            same_parts.append(c)
             builds.append(c)
     groups = []
     for c in builds:
