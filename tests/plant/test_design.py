@@ -361,19 +361,19 @@ def test_alternatives_differ_and_sit_in_the_resistor_band(fc, zeta):
         assert worst <= in_band.worst
 
 
-def _pipelines(fc, zeta, gain, compensate=False):
+def _pipelines(fc, zeta, gain, compensate=False, **rc):
     """The parts of the seed plant's pipeline (choose_parts) and of the generic one on the same section
     (design-plant --topology sallen-key-lowpass[-gain]): (built, alternatives) each, or the refusal's type."""
     from designer.filters.sallen_key_lowpass_parts import part_values
     from designer.plant.circuit_design import design_circuit_plant
     name = "sallen-key-lowpass" if gain == 1.0 else "sallen-key-lowpass-gain"
     try:
-        choice = choose_parts(PlantSpec(fc, zeta, gain=gain, compensate_gbw=compensate))
+        choice = choose_parts(PlantSpec(fc, zeta, gain=gain, compensate_gbw=compensate, **rc))
         sk = (part_values(choice.built), [(c.r1, c.r2, c.c1, c.c2) for c in choice.ranked])
     except DesignError as exc:
         sk = type(exc)
     try:
-        r = design_circuit_plant(PlantSpec(fc, zeta, gain=gain, topology=name, compensate_gbw=compensate),
+        r = design_circuit_plant(PlantSpec(fc, zeta, gain=gain, topology=name, compensate_gbw=compensate, **rc),
                                  simulate=False)
         generic = (dict(r.values), [tuple(c.values[k] for k in ("R1", "R2", "C1", "C2")) for c in r.alternatives])
     except DesignError:
@@ -389,6 +389,15 @@ def test_both_pipelines_build_the_seed_plant_alike():
     built = json.loads(REFERENCE.read_text())["built"]     # the committed reference's build
     assert sk[0] == {ref: built[f"{ref}_{'ohm' if ref[0] == 'R' else 'f'}"] for ref in sk[0]}
     assert _pipelines(3500.0, 0.2, 1.0, compensate=True)[0] == _pipelines(3500.0, 0.2, 1.0, compensate=True)[1]
+
+
+@pytest.mark.parametrize("fc, zeta, gain, r, c", [(3500.0, 0.2, 1.0, 1e3, 10e-9), (1e3, 0.707, 1.0, 4.7e3, 10e-9),
+                                                  (2e3, 0.5, 2.0, 4.7e3, 10e-9), (800.0, 0.3, 1.5, 10e3, 10e-9)])
+def test_both_pipelines_round_the_seed_s_procedure_alike(fc, zeta, gain, r, c):
+    """--r/--c (the seed's fix R and C, solve m and n): the seed plant's pipeline rounds through circuit.rounded
+    (the fast path: R1/R2's and C1/C2's neighbours pooled), as --topology sallen-key-lowpass[-gain] does."""
+    sk, generic = _pipelines(fc, zeta, gain, r=r, c=c)
+    assert not isinstance(sk, type) and sk == generic
 
 
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
