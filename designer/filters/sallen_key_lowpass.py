@@ -44,6 +44,11 @@ R2 = R, R1 = m R, C1 = C, C2 = n C with
     m n = 1/(wn R C)^2,   m = 2 zeta sqrt(m n) - 1 + m n (K - 1),   zeta = 1/(2 Q),
 
 positive only when R C < 2 zeta / wn at unity gain; with gain R3 = R, R4 = (K - 1) R.
+
+E-series search (:meth:`SallenKeyLowPass.fast_search`, the plant's search entry's fast path): the
+parallelogram search of :mod:`~designer.filters.sallen_key_lowpass_search` over the whole grid, exact
+(brute force's ranking) in bounded memory; with gain, K is set first by the pair of series values
+nearest the ratio K - 1 (R4/R3), and the network is searched at the K it gives.
 """
 
 from __future__ import annotations

@@ -37,6 +37,12 @@ The op-amp-aware model as polynomials, :meth:`Topology.opamp_model`, is a hook: 
 default :meth:`Topology.nodal_model` (Cramer's rule on those equations), overridden by a
 section with closed forms (the Sallen-Key low-pass: seed 001, IV.3-IV.9), which must
 equal the nodal solution to rounding (the conformance suite checks every section).
+
+The plant's E-series search has a hook too, :meth:`Topology.fast_search`: None by default (the
+generic search, :func:`designer.plant.circuit.search`, enumerates its candidate set), overridden by a
+section with an exact search of its own (the Sallen-Key low-pass: seed 001's parallelogram search over
+the whole grid, :mod:`designer.filters.sallen_key_lowpass_search`), which must equal brute force over
+the grid it is given (the tests check it).
 """
 
 from __future__ import annotations
