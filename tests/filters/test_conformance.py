@@ -166,7 +166,6 @@ def test_opamp_model_is_the_nodal_solution(topology):
         np.testing.assert_allclose(num_g[i], n1, rtol=1e-12, atol=1e-300)
 
 
-@pytest.mark.spice
 @pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
 def test_ideal_pair_is_the_coefficients_pair(topology):
     """The ideal (fn, zeta) a PID's plant is named and sized by (:meth:`Topology.ideal_pair`, a section's own
@@ -187,6 +186,7 @@ def test_ideal_pair_is_the_coefficients_pair(topology):
         assert (fn, zeta) == pytest.approx(dominant_pair(topology.coefficients(values)[1]), rel=1e-9)
 
 
+@pytest.mark.spice
 @pytest.mark.parametrize("opamp", ["ideal", "LM741"])
 @pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
 def test_analytic_response_matches_ngspice_ac(topology, opamp):
