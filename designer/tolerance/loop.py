@@ -100,12 +100,12 @@ def loop_parts(result, tol_items=()) -> dict:
     dict
         Designator -> nominal value.
     """
-    from ..filters.sallen_key_lowpass_parts import part_values, refs
+    from ..filters.sallen_key_lowpass_parts import refs
     from .parts import opamp_nominal
     c = result.parts
-    p = None if is_model_loop(result) else result.plant
+    p = None if is_model_loop(result) else result.plant   # the generic record (designer.pid.plant.PlantCircuit)
     # the plant's network only: its gain pair's designators are the controller's R3, R4 here
-    out = {} if p is None else {r: v for r, v in part_values(p).items() if r in refs(with_gain=False)}
+    out = {} if p is None else {r: v for r, v in p.stages[0].values.items() if r in refs(with_gain=False)}
     for f in fields(c):
         v = getattr(c, f.name)
         if v is not None:
