@@ -13,7 +13,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "compare": ("AGREEMENT", "disagreements", "metric_deltas", "nrms", "resample", "trapezoid_weights"),
     "errors": ("DeckError", "DesignError", "EXIT_BAD_INPUT", "EXIT_CHECK_FAILED", "EXIT_OK", "EXIT_SIMULATOR",
                "ParamError", "SimulatorError"),
-    "eseries": ("PartBounds", "SERIES", "TOLERANCE", "check_bounds", "nearest", "nearest_ratio_pair", "series_name",
+    "eseries": ("PartBounds", "SERIES", "TOLERANCE", "check_bounds", "nearest", "nearest_ratio_pair", "nearest_ratio_of", "series_name",
                 "smallest_series", "values"),
     "exports": ("lazy_exports",),
     "fileio": ("BLOCK_BYTES", "LimitedReader", "MAX_CAPTURE_BYTES", "MAX_CAPTURE_ROWS", "MAX_LINE_BYTES",

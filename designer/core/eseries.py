@@ -15,7 +15,7 @@ import numpy as np
 from .errors import DesignError, ParamError
 from .ranges import parse_in_range
 
-__all__ = ["PartBounds", "SERIES", "TOLERANCE", "check_bounds", "nearest", "nearest_ratio_pair", "series_name",
+__all__ = ["PartBounds", "SERIES", "TOLERANCE", "check_bounds", "nearest", "nearest_ratio_pair", "nearest_ratio_of", "series_name",
            "smallest_series", "values"]
 
 _E24 = (1.0, 1.1, 1.2, 1.3, 1.5, 1.6, 1.8, 2.0, 2.2, 2.4, 2.7, 3.0,
@@ -222,6 +222,26 @@ def nearest_ratio_pair(ratio: float, series: str, lo: float, hi: float):
     v = values(series, lo, hi)
     if v.size == 0:
         raise DesignError(f"no {series} value between {lo:g} and {hi:g}")
+    return nearest_ratio_of(ratio, v)
+
+
+def nearest_ratio_of(ratio: float, v) -> tuple:
+    """Two of the values ``v`` whose ratio a/b is nearest to ``ratio`` (log distance; of
+    equal ones the first in ``v``'s order of a, then of b): :func:`nearest_ratio_pair` on given values.
+
+    Parameters
+    ----------
+    ratio : float
+        The ratio wanted.
+    v : array_like
+        The values (ascending, as :func:`values` gives them).
+
+    Returns
+    -------
+    tuple of float
+        (a, b).
+    """
+    v = np.asarray(v, dtype=float)
     err = np.abs(np.log(np.outer(v, 1.0 / v) / ratio))
     i, j = np.unravel_index(np.argmin(err), err.shape)
     return float(v[i]), float(v[j])

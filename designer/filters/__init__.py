@@ -40,7 +40,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "sallen_key_lowpass": ("SallenKeyLowPass", "sallen_key_ratio_min",),
     "sallen_key_lowpass_parts": ("FIELD_OF", "REF_OF", "gain_of", "gain_refs", "network",
                                  "part_values", "parts_of", "record_of", "refs", "section_of",),
-    "sallen_key_lowpass_search": ("Candidate",),
+    "sallen_key_lowpass_search": ("Candidate", "around", "scored"),
     "sallen_key_lowpass_synthesis": ("DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts",
                                      "coefficients", "fn_zeta", "opamp_denominator", "ratios_from_rc", "realizability_notes",
                                      "resistors_for_caps",),

@@ -44,6 +44,11 @@ R2 = R, R1 = m R, C1 = C, C2 = n C with
     m n = 1/(wn R C)^2,   m = 2 zeta sqrt(m n) - 1 + m n (K - 1),   zeta = 1/(2 Q),
 
 positive only when R C < 2 zeta / wn at unity gain; with gain R3 = R, R4 = (K - 1) R.
+
+E-series search (:meth:`SallenKeyLowPass.fast_search`, the plant's search entry's fast path): the
+parallelogram search of :mod:`~designer.filters.sallen_key_lowpass_search` over the whole grid, exact
+(brute force's ranking) in bounded memory; with gain, K is set first by the pair of series values
+nearest the ratio K - 1 (R4/R3), and the network is searched at the K it gives.
 """
 
 from __future__ import annotations
@@ -51,9 +56,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.errors import DesignError, ParamError
+from ..core.eseries import nearest_ratio_of
 from ..core.i18n import N_
 from ..spice.deck import GROUND, Netlist
 from .sallen_key import SallenKeySection
+from .sallen_key_lowpass_search import around as near, joint_search
 from .sallen_key_lowpass_synthesis import coefficients, fn_zeta, opamp_denominator, ratios_from_rc
 from .topology import PartSpec, SectionTarget, polynomial, quadratic_root
 
@@ -120,6 +127,28 @@ class SallenKeyLowPass(SallenKeySection):
 
     def limits(self, target: SectionTarget) -> dict:
         return {"ratio_min": sallen_key_ratio_min(target.q, target.gain)}
+
+    def fast_search(self, target: SectionTarget, r_values, c_values, top: int, around: dict | None = None,
+                    width: int = 2) -> dict:
+        # the seed plant's exact search over the whole grid (sallen_key_lowpass_search.joint_search, the
+        # module docstring's separation of fn and zeta), ranked by the fn and zeta errors: with gain, K is
+        # set first by R3, R4, the pair of series values nearest the ratio K - 1 (the same for every
+        # combination, so its error ranks nothing), and R1 R2 C1 C2 are searched at the K they give
+        self.check_realisable(target)
+        rv = np.unique(np.asarray(r_values, float))
+        cv = np.unique(np.asarray(c_values, float))
+        gain = {}
+        if self.with_gain:
+            r4, r3 = nearest_ratio_of(target.gain - 1.0, rv)
+            gain = {"R3": r3, "R4": r4}
+        k = self.gain_of(gain)
+        if around is not None:
+            # the exact design's neighbours, pooled per kind (the seed's joint rounding)
+            rv = np.unique(np.concatenate([near(around[r], rv, width) for r in ("R1", "R2")]))
+            cv = np.unique(np.concatenate([near(around[c], cv, width) for c in ("C1", "C2")]))
+        found = joint_search(target.fn_hz, 1.0 / (2.0 * target.q), rv, cv, k, top=top)
+        values = {ref: np.array([getattr(c, ref.lower()) for c in found], float) for ref in ("R1", "R2", "C1", "C2")}
+        return {**values, **{ref: np.full(len(found), v) for ref, v in gain.items()}}
 
     def _check_limits(self, target: SectionTarget, choices: dict) -> None:
         self.check_gain(target)

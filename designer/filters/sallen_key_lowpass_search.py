@@ -50,7 +50,7 @@ import numpy as np
 
 from .sallen_key_lowpass_synthesis import fn_zeta, resistors_for_caps
 
-__all__ = ["Candidate", "brute_force", "joint_search"]
+__all__ = ["Candidate", "around", "brute_force", "joint_search", "scored"]
 
 
 @dataclass(frozen=True)
@@ -118,9 +118,31 @@ def _order(r1, r2, c1, c2, fn0, zeta0, gain):
 
 def _rank(r1, r2, c1, c2, fn0, zeta0, gain, top):
     order = _order(r1, r2, c1, c2, fn0, zeta0, gain)[0][:top]
-    fn, z, efn, ez, _ = _score(r1[order], r2[order], c1[order], c2[order], fn0, zeta0, gain)
-    return [Candidate(float(r1[i]), float(r2[i]), float(c1[i]), float(c2[i]), float(fn[j]),
-                      float(z[j]), float(efn[j]), float(ez[j])) for j, i in enumerate(order)]
+    return scored(r1[order], r2[order], c1[order], c2[order], fn0, zeta0, gain)
+
+
+def scored(r1, r2, c1, c2, fn0: float, zeta0: float, gain: float = 1.0) -> list:
+    """Combinations as :class:`Candidate` (what each gives, its errors against the targets), in
+    the order given (the plant's generic search ranks them: :func:`designer.plant.circuit.search`).
+
+    Parameters
+    ----------
+    r1, r2, c1, c2 : array_like
+        The parts of each combination (ohm, farad), one array each.
+    fn0, zeta0 : float
+        The targets: natural frequency (Hz) and damping ratio.
+    gain : float
+        The amplifier gain K.
+
+    Returns
+    -------
+    list of Candidate
+        One per combination, in the order given.
+    """
+    r1, r2, c1, c2 = (np.asarray(x, float) for x in (r1, r2, c1, c2))
+    fn, z, efn, ez, _ = _score(r1, r2, c1, c2, fn0, zeta0, gain)
+    return [Candidate(float(r1[i]), float(r2[i]), float(c1[i]), float(c2[i]), float(fn[i]),
+                      float(z[i]), float(efn[i]), float(ez[i])) for i in range(r1.size)]
 
 
 def _bound(kth_worst):
@@ -456,7 +478,22 @@ def brute_force(fn0: float, zeta0: float, r_values, c_values, gain: float = 1.0,
 
 
 def around(value: float, series_values, k: int = 2) -> np.ndarray:
-    """The ``k`` series values on each side of ``value`` (for rounding a fixed design jointly)."""
+    """The ``k`` series values on each side of ``value`` (for rounding a fixed design jointly).
+
+    Parameters
+    ----------
+    value : float
+        The continuous value.
+    series_values : array_like
+        The series values (any order).
+    k : int
+        How many on each side.
+
+    Returns
+    -------
+    ndarray
+        Ascending: the ``k`` below ``value`` and the ``k`` at or above it (fewer at the series' ends).
+    """
     v = np.unique(np.asarray(series_values, float))
     i = int(np.searchsorted(v, value))
     return v[max(0, i - k): i + k]

@@ -39,6 +39,12 @@ section with closed forms (the Sallen-Key low-pass: seed 001, IV.3-IV.9), which 
 equal the nodal solution to rounding (the conformance suite checks every section).
 So is the ideal (fn, zeta) a PID's plant is sized by, :meth:`Topology.ideal_pair` (by default
 from the coefficients; the Sallen-Key low-pass gives its parts record's exact arithmetic).
+
+The plant's E-series search has a hook too, :meth:`Topology.fast_search`: None by default (the
+generic search, :func:`designer.plant.circuit.search`, enumerates its candidate set), overridden by a
+section with an exact search of its own (the Sallen-Key low-pass: seed 001's parallelogram search over
+the whole grid, :mod:`designer.filters.sallen_key_lowpass_search`), which must equal brute force over
+the grid it is given (the tests check it).
 """
 
 from __future__ import annotations
@@ -489,6 +495,36 @@ class Topology(ABC):
             Name -> bound (``{"ratio_min": 2.0}``).
         """
         return {}
+
+    # ---- the E-series search's fast path (a hook) ----------------------------------------------
+    def fast_search(self, target: SectionTarget, r_values, c_values, top: int, around: dict | None = None,
+                    width: int = 2) -> dict | None:
+        """The section's own exact E-series search, or None (the default): then the plant's generic
+        search (:func:`designer.plant.circuit.search`, :func:`designer.plant.circuit.rounded`)
+        enumerates its candidate set. A section with a faster exact search overrides this (the
+        Sallen-Key low-pass: its parallelogram search over the whole grid, seed 001's plant).
+
+        Parameters
+        ----------
+        target : SectionTarget
+            The target (fn, Q, gain).
+        r_values, c_values : array_like
+            The resistor and capacitor series values inside the bounds, ascending.
+        top : int
+            How many combinations to return at most.
+        around : dict, optional
+            An exact design (designator -> continuous value) to round jointly (the seed's "fix R
+            and C"): the parts then come from the ``width`` series values on each side of its values.
+        width : int
+            Series values on each side of each value of ``around``.
+
+        Returns
+        -------
+        dict or None
+            Designator -> 1-D array of values, the ranked combinations best first (every array
+            the same length, at most ``top``); None: the section has no fast path.
+        """
+        return None
 
     # ---- inherited ---------------------------------------------------------------------------
     @property

@@ -8,7 +8,10 @@ sensitivities over the declared parts, the deck, BOM and wiring from the topolog
 netlist (:func:`designer.spice.deck.board`), and the ngspice ``.ac`` of that deck
 against the op-amp-aware model (the conformance's rule: 0.05 dB and 0.5 degrees over
 fn / 30 .. 30 fn). The seed's Sallen-Key low-pass keeps its own pipeline
-(:mod:`designer.plant.design`), byte for byte.
+(:mod:`designer.plant.design`), byte for byte, its parts chosen through the same search entry (the
+section's fast path, :meth:`~designer.filters.topology.Topology.fast_search`), listing
+(:func:`designer.plant.circuit.listed`) and ``--compensate-gbw`` (:func:`designer.plant.circuit.compensate_gbw`):
+``--topology sallen-key-lowpass`` builds the same parts.
 
 The op-amp's reach: a section needs GBW >= :data:`GBW_MARGIN` x fn x Q x noise gain
 (the noise gain 1 + |G| of an inverting section, G of a non-inverting one): the rule of
@@ -38,7 +41,6 @@ from ..core.ranges import parse_in_range
 from ..core.units import format_eng
 from ..filters import registry
 from ..filters.deck import ac_deck, simulate_ac
-from ..filters.design import predistort
 from ..filters.topology import SectionTarget
 from ..spice.simulate import tool_info
 from . import circuit
@@ -297,15 +299,22 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
     target = Target(spec.fc_hz, spec.zeta, spec.gain)
     section = circuit.plant_target(topo, spec.fc_hz, spec.zeta, spec.gain)
     check_opamp_reach(topo, section, amp)
-    aim = predistort(topo, section, amp) if spec.compensate_gbw else section
     rv = candidates(spec.r_series, spec.r_min, spec.r_max, "resistor")
     cv = candidates(spec.c_series, spec.c_min, spec.c_max, "capacitor")
-    if spec.r is None:
-        ranked = circuit.search(topo, aim, rv, cv, top=spec.alternatives)
-    else:
-        # the seed's procedure on the section: R and C fixed, the rest solved, then rounded jointly
+
+    def rank(aim):
+        # a pool four times the list: impedance-scaled copies and swapped builds fold into one (circuit.listed)
+        if spec.r is None:
+            return circuit.listed(topo, circuit.search(topo, aim, rv, cv, top=4 * spec.alternatives),
+                                  spec.alternatives)
+        # the seed's procedure on the section: R and C fixed, the rest solved, then rounded jointly; the level
+        # is the user's: each response once, best error first
         exact = topo.synthesize_rc(aim, spec.r, spec.c)
-        ranked = circuit.rounded(topo, aim, exact, rv, cv, top=spec.alternatives)
+        return circuit.listed(topo, circuit.rounded(topo, aim, exact, rv, cv, top=4 * spec.alternatives),
+                              spec.alternatives, band=False)
+    # the plant's spec is its dominant pair: aim off by the op-amp's shift of it (as the seed's plant does)
+    aim, ranked = circuit.compensate_gbw(topo, section, amp, rank) if spec.compensate_gbw else (section, rank(section))
+    exact = None if spec.r is None else topo.synthesize_rc(aim, spec.r, spec.c)
     best = ranked[0]
     if aim is section and best.worst > MAX_ERROR:
         raise DesignError(f"fc_hz: the best {spec.r_series}/{spec.c_series} parts for {topo.name} land "

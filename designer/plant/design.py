@@ -8,27 +8,13 @@ jointly and its LM741 modelled).
 JSON of ``design-plant --json`` and ``result.json``, and the report module
 renders the same object as text, Markdown and HTML.
 
-Which builds are listed (:func:`listed`). The search ranks combinations by
-their error alone, and the same response comes back at other impedance levels:
-R1, R2 times ten with C1, C2 over ten has the same ratios and time constants,
-so the same fn and zeta (30k/120k/1n5/4n7 and 3k/12k/15n/47n). Each response is
-listed once, at the level whose resistors lie in :data:`R_BAND`, 1 kOhm to
-100 kOhm (nearest its middle, 10 kOhm, otherwise), and among the builds within
-:data:`NOTE_ERROR` of the target (well inside what the parts' own tolerance
-moves: a 5 % resistor moves fn 2.5 %) those in the band come first. Why the band:
-
-- below 1 kOhm the op-amp's output drives R1 (through C2) and R2 with C1
-  (the LM741 is specified into 2 kOhm, TI SNOSC25), and the generator's 50 Ohm
-  output adds to R1: 5 % of 1 kOhm already;
-- above 100 kOhm the resistors' thermal noise, sqrt(4 k T R) = 41 nV/sqrt(Hz)
-  at 100 kOhm and 300 K (Johnson-Nyquist; Horowitz and Hill, *The Art of
-  Electronics*, 3rd ed., 8.1.1), and the op-amp's input bias current through
-  R1 + R2 (LM741: 80 nA typical, 500 nA max, TI SNOSC25: 8 mV to 50 mV of
-  output offset at 100 kOhm) grow, and a few pF of board and input capacitance
-  and leakage become part of the circuit.
-
-The ``--r-min``/``--r-max`` bounds still decide what the search may use (a
-design the band cannot reach is built outside it, best error first).
+Which builds are listed: :func:`designer.plant.circuit.listed`, every section's rule (each
+response once, at the level whose resistors lie in 1 kOhm..100 kOhm, those within 0.5 % of the
+target in that band first; the module says why). The parts are ranked by the generic entry,
+:func:`designer.plant.circuit.search` (:func:`~designer.plant.circuit.rounded` with R and C fixed),
+which takes the Sallen-Key low-pass's own exact search (its
+:meth:`~designer.filters.topology.Topology.fast_search`), as ``design-plant --topology
+sallen-key-lowpass`` does.
 """
 
 from __future__ import annotations
@@ -57,7 +43,8 @@ from .bench import (
     sine_check,
     tolerance_band,
 )
-from .model import opamp_pair, plant_tf, plant_tf_opamp, sensitivities
+from . import circuit
+from .model import plant_tf, plant_tf_opamp, sensitivities
 from .netlist import plant_ac_deck, plant_deck
 from .result import (
     Alternative,
@@ -78,12 +65,12 @@ from ..filters.sallen_key_lowpass_synthesis import (
     resistors_for_caps,
     unity_gain_c2_min,
 )
-from ..filters.sallen_key_lowpass_parts import part_values, section_of
-from ..filters.sallen_key_lowpass_search import around, brute_force, joint_search
+from ..filters.sallen_key_lowpass_parts import gain_of, network, part_values, section_of
+from ..filters.sallen_key_lowpass_search import scored
+from ..filters.topology import SectionTarget
 from .spec import AnalysisSpec, PlantSpec
 
-__all__ = ["PlantSpec", "AnalysisSpec", "PlantResult", "choose_parts", "design_plant", "analyze_plant", "listed",
-           "R_BAND"]
+__all__ = ["PlantSpec", "AnalysisSpec", "PlantResult", "choose_parts", "design_plant", "analyze_plant"]
 
 
 def candidates(series: str, lo: float, hi: float, what: str) -> np.ndarray:
@@ -99,13 +86,6 @@ def gain_resistors(gain: float, spec: PlantSpec):
         return None, None, 1.0
     r4, r3 = eseries.nearest_ratio_pair(gain - 1.0, spec.r_series, spec.r_min, spec.r_max)
     return r3, r4, 1.0 + r4 / r3
-
-
-def gbw_shift(parts: SallenKeyParts, opamp: OpAmp):
-    """How far the op-amp's finite GBW moves these parts: (fn_ideal / fn_opamp,
-    zeta_ideal / zeta_opamp). ``compensate_gbw`` multiplies the targets by it."""
-    fo, zo = opamp_pair(parts, opamp)
-    return parts.fn_hz / fo, parts.zeta / zo
 
 
 @dataclass(frozen=True)
@@ -144,35 +124,35 @@ def choose_parts(spec: PlantSpec) -> Choice:
     if k != spec.gain:
         notes.append(f"gain K = {spec.gain:g} realised as 1 + {r4:g}/{r3:g} = {k:.5g}")
     top = spec.alternatives
+    topo = section_of(with_gain=r3 is not None)
 
-    def rank(fc_t, z_t):
-        """Ranked E-series candidates for a target; with R and C fixed (the seed's
-        procedure) also the exact design they round, and its m and n."""
-        if spec.r is None:
-            return joint_search(fc_t, z_t, rv, cv, k, top=4 * top), None, None
-        m, n = ratios_from_rc(fc_t, z_t, spec.r, spec.c, k)
-        ideal = SallenKeyParts(m * spec.r, spec.r, spec.c, n * spec.c, k, r3, r4)
-        # each part rounded jointly around the exact design
-        pool_r = np.unique(np.concatenate([around(ideal.r1, rv), around(ideal.r2, rv)]))
-        pool_c = np.unique(np.concatenate([around(ideal.c1, cv), around(ideal.c2, cv)]))
-        return brute_force(fc_t, z_t, pool_r, pool_c, k, top=4 * top), ideal, Ratios(m, n)
-
-    fc_t, z_t = spec.fc_hz, spec.zeta
-    ranked, ideal, ratios = rank(fc_t, z_t)
     # with R and C fixed (the seed's procedure) the level is the user's: each response once, best error first
     band = spec.r is None
-    if spec.compensate_gbw:
-        # aim off by the shift the op-amp causes on the parts chosen, and choose again;
-        # the shift hardly depends on the parts, so two or three rounds settle it
-        for _ in range(4):
-            b = listed(ranked, k, 1, band)[0]
-            sf, sz = gbw_shift(SallenKeyParts(b.r1, b.r2, b.c1, b.c2, k, r3, r4), spec.amp)
-            new = (spec.fc_hz * sf, spec.zeta * sz)
-            if abs(new[0] / fc_t - 1) < 1e-9 and abs(new[1] / z_t - 1) < 1e-9:
-                break
-            fc_t, z_t = new
-            ranked, ideal, ratios = rank(fc_t, z_t)
-    ranked = listed(ranked, k, top, band)
+    target = SectionTarget("lowpass", spec.fc_hz, q=1.0 / (2.0 * spec.zeta), gain=spec.gain)
+    exact = {"ideal": None, "ratios": None}
+
+    def zeta_of(aim):
+        return spec.zeta if aim is target else 1.0 / (2.0 * aim.q)
+
+    def rank(aim):
+        """The builds listed for a target (circuit.listed) from the generic entry, circuit.search (the section's
+        fast path); with R and C fixed (the seed's procedure) circuit.rounded of the exact design they give."""
+        if spec.r is None:
+            return circuit.listed(topo, circuit.search(topo, aim, rv, cv, top=4 * top), top, band)
+        m, n = ratios_from_rc(aim.fn_hz, zeta_of(aim), spec.r, spec.c, k)
+        ideal = SallenKeyParts(m * spec.r, spec.r, spec.c, n * spec.c, k, r3, r4)
+        # each part rounded jointly around the exact design
+        found = circuit.rounded(topo, aim, part_values(ideal), rv, cv, top=4 * top)
+        exact.update(ideal=ideal, ratios=Ratios(m, n))
+        return circuit.listed(topo, found, top, band)
+
+    # --compensate-gbw: aim off by the shift the op-amp causes on the parts chosen, and choose again (every
+    # section's rule, circuit.compensate_gbw)
+    aim, chosen = circuit.compensate_gbw(topo, target, spec.amp, rank) if spec.compensate_gbw else (target,
+                                                                                                     rank(target))
+    fc_t, z_t = aim.fn_hz, zeta_of(aim)
+    ideal, ratios = exact["ideal"], exact["ratios"]
+    ranked = scored(*network({r: np.array([c.values[r] for c in chosen]) for r in topo.designators}), fc_t, z_t, k)
     best = ranked[0]
     if spec.r is None:
         # solved once, for the target finally aimed at
@@ -181,7 +161,7 @@ def choose_parts(spec: PlantSpec) -> Choice:
     if best.worst > MAX_ERROR:
         raise _unreachable(spec, fc_t, best.worst)
     if spec.r is None and best.worst > NOTE_ERROR:
-        notes += _bound_notes(spec, fc_t, z_t, k, best.worst)
+        notes += _bound_notes(spec, fc_t, z_t, best.worst)
     return Choice(built, ideal, ratios, ranked, notes, fc_t, z_t)
 
 
@@ -326,7 +306,7 @@ MAX_ERROR = 0.05
 NOTE_ERROR = 0.005
 
 
-def _bound_notes(spec: PlantSpec, fc: float, zeta: float, gain: float, worst: float) -> list:
+def _bound_notes(spec: PlantSpec, fc: float, zeta: float, worst: float) -> list:
     """Which part bound keeps the design ``worst`` off. Each bound is relaxed by a
     decade (within the physical ranges) and the search run again; where that at
     least halves the error, the bound is named with the mildest series value
@@ -342,7 +322,14 @@ def _bound_notes(spec: PlantSpec, fc: float, zeta: float, gain: float, worst: fl
         b = {k: getattr(spec, k) for k in ("r_min", "r_max", "c_min", "c_max")} | {attr: value}
         rv = eseries.values(spec.r_series, b["r_min"], b["r_max"])
         cv = eseries.values(spec.c_series, b["c_min"], b["c_max"])
-        return joint_search(fc, zeta, rv, cv, gain, top=1)[0].worst if rv.size and cv.size else math.inf
+        if not (rv.size and cv.size):
+            return math.inf
+        # the generic entry (the section's fast path), the gain pair chosen again within the bounds tried
+        found = {r: np.array([v]) for r, v in circuit.search(section_of(with_gain=spec.gain != 1.0), aim, rv, cv,
+                                                                 top=1)[0].values.items()}
+        return scored(*network(found), fc, zeta, float(gain_of(found)[0]))[0].worst
+
+    aim = SectionTarget("lowpass", fc, q=1.0 / (2.0 * zeta), gain=spec.gain)
 
     for flag, attr, factor, key, unit, series in tries:
         rng, bound = RANGES[key], getattr(spec, attr)
@@ -385,72 +372,6 @@ def _unreachable(spec: PlantSpec, fc: float, worst: float) -> ParamError:
     else:
         why = "; widen the bounds or use a finer series ({r_series}/{c_series})"
     return ParamError(head + why, params=("r_min", "r_max", "c_min", "c_max", "gain", "r_series", "c_series"))
-
-
-def _distinct(ranked, gain):
-    """For unity gain R1 and R2 can swap without changing anything: list each build once."""
-    seen, out = set(), []
-    for c in ranked:
-        key = (tuple(sorted((c.r1, c.r2))) if gain == 1.0 else (c.r1, c.r2), c.c1, c.c2)
-        if key not in seen:
-            seen.add(key)
-            out.append(c)
-    return out
-
-
-#: the resistors' preferred band, Ohm (see the module docstring: loading below, noise and offset above)
-R_BAND = (1e3, 100e3)
-
-
-def _outside_band(c) -> float:
-    """How far (decades) a build's resistors stray outside :data:`R_BAND` (0: inside)."""
-    lo, hi = R_BAND
-    return max(0.0, math.log10(lo / min(c.r1, c.r2)), math.log10(max(c.r1, c.r2) / hi))
-
-
-def _same_response(a, b) -> bool:
-    """The same ratios R1/R2 and C2/C1 and the same time constant R1 C1: one build scaled in
-    impedance (R times s, C over s), with the same fn and zeta."""
-    return all(math.isclose(x, y, rel_tol=1e-9) for x, y in
-               ((a.r1 / a.r2, b.r1 / b.r2), (a.c2 / a.c1, b.c2 / b.c1), (a.r1 * a.c1, b.r1 * b.c1)))
-
-
-def listed(ranked, gain: float, top: int, band: bool = True) -> list:
-    """The builds a design lists, best first, from candidates ranked by error.
-
-    Each build once (R1, R2 swapped at unity gain), each response once (an
-    impedance-scaled copy is the same design): at the level whose resistors stray
-    least outside :data:`R_BAND`, nearest 10 kOhm when several lie inside. With
-    ``band``, the builds in the band within :data:`NOTE_ERROR` of the target
-    come first (the module docstring says why).
-
-    Parameters
-    ----------
-    ranked : list of Candidate
-        Combinations, best error first (:func:`~designer.plant.selection.joint_search`).
-    gain : float
-        The amplifier gain K (at 1, R1 and R2 may swap).
-    top : int
-        How many to list at most.
-    band : bool
-        Put the builds in the resistor band first (False: the user fixed R, keep the error order).
-
-    Returns
-    -------
-    list of Candidate
-    """
-    groups = []
-    for c in _distinct(ranked, gain):
-        home = next((g for g in groups if _same_response(g[0], c)), None)
-        if home is None:
-            groups.append([c])
-        else:
-            home.append(c)
-    # a group's members have the same errors: its place in the ranking is its first member's
-    reps = [min(g, key=lambda c: (_outside_band(c), abs(math.log10(math.sqrt(c.r1 * c.r2) / 1e4)))) for g in groups]
-    if band:
-        reps.sort(key=lambda c: not (_outside_band(c) == 0 and c.worst <= NOTE_ERROR))   # stable: by error within
-    return reps[:top]
 
 
 def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternatives, amp: OpAmp, amplitude_v,

@@ -7,7 +7,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from designer.core.errors import DesignError
-from designer.plant.design import MAX_ERROR, analyze_plant, design_plant
+from designer.plant.design import MAX_ERROR, analyze_plant, choose_parts, design_plant
 from designer.plant.sallenkey import SallenKeyParts
 from designer.plant.spec import AnalysisSpec, PlantSpec
 
@@ -341,7 +341,7 @@ def test_alternatives_differ_and_sit_in_the_resistor_band(fc, zeta):
     30k/120k/1n5/4n7 then 3k/12k/15n/47n); the build is the best the search finds
     with every resistor in 1k..100k when that is within 0.5 %."""
     from designer.core import eseries
-    from designer.plant.design import NOTE_ERROR, R_BAND
+    from designer.plant.circuit import BAND_ERROR, R_BAND
     from designer.plant.selection import joint_search
     r = design_plant(PlantSpec(fc, zeta, alternatives=8), simulate=False)
     alts = r.alternatives
@@ -354,24 +354,61 @@ def test_alternatives_differ_and_sit_in_the_resistor_band(fc, zeta):
                            eseries.values(spec.c_series, spec.c_min, spec.c_max), top=1)[0]
     b = r.built
     worst = max(abs(b.fn_hz / fc - 1), abs(b.zeta / zeta - 1))
-    if in_band.worst <= NOTE_ERROR:
+    if in_band.worst <= BAND_ERROR:
         assert R_BAND[0] <= min(b.r1, b.r2) and max(b.r1, b.r2) <= R_BAND[1]
         assert worst == pytest.approx(in_band.worst, abs=1e-12)
     else:   # the band cannot reach 0.5 %: the best error within the bounds, wherever it is
         assert worst <= in_band.worst
 
 
-def test_listed_keeps_one_build_per_response_at_the_level_in_the_band():
-    from designer.plant.design import listed
-    from designer.plant.selection import Candidate
+def _pipelines(fc, zeta, gain, compensate=False, **rc):
+    """The parts of the seed plant's pipeline (choose_parts) and of the generic one on the same section
+    (design-plant --topology sallen-key-lowpass[-gain]): (built, alternatives) each, or the refusal's type."""
+    from designer.filters.sallen_key_lowpass_parts import part_values
+    from designer.plant.circuit_design import design_circuit_plant
+    name = "sallen-key-lowpass" if gain == 1.0 else "sallen-key-lowpass-gain"
+    try:
+        choice = choose_parts(PlantSpec(fc, zeta, gain=gain, compensate_gbw=compensate, **rc))
+        sk = (part_values(choice.built), [(c.r1, c.r2, c.c1, c.c2) for c in choice.ranked])
+    except DesignError as exc:
+        sk = type(exc)
+    try:
+        r = design_circuit_plant(PlantSpec(fc, zeta, gain=gain, topology=name, compensate_gbw=compensate, **rc),
+                                 simulate=False)
+        generic = (dict(r.values), [tuple(c.values[k] for k in ("R1", "R2", "C1", "C2")) for c in r.alternatives])
+    except DesignError:
+        generic = DesignError
+    return sk, generic
 
-    def cand(r1, r2, c1, c2, err):
-        return Candidate(r1, r2, c1, c2, 0.0, 0.0, err, 0.0)
 
-    far = cand(30e3, 120e3, 1.5e-9, 4.7e-9, 0.001)       # R2 above 100k
-    near = cand(3e3, 12e3, 15e-9, 47e-9, 0.001)          # the same response, ten times lower
-    other = cand(18e3, 30e3, 4.7e-9, 10e-9, 0.002)
-    assert listed([far, near, other], 1.0, 5) == [near, other]
-    # an out-of-band build with a better error ranks after an in-band one within 0.5 %
-    assert listed([far, other], 1.0, 5) == [other, far]
-    assert listed([far, other], 1.0, 5, band=False) == [far, other]
+def test_both_pipelines_build_the_seed_plant_alike():
+    """design-plant --fc 3.5k --zeta 0.2 and the same with --topology sallen-key-lowpass: one search (the
+    section's fast path through circuit.search), one listing (circuit.listed): the same build and alternatives."""
+    sk, generic = _pipelines(3500.0, 0.2, 1.0)
+    assert sk == generic
+    built = json.loads(REFERENCE.read_text())["built"]     # the committed reference's build
+    assert sk[0] == {ref: built[f"{ref}_{'ohm' if ref[0] == 'R' else 'f'}"] for ref in sk[0]}
+    assert _pipelines(3500.0, 0.2, 1.0, compensate=True)[0] == _pipelines(3500.0, 0.2, 1.0, compensate=True)[1]
+
+
+@pytest.mark.parametrize("fc, zeta, gain, r, c", [(3500.0, 0.2, 1.0, 1e3, 10e-9), (1e3, 0.707, 1.0, 4.7e3, 10e-9),
+                                                  (2e3, 0.5, 2.0, 4.7e3, 10e-9), (800.0, 0.3, 1.5, 10e3, 10e-9)])
+def test_both_pipelines_round_the_seed_s_procedure_alike(fc, zeta, gain, r, c):
+    """--r/--c (the seed's fix R and C, solve m and n): the seed plant's pipeline rounds through circuit.rounded
+    (the fast path: R1/R2's and C1/C2's neighbours pooled), as --topology sallen-key-lowpass[-gain] does."""
+    sk, generic = _pipelines(fc, zeta, gain, r=r, c=c)
+    assert not isinstance(sk, type) and sk == generic
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(fc=st.floats(100.0, 20e3), zeta=st.floats(0.1, 1.5),
+       gain=st.one_of(st.just(1.0), st.floats(1.0, 3.0).filter(lambda g: g > 1.0)), compensate=st.booleans())
+def test_both_pipelines_build_the_same_parts(fc, zeta, gain, compensate):
+    """The seed plant's pipeline and the generic one on the Sallen-Key low-pass (unity or gain K) build the
+    same parts and list the same alternatives, or both refuse; with --compensate-gbw (LM741) too, one rule
+    (circuit.compensate_gbw)."""
+    sk, generic = _pipelines(fc, zeta, gain, compensate)
+    refused = [isinstance(x, type) for x in (sk, generic)]
+    assert refused[0] == refused[1], (sk, generic)
+    if not refused[0]:
+        assert sk == generic
