@@ -115,6 +115,9 @@ START_SAMPLES = 5000
 MAX_START_DELAY = 150
 #: the damping ratio's bounds (zeta >= 1 is the SOPDT)
 ZETA_BOUNDS = (0.005, 0.999)
+#: Jacobian columns whose norms span more than this are scaled to unit norm before the intervals' pseudo-inverse
+#: (J^T J's condition from the scales alone then 1e8, far from pinv's 1e-15 cut-off below it)
+SCALE_SPAN = 1e4
 #: a time constant below this fraction of the sample interval cannot be seen in the record
 MIN_TAU_OF_T = 1e-3
 
@@ -770,7 +773,19 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     s2 = float(r @ r) / dof
     ci = {k: None for k in names}
     if free.any():
-        cov = np.linalg.pinv(J.T @ J) * s2
+        # columns of very different lengths scaled to unit norm before the pseudo-inverse: its cut-off is
+        # relative to the largest singular value, and a dead time started near 0 is scaled by the sample
+        # interval, so its column can be 1e8 times shorter than the gain's; unscaled, pinv dropped it and
+        # gave the dead time an interval of 3e-18 s (an integrator under a step, 15,561 samples over 30 s at
+        # 20 dB: +-0.05 s by the same Jacobian scaled). Columns within SCALE_SPAN of each other keep the
+        # unscaled product (the same intervals to the last bit as before)
+        d = np.linalg.norm(J, axis=0)
+        if d.max() > 0 and d.min() < d.max() / SCALE_SPAN:
+            d = np.where(d > 0, d, 1.0)
+            Jn = J / d
+            cov = np.linalg.pinv(Jn.T @ Jn) / np.outer(d, d) * s2
+        else:
+            cov = np.linalg.pinv(J.T @ J) * s2
         half = float(stdtrit(dof, 0.975)) * np.sqrt(np.clip(np.diag(cov), 0.0, None))
         for k, h in zip(np.array(names)[free], half):
             ci[str(k)] = float(h)

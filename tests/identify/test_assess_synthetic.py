@@ -13,12 +13,31 @@ gain within 2 %, time constants and dead time within 5 %, zeta within 0.02,
 and a validation fit within 1 point of the true model's own fit, computed
 with the library's validation function on the same split and hold.
 
-The record is sized for the noise, as an engineer sizes it: 300 s (3001
-samples) unless the 300 s fit's 95 % interval on some parameter is wider than
-the issue's tolerance. A parameter's interval shrinks like 1/sqrt(N) with the
-number of independent input edges or sweep cycles, so such a case gets
-N = 3001 (interval / tolerance)^2 x 1.2 samples (:data:`WIDE`, the widest
-ratio measured at 300 s), at most :data:`LONGEST` (100,000). Beyond
+The record is sized as an engineer sizes a capture: the scope's time base
+to the plant's dynamics, its sample count to the noise. A first capture of
+3001 samples (:data:`POINTS`) spans the case's window: 300 s every 0.1 s
+(TS) under a random binary signal or a chirp, 60 s under a single step
+(:data:`STEP_WINDOW`: the step at a tenth, then 2.6 times the slowest
+plant's dead time plus 2 % settling; the library refuses a record too short
+for the model's settling), 30 s for the integrator under any input
+(:data:`INTEGRATOR_WINDOW`: 27 dead times, about 30 switches of the random
+binary signal p 0.1 at its 0.1 s clock, which stays the same whatever the
+sample interval). When the best model's 95 % interval on some parameter is
+wider than the issue's tolerance there, by the ratio r (:data:`WIDE`, the
+widest ratio measured at the first capture), the case gets
+N = 3001 r^2 x 1.2 samples, at most :data:`LONGEST` (100,000, the library's
+cap; over a set window rounded to a whole number of samples per 0.1 s, the
+random binary clock a multiple of the sample interval as the correlation
+route requires): a parameter's interval shrinks like 1/sqrt(N), with the number of
+independent input edges or sweep cycles (random inputs and chirps: the
+record lengthened at TS, a chirp sweeping the same band more slowly), or
+with the samples around each edge at a fixed SNR (a single step, whose one
+edge holds all the dead time's information, and the integrator: the window
+kept, the sample interval window / (N - 1)). The integrator's window
+is short on purpose: the SNR is against the clean output's variance, a
+ramp's or a random walk's drift, which grows as the window squared, so a
+longer window raises the noise faster than it adds edges (at 300 s its dead
+time was 46 % off at 20 dB and no model was valid at 10 dB). Beyond
 :data:`~designer.identify.assess.MAX_SAMPLES` (20,000) the assessment fits
 and scores block means; the output-error fits simulate the model at the
 record's own rate and compare its block means with the output's, so the
@@ -26,14 +45,11 @@ means leave the fit unbiased (:func:`test_block_means_leave_the_fit_unbiased`;
 fitted on the block means as a record of their own they moved an SOPDT's dead
 time under a random binary signal p 0.5 at 10 dB to 0.950 s and 0.944 s for
 0.900 s with blocks of 2 and 3 samples). The true model's fit is computed on
-the record the assessment scored (its block means). A chirp sweeps the same
-band over the longer record (a slower sweep). Not lengthened: a single step (its one edge holds all
-its information on the dead time: a longer record adds none) and the
-integrating plant (the SNR is against the clean output's variance, a ramp's,
-which grows as the record squared: the noise grows with the record faster
-than the edges, and at 600 s the 20 dB random binary p 0.5 capture is refused
-as too short for an SOPDT of 15.8 ks settling, the 10 dB one's best is a
-correlation double-pole, K 34.8)."""
+the record the assessment scored (its block means). The SOPDT under a step
+at 10 dB would need 409,000 samples over its 60 s, over the cap: at 99,601
+it passes, its short lag's interval (+-0.14 s) still wider than its
+tolerance. The FOPDT under a step at 10 dB misses on the ranking, not on the
+data (:func:`test_a_step_miss_is_a_tie_not_the_data`)."""
 
 import math
 
@@ -62,14 +78,28 @@ PLANTS = {
 }
 INPUTS = ("rb0.1", "rb0.5", "chirp", "step")
 
-#: the widest 95 % interval over the issue's tolerance among the best model's parameters, at 300 s (seed 28):
-#: an SOPDT at 10 dB, its short lag (tolerance 0.075 s) the widest under each input
+#: the widest 95 % interval over the issue's tolerance among the best model's parameters at the first capture
+#: (POINTS samples over the case's window, seed 28). 300 s: an SOPDT at 10 dB, its short lag (tolerance 0.075 s)
+#: the widest under each input. A step's 60 s and an integrator's 30 s: the dead time (tolerance 0.065 s, 0.045 s,
+#: 0.025 s and 0.055 s) the widest, but for the SOPDT under a step at 10 dB its short lag (the step route's
+#: overdamped least squares, 1.637 s +-0.799 s)
 WIDE = {("sopdt", "rb0.1", 10): 0.2028 / 0.075, ("sopdt", "rb0.5", 10): 0.2163 / 0.075,
-        ("sopdt", "chirp", 10): 0.3590 / 0.075}
+        ("sopdt", "chirp", 10): 0.3590 / 0.075,
+        ("fopdt", "step", 10): 0.1417 / 0.065, ("sopdt", "step", 20): 0.1478 / 0.045,
+        ("sopdt", "step", 10): 0.7993 / 0.075, ("underdamped", "step", 10): 0.0432 / 0.025,
+        ("integrating", "rb0.1", 10): 0.1666 / 0.055, ("integrating", "rb0.5", 10): 0.1197 / 0.055,
+        ("integrating", "chirp", 20): 0.0945 / 0.055, ("integrating", "chirp", 10): 0.3008 / 0.055,
+        ("integrating", "step", 20): 0.1142 / 0.055, ("integrating", "step", 10): 0.4126 / 0.055}
 #: the margin over the predicted record
 MARGIN = 1.2
-#: the longest record made (samples)
+#: the longest record made (samples): the library's sample cap
 LONGEST = 100_000
+#: a step's window (s): the step at a tenth, then 54 s, 2.6 times the slowest settling plant's dead time plus 2 %
+#: settling (the FOPDT's 20.9 s)
+STEP_WINDOW = 60.0
+#: an integrator's window (s): 27 dead times, about 30 edges of the random binary signal p 0.1 (a switch a
+#: second on average at its 0.1 s clock) and 27 s of ramp under a step
+INTEGRATOR_WINDOW = 30.0
 
 
 def record_points(plant: str, inp: str, snr_db: float) -> int:
@@ -77,6 +107,29 @@ def record_points(plant: str, inp: str, snr_db: float) -> int:
     (interval / tolerance)^2 MARGIN, at most LONGEST."""
     r = WIDE.get((plant, inp, snr_db))
     return POINTS if r is None else min(LONGEST, int(math.ceil(POINTS * r * r * MARGIN)))
+
+
+def window(plant: str, inp: str) -> float | None:
+    """The case's window (s) set by the plant's dynamics, or None: an input
+    of many edges, its record lengthened at TS."""
+    if PLANTS[plant][0] == "integrating":
+        return INTEGRATOR_WINDOW
+    return STEP_WINDOW if inp == "step" else None
+
+
+def capture_design(plant: str, inp: str, snr_db: float) -> tuple:
+    """(sample interval, samples) of the case's capture (the module
+    docstring's rule): more edges at TS, or a finer interval over the
+    window the plant's dynamics set."""
+    n = record_points(plant, inp, snr_db)
+    w = window(plant, inp)
+    if w is None:
+        return TS, n
+    # a whole number of samples per TS: the random binary signal's clock a multiple of the sample interval
+    # (the correlation route refuses any other), the same rounding for every input
+    per = round(w / TS)
+    n = per * min((LONGEST - 1) // per, math.ceil((n - 1) / per)) + 1
+    return w / (n - 1), n
 
 
 def true_model(plant: str):
@@ -91,9 +144,10 @@ def true_model(plant: str):
     return pb.integrating(p["K"], 0.0, p["theta_s"])
 
 
-def excitation(kind: str, points: int = POINTS, seed: int = SEED):
-    """The library's input (simulate-capture's ``--input``), as a PWL source."""
-    duration = TS * (points - 1)
+def excitation(kind: str, points: int = POINTS, seed: int = SEED, ts: float = TS):
+    """The library's input (simulate-capture's ``--input``), as a PWL source:
+    a random binary signal clocked at TS whatever the sample interval."""
+    duration = ts * (points - 1)
     if kind.startswith("rb"):
         return random_binary_input(float(kind[2:]), TS, LEVEL, duration, points, seed=seed)
     if kind == "chirp":
@@ -102,13 +156,14 @@ def excitation(kind: str, points: int = POINTS, seed: int = SEED):
 
 
 def capture(plant: str, inp: str, snr_db: float, seed: int = SEED, points: int | None = None) -> tuple:
-    """(t, u, y_clean, y): the plant's response sampled every TS, noise at
-    ``snr_db`` (seeded) and 8-bit quantisation over the output's span."""
+    """(t, u, y_clean, y): the plant's response sampled as the case's design
+    says (``points`` given: that many every TS), noise at ``snr_db`` (seeded)
+    and 8-bit quantisation over the output's span."""
     m = true_model(plant)
-    points = record_points(plant, inp, snr_db) if points is None else points
-    t = np.arange(points) * TS
-    tf = np.arange((points - 1) * FINE + 1) * (TS / FINE)
-    ex = excitation(inp, points, seed)
+    ts, points = capture_design(plant, inp, snr_db) if points is None else (TS, points)
+    t = np.arange(points) * ts
+    tf = np.arange((points - 1) * FINE + 1) * (ts / FINE)
+    ex = excitation(inp, points, seed, ts)
     if ex is None:          # a step at a tenth of the record, from 0 V
         def at(x):
             return np.where(x >= t[points // 10], LEVEL, 0.0)
@@ -133,10 +188,27 @@ class _True:
         return simulate(self.model, u, self.ts, self.hold)
 
 
+#: the xfails whose best model is another structure that ties the true one's fit (the ranking's, not the data's)
+TIES = [("fopdt", "step", 10)]
+#: their captures and identifications, shared by the two tests that read them (one identification each)
+_SHARED = {}
+
+
+def identified(plant: str, inp: str, snr_db: float, seed: int = SEED) -> tuple:
+    """(t, u, y, identify_record's result) of the case's capture."""
+    key = (plant, inp, snr_db, seed)
+    if key in _SHARED:
+        return _SHARED[key]
+    t, u, _, y = capture(plant, inp, snr_db, seed)
+    out = (t, u, y, identify_record(t, y, u, name=f"{plant}/{inp}/{snr_db:g} dB"))
+    if (plant, inp, snr_db) in TIES and seed == SEED:
+        _SHARED[key] = out
+    return out
+
+
 def run(plant: str, inp: str, snr_db: float, seed: int = SEED) -> dict:
     """identify_record on the capture; the best model and the true model's fit."""
-    t, u, _, y = capture(plant, inp, snr_db, seed)
-    res = identify_record(t, y, u, name=f"{plant}/{inp}/{snr_db:g} dB")
+    t, u, y, res = identified(plant, inp, snr_db, seed)
     a = res.assessment
     k = a.decimated_by
     assert k == math.ceil(u.size / MAX_SAMPLES)
@@ -173,7 +245,6 @@ def misses(plant: str, best) -> list:
 # (the best model's validation fit is the true model's to 0.05 point in each: the data cannot tell them apart)
 _SAME = "; its fit {} equals the true model's {}"
 DATA = {
-    ("fopdt", "step", 10): "a step at 10 dB: theta 1.404 s (true 1.3 s, +8.0 %)" + _SAME.format(69.70, 69.69),
     # the predicted 26,331 samples (blocks of 2; at 300 s K 1.537, +2.5 %, the short lag 1.612 s, +7.5 % +-0.20 s,
     # theta 0.816 s, -9.4 %): the output-error SOPDT is within the tolerances (K 1.506, lags 4.000 s and 1.533 s,
     # theta 0.879 s +-0.024 s) but the lead-lag's fit ties it to 0.001 point and ranks first (at 2000 s without
@@ -182,42 +253,23 @@ DATA = {
                              "lead-lag (lags 3.963 s and 1.578 s, a zero at 0.165 s +-0.10 s, theta 1.027 s); "
                              "the SOPDT beside it is within the tolerances, its fit 0.001 point lower"
                              + _SAME.format(79.38, 79.38)),
-    ("sopdt", "step", 20): ("a step at 20 dB: the lags 1.304 s and 4.214 s (true 1.5 s, -13.1 %, and 4 s, +5.3 %)"
-                            + _SAME.format(90.01, 90.01)),
-    ("sopdt", "step", 10): ("a step at 10 dB: the short lag 1.407 s (-6.2 %), theta 1.076 s (true 0.9 s, +19.6 %)"
-                            + _SAME.format(69.68, 69.68)),
     # ("sopdt", "chirp", 10) passes at its predicted 82,512 samples (blocks of 5, foh: the output-error SOPDT, K
     # 1.497, lags 4.011 s and 1.471 s, theta 0.913 s +-0.032 s); at 2000 s, the longest record before the block
     # means were unbiased, its short lag was 1.412 s (-5.9 %, +-0.137 s), theta 0.961 s (+6.8 %)
-    ("underdamped", "step", 10): ("a step at 10 dB: theta 0.597 s (true 0.5 s, +19.4 %)"
-                                  + _SAME.format(69.71, 69.67)),
-    # the integrator: its gain within 0.2 %, its dead time's 95 % interval about +-0.4 s at 20 dB (the noise
-    # against the clean output's variance, a ramp's: 1.3 V rms). Data-limited, not the optimiser's: the fitted
-    # model's in-sample rms is below the true model's (test_an_integrators_dead_time_is_data_limited), and the
-    # fit is the lowest of a 0.01 s grid of dead times (tests/identify/test_outputerror.py)
-    ("integrating", "rb0.1", 20): ("random binary p 0.1 at 20 dB: K 0.2993 /s, theta 0.592 s (true 1.1 s, -46 %, "
-                                   "+-0.41 s); in-sample rms 1.38523 V, the true model's 1.38595 V"
-                                   + _SAME.format(70.49, 70.56)),
-    ("integrating", "rb0.5", 20): ("random binary p 0.5 at 20 dB: K 0.2994 /s, theta 0.900 s (true 1.1 s, -18 %, "
-                                   "+-0.39 s); in-sample rms 1.34041 V, the true model's 1.34125 V"
-                                   + _SAME.format(70.83, 70.84)),
-    ("integrating", "chirp", 20): ("a chirp at 20 dB: K 0.2994 /s, theta 1.253 s (true 1.1 s, +14 %, +-0.55 s); "
-                                   "in-sample rms 1.33092 V, the true model's 1.33114 V" + _SAME.format(71.15, 71.16)),
-    # under a step the asymptote (integrating-asymptote, the step route) and the output-error integrator tie;
-    # one edge holds all the dead time's information, the ramp's noise (2.5 V rms at 20 dB) hides it
-    ("integrating", "step", 20): ("a step at 20 dB: the asymptote's K 0.3003 /s, theta 1.819 s (true 1.1 s, +65 %, "
-                                  "+-1.37 s; the output-error fit's 1.854 s +-1.23 s); in-sample rms 2.5410 V, the "
-                                  "true model's 2.5423 V" + _SAME.format(72.32, 72.31)),
-    ("integrating", "step", 10): ("a step at 10 dB: the asymptote's K 0.2972 /s (-0.9 %), theta 0.004 s (+-4.6 s; the "
-                                  "output-error fit's 1.40 s +-3.9 s, not valid)" + _SAME.format(31.03, 31.01)),
+    # the FOPDT under a step at 10 dB, 17,401 samples over 60 s: the output-error FOPDT is within the tolerances
+    # (K 2.012, tau 5.033 s, theta 1.246 s +-0.070 s, -4.2 %) but an output-error lead-lag whose zero and second
+    # lag are an all-pass pair (tz -0.280 s +-0.204 s, tau2 0.291 s +-0.200 s: half a second of delay, its
+    # theta 0.703 s) fits 0.002 point better and ranks first; at 14,201 samples the FOPDT ranked first
+    ("fopdt", "step", 10): ("a step at 10 dB, 17,401 samples: the best is the output-error lead-lag (an all-pass "
+                            "pair, tz -0.280 s, tau2 0.291 s, theta 0.703 s); the FOPDT beside it is within the "
+                            "tolerances, its fit 0.002 point lower" + _SAME.format(69.96, 69.96)),
 }
-# at 10 dB no model is valid: the integrator's dead time interval is wider than the dead time (+-1.25 s at p 0.5),
-# and the record is refused as too short for the best-fitting lag (an SOPDT or FOPDT of 7.6-7.8 ks settling).
-# A longer record does not resolve it (the noise grows with the ramp's spread): at 600 s, random binary p 0.5, the
-# best is a correlation double-pole (K 34.8, a settling plant; fit -3.1 against the true model's 30.7)
-for _inp in ("rb0.1", "rb0.5", "chirp"):
-    DATA[("integrating", _inp, 10)] = ("10 dB: the integrator's dead time interval is wider than its dead time, no "
-                                       "model valid; refused as too short for the best-fitting lag's settling")
+# sized by the rule (module docstring) every other single step and every integrating case meets the tolerances:
+# the FOPDT, SOPDT and underdamped plants under a step over 60 s at 3001 samples (20 dB) or at 39,001 (the SOPDT
+# at 20 dB), 10,801 (the underdamped at 10 dB) and 99,601 (the SOPDT at 10 dB: the cap, 409,000 predicted; its
+# short lag 1.470 s, -2.0 %, within the tolerance though its interval +-0.14 s is not), the integrator over 30 s
+# at 3001 to 99,901 samples (at 300 s its dead time was 46 % off under a random binary signal p 0.1 at 20 dB, and
+# no model was valid at 10 dB: the noise, set against a ramp's spread over 300 s, was 10 times the 30 s record's)
 
 
 def _case(plant, inp, snr):
@@ -238,72 +290,31 @@ def test_best_model_recovers_the_plant(plant, inp, snr_db):
     assert best.fit_percent >= r["truth"] - 1.0, (best.label, best.fit_percent, r["truth"])
 
 
-def _rms(model, u, y, ts: float, hold: str) -> float:
-    """In-sample rms of a model from rest, its output level by least squares
-    (the output-error fit's ``initial="rest"``)."""
-    e = y - simulate(model, u - u[0], ts, hold)
-    e = e - e.mean()
-    return math.sqrt(float(e @ e) / e.size)
-
-
-@pytest.mark.parametrize("inp", INPUTS)
-def test_an_integrators_dead_time_is_data_limited(inp):
-    """The integrating plant at 20 dB (its xfails above): the output-error
-    integrator's in-sample rms is at most the true model's on the same
-    estimation data, so no optimiser can bring the dead time closer: the data
-    prefer the wrong one. Under a step the capture is read as a ramp: the
-    asymptote method is the step route's model."""
-    t, u, _, y = capture("integrating", inp, 20)
-    res = identify_record(t, y, u, name=f"integrating/{inp}")
-    a = res.assessment
-    est = a.split.estimation if a.split is not None else slice(None)
-    fit = next(c for c in a.candidates if c.route == "output-error" and c.kind == "integrating")
-    assert fit.params["K"] == pytest.approx(PLANTS["integrating"][1]["K"], rel=0.02)
-    ue, ye = u[est], y[est]
-    assert (_rms(fit.model, ue, ye, a.sample_time_s, a.hold)
-            <= _rms(true_model("integrating"), ue, ye, a.sample_time_s, a.hold))
-    if inp == "step":
-        assert [c.name for c in a.candidates if c.route == "step"] == ["integrating-asymptote"]
-
-
-def _tolerance(name: str, want: float) -> float:
-    """The issue's tolerance on one parameter, in its units."""
-    return 0.02 if name == "zeta" else (0.02 if name == "K" else 0.05) * abs(want)
-
-
-@pytest.mark.parametrize("plant, inp, snr_db",
-                         [c for c in CASES if c in DATA and c[0] != "integrating" and c not in WIDE])
-def test_the_settling_plants_misses_are_the_datas(plant, inp, snr_db):
-    """The non-integrating xfails above at 300 s (10 dB, and an SOPDT under a
-    step at 20 dB; the lengthened ones are not shown here): the misses are the record's, not the estimator's. The output-error fit
-    of the true structure started from the true parameters ends where the fit
-    from its own starts ends (the same rms: no start, and no ranking among the
-    routes' candidates, can do better by least squares), its in-sample rms from
-    rest is at most the true model's on the same estimation data, and every
-    parameter the best model misses has a 95 % interval wider than the issue's
-    tolerance on it: the record cannot place it that close."""
+@pytest.mark.parametrize("plant, inp, snr_db", TIES)
+def test_a_step_miss_is_a_tie_not_the_data(plant, inp, snr_db):
+    """The step's xfail above at its sized record: the data place the plant,
+    the ranking does not pick it. The output-error fit of the true structure
+    is valid, every parameter within the issue's tolerance, its validation
+    fit within 0.01 point of the best's; the output-error fit started at the true parameters ends where the
+    fit from its own starts ends (the same rms: the estimator is not the
+    limit). Every other single step and integrating case passes at its
+    sized record (the module docstring)."""
+    from designer.identify.assess import OE_INITIAL
     from designer.identify.outputerror import fit_output_error
-    t, u, _, y = capture(plant, inp, snr_db)
-    a = identify_record(t, y, u, name=f"{plant}/{inp}/{snr_db:g} dB").assessment
+    t, u, y, res = identified(plant, inp, snr_db)
+    a = res.assessment
     kind, p = PLANTS[plant]
-    est = a.split.estimation if a.split is not None else slice(None)
-    ue, ye, ts = u[est], y[est], a.sample_time_s
-    for initial in ("rest", "estimate"):
-        own = fit_output_error(ue, ye, ts, kind, hold=a.hold, initial=initial)
-        from_truth = fit_output_error(ue, ye, ts, kind, hold=a.hold, initial=initial, start=p)
-        assert from_truth.rms_residual == pytest.approx(own.rms_residual, rel=1e-6), initial
-    rest = fit_output_error(ue, ye, ts, kind, hold=a.hold, initial="rest", start=p)
-    assert _rms(rest.model, ue, ye, ts, a.hold) <= _rms(true_model(plant), ue, ye, ts, a.hold)
+    oe = next(c for c in a.candidates if c.route == "output-error" and c.kind == kind)
+    assert oe.valid and not misses(plant, oe), (oe.params, oe.note)
     best = a.best_candidate
-    assert best is not None and best.kind in (kind, "overdamped"), best
-    got, ci, want = dict(best.params), dict(best.ci95), dict(p)
-    if kind == "sopdt":     # the two lags in either order, each with its interval
-        lags = sorted(((got["tau1_s"], ci["tau1_s"]), (got["tau2_s"], ci["tau2_s"])))
-        (got["tau1_s"], ci["tau1_s"]), (got["tau2_s"], ci["tau2_s"]) = lags
-        want["tau1_s"], want["tau2_s"] = sorted((p["tau1_s"], p["tau2_s"]))
-    for name, w in want.items():
-        if abs(got[name] - w) > _tolerance(name, w):
-            assert ci[name] > _tolerance(name, w), (name, got[name], w, ci[name])
+    assert best.kind != kind and best.fit_percent - oe.fit_percent < 0.01, (best.label, best.fit_percent,
+                                                                          oe.fit_percent)
+    k = a.decimated_by
+    est = slice(0, a.split.n_est * k) if a.split is not None else slice(None)
+    ue, ye, ts, init = u[est], y[est], a.sample_time_s / k, OE_INITIAL.get(kind, "estimate")
+    own = fit_output_error(ue, ye, ts, kind, hold=a.hold, initial=init, block=k)
+    from_truth = fit_output_error(ue, ye, ts, kind, hold=a.hold, initial=init, start=p, block=k)
+    assert from_truth.rms_residual == pytest.approx(own.rms_residual, rel=1e-6)
 
 
 @pytest.mark.parametrize("points", [40_000, 100_000])
