@@ -698,6 +698,46 @@ class Topology(ABC):
         d0 = den[..., -1:]
         return num / d0, den / d0
 
+    # ---- parameters besides the parts (a sensitivity table's extra rows) ------------------------
+    def sensitivity_parameters(self) -> tuple:
+        """Names of the section's parameters besides its declared parts and the op-amp that a
+        sensitivity table lists (:func:`designer.plant.circuit.sensitivities`): none by default;
+        a section whose gain K is set by a gain pair lists ``"K"`` (the seed's plant table's row).
+
+        Returns
+        -------
+        tuple of str
+            The names :meth:`with_parameter` takes.
+        """
+        return ()
+
+    def with_parameter(self, values: dict, name: str, factor) -> dict:
+        """``values`` moved so that parameter ``name`` (of :meth:`sensitivity_parameters`) is
+        ``factor`` times its value and nothing else of the section changes (K: the feedback
+        resistor of the gain pair moves, the RC network stays).
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value, numbers or arrays.
+        name : str
+            A name of :meth:`sensitivity_parameters`.
+        factor : float or ndarray
+            The relative change (1 + h).
+
+        Returns
+        -------
+        dict
+            Designator -> value.
+
+        Raises
+        ------
+        DesignError
+            ``name`` is not one of the section's parameters.
+        """
+        raise DesignError(f"parameter: {self.name} has no parameter {name!r}; it has "
+                          f"{', '.join(self.sensitivity_parameters()) or 'none'}", param="parameter")
+
     def figures(self, values: dict) -> Figures:
         """fn, Q and the passband gain magnitude from the ideal coefficients.
 
