@@ -54,6 +54,7 @@ from ..core.errors import DesignError, ParamError
 from ..core.i18n import N_
 from ..spice.deck import GROUND, Netlist
 from .sallen_key import SallenKeySection
+from .sallen_key_lowpass_figures import sample_figures
 from .sallen_key_lowpass_synthesis import coefficients, opamp_denominator, ratios_from_rc
 from .topology import PartSpec, SectionTarget, polynomial, quadratic_root
 
@@ -110,6 +111,10 @@ class SallenKeyLowPass(SallenKeySection):
         num = np.zeros_like(d)
         num[..., -1:] = 1.0 / d0
         return num, d / d0
+
+    def sample_figures(self, values: dict, opamp=None):
+        # the plant's Monte Carlo engine: the third-order model's exact step (its module says how it differs)
+        return sample_figures(self.values_of(values), opamp)
 
     def limits(self, target: SectionTarget) -> dict:
         return {"ratio_min": sallen_key_ratio_min(target.q, target.gain)}

@@ -698,6 +698,29 @@ class Topology(ABC):
         d0 = den[..., -1:]
         return num / d0, den / d0
 
+    # ---- a section's own figures of sampled builds (the Monte Carlo's analytic engine) -----------------
+    def sample_figures(self, values: dict, opamp=None):
+        """Every figure of :data:`designer.plant.circuit.FIGURES` for arrays of sampled part values by
+        the section's own exact definitions, or None (the default): the generic ones
+        (:func:`designer.plant.circuit.circuit_figures`, the dominant pair's second-order step figures).
+        :func:`designer.plant.circuit.evaluate`, the Monte Carlo's and the worst case's chunk function,
+        takes these where a section has them (the Sallen-Key low-pass: its third-order model's exact step).
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value, numbers or arrays (one batch shape).
+        opamp : designer.core.opamps.OpAmp, optional
+            The op-amp (None or the ideal one: the ideal model); its gain-bandwidth may be an array
+            shaped as the batch.
+
+        Returns
+        -------
+        dict or None
+            Figure -> array shaped as the batch, or None.
+        """
+        return None
+
     # ---- parameters besides the parts (a sensitivity table's extra rows) ------------------------
     def sensitivity_parameters(self) -> tuple:
         """Names of the section's parameters besides its declared parts and the op-amp that a

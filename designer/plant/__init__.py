@@ -18,7 +18,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                        "check_opamp_reach",
                        "design_circuit_plant", "tolerance_nominal", "SQUARE_NRMS_PASS", "SquareRun", "square_deck",
                        "with_square_test", "default_square_hz"),
-    "circuit": ("BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "candidate_set", "capacitor_combinations",
+    "circuit": ("BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "OPAMP_PARAMETERS", "candidate_set", "capacitor_combinations",
                 "circuit_figures", "corner_frequencies", "dominant_pairs", "evaluate", "opamp_tf", "plant_target",
                 "rounded", "search", "step_of_pair"),
     "bench": ("PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",

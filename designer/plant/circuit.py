@@ -499,7 +499,9 @@ def step_of_pair(fn_hz, zeta) -> dict:
 
 
 def evaluate(context: tuple, values: dict) -> dict:
-    """The Monte Carlo's chunk function (:mod:`designer.tolerance.runner`): :func:`circuit_figures`.
+    """The Monte Carlo's chunk function (:mod:`designer.tolerance.runner`): the section's own figures
+    (:meth:`~designer.filters.topology.Topology.sample_figures`: the Sallen-Key low-pass's exact
+    third-order step) where it has them, else :func:`circuit_figures`.
 
     Parameters
     ----------
@@ -519,7 +521,9 @@ def evaluate(context: tuple, values: dict) -> dict:
     if "GBW" in values and opamp is not None and not opamp.ideal:
         # the op-amp's spread (--tol GBW): one gain-bandwidth per build, shaped as the parts' batch
         opamp = dataclasses.replace(opamp, gbw_hz=np.asarray(values["GBW"], float))
-    return circuit_figures(topo, {r: values[r] for r in topo.designators}, opamp)
+    values = {r: values[r] for r in topo.designators}
+    own = topo.sample_figures(values, opamp)
+    return circuit_figures(topo, values, opamp) if own is None else own
 
 
 #: the op-amp's figures a sensitivity table lists (label -> the :class:`~designer.core.opamps.OpAmp` field)
