@@ -179,3 +179,32 @@ def test_corner_frequencies_are_at_the_passband_gain_over_root_two(topology):
     assert len(corners) == (2 if topology.kind == "bandpass" else 1)
     for f in corners:
         assert abs(topology.response(values, 2j * np.pi * f)) == pytest.approx(gain / np.sqrt(2), rel=1e-9)
+
+
+OWN_FIGURES = [t for t in TOPOLOGIES if t.sample_figures(t.synthesize(t.example)) is not None]
+
+
+@pytest.mark.parametrize("amp", [None, "LM741", "TL072"])
+@pytest.mark.parametrize("topology", OWN_FIGURES, ids=[t.name for t in OWN_FIGURES])
+def test_a_sections_own_sample_figures_are_the_generic_ones_but_for_their_definitions(topology, amp):
+    """A section's own Monte Carlo figures (Topology.sample_figures; circuit.evaluate takes them) against the
+    generic circuit_figures over sampled builds: fn, zeta and the ideal figures to rounding; the step's
+    overshoot (the exact model's first peak, not the dominant pair's formula) within 1e-4 relative and its
+    peak time within 1 %; the gain the op-amp-aware model's at DC, K A0 / (A0 + K), where the generic one is K."""
+    opamp = None if amp is None else get_opamp(amp)
+    nominal = topology.synthesize(topology.example)
+    rng = np.random.default_rng(7)
+    values = {r: v * (1 + 0.05 * rng.uniform(-1, 1, 64)) for r, v in nominal.items()}
+    own, generic = topology.sample_figures(values, opamp), circuit.circuit_figures(topology, values, opamp)
+    assert own.keys() == set(circuit.FIGURES)
+    assert circuit.evaluate((topology.name, opamp), values).keys() == own.keys()
+    for k in ("fn_hz", "zeta", "q", "ideal_fn_hz", "ideal_zeta", "ideal_q"):
+        np.testing.assert_allclose(own[k], generic[k], rtol=1e-12, err_msg=k)
+    np.testing.assert_allclose(own["overshoot_pct"], generic["overshoot_pct"], rtol=1e-4)
+    np.testing.assert_allclose(own["peak_time_s"], generic["peak_time_s"], rtol=1e-2)
+    a0 = np.inf if opamp is None or opamp.ideal else opamp.a0
+    k = np.asarray(generic["gain"])
+    np.testing.assert_allclose(own["gain"], k * a0 / (a0 + k) if np.isfinite(a0) else k, rtol=1e-12)
+    one = {r: v[5] for r, v in values.items()}     # a number for numbers
+    assert {f: float(x) for f, x in topology.sample_figures(one, opamp).items()} == \
+        {f: float(x[5]) for f, x in own.items()}
