@@ -11,7 +11,7 @@ from __future__ import annotations
 from ..filters.sallen_key_lowpass_parts import gain_refs, section_of
 from ..plant import circuit
 
-__all__ = ["FIGURES", "context", "plant_figures"]
+__all__ = ["FIGURES", "context", "evaluate", "plant_figures"]
 
 FIGURES = circuit.FIGURES
 
@@ -51,3 +51,21 @@ def plant_figures(v: dict, opamp=None) -> dict:
         Figure -> array over the samples.
     """
     return circuit.evaluate(context(v, opamp), v)
+
+
+def evaluate(opamp, values: dict) -> dict:
+    """A chunk function (:mod:`.runner`) of the op-amp alone as context: :func:`plant_figures`.
+
+    Parameters
+    ----------
+    opamp : designer.core.opamps.OpAmp or None
+        The op-amp (None: ideal).
+    values : dict
+        Designator -> array over the chunk's samples.
+
+    Returns
+    -------
+    dict
+        Figure -> array over the samples.
+    """
+    return plant_figures(values, opamp)
