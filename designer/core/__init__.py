@@ -21,7 +21,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                "check_output_file", "check_output_folder", "check_plain_name", "clean_stale", "decode", "ensure_dir",
                "link_into", "new_folder_beside", "open_limited", "os_error", "publish_folder", "read_text",
                "remove_tree", "show_cell", "shown", "size_text"),
-    "figure_titles": ("FIGURE_TITLES", "PREFIX_TITLES", "figure_label", "figure_shown"),
+    "figure_titles": ("FIGURE_TITLES", "PREFIX_TITLES", "figure_label", "figure_range", "figure_shown", "figure_spread"),
     "i18n": ("DEFAULT", "LANGUAGES", "Message", "N_", "catalogue", "check_language", "current", "extract", "gettext",
              "language", "html_words", "localise", "missing", "negotiate", "page_catalogue", "page_messages",
              "translated", "update_catalogue"),

@@ -13,8 +13,9 @@ from __future__ import annotations
 
 from .i18n import N_
 from .i18n import gettext as _
+from .units import format_figure
 
-__all__ = ["FIGURE_TITLES", "PREFIX_TITLES", "figure_label", "figure_shown"]
+__all__ = ["FIGURE_TITLES", "PREFIX_TITLES", "figure_label", "figure_range", "figure_shown", "figure_spread"]
 
 #: figure id (without an engine's prefix) -> (title, unit of its values)
 FIGURE_TITLES = {
@@ -91,3 +92,61 @@ def figure_label(name: str) -> str:
     """
     title, unit = figure_shown(name)
     return f"{title} ({unit})" if unit else title
+
+
+def _headed(name: str, title: str) -> str:
+    # the id after the title (what --limit takes), unless the title already ends with it (damping ratio zeta)
+    return title if name in (title, title.split()[-1]) else f"{title} ({name})"
+
+
+def figure_range(name: str, lo: float, hi: float, digits: int = 5) -> str:
+    """A figure's title, its id (what ``--limit`` takes) and a range of its values with units, as the
+    command line's summaries print them (``natural frequency fn (fn_hz): 3.2392 kHz to 3.7705 kHz``).
+
+    Parameters
+    ----------
+    name : str
+        The figure's id.
+    lo, hi : float
+        The range's ends.
+    digits : int
+        Significant digits.
+
+    Returns
+    -------
+    str
+        The line's text.
+    """
+    title, _unit = figure_shown(name)
+    head = _headed(name, title)
+    return f"{head}: {format_figure(name, lo, digits)} to {format_figure(name, hi, digits)}"
+
+
+def figure_spread(name: str, nominal: float, mean: float, std: float, lo: float, hi: float,
+                  digits: int = 5) -> str:
+    """A Monte Carlo figure's statistics with units, as the command line's summaries print them
+    (``natural frequency fn (fn_hz): nominal 3.4858 kHz, mean 3.5075 kHz, std 140.4 Hz, 95 % of builds
+    3.2392 kHz to 3.7705 kHz``): the title says what it is, the id is what ``--limit`` takes.
+
+    Parameters
+    ----------
+    name : str
+        The figure's id.
+    nominal, mean, std : float
+        The nominal build's value, the builds' mean and standard deviation.
+    lo, hi : float
+        The 2.5 % and 97.5 % percentiles.
+    digits : int
+        Significant digits (the standard deviation's: four).
+
+    Returns
+    -------
+    str
+        The line's text.
+    """
+    title, _unit = figure_shown(name)
+    head = _headed(name, title)
+    def shown(v, d=digits):
+        return format_figure(name, v, d)
+    return (f"{head}: nominal {shown(nominal)}, mean {shown(mean)}, std {shown(std, 4)}, "
+            f"95 % of builds {shown(lo)} to {shown(hi)}")

@@ -37,6 +37,8 @@ The op-amp-aware model as polynomials, :meth:`Topology.opamp_model`, is a hook: 
 default :meth:`Topology.nodal_model` (Cramer's rule on those equations), overridden by a
 section with closed forms (the Sallen-Key low-pass: seed 001, IV.3-IV.9), which must
 equal the nodal solution to rounding (the conformance suite checks every section).
+So is the ideal (fn, zeta) a PID's plant is sized by, :meth:`Topology.ideal_pair` (by default
+from the coefficients; the Sallen-Key low-pass gives its parts record's exact arithmetic).
 """
 
 from __future__ import annotations
@@ -697,6 +699,33 @@ class Topology(ABC):
         num = np.where(num_size < 1e-10 * np.max(size_at, axis=-1, keepdims=True), 0.0, num)
         d0 = den[..., -1:]
         return num / d0, den / d0
+
+    # ---- the ideal pair (a hook, as opamp_model: the Sallen-Key low-pass overrides it) ------------
+    def ideal_pair(self, values: dict) -> tuple:
+        """(fn in Hz, zeta) of the section's ideal denominator, the pair a PID's
+        plant is named and sized by (:attr:`designer.pid.plant.PlantCircuit.fn_hz`):
+        by default from :meth:`coefficients`, den = d2 s^2 + d1 s + d0, wn = sqrt(d0/d2),
+        zeta = d1 / (2 sqrt(d0 d2)) (for real poles too: p1 p2 = d0/d2, p1 + p2 = d1/d2,
+        :func:`designer.core.lti.dominant_pair`'s pair); a first-order section, den =
+        d1 s + d0, has its pole wn = d0/d1 and zeta 1 (the critically damped pair at its
+        pole, whose span covers its settling). A section with closed forms of its own
+        overrides this (they must equal these to rounding: the conformance suite checks).
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value (ohm, farad), numbers.
+
+        Returns
+        -------
+        tuple of float
+            (fn_hz, zeta).
+        """
+        _, den = self.coefficients(values)
+        d = [float(x) for x in den]
+        if self.order == 1:
+            return d[-1] / d[0] / (2 * math.pi), 1.0
+        return math.sqrt(d[-1] / d[0]) / (2 * math.pi), d[1] / (2 * math.sqrt(d[-1] * d[0]))
 
     # ---- a section's own figures of sampled builds (the Monte Carlo's analytic engine) -----------------
     def sample_figures(self, values: dict, opamp=None):

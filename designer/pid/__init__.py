@@ -23,7 +23,7 @@ from ..core.exports import lazy_exports
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "plant": ("LoopNames", "PLANT_PREFIX", "Plant", "PlantCircuit", "circuit_from_cascade", "circuit_from_json", "circuit_plant",
               "parse_part_values", "part_items", "resolve_plant", "SEED_LOOP_NAMES",
-              "sallen_key_circuit", "sallen_key_parts"),
+              "pair_model", "sallen_key_circuit", "sallen_key_plant", "seed_loop_names"),
     "modelloop": ("FAR_FACTOR", "LEAK_LOOP_GAIN", "TABLE_STEP_FRACTION", "limits", "loop_figures", "size"),
     "loopchecks": ("MAX_STEADY_STATE_ERROR", "designators", "kick_note", "named", "spice_notes", "stage_checks",
                    "steady_state_check"),

@@ -59,7 +59,6 @@ from ..core.metrics import StepMetrics
 from ..core.opamps import OpAmp
 from ..core.units import format_eng
 from ..plant.bench import recommend_square_wave
-from ..plant.sallenkey import SallenKeyParts
 from ..spice.deck import SquareTest
 from . import blocks, rules, selection, tuning
 from . import model as M
@@ -89,20 +88,11 @@ LIMITS = ("closed_loop_stable", "phase_margin", "slew_rate", "output_swing")
 # ---- plant ------------------------------------------------------------------
 
 def resolve_plant(spec: PidSpec):
-    """(parts, description, series) of the Sallen-Key plant
-    (:func:`designer.pid.plant.sallen_key_parts`; every plant source as a
+    """(circuit, description, series) of the Sallen-Key plant as the generic record
+    (:func:`designer.pid.plant.sallen_key_plant`; every plant source as a
     :class:`~designer.pid.plant.Plant`: :func:`designer.pid.plant.resolve_plant`)."""
-    from .plant import sallen_key_parts
-    return sallen_key_parts(spec)
-
-
-def _sallen_key_record(circuit):
-    """The Sallen-Key parts record of a one-section circuit on that section, else None."""
-    from ..filters.sallen_key_lowpass_parts import record_of
-    if len(circuit.stages) != 1:
-        return None
-    st = circuit.stages[0]
-    return record_of(st.topology, st.values)
+    from .plant import sallen_key_plant
+    return sallen_key_plant(spec)
 
 
 def plant_model(plant, amp: OpAmp | None = None):
@@ -114,7 +104,7 @@ def plant_model(plant, amp: OpAmp | None = None):
 
     Parameters
     ----------
-    plant : designer.pid.plant.Plant, designer.pid.plant.PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+    plant : designer.pid.plant.Plant or designer.pid.plant.PlantCircuit
         The plant (:func:`designer.pid.netlist.plant_circuit`).
     amp : OpAmp, optional
         The op-amp of its sections (None: ideal).
@@ -137,13 +127,14 @@ def plant_model(plant, amp: OpAmp | None = None):
 
 
 def ideal_pair(plant) -> tuple:
-    """(fn in Hz, zeta) of the plant's ideal model: the Sallen-Key section's
-    closed forms (:func:`designer.plant.sallenkey.fn_zeta`), else the slowest
-    pole pair of its ideal denominator.
+    """(fn in Hz, zeta) of the plant's ideal model: its circuit's
+    (:meth:`designer.pid.plant.PlantCircuit.ideal_pair`: a section's own hook,
+    :meth:`designer.filters.topology.Topology.ideal_pair`, else the slowest pole pair
+    of the cascade's ideal denominator).
 
     Parameters
     ----------
-    plant : designer.pid.plant.Plant, designer.pid.plant.PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+    plant : designer.pid.plant.Plant or designer.pid.plant.PlantCircuit
         The plant.
 
     Returns
@@ -152,11 +143,7 @@ def ideal_pair(plant) -> tuple:
         (fn_hz, zeta).
     """
     from .netlist import plant_circuit
-    circuit = plant_circuit(plant)[0]
-    rec = _sallen_key_record(circuit)
-    if rec is not None:
-        return rec.fn_hz, rec.zeta
-    return dominant_pair(np.asarray(circuit.coefficients()[1], float))
+    return plant_circuit(plant)[0].ideal_pair()
 
 
 @dataclass(frozen=True)
@@ -180,7 +167,7 @@ def plant_step(plant, amp: OpAmp) -> PlantStep:
 
     Parameters
     ----------
-    plant : designer.pid.plant.Plant, designer.pid.plant.PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+    plant : designer.pid.plant.Plant or designer.pid.plant.PlantCircuit
         Any circuit plant.
     amp : OpAmp
         The op-amp of its sections.
@@ -335,7 +322,7 @@ def _run(spec: PidSpec, simulate: bool, simulator: str, as_built: bool, opamp=No
         res.notes.append(N_("SPICE simulation skipped (--no-sim): the closed-loop figures are analytic only"))
     res.scope = loop_scope(res)
     res.diff_amp = M.diff_amp_balance(parts, amp, ps.num, ps.den, loop.bode_w, loop.analytic.dc_gain)
-    if simulate and _same(parts, blocks.seed_bench_parts()) and _same(plant, SEED_BENCH_PLANT):
+    if simulate and _same(parts, blocks.seed_bench_parts()) and _same_circuit(plant, SEED_BENCH_PLANT):
         res.seed_bench = seed_bench_finding(res, spec, simulator)
     res.timings = clock.laps
     return res
@@ -351,8 +338,27 @@ def _same(a, b) -> bool:
     return True
 
 
-#: the seed's plant as built (001, V.13: R1 = 805 Ohm; its list swaps the C1/C2 names)
-SEED_BENCH_PLANT = SallenKeyParts(805.0, 1e3, 10e-9, 220e-9)
+def _same_circuit(a, b) -> bool:
+    """Two plant circuits of the same sections with their values equal to rounding."""
+    return len(a.stages) == len(b.stages) and all(
+        x.topology is y.topology and x.values.keys() == y.values.keys()
+        and all(math.isclose(v, y.values[k], rel_tol=1e-9) for k, v in x.values.items())
+        for x, y in zip(a.stages, b.stages))
+
+
+def _seed_bench_plant():
+    """The seed's plant as built (001, V.13: R1 = 805 Ohm; its list swaps the C1/C2 names): the follower's
+    network in its declared order (input resistor, resistor to +in, capacitor to ground, feedback capacitor)."""
+    from ..filters.cascade import Stage
+    from ..filters.sallen_key_lowpass_parts import section_of
+    from .plant import PlantCircuit, seed_loop_names
+    section = section_of(with_gain=False)
+    return PlantCircuit((Stage(section, dict(zip(section.designators, (805.0, 1e3, 10e-9, 220e-9)))),),
+                        seed_loop_names(section))
+
+
+#: the seed's plant as built, as the generic record (designer.pid.plant.PlantCircuit)
+SEED_BENCH_PLANT = _seed_bench_plant()
 #: the test amplitudes the seed-bench finding simulates (volts): small enough to stay linear, and the seed's 2 V
 SEED_BENCH_STEPS = (0.5, 2.0)
 
@@ -774,7 +780,8 @@ def design_model_pid(spec: PidSpec, simulate: bool = True, simulator: str = "pys
         ideal_margins=loop.ideal_margins, ideal_pid=loop.ideal_figures,
         analytic=AnalyticLoop(loop.figures, loop.margins.stable, loop.dc, loop.levels), robust=robust,
         test=loop.test, expected_final_v=loop.expected, deck=loop.deck,
-        waveforms=loop.waves, notes=list(notes), package=spec.package, limits=limits(spec))
+        waveforms=loop.waves, notes=list(notes), package=spec.package, limits=limits(spec),
+        plant=None if spec.plant.circuit is None else spec.plant.circuit.circuit)   # a circuit's generic record
     lap("analytic_s")
     if before_spice is not None:
         before_spice(res)

@@ -37,7 +37,7 @@ def designators(parts, plant, amp, package, netlist=None) -> dict:
     ----------
     parts : designer.pid.blocks.PidParts
         The controller.
-    plant : designer.pid.plant.Plant, designer.pid.plant.PlantCircuit, designer.plant.sallenkey.SallenKeyParts or None
+    plant : designer.pid.plant.Plant, designer.pid.plant.PlantCircuit or None
         A circuit plant (:func:`designer.pid.netlist.plant_circuit`), or None.
     amp : designer.core.opamps.OpAmp
         The op-amp (its packages).

@@ -96,13 +96,13 @@ def extreme_lines(parts: PidParts, test: SquareTest) -> list:
 def plant_circuit(plant):
     """The circuit a loop's plant is built as, and whether the controller's
     action is reversed: a :class:`~designer.pid.plant.Plant` with its circuit,
-    a :class:`~designer.pid.plant.PlantCircuit`, or the Sallen-Key plant's
-    parts record (its registered section, named as the seed's sheets:
+    or a :class:`~designer.pid.plant.PlantCircuit` (the seed's Sallen-Key plant
+    too: its registered section, named as the seed's sheets,
     :func:`~designer.pid.plant.sallen_key_circuit`).
 
     Parameters
     ----------
-    plant : Plant, PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+    plant : Plant or PlantCircuit
         The plant.
 
     Returns
@@ -110,12 +110,13 @@ def plant_circuit(plant):
     tuple
         (:class:`~designer.pid.plant.PlantCircuit`, bool: the action reversed).
     """
-    from .plant import Plant, PlantCircuit, sallen_key_circuit
+    from .plant import Plant, PlantCircuit
     if isinstance(plant, Plant):
         return plant.circuit, plant.reversed_action
     if isinstance(plant, PlantCircuit):
         return plant, plant.inverting
-    return sallen_key_circuit(plant), False
+    raise TypeError(f"a loop's plant is a designer.pid.plant.Plant or PlantCircuit, not {type(plant).__name__} "
+                    "(a Sallen-Key parts record: designer.pid.plant.sallen_key_circuit)")
 
 
 def plant_ref_prefix(plant) -> str:
@@ -125,7 +126,7 @@ def plant_ref_prefix(plant) -> str:
 
     Parameters
     ----------
-    plant : Plant, PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+    plant : Plant or PlantCircuit
         The plant (:func:`plant_circuit`).
 
     Returns
@@ -146,7 +147,7 @@ def loop_netlist(parts: PidParts, plant) -> Netlist:
     ----------
     parts : PidParts
         The controller.
-    plant : Plant, PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+    plant : Plant or PlantCircuit
         The plant (:func:`plant_circuit`).
 
     Returns
@@ -172,7 +173,7 @@ def closed_loop_deck(parts: PidParts, plant, opamp: OpAmp, test: SquareTest,
     ----------
     parts : PidParts
         The controller.
-    plant : Plant, PlantCircuit or designer.plant.sallenkey.SallenKeyParts
+    plant : Plant or PlantCircuit
         The plant (:func:`plant_circuit`).
     opamp : OpAmp
         The op-amp of every stage (the plant's too).

@@ -49,7 +49,8 @@ from ..spice.deck import Netlist
 
 __all__ = ["PLANT_PREFIX", "LoopNames", "SEED_LOOP_NAMES", "PlantCircuit", "Plant", "parse_part_values", "part_items", "circuit_plant",
            "circuit_from_json",
-           "circuit_from_cascade", "sallen_key_parts", "sallen_key_circuit", "resolve_plant"]
+           "circuit_from_cascade", "sallen_key_plant", "sallen_key_circuit", "seed_loop_names",
+           "pair_model", "resolve_plant"]
 
 #: the designator prefix of a one-section plant (R1 -> RP1; stage i of a cascade: RPi1)
 PLANT_PREFIX = "P"
@@ -160,6 +161,57 @@ class PlantCircuit:
             return self.names.prefix
         return PLANT_PREFIX if len(self.stages) == 1 else f"{PLANT_PREFIX}{i}"
 
+    def ideal_pair(self) -> tuple:
+        """(fn in Hz, zeta) of the circuit's ideal model, what a PID's plant is named
+        and sized by: a one-section plant's :meth:`~designer.filters.topology.Topology.ideal_pair`
+        (the section's hook: the Sallen-Key low-pass's record arithmetic), a cascade's
+        slowest pole pair (:func:`designer.core.lti.dominant_pair` of the stages' product).
+
+        Returns
+        -------
+        tuple of float
+            (fn_hz, zeta).
+        """
+        if len(self.stages) == 1:
+            st = self.stages[0]
+            return st.topology.ideal_pair(st.values)
+        from ..core.lti import dominant_pair
+        return dominant_pair(np.asarray(self.coefficients()[1], float))
+
+    @property
+    def fn_hz(self) -> float:
+        """fn of :meth:`ideal_pair`, Hz."""
+        return self.ideal_pair()[0]
+
+    @property
+    def zeta(self) -> float:
+        """zeta of :meth:`ideal_pair`."""
+        return self.ideal_pair()[1]
+
+    def with_values(self, values: dict) -> "PlantCircuit":
+        """A one-section plant with some of its part values replaced (a Monte Carlo build's).
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value, designators of the section.
+
+        Returns
+        -------
+        PlantCircuit
+            The same section and names, the other values kept.
+        """
+        from dataclasses import replace
+
+        from ..filters.cascade import Stage
+        (st,) = self.stages
+        return replace(self, stages=(Stage(st.topology, {**st.values, **{k: float(v) for k, v in values.items()}}),))
+
+    def __reduce__(self):
+        # a registered section pickles by its name and comes back as the registry's instance (a
+        # topology compares by identity): a spec holding this circuit reaches --jobs and dask workers equal
+        return (_unpickled, (tuple((_by_name(st.topology), st.values) for st in self.stages), self.names))
+
     def coefficients(self) -> tuple:
         """The ideal (num, den) polynomials in s, highest power first (the stages' products).
 
@@ -210,6 +262,19 @@ class PlantCircuit:
             out.append({"topology": t.name, "title": t.title,
                         "parts": {t.prefixed(ref, self.prefix(i)): float(v) for ref, v in st.values.items()}})
         return {"topology": self.topology, "stages": out}
+
+
+def _by_name(topology):
+    """A registered topology's name (how it pickles), else the topology itself."""
+    from ..filters.registry import REGISTRY
+    return topology.name if REGISTRY.get(topology.name) is topology else topology
+
+
+def _unpickled(stages: tuple, names) -> PlantCircuit:
+    """A :class:`PlantCircuit` from (name or topology, values) pairs (:meth:`PlantCircuit.__reduce__`)."""
+    from ..filters.cascade import Stage
+    from ..filters.registry import get
+    return PlantCircuit(tuple(Stage(get(t) if isinstance(t, str) else t, v) for t, v in stages), names)
 
 
 @dataclass(frozen=True)
@@ -438,9 +503,11 @@ def circuit_from_json(data: dict, *, name: str = "result") -> Plant:
         raise DesignError(str(exc)) from None
 
 
-def sallen_key_parts(source, *, opamp: str | None = None, bounds=None):
-    """(parts, description, series) of a Sallen-Key plant, designed, given or
-    read; every way through :func:`designer.plant.sallenkey.check_parts`.
+def sallen_key_plant(source, *, opamp: str | None = None, bounds=None):
+    """(circuit, description, series) of a Sallen-Key plant, designed, given or
+    read: its generic record (:class:`PlantCircuit`, :func:`sallen_key_circuit`), every
+    way through :func:`designer.plant.sallenkey.check_parts` first (the given and read
+    ones when their source was built, :class:`~designer.pid.plant_spec.PlantSource`).
     ``series`` is the (R, C) pair of a plant designed here, else None.
 
     Parameters
@@ -457,7 +524,7 @@ def sallen_key_parts(source, *, opamp: str | None = None, bounds=None):
     Returns
     -------
     tuple
-        (:class:`~designer.plant.sallenkey.SallenKeyParts`, str, tuple or None).
+        (:class:`PlantCircuit`, str, tuple or None).
     """
     source, opamp, bounds = _with_design_choices(source, opamp, bounds)
     if source.plant_parts is not None:
@@ -480,7 +547,7 @@ def sallen_key_parts(source, *, opamp: str | None = None, bounds=None):
         built = check_parts(res.built, name_of=names | {"plant": what})
     except DesignError as exc:
         raise ParamError(str(exc), ("plant_fc_hz", "plant_zeta")) from None
-    return (built, f"design-plant fc={fc:g} Hz zeta={zeta:g}", (bounds.r_series, bounds.c_series))
+    return (sallen_key_circuit(built), f"design-plant fc={fc:g} Hz zeta={zeta:g}", (bounds.r_series, bounds.c_series))
 
 
 def _with_design_choices(source, opamp, bounds) -> tuple:
@@ -495,30 +562,78 @@ def _with_design_choices(source, opamp, bounds) -> tuple:
 
 
 def sallen_key_circuit(parts) -> PlantCircuit:
-    """The Sallen-Key plant's circuit as its registered section (unity gain, or
-    gain K = 1 + R4/R3), named in the loop as the seed's sheets name it
+    """The Sallen-Key plant's parts record (checked) as the generic record: its
+    registered section (unity gain, or gain K = 1 + R4/R3) with its values by
+    designator, named in the loop as the seed's sheets name it
     (:data:`SEED_LOOP_NAMES`; with the gain pair its designators prefixed
-    :data:`PLANT_PREFIX`, clear of the controller's R3 and R4).
+    :data:`PLANT_PREFIX`, clear of the controller's R3 and R4). The one conversion,
+    at the edges that read the record's own keys and flags (``--plant-r1`` ..,
+    a design-plant result.json's ``built``).
 
     Parameters
     ----------
     parts : designer.plant.sallenkey.SallenKeyParts
-        The plant as built.
+        The plant as built (through :func:`~designer.plant.sallenkey.check_parts`).
 
     Returns
     -------
     PlantCircuit
         One stage.
     """
-    from dataclasses import replace
-
     from ..filters.cascade import Stage
     from ..filters.sallen_key_lowpass_parts import part_values, section_of
     follower = math.isclose(parts.gain, 1.0)
     values = part_values(parts)
     section = section_of(with_gain=not follower)
-    names = replace(SEED_LOOP_NAMES, prefix="" if follower else PLANT_PREFIX)
-    return PlantCircuit((Stage(section, {r: values[r] for r in section.designators}),), names)
+    return PlantCircuit((Stage(section, {r: float(values[r]) for r in section.designators}),),
+                        seed_loop_names(section))
+
+
+def seed_loop_names(section) -> LoopNames:
+    """How the seed's Sallen-Key plant on ``section`` is named in the loop: :data:`SEED_LOOP_NAMES`, its
+    designators prefixed :data:`PLANT_PREFIX` when the section has parts the controller's names take
+    (the gain pair's R3, R4).
+
+    Parameters
+    ----------
+    section : designer.filters.topology.Topology
+        The follower or the section with gain.
+
+    Returns
+    -------
+    LoopNames
+    """
+    from dataclasses import replace
+    return replace(SEED_LOOP_NAMES, prefix=PLANT_PREFIX if section.choice_parts else "")
+
+
+def pair_model(circuit: PlantCircuit, source: str = "Sallen-Key") -> ProcessModel:
+    """A second-order low-pass plant's ideal model K/(a s^2 + b s + 1) (its
+    coefficients, normalised to a constant term 1) as a :class:`ProcessModel`:
+    underdamped with fn = 1/(2 pi sqrt(a)) and zeta = b/(2 sqrt(a)), or for zeta >= 1
+    the SOPDT whose (tau1 s + 1)(tau2 s + 1) = a s^2 + b s + 1.
+
+    Parameters
+    ----------
+    circuit : PlantCircuit
+        The plant (its ideal coefficients of degree 2).
+    source : str
+        Where the model came from (its ``source``).
+
+    Returns
+    -------
+    ProcessModel
+    """
+    from ..core.process_build import sopdt, underdamped
+    num, den = (np.asarray(c, float) for c in circuit.coefficients())
+    if len(den) != 3:
+        raise DesignError(f"a pair model is of a second-order plant; this one has order {len(den) - 1}")
+    k, a, b = float(num[-1] / den[-1]), float(den[0] / den[-1]), float(den[1] / den[-1])
+    zeta = b / (2.0 * math.sqrt(a))
+    if zeta < 1.0:
+        return underdamped(k, 1.0 / (2 * math.pi * math.sqrt(a)), zeta, source=source)
+    tau1 = (b + math.sqrt(max(b * b - 4.0 * a, 0.0))) / 2.0
+    return sopdt(k, tau1, a / tau1, source=source)   # tau1 tau2 = a, without the cancellation of b - r
 
 
 def resolve_plant(source, *, opamp: str | None = None, bounds=None) -> Plant:
@@ -528,8 +643,8 @@ def resolve_plant(source, *, opamp: str | None = None, bounds=None) -> Plant:
     ``plant_model``, ``plant_process``, a capture), or a Sallen-Key plant
     (``plant_fc_hz``/``plant_zeta``, ``plant_parts``, a design-plant
     ``plant_json``: its circuit is the Sallen-Key low-pass section
-    (:func:`sallen_key_circuit`), its model
-    :func:`designer.pid.plant_source.sallen_key_model`).
+    (:func:`sallen_key_plant`), its model
+    :func:`pair_model`).
 
     Parameters
     ----------
@@ -551,6 +666,5 @@ def resolve_plant(source, *, opamp: str | None = None, bounds=None) -> Plant:
         return source.circuit
     if source.process is not None:
         return Plant(source.process, None, source.process.source)
-    from .plant_source import sallen_key_model
-    parts, description, _ = sallen_key_parts(source, opamp=opamp, bounds=bounds)
-    return Plant(sallen_key_model(parts, description), sallen_key_circuit(parts), description)
+    circuit, description, _ = sallen_key_plant(source, opamp=opamp, bounds=bounds)
+    return Plant(pair_model(circuit, description), circuit, description)

@@ -42,7 +42,6 @@ from ..core.errors import DesignError
 from ..core.fileio import shown
 from ..core.process import ProcessModel
 from ..core.process_build import fopdt, sopdt, underdamped
-from ..plant.model import plant_tf
 from ..plant.sallenkey import JSON_KEYS, SallenKeyParts, check_parts
 
 __all__ = ["model_from_json", "model_from_result", "result_kind", "sallen_key_model"]
@@ -297,9 +296,11 @@ def model_from_plant(data: dict, *, name: str = "result") -> ProcessModel:
 
 
 def sallen_key_model(parts: SallenKeyParts, source: str = "Sallen-Key") -> ProcessModel:
-    """K/(a s^2 + b s + 1) (:func:`designer.plant.model.plant_tf`) as a
-    :class:`ProcessModel`: underdamped with the parts' fn and zeta, or for
-    zeta >= 1 the SOPDT whose (tau1 s + 1)(tau2 s + 1) = a s^2 + b s + 1.
+    """K/(a s^2 + b s + 1) of a Sallen-Key parts record (read from a result.json's
+    ``built`` keys) as a :class:`ProcessModel`: the record as the generic plant record
+    (:func:`designer.pid.plant.sallen_key_circuit`) and its model,
+    :func:`designer.pid.plant.pair_model` (underdamped with the parts' fn and zeta,
+    or for zeta >= 1 the SOPDT whose (tau1 s + 1)(tau2 s + 1) = a s^2 + b s + 1).
 
     Parameters
     ----------
@@ -312,10 +313,5 @@ def sallen_key_model(parts: SallenKeyParts, source: str = "Sallen-Key") -> Proce
     -------
     ProcessModel
     """
-    num, den = plant_tf(parts)
-    k, (a, b, _) = float(num[0]), (float(c) for c in den)
-    zeta = b / (2.0 * math.sqrt(a))
-    if zeta < 1.0:
-        return underdamped(k, 1.0 / (2 * math.pi * math.sqrt(a)), zeta, source=source)
-    tau1 = (b + math.sqrt(max(b * b - 4.0 * a, 0.0))) / 2.0
-    return sopdt(k, tau1, a / tau1, source=source)   # tau1 tau2 = a, without the cancellation of b - r
+    from .plant import pair_model, sallen_key_circuit
+    return pair_model(sallen_key_circuit(parts), source)

@@ -32,7 +32,7 @@ from ..core.fileio import show_cell, shown
 from ..core.jsonio import read_result
 from ..core.process import ProcessModel
 from ..core.ranges import parse_in_range
-from ..filters.sallen_key_lowpass_parts import FIELD_OF, gain_refs, refs, section_of
+from ..filters.sallen_key_lowpass_parts import FIELD_OF, gain_refs, record_of, refs, section_of
 from ..plant.sallenkey import SallenKeyParts, check_parts
 from .plant_source import BUILT_KEYS
 
@@ -81,7 +81,9 @@ class PlantSource:
 
     plant_fc_hz: float | None = None
     plant_zeta: float | None = None
-    plant_parts: SallenKeyParts | None = None
+    #: a Sallen-Key low-pass as built: its parts record (the command line's --plant-r1 .., check-design's
+    #: keys), checked and held as the generic record (designer.pid.plant.PlantCircuit), or that record
+    plant_parts: object = None
     plant_json: str | None = None
     plant_tf: str | None = None
     plant_model: str | None = None
@@ -95,8 +97,9 @@ class PlantSource:
     plant_values: object = None
     #: a plant circuit given as sections: a designer.filters.cascade.Cascade or (topology, values) pairs
     plant_circuit: object = None
-    #: the plant read from ``plant_json`` (read and checked on construction, before any work)
-    json_plant: SallenKeyParts | None = field(default=None, init=False, repr=False, compare=False)
+    #: the Sallen-Key plant read from a design-plant ``plant_json`` (read and checked on construction, before
+    #: any work), as the generic record (designer.pid.plant.PlantCircuit)
+    json_plant: object = field(default=None, init=False, repr=False, compare=False)
     #: the model plant, from plant_tf, plant_model or plant_process (None for a Sallen-Key plant)
     process: ProcessModel | None = field(default=None, init=False, repr=False, compare=False)
     #: a circuit plant of any topology (designer.pid.plant.Plant), from plant_topology, plant_circuit or a
@@ -125,10 +128,7 @@ class PlantSource:
         if self.plant_fc_hz is None and self.plant_zeta is not None:
             raise _refused("{plant_zeta} needs {plant_fc_hz}")
         if self.plant_parts is not None:
-            # parts typed as text (the command line's) are read here, the rest by the plant validation
-            typed = {k: parse_in_range(getattr(self.plant_parts, k), f"plant_{k}", key)
-                     for k, key in PLANT_RANGES.items() if isinstance(getattr(self.plant_parts, k), str)}
-            put("plant_parts", _checked(replace(self.plant_parts, **typed), PLANT_NAMES))
+            put("plant_parts", _given_plant(self.plant_parts))
         if self.plant_json is not None:
             circuit = filter_plant_from_json(self.plant_json)
             if circuit is not None:
@@ -181,6 +181,28 @@ class PlantSource:
         if self.plant_method is not None:
             raise _refused("{plant_method} chooses among the methods of a {plant_model} file")
         return None
+
+
+def _given_plant(parts):
+    """``plant_parts`` as the generic record: a Sallen-Key parts record (parts typed as text, the command
+    line's, read here, the rest by the plant validation) converted once
+    (:func:`designer.pid.plant.sallen_key_circuit`), or that record again (a spec replaced, a Monte Carlo
+    build's) checked as the parts record it stands for."""
+    from .plant import PlantCircuit, sallen_key_circuit
+    if isinstance(parts, PlantCircuit):
+        st = parts.stages[0] if len(parts.stages) == 1 else None
+        record = None if st is None else record_of(st.topology, st.values)
+        if record is None:
+            raise _refused("{plant_parts} is the Sallen-Key low-pass plant's parts; give another circuit as "
+                           "{plant_topology} with {plant_values} or {plant_circuit}")
+        # gain None: the resistors' 1 + R4/R3, as the record the circuit was made from
+        return sallen_key_circuit(_checked(replace(record, gain=None), PLANT_NAMES))
+    if not isinstance(parts, SallenKeyParts):
+        raise _refused("{plant_parts} must be a designer.plant.sallenkey.SallenKeyParts or a "
+                       "designer.pid.plant.PlantCircuit")
+    typed = {k: parse_in_range(getattr(parts, k), f"plant_{k}", key)
+             for k, key in PLANT_RANGES.items() if isinstance(getattr(parts, k), str)}
+    return sallen_key_circuit(_checked(replace(parts, **typed), PLANT_NAMES))
 
 
 #: the parameters a :class:`PlantSource` takes (its fields), as :class:`~designer.pid.spec.PidSpec` takes them
@@ -263,8 +285,10 @@ def filter_plant_from_json(path):
         raise _refused(str(exc)) from None
 
 
-def plant_from_json(path) -> SallenKeyParts:
-    """The built plant of a ``design-plant``/``analyze-plant`` result.json.
+def plant_from_json(path):
+    """The built plant of a ``design-plant``/``analyze-plant`` result.json, as the
+    generic record (:class:`~designer.pid.plant.PlantCircuit`: its keys read as the
+    Sallen-Key parts record and converted once, :func:`designer.pid.plant.sallen_key_circuit`).
 
     Read by the one reader (:func:`designer.core.jsonio.read_result`) and
     checked by the one plant validation (:func:`designer.plant.sallenkey.check_parts`):
@@ -278,9 +302,10 @@ def plant_from_json(path) -> SallenKeyParts:
 
     Returns
     -------
-    SallenKeyParts
+    designer.pid.plant.PlantCircuit
         The plant as built.
     """
+    from .plant import sallen_key_circuit
     needed = tuple(BUILT_KEYS[k] for k in NETWORK_FIELDS)
     try:
         built = read_result(path, "{plant_json}", needs={"built": needed})["built"]
@@ -288,4 +313,4 @@ def plant_from_json(path) -> SallenKeyParts:
         raise _refused(str(exc)) from None
     raw = SallenKeyParts(**{k: built.get(v) for k, v in BUILT_KEYS.items()})
     names = {k: f"{{plant_json}} {shown(path)}: built.{v}" for k, v in BUILT_KEYS.items()}
-    return _checked(raw, names | {"plant": f"{{plant_json}} {shown(path)}"})
+    return sallen_key_circuit(_checked(raw, names | {"plant": f"{{plant_json}} {shown(path)}"}))

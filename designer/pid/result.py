@@ -26,11 +26,10 @@ from ..core.checks import SPICE_AGREEMENT, Check
 from ..core.jsonio import SCHEMA_VERSION, json_safe
 from ..core.metrics import StepMetrics
 from ..core.opamps import OpAmp
-from ..plant.sallenkey import SallenKeyParts
 from ..spice.deck import SquareTest
 from ..spice.simulate import tool_info
 from .blocks import PidParts
-from .plant import sallen_key_circuit
+from .plant import PlantCircuit
 from .selection import Selection
 from .spec import PidSpec
 from .tuning import Tuning
@@ -238,12 +237,15 @@ class RobustCheck:
 class PidResult(LoopVerdicts):
     """Everything known about one controller design, for either kind of plant; :meth:`to_dict` is the JSON.
 
-    The plant is either the Sallen-Key circuit of the seed (``plant`` set, the
-    reaction-curve ``tuning`` and its ``rules``) or a model (``model`` set: a
+    The plant is either the Sallen-Key circuit of the seed (the reaction-curve
+    ``tuning`` and its ``rules``) or a model (``model`` set: a
     :class:`~designer.core.process.ProcessModel`, typed or identified, that a
     registered circuit may realise; the chosen ``method`` and gains, every rule's
     :class:`RuleRow`, the ``robust`` corners). The fields of the other kind stay
-    None. ``files`` and ``timings`` are filled in as the bundle is written.
+    None. ``plant`` is the circuit of either, as the one generic record
+    (:class:`~designer.pid.plant.PlantCircuit`: the seed's Sallen-Key section, an MFB
+    low-pass, a cascade), None for a plant known only as a model. ``files`` and
+    ``timings`` are filled in as the bundle is written.
     """
 
     spec: PidSpec
@@ -262,8 +264,10 @@ class PidResult(LoopVerdicts):
     deck: str
     waveforms: Waveforms = field(repr=False)
     notes: list = field(default_factory=list)
+    #: the plant's circuit as the generic record (designer.pid.plant.PlantCircuit: its sections and values),
+    #: the seed's Sallen-Key plant or a registered circuit that realises a model; None for a model alone
+    plant: PlantCircuit | None = None
     # the Sallen-Key plant's (None for a model plant)
-    plant: SallenKeyParts | None = None
     plant_source: str | None = None
     plant_series: tuple | None = None   #: (R, C) series of a plant designed here, else None
     plant_fn_opamp_hz: float | None = None  #: the plant's dominant pair with its op-amp
@@ -345,10 +349,12 @@ class PidResult(LoopVerdicts):
 
     def _circuit_keys(self) -> dict:
         """The Sallen-Key plant's keys from ``plant`` to ``closed_loop``."""
-        pl = self.plant
+        from ..filters.sallen_key_lowpass_parts import record_of
+        st = self.plant.stages[0]
+        pl = record_of(st.topology, st.values)   # the seed plant's own keys (R1_ohm .., gain, fn_hz, zeta), as ever
         return {
             "plant": {"source": self.plant_source, **pl.as_dict(), "q": pl.q, "fn_opamp_hz": self.plant_fn_opamp_hz,
-                      "zeta_opamp": self.plant_zeta_opamp, "topology": sallen_key_circuit(pl).topology},
+                      "zeta_opamp": self.plant_zeta_opamp, "topology": self.plant.topology},
             **self._amp_keys(),
             "tuning": self.tuning.to_dict(),
             "rules": [r.to_dict(brief=True) for r in self.rules],

@@ -229,7 +229,9 @@ def pid_spec(params: dict) -> PidSpec:
     params : dict
         The spec's own fields (:class:`PidSpec`; a value None is not given), and :data:`PLAIN_PARAMS`:
         ``plant_r1``, ``plant_r2``, ``plant_c1``, ``plant_c2`` (all four together) with ``plant_gain``
-        (default 1) as the plant's :class:`~designer.plant.sallenkey.SallenKeyParts`, and ``seed_parts``
+        (default 1) as the plant's :class:`~designer.plant.sallenkey.SallenKeyParts` (the flags' record, which the
+        plant source converts once into the generic record, :func:`designer.pid.plant.sallen_key_circuit`), and
+        ``seed_parts``
         (true: the seed's controller parts, :func:`designer.pid.blocks.seed_parts`).
 
     Returns

@@ -20,6 +20,7 @@ from ..filters.prototype import SectionPlan
 from ..report import document as R
 from ..report.bundle import write_design
 from ..report.tolerance import csv_texts
+from ..report.tolerance import histogram_plots
 from ..report.tolerance import section as tolerance_section
 from ..report.wiring import bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
@@ -151,8 +152,8 @@ def sections(result, with_images: bool = False, schematic_svg: str = "") -> list
                              [[*(format_eng(c.values[r], "Ohm" if r[0] == "R" else "F", 3) for r in refs),
                                _f(c.fn_hz, "Hz"), _n(c.zeta), _n(c.gain), f"{100 * c.worst:.3g} %"]
                               for c in result.alternatives])]))
-    if result.monte_carlo is not None and result.monte_carlo.headline is None:   # --replay I: the build replayed
-        out.append((_("Tolerance analysis (Monte Carlo)"), tolerance_section(result, False)))
+    if result.monte_carlo is not None:   # the spread and its histograms; --replay I: the build replayed
+        out.append((_("Tolerance analysis (Monte Carlo)"), tolerance_section(result, with_images)))
     if result.notes:
         out.append((_("Notes"), [R.text(translated(n)) for n in result.notes]))
     return out
@@ -171,7 +172,12 @@ def summary_text(result) -> str:
     str
         Text.
     """
-    return R.to_text(title_of(result), sections(result)) + "\n"
+    text = R.to_text(title_of(result), sections(result)) + "\n"
+    # the Monte Carlo's and the worst case's lines, as the Sallen-Key plant's summary prints them
+    for extra in (result.monte_carlo, result.worst_case):
+        if extra is not None:
+            text += "\n" + "\n".join(extra.summary_lines()) + "\n"
+    return text
 
 
 @dataclass(frozen=True)
@@ -243,7 +249,7 @@ def write_outputs(result, out_dir, name: str, lang: str | None = None) -> dict:
                       "waveforms_csv": ("waveforms.csv", lambda r: r.square.csv_text())})
     # --stimulus prbs: the generator's files, its deck, and waveforms.csv becomes its run (as the Sallen-Key plant's)
     texts.update(prbs_texts(result))
-    plots = [("prbs.png", prbs_png)] if result.prbs is not None else []
+    plots = ([("prbs.png", prbs_png)] if result.prbs is not None else []) + list(histogram_plots(result))
     with language(lang):
         return write_design(result, out_dir, name, plots, schematic, lambda svg: sections(result, True, svg),
                             title_of(result), texts)

@@ -52,6 +52,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.errors import DesignError
+from ..core.figure_titles import figure_spread
 from ..filters.prototype import DELAY_POINTS
 from ..filters.registry import get as get_topology
 from ..filters.verify import mask_edges
@@ -648,8 +649,8 @@ class FilterMonteCarlo:
                "stage within its tolerance"]
         for k, s in self.stats.items():
             p = s.percentiles
-            out.append(f"  {k}: nominal {s.nominal:.5g}, mean {s.mean:.5g}, std {s.std:.3g}, 2.5..97.5 % "
-                       f"{p.get(2.5, math.nan):.5g}..{p.get(97.5, math.nan):.5g}")
+            out.append("  " + figure_spread(k, s.nominal, s.mean, s.std, p.get(2.5, math.nan),
+                                            p.get(97.5, math.nan)))
         if self.limits:
             lo, hi = self.yield_interval()
             out.append(f"  yield {100 * self.yield_count / self.n:.2f} % ({self.yield_count}/{self.n}; 95 % Wilson "

@@ -47,6 +47,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from ..core.errors import DesignError
+from ..core.figure_titles import figure_spread
 from .montecarlo import MonteCarlo
 
 __all__ = ["LIMITABLE", "LoopContext", "STEP_POINTS", "evaluate", "kick_grid", "loop_figures", "loop_monte_carlo",
@@ -99,12 +100,12 @@ def loop_parts(result, tol_items=()) -> dict:
     dict
         Designator -> nominal value.
     """
-    from ..filters.sallen_key_lowpass_parts import part_values, refs
+    from ..filters.sallen_key_lowpass_parts import refs
     from .parts import opamp_nominal
     c = result.parts
-    p = None if is_model_loop(result) else result.plant
+    p = None if is_model_loop(result) else result.plant   # the generic record (designer.pid.plant.PlantCircuit)
     # the plant's network only: its gain pair's designators are the controller's R3, R4 here
-    out = {} if p is None else {r: v for r, v in part_values(p).items() if r in refs(with_gain=False)}
+    out = {} if p is None else {r: v for r, v in p.stages[0].values.items() if r in refs(with_gain=False)}
     for f in fields(c):
         v = getattr(c, f.name)
         if v is not None:
@@ -531,10 +532,9 @@ class LoopMonteCarlo(MonteCarlo):
             if p is not None:
                 out.append(f"  {what}: {100 * p['fraction']:.2f} % (95 % Wilson {100 * p['ci95'][0]:.2f}.."
                            f"{100 * p['ci95'][1]:.2f} %)")
-        for k, unit in SHOWN:
+        for k, _unit in SHOWN:
             s = self.stats.get(k)
             if s is not None and s.percentiles:
                 p = s.percentiles
-                out.append(f"  {k}: nominal {s.nominal:.4g} {unit}, mean {s.mean:.4g} {unit}, 2.5..97.5 % "
-                           f"{p[2.5]:.4g}..{p[97.5]:.4g} {unit}")
+                out.append("  " + figure_spread(k, s.nominal, s.mean, s.std, p[2.5], p[97.5], digits=4))
         return out + self.yield_lines()

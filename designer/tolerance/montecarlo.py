@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.errors import DesignError
+from ..core.figure_titles import figure_spread
 from ..filters.sallen_key_lowpass_parts import part_values, refs
 from ..plant.circuit import evaluate as section_evaluate
 from . import plant as engine
@@ -129,8 +130,7 @@ class MonteCarlo:
         for k in ("fn_hz", "zeta", "overshoot_pct"):
             s = mc.stats[k]
             p = s.percentiles
-            out.append(f"  {k}: nominal {s.nominal:.5g}, mean {s.mean:.5g}, std {s.std:.3g}, 2.5..97.5 % "
-                       f"{p[2.5]:.5g}..{p[97.5]:.5g}")
+            out.append("  " + figure_spread(k, s.nominal, s.mean, s.std, p[2.5], p[97.5]))
         return out + self.yield_lines()
 
     def yield_lines(self) -> list:

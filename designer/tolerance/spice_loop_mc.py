@@ -263,7 +263,7 @@ def replay_spec(spec, result, values: dict):
     plant's too for a Sallen-Key plant; a model plant stays as given), no gains to meet (as built), and
     the run's square wave."""
     from ..pid.blocks import PidParts
-    from ..filters.sallen_key_lowpass_parts import parts_of, refs
+    from ..filters.sallen_key_lowpass_parts import refs
     parts = PidParts(**{f.name: (values[f.name.upper()] if f.name.upper() in values else getattr(result.parts, f.name))
                         for f in dataclasses.fields(PidParts)})
     change = dict(controller_parts=parts, tuning=None, kp=None, ti_s=None, td_s=None, target_overshoot_pct=None,
@@ -273,8 +273,7 @@ def replay_spec(spec, result, values: dict):
         p = result.plant
         # the network's parts from the build; the gain pair the design's (the build's R3 and R4 are the
         # controller's: the loop's values share its designators)
-        change.update(plant=PlantSource(plant_parts=parts_of({r: values[r] for r in refs(with_gain=False)},
-                                                             base=p, gain=None)))
+        change.update(plant=PlantSource(plant_parts=p.with_values({r: values[r] for r in refs(with_gain=False)})))
     return dataclasses.replace(spec, **change)
 
 

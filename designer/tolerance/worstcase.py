@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.i18n import N_, Message
+from ..core.figure_titles import figure_range
 
 __all__ = ["WorstCase", "worst_case"]
 
@@ -53,7 +54,7 @@ class WorstCase:
         what = "corners" if self.method.startswith("every") else "corners the sensitivities point to"
         out = [f"Worst case over the tolerance box ({self.corners} {what}, then a bounded search):"]
         for k, (lo, hi) in self.extremes.items():
-            out.append(f"  {k}: {lo.value:.5g} to {hi.value:.5g}"
+            out.append("  " + figure_range(k, lo.value, hi.value)
                        + ("" if lo.at_corner and hi.at_corner else " (an extreme inside the box)"))
         return out
 

@@ -37,3 +37,16 @@ def test_every_title_has_a_spanish_translation_and_the_page_gets_it():
 
 def test_an_id_the_table_lacks_shows_as_itself():
     assert titles.figure_shown("spice_unknown_hz") == ("spice_unknown_hz", "")
+
+
+def test_the_command_lines_statistics_name_the_figure_and_carry_units():
+    # a frequency in engineering notation, a percentage with its sign, a ratio bare; the id after the title
+    line = titles.figure_spread("fn_hz", 3485.8, 3507.5, 140.3, 3239.2, 3770.5)
+    assert line == ("natural frequency fn (fn_hz): nominal 3.4858 kHz, mean 3.5075 kHz, std 140.3 Hz, "
+                    "95 % of builds 3.2392 kHz to 3.7705 kHz")
+    assert titles.figure_spread("overshoot_pct", 52.875, 52.853, 1.52, 50.047, 55.602).startswith(
+        "step overshoot (overshoot_pct): nominal 52.875 %")
+    # a title that already ends with the id does not repeat it
+    assert titles.figure_range("zeta", 0.17894, 0.22083) == "damping ratio zeta: 0.17894 to 0.22083"
+    assert titles.figure_range("peak_time_s", 130.66e-6, 162.67e-6) == \
+        "time to the first peak (peak_time_s): 130.66 us to 162.67 us"

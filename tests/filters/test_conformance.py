@@ -166,6 +166,26 @@ def test_opamp_model_is_the_nodal_solution(topology):
         np.testing.assert_allclose(num_g[i], n1, rtol=1e-12, atol=1e-300)
 
 
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_ideal_pair_is_the_coefficients_pair(topology):
+    """The ideal (fn, zeta) a PID's plant is named and sized by (:meth:`Topology.ideal_pair`, a section's own
+    arithmetic where it has one: the Sallen-Key low-pass's) is the pair of its ideal coefficients: fn of
+    :meth:`Topology.figures` and zeta = 1/(2 Q) within 1e-15 relative (a first-order section: its pole and
+    zeta 1), and the slowest pole pair of the denominator's roots (:func:`designer.core.lti.dominant_pair`)."""
+    from designer.core.lti import dominant_pair
+    for target in targets(topology):
+        values = topology.synthesize(target)
+        fn, zeta = topology.ideal_pair(values)
+        fig = topology.figures(values)
+        assert isinstance(fn, float) and isinstance(zeta, float)
+        assert fn == pytest.approx(fig.fn_hz, rel=1e-15, abs=0)
+        if topology.order == 1:
+            assert zeta == 1.0
+            continue
+        assert zeta == pytest.approx(1 / (2 * fig.q), rel=1e-15, abs=0)
+        assert (fn, zeta) == pytest.approx(dominant_pair(topology.coefficients(values)[1]), rel=1e-9)
+
+
 @pytest.mark.spice
 @pytest.mark.parametrize("opamp", ["ideal", "LM741"])
 @pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)

@@ -13,6 +13,7 @@ from designer.filters.sallen_key_lowpass_parts import (
     network,
     part_values,
     parts_of,
+    record_of,
     refs,
     section_of,
 )
@@ -49,3 +50,23 @@ def test_the_gain_and_the_network_as_the_closed_forms_take_them():
     # a gain pair missing from the values comes from a base record
     rebuilt = parts_of({r: x for r, x in part_values(GAIN2).items() if r in refs(False)}, base=GAIN2, gain=None)
     assert (rebuilt.r3, rebuilt.r4, rebuilt.gain) == (GAIN2.r3, GAIN2.r4, None)
+
+
+@pytest.mark.parametrize("with_gain", [False, True], ids=["follower", "gain"])
+def test_the_sections_ideal_pair_is_its_parts_records_bit_for_bit(with_gain):
+    """The Sallen-Key low-pass overrides :meth:`~designer.filters.topology.Topology.ideal_pair` with its
+    parts record's arithmetic (wn = 1/sqrt(a), then fn): the PID's references are named and sized by the
+    record's fn and zeta, and a PID plant carried as the section and its values gives them bit for bit."""
+    from designer.filters.sallen_key_lowpass_synthesis import check_parts
+    section = section_of(with_gain=with_gain)
+    pairs = ((10e3, 5e3), (10e3, 8.2e3), (4.7e3, 1.8e3), (10e3, 1.2e3)) if with_gain else ((None, None),)
+    networks = (((10e3, 10e3, 10e-9, 10e-9), (4.7e3, 12e3, 10e-9, 4.7e-9), (1.6e3, 3.9e3, 33e-9, 10e-9))
+                if with_gain else ((1.6e3, 3.9e3, 3.3e-9, 100e-9), (805.0, 1e3, 10e-9, 220e-9),
+                                   (4.7e3, 12e3, 2.2e-9, 47e-9)))
+    for r1, r2, c1, c2 in networks:
+        for r3, r4 in pairs:
+            rec = check_parts(SallenKeyParts(r1, r2, c1, c2, None, r3, r4))   # the gain the resistors'
+            values = part_values(rec)
+            assert record_of(section, values) == rec
+            assert section.ideal_pair(values) == (rec.fn_hz, rec.zeta)
+            assert type(section.ideal_pair(values)[0]) is float

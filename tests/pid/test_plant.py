@@ -110,12 +110,12 @@ def test_the_sallen_key_plants_loop_is_the_generic_circuit_loop_named_as_its_own
     from designer.plant.netlist import plant_netlist
     from designer.plant.sallenkey import SallenKeyParts, check_parts
     rec = check_parts(SallenKeyParts(**SK_RECORDS[kind]))
-    circuit = sallen_key_circuit(rec)
-    prefix = plant_ref_prefix(rec)
-    assert prefix == ("" if kind == "follower" else PLANT_PREFIX) == plant_ref_prefix(circuit)
+    circuit = sallen_key_circuit(rec)   # the one conversion of the record (the loop takes the generic record)
+    prefix = plant_ref_prefix(circuit)
+    assert prefix == ("" if kind == "follower" else PLANT_PREFIX)
     own = plant_netlist(rec, "u", "y", prefix="p", amp_ref="U1", ref_prefix=prefix)
-    net = loop_netlist(seed_parts(), rec)
-    assert net == loop_netlist(seed_parts(), circuit) == loop_netlist(seed_parts(), Plant(None, circuit))
+    net = loop_netlist(seed_parts(), circuit)
+    assert net == loop_netlist(seed_parts(), Plant(None, circuit))
     assert net.parts[:len(own.parts)] == own.parts and net.amps[:1] == own.amps
     assert net.parts[len(own.parts):] == controller_netlist(seed_parts()).parts
     # the same section given by topology keeps the generic scheme (RP1 .., UP)
@@ -133,16 +133,19 @@ def test_the_sallen_key_closed_forms_equal_the_sections_nodal_model(kind):
     from designer.plant.circuit import opamp_tf
     from designer.plant.sallenkey import SallenKeyParts, check_parts
     rec = check_parts(SallenKeyParts(**SK_RECORDS[kind]))
-    st0 = sallen_key_circuit(rec).stages[0]
+    circuit = sallen_key_circuit(rec)
+    st0 = circuit.stages[0]
     for name in ("LM741", "TL072"):
         amp = opamps.get(name)
-        num, den = plant_model(rec, amp)
+        num, den = plant_model(circuit, amp)
         n, d = opamp_tf(st0.topology, st0.values, amp)
         assert np.allclose(den, d / d[-1], rtol=1e-9, atol=0) and math.isclose(num[-1], n[-1] / d[-1], rel_tol=1e-9)
-    num, den = plant_model(rec)
+    num, den = plant_model(circuit)
     n, d = st0.topology.coefficients(st0.values)
     assert np.allclose(den, np.asarray(d) / d[-1], rtol=1e-9) and math.isclose(num[-1], n[-1] / d[-1], rel_tol=1e-9)
-    assert np.allclose(ideal_pair(rec), dominant(den), rtol=1e-9)
+    assert np.allclose(ideal_pair(circuit), dominant(den), rtol=1e-9)
+    # the section's ideal-pair hook gives the parts record's own figures, bit for bit
+    assert ideal_pair(circuit) == (rec.fn_hz, rec.zeta) == circuit.ideal_pair()
 
 
 def dominant(den):
@@ -306,3 +309,43 @@ def test_the_pid_package_has_no_import_cycle():
 def test_a_malformed_plant_circuit_is_one_line(bad):
     text = str(refusal(plant_circuit=bad))
     assert "\n" not in text and ("plant_circuit" in text or "topology" in text), text
+
+
+def test_a_pid_for_an_mfb_plant_and_for_the_seed_plant_is_one_type_carrying_its_circuits_record():
+    """Issue 26: design_pid returns one type for every plant, and its ``plant`` is the generic record
+    (designer.pid.plant.PlantCircuit: the plant's topology and its values by designator), the MFB low-pass's
+    and the seed's Sallen-Key plant's alike; the seed plant's JSON keeps its own keys, its figures the record's."""
+    import pickle
+
+    from designer.pid.plant import PlantCircuit
+    mfb = design_pid(PidSpec(**CIRCUITS["mfb-lowpass"]), simulate=False)
+    seed = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2), simulate=False)
+    assert type(mfb) is type(seed) is PidResult
+    assert type(mfb.plant) is type(seed.plant) is PlantCircuit
+    assert mfb.plant.topology == "mfb-lowpass" and mfb.plant.stages[0].topology is get("mfb-lowpass")
+    assert mfb.plant.stages[0].values == parse_part_values(get("mfb-lowpass"), MFB)
+    assert mfb.plant == mfb.spec.plant.circuit.circuit and mfb.model is not None
+    assert seed.plant.topology == "sallen-key-lowpass" and seed.model is None
+    plant = seed.to_dict()["plant"]
+    assert plant["topology"] == seed.plant.topology
+    assert (plant["fn_hz"], plant["zeta"]) == seed.plant.ideal_pair() == (seed.plant.fn_hz, seed.plant.zeta)
+    assert all(plant[f"{ref}_{'ohm' if ref[0] == 'R' else 'f'}"] == v for ref, v in seed.plant.stages[0].values.items())
+    # the record travels to --jobs and dask workers as its registered section, equal
+    for circuit in (mfb.plant, seed.plant):
+        back = pickle.loads(pickle.dumps(circuit))
+        assert back == circuit and back.stages[0].topology is circuit.stages[0].topology
+
+
+def test_the_seed_plants_parts_are_given_as_its_record_or_as_the_generic_record_and_nothing_else():
+    # the flags' parts record is converted once; the generic record (a replaced spec's, a Monte Carlo
+    # build's) is checked as the record it stands for; another section is refused naming where it goes
+    from designer.pid.plant import sallen_key_circuit
+    from designer.plant.sallenkey import SallenKeyParts, check_parts
+    rec = SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, 1.5)
+    spec = PidSpec(plant_parts=rec)
+    assert spec.plant_parts == sallen_key_circuit(check_parts(rec)) == PidSpec(plant_parts=spec.plant_parts).plant_parts
+    exc = refusal(plant_parts=circuit_plant("mfb-lowpass", MFB).circuit)
+    assert "plant_topology" in str(exc) and "\n" not in str(exc)
+    assert "--plant-topology with --plant-part" in flag_message(exc)
+    exc = refusal(plant_parts=(10e3, 10e3, 10e-9, 10e-9))
+    assert "SallenKeyParts" in str(exc) and "\n" not in str(exc)

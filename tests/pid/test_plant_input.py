@@ -11,6 +11,7 @@ import pytest
 from designer.cli.pid import design_pid_main
 from designer.core.errors import DesignError
 from designer.core.ranges import RANGES
+from designer.filters.sallen_key_lowpass_parts import gain_refs
 from designer.plant.sallenkey import DEFAULT_R3_OHM, GAIN_TOLERANCE, SallenKeyParts, check_parts
 
 # an equal-component plant: zeta = 1 + (1 - K)/2 (seed 001's b with R1 = R2, C1 = C2)
@@ -104,7 +105,8 @@ def test_gain_without_resistors_from_parts_builds_them_too(capsys):
     from designer.pid.design import PidSpec, design_pid
     res = design_pid(PidSpec(plant_parts=SallenKeyParts(R, R, C, C, 1.5), opamp="ideal", tuning="simc"),
                      simulate=False)
-    assert (res.plant.r3, res.plant.r4) == (DEFAULT_R3_OHM, 0.5 * DEFAULT_R3_OHM)
+    gain_pair = [res.plant.stages[0].values[r] for r in gain_refs()]   # the generic record's values
+    assert gain_pair == [DEFAULT_R3_OHM, 0.5 * DEFAULT_R3_OHM]
     # the controller owns R3, R4: the plant's section carries the chaining prefix P (RP1 .. RP4), no renaming
     assert "RP3 pvn 0" in res.deck and "RP4 y pvn" in res.deck and "RP1 u pv1" in res.deck
     assert "RP" not in design_pid(PidSpec(plant_parts=SallenKeyParts(820, 1e3, 10e-9, 220e-9), opamp="ideal",
@@ -153,3 +155,16 @@ def test_check_parts_closed_forms():
         check_parts(SallenKeyParts(-1.0, R, C, C), name_of={"r1": "--x1"})
     with pytest.raises(DesignError, match="^part r2 must be"):
         check_parts(SallenKeyParts(R, -1.0, C, C), name_of=lambda k: f"part {k}")
+
+
+def test_a_typed_gain_plants_json_figures_are_the_circuits_it_was_sized_with():
+    # a gain typed without its resistors is built as R4 = (K - 1) R3: the result's plant is that circuit (the
+    # generic record), and its JSON figures are the ones the loop was named and sized with, 1 + R4/R3 (1.82
+    # typed: 1.8199999999999998, the last bit of 0.82), as the deck and the model build it
+    from designer.pid.design import PidSpec, design_pid
+    res = design_pid(PidSpec(plant_parts=SallenKeyParts(R, R, C, C, 1.82), opamp="ideal", tuning="simc"),
+                     simulate=False)
+    to_ground, feedback = (res.plant.stages[0].values[r] for r in gain_refs())
+    plant = res.to_dict()["plant"]
+    assert plant["gain"] == 1.0 + feedback / to_ground == pytest.approx(1.82, rel=1e-15)
+    assert (plant["fn_hz"], plant["zeta"]) == res.plant.ideal_pair()

@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from designer.filters.sallen_key_lowpass_parts import record_of
 from designer.pid import model as M
 from designer.pid.design import design_pid
 from designer.plant.model import plant_tf_opamp
@@ -94,7 +95,8 @@ def test_the_sallen_key_loops_margins_carry_its_ms(kw):
     loop as built, C(s) with every op-amp's pole times the plant with its op-amp, over the band of the loop-gain
     plot; the result's JSON keeps its keys (reports/ stay byte for byte)."""
     res = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2, opamp="LM741", **kw), simulate=False)
-    pn, pd = plant_tf_opamp(res.plant, res.opamp)   # (LM741: not the ideal op-amp)
+    st = res.plant.stages[0]   # the generic record; the closed forms take its parts record
+    pn, pd = plant_tf_opamp(record_of(st.topology, st.values), res.opamp)   # (LM741: not the ideal op-amp)
     loop = lambda w: M.loop_gain(res.parts, res.opamp, pn, pd, w)  # noqa: E731
     bode_w = np.asarray(res.waveforms.bode_w)
     # the loop brute-forced here is the loop plotted and whose margins are reported

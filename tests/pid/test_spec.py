@@ -9,6 +9,7 @@ import pytest
 
 from designer.cli.common import flag_message
 from designer.core.errors import DesignError
+from designer.filters.sallen_key_lowpass_parts import gain_of, gain_refs, refs, section_of
 from designer.pid.spec import PidSpec
 from designer.plant.sallenkey import SallenKeyParts
 
@@ -61,15 +62,19 @@ def test_a_spec_is_normalised_once_and_frozen():
     with pytest.raises(dataclasses.FrozenInstanceError):
         spec.kp = 1e9
     # a plant given as built comes out of the plant validation: floats, R3/R4 derived from its gain
+    # (held as the generic record: the gain section and its values by designator)
     p = PidSpec(plant_parts=SallenKeyParts("10k", "10k", "10n", "10n", "1.5")).plant_parts
-    assert (p.r1, p.gain, p.r3, p.r4) == (1e4, 1.5, 1e4, 5e3)
+    st = p.stages[0]
+    assert st.topology is section_of(with_gain=True) and gain_of(st.values) == 1.5
+    assert [st.values[r] for r in (*refs(with_gain=False)[:1], *gain_refs())] == [1e4, 1e4, 5e3]
 
 
 def test_a_plant_json_is_read_and_checked_when_the_spec_is_built(tmp_path):
     path = tmp_path / "plant.json"
     path.write_text(json.dumps({"built": {"R1_ohm": 820, "R2_ohm": 1e3, "C1_f": 10e-9, "C2_f": 220e-9}}))
     spec = PidSpec(plant_json=str(path))
-    assert spec.json_plant.r1 == 820.0 and spec.json_plant.gain == 1.0
+    st = spec.json_plant.stages[0]   # the generic record: the follower, its values by designator
+    assert st.topology is section_of(with_gain=False) and st.values[refs()[0]] == 820.0
     path.write_text(json.dumps({"built": {"R1_ohm": 820, "R2_ohm": 1e3, "C1_f": 10e-9, "C2_f": "x"}}))
     exc = refusal(plant_json=str(path))
     assert str(exc).startswith("plant_json ") and "built.C2_f must be a number" in str(exc)

@@ -10,6 +10,7 @@ from designer.core import opamps
 from designer.pid import blocks, selection, verify
 from designer.pid.design import PidSpec, design_pid
 from designer.pid.netlist import closed_loop_deck
+from designer.pid.plant import sallen_key_circuit
 from designer.plant.sallenkey import SallenKeyParts
 from designer.spice.deck import SquareTest
 from designer.spice.simulate import get_simulator
@@ -84,7 +85,7 @@ def test_positive_feedback_latches_at_a_rail():
     amp = opamps.get("LM741")
     parts = selection.select_parts(1.0, 60e-6, 5e-6, SEED_PLANT.fn_hz).parts
     test = SquareTest(1.0, 330.0, 50e-6, 100e-9)
-    deck = closed_loop_deck(parts, SEED_PLANT, amp, test, "positive feedback", 1.0)
+    deck = closed_loop_deck(parts, sallen_key_circuit(SEED_PLANT), amp, test, "positive feedback", 1.0)
     deck = re.sub(r"^R15 ref n2", "R15 y n2", deck, flags=re.M)
     deck = re.sub(r"^R17 y p2", "R17 ref p2", deck, flags=re.M)
     assert "R15 y n2" in deck and "R17 ref p2" in deck

@@ -119,3 +119,26 @@ def test_the_bundle_shows_the_schematic(tmp_path):
     # the terminal summary is the sheet's text without the picture
     text = summary_text(result)
     assert "R1" in text and "<svg" not in text and "schematic" not in text
+
+
+def test_a_sections_monte_carlo_is_on_its_sheet_and_in_its_summary(tmp_path):
+    """A bug: the section plant's sheet showed the Monte Carlo only for a replayed build (--replay I), so a
+    Monte Carlo of an MFB low-pass wrote monte-carlo.csv but no tolerance section, no histogram and no summary
+    lines (the Sallen-Key plant's have all three)."""
+    from designer.tolerance.spice_mc import section_monte_carlo_engine
+    from designer.tolerance.worstcase import worst_case
+    from designer.plant.circuit_design import tolerance_nominal
+    from designer.tolerance.parts import resolve
+    result = _plant("mfb-lowpass")
+    series = {"R": result.sourcing.r_series, "C": result.sourcing.c_series}
+    result.monte_carlo = section_monte_carlo_engine(result, series, 60, seed=5, limit_items=("fn_hz=950:1050",))
+    nominal = tolerance_nominal(result)
+    result.worst_case = worst_case(lambda v: circuit.evaluate((result.topology, result.opamp), v), nominal,
+                                   resolve((), nominal, series).of)
+    files = write_outputs(result, tmp_path, "mfb")
+    sheet = (tmp_path / "reports" / "mfb" / "build-sheet.md").read_text()
+    assert "Tolerance analysis (Monte Carlo)" in sheet and "60 builds drawn" in sheet and "mc-fn_hz.png" in sheet
+    assert str(tmp_path / "reports" / "mfb" / "mc-fn_hz.png") in files["plots"]
+    text = summary_text(result)
+    assert "Monte Carlo: 60 samples" in text and "natural frequency fn (fn_hz): nominal" in text
+    assert "Worst case over the tolerance box" in text

@@ -13,6 +13,7 @@ from designer.pid.blocks import seed_parts
 from designer.pid.netlist import closed_loop_deck, loop_netlist
 from designer.pid.schematic import draw_loop
 from designer.plant.netlist import plant_deck, plant_netlist
+from designer.pid.plant import sallen_key_circuit
 from designer.plant.sallenkey import SallenKeyParts
 from designer.plant.schematic import draw_plant
 from designer.report.schematic import check_connectivity
@@ -67,7 +68,7 @@ def test_the_loop_drawing_is_its_deck(derivative, name, kind):
     from dataclasses import replace
     amp = opamps.get(name)
     parts = seed_parts() if derivative else replace(seed_parts(), r7=None, r11=None, r12=None, c3=None)
-    plant = SallenKeyParts(820, 1e3, 10e-9, 220e-9)
+    plant = sallen_key_circuit(SallenKeyParts(820, 1e3, 10e-9, 220e-9))   # the flags' record, converted once
     deck = closed_loop_deck(parts, plant, amp, TEST, "t", 2.0)
     b = board(loop_netlist(parts, plant), amp, kind)
     sheet = draw_loop(b, amp)
@@ -86,7 +87,7 @@ def test_a_gain_plant_in_the_loop_is_drawn_with_its_prefixed_designators():
     # drawing finds its parts by the same prefix
     from designer.pid.netlist import plant_ref_prefix
     amp = opamps.get("LM741")
-    plant = SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, 1.5, 10e3, 5e3)
+    plant = sallen_key_circuit(SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, 1.5, 10e3, 5e3))
     deck = closed_loop_deck(seed_parts(), plant, amp, TEST, "t", 2.0)
     b = board(loop_netlist(seed_parts(), plant), amp)
     sheet = draw_loop(b, amp, plant_prefix=plant_ref_prefix(plant))
@@ -112,7 +113,7 @@ def test_a_miswired_drawing_is_caught():
 
 def test_the_drawing_shows_designators_codes_pins_and_probes():
     amp = opamps.get("TL072")
-    b = board(loop_netlist(seed_parts(), SallenKeyParts(820, 1e3, 10e-9, 220e-9)), amp, "quad")
+    b = board(loop_netlist(seed_parts(), sallen_key_circuit(SallenKeyParts(820, 1e3, 10e-9, 220e-9))), amp, "quad")
     svg = draw_loop(b, amp).svg()
     texts = set(re.findall(r"<tspan[^>]*>([^<]+)<", svg))
     joined = " ".join(texts)

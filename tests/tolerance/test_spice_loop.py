@@ -14,6 +14,7 @@ from designer.pid.blocks import PidParts
 from designer.pid.design import design_pid
 from designer.pid.netlist import closed_loop_deck
 from designer.pid.spec import PidSpec
+from designer.pid.plant import sallen_key_circuit
 from designer.plant.sallenkey import SallenKeyParts
 from designer.spice.simulate import get_simulator
 from designer.tolerance import sampling, spice_loop
@@ -54,7 +55,7 @@ def build_deck(loop, values, i):
     """A standalone deck of build ``i``: its parts and its op-amp (the drawn GBW and SR), as
     design-pid would write it, its .meas levels the engine's settled output for it."""
     v = {k: float(a[i]) for k, a in values.items()}
-    plant = SallenKeyParts(v["R1"], v["R2"], v["C1"], v["C2"])
+    plant = sallen_key_circuit(SallenKeyParts(v["R1"], v["R2"], v["C1"], v["C2"]))   # the loop's generic record
     parts = PidParts(**{f.name: v.get(f.name.upper()) for f in dataclasses.fields(PidParts)})
     amp = dataclasses.replace(loop.opamp, gbw_hz=v["GBW"], slew_v_per_s=v["SR"])
     return plant, parts, amp
