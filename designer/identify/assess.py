@@ -42,7 +42,7 @@ from ..core.errors import DesignError, ParamError
 from ..core.process import ProcessModel
 from .frequency import wide_interval
 from .outputerror import fit_output_error, simulate
-from .validation import Split, Validation, validate
+from .validation import Split, Validation, block_means, validate
 
 __all__ = ["ROUTES", "ESTIMATION_FRACTION", "MAX_SAMPLES", "OE_KINDS", "OE_INITIAL", "Candidate", "Assessment",
            "method_process", "choose_split", "choose_hold", "judge_candidate", "assess", "regular_interval",
@@ -52,9 +52,9 @@ __all__ = ["ROUTES", "ESTIMATION_FRACTION", "MAX_SAMPLES", "OE_KINDS", "OE_INITI
 ROUTES = ("step", "correlation", "spectral", "output-error")
 #: the estimation part's share of one record
 ESTIMATION_FRACTION = 2.0 / 3.0
-#: records longer than this are block-averaged to it: the output-error fits compare block means (the model
-#: simulated at the record's own rate, :func:`~.outputerror.fit_output_error`'s ``block``), the scoring
-#: runs on the block means as a record
+#: records longer than this are block-averaged to it: the output-error fits and the validation scores compare
+#: block means of the output with those of the model simulated at the record's own rate
+#: (:func:`~.outputerror.fit_output_error`'s and :func:`~.validation.validate`'s ``block``)
 MAX_SAMPLES = 20_000
 #: the output-error route's model structures
 OE_KINDS = ("fopdt", "sopdt", "underdamped", "lead-lag", "integrating")
@@ -200,9 +200,9 @@ class Assessment:
         Of the record scored.
     decimated_by : int
         Block means of this many samples (1: none): the output-error fits
-        compare them with the block means of the model simulated at the
-        record's own rate (unbiased), the scoring simulates every candidate
-        on the block means.
+        and every candidate's validation compare them with the block means
+        of the model simulated at the record's own rate (``sample_time_s``
+        is the block means' interval).
     candidates : list of Candidate
     best : int or None
         Index of the valid candidate with the best validation fit.
@@ -328,11 +328,6 @@ def match_validation(ts: float, tv, uv, yv, name: str = "validation record") -> 
                       "multiple of it".format(ratio))
 
 
-def _block(x, k: int) -> np.ndarray:
-    n = x.size // k
-    return np.asarray(x[:n * k], float).reshape(n, k).mean(axis=1)
-
-
 def choose_split(n: int, excitation=None, fraction: float = ESTIMATION_FRACTION) -> tuple:
     """Where the estimation part of one record ends, and why.
 
@@ -427,11 +422,13 @@ def _check_settles(c: Candidate, span: float) -> None:
                                        f"estimation record ({fe(span, 's')})") if n)
 
 
-def _score(c: Candidate, ts: float, hold: str, u, y, split: Split | None, how: str = "detrend") -> None:
+def _score(c: Candidate, ts: float, hold: str, u, y, split: Split | None, how: str = "detrend",
+           block: int = 1) -> None:
+    """Validate ``c`` on the record ``u``, ``y`` sampled every ``ts`` (block means of ``block`` scored)."""
     if c.model is None:
         return
     try:
-        v = validate(_Simulated(c.model, ts, hold), u, y, split, how=how)
+        v = validate(_Simulated(c.model, ts, hold), u, y, split, how=how, block=block)
     except (DesignError, ValueError, np.linalg.LinAlgError) as exc:
         c.valid = False
         c.note = "; ".join(n for n in (c.note, f"not simulated: {exc}") if n)
@@ -494,12 +491,10 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
         raise DesignError(f"{source}: the input never moves: there is nothing to identify (a capture of the "
                           "plant under a step, a sequence or any moving input)")
     k = max(1, int(math.ceil(u.size / MAX_SAMPLES)))
-    uu, yy, T = (_block(u, k), _block(y, k), ts * k) if k > 1 else (u, y, ts)
+    uu, T = block_means(u, k), ts * k
     vu = vy = None
     if validation is not None:
         vu, vy = (np.asarray(a, float) for a in validation)
-        if k > 1:
-            vu, vy = _block(vu, k), _block(vy, k)
     split = None
     full = slice(None)      # the estimation part at the record's own rate, for the output-error fits
     if validation is not None:
@@ -559,12 +554,14 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
     span = T * (uu[est].size - 1)
     for c in res.candidates:
         _check_settles(c, span)
-    drive = (vu, vy, None) if validation is not None else (uu, yy, split)
+    # every candidate simulated at the record's own rate, its block means scored (validate's block): the
+    # response to the block means of the input is not the block means of the response
+    drive = (vu, vy, None) if validation is not None else (u, y, split)
     how = "rest" if scope == "whole" and rest == "fitted" else "detrend"
     if how == "rest":
         res.note += "; each model from rest at the input level that fits the output best"
     for c in res.candidates:
-        _score(c, T, res.hold, *drive, how=how)
+        _score(c, ts, res.hold, *drive, how=how, block=k)
         if c.kind == "integrating" and c.valid and c.fit_percent < 0:
             # its dead time at 0 has no interval to fail: a settling plant's integrator, worse than the mean
             c.valid = False
