@@ -8,7 +8,10 @@ Each model is simulated under the recorded input of the validation data
 (:func:`designer.identify.outputerror.simulate`: zero-order hold, the dead
 time not a whole number of samples) and scored by MATLAB ``compare``'s fit
 percentage and the residual tests of ``resid`` (:mod:`.validation`). The best
-model is the valid one with the best validation fit across all routes.
+model is the valid one with the best validation fit across all routes, a
+difference within one standard error of the two models' validation losses
+being none: among the models so tied with the best fit, the one with the
+fewest parameters (:mod:`.ranking`).
 
 Sources: L. Ljung, *System Identification: Theory for the User*, 2nd ed.
 (1999), section 16.6 (validation on fresh data, residual analysis) and the
@@ -42,6 +45,7 @@ from ..core.errors import DesignError, ParamError
 from ..core.process import ProcessModel
 from .frequency import wide_interval
 from .outputerror import fit_output_error, simulate
+from .ranking import rank
 from .validation import Split, Validation, block_means, validate
 
 __all__ = ["ROUTES", "ESTIMATION_FRACTION", "MAX_SAMPLES", "OE_KINDS", "OE_INITIAL", "Candidate", "Assessment",
@@ -205,7 +209,8 @@ class Assessment:
         is the block means' interval).
     candidates : list of Candidate
     best : int or None
-        Index of the valid candidate with the best validation fit.
+        Index of the best valid candidate: the best validation fit, or among
+        those tied with it the one with the fewest parameters (``ranking``).
     skipped : dict
         Route -> why it gave no model.
     output_error : list
@@ -215,6 +220,9 @@ class Assessment:
         ``foh``): the one under which the output-error FOPDT fits the
         estimation data better (a sequence switching between the scope's
         samples is a ramp to a first-order hold, centred where it switched).
+    ranking : str
+        Why the best is not the best validation fit ("" when it is): tied
+        with it within the margin, fewer parameters (:func:`~.ranking.rank`).
     """
 
     scope: str
@@ -228,6 +236,7 @@ class Assessment:
     output_error: list = field(default_factory=list)
     hold: str = "zoh"
     view: object | None = None
+    ranking: str = ""
 
     @property
     def best_candidate(self) -> Candidate | None:
@@ -249,10 +258,14 @@ class Assessment:
         dict
             The split, every candidate, the best, the skipped routes.
         """
-        return {"scope": self.scope, "split": None if self.split is None else self.split.to_dict(),
-                "split_note": self.note, "sample_time_s": self.sample_time_s, "decimated_by": self.decimated_by, "hold": self.hold,
-                "best": None if self.best_candidate is None else self.best_candidate.to_dict(),
-                "skipped": dict(self.skipped), "models": [c.to_dict() for c in self.candidates]}
+        out = {"scope": self.scope, "split": None if self.split is None else self.split.to_dict(),
+               "split_note": self.note, "sample_time_s": self.sample_time_s, "decimated_by": self.decimated_by,
+               "hold": self.hold, "best": None if self.best_candidate is None else self.best_candidate.to_dict(),
+               "skipped": dict(self.skipped), "models": [c.to_dict() for c in self.candidates]}
+        if self.ranking:
+            # only when a tie decided: a capture whose best is its best fit keeps its JSON as it was
+            out["ranking"] = self.ranking
+        return out
 
 
 # --------------------------------------------------------------------------- the record
@@ -567,8 +580,12 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
             c.valid = False
             c.note = "; ".join(n for n in (c.note, f"its validation fit ({c.fit_percent:.1f} %) is below 0: the "
                                            "output does not follow the input's integral") if n)
-    ok = [i for i, c in enumerate(res.candidates) if c.valid and math.isfinite(c.fit_percent)]
-    res.best = max(ok, key=lambda i: res.candidates[i].fit_percent) if ok else None
+    r = rank(res.candidates)
+    if r is not None:
+        res.best, res.ranking = r.best, r.note
+        if r.note:
+            c = res.candidates[r.best]
+            c.note = "; ".join(n for n in (c.note, r.note) if n)
     return res
 
 

@@ -73,7 +73,7 @@ class RecordView:
     note : str
         The split in words.
     models : tuple of ModelTrace
-        Up to ``n_models`` valid models, the best validation fit first.
+        Up to ``n_models`` valid models: the assessment's best, then by validation fit.
     """
 
     t: np.ndarray
@@ -114,8 +114,9 @@ def record_view(assessment, t, u, y, n_models: int = 3) -> RecordView:
         start, val = None, slice(0, ub.size)
     else:
         start, val = float(tb[a.split.n_est]), a.split.validation
+    best = a.best_candidate     # first, even where a tie within the margin put it after a better fit
     order = sorted((c for c in a.candidates if c.valid and c.model is not None and math.isfinite(c.fit_percent)),
-                   key=lambda c: -c.fit_percent)[:n_models]
+                   key=lambda c: (c is not best, -c.fit_percent))[:n_models]
     traces = []
     for c in order:
         ym = block_means(simulate(c.model, u[:ub.size * k] - u[0] + c.validation.rest_shift,

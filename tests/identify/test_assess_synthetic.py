@@ -176,18 +176,19 @@ def misses(plant: str, best) -> list:
 _SAME = "; its fit {} equals the true model's {}"
 DATA = {
     ("fopdt", "step", 10): "a step at 10 dB: theta 1.404 s (true 1.3 s, +8.0 %)" + _SAME.format(69.70, 69.69),
-    # the predicted 26,331 samples (blocks of 2; at 300 s K 1.537, +2.5 %, the short lag 1.612 s, +7.5 % +-0.20 s,
-    # theta 0.816 s, -9.4 %): the output-error SOPDT is within the tolerances (K 1.506, lags 4.000 s and 1.533 s,
-    # theta 0.879 s +-0.024 s) but the lead-lag's fit ties it to 0.001 point and ranks first (at 2000 s without
-    # block means the best SOPDT's short lag was 1.591 s, +6.0 % +-0.090 s, theta 0.855 s, -5.0 % +-0.028 s)
-    ("sopdt", "rb0.1", 10): ("random binary p 0.1 at 10 dB, 26,331 samples: the best is the output-error "
-                             "lead-lag (lags 3.963 s and 1.578 s, a zero at 0.165 s +-0.10 s, theta 1.027 s); "
-                             "the SOPDT beside it is within the tolerances, its fit 0.001 point lower"
-                             + _SAME.format(79.38, 79.38)),
+    # ("sopdt", "rb0.1", 10) passes at its predicted 26,331 samples (blocks of 2): the best is the correlation
+    # route's stark-mollenkamp overdamped (K 1.494, lags 3.946 s and 1.532 s, theta 0.897 s), 79.483 % against
+    # the true model's 79.493 %, the output-error SOPDT (within the tolerances too) and lead-lag tied with it
+    # within one standard error (0.010 and 0.011 point). Its models simulated on the input's block means,
+    # the lead-lag came first, 0.0001 point above the SOPDT (at 300 s K 1.537, +2.5 %, the short lag
+    # 1.612 s, +7.5 % +-0.20 s, theta 0.816 s, -9.4 %)
     ("sopdt", "step", 20): ("a step at 20 dB: the lags 1.304 s and 4.214 s (true 1.5 s, -13.1 %, and 4 s, +5.3 %)"
                             + _SAME.format(90.01, 90.01)),
-    ("sopdt", "step", 10): ("a step at 10 dB: the short lag 1.407 s (-6.2 %), theta 1.076 s (true 0.9 s, +19.6 %)"
-                            + _SAME.format(69.68, 69.68)),
+    # the output-error SOPDT ranks first by fit, 0.017 point above its FOPDT, within one standard error of
+    # their validation losses' difference (0.019 point): the FOPDT, fewer parameters, is the best
+    ("sopdt", "step", 10): ("a step at 10 dB: the best is the output-error FOPDT, tied with the SOPDT within the "
+                            "margin; the SOPDT's short lag 1.407 s (-6.2 %), theta 1.076 s (true 0.9 s, +19.6 %)"
+                            + _SAME.format(69.67, 69.68)),
     # ("sopdt", "chirp", 10) passes at its predicted 82,512 samples (blocks of 5, foh: the output-error SOPDT, K
     # 1.497, lags 4.011 s and 1.471 s, theta 0.913 s +-0.032 s); at 2000 s, the longest record before the block
     # means were unbiased, its short lag was 1.412 s (-5.9 %, +-0.137 s), theta 0.961 s (+6.8 %)
@@ -283,7 +284,10 @@ def test_the_settling_plants_misses_are_the_datas(plant, inp, snr_db):
     routes' candidates, can do better by least squares), its in-sample rms from
     rest is at most the true model's on the same estimation data, and every
     parameter the best model misses has a 95 % interval wider than the issue's
-    tolerance on it: the record cannot place it that close."""
+    tolerance on it: the record cannot place it that close. Where the best is
+    a simpler structure tied with the true one's better fit within the margin
+    (the SOPDT under a step at 10 dB: an FOPDT), the true structure's best
+    fit is the one checked."""
     from designer.identify.outputerror import fit_output_error
     t, u, _, y = capture(plant, inp, snr_db)
     a = identify_record(t, y, u, name=f"{plant}/{inp}/{snr_db:g} dB").assessment
@@ -297,6 +301,12 @@ def test_the_settling_plants_misses_are_the_datas(plant, inp, snr_db):
     rest = fit_output_error(ue, ye, ts, kind, hold=a.hold, initial="rest", start=p)
     assert _rms(rest.model, ue, ye, ts, a.hold) <= _rms(true_model(plant), ue, ye, ts, a.hold)
     best = a.best_candidate
+    if best is not None and best.kind not in (kind, "overdamped") and a.ranking:
+        # chosen over the true structure's better fit within the margin (fewer parameters): that fit is the one
+        # whose misses are checked
+        best = max((c for c in a.candidates if c.valid and c.kind in (kind, "overdamped")),
+                   key=lambda c: c.fit_percent)
+        assert a.ranking.startswith(f"tied with {best.label} within the margin"), a.ranking
     assert best is not None and best.kind in (kind, "overdamped"), best
     got, ci, want = dict(best.params), dict(best.ci95), dict(p)
     if kind == "sopdt":     # the two lags in either order, each with its interval
@@ -380,3 +390,30 @@ def test_validation_of_block_means_is_exact(points):
         former.append(abs(_fit(yb[val], old[val]) - c.fit_percent))
     # measured: 0.11 to 1.3 points with blocks of 2 (40,000 samples), 0.009 to 9.0 with blocks of 5
     assert min(former) > 1e-3, sorted(former)
+
+
+def test_a_tie_within_the_margin_goes_to_fewer_parameters():
+    """The SOPDT under a step at 10 dB, 300 s (its xfail above): the output-error
+    SOPDT has the best validation fit, its FOPDT 0.017 point lower, within one
+    standard error of their validation losses' difference: the FOPDT, with a
+    parameter fewer, is the best, and the assessment's JSON ("ranking" and the
+    best's note) and its validation text say why. A capture whose best is its
+    best fit has no "ranking" in its JSON."""
+    from designer.identify.ranking import rank
+    from designer.identify.report import validation_text
+    t, u, _, y = capture("sopdt", "step", 10, points=POINTS)
+    a = identify_record(t, y, u, name="sopdt/step/10 dB").assessment
+    r = rank(a.candidates)
+    best, top = a.best_candidate, a.candidates[r.top]
+    assert (best.label, top.label) == ("output-error oe fopdt", "output-error oe sopdt")
+    assert 0.0 < top.fit_percent - best.fit_percent <= r.margin
+    want = f"tied with output-error oe sopdt within the margin (fit {best.fit_percent:.3f} % against " \
+           f"{top.fit_percent:.3f} %"
+    assert a.ranking.startswith(want) and a.ranking.endswith("; fewer parameters (3 against 4)")
+    d = a.to_dict()
+    assert d["ranking"] == a.ranking and a.ranking in d["best"]["note"]
+    line = next(x for x in validation_text(a) if x.startswith("Best by validation fit: "))
+    assert line.startswith(f"Best by validation fit: output-error oe fopdt, fit {best.fit_percent:.2f} % ({want}")
+    t, u, _, y = capture("fopdt", "rb0.5", 20)
+    plain = identify_record(t, y, u, name="fopdt/rb0.5/20 dB").assessment
+    assert plain.ranking == "" and "ranking" not in plain.to_dict()
