@@ -91,7 +91,7 @@ import numpy as np
 from ..core import process_build as pb
 from ..core.errors import DesignError
 from ..core.process import ProcessModel
-from .validation import DEFAULT_FRACTION, Split, arx_fit, split_record, validate
+from .validation import DEFAULT_FRACTION, Split, arx_fit, block_means, split_record, validate
 
 __all__ = ["FIT_KINDS", "HOLDS", "INITIALS", "Sampled", "sample_model", "simulate", "OEFit", "OEResult", "power_of_two",
            "fit_output_error", "identify_output_error"]
@@ -356,7 +356,7 @@ def _regressors(s: Sampled, ud, integrating: bool, initial: str, block: int) -> 
     sim = s.run(ud)
     X = _columns(s, ud.size, integrating, initial)
     if block > 1:
-        return _block_means(sim, block), _block_means(X, block)
+        return block_means(sim, block), block_means(X, block)
     return sim, X
 
 
@@ -368,7 +368,7 @@ def _evaluate(kind: str, p: dict, ud, y, T: float, hold: str, initial: str, bloc
     if initial == "rest":
         sim = s.run(ud)
         if block > 1:
-            sim = _block_means(sim, block)
+            sim = block_means(sim, block)
         rest = y - sim
         beta = np.array([rest.mean()])
         return rest - beta[0], sim, beta
@@ -508,18 +508,12 @@ class OEFit:
 
 # --------------------------------------------------------------------------- start
 
-def _block_means(x, m: int) -> np.ndarray:
-    """Means of ``m`` consecutive rows (a trailing partial block dropped)."""
-    k = x.shape[0] // m
-    return x[:k * m].reshape(k, m, *x.shape[1:]).mean(axis=1)
-
-
 def _arx_start(kind: str, ud, y, T: float) -> dict:
     """A start from ARX models (numpy least squares): the input delay from a grid
     (the lowest one-step loss), poles and gain converted to continuous time, the
     fraction of a sample from the two taps' balance."""
     m = max(1, int(math.ceil(ud.size / START_SAMPLES)))
-    us, ys, Ts = (_block_means(ud, m), _block_means(y, m), T * m) if m > 1 else (ud, y, T)
+    us, ys, Ts = (block_means(ud, m), block_means(y, m), T * m) if m > 1 else (ud, y, T)
     integ = kind.startswith("integrating")
     if integ:
         # the output follows the input's running integral like a non-integrating
@@ -703,7 +697,7 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     if start is not None:
         start = {k: float(v) / _scale_of(kind, k, su, sy, st) for k, v in start.items() if k in names}
     ud = u - u[0]
-    yb = _block_means(y, block) if block > 1 else y
+    yb = block_means(y, block) if block > 1 else y
     n = yb.size
     bounds = _bounds(kind, T, u.size * T)
     lo = np.array([bounds[k][0] for k in names])

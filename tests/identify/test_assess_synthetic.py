@@ -44,13 +44,16 @@ record's own rate and compare its block means with the output's, so the
 means leave the fit unbiased (:func:`test_block_means_leave_the_fit_unbiased`;
 fitted on the block means as a record of their own they moved an SOPDT's dead
 time under a random binary signal p 0.5 at 10 dB to 0.950 s and 0.944 s for
-0.900 s with blocks of 2 and 3 samples). The true model's fit is computed on
-the record the assessment scored (its block means). The SOPDT under a step
+0.900 s with blocks of 2 and 3 samples). Every candidate's validation, and
+the true model's fit here, simulate the model at the record's own rate too and
+score the block means of the simulation against the output's
+(:func:`test_validation_of_block_means_is_exact`). The SOPDT under a step
 at 10 dB would need 409,000 samples over its 60 s, over the cap: at 99,601
 it passes, its short lag's interval (+-0.14 s) still wider than its
 tolerance. The FOPDT under a step at 10 dB misses on the ranking, not on the
 data (:func:`test_a_step_miss_is_a_tie_not_the_data`)."""
 
+import functools
 import math
 
 import numpy as np
@@ -212,9 +215,8 @@ def run(plant: str, inp: str, snr_db: float, seed: int = SEED) -> dict:
     a = res.assessment
     k = a.decimated_by
     assert k == math.ceil(u.size / MAX_SAMPLES)
-    if k > 1:       # the record the assessment scored: its block means
-        u, y = (x[:x.size // k * k].reshape(-1, k).mean(axis=1) for x in (u, y))
-    truth = validate(_True(true_model(plant), a.sample_time_s, a.hold), u, y, a.split).fit_percent
+    # simulated at the record's own rate, its block means scored (as the assessment scores every candidate)
+    truth = validate(_True(true_model(plant), TS, a.hold), u, y, a.split, block=k).fit_percent
     return {"a": a, "best": a.best_candidate, "truth": truth}
 
 
@@ -245,14 +247,11 @@ def misses(plant: str, best) -> list:
 # (the best model's validation fit is the true model's to 0.05 point in each: the data cannot tell them apart)
 _SAME = "; its fit {} equals the true model's {}"
 DATA = {
-    # the predicted 26,331 samples (blocks of 2; at 300 s K 1.537, +2.5 %, the short lag 1.612 s, +7.5 % +-0.20 s,
-    # theta 0.816 s, -9.4 %): the output-error SOPDT is within the tolerances (K 1.506, lags 4.000 s and 1.533 s,
-    # theta 0.879 s +-0.024 s) but the lead-lag's fit ties it to 0.001 point and ranks first (at 2000 s without
-    # block means the best SOPDT's short lag was 1.591 s, +6.0 % +-0.090 s, theta 0.855 s, -5.0 % +-0.028 s)
-    ("sopdt", "rb0.1", 10): ("random binary p 0.1 at 10 dB, 26,331 samples: the best is the output-error "
-                             "lead-lag (lags 3.963 s and 1.578 s, a zero at 0.165 s +-0.10 s, theta 1.027 s); "
-                             "the SOPDT beside it is within the tolerances, its fit 0.001 point lower"
-                             + _SAME.format(79.38, 79.38)),
+    # ("sopdt", "rb0.1", 10) passes at its predicted 26,331 samples (blocks of 2): the best is the correlation
+    # route's stark-mollenkamp overdamped (K 1.494, lags 3.946 s and 1.532 s, theta 0.897 s), 79.483 % against
+    # the true model's 79.493 %, the output-error SOPDT (within the tolerances too) and lead-lag tied with it
+    # within one standard error (0.010 and 0.011 point). Its models simulated on the input's block means,
+    # the lead-lag came first, 0.0001 point above the SOPDT
     # ("sopdt", "chirp", 10) passes at its predicted 82,512 samples (blocks of 5, foh: the output-error SOPDT, K
     # 1.497, lags 4.011 s and 1.471 s, theta 0.913 s +-0.032 s); at 2000 s, the longest record before the block
     # means were unbiased, its short lag was 1.412 s (-5.9 %, +-0.137 s), theta 0.961 s (+6.8 %)
@@ -317,6 +316,21 @@ def test_a_step_miss_is_a_tie_not_the_data(plant, inp, snr_db):
     assert from_truth.rms_residual == pytest.approx(own.rms_residual, rel=1e-6)
 
 
+@functools.lru_cache(maxsize=2)
+def _long_capture(points: int) -> tuple:
+    """(t, u, y, assessment) of the SOPDT at 10 dB under a random binary signal
+    p 0.5, ``points`` samples (scored on block means)."""
+    t, u, _, y = capture("sopdt", "rb0.5", 10, points=points)
+    a = identify_record(t, y, u, name=f"sopdt/rb0.5/10 dB, {points} samples").assessment
+    return t, u, y, a
+
+
+def _fit(y, yhat) -> float:
+    """MATLAB compare's fit of ``yhat`` to ``y``, each with its mean removed (percent)."""
+    y, yhat = y - y.mean(), yhat - yhat.mean()
+    return 100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y))
+
+
 @pytest.mark.parametrize("points", [40_000, 100_000])
 def test_block_means_leave_the_fit_unbiased(points):
     """A record longer than MAX_SAMPLES is fitted on block means (issue 28's
@@ -331,8 +345,7 @@ def test_block_means_leave_the_fit_unbiased(points):
     0.892 s)."""
     from designer.identify.assess import OE_INITIAL
     from designer.identify.outputerror import fit_output_error
-    t, u, _, y = capture("sopdt", "rb0.5", 10, points=points)
-    a = identify_record(t, y, u, name=f"sopdt/rb0.5/10 dB, {points} samples").assessment
+    _, u, y, a = _long_capture(points)
     k = math.ceil(points / MAX_SAMPLES)
     assert k > 1 and a.decimated_by == k and a.hold == "zoh"
     fit = next(f for f in a.output_error if f.kind == "sopdt")
@@ -346,3 +359,59 @@ def test_block_means_leave_the_fit_unbiased(points):
     ub, yb = (x[:n].reshape(-1, k).mean(axis=1) for x in (u, y))
     former = fit_output_error(ub, yb, TS * k, "sopdt", hold="foh", initial=initial)
     assert abs(former.params["theta_s"] - full.params["theta_s"]) > full.ci95["theta_s"]
+
+
+@pytest.mark.parametrize("points", [40_000, 100_000])
+def test_validation_of_block_means_is_exact(points):
+    """A record scored on block means: every candidate's validation fit is the
+    fit of the block means of its simulation at the record's own rate, under
+    the assessment's hold, from the record's start at rest, against the
+    output's block means on the validation part (to 1e-9 point). The former
+    way, the model simulated on the input's block means at their own interval,
+    gave other numbers for every candidate (a held input's block means are
+    ramps between its levels, not the input the plant saw): 0.11 to 1.3 points
+    off with blocks of 2, 0.009 to 9.0 with blocks of 5."""
+    _, u, y, a = _long_capture(points)
+    k = a.decimated_by
+    assert k == math.ceil(points / MAX_SAMPLES) and k > 1 and a.split is not None
+    n = u.size // k * k
+    ub, yb = (x[:n].reshape(-1, k).mean(axis=1) for x in (u, y))
+    val = a.split.validation
+    scored = [c for c in a.candidates if c.validation is not None]
+    assert len(scored) >= 5
+    former = []
+    for c in scored:
+        sim = simulate(c.model, u[:n] - u[0], TS, a.hold).reshape(-1, k).mean(axis=1)
+        assert c.fit_percent == pytest.approx(_fit(yb[val], sim[val]), abs=1e-9), c.label
+        assert c.validation.samples == ub[val].size
+        old = simulate(c.model, ub - ub[0], TS * k, a.hold)
+        former.append(abs(_fit(yb[val], old[val]) - c.fit_percent))
+    # measured: 0.11 to 1.3 points with blocks of 2 (40,000 samples), 0.009 to 9.0 with blocks of 5
+    assert min(former) > 1e-3, sorted(former)
+
+
+def test_a_tie_within_the_margin_goes_to_fewer_parameters():
+    """The SOPDT under a step at 10 dB, 300 s (its xfail above): the output-error
+    SOPDT has the best validation fit, its FOPDT 0.017 point lower, within one
+    standard error of their validation losses' difference: the FOPDT, with a
+    parameter fewer, is the best, and the assessment's JSON ("ranking" and the
+    best's note) and its validation text say why. A capture whose best is its
+    best fit has no "ranking" in its JSON."""
+    from designer.identify.ranking import rank
+    from designer.identify.report import validation_text
+    t, u, _, y = capture("sopdt", "step", 10, points=POINTS)
+    a = identify_record(t, y, u, name="sopdt/step/10 dB").assessment
+    r = rank(a.candidates)
+    best, top = a.best_candidate, a.candidates[r.top]
+    assert (best.label, top.label) == ("output-error oe fopdt", "output-error oe sopdt")
+    assert 0.0 < top.fit_percent - best.fit_percent <= r.margin
+    want = f"tied with output-error oe sopdt within the margin (fit {best.fit_percent:.3f} % against " \
+           f"{top.fit_percent:.3f} %"
+    assert a.ranking.startswith(want) and a.ranking.endswith("; fewer parameters (3 against 4)")
+    d = a.to_dict()
+    assert d["ranking"] == a.ranking and a.ranking in d["best"]["note"]
+    line = next(x for x in validation_text(a) if x.startswith("Best by validation fit: "))
+    assert line.startswith(f"Best by validation fit: output-error oe fopdt, fit {best.fit_percent:.2f} % ({want}")
+    t, u, _, y = capture("fopdt", "rb0.5", 20)
+    plain = identify_record(t, y, u, name="fopdt/rb0.5/20 dB").assessment
+    assert plain.ranking == "" and "ranking" not in plain.to_dict()
