@@ -55,7 +55,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
            "OUTPUT_NAMES", "PARSED", "PHASE_UNITS", "TIME_NAMES", "check_format", "format_generic", "freq_data",
            "looks_like_step_input", "parse_capture_text", "parse_freq_table", "plain_columns", "read_capture",
            "read_freq_table", "text_lines", "unit_hint"),
-    "outputerror": ("FIT_KINDS", "HOLDS", "INITIALS", "OEFit", "OEResult", "Sampled", "fit_output_error",
+    "outputerror": ("FIT_KINDS", "all_pass_pair", "HOLDS", "INITIALS", "OEFit", "OEResult", "Sampled", "fit_output_error",
                     "identify_output_error", "power_of_two", "sample_model", "simulate"),
     "overdamped": ("alfaro_123c_overdamped", "harriott", "jahanmiri_fallahi", "peeling", "stark_mollenkamp",
                    "two_pole"),
