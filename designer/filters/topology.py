@@ -40,6 +40,10 @@ equal the nodal solution to rounding (the conformance suite checks every section
 So is the ideal (fn, zeta) a PID's plant is sized by, :meth:`Topology.ideal_pair` (by default
 from the coefficients; the Sallen-Key low-pass gives its parts record's exact arithmetic).
 
+So is what a step settles to, :meth:`Topology.step_final` (amplitude x G(0) by nodal analysis at DC; the
+Sallen-Key low-pass gives its closed form K A0/(K + A0)), the levels of the SPICE step engine
+(:mod:`designer.tolerance.spice_engine`).
+
 The plant's E-series search has a hook too, :meth:`Topology.fast_search`: None by default (the
 generic search, :func:`designer.plant.circuit.search`, enumerates its candidate set), overridden by a
 section with an exact search of its own (the Sallen-Key low-pass: seed 001's parallelogram search over
