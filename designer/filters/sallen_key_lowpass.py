@@ -130,6 +130,13 @@ class SallenKeyLowPass(SallenKeySection):
         # the plant's Monte Carlo engine: the third-order model's exact step (its module says how it differs)
         return sample_figures(self.values_of(values), opamp)
 
+    def step_final(self, values: dict, opamp, amplitude_v: float = 1.0):
+        # the closed-loop DC gain of the op-amp model, K A0/(K + A0) (the ideal one's A0 too: the deck's),
+        # in the seed plant's SPICE engine's order of operations, so its levels and overshoots keep their bits
+        v = self.values_of(values)
+        k = self.gain_of(v) * np.ones(np.broadcast_shapes(*(x.shape for x in v.values())))
+        return amplitude_v * k * opamp.a0 / (k + opamp.a0)
+
     def limits(self, target: SectionTarget) -> dict:
         return {"ratio_min": sallen_key_ratio_min(target.q, target.gain)}
 

@@ -40,6 +40,10 @@ equal the nodal solution to rounding (the conformance suite checks every section
 So is the ideal (fn, zeta) a PID's plant is sized by, :meth:`Topology.ideal_pair` (by default
 from the coefficients; the Sallen-Key low-pass gives its parts record's exact arithmetic).
 
+So is what a step settles to, :meth:`Topology.step_final` (amplitude x G(0) by nodal analysis at DC; the
+Sallen-Key low-pass gives its closed form K A0/(K + A0)), the levels of the SPICE step engine
+(:mod:`designer.tolerance.spice_engine`).
+
 The plant's E-series search has a hook too, :meth:`Topology.fast_search`: None by default (the
 generic search, :func:`designer.plant.circuit.search`, enumerates its candidate set), overridden by a
 section with an exact search of its own (the Sallen-Key low-pass: seed 001's parallelogram search over
@@ -785,6 +789,34 @@ class Topology(ABC):
             Figure -> array shaped as the batch, or None.
         """
         return None
+
+    # ---- the settled output of a step (the SPICE step engine's levels; a hook, as opamp_model) ----------
+    def step_final(self, values: dict, opamp, amplitude_v: float = 1.0):
+        """What the output settles to after an input step of ``amplitude_v``: amplitude_v G(0), G the
+        op-amp-aware response at DC by nodal analysis of :meth:`netlist` (the op-amp's finite A0,
+        the ideal one's too: the deck simulates it), negative for an inverting section. The SPICE
+        step engine's 10/90 % and 2 % levels and overshoot are read against it
+        (:mod:`designer.tolerance.spice_engine`). A section with a closed form overrides this (the
+        Sallen-Key low-pass: amplitude K A0/(K + A0), the seed plant's engine's arithmetic to the
+        bit); it must equal this to rounding (the conformance suite checks every section).
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value, numbers or arrays (one batch shape).
+        opamp : designer.core.opamps.OpAmp
+            The op-amp (its A0).
+        amplitude_v : float
+            The step (V).
+
+        Returns
+        -------
+        ndarray
+            The settled output (V), shaped as the batch.
+        """
+        vals = self.values_of(values)
+        net = self.netlist({r: 1.0 for r in self.designators})
+        return amplitude_v * np.real(nodal_response(net, vals, 0j, opamp))
 
     # ---- parameters besides the parts (a sensitivity table's extra rows) ------------------------
     def sensitivity_parameters(self) -> tuple:
