@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -26,11 +26,9 @@ from ..core.lti import dense_time, dominant_pair, step_response
 from ..core.metrics import step_metrics
 from ..core.opamps import OpAmp
 from ..spice.deck import SquareTest
-from .model import plant_tf
-from .sallenkey import SallenKeyParts
 
 __all__ = ["PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",
-           "tolerance_band"]
+           "corner_tolerances", "tolerance_band"]
 
 
 def recommend_square_wave(settling_time_s: float, amplitude_v: float, frequency_hz=None,
@@ -141,16 +139,45 @@ class ToleranceBand:
         return out
 
 
-def tolerance_band(parts: SallenKeyParts, r_tol: float, c_tol: float, t_end: float) -> ToleranceBand:
-    """Min and max of fn, zeta and the step metrics over the 16 corners of
-    R1, R2, C1, C2 at +/- their tolerance (ideal op-amp), for the scope readings.
+def corner_tolerances(topology, tolerances: dict) -> dict:
+    """Each part's tolerance (fraction) from ``tolerances`` given per part kind (``{"R": 0.05, "C": 0.1}``)
+    or per designator (parts not named are held at their value).
 
     Parameters
     ----------
-    parts : SallenKeyParts
-        The parts.
-    r_tol, c_tol : float
-        The resistors' and capacitors' tolerances (fractions).
+    topology : designer.filters.topology.Topology
+        The section.
+    tolerances : dict
+        ``"R"``/``"C"`` -> fraction, or designator -> fraction.
+
+    Returns
+    -------
+    dict
+        Designator -> fraction, in the section's declared order, for the parts that vary.
+    """
+    by_kind = set(tolerances) <= {"R", "C"}
+    return {p.ref: float(tolerances[p.kind] if by_kind else tolerances[p.ref]) for p in topology.parts
+            if (p.kind if by_kind else p.ref) in tolerances}
+
+
+def tolerance_band(topology, values: dict, tolerances: dict, t_end: float) -> ToleranceBand:
+    """Min and max of fn, zeta and the step metrics over the tolerance corners of a section
+    (every varying part at -/+ its tolerance: 2^n corners, the parts in the section's declared
+    order, the last part's sign the fastest; ideal op-amp), for the scope readings.
+
+    fn and zeta are the section's ideal pair (:meth:`~designer.filters.topology.Topology.ideal_pair`;
+    a band-pass's centre and 1/(2 Q)); the step metrics are a low-pass's (a high- or band-pass's
+    step settles to 0: their bands are empty, the envelope of the steps is still drawn).
+
+    Parameters
+    ----------
+    topology : designer.filters.topology.Topology
+        The section.
+    values : dict
+        Designator -> value (ohm, farad), every declared part.
+    tolerances : dict
+        Per part kind (``{"R": r_tol, "C": c_tol}``) or per designator (fractions); a designator
+        not named is held (the Sallen-Key plant's band varies its RC network, not its gain pair).
     t_end : float
         The step response's span (s).
 
@@ -159,21 +186,31 @@ def tolerance_band(parts: SallenKeyParts, r_tol: float, c_tol: float, t_end: flo
     ToleranceBand
         The extremes and the band of step responses.
     """
+    tol = corner_tolerances(topology, tolerances)
     t = dense_time(t_end, 8001)
     rows = []
     lo = hi = None
-    for s in itertools.product((-1, 1), repeat=4):
-        p = replace(parts, r1=parts.r1 * (1 + s[0] * r_tol), r2=parts.r2 * (1 + s[1] * r_tol),
-                    c1=parts.c1 * (1 + s[2] * c_tol), c2=parts.c2 * (1 + s[3] * c_tol))
-        y = step_response(*plant_tf(p), t)
+    for signs in itertools.product((-1, 1), repeat=len(tol)):
+        v = dict(values)
+        for (ref, x), sign in zip(tol.items(), signs):
+            v[ref] = values[ref] * (1 + sign * x)
+        num, den = (np.asarray(c, float) for c in topology.coefficients(v))
+        num = np.trim_zeros(num, "f") if np.any(num) else num
+        y = step_response(num, den, t)
         lo = y if lo is None else np.minimum(lo, y)
         hi = y if hi is None else np.maximum(hi, y)
-        m = step_metrics(t, y, final=p.gain)
-        rows.append((p.fn_hz, p.zeta, m.overshoot_pct, m.peak_time_s, m.rise_time_s, m.settling_time_s))
+        fn, zeta = topology.ideal_pair(v)
+        if topology.kind == "lowpass":
+            m = step_metrics(t, y, final=float(num[-1] / den[-1]))
+            rows.append((fn, zeta, m.overshoot_pct, m.peak_time_s, m.rise_time_s, m.settling_time_s))
+        else:
+            rows.append((fn, zeta, None, None, None, None))
     bands = []
     for column in zip(*rows):
         vals = [v for v in column if v is not None and not math.isnan(v)]
         bands.append(Band(min(vals), max(vals)) if vals else Band(None, None))
+    r_tol = max((x for ref, x in tol.items() if ref[0] == "R"), default=0.0)
+    c_tol = max((x for ref, x in tol.items() if ref[0] == "C"), default=0.0)
     return ToleranceBand(*bands, r_tolerance_pct=100 * r_tol, c_tolerance_pct=100 * c_tol, t_s=t, lo=lo, hi=hi)
 
 
