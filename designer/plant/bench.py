@@ -394,12 +394,21 @@ class SineCheck:
     h_spice: np.ndarray | None = None
     no_peak: str | None = None          #: why the model shows no peak (None: it does)
     spice_no_peak: str | None = None    #: why SPICE's .ac shows none (None: it does, or not simulated)
+    #: the response read: a low-pass's gain against DC (the Sallen-Key plant's), a high-pass's against its
+    #: high-frequency gain (``dc_gain`` is then that passband gain), a band-pass's at its centre (``f_peak_hz``,
+    #: ``peak_gain`` and ``dc_gain`` the centre's; ``f_3db_hz`` the upper -3 dB point, ``f_3db_low_hz`` the lower)
+    kind: str = "lowpass"
+    f_3db_low_hz: float | None = None
+    spice_f_3db_low_hz: float | None = None
 
     def to_dict(self) -> dict:
-        return {"amplitude_v": self.amplitude_v, "dc_gain": self.dc_gain, "f_peak_hz": self.f_peak_hz,
-                "peak_gain": self.peak_gain, "no_peak_reason": self.no_peak, "f_3db_hz": self.f_3db_hz,
-                "spice_f_peak_hz": self.spice_f_peak_hz, "spice_peak_gain": self.spice_peak_gain,
-                "spice_no_peak_reason": self.spice_no_peak, "spice_f_3db_hz": self.spice_f_3db_hz}
+        out = {"amplitude_v": self.amplitude_v, "dc_gain": self.dc_gain, "f_peak_hz": self.f_peak_hz,
+               "peak_gain": self.peak_gain, "no_peak_reason": self.no_peak, "f_3db_hz": self.f_3db_hz,
+               "spice_f_peak_hz": self.spice_f_peak_hz, "spice_peak_gain": self.spice_peak_gain,
+               "spice_no_peak_reason": self.spice_no_peak, "spice_f_3db_hz": self.spice_f_3db_hz}
+        if self.kind != "lowpass":   # a section's high- or band-pass: the keys a low-pass's JSON never had
+            out.update(kind=self.kind, f_3db_low_hz=self.f_3db_low_hz, spice_f_3db_low_hz=self.spice_f_3db_low_hz)
+        return out
 
 
 #: the damping at and above which a second-order low-pass has no resonance peak (Mr = 1 there)
@@ -462,37 +471,89 @@ def peak_and_corner(f, h) -> tuple:
     return fp, gp, f3
 
 
-def sine_check(num, den, opamp: OpAmp, amplitude_v: float, fn_hz: float, spice=None) -> SineCheck:
+def centre_and_corners(f, h) -> tuple:
+    """(f_centre, |H| there, f_-3dB low, f_-3dB high) of a band-pass's sampled response ``h`` on ``f``
+    (ascending): the centre refined by a parabola in log f, as :func:`peak_and_corner` refines a peak,
+    and the -3 dB points where |H| falls below the centre's gain over sqrt(2) on either side (None
+    where the sweep does not reach it).
+
+    Parameters
+    ----------
+    f : array_like
+        The frequencies (Hz), ascending.
+    h : array_like
+        The complex response on them.
+
+    Returns
+    -------
+    tuple
+        (f_centre, gain at the centre, f_low, f_high).
+    """
+    f = np.asarray(f, float)
+    mag = np.abs(np.asarray(h))
+    i = int(np.argmax(mag))
+    fc, gc = float(f[i]), float(mag[i])
+    if 0 < i < mag.size - 1:
+        x = np.log(f[i - 1:i + 2])
+        c = np.polyfit(x - x[1], mag[i - 1:i + 2], 2)
+        dx = float(np.clip(-c[1] / (2 * c[0]), x[0] - x[1], x[2] - x[1])) if c[0] < 0 else 0.0
+        fc, gc = float(f[i] * math.exp(dx)), float(np.polyval(c, dx))
+    # each side as a low-pass read from the centre outwards: peak_and_corner's -3 dB interpolation
+    low = peak_and_corner(f[:i + 1][::-1], np.concatenate(([gc], mag[:i][::-1])))[2] if i else None
+    high = peak_and_corner(f[i:], np.concatenate(([gc], mag[i + 1:])))[2]
+    return fc, gc, low, high
+
+
+def sine_check(num, den, opamp: OpAmp, amplitude_v: float, fn_hz: float, spice=None, kind: str = "lowpass",
+               zeta: float | None = None) -> SineCheck:
     """The sine check of a plant model (num, den) with natural frequency ``fn_hz``:
     the sweep fn/100 .. 100 fn (the ``.ac`` deck's), its peak and -3 dB point, and
     the generator amplitude: half the square wave's, lowered (1-2-5 steps) until
     the peak output stays inside the op-amp's swing and needs at most half its slew
-    rate. ``spice``: (f, complex H) of the ``.ac`` run."""
+    rate. ``spice``: (f, complex H) of the ``.ac`` run.
+
+    A high-pass is read as a low-pass in 1/f (its gain against the high-frequency end, its peak
+    and -3 dB point found going down from there: the same rule, mirrored); a band-pass at its
+    centre, where a sine comes through largest (its gain there and the -3 dB points either side:
+    a band-pass has no DC gain to read a resonance against, its centre is its passband).
+    ``zeta``: the damping the no-peak rule reads (None: the dominant pair of ``den``; a
+    first-order section passes 1, the critically damped pair of its pole).
+    """
     from ..core.lti import freq_response
     f = np.logspace(math.log10(fn_hz / 100), math.log10(fn_hz * 100), 1201)
     h = freq_response(num, den, f)
-    fp, gp, f3 = peak_and_corner(f, h)
-    dc = float(abs(h[0]))
-    zeta = dominant_pair(den)[1]
-    why = no_peak_reason(zeta, gp, dc)
-    if why is not None:
-        fp = gp = None
     top = float(np.max(np.abs(h)))
+    zeta = dominant_pair(den)[1] if zeta is None else zeta
+
+    def read(fs, hs):
+        """(f_peak, peak gain, f_-3dB, f_-3dB low, why no peak, reference gain) of one sweep."""
+        fs, mag = np.asarray(fs, float), np.abs(np.asarray(hs))
+        if kind == "bandpass":
+            fc, gc, lo3, hi3 = centre_and_corners(fs, hs)
+            return fc, gc, hi3, lo3, None, gc
+        if kind == "highpass":
+            fs, hs, mag = fs[::-1], np.asarray(hs)[::-1], mag[::-1]
+        fp, gp, f3 = peak_and_corner(fs, hs)
+        why = no_peak_reason(zeta, gp, float(mag[0]))
+        if why is not None:
+            fp = gp = None
+        return fp, gp, f3, None, why, float(mag[0])
+
+    fp, gp, f3, f3_low, why, dc = read(f, h)
     amp = amplitude_v / 2
     if not opamp.ideal:
         fmax = fp or fn_hz
         amp = min(amp, 0.9 * opamp.vout_max / top, 0.5 * opamp.slew_v_per_s / (2 * math.pi * fmax * top))
     amp = _one_two_five_below(amp)
     if spice is None:
-        return SineCheck(amp, dc, fp, gp, f3, f_hz=f, h_model=h, no_peak=why)
+        return SineCheck(amp, dc, fp, gp, f3, f_hz=f, h_model=h, no_peak=why, kind=kind, f_3db_low_hz=f3_low)
     fs, hs = spice
-    sfp, sgp, sf3 = peak_and_corner(fs, hs)
-    # SPICE's own DC gain (its sweep's first point, fn/100): the rise is judged against what it starts from
-    spice_why = no_peak_reason(zeta, sgp, float(np.abs(np.asarray(hs))[0]))
-    if spice_why is not None:
-        sfp = sgp = None
+    # SPICE's own reference gain (its sweep's first point, fn/100, for a low-pass): the rise is judged against
+    # what it starts from
+    sfp, sgp, sf3, sf3_low, spice_why, _ = read(fs, hs)
     return SineCheck(amp, dc, fp, gp, f3, sfp, sgp, sf3, f, h, np.asarray(fs, float), np.asarray(hs),
-                     no_peak=why, spice_no_peak=spice_why)
+                     no_peak=why, spice_no_peak=spice_why, kind=kind, f_3db_low_hz=f3_low,
+                     spice_f_3db_low_hz=sf3_low)
 
 
 def _one_two_five_below(x: float) -> float:
