@@ -21,7 +21,7 @@ import numpy as np
 
 from ..core.checks import Check
 from ..core.compare import resample
-from ..core.i18n import N_
+from ..core.i18n import N_, Message
 from ..core.lti import dense_time, dominant_pair, step_response
 from ..core.metrics import step_metrics
 from ..core.opamps import OpAmp
@@ -436,10 +436,12 @@ def no_peak_reason(zeta: float, peak_gain, dc_gain: float) -> str | None:
         "no resonance peak (zeta >= 0.707)", or, for a rise under :data:`PEAK_MIN_DB`,
         the same with the damping; None for a peak of at least :data:`PEAK_MIN_DB`.
     """
+    # a Message: the English text (result.json's), shown on a sheet in its language
     if zeta >= ZETA_NO_PEAK:
-        return "no resonance peak (zeta >= 0.707)"
+        return Message(N_("no resonance peak (zeta >= 0.707)"))
     if peak_gain is None or 20 * math.log10(peak_gain / dc_gain) < PEAK_MIN_DB:
-        return f"no resonance peak (zeta {zeta:.4g}, near 0.707: under {PEAK_MIN_DB:g} dB)"
+        return Message(N_("no resonance peak (zeta {zeta}, near 0.707: under {db} dB)"), zeta=f"{zeta:.4g}",
+                       db=f"{PEAK_MIN_DB:g}")
     return None
 
 
@@ -499,7 +501,9 @@ def centre_and_corners(f, h) -> tuple:
         dx = float(np.clip(-c[1] / (2 * c[0]), x[0] - x[1], x[2] - x[1])) if c[0] < 0 else 0.0
         fc, gc = float(f[i] * math.exp(dx)), float(np.polyval(c, dx))
     # each side as a low-pass read from the centre outwards: peak_and_corner's -3 dB interpolation
-    low = peak_and_corner(f[:i + 1][::-1], np.concatenate(([gc], mag[:i][::-1])))[2] if i else None
+    # (the lower side in 1/f, ascending, its corner mapped back)
+    low = peak_and_corner(1 / f[:i + 1][::-1], np.concatenate(([gc], mag[:i][::-1])))[2] if i else None
+    low = None if low is None else 1 / low
     high = peak_and_corner(f[i:], np.concatenate(([gc], mag[i + 1:])))[2]
     return fc, gc, low, high
 
@@ -532,12 +536,18 @@ def sine_check(num, den, opamp: OpAmp, amplitude_v: float, fn_hz: float, spice=N
             fc, gc, lo3, hi3 = centre_and_corners(fs, hs)
             return fc, gc, hi3, lo3, None, gc
         if kind == "highpass":
-            fs, hs, mag = fs[::-1], np.asarray(hs)[::-1], mag[::-1]
-        fp, gp, f3 = peak_and_corner(fs, hs)
-        why = no_peak_reason(zeta, gp, float(mag[0]))
+            # a low-pass in 1/f (ascending), its frequencies mapped back: the parabola and the interpolation
+            # in log(1/f) = -log f are the low-pass's, mirrored
+            fp, gp, f3 = peak_and_corner(1 / fs[::-1], np.asarray(hs)[::-1])
+            fp, f3 = (None if x is None else 1 / x for x in (fp, f3))
+            ref = float(mag[-1])
+        else:
+            fp, gp, f3 = peak_and_corner(fs, hs)
+            ref = float(mag[0])
+        why = no_peak_reason(zeta, gp, ref)
         if why is not None:
             fp = gp = None
-        return fp, gp, f3, None, why, float(mag[0])
+        return fp, gp, f3, None, why, ref
 
     fp, gp, f3, f3_low, why, dc = read(f, h)
     amp = amplitude_v / 2

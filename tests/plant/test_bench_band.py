@@ -13,6 +13,8 @@ import numpy as np
 import pytest
 import scipy.signal as sig
 
+from designer.core import eseries
+
 from designer.core.lti import dense_time, step_response
 from designer.core.metrics import step_metrics
 from designer.filters import REGISTRY
@@ -131,3 +133,110 @@ def test_per_designator_tolerances_hold_the_parts_not_named():
     fns = [topology.ideal_pair({**values, "R1": values["R1"] * (1 + s * 0.05)})[0] for s in (-1, 1)]
     assert (band.fn_hz.lo, band.fn_hz.hi) == (min(fns), max(fns))
     assert band.c_tolerance_pct == 0.0
+
+
+# ---- the sine check of a high- and a band-pass (closed forms), and the section plant's bench ---------------
+
+def test_a_high_pass_sine_check_is_the_low_pass_mirrored():
+    """H = s^2 / (s^2 + 2 zeta wn s + wn^2): the peak Mr = 1/(2 zeta sqrt(1 - zeta^2)) at fn / sqrt(1 - 2 zeta^2)
+    (the low-pass's, f -> fn^2 / f), the gain read against the high-frequency end; Butterworth's -3 dB at fn."""
+    from designer.core.opamps import get as get_opamp
+    from designer.plant.bench import sine_check
+    ideal = get_opamp("ideal")
+    fn = 1e3
+    wn = 2 * math.pi * fn
+    zeta = 0.3
+    s = sine_check([1.0, 0.0, 0.0], [1.0, 2 * zeta * wn, wn ** 2], ideal, 2.0, fn, kind="highpass")
+    assert s.f_peak_hz == pytest.approx(fn / math.sqrt(1 - 2 * zeta ** 2), rel=1e-3)
+    assert s.peak_gain / s.dc_gain == pytest.approx(1 / (2 * zeta * math.sqrt(1 - zeta ** 2)), rel=1e-4)
+    assert s.dc_gain == pytest.approx(1.0, rel=1e-3) and s.f_3db_hz < fn
+    assert s.to_dict()["kind"] == "highpass"
+    b = sine_check([1.0, 0.0, 0.0], [1.0, math.sqrt(2) * wn, wn ** 2], ideal, 2.0, fn, kind="highpass")
+    assert b.f_peak_hz is None and b.no_peak == "no resonance peak (zeta >= 0.707)"
+    assert b.f_3db_hz == pytest.approx(fn, rel=1e-4)
+
+
+def test_a_band_pass_sine_check_is_read_at_its_centre():
+    """H = K (wn/Q) s / (s^2 + (wn/Q) s + wn^2): the centre fn with gain K, the -3 dB points
+    fn (sqrt(1 + 1/(4 Q^2)) -/+ 1/(2 Q))."""
+    from designer.core.opamps import get as get_opamp
+    from designer.plant.bench import sine_check
+    fn, q, k = 1e3, 5.0, 4.0
+    wn = 2 * math.pi * fn
+    s = sine_check([0.0, k * wn / q, 0.0], [1.0, wn / q, wn ** 2], get_opamp("ideal"), 2.0, fn, kind="bandpass")
+    assert s.f_peak_hz == pytest.approx(fn, rel=1e-4) and s.peak_gain == pytest.approx(k, rel=1e-5)
+    root = math.sqrt(1 + 1 / (4 * q * q))
+    assert s.f_3db_low_hz == pytest.approx(fn * (root - 1 / (2 * q)), rel=1e-4)
+    assert s.f_3db_hz == pytest.approx(fn * (root + 1 / (2 * q)), rel=1e-4)
+    assert s.no_peak is None
+
+
+def _section_plant(name, simulate=False):
+    from designer.plant.circuit_design import design_circuit_plant
+    from designer.plant.spec import PlantSpec
+    topology = REGISTRY[name]
+    ex = topology.example
+    return design_circuit_plant(PlantSpec(fc_hz=ex.fn_hz, zeta=None if ex.q is None else 1 / (2 * ex.q),
+                                          gain=ex.gain, opamp="TL072", topology=name), simulate=simulate)
+
+
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_a_section_plant_has_the_bench_in_its_json(topology):
+    """The new keys (test_signal, tolerance_band, scope, sine_check) beside the old ones; the band is the bench
+    function's over every declared part at its series' tolerance; CH2 holds the op-amp-aware step's swing."""
+    from designer.plant.circuit import opamp_tf
+    r = _section_plant(topology.name)
+    d = r.to_dict()
+    assert {"test_signal", "tolerance_band", "scope", "sine_check"} <= set(d)
+    tol = {"R": eseries.TOLERANCE[r.sourcing.r_series], "C": eseries.TOLERANCE[r.sourcing.c_series]}
+    band = tolerance_band(topology, r.values, tol, r.tolerance.t_s[-1])
+    same_bits(band, r.tolerance)
+    assert d["tolerance_band"]["fn_hz"]["min"] < r.figures["ideal"]["fn_hz"] < d["tolerance_band"]["fn_hz"]["max"]
+    num, den = (np.asarray(c, float) for c in opamp_tf(topology, r.values, r.opamp))
+    y = sig.step((num[int(np.argmax(np.abs(num) > 0)):], den), T=np.linspace(0, 40 * r.tolerance.t_s[-1], 40001))[1]
+    ch2 = r.scope.channels[1]
+    a = r.amplitude_v
+    # the extremes read on the bench's grid: within 0.1 % of the swing of scipy's on its own grid
+    swing = a * (y.max() - min(y.min(), 0.0))
+    assert ch2.lo_v <= a * min(y.min(), 0.0) + 1e-3 * swing and ch2.hi_v >= a * y.max() - 1e-3 * swing
+    assert 6 * ch2.volts_per_div >= ch2.hi_v - ch2.lo_v
+    assert d["sine_check"]["amplitude_v"] > 0
+    if topology.kind != "lowpass":
+        assert d["sine_check"]["kind"] == topology.kind
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("name", ["mfb-bandpass", "sallen-key-highpass"])
+def test_a_section_plant_s_sine_check_measures_spice_s_ac(name):
+    """Simulated, the sine check's SPICE figures come from ngspice's .ac (fn/100 .. 100 fn) and agree with the
+    op-amp-aware model's (the section plant's own rule, 0.05 dB: a -3 dB point within 0.5 %)."""
+    r = _section_plant(name, simulate=True)
+    s = r.sine
+    # (the deck writes the sweep's ends to six digits)
+    assert s.spice_f_hz[0] == pytest.approx(r.figures["ideal"]["fn_hz"] / 100, rel=1e-5)
+    assert s.spice_f_3db_hz == pytest.approx(s.f_3db_hz, rel=5e-3)
+    if name == "mfb-bandpass":
+        assert s.spice_f_peak_hz == pytest.approx(s.f_peak_hz, rel=5e-3)
+        assert s.spice_f_3db_low_hz == pytest.approx(s.f_3db_low_hz, rel=5e-3)
+
+
+@pytest.mark.parametrize("name", ["mfb-bandpass", "sallen-key-highpass", "mfb-lowpass"])
+def test_the_section_sheet_shows_the_bench_in_english_and_spanish(name):
+    """The sheet's bench section: the band's heading and the sine check in English, and in Spanish with no
+    English word left."""
+    from helpers import english_left, foreign, sheet_text_nodes, vocabulary
+
+    from designer.core.i18n import language
+    from designer.plant import circuit_report as rep
+    from designer.report.document import to_html
+    r = _section_plant(name)
+    with language("en"):
+        en = to_html(rep.title_of(r), rep.sections(r), {})
+    assert "Bench test: what the scope shows" in en and "band (R 5 %, C 10 %)" in en and "sine check" in en
+    if name == "mfb-bandpass":
+        assert "at the centre" in en
+    with language("es"):
+        es = to_html(rep.title_of(r), rep.sections(r), {})
+    english, _spanish = vocabulary()
+    assert english_left(es) == [] and foreign(sheet_text_nodes(es), english) == []
+    assert "Bench test" not in es and "banda (R 5 %, C 10 %)" in es
