@@ -3,6 +3,13 @@ section IV.9), the slew, swing and period checks for it, the band of the
 readings that part tolerances allow (worst case over the tolerance corners),
 the whole bench period as a scope would capture it, and the sine check.
 
+Written once against the :class:`~designer.filters.topology.Topology` (issue 26): the
+tolerance band takes a section, its values by designator and the tolerances per part kind
+or per part (its corners' fn and zeta the section's :meth:`~designer.filters.topology.Topology.ideal_pair`,
+their steps from its coefficients), so the Sallen-Key plant and a section plant
+(``design-plant --topology``) read the same band; the sine check takes any transfer function
+and the section's kind (a high-pass read as a low-pass in 1/f, a band-pass at its centre).
+
 The sine check's resonance peak: a second-order low-pass peaks only for
 zeta < 1/sqrt(2) = 0.707, by Mr = 1 / (2 zeta sqrt(1 - zeta^2)) at
 fn sqrt(1 - 2 zeta^2) (seed 000, eq 79; Ogata, *Modern Control Engineering*,

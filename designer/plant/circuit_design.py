@@ -7,7 +7,8 @@ given, the seed's procedure: the section's exact design from them rounded jointl
 sensitivities over the declared parts, the deck, BOM and wiring from the topology's
 netlist (:func:`designer.spice.deck.board`), and the ngspice ``.ac`` of that deck
 against the op-amp-aware model (the conformance's rule: 0.05 dB and 0.5 degrees over
-fn / 30 .. 30 fn). The seed's Sallen-Key low-pass keeps its own pipeline
+fn / 30 .. 30 fn), and the Sallen-Key plant's bench (:func:`with_bench`: the tolerance band,
+the sine check, the scope settings, :mod:`designer.plant.bench`). The seed's Sallen-Key low-pass keeps its own pipeline
 (:mod:`designer.plant.design`), byte for byte, its parts chosen through the same search entry (the
 section's fast path, :meth:`~designer.filters.topology.Topology.fast_search`), listing
 (:func:`designer.plant.circuit.listed`) and ``--compensate-gbw`` (:func:`designer.plant.circuit.compensate_gbw`):
@@ -194,13 +195,13 @@ class CircuitPlantResult:
             **({} if self.square is None else {"square_test": self.square.to_dict()}),
             "monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
             "worst_case": None if self.worst_case is None else self.worst_case.to_dict(),
-            # only with --stimulus prbs, before files (the Sallen-Key plant's JSON's place)
-            **({} if self.prbs is None else {"prbs": self.prbs.to_dict()}),
             # the bench (the Sallen-Key plant's): the square wave, the tolerance band, the scope, the sine check
             **({} if self.tolerance is None else {
                 "test_signal": self.test.to_dict(), "tolerance_band": self.tolerance.to_dict(),
                 "scope": None if self.scope is None else self.scope.to_dict(),
                 "sine_check": None if self.sine is None else self.sine.to_dict()}),
+            # only with --stimulus prbs, before files (the Sallen-Key plant's JSON's place)
+            **({} if self.prbs is None else {"prbs": self.prbs.to_dict()}),
             "files": self.files,
         })
 

@@ -2,7 +2,8 @@
 (:class:`~designer.plant.circuit_design.CircuitPlantResult`): the bill of materials
 and the wiring from the topology's netlist on the bench board
 (:func:`designer.spice.deck.board`, :mod:`designer.report.wiring`: topology-free), the
-target and what the build achieves, the SPICE agreement, the sensitivities over the
+target and what the build achieves, the bench (the generator and scope settings, the sine
+check, the readings' tolerance band and its plot, ``band.png``), the SPICE agreement, the sensitivities over the
 declared parts and the alternatives; rendered as the result is (nothing recomputed).
 The schematic is the filter cascade's drawing of one stage
 (:func:`designer.filters.report.draw_cascade`: any registered section), titled with
