@@ -763,6 +763,69 @@ class Topology(ABC):
             return d[-1] / d[0] / (2 * math.pi), 1.0
         return math.sqrt(d[-1] / d[0]) / (2 * math.pi), d[1] / (2 * math.sqrt(d[-1] * d[0]))
 
+    # ---- a section's own figures of sampled builds (the Monte Carlo's analytic engine) -----------------
+    def sample_figures(self, values: dict, opamp=None):
+        """Every figure of :data:`designer.plant.circuit.FIGURES` for arrays of sampled part values by
+        the section's own exact definitions, or None (the default): the generic ones
+        (:func:`designer.plant.circuit.circuit_figures`, the dominant pair's second-order step figures).
+        :func:`designer.plant.circuit.evaluate`, the Monte Carlo's and the worst case's chunk function,
+        takes these where a section has them (the Sallen-Key low-pass: its third-order model's exact step).
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value, numbers or arrays (one batch shape).
+        opamp : designer.core.opamps.OpAmp, optional
+            The op-amp (None or the ideal one: the ideal model); its gain-bandwidth may be an array
+            shaped as the batch.
+
+        Returns
+        -------
+        dict or None
+            Figure -> array shaped as the batch, or None.
+        """
+        return None
+
+    # ---- parameters besides the parts (a sensitivity table's extra rows) ------------------------
+    def sensitivity_parameters(self) -> tuple:
+        """Names of the section's parameters besides its declared parts and the op-amp that a
+        sensitivity table lists (:func:`designer.plant.circuit.sensitivities`): none by default;
+        a section whose gain K is set by a gain pair lists ``"K"`` (the seed's plant table's row).
+
+        Returns
+        -------
+        tuple of str
+            The names :meth:`with_parameter` takes.
+        """
+        return ()
+
+    def with_parameter(self, values: dict, name: str, factor) -> dict:
+        """``values`` moved so that parameter ``name`` (of :meth:`sensitivity_parameters`) is
+        ``factor`` times its value and nothing else of the section changes (K: the feedback
+        resistor of the gain pair moves, the RC network stays).
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value, numbers or arrays.
+        name : str
+            A name of :meth:`sensitivity_parameters`.
+        factor : float or ndarray
+            The relative change (1 + h).
+
+        Returns
+        -------
+        dict
+            Designator -> value.
+
+        Raises
+        ------
+        DesignError
+            ``name`` is not one of the section's parameters.
+        """
+        raise DesignError(f"parameter: {self.name} has no parameter {name!r}; it has "
+                          f"{', '.join(self.sensitivity_parameters()) or 'none'}", param="parameter")
+
     def figures(self, values: dict) -> Figures:
         """fn, Q and the passband gain magnitude from the ideal coefficients.
 
