@@ -11,18 +11,19 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    "circuit_report": ("bom", "sections", "title_of"),
+    "circuit_report": ("band_png", "bench_blocks", "bom", "sections", "title_of"),
     "circuit_prbs": ("band_edge_hz", "section_plan", "with_section_prbs"),
     "circuit_design": ("CircuitAnalysisSpec", "CircuitPlantResult", "GBW_MARGIN", "SPICE_DB", "SPICE_DEG",
                        "analyze_circuit_plant", "analyze_circuit_spec", "built_name", "check_circuit_parts",
                        "check_opamp_reach",
                        "design_circuit_plant", "tolerance_nominal", "SQUARE_NRMS_PASS", "SquareRun", "square_deck",
-                       "with_square_test", "default_square_hz"),
+                       "with_square_test", "default_square_hz", "with_bench"),
     "circuit": ("BAND_ERROR", "BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "OPAMP_PARAMETERS", "R_BAND", "candidate_set",
                 "capacitor_combinations", "circuit_figures", "corner_frequencies", "dominant_pairs", "evaluate", "listed",
                 "opamp_tf", "GBW_ROUNDS", "gbw_shift", "compensate_gbw", "plant_target", "rounded", "search",
                 "step_of_pair"),
-    "bench": ("PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",
+    "bench": ("PEAK_MIN_DB", "ScopeSetup", "channel", "corner_tolerances", "no_peak_reason", "recommend_square_wave",
+              "scope_setup",
               "tolerance_band"),
     "design": ("analyze_plant", "choose_parts", "design_plant"),
     "model": ("opamp_pair", "plant_model", "plant_tf", "plant_tf_opamp", "sensitivities"),

@@ -3,6 +3,13 @@ section IV.9), the slew, swing and period checks for it, the band of the
 readings that part tolerances allow (worst case over the tolerance corners),
 the whole bench period as a scope would capture it, and the sine check.
 
+Written once against the :class:`~designer.filters.topology.Topology` (issue 26): the
+tolerance band takes a section, its values by designator and the tolerances per part kind
+or per part (its corners' fn and zeta the section's :meth:`~designer.filters.topology.Topology.ideal_pair`,
+their steps from its coefficients), so the Sallen-Key plant and a section plant
+(``design-plant --topology``) read the same band; the sine check takes any transfer function
+and the section's kind (a high-pass read as a low-pass in 1/f, a band-pass at its centre).
+
 The sine check's resonance peak: a second-order low-pass peaks only for
 zeta < 1/sqrt(2) = 0.707, by Mr = 1 / (2 zeta sqrt(1 - zeta^2)) at
 fn sqrt(1 - 2 zeta^2) (seed 000, eq 79; Ogata, *Modern Control Engineering*,
@@ -15,22 +22,20 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
 from ..core.checks import Check
 from ..core.compare import resample
-from ..core.i18n import N_
+from ..core.i18n import N_, Message
 from ..core.lti import dense_time, dominant_pair, step_response
 from ..core.metrics import step_metrics
 from ..core.opamps import OpAmp
 from ..spice.deck import SquareTest
-from .model import plant_tf
-from .sallenkey import SallenKeyParts
 
 __all__ = ["PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",
-           "tolerance_band"]
+           "corner_tolerances", "tolerance_band"]
 
 
 def recommend_square_wave(settling_time_s: float, amplitude_v: float, frequency_hz=None,
@@ -141,16 +146,45 @@ class ToleranceBand:
         return out
 
 
-def tolerance_band(parts: SallenKeyParts, r_tol: float, c_tol: float, t_end: float) -> ToleranceBand:
-    """Min and max of fn, zeta and the step metrics over the 16 corners of
-    R1, R2, C1, C2 at +/- their tolerance (ideal op-amp), for the scope readings.
+def corner_tolerances(topology, tolerances: dict) -> dict:
+    """Each part's tolerance (fraction) from ``tolerances`` given per part kind (``{"R": 0.05, "C": 0.1}``)
+    or per designator (parts not named are held at their value).
 
     Parameters
     ----------
-    parts : SallenKeyParts
-        The parts.
-    r_tol, c_tol : float
-        The resistors' and capacitors' tolerances (fractions).
+    topology : designer.filters.topology.Topology
+        The section.
+    tolerances : dict
+        ``"R"``/``"C"`` -> fraction, or designator -> fraction.
+
+    Returns
+    -------
+    dict
+        Designator -> fraction, in the section's declared order, for the parts that vary.
+    """
+    by_kind = set(tolerances) <= {"R", "C"}
+    return {p.ref: float(tolerances[p.kind] if by_kind else tolerances[p.ref]) for p in topology.parts
+            if (p.kind if by_kind else p.ref) in tolerances}
+
+
+def tolerance_band(topology, values: dict, tolerances: dict, t_end: float) -> ToleranceBand:
+    """Min and max of fn, zeta and the step metrics over the tolerance corners of a section
+    (every varying part at -/+ its tolerance: 2^n corners, the parts in the section's declared
+    order, the last part's sign the fastest; ideal op-amp), for the scope readings.
+
+    fn and zeta are the section's ideal pair (:meth:`~designer.filters.topology.Topology.ideal_pair`;
+    a band-pass's centre and 1/(2 Q)); the step metrics are a low-pass's (a high- or band-pass's
+    step settles to 0: their bands are empty, the envelope of the steps is still drawn).
+
+    Parameters
+    ----------
+    topology : designer.filters.topology.Topology
+        The section.
+    values : dict
+        Designator -> value (ohm, farad), every declared part.
+    tolerances : dict
+        Per part kind (``{"R": r_tol, "C": c_tol}``) or per designator (fractions); a designator
+        not named is held (the Sallen-Key plant's band varies its RC network, not its gain pair).
     t_end : float
         The step response's span (s).
 
@@ -159,21 +193,31 @@ def tolerance_band(parts: SallenKeyParts, r_tol: float, c_tol: float, t_end: flo
     ToleranceBand
         The extremes and the band of step responses.
     """
+    tol = corner_tolerances(topology, tolerances)
     t = dense_time(t_end, 8001)
     rows = []
     lo = hi = None
-    for s in itertools.product((-1, 1), repeat=4):
-        p = replace(parts, r1=parts.r1 * (1 + s[0] * r_tol), r2=parts.r2 * (1 + s[1] * r_tol),
-                    c1=parts.c1 * (1 + s[2] * c_tol), c2=parts.c2 * (1 + s[3] * c_tol))
-        y = step_response(*plant_tf(p), t)
+    for signs in itertools.product((-1, 1), repeat=len(tol)):
+        v = dict(values)
+        for (ref, x), sign in zip(tol.items(), signs):
+            v[ref] = values[ref] * (1 + sign * x)
+        num, den = (np.asarray(c, float) for c in topology.coefficients(v))
+        num = np.trim_zeros(num, "f") if np.any(num) else num
+        y = step_response(num, den, t)
         lo = y if lo is None else np.minimum(lo, y)
         hi = y if hi is None else np.maximum(hi, y)
-        m = step_metrics(t, y, final=p.gain)
-        rows.append((p.fn_hz, p.zeta, m.overshoot_pct, m.peak_time_s, m.rise_time_s, m.settling_time_s))
+        fn, zeta = topology.ideal_pair(v)
+        if topology.kind == "lowpass":
+            m = step_metrics(t, y, final=float(num[-1] / den[-1]))
+            rows.append((fn, zeta, m.overshoot_pct, m.peak_time_s, m.rise_time_s, m.settling_time_s))
+        else:
+            rows.append((fn, zeta, None, None, None, None))
     bands = []
     for column in zip(*rows):
         vals = [v for v in column if v is not None and not math.isnan(v)]
         bands.append(Band(min(vals), max(vals)) if vals else Band(None, None))
+    r_tol = max((x for ref, x in tol.items() if ref[0] == "R"), default=0.0)
+    c_tol = max((x for ref, x in tol.items() if ref[0] == "C"), default=0.0)
     return ToleranceBand(*bands, r_tolerance_pct=100 * r_tol, c_tolerance_pct=100 * c_tol, t_s=t, lo=lo, hi=hi)
 
 
@@ -357,12 +401,21 @@ class SineCheck:
     h_spice: np.ndarray | None = None
     no_peak: str | None = None          #: why the model shows no peak (None: it does)
     spice_no_peak: str | None = None    #: why SPICE's .ac shows none (None: it does, or not simulated)
+    #: the response read: a low-pass's gain against DC (the Sallen-Key plant's), a high-pass's against its
+    #: high-frequency gain (``dc_gain`` is then that passband gain), a band-pass's at its centre (``f_peak_hz``,
+    #: ``peak_gain`` and ``dc_gain`` the centre's; ``f_3db_hz`` the upper -3 dB point, ``f_3db_low_hz`` the lower)
+    kind: str = "lowpass"
+    f_3db_low_hz: float | None = None
+    spice_f_3db_low_hz: float | None = None
 
     def to_dict(self) -> dict:
-        return {"amplitude_v": self.amplitude_v, "dc_gain": self.dc_gain, "f_peak_hz": self.f_peak_hz,
-                "peak_gain": self.peak_gain, "no_peak_reason": self.no_peak, "f_3db_hz": self.f_3db_hz,
-                "spice_f_peak_hz": self.spice_f_peak_hz, "spice_peak_gain": self.spice_peak_gain,
-                "spice_no_peak_reason": self.spice_no_peak, "spice_f_3db_hz": self.spice_f_3db_hz}
+        out = {"amplitude_v": self.amplitude_v, "dc_gain": self.dc_gain, "f_peak_hz": self.f_peak_hz,
+               "peak_gain": self.peak_gain, "no_peak_reason": self.no_peak, "f_3db_hz": self.f_3db_hz,
+               "spice_f_peak_hz": self.spice_f_peak_hz, "spice_peak_gain": self.spice_peak_gain,
+               "spice_no_peak_reason": self.spice_no_peak, "spice_f_3db_hz": self.spice_f_3db_hz}
+        if self.kind != "lowpass":   # a section's high- or band-pass: the keys a low-pass's JSON never had
+            out.update(kind=self.kind, f_3db_low_hz=self.f_3db_low_hz, spice_f_3db_low_hz=self.spice_f_3db_low_hz)
+        return out
 
 
 #: the damping at and above which a second-order low-pass has no resonance peak (Mr = 1 there)
@@ -390,10 +443,12 @@ def no_peak_reason(zeta: float, peak_gain, dc_gain: float) -> str | None:
         "no resonance peak (zeta >= 0.707)", or, for a rise under :data:`PEAK_MIN_DB`,
         the same with the damping; None for a peak of at least :data:`PEAK_MIN_DB`.
     """
+    # a Message: the English text (result.json's), shown on a sheet in its language
     if zeta >= ZETA_NO_PEAK:
-        return "no resonance peak (zeta >= 0.707)"
+        return Message(N_("no resonance peak (zeta >= 0.707)"))
     if peak_gain is None or 20 * math.log10(peak_gain / dc_gain) < PEAK_MIN_DB:
-        return f"no resonance peak (zeta {zeta:.4g}, near 0.707: under {PEAK_MIN_DB:g} dB)"
+        return Message(N_("no resonance peak (zeta {zeta}, near 0.707: under {db} dB)"), zeta=f"{zeta:.4g}",
+                       db=f"{PEAK_MIN_DB:g}")
     return None
 
 
@@ -425,37 +480,97 @@ def peak_and_corner(f, h) -> tuple:
     return fp, gp, f3
 
 
-def sine_check(num, den, opamp: OpAmp, amplitude_v: float, fn_hz: float, spice=None) -> SineCheck:
+def centre_and_corners(f, h) -> tuple:
+    """(f_centre, |H| there, f_-3dB low, f_-3dB high) of a band-pass's sampled response ``h`` on ``f``
+    (ascending): the centre refined by a parabola in log f, as :func:`peak_and_corner` refines a peak,
+    and the -3 dB points where |H| falls below the centre's gain over sqrt(2) on either side (None
+    where the sweep does not reach it).
+
+    Parameters
+    ----------
+    f : array_like
+        The frequencies (Hz), ascending.
+    h : array_like
+        The complex response on them.
+
+    Returns
+    -------
+    tuple
+        (f_centre, gain at the centre, f_low, f_high).
+    """
+    f = np.asarray(f, float)
+    mag = np.abs(np.asarray(h))
+    i = int(np.argmax(mag))
+    fc, gc = float(f[i]), float(mag[i])
+    if 0 < i < mag.size - 1:
+        x = np.log(f[i - 1:i + 2])
+        c = np.polyfit(x - x[1], mag[i - 1:i + 2], 2)
+        dx = float(np.clip(-c[1] / (2 * c[0]), x[0] - x[1], x[2] - x[1])) if c[0] < 0 else 0.0
+        fc, gc = float(f[i] * math.exp(dx)), float(np.polyval(c, dx))
+    # each side as a low-pass read from the centre outwards: peak_and_corner's -3 dB interpolation
+    # (the lower side in 1/f, ascending, its corner mapped back)
+    low = peak_and_corner(1 / f[:i + 1][::-1], np.concatenate(([gc], mag[:i][::-1])))[2] if i else None
+    low = None if low is None else 1 / low
+    high = peak_and_corner(f[i:], np.concatenate(([gc], mag[i + 1:])))[2]
+    return fc, gc, low, high
+
+
+def sine_check(num, den, opamp: OpAmp, amplitude_v: float, fn_hz: float, spice=None, kind: str = "lowpass",
+               zeta: float | None = None) -> SineCheck:
     """The sine check of a plant model (num, den) with natural frequency ``fn_hz``:
     the sweep fn/100 .. 100 fn (the ``.ac`` deck's), its peak and -3 dB point, and
     the generator amplitude: half the square wave's, lowered (1-2-5 steps) until
     the peak output stays inside the op-amp's swing and needs at most half its slew
-    rate. ``spice``: (f, complex H) of the ``.ac`` run."""
+    rate. ``spice``: (f, complex H) of the ``.ac`` run.
+
+    A high-pass is read as a low-pass in 1/f (its gain against the high-frequency end, its peak
+    and -3 dB point found going down from there: the same rule, mirrored); a band-pass at its
+    centre, where a sine comes through largest (its gain there and the -3 dB points either side:
+    a band-pass has no DC gain to read a resonance against, its centre is its passband).
+    ``zeta``: the damping the no-peak rule reads (None: the dominant pair of ``den``; a
+    first-order section passes 1, the critically damped pair of its pole).
+    """
     from ..core.lti import freq_response
     f = np.logspace(math.log10(fn_hz / 100), math.log10(fn_hz * 100), 1201)
     h = freq_response(num, den, f)
-    fp, gp, f3 = peak_and_corner(f, h)
-    dc = float(abs(h[0]))
-    zeta = dominant_pair(den)[1]
-    why = no_peak_reason(zeta, gp, dc)
-    if why is not None:
-        fp = gp = None
     top = float(np.max(np.abs(h)))
+    zeta = dominant_pair(den)[1] if zeta is None else zeta
+
+    def read(fs, hs):
+        """(f_peak, peak gain, f_-3dB, f_-3dB low, why no peak, reference gain) of one sweep."""
+        fs, mag = np.asarray(fs, float), np.abs(np.asarray(hs))
+        if kind == "bandpass":
+            fc, gc, lo3, hi3 = centre_and_corners(fs, hs)
+            return fc, gc, hi3, lo3, None, gc
+        if kind == "highpass":
+            # a low-pass in 1/f (ascending), its frequencies mapped back: the parabola and the interpolation
+            # in log(1/f) = -log f are the low-pass's, mirrored
+            fp, gp, f3 = peak_and_corner(1 / fs[::-1], np.asarray(hs)[::-1])
+            fp, f3 = (None if x is None else 1 / x for x in (fp, f3))
+            ref = float(mag[-1])
+        else:
+            fp, gp, f3 = peak_and_corner(fs, hs)
+            ref = float(mag[0])
+        why = no_peak_reason(zeta, gp, ref)
+        if why is not None:
+            fp = gp = None
+        return fp, gp, f3, None, why, ref
+
+    fp, gp, f3, f3_low, why, dc = read(f, h)
     amp = amplitude_v / 2
     if not opamp.ideal:
         fmax = fp or fn_hz
         amp = min(amp, 0.9 * opamp.vout_max / top, 0.5 * opamp.slew_v_per_s / (2 * math.pi * fmax * top))
     amp = _one_two_five_below(amp)
     if spice is None:
-        return SineCheck(amp, dc, fp, gp, f3, f_hz=f, h_model=h, no_peak=why)
+        return SineCheck(amp, dc, fp, gp, f3, f_hz=f, h_model=h, no_peak=why, kind=kind, f_3db_low_hz=f3_low)
     fs, hs = spice
-    sfp, sgp, sf3 = peak_and_corner(fs, hs)
-    # SPICE's own DC gain (its sweep's first point, fn/100): the rise is judged against what it starts from
-    spice_why = no_peak_reason(zeta, sgp, float(np.abs(np.asarray(hs))[0]))
-    if spice_why is not None:
-        sfp = sgp = None
+    # SPICE's own reference gain (its sweep's first point, fn/100, for a low-pass): the rise is judged against
+    # what it starts from
+    sfp, sgp, sf3, sf3_low, spice_why, _ = read(fs, hs)
     return SineCheck(amp, dc, fp, gp, f3, sfp, sgp, sf3, f, h, np.asarray(fs, float), np.asarray(hs),
-                     no_peak=why, spice_no_peak=spice_why)
+                     no_peak=why, spice_no_peak=spice_why, kind=kind, f_3db_low_hz=f3_low,
+                     spice_f_3db_low_hz=sf3_low)
 
 
 def _one_two_five_below(x: float) -> float:

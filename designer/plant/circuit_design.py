@@ -7,7 +7,8 @@ given, the seed's procedure: the section's exact design from them rounded jointl
 sensitivities over the declared parts, the deck, BOM and wiring from the topology's
 netlist (:func:`designer.spice.deck.board`), and the ngspice ``.ac`` of that deck
 against the op-amp-aware model (the conformance's rule: 0.05 dB and 0.5 degrees over
-fn / 30 .. 30 fn). The seed's Sallen-Key low-pass keeps its own pipeline
+fn / 30 .. 30 fn), and the Sallen-Key plant's bench (:func:`with_bench`: the tolerance band,
+the sine check, the scope settings, :mod:`designer.plant.bench`). The seed's Sallen-Key low-pass keeps its own pipeline
 (:mod:`designer.plant.design`), byte for byte, its parts chosen through the same search entry (the
 section's fast path, :meth:`~designer.filters.topology.Topology.fast_search`), listing
 (:func:`designer.plant.circuit.listed`) and ``--compensate-gbw`` (:func:`designer.plant.circuit.compensate_gbw`):
@@ -50,7 +51,7 @@ from .result import METRICS, PLANT_SCHEMA_VERSION, Sourcing, Target
 __all__ = ["GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "CircuitAnalysisSpec", "CircuitPlantResult", "design_circuit_plant",
            "check_opamp_reach", "analyze_circuit_plant", "analyze_circuit_spec", "check_circuit_parts",
            "tolerance_nominal", "built_name", "SQUARE_NRMS_PASS", "SquareRun", "square_deck", "with_square_test",
-           "default_square_hz"]
+           "default_square_hz", "with_bench"]
 
 #: the op-amp's gain-bandwidth a section needs, in units of fn x Q x noise gain
 GBW_MARGIN = 10.0
@@ -106,6 +107,14 @@ class CircuitPlantResult:
         The bench's high level (V): the square wave's and the PRBS's.
     prbs : designer.plant.prbs.PrbsRun or None
         The PRBS bench test (``--stimulus prbs``, :func:`designer.plant.circuit_prbs.with_section_prbs`).
+    test : designer.spice.deck.SquareTest or None
+        The bench's square wave (the square-wave test's, else the one recommended: :func:`with_bench`).
+    tolerance : designer.plant.bench.ToleranceBand or None
+        The readings' band over the parts' tolerance corners (:func:`designer.plant.bench.tolerance_band`).
+    sine : designer.plant.bench.SineCheck or None
+        The sine check of the op-amp-aware model (and of SPICE's ``.ac`` when simulated).
+    scope : designer.plant.bench.ScopeSetup or None
+        The scope as set for the square wave.
     """
 
     topology: str
@@ -130,6 +139,10 @@ class CircuitPlantResult:
     worst_case: object = None
     amplitude_v: float = 2.0
     prbs: object = None
+    test: object = None
+    tolerance: object = None
+    sine: object = None
+    scope: object = None
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
 
@@ -182,6 +195,11 @@ class CircuitPlantResult:
             **({} if self.square is None else {"square_test": self.square.to_dict()}),
             "monte_carlo": None if self.monte_carlo is None else self.monte_carlo.to_dict(),
             "worst_case": None if self.worst_case is None else self.worst_case.to_dict(),
+            # the bench (the Sallen-Key plant's): the square wave, the tolerance band, the scope, the sine check
+            **({} if self.tolerance is None else {
+                "test_signal": self.test.to_dict(), "tolerance_band": self.tolerance.to_dict(),
+                "scope": None if self.scope is None else self.scope.to_dict(),
+                "sine_check": None if self.sine is None else self.sine.to_dict()}),
             # only with --stimulus prbs, before files (the Sallen-Key plant's JSON's place)
             **({} if self.prbs is None else {"prbs": self.prbs.to_dict()}),
             "files": self.files,
@@ -354,6 +372,68 @@ def _square(result, amplitude_v: float, square_hz, simulate: bool, simulator: st
         with_square_test(result, amplitude_v, square_hz, simulator)
     elif square_hz is not None:
         result.notes.append("--square-freq: the square-wave test is simulated; skipped with --no-sim")
+    return with_bench(result, square_hz, simulate, simulator)
+
+
+def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = False,
+               simulator: str = "ngspice-cli") -> CircuitPlantResult:
+    """``result`` with the Sallen-Key plant's bench (:mod:`designer.plant.bench`): the square wave (the
+    square-wave test's, else :func:`~designer.plant.bench.recommend_square_wave` from the op-amp-aware
+    model's 2 % settling time: a low-pass's step's, else its slowest pole's, :func:`default_square_hz`),
+    the tolerance band over every declared part at +/- its series' tolerance (the readings' span: the
+    rising half period, at most 4 response spans, as the Sallen-Key plant's), the scope as set for that
+    square wave (CH2 from the op-amp-aware step's extremes: a high- or band-pass's output jumps with the
+    edges and swings below 0 V on the falling one) and the sine check of the op-amp-aware model
+    (:func:`~designer.plant.bench.sine_check`; a band-pass at its centre, a high-pass against its
+    high-frequency gain), with, when ``simulate``, ngspice's ``.ac`` of the section over fn/100 .. 100 fn;
+    returned.
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design (its ``amplitude_v`` the bench's).
+    square_hz : float, optional
+        The square wave's frequency (None: the square-wave test's, else recommended).
+    simulate : bool
+        Run the sine check's ``.ac`` in ngspice.
+    simulator : str
+        :func:`designer.spice.simulate.get_simulator`'s name.
+
+    Returns
+    -------
+    CircuitPlantResult
+        ``result``.
+    """
+    from ..core.metrics import step_metrics as metrics
+    from ..filters.deck import simulate_ac as ac
+    from .bench import channel, recommend_square_wave, scope_setup, sine_check, tolerance_band
+    from ..core.eseries import TOLERANCE
+    topo, amp, a = result.section, result.opamp, result.amplitude_v
+    num_o, den_o = (np.asarray(c, float) for c in circuit.opamp_tf(topo, result.values, amp))
+    num_o = np.trim_zeros(num_o, "f") if np.any(num_o) else num_o
+    fig_i, fig_o = result.figures["ideal"], result.figures["opamp"]
+    span = response_span(min(fig_i["fn_hz"], fig_o["fn_hz"]), fig_o["zeta"] or 1.0)
+    t = dense_time(4 * span)
+    y = step_response(num_o, den_o, t)
+    final = float(num_o[-1] / den_o[-1])
+    settling = (metrics(t, y, final=final).settling_time_s if topo.kind == "lowpass" else
+                slowest_settling_s(den_o))
+    if result.square is not None:
+        test = result.square.test
+    else:
+        test = recommend_square_wave(settling, a, square_hz, time_scale_s=1 / (2 * math.pi * fig_o["fn_hz"]))
+    r_tol, c_tol = (TOLERANCE[s] for s in (result.sourcing.r_series, result.sourcing.c_series))
+    result.test = test
+    result.tolerance = tolerance_band(topo, result.values, {"R": r_tol, "C": c_tol},
+                                      min(test.half_period_s, 4 * span))
+    # the output over the period, per volt: the rising edge's step s(t), the falling edge's s(inf) - s(t)
+    hi, lo = max(float(y.max()), final - float(y.min())), min(float(y.min()), final - float(y.max()), 0.0)
+    window = min(1.2 * settling, test.half_period_s) if math.isfinite(settling) else test.half_period_s
+    result.scope = scope_setup(window, a / 2, (channel("CH1", N_("generator (CH1)"), 0.0, a),
+                                               channel("CH2", N_("U1 output"), a * lo, a * hi)))
+    fn = fig_i["fn_hz"]
+    spice = ac(result.netlist, amp, fn / 100, fn * 100, simulator=simulator) if simulate else None
+    result.sine = sine_check(num_o, den_o, amp, a, fn, spice, kind=topo.kind, zeta=fig_o["zeta"] or 1.0)
     return result
 
 

@@ -2,7 +2,8 @@
 (:class:`~designer.plant.circuit_design.CircuitPlantResult`): the bill of materials
 and the wiring from the topology's netlist on the bench board
 (:func:`designer.spice.deck.board`, :mod:`designer.report.wiring`: topology-free), the
-target and what the build achieves, the SPICE agreement, the sensitivities over the
+target and what the build achieves, the bench (the generator and scope settings, the sine
+check, the readings' tolerance band and its plot, ``band.png``), the SPICE agreement, the sensitivities over the
 declared parts and the alternatives; rendered as the result is (nothing recomputed).
 The schematic is the filter cascade's drawing of one stage
 (:func:`designer.filters.report.draw_cascade`: any registered section), titled with
@@ -22,12 +23,13 @@ from ..report.bundle import write_design
 from ..report.tolerance import csv_texts
 from ..report.tolerance import histogram_plots
 from ..report.tolerance import section as tolerance_section
-from ..report.wiring import bom_csv, bom_rows, wiring_rows
+from ..report.wiring import bench_rows, bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
 from . import circuit
-from .report import prbs_blocks, prbs_png, prbs_texts
+from .report import METRIC_ROWS, prbs_blocks, prbs_png, prbs_texts, sine_text
 
-__all__ = ["title_of", "sections", "bom", "schematic", "summary_text", "write_outputs"]
+__all__ = ["title_of", "sections", "bom", "schematic", "summary_text", "write_outputs", "bench_blocks",
+           "band_png"]
 
 #: the schematic's width (drawing units) that holds the op-amp's output label
 OUTPUT_LABEL_ROOM = 31.0
@@ -113,6 +115,88 @@ def _targets(result) -> list:
     return out
 
 
+def _section_sine_text(sine) -> str:
+    """The sine check in one line: a low- or high-pass's as the Sallen-Key plant's sheet gives it (its gain read
+    against DC, or against the high-frequency end), a band-pass's at its centre."""
+    if sine.kind != "bandpass":
+        return sine_text(sine)
+    spice = sine.spice_f_peak_hz is not None
+    f, g = (sine.spice_f_peak_hz, sine.spice_peak_gain) if spice else (sine.f_peak_hz, sine.peak_gain)
+    lo, hi = (sine.spice_f_3db_low_hz, sine.spice_f_3db_hz) if spice else (sine.f_3db_low_hz, sine.f_3db_hz)
+    return _("sine {amplitude} pk at the centre {f}: gain x{gain}, -3 dB (x0.707) at {lo} and {hi}").format(
+        amplitude=format_eng(sine.amplitude_v, 'V'), f=format_eng(f, 'Hz', 3), gain=f"{g:.3g}",
+        lo=_f(lo, "Hz"), hi=_f(hi, "Hz"))
+
+
+def bench_blocks(result, with_images: bool = False) -> list:
+    """The bench: the generator and the scope as set, the sine check, and the readings' band over the parts'
+    tolerance corners (a low-pass's step readings; fn and zeta for every kind), the band's plot with images.
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design (its ``tolerance``, ``scope``, ``sine`` and ``test``).
+    with_images : bool
+        Include the band's plot (``band.png``).
+
+    Returns
+    -------
+    list
+        Blocks (:mod:`designer.report.document`); empty when the result has no bench.
+    """
+    tol = result.tolerance
+    if tol is None:
+        return []
+    into = next(p.ref for p in result.section.netlist(result.values).parts if "vin" in (p.a, p.b))
+    rows = bench_rows(result.test, result.scope, into)
+    if result.sine is not None:
+        rows.append([_("sine check"), _section_sine_text(result.sine)])
+    fo = result.figures["opamp"]
+    readings = [["fn", _f(fo["fn_hz"], "Hz"), f"{_f(tol.fn_hz.lo, 'Hz')} .. {_f(tol.fn_hz.hi, 'Hz')}"]]
+    if result.section.order == 2:
+        readings.append(["zeta", _n(fo["zeta"]), f"{_n(tol.zeta.lo)} .. {_n(tol.zeta.hi)}"])
+    step = result.steps["opamp"]
+    if step is not None:
+        for key, label, f in METRIC_ROWS:
+            band = getattr(tol, key)
+            readings.append([_(label), f(step.get(key)), f"{f(band.lo)} .. {f(band.hi)}"])
+    head = _("band (R {r} %, C {c} %)").format(r=f"{tol.r_tolerance_pct:g}", c=f"{tol.c_tolerance_pct:g}")
+    image = [R.image("band.png", head)] if with_images else []
+    return [R.subhead(_("Generator and scope")), R.table([_("set"), _("to")], rows, "compact"),
+            R.table([_("reading (rising edge)"), _("expected ({opamp} model)").format(opamp=result.opamp.name), head],
+                    readings), *image]
+
+
+def band_png(result) -> bytes:
+    """The bench's square-wave step (the op-amp-aware model's, and the ideal one's) with the tolerance band shaded.
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design (its ``tolerance`` and ``test``).
+
+    Returns
+    -------
+    bytes
+        The PNG.
+    """
+    import numpy as np
+
+    from ..core.lti import step_response
+    from ..report.plots import step_plot
+    tol, a = result.tolerance, result.test.amplitude_v
+    curves = {}
+    for label, (num, den) in ((_("analytic ({opamp} model)").format(opamp=result.opamp.name),
+                               circuit.opamp_tf(result.section, result.values, result.opamp)),
+                              (N_("analytic (ideal op-amp)"), result.section.coefficients(result.values))):
+        num = np.asarray(num, float)
+        curves[label] = a * step_response(np.trim_zeros(num, "f") if np.any(num) else num, np.asarray(den, float),
+                                          tol.t_s)
+    band = (tol.t_s, tol.lo * a, tol.hi * a, _("tolerance band (R {r} %, C {c} %)").format(
+        r=f"{tol.r_tolerance_pct:g}", c=f"{tol.c_tolerance_pct:g}"))
+    return step_plot(tol.t_s, curves, _("Step response, 0 -> {v} V").format(v=f"{a:g}"), band=band)
+
+
 def sections(result, with_images: bool = False, schematic_svg: str = "") -> list:
     """The build sheet as (heading, blocks) sections (:mod:`designer.report.document`).
 
@@ -140,6 +224,8 @@ def sections(result, with_images: bool = False, schematic_svg: str = "") -> list
                                   wiring_rows(b, NET_LABELS, (result.opamp.vcc, result.opamp.vee)))]),
            *prbs,
            (_("Target and achieved"), _targets(result)),
+           *([(_("Bench test: what the scope shows"), bench_blocks(result, with_images))]
+             if result.tolerance is not None else []),
            (_("Checks"), [R.table([_("check"), _("result"), _("detail")],
                                   [[_(c.title), _("ok") if c.ok else _("FAILED"), c.shown()] for c in result.checks])]),
            (_("Sensitivity"), [R.table([_("part"), _("S wn (ideal)"), _("S zeta (ideal)"), _("S wn (op-amp)"),
@@ -249,7 +335,8 @@ def write_outputs(result, out_dir, name: str, lang: str | None = None) -> dict:
                       "waveforms_csv": ("waveforms.csv", lambda r: r.square.csv_text())})
     # --stimulus prbs: the generator's files, its deck, and waveforms.csv becomes its run (as the Sallen-Key plant's)
     texts.update(prbs_texts(result))
-    plots = ([("prbs.png", prbs_png)] if result.prbs is not None else []) + list(histogram_plots(result))
+    plots = ([("prbs.png", prbs_png)] if result.prbs is not None else []) + list(histogram_plots(result)) + \
+        ([("band.png", band_png)] if result.tolerance is not None else [])
     with language(lang):
         return write_design(result, out_dir, name, plots, schematic, lambda svg: sections(result, True, svg),
                             title_of(result), texts)

@@ -403,8 +403,12 @@ def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternati
                      y_iw * amplitude_v)
     analytic_opamp = Model(num_o, den_o, Figures.against(fn_o, z_o, target), m_o, sensitivities(built, amp),
                            y_ow * amplitude_v)
-    tolerance = tolerance_band(built, eseries.TOLERANCE[sourcing.r_series], eseries.TOLERANCE[sourcing.c_series],
-                               tw[-1])
+    # the band over the RC network's corners (R1 R2 C1 C2; the gain pair held, as the seed's band)
+    r_tol, c_tol = eseries.TOLERANCE[sourcing.r_series], eseries.TOLERANCE[sourcing.c_series]
+    section = section_of(built)
+    tolerance = tolerance_band(section, part_values(built), {r: r_tol if r[0] == "R" else c_tol
+                                                             for r in section.designators
+                                                             if r not in section.choice_parts}, tw[-1])
     timings = {"analytic_s": time.perf_counter() - tick}
     tick = time.perf_counter()
     deck = plant_deck(built, amp, test, _title(built, amp))

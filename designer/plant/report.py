@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from ..core.i18n import N_, language
+from ..core.i18n import N_, language, translated
 from ..core.i18n import gettext as _
 from ..filters.sallen_key_lowpass_parts import refs, section_of
 from ..core.units import format_eng
@@ -127,7 +127,7 @@ def sine_text(sine) -> str:
         f = sine.spice_f_peak_hz if sine.spice_f_peak_hz is not None else sine.f_peak_hz
         parts.append(_("peak x{gain} at {f}").format(gain=f"{g / sine.dc_gain:.3g}", f=format_eng(f, 'Hz', 3)))
     elif sine.no_peak:
-        parts.append(sine.no_peak)
+        parts.append(translated(sine.no_peak))
     f3 = sine.spice_f_3db_hz if sine.spice_f_3db_hz is not None else sine.f_3db_hz
     if f3 is not None:
         parts.append(_("-3 dB (x0.707) at {f}").format(f=format_eng(f3, 'Hz', 3)))
@@ -218,7 +218,7 @@ def prbs_blocks(result):
 
 def _fg(f, g, dc, why=None):
     if f is None or g is None:
-        return why or _("none (no peak)")
+        return translated(why) if why else _("none (no peak)")
     return _("x{gain} ({db} dB) at {f}").format(gain=f"{g / dc:.4g}", db=f"{20 * math.log10(g / dc):+.2f}",
                                                  f=format_eng(f, 'Hz', 4))
 

@@ -113,7 +113,9 @@ def test_the_bundle_shows_the_schematic(tmp_path):
     result = design_of(REGISTRY["mfb-lowpass"], opamp="LM741")
     files = write_outputs(result, tmp_path, "mfb")
     png = tmp_path / "reports" / "mfb" / "schematic.png"
-    assert files["plots"] == [str(png)] and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # the schematic, and the bench's tolerance band (band.png)
+    assert sorted(files["plots"]) == sorted([str(png), str(png.with_name("band.png"))])
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "schematic.png" in (tmp_path / "reports" / "mfb" / "build-sheet.md").read_text()
     assert "<svg" in (tmp_path / "reports" / "mfb" / "build-sheet.html").read_text()
     # the terminal summary is the sheet's text without the picture
