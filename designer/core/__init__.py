@@ -1,6 +1,6 @@
 """The domain-free floor every wing stands on: errors, units, E-series,
 op-amps, input ranges, files, LTI maths, waveforms, metrics, comparison,
-checks and JSON."""
+checks, JSON and the intervals of least-squares fits."""
 
 from .exports import lazy_exports
 
