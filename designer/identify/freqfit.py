@@ -145,9 +145,10 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     if m > n:
         s2 = 2.0 * best.cost / (m - n)
         try:
-            # the one rule of every fit (core.lsq_intervals): a pseudo-inverse on scaled columns when their
-            # norms span more than SCALE_SPAN, where inv() of the unscaled product gave a dead time's or a
-            # fading time constant's near-zero interval; a direction the data do not determine is unbounded
+            # the one rule of every fit (core.lsq_intervals): a pseudo-inverse, on scaled columns when their
+            # norms span more than SCALE_SPAN, and a direction the data do not determine unbounded, where
+            # inv() of the unscaled product gave a double pole fitted as two lags tau1 and tau2 +-0 (a
+            # negative variance of a singular product clipped to 0) and the fit stayed valid
             half = half_widths(best.jac, s2, m - n)
             # back from log variables: d(e^x) = e^x dx
             names = {"fopdt": ["K", "tau_s"], "underdamped": ["K", "wn_rad_s", "zeta"],

@@ -41,13 +41,13 @@ def test_a_column_1e8_shorter_keeps_its_interval():
 
 
 def test_central_differences_of_a_nonlinear_model_agree():
-    """A nonlinear model, a e^(-t/b) + c with c's effect made 1e6 times weaker than a's (c scaled by 1e-6
+    """A nonlinear model, a e^(-t/b) + c t with c's effect made 1e9 times weaker than a's (c scaled by 1e-9
     in the model): the half-widths from a central-difference Jacobian equal the QR route's on it."""
     t = np.linspace(0.0, 5.0, 300)
     rng = np.random.default_rng(3)
 
     def model(p):
-        return p[0] * np.exp(-t / p[1]) + 1e-6 * p[2] * t
+        return p[0] * np.exp(-t / p[1]) + 1e-9 * p[2] * t
 
     p = np.array([2.0, 0.7, 0.5])
     y = model(p) + 0.01 * rng.standard_normal(t.size)
@@ -68,7 +68,7 @@ def test_central_differences_of_a_nonlinear_model_agree():
 
 def test_columns_within_the_span_keep_the_unscaled_bits():
     """Columns within SCALE_SPAN of each other: the product every fit computed before, to the last bit."""
-    J = planted([1.0, 3e-3, 20.0, 2e-2])      # norms spanning 6.7e3
+    J = planted([1.0, 3e-5, 20.0, 2e-2])      # norms spanning 6.7e5
     s2, dof = 3e-5, J.shape[0] - 4
     old = stdtrit(dof, 0.975) * np.sqrt(np.clip(np.diag(np.linalg.pinv(J.T @ J) * s2), 0.0, None))
     np.testing.assert_array_equal(half_widths(J, s2, dof), old)
