@@ -157,11 +157,11 @@ def _speedups() -> dict:
     from designer.pid.spec import PidSpec
     from designer.plant.design import design_plant
     from designer.plant.spec import PlantSpec
-    from designer.tolerance import loop, spice_engine
+    from designer.tolerance import loop
     from designer.tolerance.montecarlo import apply_engine, plant_parts
     from designer.tolerance.parts import resolve
     from designer.tolerance.runner import Draw, Runner, Scale
-    from designer.tolerance.spice_mc import spice_evaluate
+    from designer.tolerance.spice_mc import plant_context, spice_evaluate
     series = {"R": "E24", "C": "E12"}
     res = design_pid(PidSpec(plant_fc_hz=3500, plant_zeta=0.2, tuning="optimize", target_overshoot_pct=10),
                      simulate=False)
@@ -171,8 +171,7 @@ def _speedups() -> dict:
     engines = {   # engine -> (chunk function, context, draw)
         "loop": (loop.evaluate, loop.LoopContext.of(res),
                  Draw(nominal, resolve((), nominal, series).of, SPEEDUP_BUILDS, 1)),
-        "spice": (apply_engine, spice_evaluate(spice_engine.context(plant.deck, plant.built, plant.opamp, plant.test,
-                                                              "ngspice-cli"), plant.opamp),
+        "spice": (apply_engine, spice_evaluate(plant_context(plant, "ngspice-cli"), plant.opamp),
                   Draw(p_nominal, resolve((), p_nominal, series).of, SPICE_SCALE_BUILDS, 1))}
     out = {}
     for name, (fn, ctx, draw) in engines.items():
@@ -329,13 +328,13 @@ def spice_section():
 
     from designer.plant.design import design_plant
     from designer.plant.spec import PlantSpec
-    from designer.tolerance import sampling, spice_engine
+    from designer.tolerance import sampling
     from designer.tolerance.montecarlo import plant_parts
-    from designer.tolerance.spice_mc import plant_monte_carlo_engine
+    from designer.tolerance.spice_mc import plant_context, plant_monte_carlo_engine
     res = design_plant(PlantSpec(fc_hz=3500, zeta=0.2), simulate=False)
     series, n = {"R": "E24", "C": "E12"}, SPICE_BUILDS
     values = sampling.values(plant_parts(res.built), {"R1": .05, "R2": .05, "C1": .1, "C2": .1}, n, 1)
-    ctx = spice_engine.context(res.deck, res.built, res.opamp, res.test)
+    ctx = plant_context(res)
     exe = shutil.which("ngspice")
 
     def floor():

@@ -38,6 +38,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "sallen_key": ("GAIN_PARTS", "SallenKeySection",),
     "sallen_key_highpass": ("SallenKeyHighPass",),
     "sallen_key_lowpass": ("SallenKeyLowPass", "sallen_key_ratio_min",),
+    "sallen_key_lowpass_figures": ("sample_figures",),
     "sallen_key_lowpass_parts": ("FIELD_OF", "REF_OF", "gain_of", "gain_refs", "network",
                                  "part_values", "parts_of", "record_of", "refs", "section_of",),
     "sallen_key_lowpass_search": ("Candidate", "around", "scored"),

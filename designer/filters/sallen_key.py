@@ -73,6 +73,15 @@ class SallenKeySection(Topology):
         """
         return 1.0 + v["R4"] / v["R3"] if self.with_gain else 1.0
 
+    def sensitivity_parameters(self) -> tuple:
+        return ("K",) if self.with_gain else ()
+
+    def with_parameter(self, values: dict, name: str, factor) -> dict:
+        if name not in self.sensitivity_parameters():
+            return super().with_parameter(values, name, factor)
+        # K = 1 + R4/R3 times factor with R3 kept: R4 = (K factor - 1) R3 (the network untouched)
+        return {**values, "R4": (self.gain_of(values) * factor - 1.0) * values["R3"]}
+
     def check_gain(self, target: SectionTarget) -> None:
         """Refuse a gain the amplifier cannot give: not 1 for the follower, not above 1 with gain.
 

@@ -60,6 +60,7 @@ from ..core.eseries import nearest_ratio_of
 from ..core.i18n import N_
 from ..spice.deck import GROUND, Netlist
 from .sallen_key import SallenKeySection
+from .sallen_key_lowpass_figures import sample_figures
 from .sallen_key_lowpass_search import around as near, joint_search
 from .sallen_key_lowpass_synthesis import coefficients, fn_zeta, opamp_denominator, ratios_from_rc
 from .topology import PartSpec, SectionTarget, polynomial, quadratic_root
@@ -124,6 +125,17 @@ class SallenKeyLowPass(SallenKeySection):
         v = self.values_of(values)
         fn, zeta = fn_zeta(v["R1"], v["R2"], v["C1"], v["C2"], self.gain_of(v))
         return float(fn), float(zeta)
+
+    def sample_figures(self, values: dict, opamp=None):
+        # the plant's Monte Carlo engine: the third-order model's exact step (its module says how it differs)
+        return sample_figures(self.values_of(values), opamp)
+
+    def step_final(self, values: dict, opamp, amplitude_v: float = 1.0):
+        # the closed-loop DC gain of the op-amp model, K A0/(K + A0) (the ideal one's A0 too: the deck's),
+        # in the seed plant's SPICE engine's order of operations, so its levels and overshoots keep their bits
+        v = self.values_of(values)
+        k = self.gain_of(v) * np.ones(np.broadcast_shapes(*(x.shape for x in v.values())))
+        return amplitude_v * k * opamp.a0 / (k + opamp.a0)
 
     def limits(self, target: SectionTarget) -> dict:
         return {"ratio_min": sallen_key_ratio_min(target.q, target.gain)}

@@ -40,6 +40,10 @@ equal the nodal solution to rounding (the conformance suite checks every section
 So is the ideal (fn, zeta) a PID's plant is sized by, :meth:`Topology.ideal_pair` (by default
 from the coefficients; the Sallen-Key low-pass gives its parts record's exact arithmetic).
 
+So is what a step settles to, :meth:`Topology.step_final` (amplitude x G(0) by nodal analysis at DC; the
+Sallen-Key low-pass gives its closed form K A0/(K + A0)), the levels of the SPICE step engine
+(:mod:`designer.tolerance.spice_engine`).
+
 The plant's E-series search has a hook too, :meth:`Topology.fast_search`: None by default (the
 generic search, :func:`designer.plant.circuit.search`, enumerates its candidate set), overridden by a
 section with an exact search of its own (the Sallen-Key low-pass: seed 001's parallelogram search over
@@ -762,6 +766,97 @@ class Topology(ABC):
         if self.order == 1:
             return d[-1] / d[0] / (2 * math.pi), 1.0
         return math.sqrt(d[-1] / d[0]) / (2 * math.pi), d[1] / (2 * math.sqrt(d[-1] * d[0]))
+
+    # ---- a section's own figures of sampled builds (the Monte Carlo's analytic engine) -----------------
+    def sample_figures(self, values: dict, opamp=None):
+        """Every figure of :data:`designer.plant.circuit.FIGURES` for arrays of sampled part values by
+        the section's own exact definitions, or None (the default): the generic ones
+        (:func:`designer.plant.circuit.circuit_figures`, the dominant pair's second-order step figures).
+        :func:`designer.plant.circuit.evaluate`, the Monte Carlo's and the worst case's chunk function,
+        takes these where a section has them (the Sallen-Key low-pass: its third-order model's exact step).
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value, numbers or arrays (one batch shape).
+        opamp : designer.core.opamps.OpAmp, optional
+            The op-amp (None or the ideal one: the ideal model); its gain-bandwidth may be an array
+            shaped as the batch.
+
+        Returns
+        -------
+        dict or None
+            Figure -> array shaped as the batch, or None.
+        """
+        return None
+
+    # ---- the settled output of a step (the SPICE step engine's levels; a hook, as opamp_model) ----------
+    def step_final(self, values: dict, opamp, amplitude_v: float = 1.0):
+        """What the output settles to after an input step of ``amplitude_v``: amplitude_v G(0), G the
+        op-amp-aware response at DC by nodal analysis of :meth:`netlist` (the op-amp's finite A0,
+        the ideal one's too: the deck simulates it), negative for an inverting section. The SPICE
+        step engine's 10/90 % and 2 % levels and overshoot are read against it
+        (:mod:`designer.tolerance.spice_engine`). A section with a closed form overrides this (the
+        Sallen-Key low-pass: amplitude K A0/(K + A0), the seed plant's engine's arithmetic to the
+        bit); it must equal this to rounding (the conformance suite checks every section).
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value, numbers or arrays (one batch shape).
+        opamp : designer.core.opamps.OpAmp
+            The op-amp (its A0).
+        amplitude_v : float
+            The step (V).
+
+        Returns
+        -------
+        ndarray
+            The settled output (V), shaped as the batch.
+        """
+        vals = self.values_of(values)
+        net = self.netlist({r: 1.0 for r in self.designators})
+        return amplitude_v * np.real(nodal_response(net, vals, 0j, opamp))
+
+    # ---- parameters besides the parts (a sensitivity table's extra rows) ------------------------
+    def sensitivity_parameters(self) -> tuple:
+        """Names of the section's parameters besides its declared parts and the op-amp that a
+        sensitivity table lists (:func:`designer.plant.circuit.sensitivities`): none by default;
+        a section whose gain K is set by a gain pair lists ``"K"`` (the seed's plant table's row).
+
+        Returns
+        -------
+        tuple of str
+            The names :meth:`with_parameter` takes.
+        """
+        return ()
+
+    def with_parameter(self, values: dict, name: str, factor) -> dict:
+        """``values`` moved so that parameter ``name`` (of :meth:`sensitivity_parameters`) is
+        ``factor`` times its value and nothing else of the section changes (K: the feedback
+        resistor of the gain pair moves, the RC network stays).
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value, numbers or arrays.
+        name : str
+            A name of :meth:`sensitivity_parameters`.
+        factor : float or ndarray
+            The relative change (1 + h).
+
+        Returns
+        -------
+        dict
+            Designator -> value.
+
+        Raises
+        ------
+        DesignError
+            ``name`` is not one of the section's parameters.
+        """
+        raise DesignError(f"parameter: {self.name} has no parameter {name!r}; it has "
+                          f"{', '.join(self.sensitivity_parameters()) or 'none'}", param="parameter")
 
     def figures(self, values: dict) -> Figures:
         """fn, Q and the passband gain magnitude from the ideal coefficients.

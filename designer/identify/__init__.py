@@ -17,8 +17,9 @@ noise: seed 003, 2.4 and 3.2) and ``broadband`` recognises such an input and
 runs both, with the step and frequency methods on their results;
 ``outputerror`` fits continuous-time models with dead time to any recorded
 input by output error, and ``validation`` judges a model on data it was not
-fitted to (fit percentage, residual tests, an ARX reference), and
-``recordview`` simulates the best models over the record they were scored on;
+fitted to (fit percentage, residual tests, an ARX reference), ``ranking``
+chooses the best of the models so scored (ties within the data's margin go to
+fewer parameters), and ``recordview`` simulates the best models over the record they were scored on;
 ``against`` compares an identified plant with its design (the one use of the
 plant wing) and ``report`` prints and plots the results; ``spec`` is a
 request about one file (``IdentifySpec``) and ``identify_file``, what the
@@ -54,11 +55,12 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
            "OUTPUT_NAMES", "PARSED", "PHASE_UNITS", "TIME_NAMES", "check_format", "format_generic", "freq_data",
            "looks_like_step_input", "parse_capture_text", "parse_freq_table", "plain_columns", "read_capture",
            "read_freq_table", "text_lines", "unit_hint"),
-    "outputerror": ("FIT_KINDS", "HOLDS", "INITIALS", "OEFit", "OEResult", "Sampled", "fit_output_error",
+    "outputerror": ("FIT_KINDS", "all_pass_pair", "HOLDS", "INITIALS", "OEFit", "OEResult", "Sampled", "fit_output_error",
                     "identify_output_error", "power_of_two", "sample_model", "simulate"),
     "overdamped": ("alfaro_123c_overdamped", "harriott", "jahanmiri_fallahi", "peeling", "stark_mollenkamp",
                    "two_pole"),
     "preprocess": ("check_window", "prepare_step"),
+    "ranking": ("PARAMETERS", "Ranking", "loss_difference", "nw_lags", "parameter_count", "rank"),
     "refine": ("fit", "refine_all"),
     "recordview": ("ModelTrace", "RecordView", "record_view"),
     "report": ("bode_fit_plot", "broadband_plot", "broadband_text", "fit_plot", "freq_text", "ranked_candidates",
@@ -74,5 +76,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "underdamped": ("chen", "extrema", "log_decrement", "normalized_step", "overshoot", "t4_t3", "t4_t3_ratio",
                     "t4_t3_table", "wn_from_peak_time", "zeta_from_overshoot", "zeta_from_t4_t3"),
     "validation": ("ARXModel", "Correlation", "DEFAULT_FRACTION", "RESID_LAGS", "Split", "Validation", "Z99",
-                   "arx_fit", "compare_fit", "cross_correlation", "split_record", "validate", "whiteness"),
+                   "arx_fit", "block_means", "compare_fit", "cross_correlation", "split_record", "validate",
+                   "whiteness"),
 })

@@ -8,7 +8,10 @@ Each model is simulated under the recorded input of the validation data
 (:func:`designer.identify.outputerror.simulate`: zero-order hold, the dead
 time not a whole number of samples) and scored by MATLAB ``compare``'s fit
 percentage and the residual tests of ``resid`` (:mod:`.validation`). The best
-model is the valid one with the best validation fit across all routes.
+model is the valid one with the best validation fit across all routes, a
+difference within one standard error of the two models' validation losses
+being none: among the models so tied with the best fit, the one with the
+fewest parameters (:mod:`.ranking`).
 
 Sources: L. Ljung, *System Identification: Theory for the User*, 2nd ed.
 (1999), section 16.6 (validation on fresh data, residual analysis) and the
@@ -42,7 +45,8 @@ from ..core.errors import DesignError, ParamError
 from ..core.process import ProcessModel
 from .frequency import wide_interval
 from .outputerror import fit_output_error, simulate
-from .validation import Split, Validation, validate
+from .ranking import rank
+from .validation import Split, Validation, block_means, validate
 
 __all__ = ["ROUTES", "ESTIMATION_FRACTION", "MAX_SAMPLES", "OE_KINDS", "OE_INITIAL", "Candidate", "Assessment",
            "method_process", "choose_split", "choose_hold", "judge_candidate", "assess", "regular_interval",
@@ -52,9 +56,9 @@ __all__ = ["ROUTES", "ESTIMATION_FRACTION", "MAX_SAMPLES", "OE_KINDS", "OE_INITI
 ROUTES = ("step", "correlation", "spectral", "output-error")
 #: the estimation part's share of one record
 ESTIMATION_FRACTION = 2.0 / 3.0
-#: records longer than this are block-averaged to it: the output-error fits compare block means (the model
-#: simulated at the record's own rate, :func:`~.outputerror.fit_output_error`'s ``block``), the scoring
-#: runs on the block means as a record
+#: records longer than this are block-averaged to it: the output-error fits and the validation scores compare
+#: block means of the output with those of the model simulated at the record's own rate
+#: (:func:`~.outputerror.fit_output_error`'s and :func:`~.validation.validate`'s ``block``)
 MAX_SAMPLES = 20_000
 #: the output-error route's model structures
 OE_KINDS = ("fopdt", "sopdt", "underdamped", "lead-lag", "integrating")
@@ -200,12 +204,13 @@ class Assessment:
         Of the record scored.
     decimated_by : int
         Block means of this many samples (1: none): the output-error fits
-        compare them with the block means of the model simulated at the
-        record's own rate (unbiased), the scoring simulates every candidate
-        on the block means.
+        and every candidate's validation compare them with the block means
+        of the model simulated at the record's own rate (``sample_time_s``
+        is the block means' interval).
     candidates : list of Candidate
     best : int or None
-        Index of the valid candidate with the best validation fit.
+        Index of the best valid candidate: the best validation fit, or among
+        those tied with it the one with the fewest parameters (``ranking``).
     skipped : dict
         Route -> why it gave no model.
     output_error : list
@@ -215,6 +220,9 @@ class Assessment:
         ``foh``): the one under which the output-error FOPDT fits the
         estimation data better (a sequence switching between the scope's
         samples is a ramp to a first-order hold, centred where it switched).
+    ranking : str
+        Why the best is not the best validation fit ("" when it is): tied
+        with it within the margin, fewer parameters (:func:`~.ranking.rank`).
     """
 
     scope: str
@@ -228,6 +236,7 @@ class Assessment:
     output_error: list = field(default_factory=list)
     hold: str = "zoh"
     view: object | None = None
+    ranking: str = ""
 
     @property
     def best_candidate(self) -> Candidate | None:
@@ -249,10 +258,14 @@ class Assessment:
         dict
             The split, every candidate, the best, the skipped routes.
         """
-        return {"scope": self.scope, "split": None if self.split is None else self.split.to_dict(),
-                "split_note": self.note, "sample_time_s": self.sample_time_s, "decimated_by": self.decimated_by, "hold": self.hold,
-                "best": None if self.best_candidate is None else self.best_candidate.to_dict(),
-                "skipped": dict(self.skipped), "models": [c.to_dict() for c in self.candidates]}
+        out = {"scope": self.scope, "split": None if self.split is None else self.split.to_dict(),
+               "split_note": self.note, "sample_time_s": self.sample_time_s, "decimated_by": self.decimated_by,
+               "hold": self.hold, "best": None if self.best_candidate is None else self.best_candidate.to_dict(),
+               "skipped": dict(self.skipped), "models": [c.to_dict() for c in self.candidates]}
+        if self.ranking:
+            # only when a tie decided: a capture whose best is its best fit keeps its JSON as it was
+            out["ranking"] = self.ranking
+        return out
 
 
 # --------------------------------------------------------------------------- the record
@@ -326,11 +339,6 @@ def match_validation(ts: float, tv, uv, yv, name: str = "validation record") -> 
     raise DesignError(f"{name} is sampled every {fe(tv_s, 's')}, the capture every {fe(ts, 's')}: not a whole "
                       "multiple of one another (ratio {:.4g}); record it at the capture's rate or a whole "
                       "multiple of it".format(ratio))
-
-
-def _block(x, k: int) -> np.ndarray:
-    n = x.size // k
-    return np.asarray(x[:n * k], float).reshape(n, k).mean(axis=1)
 
 
 def choose_split(n: int, excitation=None, fraction: float = ESTIMATION_FRACTION) -> tuple:
@@ -427,11 +435,13 @@ def _check_settles(c: Candidate, span: float) -> None:
                                        f"estimation record ({fe(span, 's')})") if n)
 
 
-def _score(c: Candidate, ts: float, hold: str, u, y, split: Split | None, how: str = "detrend") -> None:
+def _score(c: Candidate, ts: float, hold: str, u, y, split: Split | None, how: str = "detrend",
+           block: int = 1) -> None:
+    """Validate ``c`` on the record ``u``, ``y`` sampled every ``ts`` (block means of ``block`` scored)."""
     if c.model is None:
         return
     try:
-        v = validate(_Simulated(c.model, ts, hold), u, y, split, how=how)
+        v = validate(_Simulated(c.model, ts, hold), u, y, split, how=how, block=block)
     except (DesignError, ValueError, np.linalg.LinAlgError) as exc:
         c.valid = False
         c.note = "; ".join(n for n in (c.note, f"not simulated: {exc}") if n)
@@ -494,12 +504,10 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
         raise DesignError(f"{source}: the input never moves: there is nothing to identify (a capture of the "
                           "plant under a step, a sequence or any moving input)")
     k = max(1, int(math.ceil(u.size / MAX_SAMPLES)))
-    uu, yy, T = (_block(u, k), _block(y, k), ts * k) if k > 1 else (u, y, ts)
+    uu, T = block_means(u, k), ts * k
     vu = vy = None
     if validation is not None:
         vu, vy = (np.asarray(a, float) for a in validation)
-        if k > 1:
-            vu, vy = _block(vu, k), _block(vy, k)
     split = None
     full = slice(None)      # the estimation part at the record's own rate, for the output-error fits
     if validation is not None:
@@ -559,19 +567,25 @@ def assess(u, y, ts: float, route_results: dict, *, split_at: int | None, note: 
     span = T * (uu[est].size - 1)
     for c in res.candidates:
         _check_settles(c, span)
-    drive = (vu, vy, None) if validation is not None else (uu, yy, split)
+    # every candidate simulated at the record's own rate, its block means scored (validate's block): the
+    # response to the block means of the input is not the block means of the response
+    drive = (vu, vy, None) if validation is not None else (u, y, split)
     how = "rest" if scope == "whole" and rest == "fitted" else "detrend"
     if how == "rest":
         res.note += "; each model from rest at the input level that fits the output best"
     for c in res.candidates:
-        _score(c, T, res.hold, *drive, how=how)
+        _score(c, ts, res.hold, *drive, how=how, block=k)
         if c.kind == "integrating" and c.valid and c.fit_percent < 0:
             # its dead time at 0 has no interval to fail: a settling plant's integrator, worse than the mean
             c.valid = False
             c.note = "; ".join(n for n in (c.note, f"its validation fit ({c.fit_percent:.1f} %) is below 0: the "
                                            "output does not follow the input's integral") if n)
-    ok = [i for i, c in enumerate(res.candidates) if c.valid and math.isfinite(c.fit_percent)]
-    res.best = max(ok, key=lambda i: res.candidates[i].fit_percent) if ok else None
+    r = rank(res.candidates)
+    if r is not None:
+        res.best, res.ranking = r.best, r.note
+        if r.note:
+            c = res.candidates[r.best]
+            c.note = "; ".join(n for n in (c.note, r.note) if n)
     return res
 
 

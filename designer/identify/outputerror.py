@@ -93,10 +93,10 @@ from ..core import process_build as pb
 from ..core.errors import DesignError
 from ..core.lsq_intervals import half_widths
 from ..core.process import ProcessModel
-from .validation import DEFAULT_FRACTION, Split, arx_fit, split_record, validate
+from .validation import DEFAULT_FRACTION, Split, arx_fit, block_means, split_record, validate
 
 __all__ = ["FIT_KINDS", "HOLDS", "INITIALS", "Sampled", "sample_model", "simulate", "OEFit", "OEResult", "power_of_two",
-           "fit_output_error", "identify_output_error"]
+           "fit_output_error", "identify_output_error", "all_pass_pair"]
 
 #: the model structures fitted, with their parameters (in the solver's order)
 FIT_KINDS = {
@@ -355,7 +355,7 @@ def _regressors(s: Sampled, ud, integrating: bool, initial: str, block: int) -> 
     sim = s.run(ud)
     X = _columns(s, ud.size, integrating, initial)
     if block > 1:
-        return _block_means(sim, block), _block_means(X, block)
+        return block_means(sim, block), block_means(X, block)
     return sim, X
 
 
@@ -367,7 +367,7 @@ def _evaluate(kind: str, p: dict, ud, y, T: float, hold: str, initial: str, bloc
     if initial == "rest":
         sim = s.run(ud)
         if block > 1:
-            sim = _block_means(sim, block)
+            sim = block_means(sim, block)
         rest = y - sim
         beta = np.array([rest.mean()])
         return rest - beta[0], sim, beta
@@ -507,18 +507,12 @@ class OEFit:
 
 # --------------------------------------------------------------------------- start
 
-def _block_means(x, m: int) -> np.ndarray:
-    """Means of ``m`` consecutive rows (a trailing partial block dropped)."""
-    k = x.shape[0] // m
-    return x[:k * m].reshape(k, m, *x.shape[1:]).mean(axis=1)
-
-
 def _arx_start(kind: str, ud, y, T: float) -> dict:
     """A start from ARX models (numpy least squares): the input delay from a grid
     (the lowest one-step loss), poles and gain converted to continuous time, the
     fraction of a sample from the two taps' balance."""
     m = max(1, int(math.ceil(ud.size / START_SAMPLES)))
-    us, ys, Ts = (_block_means(ud, m), _block_means(y, m), T * m) if m > 1 else (ud, y, T)
+    us, ys, Ts = (block_means(ud, m), block_means(y, m), T * m) if m > 1 else (ud, y, T)
     integ = kind.startswith("integrating")
     if integ:
         # the output follows the input's running integral like a non-integrating
@@ -701,7 +695,7 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     if start is not None:
         start = {k: float(v) / _scale_of(kind, k, su, sy, st) for k, v in start.items() if k in names}
     ud = u - u[0]
-    yb = _block_means(y, block) if block > 1 else y
+    yb = block_means(y, block) if block > 1 else y
     n = yb.size
     bounds = _bounds(kind, T, u.size * T)
     lo = np.array([bounds[k][0] for k in names])
@@ -804,12 +798,48 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     if kind in ("sopdt", "lead-lag") and params["tau1_s"] < params["tau2_s"]:   # the slow time constant first
         params["tau1_s"], params["tau2_s"] = params["tau2_s"], params["tau1_s"]
         ci["tau1_s"], ci["tau2_s"] = ci["tau2_s"], ci["tau1_s"]
+    if kind == "lead-lag":
+        notes += all_pass_pair(params, ci)
     model, why = _process_model(kind, params, ci)
     if why:
         notes.append(why)
     return OEFit(kind, params, ci, model, not notes, "; ".join(notes), T_record, hold, initial, u0,
                  _linear_back(beta, sy, su, kind, initial), float(math.sqrt(r @ r / n)) * sy, n, evals, converged,
                  block)
+
+
+def all_pass_pair(params: dict, ci: dict) -> list:
+    """Why a lead-lag is not a structure of its own: its zero in the right half plane mirrors one of its lags.
+
+    (1 - a s)/(1 + a s) is Pade's first-order approximation of a delay of 2a (its phase -2 atan(a w), the
+    delay's -2 a w at low frequency): a lead-lag whose zero -|tz| mirrors a lag tau within their 95 %
+    intervals (|tau + tz| below the intervals' root sum of squares) trades dead time for the pair, and the
+    data cannot tell them apart: the structure without the pair (an FOPDT or SOPDT with a longer dead time)
+    says the same with fewer parameters. Measured: an FOPDT (K 2, tau 5 s, theta 1.3 s) under a step at
+    10 dB fitted a lead-lag with tz -0.280 s +-0.204 s, tau2 0.291 s +-0.200 s and theta 0.703 s, 0.002
+    point of validation fit above the FOPDT (within its tolerances) and ranked first.
+
+    Parameters
+    ----------
+    params : dict
+        The lead-lag's parameters (``K``, ``tau1_s``, ``tau2_s``, ``tz_s``, ``theta_s``).
+    ci : dict
+        Their 95 % half-widths (None where not computed).
+
+    Returns
+    -------
+    list of str
+        The note ([] when the zero is in the left half plane or mirrors no lag).
+    """
+    tz, hz = params["tz_s"], ci.get("tz_s")
+    if not tz < 0 or hz is None:
+        return []
+    for lag in ("tau2_s", "tau1_s"):
+        h = ci.get(lag)
+        if h is not None and abs(params[lag] + tz) < math.hypot(hz, h):
+            return [f"its zero (tz_s = {tz:.4g} s) mirrors {lag} = {params[lag]:.4g} s within their intervals: an "
+                    "all-pass pair, Pade's approximation of dead time, not a structure of its own"]
+    return []
 
 
 def _scale_of(kind: str, name: str, su: float, sy: float, st: float) -> float:

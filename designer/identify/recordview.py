@@ -3,10 +3,11 @@
 the recorded input, as MATLAB's ``compare`` draws them.
 
 Each model is simulated as the assessment scored it
-(:func:`~.outputerror.simulate` at the assessment's sample interval and hold,
-driven from the record's start at rest at its first input level, or at the
-rest level the score fitted (``Validation.rest_shift``); a separate
-validation record from its own start), then raised by the difference of the
+(:func:`~.outputerror.simulate` at the record's own sample interval under the
+assessment's hold, driven from the record's start at rest at its first input
+level, or at the rest level the score fitted (``Validation.rest_shift``); a
+separate validation record from its own start; a long record's block means
+of the simulation, as :func:`~.validation.validate`'s ``block``), then raised by the difference of the
 validation part's means: the fit percentage compares the two with their means
 removed (:func:`~.validation.validate`, ``how="detrend"``), so this is the
 level at which the score sees the model. Nothing is fitted here.
@@ -23,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .outputerror import simulate
-from .settle import block_mean
+from .validation import block_means
 
 __all__ = ["ModelTrace", "RecordView", "record_view"]
 
@@ -72,7 +73,7 @@ class RecordView:
     note : str
         The split in words.
     models : tuple of ModelTrace
-        Up to ``n_models`` valid models, the best validation fit first.
+        Up to ``n_models`` valid models: the assessment's best, then by validation fit.
     """
 
     t: np.ndarray
@@ -105,21 +106,21 @@ def record_view(assessment, t, u, y, n_models: int = 3) -> RecordView:
     a = assessment
     t, u, y = (np.asarray(x, float) for x in (t, u, y))
     k = a.decimated_by
-    # block means of k samples, as the assessment scored them (block_mean's blocks are k long at this size)
-    cap = u.size if k == 1 else int(math.ceil(u.size / k))
-    tb, ub = block_mean(t, u, cap)
-    _, yb = block_mean(t, y, cap)
+    # block means of k samples, as the assessment scored them
+    tb, ub, yb = (block_means(x, k) for x in (t, u, y))
     if a.scope == "separate":
         start, val = float(tb[0]), slice(0, ub.size)
     elif a.split is None:
         start, val = None, slice(0, ub.size)
     else:
         start, val = float(tb[a.split.n_est]), a.split.validation
+    best = a.best_candidate     # first, even where a tie within the margin put it after a better fit
     order = sorted((c for c in a.candidates if c.valid and c.model is not None and math.isfinite(c.fit_percent)),
-                   key=lambda c: -c.fit_percent)[:n_models]
+                   key=lambda c: (c is not best, -c.fit_percent))[:n_models]
     traces = []
     for c in order:
-        ym = simulate(c.model, ub - ub[0] + c.validation.rest_shift, a.sample_time_s, a.hold)
+        ym = block_means(simulate(c.model, u[:ub.size * k] - u[0] + c.validation.rest_shift,
+                                  a.sample_time_s / k, a.hold), k)
         traces.append(ModelTrace(c.route, c.name, c.kind, c.fit_percent,
                                  ym + (yb[val].mean() - ym[val].mean())))
     return RecordView(tb, ub, yb, start, a.scope, a.note, tuple(traces))

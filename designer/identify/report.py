@@ -134,7 +134,8 @@ def _verdict(c) -> str:
 
 def ranked_candidates(a) -> list:
     """The candidates of an :class:`~.assess.Assessment` as its tables list them:
-    the valid ones first, each group by validation fit, the best first.
+    the best first (a tie within the margin can put it after a better fit,
+    :mod:`.ranking`), then the valid ones, each group by validation fit.
 
     Parameters
     ----------
@@ -144,8 +145,9 @@ def ranked_candidates(a) -> list:
     -------
     list of Candidate
     """
-    return sorted(a.candidates, key=lambda c: (not c.valid, -c.fit_percent if math.isfinite(c.fit_percent)
-                                               else math.inf))
+    best = a.best_candidate
+    return sorted(a.candidates, key=lambda c: (c is not best, not c.valid,
+                                               -c.fit_percent if math.isfinite(c.fit_percent) else math.inf))
 
 
 def validation_text(a) -> list:
@@ -168,8 +170,9 @@ def validation_text(a) -> list:
                      f"{'yes' if c.valid else 'no ':3s} {format_params(c.params, False)}"
                      + (f"  ({c.note})" if c.note and not c.valid else ""))
     best = a.best_candidate
-    lines.append("Best by validation fit: " + (f"{best.label}, fit {best.fit_percent:.2f} %: "
-                                                f"{format_params(best.params, False)}" if best else
+    lines.append("Best by validation fit: " + (f"{best.label}, fit {best.fit_percent:.2f} %"
+                                                + (f" ({a.ranking})" if getattr(a, "ranking", "") else "")
+                                                + f": {format_params(best.params, False)}" if best else
                                                 "none valid"))
     return lines
 

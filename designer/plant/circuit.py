@@ -71,10 +71,10 @@ from ..core.errors import DesignError
 from ..filters import registry
 from ..filters.topology import SectionTarget, Topology
 
-__all__ = ["BAND_ERROR", "BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "R_BAND", "Candidate", "plant_target",
-           "capacitor_combinations", "candidate_set", "search", "rounded", "brute_force", "listed", "GBW_ROUNDS",
-           "gbw_shift", "compensate_gbw", "opamp_tf", "dominant_pairs", "circuit_figures", "evaluate", "sensitivities",
-           "corner_frequencies", "step_of_pair"]
+__all__ = ["BAND_ERROR", "BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "OPAMP_PARAMETERS", "R_BAND", "Candidate",
+           "plant_target", "capacitor_combinations", "candidate_set", "search", "rounded", "brute_force", "listed",
+           "GBW_ROUNDS", "gbw_shift", "compensate_gbw", "opamp_tf", "dominant_pairs", "circuit_figures", "evaluate",
+           "sensitivities", "corner_frequencies", "step_of_pair"]
 
 #: the topology of ``design-plant`` without ``--topology``: the seed's plant (its own search, :mod:`.selection`)
 DEFAULT_TOPOLOGY = "sallen-key-lowpass"
@@ -664,8 +664,11 @@ def dominant_pairs(den: np.ndarray, first_order: bool = False) -> tuple:
         w_r = np.sqrt(real[..., 0] * real[..., 1])
         z_r = (real[..., 0] + real[..., 1]) / (2 * w_r)
     has = np.any(cplx, axis=-1)
-    w = np.where(has, np.abs(pc), w_r)
-    z = np.where(has, -pc.real / np.where(has, np.abs(pc), 1.0), z_r)
+    # |p| as hypot(Re, Im), which is dominant_pair's abs() of one pole to the bit (numpy's vectorised complex
+    # abs rounds differently in a third of cases: the plant's sensitivities, finite differences, would move)
+    mag_c = np.hypot(pc.real, pc.imag)
+    w = np.where(has, mag_c, w_r)
+    z = np.where(has, -pc.real / np.where(has, mag_c, 1.0), z_r)
     return w / (2 * math.pi), z
 
 
@@ -727,7 +730,9 @@ def step_of_pair(fn_hz, zeta) -> dict:
 
 
 def evaluate(context: tuple, values: dict) -> dict:
-    """The Monte Carlo's chunk function (:mod:`designer.tolerance.runner`): :func:`circuit_figures`.
+    """The Monte Carlo's chunk function (:mod:`designer.tolerance.runner`): the section's own figures
+    (:meth:`~designer.filters.topology.Topology.sample_figures`: the Sallen-Key low-pass's exact
+    third-order step) where it has them, else :func:`circuit_figures`.
 
     Parameters
     ----------
@@ -747,12 +752,38 @@ def evaluate(context: tuple, values: dict) -> dict:
     if "GBW" in values and opamp is not None and not opamp.ideal:
         # the op-amp's spread (--tol GBW): one gain-bandwidth per build, shaped as the parts' batch
         opamp = dataclasses.replace(opamp, gbw_hz=np.asarray(values["GBW"], float))
-    return circuit_figures(topo, {r: values[r] for r in topo.designators}, opamp)
+    values = {r: values[r] for r in topo.designators}
+    own = topo.sample_figures(values, opamp)
+    return circuit_figures(topo, values, opamp) if own is None else own
+
+
+#: the op-amp's figures a sensitivity table lists (label -> the :class:`~designer.core.opamps.OpAmp` field)
+OPAMP_PARAMETERS = {"GBW": "gbw_hz", "A0": "a0"}
+
+
+def _pair(topology: Topology, values: dict, opamp) -> tuple:
+    """wn (rad/s) and zeta of arrays of part values: the ideal coefficients' (den = d2 s^2 + d1 s + d0:
+    wn = sqrt(d0) / sqrt(d2), zeta = d1 / (2 sqrt(d0 d2)), which for the Sallen-Key plant's
+    den = a s^2 + b s + 1 is its record's 1/sqrt(a) and b / (2 sqrt(a)) to the bit), else the dominant pair
+    of the op-amp-aware model (:func:`circuit_figures`'s) with wn = 2 pi fn, as the plant's model has it."""
+    if opamp is None or opamp.ideal:
+        den = topology.coefficients(values)[1]
+        if topology.order == 1:
+            return den[-1] / den[0], np.full(np.shape(den[0]), np.nan)
+        return np.sqrt(den[-1]) / np.sqrt(den[0]), den[1] / (2 * np.sqrt(den[-1] * den[0]))
+    fn, z = dominant_pairs(opamp_tf(topology, values, opamp)[1], topology.order == 1)
+    return 2 * math.pi * fn, z
 
 
 def sensitivities(topology: Topology, values: dict, opamp=None, rel_step: float = 1e-6) -> dict:
-    """Relative sensitivities S = d ln y / d ln x of wn and zeta to every declared part
-    (central differences in log space, all parts at once).
+    """Relative sensitivities S = d ln y / d ln x of wn and zeta to every declared part, the section's
+    other parameters (:meth:`~designer.filters.topology.Topology.sensitivity_parameters`: a gain section's K)
+    and, with a real op-amp, its gain-bandwidth ``GBW`` and DC gain ``A0`` (through the section's
+    :meth:`~designer.filters.topology.Topology.opamp_model`).
+
+    Central differences in log space, x (1 + h) against x (1 - h), every row in one batch:
+    S = ln(y+ / y-) / ln((1 + h) / (1 - h)). The Sallen-Key plant's table
+    (:func:`designer.plant.model.sensitivities`) is this one's rows, bit for bit its old closed forms'.
 
     Parameters
     ----------
@@ -761,26 +792,43 @@ def sensitivities(topology: Topology, values: dict, opamp=None, rel_step: float 
     values : dict
         Designator -> value.
     opamp : designer.core.opamps.OpAmp, optional
-        The op-amp-aware model's (None: the ideal one).
+        The op-amp-aware model's (None or the ideal one: the ideal model, no op-amp rows).
     rel_step : float
-        The relative step.
+        The relative step h.
 
     Returns
     -------
     dict
-        Designator -> {"wn": S, "zeta": S} (zeta None for a first-order section).
+        Label -> {"wn": S, "zeta": S} (zeta None for a first-order section): the designators in their
+        declared order, then the section's parameters, then ``GBW`` and ``A0``.
     """
-    refs = topology.designators
-    batch = {r: np.array([values[r] * (1 + rel_step * sgn * (r == p)) for p in refs for sgn in (1, -1)])
-             for r in refs}
-    f = circuit_figures(topology, batch, opamp)
+    h = rel_step
+    base = {r: float(values[r]) for r in topology.designators}
+    real_amp = opamp is not None and not opamp.ideal
+    labels, rows = [], []
+    for ref in topology.designators:
+        labels.append(ref)
+        rows += [{**base, ref: base[ref] * f} for f in (1 + h, 1 - h)]
+    for name in topology.sensitivity_parameters():
+        labels.append(name)
+        rows += [topology.with_parameter(base, name, f) for f in (1 + h, 1 - h)]
+    if real_amp:
+        # one op-amp per row, shaped as the batch: the parts' rows at its own figures, then each figure moved
+        figures = {f: [getattr(opamp, f)] * len(rows) for f in OPAMP_PARAMETERS.values()}
+        for label, field in OPAMP_PARAMETERS.items():
+            labels.append(label)
+            rows += [base, base]
+            for f, column in figures.items():
+                column += [getattr(opamp, f) * m if f == field else getattr(opamp, f) for m in (1 + h, 1 - h)]
+        opamp = dataclasses.replace(opamp, **{f: np.array(c, float) for f, c in figures.items()})
+    batch = {r: np.array([row[r] for row in rows], float) for r in topology.designators}
+    wn, zeta = (np.asarray(x, float) for x in _pair(topology, batch, opamp))
+    dl = math.log((1 + h) / (1 - h))
     out = {}
-    for i, ref in enumerate(refs):
+    for i, label in enumerate(labels):
         up, down = 2 * i, 2 * i + 1
-        d = math.log1p(rel_step) - math.log1p(-rel_step)
-        s_wn = float(np.log(f["fn_hz"][up] / f["fn_hz"][down]) / d)
-        s_z = None if topology.order == 1 else float(np.log(f["zeta"][up] / f["zeta"][down]) / d)
-        out[ref] = {"wn": s_wn, "zeta": s_z}
+        s_z = None if topology.order == 1 else math.log(float(zeta[up]) / float(zeta[down])) / dl
+        out[label] = {"wn": math.log(float(wn[up]) / float(wn[down])) / dl, "zeta": s_z}
     return out
 
 

@@ -24,6 +24,7 @@ from ..report.tolerance import histogram_plots
 from ..report.tolerance import section as tolerance_section
 from ..report.wiring import bom_csv, bom_rows, wiring_rows
 from ..spice.deck import board
+from . import circuit
 from .report import prbs_blocks, prbs_png, prbs_texts
 
 __all__ = ["title_of", "sections", "bom", "schematic", "summary_text", "write_outputs"]
@@ -84,6 +85,18 @@ def _n(v) -> str:
     return "-" if v is None else f"{v:.4g}"
 
 
+def _sensitivity_rows(sensitivity: dict) -> list:
+    """The parts' (and the section's parameters') rows, ideal and op-amp-aware side by side, then the
+    op-amp's own (GBW, A0: the op-amp-aware model's only)."""
+    ideal, opamp = sensitivity["ideal"], sensitivity["opamp"]
+    none = {"wn": None, "zeta": None}
+    # the op-amp's rows to four decimals, as the plant's sheet: their finite differences resolve ~1e-7
+    # (A0's row of wn is that small), so more digits would show rounding
+    fmt = {label: (lambda v: "-" if v is None else f"{v:+.4f}") for label in circuit.OPAMP_PARAMETERS}
+    return [[label, *(fmt.get(label, _n)(table.get(label, none)[k]) for table in (ideal, opamp) for k in ("wn", "zeta"))]
+            for label in {**ideal, **opamp}]
+
+
 def _targets(result) -> list:
     t, fi, fo = result.target, result.figures["ideal"], result.figures["opamp"]
     rows = [["fn", _f(t.fc_hz, "Hz"), _f(fi["fn_hz"], "Hz"), _f(fo["fn_hz"], "Hz")],
@@ -131,9 +144,7 @@ def sections(result, with_images: bool = False, schematic_svg: str = "") -> list
                                   [[_(c.title), _("ok") if c.ok else _("FAILED"), c.shown()] for c in result.checks])]),
            (_("Sensitivity"), [R.table([_("part"), _("S wn (ideal)"), _("S zeta (ideal)"), _("S wn (op-amp)"),
                                         _("S zeta (op-amp)")],
-                                    [[ref, _n(s["wn"]), _n(s["zeta"]), _n(result.sensitivity["opamp"][ref]["wn"]),
-                                      _n(result.sensitivity["opamp"][ref]["zeta"])]
-                                     for ref, s in result.sensitivity["ideal"].items()])])]
+                                    _sensitivity_rows(result.sensitivity))])]
     if len(result.alternatives) > 1:
         refs = result.section.designators
         out.append((_("Alternatives (best first)"),

@@ -6,15 +6,15 @@ Step and frequency responses come from :mod:`designer.core.lti`.
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..core.lti import dominant_pair
 from ..core.opamps import OpAmp
-from ..filters.sallen_key_lowpass_parts import FIELD_OF, refs
+from ..filters.sallen_key_lowpass_parts import part_values, section_of
 from ..filters.sallen_key_lowpass_synthesis import opamp_denominator
+from . import circuit
 from .sallenkey import SallenKeyParts
 
 __all__ = ["plant_tf", "plant_tf_opamp", "plant_model", "opamp_pair", "sensitivities"]
@@ -109,48 +109,26 @@ class Sensitivity:
 
 
 def sensitivities(parts: SallenKeyParts, opamp: OpAmp | None = None, rel_step: float = 1e-6) -> dict:
-    """Relative sensitivities S_x^y = d ln y / d ln x of wn and zeta.
-
-    x runs over R1, R2, C1, C2, the gain K (when not a follower) and, with an
-    op-amp, its GBW and DC gain A0 (through the op-amp-aware model). Central
-    differences in log space.
+    """Relative sensitivities S_x^y = d ln y / d ln x of wn and zeta: the generic section's
+    (:func:`designer.plant.circuit.sensitivities` of the Sallen-Key low-pass the parts realise), its
+    RC network's rows, the gain K's (when not a follower) and, with a real op-amp, GBW's and A0's.
 
     Parameters
     ----------
     parts : SallenKeyParts
         The parts.
     opamp : OpAmp, optional
-        The op-amp (its GBW and A0 join the list).
+        The op-amp (its GBW and A0 join the list; the ideal one: the ideal model, as with none).
     rel_step : float
         The central differences' relative step.
 
     Returns
     -------
     dict
-        ``{"R1": Sensitivity, ...}`` in that order.
+        ``{"R1": Sensitivity, ...}``: the network, then K, GBW, A0.
     """
-    def figures(p, amp):
-        if amp is None:
-            return p.wn, p.zeta
-        fn, z = opamp_pair(p, amp)
-        return 2 * math.pi * fn, z
-
-    h = rel_step
-    dl = math.log((1 + h) / (1 - h))
-
-    def moved(obj, attr):
-        """S of wn and zeta for ``attr`` of ``obj`` (the parts or the op-amp)."""
-        up, dn = (replace(obj, **{attr: getattr(obj, attr) * f}) for f in (1 + h, 1 - h))
-        if obj is parts:
-            (wu, zu), (wd, zd) = figures(up, opamp), figures(dn, opamp)
-        else:
-            (wu, zu), (wd, zd) = figures(parts, up), figures(parts, dn)
-        return Sensitivity(math.log(wu / wd) / dl, math.log(zu / zd) / dl)
-
-    names = {r: FIELD_OF[r] for r in refs(with_gain=False)}
-    if parts.gain != 1.0:
-        names["K"] = "gain"
-    table = {label: moved(parts, attr) for label, attr in names.items()}
-    if opamp is not None and not opamp.ideal:
-        table.update({label: moved(opamp, attr) for label, attr in (("GBW", "gbw_hz"), ("A0", "a0"))})
-    return table
+    section = section_of(parts)
+    table = circuit.sensitivities(section, part_values(parts), opamp, rel_step)
+    # the plant's table has always shown K rather than the gain pair that sets it (R3, R4)
+    return {label: Sensitivity(s["wn"], s["zeta"]) for label, s in table.items()
+            if label not in section.choice_parts}

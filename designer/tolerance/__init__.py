@@ -3,7 +3,7 @@
 A design's parts vary within their tolerances (:mod:`.parts`); samples of
 them are drawn reproducibly, sample i a function of (seed, i) alone
 (:mod:`.sampling`); an engine computes every figure of every sample at once
-(:mod:`.plant`: the Sallen-Key plant, analytic, vectorised over the samples);
+(:mod:`.plant`: the Sallen-Key plant, analytic, vectorised over the samples, through the generic chunk function);
 :mod:`.stats` turns the figures into statistics, a yield with its Wilson
 interval, variance shares and the part to buy tighter. Imports go
 front ends -> check -> tolerance -> wings.
@@ -32,10 +32,11 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                "Scale", "parse_jobs",),
     "sampling": ("CHUNK", "SAMPLERS", "deviations", "unit_samples", "values",),
     "spice_ac": ("AcContext", "POINTS_PER_DECADE", "SPAN", "fit", "section_chunk", "section_evaluate",),
-    "spice_engine": ("batched", "commands", "measures", "parse",),
+    "spice_engine": ("batched", "commands", "measures", "parse", "step_sections",),
     "spice_loop_mc": ("loop_monte_carlo_engine",),
-    "spice_mc": ("drawn_values", "plant_monte_carlo_engine", "replay_values", "run_engine", "section_context",
-                 "section_monte_carlo_engine", "section_replay", "section_replay_result", "spice_samples",),
+    "spice_mc": ("drawn_values", "plant_context", "plant_monte_carlo_engine", "replay_values", "run_engine", "section_context",
+                 "section_monte_carlo_engine", "section_replay", "section_replay_result", "section_step_context",
+                 "spice_samples",),
     "stats": ("Limit", "Z95", "figure_stats", "variance_shares", "wilson",),
     "worstcase": ("WorstCase", "worst_case",),
     "yields": ("ENGINES", "FILTER", "LOOP", "PLANT", "SECTION", "TABLES", "counted", "spec_yield",),

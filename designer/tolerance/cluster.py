@@ -157,7 +157,7 @@ def _adopt(command_pid: int) -> None:
 #: Processes for Python's own work (the analytic and loop engines hold the GIL) and for the shared
 #: library (ngspice's, one instance per process, not thread-safe).
 WORKERS = {
-    "analytic": (False, ("designer.tolerance.plant", "designer.tolerance.montecarlo")),
+    "analytic": (False, ("designer.plant.circuit", "designer.tolerance.montecarlo")),
     "loop": (False, ("designer.tolerance.loop", "designer.pid.model", "designer.pid.blocks", "designer.pid.verify",
                      "designer.plant.model", "scipy.linalg")),
     "spice": (False, ("designer.tolerance.spice_mc", "designer.tolerance.montecarlo", "designer.spice.simulate",

@@ -14,6 +14,7 @@ import numpy as np
 from ..core.errors import DesignError
 from ..core.figure_titles import figure_spread
 from ..filters.sallen_key_lowpass_parts import part_values, refs
+from ..plant.circuit import evaluate as section_evaluate
 from . import plant as engine
 from . import runner, sampling
 from .parts import DISTRIBUTIONS, opamp_nominal, resolve
@@ -267,8 +268,11 @@ def plant_monte_carlo(parts, series: dict, opamp, n: int, seed: int = 0, sampler
     """
     check_draw(n, dist, sampler)
     limits = tuple(t if isinstance(t, Limit) else parse_limit(t, engine.FIGURES) for t in limit_items or ())
-    analytic = (engine.evaluate, opamp) if circuit is None else circuit[1:]
-    nominal = {**(plant_parts(parts) if circuit is None else circuit[0]), **opamp_nominal(tol_items, opamp)}
+    if circuit is None:
+        # the Sallen-Key plant: the generic chunk function on its section (its own exact figures)
+        circuit = (plant_parts(parts), section_evaluate, engine.context(part_values(parts), opamp))
+    analytic = circuit[1:]
+    nominal = {**circuit[0], **opamp_nominal(tol_items, opamp)}
     if "SR" in nominal and evaluate is None:
         raise DesignError(NO_SLEW)
     tol = resolve(tol_items, nominal, series)

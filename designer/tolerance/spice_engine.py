@@ -1,10 +1,13 @@
 """The SPICE engine of the plant Monte Carlo (issue 17): every sample simulated
 in ngspice, many samples per ngspice process.
 
-The plant deck design-plant writes (:func:`designer.plant.netlist.plant_deck`)
-is loaded once, without its ``.tran`` and ``.meas`` lines; a loop of control
-commands then, per sample, ``alter``\\ s each part of the deck's Sallen-Key section
-(by its designator; the op-amp's integrating capacitor for
+The engine takes a section (issue 26): a registered low-pass
+:class:`~designer.filters.topology.Topology`, its values by designator and its op-amp, and a
+deck of it under a square-wave test (the Sallen-Key plant's, :func:`designer.plant.netlist.plant_deck`,
+output net ``out``; any low-pass section's, :func:`designer.plant.circuit_design.square_deck`,
+output net ``vout``). The deck is loaded once, without its ``.tran`` and ``.meas`` lines; a loop of control
+commands then, per sample, ``alter``\\ s each part of the section
+(by its designator, as the section's ``.ac`` engine does, :mod:`.spice_ac`; the op-amp's integrating capacitor for
 ``--tol GBW``; for ``--tol SR`` the op-amp subcircuit's own ``SR`` parameter,
 made a global ``.param`` of the loaded copy, is changed by ``alterparam`` and the
 circuit ``reset`` before the other alters, :func:`opamp_commands`), runs ``tran`` over the rising half of the bench period only, and
@@ -16,8 +19,9 @@ with a ``.control`` block, or the shared library fed the commands one by one.
 Measured per sample: the peak of v(out) (MAX), the first peak's time (where
 d v(out)/dt falls through 0: MAX_AT is quantised to the time grid), the 10 % and
 90 % crossings and the last time |v(out) - final|/final crosses 2 %. From them,
-with the final value final = amplitude x K A0/(K + A0) (the closed-loop DC gain
-of the op-amp model, K = 1 + R4/R3):
+with the final value final = amplitude x G(0), the op-amp model's DC gain
+(:meth:`~designer.filters.topology.Topology.step_final`; the Sallen-Key low-pass's K A0/(K + A0),
+K = 1 + R4/R3; an inverting section's output, negative, is measured negated):
 
 - ``overshoot_pct`` = 100 (peak - final)/final, ``peak_time_s`` (from the step's edge),
   ``rise_time_s`` (10-90 %), ``settling_time_s`` (2 %);
@@ -28,6 +32,10 @@ of the op-amp model, K = 1 + R4/R3):
   (GBW 1 MHz) under the seed's 3.5 kHz plant the two definitions differ by about
   0.1 % in fn. Without an overshoot (below :data:`OVERSHOOT_FLOOR_PCT`) the step has
   no peak: peak time, fn, zeta and Q are NaN.
+
+A low-pass steps to its DC gain: the engine takes the low-pass sections only (a high-pass's or a
+band-pass's step settles to 0, where these levels mean nothing). On a first-order section (the RC
+low-pass) the step has no overshoot: its rise and settling times are measured, its fn and zeta NaN.
 
 The maximum step is :data:`MAX_STEP_FACTOR` times the deck's (at most 1/30 of the
 response's time scale): /work/shared/FACTS.md measured 0.007 pp of overshoot and
@@ -45,10 +53,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.errors import SimulatorError
-from ..filters.sallen_key_lowpass_parts import gain_refs
+from ..core.errors import DesignError, SimulatorError
+from ..filters import registry
 
-__all__ = ["FIGURES", "batched", "commands", "context", "evaluate", "measures", "parse"]
+__all__ = ["FIGURES", "batched", "commands", "context", "evaluate", "measures", "parse", "step_sections"]
 
 #: the figures the SPICE engine gives
 FIGURES = ("fn_hz", "zeta", "q", "overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
@@ -76,15 +84,17 @@ SLEW_PARAM = "mcsr"
 
 @dataclass(frozen=True)
 class SpiceContext:
-    """What every sample of one design shares (picklable: strings and numbers).
+    """What every sample of one design shares (picklable: strings, numbers and the op-amp record).
 
-    ``circuit`` is the plant deck without its analyses; ``elements`` maps each
+    ``circuit`` is the deck without its analyses; ``elements`` maps each
     designator that may vary to its element in the deck (``R3`` -> ``r3``);
     ``cint`` names the op-amp's integrating capacitor and ``rint`` its resistor
     (``GBW`` varies through C = A0/(2 pi GBW RINT); the model's slew current is fixed
     at the nominal one, so the slew rate follows the gain-bandwidth, as a real
     op-amp's compensation capacitor moves both, unless ``SR`` varies too:
-    :func:`opamp_commands`, :func:`designer.tolerance.parts.opamp_arrays`)."""
+    :func:`opamp_commands`, :func:`designer.tolerance.parts.opamp_arrays`); ``section`` the
+    registered section, ``node`` its output net in the deck, ``sign`` -1 for an inverting
+    section (its output measured negated), ``opamp`` the op-amp (the settled output's A0)."""
 
     circuit: str
     elements: tuple
@@ -97,45 +107,74 @@ class SpiceContext:
     cint: str | None = None
     rint: float | None = None
     simulator: str = "ngspice-cli"
+    section: str = "sallen-key-lowpass"
+    node: str = "out"
+    sign: float = 1.0
+    opamp: object = None
 
     def final_v(self, values: dict, n: int) -> np.ndarray:
-        """Each sample's settled output: amplitude x K A0/(K + A0)."""
+        """Each sample's settled output: amplitude x G(0) of its parts (the drawn ones, the others
+        at their nominal), :meth:`~designer.filters.topology.Topology.step_final`."""
+        topo = registry.get(self.section)
         nom = dict(self.nominal)
-        to_ground, feedback = gain_refs()
-        r3 = np.asarray(values.get(to_ground, nom.get(to_ground, np.nan)), float)
-        r4 = np.asarray(values.get(feedback, nom.get(feedback, np.nan)), float)
-        k = np.where(np.isfinite(r3) & np.isfinite(r4), 1.0 + r4 / r3, 1.0) * np.ones(n)
-        return self.amplitude_v * k * self.a0 / (k + self.a0)
+        parts = {r: np.broadcast_to(np.asarray(values.get(r, nom[r]), float), (n,)) for r in topo.designators}
+        return np.asarray(topo.step_final(parts, self.opamp, self.amplitude_v), float) * np.ones(n)
 
 
-def context(deck: str, parts, opamp, test, simulator: str = "ngspice-cli") -> SpiceContext:
-    """The :class:`SpiceContext` of a plant deck (a :class:`~designer.plant.result.PlantResult`'s
-    ``deck``, ``built``, ``opamp`` and ``test``) for the backend ``simulator``.
+def step_sections() -> tuple:
+    """The registered sections the step engine takes: the low-passes (a step settles to their DC gain).
+
+    Returns
+    -------
+    tuple of str
+        Their registry names.
+    """
+    return tuple(n for n in registry.names() if registry.get(n).kind == "lowpass")
+
+
+def context(deck: str, topology, values: dict, opamp, test, simulator: str = "ngspice-cli",
+            node: str = "out") -> SpiceContext:
+    """The :class:`SpiceContext` of a section's step deck for the backend ``simulator``: the
+    Sallen-Key plant's (a :class:`~designer.plant.result.PlantResult`'s ``deck``, its parts' section
+    and values, ``opamp`` and ``test``), or any low-pass section's under a square wave.
 
     Parameters
     ----------
     deck : str
-        The plant's deck.
-    parts : designer.plant.sallenkey.SallenKeyParts
-        Its parts.
+        The deck: the section (its parts named by designator, its op-amp ``U1``) under ``test``.
+    topology : designer.filters.topology.Topology or str
+        The section (or its registry name): a low-pass (:func:`step_sections`).
+    values : dict
+        Its nominal values by designator.
     opamp : designer.core.opamps.OpAmp
         Its op-amp.
     test : designer.spice.deck.SquareTest
-        Its square-wave test.
+        The deck's square-wave test.
     simulator : str
         The backend.
+    node : str
+        The section's output net in the deck (the plant deck's ``out``; a section's own netlist's ``vout``).
 
     Returns
     -------
     SpiceContext
         The context.
+
+    Raises
+    ------
+    DesignError
+        The section is not a low-pass.
     """
-    from ..plant.netlist import plant_netlist
+    topo = registry.get(topology) if isinstance(topology, str) else topology
+    if topo.kind != "lowpass":
+        raise DesignError(f"topology: the SPICE step engine measures a low-pass's step (it settles to the DC gain); "
+                          f"{topo.name} is a {topo.kind}; allowed: {', '.join(step_sections())}", param="topology")
     keep = [ln for ln in deck.splitlines()
             if not re.match(r"\s*\.(meas\w*|tran|end)\b", ln, re.I)]
-    net = plant_netlist(parts)
+    values = topo.values_of(values)
+    net = topo.netlist({r: float(v) for r, v in values.items()})
     elements = tuple((p.ref, p.ref.lower()) for p in net.parts)
-    nominal = tuple((p.ref, p.value) for p in net.parts)
+    nominal = tuple((p.ref, float(values[p.ref])) for p in net.parts)
     step = MAX_STEP_FACTOR * test.max_step_s()
     if test.time_scale_s is not None:
         step = min(step, test.time_scale_s / MIN_STEPS_PER_TIME_SCALE)
@@ -148,7 +187,8 @@ def context(deck: str, parts, opamp, test, simulator: str = "ngspice-cli") -> Sp
         circuit = slew_parametrised(circuit)
     from ..spice.simulate import get_simulator
     return SpiceContext(circuit, elements, test.delay_s, test.delay_s + test.half_period_s,
-                        step, test.amplitude_v, opamp.a0, nominal, cint, rint, get_simulator(simulator).name)
+                        step, test.amplitude_v, opamp.a0, nominal, cint, rint, get_simulator(simulator).name,
+                        topo.name, node, -1.0 if topo.inverting else 1.0, opamp)
 
 
 def commands(ctx: SpiceContext, values: dict, start: int = 0) -> list:
@@ -174,7 +214,7 @@ def commands(ctx: SpiceContext, values: dict, start: int = 0) -> list:
     elem = dict(ctx.elements)
     unknown = [d for d in values if d not in elem and d not in OPAMP]
     if unknown:
-        raise ValueError(f"the plant deck has no part {unknown[0]}")
+        raise ValueError(f"the deck has no part {unknown[0]}")
     if any(d in values for d in OPAMP) and ctx.cint is None:
         raise ValueError("the ideal op-amp has no gain-bandwidth or slew rate to vary")
     win = f"FROM={ctx.t0:.10g} TO={ctx.t1:.10g}"
@@ -187,8 +227,9 @@ def commands(ctx: SpiceContext, values: dict, start: int = 0) -> list:
         for d, v in values.items():
             if d not in OPAMP:
                 out.append(f"alter {elem[d]} = {float(v[i]):.12g}")
-        f = float(final[i])
-        out += [tran, f"echo MCROW {start + i}", *measures(win, f), "destroy all"]
+        # an inverting section's output measured negated: its step rises to |final| as a plant's does
+        f = ctx.sign * float(final[i])
+        out += [tran, f"echo MCROW {start + i}", *measures(win, f, ctx.node, sign=ctx.sign), "destroy all"]
     return out
 
 
@@ -235,7 +276,7 @@ def opamp_commands(values: dict, i: int, cints, a0: float, rint: float, gbw_nomi
     return out
 
 
-def measures(win: str, final: float, node: str = "out", first_peak: bool = True) -> list:
+def measures(win: str, final: float, node: str = "out", first_peak: bool = True, sign: float = 1.0) -> list:
     """The control block's measurements of one run (peak, peak time, 10-90 % and 2 % settling
     crossings) of ``v(node)`` within ``win`` (``FROM=.. TO=..``), ``final`` the settled output.
     The peak's time: ``first_peak``, where the slope first falls through 0 (a plant's second-order
@@ -253,6 +294,8 @@ def measures(win: str, final: float, node: str = "out", first_peak: bool = True)
         The node measured.
     first_peak : bool
         The peak's time where the slope first falls through 0.
+    sign : float
+        -1: ``-v(node)`` measured (an inverting section's output; ``final`` then its magnitude).
 
     Returns
     -------
@@ -260,9 +303,12 @@ def measures(win: str, final: float, node: str = "out", first_peak: bool = True)
         The ``meas`` commands.
     """
     f, v = final, f"v({node})"
+    neg = []
+    if sign < 0:
+        neg, v = [f"let mcneg = -{v}"], "mcneg"
     peak = ([f"let mcdv = deriv({v})", f"meas tran mctpk WHEN mcdv=0 FALL=1 {win}"] if first_peak else
             [f"meas tran mctpk MAX_AT {v} {win}"])
-    return [f"meas tran mcpeak MAX {v} {win}",
+    return [*neg, f"meas tran mcpeak MAX {v} {win}",
             *peak,
             f"meas tran mct10 WHEN {v}={0.1 * f:.10g} CROSS=1 {win}",
             f"meas tran mct90 WHEN {v}={0.9 * f:.10g} CROSS=1 {win}",
@@ -307,7 +353,7 @@ def parse(output: str, start: int, n: int) -> dict:
 
 def figures(ctx: SpiceContext, values: dict, raw: dict) -> dict:
     """The figures of :data:`FIGURES` from each sample's measurements (module docstring)."""
-    return step_figures(raw, ctx.final_v(values, len(raw["mcpeak"])), ctx.t0)
+    return step_figures(raw, ctx.sign * ctx.final_v(values, len(raw["mcpeak"])), ctx.t0)
 
 
 def step_figures(raw: dict, final, t0: float) -> dict:

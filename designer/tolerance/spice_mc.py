@@ -25,8 +25,8 @@ import numpy as np
 from ..core.errors import DesignError
 from . import spice_engine
 
-__all__ = ["drawn_values", "plant_monte_carlo_engine", "replay", "replay_result", "replay_values", "run_engine",
-           "section_context", "section_monte_carlo_engine", "section_replay", "section_replay_result",
+__all__ = ["drawn_values", "plant_context", "plant_monte_carlo_engine", "replay", "replay_result", "replay_values", "run_engine",
+           "section_context", "section_monte_carlo_engine", "section_step_context", "section_replay", "section_replay_result",
            "spice_evaluate", "spice_samples"]
 
 ENGINES = ("analytic", "spice", "both")
@@ -56,8 +56,61 @@ def spice_step_evaluate(result, simulator: str = "ngspice-cli"):
     """``evaluate(values) -> figures`` of :func:`step_chunk` for a plant result (its deck, parts
     as built, op-amp and test) on the backend ``simulator`` (picklable)."""
     import functools
-    ctx = spice_engine.context(result.deck, result.built, result.opamp, result.test, simulator)
-    return functools.partial(step_chunk, ctx, result.opamp)
+    return functools.partial(step_chunk, plant_context(result, simulator), result.opamp)
+
+
+def plant_context(result, simulator: str = "ngspice-cli"):
+    """The step engine's context (:func:`designer.tolerance.spice_engine.context`) of a Sallen-Key plant:
+    its deck (output net ``out``) on its section (the Sallen-Key low-pass its parts as built realise, their
+    values by designator), op-amp and square-wave test.
+
+    Parameters
+    ----------
+    result : designer.plant.result.PlantResult
+        The design.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    designer.tolerance.spice_engine.SpiceContext
+        The context.
+    """
+    from ..filters.sallen_key_lowpass_parts import part_values, section_of
+    return spice_engine.context(result.deck, section_of(result.built), part_values(result.built), result.opamp,
+                                result.test, simulator, node="out")
+
+
+def section_step_context(result, simulator: str = "ngspice-cli"):
+    """The step engine's context (:func:`designer.tolerance.spice_engine.context`) of a low-pass section
+    plant with its square-wave test (a :class:`~designer.plant.circuit_design.CircuitPlantResult` designed
+    or analysed with ``square_hz``, ``--square-freq``): that test's deck (the section's netlist, output net
+    ``vout``), the section, its values and op-amp. What the Sallen-Key plant's SPICE engine measures
+    (overshoot, peak, rise and settling times from ngspice's ``.tran``), on any low-pass.
+
+    Parameters
+    ----------
+    result : designer.plant.circuit_design.CircuitPlantResult
+        The design, with its square-wave test.
+    simulator : str
+        The backend.
+
+    Returns
+    -------
+    designer.tolerance.spice_engine.SpiceContext
+        The context.
+
+    Raises
+    ------
+    DesignError
+        No square-wave test, or the section is not a low-pass.
+    """
+    run = result.square
+    if run is None:
+        raise DesignError("square_hz: the step engine runs the section's square-wave test; give its frequency "
+                          "(a positive number of hertz)", param="square_hz")
+    return spice_engine.context(run.deck, result.section, dict(result.values), result.opamp, run.test, simulator,
+                                node=result.netlist.amps[0].out)
 
 
 def spice_evaluate(ctx, opamp):
@@ -216,7 +269,7 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
     amp = result.opamp
     if engine == "analytic":
         return plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist, tol_items, limit_items, **where)
-    ctx = spice_engine.context(result.deck, result.built, amp, result.test, simulator)
+    ctx = plant_context(result, simulator)
     settings = {"engine": engine, "simulator": ctx.simulator, "max_step_s": ctx.max_step_s,
                 "rising_half_s": [ctx.t0, ctx.t1],
                 "fn_zeta": "second-order equivalents of the simulated step (zeta from the overshoot, fn from "
@@ -524,7 +577,7 @@ def replay(result, series: dict, index: int, n: int, seed: int, sampler: str, di
     from .montecarlo import figures_with_fixed
     _, tol, v = replay_values(result.built, series, result.opamp, index, n, seed, sampler, dist, tol_items)
     arr = {k: np.array([x]) for k, x in v.items()}
-    ctx = spice_engine.context(result.deck, result.built, result.opamp, result.test, simulator)
+    ctx = plant_context(result, simulator)
     sp = spice_engine.evaluate(ctx, arr, start=index)
     model = figures_with_fixed(arr, {}, result.opamp)
     settings = {"samples": n, "seed": seed, "sampler": sampler, "dist": dist, "engine": "spice",

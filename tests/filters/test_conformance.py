@@ -167,6 +167,33 @@ def test_opamp_model_is_the_nodal_solution(topology):
 
 
 @pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_step_final_is_the_opamp_models_dc_gain(topology):
+    """What a step settles to (:meth:`Topology.step_final`, a closed form where the section overrides it: the
+    Sallen-Key low-pass's K A0/(K + A0)) is the amplitude times the op-amp-aware model's DC gain, num(0)/den(0)
+    of :meth:`Topology.opamp_model`, and the base class's nodal solution at s = 0, to 1e-12 relative (0 for a
+    high-pass or a band-pass); the ideal op-amp's finite A0 counts (the deck simulates it); batched as one by one."""
+    for target in targets(topology):
+        values = topology.synthesize(target)
+        for name in ("ideal", "LM741"):
+            amp = get_opamp(name)
+            num, den = topology.opamp_model(values, amp)
+            got = topology.step_final(values, amp, 2.5)
+            np.testing.assert_allclose(got, 2.5 * num[-1] / den[-1], rtol=1e-9, atol=1e-12)
+            np.testing.assert_allclose(got, Topology.step_final(topology, values, amp, 2.5), rtol=1e-12, atol=1e-12)
+            if topology.kind == "lowpass":
+                sign = -1 if topology.inverting else 1
+                assert sign * got > 2.5 * abs(target.gain) * (1 - 1e-3)       # A0 costs a little of the gain
+    rng = np.random.default_rng(20261204)
+    arrays = {r: v * rng.uniform(0.9, 1.1, size=5) for r, v in topology.synthesize(topology.example).items()}
+    amp = get_opamp("TL072")
+    batch = topology.step_final(arrays, amp, 2.0)
+    assert batch.shape == (5,)
+    for i in range(5):
+        one = topology.step_final({r: float(a[i]) for r, a in arrays.items()}, amp, 2.0)
+        assert float(one) == batch[i]
+
+
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
 def test_ideal_pair_is_the_coefficients_pair(topology):
     """The ideal (fn, zeta) a PID's plant is named and sized by (:meth:`Topology.ideal_pair`, a section's own
     arithmetic where it has one: the Sallen-Key low-pass's) is the pair of its ideal coefficients: fn of

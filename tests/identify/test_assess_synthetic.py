@@ -44,13 +44,17 @@ record's own rate and compare its block means with the output's, so the
 means leave the fit unbiased (:func:`test_block_means_leave_the_fit_unbiased`;
 fitted on the block means as a record of their own they moved an SOPDT's dead
 time under a random binary signal p 0.5 at 10 dB to 0.950 s and 0.944 s for
-0.900 s with blocks of 2 and 3 samples). The true model's fit is computed on
-the record the assessment scored (its block means). The SOPDT under a step
+0.900 s with blocks of 2 and 3 samples). Every candidate's validation, and
+the true model's fit here, simulate the model at the record's own rate too and
+score the block means of the simulation against the output's
+(:func:`test_validation_of_block_means_is_exact`). The SOPDT under a step
 at 10 dB would need 409,000 samples over its 60 s, over the cap: at 99,601
 it passes, its short lag's interval (+-0.14 s) still wider than its
-tolerance. The FOPDT under a step at 10 dB misses on the ranking, not on the
-data (:func:`test_a_step_miss_is_a_tie_not_the_data`)."""
+tolerance. Under a step at 10 dB an FOPDT's best rival is a lead-lag whose
+zero mirrors its fast lag, an approximation of dead time that is not valid
+(:func:`test_an_all_pass_lead_lag_is_not_a_structure_of_its_own`)."""
 
+import functools
 import math
 
 import numpy as np
@@ -188,7 +192,7 @@ class _True:
         return simulate(self.model, u, self.ts, self.hold)
 
 
-#: the xfails whose best model is another structure that ties the true one's fit (the ranking's, not the data's)
+#: the cases whose best model another structure's fit came close to (an all-pass lead-lag: its test below)
 TIES = [("fopdt", "step", 10)]
 #: their captures and identifications, shared by the two tests that read them (one identification each)
 _SHARED = {}
@@ -212,9 +216,9 @@ def run(plant: str, inp: str, snr_db: float, seed: int = SEED) -> dict:
     a = res.assessment
     k = a.decimated_by
     assert k == math.ceil(u.size / MAX_SAMPLES)
-    if k > 1:       # the record the assessment scored: its block means
-        u, y = (x[:x.size // k * k].reshape(-1, k).mean(axis=1) for x in (u, y))
-    truth = validate(_True(true_model(plant), a.sample_time_s, a.hold), u, y, a.split).fit_percent
+    # simulated at the record's own rate, its block means scored (as the assessment scores every candidate)
+    # (the capture's own sample interval: a step's and the integrator's are finer than TS)
+    truth = validate(_True(true_model(plant), float(t[1] - t[0]), a.hold), u, y, a.split, block=k).fit_percent
     return {"a": a, "best": a.best_candidate, "truth": truth}
 
 
@@ -245,24 +249,19 @@ def misses(plant: str, best) -> list:
 # (the best model's validation fit is the true model's to 0.05 point in each: the data cannot tell them apart)
 _SAME = "; its fit {} equals the true model's {}"
 DATA = {
-    # the predicted 26,331 samples (blocks of 2; at 300 s K 1.537, +2.5 %, the short lag 1.612 s, +7.5 % +-0.20 s,
-    # theta 0.816 s, -9.4 %): the output-error SOPDT is within the tolerances (K 1.506, lags 4.000 s and 1.533 s,
-    # theta 0.879 s +-0.024 s) but the lead-lag's fit ties it to 0.001 point and ranks first (at 2000 s without
-    # block means the best SOPDT's short lag was 1.591 s, +6.0 % +-0.090 s, theta 0.855 s, -5.0 % +-0.028 s)
-    ("sopdt", "rb0.1", 10): ("random binary p 0.1 at 10 dB, 26,331 samples: the best is the output-error "
-                             "lead-lag (lags 3.963 s and 1.578 s, a zero at 0.165 s +-0.10 s, theta 1.027 s); "
-                             "the SOPDT beside it is within the tolerances, its fit 0.001 point lower"
-                             + _SAME.format(79.38, 79.38)),
+    # ("sopdt", "rb0.1", 10) passes at its predicted 26,331 samples (blocks of 2): the best is the correlation
+    # route's stark-mollenkamp overdamped (K 1.494, lags 3.946 s and 1.532 s, theta 0.897 s), 79.483 % against
+    # the true model's 79.493 %, the output-error SOPDT (within the tolerances too) and lead-lag tied with it
+    # within one standard error (0.010 and 0.011 point). Its models simulated on the input's block means,
+    # the lead-lag came first, 0.0001 point above the SOPDT
     # ("sopdt", "chirp", 10) passes at its predicted 82,512 samples (blocks of 5, foh: the output-error SOPDT, K
     # 1.497, lags 4.011 s and 1.471 s, theta 0.913 s +-0.032 s); at 2000 s, the longest record before the block
     # means were unbiased, its short lag was 1.412 s (-5.9 %, +-0.137 s), theta 0.961 s (+6.8 %)
-    # the FOPDT under a step at 10 dB, 17,401 samples over 60 s: the output-error FOPDT is within the tolerances
-    # (K 2.012, tau 5.033 s, theta 1.246 s +-0.070 s, -4.2 %) but an output-error lead-lag whose zero and second
-    # lag are an all-pass pair (tz -0.280 s +-0.204 s, tau2 0.291 s +-0.200 s: half a second of delay, its
-    # theta 0.703 s) fits 0.002 point better and ranks first; at 14,201 samples the FOPDT ranked first
-    ("fopdt", "step", 10): ("a step at 10 dB, 17,401 samples: the best is the output-error lead-lag (an all-pass "
-                            "pair, tz -0.280 s, tau2 0.291 s, theta 0.703 s); the FOPDT beside it is within the "
-                            "tolerances, its fit 0.002 point lower" + _SAME.format(69.96, 69.96)),
+    # the FOPDT under a step at 10 dB, 17,401 samples over 60 s: the output-error FOPDT, within the tolerances
+    # (K 2.012, tau 5.033 s, theta 1.246 s +-0.070 s, -4.2 %); an output-error lead-lag whose zero and second lag
+    # are an all-pass pair (tz -0.280 s +-0.204 s, tau2 0.291 s +-0.200 s: Pade's approximation of half a second
+    # of delay, its theta 0.703 s) fitted 0.002 point better and ranked first until such a pair made a lead-lag
+    # invalid (identify.outputerror.all_pass_pair; test_an_all_pass_lead_lag_is_not_a_structure_of_its_own)
 }
 # sized by the rule (module docstring) every other single step and every integrating case meets the tolerances:
 # the FOPDT, SOPDT and underdamped plants under a step over 60 s at 3001 samples (20 dB) or at 39,001 (the SOPDT
@@ -291,14 +290,14 @@ def test_best_model_recovers_the_plant(plant, inp, snr_db):
 
 
 @pytest.mark.parametrize("plant, inp, snr_db", TIES)
-def test_a_step_miss_is_a_tie_not_the_data(plant, inp, snr_db):
-    """The step's xfail above at its sized record: the data place the plant,
-    the ranking does not pick it. The output-error fit of the true structure
-    is valid, every parameter within the issue's tolerance, its validation
-    fit within 0.01 point of the best's; the output-error fit started at the true parameters ends where the
-    fit from its own starts ends (the same rms: the estimator is not the
-    limit). Every other single step and integrating case passes at its
-    sized record (the module docstring)."""
+def test_an_all_pass_lead_lag_is_not_a_structure_of_its_own(plant, inp, snr_db):
+    """The FOPDT under a step at 10 dB: an output-error lead-lag fits the
+    validation data a little better than the FOPDT, its zero in the right half
+    plane mirroring its fast lag within their intervals, (1 - a s)/(1 + a s),
+    Pade's approximation of a delay: it is not valid (the note says why), and
+    the best is the true structure, within the tolerances. The fit of the true
+    structure started at the true parameters ends where the fit from its own
+    starts ends (the estimator is not the limit)."""
     from designer.identify.assess import OE_INITIAL
     from designer.identify.outputerror import fit_output_error
     t, u, y, res = identified(plant, inp, snr_db)
@@ -306,15 +305,31 @@ def test_a_step_miss_is_a_tie_not_the_data(plant, inp, snr_db):
     kind, p = PLANTS[plant]
     oe = next(c for c in a.candidates if c.route == "output-error" and c.kind == kind)
     assert oe.valid and not misses(plant, oe), (oe.params, oe.note)
-    best = a.best_candidate
-    assert best.kind != kind and best.fit_percent - oe.fit_percent < 0.01, (best.label, best.fit_percent,
-                                                                          oe.fit_percent)
+    ll = next(c for c in a.candidates if c.route == "output-error" and c.kind == "lead-lag")
+    assert not ll.valid and "all-pass pair" in ll.note and ll.params["tz_s"] < 0
+    assert abs(ll.params["tz_s"] + ll.params["tau2_s"]) < math.hypot(ll.ci95["tz_s"], ll.ci95["tau2_s"])
+    assert ll.fit_percent > oe.fit_percent and a.best_candidate is oe
     k = a.decimated_by
     est = slice(0, a.split.n_est * k) if a.split is not None else slice(None)
     ue, ye, ts, init = u[est], y[est], a.sample_time_s / k, OE_INITIAL.get(kind, "estimate")
     own = fit_output_error(ue, ye, ts, kind, hold=a.hold, initial=init, block=k)
     from_truth = fit_output_error(ue, ye, ts, kind, hold=a.hold, initial=init, start=p, block=k)
     assert from_truth.rms_residual == pytest.approx(own.rms_residual, rel=1e-6)
+
+
+@functools.lru_cache(maxsize=2)
+def _long_capture(points: int) -> tuple:
+    """(t, u, y, assessment) of the SOPDT at 10 dB under a random binary signal
+    p 0.5, ``points`` samples (scored on block means)."""
+    t, u, _, y = capture("sopdt", "rb0.5", 10, points=points)
+    a = identify_record(t, y, u, name=f"sopdt/rb0.5/10 dB, {points} samples").assessment
+    return t, u, y, a
+
+
+def _fit(y, yhat) -> float:
+    """MATLAB compare's fit of ``yhat`` to ``y``, each with its mean removed (percent)."""
+    y, yhat = y - y.mean(), yhat - yhat.mean()
+    return 100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y))
 
 
 @pytest.mark.parametrize("points", [40_000, 100_000])
@@ -331,8 +346,7 @@ def test_block_means_leave_the_fit_unbiased(points):
     0.892 s)."""
     from designer.identify.assess import OE_INITIAL
     from designer.identify.outputerror import fit_output_error
-    t, u, _, y = capture("sopdt", "rb0.5", 10, points=points)
-    a = identify_record(t, y, u, name=f"sopdt/rb0.5/10 dB, {points} samples").assessment
+    _, u, y, a = _long_capture(points)
     k = math.ceil(points / MAX_SAMPLES)
     assert k > 1 and a.decimated_by == k and a.hold == "zoh"
     fit = next(f for f in a.output_error if f.kind == "sopdt")
@@ -346,3 +360,59 @@ def test_block_means_leave_the_fit_unbiased(points):
     ub, yb = (x[:n].reshape(-1, k).mean(axis=1) for x in (u, y))
     former = fit_output_error(ub, yb, TS * k, "sopdt", hold="foh", initial=initial)
     assert abs(former.params["theta_s"] - full.params["theta_s"]) > full.ci95["theta_s"]
+
+
+@pytest.mark.parametrize("points", [40_000, 100_000])
+def test_validation_of_block_means_is_exact(points):
+    """A record scored on block means: every candidate's validation fit is the
+    fit of the block means of its simulation at the record's own rate, under
+    the assessment's hold, from the record's start at rest, against the
+    output's block means on the validation part (to 1e-9 point). The former
+    way, the model simulated on the input's block means at their own interval,
+    gave other numbers for every candidate (a held input's block means are
+    ramps between its levels, not the input the plant saw): 0.11 to 1.3 points
+    off with blocks of 2, 0.009 to 9.0 with blocks of 5."""
+    _, u, y, a = _long_capture(points)
+    k = a.decimated_by
+    assert k == math.ceil(points / MAX_SAMPLES) and k > 1 and a.split is not None
+    n = u.size // k * k
+    ub, yb = (x[:n].reshape(-1, k).mean(axis=1) for x in (u, y))
+    val = a.split.validation
+    scored = [c for c in a.candidates if c.validation is not None]
+    assert len(scored) >= 5
+    former = []
+    for c in scored:
+        sim = simulate(c.model, u[:n] - u[0], TS, a.hold).reshape(-1, k).mean(axis=1)
+        assert c.fit_percent == pytest.approx(_fit(yb[val], sim[val]), abs=1e-9), c.label
+        assert c.validation.samples == ub[val].size
+        old = simulate(c.model, ub - ub[0], TS * k, a.hold)
+        former.append(abs(_fit(yb[val], old[val]) - c.fit_percent))
+    # measured: 0.11 to 1.3 points with blocks of 2 (40,000 samples), 0.009 to 9.0 with blocks of 5
+    assert min(former) > 1e-3, sorted(former)
+
+
+def test_a_tie_within_the_margin_goes_to_fewer_parameters():
+    """The SOPDT under a step at 10 dB, 300 s (its xfail above): the output-error
+    SOPDT has the best validation fit, its FOPDT 0.017 point lower, within one
+    standard error of their validation losses' difference: the FOPDT, with a
+    parameter fewer, is the best, and the assessment's JSON ("ranking" and the
+    best's note) and its validation text say why. A capture whose best is its
+    best fit has no "ranking" in its JSON."""
+    from designer.identify.ranking import rank
+    from designer.identify.report import validation_text
+    t, u, _, y = capture("sopdt", "step", 10, points=POINTS)
+    a = identify_record(t, y, u, name="sopdt/step/10 dB").assessment
+    r = rank(a.candidates)
+    best, top = a.best_candidate, a.candidates[r.top]
+    assert (best.label, top.label) == ("output-error oe fopdt", "output-error oe sopdt")
+    assert 0.0 < top.fit_percent - best.fit_percent <= r.margin
+    want = f"tied with output-error oe sopdt within the margin (fit {best.fit_percent:.3f} % against " \
+           f"{top.fit_percent:.3f} %"
+    assert a.ranking.startswith(want) and a.ranking.endswith("; fewer parameters (3 against 4)")
+    d = a.to_dict()
+    assert d["ranking"] == a.ranking and a.ranking in d["best"]["note"]
+    line = next(x for x in validation_text(a) if x.startswith("Best by validation fit: "))
+    assert line.startswith(f"Best by validation fit: output-error oe fopdt, fit {best.fit_percent:.2f} % ({want}")
+    t, u, _, y = capture("fopdt", "rb0.5", 20)
+    plain = identify_record(t, y, u, name="fopdt/rb0.5/20 dB").assessment
+    assert plain.ranking == "" and "ranking" not in plain.to_dict()

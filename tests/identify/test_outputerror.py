@@ -454,3 +454,18 @@ def test_a_dead_times_interval_survives_a_short_jacobian_column():
     half = stdtrit(dof, 0.975) * np.sqrt(np.diag(np.linalg.inv(jac.T @ jac)) * (r @ r) / dof)
     assert fit.ci95["K"] == pytest.approx(half[0], rel=0.05)
     assert fit.ci95["theta_s"] == pytest.approx(half[1], rel=0.05)
+
+
+def test_an_all_pass_pair_is_named_and_a_real_zero_is_not():
+    """A lead-lag whose right-half-plane zero mirrors a lag within their intervals is Pade's delay, not a
+    structure (issue 28: a model is valid only where its structure is what the data show)."""
+    from designer.identify.outputerror import all_pass_pair
+    p = {"K": 2.0, "tau1_s": 5.0, "tau2_s": 0.291, "tz_s": -0.280, "theta_s": 0.7}
+    ci = {"K": 0.01, "tau1_s": 0.1, "tau2_s": 0.200, "tz_s": 0.204, "theta_s": 0.3}
+    assert "all-pass pair" in all_pass_pair(p, ci)[0]
+    # the mirror against the slow lag counts too; a left-half-plane zero (seed 003's furnace) never does
+    assert all_pass_pair(dict(p, tau1_s=0.3, tau2_s=5.0), dict(ci, tau1_s=0.2, tau2_s=0.1))
+    assert all_pass_pair(dict(p, tz_s=0.280), ci) == []
+    # a zero the intervals place away from every lag, or without an interval, is a structure of its own
+    assert all_pass_pair(dict(p, tz_s=-1.5), ci) == []
+    assert all_pass_pair(p, dict(ci, tz_s=None)) == []

@@ -142,3 +142,56 @@ def test_a_record_scored_whole_fits_the_level_it_rested_at():
     assert fitted.how == "rest" and not np.any(np.abs(fitted.whiteness.r) > 1.0)
     with pytest.raises(DesignError, match="scored whole"):
         va.validate(Model(), u, y, va.split_record(u.size), how="rest")
+
+
+def test_block_means_score_the_simulation_at_the_records_own_rate():
+    """``block`` = k: the model is simulated on every sample and the block
+    means of its simulation scored against the output's (a trailing partial
+    block dropped): the true model's residuals are then the noise's block
+    means alone, under every way of scoring, where simulated on the input's
+    block means (as a record of their own, every k-th interval) it misses;
+    block 1 is the unblocked score, and a block that is not a whole number
+    from 1 is refused."""
+    b, a = [0.0, 0.0, 0.2], [1.0, -0.8]      # a lag of 4.5 samples, gain 1, one sample of dead time
+
+    class Model:
+        def response(self, x):
+            return lfilter(b, a, np.asarray(x, float))
+
+        def simulate(self, x):
+            return self.response(np.asarray(x, float) - x[0]) + 3.0
+
+    rng = np.random.default_rng(22)
+    flips = rng.random(4003) < 0.05
+    flips[0] = False
+    u = np.where(np.cumsum(flips) % 2 == 0, 1.0, -1.0)
+    noise = 0.05 * rng.standard_normal(u.size)
+    y = Model().simulate(u) + noise
+    k = 3
+    ub, yb, nb = (x[:4002].reshape(-1, k).mean(axis=1) for x in (u, y, noise))
+    assert np.array_equal(va.block_means(u, k), ub)
+    assert np.array_equal(va.block_means(np.column_stack((u, y)), k), np.column_stack((ub, yb)))
+    assert np.array_equal(va.block_means(u, 1), u)
+    split = va.split_record(ub.size)
+    val = split.validation
+    yv, nv = yb[val] - yb[val].mean(), nb[val] - nb[val].mean()
+    want = {"detrend": va.compare_fit(yv, yv - nv), "continue": va.compare_fit(yb[val], yb[val] - nb[val])}
+    for how in want:
+        v = va.validate(Model(), u, y, split, how=how, block=k)
+        assert v.fit_percent == pytest.approx(want[how], abs=1e-9), how
+        assert v.samples == ub.size - split.n_est and v.residuals.size == v.samples
+    whole = va.validate(Model(), u, y, None, block=k)
+    assert whole.fit_percent == pytest.approx(va.compare_fit(yb - yb.mean(), yb - nb - (yb - nb).mean()), abs=1e-9)
+    assert whole.spread == pytest.approx(np.linalg.norm(yb - yb.mean()))
+
+    class Coarse(Model):      # the former way: the same lag sampled every k samples, on the input's means
+        def response(self, x):
+            return lfilter([0.0, 1 - 0.8 ** k], [1.0, -0.8 ** k], np.asarray(x, float))
+
+    assert va.validate(Coarse(), ub, yb, split).fit_percent < want["detrend"] - 1.0
+    plain = va.validate(Model(), u, y, va.split_record(u.size))
+    same = va.validate(Model(), u, y, va.split_record(u.size), block=1)
+    assert (plain.fit_percent, plain.samples) == (same.fit_percent, same.samples)
+    for bad in (0, -2, 1.5, True, "3"):
+        with pytest.raises(DesignError, match="block must be a whole number"):
+            va.validate(Model(), u, y, split, block=bad)

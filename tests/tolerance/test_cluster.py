@@ -18,6 +18,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from designer.tolerance.spice_mc import plant_context
 from designer.core import opamps
 from designer.core.errors import DesignError, SimulatorError
 from designer.tolerance import cluster, plant
@@ -106,12 +107,11 @@ def test_spice_chunks_of_ngspice_processes_run_on_thread_workers():
 
     from designer.plant.design import design_plant
     from designer.plant.spec import PlantSpec
-    from designer.tolerance import spice_engine
     from designer.tolerance.montecarlo import apply_engine, plant_parts
     from designer.tolerance.spice_mc import spice_evaluate
     res = design_plant(PlantSpec(fc_hz=3500, zeta=0.2), simulate=False)
     nominal = plant_parts(res.built)
-    ctx = spice_evaluate(spice_engine.context(res.deck, res.built, res.opamp, res.test, "ngspice-cli"), res.opamp)
+    ctx = spice_evaluate(plant_context(res, "ngspice-cli"), res.opamp)
     draw = Draw(nominal, {k: 0.05 for k in nominal}, 48, 2)
     _, ref, _ = Runner().run(apply_engine, ctx, draw)
     before = _children()

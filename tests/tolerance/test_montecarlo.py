@@ -136,3 +136,21 @@ def test_a_plant_on_another_topology_runs_the_same_monte_carlo_over_its_declared
     for k in ("fn_hz", "zeta", "ideal_fn_hz", "gain"):
         assert np.allclose(mc.figures[k], again[k], rtol=1e-12), k
     assert mc.tighten["part"] in mfb.designators
+
+
+@pytest.mark.parametrize("parts", [PARTS, SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, 2.0, 10e3, 10e3)],
+                         ids=["follower", "gain2"])
+def test_the_sallen_key_plant_and_its_section_run_one_monte_carlo(parts):
+    """Issue 26, written once: the plant's Monte Carlo is the generic one on its section (the chunk function
+    circuit.evaluate, which takes the Sallen-Key low-pass's own exact figures), so the section given as a
+    circuit draws the same builds and finds the same figures, to the bit, GBW spread included."""
+    from designer.filters.sallen_key_lowpass_parts import part_values, section_of
+    from designer.tolerance.montecarlo import plant_parts
+    amp = opamps.get("LM741")
+    kw = dict(seed=3, limit_items=["overshoot_pct=0:60"], tol_items=["GBW=30%"])
+    plant = plant_monte_carlo(parts, SERIES, amp, 300, **kw)
+    section = plant_monte_carlo(None, SERIES, amp, 300, circuit=(plant_parts(parts), circuit.evaluate,
+                                                                 (section_of(parts).name, amp)), **kw)
+    assert plant.to_dict() == section.to_dict()
+    assert plant.csv_text() == section.csv_text()
+    assert set(plant.values) == set(part_values(parts)) | {"GBW"}

@@ -5,6 +5,7 @@ import io
 import numpy as np
 import pytest
 
+from designer.tolerance.spice_mc import plant_context
 from designer.core.errors import DesignError
 from designer.plant.design import design_plant
 from designer.plant.spec import PlantSpec
@@ -115,10 +116,8 @@ def test_sampling_matches_replay_offsets():
 def test_the_engine_pickles_for_workers(seed_plant):
     import pickle
 
-    from designer.tolerance import spice_engine
     from designer.tolerance.spice_mc import spice_evaluate
-    f = pickle.loads(pickle.dumps(spice_evaluate(spice_engine.context(seed_plant.deck, seed_plant.built,
-                                                                      seed_plant.opamp, seed_plant.test),
+    f = pickle.loads(pickle.dumps(spice_evaluate(plant_context(seed_plant),
                                                  seed_plant.opamp)))
     v = sampling.values({"R1": 1.6e3, "R2": 3.9e3, "C1": 3.3e-9, "C2": 100e-9},
                         {"R1": .05, "R2": .05, "C1": .1, "C2": .1}, 4, 1)

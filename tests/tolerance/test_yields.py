@@ -7,6 +7,7 @@ import io
 import numpy as np
 import pytest
 
+from designer.tolerance.spice_mc import plant_context
 from designer.check.limits import Limit as CheckLimit
 from designer.plant.design import design_plant
 from designer.plant.spec import PlantSpec
@@ -76,7 +77,7 @@ def test_the_spice_engine_counts_spices_step_figures_and_the_models_others(plant
     inside = ((rows["fn_hz"] >= 3400) & (rows["fn_hz"] <= 3600) & (rows["spice_overshoot_pct"] <= 54)
               & (rows["spice_settling_time_s"] <= 1.5e-3))
     assert v.mc.yield_count == int(inside.sum()) and v.mc.engine == "spice"
-    ctx = spice_engine.context(plant.deck, plant.built, plant.opamp, plant.test)
+    ctx = plant_context(plant)
     parts = ("R1", "R2", "C1", "C2", "SR")
     again = spice_engine.evaluate(ctx, {k: rows[k][:3] for k in parts})
     np.testing.assert_allclose(again["overshoot_pct"], rows["spice_overshoot_pct"][:3], rtol=1e-9)
