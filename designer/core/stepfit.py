@@ -17,7 +17,10 @@ The fit starts from a classical estimate (or a few points of the response),
 minimises the sum of squared errors with scipy's trust-region reflective solver
 under physical bounds (tau > 0, theta >= 0, 0 < zeta < 1), and reports 95 %
 confidence half-widths from the residual variance and the Jacobian at the
-optimum: cov = s^2 (J^T J)^-1, s^2 = SSE / (n - p). They assume white
+optimum: cov = s^2 (J^T J)^-1, s^2 = SSE / (n - p), by
+:func:`~designer.core.lsq_intervals.half_widths` (columns of very different
+lengths scaled first; a parameter the data do not determine gets an infinite
+half-width). They assume white
 residuals; with model-structure error the residuals are correlated and the
 intervals are optimistic.
 """
@@ -29,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .lsq_intervals import half_widths
 from .metrics import Overshoot, measure_step
 from .waveform import crossing_time, noise_sigma
 
@@ -358,21 +362,21 @@ def _confidence(model, sol, n):
     dof = max(n - p, 1)
     s2 = 2.0 * sol.cost / dof
     try:
-        cov = np.linalg.pinv(J.T @ J) * s2
+        # scaled columns when their norms span more than SCALE_SPAN: an overdamped fit of a first-order
+        # response shrinks tau1 towards 0, its column with it, and the unscaled pseudo-inverse dropped it
+        # (tau1 +-3.4e-8 s, an unidentifiable time constant reported as exact)
+        sd = half_widths(J, s2, dof)
     except np.linalg.LinAlgError:  # pragma: no cover - defensive
         return {k: math.nan for k in names}
-    from scipy.special import stdtrit
-    q = float(stdtrit(dof, 0.975))
-    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     x = sol.x
     out = {}
     for i, k in enumerate(names):
         if k in ("tau_s", "tau1_s", "tau2_s", "wn_rad_s"):
-            out[k] = float(q * sd[i] * math.exp(x[i]))  # d exp(x) = exp(x) dx
+            out[k] = float(sd[i] * math.exp(x[i]))  # d exp(x) = exp(x) dx
         else:
             # K, zeta, theta are free variables themselves. (Residuals are
             # divided by |yf|, a constant: it cancels between s^2 and J.)
-            out[k] = float(q * sd[i])
+            out[k] = float(sd[i])
     return out
 
 

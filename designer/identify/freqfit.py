@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 
+from ..core.lsq_intervals import half_widths
 from ..core.ranges import RANGES
 from .bode_readings import invalid_result, fit_error, model_phase, model_response
 from .io import FreqData
@@ -115,9 +116,6 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     """
     from scipy.optimize import least_squares
 
-    # Student t quantile from scipy.special: scipy.stats costs 0.4 s to import
-    from scipy.special import stdtrit
-
     name = "least-squares"
     fit_delay = data.phase is not None
     fun = _residual(model, data, fit_delay)
@@ -147,8 +145,11 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     if m > n:
         s2 = 2.0 * best.cost / (m - n)
         try:
-            cov = np.linalg.inv(best.jac.T @ best.jac) * s2
-            half = stdtrit(m - n, 0.975) * np.sqrt(np.clip(np.diag(cov), 0.0, None))
+            # the one rule of every fit (core.lsq_intervals): a pseudo-inverse, on scaled columns when their
+            # norms span more than SCALE_SPAN, and a direction the data do not determine unbounded, where
+            # inv() of the unscaled product gave a double pole fitted as two lags tau1 and tau2 +-0 (a
+            # negative variance of a singular product clipped to 0) and the fit stayed valid
+            half = half_widths(best.jac, s2, m - n)
             # back from log variables: d(e^x) = e^x dx
             names = {"fopdt": ["K", "tau_s"], "underdamped": ["K", "wn_rad_s", "zeta"],
                      "overdamped": ["K", "tau1_s", "tau2_s"]}[model]

@@ -70,9 +70,10 @@ means' half-block delay and low-pass act on both sides alike; fitting the
 block means as a record of their own does not, it turns a held input into
 ramps and moved an SOPDT's dead time by half a sample), with m times fewer
 residuals. 95 % half-widths from the Jacobian at the optimum,
-t(0.975, N - p) sqrt(diag((J^T J)^-1) s^2), s^2 = SSE/(N - p) (they assume
-white output noise: with coloured noise or a wrong structure they are
-optimistic). A parameter held at its bound has no interval (a dead time at
+t(0.975, N - p) sqrt(diag((J^T J)^-1) s^2), s^2 = SSE/(N - p), by
+:func:`designer.core.lsq_intervals.half_widths` (columns of very different
+lengths scaled first; they assume white output noise: with coloured noise or a
+wrong structure they are optimistic). A parameter held at its bound has no interval (a dead time at
 0 is a plant without one); any other at a bound makes the model invalid. A
 model is valid when the solver converged, no parameter but the dead time
 sits at a bound, every interval is narrower than its parameter (the dead
@@ -90,6 +91,7 @@ import numpy as np
 
 from ..core import process_build as pb
 from ..core.errors import DesignError
+from ..core.lsq_intervals import half_widths
 from ..core.process import ProcessModel
 from .validation import DEFAULT_FRACTION, Split, arx_fit, block_means, split_record, validate
 
@@ -115,9 +117,6 @@ START_SAMPLES = 5000
 MAX_START_DELAY = 150
 #: the damping ratio's bounds (zeta >= 1 is the SOPDT)
 ZETA_BOUNDS = (0.005, 0.999)
-#: Jacobian columns whose norms span more than this are scaled to unit norm before the intervals' pseudo-inverse
-#: (J^T J's condition from the scales alone then 1e8, far from pinv's 1e-15 cut-off below it)
-SCALE_SPAN = 1e4
 #: a time constant below this fraction of the sample interval cannot be seen in the record
 MIN_TAU_OF_T = 1e-3
 
@@ -661,7 +660,6 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
         a block that is not a whole number of samples from 1 up.
     """
     from scipy.optimize import least_squares
-    from scipy.special import stdtrit
     if kind not in FIT_KINDS:
         raise DesignError(f"kind {kind!r} unknown; allowed: {', '.join(FIT_KINDS)}")
     if initial not in INITIALS:
@@ -767,20 +765,12 @@ def fit_output_error(u, y, sample_time_s: float, kind: str = "fopdt", *, hold: s
     s2 = float(r @ r) / dof
     ci = {k: None for k in names}
     if free.any():
-        # columns of very different lengths scaled to unit norm before the pseudo-inverse: its cut-off is
-        # relative to the largest singular value, and a dead time started near 0 is scaled by the sample
-        # interval, so its column can be 1e8 times shorter than the gain's; unscaled, pinv dropped it and
-        # gave the dead time an interval of 3e-18 s (an integrator under a step, 15,561 samples over 30 s at
-        # 20 dB: +-0.05 s by the same Jacobian scaled). Columns within SCALE_SPAN of each other keep the
-        # unscaled product (the same intervals to the last bit as before)
-        d = np.linalg.norm(J, axis=0)
-        if d.max() > 0 and d.min() < d.max() / SCALE_SPAN:
-            d = np.where(d > 0, d, 1.0)
-            Jn = J / d
-            cov = np.linalg.pinv(Jn.T @ Jn) / np.outer(d, d) * s2
-        else:
-            cov = np.linalg.pinv(J.T @ J) * s2
-        half = float(stdtrit(dof, 0.975)) * np.sqrt(np.clip(np.diag(cov), 0.0, None))
+        # one rule for every fit's intervals (core.lsq_intervals): columns of very different lengths scaled to
+        # unit norm before the pseudo-inverse (a dead time started near 0 is scaled by the sample interval, so
+        # its column can be 1e8 times shorter than the gain's; unscaled, pinv dropped it and gave the dead
+        # time an interval of 3e-18 s: an integrator under a step, 15,561 samples over 30 s at 20 dB, +-0.05 s
+        # scaled)
+        half = half_widths(J, s2, dof)
         for k, h in zip(np.array(names)[free], half):
             ci[str(k)] = float(h)
     # back to the record's units
@@ -875,7 +865,8 @@ def _linear_back(beta, sy: float, su: float, kind: str, initial: str) -> tuple:
 
 def _process_model(kind: str, p: dict, ci: dict) -> tuple:
     """The fit as a :class:`ProcessModel` (its constructor checks the ranges), and why not."""
-    c = {k: v for k, v in ci.items() if v is not None}
+    # an unbounded half-width (a direction the data do not determine) is noted by the caller, not carried
+    c = {k: v for k, v in ci.items() if v is not None and math.isfinite(v)}
     src = f"output error ({kind})"
     try:
         if kind == "fopdt":

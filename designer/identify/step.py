@@ -286,7 +286,8 @@ def judge(m: MethodResult, step: PreparedStep, overshoot: Overshoot | None = Non
         for k in _SCALES:
             ci = m.points.get(f"{k}_ci95")
             v = m.params.get(k)
-            if ci is not None and v and math.isfinite(ci) and ci > MAX_CI_FRACTION * abs(v):
+            # an infinite half-width (a direction the data do not determine) too; nan (no interval) passes
+            if ci is not None and v and ci > MAX_CI_FRACTION * abs(v):
                 why = (f"the 95 % confidence interval of {k} (±{ci:.3g}) is wider than its "
                        f"value ({v:.3g}): not determined by the data")
                 break

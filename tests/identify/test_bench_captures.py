@@ -453,3 +453,19 @@ def test_real_tek0001_prints_no_femtoseconds():
         th = m.params.get("theta_s")
         if th is not None and math.isfinite(th) and m.name == "least-squares":
             assert th == 0.0 or th >= 1e-3 * r.step.dt, m.model
+
+
+def test_an_unbounded_interval_makes_a_least_squares_result_invalid():
+    """core.lsq_intervals gives a parameter the data do not determine an infinite half-width; the judge
+    skipped non-finite intervals, so such a fit stayed valid (bug). inf is now wider than any value; a
+    nan (no interval computed) still passes, as before."""
+    from designer.identify.step import judge
+    from designer.identify.structures import MethodResult
+    p = {"K": 1.0, "wn_rad_s": 2e4, "zeta": 0.6, "theta_s": 0.0}
+    t = np.linspace(-2e-4, 2e-3, 4401)
+    r = identify_step(t, model_step("underdamped", p, t), np.where(t >= 0, 1.0, 0.0))
+    for h, valid in ((float("inf"), False), (float("nan"), True), (0.01, True)):
+        m = MethodResult("least-squares", "underdamped", dict(p), points={"zeta_ci95": h, "K_ci95": 0.001})
+        judge(m, r.step, r.overshoot)
+        assert m.valid is valid, (h, m.note)
+        assert valid or "zeta (±inf) is wider than its value" in m.note
