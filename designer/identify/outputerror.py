@@ -329,20 +329,55 @@ def simulate(model: ProcessModel, u, sample_time_s: float, hold: str = "zoh") ->
 
 # --------------------------------------------------------------------------- one evaluation
 
-def _columns(s: Sampled, n: int, integrating: bool, initial: str) -> np.ndarray:
+#: samples of a free response filtered at a time: the rest is exactly zero once the state underflows
+FREE_CHUNK = 1 << 14
+
+
+#: the smallest normal float
+TINY = float(np.finfo(float).tiny)
+
+
+def _free_response(a: np.ndarray, n: int) -> np.ndarray:
+    """The free response of 1/a(z^-1) from the unit state 0 over ``n``
+    samples: ``lfilter([1], a, zeros(n), zi=e_0)[0]`` (one filter, its state
+    carried from chunk to chunk: the same numbers), but a stable model's
+    response stops being filtered once every state is below the smallest
+    normal float (the rest is then zeros where the one filter gives
+    subnormals, which round to nothing beside any normal value and never
+    reach zero: x 0.9975 rounds the smallest subnormal to itself; a pole at
+    0.9975, 10^6 samples: stopped after about 300,000)."""
+    from scipy.signal import lfilter
+    out = np.zeros(n)
+    zi = np.zeros(a.size - 1)
+    zi[0] = 1.0
+    zero = np.zeros(min(FREE_CHUNK, n))
+    for j in range(0, n, FREE_CHUNK):
+        m = min(FREE_CHUNK, n - j)
+        out[j:j + m], zi = lfilter([1.0], a, zero[:m], zi=zi)
+        if np.all(np.abs(zi) < TINY):
+            break
+    return out
+
+
+def _columns(s: Sampled, n: int, integrating: bool, initial: str, block: int = 1) -> np.ndarray:
     """The linear part's regressors: the output level; with ``initial="estimate"``
     also the free response of each state of 1/a(z^-1) and, for an integrating
-    model, the response to a constant input (an unknown balance input)."""
-    from scipy.signal import lfilter
-    cols = [np.ones(n)]
+    model, the response to a constant input (an unknown balance input); as
+    block means of ``block`` samples when ``block`` > 1, each column's means
+    taken on its own (a long record's (n, columns) array never built: 10^6
+    samples, a quarter of an identification's time went to stacking and
+    averaging it). The free response from state i is the one from state 0
+    delayed i samples (lfilter's state z^-i / a(z^-1) with no input: the
+    first i outputs are exact zeros and the state shifts down unchanged), so
+    it is filtered once."""
+    rows = n // block
+    cols = [np.ones(rows if block > 1 else n)]
     if initial == "estimate":
-        zero = np.zeros(n)
+        free = _free_response(s.a, n)
         for i in range(s.a.size - 1):
-            zi = np.zeros(s.a.size - 1)
-            zi[i] = 1.0
-            cols.append(lfilter([1.0], s.a, zero, zi=zi)[0])
+            cols.append(block_means(np.concatenate((np.zeros(i), free[:n - i])) if i else free, block))
         if integrating:
-            cols.append(s.run(np.ones(n)))
+            cols.append(block_means(s.run(np.ones(n)), block))
     return np.column_stack(cols)
 
 
@@ -352,11 +387,7 @@ def _regressors(s: Sampled, ud, integrating: bool, initial: str, block: int) -> 
     the model sees the input the plant saw (its hold, its levels), and the
     output's block means are compared with the same means of the simulation,
     the block's half-sample delay and low-pass on both sides alike."""
-    sim = s.run(ud)
-    X = _columns(s, ud.size, integrating, initial)
-    if block > 1:
-        return block_means(sim, block), block_means(X, block)
-    return sim, X
+    return block_means(s.run(ud), block), _columns(s, ud.size, integrating, initial, block)
 
 
 def _evaluate(kind: str, p: dict, ud, y, T: float, hold: str, initial: str, block: int = 1) -> tuple:
