@@ -11,7 +11,7 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    "circuit_report": ("band_png", "bench_blocks", "bom", "sections", "title_of"),
+    "circuit_report": ("band_png", "bench_blocks", "bench_settings", "bom", "sections", "title_of"),
     "circuit_prbs": ("band_edge_hz", "section_plan", "with_section_prbs"),
     "circuit_design": ("CircuitAnalysisSpec", "CircuitPlantResult", "GBW_MARGIN", "SPICE_DB", "SPICE_DEG",
                        "analyze_circuit_plant", "analyze_circuit_spec", "built_name", "check_circuit_parts",

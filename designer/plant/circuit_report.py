@@ -28,7 +28,7 @@ from ..spice.deck import board
 from . import circuit
 from .report import METRIC_ROWS, prbs_blocks, prbs_png, prbs_texts, sine_text
 
-__all__ = ["title_of", "sections", "bom", "schematic", "summary_text", "write_outputs", "bench_blocks",
+__all__ = ["bench_settings", "title_of", "sections", "bom", "schematic", "summary_text", "write_outputs", "bench_blocks",
            "band_png"]
 
 #: the schematic's width (drawing units) that holds the op-amp's output label
@@ -128,6 +128,29 @@ def _section_sine_text(sine) -> str:
         lo=_f(lo, "Hz"), hi=_f(hi, "Hz"))
 
 
+def bench_settings(result) -> list:
+    """The generator and the scope as set for the square wave (into the section's input part, as its
+    declaration names it), and the sine check: the sheet's settings table, which the page shows too.
+
+    Parameters
+    ----------
+    result : CircuitPlantResult
+        The design with its bench (:func:`designer.plant.circuit_design.with_bench`).
+
+    Returns
+    -------
+    list
+        (set, to) rows; empty when the result has no bench.
+    """
+    if result.test is None:
+        return []
+    into = next(p.ref for p in result.section.netlist(result.values).parts if "vin" in (p.a, p.b))
+    rows = bench_rows(result.test, result.scope, into)
+    if result.sine is not None:
+        rows.append([_("sine check"), _section_sine_text(result.sine)])
+    return rows
+
+
 def bench_blocks(result, with_images: bool = False) -> list:
     """The bench: the generator and the scope as set, the sine check, and the readings' band over the parts'
     tolerance corners (a low-pass's step readings; fn and zeta for every kind), the band's plot with images.
@@ -147,10 +170,7 @@ def bench_blocks(result, with_images: bool = False) -> list:
     tol = result.tolerance
     if tol is None:
         return []
-    into = next(p.ref for p in result.section.netlist(result.values).parts if "vin" in (p.a, p.b))
-    rows = bench_rows(result.test, result.scope, into)
-    if result.sine is not None:
-        rows.append([_("sine check"), _section_sine_text(result.sine)])
+    rows = bench_settings(result)
     fo = result.figures["opamp"]
     readings = [["fn", _f(fo["fn_hz"], "Hz"), f"{_f(tol.fn_hz.lo, 'Hz')} .. {_f(tol.fn_hz.hi, 'Hz')}"]]
     if result.section.order == 2:

@@ -367,14 +367,42 @@ def circuit_plant_page(result) -> dict:
     f = np.geomspace(fn / 100, fn * 100, BODE_POINTS)
     s = 2j * np.pi * f
     resp = {"ideal op-amp": topo.response(result.values, s), f"{amp.name} model": topo.response(result.values, s, amp)}
+    sine = result.sine
+    if sine is not None and sine.h_spice is not None:
+        resp["SPICE .ac"] = _complex_on_grid(sine.spice_f_hz, sine.h_spice, f)
     bom = rep.bom(result)
+    bench = rep.bench_settings(result)
     return {"parts": [{"ref": p.ref, "role": p.role, "value": result.values[p.ref], "kind": p.kind}
                       for p in topo.parts],
             "bode": _bode(f, resp), "histograms": histograms(result.monte_carlo), **bom_shown(bom),
+            "bench": [[localise(c) for c in row] for row in bench],
+            **({} if result.tolerance is None or result.tolerance.t_s is None else {"step": _section_step(result)}),
             "checks": checks_shown(result.checks), "notes": [localise(translated(n)) for n in result.notes],
             "schematic_svg": _schematic_svg(rep, result, [topo.name, dict(result.values), result.package]),
             "sheet_html": to_html(rep.title_of(result), rep.sections(result), {}),
             "title": localise(rep.title_of(result))}
+
+
+def _section_step(result) -> dict:
+    """A section plant's output after the bench square wave's rising edge, as the seed plant's page shows it:
+    both models (the section's transfer function with the parts as built, ideal and with the op-amp's model),
+    the tolerance band of the builds over the parts' tolerance corners and, when the square-wave test ran,
+    SPICE's output; on the band's grid (the rising half period, at most four response spans)."""
+    from ..core.lti import step_response
+    from ..plant import circuit
+    topo, amp, tol = result.section, result.opamp, result.tolerance
+    a, t = result.test.amplitude_v, np.asarray(tol.t_s, float)
+    step = {}
+    sq = result.square
+    if sq is not None:   # its period's rising edge (its middle: the models' step is taken there)
+        step["SPICE (ngspice)"] = np.interp(t + sq.test.delay_s + sq.test.edge_s / 2, sq.t, sq.y_spice)
+    for label, (num, den) in ((f"analytic ({amp.name} model)", circuit.opamp_tf(topo, result.values, amp)),
+                              ("analytic (ideal op-amp)", topo.coefficients(result.values))):
+        num, den = np.asarray(num, float), np.asarray(den, float)
+        num = np.trim_zeros(num, "f") if np.any(num) else num
+        step[label] = a * step_response(num, den, t)
+    step["tolerance band low"], step["tolerance band high"] = tol.lo * a, tol.hi * a
+    return _trace(t, step, "time from the edge (s)")
 
 
 def design_filter_task(fields: dict, want: str = "json", tmp: str | None = None) -> dict:

@@ -998,9 +998,17 @@ def test_the_plant_pages_topology_menu_designs_an_mfb_lowpass(page, server):
         assert shown == page.evaluate("([v, u]) => D.eng(v, u, 3)", [want["parts"][p.ref]["value"],
                                                                       "Ohm" if p.kind == "R" else "F"])
     assert "MFB low-pass" in page.inner_text("#title") and "topology=mfb-lowpass" in page.url
-    assert page.locator("#bode-gain canvas").count() == 1 and not page.locator("#step-section").is_visible()
-    assert figure(page, "SPICE agrees with the model") == "yes" and not page.locator("#topid").is_visible()
+    assert page.locator("#bode-gain canvas").count() == 1
+    assert figure(page, "SPICE agrees with the model") == "yes" and page.locator("#topid").is_visible()
     assert not page.locator("#bom").is_disabled()
+    # its step after the bench's rising edge (both models, the band) and the bench as its sheet sets it, the BOM
+    assert page.locator("#step-section").is_visible() and page.locator("#step canvas").count() == 1
+    bench = page.inner_text("#bench")
+    assert "into R1" in bench and "sine check" in bench, bench
+    assert page.locator("#bench-section").is_visible()
+    bom = {ref.strip() for i in range(page.locator("#bomtable tbody tr").count())   # a row per value: "R1, R2"
+           for ref in page.locator("#bomtable tbody tr").nth(i).locator("td").first.inner_text().split(",")}
+    assert set(topo.designators) <= bom and "U1" in bom, bom
     # its schematic (the sheet's one-stage drawing), labelled with its parts as the seed circuit's
     svg = page.locator("#schematic svg")
     assert svg.count() == 1 and svg.get_attribute("role") == "img"
@@ -1011,6 +1019,43 @@ def test_the_plant_pages_topology_menu_designs_an_mfb_lowpass(page, server):
     # back to the seed's circuit: its own panels
     assert after(page, lambda: menu.select_option("sallen-key-lowpass"), timeout=120000) == "done"
     assert page.locator("#step-section").is_visible() and page.locator("#topid").is_visible()
+
+
+def test_a_pid_for_a_section_plant_takes_its_topology_and_parts(page, server):
+    """Issue 26: "a PID for this plant" on an MFB low-pass opens the PID page on that circuit as built (its
+    topology chosen, one field per declared part, filled with the parts shown) and designs the loop with it; the
+    section's fields are its own (another topology's empty), and the link keeps them."""
+    from designer.filters import registry
+    open_page(page, server, "/plant?topology=mfb-lowpass&fc=1k&zeta=0.3")
+    assert page.evaluate("document.body.dataset.state") == "done", page.inner_text(".form-foot")
+    status, plant = server.post_json("/api/plant", {"fc": 1000, "zeta": 0.3, "topology": "mfb-lowpass"})
+    assert status == 200
+    page.click("#topid")
+    page.wait_for_url("**/pid?**")
+    page.wait_for_function("() => +(document.body.dataset.answers || 0) > 0", timeout=120000)
+    assert page.evaluate("document.body.dataset.state") == "done", page.inner_text(".form-foot")
+    assert page.locator("select[name=plant-topology]").input_value() == "mfb-lowpass"
+    assert not page.locator("input[name=plant-r1]").is_visible()
+    topo = registry.get("mfb-lowpass")
+    typed = {r: page.locator(f"#section-part-fields input[data-ref={r}]").input_value() for r in topo.designators}
+    shown = {r: page.evaluate("v => D.engTyped(v, '', 6).replace(' ', '')", plant["parts"][r]["value"])
+             for r in topo.designators}
+    assert typed == shown
+    assert page.locator("#closed canvas").count() == 1
+    # the loop designed is that circuit's: its plant record names the section and its parts as typed
+    plant_shown = page.evaluate("last.answer.result.plant")
+    assert plant_shown["topology"] == "mfb-lowpass"
+    assert plant_shown["circuit"][0]["parts"] == pytest.approx(
+        {f"{r[0]}P{r[1:]}": plant["parts"][r]["value"] for r in topo.designators}, rel=1e-5)
+    assert page.locator("#schematic svg").count() == 1
+    # another topology: its own parts' fields, empty
+    menu = page.locator("select[name=plant-topology]")
+    menu.select_option("rc-lowpass")
+    assert [page.locator("#section-part-fields input").nth(i).get_attribute("data-ref")
+            for i in range(page.locator("#section-part-fields input").count())] == list(
+        registry.get("rc-lowpass").designators)
+    assert all(not page.locator("#section-part-fields input").nth(i).input_value()
+               for i in range(page.locator("#section-part-fields input").count()))
 
 
 # ----------------------------------------------------------------------------------------------- languages

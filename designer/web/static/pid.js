@@ -10,6 +10,37 @@ const identified = JSON.parse(sessionStorage.getItem("identify-result") || "null
 
 function plantKind() { return form.querySelector("input[name=plant]:checked").value; }
 
+const SEED_TOPOLOGY = "sallen-key-lowpass";   // the seed's circuit: its parts by their own fields (R1 .. gain K)
+let topologies = [];
+
+// A plant as built on another registered section: one field per declared part (its designator, its role), the
+// values typed as "REF=VALUE" items of the plant-part field the API takes (the address keeps them there).
+function showSection() {
+  const name = form.elements["plant-topology"].value, seed = name === SEED_TOPOLOGY;
+  document.getElementById("seed-parts").hidden = !seed;
+  document.getElementById("section-parts").hidden = seed;
+  const box = document.getElementById("section-part-fields");
+  const topo = topologies.find(t => t.name === name);
+  if (seed || !topo) { box.replaceChildren(); return; }
+  const typed = Object.fromEntries(String(form.elements["plant-part"].value || "").split(/\s+/).filter(Boolean)
+                                   .map(x => x.split("=")).map(([k, ...v]) => [k, v.join("=")]));
+  box.replaceChildren(...topo.parts.map(x => {
+    const label = document.createElement("label"), input = document.createElement("input");
+    label.title = D.t(x.role);
+    input.dataset.ref = x.ref;
+    input.value = typed[x.ref] || "";
+    input.placeholder = x.kind === "R" ? "10k" : "10n";
+    label.append(`${x.ref} `, input);
+    return label;
+  }));
+}
+
+// the section's fields as plant-part's items ("R1=10k"), in its declared order
+function sectionParts() {
+  return [...document.querySelectorAll("#section-part-fields input")].filter(i => i.value.trim())
+    .map(i => `${i.dataset.ref}=${i.value.trim()}`);
+}
+
 function showPlantKind() {
   for (const d of form.querySelectorAll("[data-plant]")) d.hidden = d.dataset.plant !== plantKind();
 }
@@ -23,6 +54,15 @@ function showTargets() {
 function request() {
   const o = D.options(form);
   delete o.plant;
+  if (plantKind() === "parts") {
+    // the seed's circuit by its own fields (as ever); another section by its declared parts
+    if (o["plant-topology"] === SEED_TOPOLOGY) delete o["plant-topology"];
+    else {
+      const items = sectionParts();
+      form.elements["plant-part"].value = items.join(" ");
+      if (items.length) o["plant-part"] = items; else delete o["plant-part"];
+    }
+  }
   // the tolerance panel's fields hold several items apart ("R=1% C=5%"): the API takes them as a list
   for (const k of ["tol", "limit"]) if (o[k]) o[k] = o[k].split(/\s+/);
   if (plantKind() === "identify") {
@@ -117,8 +157,12 @@ async function file(kind) {
     D.fill(s, [...keepFirst, ...c[s.dataset.choices]], s.dataset.default || keepFirst[0]);
     if (keepFirst.length && s.options[0].value === "") s.options[0].textContent = D.t("default");
   }
+  topologies = c.topologies;
+  const menu = form.elements["plant-topology"];
+  D.fill(menu, topologies.map(t => t.name), SEED_TOPOLOGY);
+  for (const o of menu.options) o.textContent = D.t(topologies.find(t => t.name === o.value).title);
   D.fillFromQuery(form);
-  D.onRestore = () => { showPlantKind(); showTargets(); };
+  D.onRestore = () => { showPlantKind(); showTargets(); showSection(); };
   if (identified) {
     const b = identified.best || {};
     document.getElementById("model-text").textContent =
@@ -127,11 +171,13 @@ async function file(kind) {
   }
   showPlantKind();
   showTargets();
-  // the plant's kind shows its fields before the form is read
+  showSection();
+  // the plant's kind shows its fields before the form is read (a section's own, empty, when it changes)
   form.addEventListener("change", e => {
     if (e.target.name === "plant") showPlantKind();
     if (e.target.name === "tuning") showTargets();
-  });
+    if (e.target.name === "plant-topology") { form.elements["plant-part"].value = ""; showSection(); }
+  }, true);
   const live = D.liveForm(form, design, () => JSON.stringify(request()));
   document.getElementById("sheet").onclick = () => file("sheet");
   document.getElementById("bundle").onclick = () => file("bundle");

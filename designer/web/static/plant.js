@@ -22,8 +22,9 @@ function showTopology() {
 }
 D.onRestore = showTopology;
 
-// A plant on another registered section (the generic pipeline): its declared parts, both models' figures and
-// Bode plot, its schematic, the BOM, checks and sheet; the seed circuit's step and bench panels are not its.
+// A plant on another registered section (the generic pipeline): its declared parts, both models' figures, its
+// step after the bench's rising edge (both models and the tolerance band) and Bode plot, its schematic, the
+// bench's generator and scope, the BOM, checks and sheet.
 function showCircuit(answer) {
   const r = answer.result, p = answer.page, o = r.built.opamp, i = r.built.ideal;
   document.getElementById("title").textContent = p.title;
@@ -38,20 +39,19 @@ function showCircuit(answer) {
   document.getElementById("notes").replaceChildren(...(p.notes || r.notes).map(n => { const e = document.createElement("p"); e.textContent = D.inPageWords(form, n); return e; }));
   D.schematic(document.getElementById("schematic"), p.schematic_svg,
               D.t("schematic: {parts}", {parts: p.bom.rows.map(x => `${x[0]} ${D.localNum(x[1])}`).join(", ")}));
+  document.getElementById("bench").replaceChildren(D.table([D.t("set"), D.t("to")], p.bench || []));
   document.getElementById("bomtable").replaceChildren(D.bomTable(p));
   document.getElementById("checks").replaceChildren(D.checksTable(p.checks || r.checks));
   D.tolerance(r.monte_carlo, p.histograms);
   D.sheet(document.getElementById("sheet-html"), p.sheet_html, form);
+  if (p.step) D.plot(document.getElementById("step"), p.step, {xUnit: "s", yLabel: D.t("output (V)")});
   D.plot(document.getElementById("bode-gain"), p.bode.gain, {xUnit: "Hz", yLabel: D.t("gain (dB)"), height: 240});
   D.plot(document.getElementById("bode-phase"), p.bode.phase, {xUnit: "Hz", yLabel: D.t("phase (deg)"), height: 200});
 }
 
 function show(answer) {
   const seed = (answer.result.topology || SEED_TOPOLOGY) === SEED_TOPOLOGY;
-  document.getElementById("step-section").hidden = !seed;
-  document.getElementById("bench-section").hidden = !seed;
-  // "a PID for this plant" takes the seed circuit's four parts
-  document.getElementById("topid").hidden = !seed;
+  document.getElementById("step-section").hidden = !seed && !answer.page.step;
   if (!seed) { showCircuit(answer); return; }
   const r = answer.result, p = answer.page, b = r.built;
   document.getElementById("title").textContent = p.title;
@@ -99,13 +99,18 @@ const page = D.designPage(form, status, "/api/plant", show,
   document.getElementById("topid").onclick = () => {
     const last = page.shown();
     if (!last || D.isStale()) return;
-    const o = last.opts, b = last.answer.result.built;
+    const o = last.opts, r = last.answer.result, b = r.built;
     // the plant as built, by its parts: the PID is designed for the circuit on the bench
     const code = v => D.engTyped(v, "", 6).replace(" ", "");   // 1.6k, 3.3n: engineering notation as typed
-    const q = new URLSearchParams({"plant": "parts", "plant-r1": code(b.R1_ohm), "plant-r2": code(b.R2_ohm),
-                                   "plant-c1": code(b.C1_f), "plant-c2": code(b.C2_f), "opamp": o.opamp || "LM741"});
+    const seed = (r.topology || SEED_TOPOLOGY) === SEED_TOPOLOGY;
+    const q = new URLSearchParams(seed ? {"plant": "parts", "plant-r1": code(b.R1_ohm), "plant-r2": code(b.R2_ohm),
+                                          "plant-c1": code(b.C1_f), "plant-c2": code(b.C2_f)}
+                                       // another section: its declared parts by designator, items apart as typed
+                                       : {"plant": "parts", "plant-topology": r.topology,
+                                          "plant-part": Object.entries(r.parts).map(([ref, x]) => `${ref}=${code(x.value)}`).join(" ")});
+    q.set("opamp", o.opamp || "LM741");
     if (D.lang !== "en") q.set("lang", D.lang);
-    if (b.gain !== 1) q.set("plant-gain", b.gain);
+    if (seed && b.gain !== 1) q.set("plant-gain", b.gain);
     location.href = "/pid?" + q.toString();
   };
   live.now();   // (through the form: typing back to these inputs asks nothing)
