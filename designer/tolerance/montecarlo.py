@@ -151,7 +151,10 @@ class MonteCarlo:
 def spice_lines(mc) -> list:
     """The summary's lines on SPICE's part of a Monte Carlo."""
     s = mc.spice
-    out = [f"  engine {s['engine']}: ngspice ({s['simulator']}), rising half, max step {s['max_step_s']:.3g} s"
+    # the step engine's record (the Sallen-Key plant's, a low-pass section's) or a section's .ac sweep
+    how = (f"rising half, max step {s['max_step_s']:.3g} s" if "max_step_s" in s else
+           f".ac {s['sweep_hz'][0]:.4g} Hz to {s['sweep_hz'][1]:.4g} Hz")
+    out = [f"  engine {s['engine']}: ngspice ({s['simulator']}), {how}"
            + (f"; SPICE on {s['samples_checked']} samples ({len(s['worst'])} from the tails, "
               f"{len(s['random'])} random)" if "samples_checked" in s else "")]
     for k, d in (s.get("disagreement") or {}).items():
