@@ -158,15 +158,17 @@ def test_analyze_plant_part_refusals_are_one_line(args, words, tmp_path):
 
 @pytest.mark.spice
 def test_engine_both_on_a_section_runs_each_build_s_ac_in_ngspice(tmp_path):
-    """--engine both: the CSV's SPICE rows are the analytic engine's next to them (its dominant pair: fn within
-    1 %), the model's rows recomputed from the parts exactly; --spice-samples checks the tails."""
-    topology = REGISTRY["mfb-lowpass"]
-    args = [*target_args(topology), "--monte-carlo", "30", "--seed", "2", "--limit", "fn_hz=950:1050",
-            "--simulator", "ngspice-cli", "--json"]
+    """--engine both on a high-pass (its step settles to 0: no step engine): each build's .ac, recorded as
+    such; the CSV's SPICE rows are the analytic engine's next to them (its dominant pair: fn within 1 %), the
+    model's rows recomputed from the parts exactly; --spice-samples checks the tails."""
+    topology = REGISTRY["mfb-highpass"]
+    fn = topology.example.fn_hz
+    args = [*target_args(topology), "--monte-carlo", "30", "--seed", "2", "--limit",
+            f"fn_hz={0.95 * fn:g}:{1.05 * fn:g}", "--simulator", "ngspice-cli", "--json"]
     out = run(*args, "--engine", "both", "--out", str(tmp_path))
     assert out.returncode == 0, out.stderr
     d = json.loads(out.stdout)
-    assert d["monte_carlo"]["spice"]["engine"] == "both"
+    assert d["monte_carlo"]["spice"]["engine"] == "both" and d["monte_carlo"]["spice"]["analysis"] == "ac"
     with open(d["files"]["monte_carlo_csv"], newline="") as fh:
         rows = list(csv.DictReader(fh))
     col = lambda k: np.array([float(r[k]) for r in rows])  # noqa: E731
@@ -174,6 +176,9 @@ def test_engine_both_on_a_section_runs_each_build_s_ac_in_ngspice(tmp_path):
                                    get_opamp(d["opamp"]["name"]))
     assert np.allclose(col("model_fn_hz"), figs["fn_hz"], rtol=1e-8)
     assert np.allclose(col("fn_hz"), figs["fn_hz"], rtol=0.01)
+    text = run(*args[:-1], "--engine", "spice", "--no-files")     # the text summary names the sweep
+    assert text.returncode == 0, text.stderr
+    assert "engine spice: ngspice (ngspice-cli), .ac " in text.stdout
     picked = run(*args, "--engine", "both", "--spice-samples", "2", "--no-files")
     assert picked.returncode == 0, picked.stderr
     assert json.loads(picked.stdout)["monte_carlo"]["spice"]["samples_checked"] >= 2
@@ -306,3 +311,41 @@ def test_r_and_c_on_a_section_is_its_exact_design_rounded_jointly(name, args, tm
 ])
 def test_r_and_c_a_section_cannot_take_are_one_line(args, words, tmp_path):
     refused(run(*args, "--no-sim", cwd=tmp_path), words, tmp_path)
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("name", ["mfb-lowpass", "rc-lowpass"])
+def test_engine_both_on_a_lowpass_section_is_the_seed_plant_s_step_engine(name, tmp_path):
+    """Issue 26: --engine spice|both on a low-pass section runs the seed plant's step engine (each build's
+    rising half under the bench's square wave, result.json's monte_carlo.spice.analysis "step", the same
+    figures), within the seed plant's test tolerance of the analytic engine (overshoot 0.02 pp; zeta 0.1 %, fn
+    0.3 %: the step's second-order equivalents against the dominant pair); a first-order step has no peak (fn,
+    zeta, Q, peak time compared on no build), its rise and settling times those of its pole, ln 9 and ln 50
+    time constants. The replay of a build gives that build's row (one replay function for every plant)."""
+    from designer.tolerance import spice_engine
+    topology = REGISTRY[name]
+    args = [*target_args(topology), "--monte-carlo", "12", "--seed", "3", "--simulator", "ngspice-cli"]
+    out = run(*args, "--engine", "both", "--json", "--out", str(tmp_path / "mc"))
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    s = d["monte_carlo"]["spice"]
+    assert s["analysis"] == "step" and s["measured"] == list(spice_engine.FIGURES)
+    assert s["rising_half_s"][1] - s["rising_half_s"][0] == pytest.approx(0.5 / d["test_signal"]["frequency_hz"])
+    dis = s["disagreement"]
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    col = lambda k: np.array([float(r[k]) for r in rows])  # noqa: E731
+    if topology.order == 2:
+        assert dis["overshoot_pct"]["compared"] == 12 and dis["overshoot_pct"]["max_abs"] < 0.02
+        np.testing.assert_allclose(col("zeta"), col("model_zeta"), rtol=1e-3)
+        np.testing.assert_allclose(col("fn_hz"), col("model_fn_hz"), rtol=3e-3)
+    else:
+        assert all(dis[k]["compared"] == 0 for k in ("fn_hz", "zeta", "q", "peak_time_s"))
+        tau = 1 / (2 * np.pi * col("model_fn_hz"))
+        np.testing.assert_allclose(col("rise_time_s"), np.log(9) * tau, rtol=5e-3)
+        np.testing.assert_allclose(col("settling_time_s"), np.log(50) * tau, rtol=5e-3)
+    rep = run(*args, "--replay", "7", "--json", "--out", str(tmp_path / "r"))
+    assert rep.returncode == 0, rep.stderr
+    r = json.loads(rep.stdout)["monte_carlo"]["replay"]
+    for k in ("overshoot_pct", "rise_time_s", "settling_time_s"):
+        assert r["spice_figures"][k] == pytest.approx(col(k)[7], rel=1e-9, abs=1e-12)
