@@ -512,7 +512,7 @@ def _analyze_circuit(args, topo) -> int:
     if spice[2] is not None:
         return _circuit_replay(analyze_circuit_plant(
             topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,
-            simulate=False, amplitude_v=args.amplitude), args, mc, spice, name)
+            simulate=False, amplitude_v=args.amplitude, square_hz=args.square_freq), args, mc, spice, name)
     with cluster_ahead(args):
         result = _circuit_stimulus(analyze_circuit_plant(
             topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,

@@ -349,3 +349,26 @@ def test_engine_both_on_a_lowpass_section_is_the_seed_plant_s_step_engine(name, 
     r = json.loads(rep.stdout)["monte_carlo"]["replay"]
     for k in ("overshoot_pct", "rise_time_s", "settling_time_s"):
         assert r["spice_figures"][k] == pytest.approx(col(k)[7], rel=1e-9, abs=1e-12)
+
+
+@pytest.mark.spice
+def test_a_replayed_section_build_steps_under_the_runs_square_wave(tmp_path):
+    """analyze-plant --topology --square-freq --replay I: the build's step under the run's --square-freq (the
+    design the draw is made on had the recommended square wave before: its row I then differed from the run's),
+    and its bundle the square-wave test of that frequency."""
+    parts = ["--part", "R1=10k", "--part", "R2=20k", "--part", "R3=24k", "--part", "C1=4n7", "--part", "C2=47n"]
+    args = ["--topology", "mfb-lowpass", *parts, "--square-freq", "120", "--monte-carlo", "10", "--seed", "1",
+            "--engine", "spice", "--simulator", "ngspice-cli", "--json"]
+    mc = analyze(*args, "--out", str(tmp_path / "mc"))
+    assert mc.returncode == 0, mc.stderr
+    d = json.loads(mc.stdout)
+    assert d["monte_carlo"]["spice"]["rising_half_s"][1] - d["monte_carlo"]["spice"]["rising_half_s"][0] == \
+        pytest.approx(0.5 / 120)
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        row = list(csv.DictReader(fh))[4]
+    rep = analyze(*args, "--replay", "4", "--out", str(tmp_path / "r"))
+    assert rep.returncode == 0, rep.stderr
+    r = json.loads(rep.stdout)
+    for k in ("overshoot_pct", "peak_time_s", "settling_time_s"):
+        assert r["monte_carlo"]["replay"]["spice_figures"][k] == pytest.approx(float(row[k]), rel=1e-9)
+    assert r["square_test"]["generator"]["frequency_hz"] == 120
