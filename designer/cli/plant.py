@@ -432,8 +432,7 @@ def _design_circuit(args, topo) -> int:
                      square_hz=args.square_freq, alternatives=args.alternatives, package=args.package,
                      topology=topo.name)
     _circuit_unsupported(args, topo)
-    from ..tolerance.montecarlo import check_section_spread
-    check_section_spread(args.tol)
+    _check_section_spread(args, topo)
     name = args.name if args.name is not None else (
         f"plant_{topo.name}_fc{spec.fc_hz:g}" + ("" if spec.zeta is None else f"_z{spec.zeta:g}")
         + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
@@ -450,6 +449,15 @@ def _design_circuit(args, topo) -> int:
                                    args, stim)
         result = _circuit_tolerance(result, args, mc, spice)
     return emit(result, args, name, write_outputs, summary_text)
+
+
+def _check_section_spread(args, topo) -> None:
+    """``--tol SR`` on a section before any work: only where ngspice's op-amp slews, a low-pass's step (--engine
+    spice or both, or --replay), not on the analytic model (nor --worst-case, which searches it) or an .ac sweep."""
+    from ..tolerance.montecarlo import check_section_spread
+    from ..tolerance.spice_mc import section_analysis
+    slews = section_analysis(topo) == "step" and (args.engine != "analytic" or args.replay is not None)
+    check_section_spread(args.tol, slews=slews and not args.worst_case)
 
 
 def _circuit_replay(result, args, settings, spice, name) -> int:
@@ -491,8 +499,7 @@ def _analyze_circuit(args, topo) -> int:
         raise DesignError(f"--{named[0]} is the {DEFAULT_TOPOLOGY}'s; give {topo.name}'s parts as --part REF=VALUE "
                           f"({', '.join(topo.designators)})")
     _circuit_unsupported(args, topo)
-    from ..tolerance.montecarlo import check_section_spread
-    check_section_spread(args.tol)
+    _check_section_spread(args, topo)
     from ..plant.circuit_design import analyze_circuit_plant, built_name
     from ..plant.circuit_report import summary_text, write_outputs
     parts = part_values(args.part)

@@ -475,14 +475,15 @@ def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, samp
     Raises
     ------
     DesignError
-        An unknown engine or analysis, a step on a section that is no low-pass; ``SR`` in ``tol_items``
-        (both engines are linear: :func:`designer.tolerance.montecarlo.check_section_spread`).
+        An unknown engine or analysis, a step on a section that is no low-pass; ``SR`` in ``tol_items`` but for
+        a SPICE step (the other engines are linear: :func:`designer.tolerance.montecarlo.check_section_spread`).
     """
     from ..plant import circuit
     from .montecarlo import check_section_spread, plant_monte_carlo
     if engine not in ENGINES:
         raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
-    check_section_spread(tol_items)
+    analysis = section_analysis(result.section) if analysis is None else analysis
+    check_section_spread(tol_items, slews=engine != "analytic" and analysis == "step")
     model = (result.topology, result.opamp)
     nominal = dict(result.values)
     draw = lambda **kw: plant_monte_carlo(None, series, result.opamp, n, seed, sampler, dist,  # noqa: E731
@@ -731,6 +732,8 @@ def replay(result, series: dict, index: int, n: int, seed: int, sampler: str, di
         model, measured, shared = figures_with_fixed(arr, {}, result.opamp), spice_engine.FIGURES, spice_engine.SHARED
     else:                                # a section: the SPICE engine's whole row, the analytic engine's beside
         from ..plant import circuit
+        from .montecarlo import check_section_spread
+        check_section_spread(tol_items, slews=section_analysis(result.section) == "step")
         evaluate, st, measured, shared = section_engine(result, simulator)
         sp, backend = evaluate(arr, start=index), st["simulator"]
         model = circuit.evaluate((result.topology, result.opamp), arr)
