@@ -130,12 +130,15 @@ def _simulate(spec: CheckSpec, index: int, simulator: str):
         return res.figures, res, res.to_dict(), (None, {})
     if spec.kind == "plant" and hasattr(design, "topology") and design.topology != DEFAULT_TOPOLOGY:
         from ..plant.circuit_design import (analyze_circuit_spec, default_square_hz, design_circuit_plant,
-                                            with_square_test)
+                                            with_bench, with_square_test)
         res = (analyze_circuit_spec if spec.analyze else design_circuit_plant)(design, simulate=True,
                                                                                 simulator=simulator)
         if res.square is None and (spec.agreement is not None or spec.golden is not None):
-            # the SPICE agreement and the golden waveforms are the square-wave test's, as the Sallen-Key plant's
+            # the SPICE agreement and the golden waveforms are the square-wave test's, as the Sallen-Key plant's;
+            # the bench (test signal, scope, tolerance band) is then set for that test, as the seed plant's is for
+            # its own, not for the square wave recommended before it ran
             with_square_test(res, design.amplitude_v, default_square_hz(res), simulator)
+            with_bench(res, None, True, simulator)
         return F.circuit_plant_figures(res), res, res.to_dict(), (None, {}) if res.square is None else \
             res.square.waves()
     if spec.kind == "plant":

@@ -187,7 +187,11 @@ def _add_spice_options(g):
                    help="analytic (default: the op-amp-aware model, vectorised), spice (every build simulated in "
                         "ngspice with --simulator's backend, many builds per ngspice process: fn_hz, zeta, q from "
                         "the step's overshoot and peak time, rise_time_s and settling_time_s too) or both (SPICE "
-                        "and the model on every build, their disagreement per figure and the yield each gives)")
+                        "and the model on every build, their disagreement per figure and the yield each gives). "
+                        "The step is the bench square wave's rising half, on the seed's plant and on every "
+                        "low-pass --topology; a high- or band-pass --topology, whose step settles to 0, runs each "
+                        "build's .ac instead (fn_hz, zeta, q, gain fitted to it); result.json's "
+                        "monte_carlo.spice.analysis says which: step or ac")
     g.add_argument("--spice-samples", metavar="K",
                    help="with --engine both and --limit: the model on every build, SPICE only on the K nearest "
                         "each limit (the tails) plus K random ones; reports the verdicts SPICE flips and the "
@@ -428,8 +432,7 @@ def _design_circuit(args, topo) -> int:
                      square_hz=args.square_freq, alternatives=args.alternatives, package=args.package,
                      topology=topo.name)
     _circuit_unsupported(args, topo)
-    from ..tolerance.montecarlo import check_section_spread
-    check_section_spread(args.tol)
+    _check_section_spread(args, topo)
     name = args.name if args.name is not None else (
         f"plant_{topo.name}_fc{spec.fc_hz:g}" + ("" if spec.zeta is None else f"_z{spec.zeta:g}")
         + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
@@ -448,16 +451,26 @@ def _design_circuit(args, topo) -> int:
     return emit(result, args, name, write_outputs, summary_text)
 
 
+def _check_section_spread(args, topo) -> None:
+    """``--tol SR`` on a section before any work: only where ngspice's op-amp slews, a low-pass's step (--engine
+    spice or both, or --replay), not on the analytic model (nor --worst-case, which searches it) or an .ac sweep."""
+    from ..tolerance.montecarlo import check_section_spread
+    from ..tolerance.spice_mc import section_analysis
+    slews = section_analysis(topo) == "step" and (args.engine != "analytic" or args.replay is not None)
+    check_section_spread(args.tol, slews=slews and not args.worst_case)
+
+
 def _circuit_replay(result, args, settings, spice, name) -> int:
-    """--replay I on a section plant: the build's values drawn again, its .ac in ngspice (the SPICE engine's row
-    I), and its bundle (analyze-plant --topology of its exact values) written under ``name``_sample<I>."""
+    """--replay I on a section plant: the build's values drawn again, through its SPICE engine (the engine's row
+    I: a low-pass's step, another section's .ac), and its bundle (analyze-plant --topology of its exact values)
+    written under ``name``_sample<I>: the seed plant's replay, one function (designer.tolerance.spice_mc.replay)."""
     from ..plant.circuit_report import summary_text, write_outputs
-    from ..tolerance.spice_mc import section_replay, section_replay_result
+    from ..tolerance.spice_mc import replay, replay_result
     s = result.sourcing
     n, seed = settings
-    rep = section_replay(result, {"R": s.r_series, "C": s.c_series}, spice[2], n, seed, args.sampler, args.dist,
-                         args.tol or (), args.simulator)
-    out = section_replay_result(result, rep, args.simulator, args.square_freq)
+    rep = replay(result, {"R": s.r_series, "C": s.c_series}, spice[2], n, seed, args.sampler, args.dist,
+                 args.tol or (), args.simulator)
+    out = replay_result(result, rep, args.simulator, square_hz=args.square_freq)
     return emit(out, args, f"{name}_sample{spice[2]}", write_outputs, summary_text)
 
 
@@ -476,7 +489,7 @@ def _circuit_unsupported(args, topo, options=()) -> None:
     if unsupported:
         raise DesignError(f"{unsupported[0].split()[0]}: {unsupported[0]} is the {DEFAULT_TOPOLOGY}'s for now; "
                           f"--topology {topo.name} has the .ac check, the --square-freq test and the Monte Carlo "
-                          "(--engine analytic, spice or both, its SPICE engine an .ac per build)")
+                          "(--engine analytic, spice or both: a low-pass's step per build, another section's .ac)")
 
 
 def _analyze_circuit(args, topo) -> int:
@@ -486,8 +499,7 @@ def _analyze_circuit(args, topo) -> int:
         raise DesignError(f"--{named[0]} is the {DEFAULT_TOPOLOGY}'s; give {topo.name}'s parts as --part REF=VALUE "
                           f"({', '.join(topo.designators)})")
     _circuit_unsupported(args, topo)
-    from ..tolerance.montecarlo import check_section_spread
-    check_section_spread(args.tol)
+    _check_section_spread(args, topo)
     from ..plant.circuit_design import analyze_circuit_plant, built_name
     from ..plant.circuit_report import summary_text, write_outputs
     parts = part_values(args.part)
@@ -507,7 +519,7 @@ def _analyze_circuit(args, topo) -> int:
     if spice[2] is not None:
         return _circuit_replay(analyze_circuit_plant(
             topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,
-            simulate=False, amplitude_v=args.amplitude), args, mc, spice, name)
+            simulate=False, amplitude_v=args.amplitude, square_hz=args.square_freq), args, mc, spice, name)
     with cluster_ahead(args):
         result = _circuit_stimulus(analyze_circuit_plant(
             topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,
@@ -519,7 +531,8 @@ def _analyze_circuit(args, topo) -> int:
 
 def _circuit_tolerance(result, args, mc, spice=("analytic", None, None)):
     """--worst-case and --monte-carlo of a plant on another topology (the analytic engine over its parts;
-    --engine spice|both, --spice-samples: every build's .ac in ngspice)."""
+    --engine spice|both, --spice-samples: every build in ngspice, a low-pass's step on its bench's square wave as
+    the seed plant's, another section's .ac: designer.tolerance.spice_mc.section_analysis)."""
     from ..plant import circuit
     from ..plant.circuit_design import tolerance_nominal
     from ..tolerance.parts import opamp_nominal

@@ -35,26 +35,30 @@ MAX_TARGET_CI = 0.5
 #: --tol SR on the analytic plant engine (a linear model: nothing in it slews)
 NO_SLEW = ("--tol SR: the plant's analytic model is linear, no figure of it depends on the slew rate; spread SR "
            "with --engine spice or both (ngspice's op-amp slews)")
-#: --tol SR on a plant of another topology: both its engines are linear
-NO_SLEW_SECTION = ("--tol SR: a section plant's engines are linear (its analytic model, and ngspice's .ac sweep: "
-                   "small signal), no figure of them depends on the slew rate; drop SR from --tol (GBW=.. spreads "
-                   "the op-amp)")
+#: --tol SR on a plant of another topology where its engine is linear (the analytic one; a high- or band-pass's .ac)
+NO_SLEW_SECTION = ("--tol SR: a section plant's analytic model and a high- or band-pass's SPICE engine (ngspice's .ac "
+                   "sweep: small signal) are linear, no figure of them depends on the slew rate; spread SR with "
+                   "--engine spice or both on a low-pass section (its step slews), or drop SR from --tol (GBW=.. "
+                   "spreads the op-amp)")
 
 
-def check_section_spread(tol_items) -> None:
-    """Refuse ``--tol SR`` on a plant of another topology (:data:`NO_SLEW_SECTION`), before any work.
+def check_section_spread(tol_items, slews: bool = False) -> None:
+    """Refuse ``--tol SR`` on a plant of another topology (:data:`NO_SLEW_SECTION`), before any work, unless its
+    engine ``slews`` (a low-pass's SPICE step engine, :func:`designer.tolerance.spice_mc.section_analysis`).
 
     Parameters
     ----------
     tol_items : sequence of str
         The ``--tol`` items.
+    slews : bool
+        The engine simulates the op-amp's slew rate.
 
     Raises
     ------
     DesignError
         One line, ``param`` "SR".
     """
-    if any(str(t).split("=")[0].strip().upper() == "SR" for t in tol_items or ()):
+    if not slews and any(str(t).split("=")[0].strip().upper() == "SR" for t in tol_items or ()):
         raise DesignError(NO_SLEW_SECTION, param="SR")
 
 
@@ -151,7 +155,10 @@ class MonteCarlo:
 def spice_lines(mc) -> list:
     """The summary's lines on SPICE's part of a Monte Carlo."""
     s = mc.spice
-    out = [f"  engine {s['engine']}: ngspice ({s['simulator']}), rising half, max step {s['max_step_s']:.3g} s"
+    # the step engine's record (the Sallen-Key plant's, a low-pass section's) or a section's .ac sweep
+    how = (f"rising half, max step {s['max_step_s']:.3g} s" if "max_step_s" in s else
+           f".ac {s['sweep_hz'][0]:.4g} Hz to {s['sweep_hz'][1]:.4g} Hz")
+    out = [f"  engine {s['engine']}: ngspice ({s['simulator']}), {how}"
            + (f"; SPICE on {s['samples_checked']} samples ({len(s['worst'])} from the tails, "
               f"{len(s['random'])} random)" if "samples_checked" in s else "")]
     for k, d in (s.get("disagreement") or {}).items():

@@ -25,9 +25,10 @@ import numpy as np
 from ..core.errors import DesignError
 from . import spice_engine
 
-__all__ = ["drawn_values", "plant_context", "plant_monte_carlo_engine", "replay", "replay_result", "replay_values", "run_engine",
-           "section_context", "section_monte_carlo_engine", "section_step_context", "section_replay", "section_replay_result",
-           "spice_evaluate", "spice_samples"]
+__all__ = ["drawn_values", "plant_context", "plant_monte_carlo_engine", "replay", "replay_parts", "replay_result",
+           "replay_values", "run_engine", "section_analysis", "section_context", "section_engine",
+           "section_monte_carlo_engine", "section_replay", "section_replay_result", "section_step_chunk",
+           "section_step_context", "spice_evaluate", "spice_samples", "step_settings"]
 
 ENGINES = ("analytic", "spice", "both")
 #: the seed of the random part of --spice-samples: SeedSequence(seed, spawn_key=(RANDOM_KEY,)) (chunks use (c,))
@@ -83,15 +84,17 @@ def plant_context(result, simulator: str = "ngspice-cli"):
 
 def section_step_context(result, simulator: str = "ngspice-cli"):
     """The step engine's context (:func:`designer.tolerance.spice_engine.context`) of a low-pass section
-    plant with its square-wave test (a :class:`~designer.plant.circuit_design.CircuitPlantResult` designed
-    or analysed with ``square_hz``, ``--square-freq``): that test's deck (the section's netlist, output net
-    ``vout``), the section, its values and op-amp. What the Sallen-Key plant's SPICE engine measures
-    (overshoot, peak, rise and settling times from ngspice's ``.tran``), on any low-pass.
+    plant (a :class:`~designer.plant.circuit_design.CircuitPlantResult`) under its bench's square wave: its
+    square-wave test's deck when it ran one (``square_hz``, ``--square-freq``), else the section's netlist under
+    the square wave its bench recommends (``result.test``, :func:`designer.plant.circuit_design.with_bench`, the
+    Sallen-Key plant's rule), output net ``vout``; the section, its values and op-amp. What the Sallen-Key
+    plant's SPICE engine measures (overshoot, peak, rise and settling times from ngspice's ``.tran``), on any
+    low-pass.
 
     Parameters
     ----------
     result : designer.plant.circuit_design.CircuitPlantResult
-        The design, with its square-wave test.
+        The design, with its bench (or its square-wave test).
     simulator : str
         The backend.
 
@@ -103,14 +106,70 @@ def section_step_context(result, simulator: str = "ngspice-cli"):
     Raises
     ------
     DesignError
-        No square-wave test, or the section is not a low-pass.
+        No square wave (neither a test nor a bench), or the section is not a low-pass.
     """
     run = result.square
-    if run is None:
+    if run is not None:
+        deck, test = run.deck, run.test
+    elif result.test is not None:
+        from ..plant.circuit_design import square_deck
+        topo, amp = result.section, result.opamp
+        test = result.test
+        deck = square_deck(result.netlist, amp, test, f"{topo.title} plant square-wave test op-amp={amp.name}")
+    else:
         raise DesignError("square_hz: the step engine runs the section's square-wave test; give its frequency "
                           "(a positive number of hertz)", param="square_hz")
-    return spice_engine.context(run.deck, result.section, dict(result.values), result.opamp, run.test, simulator,
+    return spice_engine.context(deck, result.section, dict(result.values), result.opamp, test, simulator,
                                 node=result.netlist.amps[0].out)
+
+
+def section_step_chunk(ctx, model: tuple, values: dict, start: int = 0) -> dict:
+    """A chunk's figures with a low-pass section's step engine: the analytic engine's
+    (:func:`designer.plant.circuit.evaluate` of ``model``, (topology name, op-amp)), with those SPICE's step
+    measures (:data:`designer.tolerance.spice_engine.FIGURES`) in their place, as the Sallen-Key plant's
+    :func:`plant_chunk`. Pure, of picklable arguments.
+
+    Parameters
+    ----------
+    ctx : designer.tolerance.spice_engine.SpiceContext
+        The deck and its square wave (:func:`section_step_context`).
+    model : tuple
+        (topology name, op-amp).
+    values : dict
+        Designator -> array over the chunk's builds.
+    start : int
+        The first build's index.
+
+    Returns
+    -------
+    dict
+        Figure -> array over the builds.
+    """
+    from ..plant.circuit import evaluate as analytic
+    return {**analytic(model, values), **spice_engine.evaluate(ctx, values, start)}
+
+
+#: a section plant's SPICE engine: the step's ``.tran`` for a low-pass (it settles to its DC gain, the
+#: Sallen-Key plant's engine), the ``.ac`` sweep for the others (a high- or band-pass's step settles to 0)
+SECTION_ANALYSES = ("step", "ac")
+
+
+def section_analysis(topology) -> str:
+    """Which SPICE engine a section plant's Monte Carlo runs (:data:`SECTION_ANALYSES`): ``step`` (every build's
+    square-wave step in ngspice's ``.tran``, :mod:`.spice_engine`, the Sallen-Key plant's engine) for a low-pass,
+    ``ac`` (every build's ``.ac`` fitted, :mod:`.spice_ac`) for a high- or band-pass, whose step settles to 0.
+
+    Parameters
+    ----------
+    topology : designer.filters.topology.Topology
+        The section.
+
+    Returns
+    -------
+    str
+        ``step`` or ``ac``.
+    """
+    return "step" if topology.kind == "lowpass" else "ac"
 
 
 def spice_evaluate(ctx, opamp):
@@ -270,15 +329,34 @@ def plant_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sample
     if engine == "analytic":
         return plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist, tol_items, limit_items, **where)
     ctx = plant_context(result, simulator)
-    settings = {"engine": engine, "simulator": ctx.simulator, "max_step_s": ctx.max_step_s,
-                "rising_half_s": [ctx.t0, ctx.t1],
-                "fn_zeta": "second-order equivalents of the simulated step (zeta from the overshoot, fn from "
-                           "the peak time); the model's are its dominant pole pair",
-                "measured": list(spice_engine.FIGURES)}
+    settings = step_settings(ctx, engine)
     draw = lambda **kw: plant_monte_carlo(result.built, series, amp, n, seed, sampler, dist,  # noqa: E731
                                           tol_items, limit_items, **where, **kw)
     return run_engine(draw, spice_evaluate(ctx, amp), lambda v: figures_with_fixed(v, {}, amp), settings, engine,
                       spice_k, seed, scale, spice_engine.FIGURES, spice_engine.SHARED)
+
+
+def step_settings(ctx, engine: str) -> dict:
+    """The step engine's record under ``monte_carlo.spice`` (the Sallen-Key plant's and a low-pass
+    section's): its analysis, backend, time step, the rising half simulated, how fn and zeta are read.
+
+    Parameters
+    ----------
+    ctx : designer.tolerance.spice_engine.SpiceContext
+        The engine's context.
+    engine : str
+        ``spice`` or ``both``.
+
+    Returns
+    -------
+    dict
+        The record.
+    """
+    return {"engine": engine, "analysis": "step", "simulator": ctx.simulator, "max_step_s": ctx.max_step_s,
+            "rising_half_s": [ctx.t0, ctx.t1],
+            "fn_zeta": "second-order equivalents of the simulated step (zeta from the overshoot, fn from "
+                       "the peak time); the model's are its dominant pole pair",
+            "measured": list(spice_engine.FIGURES)}
 
 
 def run_engine(draw, evaluate, model, settings: dict, engine: str, spice_k, seed: int, scale, measured, shared):
@@ -353,11 +431,13 @@ def run_engine(draw, evaluate, model, settings: dict, engine: str, spice_k, seed
 def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler: str = "random",
                                dist: str = "uniform", tol_items=(), limit_items=(), engine: str = "analytic",
                                spice_k: int | None = None, simulator: str = "ngspice-cli", scale=None,
-                               target_ci: float | None = None):
+                               target_ci: float | None = None, analysis: str | None = None):
     """:func:`plant_monte_carlo_engine` of a plant on a registered section (a
     :class:`~designer.plant.circuit_design.CircuitPlantResult`): the analytic engine over its
-    declared parts (:func:`designer.plant.circuit.evaluate`) or, with a SPICE engine, every
-    build's ``.ac`` in ngspice (:mod:`.spice_ac`).
+    declared parts (:func:`designer.plant.circuit.evaluate`) or, with a SPICE engine, every build in
+    ngspice: a low-pass's square-wave step (:mod:`.spice_engine`, the Sallen-Key plant's engine and figures,
+    on its bench's square wave: :func:`section_step_context`), another section's ``.ac`` (:mod:`.spice_ac`):
+    :func:`section_analysis`. ``monte_carlo.spice.analysis`` records which.
 
     Parameters
     ----------
@@ -383,6 +463,9 @@ def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, samp
         Where the chunks run.
     target_ci : float, optional
         ``--target-ci``.
+    analysis : str, optional
+        :data:`SECTION_ANALYSES`: ``ac`` runs a low-pass's ``.ac`` instead of its step (None: the rule of
+        :func:`section_analysis`).
 
     Returns
     -------
@@ -392,15 +475,15 @@ def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, samp
     Raises
     ------
     DesignError
-        An unknown engine; ``SR`` in ``tol_items`` (both engines are linear:
-        :func:`designer.tolerance.montecarlo.check_section_spread`).
+        An unknown engine or analysis, a step on a section that is no low-pass; ``SR`` in ``tol_items`` but for
+        a SPICE step (the other engines are linear: :func:`designer.tolerance.montecarlo.check_section_spread`).
     """
     from ..plant import circuit
-    from . import spice_ac
     from .montecarlo import check_section_spread, plant_monte_carlo
     if engine not in ENGINES:
         raise DesignError(f"--engine {engine!r} unknown; allowed: {', '.join(ENGINES)}")
-    check_section_spread(tol_items)
+    analysis = section_analysis(result.section) if analysis is None else analysis
+    check_section_spread(tol_items, slews=engine != "analytic" and analysis == "step")
     model = (result.topology, result.opamp)
     nominal = dict(result.values)
     draw = lambda **kw: plant_monte_carlo(None, series, result.opamp, n, seed, sampler, dist,  # noqa: E731
@@ -408,14 +491,48 @@ def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, samp
                                           circuit=(nominal, circuit.evaluate, model), **kw)
     if engine == "analytic":
         return draw()
+    evaluate, settings, measured, shared = section_engine(result, simulator, engine, analysis)
+    return run_engine(draw, evaluate, lambda v: circuit.evaluate(model, v), settings, engine, spice_k, seed, scale,
+                      measured, shared)
+
+
+def section_engine(result, simulator: str = "ngspice-cli", engine: str = "spice", analysis: str | None = None):
+    """A section plant's SPICE engine (:func:`section_analysis`): (``evaluate(values) -> figures``, picklable;
+    its record under ``monte_carlo.spice``; the figures SPICE measures; those the model gives too).
+
+    Parameters
+    ----------
+    result : designer.plant.circuit_design.CircuitPlantResult
+        The design.
+    simulator : str
+        The backend.
+    engine : str
+        ``spice`` or ``both`` (recorded).
+    analysis : str, optional
+        ``step`` or ``ac`` (None: :func:`section_analysis`).
+
+    Returns
+    -------
+    tuple
+        (evaluate, settings, measured, shared).
+    """
+    import functools
+    from . import spice_ac
+    analysis = section_analysis(result.section) if analysis is None else analysis
+    if analysis not in SECTION_ANALYSES:
+        raise DesignError(f"analysis {analysis!r} unknown; allowed: {', '.join(SECTION_ANALYSES)}", param="analysis")
+    model = (result.topology, result.opamp)
+    if analysis == "step":
+        ctx = section_step_context(result, simulator)
+        return (functools.partial(section_step_chunk, ctx, model), step_settings(ctx, engine), spice_engine.FIGURES,
+                spice_engine.SHARED)
     ctx = section_context(result, simulator)
-    settings = {"engine": engine, "simulator": ctx.simulator, "sweep_hz": [ctx.f_lo_hz, ctx.f_hi_hz],
+    settings = {"engine": engine, "analysis": "ac", "simulator": ctx.simulator, "sweep_hz": [ctx.f_lo_hz, ctx.f_hi_hz],
                 "points_per_decade": spice_ac.POINTS_PER_DECADE,
                 "fn_zeta": "the section's form fitted to the simulated .ac response over the sweep (Levy's least "
                            "squares); the model's are its dominant pole pair",
                 "measured": list(spice_ac.FIGURES)}
-    return run_engine(draw, spice_ac.section_evaluate(ctx, model), lambda v: circuit.evaluate(model, v), settings,
-                      engine, spice_k, seed, scale, spice_ac.FIGURES, spice_ac.FIGURES)
+    return spice_ac.section_evaluate(ctx, model), settings, spice_ac.FIGURES, spice_ac.FIGURES
 
 
 def section_context(result, simulator: str = "ngspice-cli"):
@@ -473,27 +590,31 @@ class Replay:
                 "  model: " + ", ".join(f"{k} {self.model[k]:.5g}" for k in self.shared)]
 
 
-def replay_values(parts, series: dict, opamp, index: int, n: int, seed: int, sampler: str, dist: str,
-                  tol_items=()) -> tuple:
-    """(nominal, tolerances, values) of sample ``index`` of an ``n``-sample draw: exactly the
-    values :func:`designer.tolerance.montecarlo.plant_monte_carlo` drew for it.
+def replay_values(topology, values: dict, series: dict, opamp, index: int, n: int, seed: int, sampler: str,
+                  dist: str, tol_items=()) -> tuple:
+    """(nominal, tolerances, values) of build ``index`` of an ``n``-build draw over a section's parts
+    (``values``, designator -> nominal value: those of ``topology``'s that vary, in its order): exactly the
+    values :func:`designer.tolerance.montecarlo.plant_monte_carlo` drew for it, the Sallen-Key plant's
+    (:func:`replay_parts`) or any section's.
 
     Parameters
     ----------
-    parts : designer.plant.sallenkey.SallenKeyParts
-        The plant's parts.
+    topology : designer.filters.topology.Topology
+        The section.
+    values : dict
+        Designator -> nominal value of the parts that vary.
     series : dict
         ``{"R": series, "C": series}``.
     opamp : designer.core.opamps.OpAmp
         The op-amp.
     index : int
-        The sample.
+        The build.
     n : int
-        The draw's samples.
+        The draw's builds.
     seed : int
         The seed.
     sampler, dist : str
-        How the samples are drawn.
+        How the builds are drawn.
     tol_items : sequence of str
         The ``--tol`` items.
 
@@ -502,8 +623,31 @@ def replay_values(parts, series: dict, opamp, index: int, n: int, seed: int, sam
     tuple
         (nominal, tolerances, values).
     """
-    from .montecarlo import plant_parts
-    return drawn_values(plant_parts(parts), series, opamp, index, n, seed, sampler, dist, tol_items)
+    parts = {r: values[r] for r in topology.designators if r in values}
+    return drawn_values(parts, series, opamp, index, n, seed, sampler, dist, tol_items)
+
+
+def replay_parts(result) -> tuple:
+    """(section, designator -> nominal value of the parts its Monte Carlo varies) of a plant result: the
+    Sallen-Key plant's (:class:`~designer.plant.result.PlantResult`: the section its parts as built realise,
+    the gain pair only for a gain above 1, :func:`designer.tolerance.montecarlo.plant_parts`) or a section
+    plant's (:class:`~designer.plant.circuit_design.CircuitPlantResult`: every declared part).
+
+    Parameters
+    ----------
+    result : designer.plant.result.PlantResult or designer.plant.circuit_design.CircuitPlantResult
+        The design.
+
+    Returns
+    -------
+    tuple
+        (designer.filters.topology.Topology, dict).
+    """
+    if hasattr(result, "built"):
+        from ..filters.sallen_key_lowpass_parts import section_of
+        from .montecarlo import plant_parts
+        return section_of(result.built), plant_parts(result.built)
+    return result.section, dict(result.values)
 
 
 def drawn_values(parts: dict, series: dict, opamp, index: int, n: int, seed: int, sampler: str, dist: str,
@@ -548,22 +692,26 @@ def drawn_values(parts: dict, series: dict, opamp, index: int, n: int, seed: int
 
 def replay(result, series: dict, index: int, n: int, seed: int, sampler: str, dist: str, tol_items=(),
            simulator: str = "ngspice-cli") -> Replay:
-    """Sample ``index`` of the draw on ``result``'s parts, through the SPICE engine and the model.
+    """Build ``index`` of the Monte Carlo on ``result``'s parts (its section and values by designator,
+    :func:`replay_parts`), through its SPICE engine (the row ``--engine spice`` gives it) and its model: the
+    Sallen-Key plant's step engine (:func:`plant_context`) and third-order model, a low-pass section's step
+    engine (:func:`section_step_context`) or another section's ``.ac`` (:func:`section_engine`) and the analytic
+    engine (:func:`designer.plant.circuit.evaluate`).
 
     Parameters
     ----------
-    result : designer.plant.result.PlantResult
+    result : designer.plant.result.PlantResult or designer.plant.circuit_design.CircuitPlantResult
         The design.
     series : dict
         ``{"R": series, "C": series}``.
     index : int
-        The sample replayed.
+        The build replayed.
     n : int
-        The draw's samples.
+        The draw's builds.
     seed : int
         The seed.
     sampler, dist : str
-        How the samples are drawn.
+        How the builds are drawn.
     tol_items : sequence of str
         The ``--tol`` items.
     simulator : str
@@ -572,50 +720,84 @@ def replay(result, series: dict, index: int, n: int, seed: int, sampler: str, di
     Returns
     -------
     Replay
-        The sample's values and figures.
+        The build's values and figures.
     """
-    from .montecarlo import figures_with_fixed
-    _, tol, v = replay_values(result.built, series, result.opamp, index, n, seed, sampler, dist, tol_items)
+    topology, nominal = replay_parts(result)
+    _, tol, v = replay_values(topology, nominal, series, result.opamp, index, n, seed, sampler, dist, tol_items)
     arr = {k: np.array([x]) for k, x in v.items()}
-    ctx = plant_context(result, simulator)
-    sp = spice_engine.evaluate(ctx, arr, start=index)
-    model = figures_with_fixed(arr, {}, result.opamp)
+    if hasattr(result, "built"):         # the Sallen-Key plant: SPICE's step figures, its model's beside
+        from .montecarlo import figures_with_fixed
+        ctx = plant_context(result, simulator)
+        sp, backend = spice_engine.evaluate(ctx, arr, start=index), ctx.simulator
+        model, measured, shared = figures_with_fixed(arr, {}, result.opamp), spice_engine.FIGURES, spice_engine.SHARED
+    else:                                # a section: the SPICE engine's whole row, the analytic engine's beside
+        from ..plant import circuit
+        from .montecarlo import check_section_spread
+        check_section_spread(tol_items, slews=section_analysis(result.section) == "step")
+        evaluate, st, measured, shared = section_engine(result, simulator)
+        sp, backend = evaluate(arr, start=index), st["simulator"]
+        model = circuit.evaluate((result.topology, result.opamp), arr)
     settings = {"samples": n, "seed": seed, "sampler": sampler, "dist": dist, "engine": "spice",
-                "simulator": ctx.simulator, "tolerances_pct": tol.to_dict()}
+                "simulator": backend, "tolerances_pct": tol.to_dict()}
     return Replay(index, settings, v, {k: float(a[0]) for k, a in sp.items()},
-                  {k: float(model[k][0]) for k in spice_engine.SHARED})
+                  {k: float(model[k][0]) for k in shared}, measured, shared)
 
 
-def replay_result(result, rep: Replay, simulator: str, r_series=None, c_series=None, package=None):
-    """The full analyze-plant result (sheet, deck, waveforms) of the replayed sample's parts, exact
-    values (no E-series rounding), on the design's op-amp (with the sample's gain-bandwidth and slew
-    rate when they vary, :func:`designer.tolerance.parts.sample_opamp`) and square wave; its ``monte_carlo`` is the :class:`Replay`.
+def replay_result(result, rep: Replay, simulator: str, r_series=None, c_series=None, package=None, square_hz=None):
+    """The full analysis (sheet, deck, SPICE) of the replayed build's parts as drawn (its values by designator,
+    no E-series rounding) on the design's section and op-amp (with the build's gain-bandwidth and slew rate when
+    they vary, :func:`designer.tolerance.parts.sample_opamp`); its ``monte_carlo`` is the :class:`Replay`. The
+    Sallen-Key plant's (analyze-plant: its square wave, waveforms) or a section's (analyze-plant --topology: its
+    ``.ac`` check, and the square-wave test of ``square_hz``, else, for a low-pass whose engine is the step, of the
+    design's bench square wave, the one its engine stepped).
 
     Parameters
     ----------
-    result : designer.plant.result.PlantResult
+    result : designer.plant.result.PlantResult or designer.plant.circuit_design.CircuitPlantResult
         The design.
     rep : Replay
-        The sample replayed.
+        The build replayed.
     simulator : str
         The backend.
     r_series, c_series : str, optional
-        The parts' series, shown on the sheet.
+        The parts' series, shown on the sheet (None: the design's).
     package : str, optional
-        The op-amp's package.
+        The op-amp's package (None: the design's).
+    square_hz : float or str, optional
+        A section's square-wave test's frequency (None: as above).
 
     Returns
     -------
-    designer.plant.result.PlantResult
-        The analysis of the sample.
+    designer.plant.result.PlantResult or designer.plant.circuit_design.CircuitPlantResult
+        The analysis of the build.
     """
-    from ..plant.design import analyze_plant
-    from ..filters.sallen_key_lowpass_parts import parts_of
-    from ..plant.spec import AnalysisSpec
     from .parts import sample_opamp
     v = rep.values
-    parts = parts_of(v, base=result.built, gain=None)
     amp = sample_opamp(result.opamp, {k: np.array([x]) for k, x in v.items()}, 0)
+    if hasattr(result, "built"):
+        out = _replay_plant(result, v, amp, simulator, r_series, c_series, package)
+    else:
+        from ..plant.circuit_design import analyze_circuit_plant
+        topo, s = result.section, result.sourcing
+        if square_hz is None and section_analysis(topo) == "step" and result.test is not None:
+            square_hz = result.test.frequency_hz
+        out = analyze_circuit_plant(topo.name, {r: v[r] for r in topo.designators}, amp, result.target.fc_hz,
+                                    result.target.zeta, r_series or s.r_series, c_series or s.c_series,
+                                    package or result.package, simulate=True, simulator=simulator,
+                                    amplitude_v=result.amplitude_v, square_hz=square_hz)
+    out.notes.append(f"Monte Carlo sample {rep.index} replayed (seed {rep.settings['seed']}, "
+                     f"{rep.settings['sampler']}, {rep.settings['dist']}): these are its exact drawn values")
+    out.monte_carlo = rep
+    return out
+
+
+def _replay_plant(result, values: dict, amp, simulator: str, r_series, c_series, package):
+    """analyze-plant of the Sallen-Key plant's build ``values`` (by designator; a gain pair not drawn is the
+    design's) on the op-amp ``amp`` and the design's square wave."""
+    from ..filters.sallen_key_lowpass_parts import parts_of
+    from ..plant.design import analyze_plant
+    from ..plant.spec import AnalysisSpec
+    parts = parts_of(values, base=result.built, gain=None)
 
     class _SampleSpec(AnalysisSpec):
         @property
@@ -623,18 +805,12 @@ def replay_result(result, rep: Replay, simulator: str, r_series=None, c_series=N
             return amp
     spec = _SampleSpec(parts, opamp=result.opamp.name, r_series=r_series, c_series=c_series,
                        amplitude_v=result.test.amplitude_v, square_hz=result.test.frequency_hz, package=package)
-    out = analyze_plant(spec, simulate=True, simulator=simulator)
-    out.notes.append(f"Monte Carlo sample {rep.index} replayed (seed {rep.settings['seed']}, "
-                     f"{rep.settings['sampler']}, {rep.settings['dist']}): these are its exact drawn values")
-    out.monte_carlo = rep
-    return out
+    return analyze_plant(spec, simulate=True, simulator=simulator)
 
 
 def section_replay(result, series: dict, index: int, n: int, seed: int, sampler: str, dist: str, tol_items=(),
                    simulator: str = "ngspice-cli") -> Replay:
-    """Build ``index`` of the Monte Carlo on a section plant's parts (:func:`section_monte_carlo_engine`'s
-    draw), through its SPICE engine (the build's ``.ac`` in ngspice, :func:`designer.tolerance.spice_ac.section_chunk`:
-    the row ``--engine spice`` gives it) and the analytic engine.
+    """:func:`replay` (a section plant's build; the name the web page calls).
 
     Parameters
     ----------
@@ -660,24 +836,11 @@ def section_replay(result, series: dict, index: int, n: int, seed: int, sampler:
     Replay
         The build's values and figures.
     """
-    from ..plant import circuit
-    from . import spice_ac
-    _, tol, v = drawn_values(dict(result.values), series, result.opamp, index, n, seed, sampler, dist, tol_items)
-    arr = {k: np.array([x]) for k, x in v.items()}
-    ctx = section_context(result, simulator)
-    model = (result.topology, result.opamp)
-    sp = spice_ac.section_chunk(ctx, model, arr, start=index)
-    figs = circuit.evaluate(model, arr)
-    settings = {"samples": n, "seed": seed, "sampler": sampler, "dist": dist, "engine": "spice",
-                "simulator": ctx.simulator, "tolerances_pct": tol.to_dict()}
-    return Replay(index, settings, v, {k: float(a[0]) for k, a in sp.items()},
-                  {k: float(figs[k][0]) for k in spice_ac.FIGURES}, spice_ac.FIGURES, spice_ac.FIGURES)
+    return replay(result, series, index, n, seed, sampler, dist, tol_items, simulator)
 
 
 def section_replay_result(result, rep: Replay, simulator: str, square_hz=None):
-    """The analysis (sheet, deck, SPICE's ``.ac`` check) of the replayed build's parts as drawn (no E-series
-    rounding) on the design's section and op-amp (with the build's gain-bandwidth and slew rate when they
-    vary); its ``monte_carlo`` is the :class:`Replay`.
+    """:func:`replay_result` of a section plant's build (the name the web page calls).
 
     Parameters
     ----------
@@ -688,23 +851,11 @@ def section_replay_result(result, rep: Replay, simulator: str, square_hz=None):
     simulator : str
         The backend.
     square_hz : float or str, optional
-        The square-wave bench test's frequency (None: none).
+        The square-wave test's frequency (None: :func:`replay_result`'s rule).
 
     Returns
     -------
     designer.plant.circuit_design.CircuitPlantResult
         The analysis of the build (``mode`` "analyze").
     """
-    from ..plant.circuit_design import analyze_circuit_plant
-    from .parts import sample_opamp
-    topo = result.section
-    values = {r: rep.values[r] for r in topo.designators}
-    amp = sample_opamp(result.opamp, {k: np.array([x]) for k, x in rep.values.items()}, 0)
-    s = result.sourcing
-    out = analyze_circuit_plant(topo.name, values, amp, result.target.fc_hz, result.target.zeta, s.r_series,
-                                s.c_series, result.package, simulate=True, simulator=simulator,
-                                amplitude_v=result.amplitude_v, square_hz=square_hz)
-    out.notes.append(f"Monte Carlo sample {rep.index} replayed (seed {rep.settings['seed']}, "
-                     f"{rep.settings['sampler']}, {rep.settings['dist']}): these are its exact drawn values")
-    out.monte_carlo = rep
-    return out
+    return replay_result(result, rep, simulator, square_hz=square_hz)

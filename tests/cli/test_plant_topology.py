@@ -158,15 +158,17 @@ def test_analyze_plant_part_refusals_are_one_line(args, words, tmp_path):
 
 @pytest.mark.spice
 def test_engine_both_on_a_section_runs_each_build_s_ac_in_ngspice(tmp_path):
-    """--engine both: the CSV's SPICE rows are the analytic engine's next to them (its dominant pair: fn within
-    1 %), the model's rows recomputed from the parts exactly; --spice-samples checks the tails."""
-    topology = REGISTRY["mfb-lowpass"]
-    args = [*target_args(topology), "--monte-carlo", "30", "--seed", "2", "--limit", "fn_hz=950:1050",
-            "--simulator", "ngspice-cli", "--json"]
+    """--engine both on a high-pass (its step settles to 0: no step engine): each build's .ac, recorded as
+    such; the CSV's SPICE rows are the analytic engine's next to them (its dominant pair: fn within 1 %), the
+    model's rows recomputed from the parts exactly; --spice-samples checks the tails."""
+    topology = REGISTRY["mfb-highpass"]
+    fn = topology.example.fn_hz
+    args = [*target_args(topology), "--monte-carlo", "30", "--seed", "2", "--limit",
+            f"fn_hz={0.95 * fn:g}:{1.05 * fn:g}", "--simulator", "ngspice-cli", "--json"]
     out = run(*args, "--engine", "both", "--out", str(tmp_path))
     assert out.returncode == 0, out.stderr
     d = json.loads(out.stdout)
-    assert d["monte_carlo"]["spice"]["engine"] == "both"
+    assert d["monte_carlo"]["spice"]["engine"] == "both" and d["monte_carlo"]["spice"]["analysis"] == "ac"
     with open(d["files"]["monte_carlo_csv"], newline="") as fh:
         rows = list(csv.DictReader(fh))
     col = lambda k: np.array([float(r[k]) for r in rows])  # noqa: E731
@@ -174,6 +176,9 @@ def test_engine_both_on_a_section_runs_each_build_s_ac_in_ngspice(tmp_path):
                                    get_opamp(d["opamp"]["name"]))
     assert np.allclose(col("model_fn_hz"), figs["fn_hz"], rtol=1e-8)
     assert np.allclose(col("fn_hz"), figs["fn_hz"], rtol=0.01)
+    text = run(*args[:-1], "--engine", "spice", "--no-files")     # the text summary names the sweep
+    assert text.returncode == 0, text.stderr
+    assert "engine spice: ngspice (ngspice-cli), .ac " in text.stdout
     picked = run(*args, "--engine", "both", "--spice-samples", "2", "--no-files")
     assert picked.returncode == 0, picked.stderr
     assert json.loads(picked.stdout)["monte_carlo"]["spice"]["samples_checked"] >= 2
@@ -184,11 +189,18 @@ def test_engine_both_on_a_section_runs_each_build_s_ac_in_ngspice(tmp_path):
     (["--replay", "3"], ["--replay I goes with --monte-carlo N"]),
     (["--engine", "spice"], ["--engine spice goes with --monte-carlo N"]),
     (["--monte-carlo", "20", "--spice-samples", "2"], ["--spice-samples K goes with --engine both"]),
-    (["--monte-carlo", "20", "--engine", "spice", "--tol", "SR=20%"], ["--tol SR", "linear", "drop SR from --tol"]),
+    (["--monte-carlo", "20", "--tol", "SR=20%"], ["--tol SR", "linear", "drop SR from --tol"]),
     (["--worst-case", "--tol", "SR=20%"], ["--tol SR", "linear"]),
+    (["--monte-carlo", "20", "--engine", "spice", "--worst-case", "--tol", "SR=20%"], ["--tol SR", "linear"]),
 ])
 def test_what_a_section_plant_has_not_is_one_line(args, words, tmp_path):
     refused(run(*target_args(REGISTRY["mfb-lowpass"]), *args, "--no-sim", cwd=tmp_path), words, tmp_path)
+
+
+def test_a_slew_spread_on_an_ac_engine_is_one_line(tmp_path):
+    """--tol SR on a high-pass's SPICE engine (its .ac: small signal, linear) is refused before any work."""
+    refused(run(*target_args(REGISTRY["mfb-highpass"]), "--monte-carlo", "20", "--engine", "spice", "--tol",
+                "SR=20%", "--no-sim", cwd=tmp_path), ["--tol SR", "linear", "on a low-pass section"], tmp_path)
 
 
 @pytest.mark.spice
@@ -306,3 +318,85 @@ def test_r_and_c_on_a_section_is_its_exact_design_rounded_jointly(name, args, tm
 ])
 def test_r_and_c_a_section_cannot_take_are_one_line(args, words, tmp_path):
     refused(run(*args, "--no-sim", cwd=tmp_path), words, tmp_path)
+
+
+@pytest.mark.spice
+@pytest.mark.parametrize("name", ["mfb-lowpass", "rc-lowpass"])
+def test_engine_both_on_a_lowpass_section_is_the_seed_plant_s_step_engine(name, tmp_path):
+    """Issue 26: --engine spice|both on a low-pass section runs the seed plant's step engine (each build's
+    rising half under the bench's square wave, result.json's monte_carlo.spice.analysis "step", the same
+    figures), within the seed plant's test tolerance of the analytic engine (overshoot 0.02 pp; zeta 0.1 %, fn
+    0.3 %: the step's second-order equivalents against the dominant pair); a first-order step has no peak (fn,
+    zeta, Q, peak time compared on no build), its rise and settling times those of its pole, ln 9 and ln 50
+    time constants. The replay of a build gives that build's row (one replay function for every plant)."""
+    from designer.tolerance import spice_engine
+    topology = REGISTRY[name]
+    args = [*target_args(topology), "--monte-carlo", "12", "--seed", "3", "--simulator", "ngspice-cli"]
+    out = run(*args, "--engine", "both", "--json", "--out", str(tmp_path / "mc"))
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    s = d["monte_carlo"]["spice"]
+    assert s["analysis"] == "step" and s["measured"] == list(spice_engine.FIGURES)
+    assert s["rising_half_s"][1] - s["rising_half_s"][0] == pytest.approx(0.5 / d["test_signal"]["frequency_hz"])
+    dis = s["disagreement"]
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    col = lambda k: np.array([float(r[k]) for r in rows])  # noqa: E731
+    if topology.order == 2:
+        assert dis["overshoot_pct"]["compared"] == 12 and dis["overshoot_pct"]["max_abs"] < 0.02
+        np.testing.assert_allclose(col("zeta"), col("model_zeta"), rtol=1e-3)
+        np.testing.assert_allclose(col("fn_hz"), col("model_fn_hz"), rtol=3e-3)
+    else:
+        assert all(dis[k]["compared"] == 0 for k in ("fn_hz", "zeta", "q", "peak_time_s"))
+        tau = 1 / (2 * np.pi * col("model_fn_hz"))
+        np.testing.assert_allclose(col("rise_time_s"), np.log(9) * tau, rtol=5e-3)
+        np.testing.assert_allclose(col("settling_time_s"), np.log(50) * tau, rtol=5e-3)
+    rep = run(*args, "--replay", "7", "--json", "--out", str(tmp_path / "r"))
+    assert rep.returncode == 0, rep.stderr
+    r = json.loads(rep.stdout)["monte_carlo"]["replay"]
+    for k in ("overshoot_pct", "rise_time_s", "settling_time_s"):
+        assert r["spice_figures"][k] == pytest.approx(col(k)[7], rel=1e-9, abs=1e-12)
+
+
+@pytest.mark.spice
+def test_a_replayed_section_build_steps_under_the_runs_square_wave(tmp_path):
+    """analyze-plant --topology --square-freq --replay I: the build's step under the run's --square-freq (the
+    design the draw is made on had the recommended square wave before: its row I then differed from the run's),
+    and its bundle the square-wave test of that frequency."""
+    parts = ["--part", "R1=10k", "--part", "R2=20k", "--part", "R3=24k", "--part", "C1=4n7", "--part", "C2=47n"]
+    args = ["--topology", "mfb-lowpass", *parts, "--square-freq", "120", "--monte-carlo", "10", "--seed", "1",
+            "--engine", "spice", "--simulator", "ngspice-cli", "--json"]
+    mc = analyze(*args, "--out", str(tmp_path / "mc"))
+    assert mc.returncode == 0, mc.stderr
+    d = json.loads(mc.stdout)
+    assert d["monte_carlo"]["spice"]["rising_half_s"][1] - d["monte_carlo"]["spice"]["rising_half_s"][0] == \
+        pytest.approx(0.5 / 120)
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        row = list(csv.DictReader(fh))[4]
+    rep = analyze(*args, "--replay", "4", "--out", str(tmp_path / "r"))
+    assert rep.returncode == 0, rep.stderr
+    r = json.loads(rep.stdout)
+    for k in ("overshoot_pct", "peak_time_s", "settling_time_s"):
+        assert r["monte_carlo"]["replay"]["spice_figures"][k] == pytest.approx(float(row[k]), rel=1e-9)
+    assert r["square_test"]["generator"]["frequency_hz"] == 120
+
+
+@pytest.mark.spice
+def test_a_slew_spread_reaches_a_lowpass_sections_step(tmp_path):
+    """--tol SR on a low-pass section with the step engine (as on the seed plant): each build's op-amp slews at its
+    drawn rate in ngspice. A 20 kHz MFB low-pass, gain 2, 0 -> 5 V on an LM741 (0.5 V/us): the 10 V edge is
+    slew-limited, so each build's rise time follows 1/SR (correlation above 0.95) while the parts, at 0.01 %, move
+    it by less than 0.1 % without SR."""
+    base = ["--fc", "20k", "--zeta", "0.5", "--gain", "2", "--topology", "mfb-lowpass", "--amplitude", "5",
+            "--monte-carlo", "12", "--seed", "1", "--engine", "spice", "--simulator", "ngspice-cli", "--json"]
+    cols = {}
+    for tag, tol in (("sr", ["R=0.01%", "C=0.01%", "SR=40%"]), ("parts", ["R=0.01%", "C=0.01%"])):
+        out = run(*base, "--tol", *tol, "--out", str(tmp_path / tag))
+        assert out.returncode == 0, out.stderr
+        with open(json.loads(out.stdout)["files"]["monte_carlo_csv"], newline="") as fh:
+            cols[tag] = list(csv.DictReader(fh))
+    sr = np.array([float(r["SR"]) for r in cols["sr"]])
+    rise = np.array([float(r["rise_time_s"]) for r in cols["sr"]])
+    assert np.corrcoef(1 / sr, rise)[0, 1] > 0.95
+    still = np.array([float(r["rise_time_s"]) for r in cols["parts"]])
+    assert np.ptp(still) / np.mean(still) < 1e-3 < np.ptp(rise) / np.mean(rise)

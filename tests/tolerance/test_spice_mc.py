@@ -12,7 +12,7 @@ from designer.plant.spec import PlantSpec
 from designer.tolerance import sampling
 from designer.tolerance.montecarlo import plant_monte_carlo
 from designer.tolerance.plant import plant_figures
-from designer.tolerance.spice_mc import plant_monte_carlo_engine, replay, replay_values, spice_samples
+from designer.tolerance.spice_mc import plant_monte_carlo_engine, replay, replay_parts, replay_values, spice_samples
 from designer.tolerance.stats import parse_limit
 
 pytestmark = pytest.mark.spice
@@ -83,10 +83,11 @@ def test_replay_draws_the_samples_values_again(seed_plant, sampler):
     full = plant_monte_carlo(seed_plant.built, SERIES, seed_plant.opamp, 300, seed=7, sampler=sampler,
                              dist="normal", tol_items=["C2=2%"], tighten=False)
     for i in (0, 123, 299):
-        _, _, v = replay_values(seed_plant.built, SERIES, seed_plant.opamp, i, 300, 7, sampler, "normal", ["C2=2%"])
+        _, _, v = replay_values(*replay_parts(seed_plant), SERIES, seed_plant.opamp, i, 300, 7, sampler, "normal",
+                                ["C2=2%"])
         assert v == {k: a[i] for k, a in full.values.items()}
     with pytest.raises(DesignError, match="samples 0 to 299"):
-        replay_values(seed_plant.built, SERIES, seed_plant.opamp, 300, 300, 7, sampler, "normal")
+        replay_values(*replay_parts(seed_plant), SERIES, seed_plant.opamp, 300, 300, 7, sampler, "normal")
 
 
 def test_replay_gives_the_runs_figures(seed_plant):
