@@ -297,32 +297,31 @@ def _run(args) -> int:
     from ..pid.report import summary_text, write_outputs
     from ..pid.spec import default_name
     spec = _build_spec(args)
-    mc, spice = monte_carlo_settings(args, spec)
+    mc, i = monte_carlo_settings(args, spec)
     if spec.process is not None:
-        common.check_output(args, replay_name(args.name if args.name is not None else "pid_model", spice))
-        if spice[2] is not None:    # the design is the draw's nominal; the build's own run is the simulation
+        common.check_output(args, replay_name(args.name if args.name is not None else "pid_model", i))
+        if i is not None:    # the design is the draw's nominal; the build's own run is the simulation
             result = design_pid(spec, simulate=False, simulator=args.simulator)
             name = args.name or default_name(spec, result)
-            return emit(replay(spec, result, args, mc, spice), args, replay_name(name, spice), write_outputs,
+            return emit(replay(spec, result, args, mc, i), args, replay_name(name, i), write_outputs,
                         summary_text)
         early = []   # the pictures that need no SPICE, drawn in the renderer while ngspice runs
         with cluster_ahead(args):
             result = design_pid(spec, simulate=not args.no_sim, simulator=args.simulator,
                                 rules_spice=args.rules_spice,
                                 before_spice=None if args.no_files else lambda r: early.append(_early(r, args)))
-            result = loop_monte_carlo(result, args, mc, spice)
+            result = loop_monte_carlo(result, args, mc)
         return emit(result, args, args.name or default_name(spec, result),
                     lambda *a: write_outputs(*a, early=early[0] if early else None), summary_text)
     # the default name needs the plant as built; its fixed start stands in for it in the check
-    common.check_output(args, replay_name(args.name if args.name is not None else f"pid_{spec.method}", spice))
-    if spice[2] is not None:
+    common.check_output(args, replay_name(args.name if args.name is not None else f"pid_{spec.method}", i))
+    if i is not None:
         result = design_pid(spec, simulate=False, simulator=args.simulator)
         name = args.name or default_name(spec, result)
-        return emit(replay(spec, result, args, mc, spice), args, replay_name(name, spice), write_outputs,
+        return emit(replay(spec, result, args, mc, i), args, replay_name(name, i), write_outputs,
                     summary_text)
     with cluster_ahead(args):
-        result = loop_monte_carlo(design_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc,
-                                  spice)
+        result = loop_monte_carlo(design_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
     name = args.name or default_name(spec, result)
     return emit(result, args, name, write_outputs, summary_text)
 
@@ -401,15 +400,14 @@ def _analyze(args) -> int:
     typed = _typed(args, ANALYZE_PARAMS + PLANT_PARTS)
     process = _captured_model(args, typed)
     spec = pid_spec({**typed, "controller_parts": parts, "package": args.package, "plant_process": process})
-    mc, spice = monte_carlo_settings(args, spec)
-    common.check_output(args, replay_name(args.name if args.name is not None else "pid_as-built", spice))
-    if spice[2] is not None:    # the parts as given are the draw's nominal; the build's own run is the simulation
+    mc, i = monte_carlo_settings(args, spec)
+    common.check_output(args, replay_name(args.name if args.name is not None else "pid_as-built", i))
+    if i is not None:    # the parts as given are the draw's nominal; the build's own run is the simulation
         result = analyze_pid(spec, simulate=False, simulator=args.simulator)
-        return emit(replay(spec, result, args, mc, spice), args,
-                    replay_name(args.name or analyzed_name(spec, result), spice), write_outputs, summary_text)
+        return emit(replay(spec, result, args, mc, i), args,
+                    replay_name(args.name or analyzed_name(spec, result), i), write_outputs, summary_text)
     with cluster_ahead(args):
-        result = loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc,
-                                  spice)
+        result = loop_monte_carlo(analyze_pid(spec, simulate=not args.no_sim, simulator=args.simulator), args, mc)
     return emit(result, args, args.name or analyzed_name(spec, result), write_outputs, summary_text)
 
 

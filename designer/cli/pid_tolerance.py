@@ -53,7 +53,8 @@ def add_monte_carlo(p):
 
 
 def monte_carlo_settings(args, spec):
-    """The Monte Carlo's options checked before any work: (``(n, seed)`` or None, ``(engine, K, I)``)."""
+    """The Monte Carlo's options checked before any work: (the library's
+    :class:`~designer.tolerance.mcspec.MonteCarloSpec` or None, the build I to replay or None)."""
     from ..tolerance.loop import parse_loop_limit
     from ..tolerance.spice_loop_mc import parse_limit
     from .plant import monte_carlo_settings as checked, spice_settings
@@ -64,40 +65,29 @@ def monte_carlo_settings(args, spec):
         from ..core import opamps
         from ..tolerance.parts import opamp_nominal
         opamp_nominal(args.tol, opamps.get(spec.opamp))
-    spice = spice_settings(args, settings, plant=False)
-    if spice[2] is not None and getattr(args, "rules_spice", False):
+    mc, i = spice_settings(args, settings, plant=False)
+    if i is not None and getattr(args, "rules_spice", False):
         raise DesignError("--rules-spice does not go with --replay (a replayed build is analysed as built)")
-    return settings, spice
+    return mc, i
 
 
-def loop_monte_carlo(result, args, settings, spice=("analytic", None, None)):
-    """The loop's tolerance analysis (--monte-carlo with its engine, --worst-case), attached to the result."""
-    from ..tolerance.loop import loop_series, loop_worst_case
-    if args.worst_case:
-        result.worst_case = loop_worst_case(result, loop_series(result), args.tol or (), args.limit or ())
-    if settings is None:
-        return result
-    n, seed = settings
-    from ..tolerance.spice_loop_mc import loop_monte_carlo_engine
+def loop_monte_carlo(result, args, mc):
+    """The loop's tolerance analysis (--monte-carlo with its engine, --worst-case), attached to the result: the
+    library's :func:`designer.tolerance.mcspec.loop_tolerance`, as the page runs it."""
+    from ..tolerance.mcspec import loop_tolerance
     from .plant import scale_settings
-    scale, target = scale_settings(args)
-    result.monte_carlo = loop_monte_carlo_engine(result, loop_series(result), n, seed, args.sampler, args.dist,
-                                                 args.tol or (), args.limit or (), spice[0], spice[1],
-                                                 args.simulator, scale=scale, target_ci=target)
-    return result
+    return loop_tolerance(result, mc, args.worst_case, args.tol or (), args.simulator, scale=scale_settings(args)[0])
 
 
-def replay(spec, result, args, settings, spice):
+def replay(spec, result, args, mc, i):
     """--replay I: the build's own analyze-pid result (its exact values, in SPICE), its
     ``monte_carlo`` the replayed row (:func:`designer.tolerance.spice_loop_mc.replay_result`)."""
     from ..tolerance.loop import loop_series
     from ..tolerance.spice_loop_mc import replay as replay_build, replay_result
-    n, seed = settings
-    rep = replay_build(result, loop_series(result), spice[2], n, seed, args.sampler, args.dist, args.tol or (),
-                       args.simulator)
+    rep = replay_build(result, loop_series(result), i, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol, args.simulator)
     return replay_result(spec, result, rep, args.simulator)
 
 
-def replay_name(name: str, spice) -> str:
-    """The bundle's name: the run's, with ``_sample<I>`` when a build is replayed."""
-    return name if spice[2] is None else f"{name}_sample{spice[2]}"
+def replay_name(name: str, i) -> str:
+    """The bundle's name: the run's, with ``_sample<I>`` when build ``i`` is replayed."""
+    return name if i is None else f"{name}_sample{i}"

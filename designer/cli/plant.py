@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 
 from .. import __version__
@@ -206,8 +207,9 @@ PLANT_PARTS = refs()      # the Sallen-Key low-pass section's, with its gain pai
 
 
 def monte_carlo_settings(args, designators=PLANT_PARTS, parse_limit_item=None):
-    """The Monte Carlo's options checked before any work (None without --monte-carlo);
-    ``parse_limit_item(text)`` checks a --limit (default: a plant figure's)."""
+    """The Monte Carlo's options checked before any work, as the library's spec
+    (:class:`designer.tolerance.mcspec.MonteCarloSpec`; None without --monte-carlo; its engine set by
+    :func:`spice_settings`); ``parse_limit_item(text)`` checks a --limit (default: a plant figure's)."""
     given = [f for f, v in (("--tol", args.tol), ("--limit", args.limit)) if v]
     if args.monte_carlo is None:
         if args.limit or (args.tol and not args.worst_case):
@@ -239,12 +241,15 @@ def monte_carlo_settings(args, designators=PLANT_PARTS, parse_limit_item=None):
     from ..tolerance.parts import check_items
     check_items(args.tol or (), designators)
     scale_settings(args)
-    return n, seed
+    from ..tolerance.mcspec import MonteCarloSpec
+    return MonteCarloSpec(n, seed, args.sampler, args.dist, tuple(args.tol or ()), tuple(args.limit or ()),
+                          args.target_ci)
 
 
-def spice_settings(args, settings, plant: bool = True):
-    """--engine, --spice-samples and --replay checked before any work: (engine, K or None, I or None);
-    ``plant``: the plant's op-amp spread checked too (a loop's analytic engine has a slew check)."""
+def spice_settings(args, mc, plant: bool = True):
+    """--engine, --spice-samples and --replay checked before any work: (the Monte Carlo ``mc`` with its engine
+    and K, or None; the build I to replay, or None); ``plant``: the plant's op-amp spread checked too (a loop's
+    analytic engine has a slew check)."""
     def whole(opt, text, lo, hi):
         try:
             v = int(str(text).strip())
@@ -255,24 +260,24 @@ def spice_settings(args, settings, plant: bool = True):
         return v
     k = i = None
     if args.replay is not None:
-        if settings is None:
+        if mc is None:
             raise DesignError("--replay I goes with --monte-carlo N (and the run's --seed, --sampler, --dist, --tol)")
         if args.no_sim:
             raise DesignError("--replay simulates the build in SPICE: drop --no-sim")
-        i = whole("--replay", args.replay, 0, settings[0] - 1)
+        i = whole("--replay", args.replay, 0, mc.n - 1)
     if args.spice_samples is not None:
         if args.engine != "both":
             raise DesignError("--spice-samples K goes with --engine both")
-        if settings is None:
+        if mc is None:
             raise DesignError("--spice-samples K goes with --monte-carlo N")
         if not args.limit:
             raise DesignError("--spice-samples needs --limit: its samples are the tails of each limited figure")
-        k = whole("--spice-samples", args.spice_samples, 1, settings[0])
-    if args.engine != "analytic" and settings is None:
+        k = whole("--spice-samples", args.spice_samples, 1, mc.n)
+    if args.engine != "analytic" and mc is None:
         raise DesignError(f"--engine {args.engine} goes with --monte-carlo N")
     if plant:
         _check_opamp_spread(args, i)
-    return args.engine, k, i
+    return (None if mc is None else dataclasses.replace(mc, engine=args.engine, spice_samples=k)), i
 
 
 def _check_opamp_spread(args, replay) -> None:
@@ -289,40 +294,21 @@ def _check_opamp_spread(args, replay) -> None:
                           "searches that model: drop SR from --tol")
 
 
-def _replay(result, args, settings, spice, name):
+def _replay(result, args, mc, i, name):
     """--replay I: the sample's own bundle (analyze-plant of its exact values), written under ``name``_sample<I>."""
     from ..tolerance.spice_mc import replay, replay_result
     s = result.sourcing
-    n, seed = settings
-    rep = replay(result, {"R": s.r_series, "C": s.c_series}, spice[2], n, seed, args.sampler, args.dist,
-                 args.tol or (), args.simulator)
+    rep = replay(result, {"R": s.r_series, "C": s.c_series}, i, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol,
+                 args.simulator)
     out = replay_result(result, rep, args.simulator, s.r_series, s.c_series, args.package)
-    return _emit(out, args, f"{name}_sample{spice[2]}")
+    return _emit(out, args, f"{name}_sample{i}")
 
 
-def _with_monte_carlo(result, args, settings, spice=("analytic", None, None)):
-    """The tolerance analysis of the result's parts as built (--monte-carlo, --worst-case), attached to it."""
-    s = result.sourcing
-    if args.worst_case:
-        from ..tolerance.montecarlo import plant_worst_case
-        result.worst_case = plant_worst_case(result.built, {"R": s.r_series, "C": s.c_series}, result.opamp,
-                                             args.tol or ())
-    if settings is None:
-        return result
-    from ..tolerance.montecarlo import plant_monte_carlo
-    n, seed = settings
-    scale, target = scale_settings(args)
-    if spice[0] != "analytic":
-        from ..tolerance.spice_mc import plant_monte_carlo_engine
-        result.monte_carlo = plant_monte_carlo_engine(result, {"R": s.r_series, "C": s.c_series}, n, seed,
-                                                      args.sampler, args.dist, args.tol or (), args.limit or (),
-                                                      spice[0], spice[1], args.simulator, scale=scale,
-                                                      target_ci=target)
-        return result
-    result.monte_carlo = plant_monte_carlo(result.built, {"R": s.r_series, "C": s.c_series}, result.opamp, n, seed,
-                                           args.sampler, args.dist, args.tol or (), args.limit or (), scale=scale,
-                                           target_ci=target)
-    return result
+def _with_monte_carlo(result, args, mc):
+    """The tolerance analysis of the result's parts as built (--monte-carlo, --worst-case), attached to it: the
+    library's :func:`designer.tolerance.mcspec.plant_tolerance`, as the page runs it."""
+    from ..tolerance.mcspec import plant_tolerance
+    return plant_tolerance(result, mc, args.worst_case, args.tol or (), args.simulator, scale=scale_settings(args)[0])
 
 
 def _add_bench_options(group):
@@ -411,16 +397,15 @@ def _design(args) -> int:
                      square_hz=args.square_freq, alternatives=args.alternatives, package=args.package)
     name = args.name if args.name is not None else (
         f"plant_fc{spec.fc_hz:g}_z{spec.zeta:g}" + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
-    mc = monte_carlo_settings(args)
-    spice = spice_settings(args, mc)
+    mc, i = spice_settings(args, monte_carlo_settings(args))
     stim = stimulus_settings(args)
-    check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
+    check_output(args, name if i is None else f"{name}_sample{i}")
     from ..plant.design import design_plant
-    if spice[2] is not None:     # the design is the draw's nominal; the sample's own run is the simulation
-        return _replay(design_plant(spec, simulate=False), args, mc, spice, name)
+    if i is not None:     # the design is the draw's nominal; the sample's own run is the simulation
+        return _replay(design_plant(spec, simulate=False), args, mc, i, name)
     with cluster_ahead(args):
         result = _with_stimulus(design_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, stim)
-        result = _with_monte_carlo(result, args, mc, spice)
+        result = _with_monte_carlo(result, args, mc)
     return _emit(result, args, name)
 
 
@@ -436,18 +421,17 @@ def _design_circuit(args, topo) -> int:
     name = args.name if args.name is not None else (
         f"plant_{topo.name}_fc{spec.fc_hz:g}" + ("" if spec.zeta is None else f"_z{spec.zeta:g}")
         + ("" if spec.gain == 1 else f"_k{spec.gain:g}"))
-    mc = monte_carlo_settings(args, topo.designators)
-    spice = spice_settings(args, mc, plant=False)
+    mc, i = spice_settings(args, monte_carlo_settings(args, topo.designators), plant=False)
     stim = stimulus_settings(args)
-    check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
+    check_output(args, name if i is None else f"{name}_sample{i}")
     from ..plant.circuit_design import design_circuit_plant
     from ..plant.circuit_report import summary_text, write_outputs
-    if spice[2] is not None:     # the design is the draw's nominal; the build's own run the simulation
-        return _circuit_replay(design_circuit_plant(spec, simulate=False), args, mc, spice, name)
+    if i is not None:     # the design is the draw's nominal; the build's own run the simulation
+        return _circuit_replay(design_circuit_plant(spec, simulate=False), args, mc, i, name)
     with cluster_ahead(args):
         result = _circuit_stimulus(design_circuit_plant(spec, simulate=not args.no_sim, simulator=args.simulator),
                                    args, stim)
-        result = _circuit_tolerance(result, args, mc, spice)
+        result = _circuit_tolerance(result, args, mc)
     return emit(result, args, name, write_outputs, summary_text)
 
 
@@ -460,18 +444,17 @@ def _check_section_spread(args, topo) -> None:
     check_section_spread(args.tol, slews=slews and not args.worst_case)
 
 
-def _circuit_replay(result, args, settings, spice, name) -> int:
+def _circuit_replay(result, args, mc, i, name) -> int:
     """--replay I on a section plant: the build's values drawn again, through its SPICE engine (the engine's row
     I: a low-pass's step, another section's .ac), and its bundle (analyze-plant --topology of its exact values)
     written under ``name``_sample<I>: the seed plant's replay, one function (designer.tolerance.spice_mc.replay)."""
     from ..plant.circuit_report import summary_text, write_outputs
     from ..tolerance.spice_mc import replay, replay_result
     s = result.sourcing
-    n, seed = settings
-    rep = replay(result, {"R": s.r_series, "C": s.c_series}, spice[2], n, seed, args.sampler, args.dist,
-                 args.tol or (), args.simulator)
+    rep = replay(result, {"R": s.r_series, "C": s.c_series}, i, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol,
+                 args.simulator)
     out = replay_result(result, rep, args.simulator, square_hz=args.square_freq)
-    return emit(out, args, f"{name}_sample{spice[2]}", write_outputs, summary_text)
+    return emit(out, args, f"{name}_sample{i}", write_outputs, summary_text)
 
 
 def _circuit_stimulus(result, args, stim):
@@ -508,50 +491,34 @@ def _analyze_circuit(args, topo) -> int:
     if bad or missing:
         what = f"has no part {bad[0]}" if bad else f"needs {', '.join(missing)} too"
         raise DesignError(f"--part: {topo.name} {what}; its parts are {', '.join(topo.designators)}")
-    mc = monte_carlo_settings(args, topo.designators)
-    spice = spice_settings(args, mc, plant=False)
+    mc, i = spice_settings(args, monte_carlo_settings(args, topo.designators), plant=False)
     from ..core.ranges import parse_in_range
     values = {r: parse_in_range(v, f"--part {r}", "resistor_ohm" if r[0] == "R" else "capacitor_f")
               for r, v in parts.items()}
     stim = stimulus_settings(args)
     name = args.name if args.name is not None else built_name(topo.name, values)
-    check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
-    if spice[2] is not None:
+    check_output(args, name if i is None else f"{name}_sample{i}")
+    if i is not None:
         return _circuit_replay(analyze_circuit_plant(
             topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,
-            simulate=False, amplitude_v=args.amplitude, square_hz=args.square_freq), args, mc, spice, name)
+            simulate=False, amplitude_v=args.amplitude, square_hz=args.square_freq), args, mc, i, name)
     with cluster_ahead(args):
         result = _circuit_stimulus(analyze_circuit_plant(
             topo.name, values, args.opamp, args.fc, args.zeta, args.r_series, args.c_series, args.package,
             simulate=not args.no_sim, simulator=args.simulator, amplitude_v=args.amplitude,
             square_hz=args.square_freq), args, stim)
-        result = _circuit_tolerance(result, args, mc, spice)
+        result = _circuit_tolerance(result, args, mc)
     return emit(result, args, name, write_outputs, summary_text)
 
 
-def _circuit_tolerance(result, args, mc, spice=("analytic", None, None)):
-    """--worst-case and --monte-carlo of a plant on another topology (the analytic engine over its parts;
-    --engine spice|both, --spice-samples: every build in ngspice, a low-pass's step on its bench's square wave as
-    the seed plant's, another section's .ac: designer.tolerance.spice_mc.section_analysis)."""
-    from ..plant import circuit
-    from ..plant.circuit_design import tolerance_nominal
-    from ..tolerance.parts import opamp_nominal
-    s = result.sourcing
-    series = {"R": s.r_series, "C": s.c_series}
-    nominal = {**tolerance_nominal(result), **opamp_nominal(args.tol, result.opamp)}   # --tol GBW: the op-amp's
-    context = (result.topology, result.opamp)
-    if args.worst_case:
-        from ..tolerance.parts import resolve
-        from ..tolerance.worstcase import worst_case
-        tol = resolve(args.tol or (), nominal, series)
-        result.worst_case = worst_case(lambda v: circuit.evaluate(context, v), nominal, tol.of)
-    if mc is not None:
-        from ..tolerance.spice_mc import section_monte_carlo_engine
-        scale, target = scale_settings(args)
-        result.monte_carlo = section_monte_carlo_engine(result, series, mc[0], mc[1], args.sampler, args.dist,
-                                                        args.tol or (), args.limit or (), spice[0], spice[1],
-                                                        args.simulator, scale=scale, target_ci=target)
-    return result
+def _circuit_tolerance(result, args, mc):
+    """--worst-case and --monte-carlo of a plant on another topology: the library's
+    :func:`designer.tolerance.mcspec.section_tolerance` (the analytic engine over its parts; --engine
+    spice|both, --spice-samples: every build in ngspice, a low-pass's step on its bench's square wave as the
+    seed plant's, another section's .ac), as the page runs it."""
+    from ..tolerance.mcspec import section_tolerance
+    return section_tolerance(result, mc, args.worst_case, args.tol or (), args.simulator,
+                             scale=scale_settings(args)[0])
 
 
 def _emit(result, args, name) -> int:
@@ -676,15 +643,14 @@ def _analyze(args) -> int:
     p = spec.parts
     name = args.name if args.name is not None else built_name(DEFAULT_TOPOLOGY, {
         r: getattr(p, FIELD_OF[r]) for r in refs(with_gain=False)})
-    mc = monte_carlo_settings(args)
-    spice = spice_settings(args, mc)
+    mc, i = spice_settings(args, monte_carlo_settings(args))
     stim = stimulus_settings(args)
-    check_output(args, name if spice[2] is None else f"{name}_sample{spice[2]}")
-    if spice[2] is not None:
-        return _replay(analyze_plant(spec, simulate=False), args, mc, spice, name)
+    check_output(args, name if i is None else f"{name}_sample{i}")
+    if i is not None:
+        return _replay(analyze_plant(spec, simulate=False), args, mc, i, name)
     with cluster_ahead(args):
         result = _with_stimulus(analyze_plant(spec, simulate=not args.no_sim, simulator=args.simulator), args, stim)
-        result = _with_monte_carlo(result, args, mc, spice)
+        result = _with_monte_carlo(result, args, mc)
     return _emit(result, args, name)
 
 

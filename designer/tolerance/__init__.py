@@ -15,7 +15,7 @@ from ..core.exports import lazy_exports
 #: pays only for what it runs); a name several modules share, or a module's own name, is reached through
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    "mcspec": ("MonteCarloSpec", "loop_tolerance", "plant_tolerance"),
+    "mcspec": ("MonteCarloSpec", "loop_tolerance", "plant_tolerance", "section_tolerance"),
     "chunks": ("lost_twice", "run_chunk",),
     "cluster": ("CONNECT_TIMEOUT", "ClusterStart", "DaskPool", "WORKERS", "cluster_ahead", "parse_dask", "probe",),
     "filter": ("BANDPASS_FIGURES", "FilterContext", "FilterMonteCarlo", "LOWHIGH_FIGURES",

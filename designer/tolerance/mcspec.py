@@ -21,7 +21,7 @@ from .montecarlo import MAX_SAMPLES, MIN_SAMPLES
 from .parts import DISTRIBUTIONS
 from .sampling import SAMPLERS
 
-__all__ = ["ENGINES", "MonteCarloSpec", "loop_tolerance", "plant_tolerance"]
+__all__ = ["ENGINES", "MonteCarloSpec", "loop_tolerance", "plant_tolerance", "section_tolerance"]
 
 #: where each build's figures come from (the plant's; a loop's Monte Carlo is analytic)
 ENGINES = ("analytic", "spice", "both")
@@ -204,4 +204,63 @@ def loop_tolerance(result, mc: MonteCarloSpec | None, worst_case: bool = False, 
     result.monte_carlo = loop_monte_carlo_engine(result, series, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol,
                                                  mc.limits, mc.engine, mc.spice_samples, simulator, scale=scale,
                                                  target_ci=mc.target_ci)
+    return result
+
+
+def section_tolerance(result, mc: MonteCarloSpec | None, worst_case: bool = False, tol=(),
+                      simulator: str = "ngspice-cli", scale=None):
+    """The tolerance analysis of a plant on a registered section, its parts as built, attached to it: the
+    worst case over its declared parts (and the op-amp's GBW when ``tol`` spreads it) and the Monte Carlo (the
+    analytic engine, or every build in ngspice: a low-pass's step, another section's ``.ac``,
+    :func:`designer.tolerance.spice_mc.section_monte_carlo_engine`); what the command line's
+    ``design-plant --topology`` and the page run.
+
+    Parameters
+    ----------
+    result : designer.plant.circuit_design.CircuitPlantResult
+        The design (its section, values, series and op-amp).
+    mc : MonteCarloSpec or None
+        The Monte Carlo to run (None: none).
+    worst_case : bool
+        Also the true extremes of the figures over the tolerance box.
+    tol : tuple of str
+        The tolerances of the worst case when there is no Monte Carlo (else ``mc.tol``).
+    simulator : str
+        The SPICE engine's backend.
+    scale : designer.tolerance.runner.Scale, optional
+        Where the builds run (default: this process).
+
+    Returns
+    -------
+    CircuitPlantResult
+        ``result``, with ``worst_case`` and ``monte_carlo`` set as asked.
+
+    Raises
+    ------
+    DesignError
+        ``SR`` in the tolerances where no engine simulates the op-amp's slew (the analytic model, the worst
+        case's search of it, an ``.ac`` sweep).
+    """
+    from ..plant import circuit
+    from ..plant.circuit_design import tolerance_nominal
+    from .montecarlo import check_section_spread
+    from .parts import opamp_nominal, resolve
+    from .spice_mc import section_analysis
+    s = result.sourcing
+    series = {"R": s.r_series, "C": s.c_series}
+    tol = mc.tol if mc is not None else tuple(tol or ())
+    # only a low-pass's SPICE step slews: SR elsewhere would be silently ignored
+    slews = mc is not None and mc.engine != "analytic" and section_analysis(result.section) == "step"
+    check_section_spread(tol, slews=slews and not worst_case)
+    if worst_case:
+        from .worstcase import worst_case as search
+        nominal = {**tolerance_nominal(result), **opamp_nominal(tol, result.opamp)}   # GBW: the op-amp's
+        context = (result.topology, result.opamp)
+        result.worst_case = search(lambda v: circuit.evaluate(context, v), nominal, resolve(tol, nominal, series).of)
+    if mc is None:
+        return result
+    from .spice_mc import section_monte_carlo_engine
+    result.monte_carlo = section_monte_carlo_engine(result, series, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol,
+                                                    mc.limits, mc.engine, mc.spice_samples, simulator, scale=scale,
+                                                    target_ci=mc.target_ci)
     return result

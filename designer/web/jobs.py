@@ -308,27 +308,15 @@ def _plant_answer(result, rq, want: str, tmp: str | None, lang: str | None, name
 
 def _circuit_plant(result, rq, want: str, tmp: str | None, lang: str | None) -> tuple:
     """A plant on a registered topology other than the seed's (designed, :func:`designer.plant.circuit_design.
-    design_circuit_plant`, or as built), with the Monte Carlo (the analytic engine, or every build's .ac in
-    ngspice) and worst case over its declared parts and the PRBS bench test, as design-plant --topology runs
-    them; as :func:`_library_task`'s ``work`` answers."""
-    from ..plant import circuit
-    from ..plant.circuit_design import tolerance_nominal
-    from ..tolerance.parts import resolve
-    from ..tolerance.spice_mc import section_monte_carlo_engine
-    from ..tolerance.worstcase import worst_case
+    design_circuit_plant`, or as built), with the PRBS bench test and the tolerance analysis
+    (:func:`designer.tolerance.mcspec.section_tolerance`, as design-plant --topology runs it); as
+    :func:`_library_task`'s ``work`` answers."""
+    from ..tolerance.mcspec import section_tolerance
     if rq.stimulus is not None:
         from ..plant.circuit_prbs import with_section_prbs
         result = with_section_prbs(result, result.amplitude_v, rq.stimulus[0], rq.stimulus[1], rq.simulate,
                                    rq.simulator)
-    series = {"R": result.sourcing.r_series, "C": result.sourcing.c_series}
-    nominal, context, mc = tolerance_nominal(result), (result.topology, result.opamp), rq.monte_carlo
-    if rq.worst_case:
-        tol = resolve(mc.tol if mc is not None else rq.tol, nominal, series)
-        result.worst_case = worst_case(lambda v: circuit.evaluate(context, v), nominal, tol.of)
-    if mc is not None:
-        result.monte_carlo = section_monte_carlo_engine(result, series, mc.n, mc.seed, mc.sampler, mc.dist, mc.tol,
-                                                        mc.limits, mc.engine, mc.spice_samples, rq.simulator,
-                                                        target_ci=mc.target_ci)
+    result = section_tolerance(result, rq.monte_carlo, rq.worst_case, rq.tol, rq.simulator)
     return _circuit_answer(result, rq, want, tmp, lang, rq.name)
 
 

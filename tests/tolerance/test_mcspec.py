@@ -59,3 +59,44 @@ def test_plant_tolerance_is_the_libraries_monte_carlo_and_worst_case():
                              ("fn_hz=3.3k:3.7k",))
     assert got.monte_carlo.to_dict() == want.to_dict()
     assert got.worst_case.to_dict() == plant_worst_case(result.built, series, result.opamp, ("R=1%",)).to_dict()
+
+
+def test_section_tolerance_is_the_libraries_monte_carlo_and_worst_case_with_the_opamps_gbw():
+    """One tolerance analysis of a section plant for the command line and the page (issue 26): the worst case
+    spreads the op-amp's GBW when the tolerances name it (the page's own copy refused it: "this design has no part
+    GBW"), the Monte Carlo is the section engine's."""
+    from designer.plant import circuit
+    from designer.plant.circuit_design import design_circuit_plant, tolerance_nominal
+    from designer.plant.spec import PlantSpec
+    from designer.tolerance.mcspec import section_tolerance
+    from designer.tolerance.parts import opamp_nominal, resolve
+    from designer.tolerance.spice_mc import section_monte_carlo_engine
+    from designer.tolerance.worstcase import worst_case
+    result = design_circuit_plant(PlantSpec(fc_hz=1000, zeta=0.3, topology="mfb-lowpass"), simulate=False)
+    tol = ("R=1%", "GBW=30%")
+    got = section_tolerance(dataclasses.replace(result), None, worst_case=True, tol=tol)
+    series = {"R": result.sourcing.r_series, "C": result.sourcing.c_series}
+    nominal = {**tolerance_nominal(result), **opamp_nominal(tol, result.opamp)}
+    want = worst_case(lambda v: circuit.evaluate((result.topology, result.opamp), v), nominal,
+                      resolve(tol, nominal, series).of)
+    assert got.worst_case.to_dict() == want.to_dict() and "GBW" in got.worst_case.to_dict()["fn_hz"]["min"][
+        "deviations"]
+    mc = MonteCarloSpec(n=200, seed=3, tol=tol, limits=("fn_hz=900:1.1k",))
+    got = section_tolerance(dataclasses.replace(result), mc)
+    want = section_monte_carlo_engine(result, series, 200, 3, "random", "uniform", tol, ("fn_hz=900:1.1k",))
+    assert got.monte_carlo.to_dict() == want.to_dict()
+
+
+def test_section_tolerance_refuses_a_slew_rate_spread_no_engine_simulates():
+    """--tol SR on a section: the analytic model and an .ac sweep have no slew in them; refused (param SR), not
+    silently ignored."""
+    from designer.plant.circuit_design import design_circuit_plant
+    from designer.plant.spec import PlantSpec
+    from designer.tolerance.mcspec import section_tolerance
+    for topology in ("mfb-lowpass", "mfb-highpass"):
+        result = design_circuit_plant(PlantSpec(fc_hz=1000, zeta=0.3, topology=topology), simulate=False)
+        with pytest.raises(DesignError) as e:
+            section_tolerance(result, MonteCarloSpec(n=20, tol=("SR=20%",)))
+        assert e.value.param == "SR"
+        with pytest.raises(DesignError):
+            section_tolerance(result, None, worst_case=True, tol=("SR=20%",))

@@ -255,3 +255,21 @@ def test_a_cached_schematic_is_drawn_in_the_requests_language():
     assert es["status"] == 0 and en["status"] == 0, (es["error"], en["error"])
     assert "Etapa" in es["page"]["schematic_svg"] and "Etapa" not in en["page"]["schematic_svg"]
     assert "Stage" in en["page"]["schematic_svg"]
+
+
+def test_a_section_plants_worst_case_on_the_page_spreads_the_opamps_gbw_as_the_command_line_does(tmp_path):
+    """Bug (issue 26): the page's worst case of a section plant refused --tol GBW=30% ("this design has no part
+    GBW") while design-plant --topology took it; one library call now (tolerance.mcspec.section_tolerance)."""
+    import subprocess
+
+    from helpers import script
+    fields = {"fc": 1000, "zeta": 0.3, "topology": "mfb-lowpass", "worst-case": True, "tol": ["GBW=30%"],
+              "no-sim": True}
+    out = jobs.run({"prog": "design-plant", "fields": fields, "want": "json"})
+    assert out["status"] == 0, out["error"]
+    cli = subprocess.run([script("design-plant"), "--topology", "mfb-lowpass", "--fc", "1000", "--zeta", "0.3", "--worst-case", "--tol", "GBW=30%",
+                          "--no-sim", "--json", "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert cli.returncode == 0, cli.stderr
+    assert out["json"]["worst_case"] == json.loads(cli.stdout)["worst_case"]
+    out = jobs.run({"prog": "design-plant", "fields": {**fields, "tol": ["SR=30%"]}, "want": "json"})
+    assert out["status"] == 2 and out["field"] == "tol", out
