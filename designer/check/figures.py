@@ -17,7 +17,6 @@ the deck's own ``.meas`` results, by name.
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import replace
 
 __all__ = ["ALIASES", "BAND", "PID", "PLANT", "SECTION_BAND", "band_of", "circuit_band_of", "corner_band",
@@ -272,10 +271,9 @@ def corner_band(topology, values: dict, tolerances: dict, opamp) -> dict:
     import numpy as np
 
     from ..plant import circuit
-    signs = np.array(list(itertools.product((-1.0, 1.0), repeat=len(tolerances))))
-    col = {r: k for k, r in enumerate(tolerances)}
-    corners = {r: values[r] * (1 + tolerances[r] * signs[:, col[r]]) if r in col else np.full(len(signs), values[r])
-               for r in topology.designators}
+    from ..plant.bench import tolerance_corners
+    every = tolerance_corners({r: values[r] for r in topology.designators}, tolerances)
+    corners = {r: np.array([v[r] for v in every], float) for r in topology.designators}
     figs = circuit.circuit_figures(topology, corners, opamp)
     out = {}
     for f in SECTION_BAND:
