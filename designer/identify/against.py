@@ -74,11 +74,18 @@ def overshoot_from_zeta(zeta: float) -> float:
     Returns
     -------
     float
-        Overshoot in percent of the final value; 0 for zeta >= 1 or not finite.
+        Overshoot in percent of the final value; 0 for zeta >= 1 or not finite; infinite for
+        zeta <= -1 (the formula's limit as zeta falls to -1: two real poles in the right half-plane,
+        a step that grows without bound; a tolerance corner of a plant with much gain can be there).
     """
     if not math.isfinite(zeta) or zeta >= 1:
         return 0.0
-    return 100.0 * math.exp(-math.pi * zeta / math.sqrt(1 - zeta * zeta))
+    if zeta <= -1:
+        return math.inf
+    try:
+        return 100.0 * math.exp(-math.pi * zeta / math.sqrt(1 - zeta * zeta))
+    except OverflowError:   # zeta just above -1: past a float, as the limit
+        return math.inf
 
 
 @dataclass(frozen=True)

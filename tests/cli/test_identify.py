@@ -223,6 +223,19 @@ def test_agreement_band_with_gain_is_the_closed_form_at_the_gain_extremes():
         assert band.gain[0] < gain < band.gain[1] and band.basis == "corners of the built parts"
 
 
+def test_a_band_whose_corners_run_away_has_an_unbounded_overshoot():
+    """Bug: a design whose gain puts its tolerance corners past zeta = -1 (two real right-half-plane poles)
+    raised a math domain error (a traceback from identify --against); the overshoot there is unbounded, the
+    formula's own limit as zeta falls to -1."""
+    import math
+
+    from designer.identify.against import agreement_band
+    assert overshoot_from_zeta(-1.0) == math.inf and overshoot_from_zeta(-1 + 1e-9) > 1e10
+    built = {"R1_ohm": 10e3, "R2_ohm": 10e3, "C1_f": 10e-9, "C2_f": 10e-9, "fn_hz": 1591.5, "zeta": 0.5}
+    band = agreement_band(built, 10.0)
+    assert band.zeta[1] < -1 and band.overshoot_pct == (math.inf, math.inf)
+
+
 def test_help_states_every_numeric_range():
     from designer.core.fileio import MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, size_text
     from designer.core.ranges import RANGES
