@@ -19,7 +19,8 @@ from ..core.exports import lazy_exports
 #: its module (designer.core.exports)
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "batch": ("CheckRun", "check_specs", "load_specs", "run_specs",),
-    "figures": ("ALIASES", "BAND", "PID", "PLANT", "SECTION_BAND", "band_of", "circuit_band_of", "plant_figures",),
+    "figures": ("ALIASES", "BAND", "PID", "PLANT", "SECTION_BAND", "band_of", "circuit_band_of", "corner_band",
+                "plant_figures",),
     "filter_kind": ("DELAY_FIGURES", "DELAY_KEYS", "FILTER_KEYS", "FilterCase", "MASK_FIGURES", "MASK_KEYS",
                     "SUB_FILTER", "corner_stages", "delay_limits", "filter_designs", "filter_figures", "mask_limits",
                     "model_grid", "run_filter", "spice_sweep",),

@@ -17,10 +17,10 @@ the deck's own ``.meas`` results, by name.
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import replace
 
-__all__ = ["ALIASES", "BAND", "PID", "PLANT", "SECTION_BAND", "band_of", "circuit_band_of", "plant_figures"]
+__all__ = ["ALIASES", "BAND", "PID", "PLANT", "SECTION_BAND", "band_of", "circuit_band_of", "corner_band",
+           "plant_figures"]
 
 STEP = ("overshoot_pct", "peak_time_s", "rise_time_s", "settling_time_s")
 
@@ -181,12 +181,14 @@ def pid_figures(res) -> dict:
 def band_of(res) -> dict:
     """figure -> (lo, hi) of a plant's tolerance band (:data:`BAND`).
 
-    The band is the worst case over the 16 corners of R1, R2, C1, C2 at +/-
-    their tolerance (:func:`~designer.plant.bench.tolerance_band`). ``fn_hz``
-    and ``zeta`` (and their aliases) follow the corner, as their figures do:
-    the dominant pair of the op-amp-aware model at each tolerance corner, with
-    the corner's op-amp, computed exactly rather than by scaling the passive
-    band (the op-amp's shift itself moves a little with the parts).
+    The band is the worst case over the 16 corners of the Sallen-Key section's
+    RC network at +/- its tolerance, the gain pair held
+    (:func:`~designer.plant.bench.tolerance_band`). ``fn_hz`` and ``zeta`` (and
+    their aliases) follow the corner, as their figures do: the dominant pair of
+    the op-amp-aware model at each tolerance corner, with the corner's op-amp,
+    computed exactly rather than by scaling the passive band (the op-amp's shift
+    itself moves a little with the parts): :func:`corner_band` on the section,
+    as a plant on any other section has it (:func:`circuit_band_of`).
     ``ideal_fn_hz`` and ``ideal_zeta`` are the passive band (ideal op-amp).
     The step figures' band is the ideal-op-amp model's, as the build sheet
     prints it.
@@ -203,10 +205,20 @@ def band_of(res) -> dict:
     """
     if hasattr(res, "section"):
         return circuit_band_of(res)
+    # imported here: loading a spec (which reads this module) needs no plant model
+    from ..filters.sallen_key_lowpass_parts import part_values, section_of
     t = res.tolerance
     out = {f: (getattr(t, f).lo, getattr(t, f).hi) for f in BAND if hasattr(t, f)}
     out["ideal_fn_hz"], out["ideal_zeta"] = out["fn_hz"], out["zeta"]
-    out["fn_hz"], out["zeta"] = _opamp_band(res.built, res.opamp, t.r_tolerance_pct / 100, t.c_tolerance_pct / 100)
+    # the corners of the passive band: the RC network at the series' tolerances, the gain pair held
+    section = section_of(res.built)
+    tol = {p.ref: (t.r_tolerance_pct if p.kind == "R" else t.c_tolerance_pct) / 100 for p in section.parts
+           if p.ref not in section.choice_parts}
+    # the plant's corner figures take its op-amp model even for the ideal op-amp (its finite A0 and GBW:
+    # PlantResult.analytic_opamp), where circuit_figures takes the ideal one's pair: its band does the same
+    amp = replace(res.opamp, ideal=False)
+    corners = corner_band(section, part_values(res.built), tol, amp)
+    out["fn_hz"], out["zeta"] = corners["fn_hz"], corners["zeta"]
     out.update({alias: out[name] for alias, name in ALIASES.items()})
     return out
 
@@ -229,32 +241,43 @@ def circuit_band_of(res) -> dict:
     dict
         figure -> (lo, hi); (None, None) where no corner has the figure (a first-order section's zeta).
     """
+    from ..tolerance.parts import resolve
+    s = res.sourcing
+    return corner_band(res.section, res.values, resolve((), res.values, {"R": s.r_series, "C": s.c_series}).of,
+                       res.opamp)
+
+
+def corner_band(topology, values: dict, tolerances: dict, opamp) -> dict:
+    """figure -> (lo, hi) of :data:`SECTION_BAND` over the 2^n corners of the n parts of ``tolerances``
+    at +/- their tolerance, the other parts held: ``fn_hz``, ``zeta`` the op-amp-aware model's dominant
+    pair, ``ideal_*`` the parts alone (:func:`designer.plant.circuit.circuit_figures`, every corner at once).
+
+    Parameters
+    ----------
+    topology : designer.filters.topology.Topology
+        The section.
+    values : dict
+        Designator -> nominal value, every declared part.
+    tolerances : dict
+        Designator -> tolerance (a fraction) of each part that varies.
+    opamp : designer.core.opamps.OpAmp
+        The corner's op-amp (the ideal one: the parts' own pair).
+
+    Returns
+    -------
+    dict
+        figure -> (lo, hi); (None, None) where no corner has the figure (a first-order section's zeta).
+    """
     import numpy as np
 
     from ..plant import circuit
-    from ..tolerance.parts import resolve
-    s = res.sourcing
-    tol = resolve((), res.values, {"R": s.r_series, "C": s.c_series}).of
-    signs = np.array(list(itertools.product((-1.0, 1.0), repeat=len(tol))))
-    values = {r: res.values[r] * (1 + tol[r] * signs[:, k]) for k, r in enumerate(tol)}
-    figs = circuit.circuit_figures(res.section, values, res.opamp)
+    from ..plant.bench import tolerance_corners
+    every = tolerance_corners({r: values[r] for r in topology.designators}, tolerances)
+    corners = {r: np.array([v[r] for v in every], float) for r in topology.designators}
+    figs = circuit.circuit_figures(topology, corners, opamp)
     out = {}
     for f in SECTION_BAND:
         v = np.asarray(figs[ALIASES.get(f, f)], float)
         v = v[np.isfinite(v)]
         out[f] = (float(v.min()), float(v.max())) if v.size else (None, None)
     return out
-
-
-def _opamp_band(parts, opamp, r_tol: float, c_tol: float) -> tuple:
-    """((lo, hi) of fn, (lo, hi) of zeta) with ``opamp`` over the tolerance corners of ``parts``."""
-    # imported here: loading a spec (which reads this module) needs no plant model
-    from ..plant.model import opamp_pair
-    fns, zetas = [], []
-    for s in itertools.product((-1, 1), repeat=4):   # the same 16 corners as the passive band
-        p = replace(parts, r1=parts.r1 * (1 + s[0] * r_tol), r2=parts.r2 * (1 + s[1] * r_tol),
-                    c1=parts.c1 * (1 + s[2] * c_tol), c2=parts.c2 * (1 + s[3] * c_tol))
-        fn, z = opamp_pair(p, opamp)
-        fns.append(float(fn))
-        zetas.append(float(z))
-    return (min(fns), max(fns)), (min(zetas), max(zetas))

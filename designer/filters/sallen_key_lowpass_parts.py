@@ -18,16 +18,19 @@ from __future__ import annotations
 import numpy as np
 
 from .registry import get
-from .sallen_key_lowpass_synthesis import SallenKeyParts
+from .sallen_key_lowpass_synthesis import JSON_KEYS, SallenKeyParts
 from .topology import Topology
 
-__all__ = ["FIELD_OF", "REF_OF", "section_of", "part_values", "refs", "gain_refs",
-           "parts_of", "gain_of", "network", "record_of"]
+__all__ = ["FIELD_OF", "KEY_OF", "REF_OF", "section_of", "part_values", "refs", "gain_refs",
+           "parts_of", "gain_of", "network", "record_of", "json_values", "ratio_pair"]
 
 #: the plant record's field of each designator of the section (with gain)
 FIELD_OF = {"R1": "r1", "R2": "r2", "C1": "c1", "C2": "c2", "R3": "r3", "R4": "r4"}
 #: the designator of each field
 REF_OF = {f: r for r, f in FIELD_OF.items()}
+#: the result.json key of each designator (:data:`~designer.filters.sallen_key_lowpass_synthesis.JSON_KEYS`
+#: by field: design-plant's ``built`` record)
+KEY_OF = {r: JSON_KEYS[f] for r, f in FIELD_OF.items()}
 #: the registry names of the follower and of the section with gain
 _NAMES = ("sallen-key-lowpass", "sallen-key-lowpass-gain")
 
@@ -181,3 +184,44 @@ def record_of(topology, values: dict):
     with_gain = "R3" in topology.designators
     gain = 1.0 + values["R4"] / values["R3"] if with_gain else 1.0
     return parts_of(values, gain=gain)
+
+
+def json_values(record: dict, with_gain: bool = False) -> dict | None:
+    """The values by designator of a result.json's parts record (design-plant's ``built``,
+    its keys :data:`KEY_OF`), or None when one of them is missing or not a number.
+
+    Parameters
+    ----------
+    record : dict
+        The parsed record.
+    with_gain : bool
+        Read the gain pair too (else the RC network only).
+
+    Returns
+    -------
+    dict or None
+        Designator -> value (float), the section's declared order.
+    """
+    keys = [KEY_OF[r] for r in refs(with_gain)]
+    if not all(isinstance(record.get(k), (int, float)) for k in keys):
+        return None
+    return {r: float(record[k]) for r, k in zip(refs(with_gain), keys)}
+
+
+def ratio_pair(gain: float) -> dict:
+    """A gain pair that gives K = ``gain`` by its ratio alone: to ground 1, feedback K - 1
+    (K = 1 + R4/R3 only knows their ratio; a band over its tolerance corners, R4 (1 +- t) /
+    (R3 (1 -+ t)), is then the closed form's 1 + (K - 1)(1 +- t)/(1 -+ t), to the bit).
+
+    Parameters
+    ----------
+    gain : float
+        K > 1.
+
+    Returns
+    -------
+    dict
+        The gain pair's designators -> values.
+    """
+    to_ground, feedback = gain_refs()
+    return {to_ground: 1.0, feedback: gain - 1.0}

@@ -7,21 +7,25 @@ judged against its :class:`AgreementBand`, the range the design allows over
 its part tolerances (the result's own ``built.tolerance_band``, the scope
 readings design-plant computed from the parts, where it has one; the corners
 of the parts here otherwise), widened for the gain by the measurement's own
-error. The Sallen-Key relations are the plant's own
-(:func:`designer.plant.sallenkey.fn_zeta`, seed 001 fig. 43-45): this module
-is identification's one use of the plant wing.
+error. The Sallen-Key relations are the plant's own: the built record read
+into the Sallen-Key low-pass section's values by designator
+(:func:`designer.plant.sallenkey.json_values`), each corner's fn and zeta its
+ideal pair (:meth:`~designer.filters.topology.Topology.ideal_pair`, seed 001
+fig. 43-45), the corners those of the plant's own band
+(:func:`designer.plant.bench.tolerance_corners`): this module is
+identification's one use of the plant wing.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass
 
 from ..core.errors import DesignError
 from ..core.fileio import shown
 from ..core.jsonio import json_safe, read_result
-from ..plant.sallenkey import NETWORK_KEYS, fn_zeta
+from ..plant.bench import tolerance_corners
+from ..plant.sallenkey import KEY_OF, json_values, ratio_pair, section_of
 
 __all__ = ["agreement_band", "compare_with_design", "load_design", "model_fn_zeta", "overshoot_from_zeta"]
 
@@ -32,7 +36,6 @@ DEFAULT_C_TOL = 0.10
 GAIN_MEASUREMENT_TOL = 0.02
 #: The identified models a design is compared with, best first.
 SECOND_ORDER = ("underdamped", "overdamped", "double-pole")
-PART_KEYS = NETWORK_KEYS
 
 
 def model_fn_zeta(m) -> tuple:
@@ -71,11 +74,18 @@ def overshoot_from_zeta(zeta: float) -> float:
     Returns
     -------
     float
-        Overshoot in percent of the final value; 0 for zeta >= 1 or not finite.
+        Overshoot in percent of the final value; 0 for zeta >= 1 or not finite; infinite for
+        zeta <= -1 (the formula's limit as zeta falls to -1: two real poles in the right half-plane,
+        a step that grows without bound; a tolerance corner of a plant with much gain can be there).
     """
     if not math.isfinite(zeta) or zeta >= 1:
         return 0.0
-    return 100.0 * math.exp(-math.pi * zeta / math.sqrt(1 - zeta * zeta))
+    if zeta <= -1:
+        return math.inf
+    try:
+        return 100.0 * math.exp(-math.pi * zeta / math.sqrt(1 - zeta * zeta))
+    except OverflowError:   # zeta just above -1: past a float, as the limit
+        return math.inf
 
 
 @dataclass(frozen=True)
@@ -100,9 +110,9 @@ def agreement_band(built: dict, gain: float = 1.0, r_tol: float = DEFAULT_R_TOL,
                    c_tol: float = DEFAULT_C_TOL) -> AgreementBand:
     """Worst-case band of fn, zeta, overshoot and gain over the part tolerances.
 
-    With the built part values (R1_ohm, R2_ohm, C1_f, C2_f) every corner of the
-    tolerance box is evaluated (2^4, or 2^5 with the gain resistors'
-    extremes); without them the nominal fn and zeta are scaled by the corner
+    With the built part values (the Sallen-Key network's, by designator) every
+    corner of the tolerance box is evaluated (2^4, or 2^6 with the gain pair's
+    corners: its extremes are K's); without them the nominal fn and zeta are scaled by the corner
     factors of fn ~ 1/sqrt(R1 R2 C1 C2) and zeta ~ sqrt(C1/C2) (unity gain).
     The gain, read as the ratio of two measured signals, gets the
     measurement's own error (:data:`GAIN_MEASUREMENT_TOL`) on top.
@@ -110,8 +120,8 @@ def agreement_band(built: dict, gain: float = 1.0, r_tol: float = DEFAULT_R_TOL,
     Parameters
     ----------
     built : dict
-        The design's ``built`` record: the part values ``R1_ohm``, ``R2_ohm``,
-        ``C1_f``, ``C2_f`` when known, else its ``fn_hz`` and ``zeta``.
+        The design's ``built`` record: the network's part values when known
+        (:func:`designer.plant.sallenkey.json_values`), else its ``fn_hz`` and ``zeta``.
     gain : float, optional
         The design's DC gain K (1: unity-gain follower).
     r_tol, c_tol : float, optional
@@ -129,15 +139,14 @@ def agreement_band(built: dict, gain: float = 1.0, r_tol: float = DEFAULT_R_TOL,
         ratio = gain - 1.0
         g_lo = 1 + ratio * (1 - r_tol) / (1 + r_tol)
         g_hi = 1 + ratio * (1 + r_tol) / (1 - r_tol)
-    if all(isinstance(built.get(k), (int, float)) for k in PART_KEYS):
-        r1, r2, c1, c2 = (float(built[k]) for k in PART_KEYS)   # the network in fn_zeta's order
-        fns, zetas = [], []
-        for s in itertools.product((-1, 1), repeat=4):
-            for k in ((g_lo, g_hi) if gain != 1.0 else (gain,)):
-                fn, z = fn_zeta(r1 * (1 + s[0] * r_tol), r2 * (1 + s[1] * r_tol),
-                                c1 * (1 + s[2] * c_tol), c2 * (1 + s[3] * c_tol), k)
-                fns.append(float(fn))
-                zetas.append(float(z))
+    values = json_values(built)
+    if values is not None:
+        # the follower, or with K the gain section whose pair gives K by its ratio (ratio_pair): its
+        # corners are the closed form's K extremes, 1 + (K - 1)(1 -+ t)/(1 +- t)
+        section = section_of(with_gain=gain != 1.0)
+        values = values | (ratio_pair(gain) if gain != 1.0 else {})
+        tol = {p.ref: r_tol if p.kind == "R" else c_tol for p in section.parts}
+        fns, zetas = zip(*(section.ideal_pair(v) for v in tolerance_corners(values, tol)))
         basis = "corners of the built parts"
     else:
         fn0, z0 = float(built.get("fn_hz", math.nan)), float(built.get("zeta", math.nan))
@@ -205,7 +214,7 @@ def _check_design(d: dict, name: str) -> None:
     for k in ("fn_hz", "zeta"):
         if not (_is_number(built[k]) and built[k] > 0):
             bad(f"built.{k}", "a positive number")
-    for k in PART_KEYS:
+    for k in (KEY_OF[r] for r in section_of(with_gain=False).designators):
         if k in built and built[k] is not None and not (_is_number(built[k]) and built[k] > 0):
             bad(f"built.{k}", "a positive number (or absent)")
     for key in ("spec", "spice"):

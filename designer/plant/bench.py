@@ -35,7 +35,7 @@ from ..core.opamps import OpAmp
 from ..spice.deck import SquareTest
 
 __all__ = ["PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",
-           "corner_tolerances", "tolerance_band"]
+           "corner_tolerances", "tolerance_band", "tolerance_corners"]
 
 
 def recommend_square_wave(settling_time_s: float, amplitude_v: float, frequency_hz=None,
@@ -167,6 +167,32 @@ def corner_tolerances(topology, tolerances: dict) -> dict:
             if (p.kind if by_kind else p.ref) in tolerances}
 
 
+def tolerance_corners(values: dict, tolerances: dict) -> list:
+    """The 2^n corners of the n parts of ``tolerances`` at -/+ their tolerance, the other parts of
+    ``values`` held: in ``tolerances``' order, its last part's sign the fastest (every band over a
+    section's corners takes them from here: :func:`tolerance_band`, check-design's, identify's).
+
+    Parameters
+    ----------
+    values : dict
+        Designator -> nominal value.
+    tolerances : dict
+        Designator -> tolerance (a fraction) of each part that varies.
+
+    Returns
+    -------
+    list of dict
+        Designator -> value, one per corner.
+    """
+    out = []
+    for signs in itertools.product((-1, 1), repeat=len(tolerances)):
+        v = dict(values)
+        for (ref, x), sign in zip(tolerances.items(), signs):
+            v[ref] = values[ref] * (1 + sign * x)
+        out.append(v)
+    return out
+
+
 def tolerance_band(topology, values: dict, tolerances: dict, t_end: float) -> ToleranceBand:
     """Min and max of fn, zeta and the step metrics over the tolerance corners of a section
     (every varying part at -/+ its tolerance: 2^n corners, the parts in the section's declared
@@ -197,10 +223,7 @@ def tolerance_band(topology, values: dict, tolerances: dict, t_end: float) -> To
     t = dense_time(t_end, 8001)
     rows = []
     lo = hi = None
-    for signs in itertools.product((-1, 1), repeat=len(tol)):
-        v = dict(values)
-        for (ref, x), sign in zip(tol.items(), signs):
-            v[ref] = values[ref] * (1 + sign * x)
+    for v in tolerance_corners(values, tol):
         num, den = (np.asarray(c, float) for c in topology.coefficients(v))
         num = np.trim_zeros(num, "f") if np.any(num) else num
         y = step_response(num, den, t)

@@ -8,12 +8,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
 
 from ..core.lti import dominant_pair
 from ..core.opamps import OpAmp
 from ..filters.sallen_key_lowpass_parts import part_values, section_of
-from ..filters.sallen_key_lowpass_synthesis import opamp_denominator
 from . import circuit
 from .sallenkey import SallenKeyParts
 
@@ -21,7 +19,8 @@ __all__ = ["plant_tf", "plant_tf_opamp", "plant_model", "opamp_pair", "sensitivi
 
 
 def plant_tf(parts: SallenKeyParts):
-    """Ideal op-amp: K / (a s^2 + b s + 1).
+    """Ideal op-amp: K / (a s^2 + b s + 1), the section's own coefficients
+    (:meth:`~designer.filters.topology.Topology.coefficients` of the Sallen-Key low-pass the parts realise).
 
     Parameters
     ----------
@@ -33,14 +32,17 @@ def plant_tf(parts: SallenKeyParts):
     tuple of numpy.ndarray
         (num, den), highest power first.
     """
-    return np.array([parts.gain]), np.array([parts.a, parts.b, 1.0])
+    num, den = section_of(parts).coefficients(part_values(parts))
+    return num[-1:], den   # a low-pass's numerator is its constant term K
 
 
 def plant_tf_opamp(parts: SallenKeyParts, opamp: OpAmp):
     """Sallen-Key low-pass with a single-pole op-amp (third order).
 
-    Vo/Vin = 1/D(s), D from the section's closed form
-    (:func:`designer.filters.sallen_key_lowpass_synthesis.opamp_denominator`), normalised to D(0) = 1.
+    Vo/Vin = 1/D(s), normalised to D(0) = 1: the generic op-amp-aware model
+    (:func:`designer.plant.circuit.opamp_tf`) of the Sallen-Key low-pass the parts realise, which is
+    the section's closed form (:func:`designer.filters.sallen_key_lowpass_synthesis.opamp_denominator`,
+    :meth:`~designer.filters.sallen_key_lowpass.SallenKeyLowPass.opamp_model`), K = 1 + R4/R3.
 
     Parameters
     ----------
@@ -54,8 +56,8 @@ def plant_tf_opamp(parts: SallenKeyParts, opamp: OpAmp):
     tuple of numpy.ndarray
         (num, den), highest power first.
     """
-    d = opamp_denominator(parts.r1, parts.r2, parts.c1, parts.c2, parts.gain, opamp.a0, opamp.gbw_hz)
-    return np.array([1.0 / d[-1]]), d / d[-1]
+    num, den = circuit.opamp_tf(section_of(parts), part_values(parts), opamp)
+    return num[-1:], den   # the numerator's constant term alone, as the model has always had it
 
 
 def plant_model(parts: SallenKeyParts, opamp: OpAmp):

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..core.errors import DesignError
 from ..core.figure_titles import figure_spread
-from ..filters.sallen_key_lowpass_parts import part_values, refs
+from ..filters.sallen_key_lowpass_parts import gain_of, part_values, section_of
 from ..plant.circuit import evaluate as section_evaluate
 from . import plant as engine
 from . import runner, sampling
@@ -198,8 +198,9 @@ def plant_parts(parts) -> dict:
         Designator -> nominal value.
     """
     nominal = part_values(parts)
-    if not (parts.r3 is not None and parts.r4 is not None and parts.gain > 1):
-        nominal = {r: v for r, v in nominal.items() if r in refs(with_gain=False)}
+    # the gain pair varies only where it sets a gain (K = 1 + R4/R3 above 1)
+    if not gain_of(nominal) > 1:
+        nominal = {r: v for r, v in nominal.items() if r not in section_of(parts).choice_parts}
     return nominal
 
 

@@ -89,3 +89,24 @@ def test_the_readme_example_checks_each_figure_once_per_corner():
     # no figure and its alias, nor a figure that is the same number in every corner
     named = [F.ALIASES.get(f, f) for f in figures]
     assert len(named) == len(set(named)) and not any(f.startswith("ideal_") for f in figures)
+
+
+def test_the_band_is_the_op_amp_model_s_pair_over_the_network_s_corners(corners):
+    """Brute force: the op-amp model's dominant pair (seed 001's D(s), core.lti.dominant_pair) at each of
+    the 16 corners of R1 R2 C1 C2, as band_of's generic corner_band on the section gives it, to the bit
+    (the ideal op-amp's too: the plant's own figures take its model with its finite A0 and GBW)."""
+    import itertools
+
+    from designer.core.lti import dominant_pair
+    from designer.filters.sallen_key_lowpass_synthesis import opamp_denominator
+    for amp, res in corners.items():
+        t, p, a = res.tolerance, res.built, res.opamp
+        rt, ct = t.r_tolerance_pct / 100, t.c_tolerance_pct / 100
+        pairs = []
+        for s in itertools.product((-1, 1), repeat=4):
+            d = opamp_denominator(p.r1 * (1 + s[0] * rt), p.r2 * (1 + s[1] * rt), p.c1 * (1 + s[2] * ct),
+                                  p.c2 * (1 + s[3] * ct), p.gain, a.a0, a.gbw_hz)
+            pairs.append(dominant_pair(d / d[-1]))
+        fns, zetas = zip(*pairs)
+        band = F.band_of(res)
+        assert band["fn_hz"] == (min(fns), max(fns)) and band["zeta"] == (min(zetas), max(zetas)), amp

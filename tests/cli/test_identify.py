@@ -201,6 +201,41 @@ def test_agreement_band_contains_every_part_combination():
     assert nominal.fn_hz == pytest.approx(band.fn_hz, rel=1e-12)
 
 
+def test_agreement_band_with_gain_is_the_closed_form_at_the_gain_extremes():
+    """Brute force: with gain K the band is the plant's fn and zeta (seed 001's closed forms) over the
+    network's 16 corners at K's two extremes, 1 + (K - 1)(1 -+ t)/(1 +- t), to the bit: the section's
+    corners (its gain pair's too) give nothing outside them."""
+    import itertools
+
+    from designer.identify.against import agreement_band
+    from designer.plant.design import choose_parts
+    from designer.plant.sallenkey import fn_zeta
+    from designer.plant.spec import PlantSpec
+    for gain, fc, zeta in ((2.5, 1e3, 0.5), (1.5, 3.5e3, 0.3)):
+        built = choose_parts(PlantSpec(fc_hz=fc, zeta=zeta, gain=gain)).built
+        rt, ct = 0.01, 0.05
+        ks = (1 + (gain - 1) * (1 - rt) / (1 + rt), 1 + (gain - 1) * (1 + rt) / (1 - rt))
+        got = [fn_zeta(built.r1 * (1 + a * rt), built.r2 * (1 + b * rt), built.c1 * (1 + c * ct),
+                       built.c2 * (1 + d * ct), k) for a, b, c, d in itertools.product((-1, 1), repeat=4) for k in ks]
+        band = agreement_band(built.as_dict(), gain, rt, ct)
+        assert band.fn_hz == (min(g[0] for g in got), max(g[0] for g in got))
+        assert band.zeta == (min(g[1] for g in got), max(g[1] for g in got))
+        assert band.gain[0] < gain < band.gain[1] and band.basis == "corners of the built parts"
+
+
+def test_a_band_whose_corners_run_away_has_an_unbounded_overshoot():
+    """Bug: a design whose gain puts its tolerance corners past zeta = -1 (two real right-half-plane poles)
+    raised a math domain error (a traceback from identify --against); the overshoot there is unbounded, the
+    formula's own limit as zeta falls to -1."""
+    import math
+
+    from designer.identify.against import agreement_band
+    assert overshoot_from_zeta(-1.0) == math.inf and overshoot_from_zeta(-1 + 1e-9) > 1e10
+    built = {"R1_ohm": 10e3, "R2_ohm": 10e3, "C1_f": 10e-9, "C2_f": 10e-9, "fn_hz": 1591.5, "zeta": 0.5}
+    band = agreement_band(built, 10.0)
+    assert band.zeta[1] < -1 and band.overshoot_pct == (math.inf, math.inf)
+
+
 def test_help_states_every_numeric_range():
     from designer.core.fileio import MAX_CAPTURE_BYTES, MAX_CAPTURE_ROWS, size_text
     from designer.core.ranges import RANGES

@@ -70,3 +70,19 @@ def test_the_sections_ideal_pair_is_its_parts_records_bit_for_bit(with_gain):
             assert record_of(section, values) == rec
             assert section.ideal_pair(values) == (rec.fn_hz, rec.zeta)
             assert type(section.ideal_pair(values)[0]) is float
+
+
+def test_a_result_json_record_reads_into_values_by_designator():
+    from designer.filters.sallen_key_lowpass_parts import KEY_OF, json_values, ratio_pair
+    record = GAIN2.as_dict()
+    assert {KEY_OF[r] for r in refs()} == {JSON_KEYS[FIELD_OF[r]] for r in refs()}
+    assert json_values(record) == {r: v for r, v in part_values(GAIN2).items() if r in refs(with_gain=False)}
+    assert json_values(record, with_gain=True) == part_values(GAIN2)
+    # a record without every network part, or with one that is no number, has no values
+    missing = dict(record)
+    del missing[KEY_OF[refs()[0]]]
+    assert json_values(missing) is None
+    assert json_values({**record, KEY_OF[refs()[1]]: "1k"}) is None
+    # the ratio pair gives the gain it is asked for, by its ratio
+    pair = ratio_pair(2.5)
+    assert set(pair) == set(gain_refs()) and float(gain_of(pair | part_values(UNITY))) == 2.5

@@ -240,3 +240,14 @@ def test_the_section_sheet_shows_the_bench_in_english_and_spanish(name):
     english, _spanish = vocabulary()
     assert english_left(es) == [] and foreign(sheet_text_nodes(es), english) == []
     assert "Bench test" not in es and "banda (R 5 %, C 10 %)" in es
+
+
+def test_tolerance_corners_are_every_sign_combination_of_the_named_parts():
+    from designer.plant.bench import tolerance_corners
+    values = part_values(SallenKeyParts(10e3, 10e3, 10e-9, 10e-9, 2.0, 10e3, 10e3))
+    tol = {"R1": 0.05, "C2": 0.1}
+    corners = tolerance_corners(values, tol)
+    want = [{**values, "R1": values["R1"] * (1 + a * 0.05), "C2": values["C2"] * (1 + b * 0.1)}
+            for a, b in itertools.product((-1, 1), repeat=2)]
+    assert corners == want and len(corners) == 4
+    assert tolerance_corners(values, {}) == [values]
