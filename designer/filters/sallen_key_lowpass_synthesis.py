@@ -25,7 +25,7 @@ from ..core.errors import DesignError
 from ..core.ranges import RANGES, parse_in_range
 
 __all__ = ["DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts", "coefficients", "fn_zeta",
-           "opamp_denominator", "ratios_from_rc", "realizability_notes", "resistors_for_caps"]
+           "opamp_denominator", "ratios_from_rc", "realizability_notes", "resistors_for_caps", "wn_zeta"]
 
 #: the result.json key of each field of the record (:meth:`SallenKeyParts.as_dict`), the network first
 JSON_KEYS = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "r3": "R3_ohm", "r4": "R4_ohm"}
@@ -148,9 +148,33 @@ def opamp_denominator(r1, r2, c1, c2, gain, a0, gbw_hz):
     return np.stack(np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in d)), axis=-1)
 
 
+def wn_zeta(r1, r2, c1, c2, gain=1.0):
+    """Angular natural frequency (rad/s) and damping of the Sallen-Key low-pass, for
+    numbers or arrays of them: wn = 1/sqrt(a), zeta = b / (2 sqrt(a)) (the section's
+    :meth:`~designer.filters.topology.Topology.ideal_wn_zeta`, its parts record's and the
+    joint search's arithmetic).
+
+    Parameters
+    ----------
+    r1, r2, c1, c2 : float or array_like
+        The parts (Ohm, F).
+    gain : float or array_like
+        The gain K.
+
+    Returns
+    -------
+    tuple
+        (wn in rad/s, zeta).
+    """
+    a, b = coefficients(r1, r2, c1, c2, gain)
+    sa = np.sqrt(a)
+    return 1.0 / sa, b / (2 * sa)
+
+
 def fn_zeta(r1, r2, c1, c2, gain=1.0):
     """Natural frequency (Hz) and damping of the Sallen-Key low-pass, for numbers
-    or arrays of them (the joint search evaluates millions at once).
+    or arrays of them (the joint search evaluates millions at once): :func:`wn_zeta`'s
+    pair with fn = wn / (2 pi).
 
     Parameters
     ----------
@@ -164,10 +188,9 @@ def fn_zeta(r1, r2, c1, c2, gain=1.0):
     tuple
         (fn in Hz, zeta).
     """
-    a, b = coefficients(r1, r2, c1, c2, gain)
-    sa = np.sqrt(a)
+    wn, zeta = wn_zeta(r1, r2, c1, c2, gain)
     # wn = 1/sqrt(a) first, then fn: the rounding the designs' figures have always had
-    return (1.0 / sa) / (2 * np.pi), b / (2 * sa)
+    return wn / (2 * np.pi), zeta
 
 
 def unity_gain_c2_min(c1, zeta: float):
