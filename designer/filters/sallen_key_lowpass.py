@@ -119,9 +119,10 @@ class SallenKeyLowPass(SallenKeySection):
         num[..., -1:] = 1.0 / d0
         return num, d / d0
 
-    def ideal_wn_zeta(self, values: dict) -> tuple:
+    def ideal_wn_zeta(self, values: dict, den=None) -> tuple:
         # the parts record's arithmetic (wn_zeta: wn = 1/sqrt(a), zeta = b / (2 sqrt(a))), bit for bit, where the
         # default's sqrt(1/a) may differ in the last bit: the references' fn, zeta and sensitivities are this pair
+        # (from the parts, not den: a and b are the record's products, which den holds too)
         v = self.values_of(values)
         return wn_zeta(v["R1"], v["R2"], v["C1"], v["C2"], self.gain_of(v))
 

@@ -752,7 +752,7 @@ class Topology(ABC):
         return num / d0, den / d0
 
     # ---- the ideal pair (a hook, as opamp_model: the Sallen-Key low-pass overrides it) ------------
-    def ideal_wn_zeta(self, values: dict) -> tuple:
+    def ideal_wn_zeta(self, values: dict, den=None) -> tuple:
         """(wn in rad/s, zeta) of the section's ideal denominator, vectorised: the one hook
         every ideal pair is computed by (:meth:`ideal_pair`, :meth:`figures`,
         :func:`designer.plant.circuit.sensitivities`, :func:`designer.plant.circuit.circuit_figures`).
@@ -771,13 +771,18 @@ class Topology(ABC):
         ----------
         values : dict
             Designator -> value (ohm, farad), numbers or arrays (one batch shape).
+        den : ndarray, optional
+            The ideal denominator of ``values`` (:meth:`coefficients`' second), when the caller has
+            it already (:meth:`figures`): the default then does not compute it again; a section's own
+            arithmetic may ignore it.
 
         Returns
         -------
         tuple of ndarray
             (wn, zeta), each shaped as the batch (0-d for numbers).
         """
-        _, den = self.coefficients(values)
+        if den is None:
+            den = self.coefficients(values)[1]
         if self.order == 1:
             wn = den[-1] / den[0]
             return wn, np.ones_like(wn)
@@ -911,7 +916,7 @@ class Topology(ABC):
             Numbers for numbers, arrays for arrays.
         """
         num, den = self.coefficients(values)
-        wn, zeta = self.ideal_wn_zeta(values)
+        wn, zeta = self.ideal_wn_zeta(values, den)
         zeta, q = (zeta, 1 / (2 * zeta)) if self.order == 2 else (None, None)
         if self.kind == "lowpass":
             gain = num[-1] / den[-1]
