@@ -9,8 +9,9 @@ voltage follower.
     b = C1 (R1 + R2) + R1 C2 (1 - K)
     wn = 1/sqrt(a),  zeta = b / (2 sqrt(a)),  Q = 1 / (2 zeta)
 
-These formulas live in :func:`coefficients` and :func:`fn_zeta` only (the
-parts' properties and the vectorised search use them). At unity gain zeta can
+These formulas live in :func:`coefficients` and :func:`wn_zeta` only (the
+parts' properties, :func:`fn_zeta`, the section's ideal-pair hook and the
+vectorised search use them). At unity gain zeta can
 only be reached with C2/C1 >= 1/zeta^2 (:func:`unity_gain_c2_min`).
 """
 
@@ -67,7 +68,7 @@ class SallenKeyParts:
 
     @property
     def wn(self) -> float:
-        return 1.0 / math.sqrt(self.a)
+        return float(wn_zeta(self.r1, self.r2, self.c1, self.c2, self.gain)[0])
 
     @property
     def fn_hz(self) -> float:
