@@ -26,7 +26,7 @@ from ..core.errors import DesignError
 from ..core.ranges import RANGES, parse_in_range
 
 __all__ = ["DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts", "coefficients", "fn_zeta",
-           "opamp_denominator", "ratios_from_rc", "realizability_notes", "resistors_for_caps", "wn_zeta"]
+           "opamp_denominator", "ratios_from_rc", "realizability_notes", "pair_of", "resistors_for_caps", "wn_zeta"]
 
 #: the result.json key of each field of the record (:meth:`SallenKeyParts.as_dict`), the network first
 JSON_KEYS = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "r3": "R3_ohm", "r4": "R4_ohm"}
@@ -167,7 +167,23 @@ def wn_zeta(r1, r2, c1, c2, gain=1.0):
     tuple
         (wn in rad/s, zeta).
     """
-    a, b = coefficients(r1, r2, c1, c2, gain)
+    return pair_of(*coefficients(r1, r2, c1, c2, gain))
+
+
+def pair_of(a, b):
+    """(wn in rad/s, zeta) of K / (a s^2 + b s + 1): wn = 1/sqrt(a), zeta = b / (2 sqrt(a))
+    (numbers or arrays), the arithmetic of :func:`wn_zeta` on :func:`coefficients`' a and b.
+
+    Parameters
+    ----------
+    a, b : float or array_like
+        The coefficients of s^2 and s.
+
+    Returns
+    -------
+    tuple
+        (wn in rad/s, zeta).
+    """
     sa = np.sqrt(a)
     return 1.0 / sa, b / (2 * sa)
 
