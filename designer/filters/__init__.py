@@ -44,7 +44,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "sallen_key_lowpass_search": ("Candidate", "around", "scored"),
     "sallen_key_lowpass_synthesis": ("DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts",
                                      "coefficients", "fn_zeta", "opamp_denominator", "ratios_from_rc", "realizability_notes",
-                                     "resistors_for_caps",),
+                                     "pair_of", "resistors_for_caps", "wn_zeta",),
     "spec": ("FilterSpec", "TOPOLOGY_CHOICES",),
     "tables": ("TableRow", "coefficient_table", "section_3db_ratio", "table_corner",),
     "topology": ("DEFAULT_IMPEDANCE_OHM", "Figures", "KINDS", "PartSpec", "RC_MATCH", "SectionTarget", "Topology",

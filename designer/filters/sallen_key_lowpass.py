@@ -62,7 +62,7 @@ from ..spice.deck import GROUND, Netlist
 from .sallen_key import SallenKeySection
 from .sallen_key_lowpass_figures import sample_figures
 from .sallen_key_lowpass_search import around as near, joint_search
-from .sallen_key_lowpass_synthesis import coefficients, fn_zeta, opamp_denominator, ratios_from_rc
+from .sallen_key_lowpass_synthesis import coefficients, opamp_denominator, pair_of, ratios_from_rc, wn_zeta
 from .topology import PartSpec, SectionTarget, polynomial, quadratic_root
 
 __all__ = ["SallenKeyLowPass", "sallen_key_ratio_min"]
@@ -119,12 +119,14 @@ class SallenKeyLowPass(SallenKeySection):
         num[..., -1:] = 1.0 / d0
         return num, d / d0
 
-    def ideal_pair(self, values: dict) -> tuple:
-        # the parts record's arithmetic (fn_zeta: wn = 1/sqrt(a), then fn), bit for bit, where the default's
-        # sqrt(1/a) may differ in the last bit: the PID references are named and sized by this pair
+    def ideal_wn_zeta(self, values: dict, den=None) -> tuple:
+        # the parts record's arithmetic (wn_zeta: wn = 1/sqrt(a), zeta = b / (2 sqrt(a))), bit for bit, where the
+        # default's sqrt(1/a) may differ in the last bit: the references' fn, zeta and sensitivities are this pair
+        if den is not None:
+            # den = a s^2 + b s + 1 holds the record's products a and b themselves (coefficients above)
+            return pair_of(den[0], den[1])
         v = self.values_of(values)
-        fn, zeta = fn_zeta(v["R1"], v["R2"], v["C1"], v["C2"], self.gain_of(v))
-        return float(fn), float(zeta)
+        return wn_zeta(v["R1"], v["R2"], v["C1"], v["C2"], self.gain_of(v))
 
     def sample_figures(self, values: dict, opamp=None):
         # the plant's Monte Carlo engine: the third-order model's exact step (its module says how it differs)

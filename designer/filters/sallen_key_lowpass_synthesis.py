@@ -9,8 +9,9 @@ voltage follower.
     b = C1 (R1 + R2) + R1 C2 (1 - K)
     wn = 1/sqrt(a),  zeta = b / (2 sqrt(a)),  Q = 1 / (2 zeta)
 
-These formulas live in :func:`coefficients` and :func:`fn_zeta` only (the
-parts' properties and the vectorised search use them). At unity gain zeta can
+These formulas live in :func:`coefficients` and :func:`wn_zeta` only (the
+parts' properties, :func:`fn_zeta`, the section's ideal-pair hook and the
+vectorised search use them). At unity gain zeta can
 only be reached with C2/C1 >= 1/zeta^2 (:func:`unity_gain_c2_min`).
 """
 
@@ -25,7 +26,7 @@ from ..core.errors import DesignError
 from ..core.ranges import RANGES, parse_in_range
 
 __all__ = ["DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts", "coefficients", "fn_zeta",
-           "opamp_denominator", "ratios_from_rc", "realizability_notes", "resistors_for_caps"]
+           "opamp_denominator", "ratios_from_rc", "realizability_notes", "pair_of", "resistors_for_caps", "wn_zeta"]
 
 #: the result.json key of each field of the record (:meth:`SallenKeyParts.as_dict`), the network first
 JSON_KEYS = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "r3": "R3_ohm", "r4": "R4_ohm"}
@@ -67,7 +68,7 @@ class SallenKeyParts:
 
     @property
     def wn(self) -> float:
-        return 1.0 / math.sqrt(self.a)
+        return float(wn_zeta(self.r1, self.r2, self.c1, self.c2, self.gain)[0])
 
     @property
     def fn_hz(self) -> float:
@@ -148,9 +149,49 @@ def opamp_denominator(r1, r2, c1, c2, gain, a0, gbw_hz):
     return np.stack(np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in d)), axis=-1)
 
 
+def wn_zeta(r1, r2, c1, c2, gain=1.0):
+    """Angular natural frequency (rad/s) and damping of the Sallen-Key low-pass, for
+    numbers or arrays of them: wn = 1/sqrt(a), zeta = b / (2 sqrt(a)) (the section's
+    :meth:`~designer.filters.topology.Topology.ideal_wn_zeta`, its parts record's and the
+    joint search's arithmetic).
+
+    Parameters
+    ----------
+    r1, r2, c1, c2 : float or array_like
+        The parts (Ohm, F).
+    gain : float or array_like
+        The gain K.
+
+    Returns
+    -------
+    tuple
+        (wn in rad/s, zeta).
+    """
+    return pair_of(*coefficients(r1, r2, c1, c2, gain))
+
+
+def pair_of(a, b):
+    """(wn in rad/s, zeta) of K / (a s^2 + b s + 1): wn = 1/sqrt(a), zeta = b / (2 sqrt(a))
+    (numbers or arrays), the arithmetic of :func:`wn_zeta` on :func:`coefficients`' a and b.
+
+    Parameters
+    ----------
+    a, b : float or array_like
+        The coefficients of s^2 and s.
+
+    Returns
+    -------
+    tuple
+        (wn in rad/s, zeta).
+    """
+    sa = np.sqrt(a)
+    return 1.0 / sa, b / (2 * sa)
+
+
 def fn_zeta(r1, r2, c1, c2, gain=1.0):
     """Natural frequency (Hz) and damping of the Sallen-Key low-pass, for numbers
-    or arrays of them (the joint search evaluates millions at once).
+    or arrays of them (the joint search evaluates millions at once): :func:`wn_zeta`'s
+    pair with fn = wn / (2 pi).
 
     Parameters
     ----------
@@ -164,10 +205,9 @@ def fn_zeta(r1, r2, c1, c2, gain=1.0):
     tuple
         (fn in Hz, zeta).
     """
-    a, b = coefficients(r1, r2, c1, c2, gain)
-    sa = np.sqrt(a)
+    wn, zeta = wn_zeta(r1, r2, c1, c2, gain)
     # wn = 1/sqrt(a) first, then fn: the rounding the designs' figures have always had
-    return (1.0 / sa) / (2 * np.pi), b / (2 * sa)
+    return wn / (2 * np.pi), zeta
 
 
 def unity_gain_c2_min(c1, zeta: float):

@@ -37,8 +37,10 @@ The op-amp-aware model as polynomials, :meth:`Topology.opamp_model`, is a hook: 
 default :meth:`Topology.nodal_model` (Cramer's rule on those equations), overridden by a
 section with closed forms (the Sallen-Key low-pass: seed 001, IV.3-IV.9), which must
 equal the nodal solution to rounding (the conformance suite checks every section).
-So is the ideal (fn, zeta) a PID's plant is sized by, :meth:`Topology.ideal_pair` (by default
-from the coefficients; the Sallen-Key low-pass gives its parts record's exact arithmetic).
+So is the ideal pair (wn, zeta) of the denominator, :meth:`Topology.ideal_wn_zeta` (by default from
+the coefficients, wn = sqrt(d0/d2), zeta = d1 / (2 sqrt(d0 d2)); the Sallen-Key low-pass gives its parts
+record's exact arithmetic), vectorised: the figures' fn and Q, the (fn, zeta) a PID's plant is sized by
+(:meth:`Topology.ideal_pair`) and the plant's sensitivities are all this one pair.
 
 So is what a step settles to, :meth:`Topology.step_final` (amplitude x G(0) by nodal analysis at DC; the
 Sallen-Key low-pass gives its closed form K A0/(K + A0)), the levels of the SPICE step engine
@@ -141,11 +143,15 @@ class Figures:
         Quality factor; None for a first-order section.
     gain : float or ndarray
         Passband gain magnitude (V/V).
+    zeta : float or ndarray or None
+        Damping, 1/(2 Q) (the section's ideal pair, :meth:`Topology.ideal_wn_zeta`); None for a
+        first-order section.
     """
 
     fn_hz: object
     q: object
     gain: object
+    zeta: object = None
 
 
 def polynomial(*coeffs) -> np.ndarray:
@@ -207,6 +213,11 @@ def quadratic_root(a: float, b: float, c: float) -> float:
     if d < 0:
         d = 0.0 if d > -1e-9 * b * b else math.nan
     return 2 * c / (b + math.sqrt(d)) if c > 0 else (b + math.sqrt(d)) / (2 * a)
+
+
+def _plain(x):
+    """A 0-d result as a float (a number's figures are numbers); arrays and None as they are."""
+    return float(x) if x is not None and np.ndim(x) == 0 else x
 
 
 def open_loop_gain(opamp, s) -> np.ndarray:
@@ -741,31 +752,59 @@ class Topology(ABC):
         return num / d0, den / d0
 
     # ---- the ideal pair (a hook, as opamp_model: the Sallen-Key low-pass overrides it) ------------
-    def ideal_pair(self, values: dict) -> tuple:
-        """(fn in Hz, zeta) of the section's ideal denominator, the pair a PID's
-        plant is named and sized by (:attr:`designer.pid.plant.PlantCircuit.fn_hz`):
-        by default from :meth:`coefficients`, den = d2 s^2 + d1 s + d0, wn = sqrt(d0/d2),
+    def ideal_wn_zeta(self, values: dict, den=None) -> tuple:
+        """(wn in rad/s, zeta) of the section's ideal denominator, vectorised: the one hook
+        every ideal pair is computed by (:meth:`ideal_pair`, :meth:`figures`,
+        :func:`designer.plant.circuit.sensitivities`, :func:`designer.plant.circuit.circuit_figures`).
+        By default from :meth:`coefficients`, den = d2 s^2 + d1 s + d0: wn = sqrt(d0/d2),
         zeta = d1 / (2 sqrt(d0 d2)) (for real poles too: p1 p2 = d0/d2, p1 + p2 = d1/d2,
         :func:`designer.core.lti.dominant_pair`'s pair); a first-order section, den =
         d1 s + d0, has its pole wn = d0/d1 and zeta 1 (the critically damped pair at its
         pole, whose span covers its settling). A section with closed forms of its own
-        overrides this (they must equal these to rounding: the conformance suite checks).
+        overrides this (they must equal these to rounding: the conformance suite checks; the
+        Sallen-Key low-pass gives its parts record's arithmetic, which the reference outputs hold).
+
+        wn is returned in rad/s, undivided: a sensitivity is a ratio of two wn a relative 1e-6
+        apart, and fn = wn / (2 pi) rounds each of them once more.
 
         Parameters
         ----------
         values : dict
-            Designator -> value (ohm, farad), numbers.
+            Designator -> value (ohm, farad), numbers or arrays (one batch shape).
+        den : ndarray, optional
+            The ideal denominator of ``values`` (:meth:`coefficients`' second), when the caller has
+            it already (:meth:`figures`): the default then does not compute it again; a section's own
+            arithmetic may ignore it.
 
         Returns
         -------
-        tuple of float
-            (fn_hz, zeta).
+        tuple of ndarray
+            (wn, zeta), each shaped as the batch (0-d for numbers).
         """
-        _, den = self.coefficients(values)
-        d = [float(x) for x in den]
+        if den is None:
+            den = self.coefficients(values)[1]
         if self.order == 1:
-            return d[-1] / d[0] / (2 * math.pi), 1.0
-        return math.sqrt(d[-1] / d[0]) / (2 * math.pi), d[1] / (2 * math.sqrt(d[-1] * d[0]))
+            wn = den[-1] / den[0]
+            return wn, np.ones_like(wn)
+        return np.sqrt(den[-1] / den[0]), den[1] / (2 * np.sqrt(den[-1] * den[0]))
+
+    def ideal_pair(self, values: dict) -> tuple:
+        """(fn in Hz, zeta) of the section's ideal denominator, the pair a PID's plant is
+        named and sized by (:attr:`designer.pid.plant.PlantCircuit.fn_hz`): the hook
+        :meth:`ideal_wn_zeta`'s, fn = wn / (2 pi). Sections override the hook, not this.
+
+        Parameters
+        ----------
+        values : dict
+            Designator -> value (ohm, farad), numbers or arrays (one batch shape).
+
+        Returns
+        -------
+        tuple
+            (fn_hz, zeta): floats for numbers, arrays shaped as the batch for arrays.
+        """
+        wn, zeta = self.ideal_wn_zeta(values)
+        return _plain(wn / (2 * math.pi)), _plain(zeta)
 
     # ---- a section's own figures of sampled builds (the Monte Carlo's analytic engine) -----------------
     def sample_figures(self, values: dict, opamp=None):
@@ -859,11 +898,12 @@ class Topology(ABC):
                           f"{', '.join(self.sensitivity_parameters()) or 'none'}", param="parameter")
 
     def figures(self, values: dict) -> Figures:
-        """fn, Q and the passband gain magnitude from the ideal coefficients.
+        """fn, Q, zeta and the passband gain magnitude: fn, zeta and Q = 1/(2 zeta) from the ideal
+        pair (:meth:`ideal_wn_zeta`, the section's hook), the gain from the ideal coefficients.
 
-        Second order, den = d2 s^2 + d1 s + d0: wn = sqrt(d0/d2), Q = sqrt(d0 d2)/d1;
-        gain num/den at DC (low-pass), at infinity (high-pass), at wn (band-pass, n1/d1).
-        First order, den = d1 s + d0: wn = d0/d1.
+        Second order, den = d2 s^2 + d1 s + d0: wn = sqrt(d0/d2), zeta = d1 / (2 sqrt(d0 d2))
+        (by default); gain num/den at DC (low-pass), at infinity (high-pass), at wn
+        (band-pass, n1/d1). First order, den = d1 s + d0: wn = d0/d1, no Q.
 
         Parameters
         ----------
@@ -876,16 +916,15 @@ class Topology(ABC):
             Numbers for numbers, arrays for arrays.
         """
         num, den = self.coefficients(values)
-        wn = np.sqrt(den[-1] / den[0]) if self.order == 2 else den[-1] / den[0]
-        q = np.sqrt(den[-1] * den[0]) / den[1] if self.order == 2 else None
+        wn, zeta = self.ideal_wn_zeta(values, den)
+        zeta, q = (zeta, 1 / (2 * zeta)) if self.order == 2 else (None, None)
         if self.kind == "lowpass":
             gain = num[-1] / den[-1]
         elif self.kind == "highpass":
             gain = num[0] / den[0]
         else:
             gain = num[1] / den[1]
-        scalar = lambda x: float(x) if x is not None and np.ndim(x) == 0 else x  # noqa: E731
-        return Figures(scalar(wn / (2 * math.pi)), scalar(q), scalar(np.abs(gain)))
+        return Figures(_plain(wn / (2 * math.pi)), _plain(q), _plain(np.abs(gain)), _plain(zeta))
 
     def check_realisable(self, target: SectionTarget, **choices) -> None:
         """Refuse a target or choices the topology cannot realise, in one line that

@@ -610,7 +610,9 @@ def seed_loop_names(section) -> LoopNames:
 def pair_model(circuit: PlantCircuit, source: str = "Sallen-Key") -> ProcessModel:
     """A second-order low-pass plant's ideal model K/(a s^2 + b s + 1) (its
     coefficients, normalised to a constant term 1) as a :class:`ProcessModel`:
-    underdamped with fn = 1/(2 pi sqrt(a)) and zeta = b/(2 sqrt(a)), or for zeta >= 1
+    underdamped with the circuit's ideal pair (:meth:`PlantCircuit.ideal_pair`: a section's
+    hook, fn = 1/(2 pi sqrt(a)) and zeta = b/(2 sqrt(a)) in the Sallen-Key record's arithmetic,
+    so the model's fn and zeta are the plant's named ones to the bit), or for zeta >= 1
     the SOPDT whose (tau1 s + 1)(tau2 s + 1) = a s^2 + b s + 1.
 
     Parameters
@@ -629,9 +631,9 @@ def pair_model(circuit: PlantCircuit, source: str = "Sallen-Key") -> ProcessMode
     if len(den) != 3:
         raise DesignError(f"a pair model is of a second-order plant; this one has order {len(den) - 1}")
     k, a, b = float(num[-1] / den[-1]), float(den[0] / den[-1]), float(den[1] / den[-1])
-    zeta = b / (2.0 * math.sqrt(a))
+    fn, zeta = circuit.ideal_pair()
     if zeta < 1.0:
-        return underdamped(k, 1.0 / (2 * math.pi * math.sqrt(a)), zeta, source=source)
+        return underdamped(k, fn, zeta, source=source)
     tau1 = (b + math.sqrt(max(b * b - 4.0 * a, 0.0))) / 2.0
     return sopdt(k, tau1, a / tau1, source=source)   # tau1 tau2 = a, without the cancellation of b - r
 

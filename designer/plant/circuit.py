@@ -275,7 +275,7 @@ def _errors(topology: Topology, target: SectionTarget, values: dict) -> tuple:
     errs = [np.abs(np.asarray(f.fn_hz) / target.fn_hz - 1), np.abs(np.asarray(f.gain) / target.gain - 1)]
     zeta = None
     if f.q is not None:
-        zeta = 1.0 / (2.0 * np.asarray(f.q))
+        zeta = np.asarray(f.zeta)
         errs.append(np.abs(zeta * 2.0 * target.q - 1))
     worst = np.maximum.reduce(errs)
     return worst, sum(errs), f, zeta
@@ -697,7 +697,7 @@ def circuit_figures(topology: Topology, values: dict, opamp=None) -> dict:
     """
     f = topology.figures(values)
     fn_i = np.asarray(f.fn_hz, float)
-    z_i = np.full(fn_i.shape, np.nan) if f.q is None else 1.0 / (2.0 * np.asarray(f.q, float))
+    z_i = np.full(fn_i.shape, np.nan) if f.zeta is None else np.asarray(f.zeta, float)
     if opamp is None or opamp.ideal:
         fn, z = fn_i, z_i
     else:
@@ -762,15 +762,12 @@ OPAMP_PARAMETERS = {"GBW": "gbw_hz", "A0": "a0"}
 
 
 def _pair(topology: Topology, values: dict, opamp) -> tuple:
-    """wn (rad/s) and zeta of arrays of part values: the ideal coefficients' (den = d2 s^2 + d1 s + d0:
-    wn = sqrt(d0) / sqrt(d2), zeta = d1 / (2 sqrt(d0 d2)), which for the Sallen-Key plant's
-    den = a s^2 + b s + 1 is its record's 1/sqrt(a) and b / (2 sqrt(a)) to the bit), else the dominant pair
-    of the op-amp-aware model (:func:`circuit_figures`'s) with wn = 2 pi fn, as the plant's model has it."""
+    """wn (rad/s) and zeta of arrays of part values: the section's ideal pair (its hook,
+    :meth:`~designer.filters.topology.Topology.ideal_wn_zeta`: the Sallen-Key plant's record arithmetic), else
+    the dominant pair of the op-amp-aware model (:func:`circuit_figures`'s) with wn = 2 pi fn, as the plant's
+    model has it."""
     if opamp is None or opamp.ideal:
-        den = topology.coefficients(values)[1]
-        if topology.order == 1:
-            return den[-1] / den[0], np.full(np.shape(den[0]), np.nan)
-        return np.sqrt(den[-1]) / np.sqrt(den[0]), den[1] / (2 * np.sqrt(den[-1] * den[0]))
+        return topology.ideal_wn_zeta(values)
     fn, z = dominant_pairs(opamp_tf(topology, values, opamp)[1], topology.order == 1)
     return 2 * math.pi * fn, z
 

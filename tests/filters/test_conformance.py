@@ -193,6 +193,43 @@ def test_step_final_is_the_opamp_models_dc_gain(topology):
         assert float(one) == batch[i]
 
 
+def _moved_batch(topology, n: int = 64, seed: int = 26) -> dict:
+    """Part sets around each target's synthesis (every part moved by up to 5 %, as E-series rounding
+    and tolerances move them), as arrays: designator -> shape (n * len(targets),)."""
+    rng = np.random.default_rng(seed)
+    sets = [topology.synthesize(t) for t in targets(topology)]
+    return {r: np.concatenate([s[r] * rng.uniform(0.95, 1.05, n) for s in sets]) for r in topology.designators}
+
+
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_one_ideal_pair_hook_behind_the_figures_and_the_scalar_pair(topology):
+    """Every ideal pair is the hook's (:meth:`Topology.ideal_wn_zeta`, issue 26: written once): on a batch of
+    part sets the figures' fn and Q are its wn / (2 pi) and 1 / (2 zeta) and their zeta its zeta, to the bit;
+    :meth:`Topology.ideal_pair` is (wn / (2 pi), zeta), arrays for arrays and, for each element called alone,
+    floats equal to the batch's element to the bit (the vectorised hook gives a number's pair as a 0-d one)."""
+    batch = _moved_batch(topology)
+    n = len(next(iter(batch.values())))
+    wn, zeta = topology.ideal_wn_zeta(batch)
+    assert np.shape(wn) == np.shape(zeta) == (n,)
+    fig = topology.figures(batch)
+    assert np.array_equal(fig.fn_hz, wn / (2 * np.pi))
+    fn, z = topology.ideal_pair(batch)
+    assert np.array_equal(fn, fig.fn_hz) and np.array_equal(z, zeta)
+    if topology.order == 2:
+        assert np.array_equal(fig.zeta, zeta) and np.array_equal(fig.q, 1 / (2 * zeta))
+    else:
+        assert fig.q is None and fig.zeta is None and np.array_equal(zeta, np.ones(n))
+    for i in range(n):
+        one = {r: float(v[i]) for r, v in batch.items()}
+        pair = topology.ideal_pair(one)
+        assert all(type(x) is float for x in pair)
+        assert pair == (fn[i], z[i])
+        w1, z1 = topology.ideal_wn_zeta(one)
+        assert np.ndim(w1) == np.ndim(z1) == 0 and (float(w1), float(z1)) == (wn[i], zeta[i])
+        f1 = topology.figures(one)
+        assert f1.fn_hz == fn[i] and (f1.q is None or f1.q == fig.q[i])
+
+
 @pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
 def test_ideal_pair_is_the_coefficients_pair(topology):
     """The ideal (fn, zeta) a PID's plant is named and sized by (:meth:`Topology.ideal_pair`, a section's own

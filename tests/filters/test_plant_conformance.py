@@ -129,6 +129,25 @@ def test_op_amp_rows_are_finite_differences_of_the_sections_own_figures(topology
 
 
 @pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
+def test_the_ideal_rows_and_figures_are_the_sections_ideal_pair(topology):
+    """The ideal sensitivities and circuit_figures' ideal_* are the section's one ideal pair
+    (:meth:`~designer.filters.topology.Topology.ideal_wn_zeta`, issue 26): each row the log difference of the
+    hook's wn and zeta at the part moved by 1 +- 1e-6, to the bit; ideal_fn_hz and ideal_zeta its pair
+    (NaN zeta for a first-order section)."""
+    values = topology.synthesize(topology.example)
+    sens = circuit.sensitivities(topology, values)
+    h = 1e-6
+    for ref in topology.designators:
+        (w_up, z_up), (w_dn, z_dn) = (topology.ideal_wn_zeta({**values, ref: values[ref] * m}) for m in (1 + h, 1 - h))
+        assert sens[ref]["wn"] == _log_difference(float(w_up), float(w_dn), h)
+        assert sens[ref]["zeta"] == (None if topology.order == 1 else _log_difference(float(z_up), float(z_dn), h))
+    fig = circuit.circuit_figures(topology, values)
+    fn, zeta = topology.ideal_pair(values)
+    assert float(fig["ideal_fn_hz"]) == fn
+    assert math.isnan(fig["ideal_zeta"]) if topology.order == 1 else float(fig["ideal_zeta"]) == zeta
+
+
+@pytest.mark.parametrize("topology", TOPOLOGIES, ids=IDS)
 def test_without_a_real_op_amp_there_are_no_op_amp_rows(topology):
     values = topology.synthesize(topology.example)
     ideal = circuit.sensitivities(topology, values)

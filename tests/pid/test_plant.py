@@ -148,6 +148,35 @@ def test_the_sallen_key_closed_forms_equal_the_sections_nodal_model(kind):
     assert ideal_pair(circuit) == (rec.fn_hz, rec.zeta) == circuit.ideal_pair()
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_the_sallen_key_plants_model_is_named_by_its_ideal_pair_to_the_bit(seed):
+    """pair_model (the Sallen-Key plant's ProcessModel) takes the circuit's ideal pair, the section's one hook
+    (issue 26), not a copy of it (its 1/(2 pi sqrt(a)) differed from the record's (1/sqrt(a))/(2 pi) in the
+    last bit on a third of networks): the model's fn and zeta are the plant's named pair, bit for bit; an
+    overdamped plant's model is the SOPDT of the same denominator."""
+    from designer.pid.plant import pair_model, sallen_key_circuit
+    from designer.plant.sallenkey import SallenKeyParts, check_parts
+    rng = np.random.default_rng(seed)
+    for _ in range(40):
+        r1, r2 = 10 ** rng.uniform(3, 5, 2)
+        c1 = 10 ** rng.uniform(-9, -7)
+        c2 = c1 * 10 ** rng.uniform(-0.5, 2)
+        circuit = sallen_key_circuit(check_parts(SallenKeyParts(r1, r2, c1, c2)))
+        fn, zeta = circuit.ideal_pair()
+        model = pair_model(circuit)
+        if zeta < 1:
+            assert (model.kind, model.params["fn_hz"], model.params["zeta"]) == ("underdamped", fn, zeta)
+        else:
+            assert model.kind == "sopdt"
+            assert np.allclose(model.den, plant_model_den(circuit), rtol=1e-12)
+
+
+def plant_model_den(circuit):
+    """The circuit's ideal denominator, constant term 1."""
+    den = np.asarray(circuit.coefficients()[1], float)
+    return den / den[-1]
+
+
 def dominant(den):
     from designer.core.lti import dominant_pair
     return dominant_pair(den)
