@@ -68,6 +68,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.errors import DesignError
+from ..core.units import format_eng
 from ..filters import registry
 from ..filters.topology import SectionTarget, Topology
 
@@ -221,9 +222,10 @@ def capacitor_combinations(topology: Topology, target: SectionTarget, c_values) 
             columns[r] = base if r in topology.choice_parts else base / scale
     if not len(columns[topology.designators[0]]):
         why = f"its capacitor ratio must be at least {bound:.4g}" if bound else "no capacitor value fits"
-        raise DesignError(f"c_max: {topology.name} cannot realise fn {target.fn_hz:g} Hz"
+        raise DesignError(f"c_max: {topology.name} cannot realise fn {format_eng(target.fn_hz, 'Hz', 4)}"
                           + (f", Q {target.q:.4g}" if target.q else "")
-                          + f" with capacitors from {c_values[0]:g} to {c_values[-1]:g} F: {why}; widen the "
+                          + f" with capacitors from {format_eng(c_values[0], 'F')} to {format_eng(c_values[-1], 'F')}"
+                          f": {why}; widen the "
                           "capacitor bounds, lower Q, or use another topology", param="c_max")
     return columns
 

@@ -84,6 +84,8 @@ def test_unrealisable_in_the_capacitor_range_is_one_line_naming_the_limit():
         circuit.search(mfb, target, eseries.values("E24", 100, 1e6), eseries.values("E12", 1e-9, 10e-9))
     msg = str(exc.value)
     assert "\n" not in msg and "capacitor ratio must be at least 300" in msg and exc.value.param == "c_max"
+    # the numbers in engineering notation with their units (they were "1e-09 to 1e-08 F")
+    assert "fn 1 kHz" in msg and "capacitors from 1 nF to 10 nF" in msg, msg
 
 
 def test_a_damping_for_a_first_order_section_is_refused():
