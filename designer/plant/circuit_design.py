@@ -45,6 +45,7 @@ from ..core.units import format_eng
 from ..filters import registry
 from ..filters.deck import ac_deck, simulate_ac
 from ..filters.topology import SectionTarget
+from ..spice.deck import SINE_POINTS_PER_DECADE
 from ..spice.simulate import tool_info
 from . import circuit
 from .sourcing import MAX_ERROR, candidates, part_series
@@ -407,7 +408,7 @@ def _square(result, amplitude_v: float, square_hz, simulate: bool, simulator: st
 
 
 def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = False,
-               simulator: str = "ngspice-cli", hold=(), spice_ac=None) -> CircuitPlantResult:
+               simulator: str = "ngspice-cli", hold=(), refuse_unsimulable: bool = False) -> CircuitPlantResult:
     """``result`` with the Sallen-Key plant's bench (:mod:`designer.plant.bench`): the square wave (the
     square-wave test's, else :func:`~designer.plant.bench.recommend_square_wave` from the op-amp-aware
     model's 2 % settling time: a low-pass's step's, else its slowest pole's, :func:`default_square_hz`),
@@ -416,7 +417,8 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     square wave (CH2 from the op-amp-aware step's extremes: a high- or band-pass's output jumps with the
     edges and swings below 0 V on the falling one) and the sine check of the op-amp-aware model
     (:func:`~designer.plant.bench.sine_check`; a band-pass at its centre, a high-pass against its
-    high-frequency gain), with, when ``simulate``, ngspice's ``.ac`` of the section over fn/100 .. 100 fn;
+    high-frequency gain), with, when ``simulate``, ngspice's ``.ac`` of the section over fn/100 .. 100 fn at
+    :data:`~designer.spice.deck.SINE_POINTS_PER_DECADE` (the Sallen-Key plant's sine check, bit for bit);
     returned.
 
     Parameters
@@ -431,10 +433,9 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
         :func:`designer.spice.simulate.get_simulator`'s name.
     hold : sequence of str
         Designators the tolerance band holds at their values (the Sallen-Key plant's gain pair).
-    spice_ac : callable, optional
-        ``spice_ac(test)`` -> (frequencies, complex gain): the sine check's ``.ac``, run by the caller once the
-        square wave ``test`` is set (the Sallen-Key plant's: its own deck's, after refusing a square wave too
-        slow to simulate); None: ngspice's ``.ac`` of the section when ``simulate``.
+    refuse_unsimulable : bool
+        With ``simulate``, refuse a square wave too slow to simulate before any SPICE run (the Sallen-Key plant
+        simulates it: :meth:`designer.spice.deck.SquareTest.check_simulable`).
 
     Returns
     -------
@@ -480,18 +481,25 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     result.scope = scope_setup(window, a / 2, (channel("CH1", N_("generator (CH1)"), 0.0, a),
                                                channel("CH2", N_("U1 output"), a * lo, a * hi)))
     fn = fig_i["fn_hz"]
-    if spice_ac is not None:
-        spice = spice_ac(test)
-    else:
-        spice = ac(result.netlist, amp, fn / 100, fn * 100, simulator=simulator) if simulate else None
+    spice = None
+    if simulate:
+        if refuse_unsimulable:
+            test.check_simulable()
+        tick = time.perf_counter()
+        # at the sine check's density: its peak and -3 dB point are read off the sweep
+        spice = ac(result.netlist, amp, fn / 100, fn * 100, simulator=simulator,
+                   points_per_decade=SINE_POINTS_PER_DECADE)
+        result.timings["simulation_s"] = result.timings.get("simulation_s", 0.0) + time.perf_counter() - tick
     result.sine = sine_check(num_o, den_o, amp, a, fn, spice, kind=topo.kind, zeta=fig_o["zeta"] or 1.0)
     return result
 
 
 def section_analysis(topology, mode: str, target: Target, values: dict, sourcing: Sourcing, amp, amplitude_v: float,
-                     square_hz=None, package=None, hold=(), spice_ac=None) -> CircuitPlantResult:
-    """A build's analysis by the section pipeline without running ngspice: the figures, steps, sensitivities
-    and deck, and the bench (:func:`with_bench`); what the seed's Sallen-Key plant
+                     square_hz=None, package=None, hold=(), simulate: bool = False,
+                     simulator: str = "ngspice-cli") -> CircuitPlantResult:
+    """A build's analysis by the section pipeline: the figures, steps, sensitivities and deck, and the bench
+    (:func:`with_bench`, its sine check's ``.ac`` in ngspice when ``simulate``, a square wave too slow to
+    simulate refused first); what the seed's Sallen-Key plant
     (:func:`designer.plant.design.design_plant`, ``analyze_plant``) computes its result from.
 
     Parameters
@@ -516,17 +524,19 @@ def section_analysis(topology, mode: str, target: Target, values: dict, sourcing
         The op-amp package of the wiring.
     hold : sequence of str
         Designators the tolerance band holds (:func:`with_bench`).
-    spice_ac : callable, optional
-        The sine check's SPICE ``.ac`` of the square wave (:func:`with_bench`).
+    simulate : bool
+        Run the sine check's ``.ac`` in ngspice.
+    simulator : str
+        :func:`designer.spice.simulate.get_simulator`'s name.
 
     Returns
     -------
     CircuitPlantResult
-        The result, with no ``spice`` run.
+        The result (no ``spice`` agreement check: its caller simulates the build its own way).
     """
-    result = _analyse(topology, mode, target, values, None, [], sourcing, amp, [], package, False, "ngspice-cli")
+    result = _analyse(topology, mode, target, values, None, [], sourcing, amp, [], package, False, simulator)
     result.amplitude_v = amplitude_v
-    return with_bench(result, square_hz, hold=hold, spice_ac=spice_ac)
+    return with_bench(result, square_hz, simulate, simulator, hold=hold, refuse_unsimulable=True)
 
 
 def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", target_fc_hz=None, target_zeta=None,

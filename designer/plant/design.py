@@ -11,7 +11,7 @@ pipeline's on the Sallen-Key low-pass (:func:`designer.plant.circuit_design.sect
 figures, steps, sensitivities, square wave, tolerance band with the gain pair held, sine
 check); this module adds what only the seed's plant has: the models' responses over the
 bench's rising half period, the slew-rate and swing checks, the scope, and its own
-``.tran`` and ``.ac`` decks in SPICE (the ``netlists/`` reference, compared with both models).
+``.tran`` deck in SPICE (the ``netlists/`` reference, compared with both models).
 
 Which builds are listed: :func:`designer.plant.circuit.listed`, every section's rule (each
 response once, at the level whose resistors lie in 1 kOhm..100 kOhm, those within 0.5 % of the
@@ -43,7 +43,7 @@ from .bench import bench_period, period_check, plant_scope, signal_checks
 from .circuit_design import section_analysis, step_span
 from . import circuit
 from .model import Sensitivity
-from .netlist import plant_ac_deck, plant_deck
+from .netlist import plant_deck
 from .result import (
     Alternative,
     Comparison,
@@ -324,27 +324,14 @@ def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternati
     (:func:`designer.plant.circuit_design.section_analysis`: the figures, steps, sensitivities, the bench's
     square wave, tolerance band and sine check), seen as the seed's :class:`PlantResult`, with what only the
     seed's plant has: the models' responses over the bench's rising half period, the slew-rate and swing
-    checks, the scope, and its own ``.tran`` deck (the ``netlists/`` reference) and ``.ac`` in SPICE."""
+    checks, the scope, and its own ``.tran`` deck in SPICE (the ``netlists/`` reference) against both models."""
     tick = time.perf_counter()
     built = choice.built
     section, values = section_of(built), part_values(built)
-    simulated = [0.0]     # seconds in ngspice (the sine's .ac, then the .tran)
-
-    def spice_ac(test):
-        """The sine check measured in SPICE: an .ac sweep of the seed's own deck, fn/100 .. 100 fn (None
-        without ``simulate``), once a square wave too slow to simulate is refused."""
-        if not simulate:
-            return None
-        test.check_simulable()
-        tock = time.perf_counter()
-        fn = built.fn_hz
-        res = get_simulator(simulator).run(plant_ac_deck(built, amp, fn / 100, fn * 100, _title(built, amp)))
-        simulated[0] += time.perf_counter() - tock
-        return res["frequency"], res["v(out)"]
-
     # the gain pair held in the band, as the seed's band (the RC network's corners)
     sec = section_analysis(section, mode, target, values, sourcing, amp, amplitude_v, square_hz, package,
-                           hold=section.choice_parts, spice_ac=spice_ac)
+                           hold=section.choice_parts, simulate=simulate, simulator=simulator)
+    simulated = sec.timings.get("simulation_s", 0.0)   # the sine check's .ac
     test, m_i, m_o = sec.test, sec.step_metrics["ideal"], sec.step_metrics["opamp"]
     (num_i, den_i), (num_o, den_o) = sec.models["ideal"], sec.models["opamp"]
     # the comparisons and plots use the rising half period of the bench test (its start, if
@@ -364,7 +351,7 @@ def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternati
                      table, response * amplitude_v)
 
     analytic, analytic_opamp = model("ideal", num_i, den_i, m_i, y_iw), model("opamp", num_o, den_o, m_o, y_ow)
-    timings = {"analytic_s": time.perf_counter() - tick - simulated[0]}
+    timings = {"analytic_s": time.perf_counter() - tick - simulated}
     tick = time.perf_counter()
     deck = plant_deck(built, amp, test, _title(built, amp))
     timings["netlist_s"] = time.perf_counter() - tick
@@ -375,7 +362,7 @@ def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternati
         spice, period = run_spice(deck, test, tw, analytic, analytic_opamp, built.gain, simulator)
         if not spice.comparison.passed:
             notes.append("SPICE disagrees with the op-amp-aware model: " + "; ".join(spice.comparison.disagreements))
-        timings["simulation_s"] = simulated[0] + time.perf_counter() - tick
+        timings["simulation_s"] = simulated + time.perf_counter() - tick
     else:
         notes.append("SPICE simulation skipped (--no-sim): the figures are analytic only")
     tick = time.perf_counter()

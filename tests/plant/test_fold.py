@@ -84,3 +84,15 @@ def test_parts_as_built_agree_bit_for_bit():
                                     spec.target_fc_hz, spec.target_zeta, simulate=False)
     same_fields(seed, section)
     assert seed.analytic.step.to_dict() == {**seed.analytic.step.to_dict(), **section.steps["ideal"]}
+
+
+@pytest.mark.spice
+def test_the_sine_check_s_spice_ac_is_one_run():
+    """The seed's sine check measures the section's .ac (its netlist at the sine check's density); the
+    section pipeline's gives the same numbers, bit for bit."""
+    kw = dict(fc_hz=3500, zeta=0.2)
+    seed = design_plant(PlantSpec(**kw), simulator="ngspice-cli")
+    section = design_circuit_plant(PlantSpec(**kw, topology=section_name(1.0)), simulator="ngspice-cli")
+    for key in ("spice_f_peak_hz", "spice_peak_gain", "spice_f_3db_hz"):
+        assert getattr(seed.sine, key) == getattr(section.sine, key), key
+    assert (seed.sine.spice_f_hz == section.sine.spice_f_hz).all() and (seed.sine.h_spice == section.sine.h_spice).all()
