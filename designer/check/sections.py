@@ -492,7 +492,7 @@ def read_yield(doc, kind: str, checks):
     analysis = section_analysis(topo) if section else None
     use, skipped = yields.counted(table, checks, engine, analysis)
     if not use:
-        known = ", ".join(yields.table(table, engine, analysis))
+        known = ", ".join(yields.figure_table(table, engine, analysis))
         raise doc.error(("yield",), "yield counts the builds inside checks:, and none of them limits a figure the "
                         f"{engine} engine computes ({known})" + (f"; not: {', '.join(skipped)}" if skipped else ""))
     tolerances = _tolerances(doc, kind)

@@ -35,8 +35,8 @@ from ..core.units import format_eng
 from .loop import LIMITABLE, STANDS_IN
 from .stats import Limit
 
-__all__ = ["ENGINES", "FILTER", "LOOP", "PLANT", "SECTION", "SECTION_SPICE", "TABLES", "counted", "spec_yield",
-           "table"]
+__all__ = ["ENGINES", "FILTER", "LOOP", "PLANT", "SECTION", "SECTION_SPICE", "TABLES", "counted", "figure_table",
+           "spec_yield"]
 
 #: check-design's plant figure -> the analytic plant engine's (designer.tolerance.plant.FIGURES)
 PLANT = {**{f: f for f in ("fn_hz", "zeta", "q", "ideal_fn_hz", "ideal_zeta", "ideal_q", "gain", "overshoot_pct",
@@ -71,7 +71,7 @@ TABLES = {"analytic": {**BY_KIND, SECTION: PLANT},
 ENGINES = ("analytic", "spice")
 
 
-def table(kind: str, engine: str = "analytic", analysis: str | None = None) -> dict:
+def figure_table(kind: str, engine: str = "analytic", analysis: str | None = None) -> dict:
     """check-design's figure -> the engine's, of a spec's kind (:data:`TABLES`).
 
     Parameters
@@ -111,14 +111,14 @@ def counted(kind: str, checks, engine: str = "analytic", analysis: str | None = 
     engine : str
         The yield's engine.
     analysis : str, optional
-        A section's SPICE analysis (:func:`table`).
+        A section's SPICE analysis (:func:`figure_table`).
 
     Returns
     -------
     tuple
         (the checks counted, the names of the others).
     """
-    known = table(kind, engine, analysis)
+    known = figure_table(kind, engine, analysis)
     live = [c for c in checks if c.fail]
     return tuple(c for c in live if c.figure in known), tuple(c.figure for c in live if c.figure not in known)
 
@@ -231,7 +231,7 @@ def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int,
     key = SECTION if section else kind
     analysis = section_analysis(res.section) if section else None
     use, skipped = counted(key, checks, engine, analysis)
-    known = table(key, engine, analysis)
+    known = figure_table(key, engine, analysis)
     limits = tuple(Limit(known[c.figure], c.min, c.max) for c in use)
     names = {known[c.figure]: c.figure for c in use}
     if kind == "filter":   # a FilterRun of check-design: its design and the spec's mask
