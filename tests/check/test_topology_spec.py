@@ -274,6 +274,19 @@ def test_tolerance_on_a_section_passes_inside_and_fails_outside_its_limits(name,
         assert case["status"] == ("pass" if code == 0 else "fail")
 
 
+def _yield_run(tmp_path, text: str) -> tuple:
+    """check-design of the spec ``text`` in ngspice (it passes or fails, no error): (result.json's
+    monte_carlo, monte-carlo.csv's rows)."""
+    import csv
+    path = tmp_path / "spec.yaml"
+    path.write_text(text)
+    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
+    assert out.returncode in (0, 1), out.stdout + out.stderr
+    d = json.loads(next((tmp_path / "out").rglob("reports/*/result.json")).read_text())
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        return d["monte_carlo"], list(csv.DictReader(fh))
+
+
 @pytest.mark.spice
 @pytest.mark.parametrize("name", ["mfb-lowpass", "sallen-key-highpass"])
 def test_a_section_s_yield_with_the_spice_engine_and_the_op_amp_s_spread(name, tmp_path):
@@ -281,7 +294,6 @@ def test_a_section_s_yield_with_the_spice_engine_and_the_op_amp_s_spread(name, t
     fn next to the op-amp-aware model with that build's parts and GBW: within 1 %, the engine's tested bound),
     a low-pass's step (fn_hz then the model's, SPICE's step figures beside it); the yield the share of
     monte-carlo.csv's rows inside the check."""
-    import csv
     import dataclasses
 
     import numpy as np
@@ -290,17 +302,10 @@ def test_a_section_s_yield_with_the_spice_engine_and_the_op_amp_s_spread(name, t
     from designer.plant.circuit import circuit_figures
     topology = REGISTRY[name]
     ex = topology.example
-    path = tmp_path / "spec.yaml"
-    path.write_text(spec_text(topology).replace("opamp: TL072", "opamp: LM741").replace(
+    mc, rows = _yield_run(tmp_path, spec_text(topology).replace("opamp: TL072", "opamp: LM741").replace(
         "checks:\n", f"checks:\n  fn_hz: {{min: {0.98 * ex.fn_hz:g}, max: {1.02 * ex.fn_hz:g}}}\n")
         + "tolerances: {R: 1%, C: 2%, GBW: 30%}\nyield: {min: 10%, samples: 30, seed: 7, engine: spice}\n")
-    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
-    assert out.returncode in (0, 1), out.stdout + out.stderr
-    d = json.loads(next((tmp_path / "out").rglob("reports/*/result.json")).read_text())
-    mc = d["monte_carlo"]
     assert mc["settings"]["engine"] == "spice" and mc["settings"]["tolerances_pct"]["GBW"] == 30
-    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
-        rows = list(csv.DictReader(fh))
     assert len(rows) == 30
     amp = get_opamp("LM741")
     fn = np.array([float(r["fn_hz"]) for r in rows])
@@ -317,22 +322,14 @@ def test_a_low_pass_section_s_spice_yield_counts_spice_s_step_with_the_slew_spre
     """yield: {engine: spice} on a low-pass section runs its square-wave step in ngspice, as design-plant
     --topology --engine spice does: tolerances: {SR: ..} accepted (the step slews), rise_time_s and
     overshoot_pct counted from SPICE's step (monte-carlo.csv's spice_* columns), the yield their share."""
-    import csv
 
     import numpy as np
     topology = REGISTRY["mfb-lowpass"]
-    path = tmp_path / "spec.yaml"
-    path.write_text(spec_text(topology).replace("checks:\n", "checks:\n  overshoot_pct: {max: 4.5}\n"
-                                                "  rise_time_s: {max: 1m}\n")
-                    + "tolerances: {R: 2%, C: 5%, SR: 20%}\nyield: {min: 10%, samples: 12, seed: 5, engine: spice}\n")
-    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
-    assert out.returncode in (0, 1), out.stdout + out.stderr
-    d = json.loads(next((tmp_path / "out").rglob("reports/*/result.json")).read_text())
-    mc = d["monte_carlo"]
+    mc, rows = _yield_run(tmp_path, spec_text(topology).replace(
+        "checks:\n", "checks:\n  overshoot_pct: {max: 4.5}\n  rise_time_s: {max: 1m}\n")
+        + "tolerances: {R: 2%, C: 5%, SR: 20%}\nyield: {min: 10%, samples: 12, seed: 5, engine: spice}\n")
     assert mc["settings"]["engine"] == "spice" and mc["settings"]["tolerances_pct"]["SR"] == 20
     assert mc["spice"]["analysis"] == "step"
-    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
-        rows = list(csv.DictReader(fh))
     over = np.array([float(r["spice_overshoot_pct"]) for r in rows])
     rise = np.array([float(r["spice_rise_time_s"]) for r in rows])
     assert len(rows) == 12 and not np.allclose(over, [float(r["overshoot_pct"]) for r in rows], rtol=1e-9, atol=0)
