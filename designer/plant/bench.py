@@ -8,7 +8,9 @@ tolerance band takes a section, its values by designator and the tolerances per 
 or per part (its corners' fn and zeta the section's :meth:`~designer.filters.topology.Topology.ideal_pair`,
 their steps from its coefficients), so the Sallen-Key plant and a section plant
 (``design-plant --topology``) read the same band; the sine check takes any transfer function
-and the section's kind (a high-pass read as a low-pass in 1/f, a band-pass at its centre).
+and the section's kind (a high-pass read as a low-pass in 1/f, a band-pass at its centre); the slew and
+swing checks take any section's op-amp-aware step (:func:`signal_checks`: the extremes over the whole
+period by superposition of the two edges' steps, a high-pass's slope read after the jump at its edge).
 
 The sine check's resonance peak: a second-order low-pass peaks only for
 zeta < 1/sqrt(2) = 0.707, by Mr = 1 / (2 zeta sqrt(1 - zeta^2)) at
