@@ -8,7 +8,9 @@ tolerance band takes a section, its values by designator and the tolerances per 
 or per part (its corners' fn and zeta the section's :meth:`~designer.filters.topology.Topology.ideal_pair`,
 their steps from its coefficients), so the Sallen-Key plant and a section plant
 (``design-plant --topology``) read the same band; the sine check takes any transfer function
-and the section's kind (a high-pass read as a low-pass in 1/f, a band-pass at its centre).
+and the section's kind (a high-pass read as a low-pass in 1/f, a band-pass at its centre); the slew and
+swing checks take any section's op-amp-aware step (:func:`signal_checks`: the extremes over the whole
+period by superposition of the two edges' steps, a high-pass's slope read after the jump at its edge).
 
 The sine check's resonance peak: a second-order low-pass peaks only for
 zeta < 1/sqrt(2) = 0.707, by Mr = 1 / (2 zeta sqrt(1 - zeta^2)) at
@@ -34,8 +36,9 @@ from ..core.metrics import step_metrics
 from ..core.opamps import OpAmp
 from ..spice.deck import SquareTest
 
-__all__ = ["PEAK_MIN_DB", "ScopeSetup", "channel", "no_peak_reason", "recommend_square_wave", "scope_setup",
-           "corner_tolerances", "tolerance_band", "tolerance_corners"]
+__all__ = ["PEAK_MIN_DB", "SIGNAL_CHECKS", "ScopeSetup", "channel", "no_peak_reason", "period_extremes",
+           "recommend_square_wave", "rising_step", "scope_setup", "signal_checks", "corner_tolerances",
+           "tolerance_band", "tolerance_corners"]
 
 
 def recommend_square_wave(settling_time_s: float, amplitude_v: float, frequency_hz=None,
@@ -72,28 +75,133 @@ def recommend_square_wave(settling_time_s: float, amplitude_v: float, frequency_
                       time_scale_s=time_scale_s)
 
 
-def signal_checks(t, y_unit, amplitude_v: float, opamp: OpAmp) -> list:
-    """Slew and swing checks (:class:`~designer.core.checks.Check`) of the op-amp
-    output for a 0 <-> amplitude square wave, given the unit step response
-    ``y_unit`` of the output."""
-    slope = float(np.max(np.abs(np.gradient(y_unit, t)))) * abs(amplitude_v)
-    peak = float(np.max(y_unit)) * amplitude_v
-    # the falling edge undershoots below 0 by as much as the rising edge overshoots
-    trough = -(float(np.max(y_unit)) - float(y_unit[-1])) * amplitude_v
+#: the ids of the op-amp's checks under the bench's square wave (:func:`signal_checks`)
+SIGNAL_CHECKS = ("slew_rate", "output_swing")
+
+
+def period_extremes(y_unit) -> tuple:
+    """The output's lowest and highest values over the square wave's period, per volt of its amplitude, from
+    the unit step response ``y_unit`` over the rising half period (from the rising edge to the falling one).
+
+    By superposition the output is s(t) after the rising edge and s(T/2) - s(t) after the falling one (the
+    level the rising edge reached, s(inf) once settled, less a step): a low-pass overshoots on the rising
+    edge and undershoots below 0 V as deep on the falling one, an inverting section swings to -gain, a
+    high-pass's output jumps by the amplitude at each edge, below 0 V on the falling one. 0 V (the output at
+    rest) is inside the range; a step's value within 1e-9 of its largest below 0 is the closed form's
+    rounding, not an undershoot.
+
+    Parameters
+    ----------
+    y_unit : array_like
+        The unit step response from the rising edge to the falling one (or until it has settled).
+
+    Returns
+    -------
+    tuple of float
+        (lo, hi), per volt.
+    """
+    y = np.asarray(y_unit, float)
+    y_max, y_end = float(np.max(y)), float(y[-1])
+    y_min = float(np.min(y))
+    y_min = y_min if y_min < -1e-9 * float(np.max(np.abs(y))) else 0.0
+    # the falling edge first: it is the low end of a low-pass's swing (its -0.0 kept for a step that never
+    # overshoots, the seed plant's sheet's "-0 V")
+    return min(-(y_max - y_end), y_min, 0.0), max(y_max, y_end - y_min, 0.0)
+
+
+def signal_checks(t, y_unit, amplitude_v: float, opamp: OpAmp, edge: bool = False) -> list:
+    """Slew and swing checks (:class:`~designer.core.checks.Check`, ids :data:`SIGNAL_CHECKS`) of the op-amp
+    output for a 0 <-> amplitude square wave, given the unit step response ``y_unit`` of the output over the
+    rising half period (any section: its extremes :func:`period_extremes`; its largest slope the rising
+    edge's, the falling edge's mirrored), against half the op-amp's slew rate and its output range on its
+    supplies.
+
+    A step that jumps with the edge (``edge``: a high-pass's) asks the op-amp to follow the generator's edge,
+    which every op-amp slews through (the jump takes jump / slew rate): its slope is read after the edge, from
+    the first turn of the output's magnitude on, the response's own (2 zeta wn x the jump for a second-order
+    high-pass). That slope under half the slew rate is a jump slewed in under about 1 / (4 zeta wn), a small
+    part of the response; the detail gives the jump's time.
+
+    Parameters
+    ----------
+    t : array_like
+        The times from the rising edge (s; a grid uniform or not, fine where the step is fast:
+        :func:`rising_step`).
+    y_unit : array_like
+        The op-amp-aware unit step response on ``t``.
+    amplitude_v : float
+        The square wave's high level (V; low 0 V).
+    opamp : designer.core.opamps.OpAmp
+        The op-amp (an ideal one passes both, saying what the output needs).
+    edge : bool
+        The step jumps with the edge.
+
+    Returns
+    -------
+    list of Check
+        ``slew_rate``, ``output_swing``.
+    """
+    y = np.asarray(y_unit, float)
+    turns = np.flatnonzero(np.diff(np.abs(y)) < 0) if edge else ()
+    start = int(turns[0]) if len(turns) else 0
+    slope = float(np.max(np.abs(np.gradient(y, t)[start:]))) * abs(amplitude_v)
+    jump = abs(float(y[start]) * amplitude_v)
+    lo, hi = period_extremes(y)
+    peak, trough = hi * amplitude_v, lo * amplitude_v
+    swing = dict(lo=f"{trough:.3g}", hi=f"{peak:.3g}")
+    need = f"{slope / 1e6:.3g}"
     if opamp.ideal:
-        return [Check.of("slew_rate", True, N_("ideal op-amp; output needs {need} V/us"), need=f"{slope / 1e6:.3g}"),
-                Check.of("output_swing", True, N_("ideal op-amp; output spans {lo} V to {hi} V"),
-                         lo=f"{trough:.3g}", hi=f"{peak:.3g}")]
+        slew = Check.of("slew_rate", True, N_("ideal op-amp; output jumps {jump} V at each edge, then needs {need} "
+                                              "V/us"), jump=f"{jump:.3g}", need=need) if start else \
+            Check.of("slew_rate", True, N_("ideal op-amp; output needs {need} V/us"), need=need)
+        return [slew, Check.of("output_swing", True, N_("ideal op-amp; output spans {lo} V to {hi} V"), **swing)]
     sr = opamp.slew_v_per_s
     slew_ok = slope <= 0.5 * sr
-    return [Check.of("slew_rate", slew_ok,
-                     N_("output needs {need} V/us, {opamp} gives {have} V/us") if slew_ok else
-                     N_("output needs {need} V/us, {opamp} gives {have} V/us (keep below half of it: lower the "
-                        "amplitude)"), need=f"{slope / 1e6:.3g}", opamp=opamp.name, have=f"{sr / 1e6:.3g}"),
-            Check.of("output_swing", peak <= opamp.vout_max and trough >= opamp.vout_min,
-                     N_("output spans {lo} V to {hi} V; {opamp} on {vcc}/{vee} V reaches {min} V to {max} V"),
-                     lo=f"{trough:.3g}", hi=f"{peak:.3g}", opamp=opamp.name, vcc=f"{opamp.vcc:g}",
-                     vee=f"{opamp.vee:g}", min=f"{opamp.vout_min:.3g}", max=f"{opamp.vout_max:.3g}")]
+    have = f"{sr / 1e6:.3g}"
+    if start:
+        slew = Check.of("slew_rate", slew_ok,
+                        N_("output jumps {jump} V at each edge (slewed in {time} us), then needs {need} V/us, "
+                           "{opamp} gives {have} V/us") if slew_ok else
+                        N_("output jumps {jump} V at each edge (slewed in {time} us), then needs {need} V/us, "
+                           "{opamp} gives {have} V/us (keep below half of it: lower the amplitude)"),
+                        jump=f"{jump:.3g}", time=f"{jump / sr * 1e6:.3g}", need=need, opamp=opamp.name, have=have)
+    else:
+        slew = Check.of("slew_rate", slew_ok,
+                        N_("output needs {need} V/us, {opamp} gives {have} V/us") if slew_ok else
+                        N_("output needs {need} V/us, {opamp} gives {have} V/us (keep below half of it: lower the "
+                           "amplitude)"), need=need, opamp=opamp.name, have=have)
+    return [slew, Check.of("output_swing", peak <= opamp.vout_max and trough >= opamp.vout_min,
+                           N_("output spans {lo} V to {hi} V; {opamp} on {vcc}/{vee} V reaches {min} V to {max} V"),
+                           **swing, opamp=opamp.name, vcc=f"{opamp.vcc:g}", vee=f"{opamp.vee:g}",
+                           min=f"{opamp.vout_min:.3g}", max=f"{opamp.vout_max:.3g}")]
+
+
+def rising_step(ideal: tuple, opamp: tuple, t_end: float) -> tuple:
+    """The op-amp-aware unit step over the rising half period, on the grid :func:`signal_checks` reads: uniform
+    (:func:`~designer.core.lti.dense_time`) up to ``t_end``; where the ideal step jumps (a high-pass's: its
+    numerator of the denominator's degree) refined over the op-amp-aware model's fastest time constant from the
+    edge, where the output slews (50 time constants at 1/80 of one: the uniform grid's step may be longer than
+    the whole edge).
+
+    Parameters
+    ----------
+    ideal, opamp : tuple
+        (num, den) of the ideal and op-amp-aware models (highest power first, num's leading zeros trimmed).
+    t_end : float
+        The grid's end (s): the half period, or the span over which the step settles.
+
+    Returns
+    -------
+    tuple
+        (t, y, edge): the grid, the step on it, whether it jumps (:func:`signal_checks`'s ``edge``).
+    """
+    (num_i, den_i), (num_o, den_o) = ideal, opamp
+    t = dense_time(t_end)
+    edge = len(num_i) == len(den_i)
+    if edge:
+        fastest = 1.0 / float(np.max(np.abs(np.roots(den_o))))
+        t = np.union1d(t, np.linspace(0.0, min(t_end, 50 * fastest), 4001))
+    return t, step_response(num_o, den_o, t), edge
 
 
 def period_check(test: SquareTest, settling_time_s: float) -> Check | None:

@@ -415,7 +415,10 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     the tolerance band over every declared part at +/- its series' tolerance (the readings' span: the
     rising half period, at most 4 response spans, as the Sallen-Key plant's), the scope as set for that
     square wave (CH2 from the op-amp-aware step's extremes: a high- or band-pass's output jumps with the
-    edges and swings below 0 V on the falling one) and the sine check of the op-amp-aware model
+    edges and swings below 0 V on the falling one), the op-amp's ``slew_rate`` and ``output_swing`` checks under
+    it (:func:`~designer.plant.bench.signal_checks` of the op-amp-aware step over the rising half period, at most
+    4 response spans: the Sallen-Key plant's, bit for bit; first in ``checks``, replaced when the bench is set
+    again) and the sine check of the op-amp-aware model
     (:func:`~designer.plant.bench.sine_check`; a band-pass at its centre, a high-pass against its
     high-frequency gain), with, when ``simulate``, ngspice's ``.ac`` of the section over fn/100 .. 100 fn at
     :data:`~designer.spice.deck.SINE_POINTS_PER_DECADE` (the Sallen-Key plant's sine check, bit for bit);
@@ -444,7 +447,8 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     """
     from ..core.metrics import step_metrics as metrics
     from ..filters.deck import simulate_ac as ac
-    from .bench import channel, recommend_square_wave, scope_setup, sine_check, tolerance_band
+    from .bench import (SIGNAL_CHECKS, channel, recommend_square_wave, rising_step, scope_setup, signal_checks,
+                        sine_check, tolerance_band)
     from ..core.eseries import TOLERANCE
     topo, amp, a = result.section, result.opamp, result.amplitude_v
     models = result.models or _models(topo, result.values, amp)
@@ -475,6 +479,10 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     tolerances = {r: r_tol if r[0] == "R" else c_tol for r in topo.designators if r not in hold} if hold else \
         {"R": r_tol, "C": c_tol}
     result.tolerance = tolerance_band(topo, result.values, tolerances, min(test.half_period_s, 4 * span))
+    # the op-amp's slew and swing under the square wave, from the op-amp-aware step over the rising half period
+    # (at most 4 spans: settled), as the Sallen-Key plant's; replaced when the bench is set again
+    tw, yw, edge = rising_step(models["ideal"], models["opamp"], min(test.half_period_s, 4 * span))
+    result.checks = [*signal_checks(tw, yw, a, amp, edge), *(c for c in result.checks if c.id not in SIGNAL_CHECKS)]
     # the output over the period, per volt: the rising edge's step s(t), the falling edge's s(inf) - s(t)
     hi, lo = max(float(y.max()), final - float(y.min())), min(float(y.min()), final - float(y.max()), 0.0)
     window = min(1.2 * settling, test.half_period_s) if math.isfinite(settling) else test.half_period_s

@@ -39,7 +39,7 @@ from ..core.opamps import OpAmp
 from ..core.ranges import RANGES
 from ..core.units import format_eng, value_code
 from ..spice.simulate import get_simulator
-from .bench import bench_period, period_check, plant_scope, signal_checks
+from .bench import SIGNAL_CHECKS, bench_period, period_check, plant_scope
 from .circuit_design import section_analysis, step_span
 from . import circuit
 from .model import Sensitivity
@@ -338,7 +338,8 @@ def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternati
     # the square wave is much slower than the response: a dense grid where the metrics are taken)
     tw = dense_time(min(test.half_period_s, 4 * step_span(sec.figures)))
     y_iw, y_ow = step_response(num_i, den_i, tw), step_response(num_o, den_o, tw)
-    checks = signal_checks(tw, y_ow, amplitude_v, amp)
+    # the slew and swing checks the section pipeline's bench computed on this same grid (bench.signal_checks)
+    checks = [c for c in sec.checks if c.id in SIGNAL_CHECKS]
     late = period_check(test, m_o.settling_time_s)
     checks += [late] if late is not None else []
 

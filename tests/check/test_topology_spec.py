@@ -396,3 +396,22 @@ def test_a_section_s_bench_is_set_for_the_square_wave_test_it_ran(stimulus, tmp_
     with_bench(res)
     for key, part in (("scope", res.scope), ("tolerance_band", res.tolerance)):
         assert d[key] == json.loads(json.dumps(json_safe(part.to_dict()))), key
+
+
+@pytest.mark.spice
+def test_a_section_s_design_checks_take_the_op_amp_s_swing(tmp_path):
+    """design_checks: [slew_rate, output_swing] on a section (the seed plant's ids): an MFB low-pass with gain 10
+    under a 2 V square wave on an LM741 swings past -20 V, beyond its -14 V: output_swing fails (exit 1);
+    at 0.5 V both pass."""
+    text = ("name: clip\nkind: plant\ntopology: mfb-lowpass\ntarget: {fc: 1k, zeta: 0.5, gain: 10}\nopamp: LM741\n"
+            "design_checks: [slew_rate, output_swing]\n")
+    for amplitude, code in ((2, 1), (0.5, 0)):
+        path = tmp_path / f"spec{code}.yaml"
+        path.write_text(text + f"stimulus: {{amplitude: {amplitude}}}\n")
+        out_dir = tmp_path / f"out{code}"
+        out = check(path, "--simulator", "ngspice-cli", "--out", str(out_dir))
+        assert out.returncode == code, out.stdout + out.stderr
+        cases = _cases(out_dir)
+        assert cases["slew_rate"]["status"] == "pass"
+        assert cases["output_swing"]["status"] == ("fail" if code else "pass")
+        assert "LM741 on 15/-15 V reaches -14 V to 14 V" in cases["output_swing"]["message"]

@@ -185,7 +185,9 @@ def test_the_filter_and_circuit_plant_pages_speak_the_requests_language():
         assert trace["label"] == "chosen parts, LM741 model"
         assert trace["text"] == words.get("chosen parts, {name} model", "chosen parts, {name} model").format(name="LM741")
         shown = {ch["id"]: ch["title"] for ch in c["page"]["checks"]}
-        assert shown == {"spice_agreement": words.get("SPICE agreement", "SPICE agreement")}
+        # the op-amp's checks under the square wave (the seed plant's ids) and the SPICE agreement
+        assert shown == {i: words.get(t, t) for i, t in (("slew_rate", "slew rate"), ("output_swing", "output swing"),
+                                                          ("spice_agreement", "SPICE agreement"))}
         # the section's title and notes (its parts' roles) in the request's language, result.json's in English
         section = words.get("MFB low-pass (inverting)", "MFB low-pass (inverting)")
         assert section in c["page"]["title"] and c["page"]["notes"][0].startswith(section + ": ")

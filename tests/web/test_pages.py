@@ -1001,6 +1001,9 @@ def test_the_plant_pages_topology_menu_designs_an_mfb_lowpass(page, server):
     assert page.locator("#bode-gain canvas").count() == 1
     assert figure(page, "SPICE agrees with the model") == "yes" and page.locator("#topid").is_visible()
     assert not page.locator("#bom").is_disabled()
+    # the op-amp's checks under the square wave, as the seed plant's, in the checks table
+    checks = page.inner_text("#checks")
+    assert "slew rate" in checks and "output swing" in checks, checks
     # its step after the bench's rising edge (both models, the band) and the bench as its sheet sets it, the BOM
     assert page.locator("#step-section").is_visible() and page.locator("#step canvas").count() == 1
     bench = page.inner_text("#bench")
