@@ -69,8 +69,10 @@ topologies (--topology NAME):
                    help=f"DC gain K = 1 + R4/R3 (default 1: follower) {help_range('gain')}")
     t.add_argument("--topology", default=DEFAULT_TOPOLOGY, metavar="NAME",
                    help=f"the section that realises the plant (default {DEFAULT_TOPOLOGY}, the seed's; the "
-                        "registered ones are listed below); every one but the default is designed by the "
-                        "generic E-series search and checked by ngspice's .ac of its deck")
+                        "registered ones are listed below); each is designed by the joint E-series search over "
+                        "its declared parts (the default's exact whole-grid search its fast path) and checked in "
+                        "ngspice: the default by its bench's square wave, every other by its deck's .ac (and the "
+                        "square wave with --square-freq)")
     t.add_argument("--compensate-gbw", action="store_true",
                    help="pre-distort the targets so the circuit lands on them with the op-amp's finite GBW")
     sel = p.add_argument_group("parts")
