@@ -334,9 +334,13 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
     aim, ranked = circuit.compensate_gbw(topo, section, amp, rank) if spec.compensate_gbw else (section, rank(section))
     exact = None if spec.r is None else topo.synthesize_rc(aim, spec.r, spec.c)
     best = ranked[0]
-    if aim is section and best.worst > MAX_ERROR:
+    # against the aim, compensated or not, as the seed's plant checks its own (plant.design): a compensated
+    # aim's best parts were let through however far off (bug: fc 10 mHz, zeta 0.05, gain 100 on an LM741 with
+    # --compensate-gbw built zeta -0.33, an unstable plant 1000 % off, and the bench crashed on its NaN settling)
+    if best.worst > MAX_ERROR:
+        what = "the target" if aim is section else f"the compensated aim (fn {format_eng(aim.fn_hz, 'Hz')})"
         raise DesignError(f"fc_hz: the best {spec.r_series}/{spec.c_series} parts for {topo.name} land "
-                          f"{100 * best.worst:.3g} % off the target (more than {100 * MAX_ERROR:g} %); widen the "
+                          f"{100 * best.worst:.3g} % off {what} (more than {100 * MAX_ERROR:g} %); widen the "
                           "part bounds or use a finer series", param="fc_hz")
     t_search = time.perf_counter() - tick
     values = best.values
@@ -418,6 +422,10 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     final = float(num_o[-1] / den_o[-1])
     settling = (metrics(t, y, final=final).settling_time_s if topo.kind == "lowpass" else
                 slowest_settling_s(den_o))
+    if not math.isfinite(settling):
+        # a step that does not settle inside 4 spans (a lightly damped pair beside a slow op-amp pole): the
+        # slowest mode's envelope, which exists, rather than a NaN square wave (nice_frequency_below crashed)
+        settling = slowest_settling_s(den_o)
     if result.square is not None:
         test = result.square.test
     else:
@@ -484,12 +492,28 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
     amp.package(package)
     series = [None if s is None else series_name(s) for s in (r_series, c_series)]
     labels, r_s, c_s, why = part_series(parsed, *series)
+    _check_stable(topo, parsed, amp)
     gain = float(topo.figures(parsed).gain)
     fig = topo.figures(parsed)
     notes = [Message(N_("these parts give fn = {fn} Hz{q}, gain {gain}"), fn=f"{fig.fn_hz:.5g}",
                      q="" if fig.q is None else f", Q = {fig.q:.4g}", gain=f"{gain:.4g}"), *why]
     return _square(_analyse(topo, "analyze", Target(fc, zeta, gain), parsed, None, [], Sourcing(r_s, c_s, labels),
                             amp, notes, package, simulate, simulator), amplitude_v, square_hz, simulate, simulator)
+
+
+def _check_stable(topo, values: dict, amp) -> None:
+    """Refuse parts as built whose section is unstable, ideal or with ``amp`` (a pole with Re p >= 0: a gain
+    section's positive feedback past its edge, zeta <= 0), as the seed's plant refuses its own: such a build
+    oscillates and has no step, no settling and no bench (bug: the step's exp overflowed and the sheet filled
+    with NaN)."""
+    for who, (_, den) in (("", topo.coefficients(values)), (f" with the {amp.name}", circuit.opamp_tf(topo, values, amp))):
+        poles = np.roots(np.asarray(den, float))
+        if np.any(poles.real >= 0):
+            fn, zeta = topo.ideal_pair(values)
+            z = "" if zeta is None else f", zeta {float(zeta):.3g}"
+            raise DesignError(f"part: these parts make {topo.name} unstable{who} (fn {format_eng(float(fn), 'Hz')}{z}: "
+                              "a pole in the right half-plane, the build oscillates); change the parts",
+                              param="part")
 
 
 def _analysis_target(topo, target_fc_hz, target_zeta) -> tuple:

@@ -114,3 +114,50 @@ def test_a_first_order_section_past_its_op_amps_reach_has_a_finite_fn():
     assert np.all(poles.imag == 0)
     fn = float(circuit.circuit_figures(topo, values, amp)["fn_hz"])
     assert fn == pytest.approx(np.min(np.abs(poles)) / (2 * math.pi), rel=1e-9)
+
+
+def test_unstable_tolerance_corners_are_counted_not_stepped():
+    """Root cause (bug): a Sallen-Key gain-100 high-pass at zeta 0.01 (Q 50) on its 5 %/10 % corners: positive
+    feedback past its edge on many of them, whose step grows without bound (exp overflowed: a RuntimeWarning,
+    then NaN readings). Each such corner is left out of the step readings and the envelope and counted; the
+    count is the corners whose ideal pair has zeta <= 0 (a second-order section is unstable exactly there),
+    brute force over the corners."""
+    from designer.core.eseries import TOLERANCE
+    from designer.plant.bench import corner_tolerances, tolerance_corners
+    topo = REGISTRY["sallen-key-highpass-gain"]
+    r = design_circuit_plant(PlantSpec(fc_hz=1e3, zeta=0.01, gain=100.0, opamp="ideal", topology=topo.name),
+                             simulate=False)
+    tol = corner_tolerances(topo, {"R": TOLERANCE[r.sourcing.r_series], "C": TOLERANCE[r.sourcing.c_series]})
+    expected = sum(float(topo.ideal_pair(v)[1]) <= 0 for v in tolerance_corners(r.values, tol))
+    assert 0 < expected == r.tolerance.unstable_corners
+    assert r.tolerance.to_dict()["unstable_corners"] == expected
+    assert f"{expected} tolerance corners are unstable" in summary_text(r)
+    assert r.tolerance.zeta.lo < 0     # the corners' zeta, real numbers, stay in the band
+    # a stable band's JSON has no such key (every reference's as it was)
+    stable = design_circuit_plant(PlantSpec(fc_hz=1e3, zeta=0.5, gain=3.0, opamp="ideal", topology=topo.name),
+                                  simulate=False)
+    assert "unstable_corners" not in stable.tolerance.to_dict()
+
+
+def test_a_compensated_aim_far_off_is_refused():
+    """Root cause (bug): --compensate-gbw skipped the 5 % check: fc 10 mHz, zeta 0.05, gain 100 on an LM741
+    built zeta -0.33, an unstable plant 1000 % off, and the bench crashed on its NaN settling time. Now
+    refused as the uncompensated target is, naming the compensated aim."""
+    with pytest.raises(DesignError) as exc:
+        design_circuit_plant(PlantSpec(fc_hz=0.01, zeta=0.05, gain=100.0, opamp="LM741", compensate_gbw=True,
+                                       topology="sallen-key-lowpass-gain"), simulate=False)
+    msg = str(exc.value)
+    assert exc.value.param == "fc_hz" and "\n" not in msg and "off the compensated aim" in msg, msg
+
+
+def test_unstable_parts_as_built_are_refused():
+    """Root cause (bug): analyze-plant --topology on parts whose section is unstable (a Sallen-Key low-pass of
+    gain 11 on equal parts: zeta = (2 - 10) / 2 = -4, the closed form 3 - K over 2 at R1 = R2, C1 = C2)
+    overflowed in the step and filled the sheet with NaN. Refused in one line, as the seed's plant's are."""
+    values = {"R1": 10e3, "R2": 10e3, "C1": 10e-9, "C2": 10e-9, "R3": 1e3, "R4": 10e3}
+    with pytest.raises(DesignError) as exc:
+        analyze_circuit_plant("sallen-key-lowpass-gain", values, "LM741", simulate=False)
+    msg = str(exc.value)
+    gain = 1 + values["R4"] / values["R3"]
+    assert exc.value.param == "part" and "\n" not in msg and "unstable" in msg
+    assert f"zeta {(3 - gain) / 2:.3g}" in msg, msg
