@@ -135,13 +135,15 @@ class ToleranceBand:
     t_s: np.ndarray | None = field(default=None, repr=False, compare=False)    #: the envelope's grid
     lo: np.ndarray | None = field(default=None, repr=False, compare=False)     #: lowest unit step over the corners
     hi: np.ndarray | None = field(default=None, repr=False, compare=False)     #: highest
-    unstable_corners: int = 0    #: corners whose poles reach the right half-plane (no step readings there)
+    #: corners whose poles reach the right half-plane (no step readings there); the result's notes say it, the
+    #: band's JSON keeps its keys (identify --against reads every key as a {min, max} band)
+    unstable_corners: int = field(default=0, compare=False)
 
     def to_dict(self) -> dict:
         out = {}
         for f in fields(self):
-            if f.name in ("t_s", "lo", "hi") or (f.name == "unstable_corners" and not self.unstable_corners):
-                continue    # the count only when there is one: every stable band's JSON as it was
+            if f.name in ("t_s", "lo", "hi", "unstable_corners"):
+                continue
             value = getattr(self, f.name)
             out[f.name] = value.to_dict() if isinstance(value, Band) else value
         return out

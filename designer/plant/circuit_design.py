@@ -434,6 +434,10 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     result.test = test
     result.tolerance = tolerance_band(topo, result.values, {"R": r_tol, "C": c_tol},
                                       min(test.half_period_s, 4 * span))
+    if result.tolerance.unstable_corners:
+        result.notes.append(Message(N_("{n} tolerance corners are unstable (zeta <= 0: poles in the right "
+                                       "half-plane): a build there oscillates; their step readings are left out "
+                                       "of the band"), n=result.tolerance.unstable_corners))
     # the output over the period, per volt: the rising edge's step s(t), the falling edge's s(inf) - s(t)
     hi, lo = max(float(y.max()), final - float(y.min())), min(float(y.min()), final - float(y.max()), 0.0)
     window = min(1.2 * settling, test.half_period_s) if math.isfinite(settling) else test.half_period_s

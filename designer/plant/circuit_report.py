@@ -182,12 +182,9 @@ def bench_blocks(result, with_images: bool = False) -> list:
             readings.append([_(label), f(step.get(key)), f"{f(band.lo)} .. {f(band.hi)}"])
     head = _("band (R {r} %, C {c} %)").format(r=f"{tol.r_tolerance_pct:g}", c=f"{tol.c_tolerance_pct:g}")
     image = [R.image("band.png", head)] if with_images else []
-    unstable = [R.text(_("{n} tolerance corners are unstable (zeta <= 0: poles in the right half-plane): a build "
-                         "there oscillates; their step readings are left out of the band").format(
-        n=tol.unstable_corners))] if tol.unstable_corners else []
     return [R.subhead(_("Generator and scope")), R.table([_("set"), _("to")], rows, "compact"),
             R.table([_("reading (rising edge)"), _("expected ({opamp} model)").format(opamp=result.opamp.name), head],
-                    readings), *unstable, *image]
+                    readings), *image]
 
 
 def band_png(result) -> bytes:
