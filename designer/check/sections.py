@@ -464,6 +464,7 @@ def read_yield(doc, kind: str, checks):
     """``yield:`` with ``tolerances:`` (None without ``yield:``; ``tolerances:`` alone is refused)."""
     from ..tolerance import sampling, yields
     from ..tolerance.parts import DISTRIBUTIONS
+    from ..tolerance.spice_mc import section_analysis
     if doc.data.get("yield") is None:
         if doc.data.get("tolerances") is not None:
             raise doc.error(("tolerances",), "tolerances: set the parts' spread of a yield: give yield: {min: "
@@ -482,20 +483,25 @@ def read_yield(doc, kind: str, checks):
     from ..filters import registry
     from ..plant.circuit import DEFAULT_TOPOLOGY
     # the topology: read (and checked) with the designs, before the yield
-    topology = registry.get(doc.data["topology"]).name if kind == "plant" and "topology" in doc.data else None
+    topo = registry.get(doc.data["topology"]) if kind == "plant" and "topology" in doc.data else None
+    topology = None if topo is None else topo.name
     section = topology is not None and topology != DEFAULT_TOPOLOGY
-    table = yields.SECTION if section else kind    # a section's engines: its figures, SPICE's from its .ac
-    use, skipped = yields.counted(table, checks, engine)
+    # a section's engines: its analytic figures, or SPICE's of the analysis its engine runs (a low-pass's step,
+    # another section's .ac: the command line's rule, designer.tolerance.spice_mc.section_analysis)
+    table = yields.SECTION if section else kind
+    analysis = section_analysis(topo) if section else None
+    use, skipped = yields.counted(table, checks, engine, analysis)
     if not use:
-        known = ", ".join(yields.TABLES[engine][table])
+        known = ", ".join(yields.figure_table(table, engine, analysis))
         raise doc.error(("yield",), "yield counts the builds inside checks:, and none of them limits a figure the "
                         f"{engine} engine computes ({known})" + (f"; not: {', '.join(skipped)}" if skipped else ""))
     tolerances = _tolerances(doc, kind)
-    if section and any(t.startswith("SR=") for t in tolerances):
+    spreads_sr = any(t.startswith("SR=") for t in tolerances)
+    if section and spreads_sr and analysis != "step":
         raise doc.error(("tolerances", "SR"), f"tolerances.SR: topology {topology}'s yield engines are linear (its "
                         "analytic model, and ngspice's .ac sweep: small signal), no figure of them depends on the "
                         "slew rate; GBW: spreads the op-amp")
-    if kind == "plant" and engine == "analytic" and any(t.startswith("SR=") for t in tolerances):
+    if kind == "plant" and engine == "analytic" and spreads_sr:
         raise doc.error(("tolerances", "SR"), "tolerances.SR: the plant's analytic model is linear, no figure of it "
                         "depends on the slew rate; give yield.engine: spice (ngspice's op-amp slews)")
     lo, hi, default = YIELD_SAMPLES

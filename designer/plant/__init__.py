@@ -17,7 +17,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                        "analyze_circuit_plant", "analyze_circuit_spec", "built_name", "check_circuit_parts",
                        "check_opamp_reach",
                        "design_circuit_plant", "tolerance_nominal", "SQUARE_NRMS_PASS", "SquareRun", "square_deck",
-                       "with_square_test", "default_square_hz", "with_bench"),
+                       "with_square_test", "default_square_hz", "with_bench", "section_analysis", "step_span"),
     "circuit": ("BAND_ERROR", "BELOW_BOUND", "DEFAULT_TOPOLOGY", "FIGURES", "OPAMP_PARAMETERS", "R_BAND", "candidate_set",
                 "capacitor_combinations", "circuit_figures", "corner_frequencies", "dominant_pairs", "evaluate", "listed",
                 "opamp_tf", "GBW_ROUNDS", "gbw_shift", "compensate_gbw", "plant_target", "rounded", "search",
@@ -37,5 +37,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                   "resistors_for_caps", "section_of"),
     "schematic": ("draw_plant", "draw_supplies"),
     "selection": ("Candidate", "brute_force", "joint_search"),
+    "sourcing": ("DEFAULT_SERIES", "MAX_ERROR", "NOTE_ERROR", "candidates", "part_series"),
     "spec": ("AnalysisSpec", "PlantSpec"),
 })

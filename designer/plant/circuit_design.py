@@ -8,11 +8,13 @@ sensitivities over the declared parts, the deck, BOM and wiring from the topolog
 netlist (:func:`designer.spice.deck.board`), and the ngspice ``.ac`` of that deck
 against the op-amp-aware model (the conformance's rule: 0.05 dB and 0.5 degrees over
 fn / 30 .. 30 fn), and the Sallen-Key plant's bench (:func:`with_bench`: the tolerance band,
-the sine check, the scope settings, :mod:`designer.plant.bench`). The seed's Sallen-Key low-pass keeps its own pipeline
-(:mod:`designer.plant.design`), byte for byte, its parts chosen through the same search entry (the
-section's fast path, :meth:`~designer.filters.topology.Topology.fast_search`), listing
-(:func:`designer.plant.circuit.listed`) and ``--compensate-gbw`` (:func:`designer.plant.circuit.compensate_gbw`):
-``--topology sallen-key-lowpass`` builds the same parts.
+the sine check, the scope settings, :mod:`designer.plant.bench`). The seed's Sallen-Key low-pass
+(:mod:`designer.plant.design`) chooses its parts through the same search entry (the section's fast path,
+:meth:`~designer.filters.topology.Topology.fast_search`), listing (:func:`designer.plant.circuit.listed`) and
+``--compensate-gbw`` (:func:`designer.plant.circuit.compensate_gbw`): ``--topology sallen-key-lowpass`` builds
+the same parts; and computes its analysis here (:func:`section_analysis`: the figures, with the ideal pair
+by :meth:`~designer.filters.topology.Topology.ideal_pair`, the steps over :func:`step_span`, the
+sensitivities, the bench), its result byte for byte what it was.
 
 The op-amp's reach: a section needs GBW >= :data:`GBW_MARGIN` x fn x Q x noise gain
 (the noise gain 1 + |G| of an inverting section, G of a non-inverting one): the rule of
@@ -43,15 +45,16 @@ from ..core.units import format_eng
 from ..filters import registry
 from ..filters.deck import ac_deck, simulate_ac
 from ..filters.topology import SectionTarget
+from ..spice.deck import SINE_POINTS_PER_DECADE
 from ..spice.simulate import tool_info
 from . import circuit
-from .design import MAX_ERROR, candidates, part_series
+from .sourcing import MAX_ERROR, candidates, part_series
 from .result import METRICS, PLANT_SCHEMA_VERSION, Sourcing, Target
 
 __all__ = ["GBW_MARGIN", "SPICE_DB", "SPICE_DEG", "CircuitAnalysisSpec", "CircuitPlantResult", "design_circuit_plant",
            "check_opamp_reach", "analyze_circuit_plant", "analyze_circuit_spec", "check_circuit_parts",
            "tolerance_nominal", "built_name", "SQUARE_NRMS_PASS", "SquareRun", "square_deck", "with_square_test",
-           "default_square_hz", "with_bench"]
+           "default_square_hz", "with_bench", "section_analysis", "step_span"]
 
 #: the op-amp's gain-bandwidth a section needs, in units of fn x Q x noise gain
 GBW_MARGIN = 10.0
@@ -115,6 +118,11 @@ class CircuitPlantResult:
         The sine check of the op-amp-aware model (and of SPICE's ``.ac`` when simulated).
     scope : designer.plant.bench.ScopeSetup or None
         The scope as set for the square wave.
+    step_metrics : dict
+        ``ideal`` and ``opamp``: the :class:`~designer.core.metrics.StepMetrics` of :attr:`steps` (a low-pass's).
+    models : dict
+        ``ideal`` and ``opamp``: the (num, den) the steps and the bench are computed from (leading zeros of num
+        trimmed).
     """
 
     topology: str
@@ -145,6 +153,8 @@ class CircuitPlantResult:
     scope: object = None
     files: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
+    step_metrics: dict = field(default_factory=dict)
+    models: dict = field(default_factory=dict)
 
     @property
     def section(self):
@@ -240,11 +250,15 @@ def check_opamp_reach(topology, target: SectionTarget, amp) -> None:
 
 def _figures(topo, values: dict, amp, target: Target) -> dict:
     """The ideal and op-amp-aware figures of the build, with their errors against the target."""
-    arrays = circuit.circuit_figures(topo, values, amp)
-    ideal = {"fn_hz": float(arrays["ideal_fn_hz"]), "zeta": float(arrays["ideal_zeta"]),
-             "q": float(arrays["ideal_q"]), "gain": float(arrays["gain"]),
+    arrays = circuit.circuit_figures(topo, values)
+    # the ideal pair by the section's closed form where it has one (Topology.ideal_pair: the Sallen-Key
+    # low-pass's is its parts record's, bit for bit); the op-amp-aware pair that of the model the steps are
+    # computed from, the ideal op-amp's too (its A0 and GBW: the deck's)
+    fn_i, z_i = topo.ideal_pair(values)
+    fn_o, z_o = (float(x) for x in circuit.dominant_pairs(circuit.opamp_tf(topo, values, amp)[1], topo.order == 1))
+    ideal = {"fn_hz": fn_i, "zeta": z_i, "q": 1 / (2 * z_i), "gain": float(arrays["gain"]),
              "f3db_hz": circuit.corner_frequencies(topo, values)}
-    opa = {"fn_hz": float(arrays["fn_hz"]), "zeta": float(arrays["zeta"]), "q": float(arrays["q"]),
+    opa = {"fn_hz": fn_o, "zeta": z_o, "q": 1 / (2 * z_o) if z_o else math.inf,
            "f3db_hz": circuit.corner_frequencies(topo, values, amp)}
     for f in (ideal, opa):
         f["fn_error_pct"] = None if target.fc_hz is None else 100 * (f["fn_hz"] / target.fc_hz - 1)
@@ -255,22 +269,40 @@ def _figures(topo, values: dict, amp, target: Target) -> dict:
     return {"ideal": ideal, "opamp": opa}
 
 
-def _steps(topo, values: dict, amp, figures: dict) -> dict:
+def step_span(figures: dict) -> float:
+    """The time a build's step is read over: :func:`designer.core.lti.response_span` of the slower of the
+    ideal and op-amp-aware pairs, at the lighter damping (a first-order section's taken as 1).
+
+    Parameters
+    ----------
+    figures : dict
+        ``ideal`` and ``opamp`` figures (:attr:`CircuitPlantResult.figures`).
+
+    Returns
+    -------
+    float
+        The span (s).
+    """
+    fig_i, fig_o = figures["ideal"], figures["opamp"]
+    return response_span(min(fig_i["fn_hz"], fig_o["fn_hz"]), min(fig_i["zeta"] or 1.0, fig_o["zeta"] or 1.0))
+
+
+def _models(topo, values: dict, amp) -> dict:
+    """The ideal and op-amp-aware (num, den), num's leading zeros trimmed (scipy warns of them)."""
+    out = {}
+    for key, (num, den) in (("ideal", topo.coefficients(values)), ("opamp", circuit.opamp_tf(topo, values, amp))):
+        num, den = np.asarray(num, float), np.asarray(den, float)
+        out[key] = (np.trim_zeros(num, "f") if np.any(num) else num, den)
+    return out
+
+
+def _steps(topo, models: dict, figures: dict) -> dict:
     """Unit-step metrics of both models (a low-pass's; None for a step that settles to 0)."""
     if topo.kind != "lowpass":
         return {"ideal": None, "opamp": None}
-    num_i, den_i = (np.asarray(c, float) for c in topo.coefficients(values))
-    num_o, den_o = circuit.opamp_tf(topo, values, amp)
-    fig = figures["opamp"]
-    span = response_span(min(figures["ideal"]["fn_hz"], fig["fn_hz"]), fig["zeta"] or 1.0)
-    t = dense_time(span)
-    out = {}
-    for key, (num, den) in (("ideal", (num_i, den_i)), ("opamp", (num_o, den_o))):
-        num = np.trim_zeros(num, "f") if np.any(num) else num
-        y = step_response(num, den, t)
-        m = step_metrics(t, y, final=float(num[-1] / den[-1])).to_dict()
-        out[key] = {k: m[k] for k in METRICS}
-    return out
+    t = dense_time(step_span(figures))
+    return {key: step_metrics(t, step_response(num, den, t), final=float(num[-1] / den[-1]))
+            for key, (num, den) in models.items()}
 
 
 def _spice(netlist, amp, fn_hz: float, topo, values: dict, simulator: str) -> tuple:
@@ -380,7 +412,7 @@ def _square(result, amplitude_v: float, square_hz, simulate: bool, simulator: st
 
 
 def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = False,
-               simulator: str = "ngspice-cli") -> CircuitPlantResult:
+               simulator: str = "ngspice-cli", hold=(), refuse_unsimulable: bool = False) -> CircuitPlantResult:
     """``result`` with the Sallen-Key plant's bench (:mod:`designer.plant.bench`): the square wave (the
     square-wave test's, else :func:`~designer.plant.bench.recommend_square_wave` from the op-amp-aware
     model's 2 % settling time: a low-pass's step's, else its slowest pole's, :func:`default_square_hz`),
@@ -389,7 +421,8 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     square wave (CH2 from the op-amp-aware step's extremes: a high- or band-pass's output jumps with the
     edges and swings below 0 V on the falling one) and the sine check of the op-amp-aware model
     (:func:`~designer.plant.bench.sine_check`; a band-pass at its centre, a high-pass against its
-    high-frequency gain), with, when ``simulate``, ngspice's ``.ac`` of the section over fn/100 .. 100 fn;
+    high-frequency gain), with, when ``simulate``, ngspice's ``.ac`` of the section over fn/100 .. 100 fn at
+    :data:`~designer.spice.deck.SINE_POINTS_PER_DECADE` (the Sallen-Key plant's sine check, bit for bit);
     returned.
 
     Parameters
@@ -402,6 +435,11 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
         Run the sine check's ``.ac`` in ngspice.
     simulator : str
         :func:`designer.spice.simulate.get_simulator`'s name.
+    hold : sequence of str
+        Designators the tolerance band holds at their values (the Sallen-Key plant's gain pair).
+    refuse_unsimulable : bool
+        With ``simulate``, refuse a square wave too slow to simulate before any SPICE run (the Sallen-Key plant
+        simulates it: :meth:`designer.spice.deck.SquareTest.check_simulable`).
 
     Returns
     -------
@@ -413,27 +451,37 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     from .bench import channel, recommend_square_wave, scope_setup, sine_check, tolerance_band
     from ..core.eseries import TOLERANCE
     topo, amp, a = result.section, result.opamp, result.amplitude_v
-    num_o, den_o = (np.asarray(c, float) for c in circuit.opamp_tf(topo, result.values, amp))
-    num_o = np.trim_zeros(num_o, "f") if np.any(num_o) else num_o
+    models = result.models or _models(topo, result.values, amp)
+    num_o, den_o = models["opamp"]
     fig_i, fig_o = result.figures["ideal"], result.figures["opamp"]
-    span = response_span(min(fig_i["fn_hz"], fig_o["fn_hz"]), fig_o["zeta"] or 1.0)
+    span = step_span(result.figures)
     t = dense_time(4 * span)
     y = step_response(num_o, den_o, t)
     final = float(num_o[-1] / den_o[-1])
-    settling = (metrics(t, y, final=final).settling_time_s if topo.kind == "lowpass" else
-                slowest_settling_s(den_o))
-    if not math.isfinite(settling):
-        # a step that does not settle inside 4 spans (a lightly damped pair beside a slow op-amp pole): the
-        # slowest mode's envelope, which exists, rather than a NaN square wave (nice_frequency_below crashed)
+    if topo.kind == "lowpass":
+        # the op-amp-aware step's own 2 % settling time (its metrics, read over the step's span)
+        m_o = result.step_metrics.get("opamp")
+        if m_o is None:
+            ts = dense_time(span)
+            m_o = metrics(ts, step_response(num_o, den_o, ts), final=final)
+        settling = m_o.settling_time_s
+    if topo.kind != "lowpass" or not math.isfinite(settling):
+        # a low-pass's step that does not settle inside its span (a lightly damped pair beside a slow op-amp
+        # pole): the slowest mode's envelope, which exists, rather than a NaN square wave (nice_frequency_below
+        # crashed on it)
         settling = slowest_settling_s(den_o)
     if result.square is not None:
         test = result.square.test
     else:
-        test = recommend_square_wave(settling, a, square_hz, time_scale_s=1 / (2 * math.pi * fig_o["fn_hz"]))
+        # the response's fastest time scale (1/wn, or the fast real pole) bounds the simulation step
+        fastest = 1.0 / float(np.max(np.abs(np.roots(models["ideal"][1]))))
+        test = recommend_square_wave(settling, a, square_hz, time_scale_s=fastest)
     r_tol, c_tol = (TOLERANCE[s] for s in (result.sourcing.r_series, result.sourcing.c_series))
     result.test = test
-    result.tolerance = tolerance_band(topo, result.values, {"R": r_tol, "C": c_tol},
-                                      min(test.half_period_s, 4 * span))
+    # every declared part at its series' tolerance, but those held (the Sallen-Key plant's gain pair)
+    tolerances = {r: r_tol if r[0] == "R" else c_tol for r in topo.designators if r not in hold} if hold else \
+        {"R": r_tol, "C": c_tol}
+    result.tolerance = tolerance_band(topo, result.values, tolerances, min(test.half_period_s, 4 * span))
     if result.tolerance.unstable_corners:
         result.notes.append(Message(N_("{n} tolerance corners are unstable (zeta <= 0: poles in the right "
                                        "half-plane): a build there oscillates; their step readings are left out "
@@ -444,9 +492,62 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     result.scope = scope_setup(window, a / 2, (channel("CH1", N_("generator (CH1)"), 0.0, a),
                                                channel("CH2", N_("U1 output"), a * lo, a * hi)))
     fn = fig_i["fn_hz"]
-    spice = ac(result.netlist, amp, fn / 100, fn * 100, simulator=simulator) if simulate else None
+    spice = None
+    if simulate:
+        if refuse_unsimulable:
+            test.check_simulable()
+        tick = time.perf_counter()
+        # at the sine check's density: its peak and -3 dB point are read off the sweep
+        spice = ac(result.netlist, amp, fn / 100, fn * 100, simulator=simulator,
+                   points_per_decade=SINE_POINTS_PER_DECADE)
+        result.timings["simulation_s"] = result.timings.get("simulation_s", 0.0) + time.perf_counter() - tick
     result.sine = sine_check(num_o, den_o, amp, a, fn, spice, kind=topo.kind, zeta=fig_o["zeta"] or 1.0)
     return result
+
+
+def section_analysis(topology, mode: str, target: Target, values: dict, sourcing: Sourcing, amp, amplitude_v: float,
+                     square_hz=None, package=None, hold=(), simulate: bool = False,
+                     simulator: str = "ngspice-cli") -> CircuitPlantResult:
+    """A build's analysis by the section pipeline: the figures, steps, sensitivities and deck, and the bench
+    (:func:`with_bench`, its sine check's ``.ac`` in ngspice when ``simulate``, a square wave too slow to
+    simulate refused first); what the seed's Sallen-Key plant
+    (:func:`designer.plant.design.design_plant`, ``analyze_plant``) computes its result from.
+
+    Parameters
+    ----------
+    topology : Topology
+        The section.
+    mode : str
+        ``design`` or ``analyze``.
+    target : Target
+        What the errors are reported against.
+    values : dict
+        Designator -> value (ohm, farad).
+    sourcing : Sourcing
+        Each part's series and tolerance.
+    amp : designer.core.opamps.OpAmp
+        The op-amp.
+    amplitude_v : float
+        The bench's high level (V).
+    square_hz : float, optional
+        The square wave's frequency (None: recommended).
+    package : str, optional
+        The op-amp package of the wiring.
+    hold : sequence of str
+        Designators the tolerance band holds (:func:`with_bench`).
+    simulate : bool
+        Run the sine check's ``.ac`` in ngspice.
+    simulator : str
+        :func:`designer.spice.simulate.get_simulator`'s name.
+
+    Returns
+    -------
+    CircuitPlantResult
+        The result (no ``spice`` agreement check: its caller simulates the build its own way).
+    """
+    result = _analyse(topology, mode, target, values, None, [], sourcing, amp, [], package, False, simulator)
+    result.amplitude_v = amplitude_v
+    return with_bench(result, square_hz, simulate, simulator, hold=hold, refuse_unsimulable=True)
 
 
 def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", target_fc_hz=None, target_zeta=None,
@@ -655,7 +756,9 @@ def _analyse(topo, mode: str, target: Target, values: dict, ideal, ranked: list,
     """The figures, sensitivities, deck and (when ``simulate``) SPICE check of a build, as one result."""
     tick = time.perf_counter()
     figures = _figures(topo, values, amp, target)
-    steps = _steps(topo, values, amp, figures)
+    models = _models(topo, values, amp)
+    metrics = _steps(topo, models, figures)
+    steps = {k: None if m is None else {f: m.to_dict()[f] for f in METRICS} for k, m in metrics.items()}
     sensitivity = {"ideal": circuit.sensitivities(topo, values), "opamp": circuit.sensitivities(topo, values, amp)}
     netlist = topo.netlist(values)
     fn = figures["ideal"]["fn_hz"]
@@ -670,7 +773,8 @@ def _analyse(topo, mode: str, target: Target, values: dict, ideal, ranked: list,
     else:
         notes.append(N_("SPICE simulation skipped (--no-sim): the figures are analytic only"))
     return CircuitPlantResult(topo.name, mode, target, values, ideal, ranked, sourcing, amp, figures, steps,
-                              sensitivity, netlist, deck, checks, notes, run, package, timings=timings)
+                              sensitivity, netlist, deck, checks, notes, run, package, timings=timings,
+                              step_metrics=metrics, models=models)
 
 
 #: SPICE's square-wave output against the op-amp-aware model's: NRMS (Xyce's rule, :func:`designer.core.compare.nrms`,

@@ -6,7 +6,12 @@ jointly and its LM741 modelled).
 ``design_plant`` and ``analyze_plant`` return a
 :class:`~designer.plant.result.PlantResult`, typed; its ``to_dict`` is the
 JSON of ``design-plant --json`` and ``result.json``, and the report module
-renders the same object as text, Markdown and HTML.
+renders the same object as text, Markdown and HTML. Its analysis is the section
+pipeline's on the Sallen-Key low-pass (:func:`designer.plant.circuit_design.section_analysis`:
+figures, steps, sensitivities, square wave, tolerance band with the gain pair held, sine
+check); this module adds what only the seed's plant has: the models' responses over the
+bench's rising half period, the slew-rate and swing checks, the scope, and its own
+``.tran`` deck in SPICE (the ``netlists/`` reference, compared with both models).
 
 Which builds are listed: :func:`designer.plant.circuit.listed`, every section's rule (each
 response once, at the level whose resistors lie in 1 kOhm..100 kOhm, those within 0.5 % of the
@@ -27,25 +32,18 @@ import numpy as np
 
 from ..core import eseries
 from ..core.compare import disagreements, metric_deltas, nrms, resample
-from ..core.errors import DesignError, ParamError
-from ..core.lti import dense_time, dominant_pair, response_span, step_response
+from ..core.errors import ParamError
+from ..core.lti import dense_time, step_response
 from ..core.metrics import step_metrics
 from ..core.opamps import OpAmp
 from ..core.ranges import RANGES
 from ..core.units import format_eng, value_code
 from ..spice.simulate import get_simulator
-from .bench import (
-    bench_period,
-    period_check,
-    plant_scope,
-    recommend_square_wave,
-    signal_checks,
-    sine_check,
-    tolerance_band,
-)
+from .bench import bench_period, period_check, plant_scope, signal_checks
+from .circuit_design import section_analysis, step_span
 from . import circuit
-from .model import plant_tf, plant_tf_opamp, sensitivities
-from .netlist import plant_ac_deck, plant_deck
+from .model import Sensitivity
+from .netlist import plant_deck
 from .result import (
     Alternative,
     Comparison,
@@ -68,16 +66,10 @@ from ..filters.sallen_key_lowpass_synthesis import (
 from ..filters.sallen_key_lowpass_parts import gain_of, network, part_values, section_of
 from ..filters.sallen_key_lowpass_search import scored
 from ..filters.topology import SectionTarget
+from .sourcing import MAX_ERROR, NOTE_ERROR, candidates, part_series
 from .spec import AnalysisSpec, PlantSpec
 
 __all__ = ["PlantSpec", "AnalysisSpec", "PlantResult", "choose_parts", "design_plant", "analyze_plant"]
-
-
-def candidates(series: str, lo: float, hi: float, what: str) -> np.ndarray:
-    vals = eseries.values(series, lo, hi)
-    if vals.size == 0:
-        raise DesignError(f"no {series} {what} value between {lo:g} and {hi:g}; widen the bounds")
-    return vals
 
 
 def gain_resistors(gain: float, spec: PlantSpec):
@@ -258,54 +250,6 @@ def analyze_plant(spec: AnalysisSpec, simulate: bool = True, simulator: str = "p
                     spec.square_hz, simulate, simulator, spec.package)
 
 
-#: what an unlabelled part is assumed to be: a 5 % resistor, a 10 % capacitor
-DEFAULT_SERIES = {"R": "E24", "C": "E12"}
-
-
-def part_series(values: dict, r_series=None, c_series=None):
-    """Each part's series label and tolerance, and the series whose tolerance the band
-    uses (the loosest part's, worst case).
-
-    With a series given, every part of that kind is from it. Without, a part is
-    labelled with the smallest series that holds its value ("not a standard value"
-    when none does) and assumed at least as tight as the default E24 resistor /
-    E12 capacitor: a 1k from a 5 % kit is not a 40 % E3 part, but a 1k26 exists
-    only as an E192 (0.5 %) part.
-
-    ``r_series``/``c_series`` are normalised names (an :class:`AnalysisSpec`'s).
-    Returns (labels {ref: :class:`PartSource`}, r band series, c band series, notes).
-    """
-    order = list(eseries.SERIES)
-    given = {"R": r_series, "C": c_series}
-    labels, band, notes = {}, {"R": None, "C": None}, []
-    for ref, v in values.items():
-        kind = ref[0]
-        found = eseries.smallest_series(v)
-        if given[kind] is not None:
-            series = given[kind]
-            label = series if found is not None and order.index(found) <= order.index(series) \
-                else f"{series} (not an {series} value)"
-        elif found is None:
-            series, label = DEFAULT_SERIES[kind], "not a standard value"
-            unit = "Ohm" if kind == "R" else "F"
-            notes.append(f"{ref} = {format_eng(v, unit)} is not a standard E-series value; its tolerance is "
-                         f"taken as {100 * eseries.TOLERANCE[series]:g} %")
-        else:
-            series = order[max(order.index(found), order.index(DEFAULT_SERIES[kind]))]
-            label = found
-        labels[ref] = PartSource(label, 100 * eseries.TOLERANCE[series])
-        if band[kind] is None or eseries.TOLERANCE[series] > eseries.TOLERANCE[band[kind]]:
-            band[kind] = series
-    return labels, band["R"] or DEFAULT_SERIES["R"], band["C"] or DEFAULT_SERIES["C"], notes
-
-
-#: a design further off than this is refused, with the reason
-MAX_ERROR = 0.05
-#: a design further off than this says which bound holds it back (and, at twice it,
-#: that the op-amp's gain-bandwidth moves it)
-NOTE_ERROR = 0.005
-
-
 def _bound_notes(spec: PlantSpec, fc: float, zeta: float, worst: float) -> list:
     """Which part bound keeps the design ``worst`` off. Each bound is relaxed by a
     decade (within the physical ranges) and the search run again; where that at
@@ -376,40 +320,38 @@ def _unreachable(spec: PlantSpec, fc: float, worst: float) -> ParamError:
 
 def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternatives, amp: OpAmp, amplitude_v,
              square_hz, simulate, simulator, package=None) -> PlantResult:
-    """The models, bench test, checks, deck and (when ``simulate``) SPICE run of
-    a chosen build, as one result."""
+    """The analysis of a chosen build by the section pipeline
+    (:func:`designer.plant.circuit_design.section_analysis`: the figures, steps, sensitivities, the bench's
+    square wave, tolerance band and sine check), seen as the seed's :class:`PlantResult`, with what only the
+    seed's plant has: the models' responses over the bench's rising half period, the slew-rate and swing
+    checks, the scope, and its own ``.tran`` deck in SPICE (the ``netlists/`` reference) against both models."""
     tick = time.perf_counter()
     built = choice.built
-    num_i, den_i = plant_tf(built)
-    num_o, den_o = plant_tf_opamp(built, amp)
-    fn_o, z_o = dominant_pair(den_o)
-    span = response_span(min(built.fn_hz, fn_o), min(built.zeta, z_o))
-    t = dense_time(span)
-    m_i = step_metrics(t, step_response(num_i, den_i, t), final=float(num_i[-1] / den_i[-1]))
-    m_o = step_metrics(t, step_response(num_o, den_o, t), final=float(num_o[-1] / den_o[-1]))
-    # the response's fastest time scale (1/wn, or the fast real pole) bounds the simulation step
-    time_scale = 1.0 / float(np.max(np.abs(np.roots(den_i))))
-    test = recommend_square_wave(m_o.settling_time_s, amplitude_v, square_hz, time_scale_s=time_scale)
-    if simulate:
-        test.check_simulable()
+    section, values = section_of(built), part_values(built)
+    # the gain pair held in the band, as the seed's band (the RC network's corners)
+    sec = section_analysis(section, mode, target, values, sourcing, amp, amplitude_v, square_hz, package,
+                           hold=section.choice_parts, simulate=simulate, simulator=simulator)
+    simulated = sec.timings.get("simulation_s", 0.0)   # the sine check's .ac
+    test, m_i, m_o = sec.test, sec.step_metrics["ideal"], sec.step_metrics["opamp"]
+    (num_i, den_i), (num_o, den_o) = sec.models["ideal"], sec.models["opamp"]
     # the comparisons and plots use the rising half period of the bench test (its start, if
     # the square wave is much slower than the response: a dense grid where the metrics are taken)
-    tw = dense_time(min(test.half_period_s, 4 * span))
+    tw = dense_time(min(test.half_period_s, 4 * step_span(sec.figures)))
     y_iw, y_ow = step_response(num_i, den_i, tw), step_response(num_o, den_o, tw)
     checks = signal_checks(tw, y_ow, amplitude_v, amp)
     late = period_check(test, m_o.settling_time_s)
     checks += [late] if late is not None else []
-    analytic = Model(num_i, den_i, Figures.against(built.fn_hz, built.zeta, target), m_i, sensitivities(built),
-                     y_iw * amplitude_v)
-    analytic_opamp = Model(num_o, den_o, Figures.against(fn_o, z_o, target), m_o, sensitivities(built, amp),
-                           y_ow * amplitude_v)
-    # the band over the RC network's corners (R1 R2 C1 C2; the gain pair held, as the seed's band)
-    r_tol, c_tol = eseries.TOLERANCE[sourcing.r_series], eseries.TOLERANCE[sourcing.c_series]
-    section = section_of(built)
-    tolerance = tolerance_band(section, part_values(built), {r: r_tol if r[0] == "R" else c_tol
-                                                             for r in section.designators
-                                                             if r not in section.choice_parts}, tw[-1])
-    timings = {"analytic_s": time.perf_counter() - tick}
+
+    def model(which, num, den, step, response):
+        fig = sec.figures[which]
+        # the plant's table has always shown K rather than the gain pair that sets it
+        table = {label: Sensitivity(s["wn"], s["zeta"]) for label, s in sec.sensitivity[which].items()
+                 if label not in section.choice_parts}
+        return Model(num, den, Figures(fig["fn_hz"], fig["zeta"], fig["fn_error_pct"], fig["zeta_error_pct"]), step,
+                     table, response * amplitude_v)
+
+    analytic, analytic_opamp = model("ideal", num_i, den_i, m_i, y_iw), model("opamp", num_o, den_o, m_o, y_ow)
+    timings = {"analytic_s": time.perf_counter() - tick - simulated}
     tick = time.perf_counter()
     deck = plant_deck(built, amp, test, _title(built, amp))
     timings["netlist_s"] = time.perf_counter() - tick
@@ -420,20 +362,11 @@ def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternati
         spice, period = run_spice(deck, test, tw, analytic, analytic_opamp, built.gain, simulator)
         if not spice.comparison.passed:
             notes.append("SPICE disagrees with the op-amp-aware model: " + "; ".join(spice.comparison.disagreements))
-        timings["simulation_s"] = time.perf_counter() - tick
+        timings["simulation_s"] = simulated + time.perf_counter() - tick
     else:
         notes.append("SPICE simulation skipped (--no-sim): the figures are analytic only")
-    ac = None
-    if simulate:
-        # the sine check measured in SPICE: an .ac sweep of the same circuit, fn/100 .. 100 fn
-        tick = time.perf_counter()
-        fn = built.fn_hz
-        res = get_simulator(simulator).run(plant_ac_deck(built, amp, fn / 100, fn * 100, _title(built, amp)))
-        ac = (res["frequency"], res["v(out)"])
-        timings["simulation_s"] += time.perf_counter() - tick
     tick = time.perf_counter()
     bench = bench_period(test, (num_i, den_i), (num_o, den_o), period)
-    sine = sine_check(num_o, den_o, amp, amplitude_v, built.fn_hz, ac)
     # the output's extremes over the period (per volt of square wave): the rising edge's peak, and the
     # falling edge's undershoot below 0 V, as deep as the overshoot (superposition)
     peak = m_o.peak_value if math.isfinite(m_o.peak_value) else built.gain
@@ -441,9 +374,9 @@ def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternati
     timings["analytic_s"] += time.perf_counter() - tick
     return PlantResult(mode=mode, target=target, ratios=choice.ratios, ideal=choice.ideal, built=built,
                        sourcing=sourcing, alternatives=alternatives, opamp=amp, analytic=analytic,
-                       analytic_opamp=analytic_opamp, time_s=tw, test=test, tolerance=tolerance, checks=checks,
-                       notes=notes, deck=deck, bench=bench, spice=spice, scope=scope, sine=sine, timings=timings,
-                       package=package)
+                       analytic_opamp=analytic_opamp, time_s=tw, test=test, tolerance=sec.tolerance, checks=checks,
+                       notes=notes, deck=deck, bench=bench, spice=spice, scope=scope, sine=sec.sine,
+                       timings=timings, package=package)
 
 
 def _title(parts, amp):

@@ -40,5 +40,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                  "step_settings",),
     "stats": ("Limit", "Z95", "figure_stats", "variance_shares", "wilson",),
     "worstcase": ("WorstCase", "worst_case",),
-    "yields": ("ENGINES", "FILTER", "LOOP", "PLANT", "SECTION", "TABLES", "counted", "spec_yield",),
+    "yields": ("ENGINES", "FILTER", "LOOP", "PLANT", "SECTION", "SECTION_SPICE", "TABLES", "counted", "figure_table",
+               "spec_yield",),
 })

@@ -123,11 +123,13 @@ def section_step_context(result, simulator: str = "ngspice-cli"):
                                 node=result.netlist.amps[0].out)
 
 
-def section_step_chunk(ctx, model: tuple, values: dict, start: int = 0) -> dict:
+def section_step_chunk(ctx, model: tuple, values: dict, start: int = 0, apart: bool = False) -> dict:
     """A chunk's figures with a low-pass section's step engine: the analytic engine's
     (:func:`designer.plant.circuit.evaluate` of ``model``, (topology name, op-amp)), with those SPICE's step
     measures (:data:`designer.tolerance.spice_engine.FIGURES`) in their place, as the Sallen-Key plant's
-    :func:`plant_chunk`. Pure, of picklable arguments.
+    :func:`plant_chunk`; ``apart``: SPICE's as ``spice_<figure>`` beside the analytic engine's own, as the
+    Sallen-Key plant's :func:`step_chunk` (check-design's yield counts each check on its own engine's figure,
+    :data:`designer.tolerance.yields.SECTION_SPICE`). Pure, of picklable arguments.
 
     Parameters
     ----------
@@ -139,6 +141,8 @@ def section_step_chunk(ctx, model: tuple, values: dict, start: int = 0) -> dict:
         Designator -> array over the chunk's builds.
     start : int
         The first build's index.
+    apart : bool
+        SPICE's figures under ``spice_<figure>``, the analytic engine's all kept.
 
     Returns
     -------
@@ -146,7 +150,10 @@ def section_step_chunk(ctx, model: tuple, values: dict, start: int = 0) -> dict:
         Figure -> array over the builds.
     """
     from ..plant.circuit import evaluate as analytic
-    return {**analytic(model, values), **spice_engine.evaluate(ctx, values, start)}
+    sp = spice_engine.evaluate(ctx, values, start)
+    if apart:
+        sp = {f"spice_{k}": v for k, v in sp.items()}
+    return {**analytic(model, values), **sp}
 
 
 #: a section plant's SPICE engine: the step's ``.tran`` for a low-pass (it settles to its DC gain, the
@@ -431,7 +438,8 @@ def run_engine(draw, evaluate, model, settings: dict, engine: str, spice_k, seed
 def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, sampler: str = "random",
                                dist: str = "uniform", tol_items=(), limit_items=(), engine: str = "analytic",
                                spice_k: int | None = None, simulator: str = "ngspice-cli", scale=None,
-                               target_ci: float | None = None, analysis: str | None = None):
+                               target_ci: float | None = None, analysis: str | None = None, tighten: bool = True,
+                               apart: bool = False):
     """:func:`plant_monte_carlo_engine` of a plant on a registered section (a
     :class:`~designer.plant.circuit_design.CircuitPlantResult`): the analytic engine over its
     declared parts (:func:`designer.plant.circuit.evaluate`) or, with a SPICE engine, every build in
@@ -466,6 +474,11 @@ def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, samp
     analysis : str, optional
         :data:`SECTION_ANALYSES`: ``ac`` runs a low-pass's ``.ac`` instead of its step (None: the rule of
         :func:`section_analysis`).
+    tighten : bool
+        With limits, also the part to tighten (:func:`designer.tolerance.montecarlo.plant_monte_carlo`).
+    apart : bool
+        With the engine ``spice``: the step's figures as ``spice_<figure>`` beside the analytic engine's
+        (:func:`section_step_chunk`; check-design's yield); an ``.ac``'s replace them either way.
 
     Returns
     -------
@@ -487,16 +500,17 @@ def section_monte_carlo_engine(result, series: dict, n: int, seed: int = 0, samp
     model = (result.topology, result.opamp)
     nominal = dict(result.values)
     draw = lambda **kw: plant_monte_carlo(None, series, result.opamp, n, seed, sampler, dist,  # noqa: E731
-                                          tol_items, limit_items, scale=scale, target_ci=target_ci,
-                                          circuit=(nominal, circuit.evaluate, model), **kw)
+                                          tol_items, limit_items, tighten=tighten, scale=scale,
+                                          target_ci=target_ci, circuit=(nominal, circuit.evaluate, model), **kw)
     if engine == "analytic":
         return draw()
-    evaluate, settings, measured, shared = section_engine(result, simulator, engine, analysis)
+    evaluate, settings, measured, shared = section_engine(result, simulator, engine, analysis, apart)
     return run_engine(draw, evaluate, lambda v: circuit.evaluate(model, v), settings, engine, spice_k, seed, scale,
                       measured, shared)
 
 
-def section_engine(result, simulator: str = "ngspice-cli", engine: str = "spice", analysis: str | None = None):
+def section_engine(result, simulator: str = "ngspice-cli", engine: str = "spice", analysis: str | None = None,
+                   apart: bool = False):
     """A section plant's SPICE engine (:func:`section_analysis`): (``evaluate(values) -> figures``, picklable;
     its record under ``monte_carlo.spice``; the figures SPICE measures; those the model gives too).
 
@@ -510,6 +524,8 @@ def section_engine(result, simulator: str = "ngspice-cli", engine: str = "spice"
         ``spice`` or ``both`` (recorded).
     analysis : str, optional
         ``step`` or ``ac`` (None: :func:`section_analysis`).
+    apart : bool
+        A step's figures as ``spice_<figure>`` beside the analytic engine's (:func:`section_step_chunk`).
 
     Returns
     -------
@@ -524,8 +540,8 @@ def section_engine(result, simulator: str = "ngspice-cli", engine: str = "spice"
     model = (result.topology, result.opamp)
     if analysis == "step":
         ctx = section_step_context(result, simulator)
-        return (functools.partial(section_step_chunk, ctx, model), step_settings(ctx, engine), spice_engine.FIGURES,
-                spice_engine.SHARED)
+        return (functools.partial(section_step_chunk, ctx, model, apart=apart), step_settings(ctx, engine),
+                spice_engine.FIGURES, spice_engine.SHARED)
     ctx = section_context(result, simulator)
     settings = {"engine": engine, "analysis": "ac", "simulator": ctx.simulator, "sweep_hz": [ctx.f_lo_hz, ctx.f_hi_hz],
                 "points_per_decade": spice_ac.POINTS_PER_DECADE,

@@ -15,6 +15,13 @@ figures a check names (``overshoot_pct``, ``peak_time_s``, ``rise_time_s``,
 other figures (``fn_hz``, the gains, the margins, ``model_*``) stay the models',
 as check-design reads them on the nominal build.
 
+A plant on another section than the Sallen-Key low-pass (``topology:``) runs the
+engine the command line and the page run on it (:func:`designer.tolerance.spice_mc.section_monte_carlo_engine`,
+the rule of :func:`designer.tolerance.spice_mc.section_analysis`): with ``engine: spice`` a low-pass's square-wave
+step in ngspice, whose step figures a check names are counted from SPICE as the Sallen-Key plant's
+(:data:`SECTION_SPICE` ``step``; ``tolerances: {SR: ..}`` spreads the slew its op-amp model has), another
+section's ``.ac`` fitted (``ac``: fn_hz, zeta, q and gain SPICE's, the step figures the fitted pair's).
+
 A designed filter (``kind: filter``) counts its checks on :data:`FILTER`'s figures
 (the mask's among them) on :func:`designer.tolerance.filter.filter_spec_yield`'s builds:
 the analytic engine only, its SPICE comparison is analyze-filter's ``--spice-samples``.
@@ -28,7 +35,8 @@ from ..core.units import format_eng
 from .loop import LIMITABLE, STANDS_IN
 from .stats import Limit
 
-__all__ = ["ENGINES", "FILTER", "LOOP", "PLANT", "SECTION", "TABLES", "counted", "spec_yield"]
+__all__ = ["ENGINES", "FILTER", "LOOP", "PLANT", "SECTION", "SECTION_SPICE", "TABLES", "counted", "figure_table",
+           "spec_yield"]
 
 #: check-design's plant figure -> the analytic plant engine's (designer.tolerance.plant.FIGURES)
 PLANT = {**{f: f for f in ("fn_hz", "zeta", "q", "ideal_fn_hz", "ideal_zeta", "ideal_q", "gain", "overshoot_pct",
@@ -48,16 +56,49 @@ PLANT_SPICE = {**PLANT, **{f: f"spice_{f}" for f in SPICE_STEP}}
 #: check-design's loop figure -> the SPICE engine's (the analytic loop's besides SPICE's ``spice_*``)
 LOOP_SPICE = {**{f: f for f in LIMITABLE}, **{f: f"spice_{f}" for f in SPICE_STEP}}
 #: the table key of a plant on another topology than the Sallen-Key low-pass: the analytic engine's figures
-#: (:func:`designer.plant.circuit.evaluate`) under both engines; with the SPICE engine fn_hz, zeta, q and gain
-#: are fitted to each build's ngspice .ac and the step figures follow from the fitted pair
-#: (:func:`designer.tolerance.spice_ac.section_chunk`): its SPICE run has no step to measure
+#: (:func:`designer.plant.circuit.evaluate`, named as the Sallen-Key plant's model names them), and with the
+#: SPICE engine those of its analysis (:data:`SECTION_SPICE`)
 SECTION = "section"
-TABLES = {"analytic": {**BY_KIND, SECTION: PLANT}, "spice": {"plant": PLANT_SPICE, "pid": LOOP_SPICE, SECTION: PLANT}}
+#: check-design's figure -> a section plant's SPICE engine's, per analysis
+#: (:func:`designer.tolerance.spice_mc.section_analysis`): ``step`` (a low-pass: SPICE's step figures as
+#: ``spice_*`` beside the analytic engine's, :func:`designer.tolerance.spice_mc.section_step_chunk` apart, as
+#: :data:`PLANT_SPICE`); ``ac`` (a high- or band-pass, whose step settles to 0: fn_hz, zeta, q and gain fitted to
+#: each build's ngspice .ac, the step figures the fitted pair's, :func:`designer.tolerance.spice_ac.section_chunk`)
+SECTION_SPICE = {"step": PLANT_SPICE, "ac": PLANT}
+TABLES = {"analytic": {**BY_KIND, SECTION: PLANT},
+          "spice": {"plant": PLANT_SPICE, "pid": LOOP_SPICE, SECTION: SECTION_SPICE}}
 #: the engines a spec's yield may use
 ENGINES = ("analytic", "spice")
 
 
-def counted(kind: str, checks, engine: str = "analytic") -> tuple:
+def figure_table(kind: str, engine: str = "analytic", analysis: str | None = None) -> dict:
+    """check-design's figure -> the engine's, of a spec's kind (:data:`TABLES`).
+
+    Parameters
+    ----------
+    kind : str
+        ``plant``, ``pid``, ``filter`` or :data:`SECTION` (a plant on another topology).
+    engine : str
+        The yield's engine (:data:`ENGINES`).
+    analysis : str, optional
+        A section's SPICE analysis (:data:`SECTION_SPICE`: ``step`` or ``ac``,
+        :func:`designer.tolerance.spice_mc.section_analysis`); needed for a section with the SPICE engine.
+
+    Returns
+    -------
+    dict
+        Spec figure -> engine figure.
+    """
+    out = TABLES[engine][kind]
+    if out is SECTION_SPICE:
+        if analysis not in SECTION_SPICE:
+            raise ValueError(f"a section's SPICE yield needs its analysis ({', '.join(SECTION_SPICE)}), "
+                             f"got {analysis!r}")
+        out = SECTION_SPICE[analysis]
+    return out
+
+
+def counted(kind: str, checks, engine: str = "analytic", analysis: str | None = None) -> tuple:
     """(the checks the yield counts, the names of those it cannot): failing checks whose figure the
     ``engine`` computes, and the others'.
 
@@ -69,15 +110,17 @@ def counted(kind: str, checks, engine: str = "analytic") -> tuple:
         The spec's checks.
     engine : str
         The yield's engine.
+    analysis : str, optional
+        A section's SPICE analysis (:func:`figure_table`).
 
     Returns
     -------
     tuple
         (the checks counted, the names of the others).
     """
-    table = TABLES[engine][kind]
+    known = figure_table(kind, engine, analysis)
     live = [c for c in checks if c.fail]
-    return tuple(c for c in live if c.figure in table), tuple(c.figure for c in live if c.figure not in table)
+    return tuple(c for c in live if c.figure in known), tuple(c.figure for c in live if c.figure not in known)
 
 
 @dataclass(frozen=True)
@@ -156,7 +199,7 @@ def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int,
     res : designer.plant.result.PlantResult or designer.pid.result.PidResult or FilterRun
         The corner's design (a filter: check-design's run, :func:`designer.tolerance.filter.filter_spec_yield`;
         a plant on a registered section: a :class:`~designer.plant.circuit_design.CircuitPlantResult`, its
-        analytic engine, :func:`designer.plant.circuit.evaluate`).
+        engines :func:`designer.tolerance.spice_mc.section_monte_carlo_engine`'s).
     checks : sequence of designer.check.limits.Limit
         The spec's checks.
     required : float
@@ -183,32 +226,26 @@ def spec_yield(kind: str, res, checks, required: float, samples: int, seed: int,
     """
     from .loop import loop_monte_carlo, loop_series
     from .montecarlo import plant_monte_carlo
+    from .spice_mc import section_analysis
     section = kind == "plant" and hasattr(res, "section")
-    use, skipped = counted(SECTION if section else kind, checks, engine)
-    table = TABLES[engine][SECTION if section else kind]
-    limits = tuple(Limit(table[c.figure], c.min, c.max) for c in use)
-    names = {table[c.figure]: c.figure for c in use}
+    key = SECTION if section else kind
+    analysis = section_analysis(res.section) if section else None
+    use, skipped = counted(key, checks, engine, analysis)
+    known = figure_table(key, engine, analysis)
+    limits = tuple(Limit(known[c.figure], c.min, c.max) for c in use)
+    names = {known[c.figure]: c.figure for c in use}
     if kind == "filter":   # a FilterRun of check-design: its design and the spec's mask
         from .filter import filter_spec_yield
         mc = filter_spec_yield(res.design, res.case.mask, limits, samples, seed, tol_items, sampler, dist)
         return YieldVerdict(mc, required, names, skipped)
     if section:
-        # a plant on a registered section: its analytic engine over the declared parts (and GBW), or every
-        # build's .ac in ngspice (designer.tolerance.spice_ac)
-        from ..plant import circuit
-        from .montecarlo import check_section_spread
-        check_section_spread(tol_items)
+        # a plant on a registered section: the engine the command line and the page run on it (its analytic
+        # engine, or in ngspice a low-pass's step, another section's .ac; SR refused but where the step slews),
+        # the step's figures apart from the analytic engine's so that each check counts its own (SECTION_SPICE)
+        from .spice_mc import section_monte_carlo_engine
         s = res.sourcing
-        model = (res.topology, res.opamp)
-        evaluate = None
-        if engine == "spice":
-            from . import spice_ac
-            evaluate = spice_ac.section_evaluate(spice_ac.context(
-                res.deck, res.netlist, res.section, dict(res.values), res.figures["ideal"]["fn_hz"], simulator,
-                res.opamp), model)
-        mc = plant_monte_carlo(None, {"R": s.r_series, "C": s.c_series}, res.opamp, samples, seed, sampler, dist,
-                               tol_items, limits, tighten=False, engine_name=engine, evaluate=evaluate,
-                               circuit=(dict(res.values), circuit.evaluate, model))
+        mc = section_monte_carlo_engine(res, {"R": s.r_series, "C": s.c_series}, samples, seed, sampler, dist,
+                                        tol_items, limits, engine, simulator=simulator, tighten=False, apart=True)
     elif kind == "plant":
         s = res.sourcing
         evaluate = None

@@ -137,17 +137,23 @@ def test_a_yield_on_a_section_counts_its_builds(tmp_path):
     assert d["monte_carlo"]["yield"]["fraction"] == pytest.approx(np.mean((fn >= 950) & (fn <= 1050)))
 
 
-@pytest.mark.parametrize("extra, words", [
-    (lambda t: re.sub(r"  ideal_fn_hz: .*\n", "  rise_time_s: {max: 1m}\n", t) + "yield: {min: 50%, engine: spice}\n",
+@pytest.mark.parametrize("name, extra, words", [
+    # a high-pass's SPICE engine is its .ac: no step to time (a low-pass's step counts rise_time_s)
+    ("mfb-highpass",
+     lambda t: re.sub(r"  ideal_fn_hz: .*\n", "  rise_time_s: {max: 1m}\n", t) + "yield: {min: 50%, engine: spice}\n",
      ["yield counts the builds inside checks:", "the spice engine computes", "not: rise_time_s"]),
-    ("tolerances: {SR: 20%}\nyield: {min: 50%, engine: spice}\n",
-     ["spec.yaml:9: tolerances.SR: topology mfb-lowpass's yield engines are linear", "GBW: spreads the op-amp"]),
-    (lambda t: t.replace("checks:\n", "checks:\n  overshoot_pct: {max: 30}\n") + "tolerance: [overshoot_pct]\n",
+    ("mfb-highpass", "tolerances: {SR: 20%}\nyield: {min: 50%, engine: spice}\n",
+     ["spec.yaml:9: tolerances.SR: topology mfb-highpass's yield engines are linear", "GBW: spreads the op-amp"]),
+    # a low-pass's SPICE step slews, its analytic model does not
+    ("mfb-lowpass", "tolerances: {SR: 20%}\nyield: {min: 50%}\n",
+     ["spec.yaml:9: tolerances.SR: the plant's analytic model is linear", "give yield.engine: spice"]),
+    ("mfb-lowpass",
+     lambda t: t.replace("checks:\n", "checks:\n  overshoot_pct: {max: 30}\n") + "tolerance: [overshoot_pct]\n",
      ["spec.yaml:10: tolerance: overshoot_pct has no tolerance band on topology mfb-lowpass", "allowed: fn_hz"]),
 ])
-def test_what_a_section_s_yield_has_not_is_one_line_at_its_key(extra, words, tmp_path):
+def test_what_a_section_s_yield_has_not_is_one_line_at_its_key(name, extra, words, tmp_path):
     path = tmp_path / "spec.yaml"
-    text = spec_text(REGISTRY["mfb-lowpass"])
+    text = spec_text(REGISTRY[name])
     path.write_text(extra(text) if callable(extra) else text + extra)
     out = check(path)
     assert out.returncode == 2, out.stdout + out.stderr
@@ -268,13 +274,26 @@ def test_tolerance_on_a_section_passes_inside_and_fails_outside_its_limits(name,
         assert case["status"] == ("pass" if code == 0 else "fail")
 
 
+def _yield_run(tmp_path, text: str) -> tuple:
+    """check-design of the spec ``text`` in ngspice (it passes or fails, no error): (result.json's
+    monte_carlo, monte-carlo.csv's rows)."""
+    import csv
+    path = tmp_path / "spec.yaml"
+    path.write_text(text)
+    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
+    assert out.returncode in (0, 1), out.stdout + out.stderr
+    d = json.loads(next((tmp_path / "out").rglob("reports/*/result.json")).read_text())
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        return d["monte_carlo"], list(csv.DictReader(fh))
+
+
 @pytest.mark.spice
 @pytest.mark.parametrize("name", ["mfb-lowpass", "sallen-key-highpass"])
 def test_a_section_s_yield_with_the_spice_engine_and_the_op_amp_s_spread(name, tmp_path):
-    """yield: {engine: spice} with tolerances: {GBW: 30%} on a section: each build's .ac in ngspice (its fitted
-    fn next to the op-amp-aware model with that build's parts and GBW: within 1 %, the engine's tested bound);
-    the yield the share of monte-carlo.csv's rows inside the check."""
-    import csv
+    """yield: {engine: spice} with tolerances: {GBW: 30%} on a section: a high-pass's .ac in ngspice (its fitted
+    fn next to the op-amp-aware model with that build's parts and GBW: within 1 %, the engine's tested bound),
+    a low-pass's step (fn_hz then the model's, SPICE's step figures beside it); the yield the share of
+    monte-carlo.csv's rows inside the check."""
     import dataclasses
 
     import numpy as np
@@ -283,17 +302,10 @@ def test_a_section_s_yield_with_the_spice_engine_and_the_op_amp_s_spread(name, t
     from designer.plant.circuit import circuit_figures
     topology = REGISTRY[name]
     ex = topology.example
-    path = tmp_path / "spec.yaml"
-    path.write_text(spec_text(topology).replace("opamp: TL072", "opamp: LM741").replace(
+    mc, rows = _yield_run(tmp_path, spec_text(topology).replace("opamp: TL072", "opamp: LM741").replace(
         "checks:\n", f"checks:\n  fn_hz: {{min: {0.98 * ex.fn_hz:g}, max: {1.02 * ex.fn_hz:g}}}\n")
         + "tolerances: {R: 1%, C: 2%, GBW: 30%}\nyield: {min: 10%, samples: 30, seed: 7, engine: spice}\n")
-    out = check(path, "--simulator", "ngspice-cli", "--out", str(tmp_path / "out"))
-    assert out.returncode in (0, 1), out.stdout + out.stderr
-    d = json.loads(next((tmp_path / "out").rglob("reports/*/result.json")).read_text())
-    mc = d["monte_carlo"]
     assert mc["settings"]["engine"] == "spice" and mc["settings"]["tolerances_pct"]["GBW"] == 30
-    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
-        rows = list(csv.DictReader(fh))
     assert len(rows) == 30
     amp = get_opamp("LM741")
     fn = np.array([float(r["fn_hz"]) for r in rows])
@@ -303,6 +315,32 @@ def test_a_section_s_yield_with_the_spice_engine_and_the_op_amp_s_spread(name, t
     inside = (fn >= 0.98 * ex.fn_hz) & (fn <= 1.02 * ex.fn_hz)
     assert mc["yield"]["fraction"] == pytest.approx(inside.mean())
     assert _cases(tmp_path / "out")["yield"]["status"] == ("pass" if inside.mean() >= 0.1 else "fail")
+
+
+@pytest.mark.spice
+def test_a_low_pass_section_s_spice_yield_counts_spice_s_step_with_the_slew_spread(tmp_path):
+    """yield: {engine: spice} on a low-pass section runs its square-wave step in ngspice, as design-plant
+    --topology --engine spice does: tolerances: {SR: ..} accepted (the step slews), rise_time_s and
+    overshoot_pct counted from SPICE's step (monte-carlo.csv's spice_* columns), the yield their share."""
+
+    import numpy as np
+    topology = REGISTRY["mfb-lowpass"]
+    mc, rows = _yield_run(tmp_path, spec_text(topology).replace(
+        "checks:\n", "checks:\n  overshoot_pct: {max: 4.5}\n  rise_time_s: {max: 1m}\n")
+        + "tolerances: {R: 2%, C: 5%, SR: 20%}\nyield: {min: 10%, samples: 12, seed: 5, engine: spice}\n")
+    assert mc["settings"]["engine"] == "spice" and mc["settings"]["tolerances_pct"]["SR"] == 20
+    assert mc["spice"]["analysis"] == "step"
+    over = np.array([float(r["spice_overshoot_pct"]) for r in rows])
+    rise = np.array([float(r["spice_rise_time_s"]) for r in rows])
+    assert len(rows) == 12 and not np.allclose(over, [float(r["overshoot_pct"]) for r in rows], rtol=1e-9, atol=0)
+    ideal = np.array([float(r["ideal_fn_hz"]) for r in rows])     # spec_text's own check, the model's
+    ex = topology.example
+    inside = (over <= 4.5) & (rise <= 1e-3) & (ideal >= float(f"{0.95 * ex.fn_hz:g}")) \
+        & (ideal <= float(f"{1.05 * ex.fn_hz:g}"))
+    assert mc["yield"]["fraction"] == pytest.approx(inside.mean())
+    case = _cases(tmp_path / "out")["yield"]
+    assert case["status"] == ("pass" if inside.mean() >= 0.1 else "fail")
+    assert "over overshoot_pct, rise_time_s, ideal_fn_hz (spice engine" in case["message"]
 
 
 @pytest.mark.spice

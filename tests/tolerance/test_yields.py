@@ -101,3 +101,73 @@ def test_a_loops_spice_yield_counts_spices_overshoot():
     assert v.mc.yield_count == int(inside.sum()) and 0 < inside.sum() < 10
     assert v.names == {"phase_margin_deg": "phase_margin_deg", "spice_overshoot_pct": "overshoot_pct"}
     assert "GBW " in v.message() and "SR " in v.message() and "(spice engine" in v.message()
+
+
+# ---- a plant on a registered section ----------------------------------------------------------------
+
+def _section(name: str, **target):
+    from designer.plant.circuit_design import design_circuit_plant
+    return design_circuit_plant(PlantSpec(opamp="TL072", topology=name, **target), simulator="ngspice-cli")
+
+
+@pytest.mark.spice
+def test_a_low_pass_section_s_spice_yield_counts_spice_s_step_as_the_command_line_does(tmp_path):
+    """engine: spice on an MFB low-pass runs its step in ngspice (the command line's engine on it,
+    spice_mc.section_analysis), SR spread: overshoot_pct counted from SPICE's step beside the model's own
+    figures; the yield equals design-plant --topology --engine spice's on the same seed, build by build."""
+    import csv
+    import json
+    import subprocess
+
+    from helpers import script
+    res = _section("mfb-lowpass", fc_hz=1000, zeta=0.3, gain=2)
+    tol = ("R=2%", "C=5%", "SR=20%")
+    model = spec_yield("plant", res, (CheckLimit("overshoot_pct", 0.0, None, 37.0),), 0.5, 12, 4, tol[:2])
+    v = spec_yield("plant", res, (CheckLimit("overshoot_pct", 0.0, None, 37.0),), 0.5, 12, 4, tol, engine="spice")
+    assert v.names == {"spice_overshoot_pct": "overshoot_pct"} and v.mc.engine == "spice"
+    assert v.mc.spice["analysis"] == "step" and v.mc.tolerances.of["SR"] == pytest.approx(0.2)
+    figs = v.mc.figures
+    # the model's figures kept under their own names, SPICE's step beside them (its own numbers)
+    assert not np.array_equal(figs["spice_overshoot_pct"], figs["overshoot_pct"])
+    assert np.isfinite(figs["spice_settling_time_s"]).all() and "SR" in v.message()
+    assert v.mc.yield_count == int(np.count_nonzero(figs["spice_overshoot_pct"] <= 37.0))
+    assert model.mc.engine == "analytic" and "spice_overshoot_pct" not in model.mc.figures
+    out = subprocess.run([script("design-plant"), "--topology", "mfb-lowpass", "--fc", "1000", "--zeta", "0.3",
+                          "--gain", "2", "--opamp", "TL072", "--monte-carlo", "12", "--seed", "4", "--engine",
+                          "spice", *(a for t in tol for a in ("--tol", t)), "--limit", "overshoot_pct=0:37",
+                          "--simulator", "ngspice-cli", "--out", str(tmp_path)],
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stdout + out.stderr
+    d = json.loads(next(tmp_path.rglob("result.json")).read_text())
+    assert d["monte_carlo"]["yield"]["passed"] == v.mc.yield_count
+    with open(d["files"]["monte_carlo_csv"], newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    np.testing.assert_allclose([float(r["overshoot_pct"]) for r in rows], figs["spice_overshoot_pct"], rtol=1e-9)
+
+
+@pytest.mark.spice
+def test_a_high_pass_section_s_spice_yield_is_its_ac_as_before():
+    """engine: spice on a high-pass stays each build's .ac fitted (its step settles to 0): the same builds
+    and figures as the .ac engine's own Monte Carlo (plant_monte_carlo with spice_ac.section_evaluate)."""
+    from designer.plant import circuit
+    from designer.tolerance import spice_ac
+    from designer.tolerance.montecarlo import plant_monte_carlo
+    res = _section("sallen-key-highpass", fc_hz=1000, zeta=0.4)
+    checks = (CheckLimit("fn_hz", 980.0, None, 1020.0), CheckLimit("overshoot_pct", 0.0, None, 40.0))
+    v = spec_yield("plant", res, checks, 0.5, 10, 2, ("R=1%", "C=2%"), engine="spice")
+    assert v.names == {"fn_hz": "fn_hz", "overshoot_pct": "overshoot_pct"} and v.mc.spice["analysis"] == "ac"
+    model = (res.topology, res.opamp)
+    evaluate = spice_ac.section_evaluate(spice_ac.context(res.deck, res.netlist, res.section, dict(res.values),
+                                                          res.figures["ideal"]["fn_hz"], "ngspice-cli", res.opamp),
+                                         model)
+    s = res.sourcing
+    before = plant_monte_carlo(None, {"R": s.r_series, "C": s.c_series}, res.opamp, 10, 2, "random", "uniform",
+                               ("R=1%", "C=2%"), v.mc.limits, tighten=False, engine_name="spice",
+                               evaluate=evaluate, circuit=(dict(res.values), circuit.evaluate, model))
+    assert v.mc.yield_count == before.yield_count
+    for k in before.figures:
+        np.testing.assert_array_equal(v.mc.figures[k], before.figures[k])
+    from designer.core.errors import DesignError
+    with pytest.raises(DesignError, match="SR") as err:
+        spec_yield("plant", res, checks, 0.5, 10, 2, ("SR=20%",), engine="spice")
+    assert err.value.param == "SR"
