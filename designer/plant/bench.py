@@ -243,11 +243,14 @@ class ToleranceBand:
     t_s: np.ndarray | None = field(default=None, repr=False, compare=False)    #: the envelope's grid
     lo: np.ndarray | None = field(default=None, repr=False, compare=False)     #: lowest unit step over the corners
     hi: np.ndarray | None = field(default=None, repr=False, compare=False)     #: highest
+    #: corners whose poles reach the right half-plane (no step readings there); the result's notes say it, the
+    #: band's JSON keeps its keys (identify --against reads every key as a {min, max} band)
+    unstable_corners: int = field(default=0, compare=False)
 
     def to_dict(self) -> dict:
         out = {}
         for f in fields(self):
-            if f.name in ("t_s", "lo", "hi"):
+            if f.name in ("t_s", "lo", "hi", "unstable_corners"):
                 continue
             value = getattr(self, f.name)
             out[f.name] = value.to_dict() if isinstance(value, Band) else value
@@ -331,13 +334,21 @@ def tolerance_band(topology, values: dict, tolerances: dict, t_end: float) -> To
     t = dense_time(t_end, 8001)
     rows = []
     lo = hi = None
+    unstable = 0
     for v in tolerance_corners(values, tol):
         num, den = (np.asarray(c, float) for c in topology.coefficients(v))
         num = np.trim_zeros(num, "f") if np.any(num) else num
+        fn, zeta = topology.ideal_pair(v)
+        if np.any(np.real(np.roots(den)) >= 0):
+            # an unstable corner (a high-Q gain section's positive feedback past its edge: zeta <= 0) has no
+            # step readings and no envelope to draw (its step grows without bound: exp overflowed); its fn and
+            # zeta are real and stay in their bands, the count is reported
+            unstable += 1
+            rows.append((fn, zeta, None, None, None, None))
+            continue
         y = step_response(num, den, t)
         lo = y if lo is None else np.minimum(lo, y)
         hi = y if hi is None else np.maximum(hi, y)
-        fn, zeta = topology.ideal_pair(v)
         if topology.kind == "lowpass":
             m = step_metrics(t, y, final=float(num[-1] / den[-1]))
             rows.append((fn, zeta, m.overshoot_pct, m.peak_time_s, m.rise_time_s, m.settling_time_s))
@@ -349,7 +360,8 @@ def tolerance_band(topology, values: dict, tolerances: dict, t_end: float) -> To
         bands.append(Band(min(vals), max(vals)) if vals else Band(None, None))
     r_tol = max((x for ref, x in tol.items() if ref[0] == "R"), default=0.0)
     c_tol = max((x for ref, x in tol.items() if ref[0] == "C"), default=0.0)
-    return ToleranceBand(*bands, r_tolerance_pct=100 * r_tol, c_tolerance_pct=100 * c_tol, t_s=t, lo=lo, hi=hi)
+    return ToleranceBand(*bands, r_tolerance_pct=100 * r_tol, c_tolerance_pct=100 * c_tol,
+                         t_s=None if lo is None else t, lo=lo, hi=hi, unstable_corners=unstable)
 
 
 @dataclass(frozen=True)

@@ -640,7 +640,8 @@ def dominant_pairs(den: np.ndarray, first_order: bool = False) -> tuple:
     den : ndarray
         Shape ``batch + (m + 1,)``, highest power first.
     first_order : bool
-        A first-order section's: the slowest real pole alone (zeta NaN).
+        A first-order section's: the slowest pole alone, a real one's corner or a complex pair's |p| (the
+        section's pole merged with the op-amp's), zeta NaN.
 
     Returns
     -------
@@ -661,7 +662,11 @@ def dominant_pairs(den: np.ndarray, first_order: bool = False) -> tuple:
     pc = np.take_along_axis(poles, slow_c[..., None], -1)[..., 0]
     real = np.sort(np.where(cplx, np.inf, np.abs(poles.real)), axis=-1)
     if first_order:
-        return real[..., 0] / (2 * math.pi), np.full(den.shape[:-1], np.nan)
+        # the slowest pole, real or one of a complex pair (|p|): a first-order section near its op-amp's
+        # gain-bandwidth (an inverting high-pass at fc 100 kHz on an LM358) has its pole and the op-amp's
+        # merged into a complex pair, and no real pole at all (its fn was inf); all real, the same bits
+        slow = np.minimum(real[..., 0], np.min(np.where(cplx, mag, np.inf), axis=-1))
+        return slow / (2 * math.pi), np.full(den.shape[:-1], np.nan)
     with np.errstate(invalid="ignore", over="ignore"):
         w_r = np.sqrt(real[..., 0] * real[..., 1])
         z_r = (real[..., 0] + real[..., 1]) / (2 * w_r)

@@ -366,9 +366,13 @@ def design_circuit_plant(spec, simulate: bool = True, simulator: str = "ngspice-
     aim, ranked = circuit.compensate_gbw(topo, section, amp, rank) if spec.compensate_gbw else (section, rank(section))
     exact = None if spec.r is None else topo.synthesize_rc(aim, spec.r, spec.c)
     best = ranked[0]
-    if aim is section and best.worst > MAX_ERROR:
+    # against the aim, compensated or not, as the seed's plant checks its own (plant.design): a compensated
+    # aim's best parts were let through however far off (bug: fc 10 mHz, zeta 0.05, gain 100 on an LM741 with
+    # --compensate-gbw built zeta -0.33, an unstable plant 1000 % off, and the bench crashed on its NaN settling)
+    if best.worst > MAX_ERROR:
+        what = "the target" if aim is section else f"the compensated aim (fn {format_eng(aim.fn_hz, 'Hz')})"
         raise DesignError(f"fc_hz: the best {spec.r_series}/{spec.c_series} parts for {topo.name} land "
-                          f"{100 * best.worst:.3g} % off the target (more than {100 * MAX_ERROR:g} %); widen the "
+                          f"{100 * best.worst:.3g} % off {what} (more than {100 * MAX_ERROR:g} %); widen the "
                           "part bounds or use a finer series", param="fc_hz")
     t_search = time.perf_counter() - tick
     values = best.values
@@ -465,7 +469,10 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
             ts = dense_time(span)
             m_o = metrics(ts, step_response(num_o, den_o, ts), final=final)
         settling = m_o.settling_time_s
-    else:
+    if topo.kind != "lowpass" or not math.isfinite(settling):
+        # a low-pass's step that does not settle inside its span (a lightly damped pair beside a slow op-amp
+        # pole): the slowest mode's envelope, which exists, rather than a NaN square wave (nice_frequency_below
+        # crashed on it)
         settling = slowest_settling_s(den_o)
     if result.square is not None:
         test = result.square.test
@@ -483,6 +490,12 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     # (at most 4 spans: settled), as the Sallen-Key plant's; replaced when the bench is set again
     tw, yw, edge = rising_step(models["ideal"], models["opamp"], min(test.half_period_s, 4 * span))
     result.checks = [*signal_checks(tw, yw, a, amp, edge), *(c for c in result.checks if c.id not in SIGNAL_CHECKS)]
+    if result.tolerance.unstable_corners:
+        note = Message(N_("{n} tolerance corners are unstable (zeta <= 0: poles in the right half-plane): a build "
+                          "there oscillates; their step readings are left out of the band"),
+                       n=result.tolerance.unstable_corners)
+        if note not in result.notes:   # the bench set again (check-design's square-wave run) says it once
+            result.notes.append(note)
     # the output over the period, per volt: the rising edge's step s(t), the falling edge's s(inf) - s(t)
     hi, lo = max(float(y.max()), final - float(y.min())), min(float(y.min()), final - float(y.max()), 0.0)
     window = min(1.2 * settling, test.half_period_s) if math.isfinite(settling) else test.half_period_s
@@ -594,12 +607,28 @@ def analyze_circuit_plant(topology: str, values: dict, opamp: str = "LM741", tar
     amp.package(package)
     series = [None if s is None else series_name(s) for s in (r_series, c_series)]
     labels, r_s, c_s, why = part_series(parsed, *series)
+    _check_stable(topo, parsed, amp)
     gain = float(topo.figures(parsed).gain)
     fig = topo.figures(parsed)
     notes = [Message(N_("these parts give fn = {fn} Hz{q}, gain {gain}"), fn=f"{fig.fn_hz:.5g}",
                      q="" if fig.q is None else f", Q = {fig.q:.4g}", gain=f"{gain:.4g}"), *why]
     return _square(_analyse(topo, "analyze", Target(fc, zeta, gain), parsed, None, [], Sourcing(r_s, c_s, labels),
                             amp, notes, package, simulate, simulator), amplitude_v, square_hz, simulate, simulator)
+
+
+def _check_stable(topo, values: dict, amp) -> None:
+    """Refuse parts as built whose section is unstable, ideal or with ``amp`` (a pole with Re p >= 0: a gain
+    section's positive feedback past its edge, zeta <= 0), as the seed's plant refuses its own: such a build
+    oscillates and has no step, no settling and no bench (bug: the step's exp overflowed and the sheet filled
+    with NaN)."""
+    for who, (_, den) in (("", topo.coefficients(values)), (f" with the {amp.name}", circuit.opamp_tf(topo, values, amp))):
+        poles = np.roots(np.asarray(den, float))
+        if np.any(poles.real >= 0):
+            fn, zeta = topo.ideal_pair(values)
+            z = "" if zeta is None else f", zeta {float(zeta):.3g}"
+            raise DesignError(f"part: these parts make {topo.name} unstable{who} (fn {format_eng(float(fn), 'Hz')}{z}: "
+                              "a pole in the right half-plane, the build oscillates); change the parts",
+                              param="part")
 
 
 def _analysis_target(topo, target_fc_hz, target_zeta) -> tuple:

@@ -205,16 +205,18 @@ def band_png(result) -> bytes:
     from ..core.lti import step_response
     from ..report.plots import step_plot
     tol, a = result.tolerance, result.test.amplitude_v
+    # every corner unstable: no envelope (tolerance_band's), the models' steps over the half period alone
+    t = np.linspace(0.0, result.test.half_period_s, 4001) if tol.t_s is None else tol.t_s
     curves = {}
     for label, (num, den) in ((_("analytic ({opamp} model)").format(opamp=result.opamp.name),
                                circuit.opamp_tf(result.section, result.values, result.opamp)),
                               (N_("analytic (ideal op-amp)"), result.section.coefficients(result.values))):
         num = np.asarray(num, float)
         curves[label] = a * step_response(np.trim_zeros(num, "f") if np.any(num) else num, np.asarray(den, float),
-                                          tol.t_s)
-    band = (tol.t_s, tol.lo * a, tol.hi * a, _("tolerance band (R {r} %, C {c} %)").format(
+                                          t)
+    band = None if tol.t_s is None else (tol.t_s, tol.lo * a, tol.hi * a, _("tolerance band (R {r} %, C {c} %)").format(
         r=f"{tol.r_tolerance_pct:g}", c=f"{tol.c_tolerance_pct:g}"))
-    return step_plot(tol.t_s, curves, _("Step response, 0 -> {v} V").format(v=f"{a:g}"), band=band)
+    return step_plot(t, curves, _("Step response, 0 -> {v} V").format(v=f"{a:g}"), band=band)
 
 
 def sections(result, with_images: bool = False, schematic_svg: str = "") -> list:
