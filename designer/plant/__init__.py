@@ -22,7 +22,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                 "capacitor_combinations", "circuit_figures", "corner_frequencies", "dominant_pairs", "evaluate", "listed",
                 "opamp_tf", "GBW_ROUNDS", "gbw_shift", "compensate_gbw", "plant_target", "rounded", "search",
                 "step_of_pair"),
-    "bench": ("PEAK_MIN_DB", "SIGNAL_CHECKS", "ScopeSetup", "channel", "corner_tolerances", "no_peak_reason",
+    "bench": ("PEAK_MIN_DB", "PERIOD_CHECK", "SIGNAL_CHECKS", "ScopeSetup", "channel", "corner_tolerances", "no_peak_reason",
               "period_extremes", "recommend_square_wave", "rising_step", "scope_setup", "signal_checks",
               "tolerance_band", "tolerance_corners"),
     "design": ("analyze_plant", "choose_parts", "design_plant"),

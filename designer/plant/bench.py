@@ -36,7 +36,7 @@ from ..core.metrics import step_metrics
 from ..core.opamps import OpAmp
 from ..spice.deck import SquareTest
 
-__all__ = ["PEAK_MIN_DB", "SIGNAL_CHECKS", "ScopeSetup", "channel", "no_peak_reason", "period_extremes",
+__all__ = ["PEAK_MIN_DB", "PERIOD_CHECK", "SIGNAL_CHECKS", "ScopeSetup", "channel", "no_peak_reason", "period_extremes",
            "recommend_square_wave", "rising_step", "scope_setup", "signal_checks", "corner_tolerances",
            "tolerance_band", "tolerance_corners"]
 
@@ -204,12 +204,16 @@ def rising_step(ideal: tuple, opamp: tuple, t_end: float) -> tuple:
     return t, step_response(num_o, den_o, t), edge
 
 
+#: the id of :func:`period_check`'s check
+PERIOD_CHECK = "square_wave_period"
+
+
 def period_check(test: SquareTest, settling_time_s: float) -> Check | None:
     """A failed check when the square wave's half period is shorter than the 2 %
     settling time (the scope would never show a settled step); None when it is not."""
     if test.half_period_s >= settling_time_s:
         return None
-    return Check.of("square_wave_period", False,
+    return Check.of(PERIOD_CHECK, False,
                     N_("half period {half} us is shorter than the 2 % settling time {settling} us: the scope will "
                        "not show a settled step"), half=f"{test.half_period_s * 1e6:.4g}",
                     settling=f"{settling_time_s * 1e6:.4g}")

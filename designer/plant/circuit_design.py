@@ -451,8 +451,8 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     """
     from ..core.metrics import step_metrics as metrics
     from ..filters.deck import simulate_ac as ac
-    from .bench import (SIGNAL_CHECKS, channel, recommend_square_wave, rising_step, scope_setup, signal_checks,
-                        sine_check, tolerance_band)
+    from .bench import (PERIOD_CHECK, SIGNAL_CHECKS, channel, period_check, recommend_square_wave, rising_step,
+                        scope_setup, signal_checks, sine_check, tolerance_band)
     from ..core.eseries import TOLERANCE
     topo, amp, a = result.section, result.opamp, result.amplitude_v
     models = result.models or _models(topo, result.values, amp)
@@ -489,7 +489,10 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     # the op-amp's slew and swing under the square wave, from the op-amp-aware step over the rising half period
     # (at most 4 spans: settled), as the Sallen-Key plant's; replaced when the bench is set again
     tw, yw, edge = rising_step(models["ideal"], models["opamp"], min(test.half_period_s, 4 * span))
-    result.checks = [*signal_checks(tw, yw, a, amp, edge), *(c for c in result.checks if c.id not in SIGNAL_CHECKS)]
+    # and a square wave too fast for the step to settle in its half period (a --square-freq), as the seed's
+    late = period_check(test, settling)
+    result.checks = [*signal_checks(tw, yw, a, amp, edge), *([] if late is None else [late]),
+                     *(c for c in result.checks if c.id not in (*SIGNAL_CHECKS, PERIOD_CHECK))]
     if result.tolerance.unstable_corners:
         note = Message(N_("{n} tolerance corners are unstable (zeta <= 0: poles in the right half-plane): a build "
                           "there oscillates; their step readings are left out of the band"),

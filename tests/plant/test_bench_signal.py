@@ -166,3 +166,19 @@ def test_in_spice_the_square_wave_departs_from_the_model_where_the_output_swing_
         if not ok:
             # the rail: SPICE's output stops near the LM741's -14 V where the model goes past -20 V
             assert r.square.y_model.min() < -20 and r.square.y_spice.min() > r.opamp.vout_min - 0.5
+
+
+@pytest.mark.parametrize("name", sorted(REGISTRY))
+def test_a_square_wave_too_fast_to_settle_fails_the_period_check_on_every_section(name):
+    """The seed's square_wave_period for every section: a --square-freq whose half period is shorter than the
+    op-amp-aware response's 2 % settling time fails (the scope would never show a settled step), the recommended
+    square wave has no such check, and setting the bench again says it once."""
+    from designer.plant.bench import PERIOD_CHECK
+    result = design(name)
+    assert PERIOD_CHECK not in [c.id for c in result.checks]
+    settling = 1.0 / (2 * 1.5 * result.test.frequency_hz)      # the recommendation's 1.5 settling times a half
+    fast = 1.0 / (2 * 0.25 * settling)                          # a half period of a quarter of it
+    result = with_bench(result, fast)
+    result = with_bench(result, fast)
+    late = [c for c in result.checks if c.id == PERIOD_CHECK]
+    assert len(late) == 1 and not late[0].ok and "settling time" in late[0].shown()
