@@ -836,10 +836,14 @@ def sensitivities(topology: Topology, values: dict, opamp=None, rel_step: float 
     return out
 
 
+#: :func:`corner_frequencies`' refinement: rounds, and points a round in each crossing's bracket
+REFINE, SUBGRID = 4, 513
+
+
 def corner_frequencies(topology: Topology, values: dict, opamp=None) -> list:
     """The -3 dB frequencies of the response (Hz): where |H| crosses the passband
     gain / sqrt 2 between fn / 1000 and 1000 fn (one for a low- or high-pass, two
-    for a band-pass), found on a dense grid and refined by bisection in log f.
+    for a band-pass), found on a dense grid and refined on finer grids in log f.
 
     Parameters
     ----------
@@ -855,20 +859,22 @@ def corner_frequencies(topology: Topology, values: dict, opamp=None) -> list:
     list of float
         Ascending.
     """
-    fn = float(topology.figures(values).fn_hz)
-    level = float(topology.figures(values).gain) / math.sqrt(2)
+    fig = topology.figures(values)
+    fn, level = float(fig.fn_hz), float(fig.gain) / math.sqrt(2)
     mag = lambda f: np.abs(topology.response(values, 2j * np.pi * np.asarray(f), opamp))  # noqa: E731
     f = np.logspace(math.log10(fn) - 3, math.log10(fn) + 3, 1201)
     above = mag(f) >= level
-    out = []
-    for i in np.flatnonzero(above[1:] != above[:-1]):
-        lo, hi = math.log(f[i]), math.log(f[i + 1])
-        a_lo = bool(above[i])
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            if (mag(math.exp(mid)) >= level) == a_lo:
-                lo = mid
-            else:
-                hi = mid
-        out.append(math.exp(0.5 * (lo + hi)))
-    return out
+    cross = np.flatnonzero(above[1:] != above[:-1])
+    if not cross.size:
+        return []
+    # every crossing's bracket refined together: REFINE rounds of SUBGRID points in log f each (one response
+    # evaluation of all the brackets a round, not 60 bisection steps of one point each); the bracket's width
+    # in log f shrinks by SUBGRID - 1 a round, to ~1e-13 of f
+    lo, hi, a_lo = np.log(f[cross]), np.log(f[cross + 1]), above[cross]
+    for _ in range(REFINE):
+        grid = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, SUBGRID)[None, :]
+        side = (mag(np.exp(grid)) >= level) == a_lo[:, None]
+        k = np.clip(np.sum(np.cumprod(side, axis=1), axis=1) - 1, 0, SUBGRID - 2)   # last point on lo's side
+        rows = np.arange(len(lo))
+        lo, hi = grid[rows, k], grid[rows, k + 1]
+    return [float(x) for x in np.exp(0.5 * (lo + hi))]
