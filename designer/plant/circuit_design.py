@@ -123,6 +123,9 @@ class CircuitPlantResult:
     models : dict
         ``ideal`` and ``opamp``: the (num, den) the steps and the bench are computed from (leading zeros of num
         trimmed).
+    rising : tuple or None
+        (t, y): the op-amp-aware unit step over the bench's rising half period (at most 4 spans), the grid the
+        slew and swing checks read (:func:`designer.plant.bench.rising_step`; set with the bench).
     """
 
     topology: str
@@ -155,6 +158,7 @@ class CircuitPlantResult:
     timings: dict = field(default_factory=dict)
     step_metrics: dict = field(default_factory=dict)
     models: dict = field(default_factory=dict)
+    rising: tuple | None = None
 
     @property
     def section(self):
@@ -488,7 +492,8 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     result.tolerance = tolerance_band(topo, result.values, tolerances, min(test.half_period_s, 4 * span))
     # the op-amp's slew and swing under the square wave, from the op-amp-aware step over the rising half period
     # (at most 4 spans: settled), as the Sallen-Key plant's; replaced when the bench is set again
-    tw, yw, edge = rising_step(models["ideal"], models["opamp"], min(test.half_period_s, 4 * span))
+    tw, yw, edge = rising_step(models["ideal"], models["opamp"], min(test.half_period_s, 4 * span), known=(t, y))
+    result.rising = (tw, yw)
     # and a square wave too fast for the step to settle in its half period (a --square-freq), as the seed's
     late = period_check(test, settling)
     result.checks = [*signal_checks(tw, yw, a, amp, edge), *([] if late is None else [late]),

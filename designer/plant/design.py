@@ -337,7 +337,9 @@ def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternati
     # the comparisons and plots use the rising half period of the bench test (its start, if
     # the square wave is much slower than the response: a dense grid where the metrics are taken)
     tw = dense_time(min(test.half_period_s, 4 * step_span(sec.figures)))
-    y_iw, y_ow = step_response(num_i, den_i, tw), step_response(num_o, den_o, tw)
+    # the op-amp-aware step the section's bench computed on this grid (its slew and swing checks'), else its own
+    same = sec.rising is not None and sec.rising[0].shape == tw.shape and np.array_equal(sec.rising[0], tw)
+    y_iw, y_ow = step_response(num_i, den_i, tw), sec.rising[1] if same else step_response(num_o, den_o, tw)
     # the slew and swing checks the section pipeline's bench computed on this same grid (bench.signal_checks)
     checks = [c for c in sec.checks if c.id in SIGNAL_CHECKS]
     late = period_check(test, m_o.settling_time_s)
