@@ -39,7 +39,7 @@ from ..core.opamps import OpAmp
 from ..core.ranges import RANGES
 from ..core.units import format_eng, value_code
 from ..spice.simulate import get_simulator
-from .bench import SIGNAL_CHECKS, bench_period, period_check, plant_scope
+from .bench import PERIOD_CHECK, SIGNAL_CHECKS, bench_period, plant_scope
 from .circuit_design import section_analysis, step_span
 from . import circuit
 from .model import Sensitivity
@@ -341,9 +341,8 @@ def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternati
     same = sec.rising is not None and sec.rising[0].shape == tw.shape and np.array_equal(sec.rising[0], tw)
     y_iw, y_ow = step_response(num_i, den_i, tw), sec.rising[1] if same else step_response(num_o, den_o, tw)
     # the slew and swing checks the section pipeline's bench computed on this same grid (bench.signal_checks)
-    checks = [c for c in sec.checks if c.id in SIGNAL_CHECKS]
-    late = period_check(test, m_o.settling_time_s)
-    checks += [late] if late is not None else []
+    # and its square-wave period check (the half period against the op-amp-aware step's settling time)
+    checks = [c for c in sec.checks if c.id in (*SIGNAL_CHECKS, PERIOD_CHECK)]
 
     def model(which, num, den, step, response):
         fig = sec.figures[which]

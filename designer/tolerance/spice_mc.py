@@ -27,7 +27,7 @@ from . import spice_engine
 
 __all__ = ["drawn_values", "plant_context", "plant_monte_carlo_engine", "replay", "replay_parts", "replay_result",
            "replay_values", "run_engine", "section_analysis", "section_context", "section_engine",
-           "section_monte_carlo_engine", "section_replay", "section_replay_result", "section_step_chunk",
+           "section_monte_carlo_engine", "section_step_chunk",
            "section_step_context", "spice_evaluate", "spice_samples", "step_settings"]
 
 ENGINES = ("analytic", "spice", "both")
@@ -822,56 +822,3 @@ def _replay_plant(result, values: dict, amp, simulator: str, r_series, c_series,
     spec = _SampleSpec(parts, opamp=result.opamp.name, r_series=r_series, c_series=c_series,
                        amplitude_v=result.test.amplitude_v, square_hz=result.test.frequency_hz, package=package)
     return analyze_plant(spec, simulate=True, simulator=simulator)
-
-
-def section_replay(result, series: dict, index: int, n: int, seed: int, sampler: str, dist: str, tol_items=(),
-                   simulator: str = "ngspice-cli") -> Replay:
-    """:func:`replay` (a section plant's build; the name the web page calls).
-
-    Parameters
-    ----------
-    result : designer.plant.circuit_design.CircuitPlantResult
-        The design.
-    series : dict
-        ``{"R": series, "C": series}``.
-    index : int
-        The build replayed.
-    n : int
-        The draw's builds.
-    seed : int
-        The seed.
-    sampler, dist : str
-        How the builds are drawn.
-    tol_items : sequence of str
-        The ``--tol`` items.
-    simulator : str
-        The backend.
-
-    Returns
-    -------
-    Replay
-        The build's values and figures.
-    """
-    return replay(result, series, index, n, seed, sampler, dist, tol_items, simulator)
-
-
-def section_replay_result(result, rep: Replay, simulator: str, square_hz=None):
-    """:func:`replay_result` of a section plant's build (the name the web page calls).
-
-    Parameters
-    ----------
-    result : designer.plant.circuit_design.CircuitPlantResult
-        The design.
-    rep : Replay
-        The build replayed.
-    simulator : str
-        The backend.
-    square_hz : float or str, optional
-        The square-wave test's frequency (None: :func:`replay_result`'s rule).
-
-    Returns
-    -------
-    designer.plant.circuit_design.CircuitPlantResult
-        The analysis of the build (``mode`` "analyze").
-    """
-    return replay_result(result, rep, simulator, square_hz=square_hz)

@@ -259,12 +259,12 @@ def analyze_plant_task(fields: dict, want: str = "json", tmp: str | None = None)
         from .forms import analyze_plant_request
         rq = analyze_plant_request(fields)
         if rq.circuit is not None and rq.replay is not None:   # a section's build replayed, as the Sallen-Key's
-            from ..tolerance.spice_mc import section_replay, section_replay_result
+            from ..tolerance.spice_mc import replay, replay_result
             result, mc = analyze_circuit_plant(**rq.circuit, simulate=False), rq.monte_carlo
             s = result.sourcing
-            build = section_replay(result, {"R": s.r_series, "C": s.c_series}, rq.replay, mc.n, mc.seed, mc.sampler,
-                                   mc.dist, mc.tol, rq.simulator)
-            result = section_replay_result(result, build, rq.simulator, rq.circuit.get("square_hz"))
+            build = replay(result, {"R": s.r_series, "C": s.c_series}, rq.replay, mc.n, mc.seed, mc.sampler, mc.dist,
+                           mc.tol, rq.simulator)
+            result = replay_result(result, build, rq.simulator, square_hz=rq.circuit.get("square_hz"))
             return _circuit_answer(result, rq, want, tmp, lang, f"{rq.name}_sample{rq.replay}")
         if rq.circuit is not None:   # another registered section's parts
             return _circuit_plant(analyze_circuit_plant(**rq.circuit, simulate=rq.simulate, simulator=rq.simulator),

@@ -166,15 +166,15 @@ def test_a_section_replay_draws_the_builds_values_again(mfb_plant, sampler):
 def test_a_section_replay_gives_the_spice_engines_row(mfb_plant):
     """The replayed build's figures are the SPICE engine's row I (its .ac fitted, the model's beside); its
     bundle is the analysis of its exact values."""
-    from designer.tolerance.spice_mc import section_monte_carlo_engine, section_replay, section_replay_result
+    from designer.tolerance.spice_mc import replay, replay_result, section_monte_carlo_engine
     mc = section_monte_carlo_engine(mfb_plant, SERIES, 12, seed=3, engine="spice", simulator="ngspice-cli")
-    rep = section_replay(mfb_plant, SERIES, 9, 12, 3, "random", "uniform", simulator="ngspice-cli")
+    rep = replay(mfb_plant, SERIES, 9, 12, 3, "random", "uniform", simulator="ngspice-cli")
     assert rep.values == {k: mc.values[k][9] for k in mfb_plant.section.designators}
     assert set(rep.spice) == set(mc.figures)
     for k, v in rep.spice.items():
         assert v == pytest.approx(mc.figures[k][9], rel=1e-9)
     row = np.genfromtxt(io.StringIO(rep.csv_text()), delimiter=",", names=True)
     assert int(row["sample"]) == 9 and float(row["model_fn_hz"]) == pytest.approx(rep.model["fn_hz"], rel=1e-9)
-    out = section_replay_result(mfb_plant, rep, "ngspice-cli")
+    out = replay_result(mfb_plant, rep, "ngspice-cli")
     assert out.values == rep.values and out.mode == "analyze" and out.spice["pass"]
     assert out.to_dict()["monte_carlo"]["replay"]["sample"] == 9
