@@ -29,7 +29,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "lifetime": ("Interrupted", "WORDS", "after_native", "die_with_parent", "finish", "forget", "install",
                  "interruption", "native", "on_exit", "owned_prefix", "preexec", "quiet", "remove_stale",
                  "reset_in_child", "status_of", "to_devnull", "words_of"),
-    "lsq_intervals": ("PINV_RCOND", "SCALE_SPAN", "half_widths"),
+    "lsq_intervals": ("PINV_RCOND", "half_widths"),
     "lti": ("MAX_CLUSTER", "StepTerms", "coefficients", "dense_time", "dominant_pair", "filter_foh", "freq_response",
             "pole_clusters", "response_span", "slowest_settling_s", "step_response"),
     "metrics": ("Overshoot", "StepMetrics", "measure_step", "step_metrics"),

@@ -18,25 +18,20 @@ from the units alone, and the pseudo-inverse dropped that direction: the paramet
 time +-3e-18 s, a time constant +-3.4e-8 s) where the data say nothing of it, and a model was wrongly valid.
 Scaling every column to unit norm, D = diag(|J_j|), cov = D^-1 ((J D^-1)^T (J D^-1))^+ D^-1 s^2, is the same
 covariance where J has full rank (Golub and Van Loan, *Matrix Computations*, 4th ed., section 5.3.7, the
-column equilibration of least squares) and leaves the cut-off to collinearity alone. Columns within
-:data:`SCALE_SPAN` of each other keep the unscaled product, so the intervals the project has always
-reported keep every bit (columns of zeros, parameters the solver holds at a bound, take no part in the
-span). A direction the pseudo-inverse still drops among the other columns (collinear ones) gives every
-parameter along it an infinite half-width: the data do not bound it.
+column equilibration of least squares) and leaves the cut-off to collinearity alone. Every product is scaled:
+an earlier rule kept the unscaled product for columns within 1e6 of each other, and columns 10^5.75 apart
+then gave an infinite half-width where the QR route gives a finite one (10^5 apart, 1.4e-5 off); scaled, both
+agree with it to 1e-11 (columns of zeros, parameters the solver holds at a bound, keep a unit scale). A
+direction the pseudo-inverse still drops among the other columns (collinear ones) gives every parameter
+along it an infinite half-width: the data do not bound it.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["PINV_RCOND", "SCALE_SPAN", "half_widths"]
+__all__ = ["PINV_RCOND", "half_widths"]
 
-#: Jacobian columns whose norms span more than this are scaled to unit norm before the pseudo-inverse. Below
-#: it J^T J's condition from the scales alone is under 1e12, three decades from the cut-off (PINV_RCOND), and
-#: the unscaled product is as good: the seed plant's FOPDT fit spans 8.1e4 and its intervals agree scaled
-#: and unscaled to 2e-11 (every committed PID reference carries them, bit for bit); the fits that lost a
-#: parameter spanned 1e8 (a dead time started near 0) and 1.9e10 (tau1 of an overdamped fit fading to 0)
-SCALE_SPAN = 1e6
 #: numpy.linalg.pinv's default cut-off, relative to the largest singular value (the directions it drops)
 PINV_RCOND = 1e-15
 #: a dropped direction's loading on a parameter above this (round-off of a unit vector is ~1e-16) leaves
@@ -62,22 +57,17 @@ def half_widths(jac, s2: float, dof: int, level: float = 0.95) -> np.ndarray:
     -------
     numpy.ndarray, shape (p,)
         One half-width per column, >= 0; ``inf`` for a parameter along a direction the data do not
-        determine; 0 for a column of zeros (a parameter the solver held). Columns whose norms span more
-        than :data:`SCALE_SPAN` are scaled to unit norm first (see the module docstring); otherwise the
-        unscaled product, s2 pinv(J^T J), as the step and output-error fits always computed it.
+        determine; 0 for a column of zeros (a parameter the solver held). The columns are scaled to unit
+        norm before the pseudo-inverse (see the module docstring).
     """
     from scipy.special import stdtrit    # scipy.stats costs 0.4 s to import
 
     J = np.asarray(jac, float)
     d = np.linalg.norm(J, axis=0)
     seen = d > 0
-    if seen.any() and d[seen].min() < d[seen].max() / SCALE_SPAN:
-        d = np.where(seen, d, 1.0)
-        A = (J / d).T @ (J / d)
-        cov = np.linalg.pinv(A) / np.outer(d, d) * s2
-    else:
-        A = J.T @ J
-        cov = np.linalg.pinv(A) * s2
+    d = np.where(seen, d, 1.0)
+    A = (J / d).T @ (J / d)
+    cov = np.linalg.pinv(A) / np.outer(d, d) * s2
     half = float(stdtrit(max(int(dof), 1), 0.5 + 0.5 * level)) * np.sqrt(np.clip(np.diag(cov), 0.0, None))
     # the directions pinv dropped (the same cut-off as its own) among the columns the data move: no finite
     # interval along them. A column of zeros is a parameter the solver holds (scipy's least_squares gives a

@@ -362,7 +362,7 @@ def _confidence(model, sol, n):
     dof = max(n - p, 1)
     s2 = 2.0 * sol.cost / dof
     try:
-        # scaled columns when their norms span more than SCALE_SPAN: an overdamped fit of a first-order
+        # unit-norm columns before the pseudo-inverse: an overdamped fit of a first-order
         # response shrinks tau1 towards 0, its column with it, and the unscaled pseudo-inverse dropped it
         # (tau1 +-3.4e-8 s, an unidentifiable time constant reported as exact)
         sd = half_widths(J, s2, dof)

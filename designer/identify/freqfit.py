@@ -145,8 +145,7 @@ def least_squares_fit(data: FreqData, model: str, starts) -> MethodResult:
     if m > n:
         s2 = 2.0 * best.cost / (m - n)
         try:
-            # the one rule of every fit (core.lsq_intervals): a pseudo-inverse, on scaled columns when their
-            # norms span more than SCALE_SPAN, and a direction the data do not determine unbounded, where
+            # the one rule of every fit (core.lsq_intervals): a pseudo-inverse on unit-norm columns, and a direction the data do not determine unbounded, where
             # inv() of the unscaled product gave a double pole fitted as two lags tau1 and tau2 +-0 (a
             # negative variance of a singular product clipped to 0) and the fit stayed valid
             half = half_widths(best.jac, s2, m - n)

@@ -1,6 +1,6 @@
-"""One 95 % interval rule for every least-squares fit: exact on a linear model whatever its columns' scales,
-the unscaled product's bits kept where the columns' norms stay within SCALE_SPAN, an unbounded half-width
-along a direction the data do not determine."""
+"""One 95 % interval rule for every least-squares fit: exact on a linear model whatever its columns' scales
+(every product scaled to unit-norm columns), an unbounded half-width along a direction the data do not
+determine."""
 
 import numpy as np
 import pytest
@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.special import stdtrit
 
-from designer.core.lsq_intervals import SCALE_SPAN, half_widths
+from designer.core.lsq_intervals import half_widths
 
 
 def qr_half_widths(X, s2, dof):
@@ -60,18 +60,21 @@ def test_central_differences_of_a_nonlinear_model_agree():
         cols.append(-(model(up) - model(dn)) / (2 * h))
     J = np.column_stack(cols)
     d = np.linalg.norm(J, axis=0)
-    assert d.max() / d.min() > SCALE_SPAN         # the scaled branch
+    assert d.max() / d.min() > 1e6         # J^T J's condition from the scales alone > 1e12
     r = y - model(p)
     dof = t.size - 3
     np.testing.assert_allclose(half_widths(J, r @ r / dof, dof), qr_half_widths(J, r @ r / dof, dof), rtol=1e-6)
 
 
-def test_columns_within_the_span_keep_the_unscaled_bits():
-    """Columns within SCALE_SPAN of each other: the product every fit computed before, to the last bit."""
-    J = planted([1.0, 3e-5, 20.0, 2e-2])      # norms spanning 6.7e5
-    s2, dof = 3e-5, J.shape[0] - 4
-    old = stdtrit(dof, 0.975) * np.sqrt(np.clip(np.diag(np.linalg.pinv(J.T @ J) * s2), 0.0, None))
-    np.testing.assert_array_equal(half_widths(J, s2, dof), old)
+@pytest.mark.parametrize("exponents", [[0, 0, -5.75, 0, 0], [0, -5, 0, 0]])
+def test_columns_under_1e6_apart_match_the_qr_route(exponents):
+    """Bug (found by the property below): columns within 1e6 of each other kept the unscaled product, and
+    one column 10^5.75 shorter than the others gave an infinite half-width (the QR route: 3.1e8), one
+    10^5 shorter a half-width 1.4e-5 off. Both are scaled now."""
+    J = planted([10.0 ** e for e in exponents])
+    got, want = half_widths(J, 1.0, 1), qr_half_widths(J, 1.0, 1)
+    assert np.all(np.isfinite(got))
+    np.testing.assert_allclose(got, want, rtol=1e-9)
 
 
 def test_collinear_columns_are_unbounded():
