@@ -223,9 +223,18 @@ class StepTerms:
         y = np.zeros(t.shape, complex)
         tp = np.clip(t, 0.0, None)
         for k, (p, m, c) in enumerate(self.terms):
-            # c[j] multiplies 1/(s - p)^(m - j): t^(m-j-1)/(m-j-1)! e^(p t)
-            poly_t = sum(c[j] * tp ** (m - j - 1) / math.factorial(m - j - 1) for j in range(m))
-            y = y + poly_t * (np.exp(p * tp) if exps is None else exps[k])
+            # c[j] multiplies 1/(s - p)^(m - j): t^(m-j-1)/(m-j-1)! e^(p t). A simple pole's polynomial is
+            # its constant c[0] (t^0/0! is 1 exactly) and the step's pole at 0 has e^(0 t) = 1 exactly: both
+            # taken as scalars, the same numbers without four array passes a term (a plant's analysis
+            # evaluates some 25 steps)
+            poly_t = c[0] if m == 1 else sum(c[j] * tp ** (m - j - 1) / math.factorial(m - j - 1)
+                                             for j in range(m))
+            if exps is not None:
+                y = y + poly_t * exps[k]
+            elif p == 0:
+                y = y + poly_t
+            else:
+                y = y + poly_t * np.exp(p * tp)
         return np.where(t >= 0, y.real, 0.0)
 
 
