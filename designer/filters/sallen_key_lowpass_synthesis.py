@@ -25,8 +25,9 @@ import numpy as np
 from ..core.errors import DesignError
 from ..core.ranges import RANGES, parse_in_range
 
-__all__ = ["DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts", "coefficients", "fn_zeta",
-           "opamp_denominator", "ratios_from_rc", "realizability_notes", "pair_of", "resistors_for_caps", "wn_zeta"]
+__all__ = ["DEFAULT_R3_OHM", "GAIN_TOLERANCE", "JSON_KEYS", "NETWORK_KEYS", "SallenKeyParts", "check_parts", "coefficients", "exact_on_capacitors", "fn_zeta",
+          
+           "opamp_denominator", "ratios_from_rc", "realizability_notes", "pair_of", "resistors_for_caps", "seed_ratios", "wn_zeta"]
 
 #: the result.json key of each field of the record (:meth:`SallenKeyParts.as_dict`), the network first
 JSON_KEYS = {"r1": "R1_ohm", "r2": "R2_ohm", "c1": "C1_f", "c2": "C2_f", "r3": "R3_ohm", "r4": "R4_ohm"}
@@ -428,3 +429,51 @@ def check_parts(parts: SallenKeyParts, name_of=None, text: bool = False) -> Sall
     RANGES["fc_hz"].check(out.fn_hz, f"{name('plant')}: the natural frequency fn of these parts")
     RANGES["zeta"].check(out.zeta, f"{name('plant')}: the damping ratio zeta of these parts")
     return out
+
+
+def exact_on_capacitors(build, fc_hz: float, zeta: float, gain: float, r3=None, r4=None):
+    """The exact design a build rounds (seed 001, IV.5: the ratios m = R1/R2 and n = C2/C1 that hit fc and
+    zeta): the build's capacitors with the resistors that give the target exactly (nearest to the build's
+    R1), or, at unity gain when their ratio is below 1/zeta^2, the nearest capacitor ratio that has such
+    resistors.
+
+    Parameters
+    ----------
+    build : object
+        Has ``r1``, ``c1``, ``c2`` (a search candidate or a :class:`SallenKeyParts`).
+    fc_hz, zeta : float
+        The target.
+    gain : float
+        K, as the gain pair realises it.
+    r3, r4 : float or None
+        The gain pair (None for a follower), carried into the record.
+
+    Returns
+    -------
+    SallenKeyParts or None
+        The exact design; None when no positive resistors exist.
+    """
+    c2 = build.c2 if gain != 1.0 else max(build.c2, unity_gain_c2_min(build.c1, zeta) * (1 + 1e-12))
+    lo, hi = resistors_for_caps(fc_hz, zeta, build.c1, c2, gain)
+    roots = [float(x) for x in (lo, hi) if not math.isnan(float(x))]
+    if not roots:
+        return None
+    r1 = min(roots, key=lambda r: abs(math.log(r / build.r1)))
+    r2 = 1.0 / ((2 * math.pi * fc_hz) ** 2 * build.c1 * c2 * r1)
+    return SallenKeyParts(r1, r2, build.c1, c2, gain, r3, r4)
+
+
+def seed_ratios(parts) -> tuple:
+    """The seed's ratios of a parts record (001, IV.5): m = R1/R2 and n = C2/C1.
+
+    Parameters
+    ----------
+    parts : SallenKeyParts
+        The parts.
+
+    Returns
+    -------
+    tuple of float
+        (m, n).
+    """
+    return parts.r1 / parts.r2, parts.c2 / parts.c1

@@ -522,14 +522,31 @@ def scope_setup(window_s: float, trigger_v: float, channels) -> ScopeSetup:
 
 
 def plant_scope(test: SquareTest, peak_value: float, trough_value: float,
-                settling_time_s: float) -> ScopeSetup:
-    """The plant's bench scope: CH1 the generator (0 -> amplitude), CH2 the output
+                settling_time_s: float, generator: str = N_("generator (R1)")) -> ScopeSetup:
+    """A plant's bench scope: CH1 the generator (0 -> amplitude), CH2 the output
     (its peak and, on the falling edge, its undershoot), 1.2 settling times on screen
-    (at most the half period) after the trigger at half the amplitude."""
+    (at most the half period) after the trigger at half the amplitude.
+
+    Parameters
+    ----------
+    test : SquareTest
+        The square wave.
+    peak_value, trough_value : float
+        The output's extremes over the period per volt of square wave.
+    settling_time_s : float
+        The step's settling time (s; not finite: the whole half period on screen).
+    generator : str
+        CH1's label (the seed's plant names the part the generator drives).
+
+    Returns
+    -------
+    ScopeSetup
+        The settings.
+    """
     a = test.amplitude_v
     window = min(1.2 * settling_time_s, test.half_period_s) if math.isfinite(settling_time_s) \
         else test.half_period_s
-    return scope_setup(window, a / 2, (channel("CH1", N_("generator (R1)"), 0.0, a),
+    return scope_setup(window, a / 2, (channel("CH1", generator, 0.0, a),
                                        channel("CH2", N_("U1 output"), a * trough_value, a * peak_value)))
 
 

@@ -455,8 +455,8 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     """
     from ..core.metrics import step_metrics as metrics
     from ..filters.deck import simulate_ac as ac
-    from .bench import (PERIOD_CHECK, SIGNAL_CHECKS, channel, period_check, recommend_square_wave, rising_step,
-                        scope_setup, signal_checks, sine_check, tolerance_band)
+    from .bench import (PERIOD_CHECK, SIGNAL_CHECKS, period_check, plant_scope, recommend_square_wave, rising_step,
+                        signal_checks, sine_check, tolerance_band)
     from ..core.eseries import TOLERANCE
     topo, amp, a = result.section, result.opamp, result.amplitude_v
     models = result.models or _models(topo, result.values, amp)
@@ -506,9 +506,7 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
             result.notes.append(note)
     # the output over the period, per volt: the rising edge's step s(t), the falling edge's s(inf) - s(t)
     hi, lo = max(float(y.max()), final - float(y.min())), min(float(y.min()), final - float(y.max()), 0.0)
-    window = min(1.2 * settling, test.half_period_s) if math.isfinite(settling) else test.half_period_s
-    result.scope = scope_setup(window, a / 2, (channel("CH1", N_("generator (CH1)"), 0.0, a),
-                                               channel("CH2", N_("U1 output"), a * lo, a * hi)))
+    result.scope = plant_scope(test, hi, lo, settling, N_("generator (CH1)"))
     fn = fig_i["fn_hz"]
     spice = None
     if simulate:

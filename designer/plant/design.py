@@ -58,12 +58,13 @@ from .result import (
 )
 from ..filters.sallen_key_lowpass_synthesis import (
     SallenKeyParts,
+    exact_on_capacitors,
     ratios_from_rc,
     realizability_notes,
-    resistors_for_caps,
+    seed_ratios,
     unity_gain_c2_min,
 )
-from ..filters.sallen_key_lowpass_parts import gain_of, network, part_values, section_of
+from ..filters.sallen_key_lowpass_parts import gain_of, network, part_values, parts_of, section_of
 from ..filters.sallen_key_lowpass_search import scored
 from ..filters.topology import SectionTarget
 from .sourcing import MAX_ERROR, NOTE_ERROR, candidates, part_series
@@ -148,29 +149,14 @@ def choose_parts(spec: PlantSpec) -> Choice:
     best = ranked[0]
     if spec.r is None:
         # solved once, for the target finally aimed at
-        ideal, ratios = _exact_design(best, fc_t, z_t, k, r3, r4)
-    built = SallenKeyParts(best.r1, best.r2, best.c1, best.c2, k, r3, r4)
+        ideal = exact_on_capacitors(best, fc_t, z_t, k, r3, r4)
+        ratios = Ratios() if ideal is None else Ratios(*seed_ratios(ideal))
+    built = parts_of(part_values(best), gain=k, r3=r3, r4=r4)
     if best.worst > MAX_ERROR:
         raise _unreachable(spec, fc_t, best.worst)
     if spec.r is None and best.worst > NOTE_ERROR:
         notes += _bound_notes(spec, fc_t, z_t, best.worst)
     return Choice(built, ideal, ratios, ranked, notes, fc_t, z_t)
-
-
-def _exact_design(best, fc_hz: float, zeta: float, k: float, r3, r4):
-    """The exact design a candidate rounds, and its ratios: the candidate's
-    capacitors with the resistors that hit the target exactly (nearest to the
-    candidate's R1), or, at unity gain when their ratio is below 1/zeta^2, the
-    nearest capacitor ratio that has such resistors. (None, empty ratios)
-    when no positive resistors exist."""
-    c2 = best.c2 if k != 1.0 else max(best.c2, unity_gain_c2_min(best.c1, zeta) * (1 + 1e-12))
-    lo, hi = resistors_for_caps(fc_hz, zeta, best.c1, c2, k)
-    roots = [float(x) for x in (lo, hi) if not math.isnan(float(x))]
-    if not roots:
-        return None, Ratios()
-    r1 = min(roots, key=lambda r: abs(math.log(r / best.r1)))
-    r2 = 1.0 / ((2 * math.pi * fc_hz) ** 2 * best.c1 * c2 * r1)
-    return SallenKeyParts(r1, r2, best.c1, c2, k, r3, r4), Ratios(r1 / r2, c2 / best.c1)
 
 
 def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspice") -> PlantResult:
@@ -203,8 +189,7 @@ def design_plant(spec: PlantSpec, simulate: bool = True, simulator: str = "pyspi
         return PartSource(series, 100 * eseries.TOLERANCE[series])
 
     sourcing = Sourcing(spec.r_series, spec.c_series, {ref: source(ref) for ref in refs})
-    alternatives = [Alternative(c.r1, c.r2, c.c1, c.c2, Figures.against(c.fn_hz, c.zeta, target))
-                    for c in choice.ranked]
+    alternatives = [Alternative(part_values(c), Figures.against(c.fn_hz, c.zeta, target)) for c in choice.ranked]
     result = _analyse("design", target, choice, sourcing, alternatives, amp, spec.amplitude_v, spec.square_hz,
                       simulate, simulator, spec.package)
     if spec.compensate_gbw:
@@ -245,7 +230,7 @@ def analyze_plant(spec: AnalysisSpec, simulate: bool = True, simulator: str = "p
     notes = [f"these parts give fn = {parts.fn_hz:.5g} Hz and zeta = {parts.zeta:.4g} (Q = {parts.q:.4g})"]
     values = part_values(parts)
     labels, r_s, c_s, why = part_series(values, spec.r_series, spec.c_series)
-    choice = Choice(parts, None, Ratios(parts.r1 / parts.r2, parts.c2 / parts.c1), [], notes + why)
+    choice = Choice(parts, None, Ratios(*seed_ratios(parts)), [], notes + why)
     return _analyse("analyze", target, choice, Sourcing(r_s, c_s, labels), [], spec.amp, spec.amplitude_v,
                     spec.square_hz, simulate, simulator, spec.package)
 

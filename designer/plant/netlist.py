@@ -153,9 +153,7 @@ def plant_prbs_deck(parts: SallenKeyParts, opamp: OpAmp, plan, title: str, sampl
     str
         The deck.
     """
-    from .sallenkey import fn_zeta
-    fn, _ = fn_zeta(parts.r1, parts.r2, parts.c1, parts.c2, parts.gain)
-    return prbs_deck(plant_netlist(parts), opamp, plan, title, fn, "input", samples_per_interval)
+    return prbs_deck(plant_netlist(parts), opamp, plan, title, parts.fn_hz, "input", samples_per_interval)
 
 
 def prbs_deck(netlist, opamp: OpAmp, plan, title: str, fn_hz: float, inp: str = "input",

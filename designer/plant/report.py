@@ -245,8 +245,7 @@ ALTERNATIVES_NOTE = N_("Each response is listed once (the same parts at ten time
 
 
 def _alternatives(alternatives):
-    rows = [[i + 1, " / ".join(format_eng(v, u, 3) for v, u in ((a.r1, "Ohm"), (a.r2, "Ohm"), (a.c1, "F"),
-                                                                (a.c2, "F"))),
+    rows = [[i + 1, " / ".join(format_eng(v, "Ohm" if r[0] == "R" else "F", 3) for r, v in a.values.items()),
              _f(a.figures.fn_hz, "Hz"), _n(a.figures.zeta), R.fmt_pct(a.figures.fn_error_pct),
              R.fmt_pct(a.figures.zeta_error_pct)]
             for i, a in enumerate(alternatives)]

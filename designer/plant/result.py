@@ -25,7 +25,7 @@ from ..spice.deck import SquareTest
 from ..spice.simulate import tool_info
 from .bench import BenchPeriod, ScopeSetup, SineCheck, ToleranceBand
 from .circuit import DEFAULT_TOPOLOGY
-from .sallenkey import JSON_KEYS, SallenKeyParts
+from .sallenkey import KEY_OF, SallenKeyParts
 
 __all__ = ["PlantResult"]
 
@@ -93,17 +93,15 @@ class Ratios:
 
 @dataclass(frozen=True)
 class Alternative:
-    """One of the best E-series combinations, and where it lands."""
+    """One of the best E-series combinations (``values``: the network's designator -> value, ohm and farad), and
+    where it lands."""
 
-    r1: float
-    r2: float
-    c1: float
-    c2: float
+    values: dict
     figures: Figures
 
     def to_dict(self) -> dict:
         f = self.figures
-        return {**{key: getattr(self, attr) for attr, key in JSON_KEYS.items() if hasattr(self, attr)},
+        return {**{KEY_OF[r]: v for r, v in self.values.items()},
                 "fn_hz": f.fn_hz, "zeta": f.zeta, "fn_error_pct": f.fn_error_pct, "zeta_error_pct": f.zeta_error_pct}
 
 

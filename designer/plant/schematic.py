@@ -57,28 +57,28 @@ def draw_plant(board, opamp, sheet: Sheet | None = None, origin=(0.0, 0.0), inp_
     section = section_of(with_gain=amp.inn != amp.out)
     # the section's parts in its declared order: the network (input R, R to +in, C to ground, feedback C),
     # then the gain pair (to ground, feedback)
-    r1, r2, c1, c2, *gain = (n.part(section.prefixed(r, ref_prefix)) for r in section.designators)
+    r_in, r_pos, c_gnd, c_fb, *gain = (n.part(section.prefixed(r, ref_prefix)) for r in section.designators)
     pin = (x0, y0)
     a = (x0 + 3.0, y0)
     b = (x0 + 6.0, y0)
-    s.net_label(pin, r1.a, inp_label, loc="left")
-    if r1.a in probes:
-        s.probe(pin, probes[r1.a])
-    s.part(r1, pin, a)
-    s.part(r2, a, b)
+    s.net_label(pin, r_in.a, inp_label, loc="left")
+    if r_in.a in probes:
+        s.probe(pin, probes[r_in.a])
+    s.part(r_in, pin, a)
+    s.part(r_pos, a, b)
     s.dot(a)
     pts = s.opamp(amp, unit, board.package.part, (b[0] + 1.8, b[1]), plus_on_top=True)
     s.wire(b, pts["inp"])
     s.dot(b)
     gnd1 = (b[0], b[1] - 2.5)
-    s.part(c1, b, gnd1, label_loc="top")
+    s.part(c_gnd, b, gnd1, label_loc="top")
     s.ground(gnd1)
     out = pts["out"]
     o = (out[0] + 1.0, out[1])
     s.wire(out, o)
     top = a[1] + 2.2
     s.wire(a, (a[0], top))
-    s.part(c2, (a[0], top), (o[0], top))
+    s.part(c_fb, (a[0], top), (o[0], top))
     s.wire((o[0], top), o)
     s.dot(o)
     if amp.out in probes:
