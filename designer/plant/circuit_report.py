@@ -110,8 +110,9 @@ def _targets(result) -> list:
     step = result.steps["opamp"]
     if step is not None:
         out.append(R.text(_("step ({opamp}): overshoot {os} %, peak time {tp}, 2 % settling {ts}").format(
-            opamp=result.opamp.name, os=f"{step['overshoot_pct']:.3g}", tp=_f(step['peak_time_s'], 's'),
-            ts=_f(step['settling_time_s'], 's'))))
+            # a step without a peak (no overshoot) has no peak time: worded as the seed plant's sheet words it
+            opamp=result.opamp.name, os=f"{step['overshoot_pct']:.3g}", tp=R.fmt_time(step['peak_time_s']),
+            ts=R.fmt_time(step['settling_time_s']))))
     return out
 
 

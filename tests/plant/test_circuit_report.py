@@ -144,3 +144,14 @@ def test_a_sections_monte_carlo_is_on_its_sheet_and_in_its_summary(tmp_path):
     text = summary_text(result)
     assert "Monte Carlo: 60 samples" in text and "natural frequency fn (fn_hz): nominal" in text
     assert "Worst case over the tolerance box" in text
+
+
+def test_a_step_without_a_peak_words_its_peak_time():
+    """A first-order section's step has no peak: its sheet says "peak time n/a", as the seed plant's sheet
+    says it (it showed a bare "-")."""
+    result = _plant("rc-lowpass")
+    assert result.steps["opamp"]["peak_time_s"] is None
+    _title, page = _sheet(result, "en")
+    assert "peak time n/a," in page and "peak time -," not in page
+    _title, page = _sheet(result, "es")
+    assert f"{catalogue('es')['n/a']}," in page

@@ -1019,6 +1019,10 @@ def test_the_plant_pages_topology_menu_designs_an_mfb_lowpass(page, server):
     # a first-order section: no zeta asked
     assert after(page, lambda: menu.select_option("rc-lowpass"), timeout=120000) == "done"
     assert not page.locator("input[name=zeta]").is_visible() and "zeta=" not in page.url
+    # the heading's T(s) is the chosen section's (it once stayed the second-order low-pass's for every section)
+    assert page.inner_text("#plant-tf") == "Plant: T(s) = K wn / (s + wn)"
+    assert after(page, lambda: menu.select_option("mfb-bandpass"), timeout=120000) == "done"
+    assert page.inner_text("#plant-tf") == "Plant: T(s) = K 2 ζ wn s / (s² + 2 ζ wn s + wn²)"
     # back to the seed's circuit: its own panels
     assert after(page, lambda: menu.select_option("sallen-key-lowpass"), timeout=120000) == "done"
     assert page.locator("#step-section").is_visible() and page.locator("#topid").is_visible()

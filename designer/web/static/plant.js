@@ -8,12 +8,21 @@ const status = document.getElementById("status");
 const SEED_TOPOLOGY = "sallen-key-lowpass";   // the seed's circuit: its own pipeline (step, bench, schematic)
 let topologies = [];
 
+// The plant's transfer function by the section's response and order (the heading once showed the low-pass's
+// whatever section was chosen): the target's fn (wn = 2 pi fn), zeta and gain K in the section's form.
+const PLANT_TF = {
+  "lowpass 2": "K wn² / (s² + 2 ζ wn s + wn²)", "highpass 2": "K s² / (s² + 2 ζ wn s + wn²)",
+  "bandpass 2": "K 2 ζ wn s / (s² + 2 ζ wn s + wn²)", "lowpass 1": "K wn / (s + wn)", "highpass 1": "K s / (s + wn)",
+};
+
 // The chosen topology's declared parts (designator, R or C, role), as the registry lists them; a first-order
 // section takes no zeta (its field hidden: not sent).
 function showTopology() {
   const name = form.elements["topology"].value;
   const topo = topologies.find(t => t.name === name);
   if (!topo) return;
+  const tf = PLANT_TF[`${topo.kind} ${topo.order}`];
+  if (tf) document.getElementById("plant-tf").textContent = D.t("Plant: T(s) = {tf}", {tf});
   const zeta = form.elements["zeta"].closest("label");
   zeta.hidden = topo.order === 1;
   document.getElementById("topology-parts").replaceChildren(
