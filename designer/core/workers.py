@@ -31,14 +31,17 @@ from . import lifetime
 __all__ = ["Worker", "close_all", "death_of", "run_tasks"]
 
 
-def _serve(conn, other_end, parent_pid, work, setup) -> None:
-    """A worker's loop: receive a task, send back its result; None ends it."""
+def _serve(conn, other_end, parent_pid, work, setup, queued: bool = False) -> None:
+    """A worker's loop: receive a task, send back its result; None ends it. ``queued``: the results go
+    out from a thread of their own (:func:`_sender`), so that the loop keeps reading tasks while a
+    result waits for the parent to read it."""
     os.setpgrp()   # its own process group: the parent kills it with any ngspice it started
     lifetime.die_with_parent(parent_pid)   # and SIGKILLed with the parent, whatever kills that
     lifetime.reset_in_child()
     other_end.close()   # the parent's end: held here too, its closing at the parent's death would go unseen
     if setup is not None:
         setup()
+    send = _sender(conn) if queued else conn.send
     while True:
         try:
             task = conn.recv()
@@ -50,7 +53,45 @@ def _serve(conn, other_end, parent_pid, work, setup) -> None:
             result = ("ok", work(task))
         except Exception as exc:   # a bug, not a verdict: reported as this task's error, the worker lives on
             result = ("crash", f"{type(exc).__name__}: {exc}")
-        conn.send(result)
+        send(result)
+
+
+def _sender(conn):
+    """``send(obj)`` for a worker whose parent sends it tasks without waiting for their answers (the
+    renderer's pictures): the object is pickled here and its bytes written by a thread of their own.
+
+    A pipe holds some 200 kB each way: a parent sending a large task (a cascade plant's loop waveforms)
+    while the worker sends a large answer (a sheet's pictures) once left both blocked in ``send`` for good,
+    each waiting for the other to read (design-pid on a 4th-order cascade hung at its sheet). The thread
+    blocks instead, and the loop reads on.
+
+    Parameters
+    ----------
+    conn : multiprocessing.connection.Connection
+        The worker's end.
+
+    Returns
+    -------
+    callable
+        ``send(obj)``, which never blocks.
+    """
+    import queue
+    import threading
+
+    from multiprocessing.reduction import ForkingPickler
+    out = queue.SimpleQueue()
+
+    def write():
+        while True:
+            data = out.get()
+            try:
+                conn.send_bytes(data)
+            except OSError:   # the parent is gone: nothing to answer
+                return
+
+    threading.Thread(target=write, name="worker-replies", daemon=True).start()
+    # pickled here, in the loop's thread (as Connection.send pickles): the thread only writes bytes
+    return lambda obj: out.put(bytes(ForkingPickler.dumps(obj)))
 
 
 class Worker:
@@ -60,9 +101,10 @@ class Worker:
     workers of its own (the web page's workers run check-design, which does);
     it dies with its parent all the same (:func:`.lifetime.die_with_parent`)."""
 
-    def __init__(self, ctx, work, setup=None, daemon: bool = True):
+    def __init__(self, ctx, work, setup=None, daemon: bool = True, queued: bool = False):
         self.conn, child = ctx.Pipe()
-        self.proc = ctx.Process(target=_serve, args=(child, self.conn, os.getpid(), work, setup), daemon=daemon)
+        self.proc = ctx.Process(target=_serve, args=(child, self.conn, os.getpid(), work, setup, queued),
+                                daemon=daemon)
         self.proc.start()
         child.close()
         self.task = None

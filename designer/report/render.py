@@ -23,6 +23,7 @@ import multiprocessing
 import os
 import pickle
 import time
+import warnings
 from contextlib import contextmanager
 
 from ..core import lifetime
@@ -84,7 +85,9 @@ def start(preload=()) -> None:
     if _worker is not None:
         return
     try:
-        _worker = Worker(multiprocessing.get_context("fork"), _call, functools.partial(_warm, tuple(preload)))
+        # queued: the caller sends its pictures without reading the answers in between
+        _worker = Worker(multiprocessing.get_context("fork"), _call, functools.partial(_warm, tuple(preload)),
+                         queued=True)
     except OSError:
         _worker = None
     else:
@@ -206,7 +209,12 @@ def _many(calls) -> list:
     me = os.getpid()
     for fn, args in calls[1:]:
         r, w = os.pipe()
-        pid = os.fork()
+        with warnings.catch_warnings():
+            # the renderer's answers go out from a thread of their own (core.workers, queued): Python 3.12+
+            # warns at any fork of a process with threads, for locks a thread may hold; that thread only
+            # writes bytes to the pipe, which the helper never touches
+            warnings.simplefilter("ignore", DeprecationWarning)
+            pid = os.fork()
         if pid == 0:   # the helper: its answer through its own pipe, then gone
             os.close(r)
             try:

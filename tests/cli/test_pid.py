@@ -156,3 +156,20 @@ def test_unwritable_output_directory(tmp_path, capsys):
     blocker.write_text("x")
     code, err = _main(capsys, "--plant-fc", "3500", "--plant-zeta", "0.2", "--no-sim", "--out", str(blocker / "sub"))
     assert code == 2 and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.spice
+def test_a_cascade_plants_pid_writes_its_bundle(tmp_path):
+    """Bug: design-pid on a 4th-order design-filter cascade hung at its sheet for good (the renderer and the
+    command each blocked sending to the other, core.workers); it writes the whole bundle now."""
+    f = subprocess.run([script("design-filter"), "--family", "butterworth", "--order", "4", "--fc", "1k",
+                        "--opamp", "TL072", "--no-sim", "--name", "f4", "--out", str(tmp_path)],
+                       capture_output=True, text=True, timeout=300)
+    assert f.returncode == 0, f.stderr
+    p = subprocess.run([script("design-pid"), "--plant-json", str(tmp_path / "reports" / "f4" / "result.json"),
+                        "--name", "p4", "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    bundle = tmp_path / "reports" / "p4"
+    assert {"result.json", "build-sheet.html", "schematic.png", "closed-loop.png"} <= {x.name for x in
+                                                                                        bundle.iterdir()}
+    assert json.loads((bundle / "result.json").read_text())["closed_loop"]["spice"] is not None

@@ -48,3 +48,29 @@ def test_done_is_called_once_per_task_as_it_finishes_lost_ones_included():
                     done=lambda i, r: seen.append((i, r)))
     assert out == ["lost", "aa", "bb", "cc"]
     assert sorted(seen) == [(0, "lost"), (1, "aa"), (2, "bb"), (3, "cc")]
+
+
+def _echo_big(task):
+    return b"y" * len(task)
+
+
+def test_a_queued_worker_reads_tasks_while_a_large_answer_waits():
+    """Bug: the renderer's parent sends its pictures' tasks without reading the answers in between; a task and
+    an answer each larger than the pipe's buffer (~200 kB each way) left both processes blocked in send for
+    good (design-pid on a 4th-order cascade plant hung at its sheet). A queued worker writes its answers from
+    a thread, so the parent's sends complete and every answer arrives."""
+    import multiprocessing
+
+    from designer.core.workers import Worker
+    w = Worker(multiprocessing.get_context("fork"), _echo_big, queued=True)
+    try:
+        tasks = [b"x" * (2_000_000 + k) for k in range(4)]
+        start = time.monotonic()
+        for task in tasks:      # all sent before any answer is read, as the renderer's caller does
+            w.conn.send(task)
+        for task in tasks:
+            assert w.conn.poll(60), "no answer: the worker and its parent are blocked on each other"
+            assert w.conn.recv() == ("ok", b"y" * len(task))
+        assert time.monotonic() - start < 60
+    finally:
+        w.kill()
