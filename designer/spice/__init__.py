@@ -14,6 +14,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     "model_step": ("DURATION_SETTLING_TIMES", "MAX_POINTS", "MIN_CODES", "default_duration_s", "default_step_time_s",
                    "simulate_step", "step_deck"),
     "simulate": ("DEFAULT_TIMEOUT_S", "NgspiceCli", "PySpiceShared", "error_lines", "get_simulator", "measure_names",
-                 "ngspice_version", "private_env", "read_raw", "tool_info", "with_raw_output"),
+                 "ngspice_version", "private_env", "read_raw", "recorded_command", "tool_info", "with_raw_output"),
     "trust": ("MAX_TOTAL_BYTES", "check_deck_text", "expand_deck"),
 })

@@ -20,6 +20,7 @@ ngspice reports an error line or produces no data.
 
 from __future__ import annotations
 
+import contextvars
 import os
 import re
 import shutil
@@ -27,6 +28,7 @@ import subprocess
 import tempfile
 import sys
 import threading
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -36,7 +38,7 @@ from ..core import lifetime
 from ..core.errors import DeckError, DesignError, SimulatorError
 
 __all__ = ["DEFAULT_TIMEOUT_S", "NgspiceCli", "PySpiceShared", "error_lines", "get_simulator", "measure_names",
-           "ngspice_version", "private_env", "read_raw", "tool_info", "with_raw_output"]
+           "ngspice_version", "private_env", "read_raw", "recorded_command", "tool_info", "with_raw_output"]
 
 INSTALL_HINT = "install it with: apt-get install ngspice libngspice0-dev (or run `make setup`)"
 BACKENDS = ("pyspice", "ngspice-cli")
@@ -504,6 +506,33 @@ def _shared_version() -> str | None:
     return None if version is None else str(version)
 
 
+#: the command line the results made in this context record, when it is not this process's own (the web
+#: page's request stands for one: a record, never parsed); None: ``sys.argv``
+_COMMAND = contextvars.ContextVar("recorded_command", default=None)
+
+
+@contextmanager
+def recorded_command(argv):
+    """``with recorded_command(argv):`` the results made in the block record ``argv`` as their command line
+    (:func:`tool_info`'s default) instead of this process's ``sys.argv``, which stays untouched (the web
+    page's check job once swapped ``sys.argv`` itself, a global of the whole worker).
+
+    Parameters
+    ----------
+    argv : list of str
+        The command line recorded.
+
+    Yields
+    ------
+    None
+    """
+    token = _COMMAND.set(list(argv))
+    try:
+        yield
+    finally:
+        _COMMAND.reset(token)
+
+
 def tool_info(simulator: str | None, argv=None) -> dict:
     """What produced a result, for ``result.json``'s ``tool`` and the JUnit
     properties: this tool's name and version, Python's, ngspice's (None
@@ -514,7 +543,7 @@ def tool_info(simulator: str | None, argv=None) -> dict:
     simulator : str or None
         The backend's name; None: no simulation.
     argv : list of str, optional
-        The command line; default ``sys.argv``.
+        The command line; default the one :func:`recorded_command` set, else ``sys.argv``.
 
     Returns
     -------
@@ -522,6 +551,8 @@ def tool_info(simulator: str | None, argv=None) -> dict:
         ``name``, ``version``, ``python``, ``ngspice``, ``simulator`` and ``argv``.
     """
     from .. import __version__
+    if argv is None:
+        argv = _COMMAND.get()
     return {"name": "designer", "version": __version__, "python": sys.version.split()[0],
             "ngspice": ngspice_version(simulator), "simulator": simulator,
             "argv": list(sys.argv if argv is None else argv)}

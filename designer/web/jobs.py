@@ -21,7 +21,6 @@ import json
 import math
 import os
 import signal
-import sys
 import tempfile
 from contextlib import contextmanager
 
@@ -39,6 +38,7 @@ from ..filters.alternatives import design_alternatives
 from ..filters.design import design as design_filter
 from ..tolerance import filter as filter_tolerance
 from ..core.figure_titles import figure_shown
+from ..spice.simulate import recorded_command
 
 __all__ = ["AXES", "BODE_POINTS", "BOM_COLUMNS", "LIBRARY", "SWALLOWING_MODULES", "Superseded", "TRACES",
            "TRACE_POINTS", "analyze_pid_task", "analyze_plant_task", "bom_shown", "bundle_zip", "check_task",
@@ -617,22 +617,20 @@ def check_task(fields: dict, want: str = "check", tmp: str | None = None) -> dic
         options, lang = split_language(fields.get("options") or {})
     except DesignError as exc:
         return {"status": 2, "error": f"check-design: error: {exc}", "json": None, "field": None, "label": None}
-    argv0 = sys.argv
     with language(lang), temporaries_in(tmp):
         try:
             rq = check_request(options)
             # each result's tool.argv: the command line this request stands for (a record, never parsed)
-            sys.argv = [rq.argv[0], *specs, *rq.argv[1:], "--junit", os.path.join(tmp, "junit.xml"), "--summary",
-                        os.path.join(tmp, "summary.md"), "--out", os.path.join(tmp, "out"), "--root", inside]
+            argv = [rq.argv[0], *specs, *rq.argv[1:], "--junit", os.path.join(tmp, "junit.xml"), "--summary",
+                    os.path.join(tmp, "summary.md"), "--out", os.path.join(tmp, "out"), "--root", inside]
             before = files_in(inside)
-            run = check_specs(specs, rq.simulator, update_golden=rq.update_golden, root=inside,
-                              out=os.path.join(tmp, "out"))
+            with recorded_command(argv):
+                run = check_specs(specs, rq.simulator, update_golden=rq.update_golden, root=inside,
+                                  out=os.path.join(tmp, "out"))
         except DesignError as exc:
             text, field = check_message(exc)
             return {"status": 2, "error": f"check-design: error: {text}", "json": None, "field": field,
                     "label": _(CHECK[field].label) if field else None}
-        finally:
-            sys.argv = argv0
         # the cases' typed messages (a parameter they carry) in the page's words; the junit.xml as check-design's
         results, said = run.results(), {}
         for spec, outcome in zip(results, run.outcomes):

@@ -6,7 +6,8 @@ from designer.core.errors import DesignError
 from designer.plant.netlist import plant_deck
 from designer.plant.sallenkey import SallenKeyParts
 from designer.spice.deck import SquareTest
-from designer.spice.simulate import NgspiceCli, error_lines, get_simulator, read_raw, with_raw_output
+from designer.spice.simulate import (NgspiceCli, error_lines, get_simulator, read_raw, recorded_command, tool_info,
+                                     with_raw_output)
 
 pytestmark = pytest.mark.spice
 
@@ -127,3 +128,18 @@ def test_unreadable_raw_file_is_one_clear_error(deck, tmp_path, damage):
         read_raw(bad)
     assert "raw file" in str(e.value) and "\n" not in str(e.value)
     assert read_raw(good)["time"].size > 100
+
+
+def test_a_recorded_command_is_the_results_record_and_leaves_sys_argv():
+    """The web page's check job records the command line its request stands for by recorded_command, where it
+    once swapped sys.argv (a global of the whole worker); nested, each block its own; an explicit argv wins."""
+    import sys
+    before = list(sys.argv)
+    assert tool_info(None)["argv"] == before
+    with recorded_command(["check-design", "a.yaml"]):
+        assert tool_info(None)["argv"] == ["check-design", "a.yaml"] and sys.argv == before
+        with recorded_command(["check-design", "b.yaml"]):
+            assert tool_info(None)["argv"] == ["check-design", "b.yaml"]
+        assert tool_info(None)["argv"] == ["check-design", "a.yaml"]
+        assert tool_info(None, ["x"])["argv"] == ["x"]
+    assert tool_info(None)["argv"] == before

@@ -420,6 +420,9 @@ def test_check_takes_a_form_too(server):
     status, got = server.post_json("/api/check", body, headers=headers)
     assert status == 200, got
     assert got["specs"][0]["status"] == "pass" and got["specs"][0]["tool"]["simulator"] == "ngspice-cli"
+    # its record: the command line the request stands for (the worker's own sys.argv left alone)
+    argv = got["specs"][0]["tool"]["argv"]
+    assert argv[0] == "check-design" and argv[1].endswith("ladder2.yaml") and "--simulator=ngspice-cli" in argv
 
 
 def test_analyze_plant_and_the_pid_sheet(server):
