@@ -107,8 +107,8 @@ def figure_range(name: str, lo: float, hi: float, digits: int = 5) -> str:
     ----------
     name : str
         The figure's id.
-    lo, hi : float
-        The range's ends.
+    lo, hi : float or None
+        The range's ends; None when nothing has the figure (``... zeta: no value``).
     digits : int
         Significant digits.
 
@@ -119,6 +119,8 @@ def figure_range(name: str, lo: float, hi: float, digits: int = 5) -> str:
     """
     title, _unit = figure_shown(name)
     head = _headed(name, title)
+    if lo is None or hi is None:
+        return f"{head}: no value"
     return f"{head}: {format_figure(name, lo, digits)} to {format_figure(name, hi, digits)}"
 
 

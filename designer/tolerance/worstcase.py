@@ -40,7 +40,8 @@ class Extreme:
 
 @dataclass(frozen=True)
 class WorstCase:
-    """figure -> (min Extreme, max Extreme), and the number of corners evaluated."""
+    """figure -> (min Extreme, max Extreme), and the number of corners evaluated; a figure no corner has is
+    in ``missing`` only."""
 
     extremes: dict
     corners: int
@@ -55,7 +56,9 @@ class WorstCase:
         return {"corners": self.corners, "method": self.method,
                 **{k: {"min": lo.to_dict(), "max": hi.to_dict(),
                        **({"missing_corners": self.missing[k]} if k in self.missing else {})}
-                   for k, (lo, hi) in self.extremes.items()}}
+                   for k, (lo, hi) in self.extremes.items()},
+                **{k: {"min": None, "max": None, "missing_corners": n} for k, n in self.missing.items()
+                   if k not in self.extremes}}
 
     def summary_lines(self) -> list:
         what = "corners" if self.method.startswith("every") else "corners the sensitivities point to"
@@ -66,6 +69,8 @@ class WorstCase:
                        + ("" if k not in self.missing else
                           f" (no value at {self.missing[k]} of {self.corners} corners: over the builds that have"
                           " it, and may be exceeded near the others)"))
+        out += [f"  {figure_range(k, None, None)} at any of the {self.corners} corners"
+                for k in self.missing if k not in self.extremes]
         return out
 
 
@@ -129,6 +134,10 @@ def worst_case(evaluate, nominal: dict, tol: dict, figures=FIGURES, max_corners:
         v = np.asarray(at_corners[fig], float)
         if not np.isfinite(v).all():
             missing[fig] = int(np.count_nonzero(~np.isfinite(v)))
+        if missing.get(fig) == len(v):
+            # no corner has it (a first-order section's peak time): nothing to start a search from, and
+            # L-BFGS-B on an objective inf everywhere stepped to NaN deviations (LinAlgError in the engine)
+            continue
         pair = []
         for sign in (1.0, -1.0):                      # min, then max
             score = np.where(np.isfinite(v), sign * v, np.inf)
@@ -136,6 +145,8 @@ def worst_case(evaluate, nominal: dict, tol: dict, figures=FIGURES, max_corners:
             best, x_best, corner = float(v[k]), signs[k], True
 
             def f(x, sign=sign):
+                if not np.isfinite(x).all():    # a step from a NaN gradient: no build to evaluate there
+                    return np.inf
                 y = float(np.asarray(evaluate(values(x))[fig], float)[0])
                 return sign * y if np.isfinite(y) else np.inf
 

@@ -97,3 +97,18 @@ def test_a_figure_missing_in_part_of_the_box_is_searched_without_warnings():
     line = next(t for t in wc.summary_lines() if "peak_time_s" in t)
     assert line.endswith(f"(no value at {wc.missing['peak_time_s']} of 64 corners: over the builds that have it, "
                          "and may be exceeded near the others)")
+
+
+def test_a_figure_no_corner_has_is_said_and_not_searched():
+    # a first-order section has no peak anywhere: the search on an objective inf everywhere stepped to NaN
+    # deviations and the engine raised LinAlgError (design-plant --topology rc-lowpass --fc 100 --worst-case)
+    from designer.plant import circuit
+    nominal, tol = {"R1": 16e3, "C1": 100e-9}, {"R1": 0.05, "C1": 0.10}
+    context = ("rc-lowpass", opamps.get("LM741"))
+    wc = worst_case(lambda v: circuit.evaluate(context, v), nominal, tol)
+    assert wc.missing == {"zeta": 4, "q": 4, "peak_time_s": 4} and set(wc.extremes) == {"fn_hz", "overshoot_pct"}
+    signs = np.array(list(itertools.product((-1.0, 1.0), repeat=2)))
+    fn = circuit.evaluate(context, {r: nominal[r] * (1 + tol[r] * signs[:, k]) for k, r in enumerate(nominal)})["fn_hz"]
+    assert (wc.extremes["fn_hz"][0].value, wc.extremes["fn_hz"][1].value) == (fn.min(), fn.max())
+    assert wc.to_dict()["peak_time_s"] == {"min": None, "max": None, "missing_corners": 4}
+    assert "  time to the first peak (peak_time_s): no value at any of the 4 corners" in wc.summary_lines()
