@@ -165,8 +165,9 @@ def _add_plant_options(p):
                    help=f"with --plant-topology: every part of the section, e.g. R1=10k C1=100n "
                         f"(resistors {_r('resistor_ohm')}, capacitors {_r('capacitor_f')})")
     g.add_argument("--plant-json", metavar="FILE",
-                   help="a result.json written by design-plant or analyze-plant (its 'built' parts, checked "
-                        "against the same ranges), or by design-filter (its stages as a cascade plant)")
+                   help="a result.json written by design-plant or analyze-plant (the seed's plant: its 'built' "
+                        "parts, checked against the same ranges; a --topology section: its section and parts), or "
+                        "by design-filter (its stages as a cascade plant)")
     g.add_argument("--plant-tf", metavar="MODEL",
                    help="a model typed by hand, e.g. \"K=2 tau=1m theta=200u\" (forms below)")
     g.add_argument("--plant-model", metavar="FILE",

@@ -107,8 +107,8 @@ def figure_range(name: str, lo: float, hi: float, digits: int = 5) -> str:
     ----------
     name : str
         The figure's id.
-    lo, hi : float
-        The range's ends.
+    lo, hi : float or None
+        The range's ends; None when nothing has the figure (``... zeta: no value``).
     digits : int
         Significant digits.
 
@@ -119,6 +119,8 @@ def figure_range(name: str, lo: float, hi: float, digits: int = 5) -> str:
     """
     title, _unit = figure_shown(name)
     head = _headed(name, title)
+    if lo is None or hi is None:
+        return f"{head}: no value"
     return f"{head}: {format_figure(name, lo, digits)} to {format_figure(name, hi, digits)}"
 
 
@@ -134,8 +136,8 @@ def figure_spread(name: str, nominal: float, mean: float, std: float, lo: float,
         The figure's id.
     nominal, mean, std : float
         The nominal build's value, the builds' mean and standard deviation.
-    lo, hi : float
-        The 2.5 % and 97.5 % percentiles.
+    lo, hi : float or None
+        The 2.5 % and 97.5 % percentiles; None when no build has the figure (every build's NaN).
     digits : int
         Significant digits (the standard deviation's: four).
 
@@ -148,5 +150,9 @@ def figure_spread(name: str, nominal: float, mean: float, std: float, lo: float,
     head = _headed(name, title)
     def shown(v, d=digits):
         return format_figure(name, v, d)
+    if lo is None or hi is None:
+        # no build has the figure (a SPICE step clipped at the op-amp's swing never settles to its gain, so
+        # every build's fn, zeta and times are NaN): say so rather than print a mean and percentiles of nothing
+        return f"{head}: nominal {shown(nominal)}, no build has this figure"
     return (f"{head}: nominal {shown(nominal)}, mean {shown(mean)}, std {shown(std, 4)}, "
             f"95 % of builds {shown(lo)} to {shown(hi)}")

@@ -209,4 +209,7 @@ def format_figure(name: str, value: float, digits: int = 4) -> str:
     unit = figure_unit(name)
     if unit in ("Hz", "s"):
         return format_eng(value, unit, digits)
+    if value is None or math.isnan(value):
+        # as format_eng words it: a figure no build has (a clipped SPICE step's zeta) is not a number to show
+        return "n/a"
     return f"{value:.{digits}g}" + (f" {unit}" if unit else "")

@@ -539,8 +539,10 @@ def optimize_model_loop(spec, model, amp, table) -> ModelOptimizeResult:
     pm_min, gm_min, ms_max = limits(spec)
     starts = [r for r in table if r.figures is not None and r.figures.margins.stable and r.figures.step is not None]
     if not starts:
+        # a rule's refusal already names the rule ("simc: the model has complex poles .."): not twice
         raise DesignError("optimize needs a rule whose loop is stable to start from, and none is: "
-                          + "; ".join(f"{r.rule}: {r.reason or 'unstable'}" for r in table), param="tuning")
+                          + "; ".join((r.reason if (r.reason or "").startswith(f"{r.rule}: ")
+                                       else f"{r.rule}: {r.reason or 'unstable'}") for r in table), param="tuning")
 
     def meets(f):
         m = f.margins

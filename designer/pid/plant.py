@@ -469,7 +469,8 @@ def circuit_plant(topology, values, *, source: str = "parts", name: str = "plant
 
 def circuit_from_json(data: dict, *, name: str = "result") -> Plant:
     """The circuit of a parsed ``design-filter`` result (its ``stages``: each
-    ``topology`` and ``parts``), as a :class:`Plant`.
+    ``topology`` and ``parts``), or of a ``design-plant``/``analyze-plant --topology`` result (its one
+    section: ``topology`` and ``parts``, each designator -> ``{value: ..}``), as a :class:`Plant`.
 
     Parameters
     ----------
@@ -489,6 +490,20 @@ def circuit_from_json(data: dict, *, name: str = "result") -> Plant:
         One line naming the file and the key at fault.
     """
     where = name
+    if "stages" not in data and data.get("mode") in ("design", "analyze"):
+        # a section's plant: its one stage, the parts as its sheet lists them (the seed's Sallen-Key plant,
+        # with 'built' and no 'parts', is read by plant_spec.plant_from_json instead)
+        parts = data.get("parts")
+        if not (isinstance(data.get("topology"), str) and isinstance(parts, dict)
+                and all(isinstance(v, dict) and "value" in v for v in parts.values())):
+            raise DesignError(f"{where}: a design-plant or analyze-plant result needs topology (a name) and parts "
+                              "(designator -> {value})")
+        tool = "design-plant" if data["mode"] == "design" else "analyze-plant"
+        try:
+            return circuit_from_cascade([(data["topology"], {k: v["value"] for k, v in parts.items()})],
+                                        source=f"{tool} result", name=where)
+        except DesignError as exc:
+            raise DesignError(str(exc)) from None
     stages = data.get("stages")
     if not isinstance(stages, list) or not stages:
         raise DesignError(f"{where}: a design-filter result needs stages (each with topology and parts)")

@@ -258,8 +258,8 @@ def _checked(parts: SallenKeyParts, names: dict) -> SallenKeyParts:
 
 
 def filter_plant_from_json(path):
-    """The circuit of a ``design-filter`` result.json as a
-    :class:`~designer.pid.plant.Plant`, or None for any other file (read then
+    """The circuit of a ``design-filter`` result.json (its cascade) or of a ``design-plant``/``analyze-plant
+    --topology`` one (its section) as a :class:`~designer.pid.plant.Plant`, or None for any other file (read then
     by :func:`plant_from_json`, whose refusals name what it accepts).
 
     Parameters
@@ -276,7 +276,12 @@ def filter_plant_from_json(path):
         data = read_result(path, "{plant_json}")
     except DesignError:
         return None
-    if not (isinstance(data, dict) and data.get("tool") == "design-filter"):
+    if not isinstance(data, dict):
+        return None
+    # a design-plant/analyze-plant --topology result is a section's plant (its 'parts'); the seed's
+    # Sallen-Key plant has 'built' parts and no 'parts', and stays plant_from_json's
+    section = data.get("mode") in ("design", "analyze") and isinstance(data.get("topology"), str) and "parts" in data
+    if not (data.get("tool") == "design-filter" or section):
         return None
     from .plant import circuit_from_json
     try:

@@ -196,7 +196,16 @@ def worst_case_blocks(wc) -> list:
     head = _("Worst case over the tolerance box: {corners} corners evaluated ({method}); each part at "
              "+tol or -tol of its nominal, in tolerances where an extreme lies inside.").format(corners=wc.corners,
                                                                                                 method=translated(wc.method))
-    return [R.text(head), R.table([_("figure"), _("extreme"), _("value"), _("where (parts)")], rows)]
+    blocks = [R.text(head), R.table([_("figure"), _("extreme"), _("value"), _("where (parts)")], rows)]
+    missing = getattr(wc, "missing", {})
+    if missing:
+        # a figure missing at some corners (no peak where a build is overdamped) has extremes only over the
+        # builds that have it: near the others it may go further (a peak time grows without bound as zeta nears 1)
+        blocks.append(R.text(_("No value at some corners ({figures}): those extremes are over the builds that have "
+                               "the figure, and may be exceeded near the others.").format(
+            figures=", ".join(_("{figure} at {n} of {corners}").format(figure=_name(k), n=n, corners=wc.corners)
+                              for k, n in missing.items()))))
+    return blocks
 
 
 def section(result, with_images: bool = True, worst: bool = False) -> list:

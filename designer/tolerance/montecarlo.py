@@ -134,7 +134,8 @@ class MonteCarlo:
         for k in ("fn_hz", "zeta", "overshoot_pct"):
             s = mc.stats[k]
             p = s.percentiles
-            out.append("  " + figure_spread(k, s.nominal, s.mean, s.std, p[2.5], p[97.5]))
+            # percentiles are empty when no build has the figure (stats.figure_stats leaves NaN out)
+            out.append("  " + figure_spread(k, s.nominal, s.mean, s.std, p.get(2.5), p.get(97.5)))
         return out + self.yield_lines()
 
     def yield_lines(self) -> list:

@@ -10,6 +10,7 @@ can peak inside the box. The tests check the result against a brute-force grid.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from dataclasses import dataclass
 
@@ -39,23 +40,37 @@ class Extreme:
 
 @dataclass(frozen=True)
 class WorstCase:
-    """figure -> (min Extreme, max Extreme), and the number of corners evaluated."""
+    """figure -> (min Extreme, max Extreme), and the number of corners evaluated; a figure no corner has is
+    in ``missing`` only."""
 
     extremes: dict
     corners: int
     #: how the box was searched, in English (result.json's); a Message (a sheet shows it in its language)
     method: str = Message(N_("every corner, then L-BFGS-B from the worst corner"))
+    #: figure -> how many of the corners evaluated have no value (NaN: no peak where a build is overdamped);
+    #: only figures missing somewhere. Its extremes are then over the builds that have it, and may be
+    #: exceeded near the others (a peak time grows without bound as zeta nears 1)
+    missing: dict = dataclasses.field(default_factory=dict)
 
     def to_dict(self) -> dict:
         return {"corners": self.corners, "method": self.method,
-                **{k: {"min": lo.to_dict(), "max": hi.to_dict()} for k, (lo, hi) in self.extremes.items()}}
+                **{k: {"min": lo.to_dict(), "max": hi.to_dict(),
+                       **({"missing_corners": self.missing[k]} if k in self.missing else {})}
+                   for k, (lo, hi) in self.extremes.items()},
+                **{k: {"min": None, "max": None, "missing_corners": n} for k, n in self.missing.items()
+                   if k not in self.extremes}}
 
     def summary_lines(self) -> list:
         what = "corners" if self.method.startswith("every") else "corners the sensitivities point to"
         out = [f"Worst case over the tolerance box ({self.corners} {what}, then a bounded search):"]
         for k, (lo, hi) in self.extremes.items():
             out.append("  " + figure_range(k, lo.value, hi.value)
-                       + ("" if lo.at_corner and hi.at_corner else " (an extreme inside the box)"))
+                       + ("" if lo.at_corner and hi.at_corner else " (an extreme inside the box)")
+                       + ("" if k not in self.missing else
+                          f" (no value at {self.missing[k]} of {self.corners} corners: over the builds that have"
+                          " it, and may be exceeded near the others)"))
+        out += [f"  {figure_range(k, None, None)} at any of the {self.corners} corners"
+                for k in self.missing if k not in self.extremes]
         return out
 
 
@@ -114,9 +129,15 @@ def worst_case(evaluate, nominal: dict, tol: dict, figures=FIGURES, max_corners:
         method = Message(N_("each part alone at -tol and +tol, the corners their slopes point to, then L-BFGS-B "
                             "from the worst ({corners} corners are too many to enumerate)"), corners=str(2 ** d))
     at_corners = evaluate(values(signs))
-    out = {}
+    out, missing = {}, {}
     for fig in figures:
         v = np.asarray(at_corners[fig], float)
+        if not np.isfinite(v).all():
+            missing[fig] = int(np.count_nonzero(~np.isfinite(v)))
+        if missing.get(fig) == len(v):
+            # no corner has it (a first-order section's peak time): nothing to start a search from, and
+            # L-BFGS-B on an objective inf everywhere stepped to NaN deviations (LinAlgError in the engine)
+            continue
         pair = []
         for sign in (1.0, -1.0):                      # min, then max
             score = np.where(np.isfinite(v), sign * v, np.inf)
@@ -124,13 +145,19 @@ def worst_case(evaluate, nominal: dict, tol: dict, figures=FIGURES, max_corners:
             best, x_best, corner = float(v[k]), signs[k], True
 
             def f(x, sign=sign):
+                if not np.isfinite(x).all():    # a step from a NaN gradient: no build to evaluate there
+                    return np.inf
                 y = float(np.asarray(evaluate(values(x))[fig], float)[0])
                 return sign * y if np.isfinite(y) else np.inf
 
-            res = minimize(f, signs[k] * 0.999, method="L-BFGS-B", bounds=[(-1.0, 1.0)] * d,
-                           options={"maxiter": maxiter})
+            # a figure can be missing in part of the box (no peak where a build is overdamped): f is inf
+            # there, and a step the search tries there makes its finite-difference gradient inf - inf; the
+            # search then ends, its answer kept only when finite (below), so the NaN is no news to print
+            with np.errstate(invalid="ignore"):
+                res = minimize(f, signs[k] * 0.999, method="L-BFGS-B", bounds=[(-1.0, 1.0)] * d,
+                               options={"maxiter": maxiter})
             if np.isfinite(res.fun) and sign * res.fun < sign * best - 1e-12 * max(1.0, abs(best)):
                 best, x_best, corner = float(sign * res.fun), np.clip(res.x, -1, 1), False
             pair.append(Extreme(best, {r: float(x_best[i]) for i, r in enumerate(refs)}, corner))
         out[fig] = tuple(pair)
-    return WorstCase(out, len(signs), method)
+    return WorstCase(out, len(signs), method, missing)

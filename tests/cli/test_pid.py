@@ -173,3 +173,14 @@ def test_a_cascade_plants_pid_writes_its_bundle(tmp_path):
     assert {"result.json", "build-sheet.html", "schematic.png", "closed-loop.png"} <= {x.name for x in
                                                                                         bundle.iterdir()}
     assert json.loads((bundle / "result.json").read_text())["closed_loop"]["spice"] is not None
+
+
+def test_optimize_without_a_stable_start_names_each_rule_once():
+    # a 50 kHz Sallen-Key plant an LM741's stages cannot close: every rule's loop is unstable or refused, and
+    # the refusal printed 'simc: simc: the model has complex poles ..' (the rule's reason already names it)
+    p = run("--plant-topology", "sallen-key-lowpass", "--plant-part", "R1=1300", "R2=2400", "C1=1.2n", "C2=2.7n",
+            "--tuning", "optimize", "--no-sim", "--no-files")
+    assert p.returncode == 2 and len(p.stderr.splitlines()) == 1, p.stderr
+    assert "optimize needs a rule whose loop is stable to start from" in p.stderr
+    assert "simc: the model has complex poles" in p.stderr and "simc: simc:" not in p.stderr
+    assert "imc: imc:" not in p.stderr and "zn: unstable" in p.stderr

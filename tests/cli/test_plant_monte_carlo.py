@@ -3,6 +3,7 @@
 import io
 import json
 import os
+import re
 import subprocess
 
 import numpy as np
@@ -229,3 +230,14 @@ def test_a_plants_slew_spread_is_refused_where_nothing_slews(tmp_path, args, wha
     p = run(DESIGN_PLANT, *SEED, *args, "--out", str(tmp_path))
     assert p.returncode == 2 and len(p.stderr.splitlines()) == 1 and what in p.stderr, p.stderr
     assert not any(tmp_path.iterdir())
+
+
+@pytest.mark.spice
+def test_a_spice_monte_carlo_whose_steps_clip_says_so(tmp_path):
+    # gain 10 on a 2 V square wave asks 20 V of an LM741 (14 V swing): no build's SPICE step settles to its
+    # gain, so no build has fn or zeta; the summary raised KeyError: 2.5 after the files were written
+    p = run(DESIGN_PLANT, "--topology", "sallen-key-lowpass-gain", "--fc", "3.5k", "--zeta", "0.7", "--gain", "10",
+            "--monte-carlo", "10", "--seed", "1", "--engine", "spice", "--out", str(tmp_path))
+    assert p.returncode == 0 and p.stderr == "", p.stderr
+    assert "natural frequency fn (fn_hz): nominal n/a, no build has this figure" in p.stdout
+    assert not re.search(r"\bnan\b", p.stdout)

@@ -179,3 +179,36 @@ def test_a_spec_reaches_a_worker_process_unchanged(case):
     if spec.circuit is not None:   # a registered topology compares by identity: the circuit by what it holds
         assert back.circuit.circuit.to_dict() == spec.circuit.circuit.to_dict()
         assert back.circuit.model == spec.circuit.model
+
+
+@pytest.mark.parametrize("topology, target", [("mfb-lowpass", ["--fc", "3.5k", "--zeta", "0.7", "--gain", "2"]),
+                                              ("sallen-key-lowpass-gain", ["--fc", "100", "--zeta", "0.7", "--gain", "2"]),
+                                              ("rc-lowpass", ["--fc", "100"])])
+def test_a_section_plants_result_is_a_plant_json_as_its_parts_are(topology, target, tmp_path):
+    # design-pid --plant-json of a design-plant --topology result.json was refused as 'not a design-plant
+    # result.json (needs built with R1_ohm ..)': only the seed's Sallen-Key record and design-filter's
+    # stages were read. Its section and parts are the plant, as --plant-topology with --plant-part gives it.
+    import subprocess
+
+    from helpers import script
+    p = subprocess.run([script("design-plant"), "--topology", topology, *target, "--no-sim", "--out", str(tmp_path),
+                        "--name", "p"], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    path = tmp_path / "reports" / "p" / "result.json"
+    parts = {k: v["value"] for k, v in json.loads(path.read_text())["parts"].items()}
+    read = PlantSource(plant_json=str(path)).circuit
+    typed = PlantSource(plant_topology=topology, plant_values=parts).circuit
+    assert read.circuit == typed.circuit
+    assert (list(read.model.num), list(read.model.den)) == (list(typed.model.num), list(typed.model.den))
+    assert "design-plant result" in read.source
+
+
+def test_a_section_plant_json_that_passes_no_dc_is_one_line(tmp_path):
+    import subprocess
+
+    from helpers import script
+    p = subprocess.run([script("design-plant"), "--topology", "mfb-highpass", "--fc", "1k", "--zeta", "0.7",
+                        "--no-sim", "--out", str(tmp_path), "--name", "p"], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    with pytest.raises(DesignError, match="mfb-highpass passes no DC"):
+        PlantSource(plant_json=str(tmp_path / "reports" / "p" / "result.json"))

@@ -154,3 +154,20 @@ def test_the_sallen_key_plant_and_its_section_run_one_monte_carlo(parts):
     assert plant.to_dict() == section.to_dict()
     assert plant.csv_text() == section.csv_text()
     assert set(plant.values) == set(part_values(parts)) | {"GBW"}
+
+
+def test_a_figure_no_build_has_is_said_not_a_traceback(mc):
+    # a SPICE step clipped at the op-amp's swing never settles to its gain: every build's fn and zeta are
+    # NaN, so the figure's percentiles are empty; the summary raised KeyError: 2.5 (design-plant --topology
+    # sallen-key-lowpass-gain --fc 3.5k --zeta 0.7 --gain 10 --monte-carlo 50 --engine spice)
+    import dataclasses
+
+    from designer.tolerance.stats import figure_stats
+    nothing = np.full(mc.n, np.nan)
+    bad = dataclasses.replace(mc, stats={**mc.stats, "fn_hz": figure_stats("fn_hz", nothing, np.nan),
+                                         "zeta": figure_stats("zeta", nothing, np.nan)})
+    lines = bad.summary_lines()
+    assert "  natural frequency fn (fn_hz): nominal n/a, no build has this figure" in lines
+    assert "  damping ratio zeta: nominal n/a, no build has this figure" in lines
+    assert not any("nan" in line for line in lines)
+    assert lines[3] == mc.summary_lines()[3]    # the overshoot's line as before
