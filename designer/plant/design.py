@@ -290,12 +290,18 @@ def _unreachable(spec: PlantSpec, fc: float, worst: float) -> ParamError:
             f"{100 * MAX_ERROR:g} % of the target (best: {100 * worst:.3g} % off)")
     rc = 1.0 / (2 * math.pi * fc)
     need = unity_gain_c2_min(1.0, spec.zeta)
-    if rc < spec.r_min * spec.c_min:
-        why = (f": fc {fc:.4g} Hz needs R*C near {rc:.3g} s but the bounds allow no less than "
-               f"{spec.r_min * spec.c_min:.3g} s; lower {{r_min}} or {{c_min}}")
-    elif rc > spec.r_max * spec.c_max:
-        why = (f": fc {fc:.4g} Hz needs R*C near {rc:.3g} s but the bounds allow no more than "
-               f"{spec.r_max * spec.c_max:.3g} s; raise {{r_max}} or {{c_max}}")
+    # at unity gain C2 >= C1/zeta^2, so the time constants sqrt(R1 R2 C1 C2) the bounds allow run from
+    # r_min c_min / zeta to r_max c_max zeta, not from r_min c_min to r_max c_max (fc 50 kHz, zeta 0.2: 5 us
+    # at least, 3.2 us needed; it said "widen the bounds or use a finer series", and no series can help)
+    spread = math.sqrt(need) if spec.gain == 1.0 else 1.0
+    floor, ceiling = spec.r_min * spec.c_min * spread, spec.r_max * spec.c_max / spread
+    ratio = f" (unity gain: C2/C1 >= 1/zeta^2 = {need:.4g})" if spec.gain == 1.0 else ""
+    if rc < floor:
+        why = (f": fc {format_eng(fc, 'Hz')} needs R*C near {format_eng(rc, 's')} but the bounds allow no less "
+               f"than {format_eng(floor, 's')}{ratio}; lower {{r_min}} or {{c_min}}")
+    elif rc > ceiling:
+        why = (f": fc {format_eng(fc, 'Hz')} needs R*C near {format_eng(rc, 's')} but the bounds allow no more "
+               f"than {format_eng(ceiling, 's')}{ratio}; raise {{r_max}} or {{c_max}}")
     elif spec.gain == 1.0 and need > spec.c_max / spec.c_min:
         why = f": unity gain needs C2/C1 >= 1/zeta^2 = {need:.4g}; use {{gain}} K > 1 or widen {{c_min}}/{{c_max}}"
     else:

@@ -6,7 +6,7 @@ from helpers import ROOT
 from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
-from designer.core.errors import DesignError
+from designer.core.errors import DesignError, ParamError
 from designer.plant.design import MAX_ERROR, analyze_plant, choose_parts, design_plant
 from designer.plant.sallenkey import SallenKeyParts
 from designer.plant.spec import AnalysisSpec, PlantSpec
@@ -422,3 +422,18 @@ def test_both_pipelines_build_the_same_parts(fc, zeta, gain, compensate):
     assert refused[0] == refused[1], (sk, generic)
     if not refused[0]:
         assert sk == generic
+
+
+@pytest.mark.parametrize("fc, bound, move", [(50e3, "c_min", 0.1), (0.05, "c_max", 10.0)])
+def test_a_unity_gain_plant_beyond_the_time_constants_its_ratio_allows_names_the_bound(fc, bound, move):
+    """Bug: fc 50 kHz at zeta 0.2 (unity gain) was refused with "widen the bounds or use a finer series": its
+    C2/C1 >= 1/zeta^2 = 25 keeps sqrt(R1 R2 C1 C2) >= r_min c_min / zeta = 5 us, above the 3.2 us it needs,
+    and no series can help. The refusal names the capacitor bound to move (and the same at the slow end);
+    moved a decade, the design is made."""
+    with pytest.raises(ParamError) as err:
+        design_plant(PlantSpec(fc, 0.2), simulate=False)
+    text = str(err.value)
+    assert "C2/C1 >= 1/zeta^2 = 25" in text and bound in text and "finer series" not in text
+    spec = PlantSpec(fc, 0.2)
+    moved = PlantSpec(fc, 0.2, **{bound: getattr(spec, bound) * move})
+    assert design_plant(moved, simulate=False).analytic.figures.fn_hz == pytest.approx(fc, rel=0.05)
