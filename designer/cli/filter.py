@@ -16,7 +16,7 @@ from ..core.eseries import SERIES
 from ..core.opamps import names as opamp_names
 from ..core.ranges import help_range
 from ..core.units import format_eng
-from .common import command_parser, print_output, run_cli
+from .common import ExtendList, command_parser, print_output, run_cli
 from .filter_tolerance import add_filter_tolerance, run_tolerance, tolerance_json, tolerance_lines, tolerance_settings
 
 __all__ = ["design_filter_main", "analyze_filter_main", "summary_text"]
@@ -366,8 +366,10 @@ def _analyze_parser():
                         "or \"--family chebyshev --passband 3k --max-loss 1 --stopband 12k --min-attenuation 40\"")
     g.add_argument("--stage", action="append", metavar="SECTION",
                    help="without --from: each stage's section, input first (repeatable): " + _section_names())
-    g.add_argument("--part", action="append", metavar="DESIGNATOR=VALUE",
-                   help="a part as built, e.g. R101=10.2k or C202=4.7n (repeatable)")
+    # a list or repeated, as analyze-plant's --part and design-pid's --plant-part (the two accumulate)
+    g.add_argument("--part", nargs="+", action=ExtendList, metavar="DESIGNATOR=VALUE",
+                   help="parts as built, e.g. --part R101=10.2k C202=4.7n, or repeated: --part R101=10.2k --part "
+                        "C202=4.7n")
     g.add_argument("--opamp", metavar="NAME", help=f"another op-amp for every stage: {', '.join(opamp_names())}")
     add_filter_tolerance(p)
     o = p.add_argument_group("output")

@@ -14,6 +14,7 @@ from ..filters import registry
 from ..filters.sallen_key_lowpass_parts import FIELD_OF, refs
 from ..plant.circuit import DEFAULT_TOPOLOGY
 from .common import (
+    ExtendList,
     OneLineParser,
     add_opamp_option,
     add_output_options,
@@ -561,9 +562,11 @@ topologies (--topology NAME):
     g.add_argument("--topology", default=DEFAULT_TOPOLOGY, metavar="NAME",
                    help=f"the section the parts are (default {DEFAULT_TOPOLOGY}, the seed's, whose parts are "
                         "also --r1 .. --r4; the registered ones are listed below)")
-    g.add_argument("--part", action="append", metavar="REF=VALUE",
-                   help="a part by its designator, repeatable: --part R1=1k6 --part C2=220n (a designator given "
-                        "twice is refused); every part of --topology")
+    # a list as design-pid's --plant-part takes it, and repeatable (the two accumulate): --part R1=1k6 R2=3k9
+    # was refused as "unrecognized arguments" where design-pid takes the same words
+    g.add_argument("--part", nargs="+", action=ExtendList, metavar="REF=VALUE",
+                   help="parts by their designators: --part R1=1k6 C2=220n, or repeated: --part R1=1k6 --part "
+                        "C2=220n (a designator given twice is refused); every part of --topology")
     g.add_argument("--gain", default=None, metavar="K", help=f"gain K = 1 + R4/R3 (default 1) {help_range('gain')}")
     g.add_argument("--r3", help="gain resistor to ground (with --r4, instead of --gain)")
     g.add_argument("--r4", help="gain feedback resistor")

@@ -146,6 +146,21 @@ def test_analyze_filter_part_as_built_moves_the_response(designed, capsys):
     assert a["figures"]["f3_hz"] < d["figures"]["f3_hz"]
 
 
+def test_analyze_filter_part_takes_a_list_as_analyze_plant_does(designed, capsys):
+    """--part R101=.. C101=.. (a list) is two repeated --part: analyze-plant and design-pid take a list too."""
+    d = json.loads(designed.read_text())
+    p = d["stages"][0]["parts"]
+    items = [f"R101={1.2 * p['R1']}", f"C101={0.9 * p['C1']}"]
+    got = []
+    for argv in (["--part", *items], ["--part", items[0], "--part", items[1]]):
+        capsys.readouterr()
+        assert analyze_filter_main(["--from", str(designed), "--no-sim", "--json", *argv]) == 0
+        a = json.loads(capsys.readouterr().out)
+        a.pop("tool")
+        got.append(a)
+    assert got[0] == got[1] and got[0]["stages"][0]["parts"]["C1"] == pytest.approx(0.9 * p["C1"])
+
+
 @pytest.mark.parametrize("argv, words", [
     (["--part", "R909=1k"], "--part 'R909=1k': give DESIGNATOR=VALUE with one of this filter's parts: R101"),
     (["--part", "R101=-1k"], "--part R101 must be above 0"),

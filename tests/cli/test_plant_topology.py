@@ -129,6 +129,23 @@ def test_analyze_plant_takes_every_topology_s_parts_by_designator(topology, tmp_
     assert d["built"]["ideal"]["gain"] == pytest.approx(topology.example.gain, rel=1e-9)
 
 
+def test_part_takes_a_list_as_design_pid_s_plant_part_does(tmp_path):
+    """--part R1=.. R2=.. (one flag, a list) is the repeated flag's result: it was refused as "unrecognized
+    arguments" while design-pid --plant-part takes the same words; the two forms accumulate."""
+    topology = REGISTRY["mfb-lowpass"]
+    items = [f"{r}={v!r}" for r, v in topology.synthesize(topology.example).items()]
+    listed = analyze("--topology", topology.name, "--part", *items, "--no-sim", "--json", "--no-files")
+    repeated = analyze("--topology", topology.name, *(a for i in items for a in ("--part", i)), "--no-sim", "--json",
+                       "--no-files")
+    mixed = analyze("--topology", topology.name, "--part", *items[:2], "--part", *items[2:], "--no-sim", "--json",
+                    "--no-files")
+    assert listed.returncode == repeated.returncode == mixed.returncode == 0, listed.stderr + mixed.stderr
+    got = [json.loads(o.stdout) for o in (listed, repeated, mixed)]
+    for d in got:
+        d.pop("tool")
+    assert got[0] == got[1] == got[2]
+
+
 def test_part_on_the_sallen_key_low_pass_is_its_r1_to_c2(tmp_path):
     """--part R1=820 is --r1 820: the same result."""
     a = analyze("--part", "R1=820", "--part", "C2=220n", "--r2", "1k", "--c1", "10n", "--no-sim", "--json",
