@@ -455,8 +455,8 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
     """
     from ..core.metrics import step_metrics as metrics
     from ..filters.deck import simulate_ac as ac
-    from .bench import (PERIOD_CHECK, SIGNAL_CHECKS, period_check, plant_scope, recommend_square_wave, rising_step,
-                        signal_checks, sine_check, tolerance_band)
+    from .bench import (PERIOD_CHECK, SIGNAL_CHECKS, period_check, period_extremes, plant_scope, recommend_square_wave,
+                        rising_step, signal_checks, sine_check, tolerance_band)
     from ..core.eseries import TOLERANCE
     topo, amp, a = result.section, result.opamp, result.amplitude_v
     models = result.models or _models(topo, result.values, amp)
@@ -504,8 +504,8 @@ def with_bench(result: CircuitPlantResult, square_hz=None, simulate: bool = Fals
                        n=result.tolerance.unstable_corners)
         if note not in result.notes:   # the bench set again (check-design's square-wave run) says it once
             result.notes.append(note)
-    # the output over the period, per volt: the rising edge's step s(t), the falling edge's s(inf) - s(t)
-    hi, lo = max(float(y.max()), final - float(y.min())), min(float(y.min()), final - float(y.max()), 0.0)
+    # the output over the period, per volt (the two edges' steps by superposition), as the swing check reads it
+    lo, hi = period_extremes(y)
     result.scope = plant_scope(test, hi, lo, settling, N_("generator (CH1)"))
     fn = fig_i["fn_hz"]
     spice = None

@@ -33,13 +33,13 @@ import numpy as np
 from ..core import eseries
 from ..core.compare import disagreements, metric_deltas, nrms, resample
 from ..core.errors import ParamError
-from ..core.lti import dense_time, step_response
+from ..core.lti import step_response
 from ..core.metrics import step_metrics
 from ..core.opamps import OpAmp
 from ..core.ranges import RANGES
 from ..core.units import format_eng, value_code
 from ..spice.simulate import get_simulator
-from .bench import PERIOD_CHECK, SIGNAL_CHECKS, bench_period, plant_scope
+from .bench import PERIOD_CHECK, SIGNAL_CHECKS, bench_period, plant_scope, rising_step
 from .circuit_design import section_analysis, step_span
 from . import circuit
 from .model import Sensitivity
@@ -327,10 +327,10 @@ def _analyse(mode, target: Target, choice: Choice, sourcing: Sourcing, alternati
     (num_i, den_i), (num_o, den_o) = sec.models["ideal"], sec.models["opamp"]
     # the comparisons and plots use the rising half period of the bench test (its start, if
     # the square wave is much slower than the response: a dense grid where the metrics are taken)
-    tw = dense_time(min(test.half_period_s, 4 * step_span(sec.figures)))
-    # the op-amp-aware step the section's bench computed on this grid (its slew and swing checks'), else its own
-    same = sec.rising is not None and sec.rising[0].shape == tw.shape and np.array_equal(sec.rising[0], tw)
-    y_iw, y_ow = step_response(num_i, den_i, tw), sec.rising[1] if same else step_response(num_o, den_o, tw)
+    # (the op-amp-aware step the section's bench computed on this grid, its slew and swing checks', else its own)
+    tw, y_ow, _ = rising_step((num_i, den_i), (num_o, den_o), min(test.half_period_s, 4 * step_span(sec.figures)),
+                              known=sec.rising)
+    y_iw = step_response(num_i, den_i, tw)
     # the slew and swing checks the section pipeline's bench computed on this same grid (bench.signal_checks)
     # and its square-wave period check (the half period against the op-amp-aware step's settling time)
     checks = [c for c in sec.checks if c.id in (*SIGNAL_CHECKS, PERIOD_CHECK)]

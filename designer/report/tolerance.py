@@ -197,7 +197,7 @@ def worst_case_blocks(wc) -> list:
              "+tol or -tol of its nominal, in tolerances where an extreme lies inside.").format(corners=wc.corners,
                                                                                                 method=translated(wc.method))
     blocks = [R.text(head), R.table([_("figure"), _("extreme"), _("value"), _("where (parts)")], rows)]
-    missing = getattr(wc, "missing", {})
+    missing = wc.missing
     if missing:
         # a figure missing at some corners (no peak where a build is overdamped) has extremes only over the
         # builds that have it: near the others it may go further (a peak time grows without bound as zeta nears 1)
