@@ -271,7 +271,12 @@ def sample_model(num, den, theta_s: float, sample_time_s: float, hold: str = "zo
     # (against a monic denominator: a gain of 1e-9, or 0.015 over time constants of 5e5 s, in the scale
     # fuzz) as badly conditioned and strips them. A power of two: the scaling is exact.
     g = power_of_two(float(np.max(np.abs(num))) / abs(den[0])) if num.size else 1.0
-    A, B, C, _ = tf2ss(num / g, den)
+    scaled = num / g
+    # and its leading coefficients within 1e-14 of 0 against the monic denominator stripped here, as normalize
+    # would strip them, silently: it warned BadCoefficients on an overdamped fit of a record sampled every
+    # 1e-10 s (its zero's coefficient 1e-16 of the constant one), the same numbers either way
+    keep = np.flatnonzero(np.abs(scaled / den[0]) > 1e-14)
+    A, B, C, _ = tf2ss(scaled[min(int(keep[0]) if keep.size else scaled.size - 1, scaled.size - 1):], den)
     B, C = B[:, 0], C[0] * g
     n = A.shape[0]
     d = int(math.floor(theta_s / T + 1e-12))

@@ -237,6 +237,8 @@ def test_identify_odd_paths(capfd, path, plot):
 @example(model="fopdt", t_exp=7, y_exp=-2, u_exp=0, t0=0.0)
 @example(model="fopdt", t_exp=0, y_exp=2, u_exp=-12, t0=0.0)
 @example(model="underdamped", t_exp=-11, y_exp=0, u_exp=0, t0=0.0)
+# an overdamped fit at 1e-8 s scale: the sampled model's tf2ss warned BadCoefficients (identify.outputerror)
+@example(model="overdamped", t_exp=-8, y_exp=0, u_exp=0, t0=0.0)
 def test_identify_in_range_scales_give_the_right_model(capfd, model, t_exp, y_exp, u_exp, t0):
     """Inside the physical ranges the answer is right at any scale: the best
     model's step response, scaled back, is the truth's within 1 % of K (with an
