@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from designer.filters.sallen_key_lowpass_parts import record_of
@@ -49,7 +49,13 @@ def agrees(loop, w_lo, w_hi, points=400):
     ms, w_ms = sensitivity_peak(w, loop(w), loop)
     b, w_b = brute_force(loop, w_lo, w_hi)
     step = math.log(w_hi / w_lo) / (BRUTE_POINTS - 1)
-    assert abs(ms - b) <= 1e-6 * b and ms >= b * (1 - 1e-12), (ms, b)
+    # the grid's own step misses a sharp peak's top by more than 1e-6 (k 0.5, tau 1/128, zeta 0.5, wn 0.5: Ms 363,
+    # the grid 1.2e-6 below the refined value): its maximum brute-forced again over its two neighbouring steps
+    wf = w_b * np.exp(np.linspace(-step, step, 100_001))
+    top = max(b, float(np.max(1 / np.abs(1 + loop(wf)))))
+    assert abs(ms - top) <= 1e-6 * top and ms >= b * (1 - 1e-12), (ms, b, top)
+    # and the peak is a value of the function, at its frequency
+    assert ms == pytest.approx(float(1 / abs(1 + loop(np.array([w_ms])))[0]), rel=1e-12)
     if b > 1.01 and w_lo < w_b < w_hi * (1 - step):
         assert abs(math.log(w_ms / w_b)) <= 2 * step, (w_ms, w_b)
     return ms, w_ms
@@ -81,6 +87,8 @@ def test_a_peak_at_the_bands_edge_is_not_refined_outside_it():
 
 @settings(max_examples=15, deadline=None)
 @given(k=st.floats(0.2, 20.0), tau=st.floats(1e-3, 1.0), zeta=st.floats(0.05, 1.0), wn=st.floats(0.5, 50.0))
+# a peak sharper than the brute force's grid resolves (found by hypothesis in a clean-clone run)
+@example(k=0.5, tau=0.0078125, zeta=0.5, wn=0.5)
 def test_random_rational_loops_agree_with_the_brute_force(k, tau, zeta, wn):
     # L = k wn^2 / (s (tau s + 1)(s^2 + 2 zeta wn s + wn^2)): an integrator, a pole and a resonance
     den = np.polymul(np.polymul([1.0, 0.0], [tau, 1.0]), [1.0, 2 * zeta * wn, wn * wn])
